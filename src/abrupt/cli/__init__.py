@@ -1,0 +1,1 @@
+"""The ``abrupt`` command line: one entry point, one sub-command per capability."""

@@ -1,0 +1,1 @@
+"""Command-line commands for attitude telemetry (registered on the shared groups)."""

@@ -1,0 +1,30 @@
+"""Entry point of the ``abrupt`` command: imports every capability module so it registers its commands."""
+
+from __future__ import annotations
+
+import sys
+
+import click
+
+from abrupt.cli import attitude, catalog_commands, orbit, rates, tle, tracking  # noqa: F401  (registration)
+from abrupt.cli.groups import cli
+from abrupt.errors import AbruptError
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Run the command line; turn abrupt's own errors into a one-line message and exit status 2."""
+    try:
+        cli.main(args=argv, prog_name="abrupt", standalone_mode=False)
+    except AbruptError as exc:
+        click.echo(f"error: {exc}", err=True)
+        sys.exit(2)
+    except click.exceptions.Abort:
+        click.echo("aborted", err=True)
+        sys.exit(130)
+    except click.ClickException as exc:
+        exc.show()
+        sys.exit(exc.exit_code)
+
+
+if __name__ == "__main__":
+    main()

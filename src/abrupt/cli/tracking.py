@@ -1,0 +1,1 @@
+"""Command-line commands for this capability (registered on the shared groups)."""

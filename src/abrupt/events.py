@@ -1,0 +1,215 @@
+"""The one event schema every detector returns (DESIGN.md, "Events").
+
+A detector returns a :class:`pandas.DataFrame` whose first columns are exactly
+:data:`EVENT_COLUMNS`, in that order; further columns may follow. A value a detector does not
+estimate is empty (NaN). A detector that finds nothing returns :func:`empty_frame`, which has the
+same columns and no rows.
+
+Event identifiers are deterministic (a hash of spacecraft, detector, kind, time and configuration
+hash), so re-running the same input and configuration yields the same ``event_id`` and the catalog
+does not duplicate events.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import uuid
+from collections.abc import Iterable, Mapping
+from dataclasses import asdict, dataclass, field, fields
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+EVENT_KINDS = ("strike", "maneuver", "mass_change", "unknown")
+
+EVENT_COLUMNS: tuple[str, ...] = (
+    "event_id",
+    "spacecraft",
+    "kind",
+    "detector",
+    "time_utc",
+    "time_sigma_s",
+    "statistic",
+    "threshold",
+    "false_alarms_per_day",
+    "dH_N_x_Nms",
+    "dH_N_y_Nms",
+    "dH_N_z_Nms",
+    "dH_Nms",
+    "dv_r_mps",
+    "dv_t_mps",
+    "dv_n_mps",
+    "dv_mps",
+    "run_id",
+    "config_hash",
+)
+
+_FLOAT_COLUMNS = (
+    "time_sigma_s",
+    "statistic",
+    "threshold",
+    "false_alarms_per_day",
+    "dH_N_x_Nms",
+    "dH_N_y_Nms",
+    "dH_N_z_Nms",
+    "dH_Nms",
+    "dv_r_mps",
+    "dv_t_mps",
+    "dv_n_mps",
+    "dv_mps",
+)
+
+NAN = float("nan")
+
+
+def config_hash(config: Mapping[str, Any] | Any) -> str:
+    """Stable 16-hex-digit hash of a configuration (a mapping or a dataclass), for ``config_hash``."""
+    if hasattr(config, "__dataclass_fields__"):
+        config = asdict(config)
+    text = json.dumps(config, sort_keys=True, default=_json_default)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _json_default(obj: Any) -> Any:
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        return obj.item()
+    return str(obj)
+
+
+def new_run_id() -> str:
+    """A fresh identifier for one run of a command."""
+    return uuid.uuid4().hex[:16]
+
+
+def make_event_id(spacecraft: str, detector: str, kind: str, time_utc: str, cfg_hash: str) -> str:
+    """Deterministic event identifier: same input and configuration give the same id."""
+    key = "|".join((spacecraft, detector, kind, time_utc, cfg_hash))
+    return hashlib.sha256(key.encode()).hexdigest()[:20]
+
+
+def format_time_utc(t: Any) -> str:
+    """ISO-8601 UTC with microseconds and a ``Z`` suffix, from datetime64, Timestamp or string."""
+    ts = pd.Timestamp(t)
+    if ts.tzinfo is not None:
+        ts = ts.tz_convert("UTC").tz_localize(None)
+    return ts.strftime("%Y-%m-%dT%H:%M:%S.%fZ")
+
+
+@dataclass(frozen=True)
+class Event:
+    """One detected abrupt momentum change. Units in the field names; NaN where not estimated.
+
+    ``dH_N_*`` is the angular momentum change in the inertial frame N (N·m·s); ``dv_*`` the
+    velocity change in the orbit frame (radial, along-track, cross-track; m/s).
+    """
+
+    spacecraft: str
+    kind: str
+    detector: str
+    time_utc: str
+    statistic: float
+    threshold: float
+    false_alarms_per_day: float
+    run_id: str
+    config_hash: str
+    time_sigma_s: float = NAN
+    dH_N_x_Nms: float = NAN
+    dH_N_y_Nms: float = NAN
+    dH_N_z_Nms: float = NAN
+    dH_Nms: float = NAN
+    dv_r_mps: float = NAN
+    dv_t_mps: float = NAN
+    dv_n_mps: float = NAN
+    dv_mps: float = NAN
+    extra: Mapping[str, Any] = field(default_factory=dict)
+    event_id: str = ""
+
+    def __post_init__(self) -> None:
+        if self.kind not in EVENT_KINDS:
+            raise ValueError(f"event kind {self.kind!r} is not one of {EVENT_KINDS}")
+        if not self.spacecraft:
+            raise ValueError("event spacecraft pseudonym is empty")
+        if not self.detector:
+            raise ValueError("event detector name is empty")
+        object.__setattr__(self, "time_utc", format_time_utc(self.time_utc))
+        for name in _FLOAT_COLUMNS:
+            object.__setattr__(self, name, float(getattr(self, name)))
+        if self.time_sigma_s < 0:
+            raise ValueError(f"time_sigma_s must be >= 0, got {self.time_sigma_s}")
+        # Fill magnitudes from components when a detector gave only the vector.
+        dh = (self.dH_N_x_Nms, self.dH_N_y_Nms, self.dH_N_z_Nms)
+        if math.isnan(self.dH_Nms) and not any(math.isnan(c) for c in dh):
+            object.__setattr__(self, "dH_Nms", math.sqrt(sum(c * c for c in dh)))
+        dv = (self.dv_r_mps, self.dv_t_mps, self.dv_n_mps)
+        if math.isnan(self.dv_mps) and not any(math.isnan(c) for c in dv):
+            object.__setattr__(self, "dv_mps", math.sqrt(sum(c * c for c in dv)))
+        if not self.event_id:
+            object.__setattr__(
+                self,
+                "event_id",
+                make_event_id(self.spacecraft, self.detector, self.kind, self.time_utc, self.config_hash),
+            )
+
+    def as_row(self) -> dict[str, Any]:
+        row = {name: getattr(self, name) for name in EVENT_COLUMNS}
+        row.update(self.extra)
+        return row
+
+
+def empty_frame(extra_columns: Iterable[str] = ()) -> pd.DataFrame:
+    """The event frame with no rows: same columns and dtypes as a frame with events."""
+    return events_frame([], extra_columns=extra_columns)
+
+
+def events_frame(events: Iterable[Event], extra_columns: Iterable[str] = ()) -> pd.DataFrame:
+    """Frame of events with :data:`EVENT_COLUMNS` first, in order, then any extra columns."""
+    rows = [e.as_row() for e in events]
+    extra = list(dict.fromkeys([*extra_columns, *(k for r in rows for k in r if k not in EVENT_COLUMNS)]))
+    frame = pd.DataFrame(rows, columns=[*EVENT_COLUMNS, *extra])
+    return normalise_frame(frame)
+
+
+def normalise_frame(frame: pd.DataFrame) -> pd.DataFrame:
+    """Check and coerce a frame to the event schema: required columns first, in order, with dtypes."""
+    missing = [c for c in EVENT_COLUMNS if c not in frame.columns]
+    if missing:
+        raise ValueError(f"event frame lacks required columns {missing}")
+    ordered = [*EVENT_COLUMNS, *(c for c in frame.columns if c not in EVENT_COLUMNS)]
+    out = frame.loc[:, ordered].copy()
+    for name in _FLOAT_COLUMNS:
+        out[name] = pd.to_numeric(out[name], errors="raise").astype("float64")
+    for name in ("event_id", "spacecraft", "kind", "detector", "time_utc", "run_id", "config_hash"):
+        out[name] = out[name].astype("string") if len(out) else out[name].astype("string")
+    bad = ~out["kind"].isin(EVENT_KINDS)
+    if bad.any():
+        raise ValueError(f"event kinds {sorted(set(out.loc[bad, 'kind']))} not in {EVENT_KINDS}")
+    return out.reset_index(drop=True)
+
+
+def event_field_names() -> list[str]:
+    """Names of the :class:`Event` fields (for documentation and checks)."""
+    return [f.name for f in fields(Event)]
+
+
+def write_events(frame: pd.DataFrame, path: str) -> None:
+    """Write events to CSV or Parquet, chosen by the file suffix (``.csv``, ``.parquet``/``.pq``)."""
+    frame = normalise_frame(frame)
+    lower = str(path).lower()
+    if lower.endswith((".parquet", ".pq")):
+        frame.to_parquet(path, index=False)
+    elif lower.endswith(".csv"):
+        frame.to_csv(path, index=False)
+    else:
+        raise ValueError(f"{path}: events file must end in .csv or .parquet")
+
+
+def read_events(path: str) -> pd.DataFrame:
+    """Read an events file written by :func:`write_events` and check it against the schema."""
+    lower = str(path).lower()
+    frame = pd.read_parquet(path) if lower.endswith((".parquet", ".pq")) else pd.read_csv(path)
+    return normalise_frame(frame)

@@ -1,0 +1,228 @@
+"""Thresholds from a false-alarm budget (DESIGN.md principle; Bennett 2022 §2.2.3, §2.4.2, §2.5.1).
+
+A threshold is never a magic number: it is fitted to the statistic on event-free data and stated
+with the false-alarm rate it was set for. Supported fits of the event-free ("null") statistic:
+
+``gaussian``   mean + z·sd (Bennett 2022 summation filter, §2.4.2.2);
+``gamma``      a Gamma fit of a non-negative statistic (Harris 2025 §3.4);
+``kde``        Gaussian kernel density (Bennett 2022 CUSUM, §2.4.2.3; trade procedure §2.5.1 step 3);
+``empirical``  the plain sample quantile (Bennett 2022 Shiryaev, §2.4.2.4);
+``gpd``        generalised Pareto tail above a high sample quantile (peaks over threshold), for
+               false-alarm probabilities far below 1/n where a KDE's tail is only its kernel.
+
+Probability per sample follows Bennett 2022 §2.5.1 step 4: one false alarm per day at 10 Hz is
+``p_fa = 1 / 864000``. :func:`episode_rate` counts distinct exceedance episodes, which is what an
+operator experiences as "false alarms per day" when a sliding-window statistic is correlated.
+
+The Neyman-Pearson procedure of Bennett 2022 §2.2.3 (ROC, likelihood-ratio slope at α, Eq. 2.10-2.11)
+is :func:`neyman_pearson_threshold`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import optimize, special, stats
+
+FitMethod = Literal["gaussian", "gamma", "kde", "empirical", "gpd"]
+FIT_METHODS: tuple[str, ...] = ("gaussian", "gamma", "kde", "empirical", "gpd")
+
+SECONDS_PER_DAY = 86400.0
+
+
+def p_fa_per_sample(false_alarms_per_day: float, sample_rate_hz: float) -> float:
+    """Per-sample false-alarm probability for a budget in false alarms per day (Bennett 2022 §2.5.1)."""
+    if false_alarms_per_day <= 0 or sample_rate_hz <= 0:
+        raise ValueError("false_alarms_per_day and sample_rate_hz must be positive")
+    return min(1.0, false_alarms_per_day / (sample_rate_hz * SECONDS_PER_DAY))
+
+
+def false_alarms_per_day_from_p_fa(p_fa: float, sample_rate_hz: float) -> float:
+    """Inverse of :func:`p_fa_per_sample`."""
+    return p_fa * sample_rate_hz * SECONDS_PER_DAY
+
+
+@dataclass(frozen=True)
+class Threshold:
+    """A detection threshold with the false-alarm budget it was set for.
+
+    ``value`` is in the units of the statistic; ``p_fa`` the per-sample false-alarm probability;
+    ``false_alarms_per_day`` the corresponding rate at ``sample_rate_hz`` (NaN if not given).
+    """
+
+    value: float
+    p_fa: float
+    method: str
+    n_samples: int
+    false_alarms_per_day: float = float("nan")
+    sample_rate_hz: float = float("nan")
+
+    def as_dict(self) -> dict[str, float | int | str]:
+        return asdict(self)
+
+
+def _clean_null(null_statistic: ArrayLike) -> NDArray[np.float64]:
+    x = np.asarray(null_statistic, dtype=np.float64).ravel()
+    x = x[np.isfinite(x)]
+    if x.size < 10:
+        raise ValueError(f"need at least 10 finite event-free samples to fit a threshold, got {x.size}")
+    return x
+
+
+def kde_quantile(x: NDArray[np.float64], q_upper: float, bandwidth: str | float = "scott") -> float:
+    """The value v with P(X > v) = q_upper under a Gaussian kernel density of the samples x.
+
+    The kernel survival function is the mean of the Gaussian survival functions of each kernel; it
+    is solved by Brent's method. Samples are thinned to at most 20000 kernels for speed, which
+    changes the bandwidth choice but not the tail shape materially.
+    """
+    if x.size > 20000:
+        x = np.sort(x)[:: int(np.ceil(x.size / 20000))]
+    kde = stats.gaussian_kde(x, bw_method=bandwidth)
+    h = float(np.sqrt(kde.covariance[0, 0]))
+
+    def log_sf(v: float) -> float:
+        return float(special.logsumexp(special.log_ndtr(-(v - x) / h)) - np.log(x.size))
+
+    target = np.log(q_upper)
+    lo = float(np.min(x))
+    hi = float(np.max(x)) + h
+    while log_sf(hi) > target:
+        hi += 2 * h + (hi - lo)
+    return float(optimize.brentq(lambda v: log_sf(v) - target, lo - 10 * h, hi, xtol=1e-12 * max(1.0, abs(hi))))
+
+
+def gpd_quantile(x: NDArray[np.float64], q_upper: float, tail_fraction: float = 0.02) -> float:
+    """Peaks-over-threshold quantile: GPD fitted to the excesses above the (1 - tail_fraction) quantile."""
+    if q_upper >= tail_fraction:
+        return float(np.quantile(x, 1.0 - q_upper))
+    u = float(np.quantile(x, 1.0 - tail_fraction))
+    excess = x[x > u] - u
+    if excess.size < 30:
+        raise ValueError("too few tail samples for a generalised Pareto fit; give more event-free data")
+    shape, _, scale = stats.genpareto.fit(excess, floc=0.0)
+    return u + float(stats.genpareto.isf(q_upper / tail_fraction, shape, loc=0.0, scale=scale))
+
+
+def fit_threshold(
+    null_statistic: ArrayLike,
+    *,
+    p_fa: float | None = None,
+    false_alarms_per_day: float | None = None,
+    sample_rate_hz: float | None = None,
+    method: FitMethod = "kde",
+) -> Threshold:
+    """Fit the event-free statistic and return the threshold exceeded with probability ``p_fa``.
+
+    Give either ``p_fa`` (per sample) or ``false_alarms_per_day`` with ``sample_rate_hz`` (the rate at
+    which the statistic is evaluated). The statistic is one-sided: large values are alarms.
+    """
+    x = _clean_null(null_statistic)
+    if p_fa is None:
+        if false_alarms_per_day is None or sample_rate_hz is None:
+            raise ValueError("give p_fa, or false_alarms_per_day with sample_rate_hz")
+        p_fa = p_fa_per_sample(false_alarms_per_day, sample_rate_hz)
+    if not 0 < p_fa < 1:
+        raise ValueError(f"p_fa must be in (0, 1), got {p_fa}")
+    if method == "gaussian":
+        value = float(np.mean(x) + stats.norm.isf(p_fa) * np.std(x, ddof=1))
+    elif method == "gamma":
+        shift = min(0.0, float(np.min(x))) - 1e-12
+        a, loc, scale = stats.gamma.fit(x - shift, floc=0.0)
+        value = float(stats.gamma.isf(p_fa, a, loc=loc, scale=scale)) + shift
+    elif method == "kde":
+        value = kde_quantile(x, p_fa)
+    elif method == "empirical":
+        value = float(np.quantile(x, 1.0 - p_fa))
+    elif method == "gpd":
+        value = gpd_quantile(x, p_fa)
+    else:
+        raise ValueError(f"unknown threshold method {method!r}; choose one of {FIT_METHODS}")
+    rate = float("nan") if sample_rate_hz is None else false_alarms_per_day_from_p_fa(p_fa, sample_rate_hz)
+    return Threshold(
+        value=value,
+        p_fa=float(p_fa),
+        method=method,
+        n_samples=int(x.size),
+        false_alarms_per_day=rate,
+        sample_rate_hz=float("nan") if sample_rate_hz is None else float(sample_rate_hz),
+    )
+
+
+def qq_points(
+    null_statistic: ArrayLike, method: FitMethod = "gaussian", n_points: int = 200
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Q-Q diagnostic: (theoretical quantiles of the fitted family, sample quantiles).
+
+    Points on the diagonal mean the family fits; a sample tail above the diagonal means the fit
+    under-states the false-alarm rate there (Bennett 2022 Fig. 2.17).
+    """
+    x = np.sort(_clean_null(null_statistic))
+    probs = (np.arange(1, n_points + 1) - 0.5) / n_points
+    sample_q = np.quantile(x, probs)
+    if method == "gaussian":
+        theo = stats.norm.ppf(probs, loc=np.mean(x), scale=np.std(x, ddof=1))
+    elif method == "gamma":
+        shift = min(0.0, float(x[0])) - 1e-12
+        a, loc, scale = stats.gamma.fit(x - shift, floc=0.0)
+        theo = stats.gamma.ppf(probs, a, loc=loc, scale=scale) + shift
+    elif method in ("kde", "empirical", "gpd"):
+        kde = stats.gaussian_kde(x[:: max(1, x.size // 20000)])
+        draws = kde.resample(200000, seed=np.random.default_rng(0)).ravel()
+        theo = np.quantile(draws, probs)
+    else:
+        raise ValueError(f"unknown method {method!r}")
+    return np.asarray(theo, dtype=np.float64), np.asarray(sample_q, dtype=np.float64)
+
+
+def roc_curve(
+    null_statistic: ArrayLike, event_statistic: ArrayLike, n_points: int = 400
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Empirical ROC: (thresholds, P_FA, P_D) from event-free and with-event statistic samples."""
+    x0 = np.sort(_clean_null(null_statistic))
+    x1 = np.sort(_clean_null(event_statistic))
+    lo, hi = min(x0[0], x1[0]), max(x0[-1], x1[-1])
+    thr = np.linspace(lo, hi, n_points)
+    p_fa = 1.0 - np.searchsorted(x0, thr, side="right") / x0.size
+    p_d = 1.0 - np.searchsorted(x1, thr, side="right") / x1.size
+    return thr, p_fa, p_d
+
+
+def neyman_pearson_threshold(
+    null_statistic: ArrayLike, event_statistic: ArrayLike, alpha: float
+) -> tuple[float, float]:
+    """Bennett 2022 §2.2.3 (Eqs. 2.10-2.11): likelihood-ratio threshold at P_FA = alpha.
+
+    Kernel densities p0, p1 are fitted to the event-free and with-event statistics. The ROC slope
+    dP_D/dP_FA at P_FA = alpha equals the likelihood ratio tau = p1(y_a)/p0(y_a) at the statistic
+    value y_a whose null exceedance is alpha; returns (y_thresh, tau). For a monotone likelihood
+    ratio y_thresh equals the alpha-quantile threshold of the null, the cross-check the spec gives.
+    """
+    x0 = _clean_null(null_statistic)
+    x1 = _clean_null(event_statistic)
+    y_alpha = kde_quantile(x0, alpha)
+    k0 = stats.gaussian_kde(x0[:: max(1, x0.size // 20000)])
+    k1 = stats.gaussian_kde(x1[:: max(1, x1.size // 20000)])
+    log_tau = float(k1.logpdf(y_alpha)[0] - k0.logpdf(y_alpha)[0])
+    return y_alpha, float(np.exp(min(log_tau, 700.0)))
+
+
+def episode_rate(
+    statistic: ArrayLike, threshold: float, *, sample_rate_hz: float, min_separation_samples: int
+) -> tuple[int, float]:
+    """Count exceedance episodes (runs above threshold, merged when closer than the separation).
+
+    Returns (episodes, episodes per day). A sliding-window statistic exceeds its threshold for many
+    consecutive samples around one event; an operator sees one alarm, so this is the rate to report.
+    """
+    s = np.asarray(statistic, dtype=np.float64)
+    above = np.flatnonzero(s > threshold)
+    if above.size == 0:
+        episodes = 0
+    else:
+        episodes = 1 + int(np.count_nonzero(np.diff(above) > min_separation_samples))
+    days = s.size / (sample_rate_hz * SECONDS_PER_DAY)
+    return episodes, episodes / days if days > 0 else float("nan")
