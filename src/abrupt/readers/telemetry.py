@@ -1,0 +1,261 @@
+"""Attitude-control telemetry reader: CSV or Parquet, mapped and checked by a spacecraft file.
+
+The spacecraft file's ``[telemetry]`` table names the time column, the quaternion, body-rate and
+wheel-speed columns and their units. Reading converts to SI (rad/s), orders quaternions scalar first
+as q_BN, and checks the input. What it does with bad input (each case has a test):
+
+=====================================  ==========================================================
+input                                  outcome
+=====================================  ==========================================================
+empty file, or header without rows     error
+unparseable time or number             error naming the line and column
+a mapped column missing                error naming the column and the spacecraft-file key
+quaternion norm off by more than 10%   error (wrong scaling or not a quaternion)
+quaternion norm off by 1e-6 .. 10%     repair: renormalised, counted
+|body rate| above 2 rad/s              error (deg/s declared as rad/s?)
+wheel speed above 1.5 x its maximum    error naming the unit to check (rpm declared as rad/s?)
+empty cells (NaN)                      repair: row removed, counted; leaves a gap
+duplicate timestamps                   repair: exact duplicates removed; conflicting ones keep the
+                                       first row; each counted
+timestamps out of order                repair: stable sort, counted
+gaps longer than 1.5 nominal intervals reported; the data are split into contiguous segments and
+                                       no detector window spans a gap
+=====================================  ==========================================================
+
+Repairs are counted in :attr:`Telemetry.repairs` and logged; nothing is dropped silently.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+
+from abrupt.errors import InputError, RepairLog
+from abrupt.model.spacecraft import RATE_UNITS, WHEEL_SPEED_UNITS, Spacecraft
+
+QUATERNION_NORM_ERROR = 0.1  # relative norm deviation above which a quaternion is rejected
+QUATERNION_NORM_REPAIR = 1e-6  # relative deviation above which a renormalisation is counted
+MAX_BODY_RATE_RAD_S = 2.0  # [rad/s] above this the rate unit is almost surely wrong
+WHEEL_OVERSPEED_FACTOR = 1.5
+GAP_FACTOR = 1.5  # a step longer than this many nominal intervals is a gap
+
+
+@dataclass
+class Telemetry:
+    """Attitude telemetry in SI units, sorted by time, with its segments and repairs.
+
+    ``time``: UTC datetime64[ns]; ``t_s``: seconds since the first sample; ``quaternion_BN`` (n, 4)
+    scalar first; ``body_rate_rad_s`` (n, 3); ``wheel_speed_rad_s`` (n, N) relative to the body;
+    ``segments``: (start, stop) row ranges without gaps; ``sample_interval_s``: the nominal interval.
+    """
+
+    time: NDArray[np.datetime64]
+    t_s: NDArray[np.float64]
+    quaternion_BN: NDArray[np.float64]
+    body_rate_rad_s: NDArray[np.float64]
+    wheel_speed_rad_s: NDArray[np.float64]
+    sample_interval_s: float
+    segments: list[tuple[int, int]]
+    repairs: RepairLog
+    source: str = "<memory>"
+    gaps: list[tuple[int, float]] = field(default_factory=list)
+
+    def __len__(self) -> int:
+        return int(self.t_s.size)
+
+    @property
+    def sample_rate_hz(self) -> float:
+        return 1.0 / self.sample_interval_s
+
+
+def _read_table(path: Path) -> pd.DataFrame:
+    suffix = path.suffix.lower()
+    if not path.exists():
+        raise InputError("file not found", file=path)
+    if path.stat().st_size == 0:
+        raise InputError("file is empty", file=path)
+    try:
+        if suffix in (".parquet", ".pq"):
+            return pd.read_parquet(path)
+        if suffix in (".csv", ".txt"):
+            return pd.read_csv(path, dtype=str, keep_default_na=False, skip_blank_lines=True)
+    except (ValueError, OSError, pd.errors.ParserError) as exc:
+        raise InputError(f"cannot parse table: {exc}", file=path) from None
+    raise InputError(f"unknown telemetry format {suffix!r}; use .csv or .parquet", file=path)
+
+
+def _line(row: int, is_csv: bool) -> int | None:
+    """1-based file line of a data row (CSV: header is line 1)."""
+    return row + 2 if is_csv else None
+
+
+def _numeric(frame: pd.DataFrame, column: str, path: Path, is_csv: bool) -> NDArray[np.float64]:
+    raw = frame[column]
+    if is_csv:
+        text = raw.astype(str).str.strip()
+        empty = text.isin(["", "nan", "NaN", "NA", "null"])
+        values = pd.to_numeric(text.where(~empty, None), errors="coerce")
+        bad = values.isna() & ~empty
+    else:
+        values = pd.to_numeric(raw, errors="coerce")
+        bad = values.isna() & raw.notna()
+    if bad.any():
+        row = int(np.flatnonzero(bad.to_numpy())[0])
+        raise InputError(f"not a number: {raw.iloc[row]!r}", file=path, line=_line(row, is_csv), column=column)
+    return values.to_numpy(dtype=np.float64)
+
+
+def telemetry_from_frame(
+    frame: pd.DataFrame, spacecraft: Spacecraft, *, source: str | Path = "<memory>", is_csv: bool = False
+) -> Telemetry:
+    """Map, convert and check a telemetry table (see the module docstring for every rule)."""
+    path = Path(str(source))
+    repairs = RepairLog(str(source))
+    tmap = spacecraft.telemetry
+    if frame.shape[0] == 0:
+        raise InputError("no data rows", file=path)
+    keys = {
+        tmap.time: "telemetry.time",
+        **{c: "telemetry.quaternion" for c in tmap.quaternion.columns},
+        **{c: "telemetry.body_rate" for c in tmap.body_rate.columns},
+        **{c: "telemetry.wheel_speed" for c in tmap.wheel_speed.columns},
+    }
+    for col, key in keys.items():
+        if col not in frame.columns:
+            raise InputError(
+                f"column required by the spacecraft file ({spacecraft.source}: [{key}]) is missing; "
+                f"columns present: {list(frame.columns)}",
+                file=path,
+                column=col,
+            )
+
+    # Time: ISO-8601 UTC (or datetime64 in Parquet).
+    raw_time = frame[tmap.time]
+    times = pd.to_datetime(raw_time, utc=True, errors="coerce", format="ISO8601")
+    if times.isna().any():
+        row = int(np.flatnonzero(times.isna().to_numpy())[0])
+        raise InputError(
+            f"not an ISO-8601 time: {raw_time.iloc[row]!r}", file=path, line=_line(row, is_csv), column=tmap.time
+        )
+    time_ns = times.dt.tz_localize(None).to_numpy(dtype="datetime64[ns]")
+
+    q = np.column_stack([_numeric(frame, c, path, is_csv) for c in tmap.quaternion.columns])
+    w = np.column_stack([_numeric(frame, c, path, is_csv) for c in tmap.body_rate.columns])
+    if tmap.wheel_speed.columns:
+        omega = np.column_stack([_numeric(frame, c, path, is_csv) for c in tmap.wheel_speed.columns])
+    else:
+        omega = np.zeros((len(frame), 0))
+    line_of_row = np.arange(len(frame))
+
+    # Empty cells: remove the row, count it.
+    finite = np.all(np.isfinite(q), axis=1) & np.all(np.isfinite(w), axis=1) & np.all(np.isfinite(omega), axis=1)
+    if not finite.all():
+        repairs.record("rows with empty or NaN values removed", int((~finite).sum()))
+        time_ns, q, w, omega, line_of_row = time_ns[finite], q[finite], w[finite], omega[finite], line_of_row[finite]
+    if time_ns.size == 0:
+        raise InputError("no complete data rows (every row has an empty value)", file=path)
+
+    # Order and duplicates.
+    order = np.argsort(time_ns, kind="stable")
+    if np.any(order != np.arange(order.size)):
+        n_out = int(np.count_nonzero(np.diff(time_ns.astype(np.int64)) < 0))
+        repairs.record("timestamps out of order (rows sorted)", n_out)
+        time_ns, q, w, omega, line_of_row = time_ns[order], q[order], w[order], omega[order], line_of_row[order]
+    dup = np.concatenate([[False], np.diff(time_ns.astype(np.int64)) == 0])
+    if dup.any():
+        prev = np.flatnonzero(dup) - 1
+        same = (
+            np.all(q[dup] == q[prev], axis=1) & np.all(w[dup] == w[prev], axis=1) & np.all(omega[dup] == omega[prev], axis=1)
+        )
+        repairs.record("duplicate timestamps with identical values removed", int(same.sum()))
+        repairs.record("duplicate timestamps with conflicting values (first row kept)", int((~same).sum()))
+        keep = ~dup
+        time_ns, q, w, omega, line_of_row = time_ns[keep], q[keep], w[keep], omega[keep], line_of_row[keep]
+
+    # Units and conventions.
+    order_spec = tmap.quaternion.order or "scalar_first,q_BN"
+    if order_spec.startswith("scalar_last"):
+        q = q[:, [3, 0, 1, 2]]
+    norm = np.linalg.norm(q, axis=1)
+    dev = np.abs(norm - 1.0)
+    if np.any(dev > QUATERNION_NORM_ERROR):
+        row = int(np.argmax(dev > QUATERNION_NORM_ERROR))
+        raise InputError(
+            f"quaternion norm {norm[row]:.6g} is not 1 (more than {QUATERNION_NORM_ERROR:.0%} off): "
+            "wrong scaling or wrong columns?",
+            file=path,
+            line=_line(int(line_of_row[row]), is_csv),
+            column=",".join(tmap.quaternion.columns),
+        )
+    n_fix = int(np.count_nonzero(dev > QUATERNION_NORM_REPAIR))
+    repairs.record("quaternions renormalised to unit norm", n_fix)
+    q = q / norm[:, None]
+    if order_spec.endswith("q_NB"):
+        q[:, 1:] *= -1.0
+    q = np.where(q[:, :1] < 0, -q, q)
+
+    w = w * RATE_UNITS[tmap.body_rate.unit or "rad/s"]
+    rate_mag = np.linalg.norm(w, axis=1)
+    if np.any(rate_mag > MAX_BODY_RATE_RAD_S):
+        row = int(np.argmax(rate_mag > MAX_BODY_RATE_RAD_S))
+        raise InputError(
+            f"body rate {rate_mag[row]:.4g} rad/s exceeds {MAX_BODY_RATE_RAD_S} rad/s after conversion from "
+            f"{tmap.body_rate.unit!r}: is the unit in the spacecraft file right?",
+            file=path,
+            line=_line(int(line_of_row[row]), is_csv),
+            column=",".join(tmap.body_rate.columns),
+        )
+    omega = omega * WHEEL_SPEED_UNITS[tmap.wheel_speed.unit or "rad/s"]
+    if omega.shape[1]:
+        limits = spacecraft.wheel_max_speeds_rad_s * WHEEL_OVERSPEED_FACTOR
+        over = np.abs(omega) > limits[None, :]
+        if over.any():
+            row, col = (int(v) for v in np.argwhere(over)[0])
+            hint = " (values look like rpm: set unit = \"rpm\")" if tmap.wheel_speed.unit == "rad/s" else ""
+            raise InputError(
+                f"wheel speed {omega[row, col]:.6g} rad/s exceeds {WHEEL_OVERSPEED_FACTOR} x the wheel's maximum "
+                f"{spacecraft.wheel_max_speeds_rad_s[col]:.6g} rad/s with unit {tmap.wheel_speed.unit!r}{hint}",
+                file=path,
+                line=_line(int(line_of_row[row]), is_csv),
+                column=tmap.wheel_speed.columns[col],
+            )
+
+    t_ns = time_ns.astype(np.int64)
+    t_s = (t_ns - t_ns[0]) / 1e9
+    steps = np.diff(t_s)
+    interval = float(np.median(steps)) if steps.size else float("nan")
+    gaps: list[tuple[int, float]] = []
+    segments: list[tuple[int, int]] = []
+    if steps.size:
+        gap_idx = np.flatnonzero(steps > GAP_FACTOR * interval)
+        gaps = [(int(i + 1), float(steps[i])) for i in gap_idx]
+        bounds = [0, *[g[0] for g in gaps], t_s.size]
+        segments = [(bounds[i], bounds[i + 1]) for i in range(len(bounds) - 1)]
+        if gaps:
+            repairs.record(f"gaps longer than {GAP_FACTOR} sample intervals (data split into segments)", len(gaps))
+    else:
+        segments = [(0, 1)]
+    return Telemetry(
+        time=time_ns,
+        t_s=t_s,
+        quaternion_BN=q,
+        body_rate_rad_s=w,
+        wheel_speed_rad_s=omega,
+        sample_interval_s=interval,
+        segments=segments,
+        repairs=repairs,
+        source=str(source),
+        gaps=gaps,
+    )
+
+
+def read_telemetry(path: str | Path, spacecraft: Spacecraft) -> Telemetry:
+    """Read attitude telemetry (CSV or Parquet) using the spacecraft file's column mapping."""
+    path = Path(path)
+    frame = _read_table(path)
+    is_csv = path.suffix.lower() in (".csv", ".txt")
+    return telemetry_from_frame(frame, spacecraft, source=path, is_csv=is_csv)
