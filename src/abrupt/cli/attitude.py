@@ -1,1 +1,309 @@
-"""Command-line commands for attitude telemetry (registered on the shared groups)."""
+"""Attitude commands: ``simulate attitude``, ``detect attitude``, ``report attitude`` and ``demo``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import click
+
+from abrupt.cli.groups import catalog_option, cli, detect, record_run, report, simulate
+
+if TYPE_CHECKING:
+    from abrupt.simulate.attitude import Strike
+
+DETECTOR_CHOICES = ("glr", "cusum", "summation", "shiryaev", "all")
+
+
+def _spacecraft(path: str | None) -> Any:
+    from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
+
+    return load_spacecraft(path or bundled_spacecraft_path("thesis"))
+
+
+def parse_strike(text: str) -> Strike:
+    """``TIME_S:DHX,DHY,DHZ`` (seconds from start; angular impulse in body axes, N·m·s)."""
+    from abrupt.simulate.attitude import Strike
+
+    try:
+        time_part, vec_part = text.split(":")
+        dh = tuple(float(v) for v in vec_part.split(","))
+        if len(dh) != 3:
+            raise ValueError
+        return Strike(float(time_part), (dh[0], dh[1], dh[2]))
+    except ValueError:
+        raise click.BadParameter(f"{text!r}: expected TIME_S:DHX,DHY,DHZ, e.g. 600:0.08,0,0") from None
+
+
+def random_strikes(n: int, duration_s: float, dh_min: float, dh_max: float, seed: int) -> list[Strike]:
+    """n strikes, evenly spaced with random jitter, log-uniform |ΔH| in [dh_min, dh_max], random directions."""
+    import numpy as np
+
+    from abrupt.simulate.attitude import Strike
+
+    rng = np.random.default_rng(seed + 1)
+    spacing = duration_s / (n + 1)
+    out = []
+    for k in range(n):
+        t = spacing * (k + 1) + rng.uniform(-0.2, 0.2) * spacing
+        mag = float(np.exp(rng.uniform(np.log(dh_min), np.log(dh_max))))
+        u = rng.normal(size=3)
+        u /= np.linalg.norm(u)
+        out.append(Strike(round(float(t), 2), tuple(float(v) for v in mag * u)))  # type: ignore[arg-type]
+    return out
+
+
+@simulate.command("attitude")
+@click.option("--spacecraft", "spacecraft_path", type=click.Path(exists=True, dir_okay=False), default=None,
+              help="Spacecraft TOML (default: the thesis spacecraft, Bennett 2022 Table 2.1).")
+@click.option("--duration", "duration_s", type=float, default=3600.0, show_default=True, help="Simulated time [s].")
+@click.option("--telemetry-rate", "telemetry_rate_hz", type=float, default=10.0, show_default=True, help="[Hz]")
+@click.option("--rate-noise", "rate_noise", type=float, default=4e-5, show_default=True,
+              help="Body-rate telemetry noise σ [rad/s] (spec §3.6; Table 2.1 prints 2e-4).")
+@click.option("--no-noise", is_flag=True, help="Noise-free simulation.")
+@click.option("--strike", "strikes", multiple=True, help="TIME_S:DHX,DHY,DHZ (body axes, N·m·s); repeatable.")
+@click.option("--random-strikes", type=int, default=0, help="Add N strikes at random times and directions.")
+@click.option("--strike-range", type=(float, float), default=(0.02, 0.5), show_default=True,
+              help="|ΔH| range of random strikes [N·m·s] (log-uniform).")
+@click.option("--wheel-resolution", type=float, default=None, help="Tachometer discretisation [rad/s].")
+@click.option("--start", "start_utc", default="2026-01-01T00:00:00", show_default=True, help="Start time (UTC).")
+@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--out", type=click.Path(dir_okay=False), required=True, help="Telemetry file (.csv or .parquet).")
+def simulate_attitude_cmd(
+    spacecraft_path: str | None,
+    duration_s: float,
+    telemetry_rate_hz: float,
+    rate_noise: float,
+    no_noise: bool,
+    strikes: tuple[str, ...],
+    random_strikes: int,
+    strike_range: tuple[float, float],
+    wheel_resolution: float | None,
+    start_utc: str,
+    seed: int,
+    out: str,
+) -> None:
+    """Simulate attitude telemetry of a spacecraft with reaction wheels, with strikes.
+
+    Writes the telemetry and, beside it, <name>_truth.csv with each strike's time and ΔH.
+    """
+    from abrupt.simulate.attitude import AttitudeSimConfig, simulate_attitude, write_telemetry
+
+    sc = _spacecraft(spacecraft_path)
+    strike_list = [parse_strike(s) for s in strikes]
+    if random_strikes:
+        strike_list += _random_strikes(random_strikes, duration_s, strike_range, seed)
+    cfg = AttitudeSimConfig(
+        duration_s=duration_s,
+        telemetry_rate_hz=telemetry_rate_hz,
+        telemetry_noise_rate_rad_s=rate_noise,
+        noise=not no_noise,
+        wheel_speed_resolution_rad_s=wheel_resolution,
+        start_time_utc=start_utc,
+        seed=seed,
+    )
+    result = simulate_attitude(sc, cfg, sorted(strike_list, key=lambda s: s.time_s))
+    tel_path, truth_path = write_telemetry(result, out)
+    click.echo(f"telemetry: {tel_path} ({len(result.telemetry)} samples); truth: {truth_path} ({len(result.truth)} strikes)")
+
+
+def _random_strikes(n: int, duration_s: float, strike_range: tuple[float, float], seed: int) -> list[Strike]:
+    return random_strikes(n, duration_s, strike_range[0], strike_range[1], seed)
+
+
+def _detection_config(
+    detectors: tuple[str, ...], fa_per_day: float, pre: int, post: int, method: str, null_samples: int
+) -> Any:
+    from abrupt.detect.attitude import ATTITUDE_DETECTORS, AttitudeDetectionConfig
+    from abrupt.detect.change_detection import WindowConfig
+
+    chosen = ATTITUDE_DETECTORS if "all" in detectors else tuple(dict.fromkeys(detectors or ("glr",)))
+    return AttitudeDetectionConfig(
+        detectors=chosen,
+        windows=WindowConfig(pre=pre, post=post),
+        false_alarms_per_day=fa_per_day,
+        threshold_method=method,
+        null_samples=null_samples,
+    )
+
+
+detector_options = [
+    click.option("--detector", "detectors", multiple=True, type=click.Choice(DETECTOR_CHOICES), default=("glr",),
+                 show_default=True, help="Detector(s); repeatable; 'all' runs every one."),
+    click.option("--false-alarms-per-day", "fa_per_day", type=float, default=1.0, show_default=True,
+                 help="False-alarm budget the thresholds are set for."),
+    click.option("--pre", type=int, default=200, show_default=True, help="Pre-window [samples] (thesis detectors)."),
+    click.option("--post", type=int, default=180, show_default=True, help="Post-window [samples] (thesis detectors)."),
+    click.option("--threshold-fit", "method", type=click.Choice(["gev", "gpd", "kde", "gaussian", "gamma", "empirical"]),
+                 default="gev", show_default=True,
+                 help="Fit of the event-free statistic (gev: block maxima, sets alarm episodes per day)."),
+    click.option("--null-samples", type=int, default=2_000_000, show_default=True,
+                 help="Event-free samples simulated for threshold calibration (without --calibration)."),
+    click.option("--calibration", type=click.Path(exists=True, dir_okay=False), default=None,
+                 help="Event-free telemetry of the same spacecraft to fit thresholds on."),
+]
+
+
+def _with_options(options: list[Any]) -> Any:
+    def wrap(f: Any) -> Any:
+        for opt in reversed(options):
+            f = opt(f)
+        return f
+
+    return wrap
+
+
+def run_attitude_detection(
+    telemetry_path: str, spacecraft_path: str | None, detectors: tuple[str, ...], fa_per_day: float, pre: int,
+    post: int, method: str, null_samples: int, calibration: str | None, name: str | None,
+) -> tuple[Any, Any, Any, Any]:
+    """Read, calibrate and detect, with a progress line per stage. Returns (sc, telemetry, config, result)."""
+    from abrupt.detect.attitude import detect_attitude
+    from abrupt.readers.telemetry import read_telemetry
+
+    sc = _spacecraft(spacecraft_path)
+    tel = read_telemetry(telemetry_path, sc)
+    for line in tel.repairs.summary():
+        click.echo(f"repaired: {line}", err=True)
+    cal = read_telemetry(calibration, sc) if calibration else None
+    cfg = _detection_config(detectors, fa_per_day, pre, post, method, null_samples)
+    stages = iter(range(10_000))
+
+    def progress(stage: str) -> None:
+        click.echo(f"[{next(stages) + 1}] {stage} ...", err=True)
+
+    result = detect_attitude(tel, sc, cfg, calibration=cal, spacecraft_name=name, progress=progress)
+    return sc, tel, cfg, result
+
+
+@detect.command("attitude")
+@click.argument("telemetry", type=click.Path(exists=True, dir_okay=False))
+@click.option("--spacecraft", "spacecraft_path", type=click.Path(exists=True, dir_okay=False), required=True,
+              help="Spacecraft TOML with the telemetry column mapping.")
+@_with_options(detector_options)
+@click.option("--name", default=None, help="Spacecraft pseudonym in events (default: the spacecraft file's name).")
+@catalog_option
+@click.option("--out", type=click.Path(dir_okay=False), required=True, help="Events file (.csv or .parquet).")
+@click.option("--report", "report_path", type=click.Path(dir_okay=False), default=None,
+              help="Also write the report figure (.png or .html).")
+def detect_attitude_cmd(
+    telemetry: str, spacecraft_path: str, detectors: tuple[str, ...], fa_per_day: float, pre: int, post: int,
+    method: str, null_samples: int, calibration: str | None, name: str | None, catalog_target: str, out: str,
+    report_path: str | None,
+) -> None:
+    """Detect strikes in attitude TELEMETRY (CSV or Parquet); write events and the catalog."""
+    sc, tel, cfg, result = run_attitude_detection(
+        telemetry, spacecraft_path, detectors, fa_per_day, pre, post, method, null_samples, calibration, name
+    )
+    details = {
+        "thresholds": {k: v.as_dict() for k, v in result.thresholds.items()},
+        "repairs": tel.repairs.as_dict(),
+        "gaps": len(tel.gaps),
+    }
+    record_run(
+        catalog_target=catalog_target,
+        command="detect attitude " + telemetry,
+        events=result.events,
+        config_hash=result.config_hash,
+        run_id=result.run_id,
+        input_path=telemetry,
+        out=out,
+        details=details,
+    )
+    for k, thr in result.thresholds.items():
+        click.echo(f"threshold {k}: {thr.value:.4g} ({thr.false_alarms_per_day:g} false alarms/day, {thr.method})", err=True)
+    if report_path:
+        from abrupt.report.attitude import write_attitude_report
+
+        write_attitude_report(report_path, tel, result)
+        click.echo(f"report: {report_path}", err=True)
+
+
+@report.command("attitude")
+@click.argument("telemetry", type=click.Path(exists=True, dir_okay=False))
+@click.option("--spacecraft", "spacecraft_path", type=click.Path(exists=True, dir_okay=False), required=True)
+@_with_options(detector_options)
+@click.option("--truth", type=click.Path(exists=True, dir_okay=False), default=None,
+              help="Truth file of a simulation (marks the true strike times).")
+@click.option("--out", type=click.Path(dir_okay=False), required=True, help="Figure (.png) or page (.html).")
+def report_attitude_cmd(
+    telemetry: str, spacecraft_path: str, detectors: tuple[str, ...], fa_per_day: float, pre: int, post: int,
+    method: str, null_samples: int, calibration: str | None, truth: str | None, out: str,
+) -> None:
+    """Draw the attitude report: momentum, contributions, raw channels, statistics, thresholds, events."""
+    import pandas as pd
+
+    from abrupt.report.attitude import write_attitude_report
+
+    _, tel, _, result = run_attitude_detection(
+        telemetry, spacecraft_path, detectors, fa_per_day, pre, post, method, null_samples, calibration, None
+    )
+    truth_frame = pd.read_csv(truth) if truth else None
+    write_attitude_report(out, tel, result, truth=truth_frame)
+    click.echo(f"report: {out}")
+
+
+@cli.command("demo")
+@click.option("--out", "out_dir", type=click.Path(file_okay=False), default="abrupt_demo", show_default=True,
+              help="Folder for the demo's telemetry, events, catalog and report.")
+@click.option("--duration", "duration_s", type=float, default=3 * 3600.0, show_default=True, help="[s]")
+@click.option("--seed", type=int, default=7, show_default=True)
+def demo(out_dir: str, duration_s: float, seed: int) -> None:
+    """Simulate telemetry of the thesis spacecraft with strikes, detect them, write catalog and report."""
+    import numpy as np
+    import pandas as pd
+
+    from abrupt.detect.attitude import AttitudeDetectionConfig, detect_attitude
+    from abrupt.readers.telemetry import read_telemetry
+    from abrupt.report.attitude import write_attitude_report
+    from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude, write_telemetry
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    sc = _spacecraft(None)
+    # Strikes from 2.5 mg to 60 mg equivalent (0.02-0.48 N m s) in random directions.
+    rng = np.random.default_rng(seed)
+    sizes = [0.48, 0.16, 0.08, 0.05, 0.04, 0.02]
+    times = np.linspace(duration_s / 8, duration_s * 7 / 8, len(sizes))
+    strikes = []
+    for t, size in zip(times, sizes, strict=True):
+        u = rng.normal(size=3)
+        u /= np.linalg.norm(u)
+        strikes.append(Strike(round(float(t), 1), tuple(float(v) for v in size * u)))  # type: ignore[arg-type]
+    click.echo(f"[1/4] simulating {duration_s / 3600:g} h of 10 Hz telemetry with {len(strikes)} strikes ...", err=True)
+    sim = simulate_attitude(sc, AttitudeSimConfig(duration_s=duration_s, seed=seed), strikes)
+    tel_path, truth_path = write_telemetry(sim, out / "telemetry.parquet")
+    click.echo("[2/4] reading telemetry and calibrating thresholds (one false alarm per day) ...", err=True)
+    tel = read_telemetry(tel_path, sc)
+    cfg = AttitudeDetectionConfig(detectors=("glr", "cusum", "summation"))
+    result = detect_attitude(tel, sc, cfg, spacecraft_name="demo-sat")
+    click.echo("[3/4] writing events and catalog ...", err=True)
+    record_run(
+        catalog_target=str(out / "catalog.sqlite"),
+        command="demo",
+        events=result.events,
+        config_hash=result.config_hash,
+        run_id=result.run_id,
+        input_path=tel_path,
+        out=out / "events.csv",
+        details={"thresholds": {k: v.as_dict() for k, v in result.thresholds.items()}},
+    )
+    click.echo("[4/4] drawing the report ...", err=True)
+    truth = pd.read_csv(truth_path)
+    write_attitude_report(out / "report.png", tel, result, truth=truth, title="abrupt demo: thesis spacecraft")
+    write_attitude_report(out / "report.html", tel, result, truth=truth, title="abrupt demo: thesis spacecraft")
+    click.echo("\ntruth vs detections (match within 5 s):")
+    ev = result.events
+    ev_t = pd.to_datetime(ev["time_utc"].astype(str)).dt.tz_localize(None) if len(ev) else pd.Series([], dtype="datetime64[ns]")
+    start = pd.Timestamp(sim.telemetry["time"].iloc[0])
+    for _, row in truth.iterrows():
+        t_true = start + pd.Timedelta(seconds=float(row["time_s"]))
+        line = f"  strike at {float(row['time_s']):8.1f} s, |ΔH| = {float(row['dH_Nms']):.3f} N·m·s:"
+        for det in cfg.detectors:
+            sel = ev[(ev["detector"] == f"attitude.{det}") & ((ev_t - t_true).abs() <= pd.Timedelta(seconds=5)).to_numpy()]
+            if len(sel):
+                line += f"  {det} ✓ (ΔH {float(sel['dH_Nms'].iloc[0]):.3f})"
+            else:
+                line += f"  {det} –"
+        click.echo(line)
+    click.echo(f"\noutputs in {out}/: telemetry.parquet, telemetry_truth.csv, events.csv, catalog.sqlite, report.png, report.html")

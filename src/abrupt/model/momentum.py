@@ -90,34 +90,3 @@ def system_momentum(
         H_wheels_N_Nms=h_wheels_n,
     )
 
-
-def low_noise_inertial_momentum(
-    spacecraft: Spacecraft,
-    quaternion_BN: ArrayLike,
-    body_rate_rad_s: ArrayLike,
-    wheel_speed_rad_s: ArrayLike,
-    rate_smoothing_samples: int,
-) -> FloatArray:
-    """ᴺH with the rigid-body term J ω replaced by its centred moving average [N·m·s].
-
-    In a controlled spacecraft the true J ω varies slowly (the reference motion) except for the
-    ~25 s control transient that follows a strike; its telemetry, however, carries most of the
-    noise of ᴺH (Bennett 2022 §3.6: J σ_ω ≈ 0.12 N·m·s against J_s σ_Ω ≈ 0.04 N·m·s for the thesis
-    spacecraft). Averaging J ω over ``rate_smoothing_samples`` removes that noise; away from the
-    transient the result equals ᴺH, so a step detector that skips the transient with a guard gap
-    measures the strike's ΔH with the lower noise floor of the wheel term.
-    """
-    from scipy.ndimage import uniform_filter1d
-
-    q = np.asarray(quaternion_BN, dtype=np.float64)
-    h_body_b, h_wheels_b = body_momentum(
-        body_rate_rad_s,
-        wheel_speed_rad_s,
-        spacecraft.inertia_kgm2,
-        spacecraft.wheel_axes,
-        spacecraft.wheel_spin_inertias_kgm2,
-    )
-    if rate_smoothing_samples > 1:
-        h_body_b = uniform_filter1d(h_body_b, size=int(rate_smoothing_samples), axis=0, mode="nearest")
-    bn = dcm_from_quaternion(q)
-    return np.asarray(np.einsum("nji,nj->ni", bn, h_body_b + h_wheels_b), dtype=np.float64)

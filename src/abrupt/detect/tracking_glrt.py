@@ -1,0 +1,475 @@
+"""Beyond the thesis: batch orbit fits and a GLRT for maneuvers that happen out of view.
+
+Kaderali's EKF needs measurements during the burn. A burn made between passes only shows in the next
+passes' residuals. This module
+
+1. fits the orbit by weighted Gauss-Newton least squares to all measurements (state at t0, optional
+   per-station range biases, an optional constant unmodelled acceleration, and impulses at given epochs);
+2. scans candidate epochs τ with a generalised likelihood-ratio test (GLRT; Willsky & Jones 1976, "A
+   generalized likelihood ratio approach to the detection and estimation of jumps in linear systems"):
+   for each τ the linearised whitened model is r = J₀ δp + J_v(τ) Δv + w, with J_v(τ) the sensitivity of
+   every later measurement to an impulse Δv (RSW components) at τ,
+   J_v(τ)_k = W_k H_k Φ(t_k, t₀) Φ(τ, t₀)⁻¹ [0; I] C_RSW(τ) for t_k > τ. The statistic
+   T(τ) = r̃ᵀ J̃_v (J̃_vᵀ J̃_v)⁻¹ J̃_vᵀ r̃ (tildes: projected orthogonally to J₀) is χ²₃ under "no maneuver";
+   Δv̂(τ) = (J̃_vᵀ J̃_v)⁻¹ J̃_vᵀ r̃ with covariance (J̃_vᵀ J̃_v)⁻¹;
+3. declares a maneuver when max_τ T(τ) exceeds a threshold set for a false-alarm rate (Bonferroni over the
+   candidate epochs: P_fa per arc / n_candidates, χ²₃), refits jointly with the impulse at τ̂, and repeats
+   for further maneuvers. The epoch uncertainty is the half-width of the set {τ : T(τ) ≥ T_max − 1}.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+
+import numba
+import numpy as np
+from numpy.typing import NDArray
+from scipy.stats import chi2
+
+from abrupt.model.tracking_measurements import TrackingArrays, predict_measurement, wrap_angle
+from abrupt.model.tracking_orbit import ForceModel, propagate_with_stm, rsw_basis
+
+
+@dataclass(frozen=True)
+class BatchFitConfig:
+    """Settings of the least-squares orbit fit. ``estimate_range_bias``: station names (or all if True)."""
+
+    force: ForceModel = field(default_factory=ForceModel)
+    estimate_range_bias: bool | tuple[str, ...] = False
+    estimate_acceleration: bool = False
+    max_iterations: int = 25
+    tolerance: float = 1e-4  # relative change of the weighted residual sum of squares
+    max_step_s: float = 10.0
+    outlier_sigma: float | None = 6.0  # Orekit-style rejection from the 3rd iteration on
+    elevation_mask_deg: float | None = None
+
+
+@dataclass
+class BatchFit:
+    """Result of :func:`fit_orbit`. Parameter order: x0 (6), range biases, acceleration (3), impulses (3 each)."""
+
+    x0: NDArray[np.float64]
+    t0_s: float
+    range_bias_m: dict[str, float]
+    acceleration_mps2: NDArray[np.float64]
+    impulse_times_s: list[float]
+    impulse_dv_rsw_mps: NDArray[np.float64]
+    covariance: NDArray[np.float64]
+    parameter_names: list[str]
+    residuals_white: NDArray[np.float64]
+    jacobian_white: NDArray[np.float64]
+    row_index: NDArray[np.int64]
+    row_component: NDArray[np.int64]
+    used: NDArray[np.bool_]
+    chi2: float
+    n_obs: int
+    iterations: int
+    converged: bool
+    stm_x0: NDArray[np.float64]  # (n_meas, 6, 6): d state(t_k) / d x0
+    states: NDArray[np.float64]
+    config: BatchFitConfig
+
+    @property
+    def rms_white(self) -> float:
+        r = self.residuals_white[self.used]
+        return float(np.sqrt(np.mean(r**2))) if r.size else float("nan")
+
+    def sigma(self, name: str) -> float:
+        k = self.parameter_names.index(name)
+        return float(math.sqrt(max(self.covariance[k, k], 0.0)))
+
+
+def _bias_stations(data: TrackingArrays, cfg: BatchFitConfig) -> list[str]:
+    with_range = sorted({s for s, y in zip(data.station_names, data.y[:, 0], strict=True) if np.isfinite(y)})
+    if cfg.estimate_range_bias is True:
+        return with_range
+    if cfg.estimate_range_bias is False:
+        return []
+    return [s for s in with_range if s in set(cfg.estimate_range_bias)]
+
+
+def trajectory(
+    x0: NDArray[np.float64],
+    t0_s: float,
+    t_out_s: NDArray[np.float64],
+    *,
+    force: ForceModel,
+    accel_mps2: NDArray[np.float64],
+    impulse_times_s: Sequence[float] = (),
+    impulse_dv_rsw: NDArray[np.float64] | None = None,
+    max_step_s: float = 10.0,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """States (n,6) and D = ∂state/∂(x0, accel, Δv₁..Δv_m) (n,6,9+3m) at sorted ``t_out_s`` ≥ t0.
+
+    Impulses are applied in the RSW frame of the state at their epoch; ∂C_RSW/∂x is neglected.
+    """
+    n_imp = len(impulse_times_s)
+    dv = np.zeros((n_imp, 3)) if impulse_dv_rsw is None else np.asarray(impulse_dv_rsw, float).reshape(n_imp, 3)
+    n_p = 9 + 3 * n_imp
+    order = np.argsort(impulse_times_s) if n_imp else np.array([], dtype=int)
+    breaks = [float(impulse_times_s[k]) for k in order]
+    t_out = np.asarray(t_out_s, dtype=float)
+    states = np.empty((t_out.size, 6))
+    dmat = np.empty((t_out.size, 6, n_p))
+    d_start = np.zeros((6, n_p))
+    d_start[:, :6] = np.eye(6)
+    x_start = np.asarray(x0, float).copy()
+    t_start = float(t0_s)
+    seg_edges = [*breaks, math.inf]
+    i0 = 0
+    for seg, t_edge in enumerate(seg_edges):
+        i1 = int(np.searchsorted(t_out, t_edge, side="right")) if math.isfinite(t_edge) else t_out.size
+        times = t_out[i0:i1]
+        extra = [t_edge] if math.isfinite(t_edge) else []
+        t_eval = np.concatenate([times, extra]) if extra else times
+        if t_eval.size:
+            st, phi, sens = propagate_with_stm(
+                x_start, t_start, t_eval, force=force, accel_mps2=accel_mps2, max_step_s=max_step_s
+            )
+            d_all = np.einsum("nij,jk->nik", phi, d_start)
+            d_all[:, :, 6:9] += sens
+            states[i0:i1] = st[: times.size]
+            dmat[i0:i1] = d_all[: times.size]
+            if extra:
+                x_start = st[-1].copy()
+                d_start = d_all[-1].copy()
+        if not math.isfinite(t_edge):
+            break
+        k = int(order[seg])
+        c = rsw_basis(x_start)
+        x_start[3:6] += c @ dv[k]
+        d_start[3:6, 9 + 3 * k : 12 + 3 * k] += c
+        t_start = t_edge
+        i0 = i1
+    return states, dmat
+
+
+def fit_orbit(
+    data: TrackingArrays,
+    x0: NDArray[np.float64],
+    *,
+    t0_s: float = 0.0,
+    config: BatchFitConfig | None = None,
+    impulse_times_s: Sequence[float] = (),
+    initial_range_bias_m: dict[str, float] | None = None,
+    initial_impulse_dv_rsw: NDArray[np.float64] | None = None,
+    initial_acceleration_mps2: NDArray[np.float64] | None = None,
+) -> BatchFit:
+    """Weighted Gauss-Newton fit of the orbit (and biases, acceleration, impulses) to all measurements.
+
+    Residual weights are the station sigmas. Range biases start from the station values (or
+    ``initial_range_bias_m``). Outliers beyond ``outlier_sigma`` are excluded from the 3rd iteration on.
+    """
+    cfg = config or BatchFitConfig()
+    n = len(data)
+    bias_st = _bias_stations(data, cfg)
+    n_imp = len(impulse_times_s)
+    names = ["x", "y", "z", "vx", "vy", "vz", *[f"range_bias[{s}]" for s in bias_st]]
+    if cfg.estimate_acceleration:
+        names += ["accel_x", "accel_y", "accel_z"]
+    for k in range(n_imp):
+        names += [f"dv{k}_r", f"dv{k}_s", f"dv{k}_w"]
+    x = np.asarray(x0, float).copy()
+    bias = {s: (initial_range_bias_m or {}).get(s, data.stations[s].range_bias_m) for s in data.stations}
+    accel = np.zeros(3) if initial_acceleration_mps2 is None else np.asarray(initial_acceleration_mps2, float).copy()
+    dv = np.zeros((n_imp, 3)) if initial_impulse_dv_rsw is None else np.asarray(initial_impulse_dv_rsw, float).reshape(n_imp, 3).copy()
+    # rows: (measurement index, component)
+    valid = np.isfinite(data.y)
+    if cfg.elevation_mask_deg is not None:
+        low = ~(data.y[:, 2] >= math.radians(cfg.elevation_mask_deg))
+        valid[low] = False
+    row_i, row_c = np.nonzero(valid)
+    n_rows = row_i.size
+    used = np.ones(n_rows, dtype=bool)
+    prev_cost = math.inf
+    converged = False
+    it = 0
+    resid = np.zeros(n_rows)
+    jac = np.zeros((n_rows, len(names)))
+    states = np.empty((n, 6))
+    dmat = np.empty((n, 6, 9 + 3 * n_imp))
+    cov = np.full((len(names), len(names)), np.nan)
+    for it in range(1, cfg.max_iterations + 1):
+        states, dmat = trajectory(
+            x, t0_s, data.t_s, force=cfg.force, accel_mps2=accel, impulse_times_s=impulse_times_s,
+            impulse_dv_rsw=dv, max_step_s=cfg.max_step_s,
+        )
+        resid, jac = _residuals(data, states, dmat, bias, bias_st, cfg.estimate_acceleration, n_imp, row_i, row_c)
+        if cfg.outlier_sigma is not None and it >= 3:
+            used = np.abs(resid) <= cfg.outlier_sigma
+        cost = float(np.sum(resid[used] ** 2))
+        a = jac[used]
+        normal = a.T @ a
+        try:
+            cov = np.linalg.inv(normal)
+        except np.linalg.LinAlgError:
+            cov = np.linalg.pinv(normal)
+        step = cov @ (a.T @ resid[used])
+        if abs(prev_cost - cost) <= cfg.tolerance * max(cost, 1.0) and it >= 2:
+            converged = True
+            break
+        prev_cost = cost
+        x = x + step[:6]
+        k = 6
+        for s in bias_st:
+            bias[s] += step[k]
+            k += 1
+        if cfg.estimate_acceleration:
+            accel = accel + step[k : k + 3]
+            k += 3
+        for j in range(n_imp):
+            dv[j] += step[k : k + 3]
+            k += 3
+    return BatchFit(
+        x0=x,
+        t0_s=t0_s,
+        range_bias_m={s: bias[s] for s in bias_st},
+        acceleration_mps2=accel,
+        impulse_times_s=list(impulse_times_s),
+        impulse_dv_rsw_mps=dv,
+        covariance=cov,
+        parameter_names=names,
+        residuals_white=resid,
+        jacobian_white=jac,
+        row_index=row_i,
+        row_component=row_c,
+        used=used,
+        chi2=float(np.sum(resid[used] ** 2)),
+        n_obs=int(used.sum()),
+        iterations=it,
+        converged=converged,
+        stm_x0=dmat[:, :, :6],
+        states=states,
+        config=cfg,
+    )
+
+
+def _residuals(
+    data: TrackingArrays,
+    states: NDArray[np.float64],
+    dmat: NDArray[np.float64],
+    bias: dict[str, float],
+    bias_st: list[str],
+    with_accel: bool,
+    n_imp: int,
+    row_i: NDArray[np.int64],
+    row_c: NDArray[np.int64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    y_hat, h = _predict_all(data.c_fi, data.site, data.c_sf, states)
+    offsets = np.array([bias.get(name, data.range_bias_m[k]) for k, name in enumerate(data.station_names)])
+    y_hat[:, 0] += offsets
+    d = data.y[row_i, row_c] - y_hat[row_i, row_c]
+    az = row_c == 1
+    d[az] = wrap_angle(d[az])
+    sig = data.sigma[row_i, row_c]
+    resid = d / sig
+    hd = np.einsum("rk,rkp->rp", h[row_i, row_c], dmat[row_i])
+    n_par = 6 + len(bias_st) + (3 if with_accel else 0) + 3 * n_imp
+    jac = np.zeros((row_i.size, n_par))
+    jac[:, :6] = hd[:, :6] / sig[:, None]
+    col = 6 + len(bias_st)
+    if with_accel:
+        jac[:, col : col + 3] = hd[:, 6:9] / sig[:, None]
+        col += 3
+    if n_imp:
+        jac[:, col:] = hd[:, 9:] / sig[:, None]
+    names = np.asarray(data.station_names)[row_i]
+    for k, st in enumerate(bias_st):
+        sel = (row_c == 0) & (names == st)
+        jac[sel, 6 + k] = 1.0 / sig[sel]
+    return resid, jac
+
+
+@numba.njit(cache=True)
+def _predict_all(
+    c_fi: NDArray[np.float64], site: NDArray[np.float64], c_sf: NDArray[np.float64], states: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    n = states.shape[0]
+    y = np.empty((n, 4))
+    h = np.empty((n, 4, 6))
+    for i in range(n):
+        yi, hi = predict_measurement(states[i].copy(), c_fi[i].copy(), site[i].copy(), c_sf[i].copy())
+        y[i] = yi
+        h[i] = hi
+    return y, h
+
+
+@dataclass
+class GlrtScan:
+    """T(τ), Δv̂(τ) (RSW, m/s) and its covariance over candidate epochs."""
+
+    t_candidates_s: NDArray[np.float64]
+    statistic: NDArray[np.float64]
+    dv_rsw_mps: NDArray[np.float64]
+    dv_covariance: NDArray[np.float64]
+
+    @property
+    def best(self) -> int:
+        return int(np.nanargmax(self.statistic))
+
+
+def glrt_scan(data: TrackingArrays, fit: BatchFit, t_candidates_s: NDArray[np.float64]) -> GlrtScan:
+    """Linearised GLRT for one impulse at each candidate epoch, on the residuals of ``fit`` (module doc)."""
+    cand = np.asarray(t_candidates_s, dtype=float)
+    states_c, d_c = trajectory(
+        fit.x0, fit.t0_s, cand, force=fit.config.force, accel_mps2=fit.acceleration_mps2,
+        impulse_times_s=fit.impulse_times_s, impulse_dv_rsw=fit.impulse_dv_rsw_mps, max_step_s=fit.config.max_step_s,
+    )
+    used = fit.used
+    r = fit.residuals_white[used]
+    j0 = fit.jacobian_white[used]
+    q0, _ = np.linalg.qr(j0)
+    r_perp = r - q0 @ (q0.T @ r)
+    # whitened ∂y/∂x0 per row: J0[:, :6] (with impulses in the fit this is W H Φ(t_k, t0) through them)
+    jx = j0[:, :6]
+    t_rows = data.t_s[fit.row_index[used]]
+    stat = np.full(cand.size, np.nan)
+    dvs = np.full((cand.size, 3), np.nan)
+    covs = np.full((cand.size, 3, 3), np.nan)
+    for k, tau in enumerate(cand):
+        after = t_rows > tau
+        if after.sum() < 6 or (~after).sum() < 6:
+            continue
+        phi_tau = d_c[k, :, :6]
+        m = np.linalg.solve(phi_tau, np.vstack([np.zeros((3, 3)), rsw_basis(states_c[k])]))
+        jv = np.zeros((r.size, 3))
+        jv[after] = jx[after] @ m
+        jv_perp = jv - q0 @ (q0.T @ jv)
+        info = jv_perp.T @ jv_perp
+        try:
+            cov = np.linalg.inv(info)
+        except np.linalg.LinAlgError:
+            continue
+        g = jv_perp.T @ r_perp
+        dv = cov @ g
+        stat[k] = float(g @ dv)
+        dvs[k] = dv
+        covs[k] = cov
+    return GlrtScan(cand, stat, dvs, covs)
+
+
+@dataclass(frozen=True)
+class GlrtConfig:
+    """Detection settings: false alarms per day sets the threshold (Bonferroni over candidates, χ²₃)."""
+
+    false_alarms_per_day: float = 0.1
+    candidate_step_s: float | None = None  # default: orbital period / 120
+    max_maneuvers: int = 3
+    threshold: float | None = None  # override the χ² threshold
+
+
+@dataclass
+class GlrtDetection:
+    """One detected impulse: epoch (s after the data epoch), RSW Δv and uncertainties."""
+
+    t_s: float
+    time_sigma_s: float
+    dv_rsw_mps: NDArray[np.float64]
+    dv_covariance: NDArray[np.float64]
+    statistic: float
+    threshold: float
+
+    @property
+    def dv_mps(self) -> float:
+        return float(np.linalg.norm(self.dv_rsw_mps))
+
+    @property
+    def dv_sigma_mps(self) -> float:
+        u = self.dv_rsw_mps / max(self.dv_mps, 1e-30)
+        return float(math.sqrt(max(float(u @ self.dv_covariance @ u), 0.0)))
+
+
+def glrt_threshold(n_candidates: int, arc_days: float, false_alarms_per_day: float) -> float:
+    """χ²₃ threshold with a Bonferroni split of the arc's false-alarm probability over the candidates."""
+    p_arc = min(max(false_alarms_per_day * arc_days, 1e-12), 0.5)
+    return float(chi2.isf(p_arc / max(n_candidates, 1), 3))
+
+
+def detect_maneuvers_glrt(
+    data: TrackingArrays,
+    x0_apriori: NDArray[np.float64],
+    *,
+    t0_s: float = 0.0,
+    fit_config: BatchFitConfig | None = None,
+    config: GlrtConfig | None = None,
+) -> tuple[list[GlrtDetection], BatchFit, list[GlrtScan]]:
+    """Fit, scan, refine, refit: greedy detection of up to ``max_maneuvers`` impulses.
+
+    The linear scan finds the plateau of candidate epochs; the epoch is then chosen by the full nonlinear
+    refit (minimum weighted residual sum of squares over the plateau, then a local bisection), because a
+    transverse impulse anywhere between two passes has nearly the same linear signature. The reported
+    statistic is the nonlinear likelihood ratio χ²(no new impulse) − χ²(with it).
+    """
+    cfg = config or GlrtConfig()
+    fcfg = fit_config or BatchFitConfig()
+    x_ap = np.asarray(x0_apriori, float)
+    # no outlier rejection while searching: a maneuver's signature must not be rejected as outliers
+    scan_cfg = replace(fcfg, outlier_sigma=None)
+    fit = fit_orbit(data, x_ap, t0_s=t0_s, config=scan_cfg)
+    mu = fcfg.force.mu_m3_s2
+    r, v = fit.x0[:3], fit.x0[3:]
+    energy = float(v @ v) / 2 - mu / float(np.linalg.norm(r))
+    period = 2 * math.pi * math.sqrt((-mu / (2 * energy)) ** 3 / mu) if energy < 0 else 86400.0
+    step = cfg.candidate_step_s or period / 120.0
+    t_first, t_last = float(data.t_s.min()), float(data.t_s.max())
+    cand = np.arange(t_first + step, t_last, step)
+    arc_days = max((t_last - t_first) / 86400.0, 1e-3)
+    threshold = cfg.threshold if cfg.threshold is not None else glrt_threshold(cand.size, arc_days, cfg.false_alarms_per_day)
+    scans: list[GlrtScan] = []
+    times: list[float] = []
+    sigmas: list[float] = []
+    stats: list[float] = []
+    for _ in range(cfg.max_maneuvers):
+        scan = glrt_scan(data, fit, cand)
+        scans.append(scan)
+        if not np.any(np.isfinite(scan.statistic)):
+            break
+        t_max = float(np.nanmax(scan.statistic))
+        if t_max <= threshold:
+            break
+        chi2_null = fit.chi2
+        tried: dict[float, BatchFit] = {}
+
+        def refit(tau: float, _times: list[float] = times, _fit: BatchFit = fit, _scan: GlrtScan = scan) -> BatchFit:
+            if tau not in tried:
+                k_near = int(np.argmin(np.abs(cand - tau)))
+                guess = _scan.dv_rsw_mps[k_near] if np.all(np.isfinite(_scan.dv_rsw_mps[k_near])) else np.zeros(3)
+                dv0 = np.vstack([_fit.impulse_dv_rsw_mps, guess[None, :]])
+                tried[tau] = fit_orbit(
+                    data, _fit.x0, t0_s=t0_s, config=scan_cfg, impulse_times_s=[*_times, tau],
+                    initial_range_bias_m=_fit.range_bias_m or None, initial_impulse_dv_rsw=dv0,
+                    initial_acceleration_mps2=_fit.acceleration_mps2,
+                )
+            return tried[tau]
+
+        plateau = cand[np.isfinite(scan.statistic) & (scan.statistic >= 0.9 * t_max)]
+        if plateau.size > 8:
+            plateau = plateau[np.linspace(0, plateau.size - 1, 8).round().astype(int)]
+        for tau in {*plateau.tolist(), float(cand[scan.best])}:
+            refit(float(tau))
+        best_tau = min(tried, key=lambda t: tried[t].chi2)
+        width = step if plateau.size <= 1 else max(step, float(np.median(np.diff(np.sort(plateau)))))
+        while width > step / 16.0:
+            width /= 2.0
+            for tau in (best_tau - width, best_tau + width):
+                if t_first < tau < t_last:
+                    refit(float(tau))
+            best_tau = min(tried, key=lambda t: tried[t].chi2)
+        best = tried[best_tau]
+        lr = chi2_null - best.chi2
+        if lr <= threshold:
+            break
+        ok = [t for t, f in tried.items() if f.chi2 <= best.chi2 + 1.0]
+        time_sigma = max(0.5 * (max(ok) - min(ok)), width / math.sqrt(3.0))
+        times.append(best_tau)
+        sigmas.append(time_sigma)
+        stats.append(lr)
+        fit = best
+    detections = []
+    base = len(fit.parameter_names) - 3 * len(times)
+    for j, tj in enumerate(times):
+        cov = fit.covariance[base + 3 * j : base + 3 * j + 3, base + 3 * j : base + 3 * j + 3]
+        detections.append(GlrtDetection(tj, sigmas[j], fit.impulse_dv_rsw_mps[j].copy(), cov, stats[j], threshold))
+    return detections, fit, scans

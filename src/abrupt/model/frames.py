@@ -1,0 +1,215 @@
+"""Orbit state series and frame conversions between ITRF (Earth-fixed) and GCRF (inertial).
+
+The rotation comes from a maintained library: the IAU 2006/2000A celestial-to-terrestrial matrix of
+ERFA (``erfa.c2t06a``, shipped with astropy) with polar motion and UT1-UTC from astropy's bundled
+IERS tables (no download: :func:`abrupt.model.timescales.offline_astropy`). Velocities are
+transformed with the Earth rotation rate (Vallado 2013, Eq. 3-82; Montenbruck & Gill 2000, Eq. 5.94):
+
+    r_GCRF = [W]^T r_ITRF,   v_GCRF = [W]^T (v_ITRF + ω⊕ × r_ITRF)
+
+where [W] maps GCRF to ITRF components and ω⊕ = 7.292115e-5 rad/s about the ITRF z axis (length-of-day
+variations, below 1e-11 rad/s, are ignored).
+
+Because the full matrix is expensive, it is evaluated on a grid of at most one node per
+``grid_step_s`` (default 60 s) and the nine matrix elements are interpolated with cubic splines in
+between (the precession-nutation and polar-motion parts vary over days; Earth rotation is applied
+analytically from the Earth rotation angle, so interpolation error is below 1e-12 rad).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from abrupt.errors import RepairLog
+
+FloatArray = NDArray[np.float64]
+Frame = Literal["ITRF", "GCRF"]
+
+EARTH_ROTATION_RATE_RAD_S = 7.292115e-5  # [rad/s] (IERS conventional mean rate)
+
+
+@dataclass
+class Ephemeris:
+    """A series of orbit states (navigation solutions) of one satellite.
+
+    ``times_utc`` are UTC ``datetime64[ns]``; ``position_m`` and ``velocity_mps`` are (n, 3) arrays in
+    ``frame`` (``"ITRF"`` or ``"GCRF"``). A velocity the source did not give is NaN. ``repairs`` counts
+    the documented repairs the reader made; ``source`` names the input.
+    """
+
+    satellite: str
+    times_utc: NDArray[np.datetime64]
+    position_m: FloatArray
+    velocity_mps: FloatArray
+    frame: Frame
+    source: str = "<memory>"
+    time_system: str = "UTC"
+    repairs: RepairLog = field(default_factory=RepairLog)
+
+    def __post_init__(self) -> None:
+        self.times_utc = np.asarray(self.times_utc, dtype="datetime64[ns]")
+        self.position_m = np.asarray(self.position_m, dtype=np.float64).reshape(-1, 3)
+        self.velocity_mps = np.asarray(self.velocity_mps, dtype=np.float64).reshape(-1, 3)
+        n = self.times_utc.size
+        if self.position_m.shape[0] != n or self.velocity_mps.shape[0] != n:
+            raise ValueError("times, positions and velocities must have the same length")
+
+    def __len__(self) -> int:
+        return int(self.times_utc.size)
+
+    @property
+    def seconds(self) -> FloatArray:
+        """Seconds since the first epoch (float64)."""
+        if len(self) == 0:
+            return np.zeros(0)
+        return (self.times_utc - self.times_utc[0]).astype("timedelta64[ns]").astype(np.float64) * 1e-9
+
+    @property
+    def nominal_step_s(self) -> float:
+        """Median spacing of the epochs (s)."""
+        if len(self) < 2:
+            return float("nan")
+        return float(np.median(np.diff(self.seconds)))
+
+    def to_frame(self, frame: Frame) -> Ephemeris:
+        """The same states expressed in ``frame``."""
+        if frame == self.frame:
+            return self
+        if frame == "GCRF":
+            r, v = itrf_to_gcrf(self.times_utc, self.position_m, self.velocity_mps)
+        else:
+            r, v = gcrf_to_itrf(self.times_utc, self.position_m, self.velocity_mps)
+        return replace(self, position_m=r, velocity_mps=v, frame=frame)
+
+    def select(self, mask: NDArray[np.bool_]) -> Ephemeris:
+        """The epochs where ``mask`` is true."""
+        return replace(
+            self,
+            times_utc=self.times_utc[mask],
+            position_m=self.position_m[mask],
+            velocity_mps=self.velocity_mps[mask],
+        )
+
+
+def _utc_to_jd_parts(times_utc: NDArray[np.datetime64]) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """(UT1 two-part JD, TT two-part JD) for UTC datetime64 using astropy's bundled IERS/leap tables."""
+    from abrupt.model.timescales import offline_astropy
+
+    offline_astropy()
+    from astropy.time import Time
+
+    t = Time(np.asarray(times_utc, dtype="datetime64[ns]"), scale="utc", format="datetime64")
+    ut1 = t.ut1
+    tt = t.tt
+    return (
+        np.asarray(ut1.jd1, dtype=np.float64),
+        np.asarray(ut1.jd2, dtype=np.float64),
+        np.asarray(tt.jd1, dtype=np.float64),
+        np.asarray(tt.jd2, dtype=np.float64),
+    )
+
+
+def _polar_motion_rad(times_utc: NDArray[np.datetime64]) -> tuple[FloatArray, FloatArray]:
+    from abrupt.model.timescales import offline_astropy
+
+    offline_astropy()
+    from astropy.time import Time
+    from astropy.utils import iers
+
+    t = Time(np.asarray(times_utc, dtype="datetime64[ns]"), scale="utc", format="datetime64")
+    table = iers.earth_orientation_table.get()
+    xp, yp = table.pm_xy(t)
+    return np.asarray(xp.to_value("rad"), dtype=np.float64), np.asarray(yp.to_value("rad"), dtype=np.float64)
+
+
+def gcrf_to_itrf_matrix(times_utc: NDArray[np.datetime64], grid_step_s: float = 600.0) -> FloatArray:
+    """The (n, 3, 3) matrices [W] with r_ITRF = [W] r_GCRF (IAU 2006/2000A, CIO based, ERFA c2t06a).
+
+    The matrix is computed exactly at grid nodes; between nodes the slowly varying part
+    ([W] with the Earth rotation angle removed) is interpolated and the rotation re-applied.
+    """
+    import erfa
+
+    times = np.asarray(times_utc, dtype="datetime64[ns]")
+    if times.size == 0:
+        return np.zeros((0, 3, 3))
+    sec = (times - times[0]).astype(np.float64) * 1e-9
+    span = float(sec.max() - sec.min())
+    n_nodes = max(2, int(np.ceil(span / grid_step_s)) + 1)
+    if times.size <= n_nodes:
+        node_times = times
+        node_sec = sec
+    else:
+        node_sec = np.linspace(sec.min(), sec.max(), n_nodes)
+        node_times = times[0] + (node_sec * 1e9).astype("timedelta64[ns]")
+    uta, utb, tta, ttb = _utc_to_jd_parts(node_times)
+    xp, yp = _polar_motion_rad(node_times)
+    w_nodes = erfa.c2t06a(tta, ttb, uta, utb, xp, yp)
+    if node_times is times:
+        return np.asarray(w_nodes, dtype=np.float64)
+    # Remove the Earth rotation angle so the remainder varies slowly, interpolate, re-apply.
+    era_nodes = erfa.era00(uta, utb)
+    slow = np.einsum("nij,njk->nik", _rot_z(-era_nodes), w_nodes)
+    from scipy.interpolate import CubicSpline
+
+    spline = CubicSpline(node_sec, slow.reshape(-1, 9), axis=0)
+    slow_t = spline(sec).reshape(-1, 3, 3)
+    uta_t, utb_t, _, _ = _utc_to_jd_parts(times)
+    era_t = erfa.era00(uta_t, utb_t)
+    return np.asarray(np.einsum("nij,njk->nik", _rot_z(era_t), slow_t), dtype=np.float64)
+
+
+def _rot_z(angle: FloatArray) -> FloatArray:
+    """Frame rotation about z by ``angle`` (rad): R3(angle), shape (n, 3, 3)."""
+    c, s = np.cos(angle), np.sin(angle)
+    out = np.zeros((np.size(angle), 3, 3))
+    out[:, 0, 0] = c
+    out[:, 0, 1] = s
+    out[:, 1, 0] = -s
+    out[:, 1, 1] = c
+    out[:, 2, 2] = 1.0
+    return out
+
+
+def itrf_to_gcrf(
+    times_utc: NDArray[np.datetime64], position_m: FloatArray, velocity_mps: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """ITRF position (m) and velocity (m/s) to GCRF (module docstring for the equations)."""
+    w = gcrf_to_itrf_matrix(times_utc)
+    r = np.asarray(position_m, dtype=np.float64)
+    v = np.asarray(velocity_mps, dtype=np.float64)
+    omega = np.array([0.0, 0.0, EARTH_ROTATION_RATE_RAD_S])
+    v_inertial_itrf = v + np.cross(omega, r)
+    r_g = np.einsum("nji,nj->ni", w, r)
+    v_g = np.einsum("nji,nj->ni", w, v_inertial_itrf)
+    return r_g, v_g
+
+
+def gcrf_to_itrf(
+    times_utc: NDArray[np.datetime64], position_m: FloatArray, velocity_mps: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """GCRF position (m) and velocity (m/s) to ITRF; inverse of :func:`itrf_to_gcrf`."""
+    w = gcrf_to_itrf_matrix(times_utc)
+    r = np.einsum("nij,nj->ni", w, np.asarray(position_m, dtype=np.float64))
+    v_rot = np.einsum("nij,nj->ni", w, np.asarray(velocity_mps, dtype=np.float64))
+    omega = np.array([0.0, 0.0, EARTH_ROTATION_RATE_RAD_S])
+    return r, v_rot - np.cross(omega, r)
+
+
+def rtn_matrix(position_m: FloatArray, velocity_mps: FloatArray) -> FloatArray:
+    """(n, 3, 3) matrices whose columns are r̂, t̂, n̂ (orbit frame O in inertial components).
+
+    r̂ = r/|r|, n̂ = r×v/|r×v|, t̂ = n̂×r̂ (along-track, equals v̂ for a circular orbit). A vector's
+    orbit-frame components are ``M^T x``.
+    """
+    r = np.atleast_2d(np.asarray(position_m, dtype=np.float64))
+    v = np.atleast_2d(np.asarray(velocity_mps, dtype=np.float64))
+    r_hat = r / np.linalg.norm(r, axis=1, keepdims=True)
+    h = np.cross(r, v)
+    n_hat = h / np.linalg.norm(h, axis=1, keepdims=True)
+    t_hat = np.cross(n_hat, r_hat)
+    return np.stack([r_hat, t_hat, n_hat], axis=2)

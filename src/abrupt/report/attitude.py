@@ -1,0 +1,164 @@
+"""Attitude report: time-linked stacked panels of momentum, contributions, raw channels and statistics.
+
+One figure, all panels sharing the time axis: inertial momentum ᴺH (change from its start), its body
+(J ω) and wheel contributions, body rates, wheel speeds, then each detector's statistic with its
+threshold. Detected events are vertical lines through every panel; known truth (simulations) is
+marked with triangles. Written as PNG, or as a self-contained HTML page with the figure, the events
+table, the thresholds and the input repairs.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+from numpy.typing import NDArray  # noqa: E402
+
+from abrupt.detect.attitude import STATISTIC_UNITS, DetectionResult  # noqa: E402
+from abrupt.readers.telemetry import Telemetry  # noqa: E402
+
+MAX_POINTS = 20000  # per line; longer series are min/max decimated so spikes stay visible
+
+
+def _decimate(t: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Min/max decimation to about MAX_POINTS points, keeping extremes (spikes) visible."""
+    n = t.size
+    if n <= MAX_POINTS:
+        return t, y
+    k = int(np.ceil(n / (MAX_POINTS / 2)))
+    m = (n // k) * k
+    tb = t[:m].reshape(-1, k)
+    yb = y[:m].reshape(-1, k, *y.shape[1:])
+    with np.errstate(invalid="ignore"):
+        lo = np.nanmin(yb, axis=1)
+        hi = np.nanmax(yb, axis=1)
+    tt = np.repeat(tb[:, 0], 2)
+    yy = np.empty((lo.shape[0] * 2, *y.shape[1:]))
+    yy[0::2] = lo
+    yy[1::2] = hi
+    return tt, yy
+
+
+def attitude_figure(
+    telemetry: Telemetry,
+    result: DetectionResult,
+    *,
+    truth: pd.DataFrame | None = None,
+    title: str = "",
+) -> plt.Figure:
+    """Build the stacked, time-linked attitude report figure (hours since the first sample)."""
+    t_h = telemetry.t_s / 3600.0
+    t0 = telemetry.time[0]
+    names = list(result.statistics)
+    n_panels = 4 + len(names)
+    fig, axes = plt.subplots(n_panels, 1, sharex=True, figsize=(12, 2.1 * n_panels + 1), constrained_layout=True)
+    axis_labels = ("x", "y", "z")
+    colours = ("tab:blue", "tab:orange", "tab:green")
+
+    h = result.momentum_N_Nms
+    ax = axes[0]
+    for i in range(3):
+        tt, yy = _decimate(t_h, h[:, i] - h[0, i])
+        ax.plot(tt, yy, lw=0.6, color=colours[i], label=f"ᴺH_{axis_labels[i]}")
+    ax.set_ylabel("ᴺH − ᴺH₀\n[N·m·s]")
+    ax.legend(loc="upper left", ncol=3, fontsize=8)
+
+    ax = axes[1]
+    for i in range(3):
+        tt, yy = _decimate(t_h, result.momentum_body_N_Nms[:, i])
+        ax.plot(tt, yy, lw=0.5, color=colours[i], alpha=0.6, label=f"body J ω, {axis_labels[i]}")
+        tt, yy = _decimate(t_h, result.momentum_wheels_N_Nms[:, i])
+        ax.plot(tt, yy, lw=0.8, color=colours[i], ls="--", label=f"wheels, {axis_labels[i]}")
+    ax.set_ylabel("contributions\n(inertial) [N·m·s]")
+    ax.legend(loc="upper left", ncol=6, fontsize=7)
+
+    ax = axes[2]
+    for i in range(3):
+        tt, yy = _decimate(t_h, telemetry.body_rate_rad_s[:, i])
+        ax.plot(tt, yy, lw=0.5, color=colours[i], label=f"ω_{axis_labels[i]}")
+    ax.set_ylabel("body rate\n[rad/s]")
+    ax.legend(loc="upper left", ncol=3, fontsize=8)
+
+    ax = axes[3]
+    for j in range(telemetry.wheel_speed_rad_s.shape[1]):
+        tt, yy = _decimate(t_h, telemetry.wheel_speed_rad_s[:, j])
+        ax.plot(tt, yy, lw=0.5, label=f"wheel {j + 1}")
+    ax.set_ylabel("wheel speed\n[rad/s]")
+    ax.legend(loc="upper left", ncol=4, fontsize=8)
+
+    for k, name in enumerate(names):
+        ax = axes[4 + k]
+        tt, yy = _decimate(t_h, result.statistics[name])
+        ax.plot(tt, yy, lw=0.6, color="black")
+        thr = result.thresholds[name]
+        ax.axhline(thr.value, color="tab:red", lw=1.0, ls="--", label=f"threshold ({thr.false_alarms_per_day:g}/day)")
+        ax.set_ylabel(f"{name}\n[{STATISTIC_UNITS[name]}]")
+        ax.legend(loc="upper left", fontsize=8)
+
+    events = result.events
+    if len(events):
+        ev_t = (pd.to_datetime(events["time_utc"].astype(str)).dt.tz_localize(None) - pd.Timestamp(t0)).dt.total_seconds() / 3600
+        for ax in axes:
+            for x in ev_t:
+                ax.axvline(float(x), color="tab:red", lw=0.8, alpha=0.5)
+    if truth is not None and len(truth):
+        tr_t = np.asarray(truth["time_s"], dtype=float) / 3600.0 if "time_s" in truth else np.array([])
+        for x in tr_t:
+            axes[0].plot([x], [0.0], marker="v", color="tab:purple", ms=8, zorder=5)
+    axes[-1].set_xlabel(f"hours since {pd.Timestamp(t0).isoformat()} UTC")
+    fig.suptitle(title or f"abrupt attitude report: {telemetry.source}", fontsize=11)
+    return fig
+
+
+def write_attitude_report(
+    path: str | Path,
+    telemetry: Telemetry,
+    result: DetectionResult,
+    *,
+    truth: pd.DataFrame | None = None,
+    title: str = "",
+) -> Path:
+    """Write the report as PNG (``.png``) or self-contained HTML (``.html``)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig = attitude_figure(telemetry, result, truth=truth, title=title)
+    suffix = path.suffix.lower()
+    if suffix == ".png":
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        return path
+    if suffix not in (".html", ".htm"):
+        plt.close(fig)
+        raise ValueError(f"{path}: report must end in .png or .html")
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    plt.close(fig)
+    img = base64.b64encode(buf.getvalue()).decode()
+    thr_rows = "".join(
+        f"<tr><td>{html.escape(k)}</td><td>{v.value:.4g}</td><td>{html.escape(STATISTIC_UNITS[k])}</td>"
+        f"<td>{v.false_alarms_per_day:g}</td><td>{html.escape(v.method)}</td><td>{v.n_samples}</td></tr>"
+        for k, v in result.thresholds.items()
+    )
+    repairs = "".join(f"<li>{html.escape(line)}</li>" for line in telemetry.repairs.summary()) or "<li>none</li>"
+    cols = ["detector", "time_utc", "time_sigma_s", "statistic", "threshold", "dH_N_x_Nms", "dH_N_y_Nms", "dH_N_z_Nms", "dH_Nms"]
+    table = result.events[cols].to_html(index=False, float_format=lambda v: f"{v:.4g}") if len(result.events) else "<p>No events.</p>"
+    page = f"""<!doctype html><html><head><meta charset="utf-8"><title>abrupt attitude report</title>
+<style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:2px 6px}}</style>
+</head><body><h1>{html.escape(title or "abrupt attitude report")}</h1>
+<p>Input: {html.escape(telemetry.source)}; {len(telemetry)} samples at {telemetry.sample_rate_hz:.4g} Hz;
+{len(telemetry.segments)} contiguous segment(s).</p>
+<img src="data:image/png;base64,{img}" style="max-width:100%">
+<h2>Events</h2>{table}
+<h2>Thresholds</h2><table><tr><th>detector</th><th>threshold</th><th>units</th><th>false alarms/day</th>
+<th>fit</th><th>event-free samples</th></tr>{thr_rows}</table>
+<h2>Input repairs</h2><ul>{repairs}</ul></body></html>"""
+    path.write_text(page)
+    return path

@@ -1,0 +1,236 @@
+"""Orbit truth simulation with impulsive ΔV, simulated GNSS navigation solutions, and injection of a ΔV
+into a real ephemeris.
+
+Bennett 2022 §3.1 (spec §4.2-4.3): Cowell propagation (here ``scipy.integrate.solve_ivp``, DOP853,
+rtol 1e-12) of the forces in :class:`abrupt.model.orbit_dynamics.ForceModel`; a strike is an
+instantaneous ΔV = β m_d v_d / m_s (Eqs. 3.1-3.2) added to the truth velocity; measurements are truth
+plus white Gaussian noise (σ_pos = 10 m, σ_vel = 0.25 m/s per axis, 1 Hz; Table 3.1).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.integrate import solve_ivp
+
+from abrupt.model.frames import Ephemeris, rtn_matrix
+from abrupt.model.orbit_dynamics import R_EARTH_M, ForceModel, acceleration, kepler_to_cartesian
+
+FloatArray = NDArray[np.float64]
+
+#: Thesis default ΔV: 2 × 0.2 g × 12 km/s / 200 kg (Table 3.1, Eqs. 3.1-3.2).
+THESIS_DEBRIS_MASS_KG = 0.2e-3  # [kg]
+THESIS_DEBRIS_SPEED_MPS = 12000.0  # [m/s]
+THESIS_MEF = 2.0  # [-]
+THESIS_SPACECRAFT_MASS_KG = 200.0  # [kg]
+
+
+def strike_delta_v(debris_mass_kg: float, debris_speed_mps: float, mef: float, spacecraft_mass_kg: float) -> float:
+    """|ΔV| = β m_d v_d / m_s (m/s), Bennett 2022 Eqs. 3.1-3.2."""
+    return mef * debris_mass_kg * debris_speed_mps / spacecraft_mass_kg
+
+
+THESIS_DV_MPS = strike_delta_v(THESIS_DEBRIS_MASS_KG, THESIS_DEBRIS_SPEED_MPS, THESIS_MEF, THESIS_SPACECRAFT_MASS_KG)
+
+
+@dataclass(frozen=True)
+class Impulse:
+    """An instantaneous velocity change at ``time_s`` (s after the start); ``dv_mps`` in ``frame``
+    ("inertial" or "rtn": radial, along-track, cross-track)."""
+
+    time_s: float
+    dv_mps: tuple[float, float, float]
+    frame: str = "inertial"
+
+    def __post_init__(self) -> None:
+        if self.frame not in ("inertial", "rtn"):
+            raise ValueError(f"impulse frame must be 'inertial' or 'rtn', got {self.frame!r}")
+
+
+@dataclass(frozen=True)
+class OrbitSimulationConfig:
+    """Truth orbit and measurement settings (defaults: Bennett 2022 Table 3.1)."""
+
+    altitude_m: float = 800e3
+    eccentricity: float = 0.0
+    inclination_deg: float = 40.0
+    raan_deg: float = 30.0
+    arg_perigee_deg: float = 50.0
+    true_anomaly_deg: float = 0.0
+    duration_s: float = 10800.0
+    rate_hz: float = 1.0
+    sigma_pos_m: float = 10.0
+    sigma_vel_mps: float = 0.25
+    epoch_utc: str = "2020-01-01T00:00:00"
+    forces: ForceModel = field(default_factory=ForceModel)
+    impulses: tuple[Impulse, ...] = ()
+    seed: int | None = 0
+
+    def __post_init__(self) -> None:
+        if self.duration_s <= 0 or self.rate_hz <= 0:
+            raise ValueError("duration_s and rate_hz must be positive")
+        if self.sigma_pos_m < 0 or self.sigma_vel_mps < 0:
+            raise ValueError("measurement sigmas must be non-negative")
+
+
+@dataclass
+class SimulatedOrbit:
+    """Truth and measurements: ``t_s`` (n), truth and measured (n, 3) arrays (GCRF), the epoch."""
+
+    t_s: FloatArray
+    truth_position_m: FloatArray
+    truth_velocity_mps: FloatArray
+    measured_position_m: FloatArray
+    measured_velocity_mps: FloatArray
+    epoch_utc: np.datetime64
+    impulses_inertial: list[tuple[float, FloatArray]]
+
+    def ephemeris(self, satellite: str = "SIM") -> Ephemeris:
+        times = self.epoch_utc + (self.t_s * 1e9).round().astype("timedelta64[ns]")
+        return Ephemeris(
+            satellite=satellite,
+            times_utc=times,
+            position_m=self.measured_position_m,
+            velocity_mps=self.measured_velocity_mps,
+            frame="GCRF",
+            source="simulation",
+        )
+
+
+def _jd_tt(epoch_utc: np.datetime64) -> float:
+    # UTC→TT offset (69.184 s since 2017) only shifts Sun/Moon positions by seconds of motion.
+    days = (np.datetime64(epoch_utc, "ns") - np.datetime64("2000-01-01T12:00:00", "ns")).astype(np.float64) * 1e-9
+    return 2451545.0 + (days + 69.184) / 86400.0
+
+
+def _era(epoch_utc: np.datetime64) -> float:
+    days = (np.datetime64(epoch_utc, "ns") - np.datetime64("2000-01-01T12:00:00", "ns")).astype(np.float64) * 1e-9
+    return float(2 * math.pi * ((0.7790572732640 + 1.00273781191135448 * days / 86400.0) % 1.0))
+
+
+def propagate(
+    t0_s: float,
+    state0: FloatArray,
+    t_out_s: FloatArray,
+    forces: ForceModel,
+    epoch_utc: np.datetime64 | str = "2020-01-01T00:00:00",
+    impulses: list[tuple[float, FloatArray]] | None = None,
+    rtol: float = 1e-12,
+    atol: float = 1e-6,
+) -> FloatArray:
+    """Propagate [r; v] (m, m/s, GCRF) from ``t0_s`` to the times ``t_out_s`` (≥ t0, sorted), applying
+    inertial impulses [(t_s, dv)] on the way. Returns (n, 6)."""
+    epoch = np.datetime64(epoch_utc, "ns")
+    jd = _jd_tt(epoch)
+    era = _era(epoch)
+    t_out = np.asarray(t_out_s, dtype=np.float64)
+    out = np.empty((t_out.size, 6))
+
+    def rhs(t: float, y: FloatArray) -> FloatArray:
+        a = acceleration(t, y[:3], y[3:], forces, jd, era)
+        return np.concatenate([y[3:], a])
+
+    kicks = sorted(impulses or [], key=lambda k: k[0])
+    bounds = [t0_s, *[k[0] for k in kicks if t0_s < k[0] <= (t_out[-1] if t_out.size else t0_s)]]
+    state = np.asarray(state0, dtype=np.float64).copy()
+    t_end = float(t_out[-1]) if t_out.size else t0_s
+    edges = [*bounds, t_end]
+    for seg in range(len(edges) - 1):
+        ta, tb = edges[seg], edges[seg + 1]
+        if seg > 0:
+            state = state.copy()
+            state[3:] += np.asarray(kicks[seg - 1][1], dtype=np.float64)
+        last = seg == len(edges) - 2
+        sel = (t_out >= ta) & ((t_out < tb) | (last & (t_out <= tb)))
+        if tb > ta:
+            sol = solve_ivp(rhs, (ta, tb), state, method="DOP853", rtol=rtol, atol=atol, dense_output=True)
+            if not sol.success:
+                raise RuntimeError(f"orbit propagation failed: {sol.message}")
+            if sel.any():
+                out[sel] = sol.sol(t_out[sel]).T
+            state = sol.y[:, -1]
+        elif sel.any():
+            out[sel] = state
+    return out
+
+
+def simulate_orbit(config: OrbitSimulationConfig) -> SimulatedOrbit:
+    """Truth orbit with the configured impulses and noisy navigation solutions (Bennett 2022 §3.1)."""
+    a = R_EARTH_M + config.altitude_m
+    r0, v0 = kepler_to_cartesian(
+        a,
+        config.eccentricity,
+        math.radians(config.inclination_deg),
+        math.radians(config.raan_deg),
+        math.radians(config.arg_perigee_deg),
+        math.radians(config.true_anomaly_deg),
+    )
+    n = int(round(config.duration_s * config.rate_hz)) + 1
+    t = np.arange(n) / config.rate_hz
+    epoch = np.datetime64(config.epoch_utc, "ns")
+    # Impulses given in RTN are resolved with the no-impulse truth at their time (iteratively in order).
+    kicks: list[tuple[float, FloatArray]] = []
+    for imp in sorted(config.impulses, key=lambda k: k.time_s):
+        dv = np.asarray(imp.dv_mps, dtype=np.float64)
+        if imp.frame == "rtn":
+            st = propagate(0.0, np.r_[r0, v0], np.array([imp.time_s]), config.forces, epoch, kicks)[0]
+            dv = rtn_matrix(st[:3], st[3:])[0] @ dv
+        kicks.append((float(imp.time_s), dv))
+    truth = propagate(0.0, np.r_[r0, v0], t, config.forces, epoch, kicks)
+    rng = np.random.default_rng(config.seed)
+    pos_noise = rng.normal(0.0, config.sigma_pos_m, (n, 3)) if config.sigma_pos_m > 0 else np.zeros((n, 3))
+    vel_noise = rng.normal(0.0, config.sigma_vel_mps, (n, 3)) if config.sigma_vel_mps > 0 else np.zeros((n, 3))
+    return SimulatedOrbit(
+        t_s=t,
+        truth_position_m=truth[:, :3],
+        truth_velocity_mps=truth[:, 3:],
+        measured_position_m=truth[:, :3] + pos_noise,
+        measured_velocity_mps=truth[:, 3:] + vel_noise,
+        epoch_utc=epoch,
+        impulses_inertial=kicks,
+    )
+
+
+def inject_impulse(
+    ephemeris: Ephemeris,
+    time_utc: np.datetime64 | str,
+    dv_rtn_mps: tuple[float, float, float] | FloatArray,
+    forces: ForceModel | None = None,
+) -> Ephemeris:
+    """Add the effect of a ΔV (orbit frame: radial, along-track, cross-track; m/s) at ``time_utc`` to a
+    real ephemeris: the state at that time (propagated from the last epoch before it) is propagated
+    with and without the ΔV and the difference is added to every later epoch (in GCRF, then
+    converted back to the ephemeris' frame). The force model (default two-body + J2-J4) only shapes
+    the difference, so its errors are second order.
+    """
+    forces = forces or ForceModel(zonal_degree=4)
+    gcrf = ephemeris.to_frame("GCRF")
+    t_imp = np.datetime64(time_utc, "ns")
+    sec = gcrf.seconds
+    t_imp_s = float((t_imp - gcrf.times_utc[0]).astype(np.float64) * 1e-9)
+    if not sec[0] <= t_imp_s < sec[-1]:
+        raise ValueError(f"injection time {time_utc} is outside the ephemeris span")
+    k0 = int(np.searchsorted(sec, t_imp_s, side="right") - 1)
+    state0 = np.r_[gcrf.position_m[k0], gcrf.velocity_mps[k0]]
+    if not np.isfinite(state0).all():
+        raise ValueError("the epoch before the injection time has no velocity; choose another time")
+    after = np.flatnonzero(sec > t_imp_s)
+    t_eval = np.r_[t_imp_s, sec[after]]
+    nominal = propagate(sec[k0], state0, t_eval, forces, gcrf.times_utc[0])
+    at_imp = nominal[0]
+    dv_in = rtn_matrix(at_imp[:3], at_imp[3:])[0] @ np.asarray(dv_rtn_mps, dtype=np.float64)
+    kicked_state = at_imp.copy()
+    kicked_state[3:] += dv_in
+    kicked = propagate(t_imp_s, kicked_state, t_eval, forces, gcrf.times_utc[0])
+    delta = kicked[1:] - nominal[1:]
+    pos = gcrf.position_m.copy()
+    vel = gcrf.velocity_mps.copy()
+    pos[after] += delta[:, :3]
+    vel[after] += delta[:, 3:]
+    from dataclasses import replace
+
+    out = replace(gcrf, position_m=pos, velocity_mps=vel, source=f"{ephemeris.source} + injected ΔV")
+    return out.to_frame(ephemeris.frame)

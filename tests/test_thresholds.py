@@ -1,0 +1,86 @@
+"""Thresholds against analytic quantiles of known distributions."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from abrupt.thresholds import (
+    episode_rate,
+    fit_block_maxima_threshold,
+    fit_threshold,
+    neyman_pearson_threshold,
+    p_fa_per_sample,
+    qq_points,
+    roc_curve,
+)
+
+RNG = np.random.default_rng(42)
+GAUSS = RNG.normal(2.0, 3.0, size=200_000)
+
+
+def test_one_false_alarm_per_day_at_10_hz_is_1_over_864000() -> None:
+    assert p_fa_per_sample(1.0, 10.0) == pytest.approx(1 / 864000)
+
+
+def test_gaussian_fit_matches_the_normal_quantile() -> None:
+    thr = fit_threshold(GAUSS, p_fa=1e-4, method="gaussian")
+    assert thr.value == pytest.approx(2.0 + 3.0 * stats.norm.isf(1e-4), rel=0.01)
+
+
+def test_kde_and_gpd_tails_match_the_normal_quantile() -> None:
+    truth = 2.0 + 3.0 * stats.norm.isf(1e-4)
+    assert fit_threshold(GAUSS, p_fa=1e-4, method="kde").value == pytest.approx(truth, rel=0.04)
+    assert fit_threshold(GAUSS, p_fa=1e-4, method="gpd").value == pytest.approx(truth, rel=0.04)
+
+
+def test_gamma_fit_matches_the_gamma_quantile() -> None:
+    x = RNG.gamma(3.0, 2.0, size=100_000)
+    assert fit_threshold(x, p_fa=1e-3, method="gamma").value == pytest.approx(stats.gamma.isf(1e-3, 3.0, scale=2.0), rel=0.02)
+
+
+def test_threshold_records_its_false_alarm_rate() -> None:
+    thr = fit_threshold(GAUSS, false_alarms_per_day=2.0, sample_rate_hz=1.0, method="gaussian")
+    assert thr.false_alarms_per_day == pytest.approx(2.0)
+    assert thr.p_fa == pytest.approx(2.0 / 86400)
+
+
+def test_gev_threshold_sets_the_episode_rate_of_independent_gaussian_noise() -> None:
+    # Independent N(0,1) samples at 1 Hz: P(block max > c) = 1 - Φ(c)^block exactly.
+    x = np.random.default_rng(1).normal(size=3_000_000)
+    thr = fit_block_maxima_threshold(x, sample_rate_hz=1.0, false_alarms_per_day=1.0, block_s=3600.0)
+    # one alarm per day with independent samples: per-sample probability 1/86400
+    assert thr.value == pytest.approx(stats.norm.isf(1 / 86400), rel=0.03)
+
+
+def test_neyman_pearson_threshold_equals_the_null_quantile_for_a_gaussian_shift() -> None:
+    null = RNG.normal(size=100_000)
+    alt = RNG.normal(3.0, 1.0, size=100_000)
+    y, tau = neyman_pearson_threshold(null, alt, alpha=1e-3)
+    assert y == pytest.approx(stats.norm.isf(1e-3), rel=0.03)
+    # likelihood ratio of two unit Gaussians at y: exp(3 y - 4.5)
+    assert np.log(tau) == pytest.approx(3 * y - 4.5, abs=0.5)
+
+
+def test_roc_is_monotone_from_one_to_zero() -> None:
+    _, pfa, pd_ = roc_curve(RNG.normal(size=1000), RNG.normal(1, 1, size=1000))
+    assert np.all(np.diff(pfa) <= 0) and np.all(np.diff(pd_) <= 0)
+    assert pfa[0] > 0.99 and pd_[-1] == 0
+
+
+def test_qq_points_lie_on_the_diagonal_for_the_right_family() -> None:
+    theo, sample = qq_points(GAUSS, "gaussian")
+    assert np.max(np.abs(theo - sample)) < 0.1
+
+
+def test_episode_rate_merges_neighbouring_exceedances() -> None:
+    s = np.zeros(86400)
+    s[[10, 11, 12, 5000, 5003]] = 5.0
+    n, per_day = episode_rate(s, 1.0, sample_rate_hz=1.0, min_separation_samples=10)
+    assert n == 2 and per_day == pytest.approx(2.0)
+
+
+def test_too_little_data_is_an_error() -> None:
+    with pytest.raises(ValueError, match="at least 10"):
+        fit_threshold([1.0, 2.0], p_fa=0.1)
