@@ -137,7 +137,7 @@ detector_options = [
     click.option("--threshold-fit", "method", type=click.Choice(["gev", "gpd", "kde", "gaussian", "gamma", "empirical"]),
                  default="gev", show_default=True,
                  help="Fit of the event-free statistic (gev: block maxima, sets alarm episodes per day)."),
-    click.option("--null-samples", type=int, default=2_000_000, show_default=True,
+    click.option("--null-samples", type=int, default=10_000_000, show_default=True,
                  help="Event-free samples simulated for threshold calibration (without --calibration)."),
     click.option("--calibration", type=click.Path(exists=True, dir_okay=False), default=None,
                  help="Event-free telemetry of the same spacecraft to fit thresholds on."),
@@ -295,7 +295,7 @@ def demo(out_dir: str, duration_s: float, seed: int) -> None:
     click.echo("\ntruth vs detections (match within 5 s):")
     ev = result.events
     ev_t = pd.to_datetime(ev["time_utc"].astype(str)).dt.tz_localize(None) if len(ev) else pd.Series([], dtype="datetime64[ns]")
-    start = pd.Timestamp(sim.telemetry["time"].iloc[0])
+    start = pd.Timestamp(tel.time[0])
     for _, row in truth.iterrows():
         t_true = start + pd.Timedelta(seconds=float(row["time_s"]))
         line = f"  strike at {float(row['time_s']):8.1f} s, |ΔH| = {float(row['dH_Nms']):.3f} N·m·s:"

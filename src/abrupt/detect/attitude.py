@@ -58,7 +58,7 @@ class AttitudeDetectionConfig:
     glr_windows: WindowConfig = field(default_factory=lambda: WindowConfig(pre=1000, post=1000))
     false_alarms_per_day: float = 1.0
     threshold_method: str = "gev"
-    null_samples: int = 2_000_000
+    null_samples: int = 10_000_000
     seed: int = 0
 
     def __post_init__(self) -> None:

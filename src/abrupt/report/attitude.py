@@ -12,6 +12,7 @@ from __future__ import annotations
 import base64
 import html
 import io
+import warnings
 from pathlib import Path
 
 import matplotlib
@@ -26,6 +27,13 @@ from abrupt.detect.attitude import STATISTIC_UNITS, DetectionResult  # noqa: E40
 from abrupt.readers.telemetry import Telemetry  # noqa: E402
 
 MAX_POINTS = 20000  # per line; longer series are min/max decimated so spikes stay visible
+SMOOTHING_S = 30.0  # [s] running mean drawn over the noisy momentum
+
+
+def _running_mean(y: NDArray[np.float64], n: int) -> NDArray[np.float64]:
+    from scipy.ndimage import uniform_filter1d
+
+    return np.asarray(uniform_filter1d(y, size=n, mode="nearest"), dtype=np.float64) if n > 1 else y
 
 
 def _decimate(t: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -37,7 +45,8 @@ def _decimate(t: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[NDArray[n
     m = (n // k) * k
     tb = t[:m].reshape(-1, k)
     yb = y[:m].reshape(-1, k, *y.shape[1:])
-    with np.errstate(invalid="ignore"):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN blocks where no window fits
         lo = np.nanmin(yb, axis=1)
         hi = np.nanmax(yb, axis=1)
     tt = np.repeat(tb[:, 0], 2)
@@ -64,20 +73,23 @@ def attitude_figure(
     colours = ("tab:blue", "tab:orange", "tab:green")
 
     h = result.momentum_N_Nms
+    smooth_n = max(1, int(round(SMOOTHING_S / telemetry.sample_interval_s)))
     ax = axes[0]
     for i in range(3):
         tt, yy = _decimate(t_h, h[:, i] - h[0, i])
-        ax.plot(tt, yy, lw=0.6, color=colours[i], label=f"ᴺH_{axis_labels[i]}")
+        ax.plot(tt, yy, lw=0.4, color=colours[i], alpha=0.25)
+        tt, yy = _decimate(t_h, _running_mean(h[:, i] - h[0, i], smooth_n))
+        ax.plot(tt, yy, lw=1.0, color=colours[i], label=f"ᴺH_{axis_labels[i]} ({SMOOTHING_S:g} s mean)")
     ax.set_ylabel("ᴺH − ᴺH₀\n[N·m·s]")
     ax.legend(loc="upper left", ncol=3, fontsize=8)
 
     ax = axes[1]
     for i in range(3):
-        tt, yy = _decimate(t_h, result.momentum_body_N_Nms[:, i])
-        ax.plot(tt, yy, lw=0.5, color=colours[i], alpha=0.6, label=f"body J ω, {axis_labels[i]}")
-        tt, yy = _decimate(t_h, result.momentum_wheels_N_Nms[:, i])
-        ax.plot(tt, yy, lw=0.8, color=colours[i], ls="--", label=f"wheels, {axis_labels[i]}")
-    ax.set_ylabel("contributions\n(inertial) [N·m·s]")
+        tt, yy = _decimate(t_h, _running_mean(result.momentum_body_N_Nms[:, i], smooth_n))
+        ax.plot(tt, yy, lw=0.8, color=colours[i], alpha=0.7, label=f"body J ω, {axis_labels[i]}")
+        tt, yy = _decimate(t_h, _running_mean(result.momentum_wheels_N_Nms[:, i], smooth_n))
+        ax.plot(tt, yy, lw=1.0, color=colours[i], ls="--", label=f"wheels, {axis_labels[i]}")
+    ax.set_ylabel(f"contributions, inertial\n({SMOOTHING_S:g} s mean) [N·m·s]")
     ax.legend(loc="upper left", ncol=6, fontsize=7)
 
     ax = axes[2]
