@@ -1,1 +1,452 @@
-"""Command-line commands for this capability (registered on the shared groups)."""
+"""``abrupt rates``: expected rates of detectable strikes (flux models, Monte Carlo, trades, plots)."""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import click
+
+from abrupt.cli.groups import cli, progress
+
+DEFAULT_THRESHOLDS = {
+    "dH": [1e-3, 3e-3, 1e-2, 2e-2, 3e-2, 0.1, 0.3, 0.4, 1.0],  # [N m s]
+    "dV": [1e-5, 1e-4, 1e-3, 1e-2, 2.4e-2, 0.1],  # [m/s]
+    "da": [0.1, 1.0, 10.0, 46.0, 100.0],  # [m]
+}
+
+
+@cli.group()
+def rates() -> None:
+    """Expected rates of detectable strikes: flux models, Monte Carlo, trades and plots.
+
+    \b
+    abrupt rates flux --model nasa90 --altitude-km 500 --inclination-deg 28.5 --epoch 1995
+    abrupt rates run --spacecraft examples/spacecraft/oco2_like.toml --altitude-km 700 \\
+        --inclination-deg 98 --mass-model ordem_sphere --mef rembor --plot oco2.png
+    abrupt rates trade --spacecraft examples/spacecraft/smallsat200.toml \\
+        --vary mef=const1,const2,rembor --vary mass_model=al_sphere,socit --plot trade.png
+    """
+
+
+def _scenario_options(func: Callable[..., Any]) -> Callable[..., Any]:
+    options = [
+        click.option(
+            "--spacecraft",
+            "spacecraft",
+            type=click.Path(dir_okay=False),
+            required=True,
+            help="Spacecraft TOML file with [[surfaces]] and mass_kg.",
+        ),
+        click.option(
+            "--altitude-km",
+            type=float,
+            default=550.0,
+            show_default=True,
+            help="Circular-orbit altitude [km].",
+        ),
+        click.option(
+            "--inclination-deg", type=float, default=28.5, show_default=True, help="Inclination [deg]."
+        ),
+        click.option(
+            "--epoch",
+            "epoch_year",
+            type=float,
+            default=2020.0,
+            show_default=True,
+            help="Epoch [decimal year].",
+        ),
+        click.option(
+            "--solar-flux",
+            "solar_flux_sfu",
+            type=float,
+            default=100.0,
+            show_default=True,
+            help="NASA-90: smoothed F10.7 of the previous year [sfu].",
+        ),
+        click.option(
+            "--flux",
+            "flux_model",
+            default="nasa90",
+            show_default=True,
+            help="nasa90, grun, nasa90+grun, or a flux-table manifest .toml (joined with '+').",
+        ),
+        click.option(
+            "--flux-sigma-factor",
+            type=float,
+            default=0.0,
+            show_default=True,
+            help="Analytic models: 1-sigma as a fraction of the flux (for --flux-bound).",
+        ),
+        click.option(
+            "--flux-bound",
+            type=float,
+            default=0.0,
+            show_default=True,
+            help="Shift flux by this many sigma (e.g. -2, 2).",
+        ),
+        click.option(
+            "--mass-model",
+            default="al_sphere",
+            show_default=True,
+            help="al_sphere, ordem_sphere, socit, socit_literal, socit_no_steel, debrisat.",
+        ),
+        click.option(
+            "--mef",
+            default="const2",
+            show_default=True,
+            help="const1, const2, const3, const:<x>, nysmith_denardo, rembor, rembor_array.",
+        ),
+        click.option(
+            "--lc-min-m", type=float, default=3e-5, show_default=True, help="Lower Lc truncation [m]."
+        ),
+        click.option(
+            "--draws",
+            "n_draws",
+            type=int,
+            default=10_000,
+            show_default=True,
+            help="Monte Carlo draws per case.",
+        ),
+        click.option(
+            "--size-sampling",
+            type=click.Choice(["log_uniform", "population"]),
+            default="log_uniform",
+            show_default=True,
+            help="Lc draws: importance-weighted log-uniform, or the population itself (thesis).",
+        ),
+        click.option("--seed", type=int, default=0, show_default=True, help="Random seed (reproducible)."),
+        click.option(
+            "--location",
+            type=click.Choice(["silhouette", "point_cloud"]),
+            default="silhouette",
+            show_default=True,
+            help="Strike-location method.",
+        ),
+        click.option(
+            "--grid-spacing-m",
+            type=float,
+            default=None,
+            help="Point-cloud grid spacing [m] (default 1/6 smallest dimension).",
+        ),
+        click.option(
+            "--area",
+            type=click.Choice(["thesis", "silhouette"]),
+            default="thesis",
+            show_default=True,
+            help="Effective area: thesis Eqs. 5.15-5.18 or mean silhouette.",
+        ),
+        click.option(
+            "--metric",
+            type=click.Choice(["dH", "dV", "da"]),
+            multiple=True,
+            help="Metric(s) for the table and plot (default: all for the table, dH for the plot).",
+        ),
+        click.option(
+            "--thresholds",
+            default=None,
+            help="Comma-separated thresholds in SI units (N m s, m/s, m) for the first metric.",
+        ),
+        click.option(
+            "--out", type=click.Path(dir_okay=False), default=None, help="Write the rate table (.csv)."
+        ),
+        click.option(
+            "--plot",
+            type=click.Path(dir_okay=False),
+            default=None,
+            help="Write the rate-vs-threshold plot (PNG).",
+        ),
+        click.option(
+            "--scatter", type=click.Path(dir_okay=False), default=None, help="Write the ΔH-ΔV scatter (PNG)."
+        ),
+    ]
+    for opt in reversed(options):
+        func = opt(func)
+    return func
+
+
+def _build_base(kw: dict[str, Any]) -> Any:
+    from abrupt.rates.montecarlo import RateConfig
+    from abrupt.rates.trades import Scenario
+
+    config = RateConfig(
+        mass_model=kw["mass_model"],
+        mef_model=kw["mef"],
+        lc_min_m=kw["lc_min_m"],
+        n_draws=kw["n_draws"],
+        location=kw["location"],
+        grid_spacing_m=kw["grid_spacing_m"],
+        area=kw["area"],
+        flux_bound_sigma=kw["flux_bound"],
+        size_sampling=kw["size_sampling"],
+        seed=kw["seed"],
+    )
+    return Scenario(
+        spacecraft=kw["spacecraft"],
+        altitude_km=kw["altitude_km"],
+        inclination_deg=kw["inclination_deg"],
+        epoch_year=kw["epoch_year"],
+        solar_flux_sfu=kw["solar_flux_sfu"],
+        flux=kw["flux_model"],
+        flux_sigma_factor=kw["flux_sigma_factor"],
+        config=config,
+    )
+
+
+def _thresholds(metric: str, text: str | None, first: bool) -> list[float]:
+    from abrupt.errors import ConfigError
+
+    if text is None or not first:
+        return DEFAULT_THRESHOLDS[metric]
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise ConfigError(f"cannot read thresholds {text!r}", key="thresholds") from None
+    if not values or any(v <= 0 for v in values):
+        raise ConfigError("thresholds must be positive numbers", key="thresholds")
+    return values
+
+
+def _report(results: Sequence[Any], kw: dict[str, Any]) -> None:
+    import pandas as pd
+
+    metrics = list(kw["metric"]) or ["dH", "dV", "da"]
+    rows = []
+    for r in results:
+        for i, m in enumerate(metrics):
+            t = _thresholds(m, kw["thresholds"], i == 0)
+            for thr, rate in zip(t, r.detectable_per_year(m, t), strict=True):
+                rows.append(
+                    {
+                        "case": r.label,
+                        "metric": m,
+                        "threshold_SI": thr,
+                        "detectable_per_year": rate,
+                        "strikes_per_year": r.strikes_per_year,
+                        "area_m2": r.area_m2,
+                        "flux_m2_yr": r.flux_m2_yr,
+                        "on_array_fraction": r.on_array_fraction,
+                        **r.params,
+                    }
+                )
+    frame = pd.DataFrame(rows)
+    for r in results:
+        click.echo(
+            f"{r.label}: {r.strikes_per_year:.4g} strikes/yr above Lc {kw['lc_min_m']:g} m "
+            f"(A_eff {r.area_m2:.3g} m², flux {r.flux_m2_yr:.4g} /m²/yr, arrays {r.on_array_fraction:.0%})"
+        )
+    units = {"dH": "N m s", "dV": "m/s", "da": "m"}
+    for m in metrics:
+        sub = frame[frame.metric == m].pivot(
+            index="threshold_SI", columns="case", values="detectable_per_year"
+        )
+        click.echo(f"\nexpected detectable strikes per year, {m} threshold [{units[m]}]:")
+        click.echo(sub.to_string(float_format=lambda v: f"{v:.4g}"))
+    if kw["out"]:
+        Path(kw["out"]).parent.mkdir(parents=True, exist_ok=True)
+        frame.to_csv(kw["out"], index=False)
+        click.echo(f"table written to {kw['out']}", err=True)
+    if kw["plot"]:
+        import numpy as np
+
+        from abrupt.rates.plots import plot_rate_curves
+
+        m = metrics[0]
+        thr_plot = None
+        if kw["thresholds"]:
+            thr_plot = np.asarray(_thresholds(m, kw["thresholds"], True), dtype=np.float64)
+        plot_rate_curves(results, m, kw["plot"], thresholds=thr_plot)
+        click.echo(f"plot written to {kw['plot']}", err=True)
+    if kw["scatter"]:
+        from abrupt.rates.plots import plot_dh_dv_scatter
+
+        plot_dh_dv_scatter(results, kw["scatter"])
+        click.echo(f"scatter written to {kw['scatter']}", err=True)
+
+
+@rates.command("run")
+@_scenario_options
+def run_command(**kw: Any) -> None:
+    """One Monte Carlo: expected detectable strikes per year against threshold."""
+    from abrupt.rates.trades import _run_case
+
+    base = _build_base(kw)
+    _report([_run_case(base)], kw)
+
+
+@rates.command("trade")
+@_scenario_options
+@click.option(
+    "--vary",
+    "vary",
+    multiple=True,
+    required=True,
+    help="NAME=V1,V2,... (one or two); NAME in spacecraft, orbit (ALT_KM/INC_DEG), flux, flux_bound, "
+    "mass_model, mef, grid_spacing, size_scale, location, area, lc_min, size_sampling. "
+    "Spacecraft paths join with ';'.",
+)
+@click.option(
+    "--scheduler", default=None, help="Dask scheduler address (tcp://host:8786); in-process when absent."
+)
+def trade_command(vary: tuple[str, ...], scheduler: str | None, **kw: Any) -> None:
+    """A trade over one or two variables; one Monte Carlo per case (Dask-parallel with --scheduler)."""
+    from abrupt.errors import ConfigError
+    from abrupt.rates.trades import run_trade
+
+    variables = []
+    for item in vary:
+        if "=" not in item:
+            raise ConfigError(f"--vary needs NAME=V1,V2, got {item!r}", key="vary")
+        name, values = item.split("=", 1)
+        sep = ";" if name.strip() == "spacecraft" else ","
+        variables.append((name.strip(), [v.strip() for v in values.split(sep) if v.strip()]))
+    base = _build_base(kw)
+    results = run_trade(
+        base,
+        variables,
+        scheduler=scheduler,
+        progress=functools.partial(progress, desc="trade cases", unit="case"),
+    )
+    _report(results, kw)
+
+
+@rates.command("flux")
+@click.option("--model", type=click.Choice(["nasa90", "grun"]), default="nasa90", show_default=True)
+@click.option("--altitude-km", type=float, required=True)
+@click.option("--inclination-deg", type=float, default=28.5, show_default=True)
+@click.option("--epoch", "epoch_year", type=float, default=2020.0, show_default=True)
+@click.option("--solar-flux", "solar_flux_sfu", type=float, default=100.0, show_default=True)
+@click.option(
+    "--sizes-m",
+    default="1e-5,1e-4,1e-3,1e-2,1e-1",
+    show_default=True,
+    help="Comma-separated sizes [m] (NASA-90: diameter; Grün: sphere diameter).",
+)
+@click.option(
+    "--write-table",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Also write the model as a flux table (abrupt-flux-table/1 manifest .toml).",
+)
+def flux_command(
+    model: str,
+    altitude_km: float,
+    inclination_deg: float,
+    epoch_year: float,
+    solar_flux_sfu: float,
+    sizes_m: str,
+    write_table: str | None,
+) -> None:
+    """Cumulative flux against size of an analytic model for an orbit (tumbling-plate and cross-section)."""
+    import numpy as np
+
+    from abrupt.errors import ConfigError
+    from abrupt.rates import flux as fx
+    from abrupt.rates import tables
+
+    try:
+        sizes = np.array([float(s) for s in sizes_m.split(",")])
+    except ValueError:
+        raise ConfigError(f"cannot read sizes {sizes_m!r}", key="sizes_m") from None
+    if np.any(sizes <= 0):
+        raise ConfigError("sizes must be positive", key="sizes_m")
+    alt = altitude_km * 1e3
+    if model == "nasa90":
+        f = fx.nasa90_flux_tumbling(
+            sizes,
+            altitude_m=alt,
+            inclination_deg=inclination_deg,
+            epoch_year=epoch_year,
+            solar_flux_sfu=solar_flux_sfu,
+        )
+        click.echo(
+            f"NASA-90/91 debris, {altitude_km:g} km, {inclination_deg:g} deg, {epoch_year:g}, "
+            f"S={solar_flux_sfu:g}"
+        )
+        click.echo(f"{'diameter_m':>12} {'tumbling_/m2/yr':>16} {'cross_section_/m2/yr':>21}")
+        for s, v in zip(sizes, f, strict=True):
+            click.echo(f"{s:12.4g} {v:16.5g} {4 * v:21.5g}")
+        table = (
+            tables.nasa90_table(alt, inclination_deg, epoch_year, solar_flux_sfu=solar_flux_sfu)
+            if write_table
+            else None
+        )
+    else:
+        fac = fx.meteoroid_earth_factors(alt)
+        masses = fx.sphere_mass_kg(sizes, fx.METEOROID_DENSITY_KG_M3)
+        f0 = fx.grun_flux_interplanetary(masses)
+        click.echo(
+            f"Grün meteoroids at {altitude_km:g} km: focusing G={fac.focusing:.3f}, "
+            f"shielding sf={fac.shielding:.3f}, "
+            f"motion K={fac.motion:.3f}, density {fx.METEOROID_DENSITY_KG_M3:g} kg/m3"
+        )
+        click.echo(
+            f"{'diameter_m':>12} {'mass_kg':>12} {'1AU_/m2/yr':>12} {'orbit_plate_/m2/yr':>19} "
+            f"{'cross_section':>14}"
+        )
+        for s, m, v in zip(sizes, masses, f0, strict=True):
+            click.echo(f"{s:12.4g} {m:12.4g} {v:12.5g} {v * fac.total:19.5g} {4 * v * fac.total:14.5g}")
+        table = tables.grun_table(alt) if write_table else None
+    if table is not None and write_table:
+        tables.write_flux_table(table, write_table)
+        click.echo(f"flux table written to {write_table}", err=True)
+
+
+@rates.command("import-ordem")
+@click.argument("size_file", type=click.Path(exists=True, dir_okay=False))
+@click.argument("igloo_file", type=click.Path(exists=True, dir_okay=False))
+@click.option(
+    "--out",
+    type=click.Path(dir_okay=False),
+    required=True,
+    help="Manifest (.toml) of the flux table to write.",
+)
+@click.option("--name", default="ORDEM", show_default=True)
+@click.option("--altitude-km", type=float, default=float("nan"))
+@click.option("--inclination-deg", type=float, default=float("nan"))
+@click.option("--epoch", "epoch_year", type=float, default=float("nan"))
+@click.option(
+    "--flux-convention",
+    type=click.Choice(["cross_section", "tumbling"]),
+    default="cross_section",
+    show_default=True,
+)
+@click.option(
+    "--intact-class", type=click.Choice(["nak", "low", "medium", "high"]), default="high", show_default=True
+)
+def import_ordem_command(
+    size_file: str,
+    igloo_file: str,
+    out: str,
+    name: str,
+    altitude_km: float,
+    inclination_deg: float,
+    epoch_year: float,
+    flux_convention: str,
+    intact_class: str,
+) -> None:
+    """Convert ORDEM 3.x spacecraft-mode size and igloo tables into an abrupt flux table."""
+    from abrupt.rates.ordem import _read_numeric, describe_mapping, import_ordem
+    from abrupt.rates.tables import write_flux_table
+
+    header, _, _ = _read_numeric(Path(size_file))
+    for col, meaning in describe_mapping(header).items():
+        click.echo(f"  {col}: {meaning}", err=True)
+    table = import_ordem(
+        size_file,
+        igloo_file,
+        name=name,
+        altitude_km=altitude_km,
+        inclination_deg=inclination_deg,
+        epoch_year=epoch_year,
+        flux_convention=flux_convention,
+        intact_class=intact_class,
+    )
+    write_flux_table(table, out)
+    click.echo(
+        f"{len(table.classes)} class(es) x {table.sizes_m.size} sizes, "
+        f"{table.directions.weight.size} direction "
+        f"bins -> {out}"
+    )

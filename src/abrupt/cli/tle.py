@@ -1,1 +1,260 @@
-"""Command-line commands for this capability (registered on the shared groups)."""
+"""Command-line commands for TLE/OMM maneuver detection and for scoring events against truth.
+
+``abrupt detect tle FILE --out EVENTS.csv``   detect maneuvers in a TLE/3LE/OMM history;
+``abrupt report tle FILE --events EVENTS.csv`` element series with detections (and truth);
+``abrupt score EVENTS --truth TRUTH``          precision, recall, F1 and recall at a false-alarm rate.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import click
+
+from abrupt.cli.groups import catalog_option, cli, detect, record_run, report, spacecraft_name_option
+
+norad_option = click.option(
+    "--norad",
+    "norad_id",
+    type=int,
+    default=None,
+    help="Catalog number to select in a file of several satellites.",
+)
+
+
+@detect.command("tle")
+@click.argument("path", type=click.Path(exists=True, dir_okay=False))
+@click.option("--out", type=click.Path(dir_okay=False), default=None, help="Events file (.csv or .parquet).")
+@norad_option
+@spacecraft_name_option
+@click.option(
+    "--false-alarms-per-year",
+    type=float,
+    default=1.0,
+    show_default=True,
+    help="False-alarm budget per satellite-year that sets the threshold.",
+)
+@click.option(
+    "--threshold", type=float, default=None, help="Fixed threshold on the statistic (overrides the budget)."
+)
+@click.option(
+    "--window-sets",
+    type=int,
+    default=6,
+    show_default=True,
+    help="Element sets each side of a gap in the step test.",
+)
+@click.option(
+    "--all-candidates",
+    is_flag=True,
+    help="Also write sub-threshold candidates (for recall-versus-false-alarm curves); "
+    "'statistic >= threshold' selects detections.",
+)
+@catalog_option
+def detect_tle(
+    path: str,
+    out: str | None,
+    norad_id: int | None,
+    pseudonym: str | None,
+    false_alarms_per_year: float,
+    threshold: float | None,
+    window_sets: int,
+    all_candidates: bool,
+    catalog_target: str,
+) -> None:
+    """Detect maneuvers in a TLE, 3LE or OMM (XML, KVN, JSON, CSV) history of one satellite.
+
+    Example: abrupt detect tle Jason-3.tle --out jason3_events.csv
+    """
+    from dataclasses import asdict
+
+    from abrupt.detect.tle_maneuvers import TleDetectorConfig, detect_tle_maneuvers
+    from abrupt.events import config_hash, new_run_id
+    from abrupt.readers.omm import read_elements
+
+    try:
+        cfg = TleDetectorConfig(
+            window_sets=window_sets, false_alarms_per_year=false_alarms_per_year, threshold=threshold
+        )
+    except ValueError as exc:
+        raise click.BadParameter(str(exc)) from None
+    history = read_elements(path, norad_id=norad_id)
+    for line in history.repairs.summary():
+        click.echo(f"repaired: {line}", err=True)
+    run_id = new_run_id()
+    events = detect_tle_maneuvers(
+        history, cfg, spacecraft=pseudonym, run_id=run_id, all_candidates=all_candidates
+    )
+    details: dict[str, Any] = {
+        "element_sets": len(history),
+        "first_epoch_utc": str(history.elements["epoch_utc"].iloc[0]),
+        "last_epoch_utc": str(history.elements["epoch_utc"].iloc[-1]),
+        "repairs": history.repairs.as_dict(),
+        "config": asdict(cfg),
+    }
+    record_run(
+        catalog_target=catalog_target,
+        command="detect tle",
+        events=events,
+        config_hash=config_hash(asdict(cfg)),
+        run_id=run_id,
+        input_path=path,
+        out=out,
+        details=details,
+    )
+
+
+@report.command("tle")
+@click.argument("path", type=click.Path(exists=True, dir_okay=False))
+@click.option(
+    "--events",
+    "events_path",
+    type=click.Path(exists=True, dir_okay=False),
+    default=None,
+    help="Events file from 'abrupt detect tle' (default: run detection now).",
+)
+@click.option(
+    "--truth",
+    type=click.Path(exists=True, dir_okay=False),
+    default=None,
+    help="Operator maneuver file (IDS format) or events file.",
+)
+@click.option("--tolerance-days", type=float, default=1.0, show_default=True)
+@click.option("--out", type=click.Path(dir_okay=False), required=True, help="Figure file (.png, .svg, .pdf).")
+@norad_option
+def report_tle(
+    path: str,
+    events_path: str | None,
+    truth: str | None,
+    tolerance_days: float,
+    out: str,
+    norad_id: int | None,
+) -> None:
+    """Element series of a TLE/OMM history with detected maneuvers and (optionally) the operator's."""
+    from abrupt.detect.tle_maneuvers import detect_tle_maneuvers
+    from abrupt.events import read_events
+    from abrupt.readers.omm import read_elements
+    from abrupt.report.tle import plot_tle_report
+
+    history = read_elements(path, norad_id=norad_id)
+    events = read_events(events_path) if events_path else detect_tle_maneuvers(history)
+    truth_frame = _read_truth(truth) if truth else None
+    written = plot_tle_report(history, events, out, truth=truth_frame, tolerance_s=tolerance_days * 86400.0)
+    click.echo(f"report written to {written}", err=True)
+
+
+def _read_truth(path: str) -> Any:
+    """Truth list: an events file (.csv/.parquet with the event columns) or an IDS maneuver file."""
+    from abrupt.events import read_events
+    from abrupt.readers.ids_maneuvers import read_ids_maneuvers
+
+    if path.lower().endswith((".parquet", ".pq")):
+        return read_events(path)
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        first = fh.readline()
+    if first.startswith("event_id,"):
+        return read_events(path)
+    return read_ids_maneuvers(path)
+
+
+@cli.command("score")
+@click.argument("events_path", type=click.Path(exists=True, dir_okay=False))
+@click.option(
+    "--truth",
+    type=click.Path(exists=True, dir_okay=False),
+    required=True,
+    help="Operator maneuver file (IDS format, TAI epochs) or an events file.",
+)
+@click.option(
+    "--tolerance-days",
+    type=float,
+    default=1.0,
+    show_default=True,
+    help="One-to-one matching tolerance ± days.",
+)
+@click.option(
+    "--elements",
+    type=click.Path(exists=True, dir_okay=False),
+    default=None,
+    help="The TLE/OMM file the events came from: its span limits the truth and gives the satellite-years.",
+)
+@click.option(
+    "--start", default=None, help="Start of the observed span (ISO UTC), if --elements is not given."
+)
+@click.option("--end", default=None, help="End of the observed span (ISO UTC).")
+@click.option(
+    "--false-alarms-per-year",
+    "fa_rates",
+    type=float,
+    multiple=True,
+    default=(1.0,),
+    show_default=True,
+    help="Operating points for recall at a false-alarm rate (repeatable).",
+)
+@click.option(
+    "--json",
+    "json_out",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Also write the figures as JSON.",
+)
+def score(
+    events_path: str,
+    truth: str,
+    tolerance_days: float,
+    elements: str | None,
+    start: str | None,
+    end: str | None,
+    fa_rates: tuple[float, ...],
+    json_out: str | None,
+) -> None:
+    """Score detections against truth: precision, recall, F1, and recall at false alarms per satellite-year.
+
+    Example: abrupt score jason3_events.csv --truth ja3man.txt --elements Jason-3.tle
+    """
+    from abrupt.events import read_events
+    from abrupt.score import recall_at_false_alarm_rate, score_events
+
+    events = read_events(events_path)
+    truth_frame = _read_truth(truth)
+    if elements:
+        from abrupt.readers.omm import read_elements
+
+        el = read_elements(elements).elements
+        start, end = str(el["epoch_utc"].iloc[0]), str(el["epoch_utc"].iloc[-1])
+    tol = tolerance_days * 86400.0
+    result = score_events(events, truth_frame, tolerance_s=tol, start=start, end=end)
+    out: dict[str, Any] = {"events": events_path, "truth": truth, **result.as_dict()}
+    click.echo(
+        f"tolerance ±{tolerance_days:g} d, one-to-one: {result.n_detections} detections, "
+        f"{result.n_truth} truth"
+        + (
+            f" ({result.n_truth_outside_span} outside the observed span ignored)"
+            if result.n_truth_outside_span
+            else ""
+        )
+    )
+    click.echo(
+        f"TP {result.true_positives}  FP {result.false_positives}  FN {result.false_negatives}  "
+        f"precision {result.precision:.3f}  recall {result.recall:.3f}  F1 {result.f1:.3f}"
+    )
+    if start is not None and end is not None:
+        out["operating_points"] = []
+        for rate in fa_rates:
+            op = recall_at_false_alarm_rate(
+                events, truth_frame, false_alarms_per_year=rate, start=start, end=end, tolerance_s=tol
+            )
+            click.echo(
+                f"recall at {rate:g} false alarm(s) per satellite-year: {op.recall:.3f} "
+                f"(TP {op.true_positives}, FP {op.false_positives} of {op.allowed_false_alarms:.1f} allowed, "
+                f"cut {op.score_cut:.3g})"
+            )
+            out["operating_points"].append(op.__dict__)
+    else:
+        click.echo(
+            "recall at a false-alarm rate needs the observed span: give --elements or --start/--end", err=True
+        )
+    if json_out:
+        Path(json_out).write_text(json.dumps(out, indent=2, default=str))

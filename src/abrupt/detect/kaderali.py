@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import curve_fit
 
+from abrupt.events import Event, format_time_utc
 from abrupt.model.tracking_measurements import TrackingArrays, wrap_angle
 from abrupt.model.tracking_orbit import ForceModel, propagate_with_stm
 
@@ -113,13 +114,17 @@ class KaderaliResult:
 
 
 def q_from_table(psi: float, config: KaderaliConfig) -> tuple[int, float, float]:
-    """Q band (index, q_r m², q_v m²/s²) for Ψ: the row with the largest lower bound ≤ Ψ (spec §6.4 step 14)."""
+    """Q band (index, q_r m², q_v m²/s²) for Ψ: the row with the largest lower bound ≤ Ψ (spec §6.4/14)."""
     level = 0
     for k, (lower, _, _) in enumerate(config.q_table_km):
         if psi >= lower:
             level = k
     _, qr, qv = config.q_table_km[level]
-    return level, max(qr * KM2_TO_M2, config.q_floor_position_m2), max(qv * KM2_TO_M2, config.q_floor_velocity_m2_s2)
+    return (
+        level,
+        max(qr * KM2_TO_M2, config.q_floor_position_m2),
+        max(qv * KM2_TO_M2, config.q_floor_velocity_m2_s2),
+    )
 
 
 def run_kaderali_filter(
@@ -274,7 +279,9 @@ class CharacterisationFit:
         }
 
 
-def fit_characterisation(dv_mps: Sequence[float], y: Sequence[float], model: str = "log") -> CharacterisationFit:
+def fit_characterisation(
+    dv_mps: Sequence[float], y: Sequence[float], model: str = "log"
+) -> CharacterisationFit:
     """Least-squares fit of one thesis model; R² and adjusted R² = 1 − (1−R²)(n−1)/(n−p) (spec §7.2).
 
     The square model is fitted as y² = c + b x (the thesis's form) with R² computed on y².
@@ -288,9 +295,13 @@ def fit_characterisation(dv_mps: Sequence[float], y: Sequence[float], model: str
     p = len(names)
     if n < p:
         raise ValueError(f"{model} fit needs at least {p} points, got {n}")
+    coef_t: tuple[float, ...]
     if model == "linear":
-        coef, cov = np.polyfit(x, yy, 1, cov=n > p + 1) if n > p + 1 else (np.polyfit(x, yy, 1), np.zeros((2, 2)))
+        coef = np.polyfit(x, yy, 1)
+        a_lin = np.column_stack([x, np.ones(n)])
         coef_t = (float(coef[0]), float(coef[1]))
+        res_lin = yy - a_lin @ coef
+        cov = float(res_lin @ res_lin) / max(n - p, 1) * np.linalg.pinv(a_lin.T @ a_lin)
         resid = yy - func(x, *coef_t)
         target = yy
     elif model == "square":
@@ -339,7 +350,7 @@ def _fit_nonlinear(
 
 @dataclass(frozen=True)
 class DeltaVEstimate:
-    """Δv (m/s) from an observed K_max through a calibration fit, with a 1-σ uncertainty; NaN if undetermined."""
+    """Δv (m/s) from an observed K_max through a calibration fit, ±1 σ; NaN if undetermined."""
 
     dv_mps: float
     sigma_mps: float
@@ -396,9 +407,71 @@ def thesis_apogee_transverse_fit() -> CharacterisationFit:
 
 
 def direction_heuristic(k_max: float) -> str:
-    """Thesis apogee direction reading (Section 4.2.1; spec §7.4): K<45 normal, 45-85 transverse, >85 radial."""
+    """Thesis apogee direction reading (Section 4.2.1; spec §7.4): K<45 normal, ≤85 transverse, or radial."""
     if k_max < 45.0:
         return "normal"
     if k_max <= 85.0:
         return "transverse"
     return "radial"
+
+
+def kaderali_events(
+    result: KaderaliResult,
+    *,
+    epoch_utc: np.datetime64,
+    spacecraft: str,
+    run_id: str,
+    config_hash: str,
+    psi_detection_threshold: float,
+    false_alarms_per_day: float,
+    calibration: CharacterisationFit | None = None,
+    merge_gap_s: float = 600.0,
+) -> list[Event]:
+    """Events from the Ψ series: runs of Ψ above the detection threshold (merged across gaps shorter than
+    ``merge_gap_s``), each reported at its K_max (Kaderali 2021 Section 3.3.1) with a Δv from the
+    calibration fit (default: the thesis's apogee transverse log fit; spec §7.3) and the thesis's
+    direction reading in ``extra``."""
+    cal = calibration or thesis_apogee_transverse_fit()
+    above = np.flatnonzero(result.psi > psi_detection_threshold)
+    events: list[Event] = []
+    if above.size == 0:
+        return events
+    groups: list[list[int]] = [[int(above[0])]]
+    for k in above[1:]:
+        if result.t_s[k] - result.t_s[groups[-1][-1]] <= merge_gap_s:
+            groups[-1].append(int(k))
+        else:
+            groups.append([int(k)])
+    k_th = float(k_db(psi_detection_threshold))
+    for g in groups:
+        idx = np.asarray(g)
+        best = int(idx[np.argmax(result.k_db[idx])])
+        k_max = float(result.k_db[best])
+        est = invert_characterisation(cal, k_max, floor=None)
+        spread = float(result.t_s[idx].max() - result.t_s[idx].min())
+        events.append(
+            Event(
+                spacecraft=spacecraft,
+                kind="maneuver",
+                detector="kaderali_k",
+                time_utc=format_time_utc(
+                    epoch_utc + np.timedelta64(round(float(result.t_s[best]) * 1e9), "ns")
+                ),
+                statistic=k_max,
+                threshold=k_th,
+                false_alarms_per_day=false_alarms_per_day,
+                run_id=run_id,
+                config_hash=config_hash,
+                time_sigma_s=max(spread / 2.0, 5.0),
+                dv_mps=est.dv_mps,
+                extra={
+                    "psi_max": float(result.psi[best]),
+                    "dv_sigma_mps": est.sigma_mps,
+                    "dv_calibration_status": est.status,
+                    "direction_heuristic": direction_heuristic(k_max),
+                    "station": result.station[best],
+                    "n_above": int(idx.size),
+                },
+            )
+        )
+    return events

@@ -138,7 +138,8 @@ class WaveletSet:
 
     ``attitude[j]`` and ``rate[j]`` have shape (L, 3): the response of the three channels (error
     quaternion vector part [-]; body rate [rad/s]) to a strike of ``dH_Nms[j]`` N·m·s about body
-    axis ``j``, starting at the telemetry sample at or just before the strike. ``bank_attitude`` and
+    axis ``j``, starting at the telemetry sample at or just before the strike; ``wheel[j]`` (L, N) the
+    wheel speeds relative to their pre-strike value [rad/s] (empty when not built). ``bank_attitude`` and
     ``bank_rate`` have shape (M, 3, L, 3): the same for every size of the ladder ``bank_dH_Nms`` (M,),
     whose first entry is 0 (no strike).
     """
@@ -152,6 +153,7 @@ class WaveletSet:
     bank_rate: FloatArray
     spacecraft: str = ""
     meta: dict[str, Any] = field(default_factory=dict)
+    wheel: FloatArray = field(default_factory=lambda: np.zeros((3, 0, 0)))
 
     @property
     def length(self) -> int:
@@ -178,6 +180,7 @@ class WaveletSet:
             bank_attitude=self.bank_attitude,
             bank_rate=self.bank_rate,
             spacecraft=np.array(self.spacecraft),
+            wheel=self.wheel,
         )
 
     @classmethod
@@ -192,6 +195,7 @@ class WaveletSet:
                 bank_attitude=d["bank_attitude"],
                 bank_rate=d["bank_rate"],
                 spacecraft=str(d["spacecraft"]),
+                wheel=d["wheel"] if "wheel" in d else np.zeros((3, 0, 0)),
             )
 
 
@@ -204,12 +208,14 @@ def strike_responses(
     gain_K_Nm: float = 480.0,
     gain_P_Nms: float = 1080.0,
     lead_s: float = 2.0,
-) -> tuple[FloatArray, FloatArray]:
+    return_wheels: bool = False,
+) -> Any:
     """Noise-free responses to strikes, one simulator run per row of ``dH_B_Nms`` (m, 3) [N·m·s].
 
     Returns (attitude error vector part, body rate [rad/s]), each (m, L, 3) with L = duration x rate,
     starting at the telemetry sample at or just before the strike (the pre-strike state), with the
-    initial attitude as the reference. Runs the attitude simulator in batch mode.
+    initial attitude as the reference; with ``return_wheels`` also the wheel speeds relative to their
+    pre-strike value (m, L, N) [rad/s]. Runs the attitude simulator in batch mode.
     """
     from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude_batch
 
@@ -227,7 +233,11 @@ def strike_responses(
     i0 = int(np.searchsorted(out["t_s"], lead_s + 1e-9, side="right")) - 1
     q = out["true_q_BN"]
     att = np.stack([attitude_error_vector(q[r], q[r, 0]) for r in range(dh.shape[0])])
-    return att[:, i0 : i0 + n].copy(), out["true_omega_B_rad_s"][:, i0 : i0 + n].copy()
+    if not return_wheels:
+        return att[:, i0 : i0 + n].copy(), out["true_omega_B_rad_s"][:, i0 : i0 + n].copy()
+    wheels = out["true_wheel_speed_rad_s"]
+    wheels = wheels[:, i0 : i0 + n] - wheels[:, i0 : i0 + 1]
+    return att[:, i0 : i0 + n].copy(), out["true_omega_B_rad_s"][:, i0 : i0 + n].copy(), wheels.copy()
 
 
 def largest_unsaturated_strike_Nms(
@@ -286,7 +296,7 @@ def build_wavelets(
     kw: dict[str, Any] = dict(
         sample_rate_hz=sample_rate_hz, duration_s=duration_s, gain_K_Nm=gain_K_Nm, gain_P_Nms=gain_P_Nms
     )
-    att, rate = strike_responses(spacecraft, np.diag(sizes), **kw)
+    att, rate, wheel = strike_responses(spacecraft, np.diag(sizes), return_wheels=True, **kw)
     dh_bank = np.concatenate([d * np.eye(3) for d in ladder])  # (3M, 3)
     b_att, b_rate = strike_responses(spacecraft, dh_bank, **kw)
     shape = (ladder.size, 3, att.shape[1], 3)
@@ -301,6 +311,7 @@ def build_wavelets(
         bank_rate=bank_rate,
         spacecraft=str(getattr(spacecraft, "name", "")),
         meta={"gain_K_Nm": gain_K_Nm, "gain_P_Nms": gain_P_Nms, "duration_s": duration_s},
+        wheel=wheel,
     )
 
 
@@ -672,6 +683,58 @@ def _time_sigma_s(wavelet: FloatArray, scale: float, noise_sd: float, sample_rat
     return max(floor, noise_sd / denom)
 
 
+def refine_strike(
+    channels: FloatArray, peak: int, combined: CombinedFilter, baseline_samples: int
+) -> tuple[int, FloatArray, float]:
+    """Maximum-likelihood strike sample, size and time sigma around a detection of :class:`CombinedFilter`.
+
+    The sliding statistic compares differently-baselined data at each lag, so with the wheel step its
+    argmax drifts late. Here one window of +-L/2 lags around ``peak`` (plus the response length) is
+    referred to one baseline (the ``baseline_samples`` before it), and each candidate strike sample d
+    is fitted by least squares with the response placed at d and held at its final value to the end of
+    the window (the momentum stays in the wheels). The best d maximises the explained energy
+    E_d = b_d^T G_d^-1 b_d (twice the log-likelihood ratio); the time sigma is the spread of the
+    likelihood profile exp(E_d / 2) over d, in samples, floored at one sample.
+    Returns (sample index, dH_hat_B [N·m·s], sigma [samples]).
+    """
+    resp = combined.response / combined.noise_sd[None, :, None]  # whitened (L, C, 3)
+    length = resp.shape[0]
+    half = length // 2
+    lo = peak - half
+    hi = peak + half + length
+    n = channels.shape[0]
+    if lo - baseline_samples < 0 or hi > n:
+        return peak, np.full(3, np.nan), 1.0
+    window = channels[lo:hi]
+    base = (
+        channels[lo - baseline_samples : lo].mean(axis=0)
+        if baseline_samples > 0
+        else np.zeros(channels.shape[1])
+    )
+    y = (window - base) / combined.noise_sd
+    if not np.all(np.isfinite(y)):
+        return peak, np.full(3, np.nan), 1.0
+    m = hi - lo
+    energy = np.full(2 * half + 1, -np.inf)
+    estimates = np.full((2 * half + 1, 3), np.nan)
+    ext = np.empty((m, resp.shape[1], 3))
+    for d in range(2 * half + 1):
+        ext[:d] = 0.0
+        ext[d : d + length] = resp
+        ext[d + length :] = resp[-1]
+        b = np.einsum("kcj,kc->j", ext, y)
+        g = np.einsum("kcj,kci->ji", ext, ext)
+        est = np.linalg.solve(g, b)
+        energy[d] = float(b @ est)
+        estimates[d] = est
+    best = int(np.argmax(energy))
+    weight = np.exp(0.5 * (energy - energy[best]))
+    lags = np.arange(energy.size, dtype=np.float64)
+    mean = float(np.sum(weight * lags) / np.sum(weight))
+    sigma = max(1.0, math.sqrt(float(np.sum(weight * (lags - mean) ** 2) / np.sum(weight))))
+    return lo + best, estimates[best], sigma
+
+
 def detections_to_events(
     detections: pd.DataFrame,
     *,
@@ -756,14 +819,28 @@ class CombinedFilter:
     gram: FloatArray  # (3, 3)
 
     @classmethod
-    def from_wavelets(cls, wavelets: WaveletSet, noise_sd: ArrayLike) -> CombinedFilter:
+    def from_wavelets(
+        cls, wavelets: WaveletSet, noise_sd: ArrayLike, *, use_wheels: bool = False
+    ) -> CombinedFilter:
+        """Joint filter on attitude and rate (6 channels), and with ``use_wheels`` the N wheel speeds.
+
+        ``noise_sd``: 3 attitude (error-quaternion component), 3 rate [rad/s], then N wheel [rad/s].
+        The wheel channels see the strike as a persistent step (the momentum ends in the wheels), so
+        they must be used with a baseline (``baseline_samples > 0``).
+        """
         sd = np.asarray(noise_sd, dtype=np.float64)
-        if sd.shape != (6,) or np.any(sd <= 0):
-            raise ValueError("noise_sd must give six positive values (3 attitude, 3 rate)")
-        resp = np.empty((wavelets.length, 6, 3))
+        n_wheels = wavelets.wheel.shape[2] if use_wheels else 0
+        if use_wheels and wavelets.wheel.shape[1] != wavelets.length:
+            raise ValueError("this wavelet set has no wheel responses; rebuild it with build_wavelets")
+        n_ch = 6 + n_wheels
+        if sd.shape != (n_ch,) or np.any(sd <= 0):
+            raise ValueError(f"noise_sd must give {n_ch} positive values (3 attitude, 3 rate, wheels)")
+        resp = np.empty((wavelets.length, n_ch, 3))
         for j in range(3):
             resp[:, :3, j] = wavelets.attitude[j] / wavelets.dH_Nms[j]
-            resp[:, 3:, j] = wavelets.rate[j] / wavelets.dH_Nms[j]
+            resp[:, 3:6, j] = wavelets.rate[j] / wavelets.dH_Nms[j]
+            if n_wheels:
+                resp[:, 6:, j] = wavelets.wheel[j] / wavelets.dH_Nms[j]
         white = resp / sd[None, :, None]
         gram = np.einsum("kcj,kci->ji", white, white)
         return cls(response=resp, noise_sd=sd, gram=gram)
@@ -771,12 +848,13 @@ class CombinedFilter:
     def statistic(self, channels: ArrayLike, *, baseline_samples: int = 0) -> tuple[FloatArray, FloatArray]:
         """(T (n,), dH_hat_B (n, 3) [N·m·s]) for channels (n, 6) = attitude vector part, rates [rad/s]."""
         x = np.asarray(channels, dtype=np.float64)
-        if x.ndim != 2 or x.shape[1] != 6:
-            raise ValueError(f"channels must have shape (n, 6), got {x.shape}")
+        n_ch = self.noise_sd.size
+        if x.ndim != 2 or x.shape[1] != n_ch:
+            raise ValueError(f"channels must have shape (n, {n_ch}), got {x.shape}")
         white = self.response / self.noise_sd[None, :, None] ** 2
         b = np.zeros((x.shape[0], 3))
         for j in range(3):
-            for c in range(6):
+            for c in range(n_ch):
                 s = white[:, c, j]
                 if not np.any(s):
                     continue
@@ -813,6 +891,7 @@ def detect_combined(
     wavelets: WaveletSet,
     threshold: Threshold,
     *,
+    wheel_speed_rad_s: ArrayLike | None = None,
     noise_sd: ArrayLike | None = None,
     reference_q_BN: ArrayLike | None = None,
     baseline_samples: int | None = None,
@@ -820,19 +899,26 @@ def detect_combined(
     """Detections of the joint filter (:class:`CombinedFilter`); columns of :func:`detect_matched_filter`.
 
     ``threshold`` is on T (chi-square with 3 dof in white noise; fit it with
-    ``fit_threshold(null_T, ..., method="gamma")`` or use :func:`chi2_threshold`). ``noise_sd`` (6,)
-    defaults to :func:`robust_noise_sd` of the channels. The strike estimate is the least-squares
-    dH_hat, not the bank (``dH_B_*`` and ``dH_ls_B_*`` are equal).
+    ``fit_threshold(null_T, ..., method="gamma")`` or use :func:`chi2_threshold`). With
+    ``wheel_speed_rad_s`` (n, N; relative to the body) the wheel channels join the filter (detector
+    ``mf_joint``; a baseline is then always used, 120 s unless given), otherwise the six attitude and
+    rate channels (``mf_combined``). ``noise_sd`` defaults to :func:`robust_noise_sd` of the channels.
+    The strike estimate is the least-squares dH_hat, not the bank (``dH_B_*`` = ``dH_ls_B_*``).
     """
     q = np.asarray(q_BN, dtype=np.float64)
     t = np.asarray(time)
     ch = combined_channels(q, omega_B_rad_s, reference_q_BN)
     baseline_samples = resolve_baseline(baseline_samples, reference_q_BN, wavelets.sample_rate_hz)
+    use_wheels = wheel_speed_rad_s is not None
+    if use_wheels:
+        ch = np.column_stack([ch, np.asarray(wheel_speed_rad_s, dtype=np.float64)])
+        if baseline_samples == 0:
+            baseline_samples = round(DEFAULT_BASELINE_S * wavelets.sample_rate_hz)
     if ch.shape[0] != t.shape[0]:
-        raise ValueError("time, q_BN and omega must have the same length")
+        raise ValueError("time, q_BN, omega and wheel speeds must have the same length")
     sd = robust_noise_sd(ch) if noise_sd is None else np.asarray(noise_sd, dtype=np.float64)
-    filt = CombinedFilter.from_wavelets(wavelets, sd)
-    stat, dh = filt.statistic(ch, baseline_samples=baseline_samples)
+    filt = CombinedFilter.from_wavelets(wavelets, sd, use_wheels=use_wheels)
+    stat, _ = filt.statistic(ch, baseline_samples=baseline_samples)
     score = np.where(np.isfinite(stat), stat, -np.inf)
     above = np.flatnonzero(score > threshold.value)
     rows: list[dict[str, Any]] = []
@@ -840,14 +926,14 @@ def detect_combined(
         breaks = np.flatnonzero(np.diff(above) > wavelets.length) + 1
         for group in np.split(above, breaks):
             i = int(group[np.argmax(score[group])])
-            dh_b = dh[i]
+            i, dh_b, sigma_samples = refine_strike(ch, i, filt, baseline_samples)
             dh_n = dcm_from_quaternion(q[i]).T @ dh_b if np.all(np.isfinite(q[i])) else np.full(3, np.nan)
             rows.append(
                 {
                     "index": i,
                     "time": t[i],
-                    "time_sigma_s": 1.0 / wavelets.sample_rate_hz,
-                    "detector": "mf_combined",
+                    "time_sigma_s": sigma_samples / wavelets.sample_rate_hz,
+                    "detector": "mf_joint" if use_wheels else "mf_combined",
                     "axis": int(np.argmax(np.abs(dh_b))),
                     "statistic": float(stat[i]),
                     "threshold": float(threshold.value),
@@ -905,7 +991,7 @@ class CombinedFilterStream:
         white = combined.response / combined.noise_sd[None, :, None] ** 2
         self._streams: list[tuple[int, int, MatchedFilterStream]] = []
         for j in range(3):
-            for c in range(6):
+            for c in range(combined.noise_sd.size):
                 s = white[:, c, j]
                 if np.any(s):
                     stream = MatchedFilterStream(
@@ -922,8 +1008,8 @@ class CombinedFilterStream:
 
     def update(self, rows: ArrayLike) -> tuple[FloatArray, FloatArray]:
         x = np.atleast_2d(np.asarray(rows, dtype=np.float64))
-        if x.shape[1] != 6:
-            raise ValueError(f"rows must have 6 channels, got {x.shape}")
+        if x.shape[1] != self._filter.noise_sd.size:
+            raise ValueError(f"rows must have {self._filter.noise_sd.size} channels, got {x.shape}")
         return self._finish([(j, st.update(x[:, c])) for j, c, st in self._streams])
 
     def flush(self) -> tuple[FloatArray, FloatArray]:
@@ -972,6 +1058,7 @@ def detect_strikes(
     wavelets: WaveletSet,
     *,
     kinds: Sequence[str] = ("attitude", "rate"),
+    wheel_speed_rad_s: ArrayLike | None = None,
     false_alarms_per_day: float = 1.0,
     thresholds: dict[str, Any] | None = None,
     reference_q_BN: ArrayLike | None = None,
@@ -980,12 +1067,14 @@ def detect_strikes(
 ) -> tuple[pd.DataFrame, dict[str, Any]]:
     """One call for a telemetry table: matched-filter detections of every requested kind.
 
-    ``kinds`` from ``"attitude"``, ``"rate"`` (Bennett 2022 §2.4.1 per-axis filters) and ``"combined"``
-    (the joint GLRT, :class:`CombinedFilter`). ``thresholds`` maps a kind to its thresholds (three
-    :class:`Threshold` for attitude/rate, one on T for combined), e.g. fitted on event-free data with
-    :func:`fit_matched_filter_thresholds`; missing kinds are set from the series itself for
-    ``false_alarms_per_day`` (robust Gaussian per axis; chi-square(3) for combined). The time step must
-    match ``wavelets.sample_rate_hz`` (build the wavelets at the telemetry rate).
+    ``kinds`` from ``"attitude"``, ``"rate"`` (Bennett 2022 §2.4.1 per-axis filters), ``"combined"``
+    (the GLRT on attitude and rate, :class:`CombinedFilter`) and ``"joint"`` (the same with the wheel
+    speeds ``wheel_speed_rad_s`` (n, N) [rad/s, relative to the body], the most sensitive).
+    ``thresholds`` maps a kind to its thresholds (three :class:`Threshold` for attitude/rate, one on T
+    for combined/joint), e.g. fitted on event-free data with :func:`fit_matched_filter_thresholds`;
+    missing kinds are set from the series itself for ``false_alarms_per_day`` (robust Gaussian per
+    axis; chi-square(3) for combined/joint). The time step must match ``wavelets.sample_rate_hz``
+    (build the wavelets at the telemetry rate).
 
     Returns (detections with :data:`DETECTION_COLUMNS`, the thresholds used per kind).
     """
@@ -1027,7 +1116,9 @@ def detect_strikes(
                     statistic=stat,
                 )
             )
-        elif kind == "combined":
+        elif kind in ("combined", "joint"):
+            if kind == "joint" and wheel_speed_rad_s is None:
+                raise ValueError("the joint filter needs wheel_speed_rad_s")
             if kind not in used:
                 used[kind] = chi2_threshold(
                     false_alarms_per_day=false_alarms_per_day, sample_rate_hz=wavelets.sample_rate_hz
@@ -1039,12 +1130,15 @@ def detect_strikes(
                     omega_B_rad_s,
                     wavelets,
                     used[kind],
+                    wheel_speed_rad_s=wheel_speed_rad_s if kind == "joint" else None,
                     reference_q_BN=reference_q_BN,
                     baseline_samples=baseline_samples,
                 )
             )
         else:
-            raise ValueError(f"unknown matched-filter kind {kind!r}; choose attitude, rate or combined")
+            raise ValueError(
+                f"unknown matched-filter kind {kind!r}; choose attitude, rate, combined or joint"
+            )
     frames = [f for f in frames if not f.empty]
     out = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=DETECTION_COLUMNS)
     return out.sort_values("index", kind="stable").reset_index(drop=True), used

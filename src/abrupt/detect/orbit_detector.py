@@ -21,6 +21,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from abrupt.detect.orbit_ekf import FilterConfig, FilterRun, run_backward, run_forward
+from abrupt.detect.orbit_glr import JumpEstimate, localise_jump
 from abrupt.detect.orbit_statistics import (
     STATISTIC_NAMES,
     FusionResult,
@@ -29,7 +30,7 @@ from abrupt.detect.orbit_statistics import (
 )
 from abrupt.events import Event, config_hash, empty_frame, events_frame
 from abrupt.model.frames import Ephemeris, rtn_matrix
-from abrupt.thresholds import Threshold, fit_threshold
+from abrupt.thresholds import Threshold, fit_threshold, gpd_quantile, p_fa_per_sample
 
 FloatArray = NDArray[np.float64]
 SECONDS_PER_WEEK = 7 * 86400.0
@@ -47,6 +48,12 @@ class OrbitDetectorConfig:
     ``settle_s``: epochs this close to either end are not evaluated (filters still converging).
     ``merge_s``: exceedances closer than this form one event.
     ``oc_q_factor``, ``oc_window_s``: TS6 filter tuning (q × 100, §3.3.6) and averaging window.
+    ``localise``: "glr" estimates each event's time and ΔV by the generalised likelihood ratio over
+    ±``glr_search_s`` around the statistic's peak with ``glr_horizon_s`` of data after the window
+    (:mod:`abrupt.detect.orbit_glr`); "peak" uses the ``mcr_w`` peak.
+    ``dv_estimate``: "fb" (default) reports the thesis TS1 difference v_B − v_F at the last epoch
+    before the located jump (robust to unmodelled dynamics on real data); "glr" the GLR estimate
+    (best when the filter dynamics match the truth). The other is in extra columns ``dv_glr_*``.
     """
 
     filter: FilterConfig = field(default_factory=FilterConfig)
@@ -60,6 +67,10 @@ class OrbitDetectorConfig:
     oc_window_s: float = 600.0
     orbital_constants: bool = True
     kind: str = "unknown"
+    localise: str = "glr"
+    glr_horizon_s: float = 1800.0
+    glr_search_s: float = 1200.0
+    dv_estimate: str = "fb"
 
     def __post_init__(self) -> None:
         if self.statistic not in STATISTIC_NAMES:
@@ -68,6 +79,10 @@ class OrbitDetectorConfig:
             raise ValueError("false_alarms_per_day must be positive")
         if self.sigma_pos_m <= 0 or self.sigma_vel_mps <= 0:
             raise ValueError("measurement sigmas must be positive")
+        if self.dv_estimate not in ("fb", "glr"):
+            raise ValueError("dv_estimate must be 'fb' or 'glr'")
+        if self.localise not in ("glr", "peak"):
+            raise ValueError("localise must be 'glr' or 'peak'")
         if self.kind not in ("strike", "maneuver", "unknown"):
             raise ValueError("kind must be 'strike', 'maneuver' or 'unknown'")
 
@@ -154,7 +169,7 @@ def self_calibrate(
     analysis: OrbitAnalysis,
     *,
     false_alarms_per_day: float | None = None,
-    leave_out_s: float = 1800.0,
+    leave_out_s: float | None = None,
     outlier_sigma: float = 8.0,
     iterations: int = 3,
     names: tuple[str, ...] | None = None,
@@ -163,14 +178,17 @@ def self_calibrate(
 
     Procedure (documented in docs/orbit.md; nothing depends on a particular satellite):
     1. robust scale: median and 1.4826·MAD of the statistic over the valid epochs;
-    2. leave-out: epochs within ``leave_out_s`` of any value above median + ``outlier_sigma``·scale
+    2. leave-out: epochs within ``leave_out_s`` (default max(1800 s, 2 × settle_s)) of any value above median + ``outlier_sigma``·scale
        are removed (candidate events must not inflate their own threshold); repeat ``iterations``
        times with the new median/scale;
-    3. the remaining values are fitted with a generalised Pareto tail (peaks over the 98 % quantile)
+    3. the remaining values are fitted with a generalised Pareto tail (peaks over the 98 % quantile,
+       or the top 40 values on short arcs)
        and the threshold is the value exceeded with probability P_fa per sample for the budget
        ``false_alarms_per_day`` at the data rate.
     """
     rate = analysis.sample_rate_hz
+    if leave_out_s is None:
+        leave_out_s = max(1800.0, 2.0 * analysis.config.settle_s)
     fa = false_alarms_per_day if false_alarms_per_day is not None else analysis.config.false_alarms_per_day
     out: dict[str, Threshold] = {}
     t = analysis.t_s
@@ -180,6 +198,8 @@ def self_calibrate(
         if keep.sum() < 100:
             continue
         for _ in range(iterations):
+            if keep.sum() < 100:
+                break
             med = float(np.median(s[keep]))
             scale = 1.4826 * float(np.median(np.abs(s[keep] - med)))
             if scale <= 0:
@@ -193,7 +213,18 @@ def self_calibrate(
             keep &= ~drop
         if keep.sum() < 100:
             continue
-        out[name] = fit_threshold(s[keep], false_alarms_per_day=fa, sample_rate_hz=rate, method="gpd")
+        x = s[keep]
+        p_fa = p_fa_per_sample(fa, rate)
+        # peaks over threshold: the upper 2 % (at least 40 samples) of the kept values
+        tail = min(0.5, max(0.02, 40.0 / x.size))
+        out[name] = Threshold(
+            value=gpd_quantile(x, p_fa, tail_fraction=tail),
+            p_fa=p_fa,
+            method="gpd",
+            n_samples=int(x.size),
+            false_alarms_per_day=fa,
+            sample_rate_hz=rate,
+        )
     return out
 
 
@@ -223,7 +254,15 @@ def find_events(
     thr = thresholds[name]
     s = analysis.statistics[name]
     above = np.flatnonzero(np.nan_to_num(s, nan=-np.inf) > thr.value)
-    extra_cols = ["dv_sigma_mps", "snr", *[f"snr_{k}" for k in thresholds]]
+    extra_cols = [
+        "dv_sigma_mps",
+        "snr",
+        "glr",
+        "dv_glr_r_mps",
+        "dv_glr_t_mps",
+        "dv_glr_n_mps",
+        *[f"snr_{k}" for k in thresholds],
+    ]
     if above.size == 0:
         return empty_frame(extra_cols)
     t = analysis.t_s
@@ -233,6 +272,17 @@ def find_events(
             groups[-1].append(int(k))
         else:
             groups.append([int(k)])
+    # An impulse disturbs the forward filter after it and the backward filter before it for about the
+    # filters' convergence time (§3.2.5: ~50 min with the thesis tuning), so weaker exceedance episodes
+    # within ``suppress_s`` of a stronger one belong to the same event.
+    suppress_s = max(cfg.merge_s, cfg.settle_s)
+    order = sorted(range(len(groups)), key=lambda j: -float(np.nanmax(s[groups[j]])))
+    accepted: list[int] = []
+    for j in order:
+        tj = t[groups[j][int(np.nanargmax(s[groups[j]]))]]
+        if all(abs(tj - t[groups[a][int(np.nanargmax(s[groups[a]]))]]) > suppress_s for a in accepted):
+            accepted.append(j)
+    groups = [groups[j] for j in sorted(accepted)]
     eph = analysis.ephemeris
     sc = spacecraft or eph.satellite
     chash = cfg_hash or config_hash(asdict(cfg))
@@ -246,11 +296,30 @@ def find_events(
         k = int(win[np.argmax(m)]) if np.isfinite(m).any() else int(peak_stat)
         dt_next = t[k + 1] - t[k] if k + 1 < t.size else analysis.ephemeris.nominal_step_s
         t_event = t[k] + 0.5 * dt_next
+        time_sigma = float(dt_next / np.sqrt(12.0))
         xf = analysis.forward.x[k]
-        m_rtn = rtn_matrix(xf[:3], xf[3:6])[0]
         dv_in = analysis.fusion.dv_inertial[k]
-        dv_rtn = m_rtn.T @ dv_in
         cov = analysis.fusion.dv_cov[k]
+        glr_value = float("nan")
+        glr_rtn = np.full(3, np.nan)
+        if cfg.localise == "glr":
+            jump = _localise(analysis, t[peak_stat] - cfg.glr_search_s, t[peak_stat] + cfg.glr_search_s)
+            if jump is not None:
+                k_j = jump.index
+                t_event = jump.time_s if jump.time_s > t[k_j - 1] else t[k_j] - 0.5 * (t[k_j] - t[k_j - 1])
+                time_sigma = jump.time_sigma_s
+                xf = analysis.forward.x[k_j - 1]
+                glr_value = jump.glr
+                glr_rtn = rtn_matrix(xf[:3], xf[3:6])[0].T @ jump.dv_inertial_mps
+                if cfg.dv_estimate == "glr":
+                    dv_in = jump.dv_inertial_mps
+                    cov = jump.dv_cov
+                else:
+                    # TS1 at the last pre-jump epoch: forward saw only pre-jump data, backward only post-jump
+                    dv_in = analysis.fusion.dv_inertial[k_j - 1]
+                    cov = analysis.fusion.dv_cov[k_j - 1]
+        m_rtn = rtn_matrix(xf[:3], xf[3:6])[0]
+        dv_rtn = m_rtn.T @ dv_in
         u = dv_in / max(float(np.linalg.norm(dv_in)), 1e-300)
         dv_sigma = float(np.sqrt(max(0.0, u @ cov @ u)))
         time_utc = eph.times_utc[0] + np.timedelta64(int(round(t_event * 1e9)), "ns")
@@ -271,14 +340,46 @@ def find_events(
                 false_alarms_per_day=thr.false_alarms_per_day,
                 run_id=run_id,
                 config_hash=chash,
-                time_sigma_s=float(dt_next / np.sqrt(12.0)),
+                time_sigma_s=time_sigma,
                 dv_r_mps=float(dv_rtn[0]),
                 dv_t_mps=float(dv_rtn[1]),
                 dv_n_mps=float(dv_rtn[2]),
-                extra={"dv_sigma_mps": dv_sigma, "snr": float(s[peak_stat] / thr.value), **snrs},
+                extra={"dv_sigma_mps": dv_sigma, "snr": float(s[peak_stat] / thr.value), "glr": glr_value,
+                    "dv_glr_r_mps": float(glr_rtn[0]),
+                    "dv_glr_t_mps": float(glr_rtn[1]),
+                    "dv_glr_n_mps": float(glr_rtn[2]),
+                    **snrs,
+                },
             )
         )
     return events_frame(events, extra_columns=extra_cols)
+
+
+def _localise(analysis: OrbitAnalysis, t_from: float, t_to: float) -> JumpEstimate | None:
+    """GLR jump time and ΔV between ``t_from`` and ``t_to`` (s), or None where it cannot be formed."""
+    cfg = analysis.config
+    t = analysis.t_s
+    first = max(1, int(np.searchsorted(t, t_from, side="left")))
+    last = min(t.size - 2, int(np.searchsorted(t, t_to, side="right")))
+    if last <= first:
+        return None
+    eph = analysis.ephemeris
+    try:
+        return localise_jump(
+            t,
+            eph.position_m,
+            eph.velocity_mps,
+            analysis.forward.x,
+            analysis.forward.p,
+            cfg.sigma_pos_m,
+            cfg.sigma_vel_mps,
+            cfg.filter,
+            first,
+            last,
+            cfg.glr_horizon_s,
+        )
+    except (ValueError, np.linalg.LinAlgError):
+        return None
 
 
 def stream_statistics(
@@ -349,8 +450,8 @@ def auto_tune(
     - σ_vel = std(Δ³ m_k)/√70 and σ_pos likewise from the position misses (third differences remove
       any smooth model error; m_k carries the noise difference n_{k+1} − n_k, so Δ³ m_k is a fourth
       difference of white noise, variance 70σ²), floored at ``min_sigma_*``;
-    - data whose step-to-step model error is below the noise (GNSS navigation solutions) fall back
-      to the thesis tuning (Table 3.1) with the estimated sigmas;
+    - data whose step-to-step model error is below the noise get q = 1 % of the noise-equivalent
+      level (for 1 Hz GNSS-like solutions the thesis tuning, Table 3.1, is the better choice);
     - τ = ``tau_factor`` × the nominal step.
 
     Nothing here depends on a particular satellite; the same rule runs on any ephemeris.
@@ -389,11 +490,9 @@ def auto_tune(
     var_signal = float(np.nanmean([_robust_std(d_acc[:, i]) ** 2 for i in range(3)]))
     # white velocity noise enters Δ(m/Δt) with coefficients (1, -2, 1)/Δt: variance 6σ_v²/Δt²
     var_noise = 6.0 * sigma_v**2 / dt_nom**2
-    if var_signal <= 2.0 * var_noise:
-        # Noise-dominated data (e.g. GNSS navigation solutions): the model error is not measurable
-        # step to step; fall back to the thesis tuning (Table 3.1).
-        fc = FilterConfig(zonal_degree=zonal_degree)
-    else:
-        q = (var_signal - var_noise) / dt_nom
-        fc = FilterConfig.isotropic(tau_factor * dt_nom, q, zonal_degree=zonal_degree)
+    # Where the step-to-step model error is not measurable above the noise, q is set to 1 % of the
+    # noise-equivalent level (the filter then trusts its dynamics; for 1 Hz GNSS-like data use the
+    # thesis tuning instead, ``--tuning thesis``).
+    q = max(var_signal - var_noise, 0.01 * var_noise) / dt_nom
+    fc = FilterConfig.isotropic(tau_factor * dt_nom, q, zonal_degree=zonal_degree)
     return fc, sigma_r, sigma_v

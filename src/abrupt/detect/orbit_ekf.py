@@ -486,3 +486,54 @@ def run_backward(
         mirrored,
     )
     return FilterRun(xs, ps)
+
+
+@nb.njit(cache=True)
+def forward_kernel_detailed(
+    t: FloatArray,
+    y: FloatArray,
+    rdiag: FloatArray,
+    x0: FloatArray,
+    p0: FloatArray,
+    tau: float,
+    q_rtn: FloatArray,
+    mu: float,
+    zonal: int,
+    max_step: float,
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Forward filter from the a-posteriori (x0, p0) at t[0], storing per step k ≥ 1 the STM Φ_k,
+    the gain K_k, the inverse innovation covariance S_k⁻¹ and the innovation γ_k (for the GLR)."""
+    n = t.size
+    phis = np.zeros((n, 9, 9))
+    gains = np.zeros((n, 9, 6))
+    sinvs = np.zeros((n, 6, 6))
+    innovs = np.zeros((n, 6))
+    x = x0.copy()
+    p = p0.copy()
+    phi = np.empty((9, 9))
+    s = np.empty((9, 9))
+    pbar = np.empty((9, 9))
+    for i in range(1, n):
+        dt = t[i] - t[i - 1]
+        _process_noise(x, dt, tau, q_rtn, s)
+        x = _propagate(x, dt, tau, mu, zonal, max_step, phi)
+        _time_update_cov(p, phi, s, 1.0, pbar)
+        p[:, :] = pbar
+        phis[i] = phi
+        smat = np.empty((6, 6))
+        for a in range(6):
+            for b in range(6):
+                smat[a, b] = p[a, b]
+            smat[a, a] += rdiag[i, a]
+        sinv = np.linalg.inv(smat)
+        sinvs[i] = sinv
+        for a in range(9):
+            for b in range(6):
+                acc = 0.0
+                for m in range(6):
+                    acc += p[a, m] * sinv[m, b]
+                gains[i, a, b] = acc
+        innov = np.empty(6)
+        _measurement_update(x, p, y[i], rdiag[i], innov)
+        innovs[i] = innov
+    return phis, gains, sinvs, innovs

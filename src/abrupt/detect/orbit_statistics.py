@@ -78,10 +78,43 @@ class FusionResult:
 
 
 @nb.njit(cache=True)
+def _mm9(a: FloatArray, b: FloatArray, out: FloatArray) -> None:
+    for i in range(9):
+        for j in range(9):
+            acc = 0.0
+            for k in range(9):
+                acc += a[i, k] * b[k, j]
+            out[i, j] = acc
+
+
+@nb.njit(cache=True)
+def _inv3(m: FloatArray) -> FloatArray:
+    a, b, c = m[0, 0], m[0, 1], m[0, 2]
+    d, e, f = m[1, 0], m[1, 1], m[1, 2]
+    g, h, k = m[2, 0], m[2, 1], m[2, 2]
+    det = a * (e * k - f * h) - b * (d * k - f * g) + c * (d * h - e * g)
+    out = np.empty((3, 3))
+    out[0, 0] = (e * k - f * h) / det
+    out[0, 1] = (c * h - b * k) / det
+    out[0, 2] = (b * f - c * e) / det
+    out[1, 0] = (f * g - d * k) / det
+    out[1, 1] = (a * k - c * g) / det
+    out[1, 2] = (c * d - a * f) / det
+    out[2, 0] = (d * h - e * g) / det
+    out[2, 1] = (b * g - a * h) / det
+    out[2, 2] = (a * e - b * d) / det
+    return out
+
+
+@nb.njit(cache=True)
 def fusion_kernel(
     xf: FloatArray, pf: FloatArray, xb: FloatArray, pb: FloatArray
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
     """Fraser-Potter fusion and TS1-TS4 at every epoch (see module docstring).
+
+    Uses the identities of the optimal two-filter fusion (exact in exact arithmetic):
+    W_F = P̄_B S⁻¹ with S = P_F + P̄_B, X_S = X̄_B + W_F d (d = X_F − X̄_B),
+    P_S = W_F P_F = P̄_B S⁻¹ P_F (equal to Eq. 3.56), X_D = (I − W_F) d, P_D = P_F S⁻¹ P_F.
 
     Returns (x_s, diag P_s, Δv = v_B − v_F, cov of Δv (P_F,vv + P̄_B,vv), McReynolds per state,
     [mahalanobis_v, mcr_scalar, mcr_scalar_printed] (n, 3), |w_S| (n)).
@@ -94,14 +127,22 @@ def fusion_kernel(
     mcr = np.empty((n, 9))
     scal = np.empty((n, 3))
     wmag = np.empty(n)
-    eye = np.eye(9)
+    ssum = np.empty((9, 9))
+    a_buf = np.empty((9, 9))
+    w = np.empty((9, 9))
+    p_s = np.empty((9, 9))
+    p_d = np.empty((9, 9))
+    d = np.empty(9)
+    x_s = np.empty(9)
+    x_d = np.empty(9)
     for i in range(n):
         pff = pf[i]
         pbb = pb[i]
-        ssum = pff + pbb
         ok = True
-        for j in range(9):
-            if not math.isfinite(ssum[j, j]) or ssum[j, j] <= 0.0:
+        for r in range(9):
+            for c in range(9):
+                ssum[r, c] = pff[r, c] + pbb[r, c]
+            if not math.isfinite(ssum[r, r]) or ssum[r, r] <= 0.0:
                 ok = False
         if not ok:
             xs[i] = np.nan
@@ -113,28 +154,45 @@ def fusion_kernel(
             wmag[i] = np.nan
             continue
         sinv = np.linalg.inv(ssum)
-        w = pbb @ sinv
-        d = xf[i] - xb[i]
-        x_s = w @ xf[i] + (eye - w) @ xb[i]
-        imw = eye - w
-        p_s = w @ pff @ w.T + imw @ pbb @ imw.T
-        xs[i] = x_s
-        for j in range(9):
-            ps_diag[i, j] = p_s[j, j]
-        for j in range(3):
-            dv[i, j] = -d[3 + j]
-        dv_cov[i] = ssum[3:6, 3:6]
-        # McReynolds: X_D = X_F - X_S, P_D = P_F (P_F + P_B)^-1 P_F (equals P_F - P_S)
-        x_d = xf[i] - x_s
-        p_d = pff @ sinv @ pff
-        for j in range(9):
-            mcr[i, j] = abs(x_d[j]) / math.sqrt(p_d[j, j]) if p_d[j, j] > 0 else np.nan
+        _mm9(pbb, sinv, w)
+        _mm9(sinv, pff, a_buf)
+        _mm9(pbb, a_buf, p_s)
+        _mm9(pff, a_buf, p_d)
+        for r in range(9):
+            d[r] = xf[i, r] - xb[i, r]
+        for r in range(9):
+            acc = 0.0
+            for c in range(9):
+                acc += w[r, c] * d[c]
+            x_s[r] = xb[i, r] + acc
+            x_d[r] = d[r] - acc
+        for r in range(9):
+            xs[i, r] = x_s[r]
+            ps_diag[i, r] = p_s[r, r]
+            mcr[i, r] = abs(x_d[r]) / math.sqrt(p_d[r, r]) if p_d[r, r] > 0 else np.nan
+        for r in range(3):
+            dv[i, r] = -d[3 + r]
+            for c in range(3):
+                dv_cov[i, r, c] = ssum[3 + r, 3 + c]
         # Mahalanobis velocity distance with P_S,vv (Eq. 3.53)
-        pv = np.ascontiguousarray(p_s[3:6, 3:6])
-        dvv = np.ascontiguousarray(d[3:6])
-        scal[i, 0] = math.sqrt(max(0.0, dvv @ np.linalg.solve(pv, dvv)))
-        scal[i, 1] = math.sqrt(max(0.0, d @ (sinv @ d)))
-        scal[i, 2] = math.sqrt(max(0.0, x_d @ (p_d @ x_d)))
+        pv = np.empty((3, 3))
+        for r in range(3):
+            for c in range(3):
+                pv[r, c] = 0.5 * (p_s[3 + r, 3 + c] + p_s[3 + c, 3 + r])
+        pvi = _inv3(pv)
+        m2 = 0.0
+        for r in range(3):
+            for c in range(3):
+                m2 += d[3 + r] * pvi[r, c] * d[3 + c]
+        scal[i, 0] = math.sqrt(max(0.0, m2))
+        q1 = 0.0
+        q2 = 0.0
+        for r in range(9):
+            for c in range(9):
+                q1 += d[r] * sinv[r, c] * d[c]
+                q2 += x_d[r] * p_d[r, c] * x_d[c]
+        scal[i, 1] = math.sqrt(max(0.0, q1))
+        scal[i, 2] = math.sqrt(max(0.0, q2))
         wmag[i] = math.sqrt(x_s[6] ** 2 + x_s[7] ** 2 + x_s[8] ** 2)
     return xs, ps_diag, dv, dv_cov, mcr, scal, wmag
 

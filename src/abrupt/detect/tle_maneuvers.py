@@ -115,7 +115,7 @@ class StepSeries:
 
 
 def mean_element_series(history: ElementHistory) -> dict[str, NDArray[np.float64]]:
-    """Series used by the detector: time (s from the first epoch), a (m), e-vector, i and RAAN residual (rad)."""
+    """Detector series: time (s from the first epoch), a (m), e-vector, i and RAAN residual (rad)."""
     el = history.elements
     t = (el["epoch_utc"] - el["epoch_utc"].iloc[0]).dt.total_seconds().to_numpy(dtype=float)
     e = el["e"].to_numpy(dtype=float)
@@ -167,13 +167,37 @@ def _theil_sen(t: NDArray[np.float64], y: NDArray[np.float64]) -> float:
     return float(np.median((y[j] - y[i])[ok] / dt[ok]))
 
 
-def _step(t: NDArray[np.float64], y: NDArray[np.float64], pre: slice, post: slice, t0: float) -> tuple[float, int, int]:
-    tp, yp, tq, yq = t[pre], y[pre], t[post], y[post]
-    slopes = [s for s, n in ((_theil_sen(tp, yp), tp.size), (_theil_sen(tq, yq), tq.size)) if n >= 2]
-    slope = float(np.median(slopes)) if slopes else 0.0
-    lp = float(np.median(yp - slope * (tp - t0)))
-    lq = float(np.median(yq - slope * (tq - t0)))
-    return lq - lp, tp.size, tq.size
+def _pooled_slope(t: NDArray[np.float64], y: NDArray[np.float64], sides: tuple[slice, slice]) -> float:
+    """Median of the pairwise slopes within each side (a Theil-Sen slope shared by both sides, Sen 1968).
+
+    Pairs never straddle the gap, so a step does not bias the slope.
+    """
+    slopes = []
+    for side in sides:
+        ts, ys = t[side], y[side]
+        if ts.size < 2:
+            continue
+        i, j = np.triu_indices(ts.size, 1)
+        dt = ts[j] - ts[i]
+        ok = dt > 60.0
+        slopes.append((ys[j] - ys[i])[ok] / dt[ok])
+    allslopes = np.concatenate(slopes) if slopes else np.zeros(0)
+    return float(np.median(allslopes)) if allslopes.size else 0.0
+
+
+def _step(
+    t: NDArray[np.float64],
+    y: NDArray[np.float64],
+    pre: slice,
+    post: slice,
+    t0: float,
+    slope_sides: tuple[slice, slice],
+) -> float:
+    """Difference of the post and pre medians of ``y − slope·(t − t0)`` (robust level step at ``t0``)."""
+    slope = _pooled_slope(t, y, slope_sides)
+    lp = float(np.median(y[pre] - slope * (t[pre] - t0)))
+    lq = float(np.median(y[post] - slope * (t[post] - t0)))
+    return lq - lp
 
 
 class _StepModel:
@@ -189,7 +213,7 @@ class _StepModel:
         self.scales = {k: _robust_scale_rolling(self.s[k], cfg.noise_half_window) for k in self.NAMES}
 
     def gap(self, g: int, lo_bound: int = 0, hi_bound: int | None = None) -> tuple[dict[str, float], float]:
-        """Steps of every series at gap g using sets [max(lo_bound, g+1-W), g] and [g+1, min(hi_bound, g+1+W)).
+        """Steps of every series at gap g from sets [max(lo_bound, g+1-W), g], [g+1, min(hi_bound, g+1+W)).
 
         Returns the steps and the median standard-error factor; the factor is inf when a side has
         fewer than two sets (no test possible).
@@ -207,8 +231,16 @@ class _StepModel:
         if n1 < self.cfg.min_side_sets or n2 < self.cfg.min_side_sets:
             return {k: 0.0 for k in self.NAMES}, math.inf
         pre, post = slice(lo, g + 1), slice(g + 1, hi)
+        # the slope (drag decay, J2/J3 and luni-solar drifts) from twice as many sets each side
+        slo = max(lo_bound, g + 1 - 2 * cfg.window_sets)
+        shi = min(hi_bound, g + 1 + 2 * cfg.window_sets)
+        while slo < lo and t[g] - t[slo] > 2 * max_win_s:
+            slo += 1
+        while shi > hi and t[shi - 1] - t[g + 1] > 2 * max_win_s:
+            shi -= 1
+        sides = (slice(slo, g + 1), slice(g + 1, shi))
         t0 = 0.5 * (t[g] + t[g + 1])
-        steps = {k: _step(t, self.s[k], pre, post, t0)[0] for k in self.NAMES}
+        steps = {k: _step(t, self.s[k], pre, post, t0, sides) for k in self.NAMES}
         return steps, math.sqrt(math.pi / 2.0) * math.sqrt(1.0 / n1 + 1.0 / n2)
 
     def localise(self, g: int, lo_bound: int, hi_bound: int, weights: tuple[float, float, float]) -> int:
@@ -221,7 +253,13 @@ class _StepModel:
         t = self.t
         lo = max(lo_bound, g + 1 - self.cfg.window_sets - 2)
         hi = min(hi_bound, g + 1 + self.cfg.window_sets + 2)
-        wmap = {"a_m": weights[0], "ex": weights[1], "ey": weights[1], "i_rad": weights[2], "raan_resid_sin_i_rad": weights[2]}
+        wmap = {
+            "a_m": weights[0],
+            "ex": weights[1],
+            "ey": weights[1],
+            "i_rad": weights[2],
+            "raan_resid_sin_i_rad": weights[2],
+        }
         best, best_cost = g, math.inf
         for c in range(g - 2, g + 3):
             if c + 1 - lo < self.cfg.min_side_sets or hi - c - 1 < self.cfg.min_side_sets:
@@ -243,7 +281,9 @@ class _StepModel:
         sc = {k: self.scales[k][g] * factor for k in self.NAMES}
         z_a = abs(steps["a_m"]) / sc["a_m"]
         z_e = math.hypot(steps["ex"] / sc["ex"], steps["ey"] / sc["ey"])
-        z_n = math.hypot(steps["i_rad"] / sc["i_rad"], steps["raan_resid_sin_i_rad"] / sc["raan_resid_sin_i_rad"])
+        z_n = math.hypot(
+            steps["i_rad"] / sc["i_rad"], steps["raan_resid_sin_i_rad"] / sc["raan_resid_sin_i_rad"]
+        )
         return z_a, z_e, z_n
 
 
@@ -400,7 +440,11 @@ def component_weights(first: StepSeries, guard: int, quantile: float = 0.99) -> 
     from scipy import stats
 
     keep = event_free_mask(first.statistic, guard)
-    refs = (float(stats.chi.ppf(quantile, 1)), float(stats.chi.ppf(quantile, 2)), float(stats.chi.ppf(quantile, 2)))
+    refs = (
+        float(stats.chi.ppf(quantile, 1)),
+        float(stats.chi.ppf(quantile, 2)),
+        float(stats.chi.ppf(quantile, 2)),
+    )
     out = []
     for z, ref in zip((first.z_a, first.z_e, first.z_n), refs, strict=True):
         sample = z[keep & np.isfinite(z) & (z > 0)]

@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.stats import chi2
 
+from abrupt.events import Event, format_time_utc
 from abrupt.model.tracking_measurements import TrackingArrays, predict_measurement, wrap_angle
 from abrupt.model.tracking_orbit import ForceModel, propagate_with_stm, rsw_basis
 
@@ -38,6 +39,7 @@ class BatchFitConfig:
 
     force: ForceModel = field(default_factory=ForceModel)
     estimate_range_bias: bool | tuple[str, ...] = False
+    estimate_angle_bias: bool | tuple[str, ...] = False
     estimate_acceleration: bool = False
     max_iterations: int = 25
     tolerance: float = 1e-4  # relative change of the weighted residual sum of squares
@@ -48,11 +50,12 @@ class BatchFitConfig:
 
 @dataclass
 class BatchFit:
-    """Result of :func:`fit_orbit`. Parameter order: x0 (6), range biases, acceleration (3), impulses (3 each)."""
+    """Result of :func:`fit_orbit`. Parameters: x0 (6), biases, acceleration (3), impulses (3 each)."""
 
     x0: NDArray[np.float64]
     t0_s: float
     range_bias_m: dict[str, float]
+    angle_bias_rad: dict[str, tuple[float, float]]
     acceleration_mps2: NDArray[np.float64]
     impulse_times_s: list[float]
     impulse_dv_rsw_mps: NDArray[np.float64]
@@ -81,13 +84,20 @@ class BatchFit:
         return float(math.sqrt(max(self.covariance[k, k], 0.0)))
 
 
-def _bias_stations(data: TrackingArrays, cfg: BatchFitConfig) -> list[str]:
-    with_range = sorted({s for s, y in zip(data.station_names, data.y[:, 0], strict=True) if np.isfinite(y)})
-    if cfg.estimate_range_bias is True:
-        return with_range
-    if cfg.estimate_range_bias is False:
-        return []
-    return [s for s in with_range if s in set(cfg.estimate_range_bias)]
+def _bias_keys(data: TrackingArrays, cfg: BatchFitConfig) -> list[tuple[str, int]]:
+    """(station, component) pairs whose bias is estimated: range (0), azimuth (1), elevation (2)."""
+    keys: list[tuple[str, int]] = []
+    for comp, setting in (
+        (0, cfg.estimate_range_bias),
+        (1, cfg.estimate_angle_bias),
+        (2, cfg.estimate_angle_bias),
+    ):
+        have = sorted({s for s, y in zip(data.station_names, data.y[:, comp], strict=True) if np.isfinite(y)})
+        if setting is True:
+            keys += [(s, comp) for s in have]
+        elif setting:
+            keys += [(s, comp) for s in have if s in set(setting)]
+    return keys
 
 
 def trajectory(
@@ -106,7 +116,11 @@ def trajectory(
     Impulses are applied in the RSW frame of the state at their epoch; ∂C_RSW/∂x is neglected.
     """
     n_imp = len(impulse_times_s)
-    dv = np.zeros((n_imp, 3)) if impulse_dv_rsw is None else np.asarray(impulse_dv_rsw, float).reshape(n_imp, 3)
+    dv = (
+        np.zeros((n_imp, 3))
+        if impulse_dv_rsw is None
+        else np.asarray(impulse_dv_rsw, float).reshape(n_imp, 3)
+    )
     n_p = 9 + 3 * n_imp
     order = np.argsort(impulse_times_s) if n_imp else np.array([], dtype=int)
     breaks = [float(impulse_times_s[k]) for k in order]
@@ -156,6 +170,7 @@ def fit_orbit(
     initial_range_bias_m: dict[str, float] | None = None,
     initial_impulse_dv_rsw: NDArray[np.float64] | None = None,
     initial_acceleration_mps2: NDArray[np.float64] | None = None,
+    initial_angle_bias_rad: dict[str, tuple[float, float]] | None = None,
 ) -> BatchFit:
     """Weighted Gauss-Newton fit of the orbit (and biases, acceleration, impulses) to all measurements.
 
@@ -164,17 +179,30 @@ def fit_orbit(
     """
     cfg = config or BatchFitConfig()
     n = len(data)
-    bias_st = _bias_stations(data, cfg)
+    bias_keys = _bias_keys(data, cfg)
     n_imp = len(impulse_times_s)
-    names = ["x", "y", "z", "vx", "vy", "vz", *[f"range_bias[{s}]" for s in bias_st]]
+    label = {0: "range_bias", 1: "azimuth_bias", 2: "elevation_bias"}
+    names = ["x", "y", "z", "vx", "vy", "vz", *[f"{label[c]}[{s}]" for s, c in bias_keys]]
     if cfg.estimate_acceleration:
         names += ["accel_x", "accel_y", "accel_z"]
     for k in range(n_imp):
         names += [f"dv{k}_r", f"dv{k}_s", f"dv{k}_w"]
     x = np.asarray(x0, float).copy()
-    bias = {s: (initial_range_bias_m or {}).get(s, data.stations[s].range_bias_m) for s in data.stations}
-    accel = np.zeros(3) if initial_acceleration_mps2 is None else np.asarray(initial_acceleration_mps2, float).copy()
-    dv = np.zeros((n_imp, 3)) if initial_impulse_dv_rsw is None else np.asarray(initial_impulse_dv_rsw, float).reshape(n_imp, 3).copy()
+    bias: dict[tuple[str, int], float] = {}
+    for s in data.stations:
+        bias[(s, 0)] = (initial_range_bias_m or {}).get(s, data.stations[s].range_bias_m)
+        bias[(s, 1)] = (initial_angle_bias_rad or {}).get(s, (0.0, 0.0))[0]
+        bias[(s, 2)] = (initial_angle_bias_rad or {}).get(s, (0.0, 0.0))[1]
+    accel = (
+        np.zeros(3)
+        if initial_acceleration_mps2 is None
+        else np.asarray(initial_acceleration_mps2, float).copy()
+    )
+    dv = (
+        np.zeros((n_imp, 3))
+        if initial_impulse_dv_rsw is None
+        else np.asarray(initial_impulse_dv_rsw, float).reshape(n_imp, 3).copy()
+    )
     # rows: (measurement index, component)
     valid = np.isfinite(data.y)
     if cfg.elevation_mask_deg is not None:
@@ -193,11 +221,19 @@ def fit_orbit(
     cov = np.full((len(names), len(names)), np.nan)
     for it in range(1, cfg.max_iterations + 1):
         states, dmat = trajectory(
-            x, t0_s, data.t_s, force=cfg.force, accel_mps2=accel, impulse_times_s=impulse_times_s,
-            impulse_dv_rsw=dv, max_step_s=cfg.max_step_s,
+            x,
+            t0_s,
+            data.t_s,
+            force=cfg.force,
+            accel_mps2=accel,
+            impulse_times_s=impulse_times_s,
+            impulse_dv_rsw=dv,
+            max_step_s=cfg.max_step_s,
         )
-        resid, jac = _residuals(data, states, dmat, bias, bias_st, cfg.estimate_acceleration, n_imp, row_i, row_c)
-        if cfg.outlier_sigma is not None and it >= 3:
+        resid, jac = _residuals(
+            data, states, dmat, bias, bias_keys, cfg.estimate_acceleration, n_imp, row_i, row_c
+        )
+        if cfg.outlier_sigma is not None and 3 <= it <= 5:  # re-select outliers, then freeze the set
             used = np.abs(resid) <= cfg.outlier_sigma
         cost = float(np.sum(resid[used] ** 2))
         a = jac[used]
@@ -207,14 +243,17 @@ def fit_orbit(
         except np.linalg.LinAlgError:
             cov = np.linalg.pinv(normal)
         step = cov @ (a.T @ resid[used])
-        if abs(prev_cost - cost) <= cfg.tolerance * max(cost, 1.0) and it >= 2:
+        normalised = np.abs(step) / np.sqrt(np.maximum(np.diag(cov), 1e-300))
+        if it >= 2 and (
+            abs(prev_cost - cost) <= cfg.tolerance * max(cost, 1.0) or float(normalised.max()) < 1e-3
+        ):
             converged = True
             break
         prev_cost = cost
         x = x + step[:6]
         k = 6
-        for s in bias_st:
-            bias[s] += step[k]
+        for key in bias_keys:
+            bias[key] += step[k]
             k += 1
         if cfg.estimate_acceleration:
             accel = accel + step[k : k + 3]
@@ -225,7 +264,8 @@ def fit_orbit(
     return BatchFit(
         x0=x,
         t0_s=t0_s,
-        range_bias_m={s: bias[s] for s in bias_st},
+        range_bias_m={s: bias[(s, c)] for s, c in bias_keys if c == 0},
+        angle_bias_rad={s: (bias[(s, 1)], bias[(s, 2)]) for s in {s for s, c in bias_keys if c > 0}},
         acceleration_mps2=accel,
         impulse_times_s=list(impulse_times_s),
         impulse_dv_rsw_mps=dv,
@@ -250,41 +290,44 @@ def _residuals(
     data: TrackingArrays,
     states: NDArray[np.float64],
     dmat: NDArray[np.float64],
-    bias: dict[str, float],
-    bias_st: list[str],
+    bias: dict[tuple[str, int], float],
+    bias_keys: list[tuple[str, int]],
     with_accel: bool,
     n_imp: int,
     row_i: NDArray[np.int64],
     row_c: NDArray[np.int64],
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     y_hat, h = _predict_all(data.c_fi, data.site, data.c_sf, states)
-    offsets = np.array([bias.get(name, data.range_bias_m[k]) for k, name in enumerate(data.station_names)])
-    y_hat[:, 0] += offsets
+    for c in range(3):
+        y_hat[:, c] += np.array([bias.get((name, c), 0.0) for name in data.station_names])
     d = data.y[row_i, row_c] - y_hat[row_i, row_c]
     az = row_c == 1
     d[az] = wrap_angle(d[az])
     sig = data.sigma[row_i, row_c]
     resid = d / sig
     hd = np.einsum("rk,rkp->rp", h[row_i, row_c], dmat[row_i])
-    n_par = 6 + len(bias_st) + (3 if with_accel else 0) + 3 * n_imp
+    n_par = 6 + len(bias_keys) + (3 if with_accel else 0) + 3 * n_imp
     jac = np.zeros((row_i.size, n_par))
     jac[:, :6] = hd[:, :6] / sig[:, None]
-    col = 6 + len(bias_st)
+    col = 6 + len(bias_keys)
     if with_accel:
         jac[:, col : col + 3] = hd[:, 6:9] / sig[:, None]
         col += 3
     if n_imp:
         jac[:, col:] = hd[:, 9:] / sig[:, None]
     names = np.asarray(data.station_names)[row_i]
-    for k, st in enumerate(bias_st):
-        sel = (row_c == 0) & (names == st)
+    for k, (st, c) in enumerate(bias_keys):
+        sel = (row_c == c) & (names == st)
         jac[sel, 6 + k] = 1.0 / sig[sel]
     return resid, jac
 
 
 @numba.njit(cache=True)
 def _predict_all(
-    c_fi: NDArray[np.float64], site: NDArray[np.float64], c_sf: NDArray[np.float64], states: NDArray[np.float64]
+    c_fi: NDArray[np.float64],
+    site: NDArray[np.float64],
+    c_sf: NDArray[np.float64],
+    states: NDArray[np.float64],
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     n = states.shape[0]
     y = np.empty((n, 4))
@@ -314,8 +357,14 @@ def glrt_scan(data: TrackingArrays, fit: BatchFit, t_candidates_s: NDArray[np.fl
     """Linearised GLRT for one impulse at each candidate epoch, on the residuals of ``fit`` (module doc)."""
     cand = np.asarray(t_candidates_s, dtype=float)
     states_c, d_c = trajectory(
-        fit.x0, fit.t0_s, cand, force=fit.config.force, accel_mps2=fit.acceleration_mps2,
-        impulse_times_s=fit.impulse_times_s, impulse_dv_rsw=fit.impulse_dv_rsw_mps, max_step_s=fit.config.max_step_s,
+        fit.x0,
+        fit.t0_s,
+        cand,
+        force=fit.config.force,
+        accel_mps2=fit.acceleration_mps2,
+        impulse_times_s=fit.impulse_times_s,
+        impulse_dv_rsw=fit.impulse_dv_rsw_mps,
+        max_step_s=fit.config.max_step_s,
     )
     used = fit.used
     r = fit.residuals_white[used]
@@ -416,7 +465,11 @@ def detect_maneuvers_glrt(
     t_first, t_last = float(data.t_s.min()), float(data.t_s.max())
     cand = np.arange(t_first + step, t_last, step)
     arc_days = max((t_last - t_first) / 86400.0, 1e-3)
-    threshold = cfg.threshold if cfg.threshold is not None else glrt_threshold(cand.size, arc_days, cfg.false_alarms_per_day)
+    threshold = (
+        cfg.threshold
+        if cfg.threshold is not None
+        else glrt_threshold(cand.size, arc_days, cfg.false_alarms_per_day)
+    )
     scans: list[GlrtScan] = []
     times: list[float] = []
     sigmas: list[float] = []
@@ -432,15 +485,29 @@ def detect_maneuvers_glrt(
         chi2_null = fit.chi2
         tried: dict[float, BatchFit] = {}
 
-        def refit(tau: float, _times: list[float] = times, _fit: BatchFit = fit, _scan: GlrtScan = scan) -> BatchFit:
+        def refit(
+            tau: float,
+            _times: list[float] = times,
+            _fit: BatchFit = fit,
+            _scan: GlrtScan = scan,
+            tried: dict[float, BatchFit] = tried,
+        ) -> BatchFit:
             if tau not in tried:
                 k_near = int(np.argmin(np.abs(cand - tau)))
-                guess = _scan.dv_rsw_mps[k_near] if np.all(np.isfinite(_scan.dv_rsw_mps[k_near])) else np.zeros(3)
+                guess = (
+                    _scan.dv_rsw_mps[k_near] if np.all(np.isfinite(_scan.dv_rsw_mps[k_near])) else np.zeros(3)
+                )
                 dv0 = np.vstack([_fit.impulse_dv_rsw_mps, guess[None, :]])
                 tried[tau] = fit_orbit(
-                    data, _fit.x0, t0_s=t0_s, config=scan_cfg, impulse_times_s=[*_times, tau],
-                    initial_range_bias_m=_fit.range_bias_m or None, initial_impulse_dv_rsw=dv0,
+                    data,
+                    _fit.x0,
+                    t0_s=t0_s,
+                    config=scan_cfg,
+                    impulse_times_s=[*_times, tau],
+                    initial_range_bias_m=_fit.range_bias_m or None,
+                    initial_impulse_dv_rsw=dv0,
                     initial_acceleration_mps2=_fit.acceleration_mps2,
+                    initial_angle_bias_rad=_fit.angle_bias_rad,
                 )
             return tried[tau]
 
@@ -471,5 +538,46 @@ def detect_maneuvers_glrt(
     base = len(fit.parameter_names) - 3 * len(times)
     for j, tj in enumerate(times):
         cov = fit.covariance[base + 3 * j : base + 3 * j + 3, base + 3 * j : base + 3 * j + 3]
-        detections.append(GlrtDetection(tj, sigmas[j], fit.impulse_dv_rsw_mps[j].copy(), cov, stats[j], threshold))
+        detections.append(
+            GlrtDetection(tj, sigmas[j], fit.impulse_dv_rsw_mps[j].copy(), cov, stats[j], threshold)
+        )
     return detections, fit, scans
+
+
+def glrt_events(
+    detections: Sequence[GlrtDetection],
+    *,
+    epoch_utc: np.datetime64,
+    spacecraft: str,
+    run_id: str,
+    config_hash: str,
+    false_alarms_per_day: float,
+) -> list[Event]:
+    """Events (kind ``maneuver``) with epoch, RSW Δv and 1-σ uncertainties in ``extra``."""
+    out = []
+    for d in detections:
+        sig = np.sqrt(np.maximum(np.diag(d.dv_covariance), 0.0))
+        out.append(
+            Event(
+                spacecraft=spacecraft,
+                kind="maneuver",
+                detector="tracking_glrt",
+                time_utc=format_time_utc(epoch_utc + np.timedelta64(round(d.t_s * 1e9), "ns")),
+                statistic=d.statistic,
+                threshold=d.threshold,
+                false_alarms_per_day=false_alarms_per_day,
+                run_id=run_id,
+                config_hash=config_hash,
+                time_sigma_s=d.time_sigma_s,
+                dv_r_mps=float(d.dv_rsw_mps[0]),
+                dv_t_mps=float(d.dv_rsw_mps[1]),
+                dv_n_mps=float(d.dv_rsw_mps[2]),
+                extra={
+                    "dv_sigma_mps": d.dv_sigma_mps,
+                    "dv_r_sigma_mps": float(sig[0]),
+                    "dv_t_sigma_mps": float(sig[1]),
+                    "dv_n_sigma_mps": float(sig[2]),
+                },
+            )
+        )
+    return out

@@ -36,6 +36,14 @@ EarthRotationModel = Literal["simple", "iers"]
 SPEED_OF_LIGHT_MPS = 299792458.0
 
 
+def as_datetime64_ns(t: object) -> np.datetime64:
+    """A scalar ``datetime64[ns]`` from a datetime64, Timestamp or ISO string (naive = UTC)."""
+    ts = pd.Timestamp(t)  # type: ignore[arg-type]
+    if ts.tzinfo is not None:
+        ts = ts.tz_convert("UTC").tz_localize(None)
+    return np.datetime64(ts.value, "ns")
+
+
 def c3(theta_rad: float) -> NDArray[np.float64]:
     """Passive rotation about the third axis (Kaderali 2021, Eq. 2.1)."""
     c, s = math.cos(theta_rad), math.sin(theta_rad)
@@ -75,7 +83,7 @@ def earth_rotation_matrices(
     from abrupt.model.timescales import offline_astropy
 
     offline_astropy()
-    times = np.datetime64(epoch_utc, "ns") + (t * 1e9).astype("timedelta64[ns]")
+    times = as_datetime64_ns(epoch_utc) + (t * 1e9).astype("timedelta64[ns]")
     tt = Time(times, scale="utc", format="datetime64")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -199,7 +207,7 @@ class TrackingArrays:
 
         meas = measurements.sort_values("time_utc", kind="stable").reset_index(drop=True)
         times = np.asarray(meas["time_utc"], dtype="datetime64[ns]")
-        self.epoch_utc = np.datetime64(epoch_utc if epoch_utc is not None else times[0], "ns")
+        self.epoch_utc = as_datetime64_ns(epoch_utc if epoch_utc is not None else times[0])
         self.t_s = (times - self.epoch_utc).astype("timedelta64[ns]").astype(np.int64) / 1e9
         self.times_utc = times
         self.y = np.column_stack([np.asarray(meas[c], dtype=float) for c in MEASUREMENT_COLUMNS])
@@ -215,7 +223,9 @@ class TrackingArrays:
                 self.stations[name] = lookup_station(name, stations)
             except KeyError:
                 known = ", ".join(sorted(stations)) or "none given"
-                raise InputError(f"unknown station {name!r} (known: {known})", file=source, column="station") from None
+                raise InputError(
+                    f"unknown station {name!r} (known: {known})", file=source, column="station"
+                ) from None
         for i, name in enumerate(self.station_names):
             st = self.stations[name]
             self.site[i] = st.position_ecef_m
@@ -235,3 +245,25 @@ class TrackingArrays:
         y, h = predict_measurement(np.ascontiguousarray(x), self.c_fi[i], self.site[i], self.c_sf[i])
         y[0] += self.range_bias_m[i]
         return y, h
+
+
+def bennett_refraction_rad(apparent_elevation_rad: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Atmospheric refraction R = cot(h + 7.31/(h + 4.4)) arcmin, h apparent elevation in degrees.
+
+    Bennett (1982), "The calculation of astronomical refraction in marine navigation", J. Navigation 35;
+    standard conditions (10 °C, 1010 hPa). True elevation = apparent − R.
+    """
+    h = np.degrees(np.asarray(apparent_elevation_rad, dtype=float))
+    h = np.maximum(h, -1.0)
+    arcmin = 1.0 / np.tan(np.radians(h + 7.31 / (h + 4.4)))
+    return np.asarray(np.radians(arcmin / 60.0))
+
+
+def correct_refraction(measurements: pd.DataFrame) -> pd.DataFrame:
+    """Copy of the table with measured (apparent) elevations turned into geometric ones (Bennett 1982)."""
+    out = measurements.copy()
+    el = out["elevation_rad"].to_numpy(dtype=float, copy=True)
+    ok = np.isfinite(el)
+    el[ok] = el[ok] - bennett_refraction_rad(el[ok])
+    out["elevation_rad"] = el
+    return out

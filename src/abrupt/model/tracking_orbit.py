@@ -1,4 +1,4 @@
-"""Small orbit propagator for ground-tracking work: two-body (+ optional J2, Sun, Moon, constant acceleration).
+"""Small orbit propagator for ground tracking: two-body (+ optional J2, Sun, Moon, constant acceleration).
 
 Everything is SI (m, m/s, s) in an inertial frame N (GCRF/EME2000; the thesis's "ECI").
 
@@ -14,6 +14,7 @@ Everything is SI (m, m/s, s) in an inertial frame N (GCRF/EME2000; the thesis's 
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -300,7 +301,7 @@ def _rk4_stm(
     t = t0_s
     for i in range(n):
         dt_total = t_eval_s[i] - t
-        nsub = max(1, int(math.ceil(abs(dt_total) / max_step_s - 1e-9)))
+        nsub = max(1, math.ceil(abs(dt_total) / max_step_s - 1e-9))
         h = dt_total / nsub
         for _ in range(nsub):
             k1 = _deriv(y, t, mu, use_j2, use_third, epoch_jd_tt, a_const)
@@ -367,7 +368,6 @@ def propagate_truth(
     break-points at every burn start and end (spec §4.1, erratum 10). Burn thrust is fixed in the
     inertial frame at onset (thesis Section 4.1) or follows the RSW frame when ``rotating``.
     """
-    from scipy.integrate import solve_ivp
 
     f = force or ForceModel()
     t_eval = np.asarray(t_eval_s, dtype=float)
@@ -378,11 +378,10 @@ def propagate_truth(
     t_final = float(t_eval[-1])
     breaks = sorted({0.0, t_final, *[b.t_start_s for b in burns], *[b.t_end_s for b in burns]})
     breaks = [b for b in breaks if 0.0 <= b <= t_final]
-    zero = np.zeros(3)
     state = np.asarray(x0, dtype=float).copy()
     out = np.full((t_eval.size, 6), np.nan)
     onset_dcm: dict[int, NDArray[np.float64]] = {}
-    for seg_start, seg_end in zip(breaks[:-1], breaks[1:], strict=True):
+    for seg_start, seg_end in itertools.pairwise(breaks):
         mid = 0.5 * (seg_start + seg_end)
         fixed_acc = np.zeros(3)
         rotating: list[NDArray[np.float64]] = []

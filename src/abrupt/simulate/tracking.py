@@ -16,11 +16,12 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from abrupt.events import Event, empty_frame, events_frame
+from abrupt.events import Event, empty_frame, events_frame, format_time_utc
 from abrupt.model.stations import Station, ascension
 from abrupt.model.tracking_measurements import (
     MEASUREMENT_COLUMNS,
     EarthRotationModel,
+    as_datetime64_ns,
     earth_rotation_matrices,
     predict_many,
 )
@@ -105,7 +106,9 @@ class TrackingSimulation:
     truth_events: pd.DataFrame
 
 
-def burn_onset_s(location: Location | str, period_s: float, after_orbits: int = 2, *, nu0_deg: float = 0.0) -> float:
+def burn_onset_s(
+    location: Location | str, period_s: float, after_orbits: int = 2, *, nu0_deg: float = 0.0
+) -> float:
     """Burn start (s) at an orbit location after ``after_orbits`` full orbits (spec §4.4, from ν₀ = 0).
 
     perigee 2T, apogee 2.5T, a quarter (in time) after perigee 2.25T, a quarter after apogee 2.75T.
@@ -144,8 +147,10 @@ def simulate_tracking(scenario: TrackingScenario, *, seed: int | None = 0) -> Tr
     t = np.arange(0.0, t_end + 1e-9, scenario.cadence_s)
     force = ForceModel(mu_m3_s2=scenario.mu_m3_s2)
     states = propagate_truth(x0, t, scenario.burns, force=force)
-    epoch = np.datetime64(pd.Timestamp(scenario.epoch_utc).tz_localize(None).to_datetime64(), "ns")
-    c_fi = earth_rotation_matrices(t, model=scenario.earth_rotation, epoch_utc=epoch, theta0_rad=scenario.theta0_rad)
+    epoch = as_datetime64_ns(scenario.epoch_utc)
+    c_fi = earth_rotation_matrices(
+        t, model=scenario.earth_rotation, epoch_utc=epoch, theta0_rad=scenario.theta0_rad
+    )
     frames = []
     for st in scenario.stations:
         y = predict_many(states, c_fi, st.position_ecef_m, st.ecef_to_sez)
@@ -172,7 +177,7 @@ def simulate_tracking(scenario: TrackingScenario, *, seed: int | None = 0) -> Tr
                 spacecraft=scenario.spacecraft,
                 kind="maneuver",
                 detector="truth",
-                time_utc=epoch + np.timedelta64(int(round(mid * 1e9)), "ns"),
+                time_utc=format_time_utc(epoch + np.timedelta64(round(mid * 1e9), "ns")),
                 statistic=float("nan"),
                 threshold=float("nan"),
                 false_alarms_per_day=float("nan"),

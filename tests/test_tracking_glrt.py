@@ -1,0 +1,216 @@
+"""Beyond the thesis: batch orbit fit and GLRT detection of maneuvers made out of view; CLI end to end."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from abrupt.detect.tracking_glrt import BatchFitConfig, GlrtConfig, detect_maneuvers_glrt, fit_orbit
+from abrupt.model.stations import ascension
+from abrupt.model.tracking_measurements import TrackingArrays
+from abrupt.simulate.tracking import TrackingScenario, simulate_tracking, thesis_burn
+
+
+def _data(burn=None, seed: int = 4, cadence: float = 10.0):
+    sc = TrackingScenario(
+        stations=(ascension(1.0),), burns=() if burn is None else (burn,), cadence_s=cadence
+    )
+    sim = simulate_tracking(sc, seed=seed)
+    return TrackingArrays(sim.measurements, {}, epoch_utc=sim.epoch_utc), sim
+
+
+def _perturbed(x: np.ndarray, seed: int = 9) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    return x + np.r_[rng.normal(0, 50.0, 3), rng.normal(0, 0.05, 3)]
+
+
+def test_batch_fit_recovers_the_initial_state_and_a_range_bias() -> None:
+    data, sim = _data()
+    truth_bias = 150.0
+    data.y[:, 0] += truth_bias
+    fit = fit_orbit(data, _perturbed(sim.initial_state), config=BatchFitConfig(estimate_range_bias=True))
+    assert fit.converged
+    assert fit.range_bias_m["ASCENSION"] == pytest.approx(
+        truth_bias, abs=4 * fit.sigma("range_bias[ASCENSION]")
+    )
+    assert np.linalg.norm(fit.x0[:3] - sim.initial_state[:3]) < 20.0
+    assert fit.rms_white == pytest.approx(1.0, abs=0.1)
+
+
+def test_glrt_is_quiet_without_a_maneuver() -> None:
+    data, sim = _data()
+    det, _, scans = detect_maneuvers_glrt(
+        data, _perturbed(sim.initial_state), config=GlrtConfig(max_maneuvers=1)
+    )
+    assert det == []
+    assert np.nanmax(scans[0].statistic) < glrt_threshold_for(scans[0].t_candidates_s.size, data)
+
+
+def glrt_threshold_for(n: int, data: TrackingArrays) -> float:
+    from abrupt.detect.tracking_glrt import glrt_threshold
+
+    return glrt_threshold(n, (data.t_s.max() - data.t_s.min()) / 86400.0, 0.1)
+
+
+@pytest.mark.parametrize(("location", "direction"), [("apogee", "R"), ("perigee", "S")])
+def test_glrt_detects_and_sizes_a_5_cm_s_burn_made_out_of_view(location: str, direction: str) -> None:
+    """5 cm/s at perigee or apogee, outside every pass (1° mask): the thesis cannot see it (spec §9.10)."""
+    burn = thesis_burn(location, direction, 0.05)
+    data, sim = _data(burn)
+    det, _, _ = detect_maneuvers_glrt(data, _perturbed(sim.initial_state), config=GlrtConfig(max_maneuvers=1))
+    assert len(det) == 1
+    d = det[0]
+    k = "RSW".index(direction)
+    assert d.dv_mps == pytest.approx(0.05, rel=0.2)
+    assert abs(d.dv_rsw_mps[k]) / d.dv_mps > 0.9
+    mid = burn.t_start_s + 0.5 * burn.duration_s
+    assert abs(d.t_s - mid) < max(3 * d.time_sigma_s, 300.0)
+
+
+def test_glrt_detects_an_out_of_view_normal_burn_whose_epoch_is_ambiguous_by_half_an_orbit() -> None:
+    """A cross-track impulse fixes only the new orbit plane: its node line (epoch modulo T/2) and tilt."""
+    burn = thesis_burn("perigee", "W", 0.05)
+    data, sim = _data(burn)
+    det, _, _ = detect_maneuvers_glrt(data, _perturbed(sim.initial_state), config=GlrtConfig(max_maneuvers=1))
+    assert len(det) == 1
+    assert abs(det[0].dv_rsw_mps[2]) / det[0].dv_mps > 0.9
+    half = sim.scenario.orbit.period_s() / 2
+    offset = (det[0].t_s - burn.t_start_s) / half
+    assert abs(offset - round(offset)) < 0.25
+
+
+def test_cli_simulate_detect_report_end_to_end(tmp_path: Path) -> None:
+    from click.testing import CliRunner
+
+    from abrupt.cli.main import cli
+
+    runner = CliRunner()
+    sim = tmp_path / "sim.tdm"
+    r = runner.invoke(
+        cli,
+        [
+            "simulate",
+            "tracking",
+            "--out",
+            str(sim),
+            "--truth-out",
+            str(tmp_path / "truth.csv"),
+            "--location",
+            "apogee",
+            "--direction",
+            "S",
+            "--dv",
+            "0.1",
+            "--cadence",
+            "20",
+            "--seed",
+            "3",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(
+        cli,
+        [
+            "detect",
+            "tracking",
+            str(sim),
+            "--setup",
+            str(tmp_path / "sim.in"),
+            "--out",
+            str(tmp_path / "ev.csv"),
+            "--diagnostics-out",
+            str(tmp_path / "diag.csv"),
+            "--catalog",
+            str(tmp_path / "cat.sqlite"),
+            "--max-maneuvers",
+            "1",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    ev = pd.read_csv(tmp_path / "ev.csv")
+    glrt = ev[ev["detector"] == "tracking_glrt"]
+    assert len(glrt) == 1
+    assert glrt["dv_t_mps"].iloc[0] == pytest.approx(0.1, rel=0.2)
+    truth = pd.read_csv(tmp_path / "truth.csv")
+    dt = abs(
+        (pd.Timestamp(glrt["time_utc"].iloc[0]) - pd.Timestamp(truth["time_utc"].iloc[0])).total_seconds()
+    )
+    assert dt < 900.0
+    r = runner.invoke(
+        cli,
+        [
+            "report",
+            "tracking",
+            str(tmp_path / "diag.csv"),
+            "--events",
+            str(tmp_path / "ev.csv"),
+            "--truth",
+            str(tmp_path / "truth.csv"),
+            "--out",
+            str(tmp_path / "r.png"),
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "r.png").stat().st_size > 10_000
+
+
+def test_cli_reports_unknown_station_as_a_clear_error(tmp_path: Path) -> None:
+    from abrupt.cli.main import main
+
+    (tmp_path / "a.aer").write_text("2024-01-01T00:00:00 RANGE Nowhere 2000.0\n")
+    (tmp_path / "s.in").write_text(
+        "orbit.date = 2024-01-01T00:00:00\norbit.cartesian.px = 7378137\n"
+        "orbit.cartesian.py = 0\norbit.cartesian.pz = 0\n"
+        "orbit.cartesian.vx = 0\norbit.cartesian.vy = 7600\norbit.cartesian.vz = 0\n"
+        "ground.station.name [0] = Home\nground.station.latitude [0] = 0\nground.station.longitude [0] = 0\n"
+        "ground.station.altitude [0] = 0\n"
+    )
+    with pytest.raises(SystemExit) as exc:
+        main(
+            [
+                "detect",
+                "tracking",
+                str(tmp_path / "a.aer"),
+                "--setup",
+                str(tmp_path / "s.in"),
+                "--catalog",
+                str(tmp_path / "c.sqlite"),
+            ]
+        )
+    assert exc.value.code == 2
+
+
+def test_w3b_real_tracking_fit_estimates_biases_and_an_unmodelled_acceleration(shared_data: Path) -> None:
+    """Orekit's W3B case: biases near the reference (station + 5969 m on-board), acceleration ~1e-5 m/s²."""
+    from astropy.time import Time
+
+    from abrupt.model.tracking_measurements import correct_refraction
+    from abrupt.model.tracking_orbit import MU_EARTH_M3_S2, ForceModel
+    from abrupt.readers.aer import read_aer
+    from abrupt.readers.orekit_od_input import read_od_input
+
+    setup = read_od_input(shared_data / "tracking" / "od_test_W3.in")
+    meas = correct_refraction(read_aer(shared_data / "tracking" / "W3B.aer", known_stations=setup.stations))
+    data = TrackingArrays(meas, setup.stations, epoch_utc=setup.epoch_utc, earth_rotation="iers")
+    force = ForceModel(
+        MU_EARTH_M3_S2, j2=True, third_body=True, epoch_jd_tt=float(Time(setup.epoch_utc).tt.jd)
+    )
+    cfg = BatchFitConfig(
+        force=force,
+        estimate_range_bias=True,
+        estimate_angle_bias=True,
+        estimate_acceleration=True,
+        max_step_s=60.0,
+    )
+    fit = fit_orbit(data, setup.initial_state, config=cfg)
+    assert fit.converged
+    assert fit.rms_white < 1.0
+    for name, bias in fit.range_bias_m.items():
+        assert bias == pytest.approx(setup.stations[name].range_bias_m + 5969.0, abs=1500.0)
+    acc = float(np.linalg.norm(fit.acceleration_mps2))
+    assert 1e-6 < acc < 1e-4
+    assert math.isfinite(fit.sigma("accel_x"))
