@@ -23,7 +23,12 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
-from abrupt.detect.attitude import AttitudeDetectionConfig, _combined_statistic, calibrate_thresholds, detector_windows
+from abrupt.detect.attitude import (
+    AttitudeDetectionConfig,
+    _combined_statistic,
+    calibrate_thresholds,
+    detector_windows,
+)
 from abrupt.detect.change_detection import WindowConfig, sliding_statistic
 from abrupt.model.momentum import system_momentum
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
@@ -42,7 +47,10 @@ def batch_momentum(duration_s: float, strikes: list[list[Strike]], seed0: int) -
     out = simulate_attitude_batch(SC, cfg, strikes, seeds=[seed0 + k for k in range(len(strikes))])
     r, n = out["q_BN"].shape[:2]
     h = system_momentum(
-        SC, out["q_BN"].reshape(-1, 4), out["omega_B_rad_s"].reshape(-1, 3), out["wheel_speed_rad_s"].reshape(r * n, -1)
+        SC,
+        out["q_BN"].reshape(-1, 4),
+        out["omega_B_rad_s"].reshape(-1, 3),
+        out["wheel_speed_rad_s"].reshape(r * n, -1),
     ).H_N_Nms.reshape(r, n, 3)
     dh = np.asarray(out["strike_dH_N_Nms"]).reshape(r, -1, 3)[:, 0, :] if strikes and strikes[0] else np.zeros((r, 3))
     return h, dh
@@ -62,11 +70,15 @@ def part_a(n_runs: int, seeds: int) -> None:
         c = c[np.isfinite(c)][:40000]
         cusum_q.append(float(np.quantile(c, 1 - 1e-4)))
         cusum_kde.append(fit_threshold(c, p_fa=1e-4, method="kde").value)
-    print(f"summation threshold (Gaussian, P_fa 1e-4, 40,000 points, {seeds} seeds): "
-          f"{np.mean(sums):.2f} ± {np.std(sums):.2f}   [thesis 8.8, target 8.8 ± 0.5; analytic 3.72·σ_y = "
-          f"{stats.norm.isf(1e-4) * 0.129 * np.sqrt(180 + 180**2 / 200):.2f}]")
-    print(f"CUSUM event-free 1e-4 quantile, empirical: {np.mean(cusum_q):.2f} ± {np.std(cusum_q):.2f}; "
-          f"kernel-density fit: {np.mean(cusum_kde):.2f} ± {np.std(cusum_kde):.2f}   [thesis 13.4, target 11-14]")
+    print(
+        f"summation threshold (Gaussian, P_fa 1e-4, 40,000 points, {seeds} seeds): "
+        f"{np.mean(sums):.2f} ± {np.std(sums):.2f}   [thesis 8.8, target 8.8 ± 0.5; analytic 3.72·σ_y = "
+        f"{stats.norm.isf(1e-4) * 0.129 * np.sqrt(180 + 180**2 / 200):.2f}]"
+    )
+    print(
+        f"CUSUM event-free 1e-4 quantile, empirical: {np.mean(cusum_q):.2f} ± {np.std(cusum_q):.2f}; "
+        f"kernel-density fit: {np.mean(cusum_kde):.2f} ± {np.std(cusum_kde):.2f}   [thesis 13.4, target 11-14]"
+    )
     thr_cusum = 13.4
     rng = np.random.default_rng(5)
     duration = 60.0
@@ -85,8 +97,10 @@ def part_a(n_runs: int, seeds: int) -> None:
         for r in range(n_runs):
             c = sliding_statistic("cusum", h[r], THESIS)
             det += bool(np.nanmax(c) > thr_cusum)
-        print(f"CUSUM detection of 10 mg (0.08 N·m·s) strikes, {mode}, {n_runs} runs, threshold 13.4: "
-              f"{det / n_runs:.1%}   [target ≥ 95% about a body axis]")
+        print(
+            f"CUSUM detection of 10 mg (0.08 N·m·s) strikes, {mode}, {n_runs} runs, threshold 13.4: "
+            f"{det / n_runs:.1%}   [target ≥ 95% about a body axis]"
+        )
     # ΔH estimation for detected 10-100 mg strikes in random directions.
     masses = rng.uniform(10, 100, n_runs)
     strikes = []
@@ -109,8 +123,10 @@ def part_a(n_runs: int, seeds: int) -> None:
         est = h[r, j : j + THESIS.post].mean(axis=0) - h[r, j - THESIS.pre : j].mean(axis=0)
         errs.append(float(np.linalg.norm(est - dh_true[r])))
     errs_arr = np.array(errs)
-    print(f"ΔH error (vector) of detected 10-100 mg strikes: within 0.04 N·m·s for {np.mean(errs_arr <= 0.04):.1%} "
-          f"of {errs_arr.size} detected (median {np.median(errs_arr):.4f} N·m·s)   [target ≥ 90%]")
+    print(
+        f"ΔH error (vector) of detected 10-100 mg strikes: within 0.04 N·m·s for {np.mean(errs_arr <= 0.04):.1%} "
+        f"of {errs_arr.size} detected (median {np.median(errs_arr):.4f} N·m·s)   [target ≥ 90%]"
+    )
 
 
 def part_b(n_runs: int, plot: str | None) -> None:
@@ -120,8 +136,11 @@ def part_b(n_runs: int, plot: str | None) -> None:
     tel = telemetry_from_frame(sim.telemetry, SC)
     t0 = time.perf_counter()
     thresholds, noise = calibrate_thresholds(SC, tel, cfg)
-    print(f"thresholds calibrated in {time.perf_counter() - t0:.1f} s from the momentum noise model "
-          f"(white σ {np.round(noise['white_sigma_Nms'], 4)}, random walk σ {np.round(noise['random_walk_sigma_Nms'], 6)} per sample):")
+    print(
+        f"thresholds calibrated in {time.perf_counter() - t0:.1f} s from the momentum noise model "
+        f"(white σ {np.round(noise['white_sigma_Nms'], 4)}, "
+        f"random walk σ {np.round(noise['random_walk_sigma_Nms'], 6)} per sample):"
+    )
     for k, v in thresholds.items():
         print(f"  {k:10s} {v.value:8.3f}  ({v.method}, {v.false_alarms_per_day:g}/day)")
     sizes = np.array([0.01, 0.015, 0.02, 0.025, 0.03, 0.035, 0.04, 0.05, 0.06, 0.08, 0.1, 0.15, 0.2, 0.3])
@@ -137,7 +156,7 @@ def part_b(n_runs: int, plot: str | None) -> None:
         h, _ = batch_momentum(duration, strikes, int(size * 1e6))
         hits = {k: 0 for k in cfg.detectors}
         for r in range(n_runs):
-            k_strike = int(round(strikes[r][0].time_s * 10))
+            k_strike = round(strikes[r][0].time_s * 10)
             for name in cfg.detectors:
                 win = detector_windows(name, cfg, 0.1)
                 lo = max(0, k_strike - win.pre - win.post - 50)
@@ -147,8 +166,10 @@ def part_b(n_runs: int, plot: str | None) -> None:
                 hits[name] += bool(np.nanmax(near) > thresholds[name].value)
         for name in cfg.detectors:
             curves[name].append(hits[name] / n_runs)
-        print(f"  |ΔH| = {size:5.3f} N·m·s ({size / MG_TO_NMS:5.2f} mg): "
-              + "  ".join(f"{k} {v[-1]:5.1%}" for k, v in curves.items()))
+        print(
+            f"  |ΔH| = {size:5.3f} N·m·s ({size / MG_TO_NMS:5.2f} mg): "
+            + "  ".join(f"{k} {v[-1]:5.1%}" for k, v in curves.items())
+        )
     print("90% detection point (|ΔH| where P_D first reaches 0.9, linear interpolation):")
     for name, pd_ in curves.items():
         p = np.array(pd_)

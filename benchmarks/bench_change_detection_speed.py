@@ -15,10 +15,10 @@ import time
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
-import numpy as np  # noqa: E402
-import psutil  # noqa: E402
+import numpy as np
+import psutil
 
-from abrupt.detect.change_detection import StreamingStatistic, WindowConfig, sliding_statistic  # noqa: E402
+from abrupt.detect.change_detection import StreamingStatistic, WindowConfig, sliding_statistic
 
 
 def throughput(n: int) -> None:
@@ -26,7 +26,13 @@ def throughput(n: int) -> None:
     x = rng.normal(0.0, 0.13, size=(n, 1))
     cfg = WindowConfig()
     print(f"== throughput, one channel, windows {cfg.pre}/{cfg.post}, {n:.0e} samples, one core ==")
-    for name, target in (("cusum", 2e7), ("summation", None), ("mean_difference", None), ("glr", None), ("shiryaev", None)):
+    for name, target in (
+        ("cusum", 2e7),
+        ("summation", None),
+        ("mean_difference", None),
+        ("glr", None),
+        ("shiryaev", None),
+    ):
         m = n if name != "shiryaev" else n // 100
         data = x[:m] if name != "glr" else np.repeat(x[:m], 3, axis=1)
         sliding_statistic(name, data[:5000], cfg)  # compile / load cache

@@ -84,12 +84,26 @@ def test_a_gap_is_never_spanned_by_a_window() -> None:
 def test_cli_simulate_detect_report_and_catalog(tmp_path: Path) -> None:
     runner = CliRunner()
     tel = tmp_path / "tel.csv"
-    r = runner.invoke(cli, ["simulate", "attitude", "--duration", "1500", "--strike", "700:0.2,0.1,0", "--out", str(tel)])
+    r = runner.invoke(
+        cli, ["simulate", "attitude", "--duration", "1500", "--strike", "700:0.2,0.1,0", "--out", str(tel)]
+    )
     assert r.exit_code == 0, r.output
     assert (tmp_path / "tel_truth.csv").exists()
-    args = ["detect", "attitude", str(tel), "--spacecraft", str(bundled_spacecraft_path()), "--null-samples", "500000",
-            "--catalog", str(tmp_path / "cat.sqlite"), "--out", str(tmp_path / "ev.csv"),
-            "--report", str(tmp_path / "r.html")]
+    args = [
+        "detect",
+        "attitude",
+        str(tel),
+        "--spacecraft",
+        str(bundled_spacecraft_path()),
+        "--null-samples",
+        "500000",
+        "--catalog",
+        str(tmp_path / "cat.sqlite"),
+        "--out",
+        str(tmp_path / "ev.csv"),
+        "--report",
+        str(tmp_path / "r.html"),
+    ]
     r = runner.invoke(cli, args)
     assert r.exit_code == 0, r.output
     ev = pd.read_csv(tmp_path / "ev.csv")
@@ -99,9 +113,22 @@ def test_cli_simulate_detect_report_and_catalog(tmp_path: Path) -> None:
     assert r.exit_code == 0 and "0 new" in r.output
     assert len(Catalog(tmp_path / "cat.sqlite").events()) == 1
     assert len(Catalog(tmp_path / "cat.sqlite").runs()) == 2
-    r = runner.invoke(cli, ["report", "attitude", str(tel), "--spacecraft", str(bundled_spacecraft_path()),
-                            "--null-samples", "500000", "--truth", str(tmp_path / "tel_truth.csv"),
-                            "--out", str(tmp_path / "r.png")])
+    r = runner.invoke(
+        cli,
+        [
+            "report",
+            "attitude",
+            str(tel),
+            "--spacecraft",
+            str(bundled_spacecraft_path()),
+            "--null-samples",
+            "500000",
+            "--truth",
+            str(tmp_path / "tel_truth.csv"),
+            "--out",
+            str(tmp_path / "r.png"),
+        ],
+    )
     assert r.exit_code == 0, r.output
     assert (tmp_path / "r.png").read_bytes()[:4] == b"\x89PNG"
 
@@ -110,6 +137,16 @@ def test_cli_reports_bad_input_as_a_one_line_error(tmp_path: Path, capsys: pytes
     bad = tmp_path / "empty.csv"
     bad.write_text("")
     with pytest.raises(SystemExit) as exit_info:
-        main(["detect", "attitude", str(bad), "--spacecraft", str(bundled_spacecraft_path()), "--out", str(tmp_path / "e.csv")])
+        main(
+            [
+                "detect",
+                "attitude",
+                str(bad),
+                "--spacecraft",
+                str(bundled_spacecraft_path()),
+                "--out",
+                str(tmp_path / "e.csv"),
+            ]
+        )
     assert exit_info.value.code == 2
     assert "empty.csv: file is empty" in capsys.readouterr().err

@@ -13,8 +13,18 @@ from abrupt.events import EVENT_COLUMNS, Event, empty_frame, events_frame, read_
 
 def _event(t: str = "2026-01-01T00:10:00", detector: str = "attitude.glr") -> Event:
     return Event(
-        spacecraft="sat-a", kind="strike", detector=detector, time_utc=t, statistic=7.0, threshold=5.0,
-        false_alarms_per_day=1.0, run_id="r1", config_hash="c1", dH_N_x_Nms=0.03, dH_N_y_Nms=0.04, dH_N_z_Nms=0.0,
+        spacecraft="sat-a",
+        kind="strike",
+        detector=detector,
+        time_utc=t,
+        statistic=7.0,
+        threshold=5.0,
+        false_alarms_per_day=1.0,
+        run_id="r1",
+        config_hash="c1",
+        dH_N_x_Nms=0.03,
+        dH_N_y_Nms=0.04,
+        dH_N_z_Nms=0.0,
     )
 
 
@@ -43,8 +53,15 @@ def test_event_ids_are_deterministic_and_distinguish_detectors() -> None:
 @pytest.mark.parametrize("bad", [{"kind": "meteor"}, {"spacecraft": ""}, {"time_sigma_s": -1.0}])
 def test_invalid_events_are_rejected(bad: dict[str, object]) -> None:
     fields = {
-        "spacecraft": "s", "kind": "strike", "detector": "d", "time_utc": "2026-01-01", "statistic": 1.0,
-        "threshold": 1.0, "false_alarms_per_day": 1.0, "run_id": "r", "config_hash": "c",
+        "spacecraft": "s",
+        "kind": "strike",
+        "detector": "d",
+        "time_utc": "2026-01-01",
+        "statistic": 1.0,
+        "threshold": 1.0,
+        "false_alarms_per_day": 1.0,
+        "run_id": "r",
+        "config_hash": "c",
     }
     fields.update(bad)
     with pytest.raises(ValueError):
@@ -77,5 +94,5 @@ def test_export_round_trips(tmp_path, suffix: str) -> None:  # type: ignore[no-u
 
 
 def test_write_events_rejects_unknown_suffix(tmp_path) -> None:  # type: ignore[no-untyped-def]
-    with pytest.raises(ValueError, match="csv or .parquet"):
+    with pytest.raises(ValueError, match=r"csv or \.parquet"):
         write_events(empty_frame(), str(tmp_path / "e.txt"))

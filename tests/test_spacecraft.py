@@ -20,7 +20,20 @@ def test_thesis_spacecraft_matches_table_2_1() -> None:
     np.testing.assert_allclose(sc.wheel_axes[:, 3], np.ones(3) / np.sqrt(3))
     assert sc.wheel_spin_inertias_kgm2.tolist() == [0.16] * 4
     assert sc.wheel_max_torques_Nm.tolist() == [0.2] * 4
-    assert sc.telemetry.required_columns() == ["time", "q0", "q1", "q2", "q3", "wx", "wy", "wz", "rw1", "rw2", "rw3", "rw4"]
+    assert sc.telemetry.required_columns() == [
+        "time",
+        "q0",
+        "q1",
+        "q2",
+        "q3",
+        "wx",
+        "wy",
+        "wz",
+        "rw1",
+        "rw2",
+        "rw3",
+        "rw4",
+    ]
 
 
 def test_example_file_is_the_bundled_file() -> None:
@@ -39,12 +52,21 @@ BASE = THESIS.read_text()
 @pytest.mark.parametrize(
     ("edit", "key"),
     [
-        (lambda t: t.replace('lever_arm_m = 1.0', 'lever_arm_m = 1.0\ncolour = "red"'), "colour"),
-        (lambda t: t.replace('max_torque_Nm = 0.2 ', 'max_torque_Nm = 0.2\nmax_torqe = 1 ', 1), "wheels[0].max_torqe"),
-        (lambda t: t.replace('inertia_kgm2 = [[3000.0', 'inertia_kgm2 = [[-3000.0'), "inertia_kgm2"),
-        (lambda t: t.replace('unit = "rad/s" }\nwheel', 'unit = "furlong" }\nwheel'), "telemetry.body_rate.unit"),
-        (lambda t: t.replace('columns = ["wx", "wy", "wz"]', 'columns = ["wx", "wy"]'), "telemetry.body_rate.columns"),
-        (lambda t: t.replace('name = "thesis"\n', ''), "name"),
+        (lambda t: t.replace("lever_arm_m = 1.0", 'lever_arm_m = 1.0\ncolour = "red"'), "colour"),
+        (
+            lambda t: t.replace("max_torque_Nm = 0.2 ", "max_torque_Nm = 0.2\nmax_torqe = 1 ", 1),
+            "wheels[0].max_torqe",
+        ),
+        (lambda t: t.replace("inertia_kgm2 = [[3000.0", "inertia_kgm2 = [[-3000.0"), "inertia_kgm2"),
+        (
+            lambda t: t.replace('unit = "rad/s" }\nwheel', 'unit = "furlong" }\nwheel'),
+            "telemetry.body_rate.unit",
+        ),
+        (
+            lambda t: t.replace('columns = ["wx", "wy", "wz"]', 'columns = ["wx", "wy"]'),
+            "telemetry.body_rate.columns",
+        ),
+        (lambda t: t.replace('name = "thesis"\n', ""), "name"),
     ],
 )
 def test_bad_spacecraft_files_name_the_key(tmp_path: Path, edit, key: str) -> None:  # type: ignore[no-untyped-def]
@@ -54,7 +76,9 @@ def test_bad_spacecraft_files_name_the_key(tmp_path: Path, edit, key: str) -> No
 
 
 def test_wheels_that_do_not_span_three_axes_are_rejected(tmp_path: Path) -> None:
-    text = BASE.replace("axis = [0.0, 0.0, 1.0]", "axis = [1.0, 0.0, 0.0]").replace("axis = [1.0, 1.0, 1.0]", "axis = [0.0, 1.0, 0.0]")
+    text = BASE.replace("axis = [0.0, 0.0, 1.0]", "axis = [1.0, 0.0, 0.0]").replace(
+        "axis = [1.0, 1.0, 1.0]", "axis = [0.0, 1.0, 0.0]"
+    )
     with pytest.raises(ConfigError, match="span"):
         load_spacecraft(_write(tmp_path, text))
 

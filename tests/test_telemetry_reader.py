@@ -110,9 +110,13 @@ def test_wheel_speeds_in_rpm_declared_as_rad_s_are_an_error(tmp_path: Path) -> N
 
 
 def test_wheel_speeds_in_rpm_read_correctly_when_declared(tmp_path: Path) -> None:
-    text = bundled_spacecraft_path().read_text().replace(
-        'wheel_speed = { columns = ["rw1", "rw2", "rw3", "rw4"], unit = "rad/s" }',
-        'wheel_speed = { columns = ["rw1", "rw2", "rw3", "rw4"], unit = "rpm" }',
+    text = (
+        bundled_spacecraft_path()
+        .read_text()
+        .replace(
+            'wheel_speed = { columns = ["rw1", "rw2", "rw3", "rw4"], unit = "rad/s" }',
+            'wheel_speed = { columns = ["rw1", "rw2", "rw3", "rw4"], unit = "rpm" }',
+        )
     )
     (tmp_path / "sc.toml").write_text(text)
     sc = load_spacecraft(tmp_path / "sc.toml")
@@ -130,7 +134,11 @@ def test_body_rates_in_degrees_declared_as_radians_are_an_error(tmp_path: Path) 
 
 
 def test_unknown_key_in_the_spacecraft_file_is_an_error(tmp_path: Path) -> None:
-    text = bundled_spacecraft_path().read_text().replace("[telemetry]", "[telemetry]\nattitude_error = { columns = [\"e\"] }")
+    text = (
+        bundled_spacecraft_path()
+        .read_text()
+        .replace("[telemetry]", '[telemetry]\nattitude_error = { columns = ["e"] }')
+    )
     (tmp_path / "sc.toml").write_text(text)
     with pytest.raises(ConfigError, match=r"telemetry\.attitude_error"):
         load_spacecraft(tmp_path / "sc.toml")
@@ -144,7 +152,9 @@ def test_spacecraft_file_naming_a_column_the_telemetry_lacks_is_an_error(tmp_pat
         read_telemetry(_write(tmp_path, _frame()), sc)
 
 
-@pytest.mark.parametrize(("content", "message"), [("", "file is empty"), (",".join(_frame().columns) + "\n", "no data rows")])
+@pytest.mark.parametrize(
+    ("content", "message"), [("", "file is empty"), (",".join(_frame().columns) + "\n", "no data rows")]
+)
 def test_empty_files_are_errors(tmp_path: Path, content: str, message: str) -> None:
     p = tmp_path / "e.csv"
     p.write_text(content)

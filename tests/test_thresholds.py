@@ -37,7 +37,9 @@ def test_kde_and_gpd_tails_match_the_normal_quantile() -> None:
 
 def test_gamma_fit_matches_the_gamma_quantile() -> None:
     x = RNG.gamma(3.0, 2.0, size=100_000)
-    assert fit_threshold(x, p_fa=1e-3, method="gamma").value == pytest.approx(stats.gamma.isf(1e-3, 3.0, scale=2.0), rel=0.02)
+    assert fit_threshold(x, p_fa=1e-3, method="gamma").value == pytest.approx(
+        stats.gamma.isf(1e-3, 3.0, scale=2.0), rel=0.02
+    )
 
 
 def test_threshold_records_its_false_alarm_rate() -> None:

@@ -113,9 +113,7 @@ class Catalog:
             existing: set[str] = set()
             for start in range(0, len(ids), 500):
                 chunk = ids[start : start + 500]
-                rows = conn.execute(
-                    sa.select(events_table.c.event_id).where(events_table.c.event_id.in_(chunk))
-                )
+                rows = conn.execute(sa.select(events_table.c.event_id).where(events_table.c.event_id.in_(chunk)))
                 existing.update(r[0] for r in rows)
             extra_cols = [c for c in frame.columns if c not in EVENT_COLUMNS]
             records = []

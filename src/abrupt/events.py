@@ -17,7 +17,7 @@ import json
 import math
 import uuid
 from collections.abc import Iterable, Mapping
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import asdict, dataclass, field, fields, is_dataclass
 from typing import Any
 
 import numpy as np
@@ -67,7 +67,7 @@ NAN = float("nan")
 
 def config_hash(config: Mapping[str, Any] | Any) -> str:
     """Stable 16-hex-digit hash of a configuration (a mapping or a dataclass), for ``config_hash``."""
-    if hasattr(config, "__dataclass_fields__"):
+    if is_dataclass(config) and not isinstance(config, type):
         config = asdict(config)
     text = json.dumps(config, sort_keys=True, default=_json_default)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
@@ -184,7 +184,7 @@ def normalise_frame(frame: pd.DataFrame) -> pd.DataFrame:
     for name in _FLOAT_COLUMNS:
         out[name] = pd.to_numeric(out[name], errors="raise").astype("float64")
     for name in ("event_id", "spacecraft", "kind", "detector", "time_utc", "run_id", "config_hash"):
-        out[name] = out[name].astype("string") if len(out) else out[name].astype("string")
+        out[name] = out[name].astype("string")
     bad = ~out["kind"].isin(EVENT_KINDS)
     if bad.any():
         raise ValueError(f"event kinds {sorted(set(out.loc[bad, 'kind']))} not in {EVENT_KINDS}")

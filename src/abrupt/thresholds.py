@@ -146,7 +146,8 @@ def fit_threshold(
         if sample_rate_hz is None:
             raise ValueError("the gev fit needs sample_rate_hz")
         return fit_block_maxima_threshold(
-            null_statistic, sample_rate_hz=sample_rate_hz,
+            null_statistic,
+            sample_rate_hz=sample_rate_hz,
             false_alarms_per_day=false_alarms_from_p(p_fa, sample_rate_hz),
         )
     else:
@@ -190,7 +191,7 @@ def fit_block_maxima_threshold(
     fitted to the maxima and the threshold is the level exceeded in a block with probability
     1 − exp(−rate · block length), i.e. a Poisson rate of ``false_alarms_per_day`` episodes.
     """
-    block = max(2, int(round(block_s * sample_rate_hz)))
+    block = max(2, round(block_s * sample_rate_hz))
     maxima = block_maxima(null_statistic, block)
     if maxima.size < 20:
         raise ValueError(

@@ -54,17 +54,33 @@ def random_strikes(n: int, duration_s: float, dh_min: float, dh_max: float, seed
 
 
 @simulate.command("attitude")
-@click.option("--spacecraft", "spacecraft_path", type=click.Path(exists=True, dir_okay=False), default=None,
-              help="Spacecraft TOML (default: the thesis spacecraft, Bennett 2022 Table 2.1).")
+@click.option(
+    "--spacecraft",
+    "spacecraft_path",
+    type=click.Path(exists=True, dir_okay=False),
+    default=None,
+    help="Spacecraft TOML (default: the thesis spacecraft, Bennett 2022 Table 2.1).",
+)
 @click.option("--duration", "duration_s", type=float, default=3600.0, show_default=True, help="Simulated time [s].")
 @click.option("--telemetry-rate", "telemetry_rate_hz", type=float, default=10.0, show_default=True, help="[Hz]")
-@click.option("--rate-noise", "rate_noise", type=float, default=4e-5, show_default=True,
-              help="Body-rate telemetry noise σ [rad/s] (spec §3.6; Table 2.1 prints 2e-4).")
+@click.option(
+    "--rate-noise",
+    "rate_noise",
+    type=float,
+    default=4e-5,
+    show_default=True,
+    help="Body-rate telemetry noise σ [rad/s] (spec §3.6; Table 2.1 prints 2e-4).",
+)
 @click.option("--no-noise", is_flag=True, help="Noise-free simulation.")
 @click.option("--strike", "strikes", multiple=True, help="TIME_S:DHX,DHY,DHZ (body axes, N·m·s); repeatable.")
 @click.option("--random-strikes", type=int, default=0, help="Add N strikes at random times and directions.")
-@click.option("--strike-range", type=(float, float), default=(0.02, 0.5), show_default=True,
-              help="|ΔH| range of random strikes [N·m·s] (log-uniform).")
+@click.option(
+    "--strike-range",
+    type=(float, float),
+    default=(0.02, 0.5),
+    show_default=True,
+    help="|ΔH| range of random strikes [N·m·s] (log-uniform).",
+)
 @click.option("--wheel-resolution", type=float, default=None, help="Tachometer discretisation [rad/s].")
 @click.option("--start", "start_utc", default="2026-01-01T00:00:00", show_default=True, help="Start time (UTC).")
 @click.option("--seed", type=int, default=0, show_default=True)
@@ -104,7 +120,9 @@ def simulate_attitude_cmd(
     )
     result = simulate_attitude(sc, cfg, sorted(strike_list, key=lambda s: s.time_s))
     tel_path, truth_path = write_telemetry(result, out)
-    click.echo(f"telemetry: {tel_path} ({len(result.telemetry)} samples); truth: {truth_path} ({len(result.truth)} strikes)")
+    click.echo(
+        f"telemetry: {tel_path} ({len(result.telemetry)} samples); truth: {truth_path} ({len(result.truth)} strikes)"
+    )
 
 
 def _random_strikes(n: int, duration_s: float, strike_range: tuple[float, float], seed: int) -> list[Strike]:
@@ -128,19 +146,46 @@ def _detection_config(
 
 
 detector_options = [
-    click.option("--detector", "detectors", multiple=True, type=click.Choice(DETECTOR_CHOICES), default=("glr",),
-                 show_default=True, help="Detector(s); repeatable; 'all' runs every one."),
-    click.option("--false-alarms-per-day", "fa_per_day", type=float, default=1.0, show_default=True,
-                 help="False-alarm budget the thresholds are set for."),
+    click.option(
+        "--detector",
+        "detectors",
+        multiple=True,
+        type=click.Choice(DETECTOR_CHOICES),
+        default=("glr",),
+        show_default=True,
+        help="Detector(s); repeatable; 'all' runs every one.",
+    ),
+    click.option(
+        "--false-alarms-per-day",
+        "fa_per_day",
+        type=float,
+        default=1.0,
+        show_default=True,
+        help="False-alarm budget the thresholds are set for.",
+    ),
     click.option("--pre", type=int, default=200, show_default=True, help="Pre-window [samples] (thesis detectors)."),
     click.option("--post", type=int, default=180, show_default=True, help="Post-window [samples] (thesis detectors)."),
-    click.option("--threshold-fit", "method", type=click.Choice(["gev", "gpd", "kde", "gaussian", "gamma", "empirical"]),
-                 default="gev", show_default=True,
-                 help="Fit of the event-free statistic (gev: block maxima, sets alarm episodes per day)."),
-    click.option("--null-samples", type=int, default=10_000_000, show_default=True,
-                 help="Event-free samples simulated for threshold calibration (without --calibration)."),
-    click.option("--calibration", type=click.Path(exists=True, dir_okay=False), default=None,
-                 help="Event-free telemetry of the same spacecraft to fit thresholds on."),
+    click.option(
+        "--threshold-fit",
+        "method",
+        type=click.Choice(["gev", "gpd", "kde", "gaussian", "gamma", "empirical"]),
+        default="gev",
+        show_default=True,
+        help="Fit of the event-free statistic (gev: block maxima, sets alarm episodes per day).",
+    ),
+    click.option(
+        "--null-samples",
+        type=int,
+        default=10_000_000,
+        show_default=True,
+        help="Event-free samples simulated for threshold calibration (without --calibration).",
+    ),
+    click.option(
+        "--calibration",
+        type=click.Path(exists=True, dir_okay=False),
+        default=None,
+        help="Event-free telemetry of the same spacecraft to fit thresholds on.",
+    ),
 ]
 
 
@@ -154,8 +199,16 @@ def _with_options(options: list[Any]) -> Any:
 
 
 def run_attitude_detection(
-    telemetry_path: str, spacecraft_path: str | None, detectors: tuple[str, ...], fa_per_day: float, pre: int,
-    post: int, method: str, null_samples: int, calibration: str | None, name: str | None,
+    telemetry_path: str,
+    spacecraft_path: str | None,
+    detectors: tuple[str, ...],
+    fa_per_day: float,
+    pre: int,
+    post: int,
+    method: str,
+    null_samples: int,
+    calibration: str | None,
+    name: str | None,
 ) -> tuple[Any, Any, Any, Any]:
     """Read, calibrate and detect, with a progress line per stage. Returns (sc, telemetry, config, result)."""
     from abrupt.detect.attitude import detect_attitude
@@ -178,21 +231,41 @@ def run_attitude_detection(
 
 @detect.command("attitude")
 @click.argument("telemetry", type=click.Path(exists=True, dir_okay=False))
-@click.option("--spacecraft", "spacecraft_path", type=click.Path(exists=True, dir_okay=False), required=True,
-              help="Spacecraft TOML with the telemetry column mapping.")
+@click.option(
+    "--spacecraft",
+    "spacecraft_path",
+    type=click.Path(exists=True, dir_okay=False),
+    required=True,
+    help="Spacecraft TOML with the telemetry column mapping.",
+)
 @_with_options(detector_options)
 @click.option("--name", default=None, help="Spacecraft pseudonym in events (default: the spacecraft file's name).")
 @catalog_option
 @click.option("--out", type=click.Path(dir_okay=False), required=True, help="Events file (.csv or .parquet).")
-@click.option("--report", "report_path", type=click.Path(dir_okay=False), default=None,
-              help="Also write the report figure (.png or .html).")
+@click.option(
+    "--report",
+    "report_path",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Also write the report figure (.png or .html).",
+)
 def detect_attitude_cmd(
-    telemetry: str, spacecraft_path: str, detectors: tuple[str, ...], fa_per_day: float, pre: int, post: int,
-    method: str, null_samples: int, calibration: str | None, name: str | None, catalog_target: str, out: str,
+    telemetry: str,
+    spacecraft_path: str,
+    detectors: tuple[str, ...],
+    fa_per_day: float,
+    pre: int,
+    post: int,
+    method: str,
+    null_samples: int,
+    calibration: str | None,
+    name: str | None,
+    catalog_target: str,
+    out: str,
     report_path: str | None,
 ) -> None:
     """Detect strikes in attitude TELEMETRY (CSV or Parquet); write events and the catalog."""
-    sc, tel, cfg, result = run_attitude_detection(
+    _, tel, _, result = run_attitude_detection(
         telemetry, spacecraft_path, detectors, fa_per_day, pre, post, method, null_samples, calibration, name
     )
     details = {
@@ -211,7 +284,10 @@ def detect_attitude_cmd(
         details=details,
     )
     for k, thr in result.thresholds.items():
-        click.echo(f"threshold {k}: {thr.value:.4g} ({thr.false_alarms_per_day:g} false alarms/day, {thr.method})", err=True)
+        click.echo(
+            f"threshold {k}: {thr.value:.4g} ({thr.false_alarms_per_day:g} false alarms/day, {thr.method})",
+            err=True,
+        )
     if report_path:
         from abrupt.report.attitude import write_attitude_report
 
@@ -223,12 +299,25 @@ def detect_attitude_cmd(
 @click.argument("telemetry", type=click.Path(exists=True, dir_okay=False))
 @click.option("--spacecraft", "spacecraft_path", type=click.Path(exists=True, dir_okay=False), required=True)
 @_with_options(detector_options)
-@click.option("--truth", type=click.Path(exists=True, dir_okay=False), default=None,
-              help="Truth file of a simulation (marks the true strike times).")
+@click.option(
+    "--truth",
+    type=click.Path(exists=True, dir_okay=False),
+    default=None,
+    help="Truth file of a simulation (marks the true strike times).",
+)
 @click.option("--out", type=click.Path(dir_okay=False), required=True, help="Figure (.png) or page (.html).")
 def report_attitude_cmd(
-    telemetry: str, spacecraft_path: str, detectors: tuple[str, ...], fa_per_day: float, pre: int, post: int,
-    method: str, null_samples: int, calibration: str | None, truth: str | None, out: str,
+    telemetry: str,
+    spacecraft_path: str,
+    detectors: tuple[str, ...],
+    fa_per_day: float,
+    pre: int,
+    post: int,
+    method: str,
+    null_samples: int,
+    calibration: str | None,
+    truth: str | None,
+    out: str,
 ) -> None:
     """Draw the attitude report: momentum, contributions, raw channels, statistics, thresholds, events."""
     import pandas as pd
@@ -244,8 +333,14 @@ def report_attitude_cmd(
 
 
 @cli.command("demo")
-@click.option("--out", "out_dir", type=click.Path(file_okay=False), default="abrupt_demo", show_default=True,
-              help="Folder for the demo's telemetry, events, catalog and report.")
+@click.option(
+    "--out",
+    "out_dir",
+    type=click.Path(file_okay=False),
+    default="abrupt_demo",
+    show_default=True,
+    help="Folder for the demo's telemetry, events, catalog and report.",
+)
 @click.option("--duration", "duration_s", type=float, default=3 * 3600.0, show_default=True, help="[s]")
 @click.option("--seed", type=int, default=7, show_default=True)
 def demo(out_dir: str, duration_s: float, seed: int) -> None:
@@ -270,7 +365,10 @@ def demo(out_dir: str, duration_s: float, seed: int) -> None:
         u = rng.normal(size=3)
         u /= np.linalg.norm(u)
         strikes.append(Strike(round(float(t), 1), tuple(float(v) for v in size * u)))  # type: ignore[arg-type]
-    click.echo(f"[1/4] simulating {duration_s / 3600:g} h of 10 Hz telemetry with {len(strikes)} strikes ...", err=True)
+    click.echo(
+        f"[1/4] simulating {duration_s / 3600:g} h of 10 Hz telemetry with {len(strikes)} strikes ...",
+        err=True,
+    )
     sim = simulate_attitude(sc, AttitudeSimConfig(duration_s=duration_s, seed=seed), strikes)
     tel_path, truth_path = write_telemetry(sim, out / "telemetry.parquet")
     click.echo("[2/4] reading telemetry and calibrating thresholds (one false alarm per day) ...", err=True)
@@ -294,16 +392,21 @@ def demo(out_dir: str, duration_s: float, seed: int) -> None:
     write_attitude_report(out / "report.html", tel, result, truth=truth, title="abrupt demo: thesis spacecraft")
     click.echo("\ntruth vs detections (match within 5 s):")
     ev = result.events
-    ev_t = pd.to_datetime(ev["time_utc"].astype(str)).dt.tz_localize(None) if len(ev) else pd.Series([], dtype="datetime64[ns]")
+    ev_t = pd.Series(pd.to_datetime(ev["time_utc"].astype(str)).dt.tz_localize(None), dtype="datetime64[ns]")
     start = pd.Timestamp(tel.time[0])
     for _, row in truth.iterrows():
         t_true = start + pd.Timedelta(seconds=float(row["time_s"]))
         line = f"  strike at {float(row['time_s']):8.1f} s, |ΔH| = {float(row['dH_Nms']):.3f} N·m·s:"
         for det in cfg.detectors:
-            sel = ev[(ev["detector"] == f"attitude.{det}") & ((ev_t - t_true).abs() <= pd.Timedelta(seconds=5)).to_numpy()]
+            sel = ev[
+                (ev["detector"] == f"attitude.{det}") & ((ev_t - t_true).abs() <= pd.Timedelta(seconds=5)).to_numpy()
+            ]
             if len(sel):
                 line += f"  {det} ✓ (ΔH {float(sel['dH_Nms'].iloc[0]):.3f})"
             else:
                 line += f"  {det} –"
         click.echo(line)
-    click.echo(f"\noutputs in {out}/: telemetry.parquet, telemetry_truth.csv, events.csv, catalog.sqlite, report.png, report.html")
+    click.echo(
+        f"\noutputs in {out}/: telemetry.parquet, telemetry_truth.csv, events.csv, catalog.sqlite, "
+        "report.png, report.html"
+    )

@@ -65,7 +65,10 @@ catalog_option = click.option(
 )
 
 spacecraft_name_option = click.option(
-    "--name", "pseudonym", default=None, help="Pseudonym for the spacecraft in events (default: from the input)."
+    "--name",
+    "pseudonym",
+    default=None,
+    help="Pseudonym for the spacecraft in events (default: from the input).",
 )
 
 

@@ -123,6 +123,15 @@ def _combined_statistic(name: str, h: FloatArray, win: WindowConfig) -> FloatArr
     return np.asarray(out, dtype=np.float64)
 
 
+def _segment_statistic(name: str, h: FloatArray, win: WindowConfig) -> Callable[[int, int], FloatArray]:
+    """The combined statistic of rows [a, b) of h, for :func:`_per_segment`."""
+
+    def statistic(a: int, b: int) -> FloatArray:
+        return _combined_statistic(name, h[a:b], win)
+
+    return statistic
+
+
 def _per_segment(segments: list[tuple[int, int]], n: int, fn: Callable[[int, int], FloatArray]) -> FloatArray:
     out = np.full(n, np.nan)
     for a, b in segments:
@@ -226,7 +235,7 @@ def calibrate_thresholds(
             segs = [(0, h.shape[0])]
         else:
             segs = segments
-        stat = _per_segment(segs, h.shape[0], lambda a, b, h=h, win=win, name=name: _combined_statistic(name, h[a:b], win))
+        stat = _per_segment(segs, h.shape[0], _segment_statistic(name, h, win))
         thresholds[name] = fit_threshold(
             stat,
             false_alarms_per_day=config.false_alarms_per_day,
@@ -250,9 +259,7 @@ def _window_mean(h: FloatArray, a: int, b: int) -> FloatArray:
     return np.asarray(h[max(a, 0) : max(b, 0)].mean(axis=0), dtype=np.float64)
 
 
-def _locate_step(
-    h_total: FloatArray, lo: int, hi: int, m: int, direction: FloatArray
-) -> tuple[int, float]:
+def _locate_step(h_total: FloatArray, lo: int, hi: int, m: int, direction: FloatArray) -> tuple[int, float]:
     """Sample index τ in [lo, hi) maximising the projected step d(τ)·û of total ᴺH (windows of m).
 
     Total momentum is conserved through the control transient, so it steps at the strike sample;
@@ -299,7 +306,12 @@ def detect_attitude(
     noise: dict[str, FloatArray] = {}
     if thresholds is None:
         thresholds, noise = calibrate_thresholds(
-            spacecraft, telemetry, config, calibration=calibration, data_momentum_N_Nms=mom.H_N_Nms, progress=progress
+            spacecraft,
+            telemetry,
+            config,
+            calibration=calibration,
+            data_momentum_N_Nms=mom.H_N_Nms,
+            progress=progress,
         )
     statistics: dict[str, FloatArray] = {}
     events: list[Event] = []
@@ -309,7 +321,7 @@ def detect_attitude(
             progress(name)
         win = detector_windows(name, config, dt)
         h = mom.H_N_Nms
-        stat = _per_segment(telemetry.segments, n, lambda a, b, h=h, win=win, name=name: _combined_statistic(name, h[a:b], win))
+        stat = _per_segment(telemetry.segments, n, _segment_statistic(name, h, win))
         statistics[name] = stat
         thr = thresholds[name]
         for a, b in _episodes(stat, thr.value, merge=win.span):

@@ -179,7 +179,12 @@ def _mean_difference_kernel(
 
 @nb.njit(cache=True)
 def _cusum_lanes(
-    x32: NDArray[np.float32], m32: NDArray[np.float32], a32: NDArray[np.float32], start: int, post: int, h: float
+    x32: NDArray[np.float32],
+    m32: NDArray[np.float32],
+    a32: NDArray[np.float32],
+    start: int,
+    post: int,
+    h: float,
 ) -> NDArray[np.float32]:
     """CUSUM of 64 neighbouring windows at once (inner loop vectorises across windows, float32)."""
     lanes = 64
@@ -366,9 +371,7 @@ def _glr_kernel(
     return out
 
 
-def _evaluate(
-    name: str, x: FloatArray, offset: int, n_first: int, count: int, cfg: WindowConfig
-) -> FloatArray:
+def _evaluate(name: str, x: FloatArray, offset: int, n_first: int, count: int, cfg: WindowConfig) -> FloatArray:
     args = (x, offset, cfg.pre, cfg.guard, cfg.post, n_first, count, ANCHOR)
     if name == "summation":
         return _summation_kernel(*args)
@@ -449,7 +452,9 @@ class StreamingStatistic:
         count = last_junction - self._next_junction + 1
         if count > 0:
             # The anchored running sums may start up to ANCHOR - 1 samples before the first window.
-            values = _evaluate(self.name, np.ascontiguousarray(buf), self._offset, self._next_junction, count, self.config)
+            values = _evaluate(
+                self.name, np.ascontiguousarray(buf), self._offset, self._next_junction, count, self.config
+            )
             idx = np.arange(self._next_junction, self._next_junction + count, dtype=np.int64)
             self._next_junction += count
         else:
@@ -468,4 +473,8 @@ def statistic_function(name: str) -> Callable[[ArrayLike, WindowConfig | None], 
     """The batch function for a statistic name (registry by name, as in ruptures)."""
     if name not in STATISTICS:
         raise ValueError(f"unknown statistic {name!r}; choose one of {STATISTICS}")
-    return lambda x, cfg=None: sliding_statistic(name, x, cfg)
+
+    def statistic(x: ArrayLike, cfg: WindowConfig | None = None) -> FloatArray:
+        return sliding_statistic(name, x, cfg)
+
+    return statistic

@@ -89,4 +89,3 @@ def system_momentum(
         H_body_N_Nms=h_body_n,
         H_wheels_N_Nms=h_wheels_n,
     )
-

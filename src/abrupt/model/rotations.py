@@ -14,9 +14,9 @@ FloatArray = NDArray[np.float64]
 
 def normalise_quaternion(q: ArrayLike) -> FloatArray:
     """Unit quaternion(s) along the last axis, sign chosen so that q0 >= 0."""
-    q = np.asarray(q, dtype=np.float64)
-    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
-    return np.where(q[..., :1] < 0, -q, q)
+    arr = np.asarray(q, dtype=np.float64)
+    arr = arr / np.linalg.norm(arr, axis=-1, keepdims=True)
+    return np.where(arr[..., :1] < 0, -arr, arr)
 
 
 def dcm_from_quaternion(q: ArrayLike) -> FloatArray:

@@ -58,7 +58,16 @@ RATE_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0, "arcsec/s": math.pi / 180.
 WHEEL_SPEED_UNITS = {"rad/s": 1.0, "rpm": 2.0 * math.pi / 60.0, "rps": 2.0 * math.pi}
 ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180.0}
 
-_TOP_KEYS = {"name", "mass_kg", "inertia_kgm2", "lever_arm_m", "wheels", "appendages", "surfaces", "telemetry"}
+_TOP_KEYS = {
+    "name",
+    "mass_kg",
+    "inertia_kgm2",
+    "lever_arm_m",
+    "wheels",
+    "appendages",
+    "surfaces",
+    "telemetry",
+}
 _WHEEL_KEYS = {"name", "axis", "spin_inertia_kgm2", "max_torque_Nm", "max_speed_rad_s"}
 _APPENDAGE_KEYS = {"name", "mass_kg", "inertia_kgm2", "hinge_m", "gimbal_axes", "angle_columns", "angle_unit"}
 _SURFACE_KEYS = {"name", "shape", "size_m", "center_m", "normal", "u_axis", "kind"}
@@ -260,7 +269,9 @@ def spacecraft_from_dict(data: dict[str, Any], *, source: str = "<memory>") -> S
             Wheel(
                 name=str(w.get("name", f"rw{i + 1}")),
                 axis=_unit_vector(_require(w, "axis", where, file), f"{where}.axis", file),
-                spin_inertia_kgm2=_positive(_require(w, "spin_inertia_kgm2", where, file), f"{where}.spin_inertia_kgm2", file),
+                spin_inertia_kgm2=_positive(
+                    _require(w, "spin_inertia_kgm2", where, file), f"{where}.spin_inertia_kgm2", file
+                ),
                 max_torque_Nm=_positive(_require(w, "max_torque_Nm", where, file), f"{where}.max_torque_Nm", file),
                 max_speed_rad_s=_positive(w.get("max_speed_rad_s", 630.0), f"{where}.max_speed_rad_s", file),
             )
@@ -337,8 +348,8 @@ def spacecraft_from_dict(data: dict[str, Any], *, source: str = "<memory>") -> S
         )
     else:
         telemetry = TelemetryMap(wheel_speed=ChannelMap(tuple(w.name for w in wheels), "rad/s"))
-    cols = telemetry.required_columns()
-    dup = sorted({c for c in cols if cols.count(c) > 1})
+    mapped = telemetry.required_columns()
+    dup = sorted({c for c in mapped if mapped.count(c) > 1})
     if dup:
         raise ConfigError(f"column(s) {dup} mapped to more than one quantity", file=file, key="telemetry")
     return Spacecraft(

@@ -139,7 +139,10 @@ def telemetry_from_frame(
     if times.isna().any():
         row = int(np.flatnonzero(times.isna().to_numpy())[0])
         raise InputError(
-            f"not an ISO-8601 time: {raw_time.iloc[row]!r}", file=path, line=_line(row, is_csv), column=tmap.time
+            f"not an ISO-8601 time: {raw_time.iloc[row]!r}",
+            file=path,
+            line=_line(row, is_csv),
+            column=tmap.time,
         )
     time_ns = times.dt.tz_localize(None).to_numpy(dtype="datetime64[ns]")
 
@@ -155,7 +158,13 @@ def telemetry_from_frame(
     finite = np.all(np.isfinite(q), axis=1) & np.all(np.isfinite(w), axis=1) & np.all(np.isfinite(omega), axis=1)
     if not finite.all():
         repairs.record("rows with empty or NaN values removed", int((~finite).sum()))
-        time_ns, q, w, omega, line_of_row = time_ns[finite], q[finite], w[finite], omega[finite], line_of_row[finite]
+        time_ns, q, w, omega, line_of_row = (
+            time_ns[finite],
+            q[finite],
+            w[finite],
+            omega[finite],
+            line_of_row[finite],
+        )
     if time_ns.size == 0:
         raise InputError("no complete data rows (every row has an empty value)", file=path)
 
@@ -164,12 +173,20 @@ def telemetry_from_frame(
     if np.any(order != np.arange(order.size)):
         n_out = int(np.count_nonzero(np.diff(time_ns.astype(np.int64)) < 0))
         repairs.record("timestamps out of order (rows sorted)", n_out)
-        time_ns, q, w, omega, line_of_row = time_ns[order], q[order], w[order], omega[order], line_of_row[order]
+        time_ns, q, w, omega, line_of_row = (
+            time_ns[order],
+            q[order],
+            w[order],
+            omega[order],
+            line_of_row[order],
+        )
     dup = np.concatenate([[False], np.diff(time_ns.astype(np.int64)) == 0])
     if dup.any():
         prev = np.flatnonzero(dup) - 1
         same = (
-            np.all(q[dup] == q[prev], axis=1) & np.all(w[dup] == w[prev], axis=1) & np.all(omega[dup] == omega[prev], axis=1)
+            np.all(q[dup] == q[prev], axis=1)
+            & np.all(w[dup] == w[prev], axis=1)
+            & np.all(omega[dup] == omega[prev], axis=1)
         )
         repairs.record("duplicate timestamps with identical values removed", int(same.sum()))
         repairs.record("duplicate timestamps with conflicting values (first row kept)", int((~same).sum()))
@@ -214,14 +231,14 @@ def telemetry_from_frame(
         limits = spacecraft.wheel_max_speeds_rad_s * WHEEL_OVERSPEED_FACTOR
         over = np.abs(omega) > limits[None, :]
         if over.any():
-            row, col = (int(v) for v in np.argwhere(over)[0])
-            hint = " (values look like rpm: set unit = \"rpm\")" if tmap.wheel_speed.unit == "rad/s" else ""
+            row, wheel = (int(v) for v in np.argwhere(over)[0])
+            hint = ' (values look like rpm: set unit = "rpm")' if tmap.wheel_speed.unit == "rad/s" else ""
             raise InputError(
-                f"wheel speed {omega[row, col]:.6g} rad/s exceeds {WHEEL_OVERSPEED_FACTOR} x the wheel's maximum "
-                f"{spacecraft.wheel_max_speeds_rad_s[col]:.6g} rad/s with unit {tmap.wheel_speed.unit!r}{hint}",
+                f"wheel speed {omega[row, wheel]:.6g} rad/s exceeds {WHEEL_OVERSPEED_FACTOR} x the wheel's maximum "
+                f"{spacecraft.wheel_max_speeds_rad_s[wheel]:.6g} rad/s with unit {tmap.wheel_speed.unit!r}{hint}",
                 file=path,
                 line=_line(int(line_of_row[row]), is_csv),
-                column=tmap.wheel_speed.columns[col],
+                column=tmap.wheel_speed.columns[wheel],
             )
 
     t_ns = time_ns.astype(np.int64)

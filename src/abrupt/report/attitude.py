@@ -18,13 +18,13 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-from numpy.typing import NDArray  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
 
-from abrupt.detect.attitude import STATISTIC_UNITS, DetectionResult  # noqa: E402
-from abrupt.readers.telemetry import Telemetry  # noqa: E402
+from abrupt.detect.attitude import STATISTIC_UNITS, DetectionResult
+from abrupt.readers.telemetry import Telemetry
 
 MAX_POINTS = 20000  # per line; longer series are min/max decimated so spikes stay visible
 SMOOTHING_S = 30.0  # [s] running mean drawn over the noisy momentum
@@ -73,7 +73,7 @@ def attitude_figure(
     colours = ("tab:blue", "tab:orange", "tab:green")
 
     h = result.momentum_N_Nms
-    smooth_n = max(1, int(round(SMOOTHING_S / telemetry.sample_interval_s)))
+    smooth_n = max(1, round(SMOOTHING_S / telemetry.sample_interval_s))
     ax = axes[0]
     for i in range(3):
         tt, yy = _decimate(t_h, h[:, i] - h[0, i])
@@ -117,7 +117,9 @@ def attitude_figure(
 
     events = result.events
     if len(events):
-        ev_t = (pd.to_datetime(events["time_utc"].astype(str)).dt.tz_localize(None) - pd.Timestamp(t0)).dt.total_seconds() / 3600
+        ev_t = (
+            pd.to_datetime(events["time_utc"].astype(str)).dt.tz_localize(None) - pd.Timestamp(t0)
+        ).dt.total_seconds() / 3600
         for ax in axes:
             for x in ev_t:
                 ax.axvline(float(x), color="tab:red", lw=0.8, alpha=0.5)
@@ -160,10 +162,25 @@ def write_attitude_report(
         for k, v in result.thresholds.items()
     )
     repairs = "".join(f"<li>{html.escape(line)}</li>" for line in telemetry.repairs.summary()) or "<li>none</li>"
-    cols = ["detector", "time_utc", "time_sigma_s", "statistic", "threshold", "dH_N_x_Nms", "dH_N_y_Nms", "dH_N_z_Nms", "dH_Nms"]
-    table = result.events[cols].to_html(index=False, float_format=lambda v: f"{v:.4g}") if len(result.events) else "<p>No events.</p>"
+    cols = [
+        "detector",
+        "time_utc",
+        "time_sigma_s",
+        "statistic",
+        "threshold",
+        "dH_N_x_Nms",
+        "dH_N_y_Nms",
+        "dH_N_z_Nms",
+        "dH_Nms",
+    ]
+    table = (
+        result.events[cols].to_html(index=False, float_format=lambda v: f"{v:.4g}")
+        if len(result.events)
+        else "<p>No events.</p>"
+    )
     page = f"""<!doctype html><html><head><meta charset="utf-8"><title>abrupt attitude report</title>
-<style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:2px 6px}}</style>
+<style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}
+td,th{{border:1px solid #ccc;padding:2px 6px}}</style>
 </head><body><h1>{html.escape(title or "abrupt attitude report")}</h1>
 <p>Input: {html.escape(telemetry.source)}; {len(telemetry)} samples at {telemetry.sample_rate_hz:.4g} Hz;
 {len(telemetry.segments)} contiguous segment(s).</p>
