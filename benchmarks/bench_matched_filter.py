@@ -63,9 +63,7 @@ class Study:
         self.sd6 = np.array([7e-5] * 3 + [rate_noise] * 3)
         self.combined = CombinedFilter.from_wavelets(wav, self.sd6)
         n_wheels = wav.wheel.shape[2]
-        self.joint = CombinedFilter.from_wavelets(
-            wav, np.concatenate([self.sd6, [0.25] * n_wheels]), use_wheels=True
-        )
+        self.joint = CombinedFilter.from_wavelets(wav, np.concatenate([self.sd6, [0.25] * n_wheels]), use_wheels=True)
 
     def _config(self, duration_s: float) -> AttitudeSimConfig:
         return AttitudeSimConfig(
@@ -102,8 +100,7 @@ class Study:
         rng = np.random.default_rng(seed)
         times = rng.uniform(25.0, 30.0, size=dh_b.shape[0])
         strikes = [
-            [Strike(float(t), (float(d[0]), float(d[1]), float(d[2])))]
-            for t, d in zip(times, dh_b, strict=True)
+            [Strike(float(t), (float(d[0]), float(d[1]), float(d[2])))] for t, d in zip(times, dh_b, strict=True)
         ]
         out = simulate_attitude_batch(
             self.sc, self._config(60.0), strikes, [seed * 100_000 + r for r in range(len(strikes))]
@@ -170,8 +167,7 @@ def run(quick: bool) -> None:
             sd_emp = np.std(null[kind], axis=0)
             noise = 7e-5 if kind == "attitude" else rate_noise
             sd_an = [
-                analytic_output_sd(wav.wavelet(kind, a), noise, dH_wavelet_Nms=float(wav.dH_Nms[a]))
-                for a in range(3)
+                analytic_output_sd(wav.wavelet(kind, a), noise, dH_wavelet_Nms=float(wav.dH_Nms[a])) for a in range(3)
             ]  # type: ignore[arg-type]
             print(
                 f"  {kind:8s} output sd [N·m·s] measured {np.round(sd_emp, 4)} "
@@ -221,9 +217,7 @@ def run(quick: bool) -> None:
                 )
 
         # ---- Table 2.3: size estimation over random sizes/directions, detected strikes only ----
-        print(
-            "\n-- Table 2.3: wavelet-bank size error [mg] (estimated - true |dH|), detected strikes only --"
-        )
+        print("\n-- Table 2.3: wavelet-bank size error [mg] (estimated - true |dH|), detected strikes only --")
         mg_true = rng.uniform(1.0, 100.0, size=n_size)
         dirs = _random_directions(rng, n_size)
         runs = st.strikes(dirs * (mg_true * NMS_PER_MG)[:, None], seed=int(rng.integers(1 << 30)))
@@ -253,11 +247,7 @@ def run(quick: bool) -> None:
                 errs["least-squares"].append(np.linalg.norm(r[kind][i]) / NMS_PER_MG - m_true)
             big = 60.0 if kind == "attitude" else 80.0
             sel = mg_true > big
-            hit = [
-                _peak(r[kind], thr_np[kind], int(r["k0"]))[1] > 1.0
-                for r, ok in zip(runs, sel, strict=True)
-                if ok
-            ]
+            hit = [_peak(r[kind], thr_np[kind], int(r["k0"]))[1] > 1.0 for r, ok in zip(runs, sel, strict=True) if ok]
             print(
                 f"  {kind} ({det}/{n_size} detected; of the strikes > {big:.0f} mg: "
                 f"{100 * np.mean(hit):.1f}% of {len(hit)}):"
@@ -286,10 +276,7 @@ def run(quick: bool) -> None:
         thr_day["combined"] = np.array(max(t_chi.value, t_gam))
         t_joint = fit_threshold(null["joint"], p_fa=p_day, method="gamma").value
         thr_day["joint"] = np.array(max(t_chi.value, t_joint))
-        print(
-            "\n-- Acceptance 3: P_D vs |dH|, random directions, "
-            f"1 false alarm/day at 10 Hz (p_fa {p_day:.3g}) --"
-        )
+        print(f"\n-- Acceptance 3: P_D vs |dH|, random directions, 1 false alarm/day at 10 Hz (p_fa {p_day:.3g}) --")
         print(
             f"  thresholds: attitude {np.round(thr_day['attitude'], 4)} N·m·s, "
             f"rate {np.round(thr_day['rate'], 4)} N·m·s "
@@ -310,19 +297,14 @@ def run(quick: bool) -> None:
             v = null[k]
             exceed = int(np.sum((np.abs(v) / thr).max(axis=1) > 1.0)) if v.ndim == 2 else int(np.sum(v > thr))
             print(
-                f"  null check {k:8s}: {exceed} exceedances in {v.shape[0]} samples "
-                f"(expected {v.shape[0] * p_day:.2f})"
+                f"  null check {k:8s}: {exceed} exceedances in {v.shape[0]} samples (expected {v.shape[0] * p_day:.2f})"
             )
         sizes_mg = np.array([2.5, 3.0, 3.5, 4.0, 5.0, 7.5, 10.0, 15.0, 20.0, 30.0, 40.0, 60.0, 80.0, 100.0])
         curves: dict[str, list[float]] = {"attitude": [], "rate": [], "combined": [], "joint": []}
         for mg in sizes_mg:
-            runs = st.strikes(
-                _random_directions(rng, n_curve) * mg * NMS_PER_MG, seed=int(rng.integers(1 << 30))
-            )
+            runs = st.strikes(_random_directions(rng, n_curve) * mg * NMS_PER_MG, seed=int(rng.integers(1 << 30)))
             for k in curves:
-                curves[k].append(
-                    float(np.mean([_peak(r[k], thr_day[k], int(r["k0"]))[1] > 1.0 for r in runs]))
-                )
+                curves[k].append(float(np.mean([_peak(r[k], thr_day[k], int(r["k0"]))[1] > 1.0 for r in runs])))
         print("  |dH| [mg]      " + " ".join(f"{m:6.1f}" for m in sizes_mg))
         print("  |dH| [N·m·s]   " + " ".join(f"{m * NMS_PER_MG:6.3f}" for m in sizes_mg))
         for k, c in curves.items():
@@ -369,13 +351,45 @@ def throughput(n_samples: int) -> None:
     )
 
 
+def timing_calibration(runs: int) -> None:
+    """Joint filter through detect_strikes: strike-time error over the reported time_sigma_s."""
+    from abrupt.detect.matched_filter import detect_strikes
+
+    sc = load_spacecraft(bundled_spacecraft_path("thesis"))
+    wav = build_wavelets(sc, sample_rate_hz=RATE_HZ, bank_size=4)
+    rng = np.random.default_rng(7)
+    print("\n== Strike time of the joint filter (detect_strikes, refine_strike), rate noise 4e-5 ==")
+    for mg in (5.0, 20.0):
+        dirs = _random_directions(rng, runs)
+        strikes = [[Strike(60.0, (float(d[0]), float(d[1]), float(d[2])))] for d in dirs * mg * NMS_PER_MG]
+        out = simulate_attitude_batch(sc, AttitudeSimConfig(duration_s=120.0), strikes, list(range(runs)))
+        z, err = [], []
+        for r in range(runs):
+            det, _ = detect_strikes(
+                out["t_s"],
+                out["q_BN"][r],
+                out["omega_B_rad_s"][r],
+                wav,
+                kinds=("joint",),
+                wheel_speed_rad_s=out["wheel_speed_rad_s"][r],
+                baseline_samples=200,
+            )
+            if len(det) == 1:
+                err.append(float(det["time"].iloc[0]) - 60.0)
+                z.append(err[-1] / float(det["time_sigma_s"].iloc[0]))
+        print(
+            f"  {mg:4.0f} mg: {len(z)}/{runs} single detections, "
+            f"rms time error {np.sqrt(np.mean(np.square(err))):.2f} s, "
+            f"rms (error / time_sigma_s) {np.sqrt(np.mean(np.square(z))):.2f} (1 = calibrated)"
+        )
+
+
 def main() -> None:
-    parser = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
-    )
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="short run (fewer Monte Carlo runs)")
     args = parser.parse_args()
     run(args.quick)
+    timing_calibration(30 if args.quick else 100)
     throughput(10_000_000 if args.quick else 100_000_000)
 
 

@@ -366,9 +366,7 @@ def test_thesis_attitude_filter_detects_60mg_random_directions(thesis_wavelets) 
     dirs = rng.normal(size=(runs, 3))
     dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
     strikes = [[Strike(10.0, tuple(0.48 * d))] for d in dirs]  # type: ignore[arg-type]
-    out = simulate_attitude_batch(
-        sc, AttitudeSimConfig(duration_s=40.0), strikes, list(range(100, 100 + runs))
-    )
+    out = simulate_attitude_batch(sc, AttitudeSimConfig(duration_s=40.0), strikes, list(range(100, 100 + runs)))
     hits = 0
     for r in range(runs):
         st = matched_filter_bank_statistics("attitude", attitude_error_vector(out["q_BN"][r], q0), wav)
@@ -432,9 +430,7 @@ def test_joint_filter_with_wheels_detects_a_5mg_strike(thesis_wavelets) -> None:
 
     sc, wav = thesis_wavelets
     dh_b = 0.04 * np.array([0.6, -0.64, 0.48])  # 5 mg, |dH| = 0.04 N·m·s
-    out = simulate_attitude_batch(
-        sc, AttitudeSimConfig(duration_s=900.0), [[Strike(450.0, tuple(dh_b))]], [3]
-    )  # type: ignore[arg-type]
+    out = simulate_attitude_batch(sc, AttitudeSimConfig(duration_s=900.0), [[Strike(450.0, tuple(dh_b))]], [3])  # type: ignore[arg-type]
     det, used = detect_strikes(
         out["t_s"],
         out["q_BN"][0],
@@ -452,3 +448,18 @@ def test_joint_filter_with_wheels_detects_a_5mg_strike(thesis_wavelets) -> None:
     np.testing.assert_allclose(est, out["strike_dH_N_Nms"][0, 0], atol=0.015)
     assert (det["detector"] == "mf_combined").sum() == 0  # the attitude+rate filter cannot see 5 mg
     assert used["joint"].false_alarms_per_day == pytest.approx(1.0)
+
+
+def test_attitude_error_ignores_quaternion_scale_and_sign() -> None:
+    rng = np.random.default_rng(14)
+    q = quaternion_from_mrp(rng.normal(scale=1e-3, size=(50, 3)))
+    scaled = q * rng.uniform(0.5, 2.0, size=(50, 1)) * np.where(rng.random((50, 1)) < 0.5, -1.0, 1.0)
+    np.testing.assert_allclose(attitude_error_vector(scaled, q[0]), attitude_error_vector(q, q[0]), atol=1e-15)
+
+
+def test_empty_or_too_short_telemetry_gives_a_clear_error() -> None:
+    from abrupt.detect.matched_filter import detect_strikes
+
+    wav = _synthetic_wavelets()
+    with pytest.raises(ValueError, match="at least 10 finite"):
+        detect_strikes(np.zeros(0), np.zeros((0, 4)), np.zeros((0, 3)), wav, kinds=("rate",))

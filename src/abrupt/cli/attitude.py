@@ -12,7 +12,7 @@ from abrupt.cli.groups import catalog_option, cli, detect, record_run, report, s
 if TYPE_CHECKING:
     from abrupt.simulate.attitude import Strike
 
-DETECTOR_CHOICES = ("glr", "cusum", "summation", "shiryaev", "all")
+DETECTOR_CHOICES = ("glr", "cusum", "summation", "shiryaev", "mf_attitude", "mf_rate", "mf_joint", "all")
 
 
 def _spacecraft(path: str | None) -> Any:

@@ -25,6 +25,12 @@ Pieces, all plain functions on arrays:
 * :func:`fit_matched_filter_thresholds` turns an event-free statistic into per-axis thresholds
   (``abrupt.thresholds``), and :func:`detect_matched_filter` returns one row per detected strike,
   ready for :func:`detections_to_events`.
+* Beyond the thesis, :class:`CombinedFilter` is the generalised-likelihood-ratio filter for a strike
+  of unknown direction on all attitude and rate channels at once, optionally with the wheel speeds
+  (which keep the strike's momentum, so they add a persistent step); :func:`detect_combined` and
+  :func:`refine_strike` detect and locate with it.
+* :func:`detect_strikes` is the one call for a telemetry table (any subset of the four detectors,
+  thresholds from event-free data or from the series itself for a per-day false-alarm budget).
 
 Gaps are NaN rows: a filter output whose window touches a NaN sample is NaN (not a detection).
 Telemetry must be uniformly sampled at the wavelet set's rate.
@@ -507,9 +513,7 @@ def fit_matched_filter_thresholds(
         p_fa = false_alarms_per_day / 3.0 / (sample_rate_hz * 86400.0)
     out = []
     for a in range(3):
-        thr = fit_threshold(
-            _two_sided_null(stat[:, a]), p_fa=p_fa / 2.0, sample_rate_hz=sample_rate_hz, method=method
-        )
+        thr = fit_threshold(_two_sided_null(stat[:, a]), p_fa=p_fa / 2.0, sample_rate_hz=sample_rate_hz, method=method)
         rate = float("nan") if sample_rate_hz is None else p_fa * sample_rate_hz * 86400.0
         out.append(replace(thr, p_fa=float(p_fa), false_alarms_per_day=rate))
     return out[0], out[1], out[2]
@@ -519,9 +523,7 @@ def fit_matched_filter_thresholds(
 DEFAULT_BASELINE_S = 120.0
 
 
-def resolve_baseline(
-    baseline_samples: int | None, reference_q_BN: ArrayLike | None, sample_rate_hz: float
-) -> int:
+def resolve_baseline(baseline_samples: int | None, reference_q_BN: ArrayLike | None, sample_rate_hz: float) -> int:
     """Baseline length in samples: as given, else 0 with a reference attitude, else 120 s of samples.
 
     Without the commanded attitude the error quaternion is measured from the first sample, whose
@@ -706,11 +708,7 @@ def refine_strike(
     if lo - baseline_samples < 0 or hi > n:
         return peak, np.full(3, np.nan), 1.0
     window = channels[lo:hi]
-    base = (
-        channels[lo - baseline_samples : lo].mean(axis=0)
-        if baseline_samples > 0
-        else np.zeros(channels.shape[1])
-    )
+    base = channels[lo - baseline_samples : lo].mean(axis=0) if baseline_samples > 0 else np.zeros(channels.shape[1])
     y = (window - base) / combined.noise_sd
     if not np.all(np.isfinite(y)):
         return peak, np.full(3, np.nan), 1.0
@@ -819,9 +817,7 @@ class CombinedFilter:
     gram: FloatArray  # (3, 3)
 
     @classmethod
-    def from_wavelets(
-        cls, wavelets: WaveletSet, noise_sd: ArrayLike, *, use_wheels: bool = False
-    ) -> CombinedFilter:
+    def from_wavelets(cls, wavelets: WaveletSet, noise_sd: ArrayLike, *, use_wheels: bool = False) -> CombinedFilter:
         """Joint filter on attitude and rate (6 channels), and with ``use_wheels`` the N wheel speeds.
 
         ``noise_sd``: 3 attitude (error-quaternion component), 3 rate [rad/s], then N wheel [rad/s].
@@ -877,9 +873,7 @@ class CombinedFilter:
         return np.asarray(np.einsum("nj,nj->n", b, w), dtype=np.float64), np.asarray(dh, dtype=np.float64)
 
 
-def combined_channels(
-    q_BN: ArrayLike, omega_B_rad_s: ArrayLike, reference_q_BN: ArrayLike | None = None
-) -> FloatArray:
+def combined_channels(q_BN: ArrayLike, omega_B_rad_s: ArrayLike, reference_q_BN: ArrayLike | None = None) -> FloatArray:
     """The six channels of :class:`CombinedFilter`: attitude-error vector part and body rates, (n, 6)."""
     return np.column_stack([attitude_error_vector(q_BN, reference_q_BN), np.asarray(omega_B_rad_s, float)])
 
@@ -925,8 +919,8 @@ def detect_combined(
     if above.size:
         breaks = np.flatnonzero(np.diff(above) > wavelets.length) + 1
         for group in np.split(above, breaks):
-            i = int(group[np.argmax(score[group])])
-            i, dh_b, sigma_samples = refine_strike(ch, i, filt, baseline_samples)
+            peak = int(group[np.argmax(score[group])])
+            i, dh_b, sigma_samples = refine_strike(ch, peak, filt, baseline_samples)
             dh_n = dcm_from_quaternion(q[i]).T @ dh_b if np.all(np.isfinite(q[i])) else np.full(3, np.nan)
             rows.append(
                 {
@@ -935,7 +929,7 @@ def detect_combined(
                     "time_sigma_s": sigma_samples / wavelets.sample_rate_hz,
                     "detector": "mf_joint" if use_wheels else "mf_combined",
                     "axis": int(np.argmax(np.abs(dh_b))),
-                    "statistic": float(stat[i]),
+                    "statistic": float(stat[peak]),  # the alarm value, before time refinement
                     "threshold": float(threshold.value),
                     "p_fa": float(threshold.p_fa),
                     "false_alarms_per_day": float(threshold.false_alarms_per_day),
@@ -1092,19 +1086,16 @@ def detect_strikes(
     frames = []
     for kind in kinds:
         if kind in ("attitude", "rate"):
-            ch = (
-                attitude_error_vector(q_BN, reference_q_BN)
-                if kind == "attitude"
-                else np.asarray(omega_B_rad_s)
-            )
-            stat = matched_filter_bank_statistics(kind, ch, wavelets, baseline_samples=baseline_samples)  # type: ignore[arg-type]
+            kd: Kind = "attitude" if kind == "attitude" else "rate"
+            ch = attitude_error_vector(q_BN, reference_q_BN) if kd == "attitude" else np.asarray(omega_B_rad_s)
+            stat = matched_filter_bank_statistics(kd, ch, wavelets, baseline_samples=baseline_samples)
             if kind not in used:
                 used[kind] = robust_gaussian_thresholds(
                     stat, false_alarms_per_day=false_alarms_per_day, sample_rate_hz=wavelets.sample_rate_hz
                 )
             frames.append(
                 detect_matched_filter(
-                    kind,  # type: ignore[arg-type]
+                    kd,
                     t,
                     q_BN,
                     omega_B_rad_s,
@@ -1136,9 +1127,7 @@ def detect_strikes(
                 )
             )
         else:
-            raise ValueError(
-                f"unknown matched-filter kind {kind!r}; choose attitude, rate, combined or joint"
-            )
+            raise ValueError(f"unknown matched-filter kind {kind!r}; choose attitude, rate, combined or joint")
     frames = [f for f in frames if not f.empty]
     out = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=DETECTION_COLUMNS)
     return out.sort_values("index", kind="stable").reset_index(drop=True), used
