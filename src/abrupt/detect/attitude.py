@@ -34,7 +34,7 @@ from abrupt.events import Event, config_hash, empty_frame, events_frame, format_
 from abrupt.model.momentum import system_momentum
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.readers.telemetry import Telemetry
-from abrupt.thresholds import Threshold, fit_threshold
+from abrupt.thresholds import Threshold, block_maxima, fit_block_maxima_threshold, fit_threshold
 
 FloatArray = NDArray[np.float64]
 
@@ -208,6 +208,9 @@ def calibrate_thresholds(
 ) -> tuple[dict[str, Threshold], dict[str, FloatArray]]:
     """Thresholds for each detector at ``config.false_alarms_per_day`` from event-free statistics.
 
+    Returns the thresholds and a calibration summary: the noise model (``white_sigma_Nms``,
+    ``random_walk_sigma_Nms``) and, for GEV fits, the event-free block maxima (``block_maxima:<name>``).
+
     Event-free ᴺH comes from ``calibration`` telemetry when given; otherwise it is simulated from the
     white + random-walk noise model measured on the input itself (:func:`momentum_noise_model`).
     """
@@ -237,19 +240,29 @@ def calibrate_thresholds(
             progress(name)
         win = detector_windows(name, config, dt)
         h = h_null
+        # Blocks for the extreme-value fit: at least 5 min and three window spans, so maxima are
+        # nearly independent.
+        block_s = max(300.0, 3.0 * win.span * dt)
         if name == "shiryaev" and calibration is None:
-            # Shiryaev costs 21 likelihoods per sample per window: calibrate on a tenth of the data.
-            h = h[: max(win.span * 20, config.null_samples // 10)]
+            # Shiryaev costs 21 likelihoods per sample per window: calibrate on 40 blocks only.
+            h = h[: max(win.span * 20, round(40 * block_s / dt))]
             segs = [(0, h.shape[0])]
         else:
             segs = segments
         stat = _per_segment(segs, h.shape[0], _segment_statistic(name, h, win))
-        thresholds[name] = fit_threshold(
-            stat,
-            false_alarms_per_day=config.false_alarms_per_day,
-            sample_rate_hz=rate,
-            method=config.threshold_method,  # type: ignore[arg-type]
-        )
+        if config.threshold_method == "gev":
+            thresholds[name] = fit_block_maxima_threshold(
+                stat, sample_rate_hz=rate, false_alarms_per_day=config.false_alarms_per_day, block_s=block_s
+            )
+            # kept for the Q-Q diagnostic of the report
+            noise[f"block_maxima:{name}"] = block_maxima(stat, max(2, round(block_s / dt)))
+        else:
+            thresholds[name] = fit_threshold(
+                stat,
+                false_alarms_per_day=config.false_alarms_per_day,
+                sample_rate_hz=rate,
+                method=config.threshold_method,  # type: ignore[arg-type]
+            )
     return thresholds, noise
 
 

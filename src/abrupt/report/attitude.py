@@ -132,6 +132,40 @@ def attitude_figure(
     return fig
 
 
+def qq_figure(result: DetectionResult) -> plt.Figure | None:
+    """Q-Q plots of event-free block maxima against their fitted GEV law, one panel per detector.
+
+    Points on the diagonal mean the extreme-value fit that set the threshold describes the data; the
+    dashed line marks the threshold.
+    """
+    from scipy import stats
+
+    names = [k.split(":", 1)[1] for k in result.noise_sigma if k.startswith("block_maxima:")]
+    if not names:
+        return None
+    fig, axes = plt.subplots(1, len(names), figsize=(3.6 * len(names), 3.4), constrained_layout=True, squeeze=False)
+    for ax, name in zip(axes[0], names, strict=True):
+        maxima = np.sort(result.noise_sigma[f"block_maxima:{name}"])
+        probs = (np.arange(1, maxima.size + 1) - 0.5) / maxima.size
+        shape, loc, scale = stats.genextreme.fit(maxima)
+        theo = stats.genextreme.ppf(probs, shape, loc=loc, scale=scale)
+        ax.plot(theo, maxima, ".", ms=3)
+        lim = [min(theo[0], maxima[0]), max(theo[-1], maxima[-1], result.thresholds[name].value)]
+        ax.plot(lim, lim, color="grey", lw=0.8)
+        ax.axhline(result.thresholds[name].value, color="tab:red", ls="--", lw=0.8)
+        ax.set_title(f"{name}: {maxima.size} event-free blocks", fontsize=9)
+        ax.set_xlabel("GEV quantile")
+        ax.set_ylabel("block maximum")
+    return fig
+
+
+def _png_base64(fig: plt.Figure) -> str:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    plt.close(fig)
+    return base64.b64encode(buf.getvalue()).decode()
+
+
 def write_attitude_report(
     path: str | Path,
     telemetry: Telemetry,
@@ -152,10 +186,14 @@ def write_attitude_report(
     if suffix not in (".html", ".htm"):
         plt.close(fig)
         raise ValueError(f"{path}: report must end in .png or .html")
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    plt.close(fig)
-    img = base64.b64encode(buf.getvalue()).decode()
+    img = _png_base64(fig)
+    qq = qq_figure(result)
+    qq_html = (
+        f"<h2>Threshold diagnostics</h2><p>Q-Q plot of event-free block maxima against the fitted GEV law.</p>"
+        f'<img src="data:image/png;base64,{_png_base64(qq)}" style="max-width:100%">'
+        if qq is not None
+        else ""
+    )
     thr_rows = "".join(
         f"<tr><td>{html.escape(k)}</td><td>{v.value:.4g}</td><td>{html.escape(STATISTIC_UNITS[k])}</td>"
         f"<td>{v.false_alarms_per_day:g}</td><td>{html.escape(v.method)}</td><td>{v.n_samples}</td></tr>"
@@ -188,6 +226,7 @@ td,th{{border:1px solid #ccc;padding:2px 6px}}</style>
 <h2>Events</h2>{table}
 <h2>Thresholds</h2><table><tr><th>detector</th><th>threshold</th><th>units</th><th>false alarms/day</th>
 <th>fit</th><th>event-free samples</th></tr>{thr_rows}</table>
+{qq_html}
 <h2>Input repairs</h2><ul>{repairs}</ul></body></html>"""
     path.write_text(page)
     return path
