@@ -150,3 +150,34 @@ def test_cli_reports_bad_input_as_a_one_line_error(tmp_path: Path, capsys: pytes
         )
     assert exit_info.value.code == 2
     assert "empty.csv: file is empty" in capsys.readouterr().err
+
+
+def test_cli_rejects_a_bad_output_suffix_before_any_work(tmp_path: Path) -> None:
+    runner = CliRunner()
+    r = runner.invoke(
+        cli,
+        [
+            "detect",
+            "attitude",
+            str(bundled_spacecraft_path()),
+            "--spacecraft",
+            str(bundled_spacecraft_path()),
+            "--out",
+            str(tmp_path / "e.txt"),
+            "--catalog",
+            str(tmp_path / "c.sqlite"),
+        ],
+    )
+    assert r.exit_code == 2 and "must end in .csv or .parquet" in r.output
+    assert not (tmp_path / "c.sqlite").exists()
+
+
+def test_calibration_at_another_rate_is_an_error() -> None:
+    fast = simulate_attitude(SC, AttitudeSimConfig(duration_s=600.0, seed=1), [])
+    slow = simulate_attitude(SC, AttitudeSimConfig(duration_s=600.0, telemetry_rate_hz=5.0, seed=2), [])
+    from abrupt.errors import InputError
+
+    with pytest.raises(InputError, match="sampled every"):
+        detect_attitude(
+            telemetry_from_frame(fast.telemetry, SC), SC, FAST, calibration=telemetry_from_frame(slow.telemetry, SC)
+        )

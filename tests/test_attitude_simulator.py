@@ -62,9 +62,7 @@ def test_inertial_momentum_steps_by_applied_impulse_and_is_otherwise_conserved(t
     for (_, row), dh in zip(result.truth.iterrows(), dh_n, strict=True):
         k = int(np.searchsorted(t, row["time_s"]))  # the sample at the start of the strike step
         bn = dcm_from_quaternion(state["q_BN"][k])
-        np.testing.assert_allclose(
-            bn.T @ [row["dH_B_x_Nms"], row["dH_B_y_Nms"], row["dH_B_z_Nms"]], dh, rtol=1e-9
-        )
+        np.testing.assert_allclose(bn.T @ [row["dH_B_x_Nms"], row["dH_B_y_Nms"], row["dH_B_z_Nms"]], dh, rtol=1e-9)
     segments = [(t <= 30.0), (t > 30.0) & (t <= 70.0), (t > 70.0)]
     expected = [h[0], h[0] + dh_n[0], h[0] + dh_n[0] + dh_n[1]]
     for mask, h_exp in zip(segments, expected, strict=True):
@@ -140,15 +138,11 @@ def test_wheel_torque_saturates_at_its_limit(thesis: Spacecraft) -> None:
 
 
 def test_noise_free_telemetry_equals_true_state(thesis: Spacecraft) -> None:
-    result = simulate_attitude(
-        thesis, AttitudeSimConfig(duration_s=10.0, noise=False), [Strike(2.0, (0.1, 0, 0))]
-    )
+    result = simulate_attitude(thesis, AttitudeSimConfig(duration_s=10.0, noise=False), [Strike(2.0, (0.1, 0, 0))])
     tel = result.telemetry
     np.testing.assert_array_equal(tel[["q0", "q1", "q2", "q3"]].to_numpy(), result.true_state["q_BN"])
     np.testing.assert_array_equal(tel[["wx", "wy", "wz"]].to_numpy(), result.true_state["omega_B_rad_s"])
-    np.testing.assert_array_equal(
-        tel[["rw1", "rw2", "rw3", "rw4"]].to_numpy(), result.true_state["wheel_speed_rad_s"]
-    )
+    np.testing.assert_array_equal(tel[["rw1", "rw2", "rw3", "rw4"]].to_numpy(), result.true_state["wheel_speed_rad_s"])
 
 
 def test_telemetry_noise_has_the_configured_sigma(thesis: Spacecraft) -> None:
@@ -199,12 +193,8 @@ def test_batch_runs_equal_single_runs_with_the_same_seeds(thesis: Spacecraft) ->
     assert batch["q_BN"].shape == (3, config.n_samples, 4)
     for r in range(3):
         single = simulate_attitude(thesis, AttitudeSimConfig(duration_s=30.0, seed=seeds[r]), strikes[r])
-        np.testing.assert_array_equal(
-            batch["omega_B_rad_s"][r], single.telemetry[["wx", "wy", "wz"]].to_numpy()
-        )
-        np.testing.assert_array_equal(
-            batch["true_wheel_speed_rad_s"][r], single.true_state["wheel_speed_rad_s"]
-        )
+        np.testing.assert_array_equal(batch["omega_B_rad_s"][r], single.telemetry[["wx", "wy", "wz"]].to_numpy())
+        np.testing.assert_array_equal(batch["true_wheel_speed_rad_s"][r], single.true_state["wheel_speed_rad_s"])
         n = len(strikes[r])
         np.testing.assert_array_equal(
             batch["strike_dH_N_Nms"][r, :n],
@@ -214,9 +204,7 @@ def test_batch_runs_equal_single_runs_with_the_same_seeds(thesis: Spacecraft) ->
 
 def test_tachometer_discretisation_quantises_wheel_telemetry(thesis: Spacecraft) -> None:
     res = 2 * np.pi / 60.0  # 1 rpm [rad/s]
-    tel = simulate_attitude(
-        thesis, AttitudeSimConfig(duration_s=5.0, wheel_speed_resolution_rad_s=res)
-    ).telemetry
+    tel = simulate_attitude(thesis, AttitudeSimConfig(duration_s=5.0, wheel_speed_resolution_rad_s=res)).telemetry
     counts = tel[["rw1", "rw2", "rw3", "rw4"]].to_numpy() / res
     np.testing.assert_allclose(counts, np.round(counts), atol=1e-9)
 
@@ -230,14 +218,10 @@ def test_telemetry_is_written_in_the_spacecraft_files_units_and_convention() -> 
     data["telemetry"]["body_rate"]["unit"] = "deg/s"
     data["telemetry"]["quaternion"]["order"] = "scalar_last"
     sc = spacecraft_from_dict(data)
-    result = simulate_attitude(
-        sc, AttitudeSimConfig(duration_s=20.0, noise=False), [Strike(1.0, (0.3, 0.2, 0.1))]
-    )
+    result = simulate_attitude(sc, AttitudeSimConfig(duration_s=20.0, noise=False), [Strike(1.0, (0.3, 0.2, 0.1))])
     tel = result.telemetry
     st = result.true_state
-    np.testing.assert_allclose(
-        tel[["rw1", "rw2", "rw3", "rw4"]].to_numpy(), st["wheel_speed_rad_s"] * 60 / (2 * np.pi)
-    )
+    np.testing.assert_allclose(tel[["rw1", "rw2", "rw3", "rw4"]].to_numpy(), st["wheel_speed_rad_s"] * 60 / (2 * np.pi))
     np.testing.assert_allclose(tel[["wx", "wy", "wz"]].to_numpy(), np.degrees(st["omega_B_rad_s"]))
     # scalar_last: column q0 of the file holds the first vector component.
     np.testing.assert_allclose(tel[["q0", "q1", "q2", "q3"]].to_numpy(), st["q_BN"][:, [1, 2, 3, 0]])
@@ -245,9 +229,7 @@ def test_telemetry_is_written_in_the_spacecraft_files_units_and_convention() -> 
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])
 def test_written_telemetry_round_trips(thesis: Spacecraft, tmp_path: Path, suffix: str) -> None:
-    result = simulate_attitude(
-        thesis, AttitudeSimConfig(duration_s=5.0, seed=1), [Strike(2.5, (0.1, 0.2, 0.0))]
-    )
+    result = simulate_attitude(thesis, AttitudeSimConfig(duration_s=5.0, seed=1), [Strike(2.5, (0.1, 0.2, 0.0))])
     path, truth_path = write_telemetry(result, tmp_path / f"tlm{suffix}")
     assert truth_path == tmp_path / "tlm_truth.csv"
     back = pd.read_csv(path) if suffix == ".csv" else pd.read_parquet(path)

@@ -112,3 +112,14 @@ def test_bad_window_settings_are_rejected() -> None:
         WindowConfig(pre=1)
     with pytest.raises(ValueError, match="unknown statistic"):
         sliding_statistic("median", X, CFG)
+
+
+def test_glr_rejects_more_than_three_channels() -> None:
+    with pytest.raises(ValueError, match="1 to 3 channels"):
+        sliding_statistic("glr", np.zeros((500, 4)), CFG)
+
+
+def test_cusum_does_not_lose_precision_on_a_large_offset() -> None:
+    base = sliding_statistic("cusum", X[:, :1], CFG)
+    shifted = sliding_statistic("cusum", X[:, :1] + 50.0, CFG)  # |H| of a biased-wheel spacecraft
+    np.testing.assert_allclose(shifted, base, atol=1e-4)

@@ -96,3 +96,13 @@ def test_export_round_trips(tmp_path, suffix: str) -> None:  # type: ignore[no-u
 def test_write_events_rejects_unknown_suffix(tmp_path) -> None:  # type: ignore[no-untyped-def]
     with pytest.raises(ValueError, match=r"csv or \.parquet"):
         write_events(empty_frame(), str(tmp_path / "e.txt"))
+
+
+def test_csv_round_trip_keeps_identifiers_as_text(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    e = Event(**{**_event().__dict__, "spacecraft": "007", "event_id": "12345e67", "extra": {}})
+    path = tmp_path / "e.csv"
+    write_events(events_frame([e]), str(path))
+    back = read_events(str(path))
+    assert back.loc[0, "event_id"] == "12345e67"
+    assert back.loc[0, "spacecraft"] == "007"
+    assert math.isnan(back.loc[0, "dv_mps"])

@@ -35,3 +35,13 @@ def test_inertial_momentum_does_not_depend_on_attitude_for_a_fixed_inertial_vect
     w = np.linalg.solve(SC.inertia_kgm2, h_b.T).T
     m = system_momentum(SC, q, w, np.zeros((20, 4)))
     np.testing.assert_allclose(m.H_N_Nms, np.tile(h_n, (20, 1)), atol=1e-12)
+
+
+def test_a_known_rotation_maps_body_momentum_to_inertial_axes() -> None:
+    # Body rotated +90 deg about inertial z: body x points along inertial y, so [BN] = Rz(90)^T.
+    q = np.array([[np.cos(np.pi / 4), 0.0, 0.0, np.sin(np.pi / 4)]])
+    bn = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    np.testing.assert_allclose(dcm_from_quaternion(q)[0], bn, atol=1e-15)
+    w = np.array([[1e-3, 0.0, 0.0]])  # spin about body x = inertial y
+    m = system_momentum(SC, q, w, np.zeros((1, 4)))
+    np.testing.assert_allclose(m.H_N_Nms[0], [0.0, 3.0, 0.0], atol=1e-12)

@@ -38,7 +38,9 @@ def thesis_thresholds() -> dict:
 
 def test_thesis_default_strike_is_detected_with_time_and_delta_v(thesis_thresholds: dict) -> None:
     sim = simulate_orbit(
-        OrbitSimulationConfig(duration_s=3 * 3600.0, seed=12, impulses=(Impulse(5400.0, tuple(THESIS_DV_MPS * STRIKE_DIR)),))
+        OrbitSimulationConfig(
+            duration_s=3 * 3600.0, seed=12, impulses=(Impulse(5400.0, tuple(THESIS_DV_MPS * STRIKE_DIR)),)
+        )
     )
     cfg = OrbitDetectorConfig(settle_s=1800.0, statistic="mcr_w", orbital_constants=False)
     an = analyse(sim.ephemeris(), cfg)
@@ -49,7 +51,9 @@ def test_thesis_default_strike_is_detected_with_time_and_delta_v(thesis_threshol
     assert list(events.columns[: len(EVENT_COLUMNS)]) == list(EVENT_COLUMNS)
     t_event = (pd.Timestamp(events["time_utc"].iloc[0]).tz_localize(None) - pd.Timestamp("2020-01-01")).total_seconds()
     assert abs(t_event - 5400.0) <= 2.0
-    dv_true_rtn = rtn_matrix(sim.truth_position_m[5400], sim.truth_velocity_mps[5400])[0].T @ (THESIS_DV_MPS * STRIKE_DIR)
+    dv_true_rtn = rtn_matrix(sim.truth_position_m[5400], sim.truth_velocity_mps[5400])[0].T @ (
+        THESIS_DV_MPS * STRIKE_DIR
+    )
     got = events[["dv_r_mps", "dv_t_mps", "dv_n_mps"]].iloc[0].to_numpy()
     assert np.linalg.norm(got - dv_true_rtn) < 0.2 * THESIS_DV_MPS
     assert events["dv_mps"].iloc[0] == pytest.approx(THESIS_DV_MPS, rel=0.2)
@@ -91,26 +95,41 @@ def test_cli_simulate_detect_report_end_to_end(tmp_path: Path) -> None:
     nav = tmp_path / "nav.csv"
     res = runner.invoke(
         cli,
-        ["simulate", "orbit", "--out", str(nav), "--duration-s", "21600", "--impulse", "9000:0.0,0.05,0.0", "--seed", "3"],
+        [
+            "simulate",
+            "orbit",
+            "--out",
+            str(nav),
+            "--duration-s",
+            "21600",
+            "--impulse",
+            "9000:0.0,0.05,0.0",
+            "--seed",
+            "3",
+        ],
     )
-    assert res.exit_code == 0, (res.output, res.exc_info and __import__('traceback').format_exception(*res.exc_info))
+    assert res.exit_code == 0, (res.output, res.exc_info and __import__("traceback").format_exception(*res.exc_info))
     null = tmp_path / "null.csv"
     res = runner.invoke(cli, ["simulate", "orbit", "--out", str(null), "--duration-s", "43200", "--seed", "4"])
     assert res.exit_code == 0, res.output
     out = tmp_path / "events.csv"
     res = runner.invoke(
         cli,
-        ["detect", "orbit", str(nav), "--out", str(out), "--tuning", "thesis", "--null", str(null)]
-        + ["--catalog", str(tmp_path / "c.sqlite")],
+        [
+            *("detect", "orbit", str(nav), "--out", str(out), "--tuning", "thesis"),
+            *("--null", str(null), "--catalog", str(tmp_path / "c.sqlite")),
+        ],
     )
-    assert res.exit_code == 0, (res.output, res.exc_info and __import__('traceback').format_exception(*res.exc_info))
+    assert res.exit_code == 0, (res.output, res.exc_info and __import__("traceback").format_exception(*res.exc_info))
     ev = read_events(str(out))
     assert len(ev) == 1
     times = (pd.to_datetime(ev["time_utc"]).dt.tz_localize(None) - pd.Timestamp("2020-01-01")).dt.total_seconds()
     assert abs(times.iloc[0] - 9000.0) < 3.0 * ev["time_sigma_s"].iloc[0] + 1.0
     png = tmp_path / "r.png"
-    res = runner.invoke(cli, ["report", "orbit", str(nav), "--out", str(png), "--tuning", "thesis", "--events", str(out)])
-    assert res.exit_code == 0, (res.output, res.exc_info and __import__('traceback').format_exception(*res.exc_info))
+    res = runner.invoke(
+        cli, ["report", "orbit", str(nav), "--out", str(png), "--tuning", "thesis", "--events", str(out)]
+    )
+    assert res.exit_code == 0, (res.output, res.exc_info and __import__("traceback").format_exception(*res.exc_info))
     assert png.stat().st_size > 10000
 
 
@@ -145,3 +164,19 @@ def test_real_sp3_injected_5_mm_s_is_detected_in_time_with_its_magnitude(shared_
     # magnitude consistent with the reported 1σ uncertainty (the 20 % figure is a benchmark statistic)
     assert abs(events["dv_mps"].iloc[best] - 0.005) < 3.0 * events["dv_sigma_mps"].iloc[best] + 1e-4
     write_navigation_csv(injected, tmp_path / "inj.csv")
+
+
+def test_tau_q_grid_reports_snr_of_each_statistic_at_each_grid_point() -> None:
+    from abrupt.detect.orbit_detector import tau_q_grid
+
+    null = simulate_orbit(OrbitSimulationConfig(duration_s=7200.0, seed=21)).ephemeris()
+    strike = simulate_orbit(
+        OrbitSimulationConfig(
+            duration_s=7200.0, seed=22, impulses=(Impulse(3600.0, tuple(THESIS_DV_MPS * STRIKE_DIR)),)
+        )
+    ).ephemeris()
+    base = OrbitDetectorConfig(settle_s=1200.0, orbital_constants=False, glr_window_samples=0)
+    grid = tau_q_grid(null, [(strike, 3600.0)], [1.0], [2.15e-11, 2.15e-13], base)
+    assert set(grid["q_m2_s5"]) == {2.15e-11, 2.15e-13}
+    acc = grid[grid["statistic"] == "accel_smoothed"].set_index("q_m2_s5")["snr"]
+    assert np.all(acc > 1.0)  # the default strike stands out at both tunings

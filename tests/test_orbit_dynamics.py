@@ -39,9 +39,7 @@ def _zonal_potential(r: np.ndarray, degree: int) -> float:
 @pytest.mark.parametrize("r", [np.array([7.0e6, 0.3e6, 2.1e6]), np.array([-1.0e6, 6.5e6, -3.0e6])])
 def test_zonal_acceleration_is_the_gradient_of_the_zonal_potential(r: np.ndarray) -> None:
     h = 10.0
-    grad = np.array(
-        [(_zonal_potential(r + h * e, 4) - _zonal_potential(r - h * e, 4)) / (2 * h) for e in np.eye(3)]
-    )
+    grad = np.array([(_zonal_potential(r + h * e, 4) - _zonal_potential(r - h * e, 4)) / (2 * h) for e in np.eye(3)])
     np.testing.assert_allclose(zonal_acceleration(r, 4, False), grad, rtol=1e-6)
 
 
@@ -122,7 +120,9 @@ def test_itrf_gcrf_agrees_with_astropy_and_round_trips() -> None:
 def test_two_body_simulation_conserves_energy_and_applies_the_impulse() -> None:
     dv = np.array([0.0, 0.024, 0.0])
     sim = simulate_orbit(
-        OrbitSimulationConfig(duration_s=2000.0, sigma_pos_m=0.0, sigma_vel_mps=0.0, impulses=(Impulse(1000.0, tuple(dv), "rtn"),))
+        OrbitSimulationConfig(
+            duration_s=2000.0, sigma_pos_m=0.0, sigma_vel_mps=0.0, impulses=(Impulse(1000.0, tuple(dv), "rtn"),)
+        )
     )
     r = np.linalg.norm(sim.truth_position_m, axis=1)
     energy = 0.5 * np.sum(sim.truth_velocity_mps**2, axis=1) - MU_EARTH_M3_S2 / r

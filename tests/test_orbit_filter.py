@@ -31,7 +31,12 @@ def _gamma_by_quadrature(dt: float, tau: float) -> np.ndarray:
         return tau * u - tau**2 * (1 - math.exp(-u / tau)), tau * (1 - math.exp(-u / tau)), math.exp(-u / tau)
 
     pairs = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)]
-    return np.array([integrate.quad(lambda u, a=a, b=b: phis(u)[a] * phis(u)[b], 0, dt, epsabs=0, epsrel=1e-12)[0] for a, b in pairs])
+    return np.array(
+        [
+            integrate.quad(lambda u, a=a, b=b: phis(u)[a] * phis(u)[b], 0, dt, epsabs=0, epsrel=1e-12)[0]
+            for a, b in pairs
+        ]
+    )
 
 
 @pytest.mark.filterwarnings("ignore::scipy.integrate.IntegrationWarning")
@@ -114,7 +119,7 @@ def quiet_orbit() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.nd
 
 
 def test_forward_filter_is_consistent_on_event_free_thesis_data(quiet_orbit: tuple[np.ndarray, ...]) -> None:
-    t, pos, vel, truth_r, truth_v = quiet_orbit
+    t, pos, vel, truth_r, _truth_v = quiet_orbit
     run = run_forward(t, pos, vel, 10.0, 0.25, FilterConfig())
     # NIS of a consistent filter averages the measurement dimension (6)
     assert 5.0 < np.nanmean(run.nis[600:]) < 7.0
@@ -126,7 +131,7 @@ def test_forward_filter_is_consistent_on_event_free_thesis_data(quiet_orbit: tup
 
 def test_mirrored_backward_filter_stays_bounded_and_naive_one_diverges(quiet_orbit: tuple[np.ndarray, ...]) -> None:
     """Bennett 2022 §3.2.6: the unmirrored FOGM grows backward in time; the mirrored one does not."""
-    t, pos, vel, truth_r, truth_v = quiet_orbit
+    t, pos, vel, _truth_r, truth_v = quiet_orbit
     cfg = FilterConfig(tau_s=10.0, q_rtn_m2_s5=(2e-12, 2e-12, 2e-12))
     fwd = run_forward(t, pos, vel, 10.0, 0.25, cfg)
     mirrored = run_backward(t, pos, vel, 10.0, 0.25, cfg, fwd.x[-1], fwd.p[-1], mirrored=True)

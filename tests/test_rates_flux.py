@@ -24,9 +24,7 @@ def _nasa90_by_hand(d_cm: float, h_km: float, psi: float, t: float, s: float) ->
 
 def test_nasa90_one_centimetre_flux_at_500_km_in_1995_is_about_1e_5() -> None:
     f = float(
-        fx.nasa90_flux_tumbling(
-            0.01, altitude_m=500e3, inclination_deg=28.5, epoch_year=1995, solar_flux_sfu=100
-        )
+        fx.nasa90_flux_tumbling(0.01, altitude_m=500e3, inclination_deg=28.5, epoch_year=1995, solar_flux_sfu=100)
     )
     assert f == pytest.approx(_nasa90_by_hand(1.0, 500, 0.91, 1995, 100), rel=1e-12)
     assert f == pytest.approx(1.14e-5, rel=0.01)  # Φ = 0.659, H(1 cm) = 1.293, g1 = 1.149, g2 = 1.35
@@ -36,13 +34,9 @@ def test_nasa90_one_centimetre_flux_at_500_km_in_1995_is_about_1e_5() -> None:
     "d_cm,h_km,inc,t,s",
     [(0.001, 400, 51.6, 2000, 150), (0.1, 800, 98.0, 2020, 70), (10.0, 1500, 65.0, 2015, 200)],
 )
-def test_nasa90_matches_term_by_term_evaluation(
-    d_cm: float, h_km: float, inc: float, t: float, s: float
-) -> None:
+def test_nasa90_matches_term_by_term_evaluation(d_cm: float, h_km: float, inc: float, t: float, s: float) -> None:
     f = float(
-        fx.nasa90_flux_tumbling(
-            d_cm / 100, altitude_m=h_km * 1e3, inclination_deg=inc, epoch_year=t, solar_flux_sfu=s
-        )
+        fx.nasa90_flux_tumbling(d_cm / 100, altitude_m=h_km * 1e3, inclination_deg=inc, epoch_year=t, solar_flux_sfu=s)
     )
     assert f == pytest.approx(_nasa90_by_hand(d_cm, h_km, fx.nasa90_psi(inc), t, s), rel=1e-12)
 
@@ -62,9 +56,7 @@ def test_grun_flux_matches_term_by_term_evaluation() -> None:
         f1 = (2.2e3 * m_g**0.306 + 15) ** -4.38
         f2 = 1.3e-9 * (m_g + 1e11 * m_g**2 + 1e27 * m_g**4) ** -0.36
         f3 = 1.3e-16 * (m_g + 1e6 * m_g**2) ** -0.85
-        assert float(fx.grun_flux_interplanetary(m_g * 1e-3)) == pytest.approx(
-            3.15576e7 * (f1 + f2 + f3), rel=1e-12
-        )
+        assert float(fx.grun_flux_interplanetary(m_g * 1e-3)) == pytest.approx(3.15576e7 * (f1 + f2 + f3), rel=1e-12)
     # worked value: m >= 1e-6 g -> 4.72e-8 m^-2 s^-1 = 1.49 m^-2 yr^-1 (F1 dominates: 47.1^-4.38)
     assert float(fx.grun_flux_interplanetary(1e-9)) == pytest.approx(1.488, rel=2e-3)
 

@@ -25,9 +25,7 @@ SMALLSAT = str(EXAMPLES / "smallsat200.toml")
 def test_each_draw_obeys_the_strike_equations() -> None:
     sc = load_spacecraft(SMALLSAT)
     cfg = RateConfig(n_draws=2000, mef_model="rembor_array", mass_model="ordem_sphere", seed=3)
-    s = simulate_strikes(
-        [nasa90_table(550e3, 28.5, 2020.0)], geometry_from_spacecraft(sc), sc.mass_kg, 550e3, cfg
-    )
+    s = simulate_strikes([nasa90_table(550e3, 28.5, 2020.0)], geometry_from_spacecraft(sc), sc.mass_kg, 550e3, cfg)
     p = s.beta * s.mass_kg * s.speed_mps
     assert np.allclose(np.linalg.norm(s.dP_Ns, axis=1), p)  # Eq. 5.1
     assert np.allclose(s.dH_Nms_vec, np.cross(s.position_m, s.dP_Ns))  # Eq. 5.2
@@ -42,8 +40,7 @@ def test_semi_major_axis_change_matches_vis_viva() -> None:
     v = math.sqrt(fx.EARTH_MU_M3_S2 / r)
     dv = np.array([[0.0, 0.024, 0.0], [0.01, -0.02, 0.005]])
     direct = [
-        fx.EARTH_MU_M3_S2 * r / (2 * fx.EARTH_MU_M3_S2 - r * np.sum((np.array([0, v, 0]) + d) ** 2)) - r
-        for d in dv
+        fx.EARTH_MU_M3_S2 * r / (2 * fx.EARTH_MU_M3_S2 - r * np.sum((np.array([0, v, 0]) + d) ** 2)) - r for d in dv
     ]
     assert semi_major_axis_change_m(r, np.array([0.0, v, 0.0]), dv) == pytest.approx(direct, rel=1e-6)
     # along-track 2.4 cm/s at 800 km: Δa ≈ 2 a² v Δv / μ ≈ 46 m (spec §4.3)
@@ -206,9 +203,7 @@ def test_cli_reports_bad_input_as_errors(tmp_path: Path) -> None:
     runner = CliRunner()
     res = runner.invoke(cli, ["rates", "run", "--spacecraft", str(nogeo), "--draws", "100"])
     assert isinstance(res.exception, ConfigError) and "surfaces" in str(res.exception)
-    res = runner.invoke(
-        cli, ["rates", "run", "--spacecraft", SMALLSAT, "--altitude-km", "2500", "--draws", "100"]
-    )
+    res = runner.invoke(cli, ["rates", "run", "--spacecraft", SMALLSAT, "--altitude-km", "2500", "--draws", "100"])
     assert isinstance(res.exception, ConfigError) and "range" in str(res.exception)
     nomass = tmp_path / "nomass.toml"
     nomass.write_text(

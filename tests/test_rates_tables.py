@@ -12,9 +12,7 @@ from abrupt.rates.ordem import import_ordem, read_ordem_igloo, read_ordem_size
 from abrupt.rates.tables import nasa90_table, read_flux_table, write_flux_table
 
 SIZE_HEADER = "size_m,density_class,cumulative_flux_m2_yr,sigma_m2_yr\n"
-DIR_HEADER = (
-    "speed_kms_lo,speed_kms_hi,azimuth_deg_lo,azimuth_deg_hi,elevation_deg_lo,elevation_deg_hi,flux_m2_yr\n"
-)
+DIR_HEADER = "speed_kms_lo,speed_kms_hi,azimuth_deg_lo,azimuth_deg_hi,elevation_deg_lo,elevation_deg_hi,flux_m2_yr\n"
 GOOD_SIZE = SIZE_HEADER + "1e-4,medium,10,1\n1e-3,medium,0.1,0.01\n1e-4,high,2,0.5\n1e-3,high,0.02,0.005\n"
 GOOD_DIR = DIR_HEADER + "9,10,-10,0,0,0,3\n10,11,0,10,0,0,1\n"
 
@@ -24,8 +22,7 @@ def _write(tmp_path: Path, size: str = GOOD_SIZE, direction: str = GOOD_DIR, ext
     (tmp_path / "d.csv").write_text(direction)
     manifest = tmp_path / "t.toml"
     manifest.write_text(
-        f'format = "abrupt-flux-table/1"\nname = "test"\n{extra}size_table = "s.csv"\n'
-        'direction_table = "d.csv"\n'
+        f'format = "abrupt-flux-table/1"\nname = "test"\n{extra}size_table = "s.csv"\ndirection_table = "d.csv"\n'
     )
     return manifest
 

@@ -76,15 +76,11 @@ def test_recall_at_false_alarm_rate_stops_before_the_budget_is_exceeded() -> Non
     # one year; ranked: TP, FP, TP, FP, TP → budget 1 FA/yr admits the first three (1 FP)
     det = _frame([10, 50, 100, 150, 200], stats=[9, 8, 7, 6, 5])
     truth = _frame([10, 100, 200])
-    op = recall_at_false_alarm_rate(
-        det, truth, false_alarms_per_year=1.0, start="2020-01-01", end="2021-01-01"
-    )
+    op = recall_at_false_alarm_rate(det, truth, false_alarms_per_year=1.0, start="2020-01-01", end="2021-01-01")
     assert op.false_positives == 1 and op.true_positives == 2
     assert op.recall == pytest.approx(2 / 3)
     assert op.score_cut == 7
-    op = recall_at_false_alarm_rate(
-        det, truth, false_alarms_per_year=2.0, start="2020-01-01", end="2021-01-01"
-    )
+    op = recall_at_false_alarm_rate(det, truth, false_alarms_per_year=2.0, start="2020-01-01", end="2021-01-01")
     assert op.recall == 1.0
 
 

@@ -179,3 +179,17 @@ def test_unknown_format_is_an_error(tmp_path: Path) -> None:
     p.write_text("x")
     with pytest.raises(InputError, match="unknown telemetry format"):
         read_telemetry(p, SC)
+
+
+def test_a_single_sample_is_an_error(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match="at least 2 samples"):
+        read_telemetry(_write(tmp_path, _frame(1)), SC)
+
+
+def test_keys_that_do_not_apply_to_a_quantity_are_errors(tmp_path: Path) -> None:
+    text = (
+        bundled_spacecraft_path().read_text().replace('order = "scalar_first"', 'order = "scalar_first", unit = "rad"')
+    )
+    (tmp_path / "sc.toml").write_text(text)
+    with pytest.raises(ConfigError, match=r"telemetry\.quaternion\.unit"):
+        load_spacecraft(tmp_path / "sc.toml")

@@ -86,3 +86,9 @@ def test_episode_rate_merges_neighbouring_exceedances() -> None:
 def test_too_little_data_is_an_error() -> None:
     with pytest.raises(ValueError, match="at least 10"):
         fit_threshold([1.0, 2.0], p_fa=0.1)
+
+
+def test_kde_tail_follows_the_data_far_beyond_its_thinned_body() -> None:
+    x = np.random.default_rng(3).exponential(size=2_000_000)
+    # exponential: P(X > v) = exp(-v)
+    assert fit_threshold(x, p_fa=1e-5, method="kde").value == pytest.approx(-np.log(1e-5), rel=0.04)

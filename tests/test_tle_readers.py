@@ -108,9 +108,7 @@ def test_same_epoch_reissue_keeps_the_higher_element_set_number(tmp_path: Path) 
 
 def test_mixed_satellites_are_an_error_unless_one_is_selected(tmp_path: Path) -> None:
     p = _write(tmp_path, [*J3_A, *S3A, *J3_B])
-    with pytest.raises(
-        InputError, match=r"x\.tle:3: element set of satellite 41335 in a file of satellite 41240"
-    ):
+    with pytest.raises(InputError, match=r"x\.tle:3: element set of satellite 41335 in a file of satellite 41240"):
         read_tle(p)
     h = read_tle(p, norad_id=41240)
     assert len(h) == 2

@@ -23,9 +23,7 @@ FILES = {"Jason-3": "ja3man.txt", "Sentinel-3A": "s3aman.txt"}
 
 
 @pytest.mark.parametrize("satellite", ["Jason-3", "Sentinel-3A"])
-def test_beats_the_maneuver_detect_baseline_and_estimates_in_track_delta_v(
-    shared_data: Path, satellite: str
-) -> None:
+def test_beats_the_maneuver_detect_baseline_and_estimates_in_track_delta_v(shared_data: Path, satellite: str) -> None:
     history = read_tle(shared_data / "tle" / f"{satellite}.tle")
     truth = read_ids_maneuvers(shared_data / "maneuvers" / FILES[satellite])
     events = detect_tle_maneuvers(history, all_candidates=True)

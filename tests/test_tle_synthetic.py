@@ -88,9 +88,7 @@ def synthetic_tle_text(
         epoch_days_since_1949 = (
             EPOCH0 + pd.Timedelta(days=float(td)) - pd.Timestamp("1949-12-31")
         ).total_seconds() / 86400.0
-        sat.sgp4init(
-            WGS72, "i", norad, epoch_days_since_1949, 1e-5, 0.0, 0.0, ecc, argp, inc_k, mo, n_rad_min, raan
-        )
+        sat.sgp4init(WGS72, "i", norad, epoch_days_since_1949, 1e-5, 0.0, 0.0, ecc, argp, inc_k, mo, n_rad_min, raan)
         sat.classification = "U"
         sat.intldesg = "20001A"
         sat.elnum = 999
@@ -192,9 +190,7 @@ def test_cli_detect_score_and_report_run_end_to_end(maneuvering, tmp_path: Path)
         str(truth_file),
     )
     js = tmp_path / "score.json"
-    r = runner.invoke(
-        cli, ["score", str(out), "--truth", str(truth_file), "--elements", str(path), "--json", str(js)]
-    )
+    r = runner.invoke(cli, ["score", str(out), "--truth", str(truth_file), "--elements", str(path), "--json", str(js)])
     assert r.exit_code == 0, r.output
     assert "recall 1.000" in r.output
     png = tmp_path / "report.png"

@@ -16,9 +16,7 @@ from abrupt.simulate.tracking import TrackingScenario, simulate_tracking, thesis
 
 
 def _data(burn=None, seed: int = 4, cadence: float = 10.0):
-    sc = TrackingScenario(
-        stations=(ascension(1.0),), burns=() if burn is None else (burn,), cadence_s=cadence
-    )
+    sc = TrackingScenario(stations=(ascension(1.0),), burns=() if burn is None else (burn,), cadence_s=cadence)
     sim = simulate_tracking(sc, seed=seed)
     return TrackingArrays(sim.measurements, {}, epoch_utc=sim.epoch_utc), sim
 
@@ -34,18 +32,14 @@ def test_batch_fit_recovers_the_initial_state_and_a_range_bias() -> None:
     data.y[:, 0] += truth_bias
     fit = fit_orbit(data, _perturbed(sim.initial_state), config=BatchFitConfig(estimate_range_bias=True))
     assert fit.converged
-    assert fit.range_bias_m["ASCENSION"] == pytest.approx(
-        truth_bias, abs=4 * fit.sigma("range_bias[ASCENSION]")
-    )
+    assert fit.range_bias_m["ASCENSION"] == pytest.approx(truth_bias, abs=4 * fit.sigma("range_bias[ASCENSION]"))
     assert np.linalg.norm(fit.x0[:3] - sim.initial_state[:3]) < 20.0
     assert fit.rms_white == pytest.approx(1.0, abs=0.1)
 
 
 def test_glrt_is_quiet_without_a_maneuver() -> None:
     data, sim = _data()
-    det, _, scans = detect_maneuvers_glrt(
-        data, _perturbed(sim.initial_state), config=GlrtConfig(max_maneuvers=1)
-    )
+    det, _, scans = detect_maneuvers_glrt(data, _perturbed(sim.initial_state), config=GlrtConfig(max_maneuvers=1))
     assert det == []
     assert np.nanmax(scans[0].statistic) < glrt_threshold_for(scans[0].t_candidates_s.size, data)
 
@@ -136,9 +130,7 @@ def test_cli_simulate_detect_report_end_to_end(tmp_path: Path) -> None:
     assert len(glrt) == 1
     assert glrt["dv_t_mps"].iloc[0] == pytest.approx(0.1, rel=0.2)
     truth = pd.read_csv(tmp_path / "truth.csv")
-    dt = abs(
-        (pd.Timestamp(glrt["time_utc"].iloc[0]) - pd.Timestamp(truth["time_utc"].iloc[0])).total_seconds()
-    )
+    dt = abs((pd.Timestamp(glrt["time_utc"].iloc[0]) - pd.Timestamp(truth["time_utc"].iloc[0])).total_seconds())
     assert dt < 900.0
     r = runner.invoke(
         cli,
@@ -196,9 +188,7 @@ def test_w3b_real_tracking_fit_estimates_biases_and_an_unmodelled_acceleration(s
     setup = read_od_input(shared_data / "tracking" / "od_test_W3.in")
     meas = correct_refraction(read_aer(shared_data / "tracking" / "W3B.aer", known_stations=setup.stations))
     data = TrackingArrays(meas, setup.stations, epoch_utc=setup.epoch_utc, earth_rotation="iers")
-    force = ForceModel(
-        MU_EARTH_M3_S2, j2=True, third_body=True, epoch_jd_tt=float(Time(setup.epoch_utc).tt.jd)
-    )
+    force = ForceModel(MU_EARTH_M3_S2, j2=True, third_body=True, epoch_jd_tt=float(Time(setup.epoch_utc).tt.jd))
     cfg = BatchFitConfig(
         force=force,
         estimate_range_bias=True,

@@ -108,9 +108,7 @@ def test_inversion_round_trips_and_flags_non_monotonic_or_below_floor() -> None:
         est = invert_characterisation(fit, float(fit.predict(dv)))
         assert est.status == "ok" and est.dv_mps == pytest.approx(dv, rel=1e-3)
         assert est.sigma_mps > 0
-    assert invert_characterisation(fit, 45.0).dv_mps == pytest.approx(
-        3.24, abs=0.02
-    )  # spec §7.3 worked example
+    assert invert_characterisation(fit, 45.0).dv_mps == pytest.approx(3.24, abs=0.02)  # spec §7.3 worked example
     assert invert_characterisation(fit, 30.0, floor=30.127).status == "below_floor"
     dv = np.array([1, 5, 10, 25, 50, 75, 100.0])
     bent = fit_characterisation(dv, 31.4265 - 0.0177 * dv + 0.001487 * dv**2, "quadratic")  # vertex at ~6 m/s

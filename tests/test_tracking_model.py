@@ -29,9 +29,7 @@ def test_coe_round_trip_recovers_elements_of_an_inclined_orbit() -> None:
     coe = rv_to_coe(x, MU)
     assert coe["a_m"] == pytest.approx(7.3454e6, rel=1e-12)
     assert coe["e"] == pytest.approx(0.05, abs=1e-12)
-    assert (coe["i_deg"], coe["raan_deg"], coe["argp_deg"], coe["nu_deg"]) == pytest.approx(
-        (10, 30, 40, 50), abs=1e-9
-    )
+    assert (coe["i_deg"], coe["raan_deg"], coe["argp_deg"], coe["nu_deg"]) == pytest.approx((10, 30, 40, 50), abs=1e-9)
 
 
 def test_energy_is_conserved_between_burns_and_jumps_by_the_impulse_value() -> None:
@@ -66,12 +64,8 @@ def test_short_burn_changes_the_orbit_like_a_long_one_of_equal_dv() -> None:
     """Spec §15.3 item 8: with break-points a 10 s burn is not stepped over (thesis t_man = 10 s artefact)."""
     period = CASE1.period_s()
     t = np.array([0.0, 3 * period])
-    a10 = rv_to_coe(
-        propagate_truth(CASE1.state(), t, [thesis_burn("apogee", "S", 5.0, duration_s=10.0)])[-1], MU
-    )
-    a100 = rv_to_coe(
-        propagate_truth(CASE1.state(), t, [thesis_burn("apogee", "S", 5.0, duration_s=100.0)])[-1], MU
-    )
+    a10 = rv_to_coe(propagate_truth(CASE1.state(), t, [thesis_burn("apogee", "S", 5.0, duration_s=10.0)])[-1], MU)
+    a100 = rv_to_coe(propagate_truth(CASE1.state(), t, [thesis_burn("apogee", "S", 5.0, duration_s=100.0)])[-1], MU)
     a0 = rv_to_coe(CASE1.state(), MU)
     assert a10["a_m"] - a0["a_m"] == pytest.approx(a100["a_m"] - a0["a_m"], rel=0.01)
     assert a10["a_m"] - a0["a_m"] > 10e3
@@ -95,9 +89,7 @@ def test_station_site_vector_matches_astropy_geodetic_conversion() -> None:
     from astropy.coordinates import EarthLocation
 
     st = Station("X", 41.9774962512, 13.6004229863, 671.354)
-    loc = EarthLocation.from_geodetic(
-        st.longitude_deg * u.deg, st.latitude_deg * u.deg, st.altitude_m * u.m, "WGS84"
-    )
+    loc = EarthLocation.from_geodetic(st.longitude_deg * u.deg, st.latitude_deg * u.deg, st.altitude_m * u.m, "WGS84")
     ref = np.array([q.to_value(u.m) for q in loc.geocentric])
     np.testing.assert_allclose(st.position_ecef_m, ref, atol=0.01)
 
@@ -132,9 +124,7 @@ def test_range_rate_includes_earth_rotation() -> None:
 @pytest.mark.parametrize("model", ["simple", "iers"])
 def test_analytic_measurement_jacobian_matches_finite_differences(model: str) -> None:
     st = ascension()
-    c_fi = earth_rotation_matrices(
-        np.array([500.0]), model=model, epoch_utc=np.datetime64("2020-01-01T00:00")
-    )[0]
+    c_fi = earth_rotation_matrices(np.array([500.0]), model=model, epoch_utc=np.datetime64("2020-01-01T00:00"))[0]
     site_i = c_fi.T @ st.position_ecef_m
     x = np.r_[site_i * 1.3 + np.array([3e5, -2e5, 1e5]), 1000.0, 7000.0, 500.0]
     _, h = predict_measurement(x, c_fi, st.position_ecef_m, st.ecef_to_sez)
@@ -158,11 +148,7 @@ def test_iers_rotation_matches_astropy_gcrs_to_itrs() -> None:
     c = earth_rotation_matrices(np.array([3600.0]), model="iers", epoch_utc=epoch)[0]
     r = np.array([-4.05e7, -1.0e7, 1.6e5])
     t = Time(epoch + np.timedelta64(3600, "s"))
-    ref = (
-        GCRS(CartesianRepresentation(r * u.m), obstime=t)
-        .transform_to(ITRS(obstime=t))
-        .cartesian.xyz.to_value(u.m)
-    )
+    ref = GCRS(CartesianRepresentation(r * u.m), obstime=t).transform_to(ITRS(obstime=t)).cartesian.xyz.to_value(u.m)
     assert np.linalg.norm(c @ r - ref) < 300.0  # [m] polar motion neglected (~0.3" at 42 000 km)
 
 

@@ -211,10 +211,6 @@ def test_tdm_reader_rejects_malformed_or_truncated_files(tmp_path: Path, tail: s
 
 def test_tdm_reader_rejects_unsupported_units_and_missing_header(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="RANGE_UNITS"):
-        read_tdm(
-            _write(
-                tmp_path, "u.tdm", TDM_HEAD.replace("RANGE_UNITS = km", "RANGE_UNITS = RU") + "DATA_STOP\n"
-            )
-        )
+        read_tdm(_write(tmp_path, "u.tdm", TDM_HEAD.replace("RANGE_UNITS = km", "RANGE_UNITS = RU") + "DATA_STOP\n"))
     with pytest.raises(InputError, match="CCSDS_TDM_VERS"):
         read_tdm(_write(tmp_path, "h.tdm", TDM_HEAD.replace("CCSDS_TDM_VERS = 2.0\n", "") + "DATA_STOP\n"))

@@ -72,7 +72,7 @@ class Catalog:
     """Events and run records in a SQL database.
 
     >>> cat = Catalog("events.sqlite")          # doctest: +SKIP
-    >>> n_new = cat.add_events(frame, run)      # doctest: +SKIP
+    >>> n_new = cat.add_events(frame)           # doctest: +SKIP
     """
 
     def __init__(self, target: str | Path = "abrupt_catalog.sqlite") -> None:
@@ -127,7 +127,7 @@ class Catalog:
                 row["extra_json"] = json.dumps({c: _clean(rec[c]) for c in extra_cols}, default=str)
                 records.append(row)
             if records:
-                conn.execute(events_table.insert(), records)
+                conn.execute(_insert_ignoring_duplicates(self.engine.dialect.name), records)
         return len(records)
 
     def finish_run(self, run_id: str, *, n_found: int, n_new: int, details: Mapping[str, Any] | None = None) -> None:
@@ -166,6 +166,19 @@ class Catalog:
         frame = self.events(spacecraft=spacecraft, kind=kind)
         write_events(frame, str(path))
         return len(frame)
+
+
+def _insert_ignoring_duplicates(dialect: str) -> Any:
+    """INSERT that skips rows whose event_id exists (concurrent writers, e.g. Dask workers)."""
+    if dialect == "sqlite":
+        from sqlalchemy.dialects.sqlite import insert as sqlite_insert
+
+        return sqlite_insert(events_table).on_conflict_do_nothing(index_elements=["event_id"])
+    if dialect == "postgresql":
+        from sqlalchemy.dialects.postgresql import insert as pg_insert
+
+        return pg_insert(events_table).on_conflict_do_nothing(index_elements=["event_id"])
+    return events_table.insert()
 
 
 def _now() -> str:

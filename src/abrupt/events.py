@@ -211,5 +211,15 @@ def write_events(frame: pd.DataFrame, path: str) -> None:
 def read_events(path: str) -> pd.DataFrame:
     """Read an events file written by :func:`write_events` and check it against the schema."""
     lower = str(path).lower()
-    frame = pd.read_parquet(path) if lower.endswith((".parquet", ".pq")) else pd.read_csv(path)
+    if lower.endswith((".parquet", ".pq")):
+        frame = pd.read_parquet(path)
+    else:
+        # identifiers stay text: a hash like "12345e67" or a pseudonym "007" must not become a number
+        text_columns = ("event_id", "spacecraft", "kind", "detector", "time_utc", "run_id", "config_hash")
+        frame = pd.read_csv(
+            path,
+            dtype={c: str for c in text_columns},
+            keep_default_na=False,
+            na_values={c: [""] for c in _FLOAT_COLUMNS},
+        )
     return normalise_frame(frame)

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from abrupt.cli.groups import catalog_option, cli, detect, record_run, report, simulate
+from abrupt.cli.groups import catalog_option, check_suffix, cli, detect, record_run, report, simulate
 
 if TYPE_CHECKING:
     from abrupt.simulate.attitude import Strike
@@ -84,7 +84,13 @@ def random_strikes(n: int, duration_s: float, dh_min: float, dh_max: float, seed
 @click.option("--wheel-resolution", type=float, default=None, help="Tachometer discretisation [rad/s].")
 @click.option("--start", "start_utc", default="2026-01-01T00:00:00", show_default=True, help="Start time (UTC).")
 @click.option("--seed", type=int, default=0, show_default=True)
-@click.option("--out", type=click.Path(dir_okay=False), required=True, help="Telemetry file (.csv or .parquet).")
+@click.option(
+    "--out",
+    type=click.Path(dir_okay=False),
+    required=True,
+    callback=check_suffix(".csv", ".parquet"),
+    help="Telemetry file (.csv or .parquet).",
+)
 def simulate_attitude_cmd(
     spacecraft_path: str | None,
     duration_s: float,
@@ -130,7 +136,13 @@ def _random_strikes(n: int, duration_s: float, strike_range: tuple[float, float]
 
 
 def _detection_config(
-    detectors: tuple[str, ...], fa_per_day: float, pre: int, post: int, method: str, null_samples: int
+    detectors: tuple[str, ...],
+    fa_per_day: float,
+    pre: int,
+    post: int,
+    glr_window: int,
+    method: str,
+    null_samples: int,
 ) -> Any:
     from abrupt.detect.attitude import ATTITUDE_DETECTORS, AttitudeDetectionConfig
     from abrupt.detect.change_detection import WindowConfig
@@ -139,6 +151,7 @@ def _detection_config(
     return AttitudeDetectionConfig(
         detectors=chosen,
         windows=WindowConfig(pre=pre, post=post),
+        glr_windows=WindowConfig(pre=glr_window, post=glr_window),
         false_alarms_per_day=fa_per_day,
         threshold_method=method,
         null_samples=null_samples,
@@ -158,13 +171,32 @@ detector_options = [
     click.option(
         "--false-alarms-per-day",
         "fa_per_day",
-        type=float,
+        type=click.FloatRange(min=0.0, min_open=True),
         default=1.0,
         show_default=True,
         help="False-alarm budget the thresholds are set for.",
     ),
-    click.option("--pre", type=int, default=200, show_default=True, help="Pre-window [samples] (thesis detectors)."),
-    click.option("--post", type=int, default=180, show_default=True, help="Post-window [samples] (thesis detectors)."),
+    click.option(
+        "--pre",
+        type=click.IntRange(min=2),
+        default=200,
+        show_default=True,
+        help="Pre-window [samples] of cusum, summation, shiryaev (thesis: 200).",
+    ),
+    click.option(
+        "--post",
+        type=click.IntRange(min=1),
+        default=180,
+        show_default=True,
+        help="Post-window [samples] of cusum, summation, shiryaev (thesis: 180).",
+    ),
+    click.option(
+        "--glr-window",
+        type=click.IntRange(min=10),
+        default=1000,
+        show_default=True,
+        help="Pre- and post-window [samples] of the glr detector.",
+    ),
     click.option(
         "--threshold-fit",
         "method",
@@ -175,7 +207,7 @@ detector_options = [
     ),
     click.option(
         "--null-samples",
-        type=int,
+        type=click.IntRange(min=100_000),
         default=10_000_000,
         show_default=True,
         help="Event-free samples simulated for threshold calibration (without --calibration).",
@@ -201,14 +233,9 @@ def _with_options(options: list[Any]) -> Any:
 def run_attitude_detection(
     telemetry_path: str,
     spacecraft_path: str | None,
-    detectors: tuple[str, ...],
-    fa_per_day: float,
-    pre: int,
-    post: int,
-    method: str,
-    null_samples: int,
     calibration: str | None,
     name: str | None,
+    settings: dict[str, Any],
 ) -> tuple[Any, Any, Any, Any]:
     """Read, calibrate and detect, with a progress line per stage. Returns (sc, telemetry, config, result)."""
     from abrupt.detect.attitude import detect_attitude
@@ -219,13 +246,31 @@ def run_attitude_detection(
     for line in tel.repairs.summary():
         click.echo(f"repaired: {line}", err=True)
     cal = read_telemetry(calibration, sc) if calibration else None
-    cfg = _detection_config(detectors, fa_per_day, pre, post, method, null_samples)
-    stages = iter(range(10_000))
+    if cal is not None:
+        for line in cal.repairs.summary():
+            click.echo(f"repaired (calibration): {line}", err=True)
+    cfg = _detection_config(**settings)
+    stages = iter(range(1, 10_000))
 
     def progress(stage: str) -> None:
-        click.echo(f"[{next(stages) + 1}] {stage} ...", err=True)
+        click.echo(f"[{next(stages)}] {stage} ...", err=True)
 
     result = detect_attitude(tel, sc, cfg, calibration=cal, spacecraft_name=name, progress=progress)
+    for warning in result.details.get("warnings", []):
+        click.echo(f"warning: {warning}", err=True)
+    noise = result.details.get("noise_model", {})
+    if noise:
+        click.echo(
+            "momentum noise model: white σ "
+            + ", ".join(f"{v:.3g}" for v in noise["white_sigma_Nms"])
+            + " N·m·s; random walk σ "
+            + ", ".join(f"{v:.3g}" for v in noise["random_walk_sigma_Nms"])
+            + " N·m·s per sample",
+            err=True,
+        )
+    for det, frac in result.details.get("analysed_fraction", {}).items():
+        if frac < 0.999:
+            click.echo(f"{det}: {frac:.1%} of samples analysed (window edges and short segments excluded)", err=True)
     return sc, tel, cfg, result
 
 
@@ -241,37 +286,36 @@ def run_attitude_detection(
 @_with_options(detector_options)
 @click.option("--name", default=None, help="Spacecraft pseudonym in events (default: the spacecraft file's name).")
 @catalog_option
-@click.option("--out", type=click.Path(dir_okay=False), required=True, help="Events file (.csv or .parquet).")
+@click.option(
+    "--out",
+    type=click.Path(dir_okay=False),
+    required=True,
+    callback=check_suffix(".csv", ".parquet"),
+    help="Events file (.csv or .parquet).",
+)
 @click.option(
     "--report",
     "report_path",
     type=click.Path(dir_okay=False),
     default=None,
+    callback=check_suffix(".png", ".html"),
     help="Also write the report figure (.png or .html).",
 )
 def detect_attitude_cmd(
     telemetry: str,
     spacecraft_path: str,
-    detectors: tuple[str, ...],
-    fa_per_day: float,
-    pre: int,
-    post: int,
-    method: str,
-    null_samples: int,
     calibration: str | None,
     name: str | None,
     catalog_target: str,
     out: str,
     report_path: str | None,
+    **settings: Any,
 ) -> None:
     """Detect strikes in attitude TELEMETRY (CSV or Parquet); write events and the catalog."""
-    _, tel, _, result = run_attitude_detection(
-        telemetry, spacecraft_path, detectors, fa_per_day, pre, post, method, null_samples, calibration, name
-    )
+    _, tel, _, result = run_attitude_detection(telemetry, spacecraft_path, calibration, name, settings)
     details = {
         "thresholds": {k: v.as_dict() for k, v in result.thresholds.items()},
-        "repairs": tel.repairs.as_dict(),
-        "gaps": len(tel.gaps),
+        **{k: v for k, v in result.details.items()},
     }
     record_run(
         catalog_target=catalog_target,
@@ -305,28 +349,22 @@ def detect_attitude_cmd(
     default=None,
     help="Truth file of a simulation (marks the true strike times).",
 )
-@click.option("--out", type=click.Path(dir_okay=False), required=True, help="Figure (.png) or page (.html).")
+@click.option(
+    "--out",
+    type=click.Path(dir_okay=False),
+    required=True,
+    callback=check_suffix(".png", ".html"),
+    help="Figure (.png) or page (.html).",
+)
 def report_attitude_cmd(
-    telemetry: str,
-    spacecraft_path: str,
-    detectors: tuple[str, ...],
-    fa_per_day: float,
-    pre: int,
-    post: int,
-    method: str,
-    null_samples: int,
-    calibration: str | None,
-    truth: str | None,
-    out: str,
+    telemetry: str, spacecraft_path: str, calibration: str | None, truth: str | None, out: str, **settings: Any
 ) -> None:
     """Draw the attitude report: momentum, contributions, raw channels, statistics, thresholds, events."""
     import pandas as pd
 
     from abrupt.report.attitude import write_attitude_report
 
-    _, tel, _, result = run_attitude_detection(
-        telemetry, spacecraft_path, detectors, fa_per_day, pre, post, method, null_samples, calibration, None
-    )
+    _, tel, _, result = run_attitude_detection(telemetry, spacecraft_path, calibration, None, settings)
     truth_frame = pd.read_csv(truth) if truth else None
     write_attitude_report(out, tel, result, truth=truth_frame)
     click.echo(f"report: {out}")

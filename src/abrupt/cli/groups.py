@@ -72,6 +72,17 @@ spacecraft_name_option = click.option(
 )
 
 
+def check_suffix(*suffixes: str) -> Any:
+    """A click callback rejecting a path whose suffix is not one of ``suffixes`` (before any work)."""
+
+    def callback(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
+        if value is not None and not str(value).lower().endswith(suffixes):
+            raise click.BadParameter(f"{value!r} must end in {' or '.join(suffixes)}")
+        return value
+
+    return callback
+
+
 def file_hash(path: str | Path) -> str:
     """SHA-256 (first 16 hex digits) of a file's bytes, for run records."""
     h = hashlib.sha256()
@@ -106,6 +117,9 @@ def record_run(
     from abrupt.catalog import Catalog
     from abrupt.events import write_events
 
+    if out is not None:  # write the file first: a bad path must not leave events in the catalog only
+        Path(out).parent.mkdir(parents=True, exist_ok=True)
+        write_events(events, str(out))
     catalog = Catalog(catalog_target)
     catalog.start_run(
         run_id,
@@ -116,9 +130,6 @@ def record_run(
     )
     n_new = catalog.add_events(events)
     catalog.finish_run(run_id, n_found=len(events), n_new=n_new, details=details)
-    if out is not None:
-        Path(out).parent.mkdir(parents=True, exist_ok=True)
-        write_events(events, str(out))
     click.echo(
         f"{len(events)} event(s) found, {n_new} new in catalog {catalog_target}"
         + (f"; written to {out}" if out is not None else ""),

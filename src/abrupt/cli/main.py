@@ -15,7 +15,9 @@ def main(argv: list[str] | None = None) -> None:
     """Run the command line; turn abrupt's own errors into a one-line message and exit status 2."""
     try:
         cli.main(args=argv, prog_name="abrupt", standalone_mode=False)
-    except AbruptError as exc:
+    except (AbruptError, ValueError) as exc:
+        # abrupt's own errors name the file, line and reason; a ValueError from a setting is shown
+        # the same way (a one-line message, exit status 2), never as a traceback.
         click.echo(f"error: {exc}", err=True)
         sys.exit(2)
     except click.exceptions.Abort:

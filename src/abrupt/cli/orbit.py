@@ -14,7 +14,17 @@ import click
 from abrupt.cli.groups import catalog_option, detect, inject, record_run, report, simulate, spacecraft_name_option
 from abrupt.errors import ConfigError
 
-STATISTIC_CHOICES = ("dv_fb", "mahalanobis_v", "accel_smoothed", "mcr_w", "mcr_scalar", "d_sma", "d_ecc", "d_hdir")
+STATISTIC_CHOICES = (
+    "glr",
+    "dv_fb",
+    "mahalanobis_v",
+    "accel_smoothed",
+    "mcr_w",
+    "mcr_scalar",
+    "d_sma",
+    "d_ecc",
+    "d_hdir",
+)
 
 
 def _parse_vector(text: str, what: str) -> tuple[float, float, float]:
@@ -24,7 +34,7 @@ def _parse_vector(text: str, what: str) -> tuple[float, float, float]:
         raise ConfigError(f"{what} must be three comma-separated numbers, got {text!r}", key=what) from None
     if len(parts) != 3:
         raise ConfigError(f"{what} must have three components, got {len(parts)}", key=what)
-    return parts  # type: ignore[return-value]
+    return parts
 
 
 def _filter_options(f: Any) -> Any:
@@ -177,9 +187,8 @@ def simulate_orbit_command(
 @click.option(
     "--statistic",
     type=click.Choice(STATISTIC_CHOICES),
-    default="mcr_w",
-    show_default=True,
-    help="Statistic that raises events (McReynolds acceleration consistency by default).",
+    default=None,
+    help="Statistic that raises events (default: glr with auto tuning, mcr_w with thesis tuning).",
 )
 @click.option(
     "--false-alarms-per-week", type=float, default=1.0, show_default=True, help="False-alarm budget of thresholds."
@@ -192,7 +201,9 @@ def simulate_orbit_command(
     help="Event-free data of the same satellite to set thresholds from (default: the arc itself, with leave-out).",
 )
 @click.option("--kind", type=click.Choice(["unknown", "maneuver", "strike"]), default="unknown", show_default=True)
-@click.option("--statistics-out", type=click.Path(dir_okay=False), default=None, help="Per-epoch statistics (.parquet/.csv).")
+@click.option(
+    "--statistics-out", type=click.Path(dir_okay=False), default=None, help="Per-epoch statistics (.parquet/.csv)."
+)
 @spacecraft_name_option
 @catalog_option
 def detect_orbit_command(
@@ -205,7 +216,7 @@ def detect_orbit_command(
     sigma_vel_mps: float | None,
     dynamics: str | None,
     satellite: str | None,
-    statistic: str,
+    statistic: str | None,
     false_alarms_per_week: float,
     null_file: str | None,
     kind: str,
@@ -227,6 +238,8 @@ def detect_orbit_command(
     if false_alarms_per_week <= 0:
         raise ConfigError("--false-alarms-per-week must be positive", key="false-alarms-per-week")
     eph = read_ephemeris(file, satellite)
+    if statistic is None:
+        statistic = "glr" if tuning == "auto" else "mcr_w"
     for line in eph.repairs.summary():
         click.echo(f"repaired: {line}", err=True)
     cfg = _detector_config(
@@ -340,7 +353,14 @@ def report_orbit_command(
 
     eph = read_ephemeris(file, satellite)
     cfg = _detector_config(
-        eph, tuning, tau_s, q_m2_s5, sigma_pos_m, sigma_vel_mps, dynamics, false_alarms_per_day=false_alarms_per_week / 7
+        eph,
+        tuning,
+        tau_s,
+        q_m2_s5,
+        sigma_pos_m,
+        sigma_vel_mps,
+        dynamics,
+        false_alarms_per_day=false_alarms_per_week / 7,
     )
     analysis = analyse(eph, cfg)
     thresholds = self_calibrate(analysis)

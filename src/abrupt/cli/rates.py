@@ -47,9 +47,7 @@ def _scenario_options(func: Callable[..., Any]) -> Callable[..., Any]:
             show_default=True,
             help="Circular-orbit altitude [km].",
         ),
-        click.option(
-            "--inclination-deg", type=float, default=28.5, show_default=True, help="Inclination [deg]."
-        ),
+        click.option("--inclination-deg", type=float, default=28.5, show_default=True, help="Inclination [deg]."),
         click.option(
             "--epoch",
             "epoch_year",
@@ -99,9 +97,7 @@ def _scenario_options(func: Callable[..., Any]) -> Callable[..., Any]:
             show_default=True,
             help="const1, const2, const3, const:<x>, nysmith_denardo, rembor, rembor_array.",
         ),
-        click.option(
-            "--lc-min-m", type=float, default=3e-5, show_default=True, help="Lower Lc truncation [m]."
-        ),
+        click.option("--lc-min-m", type=float, default=3e-5, show_default=True, help="Lower Lc truncation [m]."),
         click.option(
             "--draws",
             "n_draws",
@@ -149,18 +145,14 @@ def _scenario_options(func: Callable[..., Any]) -> Callable[..., Any]:
             default=None,
             help="Comma-separated thresholds in SI units (N m s, m/s, m) for the first metric.",
         ),
-        click.option(
-            "--out", type=click.Path(dir_okay=False), default=None, help="Write the rate table (.csv)."
-        ),
+        click.option("--out", type=click.Path(dir_okay=False), default=None, help="Write the rate table (.csv)."),
         click.option(
             "--plot",
             type=click.Path(dir_okay=False),
             default=None,
             help="Write the rate-vs-threshold plot (PNG).",
         ),
-        click.option(
-            "--scatter", type=click.Path(dir_okay=False), default=None, help="Write the ΔH-ΔV scatter (PNG)."
-        ),
+        click.option("--scatter", type=click.Path(dir_okay=False), default=None, help="Write the ΔH-ΔV scatter (PNG)."),
     ]
     for opt in reversed(options):
         func = opt(func)
@@ -239,9 +231,7 @@ def _report(results: Sequence[Any], kw: dict[str, Any]) -> None:
         )
     units = {"dH": "N m s", "dV": "m/s", "da": "m"}
     for m in metrics:
-        sub = frame[frame.metric == m].pivot(
-            index="threshold_SI", columns="case", values="detectable_per_year"
-        )
+        sub = frame[frame.metric == m].pivot(index="threshold_SI", columns="case", values="detectable_per_year")
         click.echo(f"\nexpected detectable strikes per year, {m} threshold [{units[m]}]:")
         click.echo(sub.to_string(float_format=lambda v: f"{v:.4g}"))
     if kw["out"]:
@@ -287,9 +277,7 @@ def run_command(**kw: Any) -> None:
     "mass_model, mef, grid_spacing, size_scale, location, area, lc_min, size_sampling. "
     "Spacecraft paths join with ';'.",
 )
-@click.option(
-    "--scheduler", default=None, help="Dask scheduler address (tcp://host:8786); in-process when absent."
-)
+@click.option("--scheduler", default=None, help="Dask scheduler address (tcp://host:8786); in-process when absent.")
 def trade_command(vary: tuple[str, ...], scheduler: str | None, **kw: Any) -> None:
     """A trade over one or two variables; one Monte Carlo per case (Dask-parallel with --scheduler)."""
     from abrupt.errors import ConfigError
@@ -362,8 +350,7 @@ def flux_command(
             solar_flux_sfu=solar_flux_sfu,
         )
         click.echo(
-            f"NASA-90/91 debris, {altitude_km:g} km, {inclination_deg:g} deg, {epoch_year:g}, "
-            f"S={solar_flux_sfu:g}"
+            f"NASA-90/91 debris, {altitude_km:g} km, {inclination_deg:g} deg, {epoch_year:g}, S={solar_flux_sfu:g}"
         )
         click.echo(f"{'diameter_m':>12} {'tumbling_/m2/yr':>16} {'cross_section_/m2/yr':>21}")
         for s, v in zip(sizes, f, strict=True):
@@ -383,8 +370,7 @@ def flux_command(
             f"motion K={fac.motion:.3f}, density {fx.METEOROID_DENSITY_KG_M3:g} kg/m3"
         )
         click.echo(
-            f"{'diameter_m':>12} {'mass_kg':>12} {'1AU_/m2/yr':>12} {'orbit_plate_/m2/yr':>19} "
-            f"{'cross_section':>14}"
+            f"{'diameter_m':>12} {'mass_kg':>12} {'1AU_/m2/yr':>12} {'orbit_plate_/m2/yr':>19} {'cross_section':>14}"
         )
         for s, m, v in zip(sizes, masses, f0, strict=True):
             click.echo(f"{s:12.4g} {m:12.4g} {v:12.5g} {v * fac.total:19.5g} {4 * v * fac.total:14.5g}")
@@ -413,9 +399,7 @@ def flux_command(
     default="cross_section",
     show_default=True,
 )
-@click.option(
-    "--intact-class", type=click.Choice(["nak", "low", "medium", "high"]), default="high", show_default=True
-)
+@click.option("--intact-class", type=click.Choice(["nak", "low", "medium", "high"]), default="high", show_default=True)
 def import_ordem_command(
     size_file: str,
     igloo_file: str,

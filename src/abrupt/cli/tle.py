@@ -36,9 +36,7 @@ norad_option = click.option(
     show_default=True,
     help="False-alarm budget per satellite-year that sets the threshold.",
 )
-@click.option(
-    "--threshold", type=float, default=None, help="Fixed threshold on the statistic (overrides the budget)."
-)
+@click.option("--threshold", type=float, default=None, help="Fixed threshold on the statistic (overrides the budget).")
 @click.option(
     "--window-sets",
     type=int,
@@ -84,9 +82,7 @@ def detect_tle(
     for line in history.repairs.summary():
         click.echo(f"repaired: {line}", err=True)
     run_id = new_run_id()
-    events = detect_tle_maneuvers(
-        history, cfg, spacecraft=pseudonym, run_id=run_id, all_candidates=all_candidates
-    )
+    events = detect_tle_maneuvers(history, cfg, spacecraft=pseudonym, run_id=run_id, all_candidates=all_candidates)
     details: dict[str, Any] = {
         "element_sets": len(history),
         "first_epoch_utc": str(history.elements["epoch_utc"].iloc[0]),
@@ -180,9 +176,7 @@ def _read_truth(path: str) -> Any:
     default=None,
     help="The TLE/OMM file the events came from: its span limits the truth and gives the satellite-years.",
 )
-@click.option(
-    "--start", default=None, help="Start of the observed span (ISO UTC), if --elements is not given."
-)
+@click.option("--start", default=None, help="Start of the observed span (ISO UTC), if --elements is not given.")
 @click.option("--end", default=None, help="End of the observed span (ISO UTC).")
 @click.option(
     "--false-alarms-per-year",
@@ -230,11 +224,7 @@ def score(
     click.echo(
         f"tolerance ±{tolerance_days:g} d, one-to-one: {result.n_detections} detections, "
         f"{result.n_truth} truth"
-        + (
-            f" ({result.n_truth_outside_span} outside the observed span ignored)"
-            if result.n_truth_outside_span
-            else ""
-        )
+        + (f" ({result.n_truth_outside_span} outside the observed span ignored)" if result.n_truth_outside_span else "")
     )
     click.echo(
         f"TP {result.true_positives}  FP {result.false_positives}  FN {result.false_negatives}  "
@@ -253,8 +243,6 @@ def score(
             )
             out["operating_points"].append(op.__dict__)
     else:
-        click.echo(
-            "recall at a false-alarm rate needs the observed span: give --elements or --start/--end", err=True
-        )
+        click.echo("recall at a false-alarm rate needs the observed span: give --elements or --start/--end", err=True)
     if json_out:
         Path(json_out).write_text(json.dumps(out, indent=2, default=str))

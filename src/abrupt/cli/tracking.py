@@ -26,9 +26,7 @@ from abrupt.cli.groups import catalog_option, detect, progress, record_run, repo
     default=None,
     help="A-priori orbit and stations (default: OUT with .in).",
 )
-@click.option(
-    "--truth-out", type=click.Path(dir_okay=False), default=None, help="Truth events (.csv/.parquet)."
-)
+@click.option("--truth-out", type=click.Path(dir_okay=False), default=None, help="Truth events (.csv/.parquet).")
 @click.option(
     "--orbit",
     type=click.Choice(["case1", "case2"]),
@@ -49,9 +47,7 @@ from abrupt.cli.groups import catalog_option, detect, progress, record_run, repo
     show_default=True,
     help="Radial, transverse or normal.",
 )
-@click.option(
-    "--dv", "dv_mps", type=float, default=1.0, show_default=True, help="Burn Δv (m/s); 0 for no maneuver."
-)
+@click.option("--dv", "dv_mps", type=float, default=1.0, show_default=True, help="Burn Δv (m/s); 0 for no maneuver.")
 @click.option(
     "--burn-duration",
     "burn_s",
@@ -68,9 +64,7 @@ from abrupt.cli.groups import catalog_option, detect, progress, record_run, repo
     show_default=True,
     help="Elevation mask (deg); -90 tracks continuously.",
 )
-@click.option(
-    "--cadence", "cadence_s", type=float, default=5.0, show_default=True, help="Measurement interval (s)."
-)
+@click.option("--cadence", "cadence_s", type=float, default=5.0, show_default=True, help="Measurement interval (s).")
 @click.option(
     "--noise-scale",
     type=float,
@@ -78,9 +72,7 @@ from abrupt.cli.groups import catalog_option, detect, progress, record_run, repo
     show_default=True,
     help="Multiply the thesis noise (5 m, 0.02 rad, 0.5 m/s).",
 )
-@click.option(
-    "--epoch", "epoch_utc", default="2024-01-01T00:00:00", show_default=True, help="UTC epoch of the start."
-)
+@click.option("--epoch", "epoch_utc", default="2024-01-01T00:00:00", show_default=True, help="UTC epoch of the start.")
 @click.option("--earth-rotation", type=click.Choice(["simple", "iers"]), default="simple", show_default=True)
 @click.option("--seed", type=int, default=0, show_default=True)
 @click.option("--name", "spacecraft", default="SIM-TRACK", show_default=True, help="Spacecraft pseudonym.")
@@ -181,9 +173,7 @@ def _write_aer(measurements: Any, path: Path) -> None:
     type=click.Path(exists=True, dir_okay=False),
     help="Orekit-style input: a-priori orbit and stations (e.g. od_test_W3.in).",
 )
-@click.option(
-    "--out", "out", type=click.Path(dir_okay=False), default=None, help="Events file (.csv/.parquet)."
-)
+@click.option("--out", "out", type=click.Path(dir_okay=False), default=None, help="Events file (.csv/.parquet).")
 @click.option("--method", type=click.Choice(["both", "kaderali", "glrt"]), default="both", show_default=True)
 @click.option(
     "--false-alarms-per-day",
@@ -199,12 +189,8 @@ def _write_aer(measurements: Any, path: Path) -> None:
     show_default=True,
     help="Ψ_th for covariance inflation (Kaderali 2021).",
 )
-@click.option(
-    "--eta-threshold", type=float, default=1.0, show_default=True, help="η_th (km² + km²/s²) for inflation."
-)
-@click.option(
-    "--mask", "mask_deg", type=float, default=None, help="Skip measurements below this elevation (deg)."
-)
+@click.option("--eta-threshold", type=float, default=1.0, show_default=True, help="η_th (km² + km²/s²) for inflation.")
+@click.option("--mask", "mask_deg", type=float, default=None, help="Skip measurements below this elevation (deg).")
 @click.option(
     "--estimate-biases/--no-estimate-biases",
     default=None,
@@ -330,6 +316,8 @@ def detect_tracking_command(
     name = spacecraft or Path(file).stem
     fit = fit_orbit(data, setup.initial_state, config=fit_cfg)
     start_state = fit.x0
+    accel_state = fit.acceleration_mps2
+    final_fit = fit
     events = []
     diag_frames = []
     arc_s = float(data.t_s.max() - data.t_s.min())
@@ -341,6 +329,8 @@ def detect_tracking_command(
             config=GlrtConfig(false_alarms_per_day=false_alarms_per_day, max_maneuvers=max_maneuvers),
         )
         start_state = fit_m.x0  # the maneuver-aware state at t0 starts the EKF
+        accel_state = fit_m.acceleration_mps2
+        final_fit = fit_m
         events += glrt_events(
             detections,
             epoch_utc=data.epoch_utc,
@@ -354,8 +344,7 @@ def detect_tracking_command(
                 pd.DataFrame(
                     {
                         "series": "glrt",
-                        "time_utc": data.epoch_utc
-                        + (scans[0].t_candidates_s * 1e9).astype("timedelta64[ns]"),
+                        "time_utc": data.epoch_utc + (scans[0].t_candidates_s * 1e9).astype("timedelta64[ns]"),
                         "glrt_statistic": scans[0].statistic,
                         "threshold": detections[0].threshold if detections else np.nan,
                     }
@@ -376,6 +365,7 @@ def detect_tracking_command(
             elevation_mask_deg=mask_deg,
             force=force,
             max_step_s=max_step,
+            accel_mps2=tuple(float(v) for v in accel_state),  # type: ignore[arg-type]
         )
         result = run_kaderali_filter(kdata, start_state, config=kcfg)
         rate_hz = max(len(result.t_s) - 1, 1) / max(arc_s, 1.0)
@@ -406,7 +396,7 @@ def detect_tracking_command(
             )
         )
     frame = events_frame(events) if events else empty_frame()
-    summary = _fit_summary(fit, force, sun_position_m(jd_tt))
+    summary = _fit_summary(final_fit, force, sun_position_m(jd_tt))
     summary["repairs"] = repairs.as_dict()
     for line in _summary_lines(summary):
         click.echo(line, err=True)
@@ -449,14 +439,13 @@ def _fit_summary(fit: Any, force: Any, sun_m: Any) -> dict[str, Any]:
 
     out: dict[str, Any] = {
         "converged": bool(fit.converged),
+        "n_impulses": len(fit.impulse_times_s),
         "iterations": int(fit.iterations),
         "n_observations": int(fit.n_obs),
         "weighted_rms": float(fit.rms_white),
         "x0_m_mps": [float(v) for v in fit.x0],
         "range_bias_m": {k: [float(v), fit.sigma(f"range_bias[{k}]")] for k, v in fit.range_bias_m.items()},
-        "angle_bias_deg": {
-            k: [math.degrees(v[0]), math.degrees(v[1])] for k, v in fit.angle_bias_rad.items()
-        },
+        "angle_bias_deg": {k: [math.degrees(v[0]), math.degrees(v[1])] for k, v in fit.angle_bias_rad.items()},
         "force_model": {"mu_m3_s2": force.mu_m3_s2, "j2": force.j2, "sun_moon": force.third_body},
     }
     if "accel_x" in fit.parameter_names:
@@ -479,7 +468,7 @@ def _fit_summary(fit: Any, force: Any, sun_m: Any) -> dict[str, Any]:
 def _summary_lines(summary: dict[str, Any]) -> list[str]:
     lines = [
         f"orbit fit: {'converged' if summary['converged'] else 'NOT converged'} "
-        f"in {summary['iterations']} iterations, "
+        f"in {summary['iterations']} iterations with {summary['n_impulses']} impulse(s), "
         f"{summary['n_observations']} observations, weighted RMS {summary['weighted_rms']:.3f}"
     ]
     for st, (b, s) in summary["range_bias_m"].items():
@@ -506,13 +495,9 @@ def _summary_lines(summary: dict[str, Any]) -> list[str]:
     default=None,
     help="Detected events.",
 )
-@click.option(
-    "--truth", "truth_path", type=click.Path(exists=True, dir_okay=False), default=None, help="Truth events."
-)
+@click.option("--truth", "truth_path", type=click.Path(exists=True, dir_okay=False), default=None, help="Truth events.")
 @click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Figure (.png/.pdf/.svg).")
-def report_tracking_command(
-    diagnostics: str, events_path: str | None, truth_path: str | None, out: str
-) -> None:
+def report_tracking_command(diagnostics: str, events_path: str | None, truth_path: str | None, out: str) -> None:
     """Ψ and K against time (Kaderali 2021 Figs. 3.2-3.4) and the GLRT statistic, with events and truth."""
     import pandas as pd
 

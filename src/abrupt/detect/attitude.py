@@ -30,6 +30,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from abrupt.detect.change_detection import WindowConfig, sliding_statistic
+from abrupt.errors import InputError
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc, new_run_id
 from abrupt.model.momentum import system_momentum
 from abrupt.model.spacecraft import Spacecraft
@@ -90,6 +91,19 @@ class DetectionResult:
     config_hash: str
     run_id: str
     details: dict[str, Any] = field(default_factory=dict)
+
+
+def spacecraft_fingerprint(spacecraft: Spacecraft) -> str:
+    """Hash of everything in a spacecraft description that changes momentum or detection."""
+    return config_hash(
+        {
+            "name": spacecraft.name,
+            "inertia": spacecraft.inertia_kgm2,
+            "wheel_axes": spacecraft.wheel_axes,
+            "wheel_inertias": spacecraft.wheel_spin_inertias_kgm2,
+            "telemetry": repr(spacecraft.telemetry),
+        }
+    )
 
 
 def robust_noise_sigma(x: FloatArray) -> FloatArray:
@@ -183,7 +197,7 @@ def momentum_noise_model(h: FloatArray, segments: list[tuple[int, int]] | None =
     longest = max(segments, key=lambda s: s[1] - s[0])
     x = h[longest[0] : longest[1]]
     white = robust_noise_sigma(x)
-    scales = [m for m in (10, 30, 100, 300, 1000, 3000) if x.shape[0] >= 6 * m]
+    scales = [m for m in (10, 30, 100, 300, 1000, 3000) if x.shape[0] >= 20 * m]  # ≥ 20 clusters each
     walk = np.zeros(3)
     if scales:
         avar = np.array([robust_allan_variance(x, m) for m in scales])  # (k, 3)
@@ -237,7 +251,7 @@ def calibrate_thresholds(
         if name in MATCHED_FILTERS:
             continue  # matched filters set their own thresholds (abrupt.detect.matched_filter)
         if progress is not None:
-            progress(name)
+            progress(f"calibrating the {name} threshold on event-free data")
         win = detector_windows(name, config, dt)
         h = h_null
         # Blocks for the extreme-value fit: at least 5 min and three window spans, so maxima are
@@ -280,24 +294,59 @@ def _window_mean(h: FloatArray, a: int, b: int) -> FloatArray:
     return np.asarray(h[max(a, 0) : max(b, 0)].mean(axis=0), dtype=np.float64)
 
 
-def _locate_step(h_total: FloatArray, lo: int, hi: int, m: int, direction: FloatArray) -> tuple[int, float]:
-    """Sample index τ in [lo, hi) maximising the projected step d(τ)·û of total ᴺH (windows of m).
+def _locate_step(
+    h_total: FloatArray, lo: int, hi: int, segment: tuple[int, int], win: WindowConfig
+) -> tuple[int, float, FloatArray]:
+    """Sample τ in [lo, hi) where total ᴺH steps, its projected noise σ and the step ΔH [N·m·s].
 
-    Total momentum is conserved through the control transient, so it steps at the strike sample;
-    returns (τ, projected noise σ per sample along û).
+    τ maximises the noise-weighted squared pre/post mean difference with windows of m = min(pre, post)
+    samples (both inside the segment); ΔH is then the mean difference over the detector's own windows
+    around τ, clipped to the segment. Total momentum is conserved through the control transient, so it
+    steps at the strike sample.
     """
-    n = h_total.shape[0]
-    lo = max(lo, m)
-    hi = min(hi, n - m)
-    proj = h_total @ direction
+    s0, s1 = segment
+    m = max(2, min(win.pre, win.post))
+    lo = max(lo, s0 + m)
+    hi = min(hi, s1 - m)
+    x = h_total[s0:s1]
+    sigma = robust_noise_sigma(x)
+    sigma = np.where(sigma > 0, sigma, 1.0)
     if hi <= lo:
-        return max(min((lo + hi) // 2, n - 1), 0), float("nan")
-    c = np.concatenate([[0.0], np.cumsum(proj)])
-    taus = np.arange(lo, hi)
-    d = (c[taus + m] - c[taus]) / m - (c[taus] - c[taus - m]) / m
-    tau = int(taus[np.argmax(d)])
-    sigma = float(robust_noise_sigma(proj[:, None])[0])
-    return tau, sigma
+        tau = int(np.clip((lo + hi) // 2, s0, s1 - 1))
+    else:
+        c = np.vstack([np.zeros((1, 3)), np.cumsum(x, axis=0)])
+        taus = np.arange(lo, hi) - s0
+        d = (c[taus + m] - c[taus]) / m - (c[taus] - c[taus - m]) / m
+        tau = s0 + int(taus[np.argmax(np.sum((d / sigma) ** 2, axis=1))])
+    d_h = _window_mean(h_total, tau, min(s1, tau + win.post)) - _window_mean(h_total, max(s0, tau - win.pre), tau)
+    mag = float(np.linalg.norm(d_h))
+    if mag > 0:
+        # Refine by maximum likelihood for a step of the estimated size along û: τ minimises the
+        # cumulative sum of (h·û − mid) over ±m, mid the midpoint of the two levels.
+        u = d_h / mag
+        r0, r1 = max(s0 + 1, tau - m), min(s1 - 1, tau + m)
+        proj = h_total[r0 - 1 : r1] @ u
+        mid = float(_window_mean(h_total, max(s0, tau - win.pre), tau) @ u) + mag / 2.0
+        csum = np.concatenate([[0.0], np.cumsum(proj - mid)])
+        tau = r0 - 1 + int(np.argmin(csum))
+        tau = int(np.clip(tau, s0 + 1, s1 - 1))
+        d_h = _window_mean(h_total, tau, min(s1, tau + win.post)) - _window_mean(h_total, max(s0, tau - win.pre), tau)
+        mag = float(np.linalg.norm(d_h))
+    sig = float(np.sqrt(np.sum((sigma * d_h / mag) ** 2))) if mag > 0 else float("nan")
+    return tau, sig, d_h
+
+
+def _input_warnings(telemetry: Telemetry, config: AttitudeDetectionConfig, calibration: Telemetry | None) -> list[str]:
+    """Warnings about inputs that make the thresholds or the coverage uncertain."""
+    out = []
+    longest = max((b - a for a, b in telemetry.segments), default=0)
+    spans = [detector_windows(d, config, telemetry.sample_interval_s).span for d in config.detectors]
+    if calibration is None and longest < 20 * max(spans, default=1):
+        out.append(
+            f"longest gap-free segment has {longest} samples (< 20 window spans): the noise model the "
+            "thresholds rest on is uncertain; give event-free telemetry with --calibration"
+        )
+    return out
 
 
 _WAVELET_CACHE: dict[tuple[str, str, float], Any] = {}
@@ -365,7 +414,24 @@ def detect_attitude(
     """
     config = config or AttitudeDetectionConfig()
     run_id = run_id or new_run_id()
-    cfg_hash = config_hash({"attitude": asdict(config), "spacecraft": spacecraft.name})
+    if calibration is not None:
+        ratio = calibration.sample_interval_s / telemetry.sample_interval_s
+        if abs(ratio - 1.0) > 0.01:
+            raise InputError(
+                f"calibration telemetry is sampled every {calibration.sample_interval_s:g} s but the input every "
+                f"{telemetry.sample_interval_s:g} s; thresholds only transfer at the same rate",
+                file=calibration.source,
+            )
+    cfg_hash = config_hash(
+        {
+            "attitude": asdict(config),
+            "spacecraft": spacecraft_fingerprint(spacecraft),
+            "calibration": None
+            if calibration is None
+            else config_hash({"h": calibration.quaternion_BN[:: max(1, len(calibration) // 1000)]}),
+            "thresholds": None if thresholds is None else {k: v.as_dict() for k, v in thresholds.items()},
+        }
+    )
     name_sc = spacecraft_name or spacecraft.name
     dt = telemetry.sample_interval_s
     n = len(telemetry)
@@ -383,35 +449,50 @@ def detect_attitude(
         )
     statistics: dict[str, FloatArray] = {}
     events: list[Event] = []
+    analysed: dict[str, float] = {}
+    merged: dict[str, int] = {}
+    warnings = list(_input_warnings(telemetry, config, calibration))
     t_ns = telemetry.time.astype("datetime64[ns]").astype(np.int64)
     for name in config.detectors:
         if name in MATCHED_FILTERS:
             continue
         if progress is not None:
-            progress(name)
+            progress(f"running {name}")
         win = detector_windows(name, config, dt)
         h = mom.H_N_Nms
         stat = _per_segment(telemetry.segments, n, _segment_statistic(name, h, win))
         statistics[name] = stat
         thr = thresholds[name]
-        for a, b in _episodes(stat, thr.value, merge=win.span):
+        finite = np.isfinite(stat)
+        analysed[name] = float(finite.mean()) if n else 0.0
+        if name == "shiryaev" and thr.value >= (config.windows.shiryaev_n - 0.5) * config.windows.shiryaev_delta_mu_Nms:
+            warnings.append(
+                f"shiryaev threshold {thr.value:.3g} N·m·s is at the top of its hypothesis grid "
+                f"(±{config.windows.shiryaev_n * config.windows.shiryaev_delta_mu_Nms:.3g} N·m·s): it cannot alarm at "
+                f"{thr.false_alarms_per_day:g} false alarms/day"
+            )
+        taus: list[int] = []
+        for a, b in _episodes(stat, thr.value, merge=max(1, win.span // 10)):
             peak = a + int(np.nanargmax(stat[a:b]))
-            seg = next((s for s in telemetry.segments if s[0] <= peak < s[1]), (0, n))
-            # ΔH: guarded pre/post mean difference at the peak junction.
-            d_h = _window_mean(h, peak + win.guard, peak + win.guard + win.post) - _window_mean(h, peak - win.pre, peak)
+            seg = next((sg for sg in telemetry.segments if sg[0] <= peak < sg[1]), (0, n))
+            # The step is where total ᴺH (conserved through the control transient) changes most: search
+            # the whole episode widened by the windows, since some statistics (CUSUM, Shiryaev) peak
+            # up to a window away from the junction.
+            lo = max(seg[0], a - win.pre)
+            hi = min(seg[1], b + win.post + win.guard)
+            tau, sig, d_h = _locate_step(mom.H_N_Nms, lo, hi, seg, win)
+            if any(abs(tau - t_prev) < win.post for t_prev in taus):
+                merged[name] = merged.get(name, 0) + 1  # same step seen by two episodes
+                continue
+            taus.append(tau)
             mag = float(np.linalg.norm(d_h))
-            direction = d_h / mag if mag > 0 else np.array([1.0, 0.0, 0.0])
-            m = min(win.pre, win.post)
-            lo, hi = peak - win.post // 2, peak + win.guard + win.post // 2 + 1
-            tau_local, sig = _locate_step(mom.H_N_Nms[seg[0] : seg[1]], lo - seg[0], hi - seg[0], m, direction)
-            tau = seg[0] + tau_local
-            if not np.isfinite(sig) or mag == 0:
-                time_sigma = dt * max(1.0, win.guard / 2)
-            else:
-                # Change-point location error grows as (σ/Δ)² samples (Hinkley 1970); factor 3 from
-                # simulation (tests/test_attitude_detection.py).
-                time_sigma = max(dt / np.sqrt(12.0), 3.0 * dt * (sig / mag) ** 2)
-            t_event = (t_ns[tau - 1] + t_ns[tau]) // 2 if tau > 0 else t_ns[tau]
+            # Change-point location error grows as (σ/Δ)² samples (Hinkley 1970); factor 3 from simulation.
+            time_sigma = (
+                dt * max(1.0, win.guard / 2)
+                if not (np.isfinite(sig) and mag > 0)
+                else (max(dt / np.sqrt(12.0), 3.0 * dt * (sig / mag) ** 2))
+            )
+            t_event = (t_ns[tau - 1] + t_ns[tau]) // 2 if tau > seg[0] else t_ns[tau]
             events.append(
                 Event(
                     spacecraft=name_sc,
@@ -449,5 +530,12 @@ def detect_attitude(
         noise_sigma=noise,
         config_hash=cfg_hash,
         run_id=run_id,
-        details={"repairs": telemetry.repairs.as_dict(), "gaps": len(telemetry.gaps)},
+        details={
+            "repairs": telemetry.repairs.as_dict(),
+            "gaps": len(telemetry.gaps),
+            "analysed_fraction": analysed,
+            "merged_episodes": merged,
+            "noise_model": {k: np.asarray(v).tolist() for k, v in noise.items() if "sigma" in k},
+            "warnings": warnings,
+        },
     )

@@ -179,21 +179,19 @@ def _mean_difference_kernel(
 
 @nb.njit(cache=True)
 def _cusum_lanes(
-    x32: NDArray[np.float32],
-    m32: NDArray[np.float32],
-    a32: NDArray[np.float32],
-    start: int,
-    post: int,
-    h: float,
+    x32: NDArray[np.float32], m32: NDArray[np.float32], a32: NDArray[np.float32], post: int, h: float
 ) -> NDArray[np.float32]:
-    """CUSUM of 64 neighbouring windows at once (inner loop vectorises across windows, float32)."""
+    """CUSUM of 64 neighbouring windows at once (inner loop vectorises across windows, float32).
+
+    ``x32[w + i]`` is sample i of window w's post-window, already centred by the group's offset.
+    """
     lanes = 64
     gp = np.zeros(lanes, dtype=np.float32)
     gn = np.zeros(lanes, dtype=np.float32)
     h32 = np.float32(h)
     zero = np.float32(0.0)
     for i in range(post):
-        xs = x32[start + i : start + i + lanes]
+        xs = x32[i : i + lanes]
         for w in range(lanes):
             d = xs[w] - m32[w]
             v = gp[w] + a32[w] * (d - h32)
@@ -218,37 +216,43 @@ def _cusum_kernel(
     """Two-sided CUSUM at the end of each post-window (Bennett 2022 Eqs. 2.12-2.13).
 
     Per sample, ln L± = (Δμ/σ²)(±(x − μ) − Δμ/2); g = max(0, g + ln L); output max(g+, g−).
-    Windows are processed 64 at a time in float32 so the inner loop vectorises across windows
-    (about 2-4e7 samples per second per core); each window's arithmetic is the same whatever its
-    lane, so results do not depend on chunking. float32 rounding is ~1e-6 of the statistic.
+    Windows are processed in groups of 64 whose junctions start at absolute indices divisible by
+    64, in float32 so the inner loop vectorises across windows (2-4e7 samples per second per core).
+    Each group is centred in float64 on the sample at its first junction before the cast, so the
+    float32 rounding is relative to the noise, not to |H|; and because groups are aligned to
+    absolute indices, results do not depend on chunking.
     """
     mu, sd = _pre_mean_std(x, offset, pre, n_first, count, anchor)
     k = x.shape[1]
     lanes = 64
     out = np.empty((count, k))
     h = delta_mu / 2.0
-    base0 = n_first + guard - offset
-    n_rows = count + post + lanes
-    x32 = np.zeros(n_rows, dtype=np.float32)
+    x32 = np.zeros(lanes + post, dtype=np.float32)
     m32 = np.zeros(lanes, dtype=np.float32)
     a32 = np.zeros(lanes, dtype=np.float32)
+    last = n_first + count  # exclusive, absolute
     for c in range(k):
-        avail = min(n_rows, x.shape[0] - base0)
-        for i in range(avail):
-            x32[i] = np.float32(x[base0 + i, c])
-        for b0 in range(0, count, lanes):
-            nl = min(lanes, count - b0)
+        g0 = n_first - (n_first % lanes)
+        while g0 < last:
+            ref = x[g0 - offset, c]
+            n_rows = min(lanes + post, x.shape[0] - (g0 + guard - offset))
+            for i in range(lanes + post):
+                x32[i] = np.float32(x[g0 + guard + i - offset, c] - ref) if i < n_rows else np.float32(0.0)
             for w in range(lanes):
-                if w < nl:
-                    s = sd[b0 + w, c]
+                j = g0 + w - n_first
+                if 0 <= j < count:
+                    s = sd[j, c]
                     a32[w] = np.float32(delta_mu / (s * s)) if s > 0 else np.float32(0.0)
-                    m32[w] = np.float32(mu[b0 + w, c])
+                    m32[w] = np.float32(mu[j, c] - ref)
                 else:
                     a32[w] = np.float32(0.0)
                     m32[w] = np.float32(0.0)
-            g = _cusum_lanes(x32, m32, a32, b0, post, h)
-            for w in range(nl):
-                out[b0 + w, c] = g[w]
+            g = _cusum_lanes(x32, m32, a32, post, h)
+            for w in range(lanes):
+                j = g0 + w - n_first
+                if 0 <= j < count:
+                    out[j, c] = g[w]
+            g0 += lanes
     return out
 
 
@@ -386,6 +390,11 @@ def _evaluate(name: str, x: FloatArray, offset: int, n_first: int, count: int, c
     raise ValueError(f"unknown statistic {name!r}; choose one of {STATISTICS}")
 
 
+def _check_channels(name: str, channels: int) -> None:
+    if name == "glr" and not 1 <= channels <= 3:
+        raise ValueError(f"the glr statistic takes 1 to 3 channels (inertial axes), got {channels}")
+
+
 def _as_2d(x: ArrayLike) -> FloatArray:
     arr = np.asarray(x, dtype=np.float64)
     if arr.ndim == 1:
@@ -403,6 +412,7 @@ def sliding_statistic(name: StatisticName | str, x: ArrayLike, config: WindowCon
     """
     cfg = config or WindowConfig()
     data = _as_2d(x)
+    _check_channels(name, data.shape[1])
     n = data.shape[0]
     k_out = 1 if name == "glr" else data.shape[1]
     out = np.full((n, k_out), np.nan)
@@ -430,6 +440,7 @@ class StreamingStatistic:
     def __post_init__(self) -> None:
         if self.name not in STATISTICS:
             raise ValueError(f"unknown statistic {self.name!r}; choose one of {STATISTICS}")
+        _check_channels(self.name, self.channels)
         self._keep = self.config.span - 1 + ANCHOR
         self._buffer = np.empty((0, self.channels))
         self._offset = 0  # absolute index of buffer row 0

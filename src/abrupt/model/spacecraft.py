@@ -229,7 +229,8 @@ def _require(table: dict[str, Any], key: str, where: str, file: str) -> Any:
 
 
 def _channel(table: Any, where: str, file: str, units: dict[str, float] | None, n: int | None) -> ChannelMap:
-    table = _check_keys(table, {"columns", "unit", "order", "frame"}, where, file)
+    allowed = {"columns", "order", "frame"} if where.endswith("quaternion") else {"columns", "unit"}
+    table = _check_keys(table, allowed, where, file)
     cols = _require(table, "columns", where, file)
     if not isinstance(cols, list) or not all(isinstance(c, str) and c for c in cols):
         raise ConfigError("columns must be a list of column names", file=file, key=f"{where}.columns")

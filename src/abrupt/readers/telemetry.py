@@ -7,7 +7,7 @@ as q_BN, and checks the input. What it does with bad input (each case has a test
 =====================================  ==========================================================
 input                                  outcome
 =====================================  ==========================================================
-empty file, or header without rows     error
+empty file, header only, one sample    error
 unparseable time or number             error naming the line and column
 a mapped column missing                error naming the column and the spacecraft-file key
 quaternion norm off by more than 10%   error (wrong scaling or not a quaternion)
@@ -241,6 +241,8 @@ def telemetry_from_frame(
                 column=tmap.wheel_speed.columns[wheel],
             )
 
+    if time_ns.size < 2:
+        raise InputError(f"need at least 2 samples with distinct times, got {time_ns.size}", file=path)
     t_ns = time_ns.astype(np.int64)
     t_s = (t_ns - t_ns[0]) / 1e9
     steps = np.diff(t_s)
