@@ -202,18 +202,43 @@ def part_b(n_runs: int, plot: str | None) -> None:
         print(f"plot: {plot}")
 
 
+def part_c(days: float) -> None:
+    print(f"\n== C. False alarms on {days:g} days of event-free telemetry (budget: one per day) ==")
+    from abrupt.detect.attitude import detect_attitude
+
+    cfg = AttitudeDetectionConfig(detectors=("glr", "cusum", "summation"))
+    counts = dict.fromkeys(cfg.detectors, 0)
+    n_runs = max(1, round(days * 2))
+    for k in range(n_runs):
+        sim = simulate_attitude(SC, AttitudeSimConfig(duration_s=43200.0, seed=5000 + k), [])
+        tel = telemetry_from_frame(sim.telemetry, SC)
+        ev = detect_attitude(tel, SC, cfg).events
+        for name in cfg.detectors:
+            counts[name] += int((ev["detector"] == f"attitude.{name}").sum())
+    total_days = n_runs / 2
+    for name, c in counts.items():
+        # 95% Poisson interval of the rate (Garwood)
+        lo = stats.chi2.ppf(0.025, 2 * c) / 2 / total_days if c else 0.0
+        hi = stats.chi2.ppf(0.975, 2 * c + 2) / 2 / total_days
+        rate = c / total_days
+        print(f"  {name:10s} {c:3d} alarms in {total_days:g} days = {rate:.2f}/day (95% interval {lo:.2f}-{hi:.2f})")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="fewer runs (200 and 40) for a fast look")
     ap.add_argument("--runs", type=int, default=None, help="runs per Monte Carlo point")
     ap.add_argument("--plot", default=None, help="write the power-curve PNG here")
-    ap.add_argument("--part", choices=["a", "b", "ab"], default="ab")
+    ap.add_argument("--part", choices=["a", "b", "c", "ab", "abc"], default="abc")
+    ap.add_argument("--days", type=float, default=None, help="event-free days for part c")
     args = ap.parse_args()
     t0 = time.perf_counter()
     if "a" in args.part:
         part_a(args.runs or (200 if args.quick else 1000), 3 if args.quick else 10)
     if "b" in args.part:
         part_b(args.runs or (40 if args.quick else 200), args.plot)
+    if "c" in args.part:
+        part_c(args.days or (1.0 if args.quick else 5.0))
     print(f"\ntotal {time.perf_counter() - t0:.0f} s")
 
 
