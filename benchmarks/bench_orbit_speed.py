@@ -85,7 +85,9 @@ def main() -> None:
     print(f"  forward filter         {t1 - t0:7.3f} s")
     print(f"  backward filter        {t2 - t1:7.3f} s")
     print(f"  fusion + TS1-TS4       {t3 - t2:7.3f} s")
-    print(f"  TS6 orbital constants  {t4 - t3:7.3f} s (from the forward states; the q×100 filter adds one forward pass)")
+    print(
+        f"  TS6 orbital constants  {t4 - t3:7.3f} s (from the forward states; the q×100 filter adds one forward pass)"
+    )
     print(f"  total                  {total:7.3f} s   target < 2 s: {'MET' if total < 2.0 else 'NOT MET'}")
     _ = (fusion, oc)
 
@@ -97,8 +99,14 @@ def main() -> None:
     per_epoch_fp = (tf1 - tf0) / n_fp
     per_epoch_ours = (t1 - t0) / t.size
     err = np.max(np.abs(xs_fp[:, :6] - fwd.x[:n_fp, :6]))
-    print(f"filterpy forward filter: {per_epoch_fp * 1e6:.1f} µs/epoch over {n_fp} epochs; abrupt: {per_epoch_ours * 1e6:.1f} µs/epoch")
-    print(f"  speed ratio filterpy / abrupt = {per_epoch_fp / per_epoch_ours:.1f}x; max state difference {err:.2e} (m, m/s)")
+    print(
+        f"filterpy forward filter: {per_epoch_fp * 1e6:.1f} µs/epoch over {n_fp} epochs; "
+        f"abrupt: {per_epoch_ours * 1e6:.1f} µs/epoch"
+    )
+    print(
+        f"  speed ratio filterpy / abrupt = {per_epoch_fp / per_epoch_ours:.1f}x; "
+        f"max state difference {err:.2e} (m, m/s)"
+    )
 
 
 if __name__ == "__main__":

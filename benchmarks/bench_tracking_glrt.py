@@ -38,37 +38,52 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="5 runs per cell, 5 cm/s only")
     ap.add_argument("--runs", type=int, default=None)
     ap.add_argument("--cadence", type=float, default=5.0, help="measurement interval (s); thesis 5")
+    ap.add_argument("--grid", type=str, default=None, help="comma-separated dv grid in cm/s (default 1,2,5)")
+    ap.add_argument("--null-runs", type=int, default=None, help="null (no-maneuver) runs (default = runs)")
     args = ap.parse_args()
     n = args.runs or (5 if args.quick else 10)
     grid = (0.05,) if args.quick else (0.01, 0.02, 0.05)
+    if args.grid:
+        grid = tuple(float(g) / 100.0 for g in args.grid.split(","))
     t0 = time.time()
     false_alarms, arc_total = 0, 0.0
-    for s in range(n):
+    n_null = args.null_runs if args.null_runs is not None else n
+    for s in range(n_null):
         det, arc = one_run(None, 500 + s, args.cadence)
         false_alarms += len(det)
         arc_total += arc
     print(
-        f"null: {false_alarms} false alarm(s) in {n} arcs ({arc_total:.2f} days): "
+        f"null: {false_alarms} false alarm(s) in {n_null} arcs ({arc_total:.2f} days): "
         f"{false_alarms / arc_total:.2f} per day measured (threshold set for 0.1 per day)"
     )
-    print(f"{'loc':8s}{'dir':4s}{'dv cm/s':>8s}{'Pd':>6s}{'|dv| err median':>17s}{'err 90%':>9s}{'epoch err med s':>16s}")
+    print(
+        f"{'loc':8s}{'dir':4s}{'dv cm/s':>8s}{'Pd':>6s}{'|dv| err median':>17s}{'err 90%':>9s}{'epoch err med s':>16s}"
+    )
     smallest: dict[tuple[str, str], float] = {}
     for loc in ("perigee", "apogee"):
         for d in ("R", "S", "W"):
             for dv in grid:
                 burn = thesis_burn(loc, d, dv)
-                hits, errs, terr = 0, [], []
+                hits, errs, terr, errs_set, n_ambiguous = 0, [], [], [], 0
                 for s in range(n):
                     det, _ = one_run(burn, s, args.cadence)
                     if det:
                         hits += 1
                         errs.append(abs(det[0].dv_mps - dv) / dv)
                         terr.append(abs(det[0].t_s - (burn.t_start_s + 50.0)))
+                        options = [det[0].dv_mps] + [float(np.linalg.norm(v)) for _, v in det[0].alternatives]
+                        errs_set.append(min(abs(o - dv) / dv for o in options))
+                        n_ambiguous += bool(det[0].alternatives)
                 pd_ = hits / n
                 e_med = np.median(errs) if errs else np.nan
                 e_90 = np.percentile(errs, 90) if errs else np.nan
                 t_med = np.median(terr) if terr else np.nan
-                print(f"{loc:8s}{d:4s}{dv * 100:8.1f}{pd_:6.2f}{e_med:17.3f}{e_90:9.3f}{t_med:16.0f}", flush=True)
+                e_set = np.median(errs_set) if errs_set else np.nan
+                print(
+                    f"{loc:8s}{d:4s}{dv * 100:8.1f}{pd_:6.2f}{e_med:17.3f}{e_90:9.3f}{t_med:16.0f}"
+                    f"{n_ambiguous:6d}{e_set:12.3f}",
+                    flush=True,
+                )
                 if pd_ >= 0.9 and (loc, d) not in smallest:
                     smallest[(loc, d)] = dv
     print("\nsmallest dv detected in >= 90% of runs (grid " + ", ".join(f"{g * 100:g}" for g in grid) + " cm/s):")

@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 
-from abrupt.detect.kaderali import KaderaliResult, fit_characterisation, run_kaderali_filter
+from abrupt.detect.kaderali import KaderaliConfig, KaderaliResult, fit_characterisation, run_kaderali_filter
 from abrupt.model.stations import ascension
 from abrupt.model.tracking_measurements import TrackingArrays
 from abrupt.simulate.tracking import TrackingScenario, simulate_tracking, thesis_burn
@@ -43,11 +43,11 @@ THESIS_PSI_QUAD = {  # Table 4.4 (apogee), quadratic (b, c, d) and R²
 }
 
 
-def run(burn, mask: float, seed: int) -> KaderaliResult:
+def run(burn, mask: float, seed: int, config: KaderaliConfig | None = None) -> KaderaliResult:
     sc = TrackingScenario(stations=(ascension(mask),), burns=() if burn is None else (burn,))
     sim = simulate_tracking(sc, seed=seed)
     data = TrackingArrays(sim.measurements, {}, epoch_utc=sim.epoch_utc)
-    return run_kaderali_filter(data, sim.initial_state)
+    return run_kaderali_filter(data, sim.initial_state, config=config)
 
 
 def main() -> None:
@@ -88,13 +88,24 @@ def main() -> None:
                 if mask < 0 and loc == "apogee":
                     for model in ("linear", "sqrt", "square", "quadratic"):
                         f = fit_characterisation(DV_GRID, k, model)
-                        print(f"      {model:9s} K fit coefficients {np.round(f.coefficients, 5).tolist()} R2={f.r2:.4f}")
+                        print(
+                            f"      {model:9s} K fit coefficients {np.round(f.coefficients, 5).tolist()} R2={f.r2:.4f}"
+                        )
                     fq = fit_characterisation(DV_GRID, psi, "quadratic")
                     (pb, pc, pd_), pr2 = THESIS_PSI_QUAD[(loc, d)]
                     print(
                         f"      quad Psi fit: ours {np.round(fq.coefficients, 4).tolist()} R2={fq.r2:.4f} | "
                         f"thesis ({pb}, {pc}, {pd_}) R2={pr2}"
                     )
+    print("\n== E8: cm/s burns with Psi_th = 10, eta_th = 0.1 (thesis: apogee 21-46, perigee 21-22 'undetectable')")
+    cm_cfg = KaderaliConfig(psi_threshold=10.0, eta_threshold_km=0.1)
+    for mask_label, mask in (("continuous", -90.0), ("1 deg mask", 1.0)):
+        null = [run(None, mask, s, cm_cfg).k_max for s in range(5)]
+        line = f"  {mask_label:10s} null K_max (5 seeds) {np.round(null, 1).tolist()};"
+        for loc in ("apogee", "perigee"):
+            ks = [run(thesis_burn(loc, "S", dv), mask, args.seed, cm_cfg).k_max for dv in (0.05, 0.2, 1.0)]
+            line += f" {loc} S 5/20/100 cm/s K_max {np.round(ks, 1).tolist()};"
+        print(line)
     print(f"\nelapsed {time.time() - t_start:.0f} s")
 
 

@@ -204,3 +204,31 @@ def test_w3b_real_tracking_fit_estimates_biases_and_an_unmodelled_acceleration(s
     acc = float(np.linalg.norm(fit.acceleration_mps2))
     assert 1e-6 < acc < 1e-4
     assert math.isfinite(fit.sigma("accel_x"))
+
+
+@pytest.mark.slow
+def test_cli_detect_tracking_runs_on_w3b_and_reports_the_unmodelled_acceleration(
+    shared_data: Path, tmp_path: Path
+) -> None:
+    import json
+
+    from click.testing import CliRunner
+
+    from abrupt.cli.main import cli
+
+    r = CliRunner().invoke(
+        cli,
+        [
+            "detect", "tracking", str(shared_data / "tracking" / "W3B.aer"),
+            "--setup", str(shared_data / "tracking" / "od_test_W3.in"),
+            "--fit-out", str(tmp_path / "fit.json"), "--out", str(tmp_path / "ev.csv"),
+            "--catalog", str(tmp_path / "c.sqlite"),
+        ],
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    fit = json.loads((tmp_path / "fit.json").read_text())
+    assert fit["converged"]
+    assert set(fit["range_bias_m"]) == {"CastleRock", "Fucino", "Kumsan", "Pretoria", "Uralla"}
+    acc = fit["unmodelled_acceleration"]
+    assert 1e-6 < acc["magnitude_mps2"] < 1e-4
+    assert acc["magnitude_sigma_mps2"] < acc["magnitude_mps2"]

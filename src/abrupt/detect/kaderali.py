@@ -78,6 +78,7 @@ class KaderaliConfig:
     joseph_form: bool = True
     max_step_s: float = 5.0
     force: ForceModel = field(default_factory=ForceModel)
+    accel_mps2: tuple[float, float, float] = (0.0, 0.0, 0.0)  # known constant acceleration (e.g. from a fit)
 
     @property
     def k_threshold_db(self) -> float:
@@ -168,7 +169,13 @@ def run_kaderali_filter(
         t_i = float(data.t_s[i])
         if t_i != t_prev:
             states, stm, _ = propagate_with_stm(
-                x, t_prev, np.array([t_i]), force=cfg.force, max_step_s=cfg.max_step_s, step_wise=True
+                x,
+                t_prev,
+                np.array([t_i]),
+                force=cfg.force,
+                accel_mps2=cfg.accel_mps2,
+                max_step_s=cfg.max_step_s,
+                step_wise=True,
             )
             x_bar = states[0]
             phi = stm[0]
@@ -279,9 +286,7 @@ class CharacterisationFit:
         }
 
 
-def fit_characterisation(
-    dv_mps: Sequence[float], y: Sequence[float], model: str = "log"
-) -> CharacterisationFit:
+def fit_characterisation(dv_mps: Sequence[float], y: Sequence[float], model: str = "log") -> CharacterisationFit:
     """Least-squares fit of one thesis model; R² and adjusted R² = 1 − (1−R²)(n−1)/(n−p) (spec §7.2).
 
     The square model is fitted as y² = c + b x (the thesis's form) with R² computed on y².
@@ -401,9 +406,7 @@ def _coef_gradient(fit: CharacterisationFit, dv: float) -> NDArray[np.float64]:
 
 def thesis_apogee_transverse_fit() -> CharacterisationFit:
     """The thesis's recommended calibration: apogee transverse log fit (Table 4.2; spec §13 item 9)."""
-    return CharacterisationFit(
-        "log", (6.1991, 50.6466, 0.7132), ((0.0,) * 3,) * 3, 0.9810, 0.9715, 2.0, (1.0, 100.0)
-    )
+    return CharacterisationFit("log", (6.1991, 50.6466, 0.7132), ((0.0,) * 3,) * 3, 0.9810, 0.9715, 2.0, (1.0, 100.0))
 
 
 def direction_heuristic(k_max: float) -> str:
@@ -454,9 +457,7 @@ def kaderali_events(
                 spacecraft=spacecraft,
                 kind="maneuver",
                 detector="kaderali_k",
-                time_utc=format_time_utc(
-                    epoch_utc + np.timedelta64(round(float(result.t_s[best]) * 1e9), "ns")
-                ),
+                time_utc=format_time_utc(epoch_utc + np.timedelta64(round(float(result.t_s[best]) * 1e9), "ns")),
                 statistic=k_max,
                 threshold=k_th,
                 false_alarms_per_day=false_alarms_per_day,

@@ -21,7 +21,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from abrupt.detect.orbit_ekf import FilterConfig, FilterRun, run_backward, run_forward
-from abrupt.detect.orbit_glr import JumpEstimate, localise_jump
+from abrupt.detect.orbit_glr import JumpEstimate, glr_statistic, localise_jump
 from abrupt.detect.orbit_statistics import (
     STATISTIC_NAMES,
     FusionResult,
@@ -49,8 +49,11 @@ class OrbitDetectorConfig:
     ``merge_s``: exceedances closer than this form one event.
     ``oc_q_factor``, ``oc_window_s``: TS6 filter tuning (q × 100, §3.3.6) and averaging window.
     ``localise``: "glr" estimates each event's time and ΔV by the generalised likelihood ratio over
-    ±``glr_search_s`` around the statistic's peak with ``glr_horizon_s`` of data after the window
+    ±``glr_search_s`` around the statistic's peak (default: only the interval before the peak for the sliding ``glr``,
+    1200 s for the thesis statistics) with ``glr_horizon_s`` of data after the window (the sliding
+    statistic's own window when the event statistic is ``glr``)
     (:mod:`abrupt.detect.orbit_glr`); "peak" uses the ``mcr_w`` peak.
+    ``glr_window_samples``: length of the sliding GLR statistic's data window (0 disables it).
     ``dv_estimate``: "fb" (default) reports the thesis TS1 difference v_B − v_F at the last epoch
     before the located jump (robust to unmodelled dynamics on real data); "glr" the GLR estimate
     (best when the filter dynamics match the truth). The other is in extra columns ``dv_glr_*``.
@@ -69,8 +72,9 @@ class OrbitDetectorConfig:
     kind: str = "unknown"
     localise: str = "glr"
     glr_horizon_s: float = 1800.0
-    glr_search_s: float = 1200.0
+    glr_search_s: float | None = None
     dv_estimate: str = "fb"
+    glr_window_samples: int = 10
 
     def __post_init__(self) -> None:
         if self.statistic not in STATISTIC_NAMES:
@@ -135,6 +139,20 @@ def analyse(ephemeris: Ephemeris, config: OrbitDetectorConfig | None = None) -> 
     else:
         for name in ("d_sma", "d_ecc", "d_hdir"):
             stats[name] = np.full(t.size, np.nan)
+    if config.glr_window_samples > 0:
+        stats["glr"] = glr_statistic(
+            t,
+            eph.position_m,
+            eph.velocity_mps,
+            config.sigma_pos_m,
+            config.sigma_vel_mps,
+            fc,
+            fwd.x[0],
+            fwd.p[0],
+            config.glr_window_samples * eph.nominal_step_s,
+        )
+    else:
+        stats["glr"] = np.full(t.size, np.nan)
     valid = (t - t[0] >= config.settle_s) & (t[-1] - t >= config.settle_s)
     for name in stats:
         stats[name] = np.where(valid, stats[name], np.nan)
@@ -170,15 +188,17 @@ def self_calibrate(
     *,
     false_alarms_per_day: float | None = None,
     leave_out_s: float | None = None,
-    outlier_sigma: float = 8.0,
+    outlier_sigma: float = 6.0,
     iterations: int = 3,
     names: tuple[str, ...] | None = None,
 ) -> dict[str, Threshold]:
     """Thresholds from the arc itself when no event-free reference exists (real data).
 
     Procedure (documented in docs/orbit.md; nothing depends on a particular satellite):
-    1. robust scale: median and 1.4826·MAD of the statistic over the valid epochs;
-    2. leave-out: epochs within ``leave_out_s`` (default max(1800 s, 2 × settle_s)) of any value above median + ``outlier_sigma``·scale
+    1. robust location and scale: median and 1.4826·MAD of the statistic over the valid epochs — of
+       its logarithm when the statistic is positive (the statistics are skewed, chi-like);
+    2. leave-out: epochs within ``leave_out_s`` (default max(1800 s, 2 × settle_s)) of any value
+       above median + ``outlier_sigma``·scale
        are removed (candidate events must not inflate their own threshold); repeat ``iterations``
        times with the new median/scale;
     3. the remaining values are fitted with a generalised Pareto tail (peaks over the 98 % quantile,
@@ -197,14 +217,16 @@ def self_calibrate(
         keep = np.isfinite(s)
         if keep.sum() < 100:
             continue
+        positive = bool(np.all(s[keep] > 0))
+        z = np.log(np.where(keep, s, 1.0)) if positive else s
         for _ in range(iterations):
             if keep.sum() < 100:
                 break
-            med = float(np.median(s[keep]))
-            scale = 1.4826 * float(np.median(np.abs(s[keep] - med)))
+            med = float(np.median(z[keep]))
+            scale = 1.4826 * float(np.median(np.abs(z[keep] - med)))
             if scale <= 0:
                 break
-            hot = np.flatnonzero(keep & (s > med + outlier_sigma * scale))
+            hot = np.flatnonzero(keep & (z > med + outlier_sigma * scale))
             if hot.size == 0:
                 break
             drop = np.zeros_like(keep)
@@ -303,7 +325,18 @@ def find_events(
         glr_value = float("nan")
         glr_rtn = np.full(3, np.nan)
         if cfg.localise == "glr":
-            jump = _localise(analysis, t[peak_stat] - cfg.glr_search_s, t[peak_stat] + cfg.glr_search_s)
+            if cfg.glr_search_s is not None:
+                search = cfg.glr_search_s
+            elif name == "glr":
+                search = 0.0  # the sliding GLR peaks at the first post-jump epoch; scan within its interval
+            else:
+                search = 1200.0  # thesis statistics form a hump around the impulse
+            horizon = (
+                cfg.glr_window_samples * analysis.ephemeris.nominal_step_s
+                if name == "glr" and cfg.glr_window_samples > 0
+                else cfg.glr_horizon_s
+            )
+            jump = _localise(analysis, t[peak_stat] - search, t[peak_stat] + search, horizon)
             if jump is not None:
                 k_j = jump.index
                 t_event = jump.time_s if jump.time_s > t[k_j - 1] else t[k_j] - 0.5 * (t[k_j] - t[k_j - 1])
@@ -322,7 +355,7 @@ def find_events(
         dv_rtn = m_rtn.T @ dv_in
         u = dv_in / max(float(np.linalg.norm(dv_in)), 1e-300)
         dv_sigma = float(np.sqrt(max(0.0, u @ cov @ u)))
-        time_utc = eph.times_utc[0] + np.timedelta64(int(round(t_event * 1e9)), "ns")
+        time_utc = eph.times_utc[0] + np.timedelta64(round(t_event * 1e9), "ns")
         snrs = {
             f"snr_{key}": float(np.nanmax(analysis.statistics[key][win]) / th.value)
             if np.isfinite(analysis.statistics[key][win]).any() and th.value > 0
@@ -344,7 +377,10 @@ def find_events(
                 dv_r_mps=float(dv_rtn[0]),
                 dv_t_mps=float(dv_rtn[1]),
                 dv_n_mps=float(dv_rtn[2]),
-                extra={"dv_sigma_mps": dv_sigma, "snr": float(s[peak_stat] / thr.value), "glr": glr_value,
+                extra={
+                    "dv_sigma_mps": dv_sigma,
+                    "snr": float(s[peak_stat] / thr.value),
+                    "glr": glr_value,
                     "dv_glr_r_mps": float(glr_rtn[0]),
                     "dv_glr_t_mps": float(glr_rtn[1]),
                     "dv_glr_n_mps": float(glr_rtn[2]),
@@ -355,13 +391,13 @@ def find_events(
     return events_frame(events, extra_columns=extra_cols)
 
 
-def _localise(analysis: OrbitAnalysis, t_from: float, t_to: float) -> JumpEstimate | None:
+def _localise(analysis: OrbitAnalysis, t_from: float, t_to: float, horizon_s: float) -> JumpEstimate | None:
     """GLR jump time and ΔV between ``t_from`` and ``t_to`` (s), or None where it cannot be formed."""
     cfg = analysis.config
     t = analysis.t_s
     first = max(1, int(np.searchsorted(t, t_from, side="left")))
-    last = min(t.size - 2, int(np.searchsorted(t, t_to, side="right")))
-    if last <= first:
+    last = min(t.size - 2, int(np.searchsorted(t, t_to, side="right")) - 1)
+    if last < first:
         return None
     eph = analysis.ephemeris
     try:
@@ -376,7 +412,7 @@ def _localise(analysis: OrbitAnalysis, t_from: float, t_to: float) -> JumpEstima
             cfg.filter,
             first,
             last,
-            cfg.glr_horizon_s,
+            horizon_s,
         )
     except (ValueError, np.linalg.LinAlgError):
         return None
@@ -496,3 +532,42 @@ def auto_tune(
     q = max(var_signal - var_noise, 0.01 * var_noise) / dt_nom
     fc = FilterConfig.isotropic(tau_factor * dt_nom, q, zonal_degree=zonal_degree)
     return fc, sigma_r, sigma_v
+
+
+def tau_q_grid(
+    null_ephemeris: Ephemeris,
+    strike_cases: list[tuple[Ephemeris, float]],
+    taus_s: list[float],
+    qs_m2_s5: list[float],
+    base: OrbitDetectorConfig | None = None,
+    *,
+    window_s: float = 5.0,
+) -> pd.DataFrame:
+    """The τ-q trade of Bennett 2022 §3.4.2 (Figs. 3.16-3.17): SNR of every statistic on a grid.
+
+    For each (τ, q): thresholds from ``null_ephemeris`` at the configured false-alarm rate (KDE), then
+    the mean over ``strike_cases`` [(ephemeris, strike time in s from its start)] of the peak of each
+    statistic within ±``window_s`` of the strike divided by its threshold (SNR, §3.4.1). One row per
+    (τ, q, statistic).
+    """
+    base = base or OrbitDetectorConfig()
+    rows = []
+    for tau in taus_s:
+        for q in qs_m2_s5:
+            fc = replace(base.filter, tau_s=tau, q_rtn_m2_s5=(q, q, q))
+            cfg = replace(base, filter=fc)
+            null = analyse(null_ephemeris, cfg)
+            thr = calibrate_thresholds(
+                null.statistics, sample_rate_hz=null.sample_rate_hz, false_alarms_per_day=cfg.false_alarms_per_day
+            )
+            snr: dict[str, list[float]] = {k: [] for k in thr}
+            for eph, t_strike in strike_cases:
+                an = analyse(eph, cfg)
+                sel = np.abs(an.t_s - t_strike) <= window_s
+                for k, th in thr.items():
+                    vals = an.statistics[k][sel]
+                    if np.isfinite(vals).any() and th.value > 0:
+                        snr[k].append(float(np.nanmax(vals) / th.value))
+            for k, v in snr.items():
+                rows.append({"tau_s": tau, "q_m2_s5": q, "statistic": k, "snr": float(np.mean(v)) if v else np.nan})
+    return pd.DataFrame(rows)

@@ -226,7 +226,7 @@ def _propagate(
     x: FloatArray, dt: float, tau: float, mu: float, zonal: int, max_step: float, phi: FloatArray
 ) -> FloatArray:
     """RK4 state propagation over dt (sub-stepped) and the Lear RK2 STM (Eq. 3.8, erratum A7)."""
-    nsub = max(1, int(math.ceil(abs(dt) / max_step - 1e-9)))
+    nsub = max(1, math.ceil(abs(dt) / max_step - 1e-9))
     h = dt / nsub
     for i in range(9):
         for j in range(9):
@@ -274,9 +274,7 @@ def _time_update_cov(p: FloatArray, phi: FloatArray, s: FloatArray, sign: float,
 
 
 @nb.njit(cache=True)
-def _measurement_update(
-    x: FloatArray, p: FloatArray, y: FloatArray, rdiag: FloatArray, innov: FloatArray
-) -> float:
+def _measurement_update(x: FloatArray, p: FloatArray, y: FloatArray, rdiag: FloatArray, innov: FloatArray) -> float:
     """Joseph-form update with H = [I6 0]; updates x and p in place; returns the NIS."""
     s = np.empty((6, 6))
     for i in range(6):
@@ -412,9 +410,7 @@ def backward_kernel(
 # Python wrappers
 
 
-def measurement_variances(
-    velocity_mps: FloatArray, sigma_pos_m: float, sigma_vel_m_s: float, n: int
-) -> FloatArray:
+def measurement_variances(velocity_mps: FloatArray, sigma_pos_m: float, sigma_vel_m_s: float, n: int) -> FloatArray:
     """Diagonal of R per epoch (n, 6); a missing (NaN) velocity gets a variance of 1e12 (m/s)²."""
     r = np.empty((n, 6))
     r[:, :3] = sigma_pos_m**2

@@ -23,6 +23,9 @@ Statistics (names used as keys throughout abrupt):
                     momentum direction (rad) between windows before and after each epoch, from a
                     conventionally tuned forward filter (q × 100; §3.3.6, Eqs. 3.61-3.63).
 
+``glr``             beyond the thesis: sliding generalised likelihood ratio of a velocity jump in the
+                    forward innovations (Willsky & Jones 1976; :mod:`abrupt.detect.orbit_glr`).
+
 TS5 (residuals against propagated reference orbits, §3.3.5) is evaluated only at candidate epochs:
 :func:`propagated_reference_statistic`.
 """
@@ -51,6 +54,7 @@ STATISTIC_NAMES: tuple[str, ...] = (
     "d_sma",
     "d_ecc",
     "d_hdir",
+    "glr",
 )
 STATISTIC_UNITS = {
     "dv_fb": "m/s",
@@ -62,6 +66,7 @@ STATISTIC_UNITS = {
     "d_sma": "m",
     "d_ecc": "-",
     "d_hdir": "rad",
+    "glr": "-",
 }
 
 
@@ -154,8 +159,8 @@ def fusion_kernel(
             wmag[i] = np.nan
             continue
         sinv = np.linalg.inv(ssum)
-        _mm9(pbb, sinv, w)
-        _mm9(sinv, pff, a_buf)
+        _mm9(pbb, sinv, w)  # type: ignore[arg-type]
+        _mm9(sinv, pff, a_buf)  # type: ignore[arg-type]
         _mm9(pbb, a_buf, p_s)
         _mm9(pff, a_buf, p_d)
         for r in range(9):
@@ -283,7 +288,9 @@ def propagated_reference_statistic(
     x = x_forward[index - 1].copy()
     x[6:9] = 0.0
     for k in range(index, min(n, index + span)):
-        x = _propagate(x, t_s[k] - t_s[k - 1], config.tau_s, config.mu_m3_s2, config.zonal_degree, config.max_step_s, phi)
+        x = _propagate(
+            x, t_s[k] - t_s[k - 1], config.tau_s, config.mu_m3_s2, config.zonal_degree, config.max_step_s, phi
+        )
         res = np.r_[position_m[k], velocity_mps[k]] - x[:6]
         ok = np.isfinite(res)
         chi += float(np.sum((res[ok] / sig[ok]) ** 2))

@@ -116,11 +116,7 @@ def trajectory(
     Impulses are applied in the RSW frame of the state at their epoch; ∂C_RSW/∂x is neglected.
     """
     n_imp = len(impulse_times_s)
-    dv = (
-        np.zeros((n_imp, 3))
-        if impulse_dv_rsw is None
-        else np.asarray(impulse_dv_rsw, float).reshape(n_imp, 3)
-    )
+    dv = np.zeros((n_imp, 3)) if impulse_dv_rsw is None else np.asarray(impulse_dv_rsw, float).reshape(n_imp, 3)
     n_p = 9 + 3 * n_imp
     order = np.argsort(impulse_times_s) if n_imp else np.array([], dtype=int)
     breaks = [float(impulse_times_s[k]) for k in order]
@@ -193,11 +189,7 @@ def fit_orbit(
         bias[(s, 0)] = (initial_range_bias_m or {}).get(s, data.stations[s].range_bias_m)
         bias[(s, 1)] = (initial_angle_bias_rad or {}).get(s, (0.0, 0.0))[0]
         bias[(s, 2)] = (initial_angle_bias_rad or {}).get(s, (0.0, 0.0))[1]
-    accel = (
-        np.zeros(3)
-        if initial_acceleration_mps2 is None
-        else np.asarray(initial_acceleration_mps2, float).copy()
-    )
+    accel = np.zeros(3) if initial_acceleration_mps2 is None else np.asarray(initial_acceleration_mps2, float).copy()
     dv = (
         np.zeros((n_imp, 3))
         if initial_impulse_dv_rsw is None
@@ -230,9 +222,7 @@ def fit_orbit(
             impulse_dv_rsw=dv,
             max_step_s=cfg.max_step_s,
         )
-        resid, jac = _residuals(
-            data, states, dmat, bias, bias_keys, cfg.estimate_acceleration, n_imp, row_i, row_c
-        )
+        resid, jac = _residuals(data, states, dmat, bias, bias_keys, cfg.estimate_acceleration, n_imp, row_i, row_c)
         if cfg.outlier_sigma is not None and 3 <= it <= 5:  # re-select outliers, then freeze the set
             used = np.abs(resid) <= cfg.outlier_sigma
         cost = float(np.sum(resid[used] ** 2))
@@ -244,9 +234,7 @@ def fit_orbit(
             cov = np.linalg.pinv(normal)
         step = cov @ (a.T @ resid[used])
         normalised = np.abs(step) / np.sqrt(np.maximum(np.diag(cov), 1e-300))
-        if it >= 2 and (
-            abs(prev_cost - cost) <= cfg.tolerance * max(cost, 1.0) or float(normalised.max()) < 1e-3
-        ):
+        if it >= 2 and (abs(prev_cost - cost) <= cfg.tolerance * max(cost, 1.0) or float(normalised.max()) < 1e-3):
             converged = True
             break
         prev_cost = cost
@@ -419,6 +407,7 @@ class GlrtDetection:
     dv_covariance: NDArray[np.float64]
     statistic: float
     threshold: float
+    alternatives: list[tuple[float, NDArray[np.float64]]] = field(default_factory=list)
 
     @property
     def dv_mps(self) -> float:
@@ -466,11 +455,10 @@ def detect_maneuvers_glrt(
     cand = np.arange(t_first + step, t_last, step)
     arc_days = max((t_last - t_first) / 86400.0, 1e-3)
     threshold = (
-        cfg.threshold
-        if cfg.threshold is not None
-        else glrt_threshold(cand.size, arc_days, cfg.false_alarms_per_day)
+        cfg.threshold if cfg.threshold is not None else glrt_threshold(cand.size, arc_days, cfg.false_alarms_per_day)
     )
     scans: list[GlrtScan] = []
+    alternatives: list[list[tuple[float, NDArray[np.float64]]]] = []
     times: list[float] = []
     sigmas: list[float] = []
     stats: list[float] = []
@@ -494,9 +482,7 @@ def detect_maneuvers_glrt(
         ) -> BatchFit:
             if tau not in tried:
                 k_near = int(np.argmin(np.abs(cand - tau)))
-                guess = (
-                    _scan.dv_rsw_mps[k_near] if np.all(np.isfinite(_scan.dv_rsw_mps[k_near])) else np.zeros(3)
-                )
+                guess = _scan.dv_rsw_mps[k_near] if np.all(np.isfinite(_scan.dv_rsw_mps[k_near])) else np.zeros(3)
                 dv0 = np.vstack([_fit.impulse_dv_rsw_mps, guess[None, :]])
                 tried[tau] = fit_orbit(
                     data,
@@ -530,6 +516,32 @@ def detect_maneuvers_glrt(
             break
         ok = [t for t, f in tried.items() if f.chi2 <= best.chi2 + 1.0]
         time_sigma = max(0.5 * (max(ok) - min(ok)), width / math.sqrt(3.0))
+        # A cross-track impulse only fixes the new plane (node line and tilt r·Δv/h): epochs half an orbit
+        # apart fit almost equally, with Δv scaled by r(τ). Report such alternatives (chi² within 9).
+        alt: list[tuple[float, NDArray[np.float64]]] = []
+        dv_new = best.impulse_dv_rsw_mps[-1]
+        if abs(dv_new[2]) > 0.9 * float(np.linalg.norm(dv_new)):
+            for centre in (best_tau - period / 2.0, best_tau + period / 2.0):
+                local = [centre + k * step for k in (-2, -1, 0, 1, 2) if t_first < centre + k * step < t_last]
+                if not local:
+                    continue
+                tau_alt = min(local, key=lambda t: refit(float(t)).chi2)
+                for half in (step / 2.0, step / 4.0):
+                    for t_try in (tau_alt - half, tau_alt + half):
+                        if t_first < t_try < t_last:
+                            refit(float(t_try))
+                    near_alt = [t for t in tried if abs(t - tau_alt) <= step]
+                    tau_alt = min(near_alt, key=lambda t: tried[t].chi2)
+                alt.append((float(tau_alt), tried[tau_alt].impulse_dv_rsw_mps[-1].copy()))
+            # the better of the two ambiguous solutions becomes the primary one
+            if alt:
+                cand_best = min([best_tau, *[t for t, _ in alt]], key=lambda t: tried[t].chi2)
+                if cand_best != best_tau:
+                    alt = [(best_tau, best.impulse_dv_rsw_mps[-1].copy())] + [a for a in alt if a[0] != cand_best]
+                    best_tau, best = cand_best, tried[cand_best]
+                    lr = chi2_null - best.chi2
+            alt = [(t, v) for t, v in alt if tried[t].chi2 <= best.chi2 + 9.0]
+        alternatives.append(alt)
         times.append(best_tau)
         sigmas.append(time_sigma)
         stats.append(lr)
@@ -539,7 +551,7 @@ def detect_maneuvers_glrt(
     for j, tj in enumerate(times):
         cov = fit.covariance[base + 3 * j : base + 3 * j + 3, base + 3 * j : base + 3 * j + 3]
         detections.append(
-            GlrtDetection(tj, sigmas[j], fit.impulse_dv_rsw_mps[j].copy(), cov, stats[j], threshold)
+            GlrtDetection(tj, sigmas[j], fit.impulse_dv_rsw_mps[j].copy(), cov, stats[j], threshold, alternatives[j])
         )
     return detections, fit, scans
 
@@ -573,6 +585,11 @@ def glrt_events(
                 dv_t_mps=float(d.dv_rsw_mps[1]),
                 dv_n_mps=float(d.dv_rsw_mps[2]),
                 extra={
+                    "n_alternative_epochs": len(d.alternatives),
+                    "alternative_time_utc": ";".join(
+                        format_time_utc(epoch_utc + np.timedelta64(round(t * 1e9), "ns")) for t, _ in d.alternatives
+                    ),
+                    "alternative_dv_mps": ";".join(f"{float(np.linalg.norm(v)):.6g}" for _, v in d.alternatives),
                     "dv_sigma_mps": d.dv_sigma_mps,
                     "dv_r_sigma_mps": float(sig[0]),
                     "dv_t_sigma_mps": float(sig[1]),

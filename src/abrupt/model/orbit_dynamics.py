@@ -337,7 +337,7 @@ def msis_density(t_s: float, r: FloatArray, jd_tt_epoch: float, era_epoch_rad: f
     lon = math.degrees(math.atan2(r[1], r[0]) - era_epoch_rad - OMEGA_EARTH_RAD_S * t_s)
     lon = (lon + 180.0) % 360.0 - 180.0
     jd = jd_tt_epoch + t_s / 86400.0
-    date = np.datetime64("2000-01-01T12:00:00", "ms") + np.timedelta64(int(round((jd - 2451545.0) * 86400e3)), "ms")
+    date = np.datetime64("2000-01-01T12:00:00", "ms") + np.timedelta64(round((jd - 2451545.0) * 86400e3), "ms")
     out = pymsis.calculate(
         np.array([date]),
         np.array([lon]),
@@ -371,7 +371,9 @@ def kepler_to_cartesian(
     return rot @ r_pqw, rot @ v_pqw
 
 
-def orbital_constants(r: FloatArray, v: FloatArray, mu: float = MU_EARTH_M3_S2) -> tuple[FloatArray, FloatArray, FloatArray]:
+def orbital_constants(
+    r: FloatArray, v: FloatArray, mu: float = MU_EARTH_M3_S2
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Semi-major axis a (m), eccentricity vector e and angular momentum h = r × v (Bennett 2022 Eqs. 3.61-3.63).
 
     ``r`` and ``v`` are (n, 3).

@@ -46,13 +46,9 @@ class Station:
         if not self.name:
             raise ConfigError("station name is empty", key="name")
         if not -90.0 <= self.latitude_deg <= 90.0:
-            raise ConfigError(
-                f"latitude {self.latitude_deg} deg outside [-90, 90]", key=f"{self.name}.latitude"
-            )
+            raise ConfigError(f"latitude {self.latitude_deg} deg outside [-90, 90]", key=f"{self.name}.latitude")
         if not -360.0 <= self.longitude_deg <= 360.0:
-            raise ConfigError(
-                f"longitude {self.longitude_deg} deg outside [-360, 360]", key=f"{self.name}.longitude"
-            )
+            raise ConfigError(f"longitude {self.longitude_deg} deg outside [-360, 360]", key=f"{self.name}.longitude")
         if not -1000.0 <= self.altitude_m <= 1.0e5:
             raise ConfigError(
                 f"altitude {self.altitude_m} m is implausible (expected metres above the ellipsoid)",

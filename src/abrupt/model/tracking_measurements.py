@@ -223,9 +223,7 @@ class TrackingArrays:
                 self.stations[name] = lookup_station(name, stations)
             except KeyError:
                 known = ", ".join(sorted(stations)) or "none given"
-                raise InputError(
-                    f"unknown station {name!r} (known: {known})", file=source, column="station"
-                ) from None
+                raise InputError(f"unknown station {name!r} (known: {known})", file=source, column="station") from None
         for i, name in enumerate(self.station_names):
             st = self.stations[name]
             self.site[i] = st.position_ecef_m

@@ -104,9 +104,7 @@ def read_aer(
         spec = _TYPES[kind]
         values = tokens[3:]
         if len(values) != len(spec):
-            raise InputError(
-                f"{kind} needs {len(spec)} value(s), got {len(values)}", file=path, line=lineno, column=4
-            )
+            raise InputError(f"{kind} needs {len(spec)} value(s), got {len(values)}", file=path, line=lineno, column=4)
         row: dict[str, object] = {
             "time_utc": t,
             "station": station if known is None else known[station.upper()],

@@ -113,7 +113,7 @@ def read_oem(path: str | Path, satellite: str | None = None) -> Ephemeris:
     first_meta: dict[str, str] = chosen[0]["meta"]  # type: ignore[assignment]
     objects = {m["meta"]["OBJECT_ID"] for m in chosen}  # type: ignore[index]
     if satellite is None and len(objects) > 1:
-        raise InputError(f"file holds several objects {sorted(objects)}; choose one", file=file)  # type: ignore[type-var]
+        raise InputError(f"file holds several objects {sorted(objects)}; choose one", file=file)
     frames = {str(s["meta"]["REF_FRAME"]).upper() for s in chosen}  # type: ignore[index]
     systems = {str(s["meta"]["TIME_SYSTEM"]).upper() for s in chosen}  # type: ignore[index]
     if len(frames) > 1 or len(systems) > 1:

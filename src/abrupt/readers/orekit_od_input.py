@@ -75,9 +75,7 @@ def read_od_input(path: str | Path) -> OrbitDeterminationSetup:
             slot[key] = (value, lineno)
         else:
             if key in plain:
-                raise InputError(
-                    f"key {key} given twice (first on line {plain[key][1]})", file=path, line=lineno
-                )
+                raise InputError(f"key {key} given twice (first on line {plain[key][1]})", file=path, line=lineno)
             plain[key] = (value, lineno)
 
     def num(src: dict[str, tuple[str, int]], key: str, default: float | None = None) -> float:
@@ -107,8 +105,7 @@ def read_od_input(path: str | Path) -> OrbitDeterminationSetup:
         state = np.array([num(plain, f"orbit.cartesian.{k}") for k in ("px", "py", "pz", "vx", "vy", "vz")])
         if np.linalg.norm(state[:3]) < 6.0e6:
             raise InputError(
-                f"orbit.cartesian position norm {np.linalg.norm(state[:3]):.1f} m is inside the Earth "
-                "(km given?)",
+                f"orbit.cartesian position norm {np.linalg.norm(state[:3]):.1f} m is inside the Earth (km given?)",
                 file=path,
                 line=plain["orbit.cartesian.px"][1],
             )

@@ -32,6 +32,7 @@ from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.frames import Ephemeris
@@ -127,7 +128,9 @@ def _to_utc(t_sys: np.ndarray, time_system: str) -> np.ndarray:
         return t_sys
     if time_system == "GLO":
         return t_sys - np.timedelta64(3, "h")
-    tai = t_sys + np.timedelta64(int(round(_TAI_OFFSETS_S[time_system] * 1e9)), "ns")
+    offset_ns = round(_TAI_OFFSETS_S[time_system] * 1e9)
+    tai_ns = np.asarray(t_sys, dtype="datetime64[ns]").astype(np.int64) + offset_ns
+    tai: NDArray[np.datetime64] = tai_ns.astype("datetime64[ns]")
     return to_utc(tai, "tai")
 
 
@@ -226,7 +229,9 @@ def _parse(
             if wanted is not None and sid != wanted:
                 continue
             if sid not in sats:
-                raise InputError(f"record for satellite {sid!r} not listed in the header", file=file, line=idx, column=2)
+                raise InputError(
+                    f"record for satellite {sid!r} not listed in the header", file=file, line=idx, column=2
+                )
             if current is None:
                 raise InputError("position record before the first epoch line", file=file, line=idx)
             if len(line) < 46:
@@ -287,8 +292,12 @@ def _epoch(text: str, *, file: str, line_no: int) -> np.datetime64:
     """Parse an epoch record ``*  yyyy mm dd hh mm ss.ssssssss`` (columns 4-31)."""
     parts = text[1:].split()
     if len(parts) < 6:
-        raise InputError(f"epoch line needs 6 fields (year month day hour minute second), got {len(parts)}",
-                         file=file, line=line_no, column=4)
+        raise InputError(
+            f"epoch line needs 6 fields (year month day hour minute second), got {len(parts)}",
+            file=file,
+            line=line_no,
+            column=4,
+        )
     try:
         year, month, day, hour, minute = (int(p) for p in parts[:5])
         second = float(parts[5])
@@ -297,6 +306,6 @@ def _epoch(text: str, *, file: str, line_no: int) -> np.datetime64:
     if not (1 <= month <= 12 and 1 <= day <= 31 and 0 <= hour <= 23 and 0 <= minute <= 59 and 0 <= second < 61):
         raise InputError(f"epoch {text[3:].strip()!r} is out of range", file=file, line=line_no, column=4)
     whole = int(second)
-    ns = int(round((second - whole) * 1e9))
+    ns = round((second - whole) * 1e9)
     base = np.datetime64(f"{year:04d}-{month:02d}-{day:02d}T{hour:02d}:{minute:02d}:00", "ns")
     return base + np.timedelta64(whole, "s") + np.timedelta64(ns, "ns")

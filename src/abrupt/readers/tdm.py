@@ -139,16 +139,12 @@ def read_tdm(path: str | Path, *, repairs: RepairLog | None = None) -> pd.DataFr
         try:
             v = float(parts[1])
         except ValueError:
-            raise InputError(
-                f"{key} value {parts[1]!r} is not a number", file=path, line=lineno, column=3
-            ) from None
+            raise InputError(f"{key} value {parts[1]!r} is not a number", file=path, line=lineno, column=3) from None
         rows.append(_convert(key, epoch, v, meta, path, lineno))
     if not saw_version:
         raise InputError("missing CCSDS_TDM_VERS header line", file=path, line=1)
     if state == "data":
-        raise InputError(
-            "file ends inside a DATA section (missing DATA_STOP; truncated?)", file=path, line=len(lines)
-        )
+        raise InputError("file ends inside a DATA section (missing DATA_STOP; truncated?)", file=path, line=len(lines))
     if state == "meta":
         raise InputError("file ends inside a META section (truncated?)", file=path, line=len(lines))
     if not rows:
@@ -167,9 +163,9 @@ def read_tdm(path: str | Path, *, repairs: RepairLog | None = None) -> pd.DataFr
     )
     if merged[list(MEASUREMENT_COLUMNS)].map(lambda v: isinstance(v, str)).to_numpy().any():
         i = int(
-            np.flatnonzero(
-                merged[list(MEASUREMENT_COLUMNS)].map(lambda v: isinstance(v, str)).to_numpy().any(axis=1)
-            )[0]
+            np.flatnonzero(merged[list(MEASUREMENT_COLUMNS)].map(lambda v: isinstance(v, str)).to_numpy().any(axis=1))[
+                0
+            ]
         )
         raise InputError(
             "duplicated record (same epoch, station and keyword) with a different value",
@@ -231,9 +227,7 @@ def _convert(
         row["azimuth_rad"] = math.radians(v)
     elif key == "ANGLE_2":
         if not -90.0 <= v <= 90.0:
-            raise InputError(
-                f"ANGLE_2 (elevation) {v} deg outside [-90, 90]", file=path, line=lineno, column=3
-            )
+            raise InputError(f"ANGLE_2 (elevation) {v} deg outside [-90, 90]", file=path, line=lineno, column=3)
         row["elevation_rad"] = math.radians(v)
     else:  # DOPPLER_INSTANTANEOUS, km/s
         if abs(v) > 20.0:

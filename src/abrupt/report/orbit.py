@@ -13,7 +13,7 @@ if TYPE_CHECKING:
     from abrupt.detect.orbit_detector import OrbitAnalysis
     from abrupt.thresholds import Threshold
 
-PANEL_STATISTICS = ("dv_fb", "mahalanobis_v", "accel_smoothed", "mcr_w", "mcr_scalar", "d_sma")
+PANEL_STATISTICS = ("glr", "dv_fb", "mahalanobis_v", "accel_smoothed", "mcr_w", "mcr_scalar", "d_sma")
 
 
 def plot_orbit_report(

@@ -26,9 +26,7 @@ def plot_tracking_report(
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    kad = (
-        diagnostics[diagnostics["series"] == "kaderali"] if "series" in diagnostics else diagnostics.iloc[:0]
-    )
+    kad = diagnostics[diagnostics["series"] == "kaderali"] if "series" in diagnostics else diagnostics.iloc[:0]
     glrt = diagnostics[diagnostics["series"] == "glrt"] if "series" in diagnostics else diagnostics.iloc[:0]
     panels = (["psi", "k"] if len(kad) else []) + (["glrt"] if len(glrt) else [])
     if not panels:

@@ -100,14 +100,19 @@ class SimulatedOrbit:
         )
 
 
+def _to_ns(value: np.datetime64 | str) -> np.datetime64:
+    out: np.datetime64 = np.asarray(value, dtype="datetime64[ns]").reshape(-1)[0]
+    return out
+
+
 def _jd_tt(epoch_utc: np.datetime64) -> float:
     # UTC→TT offset (69.184 s since 2017) only shifts Sun/Moon positions by seconds of motion.
-    days = (np.datetime64(epoch_utc, "ns") - np.datetime64("2000-01-01T12:00:00", "ns")).astype(np.float64) * 1e-9
+    days = (_to_ns(epoch_utc) - np.datetime64("2000-01-01T12:00:00", "ns")).astype(np.float64) * 1e-9
     return 2451545.0 + (days + 69.184) / 86400.0
 
 
 def _era(epoch_utc: np.datetime64) -> float:
-    days = (np.datetime64(epoch_utc, "ns") - np.datetime64("2000-01-01T12:00:00", "ns")).astype(np.float64) * 1e-9
+    days = (_to_ns(epoch_utc) - np.datetime64("2000-01-01T12:00:00", "ns")).astype(np.float64) * 1e-9
     return float(2 * math.pi * ((0.7790572732640 + 1.00273781191135448 * days / 86400.0) % 1.0))
 
 
@@ -123,7 +128,7 @@ def propagate(
 ) -> FloatArray:
     """Propagate [r; v] (m, m/s, GCRF) from ``t0_s`` to the times ``t_out_s`` (≥ t0, sorted), applying
     inertial impulses [(t_s, dv)] on the way. Returns (n, 6)."""
-    epoch = np.datetime64(epoch_utc, "ns")
+    epoch = _to_ns(epoch_utc)
     jd = _jd_tt(epoch)
     era = _era(epoch)
     t_out = np.asarray(t_out_s, dtype=np.float64)
@@ -168,9 +173,9 @@ def simulate_orbit(config: OrbitSimulationConfig) -> SimulatedOrbit:
         math.radians(config.arg_perigee_deg),
         math.radians(config.true_anomaly_deg),
     )
-    n = int(round(config.duration_s * config.rate_hz)) + 1
+    n = round(config.duration_s * config.rate_hz) + 1
     t = np.arange(n) / config.rate_hz
-    epoch = np.datetime64(config.epoch_utc, "ns")
+    epoch = _to_ns(config.epoch_utc)
     # Impulses given in RTN are resolved with the no-impulse truth at their time (iteratively in order).
     kicks: list[tuple[float, FloatArray]] = []
     for imp in sorted(config.impulses, key=lambda k: k.time_s):
@@ -208,7 +213,7 @@ def inject_impulse(
     """
     forces = forces or ForceModel(zonal_degree=4)
     gcrf = ephemeris.to_frame("GCRF")
-    t_imp = np.datetime64(time_utc, "ns")
+    t_imp = _to_ns(time_utc)
     sec = gcrf.seconds
     t_imp_s = float((t_imp - gcrf.times_utc[0]).astype(np.float64) * 1e-9)
     if not sec[0] <= t_imp_s < sec[-1]:

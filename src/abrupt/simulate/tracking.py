@@ -106,9 +106,7 @@ class TrackingSimulation:
     truth_events: pd.DataFrame
 
 
-def burn_onset_s(
-    location: Location | str, period_s: float, after_orbits: int = 2, *, nu0_deg: float = 0.0
-) -> float:
+def burn_onset_s(location: Location | str, period_s: float, after_orbits: int = 2, *, nu0_deg: float = 0.0) -> float:
     """Burn start (s) at an orbit location after ``after_orbits`` full orbits (spec §4.4, from ν₀ = 0).
 
     perigee 2T, apogee 2.5T, a quarter (in time) after perigee 2.25T, a quarter after apogee 2.75T.
@@ -148,9 +146,7 @@ def simulate_tracking(scenario: TrackingScenario, *, seed: int | None = 0) -> Tr
     force = ForceModel(mu_m3_s2=scenario.mu_m3_s2)
     states = propagate_truth(x0, t, scenario.burns, force=force)
     epoch = as_datetime64_ns(scenario.epoch_utc)
-    c_fi = earth_rotation_matrices(
-        t, model=scenario.earth_rotation, epoch_utc=epoch, theta0_rad=scenario.theta0_rad
-    )
+    c_fi = earth_rotation_matrices(t, model=scenario.earth_rotation, epoch_utc=epoch, theta0_rad=scenario.theta0_rad)
     frames = []
     for st in scenario.stations:
         y = predict_many(states, c_fi, st.position_ecef_m, st.ecef_to_sez)
