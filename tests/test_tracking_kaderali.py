@@ -113,3 +113,16 @@ def test_inversion_round_trips_and_flags_non_monotonic_or_below_floor() -> None:
     dv = np.array([1, 5, 10, 25, 50, 75, 100.0])
     bent = fit_characterisation(dv, 31.4265 - 0.0177 * dv + 0.001487 * dv**2, "quadratic")  # vertex at ~6 m/s
     assert invert_characterisation(bent, 40.0).status == "not_monotonic"
+
+
+def test_simulated_psi_threshold_holds_its_false_alarm_rate_on_independent_null_arcs() -> None:
+    from abrupt.detect.kaderali import calibrate_psi_threshold
+
+    sim = simulate_tracking(TrackingScenario(), seed=11)
+    data = TrackingArrays(sim.measurements, {}, epoch_utc=sim.epoch_utc)
+    rate_hz = (len(data) - 1) / float(np.ptp(data.t_s))
+    per_day = 0.035 * rate_hz * 86400.0  # budget equivalent to 3.5 % of samples
+    th, null_psi = calibrate_psi_threshold(data, sim.initial_state, false_alarms_per_day=per_day, n_runs=4, seed=3)
+    assert null_psi.size == 4 * len(data)
+    fresh = np.concatenate([_run(mask=1.0, seed=s)[0].psi for s in (21, 22)])
+    assert 0.02 < np.mean(fresh > th) < 0.05

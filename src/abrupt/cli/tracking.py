@@ -207,6 +207,13 @@ def _write_aer(measurements: Any, path: Path) -> None:
     help="Correct elevations for refraction (default: as the setup file says).",
 )
 @click.option("--max-maneuvers", type=int, default=3, show_default=True)
+@click.option(
+    "--kaderali-threshold",
+    type=click.Choice(["simulated", "chi2"]),
+    default="simulated",
+    show_default=True,
+    help="Ψ detection threshold: GPD tail of event-free simulations of this data set, or the χ²_m quantile.",
+)
 @click.option("--fit-out", type=click.Path(dir_okay=False), default=None, help="Orbit-fit summary (JSON).")
 @click.option(
     "--diagnostics-out",
@@ -229,6 +236,7 @@ def detect_tracking_command(
     estimate_acceleration: bool | None,
     refraction: bool | None,
     max_maneuvers: int,
+    kaderali_threshold: str,
     fit_out: str | None,
     diagnostics_out: str | None,
     spacecraft: str | None,
@@ -243,7 +251,12 @@ def detect_tracking_command(
     import pandas as pd
     from astropy.time import Time
 
-    from abrupt.detect.kaderali import KaderaliConfig, kaderali_events, run_kaderali_filter
+    from abrupt.detect.kaderali import (
+        KaderaliConfig,
+        calibrate_psi_threshold,
+        kaderali_events,
+        run_kaderali_filter,
+    )
     from abrupt.detect.tracking_glrt import (
         BatchFitConfig,
         GlrtConfig,
@@ -310,6 +323,7 @@ def detect_tracking_command(
         "refraction": use_refraction,
         "force": [force.mu_m3_s2, force.j2, force.third_body],
         "max_maneuvers": max_maneuvers,
+        "kaderali_threshold": kaderali_threshold,
     }
     cfg_hash = config_hash(settings)
     run_id = new_run_id()
@@ -368,11 +382,16 @@ def detect_tracking_command(
             accel_mps2=tuple(float(v) for v in accel_state),  # type: ignore[arg-type]
         )
         result = run_kaderali_filter(kdata, start_state, config=kcfg)
-        rate_hz = max(len(result.t_s) - 1, 1) / max(arc_s, 1.0)
-        m = int(np.median(result.n_components)) if result.n_components.size else 4
-        from scipy.stats import chi2
+        if kaderali_threshold == "chi2":
+            from scipy.stats import chi2
 
-        psi_det = float(chi2.isf(p_fa_per_sample(false_alarms_per_day, rate_hz), m))
+            rate_hz = max(len(result.t_s) - 1, 1) / max(arc_s, 1.0)
+            m = int(np.median(result.n_components)) if result.n_components.size else 4
+            psi_det = float(chi2.isf(p_fa_per_sample(false_alarms_per_day, rate_hz), m))
+        else:
+            psi_det, _ = calibrate_psi_threshold(
+                kdata, start_state, config=kcfg, false_alarms_per_day=false_alarms_per_day
+            )
         events += kaderali_events(
             result,
             epoch_utc=data.epoch_utc,

@@ -476,3 +476,55 @@ def kaderali_events(
             )
         )
     return events
+
+
+def calibrate_psi_threshold(
+    data: TrackingArrays,
+    x0: NDArray[np.float64],
+    *,
+    t0_s: float = 0.0,
+    config: KaderaliConfig | None = None,
+    false_alarms_per_day: float = 0.1,
+    n_runs: int = 8,
+    seed: int = 0,
+) -> tuple[float, NDArray[np.float64]]:
+    """Ψ detection threshold from event-free simulations of this very data set (DESIGN.md, thresholds).
+
+    The orbit from ``x0`` (with the configured forces and constant acceleration) is sampled at the data's
+    epochs, stations and measurement types; noise with the station sigmas is added; the filter runs
+    ``n_runs`` times and a generalised-Pareto tail (``abrupt.thresholds.fit_threshold``, method ``gpd``) of
+    the pooled Ψ gives the value exceeded ``false_alarms_per_day`` times per day. Returns the threshold and
+    the pooled null Ψ (for Q-Q checks). Falls back to the empirical quantile when the tail is too short.
+    """
+    from abrupt.thresholds import fit_threshold
+
+    cfg = config or KaderaliConfig()
+    rng = np.random.default_rng(seed)
+    order = np.argsort(data.t_s, kind="stable")
+    states = np.empty((len(data), 6))
+    st_sorted, _, _ = propagate_with_stm(
+        x0, t0_s, data.t_s[order], force=cfg.force, accel_mps2=cfg.accel_mps2, max_step_s=cfg.max_step_s
+    )
+    states[order] = st_sorted
+    clean = np.empty_like(data.y)
+    for i in range(len(data)):
+        clean[i], _ = data.predict(i, states[i])
+    pooled = []
+    y_saved = data.y
+    try:
+        for _ in range(n_runs):
+            noisy = clean + rng.standard_normal(clean.shape) * data.sigma
+            noisy[:, 1] = np.mod(noisy[:, 1], 2 * np.pi)
+            noisy[np.isnan(y_saved)] = np.nan
+            data.y = noisy
+            pooled.append(run_kaderali_filter(data, x0, t0_s=t0_s, config=cfg).psi)
+    finally:
+        data.y = y_saved
+    psi = np.concatenate(pooled)
+    arc_s = float(np.ptp(data.t_s)) if len(data) > 1 else 1.0
+    rate_hz = max(psi.size / n_runs - 1, 1) / max(arc_s, 1.0)
+    try:
+        th = fit_threshold(psi, false_alarms_per_day=false_alarms_per_day, sample_rate_hz=rate_hz, method="gpd")
+    except ValueError:
+        th = fit_threshold(psi, false_alarms_per_day=false_alarms_per_day, sample_rate_hz=rate_hz, method="empirical")
+    return float(th.value), psi
