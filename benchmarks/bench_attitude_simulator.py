@@ -31,9 +31,7 @@ from abrupt.simulate.attitude import (
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
-    )
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="5 simulated minutes instead of 1 hour")
     parser.add_argument("--runs", type=int, default=None, help="runs in the batched throughput test")
     args = parser.parse_args()
@@ -43,9 +41,7 @@ def main() -> None:
 
     print("== physics (noise-free, thesis spacecraft, K = 480 N m, P = 1080 N m s) ==")
     strikes = [Strike(20.0, (0.31, -0.22, 0.17))]
-    cfg = AttitudeSimConfig(
-        duration_s=80.0, noise=False, initial_wheel_speed_rad_s=(120.0, -80.0, 60.0, 200.0)
-    )
+    cfg = AttitudeSimConfig(duration_s=80.0, noise=False, initial_wheel_speed_rad_s=(120.0, -80.0, 60.0, 200.0))
     res = simulate_attitude(sc, cfg, strikes)
     st = res.true_state
     h = system_momentum(sc, st["q_BN"], st["omega_B_rad_s"], st["wheel_speed_rad_s"]).H_N_Nms
@@ -63,10 +59,7 @@ def main() -> None:
         w = np.abs(r.true_state["omega_B_rad_s"][:, axis])
         t = r.true_state["t_s"]
         settle = t[np.nonzero(w > 0.05 * w.max())[0].max()] - 10.0
-        print(
-            f"60 mg about {name}: peak rate {w.max():.3e} rad/s, "
-            f"to 5% of peak in {settle:.1f} s   (target ~25 s)"
-        )
+        print(f"60 mg about {name}: peak rate {w.max():.3e} rad/s, to 5% of peak in {settle:.1f} s   (target ~25 s)")
 
     try:
         import Basilisk  # noqa: F401
@@ -85,9 +78,7 @@ def main() -> None:
             n = min(ours["t_s"].size, theirs["t_s"].size)
             peak = np.abs(ours["omega_B_rad_s"][:n]).max()
             diff = np.abs(ours["omega_B_rad_s"][:n] - theirs["omega_B_rad_s"][:n]).max() / peak
-            print(
-                f"dH_B = {dh_b} N m s, wheels {wheels}: max |dw| = {100 * diff:.4f}% of peak   (target <= 2%)"
-            )
+            print(f"dH_B = {dh_b} N m s, wheels {wheels}: max |dw| = {100 * diff:.4f}% of peak   (target <= 2%)")
 
     print(f"\n== speed: {duration:.0f} s simulated at 100 Hz, 10 Hz telemetry, one strike ==")
     one_strike = [Strike(duration / 2, (0.3, 0.1, -0.2))]

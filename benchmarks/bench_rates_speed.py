@@ -38,9 +38,7 @@ def main() -> None:
         simulate_strikes(tables, geo, sc.mass_kg, 550e3, cfg)  # compile
         best = float("inf")
         for seed in range(args.repeats):
-            cfg = RateConfig(
-                n_draws=n, mass_model="debrisat", mef_model="rembor_array", location=location, seed=seed
-            )
+            cfg = RateConfig(n_draws=n, mass_model="debrisat", mef_model="rembor_array", location=location, seed=seed)
             t0 = time.perf_counter()
             s = simulate_strikes(tables, geo, sc.mass_kg, 550e3, cfg)
             best = min(best, time.perf_counter() - t0)
@@ -55,10 +53,7 @@ def main() -> None:
     t0 = time.perf_counter()
     simulate_strikes(tables, geo, sc.mass_kg, 550e3, cfg)
     dt = time.perf_counter() - t0
-    print(
-        f"point_cloud: 10,000 draws in {dt:.2f} s = {1e4 / dt:,.0f} draws/s "
-        "(thesis method, grid 1/6 smallest dim)"
-    )
+    print(f"point_cloud: 10,000 draws in {dt:.2f} s = {1e4 / dt:,.0f} draws/s (thesis method, grid 1/6 smallest dim)")
 
 
 if __name__ == "__main__":

@@ -43,9 +43,7 @@ def _rates(results: list[CaseResult], metric: str, t: float) -> dict[str, float]
 
 def trade_size_orbit(n: int, out: Path) -> None:
     print("\n== Trade 1: spacecraft size x orbit (NASA-90/91 2020, Al sphere, MEF 2; thesis Figs. 5.11-5.12)")
-    base = Scenario(
-        SPACECRAFT[0], epoch_year=2020.0, flux="nasa90", config=RateConfig(n_draws=n, seed=1, **SAMPLING)
-    )
+    base = Scenario(SPACECRAFT[0], epoch_year=2020.0, flux="nasa90", config=RateConfig(n_draws=n, seed=1, **SAMPLING))
     res = run_trade(base, [("spacecraft", SPACECRAFT), ("orbit", ["550/28.5", "800/90"])])
     print(
         f"{'case':<48} {'strikes/yr':>10} {'A_eff m2':>8} {'dH>20mNms':>10} {'dH>400mNms':>10} "
@@ -68,15 +66,9 @@ def trade_size_orbit(n: int, out: Path) -> None:
     )
     c = by[("smallsat200", 800.0)].detectable_per_year("dH", [0.02])[0]
     d = s4000.detectable_per_year("dH", [0.02])[0]
-    print(
-        f"thesis: 4000 kg @550 ≈ 200 kg @800 (ΔH) -> at 20 mN·m·s here {d:.3g} vs {c:.3g} /yr "
-        f"(ratio {_ratio(d, c)})"
-    )
+    print(f"thesis: 4000 kg @550 ≈ 200 kg @800 (ΔH) -> at 20 mN·m·s here {d:.3g} vs {c:.3g} /yr (ratio {_ratio(d, c)})")
     for alt in (550.0, 800.0):
-        v = [
-            by[(s, alt)].detectable_per_year("dV", [1e-4])[0]
-            for s in ("cubesat6u", "smallsat200", "fermi_like")
-        ]
+        v = [by[(s, alt)].detectable_per_year("dV", [1e-4])[0] for s in ("cubesat6u", "smallsat200", "fermi_like")]
         print(
             f"thesis: ΔV rates roughly size-independent within an orbit -> {alt:.0f} km, ΔV > 0.1 mm/s: "
             + ", ".join(f"{x:.3g}" for x in v)

@@ -83,9 +83,7 @@ def run_baseline(python: Path, tle: Path) -> tuple[pd.DataFrame, str, float]:
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "md.csv"
         t0 = time.perf_counter()
-        proc = subprocess.run(
-            [str(python), "-c", _MD_SCRIPT, str(tle), str(out)], capture_output=True, text=True
-        )
+        proc = subprocess.run([str(python), "-c", _MD_SCRIPT, str(tle), str(out)], capture_output=True, text=True)
         elapsed = time.perf_counter() - t0
         if proc.returncode != 0:
             raise RuntimeError(f"maneuver-detect failed:\n{proc.stderr[-2000:]}")
@@ -113,9 +111,7 @@ def delta_v_ratios(
     return np.asarray(ratios), np.asarray(iso, dtype=bool)
 
 
-def evaluate(
-    name: str, events: pd.DataFrame, truth: pd.DataFrame, start, end, signed: bool
-) -> dict[str, float]:
+def evaluate(name: str, events: pd.DataFrame, truth: pd.DataFrame, start, end, signed: bool) -> dict[str, float]:
     res = score_events(events, truth, tolerance_s=TOLERANCE_S, start=start, end=end)
     op = recall_at_false_alarm_rate(
         events, truth, false_alarms_per_year=1.0, start=start, end=end, tolerance_s=TOLERANCE_S
@@ -182,9 +178,7 @@ def main() -> None:
         "dv_median_ratio",
         "seconds",
     ]
-    with pd.option_context(
-        "display.width", 250, "display.max_columns", 30, "display.float_format", "{:.2f}".format
-    ):
+    with pd.option_context("display.width", 250, "display.max_columns", 30, "display.float_format", "{:.2f}".format):
         print(table[cols].to_string(index=False))
     print("\nTargets (issue 5, acceptance 3; ±1 day one-to-one matching):")
     for sat in sats:

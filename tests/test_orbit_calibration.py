@@ -94,3 +94,31 @@ def test_interval_dv_recovers_injected_impulses_on_real_data_better_than_ts1(sha
         err_fb.append(np.linalg.norm(fb[cols].iloc[best].to_numpy() - dv))
     assert max(err_interval) < 0.2 * 0.005
     assert np.mean(err_interval) < np.mean(err_fb)
+
+
+def test_cli_threshold_confidence_zero_gives_the_lower_point_estimate_threshold(
+    shared_data: Path, tmp_path: Path
+) -> None:
+    from click.testing import CliRunner
+
+    import abrupt.cli.orbit  # noqa: F401  (registers the orbit commands)
+    from abrupt.cli.groups import cli
+    from abrupt.events import read_events
+    from abrupt.readers.navigation_csv import write_navigation_csv
+    from abrupt.readers.sp3 import read_sp3
+    from abrupt.simulate.orbit import inject_impulse
+
+    eph = read_sp3(shared_data / SP3, "L74")
+    eph = eph.select(np.arange(len(eph)) < 1440)
+    injected = inject_impulse(eph, eph.times_utc[700] + np.timedelta64(17, "s"), np.array([0.0, 0.01, 0.0]))
+    write_navigation_csv(injected, tmp_path / "inj.csv")
+    thresholds = []
+    for z in ("1", "0"):
+        out = tmp_path / f"events_{z}.csv"
+        args = ["detect", "orbit", str(tmp_path / "inj.csv"), "--out", str(out), "--threshold-confidence", z]
+        res = CliRunner().invoke(cli, [*args, "--catalog", str(tmp_path / "c.sqlite")])
+        assert res.exit_code == 0, res.output
+        events = read_events(str(out))
+        assert len(events) >= 1
+        thresholds.append(float(events["threshold"].iloc[0]))
+    assert thresholds[1] < thresholds[0]

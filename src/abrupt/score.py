@@ -85,11 +85,7 @@ def match_times(
     big = 1e6 * max(tolerance_s, 1.0)
     cost = np.where(ok, sub - big, 0.0)
     r, c = linear_sum_assignment(cost)
-    return [
-        (int(rows[i]), int(cols[j]), float(dt[rows[i], cols[j]]))
-        for i, j in zip(r, c, strict=True)
-        if ok[i, j]
-    ]
+    return [(int(rows[i]), int(cols[j]), float(dt[rows[i], cols[j]])) for i, j in zip(r, c, strict=True) if ok[i, j]]
 
 
 def _restrict_truth(truth: pd.DataFrame, time_column: str, start: Any, end: Any) -> tuple[pd.DataFrame, int]:
@@ -100,15 +96,9 @@ def _restrict_truth(truth: pd.DataFrame, time_column: str, start: Any, end: Any)
     t = pd.to_datetime(truth[time_column], utc=True, format="ISO8601").dt.tz_localize(None)
     keep = pd.Series(True, index=truth.index)
     if start is not None:
-        keep &= (
-            t >= pd.Timestamp(start).tz_localize(None)
-            if pd.Timestamp(start).tzinfo
-            else t >= pd.Timestamp(start)
-        )
+        keep &= t >= pd.Timestamp(start).tz_localize(None) if pd.Timestamp(start).tzinfo else t >= pd.Timestamp(start)
     if end is not None:
-        keep &= (
-            t <= pd.Timestamp(end).tz_localize(None) if pd.Timestamp(end).tzinfo else t <= pd.Timestamp(end)
-        )
+        keep &= t <= pd.Timestamp(end).tz_localize(None) if pd.Timestamp(end).tzinfo else t <= pd.Timestamp(end)
     return truth.loc[keep], int((~keep).sum())
 
 

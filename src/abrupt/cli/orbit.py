@@ -200,6 +200,15 @@ def simulate_orbit_command(
     default=None,
     help="Event-free data of the same satellite to set thresholds from (default: the arc itself, with leave-out).",
 )
+@click.option(
+    "--threshold-confidence",
+    "confidence_z",
+    type=click.FloatRange(min=0.0),
+    default=1.0,
+    show_default=True,
+    help="Self-calibrated thresholds: standard errors of the fitted one-per-week level added to it "
+    "(1: the false-alarm rate stays within the budget with ~84 % confidence; 0: point estimate).",
+)
 @click.option("--kind", type=click.Choice(["unknown", "maneuver", "strike"]), default="unknown", show_default=True)
 @click.option(
     "--statistics-out", type=click.Path(dir_okay=False), default=None, help="Per-epoch statistics (.parquet/.csv)."
@@ -219,6 +228,7 @@ def detect_orbit_command(
     statistic: str | None,
     false_alarms_per_week: float,
     null_file: str | None,
+    confidence_z: float,
     kind: str,
     statistics_out: str | None,
     pseudonym: str | None,
@@ -261,7 +271,7 @@ def detect_orbit_command(
             null.statistics, sample_rate_hz=null.sample_rate_hz, false_alarms_per_day=cfg.false_alarms_per_day
         )
     else:
-        thresholds = self_calibrate(analysis)
+        thresholds = self_calibrate(analysis, confidence_z=confidence_z)
     if statistic not in thresholds:
         raise ConfigError(
             f"too few event-free epochs in {file} to set a threshold for {statistic}; "
@@ -269,7 +279,7 @@ def detect_orbit_command(
             key="null",
         )
     run_id = new_run_id()
-    chash = config_hash({**asdict(cfg), "null": null_file is not None})
+    chash = config_hash({**asdict(cfg), "null": null_file is not None, "threshold_confidence": confidence_z})
     events = find_events(analysis, thresholds, spacecraft=pseudonym or eph.satellite, run_id=run_id, cfg_hash=chash)
     if statistics_out:
         import pandas as pd

@@ -281,9 +281,7 @@ class _StepModel:
         sc = {k: self.scales[k][g] * factor for k in self.NAMES}
         z_a = abs(steps["a_m"]) / sc["a_m"]
         z_e = math.hypot(steps["ex"] / sc["ex"], steps["ey"] / sc["ey"])
-        z_n = math.hypot(
-            steps["i_rad"] / sc["i_rad"], steps["raan_resid_sin_i_rad"] / sc["raan_resid_sin_i_rad"]
-        )
+        z_n = math.hypot(steps["i_rad"] / sc["i_rad"], steps["raan_resid_sin_i_rad"] / sc["raan_resid_sin_i_rad"])
         return z_a, z_e, z_n
 
 

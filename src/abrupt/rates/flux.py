@@ -82,17 +82,14 @@ def check_orbit(altitude_m: float, *, max_altitude_m: float | None = None, model
         )
     if max_altitude_m is not None and altitude_m > max_altitude_m:
         raise ConfigError(
-            f"altitude {altitude_m / 1e3:.1f} km is above the {model} model's range "
-            f"(<= {max_altitude_m / 1e3:.0f} km)",
+            f"altitude {altitude_m / 1e3:.1f} km is above the {model} model's range (<= {max_altitude_m / 1e3:.0f} km)",
             key="altitude_km",
         )
 
 
 def _check_inclination(inclination_deg: float) -> None:
     if not (0.0 <= inclination_deg <= 180.0):
-        raise ConfigError(
-            f"inclination must be in [0, 180] deg, got {inclination_deg!r}", key="inclination_deg"
-        )
+        raise ConfigError(f"inclination must be in [0, 180] deg, got {inclination_deg!r}", key="inclination_deg")
 
 
 def nasa90_psi(inclination_deg: float) -> float:
@@ -214,9 +211,7 @@ def earth_shielding_factor(altitude_m: float) -> float:
     return 0.5 * (1.0 + math.sqrt(1.0 - sin_eta**2))
 
 
-def meteoroid_focusing(
-    altitude_m: float, n_bins: int = 400
-) -> tuple[float, NDArray[np.float64], NDArray[np.float64]]:
+def meteoroid_focusing(altitude_m: float, n_bins: int = 400) -> tuple[float, NDArray[np.float64], NDArray[np.float64]]:
     """Gravitational focusing factor G(h) and the speed distribution at altitude h.
 
     The near-Earth (100 km) distribution :func:`meteoroid_speed_pdf_100km` is mapped to speeds at
@@ -242,9 +237,7 @@ def meteoroid_focusing(
     return focusing, v_r, w_r / w_r.sum()
 
 
-def meteoroid_earth_factors(
-    altitude_m: float, *, n_samples: int = 200_000, seed: int = 0
-) -> MeteoroidEarthFactors:
+def meteoroid_earth_factors(altitude_m: float, *, n_samples: int = 200_000, seed: int = 0) -> MeteoroidEarthFactors:
     """Focusing G, shielding sf and spacecraft-motion factor K for a circular orbit (ECSS Eq. C-15).
 
     K is the mean of |v_met - v_sc| / |v_met| over meteoroid directions isotropic in the unshielded sky

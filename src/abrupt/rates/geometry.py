@@ -448,9 +448,7 @@ def _grid_1d(length: float, spacing: float) -> NDArray[np.float64]:
     return np.linspace(0.0, length, n)
 
 
-def _point_cloud(
-    g: Geometry, spacing: float
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+def _point_cloud(g: Geometry, spacing: float) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
     """Bus face points (body) and panel points as (a, b) coordinates along (u, v) per panel."""
     pts = []
     for lo, hi in zip(g.box_lo, g.box_hi, strict=True):

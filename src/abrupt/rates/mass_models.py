@@ -65,9 +65,7 @@ def sphere_mass(lc_m: ArrayLike, density_kg_m3: ArrayLike) -> NDArray[np.float64
     return np.asarray(4.0 / 3.0 * math.pi * np.asarray(density_kg_m3) * (lc / 2.0) ** 3, dtype=np.float64)
 
 
-def socit_density_kg_m3(
-    lc_m: ArrayLike, high_density: ArrayLike, *, literal: bool = False
-) -> NDArray[np.float64]:
+def socit_density_kg_m3(lc_m: ArrayLike, high_density: ArrayLike, *, literal: bool = False) -> NDArray[np.float64]:
     """SOCIT voided-sphere density [kg/m³] (Bennett 2022 Eqs. 5.6-5.7), continuous or literal reading."""
     lc_mm = _lc(lc_m) * 1e3
     high = np.broadcast_to(np.asarray(high_density, dtype=bool), lc_mm.shape)

@@ -34,9 +34,7 @@ def rembor(speed_mps: ArrayLike) -> NDArray[np.float64]:
     return np.asarray(np.maximum(1.0 + 0.3 * (v - 2.0), 1.0), dtype=np.float64)
 
 
-def momentum_enhancement(
-    model: str, speed_mps: ArrayLike, on_array: ArrayLike | None = None
-) -> NDArray[np.float64]:
+def momentum_enhancement(model: str, speed_mps: ArrayLike, on_array: ArrayLike | None = None) -> NDArray[np.float64]:
     """β per strike for a named model; ``on_array`` flags solar-array strikes (model ``rembor_array``)."""
     v = np.asarray(speed_mps, dtype=np.float64)
     if np.any(~np.isfinite(v)) or np.any(v <= 0):
@@ -59,6 +57,4 @@ def momentum_enhancement(
         if on_array is not None:
             beta = np.where(np.asarray(on_array, dtype=bool), ARRAY_MEF, beta).astype(np.float64)
         return beta
-    raise ConfigError(
-        f"unknown MEF model {model!r}; choose one of {list(MEF_MODELS)} or const:<value>", key="mef"
-    )
+    raise ConfigError(f"unknown MEF model {model!r}; choose one of {list(MEF_MODELS)} or const:<value>", key="mef")

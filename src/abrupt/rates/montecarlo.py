@@ -215,9 +215,7 @@ def sample_directions(
     return speed, direction
 
 
-def semi_major_axis_change_m(
-    r_m: float, v_vec: NDArray[np.float64], dv: NDArray[np.float64]
-) -> NDArray[np.float64]:
+def semi_major_axis_change_m(r_m: float, v_vec: NDArray[np.float64], dv: NDArray[np.float64]) -> NDArray[np.float64]:
     """Δa = a(r,|v+Δv|) - a(r,|v|), a = μ r/(2μ - r v²) (Bennett 2022 Eq. 5.4), cancellation-free form."""
     mu = fx.EARTH_MU_M3_S2
     v2 = float(v_vec @ v_vec)
@@ -227,9 +225,7 @@ def semi_major_axis_change_m(
     return np.asarray(mu * r_m * r_m * dv2 / (den0 * den1), dtype=np.float64)
 
 
-def effective_area_m2(
-    geometry: Geometry, table: FluxTable, config: RateConfig, rng: np.random.Generator
-) -> float:
+def effective_area_m2(geometry: Geometry, table: FluxTable, config: RateConfig, rng: np.random.Generator) -> float:
     """A_eff by the thesis formula, or the flux-weighted mean silhouette area over the table's directions."""
     if config.area == "thesis":
         return thesis_effective_area_m2(geometry)
@@ -249,9 +245,7 @@ def simulate_strikes(
     if not tables:
         raise ConfigError("no flux table given", key="flux")
     if not (math.isfinite(spacecraft_mass_kg) and spacecraft_mass_kg > 0):
-        raise ConfigError(
-            "spacecraft mass_kg is needed for ΔV (set mass_kg in the spacecraft file)", key="mass_kg"
-        )
+        raise ConfigError("spacecraft mass_kg is needed for ΔV (set mass_kg in the spacecraft file)", key="mass_kg")
     fx.check_orbit(altitude_m)
     rng = np.random.default_rng(config.seed)
     tabs = [t.bounded(config.flux_bound_sigma) for t in tables]
@@ -266,9 +260,7 @@ def simulate_strikes(
     for t, n in zip(tabs, counts, strict=True):
         if n == 0:
             continue
-        lc, ci, w = sample_sizes(
-            t, config.lc_min_m, int(n), rng, importance=config.size_sampling == "log_uniform"
-        )
+        lc, ci, w = sample_sizes(t, config.lc_min_m, int(n), rng, importance=config.size_sampling == "log_uniform")
         w_parts.append(w)
         spd, d = sample_directions(t.directions, int(n), rng)
         lc_parts.append(lc)

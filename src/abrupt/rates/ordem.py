@@ -118,9 +118,7 @@ def read_ordem_size(
     mapping = describe_mapping(header)
     size_cols = [i for i, h in enumerate(header) if mapping[h] == "size"]
     if len(size_cols) != 1:
-        raise InputError(
-            f"need exactly one size column, found {len(size_cols)} in header {header}", file=path
-        )
+        raise InputError(f"need exactly one size column, found {len(size_cols)} in header {header}", file=path)
     scol = size_cols[0]
     scale = next((f for u, f in _SIZE_UNITS.items() if u in header[scol]), 1.0)
     sizes = data[:, scol] * scale
@@ -166,9 +164,7 @@ def read_ordem_size(
         rises = np.diff(flux[c]) > flux[c, :-1] * 1e-9
         if np.any(rises):
             k = int(order[np.argmax(rises) + 1])
-            raise InputError(
-                "cumulative flux increases with size", file=path, line=line_nos[k], column=header[cols[0]]
-            )
+            raise InputError("cumulative flux increases with size", file=path, line=line_nos[k], column=header[cols[0]])
     sigma = np.zeros_like(flux)
 
     def _sig(cols: list[tuple[int, str]]) -> NDArray[np.float64]:

@@ -81,9 +81,7 @@ def plot_dh_dv_scatter(results: Sequence[CaseResult], out: str | Path, *, max_po
         seen.add(r.spacecraft_name)
         k = min(max_points, r.dH_Nms.size)
         ok = (r.dH_Nms[:k] > 0) & (r.dV_mps[:k] > 0)
-        ax.loglog(
-            r.dV_mps[:k][ok] * 1e3, r.dH_Nms[:k][ok] * 1e3, ".", ms=2, alpha=0.4, label=r.spacecraft_name
-        )
+        ax.loglog(r.dV_mps[:k][ok] * 1e3, r.dH_Nms[:k][ok] * 1e3, ".", ms=2, alpha=0.4, label=r.spacecraft_name)
     ax.set_xlabel("ΔV [mm/s]")
     ax.set_ylabel("ΔH [mN·m·s]")
     ax.grid(True, which="both", alpha=0.3)

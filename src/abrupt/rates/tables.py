@@ -144,9 +144,7 @@ def _float(text: str, file: Path, line: int, column: str) -> float:
     return value
 
 
-def _rows(
-    path: Path, required: Sequence[str], optional: Sequence[str] = ()
-) -> list[tuple[int, dict[str, str]]]:
+def _rows(path: Path, required: Sequence[str], optional: Sequence[str] = ()) -> list[tuple[int, dict[str, str]]]:
     try:
         fh = path.open(newline="")
     except OSError as exc:
@@ -159,9 +157,7 @@ def _rows(
     names = [h.strip() for h in next(csv.reader([header]))]
     missing = [c for c in required if c not in names]
     if missing:
-        raise InputError(
-            f"missing column(s) {missing}; expected {list(required)}", file=path, line=header_line
-        )
+        raise InputError(f"missing column(s) {missing}; expected {list(required)}", file=path, line=header_line)
     unknown = [c for c in names if c not in (*required, *optional)]
     if unknown:
         raise InputError(f"unknown column(s) {unknown}", file=path, line=header_line)
@@ -197,9 +193,7 @@ def read_size_table(
             )
         flux = _float(row["cumulative_flux_m2_yr"], path, line, "cumulative_flux_m2_yr")
         if flux < 0:
-            raise InputError(
-                "flux must not be negative", file=path, line=line, column="cumulative_flux_m2_yr"
-            )
+            raise InputError("flux must not be negative", file=path, line=line, column="cumulative_flux_m2_yr")
         sig_text = row.get("sigma_m2_yr", "")
         sigma = _float(sig_text, path, line, "sigma_m2_yr") if sig_text else 0.0
         if sigma < 0:
@@ -215,9 +209,7 @@ def read_size_table(
                     column="size_m",
                 )
             if size < prev_size:
-                raise InputError(
-                    f"sizes out of order for class {cls!r}", file=path, line=line, column="size_m"
-                )
+                raise InputError(f"sizes out of order for class {cls!r}", file=path, line=line, column="size_m")
             if flux > prev_flux * (1 + 1e-9):
                 raise InputError(
                     "cumulative flux increases with size (not a cumulative table?)",
@@ -264,15 +256,11 @@ def read_direction_table(path: str | Path) -> DirectionBins:
         if vals["speed_kms_lo"][i] < 0 or vals["speed_kms_hi"][i] <= 0:
             raise InputError("speeds must be positive", file=path, line=line, column="speed_kms_lo")
         if vals["speed_kms_hi"][i] > 100.0:
-            raise InputError(
-                "speed above 100 km/s (units must be km/s)", file=path, line=line, column="speed_kms_hi"
-            )
+            raise InputError("speed above 100 km/s (units must be km/s)", file=path, line=line, column="speed_kms_hi")
         if not (-360.0 <= vals["azimuth_deg_lo"][i] and vals["azimuth_deg_hi"][i] <= 360.0):
             raise InputError("azimuth outside [-360, 360] deg", file=path, line=line, column="azimuth_deg_lo")
         if not (-90.0 <= vals["elevation_deg_lo"][i] and vals["elevation_deg_hi"][i] <= 90.0):
-            raise InputError(
-                "elevation outside [-90, 90] deg", file=path, line=line, column="elevation_deg_lo"
-            )
+            raise InputError("elevation outside [-90, 90] deg", file=path, line=line, column="elevation_deg_lo")
         if vals["flux_m2_yr"][i] < 0:
             raise InputError("flux must not be negative", file=path, line=line, column="flux_m2_yr")
     total = vals["flux_m2_yr"].sum()
@@ -321,9 +309,7 @@ def read_flux_table(path: str | Path) -> FluxTable:
             raise ConfigError("missing required key", file=path, key=key)
     convention = data.get("flux_convention", "cross_section")
     if convention not in ("cross_section", "tumbling"):
-        raise ConfigError(
-            "flux_convention must be 'cross_section' or 'tumbling'", file=path, key="flux_convention"
-        )
+        raise ConfigError("flux_convention must be 'cross_section' or 'tumbling'", file=path, key="flux_convention")
     sizes, classes, flux, sigma = read_size_table(path.parent / data["size_table"])
     if convention == "tumbling":
         flux, sigma = 4.0 * flux, 4.0 * sigma
@@ -472,9 +458,7 @@ def debris_crossing_directions(
     si, ai = np.nonzero(hist)
     weight = hist[si, ai] / hist.sum()
     zeros = np.zeros(si.size)
-    return DirectionBins(
-        s_edges[si], s_edges[si + 1], a_edges[ai], a_edges[ai + 1], zeros, zeros.copy(), weight
-    )
+    return DirectionBins(s_edges[si], s_edges[si + 1], a_edges[ai], a_edges[ai + 1], zeros, zeros.copy(), weight)
 
 
 def meteoroid_directions(

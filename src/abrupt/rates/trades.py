@@ -103,9 +103,7 @@ def flux_tables(
     for part in (p.strip() for p in spec.split("+")):
         if part in ("nasa90", "nasa91"):
             out.append(
-                nasa90_table(
-                    alt, inclination_deg, epoch_year, solar_flux_sfu=solar_flux_sfu, sigma_factor=sigma_factor
-                )
+                nasa90_table(alt, inclination_deg, epoch_year, solar_flux_sfu=solar_flux_sfu, sigma_factor=sigma_factor)
             )
         elif part == "grun":
             out.append(grun_table(alt, sigma_factor=sigma_factor))
@@ -113,15 +111,12 @@ def flux_tables(
             table = read_flux_table(part)
             if math.isfinite(table.altitude_m) and abs(table.altitude_m - alt) > 1.0:
                 raise ConfigError(
-                    f"flux table {part} is for {table.altitude_m / 1e3:g} km, "
-                    f"the scenario for {altitude_km:g} km",
+                    f"flux table {part} is for {table.altitude_m / 1e3:g} km, the scenario for {altitude_km:g} km",
                     key="altitude_km",
                 )
             out.append(table)
         else:
-            raise ConfigError(
-                f"unknown flux model {part!r}; use nasa90, grun or a flux-table .toml", key="flux"
-            )
+            raise ConfigError(f"unknown flux model {part!r}; use nasa90, grun or a flux-table .toml", key="flux")
     if not out:
         raise ConfigError("empty flux model", key="flux")
     return tuple(out)
@@ -226,9 +221,7 @@ def trade_scenarios(base: Scenario, variables: Sequence[tuple[str, Sequence[str]
         sc = base
         for name, value in combo:
             sc = apply_variable(sc, name, value)
-        label = ", ".join(
-            f"{name}={Path(value).stem if name == 'spacecraft' else value}" for name, value in combo
-        )
+        label = ", ".join(f"{name}={Path(value).stem if name == 'spacecraft' else value}" for name, value in combo)
         out.append(replace(sc, label=label))
     return out
 

@@ -66,9 +66,7 @@ def _doy_time(tokens: list[str], file: str, line_no: int, what: str) -> np.datet
             f"{what}: cannot read {' '.join(tokens)!r} as year, day of year, time", file=file, line=line_no
         ) from None
     if not (1 <= doy <= 366 and 0 <= hh <= 23 and 0 <= mm <= 59 and 0.0 <= sec < 61.0):
-        raise InputError(
-            f"{what}: {' '.join(tokens)!r} is not a valid year/day-of-year/time", file=file, line=line_no
-        )
+        raise InputError(f"{what}: {' '.join(tokens)!r} is not a valid year/day-of-year/time", file=file, line=line_no)
     base = np.datetime64(f"{year:04d}-01-01T00:00:00", "ns")
     offset_ns = round((((doy - 1) * 24 + hh) * 60 + mm) * 60e9 + sec * 1e9)
     return base + np.timedelta64(offset_ns, "ns")
@@ -99,9 +97,7 @@ def read_ids_maneuvers(path: str | Path, *, repairs: RepairLog | None = None) ->
         seen.add(text)
         tok = text.split()
         if len(tok) < 11:
-            raise InputError(
-                f"maneuver line has {len(tok)} fields, expected at least 11", file=file, line=line_no
-            )
+            raise InputError(f"maneuver line has {len(tok)} fields, expected at least 11", file=file, line=line_no)
         head = 9
         # optional flag: the parameter type is a 3-digit code followed by the burn count N
         if len(tok) > head + 2 and len(tok[head + 1]) <= 3 and (len(tok) - head - 3) % BURN_TOKENS == 0:
@@ -110,14 +106,11 @@ def read_ids_maneuvers(path: str | Path, *, repairs: RepairLog | None = None) ->
         try:
             n_burns = int(n_text)
         except ValueError:
-            raise InputError(
-                f"number of burns {n_text!r} is not an integer", file=file, line=line_no
-            ) from None
+            raise InputError(f"number of burns {n_text!r} is not an integer", file=file, line=line_no) from None
         burns = tok[head + 2 :]
         if n_burns < 1 or len(burns) != n_burns * BURN_TOKENS:
             raise InputError(
-                f"{n_burns} burn(s) announced but {len(burns)} burn tokens found "
-                f"(expected {BURN_TOKENS} per burn)",
+                f"{n_burns} burn(s) announced but {len(burns)} burn tokens found (expected {BURN_TOKENS} per burn)",
                 file=file,
                 line=line_no,
             )

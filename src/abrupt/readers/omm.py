@@ -82,9 +82,7 @@ def record_to_set(record: dict[str, Any], *, file: str, index: int, line: int | 
         raise InputError(f"{where}OMM record lacks {', '.join(missing)}", file=file, line=line)
     ts = rec.get("TIME_SYSTEM", "UTC").upper()
     if ts != "UTC":
-        raise InputError(
-            f"{where}TIME_SYSTEM {ts!r}: SGP4 mean elements must be in UTC", file=file, line=line
-        )
+        raise InputError(f"{where}TIME_SYSTEM {ts!r}: SGP4 mean elements must be in UTC", file=file, line=line)
     theory = rec.get("MEAN_ELEMENT_THEORY", "SGP4").upper()
     if theory not in ("SGP4", "SGP/SGP4"):
         raise InputError(f"{where}MEAN_ELEMENT_THEORY {theory!r} is not SGP4", file=file, line=line)
@@ -95,9 +93,7 @@ def record_to_set(record: dict[str, Any], *, file: str, index: int, line: int | 
         try:
             float(rec[k])
         except ValueError:
-            raise InputError(
-                f"{where}{k} {rec[k]!r} is not a number", file=file, line=line, column=k
-            ) from None
+            raise InputError(f"{where}{k} {rec[k]!r} is not a number", file=file, line=line, column=k) from None
     try:
         norad = int(float(rec["NORAD_CAT_ID"]))
         elnum = int(float(rec["ELEMENT_SET_NO"]))
@@ -113,9 +109,7 @@ def record_to_set(record: dict[str, Any], *, file: str, index: int, line: int | 
     rec["ELEMENT_SET_NO"] = str(elnum)
     rec["EPOCH"] = _normalise_epoch(rec["EPOCH"], where, file, line)
     if float(rec["MEAN_MOTION"]) <= 0:
-        raise InputError(
-            f"{where}MEAN_MOTION {rec['MEAN_MOTION']} rev/day is not positive", file=file, line=line
-        )
+        raise InputError(f"{where}MEAN_MOTION {rec['MEAN_MOTION']} rev/day is not positive", file=file, line=line)
     if not 0.0 <= float(rec["ECCENTRICITY"]) < 1.0:
         raise InputError(f"{where}ECCENTRICITY {rec['ECCENTRICITY']} outside [0, 1)", file=file, line=line)
     sat = Satrec()
@@ -124,9 +118,7 @@ def record_to_set(record: dict[str, Any], *, file: str, index: int, line: int | 
     except (ValueError, KeyError) as exc:
         raise InputError(f"{where}sgp4 cannot initialise this record: {exc}", file=file, line=line) from None
     key = "|".join(rec.get(k, "") for k in ("NORAD_CAT_ID", "EPOCH", *NUMERIC))
-    return RawElementSet(
-        sat, norad, elnum, line if line is not None else index, key, rec.get("OBJECT_NAME") or None
-    )
+    return RawElementSet(sat, norad, elnum, line if line is not None else index, key, rec.get("OBJECT_NAME") or None)
 
 
 def _local(tag: str) -> str:
@@ -174,9 +166,7 @@ def parse_kvn(text: str, file: str) -> list[tuple[dict[str, str], int | None]]:
         if not rec:
             start = n
         if key in rec and key != "COMMENT":
-            raise InputError(
-                f"keyword {key} repeated within one OMM (missing CCSDS_OMM_VERS?)", file=file, line=n
-            )
+            raise InputError(f"keyword {key} repeated within one OMM (missing CCSDS_OMM_VERS?)", file=file, line=n)
         rec[key] = value
     if rec:
         out.append((rec, start))
@@ -209,9 +199,7 @@ def detect_format(text: str) -> str:
         return "xml"
     if head.startswith(("[", "{")):
         return "json"
-    if re.search(r"^\s*CCSDS_OMM_VERS\s*=", head, re.MULTILINE) or re.search(
-        r"^\s*[A-Z_]+\s*=", head, re.MULTILINE
-    ):
+    if re.search(r"^\s*CCSDS_OMM_VERS\s*=", head, re.MULTILINE) or re.search(r"^\s*[A-Z_]+\s*=", head, re.MULTILINE):
         return "kvn"
     if "MEAN_MOTION" in head.split("\n", 1)[0].upper():
         return "csv"

@@ -120,9 +120,7 @@ def _check_line(text: str, expected: str, file: str, line_no: int) -> str:
             column=min(len(line), TLE_LINE_LENGTH) + 1,
         )
     if not line[68].isdigit():
-        raise InputError(
-            f"checksum character {line[68]!r} is not a digit", file=file, line=line_no, column=69
-        )
+        raise InputError(f"checksum character {line[68]!r} is not a digit", file=file, line=line_no, column=69)
     expected_sum = tle_checksum(line)
     if int(line[68]) != expected_sum:
         raise InputError(
@@ -142,9 +140,7 @@ def _field(line: str, start: int, stop: int, what: str, file: str, line_no: int)
             return _implied_decimal(raw)
         return float(raw)
     except ValueError:
-        raise InputError(
-            f"{what}: cannot read {raw!r} as a number", file=file, line=line_no, column=start
-        ) from None
+        raise InputError(f"{what}: cannot read {raw!r} as a number", file=file, line=line_no, column=start) from None
 
 
 def _implied_decimal(raw: str) -> float:
@@ -276,9 +272,7 @@ def history_from_sets(
         kept.append(s)
     repairs.record("element sets of other satellites skipped", skipped)
     if not kept:
-        raise InputError(
-            "no element sets" + (f" of satellite {norad_id}" if norad_id is not None else ""), file=source
-        )
+        raise InputError("no element sets" + (f" of satellite {norad_id}" if norad_id is not None else ""), file=source)
     # Exact duplicates.
     seen: set[str] = set()
     unique: list[RawElementSet] = []
@@ -292,9 +286,7 @@ def history_from_sets(
     if np.any(np.diff(epochs) < 0):
         repairs.record("element sets out of epoch order, sorted", int(np.sum(np.diff(epochs) < 0)))
     # Stable sort by epoch; within one epoch the highest element-set number, then file order, wins.
-    order = sorted(
-        range(len(unique)), key=lambda k: (round(float(epochs[k]) * 86400e3), unique[k].element_set_no, k)
-    )
+    order = sorted(range(len(unique)), key=lambda k: (round(float(epochs[k]) * 86400e3), unique[k].element_set_no, k))
     by_epoch: dict[int, RawElementSet] = {}
     replaced = 0
     for k in order:
@@ -351,9 +343,7 @@ def read_tle(path: str | Path, *, norad_id: int | None = None) -> ElementHistory
         raise InputError(f"not an ASCII TLE file (byte {exc.start})", file=path) from None
     lines = text.splitlines()
     repairs = RepairLog(source=str(path))
-    return history_from_sets(
-        iter_tle_sets(lines, file=str(path)), source=str(path), norad_id=norad_id, repairs=repairs
-    )
+    return history_from_sets(iter_tle_sets(lines, file=str(path)), source=str(path), norad_id=norad_id, repairs=repairs)
 
 
 def is_tle_text(head: str) -> bool:

@@ -18,9 +18,7 @@ from abrupt.readers.tle import ElementHistory
 
 
 def _utc(values: Any) -> pd.DatetimeIndex:
-    return pd.DatetimeIndex(
-        pd.to_datetime(pd.Series(values).astype(str), utc=True, format="ISO8601")
-    ).tz_localize(None)
+    return pd.DatetimeIndex(pd.to_datetime(pd.Series(values).astype(str), utc=True, format="ISO8601")).tz_localize(None)
 
 
 def plot_tle_report(
@@ -85,9 +83,7 @@ def plot_tle_report(
         ymax = float(axes[0].get_ylim()[1])
         axes[0].plot(tt, np.full(len(tt), ymax), "v", color="k", ms=6, label="operator maneuver")
         axes[0].legend(loc="upper right", fontsize=8)
-        summary = (
-            f"P={result.precision:.2f} R={result.recall:.2f} F1={result.f1:.2f} (±{tolerance_s / 86400:g} d)"
-        )
+        summary = f"P={result.precision:.2f} R={result.recall:.2f} F1={result.f1:.2f} (±{tolerance_s / 86400:g} d)"
     else:
         shown = events.loc[events["statistic"] >= events["threshold"]] if len(events) else events
         summary = ""

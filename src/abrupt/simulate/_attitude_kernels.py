@@ -209,9 +209,7 @@ def simulate_one(
         for j in range(3):
             h_body[j] = inertia[j, 0] * w_meas[0] + inertia[j, 1] * w_meas[1] + inertia[j, 2] * w_meas[2]
         for i in range(n_w):
-            hs = spin_inertia[i] * (
-                axes[0, i] * w_meas[0] + axes[1, i] * w_meas[1] + axes[2, i] * w_meas[2] + x[7 + i]
-            )
+            hs = spin_inertia[i] * (axes[0, i] * w_meas[0] + axes[1, i] * w_meas[1] + axes[2, i] * w_meas[2] + x[7 + i])
             for j in range(3):
                 h_body[j] += axes[j, i] * hs
         l_des[0] = gain_k * sigma[0] + gain_p * w_meas[0] - (w_meas[1] * h_body[2] - w_meas[2] * h_body[1])

@@ -158,9 +158,7 @@ class AttitudeSimConfig:
         try:
             pd.Timestamp(self.start_time_utc)
         except ValueError:
-            raise ConfigError(
-                f"not an ISO-8601 time: {self.start_time_utc!r}", key="start_time_utc"
-            ) from None
+            raise ConfigError(f"not an ISO-8601 time: {self.start_time_utc!r}", key="start_time_utc") from None
 
     @property
     def dt_s(self) -> float:
@@ -222,9 +220,7 @@ def _prepare(spacecraft: Spacecraft, config: AttitudeSimConfig) -> _Prepared:
     axes = np.ascontiguousarray(spacecraft.wheel_axes, dtype=np.float64)
     n_w = axes.shape[1]
     if n_w == 0 or np.linalg.matrix_rank(axes) < 3:
-        raise ConfigError(
-            "the attitude simulator needs reaction wheels whose axes span 3 dimensions", key="wheels"
-        )
+        raise ConfigError("the attitude simulator needs reaction wheels whose axes span 3 dimensions", key="wheels")
     inertia = np.ascontiguousarray(spacecraft.inertia_kgm2, dtype=np.float64)
     js = np.ascontiguousarray(spacecraft.wheel_spin_inertias_kgm2, dtype=np.float64)
     # Eliminating Ω̇ from Eqs. 2.2-2.3: (J - G diag(Js) Gᵀ) ω̇ = ... (J includes the wheels).
@@ -262,8 +258,7 @@ def _strike_arrays(
     if steps.size and steps.max() >= n_steps:
         bad = int(np.argmax(steps >= n_steps))
         raise ConfigError(
-            f"strike {bad} at {strikes[bad].time_s} s is at or after the end of the run "
-            f"({config.duration_s} s)",
+            f"strike {bad} at {strikes[bad].time_s} s is at or after the end of the run ({config.duration_s} s)",
             key="strikes",
         )
     order = np.argsort(steps, kind="stable")
@@ -306,9 +301,7 @@ def telemetry_frame(
     if order == "scalar_last":
         q = q[:, [1, 2, 3, 0]]
     rate = np.asarray(omega_B_rad_s, dtype=np.float64) / RATE_UNITS[tm.body_rate.unit or "rad/s"]
-    wheels = (
-        np.asarray(wheel_speed_rad_s, dtype=np.float64) / WHEEL_SPEED_UNITS[tm.wheel_speed.unit or "rad/s"]
-    )
+    wheels = np.asarray(wheel_speed_rad_s, dtype=np.float64) / WHEEL_SPEED_UNITS[tm.wheel_speed.unit or "rad/s"]
     data: dict[str, object] = {tm.time: time}
     for k, c in enumerate(tm.quaternion.columns):
         data[c] = q[:, k]
@@ -372,9 +365,7 @@ def simulate_attitude(
     dh_n_user = np.empty_like(dh_n)
     dh_n_user[order] = dh_n
     dh_b_user = np.array([s.dH_B_Nms for s in strikes], dtype=np.float64).reshape(len(strikes), 3)
-    strike_t = np.array(
-        [round(s.time_s * config.sim_rate_hz) / config.sim_rate_hz for s in strikes], dtype=np.float64
-    )
+    strike_t = np.array([round(s.time_s * config.sim_rate_hz) / config.sim_rate_hz for s in strikes], dtype=np.float64)
     truth = pd.DataFrame(
         {
             "time_utc": _times(config, strike_t),
@@ -427,9 +418,7 @@ def simulate_attitude_batch(
         dh_list.append(d)
         order_list.append(o)
         offsets[r + 1] = offsets[r] + s.shape[0]
-    steps = np.ascontiguousarray(
-        np.concatenate(steps_list) if n_runs else np.zeros(0, np.int64), dtype=np.int64
-    )
+    steps = np.ascontiguousarray(np.concatenate(steps_list) if n_runs else np.zeros(0, np.int64), dtype=np.int64)
     dh_b = np.ascontiguousarray(np.concatenate(dh_list) if n_runs else np.zeros((0, 3))).reshape(-1, 3)
     n_s = config.n_samples
     n_x = prep.x0.shape[0]
