@@ -47,20 +47,8 @@ EVENT_COLUMNS: tuple[str, ...] = (
     "config_hash",
 )
 
-_FLOAT_COLUMNS = (
-    "time_sigma_s",
-    "statistic",
-    "threshold",
-    "false_alarms_per_day",
-    "dH_N_x_Nms",
-    "dH_N_y_Nms",
-    "dH_N_z_Nms",
-    "dH_Nms",
-    "dv_r_mps",
-    "dv_t_mps",
-    "dv_n_mps",
-    "dv_mps",
-)
+_TEXT_COLUMNS = ("event_id", "spacecraft", "kind", "detector", "time_utc", "run_id", "config_hash")
+_FLOAT_COLUMNS = tuple(c for c in EVENT_COLUMNS if c not in _TEXT_COLUMNS)
 
 NAN = float("nan")
 
@@ -183,7 +171,7 @@ def normalise_frame(frame: pd.DataFrame) -> pd.DataFrame:
     out = frame.loc[:, ordered].copy()
     for name in _FLOAT_COLUMNS:
         out[name] = pd.to_numeric(out[name], errors="raise").astype("float64")
-    for name in ("event_id", "spacecraft", "kind", "detector", "time_utc", "run_id", "config_hash"):
+    for name in _TEXT_COLUMNS:
         out[name] = out[name].astype("string")
     bad = ~out["kind"].isin(EVENT_KINDS)
     if bad.any():
@@ -215,10 +203,9 @@ def read_events(path: str) -> pd.DataFrame:
         frame = pd.read_parquet(path)
     else:
         # identifiers stay text: a hash like "12345e67" or a pseudonym "007" must not become a number
-        text_columns = ("event_id", "spacecraft", "kind", "detector", "time_utc", "run_id", "config_hash")
         frame = pd.read_csv(
             path,
-            dtype={c: str for c in text_columns},
+            dtype={c: str for c in _TEXT_COLUMNS},
             keep_default_na=False,
             na_values={c: [""] for c in _FLOAT_COLUMNS},
         )

@@ -172,9 +172,8 @@ def _summation_kernel(
 def _mean_difference_kernel(
     x: FloatArray, offset: int, pre: int, guard: int, post: int, n_first: int, count: int, anchor: int
 ) -> FloatArray:
-    mu, _ = _pre_mean_std(x, offset, pre, n_first, count, anchor)
-    p1, _ = _window_sums(x, offset, post, n_first + guard, count, anchor)
-    return p1 / post - mu
+    """x̄_post − x̄_pre: the summation statistic divided by the post-window length."""
+    return _summation_kernel(x, offset, pre, guard, post, n_first, count, anchor) / post
 
 
 @nb.njit(cache=True)
