@@ -193,3 +193,29 @@ def test_keys_that_do_not_apply_to_a_quantity_are_errors(tmp_path: Path) -> None
     (tmp_path / "sc.toml").write_text(text)
     with pytest.raises(ConfigError, match=r"telemetry\.quaternion\.unit"):
         load_spacecraft(tmp_path / "sc.toml")
+
+
+def _spinning_frame(rate_factor: float) -> pd.DataFrame:
+    """A slow spin about body z at 2e-3 rad/s: quaternion and gyro agree when rate_factor = 1."""
+    n = 3000
+    t = np.arange(n) * 0.1
+    rng = np.random.default_rng(4)
+    angle = 2e-3 * t
+    f = pd.DataFrame({"time": pd.to_datetime(t, unit="s", origin="2026-01-01").strftime("%Y-%m-%dT%H:%M:%S.%fZ")})
+    f["q0"], f["q1"], f["q2"], f["q3"] = np.cos(angle / 2), 0.0, 0.0, np.sin(angle / 2)
+    f["wx"] = rng.normal(0, 4e-5, n) * rate_factor
+    f["wy"] = rng.normal(0, 4e-5, n) * rate_factor
+    f["wz"] = (2e-3 + rng.normal(0, 4e-5, n)) * rate_factor
+    for k in range(4):
+        f[f"rw{k + 1}"] = 0.0
+    return f
+
+
+def test_rates_that_agree_with_the_quaternions_are_accepted(tmp_path: Path) -> None:
+    tel = read_telemetry(_write(tmp_path, _spinning_frame(1.0)), SC)
+    assert len(tel) == 3000
+
+
+def test_rates_in_degrees_declared_as_radians_are_caught_by_the_attitude_cross_check(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match="look like deg/s"):
+        read_telemetry(_write(tmp_path, _spinning_frame(180.0 / np.pi)), SC)

@@ -13,6 +13,8 @@ a mapped column missing                error naming the column and the spacecraf
 quaternion norm off by more than 10%   error (wrong scaling or not a quaternion)
 quaternion norm off by 1e-6 .. 10%     repair: renormalised, counted
 |body rate| above 2 rad/s              error (deg/s declared as rad/s?)
+gyro rates k x the quaternion rate     error when the attitude moves well above noise and k is
+                                       outside [0.5, 2] (names deg/rad confusion when k ≈ 57.3)
 wheel speed above 1.5 x its maximum    error naming the unit to check (rpm declared as rad/s?)
 empty cells (NaN)                      repair: row removed, counted; leaves a gap
 duplicate timestamps                   repair: exact duplicates removed; conflicting ones keep the
@@ -107,6 +109,68 @@ def _numeric(frame: pd.DataFrame, column: str, path: Path, is_csv: bool) -> NDAr
         row = int(np.flatnonzero(bad.to_numpy())[0])
         raise InputError(f"not a number: {raw.iloc[row]!r}", file=path, line=_line(row, is_csv), column=column)
     return values.to_numpy(dtype=np.float64)
+
+
+RATE_CHECK_BLOCK_S = 10.0  # [s] averaging block for the gyro / quaternion-derivative cross-check
+RATE_CHECK_MIN_SNR = 10.0  # the check speaks only when the attitude motion stands well above noise
+
+
+def _check_rates_against_attitude(
+    t_s: NDArray[np.float64],
+    q: NDArray[np.float64],
+    w: NDArray[np.float64],
+    segments: list[tuple[int, int]],
+    path: Path,
+    unit: str,
+) -> None:
+    """Cross-check gyro rates against the rate implied by the quaternions, when the motion allows.
+
+    ω_q = 2 vec(q_k* ⊗ q_k+1) / Δt (body axes) and the gyro ω are averaged over 10 s blocks; if the
+    block-averaged attitude rate stands ten times above its own noise, the least-squares factor k in
+    ω ≈ k ω_q must be near 1. A factor near 57.3 (or 1/57.3) means degrees and radians were confused;
+    any other factor outside [0.5, 2] means a wrong unit, axis order or quaternion convention. For an
+    inertially pointing spacecraft the attitude rate is at noise level and the check stays silent.
+    """
+    from abrupt.model.rotations import quaternion_conjugate, quaternion_multiply
+
+    num = den = 0.0
+    signal: list[float] = []
+    noise: list[float] = []
+    for a, b in segments:
+        if b - a < 3:
+            continue
+        dq = quaternion_multiply(quaternion_conjugate(q[a : b - 1]), q[a + 1 : b])
+        dq = np.where(dq[:, :1] < 0, -dq, dq)
+        dt = np.diff(t_s[a:b])[:, None]
+        wq = 2.0 * dq[:, 1:] / dt
+        wg = 0.5 * (w[a : b - 1] + w[a + 1 : b])
+        block = max(2, round(RATE_CHECK_BLOCK_S / float(np.median(dt))))
+        m = (wq.shape[0] // block) * block
+        if m < 2 * block:
+            continue
+        wq_b = wq[:m].reshape(-1, block, 3).mean(axis=1)
+        wg_b = wg[:m].reshape(-1, block, 3).mean(axis=1)
+        num += float(np.sum(wg_b * wq_b))
+        den += float(np.sum(wq_b * wq_b))
+        signal.append(float(np.sqrt(np.mean(wq_b**2))))
+        noise.append(float(1.4826 * np.median(np.abs(np.diff(wq_b, axis=0))) / np.sqrt(2.0)))
+    if not signal or den <= 0 or max(signal) < RATE_CHECK_MIN_SNR * max(min(noise), 1e-300):
+        return
+    k = num / den
+    if 0.5 <= k <= 2.0:
+        return
+    deg = np.pi / 180.0
+    if abs(k * deg - 1.0) < 0.2:
+        hint = f"the rates look like deg/s although the spacecraft file says {unit!r}"
+    elif abs(k / deg - 1.0) < 0.2:
+        hint = f"the rates look like rad/s although the spacecraft file says {unit!r}"
+    else:
+        hint = "check the rate unit, the axis order and the quaternion convention (q_BN, scalar first)"
+    raise InputError(
+        f"body rates are {k:.4g} x the rate implied by the quaternions: {hint}",
+        file=path,
+        column="body_rate",
+    )
 
 
 def telemetry_from_frame(
@@ -258,6 +322,7 @@ def telemetry_from_frame(
             repairs.record(f"gaps longer than {GAP_FACTOR} sample intervals (data split into segments)", len(gaps))
     else:
         segments = [(0, 1)]
+    _check_rates_against_attitude(t_s, q, w, segments, path, tmap.body_rate.unit or "rad/s")
     return Telemetry(
         time=time_ns,
         t_s=t_s,
