@@ -181,3 +181,31 @@ def test_calibration_at_another_rate_is_an_error() -> None:
         detect_attitude(
             telemetry_from_frame(fast.telemetry, SC), SC, FAST, calibration=telemetry_from_frame(slow.telemetry, SC)
         )
+
+
+def test_a_masked_planned_event_is_not_reported(tmp_path: Path) -> None:
+    from abrupt.readers.telemetry import apply_mask, read_mask
+
+    # a "momentum dump" at 900 s: a real step, but planned
+    sim = simulate_attitude(SC, AttitudeSimConfig(duration_s=1800.0, seed=8), [Strike(900.0, (0.3, 0.0, 0.0))])
+    tel = telemetry_from_frame(sim.telemetry, SC)
+    assert len(detect_attitude(tel, SC, FAST).events[lambda e: e.detector == "attitude.glr"]) == 1
+    t0 = pd.Timestamp(tel.time[0])
+    mask = tmp_path / "mask.csv"
+    mask.write_text(
+        "start_utc,end_utc,reason\n"
+        f"{(t0 + pd.Timedelta(seconds=890)).isoformat()}Z,{(t0 + pd.Timedelta(seconds=960)).isoformat()}Z,dump\n"
+    )
+    masked = apply_mask(tel, read_mask(mask))
+    assert masked.repairs.counts["samples blanked by the mask (planned events)"] == 701
+    assert len(detect_attitude(masked, SC, FAST).events) == 0
+
+
+def test_a_mask_interval_that_ends_before_it_starts_is_an_error(tmp_path: Path) -> None:
+    from abrupt.errors import InputError
+    from abrupt.readers.telemetry import read_mask
+
+    mask = tmp_path / "mask.csv"
+    mask.write_text("start_utc,end_utc\n2026-01-01T00:10:00Z,2026-01-01T00:05:00Z\n")
+    with pytest.raises(InputError, match=r"mask\.csv:2: interval ends before it starts"):
+        read_mask(mask)

@@ -213,6 +213,12 @@ detector_options = [
         help="Event-free samples simulated for threshold calibration (without --calibration).",
     ),
     click.option(
+        "--mask",
+        type=click.Path(exists=True, dir_okay=False),
+        default=None,
+        help="CSV of intervals to blank (start_utc,end_utc[,reason]): thruster firings, momentum dumps, slews.",
+    ),
+    click.option(
         "--calibration",
         type=click.Path(exists=True, dir_okay=False),
         default=None,
@@ -236,13 +242,16 @@ def run_attitude_detection(
     calibration: str | None,
     name: str | None,
     settings: dict[str, Any],
+    mask: str | None = None,
 ) -> tuple[Any, Any, Any, Any]:
     """Read, calibrate and detect, with a progress line per stage. Returns (sc, telemetry, config, result)."""
     from abrupt.detect.attitude import detect_attitude
-    from abrupt.readers.telemetry import read_telemetry
+    from abrupt.readers.telemetry import apply_mask, read_mask, read_telemetry
 
     sc = _spacecraft(spacecraft_path)
     tel = read_telemetry(telemetry_path, sc)
+    if mask:
+        tel = apply_mask(tel, read_mask(mask))
     for line in tel.repairs.summary():
         click.echo(f"repaired: {line}", err=True)
     cal = read_telemetry(calibration, sc) if calibration else None
@@ -312,7 +321,8 @@ def detect_attitude_cmd(
     **settings: Any,
 ) -> None:
     """Detect strikes in attitude TELEMETRY (CSV or Parquet); write events and the catalog."""
-    _, tel, _, result = run_attitude_detection(telemetry, spacecraft_path, calibration, name, settings)
+    mask = settings.pop("mask")
+    _, tel, _, result = run_attitude_detection(telemetry, spacecraft_path, calibration, name, settings, mask)
     details = {
         "thresholds": {k: v.as_dict() for k, v in result.thresholds.items()},
         **{k: v for k, v in result.details.items()},
@@ -364,7 +374,8 @@ def report_attitude_cmd(
 
     from abrupt.report.attitude import write_attitude_report
 
-    _, tel, _, result = run_attitude_detection(telemetry, spacecraft_path, calibration, None, settings)
+    mask = settings.pop("mask")
+    _, tel, _, result = run_attitude_detection(telemetry, spacecraft_path, calibration, None, settings, mask)
     truth_frame = pd.read_csv(truth) if truth else None
     write_attitude_report(out, tel, result, truth=truth_frame)
     click.echo(f"report: {out}")

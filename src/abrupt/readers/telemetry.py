@@ -343,3 +343,65 @@ def read_telemetry(path: str | Path, spacecraft: Spacecraft) -> Telemetry:
     frame = _read_table(path)
     is_csv = path.suffix.lower() in (".csv", ".txt")
     return telemetry_from_frame(frame, spacecraft, source=path, is_csv=is_csv)
+
+
+def read_mask(path: str | Path) -> list[tuple[np.datetime64, np.datetime64, str]]:
+    """Intervals to blank (thruster firings, momentum dumps, slews): CSV ``start_utc,end_utc[,reason]``.
+
+    Times are ISO-8601 UTC; an interval whose end precedes its start is an error naming the line.
+    """
+    path = Path(path)
+    frame = _read_table(path)
+    for col in ("start_utc", "end_utc"):
+        if col not in frame.columns:
+            raise InputError(
+                f"mask file needs columns start_utc, end_utc[, reason]; got {list(frame.columns)}",
+                file=path,
+                column=col,
+            )
+    start = pd.to_datetime(frame["start_utc"], utc=True, errors="coerce", format="ISO8601")
+    end = pd.to_datetime(frame["end_utc"], utc=True, errors="coerce", format="ISO8601")
+    out = []
+    for i in range(len(frame)):
+        if pd.isna(start.iloc[i]) or pd.isna(end.iloc[i]):
+            col = "start_utc" if pd.isna(start.iloc[i]) else "end_utc"
+            raise InputError(f"not an ISO-8601 time: {frame[col].iloc[i]!r}", file=path, line=i + 2, column=col)
+        if end.iloc[i] < start.iloc[i]:
+            raise InputError("interval ends before it starts", file=path, line=i + 2)
+        reason = str(frame["reason"].iloc[i]) if "reason" in frame.columns else ""
+        out.append(
+            (start.iloc[i].tz_localize(None).to_datetime64(), end.iloc[i].tz_localize(None).to_datetime64(), reason)
+        )
+    return out
+
+
+def apply_mask(telemetry: Telemetry, intervals: list[tuple[np.datetime64, np.datetime64, str]]) -> Telemetry:
+    """Blank masked intervals: segments are split so that no detector window touches a masked sample.
+
+    The masked samples stay in the arrays (for reports) but belong to no segment; their number is
+    counted in the repairs.
+    """
+    masked = np.zeros(len(telemetry), dtype=bool)
+    for start, end, _ in intervals:
+        masked |= (telemetry.time >= start) & (telemetry.time <= end)
+    if not masked.any():
+        return telemetry
+    segments: list[tuple[int, int]] = []
+    for a, b in telemetry.segments:
+        keep = ~masked[a:b]
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], keep.astype(np.int8), [0]])))
+        segments += [(a + int(s), a + int(e)) for s, e in zip(edges[::2], edges[1::2], strict=True)]
+    repairs = RepairLog(telemetry.repairs.source, telemetry.repairs.counts.copy())
+    repairs.record("samples blanked by the mask (planned events)", int(masked.sum()))
+    return Telemetry(
+        time=telemetry.time,
+        t_s=telemetry.t_s,
+        quaternion_BN=telemetry.quaternion_BN,
+        body_rate_rad_s=telemetry.body_rate_rad_s,
+        wheel_speed_rad_s=telemetry.wheel_speed_rad_s,
+        sample_interval_s=telemetry.sample_interval_s,
+        segments=segments,
+        repairs=repairs,
+        source=telemetry.source,
+        gaps=telemetry.gaps,
+    )
