@@ -318,6 +318,44 @@ def _kernel_args(spacecraft: Spacecraft, config: AttitudeSimConfig) -> tuple[_Pr
     return prep, n_steps, config.noise_vector()
 
 
+def _run_kernel(
+    prep: _Prepared,
+    n_steps: int,
+    noise: FloatArray,
+    config: AttitudeSimConfig,
+    seed: int | None,
+    steps: NDArray[np.int64],
+    dh_b: FloatArray,
+    out_true: FloatArray,
+    out_meas: FloatArray,
+    dh_n: FloatArray,
+) -> None:
+    """One run of the compiled kernel, writing into the output arrays (shared by single and batch runs)."""
+    kern.simulate_one(
+        n_steps,
+        config.dt_s,
+        config.decimation,
+        prep.inertia,
+        prep.m_inv,
+        prep.axes,
+        prep.spin_inertia,
+        prep.max_torque,
+        prep.pinv,
+        float(config.gain_K_Nm),
+        float(config.gain_P_Nms),
+        noise,
+        bool(config.noise),
+        _rng(seed),
+        prep.x0,
+        steps,
+        dh_b,
+        float(config.wheel_speed_resolution_rad_s or 0.0),
+        out_true,
+        out_meas,
+        dh_n,
+    )
+
+
 def simulate_attitude(
     spacecraft: Spacecraft,
     config: AttitudeSimConfig = AttitudeSimConfig(),
@@ -335,29 +373,7 @@ def simulate_attitude(
     out_true = np.empty((n_s, n_x))
     out_meas = np.empty((n_s, n_x))
     dh_n = np.zeros((steps.shape[0], 3))
-    kern.simulate_one(
-        n_steps,
-        config.dt_s,
-        config.decimation,
-        prep.inertia,
-        prep.m_inv,
-        prep.axes,
-        prep.spin_inertia,
-        prep.max_torque,
-        prep.pinv,
-        float(config.gain_K_Nm),
-        float(config.gain_P_Nms),
-        noise,
-        bool(config.noise),
-        _rng(config.seed),
-        prep.x0,
-        steps,
-        dh_b,
-        float(config.wheel_speed_resolution_rad_s or 0.0),
-        out_true,
-        out_meas,
-        dh_n,
-    )
+    _run_kernel(prep, n_steps, noise, config, config.seed, steps, dh_b, out_true, out_meas, dh_n)
     t_s: FloatArray = np.arange(n_s, dtype=np.float64) * (config.decimation * config.dt_s)
     times = _times(config, t_s)
     telemetry = telemetry_frame(spacecraft, times, out_meas[:, :4], out_meas[:, 4:7], out_meas[:, 7:])
@@ -428,28 +444,8 @@ def simulate_attitude_batch(
 
     def run(r: int) -> None:
         a, b = offsets[r], offsets[r + 1]
-        kern.simulate_one(
-            n_steps,
-            config.dt_s,
-            config.decimation,
-            prep.inertia,
-            prep.m_inv,
-            prep.axes,
-            prep.spin_inertia,
-            prep.max_torque,
-            prep.pinv,
-            float(config.gain_K_Nm),
-            float(config.gain_P_Nms),
-            noise,
-            bool(config.noise),
-            _rng(int(seeds[r])),
-            prep.x0,
-            steps[a:b],
-            dh_b[a:b],
-            float(config.wheel_speed_resolution_rad_s or 0.0),
-            out_true[r],
-            out_meas[r],
-            dh_n[a:b],
+        _run_kernel(
+            prep, n_steps, noise, config, int(seeds[r]), steps[a:b], dh_b[a:b], out_true[r], out_meas[r], dh_n[a:b]
         )
 
     # The compiled kernel releases the GIL, so threads run the independent runs in parallel.
