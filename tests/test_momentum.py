@@ -45,3 +45,13 @@ def test_a_known_rotation_maps_body_momentum_to_inertial_axes() -> None:
     w = np.array([[1e-3, 0.0, 0.0]])  # spin about body x = inertial y
     m = system_momentum(SC, q, w, np.zeros((1, 4)))
     np.testing.assert_allclose(m.H_N_Nms[0], [0.0, 3.0, 0.0], atol=1e-12)
+
+
+def test_robust_noise_sigma_recovers_white_noise_despite_a_step_and_nans() -> None:
+    from abrupt.model.noise import robust_noise_sigma
+
+    rng = np.random.default_rng(2)
+    x = rng.normal(0.0, [0.13, 0.05], size=(20000, 2))
+    x[10000:] += 5.0  # a large step touches one difference only
+    x[123, 0] = np.nan
+    np.testing.assert_allclose(robust_noise_sigma(x), [0.13, 0.05], rtol=0.03)

@@ -17,7 +17,7 @@ import json
 import math
 import uuid
 from collections.abc import Iterable, Mapping
-from dataclasses import asdict, dataclass, field, fields, is_dataclass
+from dataclasses import asdict, dataclass, field, is_dataclass
 from typing import Any
 
 import numpy as np
@@ -177,11 +177,6 @@ def normalise_frame(frame: pd.DataFrame) -> pd.DataFrame:
     if bad.any():
         raise ValueError(f"event kinds {sorted(set(out.loc[bad, 'kind']))} not in {EVENT_KINDS}")
     return out.reset_index(drop=True)
-
-
-def event_field_names() -> list[str]:
-    """Names of the :class:`Event` fields (for documentation and checks)."""
-    return [f.name for f in fields(Event)]
 
 
 def write_events(frame: pd.DataFrame, path: str) -> None:

@@ -158,7 +158,7 @@ def fit_threshold(
         return fit_block_maxima_threshold(
             null_statistic,
             sample_rate_hz=sample_rate_hz,
-            false_alarms_per_day=false_alarms_from_p(p_fa, sample_rate_hz),
+            false_alarms_per_day=false_alarms_per_day_from_p_fa(p_fa, sample_rate_hz),
         )
     else:
         raise ValueError(f"unknown threshold method {method!r}; choose one of {FIT_METHODS}")
@@ -171,11 +171,6 @@ def fit_threshold(
         false_alarms_per_day=rate,
         sample_rate_hz=float("nan") if sample_rate_hz is None else float(sample_rate_hz),
     )
-
-
-def false_alarms_from_p(p_fa: float, sample_rate_hz: float) -> float:
-    """False alarms per day for a per-sample probability (alias of the inverse conversion)."""
-    return false_alarms_per_day_from_p_fa(p_fa, sample_rate_hz)
 
 
 def block_maxima(statistic: ArrayLike, block_samples: int) -> NDArray[np.float64]:

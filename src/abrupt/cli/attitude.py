@@ -73,7 +73,9 @@ def random_strikes(n: int, duration_s: float, dh_min: float, dh_max: float, seed
 )
 @click.option("--no-noise", is_flag=True, help="Noise-free simulation.")
 @click.option("--strike", "strikes", multiple=True, help="TIME_S:DHX,DHY,DHZ (body axes, N·m·s); repeatable.")
-@click.option("--random-strikes", type=int, default=0, help="Add N strikes at random times and directions.")
+@click.option(
+    "--random-strikes", "n_random_strikes", type=int, default=0, help="Add N strikes at random times and directions."
+)
 @click.option(
     "--strike-range",
     type=(float, float),
@@ -98,7 +100,7 @@ def simulate_attitude_cmd(
     rate_noise: float,
     no_noise: bool,
     strikes: tuple[str, ...],
-    random_strikes: int,
+    n_random_strikes: int,
     strike_range: tuple[float, float],
     wheel_resolution: float | None,
     start_utc: str,
@@ -113,8 +115,8 @@ def simulate_attitude_cmd(
 
     sc = _spacecraft(spacecraft_path)
     strike_list = [parse_strike(s) for s in strikes]
-    if random_strikes:
-        strike_list += _random_strikes(random_strikes, duration_s, strike_range, seed)
+    if n_random_strikes:
+        strike_list += random_strikes(n_random_strikes, duration_s, strike_range[0], strike_range[1], seed)
     cfg = AttitudeSimConfig(
         duration_s=duration_s,
         telemetry_rate_hz=telemetry_rate_hz,
@@ -129,10 +131,6 @@ def simulate_attitude_cmd(
     click.echo(
         f"telemetry: {tel_path} ({len(result.telemetry)} samples); truth: {truth_path} ({len(result.truth)} strikes)"
     )
-
-
-def _random_strikes(n: int, duration_s: float, strike_range: tuple[float, float], seed: int) -> list[Strike]:
-    return random_strikes(n, duration_s, strike_range[0], strike_range[1], seed)
 
 
 def _detection_config(

@@ -33,6 +33,7 @@ from abrupt.detect.change_detection import WindowConfig, sliding_statistic
 from abrupt.errors import InputError
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc, new_run_id
 from abrupt.model.momentum import system_momentum
+from abrupt.model.noise import robust_noise_sigma
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.readers.telemetry import Telemetry
 from abrupt.thresholds import Threshold, block_maxima, fit_block_maxima_threshold, fit_threshold
@@ -104,15 +105,6 @@ def spacecraft_fingerprint(spacecraft: Spacecraft) -> str:
             "telemetry": repr(spacecraft.telemetry),
         }
     )
-
-
-def robust_noise_sigma(x: FloatArray) -> FloatArray:
-    """White-noise standard deviation per column from first differences: 1.4826 MAD(Δx)/√2."""
-    d = np.diff(np.asarray(x, dtype=np.float64), axis=0)
-    if d.shape[0] < 2:
-        return np.zeros(x.shape[1] if x.ndim > 1 else 1)
-    mad = np.median(np.abs(d - np.median(d, axis=0)), axis=0)
-    return np.asarray(1.4826 * mad / np.sqrt(2.0), dtype=np.float64)
 
 
 def detector_windows(name: str, config: AttitudeDetectionConfig, dt: float) -> WindowConfig:

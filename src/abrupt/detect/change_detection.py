@@ -26,7 +26,6 @@ data, not on how the stream was cut into chunks: streaming and batch give the sa
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -477,14 +476,3 @@ class StreamingStatistic:
         self._buffer = buf[drop:].copy() if drop else buf
         self._offset += drop
         return idx, values
-
-
-def statistic_function(name: str) -> Callable[[ArrayLike, WindowConfig | None], FloatArray]:
-    """The batch function for a statistic name (registry by name, as in ruptures)."""
-    if name not in STATISTICS:
-        raise ValueError(f"unknown statistic {name!r}; choose one of {STATISTICS}")
-
-    def statistic(x: ArrayLike, cfg: WindowConfig | None = None) -> FloatArray:
-        return sliding_statistic(name, x, cfg)
-
-    return statistic

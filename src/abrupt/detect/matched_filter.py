@@ -786,15 +786,14 @@ def analytic_output_sd(wavelet: ArrayLike, noise_sd: float, *, dH_wavelet_Nms: f
 
 
 def robust_noise_sd(x: ArrayLike) -> FloatArray:
-    """Per-column white-noise sd from first differences: 1.4826 MAD(diff) / sqrt(2).
+    """Per-column white-noise sd from first differences (:func:`abrupt.model.noise.robust_noise_sigma`).
 
     The strike response is smooth at the telemetry rate, so differencing removes it and the median
     ignores the few samples it does touch.
     """
-    a = np.asarray(x, dtype=np.float64)
-    d = np.diff(a, axis=0)
-    med = np.nanmedian(d, axis=0)
-    return np.asarray(1.4826 * np.nanmedian(np.abs(d - med), axis=0) / math.sqrt(2.0))
+    from abrupt.model.noise import robust_noise_sigma
+
+    return robust_noise_sigma(x)
 
 
 @dataclass(frozen=True)

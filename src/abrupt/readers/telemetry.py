@@ -37,6 +37,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from abrupt.errors import InputError, RepairLog
+from abrupt.model.noise import robust_noise_sigma
 from abrupt.model.spacecraft import RATE_UNITS, WHEEL_SPEED_UNITS, Spacecraft
 
 QUATERNION_NORM_ERROR = 0.1  # relative norm deviation above which a quaternion is rejected
@@ -153,7 +154,7 @@ def _check_rates_against_attitude(
         num += float(np.sum(wg_b * wq_b))
         den += float(np.sum(wq_b * wq_b))
         signal.append(float(np.sqrt(np.mean(wq_b**2))))
-        noise.append(float(1.4826 * np.median(np.abs(np.diff(wq_b, axis=0))) / np.sqrt(2.0)))
+        noise.append(float(np.median(robust_noise_sigma(wq_b))))
     if not signal or den <= 0 or max(signal) < RATE_CHECK_MIN_SNR * max(min(noise), 1e-300):
         return
     k = num / den
