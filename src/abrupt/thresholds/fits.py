@@ -30,10 +30,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, special, stats
 
+from abrupt.thresholds.budget import SECONDS_PER_DAY
+
 FitMethod = Literal["gaussian", "gamma", "kde", "empirical", "gpd", "gev"]
 FIT_METHODS: tuple[str, ...] = ("gaussian", "gamma", "kde", "empirical", "gpd", "gev")
-
-SECONDS_PER_DAY = 86400.0
 
 
 def p_fa_per_sample(false_alarms_per_day: float, sample_rate_hz: float) -> float:

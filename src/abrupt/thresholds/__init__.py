@@ -1,0 +1,47 @@
+"""Thresholds from a false-alarm budget: the one place where a rate becomes a threshold.
+
+:mod:`abrupt.thresholds.budget` holds :class:`FalseAlarmBudget` (a rate per day, week or
+satellite-year and its conversions to per-sample, per-block and per-test levels);
+:mod:`abrupt.thresholds.fits` holds the fits of event-free statistics that return a
+:class:`Threshold` (Gaussian, Gamma, KDE, empirical, GPD, GEV block maxima).
+Detectors import from this package, never from a private helper of another detector.
+"""
+
+from abrupt.thresholds.budget import DAYS_PER_YEAR, SECONDS_PER_DAY, BudgetUnit, FalseAlarmBudget
+from abrupt.thresholds.fits import (
+    FIT_METHODS,
+    FitMethod,
+    Threshold,
+    block_maxima,
+    episode_rate,
+    false_alarms_per_day_from_p_fa,
+    fit_block_maxima_threshold,
+    fit_threshold,
+    gpd_quantile,
+    kde_quantile,
+    neyman_pearson_threshold,
+    p_fa_per_sample,
+    qq_points,
+    roc_curve,
+)
+
+__all__ = [
+    "DAYS_PER_YEAR",
+    "FIT_METHODS",
+    "SECONDS_PER_DAY",
+    "BudgetUnit",
+    "FalseAlarmBudget",
+    "FitMethod",
+    "Threshold",
+    "block_maxima",
+    "episode_rate",
+    "false_alarms_per_day_from_p_fa",
+    "fit_block_maxima_threshold",
+    "fit_threshold",
+    "gpd_quantile",
+    "kde_quantile",
+    "neyman_pearson_threshold",
+    "p_fa_per_sample",
+    "qq_points",
+    "roc_curve",
+]

@@ -1,0 +1,106 @@
+"""The false-alarm budget: one rate with its unit, converted to test levels in one place.
+
+Every detector is given a :class:`FalseAlarmBudget` (DESIGN.md, "Detectors") and sets its threshold
+for it. A budget is a Poisson rate of alarms on event-free data, stated per day, per week or per
+satellite-year; the conversions below turn it into the level a threshold fit needs:
+
+``per_sample(sample_rate_hz)``   probability that one sample of a statistic exceeds the threshold
+                                 (Bennett 2022 §2.5.1 step 4: 1/day at 10 Hz is 1/864000);
+``per_block(block_s)``           probability that the maximum over a block exceeds it,
+                                 1 − exp(−rate·block) (GEV block maxima, Coles 2001 §3);
+``per_test(tests_per_day)``      probability per independent test when tests come at a known rate
+                                 (a TLE gap, a tracking pass, a window of routine telemetry);
+``bonferroni(n)``                the budget split evenly over ``n`` parallel statistics.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from typing import ClassVar, Literal
+
+BudgetUnit = Literal["day", "week", "year"]
+
+SECONDS_PER_DAY = 86400.0
+DAYS_PER_YEAR = 365.25
+
+
+@dataclass(frozen=True)
+class FalseAlarmBudget:
+    """A false-alarm rate: ``rate`` alarms per ``per`` (``day``, ``week`` or satellite-``year``).
+
+    >>> FalseAlarmBudget(1, "week").per_day
+    0.14285714285714285
+    """
+
+    rate: float
+    per: BudgetUnit = "day"
+
+    DAYS: ClassVar[dict[str, float]] = {"day": 1.0, "week": 7.0, "year": DAYS_PER_YEAR}
+
+    def __post_init__(self) -> None:
+        if self.per not in self.DAYS:
+            raise ValueError(f"false-alarm budget unit must be one of {tuple(self.DAYS)}, got {self.per!r}")
+        if not (math.isfinite(self.rate) and self.rate > 0):
+            raise ValueError(f"false-alarm budget must be a positive finite rate, got {self.rate!r}")
+
+    # ------------------------------------------------------------------ constructors
+    @classmethod
+    def per_day_rate(cls, rate: float) -> FalseAlarmBudget:
+        return cls(float(rate), "day")
+
+    @classmethod
+    def parse(cls, text: str) -> FalseAlarmBudget:
+        """Read ``"1/day"``, ``"0.1 per week"``, ``"1/year"`` (satellite-year) or a bare number (per day)."""
+        m = re.fullmatch(r"\s*([0-9.eE+-]+)\s*(?:(?:/|per)\s*(?:satellite[- ]?)?(day|week|year|yr|d|w|y))?\s*", text)
+        if m is None:
+            raise ValueError(f"cannot read a false-alarm budget from {text!r}; write e.g. '1/day', '1/week', '1/year'")
+        unit = {"d": "day", "w": "week", "y": "year", "yr": "year"}.get(m.group(2) or "day", m.group(2) or "day")
+        return cls(float(m.group(1)), unit)  # type: ignore[arg-type]
+
+    # ------------------------------------------------------------------ rates
+    @property
+    def per_day(self) -> float:
+        """Alarms per day."""
+        return self.rate / self.DAYS[self.per]
+
+    @property
+    def per_second(self) -> float:
+        return self.per_day / SECONDS_PER_DAY
+
+    @property
+    def per_year(self) -> float:
+        return self.per_day * DAYS_PER_YEAR
+
+    def expected_in(self, duration_s: float) -> float:
+        """Expected number of false alarms in ``duration_s`` seconds of event-free data."""
+        return self.per_second * duration_s
+
+    # ------------------------------------------------------------------ test levels
+    def per_sample(self, sample_rate_hz: float) -> float:
+        """Per-sample exceedance probability at ``sample_rate_hz`` (Bennett 2022 §2.5.1 step 4)."""
+        if not sample_rate_hz > 0:
+            raise ValueError(f"sample_rate_hz must be positive, got {sample_rate_hz}")
+        return min(1.0, self.per_day / (sample_rate_hz * SECONDS_PER_DAY))
+
+    def per_block(self, block_s: float) -> float:
+        """Probability that a block of ``block_s`` seconds holds an alarm, for a Poisson rate."""
+        if not block_s > 0:
+            raise ValueError(f"block_s must be positive, got {block_s}")
+        return -math.expm1(-self.per_second * block_s)
+
+    def per_test(self, tests_per_day: float) -> float:
+        """Probability per test when independent tests come at ``tests_per_day``."""
+        if not tests_per_day > 0:
+            raise ValueError(f"tests_per_day must be positive, got {tests_per_day}")
+        return min(1.0, self.per_day / tests_per_day)
+
+    def bonferroni(self, n: int) -> FalseAlarmBudget:
+        """This budget split evenly over ``n`` parallel statistics (the union keeps the total rate)."""
+        if n < 1:
+            raise ValueError(f"need at least one statistic, got {n}")
+        return FalseAlarmBudget(self.rate / n, self.per)
+
+    def __str__(self) -> str:
+        return f"{self.rate:g}/{self.per}"
