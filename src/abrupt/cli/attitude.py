@@ -243,8 +243,9 @@ def run_attitude_detection(
     mask: str | None = None,
 ) -> tuple[Any, Any, Any, Any]:
     """Read, calibrate and detect, with a progress line per stage. Returns (sc, telemetry, config, result)."""
+    from abrupt.clean.masks import apply_mask, read_mask
     from abrupt.detect.attitude import detect_attitude
-    from abrupt.readers.telemetry import apply_mask, read_mask, read_telemetry
+    from abrupt.readers.telemetry import read_telemetry
 
     sc = _spacecraft(spacecraft_path)
     tel = read_telemetry(telemetry_path, sc)

@@ -45,9 +45,10 @@ from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 from scipy import signal
 
+from abrupt.clean.noise import robust_noise_sigma, robust_scale
 from abrupt.model.rotations import (
     dcm_from_quaternion,
     normalise_quaternion,
@@ -55,8 +56,8 @@ from abrupt.model.rotations import (
     quaternion_multiply,
 )
 from abrupt.thresholds import FitMethod, Threshold, fit_threshold
+from abrupt.types import FloatArray
 
-FloatArray = NDArray[np.float64]
 Kind = Literal["attitude", "rate"]
 SizeMetric = Literal["mmse", "rsse", "mae", "cubic"]
 SIZE_METRICS: tuple[str, ...] = ("mmse", "rsse", "mae", "cubic")
@@ -594,7 +595,7 @@ def detect_matched_filter(
         else statistic
     )
     thr = np.array([th.value for th in thresholds])
-    noise_sd = robust_noise_sd(ch)
+    noise_sd = robust_noise_sigma(ch)
     with np.errstate(invalid="ignore"):
         ratio = np.abs(stat) / thr
     best = np.where(np.isfinite(ratio), ratio, -np.inf).max(axis=1)
@@ -785,17 +786,6 @@ def analytic_output_sd(wavelet: ArrayLike, noise_sd: float, *, dH_wavelet_Nms: f
 # ----------------------------------------------------------------------------------------------
 
 
-def robust_noise_sd(x: ArrayLike) -> FloatArray:
-    """Per-column white-noise sd from first differences (:func:`abrupt.model.noise.robust_noise_sigma`).
-
-    The strike response is smooth at the telemetry rate, so differencing removes it and the median
-    ignores the few samples it does touch.
-    """
-    from abrupt.model.noise import robust_noise_sigma
-
-    return robust_noise_sigma(x)
-
-
 @dataclass(frozen=True)
 class CombinedFilter:
     """Generalised-likelihood-ratio matched filter on all six channels (attitude and rate).
@@ -895,7 +885,8 @@ def detect_combined(
     ``fit_threshold(null_T, ..., method="gamma")`` or use :func:`chi2_threshold`). With
     ``wheel_speed_rad_s`` (n, N; relative to the body) the wheel channels join the filter (detector
     ``mf_joint``; a baseline is then always used, 120 s unless given), otherwise the six attitude and
-    rate channels (``mf_combined``). ``noise_sd`` defaults to :func:`robust_noise_sd` of the channels.
+    rate channels (``mf_combined``). ``noise_sd`` defaults to
+    :func:`abrupt.clean.noise.robust_noise_sigma` of the channels.
     The strike estimate is the least-squares dH_hat, not the bank (``dH_B_*`` = ``dH_ls_B_*``).
     """
     q = np.asarray(q_BN, dtype=np.float64)
@@ -909,7 +900,7 @@ def detect_combined(
             baseline_samples = round(DEFAULT_BASELINE_S * wavelets.sample_rate_hz)
     if ch.shape[0] != t.shape[0]:
         raise ValueError("time, q_BN, omega and wheel speeds must have the same length")
-    sd = robust_noise_sd(ch) if noise_sd is None else np.asarray(noise_sd, dtype=np.float64)
+    sd = robust_noise_sigma(ch) if noise_sd is None else np.asarray(noise_sd, dtype=np.float64)
     filt = CombinedFilter.from_wavelets(wavelets, sd, use_wheels=use_wheels)
     stat, _ = filt.statistic(ch, baseline_samples=baseline_samples)
     score = np.where(np.isfinite(stat), stat, -np.inf)
@@ -1030,7 +1021,7 @@ def robust_gaussian_thresholds(
         if x.size < 10:
             raise ValueError("need at least 10 finite filter outputs to set a threshold")
         med = float(np.median(x))
-        sd = 1.4826 * float(np.median(np.abs(x - med)))
+        sd = float(robust_scale(x))
         out.append(
             Threshold(
                 value=abs(med) + z * sd,

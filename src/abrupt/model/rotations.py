@@ -7,9 +7,9 @@ inertial frame N, so that ``[BN](q)`` maps N-components to B-components (Schaub 
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
-FloatArray = NDArray[np.float64]
+from abrupt.types import FloatArray
 
 
 def normalise_quaternion(q: ArrayLike) -> FloatArray:
