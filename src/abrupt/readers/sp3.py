@@ -17,9 +17,9 @@ Documented repairs (counted in the :class:`~abrupt.errors.RepairLog` of each eph
   analysis centres) — is normalised ("epoch field at rollover value normalised");
 - a position given as 0.000000 or 999999.999999 (the SP3 "bad or absent" markers) removes that epoch
   for that satellite; such a velocity becomes NaN;
-- one malformed ephemeris record (unreadable number, truncated ``P``/``V`` line, unknown record type,
-  implausible radius, malformed epoch line) in a long file is skipped and counted; more than
-  ``max(1, 1 %)`` of the records bad is an error naming the first bad line;
+- a malformed ephemeris record (unreadable number, truncated ``P``/``V`` line, unknown record type,
+  implausible radius, malformed epoch line) in a long file is skipped and counted, up to 1 % of the
+  records (so none in a file of fewer than 100 records); more is an error naming the first bad line;
 - an epoch repeated with identical states is dropped; epochs out of order are sorted; gaps against the
   header interval are counted (the filter propagates across them);
 - records of a satellite missing from the header list are read and counted;
@@ -451,11 +451,12 @@ def parse_sp3(path: str | Path, *, allow_truncated: bool = False, repairs: Repai
             bad.append((no, exc))
     if lines_after_eof:
         log.record("lines after EOF ignored", lines_after_eof)
-    limit = max(1, int(BAD_RECORD_FRACTION * n_records))
+    limit = int(BAD_RECORD_FRACTION * n_records)
     if len(bad) > limit:
         first_no, first = bad[0]
+        extra = f" ({len(bad)} malformed records, more than the {limit} that would be skipped)" if limit else ""
         raise InputError(
-            f"{first.reason} ({len(bad)} malformed records, more than the {limit} that would be skipped)",
+            first.reason + extra,
             file=file,
             line=first_no,
             column=first.column,
