@@ -105,7 +105,9 @@ def _check_metadata(meta: dict[str, str], file: str, line: int, column: int | No
         )
     ts = meta["TIME_SYSTEM"].upper()
     if ts not in TIME_SYSTEMS:
-        raise InputError(f"unknown TIME_SYSTEM {ts!r}; known: {sorted(TIME_SYSTEMS)}", file=file, line=line, column=column)
+        raise InputError(
+            f"unknown TIME_SYSTEM {ts!r}; known: {sorted(TIME_SYSTEMS)}", file=file, line=line, column=column
+        )
 
 
 class _Bad(Exception):
@@ -258,6 +260,8 @@ _XML_STATE = ("X", "Y", "Z", "X_DOT", "Y_DOT", "Z_DOT")
 def _parse_xml(raw: bytes, file: str, log: RepairLog) -> tuple[list[_Segment], list[tuple[int, _Bad]], int]:
     root = _parse_xml_tree(raw, file)
     oem = root.child("oem")
+    if oem is None and root.children and root.children[0].tag == "ndm":
+        oem = root.children[0].child("oem")  # a combined Navigation Data Message holding one OEM
     if oem is None:
         top = root.children[0] if root.children else root
         raise InputError(f"root element is <{top.tag}>, not <oem>", file=file, line=top.line, column=top.column)
@@ -287,13 +291,16 @@ def _parse_xml(raw: bytes, file: str, log: RepairLog) -> tuple[list[_Segment], l
                 continue
             n_records += 1
             fields = {c.tag.upper(): c for c in sv.children}
+            missing = [k for k in ("EPOCH", *_XML_STATE) if k not in fields]
+            if missing:
+                bad.append((sv.line, _Bad(f"<stateVector> lacks {', '.join(missing)}", sv.column)))
+                continue
+            nodes = [fields[k] for k in ("EPOCH", *_XML_STATE)]
             try:
-                missing = [k for k in ("EPOCH", *_XML_STATE) if k not in fields]
-                if missing:
-                    raise _Bad(f"<stateVector> lacks {', '.join(missing)}", sv.column)
-                epoch, values = _state_from_tokens([fields[k].text.strip() or "?" for k in ("EPOCH", *_XML_STATE)])
+                epoch, values = _state_from_tokens([n.text.strip() or "?" for n in nodes])
             except _Bad as exc:
-                bad.append((sv.line, exc))
+                node = nodes[(exc.column or 1) - 1]
+                bad.append((node.line, _Bad(exc.reason, node.column)))
                 continue
             current.epochs.append(epoch)
             current.states.append(values)
@@ -336,7 +343,9 @@ def _to_ephemeris(segments: list[_Segment], satellite: str | None, file: str, lo
     systems = {s.meta["TIME_SYSTEM"].upper() for s in chosen}
     if len({"GCRF" if f in GCRF_NAMES else "ITRF" for f in frames}) > 1 or len(systems) > 1:
         raise InputError(
-            f"segments mix frames {sorted(frames)} or time systems {sorted(systems)}", file=file, line=chosen[0].meta_line
+            f"segments mix frames {sorted(frames)} or time systems {sorted(systems)}",
+            file=file,
+            line=chosen[0].meta_line,
         )
     t = np.array([e for s in chosen for e in s.epochs], dtype="datetime64[ns]")
     st = np.array([v for s in chosen for v in s.states], dtype=np.float64).reshape(-1, 6)
@@ -433,7 +442,9 @@ def _from_utc(t_utc: NDArray[np.datetime64], time_system: str) -> NDArray[np.dat
     offline_astropy()
     tt = Time(t_utc, scale="utc", format="datetime64")
     if time_system == "GPS":
-        return np.asarray(tt.tai.datetime64, dtype="datetime64[ns]") - np.timedelta64(19, "s")
+        tai = np.asarray(tt.tai.datetime64, dtype="datetime64[ns]")
+        gps: NDArray[np.datetime64] = (tai.astype(np.int64) - 19_000_000_000).astype("datetime64[ns]")
+        return gps
     return np.asarray(getattr(tt, time_system.lower()).datetime64, dtype="datetime64[ns]")
 
 
