@@ -233,7 +233,7 @@ def calibrate_thresholds(
                 spacecraft, telemetry.quaternion_BN, telemetry.body_rate_rad_s, telemetry.wheel_speed_rad_s
             ).H_N_Nms
         model = momentum_noise_model(h_data, telemetry.segments)
-        h_null = model.simulate(config.null_samples, config.seed)
+        h_null = model.simulate(max(config.null_samples, _null_samples_needed(config, dt)), config.seed)
         segments = [(0, h_null.shape[0])]
     noise = {"white_sigma_Nms": model.white_sigma_Nms, "random_walk_sigma_Nms": model.random_walk_sigma_Nms}
     thresholds: dict[str, Threshold] = {}
@@ -268,6 +268,21 @@ def calibrate_thresholds(
                 method=config.threshold_method,  # type: ignore[arg-type]
             )
     return thresholds, noise
+
+
+def _null_samples_needed(config: AttitudeDetectionConfig, dt: float) -> int:
+    """Fewest simulated event-free samples giving every block-maxima fit enough blocks.
+
+    ``fit_block_maxima_threshold`` needs 20 blocks; one more block and a window span of margin.
+    """
+    need = 0
+    for name in config.detectors:
+        if name in MATCHED_FILTERS:
+            continue
+        win = detector_windows(name, config, dt)
+        block_s = max(300.0, 3.0 * win.span * dt)
+        need = max(need, round(21 * block_s / dt) + win.span)
+    return need
 
 
 def _episodes(stat: FloatArray, threshold: float, merge: int) -> list[tuple[int, int]]:
