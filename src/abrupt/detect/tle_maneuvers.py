@@ -83,6 +83,8 @@ class TleDetectorConfig:
     refine_time: bool = True
     time_window_sets: int = 8
     min_side_sets: int = 3
+    regime: str = "auto"
+    time_search_sets_before: int = 3
     group_gain: tuple[float, float, float] = (1.0, 1.0, 1.0)
 
     def __post_init__(self) -> None:
@@ -133,14 +135,46 @@ def chi2_as_normal(z: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.asarray(out, dtype=float)
 
 
-def mean_element_series(history: ElementHistory) -> dict[str, NDArray[np.float64]]:
-    """Detector series: time (s from the first epoch), a (m), e-vector, i and RAAN residual (rad)."""
+GEO_MEAN_MOTION_RANGE_REV_DAY = (0.9, 1.1)
+
+
+def orbit_regime(history: ElementHistory) -> str:
+    """``"geo"`` for near-geosynchronous near-circular orbits (median mean motion 0.9-1.1 rev/day,
+    e < 0.1), else ``"leo"`` (the mean-element detector's general case)."""
+    el = history.elements
+    if len(el) == 0:
+        return "leo"
+    rev_day = float(np.median(el["n_rad_s"])) * SECONDS_PER_DAY / (2.0 * math.pi)
+    lo, hi = GEO_MEAN_MOTION_RANGE_REV_DAY
+    return "geo" if lo <= rev_day <= hi and float(np.median(el["e"])) < 0.1 else "leo"
+
+
+def mean_element_series(history: ElementHistory, regime: str = "leo") -> dict[str, NDArray[np.float64]]:
+    """Detector series: time (s from the first epoch), a (m), e-vector, and two orbit-normal angles (rad).
+
+    ``leo``: e-vector ``e(cos ω, sin ω)``; normal = (``i``, ``sin i`` × RAAN minus the SGP4 secular J2
+    drift, accumulated set to set). ``geo``: the equinoctial vectors that stay defined at small
+    inclination (Soop 1994, §3): ``e(cos ϖ, sin ϖ)`` with ϖ = Ω + ω, and the inclination vector
+    ``i(sin Ω, −cos Ω)``; east-west burns move ``a`` (longitude drift) and the e-vector, north-south
+    burns the inclination vector. The keys ``i_rad`` and ``raan_resid_sin_i_rad`` hold the two normal
+    components in both regimes.
+    """
     el = history.elements
     t = (el["epoch_utc"] - el["epoch_utc"].iloc[0]).dt.total_seconds().to_numpy(dtype=float)
     e = el["e"].to_numpy(dtype=float)
     w = el["argp_rad"].to_numpy(dtype=float)
     inc = el["i_rad"].to_numpy(dtype=float)
     raan = el["raan_rad"].to_numpy(dtype=float)
+    if regime == "geo":
+        varpi = w + raan
+        return {
+            "t_s": t,
+            "a_m": el["a_m"].to_numpy(dtype=float),
+            "ex": e * np.cos(varpi),
+            "ey": e * np.sin(varpi),
+            "i_rad": inc * np.sin(raan),
+            "raan_resid_sin_i_rad": -inc * np.cos(raan),
+        }
     rate = el["raan_rate_rad_s"].to_numpy(dtype=float)
     incr = np.zeros_like(raan)
     if len(raan) > 1:
@@ -226,7 +260,8 @@ class _StepModel:
 
     def __init__(self, history: ElementHistory, cfg: TleDetectorConfig) -> None:
         self.cfg = cfg
-        self.s = mean_element_series(history)
+        self.regime = orbit_regime(history) if cfg.regime == "auto" else cfg.regime
+        self.s = mean_element_series(history, self.regime)
         self.t = self.s["t_s"]
         self.n = self.t.size
         self.scales = {k: _robust_scale_rolling(self.s[k], cfg.noise_half_window) for k in self.NAMES}
@@ -514,11 +549,17 @@ def null_threshold(stat: NDArray[np.float64], guard: int, p_fa: float, method: s
         return float(fit_threshold(null, p_fa=p_fa, method="empirical").value)
 
 
-def refine_burn_time(history: ElementHistory, gap: int, window_sets: int) -> tuple[float, bool]:
+def refine_burn_time(
+    history: ElementHistory, gap: int, window_sets: int, *, search_sets_before: int = 2, geo: bool = False
+) -> tuple[float, bool]:
     """Burn time (s from the first epoch) by along-track position continuity (module docstring, step 4).
 
-    Returns ``(t_m, refined)``; ``refined`` is False when the fit was not usable and the gap middle
-    of the bracketing element sets was returned instead.
+    The along-track angle is the mean argument of latitude ω + M (LEO) or the mean longitude
+    Ω + ω + M (GEO, where Ω and ω are ill-defined separately). The search runs from
+    ``search_sets_before`` sets before the step to the set after it: the first sets after a burn are
+    often still fitted to pre-burn tracking, so the step in the elements shows late while the
+    change of along-track drift (the hinge) does not. Returns ``(t_m, refined)``; ``refined`` is
+    False when the fit was not usable and the gap middle was returned instead.
     """
     el = history.elements
     t = (el["epoch_utc"] - el["epoch_utc"].iloc[0]).dt.total_seconds().to_numpy(dtype=float)
@@ -528,15 +569,19 @@ def refine_burn_time(history: ElementHistory, gap: int, window_sets: int) -> tup
     hi = min(n, gap + 1 + window_sets)
     if gap - lo < 2 or hi - (gap + 1) < 2:
         return mid, False
+
+    def along(sat: Any) -> float:
+        return float(sat.argpo + sat.mo + (sat.nodeo if geo else 0.0))
+
     ref = history.satrecs[gap]
-    u_ref = ref.argpo + ref.mo
-    rate = (ref.argpdot + ref.mdot) / 60.0  # [rad/s] SGP4 secular rates
+    u_ref = along(ref)
+    rate = (ref.argpdot + ref.mdot + (ref.nodedot if geo else 0.0)) / 60.0  # [rad/s] SGP4 secular rates
     idx = np.arange(lo, hi)
-    u = np.array([history.satrecs[k].argpo + history.satrecs[k].mo for k in idx])
+    u = np.array([along(history.satrecs[k]) for k in idx])
     du = np.angle(np.exp(1j * (u - u_ref - rate * (t[idx] - t[gap]))))
     tau = (t[idx] - t[gap]) / SECONDS_PER_DAY
     # candidate burn times: from the set two before the gap to the set after it
-    t_lo = t[max(lo, gap - 2)]
+    t_lo = t[max(lo, gap - search_sets_before)]
     t_hi = t[gap + 1]
     grid = np.linspace(t_lo, t_hi, 97)
     best = (np.inf, mid)
@@ -634,7 +679,13 @@ def detect_tle_maneuvers(
         if not all_candidates and stat[g] < threshold:
             continue
         if cfg.refine_time:
-            t_m, refined = refine_burn_time(history, int(g), cfg.time_window_sets)
+            t_m, refined = refine_burn_time(
+                history,
+                int(g),
+                cfg.time_window_sets,
+                search_sets_before=cfg.time_search_sets_before,
+                geo=model.regime == "geo",
+            )
         else:
             t_m, refined = 0.5 * (steps.t_before_s[g] + steps.t_after_s[g]), False
         timed.append((int(g), t_m, refined))
@@ -647,7 +698,7 @@ def detect_tle_maneuvers(
             kept.append(item)
     events: list[Event] = []
     for g, t_m, refined in sorted(kept, key=lambda it: it[1]):
-        t_lo = steps.t_before_s[max(0, g - 2)] if refined else steps.t_before_s[g]
+        t_lo = steps.t_before_s[max(0, g - cfg.time_search_sets_before)] if refined else steps.t_before_s[g]
         sigma = (steps.t_after_s[g] - t_lo) / math.sqrt(12.0)  # uniform over the bracket
         a_ref = float(el["a_m"].iloc[g])
         w = steps.weights
