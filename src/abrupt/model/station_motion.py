@@ -32,7 +32,7 @@ def plate_motion(
     position_m: ArrayLike, velocity_m_per_yr: ArrayLike, reference_epoch: np.datetime64, epoch: ArrayLike
 ) -> FloatArray:
     """Station positions (n, 3) at ``epoch`` from a SINEX position and velocity at ``reference_epoch``."""
-    dt_yr = (np.asarray(epoch, dtype="datetime64[ns]") - np.datetime64(reference_epoch, "ns")).astype(np.float64) / (
+    dt_yr = (np.asarray(epoch, dtype="datetime64[ns]") - np.asarray(reference_epoch, dtype="datetime64[ns]")).astype(np.float64) / (
         1e9 * SECONDS_PER_YEAR
     )
     x0 = np.asarray(position_m, dtype=float)
@@ -72,7 +72,7 @@ def sun_moon_ecef_m(epoch_utc: np.datetime64) -> tuple[FloatArray, FloatArray]:
     from astropy.utils import iers
 
     iers.conf.auto_download = False
-    t = Time(np.datetime64(epoch_utc, "ns"), scale="utc")
+    t = Time(np.asarray(epoch_utc, dtype="datetime64[ns]"), scale="utc")
     tt, tdb = t.tt, t.tdb
     pvh, _ = erfa.epv00(tdb.jd1, tdb.jd2)
     sun_gcrs = -np.asarray(pvh["p"], dtype=float) * AU_M  # Earth→Sun, BCRS-aligned (aberration neglected)
