@@ -18,7 +18,7 @@ import pandas as pd
 import sqlalchemy as sa
 
 from abrupt import __version__
-from abrupt.events import _FLOAT_COLUMNS, EVENT_COLUMNS, normalise_frame
+from abrupt.events import EVENT_COLUMNS, FLOAT_COLUMNS, normalise_frame
 
 _metadata = sa.MetaData()
 
@@ -27,7 +27,7 @@ events_table = sa.Table(
     _metadata,
     *[
         sa.Column(name, sa.Float, nullable=True)
-        if name in _FLOAT_COLUMNS
+        if name in FLOAT_COLUMNS
         else sa.Column(name, sa.String(64), primary_key=(name == "event_id"), nullable=(name == "run_id"))
         for name in EVENT_COLUMNS
     ],
