@@ -243,6 +243,19 @@ class MomentumChangeDetector(Detector[AttitudeSeries]):
         return _per_segment(segments, h.shape[0], lambda a, b: self.combined_statistic(h[a:b]))
 
     # ------------------------------------------------------------------ threshold
+    def block_s(self, dt: float) -> float:
+        """Blocks of the extreme-value fit [s]: at least 5 min and three window spans (nearly independent maxima)."""
+        return max(300.0, 3.0 * self.windows.span * dt)
+
+    def null_samples_needed(self, dt: float) -> int:
+        """Fewest simulated event-free samples giving a block-maxima fit its 20 blocks (plus one and a span).
+
+        Other fits need no minimum beyond their 10 finite values.
+        """
+        if self.threshold_method != "gev":
+            return 0
+        return round(21 * self.block_s(dt) / dt) + self.windows.span
+
     def calibration_rows(
         self, h: FloatArray, segments: list[tuple[int, int]], simulated: bool, block_s: float, dt: float
     ) -> tuple[FloatArray, list[tuple[int, int]]]:
@@ -253,10 +266,8 @@ class MomentumChangeDetector(Detector[AttitudeSeries]):
         """Fit the threshold for ``budget`` on event-free momentum (calibration data or simulated)."""
         dt = series.telemetry.sample_interval_s
         rate = 1.0 / dt
-        h, segments, model = series.event_free_momentum(self.null_samples, self.seed)
-        # Blocks for the extreme-value fit: at least 5 min and three window spans, so maxima are
-        # nearly independent.
-        block_s = max(300.0, 3.0 * self.windows.span * dt)
+        h, segments, model = series.event_free_momentum(max(self.null_samples, self.null_samples_needed(dt)), self.seed)
+        block_s = self.block_s(dt)
         h, segments = self.calibration_rows(h, segments, series.calibration is None, block_s, dt)
         stat = self.statistic(h, segments)
         if self.threshold_method == "gev":

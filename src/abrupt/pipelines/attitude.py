@@ -167,6 +167,11 @@ def detect_attitude(
     series = AttitudeSeries(telemetry, spacecraft, calibration=calibration, name=spacecraft_name)
     given = thresholds or {}
     detectors = {name: _build(name, config, given.get(display_name(name))) for name in config.detectors}
+    # One simulated event-free momentum for every change detector: enough samples for the neediest.
+    change_dets = [d for d in detectors.values() if isinstance(d, MomentumChangeDetector)]
+    shared_null = max([config.null_samples, *(d.null_samples_needed(telemetry.sample_interval_s) for d in change_dets)])
+    for d in change_dets:
+        d.null_samples = shared_null
     say = progress or (lambda _: None)
     # Change detectors: calibrate all thresholds first (they share the event-free momentum), then run.
     change = {n: d for n, d in detectors.items() if isinstance(d, MomentumChangeDetector)}
