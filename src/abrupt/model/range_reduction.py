@@ -36,6 +36,7 @@ from abrupt.errors import RepairLog
 from abrupt.model.light_time import SPEED_OF_LIGHT_MPS, shapiro_delay_m
 from abrupt.model.station_motion import eccentricity_ecef_m, solid_tide_displacement_m, sun_moon_ecef_m
 from abrupt.model.tracking_measurements import as_datetime64_ns, earth_rotation_matrices
+from abrupt.model.tracking_orbit import OMEGA_EARTH_RAD_S
 from abrupt.model.troposphere import laser_delay_m, radio_delay_m, water_vapour_pressure_hpa
 from abrupt.types import FloatArray
 
@@ -61,7 +62,10 @@ class RangeModel:
             return replace(self, troposphere="none")
         if term not in {"light_time", "shapiro", "plate_motion", "eccentricity", "solid_tides"}:
             raise ValueError(f"unknown range-model term {term!r}")
-        return replace(self, **{term: False})
+        flags = {"light_time": self.light_time, "shapiro": self.shapiro, "plate_motion": self.plate_motion}
+        flags |= {"eccentricity": self.eccentricity, "solid_tides": self.solid_tides}
+        flags[term] = False
+        return RangeModel(troposphere=self.troposphere, wavelength_um=self.wavelength_um, **flags)
 
 
 RANGE_MODEL_TERMS = ("light_time", "troposphere", "shapiro", "plate_motion", "eccentricity", "solid_tides")
@@ -102,23 +106,23 @@ class StationSite:
         return x
 
 
-def tide_displacements_m(site_ecef_m: FloatArray, times_utc: np.ndarray, step_s: float = 600.0) -> FloatArray:
-    """Solid-tide displacements (n, 3) at ``times_utc``, evaluated every ``step_s`` and interpolated.
+def tide_displacements_m(site_ecef_m: FloatArray, times_utc: np.ndarray, step_s: float = 1800.0) -> FloatArray:
+    """Solid-tide displacements (n, 3) at ``times_utc``: nodes every ``step_s`` and a cubic spline.
 
-    The tide varies with periods of 12 h and longer, so ten-minute nodes and linear interpolation are good
-    to a few micrometres while keeping the Sun/Moon ephemeris calls few.
+    The tide varies with periods of 12 h and longer, so half-hour nodes and a cubic spline are good to a
+    few micrometres while keeping the Sun/Moon ephemeris evaluations few (one vectorised call).
     """
+    from scipy.interpolate import CubicSpline
+
     t = np.asarray(times_utc, dtype="datetime64[ns]")
     if t.size == 0:
         return np.empty((0, 3))
-    t0 = t.min()
+    t0 = t.min() - np.timedelta64(int(2 * step_s), "s")
     ts = (t - t0).astype(np.int64) / 1e9
-    nodes = np.arange(0.0, float(ts.max()) + step_s, step_s)
-    disp = np.empty((nodes.size, 3))
-    for k, s in enumerate(nodes):
-        sun, moon = sun_moon_ecef_m(t0 + np.timedelta64(int(s * 1e9), "ns"))
-        disp[k] = solid_tide_displacement_m(site_ecef_m, sun, moon)
-    return np.column_stack([np.interp(ts, nodes, disp[:, j]) for j in range(3)])
+    nodes = np.arange(0.0, float(ts.max()) + 3 * step_s, step_s)
+    sun, moon = sun_moon_ecef_m(t0 + (nodes * 1e9).astype("timedelta64[ns]"))
+    disp = solid_tide_displacement_m(site_ecef_m, sun, moon)
+    return np.asarray(CubicSpline(nodes, disp, axis=0)(ts))
 
 
 def standard_meteorology(height_m: float) -> tuple[float, float, float]:
@@ -153,12 +157,18 @@ def model_two_way_ranges(
     """
     t_r = np.asarray(t_receive_s, dtype=float)
     epoch = as_datetime64_ns(epoch_utc)
+    # Earth orientation and the station's ECEF position once, at the receive epochs; within the light time
+    # (≤ 0.1 s) the Earth turns by ω_E·δ about its pole and the station does not otherwise move.
+    c_fi_r = earth_rotation_matrices(t_r, model="iers", epoch_utc=epoch)
+    r_f = site.position_at(epoch + (t_r * 1e9).astype("timedelta64[ns]"), model)
 
     def station(ts: FloatArray) -> FloatArray:
-        times = epoch + (np.asarray(ts) * 1e9).astype("timedelta64[ns]")
-        ecef = site.position_at(times, model)
-        c_fi = earth_rotation_matrices(np.asarray(ts, dtype=float), model="iers", epoch_utc=epoch)
-        return np.einsum("nji,nj->ni", c_fi, ecef)
+        angle = OMEGA_EARTH_RAD_S * (np.asarray(ts, dtype=float) - t_r)
+        c, s = np.cos(angle), np.sin(angle)
+        # r_I = C_FI(t)ᵀ r_F with C_FI(t) = R3(ω δ) C_FI(t_r): first R3(ω δ)ᵀ r_F, then C_FI(t_r)ᵀ.
+        x = c * r_f[:, 0] - s * r_f[:, 1]
+        y = s * r_f[:, 0] + c * r_f[:, 1]
+        return np.einsum("nji,nj->ni", c_fi_r, np.column_stack([x, y, r_f[:, 2]]))
 
     r_sta_r = station(t_r)
     if model.light_time:
@@ -186,8 +196,7 @@ def model_two_way_ranges(
     if model.troposphere != "none":
         lat, _, h = site.geodetic
         up_vec = np.array([np.cos(lat) * np.cos(site.geodetic[1]), np.cos(lat) * np.sin(site.geodetic[1]), np.sin(lat)])
-        c_fi = earth_rotation_matrices(t_b, model="iers", epoch_utc=epoch)
-        los = np.einsum("nij,nj->ni", c_fi, r_b - r_sta_r)
+        los = np.einsum("nij,nj->ni", c_fi_r, r_b - r_sta_r)
         elev = np.arcsin(np.clip(los @ up_vec / np.linalg.norm(los, axis=1), -1.0, 1.0))
         p_std, t_std, rh_std = standard_meteorology(h)
         p = np.full(t_r.size, p_std) if pressure_hpa is None else np.asarray(pressure_hpa, dtype=float)
@@ -209,6 +218,7 @@ def reduce_ranges(
     model: RangeModel,
     *,
     epoch_utc: np.datetime64,
+    nominal_ecef_m: dict[str, FloatArray] | None = None,
     repairs: RepairLog | None = None,
 ) -> pd.DataFrame:
     """Measurements with ``range_m`` reduced to instantaneous geometric ranges at the bounce epoch.
@@ -251,7 +261,8 @@ def reduce_ranges(
             temperature_k=meteo["temperature_k"],
             humidity=meteo["humidity"],
         )
-        nominal = StationSite(site.name, site.position_ecef_m, site.reference_epoch)
+        marker = site.position_ecef_m if nominal_ecef_m is None else tuple(np.asarray(nominal_ecef_m[str(name)], float))
+        nominal = StationSite(site.name, marker, site.reference_epoch)
         geometric, _ = model_two_way_ranges(t_b, epoch, satellite_position, nominal, GEOMETRIC)
         correction = rng - geometric
         out.loc[idx, "range_m"] = rows["range_m"].to_numpy(dtype=float) - correction

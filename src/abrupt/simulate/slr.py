@@ -133,7 +133,8 @@ def simulate_slr(scenario: SlrScenario, *, seed: int = 0, grid_step_s: float = 2
     sat = trajectory_interpolator(grid, states)
 
     sites = {
-        name: site_from_geodetic(name, lat, lon, h, vel, ecc, sinex_epoch) for name, lat, lon, h, vel, ecc in DEFAULT_SITES
+        name: site_from_geodetic(name, lat, lon, h, vel, ecc, sinex_epoch)
+        for name, lat, lon, h, vel, ecc in DEFAULT_SITES
     }
     rows = []
     bias = {name: float(rng.normal(0.0, scenario.bias_sigma_m)) for name in sites}
