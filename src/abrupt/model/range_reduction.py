@@ -224,7 +224,8 @@ def reduce_ranges(
     """Measurements with ``range_m`` reduced to instantaneous geometric ranges at the bounce epoch.
 
     ``measurements`` has ``time_utc`` (receive epoch), ``station`` and ``range_m``; optional
-    ``pressure_hpa``, ``temperature_k``, ``humidity`` (fraction) columns from the meteorological records.
+    ``pressure_hpa``, ``temperature_k``, ``humidity`` (fraction) columns from the meteorological records,
+    and ``troposphere_applied`` (rows already corrected by the station get no tropospheric delay).
     Rows of a station without meteorology use the standard atmosphere, counted in ``repairs``. The
     returned table is time-tagged at the bounce epoch and keeps the original receive time in
     ``time_receive_utc`` and the applied correction in ``range_correction_m``.
@@ -233,8 +234,11 @@ def reduce_ranges(
     out["time_receive_utc"] = out["time_utc"]
     out["range_correction_m"] = 0.0
     epoch = as_datetime64_ns(epoch_utc)
-    for name, rows in out.groupby("station", sort=True):
+    if "troposphere_applied" not in out:
+        out["troposphere_applied"] = False
+    for (name, applied), rows in out.groupby(["station", "troposphere_applied"], sort=True):
         site = sites[str(name)]
+        row_model = replace(model, troposphere="none") if bool(applied) else model
         idx = rows.index
         times = np.asarray(rows["time_utc"], dtype="datetime64[ns]")
         t_r = (times - epoch).astype(np.int64) / 1e9
@@ -243,7 +247,7 @@ def reduce_ranges(
             values = rows[col].to_numpy(dtype=float) if col in rows else np.full(len(rows), np.nan)
             meteo[col] = values
         missing = ~np.isfinite(np.asarray(meteo["pressure_hpa"]))
-        if model.troposphere != "none" and missing.any():
+        if row_model.troposphere != "none" and missing.any():
             p_std, t_std, rh_std = standard_meteorology(site.geodetic[2])
             for col, std in (("pressure_hpa", p_std), ("temperature_k", t_std), ("humidity", rh_std)):
                 arr = np.asarray(meteo[col]).copy()
@@ -256,7 +260,7 @@ def reduce_ranges(
             epoch,
             satellite_position,
             site,
-            model,
+            row_model,
             pressure_hpa=meteo["pressure_hpa"],
             temperature_k=meteo["temperature_k"],
             humidity=meteo["humidity"],

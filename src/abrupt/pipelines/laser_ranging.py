@@ -148,3 +148,54 @@ def _station_rms_m(data: TrackingArrays, fit: BatchFit) -> dict[str, float]:
     names = np.asarray(data.station_names)[fit.row_index]
     resid_m = fit.residuals_white * data.sigma[fit.row_index, fit.row_component]
     return {str(n): float(np.sqrt(np.mean(resid_m[(names == n) & fit.used] ** 2))) for n in sorted(set(names))}
+
+
+# ---------------------------------------------------------------------------------------------- real files
+CRD_RECEIVE_OFFSET = {0: 0.0, 1: 0.5, 2: 1.0}  # epoch event → fraction of the time of flight to the receive time
+
+
+def ranges_from_crd(table: pd.DataFrame, *, repairs: RepairLog | None = None) -> pd.DataFrame:
+    """The CRD table of :func:`abrupt.readers.crd.read_crd` in the convention of :func:`reduce_ranges`.
+
+    CRD epochs are the ground receive (event 0), bounce (1) or ground transmit (2) time (ILRS CRD v2.01
+    §2.2, record 10/11 field "epoch event"); the reduction wants the receive time, so the epoch is moved
+    by 0, ½ or 1 time of flight. Humidity goes from percent to a fraction. One-way ranges and other epoch
+    events are skipped and counted; ranges already corrected for the troposphere keep the flag in
+    ``troposphere_applied`` (the reduction then adds no tropospheric delay for them).
+    """
+    events = table["epoch_event"].to_numpy(dtype=int) if "epoch_event" in table else np.zeros(len(table), int)
+    ok = np.isin(events, list(CRD_RECEIVE_OFFSET))
+    if repairs is not None:
+        repairs.record("ranges with an epoch event other than two-way receive/bounce/transmit skipped", int((~ok).sum()))
+    out = table.loc[ok].copy()
+    tof = out["time_of_flight_s"].to_numpy(dtype=float)
+    shift = np.array([CRD_RECEIVE_OFFSET[int(e)] for e in events[ok]]) * tof
+    out["time_utc"] = np.asarray(out["time_utc"], dtype="datetime64[ns]") + (shift * 1e9).astype("timedelta64[ns]")
+    if "humidity_pct" in out:
+        out["humidity"] = out["humidity_pct"].to_numpy(dtype=float) / 100.0
+    return out.sort_values("time_utc", kind="stable").reset_index(drop=True)
+
+
+def sites_from_sinex(stations_sinex: dict, codes: list[str], epoch_utc: np.datetime64) -> dict[str, StationSite]:  # type: ignore[type-arg]
+    """Precise sites for the station codes of a CRD file from a SINEX solution (position, velocity, eccentricity)."""
+    from abrupt.errors import InputError
+
+    out = {}
+    for code in codes:
+        if code not in stations_sinex:
+            known = ", ".join(sorted(stations_sinex)[:20])
+            raise InputError(f"station {code!r} is not in the SINEX file (sites: {known}...)", column="station")
+        st = stations_sinex[code]
+        sol = st.solution_at(epoch_utc)
+        frame, ecc = st.eccentricity_at(epoch_utc)
+        if frame != "UNE":
+            raise InputError(f"station {code!r}: eccentricity frame {frame!r} is not supported (need UNE)")
+        vel_m_per_yr = np.nan_to_num(np.asarray(sol.velocity_mps, float)) * 365.25 * 86400.0
+        out[code] = StationSite(
+            code,
+            tuple(float(v) for v in sol.position_m),  # type: ignore[arg-type]
+            sol.epoch_utc,
+            tuple(float(v) for v in vel_m_per_yr),  # type: ignore[arg-type]
+            tuple(float(v) for v in ecc),  # type: ignore[arg-type]
+        )
+    return out
