@@ -88,8 +88,6 @@ def read_tracking_series(
     ``settings`` says); for real-data set-ups (central/third-body keys present) a constant unmodelled
     acceleration and angle biases are estimated too.
     """
-    from astropy.time import Time
-
     from abrupt.model.timescales import offline_astropy
     from abrupt.model.tracking_measurements import TrackingArrays, correct_refraction
     from abrupt.readers.aer import read_aer
@@ -115,10 +113,7 @@ def read_tracking_series(
         source=str(file),
     )
     real = any(k.startswith("central.body") or k.startswith("third.body") for k in setup.extra)
-    degree = int(float(setup.extra.get("central.body.degree", "0") or 0))
-    third = any(setup.extra.get(k, "false").lower() == "true" for k in ("third.body.sun", "third.body.moon"))
-    jd_tt = float(Time(setup.epoch_utc, scale="utc").tt.jd)
-    force = ForceModel(mu_m3_s2=setup.mu_m3_s2, j2=degree >= 2, third_body=third, epoch_jd_tt=jd_tt)
+    force, jd_tt = setup_force_model(setup)
     biases = any(setup.range_bias_estimated.values()) if settings.estimate_biases is None else settings.estimate_biases
     accel = real if settings.estimate_acceleration is None else settings.estimate_acceleration
     probe = TrackingSeries(data, np.asarray(setup.initial_state, float), BatchFitConfig(force=force))
@@ -133,6 +128,20 @@ def read_tracking_series(
     )
     series = TrackingSeries(data, np.asarray(setup.initial_state, float), fit_cfg, name=name or Path(file).stem)
     return TrackingInputs(series, force, use_refraction, biases, accel, repairs, jd_tt)
+
+
+def setup_force_model(setup: Any) -> tuple[ForceModel, float]:
+    """The fit's force model from an Orekit set-up file, and the epoch as a TT Julian date.
+
+    Two-body with the set-up's μ; J2 when ``central.body.degree`` is at least 2; Sun and Moon when
+    ``third.body.sun`` or ``third.body.moon`` is true.
+    """
+    from astropy.time import Time
+
+    degree = int(float(setup.extra.get("central.body.degree", "0") or 0))
+    third = any(setup.extra.get(k, "false").lower() == "true" for k in ("third.body.sun", "third.body.moon"))
+    jd_tt = float(Time(setup.epoch_utc, scale="utc").tt.jd)
+    return ForceModel(mu_m3_s2=setup.mu_m3_s2, j2=degree >= 2, third_body=third, epoch_jd_tt=jd_tt), jd_tt
 
 
 def detect_tracking(
