@@ -5,4 +5,6 @@ plug-in, a test) registers as soon as its class is defined.
 """
 
 import abrupt.detect.attitude
-import abrupt.detect.matched_filter.detectors  # noqa: F401  attitude.mf_attitude, attitude.mf_rate, attitude.mf_joint
+import abrupt.detect.kaderali
+import abrupt.detect.matched_filter.detectors
+import abrupt.detect.tracking_glrt  # noqa: F401  tracking.glrt
