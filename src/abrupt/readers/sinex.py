@@ -84,7 +84,7 @@ class SinexStation:
 
     def position_at(self, t_utc: np.datetime64 | str) -> NDArray[np.float64]:
         """ITRF position (m) at ``t_utc``: r₀ + v·(t − t₀) (velocity 0 when the file gives none)."""
-        t = np.datetime64(t_utc, "ns")
+        t: np.datetime64 = np.asarray(t_utc, dtype="datetime64[ns]")[()]
         s = self.solution_at(t)
         dt_s = float((t - s.epoch_utc).astype(np.int64)) * 1e-9
         v = np.nan_to_num(s.velocity_mps)
@@ -93,7 +93,7 @@ class SinexStation:
 
     def eccentricity_at(self, t_utc: np.datetime64 | str) -> tuple[str, NDArray[np.float64]]:
         """(frame, offset m) of the eccentricity valid at ``t_utc``; ("UNE", 0) when none is given."""
-        t = np.datetime64(t_utc, "ns")
+        t: np.datetime64 = np.asarray(t_utc, dtype="datetime64[ns]")[()]
         for start, end, frame, offset in self.eccentricities:
             if (start is None or start <= t) and (end is None or t <= end):
                 return frame, offset
@@ -170,8 +170,8 @@ def read_sinex(path: str | Path) -> dict[str, SinexStation]:
             continue
         missing = [k for k in ("STAX", "STAY", "STAZ") if k not in est]
         if missing:
-            line = next(iter(est.values()))[3]
-            raise InputError(f"station {code} solution {soln} lacks {', '.join(missing)}", file=file, line=line)
+            first_line = next(iter(est.values()))[3]
+            raise InputError(f"station {code} solution {soln} lacks {', '.join(missing)}", file=file, line=first_line)
         pos = np.array([est[k][0] for k in ("STAX", "STAY", "STAZ")])
         sig = np.array([est[k][1] for k in ("STAX", "STAY", "STAZ")])
         vel = np.array(
