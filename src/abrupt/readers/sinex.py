@@ -48,6 +48,11 @@ def parse_sinex_epoch(text: str) -> np.datetime64 | None:
     return np.datetime64(f"{year:04d}-01-01", "ns") + np.timedelta64(doy - 1, "D") + np.timedelta64(sod, "s")
 
 
+def _as_datetime(t: np.datetime64 | str) -> np.datetime64:
+    out: np.datetime64 = np.datetime64(t, "ns") if isinstance(t, str) else t.astype("datetime64[ns]")
+    return out
+
+
 @dataclass
 class SinexSolution:
     """One solution (site, point, solution number): position at ``epoch_utc`` and velocity."""
@@ -84,7 +89,7 @@ class SinexStation:
 
     def position_at(self, t_utc: np.datetime64 | str) -> NDArray[np.float64]:
         """ITRF position (m) at ``t_utc``: r₀ + v·(t − t₀) (velocity 0 when the file gives none)."""
-        t: np.datetime64 = np.asarray(t_utc, dtype="datetime64[ns]")[()]
+        t = _as_datetime(t_utc)
         s = self.solution_at(t)
         dt_s = float((t - s.epoch_utc).astype(np.int64)) * 1e-9
         v = np.nan_to_num(s.velocity_mps)
@@ -93,7 +98,7 @@ class SinexStation:
 
     def eccentricity_at(self, t_utc: np.datetime64 | str) -> tuple[str, NDArray[np.float64]]:
         """(frame, offset m) of the eccentricity valid at ``t_utc``; ("UNE", 0) when none is given."""
-        t: np.datetime64 = np.asarray(t_utc, dtype="datetime64[ns]")[()]
+        t = _as_datetime(t_utc)
         for start, end, frame, offset in self.eccentricities:
             if (start is None or start <= t) and (end is None or t <= end):
                 return frame, offset
