@@ -194,3 +194,18 @@ def test_sinex_malformed_input(tmp_path: Path) -> None:
     path.write_text(text.replace("     9 STAZ   7839", "     9 VELZ   7839"))
     with pytest.raises(InputError, match=r"station 7839 solution 1 lacks STAZ"):
         read_sinex(path)
+
+
+def test_tracking_files_are_recognised_by_content(shared_data: Path, tmp_path: Path) -> None:
+    import gzip
+
+    from abrupt.readers.tracking import read_tracking, sniff_tracking_format
+
+    assert sniff_tracking_format(shared_data / "tracking/W3B.aer") == "aer"
+    crd = tmp_path / "pass.frd.gz"
+    crd.write_bytes(gzip.compress((shared_data / CORPUS / "lageos1-test.npt").read_bytes()))
+    assert sniff_tracking_format(crd) == "crd"
+    table = read_tracking(crd, known_stations=["KTZL", "GRZL"])
+    assert set(table["station"]) == {"KTZL", "GRZL"} and table["range_m"].between(5e6, 1e7).all()
+    with pytest.raises(InputError, match="unknown station 'GRZL'"):
+        read_tracking(crd, known_stations=["KTZL"])

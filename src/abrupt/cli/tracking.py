@@ -269,9 +269,8 @@ def detect_tracking_command(
     from abrupt.model.timescales import offline_astropy
     from abrupt.model.tracking_measurements import TrackingArrays, correct_refraction
     from abrupt.model.tracking_orbit import ForceModel, sun_position_m
-    from abrupt.readers.aer import read_aer
     from abrupt.readers.orekit_od_input import read_od_input
-    from abrupt.readers.tdm import read_tdm
+    from abrupt.readers.tracking import read_tracking
     from abrupt.thresholds import p_fa_per_sample
 
     if false_alarms_per_day <= 0:
@@ -279,10 +278,7 @@ def detect_tracking_command(
     offline_astropy()
     setup = read_od_input(setup_path)
     repairs = RepairLog(file)
-    if Path(file).suffix.lower() in (".tdm", ".kvn", ".txt") and _looks_like_tdm(file):
-        meas = read_tdm(file, repairs=repairs)
-    else:
-        meas = read_aer(file, known_stations=setup.stations, repairs=repairs)
+    meas = read_tracking(file, known_stations=setup.stations, repairs=repairs)  # CRD, TDM or .aer by content
     use_refraction = setup.refraction_correction if refraction is None else refraction
     if use_refraction:
         meas = correct_refraction(meas)
@@ -433,12 +429,6 @@ def detect_tracking_command(
         out=out,
         details={"settings": settings, "fit": summary},
     )
-
-
-def _looks_like_tdm(path: str) -> bool:
-    with open(path, errors="replace") as fh:
-        head = fh.read(2000)
-    return "CCSDS_TDM_VERS" in head
 
 
 def _period_s(state: Any, mu: float) -> float:
