@@ -93,8 +93,8 @@ def _num(tokens: list[str], i: int, what: str) -> float:
         v = float(tokens[i])
     except ValueError:
         raise _Bad(f"{what}: cannot read number {tokens[i]!r}", i + 1) from None
-    if not math.isfinite(v):
-        raise _Bad(f"{what}: {tokens[i]!r} is not finite", i + 1)
+    if not (math.isfinite(v) and abs(v) < 1e12):
+        raise _Bad(f"{what}: {tokens[i]!r} is not finite or absurdly large", i + 1)
     return v
 
 

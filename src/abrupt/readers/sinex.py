@@ -151,8 +151,8 @@ def read_sinex(path: str | Path) -> dict[str, SinexStation]:
                         raise ValueError("estimate without a reference epoch")
                     value = float(tok[8])
                     sigma = float(tok[9]) if len(tok) > 9 else math.nan
-                    if not math.isfinite(value):
-                        raise ValueError(f"value {tok[8]!r} is not finite")
+                    if not (math.isfinite(value) and abs(value) < 1e12):
+                        raise ValueError(f"value {tok[8]!r} is not finite or absurdly large")
                     estimates.setdefault((code, point, soln), {})[kind] = (value, sigma, t0, no)
             elif block == "SOLUTION/EPOCHS":
                 if len(tok) >= 6:
@@ -164,6 +164,8 @@ def read_sinex(path: str | Path) -> dict[str, SinexStation]:
                 if frame not in ("UNE", "XYZ"):
                     raise ValueError(f"eccentricity reference {tok[6]!r} is not UNE or XYZ")
                 offset = np.array([float(v) for v in tok[7:10]])
+                if not np.all(np.abs(offset) < 1e3):
+                    raise ValueError(f"eccentricity {tok[7:10]} is not a few metres")
                 st = stations.setdefault(tok[0], SinexStation(tok[0]))
                 st.eccentricities.append((parse_sinex_epoch(tok[4]), parse_sinex_epoch(tok[5]), frame, offset))
         except ValueError as exc:
