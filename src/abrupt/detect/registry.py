@@ -5,3 +5,4 @@ plug-in, a test) registers as soon as its class is defined.
 """
 
 # Built-in detector modules are imported below as they adopt abrupt.detect.base.Detector.
+import abrupt.detect.tle_detectors  # noqa: F401  (tle.mean_elements, tle.geo_station_keeping)
