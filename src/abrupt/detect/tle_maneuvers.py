@@ -204,11 +204,21 @@ def mean_element_series(history: ElementHistory, regime: str = "leo") -> dict[st
     }
 
 
-def _robust_scale_rolling(y: NDArray[np.float64], half: int) -> NDArray[np.float64]:
-    """Per-sample noise of a series: rolling 1.4826·MAD of first differences / √2 (Hampel 1974)."""
+def _robust_scale_rolling(
+    y: NDArray[np.float64], half: int, t: NDArray[np.float64] | None = None
+) -> NDArray[np.float64]:
+    """Per-gap noise of a series: rolling 1.4826·MAD of first differences / √2 (Hampel 1974).
+
+    With the epochs ``t`` the differences are first detrended by the rolling median rate × gap, so
+    a secular drift (drag decay, an unmodelled nodal rate) seen over uneven gaps is not noise.
+    """
     d = np.diff(y)
     if d.size == 0:
         return np.full_like(y, np.nan)
+    if t is not None:
+        dt = np.diff(t)
+        rate = pd.Series(d / np.maximum(dt, 60.0)).rolling(2 * half + 1, center=True, min_periods=5).median()
+        d = d - np.nan_to_num(rate.to_numpy()) * dt
     s = pd.Series(d)
     med = s.rolling(2 * half + 1, center=True, min_periods=5).median()
     mad = (s - med).abs().rolling(2 * half + 1, center=True, min_periods=5).median()
@@ -306,7 +316,7 @@ class _StepModel:
         self.s = mean_element_series(history, self.regime)
         self.t = self.s["t_s"]
         self.n = self.t.size
-        self.scales = {k: _robust_scale_rolling(self.s[k], cfg.noise_half_window) for k in self.NAMES}
+        self.scales = {k: _robust_scale_rolling(self.s[k], cfg.noise_half_window, self.t) for k in self.NAMES}
         self.drift_q = {k: drift_noise_rate(self.t, self.s[k], cfg.noise_half_window) for k in self.NAMES}
 
     def gap(self, g: int, lo_bound: int = 0, hi_bound: int | None = None) -> tuple[dict[str, float], float]:
