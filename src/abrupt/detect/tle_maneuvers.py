@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -272,37 +273,38 @@ def _theil_sen(t: NDArray[np.float64], y: NDArray[np.float64]) -> float:
     return float(np.median((y[j] - y[i])[ok] / dt[ok]))
 
 
-def _pooled_slope(t: NDArray[np.float64], y: NDArray[np.float64], sides: tuple[slice, slice]) -> float:
-    """Median of the pairwise slopes within each side (a Theil-Sen slope shared by both sides, Sen 1968).
-
-    Pairs never straddle the gap, so a step does not bias the slope.
-    """
-    slopes = []
-    for side in sides:
-        ts, ys = t[side], y[side]
-        if ts.size < 2:
-            continue
-        i, j = np.triu_indices(ts.size, 1)
-        dt = ts[j] - ts[i]
-        ok = dt > 60.0
-        slopes.append((ys[j] - ys[i])[ok] / dt[ok])
-    allslopes = np.concatenate(slopes) if slopes else np.zeros(0)
-    return float(np.median(allslopes)) if allslopes.size else 0.0
+@lru_cache(maxsize=64)
+def _pair_indices(m: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    i, j = np.triu_indices(m, 1)
+    return i, j
 
 
-def _step(
+def _steps_all(
     t: NDArray[np.float64],
-    y: NDArray[np.float64],
+    ys: NDArray[np.float64],
     pre: slice,
     post: slice,
     t0: float,
     slope_sides: tuple[slice, slice],
-) -> float:
-    """Difference of the post and pre medians of ``y − slope·(t − t0)`` (robust level step at ``t0``)."""
-    slope = _pooled_slope(t, y, slope_sides)
-    lp = float(np.median(y[pre] - slope * (t[pre] - t0)))
-    lq = float(np.median(y[post] - slope * (t[post] - t0)))
-    return lq - lp
+) -> NDArray[np.float64]:
+    """Robust level step at ``t0`` of every row of ``ys`` (series × sets): post minus pre median of
+    ``y − slope·(t − t0)``, the slope a Theil-Sen median of pairwise slopes within each side (Sen
+    1968) so pairs never straddle the gap and a step does not bias it."""
+    slopes = []
+    for side in slope_sides:
+        ts = t[side]
+        if ts.size < 2:
+            continue
+        i, j = _pair_indices(ts.size)
+        dt = ts[j] - ts[i]
+        ok = dt > 60.0
+        block = ys[:, side]
+        slopes.append((block[:, j[ok]] - block[:, i[ok]]) / dt[ok])
+    allslopes = np.concatenate(slopes, axis=1) if slopes else np.zeros((ys.shape[0], 0))
+    slope = np.median(allslopes, axis=1) if allslopes.shape[1] else np.zeros(ys.shape[0])
+    lp = np.median(ys[:, pre] - slope[:, None] * (t[pre] - t0), axis=1)
+    lq = np.median(ys[:, post] - slope[:, None] * (t[post] - t0), axis=1)
+    return np.asarray(lq - lp, dtype=float)
 
 
 class _StepModel:
@@ -314,6 +316,7 @@ class _StepModel:
         self.cfg = cfg
         self.regime = orbit_regime(history) if cfg.regime == "auto" else cfg.regime
         self.s = mean_element_series(history, self.regime)
+        self.stack = np.stack([self.s[k] for k in self.NAMES])  # (series, sets)
         self.t = self.s["t_s"]
         self.n = self.t.size
         self.scales = {k: _robust_scale_rolling(self.s[k], cfg.noise_half_window, self.t) for k in self.NAMES}
@@ -347,7 +350,8 @@ class _StepModel:
             shi -= 1
         sides = (slice(slo, g + 1), slice(g + 1, shi))
         t0 = 0.5 * (t[g] + t[g + 1])
-        steps = {k: _step(t, self.s[k], pre, post, t0, sides) for k in self.NAMES}
+        values = _steps_all(t, self.stack, pre, post, t0, sides)
+        steps = {k: float(v) for k, v in zip(self.NAMES, values, strict=True)}
         return steps, math.sqrt(math.pi / 2.0) * math.sqrt(1.0 / n1 + 1.0 / n2)
 
     def localise(self, g: int, lo_bound: int, hi_bound: int, weights: tuple[float, float, float]) -> int:
@@ -648,16 +652,13 @@ def refine_burn_time(
     t_lo = t[max(lo, gap - search_sets_before)]
     t_hi = t[gap + 1]
     grid = np.linspace(t_lo, t_hi, 97)
-    best = (np.inf, mid)
-    for tm in grid:
-        hinge = np.maximum(0.0, (t[idx] - tm) / SECONDS_PER_DAY)
-        A = np.column_stack([np.ones_like(tau), tau, tau**2, hinge])
-        coef, *_ = np.linalg.lstsq(A, du, rcond=None)
-        r = du - A @ coef
-        cost = float(np.sum(np.abs(r)))  # L1: one poor set does not move the time
-        if cost < best[0]:
-            best = (cost, float(tm))
-    return best[1], True
+    hinge = np.maximum(0.0, (t[idx][None, :] - grid[:, None]) / SECONDS_PER_DAY)  # (grid, sets)
+    base = np.broadcast_to(np.column_stack([np.ones_like(tau), tau, tau**2]), (grid.size, tau.size, 3))
+    A = np.concatenate([base, hinge[:, :, None]], axis=2)  # (grid, sets, 4)
+    coef = np.linalg.pinv(A) @ du  # least squares for every candidate time at once
+    r = du[None, :] - np.einsum("gsk,gk->gs", A, coef)
+    cost = np.sum(np.abs(r), axis=1)  # L1: one poor set does not move the time
+    return float(grid[int(np.argmin(cost))]), True
 
 
 def characterise(
