@@ -5,9 +5,11 @@ Every shared history (``../shared/data/tle``) is scored against its operator fil
 China Standard Time; both converted to UTC, truth time = first burn / window start) by the same
 scorer (:mod:`abrupt.score`): ±1 day one-to-one matching, truth limited to the history's span.
 
-**Leave-one-satellite-out.** abrupt has one setting tuned on data: the gain of the eccentricity and
-orbit-normal groups relative to the semi-major axis in the combined statistic (``group_gain``), from
-the grid :data:`GAINS`. For each satellite the gain is chosen by the pooled F1 of the *other*
+**Leave-one-satellite-out.** abrupt has two settings tuned on data: the gain of the eccentricity and
+orbit-normal groups relative to the semi-major axis in the combined statistic (``group_gain``, grid
+:data:`GAINS`) and whether a side of two sets is enough next to an accepted maneuver (campaigns of
+burns days apart, ``campaign_min_side_sets``, :data:`CAMPAIGN_SIDES`). For each satellite the pair is
+chosen by the pooled F1 of the *other*
 satellites of its class (LEO: Jason-3, Sentinel-3A, CryoSat-2; GEO: Fengyun-2D, 2E — the class picks
 the detector, ``tle.mean_elements`` or ``tle.geo_station_keeping``) and the satellite is scored with
 it. Everything else (noise model, weights, tails, threshold) is learned by the detector from each
@@ -64,7 +66,9 @@ SATELLITES: dict[str, tuple[str, str]] = {
     "Fengyun-2D": ("manFY2D.txt.fy", "GEO"),
     "Fengyun-2E": ("manFY2E.txt.fy", "GEO"),
 }
-GAINS = (0.2, 0.3, 0.5, 1.0)  # gain of the e-vector and orbit-normal groups (the a group has gain 1)
+GAINS = (0.2, 0.5, 1.0)  # gain of the e-vector and orbit-normal groups (the a group has gain 1)
+CAMPAIGN_SIDES = (3, 2)  # sets a side needs near an accepted maneuver (3 = as elsewhere: no campaign split)
+GRID = tuple((g, c) for g in GAINS for c in CAMPAIGN_SIDES)
 BUDGET = FalseAlarmBudget(1.0, "year")
 TOLERANCE_S = 86400.0
 BIG_BURN_MPS = 0.05
@@ -92,15 +96,17 @@ print(json.dumps({"version": maneuver_detect.__version__, "rows": rows}))
 
 
 # ---------------------------------------------------------------------------------------------- abrupt
-def detect_one(args: tuple[str, float]) -> tuple[str, float, pd.DataFrame, dict[str, Any], float]:
-    """Run the regime's detector on one satellite with one gain (all candidates kept)."""
-    sat, gain = args
+def detect_one(
+    args: tuple[str, tuple[float, int]],
+) -> tuple[str, tuple[float, int], pd.DataFrame, dict[str, Any], float]:
+    """Run the regime's detector on one satellite with one setting (all candidates kept)."""
+    sat, (gain, sides) = args
     history = read_tle(DATA / "tle" / f"{sat}.tle")
     cls = TleGeoStationKeeping if SATELLITES[sat][1] == "GEO" else TleMeanElements
-    det = cls(group_gain=(1.0, gain, gain), all_candidates=True, spacecraft=sat)
+    det = cls(group_gain=(1.0, gain, gain), campaign_min_side_sets=sides, all_candidates=True, spacecraft=sat)
     t0 = time.perf_counter()
     run = det.run(history, BUDGET)
-    return sat, gain, run.events, run.noise_model, time.perf_counter() - t0
+    return sat, (gain, sides), run.events, run.noise_model, time.perf_counter() - t0
 
 
 def span(sat: str) -> tuple[pd.Timestamp, pd.Timestamp]:
@@ -252,7 +258,7 @@ def main() -> None:
     sats = list(SATELLITES)
     truth = {s: read_maneuver_file(DATA / "maneuvers" / SATELLITES[s][0]) for s in sats}
     spans = {s: span(s) for s in sats}
-    jobs = [(s, g) for s in sats for g in GAINS]
+    jobs = [(s, g) for s in sorted(sats, key=lambda x: -(DATA / "tle" / f"{x}.tle").stat().st_size) for g in GRID]
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
         results = list(pool.map(detect_one, jobs))
     runs = {(s, g): (ev, nm, sec) for s, g, ev, nm, sec in results}
@@ -262,7 +268,7 @@ def main() -> None:
     for sat in sats:
         cls = SATELLITES[sat][1]
         train = [o for o in sats if o != sat and SATELLITES[o][1] == cls]
-        best = max(GAINS, key=lambda g: (pooled([scores[(o, g)] for o in train])["f1"], -abs(g - 0.5)))
+        best = max(GRID, key=lambda g: (pooled([scores[(o, g)] for o in train])["f1"], -abs(g[0] - 0.5), g[1]))
         ev, nm, sec = runs[(sat, best)]
         rows.append(
             {
@@ -319,7 +325,10 @@ def main() -> None:
         print("\nGain chosen for each held-out satellite, tuned on:")
         for r in rows:
             if str(r["detector"]).startswith("abrupt"):
-                print(f"  {r['satellite']}: gain {r['gain']} (tuned on {r['tuned_on']})")
+                print(
+                    f"  {r['satellite']}: gain {r['gain'][0]}, campaign side {r['gain'][1]} sets "
+                    f"(tuned on {r['tuned_on']})"
+                )
         print("\nPooled per class")
         pooled_rows = []
         for cls in ("LEO", "GEO"):

@@ -92,6 +92,7 @@ class TleDetectorConfig:
     min_side_sets: int = 3
     regime: str = "auto"
     campaign_days: float = 3.0
+    campaign_min_side_sets: int = 3
     time_search_sets_before: int = 3
     group_gain: tuple[float, float, float] = (1.0, 0.3, 0.3)
 
@@ -317,6 +318,7 @@ class _StepModel:
         self.regime = orbit_regime(history) if cfg.regime == "auto" else cfg.regime
         self.s = mean_element_series(history, self.regime)
         self.stack = np.stack([self.s[k] for k in self.NAMES])  # (series, sets)
+        self.min_side = cfg.min_side_sets
         self.t = self.s["t_s"]
         self.n = self.t.size
         self.scales = {k: _robust_scale_rolling(self.s[k], cfg.noise_half_window, self.t) for k in self.NAMES}
@@ -338,7 +340,7 @@ class _StepModel:
         while hi - 1 > g + 1 and t[hi - 1] - t[g + 1] > max_win_s:
             hi -= 1
         n1, n2 = g + 1 - lo, hi - g - 1
-        if n1 < self.cfg.min_side_sets or n2 < self.cfg.min_side_sets:
+        if n1 < self.min_side or n2 < self.min_side:
             return {k: 0.0 for k in self.NAMES}, math.inf
         pre, post = slice(lo, g + 1), slice(g + 1, hi)
         # the slope (drag decay, J2/J3 and luni-solar drifts) from twice as many sets each side
@@ -508,6 +510,28 @@ def segment(
         for k in range(max(0, g - reach), min(n_gaps, g + reach + 1)):
             if not blocked[k]:
                 _fill(cur, model, k, cps)
+    if cfg.campaign_min_side_sets < cfg.min_side_sets and accepted:
+        # Campaigns: near an accepted maneuver, a further burn may be only one or two sets away.
+        # Between accepted change points a side of fewer sets is allowed, at the same threshold.
+        model.min_side = cfg.campaign_min_side_sets
+        near = np.zeros(n_gaps, dtype=bool)
+        for a in accepted:
+            near[max(0, a - reach) : a + reach + 1] = True
+        cps = sorted(accepted)
+        for k in np.flatnonzero(near & ~blocked):
+            _fill(cur, model, int(k), cps)
+        while True:
+            stat = np.where(blocked | ~near, -np.inf, cur.statistic)
+            g = int(np.argmax(stat))
+            if not np.isfinite(stat[g]) or stat[g] < max(cut_level, cfg.min_statistic):
+                break
+            accepted.append(g)
+            blocked[max(0, g - cfg.peak_half_width + 1) : g + cfg.peak_half_width] = True
+            cps = sorted(accepted)
+            for k in range(max(0, g - reach), min(n_gaps, g + reach + 1)):
+                if not blocked[k] and near[k]:
+                    _fill(cur, model, k, cps)
+        model.min_side = cfg.min_side_sets
     rest = np.where(blocked, -np.inf, cur.statistic)
     for g in local_peaks(rest, cfg.peak_half_width, cfg.min_statistic):
         if not blocked[max(0, g - cfg.peak_half_width) : g + cfg.peak_half_width + 1].any():
