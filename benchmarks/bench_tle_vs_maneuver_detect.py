@@ -67,7 +67,7 @@ SATELLITES: dict[str, tuple[str, str]] = {
     "Fengyun-2E": ("manFY2E.txt.fy", "GEO"),
 }
 GAINS = (0.2, 0.5, 1.0)  # gain of the e-vector and orbit-normal groups (the a group has gain 1)
-CAMPAIGN_SIDES = (3, 2)  # sets a side needs near an accepted maneuver (3 = as elsewhere: no campaign split)
+CAMPAIGN_SIDES = (3,)  # sets a side needs near an accepted maneuver (2 was tried: LOSO results identical)
 GRID = tuple((g, c) for g in GAINS for c in CAMPAIGN_SIDES)
 BUDGET = FalseAlarmBudget(1.0, "year")
 TOLERANCE_S = 86400.0
@@ -128,6 +128,14 @@ def evaluate(events: pd.DataFrame, truth: pd.DataFrame, start: Any, end: Any, si
     found = {j for _, j, _ in r_op.pairs}
     n_big = int(big.sum())
     big_found = sum(1 for j in np.flatnonzero(big.to_numpy()) if j in found)
+    # resolvable: no other operator maneuver between the element sets that bracket this one
+    epochs = np.asarray(elset_epochs(events, start, end))
+    tt = truth["time_utc"].to_numpy(dtype="datetime64[ns]")
+    gap_of = np.searchsorted(epochs, tt)
+    alone = np.array([(gap_of == gap_of[j]).sum() == 1 for j in range(len(truth))], dtype=bool)
+    big_res = big.to_numpy() & alone
+    n_big_res = int(big_res.sum())
+    big_res_found = sum(1 for j in np.flatnonzero(big_res) if j in found)
     ratios, iso = delta_v_ratios(events, truth, res.pairs, signed)
     dts = np.array([abs(p[2]) for p in res.pairs]) / 3600.0
     return {
@@ -146,11 +154,29 @@ def evaluate(events: pd.DataFrame, truth: pd.DataFrame, start: Any, end: Any, si
         "n_big": n_big,
         "big_found": big_found,
         "recall_big_at_1fa": big_found / n_big if n_big else float("nan"),
+        "n_big_res": n_big_res,
+        "big_res_found": big_res_found,
+        "recall_big_res_at_1fa": big_res_found / n_big_res if n_big_res else float("nan"),
         "median_abs_dt_h": float(np.median(dts)) if dts.size else float("nan"),
         "dv_isolated_n": int(iso.sum()),
         "dv_isolated_within_2x": float(((ratios > 0.5) & (ratios < 2.0))[iso].mean()) if iso.any() else float("nan"),
         "dv_median_ratio": float(np.median(ratios)) if ratios.size else float("nan"),
     }
+
+
+_EPOCHS: dict[tuple[str, str], np.ndarray] = {}
+
+
+def elset_epochs(events: pd.DataFrame, start: Any, end: Any) -> np.ndarray:
+    """Element-set epochs of the satellite whose span is [start, end] (read once)."""
+    key = (str(start), str(end))
+    if key not in _EPOCHS:
+        for sat in SATELLITES:
+            el = read_tle(DATA / "tle" / f"{sat}.tle").elements
+            _EPOCHS[(str(el["epoch_utc"].iloc[0]), str(el["epoch_utc"].iloc[-1]))] = el["epoch_utc"].to_numpy(
+                dtype="datetime64[ns]"
+            )
+    return _EPOCHS[key]
 
 
 def delta_v_ratios(
@@ -193,6 +219,8 @@ def pooled(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "recall_at_1fa": sum(r["tp_at_1fa"] for r in rows) / n_truth if n_truth else float("nan"),
         "n_big": n_big,
         "recall_big_at_1fa": sum(r["big_found"] for r in rows) / n_big if n_big else float("nan"),
+        "n_big_res": sum(r["n_big_res"] for r in rows),
+        "recall_big_res_at_1fa": sum(r["big_res_found"] for r in rows) / max(sum(r["n_big_res"] for r in rows), 1),
     }
 
 
@@ -311,6 +339,8 @@ def main() -> None:
         "recall_at_1fa",
         "n_big",
         "recall_big_at_1fa",
+        "n_big_res",
+        "recall_big_res_at_1fa",
         "median_abs_dt_h",
         "min_dv_t_cm_s",
         "min_dv_n_cm_s",
@@ -351,7 +381,8 @@ def main() -> None:
             okb = r["recall_big_at_1fa"] >= 0.9
             print(
                 f"; recall of {r['n_big']} burns >= 5 cm/s at 1 FA/yr {r['recall_big_at_1fa']:.2f} "
-                f"-> {'MET' if okb else 'NOT MET'}",
+                f"-> {'MET' if okb else 'NOT MET'} ({r['n_big_res']} of them alone between two element sets: "
+                f"{r['recall_big_res_at_1fa']:.2f})",
                 end="",
             )
         print()
