@@ -94,7 +94,7 @@ class TleDetectorConfig:
     campaign_days: float = 3.0
     campaign_min_side_sets: int = 3
     time_search_sets_before: int = 3
-    group_gain: tuple[float, float, float] = (1.0, 0.3, 0.3)
+    group_gain: tuple[float, float, float] = (1.0, 0.2, 0.2)
 
     def __post_init__(self) -> None:
         if self.window_sets < 2:
