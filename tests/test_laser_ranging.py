@@ -28,7 +28,7 @@ def one_day() -> tuple[SlrSimulation, object]:
     scenario = SlrScenario(duration_days=1.0, noise_m=NOISE_M, pass_probability=1.0)
     sim = simulate_slr(scenario, seed=3)
     grid = np.arange(0.0, 86400.0 + 60.0, 20.0)
-    truth = trajectory_interpolator(grid, propagate_truth(sim.x0, grid, force=scenario.force))
+    truth = trajectory_interpolator(grid, propagate_truth(sim.x0, grid, force=sim.force))
     return sim, truth
 
 

@@ -17,6 +17,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -36,6 +37,7 @@ from abrupt.errors import RepairLog
 from abrupt.model.range_reduction import RangeModel, StationSite, reduce_ranges
 from abrupt.model.stations import Station
 from abrupt.model.tracking_measurements import TrackingArrays, as_datetime64_ns
+from abrupt.readers.sinex import SinexStation
 from abrupt.simulate.slr import trajectory_interpolator
 from abrupt.thresholds import FalseAlarmBudget
 from abrupt.types import FloatArray
@@ -51,6 +53,13 @@ class LaserRangingResult:
     sigma_scale: dict[str, float]
     data: TrackingArrays
     repairs: RepairLog = field(default_factory=RepairLog)
+
+
+def jd_tt(epoch_utc: np.datetime64) -> float:
+    """Julian date (TT) of a UTC epoch (astropy/ERFA, leap seconds from the library)."""
+    from astropy.time import Time
+
+    return float(Time(np.asarray(epoch_utc, dtype="datetime64[ns]"), scale="utc").tt.jd)
 
 
 def _positions(
@@ -99,6 +108,8 @@ def detect_laser_ranging(
     model = range_model or RangeModel()
     fcfg = fit_config or BatchFitConfig(estimate_range_bias=True)
     epoch = as_datetime64_ns(epoch_utc)
+    # The Sun and Moon of the force model are anchored at the data's own epoch (t = 0 of the fit).
+    fcfg = replace(fcfg, force=replace(fcfg.force, epoch_jd_tt=jd_tt(epoch)))
     repairs = RepairLog("laser ranging")
     t_end = float((np.asarray(measurements["time_utc"]).max() - epoch) / np.timedelta64(1, "s"))
     gcfg = GlrtConfig(false_alarms_per_day=budget.per_day, max_maneuvers=max_maneuvers)
@@ -166,7 +177,9 @@ def ranges_from_crd(table: pd.DataFrame, *, repairs: RepairLog | None = None) ->
     events = table["epoch_event"].to_numpy(dtype=int) if "epoch_event" in table else np.zeros(len(table), int)
     ok = np.isin(events, list(CRD_RECEIVE_OFFSET))
     if repairs is not None:
-        repairs.record("ranges with an epoch event other than two-way receive/bounce/transmit skipped", int((~ok).sum()))
+        repairs.record(
+            "ranges with an epoch event other than two-way receive/bounce/transmit skipped", int((~ok).sum())
+        )
     out = table.loc[ok].copy()
     tof = out["time_of_flight_s"].to_numpy(dtype=float)
     shift = np.array([CRD_RECEIVE_OFFSET[int(e)] for e in events[ok]]) * tof
@@ -176,26 +189,149 @@ def ranges_from_crd(table: pd.DataFrame, *, repairs: RepairLog | None = None) ->
     return out.sort_values("time_utc", kind="stable").reset_index(drop=True)
 
 
-def sites_from_sinex(stations_sinex: dict, codes: list[str], epoch_utc: np.datetime64) -> dict[str, StationSite]:  # type: ignore[type-arg]
+def sites_from_sinex(
+    stations_sinex: Mapping[str, SinexStation], codes: list[str], epoch_utc: np.datetime64, *, file: str | None = None
+) -> dict[str, StationSite]:
     """Precise sites for the station codes of a CRD file from a SINEX solution (position, velocity, eccentricity)."""
     from abrupt.errors import InputError
+    from abrupt.readers.sinex import sinex_station
 
     out = {}
     for code in codes:
-        if code not in stations_sinex:
-            known = ", ".join(sorted(stations_sinex)[:20])
-            raise InputError(f"station {code!r} is not in the SINEX file (sites: {known}...)", column="station")
-        st = stations_sinex[code]
+        st = sinex_station(dict(stations_sinex), code, file=file)
         sol = st.solution_at(epoch_utc)
         frame, ecc = st.eccentricity_at(epoch_utc)
         if frame != "UNE":
-            raise InputError(f"station {code!r}: eccentricity frame {frame!r} is not supported (need UNE)")
+            raise InputError(f"station {code!r}: eccentricity frame {frame!r} is not supported (need UNE)", file=file)
         vel_m_per_yr = np.nan_to_num(np.asarray(sol.velocity_mps, float)) * 365.25 * 86400.0
         out[code] = StationSite(
             code,
-            tuple(float(v) for v in sol.position_m),  # type: ignore[arg-type]
+            (float(sol.position_m[0]), float(sol.position_m[1]), float(sol.position_m[2])),
             sol.epoch_utc,
-            tuple(float(v) for v in vel_m_per_yr),  # type: ignore[arg-type]
-            tuple(float(v) for v in ecc),  # type: ignore[arg-type]
+            (float(vel_m_per_yr[0]), float(vel_m_per_yr[1]), float(vel_m_per_yr[2])),
+            (float(ecc[0]), float(ecc[1]), float(ecc[2])),
         )
     return out
+
+
+@dataclass
+class LaserRangingRun:
+    """Events (the frozen schema), the fit summary lines and the run identifiers of one file run."""
+
+    events: pd.DataFrame
+    result: LaserRangingResult
+    summary: dict[str, object]
+    run_id: str
+    config_hash: str
+
+    def summary_lines(self) -> list[str]:
+        lines = [f"post-fit range RMS per station (mm): {self.summary['residual_rms_mm']}"]
+        lines.append(f"station sigma scale (post-fit / stated): {self.summary['sigma_scale']}")
+        lines.append(f"range biases (mm): {self.summary['range_bias_mm']}")
+        lines += [f"repaired: {k} ({n})" for k, n in self.result.repairs.counts.items()]
+        return lines
+
+
+def apriori_state_gcrf(ephemeris: object, epoch_utc: np.datetime64) -> FloatArray:
+    """GCRF state (m, m/s) at ``epoch_utc`` from an ephemeris (e.g. an ILRS CPF prediction in ITRF).
+
+    Positions are interpolated (cubic) to the epoch; ITRF is turned into GCRF with the filter's own Earth
+    orientation (ERFA, :func:`abrupt.model.tracking_measurements.earth_rotation_matrices`) and the velocity
+    gains ω_E × r.
+    """
+    from scipy.interpolate import CubicSpline
+
+    from abrupt.model.tracking_measurements import earth_rotation_matrices
+    from abrupt.model.tracking_orbit import OMEGA_EARTH_RAD_S
+
+    times = np.asarray(ephemeris.times_utc, dtype="datetime64[ns]")  # type: ignore[attr-defined]
+    t = (times - epoch_utc).astype(np.int64) / 1e9
+    pos = np.asarray(ephemeris.position_m, dtype=np.float64)  # type: ignore[attr-defined]
+    spline = CubicSpline(t, pos, axis=0)
+    r = spline(0.0)
+    v = spline(0.0, 1)
+    frame = getattr(ephemeris, "frame", "ITRF")
+    if frame == "GCRF":
+        return np.concatenate([r, v])
+    c_fi = earth_rotation_matrices(np.zeros(1), model="iers", epoch_utc=epoch_utc)[0]
+    v_inertial_in_f = v + np.cross([0.0, 0.0, OMEGA_EARTH_RAD_S], r)
+    return np.concatenate([c_fi.T @ r, c_fi.T @ v_inertial_in_f])
+
+
+def run_laser_ranging_files(
+    crd_paths: list[str],
+    sinex_path: str,
+    apriori_path: str,
+    *,
+    budget: FalseAlarmBudget,
+    range_model: RangeModel | None = None,
+    spacecraft: str | None = None,
+    max_maneuvers: int = 3,
+    step_s: float = 5.0,
+) -> LaserRangingRun:
+    """Read CRD normal points, SINEX sites and an a-priori ephemeris; detect maneuvers; build events.
+
+    The force model is two-body + J2 + Sun and Moon (``abrupt.model.tracking_orbit.ForceModel``);
+    per-station range biases absorb the satellite's centre-of-mass offset.
+    """
+    from abrupt.detect.tracking_glrt import glrt_events
+    from abrupt.events import config_hash, empty_frame, events_frame, new_run_id
+    from abrupt.model.stations import Station
+    from abrupt.model.tracking_orbit import ForceModel
+    from abrupt.readers.crd import read_crd
+    from abrupt.readers.ephemeris import read_ephemeris
+    from abrupt.readers.sinex import read_sinex
+
+    model = range_model or RangeModel()
+    repairs = RepairLog(", ".join(crd_paths))
+    tables = [read_crd(p, repairs=repairs) for p in crd_paths]
+    meas = ranges_from_crd(pd.concat(tables, ignore_index=True), repairs=repairs)
+    if meas.empty:
+        raise ValueError(f"{crd_paths[0]}: no two-way ranges to analyse")
+    meas["station"] = meas["station_id"].astype(str)
+    epoch = as_datetime64_ns(pd.Timestamp(meas["time_utc"].min()).floor("s"))
+    sites = sites_from_sinex(read_sinex(sinex_path), sorted(meas["station"].unique()), epoch, file=sinex_path)
+    stations = {}
+    for name, site in sites.items():
+        lat, lon, h = site.geodetic
+        bins = meas.loc[meas["station"] == name, "bin_rms_s"] if "bin_rms_s" in meas else pd.Series(dtype=float)
+        sigma = float(np.nanmedian(bins)) * 299_792_458.0 / 2 if np.isfinite(bins).any() else 0.01
+        stations[name] = Station(
+            name,
+            np.degrees(lat),
+            np.degrees(lon),
+            h,
+            sigma_range_m=max(sigma, 0.002),
+            sigma_azimuth_rad=1.0,
+            sigma_elevation_rad=1.0,
+            sigma_range_rate_mps=1.0,
+        )
+    ephemeris = read_ephemeris(apriori_path)
+    x0 = apriori_state_gcrf(ephemeris, epoch)
+    force = ForceModel(mu_m3_s2=3.986004418e14, j2=True, third_body=True)
+    cfg = BatchFitConfig(force=force, estimate_range_bias=True, max_step_s=step_s)
+    result = detect_laser_ranging(
+        meas, sites, stations, x0, epoch, budget=budget, range_model=model, fit_config=cfg, max_maneuvers=max_maneuvers
+    )
+    name = spacecraft or str(meas["satellite"].iloc[0] if "satellite" in meas else "satellite")
+    settings = {"range_model": model.__dict__, "budget": str(budget), "step_s": step_s, "max_maneuvers": max_maneuvers}
+    cfg_hash = config_hash(settings)
+    run_id = new_run_id()
+    events = glrt_events(
+        result.detections,
+        epoch_utc=epoch,
+        spacecraft=name,
+        run_id=run_id,
+        config_hash=cfg_hash,
+        false_alarms_per_day=budget.per_day,
+        detector="tracking.laser_glrt",
+    )
+    frame = events_frame(events) if events else empty_frame()
+    summary: dict[str, object] = {
+        "residual_rms_mm": {k: round(v * 1000, 2) for k, v in result.residual_rms_m.items()},
+        "sigma_scale": {k: round(v, 2) for k, v in result.sigma_scale.items()},
+        "range_bias_mm": {k: round(v * 1000, 1) for k, v in result.fit.range_bias_m.items()},
+        "n_ranges": len(meas),
+        "repairs": dict(result.repairs.counts) | dict(repairs.counts),
+    }
+    return LaserRangingRun(frame, result, summary, run_id, cfg_hash)

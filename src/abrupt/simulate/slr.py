@@ -13,7 +13,7 @@ Optionally an impulsive maneuver (a one-second burn) is placed at a given time.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -102,6 +102,7 @@ class SlrSimulation:
     x0: FloatArray
     range_bias_m: dict[str, float]
     scenario: SlrScenario
+    force: ForceModel  # the truth's force model, Sun and Moon anchored at the campaign's start
 
 
 def trajectory_interpolator(t_grid_s: FloatArray, states: FloatArray) -> CubicHermiteSpline:
@@ -124,12 +125,15 @@ def simulate_slr(scenario: SlrScenario, *, seed: int = 0, grid_step_s: float = 2
         math.radians(scenario.nu0_deg),
         mu,
     )
+    from abrupt.pipelines.laser_ranging import jd_tt
+
+    force = replace(scenario.force, epoch_jd_tt=jd_tt(epoch))  # Sun and Moon of the campaign's own dates
     duration = scenario.duration_days * 86400.0
     grid = np.arange(0.0, duration + 2 * grid_step_s, grid_step_s)
     burns = []
     if scenario.maneuver_t_s is not None:
         burns.append(FiniteBurn(scenario.maneuver_t_s, 1.0, scenario.maneuver_dv_rsw_mps))
-    states = propagate_truth(x0, grid, burns, force=scenario.force)
+    states = propagate_truth(x0, grid, burns, force=force)
     sat = trajectory_interpolator(grid, states)
 
     sites = {
@@ -187,4 +191,4 @@ def simulate_slr(scenario: SlrScenario, *, seed: int = 0, grid_step_s: float = 2
     )
     meas = meas.sort_values("time_utc", kind="stable").reset_index(drop=True)
     stations = {name: nominal_station(s, scenario.noise_m, scenario.elevation_mask_deg) for name, s in sites.items()}
-    return SlrSimulation(meas, sites, stations, epoch, x0, bias, scenario)
+    return SlrSimulation(meas, sites, stations, epoch, x0, bias, scenario, force)
