@@ -336,6 +336,8 @@ def inject_orbit_command(file: str, time_utc: str, dv_rtn: str, satellite: str |
         raise ConfigError(f"cannot read time {time_utc!r}", key="time") from None
     try:
         out_eph = inject_impulse(eph, t, _parse_vector(dv_rtn, "dv-rtn"))
+    except ConfigError:
+        raise  # already names its option (a ConfigError is a ValueError: do not wrap it twice)
     except ValueError as exc:
         raise ConfigError(str(exc), key="time") from None
     fmt = write_ephemeris(out_eph, out, like=file)

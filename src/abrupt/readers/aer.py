@@ -136,10 +136,10 @@ def read_aer(
         rows.append(row)
     if not rows:
         raise InputError("no measurements found", file=path)
-    return _finish(pd.DataFrame(rows), path, log)
+    return finish_measurements(pd.DataFrame(rows), path, log)
 
 
-def _finish(frame: pd.DataFrame, path: Path, log: RepairLog) -> pd.DataFrame:
+def finish_measurements(frame: pd.DataFrame, path: Path, log: RepairLog) -> pd.DataFrame:
     """Sort (counted repair), drop identical duplicates (counted), reject conflicting duplicates."""
     for col in MEASUREMENT_COLUMNS:
         if col not in frame:
