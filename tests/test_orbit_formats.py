@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 
 from abrupt.errors import InputError
-from abrupt.model.frames import Ephemeris
 from abrupt.readers.cpf import read_cpf
 from abrupt.readers.ephemeris import read_ephemeris, sniff_format, write_ephemeris
 from abrupt.readers.oem import parse_ccsds_epoch, read_oem, read_opm, write_oem
 from abrupt.readers.sp3 import read_sp3_all, write_sp3
+from abrupt.series.ephemeris import Ephemeris
 
 MU_KM3_S2 = 398600.4418
 R_KM = 6778.0  # ISS-like, 400 km

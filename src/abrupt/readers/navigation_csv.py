@@ -20,8 +20,8 @@ import numpy as np
 import pandas as pd
 
 from abrupt.errors import InputError, RepairLog
-from abrupt.model.frames import Ephemeris
 from abrupt.readers.compression import read_text
+from abrupt.series.ephemeris import Ephemeris
 
 REQUIRED_COLUMNS = ("time_utc", "x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps")
 

@@ -32,8 +32,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from abrupt.errors import InputError, RepairLog
-from abrupt.model.frames import Ephemeris
 from abrupt.readers.compression import read_bytes
+from abrupt.series.ephemeris import Ephemeris
 
 GCRF_NAMES = {"GCRF", "ICRF", "EME2000", "J2000"}
 ITRF_NAMES = {

@@ -44,8 +44,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from abrupt.errors import InputError, RepairLog
-from abrupt.model.frames import Ephemeris
 from abrupt.readers.compression import read_bytes
+from abrupt.series.ephemeris import Ephemeris
 
 #: Offsets of SP3 time systems from TAI (s): t_TAI = t_sys + offset (GPS ICD, Galileo OS SIS ICD,
 #: BeiDou ICD). UTC and GLONASS (UTC + 3 h) go through the leap-second table instead.
