@@ -58,6 +58,7 @@ INERTIAL_FRAMES = ("GCRF", "ICRF", "J2000", "EME2000", "EME00", "ICRS")
 BAD_VALUE_MARKER = 999999.999999  # [km or dm/s] the SP3 "bad or absent value" marker
 MIN_RADIUS_KM = 6000.0  # [km] smallest plausible orbit radius
 MAX_RADIUS_KM = 2.0e6  # [km] largest plausible geocentric radius (beyond the Moon)
+MAX_INTERVAL_S = 30 * 86400.0  # [s] longest plausible epoch interval
 BAD_RECORD_FRACTION = 0.01  # more malformed records than this (and more than one) is an error
 
 
@@ -245,8 +246,10 @@ def _parse_header(lines: Sequence[str], file: str, repairs: RepairLog) -> tuple[
         raise InputError(
             "epoch interval (third field of '##' line) is not a number", file=file, line=2, column=25
         ) from None
-    if not (math.isfinite(interval_s) and interval_s >= 0.0):
-        raise InputError(f"epoch interval {interval_s} s is not a non-negative number", file=file, line=2, column=25)
+    if not (math.isfinite(interval_s) and 0.0 <= interval_s <= MAX_INTERVAL_S):
+        raise InputError(
+            f"epoch interval {interval_s:g} s is not in [0, {MAX_INTERVAL_S:g}] s", file=file, line=2, column=25
+        )
     sats: list[str] = []
     n_sats: int | None = None
     n_plus = 0
