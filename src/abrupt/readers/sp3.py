@@ -35,6 +35,7 @@ the header's sampling grid, a file with no epochs, an epoch repeated with differ
 from __future__ import annotations
 
 import math
+import warnings
 from collections import Counter, defaultdict
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
@@ -191,8 +192,8 @@ def _resolve_rollover(
     return min(candidates, key=lambda c: abs(int((c - expected).astype(np.int64))))
 
 
-def _to_utc(t_sys: NDArray[np.datetime64], time_system: str) -> NDArray[np.datetime64]:
-    from abrupt.model.timescales import to_utc
+def _to_utc(t_sys: NDArray[np.datetime64], time_system: str, log: RepairLog) -> NDArray[np.datetime64]:
+    from abrupt.readers.timesystems import to_utc_counted
 
     if time_system == "UTC":
         return t_sys
@@ -200,7 +201,7 @@ def _to_utc(t_sys: NDArray[np.datetime64], time_system: str) -> NDArray[np.datet
         return t_sys - np.timedelta64(3, "h")
     offset_ns = round(TAI_MINUS_SYSTEM_S[time_system] * 1e9)
     tai: NDArray[np.datetime64] = (t_sys.astype(np.int64) + offset_ns).astype("datetime64[ns]")
-    return to_utc(tai, "tai")
+    return to_utc_counted(tai, "tai", log)
 
 
 def _from_utc(t_utc: NDArray[np.datetime64], time_system: str) -> NDArray[np.datetime64]:
@@ -212,9 +213,12 @@ def _from_utc(t_utc: NDArray[np.datetime64], time_system: str) -> NDArray[np.dat
     if time_system == "GLO":
         return t_utc + np.timedelta64(3, "h")
     offline_astropy()
+    import erfa
     from astropy.time import Time
 
-    tai = np.asarray(Time(t_utc, scale="utc", format="datetime64").tai.datetime64, dtype="datetime64[ns]")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", erfa.ErfaWarning)  # beyond the leap-second table: TAI-UTC held
+        tai = np.asarray(Time(t_utc, scale="utc", format="datetime64").tai.datetime64, dtype="datetime64[ns]")
     offset_ns = round(TAI_MINUS_SYSTEM_S[time_system] * 1e9)
     out: NDArray[np.datetime64] = (tai.astype(np.int64) - offset_ns).astype("datetime64[ns]")
     return out
@@ -556,7 +560,7 @@ def _finish(
         log.record("missing epochs (gaps, propagated across)", n_missing)
     return Ephemeris(
         satellite=sid,
-        times_utc=_to_utc(t_sys, header.time_system),
+        times_utc=_to_utc(t_sys, header.time_system, log),
         position_m=st[:, :3] * 1e3,
         velocity_mps=st[:, 3:6] * 0.1,
         frame=frame,  # type: ignore[arg-type]
