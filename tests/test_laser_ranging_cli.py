@@ -45,9 +45,8 @@ def write_crd(sim: SlrSimulation, path: Path) -> None:
             for k, (_, row) in enumerate(r.iterrows()):
                 sod = (pd.Timestamp(row["time_utc"]) - day0).total_seconds()
                 if k == 0:
-                    lines.append(
-                        f"20 {sod:.3f} {row['pressure_hpa']:.2f} {row['temperature_k']:.2f} {100 * row['humidity']:.1f} 0"
-                    )
+                    meteo = f"{row['pressure_hpa']:.2f} {row['temperature_k']:.2f} {100 * row['humidity']:.1f}"
+                    lines.append(f"20 {sod:.3f} {meteo} 0")
                 tof = 2.0 * row["range_m"] / C
                 lines.append(f"11 {sod:.7f} {tof:.12f} std1 0 120 10 13.3 -1 -1 -1 -1 0")
             lines.append("H8")
