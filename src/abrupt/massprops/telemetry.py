@@ -200,3 +200,36 @@ def channels_by_key(frame_groups: Mapping[str, Channel], keys: list[str]) -> lis
     if missing:
         raise InputError(f"missing telemetry channel(s) {missing}", column=missing[0])
     return [frame_groups[k] for k in keys]
+
+
+def momentum_data_from_simulation(
+    result: object,
+    wheel_axes: ArrayLike,
+    wheel_spin_inertia_kgm2: ArrayLike,
+    *,
+    orbit_period_s: float | None = None,
+    appendage_axis_B: ArrayLike | None = None,
+    appendage_spin_inertia_kgm2: float = 0.0,
+    nadir_axis_B: ArrayLike = (0.0, 0.0, 1.0),
+    source: str = "<simulation>",
+) -> MomentumBalanceData:
+    """Estimator input from a :class:`~abrupt.simulate.attitude.PointingSimResult` (all channels at one rate).
+
+    The appendage rate is re-derived from the telemetered (wrapped) angle, as from flight telemetry.
+    """
+    r = result
+    t = np.asarray(r.t_s, dtype=np.float64)  # type: ignore[attr-defined]
+    return momentum_data_from_channels(
+        (t, r.q_BN),  # type: ignore[attr-defined]
+        (t, r.omega_B_rad_s),  # type: ignore[attr-defined]
+        [(t, r.wheel_speed_rad_s[:, i]) for i in range(r.wheel_speed_rad_s.shape[1])],  # type: ignore[attr-defined]
+        wheel_axes,
+        wheel_spin_inertia_kgm2,
+        appendage_angle=(t, r.appendage_angle_rad) if appendage_spin_inertia_kgm2 > 0 else None,  # type: ignore[attr-defined]
+        appendage_axis_B=appendage_axis_B,
+        appendage_spin_inertia_kgm2=appendage_spin_inertia_kgm2,
+        orbit_period_s=orbit_period_s,
+        nadir_axis_B=nadir_axis_B,
+        rate_average_s=0.0,
+        source=source,
+    )
