@@ -39,6 +39,7 @@ One linear least-squares problem (three rows per sample) gives J; no simulation,
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 
@@ -280,9 +281,7 @@ def _cumtrapz(t: FloatArray, y: FloatArray) -> FloatArray:
     return out
 
 
-def observability(
-    information: FloatArray, scale_kgm2: float, rel_sigma: float
-) -> tuple[BoolArray, FloatArray, str]:
+def observability(information: FloatArray, scale_kgm2: float, rel_sigma: float) -> tuple[BoolArray, FloatArray, str]:
     """Split parameter space into determined and undetermined directions.
 
     ``information`` is the profiled Fisher information of p (6, 6). An eigen-direction whose 1σ exceeds
@@ -414,7 +413,7 @@ def estimate_inertia(
             breaks.add(k)
     edges = [0, *sorted(breaks), n]
     seg = np.zeros(n, dtype=np.int64)
-    for s, (lo, hi) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
+    for s, (lo, hi) in enumerate(itertools.pairwise(edges)):
         seg[lo:hi] = s
     n_seg = len(edges) - 1
     seg_t0 = t[np.asarray(edges[:-1])][seg]
@@ -427,7 +426,7 @@ def estimate_inertia(
         gg_b = 3.0 * data.orbit_rate_rad_s**2 * np.einsum("nij,njk->nik", skew(r_b), inertia_regressor(r_b))
         gg_n = np.einsum("nji,njk->nik", c_bn, gg_b)
         gg_int = np.zeros_like(gg_n)
-        for lo, hi in zip(edges[:-1], edges[1:], strict=True):
+        for lo, hi in itertools.pairwise(edges):
             gg_int[lo:hi] = _cumtrapz(t[lo:hi], gg_n[lo:hi])
         a_p = a_body - gg_int
     else:
@@ -530,7 +529,7 @@ def estimate_inertia(
     rng = np.random.default_rng(seed)
     boot = np.zeros((0, 6))
     if bootstrap > 0:
-        block = max(1, int(round(block_s / max(float(np.median(np.diff(t))), 1e-9))))
+        block = max(1, round(block_s / max(float(np.median(np.diff(t))), 1e-9)))
         n_blocks = math.ceil(n / block)
         reps = []
         block_of = np.minimum(np.arange(n) // block, n_blocks - 1)
