@@ -5,3 +5,4 @@ plug-in, a test) registers as soon as its class is defined.
 """
 
 # Built-in detector modules are imported below as they adopt abrupt.detect.base.Detector.
+from abrupt.detect import mass_change  # noqa: F401  (mass.inertia_change)

@@ -197,3 +197,16 @@ def nearest_physical(j: ArrayLike, *, margin: float = 1e-6) -> FloatArray:
     res = minimize(lambda x: float(np.sum((x - w / scale) ** 2)), np.abs(w / scale) + margin, constraints=cons)
     w_new = res.x * scale
     return np.asarray(v @ np.diag(w_new) @ v.T, dtype=np.float64)
+
+
+def inertia_after_docking(
+    inertia_kgm2: ArrayLike, host_mass_kg: float, parasite_mass_kg: float, rho_B_m: ArrayLike
+) -> FloatArray:
+    """Inertia about the new CoM after a point mass m docks at ρ (from the old CoM), spec §5.7 [R]:
+
+    J_new = J + (M m / (M + m)) (|ρ|² 1 − ρ ρᵀ)  (the CoM shifts by m ρ / (M + m)).
+    """
+    j = np.asarray(inertia_kgm2, dtype=np.float64)
+    r = np.asarray(rho_B_m, dtype=np.float64).reshape(3)
+    mu = host_mass_kg * parasite_mass_kg / (host_mass_kg + parasite_mass_kg)
+    return np.asarray(j + mu * (float(r @ r) * np.eye(3) - np.outer(r, r)), dtype=np.float64)
