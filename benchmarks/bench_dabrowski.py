@@ -31,7 +31,7 @@ from abrupt.massprops.simsat import (
     testbed_runs,
 )
 
-NOISE = TestbedNoise(wheel_gain_sd=0.015, wander_deg=0.06, rate_noise_deg_s=0.03)
+NOISE = TestbedNoise(wheel_gain_sd=0.025, wander_deg=0.06, rate_noise_deg_s=0.07)
 THESIS = {  # Table 4.4 / 4.3: mean error, mean range, mean SD (Method 1); baseline SD
     0.5: (0.03518, 0.2398, 0.07733, 0.0416),
     1.0: (0.01160, 0.1094, 0.03351, 0.0313),

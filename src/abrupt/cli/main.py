@@ -6,7 +6,7 @@ import sys
 
 import click
 
-from abrupt.cli import attitude, catalog_commands, orbit, rates, tle, tracking  # noqa: F401  (registration)
+from abrupt.cli import attitude, catalog_commands, mass, orbit, rates, tle, tracking  # noqa: F401  (registration)
 from abrupt.cli.groups import cli
 from abrupt.errors import AbruptError
 

@@ -148,7 +148,7 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
             dm = float(np.sum(dj[:3]) / (2 * r2))
             w = np.zeros(d)
             for i in trace_idx:
-                w[list(idx).index(i)] = 1.0 / (2 * r2)
+                w[[int(v) for v in idx].index(i)] = 1.0 / (2 * r2)
             dm_sig = float(math.sqrt(w @ dj_cov_obs @ w))
         else:
             dm, dm_sig = math.nan, math.nan

@@ -406,7 +406,7 @@ def estimate_inertia(
         h_known_b = h_w_b
     n = t.size
     # Segments: a new one after each gap and after each impulse window.
-    breaks = set(np.flatnonzero(np.diff(t) > max_gap_s) + 1)
+    breaks: set[int] = {int(b) for b in np.flatnonzero(np.diff(t) > max_gap_s) + 1}
     for a, _b in windows:
         k = int(np.searchsorted(t, a))
         if 0 < k < n:

@@ -273,25 +273,30 @@ def momentum_exchange_estimate(
     maneuver: Maneuver | None = None,
     i_rw_kgm2: float = I_RW,
 ) -> float:
-    """I33 from the integrated single-axis momentum balance (beyond the thesis).
+    """I33 from the single-axis momentum balance over each sample step (beyond the thesis).
 
-    (I33 + I_rw) Ω + I_rw ω = H₀ (Eq. 2.19c integrated) ⇒ (I33 + I_rw) ψ + I_rw θ_w = H₀ t + c, with
-    θ_w = ∫ω dt from the wheel-speed telemetry. The wheel gain and look-up table never enter. A gyro
-    bias adds b t to ψ and slow gyro wander is locally a line, so each step period of ``maneuver`` gets
-    its own line (h_k t + c_k): only the fast momentum exchange at each step informs I33. Least squares
-    ψ = a θ_w + Σ_k (h_k t + c_k), I33 = −I_rw (1 + a) / a.
+    (I33 + I_rw) Ω + I_rw ω = H₀ (Eq. 2.19c integrated) holds over every step:
+    (I33 + I_rw) Δψ_k + I_rw Δθ_w,k = H₀ Δt, with Δψ the change of the recorded (gyro-integrated) yaw,
+    i.e. the rate gyro's reading, and Δθ_w = ω̄ Δt from the wheel-speed telemetry. The wheel gain and
+    look-up table never enter, and rate-gyro white noise stays white in this (differenced) form. A gyro
+    bias and slow gyro wander add a slowly varying rate, fitted as a line per step period of
+    ``maneuver``, so only the fast momentum exchange at each step informs I33. Least squares
+    Δψ = a Δθ_w + Σ_k (c_k + h_k t) Δt, I33 = −I_rw (1 + a) / a.
     """
-    theta_w = np.concatenate([[0.0], np.cumsum(0.5 * (wheel_speed_rad_s[1:] + wheel_speed_rad_s[:-1]) * np.diff(t_s))])
+    dt = np.diff(t_s)
+    dpsi = np.diff(yaw_meas_rad)
+    dtheta = 0.5 * (wheel_speed_rad_s[1:] + wheel_speed_rad_s[:-1]) * dt
+    tm = 0.5 * (t_s[1:] + t_s[:-1])
     if maneuver is None:
         edges = [t_s[0] - 1.0, t_s[-1] + 1.0]
     else:
         edges = [t_s[0] - 1.0, *(maneuver.hold_s + maneuver.step_period_s * np.arange(1, 4) - 0.5), t_s[-1] + 1.0]
-    cols = [theta_w]
+    cols = [dtheta]
     for lo, hi in itertools.pairwise(edges):
-        inside = ((t_s >= lo) & (t_s < hi)).astype(np.float64)
-        cols += [inside, inside * (t_s - lo)]
+        inside = ((tm >= lo) & (tm < hi)).astype(np.float64)
+        cols += [inside * dt, inside * (tm - lo) * dt]
     x = np.column_stack(cols)
-    coef, *_ = np.linalg.lstsq(x, yaw_meas_rad, rcond=None)
+    coef, *_ = np.linalg.lstsq(x, dpsi, rcond=None)
     a = coef[0]
     return float(-i_rw_kgm2 * (1.0 + a) / a)
 

@@ -777,8 +777,8 @@ class ReferenceTrajectory:
         w = np.empty((t_s.size, 3))
         w[1:-1] = 0.5 * (w_mid[1:] + w_mid[:-1])
         w[0], w[-1] = w_mid[0], w_mid[-1]
-        wdot = np.gradient(w, t_s, axis=0)
-        return q_out, w, wdot
+        wdot = np.asarray(np.gradient(w, t_s, axis=0), dtype=np.float64)
+        return np.asarray(q_out, dtype=np.float64), w, wdot
 
 
 @dataclass(frozen=True)
@@ -893,7 +893,7 @@ def simulate_pointing(
     pinv = np.ascontiguousarray(axes.T @ np.linalg.inv(axes @ axes.T))
     n_steps = round(config.duration_s * config.sim_rate_hz)
     dt = config.dt_s
-    t_grid = start_s + np.arange(n_steps + 1) * dt
+    t_grid = np.asarray(start_s + np.arange(n_steps + 1) * dt, dtype=np.float64)
     q_rn, w_r, wdot_r = scenario.reference.sample(t_grid)
     if scenario.orbit is not None:
         r_n = scenario.orbit.position_unit_N(t_grid)
@@ -939,7 +939,7 @@ def simulate_pointing(
         np.ascontiguousarray(r_n), gg, app_axis, app_j, app_rate, app_acc,
         np.asarray(scenario.torque_N_Nm, dtype=np.float64), steps, dh, x0, out_true, out_h,
     )  # fmt: skip
-    t_s = start_s + np.arange(n_s) * (config.decimation * dt)
+    t_s = np.asarray(start_s + np.arange(n_s) * (config.decimation * dt), dtype=np.float64)
     n_w = axes.shape[1]
     q_true = out_true[:, :4]
     w_true = out_true[:, 4:7]

@@ -9,8 +9,9 @@ inertial torque; at ``docking_time_s`` the truth inertia becomes the point-mass 
 
 from __future__ import annotations
 
+import itertools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -44,7 +45,7 @@ class DockingScenario:
     slews_per_day: tuple[int, int] = (2, 4)
     slew_angle_deg: tuple[float, float] = (15.0, 45.0)
     torque_N_Nm: tuple[float, float, float] = (1e-6, -5e-7, 8e-7)
-    orbit: CircularOrbit = CircularOrbit()
+    orbit: CircularOrbit = field(default_factory=CircularOrbit)
     truth_inertia_kgm2: tuple[tuple[float, ...], ...] | None = None
     appendage_axis_B: tuple[float, float, float] = (0.0, 1.0, 0.0)
     appendage_spin_inertia_kgm2: float = 18.0
@@ -141,7 +142,7 @@ def simulate_docking(
             dock = float(np.floor(dock))
             cuts = [t0, dock, t1]
         parts = []
-        for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+        for a, b in itertools.pairwise(cuts):
             after = dock is not None and a >= dock
             cfg = AttitudeSimConfig(
                 duration_s=b - a,
