@@ -90,7 +90,8 @@ class Maneuver:
 class TestbedNoise:
     """Run-to-run non-repeatability of the synthetic SIMSAT (spec §3.3, §4.3.5, §8.1 item 11).
 
-    ``wheel_gain_sd``: relative SD of the wheel gain from run to run; ``gyro_bias_deg_min``: mean residual
+    ``wheel_gain_sd``: relative SD of the wheel gain from run to run; ``lut_slope_sd``: relative SD of the
+    look-up table's slope (the unsaturated part) from run to run (§8.1 item 11); ``gyro_bias_deg_min``: mean residual
     drift after the operator's zeroing (App. F) and ``gyro_bias_sd_deg_min`` its run-to-run SD [deg/min]
     (the raw −2.5°/min of §3.3 is calibrated out before a test); ``wander_deg``: amplitude of the long-period
     gyro wander (period uniform in ``wander_period_s``); ``encoder_noise_rad_s`` wheel-speed noise;
@@ -99,6 +100,7 @@ class TestbedNoise:
     """
 
     wheel_gain_sd: float = 0.03
+    lut_slope_sd: float = 0.0
     gyro_bias_deg_min: float = -0.1
     gyro_bias_sd_deg_min: float = 0.1
     wander_deg: float = 0.05
@@ -113,6 +115,7 @@ def simulate_simsat(
     i33_kgm2: ArrayLike | None = None,
     wheel_gain: ArrayLike | None = None,
     gyro_error_rad: FloatArray | None = None,
+    lut_slope_per_s: ArrayLike | None = None,
 ) -> dict[str, FloatArray]:
     """Simulate a batch of runs (columns) of the closed-loop yaw response.
 
@@ -129,6 +132,9 @@ def simulate_simsat(
     i33 = np.broadcast_to(i33, (m,))
     wg = np.broadcast_to(wg, (m,))
     err = np.zeros((n, m)) if gyro_error_rad is None else np.broadcast_to(gyro_error_rad, (n, m))
+    k_lut = np.broadcast_to(
+        np.asarray(params.k_lut_per_s if lut_slope_per_s is None else lut_slope_per_s, dtype=np.float64), (m,)
+    )
     err_rate = np.gradient(err, params.dt_s, axis=0)
     cmd = maneuver.command_rad(t)
     dt = params.dt_s
@@ -148,7 +154,7 @@ def simulate_simsat(
         w_cmd = -(params.gain_kp * e + params.gain_kd * (-(om + err_rate[k])))
         queue.append(w_cmd)
         w_cmd_delayed = queue.pop(0)
-        wdot = wg * np.clip(params.k_lut_per_s * (w_cmd_delayed - w), -params.max_wheel_accel, params.max_wheel_accel)
+        wdot = wg * np.clip(k_lut * (w_cmd_delayed - w), -params.max_wheel_accel, params.max_wheel_accel)
         omdot = -wdot * ratio
         psi = psi + om * dt + 0.5 * omdot * dt * dt
         om = om + omdot * dt
@@ -182,7 +188,8 @@ def testbed_runs(
     err = bias * t[:, None] + wander - wander[:1]
     dt = params.dt_s
     err = err + np.cumsum(np.radians(noise.rate_noise_deg_s) * dt * rng.standard_normal(err.shape), axis=0)
-    sim = simulate_simsat(params, maneuver, i33_kgm2, wg, err)
+    k_lut = params.k_lut_per_s * (1.0 + noise.lut_slope_sd * rng.standard_normal(n_runs))
+    sim = simulate_simsat(params, maneuver, i33_kgm2, wg, err, k_lut)
     sim["wheel_speed_meas_rad_s"] = sim["wheel_speed_rad_s"] + noise.encoder_noise_rad_s * rng.standard_normal(
         sim["wheel_speed_rad_s"].shape
     )

@@ -521,7 +521,7 @@ def simulate_tracking(
                     xs[j] = x[j] + dt * k3[j]
                 frac = 1.0
             rate = app_rate[step] + frac * (app_rate[step + 1] - app_rate[step])
-            acc = app_accel[step] + frac * (app_accel[step + 1] - app_accel[step])
+            acc = app_accel[step]  # exact derivative of the piecewise-linear rate over this step
             rn = r_n[step] + frac * (r_n[step + 1] - r_n[step])
             for j in range(3):
                 h_app[j] = app_inertia * rate * app_axis[j]

@@ -907,7 +907,7 @@ def simulate_pointing(
         app_axis = np.asarray(app.axis_B, dtype=np.float64)
         app_axis = app_axis / np.linalg.norm(app_axis)
         app_rate = np.interp(t_grid, app.t_s, app.rate_rad_s)
-        app_acc = np.gradient(app_rate, t_grid)
+        app_acc = np.append(np.diff(app_rate) / dt, 0.0)  # constant over each step: consistent with the rate
         app_j = float(app.spin_inertia_kgm2)
     else:
         app_axis, app_rate, app_acc, app_j = (
