@@ -27,16 +27,15 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-from _flight_like_loader import catalogue, load_day  # noqa: E402
-
-from abrupt.massprops.inertia import axis_errors_deg, params_from_inertia, principal_axes  # noqa: E402
-from abrupt.massprops.momentum_balance import (  # noqa: E402
+from _flight_like_loader import catalogue, load_day
+from abrupt.massprops.inertia import axis_errors_deg, params_from_inertia, principal_axes
+from abrupt.massprops.momentum_balance import (
     MomentumBalanceData,
     estimate_inertia,
     nadir_from_attitude,
 )
-from abrupt.model.momentum import body_momentum  # noqa: E402
-from abrupt.model.rotations import dcm_from_quaternion  # noqa: E402
+from abrupt.model.momentum import body_momentum
+from abrupt.model.rotations import dcm_from_quaternion
 
 FOLDER = Path(__file__).resolve().parents[2] / "shared" / "data" / "flight-like"
 
@@ -137,7 +136,8 @@ def main() -> None:
         for k, h in (("cat", h_cat), ("est", h_est), ("truth J", h_tru))
     }
     print(
-        f"ᴺH error RMS during slews [N m s]: catalogue {rms['cat']:.4f}, estimate {rms['est']:.4f}, true J {rms['truth J']:.4f};"
+        f"ᴺH error RMS during slews [N m s]: catalogue {rms['cat']:.4f}, estimate {rms['est']:.4f}, true J"
+        f" {rms['truth J']:.4f};"
         f" cut {rms['cat'] / rms['est']:.1f}x (target >= 10x)"
     )
     spikes = {"cat": [], "est": []}
@@ -148,7 +148,8 @@ def main() -> None:
             line = x[0] + (x[-1] - x[0]) * np.linspace(0, 1, x.shape[0])[:, None]
             spikes[key].append(float(np.max(np.linalg.norm(x - line, axis=1))))
     print(
-        f"largest ᴺH excursion within each slew (no truth needed) [N m s]: catalogue {np.round(spikes['cat'], 3)}, estimate {np.round(spikes['est'], 3)}"
+        "largest ᴺH excursion within each slew (no truth needed) [N m s]: "
+        f"catalogue {np.round(spikes['cat'], 3)}, estimate {np.round(spikes['est'], 3)}"
     )
 
     if "--no-pso" not in sys.argv:
@@ -191,11 +192,14 @@ def pso_side_by_side(d: MomentumBalanceData, j_cat: np.ndarray, j_true: np.ndarr
     dt = time.perf_counter() - t0
     j_pso = inertia_from_correction(j_cat, second.best)
     print(
-        f"PSO (Harris §3.2 reproduction): {len(wins)} slew windows, {first.costs.size + second.costs.size} simulations, {dt:.0f} s"
+        f"PSO (Harris §3.2 reproduction): {len(wins)} slew windows, {first.costs.size + second.costs.size}"
+        f" simulations, {dt:.0f} s"
     )
     print(
-        f"  cost (MSE of ᴺH, (N m s)^2): catalogue {obj(np.array([1, 1, 1, 0, 0, 0.0])):.3e}, PSO pass 1 {first.best_cost:.3e},"
-        f" pass 2 {second.best_cost:.3e}; direct estimate's inertia evaluated by the same cost: n/a (not in the 6-parameter family)"
+        f"  cost (MSE of ᴺH, (N m s)^2): catalogue {obj(np.array([1, 1, 1, 0, 0, 0.0])):.3e}, PSO pass 1"
+        f" {first.best_cost:.3e},"
+        f" pass 2 {second.best_cost:.3e}; direct estimate's inertia evaluated by the same cost: n/a (not in"
+        f" the 6-parameter family)"
     )
     print(f"  PSO correction: scales {np.round(second.best[:3], 4)}, ypr deg {np.round(second.best[3:], 2)}")
     score(

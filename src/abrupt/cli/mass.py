@@ -166,7 +166,7 @@ def detect_mass_change_cmd(
 @simulate.command("docking")
 @_spacecraft
 @click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False), help="Output folder.")
-@click.option("--days", type=int, default=10, show_default=True)
+@click.option("--days", type=float, default=10.0, show_default=True, help="Length [days]; fractions allowed.")
 @click.option("--docking-day", type=float, default=5.3, show_default=True, help="Docking time [days]; <0: none.")
 @click.option("--mass", "mass_kg", type=float, default=5.0, show_default=True, help="Parasite mass [kg].")
 @click.option(
@@ -182,7 +182,7 @@ def detect_mass_change_cmd(
 def simulate_docking_cmd(
     spacecraft_file: str,
     out_dir: str,
-    days: int,
+    days: float,
     docking_day: float,
     mass_kg: float,
     attachment: tuple[float, float, float],

@@ -104,16 +104,15 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
         stat = np.full(k, np.nan)
         best_tau = np.full(k, -1)
         alarm_at = -1
+        cs = np.concatenate([np.zeros((1, d)), np.cumsum(x, axis=0)])
         for n in range(self.min_windows_before + 1, k + 1):  # windows 0..n-1 available
-            best, tau_best = -math.inf, -1
-            for tau in range(self.min_windows_before, n):
-                before, after = x[:tau], x[tau:n]
-                diff = after.mean(axis=0) - before.mean(axis=0)
-                nb, na = before.shape[0], after.shape[0]
-                s = nb * na / (nb + na) * float(diff @ inv @ diff)
-                if s > best:
-                    best, tau_best = s, tau
-            stat[n - 1], best_tau[n - 1] = best, tau_best
+            taus = np.arange(self.min_windows_before, n)
+            nb, na = taus.astype(np.float64), (n - taus).astype(np.float64)
+            diff = (cs[n] - cs[taus]) / na[:, None] - cs[taus] / nb[:, None]
+            s_all = nb * na / (nb + na) * np.einsum("ti,ij,tj->t", diff, inv, diff)
+            j = int(np.argmax(s_all))
+            stat[n - 1], best_tau[n - 1] = float(s_all[j]), int(taus[j])
+            best = float(s_all[j])
             if best > h and alarm_at < 0:
                 alarm_at = n - 1
         diag = Diagnostics(

@@ -37,7 +37,7 @@ SECONDS_PER_DAY = 86400.0
 class DockingScenario:
     """Settings of :func:`simulate_docking` (SI units; times in seconds from the start)."""
 
-    days: int = 10
+    days: float = 10.0
     docking_time_s: float | None = 5.3 * SECONDS_PER_DAY
     parasite_mass_kg: float = 5.0
     attachment_B_m: tuple[float, float, float] = (1.0, 0.0, 0.0)
@@ -75,9 +75,12 @@ def _concat(a: PointingSimResult, b: PointingSimResult) -> PointingSimResult:
     return PointingSimResult(**fields)
 
 
-def random_slews(rng: np.random.Generator, day_start_s: float, n: int, angle_deg: tuple[float, float]) -> list[Slew]:
-    """``n`` slews spread over a day at random times and axes (each at least an hour apart)."""
-    starts = np.sort(rng.choice(np.arange(1, 23), size=n, replace=False)) * 3600.0 + rng.uniform(0, 1800, n)
+def random_slews(
+    rng: np.random.Generator, day_start_s: float, n: int, angle_deg: tuple[float, float], span_s: float = 86400.0
+) -> list[Slew]:
+    """``n`` slews at random times (in distinct hours of ``span_s``) about random axes."""
+    hours = max(n, int(span_s // 3600) - 1)
+    starts = (np.sort(rng.choice(np.arange(hours), size=n, replace=False)) + 0.1) * 3600.0 + rng.uniform(0, 1800, n)
     out = []
     for s in starts:
         axis = rng.standard_normal(3)
@@ -113,13 +116,16 @@ def simulate_docking(
     rho = np.asarray(scenario.attachment_B_m, dtype=np.float64)
     dh_b = np.cross(rho, scenario.parasite_mass_kg * np.asarray(scenario.approach_velocity_B_mps, dtype=np.float64))
     total = scenario.days * SECONDS_PER_DAY
+    n_days = math.ceil(scenario.days - 1e-9)
     slews: list[Slew] = []
-    for d in range(scenario.days):
+    for d in range(n_days):
+        span = min(SECONDS_PER_DAY, total - d * SECONDS_PER_DAY)
         slews += random_slews(
             rng,
             d * SECONDS_PER_DAY,
             int(rng.integers(scenario.slews_per_day[0], scenario.slews_per_day[1] + 1)),
             scenario.slew_angle_deg,
+            span,
         )
     ref = ReferenceTrajectory.nadir(scenario.orbit, total, slews, step_s=1.0)
     app = AppendageMotion.sun_tracking(
@@ -134,8 +140,8 @@ def simulate_docking(
     days: list[PointingSimResult] = []
     state: FloatArray | None = None
     contact_n = np.full(3, np.nan)
-    for d in range(scenario.days):
-        t0, t1 = d * SECONDS_PER_DAY, (d + 1) * SECONDS_PER_DAY
+    for d in range(n_days):
+        t0, t1 = d * SECONDS_PER_DAY, min((d + 1) * SECONDS_PER_DAY, total)
         cuts = [t0, t1]
         dock = scenario.docking_time_s
         if dock is not None and t0 < dock < t1:
