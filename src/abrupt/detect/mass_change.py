@@ -28,6 +28,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
+from abrupt.clean.noise import robust_scale
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.events import Event, events_frame, format_time_utc
 from abrupt.massprops.inertia import INERTIA_ELEMENTS
@@ -40,8 +41,7 @@ def _robust_cov(x: np.ndarray) -> np.ndarray:
     d = np.diff(x, axis=0)
     if d.shape[0] < 3:
         return np.full((x.shape[1], x.shape[1]), np.nan)
-    med = np.median(d, axis=0)
-    mad = 1.4826 * np.median(np.abs(d - med), axis=0)
+    mad = robust_scale(d, axis=0)
     corr = np.corrcoef(d.T) if d.shape[0] > 2 else np.eye(x.shape[1])
     corr = np.nan_to_num(corr, nan=0.0)
     np.fill_diagonal(corr, 1.0)
@@ -132,8 +132,7 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
         full_stats = []
         for cand in range(self.min_windows_before, k):
             diff = x[cand:].mean(axis=0) - x[:cand].mean(axis=0)
-            nb, na = cand, k - cand
-            full_stats.append(nb * na / (nb + na) * float(diff @ inv @ diff))
+            full_stats.append(cand * (k - cand) / k * float(diff @ inv @ diff))
         tau = self.min_windows_before + int(np.argmax(full_stats)) if full_stats else tau
         before, after = series.params[:tau], series.params[tau:]
         dj = after.mean(axis=0) - before.mean(axis=0)

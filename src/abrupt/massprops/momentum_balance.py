@@ -46,6 +46,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from abrupt.clean.noise import robust_scale
 from abrupt.errors import InputError
 from abrupt.massprops.inertia import (
     INERTIA_ELEMENTS,
@@ -230,7 +231,7 @@ def _running_mean(tx: FloatArray, y: FloatArray, t_out: FloatArray, window_s: fl
     if tx.size == 0:
         return np.zeros_like(t_out)
     med = np.median(y)
-    mad = 1.4826 * np.median(np.abs(y - med)) + 1e-15
+    mad = float(robust_scale(y)) + 1e-15
     y = np.clip(y, med - 5 * mad, med + 5 * mad)
     cs = np.concatenate([[0.0], np.cumsum(y)])
     lo = np.searchsorted(tx, t_out - window_s / 2)
@@ -335,7 +336,7 @@ def _find_steps(
     valid = (n_before * dt > window_s * 0.3) & (n_after * dt > window_s * 0.3)
     if not valid.any():
         return []
-    scale = 1.4826 * np.median(np.abs(mag[valid] - np.median(mag[valid]))) + np.median(mag[valid])
+    scale = float(robust_scale(mag[valid])) + float(np.median(mag[valid]))
     stat = np.where(valid, mag / max(scale, 1e-12), 0.0)
     steps: list[float] = []
     order = np.argsort(-stat)
@@ -442,7 +443,7 @@ def estimate_inertia(
     quiet_f = (w_dev < 5e-5 + 5 * np.median(w_dev)).astype(np.float64)
     # Gyro noise from the telemetry itself (second differences), for the EIV correction.
     d2 = np.diff(w, n=2, axis=0)
-    sigma_w = float(np.median(np.abs(d2 - np.median(d2, axis=0))) * 1.4826 / math.sqrt(6.0))
+    sigma_w = float(np.median(robust_scale(d2, axis=0))) / math.sqrt(6.0)
 
     # Bin-average the (linear) balance over ``bin_s`` inside each segment: the same equations with
     # averaged regressors, fewer rows and less tachometer-quantisation noise per row.

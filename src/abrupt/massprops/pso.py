@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from abrupt.massprops.inertia import perturb_inertia
+from abrupt.model.spacecraft import Spacecraft
 from abrupt.types import FloatArray
 
 
@@ -136,7 +137,7 @@ class SlewWindow:
 
 
 def harris_objective(
-    spacecraft: object,
+    spacecraft: Spacecraft,
     windows: list[SlewWindow],
     *,
     sim_rate_hz: float = 10.0,
@@ -155,7 +156,7 @@ def harris_objective(
     from abrupt.simulate.attitude import AttitudeSimConfig, PointingScenario, ReferenceTrajectory, simulate_pointing
 
     sc = spacecraft
-    j_cat = np.asarray(sc.inertia_kgm2, dtype=np.float64)  # type: ignore[attr-defined]
+    j_cat = np.asarray(sc.inertia_kgm2, dtype=np.float64)
     prepared = []
     for w in windows:
         ref = ReferenceTrajectory.from_telemetry(w.t_s, w.q_BN)
@@ -176,10 +177,10 @@ def harris_objective(
         total, count = 0.0, 0
         for ref, cfg, x0, meas, w in prepared:
             shifted = ReferenceTrajectory(ref.t_s - ref.t_s[0], ref.q_RN)
-            res = simulate_pointing(sc, cfg, PointingScenario(shifted, j_cand, None, False), initial_state=x0)  # type: ignore[arg-type]
+            res = simulate_pointing(sc, cfg, PointingScenario(shifted, j_cand, None, False), initial_state=x0)
             hb, hw = body_momentum(
                 res.true_omega_B_rad_s, res.true_wheel_speed_rad_s, j_cat, sc.wheel_axes, sc.wheel_spin_inertias_kgm2
-            )  # type: ignore[attr-defined]
+            )
             app = np.interp(res.t_s, w.t_s - w.t_s[0], np.arange(w.t_s.size))
             h_app = w.appendage_momentum_B_Nms[np.clip(np.round(app).astype(int), 0, w.t_s.size - 1)]
             c = dcm_from_quaternion(res.true_q_BN)
