@@ -55,16 +55,19 @@ def main(n: int) -> None:
             wheel_speed_resolution_rad_s=2 * np.pi / 64, seed=int(rng.integers(1 << 30)),
         )  # fmt: skip
         res = simulate_pointing(sc, cfg, PointingScenario(ref, j_true, orbit, True, app, tuple(rng.normal(0, 2e-6, 3))))
-        data = momentum_data_from_simulation(res, sc.wheel_axes, sc.wheel_spin_inertias_kgm2, orbit_period_s=orbit.period_s,
-                                             appendage_axis_B=(0, 1, 0), appendage_spin_inertia_kgm2=18.0)  # fmt: skip
+        data = momentum_data_from_simulation(
+            res, sc.wheel_axes, sc.wheel_spin_inertias_kgm2, orbit_period_s=orbit.period_s,
+            appendage_axis_B=(0, 1, 0), appendage_spin_inertia_kgm2=18.0,
+        )  # fmt: skip
         est = estimate_inertia(data, j_cat)
         z = (est.params - params_from_inertia(j_true)) / est.params_sigma
         zs.append(z)
         print(f"run {k}: z = {np.round(z, 2)}")
     z = np.asarray(zs)
     fin = np.isfinite(z)
-    print(f"{n} runs, {time.perf_counter() - t0:.0f} s: fraction |z| < 2 = {np.mean(np.abs(z[fin]) < 2):.3f} (95% if honest);"
-          f" RMS z = {np.sqrt(np.mean(z[fin] ** 2)):.2f} (1 if honest); per parameter RMS z {np.round(np.sqrt(np.nanmean(z**2, axis=0)), 2)}")  # fmt: skip
+    per_param = np.round(np.sqrt(np.nanmean(z**2, axis=0)), 2)
+    print(f"{n} runs, {time.perf_counter() - t0:.0f} s: fraction |z| < 2 = {np.mean(np.abs(z[fin]) < 2):.3f}")
+    print(f"  (95% if honest); RMS z = {np.sqrt(np.mean(z[fin] ** 2)):.2f} (1 if honest); per parameter {per_param}")
 
 
 if __name__ == "__main__":
