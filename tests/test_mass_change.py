@@ -109,7 +109,7 @@ def test_false_alarm_rate_on_unchanged_inertia_is_within_budget():
     rng = np.random.default_rng(2)
     det = InertiaChangeDetector()
     budget = FalseAlarmBudget(12, "year")  # 1 per month, so the test can measure it
-    n_tracks, n_windows = 300, 30
+    n_tracks, n_windows = 200, 30
     alarms = sum(len(det.detect(_track(n_windows, None, 0.0, rng), budget).events) for _ in range(n_tracks))
     expected = budget.per_day * n_windows * n_tracks  # at most one alarm per track
     assert alarms <= 2 * expected + 3
@@ -182,3 +182,32 @@ def test_cli_refuses_a_non_physical_catalogue(tmp_path):
     with pytest.raises(SystemExit) as exc:
         main(["estimate", "inertia", str(tel), "--spacecraft", str(sc), "--out", str(tmp_path / "o.toml")])
     assert exc.value.code == 2
+
+
+@pytest.mark.slow
+def test_cli_detect_mass_change_runs_on_simulated_docking(tmp_path):
+    from abrupt.cli.main import cli
+
+    sc = tmp_path / "sc.toml"
+    sc.write_text(
+        'name = "SC-E"\nmass_kg = 1000.0\ninertia_kgm2 = [[900.0, 5.0, -3.0], [5.0, 700.0, 2.0], [-3.0, 2.0, 1000.0]]\n'
+        + "".join(
+            f'[[wheels]]\nname = "rw{i}"\naxis = {a}\nspin_inertia_kgm2 = 0.12\nmax_torque_Nm = 0.2\n'
+            for i, a in enumerate([[1, 1, 1], [-1, 1, 1], [-1, -1, 1], [1, -1, 1]])
+        )
+    )
+    runner = CliRunner()
+    out = tmp_path / "sim"
+    args = ["simulate", "docking", "--spacecraft", str(sc), "--out", str(out), "--days", "0.4", "--docking-day", "0.2"]
+    args += ["--mass", "50", "--seed", "5"]
+    r = runner.invoke(cli, args)
+    assert r.exit_code == 0, r.output
+    events = tmp_path / "ev.csv"
+    r = runner.invoke(
+        cli,
+        ["detect", "mass-change", "--store", str(out), "--spacecraft", str(sc), "--orbit-period", "5926.4",
+         "--window", "4320", "--false-alarms", "1/year", "--out", str(events), "--catalog", str(tmp_path / "c.sqlite")],
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    assert "windows; GLR statistic max" in r.output
+    assert events.exists()
