@@ -7,10 +7,12 @@ newest window n and every candidate change window τ ≤ n,
     S(τ, n) = (n_b n_a / (n_b + n_a)) (x̄_after − x̄_before)ᵀ Σ⁻¹ (x̄_after − x̄_before),
 
 with x the observable inertia parameters, n_b/n_a the windows before/after τ and Σ the covariance of one
-window's estimate. Under no change S is χ² with d degrees of freedom. Σ is the data's own noise model:
-the robust scatter of window-to-window differences (÷2), or the estimator's bootstrap covariance when
-that is larger (never below what the estimator claims). The threshold is χ²_d at the per-test level of
-the false-alarm budget (one test per window), Bonferroni-corrected over the candidate change times.
+window's estimate. Σ is the data's own noise model: the shape of the estimator's bootstrap covariance,
+scaled by c ≥ 1 estimated from the window-to-window differences (robust median, so a step does not
+inflate it). With an estimated scale, S/c follows d·F(d, ν) (Hotelling's T²), and the threshold is
+that quantile at the per-test level of the false-alarm budget (one test per window), Bonferroni-
+corrected over the candidate change times. A change must persist for ``min_windows_after`` windows
+(default 2), so one bad window cannot raise an alarm.
 
 An alarm gives one ``mass_change`` event: the change time bracketed by the windows on either side of
 τ̂, ΔJ with its 1σ, and the implied mass for an assumed attachment radius r: a point mass m at distance
@@ -61,6 +63,7 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
         *,
         attachment_radius_m: float = 1.0,
         min_windows_before: int = 3,
+        min_windows_after: int = 2,
         attitude_events: pd.DataFrame | None = None,
         run_id: str = "",
         config_hash: str = "",
@@ -71,6 +74,9 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
             raise ValueError("min_windows_before must be at least 2")
         self.attachment_radius_m = float(attachment_radius_m)
         self.min_windows_before = int(min_windows_before)
+        if min_windows_after < 1:
+            raise ValueError("min_windows_after must be at least 1")
+        self.min_windows_after = int(min_windows_after)
         self._attitude_events = attitude_events
         self.run_id = run_id
         self.config_hash = config_hash
@@ -84,37 +90,50 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
             return DetectionResult.empty(warnings=("no inertia parameter is observable in every window",))
         x = series.params[:, idx]
         d = idx.size
-        sigma = _robust_cov(x)
+        # Shape of one window's covariance from the estimator; its scale from the data (below).
         boot = np.nanmedian(series.covariance[:, idx][:, :, idx], axis=0)
-        if not np.all(np.isfinite(sigma)):
-            sigma = boot
-            warnings.append("fewer than 4 windows: using the estimator's bootstrap covariance")
-        else:
-            # Never below the estimator's own claim (the larger of the two per eigen-direction).
-            w_s, v_s = np.linalg.eigh(0.5 * (sigma + sigma.T))
-            lam_b = np.einsum("ik,ij,jk->k", v_s, boot, v_s)
-            sigma = v_s @ np.diag(np.maximum(w_s, lam_b)) @ v_s.T
-        inv = np.linalg.pinv(sigma)
+        if not np.all(np.isfinite(boot)):
+            boot = _robust_cov(x)
+        if not np.all(np.isfinite(boot)):
+            return DetectionResult.empty(warnings=("fewer than 4 windows and no estimator covariance",))
+        inv_b = np.linalg.pinv(boot)
         window_s = float(np.median(series.t_end_s - series.t_start_s))
         tests_per_day = 86400.0 / window_s
-        n_candidates = max(1, k - self.min_windows_before)
+        n_candidates = max(1, k - self.min_windows_before - self.min_windows_after + 1)
         p_test = budget.per_test(tests_per_day) / n_candidates
-        h = float(stats.chi2.isf(p_test, d))
-        threshold = Threshold(h, p_test, f"chi2(d={d})/bonferroni({n_candidates})", k, budget.per_day)
+        # Scale factor c_n ≥ 1 of the covariance from consecutive differences of windows 0..n-1:
+        # m_j = Δxᵀ (2 Σ_b)⁻¹ Δx / d is χ²_d / d under no change; the median ignores the one difference
+        # that spans a step. The statistic S / c_n is then compared with d F(d, ν), ν the degrees of
+        # freedom of c_n (median efficiency 2/π), Hotelling's T² with an estimated scale.
+        dx = np.diff(x, axis=0)
+        m = np.einsum("ti,ij,tj->t", dx, inv_b, dx) / (2.0 * d)
+        med_chi = float(stats.chi2.median(d)) / d
         stat = np.full(k, np.nan)
+        thr = np.full(k, np.nan)
+        scale = np.full(k, np.nan)
         best_tau = np.full(k, -1)
         alarm_at = -1
         cs = np.concatenate([np.zeros((1, d)), np.cumsum(x, axis=0)])
-        for n in range(self.min_windows_before + 1, k + 1):  # windows 0..n-1 available
-            taus = np.arange(self.min_windows_before, n)
+        first = self.min_windows_before + self.min_windows_after
+        for n in range(first, k + 1):  # windows 0..n-1 available
+            c_n = max(1.0, float(np.median(m[: n - 1])) / med_chi)
+            nu = max(1.0, (n - 1) * d * 2.0 / math.pi)
+            h_n = d * float(stats.f.isf(p_test, d, nu))
+            taus = np.arange(self.min_windows_before, n - self.min_windows_after + 1)
             nb, na = taus.astype(np.float64), (n - taus).astype(np.float64)
             diff = (cs[n] - cs[taus]) / na[:, None] - cs[taus] / nb[:, None]
-            s_all = nb * na / (nb + na) * np.einsum("ti,ij,tj->t", diff, inv, diff)
+            s_all = nb * na / (nb + na) * np.einsum("ti,ij,tj->t", diff, inv_b, diff) / c_n
             j = int(np.argmax(s_all))
-            stat[n - 1], best_tau[n - 1] = float(s_all[j]), int(taus[j])
-            best = float(s_all[j])
-            if best > h and alarm_at < 0:
+            stat[n - 1], best_tau[n - 1], thr[n - 1], scale[n - 1] = float(s_all[j]), int(taus[j]), h_n, c_n
+            if s_all[j] > h_n and alarm_at < 0:
                 alarm_at = n - 1
+        h = float(thr[alarm_at]) if alarm_at >= 0 else float(thr[-1]) if np.isfinite(thr[-1]) else math.nan
+        threshold = Threshold(h, p_test, f"{d}F(d={d},nu)/bonferroni({n_candidates})", k, budget.per_day)
+        c_final = (
+            float(scale[alarm_at]) if alarm_at >= 0 else float(np.nanmax(scale)) if np.isfinite(scale).any() else 1.0
+        )
+        sigma = boot * c_final
+        inv = np.linalg.pinv(sigma)
         diag = Diagnostics(
             name="inertia_glr",
             time_s=series.t_end_s,
@@ -123,7 +142,7 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
             epoch_utc=np.datetime64(pd.Timestamp(series.epoch_utc or "1970-01-01").tz_localize(None)),
             unit="chi2",
             noise_model={"window_covariance_kgm2_sq": sigma, "parameters": [INERTIA_ELEMENTS[i] for i in idx]},
-            extra={"best_change_window": best_tau},
+            extra={"best_change_window": best_tau, "threshold_per_window": thr, "covariance_scale": scale},
         )
         if alarm_at < 0:
             return DetectionResult.empty(diagnostics=(diag,), warnings=tuple(warnings))

@@ -365,6 +365,7 @@ def estimate_inertia(
     bootstrap: int = 200,
     block_s: float = 1800.0,
     bin_s: float = 5.0,
+    sigma_scale: float = 1.3,
     seed: int = 0,
 ) -> InertiaEstimate:
     """Estimate J (and nuisance torques, impulses, optional wheel scale factors) from the momentum balance.
@@ -374,7 +375,10 @@ def estimate_inertia(
     scale factor per wheel (relative to the catalogue spin inertia); ``gyro_bias`` removes the slowly
     varying gyro bias with :func:`gyro_bias_from_attitude`; ``find_steps`` adds an unknown impulse at each
     momentum step found in the residual (strikes); ``bin_s`` averages the balance over bins of that
-    length before the fit (0: every sample); ``excitation_rel_sigma``: a direction of p is reported
+    length before the fit (0: every sample); ``sigma_scale`` multiplies the bootstrap spread: the wild
+    block bootstrap underestimates the error by this factor on simulated routine telemetry
+    (``benchmarks/bench_inertia_coverage.py``: RMS z = 1.30 over 12 independent half-days, 87.5% of |z| < 2
+    before the correction); ``excitation_rel_sigma``: a direction of p is reported
     only if its 1σ is below this fraction of the mean principal moment. Raises
     :class:`InsufficientExcitationError` when no direction at all is determined.
     """
@@ -544,6 +548,8 @@ def estimate_inertia(
         cov = np.cov(boot.T)
     else:
         cov = np.full((6, 6), np.nan)
+    cov = cov * sigma_scale**2
+    boot = p + sigma_scale * (boot - p) if boot.shape[0] > 1 else boot
     sig = np.sqrt(np.maximum(np.diag(cov), 0.0))
     sig = np.where(observable, sig, np.nan)
 
