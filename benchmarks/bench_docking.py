@@ -58,6 +58,8 @@ def run(days: float, docking_day: float | None, seed: int) -> None:
         rows.append((float(day.t_s[0]), float(day.t_s[-1]), estimate_inertia(data, j_cat, bootstrap=100)))
     t_est = time.perf_counter() - t0
     track = InertiaTrack.from_estimates("SC-DOCK", "2026-01-01T00:00:00Z", rows)
+    np.savez(f"/tmp/inertia_track_{'null' if docking_day is None else 'dock'}.npz", params=track.params,
+             covariance=track.covariance, t_start_s=track.t_start_s, t_end_s=track.t_end_s)  # fmt: skip
     budget = FalseAlarmBudget(1, "year")
     res = InertiaChangeDetector(attachment_radius_m=1.0).detect(track, budget)
     diag = res.diagnostic("inertia_glr")
@@ -89,5 +91,6 @@ def run(days: float, docking_day: float | None, seed: int) -> None:
 
 if __name__ == "__main__":
     days = float(sys.argv[sys.argv.index("--days") + 1]) if "--days" in sys.argv else 12.0
-    run(days, days / 2 + 0.37, seed=11)
+    if "--null-only" not in sys.argv:
+        run(days, days / 2 + 0.37, seed=11)
     run(days, None, seed=12)

@@ -8,8 +8,9 @@ newest window n and every candidate change window τ ≤ n,
 
 with x the observable inertia parameters, n_b/n_a the windows before/after τ and Σ the covariance of one
 window's estimate. Σ is the data's own noise model: the shape of the estimator's bootstrap covariance,
-scaled by c ≥ 1 estimated from the window-to-window differences (robust median, so a step does not
-inflate it). With an estimated scale, S/c follows d·F(d, ν) (Hotelling's T²), and the threshold is
+scaled by c ≥ 1 estimated from the differences of windows 1, 2 and 3 apart (robust median, so a step
+does not inflate it; the largest lag's spread is kept, so a slow drift of the estimates is not taken
+for a step). With an estimated scale, S/c follows d·F(d, ν) (Hotelling's T²), and the threshold is
 that quantile at the per-test level of the false-alarm budget (one test per window), Bonferroni-
 corrected over the candidate change times. A change must persist for ``min_windows_after`` windows
 (default 2), so one bad window cannot raise an alarm.
@@ -83,6 +84,10 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
 
     def detect(self, series: InertiaTrack, budget: FalseAlarmBudget) -> DetectionResult:
         k = series.n_windows
+        if k < self.min_windows_before + self.min_windows_after:
+            return DetectionResult.empty(
+                warnings=(f"{k} window(s): need {self.min_windows_before + self.min_windows_after} to test a change",)
+            )
         obs = np.all(series.observable, axis=0)
         idx = np.flatnonzero(obs)
         warnings: list[str] = []
@@ -105,8 +110,13 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
         # m_j = Δxᵀ (2 Σ_b)⁻¹ Δx / d is χ²_d / d under no change; the median ignores the one difference
         # that spans a step. The statistic S / c_n is then compared with d F(d, ν), ν the degrees of
         # freedom of c_n (median efficiency 2/π), Hotelling's T² with an estimated scale.
-        dx = np.diff(x, axis=0)
-        m = np.einsum("ti,ij,tj->t", dx, inv_b, dx) / (2.0 * d)
+        # Lags 1..3: under white window noise every lag has the same spread; a slow drift of the
+        # estimates (a systematic that varies over days) shows up as a spread growing with the lag,
+        # and the largest is used, so slow drifts are not taken for a step.
+        lag_m = []
+        for lag in (1, 2, 3):
+            dl = x[lag:] - x[:-lag]
+            lag_m.append(np.einsum("ti,ij,tj->t", dl, inv_b, dl) / (2.0 * d))
         med_chi = float(stats.chi2.median(d)) / d
         stat = np.full(k, np.nan)
         thr = np.full(k, np.nan)
@@ -116,7 +126,10 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
         cs = np.concatenate([np.zeros((1, d)), np.cumsum(x, axis=0)])
         first = self.min_windows_before + self.min_windows_after
         for n in range(first, k + 1):  # windows 0..n-1 available
-            c_n = max(1.0, float(np.median(m[: n - 1])) / med_chi)
+            c_n = 1.0
+            for lag, ml in enumerate(lag_m, start=1):
+                if n - lag >= 2:
+                    c_n = max(c_n, float(np.median(ml[: n - lag])) / med_chi)
             nu = max(1.0, (n - 1) * d * 2.0 / math.pi)
             h_n = d * float(stats.f.isf(p_test, d, nu))
             taus = np.arange(self.min_windows_before, n - self.min_windows_after + 1)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -37,6 +37,16 @@ class InertiaTrack:
     @property
     def n_windows(self) -> int:
         return int(self.t_start_s.shape[0])
+
+    def shifted(self, seconds: float) -> InertiaTrack:
+        """The same track ``seconds`` later (window times moved, epoch kept)."""
+        return replace(self, t_start_s=self.t_start_s + seconds, t_end_s=self.t_end_s + seconds)
+
+    @classmethod
+    def empty(cls, spacecraft: str = "SC", epoch_utc: str = "2026-01-01T00:00:00Z") -> InertiaTrack:
+        """A track with no windows."""
+        return cls(spacecraft, epoch_utc, np.zeros(0), np.zeros(0), np.zeros((0, 6)), np.zeros((0, 6, 6)),
+                   np.zeros((0, 6), dtype=bool))  # fmt: skip
 
     @classmethod
     def from_estimates(
