@@ -93,4 +93,5 @@ if __name__ == "__main__":
     days = float(sys.argv[sys.argv.index("--days") + 1]) if "--days" in sys.argv else 12.0
     if "--null-only" not in sys.argv:
         run(days, days / 2 + 0.37, seed=11)
-    run(days, None, seed=12)
+    if "--dock-only" not in sys.argv:
+        run(days, None, seed=12)
