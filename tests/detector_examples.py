@@ -127,8 +127,28 @@ def inertia_track_example() -> Any:
     return InertiaTrack("SC-X", "2026-01-01T00:00:00Z", t0, t0 + 86400.0, p, cov, np.ones((n, 6), bool))
 
 
+# ---------------------------------------------------------------------------------------------- TLE
+
+
+@cache
+def tle_example() -> Any:
+    """200 days of daily LEO element sets (sgp4's exporter, 0.5 m noise in a) with a 2 cm/s in-track burn."""
+    import tempfile
+    from pathlib import Path
+
+    from abrupt.readers.tle import read_tle
+    from test_tle_synthetic import synthetic_tle_text
+
+    text, _ = synthetic_tle_text(days=200, burns=((100.3, 0.02),), seed=2)
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "example.tle"
+        path.write_text(text)
+        return read_tle(path)
+
+
 def _examples() -> dict[type, SeriesExample]:
     from abrupt.massprops.track import InertiaTrack
+    from abrupt.readers.tle import ElementHistory
     from abrupt.series.attitude import AttitudeSeries
     from abrupt.series.tracking import TrackingSeries
 
@@ -137,6 +157,12 @@ def _examples() -> dict[type, SeriesExample]:
             make=inertia_track_example,
             empty=InertiaTrack.empty,
             shift=lambda s, seconds: s.shifted(seconds),
+        ),
+        ElementHistory: SeriesExample(
+            make=tle_example,
+            empty=ElementHistory.empty,
+            shift=lambda s, seconds: s.shifted(seconds),
+            notes="tle.geo_station_keeping runs on the LEO example too: its regime is forced",
         ),
         TrackingSeries: SeriesExample(
             make=tracking_example,
