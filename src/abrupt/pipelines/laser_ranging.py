@@ -324,7 +324,7 @@ def run_laser_ranging_files(
         run_id=run_id,
         config_hash=cfg_hash,
         false_alarms_per_day=budget.per_day,
-        detector="tracking.laser_glrt",
+        detector="tracking.glrt",  # the registered GLRT; the laser reduction is a model stage before it
     )
     frame = events_frame(events) if events else empty_frame()
     summary: dict[str, object] = {
