@@ -1,0 +1,1 @@
+"""Cleaning stages applied to momentum before detection (masks, comb filter, trend removal)."""

@@ -1,0 +1,1 @@
+"""Orchestration of each capability (no click inside): read, clean, model, detect, threshold, record."""

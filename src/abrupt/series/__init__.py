@@ -1,0 +1,1 @@
+"""Typed series and their synchronisation onto a common grid (timetable)."""
