@@ -4,4 +4,5 @@ A new capability adds its detector module here (one line); a detector defined an
 plug-in, a test) registers as soon as its class is defined.
 """
 
-# Built-in detector modules are imported below as they adopt abrupt.detect.base.Detector.
+import abrupt.detect.attitude
+import abrupt.detect.matched_filter.detectors  # noqa: F401  attitude.mf_attitude, attitude.mf_rate, attitude.mf_joint

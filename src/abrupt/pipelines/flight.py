@@ -32,13 +32,13 @@ import numpy as np
 import pandas as pd
 
 from abrupt.clean.comb import CombConfig, smooth_model
-from abrupt.clean.masks import SlewMaskConfig, event_mask, flag_intervals, slew_mask
+from abrupt.clean.flight_masks import SlewMaskConfig, event_mask, flag_intervals, slew_mask
 from abrupt.detect.change_detection import WindowConfig, sliding_statistic
 from abrupt.errors import ConfigError, InputError
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc, new_run_id
 from abrupt.model.flight_config import FlightConfig
 from abrupt.model.flight_momentum import timetable_momentum
-from abrupt.model.noise import robust_noise_sigma
+from abrupt.clean.noise import robust_noise_sigma
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.readers.archive import DayReport, read_archive, read_decoder
 from abrupt.series.timetable import NS, build_timetable
