@@ -47,3 +47,43 @@ def timetable_momentum(
     h_n[~table.valid] = np.nan
     h_b = np.where(table.valid[:, None], h_b, np.nan)
     return np.asarray(h_n, dtype=np.float64), np.asarray(h_b, dtype=np.float64)
+
+
+UNIT_RATIOS = {"rpm": 2.0 * np.pi / 60.0, "rps": 2.0 * np.pi, "deg/s": np.pi / 180.0}
+
+
+def wheel_scale_from_conservation(spacecraft: Spacecraft, table: Timetable) -> tuple[float, float]:
+    """Scale s of the wheel term that makes ᴺH most nearly constant, and how well it is determined.
+
+    ᴺH = [BN]ᵀ(Jω + appendages) + s [BN]ᵀ J_s G Ω is conserved (Bennett 2022 Eq. 2.7) only for the
+    right wheel-speed unit (s = 1). Least squares over the samples gives
+    s* = −Σ (A − Ā)·(W − W̄) / Σ |W − W̄|². Returns (s*, r) with r the fraction of the wheel term's
+    variance that the fit explains (near 1: the unit is decided by the data; near 0: the wheels barely
+    moved and nothing can be said).
+    """
+    ok = table.valid
+    if ok.sum() < 100:
+        return float("nan"), 0.0
+    t2 = Timetable(
+        table.time_ns[ok],
+        table.quaternion_BN[ok],
+        table.body_rate_rad_s[ok],
+        np.zeros_like(table.wheel_speed_rad_s[ok]),
+        table.appendage_rate_rad_s[ok],
+        table.flags[ok],
+        np.ones(int(ok.sum()), bool),
+    )
+    a, _ = timetable_momentum(spacecraft, t2)
+    q = table.quaternion_BN[ok]
+    bn = dcm_from_quaternion(q)
+    w_b = (table.wheel_speed_rad_s[ok] * spacecraft.wheel_spin_inertias_kgm2) @ spacecraft.wheel_axes.T
+    w = np.einsum("nji,nj->ni", bn, w_b)
+    a = a - a.mean(axis=0)
+    w = w - w.mean(axis=0)
+    ww = float(np.sum(w * w))
+    if ww == 0:
+        return float("nan"), 0.0
+    s = -float(np.sum(a * w)) / ww
+    resid = float(np.sum((a + s * w) ** 2))
+    total = float(np.sum(a * a))
+    return s, (1.0 - resid / total) if total > 0 else 0.0
