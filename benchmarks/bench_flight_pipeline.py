@@ -32,7 +32,11 @@ def truth() -> list[dict]:
 
 def score(events: pd.DataFrame, strikes: list[dict], tol_s: float = 10.0) -> dict:
     """Match events to strikes within tol_s; recall by size, false alarms/day, |ΔH| errors."""
-    t_ev = (pd.to_datetime(events["time_utc"]).dt.tz_localize(None).to_numpy() - T0) / np.timedelta64(1, "s") if len(events) else np.array([])
+    t_ev = (
+        (pd.to_datetime(events["time_utc"]).dt.tz_localize(None).to_numpy() - T0) / np.timedelta64(1, "s")
+        if len(events)
+        else np.array([])
+    )
     used = np.zeros(len(t_ev), bool)
     rows = []
     for s in strikes:
@@ -57,10 +61,14 @@ def print_score(label: str, sc: dict) -> None:
     small = [r for r in rows if r["dH"] < 0.1]
     print(f"\n[{label}]")
     for r in sorted(rows, key=lambda r: r["dH"]):
-        print(f"  strike {r['dH']:.3f} N m s: {'found' if r['found'] else 'MISSED'}"
-              + (f"  dt {r['dt_s']:+.1f} s  |dH| err {100 * r['rel_err']:+.0f}%" if r["found"] else ""))
-    print(f"  >= 0.1 N m s found within 10 s: {sum(r['found'] for r in big)}/{len(big)} (target all);"
-          f" max |dH| error {100 * max((abs(r['rel_err']) for r in big if r['found']), default=float('nan')):.0f}% (target 30%)")
+        print(
+            f"  strike {r['dH']:.3f} N m s: {'found' if r['found'] else 'MISSED'}"
+            + (f"  dt {r['dt_s']:+.1f} s  |dH| err {100 * r['rel_err']:+.0f}%" if r["found"] else "")
+        )
+    print(
+        f"  >= 0.1 N m s found within 10 s: {sum(r['found'] for r in big)}/{len(big)} (target all);"
+        f" max |dH| error {100 * max((abs(r['rel_err']) for r in big if r['found']), default=float('nan')):.0f}% (target 30%)"
+    )
     print(f"  < 0.1 N m s (0.02-0.03): {sum(r['found'] for r in small)}/{len(small)}")
     print(f"  false alarms: {sc['false_alarms']} in 2 days = {sc['fa_per_day']:.1f}/day (target <= 1)")
 
@@ -101,10 +109,14 @@ def part_inject(store: Path) -> None:
     print(f"\ninjection/recovery ({time.time() - t:.0f} s), threshold {res.threshold.value:.2f} (1 FA/day):")
     inj = rec.injections
     for size, grp in inj.groupby("dH_Nms"):
-        print(f"  {size:.3f} N m s: {grp['found'].mean():.0%} of {len(grp)}; |dH| err median {100 * grp['rel_err'].abs().median():.0f}%")
+        print(
+            f"  {size:.3f} N m s: {grp['found'].mean():.0%} of {len(grp)}; |dH| err median {100 * grp['rel_err'].abs().median():.0f}%"
+        )
     print(rec.per_day.to_string(index=False))
-    print(f"  90%-detectable dH per day: {', '.join(f'{v:.4f}' for v in rec.per_day['dH90_Nms'])} N m s "
-          f"(mean {rec.per_day['dH90_Nms'].mean():.4f}, spread across days {rec.per_day['dH90_Nms'].std():.4f}; target <= 0.05)")
+    print(
+        f"  90%-detectable dH per day: {', '.join(f'{v:.4f}' for v in rec.per_day['dH90_Nms'])} N m s "
+        f"(mean {rec.per_day['dH90_Nms'].mean():.4f}, spread across days {rec.per_day['dH90_Nms'].std():.4f}; target <= 0.05)"
+    )
 
 
 if __name__ == "__main__":
@@ -118,4 +130,3 @@ if __name__ == "__main__":
     ensure_store(store)
     for p in args.parts.split(","):
         globals()[f"part_{p}"](store)
-

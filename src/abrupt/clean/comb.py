@@ -64,7 +64,9 @@ def comb_subtract(x: FloatArray, t_s: FloatArray, period_s: float, n_harmonics: 
     return np.asarray(x - alpha * comb_fit(x, t_s, period_s, n_harmonics), dtype=np.float64)
 
 
-def estimate_period(h: FloatArray, t_s: FloatArray, valid: BoolArray, p_min_s: float = 4800.0, p_max_s: float = 48000.0) -> float:
+def estimate_period(
+    h: FloatArray, t_s: FloatArray, valid: BoolArray, p_min_s: float = 4800.0, p_max_s: float = 48000.0
+) -> float:
     """Period [s] of the strongest periodic component of ᴺH (Lomb-Scargle on linearly detrended axes)."""
     sel = valid & np.all(np.isfinite(h), axis=1)
     t = t_s[sel]
@@ -81,7 +83,9 @@ def estimate_period(h: FloatArray, t_s: FloatArray, valid: BoolArray, p_min_s: f
     return float(2.0 * np.pi / freqs[int(np.argmax(power))])
 
 
-def _design(t_s: FloatArray, center: float, half: float, period_s: float, k: int, order: int, steps: FloatArray) -> FloatArray:
+def _design(
+    t_s: FloatArray, center: float, half: float, period_s: float, k: int, order: int, steps: FloatArray
+) -> FloatArray:
     """Columns [trend polynomial, steps, cos/sin harmonic 1, ..., harmonic k] (nested in k)."""
     u = (t_s - center) / half
     poly = np.column_stack([u**p for p in range(max(order, 0) + 1)])

@@ -299,11 +299,20 @@ def run_attitude_detection(
 
 @detect.command("attitude")
 @click.argument("telemetry", required=False, type=click.Path(exists=True, dir_okay=False))
-@click.option("--store", "store_dir", default=None, type=click.Path(exists=True, file_okay=False),
-              help="Flight pipeline: read a store written by `abrupt ingest` instead of TELEMETRY.")
+@click.option(
+    "--store",
+    "store_dir",
+    default=None,
+    type=click.Path(exists=True, file_okay=False),
+    help="Flight pipeline: read a store written by `abrupt ingest` instead of TELEMETRY.",
+)
 @click.option("--days", multiple=True, help="With --store: days (YYYY-MM-DD or A..B); default all.")
-@click.option("--no-clean", multiple=True, type=click.Choice(FLIGHT_STAGES),
-              help="With --store: switch a cleaning stage off (repeatable; 'all' for none).")
+@click.option(
+    "--no-clean",
+    multiple=True,
+    type=click.Choice(FLIGHT_STAGES),
+    help="With --store: switch a cleaning stage off (repeatable; 'all' for none).",
+)
 @click.option(
     "--spacecraft",
     "spacecraft_path",
@@ -381,11 +390,20 @@ def detect_attitude_cmd(
 
 @report.command("attitude")
 @click.argument("telemetry", required=False, type=click.Path(exists=True, dir_okay=False))
-@click.option("--store", "store_dir", default=None, type=click.Path(exists=True, file_okay=False),
-              help="Flight pipeline: read a store written by `abrupt ingest` instead of TELEMETRY.")
+@click.option(
+    "--store",
+    "store_dir",
+    default=None,
+    type=click.Path(exists=True, file_okay=False),
+    help="Flight pipeline: read a store written by `abrupt ingest` instead of TELEMETRY.",
+)
 @click.option("--days", multiple=True, help="With --store: days (YYYY-MM-DD or A..B); default all.")
-@click.option("--no-clean", multiple=True, type=click.Choice(FLIGHT_STAGES),
-              help="With --store: switch a cleaning stage off (repeatable; 'all' for none).")
+@click.option(
+    "--no-clean",
+    multiple=True,
+    type=click.Choice(FLIGHT_STAGES),
+    help="With --store: switch a cleaning stage off (repeatable; 'all' for none).",
+)
 @click.option("--spacecraft", "spacecraft_path", type=click.Path(exists=True, dir_okay=False), required=True)
 @_with_options(detector_options)
 @click.option(

@@ -20,8 +20,13 @@ def _progress(total: int, label: str) -> Any:
 
 @cli.command("ingest")
 @click.argument("archives", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False))
-@click.option("--decoder", "decoder_path", required=True, type=click.Path(exists=True, dir_okay=False),
-              help="Pseudonym decoder CSV (real_name,pseudonym); read here only, never downstream.")
+@click.option(
+    "--decoder",
+    "decoder_path",
+    required=True,
+    type=click.Path(exists=True, dir_okay=False),
+    help="Pseudonym decoder CSV (real_name,pseudonym); read here only, never downstream.",
+)
 @click.option("--store", "store_dir", required=True, type=click.Path(file_okay=False), help="Parquet store directory.")
 @click.option("--layout", type=click.Choice(["auto", "long", "wide"]), default="auto", show_default=True)
 @click.option("--assume-utc", is_flag=True, help="Read times without a zone as UTC (counted in the report).")
@@ -37,8 +42,10 @@ def ingest_cmd(archives: tuple[str, ...], decoder_path: str, store_dir: str, lay
     for d in summary.days:
         removed = ", ".join(f"{k} {v}" for k, v in d.get("removed", {}).items()) or "none"
         reported = ", ".join(f"{k} {v}" for k, v in d.get("reported", {}).items()) or "none"
-        click.echo(f"{d['spacecraft']} {d['day']}: {d.get('rows_stored', d.get('rows_kept', 0))} rows; "
-                   f"removed: {removed}; reported: {reported}")
+        click.echo(
+            f"{d['spacecraft']} {d['day']}: {d.get('rows_stored', d.get('rows_kept', 0))} rows; "
+            f"removed: {removed}; reported: {reported}"
+        )
     for name, counts in summary.files.items():
         extra = {k: v for k, v in counts.items() if k != "rows read"}
         if extra:
@@ -100,7 +107,11 @@ def detect_from_store(
             run_id=result.run_id,
             input_path=None,
             out=out,
-            details={"store": str(store_dir), "threshold": result.threshold.as_dict(), "daily": result.daily.to_dict("records")},
+            details={
+                "store": str(store_dir),
+                "threshold": result.threshold.as_dict(),
+                "daily": result.daily.to_dict("records"),
+            },
             spacecraft=sc.name,
             detectors=["attitude.glr"],
         )
@@ -124,14 +135,23 @@ def detect_from_store(
 @inject.command("attitude")
 @click.option("--store", "store_dir", required=True, type=click.Path(exists=True, file_okay=False))
 @click.option("--spacecraft", "spacecraft_path", required=True, type=click.Path(exists=True, dir_okay=False))
-@click.option("--out-store", default=None, type=click.Path(file_okay=False),
-              help="Write a copy of the store with the strikes injected (native units).")
-@click.option("--strike", "strikes", multiple=True,
-              help="TIME_UTC:DHX,DHY,DHZ (inertial axes, N·m·s); repeatable.")
+@click.option(
+    "--out-store",
+    default=None,
+    type=click.Path(file_okay=False),
+    help="Write a copy of the store with the strikes injected (native units).",
+)
+@click.option("--strike", "strikes", multiple=True, help="TIME_UTC:DHX,DHY,DHZ (inertial axes, N·m·s); repeatable.")
 @click.option("--recovery", is_flag=True, help="Injection-recovery study: 90%-detectable ΔH per day.")
 @click.option("--days", multiple=True, help="Days (YYYY-MM-DD or A..B); default all stored days.")
-@click.option("--false-alarms", "false_alarms_per_day", type=float, default=1.0, show_default=True,
-              help="False alarms per day the threshold is set for.")
+@click.option(
+    "--false-alarms",
+    "false_alarms_per_day",
+    type=float,
+    default=1.0,
+    show_default=True,
+    help="False alarms per day the threshold is set for.",
+)
 @click.option("--seed", type=int, default=0, show_default=True)
 @click.option("--out", default=None, type=click.Path(dir_okay=False), help="Recovery table (.csv).")
 def inject_attitude_cmd(
@@ -177,7 +197,9 @@ def inject_attitude_cmd(
             frame["time"] = frame["time"].dt.tz_localize("UTC")
             report = store.report(sc.name, day)
             report["injected_strikes"] = [
-                {"time_ns": s.time_ns, "dH_N_Nms": s.dH_N_Nms.tolist()} for s in parsed if str(np.datetime64(s.time_ns, "ns"))[:10] == day
+                {"time_ns": s.time_ns, "dH_N_Nms": s.dH_N_Nms.tolist()}
+                for s in parsed
+                if str(np.datetime64(s.time_ns, "ns"))[:10] == day
             ]
             dst.write_day(sc.name, day, frame, report)
         click.echo(f"{len(parsed)} strike(s) injected; store written to {out_store}")

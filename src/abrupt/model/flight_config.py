@@ -182,8 +182,14 @@ def parse_orbit(table: Any, file: str) -> OrbitInfo:
         raise ConfigError("expected a table", file=file, key="orbit")
     unknown = sorted(set(table) - _ORBIT_KEYS)
     if unknown:
-        raise ConfigError(f"unknown key(s) {unknown}; allowed: {sorted(_ORBIT_KEYS)}", file=file, key=f"orbit.{unknown[0]}")
-    inc = _num(table["inclination_deg"], "orbit.inclination_deg", file, positive=False) if "inclination_deg" in table else math.nan
+        raise ConfigError(
+            f"unknown key(s) {unknown}; allowed: {sorted(_ORBIT_KEYS)}", file=file, key=f"orbit.{unknown[0]}"
+        )
+    inc = (
+        _num(table["inclination_deg"], "orbit.inclination_deg", file, positive=False)
+        if "inclination_deg" in table
+        else math.nan
+    )
     if "period_s" in table:
         return OrbitInfo(_num(table["period_s"], "orbit.period_s", file), inc)
     if "altitude_km" in table:
@@ -225,7 +231,11 @@ def parse_flight(table: Any, file: str, n_wheels: int, appendages: tuple[str, ..
     grid_hz = _num(grid, "flight.grid_hz", file)
     gap = _num(table.get("max_gap_intervals", 2.5), "flight.max_gap_intervals", file)
     if gap < 1.0:
-        raise ConfigError("must be at least 1 (a gap is longer than this many sample intervals)", file=file, key="flight.max_gap_intervals")
+        raise ConfigError(
+            "must be at least 1 (a gap is longer than this many sample intervals)",
+            file=file,
+            key="flight.max_gap_intervals",
+        )
     return FlightConfig(channels=tuple(channels), grid_hz=grid_hz, max_gap_intervals=gap)
 
 
@@ -255,13 +265,17 @@ def _channel(c: Any, where: str, file: str, appendages: tuple[str, ...]) -> Flig
         raise ConfigError("expected a pseudonym such as 'SC-A.ch01'", file=file, key=f"{where}.mnemonic")
     quantity = c["quantity"]
     if quantity not in QUANTITIES:
-        raise ConfigError(f"unknown quantity {quantity!r}; choose one of {QUANTITIES}", file=file, key=f"{where}.quantity")
+        raise ConfigError(
+            f"unknown quantity {quantity!r}; choose one of {QUANTITIES}", file=file, key=f"{where}.quantity"
+        )
     unit = c.get("unit", "")
     if not isinstance(unit, str):
         raise ConfigError("expected a unit name", file=file, key=f"{where}.unit")
     units = UNITS_OF.get(quantity)
     if units is not None and unit not in units:
-        raise ConfigError(f"unknown unit {unit!r} for {quantity}; choose one of {sorted(units)}", file=file, key=f"{where}.unit")
+        raise ConfigError(
+            f"unknown unit {unit!r} for {quantity}; choose one of {sorted(units)}", file=file, key=f"{where}.unit"
+        )
     default_method = {
         "quaternion": "quaternion",
         "appendage_angle": "unwrap_rate",

@@ -400,9 +400,7 @@ def spacecraft_from_dict(data: dict[str, Any], *, source: str = "<memory>") -> S
         raise ConfigError(f"column(s) {dup} mapped to more than one quantity", file=file, key="telemetry")
     orbit = parse_orbit(data["orbit"], file) if "orbit" in data else None
     flight = (
-        parse_flight(data["flight"], file, len(wheels), tuple(a.name for a in appendages))
-        if "flight" in data
-        else None
+        parse_flight(data["flight"], file, len(wheels), tuple(a.name for a in appendages)) if "flight" in data else None
     )
     return Spacecraft(
         name=name,

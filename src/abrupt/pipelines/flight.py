@@ -33,15 +33,15 @@ import pandas as pd
 
 from abrupt.clean.comb import CombConfig, smooth_model
 from abrupt.clean.flight_masks import SlewMaskConfig, event_mask, flag_intervals, slew_mask
+from abrupt.clean.noise import robust_noise_sigma
 from abrupt.detect.change_detection import WindowConfig, sliding_statistic
 from abrupt.errors import ConfigError, InputError
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc, new_run_id
 from abrupt.model.flight_config import FlightConfig
-from abrupt.model.flight_momentum import timetable_momentum
-from abrupt.clean.noise import robust_noise_sigma
+from abrupt.model.flight_momentum import timetable_momentum, wheel_scale_from_conservation
 from abrupt.model.spacecraft import Spacecraft
-from abrupt.readers.archive import DayReport, read_archive, read_decoder
-from abrupt.series.timetable import NS, build_timetable
+from abrupt.readers.archive import read_archive, read_decoder
+from abrupt.series.timetable import NS, Timetable, build_timetable
 from abrupt.store import TelemetryStore
 from abrupt.thresholds import Threshold
 from abrupt.thresholds.robust import robust_block_maxima_threshold
@@ -300,6 +300,62 @@ def local_step(h: FloatArray, ok: BoolArray, tau: int, half: int, guard: int) ->
     return np.asarray(coef[2], dtype=np.float64)
 
 
+def check_wheel_units(spacecraft: Spacecraft, table: Timetable) -> None:
+    """Raise if conservation of ᴺH says the wheel speeds are in another unit than declared.
+
+    The wheel scale that makes ᴺH most nearly constant (:func:`wheel_scale_from_conservation`) is 1 for
+    the right unit; rpm declared as rad/s gives ≈ 0.105 (2π/60), rad/s declared as rpm ≈ 9.5. Only
+    decided when the fit explains most of the wheel term's variance (the wheels moved).
+    """
+    scale, explained = wheel_scale_from_conservation(spacecraft, table)
+    if not (math.isfinite(scale) and explained > 0.5) or 1 / 3 < scale < 3:
+        return
+    flight = _flight(spacecraft)
+    k = next(i for i, c in enumerate(flight.channels) if c.quantity == "wheel_speed")
+    unit = flight.channels[k].unit
+    raise ConfigError(
+        f"wheel speeds declared in {unit!r} but conservation of angular momentum fits them {scale:.3g} times "
+        f"larger/smaller (rpm read as rad/s gives 0.105, rad/s read as rpm 9.55); check the unit",
+        file=spacecraft.source,
+        key=f"flight.channels[{k}].unit",
+    )
+
+
+def check_tachometer_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> None:
+    """Raise if a tachometer channel's values step in the quantum of another unit than declared.
+
+    A tachometer counting P pulses per revolution over a gate T reports speeds in multiples of
+    2π/(P T) rad/s = 60/(P T) rpm; the unit whose quantum makes the speed differences integers is the
+    unit the values are in.
+    """
+    from abrupt.model.flight_config import WHEEL_UNITS
+
+    flight = _flight(spacecraft)
+    for k, ch in enumerate(flight.channels):
+        if ch.quantity != "wheel_speed" or ch.tachometer is None or ch.unit == "counts":
+            continue
+        v = samples.loc[samples["mnemonic"] == ch.mnemonic, "value"].to_numpy(np.float64)
+        d = np.abs(np.diff(v))
+        d = d[d > 0][:5000]
+        if d.size < 20:
+            continue
+
+        def on_grid(unit: str) -> float:
+            q = ch.tachometer.quantum_rad_s / WHEEL_UNITS[unit]  # type: ignore[union-attr]
+            r = d / q
+            return float(np.mean(np.abs(r - np.round(r)) < 0.02))
+
+        declared = on_grid(ch.unit)
+        best = max((u for u in WHEEL_UNITS if u != "counts"), key=on_grid)
+        if declared < 0.5 and on_grid(best) > 0.9 and best != ch.unit:
+            raise ConfigError(
+                f"wheel speeds declared in {ch.unit!r} step in multiples of the tachometer quantum in {best!r} "
+                f"({ch.tachometer.quantum_rad_s / WHEEL_UNITS[best]:.5g} {best}): the values are in {best!r}",
+                file=spacecraft.source,
+                key=f"flight.channels[{k}].unit",
+            )
+
+
 def process_chunk(
     store: TelemetryStore,
     spacecraft: Spacecraft,
@@ -333,6 +389,8 @@ def process_chunk(
     table = build_timetable(samples, flight, names, lo, hi)
     g = table.time_ns
     dt = table.dt_s if len(table) > 1 else 1.0 / flight.grid_hz
+    check_wheel_units(spacecraft, table)
+    check_tachometer_units(spacecraft, samples)
     h_n, _ = timetable_momentum(spacecraft, table, inertia_kgm2)
     valid = table.valid.copy()
     ev = np.zeros(g.size, bool)
@@ -490,7 +548,10 @@ def run_flight(
         if maxima.size < 8:
             raise InputError("too little analysable telemetry to calibrate a threshold (< 8 blocks)", file=store.root)
         threshold = robust_block_maxima_threshold(
-            maxima, block_s=config.block_s, false_alarms_per_day=config.false_alarms_per_day, sample_rate_hz=_grid_hz(spacecraft)
+            maxima,
+            block_s=config.block_s,
+            false_alarms_per_day=config.false_alarms_per_day,
+            sample_rate_hz=_grid_hz(spacecraft),
         )
         if maxima.size < 144:
             warnings.append(f"threshold calibrated on {maxima.size} blocks (< one day): uncertain")
@@ -506,7 +567,9 @@ def _grid_hz(spacecraft: Spacecraft) -> float:
     return _flight(spacecraft).grid_hz
 
 
-def events_from_peaks(peaks: list[Peak], threshold: Threshold, spacecraft: str, run_id: str, cfg_hash: str) -> pd.DataFrame:
+def events_from_peaks(
+    peaks: list[Peak], threshold: Threshold, spacecraft: str, run_id: str, cfg_hash: str
+) -> pd.DataFrame:
     """Events (frozen schema) for the peaks above the threshold."""
     events = []
     for p in peaks:
@@ -542,7 +605,16 @@ def daily_table(chunks: list[ChunkResult], events: pd.DataFrame, threshold: Thre
         day = str(np.datetime64(r.start_ns, "ns").astype("datetime64[D]"))
         row = rows.setdefault(
             day,
-            {"day": day, "grid": 0, "valid": 0, "event_masked": 0, "slew_masked": 0, "analysed": 0, "noise": [], "missing": set()},
+            {
+                "day": day,
+                "grid": 0,
+                "valid": 0,
+                "event_masked": 0,
+                "slew_masked": 0,
+                "analysed": 0,
+                "noise": [],
+                "missing": set(),
+            },
         )
         row["grid"] += r.n_grid
         row["valid"] += r.n_valid
@@ -672,13 +744,17 @@ def injection_recovery(
             ev = [p for p in res.peaks if p.value > threshold.value]
             for s in strikes:
                 match = [p for p in ev if abs(p.time_ns - s.time_ns) <= tolerance_s * NS]
-                pre_existing = bool(base_times.size) and bool(np.any(np.abs(base_times - s.time_ns) <= tolerance_s * NS))
+                pre_existing = bool(base_times.size) and bool(
+                    np.any(np.abs(base_times - s.time_ns) <= tolerance_s * NS)
+                )
                 found = bool(match) and not pre_existing
                 err = float("nan")
                 if found:
                     best = min(match, key=lambda p: abs(p.time_ns - s.time_ns))
                     err = float(np.linalg.norm(best.dH_N_Nms) / s.magnitude_Nms - 1.0)
-                rows.append({"day": day, "time_ns": s.time_ns, "dH_Nms": s.magnitude_Nms, "found": found, "rel_err": err})
+                rows.append(
+                    {"day": day, "time_ns": s.time_ns, "dH_Nms": s.magnitude_Nms, "found": found, "rel_err": err}
+                )
     inj = pd.DataFrame(rows)
     out = []
     for day, grp in inj.groupby("day") if len(inj) else []:

@@ -237,8 +237,8 @@ def _parse_times(times: pa.ChunkedArray, path: Path, assume_utc: bool, counts: C
             has_zone = pc.match_substring_regex(text, r"(Z|[+-]\d\d:?\d\d)$")
             has_zone = pc.fill_null(has_zone, False)
             counts["times without zone read as UTC"] += int(pc.sum(pc.invert(has_zone)).as_py() or 0) - text.null_count
-            out = pd.Series(pd.to_datetime(np.asarray(text.to_pandas(), dtype=object), utc=True, errors="coerce"))
-            return pa.chunked_array([pa.array(out, pa.timestamp("ns", tz="UTC"))])
+            fixed = pc.if_else(has_zone, text, pc.binary_join_element_wise(text, "Z", ""))
+            return fixed.cast(pa.timestamp("ns", tz="UTC"))
         # Unparseable times: skip and count them, one bad record is not fatal.
         parsed = pd.to_datetime(pd.Series(text.to_pandas(), dtype=object), utc=True, errors="coerce", format="ISO8601")
         bad_n = int(parsed.isna().sum()) - text.null_count

@@ -53,7 +53,11 @@ def flight_figure(result: FlightResult) -> plt.Figure:
         for ax, y, title in (
             (axes[0], raw, "ᴺH before cleaning (gaps only) [N·m·s]"),
             (axes[1], masked, "after masks (event flags, slews)"),
-            (axes[2], s["H_N_clean"], "after trend (slow external torque) and comb (orbit harmonics): what the detector reads"),
+            (
+                axes[2],
+                s["H_N_clean"],
+                "after trend (slow external torque) and comb (orbit harmonics): what the detector reads",
+            ),
         ):
             for k, c in enumerate("xyz"):
                 xx, yy = _decimate(t, y[:, k])
@@ -66,8 +70,12 @@ def flight_figure(result: FlightResult) -> plt.Figure:
         axes[0].legend(loc="upper right", fontsize=8)
         xx, yy = _decimate(t, s["statistic"])
         axes[3].semilogy(xx, np.maximum(yy, 1e-3), lw=0.5, color="k", label="GLR statistic")
-        axes[3].axhline(result.threshold.value, color="tab:red", lw=1,
-                        label=f"threshold ({result.threshold.false_alarms_per_day:g}/day)")
+        axes[3].axhline(
+            result.threshold.value,
+            color="tab:red",
+            lw=1,
+            label=f"threshold ({result.threshold.false_alarms_per_day:g}/day)",
+        )
         if len(result.events):
             te = pd.to_datetime(result.events["time_utc"]).dt.tz_localize(None).to_numpy()
             axes[3].plot(te, result.events["statistic"], "v", color="tab:red", label="events")
@@ -113,7 +121,10 @@ def write_flight_report(path: str | Path, result: FlightResult) -> None:
         f"<p>threshold {result.threshold.value:.3g} at {result.threshold.false_alarms_per_day:g} false alarms/day "
         f"({result.threshold.method})</p>"
         f"<img src='data:image/png;base64,{img}' style='max-width:100%'>"
-        "<h2>Daily statistics</h2>" + result.daily.to_html(index=False, float_format=lambda v: f"{v:.4g}")
-        + "<h2>Events</h2>" + result.events.to_html(index=False) + "</body></html>"
+        "<h2>Daily statistics</h2>"
+        + result.daily.to_html(index=False, float_format=lambda v: f"{v:.4g}")
+        + "<h2>Events</h2>"
+        + result.events.to_html(index=False)
+        + "</body></html>"
     )
     path.write_text(html)

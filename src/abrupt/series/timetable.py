@@ -101,7 +101,9 @@ def _runs(t: np.ndarray, max_gap_ns: float) -> list[tuple[int, int]]:
     return [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:], strict=True)]
 
 
-def savgol_samples(v: FloatArray, t: np.ndarray, window_s: float, order: int, max_gap_ns: float, interval_ns: float) -> FloatArray:
+def savgol_samples(
+    v: FloatArray, t: np.ndarray, window_s: float, order: int, max_gap_ns: float, interval_ns: float
+) -> FloatArray:
     """Savitzky-Golay smoothing of samples, run by gap-free run (Harris et al. 2025 §3.4.1).
 
     The window is ``window_s`` seconds of nominal samples (odd, at least order + 2); a run shorter
