@@ -181,7 +181,7 @@ def test_leak_scan_of_every_output_of_the_chain(
 ) -> None:
     from abrupt.cli.main import main
 
-    d, a = synth
+    _, a = synth
     out = tmp_path / "out"
     out.mkdir()
     store = out / "store"
