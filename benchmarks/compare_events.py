@@ -1,10 +1,14 @@
 """Compare two event files column by column, ignoring ``run_id`` (issue 8, acceptance 2).
 
-    python benchmarks/compare_events.py BEFORE.csv AFTER.csv [--rtol 0]
+    python benchmarks/compare_events.py BEFORE.csv AFTER.csv [--rtol 0] [--rename OLD=NEW ...]
 
 Prints the rows and columns that differ and exits with status 1 if any do. Text columns must be
-equal; float columns equal (or within ``--rtol``; NaN equals NaN). Used to show that the refactoring
-of issue 8 leaves the events of ``abrupt demo`` and of the real W3B tracking arc unchanged.
+equal; float columns equal (or within ``--rtol``; NaN equals NaN). ``--rename`` maps an old
+detector name to its new one (issue 8 gave every detector one naming scheme, ``kaderali_k`` became
+``tracking.kaderali_k``); the old event identifiers are then recomputed with the new name, which
+checks that nothing else in the identity (spacecraft, kind, time, configuration hash) changed. Used
+to show that the refactoring of issue 8 leaves the events of ``abrupt demo`` and of the real W3B
+tracking arc unchanged.
 """
 
 from __future__ import annotations
@@ -15,7 +19,20 @@ import sys
 import numpy as np
 import pandas as pd
 
-from abrupt.events import read_events
+from abrupt.events import make_event_id, read_events
+
+
+def renamed(frame: pd.DataFrame, mapping: dict[str, str]) -> pd.DataFrame:
+    """Old events with detector names mapped and event identifiers recomputed for the new names."""
+    out = frame.copy()
+    if not mapping:
+        return out
+    out["detector"] = [mapping.get(str(d), str(d)) for d in out["detector"]]
+    out["event_id"] = [
+        make_event_id(str(r.spacecraft), str(r.detector), str(r.kind), str(r.time_utc), str(r.config_hash))
+        for r in out.itertuples()
+    ]
+    return out
 
 
 def compare(before: pd.DataFrame, after: pd.DataFrame, rtol: float = 0.0) -> list[str]:
@@ -45,13 +62,16 @@ def main() -> None:
     ap.add_argument("before")
     ap.add_argument("after")
     ap.add_argument("--rtol", type=float, default=0.0, help="relative tolerance on float columns (default: exact)")
+    ap.add_argument("--rename", action="append", default=[], metavar="OLD=NEW", help="detector renamed since BEFORE")
     args = ap.parse_args()
-    before, after = read_events(args.before), read_events(args.after)
+    mapping = dict(item.split("=", 1) for item in args.rename)
+    before, after = renamed(read_events(args.before), mapping), read_events(args.after)
     diffs = compare(before, after, args.rtol)
     for line in diffs:
         print(line)
     status = "identical" if not diffs else f"{len(diffs)} difference(s)"
-    print(f"{args.before} vs {args.after}: {len(before)} vs {len(after)} events, {status} (run_id ignored)")
+    renames = f", detectors renamed {mapping}" if mapping else ""
+    print(f"{args.before} vs {args.after}: {len(before)} vs {len(after)} events, {status} (run_id ignored{renames})")
     sys.exit(1 if diffs else 0)
 
 

@@ -86,10 +86,46 @@ def _attitude_settings() -> dict[str, dict[str, Any]]:
     return fast
 
 
+# ---------------------------------------------------------------------------------------------- tracking
+
+
+@cache
+def tracking_example() -> Any:
+    """Ten hours of 20 s range/angles/range-rate from Ascension of the thesis orbit with a 2 m/s apogee burn."""
+    from abrupt.detect.tracking_glrt import BatchFitConfig
+    from abrupt.model.stations import ascension
+    from abrupt.model.tracking_measurements import TrackingArrays
+    from abrupt.series.tracking import TrackingSeries
+    from abrupt.simulate.tracking import TrackingScenario, simulate_tracking, thesis_burn
+
+    scenario = TrackingScenario(stations=(ascension(1.0),), burns=(thesis_burn("apogee", "S", 2.0),), cadence_s=20.0)
+    sim = simulate_tracking(scenario, seed=4)
+    data = TrackingArrays(sim.measurements, {}, epoch_utc=sim.epoch_utc)
+    x0 = sim.initial_state + np.r_[30.0, 30.0, 30.0, 0.03, 0.03, 0.03]  # an a-priori 50 m and 5 cm/s off
+    return TrackingSeries(data, x0, BatchFitConfig(), name="example-track")
+
+
+def empty_tracking() -> Any:
+    from abrupt.model.tracking_measurements import TrackingArrays, empty_measurements
+    from abrupt.series.tracking import TrackingSeries
+
+    full = tracking_example()
+    data = TrackingArrays(empty_measurements(), {}, epoch_utc=full.data.epoch_utc)
+    return TrackingSeries(data, full.x0_apriori_m_mps, full.fit_config, name=full.name)
+
+
 def _examples() -> dict[type, SeriesExample]:
     from abrupt.series.attitude import AttitudeSeries
+    from abrupt.series.tracking import TrackingSeries
 
     return {
+        TrackingSeries: SeriesExample(
+            make=tracking_example,
+            empty=empty_tracking,
+            shift=lambda s, seconds: s.shifted(seconds),
+            notes="earth_rotation='simple', so a shift in time leaves the geometry unchanged",
+            settings={"tracking.glrt": {"max_maneuvers": 1}, "tracking.kaderali_k": {"n_null_runs": 4}},
+        ),
         AttitudeSeries: SeriesExample(
             make=attitude_example,
             empty=empty_attitude,

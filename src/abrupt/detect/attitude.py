@@ -76,9 +76,7 @@ class AttitudeDetectionConfig:
 
 def attitude_detector_names() -> tuple[str, ...]:
     """Every registered detector that reads an :class:`AttitudeSeries` (built-in and plug-in)."""
-    from abrupt.detect.base import get_detector as _get
-
-    return tuple(n for n in detector_names() if issubclass(_get(n).series_type, AttitudeSeries))
+    return tuple(n for n in detector_names() if issubclass(get_detector(n).series_type, AttitudeSeries))
 
 
 def attitude_detector_class(name: str) -> type[Detector[Any]]:

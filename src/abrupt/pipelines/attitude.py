@@ -80,10 +80,9 @@ class AttitudeRun:
 
 def load_spacecraft(path: str | Path | None) -> Spacecraft:
     """The spacecraft file at ``path``, or the bundled thesis spacecraft (Bennett 2022 Table 2.1)."""
-    from abrupt.model.spacecraft import bundled_spacecraft_path
-    from abrupt.model.spacecraft import load_spacecraft as _load
+    from abrupt.model import spacecraft
 
-    return _load(path or bundled_spacecraft_path("thesis"))
+    return spacecraft.load_spacecraft(path or spacecraft.bundled_spacecraft_path("thesis"))
 
 
 def read_attitude_inputs(
