@@ -119,6 +119,61 @@ def part_inject(store: Path) -> None:
     )
 
 
+def _replicated_store(src: Path, dst: Path, n_days: int) -> None:
+    """A store of n_days made by re-dating kestrel's two stored days (alternately)."""
+    from abrupt.store import TelemetryStore
+
+    s, d = TelemetryStore(src), TelemetryStore(dst)
+    days = s.days("SC-A")
+    for k in range(n_days):
+        day = str(np.datetime64("2026-04-01") + np.timedelta64(k, "D"))
+        if (dst / "spacecraft=SC-A" / f"day={day}").exists():
+            continue
+        f = s.read_day("SC-A", days[k % 2])
+        shift = np.datetime64(day, "D") - np.datetime64(days[k % 2], "D")
+        f["time"] = (f["time"] + pd.Timedelta(shift)).dt.tz_localize("UTC")
+        d.write_day("SC-A", day, f, {"replicated_from": days[k % 2]})
+
+
+def part_memory(store: Path, n_days: int = 8) -> None:
+    import psutil
+
+    dst = store.parent / (store.name + "-replicated")
+    _replicated_store(store, dst, n_days)
+    sc = load_spacecraft(KESTREL)
+    proc = psutil.Process()
+    rss: list[tuple[int, float]] = []
+    seen: set[str] = set()
+
+    def tick(day: str) -> None:
+        if day not in seen:
+            seen.add(day)
+            rss.append((len(seen) - 1, proc.memory_info().rss / 2**20))
+
+    t = time.time()
+    run_flight(dst, sc, FlightRunConfig(), days=[f"2026-04-01..2026-04-{n_days:02d}"], progress=tick)
+    rss.append((len(seen), proc.memory_info().rss / 2**20))
+    print(f"\nmemory over {n_days} days ({time.time() - t:.0f} s, {(time.time() - t) / n_days:.1f} s/day):")
+    for k, m in rss:
+        print(f"  after {k} days: RSS {m:.0f} MiB")
+
+
+def part_speed(store: Path) -> None:
+    import tempfile
+
+    t = time.time()
+    files = sorted((DATA / "telemetry").glob("*.csv.gz"))
+    with tempfile.TemporaryDirectory() as tmp:
+        ingest_archives(files, DATA / "decoder.csv", Path(tmp) / "s")
+        t_ing = (time.time() - t) / len(files)
+        sc = load_spacecraft(KESTREL)
+        t = time.time()
+        run_flight(Path(tmp) / "s", sc, FlightRunConfig())
+        t_det = (time.time() - t) / len(files)
+    print(f"\nspeed: ingest {t_ing:.1f} s/day (kestrel: 14 channels, ~2.0 M rows/day), detection {t_det:.1f} s/day")
+    print(f"  extrapolated to 365 days: {365 * (t_ing + t_det) / 60:.0f} min (target < 10 min on two cores)")
+
+
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
     ap.add_argument("--store", default="/tmp/abrupt-flight-bench-store")
