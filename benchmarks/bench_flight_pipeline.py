@@ -67,7 +67,8 @@ def print_score(label: str, sc: dict) -> None:
         )
     print(
         f"  >= 0.1 N m s found within 10 s: {sum(r['found'] for r in big)}/{len(big)} (target all);"
-        f" max |dH| error {100 * max((abs(r['rel_err']) for r in big if r['found']), default=float('nan')):.0f}% (target 30%)"
+        f" max |dH| error {100 * max((abs(r['rel_err']) for r in big if r['found']), default=float('nan')):.0f}%"
+        " (target 30%)"
     )
     print(f"  < 0.1 N m s (0.02-0.03): {sum(r['found'] for r in small)}/{len(small)}")
     print(f"  false alarms: {sc['false_alarms']} in 2 days = {sc['fa_per_day']:.1f}/day (target <= 1)")
@@ -110,12 +111,14 @@ def part_inject(store: Path) -> None:
     inj = rec.injections
     for size, grp in inj.groupby("dH_Nms"):
         print(
-            f"  {size:.3f} N m s: {grp['found'].mean():.0%} of {len(grp)}; |dH| err median {100 * grp['rel_err'].abs().median():.0f}%"
+            f"  {size:.3f} N m s: {grp['found'].mean():.0%} of {len(grp)};"
+            f" |dH| err median {100 * grp['rel_err'].abs().median():.0f}%"
         )
     print(rec.per_day.to_string(index=False))
     print(
         f"  90%-detectable dH per day: {', '.join(f'{v:.4f}' for v in rec.per_day['dH90_Nms'])} N m s "
-        f"(mean {rec.per_day['dH90_Nms'].mean():.4f}, spread across days {rec.per_day['dH90_Nms'].std():.4f}; target <= 0.05)"
+        f"(mean {rec.per_day['dH90_Nms'].mean():.4f}, spread across days {rec.per_day['dH90_Nms'].std():.4f};"
+        " target <= 0.05)"
     )
 
 

@@ -46,7 +46,7 @@ class SynthArchive:
     decoder: Path
     spacecraft: Path
     strikes: list[tuple[float, np.ndarray]] = field(default_factory=list)
-    start: np.datetime64 = np.datetime64("2026-01-05T00:00:00", "ns")
+    start: np.datetime64 = field(default_factory=lambda: np.datetime64("2026-01-05T00:00:00", "ns"))
 
 
 def _bn(t: np.ndarray, period_s: float) -> np.ndarray:
@@ -174,7 +174,7 @@ def make_archive(
         t_f += [dump_at_s, dump_at_s + 10.0]
         v_f += [1.0, 0.0]
     add("PROP.THR_DUMP_ON", np.array(t_f), np.array(v_f))
-    add("EPS.BUS_V", np.arange(0.0, dur, 10.0), np.full(int(math.ceil(dur / 10.0)), 28.0))
+    add("EPS.BUS_V", np.arange(0.0, dur, 10.0), np.full(math.ceil(dur / 10.0), 28.0))
     frame = pd.concat(frames, ignore_index=True).sort_values("t", kind="stable")
     t0 = np.datetime64(start, "ns")
     times = t0 + (frame["t"].to_numpy() * 1e9).astype("timedelta64[ns]")

@@ -102,8 +102,8 @@ class TelemetryStore:
     ) -> pd.DataFrame:
         """Samples with start <= time < end from every day partition the interval touches."""
         mn = list(mnemonics) if mnemonics is not None else None
-        d0 = np.datetime64(start, "D")
-        d1 = np.datetime64(end - np.timedelta64(1, "ns"), "D")
+        d0 = start.astype("datetime64[D]")
+        d1 = (end - np.timedelta64(1, "ns")).astype("datetime64[D]")
         frames = []
         for d in np.arange(d0, d1 + np.timedelta64(1, "D"), dtype="datetime64[D]"):
             f = self.read_day(spacecraft, str(d), mn)
@@ -113,7 +113,7 @@ class TelemetryStore:
             return self.read_day(spacecraft, "0000-00-00", mn)
         frame = pd.concat(frames, ignore_index=True) if len(frames) > 1 else frames[0]
         t = frame["time"].to_numpy()
-        sel = (t >= np.datetime64(start, "ns")) & (t < np.datetime64(end, "ns"))
+        sel = (t >= start.astype("datetime64[ns]")) & (t < end.astype("datetime64[ns]"))
         return frame.loc[sel].reset_index(drop=True)
 
     def report(self, spacecraft: str, day: str) -> dict[str, Any]:

@@ -84,10 +84,10 @@ def event_mask(grid_ns: np.ndarray, intervals: list[tuple[int, int]], before_s: 
 def slew_angle_deg(body_rate_rad_s: FloatArray, dt_s: float, config: SlewMaskConfig) -> FloatArray:
     """Attitude departure from the nominal motion over ``window_s`` [deg], per sample (NaN-safe)."""
     w = pd.DataFrame(body_rate_rad_s)
-    n_nom = max(3, int(round(config.nominal_window_s / dt_s)) | 1)
+    n_nom = max(3, round(config.nominal_window_s / dt_s) | 1)
     nominal = w.rolling(n_nom, center=True, min_periods=max(3, n_nom // 20)).median()
     dw = (w - nominal).fillna(0.0)
-    n_win = max(1, int(round(config.window_s / dt_s)))
+    n_win = max(1, round(config.window_s / dt_s))
     ang = dw.rolling(n_win, center=True, min_periods=1).sum().to_numpy() * dt_s
     return np.asarray(np.degrees(np.linalg.norm(ang, axis=1)), dtype=np.float64)
 
@@ -97,4 +97,4 @@ def slew_mask(body_rate_rad_s: FloatArray, dt_s: float, config: SlewMaskConfig |
     cfg = config or SlewMaskConfig()
     ang = slew_angle_deg(body_rate_rad_s, dt_s, cfg)
     core = ang > cfg.threshold_deg
-    return widen(core, int(round(cfg.margin_before_s / dt_s)), int(round(cfg.margin_after_s / dt_s)))
+    return widen(core, round(cfg.margin_before_s / dt_s), round(cfg.margin_after_s / dt_s))

@@ -60,7 +60,8 @@ def _cleaning(no_clean: tuple[str, ...]) -> Any:
     c = CleaningConfig()
     if "all" in no_clean:
         return CleaningConfig.off()
-    return replace(c, **{name.replace("-", "_"): False for name in no_clean})
+    off: dict[str, Any] = {name.replace("-", "_"): False for name in no_clean}
+    return replace(c, **off)
 
 
 CLEANING_STAGES = ("event-masks", "slew-masks", "savgol", "comb", "trend", "all")

@@ -157,8 +157,8 @@ class FlightRunConfig:
     peak_floor: float = 3.0
 
     def windows(self, dt_s: float) -> WindowConfig:
-        n = max(2, int(round(self.window_s / dt_s)))
-        return WindowConfig(pre=n, post=n, guard=max(0, int(round(self.guard_s / dt_s))))
+        n = max(2, round(self.window_s / dt_s))
+        return WindowConfig(pre=n, post=n, guard=max(0, round(self.guard_s / dt_s)))
 
 
 def orbit_period_s(spacecraft: Spacecraft) -> float:
@@ -340,8 +340,8 @@ def check_tachometer_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> Non
         if d.size < 20:
             continue
 
-        def on_grid(unit: str) -> float:
-            q = ch.tachometer.quantum_rad_s / WHEEL_UNITS[unit]  # type: ignore[union-attr]
+        def on_grid(unit: str, d: np.ndarray = d, quantum: float = ch.tachometer.quantum_rad_s) -> float:
+            q = quantum / WHEEL_UNITS[unit]
             r = d / q
             return float(np.mean(np.abs(r - np.round(r)) < 0.02))
 
@@ -497,7 +497,7 @@ def day_range(store: TelemetryStore, spacecraft: str, days: Iterable[str] | None
         raise InputError(f"no stored days for spacecraft {spacecraft!r}", file=store.root)
     if days is None:
         return stored
-    out = []
+    out: list[str] = []
     for d in days:
         if ".." in d:
             a, b = d.split("..", 1)
@@ -756,8 +756,9 @@ def injection_recovery(
                     {"day": day, "time_ns": s.time_ns, "dH_Nms": s.magnitude_Nms, "found": found, "rel_err": err}
                 )
     inj = pd.DataFrame(rows)
-    out = []
-    for day, grp in inj.groupby("day") if len(inj) else []:
+    out: list[dict[str, Any]] = []
+    for day_key, grp in inj.groupby("day") if len(inj) else []:
+        day = str(day_key)
         dh90 = detectable_dh90(grp["dH_Nms"].to_numpy(), grp["found"].to_numpy())
         boots = []
         for _ in range(200):

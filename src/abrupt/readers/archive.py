@@ -98,7 +98,7 @@ def read_decoder(path: str | Path) -> Decoder:
     if not mnemonics:
         raise InputError("no mnemonic pseudonyms (pseudonyms of mnemonics contain a dot: 'SC-A.ch01')", file=path)
     known = set(spacecraft.values())
-    for real, pseudo in mnemonics.items():
+    for pseudo in mnemonics.values():
         sc = pseudo.split(".", 1)[0]
         if sc not in known:
             line = seen_pseudo[pseudo]
@@ -181,7 +181,7 @@ def _read_raw(path: Path) -> pa.Table:
 def _line_of_first(path: Path, predicate_text: str) -> int | None:
     """1-based line of the first line containing ``predicate_text`` (error path only)."""
     opener = gzip.open if path.read_bytes()[:2] == b"\x1f\x8b" else open
-    with opener(path, "rt", encoding="utf-8", errors="replace") as fh:  # type: ignore[operator]
+    with opener(path, "rt", encoding="utf-8", errors="replace") as fh:
         for i, line in enumerate(fh, start=1):
             if predicate_text in line:
                 return i
@@ -359,7 +359,7 @@ def _read_archive(
     counts["blank rows"] += n_blank
     if bad_values:
         counts["unparseable values"] += bad_values
-    unknown_names = Counter()
+    unknown_names: Counter[str] = Counter()
     for c in unknown_codes:
         n_c = int(np.count_nonzero((codes == c) & ~drop_missing & ~drop_empty & ~drop_placeholder))
         if n_c:
@@ -412,7 +412,7 @@ def _read_archive(
     )
     frame = _dedupe(frame, per_day, report)
     for (sc, d), grp in frame.groupby(["spacecraft", frame["time_ns"] // day_ns], observed=True, sort=False):
-        r = report(str(sc), int(d))
+        r = report(str(sc), int(d))  # type: ignore[call-overload]
         r.rows_kept += len(grp)
         for m, n in grp["mnemonic"].value_counts().items():
             if n:

@@ -46,7 +46,8 @@ def flight_figure(result: FlightResult) -> plt.Figure:
     fig, axes = plt.subplots(5, 1, figsize=(13, 15), sharex=False)
     chunks = [c for c in result.chunks if c.series is not None]
     if chunks:
-        s = {k: np.concatenate([c.series[k] for c in chunks]) for k in chunks[0].series}  # type: ignore[index]
+        series = [c.series for c in chunks if c.series is not None]
+        s = {k: np.concatenate([x[k] for x in series]) for k in series[0]}
         t = s["time_ns"].astype("datetime64[ns]")
         raw = s["H_N_raw"]
         masked = np.where((s["event_mask"] | s["slew_mask"])[:, None], np.nan, raw)

@@ -25,6 +25,7 @@ Savitzky-Golay window), so a chunk processed with a margin gives the same values
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -98,7 +99,7 @@ def _runs(t: np.ndarray, max_gap_ns: float) -> list[tuple[int, int]]:
         return []
     breaks = np.flatnonzero(np.diff(t) > max_gap_ns) + 1
     edges = np.concatenate([[0], breaks, [t.size]])
-    return [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:], strict=True)]
+    return [(int(a), int(b)) for a, b in itertools.pairwise(edges)]
 
 
 def savgol_samples(
@@ -110,7 +111,7 @@ def savgol_samples(
     than the window is left as it is.
     """
     out = np.array(v, dtype=np.float64, copy=True)
-    n_win = int(round(window_s * NS / interval_ns))
+    n_win = round(window_s * NS / interval_ns)
     n_win += 1 - n_win % 2
     n_win = max(n_win, order + 2 + (order % 2 == 1))
     if n_win % 2 == 0:
@@ -141,7 +142,7 @@ def channel_on_grid(
     ch: FlightChannel, t: np.ndarray, v: FloatArray, g: np.ndarray, step_ns: int, max_gap_intervals: float
 ) -> tuple[FloatArray, np.ndarray]:
     """One scalar channel (times ns, raw values) onto the grid in SI units; (values, valid)."""
-    t = t + int(round(ch.time_shift_s * NS))
+    t = t + round(ch.time_shift_s * NS)
     v = np.asarray(v, dtype=np.float64) * ch.to_si
     interval = _nominal_interval_ns(ch, t)
     max_gap = max_gap_intervals * interval
