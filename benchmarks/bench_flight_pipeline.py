@@ -109,7 +109,7 @@ def part_inject(store: Path) -> None:
     rec = injection_recovery(store, sc, cfg, res.threshold, progress=lambda s: print("  ", s, flush=True))
     print(f"\ninjection/recovery ({time.time() - t:.0f} s), threshold {res.threshold.value:.2f} (1 FA/day):")
     inj = rec.injections
-    for size, grp in inj.groupby("dH_Nms"):
+    for size, grp in inj.groupby(inj["dH_Nms"].round(4)):
         print(
             f"  {size:.3f} N m s: {grp['found'].mean():.0%} of {len(grp)};"
             f" |dH| err median {100 * grp['rel_err'].abs().median():.0f}%"
