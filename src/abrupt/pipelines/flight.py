@@ -274,7 +274,10 @@ def locate_step(h: FloatArray, ok: BoolArray, peak: int, win: WindowConfig, m: i
     if hi <= lo:
         return int(np.clip(peak + win.guard // 2, a, b - 1))
     x = h[a:b]
-    sigma = robust_noise_sigma(x)
+    # Noise from a window around the peak, not the whole segment: a segment can reach the edge of a
+    # chunk's margin, and the result must not depend on where the chunk was cut.
+    near = h[max(a, peak - 2 * win.span) : min(b, peak + 2 * win.span)]
+    sigma = robust_noise_sigma(near)
     sigma = np.where(sigma > 0, sigma, 1.0)
     c = np.vstack([np.zeros((1, 3)), np.cumsum(x, axis=0)])
     taus = np.arange(lo, hi) - a
@@ -433,10 +436,12 @@ def process_chunk(
             if np.isfinite(v).sum() >= 0.5 * config.block_s / dt:
                 blocks[int(b)] = float(np.nanmax(v))
     peaks = []
-    sigma = robust_noise_sigma(hc[ok]) if ok.sum() > 3 else np.full(3, np.nan)
     for i in _local_peaks(stat, config.peak_floor, win.span):
         if not core[i]:
             continue
+        near = hc[max(0, i - 2 * win.span) : i + 2 * win.span]
+        near = near[np.all(np.isfinite(near), axis=1)]
+        sigma = robust_noise_sigma(near) if near.shape[0] > 3 else np.full(3, np.nan)
         tau = locate_step(hc, ok, i, win)
         d_h = local_step(hc, ok, tau, win.pre, win.guard)
         mag = float(np.linalg.norm(d_h))
