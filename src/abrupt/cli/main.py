@@ -10,6 +10,7 @@ from abrupt.cli import (  # noqa: F401  (registration)
     attitude,
     catalog_commands,
     detectors,
+    flight,
     laser,
     mass,
     orbit,
