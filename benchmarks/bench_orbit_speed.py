@@ -20,7 +20,7 @@ from abrupt.detect.orbit_ekf import (
     _GL_WEIGHTS,
     FilterConfig,
     _process_noise,
-    _propagate,
+    propagate_state,
     run_backward,
     run_forward,
 )
@@ -40,6 +40,7 @@ def filterpy_forward(t: np.ndarray, y: np.ndarray, sigma_pos: float, sigma_vel: 
     phi = np.empty((9, 9))
     s = np.empty((9, 9))
     q = cfg.q_array()
+    args = cfg.force_context(None).kernel_args
     out = np.empty((t.size, 9))
     ekf.update(y[0], HJacobian=lambda x: h, Hx=lambda x: h @ x)
     out[0] = ekf.x
@@ -47,7 +48,7 @@ def filterpy_forward(t: np.ndarray, y: np.ndarray, sigma_pos: float, sigma_vel: 
     for i in range(1, t.size):
         dt = t[i] - t[i - 1]
         _process_noise(ekf.x, dt, cfg.tau_s, q, s)
-        ekf.x = _propagate(ekf.x, dt, cfg.tau_s, cfg.mu_m3_s2, cfg.zonal_degree, cfg.max_step_s, phi)
+        ekf.x = propagate_state(ekf.x, 0.0, dt, cfg.tau_s, args, cfg.max_step_s, phi)
         ekf.F = phi.copy()
         ekf.Q = s.copy()
         ekf.P = ekf.F @ ekf.P @ ekf.F.T + ekf.Q

@@ -139,7 +139,7 @@ def simulate_orbit_command(
     """Simulate a truth orbit with impulsive ΔVs and GNSS-like navigation solutions (Bennett 2022 §3.1)."""
     from dataclasses import replace
 
-    from abrupt.model.orbit_dynamics import ForceModel
+    from abrupt.model.orbit import ForceModel
     from abrupt.readers.navigation_csv import write_navigation_csv
     from abrupt.simulate.orbit import Impulse, OrbitSimulationConfig, simulate_orbit
 
@@ -157,7 +157,7 @@ def simulate_orbit_command(
         "two-body": ForceModel(),
         "j2-j4": ForceModel(zonal_degree=4),
         "thesis-perturbed": ForceModel(j3_only=True, drag="exponential", array_area_m2=5.0),
-        "full": ForceModel(zonal_degree=4, drag="msis", srp=True, sun=True, moon=True),
+        "full": ForceModel(gravity_degree=40, drag="msis", srp=True, sun=True, moon=True),
     }[forces]
     cfg = OrbitSimulationConfig(
         altitude_m=altitude_km * 1e3,

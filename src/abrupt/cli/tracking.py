@@ -249,7 +249,6 @@ def detect_tracking_command(
     """
     import numpy as np
     import pandas as pd
-    from astropy.time import Time
 
     from abrupt.detect.kaderali import (
         KaderaliConfig,
@@ -266,9 +265,10 @@ def detect_tracking_command(
     )
     from abrupt.errors import ConfigError, RepairLog
     from abrupt.events import config_hash, empty_frame, events_frame, new_run_id
+    from abrupt.model.orbit import ForceContext, ForceModel
+    from abrupt.model.orbit.bodies import sun_moon_gcrf
     from abrupt.model.timescales import offline_astropy
     from abrupt.model.tracking_measurements import TrackingArrays, correct_refraction
-    from abrupt.model.tracking_orbit import ForceModel, sun_position_m
     from abrupt.readers.aer import read_aer
     from abrupt.readers.orekit_od_input import read_od_input
     from abrupt.readers.tdm import read_tdm
@@ -297,8 +297,13 @@ def detect_tracking_command(
     real = any(k.startswith("central.body") or k.startswith("third.body") for k in setup.extra)
     degree = int(float(setup.extra.get("central.body.degree", "0") or 0))
     third = any(setup.extra.get(k, "false").lower() == "true" for k in ("third.body.sun", "third.body.moon"))
-    jd_tt = float(Time(setup.epoch_utc, scale="utc").tt.jd)
-    force = ForceModel(mu_m3_s2=setup.mu_m3_s2, j2=degree >= 2, third_body=third, epoch_jd_tt=jd_tt)
+    span_s = float(np.nanmax(data.t_s)) if len(data.t_s) else 0.0
+    force = ForceContext.build(
+        ForceModel(mu_m3_s2=setup.mu_m3_s2, zonal_degree=2 if degree >= 2 else 0, sun=third, moon=third),
+        np.datetime64(setup.epoch_utc, "ns"),
+        -86400.0,
+        span_s + 86400.0,
+    )
     biases = any(setup.range_bias_estimated.values()) if estimate_biases is None else estimate_biases
     accel = real if estimate_acceleration is None else estimate_acceleration
     period = _period_s(setup.initial_state, setup.mu_m3_s2)
@@ -321,7 +326,7 @@ def detect_tracking_command(
         "biases": biases,
         "accel": accel,
         "refraction": use_refraction,
-        "force": [force.mu_m3_s2, force.j2, force.third_body],
+        "force": [force.model.mu_m3_s2, force.model.zonal_degree >= 2, force.model.sun],
         "max_maneuvers": max_maneuvers,
         "kaderali_threshold": kaderali_threshold,
     }
@@ -415,7 +420,7 @@ def detect_tracking_command(
             )
         )
     frame = events_frame(events) if events else empty_frame()
-    summary = _fit_summary(final_fit, force, sun_position_m(jd_tt))
+    summary = _fit_summary(final_fit, force.model, sun_moon_gcrf(np.datetime64(setup.epoch_utc, "ns"))[0][0])
     summary["repairs"] = repairs.as_dict()
     for line in _summary_lines(summary):
         click.echo(line, err=True)
@@ -465,7 +470,7 @@ def _fit_summary(fit: Any, force: Any, sun_m: Any) -> dict[str, Any]:
         "x0_m_mps": [float(v) for v in fit.x0],
         "range_bias_m": {k: [float(v), fit.sigma(f"range_bias[{k}]")] for k, v in fit.range_bias_m.items()},
         "angle_bias_deg": {k: [math.degrees(v[0]), math.degrees(v[1])] for k, v in fit.angle_bias_rad.items()},
-        "force_model": {"mu_m3_s2": force.mu_m3_s2, "j2": force.j2, "sun_moon": force.third_body},
+        "force_model": {"mu_m3_s2": force.mu_m3_s2, "j2": force.zonal_degree >= 2, "sun_moon": force.sun},
     }
     if "accel_x" in fit.parameter_names:
         a = np.asarray(fit.acceleration_mps2, float)

@@ -21,7 +21,16 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy import stats
 
-from abrupt.detect.orbit_ekf import FilterConfig, FilterRun, run_backward, run_forward
+from abrupt.detect.orbit_ekf import (
+    FilterConfig,
+    FilterRun,
+    measurement_update,
+    measurement_variances,
+    measurement_vectors,
+    propagate_state,
+    run_backward,
+    run_forward,
+)
 from abrupt.detect.orbit_glr import JumpEstimate, glr_statistic, localise_jump
 from abrupt.detect.orbit_statistics import (
     STATISTIC_NAMES,
@@ -30,7 +39,8 @@ from abrupt.detect.orbit_statistics import (
     orbital_constant_statistics,
 )
 from abrupt.events import Event, config_hash, empty_frame, events_frame
-from abrupt.model.frames import Ephemeris, rtn_matrix
+from abrupt.model.frames import Ephemeris
+from abrupt.model.orbit import ForceContext, rtn_matrix
 from abrupt.thresholds import Threshold, fit_threshold, p_fa_per_sample
 
 FloatArray = NDArray[np.float64]
@@ -109,6 +119,7 @@ class OrbitAnalysis:
     statistics: dict[str, FloatArray]
     valid: NDArray[np.bool_]
     config: OrbitDetectorConfig
+    context: ForceContext | None = None
 
     @property
     def sample_rate_hz(self) -> float:
@@ -125,9 +136,18 @@ def analyse(ephemeris: Ephemeris, config: OrbitDetectorConfig | None = None) -> 
     if np.any(np.diff(t) <= 0):
         raise ValueError("epochs must be strictly increasing")
     fc = config.filter
-    fwd = run_forward(t, eph.position_m, eph.velocity_mps, config.sigma_pos_m, config.sigma_vel_mps, fc)
+    ctx = fc.force_context(eph.times_utc[0], float(t[0]), float(t[-1]))
+    fwd = run_forward(t, eph.position_m, eph.velocity_mps, config.sigma_pos_m, config.sigma_vel_mps, fc, context=ctx)
     bwd = run_backward(
-        t, eph.position_m, eph.velocity_mps, config.sigma_pos_m, config.sigma_vel_mps, fc, fwd.x[-1], fwd.p[-1]
+        t,
+        eph.position_m,
+        eph.velocity_mps,
+        config.sigma_pos_m,
+        config.sigma_vel_mps,
+        fc,
+        fwd.x[-1],
+        fwd.p[-1],
+        context=ctx,
     )
     fusion = fuse(fwd.x, fwd.p, bwd.x, bwd.p)
     stats = dict(fusion.statistics)
@@ -140,6 +160,7 @@ def analyse(ephemeris: Ephemeris, config: OrbitDetectorConfig | None = None) -> 
             config.sigma_pos_m,
             config.sigma_vel_mps,
             replace(fc, q_rtn_m2_s5=q_conv),  # type: ignore[arg-type]
+            context=ctx,
         )
         stats.update(orbital_constant_statistics(t, conv.x, config.oc_window_s))
     else:
@@ -156,13 +177,14 @@ def analyse(ephemeris: Ephemeris, config: OrbitDetectorConfig | None = None) -> 
             fwd.x[0],
             fwd.p[0],
             config.glr_window_samples * eph.nominal_step_s,
+            context=ctx,
         )
     else:
         stats["glr"] = np.full(t.size, np.nan)
     valid = (t - t[0] >= config.settle_s) & (t[-1] - t >= config.settle_s)
     for name in stats:
         stats[name] = np.where(valid, stats[name], np.nan)
-    return OrbitAnalysis(eph, t, fwd, bwd, fusion, stats, valid, config)
+    return OrbitAnalysis(eph, t, fwd, bwd, fusion, stats, valid, config, ctx)
 
 
 def calibrate_thresholds(
@@ -337,6 +359,7 @@ def find_events(
     above = np.flatnonzero(np.nan_to_num(s, nan=-np.inf) > thr.value)
     extra_cols = [
         "dv_sigma_mps",
+        "duration_s",
         "snr",
         "glr",
         "dv_glr_r_mps",
@@ -383,6 +406,7 @@ def find_events(
         cov = analysis.fusion.dv_cov[k]
         glr_value = float("nan")
         glr_rtn = np.full(3, np.nan)
+        duration = 0.0
         if cfg.localise == "glr":
             if cfg.glr_search_s is not None:
                 search = cfg.glr_search_s
@@ -407,7 +431,10 @@ def find_events(
                     dv_in = jump.dv_inertial_mps
                     cov = jump.dv_cov
                 elif cfg.dv_estimate == "interval":
-                    dv_in, cov = interval_dv(analysis, k_j)
+                    burn = locate_burn(analysis, k_j)
+                    dv_in, cov = burn.dv_inertial_mps, burn.dv_cov
+                    t_event, time_sigma, duration = burn.start_s, burn.centroid_sigma_s, burn.duration_s
+                    xf = analysis.forward.x[burn.k_first - 1]
                 else:
                     # TS1 at the last pre-jump epoch: forward saw only pre-jump data, backward only post-jump
                     dv_in = analysis.fusion.dv_inertial[k_j - 1]
@@ -440,6 +467,7 @@ def find_events(
                 dv_n_mps=float(dv_rtn[2]),
                 extra={
                     "dv_sigma_mps": dv_sigma,
+                    "duration_s": duration,
                     "snr": float(s[peak_stat] / thr.value),
                     "glr": glr_value,
                     "dv_glr_r_mps": float(glr_rtn[0]),
@@ -452,44 +480,167 @@ def find_events(
     return events_frame(events, extra_columns=extra_cols)
 
 
-def interval_dv(analysis: OrbitAnalysis, k: int) -> tuple[FloatArray, FloatArray]:
-    """Velocity jump (inertial, m/s) across the sampling interval (t_{k−1}, t_k) and its covariance.
+@dataclass(frozen=True)
+class JumpInterval:
+    """A velocity change across epochs (k_first − 1, k_last): ΔV (inertial, m/s) and its covariance, the
+    centroid time (s), its 1σ, the estimated start time and duration (s; 0 for an impulse)."""
 
-    The forward a-posteriori state at k−1 has seen only pre-jump data and the backward a-posteriori state
-    at k only post-jump data (the backward a-priori estimate at k updated with the measurement at k,
-    Joseph form as in the filter). The pre-jump state is propagated to t_k with the filter's gravity
-    model and, for the unmodelled acceleration over the interval, the mean ā = ½(w_F(k−1) + w_B(k)) of
-    the two filters' DMC estimates held constant (τ → ∞ over one step); then ΔV = v_B(k) − v_F(t_k).
+    k_first: int
+    k_last: int
+    dv_inertial_mps: FloatArray
+    dv_cov: FloatArray
+    centroid_s: float
+    centroid_sigma_s: float
+    start_s: float
+    duration_s: float
 
-    Each filter's Gauss-Markov estimate lags the true acceleration from its own side (the forward one
-    from the past, the backward one from the future), so the mean cancels the first-order lag that
-    the TS1 form v̄_B(k−1) − v_F(k−1) (backward w over the whole interval) keeps; at 60 s sampling the
-    unmodelled acceleration of a LEO orbit (~7e-5 m/s² against J2-J4) integrates to ~4 mm/s per step,
-    so this matters. A jump at any time inside the interval changes v(t_k) by Φ_vv ΔV ≈ ΔV (to
-    ~n²Δt²/2 ≈ 0.2 % at 60 s). Covariance: the two velocity covariances plus (Δt/2)² times the two w
-    covariances (cross-correlations neglected).
+
+def interval_jump(analysis: OrbitAnalysis, k_first: int, k_last: int | None = None) -> JumpInterval:
+    """Velocity and position jump across (t_{k_first−1}, t_{k_last}) between the forward state before and the
+    backward state after, and the time it happened.
+
+    The forward a-posteriori state at k_first−1 has seen only pre-jump data and the backward a-posteriori
+    state at k_last only post-jump data (the backward a-priori estimate updated with the measurement at
+    k_last, Joseph form as in the filter). The pre-jump state is propagated to t_{k_last} with the filter's
+    force model and, for the unmodelled acceleration, the mean ā = ½(w_F + w_B) of the two filters' DMC
+    estimates held constant; then ΔV = v_B − v̂_F and Δr = r_B − r̂_F. Each filter's Gauss-Markov
+    estimate lags from its own side, so the mean cancels the first-order lag.
+
+    Time: a velocity change ΔV(t) spread over the interval displaces the position at t_{k_last} by
+    Δr = ∫ (t_{k_last} − t) dΔV(t) = ΔV (t_{k_last} − t_c), with t_c the ΔV-weighted centroid (exact for
+    a fixed direction, to first order in the gravity gradient over the interval); hence
+    t_c = t_{k_last} − Δr·ΔV/|ΔV|². Its variance follows from the covariances of Δr along ΔV and of |ΔV|.
+    Covariances: the forward one propagated with the STM plus the backward one, plus (Δt/2)² times the two
+    DMC covariances for the velocity; all scaled by the filter's innovation consistency (median NIS over
+    its χ²₆ median, ≥ 1) so that a filter more confident than its residuals allow does not shrink them.
     """
-    from abrupt.detect.orbit_ekf import _measurement_update, _measurements, _propagate, measurement_variances
-
+    k_last = k_first if k_last is None else k_last
     cfg = analysis.config
     fc = cfg.filter
     eph = analysis.ephemeris
     t = analysis.t_s
-    if not 1 <= k < t.size:
+    if not 1 <= k_first <= k_last < t.size:
         raise ValueError("interval index out of range")
-    xb = analysis.backward.x[k].copy()
-    pb = analysis.backward.p[k].copy()
-    y = _measurements(eph.position_m[k : k + 1], eph.velocity_mps[k : k + 1])[0]
-    rdiag = measurement_variances(eph.velocity_mps[k : k + 1], cfg.sigma_pos_m, cfg.sigma_vel_mps, 1)[0]
-    _measurement_update(xb, pb, y, rdiag, np.empty(6))
-    xf = analysis.forward.x[k - 1].copy()
-    pf = analysis.forward.p[k - 1]
+    xb = analysis.backward.x[k_last].copy()
+    pb = analysis.backward.p[k_last].copy()
+    y = measurement_vectors(eph.position_m[k_last : k_last + 1], eph.velocity_mps[k_last : k_last + 1])[0]
+    rdiag = measurement_variances(eph.velocity_mps[k_last : k_last + 1], cfg.sigma_pos_m, cfg.sigma_vel_mps, 1)[0]
+    measurement_update(xb, pb, y, rdiag, np.empty(6))
+    xf = analysis.forward.x[k_first - 1].copy()
+    pf = analysis.forward.p[k_first - 1]
     xf[6:9] = 0.5 * (xf[6:9] + xb[6:9])
-    dt = float(t[k] - t[k - 1])
-    x_pred = _propagate(xf, dt, 1e12, fc.mu_m3_s2, fc.zonal_degree, fc.max_step_s, np.empty((9, 9)))
+    dt = float(t[k_last] - t[k_first - 1])
+    ctx = _context_of(analysis)
+    phi = np.empty((9, 9))
+    x_pred = propagate_state(xf, float(t[k_first - 1]), dt, 1e12, ctx.kernel_args, fc.max_step_s, phi)
+    p_pred = phi @ pf @ phi.T
     dv = xb[3:6] - x_pred[3:6]
-    cov = pf[3:6, 3:6] + pb[3:6, 3:6] + (0.5 * dt) ** 2 * (pf[6:9, 6:9] + pb[6:9, 6:9])
-    return dv, cov
+    dr = xb[0:3] - x_pred[0:3]
+    scale = innovation_scale(analysis)
+    cov = scale * (p_pred[3:6, 3:6] + pb[3:6, 3:6] + (0.5 * dt) ** 2 * (pf[6:9, 6:9] + pb[6:9, 6:9]))
+    cov_r = scale * (p_pred[0:3, 0:3] + pb[0:3, 0:3])
+    mag = float(np.linalg.norm(dv))
+    u = dv / max(mag, 1e-300)
+    lead = float(dr @ dv) / max(mag * mag, 1e-300)
+    var_lead = float(u @ cov_r @ u) / max(mag * mag, 1e-300) + lead * lead * float(u @ cov @ u) / max(mag * mag, 1e-300)
+    t_c = float(t[k_last]) - lead
+    return JumpInterval(k_first, k_last, dv, cov, t_c, float(np.sqrt(var_lead)), t_c, 0.0)
+
+
+def innovation_scale(analysis: OrbitAnalysis) -> float:
+    """max(1, median NIS / median of χ²₆): how much the forward filter's innovations exceed its own
+    covariance (1 for a consistent filter)."""
+    nis = analysis.forward.nis
+    nis = nis[np.isfinite(nis)]
+    if nis.size < 10:
+        return 1.0
+    return max(1.0, float(np.median(nis)) / float(stats.chi2.median(6)))
+
+
+def interval_dv(analysis: OrbitAnalysis, k: int) -> tuple[FloatArray, FloatArray]:
+    """ΔV (inertial, m/s) across (t_{k−1}, t_k) and its covariance (:func:`interval_jump`)."""
+    j = interval_jump(analysis, k)
+    return j.dv_inertial_mps, j.dv_cov
+
+
+def locate_burn(analysis: OrbitAnalysis, k: int, *, search: int = 2, max_intervals: int = 30) -> JumpInterval:
+    """The velocity change near interval k: an impulse or a finite burn (seconds to ~20 min).
+
+    1. Among intervals k−``search``…k+``search`` the one with the most significant single-interval ΔV
+       (|ΔV|/σ) is the seed.
+    2. Neighbouring intervals whose own ΔV is significant (> 5σ) and at least 5 % of the seed's extend
+       the span (a finite burn puts ΔV into every interval it covers), up to ``max_intervals``.
+    3. ΔV and the centroid come from :func:`interval_jump` over the whole span. The duration is
+       |ΔV|/a with a = the largest single-interval |ΔV|/Δt (an interval fully inside the burn; for a
+       span of one interval the burn is taken as an impulse, duration 0), and the start is the centroid
+       minus half the duration (a constant acceleration). The start's σ is the centroid's σ combined
+       with a quarter of the sampling interval when a duration was estimated. For an impulse the time
+       inside the interval is used only when the position jump resolves it (σ < Δt/10); otherwise the
+       interval's midpoint is reported with σ = Δt/√12. On real precise orbits the positions and
+       velocities are not consistent to better than ~2 cm over one step, which does not resolve it.
+    """
+    t = analysis.t_s
+    n = t.size
+    singles: dict[int, JumpInterval] = {}
+
+    def single(i: int) -> JumpInterval | None:
+        if not 1 <= i < n:
+            return None
+        if i not in singles:
+            singles[i] = interval_jump(analysis, i)
+        return singles[i]
+
+    def significance(j: JumpInterval | None) -> float:
+        if j is None:
+            return -1.0
+        u = j.dv_inertial_mps / max(float(np.linalg.norm(j.dv_inertial_mps)), 1e-300)
+        sd = float(np.sqrt(max(float(u @ j.dv_cov @ u), 1e-300)))
+        return float(np.linalg.norm(j.dv_inertial_mps)) / sd
+
+    cands = [i for i in range(k - search, k + search + 1) if 1 <= i < n]
+    seed = max(cands, key=lambda i: significance(single(i)))
+    seed_j = single(seed)
+    assert seed_j is not None
+    seed_mag = float(np.linalg.norm(seed_j.dv_inertial_mps))
+
+    def part_of_burn(i: int) -> bool:
+        j = single(i)
+        return (
+            j is not None
+            and significance(j) > 5.0
+            and float(np.linalg.norm(j.dv_inertial_mps)) > 0.05 * seed_mag
+            and float(j.dv_inertial_mps @ seed_j.dv_inertial_mps) > 0
+        )
+
+    lo = hi = seed
+    while hi - lo + 1 < max_intervals and part_of_burn(lo - 1):
+        lo -= 1
+    while hi - lo + 1 < max_intervals and part_of_burn(hi + 1):
+        hi += 1
+    whole = interval_jump(analysis, lo, hi) if hi > lo else seed_j
+    if hi == lo:
+        step = float(t[lo] - t[lo - 1])
+        if whole.centroid_sigma_s < step / 10.0 and t[lo - 1] <= whole.centroid_s <= t[lo]:
+            return whole  # the position jump resolves the time inside the interval
+        # otherwise only the interval is known: its midpoint, uniform error (σ = Δt/√12)
+        mid = float(t[lo]) - 0.5 * step
+        return replace(whole, centroid_s=mid, start_s=mid, centroid_sigma_s=step / float(np.sqrt(12.0)))
+    accel = max(
+        float(np.linalg.norm(single(i).dv_inertial_mps)) / float(t[i] - t[i - 1])  # type: ignore[union-attr]
+        for i in range(lo, hi + 1)
+    )
+    duration = float(np.linalg.norm(whole.dv_inertial_mps)) / max(accel, 1e-300)
+    start = whole.centroid_s - 0.5 * duration
+    step = float(np.median(np.diff(t[lo - 1 : hi + 1])))
+    sigma = float(np.hypot(whole.centroid_sigma_s, 0.25 * step))
+    return replace(whole, start_s=start, duration_s=duration, centroid_sigma_s=sigma)
+
+
+def _context_of(analysis: OrbitAnalysis) -> ForceContext:
+    if analysis.context is not None:
+        return analysis.context
+    t = analysis.t_s
+    return analysis.config.filter.force_context(analysis.ephemeris.times_utc[0], float(t[0]), float(t[-1]))
 
 
 def _localise(analysis: OrbitAnalysis, t_from: float, t_to: float, horizon_s: float) -> JumpEstimate | None:
@@ -514,6 +665,7 @@ def _localise(analysis: OrbitAnalysis, t_from: float, t_to: float, horizon_s: fl
             first,
             last,
             horizon_s,
+            context=_context_of(analysis),
         )
     except (ValueError, np.linalg.LinAlgError):
         return None
@@ -536,7 +688,8 @@ def stream_statistics(
     eph = ephemeris.to_frame("GCRF")
     t = eph.seconds
     fc = config.filter
-    fwd = run_forward(t, eph.position_m, eph.velocity_mps, config.sigma_pos_m, config.sigma_vel_mps, fc)
+    ctx = fc.force_context(eph.times_utc[0], float(t[0]), float(t[-1]))
+    fwd = run_forward(t, eph.position_m, eph.velocity_mps, config.sigma_pos_m, config.sigma_vel_mps, fc, context=ctx)
     start = 0
     while start < t.size:
         stop = int(np.searchsorted(t, t[start] + block_s, side="left"))
@@ -553,6 +706,7 @@ def stream_statistics(
             fc,
             fwd.x[edge - 1],
             fwd.p[edge - 1],
+            context=ctx,
         )
         n = stop - start
         fusion = fuse(fwd.x[start:stop], fwd.p[start:stop], bwd.x[:n], bwd.p[:n])
@@ -571,14 +725,19 @@ def auto_tune(
     ephemeris: Ephemeris,
     *,
     zonal_degree: int = 4,
+    gravity_degree: int = 40,
+    third_body: bool = True,
     max_steps: int = 20000,
     tau_factor: float = 10.0,
     min_sigma_pos_m: float = 0.01,
     min_sigma_vel_mps: float = 1e-5,
+    in_stationary_floor: bool = True,
 ) -> tuple[FilterConfig, float, float]:
     """Filter tuning and measurement sigmas derived from the data itself (for real precise orbits).
 
-    Each step k → k+1 is propagated with the filter dynamics (two-body + J2..J``zonal_degree``, w = 0)
+    Each step k → k+1 is propagated with the filter dynamics (default: EGM2008 40×40 with Sun and Moon, the
+    degree chosen by benchmarks/bench_orbit_forces.py; J2..J``zonal_degree`` when ``gravity_degree`` = 0;
+    w = 0)
     and compared with the next epoch: m_k = v_{k+1} − v̂_{k+1} (the velocity the model misses over one
     step) and the same for position. Then, with robust (MAD) standard deviations:
 
@@ -587,15 +746,15 @@ def auto_tune(
     - σ_vel = std(Δ³ m_k)/√70 and σ_pos likewise from the position misses (third differences remove
       any smooth model error; m_k carries the noise difference n_{k+1} − n_k, so Δ³ m_k is a fourth
       difference of white noise, variance 70σ²), floored at ``min_sigma_*``;
+    - q is at least 2σ_a²/τ, σ_a² the variance of the missed acceleration m_k/Δt less its noise share
+      2σ_vel²/Δt² (``in_stationary_floor``): the FOGM's stationary variance qτ/2 then covers the
+      unmodelled acceleration itself, which with a full force model is small but smooth;
     - data whose step-to-step model error is below the noise get q = 1 % of the noise-equivalent
       level (for 1 Hz GNSS-like solutions the thesis tuning, Table 3.1, is the better choice);
     - τ = ``tau_factor`` × the nominal step.
 
     Nothing here depends on a particular satellite; the same rule runs on any ephemeris.
     """
-    from abrupt.detect.orbit_ekf import _propagate
-    from abrupt.model.orbit_dynamics import MU_EARTH_M3_S2
-
     eph = ephemeris.to_frame("GCRF")
     t = eph.seconds
     n = min(len(eph) - 1, max_steps)
@@ -604,6 +763,11 @@ def auto_tune(
     idx = np.arange(n)
     dt_nom = eph.nominal_step_s
     phi = np.empty((9, 9))
+    max_step = max(10.0, min(30.0, dt_nom / 2.0))
+    base = FilterConfig(
+        zonal_degree=zonal_degree, gravity_degree=gravity_degree, third_body=third_body, max_step_s=max_step
+    )
+    ctx = base.force_context(eph.times_utc[0], float(t[0]), float(t[-1]))
     miss_v = np.full((idx.size, 3), np.nan)
     miss_r = np.full((idx.size, 3), np.nan)
     for j, k in enumerate(idx):
@@ -611,7 +775,7 @@ def auto_tune(
         if abs(dt - dt_nom) > 1e-6 * dt_nom or not np.isfinite(eph.velocity_mps[k]).all():
             continue
         x = np.r_[eph.position_m[k], eph.velocity_mps[k], 0.0, 0.0, 0.0]
-        xp = _propagate(x, dt, 1e12, MU_EARTH_M3_S2, zonal_degree, 10.0, phi)
+        xp = propagate_state(x, float(t[k]), dt, 1e12, ctx.kernel_args, max_step, phi)
         miss_v[j] = eph.velocity_mps[k + 1] - xp[3:6]
         miss_r[j] = eph.position_m[k + 1] - xp[0:3]
     consecutive = np.diff(idx) == 1
@@ -631,7 +795,21 @@ def auto_tune(
     # noise-equivalent level (the filter then trusts its dynamics; for 1 Hz GNSS-like data use the
     # thesis tuning instead, ``--tuning thesis``).
     q = max(var_signal - var_noise, 0.01 * var_noise) / dt_nom
-    fc = FilterConfig.isotropic(tau_factor * dt_nom, q, zonal_degree=zonal_degree)
+    # The FOGM's stationary variance qτ/2 must cover the unmodelled acceleration itself, not only its
+    # step-to-step change: with a good force model the remaining error is small but smooth, and a q from
+    # the differences alone lets the filter drift away from the data (innovations ≫ their covariance).
+    tau = tau_factor * dt_nom
+    var_accel = float(np.nanmean([_robust_std(acc[:, i]) ** 2 for i in range(3)])) - 2.0 * sigma_v**2 / dt_nom**2
+    if in_stationary_floor and var_accel > 0:
+        q = max(q, 2.0 * var_accel / tau)
+    fc = FilterConfig.isotropic(
+        tau,
+        q,
+        zonal_degree=zonal_degree,
+        gravity_degree=gravity_degree,
+        third_body=third_body,
+        max_step_s=max_step,
+    )
     return fc, sigma_r, sigma_v
 
 
