@@ -6,44 +6,16 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import pytest
-from scipy import stats
 
 from abrupt.detect.orbit_detector import (
     OrbitDetectorConfig,
     analyse,
     auto_tune,
     find_events,
-    gpd_return_level_upper,
     self_calibrate,
 )
-from abrupt.thresholds import gpd_quantile
 
 SP3 = "sp3/ssas3a20.b18358.e19003.DG_.sp3"
-
-
-def test_return_level_with_z0_is_the_gpd_point_estimate() -> None:
-    x = stats.genpareto.rvs(0.1, size=4000, random_state=np.random.default_rng(3))
-    p = 2e-5
-    assert gpd_return_level_upper(x, p, tail_fraction=0.02, z=0.0) == pytest.approx(
-        gpd_quantile(x, p, tail_fraction=0.02), rel=1e-9
-    )
-    assert gpd_return_level_upper(x, p, tail_fraction=0.02, z=1.0) > gpd_quantile(x, p, tail_fraction=0.02)
-
-
-def test_upper_return_level_covers_the_true_quantile_at_about_84_percent() -> None:
-    # GPD(ξ = 0.2) samples: the true 1e-4 upper quantile is known; the z = 1 bound (delta method, Coles 2001
-    # §4.4.1) should lie above it in ~84 % of replicates, the point estimate in ~50 %.
-    rng = np.random.default_rng(5)
-    p, xi, reps = 1e-4, 0.2, 200
-    truth = stats.genpareto.isf(p, xi)
-    upper = point = 0
-    for _ in range(reps):
-        x = stats.genpareto.rvs(xi, size=5000, random_state=rng)
-        upper += gpd_return_level_upper(x, p, tail_fraction=0.02, z=1.0) >= truth
-        point += gpd_return_level_upper(x, p, tail_fraction=0.02, z=0.0) >= truth
-    assert 0.72 <= upper / reps <= 0.93
-    assert 0.35 <= point / reps <= 0.65
 
 
 def _real_config(eph: object) -> OrbitDetectorConfig:

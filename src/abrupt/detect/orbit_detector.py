@@ -41,7 +41,7 @@ from abrupt.detect.orbit_statistics import (
 from abrupt.events import Event, config_hash, empty_frame, events_frame
 from abrupt.model.frames import Ephemeris
 from abrupt.model.orbit import ForceContext, rtn_matrix
-from abrupt.thresholds import Threshold, fit_threshold, p_fa_per_sample
+from abrupt.thresholds import Threshold, fit_threshold, gpd_return_level_upper, p_fa_per_sample
 
 FloatArray = NDArray[np.float64]
 SECONDS_PER_WEEK = 7 * 86400.0
@@ -294,39 +294,6 @@ def self_calibrate(
             sample_rate_hz=rate,
         )
     return out
-
-
-def gpd_return_level_upper(x: FloatArray, p_fa: float, *, tail_fraction: float, z: float = 1.0) -> float:
-    """Upper confidence bound of the value exceeded with probability ``p_fa`` per sample (peaks over the
-    (1 − ``tail_fraction``) quantile u, generalised Pareto excesses with scale σ and shape ξ).
-
-    Return level (Coles 2001, Eq. 4.12): x_p = u + σ/ξ·(r^ξ − 1), r = tail_fraction/p_fa (→ u + σ ln r as
-    ξ → 0). Its variance by the delta method, ∇x_pᵀ V ∇x_p, with the asymptotic covariance of the ML fit of
-    n excesses V = (1+ξ)/n·[[2σ², σ], [σ, 1+ξ]] (Smith 1987, valid for ξ > −1/2; ξ is floored at −0.45
-    for V). Returns x_p + z·sd(x_p); z = 0 gives the point estimate (:func:`abrupt.thresholds.gpd_quantile`).
-    """
-    x = np.asarray(x, dtype=np.float64)
-    if p_fa >= tail_fraction:
-        return float(np.quantile(x, 1.0 - p_fa))
-    u = float(np.quantile(x, 1.0 - tail_fraction))
-    excess = x[x > u] - u
-    if excess.size < 30:
-        raise ValueError("too few tail samples for a generalised Pareto fit; give more event-free data")
-    xi, _, sigma = stats.genpareto.fit(excess, floc=0.0)
-    r = tail_fraction / p_fa
-    log_r = float(np.log(r))
-    if abs(xi) < 1e-6:
-        level = u + sigma * log_r
-        grad = np.array([log_r, 0.5 * sigma * log_r**2])
-    else:
-        rx = r**xi
-        level = u + sigma / xi * (rx - 1.0)
-        grad = np.array([(rx - 1.0) / xi, -sigma / xi**2 * (rx - 1.0) + sigma / xi * rx * log_r])
-    if z == 0.0:
-        return float(level)
-    xe = max(float(xi), -0.45)
-    cov = (1.0 + xe) / excess.size * np.array([[2.0 * sigma**2, sigma], [sigma, 1.0 + xe]])
-    return float(level + z * np.sqrt(max(0.0, float(grad @ cov @ grad))))
 
 
 def find_events(

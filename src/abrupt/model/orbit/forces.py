@@ -376,7 +376,7 @@ def _interp_row(table: FloatArray, t0: float, step: float, t: float) -> FloatArr
     if n == 1:
         return table[0].copy()
     u = (t - t0) / step
-    k = int(math.floor(u))
+    k = math.floor(u)
     k = max(0, min(n - 2, k))
     f = u - k
     return (1.0 - f) * table[k] + f * table[k + 1]

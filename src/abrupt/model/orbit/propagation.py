@@ -105,7 +105,7 @@ def propagate(
                 if k not in onset:
                     onset[k] = rsw_basis(state)
                 fixed += onset[k] @ u
-        for k, b in enumerate(burns):  # impulsive burns (zero duration) at this edge
+        for b in burns:  # impulsive burns (zero duration) at this edge
             if b.duration_s == 0 and b.t_start_s == ta:
                 state = state.copy()
                 state[3:] += rsw_basis(state) @ np.asarray(b.dv_rsw_mps, dtype=np.float64)
