@@ -47,7 +47,7 @@ FloatArray = NDArray[np.float64]
 SECONDS_PER_WEEK = 7 * 86400.0
 ONE_PER_WEEK = 1.0 / 7.0  # [false alarms per day]
 
-DETECTOR_NAME = "orbit_dmc_fb"
+DETECTOR_NAME = "orbit"
 
 
 @dataclass(frozen=True)
@@ -421,7 +421,7 @@ def find_events(
             Event(
                 spacecraft=sc,
                 kind=cfg.kind,
-                detector=f"{DETECTOR_NAME}:{name}",
+                detector=f"{DETECTOR_NAME}.{name}",
                 time_utc=str(time_utc),
                 statistic=float(s[peak_stat]),
                 threshold=thr.value,

@@ -5,3 +5,5 @@ plug-in, a test) registers as soon as its class is defined.
 """
 
 # Built-in detector modules are imported below as they adopt abrupt.detect.base.Detector.
+
+import abrupt.detect.orbit_detectors  # noqa: F401  (orbit.glr, orbit.mcr_w, ...)
