@@ -39,7 +39,9 @@ def test_real_arc_without_maneuver_gives_at_most_one_false_alarm_per_week_thresh
     assert len(events) <= 1  # issue 3 acceptance 3 (9.1 days; 1.3 expected at exactly one per week)
 
 
-def test_interval_dv_recovers_injected_impulses_on_real_data_better_than_ts1(shared_data: Path) -> None:
+def test_interval_dv_recovers_injected_impulses_on_real_data_within_five_percent(shared_data: Path) -> None:
+    """With the full force model (EGM2008 40×40, Sun, Moon) the interval estimate is within 5 % of 5 mm/s
+    (it was within 20 % and better than TS1 with J2-J4; with the full model TS1 is as good)."""
     from dataclasses import replace
 
     from abrupt.readers.sp3 import read_sp3
@@ -64,8 +66,8 @@ def test_interval_dv_recovers_injected_impulses_on_real_data_better_than_ts1(sha
         cols = ["dv_r_mps", "dv_t_mps", "dv_n_mps"]
         err_interval.append(np.linalg.norm(events[cols].iloc[best].to_numpy() - dv))
         err_fb.append(np.linalg.norm(fb[cols].iloc[best].to_numpy() - dv))
-    assert max(err_interval) < 0.2 * 0.005
-    assert np.mean(err_interval) < np.mean(err_fb)
+    assert max(err_interval) < 0.05 * 0.005
+    assert max(err_fb) < 0.2 * 0.005
 
 
 def test_cli_threshold_confidence_zero_gives_the_lower_point_estimate_threshold(

@@ -171,6 +171,8 @@ def normalise_frame(frame: pd.DataFrame) -> pd.DataFrame:
     out = frame.loc[:, ordered].copy()
     for name in _FLOAT_COLUMNS:
         out[name] = pd.to_numeric(out[name], errors="raise").astype("float64")
+    if pd.api.types.is_datetime64_any_dtype(out["time_utc"]):  # typed timestamps (Parquet) to the ISO text form
+        out["time_utc"] = [format_time_utc(t) for t in out["time_utc"]]
     for name in _TEXT_COLUMNS:
         out[name] = out[name].astype("string")
     bad = ~out["kind"].isin(EVENT_KINDS)
@@ -180,11 +182,16 @@ def normalise_frame(frame: pd.DataFrame) -> pd.DataFrame:
 
 
 def write_events(frame: pd.DataFrame, path: str) -> None:
-    """Write events to CSV or Parquet, chosen by the file suffix (``.csv``, ``.parquet``/``.pq``)."""
+    """Write events to CSV or Parquet, chosen by the file suffix (``.csv``, ``.parquet``/``.pq``).
+
+    Parquet stores ``time_utc`` as a typed UTC timestamp (microseconds); CSV as ISO-8601 text.
+    """
     frame = normalise_frame(frame)
     lower = str(path).lower()
     if lower.endswith((".parquet", ".pq")):
-        frame.to_parquet(path, index=False)
+        typed = frame.copy()
+        typed["time_utc"] = pd.to_datetime(typed["time_utc"].astype(str), utc=True).astype("datetime64[us, UTC]")
+        typed.to_parquet(path, index=False)
     elif lower.endswith(".csv"):
         frame.to_csv(path, index=False)
     else:

@@ -7,7 +7,18 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from abrupt.cli.groups import catalog_option, check_suffix, cli, detect, record_run, report, simulate
+from abrupt.cli.groups import (
+    StageProgress,
+    catalog_option,
+    check_suffix,
+    cli,
+    detect,
+    note,
+    record_run,
+    report,
+    simulate,
+    warn,
+)
 
 if TYPE_CHECKING:
     from abrupt.simulate.attitude import Strike
@@ -243,41 +254,41 @@ def run_attitude_detection(
     mask: str | None = None,
 ) -> tuple[Any, Any, Any, Any]:
     """Read, calibrate and detect, with a progress line per stage. Returns (sc, telemetry, config, result)."""
+    from abrupt.clean.masks import apply_mask, read_mask
     from abrupt.detect.attitude import detect_attitude
-    from abrupt.readers.telemetry import apply_mask, read_mask, read_telemetry
+    from abrupt.readers.telemetry import read_telemetry
 
     sc = _spacecraft(spacecraft_path)
     tel = read_telemetry(telemetry_path, sc)
     if mask:
         tel = apply_mask(tel, read_mask(mask))
     for line in tel.repairs.summary():
-        click.echo(f"repaired: {line}", err=True)
+        note(f"repaired: {line}")
     cal = read_telemetry(calibration, sc) if calibration else None
     if cal is not None:
         for line in cal.repairs.summary():
-            click.echo(f"repaired (calibration): {line}", err=True)
+            note(f"repaired (calibration): {line}")
     cfg = _detection_config(**settings)
-    stages = iter(range(1, 10_000))
-
-    def progress(stage: str) -> None:
-        click.echo(f"[{next(stages)}] {stage} ...", err=True)
-
-    result = detect_attitude(tel, sc, cfg, calibration=cal, spacecraft_name=name, progress=progress)
+    n_stat = sum(1 for d in cfg.detectors if not d.startswith("mf_"))
+    stages = StageProgress(2 * n_stat + (1 if n_stat < len(cfg.detectors) else 0), desc="detect attitude")
+    try:
+        result = detect_attitude(tel, sc, cfg, calibration=cal, spacecraft_name=name, progress=stages)
+    finally:
+        stages.close()
     for warning in result.details.get("warnings", []):
-        click.echo(f"warning: {warning}", err=True)
+        warn(warning)
     noise = result.details.get("noise_model", {})
     if noise:
-        click.echo(
+        note(
             "momentum noise model: white σ "
             + ", ".join(f"{v:.3g}" for v in noise["white_sigma_Nms"])
             + " N·m·s; random walk σ "
             + ", ".join(f"{v:.3g}" for v in noise["random_walk_sigma_Nms"])
-            + " N·m·s per sample",
-            err=True,
+            + " N·m·s per sample"
         )
     for det, frac in result.details.get("analysed_fraction", {}).items():
         if frac < 0.999:
-            click.echo(f"{det}: {frac:.1%} of samples analysed (window edges and short segments excluded)", err=True)
+            note(f"{det}: {frac:.1%} of samples analysed (window edges and short segments excluded)")
     return sc, tel, cfg, result
 
 
@@ -320,7 +331,7 @@ def detect_attitude_cmd(
 ) -> None:
     """Detect strikes in attitude TELEMETRY (CSV or Parquet); write events and the catalog."""
     mask = settings.pop("mask")
-    _, tel, _, result = run_attitude_detection(telemetry, spacecraft_path, calibration, name, settings, mask)
+    sc, tel, cfg, result = run_attitude_detection(telemetry, spacecraft_path, calibration, name, settings, mask)
     details = {
         "thresholds": {k: v.as_dict() for k, v in result.thresholds.items()},
         **{k: v for k, v in result.details.items()},
@@ -334,12 +345,12 @@ def detect_attitude_cmd(
         input_path=telemetry,
         out=out,
         details=details,
+        spacecraft=name or sc.name,
+        detectors=[f"attitude.{d}" for d in cfg.detectors],
+        span_utc=(tel.time[0], tel.time[-1]) if len(tel) else None,
     )
     for k, thr in result.thresholds.items():
-        click.echo(
-            f"threshold {k}: {thr.value:.4g} ({thr.false_alarms_per_day:g} false alarms/day, {thr.method})",
-            err=True,
-        )
+        note(f"threshold {k}: {thr.value:.4g} ({thr.false_alarms_per_day:g} false alarms/day, {thr.method})")
     if report_path:
         from abrupt.report.attitude import write_attitude_report
 
@@ -412,17 +423,14 @@ def demo(out_dir: str, duration_s: float, seed: int) -> None:
         u = rng.normal(size=3)
         u /= np.linalg.norm(u)
         strikes.append(Strike(round(float(t), 1), tuple(float(v) for v in size * u)))  # type: ignore[arg-type]
-    click.echo(
-        f"[1/4] simulating {duration_s / 3600:g} h of 10 Hz telemetry with {len(strikes)} strikes ...",
-        err=True,
-    )
+    note(f"[1/4] simulating {duration_s / 3600:g} h of 10 Hz telemetry with {len(strikes)} strikes ...")
     sim = simulate_attitude(sc, AttitudeSimConfig(duration_s=duration_s, seed=seed), strikes)
     tel_path, truth_path = write_telemetry(sim, out / "telemetry.parquet")
-    click.echo("[2/4] reading telemetry and calibrating thresholds (one false alarm per day) ...", err=True)
+    note("[2/4] reading telemetry and calibrating thresholds (one false alarm per day) ...")
     tel = read_telemetry(tel_path, sc)
     cfg = AttitudeDetectionConfig(detectors=("glr", "cusum", "summation"))
     result = detect_attitude(tel, sc, cfg, spacecraft_name="demo-sat")
-    click.echo("[3/4] writing events and catalog ...", err=True)
+    note("[3/4] writing events and catalog ...")
     record_run(
         catalog_target=str(out / "catalog.sqlite"),
         command="demo",
@@ -433,7 +441,7 @@ def demo(out_dir: str, duration_s: float, seed: int) -> None:
         out=out / "events.csv",
         details={"thresholds": {k: v.as_dict() for k, v in result.thresholds.items()}},
     )
-    click.echo("[4/4] drawing the report ...", err=True)
+    note("[4/4] drawing the report ...")
     truth = pd.read_csv(truth_path)
     write_attitude_report(out / "report.png", tel, result, truth=truth, title="abrupt demo: thesis spacecraft")
     write_attitude_report(out / "report.html", tel, result, truth=truth, title="abrupt demo: thesis spacecraft")

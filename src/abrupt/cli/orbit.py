@@ -310,22 +310,32 @@ def detect_orbit_command(
     "--duration-s", type=click.FloatRange(min=0.0), default=0.0, show_default=True, help="Burn duration (0: impulse)."
 )
 @click.option("--satellite", default=None, help="Satellite id in the file.")
-@click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Navigation CSV to write.")
+@click.option(
+    "--out",
+    "out",
+    required=True,
+    type=click.Path(dir_okay=False),
+    help="File to write, in the input's format (SP3, OEM KVN/XML); a name ending in .csv gives navigation CSV.",
+)
 def inject_orbit_command(
     file: str, time_utc: str, dv_rtn: str, duration_s: float, satellite: str | None, out: str
 ) -> None:
     """Add the effect of a ΔV (impulse or finite burn) at a chosen time to a real ephemeris."""
     from abrupt.pipelines.orbit import inject_orbit
-    from abrupt.readers.navigation_csv import write_navigation_csv
+    from abrupt.readers.ephemeris import write_ephemeris
 
     try:
         out_eph = inject_orbit(
             file, time_utc, _parse_vector(dv_rtn, "dv-rtn"), duration_s=duration_s, satellite=satellite
         )
+    except ConfigError:
+        raise  # already names its option (a ConfigError is a ValueError: do not wrap it twice)
     except ValueError as exc:
         raise ConfigError(str(exc), key="time") from None
-    write_navigation_csv(out_eph, out)
-    click.echo(f"ΔV {dv_rtn} m/s (RTN) injected at {time_utc} into {len(out_eph)} epochs; written to {out}", err=True)
+    fmt = write_ephemeris(out_eph, out, like=file)
+    click.echo(
+        f"ΔV {dv_rtn} m/s (RTN) injected at {time_utc} into {len(out_eph)} epochs; written to {out} ({fmt})", err=True
+    )
 
 
 @report.command("orbit")

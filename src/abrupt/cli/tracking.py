@@ -298,9 +298,10 @@ def detect_tracking_command(
     degree = int(float(setup.extra.get("central.body.degree", "0") or 0))
     third = any(setup.extra.get(k, "false").lower() == "true" for k in ("third.body.sun", "third.body.moon"))
     span_s = float(np.nanmax(data.t_s)) if len(data.t_s) else 0.0
+    epoch_ns = np.asarray(setup.epoch_utc, dtype="datetime64[ns]").reshape(-1)[0]
     force = ForceContext.build(
         ForceModel(mu_m3_s2=setup.mu_m3_s2, zonal_degree=2 if degree >= 2 else 0, sun=third, moon=third),
-        np.datetime64(setup.epoch_utc, "ns"),
+        epoch_ns,
         -86400.0,
         span_s + 86400.0,
     )
@@ -420,7 +421,7 @@ def detect_tracking_command(
             )
         )
     frame = events_frame(events) if events else empty_frame()
-    summary = _fit_summary(final_fit, force.model, sun_moon_gcrf(np.datetime64(setup.epoch_utc, "ns"))[0][0])
+    summary = _fit_summary(final_fit, force.model, sun_moon_gcrf(np.array([epoch_ns]))[0][0])
     summary["repairs"] = repairs.as_dict()
     for line in _summary_lines(summary):
         click.echo(line, err=True)

@@ -29,16 +29,15 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from abrupt.clean.noise import robust_noise_sigma, robust_scale
 from abrupt.detect.change_detection import WindowConfig, sliding_statistic
 from abrupt.errors import InputError
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc, new_run_id
 from abrupt.model.momentum import system_momentum
-from abrupt.model.noise import robust_noise_sigma
 from abrupt.model.spacecraft import Spacecraft
-from abrupt.readers.telemetry import Telemetry
+from abrupt.series.telemetry import Telemetry
 from abrupt.thresholds import Threshold, block_maxima, fit_block_maxima_threshold, fit_threshold
-
-FloatArray = NDArray[np.float64]
+from abrupt.types import FloatArray
 
 CHANGE_DETECTORS: tuple[str, ...] = ("glr", "cusum", "summation", "shiryaev")
 MATCHED_FILTERS: tuple[str, ...] = ("mf_attitude", "mf_rate", "mf_joint")
@@ -179,8 +178,7 @@ def robust_allan_variance(x: FloatArray, m: int) -> FloatArray:
         return np.full(x.shape[1], np.nan)
     means = x[:n].reshape(-1, m, x.shape[1]).mean(axis=1)
     d = np.diff(means, axis=0)
-    mad = np.median(np.abs(d - np.median(d, axis=0)), axis=0)
-    return np.asarray((1.4826 * mad) ** 2 / 2.0, dtype=np.float64)
+    return np.asarray(robust_scale(d, axis=0) ** 2 / 2.0, dtype=np.float64)
 
 
 def momentum_noise_model(h: FloatArray, segments: list[tuple[int, int]] | None = None) -> MomentumNoiseModel:
@@ -235,7 +233,7 @@ def calibrate_thresholds(
                 spacecraft, telemetry.quaternion_BN, telemetry.body_rate_rad_s, telemetry.wheel_speed_rad_s
             ).H_N_Nms
         model = momentum_noise_model(h_data, telemetry.segments)
-        h_null = model.simulate(config.null_samples, config.seed)
+        h_null = model.simulate(max(config.null_samples, _null_samples_needed(config, dt)), config.seed)
         segments = [(0, h_null.shape[0])]
     noise = {"white_sigma_Nms": model.white_sigma_Nms, "random_walk_sigma_Nms": model.random_walk_sigma_Nms}
     thresholds: dict[str, Threshold] = {}
@@ -270,6 +268,21 @@ def calibrate_thresholds(
                 method=config.threshold_method,  # type: ignore[arg-type]
             )
     return thresholds, noise
+
+
+def _null_samples_needed(config: AttitudeDetectionConfig, dt: float) -> int:
+    """Fewest simulated event-free samples giving every block-maxima fit enough blocks.
+
+    ``fit_block_maxima_threshold`` needs 20 blocks; one more block and a window span of margin.
+    """
+    need = 0
+    for name in config.detectors:
+        if name in MATCHED_FILTERS:
+            continue
+        win = detector_windows(name, config, dt)
+        block_s = max(300.0, 3.0 * win.span * dt)
+        need = max(need, round(21 * block_s / dt) + win.span)
+    return need
 
 
 def _episodes(stat: FloatArray, threshold: float, merge: int) -> list[tuple[int, int]]:

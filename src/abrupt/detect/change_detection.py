@@ -33,7 +33,7 @@ import numba as nb
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-FloatArray = NDArray[np.float64]
+from abrupt.types import FloatArray
 
 ANCHOR = 1024  # running sums are recomputed exactly at absolute indices divisible by this
 

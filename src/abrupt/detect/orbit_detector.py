@@ -398,10 +398,20 @@ def find_events(
                     dv_in = jump.dv_inertial_mps
                     cov = jump.dv_cov
                 elif cfg.dv_estimate == "interval":
-                    burn = locate_burn(analysis, k_j)
+                    burn = locate_burn(analysis, k_j, (int(lo), int(hi)), interval_sigma_s=jump.time_sigma_s)
                     dv_in, cov = burn.dv_inertial_mps, burn.dv_cov
                     t_event, time_sigma, duration = burn.start_s, burn.centroid_sigma_s, burn.duration_s
-                    xf = analysis.forward.x[burn.k_first - 1]
+                    # orbit frame at the burn centroid: the net ΔV of a burn held in the orbit frame (as
+                    # operators fly reboosts) points along its direction there
+                    k_c = int(np.clip(np.searchsorted(t, burn.centroid_s), 0, t.size - 1))
+                    xf = analysis.forward.x[k_c]
+                    if burn.duration_s > 0:
+                        # integrated |ΔV| of a burn fixed in the orbit frame: the net vector is shorter by
+                        # sin(θ/2)/(θ/2), θ = n·D the frame's rotation over the burn
+                        rn = float(np.linalg.norm(xf[:3]))
+                        theta = float(np.linalg.norm(np.cross(xf[:3], xf[3:6]))) / rn**2 * burn.duration_s
+                        if theta > 1e-6:
+                            dv_in = dv_in * (0.5 * theta / np.sin(0.5 * theta))
                 else:
                     # TS1 at the last pre-jump epoch: forward saw only pre-jump data, backward only post-jump
                     dv_in = analysis.fusion.dv_inertial[k_j - 1]
@@ -495,23 +505,49 @@ def interval_jump(analysis: OrbitAnalysis, k_first: int, k_last: int | None = No
     measurement_update(xb, pb, y, rdiag, np.empty(6))
     xf = analysis.forward.x[k_first - 1].copy()
     pf = analysis.forward.p[k_first - 1]
-    xf[6:9] = 0.5 * (xf[6:9] + xb[6:9])
+    if k_last == k_first or (_quiet(analysis, xf[6:9]) and _quiet(analysis, xb[6:9])):
+        xf[6:9] = 0.5 * (xf[6:9] + xb[6:9])
+    else:  # an edge inside a burn: its Gauss-Markov state holds part of the burn, not the background
+        xf[6:9] = 0.0
     dt = float(t[k_last] - t[k_first - 1])
     ctx = _context_of(analysis)
     phi = np.empty((9, 9))
     x_pred = propagate_state(xf, float(t[k_first - 1]), dt, 1e12, ctx.kernel_args, fc.max_step_s, phi)
     p_pred = phi @ pf @ phi.T
-    dv = xb[3:6] - x_pred[3:6]
-    dr = xb[0:3] - x_pred[0:3]
+    # The state difference at t_last maps back through the STM to the equivalent offset at t_first−1;
+    # a ΔV at t_c gives there [−(t_c − t₀)ΔV; ΔV] to first order. Refine by mapping the offset to t_c,
+    # where the position offset vanishes (second-order terms n²(t_c − t₀)²/2 matter for long spans).
+    dx_last = np.r_[xb[0:3] - x_pred[0:3], xb[3:6] - x_pred[3:6]]
+    dx0 = np.linalg.solve(phi[:6, :6], dx_last)
+    t0 = float(t[k_first - 1])
+    t_c = t0 - float(dx0[:3] @ dx0[3:]) / max(float(dx0[3:] @ dx0[3:]), 1e-300)
+    dv, dr = dx0[3:], dx0[:3]
+    phi_c = np.empty((9, 9))
+    for _ in range(2):
+        tau_c = min(max(t_c - t0, 0.0), dt)
+        propagate_state(xf, t0, tau_c, 1e12, ctx.kernel_args, fc.max_step_s, phi_c)
+        dx_c = phi_c[:6, :6] @ dx0
+        dv = dx_c[3:]
+        dr = dx_c[:3]
+        t_c = t0 + tau_c - float(dr @ dv) / max(float(dv @ dv), 1e-300)
     scale = innovation_scale(analysis)
     cov = scale * (p_pred[3:6, 3:6] + pb[3:6, 3:6] + (0.5 * dt) ** 2 * (pf[6:9, 6:9] + pb[6:9, 6:9]))
     cov_r = scale * (p_pred[0:3, 0:3] + pb[0:3, 0:3])
     mag = float(np.linalg.norm(dv))
     u = dv / max(mag, 1e-300)
-    lead = float(dr @ dv) / max(mag * mag, 1e-300)
+    lead = float(t[k_last]) - t_c
     var_lead = float(u @ cov_r @ u) / max(mag * mag, 1e-300) + lead * lead * float(u @ cov @ u) / max(mag * mag, 1e-300)
-    t_c = float(t[k_last]) - lead
     return JumpInterval(k_first, k_last, dv, cov, t_c, float(np.sqrt(var_lead)), t_c, 0.0)
+
+
+def _quiet(analysis: OrbitAnalysis, w: FloatArray) -> bool:
+    """Whether a DMC acceleration is within the arc's usual range (median + 10 robust sigmas of |w_F|)."""
+    mags = np.linalg.norm(analysis.forward.x[analysis.valid, 6:9], axis=1)
+    if mags.size < 10:
+        return True
+    med = float(np.median(mags))
+    scale = 1.4826 * float(np.median(np.abs(mags - med)))
+    return float(np.linalg.norm(w)) <= med + 10.0 * max(scale, 1e-12)
 
 
 def innovation_scale(analysis: OrbitAnalysis) -> float:
@@ -530,75 +566,77 @@ def interval_dv(analysis: OrbitAnalysis, k: int) -> tuple[FloatArray, FloatArray
     return j.dv_inertial_mps, j.dv_cov
 
 
-def locate_burn(analysis: OrbitAnalysis, k: int, *, search: int = 2, max_intervals: int = 30) -> JumpInterval:
-    """The velocity change near interval k: an impulse or a finite burn (seconds to ~20 min).
+def locate_burn(
+    analysis: OrbitAnalysis,
+    k: int,
+    episode: tuple[int, int] | None = None,
+    *,
+    margin: int = 3,
+    max_intervals: int = 40,
+    interval_sigma_s: float = 0.0,
+) -> JumpInterval:
+    """The velocity change of one exceedance episode: an impulse or a finite burn (seconds to ~20 min).
 
-    1. Among intervals k−``search``…k+``search`` the one with the most significant single-interval ΔV
-       (|ΔV|/σ) is the seed.
-    2. Neighbouring intervals whose own ΔV is significant (> 5σ) and at least 5 % of the seed's extend
-       the span (a finite burn puts ΔV into every interval it covers), up to ``max_intervals``.
-    3. ΔV and the centroid come from :func:`interval_jump` over the whole span. The duration is
-       |ΔV|/a with a = the largest single-interval |ΔV|/Δt (an interval fully inside the burn; for a
-       span of one interval the burn is taken as an impulse, duration 0), and the start is the centroid
-       minus half the duration (a constant acceleration). The start's σ is the centroid's σ combined
-       with a quarter of the sampling interval when a duration was estimated. For an impulse the time
-       inside the interval is used only when the position jump resolves it (σ < Δt/10); otherwise the
-       interval's midpoint is reported with σ = Δt/√12. On real precise orbits the positions and
-       velocities are not consistent to better than ~2 cm over one step, which does not resolve it.
+    ``k`` is the located jump interval (GLR) and ``episode`` the first and last exceeding epochs.
+    1. The span [lo, hi] is the episode (and k) widened by ``margin`` intervals, at most
+       ``max_intervals``; its edges lie outside the burn, so ΔV between the forward state before and the
+       backward state after it (:func:`interval_jump`) is the whole burn's, unbiased by the filters'
+       Gauss-Markov states that absorb part of a long burn.
+    2. Profile: with the forward edge fixed, the ΔV to the backward state at each epoch h of the span,
+       projected on the total, rises from 0 to the total over the burn (linearly for a constant
+       acceleration). The 10 % and 90 % crossings give the duration D = (t₉₀ − t₁₀)/0.8.
+    3. If D is shorter than a sampling interval, or the located interval k alone holds the total ΔV
+       (within 20 % or 3σ), the change is an impulse in interval k: its ΔV and time come from that
+       interval alone; the time inside the interval
+       is used only when the position jump resolves it (σ < Δt/10), otherwise the midpoint is reported
+       with σ = Δt/√12 combined with ``interval_sigma_s``, the locator's own uncertainty about which
+       interval holds the change (on real precise orbits positions and velocities are not consistent to better
+       than ~2 cm over one step, which does not resolve it).
+    4. Otherwise start = t_c − D/2 with t_c the centroid from the position jump (constant acceleration);
+       σ combines the centroid's σ with a quarter of the sampling interval.
     """
     t = analysis.t_s
     n = t.size
-    singles: dict[int, JumpInterval] = {}
+    g0, g1 = episode if episode is not None else (k, k)
+    lo = max(1, min(g0, k) - margin)
+    hi = min(n - 1, max(g1, k) + margin)
+    if hi - lo + 1 > max_intervals:  # keep the span around the located interval
+        lo = max(1, k - max_intervals // 2)
+        hi = min(n - 1, lo + max_intervals - 1)
+    whole = interval_jump(analysis, lo, hi)
+    total = whole.dv_inertial_mps
+    mag = float(np.linalg.norm(total))
+    u = total / max(mag, 1e-300)
+    prof_t = [float(t[lo - 1])]
+    prof = [0.0]
+    for h in range(lo, hi + 1):
+        j = whole if h == hi else interval_jump(analysis, lo, h)
+        prof_t.append(float(t[h]))
+        prof.append(float(j.dv_inertial_mps @ u) / max(mag, 1e-300))
+    pt = np.array(prof_t)
+    pv = np.maximum.accumulate(np.clip(np.array(prof), 0.0, None))
 
-    def single(i: int) -> JumpInterval | None:
-        if not 1 <= i < n:
-            return None
-        if i not in singles:
-            singles[i] = interval_jump(analysis, i)
-        return singles[i]
+    def crossing(level: float) -> float:
+        i = int(np.argmax(pv >= level))
+        if i == 0:
+            return float(pt[0])
+        f = (level - pv[i - 1]) / max(pv[i] - pv[i - 1], 1e-300)
+        return float(pt[i - 1] + f * (pt[i] - pt[i - 1]))
 
-    def significance(j: JumpInterval | None) -> float:
-        if j is None:
-            return -1.0
-        u = j.dv_inertial_mps / max(float(np.linalg.norm(j.dv_inertial_mps)), 1e-300)
-        sd = float(np.sqrt(max(float(u @ j.dv_cov @ u), 1e-300)))
-        return float(np.linalg.norm(j.dv_inertial_mps)) / sd
-
-    cands = [i for i in range(k - search, k + search + 1) if 1 <= i < n]
-    seed = max(cands, key=lambda i: significance(single(i)))
-    seed_j = single(seed)
-    assert seed_j is not None
-    seed_mag = float(np.linalg.norm(seed_j.dv_inertial_mps))
-
-    def part_of_burn(i: int) -> bool:
-        j = single(i)
-        return (
-            j is not None
-            and significance(j) > 5.0
-            and float(np.linalg.norm(j.dv_inertial_mps)) > 0.05 * seed_mag
-            and float(j.dv_inertial_mps @ seed_j.dv_inertial_mps) > 0
-        )
-
-    lo = hi = seed
-    while hi - lo + 1 < max_intervals and part_of_burn(lo - 1):
-        lo -= 1
-    while hi - lo + 1 < max_intervals and part_of_burn(hi + 1):
-        hi += 1
-    whole = interval_jump(analysis, lo, hi) if hi > lo else seed_j
-    if hi == lo:
-        step = float(t[lo] - t[lo - 1])
-        if whole.centroid_sigma_s < step / 10.0 and t[lo - 1] <= whole.centroid_s <= t[lo]:
-            return whole  # the position jump resolves the time inside the interval
-        # otherwise only the interval is known: its midpoint, uniform error (σ = Δt/√12)
-        mid = float(t[lo]) - 0.5 * step
-        return replace(whole, centroid_s=mid, start_s=mid, centroid_sigma_s=step / float(np.sqrt(12.0)))
-    accel = max(
-        float(np.linalg.norm(single(i).dv_inertial_mps)) / float(t[i] - t[i - 1])  # type: ignore[union-attr]
-        for i in range(lo, hi + 1)
-    )
-    duration = float(np.linalg.norm(whole.dv_inertial_mps)) / max(accel, 1e-300)
-    start = whole.centroid_s - 0.5 * duration
+    t10, t90 = crossing(0.1), crossing(0.9)
     step = float(np.median(np.diff(t[lo - 1 : hi + 1])))
+    duration = (t90 - t10) / 0.8
+    single = interval_jump(analysis, k)
+    sd_total = float(np.sqrt(max(float(u @ whole.dv_cov @ u), 0.0)))
+    impulse = duration < step or float(np.linalg.norm(single.dv_inertial_mps - total)) < max(0.2 * mag, 3.0 * sd_total)
+    if impulse:  # the located interval alone holds the change
+        step_k = float(t[k] - t[k - 1])
+        if single.centroid_sigma_s < step_k / 10.0 and t[k - 1] <= single.centroid_s <= t[k]:
+            return single
+        mid = float(t[k]) - 0.5 * step_k
+        sigma_k = float(np.hypot(step_k / np.sqrt(12.0), interval_sigma_s))
+        return replace(single, centroid_s=mid, start_s=mid, centroid_sigma_s=sigma_k)
+    start = whole.centroid_s - 0.5 * duration
     sigma = float(np.hypot(whole.centroid_sigma_s, 0.25 * step))
     return replace(whole, start_s=start, duration_s=duration, centroid_sigma_s=sigma)
 

@@ -202,7 +202,7 @@ def _process_noise(x: FloatArray, dt: float, tau: float, q_rtn: FloatArray, out:
 
 
 @nb.njit(cache=True)
-def _deriv(x: FloatArray, t: float, tau: float, args: tuple) -> FloatArray:  # type: ignore[type-arg]
+def _deriv(x: FloatArray, t: float, tau: float, args: tuple) -> FloatArray:
     """Ẋ = [v; a(t, r, v) + w; −w/τ] (Bennett 2022 Eqs. 3.4-3.7) with a from the force context."""
     d = np.empty(9)
     d[0:3] = x[3:6]
@@ -232,7 +232,7 @@ def _jacobian(x: FloatArray, tau: float, mu: float, with_j2: bool, out: FloatArr
 
 
 @nb.njit(cache=True)
-def _with_j2(args: tuple) -> bool:  # type: ignore[type-arg]
+def _with_j2(args: tuple) -> bool:
     ints = args[0]
     return ints[1] >= 2 or ints[3] >= 2
 
@@ -258,7 +258,7 @@ def propagate_state(
     tau: float,
     args: tuple,
     max_step: float,
-    phi: FloatArray,  # type: ignore[type-arg]
+    phi: FloatArray,
 ) -> FloatArray:
     """RK4 propagation of the 9-state from ``t`` over ``dt`` (sub-stepped to ``max_step``) and the Lear
     RK2 STM (Eq. 3.8, erratum A7) into ``phi``; ``args`` are :attr:`ForceContext.kernel_args`."""
@@ -374,7 +374,7 @@ def forward_kernel(
     tau: float,
     q_rtn: FloatArray,
     max_step: float,
-    args: tuple,  # type: ignore[type-arg]
+    args: tuple,
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Forward EKF-DMC: a-posteriori states/covariances at every epoch (Bennett 2022 §3.2.1-3.2.5)."""
     n = t.size
@@ -412,7 +412,7 @@ def backward_kernel(
     tau: float,
     q_rtn: FloatArray,
     max_step: float,
-    args: tuple,  # type: ignore[type-arg]
+    args: tuple,
     mirrored: bool,
 ) -> tuple[FloatArray, FloatArray]:
     """Backward filter: a-priori states/covariances at every epoch (not including that epoch's data).
@@ -552,7 +552,7 @@ def forward_kernel_detailed(
     tau: float,
     q_rtn: FloatArray,
     max_step: float,
-    args: tuple,  # type: ignore[type-arg]
+    args: tuple,
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Forward filter from the a-posteriori (x0, p0) at t[0], storing per step k ≥ 1 the STM Φ_k,
     the gain K_k, the inverse innovation covariance S_k⁻¹ and the innovation γ_k (for the GLR)."""

@@ -83,6 +83,9 @@ class TleDetectorConfig:
     refine_time: bool = True
     time_window_sets: int = 8
     min_side_sets: int = 3
+    regime: str = "auto"
+    time_search_sets_before: int = 3
+    group_gain: tuple[float, float, float] = (1.0, 1.0, 1.0)
 
     def __post_init__(self) -> None:
         if self.window_sets < 2:
@@ -106,22 +109,72 @@ class StepSeries:
     z_e: NDArray[np.float64]
     z_n: NDArray[np.float64]
     weights: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    group_gain: tuple[float, float, float] = (1.0, 1.0, 1.0)
 
     @property
     def statistic(self) -> NDArray[np.float64]:
         """Combined S = sqrt(Σ (w_k z_k)²) with the per-group tail weights (module docstring, step 3)."""
         wa, we, wn = self.weights
-        return np.sqrt((wa * self.z_a) ** 2 + (we * self.z_e) ** 2 + (wn * self.z_n) ** 2)
+        ga, ge, gn = self.group_gain
+        return np.maximum.reduce(
+            [ga * wa * self.z_a, ge * chi2_as_normal(we * self.z_e), gn * chi2_as_normal(wn * self.z_n)]
+        )
 
 
-def mean_element_series(history: ElementHistory) -> dict[str, NDArray[np.float64]]:
-    """Detector series: time (s from the first epoch), a (m), e-vector, i and RAAN residual (rad)."""
+def chi2_as_normal(z: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The |N(0,1)| value with the same tail probability as a χ₂ magnitude ``z`` (P = exp(−z²/2))."""
+    from scipy import special
+
+    z = np.asarray(z, dtype=float)
+    log_p = -0.5 * z**2  # survival of a χ₂ magnitude
+    # two-sided normal: P(|N| > x) = erfc(x/√2) → x = √2·erfcinv(P); for tiny P use the asymptote
+    p = np.exp(log_p)
+    out = np.sqrt(2.0) * special.erfcinv(np.clip(p, 1e-300, 1.0))
+    tiny = p < 1e-280
+    out[tiny] = np.sqrt(np.maximum(z[tiny] ** 2 - np.log(np.maximum(z[tiny] ** 2, 1.0)), 0.0))
+    return np.asarray(out, dtype=float)
+
+
+GEO_MEAN_MOTION_RANGE_REV_DAY = (0.9, 1.1)
+
+
+def orbit_regime(history: ElementHistory) -> str:
+    """``"geo"`` for near-geosynchronous near-circular orbits (median mean motion 0.9-1.1 rev/day,
+    e < 0.1), else ``"leo"`` (the mean-element detector's general case)."""
+    el = history.elements
+    if len(el) == 0:
+        return "leo"
+    rev_day = float(np.median(el["n_rad_s"])) * SECONDS_PER_DAY / (2.0 * math.pi)
+    lo, hi = GEO_MEAN_MOTION_RANGE_REV_DAY
+    return "geo" if lo <= rev_day <= hi and float(np.median(el["e"])) < 0.1 else "leo"
+
+
+def mean_element_series(history: ElementHistory, regime: str = "leo") -> dict[str, NDArray[np.float64]]:
+    """Detector series: time (s from the first epoch), a (m), e-vector, and two orbit-normal angles (rad).
+
+    ``leo``: e-vector ``e(cos ω, sin ω)``; normal = (``i``, ``sin i`` × RAAN minus the SGP4 secular J2
+    drift, accumulated set to set). ``geo``: the equinoctial vectors that stay defined at small
+    inclination (Soop 1994, §3): ``e(cos ϖ, sin ϖ)`` with ϖ = Ω + ω, and the inclination vector
+    ``i(sin Ω, −cos Ω)``; east-west burns move ``a`` (longitude drift) and the e-vector, north-south
+    burns the inclination vector. The keys ``i_rad`` and ``raan_resid_sin_i_rad`` hold the two normal
+    components in both regimes.
+    """
     el = history.elements
     t = (el["epoch_utc"] - el["epoch_utc"].iloc[0]).dt.total_seconds().to_numpy(dtype=float)
     e = el["e"].to_numpy(dtype=float)
     w = el["argp_rad"].to_numpy(dtype=float)
     inc = el["i_rad"].to_numpy(dtype=float)
     raan = el["raan_rad"].to_numpy(dtype=float)
+    if regime == "geo":
+        varpi = w + raan
+        return {
+            "t_s": t,
+            "a_m": el["a_m"].to_numpy(dtype=float),
+            "ex": e * np.cos(varpi),
+            "ey": e * np.sin(varpi),
+            "i_rad": inc * np.sin(raan),
+            "raan_resid_sin_i_rad": -inc * np.cos(raan),
+        }
     rate = el["raan_rate_rad_s"].to_numpy(dtype=float)
     incr = np.zeros_like(raan)
     if len(raan) > 1:
@@ -207,7 +260,8 @@ class _StepModel:
 
     def __init__(self, history: ElementHistory, cfg: TleDetectorConfig) -> None:
         self.cfg = cfg
-        self.s = mean_element_series(history)
+        self.regime = orbit_regime(history) if cfg.regime == "auto" else cfg.regime
+        self.s = mean_element_series(history, self.regime)
         self.t = self.s["t_s"]
         self.n = self.t.size
         self.scales = {k: _robust_scale_rolling(self.s[k], cfg.noise_half_window) for k in self.NAMES}
@@ -364,6 +418,7 @@ def segment(
             _fill(first, model, g, [])
     cur = _empty_steps(model.t, n_gaps)
     cur.weights = first.weights
+    cur.group_gain = first.group_gain
     for name in ("delta_a_m", "delta_e", "delta_normal_rad", "z_a", "z_e", "z_n"):
         setattr(cur, name, getattr(first, name).copy())
     accepted: list[int] = []
@@ -428,16 +483,16 @@ def event_free_mask(stat: NDArray[np.float64], guard: int) -> NDArray[np.bool_]:
     return keep
 
 
-def component_weights(first: StepSeries, guard: int, quantile: float = 0.99) -> tuple[float, float, float]:
-    """Weights that map each group's event-free ``quantile`` to the Gaussian one (χ₁ for a, χ₂ for e, n).
+def component_weights(first: StepSeries, guard: int, quantile: float = 0.5) -> tuple[float, float, float]:
+    """Weights that map each group's median z to the Gaussian median (χ₁ for a, χ₂ for e, n).
 
-    TLE noise is heavier-tailed in some elements than others (and differently for each satellite);
-    weighting by the empirical tail makes a 5σ-equivalent step count the same in every group, so no
-    group's outliers dominate the combined statistic.
+    The per-satellite noise model: each group's standardised steps are rescaled by a robust scale
+    (their median over all gaps, against the median of the χ distribution they would follow with
+    Gaussian noise; Hampel 1974). The median is unaffected by up to half the gaps being maneuvers or
+    their flanks, which a high quantile is not (CryoSat-2 has a burn every 3 weeks).
     """
     from scipy import stats
 
-    keep = event_free_mask(first.statistic, guard)
     refs = (
         float(stats.chi.ppf(quantile, 1)),
         float(stats.chi.ppf(quantile, 2)),
@@ -445,10 +500,35 @@ def component_weights(first: StepSeries, guard: int, quantile: float = 0.99) -> 
     )
     out = []
     for z, ref in zip((first.z_a, first.z_e, first.z_n), refs, strict=True):
-        sample = z[keep & np.isfinite(z) & (z > 0)]
-        q = float(np.quantile(sample, quantile)) if sample.size >= 50 else ref
-        out.append(ref / q if q > 0 else 1.0)
+        out.append(robust_group_weight(z, ref, guard, quantile))
     return out[0], out[1], out[2]
+
+
+def robust_group_weight(z: NDArray[np.float64], ref: float, guard: int, quantile: float = 0.5) -> float:
+    """``ref / quantile(z)`` over gaps away from maneuvers, found by iterated rejection (Hampel 1974).
+
+    Each pass rescales ``z`` by the current weight and removes ±``guard`` gaps around every local peak
+    above 6 (robust σ units); three passes converge on histories where a quarter of the gaps are
+    flanks of maneuvers.
+    """
+    finite = np.isfinite(z) & (z > 0)
+    if finite.sum() < 50:
+        return 1.0
+    keep = finite.copy()
+    w = 1.0
+    for _ in range(4):
+        sample = z[keep]
+        if sample.size < 50:
+            break
+        q = float(np.quantile(sample, quantile))
+        if not q > 0:
+            break
+        w = ref / q
+        peaks = local_peaks(np.where(finite, w * z, -np.inf), 1, 6.0)
+        keep = finite.copy()
+        for g in peaks:
+            keep[max(0, g - guard) : g + guard + 1] = False
+    return w
 
 
 def null_threshold(stat: NDArray[np.float64], guard: int, p_fa: float, method: str) -> float:
@@ -469,11 +549,17 @@ def null_threshold(stat: NDArray[np.float64], guard: int, p_fa: float, method: s
         return float(fit_threshold(null, p_fa=p_fa, method="empirical").value)
 
 
-def refine_burn_time(history: ElementHistory, gap: int, window_sets: int) -> tuple[float, bool]:
+def refine_burn_time(
+    history: ElementHistory, gap: int, window_sets: int, *, search_sets_before: int = 2, geo: bool = False
+) -> tuple[float, bool]:
     """Burn time (s from the first epoch) by along-track position continuity (module docstring, step 4).
 
-    Returns ``(t_m, refined)``; ``refined`` is False when the fit was not usable and the gap middle
-    of the bracketing element sets was returned instead.
+    The along-track angle is the mean argument of latitude ω + M (LEO) or the mean longitude
+    Ω + ω + M (GEO, where Ω and ω are ill-defined separately). The search runs from
+    ``search_sets_before`` sets before the step to the set after it: the first sets after a burn are
+    often still fitted to pre-burn tracking, so the step in the elements shows late while the
+    change of along-track drift (the hinge) does not. Returns ``(t_m, refined)``; ``refined`` is
+    False when the fit was not usable and the gap middle was returned instead.
     """
     el = history.elements
     t = (el["epoch_utc"] - el["epoch_utc"].iloc[0]).dt.total_seconds().to_numpy(dtype=float)
@@ -483,15 +569,19 @@ def refine_burn_time(history: ElementHistory, gap: int, window_sets: int) -> tup
     hi = min(n, gap + 1 + window_sets)
     if gap - lo < 2 or hi - (gap + 1) < 2:
         return mid, False
+
+    def along(sat: Any) -> float:
+        return float(sat.argpo + sat.mo + (sat.nodeo if geo else 0.0))
+
     ref = history.satrecs[gap]
-    u_ref = ref.argpo + ref.mo
-    rate = (ref.argpdot + ref.mdot) / 60.0  # [rad/s] SGP4 secular rates
+    u_ref = along(ref)
+    rate = (ref.argpdot + ref.mdot + (ref.nodedot if geo else 0.0)) / 60.0  # [rad/s] SGP4 secular rates
     idx = np.arange(lo, hi)
-    u = np.array([history.satrecs[k].argpo + history.satrecs[k].mo for k in idx])
+    u = np.array([along(history.satrecs[k]) for k in idx])
     du = np.angle(np.exp(1j * (u - u_ref - rate * (t[idx] - t[gap]))))
     tau = (t[idx] - t[gap]) / SECONDS_PER_DAY
     # candidate burn times: from the set two before the gap to the set after it
-    t_lo = t[max(lo, gap - 2)]
+    t_lo = t[max(lo, gap - search_sets_before)]
     t_hi = t[gap + 1]
     grid = np.linspace(t_lo, t_hi, 97)
     best = (np.inf, mid)
@@ -566,6 +656,7 @@ def detect_tle_maneuvers(
     for g in range(n_gaps):
         _fill(model_first, model, g, [])
     model_first.weights = component_weights(model_first, cfg.window_sets + 2)
+    model_first.group_gain = cfg.group_gain
     if cfg.threshold is not None:
         threshold = float(cfg.threshold)
     else:
@@ -575,7 +666,7 @@ def detect_tle_maneuvers(
         # Gaussian; a short history's tail fit cannot promise fewer false alarms than that.
         threshold = max(
             cfg.min_statistic,
-            float(stats.chi.ppf(1.0 - p_fa, 5)),
+            float(stats.norm.isf(p_fa / 6.0)),  # max of three groups, two-sided (Bonferroni)
             null_threshold(model_first.statistic, cfg.window_sets + 2, p_fa, cfg.threshold_method),
         )
     steps, accepted, _ = segment(history, cfg, threshold, model=model, first=model_first)
@@ -588,7 +679,13 @@ def detect_tle_maneuvers(
         if not all_candidates and stat[g] < threshold:
             continue
         if cfg.refine_time:
-            t_m, refined = refine_burn_time(history, int(g), cfg.time_window_sets)
+            t_m, refined = refine_burn_time(
+                history,
+                int(g),
+                cfg.time_window_sets,
+                search_sets_before=cfg.time_search_sets_before,
+                geo=model.regime == "geo",
+            )
         else:
             t_m, refined = 0.5 * (steps.t_before_s[g] + steps.t_after_s[g]), False
         timed.append((int(g), t_m, refined))
@@ -601,7 +698,7 @@ def detect_tle_maneuvers(
             kept.append(item)
     events: list[Event] = []
     for g, t_m, refined in sorted(kept, key=lambda it: it[1]):
-        t_lo = steps.t_before_s[max(0, g - 2)] if refined else steps.t_before_s[g]
+        t_lo = steps.t_before_s[max(0, g - cfg.time_search_sets_before)] if refined else steps.t_before_s[g]
         sigma = (steps.t_after_s[g] - t_lo) / math.sqrt(12.0)  # uniform over the bracket
         a_ref = float(el["a_m"].iloc[g])
         w = steps.weights

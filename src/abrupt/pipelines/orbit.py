@@ -67,7 +67,7 @@ def detector_class_name(name: str) -> str:
 def load_ephemeris(source: str | Path | Ephemeris, satellite: str | None = None) -> Ephemeris:
     if isinstance(source, Ephemeris):
         return source
-    from abrupt.readers.navigation_csv import read_ephemeris
+    from abrupt.readers.ephemeris import read_ephemeris
 
     return read_ephemeris(source, satellite)
 
@@ -91,8 +91,9 @@ def detect_orbit(
     eph = load_ephemeris(source, satellite)
     null_eph = load_ephemeris(null, satellite) if null is not None else None
     cls = get_detector(detector_class_name(detector), "orbit")
+    if not issubclass(cls, OrbitDetector):
+        raise KeyError(f"{detector!r} is not an orbit filter detector")
     det = cls(null=null_eph, **settings)
-    assert isinstance(det, OrbitDetector)
     fa = as_budget(budget)
     result = det.detect(eph, fa)
     run = OrbitRun(eph, det, result, fa)
@@ -154,8 +155,8 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
     lines = [
         f"orbit fit: {s['satellite']}, {s['epochs']} epochs over {s['span_days']:.2f} days at {s['step_s']:g} s",
         f"  force model      {s['force_model']}",
-        f"  post-fit RMS     position {s['residual_rms_pos_m']:.4g} m, velocity {1e3 * s['residual_rms_vel_mps']:.4g} mm/s"
-        f" (measurement − forward a-posteriori)",
+        f"  post-fit RMS     position {s['residual_rms_pos_m']:.4g} m, "
+        f"velocity {1e3 * s['residual_rms_vel_mps']:.4g} mm/s (measurement − forward a-posteriori)",
         f"  estimated        τ = {s['tau_s']:g} s, q = {s['q_m2_s5']:.3g} m²/s⁵, σ_pos = {s['sigma_pos_m']:.3g} m,"
         f" σ_vel = {s['sigma_vel_mps']:.3g} m/s; DMC acceleration RMS {s['dmc_accel_rms_mps2']:.3g} m/s²;"
         f" innovation scale {s['innovation_scale']:.3g}",
@@ -179,8 +180,12 @@ def inject_orbit(
 ) -> Ephemeris:
     """The ephemeris with a ΔV (orbit frame at its start) injected at ``time_utc``: an impulse or a finite
     burn of ``duration_s`` (:func:`abrupt.simulate.orbit.inject_impulse`)."""
+    from abrupt.errors import ConfigError
     from abrupt.simulate.orbit import inject_impulse
 
     eph = load_ephemeris(source, satellite)
-    t = np.datetime64(str(time_utc).rstrip("Z"), "ns")
+    try:
+        t = np.datetime64(str(time_utc).rstrip("Z"), "ns")
+    except ValueError:
+        raise ConfigError(f"cannot read time {time_utc!r}", key="time") from None
     return inject_impulse(eph, t, dv_rtn_mps, duration_s=duration_s)

@@ -128,21 +128,7 @@ def write_navigation_csv(ephemeris: Ephemeris, path: str | Path) -> None:
 
 
 def read_ephemeris(path: str | Path, satellite: str | None = None) -> Ephemeris:
-    """Read SP3 (``.sp3``, ``.sp3c``, ``.sp3d`` or an SP3 header), OEM (``.oem`` or CCSDS header) or CSV."""
-    path = Path(path)
-    try:
-        with open(path, encoding="ascii", errors="replace") as fh:
-            head = fh.read(64)
-    except FileNotFoundError:
-        raise InputError("file not found", file=path) from None
-    if head.startswith("#") and len(head) > 1 and head[1] in "abcd":
-        from abrupt.readers.sp3 import read_sp3
+    """Read any supported orbit file; see :func:`abrupt.readers.ephemeris.read_ephemeris`."""
+    from abrupt.readers.ephemeris import read_ephemeris as read_any
 
-        return read_sp3(path, satellite)
-    if head.lstrip().startswith("CCSDS_OEM_VERS"):
-        from abrupt.readers.oem import read_oem
-
-        return read_oem(path, satellite)
-    if path.suffix.lower() == ".csv" or head.startswith("time_utc"):
-        return read_navigation_csv(path, satellite)
-    raise InputError("unknown ephemeris format (expected SP3-c/d, CCSDS OEM or navigation CSV)", file=path, line=1)
+    return read_any(path, satellite)

@@ -24,7 +24,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from abrupt.detect.attitude import STATISTIC_UNITS, DetectionResult
-from abrupt.readers.telemetry import Telemetry
+from abrupt.series.telemetry import Telemetry
 
 MAX_POINTS = 20000  # per line; longer series are min/max decimated so spikes stay visible
 SMOOTHING_S = 30.0  # [s] running mean drawn over the noisy momentum

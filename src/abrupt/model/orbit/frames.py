@@ -60,7 +60,7 @@ class EarthOrientationTable:
     era0_rad: float
 
 
-def _astropy_time(times_utc: np.ndarray):  # type: ignore[no-untyped-def]
+def _astropy_time(times_utc: np.ndarray):
     from abrupt.model.timescales import offline_astropy
 
     offline_astropy()

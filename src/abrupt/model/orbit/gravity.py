@@ -38,10 +38,12 @@ def gravity_coefficients(model: str = "EGM2008", degree: int = 120) -> tuple[Flo
         raise ValueError(f"{model} degree must be 2..{min(MAX_DEGREE[model], 150)}, got {degree}")
     import brahe
 
-    kind = {"EGM2008": brahe.GravityModelType.EGM2008_120, "GGM05S": brahe.GravityModelType.GGM05S}.get(
-        model, brahe.GravityModelType.JGM3
-    )
-    field = brahe.GravityModel.from_model_type(kind)
+    kind = {
+        "EGM2008": brahe.GravityModelType.EGM2008_120,
+        "GGM05S": brahe.GravityModelType.GGM05S,
+        "JGM3": brahe.GravityModelType.JGM3,
+    }[model]
+    field = brahe.GravityModel.from_model_type(kind)  # type: ignore[arg-type]
     c = np.zeros((degree + 1, degree + 1))
     s = np.zeros((degree + 1, degree + 1))
     normalised = "unnormal" not in str(field.normalization).lower()

@@ -127,7 +127,7 @@ def propagate(
     return out
 
 
-def solve_segment(rhs, ta: float, tb: float, state: FloatArray, rtol: float, atol: float):  # type: ignore[no-untyped-def]
+def solve_segment(rhs, ta: float, tb: float, state: FloatArray, rtol: float, atol: float):
     """DOP853 over [ta, tb] with dense output; raises RuntimeError when the integrator fails."""
     from scipy.integrate import solve_ivp
 
@@ -153,7 +153,7 @@ def _two_body_gradient(r: FloatArray, mu: float) -> FloatArray:
 
 
 @nb.njit(cache=True)
-def _stm_derivative(y: FloatArray, t_s: float, a_const: FloatArray, args: tuple) -> FloatArray:  # type: ignore[type-arg]
+def _stm_derivative(y: FloatArray, t_s: float, a_const: FloatArray, args: tuple) -> FloatArray:
     """State (6) + STM (36) + constant-acceleration sensitivity (18), flattened row-major."""
     out = np.empty(60)
     r = y[0:3]
@@ -183,7 +183,7 @@ def _rk4_stm(
     max_step_s: float,
     a_const: FloatArray,
     reset_stm: bool,
-    args: tuple,  # type: ignore[type-arg]
+    args: tuple,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     n = t_eval_s.shape[0]
     states = np.empty((n, 6))
@@ -236,7 +236,7 @@ def propagate_with_stm(
     lo = min(float(t0_s), float(t_eval.min())) if t_eval.size else float(t0_s)
     hi = max(float(t0_s), float(t_eval.max())) if t_eval.size else float(t0_s)
     ctx = _context(force, lo, hi)
-    return _rk4_stm(  # type: ignore[no-any-return]
+    return _rk4_stm(
         np.ascontiguousarray(np.asarray(x0, dtype=np.float64)),
         float(t0_s),
         t_eval,
