@@ -537,7 +537,7 @@ def interval_jump(analysis: OrbitAnalysis, k_first: int, k_last: int | None = No
     u = dv / max(mag, 1e-300)
     lead = float(t[k_last]) - t_c
     var_lead = float(u @ cov_r @ u) / max(mag * mag, 1e-300) + lead * lead * float(u @ cov @ u) / max(mag * mag, 1e-300)
-    return JumpInterval(k_first, k_last, dv, cov, t_c, float(np.sqrt(var_lead)), t_c, 0.0)
+    return JumpInterval(k_first, k_last, np.asarray(dv, dtype=np.float64), cov, t_c, float(np.sqrt(var_lead)), t_c, 0.0)
 
 
 def _quiet(analysis: OrbitAnalysis, w: FloatArray) -> bool:
