@@ -737,6 +737,7 @@ def auto_tune(
     min_sigma_pos_m: float = 0.01,
     min_sigma_vel_mps: float = 1e-5,
     in_stationary_floor: bool = True,
+    velocity_consistency: bool = True,
 ) -> tuple[FilterConfig, float, float]:
     """Filter tuning and measurement sigmas derived from the data itself (for real precise orbits).
 
@@ -756,7 +757,10 @@ def auto_tune(
       unmodelled acceleration itself, which with a full force model is small but smooth;
     - data whose step-to-step model error is below the noise get q = 1 % of the noise-equivalent
       level (for 1 Hz GNSS-like solutions the thesis tuning, Table 3.1, is the better choice);
-    - τ = ``tau_factor`` × the nominal step.
+    - τ = ``tau_factor`` × the nominal step;
+    - σ_vel is at least the RMS difference between the given velocities and those a position-only filter
+      pass estimates (``velocity_consistency``): real precise orbits' velocities need not be consistent
+      with their positions to the level their scatter suggests.
 
     Nothing here depends on a particular satellite; the same rule runs on any ephemeris.
     """
@@ -815,6 +819,19 @@ def auto_tune(
         third_body=third_body,
         max_step_s=max_step,
     )
+    if velocity_consistency and np.isfinite(eph.velocity_mps).all(axis=1).mean() > 0.5:
+        # Velocities inconsistent with the positions' dynamics (SP3 velocities of DORIS orbits disagree with
+        # their own positions by ~0.6 mm/s) must not be trusted to σ_vel: run the filter on the positions
+        # alone over the first ``max_steps`` epochs and take the RMS velocity residual per axis as the
+        # velocity noise when it is larger.
+        m = min(len(eph), max_steps + 1)
+        sl = slice(0, m)
+        pos_only = run_forward(t[sl], eph.position_m[sl], np.full((m, 3), np.nan), sigma_r, sigma_v, fc, context=ctx)
+        res = eph.velocity_mps[sl] - pos_only.x[:, 3:6]
+        res = res[m // 10 :]
+        res = res[np.isfinite(res).all(axis=1)]
+        if len(res) > 10:
+            sigma_v = max(sigma_v, float(np.sqrt(np.mean(res**2))))
     return fc, sigma_r, sigma_v
 
 
