@@ -759,7 +759,8 @@ def auto_tune(
       level (for 1 Hz GNSS-like solutions the thesis tuning, Table 3.1, is the better choice);
     - τ = ``tau_factor`` × the nominal step;
     - σ_vel is at least the RMS difference between the given velocities and those a position-only filter
-      pass estimates (``velocity_consistency``): real precise orbits' velocities need not be consistent
+      pass estimates, less that estimate's own variance (``velocity_consistency``): real precise orbits'
+      velocities need not be consistent
       with their positions to the level their scatter suggests.
 
     Nothing here depends on a particular satellite; the same rule runs on any ephemeris.
@@ -827,11 +828,15 @@ def auto_tune(
         m = min(len(eph), max_steps + 1)
         sl = slice(0, m)
         pos_only = run_forward(t[sl], eph.position_m[sl], np.full((m, 3), np.nan), sigma_r, sigma_v, fc, context=ctx)
-        res = eph.velocity_mps[sl] - pos_only.x[:, 3:6]
-        res = res[m // 10 :]
-        res = res[np.isfinite(res).all(axis=1)]
-        if len(res) > 10:
-            sigma_v = max(sigma_v, float(np.sqrt(np.mean(res**2))))
+        res = (eph.velocity_mps[sl] - pos_only.x[:, 3:6])[m // 10 :]
+        p_vv = np.einsum("kii->ki", pos_only.p[m // 10 :, 3:6, 3:6])
+        ok = np.isfinite(res).all(axis=1)
+        if ok.sum() > 10:
+            # residual variance = velocity noise + the position-only estimate's own variance (robust: a
+            # maneuver inside the arc must not inflate it)
+            robust = float(np.mean([_robust_std(res[ok, i]) ** 2 for i in range(3)]))
+            excess = robust - float(np.median(p_vv[ok]))
+            sigma_v = max(sigma_v, float(np.sqrt(max(excess, 0.0))))
     return fc, sigma_r, sigma_v
 
 
