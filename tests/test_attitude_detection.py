@@ -10,11 +10,13 @@ import pytest
 from click.testing import CliRunner
 
 from abrupt.catalog import Catalog
+from abrupt.clean.noise import momentum_noise_model
 from abrupt.cli.groups import cli
 from abrupt.cli.main import main
-from abrupt.detect.attitude import AttitudeDetectionConfig, detect_attitude, momentum_noise_model
+from abrupt.detect.attitude import AttitudeDetectionConfig
 from abrupt.events import EVENT_COLUMNS
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
+from abrupt.pipelines.attitude import detect_attitude
 from abrupt.readers.telemetry import telemetry_from_frame
 from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude
 

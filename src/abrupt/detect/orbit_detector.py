@@ -21,6 +21,7 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy import stats
 
+from abrupt.clean.noise import robust_scale
 from abrupt.detect.orbit_ekf import (
     FilterConfig,
     FilterRun,
@@ -42,8 +43,8 @@ from abrupt.events import Event, config_hash, empty_frame, events_frame
 from abrupt.model.frames import Ephemeris
 from abrupt.model.orbit import ForceContext, rtn_matrix
 from abrupt.thresholds import Threshold, fit_threshold, gpd_return_level_upper, p_fa_per_sample
+from abrupt.types import FloatArray
 
-FloatArray = NDArray[np.float64]
 SECONDS_PER_WEEK = 7 * 86400.0
 ONE_PER_WEEK = 1.0 / 7.0  # [false alarms per day]
 
@@ -225,7 +226,7 @@ def self_calibrate(
     """Thresholds from the arc itself when no event-free reference exists (real data).
 
     Procedure (documented in docs/orbit.md; nothing depends on a particular satellite):
-    1. robust location and scale: median and 1.4826·MAD of the statistic over the valid epochs — of
+    1. robust location and scale: median and the normal-consistent MAD of the statistic over the valid epochs — of
        its logarithm when the statistic is positive (the statistics are skewed, chi-like);
     2. leave-out: around every value above median + ``outlier_sigma``·scale, the whole excursion that
        contains it (the contiguous epochs above median + ``episode_sigma``·scale, so a long post-event
@@ -261,7 +262,7 @@ def self_calibrate(
             if keep.sum() < 100:
                 break
             med = float(np.median(z[keep]))
-            scale = 1.4826 * float(np.median(np.abs(z[keep] - med)))
+            scale = float(robust_scale(z[keep]))
             if scale <= 0:
                 break
             hot = np.flatnonzero(keep & (z > med + outlier_sigma * scale))
@@ -546,7 +547,7 @@ def _quiet(analysis: OrbitAnalysis, w: FloatArray) -> bool:
     if mags.size < 10:
         return True
     med = float(np.median(mags))
-    scale = 1.4826 * float(np.median(np.abs(mags - med)))
+    scale = float(robust_scale(mags))
     return float(np.linalg.norm(w)) <= med + 10.0 * max(scale, 1e-12)
 
 
@@ -723,7 +724,7 @@ def _robust_std(x: FloatArray) -> float:
     x = x[np.isfinite(x)]
     if x.size == 0:
         return float("nan")
-    return float(1.4826 * np.median(np.abs(x - np.median(x))))
+    return float(robust_scale(x))
 
 
 def auto_tune(

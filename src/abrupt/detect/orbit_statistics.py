@@ -37,12 +37,10 @@ from dataclasses import dataclass, field
 
 import numba as nb
 import numpy as np
-from numpy.typing import NDArray
 
 from abrupt.detect.orbit_ekf import FilterConfig, propagate_state
 from abrupt.model.orbit import MU_EARTH_M3_S2, ForceContext, orbital_constants
-
-FloatArray = NDArray[np.float64]
+from abrupt.types import FloatArray
 
 STATISTIC_NAMES: tuple[str, ...] = (
     "dv_fb",

@@ -4,6 +4,9 @@ A new capability adds its detector module here (one line); a detector defined an
 plug-in, a test) registers as soon as its class is defined.
 """
 
-# Built-in detector modules are imported below as they adopt abrupt.detect.base.Detector.
-
-import abrupt.detect.orbit_detectors  # noqa: F401  (orbit.glr, orbit.mcr_w, ...)
+import abrupt.detect.attitude
+import abrupt.detect.kaderali
+import abrupt.detect.matched_filter.detectors
+import abrupt.detect.orbit_detectors
+import abrupt.detect.tle_detectors
+import abrupt.detect.tracking_glrt  # noqa: F401  tracking.glrt
