@@ -4,9 +4,9 @@ A new capability adds its detector module here (one line); a detector defined an
 plug-in, a test) registers as soon as its class is defined.
 """
 
-import abrupt.detect.attitude
-import abrupt.detect.kaderali
-import abrupt.detect.matched_filter.detectors
-import abrupt.detect.orbit_detectors
-import abrupt.detect.tle_detectors
+import abrupt.detect.attitude  # attitude.glr, cusum, summation, shiryaev
+import abrupt.detect.kaderali  # tracking.kaderali_k
+import abrupt.detect.matched_filter.detectors  # attitude.mf_attitude, mf_rate, mf_joint
+import abrupt.detect.orbit_detectors  # orbit.glr, orbit.mcr_w, orbit.accel_smoothed, ...
+import abrupt.detect.tle_detectors  # tle.mean_elements, tle.geo_station_keeping
 import abrupt.detect.tracking_glrt  # noqa: F401  tracking.glrt
