@@ -36,7 +36,7 @@ import numpy as np
 
 from abrupt.detect.orbit_detector import OrbitDetectorConfig, analyse, calibrate_thresholds, tau_q_grid
 from abrupt.detect.orbit_ekf import FilterConfig, run_backward, run_forward
-from abrupt.model.orbit_dynamics import MU_EARTH_M3_S2, ForceModel
+from abrupt.model.orbit import MU_EARTH_M3_S2, ForceModel
 from abrupt.simulate.orbit import THESIS_DV_MPS, Impulse, OrbitSimulationConfig, SimulatedOrbit, simulate_orbit
 
 STATS = ("dv_fb", "mahalanobis_v", "accel_smoothed", "mcr_w", "mcr_scalar", "d_sma", "d_ecc", "d_hdir", "glr")

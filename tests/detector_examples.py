@@ -114,6 +114,44 @@ def empty_tracking() -> Any:
     return TrackingSeries(data, full.x0_apriori_m_mps, full.fit_config, name=full.name)
 
 
+# ---------------------------------------------------------------------------------------------- orbit
+
+
+@cache
+def orbit_example() -> Any:
+    """Twelve hours of 60 s navigation solutions (two-body, 1 m / 1 mm/s noise) with a 0.25 m/s impulse at 6 h."""
+    from abrupt.simulate.orbit import Impulse, OrbitSimulationConfig, simulate_orbit
+
+    sim = simulate_orbit(
+        OrbitSimulationConfig(
+            duration_s=12 * 3600.0,
+            rate_hz=1 / 60.0,
+            sigma_pos_m=1.0,
+            sigma_vel_mps=1e-3,
+            seed=21,
+            impulses=(Impulse(21630.0, (0.1, 0.15, 0.15), "rtn"),),
+        )
+    )
+    return sim.ephemeris("example-orbit")
+
+
+def empty_orbit() -> Any:
+    return orbit_example().select(np.zeros(len(orbit_example()), dtype=bool))
+
+
+def shift_orbit(series: Any, seconds: float) -> Any:
+    from dataclasses import replace
+
+    return replace(series, times_utc=series.times_utc + np.timedelta64(round(seconds * 1e9), "ns"))
+
+
+def _orbit_settings() -> dict[str, dict[str, Any]]:
+    names = ("glr", "accel_smoothed", "mcr_w", "mcr_scalar", "mahalanobis_v", "dv_fb", "d_sma", "d_ecc", "d_hdir")
+    # thesis tuning (two-body dynamics): no Earth-orientation dependence, so a shift in time changes nothing
+    tuning = {"tuning": "thesis", "sigma_pos_m": 1.0, "sigma_vel_mps": 1e-3, "tau_s": 600.0, "q_m2_s5": 1e-12}
+    return {f"orbit.{n}": dict(tuning) for n in names}
+
+
 def inertia_track_example() -> Any:
     """Twelve daily inertia estimates (σ 0.3 kg m²) with a 5 kg m² step in Jyy and Jzz after day 6 (a docking)."""
     from abrupt.massprops.track import InertiaTrack
@@ -150,6 +188,7 @@ def _examples() -> dict[type, SeriesExample]:
     from abrupt.massprops.track import InertiaTrack
     from abrupt.readers.tle import ElementHistory
     from abrupt.series.attitude import AttitudeSeries
+    from abrupt.series.ephemeris import Ephemeris
     from abrupt.series.tracking import TrackingSeries
 
     return {
@@ -170,6 +209,13 @@ def _examples() -> dict[type, SeriesExample]:
             shift=lambda s, seconds: s.shifted(seconds),
             notes="earth_rotation='simple', so a shift in time leaves the geometry unchanged",
             settings={"tracking.glrt": {"max_maneuvers": 1}, "tracking.kaderali_k": {"n_null_runs": 4}},
+        ),
+        Ephemeris: SeriesExample(
+            make=orbit_example,
+            empty=empty_orbit,
+            shift=shift_orbit,
+            notes="thesis tuning: two-body dynamics, so a shift in time leaves the filters unchanged",
+            settings=_orbit_settings(),
         ),
         AttitudeSeries: SeriesExample(
             make=attitude_example,

@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 from abrupt.detect.tracking_glrt import BatchFitConfig
+from abrupt.model.orbit import propagate
 from abrupt.model.range_reduction import GEOMETRIC, RANGE_MODEL_TERMS, RangeModel, model_two_way_ranges, reduce_ranges
 from abrupt.model.tracking_measurements import TrackingArrays
-from abrupt.model.tracking_orbit import propagate_truth
 from abrupt.pipelines.laser_ranging import detect_laser_ranging
 from abrupt.simulate.slr import SlrScenario, SlrSimulation, simulate_slr, trajectory_interpolator
 from abrupt.thresholds import FalseAlarmBudget
@@ -28,7 +28,7 @@ def one_day() -> tuple[SlrSimulation, object]:
     scenario = SlrScenario(duration_days=1.0, noise_m=NOISE_M, pass_probability=1.0)
     sim = simulate_slr(scenario, seed=3)
     grid = np.arange(0.0, 86400.0 + 60.0, 20.0)
-    truth = trajectory_interpolator(grid, propagate_truth(sim.x0, grid, force=sim.force))
+    truth = trajectory_interpolator(grid, propagate(sim.x0, grid, force=sim.force))
     return sim, truth
 
 

@@ -16,8 +16,8 @@ import pytest
 from click.testing import CliRunner
 
 from abrupt.cli.main import cli
+from abrupt.model.orbit import propagate
 from abrupt.model.tracking_measurements import earth_rotation_matrices
-from abrupt.model.tracking_orbit import propagate_truth
 from abrupt.readers.ephemeris import write_ephemeris
 from abrupt.series.ephemeris import Ephemeris
 from abrupt.simulate.slr import SlrScenario, SlrSimulation, simulate_slr
@@ -84,8 +84,8 @@ def write_sinex(sim: SlrSimulation, path: Path, drop: str | None = None) -> None
 def write_apriori(sim: SlrSimulation, path: Path) -> None:
     """The true orbit, shifted by 50 m, in ITRF (as a CPF prediction would give it), written as OEM."""
     t = np.arange(-600.0, sim.scenario.duration_days * 86400.0 + 600.0, 120.0)
-    states = propagate_truth(sim.x0, t[t >= 0], force=sim.force)
-    back = propagate_truth(sim.x0, np.array([0.0]), force=sim.force)
+    states = propagate(sim.x0, t[t >= 0], force=sim.force)
+    back = propagate(sim.x0, np.array([0.0]), force=sim.force)
     states = np.vstack([np.repeat(back, int((t < 0).sum()), axis=0), states])
     states[t < 0, :3] += np.outer(t[t < 0], states[0, 3:])
     c_fi = earth_rotation_matrices(t, model="iers", epoch_utc=sim.epoch_utc)

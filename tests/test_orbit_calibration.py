@@ -6,44 +6,16 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import pytest
-from scipy import stats
 
 from abrupt.detect.orbit_detector import (
     OrbitDetectorConfig,
     analyse,
     auto_tune,
     find_events,
-    gpd_return_level_upper,
     self_calibrate,
 )
-from abrupt.thresholds import gpd_quantile
 
 SP3 = "sp3/ssas3a20.b18358.e19003.DG_.sp3"
-
-
-def test_return_level_with_z0_is_the_gpd_point_estimate() -> None:
-    x = stats.genpareto.rvs(0.1, size=4000, random_state=np.random.default_rng(3))
-    p = 2e-5
-    assert gpd_return_level_upper(x, p, tail_fraction=0.02, z=0.0) == pytest.approx(
-        gpd_quantile(x, p, tail_fraction=0.02), rel=1e-9
-    )
-    assert gpd_return_level_upper(x, p, tail_fraction=0.02, z=1.0) > gpd_quantile(x, p, tail_fraction=0.02)
-
-
-def test_upper_return_level_covers_the_true_quantile_at_about_84_percent() -> None:
-    # GPD(ξ = 0.2) samples: the true 1e-4 upper quantile is known; the z = 1 bound (delta method, Coles 2001
-    # §4.4.1) should lie above it in ~84 % of replicates, the point estimate in ~50 %.
-    rng = np.random.default_rng(5)
-    p, xi, reps = 1e-4, 0.2, 200
-    truth = stats.genpareto.isf(p, xi)
-    upper = point = 0
-    for _ in range(reps):
-        x = stats.genpareto.rvs(xi, size=5000, random_state=rng)
-        upper += gpd_return_level_upper(x, p, tail_fraction=0.02, z=1.0) >= truth
-        point += gpd_return_level_upper(x, p, tail_fraction=0.02, z=0.0) >= truth
-    assert 0.72 <= upper / reps <= 0.93
-    assert 0.35 <= point / reps <= 0.65
 
 
 def _real_config(eph: object) -> OrbitDetectorConfig:
@@ -67,7 +39,9 @@ def test_real_arc_without_maneuver_gives_at_most_one_false_alarm_per_week_thresh
     assert len(events) <= 1  # issue 3 acceptance 3 (9.1 days; 1.3 expected at exactly one per week)
 
 
-def test_interval_dv_recovers_injected_impulses_on_real_data_better_than_ts1(shared_data: Path) -> None:
+def test_interval_dv_recovers_injected_impulses_on_real_data_within_five_percent(shared_data: Path) -> None:
+    """With the full force model (EGM2008 40×40, Sun, Moon) the interval estimate is within 5 % of 5 mm/s
+    (it was within 20 % and better than TS1 with J2-J4; with the full model TS1 is as good)."""
     from dataclasses import replace
 
     from abrupt.readers.sp3 import read_sp3
@@ -92,8 +66,8 @@ def test_interval_dv_recovers_injected_impulses_on_real_data_better_than_ts1(sha
         cols = ["dv_r_mps", "dv_t_mps", "dv_n_mps"]
         err_interval.append(np.linalg.norm(events[cols].iloc[best].to_numpy() - dv))
         err_fb.append(np.linalg.norm(fb[cols].iloc[best].to_numpy() - dv))
-    assert max(err_interval) < 0.2 * 0.005
-    assert np.mean(err_interval) < np.mean(err_fb)
+    assert max(err_interval) < 0.05 * 0.005
+    assert max(err_fb) < 0.2 * 0.005
 
 
 def test_cli_threshold_confidence_zero_gives_the_lower_point_estimate_threshold(

@@ -14,14 +14,16 @@ from abrupt.detect.orbit_ekf import (
     _GL_WEIGHTS,
     FilterConfig,
     _jacobian,
-    _propagate,
     fogm_gammas,
+    propagate_state,
     run_backward,
     run_forward,
 )
 from abrupt.detect.orbit_statistics import fuse
-from abrupt.model.orbit_dynamics import MU_EARTH_M3_S2, kepler_to_cartesian
+from abrupt.model.orbit import MU_EARTH_M3_S2, kepler_to_cartesian
 from abrupt.simulate.orbit import OrbitSimulationConfig, simulate_orbit
+
+TWO_BODY = FilterConfig().force_context(None).kernel_args
 
 
 def _gamma_by_quadrature(dt: float, tau: float) -> np.ndarray:
@@ -69,7 +71,7 @@ def test_forward_gammas_at_minus_tau_equal_the_backward_formulas(dt: float, tau:
 def test_jacobian_gravity_block_is_symmetric_and_matches_finite_differences() -> None:
     x = np.r_[7.0e6, 1.2e6, -0.8e6, 100.0, 7400.0, 300.0, 0.0, 0.0, 0.0]
     a = np.empty((9, 9))
-    _jacobian(x, 5.0, MU_EARTH_M3_S2, 0, a)
+    _jacobian(x, 5.0, MU_EARTH_M3_S2, False, a)
     g = a[3:6, 0:3]
     np.testing.assert_allclose(g, g.T, rtol=1e-12)
     h = 1.0
@@ -90,7 +92,7 @@ def test_rk4_propagation_returns_to_start_after_one_kepler_period() -> None:
     x = np.r_[r0, v0, 0, 0, 0]
     n = 1000
     for _ in range(n):
-        x = _propagate(x, period / n, 1.0, MU_EARTH_M3_S2, 0, 10.0, phi)
+        x = propagate_state(x, 0.0, period / n, 1.0, TWO_BODY, 10.0, phi)
     assert np.linalg.norm(x[:3] - r0) < 5e-3  # [m] RK4 truncation over 1000 steps
     assert np.linalg.norm(x[3:6] - v0) < 5e-6  # [m/s]
 
@@ -100,15 +102,15 @@ def test_state_transition_matrix_matches_finite_difference_of_the_propagation() 
     x = np.r_[r0, v0, 1e-6, -2e-6, 3e-6]
     phi = np.empty((9, 9))
     # Lear's RK2 STM (Eq. 3.8) is second order: with Δt/τ = 0.01 its error is ~(Δt/τ)/3 relative.
-    _propagate(x, 1.0, 100.0, MU_EARTH_M3_S2, 0, 10.0, phi)
+    propagate_state(x, 0.0, 1.0, 100.0, TWO_BODY, 10.0, phi)
     scale = np.r_[np.full(3, 1.0), np.full(3, 1e-3), np.full(3, 1e-7)]
     scratch = np.empty((9, 9))
     for j in range(9):
         xp, xm = x.copy(), x.copy()
         xp[j] += scale[j]
         xm[j] -= scale[j]
-        fp = _propagate(xp, 1.0, 100.0, MU_EARTH_M3_S2, 0, 10.0, scratch)
-        fm = _propagate(xm, 1.0, 100.0, MU_EARTH_M3_S2, 0, 10.0, scratch)
+        fp = propagate_state(xp, 0.0, 1.0, 100.0, TWO_BODY, 10.0, scratch)
+        fm = propagate_state(xm, 0.0, 1.0, 100.0, TWO_BODY, 10.0, scratch)
         np.testing.assert_allclose(phi[:, j], (fp - fm) / (2 * scale[j]), rtol=5e-3, atol=1e-5)
 
 

@@ -178,17 +178,21 @@ def test_cli_reports_unknown_station_as_a_clear_error(tmp_path: Path) -> None:
 
 def test_w3b_real_tracking_fit_estimates_biases_and_an_unmodelled_acceleration(shared_data: Path) -> None:
     """Orekit's W3B case: biases near the reference (station + 5969 m on-board), acceleration ~1e-5 m/s²."""
-    from astropy.time import Time
 
+    from abrupt.model.orbit import MU_EARTH_M3_S2, ForceContext, ForceModel
     from abrupt.model.tracking_measurements import correct_refraction
-    from abrupt.model.tracking_orbit import MU_EARTH_M3_S2, ForceModel
     from abrupt.readers.aer import read_aer
     from abrupt.readers.orekit_od_input import read_od_input
 
     setup = read_od_input(shared_data / "tracking" / "od_test_W3.in")
     meas = correct_refraction(read_aer(shared_data / "tracking" / "W3B.aer", known_stations=setup.stations))
     data = TrackingArrays(meas, setup.stations, epoch_utc=setup.epoch_utc, earth_rotation="iers")
-    force = ForceModel(MU_EARTH_M3_S2, j2=True, third_body=True, epoch_jd_tt=float(Time(setup.epoch_utc).tt.jd))
+    force = ForceContext.build(
+        ForceModel(mu_m3_s2=MU_EARTH_M3_S2, zonal_degree=2, sun=True, moon=True),
+        np.datetime64(setup.epoch_utc, "ns"),
+        -86400.0,
+        float(data.t_s.max()) + 86400.0,
+    )
     cfg = BatchFitConfig(
         force=force,
         estimate_range_bias=True,

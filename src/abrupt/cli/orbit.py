@@ -52,50 +52,22 @@ def _filter_options(f: Any) -> Any:
         click.option("--sigma-vel-mps", type=float, default=None, help="Velocity noise 1σ (m/s); overrides tuning."),
         click.option(
             "--dynamics",
-            type=click.Choice(["two-body", "j2", "j3", "j4"]),
+            type=click.Choice(["two-body", "j2", "j3", "j4", "field"]),
             default=None,
-            help="Filter dynamics (default: j4 for auto tuning, two-body for thesis tuning).",
+            help="Filter dynamics (default: field (EGM2008 + Sun/Moon) for auto tuning, two-body for thesis tuning).",
+        ),
+        click.option(
+            "--gravity-degree",
+            type=click.IntRange(2, 120),
+            default=40,
+            show_default=True,
+            help="Degree and order of the EGM2008 field with --dynamics field.",
         ),
         click.option("--satellite", default=None, help="Satellite id in the file (SP3 id, OEM OBJECT_ID, CSV)."),
     ]
     for opt in reversed(options):
         f = opt(f)
     return f
-
-
-def _detector_config(
-    eph: Any,
-    tuning: str,
-    tau_s: float | None,
-    q_m2_s5: float | None,
-    sigma_pos_m: float | None,
-    sigma_vel_mps: float | None,
-    dynamics: str | None,
-    **extra: Any,
-) -> Any:
-    from dataclasses import replace
-
-    from abrupt.detect.orbit_detector import OrbitDetectorConfig, auto_tune
-    from abrupt.detect.orbit_ekf import FilterConfig
-
-    degree = {"two-body": 0, "j2": 2, "j3": 3, "j4": 4, None: None}[dynamics]
-    if tuning == "auto":
-        fc, s_pos, s_vel = auto_tune(eph, zonal_degree=4 if degree is None else degree)
-        settle = max(20.0 * fc.tau_s, 30.0 * eph.nominal_step_s)
-    else:
-        fc, s_pos, s_vel = FilterConfig(zonal_degree=0 if degree is None else degree), 10.0, 0.25
-        settle = 1800.0
-    if tau_s is not None:
-        fc = replace(fc, tau_s=tau_s)
-    if q_m2_s5 is not None:
-        fc = replace(fc, q_rtn_m2_s5=(q_m2_s5, q_m2_s5, q_m2_s5))
-    return OrbitDetectorConfig(
-        filter=fc,
-        sigma_pos_m=sigma_pos_m if sigma_pos_m is not None else float(s_pos),
-        sigma_vel_mps=sigma_vel_mps if sigma_vel_mps is not None else float(s_vel),
-        settle_s=settle,
-        **extra,
-    )
 
 
 @simulate.command("orbit")
@@ -139,7 +111,7 @@ def simulate_orbit_command(
     """Simulate a truth orbit with impulsive ΔVs and GNSS-like navigation solutions (Bennett 2022 §3.1)."""
     from dataclasses import replace
 
-    from abrupt.model.orbit_dynamics import ForceModel
+    from abrupt.model.orbit import ForceModel
     from abrupt.readers.navigation_csv import write_navigation_csv
     from abrupt.simulate.orbit import Impulse, OrbitSimulationConfig, simulate_orbit
 
@@ -157,7 +129,7 @@ def simulate_orbit_command(
         "two-body": ForceModel(),
         "j2-j4": ForceModel(zonal_degree=4),
         "thesis-perturbed": ForceModel(j3_only=True, drag="exponential", array_area_m2=5.0),
-        "full": ForceModel(zonal_degree=4, drag="msis", srp=True, sun=True, moon=True),
+        "full": ForceModel(gravity_degree=40, drag="msis", srp=True, sun=True, moon=True),
     }[forces]
     cfg = OrbitSimulationConfig(
         altitude_m=altitude_km * 1e3,
@@ -185,14 +157,24 @@ def simulate_orbit_command(
 @click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Events file (.csv/.parquet).")
 @_filter_options
 @click.option(
+    "--detector",
+    "detector_name",
+    default=None,
+    help="Orbit detector by name (orbit.glr default, orbit.mcr_w, orbit.accel_smoothed, ...).",
+)
+@click.option(
     "--statistic",
     type=click.Choice(STATISTIC_CHOICES),
     default=None,
-    help="Statistic that raises events (default: glr with auto tuning, mcr_w with thesis tuning).",
+    help="Alias of --detector orbit.STATISTIC (default: glr with auto tuning, mcr_w with thesis tuning).",
 )
 @click.option(
-    "--false-alarms-per-week", type=float, default=1.0, show_default=True, help="False-alarm budget of thresholds."
+    "--false-alarms",
+    "false_alarms",
+    default=None,
+    help="False-alarm budget, e.g. '1/week' (default), '0.5/day', '2/year'.",
 )
+@click.option("--false-alarms-per-week", type=float, default=None, help="Alias: --false-alarms N/week.")
 @click.option(
     "--null",
     "null_file",
@@ -206,10 +188,13 @@ def simulate_orbit_command(
     type=click.FloatRange(min=0.0),
     default=1.0,
     show_default=True,
-    help="Self-calibrated thresholds: standard errors of the fitted one-per-week level added to it "
+    help="Self-calibrated thresholds: standard errors of the fitted level added to it "
     "(1: the false-alarm rate stays within the budget with ~84 % confidence; 0: point estimate).",
 )
 @click.option("--kind", type=click.Choice(["unknown", "maneuver", "strike"]), default="unknown", show_default=True)
+@click.option(
+    "--report", "show_report", is_flag=True, help="Print the fit: residual RMS, estimated parameters, thresholds."
+)
 @click.option(
     "--statistics-out", type=click.Path(dir_okay=False), default=None, help="Per-epoch statistics (.parquet/.csv)."
 )
@@ -224,80 +209,86 @@ def detect_orbit_command(
     sigma_pos_m: float | None,
     sigma_vel_mps: float | None,
     dynamics: str | None,
+    gravity_degree: int,
     satellite: str | None,
+    detector_name: str | None,
     statistic: str | None,
-    false_alarms_per_week: float,
+    false_alarms: str | None,
+    false_alarms_per_week: float | None,
     null_file: str | None,
     confidence_z: float,
     kind: str,
+    show_report: bool,
     statistics_out: str | None,
     pseudonym: str | None,
     catalog_target: str,
 ) -> None:
-    """Detect impulsive velocity changes in navigation data (SP3, OEM or CSV) and write events.
+    """Detect impulsive and finite velocity changes in navigation data (SP3, OEM or CSV) and write events.
 
-    Forward EKF with dynamic model compensation, mirrored backward filter, Fraser-Potter fusion and
-    test statistics (Bennett 2022 ch. 3); thresholds at FALSE-ALARMS-PER-WEEK (default one per week).
+    Forward EKF with dynamic model compensation and the full force model (EGM2008, Sun, Moon), mirrored
+    backward filter, Fraser-Potter fusion and test statistics (Bennett 2022 ch. 3); thresholds at the
+    false-alarm budget (default one per week).
     """
-    from dataclasses import asdict
+    from abrupt.events import new_run_id
+    from abrupt.pipelines.orbit import detect_orbit, summary_lines
+    from abrupt.thresholds import FalseAlarmBudget
 
-    from abrupt.detect.orbit_detector import analyse, calibrate_thresholds, find_events, self_calibrate
-    from abrupt.events import config_hash, new_run_id
-    from abrupt.readers.navigation_csv import read_ephemeris
-
-    if false_alarms_per_week <= 0:
-        raise ConfigError("--false-alarms-per-week must be positive", key="false-alarms-per-week")
-    eph = read_ephemeris(file, satellite)
-    if statistic is None:
-        statistic = "glr" if tuning == "auto" else "mcr_w"
-    for line in eph.repairs.summary():
-        click.echo(f"repaired: {line}", err=True)
-    cfg = _detector_config(
-        eph,
-        tuning,
-        tau_s,
-        q_m2_s5,
-        sigma_pos_m,
-        sigma_vel_mps,
-        dynamics,
-        statistic=statistic,
-        false_alarms_per_day=false_alarms_per_week / 7.0,
-        kind=kind,
-    )
-    analysis = analyse(eph, cfg)
-    if null_file is not None:
-        null = analyse(read_ephemeris(null_file, satellite), cfg)
-        thresholds = calibrate_thresholds(
-            null.statistics, sample_rate_hz=null.sample_rate_hz, false_alarms_per_day=cfg.false_alarms_per_day
+    if false_alarms is not None and false_alarms_per_week is not None:
+        raise ConfigError("give --false-alarms or --false-alarms-per-week, not both", key="false-alarms")
+    try:
+        budget = (
+            FalseAlarmBudget(false_alarms_per_week, "week")
+            if false_alarms_per_week is not None
+            else FalseAlarmBudget.parse(false_alarms or "1/week")
         )
-    else:
-        thresholds = self_calibrate(analysis, confidence_z=confidence_z)
-    if statistic not in thresholds:
-        raise ConfigError(
-            f"too few event-free epochs in {file} to set a threshold for {statistic}; "
-            "give a longer arc or event-free data with --null",
-            key="null",
-        )
+    except ValueError as exc:
+        raise ConfigError(str(exc), key="false-alarms") from None
+    if detector_name is not None and statistic is not None:
+        raise ConfigError("give --detector or --statistic, not both", key="detector")
+    name = detector_name or statistic or ("glr" if tuning == "auto" else "mcr_w")
     run_id = new_run_id()
-    chash = config_hash({**asdict(cfg), "null": null_file is not None, "threshold_confidence": confidence_z})
-    events = find_events(analysis, thresholds, spacecraft=pseudonym or eph.satellite, run_id=run_id, cfg_hash=chash)
-    if statistics_out:
+    try:
+        run = detect_orbit(
+            file,
+            detector=name,
+            budget=budget,
+            satellite=satellite,
+            null=null_file,
+            tuning=tuning,
+            tau_s=tau_s,
+            q_m2_s5=q_m2_s5,
+            sigma_pos_m=sigma_pos_m,
+            sigma_vel_mps=sigma_vel_mps,
+            dynamics=dynamics,
+            gravity_degree=gravity_degree,
+            confidence_z=confidence_z,
+            kind=kind,
+            spacecraft=pseudonym,
+            run_id=run_id,
+        )
+    except KeyError as exc:
+        raise ConfigError(str(exc.args[0]), key="detector") from None
+    for line in run.ephemeris.repairs.summary():
+        click.echo(f"repaired: {line}", err=True)
+    for warning in run.result.warnings:
+        click.echo(f"warning: {warning}", err=True)
+    if show_report:
+        click.echo("\n".join(summary_lines(run.summary)))
+    if statistics_out and run.analysis is not None:
         import pandas as pd
 
-        frame = pd.DataFrame({"time_utc": eph.to_frame("GCRF").times_utc, **analysis.statistics})
+        frame = pd.DataFrame({"time_utc": run.analysis.ephemeris.times_utc, **run.analysis.statistics})
         Path(statistics_out).parent.mkdir(parents=True, exist_ok=True)
         if statistics_out.endswith(".csv"):
             frame.to_csv(statistics_out, index=False)
         else:
             frame.to_parquet(statistics_out, index=False)
-    details = {
-        "tau_s": cfg.filter.tau_s,
-        "q_m2_s5": cfg.filter.q_rtn_m2_s5[0],
-        "sigma_pos_m": cfg.sigma_pos_m,
-        "sigma_vel_mps": cfg.sigma_vel_mps,
-        "threshold": thresholds[statistic].value if statistic in thresholds else None,
-        "repairs": eph.repairs.as_dict(),
-    }
+    events = run.events
+    chash = str(events["config_hash"].iloc[0]) if len(events) else ""
+    if not chash:
+        from abrupt.events import config_hash
+
+        chash = config_hash({**run.detector.config(), "budget": str(budget)})
     record_run(
         catalog_target=catalog_target,
         command="detect orbit",
@@ -306,14 +297,18 @@ def detect_orbit_command(
         run_id=run_id,
         input_path=file,
         out=out,
-        details=details,
+        details={k: v for k, v in run.summary.items() if k != "warnings"}
+        | {"repairs": run.ephemeris.repairs.as_dict()},
     )
 
 
 @inject.command("orbit")
 @click.argument("file", type=click.Path(exists=True, dir_okay=False))
-@click.option("--time", "time_utc", required=True, help="Injection time (ISO-8601 UTC).")
+@click.option("--time", "time_utc", required=True, help="Injection (burn start) time (ISO-8601 UTC).")
 @click.option("--dv-rtn", required=True, help="ΔV in the orbit frame: radial,along-track,cross-track (m/s).")
+@click.option(
+    "--duration-s", type=click.FloatRange(min=0.0), default=0.0, show_default=True, help="Burn duration (0: impulse)."
+)
 @click.option("--satellite", default=None, help="Satellite id in the file.")
 @click.option(
     "--out",
@@ -322,20 +317,17 @@ def detect_orbit_command(
     type=click.Path(dir_okay=False),
     help="File to write, in the input's format (SP3, OEM KVN/XML); a name ending in .csv gives navigation CSV.",
 )
-def inject_orbit_command(file: str, time_utc: str, dv_rtn: str, satellite: str | None, out: str) -> None:
-    """Add the effect of a ΔV at a chosen time to a real ephemeris (propagated difference, two-body + J2-J4)."""
-    import numpy as np
+def inject_orbit_command(
+    file: str, time_utc: str, dv_rtn: str, duration_s: float, satellite: str | None, out: str
+) -> None:
+    """Add the effect of a ΔV (impulse or finite burn) at a chosen time to a real ephemeris."""
+    from abrupt.pipelines.orbit import inject_orbit
+    from abrupt.readers.ephemeris import write_ephemeris
 
-    from abrupt.readers.ephemeris import read_ephemeris, write_ephemeris
-    from abrupt.simulate.orbit import inject_impulse
-
-    eph = read_ephemeris(file, satellite)
     try:
-        t = np.datetime64(time_utc.rstrip("Z"), "ns")
-    except ValueError:
-        raise ConfigError(f"cannot read time {time_utc!r}", key="time") from None
-    try:
-        out_eph = inject_impulse(eph, t, _parse_vector(dv_rtn, "dv-rtn"))
+        out_eph = inject_orbit(
+            file, time_utc, _parse_vector(dv_rtn, "dv-rtn"), duration_s=duration_s, satellite=satellite
+        )
     except ConfigError:
         raise  # already names its option (a ConfigError is a ValueError: do not wrap it twice)
     except ValueError as exc:
@@ -361,29 +353,31 @@ def report_orbit_command(
     sigma_pos_m: float | None,
     sigma_vel_mps: float | None,
     dynamics: str | None,
+    gravity_degree: int,
     satellite: str | None,
     events_file: str | None,
     false_alarms_per_week: float,
 ) -> None:
     """Report panels: filter residuals, each statistic with its threshold, and events."""
-    from abrupt.detect.orbit_detector import analyse, self_calibrate
     from abrupt.events import read_events
-    from abrupt.readers.navigation_csv import read_ephemeris
+    from abrupt.pipelines.orbit import detect_orbit
     from abrupt.report.orbit import plot_orbit_report
+    from abrupt.thresholds import FalseAlarmBudget
 
-    eph = read_ephemeris(file, satellite)
-    cfg = _detector_config(
-        eph,
-        tuning,
-        tau_s,
-        q_m2_s5,
-        sigma_pos_m,
-        sigma_vel_mps,
-        dynamics,
-        false_alarms_per_day=false_alarms_per_week / 7,
+    run = detect_orbit(
+        file,
+        detector="glr" if tuning == "auto" else "mcr_w",
+        budget=FalseAlarmBudget(false_alarms_per_week, "week"),
+        satellite=satellite,
+        tuning=tuning,
+        tau_s=tau_s,
+        q_m2_s5=q_m2_s5,
+        sigma_pos_m=sigma_pos_m,
+        sigma_vel_mps=sigma_vel_mps,
+        dynamics=dynamics,
+        gravity_degree=gravity_degree,
     )
-    analysis = analyse(eph, cfg)
-    thresholds = self_calibrate(analysis)
+    assert run.analysis is not None
     events = read_events(events_file) if events_file else None
-    path = plot_orbit_report(analysis, thresholds, events, out)
+    path = plot_orbit_report(run.analysis, run.thresholds, events, out)
     click.echo(f"report written to {path}", err=True)

@@ -29,8 +29,8 @@ from scipy.optimize import curve_fit
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc
+from abrupt.model.orbit import MU_KADERALI_M3_S2, ForceContext, ForceModel, propagate_with_stm
 from abrupt.model.tracking_measurements import TrackingArrays, wrap_angle
-from abrupt.model.tracking_orbit import ForceModel, propagate_with_stm
 from abrupt.series.tracking import TrackingSeries
 from abrupt.thresholds import FalseAlarmBudget, Threshold, chi2_threshold
 
@@ -82,7 +82,7 @@ class KaderaliConfig:
     elevation_mask_deg: float | None = None
     joseph_form: bool = True
     max_step_s: float = 5.0
-    force: ForceModel = field(default_factory=ForceModel)
+    force: ForceModel | ForceContext = field(default_factory=lambda: ForceModel(mu_m3_s2=MU_KADERALI_M3_S2))
     accel_mps2: tuple[float, float, float] = (0.0, 0.0, 0.0)  # known constant acceleration (e.g. from a fit)
 
     @property

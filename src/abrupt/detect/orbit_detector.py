@@ -21,7 +21,17 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy import stats
 
-from abrupt.detect.orbit_ekf import FilterConfig, FilterRun, run_backward, run_forward
+from abrupt.clean.noise import robust_scale
+from abrupt.detect.orbit_ekf import (
+    FilterConfig,
+    FilterRun,
+    measurement_update,
+    measurement_variances,
+    measurement_vectors,
+    propagate_state,
+    run_backward,
+    run_forward,
+)
 from abrupt.detect.orbit_glr import JumpEstimate, glr_statistic, localise_jump
 from abrupt.detect.orbit_statistics import (
     STATISTIC_NAMES,
@@ -30,14 +40,15 @@ from abrupt.detect.orbit_statistics import (
     orbital_constant_statistics,
 )
 from abrupt.events import Event, config_hash, empty_frame, events_frame
-from abrupt.model.frames import Ephemeris, rtn_matrix
-from abrupt.thresholds import Threshold, fit_threshold, p_fa_per_sample
+from abrupt.model.frames import Ephemeris
+from abrupt.model.orbit import ForceContext, rtn_matrix
+from abrupt.thresholds import Threshold, fit_threshold, gpd_return_level_upper, p_fa_per_sample
+from abrupt.types import FloatArray
 
-FloatArray = NDArray[np.float64]
 SECONDS_PER_WEEK = 7 * 86400.0
 ONE_PER_WEEK = 1.0 / 7.0  # [false alarms per day]
 
-DETECTOR_NAME = "orbit_dmc_fb"
+DETECTOR_NAME = "orbit"
 
 
 @dataclass(frozen=True)
@@ -109,6 +120,7 @@ class OrbitAnalysis:
     statistics: dict[str, FloatArray]
     valid: NDArray[np.bool_]
     config: OrbitDetectorConfig
+    context: ForceContext | None = None
 
     @property
     def sample_rate_hz(self) -> float:
@@ -125,9 +137,18 @@ def analyse(ephemeris: Ephemeris, config: OrbitDetectorConfig | None = None) -> 
     if np.any(np.diff(t) <= 0):
         raise ValueError("epochs must be strictly increasing")
     fc = config.filter
-    fwd = run_forward(t, eph.position_m, eph.velocity_mps, config.sigma_pos_m, config.sigma_vel_mps, fc)
+    ctx = fc.force_context(eph.times_utc[0], float(t[0]), float(t[-1]))
+    fwd = run_forward(t, eph.position_m, eph.velocity_mps, config.sigma_pos_m, config.sigma_vel_mps, fc, context=ctx)
     bwd = run_backward(
-        t, eph.position_m, eph.velocity_mps, config.sigma_pos_m, config.sigma_vel_mps, fc, fwd.x[-1], fwd.p[-1]
+        t,
+        eph.position_m,
+        eph.velocity_mps,
+        config.sigma_pos_m,
+        config.sigma_vel_mps,
+        fc,
+        fwd.x[-1],
+        fwd.p[-1],
+        context=ctx,
     )
     fusion = fuse(fwd.x, fwd.p, bwd.x, bwd.p)
     stats = dict(fusion.statistics)
@@ -140,6 +161,7 @@ def analyse(ephemeris: Ephemeris, config: OrbitDetectorConfig | None = None) -> 
             config.sigma_pos_m,
             config.sigma_vel_mps,
             replace(fc, q_rtn_m2_s5=q_conv),  # type: ignore[arg-type]
+            context=ctx,
         )
         stats.update(orbital_constant_statistics(t, conv.x, config.oc_window_s))
     else:
@@ -156,13 +178,14 @@ def analyse(ephemeris: Ephemeris, config: OrbitDetectorConfig | None = None) -> 
             fwd.x[0],
             fwd.p[0],
             config.glr_window_samples * eph.nominal_step_s,
+            context=ctx,
         )
     else:
         stats["glr"] = np.full(t.size, np.nan)
     valid = (t - t[0] >= config.settle_s) & (t[-1] - t >= config.settle_s)
     for name in stats:
         stats[name] = np.where(valid, stats[name], np.nan)
-    return OrbitAnalysis(eph, t, fwd, bwd, fusion, stats, valid, config)
+    return OrbitAnalysis(eph, t, fwd, bwd, fusion, stats, valid, config, ctx)
 
 
 def calibrate_thresholds(
@@ -203,7 +226,7 @@ def self_calibrate(
     """Thresholds from the arc itself when no event-free reference exists (real data).
 
     Procedure (documented in docs/orbit.md; nothing depends on a particular satellite):
-    1. robust location and scale: median and 1.4826·MAD of the statistic over the valid epochs — of
+    1. robust location and scale: median and the normal-consistent MAD of the statistic over the valid epochs — of
        its logarithm when the statistic is positive (the statistics are skewed, chi-like);
     2. leave-out: around every value above median + ``outlier_sigma``·scale, the whole excursion that
        contains it (the contiguous epochs above median + ``episode_sigma``·scale, so a long post-event
@@ -239,7 +262,7 @@ def self_calibrate(
             if keep.sum() < 100:
                 break
             med = float(np.median(z[keep]))
-            scale = 1.4826 * float(np.median(np.abs(z[keep] - med)))
+            scale = float(robust_scale(z[keep]))
             if scale <= 0:
                 break
             hot = np.flatnonzero(keep & (z > med + outlier_sigma * scale))
@@ -274,39 +297,6 @@ def self_calibrate(
     return out
 
 
-def gpd_return_level_upper(x: FloatArray, p_fa: float, *, tail_fraction: float, z: float = 1.0) -> float:
-    """Upper confidence bound of the value exceeded with probability ``p_fa`` per sample (peaks over the
-    (1 − ``tail_fraction``) quantile u, generalised Pareto excesses with scale σ and shape ξ).
-
-    Return level (Coles 2001, Eq. 4.12): x_p = u + σ/ξ·(r^ξ − 1), r = tail_fraction/p_fa (→ u + σ ln r as
-    ξ → 0). Its variance by the delta method, ∇x_pᵀ V ∇x_p, with the asymptotic covariance of the ML fit of
-    n excesses V = (1+ξ)/n·[[2σ², σ], [σ, 1+ξ]] (Smith 1987, valid for ξ > −1/2; ξ is floored at −0.45
-    for V). Returns x_p + z·sd(x_p); z = 0 gives the point estimate (:func:`abrupt.thresholds.gpd_quantile`).
-    """
-    x = np.asarray(x, dtype=np.float64)
-    if p_fa >= tail_fraction:
-        return float(np.quantile(x, 1.0 - p_fa))
-    u = float(np.quantile(x, 1.0 - tail_fraction))
-    excess = x[x > u] - u
-    if excess.size < 30:
-        raise ValueError("too few tail samples for a generalised Pareto fit; give more event-free data")
-    xi, _, sigma = stats.genpareto.fit(excess, floc=0.0)
-    r = tail_fraction / p_fa
-    log_r = float(np.log(r))
-    if abs(xi) < 1e-6:
-        level = u + sigma * log_r
-        grad = np.array([log_r, 0.5 * sigma * log_r**2])
-    else:
-        rx = r**xi
-        level = u + sigma / xi * (rx - 1.0)
-        grad = np.array([(rx - 1.0) / xi, -sigma / xi**2 * (rx - 1.0) + sigma / xi * rx * log_r])
-    if z == 0.0:
-        return float(level)
-    xe = max(float(xi), -0.45)
-    cov = (1.0 + xe) / excess.size * np.array([[2.0 * sigma**2, sigma], [sigma, 1.0 + xe]])
-    return float(level + z * np.sqrt(max(0.0, float(grad @ cov @ grad))))
-
-
 def find_events(
     analysis: OrbitAnalysis,
     thresholds: Mapping[str, Threshold],
@@ -337,6 +327,7 @@ def find_events(
     above = np.flatnonzero(np.nan_to_num(s, nan=-np.inf) > thr.value)
     extra_cols = [
         "dv_sigma_mps",
+        "duration_s",
         "snr",
         "glr",
         "dv_glr_r_mps",
@@ -383,6 +374,7 @@ def find_events(
         cov = analysis.fusion.dv_cov[k]
         glr_value = float("nan")
         glr_rtn = np.full(3, np.nan)
+        duration = 0.0
         if cfg.localise == "glr":
             if cfg.glr_search_s is not None:
                 search = cfg.glr_search_s
@@ -407,7 +399,20 @@ def find_events(
                     dv_in = jump.dv_inertial_mps
                     cov = jump.dv_cov
                 elif cfg.dv_estimate == "interval":
-                    dv_in, cov = interval_dv(analysis, k_j)
+                    burn = locate_burn(analysis, k_j, (int(lo), int(hi)), interval_sigma_s=jump.time_sigma_s)
+                    dv_in, cov = burn.dv_inertial_mps, burn.dv_cov
+                    t_event, time_sigma, duration = burn.start_s, burn.centroid_sigma_s, burn.duration_s
+                    # orbit frame at the burn centroid: the net ΔV of a burn held in the orbit frame (as
+                    # operators fly reboosts) points along its direction there
+                    k_c = int(np.clip(np.searchsorted(t, burn.centroid_s), 0, t.size - 1))
+                    xf = analysis.forward.x[k_c]
+                    if burn.duration_s > 0:
+                        # integrated |ΔV| of a burn fixed in the orbit frame: the net vector is shorter by
+                        # sin(θ/2)/(θ/2), θ = n·D the frame's rotation over the burn
+                        rn = float(np.linalg.norm(xf[:3]))
+                        theta = float(np.linalg.norm(np.cross(xf[:3], xf[3:6]))) / rn**2 * burn.duration_s
+                        if theta > 1e-6:
+                            dv_in = dv_in * (0.5 * theta / np.sin(0.5 * theta))
                 else:
                     # TS1 at the last pre-jump epoch: forward saw only pre-jump data, backward only post-jump
                     dv_in = analysis.fusion.dv_inertial[k_j - 1]
@@ -427,7 +432,7 @@ def find_events(
             Event(
                 spacecraft=sc,
                 kind=cfg.kind,
-                detector=f"{DETECTOR_NAME}:{name}",
+                detector=f"{DETECTOR_NAME}.{name}",
                 time_utc=str(time_utc),
                 statistic=float(s[peak_stat]),
                 threshold=thr.value,
@@ -440,6 +445,7 @@ def find_events(
                 dv_n_mps=float(dv_rtn[2]),
                 extra={
                     "dv_sigma_mps": dv_sigma,
+                    "duration_s": duration,
                     "snr": float(s[peak_stat] / thr.value),
                     "glr": glr_value,
                     "dv_glr_r_mps": float(glr_rtn[0]),
@@ -452,44 +458,195 @@ def find_events(
     return events_frame(events, extra_columns=extra_cols)
 
 
-def interval_dv(analysis: OrbitAnalysis, k: int) -> tuple[FloatArray, FloatArray]:
-    """Velocity jump (inertial, m/s) across the sampling interval (t_{k−1}, t_k) and its covariance.
+@dataclass(frozen=True)
+class JumpInterval:
+    """A velocity change across epochs (k_first − 1, k_last): ΔV (inertial, m/s) and its covariance, the
+    centroid time (s), its 1σ, the estimated start time and duration (s; 0 for an impulse)."""
 
-    The forward a-posteriori state at k−1 has seen only pre-jump data and the backward a-posteriori state
-    at k only post-jump data (the backward a-priori estimate at k updated with the measurement at k,
-    Joseph form as in the filter). The pre-jump state is propagated to t_k with the filter's gravity
-    model and, for the unmodelled acceleration over the interval, the mean ā = ½(w_F(k−1) + w_B(k)) of
-    the two filters' DMC estimates held constant (τ → ∞ over one step); then ΔV = v_B(k) − v_F(t_k).
+    k_first: int
+    k_last: int
+    dv_inertial_mps: FloatArray
+    dv_cov: FloatArray
+    centroid_s: float
+    centroid_sigma_s: float
+    start_s: float
+    duration_s: float
 
-    Each filter's Gauss-Markov estimate lags the true acceleration from its own side (the forward one
-    from the past, the backward one from the future), so the mean cancels the first-order lag that
-    the TS1 form v̄_B(k−1) − v_F(k−1) (backward w over the whole interval) keeps; at 60 s sampling the
-    unmodelled acceleration of a LEO orbit (~7e-5 m/s² against J2-J4) integrates to ~4 mm/s per step,
-    so this matters. A jump at any time inside the interval changes v(t_k) by Φ_vv ΔV ≈ ΔV (to
-    ~n²Δt²/2 ≈ 0.2 % at 60 s). Covariance: the two velocity covariances plus (Δt/2)² times the two w
-    covariances (cross-correlations neglected).
+
+def interval_jump(analysis: OrbitAnalysis, k_first: int, k_last: int | None = None) -> JumpInterval:
+    """Velocity and position jump across (t_{k_first−1}, t_{k_last}) between the forward state before and the
+    backward state after, and the time it happened.
+
+    The forward a-posteriori state at k_first−1 has seen only pre-jump data and the backward a-posteriori
+    state at k_last only post-jump data (the backward a-priori estimate updated with the measurement at
+    k_last, Joseph form as in the filter). The pre-jump state is propagated to t_{k_last} with the filter's
+    force model and, for the unmodelled acceleration, the mean ā = ½(w_F + w_B) of the two filters' DMC
+    estimates held constant; then ΔV = v_B − v̂_F and Δr = r_B − r̂_F. Each filter's Gauss-Markov
+    estimate lags from its own side, so the mean cancels the first-order lag.
+
+    Time: a velocity change ΔV(t) spread over the interval displaces the position at t_{k_last} by
+    Δr = ∫ (t_{k_last} − t) dΔV(t) = ΔV (t_{k_last} − t_c), with t_c the ΔV-weighted centroid (exact for
+    a fixed direction, to first order in the gravity gradient over the interval); hence
+    t_c = t_{k_last} − Δr·ΔV/|ΔV|². Its variance follows from the covariances of Δr along ΔV and of |ΔV|.
+    Covariances: the forward one propagated with the STM plus the backward one, plus (Δt/2)² times the two
+    DMC covariances for the velocity; all scaled by the filter's innovation consistency (median NIS over
+    its χ²₆ median, ≥ 1) so that a filter more confident than its residuals allow does not shrink them.
     """
-    from abrupt.detect.orbit_ekf import _measurement_update, _measurements, _propagate, measurement_variances
-
+    k_last = k_first if k_last is None else k_last
     cfg = analysis.config
     fc = cfg.filter
     eph = analysis.ephemeris
     t = analysis.t_s
-    if not 1 <= k < t.size:
+    if not 1 <= k_first <= k_last < t.size:
         raise ValueError("interval index out of range")
-    xb = analysis.backward.x[k].copy()
-    pb = analysis.backward.p[k].copy()
-    y = _measurements(eph.position_m[k : k + 1], eph.velocity_mps[k : k + 1])[0]
-    rdiag = measurement_variances(eph.velocity_mps[k : k + 1], cfg.sigma_pos_m, cfg.sigma_vel_mps, 1)[0]
-    _measurement_update(xb, pb, y, rdiag, np.empty(6))
-    xf = analysis.forward.x[k - 1].copy()
-    pf = analysis.forward.p[k - 1]
-    xf[6:9] = 0.5 * (xf[6:9] + xb[6:9])
-    dt = float(t[k] - t[k - 1])
-    x_pred = _propagate(xf, dt, 1e12, fc.mu_m3_s2, fc.zonal_degree, fc.max_step_s, np.empty((9, 9)))
-    dv = xb[3:6] - x_pred[3:6]
-    cov = pf[3:6, 3:6] + pb[3:6, 3:6] + (0.5 * dt) ** 2 * (pf[6:9, 6:9] + pb[6:9, 6:9])
-    return dv, cov
+    xb = analysis.backward.x[k_last].copy()
+    pb = analysis.backward.p[k_last].copy()
+    y = measurement_vectors(eph.position_m[k_last : k_last + 1], eph.velocity_mps[k_last : k_last + 1])[0]
+    rdiag = measurement_variances(eph.velocity_mps[k_last : k_last + 1], cfg.sigma_pos_m, cfg.sigma_vel_mps, 1)[0]
+    measurement_update(xb, pb, y, rdiag, np.empty(6))
+    xf = analysis.forward.x[k_first - 1].copy()
+    pf = analysis.forward.p[k_first - 1]
+    if k_last == k_first or (_quiet(analysis, xf[6:9]) and _quiet(analysis, xb[6:9])):
+        xf[6:9] = 0.5 * (xf[6:9] + xb[6:9])
+    else:  # an edge inside a burn: its Gauss-Markov state holds part of the burn, not the background
+        xf[6:9] = 0.0
+    dt = float(t[k_last] - t[k_first - 1])
+    ctx = _context_of(analysis)
+    phi = np.empty((9, 9))
+    x_pred = propagate_state(xf, float(t[k_first - 1]), dt, 1e12, ctx.kernel_args, fc.max_step_s, phi)
+    p_pred = phi @ pf @ phi.T
+    # The state difference at t_last maps back through the STM to the equivalent offset at t_first−1;
+    # a ΔV at t_c gives there [−(t_c − t₀)ΔV; ΔV] to first order. Refine by mapping the offset to t_c,
+    # where the position offset vanishes (second-order terms n²(t_c − t₀)²/2 matter for long spans).
+    dx_last = np.r_[xb[0:3] - x_pred[0:3], xb[3:6] - x_pred[3:6]]
+    dx0 = np.linalg.solve(phi[:6, :6], dx_last)
+    t0 = float(t[k_first - 1])
+    t_c = t0 - float(dx0[:3] @ dx0[3:]) / max(float(dx0[3:] @ dx0[3:]), 1e-300)
+    dv, dr = dx0[3:], dx0[:3]
+    phi_c = np.empty((9, 9))
+    for _ in range(2):
+        tau_c = min(max(t_c - t0, 0.0), dt)
+        propagate_state(xf, t0, tau_c, 1e12, ctx.kernel_args, fc.max_step_s, phi_c)
+        dx_c = phi_c[:6, :6] @ dx0
+        dv = dx_c[3:]
+        dr = dx_c[:3]
+        t_c = t0 + tau_c - float(dr @ dv) / max(float(dv @ dv), 1e-300)
+    scale = innovation_scale(analysis)
+    cov = scale * (p_pred[3:6, 3:6] + pb[3:6, 3:6] + (0.5 * dt) ** 2 * (pf[6:9, 6:9] + pb[6:9, 6:9]))
+    cov_r = scale * (p_pred[0:3, 0:3] + pb[0:3, 0:3])
+    mag = float(np.linalg.norm(dv))
+    u = dv / max(mag, 1e-300)
+    lead = float(t[k_last]) - t_c
+    var_lead = float(u @ cov_r @ u) / max(mag * mag, 1e-300) + lead * lead * float(u @ cov @ u) / max(mag * mag, 1e-300)
+    return JumpInterval(k_first, k_last, np.asarray(dv, dtype=np.float64), cov, t_c, float(np.sqrt(var_lead)), t_c, 0.0)
+
+
+def _quiet(analysis: OrbitAnalysis, w: FloatArray) -> bool:
+    """Whether a DMC acceleration is within the arc's usual range (median + 10 robust sigmas of |w_F|)."""
+    mags = np.linalg.norm(analysis.forward.x[analysis.valid, 6:9], axis=1)
+    if mags.size < 10:
+        return True
+    med = float(np.median(mags))
+    scale = float(robust_scale(mags))
+    return float(np.linalg.norm(w)) <= med + 10.0 * max(scale, 1e-12)
+
+
+def innovation_scale(analysis: OrbitAnalysis) -> float:
+    """max(1, median NIS / median of χ²₆): how much the forward filter's innovations exceed its own
+    covariance (1 for a consistent filter)."""
+    nis = analysis.forward.nis
+    nis = nis[np.isfinite(nis)]
+    if nis.size < 10:
+        return 1.0
+    return max(1.0, float(np.median(nis)) / float(stats.chi2.median(6)))
+
+
+def interval_dv(analysis: OrbitAnalysis, k: int) -> tuple[FloatArray, FloatArray]:
+    """ΔV (inertial, m/s) across (t_{k−1}, t_k) and its covariance (:func:`interval_jump`)."""
+    j = interval_jump(analysis, k)
+    return j.dv_inertial_mps, j.dv_cov
+
+
+def locate_burn(
+    analysis: OrbitAnalysis,
+    k: int,
+    episode: tuple[int, int] | None = None,
+    *,
+    margin: int = 3,
+    max_intervals: int = 40,
+    interval_sigma_s: float = 0.0,
+) -> JumpInterval:
+    """The velocity change of one exceedance episode: an impulse or a finite burn (seconds to ~20 min).
+
+    ``k`` is the located jump interval (GLR) and ``episode`` the first and last exceeding epochs.
+    1. The span [lo, hi] is the episode (and k) widened by ``margin`` intervals, at most
+       ``max_intervals``; its edges lie outside the burn, so ΔV between the forward state before and the
+       backward state after it (:func:`interval_jump`) is the whole burn's, unbiased by the filters'
+       Gauss-Markov states that absorb part of a long burn.
+    2. Profile: with the forward edge fixed, the ΔV to the backward state at each epoch h of the span,
+       projected on the total, rises from 0 to the total over the burn (linearly for a constant
+       acceleration). The 10 % and 90 % crossings give the duration D = (t₉₀ − t₁₀)/0.8.
+    3. If D is shorter than a sampling interval, or the located interval k alone holds the total ΔV
+       (within 20 % or 3σ), the change is an impulse in interval k: its ΔV and time come from that
+       interval alone; the time inside the interval
+       is used only when the position jump resolves it (σ < Δt/10), otherwise the midpoint is reported
+       with σ = Δt/√12 combined with ``interval_sigma_s``, the locator's own uncertainty about which
+       interval holds the change (on real precise orbits positions and velocities are not consistent to better
+       than ~2 cm over one step, which does not resolve it).
+    4. Otherwise start = t_c − D/2 with t_c the centroid from the position jump (constant acceleration);
+       σ combines the centroid's σ with a quarter of the sampling interval.
+    """
+    t = analysis.t_s
+    n = t.size
+    g0, g1 = episode if episode is not None else (k, k)
+    lo = max(1, min(g0, k) - margin)
+    hi = min(n - 1, max(g1, k) + margin)
+    if hi - lo + 1 > max_intervals:  # keep the span around the located interval
+        lo = max(1, k - max_intervals // 2)
+        hi = min(n - 1, lo + max_intervals - 1)
+    whole = interval_jump(analysis, lo, hi)
+    total = whole.dv_inertial_mps
+    mag = float(np.linalg.norm(total))
+    u = total / max(mag, 1e-300)
+    prof_t = [float(t[lo - 1])]
+    prof = [0.0]
+    for h in range(lo, hi + 1):
+        j = whole if h == hi else interval_jump(analysis, lo, h)
+        prof_t.append(float(t[h]))
+        prof.append(float(j.dv_inertial_mps @ u) / max(mag, 1e-300))
+    pt = np.array(prof_t)
+    pv = np.maximum.accumulate(np.clip(np.array(prof), 0.0, None))
+
+    def crossing(level: float) -> float:
+        i = int(np.argmax(pv >= level))
+        if i == 0:
+            return float(pt[0])
+        f = (level - pv[i - 1]) / max(pv[i] - pv[i - 1], 1e-300)
+        return float(pt[i - 1] + f * (pt[i] - pt[i - 1]))
+
+    t10, t90 = crossing(0.1), crossing(0.9)
+    step = float(np.median(np.diff(t[lo - 1 : hi + 1])))
+    duration = (t90 - t10) / 0.8
+    single = interval_jump(analysis, k)
+    sd_total = float(np.sqrt(max(float(u @ whole.dv_cov @ u), 0.0)))
+    impulse = duration < step or float(np.linalg.norm(single.dv_inertial_mps - total)) < max(0.2 * mag, 3.0 * sd_total)
+    if impulse:  # the located interval alone holds the change
+        step_k = float(t[k] - t[k - 1])
+        if single.centroid_sigma_s < step_k / 10.0 and t[k - 1] <= single.centroid_s <= t[k]:
+            return single
+        mid = float(t[k]) - 0.5 * step_k
+        sigma_k = float(np.hypot(step_k / np.sqrt(12.0), interval_sigma_s))
+        return replace(single, centroid_s=mid, start_s=mid, centroid_sigma_s=sigma_k)
+    start = whole.centroid_s - 0.5 * duration
+    sigma = float(np.hypot(whole.centroid_sigma_s, 0.25 * step))
+    return replace(whole, start_s=start, duration_s=duration, centroid_sigma_s=sigma)
+
+
+def _context_of(analysis: OrbitAnalysis) -> ForceContext:
+    if analysis.context is not None:
+        return analysis.context
+    t = analysis.t_s
+    return analysis.config.filter.force_context(analysis.ephemeris.times_utc[0], float(t[0]), float(t[-1]))
 
 
 def _localise(analysis: OrbitAnalysis, t_from: float, t_to: float, horizon_s: float) -> JumpEstimate | None:
@@ -514,6 +671,7 @@ def _localise(analysis: OrbitAnalysis, t_from: float, t_to: float, horizon_s: fl
             first,
             last,
             horizon_s,
+            context=_context_of(analysis),
         )
     except (ValueError, np.linalg.LinAlgError):
         return None
@@ -536,7 +694,8 @@ def stream_statistics(
     eph = ephemeris.to_frame("GCRF")
     t = eph.seconds
     fc = config.filter
-    fwd = run_forward(t, eph.position_m, eph.velocity_mps, config.sigma_pos_m, config.sigma_vel_mps, fc)
+    ctx = fc.force_context(eph.times_utc[0], float(t[0]), float(t[-1]))
+    fwd = run_forward(t, eph.position_m, eph.velocity_mps, config.sigma_pos_m, config.sigma_vel_mps, fc, context=ctx)
     start = 0
     while start < t.size:
         stop = int(np.searchsorted(t, t[start] + block_s, side="left"))
@@ -553,6 +712,7 @@ def stream_statistics(
             fc,
             fwd.x[edge - 1],
             fwd.p[edge - 1],
+            context=ctx,
         )
         n = stop - start
         fusion = fuse(fwd.x[start:stop], fwd.p[start:stop], bwd.x[:n], bwd.p[:n])
@@ -564,21 +724,27 @@ def _robust_std(x: FloatArray) -> float:
     x = x[np.isfinite(x)]
     if x.size == 0:
         return float("nan")
-    return float(1.4826 * np.median(np.abs(x - np.median(x))))
+    return float(robust_scale(x))
 
 
 def auto_tune(
     ephemeris: Ephemeris,
     *,
     zonal_degree: int = 4,
+    gravity_degree: int = 40,
+    third_body: bool = True,
     max_steps: int = 20000,
     tau_factor: float = 10.0,
     min_sigma_pos_m: float = 0.01,
     min_sigma_vel_mps: float = 1e-5,
+    in_stationary_floor: bool = True,
+    velocity_consistency: bool = True,
 ) -> tuple[FilterConfig, float, float]:
     """Filter tuning and measurement sigmas derived from the data itself (for real precise orbits).
 
-    Each step k → k+1 is propagated with the filter dynamics (two-body + J2..J``zonal_degree``, w = 0)
+    Each step k → k+1 is propagated with the filter dynamics (default: EGM2008 40×40 with Sun and Moon, the
+    degree chosen by benchmarks/bench_orbit_forces.py; J2..J``zonal_degree`` when ``gravity_degree`` = 0;
+    w = 0)
     and compared with the next epoch: m_k = v_{k+1} − v̂_{k+1} (the velocity the model misses over one
     step) and the same for position. Then, with robust (MAD) standard deviations:
 
@@ -587,15 +753,19 @@ def auto_tune(
     - σ_vel = std(Δ³ m_k)/√70 and σ_pos likewise from the position misses (third differences remove
       any smooth model error; m_k carries the noise difference n_{k+1} − n_k, so Δ³ m_k is a fourth
       difference of white noise, variance 70σ²), floored at ``min_sigma_*``;
+    - q is at least 2σ_a²/τ, σ_a² the variance of the missed acceleration m_k/Δt less its noise share
+      2σ_vel²/Δt² (``in_stationary_floor``): the FOGM's stationary variance qτ/2 then covers the
+      unmodelled acceleration itself, which with a full force model is small but smooth;
     - data whose step-to-step model error is below the noise get q = 1 % of the noise-equivalent
       level (for 1 Hz GNSS-like solutions the thesis tuning, Table 3.1, is the better choice);
-    - τ = ``tau_factor`` × the nominal step.
+    - τ = ``tau_factor`` × the nominal step;
+    - σ_vel is at least the RMS difference between the given velocities and those a position-only filter
+      pass estimates, less that estimate's own variance (``velocity_consistency``): real precise orbits'
+      velocities need not be consistent
+      with their positions to the level their scatter suggests.
 
     Nothing here depends on a particular satellite; the same rule runs on any ephemeris.
     """
-    from abrupt.detect.orbit_ekf import _propagate
-    from abrupt.model.orbit_dynamics import MU_EARTH_M3_S2
-
     eph = ephemeris.to_frame("GCRF")
     t = eph.seconds
     n = min(len(eph) - 1, max_steps)
@@ -604,6 +774,11 @@ def auto_tune(
     idx = np.arange(n)
     dt_nom = eph.nominal_step_s
     phi = np.empty((9, 9))
+    max_step = max(10.0, min(30.0, dt_nom / 2.0))
+    base = FilterConfig(
+        zonal_degree=zonal_degree, gravity_degree=gravity_degree, third_body=third_body, max_step_s=max_step
+    )
+    ctx = base.force_context(eph.times_utc[0], float(t[0]), float(t[-1]))
     miss_v = np.full((idx.size, 3), np.nan)
     miss_r = np.full((idx.size, 3), np.nan)
     for j, k in enumerate(idx):
@@ -611,7 +786,7 @@ def auto_tune(
         if abs(dt - dt_nom) > 1e-6 * dt_nom or not np.isfinite(eph.velocity_mps[k]).all():
             continue
         x = np.r_[eph.position_m[k], eph.velocity_mps[k], 0.0, 0.0, 0.0]
-        xp = _propagate(x, dt, 1e12, MU_EARTH_M3_S2, zonal_degree, 10.0, phi)
+        xp = propagate_state(x, float(t[k]), dt, 1e12, ctx.kernel_args, max_step, phi)
         miss_v[j] = eph.velocity_mps[k + 1] - xp[3:6]
         miss_r[j] = eph.position_m[k + 1] - xp[0:3]
     consecutive = np.diff(idx) == 1
@@ -631,7 +806,38 @@ def auto_tune(
     # noise-equivalent level (the filter then trusts its dynamics; for 1 Hz GNSS-like data use the
     # thesis tuning instead, ``--tuning thesis``).
     q = max(var_signal - var_noise, 0.01 * var_noise) / dt_nom
-    fc = FilterConfig.isotropic(tau_factor * dt_nom, q, zonal_degree=zonal_degree)
+    # The FOGM's stationary variance qτ/2 must cover the unmodelled acceleration itself, not only its
+    # step-to-step change: with a good force model the remaining error is small but smooth, and a q from
+    # the differences alone lets the filter drift away from the data (innovations ≫ their covariance).
+    tau = tau_factor * dt_nom
+    var_accel = float(np.nanmean([_robust_std(acc[:, i]) ** 2 for i in range(3)])) - 2.0 * sigma_v**2 / dt_nom**2
+    if in_stationary_floor and var_accel > 0:
+        q = max(q, 2.0 * var_accel / tau)
+    fc = FilterConfig.isotropic(
+        tau,
+        q,
+        zonal_degree=zonal_degree,
+        gravity_degree=gravity_degree,
+        third_body=third_body,
+        max_step_s=max_step,
+    )
+    if velocity_consistency and np.isfinite(eph.velocity_mps).all(axis=1).mean() > 0.5:
+        # Velocities inconsistent with the positions' dynamics (SP3 velocities of DORIS orbits disagree with
+        # their own positions by ~0.6 mm/s) must not be trusted to σ_vel: run the filter on the positions
+        # alone over the first ``max_steps`` epochs and take the RMS velocity residual per axis as the
+        # velocity noise when it is larger.
+        m = min(len(eph), max_steps + 1)
+        sl = slice(0, m)
+        pos_only = run_forward(t[sl], eph.position_m[sl], np.full((m, 3), np.nan), sigma_r, sigma_v, fc, context=ctx)
+        res = (eph.velocity_mps[sl] - pos_only.x[:, 3:6])[m // 10 :]
+        p_vv = np.einsum("kii->ki", pos_only.p[m // 10 :, 3:6, 3:6])
+        ok = np.isfinite(res).all(axis=1)
+        if ok.sum() > 10:
+            # residual variance = velocity noise + the position-only estimate's own variance (robust: a
+            # maneuver inside the arc must not inflate it)
+            robust = float(np.mean([_robust_std(res[ok, i]) ** 2 for i in range(3)]))
+            excess = robust - float(np.median(p_vv[ok]))
+            sigma_v = max(sigma_v, float(np.sqrt(max(excess, 0.0))))
     return fc, sigma_r, sigma_v
 
 

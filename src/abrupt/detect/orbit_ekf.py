@@ -27,11 +27,10 @@ from dataclasses import dataclass, field
 
 import numba as nb
 import numpy as np
-from numpy.typing import NDArray
 
-from abrupt.model.orbit_dynamics import MU_EARTH_M3_S2, gravity_gradient, zonal_acceleration
-
-FloatArray = NDArray[np.float64]
+from abrupt.model.orbit import MU_EARTH_M3_S2, ForceContext, ForceModel
+from abrupt.model.orbit.forces import acceleration_kernel, gravity_gradient
+from abrupt.types import FloatArray
 
 #: Thesis Table 3.1 tuned values. q is given as 2.15e-17 km²/s⁵; in SI this is 2.15e-11 m²/s⁵ (the
 #: km² reading, erratum noted in the spec, reproduces the ~50 min re-convergence of §3.2.5).
@@ -48,6 +47,10 @@ class FilterConfig:
 
     ``q_rtn_m2_s5``: FOGM driving-noise PSD per orbit-frame axis (radial, along-track, cross-track).
     ``zonal_degree``: 0 for two-body dynamics inside the filter (thesis), 2-4 for J2..J4.
+    ``gravity_degree``: ≥ 2 replaces both by the spherical-harmonic field (EGM2008) to that degree and
+    order, in the Earth-fixed frame; ``third_body`` adds the Sun and the Moon (ERFA positions).
+    ``forces``: an explicit :class:`~abrupt.model.orbit.ForceModel` (SRP, drag...) overriding the three
+    fields above. Forces that depend on time need the arc's UTC epoch (:func:`run_forward`).
     ``sigma_w0_mps2``: initial std of w (default the steady-state FOGM value √(qτ/2)).
     ``backward_p0_scale``: the backward filter is seeded with the forward state at the end of the
     span and this multiple of the forward covariance (thesis §3.2.7: a "large covariance").
@@ -60,6 +63,9 @@ class FilterConfig:
     sigma_w0_mps2: float | None = None
     backward_p0_scale: float = 1.0e4
     mu_m3_s2: float = MU_EARTH_M3_S2
+    gravity_degree: int = 0
+    third_body: bool = False
+    forces: ForceModel | None = None
 
     def __post_init__(self) -> None:
         if self.tau_s <= 0:
@@ -70,6 +76,26 @@ class FilterConfig:
             raise ValueError("zonal_degree must be 0, 2, 3 or 4")
         if self.max_step_s <= 0:
             raise ValueError("max_step_s must be positive")
+        if self.gravity_degree != 0 and self.gravity_degree < 2:
+            raise ValueError("gravity_degree must be 0 or >= 2")
+
+    def force_model(self) -> ForceModel:
+        """The filter's dynamics as a :class:`~abrupt.model.orbit.ForceModel`."""
+        if self.forces is not None:
+            return self.forces
+        return ForceModel(
+            mu_m3_s2=self.mu_m3_s2,
+            zonal_degree=self.zonal_degree,
+            gravity_degree=self.gravity_degree,
+            sun=self.third_body,
+            moon=self.third_body,
+        )
+
+    def force_context(
+        self, epoch_utc: np.datetime64 | None, t_from_s: float = 0.0, t_to_s: float = 86400.0
+    ) -> ForceContext:
+        """The force model resolved for an arc starting at ``epoch_utc`` (seconds [t_from_s, t_to_s])."""
+        return ForceContext.build(self.force_model(), epoch_utc, t_from_s, t_to_s)
 
     @classmethod
     def isotropic(cls, tau_s: float, q_m2_s5: float, **kwargs: object) -> FilterConfig:
@@ -176,17 +202,14 @@ def _process_noise(x: FloatArray, dt: float, tau: float, q_rtn: FloatArray, out:
 
 
 @nb.njit(cache=True)
-def _deriv(x: FloatArray, tau: float, mu: float, zonal: int) -> FloatArray:
-    r = x[0:3]
-    rn = math.sqrt(r[0] ** 2 + r[1] ** 2 + r[2] ** 2)
-    f = -mu / (rn * rn * rn)
+def _deriv(x: FloatArray, t: float, tau: float, args: tuple) -> FloatArray:
+    """Ẋ = [v; a(t, r, v) + w; −w/τ] (Bennett 2022 Eqs. 3.4-3.7) with a from the force context."""
     d = np.empty(9)
     d[0:3] = x[3:6]
-    d[3] = f * r[0] + x[6]
-    d[4] = f * r[1] + x[7]
-    d[5] = f * r[2] + x[8]
-    if zonal > 0:
-        d[3:6] += zonal_acceleration(r, zonal, False)
+    a = acceleration_kernel(t, x[0:3], x[3:6], *args)
+    d[3] = a[0] + x[6]
+    d[4] = a[1] + x[7]
+    d[5] = a[2] + x[8]
     d[6] = -x[6] / tau
     d[7] = -x[7] / tau
     d[8] = -x[8] / tau
@@ -194,9 +217,9 @@ def _deriv(x: FloatArray, tau: float, mu: float, zonal: int) -> FloatArray:
 
 
 @nb.njit(cache=True)
-def _jacobian(x: FloatArray, tau: float, mu: float, zonal: int, out: FloatArray) -> None:
-    """A of Bennett 2022 Eq. 3.9 (symmetric G, erratum A6)."""
-    g = gravity_gradient(x[0:3], mu, zonal >= 2)
+def _jacobian(x: FloatArray, tau: float, mu: float, with_j2: bool, out: FloatArray) -> None:
+    """A of Bennett 2022 Eq. 3.9 (symmetric G, erratum A6), G two-body + J2."""
+    g = gravity_gradient(x[0:3], mu, with_j2)
     for i in range(9):
         for j in range(9):
             out[i, j] = 0.0
@@ -206,6 +229,12 @@ def _jacobian(x: FloatArray, tau: float, mu: float, zonal: int, out: FloatArray)
         out[6 + i, 6 + i] = -1.0 / tau
         for j in range(3):
             out[3 + i, j] = g[i, j]
+
+
+@nb.njit(cache=True)
+def _with_j2(args: tuple) -> bool:
+    ints = args[0]
+    return ints[1] >= 2 or ints[3] >= 2
 
 
 @nb.njit(cache=True)
@@ -222,12 +251,21 @@ def _matmul(a: FloatArray, b: FloatArray, out: FloatArray) -> None:
 
 
 @nb.njit(cache=True)
-def _propagate(
-    x: FloatArray, dt: float, tau: float, mu: float, zonal: int, max_step: float, phi: FloatArray
+def propagate_state(
+    x: FloatArray,
+    t: float,
+    dt: float,
+    tau: float,
+    args: tuple,
+    max_step: float,
+    phi: FloatArray,
 ) -> FloatArray:
-    """RK4 state propagation over dt (sub-stepped) and the Lear RK2 STM (Eq. 3.8, erratum A7)."""
+    """RK4 propagation of the 9-state from ``t`` over ``dt`` (sub-stepped to ``max_step``) and the Lear
+    RK2 STM (Eq. 3.8, erratum A7) into ``phi``; ``args`` are :attr:`ForceContext.kernel_args`."""
     nsub = max(1, math.ceil(abs(dt) / max_step - 1e-9))
     h = dt / nsub
+    mu = args[1][0]
+    j2 = _with_j2(args)
     for i in range(9):
         for j in range(9):
             phi[i, j] = 1.0 if i == j else 0.0
@@ -237,14 +275,16 @@ def _propagate(
     tmp = np.empty((9, 9))
     prod = np.empty((9, 9))
     xc = x.copy()
-    _jacobian(xc, tau, mu, zonal, a0)
+    tc = t
+    _jacobian(xc, tau, mu, j2, a0)
     for _ in range(nsub):
-        k1 = _deriv(xc, tau, mu, zonal)
-        k2 = _deriv(xc + 0.5 * h * k1, tau, mu, zonal)
-        k3 = _deriv(xc + 0.5 * h * k2, tau, mu, zonal)
-        k4 = _deriv(xc + h * k3, tau, mu, zonal)
+        k1 = _deriv(xc, tc, tau, args)
+        k2 = _deriv(xc + 0.5 * h * k1, tc + 0.5 * h, tau, args)
+        k3 = _deriv(xc + 0.5 * h * k2, tc + 0.5 * h, tau, args)
+        k4 = _deriv(xc + h * k3, tc + h, tau, args)
         xc = xc + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
-        _jacobian(xc, tau, mu, zonal, a1)
+        tc += h
+        _jacobian(xc, tau, mu, j2, a1)
         _matmul(a1, a0, prod)
         for i in range(9):
             for j in range(9):
@@ -274,7 +314,7 @@ def _time_update_cov(p: FloatArray, phi: FloatArray, s: FloatArray, sign: float,
 
 
 @nb.njit(cache=True)
-def _measurement_update(x: FloatArray, p: FloatArray, y: FloatArray, rdiag: FloatArray, innov: FloatArray) -> float:
+def measurement_update(x: FloatArray, p: FloatArray, y: FloatArray, rdiag: FloatArray, innov: FloatArray) -> float:
     """Joseph-form update with H = [I6 0]; updates x and p in place; returns the NIS."""
     s = np.empty((6, 6))
     for i in range(6):
@@ -333,9 +373,8 @@ def forward_kernel(
     p0: FloatArray,
     tau: float,
     q_rtn: FloatArray,
-    mu: float,
-    zonal: int,
     max_step: float,
+    args: tuple,
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Forward EKF-DMC: a-posteriori states/covariances at every epoch (Bennett 2022 §3.2.1-3.2.5)."""
     n = t.size
@@ -353,10 +392,10 @@ def forward_kernel(
         if i > 0:
             dt = t[i] - t[i - 1]
             _process_noise(x, dt, tau, q_rtn, s)
-            x = _propagate(x, dt, tau, mu, zonal, max_step, phi)
+            x = propagate_state(x, t[i - 1], dt, tau, args, max_step, phi)
             _time_update_cov(p, phi, s, 1.0, pbar)
             p[:, :] = pbar
-        nis[i] = _measurement_update(x, p, y[i], rdiag[i], innov)
+        nis[i] = measurement_update(x, p, y[i], rdiag[i], innov)
         innovs[i] = innov
         xs[i] = x
         ps[i] = p
@@ -372,9 +411,8 @@ def backward_kernel(
     p_seed: FloatArray,
     tau: float,
     q_rtn: FloatArray,
-    mu: float,
-    zonal: int,
     max_step: float,
+    args: tuple,
     mirrored: bool,
 ) -> tuple[FloatArray, FloatArray]:
     """Backward filter: a-priori states/covariances at every epoch (not including that epoch's data).
@@ -397,12 +435,12 @@ def backward_kernel(
         if i < n - 1:
             dt = t[i] - t[i + 1]
             _process_noise(x, dt, tau_b, q_rtn, s)
-            x = _propagate(x, dt, tau_b, mu, zonal, max_step, phi)
+            x = propagate_state(x, t[i + 1], dt, tau_b, args, max_step, phi)
             _time_update_cov(p, phi, s, sign, pbar)
             p[:, :] = pbar
         xs[i] = x
         ps[i] = p
-        _measurement_update(x, p, y[i], rdiag[i], innov)
+        measurement_update(x, p, y[i], rdiag[i], innov)
     return xs, ps
 
 
@@ -420,9 +458,20 @@ def measurement_variances(velocity_mps: FloatArray, sigma_pos_m: float, sigma_ve
     return r
 
 
-def _measurements(position_m: FloatArray, velocity_mps: FloatArray) -> FloatArray:
+def measurement_vectors(position_m: FloatArray, velocity_mps: FloatArray) -> FloatArray:
     y = np.hstack([np.asarray(position_m, dtype=np.float64), np.asarray(velocity_mps, dtype=np.float64)])
     return np.where(np.isfinite(y), y, 0.0)
+
+
+def resolve_context(
+    config: FilterConfig, t_s: FloatArray, context: ForceContext | None, epoch_utc: np.datetime64 | None
+) -> ForceContext:
+    """The force context to run over ``t_s`` (s from ``epoch_utc``): ``context`` when it covers the
+    span, else one built from ``config``."""
+    lo, hi = (float(np.min(t_s)), float(np.max(t_s))) if len(t_s) else (0.0, 0.0)
+    if context is not None and context.covers(lo, hi):
+        return context
+    return config.force_context(epoch_utc if context is None else context.epoch_utc, lo, hi)
 
 
 def run_forward(
@@ -432,10 +481,17 @@ def run_forward(
     sigma_pos_m: float,
     sigma_vel_m_s: float,
     config: FilterConfig,
+    *,
+    context: ForceContext | None = None,
+    epoch_utc: np.datetime64 | None = None,
 ) -> FilterRun:
-    """Forward EKF-DMC over the measurements (inertial frame). Seeds with the first measurement."""
+    """Forward EKF-DMC over the measurements (inertial frame). Seeds with the first measurement.
+
+    ``t_s`` are seconds from ``epoch_utc`` (needed when the forces depend on time) or from the epoch of
+    ``context``."""
     t = np.ascontiguousarray(t_s, dtype=np.float64)
-    y = _measurements(position_m, velocity_mps)
+    ctx = resolve_context(config, t, context, epoch_utc)
+    y = measurement_vectors(position_m, velocity_mps)
     rdiag = measurement_variances(velocity_mps, sigma_pos_m, sigma_vel_m_s, t.size)
     x0 = np.zeros(9)
     x0[:6] = y[0]
@@ -446,7 +502,7 @@ def run_forward(
         rdiag0 = sigma_vel_m_s**2
     p0 = np.diag(np.r_[np.full(3, sigma_pos_m**2), np.full(3, rdiag0), np.full(3, config.w0_sigma() ** 2)])
     xs, ps, innov, nis = forward_kernel(
-        t, y, rdiag, x0, p0, config.tau_s, config.q_array(), config.mu_m3_s2, config.zonal_degree, config.max_step_s
+        t, y, rdiag, x0, p0, config.tau_s, config.q_array(), config.max_step_s, ctx.kernel_args
     )
     return FilterRun(xs, ps, innov, nis)
 
@@ -462,10 +518,13 @@ def run_backward(
     seed_p: FloatArray,
     *,
     mirrored: bool = True,
+    context: ForceContext | None = None,
+    epoch_utc: np.datetime64 | None = None,
 ) -> FilterRun:
     """Backward filter a-priori estimates, seeded at the last epoch with (seed_x, seed_p·backward_p0_scale)."""
     t = np.ascontiguousarray(t_s, dtype=np.float64)
-    y = _measurements(position_m, velocity_mps)
+    ctx = resolve_context(config, t, context, epoch_utc)
+    y = measurement_vectors(position_m, velocity_mps)
     rdiag = measurement_variances(velocity_mps, sigma_pos_m, sigma_vel_m_s, t.size)
     p_seed = np.asarray(seed_p, dtype=np.float64) * config.backward_p0_scale
     xs, ps = backward_kernel(
@@ -476,9 +535,8 @@ def run_backward(
         p_seed,
         config.tau_s,
         config.q_array(),
-        config.mu_m3_s2,
-        config.zonal_degree,
         config.max_step_s,
+        ctx.kernel_args,
         mirrored,
     )
     return FilterRun(xs, ps)
@@ -493,9 +551,8 @@ def forward_kernel_detailed(
     p0: FloatArray,
     tau: float,
     q_rtn: FloatArray,
-    mu: float,
-    zonal: int,
     max_step: float,
+    args: tuple,
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Forward filter from the a-posteriori (x0, p0) at t[0], storing per step k ≥ 1 the STM Φ_k,
     the gain K_k, the inverse innovation covariance S_k⁻¹ and the innovation γ_k (for the GLR)."""
@@ -512,7 +569,7 @@ def forward_kernel_detailed(
     for i in range(1, n):
         dt = t[i] - t[i - 1]
         _process_noise(x, dt, tau, q_rtn, s)
-        x = _propagate(x, dt, tau, mu, zonal, max_step, phi)
+        x = propagate_state(x, t[i - 1], dt, tau, args, max_step, phi)
         _time_update_cov(p, phi, s, 1.0, pbar)
         p[:, :] = pbar
         phis[i] = phi
@@ -530,6 +587,6 @@ def forward_kernel_detailed(
                     acc += p[a, m] * sinv[m, b]
                 gains[i, a, b] = acc
         innov = np.empty(6)
-        _measurement_update(x, p, y[i], rdiag[i], innov)
+        measurement_update(x, p, y[i], rdiag[i], innov)
         innovs[i] = innov
     return phis, gains, sinvs, innovs

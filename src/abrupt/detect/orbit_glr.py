@@ -20,11 +20,16 @@ from dataclasses import dataclass
 
 import numba as nb
 import numpy as np
-from numpy.typing import NDArray
 
-from abrupt.detect.orbit_ekf import FilterConfig, _measurements, forward_kernel_detailed, measurement_variances
-
-FloatArray = NDArray[np.float64]
+from abrupt.detect.orbit_ekf import (
+    FilterConfig,
+    forward_kernel_detailed,
+    measurement_variances,
+    measurement_vectors,
+    resolve_context,
+)
+from abrupt.model.orbit import ForceContext
+from abrupt.types import FloatArray
 
 
 @dataclass(frozen=True)
@@ -98,6 +103,8 @@ def localise_jump(
     first: int,
     last: int,
     horizon_s: float,
+    *,
+    context: ForceContext | None = None,
 ) -> JumpEstimate:
     """ML time and ΔV of a single velocity jump between epochs ``first`` and ``last``.
 
@@ -109,8 +116,9 @@ def localise_jump(
     horizon = max(3, round(horizon_s / dt_nom))
     stop = min(n, last + horizon + 1)
     sl = slice(start, stop)
-    y = _measurements(position_m[sl], velocity_mps[sl])
+    y = measurement_vectors(position_m[sl], velocity_mps[sl])
     rdiag = measurement_variances(velocity_mps[sl], sigma_pos_m, sigma_vel_mps, stop - start)
+    ctx = resolve_context(config, t_s, context, None)
     phis, gains, sinvs, innovs = forward_kernel_detailed(
         np.ascontiguousarray(t_s[sl]),
         y,
@@ -119,9 +127,8 @@ def localise_jump(
         p_post[start].copy(),
         config.tau_s,
         config.q_array(),
-        config.mu_m3_s2,
-        config.zonal_degree,
         config.max_step_s,
+        ctx.kernel_args,
     )
     lo = max(1, first - start)
     hi = min(stop - start - 1, last - start)
@@ -201,11 +208,14 @@ def glr_statistic(
     x0: FloatArray,
     p0: FloatArray,
     horizon_s: float,
+    *,
+    context: ForceContext | None = None,
 ) -> FloatArray:
     """Sliding GLR ℓ(θ) (chi-square with 3 degrees of freedom for a matched model, no jump) at every epoch,
     the jump placed mid-interval before θ. Computed from a forward pass started at (x0, p0) at t_s[0]."""
-    y = _measurements(position_m, velocity_mps)
+    y = measurement_vectors(position_m, velocity_mps)
     rdiag = measurement_variances(velocity_mps, sigma_pos_m, sigma_vel_mps, t_s.size)
+    ctx = resolve_context(config, t_s, context, None)
     phis, gains, sinvs, innovs = forward_kernel_detailed(
         np.ascontiguousarray(t_s),
         y,
@@ -214,9 +224,8 @@ def glr_statistic(
         p0,
         config.tau_s,
         config.q_array(),
-        config.mu_m3_s2,
-        config.zonal_degree,
         config.max_step_s,
+        ctx.kernel_args,
     )
     dt_nom = float(np.median(np.diff(t_s)))
     horizon = max(2, round(horizon_s / dt_nom))

@@ -37,12 +37,10 @@ from dataclasses import dataclass, field
 
 import numba as nb
 import numpy as np
-from numpy.typing import NDArray
 
-from abrupt.detect.orbit_ekf import FilterConfig, _propagate
-from abrupt.model.orbit_dynamics import MU_EARTH_M3_S2, orbital_constants
-
-FloatArray = NDArray[np.float64]
+from abrupt.detect.orbit_ekf import FilterConfig, propagate_state
+from abrupt.model.orbit import MU_EARTH_M3_S2, ForceContext, orbital_constants
+from abrupt.types import FloatArray
 
 STATISTIC_NAMES: tuple[str, ...] = (
     "dv_fb",
@@ -270,6 +268,8 @@ def propagated_reference_statistic(
     sigma_pos_m: float,
     sigma_vel_m_s: float,
     span: int = 60,
+    *,
+    context: ForceContext | None = None,
 ) -> float:
     """TS5 (§3.3.5): residuals of propagated reference orbits against the data on the other side.
 
@@ -282,15 +282,14 @@ def propagated_reference_statistic(
     if index < 1 or index >= n:
         return float("nan")
     sig = np.r_[np.full(3, sigma_pos_m), np.full(3, sigma_vel_m_s)]
+    args = (context or config.force_context(None, float(t_s[0]), float(t_s[-1]))).kernel_args
     phi = np.empty((9, 9))
     chi = 0.0
     count = 0
     x = x_forward[index - 1].copy()
     x[6:9] = 0.0
     for k in range(index, min(n, index + span)):
-        x = _propagate(
-            x, t_s[k] - t_s[k - 1], config.tau_s, config.mu_m3_s2, config.zonal_degree, config.max_step_s, phi
-        )
+        x = propagate_state(x, t_s[k - 1], t_s[k] - t_s[k - 1], config.tau_s, args, config.max_step_s, phi)
         res = np.r_[position_m[k], velocity_mps[k]] - x[:6]
         ok = np.isfinite(res)
         chi += float(np.sum((res[ok] / sig[ok]) ** 2))
@@ -298,9 +297,7 @@ def propagated_reference_statistic(
     x = x_backward_prior[index].copy()
     x[6:9] = 0.0
     for k in range(index - 1, max(-1, index - 1 - span), -1):
-        x = _propagate(
-            x, t_s[k] - t_s[k + 1], -config.tau_s, config.mu_m3_s2, config.zonal_degree, config.max_step_s, phi
-        )
+        x = propagate_state(x, t_s[k + 1], t_s[k] - t_s[k + 1], -config.tau_s, args, config.max_step_s, phi)
         res = np.r_[position_m[k], velocity_mps[k]] - x[:6]
         ok = np.isfinite(res)
         chi += float(np.sum((res[ok] / sig[ok]) ** 2))

@@ -29,8 +29,8 @@ from numpy.typing import NDArray
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc
+from abrupt.model.orbit import MU_KADERALI_M3_S2, ForceContext, ForceModel, propagate_with_stm, rsw_basis
 from abrupt.model.tracking_measurements import TrackingArrays, predict_measurement, wrap_angle
-from abrupt.model.tracking_orbit import ForceModel, propagate_with_stm, rsw_basis
 from abrupt.series.tracking import TrackingSeries
 from abrupt.thresholds import FalseAlarmBudget, Threshold, chi2_threshold
 
@@ -39,7 +39,7 @@ from abrupt.thresholds import FalseAlarmBudget, Threshold, chi2_threshold
 class BatchFitConfig:
     """Settings of the least-squares orbit fit. ``estimate_range_bias``: station names (or all if True)."""
 
-    force: ForceModel = field(default_factory=ForceModel)
+    force: ForceModel | ForceContext = field(default_factory=lambda: ForceModel(mu_m3_s2=MU_KADERALI_M3_S2))
     estimate_range_bias: bool | tuple[str, ...] = False
     estimate_angle_bias: bool | tuple[str, ...] = False
     estimate_acceleration: bool = False
@@ -107,7 +107,7 @@ def trajectory(
     t0_s: float,
     t_out_s: NDArray[np.float64],
     *,
-    force: ForceModel,
+    force: ForceModel | ForceContext,
     accel_mps2: NDArray[np.float64],
     impulse_times_s: Sequence[float] = (),
     impulse_dv_rsw: NDArray[np.float64] | None = None,
@@ -457,7 +457,7 @@ def detect_maneuvers_glrt(
     # no outlier rejection while searching: a maneuver's signature must not be rejected as outliers
     scan_cfg = replace(fcfg, outlier_sigma=None)
     fit = fit_orbit(data, x_ap, t0_s=t0_s, config=scan_cfg)
-    mu = fcfg.force.mu_m3_s2
+    mu = (fcfg.force.model if isinstance(fcfg.force, ForceContext) else fcfg.force).mu_m3_s2
     r, v = fit.x0[:3], fit.x0[3:]
     energy = float(v @ v) / 2 - mu / float(np.linalg.norm(r))
     period = 2 * math.pi * math.sqrt((-mu / (2 * energy)) ** 3 / mu) if energy < 0 else 86400.0

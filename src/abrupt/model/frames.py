@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from abrupt.model.orbit.frames import rtn_matrix
 from abrupt.series.ephemeris import Ephemeris, Frame  # Ephemeris lives in abrupt.series; re-exported here
 from abrupt.types import FloatArray
 
@@ -140,18 +141,3 @@ def gcrf_to_itrf(
     v_rot = np.einsum("nij,nj->ni", w, np.asarray(velocity_mps, dtype=np.float64))
     omega = np.array([0.0, 0.0, EARTH_ROTATION_RATE_RAD_S])
     return r, v_rot - np.cross(omega, r)
-
-
-def rtn_matrix(position_m: FloatArray, velocity_mps: FloatArray) -> FloatArray:
-    """(n, 3, 3) matrices whose columns are r̂, t̂, n̂ (orbit frame O in inertial components).
-
-    r̂ = r/|r|, n̂ = r×v/|r×v|, t̂ = n̂×r̂ (along-track, equals v̂ for a circular orbit). A vector's
-    orbit-frame components are ``M^T x``.
-    """
-    r = np.atleast_2d(np.asarray(position_m, dtype=np.float64))
-    v = np.atleast_2d(np.asarray(velocity_mps, dtype=np.float64))
-    r_hat = r / np.linalg.norm(r, axis=1, keepdims=True)
-    h = np.cross(r, v)
-    n_hat = h / np.linalg.norm(h, axis=1, keepdims=True)
-    t_hat = np.cross(n_hat, r_hat)
-    return np.stack([r_hat, t_hat, n_hat], axis=2)

@@ -34,9 +34,9 @@ import pandas as pd
 
 from abrupt.errors import RepairLog
 from abrupt.model.light_time import SPEED_OF_LIGHT_MPS, shapiro_delay_m
+from abrupt.model.orbit import OMEGA_EARTH_RAD_S
 from abrupt.model.station_motion import eccentricity_ecef_m, solid_tide_displacement_m, sun_moon_ecef_m
 from abrupt.model.tracking_measurements import as_datetime64_ns, earth_rotation_matrices
-from abrupt.model.tracking_orbit import OMEGA_EARTH_RAD_S
 from abrupt.model.troposphere import laser_delay_m, radio_delay_m, water_vapour_pressure_hpa
 from abrupt.types import FloatArray
 

@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 if TYPE_CHECKING:
     from abrupt.model.stations import Station
 
-from abrupt.model.tracking_orbit import OMEGA_EARTH_RAD_S
+from abrupt.model.orbit import OMEGA_EARTH_RAD_S
 
 MEASUREMENT_COLUMNS = ("range_m", "azimuth_rad", "elevation_rad", "range_rate_mps")
 EarthRotationModel = Literal["simple", "iers"]

@@ -34,6 +34,7 @@ from abrupt.detect.tracking_glrt import (
     trajectory,
 )
 from abrupt.errors import RepairLog
+from abrupt.model.orbit import ForceContext, ForceModel
 from abrupt.model.range_reduction import RangeModel, StationSite, reduce_ranges
 from abrupt.model.stations import Station
 from abrupt.model.tracking_measurements import TrackingArrays, as_datetime64_ns
@@ -109,9 +110,10 @@ def detect_laser_ranging(
     fcfg = fit_config or BatchFitConfig(estimate_range_bias=True)
     epoch = as_datetime64_ns(epoch_utc)
     # The Sun and Moon of the force model are anchored at the data's own epoch (t = 0 of the fit).
-    fcfg = replace(fcfg, force=replace(fcfg.force, epoch_jd_tt=jd_tt(epoch)))
     repairs = RepairLog("laser ranging")
     t_end = float((np.asarray(measurements["time_utc"]).max() - epoch) / np.timedelta64(1, "s"))
+    model_f = fcfg.force.model if isinstance(fcfg.force, ForceContext) else fcfg.force
+    fcfg = replace(fcfg, force=ForceContext.build(model_f, epoch, -86400.0, t_end + 86400.0))
     gcfg = GlrtConfig(false_alarms_per_day=budget.per_day, max_maneuvers=max_maneuvers)
 
     def build(source: BatchFit | FloatArray, scale: dict[str, float]) -> TrackingArrays:
@@ -241,8 +243,8 @@ def apriori_state_gcrf(ephemeris: object, epoch_utc: np.datetime64) -> FloatArra
     """
     from scipy.interpolate import CubicSpline
 
+    from abrupt.model.orbit import OMEGA_EARTH_RAD_S
     from abrupt.model.tracking_measurements import earth_rotation_matrices
-    from abrupt.model.tracking_orbit import OMEGA_EARTH_RAD_S
 
     times = np.asarray(ephemeris.times_utc, dtype="datetime64[ns]")  # type: ignore[attr-defined]
     t = (times - epoch_utc).astype(np.int64) / 1e9
@@ -271,13 +273,12 @@ def run_laser_ranging_files(
 ) -> LaserRangingRun:
     """Read CRD normal points, SINEX sites and an a-priori ephemeris; detect maneuvers; build events.
 
-    The force model is two-body + J2 + Sun and Moon (``abrupt.model.tracking_orbit.ForceModel``);
+    The force model is two-body + J2 + Sun and Moon (``abrupt.model.orbit.ForceModel``);
     per-station range biases absorb the satellite's centre-of-mass offset.
     """
     from abrupt.detect.tracking_glrt import glrt_events
     from abrupt.events import config_hash, empty_frame, events_frame, new_run_id
     from abrupt.model.stations import Station
-    from abrupt.model.tracking_orbit import ForceModel
     from abrupt.readers.crd import read_crd
     from abrupt.readers.ephemeris import read_ephemeris
     from abrupt.readers.sinex import read_sinex
@@ -308,7 +309,7 @@ def run_laser_ranging_files(
         )
     ephemeris = read_ephemeris(apriori_path)
     x0 = apriori_state_gcrf(ephemeris, epoch)
-    force = ForceModel(mu_m3_s2=3.986004418e14, j2=True, third_body=True)
+    force = ForceModel(mu_m3_s2=3.986004418e14, zonal_degree=2, sun=True, moon=True)
     cfg = BatchFitConfig(force=force, estimate_range_bias=True, max_step_s=step_s)
     result = detect_laser_ranging(
         meas, sites, stations, x0, epoch, budget=budget, range_model=model, fit_config=cfg, max_maneuvers=max_maneuvers

@@ -22,7 +22,7 @@ from abrupt.detect.kaderali import KaderaliManeuverDetector
 from abrupt.detect.tracking_glrt import BatchFit, BatchFitConfig, GlrtManeuverDetector
 from abrupt.errors import RepairLog
 from abrupt.events import config_hash, empty_frame, new_run_id, restamp
-from abrupt.model.tracking_orbit import ForceModel
+from abrupt.model.orbit import ForceContext, ForceModel
 from abrupt.series.tracking import TrackingSeries
 from abrupt.thresholds import FalseAlarmBudget
 
@@ -49,12 +49,12 @@ class TrackingInputs:
     """The series plus what the run record and fit summary need from reading."""
 
     series: TrackingSeries
-    force: ForceModel
+    force: ForceContext
     refraction: bool
     biases: bool
     acceleration: bool
     repairs: RepairLog
-    epoch_jd_tt: float
+    epoch_utc: np.datetime64
 
 
 @dataclass
@@ -103,7 +103,7 @@ def read_tracking_series(
         source=str(file),
     )
     real = any(k.startswith("central.body") or k.startswith("third.body") for k in setup.extra)
-    force, jd_tt = setup_force_model(setup)
+    force, epoch = setup_force_model(setup, float(np.nanmax(data.t_s)) if len(data.t_s) else 0.0)
     biases = any(setup.range_bias_estimated.values()) if settings.estimate_biases is None else settings.estimate_biases
     accel = real if settings.estimate_acceleration is None else settings.estimate_acceleration
     probe = TrackingSeries(data, np.asarray(setup.initial_state, float), BatchFitConfig(force=force))
@@ -117,21 +117,21 @@ def read_tracking_series(
         elevation_mask_deg=settings.elevation_mask_deg,
     )
     series = TrackingSeries(data, np.asarray(setup.initial_state, float), fit_cfg, name=name or Path(file).stem)
-    return TrackingInputs(series, force, use_refraction, biases, accel, repairs, jd_tt)
+    return TrackingInputs(series, force, use_refraction, biases, accel, repairs, epoch)
 
 
-def setup_force_model(setup: Any) -> tuple[ForceModel, float]:
-    """The fit's force model from an Orekit set-up file, and the epoch as a TT Julian date.
+def setup_force_model(setup: Any, span_s: float = 0.0) -> tuple[ForceContext, np.datetime64]:
+    """The fit's force model from an Orekit set-up file, resolved for ``span_s`` seconds (± one day)
+    after the set-up epoch, and that epoch (UTC).
 
-    Two-body with the set-up's μ; J2 when ``central.body.degree`` is at least 2; Sun and Moon when
-    ``third.body.sun`` or ``third.body.moon`` is true.
+    Two-body with the set-up's μ; J2 when ``central.body.degree`` is at least 2; Sun and Moon (ERFA)
+    when ``third.body.sun`` or ``third.body.moon`` is true (the one orbit model, :mod:`abrupt.model.orbit`).
     """
-    from astropy.time import Time
-
     degree = int(float(setup.extra.get("central.body.degree", "0") or 0))
     third = any(setup.extra.get(k, "false").lower() == "true" for k in ("third.body.sun", "third.body.moon"))
-    jd_tt = float(Time(setup.epoch_utc, scale="utc").tt.jd)
-    return ForceModel(mu_m3_s2=setup.mu_m3_s2, j2=degree >= 2, third_body=third, epoch_jd_tt=jd_tt), jd_tt
+    epoch = np.asarray(setup.epoch_utc, dtype="datetime64[ns]").reshape(-1)[0]
+    model = ForceModel(mu_m3_s2=setup.mu_m3_s2, zonal_degree=2 if degree >= 2 else 0, sun=third, moon=third)
+    return ForceContext.build(model, epoch, -86400.0, span_s + 86400.0), epoch
 
 
 def detect_tracking(
@@ -143,7 +143,7 @@ def detect_tracking(
     run_id: str | None = None,
 ) -> TrackingRun:
     """Fit the orbit, run the chosen detectors and collect events, fit summary and diagnostics."""
-    from abrupt.model.tracking_orbit import sun_position_m
+    from abrupt.model.orbit.bodies import sun_moon_gcrf
 
     series, force = inputs.series, inputs.force
     run_settings = {
@@ -156,7 +156,7 @@ def detect_tracking(
         "biases": inputs.biases,
         "accel": inputs.acceleration,
         "refraction": inputs.refraction,
-        "force": [force.mu_m3_s2, force.j2, force.third_body],
+        "force": [force.model.mu_m3_s2, force.model.zonal_degree >= 2, force.model.sun],
         "max_maneuvers": settings.max_maneuvers,
         "kaderali_threshold": settings.kaderali_threshold,
     }
@@ -214,7 +214,7 @@ def detect_tracking(
         if found
         else empty_frame()
     )
-    summary = fit_summary(final_fit, force, sun_position_m(inputs.epoch_jd_tt))
+    summary = fit_summary(final_fit, force.model, sun_moon_gcrf(np.array([inputs.epoch_utc]))[0][0])
     summary["repairs"] = inputs.repairs.as_dict()
     diagnostics = pd.concat(diag_frames, ignore_index=True) if diag_frames else pd.DataFrame()
     return TrackingRun(events, summary, diagnostics, cfg_hash, run_id, run_settings)
@@ -231,7 +231,7 @@ def fit_summary(fit: BatchFit, force: ForceModel, sun_m: Any) -> dict[str, Any]:
         "x0_m_mps": [float(v) for v in fit.x0],
         "range_bias_m": {k: [float(v), fit.sigma(f"range_bias[{k}]")] for k, v in fit.range_bias_m.items()},
         "angle_bias_deg": {k: [math.degrees(v[0]), math.degrees(v[1])] for k, v in fit.angle_bias_rad.items()},
-        "force_model": {"mu_m3_s2": force.mu_m3_s2, "j2": force.j2, "sun_moon": force.third_body},
+        "force_model": {"mu_m3_s2": force.mu_m3_s2, "j2": force.zonal_degree >= 2, "sun_moon": force.sun},
     }
     if "accel_x" in fit.parameter_names:
         a = np.asarray(fit.acceleration_mps2, float)

@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 
 from abrupt.errors import InputError
+from abrupt.model.orbit import MU_EARTH_M3_S2, coe_to_rv
 from abrupt.model.stations import WGS84_A_M, Station
-from abrupt.model.tracking_orbit import MU_EARTH_M3_S2, coe_to_rv
 from abrupt.readers.aer import parse_utc
 
 _KEY = re.compile(r"^(?P<key>[A-Za-z0-9_.]+)\s*(\[\s*(?P<index>\d+)\s*\])?$")

@@ -50,10 +50,11 @@ class TrackingSeries:
 
     def orbit_period_s(self) -> float:
         """Keplerian period of the a-priori state [s] (one day for an unbound state)."""
-        from abrupt.model.tracking_orbit import orbit_period_s
+        from abrupt.model.orbit import ForceContext, orbit_period_s
 
         x = np.asarray(self.x0_apriori_m_mps, dtype=np.float64)
-        mu = self.fit_config.force.mu_m3_s2
+        force = self.fit_config.force
+        mu = (force.model if isinstance(force, ForceContext) else force).mu_m3_s2
         energy = float(np.dot(x[3:], x[3:])) / 2 - mu / float(np.linalg.norm(x[:3]))
         return 86400.0 if energy >= 0 else orbit_period_s(-mu / (2 * energy), mu)
 

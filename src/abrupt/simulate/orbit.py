@@ -2,24 +2,24 @@
 into a real ephemeris.
 
 Bennett 2022 §3.1 (spec §4.2-4.3): Cowell propagation (here ``scipy.integrate.solve_ivp``, DOP853,
-rtol 1e-12) of the forces in :class:`abrupt.model.orbit_dynamics.ForceModel`; a strike is an
-instantaneous ΔV = β m_d v_d / m_s (Eqs. 3.1-3.2) added to the truth velocity; measurements are truth
-plus white Gaussian noise (σ_pos = 10 m, σ_vel = 0.25 m/s per axis, 1 Hz; Table 3.1).
+rtol 1e-12) of the forces in :class:`abrupt.model.orbit.ForceModel` (the one orbit model); a strike is
+an instantaneous ΔV = β m_d v_d / m_s (Eqs. 3.1-3.2) added to the truth velocity; a finite burn is a
+constant acceleration over its duration (:class:`abrupt.model.orbit.FiniteBurn`); measurements are
+truth plus white Gaussian noise (σ_pos = 10 m, σ_vel = 0.25 m/s per axis, 1 Hz; Table 3.1).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
-from scipy.integrate import solve_ivp
 
-from abrupt.model.frames import Ephemeris, rtn_matrix
-from abrupt.model.orbit_dynamics import R_EARTH_M, ForceModel, acceleration, kepler_to_cartesian
-
-FloatArray = NDArray[np.float64]
+from abrupt.model.frames import Ephemeris
+from abrupt.model.orbit import R_EARTH_M, FiniteBurn, ForceContext, ForceModel, kepler_to_cartesian, rtn_matrix
+from abrupt.model.orbit import propagate as propagate_orbit
+from abrupt.types import FloatArray
 
 #: Thesis default ΔV: 2 × 0.2 g × 12 km/s / 200 kg (Table 3.1, Eqs. 3.1-3.2).
 THESIS_DEBRIS_MASS_KG = 0.2e-3  # [kg]
@@ -67,6 +67,7 @@ class OrbitSimulationConfig:
     epoch_utc: str = "2020-01-01T00:00:00"
     forces: ForceModel = field(default_factory=ForceModel)
     impulses: tuple[Impulse, ...] = ()
+    burns: tuple[FiniteBurn, ...] = ()
     seed: int | None = 0
 
     def __post_init__(self) -> None:
@@ -105,17 +106,6 @@ def _to_ns(value: np.datetime64 | str) -> np.datetime64:
     return out
 
 
-def _jd_tt(epoch_utc: np.datetime64) -> float:
-    # UTC→TT offset (69.184 s since 2017) only shifts Sun/Moon positions by seconds of motion.
-    days = (_to_ns(epoch_utc) - np.datetime64("2000-01-01T12:00:00", "ns")).astype(np.float64) * 1e-9
-    return 2451545.0 + (days + 69.184) / 86400.0
-
-
-def _era(epoch_utc: np.datetime64) -> float:
-    days = (_to_ns(epoch_utc) - np.datetime64("2000-01-01T12:00:00", "ns")).astype(np.float64) * 1e-9
-    return float(2 * math.pi * ((0.7790572732640 + 1.00273781191135448 * days / 86400.0) % 1.0))
-
-
 def propagate(
     t0_s: float,
     state0: FloatArray,
@@ -125,41 +115,17 @@ def propagate(
     impulses: list[tuple[float, FloatArray]] | None = None,
     rtol: float = 1e-12,
     atol: float = 1e-6,
+    burns: Sequence[FiniteBurn] = (),
 ) -> FloatArray:
-    """Propagate [r; v] (m, m/s, GCRF) from ``t0_s`` to the times ``t_out_s`` (≥ t0, sorted), applying
-    inertial impulses [(t_s, dv)] on the way. Returns (n, 6)."""
-    epoch = _to_ns(epoch_utc)
-    jd = _jd_tt(epoch)
-    era = _era(epoch)
+    """Propagate [r; v] (m, m/s, GCRF) from ``t0_s`` to the times ``t_out_s`` (≥ t0, sorted; seconds
+    from ``epoch_utc``), applying inertial impulses [(t_s, dv)] and finite burns on the way. Returns
+    (n, 6). See :func:`abrupt.model.orbit.propagate`."""
     t_out = np.asarray(t_out_s, dtype=np.float64)
-    out = np.empty((t_out.size, 6))
-
-    def rhs(t: float, y: FloatArray) -> FloatArray:
-        a = acceleration(t, y[:3], y[3:], forces, jd, era)
-        return np.concatenate([y[3:], a])
-
-    kicks = sorted(impulses or [], key=lambda k: k[0])
-    bounds = [t0_s, *[k[0] for k in kicks if t0_s < k[0] <= (t_out[-1] if t_out.size else t0_s)]]
-    state = np.asarray(state0, dtype=np.float64).copy()
-    t_end = float(t_out[-1]) if t_out.size else t0_s
-    edges = [*bounds, t_end]
-    for seg in range(len(edges) - 1):
-        ta, tb = edges[seg], edges[seg + 1]
-        if seg > 0:
-            state = state.copy()
-            state[3:] += np.asarray(kicks[seg - 1][1], dtype=np.float64)
-        last = seg == len(edges) - 2
-        sel = (t_out >= ta) & ((t_out < tb) | (last & (t_out <= tb)))
-        if tb > ta:
-            sol = solve_ivp(rhs, (ta, tb), state, method="DOP853", rtol=rtol, atol=atol, dense_output=True)
-            if not sol.success:
-                raise RuntimeError(f"orbit propagation failed: {sol.message}")
-            if sel.any():
-                out[sel] = sol.sol(t_out[sel]).T
-            state = sol.y[:, -1]
-        elif sel.any():
-            out[sel] = state
-    return out
+    hi = float(t_out.max()) if t_out.size else t0_s
+    ctx = ForceContext.build(forces, _to_ns(epoch_utc), t0_s, hi)
+    return propagate_orbit(
+        state0, t_out, force=ctx, t0_s=t0_s, impulses=impulses or (), burns=burns, rtol=rtol, atol_m=atol
+    )
 
 
 def simulate_orbit(config: OrbitSimulationConfig) -> SimulatedOrbit:
@@ -184,7 +150,7 @@ def simulate_orbit(config: OrbitSimulationConfig) -> SimulatedOrbit:
             st = propagate(0.0, np.r_[r0, v0], np.array([imp.time_s]), config.forces, epoch, kicks)[0]
             dv = rtn_matrix(st[:3], st[3:])[0] @ dv
         kicks.append((float(imp.time_s), dv))
-    truth = propagate(0.0, np.r_[r0, v0], t, config.forces, epoch, kicks)
+    truth = propagate(0.0, np.r_[r0, v0], t, config.forces, epoch, kicks, burns=config.burns)
     rng = np.random.default_rng(config.seed)
     pos_noise = rng.normal(0.0, config.sigma_pos_m, (n, 3)) if config.sigma_pos_m > 0 else np.zeros((n, 3))
     vel_noise = rng.normal(0.0, config.sigma_vel_mps, (n, 3)) if config.sigma_vel_mps > 0 else np.zeros((n, 3))
@@ -204,12 +170,14 @@ def inject_impulse(
     time_utc: np.datetime64 | str,
     dv_rtn_mps: tuple[float, float, float] | FloatArray,
     forces: ForceModel | None = None,
+    duration_s: float = 0.0,
 ) -> Ephemeris:
-    """Add the effect of a ΔV (orbit frame: radial, along-track, cross-track; m/s) at ``time_utc`` to a
-    real ephemeris: the state at that time (propagated from the last epoch before it) is propagated
-    with and without the ΔV and the difference is added to every later epoch (in GCRF, then
-    converted back to the ephemeris' frame). The force model (default two-body + J2-J4) only shapes
-    the difference, so its errors are second order.
+    """Add the effect of a ΔV (orbit frame at its start: radial, along-track, cross-track; m/s) starting at
+    ``time_utc`` to a real ephemeris: an impulse (``duration_s`` = 0) or a finite burn of constant
+    acceleration ΔV/duration fixed in inertial space at onset. The state of the last epoch before the
+    start is propagated with and without the ΔV and the difference is added to every later epoch (in
+    GCRF, then converted back to the ephemeris' frame). The force model (default two-body + J2-J4) only
+    shapes the difference, so its errors are second order.
     """
     forces = forces or ForceModel(zonal_degree=4)
     gcrf = ephemeris.to_frame("GCRF")
@@ -218,19 +186,18 @@ def inject_impulse(
     t_imp_s = float((t_imp - gcrf.times_utc[0]).astype(np.float64) * 1e-9)
     if not sec[0] <= t_imp_s < sec[-1]:
         raise ValueError(f"injection time {time_utc} is outside the ephemeris span")
+    if duration_s < 0:
+        raise ValueError("burn duration must be non-negative")
     k0 = int(np.searchsorted(sec, t_imp_s, side="right") - 1)
     state0 = np.r_[gcrf.position_m[k0], gcrf.velocity_mps[k0]]
     if not np.isfinite(state0).all():
         raise ValueError("the epoch before the injection time has no velocity; choose another time")
     after = np.flatnonzero(sec > t_imp_s)
-    t_eval = np.r_[t_imp_s, sec[after]]
+    t_eval = sec[after]
+    burn = FiniteBurn(t_imp_s, float(duration_s), tuple(float(x) for x in np.asarray(dv_rtn_mps)))  # type: ignore[arg-type]
     nominal = propagate(sec[k0], state0, t_eval, forces, gcrf.times_utc[0])
-    at_imp = nominal[0]
-    dv_in = rtn_matrix(at_imp[:3], at_imp[3:])[0] @ np.asarray(dv_rtn_mps, dtype=np.float64)
-    kicked_state = at_imp.copy()
-    kicked_state[3:] += dv_in
-    kicked = propagate(t_imp_s, kicked_state, t_eval, forces, gcrf.times_utc[0])
-    delta = kicked[1:] - nominal[1:]
+    kicked = propagate(sec[k0], state0, t_eval, forces, gcrf.times_utc[0], burns=[burn])
+    delta = kicked - nominal
     pos = gcrf.position_m.copy()
     vel = gcrf.velocity_mps.copy()
     pos[after] += delta[:, :3]

@@ -13,16 +13,16 @@ Optionally an impulsive maneuver (a one-second burn) is placed at a given time.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 from scipy.interpolate import CubicHermiteSpline
 
+from abrupt.model.orbit import FiniteBurn, ForceContext, ForceModel, coe_to_rv, propagate
 from abrupt.model.range_reduction import RangeModel, StationSite, model_two_way_ranges
 from abrupt.model.stations import Station
 from abrupt.model.tracking_measurements import earth_rotation_matrices
-from abrupt.model.tracking_orbit import FiniteBurn, ForceModel, coe_to_rv, propagate_truth
 from abrupt.types import FloatArray
 
 MU_EARTH_M3_S2 = 3.986004418e14  # [m³/s²]
@@ -85,7 +85,9 @@ class SlrScenario:
     noise_m: float = 0.003  # [m] 1-σ normal-point precision
     bias_sigma_m: float = 0.005  # [m] spread of the constant per-station range biases
     sinex_epoch: str = "2015-01-01T00:00:00"
-    force: ForceModel = field(default_factory=lambda: ForceModel(mu_m3_s2=MU_EARTH_M3_S2, j2=True, third_body=True))
+    force: ForceModel = field(
+        default_factory=lambda: ForceModel(mu_m3_s2=MU_EARTH_M3_S2, zonal_degree=2, sun=True, moon=True)
+    )
     truth_model: RangeModel = field(default_factory=RangeModel)
     maneuver_t_s: float | None = None
     maneuver_dv_rsw_mps: tuple[float, float, float] = (0.0, 0.0, 0.0)
@@ -102,7 +104,7 @@ class SlrSimulation:
     x0: FloatArray
     range_bias_m: dict[str, float]
     scenario: SlrScenario
-    force: ForceModel  # the truth's force model, Sun and Moon anchored at the campaign's start
+    force: ForceContext  # the truth's force model, Sun and Moon (ERFA) at the campaign's own dates
 
 
 def trajectory_interpolator(t_grid_s: FloatArray, states: FloatArray) -> CubicHermiteSpline:
@@ -125,15 +127,14 @@ def simulate_slr(scenario: SlrScenario, *, seed: int = 0, grid_step_s: float = 2
         math.radians(scenario.nu0_deg),
         mu,
     )
-    from abrupt.pipelines.laser_ranging import jd_tt
 
-    force = replace(scenario.force, epoch_jd_tt=jd_tt(epoch))  # Sun and Moon of the campaign's own dates
     duration = scenario.duration_days * 86400.0
     grid = np.arange(0.0, duration + 2 * grid_step_s, grid_step_s)
+    force = ForceContext.build(scenario.force, epoch, -86400.0, float(np.max(grid)) + 86400.0)
     burns = []
     if scenario.maneuver_t_s is not None:
         burns.append(FiniteBurn(scenario.maneuver_t_s, 1.0, scenario.maneuver_dv_rsw_mps))
-    states = propagate_truth(x0, grid, burns, force=force)
+    states = propagate(x0, grid, burns=burns, force=force)
     sat = trajectory_interpolator(grid, states)
 
     sites = {

@@ -17,6 +17,14 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from abrupt.events import Event, empty_frame, events_frame, format_time_utc
+from abrupt.model.orbit import MU_KADERALI_M3_S2 as MU_THESIS_M3_S2
+from abrupt.model.orbit import (
+    FiniteBurn,
+    ForceModel,
+    coe_to_rv,
+    orbit_period_s,
+    propagate,
+)
 from abrupt.model.stations import Station, ascension
 from abrupt.model.tracking_measurements import (
     MEASUREMENT_COLUMNS,
@@ -24,14 +32,6 @@ from abrupt.model.tracking_measurements import (
     as_datetime64_ns,
     earth_rotation_matrices,
     predict_many,
-)
-from abrupt.model.tracking_orbit import (
-    MU_THESIS_M3_S2,
-    FiniteBurn,
-    ForceModel,
-    coe_to_rv,
-    orbit_period_s,
-    propagate_truth,
 )
 
 Location = Literal["perigee", "apogee", "quarter_after_perigee", "quarter_after_apogee"]
@@ -144,7 +144,7 @@ def simulate_tracking(scenario: TrackingScenario, *, seed: int | None = 0) -> Tr
     t_end = scenario.total_duration_s()
     t = np.arange(0.0, t_end + 1e-9, scenario.cadence_s)
     force = ForceModel(mu_m3_s2=scenario.mu_m3_s2)
-    states = propagate_truth(x0, t, scenario.burns, force=force)
+    states = propagate(x0, t, burns=scenario.burns, force=force)
     epoch = as_datetime64_ns(scenario.epoch_utc)
     c_fi = earth_rotation_matrices(t, model=scenario.earth_rotation, epoch_utc=epoch, theta0_rad=scenario.theta0_rad)
     frames = []

@@ -379,3 +379,36 @@ def episode_rate(
         episodes = 1 + int(np.count_nonzero(np.diff(above) > min_separation_samples))
     days = s.size / (sample_rate_hz * SECONDS_PER_DAY)
     return episodes, episodes / days if days > 0 else float("nan")
+
+
+def gpd_return_level_upper(x: NDArray[np.float64], p_fa: float, *, tail_fraction: float, z: float = 1.0) -> float:
+    """Upper confidence bound of the value exceeded with probability ``p_fa`` per sample (peaks over the
+    (1 − ``tail_fraction``) quantile u, generalised Pareto excesses with scale σ and shape ξ).
+
+    Return level (Coles 2001, Eq. 4.12): x_p = u + σ/ξ·(r^ξ − 1), r = tail_fraction/p_fa (→ u + σ ln r as
+    ξ → 0). Its variance by the delta method, ∇x_pᵀ V ∇x_p, with the asymptotic covariance of the ML fit of
+    n excesses V = (1+ξ)/n·[[2σ², σ], [σ, 1+ξ]] (Smith 1987, valid for ξ > −1/2; ξ is floored at −0.45
+    for V). Returns x_p + z·sd(x_p); z = 0 gives the point estimate (:func:`abrupt.thresholds.gpd_quantile`).
+    """
+    x = np.asarray(x, dtype=np.float64)
+    if p_fa >= tail_fraction:
+        return float(np.quantile(x, 1.0 - p_fa))
+    u = float(np.quantile(x, 1.0 - tail_fraction))
+    excess = x[x > u] - u
+    if excess.size < 30:
+        raise ValueError("too few tail samples for a generalised Pareto fit; give more event-free data")
+    xi, _, sigma = stats.genpareto.fit(excess, floc=0.0)
+    r = tail_fraction / p_fa
+    log_r = float(np.log(r))
+    if abs(xi) < 1e-6:
+        level = u + sigma * log_r
+        grad = np.array([log_r, 0.5 * sigma * log_r**2])
+    else:
+        rx = r**xi
+        level = u + sigma / xi * (rx - 1.0)
+        grad = np.array([(rx - 1.0) / xi, -sigma / xi**2 * (rx - 1.0) + sigma / xi * rx * log_r])
+    if z == 0.0:
+        return float(level)
+    xe = max(float(xi), -0.45)
+    cov = (1.0 + xe) / excess.size * np.array([[2.0 * sigma**2, sigma], [sigma, 1.0 + xe]])
+    return float(level + z * np.sqrt(max(0.0, float(grad @ cov @ grad))))

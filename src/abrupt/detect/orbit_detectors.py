@@ -1,0 +1,239 @@
+"""Orbit detectors as :class:`~abrupt.detect.base.Detector` classes: one per statistic, ``orbit.<statistic>``.
+
+All share the same machinery (:mod:`abrupt.detect.orbit_detector`: forward EKF-DMC with the one orbit
+model, mirrored backward filter, Fraser-Potter fusion, statistics, thresholds, events; Bennett 2022
+ch. 3) and differ in the statistic that raises events:
+
+======================  ==========================================================================
+``orbit.glr``           sliding generalised likelihood ratio of a velocity jump (default, real data)
+``orbit.accel_smoothed``  smoothed unmodelled acceleration w_S (TS3, Bennett 2022 §3.3.3)
+``orbit.mcr_w``         McReynolds consistency of the acceleration states (TS4)
+``orbit.mcr_scalar``    scalar McReynolds consistency (TS4, inverse form)
+``orbit.mahalanobis_v``  velocity Mahalanobis distance (TS2)
+``orbit.dv_fb``         forward-backward velocity difference (TS1)
+``orbit.d_sma``, ``orbit.d_ecc``, ``orbit.d_hdir``  change of orbital constants (TS6)
+======================  ==========================================================================
+
+Settings (constructor keywords): ``tuning`` ("auto": τ, q and measurement sigmas from the data with
+the full force model; "thesis": Table 3.1, two-body), overrides ``tau_s``, ``q_m2_s5``,
+``sigma_pos_m``, ``sigma_vel_mps``, ``dynamics`` ("two-body", "j2".."j4", "field"),
+``gravity_degree``, ``null`` (an event-free :class:`~abrupt.model.frames.Ephemeris` of the same
+satellite for thresholds; default: the arc itself with leave-out), ``confidence_z`` (standard errors
+added to a self-calibrated level) and ``kind``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any, ClassVar
+
+import numpy as np
+
+from abrupt.detect.base import DetectionResult, Detector, Diagnostics
+from abrupt.detect.orbit_detector import (
+    OrbitAnalysis,
+    OrbitDetectorConfig,
+    analyse,
+    auto_tune,
+    calibrate_thresholds,
+    find_events,
+    innovation_scale,
+    self_calibrate,
+)
+from abrupt.detect.orbit_ekf import FilterConfig
+from abrupt.events import config_hash
+from abrupt.model.frames import Ephemeris
+from abrupt.thresholds import FalseAlarmBudget, Threshold
+
+TUNINGS = ("auto", "thesis")
+DYNAMICS = {"two-body": 0, "j2": 2, "j3": 3, "j4": 4, "field": -1}
+DEFAULT_GRAVITY_DEGREE = 40  # chosen from benchmarks/bench_orbit_forces.py (post-fit residuals, S3A and Jason-1)
+
+
+class OrbitDetector(Detector[Ephemeris]):
+    """Base of the orbit detectors; subclasses set ``name`` and ``statistic``."""
+
+    series_type: ClassVar[type] = Ephemeris
+    kind: ClassVar[str] = "unknown"
+    statistic: ClassVar[str] = "glr"
+
+    def __init__(
+        self,
+        *,
+        tuning: str = "auto",
+        tau_s: float | None = None,
+        q_m2_s5: float | None = None,
+        sigma_pos_m: float | None = None,
+        sigma_vel_mps: float | None = None,
+        dynamics: str | None = None,
+        gravity_degree: int = DEFAULT_GRAVITY_DEGREE,
+        null: Ephemeris | None = None,
+        confidence_z: float = 1.0,
+        kind: str | None = None,
+        spacecraft: str | None = None,
+        run_id: str = "",
+    ) -> None:
+        if tuning not in TUNINGS:
+            raise ValueError(f"tuning must be one of {TUNINGS}, got {tuning!r}")
+        if dynamics is not None and dynamics not in DYNAMICS:
+            raise ValueError(f"dynamics must be one of {tuple(DYNAMICS)}, got {dynamics!r}")
+        if confidence_z < 0:
+            raise ValueError("confidence_z must be non-negative")
+        if gravity_degree < 2:
+            raise ValueError("gravity_degree must be at least 2")
+        self.tuning = tuning
+        self.tau_s = tau_s
+        self.q_m2_s5 = q_m2_s5
+        self.sigma_pos_m = sigma_pos_m
+        self.sigma_vel_mps = sigma_vel_mps
+        self.dynamics = dynamics
+        self.gravity_degree = gravity_degree
+        self.confidence_z = confidence_z
+        self.event_kind = kind or type(self).kind
+        self.spacecraft = spacecraft
+        self.run_id = run_id
+        self._null = null
+        self.last_analysis: OrbitAnalysis | None = None
+        self.last_thresholds: dict[str, Threshold] = {}
+
+    def config(self) -> dict[str, Any]:
+        out = super().config()
+        out.pop("last_analysis", None)
+        out.pop("last_thresholds", None)
+        out["null"] = self._null is not None
+        return out
+
+    # ------------------------------------------------------------------ configuration
+    def detector_config(self, eph: Ephemeris, budget: FalseAlarmBudget) -> OrbitDetectorConfig:
+        """Filter tuning and detector settings for ``eph`` (auto tuning reads the data itself)."""
+        dyn = self.dynamics or ("field" if self.tuning == "auto" else "two-body")
+        zonal = max(0, DYNAMICS[dyn])
+        degree = self.gravity_degree if dyn == "field" else 0
+        if self.tuning == "auto":
+            fc, s_pos, s_vel = auto_tune(eph, zonal_degree=zonal, gravity_degree=degree, third_body=degree > 0)
+            settle = max(20.0 * fc.tau_s, 30.0 * eph.nominal_step_s)
+        else:
+            fc = FilterConfig(zonal_degree=zonal, gravity_degree=degree, third_body=degree > 0)
+            s_pos, s_vel, settle = 10.0, 0.25, 1800.0
+        if self.tau_s is not None:
+            fc = replace(fc, tau_s=self.tau_s)
+        if self.q_m2_s5 is not None:
+            fc = replace(fc, q_rtn_m2_s5=(self.q_m2_s5,) * 3)
+        return OrbitDetectorConfig(
+            filter=fc,
+            sigma_pos_m=self.sigma_pos_m if self.sigma_pos_m is not None else float(s_pos),
+            sigma_vel_mps=self.sigma_vel_mps if self.sigma_vel_mps is not None else float(s_vel),
+            settle_s=settle,
+            statistic=self.statistic,
+            false_alarms_per_day=budget.per_day,
+            kind=self.event_kind,
+            orbital_constants=self.statistic in ("d_sma", "d_ecc", "d_hdir"),
+        )
+
+    # ------------------------------------------------------------------ detection
+    def detect(self, series: Ephemeris, budget: FalseAlarmBudget) -> DetectionResult:
+        if len(series) < 10:
+            return DetectionResult.empty(warnings=(f"{len(series)} epochs: too few to filter",))
+        cfg = self.detector_config(series, budget)
+        analysis = analyse(series, cfg)
+        if self._null is not None:
+            null = analyse(self._null, cfg)
+            thresholds = calibrate_thresholds(
+                null.statistics, sample_rate_hz=null.sample_rate_hz, false_alarms_per_day=budget.per_day
+            )
+        else:
+            thresholds = self_calibrate(analysis, false_alarms_per_day=budget.per_day, confidence_z=self.confidence_z)
+        self.last_analysis = analysis
+        self.last_thresholds = thresholds
+        warnings: tuple[str, ...] = ()
+        if self.statistic not in thresholds:
+            warnings = (
+                f"too few event-free epochs to set a threshold for {self.statistic}; "
+                "give a longer arc or event-free data (null)",
+            )
+            return DetectionResult.empty(warnings=warnings, diagnostics=self._diagnostics(analysis, thresholds))
+        chash = config_hash({**self.config(), "budget": str(budget)})
+        events = find_events(
+            analysis, thresholds, spacecraft=self.spacecraft or series.satellite, run_id=self.run_id, cfg_hash=chash
+        )
+        return DetectionResult(events, self._diagnostics(analysis, thresholds), warnings)
+
+    def _diagnostics(self, analysis: OrbitAnalysis, thresholds: dict[str, Threshold]) -> tuple[Diagnostics, ...]:
+        cfg = analysis.config
+        noise = {
+            "tau_s": cfg.filter.tau_s,
+            "q_m2_s5": cfg.filter.q_rtn_m2_s5[0],
+            "sigma_pos_m": cfg.sigma_pos_m,
+            "sigma_vel_mps": cfg.sigma_vel_mps,
+            "innovation_scale": innovation_scale(analysis),
+        }
+        epoch = analysis.ephemeris.times_utc[0]
+        out = [
+            Diagnostics(
+                name=f"orbit.{self.statistic}",
+                time_s=analysis.t_s,
+                statistic=analysis.statistics[self.statistic],
+                threshold=thresholds.get(self.statistic),
+                epoch_utc=epoch,
+                unit="",
+                noise_model=noise,
+            )
+        ]
+        for key, values in analysis.statistics.items():
+            if key != self.statistic and np.isfinite(values).any():
+                out.append(Diagnostics(f"orbit.{key}", analysis.t_s, values, thresholds.get(key), epoch))
+        return tuple(out)
+
+
+class OrbitGlr(OrbitDetector):
+    name = "orbit.glr"
+    statistic = "glr"
+    summary = "sliding GLR of a velocity jump in the forward filter's innovations (default)"
+
+
+class OrbitAccelSmoothed(OrbitDetector):
+    name = "orbit.accel_smoothed"
+    statistic = "accel_smoothed"
+    summary = "smoothed unmodelled acceleration (Bennett 2022 TS3)"
+
+
+class OrbitMcrW(OrbitDetector):
+    name = "orbit.mcr_w"
+    statistic = "mcr_w"
+    summary = "McReynolds consistency of the acceleration states (Bennett 2022 TS4)"
+
+
+class OrbitMcrScalar(OrbitDetector):
+    name = "orbit.mcr_scalar"
+    statistic = "mcr_scalar"
+    summary = "scalar McReynolds consistency (Bennett 2022 TS4)"
+
+
+class OrbitMahalanobisV(OrbitDetector):
+    name = "orbit.mahalanobis_v"
+    statistic = "mahalanobis_v"
+    summary = "velocity Mahalanobis distance (Bennett 2022 TS2)"
+
+
+class OrbitDvFb(OrbitDetector):
+    name = "orbit.dv_fb"
+    statistic = "dv_fb"
+    summary = "forward-backward velocity difference (Bennett 2022 TS1)"
+
+
+class OrbitDSma(OrbitDetector):
+    name = "orbit.d_sma"
+    statistic = "d_sma"
+    summary = "change of semi-major axis (Bennett 2022 TS6)"
+
+
+class OrbitDEcc(OrbitDetector):
+    name = "orbit.d_ecc"
+    statistic = "d_ecc"
+    summary = "change of eccentricity vector (Bennett 2022 TS6)"
+
+
+class OrbitDHdir(OrbitDetector):
+    name = "orbit.d_hdir"
+    statistic = "d_hdir"
+    summary = "change of angular-momentum direction (Bennett 2022 TS6)"

@@ -1,0 +1,247 @@
+"""Orbit propagation with the one force model: Cowell truth integration with impulses and finite burns,
+and a fixed-step RK4 of the state with its state-transition matrix for the filters and batch fits.
+
+* :func:`propagate`: DOP853 (``scipy.integrate.solve_ivp``, rtol 1e-12) piecewise between break-points
+  at every impulse and every burn start and end, so no adaptive step steps over a short burn
+  (Kaderali 2021 Eqs. 2.5-2.7, spec §4.1 erratum 10; Bennett 2022 §3.1 impulses, Eqs. 3.1-3.2).
+  A burn is a constant acceleration ΔV/duration, fixed in the inertial frame at burn onset (Kaderali
+  2021 §4.1) or following the orbit frame (``rotating``).
+* :func:`propagate_with_stm`: RK4 (numba) of the state, the STM (Kaderali 2021 Eqs. 3.3-3.4) and the
+  sensitivity to a constant acceleration. The STM uses the two-body gradient only (Eq. 3.4).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numba as nb
+import numpy as np
+
+from abrupt.model.orbit.forces import ForceContext, ForceModel, acceleration, acceleration_kernel
+from abrupt.model.orbit.frames import rsw_basis
+from abrupt.types import FloatArray
+
+
+@dataclass(frozen=True)
+class FiniteBurn:
+    """A constant-acceleration burn (Kaderali 2021, Eq. 2.7: U = Δv / t_man during the burn).
+
+    ``dv_rsw_mps`` are the radial, transverse and normal components (m/s); the direction is fixed in the
+    inertial frame at burn onset (Kaderali 2021 §4.1) unless ``rotating`` is set. A zero duration is an
+    impulse.
+    """
+
+    t_start_s: float
+    duration_s: float
+    dv_rsw_mps: tuple[float, float, float]
+    rotating: bool = False
+
+    def __post_init__(self) -> None:
+        if self.duration_s < 0:
+            raise ValueError("burn duration must be non-negative")
+
+    @property
+    def t_end_s(self) -> float:
+        return self.t_start_s + self.duration_s
+
+    @property
+    def dv_mps(self) -> float:
+        return float(np.linalg.norm(self.dv_rsw_mps))
+
+
+def _context(force: ForceModel | ForceContext | None, t_lo: float, t_hi: float) -> ForceContext:
+    if isinstance(force, ForceContext):
+        return force
+    return ForceContext.build(force or ForceModel(), None, t_lo, t_hi)
+
+
+def propagate(
+    state0: FloatArray,
+    t_out_s: FloatArray,
+    *,
+    force: ForceModel | ForceContext | None = None,
+    t0_s: float = 0.0,
+    impulses: Sequence[tuple[float, FloatArray]] = (),
+    burns: Sequence[FiniteBurn] = (),
+    rtol: float = 1e-12,
+    atol_m: float = 1e-6,
+) -> FloatArray:
+    """States (n, 6) at ``t_out_s`` (s from the force context's epoch; sorted, ≥ ``t0_s``) from ``state0``
+    at ``t0_s``, with inertial impulses [(t_s, dv)] and finite burns on the way. An output time equal to
+    an impulse time gets the state after the impulse (a measurement at that epoch sees it)."""
+    t_out = np.asarray(t_out_s, dtype=np.float64)
+    if t_out.size == 0:
+        return np.empty((0, 6))
+    if np.any(np.diff(t_out) < 0) or t_out[0] < t0_s:
+        raise ValueError("output times must be increasing and not before t0_s")
+    t_end = float(t_out[-1])
+    ctx = _context(force, t0_s, t_end)
+    kicks = sorted((float(t), np.asarray(dv, dtype=np.float64)) for t, dv in impulses if t0_s <= t <= t_end)
+    edges = sorted({t0_s, t_end, *[k[0] for k in kicks], *[b.t_start_s for b in burns], *[b.t_end_s for b in burns]})
+    edges = [e for e in edges if t0_s <= e <= t_end]
+    out = np.full((t_out.size, 6), np.nan)
+    state = np.asarray(state0, dtype=np.float64).copy()
+    onset: dict[int, FloatArray] = {}
+    if len(edges) == 1:
+        out[:] = state
+    for j, (ta, tb) in enumerate(itertools.pairwise(edges)):
+        for tk, dv in kicks:
+            if tk == ta:
+                state = state.copy()
+                state[3:] += dv
+        mid = 0.5 * (ta + tb)
+        fixed = np.zeros(3)
+        rotating: list[FloatArray] = []
+        for k, b in enumerate(burns):
+            if not (b.t_start_s <= mid < b.t_end_s) or b.duration_s <= 0:
+                continue
+            u = np.asarray(b.dv_rsw_mps, dtype=np.float64) / b.duration_s
+            if b.rotating:
+                rotating.append(u)
+            else:
+                if k not in onset:
+                    onset[k] = rsw_basis(state)
+                fixed += onset[k] @ u
+        for b in burns:  # impulsive burns (zero duration) at this edge
+            if b.duration_s == 0 and b.t_start_s == ta:
+                state = state.copy()
+                state[3:] += rsw_basis(state) @ np.asarray(b.dv_rsw_mps, dtype=np.float64)
+
+        def rhs(
+            t: float, y: FloatArray, fixed: FloatArray = fixed, rotating: list[FloatArray] = rotating
+        ) -> FloatArray:
+            acc = acceleration(t, y[:3], y[3:], ctx) + fixed
+            for u in rotating:
+                acc = acc + rsw_basis(y) @ u
+            return np.concatenate([y[3:], acc])
+
+        last = j == len(edges) - 2
+        sel = (t_out >= ta) & ((t_out < tb) | (last & (t_out <= tb)))
+        sol = solve_segment(rhs, ta, tb, state, rtol, atol_m)
+        if sel.any():
+            out[sel] = sol.sol(t_out[sel]).T
+        state = sol.y[:, -1]
+    return out
+
+
+def solve_segment(rhs, ta: float, tb: float, state: FloatArray, rtol: float, atol: float):
+    """DOP853 over [ta, tb] with dense output; raises RuntimeError when the integrator fails."""
+    from scipy.integrate import solve_ivp
+
+    sol = solve_ivp(rhs, (ta, tb), state, method="DOP853", rtol=rtol, atol=atol, dense_output=True)
+    if not sol.success:
+        raise RuntimeError(f"orbit propagation failed: {sol.message}")
+    return sol
+
+
+# ----------------------------------------------------------------------------------------------
+# RK4 with STM (numba)
+
+
+@nb.njit(cache=True)
+def _two_body_gradient(r: FloatArray, mu: float) -> FloatArray:
+    rn = math.sqrt(r[0] ** 2 + r[1] ** 2 + r[2] ** 2)
+    g = np.empty((3, 3))
+    for j in range(3):
+        for k in range(3):
+            g[j, k] = 3.0 * mu * r[j] * r[k] / rn**5
+        g[j, j] -= mu / rn**3
+    return g
+
+
+@nb.njit(cache=True)
+def _stm_derivative(y: FloatArray, t_s: float, a_const: FloatArray, args: tuple) -> FloatArray:
+    """State (6) + STM (36) + constant-acceleration sensitivity (18), flattened row-major."""
+    out = np.empty(60)
+    r = y[0:3]
+    out[0:3] = y[3:6]
+    out[3:6] = acceleration_kernel(t_s, r, y[3:6], *args) + a_const
+    lam = _two_body_gradient(r, args[1][0])
+    phi = y[6:42].reshape(6, 6)
+    sens = y[42:60].reshape(6, 3)
+    dphi = np.empty((6, 6))
+    dphi[0:3, :] = phi[3:6, :]
+    dphi[3:6, :] = lam @ np.ascontiguousarray(phi[0:3, :])
+    dsens = np.empty((6, 3))
+    dsens[0:3, :] = sens[3:6, :]
+    dsens[3:6, :] = lam @ np.ascontiguousarray(sens[0:3, :])
+    for j in range(3):
+        dsens[3 + j, j] += 1.0
+    out[6:42] = dphi.reshape(36)
+    out[42:60] = dsens.reshape(18)
+    return out
+
+
+@nb.njit(cache=True)
+def _rk4_stm(
+    x0: FloatArray,
+    t0_s: float,
+    t_eval_s: FloatArray,
+    max_step_s: float,
+    a_const: FloatArray,
+    reset_stm: bool,
+    args: tuple,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    n = t_eval_s.shape[0]
+    states = np.empty((n, 6))
+    stms = np.empty((n, 6, 6))
+    sens = np.empty((n, 6, 3))
+    y = np.zeros(60)
+    y[0:6] = x0
+    for j in range(6):
+        y[6 + 7 * j] = 1.0
+    t = t0_s
+    for i in range(n):
+        dt_total = t_eval_s[i] - t
+        nsub = max(1, math.ceil(abs(dt_total) / max_step_s - 1e-9))
+        h = dt_total / nsub
+        for _ in range(nsub):
+            k1 = _stm_derivative(y, t, a_const, args)
+            k2 = _stm_derivative(y + 0.5 * h * k1, t + 0.5 * h, a_const, args)
+            k3 = _stm_derivative(y + 0.5 * h * k2, t + 0.5 * h, a_const, args)
+            k4 = _stm_derivative(y + h * k3, t + h, a_const, args)
+            y = y + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            t += h
+        t = t_eval_s[i]
+        states[i] = y[0:6]
+        stms[i] = y[6:42].reshape(6, 6)
+        sens[i] = y[42:60].reshape(6, 3)
+        if reset_stm:
+            y[6:60] = 0.0
+            for j in range(6):
+                y[6 + 7 * j] = 1.0
+    return states, stms, sens
+
+
+def propagate_with_stm(
+    x0: FloatArray,
+    t0_s: float,
+    t_eval_s: FloatArray,
+    *,
+    force: ForceModel | ForceContext | None = None,
+    accel_mps2: Sequence[float] | FloatArray = (0.0, 0.0, 0.0),
+    max_step_s: float = 5.0,
+    step_wise: bool = False,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """States (n,6), STMs (n,6,6) and constant-acceleration sensitivities (n,6,3) at ``t_eval_s``.
+
+    RK4 with at most ``max_step_s`` per step. With ``step_wise`` the STM is Φ(t_i, t_{i-1}) (reset
+    every output, as in the EKF, Kaderali 2021 Appendix A step 2); otherwise Φ(t_i, t0). The STM uses
+    the two-body gradient only (Eq. 3.4).
+    """
+    t_eval = np.ascontiguousarray(np.asarray(t_eval_s, dtype=np.float64))
+    lo = min(float(t0_s), float(t_eval.min())) if t_eval.size else float(t0_s)
+    hi = max(float(t0_s), float(t_eval.max())) if t_eval.size else float(t0_s)
+    ctx = _context(force, lo, hi)
+    return _rk4_stm(
+        np.ascontiguousarray(np.asarray(x0, dtype=np.float64)),
+        float(t0_s),
+        t_eval,
+        float(max_step_s),
+        np.ascontiguousarray(np.asarray(accel_mps2, dtype=np.float64)),
+        bool(step_wise),
+        ctx.kernel_args,
+    )
