@@ -14,6 +14,7 @@ from typing import Any
 import click
 
 from abrupt.cli.groups import catalog_option, cli, detect, record_run, report, spacecraft_name_option
+from abrupt.errors import InputError
 
 norad_option = click.option(
     "--norad",
@@ -155,6 +156,24 @@ def _read_truth(path: str) -> Any:
     return read_ids_maneuvers(path)
 
 
+def chance_matches(n_det: int, n_truth: int, tolerance_s: float, start: Any, end: Any, events: Any) -> float:
+    """Matches expected by chance: detections spread uniformly over the span, each truth matched when a
+    detection falls within ± tolerance (Poisson: 1 − exp(−n_det·2·tol/span) per truth)."""
+    import math
+
+    import pandas as pd
+
+    if start is None or end is None:
+        if len(events) < 2:
+            return 0.0
+        times = pd.to_datetime(events["time_utc"].astype(str), utc=True)
+        start, end = times.min(), times.max()
+    span_s = (pd.Timestamp(end) - pd.Timestamp(start)).total_seconds()
+    if span_s <= 0:
+        return 0.0
+    return n_truth * (1.0 - math.exp(-n_det * 2.0 * tolerance_s / span_s))
+
+
 @cli.command("score")
 @click.argument("events_path", type=click.Path(exists=True, dir_okay=False))
 @click.option(
@@ -218,8 +237,23 @@ def score(
 
         el = read_elements(elements).elements
         start, end = str(el["epoch_utc"].iloc[0]), str(el["epoch_utc"].iloc[-1])
+    if len(truth_frame) == 0:
+        raise InputError("truth file lists no maneuvers: nothing to score against", file=truth)
     tol = tolerance_days * 86400.0
     result = score_events(events, truth_frame, tolerance_s=tol, start=start, end=end)
+    if result.n_truth == 0:
+        raise InputError("no truth maneuver inside the observed span: nothing to score against", file=truth)
+    chance = chance_matches(result.n_detections, result.n_truth, tol, start, end, events)
+    if result.n_truth >= 5:
+        from scipy.stats import binom
+
+        p_chance = float(binom.sf(result.true_positives - 1, result.n_truth, chance / result.n_truth))
+        if p_chance > 0.01:  # as many matches as random times would give: likely another satellite's file
+            click.echo(
+                f"warning: {result.true_positives} match(es) where chance alone gives {chance:.1f} "
+                f"(p = {p_chance:.2g}): are the events and the truth file of the same satellite?",
+                err=True,
+            )
     out: dict[str, Any] = {"events": events_path, "truth": truth, **result.as_dict()}
     click.echo(
         f"tolerance ±{tolerance_days:g} d, one-to-one: {result.n_detections} detections, "
