@@ -80,7 +80,7 @@ def random_strikes(n: int, duration_s: float, dh_min: float, dh_max: float, seed
     type=float,
     default=4e-5,
     show_default=True,
-    help="Body-rate telemetry noise σ [rad/s] (spec §3.6; Table 2.1 prints 2e-4).",
+    help="Body-rate telemetry noise σ [rad/s] (the thesis thresholds imply 4e-5; its Table 2.1 prints 2e-4).",
 )
 @click.option("--no-noise", is_flag=True, help="Noise-free simulation.")
 @click.option("--strike", "strikes", multiple=True, help="TIME_S:DHX,DHY,DHZ (body axes, N·m·s); repeatable.")
