@@ -315,8 +315,8 @@ def run_attitude_detection(
     "report_path",
     type=click.Path(dir_okay=False),
     default=None,
-    callback=check_suffix(".png", ".html"),
-    help="Also write the report figure (.png or .html).",
+    callback=check_suffix(".png", ".svg", ".pdf", ".html"),
+    help="Also write the report (.png, .svg, .pdf or a self-contained .html page).",
 )
 def detect_attitude_cmd(
     telemetry: str,
@@ -371,8 +371,8 @@ def detect_attitude_cmd(
     "--out",
     type=click.Path(dir_okay=False),
     required=True,
-    callback=check_suffix(".png", ".html"),
-    help="Figure (.png) or page (.html).",
+    callback=check_suffix(".png", ".svg", ".pdf", ".html"),
+    help="Figure (.png, .svg, .pdf) or self-contained page (.html).",
 )
 def report_attitude_cmd(
     telemetry: str, spacecraft_path: str, calibration: str | None, truth: str | None, out: str, **settings: Any
