@@ -105,7 +105,7 @@ def clip_with_markers(ax: Any, x: NDArray[Any], y: NDArray[np.float64], lo: floa
             color="tab:red",
             ms=5,
             clip_on=False,
-            label=f"off-scale above: {int(above.sum())} point(s), up to {np.max(y[above]):.4g}{unit}",
+            label=f"off-scale above: {int(above.sum())} point(s), up to {np.max(y[above]):.6g}{unit}",
         )
     if below.any():
         ax.plot(
@@ -115,7 +115,7 @@ def clip_with_markers(ax: Any, x: NDArray[Any], y: NDArray[np.float64], lo: floa
             color="tab:red",
             ms=5,
             clip_on=False,
-            label=f"off-scale below: {int(below.sum())} point(s), down to {np.min(y[below]):.4g}{unit}",
+            label=f"off-scale below: {int(below.sum())} point(s), down to {np.min(y[below]):.6g}{unit}",
         )
     return n
 
