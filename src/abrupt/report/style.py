@@ -12,7 +12,7 @@ from __future__ import annotations
 import base64
 import io
 import zlib
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -61,7 +61,7 @@ def robust_baseline(y: NDArray[np.float64], n: int) -> NDArray[np.float64]:
 
 def draw_events(
     axes: Iterable[Any],
-    times_by_detector: dict[str, Sequence[float]],
+    times_by_detector: Mapping[str, Sequence[float]],
     *,
     alpha: float = 0.55,
     lw: float = 0.9,
