@@ -116,3 +116,40 @@ def test_html_report_is_self_contained_and_renders_in_headless_chromium(attitude
     non_white = np.mean(np.any(img < 0.9, axis=-1))
     assert non_white > 0.05  # the figure rendered (a blank or broken page is nearly all white)
     assert img.std() > 0.05
+
+
+def test_tracking_log_axis_has_several_labelled_ticks_over_a_narrow_span(tmp_path: Path) -> None:
+    import matplotlib.pyplot as plt
+
+    from abrupt.report.tracking import readable_log_axis
+
+    fig, ax = plt.subplots()
+    ax.semilogy([0, 1, 2], [1.5, 4.0, 9.0])
+    readable_log_axis(ax)
+    fig.canvas.draw()
+    lo, hi = ax.get_ylim()
+    labels = [t.get_text() for t in ax.get_yticklabels() if t.get_text() and lo <= t.get_position()[1] <= hi]
+    assert len(labels) >= 3, labels
+    plt.close(fig)
+
+
+def test_rate_plot_uncertainty_is_the_binomial_standard_error() -> None:
+    from abrupt.rates.plots import detectable_rate_sigma
+    from abrupt.rates.trades import CaseResult
+
+    rng = np.random.default_rng(1)
+    dh = rng.lognormal(0.0, 1.0, 4000)
+    r = CaseResult(
+        label="x",
+        params={},
+        strikes_per_year=10.0,
+        area_m2=1.0,
+        flux_m2_yr=1.0,
+        dH_Nms=dh,
+        dV_mps=dh,
+        da_m=dh,
+        on_array_fraction=0.0,
+        spacecraft_name="x",
+    )
+    p = np.mean(dh >= 1.0)
+    assert detectable_rate_sigma(r, "dH", np.array([1.0]))[0] == pytest.approx(10.0 * np.sqrt(p * (1 - p) / 4000))

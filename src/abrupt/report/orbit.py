@@ -94,4 +94,9 @@ def _orbit_period_samples(analysis: OrbitAnalysis) -> int:
 def _running_mean(y: NDArray[np.float64], n: int) -> NDArray[np.float64]:
     from scipy.ndimage import uniform_filter1d
 
-    return np.asarray(uniform_filter1d(np.nan_to_num(y), size=n, mode="nearest"), dtype=np.float64)
+    ok = np.isfinite(y)
+    total = uniform_filter1d(np.where(ok, y, 0.0), size=n, mode="nearest")
+    count = uniform_filter1d(ok.astype(np.float64), size=n, mode="nearest")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = np.where(count > 0.5, total / np.maximum(count, 1e-12), np.nan)  # NaN where most samples are
+    return np.asarray(mean, dtype=np.float64)
