@@ -96,6 +96,14 @@ catalog_option = click.option(
     help="Event catalog: a SQLite file path or any SQLAlchemy URL.",
 )
 
+report_option = click.option(
+    "--report",
+    "report_path",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Also draw the report figure (.png, .svg or .pdf).",
+)
+
 spacecraft_name_option = click.option(
     "--name",
     "pseudonym",

@@ -11,7 +11,16 @@ from typing import Any
 
 import click
 
-from abrupt.cli.groups import catalog_option, detect, inject, record_run, report, simulate, spacecraft_name_option
+from abrupt.cli.groups import (
+    catalog_option,
+    detect,
+    inject,
+    record_run,
+    report,
+    report_option,
+    simulate,
+    spacecraft_name_option,
+)
 from abrupt.errors import ConfigError
 
 STATISTIC_CHOICES = (
@@ -215,6 +224,7 @@ def simulate_orbit_command(
 )
 @spacecraft_name_option
 @catalog_option
+@report_option
 def detect_orbit_command(
     file: str,
     out: str,
@@ -233,6 +243,7 @@ def detect_orbit_command(
     statistics_out: str | None,
     pseudonym: str | None,
     catalog_target: str,
+    report_path: str | None,
 ) -> None:
     """Detect impulsive velocity changes in navigation data (SP3, OEM or CSV) and write events.
 
@@ -308,6 +319,10 @@ def detect_orbit_command(
         out=out,
         details=details,
     )
+    if report_path:
+        from abrupt.report.orbit import plot_orbit_report
+
+        click.echo(f"report written to {plot_orbit_report(analysis, thresholds, events, report_path)}", err=True)
 
 
 @inject.command("orbit")

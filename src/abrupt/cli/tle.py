@@ -13,7 +13,7 @@ from typing import Any
 
 import click
 
-from abrupt.cli.groups import catalog_option, cli, detect, record_run, report, spacecraft_name_option
+from abrupt.cli.groups import catalog_option, cli, detect, record_run, report, report_option, spacecraft_name_option
 from abrupt.errors import InputError
 
 norad_option = click.option(
@@ -52,6 +52,7 @@ norad_option = click.option(
     "'statistic >= threshold' selects detections.",
 )
 @catalog_option
+@report_option
 def detect_tle(
     path: str,
     out: str | None,
@@ -62,6 +63,7 @@ def detect_tle(
     window_sets: int,
     all_candidates: bool,
     catalog_target: str,
+    report_path: str | None,
 ) -> None:
     """Detect maneuvers in a TLE, 3LE or OMM (XML, KVN, JSON, CSV) history of one satellite.
 
@@ -101,6 +103,10 @@ def detect_tle(
         out=out,
         details=details,
     )
+    if report_path:
+        from abrupt.report.tle import plot_tle_report
+
+        click.echo(f"report written to {plot_tle_report(history, events, report_path)}", err=True)
 
 
 @report.command("tle")

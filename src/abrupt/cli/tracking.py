@@ -9,7 +9,7 @@ from typing import Any
 
 import click
 
-from abrupt.cli.groups import catalog_option, detect, progress, record_run, report, simulate
+from abrupt.cli.groups import catalog_option, detect, progress, record_run, report, report_option, simulate
 
 
 @simulate.command("tracking")
@@ -223,6 +223,7 @@ def _write_aer(measurements: Any, path: Path) -> None:
 )
 @click.option("--name", "spacecraft", default=None, help="Spacecraft pseudonym (default: the file stem).")
 @catalog_option
+@report_option
 def detect_tracking_command(
     file: str,
     setup_path: str,
@@ -241,6 +242,7 @@ def detect_tracking_command(
     diagnostics_out: str | None,
     spacecraft: str | None,
     catalog_target: str,
+    report_path: str | None,
 ) -> None:
     """Detect unknown maneuvers in ground tracking (TDM or .aer) and characterise them.
 
@@ -433,6 +435,13 @@ def detect_tracking_command(
         out=out,
         details={"settings": settings, "fit": summary},
     )
+    if report_path and diag_frames:
+        from abrupt.report.tracking import plot_tracking_report
+
+        diag = pd.concat(diag_frames, ignore_index=True)
+        diag["time_utc"] = pd.to_datetime(diag["time_utc"])
+        plot_tracking_report(diag, events=frame, path=report_path)
+        click.echo(f"report written to {report_path}", err=True)
 
 
 def _looks_like_tdm(path: str) -> bool:

@@ -68,7 +68,8 @@ def plot_tracking_report(
             ax.legend(loc="upper left", fontsize=8)
         ax.set_ylabel("GLRT T(τ) (χ²₃)")
         ax.set_yscale("symlog", linthresh=10.0)
-        ax.yaxis.set_major_locator(ticker.SymmetricalLogLocator(base=10, linthresh=10.0, subs=(1.0, 3.0)))
+        ax.set_ylim(bottom=0.0)  # T(τ) >= 0: no negative half of the symlog axis
+        ax.yaxis.set_major_locator(ticker.SymmetricalLogLocator(base=10, linthresh=10.0, subs=(1.0,)))
         ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
     for frame, style, label in ((events, "--", "detected"), (truth, ":", "truth")):
         if frame is None or len(frame) == 0:
