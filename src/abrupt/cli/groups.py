@@ -35,7 +35,7 @@ def cli(verbose: int, quiet: bool) -> None:
 
     global QUIET
     QUIET = quiet
-    level = logging.ERROR if quiet else logging.WARNING - 10 * min(verbose, 2)
+    level = logging.WARNING if quiet else logging.WARNING - 10 * min(verbose, 2)  # warnings even when quiet
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s", force=True)
 
 

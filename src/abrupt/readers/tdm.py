@@ -24,6 +24,7 @@ from abrupt.errors import InputError, RepairLog
 from abrupt.model.timescales import to_utc
 from abrupt.model.tracking_measurements import MEASUREMENT_COLUMNS
 from abrupt.readers.aer import _finish
+from abrupt.readers.text import read_text
 
 _DOY = re.compile(r"^(\d{4})-(\d{3})T(\d{2}):(\d{2}):(\d{2}(?:\.\d*)?)Z?$")
 _USED = {"RANGE", "ANGLE_1", "ANGLE_2", "DOPPLER_INSTANTANEOUS"}
@@ -81,7 +82,7 @@ def read_tdm(path: str | Path, *, repairs: RepairLog | None = None) -> pd.DataFr
     """Read a KVN TDM into the standard measurement table (SI units, UTC)."""
     path = Path(path)
     log = repairs if repairs is not None else RepairLog(str(path))
-    lines = path.read_text().splitlines()
+    lines = read_text(path).splitlines()
     rows: list[dict[str, object]] = []
     meta: dict[str, str] = {}
     state = "header"

@@ -29,6 +29,7 @@ Repairs are counted in :attr:`Telemetry.repairs` and logged; nothing is dropped 
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -114,6 +115,12 @@ def _numeric(frame: pd.DataFrame, column: str, path: Path, is_csv: bool) -> NDAr
 
 RATE_CHECK_BLOCK_S = 10.0  # [s] averaging block for the gyro / quaternion-derivative cross-check
 RATE_CHECK_MIN_SNR = 10.0  # the check speaks only when the attitude motion stands well above noise
+# Block-averaged gyro noise may not exceed the block-averaged noise of the quaternion-derived rate by
+# more than this factor: the body cannot rotate more than its attitude shows. Correct units give
+# ratios below 1 for a gyro with a star tracker of similar quality; rates in deg/s declared as rad/s
+# multiply it by 57.3. Above RATE_NOISE_WARN the reader warns; above RATE_NOISE_ERROR it refuses.
+RATE_NOISE_WARN = 5.0
+RATE_NOISE_ERROR = 30.0
 
 
 def _check_rates_against_attitude(
@@ -137,6 +144,7 @@ def _check_rates_against_attitude(
     num = den = 0.0
     signal: list[float] = []
     noise: list[float] = []
+    gyro_noise: list[float] = []
     for a, b in segments:
         if b - a < 3:
             continue
@@ -155,6 +163,18 @@ def _check_rates_against_attitude(
         den += float(np.sum(wq_b * wq_b))
         signal.append(float(np.sqrt(np.mean(wq_b**2))))
         noise.append(float(np.median(robust_noise_sigma(wq_b))))
+        gyro_noise.append(float(np.median(robust_noise_sigma(wg_b))))
+    if noise and gyro_noise:
+        ratio = float(np.median(gyro_noise)) / max(float(np.median(noise)), 1e-300)
+        if ratio > RATE_NOISE_WARN:
+            message = (
+                f"body-rate noise averaged over {RATE_CHECK_BLOCK_S:g} s is {ratio:.3g} x that of the rate implied "
+                f"by the quaternions: the gyro shows rotation the attitude does not; the rates look like deg/s "
+                f"although the spacecraft file says {unit!r}, or their unit is wrong"
+            )
+            if ratio > RATE_NOISE_ERROR:
+                raise InputError(message, file=path, column="body_rate")
+            logging.getLogger("abrupt").warning("%s: %s", path, message)
     if not signal or den <= 0 or max(signal) < RATE_CHECK_MIN_SNR * max(min(noise), 1e-300):
         return
     k = num / den
