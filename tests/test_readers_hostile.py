@@ -57,7 +57,8 @@ GOOD = {
     "size.out": (
         b"ORDEM 3.1 spacecraft-mode output\n! population fluxes, #/m2/yr, cumulative\n"
         b"Size(m)   Intacts   NaK   LowDensity  MedDensity  HighDensity  Total  Total_Upper  Total_Lower\n"
-        b"1.0E-05   1e-6  0.02  5.0  50.0  10.0  65.0  80.0  50.0\n1.0E-04   1e-6  0.02  0.5  5.0   1.0   6.5   8.0   5.0\n"
+        b"1.0E-05   1e-6  0.02  5.0  50.0  10.0  65.0  80.0  50.0\n"
+        b"1.0E-04   1e-6  0.02  0.5  5.0   1.0   6.5   8.0   5.0\n"
         b"1.0E-03   1e-6  0.01  0.01 0.05  0.02  0.09  0.12  0.06\n"
     ),
     "igloo.out": (

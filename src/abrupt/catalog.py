@@ -47,7 +47,7 @@ import sqlalchemy as sa
 
 from abrupt import __version__
 from abrupt.errors import AbruptError
-from abrupt.events import _FLOAT_COLUMNS, EVENT_COLUMNS, format_time_utc, normalise_frame
+from abrupt.events import EVENT_COLUMNS, FLOAT_COLUMNS, format_time_utc, normalise_frame
 
 SCHEMA_VERSION = 2
 #: Key of the PostgreSQL advisory lock that serialises catalog writers (any fixed 64-bit integer).
@@ -61,7 +61,7 @@ _metadata = sa.MetaData()
 
 
 def _event_column(name: str) -> sa.Column[Any]:
-    if name in _FLOAT_COLUMNS:
+    if name in FLOAT_COLUMNS:
         return sa.Column(name, sa.Float, nullable=True)
     if name == "time_utc":
         return sa.Column(name, sa.DateTime(timezone=False), nullable=False)  # naive UTC

@@ -47,8 +47,11 @@ EVENT_COLUMNS: tuple[str, ...] = (
     "config_hash",
 )
 
-_TEXT_COLUMNS = ("event_id", "spacecraft", "kind", "detector", "time_utc", "run_id", "config_hash")
-_FLOAT_COLUMNS = tuple(c for c in EVENT_COLUMNS if c not in _TEXT_COLUMNS)
+#: Schema columns holding text (identifiers, names, ISO-8601 times); the others are float64.
+TEXT_COLUMNS: tuple[str, ...] = ("event_id", "spacecraft", "kind", "detector", "time_utc", "run_id", "config_hash")
+FLOAT_COLUMNS: tuple[str, ...] = tuple(c for c in EVENT_COLUMNS if c not in TEXT_COLUMNS)
+_TEXT_COLUMNS = TEXT_COLUMNS  # older spelling, kept while other branches still use it
+_FLOAT_COLUMNS = FLOAT_COLUMNS
 
 NAN = float("nan")
 
@@ -179,6 +182,24 @@ def normalise_frame(frame: pd.DataFrame) -> pd.DataFrame:
     if bad.any():
         raise ValueError(f"event kinds {sorted(set(out.loc[bad, 'kind']))} not in {EVENT_KINDS}")
     return out.reset_index(drop=True)
+
+
+def restamp(frame: pd.DataFrame, *, run_id: str, config_hash: str) -> pd.DataFrame:
+    """The events of one run: ``run_id`` and the run's ``config_hash`` set, ``event_id`` recomputed.
+
+    A detector run on its own stamps its own configuration; a pipeline that runs several detectors
+    under one configuration stamps them all with it, so identifiers stay deterministic per run
+    configuration (:func:`make_event_id`).
+    """
+    out = normalise_frame(frame)
+    out["run_id"] = pd.array([run_id] * len(out), dtype="string")
+    out["config_hash"] = pd.array([config_hash] * len(out), dtype="string")
+    ids = [
+        make_event_id(str(sc), str(det), str(kind), str(t), config_hash)
+        for sc, det, kind, t in zip(out["spacecraft"], out["detector"], out["kind"], out["time_utc"], strict=True)
+    ]
+    out["event_id"] = pd.array(ids, dtype="string")
+    return out
 
 
 def write_events(frame: pd.DataFrame, path: str) -> None:

@@ -19,17 +19,16 @@ from abrupt.cli.groups import (
     simulate,
     warn,
 )
+from abrupt.cli.options import budget_options, pop_budget
 
 if TYPE_CHECKING:
     from abrupt.simulate.attitude import Strike
 
-DETECTOR_CHOICES = ("glr", "cusum", "summation", "shiryaev", "mf_attitude", "mf_rate", "mf_joint", "all")
-
 
 def _spacecraft(path: str | None) -> Any:
-    from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
+    from abrupt.pipelines.attitude import load_spacecraft
 
-    return load_spacecraft(path or bundled_spacecraft_path("thesis"))
+    return load_spacecraft(path)
 
 
 def parse_strike(text: str) -> Strike:
@@ -146,22 +145,31 @@ def simulate_attitude_cmd(
 
 def _detection_config(
     detectors: tuple[str, ...],
-    fa_per_day: float,
+    budget: Any,
     pre: int,
     post: int,
     glr_window: int,
     method: str,
     null_samples: int,
 ) -> Any:
-    from abrupt.detect.attitude import ATTITUDE_DETECTORS, AttitudeDetectionConfig
+    """The run configuration; detector names are checked against the registry now (plug-ins included)."""
+    from abrupt.detect.attitude import AttitudeDetectionConfig, attitude_detector_names
     from abrupt.detect.change_detection import WindowConfig
 
-    chosen = ATTITUDE_DETECTORS if "all" in detectors else tuple(dict.fromkeys(detectors or ("glr",)))
+    names = attitude_detector_names()
+    if "all" in detectors:
+        chosen = tuple(n.removeprefix("attitude.") for n in names if n.startswith("attitude."))
+    else:
+        chosen = tuple(dict.fromkeys(detectors or ("glr",)))
+    for d in chosen:
+        if d not in names and f"attitude.{d}" not in names:
+            short = ", ".join(n.removeprefix("attitude.") for n in names)
+            raise click.BadParameter(f"{d!r} is not a registered attitude detector; choose from {short}, all")
     return AttitudeDetectionConfig(
         detectors=chosen,
         windows=WindowConfig(pre=pre, post=post),
         glr_windows=WindowConfig(pre=glr_window, post=glr_window),
-        false_alarms_per_day=fa_per_day,
+        false_alarms_per_day=budget.per_day,
         threshold_method=method,
         null_samples=null_samples,
     )
@@ -172,19 +180,12 @@ detector_options = [
         "--detector",
         "detectors",
         multiple=True,
-        type=click.Choice(DETECTOR_CHOICES),
         default=("glr",),
         show_default=True,
-        help="Detector(s); repeatable; 'all' runs every one.",
+        help="Detector(s) by registered name (`abrupt detectors`); glr, cusum, summation, shiryaev, mf_attitude, "
+        "mf_rate, mf_joint or a plug-in's full name; repeatable; 'all' runs every attitude.* detector.",
     ),
-    click.option(
-        "--false-alarms-per-day",
-        "fa_per_day",
-        type=click.FloatRange(min=0.0, min_open=True),
-        default=1.0,
-        show_default=True,
-        help="False-alarm budget the thresholds are set for.",
-    ),
+    budget_options("1/day"),
     click.option(
         "--pre",
         type=click.IntRange(min=2),
@@ -245,6 +246,14 @@ def _with_options(options: list[Any]) -> Any:
     return wrap
 
 
+def _stage_count(cfg: Any) -> int:
+    """Progress stages of the pipeline: calibrate and run per change detector, one for the others."""
+    from abrupt.detect.attitude import MomentumChangeDetector, attitude_detector_class
+
+    n_change = sum(1 for d in cfg.detectors if issubclass(attitude_detector_class(d), MomentumChangeDetector))
+    return 2 * n_change + (1 if n_change < len(cfg.detectors) else 0)
+
+
 def run_attitude_detection(
     telemetry_path: str,
     spacecraft_path: str | None,
@@ -253,25 +262,20 @@ def run_attitude_detection(
     settings: dict[str, Any],
     mask: str | None = None,
 ) -> tuple[Any, Any, Any, Any]:
-    """Read, calibrate and detect, with a progress line per stage. Returns (sc, telemetry, config, result)."""
-    from abrupt.detect.attitude import detect_attitude
-    from abrupt.readers.telemetry import apply_mask, read_mask, read_telemetry
+    """Call the attitude pipeline, with a progress line per stage. Returns (sc, telemetry, config, run)."""
+    from abrupt.pipelines.attitude import detect_attitude, read_attitude_inputs
 
-    sc = _spacecraft(spacecraft_path)
-    tel = read_telemetry(telemetry_path, sc)
-    if mask:
-        tel = apply_mask(tel, read_mask(mask))
+    budget = pop_budget(settings, "1/day")
+    sc, tel, cal = read_attitude_inputs(telemetry_path, spacecraft_path, calibration_path=calibration, mask_path=mask)
     for line in tel.repairs.summary():
         note(f"repaired: {line}")
-    cal = read_telemetry(calibration, sc) if calibration else None
     if cal is not None:
         for line in cal.repairs.summary():
             note(f"repaired (calibration): {line}")
-    cfg = _detection_config(**settings)
-    n_stat = sum(1 for d in cfg.detectors if not d.startswith("mf_"))
-    stages = StageProgress(2 * n_stat + (1 if n_stat < len(cfg.detectors) else 0), desc="detect attitude")
+    cfg = _detection_config(budget=budget, **settings)
+    stages = StageProgress(_stage_count(cfg), desc="detect attitude")
     try:
-        result = detect_attitude(tel, sc, cfg, calibration=cal, spacecraft_name=name, progress=stages)
+        result = detect_attitude(tel, sc, cfg, calibration=cal, spacecraft_name=name, progress=stages, budget=budget)
     finally:
         stages.close()
     for warning in result.details.get("warnings", []):
@@ -345,7 +349,7 @@ def detect_attitude_cmd(
         out=out,
         details=details,
         spacecraft=name or sc.name,
-        detectors=[f"attitude.{d}" for d in cfg.detectors],
+        detectors=[d if "." in d else f"attitude.{d}" for d in cfg.detectors],
         span_utc=(tel.time[0], tel.time[-1]) if len(tel) else None,
     )
     for k, thr in result.thresholds.items():
@@ -405,7 +409,8 @@ def demo(out_dir: str, duration_s: float, seed: int) -> None:
     import numpy as np
     import pandas as pd
 
-    from abrupt.detect.attitude import AttitudeDetectionConfig, detect_attitude
+    from abrupt.detect.attitude import AttitudeDetectionConfig
+    from abrupt.pipelines.attitude import detect_attitude
     from abrupt.readers.telemetry import read_telemetry
     from abrupt.report.attitude import write_attitude_report
     from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude, write_telemetry

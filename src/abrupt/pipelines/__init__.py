@@ -1,1 +1,6 @@
-"""Orchestration of each capability (read, series, clean, model, detect, thresholds, events, catalog); no click."""
+"""Pipelines: the orchestration of one capability, read → series → clean → model → detect → events.
+
+One module per capability (``attitude``, ``tracking``, ...), with no click inside: the command line
+(:mod:`abrupt.cli`) parses options, calls a pipeline and writes its outputs, and the Python API calls
+the same functions.
+"""

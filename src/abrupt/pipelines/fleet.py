@@ -115,18 +115,15 @@ def read_manifest(path: str | Path) -> list[FleetMember]:
 
 def detect_attitude_task(task: AttitudeTask) -> TaskOutput:
     """Run one task: read, calibrate on the file's own noise, detect (a pure function of the task)."""
-    from abrupt.detect.attitude import detect_attitude
-    from abrupt.model.spacecraft import load_spacecraft
-    from abrupt.readers.telemetry import read_telemetry
+    from abrupt.pipelines.attitude import detect_attitude, read_attitude_inputs
 
-    sc = load_spacecraft(task.member.spacecraft_file)
-    tel = read_telemetry(task.member.telemetry, sc)
+    sc, tel, _ = read_attitude_inputs(task.member.telemetry, task.member.spacecraft_file)
     result = detect_attitude(tel, sc, task.config, run_id=task.run_id, spacecraft_name=task.member.spacecraft)
     coverage: tuple[Coverage, ...] = ()
     if len(tel):
         start, end = format_time_utc(tel.time[0]), format_time_utc(tel.time[-1])
         coverage = tuple(
-            Coverage(task.member.spacecraft, f"attitude.{d}", result.config_hash, start, end)
+            Coverage(task.member.spacecraft, d if "." in d else f"attitude.{d}", result.config_hash, start, end)
             for d in task.config.detectors
         )
     return TaskOutput(result.events, coverage, tel.repairs.as_dict(), tuple(result.details.get("warnings", [])))

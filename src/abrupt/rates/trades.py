@@ -177,7 +177,8 @@ def run_scenario(scenario: Scenario) -> tuple[CaseResult, StrikeSample]:
     return result, sample
 
 
-def _run_case(scenario: Scenario) -> CaseResult:
+def run_case(scenario: Scenario) -> CaseResult:
+    """The result of one scenario (the first case of :func:`run_scenario`)."""
     return run_scenario(scenario)[0]
 
 
@@ -245,7 +246,7 @@ def run_trade(
         executor = Executor(scheduler=scheduler)
     scenarios = trade_scenarios(base, variables)
     return run_tasks(
-        _run_case, scenarios, executor=executor, desc="trade cases", unit="case", show_progress=show_progress
+        run_case, scenarios, executor=executor, desc="trade cases", unit="case", show_progress=show_progress
     )
 
 
