@@ -13,8 +13,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from abrupt.detect.attitude import AttitudeDetectionConfig, detect_attitude
+from abrupt.detect.attitude import AttitudeDetectionConfig
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
+from abrupt.pipelines.attitude import detect_attitude
 from abrupt.readers.telemetry import read_telemetry
 from abrupt.report.attitude import attitude_figure, write_attitude_report
 from abrupt.report.style import PALETTE, clip_with_markers, detector_colour, robust_baseline
