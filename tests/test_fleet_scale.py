@@ -163,3 +163,16 @@ def test_killed_at_any_moment_then_resumed(
     final = _cli(fleet_manifest, catalog_target, out)
     assert final.wait(300) == 0
     _assert_same_events(out, catalog_target, reference_events)
+
+
+@pytest.mark.slow
+def test_tle_histories_on_a_two_worker_cluster_equal_in_process(shared_data: Path) -> None:
+    from abrupt.pipelines.fleet import detect_tle_batch
+    from abrupt.thresholds import FalseAlarmBudget
+
+    paths = sorted((shared_data / "tle").glob("*.tle"))
+    budget = FalseAlarmBudget.parse("1/year")
+    local = detect_tle_batch(paths, budget, run_id="r")
+    cluster = detect_tle_batch(paths, budget, run_id="r", executor=Executor(workers=2))
+    assert local["spacecraft"].nunique() == len(paths)
+    pd.testing.assert_frame_equal(local, cluster)

@@ -116,3 +116,53 @@ def detect_fleet_cmd(
     write_events(result.events, out)
     resumed = f" ({result.n_resumed} finished earlier, resumed)" if result.n_resumed else ""
     note(f"{len(result.events)} event(s) from {result.n_tasks} task(s){resumed}; run {result.run_id}; written to {out}")
+
+
+@detect.command("tle-batch")
+@click.argument("paths", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False))
+@click.option(
+    "--false-alarms",
+    default="1/year",
+    show_default=True,
+    help="False-alarm budget per satellite (RATE/day, /week or /year).",
+)
+@with_executor_options
+@catalog_option
+@click.option(
+    "--out",
+    type=click.Path(dir_okay=False),
+    required=True,
+    callback=check_suffix(".csv", ".parquet"),
+    help="Events file of all histories (.csv or .parquet).",
+)
+def detect_tle_batch_cmd(
+    paths: tuple[str, ...],
+    false_alarms: str,
+    workers: int | None,
+    scheduler: str | None,
+    catalog_target: str,
+    out: str,
+) -> None:
+    """Detect maneuvers in many TLE/OMM histories (PATHS), one task per file, in-process or on Dask."""
+    from abrupt.cli.groups import record_run
+    from abrupt.events import config_hash, new_run_id
+    from abrupt.pipelines.fleet import detect_tle_batch
+    from abrupt.thresholds import FalseAlarmBudget
+
+    try:
+        budget = FalseAlarmBudget.parse(false_alarms)
+    except ValueError as exc:
+        raise click.BadParameter(str(exc), param_hint="--false-alarms") from None
+    executor = executor_from(workers, scheduler)
+    note(f"{len(paths)} TLE/OMM file(s) on {executor.describe()}")
+    run_id = new_run_id()
+    events = detect_tle_batch(paths, budget, executor=executor, run_id=run_id, show_progress=not progress_hidden())
+    record_run(
+        catalog_target=catalog_target,
+        command="detect tle-batch " + " ".join(paths),
+        events=events,
+        config_hash=config_hash({"budget": str(budget), "detector": "auto"}),
+        run_id=run_id,
+        out=out,
+        details={"files": list(paths), "budget": str(budget)},
+    )

@@ -215,3 +215,42 @@ def detect_attitude_fleet(
         repairs={k: o.repairs for k, o in outputs.items() if o.repairs},
         warnings=[f"{k}: {w}" for k, o in outputs.items() for w in o.warnings],
     )
+
+
+@dataclass(frozen=True)
+class TleTask:
+    """One TLE/OMM file (every satellite in it) as one task."""
+
+    path: str
+    budget: Any  # FalseAlarmBudget
+    run_id: str
+
+
+def detect_tle_task(task: TleTask) -> pd.DataFrame:
+    """Run the TLE pipeline on one file (a pure function of the task)."""
+    from abrupt.pipelines.tle import detect_tle_file
+
+    return detect_tle_file(task.path, task.budget, run_id=task.run_id).events
+
+
+def detect_tle_batch(
+    paths: Sequence[str | Path],
+    budget: Any,
+    *,
+    executor: Executor | None = None,
+    run_id: str | None = None,
+    show_progress: bool | None = None,
+) -> pd.DataFrame:
+    """Maneuvers in many TLE/OMM histories, one task per file, on the executor (docs/scale.md)."""
+    from abrupt.events import new_run_id
+
+    run_id = run_id or new_run_id()
+    tasks = [TleTask(str(p), budget, run_id) for p in paths]
+    frames = run_tasks(
+        detect_tle_task, tasks, executor=executor, desc="TLE histories", unit="file", show_progress=show_progress
+    )
+    frames = [f for f in frames if len(f)]
+    if not frames:
+        return empty_frame()
+    events = pd.concat(frames, ignore_index=True)
+    return events.sort_values(["spacecraft", "time_utc", "detector"]).reset_index(drop=True)
