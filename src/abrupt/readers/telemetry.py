@@ -137,8 +137,12 @@ def _check_rates_against_attitude(
         signal.append(float(np.sqrt(np.mean(wq_b**2))))
         noise.append(float(np.median(robust_noise_sigma(wq_b))))
         gyro_noise.append(float(np.median(robust_noise_sigma(wg_b))))
-    if noise and gyro_noise:
-        ratio = float(np.median(gyro_noise)) / max(float(np.median(noise)), 1e-300)
+    q_noise = float(np.median(noise)) if noise else 0.0
+    g_noise = float(np.median(gyro_noise)) if gyro_noise else 0.0
+    # Quaternions a thousand times quieter than the gyro are smoothed or simulated without noise: the
+    # comparison then says nothing about the gyro's unit.
+    if q_noise > 1e-3 * g_noise > 0:
+        ratio = g_noise / q_noise
         if ratio > RATE_NOISE_WARN:
             message = (
                 f"body-rate noise averaged over {RATE_CHECK_BLOCK_S:g} s is {ratio:.3g} x that of the rate implied "
