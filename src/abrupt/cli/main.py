@@ -11,6 +11,7 @@ from abrupt.cli import (  # noqa: F401  (registration)
     catalog_commands,
     detectors,
     fleet,
+    flight,
     laser,
     mass,
     orbit,
