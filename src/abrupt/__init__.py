@@ -1,6 +1,6 @@
 """abrupt: find abrupt, unexpected momentum changes in satellite telemetry and tracking data.
 
-Data flow (see DESIGN.md): readers -> model -> detect -> thresholds -> events -> catalog -> report.
+Data flow: readers -> model -> detect -> thresholds -> events -> catalog -> report.
 Simulators in :mod:`abrupt.simulate` feed the same path with known truth; :mod:`abrupt.rates`
 predicts how many detectable events a spacecraft should see per year.
 """

@@ -33,7 +33,7 @@ class InputError(AbruptError, ValueError):
         line: int | None = None,
         column: str | int | None = None,
     ) -> None:
-        self.reason = reason
+        self.reason = " ".join(str(reason).split())  # one line, whatever a library's message held
         self.file = str(file) if file is not None else None
         self.line = line
         self.column = column
@@ -52,13 +52,13 @@ class ConfigError(AbruptError, ValueError):
     """Invalid configuration (spacecraft file, detector settings); names the key and the reason."""
 
     def __init__(self, reason: str, *, file: str | Path | None = None, key: str | None = None) -> None:
-        self.reason = reason
+        self.reason = " ".join(str(reason).split())
         self.file = str(file) if file is not None else None
         self.key = key
         where = self.file or "<config>"
         if key is not None:
             where += f": [{key}]"
-        super().__init__(f"{where}: {reason}")
+        super().__init__(f"{where}: {self.reason}")
 
 
 @dataclass

@@ -1,4 +1,4 @@
-"""The one event schema every detector returns (DESIGN.md, "Events").
+"""The one event schema every detector returns (README, "What it does").
 
 A detector returns a :class:`pandas.DataFrame` whose first columns are exactly
 :data:`EVENT_COLUMNS`, in that order; further columns may follow. A value a detector does not

@@ -81,7 +81,7 @@ def random_strikes(n: int, duration_s: float, dh_min: float, dh_max: float, seed
     type=float,
     default=4e-5,
     show_default=True,
-    help="Body-rate telemetry noise σ [rad/s] (spec §3.6; Table 2.1 prints 2e-4).",
+    help="Body-rate telemetry noise σ [rad/s] (the thesis thresholds imply 4e-5; its Table 2.1 prints 2e-4).",
 )
 @click.option("--no-noise", is_flag=True, help="Noise-free simulation.")
 @click.option("--strike", "strikes", multiple=True, help="TIME_S:DHX,DHY,DHZ (body axes, N·m·s); repeatable.")
@@ -335,8 +335,8 @@ def run_attitude_detection(
     "report_path",
     type=click.Path(dir_okay=False),
     default=None,
-    callback=check_suffix(".png", ".html"),
-    help="Also write the report figure (.png or .html).",
+    callback=check_suffix(".png", ".svg", ".pdf", ".html"),
+    help="Also write the report (.png, .svg, .pdf or a self-contained .html page).",
 )
 def detect_attitude_cmd(
     telemetry: str,
@@ -416,8 +416,8 @@ def detect_attitude_cmd(
     "--out",
     type=click.Path(dir_okay=False),
     required=True,
-    callback=check_suffix(".png", ".html"),
-    help="Figure (.png) or page (.html).",
+    callback=check_suffix(".png", ".svg", ".pdf", ".html"),
+    help="Figure (.png, .svg, .pdf) or self-contained page (.html).",
 )
 def report_attitude_cmd(
     telemetry: str | None,

@@ -35,7 +35,7 @@ def cli(verbose: int, quiet: bool) -> None:
 
     global QUIET
     QUIET = quiet
-    level = logging.ERROR if quiet else logging.WARNING - 10 * min(verbose, 2)
+    level = logging.WARNING if quiet else logging.WARNING - 10 * min(verbose, 2)  # warnings even when quiet
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s", force=True)
 
 
@@ -94,6 +94,14 @@ catalog_option = click.option(
     default=DEFAULT_CATALOG,
     show_default=True,
     help="Event catalog: a SQLite file path or any SQLAlchemy URL.",
+)
+
+report_option = click.option(
+    "--report",
+    "report_path",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Also draw the report figure (.png, .svg or .pdf).",
 )
 
 spacecraft_name_option = click.option(

@@ -10,6 +10,7 @@ from abrupt.cli import (  # noqa: F401  (registration)
     attitude,
     catalog_commands,
     detectors,
+    fleet,
     flight,
     laser,
     mass,

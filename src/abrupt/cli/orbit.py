@@ -11,7 +11,16 @@ from typing import Any
 
 import click
 
-from abrupt.cli.groups import catalog_option, detect, inject, record_run, report, simulate, spacecraft_name_option
+from abrupt.cli.groups import (
+    catalog_option,
+    detect,
+    inject,
+    record_run,
+    report,
+    report_option,
+    simulate,
+    spacecraft_name_option,
+)
 from abrupt.errors import ConfigError
 
 STATISTIC_CHOICES = (
@@ -193,13 +202,11 @@ def simulate_orbit_command(
 )
 @click.option("--kind", type=click.Choice(["unknown", "maneuver", "strike"]), default="unknown", show_default=True)
 @click.option(
-    "--report", "show_report", is_flag=True, help="Print the fit: residual RMS, estimated parameters, thresholds."
-)
-@click.option(
     "--statistics-out", type=click.Path(dir_okay=False), default=None, help="Per-epoch statistics (.parquet/.csv)."
 )
 @spacecraft_name_option
 @catalog_option
+@report_option
 def detect_orbit_command(
     file: str,
     out: str,
@@ -218,10 +225,10 @@ def detect_orbit_command(
     null_file: str | None,
     confidence_z: float,
     kind: str,
-    show_report: bool,
     statistics_out: str | None,
     pseudonym: str | None,
     catalog_target: str,
+    report_path: str | None,
 ) -> None:
     """Detect impulsive and finite velocity changes in navigation data (SP3, OEM or CSV) and write events.
 
@@ -272,8 +279,8 @@ def detect_orbit_command(
         click.echo(f"repaired: {line}", err=True)
     for warning in run.result.warnings:
         click.echo(f"warning: {warning}", err=True)
-    if show_report:
-        click.echo("\n".join(summary_lines(run.summary)))
+    # The fit (residual RMS, estimated parameters, thresholds) is printed on every run (issue 10 item 6).
+    click.echo("\n".join(summary_lines(run.summary)), err=True)
     if statistics_out and run.analysis is not None:
         import pandas as pd
 
@@ -300,6 +307,12 @@ def detect_orbit_command(
         details={k: v for k, v in run.summary.items() if k != "warnings"}
         | {"repairs": run.ephemeris.repairs.as_dict()},
     )
+    if report_path:
+        from abrupt.report.orbit import plot_orbit_report
+
+        if run.analysis is not None:
+            path = plot_orbit_report(run.analysis, run.thresholds, events, report_path)
+            click.echo(f"report written to {path}", err=True)
 
 
 @inject.command("orbit")

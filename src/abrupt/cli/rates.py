@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
 import click
 
-from abrupt.cli.groups import cli, progress
+from abrupt.cli.fleet import executor_from, with_executor_options
+from abrupt.cli.groups import cli, progress_hidden
 
 
 @cli.group()
@@ -212,19 +212,16 @@ def run_command(**kw: Any) -> None:
     "mass_model, mef, grid_spacing, size_scale, location, area, lc_min, size_sampling. "
     "Spacecraft paths join with ';'.",
 )
-@click.option("--scheduler", default=None, help="Dask scheduler address (tcp://host:8786); in-process when absent.")
-def trade_command(vary: tuple[str, ...], scheduler: str | None, **kw: Any) -> None:
-    """A trade over one or two variables; one Monte Carlo per case (Dask-parallel with --scheduler)."""
+@with_executor_options
+def trade_command(vary: tuple[str, ...], workers: int | None, scheduler: str | None, **kw: Any) -> None:
+    """A trade over one or two variables; one Monte Carlo per case (Dask-parallel with --workers/--scheduler)."""
     from abrupt.pipelines.rates import build_scenario, parse_vary
     from abrupt.rates.trades import run_trade
 
     variables = parse_vary(vary)
     base = build_scenario(kw)
     results = run_trade(
-        base,
-        variables,
-        scheduler=scheduler,
-        progress=functools.partial(progress, desc="trade cases", unit="case"),
+        base, variables, executor=executor_from(workers, scheduler), show_progress=not progress_hidden()
     )
     _report(results, kw)
 

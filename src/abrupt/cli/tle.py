@@ -13,7 +13,8 @@ from typing import Any
 
 import click
 
-from abrupt.cli.groups import catalog_option, cli, detect, record_run, report, spacecraft_name_option
+from abrupt.cli.groups import catalog_option, cli, detect, record_run, report, report_option, spacecraft_name_option
+from abrupt.errors import InputError
 
 norad_option = click.option(
     "--norad",
@@ -64,6 +65,7 @@ norad_option = click.option(
 )
 @click.option("--strict", is_flag=True, help="A malformed element set is an error (default: skipped and reported).")
 @catalog_option
+@report_option
 def detect_tle(
     path: str,
     out: str | None,
@@ -77,6 +79,7 @@ def detect_tle(
     all_candidates: bool,
     strict: bool,
     catalog_target: str,
+    report_path: str | None,
 ) -> None:
     """Detect maneuvers in a TLE, 3LE or OMM (XML, KVN, JSON, CSV) history; every satellite of the file.
 
@@ -152,6 +155,14 @@ def detect_tle(
         out=out,
         details=details,
     )
+    if report_path:
+        from abrupt.report.tle import plot_tle_report
+
+        for sat in result.satellites:  # one figure per satellite: NAME.png, or NAME_<norad>.png for several
+            target = Path(report_path)
+            if len(result.satellites) > 1:
+                target = target.with_name(f"{target.stem}_{sat.history.norad_id}{target.suffix}")
+            click.echo(f"report written to {plot_tle_report(sat.history, sat.events, target)}", err=True)
 
 
 @report.command("tle")
@@ -206,6 +217,24 @@ def _read_truth(path: str) -> Any:
     if first.startswith("event_id,"):
         return read_events(path)
     return read_maneuver_file(path)
+
+
+def chance_matches(n_det: int, n_truth: int, tolerance_s: float, start: Any, end: Any, events: Any) -> float:
+    """Matches expected by chance: detections spread uniformly over the span, each truth matched when a
+    detection falls within ± tolerance (Poisson: 1 − exp(−n_det·2·tol/span) per truth)."""
+    import math
+
+    import pandas as pd
+
+    if start is None or end is None:
+        if len(events) < 2:
+            return 0.0
+        times = pd.to_datetime(events["time_utc"].astype(str), utc=True)
+        start, end = times.min(), times.max()
+    span_s = (pd.Timestamp(end) - pd.Timestamp(start)).total_seconds()
+    if span_s <= 0:
+        return 0.0
+    return n_truth * (1.0 - math.exp(-n_det * 2.0 * tolerance_s / span_s))
 
 
 @cli.command("score")
@@ -271,8 +300,23 @@ def score(
 
         el = read_elements(elements).elements
         start, end = str(el["epoch_utc"].iloc[0]), str(el["epoch_utc"].iloc[-1])
+    if len(truth_frame) == 0:
+        raise InputError("truth file lists no maneuvers: nothing to score against", file=truth)
     tol = tolerance_days * 86400.0
     result = score_events(events, truth_frame, tolerance_s=tol, start=start, end=end)
+    if result.n_truth == 0:
+        raise InputError("no truth maneuver inside the observed span: nothing to score against", file=truth)
+    chance = chance_matches(result.n_detections, result.n_truth, tol, start, end, events)
+    if result.n_truth >= 5:
+        from scipy.stats import binom
+
+        p_chance = float(binom.sf(result.true_positives - 1, result.n_truth, chance / result.n_truth))
+        if p_chance > 0.01:  # as many matches as random times would give: likely another satellite's file
+            click.echo(
+                f"warning: {result.true_positives} match(es) where chance alone gives {chance:.1f} "
+                f"(p = {p_chance:.2g}): are the events and the truth file of the same satellite?",
+                err=True,
+            )
     out: dict[str, Any] = {"events": events_path, "truth": truth, **result.as_dict()}
     click.echo(
         f"tolerance ±{tolerance_days:g} d, one-to-one: {result.n_detections} detections, "

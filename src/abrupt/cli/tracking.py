@@ -9,7 +9,7 @@ from typing import Any
 
 import click
 
-from abrupt.cli.groups import catalog_option, detect, progress, record_run, report, simulate
+from abrupt.cli.groups import catalog_option, detect, progress, record_run, report, report_option, simulate
 from abrupt.cli.options import budget_options, pop_budget
 
 
@@ -218,6 +218,7 @@ def _write_aer(measurements: Any, path: Path) -> None:
 )
 @click.option("--name", "spacecraft", default=None, help="Spacecraft pseudonym (default: the file stem).")
 @catalog_option
+@report_option
 def detect_tracking_command(
     file: str,
     setup_path: str,
@@ -235,6 +236,7 @@ def detect_tracking_command(
     diagnostics_out: str | None,
     spacecraft: str | None,
     catalog_target: str,
+    report_path: str | None,
     **budget_args: Any,
 ) -> None:
     """Detect unknown maneuvers in ground tracking (TDM or .aer) and characterise them.
@@ -274,6 +276,15 @@ def detect_tracking_command(
         out=out,
         details={"settings": run.settings, "fit": run.fit_summary},
     )
+    if report_path and len(run.diagnostics):
+        import pandas as pd
+
+        from abrupt.report.tracking import plot_tracking_report
+
+        diag = run.diagnostics.copy()
+        diag["time_utc"] = pd.to_datetime(diag["time_utc"])
+        plot_tracking_report(diag, events=run.events, path=report_path)
+        click.echo(f"report written to {report_path}", err=True)
 
 
 @report.command("tracking")

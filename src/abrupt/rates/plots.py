@@ -15,11 +15,50 @@ from numpy.typing import NDArray
 
 from abrupt.rates.trades import CaseResult
 
+# SI units, as in the tables the rate commands print (N·m·s, m/s, m)
 METRIC_LABELS = {
-    "dH": ("ΔH threshold [mN·m·s]", 1e3),
-    "dV": ("ΔV threshold [mm/s]", 1e3),
+    "dH": ("ΔH threshold [N·m·s]", 1.0),
+    "dV": ("ΔV threshold [m/s]", 1.0),
     "da": ("Δa threshold [m]", 1.0),
 }
+
+
+def detectable_rate_sigma(result: CaseResult, metric: str, thresholds: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Monte Carlo standard error of the detectable rate R·p̂(T) for each threshold.
+
+    p̂ is the (importance-)weighted fraction of draws with metric >= T; its variance is
+    Σ w_k² (1[M_k >= T] − p̂)² / (Σ w_k)² (the delta-method variance of a ratio estimator), which for
+    equal weights is the binomial p̂(1 − p̂)/N.
+    """
+    values = {"dH": result.dH_Nms, "dV": result.dV_mps, "da": result.da_m}[metric]
+    w = np.ones_like(values) if result.weight is None else np.asarray(result.weight, dtype=np.float64)
+    sw = w.sum()
+    out = np.empty(len(thresholds))
+    for i, thr in enumerate(thresholds):
+        hit = (values >= thr).astype(np.float64)
+        p = float(np.sum(w * hit) / sw)
+        out[i] = result.strikes_per_year * np.sqrt(np.sum(w * w * (hit - p) ** 2)) / sw
+    return out
+
+
+def scenario_title(results: Sequence[CaseResult]) -> str:
+    """Model and orbit of the plotted cases, with what varies between them."""
+    if not results:
+        return ""
+    keys = ("flux", "altitude_km", "inclination_deg", "epoch_year", "mass_model", "mef")
+    first = results[0].params
+    fixed = [k for k in keys if k in first and all(r.params.get(k) == first[k] for r in results)]
+    parts = []
+    if "flux" in fixed:
+        parts.append(f"flux {first['flux']}")
+    if "altitude_km" in fixed and "inclination_deg" in fixed:
+        parts.append(f"{first['altitude_km']:g} km, {first['inclination_deg']:g}°")
+    if "epoch_year" in fixed:
+        parts.append(f"epoch {first['epoch_year']:g}")
+    for k in ("mass_model", "mef"):
+        if k in fixed:
+            parts.append(f"{k.replace('_', ' ')} {first[k]}")
+    return "; ".join(parts)
 
 
 def default_thresholds(results: Sequence[CaseResult], metric: str, n: int = 60) -> NDArray[np.float64]:
@@ -51,12 +90,19 @@ def plot_rate_curves(
     fig, ax = plt.subplots(figsize=(7.5, 5.0))
     for r in results:
         rate = r.detectable_per_year(metric, t)
+        sigma = detectable_rate_sigma(r, metric, t)
         ok = rate > 0
-        ax.loglog(t[ok] * scale, rate[ok], label=r.label, drawstyle="steps-post")
+        (line,) = ax.loglog(t[ok] * scale, rate[ok], label=r.label, drawstyle="steps-post")
+        lo = np.maximum(rate - 2 * sigma, rate * 1e-3)
+        ax.fill_between(
+            t[ok] * scale, lo[ok], (rate + 2 * sigma)[ok], step="post", color=line.get_color(), alpha=0.2, lw=0
+        )
+    ax.fill_between([], [], [], color="0.5", alpha=0.2, label="±2σ Monte Carlo")
     ax.set_xlabel(label)
     ax.set_ylabel("expected detectable strikes per year")
     ax.grid(True, which="both", alpha=0.3)
-    ax.set_title(title or f"Detectable perturbations against {label.split(' threshold')[0]} threshold")
+    what = f"Detectable perturbations against {label.split(' threshold')[0]} threshold"
+    ax.set_title(title or what + (f"\n{scenario_title(results)}" if scenario_title(results) else ""), fontsize=10)
     ax.legend(fontsize=7)
     fig.tight_layout()
     out = Path(out)
@@ -67,7 +113,7 @@ def plot_rate_curves(
 
 
 def plot_dh_dv_scatter(results: Sequence[CaseResult], out: str | Path, *, max_points: int = 20_000) -> Path:
-    """Scatter of ΔH [mN·m·s] against ΔV [mm/s] of the draws, one colour per spacecraft (Fig. 5.11)."""
+    """Scatter of ΔH [N·m·s] against ΔV [m/s] of the draws, one colour per spacecraft (Fig. 5.11)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -81,9 +127,11 @@ def plot_dh_dv_scatter(results: Sequence[CaseResult], out: str | Path, *, max_po
         seen.add(r.spacecraft_name)
         k = min(max_points, r.dH_Nms.size)
         ok = (r.dH_Nms[:k] > 0) & (r.dV_mps[:k] > 0)
-        ax.loglog(r.dV_mps[:k][ok] * 1e3, r.dH_Nms[:k][ok] * 1e3, ".", ms=2, alpha=0.4, label=r.spacecraft_name)
-    ax.set_xlabel("ΔV [mm/s]")
-    ax.set_ylabel("ΔH [mN·m·s]")
+        ax.loglog(r.dV_mps[:k][ok], r.dH_Nms[:k][ok], ".", ms=2, alpha=0.4, label=r.spacecraft_name)
+    ax.set_xlabel("ΔV [m/s]")
+    ax.set_ylabel("ΔH [N·m·s]")
+    if scenario_title(results):
+        ax.set_title(scenario_title(results), fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(markerscale=5)
     fig.tight_layout()

@@ -4,7 +4,7 @@ A :class:`Scenario` is one spacecraft in one circular orbit with one flux model 
 choices (:class:`~abrupt.rates.montecarlo.RateConfig`). A trade varies any one or two scenario variables
 (``spacecraft``, ``orbit``, ``flux``, ``flux_bound``, ``mass_model``, ``mef``, ``grid_spacing``,
 ``size_scale``, ``location``, ``area``, ``lc_min``) over a grid of values and runs one Monte Carlo per
-case: in-process by default, or on a Dask cluster when a scheduler address is given. Every case uses the
+case through :func:`abrupt.scale.run_tasks`: in-process, on a local Dask cluster or at a scheduler. Every case uses the
 same seed (common random numbers), so differences between cases are the models', not sampling noise,
 and results do not depend on where a case runs.
 """
@@ -14,10 +14,10 @@ from __future__ import annotations
 import functools
 import itertools
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -28,6 +28,9 @@ from abrupt.rates import flux as fx
 from abrupt.rates.geometry import geometry_from_spacecraft
 from abrupt.rates.montecarlo import RateConfig, StrikeSample, simulate_strikes
 from abrupt.rates.tables import FluxTable, grun_table, nasa90_table, read_flux_table
+
+if TYPE_CHECKING:
+    from abrupt.scale import Executor
 
 TRADE_VARIABLES = (
     "spacecraft",
@@ -231,20 +234,20 @@ def run_trade(
     base: Scenario,
     variables: Sequence[tuple[str, Sequence[str]]],
     *,
+    executor: Executor | None = None,
     scheduler: str | None = None,
-    progress: Callable[[Any], Any] | None = None,
+    show_progress: bool | None = None,
 ) -> list[CaseResult]:
-    """Run every case of a trade, in-process, or on a Dask cluster when ``scheduler`` is an address."""
-    scenarios = trade_scenarios(base, variables)
-    if scheduler:
-        from distributed import Client
+    """Run every case of a trade on ``executor`` (:mod:`abrupt.scale`: in-process, a local Dask
+    cluster or a scheduler; ``scheduler`` is shorthand for ``Executor(scheduler=...)``)."""
+    from abrupt.scale import Executor, run_tasks
 
-        with Client(scheduler) as client:
-            futures = client.map(run_case, scenarios, pure=False)
-            results: list[CaseResult] = client.gather(futures)
-        return results
-    iterator = progress(scenarios) if progress is not None else scenarios
-    return [run_case(s) for s in iterator]
+    if executor is None:
+        executor = Executor(scheduler=scheduler)
+    scenarios = trade_scenarios(base, variables)
+    return run_tasks(
+        run_case, scenarios, executor=executor, desc="trade cases", unit="case", show_progress=show_progress
+    )
 
 
 def spread(results: Sequence[CaseResult], metric: str, threshold: float) -> tuple[float, float, float]:

@@ -23,6 +23,7 @@ import pandas as pd
 
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.tracking_measurements import MEASUREMENT_COLUMNS
+from abrupt.readers.text import read_text
 
 # type -> (number of values, [(column, scale to SI, plausible range in file units)])
 _TYPES: dict[str, list[tuple[str, float, tuple[float, float]]]] = {
@@ -69,7 +70,7 @@ def read_aer(
     known = None if known_stations is None else {s.upper(): s for s in known_stations}
     rows: list[dict[str, object]] = []
     try:
-        text = path.read_text()
+        text = read_text(path)
     except UnicodeDecodeError as exc:
         raise InputError(f"not a text file ({exc.reason})", file=path) from None
     for lineno, raw in enumerate(text.splitlines(), start=1):

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +25,10 @@ from abrupt.errors import InputError, RepairLog
 from abrupt.model.timescales import to_utc
 from abrupt.model.tracking_measurements import MEASUREMENT_COLUMNS
 from abrupt.readers.aer import finish_measurements
+from abrupt.readers.text import read_text
+
+#: Epochs outside these years are errors (space tracking; keeps datetime64[ns] from overflowing).
+EPOCH_YEARS = (1957, 2200)
 
 _DOY = re.compile(r"^(\d{4})-(\d{3})T(\d{2}):(\d{2}):(\d{2}(?:\.\d*)?)Z?$")
 _USED = {"RANGE", "ANGLE_1", "ANGLE_2", "DOPPLER_INSTANTANEOUS"}
@@ -68,12 +73,16 @@ def _parse_epoch(text: str) -> np.datetime64:
     m = _DOY.match(text)
     if m:
         year, doy, hh, mm, ss = m.groups()
+        if not EPOCH_YEARS[0] <= int(year) <= EPOCH_YEARS[1]:
+            raise ValueError(text)
         base = np.datetime64(f"{year}-01-01T00:00:00", "ns") + np.timedelta64(int(doy) - 1, "D")
         if not 1 <= int(doy) <= 366:
             raise ValueError(text)
         secs = int(hh) * 3600 + int(mm) * 60 + float(ss)
         return base + np.timedelta64(round(secs * 1e9), "ns")
     ts = pd.Timestamp(text.rstrip("Z"))
+    if not EPOCH_YEARS[0] <= ts.year <= EPOCH_YEARS[1]:
+        raise ValueError(text)
     return np.datetime64(ts.value, "ns")
 
 
@@ -81,7 +90,7 @@ def read_tdm(path: str | Path, *, repairs: RepairLog | None = None) -> pd.DataFr
     """Read a KVN TDM into the standard measurement table (SI units, UTC)."""
     path = Path(path)
     log = repairs if repairs is not None else RepairLog(str(path))
-    lines = path.read_text().splitlines()
+    lines = read_text(path).splitlines()
     rows: list[dict[str, object]] = []
     meta: dict[str, str] = {}
     state = "header"
@@ -134,7 +143,7 @@ def read_tdm(path: str | Path, *, repairs: RepairLog | None = None) -> pd.DataFr
             raise InputError(f"{key} needs 'EPOCH VALUE', got {value!r}", file=path, line=lineno, column=2)
         try:
             epoch = _parse_epoch(parts[0])
-        except (ValueError, TypeError):
+        except (ValueError, TypeError, OverflowError):
             raise InputError(f"cannot parse epoch {parts[0]!r}", file=path, line=lineno, column=2) from None
         try:
             v = float(parts[1])
@@ -154,7 +163,11 @@ def read_tdm(path: str | Path, *, repairs: RepairLog | None = None) -> pd.DataFr
     frame["time_utc"] = frame["time_utc"].astype("datetime64[ns]")
     for ts in frame["_ts"].unique():
         sel = frame["_ts"] == ts
-        frame.loc[sel, "time_utc"] = to_utc(frame.loc[sel, "time_utc"].to_numpy(), ts)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            frame.loc[sel, "time_utc"] = to_utc(frame.loc[sel, "time_utc"].to_numpy(), ts)
+        if any("dubious year" in str(w.message) for w in caught):
+            log.record("epochs beyond the leap-second table: TAI-UTC extrapolated (ERFA)", int(sel.sum()))
     # merge the single-value records of one epoch and station into one row per (time, station, kind)
     merged = (
         frame.groupby(["time_utc", "station"], sort=False)

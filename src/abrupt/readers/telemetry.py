@@ -30,6 +30,7 @@ series lives in :mod:`abrupt.series.telemetry`; masks (planned events) in :mod:`
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -87,6 +88,12 @@ def _numeric(frame: pd.DataFrame, column: str, path: Path, is_csv: bool) -> NDAr
 
 RATE_CHECK_BLOCK_S = 10.0  # [s] averaging block for the gyro / quaternion-derivative cross-check
 RATE_CHECK_MIN_SNR = 10.0  # the check speaks only when the attitude motion stands well above noise
+# Block-averaged gyro noise may not exceed the block-averaged noise of the quaternion-derived rate by
+# more than this factor: the body cannot rotate more than its attitude shows. Correct units give
+# ratios below 1 for a gyro with a star tracker of similar quality; rates in deg/s declared as rad/s
+# multiply it by 57.3. Above RATE_NOISE_WARN the reader warns; above RATE_NOISE_ERROR it refuses.
+RATE_NOISE_WARN = 5.0
+RATE_NOISE_ERROR = 30.0
 
 
 def _check_rates_against_attitude(
@@ -110,6 +117,7 @@ def _check_rates_against_attitude(
     num = den = 0.0
     signal: list[float] = []
     noise: list[float] = []
+    gyro_noise: list[float] = []
     for a, b in segments:
         if b - a < 3:
             continue
@@ -128,6 +136,22 @@ def _check_rates_against_attitude(
         den += float(np.sum(wq_b * wq_b))
         signal.append(float(np.sqrt(np.mean(wq_b**2))))
         noise.append(float(np.median(robust_noise_sigma(wq_b))))
+        gyro_noise.append(float(np.median(robust_noise_sigma(wg_b))))
+    q_noise = float(np.median(noise)) if noise else 0.0
+    g_noise = float(np.median(gyro_noise)) if gyro_noise else 0.0
+    # Quaternions a thousand times quieter than the gyro are smoothed or simulated without noise: the
+    # comparison then says nothing about the gyro's unit.
+    if q_noise > 1e-3 * g_noise > 0:
+        ratio = g_noise / q_noise
+        if ratio > RATE_NOISE_WARN:
+            message = (
+                f"body-rate noise averaged over {RATE_CHECK_BLOCK_S:g} s is {ratio:.3g} x that of the rate implied "
+                f"by the quaternions: the gyro shows rotation the attitude does not; the rates look like deg/s "
+                f"although the spacecraft file says {unit!r}, or their unit is wrong"
+            )
+            if ratio > RATE_NOISE_ERROR:
+                raise InputError(message, file=path, column="body_rate")
+            logging.getLogger("abrupt").warning("%s: %s", path, message)
     if not signal or den <= 0 or max(signal) < RATE_CHECK_MIN_SNR * max(min(noise), 1e-300):
         return
     k = num / den

@@ -2,8 +2,10 @@
 
 One figure, all panels sharing the time axis: inertial momentum ᴺH (change from its start), its body
 (J ω) and wheel contributions, body rates, wheel speeds, then each detector's statistic with its
-threshold. Detected events are vertical lines through every panel; known truth (simulations) is
-marked with triangles. Written as PNG, or as a self-contained HTML page with the figure, the events
+threshold. Detected events are vertical lines through every panel, one colour and one legend entry per
+detector (abrupt.report.style); known truth (simulations) is marked with black triangles, in the legend
+too. Detectors that raised events without a kept statistic series (matched filters) get a panel of
+statistic/threshold at their events. Written as PNG, or as a self-contained HTML page with the figure, the events
 table, the thresholds and the input repairs.
 """
 
@@ -24,6 +26,15 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from abrupt.pipelines.attitude import AttitudeRun, display_name
+from abrupt.report.style import (
+    FIGURE_SUFFIXES,
+    TRUTH_STYLE,
+    detector_colour,
+    draw_events,
+    robust_baseline,
+    save_figure,
+    truth_handle,
+)
 from abrupt.series.telemetry import Telemetry
 
 MAX_POINTS = 20000  # per line; longer series are min/max decimated so spikes stay visible
@@ -68,20 +79,26 @@ def attitude_figure(
     t0 = telemetry.time[0]
     names = list(result.statistics)
     units = _units(result)
-    n_panels = 4 + len(names)
-    fig, axes = plt.subplots(n_panels, 1, sharex=True, figsize=(12, 2.1 * n_panels + 1), constrained_layout=True)
+    events = result.events
+    # detectors that raised events but keep no statistic series (matched filters): one extra panel
+    shown = {f"attitude.{n}" for n in names}
+    event_only = sorted({str(d) for d in events["detector"]} - shown) if len(events) else []
+    n_panels = 4 + len(names) + (1 if event_only else 0)
+    fig, axes = plt.subplots(n_panels, 1, sharex=True, figsize=(12, 2.1 * n_panels + 1.5), layout="constrained")
     axis_labels = ("x", "y", "z")
     colours = ("tab:blue", "tab:orange", "tab:green")
 
     h = result.momentum_N_Nms
     smooth_n = max(1, round(SMOOTHING_S / telemetry.sample_interval_s))
+    # reference: the median over the first smoothing window, not the first (noisy) sample
+    h_ref = robust_baseline(h, smooth_n)
     ax = axes[0]
     for i in range(3):
-        tt, yy = _decimate(t_h, h[:, i] - h[0, i])
+        tt, yy = _decimate(t_h, h[:, i] - h_ref[i])
         ax.plot(tt, yy, lw=0.4, color=colours[i], alpha=0.25)
-        tt, yy = _decimate(t_h, _running_mean(h[:, i] - h[0, i], smooth_n))
+        tt, yy = _decimate(t_h, _running_mean(h[:, i] - h_ref[i], smooth_n))
         ax.plot(tt, yy, lw=1.0, color=colours[i], label=f"ᴺH_{axis_labels[i]} ({SMOOTHING_S:g} s mean)")
-    ax.set_ylabel("ᴺH − ᴺH₀\n[N·m·s]")
+    ax.set_ylabel(f"ᴺH − median of\nfirst {SMOOTHING_S:g} s [N·m·s]")
     ax.legend(loc="upper left", ncol=3, fontsize=8)
 
     ax = axes[1]
@@ -109,25 +126,47 @@ def attitude_figure(
 
     for k, name in enumerate(names):
         ax = axes[4 + k]
+        colour = detector_colour(name)
         tt, yy = _decimate(t_h, result.statistics[name])
-        ax.plot(tt, yy, lw=0.6, color="black")
+        ax.plot(tt, yy, lw=0.6, color="0.25", label=f"{name} statistic")
         thr = result.thresholds[name]
-        ax.axhline(thr.value, color="tab:red", lw=1.0, ls="--", label=f"threshold ({thr.false_alarms_per_day:g}/day)")
+        ax.axhline(
+            thr.value, color=colour, lw=1.2, ls="--", label=f"{name} threshold ({thr.false_alarms_per_day:g}/day)"
+        )
         ax.set_ylabel(f"{name}\n[{units[name]}]")
         ax.legend(loc="upper left", fontsize=8)
 
-    events = result.events
+    def hours(times: pd.Series) -> NDArray[np.float64]:
+        ts = pd.to_datetime(times.astype(str)).dt.tz_localize(None) - pd.Timestamp(t0)
+        return np.asarray(ts.dt.total_seconds(), dtype=np.float64) / 3600.0
+
+    if event_only:
+        ax = axes[-1]
+        for det in event_only:
+            sel = events[events["detector"] == det]
+            x = hours(sel["time_utc"])
+            ratio = np.asarray(sel["statistic"], dtype=float) / np.asarray(sel["threshold"], dtype=float)
+            ax.vlines(x, 1.0, ratio, color=detector_colour(det), lw=2)
+            ax.plot(x, ratio, "o", color=detector_colour(det), ms=5, label=det.removeprefix("attitude."))
+        ax.axhline(1.0, color="0.3", lw=1.0, ls="--", label="threshold")
+        ax.set_ylabel("statistic / threshold\nat events (no series kept)")
+        ax.set_yscale("log")
+        ax.legend(loc="upper left", fontsize=8, ncol=4)
+
+    handles = []
     if len(events):
-        ev_t = (
-            pd.to_datetime(events["time_utc"].astype(str)).dt.tz_localize(None) - pd.Timestamp(t0)
-        ).dt.total_seconds() / 3600
-        for ax in axes:
-            for x in ev_t:
-                ax.axvline(float(x), color="tab:red", lw=0.8, alpha=0.5)
+        by_det = {
+            str(det): list(hours(events.loc[events["detector"] == det, "time_utc"]))
+            for det in sorted(set(events["detector"].astype(str)))
+        }
+        handles = draw_events(axes, by_det)
     if truth is not None and len(truth):
         tr_t = np.asarray(truth["time_s"], dtype=float) / 3600.0 if "time_s" in truth else np.array([])
-        for x in tr_t:
-            axes[0].plot([x], [0.0], marker="v", color="tab:purple", ms=8, zorder=5)
+        y_top = axes[0].get_ylim()[1]
+        axes[0].plot(tr_t, np.full(tr_t.size, y_top), **TRUTH_STYLE, clip_on=False)
+        handles.append(truth_handle(f"truth: {tr_t.size} strike(s)"))
+    if handles:
+        fig.legend(handles=handles, loc="outside lower center", ncol=min(len(handles), 5), fontsize=8, frameon=False)
     axes[-1].set_xlabel(f"hours since {pd.Timestamp(t0).isoformat()} UTC")
     fig.suptitle(title or f"abrupt attitude report: {telemetry.source}", fontsize=11)
     return fig
@@ -181,18 +220,16 @@ def write_attitude_report(
     truth: pd.DataFrame | None = None,
     title: str = "",
 ) -> Path:
-    """Write the report as PNG (``.png``) or self-contained HTML (``.html``)."""
+    """Write the report as a figure (``.png``, ``.svg``, ``.pdf``) or a self-contained page (``.html``)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig = attitude_figure(telemetry, result, truth=truth, title=title)
     suffix = path.suffix.lower()
-    if suffix == ".png":
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
-        return path
+    if suffix in FIGURE_SUFFIXES:
+        return save_figure(fig, path)
     if suffix not in (".html", ".htm"):
         plt.close(fig)
-        raise ValueError(f"{path}: report must end in .png or .html")
+        raise ValueError(f"{path}: report must end in .png, .svg, .pdf or .html")
     img = _png_base64(fig)
     qq = qq_figure(result)
     qq_html = (

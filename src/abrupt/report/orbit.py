@@ -8,6 +8,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
+
+from abrupt.report.style import detector_colour, save_figure
 
 if TYPE_CHECKING:
     from abrupt.detect.orbit_detector import OrbitAnalysis
@@ -23,8 +26,8 @@ def plot_orbit_report(
     path: str | Path,
     statistics: tuple[str, ...] = PANEL_STATISTICS,
 ) -> Path:
-    """Write a PNG: forward-filter position and velocity residuals, then one panel per statistic with its
-    threshold (dashed) and the event times (vertical lines)."""
+    """Write a figure (PNG, SVG or PDF by suffix): forward-filter position and velocity residuals, then
+    one panel per statistic with its threshold (dashed) and the event times (vertical lines)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -34,7 +37,10 @@ def plot_orbit_report(
 
     hours = analysis.t_s / 3600.0
     names = [s for s in statistics if s in analysis.statistics]
-    fig, axes = plt.subplots(2 + len(names), 1, figsize=(10, 2.0 * (2 + len(names))), sharex=True)
+    # constrained layout keeps the title clear of the top panel
+    fig, axes = plt.subplots(
+        2 + len(names), 1, figsize=(10, 2.0 * (2 + len(names)) + 0.6), sharex=True, layout="constrained"
+    )
     innov = analysis.forward.innovation
     for j, lab in enumerate("xyz"):
         axes[0].plot(hours, innov[:, j], lw=0.5, label=lab)
@@ -47,19 +53,50 @@ def plot_orbit_report(
         t0 = analysis.ephemeris.times_utc[0]
         for tt in pd.to_datetime(events["time_utc"]).dt.tz_localize(None):
             event_hours.append(float((np.datetime64(tt, "ns") - t0).astype(np.float64) * 1e-9 / 3600.0))
+    period_samples = _orbit_period_samples(analysis)
     for ax, name in zip(axes[2:], names, strict=True):
-        ax.plot(hours, analysis.statistics[name], lw=0.6, color="k")
+        stat = np.asarray(analysis.statistics[name], dtype=np.float64)
+        if name == "d_sma" and period_samples > 2:
+            # the osculating Δa oscillates within each revolution (a solid band at this scale): draw it
+            # faintly, and its mean over one orbital period, where a step shows
+            ax.plot(hours, stat, lw=0.3, color="0.7", label="osculating")
+            ax.plot(hours, _running_mean(stat, period_samples), lw=1.0, color="k", label="mean over one orbit")
+            ax.legend(loc="upper left", fontsize=7)
+        else:
+            ax.plot(hours, stat, lw=0.6, color="k")
         if name in thresholds:
-            ax.axhline(thresholds[name].value, ls="--", color="r", lw=0.8)
+            ax.axhline(thresholds[name].value, ls="--", color=detector_colour("orbit." + name), lw=1.0)
         ax.set_ylabel(f"{name}\n({STATISTIC_UNITS.get(name, '-')})", fontsize=8)
     for ax in axes:
         for h in event_hours:
             ax.axvline(h, color="tab:orange", lw=0.8, alpha=0.7)
     axes[-1].set_xlabel(f"hours since {np.datetime_as_string(analysis.ephemeris.times_utc[0], unit='s')} UTC")
     fig.suptitle(f"{analysis.ephemeris.satellite}: orbit impulse detection ({len(event_hours)} event(s))")
-    fig.tight_layout()
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    if event_hours:
+        from matplotlib.lines import Line2D
+
+        handle = Line2D([], [], color="tab:orange", lw=1.5, label=f"events: {len(event_hours)}")
+        fig.legend(handles=[handle], loc="outside lower center", fontsize=8, frameon=False)
+    return save_figure(fig, path)
+
+
+def _orbit_period_samples(analysis: OrbitAnalysis) -> int:
+    """Samples in one orbital period, T = 2π √(a³/μ) with a the mean radius (near-circular orbits)."""
+    mu = 3.986004418e14  # Earth's GM [m³/s²] (IERS 2010)
+    r = np.linalg.norm(np.asarray(analysis.ephemeris.position_m, dtype=np.float64), axis=1)
+    dt = np.median(np.diff(analysis.t_s)) if analysis.t_s.size > 1 else 0.0
+    if not (r.size and dt > 0):
+        return 0
+    period = 2 * np.pi * np.sqrt(float(np.mean(r)) ** 3 / mu)
+    return round(period / dt)
+
+
+def _running_mean(y: NDArray[np.float64], n: int) -> NDArray[np.float64]:
+    from scipy.ndimage import uniform_filter1d
+
+    ok = np.isfinite(y)
+    total = uniform_filter1d(np.where(ok, y, 0.0), size=n, mode="nearest")
+    count = uniform_filter1d(ok.astype(np.float64), size=n, mode="nearest")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = np.where(count > 0.5, total / np.maximum(count, 1e-12), np.nan)  # NaN where most samples are
+    return np.asarray(mean, dtype=np.float64)

@@ -2,8 +2,10 @@
 
 Panels, sharing the time axis: semi-major axis (m, relative to its median), eccentricity-vector
 components, inclination and J2-drift-removed RAAN (times sin i), and the combined step statistic S with
-its threshold (log scale). Detections are vertical lines (green when matched to truth, red when not,
-if a truth list is given); truth maneuvers are black triangles on the top panel.
+its threshold (log scale). Semi-major-axis points beyond the robust limits (large orbit raises) are
+triangles on the panel edge with a legend entry giving their number and extreme. Detections are
+vertical lines (green when matched to truth, red when not, if a truth list is given), in the legend with
+their counts; truth maneuvers are black triangles on the top panel.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import numpy as np
 import pandas as pd
 
 from abrupt.readers.tle import ElementHistory
+from abrupt.report.style import clip_with_markers, save_figure
 
 
 def _utc(values: Any) -> pd.DatetimeIndex:
@@ -61,7 +64,8 @@ def plot_tle_report(
     if a.size > 20:  # robust limits: large orbit changes would hide the metre-level maintenance steps
         lo, hi = np.quantile(a - np.median(a), [0.02, 0.98])
         pad = 0.3 * (hi - lo) + 1.0
-        axes[0].set_ylim(lo - pad, hi + pad)
+        # points beyond are drawn as triangles on the edge, with a legend entry saying how far they go
+        clip_with_markers(axes[0], np.asarray(t), np.asarray(a - np.median(a)), lo - pad, hi + pad, " m")
     axes[1].plot(t, s["ex"] * 1e3, ".", ms=2, label="e cos ϖ" if geo else "e cos ω")
     axes[1].plot(t, s["ey"] * 1e3, ".", ms=2, label="e sin ϖ" if geo else "e sin ω")
     axes[1].set_ylabel("e-vector [×10⁻³]")
@@ -85,8 +89,7 @@ def plot_tle_report(
         tt = _utc(truth["time_utc"])
         tt = tt[(tt >= t[0]) & (tt <= t[-1])]
         ymax = float(axes[0].get_ylim()[1])
-        axes[0].plot(tt, np.full(len(tt), ymax), "v", color="k", ms=6, label="operator maneuver")
-        axes[0].legend(loc="upper right", fontsize=8)
+        axes[0].plot(tt, np.full(len(tt), ymax), "v", color="k", ms=6, label="operator maneuver", clip_on=False)
         summary = f"P={result.precision:.2f} R={result.recall:.2f} F1={result.f1:.2f} (±{tolerance_s / 86400:g} d)"
     else:
         shown = events.loc[events["statistic"] >= events["threshold"]] if len(events) else events
@@ -96,12 +99,21 @@ def plot_tle_report(
         x = _utc([row["time_utc"]])[0]
         for ax in axes:
             ax.axvline(x, color=colour, alpha=0.35, lw=0.8)
+    if len(shown):
+        from matplotlib.lines import Line2D
+
+        n_match = len(matched & set(shown.index)) if truth is not None and len(truth) else len(shown)
+        handles = [Line2D([], [], color="tab:green", lw=1.5, label=f"detection, matched: {n_match}")]
+        if truth is not None and len(truth):
+            handles.append(
+                Line2D([], [], color="tab:red", lw=1.5, label=f"detection, unmatched: {len(shown) - n_match}")
+            )
+        axes[0].add_artist(axes[0].legend(handles=handles, loc="upper left", fontsize=8))
+    if axes[0].get_legend_handles_labels()[0]:
+        axes[0].legend(loc="upper right", fontsize=8)
     axes[0].set_title(
         (title or f"{history.name or 'satellite'} (NORAD {history.norad_id}): {len(shown)} maneuver(s)")
-        + (f" — {summary}" if summary else "")
+        + (f" — {summary}" if summary else ""),
+        pad=14,  # room for the truth triangles on the panel's top edge
     )
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    return save_figure(fig, out)

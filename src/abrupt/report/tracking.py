@@ -8,9 +8,12 @@ maneuvers as vertical lines.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
+
+from abrupt.report.style import save_figure
 
 
 def plot_tracking_report(
@@ -25,6 +28,7 @@ def plot_tracking_report(
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib import ticker
 
     kad = diagnostics[diagnostics["series"] == "kaderali"] if "series" in diagnostics else diagnostics.iloc[:0]
     glrt = diagnostics[diagnostics["series"] == "glrt"] if "series" in diagnostics else diagnostics.iloc[:0]
@@ -37,8 +41,11 @@ def plot_tracking_report(
         t = pd.to_datetime(kad["time_utc"])
         psi = kad["psi"].to_numpy(dtype=float)
         ax = ax_of["psi"]
-        ax.semilogy(t, np.maximum(psi, 1e-12), ".", ms=2, color="tab:blue")
         th = float(kad["threshold"].iloc[0])
+        positive = psi[np.isfinite(psi) & (psi > 0)]
+        floor = min(float(np.quantile(positive, 0.01)) if positive.size else 1e-3, th / 10.0)
+        ax.semilogy(t, np.maximum(psi, floor), ".", ms=2, color="tab:blue")
+        readable_log_axis(ax)
         ax.axhline(th, color="tab:red", lw=1, label=f"detection Ψ = {th:.1f}")
         ax.set_ylabel("Ψ = νᵀS⁻¹ν")
         ax.legend(loc="upper left", fontsize=8)
@@ -61,6 +68,9 @@ def plot_tracking_report(
             ax.legend(loc="upper left", fontsize=8)
         ax.set_ylabel("GLRT T(τ) (χ²₃)")
         ax.set_yscale("symlog", linthresh=10.0)
+        ax.set_ylim(bottom=0.0)  # T(τ) >= 0: no negative half of the symlog axis
+        ax.yaxis.set_major_locator(ticker.SymmetricalLogLocator(base=10, linthresh=10.0, subs=(1.0,)))
+        ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
     for frame, style, label in ((events, "--", "detected"), (truth, ":", "truth")):
         if frame is None or len(frame) == 0:
             continue
@@ -80,8 +90,22 @@ def plot_tracking_report(
     axes[0, 0].legend(loc="upper left", fontsize=8)
     axes[-1, 0].set_xlabel("time (UTC)")
     fig.tight_layout()
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    return save_figure(fig, path)
+
+
+def readable_log_axis(ax: Any) -> None:
+    """Labelled ticks on a log y-axis whatever its span: 1…9 within one decade, 1-2-5 per decade over a
+    few, decades
+    (with unlabelled minor ticks) over a wide one."""
+    from matplotlib import ticker
+
+    lo, hi = ax.get_ylim()
+    decades = np.log10(hi / lo) if lo > 0 and hi > lo else 10.0
+    subs = tuple(float(k) for k in range(1, 10)) if decades < 1 else (1.0, 2.0, 5.0) if decades < 3 else (1.0,)
+    ax.yaxis.set_major_locator(ticker.LogLocator(base=10, subs=subs, numticks=12))
+    if decades < 3:
+        ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+    else:
+        ax.yaxis.set_major_formatter(ticker.LogFormatterSciNotation())
+    ax.yaxis.set_minor_locator(ticker.LogLocator(base=10, subs=tuple(float(k) for k in range(2, 10)), numticks=12))
+    ax.yaxis.set_minor_formatter(ticker.NullFormatter())

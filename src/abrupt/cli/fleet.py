@@ -1,0 +1,168 @@
+"""``abrupt detect fleet``: attitude strike detection over many spacecraft and files, resumable, on Dask."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import click
+
+from abrupt.cli.groups import catalog_option, check_suffix, detect, note, progress_hidden, warn
+
+executor_options = [
+    click.option(
+        "--workers",
+        type=click.IntRange(min=1),
+        default=None,
+        help="Run tasks on a local Dask cluster of N worker processes (default: in-process).",
+    ),
+    click.option(
+        "--scheduler",
+        default=None,
+        help="Run tasks on the Dask cluster at this scheduler address (tcp://host:8786).",
+    ),
+]
+
+
+def with_executor_options(f: Any) -> Any:
+    """Add ``--workers`` and ``--scheduler`` to a command."""
+    for opt in reversed(executor_options):
+        f = opt(f)
+    return f
+
+
+def executor_from(workers: int | None, scheduler: str | None) -> Any:
+    from abrupt.scale import Executor
+
+    return Executor(workers=workers, scheduler=scheduler)
+
+
+@detect.command("fleet")
+@click.argument("manifest", type=click.Path(exists=True, dir_okay=False))
+@click.option(
+    "--detector",
+    "detectors",
+    multiple=True,
+    type=click.Choice(["glr", "cusum", "summation", "shiryaev", "mf_attitude", "mf_rate", "mf_joint"]),
+    default=("glr",),
+    show_default=True,
+    help="Attitude detector(s); repeatable.",
+)
+@click.option(
+    "--false-alarms-per-day",
+    "fa_per_day",
+    type=click.FloatRange(min=0.0, min_open=True),
+    default=1.0,
+    show_default=True,
+    help="False-alarm budget per spacecraft-day the thresholds are set for.",
+)
+@click.option(
+    "--null-samples",
+    type=click.IntRange(min=100_000),
+    default=10_000_000,
+    show_default=True,
+    help="Event-free samples simulated per file for threshold calibration (raised to the fit's minimum).",
+)
+@with_executor_options
+@catalog_option
+@click.option(
+    "--out",
+    type=click.Path(dir_okay=False),
+    required=True,
+    callback=check_suffix(".csv", ".parquet"),
+    help="Events file of the whole fleet (.csv or .parquet).",
+)
+def detect_fleet_cmd(
+    manifest: str,
+    detectors: tuple[str, ...],
+    fa_per_day: float,
+    null_samples: int,
+    workers: int | None,
+    scheduler: str | None,
+    catalog_target: str,
+    out: str,
+) -> None:
+    """Detect strikes in every telemetry file listed in MANIFEST (CSV: spacecraft,telemetry,spacecraft_file).
+
+    One task per row (spacecraft, file), each calibrated on its own noise. Finished tasks are stored in
+    the catalog as they end: a run that was stopped or killed resumes where it stopped when started
+    again with the same inputs and settings.
+    """
+    from pathlib import Path
+
+    from abrupt.detect.attitude import AttitudeDetectionConfig
+    from abrupt.events import write_events
+    from abrupt.pipelines.fleet import detect_attitude_fleet, read_manifest
+
+    members = read_manifest(manifest)
+    executor = executor_from(workers, scheduler)
+    config = AttitudeDetectionConfig(
+        detectors=tuple(dict.fromkeys(detectors)), false_alarms_per_day=fa_per_day, null_samples=null_samples
+    )
+    note(f"{len(members)} task(s) (spacecraft, file) on {executor.describe()}")
+    result = detect_attitude_fleet(
+        members,
+        config,
+        catalog=catalog_target,
+        executor=executor,
+        command="detect fleet " + manifest,
+        show_progress=not progress_hidden(),
+    )
+    for key, repairs in result.repairs.items():
+        for kind, n in sorted(repairs.items()):
+            note(f"repaired: {key}: {kind}: {n}")
+    for w in result.warnings:
+        warn(w)
+    Path(out).parent.mkdir(parents=True, exist_ok=True)
+    write_events(result.events, out)
+    resumed = f" ({result.n_resumed} finished earlier, resumed)" if result.n_resumed else ""
+    note(f"{len(result.events)} event(s) from {result.n_tasks} task(s){resumed}; run {result.run_id}; written to {out}")
+
+
+@detect.command("tle-batch")
+@click.argument("paths", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False))
+@click.option(
+    "--false-alarms",
+    default="1/year",
+    show_default=True,
+    help="False-alarm budget per satellite (RATE/day, /week or /year).",
+)
+@with_executor_options
+@catalog_option
+@click.option(
+    "--out",
+    type=click.Path(dir_okay=False),
+    required=True,
+    callback=check_suffix(".csv", ".parquet"),
+    help="Events file of all histories (.csv or .parquet).",
+)
+def detect_tle_batch_cmd(
+    paths: tuple[str, ...],
+    false_alarms: str,
+    workers: int | None,
+    scheduler: str | None,
+    catalog_target: str,
+    out: str,
+) -> None:
+    """Detect maneuvers in many TLE/OMM histories (PATHS), one task per file, in-process or on Dask."""
+    from abrupt.cli.groups import record_run
+    from abrupt.events import config_hash, new_run_id
+    from abrupt.pipelines.fleet import detect_tle_batch
+    from abrupt.thresholds import FalseAlarmBudget
+
+    try:
+        budget = FalseAlarmBudget.parse(false_alarms)
+    except ValueError as exc:
+        raise click.BadParameter(str(exc), param_hint="--false-alarms") from None
+    executor = executor_from(workers, scheduler)
+    note(f"{len(paths)} TLE/OMM file(s) on {executor.describe()}")
+    run_id = new_run_id()
+    events = detect_tle_batch(paths, budget, executor=executor, run_id=run_id, show_progress=not progress_hidden())
+    record_run(
+        catalog_target=catalog_target,
+        command="detect tle-batch " + " ".join(paths),
+        events=events,
+        config_hash=config_hash({"budget": str(budget), "detector": "auto"}),
+        run_id=run_id,
+        out=out,
+        details={"files": list(paths), "budget": str(budget)},
+    )
