@@ -72,12 +72,6 @@ class TrackingRun:
         return fit_summary_lines(self.fit_summary)
 
 
-def looks_like_tdm(path: str | Path) -> bool:
-    with open(path, errors="replace") as fh:
-        head = fh.read(2000)
-    return "CCSDS_TDM_VERS" in head
-
-
 def read_tracking_series(
     file: str | Path, setup_path: str | Path, settings: TrackingSettings, *, name: str | None = None
 ) -> TrackingInputs:
@@ -90,17 +84,13 @@ def read_tracking_series(
     """
     from abrupt.model.timescales import offline_astropy
     from abrupt.model.tracking_measurements import TrackingArrays, correct_refraction
-    from abrupt.readers.aer import read_aer
     from abrupt.readers.orekit_od_input import read_od_input
-    from abrupt.readers.tdm import read_tdm
+    from abrupt.readers.tracking import read_tracking
 
     offline_astropy()
     setup = read_od_input(setup_path)
     repairs = RepairLog(str(file))
-    if Path(file).suffix.lower() in (".tdm", ".kvn", ".txt") and looks_like_tdm(file):
-        meas = read_tdm(file, repairs=repairs)
-    else:
-        meas = read_aer(file, known_stations=setup.stations, repairs=repairs)
+    meas = read_tracking(file, known_stations=setup.stations, repairs=repairs)  # CRD, TDM or .aer by content
     use_refraction = setup.refraction_correction if settings.refraction is None else settings.refraction
     if use_refraction:
         meas = correct_refraction(meas)

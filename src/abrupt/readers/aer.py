@@ -43,12 +43,15 @@ _FILE_COLUMNS = {
 
 def parse_utc(text: str) -> np.datetime64:
     """ISO-8601 date (UTC; a trailing ``Z`` or offset is honoured) as ``datetime64[ns]``."""
-    ts = pd.Timestamp(text)
-    if ts is pd.NaT:
-        raise ValueError(text)
-    if ts.tzinfo is not None:
-        ts = ts.tz_convert("UTC").tz_localize(None)
-    return np.datetime64(ts.value, "ns")
+    try:
+        ts = pd.Timestamp(text)
+        if ts is pd.NaT:
+            raise ValueError(text)
+        if ts.tzinfo is not None:
+            ts = ts.tz_convert("UTC").tz_localize(None)
+        return np.datetime64(ts.value, "ns")
+    except OverflowError:  # a date outside the datetime64[ns] range (years 1677-2262)
+        raise ValueError(text) from None
 
 
 def read_aer(

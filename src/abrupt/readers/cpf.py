@@ -92,7 +92,7 @@ def read_cpf(path: str | Path, satellite: str | None = None, *, allow_truncated:
                 mjd = int(parts[2])
                 sod = float(parts[3])
                 xyz = [float(p) for p in parts[5:8]]
-                if not (all(math.isfinite(c) for c in xyz) and 0.0 <= sod < 86401.0 and 15000 < mjd < 100000):
+                if not (all(abs(c) < 1e12 for c in xyz) and 0.0 <= sod < 86401.0 and 15000 < mjd < 100000):
                     raise ValueError("values out of range")
             except ValueError as exc:
                 bad.append((no, f"malformed position record ({exc})", 1))
@@ -109,7 +109,7 @@ def read_cpf(path: str | Path, satellite: str | None = None, *, allow_truncated:
         if rec == "20" and last_pos is not None:
             try:
                 vel = [float(p) for p in parts[2:5]]
-                if len(vel) != 3 or not all(math.isfinite(v) for v in vel):
+                if len(vel) != 3 or not all(abs(v) < 1e12 for v in vel):
                     raise ValueError
             except ValueError:
                 bad.append((no, "malformed velocity record", 1))

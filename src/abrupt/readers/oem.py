@@ -130,8 +130,8 @@ def _state_from_tokens(parts: list[str]) -> tuple[np.datetime64, list[float]]:
             v = float(p)
         except ValueError:
             raise _Bad(f"cannot read state value {p!r}", k + 2) from None
-        if not math.isfinite(v):
-            raise _Bad(f"state value {p!r} is not finite", k + 2)
+        if not (math.isfinite(v) and abs(v) < 1e12):
+            raise _Bad(f"state value {p!r} is not finite or absurdly large", k + 2)
         values.append(v)
     return epoch, values
 

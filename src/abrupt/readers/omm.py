@@ -136,12 +136,39 @@ def parse_xml(text: str, file: str) -> list[tuple[dict[str, str], int | None]]:
         ) from None
     omms = [root] if _local(root.tag) == "OMM" else [el for el in root.iter() if _local(el.tag) == "OMM"]
     if not omms:
-        raise InputError("XML document holds no <omm> element", file=file)
+        raise InputError("XML document holds no <omm> element", file=file, line=1)
+    starts = [text.count("\n", 0, m.start()) + 1 for m in re.finditer(r"<(?:[\w.-]+:)?omm[\s>/]", text, re.IGNORECASE)]
     out: list[tuple[dict[str, str], int | None]] = []
-    for o in omms:
+    for k, o in enumerate(omms):
         rec = {_local(el.tag): (el.text or "").strip() for el in o.iter() if len(el) == 0}
-        out.append((rec, None))
+        out.append((rec, starts[k] if len(starts) == len(omms) else None))
     return out
+
+
+def _json_object_lines(text: str) -> list[int]:
+    """Line numbers where the top-level objects of a JSON text (a list of objects, or one) start."""
+    lines: list[int] = []
+    depth, line, in_str, esc = 0, 1, False, False
+    for ch in text:
+        if ch == "\n":
+            line += 1
+        if in_str:
+            if esc:
+                esc = False
+            elif ch == "\\":
+                esc = True
+            elif ch == '"':
+                in_str = False
+            continue
+        if ch == '"':
+            in_str = True
+        elif ch in "[{":
+            if ch == "{" and depth <= 1:
+                lines.append(line)
+            depth += 1
+        elif ch in "]}":
+            depth -= 1
+    return lines
 
 
 def parse_kvn(text: str, file: str) -> list[tuple[dict[str, str], int | None]]:
@@ -182,8 +209,9 @@ def parse_json(text: str, file: str) -> list[tuple[dict[str, Any], int | None]]:
     if isinstance(data, dict):
         data = [data]
     if not isinstance(data, list) or not all(isinstance(r, dict) for r in data):
-        raise InputError("JSON OMM must be an object or a list of objects", file=file)
-    return [(r, None) for r in data]
+        raise InputError("JSON OMM must be an object or a list of objects", file=file, line=1)
+    starts = _json_object_lines(text)
+    return [(r, starts[k] if len(starts) == len(data) else None) for k, r in enumerate(data)]
 
 
 def parse_csv(text: str, file: str) -> list[tuple[dict[str, Any], int | None]]:
@@ -203,7 +231,7 @@ def detect_format(text: str) -> str:
         return "kvn"
     if "MEAN_MOTION" in head.split("\n", 1)[0].upper():
         return "csv"
-    raise InputError("not an OMM file (expected XML, KVN, JSON or CSV)")
+    raise InputError("not an OMM file (expected XML, KVN, JSON or CSV)", line=1)
 
 
 def iter_omm_sets(
@@ -222,7 +250,7 @@ def iter_omm_sets(
     fmt = fmt or detect_format(text)
     parsers = {"xml": parse_xml, "kvn": parse_kvn, "json": parse_json, "csv": parse_csv}
     if fmt not in parsers:
-        raise InputError(f"unknown OMM format {fmt!r} (known: {sorted(parsers)})", file=file)
+        raise InputError(f"unknown OMM format {fmt!r} (known: {sorted(parsers)})", file=file, line=1)
     for i, (rec, line) in enumerate(parsers[fmt](text, file), start=1):
         try:
             yield record_to_set(rec, file=file, index=i, line=line)

@@ -122,8 +122,8 @@ def _number(text: str, column: int, what: str) -> float:
         value = float(text)
     except ValueError:
         raise _BadRecord(f"{what}: cannot read number {text.strip()!r}", column) from None
-    if not math.isfinite(value):
-        raise _BadRecord(f"{what}: {text.strip()!r} is not a finite number", column)
+    if not (math.isfinite(value) and abs(value) < 1e12):
+        raise _BadRecord(f"{what}: {text.strip()!r} is not finite or absurdly large", column)
     return value
 
 
@@ -648,7 +648,12 @@ def write_sp3(
     t_sys_by_sat = [_from_utc(e.times_utc, time_system) for e in ephs]
     all_t = np.unique(np.concatenate(t_sys_by_sat))
     has_vel = any(np.isfinite(e.velocity_mps).any() for e in ephs)
-    step_s = float(np.median(np.diff(all_t).astype(np.float64)) * 1e-9) if all_t.size > 1 else 0.0
+    step_s = 0.0  # 0 = no regular interval (the reader then does not check the sampling grid)
+    if all_t.size > 1:
+        steps_ns = np.diff(all_t).astype(np.int64)
+        smallest = int(steps_ns.min())
+        if smallest > 0 and np.all(steps_ns % smallest == 0):
+            step_s = smallest * 1e-9
     from astropy.time import Time
 
     from abrupt.model.timescales import offline_astropy

@@ -344,7 +344,7 @@ def history_from_sets(
         raise InputError(
             "no readable element sets" + (f" of satellite {norad_id}" if norad_id is not None else "") + why,
             file=source,
-            line=skipped[0].line if skipped else 1,
+            line=(skipped[0].line or 1) if skipped else 1,
         )
     # Exact duplicates.
     seen: set[str] = set()
