@@ -10,7 +10,9 @@ so a capability that registers detectors adds its example here (one function and
 
 ``make()`` returns a short series holding at least one event every detector of that type should
 find at the test budget (:data:`BUDGET`, 2/week); ``empty()`` the same type with no samples;
-``shift(series, seconds)`` the series with every time stamp moved by ``seconds``. Settings that keep
+``shift(series, seconds)`` the series with every time stamp moved by ``seconds``. A detector that
+needs a different example of the same type (a GEO history for a GEO detector) has an entry in
+:data:`EXAMPLES_BY_DETECTOR`. Settings that keep
 a detector fast on the example (fewer simulated event-free samples, ...) go in :data:`FAST_SETTINGS`
 by detector name; they must not be needed for correctness. Examples are built once per session.
 """
@@ -114,11 +116,61 @@ def empty_tracking() -> Any:
     return TrackingSeries(data, full.x0_apriori_m_mps, full.fit_config, name=full.name)
 
 
+# ---------------------------------------------------------------------------------------------- TLE
+
+
+def _tle_history(a0_m: float, burns: tuple[tuple[float, float], ...], sigma_a_m: float) -> Any:
+    import tempfile
+    from pathlib import Path
+
+    from abrupt.readers.tle import read_tle
+    from test_tle_synthetic import synthetic_tle_text
+
+    text, _ = synthetic_tle_text(days=180, burns=burns, a0_m=a0_m, sigma_a_m=sigma_a_m)
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "example.tle"
+        path.write_text(text)
+        return read_tle(path)
+
+
+@cache
+def leo_tle_example() -> Any:
+    """180 days of daily synthetic LEO TLEs (7200 km) with ±1 cm/s in-track burns on days 60 and 120."""
+    return _tle_history(7_200_000.0, ((60.3, 0.01), (120.2, -0.01)), 0.5)
+
+
+@cache
+def geo_tle_example() -> Any:
+    """The same generator at the geosynchronous radius with ±0.2 m/s burns (a contract check only: the
+    generator's inclination and RAAN drift are those of the LEO orbit)."""
+    return _tle_history(42_164_000.0, ((60.3, 0.2), (120.2, -0.2)), 5.0)
+
+
+def empty_tle() -> Any:
+    from dataclasses import replace
+
+    h = leo_tle_example()
+    return replace(h, elements=h.elements.iloc[:0].copy(), satrecs=[])
+
+
+def shift_tle(history: Any, seconds: float) -> Any:
+    """The history with every element-set epoch moved by ``seconds`` (the detectors read ``elements``)."""
+    from dataclasses import replace
+
+    import pandas as pd
+
+    el = history.elements.copy()
+    el["epoch_utc"] = el["epoch_utc"] + pd.Timedelta(seconds=seconds)
+    return replace(history, elements=el)
+
+
 def _examples() -> dict[type, SeriesExample]:
+    from abrupt.readers.tle import ElementHistory
     from abrupt.series.attitude import AttitudeSeries
     from abrupt.series.tracking import TrackingSeries
 
     return {
+        ElementHistory: SeriesExample(make=leo_tle_example, empty=empty_tle, shift=shift_tle),
         TrackingSeries: SeriesExample(
             make=tracking_example,
             empty=empty_tracking,
@@ -137,6 +189,11 @@ def _examples() -> dict[type, SeriesExample]:
 
 #: Example per series type. Add yours here (see the module docstring).
 EXAMPLES: dict[type, SeriesExample] = _examples()
+
+#: A detector that needs another example of its series type than the default (by detector name).
+EXAMPLES_BY_DETECTOR: dict[str, SeriesExample] = {
+    "tle.geo_station_keeping": SeriesExample(make=geo_tle_example, empty=empty_tle, shift=shift_tle),
+}
 
 #: Constructor settings per detector name that keep the conformance run fast.
 FAST_SETTINGS: dict[str, dict[str, Any]] = {k: v for ex in EXAMPLES.values() for k, v in ex.settings.items()}
