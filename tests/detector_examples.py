@@ -10,7 +10,9 @@ so a capability that registers detectors adds its example here (one function and
 
 ``make()`` returns a short series holding at least one event every detector of that type should
 find at the test budget (:data:`BUDGET`, 2/week); ``empty()`` the same type with no samples;
-``shift(series, seconds)`` the series with every time stamp moved by ``seconds``. Settings that keep
+``shift(series, seconds)`` the series with every time stamp moved by ``seconds``. A detector that
+needs a different example of the same type (a GEO history for a GEO detector) has an entry in
+:data:`EXAMPLES_BY_DETECTOR`. Settings that keep
 a detector fast on the example (fewer simulated event-free samples, ...) go in :data:`FAST_SETTINGS`
 by detector name; they must not be needed for correctness. Examples are built once per session.
 """
@@ -228,6 +230,9 @@ def _examples() -> dict[type, SeriesExample]:
 
 #: Example per series type. Add yours here (see the module docstring).
 EXAMPLES: dict[type, SeriesExample] = _examples()
+
+#: A detector that needs another example of its series type than the default (by detector name).
+EXAMPLES_BY_DETECTOR: dict[str, SeriesExample] = {}
 
 #: Constructor settings per detector name that keep the conformance run fast.
 FAST_SETTINGS: dict[str, dict[str, Any]] = {k: v for ex in EXAMPLES.values() for k, v in ex.settings.items()}

@@ -20,13 +20,15 @@ from abrupt.detect.base import DetectionResult, Detector, Diagnostics, detector_
 from abrupt.events import EVENT_COLUMNS, Event, empty_frame, events_frame
 from abrupt.series.attitude import AttitudeSeries
 from abrupt.thresholds import FalseAlarmBudget, robust_gaussian_threshold
-from detector_examples import BUDGET, EXAMPLES, FAST_SETTINGS, SeriesExample
+from detector_examples import BUDGET, EXAMPLES, EXAMPLES_BY_DETECTOR, FAST_SETTINGS, SeriesExample
 
 SHIFT_S = 86400.0 * 3 + 1234.5  # three days and a fraction of a second: whole microseconds
 
 
 def _example(name: str) -> SeriesExample:
     cls = get_detector(name)
+    if name in EXAMPLES_BY_DETECTOR:
+        return EXAMPLES_BY_DETECTOR[name]
     for series_type, example in EXAMPLES.items():
         if issubclass(cls.series_type, series_type):
             return example

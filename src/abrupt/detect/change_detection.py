@@ -26,6 +26,7 @@ data, not on how the stream was cut into chunks: streaming and batch give the sa
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -375,19 +376,22 @@ def _glr_kernel(
     return out
 
 
+#: Each statistic's kernel and the extra settings it takes from the window configuration.
+KERNELS: dict[str, tuple[Callable[..., FloatArray], Callable[[WindowConfig], tuple[float | int, ...]]]] = {
+    "summation": (_summation_kernel, lambda cfg: ()),
+    "mean_difference": (_mean_difference_kernel, lambda cfg: ()),
+    "cusum": (_cusum_kernel, lambda cfg: (cfg.cusum_delta_mu_Nms,)),
+    "shiryaev": (_shiryaev_kernel, lambda cfg: (cfg.shiryaev_delta_mu_Nms, cfg.shiryaev_n, cfg.shiryaev_p)),
+    "glr": (_glr_kernel, lambda cfg: ()),
+}
+
+
 def _evaluate(name: str, x: FloatArray, offset: int, n_first: int, count: int, cfg: WindowConfig) -> FloatArray:
-    args = (x, offset, cfg.pre, cfg.guard, cfg.post, n_first, count, ANCHOR)
-    if name == "summation":
-        return _summation_kernel(*args)
-    if name == "mean_difference":
-        return _mean_difference_kernel(*args)
-    if name == "cusum":
-        return _cusum_kernel(*args, cfg.cusum_delta_mu_Nms)
-    if name == "shiryaev":
-        return _shiryaev_kernel(*args, cfg.shiryaev_delta_mu_Nms, cfg.shiryaev_n, cfg.shiryaev_p)
-    if name == "glr":
-        return _glr_kernel(*args)
-    raise ValueError(f"unknown statistic {name!r}; choose one of {STATISTICS}")
+    try:
+        kernel, extra = KERNELS[name]
+    except KeyError:
+        raise ValueError(f"unknown statistic {name!r}; choose one of {STATISTICS}") from None
+    return kernel(x, offset, cfg.pre, cfg.guard, cfg.post, n_first, count, ANCHOR, *extra(cfg))
 
 
 def _check_channels(name: str, channels: int) -> None:

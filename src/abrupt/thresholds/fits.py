@@ -31,6 +31,7 @@ is :func:`neyman_pearson_threshold`.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from typing import Literal
 
@@ -128,6 +129,32 @@ def gpd_quantile(x: NDArray[np.float64], q_upper: float, tail_fraction: float = 
     return u + float(stats.genpareto.isf(q_upper / tail_fraction, shape, loc=0.0, scale=scale))
 
 
+def _gaussian_quantile(x: NDArray[np.float64], q_upper: float) -> float:
+    """mean + z·sd of a Gaussian fitted to x (Bennett 2022 §2.4.2.2)."""
+    return float(np.mean(x) + stats.norm.isf(q_upper) * np.std(x, ddof=1))
+
+
+def _gamma_quantile(x: NDArray[np.float64], q_upper: float) -> float:
+    """Upper point of a Gamma law fitted to x shifted to be positive (Harris 2025 §3.4)."""
+    shift = min(0.0, float(np.min(x))) - 1e-12
+    a, loc, scale = stats.gamma.fit(x - shift, floc=0.0)
+    return float(stats.gamma.isf(q_upper, a, loc=loc, scale=scale)) + shift
+
+
+def _empirical_quantile(x: NDArray[np.float64], q_upper: float) -> float:
+    return float(np.quantile(x, 1.0 - q_upper))
+
+
+#: The value exceeded with probability ``q_upper`` under each fitted family (``gev`` fits block maxima).
+UPPER_QUANTILES: dict[str, Callable[[NDArray[np.float64], float], float]] = {
+    "gaussian": _gaussian_quantile,
+    "gamma": _gamma_quantile,
+    "kde": lambda x, q: kde_quantile(x, q),
+    "empirical": _empirical_quantile,
+    "gpd": lambda x, q: gpd_quantile(x, q),
+}
+
+
 def fit_threshold(
     null_statistic: ArrayLike,
     *,
@@ -152,19 +179,7 @@ def fit_threshold(
         p_fa = p_fa_per_sample(false_alarms_per_day, sample_rate_hz)
     if not 0 < p_fa < 1:
         raise ValueError(f"p_fa must be in (0, 1), got {p_fa}")
-    if method == "gaussian":
-        value = float(np.mean(x) + stats.norm.isf(p_fa) * np.std(x, ddof=1))
-    elif method == "gamma":
-        shift = min(0.0, float(np.min(x))) - 1e-12
-        a, loc, scale = stats.gamma.fit(x - shift, floc=0.0)
-        value = float(stats.gamma.isf(p_fa, a, loc=loc, scale=scale)) + shift
-    elif method == "kde":
-        value = kde_quantile(x, p_fa)
-    elif method == "empirical":
-        value = float(np.quantile(x, 1.0 - p_fa))
-    elif method == "gpd":
-        value = gpd_quantile(x, p_fa)
-    elif method == "gev":
+    if method == "gev":
         if sample_rate_hz is None:
             raise ValueError("the gev fit needs sample_rate_hz")
         return fit_block_maxima_threshold(
@@ -172,8 +187,11 @@ def fit_threshold(
             sample_rate_hz=sample_rate_hz,
             false_alarms_per_day=false_alarms_per_day_from_p_fa(p_fa, sample_rate_hz),
         )
-    else:
-        raise ValueError(f"unknown threshold method {method!r}; choose one of {FIT_METHODS}")
+    try:
+        quantile = UPPER_QUANTILES[method]
+    except KeyError:
+        raise ValueError(f"unknown threshold method {method!r}; choose one of {FIT_METHODS}") from None
+    value = quantile(x, p_fa)
     rate = float("nan") if sample_rate_hz is None else false_alarms_per_day_from_p_fa(p_fa, sample_rate_hz)
     return Threshold(
         value=value,
