@@ -23,16 +23,12 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
-from abrupt.detect.attitude import (
-    AttitudeDetectionConfig,
-    _combined_statistic,
-    calibrate_thresholds,
-    detector_windows,
-)
+from abrupt.detect.attitude import AttitudeDetectionConfig, MomentumChangeDetector, attitude_detector_class
 from abrupt.detect.change_detection import WindowConfig, sliding_statistic
 from abrupt.model.momentum import system_momentum
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 from abrupt.readers.telemetry import telemetry_from_frame
+from abrupt.series.attitude import AttitudeSeries
 from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude, simulate_attitude_batch
 from abrupt.thresholds import fit_threshold
 
@@ -135,11 +131,18 @@ def part_b(n_runs: int, plot: str | None) -> None:
     sim = simulate_attitude(SC, AttitudeSimConfig(duration_s=6 * 3600.0, seed=77), [])
     tel = telemetry_from_frame(sim.telemetry, SC)
     t0 = time.perf_counter()
-    thresholds, noise = calibrate_thresholds(SC, tel, cfg)
+    series = AttitudeSeries(tel, SC)
+    detectors: dict[str, MomentumChangeDetector] = {
+        name: attitude_detector_class(name).from_attitude_config(cfg)  # type: ignore[attr-defined]
+        for name in cfg.detectors
+    }
+    calibrations = {name: det.calibrate(series, cfg.budget) for name, det in detectors.items()}
+    thresholds = {name: c.threshold for name, c in calibrations.items()}
+    noise = next(iter(calibrations.values())).noise_model
     print(
         f"thresholds calibrated in {time.perf_counter() - t0:.1f} s from the momentum noise model "
-        f"(white σ {np.round(noise['white_sigma_Nms'], 4)}, "
-        f"random walk σ {np.round(noise['random_walk_sigma_Nms'], 6)} per sample):"
+        f"(white σ {np.round(noise.white_sigma_Nms, 4)}, "
+        f"random walk σ {np.round(noise.random_walk_sigma_Nms, 6)} per sample):"
     )
     for k, v in thresholds.items():
         print(f"  {k:10s} {v.value:8.3f}  ({v.method}, {v.false_alarms_per_day:g}/day)")
@@ -158,10 +161,10 @@ def part_b(n_runs: int, plot: str | None) -> None:
         for r in range(n_runs):
             k_strike = round(strikes[r][0].time_s * 10)
             for name in cfg.detectors:
-                win = detector_windows(name, cfg, 0.1)
+                win = detectors[name].windows
                 lo = max(0, k_strike - win.pre - win.post - 50)
                 hi = min(h.shape[1], k_strike + win.post + win.pre + 50)
-                stat = _combined_statistic(name, h[r, lo:hi], win)
+                stat = detectors[name].combined_statistic(h[r, lo:hi])
                 near = stat[max(0, k_strike - lo - win.post) : k_strike - lo + win.post]
                 hits[name] += bool(np.nanmax(near) > thresholds[name].value)
         for name in cfg.detectors:
@@ -204,7 +207,7 @@ def part_b(n_runs: int, plot: str | None) -> None:
 
 def part_c(days: float) -> None:
     print(f"\n== C. False alarms on {days:g} days of event-free telemetry (budget: one per day) ==")
-    from abrupt.detect.attitude import detect_attitude
+    from abrupt.pipelines.attitude import detect_attitude
 
     cfg = AttitudeDetectionConfig(detectors=("glr", "cusum", "summation"))
     counts = dict.fromkeys(cfg.detectors, 0)

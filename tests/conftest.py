@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
 
 import matplotlib
@@ -19,3 +20,33 @@ def shared_data() -> Path:
     if not SHARED_DATA.is_dir():
         pytest.skip(f"real datasets not found at {SHARED_DATA}")
     return SHARED_DATA
+
+
+@pytest.fixture(scope="session")
+def postgresql_server_url() -> Iterator[str]:
+    """A real PostgreSQL server started for this test session (skips, saying why, where impossible)."""
+    try:
+        import psycopg  # noqa: F401
+    except ImportError:
+        pytest.skip("psycopg not installed: pip install -e '.[postgresql]'")
+    from pg_server import postgresql_server
+
+    try:
+        server = postgresql_server()
+        url = server.__enter__()
+    except RuntimeError as exc:
+        pytest.skip(f"no PostgreSQL server for the catalog tests: {exc}")
+    try:
+        yield url
+    finally:
+        server.__exit__(None, None, None)
+
+
+@pytest.fixture(params=["sqlite", "postgresql"])
+def catalog_target(request: pytest.FixtureRequest, tmp_path: Path) -> str:
+    """An empty catalog on each back-end: a SQLite file path, or a new database on a real server."""
+    if request.param == "sqlite":
+        return str(tmp_path / "catalog.sqlite")
+    from pg_server import new_database
+
+    return new_database(request.getfixturevalue("postgresql_server_url"))

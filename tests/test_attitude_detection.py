@@ -10,11 +10,13 @@ import pytest
 from click.testing import CliRunner
 
 from abrupt.catalog import Catalog
+from abrupt.clean.noise import momentum_noise_model
 from abrupt.cli.groups import cli
 from abrupt.cli.main import main
-from abrupt.detect.attitude import AttitudeDetectionConfig, detect_attitude, momentum_noise_model
+from abrupt.detect.attitude import AttitudeDetectionConfig
 from abrupt.events import EVENT_COLUMNS
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
+from abrupt.pipelines.attitude import detect_attitude
 from abrupt.readers.telemetry import telemetry_from_frame
 from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude
 
@@ -184,7 +186,7 @@ def test_calibration_at_another_rate_is_an_error() -> None:
 
 
 def test_a_masked_planned_event_is_not_reported(tmp_path: Path) -> None:
-    from abrupt.readers.telemetry import apply_mask, read_mask
+    from abrupt.clean.masks import apply_mask, read_mask
 
     # a "momentum dump" at 900 s: a real step, but planned
     sim = simulate_attitude(SC, AttitudeSimConfig(duration_s=1800.0, seed=8), [Strike(900.0, (0.3, 0.0, 0.0))])
@@ -202,8 +204,8 @@ def test_a_masked_planned_event_is_not_reported(tmp_path: Path) -> None:
 
 
 def test_a_mask_interval_that_ends_before_it_starts_is_an_error(tmp_path: Path) -> None:
+    from abrupt.clean.masks import read_mask
     from abrupt.errors import InputError
-    from abrupt.readers.telemetry import read_mask
 
     mask = tmp_path / "mask.csv"
     mask.write_text("start_utc,end_utc\n2026-01-01T00:10:00Z,2026-01-01T00:05:00Z\n")

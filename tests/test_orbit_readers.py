@@ -117,8 +117,10 @@ def test_sp3_unknown_time_system_names_line_and_column(tmp_path: Path) -> None:
 
 def test_sp3_malformed_first_header_line(tmp_path: Path) -> None:
     text = _sp3_text().replace("#cV", "#xV", 1)
-    with pytest.raises(InputError, match=r"t.sp3:1:1: first line must start"):
+    with pytest.raises(InputError, match=r"t.sp3:1:2: unsupported SP3 version 'x'"):
         read_sp3(_write(tmp_path, text))
+    with pytest.raises(InputError, match=r"t.sp3:1:1: first line must start"):
+        read_sp3(_write(tmp_path, "V" + _sp3_text()[1:]))
 
 
 def test_sp3_malformed_epoch_count_in_header(tmp_path: Path) -> None:
@@ -127,23 +129,70 @@ def test_sp3_malformed_epoch_count_in_header(tmp_path: Path) -> None:
         read_sp3(_write(tmp_path, text))
 
 
-def test_sp3_malformed_position_record_names_line_and_column(tmp_path: Path) -> None:
+def test_sp3_one_malformed_record_in_a_long_file_is_skipped_and_counted(tmp_path: Path) -> None:
+    # 1 % of the records may be skipped: none in a short file, one in a file of 100-199 records.
     bad = "PL74   7000.00000x      1.000000      1.000000 999999.999999"
-    text = _sp3_text(p_override={(2, "L74"): bad})
-    with pytest.raises(InputError, match=r"t.sp3:17:5: position \(km\): cannot read number"):
+    eph = read_sp3(_write(tmp_path, _sp3_text(n=60, p_override={(2, "L74"): bad})))
+    assert len(eph) == 59 and eph.repairs.counts["malformed ephemeris record skipped"] == 1
+    text = _sp3_text(n=60, p_override={(2, "L74"): bad, (40, "L74"): bad})
+    with pytest.raises(InputError, match=r"t.sp3:17:5: position \(km\): cannot read number .*2 malformed records"):
         read_sp3(_write(tmp_path, text))
+    with pytest.raises(InputError, match=r"t.sp3:17:5: position \(km\): cannot read number '7000.00000x'$"):
+        read_sp3(_write(tmp_path, _sp3_text(n=6, p_override={(2, "L74"): bad})))
 
 
-def test_sp3_truncated_record_is_an_error(tmp_path: Path) -> None:
-    text = _sp3_text(p_override={(1, "L74"): "PL74   7000.000000"})
-    with pytest.raises(InputError, match="truncated"):
-        read_sp3(_write(tmp_path, text))
+def test_sp3_truncated_records(tmp_path: Path) -> None:
+    short = "PL74   7000.000000"
+    eph = read_sp3(_write(tmp_path, _sp3_text(n=60, p_override={(1, "L74"): short})))
+    assert eph.repairs.counts["malformed ephemeris record skipped"] == 1
+    with pytest.raises(InputError, match="position record truncated"):
+        read_sp3(_write(tmp_path, _sp3_text(p_override={(1, "L74"): short})))
 
 
-def test_sp3_malformed_epoch_line(tmp_path: Path) -> None:
+def test_sp3_malformed_epoch_lines(tmp_path: Path) -> None:
+    text = _sp3_text(n=60).replace("*  2018 12 24 21 58", "*  2018 13 24 21 58", 1)
+    eph = read_sp3(_write(tmp_path, text))
+    assert len(eph) == 59  # the epoch and its records skipped, counted
+    assert eph.repairs.counts["malformed ephemeris record skipped"] == 1
     text = _sp3_text().replace("*  2018 12 24 21 58", "*  2018 13 24 21 58", 1)
-    with pytest.raises(InputError, match="out of range"):
+    with pytest.raises(InputError, match=r"t.sp3:16:2: epoch '2018 13 24 21 58 0.00000000' is out of range"):
         read_sp3(_write(tmp_path, text))
+
+
+def test_sp3_minute_60_and_hour_24_are_normalised_and_counted(tmp_path: Path) -> None:
+    # 21:56 ... 22:00 written as '21 60' (carry), as ILRS analysis centres do
+    text = _sp3_text(n=5).replace("*  2018 12 24 22  0", "*  2018 12 24 21 60", 1)
+    eph = read_sp3(_write(tmp_path, text))
+    np.testing.assert_array_equal(np.diff(eph.times_utc), np.timedelta64(60, "s"))
+    assert eph.repairs.counts["epoch field at rollover value normalised (minute 60, hour 24, second 60, day 0)"] == 1
+
+
+def test_sp3_truncated_file_is_an_error_or_with_the_option_a_counted_repair(tmp_path: Path) -> None:
+    text = _sp3_text(n=6)
+    cut = text[: text.index("*  2018 12 24 22  0")]  # the file stops after 4 of its 6 epochs
+    path = _write(tmp_path, cut)
+    with pytest.raises(InputError, match="header announces 6 epochs but the file holds 4 \\(truncated file\\?\\)"):
+        read_sp3(path)
+    eph = read_sp3(path, allow_truncated=True)
+    assert len(eph) == 4 and eph.repairs.counts["file truncated: announced epochs missing"] == 2
+
+
+def test_sp3_gzip_and_unix_compress_read_like_plain(tmp_path: Path) -> None:
+    import gzip
+
+    text = _sp3_text(n=6, sats=("L74", "G01"))
+    plain = read_sp3(_write(tmp_path, text), "G01")
+    gz = tmp_path / "t.sp3.gz"
+    gz.write_bytes(gzip.compress(text.encode()))
+    renamed = tmp_path / "no_extension"  # recognised by content, not by name
+    renamed.write_bytes(gzip.compress(text.encode()))
+    for path in (gz, renamed):
+        back = read_sp3(path, "G01")
+        np.testing.assert_array_equal(back.position_m, plain.position_m)
+    broken = tmp_path / "broken.sp3.gz"
+    broken.write_bytes(gzip.compress(text.encode())[:200])
+    with pytest.raises(InputError, match=r"broken\.sp3\.gz: corrupt or truncated gzip"):
+        read_sp3(broken)
 
 
 def test_sp3_missing_value_placeholders_remove_the_epoch_and_are_counted(tmp_path: Path) -> None:
@@ -172,7 +221,7 @@ def test_sp3_conflicting_duplicate_epoch_is_an_error(tmp_path: Path) -> None:
     # make the 4th epoch line carry the time of the 3rd, with different states
     idx = [i for i, s in enumerate(lines) if s.startswith("*")]
     lines[idx[3]] = lines[idx[2]]
-    with pytest.raises(InputError, match="appears twice with different states"):
+    with pytest.raises(InputError, match="appears twice for L74 with different states"):
         read_sp3(_write(tmp_path, "\n".join(lines) + "\n"))
 
 
@@ -185,7 +234,7 @@ def test_sp3_out_of_order_epochs_are_sorted_and_counted(tmp_path: Path) -> None:
 def test_sp3_positions_in_metres_instead_of_km_are_rejected(tmp_path: Path) -> None:
     bad = "PL74" + "".join(f"{c:14.3f}" for c in (7000000.0, 1000.0, 1000.0)) + f"{999999.999999:14.6f}"
     with pytest.raises(InputError, match="not an orbit radius"):
-        read_sp3(_write(tmp_path, _sp3_text(p_override={(0, "L74"): bad})))
+        read_sp3(_write(tmp_path, _sp3_text(p_override={(k, "L74"): bad for k in range(5)})))
 
 
 def _oem_text(epochs_s: list[float], frame: str = "EME2000", time_system: str = "UTC") -> str:
@@ -236,7 +285,7 @@ def test_oem_malformed_data_line_names_the_line(tmp_path: Path) -> None:
     text = _oem_text([0, 60, 120]).replace(" 0.000000000\n", "\n", 1)
     path = tmp_path / "m.oem"
     path.write_text(text)
-    with pytest.raises(InputError, match=r"m.oem:13: data line needs"):
+    with pytest.raises(InputError, match=r"m.oem:13:1: data line needs"):
         read_oem(path)
 
 

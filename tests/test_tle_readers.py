@@ -62,27 +62,27 @@ def test_checksum_error_names_file_line_and_column(tmp_path: Path) -> None:
     bad = J3_B[1][:68] + str((int(J3_B[1][68]) + 3) % 10)
     p = _write(tmp_path, [*J3_A, J3_B[0], bad])
     with pytest.raises(InputError, match=r"x\.tle:4:69: checksum error"):
-        read_tle(p)
+        read_tle(p, strict=True)
 
 
 def test_wrong_line_length_is_an_error(tmp_path: Path) -> None:
     short = J3_B[1][:60]
     p = _write(tmp_path, [*J3_A, J3_B[0], short])
     with pytest.raises(InputError, match=r"x\.tle:4:61: TLE line 2 has 60 characters, expected 69"):
-        read_tle(p)
+        read_tle(p, strict=True)
 
 
 def test_missing_line_two_is_an_error(tmp_path: Path) -> None:
     p = _write(tmp_path, [*J3_A, J3_B[0]])
     with pytest.raises(InputError, match=r"x\.tle:3: file ends after TLE line 1"):
-        read_tle(p)
+        read_tle(p, strict=True)
 
 
 def test_garbled_number_is_an_error_naming_its_column(tmp_path: Path) -> None:
     garbled = _fix_checksum(J3_B[1][:8] + "66.O395" + J3_B[1][15:])
     p = _write(tmp_path, [*J3_A, J3_B[0], garbled])
     with pytest.raises(InputError, match=r"x\.tle:4:9: inclination"):
-        read_tle(p)
+        read_tle(p, strict=True)
 
 
 def test_non_monotonic_epochs_are_sorted_and_counted(tmp_path: Path) -> None:
@@ -109,7 +109,7 @@ def test_same_epoch_reissue_keeps_the_higher_element_set_number(tmp_path: Path) 
 def test_mixed_satellites_are_an_error_unless_one_is_selected(tmp_path: Path) -> None:
     p = _write(tmp_path, [*J3_A, *S3A, *J3_B])
     with pytest.raises(InputError, match=r"x\.tle:3: element set of satellite 41335 in a file of satellite 41240"):
-        read_tle(p)
+        read_tle(p, strict=True)
     h = read_tle(p, norad_id=41240)
     assert len(h) == 2
     assert h.repairs.counts["element sets of other satellites skipped"] == 1
@@ -119,7 +119,7 @@ def test_line_numbers_must_match_catalog_numbers(tmp_path: Path) -> None:
     other = _fix_checksum(J3_A[1][:2] + "41241" + J3_A[1][7:])
     p = _write(tmp_path, [J3_A[0], other])
     with pytest.raises(InputError, match=r"x\.tle:2:3: catalog number"):
-        read_tle(p)
+        read_tle(p, strict=True)
 
 
 @pytest.fixture
@@ -176,22 +176,22 @@ def test_omm_missing_keyword_and_wrong_time_system_are_errors(
     p = tmp_path / "bad.json"
     p.write_text(json.dumps([omm_records[1], rec]))
     with pytest.raises(InputError, match=r"bad\.json: record 2: OMM record lacks MEAN_MOTION"):
-        read_omm(p)
+        read_omm(p, strict=True)
     rec = dict(omm_records[0], TIME_SYSTEM="TAI")
     p.write_text(json.dumps([rec]))
     with pytest.raises(InputError, match="TIME_SYSTEM 'TAI'"):
-        read_omm(p)
+        read_omm(p, strict=True)
 
 
 def test_malformed_omm_xml_names_the_line(tmp_path: Path) -> None:
     p = tmp_path / "bad.xml"
     p.write_text("<ndm>\n<omm>\n<body>\n</ndm>\n")
     with pytest.raises(InputError, match=r"bad\.xml:4"):
-        read_omm(p)
+        read_omm(p, strict=True)
 
 
 def test_kvn_line_without_equals_sign_is_an_error(tmp_path: Path, omm_records: list[dict[str, str]]) -> None:
     p = tmp_path / "bad.kvn"
     p.write_text(_kvn(omm_records[:1]) + "MEAN_MOTION 12.8\n")
     with pytest.raises(InputError, match=r"bad\.kvn:\d+: KVN line is not 'KEY = value'"):
-        read_omm(p)
+        read_omm(p, strict=True)

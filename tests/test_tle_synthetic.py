@@ -211,8 +211,14 @@ def test_cli_reports_a_checksum_error_with_file_and_line(tmp_path: Path) -> None
     path = tmp_path / "bad.tle"
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(SystemExit) as exc:
-        main(["detect", "tle", str(path), "--catalog", str(tmp_path / "c.sqlite")])
+        main(["detect", "tle", str(path), "--strict", "--catalog", str(tmp_path / "c.sqlite")])
     assert exc.value.code == 2
+    # without --strict the bad set is skipped and reported with its line; the rest is analysed
+    runner = CliRunner()
+    res = runner.invoke(cli, ["detect", "tle", str(path), "--catalog", str(tmp_path / "c.sqlite")])
+    assert res.exit_code == 0, res.output
+    assert f"skipped: {path}:5:69: checksum error" in res.output
+    assert "malformed element sets skipped: 1" in res.output
 
 
 def test_single_outlier_element_set_is_not_a_maneuver(tmp_path: Path) -> None:

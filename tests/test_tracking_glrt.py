@@ -126,7 +126,7 @@ def test_cli_simulate_detect_report_end_to_end(tmp_path: Path) -> None:
     )
     assert r.exit_code == 0, r.output
     ev = pd.read_csv(tmp_path / "ev.csv")
-    glrt = ev[ev["detector"] == "tracking_glrt"]
+    glrt = ev[ev["detector"] == "tracking.glrt"]
     assert len(glrt) == 1
     assert glrt["dv_t_mps"].iloc[0] == pytest.approx(0.1, rel=0.2)
     truth = pd.read_csv(tmp_path / "truth.csv")

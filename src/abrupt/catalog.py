@@ -1,37 +1,82 @@
-"""The event catalog: events and run records in a SQL database (DESIGN.md, "Catalog").
+"""The event catalog: events, runs and resumable work in a SQL database (docs/catalog.md).
 
-SQLite in a file by default; any SQLAlchemy URL (for example ``postgresql://...``) for a shared
-catalog. Events are keyed by their deterministic ``event_id``, so re-running the same input and
-configuration adds no duplicate rows. Columns beyond the frozen schema are kept as JSON.
+SQLite in a file by default; PostgreSQL (``postgresql://user@host/db``, driver: ``pip install
+'abrupt[postgresql]'``) or any other SQLAlchemy URL for a catalog shared by several people or
+processes.
+
+Identity. Every stored row is a *detection*: one event as reported by one detector under one
+configuration, keyed by the deterministic ``event_id`` (spacecraft, detector, kind, time and
+configuration hash; :func:`abrupt.events.make_event_id`). Detections of the same physical event under
+different configurations (another false-alarm budget, other windows) share an ``event_key``: a new
+detection joins an existing event of the same spacecraft, detector and kind when their times agree
+within three standard deviations of the time estimate (at least 1 s, at most 1 day) and that event has
+no detection under the new configuration yet. Re-running the same input and configuration therefore
+adds nothing; re-running with another configuration adds a new run of the same events, not a second
+copy.
+
+Latest view. Each run records what it covered (spacecraft, detector, configuration, time span). A
+detection is *current* unless a later run analysed the same spacecraft, detector and time under another
+configuration; :meth:`Catalog.events` returns current detections by default.
+
+Concurrency. Writers are serialised: ``BEGIN IMMEDIATE`` on SQLite (with a 60 s busy timeout) and a
+transaction-scoped advisory lock on PostgreSQL, so two processes writing at once lose nothing and
+duplicate nothing.
+
+Resumable runs. Work is recorded per task (one spacecraft and chunk of input): a task's events and
+its completion are written in one transaction (:meth:`Catalog.complete_task`), so a run killed at any
+point and started again redoes only unfinished tasks and ends with exactly the events of an
+uninterrupted run.
 """
 
 from __future__ import annotations
 
 import datetime as dt
+import functools
+import hashlib
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
+from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
+import numpy as np
 import pandas as pd
 import sqlalchemy as sa
 
 from abrupt import __version__
-from abrupt.events import _FLOAT_COLUMNS, EVENT_COLUMNS, normalise_frame
+from abrupt.errors import AbruptError
+from abrupt.events import EVENT_COLUMNS, FLOAT_COLUMNS, format_time_utc, normalise_frame
+
+SCHEMA_VERSION = 2
+#: Key of the PostgreSQL advisory lock that serialises catalog writers (any fixed 64-bit integer).
+_PG_LOCK_KEY = 0x61627275707431
+#: Time tolerance for joining a detection to an existing event: 3 σ of the time estimate, in [1 s, 1 day].
+MATCH_SIGMAS = 3.0
+MATCH_MIN_S = 1.0
+MATCH_MAX_S = 86_400.0
 
 _metadata = sa.MetaData()
+
+
+def _event_column(name: str) -> sa.Column[Any]:
+    if name in FLOAT_COLUMNS:
+        return sa.Column(name, sa.Float, nullable=True)
+    if name == "time_utc":
+        return sa.Column(name, sa.DateTime(timezone=False), nullable=False)  # naive UTC
+    if name == "event_id":
+        return sa.Column(name, sa.String(64), primary_key=True)
+    return sa.Column(name, sa.String(200), nullable=(name == "run_id"))
+
 
 events_table = sa.Table(
     "events",
     _metadata,
-    *[
-        sa.Column(name, sa.Float, nullable=True)
-        if name in _FLOAT_COLUMNS
-        else sa.Column(name, sa.String(64), primary_key=(name == "event_id"), nullable=(name == "run_id"))
-        for name in EVENT_COLUMNS
-    ],
+    *[_event_column(name) for name in EVENT_COLUMNS],
+    sa.Column("event_key", sa.String(32), nullable=False, index=True),
     sa.Column("extra_json", sa.Text, nullable=True),
+    sa.Index("ix_events_identity", "spacecraft", "detector", "kind", "time_utc"),
 )
 
 runs_table = sa.Table(
@@ -39,8 +84,8 @@ runs_table = sa.Table(
     _metadata,
     sa.Column("run_id", sa.String(64), primary_key=True),
     sa.Column("command", sa.Text, nullable=False),
-    sa.Column("started_utc", sa.String(40), nullable=False),
-    sa.Column("finished_utc", sa.String(40), nullable=True),
+    sa.Column("started_utc", sa.DateTime(timezone=False), nullable=False),
+    sa.Column("finished_utc", sa.DateTime(timezone=False), nullable=True),
     sa.Column("config_hash", sa.String(64), nullable=True),
     sa.Column("input_hash", sa.String(64), nullable=True),
     sa.Column("abrupt_version", sa.String(32), nullable=False),
@@ -49,37 +94,209 @@ runs_table = sa.Table(
     sa.Column("details_json", sa.Text, nullable=True),
 )
 
+coverage_table = sa.Table(
+    "coverage",
+    _metadata,
+    sa.Column("run_id", sa.String(64), primary_key=True),
+    sa.Column("spacecraft", sa.String(200), primary_key=True),
+    sa.Column("detector", sa.String(200), primary_key=True),
+    sa.Column("config_hash", sa.String(64), nullable=False),
+    sa.Column("start_utc", sa.DateTime(timezone=False), primary_key=True),
+    sa.Column("end_utc", sa.DateTime(timezone=False), nullable=False),
+    sa.Column("recorded_utc", sa.DateTime(timezone=False), nullable=False),
+)
+
+tasks_table = sa.Table(
+    "tasks",
+    _metadata,
+    sa.Column("run_key", sa.String(64), primary_key=True),
+    sa.Column("task_key", sa.String(400), primary_key=True),
+    sa.Column("spacecraft", sa.String(200), nullable=False),
+    sa.Column("chunk", sa.String(400), nullable=False),
+    sa.Column("run_id", sa.String(64), nullable=False),
+    sa.Column("n_events", sa.Integer, nullable=False),
+    sa.Column("finished_utc", sa.DateTime(timezone=False), nullable=False),
+)
+
+schema_table = sa.Table("abrupt_schema", _metadata, sa.Column("version", sa.Integer, nullable=False))
+
+
+class CatalogError(AbruptError):
+    """A catalog that cannot be opened or used; the message is one line naming the path or URL."""
+
+
+@dataclass(frozen=True)
+class Added:
+    """What a write added: new detection rows and, among them, new events (identities)."""
+
+    detections: int
+    events: int
+
+
+@dataclass(frozen=True)
+class Coverage:
+    """What a run analysed: a spacecraft, a detector and a time span, under one configuration."""
+
+    spacecraft: str
+    detector: str
+    config_hash: str
+    start_utc: str
+    end_utc: str
+
 
 def catalog_url(target: str | Path) -> str:
-    """Turn a plain file path into a SQLite URL; leave SQLAlchemy URLs alone."""
+    """A SQLAlchemy URL for a catalog target: file paths become SQLite URLs; ``postgresql://``
+    without a driver uses psycopg 3 (the ``postgresql`` extra)."""
     text = str(target)
-    if "://" in text:
+    if "://" not in text:
+        return f"sqlite:///{Path(text).expanduser().resolve()}"
+    for prefix in ("postgresql://", "postgres://"):
+        if text.startswith(prefix):
+            return "postgresql+psycopg://" + text[len(prefix) :]
+    return text
+
+
+def _display(target: str | Path) -> str:
+    """The catalog as the user named it, with any password hidden."""
+    text = str(target)
+    if "://" not in text:
         return text
-    return f"sqlite:///{Path(text).expanduser().resolve()}"
+    try:
+        return sa.engine.make_url(text).render_as_string(hide_password=True)
+    except sa.exc.ArgumentError:
+        return text
+
+
+def _first_line(exc: BaseException) -> str:
+    orig = getattr(exc, "orig", None) or exc
+    lines = [ln.strip() for ln in str(orig).splitlines() if ln.strip()]
+    return lines[0] if lines else type(orig).__name__
+
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def _one_line_errors(method: F) -> F:
+    """Turn database and driver errors into a one-line :class:`CatalogError` naming the catalog."""
+
+    @functools.wraps(method)
+    def wrapper(self: Catalog, *args: Any, **kwargs: Any) -> Any:
+        try:
+            return method(self, *args, **kwargs)
+        except CatalogError:
+            raise
+        except sa.exc.NoSuchModuleError as exc:
+            raise CatalogError(f"{self.name}: unknown database kind ({_first_line(exc)})") from None
+        except ModuleNotFoundError as exc:
+            hint = " (pip install 'abrupt[postgresql]')" if "postgres" in self.url else ""
+            raise CatalogError(f"{self.name}: no database driver: {exc.name} is not installed{hint}") from None
+        except sa.exc.ArgumentError as exc:
+            raise CatalogError(f"{self.name}: not a valid catalog URL ({_first_line(exc)})") from None
+        except sa.exc.OperationalError as exc:
+            reason = _first_line(exc)
+            if "file is not a database" in reason or "malformed" in reason:
+                raise CatalogError(f"{self.name}: not a database ({reason})") from None
+            raise CatalogError(f"{self.name}: cannot use the catalog: {reason}") from None
+        except sa.exc.DatabaseError as exc:
+            raise CatalogError(f"{self.name}: not a usable catalog ({_first_line(exc)})") from None
+
+    return wrapper  # type: ignore[return-value]
 
 
 def _clean(value: Any) -> Any:
+    if value is None or value is pd.NA or value is pd.NaT:
+        return None
     if isinstance(value, float) and math.isnan(value):
         return None
     if hasattr(value, "item"):
         return _clean(value.item())
-    if value is pd.NA:
-        return None
     return value
 
 
+def _to_naive_utc(value: Any) -> dt.datetime:
+    ts = pd.Timestamp(value)
+    if ts.tzinfo is not None:
+        ts = ts.tz_convert("UTC").tz_localize(None)
+    return ts.to_pydatetime()
+
+
+def _now() -> dt.datetime:
+    return dt.datetime.now(dt.UTC).replace(tzinfo=None)
+
+
+def event_key(spacecraft: str, detector: str, kind: str, time_utc: str) -> str:
+    """Identity of a new event (its first detection's spacecraft, detector, kind and time)."""
+    return hashlib.sha256("|".join((spacecraft, detector, kind, time_utc)).encode()).hexdigest()[:20]
+
+
+def run_key(command: str, *parts: str) -> str:
+    """Key of resumable work: the same command, inputs and configuration resume the same run."""
+    return hashlib.sha256("|".join((command, *parts)).encode()).hexdigest()[:24]
+
+
 class Catalog:
-    """Events and run records in a SQL database.
+    """Events, runs and task records in a SQL database.
+
+    ``create=False`` (``catalog list``/``export``) opens an existing catalog only: a missing SQLite
+    file or a database without abrupt's tables is an error, never a new empty catalog.
 
     >>> cat = Catalog("events.sqlite")          # doctest: +SKIP
     >>> n_new = cat.add_events(frame)           # doctest: +SKIP
     """
 
-    def __init__(self, target: str | Path = "abrupt_catalog.sqlite") -> None:
+    def __init__(self, target: str | Path = "abrupt_catalog.sqlite", *, create: bool = True) -> None:
+        self.name = _display(target)
         self.url = catalog_url(target)
-        self.engine = sa.create_engine(self.url, future=True)
-        _metadata.create_all(self.engine)
+        self._open(target, create)
 
+    # ----------------------------------------------------------------------------------- opening
+    @_one_line_errors
+    def _open(self, target: str | Path, create: bool) -> None:
+        if "://" not in str(target) or self.url.startswith("sqlite:///"):
+            path = Path(self.url.removeprefix("sqlite:///")) if "://" in str(target) else Path(str(target))
+            path = path.expanduser()
+            if str(path) not in ("", ":memory:"):
+                if path.is_dir():
+                    raise CatalogError(f"{self.name}: is a folder, not a catalog file")
+                if not path.parent.is_dir():
+                    raise CatalogError(f"{self.name}: folder {path.parent} does not exist")
+                if not create and not path.exists():
+                    raise CatalogError(
+                        f"{self.name}: no catalog here (list and export never create one; a detect command does)"
+                    )
+        if self.url.startswith("sqlite"):
+            self.engine = sa.create_engine(self.url, connect_args={"timeout": 60.0}, poolclass=sa.pool.NullPool)
+            sa.event.listen(self.engine, "connect", _sqlite_manual_transactions)
+            sa.event.listen(self.engine, "begin", _sqlite_begin_immediate)
+        else:
+            # no pool: a command holds no idle connection to a shared server, and none leaks at exit
+            self.engine = sa.create_engine(self.url, poolclass=sa.pool.NullPool)
+        self.dialect = self.engine.dialect.name
+        if create:
+            with self._writing() as conn:
+                _migrate_v1(conn)
+                _metadata.create_all(conn)
+                if conn.execute(sa.select(sa.func.count()).select_from(schema_table)).scalar_one() == 0:
+                    conn.execute(schema_table.insert().values(version=SCHEMA_VERSION))
+        else:
+            names = set(sa.inspect(self.engine).get_table_names())
+            if "events" not in names or "runs" not in names:
+                raise CatalogError(f"{self.name}: not an abrupt catalog (no events table)")
+            if "event_key" not in {c["name"] for c in sa.inspect(self.engine).get_columns("events")}:
+                raise CatalogError(
+                    f"{self.name}: catalog of an older abrupt; open it once with a detect command to upgrade it"
+                )
+
+    @contextmanager
+    def _writing(self) -> Iterator[sa.Connection]:
+        """A write transaction that excludes every other writer of the catalog."""
+        with self.engine.begin() as conn:
+            if self.dialect == "postgresql":
+                conn.execute(sa.text("SELECT pg_advisory_xact_lock(:k)"), {"k": _PG_LOCK_KEY})
+            yield conn
+
+    # -------------------------------------------------------------------------------------- runs
+    @_one_line_errors
     def start_run(
         self,
         run_id: str,
@@ -89,8 +306,11 @@ class Catalog:
         input_hash: str | None = None,
         details: Mapping[str, Any] | None = None,
     ) -> None:
-        """Record the start of a run of a command."""
-        with self.engine.begin() as conn:
+        """Record the start of a run of a command (a resumed run keeps its first record)."""
+        with self._writing() as conn:
+            exists = conn.execute(sa.select(runs_table.c.run_id).where(runs_table.c.run_id == run_id)).first()
+            if exists:
+                return
             conn.execute(
                 runs_table.insert().values(
                     run_id=run_id,
@@ -103,83 +323,365 @@ class Catalog:
                 )
             )
 
-    def add_events(self, frame: pd.DataFrame) -> int:
-        """Insert events whose ``event_id`` is not yet in the catalog; return how many were new."""
-        frame = normalise_frame(frame)
-        if frame.empty:
-            return 0
-        ids = list(frame["event_id"].astype(str))
-        with self.engine.begin() as conn:
-            existing: set[str] = set()
-            for start in range(0, len(ids), 500):
-                chunk = ids[start : start + 500]
-                rows = conn.execute(sa.select(events_table.c.event_id).where(events_table.c.event_id.in_(chunk)))
-                existing.update(r[0] for r in rows)
-            extra_cols = [c for c in frame.columns if c not in EVENT_COLUMNS]
-            records = []
-            seen: set[str] = set()
-            for rec in frame.to_dict("records"):
-                eid = str(rec["event_id"])
-                if eid in existing or eid in seen:
-                    continue
-                seen.add(eid)
-                row = {c: _clean(rec[c]) for c in EVENT_COLUMNS}
-                row["extra_json"] = json.dumps({c: _clean(rec[c]) for c in extra_cols}, default=str)
-                records.append(row)
-            if records:
-                conn.execute(_insert_ignoring_duplicates(self.engine.dialect.name), records)
-        return len(records)
-
-    def finish_run(self, run_id: str, *, n_found: int, n_new: int, details: Mapping[str, Any] | None = None) -> None:
-        """Record the end of a run with the number of events found and newly added."""
+    @_one_line_errors
+    def finish_run(
+        self,
+        run_id: str,
+        *,
+        n_found: int,
+        n_new: int,
+        details: Mapping[str, Any] | None = None,
+        coverage: Iterable[Coverage] = (),
+    ) -> None:
+        """Record the end of a run: events found and new, and what it covered (for the latest view)."""
         values: dict[str, Any] = {"finished_utc": _now(), "n_events_found": n_found, "n_events_new": n_new}
         if details is not None:
             values["details_json"] = json.dumps(details, default=str)
-        with self.engine.begin() as conn:
+        with self._writing() as conn:
             conn.execute(runs_table.update().where(runs_table.c.run_id == run_id).values(**values))
+            self._record_coverage(conn, run_id, coverage)
 
-    def events(self, *, spacecraft: str | None = None, kind: str | None = None) -> pd.DataFrame:
-        """All events (optionally of one spacecraft or kind), ordered by time, with extra columns."""
-        query = sa.select(events_table)
-        if spacecraft is not None:
-            query = query.where(events_table.c.spacecraft == spacecraft)
-        if kind is not None:
-            query = query.where(events_table.c.kind == kind)
-        query = query.order_by(events_table.c.time_utc)
-        with self.engine.connect() as conn:
-            frame = pd.DataFrame(conn.execute(query).mappings().all(), columns=[*EVENT_COLUMNS, "extra_json"])
-        extras = [json.loads(x) if x else {} for x in frame.pop("extra_json")]
-        extra_frame = pd.DataFrame(extras, index=frame.index)
-        frame = pd.concat([frame, extra_frame], axis=1) if not extra_frame.empty else frame
-        return normalise_frame(frame)
+    def _record_coverage(self, conn: sa.Connection, run_id: str, coverage: Iterable[Coverage]) -> None:
+        rows = {
+            (c.spacecraft, c.detector, _to_naive_utc(c.start_utc)): {
+                "run_id": run_id,
+                "spacecraft": c.spacecraft,
+                "detector": c.detector,
+                "config_hash": c.config_hash,
+                "start_utc": _to_naive_utc(c.start_utc),
+                "end_utc": _to_naive_utc(c.end_utc),
+                "recorded_utc": _now(),
+            }
+            for c in coverage
+        }
+        if not rows:
+            return
+        keys = list(rows)
+        existing = conn.execute(
+            sa.select(coverage_table.c.spacecraft, coverage_table.c.detector, coverage_table.c.start_utc).where(
+                coverage_table.c.run_id == run_id
+            )
+        ).all()
+        new = [rows[k] for k in keys if (k[0], k[1], k[2]) not in {tuple(r) for r in existing}]
+        if new:
+            conn.execute(coverage_table.insert(), new)
 
+    @_one_line_errors
     def runs(self) -> pd.DataFrame:
         """The run records, oldest first."""
         with self.engine.connect() as conn:
             rows = conn.execute(sa.select(runs_table).order_by(runs_table.c.started_utc)).mappings().all()
         return pd.DataFrame(rows, columns=[c.name for c in runs_table.columns])
 
-    def export(self, path: str | Path, *, spacecraft: str | None = None, kind: str | None = None) -> int:
-        """Export events to CSV or Parquet (by suffix); return the number of rows written."""
+    # ------------------------------------------------------------------------------------ events
+    @_one_line_errors
+    def add_events(self, frame: pd.DataFrame) -> int:
+        """Store detections; return how many *events* were new (see :meth:`store_events`)."""
+        return self.store_events(frame).events
+
+    @_one_line_errors
+    def store_events(self, frame: pd.DataFrame) -> Added:
+        """Store detections not yet in the catalog; new detections join existing events where they match."""
+        frame = normalise_frame(frame)
+        if frame.empty:
+            return Added(0, 0)
+        with self._writing() as conn:
+            return self._insert(conn, frame)
+
+    def _insert(self, conn: sa.Connection, frame: pd.DataFrame) -> Added:
+        frame = frame.drop_duplicates("event_id").reset_index(drop=True)
+        ids = [str(x) for x in frame["event_id"]]
+        existing_ids: set[str] = set()
+        for start in range(0, len(ids), 500):
+            chunk = ids[start : start + 500]
+            existing_ids.update(
+                r[0] for r in conn.execute(sa.select(events_table.c.event_id).where(events_table.c.event_id.in_(chunk)))
+            )
+        new = frame[~frame["event_id"].astype(str).isin(existing_ids)].reset_index(drop=True)
+        if new.empty:
+            return Added(0, 0)
+        times = pd.to_datetime(new["time_utc"].astype(str), utc=True).dt.tz_localize(None)
+        sigma = new["time_sigma_s"].fillna(0.0).to_numpy(dtype=float)
+        tol_s = np.clip(MATCH_SIGMAS * sigma, MATCH_MIN_S, MATCH_MAX_S)
+        lo = (times - pd.to_timedelta(MATCH_MAX_S * 2, unit="s")).min().to_pydatetime()
+        hi = (times + pd.to_timedelta(MATCH_MAX_S * 2, unit="s")).max().to_pydatetime()
+        c = events_table.c
+        known = pd.DataFrame(
+            conn.execute(
+                sa.select(
+                    c.event_key, c.spacecraft, c.detector, c.kind, c.time_utc, c.time_sigma_s, c.config_hash
+                ).where(
+                    c.spacecraft.in_(sorted(set(new["spacecraft"].astype(str)))),
+                    c.detector.in_(sorted(set(new["detector"].astype(str)))),
+                    c.time_utc >= lo,
+                    c.time_utc <= hi,
+                )
+            ).all(),
+            columns=["event_key", "spacecraft", "detector", "kind", "time_utc", "time_sigma_s", "config_hash"],
+        )
+        # configurations already attached to each event (a configuration sees an event once)
+        configs_of: dict[str, set[str]] = {}
+        for key, cfg in zip(known["event_key"], known["config_hash"], strict=True):
+            configs_of.setdefault(str(key), set()).add(str(cfg))
+        events_of: dict[tuple[str, str, str], list[tuple[str, pd.Timestamp, float]]] = {}
+        for rec in known.drop_duplicates("event_key").to_dict("records"):
+            ident = (str(rec["spacecraft"]), str(rec["detector"]), str(rec["kind"]))
+            events_of.setdefault(ident, []).append(
+                (str(rec["event_key"]), pd.Timestamp(rec["time_utc"]), float(rec["time_sigma_s"] or 0.0))
+            )
+        keys: list[str] = []
+        n_new_events = 0
+        for i in np.argsort(times.to_numpy(), kind="stable"):
+            sc, det, kind, cfg = (str(new.at[i, k]) for k in ("spacecraft", "detector", "kind", "config_hash"))
+            t = times.iloc[i]
+            best: tuple[float, str] | None = None
+            for key, t_known, sig_known in events_of.get((sc, det, kind), []):
+                if cfg in configs_of.get(key, set()):
+                    continue
+                gap = abs((t - t_known).total_seconds())
+                tol = max(tol_s[i], min(MATCH_MAX_S, max(MATCH_MIN_S, MATCH_SIGMAS * sig_known)))
+                if gap <= tol and (best is None or gap < best[0]):
+                    best = (gap, key)
+            if best is None:
+                key = event_key(sc, det, kind, str(new.at[i, "time_utc"]))
+                events_of.setdefault((sc, det, kind), []).append((key, t, float(sigma[i])))
+                n_new_events += 1
+            else:
+                key = best[1]
+            configs_of.setdefault(key, set()).add(cfg)
+            keys.append(key)
+        order = np.argsort(times.to_numpy(), kind="stable")
+        key_of_row = dict(zip(order.tolist(), keys, strict=True))
+        extra_cols = [col for col in new.columns if col not in EVENT_COLUMNS]
+        records: list[dict[str, Any]] = []
+        for i, new_rec in enumerate(new.to_dict("records")):
+            row = {col: _clean(new_rec[col]) for col in EVENT_COLUMNS}
+            row["time_utc"] = times.iloc[i].to_pydatetime()
+            row["event_key"] = key_of_row[i]
+            row["extra_json"] = json.dumps({str(col): _clean(new_rec[col]) for col in extra_cols}, default=str)
+            records.append(row)
+        conn.execute(events_table.insert(), records)
+        return Added(len(records), n_new_events)
+
+    @_one_line_errors
+    def events(
+        self,
+        *,
+        spacecraft: str | None = None,
+        kind: str | None = None,
+        detector: str | None = None,
+        run_id: str | None = None,
+        since: Any = None,
+        until: Any = None,
+        all_configurations: bool = False,
+    ) -> pd.DataFrame:
+        """Events ordered by time, with ``event_key`` and extra columns.
+
+        ``detector`` is a full name (``attitude.glr``), a capability (``attitude``) or a method (``glr``).
+        ``since``/``until`` bound the event time (UTC, inclusive). By default only current detections are returned (the
+        latest configuration that analysed each spacecraft, detector and time); ``all_configurations``
+        returns every stored detection. ``run_id`` keeps the detections a run reported.
+        """
+        c = events_table.c
+        query = sa.select(events_table)
+        if spacecraft is not None:
+            query = query.where(c.spacecraft == spacecraft)
+        if kind is not None:
+            query = query.where(c.kind == kind)
+        if detector is not None:
+            if "." in detector:
+                query = query.where(c.detector == detector)
+            else:  # a capability (attitude) or a method (glr)
+                query = query.where(sa.or_(c.detector.like(f"{detector}.%"), c.detector.like(f"%.{detector}")))
+        if since is not None:
+            query = query.where(c.time_utc >= _to_naive_utc(since))
+        if until is not None:
+            query = query.where(c.time_utc <= _to_naive_utc(until))
+        query = query.order_by(c.time_utc, c.detector)
+        with self.engine.connect() as conn:
+            frame = pd.DataFrame(
+                conn.execute(query).mappings().all(), columns=[*EVENT_COLUMNS, "event_key", "extra_json"]
+            )
+            cover = pd.DataFrame(
+                conn.execute(
+                    sa.select(coverage_table, runs_table.c.started_utc).join(
+                        runs_table, runs_table.c.run_id == coverage_table.c.run_id
+                    )
+                )
+                .mappings()
+                .all(),
+                columns=[*(col.name for col in coverage_table.columns), "started_utc"],
+            )
+        if run_id is not None:
+            frame = frame[_reported_by(frame, cover, run_id)]
+        elif not all_configurations:
+            frame = frame[_current(frame, cover)]
+        frame = frame.reset_index(drop=True)
+        frame["time_utc"] = [format_time_utc(t) for t in frame["time_utc"]]
+        extras = [json.loads(x) if x else {} for x in frame.pop("extra_json")]
+        extra_frame = pd.DataFrame(extras, index=frame.index)
+        if not extra_frame.empty:
+            frame = pd.concat([frame, extra_frame.drop(columns=[k for k in extra_frame if k in frame])], axis=1)
+        frame = normalise_frame(frame)
+        frame["event_key"] = frame["event_key"].astype("string")
+        return frame
+
+    @_one_line_errors
+    def export(self, path: str | Path, **filters: Any) -> int:
+        """Export events (filters as :meth:`events`) to CSV or Parquet (by suffix); return the row count.
+
+        Parquet stores ``time_utc`` as a UTC timestamp.
+        """
         from abrupt.events import write_events
 
-        frame = self.events(spacecraft=spacecraft, kind=kind)
+        frame = self.events(**filters)
         write_events(frame, str(path))
         return len(frame)
 
+    # ------------------------------------------------------------------------------------- tasks
+    @_one_line_errors
+    def finished_tasks(self, key: str) -> dict[str, int]:
+        """Tasks of resumable work ``key`` already done, with their event counts."""
+        with self.engine.connect() as conn:
+            rows = conn.execute(
+                sa.select(tasks_table.c.task_key, tasks_table.c.n_events).where(tasks_table.c.run_key == key)
+            ).all()
+        return {str(r[0]): int(r[1]) for r in rows}
 
-def _insert_ignoring_duplicates(dialect: str) -> Any:
-    """INSERT that skips rows whose event_id exists (concurrent writers, e.g. Dask workers)."""
-    if dialect == "sqlite":
-        from sqlalchemy.dialects.sqlite import insert as sqlite_insert
+    @_one_line_errors
+    def complete_task(
+        self,
+        key: str,
+        task_key: str,
+        *,
+        spacecraft: str,
+        chunk: str,
+        run_id: str,
+        events: pd.DataFrame,
+        coverage: Iterable[Coverage] = (),
+    ) -> Added:
+        """Store a task's events, coverage and completion in one transaction (all or nothing)."""
+        frame = normalise_frame(events)
+        with self._writing() as conn:
+            done = conn.execute(
+                sa.select(tasks_table.c.task_key).where(
+                    tasks_table.c.run_key == key, tasks_table.c.task_key == task_key
+                )
+            ).first()
+            if done:
+                return Added(0, 0)
+            added = self._insert(conn, frame) if len(frame) else Added(0, 0)
+            self._record_coverage(conn, run_id, coverage)
+            conn.execute(
+                tasks_table.insert().values(
+                    run_key=key,
+                    task_key=task_key,
+                    spacecraft=spacecraft,
+                    chunk=chunk,
+                    run_id=run_id,
+                    n_events=len(frame),
+                    finished_utc=_now(),
+                )
+            )
+        return added
 
-        return sqlite_insert(events_table).on_conflict_do_nothing(index_elements=["event_id"])
-    if dialect == "postgresql":
-        from sqlalchemy.dialects.postgresql import insert as pg_insert
 
-        return pg_insert(events_table).on_conflict_do_nothing(index_elements=["event_id"])
-    return events_table.insert()
+def _current(frame: pd.DataFrame, cover: pd.DataFrame) -> np.ndarray:
+    """Detections not superseded by a later run under another configuration over the same time."""
+    keep = np.ones(len(frame), dtype=bool)
+    if frame.empty or cover.empty:
+        return keep
+    groups = {k: g.sort_values("started_utc") for k, g in cover.groupby(["spacecraft", "detector"])}
+    for i, (sc, det, t, cfg) in enumerate(
+        zip(frame["spacecraft"], frame["detector"], frame["time_utc"], frame["config_hash"], strict=True)
+    ):
+        g = groups.get((sc, det))
+        if g is None:
+            continue
+        inside = g[(g["start_utc"] <= t) & (g["end_utc"] >= t)]
+        if len(inside):
+            keep[i] = inside["config_hash"].iloc[-1] == cfg
+    return keep
 
 
-def _now() -> str:
-    return dt.datetime.now(dt.UTC).strftime("%Y-%m-%dT%H:%M:%S.%fZ")
+def _reported_by(frame: pd.DataFrame, cover: pd.DataFrame, run_id: str) -> np.ndarray:
+    """Detections a run inserted or re-detected (same configuration over its covered time)."""
+    mine = frame["run_id"].astype(str).to_numpy() == run_id
+    spans = cover[cover["run_id"] == run_id]
+    for span in spans.to_dict("records"):
+        mine |= (
+            (frame["spacecraft"] == span["spacecraft"])
+            & (frame["detector"] == span["detector"])
+            & (frame["config_hash"] == span["config_hash"])
+            & (frame["time_utc"] >= span["start_utc"])
+            & (frame["time_utc"] <= span["end_utc"])
+        ).to_numpy()
+    return mine
+
+
+def coverage_of(
+    events: pd.DataFrame,
+    *,
+    config_hash: str,
+    spacecraft: str | None = None,
+    detectors: Iterable[str] = (),
+    start_utc: Any = None,
+    end_utc: Any = None,
+) -> list[Coverage]:
+    """What a run covered: the given spacecraft, detectors and span, or else those of its events."""
+    names = sorted(set(detectors) | set(events["detector"].astype(str))) if len(events) or detectors else []
+    if not names:
+        return []
+    times = pd.to_datetime(events["time_utc"].astype(str), utc=True) if len(events) else None
+    start = start_utc if start_utc is not None else (times.min() if times is not None else None)
+    end = end_utc if end_utc is not None else (times.max() if times is not None else None)
+    if start is None or end is None:
+        return []
+    crafts = [spacecraft] if spacecraft else sorted(set(events["spacecraft"].astype(str)))
+    out = []
+    for sc in crafts:
+        for det in names:
+            sel = events[(events["spacecraft"] == sc) & (events["detector"] == det)]
+            cfg = str(sel["config_hash"].iloc[0]) if len(sel) else config_hash
+            out.append(Coverage(sc, det, cfg, format_time_utc(start), format_time_utc(end)))
+    return out
+
+
+def _sqlite_manual_transactions(dbapi_connection: Any, connection_record: Any) -> None:
+    dbapi_connection.isolation_level = None  # let SQLAlchemy's "begin" event issue BEGIN IMMEDIATE
+
+
+def _sqlite_begin_immediate(conn: sa.Connection) -> None:
+    conn.exec_driver_sql("BEGIN IMMEDIATE")
+
+
+def _migrate_v1(conn: sa.Connection) -> None:
+    """Upgrade a catalog written by abrupt 0.1 (events without ``event_key``, text times) in place."""
+    inspector = sa.inspect(conn)
+    names = set(inspector.get_table_names())
+    if "events" not in names or "event_key" in {c["name"] for c in inspector.get_columns("events")}:
+        return
+    old_events = pd.DataFrame(conn.execute(sa.text("SELECT * FROM events")).mappings().all())
+    old_runs = pd.DataFrame(conn.execute(sa.text("SELECT * FROM runs")).mappings().all()) if "runs" in names else None
+    conn.execute(sa.text("DROP TABLE events"))
+    if old_runs is not None:
+        conn.execute(sa.text("DROP TABLE runs"))
+    _metadata.create_all(conn)
+    if old_runs is not None and len(old_runs):
+        run_rows: list[dict[str, Any]] = []
+        for old in old_runs.to_dict("records"):
+            run = {str(k): _clean(v) for k, v in old.items() if str(k) in runs_table.c}
+            for col in ("started_utc", "finished_utc"):
+                run[col] = _to_naive_utc(run[col]) if run.get(col) else None
+            run_rows.append(run)
+        conn.execute(runs_table.insert(), run_rows)
+    if len(old_events):
+        rows: list[dict[str, Any]] = []
+        for rec in old_events.to_dict("records"):
+            row = {str(k): _clean(v) for k, v in rec.items() if str(k) in events_table.c}
+            row["time_utc"] = _to_naive_utc(rec["time_utc"])
+            row["event_key"] = event_key(
+                str(rec["spacecraft"]), str(rec["detector"]), str(rec["kind"]), format_time_utc(rec["time_utc"])
+            )
+            rows.append(row)
+        conn.execute(events_table.insert(), rows)

@@ -76,7 +76,8 @@ class RepairLog:
         if count <= 0:
             return
         self.counts[kind] += int(count)
-        logger.warning("%s: repaired: %s (%d)", self.source, kind, count)
+        # INFO, not WARNING: the command line prints the counted summary once (-v shows each repair)
+        logger.info("%s: repaired: %s (%d)", self.source, kind, count)
 
     @property
     def total(self) -> int:

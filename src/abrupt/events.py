@@ -47,8 +47,11 @@ EVENT_COLUMNS: tuple[str, ...] = (
     "config_hash",
 )
 
-_TEXT_COLUMNS = ("event_id", "spacecraft", "kind", "detector", "time_utc", "run_id", "config_hash")
-_FLOAT_COLUMNS = tuple(c for c in EVENT_COLUMNS if c not in _TEXT_COLUMNS)
+#: Schema columns holding text (identifiers, names, ISO-8601 times); the others are float64.
+TEXT_COLUMNS: tuple[str, ...] = ("event_id", "spacecraft", "kind", "detector", "time_utc", "run_id", "config_hash")
+FLOAT_COLUMNS: tuple[str, ...] = tuple(c for c in EVENT_COLUMNS if c not in TEXT_COLUMNS)
+_TEXT_COLUMNS = TEXT_COLUMNS  # older spelling, kept while other branches still use it
+_FLOAT_COLUMNS = FLOAT_COLUMNS
 
 NAN = float("nan")
 
@@ -171,6 +174,8 @@ def normalise_frame(frame: pd.DataFrame) -> pd.DataFrame:
     out = frame.loc[:, ordered].copy()
     for name in _FLOAT_COLUMNS:
         out[name] = pd.to_numeric(out[name], errors="raise").astype("float64")
+    if pd.api.types.is_datetime64_any_dtype(out["time_utc"]):  # typed timestamps (Parquet) to the ISO text form
+        out["time_utc"] = [format_time_utc(t) for t in out["time_utc"]]
     for name in _TEXT_COLUMNS:
         out[name] = out[name].astype("string")
     bad = ~out["kind"].isin(EVENT_KINDS)
@@ -179,12 +184,35 @@ def normalise_frame(frame: pd.DataFrame) -> pd.DataFrame:
     return out.reset_index(drop=True)
 
 
+def restamp(frame: pd.DataFrame, *, run_id: str, config_hash: str) -> pd.DataFrame:
+    """The events of one run: ``run_id`` and the run's ``config_hash`` set, ``event_id`` recomputed.
+
+    A detector run on its own stamps its own configuration; a pipeline that runs several detectors
+    under one configuration stamps them all with it, so identifiers stay deterministic per run
+    configuration (:func:`make_event_id`).
+    """
+    out = normalise_frame(frame)
+    out["run_id"] = pd.array([run_id] * len(out), dtype="string")
+    out["config_hash"] = pd.array([config_hash] * len(out), dtype="string")
+    ids = [
+        make_event_id(str(sc), str(det), str(kind), str(t), config_hash)
+        for sc, det, kind, t in zip(out["spacecraft"], out["detector"], out["kind"], out["time_utc"], strict=True)
+    ]
+    out["event_id"] = pd.array(ids, dtype="string")
+    return out
+
+
 def write_events(frame: pd.DataFrame, path: str) -> None:
-    """Write events to CSV or Parquet, chosen by the file suffix (``.csv``, ``.parquet``/``.pq``)."""
+    """Write events to CSV or Parquet, chosen by the file suffix (``.csv``, ``.parquet``/``.pq``).
+
+    Parquet stores ``time_utc`` as a typed UTC timestamp (microseconds); CSV as ISO-8601 text.
+    """
     frame = normalise_frame(frame)
     lower = str(path).lower()
     if lower.endswith((".parquet", ".pq")):
-        frame.to_parquet(path, index=False)
+        typed = frame.copy()
+        typed["time_utc"] = pd.to_datetime(typed["time_utc"].astype(str), utc=True).astype("datetime64[us, UTC]")
+        typed.to_parquet(path, index=False)
     elif lower.endswith(".csv"):
         frame.to_csv(path, index=False)
     else:

@@ -7,18 +7,28 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from abrupt.cli.groups import catalog_option, check_suffix, cli, detect, record_run, report, simulate
+from abrupt.cli.groups import (
+    StageProgress,
+    catalog_option,
+    check_suffix,
+    cli,
+    detect,
+    note,
+    record_run,
+    report,
+    simulate,
+    warn,
+)
+from abrupt.cli.options import budget_options, pop_budget
 
 if TYPE_CHECKING:
     from abrupt.simulate.attitude import Strike
 
-DETECTOR_CHOICES = ("glr", "cusum", "summation", "shiryaev", "mf_attitude", "mf_rate", "mf_joint", "all")
-
 
 def _spacecraft(path: str | None) -> Any:
-    from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
+    from abrupt.pipelines.attitude import load_spacecraft
 
-    return load_spacecraft(path or bundled_spacecraft_path("thesis"))
+    return load_spacecraft(path)
 
 
 def parse_strike(text: str) -> Strike:
@@ -135,22 +145,31 @@ def simulate_attitude_cmd(
 
 def _detection_config(
     detectors: tuple[str, ...],
-    fa_per_day: float,
+    budget: Any,
     pre: int,
     post: int,
     glr_window: int,
     method: str,
     null_samples: int,
 ) -> Any:
-    from abrupt.detect.attitude import ATTITUDE_DETECTORS, AttitudeDetectionConfig
+    """The run configuration; detector names are checked against the registry now (plug-ins included)."""
+    from abrupt.detect.attitude import AttitudeDetectionConfig, attitude_detector_names
     from abrupt.detect.change_detection import WindowConfig
 
-    chosen = ATTITUDE_DETECTORS if "all" in detectors else tuple(dict.fromkeys(detectors or ("glr",)))
+    names = attitude_detector_names()
+    if "all" in detectors:
+        chosen = tuple(n.removeprefix("attitude.") for n in names if n.startswith("attitude."))
+    else:
+        chosen = tuple(dict.fromkeys(detectors or ("glr",)))
+    for d in chosen:
+        if d not in names and f"attitude.{d}" not in names:
+            short = ", ".join(n.removeprefix("attitude.") for n in names)
+            raise click.BadParameter(f"{d!r} is not a registered attitude detector; choose from {short}, all")
     return AttitudeDetectionConfig(
         detectors=chosen,
         windows=WindowConfig(pre=pre, post=post),
         glr_windows=WindowConfig(pre=glr_window, post=glr_window),
-        false_alarms_per_day=fa_per_day,
+        false_alarms_per_day=budget.per_day,
         threshold_method=method,
         null_samples=null_samples,
     )
@@ -161,19 +180,12 @@ detector_options = [
         "--detector",
         "detectors",
         multiple=True,
-        type=click.Choice(DETECTOR_CHOICES),
         default=("glr",),
         show_default=True,
-        help="Detector(s); repeatable; 'all' runs every one.",
+        help="Detector(s) by registered name (`abrupt detectors`); glr, cusum, summation, shiryaev, mf_attitude, "
+        "mf_rate, mf_joint or a plug-in's full name; repeatable; 'all' runs every attitude.* detector.",
     ),
-    click.option(
-        "--false-alarms-per-day",
-        "fa_per_day",
-        type=click.FloatRange(min=0.0, min_open=True),
-        default=1.0,
-        show_default=True,
-        help="False-alarm budget the thresholds are set for.",
-    ),
+    budget_options("1/day"),
     click.option(
         "--pre",
         type=click.IntRange(min=2),
@@ -234,6 +246,14 @@ def _with_options(options: list[Any]) -> Any:
     return wrap
 
 
+def _stage_count(cfg: Any) -> int:
+    """Progress stages of the pipeline: calibrate and run per change detector, one for the others."""
+    from abrupt.detect.attitude import MomentumChangeDetector, attitude_detector_class
+
+    n_change = sum(1 for d in cfg.detectors if issubclass(attitude_detector_class(d), MomentumChangeDetector))
+    return 2 * n_change + (1 if n_change < len(cfg.detectors) else 0)
+
+
 def run_attitude_detection(
     telemetry_path: str,
     spacecraft_path: str | None,
@@ -242,42 +262,36 @@ def run_attitude_detection(
     settings: dict[str, Any],
     mask: str | None = None,
 ) -> tuple[Any, Any, Any, Any]:
-    """Read, calibrate and detect, with a progress line per stage. Returns (sc, telemetry, config, result)."""
-    from abrupt.detect.attitude import detect_attitude
-    from abrupt.readers.telemetry import apply_mask, read_mask, read_telemetry
+    """Call the attitude pipeline, with a progress line per stage. Returns (sc, telemetry, config, run)."""
+    from abrupt.pipelines.attitude import detect_attitude, read_attitude_inputs
 
-    sc = _spacecraft(spacecraft_path)
-    tel = read_telemetry(telemetry_path, sc)
-    if mask:
-        tel = apply_mask(tel, read_mask(mask))
+    budget = pop_budget(settings, "1/day")
+    sc, tel, cal = read_attitude_inputs(telemetry_path, spacecraft_path, calibration_path=calibration, mask_path=mask)
     for line in tel.repairs.summary():
-        click.echo(f"repaired: {line}", err=True)
-    cal = read_telemetry(calibration, sc) if calibration else None
+        note(f"repaired: {line}")
     if cal is not None:
         for line in cal.repairs.summary():
-            click.echo(f"repaired (calibration): {line}", err=True)
-    cfg = _detection_config(**settings)
-    stages = iter(range(1, 10_000))
-
-    def progress(stage: str) -> None:
-        click.echo(f"[{next(stages)}] {stage} ...", err=True)
-
-    result = detect_attitude(tel, sc, cfg, calibration=cal, spacecraft_name=name, progress=progress)
+            note(f"repaired (calibration): {line}")
+    cfg = _detection_config(budget=budget, **settings)
+    stages = StageProgress(_stage_count(cfg), desc="detect attitude")
+    try:
+        result = detect_attitude(tel, sc, cfg, calibration=cal, spacecraft_name=name, progress=stages, budget=budget)
+    finally:
+        stages.close()
     for warning in result.details.get("warnings", []):
-        click.echo(f"warning: {warning}", err=True)
+        warn(warning)
     noise = result.details.get("noise_model", {})
     if noise:
-        click.echo(
+        note(
             "momentum noise model: white σ "
             + ", ".join(f"{v:.3g}" for v in noise["white_sigma_Nms"])
             + " N·m·s; random walk σ "
             + ", ".join(f"{v:.3g}" for v in noise["random_walk_sigma_Nms"])
-            + " N·m·s per sample",
-            err=True,
+            + " N·m·s per sample"
         )
     for det, frac in result.details.get("analysed_fraction", {}).items():
         if frac < 0.999:
-            click.echo(f"{det}: {frac:.1%} of samples analysed (window edges and short segments excluded)", err=True)
+            note(f"{det}: {frac:.1%} of samples analysed (window edges and short segments excluded)")
     return sc, tel, cfg, result
 
 
@@ -320,7 +334,7 @@ def detect_attitude_cmd(
 ) -> None:
     """Detect strikes in attitude TELEMETRY (CSV or Parquet); write events and the catalog."""
     mask = settings.pop("mask")
-    _, tel, _, result = run_attitude_detection(telemetry, spacecraft_path, calibration, name, settings, mask)
+    sc, tel, cfg, result = run_attitude_detection(telemetry, spacecraft_path, calibration, name, settings, mask)
     details = {
         "thresholds": {k: v.as_dict() for k, v in result.thresholds.items()},
         **{k: v for k, v in result.details.items()},
@@ -334,12 +348,12 @@ def detect_attitude_cmd(
         input_path=telemetry,
         out=out,
         details=details,
+        spacecraft=name or sc.name,
+        detectors=[d if "." in d else f"attitude.{d}" for d in cfg.detectors],
+        span_utc=(tel.time[0], tel.time[-1]) if len(tel) else None,
     )
     for k, thr in result.thresholds.items():
-        click.echo(
-            f"threshold {k}: {thr.value:.4g} ({thr.false_alarms_per_day:g} false alarms/day, {thr.method})",
-            err=True,
-        )
+        note(f"threshold {k}: {thr.value:.4g} ({thr.false_alarms_per_day:g} false alarms/day, {thr.method})")
     if report_path:
         from abrupt.report.attitude import write_attitude_report
 
@@ -395,7 +409,8 @@ def demo(out_dir: str, duration_s: float, seed: int) -> None:
     import numpy as np
     import pandas as pd
 
-    from abrupt.detect.attitude import AttitudeDetectionConfig, detect_attitude
+    from abrupt.detect.attitude import AttitudeDetectionConfig
+    from abrupt.pipelines.attitude import detect_attitude
     from abrupt.readers.telemetry import read_telemetry
     from abrupt.report.attitude import write_attitude_report
     from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude, write_telemetry
@@ -412,17 +427,14 @@ def demo(out_dir: str, duration_s: float, seed: int) -> None:
         u = rng.normal(size=3)
         u /= np.linalg.norm(u)
         strikes.append(Strike(round(float(t), 1), tuple(float(v) for v in size * u)))  # type: ignore[arg-type]
-    click.echo(
-        f"[1/4] simulating {duration_s / 3600:g} h of 10 Hz telemetry with {len(strikes)} strikes ...",
-        err=True,
-    )
+    note(f"[1/4] simulating {duration_s / 3600:g} h of 10 Hz telemetry with {len(strikes)} strikes ...")
     sim = simulate_attitude(sc, AttitudeSimConfig(duration_s=duration_s, seed=seed), strikes)
     tel_path, truth_path = write_telemetry(sim, out / "telemetry.parquet")
-    click.echo("[2/4] reading telemetry and calibrating thresholds (one false alarm per day) ...", err=True)
+    note("[2/4] reading telemetry and calibrating thresholds (one false alarm per day) ...")
     tel = read_telemetry(tel_path, sc)
     cfg = AttitudeDetectionConfig(detectors=("glr", "cusum", "summation"))
     result = detect_attitude(tel, sc, cfg, spacecraft_name="demo-sat")
-    click.echo("[3/4] writing events and catalog ...", err=True)
+    note("[3/4] writing events and catalog ...")
     record_run(
         catalog_target=str(out / "catalog.sqlite"),
         command="demo",
@@ -433,7 +445,7 @@ def demo(out_dir: str, duration_s: float, seed: int) -> None:
         out=out / "events.csv",
         details={"thresholds": {k: v.as_dict() for k, v in result.thresholds.items()}},
     )
-    click.echo("[4/4] drawing the report ...", err=True)
+    note("[4/4] drawing the report ...")
     truth = pd.read_csv(truth_path)
     write_attitude_report(out / "report.png", tel, result, truth=truth, title="abrupt demo: thesis spacecraft")
     write_attitude_report(out / "report.html", tel, result, truth=truth, title="abrupt demo: thesis spacecraft")

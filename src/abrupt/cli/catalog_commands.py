@@ -1,10 +1,15 @@
-"""``abrupt catalog``: list, export and summarise the event catalog."""
+"""``abrupt catalog``: list and export the event catalog (never creating one)."""
 
 from __future__ import annotations
+
+from typing import Any
 
 import click
 
 from abrupt.cli.groups import catalog_option, cli
+
+#: Width the default view fits in (characters).
+VIEW_WIDTH = 120
 
 
 @cli.group("catalog")
@@ -12,29 +17,115 @@ def catalog_group() -> None:
     """Inspect and export the event catalog."""
 
 
+def _filter_options(f: Any) -> Any:
+    options = [
+        click.option("--spacecraft", default=None, help="Only this spacecraft pseudonym."),
+        click.option("--kind", type=click.Choice(["strike", "maneuver", "mass_change", "unknown"]), default=None),
+        click.option(
+            "--detector", default=None, help="A detector (attitude.glr), a capability (attitude) or a method (glr)."
+        ),
+        click.option("--run", "run_id", default=None, help="Only the events reported by this run."),
+        click.option("--since", default=None, help="Only events at or after this time (UTC, ISO 8601)."),
+        click.option("--until", default=None, help="Only events at or before this time (UTC, ISO 8601)."),
+        click.option(
+            "--all-configurations",
+            is_flag=True,
+            help="Every stored detection, not only those of the latest configuration per spacecraft and detector.",
+        ),
+    ]
+    for opt in reversed(options):
+        f = opt(f)
+    return f
+
+
+def _filters(kw: dict[str, Any]) -> dict[str, Any]:
+    import pandas as pd
+
+    for key in ("since", "until"):
+        if kw[key] is not None:
+            try:
+                pd.Timestamp(kw[key])
+            except ValueError:
+                raise click.BadParameter(f"{kw[key]!r} is not a time (e.g. 2026-01-01T12:00)", param_hint=key) from None
+    return kw
+
+
 @catalog_group.command("export")
 @catalog_option
 @click.argument("out", type=click.Path(dir_okay=False))
-@click.option("--spacecraft", default=None, help="Only this spacecraft pseudonym.")
-@click.option("--kind", type=click.Choice(["strike", "maneuver", "mass_change", "unknown"]), default=None)
-def export(catalog_target: str, out: str, spacecraft: str | None, kind: str | None) -> None:
-    """Export events to OUT (.csv or .parquet)."""
+@_filter_options
+def export(catalog_target: str, out: str, **filters: Any) -> None:
+    """Export events to OUT (.csv or .parquet; Parquet keeps times as UTC timestamps)."""
     from abrupt.catalog import Catalog
 
-    n = Catalog(catalog_target).export(out, spacecraft=spacecraft, kind=kind)
+    if not out.lower().endswith((".csv", ".parquet", ".pq")):
+        raise click.BadParameter(f"{out!r} must end in .csv or .parquet", param_hint="OUT")
+    n = Catalog(catalog_target, create=False).export(out, **_filters(filters))
     click.echo(f"{n} event(s) written to {out}")
+
+
+def narrow_view(frame: Any) -> list[str]:
+    """Events as lines of at most :data:`VIEW_WIDTH` characters: time, spacecraft, kind, detector, size, margin."""
+    import math
+
+    header = (
+        f"{'time (UTC)':<23} {'spacecraft':<16} {'kind':<11} {'detector':<24} {'size':>16} {'stat/thr':>8} {'event':>8}"
+    )
+    lines = [header]
+    for row in frame.itertuples(index=False):
+        if not math.isnan(row.dH_Nms):
+            size = f"{row.dH_Nms:.3g} N·m·s"
+        elif not math.isnan(row.dv_mps):
+            size = f"{row.dv_mps:.3g} m/s"
+        else:
+            size = "–"
+        ratio = row.statistic / row.threshold if row.threshold else math.nan
+        lines.append(
+            f"{str(row.time_utc)[:23]:<23} {str(row.spacecraft)[:16]:<16} {str(row.kind)[:11]:<11} "
+            f"{str(row.detector)[:24]:<24} {size:>16} {ratio:>8.2f} {str(row.event_key)[:8]:>8}"
+        )
+    return lines
 
 
 @catalog_group.command("list")
 @catalog_option
+@_filter_options
 @click.option("--runs", is_flag=True, help="List run records instead of events.")
-def list_(catalog_target: str, runs: bool) -> None:
-    """Print the events (or run records) in the catalog."""
+@click.option("--wide", is_flag=True, help="Every column (wide lines) instead of the narrow view.")
+def list_(catalog_target: str, runs: bool, wide: bool, **filters: Any) -> None:
+    """Print the events (or run records) in the catalog; the latest configuration by default."""
     import pandas as pd
 
     from abrupt.catalog import Catalog
 
-    cat = Catalog(catalog_target)
-    frame = cat.runs() if runs else cat.events()
-    with pd.option_context("display.width", 200, "display.max_columns", 12):
-        click.echo(frame.to_string(index=False) if len(frame) else "(empty)")
+    cat = Catalog(catalog_target, create=False)
+    if runs:
+        frame = cat.runs()
+        if frame.empty:
+            click.echo("(no runs)")
+            return
+        if not wide:
+            frame = pd.DataFrame(
+                {
+                    "run_id": frame["run_id"],
+                    "started (UTC)": pd.to_datetime(frame["started_utc"]).dt.strftime("%Y-%m-%d %H:%M:%S"),
+                    "found": frame["n_events_found"].astype("Int64"),
+                    "new": frame["n_events_new"].astype("Int64"),
+                    "config": frame["config_hash"].astype(str).str[:8],
+                    "command": frame["command"].astype(str).str.slice(0, 55),
+                }
+            )
+        with pd.option_context("display.width", 400, "display.max_columns", 50, "display.max_colwidth", 400):
+            click.echo(frame.to_string(index=False))
+        return
+    frame = cat.events(**_filters(filters))
+    if frame.empty:
+        click.echo("(no events)")
+        return
+    if wide:
+        with pd.option_context("display.width", 1000, "display.max_columns", 100):
+            click.echo(frame.to_string(index=False))
+    else:
+        click.echo("\n".join(narrow_view(frame)))
+    n_events = frame["event_key"].nunique()
+    click.echo(f"{len(frame)} detection(s) of {n_events} event(s)", err=True)

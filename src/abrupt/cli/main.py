@@ -6,15 +6,16 @@ import sys
 
 import click
 
-from abrupt.cli import attitude, catalog_commands, orbit, rates, tle, tracking  # noqa: F401  (registration)
-from abrupt.cli.groups import cli
+from abrupt.cli import attitude, catalog_commands, detectors, orbit, rates, tle, tracking  # noqa: F401  (registration)
+from abrupt.cli.groups import cli, hoist_global_flags
 from abrupt.errors import AbruptError
 
 
 def main(argv: list[str] | None = None) -> None:
     """Run the command line; turn abrupt's own errors into a one-line message and exit status 2."""
+    args = hoist_global_flags(list(sys.argv[1:] if argv is None else argv))
     try:
-        cli.main(args=argv, prog_name="abrupt", standalone_mode=False)
+        cli.main(args=args, prog_name="abrupt", standalone_mode=False)
     except (AbruptError, ValueError) as exc:
         # abrupt's own errors name the file, line and reason; a ValueError from a setting is shown
         # the same way (a one-line message, exit status 2), never as a traceback.

@@ -315,12 +315,18 @@ def detect_orbit_command(
 @click.option("--time", "time_utc", required=True, help="Injection time (ISO-8601 UTC).")
 @click.option("--dv-rtn", required=True, help="ΔV in the orbit frame: radial,along-track,cross-track (m/s).")
 @click.option("--satellite", default=None, help="Satellite id in the file.")
-@click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Navigation CSV to write.")
+@click.option(
+    "--out",
+    "out",
+    required=True,
+    type=click.Path(dir_okay=False),
+    help="File to write, in the input's format (SP3, OEM KVN/XML); a name ending in .csv gives navigation CSV.",
+)
 def inject_orbit_command(file: str, time_utc: str, dv_rtn: str, satellite: str | None, out: str) -> None:
     """Add the effect of a ΔV at a chosen time to a real ephemeris (propagated difference, two-body + J2-J4)."""
     import numpy as np
 
-    from abrupt.readers.navigation_csv import read_ephemeris, write_navigation_csv
+    from abrupt.readers.ephemeris import read_ephemeris, write_ephemeris
     from abrupt.simulate.orbit import inject_impulse
 
     eph = read_ephemeris(file, satellite)
@@ -330,10 +336,14 @@ def inject_orbit_command(file: str, time_utc: str, dv_rtn: str, satellite: str |
         raise ConfigError(f"cannot read time {time_utc!r}", key="time") from None
     try:
         out_eph = inject_impulse(eph, t, _parse_vector(dv_rtn, "dv-rtn"))
+    except ConfigError:
+        raise  # already names its option (a ConfigError is a ValueError: do not wrap it twice)
     except ValueError as exc:
         raise ConfigError(str(exc), key="time") from None
-    write_navigation_csv(out_eph, out)
-    click.echo(f"ΔV {dv_rtn} m/s (RTN) injected at {time_utc} into {len(out_eph)} epochs; written to {out}", err=True)
+    fmt = write_ephemeris(out_eph, out, like=file)
+    click.echo(
+        f"ΔV {dv_rtn} m/s (RTN) injected at {time_utc} into {len(out_eph)} epochs; written to {out} ({fmt})", err=True
+    )
 
 
 @report.command("orbit")

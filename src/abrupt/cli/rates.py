@@ -11,12 +11,6 @@ import click
 
 from abrupt.cli.groups import cli, progress
 
-DEFAULT_THRESHOLDS = {
-    "dH": [1e-3, 3e-3, 1e-2, 2e-2, 3e-2, 0.1, 0.3, 0.4, 1.0],  # [N m s]
-    "dV": [1e-5, 1e-4, 1e-3, 1e-2, 2.4e-2, 0.1],  # [m/s]
-    "da": [0.1, 1.0, 10.0, 46.0, 100.0],  # [m]
-}
-
 
 @cli.group()
 def rates() -> None:
@@ -159,80 +153,20 @@ def _scenario_options(func: Callable[..., Any]) -> Callable[..., Any]:
     return func
 
 
-def _build_base(kw: dict[str, Any]) -> Any:
-    from abrupt.rates.montecarlo import RateConfig
-    from abrupt.rates.trades import Scenario
-
-    config = RateConfig(
-        mass_model=kw["mass_model"],
-        mef_model=kw["mef"],
-        lc_min_m=kw["lc_min_m"],
-        n_draws=kw["n_draws"],
-        location=kw["location"],
-        grid_spacing_m=kw["grid_spacing_m"],
-        area=kw["area"],
-        flux_bound_sigma=kw["flux_bound"],
-        size_sampling=kw["size_sampling"],
-        seed=kw["seed"],
-    )
-    return Scenario(
-        spacecraft=kw["spacecraft"],
-        altitude_km=kw["altitude_km"],
-        inclination_deg=kw["inclination_deg"],
-        epoch_year=kw["epoch_year"],
-        solar_flux_sfu=kw["solar_flux_sfu"],
-        flux=kw["flux_model"],
-        flux_sigma_factor=kw["flux_sigma_factor"],
-        config=config,
-    )
-
-
-def _thresholds(metric: str, text: str | None, first: bool) -> list[float]:
-    from abrupt.errors import ConfigError
-
-    if text is None or not first:
-        return DEFAULT_THRESHOLDS[metric]
-    try:
-        values = [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise ConfigError(f"cannot read thresholds {text!r}", key="thresholds") from None
-    if not values or any(v <= 0 for v in values):
-        raise ConfigError("thresholds must be positive numbers", key="thresholds")
-    return values
-
-
 def _report(results: Sequence[Any], kw: dict[str, Any]) -> None:
-    import pandas as pd
+
+    from abrupt.pipelines.rates import METRIC_UNITS, metric_thresholds, rate_table
 
     metrics = list(kw["metric"]) or ["dH", "dV", "da"]
-    rows = []
-    for r in results:
-        for i, m in enumerate(metrics):
-            t = _thresholds(m, kw["thresholds"], i == 0)
-            for thr, rate in zip(t, r.detectable_per_year(m, t), strict=True):
-                rows.append(
-                    {
-                        "case": r.label,
-                        "metric": m,
-                        "threshold_SI": thr,
-                        "detectable_per_year": rate,
-                        "strikes_per_year": r.strikes_per_year,
-                        "area_m2": r.area_m2,
-                        "flux_m2_yr": r.flux_m2_yr,
-                        "on_array_fraction": r.on_array_fraction,
-                        **r.params,
-                    }
-                )
-    frame = pd.DataFrame(rows)
+    frame = rate_table(results, metrics, kw["thresholds"])
     for r in results:
         click.echo(
             f"{r.label}: {r.strikes_per_year:.4g} strikes/yr above Lc {kw['lc_min_m']:g} m "
             f"(A_eff {r.area_m2:.3g} m², flux {r.flux_m2_yr:.4g} /m²/yr, arrays {r.on_array_fraction:.0%})"
         )
-    units = {"dH": "N m s", "dV": "m/s", "da": "m"}
     for m in metrics:
         sub = frame[frame.metric == m].pivot(index="threshold_SI", columns="case", values="detectable_per_year")
-        click.echo(f"\nexpected detectable strikes per year, {m} threshold [{units[m]}]:")
+        click.echo(f"\nexpected detectable strikes per year, {m} threshold [{METRIC_UNITS[m]}]:")
         click.echo(sub.to_string(float_format=lambda v: f"{v:.4g}"))
     if kw["out"]:
         Path(kw["out"]).parent.mkdir(parents=True, exist_ok=True)
@@ -246,7 +180,7 @@ def _report(results: Sequence[Any], kw: dict[str, Any]) -> None:
         m = metrics[0]
         thr_plot = None
         if kw["thresholds"]:
-            thr_plot = np.asarray(_thresholds(m, kw["thresholds"], True), dtype=np.float64)
+            thr_plot = np.asarray(metric_thresholds(m, kw["thresholds"], True), dtype=np.float64)
         plot_rate_curves(results, m, kw["plot"], thresholds=thr_plot)
         click.echo(f"plot written to {kw['plot']}", err=True)
     if kw["scatter"]:
@@ -260,10 +194,11 @@ def _report(results: Sequence[Any], kw: dict[str, Any]) -> None:
 @_scenario_options
 def run_command(**kw: Any) -> None:
     """One Monte Carlo: expected detectable strikes per year against threshold."""
-    from abrupt.rates.trades import _run_case
+    from abrupt.pipelines.rates import build_scenario
+    from abrupt.rates.trades import run_case
 
-    base = _build_base(kw)
-    _report([_run_case(base)], kw)
+    base = build_scenario(kw)
+    _report([run_case(base)], kw)
 
 
 @rates.command("trade")
@@ -280,17 +215,11 @@ def run_command(**kw: Any) -> None:
 @click.option("--scheduler", default=None, help="Dask scheduler address (tcp://host:8786); in-process when absent.")
 def trade_command(vary: tuple[str, ...], scheduler: str | None, **kw: Any) -> None:
     """A trade over one or two variables; one Monte Carlo per case (Dask-parallel with --scheduler)."""
-    from abrupt.errors import ConfigError
+    from abrupt.pipelines.rates import build_scenario, parse_vary
     from abrupt.rates.trades import run_trade
 
-    variables = []
-    for item in vary:
-        if "=" not in item:
-            raise ConfigError(f"--vary needs NAME=V1,V2, got {item!r}", key="vary")
-        name, values = item.split("=", 1)
-        sep = ";" if name.strip() == "spacecraft" else ","
-        variables.append((name.strip(), [v.strip() for v in values.split(sep) if v.strip()]))
-    base = _build_base(kw)
+    variables = parse_vary(vary)
+    base = build_scenario(kw)
     results = run_trade(
         base,
         variables,
@@ -412,10 +341,10 @@ def import_ordem_command(
     intact_class: str,
 ) -> None:
     """Convert ORDEM 3.x spacecraft-mode size and igloo tables into an abrupt flux table."""
-    from abrupt.rates.ordem import _read_numeric, describe_mapping, import_ordem
+    from abrupt.rates.ordem import describe_mapping, import_ordem, read_numeric_table
     from abrupt.rates.tables import write_flux_table
 
-    header, _, _ = _read_numeric(Path(size_file))
+    header, _, _ = read_numeric_table(Path(size_file))
     for col, meaning in describe_mapping(header).items():
         click.echo(f"  {col}: {meaning}", err=True)
     table = import_ordem(

@@ -30,11 +30,23 @@ norad_option = click.option(
 @norad_option
 @spacecraft_name_option
 @click.option(
+    "--false-alarms",
+    "false_alarms",
+    default=None,
+    help="False-alarm budget, e.g. '1/year' (per satellite-year; also '/week', '/day').  [default: 1/year]",
+)
+@click.option(
     "--false-alarms-per-year",
     type=float,
-    default=1.0,
+    default=None,
+    help="Alias of --false-alarms N/year (kept for old scripts).",
+)
+@click.option(
+    "--detector",
+    type=click.Choice(["auto", "tle.mean_elements", "tle.geo_station_keeping"]),
+    default="auto",
     show_default=True,
-    help="False-alarm budget per satellite-year that sets the threshold.",
+    help="auto: tle.geo_station_keeping for geosynchronous orbits, tle.mean_elements otherwise.",
 )
 @click.option("--threshold", type=float, default=None, help="Fixed threshold on the statistic (overrides the budget).")
 @click.option(
@@ -50,51 +62,91 @@ norad_option = click.option(
     help="Also write sub-threshold candidates (for recall-versus-false-alarm curves); "
     "'statistic >= threshold' selects detections.",
 )
+@click.option("--strict", is_flag=True, help="A malformed element set is an error (default: skipped and reported).")
 @catalog_option
 def detect_tle(
     path: str,
     out: str | None,
     norad_id: int | None,
     pseudonym: str | None,
-    false_alarms_per_year: float,
+    false_alarms: str | None,
+    false_alarms_per_year: float | None,
+    detector: str,
     threshold: float | None,
     window_sets: int,
     all_candidates: bool,
+    strict: bool,
     catalog_target: str,
 ) -> None:
-    """Detect maneuvers in a TLE, 3LE or OMM (XML, KVN, JSON, CSV) history of one satellite.
+    """Detect maneuvers in a TLE, 3LE or OMM (XML, KVN, JSON, CSV) history; every satellite of the file.
 
-    Example: abrupt detect tle Jason-3.tle --out jason3_events.csv
+    Example: abrupt detect tle Jason-3.tle --out jason3_events.csv --false-alarms 1/year
     """
-    from dataclasses import asdict
-
-    from abrupt.detect.tle_maneuvers import TleDetectorConfig, detect_tle_maneuvers
     from abrupt.events import config_hash, new_run_id
-    from abrupt.readers.omm import read_elements
+    from abrupt.pipelines.tle import detect_tle_file, satellite_label
+    from abrupt.thresholds import FalseAlarmBudget
 
+    if false_alarms is not None and false_alarms_per_year is not None:
+        raise click.BadParameter("give --false-alarms or its alias --false-alarms-per-year, not both")
     try:
-        cfg = TleDetectorConfig(
-            window_sets=window_sets, false_alarms_per_year=false_alarms_per_year, threshold=threshold
-        )
+        if false_alarms_per_year is not None:
+            budget = FalseAlarmBudget(false_alarms_per_year, "year")
+        else:
+            budget = FalseAlarmBudget.parse(false_alarms or "1/year")
+        settings: dict[str, Any] = {"window_sets": window_sets, "threshold": threshold}
+        from abrupt.detect.tle_maneuvers import TleDetectorConfig
+
+        TleDetectorConfig(window_sets=window_sets, threshold=threshold)  # validate before reading
     except ValueError as exc:
         raise click.BadParameter(str(exc)) from None
-    history = read_elements(path, norad_id=norad_id)
-    for line in history.repairs.summary():
-        click.echo(f"repaired: {line}", err=True)
     run_id = new_run_id()
-    events = detect_tle_maneuvers(history, cfg, spacecraft=pseudonym, run_id=run_id, all_candidates=all_candidates)
-    details: dict[str, Any] = {
-        "element_sets": len(history),
-        "first_epoch_utc": str(history.elements["epoch_utc"].iloc[0]),
-        "last_epoch_utc": str(history.elements["epoch_utc"].iloc[-1]),
-        "repairs": history.repairs.as_dict(),
-        "config": asdict(cfg),
-    }
+    result = detect_tle_file(
+        path,
+        budget,
+        detector=detector,
+        norad_id=norad_id,
+        strict=strict,
+        spacecraft=pseudonym,
+        all_candidates=all_candidates,
+        run_id=run_id,
+        settings=settings,
+    )
+    skipped = result.skipped
+    for err in skipped[:20]:
+        click.echo(f"skipped: {err}", err=True)
+    if len(skipped) > 20:
+        click.echo(f"skipped: ... and {len(skipped) - 20} more malformed element sets", err=True)
+    details: dict[str, Any] = {"budget": str(budget), "strict": strict, "satellites": []}
+    for sat in result.satellites:
+        h = sat.history
+        for line in h.repairs.summary():
+            click.echo(f"repaired: {line}", err=True)
+        nm = sat.noise_model
+        n_det = int((sat.events["statistic"] >= sat.events["threshold"]).sum()) if len(sat.events) else 0
+        click.echo(
+            f"{satellite_label(h)}: {len(h)} element sets, {sat.detector}, {n_det} maneuver(s); "
+            f"smallest detectable ΔV in-track {nm.get('min_detectable_dv_t_mps', float('nan')) * 100:.2g} cm/s, "
+            f"cross-track {nm.get('min_detectable_dv_n_mps', float('nan')) * 100:.2g} cm/s",
+            err=True,
+        )
+        details["satellites"].append(
+            {
+                "norad_id": h.norad_id,
+                "name": h.name,
+                "detector": sat.detector,
+                "element_sets": len(h),
+                "first_epoch_utc": str(h.elements["epoch_utc"].iloc[0]),
+                "last_epoch_utc": str(h.elements["epoch_utc"].iloc[-1]),
+                "repairs": h.repairs.as_dict(),
+                "skipped": [str(e) for e in h.skipped[:100]],
+                "noise_model": nm,
+            }
+        )
     record_run(
         catalog_target=catalog_target,
         command="detect tle",
-        events=events,
-        config_hash=config_hash(asdict(cfg)),
+        events=result.events,
+        config_hash=config_hash({"detector": detector, "budget": str(budget), **settings}),
         run_id=run_id,
         input_path=path,
         out=out,
@@ -142,9 +194,10 @@ def report_tle(
 
 
 def _read_truth(path: str) -> Any:
-    """Truth list: an events file (.csv/.parquet with the event columns) or an IDS maneuver file."""
+    """Truth list: an events file (.csv/.parquet with the event columns) or an operator maneuver file
+    (IDS ``*man.txt``, TAI epochs; Fengyun ``.fy``, China Standard Time)."""
     from abrupt.events import read_events
-    from abrupt.readers.ids_maneuvers import read_ids_maneuvers
+    from abrupt.readers.fengyun import read_maneuver_file
 
     if path.lower().endswith((".parquet", ".pq")):
         return read_events(path)
@@ -152,7 +205,7 @@ def _read_truth(path: str) -> Any:
         first = fh.readline()
     if first.startswith("event_id,"):
         return read_events(path)
-    return read_ids_maneuvers(path)
+    return read_maneuver_file(path)
 
 
 @cli.command("score")

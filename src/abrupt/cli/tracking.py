@@ -10,6 +10,7 @@ from typing import Any
 import click
 
 from abrupt.cli.groups import catalog_option, detect, progress, record_run, report, simulate
+from abrupt.cli.options import budget_options, pop_budget
 
 
 @simulate.command("tracking")
@@ -175,13 +176,7 @@ def _write_aer(measurements: Any, path: Path) -> None:
 )
 @click.option("--out", "out", type=click.Path(dir_okay=False), default=None, help="Events file (.csv/.parquet).")
 @click.option("--method", type=click.Choice(["both", "kaderali", "glrt"]), default="both", show_default=True)
-@click.option(
-    "--false-alarms-per-day",
-    type=float,
-    default=0.1,
-    show_default=True,
-    help="False-alarm budget of both detectors.",
-)
+@budget_options("0.1/day")
 @click.option(
     "--psi-threshold",
     type=float,
@@ -228,7 +223,6 @@ def detect_tracking_command(
     setup_path: str,
     out: str | None,
     method: str,
-    false_alarms_per_day: float,
     psi_threshold: float,
     eta_threshold: float,
     mask_deg: float | None,
@@ -241,268 +235,45 @@ def detect_tracking_command(
     diagnostics_out: str | None,
     spacecraft: str | None,
     catalog_target: str,
+    **budget_args: Any,
 ) -> None:
     """Detect unknown maneuvers in ground tracking (TDM or .aer) and characterise them.
 
     Fits the orbit (with station biases and, for real data, a constant unmodelled acceleration), then
     runs the Kaderali EKF (Ψ, K) and the out-of-view GLRT. Events go to the catalog and --out.
     """
-    import numpy as np
-    import pandas as pd
-    from astropy.time import Time
+    from abrupt.pipelines.tracking import TrackingSettings, detect_tracking, read_tracking_series
 
-    from abrupt.detect.kaderali import (
-        KaderaliConfig,
-        calibrate_psi_threshold,
-        kaderali_events,
-        run_kaderali_filter,
-    )
-    from abrupt.detect.tracking_glrt import (
-        BatchFitConfig,
-        GlrtConfig,
-        detect_maneuvers_glrt,
-        fit_orbit,
-        glrt_events,
-    )
-    from abrupt.errors import ConfigError, RepairLog
-    from abrupt.events import config_hash, empty_frame, events_frame, new_run_id
-    from abrupt.model.timescales import offline_astropy
-    from abrupt.model.tracking_measurements import TrackingArrays, correct_refraction
-    from abrupt.model.tracking_orbit import ForceModel, sun_position_m
-    from abrupt.readers.aer import read_aer
-    from abrupt.readers.orekit_od_input import read_od_input
-    from abrupt.readers.tdm import read_tdm
-    from abrupt.thresholds import p_fa_per_sample
-
-    if false_alarms_per_day <= 0:
-        raise ConfigError("must be > 0", key="--false-alarms-per-day")
-    offline_astropy()
-    setup = read_od_input(setup_path)
-    repairs = RepairLog(file)
-    if Path(file).suffix.lower() in (".tdm", ".kvn", ".txt") and _looks_like_tdm(file):
-        meas = read_tdm(file, repairs=repairs)
-    else:
-        meas = read_aer(file, known_stations=setup.stations, repairs=repairs)
-    use_refraction = setup.refraction_correction if refraction is None else refraction
-    if use_refraction:
-        meas = correct_refraction(meas)
-    data = TrackingArrays(
-        meas,
-        setup.stations,
-        epoch_utc=setup.epoch_utc,
-        earth_rotation=setup.earth_rotation,  # type: ignore[arg-type]
-        theta0_rad=setup.theta0_rad,
-        source=file,
-    )
-    real = any(k.startswith("central.body") or k.startswith("third.body") for k in setup.extra)
-    degree = int(float(setup.extra.get("central.body.degree", "0") or 0))
-    third = any(setup.extra.get(k, "false").lower() == "true" for k in ("third.body.sun", "third.body.moon"))
-    jd_tt = float(Time(setup.epoch_utc, scale="utc").tt.jd)
-    force = ForceModel(mu_m3_s2=setup.mu_m3_s2, j2=degree >= 2, third_body=third, epoch_jd_tt=jd_tt)
-    biases = any(setup.range_bias_estimated.values()) if estimate_biases is None else estimate_biases
-    accel = real if estimate_acceleration is None else estimate_acceleration
-    period = _period_s(setup.initial_state, setup.mu_m3_s2)
-    max_step = float(min(60.0, max(5.0, period / 1000.0)))
-    fit_cfg = BatchFitConfig(
-        force=force,
-        estimate_range_bias=biases,
-        estimate_angle_bias=biases and real,
-        estimate_acceleration=accel,
-        max_step_s=max_step,
+    budget = pop_budget(budget_args, "0.1/day")
+    settings = TrackingSettings(
+        method=method,  # type: ignore[arg-type]
+        psi_threshold=psi_threshold,
+        eta_threshold_km=eta_threshold,
         elevation_mask_deg=mask_deg,
+        estimate_biases=estimate_biases,
+        estimate_acceleration=estimate_acceleration,
+        refraction=refraction,
+        max_maneuvers=max_maneuvers,
+        kaderali_threshold=kaderali_threshold,  # type: ignore[arg-type]
     )
-    settings = {
-        "file": Path(file).name,
-        "method": method,
-        "fa_per_day": false_alarms_per_day,
-        "psi_th": psi_threshold,
-        "eta_th": eta_threshold,
-        "mask": mask_deg,
-        "biases": biases,
-        "accel": accel,
-        "refraction": use_refraction,
-        "force": [force.mu_m3_s2, force.j2, force.third_body],
-        "max_maneuvers": max_maneuvers,
-        "kaderali_threshold": kaderali_threshold,
-    }
-    cfg_hash = config_hash(settings)
-    run_id = new_run_id()
-    name = spacecraft or Path(file).stem
-    fit = fit_orbit(data, setup.initial_state, config=fit_cfg)
-    start_state = fit.x0
-    accel_state = fit.acceleration_mps2
-    final_fit = fit
-    events = []
-    diag_frames = []
-    arc_s = float(data.t_s.max() - data.t_s.min())
-    if method in ("both", "glrt"):
-        detections, fit_m, scans = detect_maneuvers_glrt(
-            data,
-            fit.x0,
-            fit_config=fit_cfg,
-            config=GlrtConfig(false_alarms_per_day=false_alarms_per_day, max_maneuvers=max_maneuvers),
-        )
-        start_state = fit_m.x0  # the maneuver-aware state at t0 starts the EKF
-        accel_state = fit_m.acceleration_mps2
-        final_fit = fit_m
-        events += glrt_events(
-            detections,
-            epoch_utc=data.epoch_utc,
-            spacecraft=name,
-            run_id=run_id,
-            config_hash=cfg_hash,
-            false_alarms_per_day=false_alarms_per_day,
-        )
-        if scans:
-            diag_frames.append(
-                pd.DataFrame(
-                    {
-                        "series": "glrt",
-                        "time_utc": data.epoch_utc + (scans[0].t_candidates_s * 1e9).astype("timedelta64[ns]"),
-                        "glrt_statistic": scans[0].statistic,
-                        "threshold": detections[0].threshold if detections else np.nan,
-                    }
-                )
-            )
-    if method in ("both", "kaderali"):
-        # measurements corrected by the fitted biases, filter started from the fitted state
-        kdata = data
-        for k, st in enumerate(data.station_names):
-            if st in fit.range_bias_m:
-                kdata.range_bias_m[k] = fit.range_bias_m[st]
-            if st in fit.angle_bias_rad:
-                kdata.y[k, 1] -= fit.angle_bias_rad[st][0]
-                kdata.y[k, 2] -= fit.angle_bias_rad[st][1]
-        kcfg = KaderaliConfig(
-            psi_threshold=psi_threshold,
-            eta_threshold_km=eta_threshold,
-            elevation_mask_deg=mask_deg,
-            force=force,
-            max_step_s=max_step,
-            accel_mps2=tuple(float(v) for v in accel_state),  # type: ignore[arg-type]
-        )
-        result = run_kaderali_filter(kdata, start_state, config=kcfg)
-        if kaderali_threshold == "chi2":
-            from scipy.stats import chi2
-
-            rate_hz = max(len(result.t_s) - 1, 1) / max(arc_s, 1.0)
-            m = int(np.median(result.n_components)) if result.n_components.size else 4
-            psi_det = float(chi2.isf(p_fa_per_sample(false_alarms_per_day, rate_hz), m))
-        else:
-            psi_det, _ = calibrate_psi_threshold(
-                kdata, start_state, config=kcfg, false_alarms_per_day=false_alarms_per_day
-            )
-        events += kaderali_events(
-            result,
-            epoch_utc=data.epoch_utc,
-            spacecraft=name,
-            run_id=run_id,
-            config_hash=cfg_hash,
-            psi_detection_threshold=psi_det,
-            false_alarms_per_day=false_alarms_per_day,
-        )
-        diag_frames.append(
-            pd.DataFrame(
-                {
-                    "series": "kaderali",
-                    "time_utc": data.epoch_utc + (result.t_s * 1e9).astype("timedelta64[ns]"),
-                    "psi": result.psi,
-                    "k_db": result.k_db,
-                    "trace_p_km": result.trace_p_km,
-                    "inflated": result.inflated,
-                    "threshold": psi_det,
-                }
-            )
-        )
-    frame = events_frame(events) if events else empty_frame()
-    summary = _fit_summary(final_fit, force, sun_position_m(jd_tt))
-    summary["repairs"] = repairs.as_dict()
-    for line in _summary_lines(summary):
+    inputs = read_tracking_series(file, setup_path, settings, name=spacecraft)
+    run = detect_tracking(inputs, settings, budget, file_name=Path(file).name)
+    for line in run.summary_lines():
         click.echo(line, err=True)
     if fit_out:
-        Path(fit_out).write_text(json.dumps(summary, indent=2, default=float))
+        Path(fit_out).write_text(json.dumps(run.fit_summary, indent=2, default=float))
     if diagnostics_out:
-        pd.concat(diag_frames, ignore_index=True).to_csv(diagnostics_out, index=False)
+        run.diagnostics.to_csv(diagnostics_out, index=False)
     record_run(
         catalog_target=catalog_target,
         command="detect tracking",
-        events=frame,
-        config_hash=cfg_hash,
-        run_id=run_id,
+        events=run.events,
+        config_hash=run.config_hash,
+        run_id=run.run_id,
         input_path=file,
         out=out,
-        details={"settings": settings, "fit": summary},
+        details={"settings": run.settings, "fit": run.fit_summary},
     )
-
-
-def _looks_like_tdm(path: str) -> bool:
-    with open(path, errors="replace") as fh:
-        head = fh.read(2000)
-    return "CCSDS_TDM_VERS" in head
-
-
-def _period_s(state: Any, mu: float) -> float:
-    import numpy as np
-
-    r = float(np.linalg.norm(state[:3]))
-    v2 = float(np.dot(state[3:], state[3:]))
-    energy = v2 / 2 - mu / r
-    if energy >= 0:
-        return 86400.0
-    a = -mu / (2 * energy)
-    return 2 * math.pi * math.sqrt(a**3 / mu)
-
-
-def _fit_summary(fit: Any, force: Any, sun_m: Any) -> dict[str, Any]:
-    import numpy as np
-
-    out: dict[str, Any] = {
-        "converged": bool(fit.converged),
-        "n_impulses": len(fit.impulse_times_s),
-        "iterations": int(fit.iterations),
-        "n_observations": int(fit.n_obs),
-        "weighted_rms": float(fit.rms_white),
-        "x0_m_mps": [float(v) for v in fit.x0],
-        "range_bias_m": {k: [float(v), fit.sigma(f"range_bias[{k}]")] for k, v in fit.range_bias_m.items()},
-        "angle_bias_deg": {k: [math.degrees(v[0]), math.degrees(v[1])] for k, v in fit.angle_bias_rad.items()},
-        "force_model": {"mu_m3_s2": force.mu_m3_s2, "j2": force.j2, "sun_moon": force.third_body},
-    }
-    if "accel_x" in fit.parameter_names:
-        a = np.asarray(fit.acceleration_mps2, float)
-        k = fit.parameter_names.index("accel_x")
-        cov = fit.covariance[k : k + 3, k : k + 3]
-        mag = float(np.linalg.norm(a))
-        u = a / mag if mag > 0 else a
-        anti_sun = -np.asarray(sun_m, float) / float(np.linalg.norm(sun_m))
-        out["unmodelled_acceleration"] = {
-            "vector_mps2": [float(v) for v in a],
-            "sigma_mps2": [float(math.sqrt(max(cov[i, i], 0.0))) for i in range(3)],
-            "magnitude_mps2": mag,
-            "magnitude_sigma_mps2": float(math.sqrt(max(float(u @ cov @ u), 0.0))),
-            "angle_to_anti_sun_deg": float(math.degrees(math.acos(max(-1.0, min(1.0, float(u @ anti_sun)))))),
-        }
-    return out
-
-
-def _summary_lines(summary: dict[str, Any]) -> list[str]:
-    lines = [
-        f"orbit fit: {'converged' if summary['converged'] else 'NOT converged'} "
-        f"in {summary['iterations']} iterations with {summary['n_impulses']} impulse(s), "
-        f"{summary['n_observations']} observations, weighted RMS {summary['weighted_rms']:.3f}"
-    ]
-    for st, (b, s) in summary["range_bias_m"].items():
-        lines.append(f"  range bias {st}: {b:.1f} ± {s:.1f} m")
-    acc = summary.get("unmodelled_acceleration")
-    if acc:
-        lines.append(
-            f"  unmodelled acceleration: {acc['magnitude_mps2']:.3e} "
-            f"± {acc['magnitude_sigma_mps2']:.1e} m/s² "
-            f"(N frame {', '.join(f'{v:.2e}' for v in acc['vector_mps2'])}), "
-            f"{acc['angle_to_anti_sun_deg']:.1f}° from the anti-Sun direction"
-        )
-    for kind, n in summary.get("repairs", {}).items():
-        lines.append(f"  repaired: {kind}: {n}")
-    return lines
 
 
 @report.command("tracking")

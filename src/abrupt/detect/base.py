@@ -51,7 +51,9 @@ class Diagnostics:
     ``time_s`` are the statistic's sample times in seconds from ``epoch_utc``; ``statistic`` the
     values (same length; NaN where not evaluated); ``threshold`` the fitted threshold with its method
     and budget; ``noise_model`` whatever the detector measured of the data's own noise (documented by
-    the detector); ``unit`` the unit of the statistic.
+    the detector); ``unit`` the unit of the statistic; ``null_sample`` the event-free values the
+    threshold was fitted to (for a GEV fit, the block maxima), for Q-Q plots; ``extra`` anything else
+    a detector reports (documented by the detector).
     """
 
     name: str
@@ -61,6 +63,7 @@ class Diagnostics:
     epoch_utc: np.datetime64 | None = None
     unit: str = ""
     noise_model: Any = None
+    null_sample: FloatArray | None = None
     extra: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:

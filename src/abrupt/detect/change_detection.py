@@ -33,7 +33,7 @@ import numba as nb
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-FloatArray = NDArray[np.float64]
+from abrupt.types import FloatArray
 
 ANCHOR = 1024  # running sums are recomputed exactly at absolute indices divisible by this
 
@@ -145,9 +145,11 @@ def _cross_sums(x: FloatArray, offset: int, length: int, first: int, count: int,
 
 
 @nb.njit(cache=True)
-def _pre_mean_std(
+def pre_window_mean_std(
     x: FloatArray, offset: int, pre: int, n_first: int, count: int, anchor: int
 ) -> tuple[FloatArray, FloatArray]:
+    """Mean and standard deviation (ddof 1) of each channel over the pre-window of junctions
+    ``n_first .. n_first + count - 1`` (absolute indices; row 0 of ``x`` is absolute ``offset``)."""
     s1, s2 = _window_sums(x, offset, pre, n_first - pre, count, anchor)
     for j in range(s1.shape[0]):
         for c in range(s1.shape[1]):
@@ -162,7 +164,7 @@ def _pre_mean_std(
 def _summation_kernel(
     x: FloatArray, offset: int, pre: int, guard: int, post: int, n_first: int, count: int, anchor: int
 ) -> FloatArray:
-    mu, _ = _pre_mean_std(x, offset, pre, n_first, count, anchor)
+    mu, _ = pre_window_mean_std(x, offset, pre, n_first, count, anchor)
     p1, _ = _window_sums(x, offset, post, n_first + guard, count, anchor)
     return p1 - post * mu
 
@@ -220,7 +222,7 @@ def _cusum_kernel(
     float32 rounding is relative to the noise, not to |H|; and because groups are aligned to
     absolute indices, results do not depend on chunking.
     """
-    mu, sd = _pre_mean_std(x, offset, pre, n_first, count, anchor)
+    mu, sd = pre_window_mean_std(x, offset, pre, n_first, count, anchor)
     k = x.shape[1]
     lanes = 64
     out = np.empty((count, k))
@@ -274,7 +276,7 @@ def _shiryaev_kernel(
     φ_{k,i} = F_{k,i} + p̃(1 − F_{k,i});  F_{k+1,i} ∝ φ_{k,i} f_i(x_{k+1}); output Σ n_i Δμ F_i.
     F_0,i = p̃ for n_i ≠ 0, the rest on n = 0 (spec assumption [A]).
     """
-    mu, sd = _pre_mean_std(x, offset, pre, n_first, count, anchor)
+    mu, sd = pre_window_mean_std(x, offset, pre, n_first, count, anchor)
     k = x.shape[1]
     nh = 2 * n_side + 1
     out = np.empty((count, k))

@@ -17,17 +17,22 @@ they are converted at this boundary (1 km² = 10⁶ m²; 1 km²/s² = 10⁶ m²/
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import curve_fit
 
-from abrupt.events import Event, format_time_utc
+from abrupt.detect.base import DetectionResult, Detector, Diagnostics
+from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc
 from abrupt.model.tracking_measurements import TrackingArrays, wrap_angle
 from abrupt.model.tracking_orbit import ForceModel, propagate_with_stm
+from abrupt.series.tracking import TrackingSeries
+from abrupt.thresholds import FalseAlarmBudget, Threshold, chi2_threshold
 
 # Thesis Table 3.1 (spec Table 6.1): Ψ lower bound, q_r (km²), q_v (km²/s²)
 THESIS_Q_TABLE_KM: tuple[tuple[float, float, float], ...] = (
@@ -429,6 +434,7 @@ def kaderali_events(
     false_alarms_per_day: float,
     calibration: CharacterisationFit | None = None,
     merge_gap_s: float = 600.0,
+    detector: str = "tracking.kaderali_k",
 ) -> list[Event]:
     """Events from the Ψ series: runs of Ψ above the detection threshold (merged across gaps shorter than
     ``merge_gap_s``), each reported at its K_max (Kaderali 2021 Section 3.3.1) with a Δv from the
@@ -456,7 +462,7 @@ def kaderali_events(
             Event(
                 spacecraft=spacecraft,
                 kind="maneuver",
-                detector="kaderali_k",
+                detector=detector,
                 time_utc=format_time_utc(epoch_utc + np.timedelta64(round(float(result.t_s[best]) * 1e9), "ns")),
                 statistic=k_max,
                 threshold=k_th,
@@ -496,8 +502,6 @@ def calibrate_psi_threshold(
     the pooled Ψ gives the value exceeded ``false_alarms_per_day`` times per day. Returns the threshold and
     the pooled null Ψ (for Q-Q checks). Falls back to the empirical quantile when the tail is too short.
     """
-    from abrupt.thresholds import fit_threshold
-
     cfg = config or KaderaliConfig()
     rng = np.random.default_rng(seed)
     order = np.argsort(data.t_s, kind="stable")
@@ -510,21 +514,131 @@ def calibrate_psi_threshold(
     for i in range(len(data)):
         clean[i], _ = data.predict(i, states[i])
     pooled = []
-    y_saved = data.y
-    try:
-        for _ in range(n_runs):
-            noisy = clean + rng.standard_normal(clean.shape) * data.sigma
-            noisy[:, 1] = np.mod(noisy[:, 1], 2 * np.pi)
-            noisy[np.isnan(y_saved)] = np.nan
-            data.y = noisy
-            pooled.append(run_kaderali_filter(data, x0, t0_s=t0_s, config=cfg).psi)
-    finally:
-        data.y = y_saved
+    for _ in range(n_runs):
+        noisy = clean + rng.standard_normal(clean.shape) * data.sigma
+        noisy[:, 1] = np.mod(noisy[:, 1], 2 * np.pi)
+        noisy[np.isnan(data.y)] = np.nan
+        simulated = copy.copy(data)  # the same epochs, stations and types; the caller's arrays stay as they are
+        simulated.y = noisy
+        pooled.append(run_kaderali_filter(simulated, x0, t0_s=t0_s, config=cfg).psi)
     psi = np.concatenate(pooled)
+    return simulated_null_threshold(psi, n_runs, data, FalseAlarmBudget.per_day_rate(false_alarms_per_day)).value, psi
+
+
+def simulated_null_threshold(
+    psi: NDArray[np.float64], n_runs: int, data: TrackingArrays, budget: FalseAlarmBudget
+) -> Threshold:
+    """GPD tail (empirical quantile when the tail is short) of Ψ pooled over ``n_runs`` event-free runs.
+
+    The rate of tests is the number of filter updates per run over the arc's length.
+    """
+    from abrupt.thresholds import fit_threshold
+
     arc_s = float(np.ptp(data.t_s)) if len(data) > 1 else 1.0
     rate_hz = max(psi.size / n_runs - 1, 1) / max(arc_s, 1.0)
     try:
-        th = fit_threshold(psi, false_alarms_per_day=false_alarms_per_day, sample_rate_hz=rate_hz, method="gpd")
+        return fit_threshold(psi, budget=budget, sample_rate_hz=rate_hz, method="gpd")
     except ValueError:
-        th = fit_threshold(psi, false_alarms_per_day=false_alarms_per_day, sample_rate_hz=rate_hz, method="empirical")
-    return float(th.value), psi
+        return fit_threshold(psi, budget=budget, sample_rate_hz=rate_hz, method="empirical")
+
+
+class KaderaliManeuverDetector(Detector[TrackingSeries]):
+    """``tracking.kaderali_k``: the Kaderali EKF's Ψ and K (dB) on bias-corrected measurements.
+
+    The filter starts from the orbit fit (``start="orbit_fit"``) or from the GLRT's maneuver-aware fit
+    (``start="maneuver_fit"``, with ``max_maneuvers``), with the fitted station biases applied to a
+    copy of the measurements and the fitted constant acceleration. The Ψ detection threshold is the
+    GPD tail of Ψ on ``n_null_runs`` event-free simulations of this data set (``threshold_fit=
+    "simulated"``) or the χ²_m upper point at the budget's per-update level (``"chi2"``), unless a
+    fixed ``psi_detection_threshold`` is given. ``psi_threshold`` and ``eta_threshold_km`` are the
+    thesis's covariance-inflation settings (Kaderali 2021 §3.3).
+    """
+
+    name = "tracking.kaderali_k"
+    series_type = TrackingSeries
+    kind = "maneuver"
+    summary = "Kaderali EKF: normalised innovation Ψ and K (dB), covariance inflation"
+
+    def __init__(
+        self,
+        *,
+        psi_threshold: float = 30.0,
+        eta_threshold_km: float = 1.0,
+        elevation_mask_deg: float | None = None,
+        threshold_fit: Literal["simulated", "chi2"] = "simulated",
+        start: Literal["orbit_fit", "maneuver_fit"] = "orbit_fit",
+        max_maneuvers: int = 3,
+        n_null_runs: int = 8,
+        seed: int = 0,
+        psi_detection_threshold: float | None = None,
+    ) -> None:
+        if threshold_fit not in ("simulated", "chi2"):
+            raise ValueError(f"threshold_fit must be 'simulated' or 'chi2', got {threshold_fit!r}")
+        if start not in ("orbit_fit", "maneuver_fit"):
+            raise ValueError(f"start must be 'orbit_fit' or 'maneuver_fit', got {start!r}")
+        self.psi_threshold = float(psi_threshold)
+        self.eta_threshold_km = float(eta_threshold_km)
+        self.elevation_mask_deg = elevation_mask_deg
+        self.threshold_fit = threshold_fit
+        self.start = start
+        self.max_maneuvers = int(max_maneuvers)
+        self.n_null_runs = int(n_null_runs)
+        self.seed = int(seed)
+        self.psi_detection_threshold = psi_detection_threshold
+
+    def filter_config(self, series: TrackingSeries, accel_mps2: NDArray[np.float64]) -> KaderaliConfig:
+        period = series.orbit_period_s()
+        return KaderaliConfig(
+            psi_threshold=self.psi_threshold,
+            eta_threshold_km=self.eta_threshold_km,
+            elevation_mask_deg=self.elevation_mask_deg,
+            force=series.fit_config.force,
+            max_step_s=float(min(60.0, max(5.0, period / 1000.0))),
+            accel_mps2=tuple(float(v) for v in accel_mps2),  # type: ignore[arg-type]
+        )
+
+    def detect(self, series: TrackingSeries, budget: FalseAlarmBudget) -> DetectionResult:
+        if len(series) == 0:
+            return DetectionResult.empty(warnings=("no tracking measurements",))
+        from abrupt.detect.tracking_glrt import GlrtConfig
+
+        if self.start == "maneuver_fit":
+            glrt = GlrtConfig(false_alarms_per_day=budget.per_day, max_maneuvers=self.max_maneuvers)
+            _, fit, _ = series.maneuver_fit(glrt)
+        else:
+            fit = series.orbit_fit()
+        data = series.bias_corrected()
+        kcfg = self.filter_config(series, np.asarray(fit.acceleration_mps2, dtype=np.float64))
+        result = run_kaderali_filter(data, fit.x0, config=kcfg)
+        if self.psi_detection_threshold is not None:
+            thr = Threshold(float(self.psi_detection_threshold), float("nan"), "fixed", 0, budget.per_day)
+        elif self.threshold_fit == "chi2":
+            rate_hz = max(len(result.t_s) - 1, 1) / max(series.arc_s, 1.0)
+            m = int(np.median(result.n_components)) if result.n_components.size else 4
+            thr = chi2_threshold(m, budget=budget, sample_rate_hz=rate_hz)
+        else:
+            psi_null, _ = calibrate_psi_threshold(
+                data, fit.x0, config=kcfg, false_alarms_per_day=budget.per_day, n_runs=self.n_null_runs, seed=self.seed
+            )
+            thr = Threshold(psi_null, float("nan"), "gpd (simulated null)", 0, budget.per_day)
+        cfg_hash = config_hash({"detector": self.name, **self.config(), "budget": str(budget)})
+        events = kaderali_events(
+            result,
+            epoch_utc=data.epoch_utc,
+            spacecraft=series.spacecraft_name,
+            run_id="",
+            config_hash=cfg_hash,
+            psi_detection_threshold=thr.value,
+            false_alarms_per_day=budget.per_day,
+            detector=self.name,
+        )
+        diagnostics = Diagnostics(
+            name=self.name,
+            time_s=result.t_s,
+            statistic=result.psi,
+            threshold=replace(thr, false_alarms_per_day=budget.per_day),
+            epoch_utc=data.epoch_utc,
+            unit="Psi (normalised innovation squared)",
+            extra={"k_db": result.k_db, "trace_p_km": result.trace_p_km, "inflated": result.inflated},
+        )
+        return DetectionResult(events_frame(events) if events else empty_frame(), (diagnostics,))

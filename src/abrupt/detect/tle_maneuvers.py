@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -51,6 +52,7 @@ from numpy.typing import NDArray
 
 from abrupt.events import Event, config_hash, empty_frame, events_frame, new_run_id
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
+from abrupt.thresholds import Threshold
 
 DETECTOR_NAME = "tle_mean_element_steps"
 SECONDS_PER_DAY = 86400.0
@@ -65,6 +67,11 @@ EXTRA_COLUMNS: tuple[str, ...] = (
     "elset_epoch_before_utc",
     "elset_epoch_after_utc",
     "time_method",
+    "regime",
+    "dv_t_sigma_mps",
+    "dv_n_sigma_mps",
+    "campaign_id",
+    "campaign_size",
 )
 
 
@@ -83,6 +90,11 @@ class TleDetectorConfig:
     refine_time: bool = True
     time_window_sets: int = 8
     min_side_sets: int = 3
+    regime: str = "auto"
+    campaign_days: float = 3.0
+    campaign_min_side_sets: int = 3
+    time_search_sets_before: int = 3
+    group_gain: tuple[float, float, float] = (1.0, 0.2, 0.2)
 
     def __post_init__(self) -> None:
         if self.window_sets < 2:
@@ -91,6 +103,10 @@ class TleDetectorConfig:
             raise ValueError("false_alarms_per_year must be > 0")
         if self.peak_half_width < 1:
             raise ValueError("peak_half_width must be >= 1")
+        if self.regime not in ("auto", "leo", "geo"):
+            raise ValueError(f"regime must be auto, leo or geo, got {self.regime!r}")
+        if any(not (g >= 0 and math.isfinite(g)) for g in self.group_gain) or len(self.group_gain) != 3:
+            raise ValueError("group_gain must be three finite non-negative numbers")
 
 
 @dataclass
@@ -105,23 +121,75 @@ class StepSeries:
     z_a: NDArray[np.float64]
     z_e: NDArray[np.float64]
     z_n: NDArray[np.float64]
+    sigma_a_m: NDArray[np.float64] | None = None  # raw step noise of a per gap (before the group weight)
+    sigma_n_rad: NDArray[np.float64] | None = None  # raw step noise of one orbit-normal component
     weights: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    group_gain: tuple[float, float, float] = (1.0, 1.0, 1.0)
 
     @property
     def statistic(self) -> NDArray[np.float64]:
         """Combined S = sqrt(Σ (w_k z_k)²) with the per-group tail weights (module docstring, step 3)."""
         wa, we, wn = self.weights
-        return np.sqrt((wa * self.z_a) ** 2 + (we * self.z_e) ** 2 + (wn * self.z_n) ** 2)
+        ga, ge, gn = self.group_gain
+        return np.maximum.reduce(
+            [ga * wa * self.z_a, ge * chi2_as_normal(we * self.z_e), gn * chi2_as_normal(wn * self.z_n)]
+        )
 
 
-def mean_element_series(history: ElementHistory) -> dict[str, NDArray[np.float64]]:
-    """Detector series: time (s from the first epoch), a (m), e-vector, i and RAAN residual (rad)."""
+def chi2_as_normal(z: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The |N(0,1)| value with the same tail probability as a χ₂ magnitude ``z`` (P = exp(−z²/2))."""
+    from scipy import special
+
+    z = np.asarray(z, dtype=float)
+    log_p = -0.5 * z**2  # survival of a χ₂ magnitude
+    # two-sided normal: P(|N| > x) = erfc(x/√2) → x = √2·erfcinv(P); for tiny P use the asymptote
+    p = np.exp(log_p)
+    out = np.sqrt(2.0) * special.erfcinv(np.clip(p, 1e-300, 1.0))
+    tiny = p < 1e-280
+    out[tiny] = np.sqrt(np.maximum(z[tiny] ** 2 - np.log(np.maximum(z[tiny] ** 2, 1.0)), 0.0))
+    return np.asarray(out, dtype=float)
+
+
+GEO_MEAN_MOTION_RANGE_REV_DAY = (0.9, 1.1)
+
+
+def orbit_regime(history: ElementHistory) -> str:
+    """``"geo"`` for near-geosynchronous near-circular orbits (median mean motion 0.9-1.1 rev/day,
+    e < 0.1), else ``"leo"`` (the mean-element detector's general case)."""
+    el = history.elements
+    if len(el) == 0:
+        return "leo"
+    rev_day = float(np.median(el["n_rad_s"])) * SECONDS_PER_DAY / (2.0 * math.pi)
+    lo, hi = GEO_MEAN_MOTION_RANGE_REV_DAY
+    return "geo" if lo <= rev_day <= hi and float(np.median(el["e"])) < 0.1 else "leo"
+
+
+def mean_element_series(history: ElementHistory, regime: str = "leo") -> dict[str, NDArray[np.float64]]:
+    """Detector series: time (s from the first epoch), a (m), e-vector, and two orbit-normal angles (rad).
+
+    ``leo``: e-vector ``e(cos ω, sin ω)``; normal = (``i``, ``sin i`` × RAAN minus the SGP4 secular J2
+    drift, accumulated set to set). ``geo``: the equinoctial vectors that stay defined at small
+    inclination (Soop 1994, §3): ``e(cos ϖ, sin ϖ)`` with ϖ = Ω + ω, and the inclination vector
+    ``i(sin Ω, −cos Ω)``; east-west burns move ``a`` (longitude drift) and the e-vector, north-south
+    burns the inclination vector. The keys ``i_rad`` and ``raan_resid_sin_i_rad`` hold the two normal
+    components in both regimes.
+    """
     el = history.elements
     t = (el["epoch_utc"] - el["epoch_utc"].iloc[0]).dt.total_seconds().to_numpy(dtype=float)
     e = el["e"].to_numpy(dtype=float)
     w = el["argp_rad"].to_numpy(dtype=float)
     inc = el["i_rad"].to_numpy(dtype=float)
     raan = el["raan_rad"].to_numpy(dtype=float)
+    if regime == "geo":
+        varpi = w + raan
+        return {
+            "t_s": t,
+            "a_m": el["a_m"].to_numpy(dtype=float),
+            "ex": e * np.cos(varpi),
+            "ey": e * np.sin(varpi),
+            "i_rad": inc * np.sin(raan),
+            "raan_resid_sin_i_rad": -inc * np.cos(raan),
+        }
     rate = el["raan_rate_rad_s"].to_numpy(dtype=float)
     incr = np.zeros_like(raan)
     if len(raan) > 1:
@@ -138,11 +206,21 @@ def mean_element_series(history: ElementHistory) -> dict[str, NDArray[np.float64
     }
 
 
-def _robust_scale_rolling(y: NDArray[np.float64], half: int) -> NDArray[np.float64]:
-    """Per-sample noise of a series: rolling 1.4826·MAD of first differences / √2 (Hampel 1974)."""
+def _robust_scale_rolling(
+    y: NDArray[np.float64], half: int, t: NDArray[np.float64] | None = None
+) -> NDArray[np.float64]:
+    """Per-gap noise of a series: rolling 1.4826·MAD of first differences / √2 (Hampel 1974).
+
+    With the epochs ``t`` the differences are first detrended by the rolling median rate × gap, so
+    a secular drift (drag decay, an unmodelled nodal rate) seen over uneven gaps is not noise.
+    """
     d = np.diff(y)
     if d.size == 0:
         return np.full_like(y, np.nan)
+    if t is not None:
+        dt = np.diff(t)
+        rate = pd.Series(d / np.maximum(dt, 60.0)).rolling(2 * half + 1, center=True, min_periods=5).median()
+        d = d - np.nan_to_num(rate.to_numpy()) * dt
     s = pd.Series(d)
     med = s.rolling(2 * half + 1, center=True, min_periods=5).median()
     mad = (s - med).abs().rolling(2 * half + 1, center=True, min_periods=5).median()
@@ -153,6 +231,35 @@ def _robust_scale_rolling(y: NDArray[np.float64], half: int) -> NDArray[np.float
     scale = np.maximum(scale, floor)
     # per gap g (between sets g and g+1): the scale of difference g
     return scale
+
+
+def drift_noise_rate(t: NDArray[np.float64], y: NDArray[np.float64], half: int = 40) -> float:
+    """Random-walk rate q (units²/s) of a mean-element series, learned from its own history.
+
+    Set-to-set differences, with a rolling median drift removed, have variance ``2σ² + q·Δt`` (white
+    fit noise σ plus unmodelled drag/luni-solar wander that accumulates over the gap Δt). The robust
+    variances (1.4826·MAD)² of short gaps (≤ median) and long gaps (≥ 2 × median) give q (≥ 0);
+    q = 0 when fewer than 20 long gaps exist. The step test adds q·Δt_gap to a gap's variance, so
+    a long gap between element sets needs a larger step.
+    """
+    d = np.diff(y)
+    dt = np.diff(t)
+    if d.size < 40:
+        return 0.0
+    rate = pd.Series(d / np.maximum(dt, 60.0)).rolling(2 * half + 1, center=True, min_periods=5).median()
+    r = d - rate.to_numpy() * dt
+    med_dt = float(np.median(dt))
+    short, long = dt <= med_dt, dt >= 2.0 * med_dt
+    ok = np.isfinite(r)
+    if (long & ok).sum() < 20 or (short & ok).sum() < 20:
+        return 0.0
+
+    def robust_var(x: NDArray[np.float64]) -> float:
+        return float((1.4826 * np.median(np.abs(x - np.median(x)))) ** 2)
+
+    v_s, v_l = robust_var(r[short & ok]), robust_var(r[long & ok])
+    span = float(np.mean(dt[long & ok]) - np.mean(dt[short & ok]))
+    return max(0.0, (v_l - v_s) / span) if span > 0 else 0.0
 
 
 def _theil_sen(t: NDArray[np.float64], y: NDArray[np.float64]) -> float:
@@ -167,37 +274,38 @@ def _theil_sen(t: NDArray[np.float64], y: NDArray[np.float64]) -> float:
     return float(np.median((y[j] - y[i])[ok] / dt[ok]))
 
 
-def _pooled_slope(t: NDArray[np.float64], y: NDArray[np.float64], sides: tuple[slice, slice]) -> float:
-    """Median of the pairwise slopes within each side (a Theil-Sen slope shared by both sides, Sen 1968).
-
-    Pairs never straddle the gap, so a step does not bias the slope.
-    """
-    slopes = []
-    for side in sides:
-        ts, ys = t[side], y[side]
-        if ts.size < 2:
-            continue
-        i, j = np.triu_indices(ts.size, 1)
-        dt = ts[j] - ts[i]
-        ok = dt > 60.0
-        slopes.append((ys[j] - ys[i])[ok] / dt[ok])
-    allslopes = np.concatenate(slopes) if slopes else np.zeros(0)
-    return float(np.median(allslopes)) if allslopes.size else 0.0
+@lru_cache(maxsize=64)
+def _pair_indices(m: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    i, j = np.triu_indices(m, 1)
+    return i, j
 
 
-def _step(
+def _steps_all(
     t: NDArray[np.float64],
-    y: NDArray[np.float64],
+    ys: NDArray[np.float64],
     pre: slice,
     post: slice,
     t0: float,
     slope_sides: tuple[slice, slice],
-) -> float:
-    """Difference of the post and pre medians of ``y − slope·(t − t0)`` (robust level step at ``t0``)."""
-    slope = _pooled_slope(t, y, slope_sides)
-    lp = float(np.median(y[pre] - slope * (t[pre] - t0)))
-    lq = float(np.median(y[post] - slope * (t[post] - t0)))
-    return lq - lp
+) -> NDArray[np.float64]:
+    """Robust level step at ``t0`` of every row of ``ys`` (series × sets): post minus pre median of
+    ``y − slope·(t − t0)``, the slope a Theil-Sen median of pairwise slopes within each side (Sen
+    1968) so pairs never straddle the gap and a step does not bias it."""
+    slopes = []
+    for side in slope_sides:
+        ts = t[side]
+        if ts.size < 2:
+            continue
+        i, j = _pair_indices(ts.size)
+        dt = ts[j] - ts[i]
+        ok = dt > 60.0
+        block = ys[:, side]
+        slopes.append((block[:, j[ok]] - block[:, i[ok]]) / dt[ok])
+    allslopes = np.concatenate(slopes, axis=1) if slopes else np.zeros((ys.shape[0], 0))
+    slope = np.median(allslopes, axis=1) if allslopes.shape[1] else np.zeros(ys.shape[0])
+    lp = np.median(ys[:, pre] - slope[:, None] * (t[pre] - t0), axis=1)
+    lq = np.median(ys[:, post] - slope[:, None] * (t[post] - t0), axis=1)
+    return np.asarray(lq - lp, dtype=float)
 
 
 class _StepModel:
@@ -207,10 +315,14 @@ class _StepModel:
 
     def __init__(self, history: ElementHistory, cfg: TleDetectorConfig) -> None:
         self.cfg = cfg
-        self.s = mean_element_series(history)
+        self.regime = orbit_regime(history) if cfg.regime == "auto" else cfg.regime
+        self.s = mean_element_series(history, self.regime)
+        self.stack = np.stack([self.s[k] for k in self.NAMES])  # (series, sets)
+        self.min_side = cfg.min_side_sets
         self.t = self.s["t_s"]
         self.n = self.t.size
-        self.scales = {k: _robust_scale_rolling(self.s[k], cfg.noise_half_window) for k in self.NAMES}
+        self.scales = {k: _robust_scale_rolling(self.s[k], cfg.noise_half_window, self.t) for k in self.NAMES}
+        self.drift_q = {k: drift_noise_rate(self.t, self.s[k], cfg.noise_half_window) for k in self.NAMES}
 
     def gap(self, g: int, lo_bound: int = 0, hi_bound: int | None = None) -> tuple[dict[str, float], float]:
         """Steps of every series at gap g from sets [max(lo_bound, g+1-W), g], [g+1, min(hi_bound, g+1+W)).
@@ -228,7 +340,7 @@ class _StepModel:
         while hi - 1 > g + 1 and t[hi - 1] - t[g + 1] > max_win_s:
             hi -= 1
         n1, n2 = g + 1 - lo, hi - g - 1
-        if n1 < self.cfg.min_side_sets or n2 < self.cfg.min_side_sets:
+        if n1 < self.min_side or n2 < self.min_side:
             return {k: 0.0 for k in self.NAMES}, math.inf
         pre, post = slice(lo, g + 1), slice(g + 1, hi)
         # the slope (drag decay, J2/J3 and luni-solar drifts) from twice as many sets each side
@@ -240,7 +352,8 @@ class _StepModel:
             shi -= 1
         sides = (slice(slo, g + 1), slice(g + 1, shi))
         t0 = 0.5 * (t[g] + t[g + 1])
-        steps = {k: _step(t, self.s[k], pre, post, t0, sides) for k in self.NAMES}
+        values = _steps_all(t, self.stack, pre, post, t0, sides)
+        steps = {k: float(v) for k, v in zip(self.NAMES, values, strict=True)}
         return steps, math.sqrt(math.pi / 2.0) * math.sqrt(1.0 / n1 + 1.0 / n2)
 
     def localise(self, g: int, lo_bound: int, hi_bound: int, weights: tuple[float, float, float]) -> int:
@@ -277,8 +390,13 @@ class _StepModel:
                 best, best_cost = c, cost
         return best
 
+    def step_sigmas(self, g: int, factor: float) -> dict[str, float]:
+        """Noise of each series' step at gap g: the medians' error plus the random walk over the gap."""
+        dt_gap = float(self.t[g + 1] - self.t[g])
+        return {k: math.sqrt((self.scales[k][g] * factor) ** 2 + self.drift_q[k] * dt_gap) for k in self.NAMES}
+
     def z(self, g: int, steps: dict[str, float], factor: float) -> tuple[float, float, float]:
-        sc = {k: self.scales[k][g] * factor for k in self.NAMES}
+        sc = self.step_sigmas(g, factor)
         z_a = abs(steps["a_m"]) / sc["a_m"]
         z_e = math.hypot(steps["ex"] / sc["ex"], steps["ey"] / sc["ey"])
         z_n = math.hypot(steps["i_rad"] / sc["i_rad"], steps["raan_resid_sin_i_rad"] / sc["raan_resid_sin_i_rad"])
@@ -324,6 +442,8 @@ def _empty_steps(t: NDArray[np.float64], n_gaps: int) -> StepSeries:
         z_a=np.zeros(n_gaps),
         z_e=np.zeros(n_gaps),
         z_n=np.zeros(n_gaps),
+        sigma_a_m=np.full(n_gaps, np.nan),
+        sigma_n_rad=np.full(n_gaps, np.nan),
     )
 
 
@@ -337,6 +457,10 @@ def _fill(out: StepSeries, model: _StepModel, g: int, cps: list[int]) -> None:
         out.z_a[g] = out.z_e[g] = out.z_n[g] = 0.0
     else:
         out.z_a[g], out.z_e[g], out.z_n[g] = model.z(g, steps, factor)
+        sc = model.step_sigmas(g, factor)
+        assert out.sigma_a_m is not None and out.sigma_n_rad is not None
+        out.sigma_a_m[g] = sc["a_m"]
+        out.sigma_n_rad[g] = math.sqrt(0.5 * (sc["i_rad"] ** 2 + sc["raan_resid_sin_i_rad"] ** 2))
 
 
 def segment(
@@ -364,7 +488,8 @@ def segment(
             _fill(first, model, g, [])
     cur = _empty_steps(model.t, n_gaps)
     cur.weights = first.weights
-    for name in ("delta_a_m", "delta_e", "delta_normal_rad", "z_a", "z_e", "z_n"):
+    cur.group_gain = first.group_gain
+    for name in ("delta_a_m", "delta_e", "delta_normal_rad", "z_a", "z_e", "z_n", "sigma_a_m", "sigma_n_rad"):
         setattr(cur, name, getattr(first, name).copy())
     accepted: list[int] = []
     blocked = np.zeros(n_gaps, dtype=bool)
@@ -385,6 +510,28 @@ def segment(
         for k in range(max(0, g - reach), min(n_gaps, g + reach + 1)):
             if not blocked[k]:
                 _fill(cur, model, k, cps)
+    if cfg.campaign_min_side_sets < cfg.min_side_sets and accepted:
+        # Campaigns: near an accepted maneuver, a further burn may be only one or two sets away.
+        # Between accepted change points a side of fewer sets is allowed, at the same threshold.
+        model.min_side = cfg.campaign_min_side_sets
+        near = np.zeros(n_gaps, dtype=bool)
+        for a in accepted:
+            near[max(0, a - reach) : a + reach + 1] = True
+        cps = sorted(accepted)
+        for k in np.flatnonzero(near & ~blocked):
+            _fill(cur, model, int(k), cps)
+        while True:
+            stat = np.where(blocked | ~near, -np.inf, cur.statistic)
+            g = int(np.argmax(stat))
+            if not np.isfinite(stat[g]) or stat[g] < max(cut_level, cfg.min_statistic):
+                break
+            accepted.append(g)
+            blocked[max(0, g - cfg.peak_half_width + 1) : g + cfg.peak_half_width] = True
+            cps = sorted(accepted)
+            for k in range(max(0, g - reach), min(n_gaps, g + reach + 1)):
+                if not blocked[k] and near[k]:
+                    _fill(cur, model, k, cps)
+        model.min_side = cfg.min_side_sets
     rest = np.where(blocked, -np.inf, cur.statistic)
     for g in local_peaks(rest, cfg.peak_half_width, cfg.min_statistic):
         if not blocked[max(0, g - cfg.peak_half_width) : g + cfg.peak_half_width + 1].any():
@@ -428,16 +575,16 @@ def event_free_mask(stat: NDArray[np.float64], guard: int) -> NDArray[np.bool_]:
     return keep
 
 
-def component_weights(first: StepSeries, guard: int, quantile: float = 0.99) -> tuple[float, float, float]:
-    """Weights that map each group's event-free ``quantile`` to the Gaussian one (χ₁ for a, χ₂ for e, n).
+def component_weights(first: StepSeries, guard: int, quantile: float = 0.5) -> tuple[float, float, float]:
+    """Weights that map each group's median z to the Gaussian median (χ₁ for a, χ₂ for e, n).
 
-    TLE noise is heavier-tailed in some elements than others (and differently for each satellite);
-    weighting by the empirical tail makes a 5σ-equivalent step count the same in every group, so no
-    group's outliers dominate the combined statistic.
+    The per-satellite noise model: each group's standardised steps are rescaled by a robust scale
+    (their median over all gaps, against the median of the χ distribution they would follow with
+    Gaussian noise; Hampel 1974). The median is unaffected by up to half the gaps being maneuvers or
+    their flanks, which a high quantile is not (CryoSat-2 has a burn every 3 weeks).
     """
     from scipy import stats
 
-    keep = event_free_mask(first.statistic, guard)
     refs = (
         float(stats.chi.ppf(quantile, 1)),
         float(stats.chi.ppf(quantile, 2)),
@@ -445,10 +592,35 @@ def component_weights(first: StepSeries, guard: int, quantile: float = 0.99) -> 
     )
     out = []
     for z, ref in zip((first.z_a, first.z_e, first.z_n), refs, strict=True):
-        sample = z[keep & np.isfinite(z) & (z > 0)]
-        q = float(np.quantile(sample, quantile)) if sample.size >= 50 else ref
-        out.append(ref / q if q > 0 else 1.0)
+        out.append(robust_group_weight(z, ref, guard, quantile))
     return out[0], out[1], out[2]
+
+
+def robust_group_weight(z: NDArray[np.float64], ref: float, guard: int, quantile: float = 0.5) -> float:
+    """``ref / quantile(z)`` over gaps away from maneuvers, found by iterated rejection (Hampel 1974).
+
+    Each pass rescales ``z`` by the current weight and removes ±``guard`` gaps around every local peak
+    above 6 (robust σ units); three passes converge on histories where a quarter of the gaps are
+    flanks of maneuvers.
+    """
+    finite = np.isfinite(z) & (z > 0)
+    if finite.sum() < 50:
+        return 1.0
+    keep = finite.copy()
+    w = 1.0
+    for _ in range(4):
+        sample = z[keep]
+        if sample.size < 50:
+            break
+        q = float(np.quantile(sample, quantile))
+        if not q > 0:
+            break
+        w = ref / q
+        peaks = local_peaks(np.where(finite, w * z, -np.inf), 1, 6.0)
+        keep = finite.copy()
+        for g in peaks:
+            keep[max(0, g - guard) : g + guard + 1] = False
+    return w
 
 
 def null_threshold(stat: NDArray[np.float64], guard: int, p_fa: float, method: str) -> float:
@@ -469,11 +641,17 @@ def null_threshold(stat: NDArray[np.float64], guard: int, p_fa: float, method: s
         return float(fit_threshold(null, p_fa=p_fa, method="empirical").value)
 
 
-def refine_burn_time(history: ElementHistory, gap: int, window_sets: int) -> tuple[float, bool]:
+def refine_burn_time(
+    history: ElementHistory, gap: int, window_sets: int, *, search_sets_before: int = 2, geo: bool = False
+) -> tuple[float, bool]:
     """Burn time (s from the first epoch) by along-track position continuity (module docstring, step 4).
 
-    Returns ``(t_m, refined)``; ``refined`` is False when the fit was not usable and the gap middle
-    of the bracketing element sets was returned instead.
+    The along-track angle is the mean argument of latitude ω + M (LEO) or the mean longitude
+    Ω + ω + M (GEO, where Ω and ω are ill-defined separately). The search runs from
+    ``search_sets_before`` sets before the step to the set after it: the first sets after a burn are
+    often still fitted to pre-burn tracking, so the step in the elements shows late while the
+    change of along-track drift (the hinge) does not. Returns ``(t_m, refined)``; ``refined`` is
+    False when the fit was not usable and the gap middle was returned instead.
     """
     el = history.elements
     t = (el["epoch_utc"] - el["epoch_utc"].iloc[0]).dt.total_seconds().to_numpy(dtype=float)
@@ -483,27 +661,28 @@ def refine_burn_time(history: ElementHistory, gap: int, window_sets: int) -> tup
     hi = min(n, gap + 1 + window_sets)
     if gap - lo < 2 or hi - (gap + 1) < 2:
         return mid, False
+
+    def along(sat: Any) -> float:
+        return float(sat.argpo + sat.mo + (sat.nodeo if geo else 0.0))
+
     ref = history.satrecs[gap]
-    u_ref = ref.argpo + ref.mo
-    rate = (ref.argpdot + ref.mdot) / 60.0  # [rad/s] SGP4 secular rates
+    u_ref = along(ref)
+    rate = (ref.argpdot + ref.mdot + (ref.nodedot if geo else 0.0)) / 60.0  # [rad/s] SGP4 secular rates
     idx = np.arange(lo, hi)
-    u = np.array([history.satrecs[k].argpo + history.satrecs[k].mo for k in idx])
+    u = np.array([along(history.satrecs[k]) for k in idx])
     du = np.angle(np.exp(1j * (u - u_ref - rate * (t[idx] - t[gap]))))
     tau = (t[idx] - t[gap]) / SECONDS_PER_DAY
     # candidate burn times: from the set two before the gap to the set after it
-    t_lo = t[max(lo, gap - 2)]
+    t_lo = t[max(lo, gap - search_sets_before)]
     t_hi = t[gap + 1]
     grid = np.linspace(t_lo, t_hi, 97)
-    best = (np.inf, mid)
-    for tm in grid:
-        hinge = np.maximum(0.0, (t[idx] - tm) / SECONDS_PER_DAY)
-        A = np.column_stack([np.ones_like(tau), tau, tau**2, hinge])
-        coef, *_ = np.linalg.lstsq(A, du, rcond=None)
-        r = du - A @ coef
-        cost = float(np.sum(np.abs(r)))  # L1: one poor set does not move the time
-        if cost < best[0]:
-            best = (cost, float(tm))
-    return best[1], True
+    hinge = np.maximum(0.0, (t[idx][None, :] - grid[:, None]) / SECONDS_PER_DAY)  # (grid, sets)
+    base = np.broadcast_to(np.column_stack([np.ones_like(tau), tau, tau**2]), (grid.size, tau.size, 3))
+    A = np.concatenate([base, hinge[:, :, None]], axis=2)  # (grid, sets, 4)
+    coef = np.linalg.pinv(A) @ du  # least squares for every candidate time at once
+    r = du[None, :] - np.einsum("gsk,gk->gs", A, coef)
+    cost = np.sum(np.abs(r), axis=1)  # L1: one poor set does not move the time
+    return float(grid[int(np.argmin(cost))]), True
 
 
 def characterise(
@@ -536,27 +715,115 @@ def characterise(
     return {"dv_r_mps": dv_r, "dv_t_mps": dv_t, "dv_n_mps": dv_n, "maneuver_type": kind}
 
 
-def detect_tle_maneuvers(
+@dataclass
+class TleRun:
+    """Everything one run of the mean-element detector computed (events plus what reports read).
+
+    ``gap_time_s`` (middle of each gap between element sets, s from ``epoch_utc``) and ``statistic``
+    are the per-gap test; ``noise_model`` the satellite's own noise as learned from its history
+    (:func:`noise_summary`).
+    """
+
+    events: pd.DataFrame
+    regime: str
+    gap_time_s: NDArray[np.float64]
+    statistic: NDArray[np.float64]
+    threshold: Threshold
+    epoch_utc: np.datetime64
+    noise_model: dict[str, Any]
+    warnings: tuple[str, ...] = ()
+
+
+def circular_speed_mps(a_m: float) -> float:
+    """Circular orbital speed sqrt(μ/a) (WGS-72 μ, as SGP4)."""
+    return math.sqrt(MU_EARTH_WGS72_M3_S2 / a_m)
+
+
+def noise_summary(
+    steps: StepSeries, model: _StepModel, threshold: float, a_ref_m: float, gaps_per_year: float
+) -> dict[str, Any]:
+    """The satellite's noise model and the smallest ΔV its threshold lets through.
+
+    Smallest detectable in-track ΔV: the step in ``a`` whose weighted, gained z reaches the
+    threshold at the median gap, ``Δa = T σ_a / (γ_a w_a)``, turned into ΔV by vis-viva
+    ``Δv = v Δa / (2a)``; cross-track: the orbit-normal rotation whose χ₂ score reaches ``T/γ_n``,
+    ``Δv = v |Δn|``. These are 50 %-detection sizes (a step of that size is found half the time).
+    """
+    from scipy import special
+
+    wa, _, wn = steps.weights
+    ga, _, gn = steps.group_gain
+    sig_a = float(np.nanmedian(steps.sigma_a_m)) if steps.sigma_a_m is not None else float("nan")
+    sig_n = float(np.nanmedian(steps.sigma_n_rad)) if steps.sigma_n_rad is not None else float("nan")
+    v = circular_speed_mps(a_ref_m)
+    da_min = threshold * sig_a / (ga * wa) if ga * wa > 0 else math.inf
+    p_n = float(special.erfc(threshold / gn / math.sqrt(2.0))) if gn > 0 else 0.0
+    zn_min = math.sqrt(-2.0 * math.log(max(p_n, 1e-300)))
+    dn_min = zn_min * sig_n / wn if wn > 0 else math.inf
+    return {
+        "regime": model.regime,
+        "group_weights": steps.weights,
+        "group_gain": steps.group_gain,
+        "step_sigma_a_m": sig_a,
+        "step_sigma_normal_rad": sig_n,
+        "robust_sigma_a_m": sig_a / wa if wa > 0 else math.inf,
+        "drift_q_a_m2_per_day": model.drift_q["a_m"] * SECONDS_PER_DAY,
+        "gaps_per_year": gaps_per_year,
+        "min_detectable_dv_t_mps": v * da_min / (2.0 * a_ref_m),
+        "min_detectable_dv_n_mps": v * dn_min,
+    }
+
+
+def label_campaigns(times_s: NDArray[np.float64], campaign_days: float) -> tuple[list[int], list[int]]:
+    """Campaign id (index of its first event) and size for events sorted by time: events closer than
+    ``campaign_days`` to the previous one belong to the same campaign (several burns within days)."""
+    ids: list[int] = []
+    for k in range(times_s.size):
+        if k and times_s[k] - times_s[k - 1] < campaign_days * SECONDS_PER_DAY:
+            ids.append(ids[-1])
+        else:
+            ids.append(k)
+    sizes = [ids.count(c) for c in ids]
+    return ids, sizes
+
+
+def run_tle_detector(
     history: ElementHistory,
     config: TleDetectorConfig | None = None,
     *,
     spacecraft: str | None = None,
     run_id: str | None = None,
     all_candidates: bool = False,
-) -> pd.DataFrame:
-    """Detect maneuvers in a mean-element history; return the event frame (DESIGN.md "Events").
+    detector_name: str = DETECTOR_NAME,
+) -> TleRun:
+    """Detect maneuvers in a mean-element history (module docstring); return a :class:`TleRun`.
 
-    ``all_candidates`` returns every local peak of the statistic above ``config.min_statistic``
+    ``all_candidates`` keeps every local peak of the statistic above ``config.min_statistic``
     (not only those above the threshold), for recall-versus-false-alarm curves; ``threshold`` then
     still holds the operating threshold so users can filter.
     """
+    from scipy import stats
+
     cfg = config or TleDetectorConfig()
     run_id = run_id or new_run_id()
     cfg_hash = config_hash(asdict(cfg))
-    name = spacecraft or (f"NORAD-{history.norad_id}" if len(history) else "unknown")
-    if len(history) < 2 * cfg.window_sets + 1:
-        return empty_frame(EXTRA_COLUMNS)
+    name = spacecraft or history.name or (f"NORAD-{history.norad_id}" if len(history) else "unknown")
+    fa_per_day = cfg.false_alarms_per_year / DAYS_PER_YEAR
     el = history.elements
+    epoch0 = el["epoch_utc"].iloc[0] if len(el) else pd.Timestamp("1970-01-01")
+    regime = (orbit_regime(history) if cfg.regime == "auto" else cfg.regime) if len(el) else "leo"
+    if len(history) < 2 * cfg.window_sets + 1:
+        msg = f"{len(history)} element sets: at least {2 * cfg.window_sets + 1} are needed; nothing tested"
+        return TleRun(
+            empty_frame(EXTRA_COLUMNS),
+            regime,
+            np.zeros(0),
+            np.zeros(0),
+            Threshold(math.inf, float("nan"), "none", 0, fa_per_day),
+            np.datetime64(epoch0.to_datetime64(), "ns"),
+            {"regime": regime},
+            (msg,),
+        )
     span_days = (el["epoch_utc"].iloc[-1] - el["epoch_utc"].iloc[0]).total_seconds() / SECONDS_PER_DAY
     n_gaps = len(history) - 1
     gaps_per_year = n_gaps / max(span_days / DAYS_PER_YEAR, 1e-9)
@@ -566,29 +833,33 @@ def detect_tle_maneuvers(
     for g in range(n_gaps):
         _fill(model_first, model, g, [])
     model_first.weights = component_weights(model_first, cfg.window_sets + 2)
+    model_first.group_gain = cfg.group_gain
     if cfg.threshold is not None:
-        threshold = float(cfg.threshold)
+        threshold, method = float(cfg.threshold), "fixed"
     else:
-        from scipy import stats
-
-        # Floor: the χ₅ quantile, the null distribution S would have if the tail-weighted noise were
-        # Gaussian; a short history's tail fit cannot promise fewer false alarms than that.
+        # Floor: the level the maximum of three Gaussian groups would need; a short history's tail
+        # fit cannot promise fewer false alarms than that.
         threshold = max(
             cfg.min_statistic,
-            float(stats.chi.ppf(1.0 - p_fa, 5)),
+            float(stats.norm.isf(p_fa / 6.0)),  # max of three groups, two-sided (Bonferroni)
             null_threshold(model_first.statistic, cfg.window_sets + 2, p_fa, cfg.threshold_method),
         )
+        method = cfg.threshold_method
     steps, accepted, _ = segment(history, cfg, threshold, model=model, first=model_first)
     stat = steps.statistic
     candidates = np.sort(np.asarray(accepted, dtype=np.int64))
-    fa_per_day = cfg.false_alarms_per_year / DAYS_PER_YEAR
-    epoch0 = el["epoch_utc"].iloc[0]
     timed: list[tuple[int, float, bool]] = []
     for g in candidates:
         if not all_candidates and stat[g] < threshold:
             continue
         if cfg.refine_time:
-            t_m, refined = refine_burn_time(history, int(g), cfg.time_window_sets)
+            t_m, refined = refine_burn_time(
+                history,
+                int(g),
+                cfg.time_window_sets,
+                search_sets_before=cfg.time_search_sets_before,
+                geo=regime == "geo",
+            )
         else:
             t_m, refined = 0.5 * (steps.t_before_s[g] + steps.t_after_s[g]), False
         timed.append((int(g), t_m, refined))
@@ -599,16 +870,26 @@ def detect_tle_maneuvers(
     for item in sorted(timed, key=lambda it: -stat[it[0]]):
         if all(abs(item[1] - k[1]) >= merge_s for k in kept):
             kept.append(item)
+    kept.sort(key=lambda it: it[1])
+    detected = [it for it in kept if stat[it[0]] >= threshold]
+    camp_ids, camp_sizes = label_campaigns(np.array([it[1] for it in detected]), cfg.campaign_days)
+    campaign = {it[0]: (c, n) for it, c, n in zip(detected, camp_ids, camp_sizes, strict=True)}
     events: list[Event] = []
-    for g, t_m, refined in sorted(kept, key=lambda it: it[1]):
-        t_lo = steps.t_before_s[max(0, g - 2)] if refined else steps.t_before_s[g]
+    for g, t_m, refined in kept:
+        t_lo = steps.t_before_s[max(0, g - cfg.time_search_sets_before)] if refined else steps.t_before_s[g]
         sigma = (steps.t_after_s[g] - t_lo) / math.sqrt(12.0)  # uniform over the bracket
         a_ref = float(el["a_m"].iloc[g])
         w = steps.weights
         wz = (w[0] * float(steps.z_a[g]), w[1] * float(steps.z_e[g]), w[2] * float(steps.z_n[g]))
         ch = characterise(float(steps.delta_a_m[g]), steps.delta_e[g], steps.delta_normal_rad[g], a_ref, wz)
+        v = circular_speed_mps(a_ref)
+        assert steps.sigma_a_m is not None and steps.sigma_n_rad is not None
+        kind = str(ch["maneuver_type"])
+        if regime == "geo":
+            kind = "north-south" if kind == "cross-track" else "east-west"
+        camp = campaign.get(g, (-1, 0))
         extra: dict[str, Any] = {
-            "maneuver_type": ch["maneuver_type"],
+            "maneuver_type": kind,
             "z_a": float(steps.z_a[g]),
             "z_e": float(steps.z_e[g]),
             "z_n": float(steps.z_n[g]),
@@ -616,12 +897,18 @@ def detect_tle_maneuvers(
             "elset_epoch_before_utc": str(el["epoch_utc"].iloc[g]),
             "elset_epoch_after_utc": str(el["epoch_utc"].iloc[g + 1]),
             "time_method": "along-track continuity" if refined else "gap middle",
+            "regime": regime,
+            # 1σ of the in-track and cross-track ΔV from the step noise (robust σ of the step)
+            "dv_t_sigma_mps": v * float(steps.sigma_a_m[g]) / (w[0] * 2.0 * a_ref) if w[0] > 0 else math.inf,
+            "dv_n_sigma_mps": v * float(steps.sigma_n_rad[g]) / w[2] if w[2] > 0 else math.inf,
+            "campaign_id": int(camp[0]),
+            "campaign_size": int(camp[1]),
         }
         events.append(
             Event(
                 spacecraft=name,
                 kind="maneuver",
-                detector=DETECTOR_NAME,
+                detector=detector_name,
                 time_utc=epoch0 + pd.Timedelta(seconds=float(t_m)),
                 statistic=float(stat[g]),
                 threshold=threshold,
@@ -635,6 +922,26 @@ def detect_tle_maneuvers(
                 extra=extra,
             )
         )
-    if not events:
-        return empty_frame(EXTRA_COLUMNS)
-    return events_frame(events, extra_columns=EXTRA_COLUMNS)
+    frame = events_frame(events, extra_columns=EXTRA_COLUMNS) if events else empty_frame(EXTRA_COLUMNS)
+    a_med = float(np.median(el["a_m"]))
+    return TleRun(
+        frame,
+        regime,
+        0.5 * (steps.t_before_s + steps.t_after_s),
+        stat,
+        Threshold(threshold, p_fa, method, n_gaps, fa_per_day),
+        np.datetime64(epoch0.to_datetime64(), "ns"),
+        noise_summary(steps, model, threshold, a_med, gaps_per_year),
+    )
+
+
+def detect_tle_maneuvers(
+    history: ElementHistory,
+    config: TleDetectorConfig | None = None,
+    *,
+    spacecraft: str | None = None,
+    run_id: str | None = None,
+    all_candidates: bool = False,
+) -> pd.DataFrame:
+    """Detect maneuvers in a mean-element history; return the event frame (DESIGN.md "Events")."""
+    return run_tle_detector(history, config, spacecraft=spacecraft, run_id=run_id, all_candidates=all_candidates).events

@@ -26,11 +26,13 @@ from dataclasses import dataclass, field, replace
 import numba
 import numpy as np
 from numpy.typing import NDArray
-from scipy.stats import chi2
 
-from abrupt.events import Event, format_time_utc
+from abrupt.detect.base import DetectionResult, Detector, Diagnostics
+from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc
 from abrupt.model.tracking_measurements import TrackingArrays, predict_measurement, wrap_angle
 from abrupt.model.tracking_orbit import ForceModel, propagate_with_stm, rsw_basis
+from abrupt.series.tracking import TrackingSeries
+from abrupt.thresholds import FalseAlarmBudget, Threshold, chi2_threshold
 
 
 @dataclass(frozen=True)
@@ -419,10 +421,19 @@ class GlrtDetection:
         return float(math.sqrt(max(float(u @ self.dv_covariance @ u), 0.0)))
 
 
+def glrt_threshold_fit(n_candidates: int, arc_days: float, budget: FalseAlarmBudget) -> Threshold:
+    """χ²₃ threshold with a Bonferroni split of the arc's false-alarm probability over the candidates.
+
+    The arc's probability is the budget's expected count over the arc (capped at 0.5), divided among
+    the candidate epochs (:func:`abrupt.thresholds.chi2_threshold`).
+    """
+    p_arc = min(max(budget.per_day * arc_days, 1e-12), 0.5)
+    return chi2_threshold(3, p_fa=p_arc / max(n_candidates, 1))
+
+
 def glrt_threshold(n_candidates: int, arc_days: float, false_alarms_per_day: float) -> float:
-    """χ²₃ threshold with a Bonferroni split of the arc's false-alarm probability over the candidates."""
-    p_arc = min(max(false_alarms_per_day * arc_days, 1e-12), 0.5)
-    return float(chi2.isf(p_arc / max(n_candidates, 1), 3))
+    """Value of :func:`glrt_threshold_fit` for a budget in false alarms per day."""
+    return glrt_threshold_fit(n_candidates, arc_days, FalseAlarmBudget.per_day_rate(false_alarms_per_day)).value
 
 
 def detect_maneuvers_glrt(
@@ -564,6 +575,7 @@ def glrt_events(
     run_id: str,
     config_hash: str,
     false_alarms_per_day: float,
+    detector: str = "tracking.glrt",
 ) -> list[Event]:
     """Events (kind ``maneuver``) with epoch, RSW Δv and 1-σ uncertainties in ``extra``."""
     out = []
@@ -573,7 +585,7 @@ def glrt_events(
             Event(
                 spacecraft=spacecraft,
                 kind="maneuver",
-                detector="tracking_glrt",
+                detector=detector,
                 time_utc=format_time_utc(epoch_utc + np.timedelta64(round(d.t_s * 1e9), "ns")),
                 statistic=d.statistic,
                 threshold=d.threshold,
@@ -598,3 +610,69 @@ def glrt_events(
             )
         )
     return out
+
+
+class GlrtManeuverDetector(Detector[TrackingSeries]):
+    """``tracking.glrt``: out-of-view impulse GLRT on the batch orbit fit (greedy, up to ``max_maneuvers``).
+
+    The threshold is the χ²₃ level of the budget split over the candidate epochs
+    (:func:`glrt_threshold_fit`) unless a fixed ``threshold`` is given. Diagnostics: the first scan's
+    statistic over the candidate epochs.
+    """
+
+    name = "tracking.glrt"
+    series_type = TrackingSeries
+    kind = "maneuver"
+    summary = "impulse GLRT on the batch orbit fit (out-of-view maneuvers)"
+
+    def __init__(
+        self, *, max_maneuvers: int = 3, candidate_step_s: float | None = None, threshold: float | None = None
+    ) -> None:
+        if max_maneuvers < 1:
+            raise ValueError(f"max_maneuvers must be at least 1, got {max_maneuvers}")
+        self.max_maneuvers = int(max_maneuvers)
+        self.candidate_step_s = candidate_step_s
+        self.threshold = threshold
+
+    def glrt_config(self, budget: FalseAlarmBudget) -> GlrtConfig:
+        return GlrtConfig(
+            false_alarms_per_day=budget.per_day,
+            candidate_step_s=self.candidate_step_s,
+            max_maneuvers=self.max_maneuvers,
+            threshold=self.threshold,
+        )
+
+    def detect(self, series: TrackingSeries, budget: FalseAlarmBudget) -> DetectionResult:
+        if len(series) == 0:
+            return DetectionResult.empty(warnings=("no tracking measurements",))
+        detections, _, scans = series.maneuver_fit(self.glrt_config(budget))
+        data = series.data
+        cfg_hash = config_hash({"detector": self.name, **self.config(), "budget": str(budget)})
+        events = glrt_events(
+            detections,
+            epoch_utc=data.epoch_utc,
+            spacecraft=series.spacecraft_name,
+            run_id="",
+            config_hash=cfg_hash,
+            false_alarms_per_day=budget.per_day,
+            detector=self.name,
+        )
+        diagnostics: tuple[Diagnostics, ...] = ()
+        if scans:
+            scan = scans[0]
+            arc_days = max(series.arc_s / 86400.0, 1e-3)
+            thr = glrt_threshold_fit(scan.t_candidates_s.size, arc_days, budget)
+            if self.threshold is not None:
+                thr = replace(thr, value=float(self.threshold), method="fixed")
+            diagnostics = (
+                Diagnostics(
+                    name=self.name,
+                    time_s=scan.t_candidates_s,
+                    statistic=scan.statistic,
+                    threshold=replace(thr, false_alarms_per_day=budget.per_day),
+                    epoch_utc=data.epoch_utc,
+                    unit="chi-square (3 dof)",
+                ),
+            )
+        frame = events_frame(events) if events else empty_frame()
+        return DetectionResult(frame, diagnostics)

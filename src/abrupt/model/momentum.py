@@ -12,12 +12,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import Spacecraft
-
-FloatArray = NDArray[np.float64]
+from abrupt.types import FloatArray
 
 
 @dataclass(frozen=True)

@@ -7,9 +7,9 @@ inertial frame N, so that ``[BN](q)`` maps N-components to B-components (Schaub 
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
-FloatArray = NDArray[np.float64]
+from abrupt.types import FloatArray
 
 
 def normalise_quaternion(q: ArrayLike) -> FloatArray:
@@ -120,3 +120,26 @@ def skew(v: ArrayLike) -> FloatArray:
         ],
         axis=-2,
     )
+
+
+def attitude_error_vector(q_BN: ArrayLike, reference_q_BN: ArrayLike | None = None) -> FloatArray:
+    """Vector part of the error quaternion q_BR = q_BN ⊗ q_RN^-1, shape (n, 3) (Bennett 2022 §2.4.1.1).
+
+    ``reference_q_BN`` is the commanded inertial attitude q_RN (4,) or (n, 4); ``None`` takes the first
+    finite sample as the reference (inertial pointing). The sign is chosen with the scalar part >= 0,
+    so under small angles each component is half the error angle about that body axis [rad/2].
+    """
+    q = np.asarray(q_BN, dtype=np.float64)
+    if q.ndim != 2 or q.shape[1] != 4:
+        raise ValueError(f"q_BN must have shape (n, 4), got {q.shape}")
+    if reference_q_BN is None:
+        finite = np.flatnonzero(np.all(np.isfinite(q), axis=1))
+        if finite.size == 0:
+            return np.full((q.shape[0], 3), np.nan)
+        ref = q[finite[0]]
+    else:
+        ref = np.asarray(reference_q_BN, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        err = quaternion_multiply(normalise_quaternion(q), quaternion_conjugate(normalise_quaternion(ref)))
+        err = np.where(err[..., :1] < 0, -err, err)
+    return np.ascontiguousarray(err[:, 1:])

@@ -247,7 +247,7 @@ def meteoroid_earth_factors(altitude_m: float, *, n_samples: int = 200_000, seed
     sf = earth_shielding_factor(altitude_m)
     rng = np.random.default_rng(seed)
     speeds = rng.choice(v_grid, size=n_samples, p=w)
-    dirs = _unshielded_isotropic(rng, n_samples, altitude_m)
+    dirs = unshielded_isotropic_directions(rng, n_samples, altitude_m)
     v_sc = math.sqrt(EARTH_MU_M3_S2 / (EARTH_RADIUS_M + altitude_m))
     # meteoroid velocity = -speed * dir_from (dir_from: unit vector toward the source); s/c along +y (o_θ)
     vrel = -speeds[:, None] * dirs - np.array([0.0, v_sc, 0.0])
@@ -255,7 +255,7 @@ def meteoroid_earth_factors(altitude_m: float, *, n_samples: int = 200_000, seed
     return MeteoroidEarthFactors(focusing, sf, k, v_grid, w)
 
 
-def _unshielded_isotropic(rng: np.random.Generator, n: int, altitude_m: float) -> NDArray[np.float64]:
+def unshielded_isotropic_directions(rng: np.random.Generator, n: int, altitude_m: float) -> NDArray[np.float64]:
     """Unit vectors (orbit frame: x radial-out, y along-track, z normal), isotropic outside Earth's cone."""
     sin_eta = (EARTH_RADIUS_M + ATMOSPHERE_HEIGHT_M) / (EARTH_RADIUS_M + altitude_m)
     cos_eta = math.sqrt(1.0 - sin_eta**2)

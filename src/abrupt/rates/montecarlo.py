@@ -189,9 +189,9 @@ def sample_sizes(
 
 
 def _interp_cum(table: FluxTable, c: int, x: float) -> float:
-    from abrupt.rates.tables import _loglog_interp
+    from abrupt.rates.tables import loglog_interp
 
-    return _loglog_interp(x, table.sizes_m, table.cumulative_flux[c])
+    return loglog_interp(x, table.sizes_m, table.cumulative_flux[c])
 
 
 def sample_directions(

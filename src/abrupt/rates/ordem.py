@@ -44,7 +44,8 @@ def _is_number(tok: str) -> bool:
     return True
 
 
-def _read_numeric(path: Path) -> tuple[list[str], NDArray[np.float64], list[int]]:
+def read_numeric_table(path: Path) -> tuple[list[str], NDArray[np.float64], list[int]]:
+    """(header names, numeric rows, file line of each row) of an ORDEM/MASTER-style whitespace table."""
     try:
         lines = path.read_text(errors="replace").splitlines()
     except OSError as exc:
@@ -114,7 +115,7 @@ def read_ordem_size(
 ) -> tuple[NDArray[np.float64], tuple[str, ...], NDArray[np.float64], NDArray[np.float64]]:
     """Read an ORDEM-style cumulative flux-vs-size table: sizes [m], classes, flux (C, K), sigma (C, K)."""
     path = Path(path)
-    header, data, line_nos = _read_numeric(path)
+    header, data, line_nos = read_numeric_table(path)
     mapping = describe_mapping(header)
     size_cols = [i for i, h in enumerate(header) if mapping[h] == "size"]
     if len(size_cols) != 1:
@@ -190,7 +191,7 @@ def read_ordem_size(
 def read_ordem_igloo(path: str | Path) -> DirectionBins:
     """Read an ORDEM-style igloo table of flux by azimuth, elevation [deg] and speed [km/s]."""
     path = Path(path)
-    header, data, line_nos = _read_numeric(path)
+    header, data, line_nos = read_numeric_table(path)
 
     def find(key: str, exclude: tuple[str, ...] = ()) -> list[int]:
         return [i for i, h in enumerate(header) if key in h and not any(x in h for x in exclude)]

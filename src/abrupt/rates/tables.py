@@ -95,7 +95,7 @@ class FluxTable:
     def class_flux_above(self, lc_min_m: float) -> NDArray[np.float64]:
         out = np.empty(len(self.classes))
         for c in range(len(self.classes)):
-            out[c] = _loglog_interp(lc_min_m, self.sizes_m, self.cumulative_flux[c])
+            out[c] = loglog_interp(lc_min_m, self.sizes_m, self.cumulative_flux[c])
         return out
 
     def bounded(self, n_sigma: float) -> FluxTable:
@@ -114,7 +114,7 @@ class FluxTable:
         )
 
 
-def _loglog_interp(x: float, xs: NDArray[np.float64], ys: NDArray[np.float64]) -> float:
+def loglog_interp(x: float, xs: NDArray[np.float64], ys: NDArray[np.float64]) -> float:
     """Cumulative flux at x by log-log interpolation; zero above the grid, power-law below its start."""
     if x >= xs[-1]:
         return float(ys[-1]) if x == xs[-1] else 0.0
@@ -477,7 +477,7 @@ def meteoroid_directions(
     factors = fx.meteoroid_earth_factors(altitude_m)
     rng = np.random.default_rng(seed)
     speeds = rng.choice(factors.speed_grid_mps, size=n_samples, p=factors.speed_weights)
-    dirs = fx._unshielded_isotropic(rng, n_samples, altitude_m)
+    dirs = fx.unshielded_isotropic_directions(rng, n_samples, altitude_m)
     v_sc = math.sqrt(fx.EARTH_MU_M3_S2 / (fx.EARTH_RADIUS_M + altitude_m))
     vrel = -speeds[:, None] * dirs - np.array([0.0, v_sc, 0.0])
     vr = np.linalg.norm(vrel, axis=1)

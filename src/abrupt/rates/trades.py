@@ -174,7 +174,8 @@ def run_scenario(scenario: Scenario) -> tuple[CaseResult, StrikeSample]:
     return result, sample
 
 
-def _run_case(scenario: Scenario) -> CaseResult:
+def run_case(scenario: Scenario) -> CaseResult:
+    """The result of one scenario (the first case of :func:`run_scenario`)."""
     return run_scenario(scenario)[0]
 
 
@@ -239,11 +240,11 @@ def run_trade(
         from distributed import Client
 
         with Client(scheduler) as client:
-            futures = client.map(_run_case, scenarios, pure=False)
+            futures = client.map(run_case, scenarios, pure=False)
             results: list[CaseResult] = client.gather(futures)
         return results
     iterator = progress(scenarios) if progress is not None else scenarios
-    return [_run_case(s) for s in iterator]
+    return [run_case(s) for s in iterator]
 
 
 def spread(results: Sequence[CaseResult], metric: str, threshold: float) -> tuple[float, float, float]:

@@ -43,12 +43,15 @@ _FILE_COLUMNS = {
 
 def parse_utc(text: str) -> np.datetime64:
     """ISO-8601 date (UTC; a trailing ``Z`` or offset is honoured) as ``datetime64[ns]``."""
-    ts = pd.Timestamp(text)
-    if ts is pd.NaT:
-        raise ValueError(text)
-    if ts.tzinfo is not None:
-        ts = ts.tz_convert("UTC").tz_localize(None)
-    return np.datetime64(ts.value, "ns")
+    try:
+        ts = pd.Timestamp(text)
+        if ts is pd.NaT:
+            raise ValueError(text)
+        if ts.tzinfo is not None:
+            ts = ts.tz_convert("UTC").tz_localize(None)
+        return np.datetime64(ts.value, "ns")
+    except OverflowError:  # a date outside the datetime64[ns] range (years 1677-2262)
+        raise ValueError(text) from None
 
 
 def read_aer(
@@ -133,10 +136,10 @@ def read_aer(
         rows.append(row)
     if not rows:
         raise InputError("no measurements found", file=path)
-    return _finish(pd.DataFrame(rows), path, log)
+    return finish_measurements(pd.DataFrame(rows), path, log)
 
 
-def _finish(frame: pd.DataFrame, path: Path, log: RepairLog) -> pd.DataFrame:
+def finish_measurements(frame: pd.DataFrame, path: Path, log: RepairLog) -> pd.DataFrame:
     """Sort (counted repair), drop identical duplicates (counted), reject conflicting duplicates."""
     for col in MEASUREMENT_COLUMNS:
         if col not in frame:

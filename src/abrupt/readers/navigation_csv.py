@@ -12,6 +12,7 @@ different states, positions whose magnitude is not an orbit radius in metres (e.
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +20,7 @@ import pandas as pd
 
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.frames import Ephemeris
+from abrupt.readers.compression import read_text
 
 REQUIRED_COLUMNS = ("time_utc", "x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps")
 
@@ -28,12 +30,12 @@ def read_navigation_csv(path: str | Path, satellite: str | None = None, *, frame
     path = Path(path)
     file = str(path)
     repairs = RepairLog(source=file)
+    text = read_text(path, encoding="utf-8", what="CSV")
     try:
-        df = pd.read_csv(path, dtype={"satellite": str, "frame": str})
-    except FileNotFoundError:
-        raise InputError("file not found", file=file) from None
-    except (pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
-        raise InputError(f"not a readable CSV file: {exc}", file=file) from None
+        df = pd.read_csv(io.StringIO(text), dtype={"satellite": str, "frame": str})
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError) as exc:
+        reason = " ".join(str(exc).split())
+        raise InputError(f"not a readable CSV file: {reason}", file=file) from None
     missing = [c for c in REQUIRED_COLUMNS if c not in df.columns]
     if missing:
         raise InputError(f"missing required columns {missing}", file=file, line=1)
@@ -58,7 +60,7 @@ def read_navigation_csv(path: str | Path, satellite: str | None = None, *, frame
     frame = (frame or "GCRF").upper()
     if frame not in ("GCRF", "ITRF"):
         raise InputError(f"unknown frame {frame!r} (GCRF or ITRF)", file=file, column="frame")
-    times = pd.to_datetime(df["time_utc"], errors="coerce", utc=True)
+    times = pd.to_datetime(df["time_utc"].astype(str), errors="coerce", utc=True, format="ISO8601")
     bad = np.flatnonzero(times.isna().to_numpy())
     if bad.size:
         row = int(df.index[bad[0]]) + 2
@@ -73,7 +75,14 @@ def read_navigation_csv(path: str | Path, satellite: str | None = None, *, frame
         if col in ("x_m", "y_m", "z_m") and v.isna().any():
             row = int(df.index[np.flatnonzero(v.isna().to_numpy())[0]]) + 2
             raise InputError("position value is empty", file=file, line=row, column=col)
-        values[col] = v.to_numpy(dtype=np.float64)
+        arr = v.to_numpy(dtype=np.float64)
+        huge = np.flatnonzero(~(np.abs(arr) < 1e12) & ~np.isnan(arr))
+        if huge.size:
+            row = int(df.index[huge[0]]) + 2
+            raise InputError(
+                f"value {df[col].iloc[huge[0]]!r} is not finite or absurdly large", file=file, line=row, column=col
+            )
+        values[col] = arr
     t = times.dt.tz_localize(None).to_numpy(dtype="datetime64[ns]")
     pos = np.column_stack([values["x_m"], values["y_m"], values["z_m"]])
     vel = np.column_stack([values["vx_mps"], values["vy_mps"], values["vz_mps"]])
@@ -128,21 +137,7 @@ def write_navigation_csv(ephemeris: Ephemeris, path: str | Path) -> None:
 
 
 def read_ephemeris(path: str | Path, satellite: str | None = None) -> Ephemeris:
-    """Read SP3 (``.sp3``, ``.sp3c``, ``.sp3d`` or an SP3 header), OEM (``.oem`` or CCSDS header) or CSV."""
-    path = Path(path)
-    try:
-        with open(path, encoding="ascii", errors="replace") as fh:
-            head = fh.read(64)
-    except FileNotFoundError:
-        raise InputError("file not found", file=path) from None
-    if head.startswith("#") and len(head) > 1 and head[1] in "abcd":
-        from abrupt.readers.sp3 import read_sp3
+    """Read any supported orbit file; see :func:`abrupt.readers.ephemeris.read_ephemeris`."""
+    from abrupt.readers.ephemeris import read_ephemeris as read_any
 
-        return read_sp3(path, satellite)
-    if head.lstrip().startswith("CCSDS_OEM_VERS"):
-        from abrupt.readers.oem import read_oem
-
-        return read_oem(path, satellite)
-    if path.suffix.lower() == ".csv" or head.startswith("time_utc"):
-        return read_navigation_csv(path, satellite)
-    raise InputError("unknown ephemeris format (expected SP3-c/d, CCSDS OEM or navigation CSV)", file=path, line=1)
+    return read_any(path, satellite)

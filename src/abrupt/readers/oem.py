@@ -1,80 +1,189 @@
-"""Reader of CCSDS Orbit Ephemeris Messages in KVN form (CCSDS 502.0-B-2/3).
+"""CCSDS Orbit Data Messages: OEM (KVN and XML) and OPM (KVN) readers, OEM writers.
 
-Reads the first (or the named) object's ephemeris data lines ``EPOCH X Y Z X_DOT Y_DOT Z_DOT`` (km,
-km/s) from every segment (META_START ... META_STOP, data, optional COVARIANCE_START ... STOP, which is
-skipped). Times are converted from TIME_SYSTEM (UTC, TAI, GPS, TT) to UTC; REF_FRAME must be an
-Earth-centred frame abrupt knows (GCRF, ICRF, EME2000/J2000 treated as GCRF — the frame bias of
-EME2000, 23 mas, is below the accuracy that matters here and is noted in the repair log — or
-ITRF/ITRF-93/ITRF2000/ITRF2008/ITRF2014/ITRF2020).
+Standard: CCSDS 502.0-B-3 "Orbit Data Messages" (2023; OEM 2.0/3.0, OPM), XML schema of CCSDS
+505.0-B-2 (the form NASA publishes ISS trajectories in: ``<oem>`` with ``<segment><metadata>…
+<data><stateVector><EPOCH>…``).
 
-Documented repairs (counted): identical repeated epochs dropped; epochs out of order sorted; gaps
-(steps longer than 1.5× the median step) counted and left for the filter to propagate across.
-Errors name file:line: missing keywords, unknown frame/time system/centre, malformed data lines,
-velocity missing, a repeated epoch with different states.
+Read: every segment of the chosen object (``OBJECT_NAME`` or ``OBJECT_ID``), state lines ``EPOCH X Y Z
+X_DOT Y_DOT Z_DOT [X_DDOT …]`` (km, km/s; accelerations ignored). Epochs are calendar
+(``2023-02-15T12:00:00.000Z``) or day-of-year (``2023-046T12:00:00.000Z``) in the segment's
+``TIME_SYSTEM`` (UTC, TAI, GPS, TT), converted to UTC with astropy's leap-second table. ``REF_FRAME``
+must be an Earth-centred frame abrupt knows: GCRF, ICRF, EME2000/J2000 (read as GCRF; the 23 mas frame
+bias is below what matters here and is noted in the repair log), or an ITRF realisation.
+
+Documented repairs (counted): covariance blocks skipped; identical repeated epochs dropped (segment
+boundaries often repeat the last epoch); epochs out of order sorted; gaps (steps over 1.5× the median
+step) counted; in a long file (≥ 100 state lines) up to 1 % malformed state lines skipped.
+Errors (:class:`~abrupt.errors.InputError`, file:line:column): missing keywords, unknown frame, time
+system or centre, malformed state lines (more than the skip limit), a repeated epoch with different
+states, a position that is not an orbit radius in km, malformed XML.
 """
 
 from __future__ import annotations
 
+import math
+import re
+import xml.parsers.expat
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
+from numpy.typing import NDArray
 
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.frames import Ephemeris
+from abrupt.readers.compression import read_bytes
 
-_GCRF_NAMES = {"GCRF", "ICRF", "EME2000", "J2000"}
-_ITRF_NAMES = {"ITRF", "ITRF-93", "ITRF-97", "ITRF2000", "ITRF2005", "ITRF2008", "ITRF2014", "ITRF2020", "ITRF93"}
-_TIME_SYSTEMS = {"UTC", "TAI", "GPS", "TT"}
+GCRF_NAMES = {"GCRF", "ICRF", "EME2000", "J2000"}
+ITRF_NAMES = {
+    "ITRF",
+    "ITRF-93",
+    "ITRF-97",
+    "ITRF93",
+    "ITRF97",
+    "ITRF2000",
+    "ITRF2005",
+    "ITRF2008",
+    "ITRF2014",
+    "ITRF2020",
+    "ITRF1993",
+    "ITRF1997",
+}
+TIME_SYSTEMS = {"UTC": "utc", "TAI": "tai", "GPS": "gps", "TT": "tt"}
+REQUIRED_METADATA = ("OBJECT_NAME", "OBJECT_ID", "CENTER_NAME", "REF_FRAME", "TIME_SYSTEM")
+BAD_RECORD_FRACTION = 0.01
+
+_CAL = re.compile(r"^(\d{4})-(\d{2})-(\d{2})T(\d{2}):(\d{2}):(\d{2}(?:\.\d*)?)Z?$")
+_DOY = re.compile(r"^(\d{4})-(\d{3})T(\d{2}):(\d{2}):(\d{2}(?:\.\d*)?)Z?$")
 
 
-def read_oem(path: str | Path, satellite: str | None = None) -> Ephemeris:
-    """Read one object's ephemeris from a KVN OEM file (positions km → m, velocities km/s → m/s)."""
-    path = Path(path)
-    file = str(path)
-    repairs = RepairLog(source=file)
+def parse_ccsds_epoch(text: str) -> np.datetime64:
+    """A CCSDS ASCII time code A or B (``YYYY-MM-DDThh:mm:ss[.d]`` or ``YYYY-DDDThh:mm:ss[.d]``,
+    optional ``Z``) as ``datetime64[ns]`` in the message's time system. Raises ``ValueError``."""
+    text = text.strip()
+    m = _CAL.match(text)
+    if m:
+        y, mo, d, hh, mm, ss = m.groups()
+        if not (1 <= int(mo) <= 12 and 1 <= int(d) <= 31):
+            raise ValueError(text)
+        base = np.datetime64(f"{y}-{mo}-01", "ns") + np.timedelta64(int(d) - 1, "D")
+        if base.astype("datetime64[M]") != np.datetime64(f"{y}-{mo}", "M"):
+            raise ValueError(text)
+    else:
+        m = _DOY.match(text)
+        if not m:
+            raise ValueError(text)
+        y, doy, hh, mm, ss = m.groups()
+        base = np.datetime64(f"{y}-01-01", "ns") + np.timedelta64(int(doy) - 1, "D")
+        if not 1 <= int(doy) <= 366 or base.astype("datetime64[Y]") != np.datetime64(y, "Y"):
+            raise ValueError(text)
+    if int(hh) > 23 or int(mm) > 59 or float(ss) >= 61.0:
+        raise ValueError(text)
+    return base + np.timedelta64(int(hh) * 3600 + int(mm) * 60, "s") + np.timedelta64(round(float(ss) * 1e9), "ns")
+
+
+@dataclass
+class _Segment:
+    meta: dict[str, str]
+    meta_line: int
+    epochs: list[np.datetime64] = field(default_factory=list)
+    states: list[list[float]] = field(default_factory=list)
+    lines: list[int] = field(default_factory=list)
+
+
+def _check_metadata(meta: dict[str, str], file: str, line: int, column: int | None = None) -> None:
+    for key in REQUIRED_METADATA:
+        if key not in meta:
+            raise InputError(f"metadata lacks {key}", file=file, line=line, column=column)
+    if meta["CENTER_NAME"].upper() != "EARTH":
+        raise InputError(f"CENTER_NAME {meta['CENTER_NAME']!r} is not EARTH", file=file, line=line, column=column)
+    frame = meta["REF_FRAME"].upper()
+    if frame not in GCRF_NAMES | ITRF_NAMES:
+        raise InputError(
+            f"unknown REF_FRAME {frame!r} (known: GCRF, ICRF, EME2000, ITRF…)", file=file, line=line, column=column
+        )
+    ts = meta["TIME_SYSTEM"].upper()
+    if ts not in TIME_SYSTEMS:
+        raise InputError(
+            f"unknown TIME_SYSTEM {ts!r}; known: {sorted(TIME_SYSTEMS)}", file=file, line=line, column=column
+        )
+
+
+class _Bad(Exception):
+    def __init__(self, reason: str, column: int | None = None) -> None:
+        super().__init__(reason)
+        self.reason = reason
+        self.column = column
+
+
+def _state_from_tokens(parts: list[str]) -> tuple[np.datetime64, list[float]]:
+    if len(parts) < 7:
+        raise _Bad(f"data line needs epoch and 6 state values (position and velocity), got {len(parts) - 1}", 1)
     try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except FileNotFoundError:
-        raise InputError("file not found", file=file) from None
-    if not lines or not lines[0].strip().startswith("CCSDS_OEM_VERS"):
-        raise InputError("first line must be 'CCSDS_OEM_VERS = ...'", file=file, line=1)
-    segments: list[dict[str, object]] = []
+        epoch = parse_ccsds_epoch(parts[0])
+    except ValueError:
+        raise _Bad(f"cannot read epoch {parts[0]!r}", 1) from None
+    values = []
+    for k, p in enumerate(parts[1:7]):
+        try:
+            v = float(p)
+        except ValueError:
+            raise _Bad(f"cannot read state value {p!r}", k + 2) from None
+        if not (math.isfinite(v) and abs(v) < 1e12):
+            raise _Bad(f"state value {p!r} is not finite or absurdly large", k + 2)
+        values.append(v)
+    return epoch, values
+
+
+def _decode(path: str | Path) -> str:
+    raw = read_bytes(path)
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        raise InputError(f"not a UTF-8 text file (byte 0x{raw[exc.start]:02x})", file=path, line=line) from None
+
+
+def _parse_kvn(text: str, file: str, log: RepairLog) -> tuple[list[_Segment], list[tuple[int, _Bad]], int]:
+    lines = text.splitlines()
+    first = next((i for i, raw in enumerate(lines) if raw.strip()), None)
+    if first is None or not lines[first].strip().startswith("CCSDS_OEM_VERS"):
+        raise InputError("first line must be 'CCSDS_OEM_VERS = ...'", file=file, line=(first or 0) + 1, column=1)
+    segments: list[_Segment] = []
     meta: dict[str, str] = {}
-    in_meta = False
-    in_cov = False
-    current: dict[str, object] | None = None
+    meta_start = 0
+    in_meta = in_cov = False
+    current: _Segment | None = None
+    bad: list[tuple[int, _Bad]] = []
+    n_records = 0
+    n_cov = 0
     for no, raw in enumerate(lines, start=1):
         line = raw.strip()
         if not line or line.startswith("COMMENT"):
             continue
         if line == "META_START":
-            in_meta = True
-            meta = {}
+            if in_meta:
+                raise InputError("META_START inside a metadata block", file=file, line=no, column=1)
+            in_meta, in_cov, meta, meta_start = True, False, {}, no
             continue
         if line == "META_STOP":
+            if not in_meta:
+                raise InputError("META_STOP without META_START", file=file, line=no, column=1)
             in_meta = False
-            for key in ("OBJECT_NAME", "OBJECT_ID", "CENTER_NAME", "REF_FRAME", "TIME_SYSTEM"):
-                if key not in meta:
-                    raise InputError(f"metadata lacks {key}", file=file, line=no)
-            if meta["CENTER_NAME"].upper() != "EARTH":
-                raise InputError(f"CENTER_NAME {meta['CENTER_NAME']!r} is not EARTH", file=file, line=no)
-            frame = meta["REF_FRAME"].upper()
-            if frame not in _GCRF_NAMES | _ITRF_NAMES:
-                raise InputError(f"unknown REF_FRAME {frame!r}", file=file, line=no)
-            ts = meta["TIME_SYSTEM"].upper()
-            if ts not in _TIME_SYSTEMS:
-                raise InputError(f"unknown TIME_SYSTEM {ts!r}; known: {sorted(_TIME_SYSTEMS)}", file=file, line=no)
-            current = {"meta": dict(meta), "rows": [], "lines": []}
+            _check_metadata(meta, file, meta_start)
+            current = _Segment(dict(meta), meta_start)
             segments.append(current)
             continue
         if in_meta:
             if "=" not in line:
-                raise InputError(f"metadata line is not 'KEY = value': {line!r}", file=file, line=no)
+                raise InputError(f"metadata line is not 'KEY = value': {line[:40]!r}", file=file, line=no, column=1)
             key, value = (s.strip() for s in line.split("=", 1))
             meta[key.upper()] = value
             continue
         if line == "COVARIANCE_START":
             in_cov = True
+            n_cov += 1
             continue
         if line == "COVARIANCE_STOP":
             in_cov = False
@@ -82,55 +191,173 @@ def read_oem(path: str | Path, satellite: str | None = None) -> Ephemeris:
         if in_cov or "=" in line:
             continue  # header keywords and covariance blocks
         if current is None:
-            raise InputError("data line before the first META_START ... META_STOP block", file=file, line=no)
-        parts = line.split()
-        if len(parts) < 7:
-            raise InputError(
-                f"data line needs epoch and 6 state values (position and velocity), got {len(parts) - 1}",
-                file=file,
-                line=no,
-            )
+            raise InputError("data line before the first META_START ... META_STOP block", file=file, line=no, column=1)
+        n_records += 1
         try:
-            epoch = np.datetime64(parts[0].replace("Z", ""), "ns")
-        except ValueError:
-            raise InputError(f"cannot read epoch {parts[0]!r}", file=file, line=no, column=1) from None
-        try:
-            values = [float(p) for p in parts[1:7]]
-        except ValueError:
-            raise InputError(f"cannot read state values {parts[1:7]}", file=file, line=no, column=2) from None
-        current["rows"].append((epoch, values))  # type: ignore[attr-defined]
-        current["lines"].append(no)  # type: ignore[attr-defined]
+            epoch, values = _state_from_tokens(line.split())
+        except _Bad as exc:
+            bad.append((no, exc))
+            continue
+        current.epochs.append(epoch)
+        current.states.append(values)
+        current.lines.append(no)
+    if in_meta:
+        raise InputError("metadata block not closed by META_STOP (truncated file?)", file=file, line=len(lines))
+    if in_cov:
+        raise InputError("covariance block not closed by COVARIANCE_STOP (truncated file?)", file=file, line=len(lines))
+    log.record("covariance blocks skipped", n_cov)
+    return segments, bad, n_records
+
+
+@dataclass
+class _Node:
+    tag: str
+    line: int
+    column: int
+    text: str = ""
+    children: list[_Node] = field(default_factory=list)
+
+    def child(self, tag: str) -> _Node | None:
+        return next((c for c in self.children if c.tag == tag), None)
+
+
+def _parse_xml_tree(raw: bytes, file: str) -> _Node:
+    """A minimal element tree with line and column of each element (expat; no external entities)."""
+    parser = xml.parsers.expat.ParserCreate()
+    root = _Node("#document", 1, 1)
+    stack = [root]
+
+    def start(name: str, _attrs: dict[str, str]) -> None:
+        node = _Node(name.rsplit(":", 1)[-1], parser.CurrentLineNumber, parser.CurrentColumnNumber + 1)
+        stack[-1].children.append(node)
+        stack.append(node)
+
+    def end(_name: str) -> None:
+        stack.pop()
+
+    def chars(data: str) -> None:
+        stack[-1].text += data
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = end
+    parser.CharacterDataHandler = chars
+    parser.SetParamEntityParsing(xml.parsers.expat.XML_PARAM_ENTITY_PARSING_NEVER)
+    try:
+        parser.Parse(raw, True)
+    except xml.parsers.expat.ExpatError as exc:
+        raise InputError(
+            f"malformed XML: {xml.parsers.expat.ErrorString(exc.code)}",
+            file=file,
+            line=exc.lineno,
+            column=exc.offset + 1,
+        ) from None
+    return root
+
+
+_XML_STATE = ("X", "Y", "Z", "X_DOT", "Y_DOT", "Z_DOT")
+
+
+def _parse_xml(raw: bytes, file: str, log: RepairLog) -> tuple[list[_Segment], list[tuple[int, _Bad]], int]:
+    root = _parse_xml_tree(raw, file)
+    oem = root.child("oem")
+    if oem is None and root.children and root.children[0].tag == "ndm":
+        oem = root.children[0].child("oem")  # a combined Navigation Data Message holding one OEM
+    if oem is None:
+        top = root.children[0] if root.children else root
+        raise InputError(f"root element is <{top.tag}>, not <oem>", file=file, line=top.line, column=top.column)
+    body = oem.child("body")
+    if body is None:
+        raise InputError("<oem> has no <body>", file=file, line=oem.line, column=oem.column)
+    segments: list[_Segment] = []
+    bad: list[tuple[int, _Bad]] = []
+    n_records = 0
+    n_cov = 0
+    for seg in (c for c in body.children if c.tag == "segment"):
+        md = seg.child("metadata")
+        if md is None:
+            raise InputError("<segment> has no <metadata>", file=file, line=seg.line, column=seg.column)
+        meta = {c.tag.upper(): c.text.strip() for c in md.children}
+        _check_metadata(meta, file, md.line, md.column)
+        current = _Segment(meta, md.line)
+        segments.append(current)
+        data = seg.child("data")
+        if data is None:
+            continue
+        for sv in data.children:
+            if sv.tag == "covarianceMatrix":
+                n_cov += 1
+                continue
+            if sv.tag != "stateVector":
+                continue
+            n_records += 1
+            fields = {c.tag.upper(): c for c in sv.children}
+            missing = [k for k in ("EPOCH", *_XML_STATE) if k not in fields]
+            if missing:
+                bad.append((sv.line, _Bad(f"<stateVector> lacks {', '.join(missing)}", sv.column)))
+                continue
+            nodes = [fields[k] for k in ("EPOCH", *_XML_STATE)]
+            try:
+                epoch, values = _state_from_tokens([n.text.strip() or "?" for n in nodes])
+            except _Bad as exc:
+                node = nodes[(exc.column or 1) - 1]
+                bad.append((node.line, _Bad(exc.reason, node.column)))
+                continue
+            current.epochs.append(epoch)
+            current.states.append(values)
+            current.lines.append(fields["EPOCH"].line)
+    if not segments:
+        raise InputError("<body> has no <segment>", file=file, line=body.line, column=body.column)
+    log.record("covariance blocks skipped", n_cov)
+    return segments, bad, n_records
+
+
+def read_oem(path: str | Path, satellite: str | None = None) -> Ephemeris:
+    """Read one object's ephemeris from an OEM in KVN or XML (positions km → m, velocities km/s → m/s)."""
+    file = str(path)
+    log = RepairLog(source=file)
+    raw = read_bytes(path)
+    if raw.lstrip()[:1] == b"<":
+        segments, bad, n_records = _parse_xml(raw, file, log)
+    else:
+        segments, bad, n_records = _parse_kvn(_decode(path), file, log)
     if not segments:
         raise InputError("no META_START ... META_STOP block", file=file)
-    names = sorted({str(s["meta"]["OBJECT_NAME"]) for s in segments} | {str(s["meta"]["OBJECT_ID"]) for s in segments})  # type: ignore[index]
-    chosen = [
-        s
-        for s in segments
-        if satellite is None or satellite in (s["meta"]["OBJECT_NAME"], s["meta"]["OBJECT_ID"])  # type: ignore[index]
-    ]
+    limit = int(BAD_RECORD_FRACTION * n_records)
+    if len(bad) > limit:
+        no, first = bad[0]
+        extra = f" ({len(bad)} malformed state lines, more than the {limit} that would be skipped)" if limit else ""
+        raise InputError(first.reason + extra, file=file, line=no, column=first.column)
+    log.record("malformed state line skipped", len(bad))
+    return _to_ephemeris(segments, satellite, file, log)
+
+
+def _to_ephemeris(segments: list[_Segment], satellite: str | None, file: str, log: RepairLog) -> Ephemeris:
+    names = sorted({s.meta["OBJECT_NAME"] for s in segments} | {s.meta["OBJECT_ID"] for s in segments})
+    chosen = [s for s in segments if satellite is None or satellite in (s.meta["OBJECT_NAME"], s.meta["OBJECT_ID"])]
     if not chosen:
         raise InputError(f"object {satellite!r} is not in the file; it holds {names}", file=file)
-    first_meta: dict[str, str] = chosen[0]["meta"]  # type: ignore[assignment]
-    objects = {m["meta"]["OBJECT_ID"] for m in chosen}  # type: ignore[index]
+    objects = {s.meta["OBJECT_ID"] for s in chosen}
     if satellite is None and len(objects) > 1:
-        raise InputError(f"file holds several objects {sorted(objects)}; choose one", file=file)
-    frames = {str(s["meta"]["REF_FRAME"]).upper() for s in chosen}  # type: ignore[index]
-    systems = {str(s["meta"]["TIME_SYSTEM"]).upper() for s in chosen}  # type: ignore[index]
-    if len(frames) > 1 or len(systems) > 1:
-        raise InputError(f"segments mix frames {sorted(frames)} or time systems {sorted(systems)}", file=file)
-    rows = [r for s in chosen for r in s["rows"]]  # type: ignore[attr-defined]
-    line_nos = np.array([n for s in chosen for n in s["lines"]])  # type: ignore[attr-defined]
-    if not rows:
-        raise InputError("no ephemeris data lines", file=file)
-    t = np.array([r[0] for r in rows], dtype="datetime64[ns]")
-    st = np.array([r[1] for r in rows], dtype=np.float64)
+        raise InputError(f"file holds several objects {sorted(objects)}; choose one with --satellite", file=file)
+    frames = {s.meta["REF_FRAME"].upper() for s in chosen}
+    systems = {s.meta["TIME_SYSTEM"].upper() for s in chosen}
+    if len({"GCRF" if f in GCRF_NAMES else "ITRF" for f in frames}) > 1 or len(systems) > 1:
+        raise InputError(
+            f"segments mix frames {sorted(frames)} or time systems {sorted(systems)}",
+            file=file,
+            line=chosen[0].meta_line,
+        )
+    t = np.array([e for s in chosen for e in s.epochs], dtype="datetime64[ns]")
+    st = np.array([v for s in chosen for v in s.states], dtype=np.float64).reshape(-1, 6)
+    line_nos = np.array([n for s in chosen for n in s.lines], dtype=np.int64)
+    if t.size == 0:
+        raise InputError("no ephemeris data lines", file=file, line=chosen[0].meta_line)
     order = np.argsort(t, kind="stable")
     if np.any(np.diff(order) < 0):
-        repairs.record("epochs sorted", int(np.count_nonzero(np.diff(t) < np.timedelta64(0))))
+        log.record("epochs sorted", int(np.count_nonzero(np.diff(t) < np.timedelta64(0))))
         t, st, line_nos = t[order], st[order], line_nos[order]
-    same_t = np.flatnonzero(np.diff(t) == np.timedelta64(0))
     keep = np.ones(t.size, dtype=bool)
-    for i in same_t:
+    for i in np.flatnonzero(np.diff(t) == np.timedelta64(0)):
         if not np.allclose(st[i], st[i + 1], rtol=0, atol=1e-9):
             raise InputError(
                 f"epoch {t[i]} appears twice with different states (also line {line_nos[i]})",
@@ -138,34 +365,168 @@ def read_oem(path: str | Path, satellite: str | None = None) -> Ephemeris:
                 line=int(line_nos[i + 1]),
             )
         keep[i + 1] = False
-    repairs.record("duplicate epoch dropped", int((~keep).sum()))
-    t, st = t[keep], st[keep]
+    log.record("duplicate epoch dropped", int((~keep).sum()))
+    t, st, line_nos = t[keep], st[keep], line_nos[keep]
     radius_km = np.linalg.norm(st[:, :3], axis=1)
-    bad = np.flatnonzero((radius_km < 6000.0) | (radius_km > 2e6))
-    if bad.size:
+    badr = np.flatnonzero((radius_km < 6000.0) | (radius_km > 2e6))
+    if badr.size:
         raise InputError(
-            f"position magnitude {radius_km[bad[0]]:.6g} km is not an orbit radius (OEM positions are km)",
+            f"position magnitude {radius_km[badr[0]]:.6g} km is not an orbit radius (OEM positions are km)",
             file=file,
-            line=int(line_nos[keep][bad[0]]),
+            line=int(line_nos[badr[0]]),
         )
     if t.size >= 3:
         step = np.diff(t).astype(np.float64)
-        gaps = int(np.count_nonzero(step > 1.5 * np.median(step)))
-        repairs.record("gaps (steps > 1.5x median; propagated across)", gaps)
+        log.record("gaps (steps > 1.5x median; propagated across)", int(np.count_nonzero(step > 1.5 * np.median(step))))
     frame_name = frames.pop()
     if frame_name in ("EME2000", "J2000"):
-        repairs.record("EME2000 treated as GCRF (frame bias 23 mas ignored)", 1)
+        log.record("EME2000 treated as GCRF (frame bias 23 mas ignored)", 1)
     from abrupt.model.timescales import to_utc
 
     ts = systems.pop()
-    times = to_utc(t, ts.lower())  # type: ignore[arg-type]
     return Ephemeris(
-        satellite=satellite or first_meta["OBJECT_ID"],
-        times_utc=times,
+        satellite=satellite or chosen[0].meta["OBJECT_ID"],
+        times_utc=to_utc(t, TIME_SYSTEMS[ts]),  # type: ignore[arg-type]
         position_m=st[:, :3] * 1e3,
         velocity_mps=st[:, 3:6] * 1e3,
-        frame="GCRF" if frame_name in _GCRF_NAMES else "ITRF",
+        frame="GCRF" if frame_name in GCRF_NAMES else "ITRF",
         source=file,
         time_system=ts,
-        repairs=repairs,
+        repairs=log,
     )
+
+
+def read_opm(path: str | Path, satellite: str | None = None) -> Ephemeris:
+    """Read the state vector of a KVN Orbit Parameter Message (one epoch; km, km/s)."""
+    file = str(path)
+    log = RepairLog(source=file)
+    lines = _decode(path).splitlines()
+    first = next((i for i, raw in enumerate(lines) if raw.strip()), None)
+    if first is None or not lines[first].strip().startswith("CCSDS_OPM_VERS"):
+        raise InputError("first line must be 'CCSDS_OPM_VERS = ...'", file=file, line=(first or 0) + 1, column=1)
+    values: dict[str, tuple[str, int]] = {}
+    for no, raw in enumerate(lines, start=1):
+        line = raw.strip()
+        if not line or line.startswith("COMMENT") or line in ("META_START", "META_STOP"):
+            continue
+        if "=" not in line:
+            raise InputError(f"line is not 'KEY = value': {line[:40]!r}", file=file, line=no, column=1)
+        key, value = (s.strip() for s in line.split("=", 1))
+        value = re.sub(r"\s*\[.*\]\s*$", "", value)  # units in brackets
+        values.setdefault(key.upper(), (value, no))
+    meta = {k: v for k, (v, _) in values.items()}
+    _check_metadata(meta, file, 1)
+    missing = [k for k in ("EPOCH", *_XML_STATE) if k not in values]
+    if missing:
+        raise InputError(f"state vector lacks {', '.join(missing)}", file=file, line=len(lines))
+    try:
+        epoch, state = _state_from_tokens([values[k][0] for k in ("EPOCH", *_XML_STATE)])
+    except _Bad as exc:
+        key = ("EPOCH", *_XML_STATE)[(exc.column or 1) - 1]
+        raise InputError(f"{key}: {exc.reason}", file=file, line=values[key][1]) from None
+    seg = _Segment(meta, 1, [epoch], [state], [values["EPOCH"][1]])
+    return _to_ephemeris([seg], satellite, file, log)
+
+
+def _fmt_time(t: np.datetime64) -> str:
+    return str(np.datetime_as_string(t, unit="us"))
+
+
+def _from_utc(t_utc: NDArray[np.datetime64], time_system: str) -> NDArray[np.datetime64]:
+    if time_system == "UTC":
+        return t_utc
+    from astropy.time import Time
+
+    from abrupt.model.timescales import offline_astropy
+
+    offline_astropy()
+    tt = Time(t_utc, scale="utc", format="datetime64")
+    if time_system == "GPS":
+        tai = np.asarray(tt.tai.datetime64, dtype="datetime64[ns]")
+        gps: NDArray[np.datetime64] = (tai.astype(np.int64) - 19_000_000_000).astype("datetime64[ns]")
+        return gps
+    return np.asarray(getattr(tt, time_system.lower()).datetime64, dtype="datetime64[ns]")
+
+
+def write_oem(
+    ephemeris: Ephemeris,
+    path: str | Path,
+    *,
+    form: Literal["kvn", "xml"] = "kvn",
+    time_system: str = "UTC",
+    object_name: str | None = None,
+    object_id: str | None = None,
+    originator: str = "abrupt",
+) -> None:
+    """Write an ephemeris as a CCSDS OEM 2.0 (KVN or XML), positions km (1 µm) and velocities km/s.
+
+    Epochs are written with microsecond resolution in ``time_system``. NaN velocities cannot be written
+    (OEM requires them): estimate them first.
+    """
+    if time_system not in TIME_SYSTEMS:
+        raise ValueError(f"unknown time system {time_system!r}")
+    if not np.all(np.isfinite(ephemeris.velocity_mps)):
+        raise ValueError("OEM needs velocities at every epoch")
+    frame = "GCRF" if ephemeris.frame == "GCRF" else "ITRF"
+    name = object_name or ephemeris.satellite
+    oid = object_id or ephemeris.satellite
+    times = [_fmt_time(t) for t in _from_utc(ephemeris.times_utc, time_system)]
+    pos = ephemeris.position_m / 1e3
+    vel = ephemeris.velocity_mps / 1e3
+    now = _fmt_time(np.datetime64("now", "us"))
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    if form == "kvn":
+        out = [
+            "CCSDS_OEM_VERS = 2.0",
+            f"CREATION_DATE = {now}",
+            f"ORIGINATOR = {originator}",
+            "",
+            "META_START",
+            f"OBJECT_NAME = {name}",
+            f"OBJECT_ID = {oid}",
+            "CENTER_NAME = EARTH",
+            f"REF_FRAME = {frame}",
+            f"TIME_SYSTEM = {time_system}",
+            f"START_TIME = {times[0]}",
+            f"STOP_TIME = {times[-1]}",
+            "META_STOP",
+            "",
+        ]
+        out += [
+            f"{t} " + " ".join(f"{c:.9f}" for c in p) + " " + " ".join(f"{c:.12f}" for c in v)
+            for t, p, v in zip(times, pos, vel, strict=True)
+        ]
+        Path(path).write_text("\n".join(out) + "\n", encoding="utf-8")
+        return
+    from xml.sax.saxutils import escape
+
+    out = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        '<oem id="CCSDS_OEM_VERS" version="2.0">',
+        "  <header>",
+        f"    <CREATION_DATE>{now}</CREATION_DATE>",
+        f"    <ORIGINATOR>{escape(originator)}</ORIGINATOR>",
+        "  </header>",
+        "  <body>",
+        "    <segment>",
+        "      <metadata>",
+        f"        <OBJECT_NAME>{escape(name)}</OBJECT_NAME>",
+        f"        <OBJECT_ID>{escape(oid)}</OBJECT_ID>",
+        "        <CENTER_NAME>EARTH</CENTER_NAME>",
+        f"        <REF_FRAME>{frame}</REF_FRAME>",
+        f"        <TIME_SYSTEM>{time_system}</TIME_SYSTEM>",
+        f"        <START_TIME>{times[0]}</START_TIME>",
+        f"        <STOP_TIME>{times[-1]}</STOP_TIME>",
+        "      </metadata>",
+        "      <data>",
+    ]
+    for t, p, v in zip(times, pos, vel, strict=True):
+        out.append("        <stateVector>")
+        out.append(f"          <EPOCH>{t}</EPOCH>")
+        for tag, c in zip(("X", "Y", "Z"), p, strict=True):
+            out.append(f'          <{tag} units="km">{c:.9f}</{tag}>')
+        for tag, c in zip(("X_DOT", "Y_DOT", "Z_DOT"), v, strict=True):
+            out.append(f'          <{tag} units="km/s">{c:.12f}</{tag}>')
+        out.append("        </stateVector>")
+    out += ["      </data>", "    </segment>", "  </body>", "</oem>"]
+    Path(path).write_text("\n".join(out) + "\n", encoding="utf-8")

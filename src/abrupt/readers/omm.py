@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from abrupt.errors import InputError, RepairLog
-from abrupt.readers.tle import ElementHistory, RawElementSet, history_from_sets
+from abrupt.readers.tle import ElementHistory, RawElementSet, history_from_sets, split_by_satellite
 
 REQUIRED = (
     "EPOCH",
@@ -136,12 +136,39 @@ def parse_xml(text: str, file: str) -> list[tuple[dict[str, str], int | None]]:
         ) from None
     omms = [root] if _local(root.tag) == "OMM" else [el for el in root.iter() if _local(el.tag) == "OMM"]
     if not omms:
-        raise InputError("XML document holds no <omm> element", file=file)
+        raise InputError("XML document holds no <omm> element", file=file, line=1)
+    starts = [text.count("\n", 0, m.start()) + 1 for m in re.finditer(r"<(?:[\w.-]+:)?omm[\s>/]", text, re.IGNORECASE)]
     out: list[tuple[dict[str, str], int | None]] = []
-    for o in omms:
+    for k, o in enumerate(omms):
         rec = {_local(el.tag): (el.text or "").strip() for el in o.iter() if len(el) == 0}
-        out.append((rec, None))
+        out.append((rec, starts[k] if len(starts) == len(omms) else None))
     return out
+
+
+def _json_object_lines(text: str) -> list[int]:
+    """Line numbers where the top-level objects of a JSON text (a list of objects, or one) start."""
+    lines: list[int] = []
+    depth, line, in_str, esc = 0, 1, False, False
+    for ch in text:
+        if ch == "\n":
+            line += 1
+        if in_str:
+            if esc:
+                esc = False
+            elif ch == "\\":
+                esc = True
+            elif ch == '"':
+                in_str = False
+            continue
+        if ch == '"':
+            in_str = True
+        elif ch in "[{":
+            if ch == "{" and depth <= 1:
+                lines.append(line)
+            depth += 1
+        elif ch in "]}":
+            depth -= 1
+    return lines
 
 
 def parse_kvn(text: str, file: str) -> list[tuple[dict[str, str], int | None]]:
@@ -182,8 +209,9 @@ def parse_json(text: str, file: str) -> list[tuple[dict[str, Any], int | None]]:
     if isinstance(data, dict):
         data = [data]
     if not isinstance(data, list) or not all(isinstance(r, dict) for r in data):
-        raise InputError("JSON OMM must be an object or a list of objects", file=file)
-    return [(r, None) for r in data]
+        raise InputError("JSON OMM must be an object or a list of objects", file=file, line=1)
+    starts = _json_object_lines(text)
+    return [(r, starts[k] if len(starts) == len(data) else None) for k, r in enumerate(data)]
 
 
 def parse_csv(text: str, file: str) -> list[tuple[dict[str, Any], int | None]]:
@@ -203,41 +231,99 @@ def detect_format(text: str) -> str:
         return "kvn"
     if "MEAN_MOTION" in head.split("\n", 1)[0].upper():
         return "csv"
-    raise InputError("not an OMM file (expected XML, KVN, JSON or CSV)")
+    raise InputError("not an OMM file (expected XML, KVN, JSON or CSV)", line=1)
 
 
-def iter_omm_sets(text: str, *, file: str, fmt: str | None = None) -> Iterable[RawElementSet]:
-    """Parse an OMM text of any supported format into checked element sets, in file order."""
+def iter_omm_sets(
+    text: str,
+    *,
+    file: str,
+    fmt: str | None = None,
+    strict: bool = True,
+    skipped: list[InputError] | None = None,
+) -> Iterable[RawElementSet]:
+    """Parse an OMM text of any supported format into checked element sets, in file order.
+
+    A malformed record raises :class:`InputError` with ``strict``; otherwise it is skipped and its
+    error appended to ``skipped`` (a malformed document, e.g. broken XML, is always an error).
+    """
     fmt = fmt or detect_format(text)
     parsers = {"xml": parse_xml, "kvn": parse_kvn, "json": parse_json, "csv": parse_csv}
     if fmt not in parsers:
-        raise InputError(f"unknown OMM format {fmt!r} (known: {sorted(parsers)})", file=file)
+        raise InputError(f"unknown OMM format {fmt!r} (known: {sorted(parsers)})", file=file, line=1)
     for i, (rec, line) in enumerate(parsers[fmt](text, file), start=1):
-        yield record_to_set(rec, file=file, index=i, line=line)
+        try:
+            yield record_to_set(rec, file=file, index=i, line=line)
+        except InputError as exc:
+            if strict:
+                raise
+            if skipped is not None:
+                skipped.append(exc)
 
 
-def read_omm(path: str | Path, *, norad_id: int | None = None, fmt: str | None = None) -> ElementHistory:
-    """Read an OMM file (XML, KVN, JSON or CSV) into a checked :class:`ElementHistory` of one satellite."""
-    path = Path(path)
-    text = path.read_text(encoding="utf-8", errors="replace")
+def _omm_sets(path: Path, fmt: str | None, strict: bool) -> tuple[list[RawElementSet], list[InputError]]:
     try:
-        sets = list(iter_omm_sets(text, file=str(path), fmt=fmt))
+        text = path.read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(f"not a UTF-8 text file (byte {exc.start})", file=path, line=1) from None
+    skipped: list[InputError] = []
+    try:
+        sets = list(iter_omm_sets(text, file=str(path), fmt=fmt, strict=strict, skipped=skipped))
     except InputError as exc:
         if exc.file is None:
-            raise InputError(exc.reason, file=path, line=exc.line, column=exc.column) from None
+            raise InputError(exc.reason, file=path, line=exc.line or 1, column=exc.column) from None
         raise
-    return history_from_sets(sets, source=str(path), norad_id=norad_id, repairs=RepairLog(source=str(path)))
+    except RecursionError:
+        raise InputError("document nested too deeply", file=path, line=1) from None
+    return sets, skipped
 
 
-def read_elements(path: str | Path, *, norad_id: int | None = None) -> ElementHistory:
-    """Read a TLE/3LE or OMM file, chosen by its content."""
-    from abrupt.readers.tle import is_tle_text, read_tle
+def read_omm(
+    path: str | Path, *, norad_id: int | None = None, fmt: str | None = None, strict: bool = False
+) -> ElementHistory:
+    """Read an OMM file (XML, KVN, JSON or CSV) into a checked :class:`ElementHistory` of one satellite.
 
+    Malformed records are skipped and counted unless ``strict``.
+    """
     path = Path(path)
+    sets, skipped = _omm_sets(path, fmt, strict)
+    return history_from_sets(
+        sets, source=str(path), norad_id=norad_id, repairs=RepairLog(source=str(path)), skipped=skipped
+    )
+
+
+def read_omm_histories(path: str | Path, *, fmt: str | None = None, strict: bool = False) -> list[ElementHistory]:
+    """Every satellite of an OMM batch, one checked history each (names from ``OBJECT_NAME``)."""
+    path = Path(path)
+    sets, skipped = _omm_sets(path, fmt, strict)
+    return split_by_satellite(sets, source=str(path), skipped=skipped)
+
+
+def _is_tle(path: Path) -> bool:
+    from abrupt.readers.tle import is_tle_text
+
     if not path.is_file():
         raise InputError("no such file", file=path)
     with open(path, encoding="utf-8", errors="replace") as fh:
         head = fh.read(4000)
-    if is_tle_text(head):
-        return read_tle(path, norad_id=norad_id)
-    return read_omm(path, norad_id=norad_id)
+    return is_tle_text(head)
+
+
+def read_elements(path: str | Path, *, norad_id: int | None = None, strict: bool = False) -> ElementHistory:
+    """Read a TLE/3LE or OMM file, chosen by its content (one satellite; see :func:`read_element_histories`)."""
+    from abrupt.readers.tle import read_tle
+
+    path = Path(path)
+    if _is_tle(path):
+        return read_tle(path, norad_id=norad_id, strict=strict)
+    return read_omm(path, norad_id=norad_id, strict=strict)
+
+
+def read_element_histories(path: str | Path, *, strict: bool = False) -> list[ElementHistory]:
+    """Every satellite of a TLE/3LE file or OMM batch, one history each, chosen by content."""
+    from abrupt.readers.tle import read_tle_histories
+
+    path = Path(path)
+    if _is_tle(path):
+        return read_tle_histories(path, strict=strict)
+    return read_omm_histories(path, strict=strict)

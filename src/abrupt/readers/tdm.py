@@ -23,7 +23,7 @@ import pandas as pd
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.timescales import to_utc
 from abrupt.model.tracking_measurements import MEASUREMENT_COLUMNS
-from abrupt.readers.aer import _finish
+from abrupt.readers.aer import finish_measurements
 
 _DOY = re.compile(r"^(\d{4})-(\d{3})T(\d{2}):(\d{2}):(\d{2}(?:\.\d*)?)Z?$")
 _USED = {"RANGE", "ANGLE_1", "ANGLE_2", "DOPPLER_INSTANTANEOUS"}
@@ -175,7 +175,7 @@ def read_tdm(path: str | Path, *, repairs: RepairLog | None = None) -> pd.DataFr
     merged["_kind"] = "TDM"
     order = np.argsort(merged["_line"].to_numpy(), kind="stable")
     merged = merged.iloc[order].reset_index(drop=True)
-    return _finish(merged.astype({c: float for c in MEASUREMENT_COLUMNS}), path, log)
+    return finish_measurements(merged.astype({c: float for c in MEASUREMENT_COLUMNS}), path, log)
 
 
 def _first_or_conflict(values: pd.Series) -> object:

@@ -24,58 +24,31 @@ gaps longer than 1.5 nominal intervals reported; the data are split into contigu
                                        no detector window spans a gap
 =====================================  ==========================================================
 
-Repairs are counted in :attr:`Telemetry.repairs` and logged; nothing is dropped silently.
+Repairs are counted in :attr:`Telemetry.repairs` and logged; nothing is dropped silently. The typed
+series lives in :mod:`abrupt.series.telemetry`; masks (planned events) in :mod:`abrupt.clean.masks`.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from abrupt.clean.noise import robust_noise_sigma
 from abrupt.errors import InputError, RepairLog
-from abrupt.model.noise import robust_noise_sigma
 from abrupt.model.spacecraft import RATE_UNITS, WHEEL_SPEED_UNITS, Spacecraft
+from abrupt.series.telemetry import GAP_FACTOR, Telemetry, split_at_gaps
 
 QUATERNION_NORM_ERROR = 0.1  # relative norm deviation above which a quaternion is rejected
 QUATERNION_NORM_REPAIR = 1e-6  # relative deviation above which a renormalisation is counted
 MAX_BODY_RATE_RAD_S = 2.0  # [rad/s] above this the rate unit is almost surely wrong
 WHEEL_OVERSPEED_FACTOR = 1.5
-GAP_FACTOR = 1.5  # a step longer than this many nominal intervals is a gap
 
 
-@dataclass
-class Telemetry:
-    """Attitude telemetry in SI units, sorted by time, with its segments and repairs.
-
-    ``time``: UTC datetime64[ns]; ``t_s``: seconds since the first sample; ``quaternion_BN`` (n, 4)
-    scalar first; ``body_rate_rad_s`` (n, 3); ``wheel_speed_rad_s`` (n, N) relative to the body;
-    ``segments``: (start, stop) row ranges without gaps; ``sample_interval_s``: the nominal interval.
-    """
-
-    time: NDArray[np.datetime64]
-    t_s: NDArray[np.float64]
-    quaternion_BN: NDArray[np.float64]
-    body_rate_rad_s: NDArray[np.float64]
-    wheel_speed_rad_s: NDArray[np.float64]
-    sample_interval_s: float
-    segments: list[tuple[int, int]]
-    repairs: RepairLog
-    source: str = "<memory>"
-    gaps: list[tuple[int, float]] = field(default_factory=list)
-
-    def __len__(self) -> int:
-        return int(self.t_s.size)
-
-    @property
-    def sample_rate_hz(self) -> float:
-        return 1.0 / self.sample_interval_s
-
-
-def _read_table(path: Path) -> pd.DataFrame:
+def read_table(path: Path) -> pd.DataFrame:
+    """A CSV (all cells as text, for line-exact errors) or Parquet table; clear errors for the rest."""
     suffix = path.suffix.lower()
     if not path.exists():
         raise InputError("file not found", file=path)
@@ -310,19 +283,9 @@ def telemetry_from_frame(
         raise InputError(f"need at least 2 samples with distinct times, got {time_ns.size}", file=path)
     t_ns = time_ns.astype(np.int64)
     t_s = (t_ns - t_ns[0]) / 1e9
-    steps = np.diff(t_s)
-    interval = float(np.median(steps)) if steps.size else float("nan")
-    gaps: list[tuple[int, float]] = []
-    segments: list[tuple[int, int]] = []
-    if steps.size:
-        gap_idx = np.flatnonzero(steps > GAP_FACTOR * interval)
-        gaps = [(int(i + 1), float(steps[i])) for i in gap_idx]
-        bounds = [0, *[g[0] for g in gaps], t_s.size]
-        segments = [(bounds[i], bounds[i + 1]) for i in range(len(bounds) - 1)]
-        if gaps:
-            repairs.record(f"gaps longer than {GAP_FACTOR} sample intervals (data split into segments)", len(gaps))
-    else:
-        segments = [(0, 1)]
+    interval, gaps, segments = split_at_gaps(t_s, GAP_FACTOR)
+    if gaps:
+        repairs.record(f"gaps longer than {GAP_FACTOR} sample intervals (data split into segments)", len(gaps))
     _check_rates_against_attitude(t_s, q, w, segments, path, tmap.body_rate.unit or "rad/s")
     return Telemetry(
         time=time_ns,
@@ -341,68 +304,6 @@ def telemetry_from_frame(
 def read_telemetry(path: str | Path, spacecraft: Spacecraft) -> Telemetry:
     """Read attitude telemetry (CSV or Parquet) using the spacecraft file's column mapping."""
     path = Path(path)
-    frame = _read_table(path)
+    frame = read_table(path)
     is_csv = path.suffix.lower() in (".csv", ".txt")
     return telemetry_from_frame(frame, spacecraft, source=path, is_csv=is_csv)
-
-
-def read_mask(path: str | Path) -> list[tuple[np.datetime64, np.datetime64, str]]:
-    """Intervals to blank (thruster firings, momentum dumps, slews): CSV ``start_utc,end_utc[,reason]``.
-
-    Times are ISO-8601 UTC; an interval whose end precedes its start is an error naming the line.
-    """
-    path = Path(path)
-    frame = _read_table(path)
-    for col in ("start_utc", "end_utc"):
-        if col not in frame.columns:
-            raise InputError(
-                f"mask file needs columns start_utc, end_utc[, reason]; got {list(frame.columns)}",
-                file=path,
-                column=col,
-            )
-    start = pd.to_datetime(frame["start_utc"], utc=True, errors="coerce", format="ISO8601")
-    end = pd.to_datetime(frame["end_utc"], utc=True, errors="coerce", format="ISO8601")
-    out = []
-    for i in range(len(frame)):
-        if pd.isna(start.iloc[i]) or pd.isna(end.iloc[i]):
-            col = "start_utc" if pd.isna(start.iloc[i]) else "end_utc"
-            raise InputError(f"not an ISO-8601 time: {frame[col].iloc[i]!r}", file=path, line=i + 2, column=col)
-        if end.iloc[i] < start.iloc[i]:
-            raise InputError("interval ends before it starts", file=path, line=i + 2)
-        reason = str(frame["reason"].iloc[i]) if "reason" in frame.columns else ""
-        out.append(
-            (start.iloc[i].tz_localize(None).to_datetime64(), end.iloc[i].tz_localize(None).to_datetime64(), reason)
-        )
-    return out
-
-
-def apply_mask(telemetry: Telemetry, intervals: list[tuple[np.datetime64, np.datetime64, str]]) -> Telemetry:
-    """Blank masked intervals: segments are split so that no detector window touches a masked sample.
-
-    The masked samples stay in the arrays (for reports) but belong to no segment; their number is
-    counted in the repairs.
-    """
-    masked = np.zeros(len(telemetry), dtype=bool)
-    for start, end, _ in intervals:
-        masked |= (telemetry.time >= start) & (telemetry.time <= end)
-    if not masked.any():
-        return telemetry
-    segments: list[tuple[int, int]] = []
-    for a, b in telemetry.segments:
-        keep = ~masked[a:b]
-        edges = np.flatnonzero(np.diff(np.concatenate([[0], keep.astype(np.int8), [0]])))
-        segments += [(a + int(s), a + int(e)) for s, e in zip(edges[::2], edges[1::2], strict=True)]
-    repairs = RepairLog(telemetry.repairs.source, telemetry.repairs.counts.copy())
-    repairs.record("samples blanked by the mask (planned events)", int(masked.sum()))
-    return Telemetry(
-        time=telemetry.time,
-        t_s=telemetry.t_s,
-        quaternion_BN=telemetry.quaternion_BN,
-        body_rate_rad_s=telemetry.body_rate_rad_s,
-        wheel_speed_rad_s=telemetry.wheel_speed_rad_s,
-        sample_interval_s=telemetry.sample_interval_s,
-        segments=segments,
-        repairs=repairs,
-        source=telemetry.source,
-        gaps=telemetry.gaps,
-    )

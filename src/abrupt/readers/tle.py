@@ -12,8 +12,16 @@ or is repaired in a documented, counted way (:class:`~abrupt.errors.RepairLog`):
 * two different element sets with the same epoch: the one with the higher element-set number
   (then the later one in the file) is kept (``same-epoch element sets replaced``);
 * epochs out of order are sorted (``element sets out of epoch order, sorted``);
-* a file with several satellites is an error unless ``norad_id`` selects one, in which case the
-  others are skipped and counted (``element sets of other satellites skipped``).
+* a file with several satellites is an error for :func:`read_tle` unless ``norad_id`` selects one
+  (the others are skipped and counted, ``element sets of other satellites skipped``);
+  :func:`read_tle_histories` returns one history per satellite instead;
+* a malformed element set (bad field, checksum, truncated or missing line, a B* such as
+  ``+0153801`` with no exponent sign) is skipped and counted (``malformed element sets skipped``),
+  and the :class:`InputError` naming its line is kept in ``ElementHistory.skipped``; with
+  ``strict=True`` the first one is raised instead;
+* tolerated as written: explicit ``+`` signs, non-breaking spaces (read as spaces), trailing blanks,
+  ``\r\n`` line ends, 3LE name lines (with or without ``0 ``), Alpha-5 catalogue numbers
+  (``A0001`` = 100001: the letter counts 10..33 with I and O skipped).
 
 TLE epochs are UTC (Vallado et al. 2006, §"Time"), so no time-scale conversion is needed.
 """
@@ -72,6 +80,7 @@ class ElementHistory:
     source: str
     name: str | None = None
     repairs: RepairLog = field(default_factory=RepairLog)
+    skipped: list[InputError] = field(default_factory=list)
 
     @property
     def norad_id(self) -> int:
@@ -104,8 +113,26 @@ def tle_checksum(line: str) -> int:
     return total % 10
 
 
+ALPHA5_LETTERS = "ABCDEFGHJKLMNPQRSTUVWXYZ"  # I and O are not used (Space-Track Alpha-5)
+
+
+def catalog_number(text: str) -> int:
+    """Catalogue number of columns 3-7: digits, or Alpha-5 (a letter for 10..33, then four digits)."""
+    text = text.strip()
+    if text.isdigit():
+        return int(text)
+    if len(text) == 5 and text[0] in ALPHA5_LETTERS and text[1:].isdigit():
+        return (ALPHA5_LETTERS.index(text[0]) + 10) * 10000 + int(text[1:])
+    raise ValueError(text)
+
+
+def clean_line(text: str) -> str:
+    """A file line without its line end and trailing blanks, non-breaking spaces read as spaces."""
+    return text.rstrip("\r\n").replace("\u00a0", " ").rstrip()
+
+
 def _check_line(text: str, expected: str, file: str, line_no: int) -> str:
-    line = text.rstrip("\r\n").rstrip()
+    line = clean_line(text)
     if not line.startswith(expected + " "):
         raise InputError(
             f"expected TLE line {expected} (starting '{expected} '), got {line[:12]!r}",
@@ -165,6 +192,12 @@ def parse_tle_pair(line1: str, line2: str, *, file: str = "<input>", line_no: in
 
     l1 = _check_line(line1, "1", file, line_no)
     l2 = _check_line(line2, "2", file, line_no + 1)
+    try:
+        catalog_number(l1[2:7])
+    except ValueError:
+        raise InputError(
+            f"catalog number {l1[2:7]!r} is neither digits nor Alpha-5", file=file, line=line_no, column=3
+        ) from None
     if l1[2:7] != l2[2:7]:
         raise InputError(
             f"catalog number {l2[2:7].strip()!r} on line 2 differs from {l1[2:7].strip()!r} on line 1",
@@ -205,39 +238,72 @@ def parse_tle_pair(line1: str, line2: str, *, file: str = "<input>", line_no: in
     return sat
 
 
-def iter_tle_sets(lines: Sequence[str], *, file: str = "<input>") -> Iterable[RawElementSet]:
+def iter_tle_sets(
+    lines: Sequence[str],
+    *,
+    file: str = "<input>",
+    strict: bool = True,
+    skipped: list[InputError] | None = None,
+) -> Iterable[RawElementSet]:
     """Yield the element sets of a two-line or three-line (name line first) text, in file order.
 
     A name line is any non-blank line that does not start with ``'1 '`` or ``'2 '`` (3LE files may
-    prefix it with ``'0 '``). Blank lines are skipped.
+    prefix it with ``'0 '``). Blank lines are skipped. With ``strict`` the first malformed element set
+    raises :class:`InputError`; otherwise it is skipped, its error appended to ``skipped``, and
+    reading goes on at the next line that starts an element set.
     """
     name: str | None = None
     i = 0
     n = len(lines)
+
+    def fail(exc: InputError) -> None:
+        if strict:
+            raise exc
+        if skipped is not None:
+            skipped.append(exc)
+
     while i < n:
-        raw = lines[i].rstrip("\r\n")
+        raw = clean_line(lines[i])
         if not raw.strip():
             i += 1
             continue
         if raw.startswith("1 "):
-            if i + 1 >= n:
-                raise InputError("file ends after TLE line 1 (line 2 missing)", file=file, line=i + 1)
-            nxt = lines[i + 1].rstrip("\r\n")
+            nxt = clean_line(lines[i + 1]) if i + 1 < n else None
+            if nxt is None:
+                fail(InputError("file ends after TLE line 1 (line 2 missing)", file=file, line=i + 1))
+                i += 1
+                continue
             if not nxt.startswith("2 "):
-                raise InputError(
-                    f"TLE line 1 must be followed by line 2, got {nxt[:12]!r}",
-                    file=file,
-                    line=i + 2,
-                    column=1,
+                fail(
+                    InputError(
+                        f"TLE line 1 must be followed by line 2, got {nxt[:12]!r}", file=file, line=i + 2, column=1
+                    )
                 )
-            sat = parse_tle_pair(raw, nxt, file=file, line_no=i + 1)
-            elnum = int(raw[64:68].strip() or 0)
-            key = raw.rstrip()[:68] + "|" + nxt.rstrip()[:68]
-            yield RawElementSet(sat, int(sat.satnum), elnum, i + 1, key, name)
+                i += 1
+                continue
+            try:
+                sat = parse_tle_pair(raw, nxt, file=file, line_no=i + 1)
+                norad = catalog_number(raw[2:7])
+                elnum = int(raw[64:68].strip() or 0)
+            except InputError as exc:
+                fail(exc)
+                name = None
+                i += 2
+                continue
+            except ValueError:
+                fail(
+                    InputError(f"element-set number {raw[64:68]!r} is not an integer", file=file, line=i + 1, column=65)
+                )
+                name = None
+                i += 2
+                continue
+            key = raw[:68] + "|" + nxt[:68]
+            yield RawElementSet(sat, norad, elnum, i + 1, key, name)
             name = None
             i += 2
         elif raw.startswith("2 "):
-            raise InputError("TLE line 2 without a preceding line 1", file=file, line=i + 1, column=1)
+            fail(InputError("TLE line 2 without a preceding line 1", file=file, line=i + 1, column=1))
+            i += 1
         else:
             name = raw[2:].strip() if raw.startswith("0 ") else raw.strip()
             i += 1
@@ -249,16 +315,18 @@ def history_from_sets(
     source: str,
     norad_id: int | None = None,
     repairs: RepairLog | None = None,
+    skipped: Sequence[InputError] = (),
 ) -> ElementHistory:
     """Check and order parsed element sets into an :class:`ElementHistory` (see module docstring)."""
     repairs = repairs if repairs is not None else RepairLog(source=source)
+    repairs.record("malformed element sets skipped", len(skipped))
     kept: list[RawElementSet] = []
     first_sat: RawElementSet | None = None
-    skipped = 0
+    other = 0
     for s in sets:
         if norad_id is not None:
             if s.norad_id != norad_id:
-                skipped += 1
+                other += 1
                 continue
         elif first_sat is None:
             first_sat = s
@@ -270,9 +338,14 @@ def history_from_sets(
                 line=s.line,
             )
         kept.append(s)
-    repairs.record("element sets of other satellites skipped", skipped)
+    repairs.record("element sets of other satellites skipped", other)
     if not kept:
-        raise InputError("no element sets" + (f" of satellite {norad_id}" if norad_id is not None else ""), file=source)
+        why = f" ({len(skipped)} malformed; first: {skipped[0]})" if skipped else ""
+        raise InputError(
+            "no readable element sets" + (f" of satellite {norad_id}" if norad_id is not None else "") + why,
+            file=source,
+            line=(skipped[0].line or 1) if skipped else 1,
+        )
     # Exact duplicates.
     seen: set[str] = set()
     unique: list[RawElementSet] = []
@@ -297,7 +370,34 @@ def history_from_sets(
     repairs.record("same-epoch element sets replaced", replaced)
     final = [by_epoch[k] for k in sorted(by_epoch)]
     name = next((s.name for s in final if s.name), None)
-    return ElementHistory(elements_frame(final), [s.satrec for s in final], source, name, repairs)
+    return ElementHistory(elements_frame(final), [s.satrec for s in final], source, name, repairs, list(skipped))
+
+
+def split_by_satellite(
+    sets: Iterable[RawElementSet], *, source: str, skipped: Sequence[InputError] = ()
+) -> list[ElementHistory]:
+    """One :class:`ElementHistory` per catalogue number, in order of first appearance.
+
+    Each history gets its own :class:`RepairLog`; the malformed sets (``skipped``) are attributed to
+    the satellite whose sets surround them when the file holds one satellite, else to the first.
+    """
+    groups: dict[int, list[RawElementSet]] = {}
+    for s in sets:
+        groups.setdefault(s.norad_id, []).append(s)
+    if not groups:
+        return [history_from_sets([], source=source, skipped=skipped)]
+    out = []
+    for k, (norad, group) in enumerate(groups.items()):
+        out.append(
+            history_from_sets(
+                group,
+                source=source,
+                norad_id=norad,
+                repairs=RepairLog(source=f"{source}[{norad}]"),
+                skipped=skipped if k == 0 else (),
+            )
+        )
+    return out
 
 
 def elements_frame(sets: Sequence[RawElementSet]) -> pd.DataFrame:
@@ -330,23 +430,39 @@ def elements_frame(sets: Sequence[RawElementSet]) -> pd.DataFrame:
     return frame
 
 
-def read_tle(path: str | Path, *, norad_id: int | None = None) -> ElementHistory:
+def _read_text(path: Path) -> list[str]:
+    data = path.read_bytes()
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data[: exc.start].count(b"\n") + 1
+        raise InputError(f"not a UTF-8/ASCII text file (byte {exc.start})", file=path, line=line) from None
+    return text.splitlines()
+
+
+def read_tle(path: str | Path, *, norad_id: int | None = None, strict: bool = False) -> ElementHistory:
     """Read a TLE or 3LE file into a checked, epoch-ordered :class:`ElementHistory` of one satellite.
 
     ``norad_id`` selects one satellite of a multi-satellite file (others are skipped and counted);
-    without it a file with several satellites is an :class:`InputError`.
+    without it a file with several satellites is an :class:`InputError` (use
+    :func:`read_tle_histories`). Malformed element sets are skipped and counted unless ``strict``.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="ascii", errors="strict")
-    except UnicodeDecodeError as exc:
-        raise InputError(f"not an ASCII TLE file (byte {exc.start})", file=path) from None
-    lines = text.splitlines()
+    skipped: list[InputError] = []
+    sets = list(iter_tle_sets(_read_text(path), file=str(path), strict=strict, skipped=skipped))
     repairs = RepairLog(source=str(path))
-    return history_from_sets(iter_tle_sets(lines, file=str(path)), source=str(path), norad_id=norad_id, repairs=repairs)
+    return history_from_sets(sets, source=str(path), norad_id=norad_id, repairs=repairs, skipped=skipped)
+
+
+def read_tle_histories(path: str | Path, *, strict: bool = False) -> list[ElementHistory]:
+    """Every satellite of a TLE/3LE file, one checked history each (malformed sets skipped unless ``strict``)."""
+    path = Path(path)
+    skipped: list[InputError] = []
+    sets = list(iter_tle_sets(_read_text(path), file=str(path), strict=strict, skipped=skipped))
+    return split_by_satellite(sets, source=str(path), skipped=skipped)
 
 
 def is_tle_text(head: str) -> bool:
     """Whether the first lines of a file look like TLE/3LE text (a line starting '1 ' then one '2 ')."""
-    lines = [ln for ln in head.splitlines() if ln.strip()]
+    lines = [ln.lstrip("\ufeff") for ln in head.splitlines() if ln.strip()]
     return any(a.startswith("1 ") and b.startswith("2 ") for a, b in itertools.pairwise(lines))

@@ -23,8 +23,8 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from abrupt.detect.attitude import STATISTIC_UNITS, DetectionResult
-from abrupt.readers.telemetry import Telemetry
+from abrupt.pipelines.attitude import AttitudeRun, display_name
+from abrupt.series.telemetry import Telemetry
 
 MAX_POINTS = 20000  # per line; longer series are min/max decimated so spikes stay visible
 SMOOTHING_S = 30.0  # [s] running mean drawn over the noisy momentum
@@ -58,7 +58,7 @@ def _decimate(t: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[NDArray[n
 
 def attitude_figure(
     telemetry: Telemetry,
-    result: DetectionResult,
+    result: AttitudeRun,
     *,
     truth: pd.DataFrame | None = None,
     title: str = "",
@@ -67,6 +67,7 @@ def attitude_figure(
     t_h = telemetry.t_s / 3600.0
     t0 = telemetry.time[0]
     names = list(result.statistics)
+    units = _units(result)
     n_panels = 4 + len(names)
     fig, axes = plt.subplots(n_panels, 1, sharex=True, figsize=(12, 2.1 * n_panels + 1), constrained_layout=True)
     axis_labels = ("x", "y", "z")
@@ -112,7 +113,7 @@ def attitude_figure(
         ax.plot(tt, yy, lw=0.6, color="black")
         thr = result.thresholds[name]
         ax.axhline(thr.value, color="tab:red", lw=1.0, ls="--", label=f"threshold ({thr.false_alarms_per_day:g}/day)")
-        ax.set_ylabel(f"{name}\n[{STATISTIC_UNITS[name]}]")
+        ax.set_ylabel(f"{name}\n[{units[name]}]")
         ax.legend(loc="upper left", fontsize=8)
 
     events = result.events
@@ -132,7 +133,7 @@ def attitude_figure(
     return fig
 
 
-def qq_figure(result: DetectionResult) -> plt.Figure | None:
+def qq_figure(result: AttitudeRun) -> plt.Figure | None:
     """Q-Q plots of event-free block maxima against their fitted GEV law, one panel per detector.
 
     Points on the diagonal mean the extreme-value fit that set the threshold describes the data; the
@@ -140,12 +141,13 @@ def qq_figure(result: DetectionResult) -> plt.Figure | None:
     """
     from scipy import stats
 
-    names = [k.split(":", 1)[1] for k in result.noise_sigma if k.startswith("block_maxima:")]
-    if not names:
+    fitted = [d for d in result.diagnostics if d.null_sample is not None and d.threshold is not None]
+    if not fitted:
         return None
-    fig, axes = plt.subplots(1, len(names), figsize=(3.6 * len(names), 3.4), constrained_layout=True, squeeze=False)
-    for ax, name in zip(axes[0], names, strict=True):
-        maxima = np.sort(result.noise_sigma[f"block_maxima:{name}"])
+    fig, axes = plt.subplots(1, len(fitted), figsize=(3.6 * len(fitted), 3.4), constrained_layout=True, squeeze=False)
+    for ax, diag in zip(axes[0], fitted, strict=True):
+        name = display_name(diag.name)
+        maxima = np.sort(np.asarray(diag.null_sample))
         probs = (np.arange(1, maxima.size + 1) - 0.5) / maxima.size
         shape, loc, scale = stats.genextreme.fit(maxima)
         theo = stats.genextreme.ppf(probs, shape, loc=loc, scale=scale)
@@ -159,6 +161,11 @@ def qq_figure(result: DetectionResult) -> plt.Figure | None:
     return fig
 
 
+def _units(result: AttitudeRun) -> dict[str, str]:
+    """Unit of each detector's statistic, from its diagnostics."""
+    return {display_name(d.name): d.unit for d in result.diagnostics}
+
+
 def _png_base64(fig: plt.Figure) -> str:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110)
@@ -169,7 +176,7 @@ def _png_base64(fig: plt.Figure) -> str:
 def write_attitude_report(
     path: str | Path,
     telemetry: Telemetry,
-    result: DetectionResult,
+    result: AttitudeRun,
     *,
     truth: pd.DataFrame | None = None,
     title: str = "",
@@ -194,8 +201,9 @@ def write_attitude_report(
         if qq is not None
         else ""
     )
+    units = _units(result)
     thr_rows = "".join(
-        f"<tr><td>{html.escape(k)}</td><td>{v.value:.4g}</td><td>{html.escape(STATISTIC_UNITS[k])}</td>"
+        f"<tr><td>{html.escape(k)}</td><td>{v.value:.4g}</td><td>{html.escape(units.get(k, ''))}</td>"
         f"<td>{v.false_alarms_per_day:g}</td><td>{html.escape(v.method)}</td><td>{v.n_samples}</td></tr>"
         for k, v in result.thresholds.items()
     )

@@ -40,15 +40,19 @@ def plot_tle_report(
         TleDetectorConfig,
         component_weights,
         mean_element_series,
+        orbit_regime,
         step_statistics,
     )
     from abrupt.score import score_events
 
-    s = mean_element_series(history)
+    regime = orbit_regime(history)
+    geo = regime == "geo"
+    s = mean_element_series(history, regime)
     t = pd.DatetimeIndex(history.elements["epoch_utc"])
-    cfg = TleDetectorConfig()
+    cfg = TleDetectorConfig(regime=regime)
     steps = step_statistics(history, cfg)
     steps.weights = component_weights(steps, cfg.window_sets + 2)
+    steps.group_gain = cfg.group_gain
     gap_t = t[:-1] + (t[1:] - t[:-1]) / 2
     fig, axes = plt.subplots(5, 1, figsize=(12, 12), sharex=True, constrained_layout=True)
     a = s["a_m"]
@@ -58,17 +62,17 @@ def plot_tle_report(
         lo, hi = np.quantile(a - np.median(a), [0.02, 0.98])
         pad = 0.3 * (hi - lo) + 1.0
         axes[0].set_ylim(lo - pad, hi + pad)
-    axes[1].plot(t, s["ex"] * 1e3, ".", ms=2, label="e cos ω")
-    axes[1].plot(t, s["ey"] * 1e3, ".", ms=2, label="e sin ω")
+    axes[1].plot(t, s["ex"] * 1e3, ".", ms=2, label="e cos ϖ" if geo else "e cos ω")
+    axes[1].plot(t, s["ey"] * 1e3, ".", ms=2, label="e sin ϖ" if geo else "e sin ω")
     axes[1].set_ylabel("e-vector [×10⁻³]")
     axes[1].legend(loc="upper right", fontsize=8)
     axes[2].plot(t, np.degrees(s["i_rad"]), ".", ms=2, color="tab:purple")
-    axes[2].set_ylabel("i [deg]")
+    axes[2].set_ylabel("i sin Ω [deg]" if geo else "i [deg]")
     axes[3].plot(t, np.degrees(s["raan_resid_sin_i_rad"]), ".", ms=2, color="tab:brown")
-    axes[3].set_ylabel("sin i·(Ω − Ω̇ₛ₉ₚ₄ t) [deg]")
+    axes[3].set_ylabel("−i cos Ω [deg]" if geo else "sin i·(Ω − Ω̇ₛ₉ₚ₄ t) [deg]")
     if len(gap_t):
         axes[4].semilogy(gap_t, np.maximum(steps.statistic, 1e-2), lw=0.7, color="0.3")
-    axes[4].set_ylabel("step statistic S\n(before segmentation)")
+    axes[4].set_ylabel("step statistic\n(before segmentation)")
     if len(events) and "threshold" in events:
         axes[4].axhline(float(events["threshold"].iloc[0]), color="tab:red", ls="--", lw=1, label="threshold")
         axes[4].legend(loc="upper right", fontsize=8)

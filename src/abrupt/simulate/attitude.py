@@ -33,8 +33,7 @@ from numpy.typing import ArrayLike, NDArray
 from abrupt.errors import ConfigError
 from abrupt.model.spacecraft import RATE_UNITS, WHEEL_SPEED_UNITS, Spacecraft
 from abrupt.simulate import _attitude_kernels as kern
-
-FloatArray = NDArray[np.float64]
+from abrupt.types import FloatArray
 
 __all__ = [
     "AttitudeSimConfig",

@@ -3,7 +3,7 @@
 :mod:`abrupt.thresholds.budget` holds :class:`FalseAlarmBudget` (a rate per day, week or
 satellite-year and its conversions to per-sample, per-block and per-test levels);
 :mod:`abrupt.thresholds.fits` holds the fits of event-free statistics that return a
-:class:`Threshold` (Gaussian, Gamma, KDE, empirical, GPD, GEV block maxima).
+:class:`Threshold` (Gaussian, Gamma, KDE, empirical, GPD, GEV block maxima, χ², robust Gaussian).
 Detectors import from this package, never from a private helper of another detector.
 """
 
@@ -13,6 +13,7 @@ from abrupt.thresholds.fits import (
     FitMethod,
     Threshold,
     block_maxima,
+    chi2_threshold,
     episode_rate,
     false_alarms_per_day_from_p_fa,
     fit_block_maxima_threshold,
@@ -22,6 +23,7 @@ from abrupt.thresholds.fits import (
     neyman_pearson_threshold,
     p_fa_per_sample,
     qq_points,
+    robust_gaussian_threshold,
     roc_curve,
 )
 
@@ -34,6 +36,7 @@ __all__ = [
     "FitMethod",
     "Threshold",
     "block_maxima",
+    "chi2_threshold",
     "episode_rate",
     "false_alarms_per_day_from_p_fa",
     "fit_block_maxima_threshold",
@@ -43,5 +46,6 @@ __all__ = [
     "neyman_pearson_threshold",
     "p_fa_per_sample",
     "qq_points",
+    "robust_gaussian_threshold",
     "roc_curve",
 ]

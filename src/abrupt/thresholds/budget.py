@@ -20,6 +20,8 @@ import re
 from dataclasses import dataclass
 from typing import ClassVar, Literal
 
+import numpy as np
+
 BudgetUnit = Literal["day", "week", "year"]
 
 SECONDS_PER_DAY = 86400.0
@@ -88,7 +90,9 @@ class FalseAlarmBudget:
         """Probability that a block of ``block_s`` seconds holds an alarm, for a Poisson rate."""
         if not block_s > 0:
             raise ValueError(f"block_s must be positive, got {block_s}")
-        return -math.expm1(-self.per_second * block_s)
+        # 1 - exp(-λT) written as the GEV fit always computed it (numpy's exp), so thresholds are
+        # bit-identical to those published before the budget existed.
+        return float(1.0 - np.exp(-self.per_day * block_s / SECONDS_PER_DAY))
 
     def per_test(self, tests_per_day: float) -> float:
         """Probability per test when independent tests come at ``tests_per_day``."""

@@ -12,6 +12,14 @@ with the false-alarm rate it was set for. Supported fits of the event-free ("nul
 ``gev``        generalised extreme-value fit of block maxima (:func:`fit_block_maxima_threshold`):
                sets the rate of alarm *episodes* per day, which is what an operator counts, and
                handles the strong correlation of sliding-window statistics.
+``chi2``       the analytic χ²(k) upper point of a statistic that is χ² in white noise
+               (:func:`chi2_threshold`; matched-filter GLRT, Kalman innovations).
+``robust_gaussian``  median + z·1.4826·MAD of a long series that is mostly event-free
+               (:func:`robust_gaussian_threshold`).
+
+Every fit takes the false-alarm budget either as a :class:`~abrupt.thresholds.FalseAlarmBudget`
+(``budget=``, the one conversion to per-sample and per-block levels) or, for older callers, as
+``false_alarms_per_day`` or a per-sample ``p_fa``.
 
 Probability per sample follows Bennett 2022 §2.5.1 step 4: one false alarm per day at 10 Hz is
 ``p_fa = 1 / 864000``. :func:`episode_rate` counts distinct exceedance episodes, which is what an
@@ -30,7 +38,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, special, stats
 
-from abrupt.thresholds.budget import SECONDS_PER_DAY
+from abrupt.thresholds.budget import SECONDS_PER_DAY, FalseAlarmBudget
 
 FitMethod = Literal["gaussian", "gamma", "kde", "empirical", "gpd", "gev"]
 FIT_METHODS: tuple[str, ...] = ("gaussian", "gamma", "kde", "empirical", "gpd", "gev")
@@ -127,13 +135,17 @@ def fit_threshold(
     false_alarms_per_day: float | None = None,
     sample_rate_hz: float | None = None,
     method: FitMethod = "kde",
+    budget: FalseAlarmBudget | None = None,
 ) -> Threshold:
     """Fit the event-free statistic and return the threshold exceeded with probability ``p_fa``.
 
-    Give either ``p_fa`` (per sample) or ``false_alarms_per_day`` with ``sample_rate_hz`` (the rate at
-    which the statistic is evaluated). The statistic is one-sided: large values are alarms.
+    Give either ``p_fa`` (per sample), or a ``budget`` (or ``false_alarms_per_day``) with
+    ``sample_rate_hz`` (the rate at which the statistic is evaluated). The statistic is one-sided:
+    large values are alarms.
     """
     x = _clean_null(null_statistic)
+    if budget is not None:
+        false_alarms_per_day = budget.per_day
     if p_fa is None:
         if false_alarms_per_day is None or sample_rate_hz is None:
             raise ValueError("give p_fa, or false_alarms_per_day with sample_rate_hz")
@@ -186,8 +198,9 @@ def fit_block_maxima_threshold(
     null_statistic: ArrayLike,
     *,
     sample_rate_hz: float,
-    false_alarms_per_day: float,
+    false_alarms_per_day: float | None = None,
     block_s: float = 600.0,
+    budget: FalseAlarmBudget | None = None,
 ) -> Threshold:
     """Threshold for a rate of alarm episodes per day, from a GEV fit to block maxima.
 
@@ -196,22 +209,99 @@ def fit_block_maxima_threshold(
     fitted to the maxima and the threshold is the level exceeded in a block with probability
     1 − exp(−rate · block length), i.e. a Poisson rate of ``false_alarms_per_day`` episodes.
     """
+    if budget is None:
+        if false_alarms_per_day is None:
+            raise ValueError("give a budget or false_alarms_per_day")
+        budget = FalseAlarmBudget(false_alarms_per_day, "day")
     block = max(2, round(block_s * sample_rate_hz))
     maxima = block_maxima(null_statistic, block)
     if maxima.size < 20:
         raise ValueError(
             f"need at least 20 blocks of {block_s:g} s of event-free data for a GEV fit, got {maxima.size}"
         )
-    p_block = 1.0 - np.exp(-false_alarms_per_day * block_s / SECONDS_PER_DAY)
     shape, loc, scale = stats.genextreme.fit(maxima)
-    value = float(stats.genextreme.isf(p_block, shape, loc=loc, scale=scale))
+    value = float(stats.genextreme.isf(budget.per_block(block_s), shape, loc=loc, scale=scale))
     return Threshold(
         value=value,
-        p_fa=p_fa_per_sample(false_alarms_per_day, sample_rate_hz),
+        p_fa=budget.per_sample(sample_rate_hz),
         method="gev",
         n_samples=int(maxima.size * block),
-        false_alarms_per_day=float(false_alarms_per_day),
+        false_alarms_per_day=float(budget.per_day),
         sample_rate_hz=float(sample_rate_hz),
+    )
+
+
+def _level(
+    p_fa: float | None,
+    false_alarms_per_day: float | None,
+    sample_rate_hz: float | None,
+    budget: FalseAlarmBudget | None,
+) -> float:
+    """Per-sample false-alarm probability from whichever form of the budget was given."""
+    if p_fa is not None:
+        return float(p_fa)
+    if sample_rate_hz is None or (budget is None and false_alarms_per_day is None):
+        raise ValueError("give p_fa, or a budget (or false_alarms_per_day) with sample_rate_hz")
+    if budget is None:
+        budget = FalseAlarmBudget(float(false_alarms_per_day), "day")  # type: ignore[arg-type]
+    return budget.per_sample(sample_rate_hz)
+
+
+def chi2_threshold(
+    dof: int = 3,
+    *,
+    p_fa: float | None = None,
+    false_alarms_per_day: float | None = None,
+    sample_rate_hz: float | None = None,
+    budget: FalseAlarmBudget | None = None,
+) -> Threshold:
+    """The χ²(``dof``) upper point exceeded with the per-sample probability of the budget.
+
+    For a statistic that is χ²-distributed without an event: the joint matched filter's GLRT
+    (3 dof, Kay 1998 §7.7), a Kalman filter's normalised innovation squared (m dof).
+    """
+    if dof < 1:
+        raise ValueError(f"a chi-square needs at least one degree of freedom, got {dof}")
+    level = _level(p_fa, false_alarms_per_day, sample_rate_hz, budget)
+    return Threshold(
+        value=float(stats.chi2.isf(level, dof)),
+        p_fa=level,
+        method="chi2",
+        n_samples=0,
+        false_alarms_per_day=float("nan")
+        if sample_rate_hz is None
+        else false_alarms_per_day_from_p_fa(level, sample_rate_hz),
+        sample_rate_hz=float("nan") if sample_rate_hz is None else float(sample_rate_hz),
+    )
+
+
+def robust_gaussian_threshold(
+    statistic: ArrayLike, *, p_fa: float, two_sided: bool = True, sample_rate_hz: float | None = None
+) -> Threshold:
+    """|median| + z·σ̂ with σ̂ = 1.4826·MAD of a mostly event-free series (Hampel 1974).
+
+    For a statistic measured on the data itself (no separate event-free data): events touch few
+    samples, so the median and MAD are those of the event-free statistic. ``z`` is the Gaussian upper
+    ``p_fa/2`` point (two-sided) or ``p_fa`` point. ``p_fa`` is per sample.
+    """
+    from abrupt.clean.noise import robust_scale
+
+    x = np.asarray(statistic, dtype=np.float64).ravel()
+    x = x[np.isfinite(x)]
+    if x.size < 10:
+        raise ValueError("need at least 10 finite values to set a threshold")
+    z = float(stats.norm.isf(p_fa / 2.0 if two_sided else p_fa))
+    med = float(np.median(x))
+    sd = float(robust_scale(x))
+    return Threshold(
+        value=abs(med) + z * sd,
+        p_fa=float(p_fa),
+        method="robust_gaussian",
+        n_samples=int(x.size),
+        false_alarms_per_day=float("nan")
+        if sample_rate_hz is None
+        else false_alarms_per_day_from_p_fa(p_fa, sample_rate_hz),
+        sample_rate_hz=float("nan") if sample_rate_hz is None else float(sample_rate_hz),
     )
 
 

@@ -1,0 +1,30 @@
+"""Cleaning: what is removed or down-weighted before detection (DESIGN.md, "cleaning" stage).
+
+:mod:`abrupt.clean.masks`   intervals of planned events (thruster firings, momentum dumps, slews)
+                            blanked from a telemetry's segments;
+:mod:`abrupt.clean.noise`   robust scale (1.4826·MAD) and the white-noise level of a sampled signal
+                            from its first differences; the white + random-walk noise model of
+                            total angular momentum (Allan variances).
+
+Filters of the flight-telemetry pipeline (comb, Savitzky-Golay) belong here as well.
+"""
+
+from abrupt.clean.masks import MaskInterval, apply_mask, read_mask
+from abrupt.clean.noise import (
+    MAD_TO_SIGMA,
+    MomentumNoiseModel,
+    momentum_noise_model,
+    robust_noise_sigma,
+    robust_scale,
+)
+
+__all__ = [
+    "MAD_TO_SIGMA",
+    "MaskInterval",
+    "MomentumNoiseModel",
+    "apply_mask",
+    "momentum_noise_model",
+    "read_mask",
+    "robust_noise_sigma",
+    "robust_scale",
+]

@@ -1,0 +1,114 @@
+"""TLE/OMM maneuver pipeline: read → split per satellite → choose the detector by regime → detect.
+
+No command-line code here (``abrupt.cli.tle`` parses options and writes outputs). A file may hold
+many satellites (a catalogue extract, an OMM batch): each is a separate history, detected with
+``tle.geo_station_keeping`` when geosynchronous and ``tle.mean_elements`` otherwise (or the detector
+named by the caller), with the same :class:`~abrupt.thresholds.FalseAlarmBudget`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from abrupt.detect.base import DetectionResult, get_detector
+from abrupt.detect.tle_detectors import TleMeanElements, detector_for, result_from_run
+from abrupt.errors import InputError
+from abrupt.events import empty_frame, new_run_id
+from abrupt.readers.omm import read_element_histories
+from abrupt.readers.tle import ElementHistory
+from abrupt.thresholds import FalseAlarmBudget
+
+
+@dataclass
+class SatelliteResult:
+    """One satellite of a TLE/OMM run: its history, the detector used and the result."""
+
+    history: ElementHistory
+    detector: str
+    result: DetectionResult
+
+    @property
+    def events(self) -> pd.DataFrame:
+        return self.result.events
+
+    @property
+    def noise_model(self) -> dict[str, Any]:
+        return dict(self.result.diagnostics[0].noise_model or {}) if self.result.diagnostics else {}
+
+
+@dataclass
+class TleRunResult:
+    """All satellites of one input file."""
+
+    path: str
+    run_id: str
+    satellites: list[SatelliteResult] = field(default_factory=list)
+
+    @property
+    def events(self) -> pd.DataFrame:
+        frames = [s.events for s in self.satellites if len(s.events)]
+        if not frames:
+            return empty_frame()
+        return pd.concat(frames, ignore_index=True).sort_values("time_utc", kind="stable").reset_index(drop=True)
+
+    @property
+    def skipped(self) -> list[InputError]:
+        return [e for s in self.satellites for e in s.history.skipped]
+
+
+def satellite_label(history: ElementHistory) -> str:
+    """``NAME (NORAD n)`` when the file names the satellite, else ``NORAD-n``."""
+    return f"{history.name} ({history.norad_id})" if history.name else f"NORAD-{history.norad_id}"
+
+
+def detect_tle_file(
+    path: str | Path,
+    budget: FalseAlarmBudget,
+    *,
+    detector: str = "auto",
+    norad_id: int | None = None,
+    strict: bool = False,
+    spacecraft: str | None = None,
+    all_candidates: bool = False,
+    run_id: str | None = None,
+    settings: dict[str, Any] | None = None,
+) -> TleRunResult:
+    """Detect maneuvers in every satellite of a TLE/3LE/OMM file (or only ``norad_id``).
+
+    ``detector``: ``auto`` (by regime), ``tle.mean_elements`` or ``tle.geo_station_keeping``.
+    ``spacecraft`` overrides the name written in the events (only with one satellite).
+    Malformed element sets are skipped and reported unless ``strict``.
+    """
+    run_id = run_id or new_run_id()
+    histories = read_element_histories(path, strict=strict)
+    if norad_id is not None:
+        histories = [h for h in histories if h.norad_id == norad_id]
+        if not histories:
+            raise InputError(f"no element sets of satellite {norad_id}", file=path, line=1)
+    if spacecraft is not None and len(histories) > 1:
+        raise InputError(
+            f"{len(histories)} satellites in the file: a single spacecraft name cannot be given to all; "
+            "select one with norad_id",
+            file=path,
+            line=1,
+        )
+    out = TleRunResult(str(path), run_id)
+    for history in histories:
+        name = spacecraft or history.name or f"NORAD-{history.norad_id}"
+        kwargs = dict(settings or {})
+        kwargs.update(all_candidates=all_candidates, spacecraft=name)
+        if detector == "auto":
+            det = detector_for(history, **kwargs)
+        else:
+            cls = get_detector(detector, "tle")
+            det = cls(**kwargs)
+        if isinstance(det, TleMeanElements):
+            result = result_from_run(det.name, det.run(history, budget, run_id=run_id))
+        else:  # a plug-in tle detector
+            result = det.detect(history, budget)
+        out.satellites.append(SatelliteResult(history, det.name, result))
+    return out

@@ -1,0 +1,272 @@
+"""Tracking pipeline: read → series → model (orbit fit) → detect → thresholds → events (no click here).
+
+:func:`read_tracking_series` reads the measurements (CCSDS TDM or ``.aer``) and the Orekit-style
+set-up file (a-priori orbit, stations, biases, force model) and builds the
+:class:`~abrupt.series.tracking.TrackingSeries`; :func:`detect_tracking` runs ``tracking.glrt``
+and/or ``tracking.kaderali_k`` for one false-alarm budget and returns a :class:`TrackingRun` with
+the events (one ``run_id`` and configuration hash), the fit summary and the diagnostics table that
+``abrupt report tracking`` draws.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+import pandas as pd
+
+from abrupt.detect.kaderali import KaderaliManeuverDetector
+from abrupt.detect.tracking_glrt import BatchFit, BatchFitConfig, GlrtManeuverDetector
+from abrupt.errors import RepairLog
+from abrupt.events import config_hash, empty_frame, new_run_id, restamp
+from abrupt.model.tracking_orbit import ForceModel
+from abrupt.series.tracking import TrackingSeries
+from abrupt.thresholds import FalseAlarmBudget
+
+Method = Literal["both", "kaderali", "glrt"]
+
+
+@dataclass(frozen=True)
+class TrackingSettings:
+    """What ``abrupt detect tracking`` can change; ``None`` means "as the set-up file says"."""
+
+    method: Method = "both"
+    psi_threshold: float = 30.0
+    eta_threshold_km: float = 1.0
+    elevation_mask_deg: float | None = None
+    estimate_biases: bool | None = None
+    estimate_acceleration: bool | None = None
+    refraction: bool | None = None
+    max_maneuvers: int = 3
+    kaderali_threshold: Literal["simulated", "chi2"] = "simulated"
+
+
+@dataclass
+class TrackingInputs:
+    """The series plus what the run record and fit summary need from reading."""
+
+    series: TrackingSeries
+    force: ForceModel
+    refraction: bool
+    biases: bool
+    acceleration: bool
+    repairs: RepairLog
+    epoch_jd_tt: float
+
+
+@dataclass
+class TrackingRun:
+    """Events of one tracking run, the fit summary and the Ψ, K and GLRT series."""
+
+    events: pd.DataFrame
+    fit_summary: dict[str, Any]
+    diagnostics: pd.DataFrame
+    config_hash: str
+    run_id: str
+    settings: dict[str, Any] = field(default_factory=dict)
+
+    def summary_lines(self) -> list[str]:
+        return fit_summary_lines(self.fit_summary)
+
+
+def read_tracking_series(
+    file: str | Path, setup_path: str | Path, settings: TrackingSettings, *, name: str | None = None
+) -> TrackingInputs:
+    """Measurements and set-up file → a :class:`TrackingSeries` with the fit model the set-up asks for.
+
+    The force model is two-body, with J2 when the set-up's central-body degree is at least 2 and Sun
+    and Moon when it names them; station biases are estimated when the set-up estimates any (or as
+    ``settings`` says); for real-data set-ups (central/third-body keys present) a constant unmodelled
+    acceleration and angle biases are estimated too.
+    """
+    from abrupt.model.timescales import offline_astropy
+    from abrupt.model.tracking_measurements import TrackingArrays, correct_refraction
+    from abrupt.readers.orekit_od_input import read_od_input
+    from abrupt.readers.tracking import read_tracking
+
+    offline_astropy()
+    setup = read_od_input(setup_path)
+    repairs = RepairLog(str(file))
+    meas = read_tracking(file, known_stations=setup.stations, repairs=repairs)  # CRD, TDM or .aer by content
+    use_refraction = setup.refraction_correction if settings.refraction is None else settings.refraction
+    if use_refraction:
+        meas = correct_refraction(meas)
+    data = TrackingArrays(
+        meas,
+        setup.stations,
+        epoch_utc=setup.epoch_utc,
+        earth_rotation=setup.earth_rotation,  # type: ignore[arg-type]
+        theta0_rad=setup.theta0_rad,
+        source=str(file),
+    )
+    real = any(k.startswith("central.body") or k.startswith("third.body") for k in setup.extra)
+    force, jd_tt = setup_force_model(setup)
+    biases = any(setup.range_bias_estimated.values()) if settings.estimate_biases is None else settings.estimate_biases
+    accel = real if settings.estimate_acceleration is None else settings.estimate_acceleration
+    probe = TrackingSeries(data, np.asarray(setup.initial_state, float), BatchFitConfig(force=force))
+    max_step = float(min(60.0, max(5.0, probe.orbit_period_s() / 1000.0)))
+    fit_cfg = BatchFitConfig(
+        force=force,
+        estimate_range_bias=biases,
+        estimate_angle_bias=biases and real,
+        estimate_acceleration=accel,
+        max_step_s=max_step,
+        elevation_mask_deg=settings.elevation_mask_deg,
+    )
+    series = TrackingSeries(data, np.asarray(setup.initial_state, float), fit_cfg, name=name or Path(file).stem)
+    return TrackingInputs(series, force, use_refraction, biases, accel, repairs, jd_tt)
+
+
+def setup_force_model(setup: Any) -> tuple[ForceModel, float]:
+    """The fit's force model from an Orekit set-up file, and the epoch as a TT Julian date.
+
+    Two-body with the set-up's μ; J2 when ``central.body.degree`` is at least 2; Sun and Moon when
+    ``third.body.sun`` or ``third.body.moon`` is true.
+    """
+    from astropy.time import Time
+
+    degree = int(float(setup.extra.get("central.body.degree", "0") or 0))
+    third = any(setup.extra.get(k, "false").lower() == "true" for k in ("third.body.sun", "third.body.moon"))
+    jd_tt = float(Time(setup.epoch_utc, scale="utc").tt.jd)
+    return ForceModel(mu_m3_s2=setup.mu_m3_s2, j2=degree >= 2, third_body=third, epoch_jd_tt=jd_tt), jd_tt
+
+
+def detect_tracking(
+    inputs: TrackingInputs,
+    settings: TrackingSettings,
+    budget: FalseAlarmBudget,
+    *,
+    file_name: str,
+    run_id: str | None = None,
+) -> TrackingRun:
+    """Fit the orbit, run the chosen detectors and collect events, fit summary and diagnostics."""
+    from abrupt.model.tracking_orbit import sun_position_m
+
+    series, force = inputs.series, inputs.force
+    run_settings = {
+        "file": file_name,
+        "method": settings.method,
+        "fa_per_day": budget.per_day,
+        "psi_th": settings.psi_threshold,
+        "eta_th": settings.eta_threshold_km,
+        "mask": settings.elevation_mask_deg,
+        "biases": inputs.biases,
+        "accel": inputs.acceleration,
+        "refraction": inputs.refraction,
+        "force": [force.mu_m3_s2, force.j2, force.third_body],
+        "max_maneuvers": settings.max_maneuvers,
+        "kaderali_threshold": settings.kaderali_threshold,
+    }
+    cfg_hash = config_hash(run_settings)
+    run_id = run_id or new_run_id()
+    final_fit: BatchFit = series.orbit_fit()
+    frames = []
+    diag_frames = []
+    data = series.data
+    if settings.method in ("both", "glrt"):
+        glrt = GlrtManeuverDetector(max_maneuvers=settings.max_maneuvers)
+        result = glrt.detect(series, budget)
+        _, final_fit, _ = series.maneuver_fit(glrt.glrt_config(budget))
+        frames.append(result.events)
+        for d in result.diagnostics:
+            first = result.events["threshold"].iloc[0] if len(result.events) else np.nan
+            diag_frames.append(
+                pd.DataFrame(
+                    {
+                        "series": "glrt",
+                        "time_utc": data.epoch_utc + (d.time_s * 1e9).astype("timedelta64[ns]"),
+                        "glrt_statistic": d.statistic,
+                        "threshold": first,
+                    }
+                )
+            )
+    if settings.method in ("both", "kaderali"):
+        kaderali = KaderaliManeuverDetector(
+            psi_threshold=settings.psi_threshold,
+            eta_threshold_km=settings.eta_threshold_km,
+            elevation_mask_deg=settings.elevation_mask_deg,
+            threshold_fit=settings.kaderali_threshold,
+            start="maneuver_fit" if settings.method == "both" else "orbit_fit",
+            max_maneuvers=settings.max_maneuvers,
+        )
+        result = kaderali.detect(series, budget)
+        frames.append(result.events)
+        d = result.diagnostics[0]
+        diag_frames.append(
+            pd.DataFrame(
+                {
+                    "series": "kaderali",
+                    "time_utc": data.epoch_utc + (d.time_s * 1e9).astype("timedelta64[ns]"),
+                    "psi": d.statistic,
+                    "k_db": d.extra["k_db"],
+                    "trace_p_km": d.extra["trace_p_km"],
+                    "inflated": d.extra["inflated"],
+                    "threshold": d.threshold.value if d.threshold is not None else np.nan,
+                }
+            )
+        )
+    found = [f for f in frames if len(f)]
+    events = (
+        restamp(pd.concat(found, ignore_index=True, sort=False), run_id=run_id, config_hash=cfg_hash)
+        if found
+        else empty_frame()
+    )
+    summary = fit_summary(final_fit, force, sun_position_m(inputs.epoch_jd_tt))
+    summary["repairs"] = inputs.repairs.as_dict()
+    diagnostics = pd.concat(diag_frames, ignore_index=True) if diag_frames else pd.DataFrame()
+    return TrackingRun(events, summary, diagnostics, cfg_hash, run_id, run_settings)
+
+
+def fit_summary(fit: BatchFit, force: ForceModel, sun_m: Any) -> dict[str, Any]:
+    """The orbit fit as a JSON-ready summary: convergence, biases, and the unmodelled acceleration."""
+    out: dict[str, Any] = {
+        "converged": bool(fit.converged),
+        "n_impulses": len(fit.impulse_times_s),
+        "iterations": int(fit.iterations),
+        "n_observations": int(fit.n_obs),
+        "weighted_rms": float(fit.rms_white),
+        "x0_m_mps": [float(v) for v in fit.x0],
+        "range_bias_m": {k: [float(v), fit.sigma(f"range_bias[{k}]")] for k, v in fit.range_bias_m.items()},
+        "angle_bias_deg": {k: [math.degrees(v[0]), math.degrees(v[1])] for k, v in fit.angle_bias_rad.items()},
+        "force_model": {"mu_m3_s2": force.mu_m3_s2, "j2": force.j2, "sun_moon": force.third_body},
+    }
+    if "accel_x" in fit.parameter_names:
+        a = np.asarray(fit.acceleration_mps2, float)
+        k = fit.parameter_names.index("accel_x")
+        cov = fit.covariance[k : k + 3, k : k + 3]
+        mag = float(np.linalg.norm(a))
+        u = a / mag if mag > 0 else a
+        anti_sun = -np.asarray(sun_m, float) / float(np.linalg.norm(sun_m))
+        out["unmodelled_acceleration"] = {
+            "vector_mps2": [float(v) for v in a],
+            "sigma_mps2": [float(math.sqrt(max(cov[i, i], 0.0))) for i in range(3)],
+            "magnitude_mps2": mag,
+            "magnitude_sigma_mps2": float(math.sqrt(max(float(u @ cov @ u), 0.0))),
+            "angle_to_anti_sun_deg": float(math.degrees(math.acos(max(-1.0, min(1.0, float(u @ anti_sun)))))),
+        }
+    return out
+
+
+def fit_summary_lines(summary: dict[str, Any]) -> list[str]:
+    """Human-readable lines of :func:`fit_summary` (what the command line prints)."""
+    lines = [
+        f"orbit fit: {'converged' if summary['converged'] else 'NOT converged'} "
+        f"in {summary['iterations']} iterations with {summary['n_impulses']} impulse(s), "
+        f"{summary['n_observations']} observations, weighted RMS {summary['weighted_rms']:.3f}"
+    ]
+    for st, (b, s) in summary["range_bias_m"].items():
+        lines.append(f"  range bias {st}: {b:.1f} ± {s:.1f} m")
+    acc = summary.get("unmodelled_acceleration")
+    if acc:
+        lines.append(
+            f"  unmodelled acceleration: {acc['magnitude_mps2']:.3e} "
+            f"± {acc['magnitude_sigma_mps2']:.1e} m/s² "
+            f"(N frame {', '.join(f'{v:.2e}' for v in acc['vector_mps2'])}), "
+            f"{acc['angle_to_anti_sun_deg']:.1f}° from the anti-Sun direction"
+        )
+    for kind, n in summary.get("repairs", {}).items():
+        lines.append(f"  repaired: {kind}: {n}")
+    return lines

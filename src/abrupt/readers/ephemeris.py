@@ -1,0 +1,100 @@
+"""One entry point for orbit files: the format is recognised from the content, not the file name.
+
+:func:`read_ephemeris` reads SP3-a/b/c/d, CCSDS OEM (KVN or XML), CCSDS OPM (KVN), ILRS CPF and
+navigation CSV, plain or compressed (gzip ``.gz``, Unix ``.Z``). :func:`write_ephemeris` writes an
+ephemeris in the format of a given input file (SP3, OEM KVN, OEM XML; navigation CSV for the others or
+when the output name ends in ``.csv``), so that ``abrupt inject orbit`` returns the input's own format.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Literal
+
+from abrupt.errors import InputError
+from abrupt.model.frames import Ephemeris
+from abrupt.readers.compression import read_bytes
+
+EphemerisFormat = Literal["sp3", "oem-kvn", "oem-xml", "opm", "cpf", "csv"]
+
+
+def sniff_format(path: str | Path) -> EphemerisFormat:
+    """The ephemeris format of a file, from its first bytes (after decompression)."""
+    head = read_bytes(path)[:4096].decode("latin-1")
+    text = head.lstrip("\ufeff\r\n\t ")
+    if len(text) > 1 and text[0] == "#" and text[1] in "abcd":
+        return "sp3"
+    if text.startswith("CCSDS_OEM_VERS"):
+        return "oem-kvn"
+    if text.startswith("CCSDS_OPM_VERS"):
+        return "opm"
+    if text.startswith("<"):
+        lowered = text.lower()
+        if "<oem" in lowered or ":oem" in lowered:
+            return "oem-xml"
+        raise InputError("XML file is not a CCSDS OEM (<oem> root expected)", file=path, line=1, column=1)
+    if text[:2].upper() == "H1" and text[2:].split()[:1] in (["CPF"], ["cpf"]):
+        return "cpf"
+    first_line = text.splitlines()[0] if text else ""
+    if "time_utc" in first_line or Path(path).suffix.lower() == ".csv":
+        return "csv"
+    raise InputError(
+        "unknown ephemeris format (expected SP3, CCSDS OEM/OPM, ILRS CPF or navigation CSV)", file=path, line=1
+    )
+
+
+def read_ephemeris(path: str | Path, satellite: str | None = None, *, allow_truncated: bool = False) -> Ephemeris:
+    """Read one satellite's ephemeris from any supported orbit file (UTC times, SI units)."""
+    fmt = sniff_format(path)
+    if fmt == "sp3":
+        from abrupt.readers.sp3 import read_sp3
+
+        return read_sp3(path, satellite, allow_truncated=allow_truncated)
+    if fmt in ("oem-kvn", "oem-xml"):
+        from abrupt.readers.oem import read_oem
+
+        return read_oem(path, satellite)
+    if fmt == "opm":
+        from abrupt.readers.oem import read_opm
+
+        return read_opm(path, satellite)
+    if fmt == "cpf":
+        from abrupt.readers.cpf import read_cpf
+
+        return read_cpf(path, satellite, allow_truncated=allow_truncated)
+    from abrupt.readers.navigation_csv import read_navigation_csv
+
+    return read_navigation_csv(path, satellite)
+
+
+def write_ephemeris(
+    ephemeris: Ephemeris, path: str | Path, *, like: str | Path | None = None, fmt: EphemerisFormat | None = None
+) -> EphemerisFormat:
+    """Write ``ephemeris`` in ``fmt``, or in the format of the file ``like`` (default: navigation CSV).
+
+    An output name ending in ``.csv`` always gives navigation CSV. SP3 keeps the ephemeris' time system
+    when SP3 knows it (GPS otherwise); OEM keeps it when OEM knows it (UTC otherwise). Formats without a
+    writer (OPM, CPF) are written as OEM KVN when the states have velocities, else as SP3. Returns the
+    format written.
+    """
+    if fmt is None:
+        fmt = "csv" if Path(path).suffix.lower() == ".csv" or like is None else sniff_format(like)
+    if fmt in ("opm", "cpf"):
+        import numpy as np
+
+        fmt = "oem-kvn" if np.all(np.isfinite(ephemeris.velocity_mps)) else "sp3"
+    if fmt == "sp3":
+        from abrupt.readers.sp3 import KNOWN_TIME_SYSTEMS, write_sp3
+
+        ts = ephemeris.time_system if ephemeris.time_system in KNOWN_TIME_SYSTEMS else "GPS"
+        write_sp3(ephemeris, path, time_system=ts)
+    elif fmt in ("oem-kvn", "oem-xml"):
+        from abrupt.readers.oem import TIME_SYSTEMS, write_oem
+
+        ts = ephemeris.time_system if ephemeris.time_system in TIME_SYSTEMS else "UTC"
+        write_oem(ephemeris, path, form="xml" if fmt == "oem-xml" else "kvn", time_system=ts)
+    else:
+        from abrupt.readers.navigation_csv import write_navigation_csv
+
+        write_navigation_csv(ephemeris, path)
+    return fmt

@@ -1,0 +1,142 @@
+"""Small example series per series type, for the detector conformance test.
+
+Every registered detector is run by ``tests/test_detector_conformance.py`` on the example of its
+``series_type``. A detector whose series type has no entry in :data:`EXAMPLES` makes that test fail,
+so a capability that registers detectors adds its example here (one function and one line):
+
+    def _ephemeris_example() -> SeriesExample: ...
+
+    EXAMPLES[Ephemeris] = SeriesExample(make=..., empty=..., shift=...)
+
+``make()`` returns a short series holding at least one event every detector of that type should
+find at the test budget (:data:`BUDGET`, 2/week); ``empty()`` the same type with no samples;
+``shift(series, seconds)`` the series with every time stamp moved by ``seconds``. Settings that keep
+a detector fast on the example (fewer simulated event-free samples, ...) go in :data:`FAST_SETTINGS`
+by detector name; they must not be needed for correctness. Examples are built once per session.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import cache
+from typing import Any
+
+import numpy as np
+
+from abrupt.errors import RepairLog
+from abrupt.thresholds import FalseAlarmBudget
+
+#: The budget every conformance check runs with (a non-day unit on purpose).
+BUDGET = FalseAlarmBudget(2.0, "week")
+
+
+@dataclass(frozen=True)
+class SeriesExample:
+    """How to build, empty and shift an example series of one type."""
+
+    make: Callable[[], Any]
+    empty: Callable[[], Any]
+    shift: Callable[[Any, float], Any]
+    notes: str = ""
+    settings: dict[str, dict[str, Any]] = field(default_factory=dict)
+
+
+# ---------------------------------------------------------------------------------------------- attitude
+
+
+@cache
+def attitude_example() -> Any:
+    """Ten minutes of 10 Hz telemetry of the thesis spacecraft with one 0.3 N·m·s strike at 300 s."""
+    from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
+    from abrupt.readers.telemetry import telemetry_from_frame
+    from abrupt.series.attitude import AttitudeSeries
+    from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude
+
+    sc = load_spacecraft(bundled_spacecraft_path("thesis"))
+    sim = simulate_attitude(sc, AttitudeSimConfig(duration_s=600.0, seed=11), [Strike(300.0, (0.2, -0.15, 0.17))])
+    return AttitudeSeries(telemetry_from_frame(sim.telemetry, sc), sc, name="example-sat")
+
+
+def empty_attitude() -> Any:
+    from abrupt.series.attitude import AttitudeSeries
+    from abrupt.series.telemetry import Telemetry
+
+    series = attitude_example()
+    n_wheels = series.telemetry.wheel_speed_rad_s.shape[1]
+    empty = Telemetry(
+        time=np.zeros(0, dtype="datetime64[ns]"),
+        t_s=np.zeros(0),
+        quaternion_BN=np.zeros((0, 4)),
+        body_rate_rad_s=np.zeros((0, 3)),
+        wheel_speed_rad_s=np.zeros((0, n_wheels)),
+        sample_interval_s=series.telemetry.sample_interval_s,
+        segments=[],
+        repairs=RepairLog("<empty>"),
+    )
+    return AttitudeSeries(empty, series.spacecraft, name="example-sat")
+
+
+def _attitude_settings() -> dict[str, dict[str, Any]]:
+    fast: dict[str, dict[str, Any]] = {
+        f"attitude.{m}": {"null_samples": 200_000} for m in ("glr", "cusum", "summation")
+    }
+    # Shiryaev costs 21 likelihoods per sample and window: a short simulated null and its maximum.
+    fast["attitude.shiryaev"] = {"null_samples": 10_000, "threshold_method": "empirical"}
+    return fast
+
+
+# ---------------------------------------------------------------------------------------------- tracking
+
+
+@cache
+def tracking_example() -> Any:
+    """Ten hours of 20 s range/angles/range-rate from Ascension of the thesis orbit with a 2 m/s apogee burn."""
+    from abrupt.detect.tracking_glrt import BatchFitConfig
+    from abrupt.model.stations import ascension
+    from abrupt.model.tracking_measurements import TrackingArrays
+    from abrupt.series.tracking import TrackingSeries
+    from abrupt.simulate.tracking import TrackingScenario, simulate_tracking, thesis_burn
+
+    scenario = TrackingScenario(stations=(ascension(1.0),), burns=(thesis_burn("apogee", "S", 2.0),), cadence_s=20.0)
+    sim = simulate_tracking(scenario, seed=4)
+    data = TrackingArrays(sim.measurements, {}, epoch_utc=sim.epoch_utc)
+    x0 = sim.initial_state + np.r_[30.0, 30.0, 30.0, 0.03, 0.03, 0.03]  # an a-priori 50 m and 5 cm/s off
+    return TrackingSeries(data, x0, BatchFitConfig(), name="example-track")
+
+
+def empty_tracking() -> Any:
+    from abrupt.model.tracking_measurements import TrackingArrays, empty_measurements
+    from abrupt.series.tracking import TrackingSeries
+
+    full = tracking_example()
+    data = TrackingArrays(empty_measurements(), {}, epoch_utc=full.data.epoch_utc)
+    return TrackingSeries(data, full.x0_apriori_m_mps, full.fit_config, name=full.name)
+
+
+def _examples() -> dict[type, SeriesExample]:
+    from abrupt.series.attitude import AttitudeSeries
+    from abrupt.series.tracking import TrackingSeries
+
+    return {
+        TrackingSeries: SeriesExample(
+            make=tracking_example,
+            empty=empty_tracking,
+            shift=lambda s, seconds: s.shifted(seconds),
+            notes="earth_rotation='simple', so a shift in time leaves the geometry unchanged",
+            settings={"tracking.glrt": {"max_maneuvers": 1}, "tracking.kaderali_k": {"n_null_runs": 4}},
+        ),
+        AttitudeSeries: SeriesExample(
+            make=attitude_example,
+            empty=empty_attitude,
+            shift=lambda s, seconds: s.shifted(seconds),
+            settings=_attitude_settings(),
+        ),
+    }
+
+
+#: Example per series type. Add yours here (see the module docstring).
+EXAMPLES: dict[type, SeriesExample] = _examples()
+
+#: Constructor settings per detector name that keep the conformance run fast.
+FAST_SETTINGS: dict[str, dict[str, Any]] = {k: v for ex in EXAMPLES.values() for k, v in ex.settings.items()}
