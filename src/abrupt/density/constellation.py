@@ -44,8 +44,11 @@ PLATFORM_COLUMNS = ("object", "shape_class", "min_area_m2", "max_area_m2", "mass
 NOMINAL_DRAG_COEFFICIENT = 2.2
 
 
-def read_platforms(path: str | Path, objects: list[str]) -> pd.DataFrame:
-    """Read and check a platforms file against the objects (module docstring); errors name file:line."""
+def read_platforms(path: str | Path, objects: list[str], aliases: dict[str, str] | None = None) -> pd.DataFrame:
+    """Read and check a platforms file against the objects (module docstring); errors name file:line.
+
+    ``aliases`` maps other spellings (e.g. catalog numbers) to the object names used in the windows.
+    """
     p = Path(path)
     try:
         frame = pd.read_csv(p, comment="#", dtype={"object": str}, skipinitialspace=True)
@@ -63,11 +66,13 @@ def read_platforms(path: str | Path, objects: list[str]) -> pd.DataFrame:
         if c not in frame.columns:
             raise InputError(f"platforms file lacks column {c!r}", file=p, line=1)
     known = set(objects)
+    lookup = {o: o for o in objects} | dict(aliases or {})
     for i, name in enumerate(frame["object"], start=2):
-        if name not in known:
+        if name not in lookup:
             raise InputError(
                 f"platform {name!r} is not among the objects given ({', '.join(sorted(known)[:5])}…)", file=p, line=i
             )
+    frame["object"] = frame["object"].map(lookup)
     dup = frame["object"][frame["object"].duplicated()]
     if len(dup):
         line = int(dup.index[0]) + 2
@@ -75,8 +80,8 @@ def read_platforms(path: str | Path, objects: list[str]) -> pd.DataFrame:
     absent = sorted(known - set(frame["object"]))
     if absent:
         raise InputError(f"no platform row for object(s) {absent[:5]} ({len(absent)} in all)", file=p)
-    for i, row in enumerate(frame.itertuples(index=False), start=2):
-        a0, a1, m = float(row.min_area_m2), float(row.max_area_m2), float(row.mass_kg)
+    for i, row in enumerate(frame.to_dict(orient="records"), start=2):
+        a0, a1, m = float(row["min_area_m2"]), float(row["max_area_m2"]), float(row["mass_kg"])
         if not (a0 > 0 and a1 >= a0 and m > 0):
             raise InputError("need 0 < min_area_m2 <= max_area_m2 and mass_kg > 0", file=p, line=i)
     return frame
@@ -114,7 +119,7 @@ def flow_from_windows(windows: pd.DataFrame, space_weather: Any) -> FlowConditio
     mids = windows["window_start_utc"].drop_duplicates().to_numpy(dtype="datetime64[ns]")
     mids = mids[:: max(1, mids.size // 30)]
     lats = np.zeros(mids.size)
-    _rho, temp, molar = msis_density(mids, lats, lats, np.full(mids.size, alt), space_weather, with_temperature=True)  # type: ignore[misc]
+    _rho, temp, molar = msis_density(mids, lats, lats, np.full(mids.size, alt), space_weather, with_temperature=True)
     speed = math.sqrt(3.986004418e14 / (6378137.0 + alt * 1e3)) * math.sqrt(float(np.nanmedian(windows["wind_factor"])))
     return FlowConditions(speed, float(np.median(temp)), float(np.median(molar)))
 
@@ -172,16 +177,19 @@ def estimate_constellation_density(
         alphas = np.linspace(*cfg.accommodation_range, cfg.n_accommodation)
         per_obj = np.stack(
             [
-                minimum_ballistic_coefficient(float(r.min_area_m2), float(r.mass_kg), flow, alphas)
-                for r in platforms.itertuples(index=False)
+                minimum_ballistic_coefficient(float(r["min_area_m2"]), float(r["mass_kg"]), flow, alphas)
+                for r in platforms.to_dict(orient="records")
             ]
         )
         b_min_alpha = per_obj.min(axis=0)  # population lower edge for each α
         b_min = float(np.mean(b_min_alpha))
         b_min_rel_sigma = float(np.std(b_min_alpha) / b_min)
         nominal = {
-            str(r.object): NOMINAL_DRAG_COEFFICIENT * 0.5 * (float(r.min_area_m2) + float(r.max_area_m2)) / float(r.mass_kg)
-            for r in platforms.itertuples(index=False)
+            str(r["object"]): NOMINAL_DRAG_COEFFICIENT
+            * 0.5
+            * (float(r["min_area_m2"]) + float(r["max_area_m2"]))
+            / float(r["mass_kg"])
+            for r in platforms.to_dict(orient="records")
         }
         w["naive_density_kg_m3"] = w["rho_b_per_m"] / w["object"].map(nominal)
     else:
@@ -195,6 +203,8 @@ def estimate_constellation_density(
         if n_k < 2:
             continue
         mean_k = float(np.mean(vals))
+        if not mean_k > 0:
+            continue  # no net decay measured at this epoch: no estimate
         s_mean = mean_k / (b_min * ybar)
         rel_stat = float(np.std(vals, ddof=1) / math.sqrt(n_k) / max(mean_k, 1e-300))
         rel_mean = math.sqrt(rel_stat**2 + b_min_rel_sigma**2 + ybar_rel_sigma**2)

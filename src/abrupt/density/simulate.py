@@ -12,7 +12,7 @@ drawn from U(0.85, 0.99) — so B is IID with a distribution the estimator does 
 
 Element sets: epochs with gamma-distributed spacing (mean ``mean_spacing_days``) and occasional
 gaps of 1-2.5 days; mean motion with heavy-tailed noise (Student t, 4 d.o.f.) equivalent to
-σ_a = 10-30 m per satellite and 1 % gross outliers (×8); exported as real TLE text with ``sgp4``.
+σ_a = 3-10 m per satellite (CryoSat-2's TLEs scatter by ~1-2 m) and 1 % gross outliers (×8); exported as real TLE text with ``sgp4``.
 """
 
 from __future__ import annotations
@@ -66,10 +66,10 @@ def storm_profile(t_days: FloatArray, start_day: float, length_days: float, ampl
 def simulate_constellation(
     n_objects: int = 30,
     *,
-    start_utc: str = "2018-03-01",
-    days: float = 40.0,
+    start_utc: str = "2014-10-01",
+    days: float = 30.0,
     seed: int = 0,
-    storm_start_day: float = 20.0,
+    storm_start_day: float = 15.0,
     storm_days: float = 2.0,
     storm_amplitude: float = 0.5,
     mean_spacing_days: float = 0.4,
@@ -88,7 +88,7 @@ def simulate_constellation(
     mu = MU_EARTH_WGS72_M3_S2
     t0 = np.datetime64(start_utc, "ns")
     n_t = int(days * 86400.0 / step_s) + 1
-    tau = np.arange(n_t) * step_s
+    tau = np.arange(n_t, dtype=np.float64) * step_s
     times = t0 + (tau * 1e9).astype("timedelta64[ns]")
     storm = storm_profile(tau / 86400.0, storm_start_day, storm_days, storm_amplitude)
     tle_texts: dict[str, str] = {}
@@ -126,7 +126,9 @@ def simulate_constellation(
             rho = np.asarray(msis_density(times, lat, lon, hkm, sw)) * storm
             f = wind_factor(pos, vel)
             if iteration == 0:
-                _rho_mid, temp, molar = msis_density(times[n_t // 2 : n_t // 2 + 1], lat[:1], lon[:1], hkm[:1], sw, with_temperature=True)  # type: ignore[misc]
+                _rho_mid, temp, molar = msis_density(
+                    times[n_t // 2 : n_t // 2 + 1], lat[:1], lon[:1], hkm[:1], sw, with_temperature=True
+                )
                 flow = FlowConditions(7600.0, float(temp[0]), float(molar[0]))
                 b = box_ballistic_coefficient(theta_t, dims, mass, flow, alpha)
             v = np.sqrt(mu / a)
@@ -142,7 +144,7 @@ def simulate_constellation(
         spacing[long_gap] = rng.uniform(1.0, 2.5, size=int(long_gap.sum()))
         ep = rng.uniform(0, 0.3) + np.cumsum(spacing)
         ep = ep[ep < days - 0.01] * 86400.0
-        sigma_a = rng.uniform(10.0, 30.0)
+        sigma_a = rng.uniform(3.0, 10.0)
         noise_a = sigma_a * rng.standard_t(4, size=ep.size) / math.sqrt(2.0)
         outlier = rng.uniform(size=ep.size) < 0.01
         noise_a[outlier] *= 8.0
@@ -187,9 +189,7 @@ def simulate_constellation(
                 "mass_kg": mass,
             }
         )
-    return SyntheticConstellation(
-        tle_texts, pd.DataFrame(rows), times, truth_rho, truth_b, weights, storm
-    )
+    return SyntheticConstellation(tle_texts, pd.DataFrame(rows), times, truth_rho, truth_b, weights, storm)
 
 
 __all__ = ["EARTH_ROTATION_RAD_S", "SyntheticConstellation", "simulate_constellation", "storm_profile"]

@@ -237,7 +237,9 @@ def maneuver_epochs(history: ElementHistory) -> list[pd.Timestamp]:
     events = detect_tle_maneuvers(history)
     if len(events) == 0:
         return []
-    return [pd.Timestamp(t).tz_localize(None) if pd.Timestamp(t).tzinfo else pd.Timestamp(t) for t in events["time_utc"]]
+    return [
+        pd.Timestamp(t).tz_localize(None) if pd.Timestamp(t).tzinfo else pd.Timestamp(t) for t in events["time_utc"]
+    ]
 
 
 def rho_b_from_history(
@@ -279,7 +281,7 @@ def rho_b_from_history(
             raise ValueError(f"maneuvers must be 'detect', 'none' or a list of times, got {maneuvers!r}")
     else:
         man_times = [pd.Timestamp(m) for m in maneuvers]
-    man64 = np.array([np.datetime64(m.to_datetime64(), "ns") for m in man_times], dtype="datetime64[ns]")
+    man64 = np.array([m.to_datetime64() for m in man_times], dtype="datetime64[ns]")
     segment_id = np.searchsorted(man64, epochs, side="right") if man64.size else np.zeros(len(epochs), dtype=np.int64)
     # Gaps longer than max_gap_days also cut.
     long_gap = np.concatenate([[False], np.diff(integ.t_s) > cfg.max_gap_days * SECONDS_PER_DAY])
@@ -321,9 +323,9 @@ def rho_b_from_history(
     repairs.record("element sets with bad fits rejected", int(np.sum(~keep)))
     # Windows on a common UTC grid.
     origin = (
-        np.datetime64(pd.Timestamp(cfg.origin_utc).to_datetime64(), "ns")
+        np.asarray([pd.Timestamp(cfg.origin_utc).to_datetime64()], dtype="datetime64[ns]")[0]
         if cfg.origin_utc
-        else epochs[0].astype("datetime64[D]").astype("datetime64[ns]")
+        else np.asarray(epochs[:1]).astype("datetime64[D]").astype("datetime64[ns]")[0]
     )
     width = np.timedelta64(round(cfg.interval_days * SECONDS_PER_DAY * 1e9), "ns")
     n_windows = int(np.ceil((epochs[-1] - origin) / width)) + 1
@@ -394,7 +396,9 @@ def rho_b_from_history(
         rows.append(
             (label, history.norad_id, b0, b1, span0, span1, int(idx.size), k_val, k_sig, alt, wfac, model, status)
         )
-    repairs.record("windows holding a maneuver, orbit rise or gap (fitted with one offset per segment)", counts["straddle"])
+    repairs.record(
+        "windows holding a maneuver, orbit rise or gap (fitted with one offset per segment)", counts["straddle"]
+    )
     repairs.record("windows with too few element sets or too short a span", counts["few"])
     repairs.record("windows with negative decay rejected", counts["negative"])
     frame = pd.DataFrame(rows, columns=list(WINDOW_COLUMNS)) if rows else _empty_windows()

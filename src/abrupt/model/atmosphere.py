@@ -25,6 +25,7 @@ import logging
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -106,8 +107,9 @@ class SpaceWeather:
         if not np.all(ok):
             bad = t[~ok]
             if fallback is None:
+                first_usable = self.days[0] + np.timedelta64(HISTORY_DAYS_NEEDED, "D")
                 raise SpaceWeatherCoverageError(
-                    f"{self.source}: space-weather table covers {self.days[0] + np.timedelta64(HISTORY_DAYS_NEEDED, 'D')}"
+                    f"{self.source}: space-weather table covers {first_usable}"
                     f" .. {self.days[-1]} (NRLMSIS needs the 3 days before a date); {bad.size} time(s) outside, "
                     f"first {str(bad.min())[:19]}, last {str(bad.max())[:19]}. Give a table that covers them "
                     "(--space-weather FILE) or ask for the constant fallback explicitly."
@@ -152,7 +154,7 @@ _CELESTRAK_F107A_OBS = (118, 124)
 def _read_celestrak(lines: list[str], source: str, include_predicted: bool) -> SpaceWeather:
     repairs = RepairLog(source=source)
     sections = {"OBSERVED"} | ({"DAILY_PREDICTED"} if include_predicted else set())
-    rows: list[tuple[np.datetime64, float, float, float, list[float]]] = []
+    rows: list[Any] = []
     section: str | None = None
     for number, raw in enumerate(lines, start=1):
         line = raw.rstrip("\r\n")
@@ -194,8 +196,8 @@ def _read_csv(path: Path) -> SpaceWeather:
     slots = [f"ap_{h:02d}" for h in range(0, 24, 3)]
     rows = []
     repairs = RepairLog(source=source)
-    for k, rec in enumerate(frame.itertuples(index=False), start=2):
-        r = rec._asdict()
+    for k, rec in enumerate(frame.to_dict(orient="records"), start=2):
+        r: dict[str, Any] = {str(key): val for key, val in rec.items()}
         try:
             day = np.datetime64(str(r["date"])[:10], "D")
             f107, f107a, ap = float(r["f107_obs_sfu"]), float(r["f107a_obs_sfu"]), float(r["ap"])
@@ -210,9 +212,7 @@ def _read_csv(path: Path) -> SpaceWeather:
     return _assemble(rows, source, repairs)
 
 
-def _assemble(
-    rows: list[tuple[np.datetime64, float, float, float, list[float]]], source: str, repairs: RepairLog
-) -> SpaceWeather:
+def _assemble(rows: list[Any], source: str, repairs: RepairLog) -> SpaceWeather:
     rows.sort(key=lambda r: r[0])
     days = np.array([r[0] for r in rows], dtype="datetime64[D]")
     if np.any(np.diff(days) == np.timedelta64(0, "D")):
