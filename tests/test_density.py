@@ -287,3 +287,35 @@ def test_radar_csv_bad_value_names_line(tmp_path: Path) -> None:
     p.write_text("meteor_id,altitude_km,velocity_mps,deceleration_mps2\n1,100,40000,300\n1,95,-3,400\n")
     with pytest.raises(InputError, match=r"radar.csv:3: velocity_mps must be a positive number"):
         read_radar_csv(p)
+
+
+# ----------------------------------------------------------------------------- command line
+
+
+def test_cli_density_tle_and_meteors(tmp_path: Path) -> None:
+    from click.testing import CliRunner
+
+    import abrupt.cli.main  # noqa: F401  (registers every command group)
+    from abrupt.cli.groups import cli
+    from abrupt.density.meteors import simulate_head_echoes
+
+    path = _synthetic_tle(tmp_path, 2e-14, days=6.0)
+    out = tmp_path / "w.csv"
+    runner = CliRunner()
+    res = runner.invoke(cli, ["density", "tle", str(path), "--out", str(out), "--interval-days", "2", "--no-model",
+                              "--maneuvers", "none"])
+    assert res.exit_code == 0, res.output
+    frame = pd.read_csv(out)
+    assert {"rho_b_per_m", "rho_b_sigma_per_m", "model_density_kg_m3"} <= set(frame.columns)
+    pop = simulate_head_echoes(80, seed=1, deceleration_noise=0.0, velocity_noise=0.0, velocity_floor_mps=0.0)
+    radar = tmp_path / "radar.csv"
+    pop.echoes.to_csv(radar, index=False)
+    res = runner.invoke(cli, ["density", "meteors", str(radar), "--out", str(tmp_path / "r.parquet")])
+    assert res.exit_code == 0, res.output
+    ratios = pd.read_parquet(tmp_path / "r.parquet")
+    truth = pop.truth_density_kg_m3[1:] / pop.truth_density_kg_m3[:-1]
+    got = ratios.set_index("upper_altitude_km")["density_ratio"]
+    # Noise-free simulated echoes: ratios within the simulator's integration error.
+    for h, t in zip(pop.levels_km[:-1], truth, strict=True):
+        if h in got.index and ratios.set_index("upper_altitude_km").loc[h, "n_meteoroids"] >= 10:
+            assert got[h] == pytest.approx(t, rel=0.03)

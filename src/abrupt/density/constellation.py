@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from abrupt.density.drag_coefficient import FlowConditions, minimum_ballistic_coefficient
+from abrupt.density.drag_coefficient import FlowConditions, box_ballistic_coefficient, minimum_ballistic_coefficient
 from abrupt.density.order_statistics import BallisticDistribution, fit_ballistic_distribution, ratios_to_minimum
 from abrupt.errors import InputError
 from abrupt.types import FloatArray
@@ -85,6 +85,23 @@ def read_platforms(path: str | Path, objects: list[str], aliases: dict[str, str]
         if not (a0 > 0 and a1 >= a0 and m > 0):
             raise InputError("need 0 < min_area_m2 <= max_area_m2 and mass_kg > 0", file=p, line=i)
     return frame
+
+
+def platform_minimum_b(row: dict[str, Any], flow: FlowConditions, alphas: FloatArray) -> FloatArray:
+    """B_min of one platform for each accommodation α (slides "Ballistic Factors", "Uncertainty in α").
+
+    With an area range (A_min < A_max) the platform is taken as a box turning about an axis normal to
+    the flow, faces A_min and √(A_max² − A_min²); B_min is the minimum of B(θ) over θ (the flat-plate
+    C_D makes the minimum a few degrees off end-on for squat boxes). Otherwise C_D(0)·A_min/m.
+    """
+    a_min, a_max, mass = float(row["min_area_m2"]), float(row["max_area_m2"]), float(row["mass_kg"])
+    if a_max <= a_min:
+        return minimum_ballistic_coefficient(a_min, mass, flow, alphas)
+    a_side = math.sqrt(a_max**2 - a_min**2)
+    theta = np.radians(np.linspace(0.0, 90.0, 181))
+    return np.array(
+        [float(np.min(box_ballistic_coefficient(theta, (1.0, a_min, a_side), mass, flow, float(al)))) for al in alphas]
+    )
 
 
 @dataclass(frozen=True)
@@ -175,12 +192,7 @@ def estimate_constellation_density(
 
             flow = flow_from_windows(w, space_weather if space_weather is not None else read_space_weather())
         alphas = np.linspace(*cfg.accommodation_range, cfg.n_accommodation)
-        per_obj = np.stack(
-            [
-                minimum_ballistic_coefficient(float(r["min_area_m2"]), float(r["mass_kg"]), flow, alphas)
-                for r in platforms.to_dict(orient="records")
-            ]
-        )
+        per_obj = np.stack([platform_minimum_b(r, flow, alphas) for r in platforms.to_dict(orient="records")])
         b_min_alpha = per_obj.min(axis=0)  # population lower edge for each α
         b_min = float(np.mean(b_min_alpha))
         b_min_rel_sigma = float(np.std(b_min_alpha) / b_min)

@@ -68,6 +68,7 @@ def simulate_head_echoes(
     seed: int = 0,
     levels_km: FloatArray | None = None,
     velocity_noise: float = 1e-3,
+    velocity_floor_mps: float = 30.0,
     deceleration_noise: float = 0.15,
     min_deceleration_mps2: float = 100.0,
     profile: tuple[FloatArray, FloatArray] | None = None,
@@ -96,24 +97,32 @@ def simulate_head_echoes(
     d_true = c_h / (c_d * h_star)
     k_true = 1.0 / (r * rho_m)
     h = np.full(n_draw, 130.0e3)
+    r0 = r.copy()
+    v0 = v.copy()
     records: dict[int, list[tuple[float, float, float]]] = {i: [] for i in range(n_draw)}
     next_level = np.zeros(n_draw, dtype=np.int64)
     alive = np.ones(n_draw, dtype=bool)
-    dt = 2e-4
+    dt = 5e-4
     while np.any(alive) and np.min(h[alive]) > levels[-1] * 1e3 - 1e3:
+        # Midpoint (RK2) step of h and v; r follows exactly from the drag/ablation ratio,
+        # r = r_0 exp(D (v² − v_0²)/6) (slide "Density Ratios"), so the radius has no step error.
         rho_a = density(h / 1e3)
-        dv = -(3.0 * rho_a * c_d) / (8.0 * rho_m * r) * v**2
-        dr = -(c_h * rho_a) / (8.0 * h_star * rho_m) * v**3
-        h_new = h - v * np.cos(chi) * dt
-        v_new = v + dv * dt
-        r_new = r + dr * dt
+        dv = -(3.0 * rho_a * c_d) / (8.0 * rho_m * np.maximum(r, 1e-12)) * v**2
+        h_half = h - v * np.cos(chi) * 0.5 * dt
+        v_half = v + dv * 0.5 * dt
+        r_half = r0 * np.exp(np.clip(d_true * (v_half**2 - v0**2) / 6.0, -700.0, 0.0))
+        dv_half = -(3.0 * density(h_half / 1e3) * c_d) / (8.0 * rho_m * np.maximum(r_half, 1e-12)) * v_half**2
+        h_new = h - v_half * np.cos(chi) * dt
+        v_new = v + dv_half * dt
+        r_new = r0 * np.exp(np.clip(d_true * (v_new**2 - v0**2) / 6.0, -700.0, 0.0))
         # Record crossings of the next level (linear interpolation within the step).
         lvl = levels[np.minimum(next_level, levels.size - 1)] * 1e3
         cross = alive & (next_level < levels.size) & (h_new <= lvl)
         for i in (int(x) for x in np.flatnonzero(cross)):
             f = (h[i] - lvl[i]) / (h[i] - h_new[i])
             vi = v[i] + f * (v_new[i] - v[i])
-            ai = -(3.0 * density(np.array([lvl[i] / 1e3]))[0] * c_d) / (8.0 * rho_m[i] * r[i]) * vi**2
+            ri = r0[i] * math.exp(d_true[i] * (vi**2 - v0[i] ** 2) / 6.0)
+            ai = -(3.0 * density(np.array([lvl[i] / 1e3]))[0] * c_d) / (8.0 * rho_m[i] * ri) * vi**2
             records[i].append((lvl[i] / 1e3, vi, -ai))
             next_level[i] += 1
         h, v, r = h_new, np.maximum(v_new, 1.0), r_new
@@ -127,7 +136,7 @@ def simulate_head_echoes(
         if len(recs) < 2:
             continue
         for alt, vel, dec in recs:
-            sv = max(velocity_noise * vel, 30.0)
+            sv = max(velocity_noise * vel, velocity_floor_mps)
             rows.append(
                 (
                     kept,
@@ -206,7 +215,11 @@ def estimate_density_ratios(echoes: pd.DataFrame, levels_km: FloatArray | None =
     n_unknown = len(ids) + n_pairs
     mat = sparse.csr_matrix((vals, (rows, cols)), shape=(eq, n_unknown))
     lower = np.concatenate([np.zeros(len(ids)), np.full(n_pairs, -np.inf)])
-    sol = lsq_linear(mat, np.asarray(rhs), bounds=(lower, np.full(n_unknown, np.inf)), lsmr_tol="auto", max_iter=5000)
+    bounds = (lower, np.full(n_unknown, np.inf))
+    if eq * n_unknown <= 2e7:  # dense bounded-variable least squares: exact active set
+        sol = lsq_linear(mat.toarray(), np.asarray(rhs), bounds=bounds, method="bvls")
+    else:
+        sol = lsq_linear(mat, np.asarray(rhs), bounds=bounds, lsmr_tol="auto", max_iter=5000)
     resid = mat @ sol.x - np.asarray(rhs)
     s2 = float(np.sum(resid**2) / max(eq - n_unknown, 1))
     x = sol.x[len(ids) :]

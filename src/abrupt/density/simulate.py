@@ -73,7 +73,7 @@ def simulate_constellation(
     storm_days: float = 2.0,
     storm_amplitude: float = 0.5,
     mean_spacing_days: float = 0.4,
-    attitude_hold_days: float = 3.0,
+    attitude_hold_days: float = 10.0,
     step_s: float = 300.0,
     space_weather: Any = None,
 ) -> SyntheticConstellation:
@@ -151,7 +151,7 @@ def simulate_constellation(
         a_ep = np.interp(ep, tau, a) + noise_a
         u_ep = np.interp(ep, tau, np.unwrap(u0 + np.concatenate([[0.0], np.cumsum(n[:-1] * step_s)])))
         raan_ep = np.interp(ep, tau, raan0 - 1.5 * n * J2_WGS72 * (EARTH_RADIUS_WGS72_M / a) ** 2 * math.cos(inc) * tau)
-        lines = []
+        lines = [name]
         jd_epoch0 = (t0.astype("datetime64[ns]").astype(np.int64) * 1e-9) / 86400.0 + 2440587.5
         for k in range(ep.size):
             sat = Satrec()
