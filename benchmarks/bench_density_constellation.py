@@ -69,7 +69,7 @@ def main() -> None:
     print(
         f"constellation: {args.objects} CubeSats (3U/6U), {args.days:.0f} days, storm +50 % for 2 days, seed {args.seed}"
     )
-    print(f"object-windows: {len(w)}  (1-day windows; B distribution fitted on 3-day windows)")
+    print(f"object-windows: {len(w)}  (1-day windows; B distribution fitted on 10-day windows)")
     print(
         f"B_min from physics: {c.b_min_m2_kg:.5f} ± {c.b_min_sigma_m2_kg:.5f} m²/kg; fitted mean B/B_min "
         f"{c.distribution.mean_ratio:.3f}"

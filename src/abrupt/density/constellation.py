@@ -214,11 +214,16 @@ def estimate_constellation_density(
         n_k = int(vals.size)
         if n_k < 2:
             continue
-        mean_k = float(np.mean(vals))
+        # Inverse-variance weights: σ_K does not depend on B_j, so the weighted mean of K̃ still
+        # estimates s·B̄, with far less noise when the platforms' decay is measured unequally well.
+        sig = g["k_norm_sigma"].to_numpy()
+        wts = 1.0 / np.maximum(sig, 1e-3 * np.median(sig)) ** 2
+        wts = wts / wts.sum()
+        mean_k = float(np.sum(wts * vals))
         if not mean_k > 0:
             continue  # no net decay measured at this epoch: no estimate
         s_mean = mean_k / (b_min * ybar)
-        rel_stat = float(np.std(vals, ddof=1) / math.sqrt(n_k) / max(mean_k, 1e-300))
+        rel_stat = float(np.std(vals, ddof=1) * math.sqrt(np.sum(wts**2)) / mean_k)
         rel_mean = math.sqrt(rel_stat**2 + b_min_rel_sigma**2 + ybar_rel_sigma**2)
         y_min = dist.expected_minimum_ratio(n_k)
         s_min = float(np.min(vals)) / (b_min * y_min)

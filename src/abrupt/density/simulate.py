@@ -73,7 +73,7 @@ def simulate_constellation(
     storm_days: float = 2.0,
     storm_amplitude: float = 0.5,
     mean_spacing_days: float = 0.4,
-    attitude_hold_days: float = 10.0,
+    attitude_hold_days: float = 60.0,
     step_s: float = 300.0,
     space_weather: Any = None,
 ) -> SyntheticConstellation:

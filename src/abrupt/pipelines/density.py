@@ -62,7 +62,7 @@ def tle_density(
     constellation: ConstellationConfig | None = None,
     maneuvers: str = "detect",
     space_weather: str | Path | None = None,
-    distribution_interval_factor: int = 3,
+    distribution_interval_factor: int = 10,
     workers: int = 1,
 ) -> TleDensityResult:
     """ρB windows of every file and, for two or more objects, the constellation density.
