@@ -114,11 +114,37 @@ def empty_tracking() -> Any:
     return TrackingSeries(data, full.x0_apriori_m_mps, full.fit_config, name=full.name)
 
 
+# ---------------------------------------------------------------------------------------------- TLE
+
+
+@cache
+def tle_example() -> Any:
+    """200 days of daily LEO element sets (sgp4's exporter, 0.5 m noise in a) with a 2 cm/s in-track burn."""
+    import tempfile
+    from pathlib import Path
+
+    from abrupt.readers.tle import read_tle
+    from test_tle_synthetic import synthetic_tle_text
+
+    text, _ = synthetic_tle_text(days=200, burns=((100.3, 0.02),), seed=2)
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "example.tle"
+        path.write_text(text)
+        return read_tle(path)
+
+
 def _examples() -> dict[type, SeriesExample]:
+    from abrupt.readers.tle import ElementHistory
     from abrupt.series.attitude import AttitudeSeries
     from abrupt.series.tracking import TrackingSeries
 
     return {
+        ElementHistory: SeriesExample(
+            make=tle_example,
+            empty=ElementHistory.empty,
+            shift=lambda s, seconds: s.shifted(seconds),
+            notes="tle.geo_station_keeping runs on the LEO example too: its regime is forced",
+        ),
         TrackingSeries: SeriesExample(
             make=tracking_example,
             empty=empty_tracking,

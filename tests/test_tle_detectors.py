@@ -85,3 +85,29 @@ def test_pipeline_runs_every_satellite_of_a_catalogue_file(shared_data: Path, tm
     geo = ev[ev["spacecraft"] == "FENGYUN-2D"]
     assert len(geo) and set(geo["maneuver_type"]) <= {"east-west", "north-south"}
     assert np.allclose(ev["false_alarms_per_day"], 1 / 365.25)
+
+
+def test_cli_budget_option_and_its_alias_agree(tmp_path: Path) -> None:
+    from click.testing import CliRunner
+
+    from abrupt.cli.main import cli
+    from abrupt.events import read_events
+
+    text, _ = synthetic_tle_text(days=120, seed=9, burns=((60.2, 0.02),))
+    p = tmp_path / "s.tle"
+    p.write_text(text)
+    runner = CliRunner()
+    thresholds = []
+    for opt in (["--false-alarms", "3/year"], ["--false-alarms-per-year", "3"]):
+        out = tmp_path / f"{opt[0]}.csv"
+        r = runner.invoke(cli, ["detect", "tle", str(p), *opt, "--out", str(out), "--catalog", str(tmp_path / "c.db")])
+        assert r.exit_code == 0, r.output
+        ev = read_events(str(out))
+        assert np.allclose(ev["false_alarms_per_day"], 3 / 365.25)
+        thresholds.append(float(ev["threshold"].iloc[0]))
+    assert thresholds[0] == pytest.approx(thresholds[1])
+    both = ["--false-alarms", "1/year", "--false-alarms-per-year", "1"]
+    r = runner.invoke(cli, ["detect", "tle", str(p), *both, "--catalog", str(tmp_path / "c.db")])
+    assert r.exit_code != 0 and "not both" in r.output
+    r = runner.invoke(cli, ["detect", "tle", str(p), "--false-alarms", "often", "--catalog", str(tmp_path / "c.db")])
+    assert r.exit_code != 0 and "false-alarm budget" in r.output

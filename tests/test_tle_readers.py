@@ -175,7 +175,7 @@ def test_omm_missing_keyword_and_wrong_time_system_are_errors(
     del rec["MEAN_MOTION"]
     p = tmp_path / "bad.json"
     p.write_text(json.dumps([omm_records[1], rec]))
-    with pytest.raises(InputError, match=r"bad\.json: record 2: OMM record lacks MEAN_MOTION"):
+    with pytest.raises(InputError, match=r"bad\.json:1: record 2: OMM record lacks MEAN_MOTION"):
         read_omm(p, strict=True)
     rec = dict(omm_records[0], TIME_SYSTEM="TAI")
     p.write_text(json.dumps([rec]))

@@ -4,8 +4,8 @@ A new capability adds its detector module here (one line); a detector defined an
 plug-in, a test) registers as soon as its class is defined.
 """
 
-import abrupt.detect.attitude  # noqa: F401  attitude.glr, cusum, summation, shiryaev
-import abrupt.detect.kaderali  # noqa: F401  tracking.kaderali_k
-import abrupt.detect.matched_filter.detectors  # noqa: F401  attitude.mf_attitude, mf_rate, mf_joint
-import abrupt.detect.tle_detectors  # noqa: F401  tle.mean_elements, tle.geo_station_keeping
+import abrupt.detect.attitude  # attitude.glr, cusum, summation, shiryaev
+import abrupt.detect.kaderali  # tracking.kaderali_k
+import abrupt.detect.matched_filter.detectors  # attitude.mf_attitude, mf_rate, mf_joint
+import abrupt.detect.tle_detectors  # tle.mean_elements, tle.geo_station_keeping
 import abrupt.detect.tracking_glrt  # noqa: F401  tracking.glrt

@@ -518,8 +518,8 @@ def segment(
         for a in accepted:
             near[max(0, a - reach) : a + reach + 1] = True
         cps = sorted(accepted)
-        for k in np.flatnonzero(near & ~blocked):
-            _fill(cur, model, int(k), cps)
+        for kk in np.flatnonzero(near & ~blocked):
+            _fill(cur, model, int(kk), cps)
         while True:
             stat = np.where(blocked | ~near, -np.inf, cur.statistic)
             g = int(np.argmax(stat))
@@ -810,7 +810,8 @@ def run_tle_detector(
     name = spacecraft or history.name or (f"NORAD-{history.norad_id}" if len(history) else "unknown")
     fa_per_day = cfg.false_alarms_per_year / DAYS_PER_YEAR
     el = history.elements
-    epoch0 = el["epoch_utc"].iloc[0] if len(el) else pd.Timestamp("1970-01-01")
+    epoch0 = pd.Timestamp(el["epoch_utc"].iloc[0]) if len(el) else pd.Timestamp("1970-01-01")
+    epoch0_np = np.datetime64(int(epoch0.value), "ns")
     regime = (orbit_regime(history) if cfg.regime == "auto" else cfg.regime) if len(el) else "leo"
     if len(history) < 2 * cfg.window_sets + 1:
         msg = f"{len(history)} element sets: at least {2 * cfg.window_sets + 1} are needed; nothing tested"
@@ -820,7 +821,7 @@ def run_tle_detector(
             np.zeros(0),
             np.zeros(0),
             Threshold(math.inf, float("nan"), "none", 0, fa_per_day),
-            np.datetime64(epoch0.to_datetime64(), "ns"),
+            epoch0_np,
             {"regime": regime},
             (msg,),
         )
@@ -909,7 +910,7 @@ def run_tle_detector(
                 spacecraft=name,
                 kind="maneuver",
                 detector=detector_name,
-                time_utc=epoch0 + pd.Timedelta(seconds=float(t_m)),
+                time_utc=(epoch0 + pd.Timedelta(seconds=float(t_m))).isoformat(),
                 statistic=float(stat[g]),
                 threshold=threshold,
                 false_alarms_per_day=fa_per_day,
@@ -930,7 +931,7 @@ def run_tle_detector(
         0.5 * (steps.t_before_s + steps.t_after_s),
         stat,
         Threshold(threshold, p_fa, method, n_gaps, fa_per_day),
-        np.datetime64(epoch0.to_datetime64(), "ns"),
+        epoch0_np,
         noise_summary(steps, model, threshold, a_med, gaps_per_year),
     )
 

@@ -32,9 +32,9 @@ def plate_motion(
     position_m: ArrayLike, velocity_m_per_yr: ArrayLike, reference_epoch: np.datetime64, epoch: ArrayLike
 ) -> FloatArray:
     """Station positions (n, 3) at ``epoch`` from a SINEX position and velocity at ``reference_epoch``."""
-    dt_yr = (np.asarray(epoch, dtype="datetime64[ns]") - np.asarray(reference_epoch, dtype="datetime64[ns]")).astype(np.float64) / (
-        1e9 * SECONDS_PER_YEAR
-    )
+    dt_yr = (np.asarray(epoch, dtype="datetime64[ns]") - np.asarray(reference_epoch, dtype="datetime64[ns]")).astype(
+        np.float64
+    ) / (1e9 * SECONDS_PER_YEAR)
     x0 = np.asarray(position_m, dtype=float)
     v = np.asarray(velocity_m_per_yr, dtype=float)
     return np.asarray(x0 + np.multiply.outer(np.atleast_1d(dt_yr), v))

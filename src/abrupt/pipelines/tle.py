@@ -14,7 +14,7 @@ from typing import Any
 
 import pandas as pd
 
-from abrupt.detect.base import DetectionResult, get_detector
+from abrupt.detect.base import DetectionResult, Detector, get_detector
 from abrupt.detect.tle_detectors import TleMeanElements, detector_for, result_from_run
 from abrupt.errors import InputError
 from abrupt.events import empty_frame, new_run_id
@@ -101,6 +101,7 @@ def detect_tle_file(
         name = spacecraft or history.name or f"NORAD-{history.norad_id}"
         kwargs = dict(settings or {})
         kwargs.update(all_candidates=all_candidates, spacecraft=name)
+        det: Detector[Any]
         if detector == "auto":
             det = detector_for(history, **kwargs)
         else:

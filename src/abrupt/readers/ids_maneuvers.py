@@ -24,10 +24,12 @@ Epochs are converted from TAI to UTC with astropy's leap-second table
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from erfa import ErfaWarning
 
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.timescales import to_utc
@@ -65,7 +67,7 @@ def _doy_time(tokens: list[str], file: str, line_no: int, what: str) -> np.datet
         raise InputError(
             f"{what}: cannot read {' '.join(tokens)!r} as year, day of year, time", file=file, line=line_no
         ) from None
-    if not (1 <= doy <= 366 and 0 <= hh <= 23 and 0 <= mm <= 59 and 0.0 <= sec < 61.0):
+    if not (1960 <= year <= 2100 and 1 <= doy <= 366 and 0 <= hh <= 23 and 0 <= mm <= 59 and 0.0 <= sec < 61.0):
         raise InputError(f"{what}: {' '.join(tokens)!r} is not a valid year/day-of-year/time", file=file, line=line_no)
     base = np.datetime64(f"{year:04d}-01-01T00:00:00", "ns")
     offset_ns = round((((doy - 1) * 24 + hh) * 60 + mm) * 60e9 + sec * 1e9)
@@ -162,8 +164,11 @@ def read_ids_maneuvers(path: str | Path, *, repairs: RepairLog | None = None) ->
     frame = pd.DataFrame(rows, columns=list(MANEUVER_COLUMNS))
     if frame.empty:
         return frame
-    for col in ("time_utc", "window_start_utc", "window_end_utc"):
-        frame[col] = to_utc(frame[col].to_numpy(dtype="datetime64[ns]"), "tai")
+    with warnings.catch_warnings():
+        # ERFA calls years past its leap-second table "dubious"; TAI−UTC is then held at the last value
+        warnings.simplefilter("ignore", ErfaWarning)
+        for col in ("time_utc", "window_start_utc", "window_end_utc"):
+            frame[col] = to_utc(frame[col].to_numpy(dtype="datetime64[ns]"), "tai")
     if not frame["time_utc"].is_monotonic_increasing:
         repairs.record("maneuvers out of time order, sorted", 1)
         frame = frame.sort_values("time_utc", kind="stable")

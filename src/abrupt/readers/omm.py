@@ -67,15 +67,18 @@ def _normalise_epoch(text: str, where: str, file: str, line: int | None) -> str:
     return f"{m.group(1)}.{frac[:6].ljust(6, '0')}"
 
 
-def record_to_set(record: dict[str, Any], *, file: str, index: int, line: int | None = None) -> RawElementSet:
+def record_to_set(
+    record: dict[str, Any], *, file: str, index: int, line: int | None = None, label: bool = False
+) -> RawElementSet:
     """Check one OMM record (keyword → value) and initialise its SGP4 record.
 
-    ``index`` is the 1-based record number (used in messages when no ``line`` is known).
+    ``index`` is the 1-based record number, named in messages when no ``line`` is known or ``label``
+    (JSON and XML, where several records may share a line).
     """
     from sgp4 import omm
     from sgp4.api import Satrec
 
-    where = "" if line is not None else f"record {index}: "
+    where = "" if line is not None and not label else f"record {index}: "
     rec = {str(k).strip().upper(): ("" if v is None else str(v).strip()) for k, v in record.items()}
     missing = [k for k in REQUIRED if not rec.get(k)]
     if missing:
@@ -253,7 +256,7 @@ def iter_omm_sets(
         raise InputError(f"unknown OMM format {fmt!r} (known: {sorted(parsers)})", file=file, line=1)
     for i, (rec, line) in enumerate(parsers[fmt](text, file), start=1):
         try:
-            yield record_to_set(rec, file=file, index=i, line=line)
+            yield record_to_set(rec, file=file, index=i, line=line, label=fmt in ("json", "xml"))
         except InputError as exc:
             if strict:
                 raise

@@ -89,6 +89,20 @@ class ElementHistory:
     def __len__(self) -> int:
         return len(self.elements)
 
+    def shifted(self, seconds: float) -> ElementHistory:
+        """The same history with every epoch moved by ``seconds`` (the SGP4 records are shared; the
+        detectors read times from ``elements`` only)."""
+        el = self.elements.copy()
+        el["epoch_utc"] = el["epoch_utc"] + pd.Timedelta(seconds=seconds)
+        return ElementHistory(el, list(self.satrecs), self.source, self.name, self.repairs, list(self.skipped))
+
+    @classmethod
+    def empty(cls, source: str = "<empty>") -> ElementHistory:
+        """A history with no element sets (the schema's columns, no rows)."""
+        frame = pd.DataFrame({c: pd.Series(dtype=float) for c in ELEMENT_COLUMNS})
+        frame["epoch_utc"] = frame["epoch_utc"].astype("datetime64[ns]")
+        return cls(frame, [], source)
+
 
 @dataclass(frozen=True)
 class RawElementSet:
