@@ -67,7 +67,8 @@ def main() -> None:
     rms_naive, bias_naive = relative_errors(w["naive_density_kg_m3"].to_numpy(), truth)
     true_b = np.concatenate(list(sim.truth_b.values()))
     print(
-        f"constellation: {args.objects} CubeSats (3U/6U), {args.days:.0f} days, storm +50 % for 2 days, seed {args.seed}"
+        f"constellation: {args.objects} CubeSats (3U/6U), {args.days:.0f} days, "
+        f"storm +50 % for 2 days, seed {args.seed}"
     )
     print(f"object-windows: {len(w)}  (1-day windows; B distribution fitted on 10-day windows)")
     print(

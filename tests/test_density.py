@@ -302,8 +302,10 @@ def test_cli_density_tle_and_meteors(tmp_path: Path) -> None:
     path = _synthetic_tle(tmp_path, 2e-14, days=6.0)
     out = tmp_path / "w.csv"
     runner = CliRunner()
-    res = runner.invoke(cli, ["density", "tle", str(path), "--out", str(out), "--interval-days", "2", "--no-model",
-                              "--maneuvers", "none"])
+    res = runner.invoke(
+        cli,
+        ["density", "tle", str(path), "--out", str(out), "--interval-days", "2", "--no-model", "--maneuvers", "none"],
+    )
     assert res.exit_code == 0, res.output
     frame = pd.read_csv(out)
     assert {"rho_b_per_m", "rho_b_sigma_per_m", "model_density_kg_m3"} <= set(frame.columns)

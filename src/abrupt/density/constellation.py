@@ -28,6 +28,7 @@ columns are empty.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -87,7 +88,7 @@ def read_platforms(path: str | Path, objects: list[str], aliases: dict[str, str]
     return frame
 
 
-def platform_minimum_b(row: dict[str, Any], flow: FlowConditions, alphas: FloatArray) -> FloatArray:
+def platform_minimum_b(row: Mapping[Any, Any], flow: FlowConditions, alphas: FloatArray) -> FloatArray:
     """B_min of one platform for each accommodation α (slides "Ballistic Factors", "Uncertainty in α").
 
     With an area range (A_min < A_max) the platform is taken as a box turning about an axis normal to

@@ -12,7 +12,8 @@ drawn from U(0.85, 0.99) — so B is IID with a distribution the estimator does 
 
 Element sets: epochs with gamma-distributed spacing (mean ``mean_spacing_days``) and occasional
 gaps of 1-2.5 days; mean motion with heavy-tailed noise (Student t, 4 d.o.f.) equivalent to
-σ_a = 3-10 m per satellite (CryoSat-2's TLEs scatter by ~1-2 m) and 1 % gross outliers (×8); exported as real TLE text with ``sgp4``.
+σ_a = 3-10 m per satellite (CryoSat-2's TLEs scatter by ~1-2 m) and 1 % gross outliers (×8);
+exported as real TLE text with ``sgp4``.
 """
 
 from __future__ import annotations
