@@ -216,7 +216,7 @@ def estimate_density_ratios(echoes: pd.DataFrame, levels_km: FloatArray | None =
     mat = sparse.csr_matrix((vals, (rows, cols)), shape=(eq, n_unknown))
     lower = np.concatenate([np.zeros(len(ids)), np.full(n_pairs, -np.inf)])
     bounds = (lower, np.full(n_unknown, np.inf))
-    if eq * n_unknown <= 2e7:  # dense bounded-variable least squares: exact active set
+    if eq * n_unknown <= 2e5:  # small: dense bounded-variable least squares (exact active set)
         sol = lsq_linear(mat.toarray(), np.asarray(rhs), bounds=bounds, method="bvls")
     else:
         sol = lsq_linear(mat, np.asarray(rhs), bounds=bounds, lsmr_tol="auto", max_iter=5000)
