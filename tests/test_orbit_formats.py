@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 
 from abrupt.errors import InputError
-from abrupt.model.frames import Ephemeris
 from abrupt.readers.cpf import read_cpf
 from abrupt.readers.ephemeris import read_ephemeris, sniff_format, write_ephemeris
 from abrupt.readers.oem import parse_ccsds_epoch, read_oem, read_opm, write_oem
 from abrupt.readers.sp3 import read_sp3_all, write_sp3
+from abrupt.series.ephemeris import Ephemeris
 
 MU_KM3_S2 = 398600.4418
 R_KM = 6778.0  # ISS-like, 400 km
@@ -253,3 +253,13 @@ def test_inject_orbit_writes_the_input_format(tmp_path: Path) -> None:
     moved = np.linalg.norm(after.position_m - before.position_m, axis=1)
     assert np.all(moved[after.times_utc < np.datetime64("2023-02-15T13:00:00")] < 1e-5)
     assert moved[-1] > 1.0  # 0.1 m/s along-track over an hour drifts by far more than a metre
+
+
+def test_epochs_beyond_the_leap_second_table_are_counted_not_warned(tmp_path: Path) -> None:
+    # A long-term prediction in GPS time: TAI - UTC is held at its last value (37 s), and said so.
+    eph = _circular(5, start="2040-01-01T00:00:00")
+    path = tmp_path / "future.sp3"
+    write_sp3(eph, path, time_system="GPS")
+    back = read_ephemeris(path)
+    assert np.all(back.times_utc == eph.times_utc)
+    assert back.repairs.counts["epochs outside the leap-second table (TAI-UTC held at its last tabulated value)"] == 1

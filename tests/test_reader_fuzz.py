@@ -21,7 +21,6 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from abrupt.errors import InputError
-from abrupt.model.frames import Ephemeris
 from abrupt.readers.cpf import read_cpf
 from abrupt.readers.crd import read_crd
 from abrupt.readers.ephemeris import read_ephemeris
@@ -29,6 +28,7 @@ from abrupt.readers.navigation_csv import read_navigation_csv, write_navigation_
 from abrupt.readers.oem import read_oem, read_opm, write_oem
 from abrupt.readers.sinex import read_sinex
 from abrupt.readers.sp3 import read_sp3, write_sp3
+from abrupt.series.ephemeris import Ephemeris
 
 DATA = Path(__file__).parent / "data" / "formats"
 REGRESSIONS = DATA / "regressions"

@@ -209,3 +209,16 @@ def test_tracking_files_are_recognised_by_content(shared_data: Path, tmp_path: P
     assert set(table["station"]) == {"KTZL", "GRZL"} and table["range_m"].between(5e6, 1e7).all()
     with pytest.raises(InputError, match="unknown station 'GRZL'"):
         read_tracking(crd, known_stations=["KTZL"])
+
+
+def test_crd_records_just_before_midnight_in_a_block_starting_after_it(tmp_path: Path) -> None:
+    text = _crd_text(1, [0.04, 0.041]).replace(
+        "H4  0 2020 01 01 02 00 00 2020 01 01 02 30 00", "H4  0 2020 01 02 00 00 30 2020 01 02 00 30 00"
+    )
+    text = text.replace("20 7000.000 950.00", "20 86390.000 950.00")  # 23:59:50 of the previous day
+    path = tmp_path / "t.frd"
+    path.write_text(text)
+    table = read_crd(path)
+    assert table["time_utc"].iloc[0] == np.datetime64("2020-01-02T02:00:00")
+    # 950 hPa at 23:59:50 (previous day) and 954 hPa at 02:03:20: linear at 02:00:00
+    assert table["pressure_hpa"].iloc[0] == pytest.approx(950.0 + 4.0 * 7210.0 / 7410.0)

@@ -27,8 +27,8 @@ from pathlib import Path
 import numpy as np
 
 from abrupt.errors import InputError, RepairLog
-from abrupt.model.frames import Ephemeris
 from abrupt.readers.compression import read_text
+from abrupt.series.ephemeris import Ephemeris
 
 BAD_RECORD_FRACTION = 0.01
 MJD_EPOCH = np.datetime64("1858-11-17", "ns")

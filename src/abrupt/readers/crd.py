@@ -127,7 +127,8 @@ class _Block:
     delays_ps: dict[str, list[float]] = field(default_factory=dict)
 
     def epoch(self, sod: float) -> np.datetime64:
-        """Seconds of day → UTC; a time more than 12 h before the block start belongs to the next day."""
+        """Seconds of day → UTC, within 12 h of the block start (passes are shorter): a time more than
+        12 h before the start belongs to the next day, more than 12 h after it to the previous day."""
         assert self.start is not None
         if not 0.0 <= sod < 86401.0:
             raise _Bad(f"seconds of day {sod} outside [0, 86400]", 2)
@@ -135,6 +136,8 @@ class _Block:
         t = day + np.timedelta64(round(sod * 1e9), "ns")
         if t < self.start - np.timedelta64(12, "h"):
             t = t + np.timedelta64(1, "D")
+        elif t > self.start + np.timedelta64(12, "h"):  # e.g. a calibration just before midnight
+            t = t - np.timedelta64(1, "D")
         return t
 
 

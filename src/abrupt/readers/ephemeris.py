@@ -12,8 +12,8 @@ from pathlib import Path
 from typing import Literal
 
 from abrupt.errors import InputError
-from abrupt.model.frames import Ephemeris
 from abrupt.readers.compression import read_bytes
+from abrupt.series.ephemeris import Ephemeris
 
 EphemerisFormat = Literal["sp3", "oem-kvn", "oem-xml", "opm", "cpf", "csv"]
 

@@ -12,6 +12,7 @@ different states, positions whose magnitude is not an orbit radius in metres (e.
 
 from __future__ import annotations
 
+import csv
 import io
 from pathlib import Path
 
@@ -19,10 +20,33 @@ import numpy as np
 import pandas as pd
 
 from abrupt.errors import InputError, RepairLog
-from abrupt.model.frames import Ephemeris
 from abrupt.readers.compression import read_text
+from abrupt.series.ephemeris import Ephemeris
 
 REQUIRED_COLUMNS = ("time_utc", "x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps")
+
+
+def _table(text: str, file: str) -> pd.DataFrame:
+    """Rows of the CSV text as strings (None for empty cells); the index is the line number - 2."""
+    try:
+        rows = list(csv.reader(io.StringIO(text, newline="")))
+    except csv.Error as exc:
+        raise InputError(f"not a readable CSV file: {exc}", file=file) from None
+    if not rows or not any(rows[0]):
+        raise InputError("empty file (a header line is needed)", file=file, line=1)
+    header = [h.strip() for h in rows[0]]
+    repeated = sorted({h for h in header if header.count(h) > 1})
+    if repeated:
+        raise InputError(f"header repeats column(s) {repeated}", file=file, line=1)
+    data, index = [], []
+    for no, row in enumerate(rows[1:], start=2):
+        if not row:
+            continue
+        if len(row) != len(header):
+            raise InputError(f"{len(row)} fields but the header has {len(header)}", file=file, line=no)
+        data.append([c if c.strip() != "" else None for c in row])
+        index.append(no - 2)
+    return pd.DataFrame(data, columns=header, index=index, dtype=object)
 
 
 def read_navigation_csv(path: str | Path, satellite: str | None = None, *, frame: str | None = None) -> Ephemeris:
@@ -30,12 +54,7 @@ def read_navigation_csv(path: str | Path, satellite: str | None = None, *, frame
     path = Path(path)
     file = str(path)
     repairs = RepairLog(source=file)
-    text = read_text(path, encoding="utf-8", what="CSV")
-    try:
-        df = pd.read_csv(io.StringIO(text), dtype={"satellite": str, "frame": str})
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError) as exc:
-        reason = " ".join(str(exc).split())
-        raise InputError(f"not a readable CSV file: {reason}", file=file) from None
+    df = _table(read_text(path, encoding="utf-8", what="CSV"), file)
     missing = [c for c in REQUIRED_COLUMNS if c not in df.columns]
     if missing:
         raise InputError(f"missing required columns {missing}", file=file, line=1)

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 import xml.parsers.expat
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,8 +33,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from abrupt.errors import InputError, RepairLog
-from abrupt.model.frames import Ephemeris
 from abrupt.readers.compression import read_bytes
+from abrupt.series.ephemeris import Ephemeris
 
 GCRF_NAMES = {"GCRF", "ICRF", "EME2000", "J2000"}
 ITRF_NAMES = {
@@ -381,12 +382,12 @@ def _to_ephemeris(segments: list[_Segment], satellite: str | None, file: str, lo
     frame_name = frames.pop()
     if frame_name in ("EME2000", "J2000"):
         log.record("EME2000 treated as GCRF (frame bias 23 mas ignored)", 1)
-    from abrupt.model.timescales import to_utc
+    from abrupt.readers.timesystems import to_utc_counted
 
     ts = systems.pop()
     return Ephemeris(
         satellite=satellite or chosen[0].meta["OBJECT_ID"],
-        times_utc=to_utc(t, TIME_SYSTEMS[ts]),  # type: ignore[arg-type]
+        times_utc=to_utc_counted(t, TIME_SYSTEMS[ts], log),  # type: ignore[arg-type]
         position_m=st[:, :3] * 1e3,
         velocity_mps=st[:, 3:6] * 1e3,
         frame="GCRF" if frame_name in GCRF_NAMES else "ITRF",
@@ -435,17 +436,20 @@ def _fmt_time(t: np.datetime64) -> str:
 def _from_utc(t_utc: NDArray[np.datetime64], time_system: str) -> NDArray[np.datetime64]:
     if time_system == "UTC":
         return t_utc
+    import erfa
     from astropy.time import Time
 
     from abrupt.model.timescales import offline_astropy
 
     offline_astropy()
     tt = Time(t_utc, scale="utc", format="datetime64")
-    if time_system == "GPS":
-        tai = np.asarray(tt.tai.datetime64, dtype="datetime64[ns]")
-        gps: NDArray[np.datetime64] = (tai.astype(np.int64) - 19_000_000_000).astype("datetime64[ns]")
-        return gps
-    return np.asarray(getattr(tt, time_system.lower()).datetime64, dtype="datetime64[ns]")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", erfa.ErfaWarning)  # beyond the leap-second table: TAI-UTC held
+        if time_system == "GPS":
+            tai = np.asarray(tt.tai.datetime64, dtype="datetime64[ns]")
+            gps: NDArray[np.datetime64] = (tai.astype(np.int64) - 19_000_000_000).astype("datetime64[ns]")
+            return gps
+        return np.asarray(getattr(tt, time_system.lower()).datetime64, dtype="datetime64[ns]")
 
 
 def write_oem(

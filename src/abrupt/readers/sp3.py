@@ -35,6 +35,7 @@ the header's sampling grid, a file with no epochs, an epoch repeated with differ
 from __future__ import annotations
 
 import math
+import warnings
 from collections import Counter, defaultdict
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
@@ -44,8 +45,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from abrupt.errors import InputError, RepairLog
-from abrupt.model.frames import Ephemeris
 from abrupt.readers.compression import read_bytes
+from abrupt.series.ephemeris import Ephemeris
 
 #: Offsets of SP3 time systems from TAI (s): t_TAI = t_sys + offset (GPS ICD, Galileo OS SIS ICD,
 #: BeiDou ICD). UTC and GLONASS (UTC + 3 h) go through the leap-second table instead.
@@ -58,6 +59,7 @@ INERTIAL_FRAMES = ("GCRF", "ICRF", "J2000", "EME2000", "EME00", "ICRS")
 BAD_VALUE_MARKER = 999999.999999  # [km or dm/s] the SP3 "bad or absent value" marker
 MIN_RADIUS_KM = 6000.0  # [km] smallest plausible orbit radius
 MAX_RADIUS_KM = 2.0e6  # [km] largest plausible geocentric radius (beyond the Moon)
+MAX_INTERVAL_S = 30 * 86400.0  # [s] longest plausible epoch interval
 BAD_RECORD_FRACTION = 0.01  # more malformed records than this (and more than one) is an error
 
 
@@ -190,8 +192,8 @@ def _resolve_rollover(
     return min(candidates, key=lambda c: abs(int((c - expected).astype(np.int64))))
 
 
-def _to_utc(t_sys: NDArray[np.datetime64], time_system: str) -> NDArray[np.datetime64]:
-    from abrupt.model.timescales import to_utc
+def _to_utc(t_sys: NDArray[np.datetime64], time_system: str, log: RepairLog) -> NDArray[np.datetime64]:
+    from abrupt.readers.timesystems import to_utc_counted
 
     if time_system == "UTC":
         return t_sys
@@ -199,7 +201,7 @@ def _to_utc(t_sys: NDArray[np.datetime64], time_system: str) -> NDArray[np.datet
         return t_sys - np.timedelta64(3, "h")
     offset_ns = round(TAI_MINUS_SYSTEM_S[time_system] * 1e9)
     tai: NDArray[np.datetime64] = (t_sys.astype(np.int64) + offset_ns).astype("datetime64[ns]")
-    return to_utc(tai, "tai")
+    return to_utc_counted(tai, "tai", log)
 
 
 def _from_utc(t_utc: NDArray[np.datetime64], time_system: str) -> NDArray[np.datetime64]:
@@ -211,9 +213,12 @@ def _from_utc(t_utc: NDArray[np.datetime64], time_system: str) -> NDArray[np.dat
     if time_system == "GLO":
         return t_utc + np.timedelta64(3, "h")
     offline_astropy()
+    import erfa
     from astropy.time import Time
 
-    tai = np.asarray(Time(t_utc, scale="utc", format="datetime64").tai.datetime64, dtype="datetime64[ns]")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", erfa.ErfaWarning)  # beyond the leap-second table: TAI-UTC held
+        tai = np.asarray(Time(t_utc, scale="utc", format="datetime64").tai.datetime64, dtype="datetime64[ns]")
     offset_ns = round(TAI_MINUS_SYSTEM_S[time_system] * 1e9)
     out: NDArray[np.datetime64] = (tai.astype(np.int64) - offset_ns).astype("datetime64[ns]")
     return out
@@ -245,8 +250,10 @@ def _parse_header(lines: Sequence[str], file: str, repairs: RepairLog) -> tuple[
         raise InputError(
             "epoch interval (third field of '##' line) is not a number", file=file, line=2, column=25
         ) from None
-    if not (math.isfinite(interval_s) and interval_s >= 0.0):
-        raise InputError(f"epoch interval {interval_s} s is not a non-negative number", file=file, line=2, column=25)
+    if not (math.isfinite(interval_s) and 0.0 <= interval_s <= MAX_INTERVAL_S):
+        raise InputError(
+            f"epoch interval {interval_s:g} s is not in [0, {MAX_INTERVAL_S:g}] s", file=file, line=2, column=25
+        )
     sats: list[str] = []
     n_sats: int | None = None
     n_plus = 0
@@ -553,7 +560,7 @@ def _finish(
         log.record("missing epochs (gaps, propagated across)", n_missing)
     return Ephemeris(
         satellite=sid,
-        times_utc=_to_utc(t_sys, header.time_system),
+        times_utc=_to_utc(t_sys, header.time_system, log),
         position_m=st[:, :3] * 1e3,
         velocity_mps=st[:, 3:6] * 0.1,
         frame=frame,  # type: ignore[arg-type]
