@@ -224,10 +224,12 @@ def neighbour_residuals(n_bar: FloatArray, integral: FloatArray) -> tuple[FloatA
 
 def robust_sigma(values: FloatArray) -> float:
     """1.4826 × median absolute deviation about the median (Hampel 1974), NaNs ignored."""
+    from abrupt.clean.noise import robust_scale
+
     v = values[np.isfinite(values)]
     if v.size == 0:
         return float("nan")
-    return float(1.4826 * np.median(np.abs(v - np.median(v))))
+    return float(robust_scale(v))
 
 
 def maneuver_epochs(history: ElementHistory) -> list[pd.Timestamp]:
