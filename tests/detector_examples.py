@@ -114,6 +114,19 @@ def empty_tracking() -> Any:
     return TrackingSeries(data, full.x0_apriori_m_mps, full.fit_config, name=full.name)
 
 
+def inertia_track_example() -> Any:
+    """Twelve daily inertia estimates (σ 0.3 kg m²) with a 5 kg m² step in Jyy and Jzz after day 6 (a docking)."""
+    from abrupt.massprops.track import InertiaTrack
+
+    rng = np.random.default_rng(13)
+    n = 12
+    p = np.array([900.0, 700.0, 1000.0, 5.0, -3.0, 2.0]) + 0.3 * rng.standard_normal((n, 6))
+    p[6:, 1:3] += 5.0
+    t0 = np.arange(n) * 86400.0
+    cov = np.broadcast_to(np.eye(6) * 0.09, (n, 6, 6)).copy()
+    return InertiaTrack("SC-X", "2026-01-01T00:00:00Z", t0, t0 + 86400.0, p, cov, np.ones((n, 6), bool))
+
+
 # ---------------------------------------------------------------------------------------------- TLE
 
 
@@ -134,11 +147,17 @@ def tle_example() -> Any:
 
 
 def _examples() -> dict[type, SeriesExample]:
+    from abrupt.massprops.track import InertiaTrack
     from abrupt.readers.tle import ElementHistory
     from abrupt.series.attitude import AttitudeSeries
     from abrupt.series.tracking import TrackingSeries
 
     return {
+        InertiaTrack: SeriesExample(
+            make=inertia_track_example,
+            empty=InertiaTrack.empty,
+            shift=lambda s, seconds: s.shifted(seconds),
+        ),
         ElementHistory: SeriesExample(
             make=tle_example,
             empty=ElementHistory.empty,

@@ -6,7 +6,10 @@
                             from its first differences; the white + random-walk noise model of
                             total angular momentum (Allan variances).
 
-Filters of the flight-telemetry pipeline (comb, Savitzky-Golay) belong here as well.
+Flight-telemetry pipeline stages: :mod:`abrupt.clean.flight_masks` (event-flag and slew masks on a
+grid), :mod:`abrupt.clean.comb` (local comb filter and slow external-torque trend, Harris et al.
+2025 Eqs. 1-2); Savitzky-Golay smoothing of tachometer speeds is a timetable method
+(:func:`abrupt.series.timetable.savgol_samples`).
 """
 
 from abrupt.clean.masks import MaskInterval, apply_mask, read_mask

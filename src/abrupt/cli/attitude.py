@@ -24,6 +24,8 @@ from abrupt.cli.options import budget_options, pop_budget
 if TYPE_CHECKING:
     from abrupt.simulate.attitude import Strike
 
+FLIGHT_STAGES = ("event-masks", "slew-masks", "savgol", "comb", "trend", "all")  # abrupt.cli.flight
+
 
 def _spacecraft(path: str | None) -> Any:
     from abrupt.pipelines.attitude import load_spacecraft
@@ -296,7 +298,21 @@ def run_attitude_detection(
 
 
 @detect.command("attitude")
-@click.argument("telemetry", type=click.Path(exists=True, dir_okay=False))
+@click.argument("telemetry", required=False, type=click.Path(exists=True, dir_okay=False))
+@click.option(
+    "--store",
+    "store_dir",
+    default=None,
+    type=click.Path(exists=True, file_okay=False),
+    help="Flight pipeline: read a store written by `abrupt ingest` instead of TELEMETRY.",
+)
+@click.option("--days", multiple=True, help="With --store: days (YYYY-MM-DD or A..B); default all.")
+@click.option(
+    "--no-clean",
+    multiple=True,
+    type=click.Choice(FLIGHT_STAGES),
+    help="With --store: switch a cleaning stage off (repeatable; 'all' for none).",
+)
 @click.option(
     "--spacecraft",
     "spacecraft_path",
@@ -330,9 +346,20 @@ def detect_attitude_cmd(
     catalog_target: str,
     out: str,
     report_path: str | None,
+    store_dir: str | None = None,
+    days: tuple[str, ...] = (),
+    no_clean: tuple[str, ...] = (),
     **settings: Any,
 ) -> None:
-    """Detect strikes in attitude TELEMETRY (CSV or Parquet); write events and the catalog."""
+    """Detect strikes in attitude TELEMETRY (CSV or Parquet), or in a --store; write events and the catalog."""
+    if store_dir is not None:  # flight-telemetry pipeline (abrupt.pipelines.flight)
+        from abrupt.cli.flight import detect_from_store
+
+        budget = pop_budget(settings, "1/day")
+        detect_from_store(store_dir, spacecraft_path, days, budget.per_day, no_clean, catalog_target, out, report_path)
+        return
+    if telemetry is None:
+        raise click.UsageError("give TELEMETRY or --store DIR")
     mask = settings.pop("mask")
     sc, tel, cfg, result = run_attitude_detection(telemetry, spacecraft_path, calibration, name, settings, mask)
     details = {
@@ -362,7 +389,21 @@ def detect_attitude_cmd(
 
 
 @report.command("attitude")
-@click.argument("telemetry", type=click.Path(exists=True, dir_okay=False))
+@click.argument("telemetry", required=False, type=click.Path(exists=True, dir_okay=False))
+@click.option(
+    "--store",
+    "store_dir",
+    default=None,
+    type=click.Path(exists=True, file_okay=False),
+    help="Flight pipeline: read a store written by `abrupt ingest` instead of TELEMETRY.",
+)
+@click.option("--days", multiple=True, help="With --store: days (YYYY-MM-DD or A..B); default all.")
+@click.option(
+    "--no-clean",
+    multiple=True,
+    type=click.Choice(FLIGHT_STAGES),
+    help="With --store: switch a cleaning stage off (repeatable; 'all' for none).",
+)
 @click.option("--spacecraft", "spacecraft_path", type=click.Path(exists=True, dir_okay=False), required=True)
 @_with_options(detector_options)
 @click.option(
@@ -379,9 +420,25 @@ def detect_attitude_cmd(
     help="Figure (.png) or page (.html).",
 )
 def report_attitude_cmd(
-    telemetry: str, spacecraft_path: str, calibration: str | None, truth: str | None, out: str, **settings: Any
+    telemetry: str | None,
+    spacecraft_path: str,
+    calibration: str | None,
+    truth: str | None,
+    out: str,
+    store_dir: str | None = None,
+    days: tuple[str, ...] = (),
+    no_clean: tuple[str, ...] = (),
+    **settings: Any,
 ) -> None:
     """Draw the attitude report: momentum, contributions, raw channels, statistics, thresholds, events."""
+    if store_dir is not None:  # flight pipeline: cleaning stages before/after and daily statistics
+        from abrupt.cli.flight import detect_from_store
+
+        budget = pop_budget(settings, "1/day")
+        detect_from_store(store_dir, spacecraft_path, days, budget.per_day, no_clean, None, None, out)
+        return
+    if telemetry is None:
+        raise click.UsageError("give TELEMETRY or --store DIR")
     import pandas as pd
 
     from abrupt.report.attitude import write_attitude_report

@@ -6,7 +6,19 @@ import sys
 
 import click
 
-from abrupt.cli import attitude, catalog_commands, density, detectors, orbit, rates, tle, tracking  # noqa: F401  (registration)
+from abrupt.cli import (  # noqa: F401  (registration)
+    attitude,
+    catalog_commands,
+    density,
+    detectors,
+    flight,
+    laser,
+    mass,
+    orbit,
+    rates,
+    tle,
+    tracking,
+)
 from abrupt.cli.groups import cli, hoist_global_flags
 from abrupt.errors import AbruptError
 

@@ -53,6 +53,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from abrupt.errors import ConfigError
+from abrupt.model.flight_config import FlightConfig, OrbitInfo, parse_flight, parse_orbit
 
 RATE_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0, "arcsec/s": math.pi / 180.0 / 3600.0}
 WHEEL_SPEED_UNITS = {"rad/s": 1.0, "rpm": 2.0 * math.pi / 60.0, "rps": 2.0 * math.pi}
@@ -67,9 +68,20 @@ _TOP_KEYS = {
     "appendages",
     "surfaces",
     "telemetry",
+    "orbit",
+    "flight",
 }
 _WHEEL_KEYS = {"name", "axis", "spin_inertia_kgm2", "max_torque_Nm", "max_speed_rad_s"}
-_APPENDAGE_KEYS = {"name", "mass_kg", "inertia_kgm2", "hinge_m", "gimbal_axes", "angle_columns", "angle_unit"}
+_APPENDAGE_KEYS = {
+    "name",
+    "mass_kg",
+    "inertia_kgm2",
+    "hinge_m",
+    "gimbal_axes",
+    "angle_columns",
+    "angle_unit",
+    "spin_inertia_kgm2",
+}
 _SURFACE_KEYS = {"name", "shape", "size_m", "center_m", "normal", "u_axis", "kind"}
 _TELEMETRY_KEYS = {"time", "quaternion", "body_rate", "wheel_speed"}
 
@@ -96,6 +108,19 @@ class Appendage:
     gimbal_axes: NDArray[np.float64]
     angle_columns: tuple[str, ...]
     angle_unit: str = "rad"
+    spin_inertia_kgm2: float = float("nan")
+
+    @property
+    def drive_inertia_kgm2(self) -> float:
+        """Inertia about the (first) drive axis [kg m^2]: ``spin_inertia_kgm2``, else aᵀ I a.
+
+        The relative angular momentum of an appendage symmetric about its drive axis a is
+        I_a θ̇ a (flight-like README; Bennett 2022 §4.1.1 for the general gimballed case).
+        """
+        if math.isfinite(self.spin_inertia_kgm2):
+            return self.spin_inertia_kgm2
+        a = self.gimbal_axes[0]
+        return float(a @ self.inertia_kgm2 @ a)
 
 
 @dataclass(frozen=True)
@@ -146,6 +171,8 @@ class Spacecraft:
     surfaces: tuple[Surface, ...] = ()
     telemetry: TelemetryMap = field(default_factory=TelemetryMap)
     source: str = "<memory>"
+    orbit: OrbitInfo | None = None
+    flight: FlightConfig | None = None
 
     @property
     def wheel_axes(self) -> NDArray[np.float64]:
@@ -294,15 +321,33 @@ def spacecraft_from_dict(data: dict[str, Any], *, source: str = "<memory>") -> S
         unit = a.get("angle_unit", "rad")
         if unit not in ANGLE_UNITS:
             raise ConfigError(f"unknown unit {unit!r}", file=file, key=f"{where}.angle_unit")
+        # With spin_inertia_kgm2 (momentum-only description) the full inertia and hinge are optional.
+        spin = (
+            _positive(a["spin_inertia_kgm2"], f"{where}.spin_inertia_kgm2", file)
+            if "spin_inertia_kgm2" in a
+            else float("nan")
+        )
+        needs_full = not math.isfinite(spin)
+        inertia_a = (
+            _inertia(_require(a, "inertia_kgm2", where, file), f"{where}.inertia_kgm2", file)
+            if needs_full or "inertia_kgm2" in a
+            else np.diag([spin, spin, spin])
+        )
+        hinge = (
+            _vector(_require(a, "hinge_m", where, file), 3, f"{where}.hinge_m", file)
+            if needs_full or "hinge_m" in a
+            else np.zeros(3)
+        )
         appendages.append(
             Appendage(
                 name=str(a.get("name", f"appendage{i + 1}")),
                 mass_kg=_positive(_require(a, "mass_kg", where, file), f"{where}.mass_kg", file),
-                inertia_kgm2=_inertia(_require(a, "inertia_kgm2", where, file), f"{where}.inertia_kgm2", file),
-                hinge_m=_vector(_require(a, "hinge_m", where, file), 3, f"{where}.hinge_m", file),
+                inertia_kgm2=inertia_a,
+                hinge_m=hinge,
                 gimbal_axes=axes_arr,
                 angle_columns=cols,
                 angle_unit=unit,
+                spin_inertia_kgm2=spin,
             )
         )
 
@@ -353,8 +398,14 @@ def spacecraft_from_dict(data: dict[str, Any], *, source: str = "<memory>") -> S
     dup = sorted({c for c in mapped if mapped.count(c) > 1})
     if dup:
         raise ConfigError(f"column(s) {dup} mapped to more than one quantity", file=file, key="telemetry")
+    orbit = parse_orbit(data["orbit"], file) if "orbit" in data else None
+    flight = (
+        parse_flight(data["flight"], file, len(wheels), tuple(a.name for a in appendages)) if "flight" in data else None
+    )
     return Spacecraft(
         name=name,
+        orbit=orbit,
+        flight=flight,
         inertia_kgm2=inertia,
         wheels=tuple(wheels),
         mass_kg=mass,

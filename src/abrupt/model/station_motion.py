@@ -66,45 +66,47 @@ def eccentricity_ecef_m(marker_ecef_m: ArrayLike, eccentricity_m: ArrayLike, *, 
     return np.asarray(enu_to_ecef_rotation(float(lat), float(lon)) @ np.array([east, north, up]))
 
 
-def sun_moon_ecef_m(epoch_utc: np.datetime64) -> tuple[FloatArray, FloatArray]:
-    """Geocentric positions (m) of the Sun and the Moon in ECEF at a UTC epoch (ERFA ephemerides)."""
+def sun_moon_ecef_m(epoch_utc: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """Geocentric positions (m) of the Sun and the Moon in ECEF at UTC epochs (ERFA ephemerides).
+
+    Vectorised: ``epoch_utc`` may be one ``datetime64`` (returns (3,) arrays) or an array (returns (n, 3)).
+    """
     from astropy.time import Time
     from astropy.utils import iers
 
     iers.conf.auto_download = False
     t = Time(np.asarray(epoch_utc, dtype="datetime64[ns]"), scale="utc")
-    tt, tdb = t.tt, t.tdb
+    tt, tdb, ut1 = t.tt, t.tdb, t.ut1
     pvh, _ = erfa.epv00(tdb.jd1, tdb.jd2)
     sun_gcrs = -np.asarray(pvh["p"], dtype=float) * AU_M  # Earth→Sun, BCRS-aligned (aberration neglected)
-    moon = erfa.moon98(tt.jd1, tt.jd2)
-    moon_gcrs = np.asarray(moon["p"], dtype=float) * AU_M
-    ut1 = t.ut1
+    moon_gcrs = np.asarray(erfa.moon98(tt.jd1, tt.jd2)["p"], dtype=float) * AU_M
     c2t = erfa.c2t06a(tt.jd1, tt.jd2, ut1.jd1, ut1.jd2, 0.0, 0.0)
-    return np.asarray(c2t @ sun_gcrs), np.asarray(c2t @ moon_gcrs)
+    sun = np.einsum("...ij,...j->...i", c2t, sun_gcrs)
+    moon = np.einsum("...ij,...j->...i", c2t, moon_gcrs)
+    return np.asarray(sun), np.asarray(moon)
 
 
 def solid_tide_displacement_m(station_ecef_m: ArrayLike, sun_ecef_m: ArrayLike, moon_ecef_m: ArrayLike) -> FloatArray:
     """Solid Earth tide displacement (m, ECEF) of a station: IERS Conventions 2010 §7.1.1 step 1.
 
     Degree 2 (Eq. 7.5) with h₂ = 0.6078 − 0.0006 (3 sin²φ − 1)/2 and l₂ = 0.0847 + 0.0002 (3 sin²φ − 1)/2,
-    and degree 3 (Eq. 7.6) with h₃ = 0.292, l₃ = 0.015, from the Sun and the Moon.
+    and degree 3 (Eq. 7.6) with h₃ = 0.292, l₃ = 0.015, from the Sun and the Moon. Sun and Moon
+    positions may be (3,) or (n, 3); the result has the same shape.
     """
     x = np.asarray(station_ecef_m, dtype=float)
     r = float(np.linalg.norm(x))
     rhat = x / r
-    sin_phi = rhat[2]
-    p2 = (3.0 * sin_phi**2 - 1.0) / 2.0
+    p2 = (3.0 * rhat[2] ** 2 - 1.0) / 2.0
     h2 = 0.6078 - 0.0006 * p2
     l2 = 0.0847 + 0.0002 * p2
     h3, l3 = 0.292, 0.015
-    out = np.zeros(3)
-    for body, gm in (
-        (np.asarray(sun_ecef_m, dtype=float), GM_SUN_M3_S2),
-        (np.asarray(moon_ecef_m, dtype=float), GM_MOON_M3_S2),
-    ):
-        rj = float(np.linalg.norm(body))
-        bhat = body / rj
-        c = float(bhat @ rhat)
+    out = np.zeros(np.broadcast_shapes(np.shape(sun_ecef_m), (3,)))
+    for body, gm in ((sun_ecef_m, GM_SUN_M3_S2), (moon_ecef_m, GM_MOON_M3_S2)):
+        b = np.asarray(body, dtype=float)
+        rj = np.linalg.norm(b, axis=-1, keepdims=True)
+        bhat = b / rj
+        c = bhat @ rhat
+        c = c[..., None]
         f2 = gm / GM_EARTH_M3_S2 * r**4 / rj**3
         out += f2 * (h2 * rhat * (1.5 * c**2 - 0.5) + 3.0 * l2 * c * (bhat - c * rhat))
         f3 = gm / GM_EARTH_M3_S2 * r**5 / rj**4

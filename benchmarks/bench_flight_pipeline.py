@@ -1,0 +1,190 @@
+"""Flight-telemetry pipeline on kestrel (issue 9): detection vs truth, baseline without cleaning,
+chunked vs whole, memory against days, injection/recovery, speed.
+
+    PYTHONPATH=$PWD/src nice python benchmarks/bench_flight_pipeline.py [--store DIR] [--parts detect,...]
+
+Reads ../shared/data/flight-like (raw archive, decoder, truth). Prints every figure beside its target.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from abrupt.model.spacecraft import load_spacecraft
+from abrupt.pipelines.flight import CleaningConfig, FlightRunConfig, ingest_archives, run_flight
+
+ROOT = Path(__file__).resolve().parent.parent
+DATA = ROOT.parent / "shared" / "data" / "flight-like"
+KESTREL = ROOT / "examples" / "spacecraft" / "kestrel.toml"
+T0 = np.datetime64("2026-03-10T00:00:00", "ns")
+
+
+def truth() -> list[dict]:
+    return json.loads((DATA / "truth_strikes.json").read_text())["strikes"]
+
+
+def score(events: pd.DataFrame, strikes: list[dict], tol_s: float = 10.0) -> dict:
+    """Match events to strikes within tol_s; recall by size, false alarms/day, |ΔH| errors."""
+    t_ev = (
+        (pd.to_datetime(events["time_utc"]).dt.tz_localize(None).to_numpy() - T0) / np.timedelta64(1, "s")
+        if len(events)
+        else np.array([])
+    )
+    used = np.zeros(len(t_ev), bool)
+    rows = []
+    for s in strikes:
+        d = np.abs(t_ev - s["time_s"]) if len(t_ev) else np.array([])
+        j = int(np.argmin(np.where(used, np.inf, d))) if len(d) else -1
+        hit = j >= 0 and d[j] <= tol_s and not used[j]
+        rel = float("nan")
+        dt = float("nan")
+        if hit:
+            used[j] = True
+            dh = events.iloc[j][["dH_N_x_Nms", "dH_N_y_Nms", "dH_N_z_Nms"]].to_numpy(float)
+            rel = float(np.linalg.norm(dh) / s["H_mag_Nms"] - 1.0)
+            dt = float(t_ev[j] - s["time_s"])
+        rows.append({"dH": s["H_mag_Nms"], "found": hit, "dt_s": dt, "rel_err": rel})
+    n_days = 2.0
+    return {"rows": rows, "false_alarms": int((~used).sum()), "fa_per_day": float((~used).sum() / n_days)}
+
+
+def print_score(label: str, sc: dict) -> None:
+    rows = sc["rows"]
+    big = [r for r in rows if r["dH"] >= 0.1]
+    small = [r for r in rows if r["dH"] < 0.1]
+    print(f"\n[{label}]")
+    for r in sorted(rows, key=lambda r: r["dH"]):
+        print(
+            f"  strike {r['dH']:.3f} N m s: {'found' if r['found'] else 'MISSED'}"
+            + (f"  dt {r['dt_s']:+.1f} s  |dH| err {100 * r['rel_err']:+.0f}%" if r["found"] else "")
+        )
+    print(
+        f"  >= 0.1 N m s found within 10 s: {sum(r['found'] for r in big)}/{len(big)} (target all);"
+        f" max |dH| error {100 * max((abs(r['rel_err']) for r in big if r['found']), default=float('nan')):.0f}%"
+        " (target 30%)"
+    )
+    print(f"  < 0.1 N m s (0.02-0.03): {sum(r['found'] for r in small)}/{len(small)}")
+    print(f"  false alarms: {sc['false_alarms']} in 2 days = {sc['fa_per_day']:.1f}/day (target <= 1)")
+
+
+def ensure_store(store: Path) -> None:
+    if (store / "spacecraft=SC-A").exists():
+        return
+    t = time.time()
+    files = sorted((DATA / "telemetry").glob("*.csv.gz"))
+    ingest_archives(files, DATA / "decoder.csv", store)
+    print(f"ingest of {len(files)} archive days: {time.time() - t:.1f} s")
+
+
+def part_detect(store: Path) -> None:
+    sc = load_spacecraft(KESTREL)
+    strikes = truth()
+    j_true = np.array(json.loads((DATA / "truth_inertia.json").read_text())["J_true_kgm2"])
+    for label, cfg, inertia in (
+        ("cleaned, catalogue inertia", FlightRunConfig(), None),
+        ("no cleaning, catalogue inertia (baseline)", FlightRunConfig(cleaning=CleaningConfig.off()), None),
+        ("cleaned, TRUE inertia (upper bound for the inertia stage)", FlightRunConfig(), j_true),
+    ):
+        t = time.time()
+        res = run_flight(store, sc, cfg, inertia_kgm2=inertia)
+        print(f"\n{label}: {time.time() - t:.1f} s, threshold {res.threshold.value:.2f} at 1/day")
+        print_score(label, score(res.events, strikes))
+        print(res.daily.to_string(index=False))
+
+
+def part_inject(store: Path) -> None:
+    from abrupt.pipelines.flight import injection_recovery
+
+    sc = load_spacecraft(KESTREL)
+    cfg = FlightRunConfig()
+    t = time.time()
+    res = run_flight(store, sc, cfg)
+    rec = injection_recovery(store, sc, cfg, res.threshold, progress=lambda s: print("  ", s, flush=True))
+    print(f"\ninjection/recovery ({time.time() - t:.0f} s), threshold {res.threshold.value:.2f} (1 FA/day):")
+    inj = rec.injections
+    for size, grp in inj.groupby(inj["dH_Nms"].round(4)):
+        print(
+            f"  {size:.3f} N m s: {grp['found'].mean():.0%} of {len(grp)};"
+            f" |dH| err median {100 * grp['rel_err'].abs().median():.0f}%"
+        )
+    print(rec.per_day.to_string(index=False))
+    print(
+        f"  90%-detectable dH per day: {', '.join(f'{v:.4f}' for v in rec.per_day['dH90_Nms'])} N m s "
+        f"(mean {rec.per_day['dH90_Nms'].mean():.4f}, spread across days {rec.per_day['dH90_Nms'].std():.4f};"
+        " target <= 0.05)"
+    )
+
+
+def _replicated_store(src: Path, dst: Path, n_days: int) -> None:
+    """A store of n_days made by re-dating kestrel's two stored days (alternately)."""
+    from abrupt.store import TelemetryStore
+
+    s, d = TelemetryStore(src), TelemetryStore(dst)
+    days = s.days("SC-A")
+    for k in range(n_days):
+        day = str(np.datetime64("2026-04-01") + np.timedelta64(k, "D"))
+        if (dst / "spacecraft=SC-A" / f"day={day}").exists():
+            continue
+        f = s.read_day("SC-A", days[k % 2])
+        shift = np.datetime64(day, "D") - np.datetime64(days[k % 2], "D")
+        f["time"] = (f["time"] + pd.Timedelta(shift)).dt.tz_localize("UTC")
+        d.write_day("SC-A", day, f, {"replicated_from": days[k % 2]})
+
+
+def part_memory(store: Path, n_days: int = 8) -> None:
+    import psutil
+
+    dst = store.parent / (store.name + "-replicated")
+    _replicated_store(store, dst, n_days)
+    sc = load_spacecraft(KESTREL)
+    proc = psutil.Process()
+    rss: list[tuple[int, float]] = []
+    seen: set[str] = set()
+
+    def tick(day: str) -> None:
+        if day not in seen:
+            seen.add(day)
+            rss.append((len(seen) - 1, proc.memory_info().rss / 2**20))
+
+    t = time.time()
+    run_flight(dst, sc, FlightRunConfig(), days=[f"2026-04-01..2026-04-{n_days:02d}"], progress=tick)
+    rss.append((len(seen), proc.memory_info().rss / 2**20))
+    print(f"\nmemory over {n_days} days ({time.time() - t:.0f} s, {(time.time() - t) / n_days:.1f} s/day):")
+    for k, m in rss:
+        print(f"  after {k} days: RSS {m:.0f} MiB")
+
+
+def part_speed(store: Path) -> None:
+    import tempfile
+
+    t = time.time()
+    files = sorted((DATA / "telemetry").glob("*.csv.gz"))
+    with tempfile.TemporaryDirectory() as tmp:
+        ingest_archives(files, DATA / "decoder.csv", Path(tmp) / "s")
+        t_ing = (time.time() - t) / len(files)
+        sc = load_spacecraft(KESTREL)
+        t = time.time()
+        run_flight(Path(tmp) / "s", sc, FlightRunConfig())
+        t_det = (time.time() - t) / len(files)
+    print(f"\nspeed: ingest {t_ing:.1f} s/day (kestrel: 14 channels, ~2.0 M rows/day), detection {t_det:.1f} s/day")
+    print(f"  extrapolated to 365 days: {365 * (t_ing + t_det) / 60:.0f} min (target < 10 min on two cores)")
+
+
+if __name__ == "__main__":
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--store", default="/tmp/abrupt-flight-bench-store")
+    ap.add_argument("--parts", default="detect")
+    args = ap.parse_args()
+    if not DATA.exists():
+        sys.exit("../shared/data/flight-like not found")
+    store = Path(args.store)
+    ensure_store(store)
+    for p in args.parts.split(","):
+        globals()[f"part_{p}"](store)

@@ -1,0 +1,223 @@
+"""Flight-telemetry commands: ``abrupt ingest``, ``abrupt inject attitude``, and the ``--store`` mode of
+``abrupt detect attitude`` / ``abrupt report attitude`` (thin: options → :mod:`abrupt.pipelines.flight`)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import click
+
+from abrupt.cli.groups import cli, inject, record_run
+
+
+def _progress(total: int, label: str) -> Any:
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=label, unit="day", leave=False, disable=None)
+
+
+@cli.command("ingest")
+@click.argument("archives", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False))
+@click.option(
+    "--decoder",
+    "decoder_path",
+    required=True,
+    type=click.Path(exists=True, dir_okay=False),
+    help="Pseudonym decoder CSV (real_name,pseudonym); read here only, never downstream.",
+)
+@click.option("--store", "store_dir", required=True, type=click.Path(file_okay=False), help="Parquet store directory.")
+@click.option("--layout", type=click.Choice(["auto", "long", "wide"]), default="auto", show_default=True)
+@click.option("--assume-utc", is_flag=True, help="Read times without a zone as UTC (counted in the report).")
+def ingest_cmd(archives: tuple[str, ...], decoder_path: str, store_dir: str, layout: str, assume_utc: bool) -> None:
+    """Ingest archive dumps (long or wide; CSV, CSV.gz, Parquet) into a pseudonymised store, one report per day."""
+    from abrupt.pipelines.flight import ingest_archives
+
+    bar = _progress(len(archives), "ingest")
+    summary = ingest_archives(
+        archives, decoder_path, store_dir, layout=layout, assume_utc=assume_utc, progress=lambda s: bar.update(1)
+    )
+    bar.close()
+    for d in summary.days:
+        removed = ", ".join(f"{k} {v}" for k, v in d.get("removed", {}).items()) or "none"
+        reported = ", ".join(f"{k} {v}" for k, v in d.get("reported", {}).items()) or "none"
+        click.echo(
+            f"{d['spacecraft']} {d['day']}: {d.get('rows_stored', d.get('rows_kept', 0))} rows; "
+            f"removed: {removed}; reported: {reported}"
+        )
+    for name, counts in summary.files.items():
+        extra = {k: v for k, v in counts.items() if k != "rows read"}
+        if extra:
+            click.echo(f"{name}: " + ", ".join(f"{k} {v}" for k, v in sorted(extra.items())), err=True)
+
+
+def _cleaning(no_clean: tuple[str, ...]) -> Any:
+    from dataclasses import replace
+
+    from abrupt.pipelines.flight import CleaningConfig
+
+    c = CleaningConfig()
+    if "all" in no_clean:
+        return CleaningConfig.off()
+    off: dict[str, Any] = {name.replace("-", "_"): False for name in no_clean}
+    return replace(c, **off)
+
+
+CLEANING_STAGES = ("event-masks", "slew-masks", "savgol", "comb", "trend", "all")
+
+
+def detect_from_store(
+    store_dir: str,
+    spacecraft_path: str,
+    days: tuple[str, ...],
+    false_alarms_per_day: float,
+    no_clean: tuple[str, ...],
+    catalog_target: str | None,
+    out: str | None,
+    report_path: str | None,
+    daily_path: str | None = None,
+) -> None:
+    """``abrupt detect attitude --store``: run the flight pipeline on stored days; write events and reports."""
+    from abrupt.events import write_events
+    from abrupt.model.spacecraft import load_spacecraft
+    from abrupt.pipelines.flight import FlightRunConfig, day_range, run_flight
+    from abrupt.store import TelemetryStore
+
+    sc = load_spacecraft(spacecraft_path)
+    cfg = FlightRunConfig(false_alarms_per_day=false_alarms_per_day, cleaning=_cleaning(no_clean))
+    day_list = day_range(TelemetryStore(store_dir), sc.name, days or None)
+    bar = _progress(len(day_list), "detect")
+    seen: set[str] = set()
+
+    def tick(day: str) -> None:
+        if day not in seen:
+            seen.add(day)
+            bar.update(1)
+
+    result = run_flight(store_dir, sc, cfg, days=day_list, keep_series=report_path is not None, progress=tick)
+    bar.close()
+    if out:
+        write_events(result.events, out)
+    if catalog_target:
+        record_run(
+            catalog_target=catalog_target,
+            command="detect attitude --store",
+            events=result.events,
+            config_hash=result.config_hash,
+            run_id=result.run_id,
+            input_path=None,
+            out=out,
+            details={
+                "store": str(store_dir),
+                "threshold": result.threshold.as_dict(),
+                "daily": result.daily.to_dict("records"),
+            },
+            spacecraft=sc.name,
+            detectors=["attitude.glr"],
+        )
+    click.echo(result.daily.to_string(index=False), err=True)
+    click.echo(
+        f"threshold {result.threshold.value:.3g} ({result.threshold.false_alarms_per_day:g} false alarms/day, "
+        f"{result.threshold.method}); {len(result.events)} events",
+        err=True,
+    )
+    for w in result.warnings:
+        click.echo(f"warning: {w}", err=True)
+    if daily_path:
+        result.daily.to_csv(daily_path, index=False)
+    if report_path:
+        from abrupt.report.flight import write_flight_report
+
+        write_flight_report(report_path, result)
+        click.echo(f"report: {report_path}", err=True)
+
+
+@inject.command("attitude")
+@click.option("--store", "store_dir", required=True, type=click.Path(exists=True, file_okay=False))
+@click.option("--spacecraft", "spacecraft_path", required=True, type=click.Path(exists=True, dir_okay=False))
+@click.option(
+    "--out-store",
+    default=None,
+    type=click.Path(file_okay=False),
+    help="Write a copy of the store with the strikes injected (native units).",
+)
+@click.option("--strike", "strikes", multiple=True, help="TIME_UTC:DHX,DHY,DHZ (inertial axes, N·m·s); repeatable.")
+@click.option("--recovery", is_flag=True, help="Injection-recovery study: 90%-detectable ΔH per day.")
+@click.option("--days", multiple=True, help="Days (YYYY-MM-DD or A..B); default all stored days.")
+@click.option(
+    "--false-alarms",
+    "false_alarms_per_day",
+    type=float,
+    default=1.0,
+    show_default=True,
+    help="False alarms per day the threshold is set for.",
+)
+@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--out", default=None, type=click.Path(dir_okay=False), help="Recovery table (.csv).")
+def inject_attitude_cmd(
+    store_dir: str,
+    spacecraft_path: str,
+    out_store: str | None,
+    strikes: tuple[str, ...],
+    recovery: bool,
+    days: tuple[str, ...],
+    false_alarms_per_day: float,
+    seed: int,
+    out: str | None,
+) -> None:
+    """Add synthetic strikes to stored telemetry (Harris et al. 2025 §3.5), or measure detectable ΔH per day."""
+    import numpy as np
+
+    from abrupt.errors import InputError
+    from abrupt.model.spacecraft import load_spacecraft
+    from abrupt.pipelines.flight import FlightRunConfig, day_range, injection_recovery, run_flight
+    from abrupt.simulate.injection import InjectedStrike, inject_strikes
+    from abrupt.store import TelemetryStore
+
+    sc = load_spacecraft(spacecraft_path)
+    store = TelemetryStore(store_dir)
+    if strikes:
+        if not out_store:
+            raise click.UsageError("--strike needs --out-store")
+        parsed = []
+        for text in strikes:
+            try:
+                t_text, v_text = text.rsplit(":", 1) if text.count(":") > 2 else text.split(":", 1)
+                vec = np.array([float(x) for x in v_text.split(",")])
+                if vec.shape != (3,):
+                    raise ValueError
+                t_ns = int(np.datetime64(t_text.rstrip("Z"), "ns").astype(np.int64))
+            except ValueError:
+                raise InputError(f"--strike {text!r}: expected TIME_UTC:DHX,DHY,DHZ") from None
+            parsed.append(InjectedStrike(t_ns, vec))
+        dst = TelemetryStore(out_store)
+        for day in day_range(store, sc.name, days or None):
+            frame = store.read_day(sc.name, day)
+            frame = inject_strikes(frame, sc, parsed, seed=seed)
+            frame["time"] = frame["time"].dt.tz_localize("UTC")
+            report = store.report(sc.name, day)
+            report["injected_strikes"] = [
+                {"time_ns": s.time_ns, "dH_N_Nms": s.dH_N_Nms.tolist()}
+                for s in parsed
+                if str(np.datetime64(s.time_ns, "ns"))[:10] == day
+            ]
+            dst.write_day(sc.name, day, frame, report)
+        click.echo(f"{len(parsed)} strike(s) injected; store written to {out_store}")
+    if recovery:
+        cfg = FlightRunConfig(false_alarms_per_day=false_alarms_per_day)
+        base = run_flight(store_dir, sc, cfg, days=days or None)
+        rec = injection_recovery(store_dir, sc, cfg, base.threshold, days=days or None, seed=seed)
+        click.echo(rec.per_day.to_string(index=False))
+        if out:
+            rec.per_day.to_csv(out, index=False)
+            Path(out).with_suffix(".injections.csv").write_text(rec.injections.to_csv(index=False))
+    if not strikes and not recovery:
+        raise click.UsageError("give --strike ... --out-store DIR, or --recovery")
+
+
+def ingest_report_json(store_dir: str, spacecraft: str, day: str) -> str:
+    """The ingest report of one stored day, as JSON text."""
+    from abrupt.store import TelemetryStore
+
+    return json.dumps(TelemetryStore(store_dir).report(spacecraft, day), indent=1)

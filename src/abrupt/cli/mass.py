@@ -1,0 +1,206 @@
+"""Mass-properties commands: ``estimate inertia``, ``detect mass-change``, ``simulate docking``."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import click
+
+from abrupt.cli.groups import catalog_option, check_suffix, cli, detect, record_run, simulate
+
+if TYPE_CHECKING:
+    from abrupt.pipelines.mass import MomentumOptions
+
+
+@cli.group("estimate")
+def estimate() -> None:
+    """Estimate spacecraft properties from routine telemetry (inertia)."""
+
+
+def _options(orbit_period_s: float | None, tachometer_gate_s: float) -> MomentumOptions:
+    from abrupt.pipelines.mass import MomentumOptions
+
+    return MomentumOptions(orbit_period_s=orbit_period_s, tachometer_gate_s=tachometer_gate_s)
+
+
+_store = click.option("--store", type=click.Path(file_okay=False), default=None, help="Folder of telemetry files.")
+_spacecraft = click.option("--spacecraft", "spacecraft_file", required=True, type=click.Path(dir_okay=False))
+_orbit = click.option(
+    "--orbit-period",
+    "orbit_period_s",
+    type=float,
+    default=None,
+    help="Orbit period [s] of a nadir-pointing spacecraft: enables the gravity-gradient torque (recommended).",
+)
+_gate = click.option(
+    "--tachometer-gate",
+    "tachometer_gate_s",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="Wheel tachometer gate [s].",
+)
+
+
+@estimate.command("inertia")
+@click.argument("telemetry", nargs=-1, type=click.Path(dir_okay=False))
+@_store
+@_spacecraft
+@_orbit
+@_gate
+@click.option("--out", "out_toml", required=True, callback=check_suffix(".toml"), help="Updated spacecraft file.")
+@click.option(
+    "--report", "report_path", default=None, callback=check_suffix(".json"), help="Report (default: OUT.json)."
+)
+@click.option("--bootstrap", type=int, default=200, show_default=True, help="Bootstrap replicates for 1-sigma.")
+def estimate_inertia_cmd(
+    telemetry: tuple[str, ...],
+    store: str | None,
+    spacecraft_file: str,
+    orbit_period_s: float | None,
+    tachometer_gate_s: float,
+    out_toml: str,
+    report_path: str | None,
+    bootstrap: int,
+) -> None:
+    """Estimate the inertia tensor from the momentum balance of routine telemetry (slews, orbit rate).
+
+    Prints the estimate, its 1-sigma, the principal moments and axes against the catalogue, writes an
+    updated spacecraft file and a JSON report. Parameters the telemetry cannot determine are named and
+    kept at the catalogue value.
+    """
+    from pathlib import Path
+
+    from abrupt.pipelines.mass import (
+        estimate_inertia_run,
+        inertia_report,
+        telemetry_paths,
+        updated_spacecraft_toml,
+        write_report,
+    )
+
+    paths = telemetry_paths(store, telemetry)
+    est, sc, repairs = estimate_inertia_run(
+        paths,
+        spacecraft_file,
+        _options(orbit_period_s, tachometer_gate_s),
+        bootstrap=bootstrap,
+    )
+    click.echo(est.summary())
+    Path(out_toml).parent.mkdir(parents=True, exist_ok=True)
+    Path(out_toml).write_text(updated_spacecraft_toml(spacecraft_file, est))
+    rep = report_path or str(Path(out_toml).with_suffix(".json"))
+    write_report(inertia_report(est, sc, repairs), rep)
+    click.echo(f"updated spacecraft file {out_toml}; report {rep}", err=True)
+
+
+@detect.command("mass-change")
+@click.argument("telemetry", nargs=-1, type=click.Path(dir_okay=False))
+@_store
+@_spacecraft
+@_orbit
+@_gate
+@click.option("--window", "window_s", type=float, default=86400.0, show_default=True, help="Window length [s].")
+@click.option("--false-alarms", "budget_text", default="1/year", show_default=True, help="Budget, e.g. 1/year.")
+@click.option("--radius", "radius_m", type=float, default=1.0, show_default=True, help="Assumed attachment radius [m].")
+@click.option("--attitude-events", type=click.Path(dir_okay=False), default=None, help="Events file to link with.")
+@click.option("--out", default=None, callback=check_suffix(".csv", ".parquet"), help="Events file.")
+@catalog_option
+def detect_mass_change_cmd(
+    telemetry: tuple[str, ...],
+    store: str | None,
+    spacecraft_file: str,
+    orbit_period_s: float | None,
+    tachometer_gate_s: float,
+    window_s: float,
+    budget_text: str,
+    radius_m: float,
+    attitude_events: str | None,
+    out: str | None,
+    catalog_target: str,
+) -> None:
+    """Track the inertia window by window and report a mass change (GLR at the false-alarm budget)."""
+    from abrupt.events import config_hash, new_run_id, read_events
+    from abrupt.pipelines.mass import detect_mass_change_run, telemetry_paths
+    from abrupt.thresholds import FalseAlarmBudget
+
+    budget = FalseAlarmBudget.parse(budget_text)
+    paths = telemetry_paths(store, telemetry)
+    att = read_events(attitude_events) if attitude_events else None
+    run_id = new_run_id()
+    cfg = config_hash({"window_s": window_s, "budget": str(budget), "radius_m": radius_m, "sc": spacecraft_file})
+    result, track = detect_mass_change_run(
+        paths,
+        spacecraft_file,
+        budget,
+        options=_options(orbit_period_s, tachometer_gate_s),
+        window_s=window_s,
+        attachment_radius_m=radius_m,
+        attitude_events=att,
+        run_id=run_id,
+        config_hash=cfg,
+    )
+    diag = result.diagnostic("inertia_glr")
+    click.echo(
+        f"{track.n_windows} windows; GLR statistic max {float(max(diag.statistic, default=0)):.1f}, "
+        f"threshold {diag.threshold.value if diag.threshold else float('nan'):.1f} ({budget})"
+    )
+    for w in result.warnings:
+        click.echo(f"warning: {w}", err=True)
+    for _, ev in result.events.iterrows():
+        click.echo(
+            f"mass change near {ev['time_utc']} "
+            f"(bracket {ev['time_bracket_start_utc']} .. {ev['time_bracket_end_utc']}):"
+            f" implied mass {ev['dm_kg']:.2f} +/- {ev['dm_sigma_kg']:.2f} kg at r = {radius_m} m"
+        )
+    record_run(
+        catalog_target=catalog_target,
+        command="detect mass-change",
+        events=result.events,
+        config_hash=cfg,
+        run_id=run_id,
+        out=out,
+    )
+
+
+@simulate.command("docking")
+@_spacecraft
+@click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False), help="Output folder.")
+@click.option("--days", type=float, default=10.0, show_default=True, help="Length [days]; fractions allowed.")
+@click.option("--docking-day", type=float, default=5.3, show_default=True, help="Docking time [days]; <0: none.")
+@click.option("--mass", "mass_kg", type=float, default=5.0, show_default=True, help="Parasite mass [kg].")
+@click.option(
+    "--at",
+    "attachment",
+    type=(float, float, float),
+    default=(1.0, 0.0, 0.0),
+    show_default=True,
+    help="Attachment point from the CoM, body axes [m].",
+)
+@click.option("--orbit-period", "orbit_period_s", type=float, default=5926.4, show_default=True)
+@click.option("--seed", type=int, default=0, show_default=True)
+def simulate_docking_cmd(
+    spacecraft_file: str,
+    out_dir: str,
+    days: float,
+    docking_day: float,
+    mass_kg: float,
+    attachment: tuple[float, float, float],
+    orbit_period_s: float,
+    seed: int,
+) -> None:
+    """Simulate routine telemetry (nadir pointing, slews) with a parasite docking; one CSV per day."""
+    from abrupt.pipelines.mass import simulate_docking_run
+    from abrupt.simulate.attitude import CircularOrbit
+    from abrupt.simulate.docking import DockingScenario
+
+    scenario = DockingScenario(
+        days=days,
+        docking_time_s=None if docking_day < 0 else docking_day * 86400.0,
+        parasite_mass_kg=mass_kg,
+        attachment_B_m=attachment,
+        orbit=CircularOrbit(period_s=orbit_period_s),
+        seed=seed,
+    )
+    paths = simulate_docking_run(spacecraft_file, out_dir, scenario)
+    click.echo(f"wrote {len(paths) - 1} day file(s) and {paths[-1]}", err=True)

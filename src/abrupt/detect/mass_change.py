@@ -1,0 +1,224 @@
+"""Mass-change detector: a change in the inertia tensor between windows of routine telemetry (issue 13).
+
+Series: an :class:`~abrupt.massprops.track.InertiaTrack` (one estimate of J per window, e.g. per day).
+Statistic (GLR for a step in the mean of Gaussian vectors, Basseville & Nikiforov 1993 §2.4): for the
+newest window n and every candidate change window τ ≤ n,
+
+    S(τ, n) = (n_b n_a / (n_b + n_a)) (x̄_after − x̄_before)ᵀ Σ⁻¹ (x̄_after − x̄_before),
+
+with x the observable inertia parameters, n_b/n_a the windows before/after τ and Σ the covariance of one
+window's estimate. Σ is the data's own noise model: the shape of the estimator's bootstrap covariance,
+scaled by c ≥ 1 estimated from the differences of windows 1, 2 and 3 apart (robust median, so a step
+does not inflate it; the largest lag's spread is kept, so a slow drift of the estimates is not taken
+for a step). With an estimated scale, S/c follows d·F(d, ν) (Hotelling's T²), and the threshold is
+that quantile at the per-test level of the false-alarm budget (one test per window), Bonferroni-
+corrected over the candidate change times. A change must persist for ``min_windows_after`` windows
+(default 2), so one bad window cannot raise an alarm.
+
+An alarm gives one ``mass_change`` event: the change time bracketed by the windows on either side of
+τ̂, ΔJ with its 1σ, and the implied mass for an assumed attachment radius r: a point mass m at distance
+r changes the trace of J by 2 m r² (spec §5.7 point-mass update; the CoM shift term is second order in
+m/M), so m = tr(ΔJ) / (2 r²). The CoM offset itself does not enter the momentum about the CoM and is not
+observable from attitude telemetry alone (not reported).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import ClassVar
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+from abrupt.clean.noise import robust_scale
+from abrupt.detect.base import DetectionResult, Detector, Diagnostics
+from abrupt.events import Event, events_frame, format_time_utc
+from abrupt.massprops.inertia import INERTIA_ELEMENTS
+from abrupt.massprops.track import InertiaTrack
+from abrupt.thresholds import FalseAlarmBudget, Threshold
+
+
+def _robust_cov(x: np.ndarray) -> np.ndarray:
+    """Covariance of one window from consecutive differences (a single step barely moves it)."""
+    d = np.diff(x, axis=0)
+    if d.shape[0] < 3:
+        return np.full((x.shape[1], x.shape[1]), np.nan)
+    mad = robust_scale(d, axis=0)
+    corr = np.corrcoef(d.T) if d.shape[0] > 2 else np.eye(x.shape[1])
+    corr = np.nan_to_num(corr, nan=0.0)
+    np.fill_diagonal(corr, 1.0)
+    return np.asarray(np.outer(mad, mad) * corr / 2.0, dtype=np.float64)
+
+
+class InertiaChangeDetector(Detector[InertiaTrack]):
+    """GLR test for a step change of the inertia between windows; emits ``mass_change`` events."""
+
+    name: ClassVar[str] = "mass.inertia_change"
+    series_type: ClassVar[type] = InertiaTrack
+    kind: ClassVar[str] = "mass_change"
+    summary: ClassVar[str] = "step in the windowed inertia estimate (GLR, χ² threshold from the budget)"
+
+    def __init__(
+        self,
+        *,
+        attachment_radius_m: float = 1.0,
+        min_windows_before: int = 3,
+        min_windows_after: int = 2,
+        attitude_events: pd.DataFrame | None = None,
+        run_id: str = "",
+        config_hash: str = "",
+    ) -> None:
+        if not (math.isfinite(attachment_radius_m) and attachment_radius_m > 0):
+            raise ValueError(f"attachment_radius_m must be positive, got {attachment_radius_m}")
+        if min_windows_before < 2:
+            raise ValueError("min_windows_before must be at least 2")
+        self.attachment_radius_m = float(attachment_radius_m)
+        self.min_windows_before = int(min_windows_before)
+        if min_windows_after < 1:
+            raise ValueError("min_windows_after must be at least 1")
+        self.min_windows_after = int(min_windows_after)
+        self._attitude_events = attitude_events
+        self.run_id = run_id
+        self.config_hash = config_hash
+
+    def detect(self, series: InertiaTrack, budget: FalseAlarmBudget) -> DetectionResult:
+        k = series.n_windows
+        if k < self.min_windows_before + self.min_windows_after:
+            return DetectionResult.empty(
+                warnings=(f"{k} window(s): need {self.min_windows_before + self.min_windows_after} to test a change",)
+            )
+        obs = np.all(series.observable, axis=0)
+        idx = np.flatnonzero(obs)
+        warnings: list[str] = []
+        if idx.size == 0:
+            return DetectionResult.empty(warnings=("no inertia parameter is observable in every window",))
+        x = series.params[:, idx]
+        d = idx.size
+        # Shape of one window's covariance from the estimator; its scale from the data (below).
+        boot = np.nanmedian(series.covariance[:, idx][:, :, idx], axis=0)
+        if not np.all(np.isfinite(boot)):
+            boot = _robust_cov(x)
+        if not np.all(np.isfinite(boot)):
+            return DetectionResult.empty(warnings=("fewer than 4 windows and no estimator covariance",))
+        inv_b = np.linalg.pinv(boot)
+        window_s = float(np.median(series.t_end_s - series.t_start_s))
+        tests_per_day = 86400.0 / window_s
+        n_candidates = max(1, k - self.min_windows_before - self.min_windows_after + 1)
+        p_test = budget.per_test(tests_per_day) / n_candidates
+        # Scale factor c_n ≥ 1 of the covariance from consecutive differences of windows 0..n-1:
+        # m_j = Δxᵀ (2 Σ_b)⁻¹ Δx / d is χ²_d / d under no change; the median ignores the one difference
+        # that spans a step. The statistic S / c_n is then compared with d F(d, ν), ν the degrees of
+        # freedom of c_n (median efficiency 2/π), Hotelling's T² with an estimated scale.
+        # Lags 1..3: under white window noise every lag has the same spread; a slow drift of the
+        # estimates (a systematic that varies over days) shows up as a spread growing with the lag,
+        # and the largest is used, so slow drifts are not taken for a step.
+        lag_m = []
+        for lag in (1, 2, 3):
+            dl = x[lag:] - x[:-lag]
+            lag_m.append(np.einsum("ti,ij,tj->t", dl, inv_b, dl) / (2.0 * d))
+        med_chi = float(stats.chi2.median(d)) / d
+        stat = np.full(k, np.nan)
+        thr = np.full(k, np.nan)
+        scale = np.full(k, np.nan)
+        best_tau = np.full(k, -1)
+        alarm_at = -1
+        cs = np.concatenate([np.zeros((1, d)), np.cumsum(x, axis=0)])
+        first = self.min_windows_before + self.min_windows_after
+        for n in range(first, k + 1):  # windows 0..n-1 available
+            c_n = 1.0
+            for lag, ml in enumerate(lag_m, start=1):
+                if n - lag >= 2:
+                    c_n = max(c_n, float(np.median(ml[: n - lag])) / med_chi)
+            nu = max(1.0, (n - 1) * d * 2.0 / math.pi)
+            h_n = d * float(stats.f.isf(p_test, d, nu))
+            taus = np.arange(self.min_windows_before, n - self.min_windows_after + 1)
+            nb, na = taus.astype(np.float64), (n - taus).astype(np.float64)
+            diff = (cs[n] - cs[taus]) / na[:, None] - cs[taus] / nb[:, None]
+            s_all = nb * na / (nb + na) * np.einsum("ti,ij,tj->t", diff, inv_b, diff) / c_n
+            j = int(np.argmax(s_all))
+            stat[n - 1], best_tau[n - 1], thr[n - 1], scale[n - 1] = float(s_all[j]), int(taus[j]), h_n, c_n
+            if s_all[j] > h_n and alarm_at < 0:
+                alarm_at = n - 1
+        h = float(thr[alarm_at]) if alarm_at >= 0 else float(thr[-1]) if np.isfinite(thr[-1]) else math.nan
+        threshold = Threshold(h, p_test, f"{d}F(d={d},nu)/bonferroni({n_candidates})", k, budget.per_day)
+        c_final = (
+            float(scale[alarm_at]) if alarm_at >= 0 else float(np.nanmax(scale)) if np.isfinite(scale).any() else 1.0
+        )
+        sigma = boot * c_final
+        inv = np.linalg.pinv(sigma)
+        diag = Diagnostics(
+            name="inertia_glr",
+            time_s=series.t_end_s,
+            statistic=stat,
+            threshold=threshold,
+            epoch_utc=np.datetime64(pd.Timestamp(series.epoch_utc or "1970-01-01").tz_localize(None)),
+            unit="chi2",
+            noise_model={"window_covariance_kgm2_sq": sigma, "parameters": [INERTIA_ELEMENTS[i] for i in idx]},
+            extra={"best_change_window": best_tau, "threshold_per_window": thr, "covariance_scale": scale},
+        )
+        if alarm_at < 0:
+            return DetectionResult.empty(diagnostics=(diag,), warnings=tuple(warnings))
+        # Characterise with every window after the change (not only up to the alarm).
+        tau = int(best_tau[alarm_at])
+        full_stats = []
+        for cand in range(self.min_windows_before, k):
+            diff = x[cand:].mean(axis=0) - x[:cand].mean(axis=0)
+            full_stats.append(cand * (k - cand) / k * float(diff @ inv @ diff))
+        tau = self.min_windows_before + int(np.argmax(full_stats)) if full_stats else tau
+        before, after = series.params[:tau], series.params[tau:]
+        dj = after.mean(axis=0) - before.mean(axis=0)
+        dj_cov_obs = sigma * (1.0 / before.shape[0] + 1.0 / after.shape[0])
+        dj_sig = np.full(6, np.nan)
+        dj_sig[idx] = np.sqrt(np.diag(dj_cov_obs))
+        dj = np.where(obs, dj, np.nan)
+        trace_idx = [i for i in range(3) if obs[i]]
+        r2 = self.attachment_radius_m**2
+        if len(trace_idx) == 3:
+            dm = float(np.sum(dj[:3]) / (2 * r2))
+            w = np.zeros(d)
+            for i in trace_idx:
+                w[[int(v) for v in idx].index(i)] = 1.0 / (2 * r2)
+            dm_sig = float(math.sqrt(w @ dj_cov_obs @ w))
+        else:
+            dm, dm_sig = math.nan, math.nan
+            warnings.append("not every principal moment is observable: implied mass not reported")
+        t_mid = 0.5 * (series.t_end_s[tau - 1] + series.t_start_s[tau])
+        epoch = pd.Timestamp(series.epoch_utc or "1970-01-01")
+        epoch = epoch.tz_localize("UTC") if epoch.tzinfo is None else epoch
+        extra: dict[str, object] = {
+            "time_bracket_start_utc": format_time_utc(epoch + pd.Timedelta(seconds=float(series.t_start_s[tau - 1]))),
+            "time_bracket_end_utc": format_time_utc(epoch + pd.Timedelta(seconds=float(series.t_end_s[tau]))),
+            "alarm_time_utc": format_time_utc(epoch + pd.Timedelta(seconds=float(series.t_end_s[alarm_at]))),
+            "dm_kg": dm,
+            "dm_sigma_kg": dm_sig,
+            "attachment_radius_m": self.attachment_radius_m,
+            "linked_event_id": "",
+        }
+        for i, name in enumerate(INERTIA_ELEMENTS):
+            extra[f"d{name}_kgm2"] = float(dj[i])
+            extra[f"d{name}_sigma_kgm2"] = float(dj_sig[i])
+        start = series.t_start_s[tau - 1]
+        end = series.t_end_s[tau]
+        if self._attitude_events is not None and len(self._attitude_events):
+            ev = self._attitude_events
+            times = (pd.to_datetime(ev["time_utc"], utc=True) - epoch).dt.total_seconds().to_numpy()
+            inside = np.flatnonzero((times >= start) & (times <= end))
+            if inside.size:
+                j = inside[np.argmin(np.abs(times[inside] - t_mid))]
+                extra["linked_event_id"] = str(ev["event_id"].iloc[j])
+                t_mid = float(times[j])
+        event = Event(
+            spacecraft=series.spacecraft,
+            kind="mass_change",
+            detector=self.name,
+            time_utc=format_time_utc(epoch + pd.Timedelta(seconds=float(t_mid))),
+            statistic=float(stat[alarm_at]),
+            threshold=h,
+            false_alarms_per_day=budget.per_day,
+            run_id=self.run_id,
+            config_hash=self.config_hash,
+            time_sigma_s=float((end - start) / math.sqrt(12.0)),
+            extra=extra,
+        )
+        return DetectionResult(events_frame([event]), (diag,), tuple(warnings))

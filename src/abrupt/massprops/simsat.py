@@ -1,0 +1,381 @@
+"""SIMSAT single-axis reproduction of Dabrowski 2003 (spec ``dabrowski-2003-spec.md`` §2, §5-7).
+
+Model (yaw axis, Eq. 2.19c with Ω1 = Ω2 = 0), fixed step 0.05 s, zero-order hold inside a step:
+
+* PD controller producing a wheel-speed command (spec §2.6 [I]): ``ω_cmd = −(K_P e + K_D ė)`` with
+  ``e = ψ_cmd − ψ_meas`` and ``ė = −Ω_meas`` (rate gyro); reconstructed gains K_P = 3000, K_D = 1200;
+* wheel motor model (§2.7): ``ω̇ = WG · sat_{±9.92}(k_lut (ω_cmd − ω))`` with the command delayed by one
+  step (Table 3.4: one delay step, no smoothing), k_lut = 5 s⁻¹;
+* body: ``Ω̇ = −ω̇ I_rw / (I33 + I_rw)`` (Eq. 2.19c), ψ̇ = Ω.
+
+Detection maneuver (§5.1): hold 15 s, steps +A, 0, −A, 0 every T; match windows on steps 1 and 3.
+Phase A tunes the wheel gain per baseline run and averages (§5.3); Phase B fits I33 per run with the
+coarse-to-fine grid search of Appendix C (§5.4; L1 cost over the match windows); aggregation methods
+1-3 (§5.5); parasite mass ΔI = m ρ² (Eq. 4.4) and ``min_detectable_mass`` (§7).
+
+Synthetic testbed (§8.1 item 11, calibrated in ``benchmarks/bench_dabrowski.py``): per-run wheel
+non-repeatability (random wheel gain), a gyro bias (drift, spec §3.3: about −2.5°/min) and a long-period
+gyro wander (60-120 s period); the controller flies the gyro-integrated attitude, which is what is recorded.
+
+Beyond the thesis, :func:`momentum_exchange_estimate` fits I33 from the same maneuver's telemetry by the
+momentum balance (I33 + I_rw) ψ + I_rw θ_w = H₀ t + c (the integral of Eq. 2.19c; Eq. 3.1 generalised
+to closed loop), which does not depend on the wheel's non-repeatable gain at all.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from abrupt.types import FloatArray
+
+I33_BASELINE = 35.15802468071735  # [kg m^2] (spec Table 4.1, code value)
+I_RW = 1.955099417802845e-2  # [kg m^2] wheel MOI (spec §2.9)
+MOI_CONFIGS = (35.15802468071735, 36.36324072038076, 37.67249505661412, 39.21527184484653, 43.24981053845178)
+
+
+@dataclass(frozen=True)
+class SimsatParams:
+    """SIMSAT model parameters (spec §2.9); gains are the spec's reconstructed defaults (§2.6)."""
+
+    i33_kgm2: float = I33_BASELINE
+    i_rw_kgm2: float = I_RW
+    gain_kp: float = 3000.0  # [rad/s of wheel speed per rad]
+    gain_kd: float = 1200.0  # [rad/s per rad/s]
+    k_lut_per_s: float = 5.0  # [1/s]
+    max_wheel_accel: float = 9.92  # [rad/s^2]
+    wheel_gain: float = 1.0
+    delay_steps: int = 1
+    dt_s: float = 0.05
+
+
+@dataclass(frozen=True)
+class Maneuver:
+    """The four-step detection maneuver (spec §5.1 timing table)."""
+
+    amplitude_deg: float
+    step_period_s: float
+    sim_length_s: float
+    hold_s: float = 15.0
+
+    @classmethod
+    def thesis(cls, amplitude_deg: float) -> Maneuver:
+        """1° and 0.5°: T = 10 s, 55 s; 2°: T = 15 s, 75 s (App. C)."""
+        if amplitude_deg >= 2.0:
+            return cls(amplitude_deg, 15.0, 75.0)
+        return cls(amplitude_deg, 10.0, 55.0)
+
+    def times(self, dt: float) -> FloatArray:
+        return np.arange(0.0, self.sim_length_s + dt / 2, dt)
+
+    def command_rad(self, t: FloatArray) -> FloatArray:
+        a = math.radians(self.amplitude_deg)
+        k = np.floor((t - self.hold_s) / self.step_period_s)
+        cmd = np.where(k == 0, a, np.where(k == 2, -a, 0.0))
+        return np.asarray(np.where(t < self.hold_s, 0.0, cmd), dtype=np.float64)
+
+    def match_mask(self, t: FloatArray) -> FloatArray:
+        """Windows on steps 1 and 3: [t0, t0+T) and [t0+2T, t0+3T) (App. C index arithmetic)."""
+        t0, p = self.hold_s, self.step_period_s
+        m = ((t >= t0) & (t < t0 + p)) | ((t >= t0 + 2 * p) & (t < t0 + 3 * p))
+        return np.asarray(m, dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class TestbedNoise:
+    """Run-to-run non-repeatability of the synthetic SIMSAT (spec §3.3, §4.3.5, §8.1 item 11).
+
+    ``wheel_gain_sd``: relative SD of the wheel gain from run to run; ``lut_slope_sd``: relative SD of the
+    look-up table's slope (the unsaturated part) from run to run (§8.1 item 11); ``gyro_bias_deg_min``: mean residual
+    drift after the operator's zeroing (App. F) and ``gyro_bias_sd_deg_min`` its run-to-run SD [deg/min]
+    (the raw −2.5°/min of §3.3 is calibrated out before a test); ``wander_deg``: amplitude of the long-period
+    gyro wander (period uniform in ``wander_period_s``); ``encoder_noise_rad_s`` wheel-speed noise;
+    ``rate_noise_deg_s`` white noise of each rate-gyro sample (its integral is a random walk of the
+    recorded attitude; the controller flies it).
+    """
+
+    wheel_gain_sd: float = 0.03
+    lut_slope_sd: float = 0.0
+    gyro_bias_deg_min: float = -0.1
+    gyro_bias_sd_deg_min: float = 0.1
+    wander_deg: float = 0.05
+    wander_period_s: tuple[float, float] = (60.0, 120.0)
+    encoder_noise_rad_s: float = 0.05
+    rate_noise_deg_s: float = 0.0
+
+
+def simulate_simsat(
+    params: SimsatParams,
+    maneuver: Maneuver,
+    i33_kgm2: ArrayLike | None = None,
+    wheel_gain: ArrayLike | None = None,
+    gyro_error_rad: FloatArray | None = None,
+    lut_slope_per_s: ArrayLike | None = None,
+) -> dict[str, FloatArray]:
+    """Simulate a batch of runs (columns) of the closed-loop yaw response.
+
+    ``i33_kgm2`` and ``wheel_gain`` broadcast to a batch (m,); ``gyro_error_rad`` (n, m) is added to the
+    true yaw to give the measured (gyro-integrated) attitude the controller flies and the telemetry
+    records. Returns ``t_s`` (n,), ``command_rad`` (n,), ``yaw_meas_rad``, ``yaw_true_rad``,
+    ``wheel_speed_rad_s`` and ``body_rate_rad_s`` (n, m).
+    """
+    t = maneuver.times(params.dt_s)
+    n = t.size
+    i33 = np.atleast_1d(np.asarray(params.i33_kgm2 if i33_kgm2 is None else i33_kgm2, dtype=np.float64))
+    wg = np.atleast_1d(np.asarray(params.wheel_gain if wheel_gain is None else wheel_gain, dtype=np.float64))
+    m = max(i33.size, wg.size, 1 if gyro_error_rad is None else gyro_error_rad.shape[1])
+    i33 = np.broadcast_to(i33, (m,))
+    wg = np.broadcast_to(wg, (m,))
+    err = np.zeros((n, m)) if gyro_error_rad is None else np.broadcast_to(gyro_error_rad, (n, m))
+    k_lut = np.broadcast_to(
+        np.asarray(params.k_lut_per_s if lut_slope_per_s is None else lut_slope_per_s, dtype=np.float64), (m,)
+    )
+    err_rate = np.gradient(err, params.dt_s, axis=0)
+    cmd = maneuver.command_rad(t)
+    dt = params.dt_s
+    ratio = params.i_rw_kgm2 / (i33 + params.i_rw_kgm2)
+    psi = np.zeros(m)
+    om = np.zeros(m)
+    w = np.zeros(m)
+    queue = [np.zeros(m) for _ in range(max(params.delay_steps, 0) + 1)]
+    out_psi = np.empty((n, m))
+    out_meas = np.empty((n, m))
+    out_w = np.empty((n, m))
+    out_om = np.empty((n, m))
+    for k in range(n):
+        meas = psi + err[k]
+        out_psi[k], out_meas[k], out_w[k], out_om[k] = psi, meas, w, om
+        e = cmd[k] - meas
+        w_cmd = -(params.gain_kp * e + params.gain_kd * (-(om + err_rate[k])))
+        queue.append(w_cmd)
+        w_cmd_delayed = queue.pop(0)
+        wdot = wg * np.clip(k_lut * (w_cmd_delayed - w), -params.max_wheel_accel, params.max_wheel_accel)
+        omdot = -wdot * ratio
+        psi = psi + om * dt + 0.5 * omdot * dt * dt
+        om = om + omdot * dt
+        w = w + wdot * dt
+    return {
+        "t_s": t,
+        "command_rad": cmd,
+        "yaw_meas_rad": out_meas,
+        "yaw_true_rad": out_psi,
+        "wheel_speed_rad_s": out_w,
+        "body_rate_rad_s": out_om,
+    }
+
+
+def testbed_runs(
+    params: SimsatParams,
+    maneuver: Maneuver,
+    i33_kgm2: float,
+    n_runs: int,
+    noise: TestbedNoise,
+    rng: np.random.Generator,
+) -> dict[str, FloatArray]:
+    """Synthetic "measured" runs on the testbed with truth ``i33_kgm2`` (columns = runs)."""
+    t = maneuver.times(params.dt_s)
+    wg = params.wheel_gain * (1.0 + noise.wheel_gain_sd * rng.standard_normal(n_runs))
+    bias = np.radians(noise.gyro_bias_deg_min + noise.gyro_bias_sd_deg_min * rng.standard_normal(n_runs)) / 60.0
+    period = rng.uniform(*noise.wander_period_s, n_runs)
+    phase = rng.uniform(0, 2 * math.pi, n_runs)
+    wander = np.radians(noise.wander_deg) * np.sin(2 * math.pi * t[:, None] / period + phase)
+    # The gyro is zeroed at power-on; drift and wander accumulate in the integrated attitude.
+    err = bias * t[:, None] + wander - wander[:1]
+    dt = params.dt_s
+    err = err + np.cumsum(np.radians(noise.rate_noise_deg_s) * dt * rng.standard_normal(err.shape), axis=0)
+    k_lut = params.k_lut_per_s * (1.0 + noise.lut_slope_sd * rng.standard_normal(n_runs))
+    sim = simulate_simsat(params, maneuver, i33_kgm2, wg, err, k_lut)
+    sim["wheel_speed_meas_rad_s"] = sim["wheel_speed_rad_s"] + noise.encoder_noise_rad_s * rng.standard_normal(
+        sim["wheel_speed_rad_s"].shape
+    )
+    return sim
+
+
+def l1_cost(y_meas: FloatArray, y_model: FloatArray, mask: FloatArray) -> FloatArray:
+    """Mean absolute mismatch over the match windows (Eqs. 2.42/2.44, App. C): Σ|Δ| / N."""
+    return np.asarray(np.sum(np.abs(y_meas - y_model) * mask[:, None], axis=0) / mask.sum(), dtype=np.float64)
+
+
+def grid_search(
+    cost: object,
+    center: float,
+    *,
+    range_lo: float = 0.5,
+    range_hi: float = 2.0,
+    n_intervals: int = 20,
+    shrink_half_width_steps: float = 2.5,
+    tol: float = 1e-6,
+) -> tuple[float, float]:
+    """Coarse-to-fine grid search of App. C (spec §5.4): 21 points, range → best ± 2.5 steps, until step ≤ tol.
+
+    ``cost`` maps an array of candidate values to an array of costs (vectorised over the grid).
+    Returns (best value, its cost).
+    """
+    lo, hi = range_lo * center, range_hi * center
+    step = (hi - lo) / n_intervals
+    best, j_min = center, math.inf
+    while step > tol:
+        grid = lo + step * np.arange(n_intervals + 1)
+        costs = np.asarray(cost(grid))  # type: ignore[operator]
+        k = int(np.argmin(costs))
+        if costs[k] < j_min:
+            j_min, best = float(costs[k]), float(grid[k])
+        lo, hi = best - shrink_half_width_steps * step, best + shrink_half_width_steps * step
+        step = (hi - lo) / n_intervals
+    return best, j_min
+
+
+def estimate_run_i33(
+    params: SimsatParams, maneuver: Maneuver, y_meas: FloatArray, tol: float = 1e-4
+) -> tuple[float, float]:
+    """Phase B for one run: grid search on I33 with all other parameters frozen (spec §5.4)."""
+    t = maneuver.times(params.dt_s)
+    mask = maneuver.match_mask(t)
+
+    def cost(grid: FloatArray) -> FloatArray:
+        sim = simulate_simsat(params, maneuver, grid)
+        return l1_cost(y_meas[:, None], sim["yaw_meas_rad"], mask)
+
+    return grid_search(cost, params.i33_kgm2, tol=tol)
+
+
+def tune_wheel_gain(
+    params: SimsatParams, maneuver: Maneuver, y_meas: FloatArray, tol: float = 1e-5
+) -> tuple[float, float]:
+    """Phase A for one baseline run: the wheel gain that best fits it with the known I33 (spec §5.3)."""
+    t = maneuver.times(params.dt_s)
+    mask = maneuver.match_mask(t)
+
+    def cost(grid: FloatArray) -> FloatArray:
+        sim = simulate_simsat(params, maneuver, None, grid)
+        return l1_cost(y_meas[:, None], sim["yaw_meas_rad"], mask)
+
+    return grid_search(cost, params.wheel_gain, tol=tol)
+
+
+def aggregate(estimates: ArrayLike, mean_errors: ArrayLike, method: int = 1) -> float:
+    """Methods 1-3 of spec §5.5: equal mean; mean of the better-fitting half; 1/E weights (Eq. 4.1)."""
+    x = np.asarray(estimates, dtype=np.float64)
+    e = np.asarray(mean_errors, dtype=np.float64)
+    if method == 1:
+        return float(np.mean(x))
+    if method == 2:
+        keep = np.argsort(e)[: max(1, x.size // 2)]
+        return float(np.mean(x[keep]))
+    if method == 3:
+        w = 1.0 / (e / np.min(e))
+        return float(np.sum(w * x) / np.sum(w))
+    raise ValueError(f"aggregation method must be 1, 2 or 3, got {method}")
+
+
+def momentum_exchange_estimate(
+    t_s: FloatArray,
+    yaw_meas_rad: FloatArray,
+    wheel_speed_rad_s: FloatArray,
+    maneuver: Maneuver | None = None,
+    i_rw_kgm2: float = I_RW,
+) -> float:
+    """I33 from the single-axis momentum balance over each sample step (beyond the thesis).
+
+    (I33 + I_rw) Ω + I_rw ω = H₀ (Eq. 2.19c integrated) holds over every step:
+    (I33 + I_rw) Δψ_k + I_rw Δθ_w,k = H₀ Δt, with Δψ the change of the recorded (gyro-integrated) yaw,
+    i.e. the rate gyro's reading, and Δθ_w = ω̄ Δt from the wheel-speed telemetry. The wheel gain and
+    look-up table never enter, and rate-gyro white noise stays white in this (differenced) form. A gyro
+    bias and slow gyro wander add a slowly varying rate, fitted as a line per step period of
+    ``maneuver``, so only the fast momentum exchange at each step informs I33. Least squares
+    Δψ = a Δθ_w + Σ_k (c_k + h_k t) Δt, I33 = −I_rw (1 + a) / a.
+    """
+    dt = np.diff(t_s)
+    dpsi = np.diff(yaw_meas_rad)
+    dtheta = 0.5 * (wheel_speed_rad_s[1:] + wheel_speed_rad_s[:-1]) * dt
+    tm = 0.5 * (t_s[1:] + t_s[:-1])
+    if maneuver is None:
+        edges = [t_s[0] - 1.0, t_s[-1] + 1.0]
+    else:
+        edges = [t_s[0] - 1.0, *(maneuver.hold_s + maneuver.step_period_s * np.arange(1, 4) - 0.5), t_s[-1] + 1.0]
+    cols = [dtheta]
+    for lo, hi in itertools.pairwise(edges):
+        inside = ((tm >= lo) & (tm < hi)).astype(np.float64)
+        cols += [inside * dt, inside * (tm - lo) * dt]
+    x = np.column_stack(cols)
+    coef, *_ = np.linalg.lstsq(x, dpsi, rcond=None)
+    a = coef[0]
+    return float(-i_rw_kgm2 * (1.0 + a) / a)
+
+
+# ------------------------------------------------------------------------------------------ mass inference
+def parasite_mass(delta_i_kgm2: ArrayLike, rho_m: ArrayLike) -> FloatArray:
+    """Eq. 4.4: m = ΔI_ii / (ρ_{i+1}² + ρ_{i+2}²) per axis (NaN where the denominator is zero) [kg]."""
+    di = np.asarray(delta_i_kgm2, dtype=np.float64).reshape(3)
+    r = np.asarray(rho_m, dtype=np.float64).reshape(3)
+    den = np.array([r[1] ** 2 + r[2] ** 2, r[0] ** 2 + r[2] ** 2, r[0] ** 2 + r[1] ** 2])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.asarray(np.where(den > 0, di / den, np.nan), dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class DetectableMass:
+    """Minimum detectable parasite: per axis [kg], the minimum, and (for a sweep) the worst location."""
+
+    per_axis_kg: FloatArray
+    minimum_kg: float
+    worst_location_m: FloatArray | None = None
+    worst_minimum_kg: float = math.nan
+
+
+def min_detectable_mass(
+    inertia_diag_kgm2: ArrayLike,
+    rho_m: ArrayLike,
+    frac_accuracy: float,
+) -> DetectableMass:
+    """Spec §7: put ΔI = frac_accuracy × I into Eq. 4.4 and take the minimum over sensitive axes.
+
+    GPS-IIR (I = diag(1725, 782, 2020), ρ = [0.8, 0, 0], 0.67%) gives 8.19 kg via axis 2.
+    """
+    i = np.asarray(inertia_diag_kgm2, dtype=np.float64).reshape(3)
+    per_axis = parasite_mass(frac_accuracy * i, rho_m)
+    return DetectableMass(per_axis, float(np.nanmin(per_axis)))
+
+
+def min_detectable_mass_over_box(
+    inertia_diag_kgm2: ArrayLike, half_size_m: ArrayLike, frac_accuracy: float, n: int = 21
+) -> DetectableMass:
+    """Sweep attachment points over the surface of a box bus centred on the CoM; report the worst case.
+
+    For each surface point the minimum over axes is the detectable mass there; the least detectable
+    location (largest of these minima) is the bus's worst case (spec §7 [R]).
+    """
+    h = np.asarray(half_size_m, dtype=np.float64).reshape(3)
+    u = np.linspace(-1.0, 1.0, n)
+    worst, worst_m, best_axis = None, -math.inf, np.full(3, np.nan)
+    for face in range(3):
+        for sign in (-1.0, 1.0):
+            a, b = [k for k in range(3) if k != face]
+            for ua in u:
+                for ub in u:
+                    rho = np.zeros(3)
+                    rho[face] = sign * h[face]
+                    rho[a], rho[b] = ua * h[a], ub * h[b]
+                    d = min_detectable_mass(inertia_diag_kgm2, rho, frac_accuracy)
+                    if d.minimum_kg > worst_m:
+                        worst_m, worst, best_axis = d.minimum_kg, rho, d.per_axis_kg
+    return DetectableMass(best_axis, float(np.nanmin(best_axis)), worst, worst_m)
+
+
+def with_wheel_gain(params: SimsatParams, wheel_gain: float) -> SimsatParams:
+    """The same parameters with another wheel gain (Phase A result)."""
+    return replace(params, wheel_gain=float(wheel_gain))
+
+
+def phase_a(
+    params: SimsatParams, maneuver: Maneuver, baseline_runs: Sequence[FloatArray], method: int = 1
+) -> SimsatParams:
+    """Tune the wheel gain on each baseline run, aggregate (method 1-3) into the detection model (§5.3)."""
+    fits = [tune_wheel_gain(params, maneuver, y) for y in baseline_runs]
+    wg = aggregate([f[0] for f in fits], [f[1] for f in fits], method)
+    return with_wheel_gain(params, wg)

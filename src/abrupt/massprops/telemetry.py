@@ -1,0 +1,235 @@
+"""Build the estimator's input from separately sampled channels (star tracker, gyro, tachometers, array).
+
+Flight archives sample each channel on its own clock (flight-like README, "Raw archive format"). The
+momentum balance is evaluated at the star-tracker stamps:
+
+* body rate: the gyro averaged over ``±rate_average_s`` around each stamp (lower noise than
+  interpolating, no lag for a symmetric window);
+* wheel speeds: a tachometer reports the mean speed over the gate that *ends* at its stamp, i.e. the
+  speed at ``stamp − gate/2`` for a smooth speed profile; the stamps are shifted by ``−gate/2`` before
+  linear interpolation (removes the half-second lag that otherwise leaves spikes around slews);
+* appendage rate: the drive angle is unwrapped and differentiated by central differences
+  (``I_app θ̇ a`` is the appendage's momentum relative to the body, flight-like README);
+* thruster dumps: each firing interval (flag 1 → 0) becomes an impulse window of the estimator.
+
+A stamp is kept only when every channel has a sample within ``max_hold_s`` of it, so nothing is
+interpolated across a loss of signal; dropped stamps are counted in the returned ``RepairLog``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from abrupt.errors import InputError, RepairLog
+from abrupt.massprops.momentum_balance import MomentumBalanceData, nadir_from_attitude
+from abrupt.model.rotations import normalise_quaternion
+from abrupt.types import FloatArray
+
+Channel = tuple[FloatArray, FloatArray]  # (t_s, value) in SI units
+
+
+def _nearest_distance(t_query: FloatArray, t_ref: FloatArray) -> FloatArray:
+    k = np.clip(np.searchsorted(t_ref, t_query), 1, t_ref.size - 1)
+    return np.asarray(np.minimum(np.abs(t_query - t_ref[k - 1]), np.abs(t_ref[k] - t_query)), dtype=np.float64)
+
+
+def _window_mean(t_ref: FloatArray, v: FloatArray, t_query: FloatArray, half: float) -> FloatArray:
+    cs = np.concatenate([[0.0], np.cumsum(v)])
+    lo = np.searchsorted(t_ref, t_query - half)
+    hi = np.searchsorted(t_ref, t_query + half, side="right")
+    cnt = hi - lo
+    out = np.interp(t_query, t_ref, v)
+    ok = cnt > 0
+    out[ok] = (cs[hi[ok]] - cs[lo[ok]]) / cnt[ok]
+    return np.asarray(out, dtype=np.float64)
+
+
+def _sorted(ch: Channel, name: str, source: str) -> Channel:
+    t, v = (np.asarray(a, dtype=np.float64) for a in ch)
+    if t.size < 2:
+        raise InputError(f"channel {name!r} has fewer than 2 samples", file=source, column=name)
+    order = np.argsort(t, kind="stable")
+    t, v = t[order], v[order]
+    keep = np.concatenate([[True], np.diff(t) > 0])
+    return t[keep], v[keep]
+
+
+def momentum_data_from_channels(
+    quaternion: tuple[FloatArray, FloatArray],
+    body_rate: tuple[FloatArray, FloatArray],
+    wheel_speeds: list[Channel],
+    wheel_axes: ArrayLike,
+    wheel_spin_inertia_kgm2: ArrayLike,
+    *,
+    tachometer_gate_s: float = 0.0,
+    appendage_angle: Channel | None = None,
+    appendage_axis_B: ArrayLike | None = None,
+    appendage_spin_inertia_kgm2: float = 0.0,
+    thruster_flag: Channel | None = None,
+    orbit_period_s: float | None = None,
+    nadir_axis_B: ArrayLike = (0.0, 0.0, 1.0),
+    rate_average_s: float = 0.5,
+    max_hold_s: float = 3.0,
+    epoch_utc: str = "",
+    source: str = "<telemetry>",
+    repairs: RepairLog | None = None,
+) -> MomentumBalanceData:
+    """Synchronise channels (SI units, seconds from ``epoch_utc``) into :class:`MomentumBalanceData`.
+
+    ``quaternion`` = (t (n,), q_BN (n, 4)); ``body_rate`` = (t (m,), ω (m, 3)) [rad/s]; ``wheel_speeds``
+    one (t, Ω [rad/s]) per wheel in the order of ``wheel_axes`` (3, N); ``appendage_angle`` (t, θ [rad],
+    wrapped or not) about ``appendage_axis_B`` with spin inertia ``appendage_spin_inertia_kgm2``;
+    ``thruster_flag`` (t, 0/1) written on change; ``orbit_period_s`` enables the gravity-gradient term
+    for a nadir-pointing spacecraft (the orbit is fitted to the attitude, :func:`nadir_from_attitude`).
+    """
+    repairs = repairs if repairs is not None else RepairLog(source)
+    axes = np.asarray(wheel_axes, dtype=np.float64)
+    js = np.asarray(wheel_spin_inertia_kgm2, dtype=np.float64).reshape(-1)
+    if len(wheel_speeds) != axes.shape[1]:
+        raise InputError(
+            f"{len(wheel_speeds)} wheel-speed channels for {axes.shape[1]} wheels in the spacecraft description; "
+            "the momentum balance needs every wheel",
+            file=source,
+            column="wheel_speed",
+        )
+    tq = np.asarray(quaternion[0], dtype=np.float64)
+    q = np.asarray(quaternion[1], dtype=np.float64).reshape(-1, 4)
+    ok = np.all(np.isfinite(q), axis=1)
+    norm = np.linalg.norm(q, axis=1)
+    bad_norm = ok & (np.abs(norm - 1.0) > 0.01)
+    if bad_norm.any():
+        repairs.record("quaternion samples with |q| far from 1 dropped", int(bad_norm.sum()))
+    ok &= ~bad_norm
+    tq, q = tq[ok], normalise_quaternion(q[ok])
+    order = np.argsort(tq, kind="stable")
+    tq, q = tq[order], q[order]
+    first = np.concatenate([[True], np.diff(tq) > 0])
+    tq, q = tq[first], q[first]
+
+    tr = np.asarray(body_rate[0], dtype=np.float64)
+    wr = np.asarray(body_rate[1], dtype=np.float64).reshape(-1, 3)
+    rok = np.all(np.isfinite(wr), axis=1)
+    tr, wr = tr[rok], wr[rok]
+    o = np.argsort(tr, kind="stable")
+    tr, wr = tr[o], wr[o]
+    if tr.size < 2:
+        raise InputError("body-rate channel has fewer than 2 samples", file=source, column="body_rate")
+    if float(np.percentile(np.abs(wr), 99)) > 1.0:
+        raise InputError(
+            "body rates above 1 rad/s in 1% of samples: wrong unit (deg/s read as rad/s?)",
+            file=source,
+            column="body_rate",
+        )
+    keep = _nearest_distance(tq, tr) <= max_hold_s
+    omega = np.column_stack([_window_mean(tr, wr[:, a], tq, rate_average_s) for a in range(3)])
+
+    wheel = np.empty((tq.size, len(wheel_speeds)))
+    for i, ch in enumerate(wheel_speeds):
+        tw, vw = _sorted(ch, f"wheel {i + 1}", source)
+        fin = np.isfinite(vw)
+        tw, vw = tw[fin], vw[fin]
+        if tw.size < 2:
+            raise InputError(f"wheel {i + 1} speed channel is empty", file=source, column=f"wheel {i + 1}")
+        tw = tw - tachometer_gate_s / 2.0
+        keep &= _nearest_distance(tq, tw) <= max_hold_s
+        wheel[:, i] = np.interp(tq, tw, vw)
+
+    h_app = None
+    if appendage_angle is not None and appendage_axis_B is not None and appendage_spin_inertia_kgm2 > 0:
+        ta, va = _sorted(appendage_angle, "appendage angle", source)
+        fin = np.isfinite(va)
+        ta, va = ta[fin], np.unwrap(va[fin])
+        rate = np.gradient(va, ta)
+        ax = np.asarray(appendage_axis_B, dtype=np.float64)
+        ax = ax / np.linalg.norm(ax)
+        keep &= _nearest_distance(tq, ta) <= max(max_hold_s, 2.5 * float(np.median(np.diff(ta))))
+        h_app = appendage_spin_inertia_kgm2 * np.interp(tq, ta, rate)[:, None] * ax[None, :]
+
+    dropped = int((~keep).sum())
+    if dropped:
+        repairs.record("attitude stamps without a nearby sample of every channel dropped", dropped)
+    windows: list[tuple[float, float]] = []
+    if thruster_flag is not None:
+        tf, vf = _sorted(thruster_flag, "thruster flag", source)
+        on = None
+        for ti, vi in zip(tf, vf, strict=True):
+            if vi > 0.5 and on is None:
+                on = float(ti)
+            elif vi <= 0.5 and on is not None:
+                windows.append((on, float(ti)))
+                on = None
+        if on is not None:
+            windows.append((on, on + 60.0))
+        # Pulses of one dump are seconds apart: merge firings closer than a minute into one window.
+        merged: list[tuple[float, float]] = []
+        for a, b in windows:
+            if merged and a - merged[-1][1] < 60.0:
+                merged[-1] = (merged[-1][0], b)
+            else:
+                merged.append((a, b))
+        windows = merged
+    t_k, q_k = tq[keep], q[keep]
+    nadir = None
+    rate_orbit = None
+    if orbit_period_s is not None and math.isfinite(orbit_period_s) and orbit_period_s > 0:
+        nadir = nadir_from_attitude(t_k, q_k, orbit_period_s, nadir_axis_B)
+        rate_orbit = 2 * math.pi / orbit_period_s
+    return MomentumBalanceData(
+        t_s=t_k,
+        q_BN=q_k,
+        omega_B_rad_s=omega[keep],
+        wheel_speed_rad_s=wheel[keep],
+        wheel_axes=axes,
+        wheel_spin_inertia_kgm2=js,
+        appendage_momentum_B_Nms=None if h_app is None else h_app[keep],
+        impulse_windows_s=tuple(windows),
+        orbit_rate_rad_s=rate_orbit,
+        nadir_N=nadir,
+        epoch_utc=epoch_utc,
+        source=source,
+    )
+
+
+def channels_by_key(frame_groups: Mapping[str, Channel], keys: list[str]) -> list[Channel]:
+    """The channels named ``keys`` from a mapping, with an error naming the first missing one."""
+    missing = [k for k in keys if k not in frame_groups]
+    if missing:
+        raise InputError(f"missing telemetry channel(s) {missing}", column=missing[0])
+    return [frame_groups[k] for k in keys]
+
+
+def momentum_data_from_simulation(
+    result: object,
+    wheel_axes: ArrayLike,
+    wheel_spin_inertia_kgm2: ArrayLike,
+    *,
+    orbit_period_s: float | None = None,
+    appendage_axis_B: ArrayLike | None = None,
+    appendage_spin_inertia_kgm2: float = 0.0,
+    nadir_axis_B: ArrayLike = (0.0, 0.0, 1.0),
+    source: str = "<simulation>",
+) -> MomentumBalanceData:
+    """Estimator input from a :class:`~abrupt.simulate.attitude.PointingSimResult` (all channels at one rate).
+
+    The appendage rate is re-derived from the telemetered (wrapped) angle, as from flight telemetry.
+    """
+    r = result
+    t = np.asarray(r.t_s, dtype=np.float64)  # type: ignore[attr-defined]
+    return momentum_data_from_channels(
+        (t, r.q_BN),  # type: ignore[attr-defined]
+        (t, r.omega_B_rad_s),  # type: ignore[attr-defined]
+        [(t, r.wheel_speed_rad_s[:, i]) for i in range(r.wheel_speed_rad_s.shape[1])],  # type: ignore[attr-defined]
+        wheel_axes,
+        wheel_spin_inertia_kgm2,
+        appendage_angle=(t, r.appendage_angle_rad) if appendage_spin_inertia_kgm2 > 0 else None,  # type: ignore[attr-defined]
+        appendage_axis_B=appendage_axis_B,
+        appendage_spin_inertia_kgm2=appendage_spin_inertia_kgm2,
+        orbit_period_s=orbit_period_s,
+        nadir_axis_B=nadir_axis_B,
+        rate_average_s=0.0,
+        source=source,
+    )

@@ -1,0 +1,185 @@
+"""Synthetic strikes in real telemetry (Harris et al. 2025 §3.5), in the telemetry's native form.
+
+Harris simulates the spacecraft following the telemetry's own attitude trajectory with and without
+the strike and adds the difference to the telemetry. Here the difference is the linear response of a
+rigid body with reaction wheels under attitude control along that trajectory (its [BN](t) from the
+telemetered quaternions), exact in angular momentum:
+
+* the strike adds ΔH_N (inertial) at t₀; total ᴺH is conserved afterwards (Bennett 2022 Eq. 2.7);
+* the body rate first jumps by Δω₀ = J⁻¹[BN(t₀)]ΔH_N and the attitude controller removes it with the
+  critically damped shape Δω(τ) = Δω₀ (1 − τ/τ_c) e^(−τ/τ_c), whose integral (the attitude error) returns
+  to zero, as for a PD attitude loop following its reference;
+* the wheels take the rest: Σ J_s ΔΩ ĝ = [BN(t)]ΔH_N − J Δω(t) (minimum-norm wheel distribution,
+  pseudo-inverse of J_s G), so ᴺH of the injected telemetry is the original plus ΔH_N exactly.
+
+The differences are added in native units: gyro rates in the channel's unit; quaternions rotated by
+the attitude error δθ(t) = ∫Δω; wheel speeds as tachometer counts regenerated from the cumulative
+pulse phase (counts c'_k = c_k + ⌊φ₀ + Δφ_k⌋ − ⌊φ₀ + Δφ_{k−1}⌋ with Δφ the added wheel angle in pulses
+and φ₀ a random phase), or as gate means when no tachometer is declared.
+
+This is not the full nonlinear simulator (`simulate/attitude.py`): the control transient's shape is
+a stand-in with time constant ``settle_s``, which only affects the first tens of seconds; detection
+on total momentum does not depend on it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from abrupt.model.rotations import dcm_from_quaternion
+from abrupt.model.spacecraft import Spacecraft
+from abrupt.series.timetable import NS, continuous_quaternion
+from abrupt.types import FloatArray
+
+
+@dataclass(frozen=True)
+class InjectedStrike:
+    """A synthetic strike: time [ns since 1970, UTC] and ΔH in inertial axes [N·m·s]."""
+
+    time_ns: int
+    dH_N_Nms: FloatArray
+
+    @property
+    def magnitude_Nms(self) -> float:
+        return float(np.linalg.norm(self.dH_N_Nms))
+
+
+def rate_response(tau_s: FloatArray, settle_s: float) -> FloatArray:
+    """Shape of the body-rate transient after a strike, (1 − τ/τ_c) e^(−τ/τ_c) for τ ≥ 0 (0 before)."""
+    x = np.maximum(tau_s, 0.0) / settle_s
+    return np.where(tau_s >= 0, (1.0 - x) * np.exp(-x), 0.0)
+
+
+def angle_response(tau_s: FloatArray, settle_s: float) -> FloatArray:
+    """∫ rate_response dτ = τ e^(−τ/τ_c) [s] (attitude error per unit Δω₀)."""
+    t = np.maximum(tau_s, 0.0)
+    return np.where(tau_s >= 0, t * np.exp(-t / settle_s), 0.0)
+
+
+def _attitude_at(samples: pd.DataFrame, spacecraft: Spacecraft, t_ns: np.ndarray) -> FloatArray:
+    """[BN] at times t_ns from the telemetered quaternion (sign-continuous, nlerp)."""
+    assert spacecraft.flight is not None
+    qch = spacecraft.flight.of("quaternion")
+    series = []
+    for c in qch:
+        sub = samples.loc[samples["mnemonic"] == c.mnemonic]
+        series.append((sub["time"].to_numpy().astype("datetime64[ns]").astype(np.int64), sub["value"].to_numpy(float)))
+    common = series[0][0]
+    for t, _ in series[1:]:
+        common = np.intersect1d(common, t)
+    q = np.column_stack([v[np.searchsorted(t, common)] for t, v in series])
+    q = continuous_quaternion(q)
+    qi = np.column_stack([np.interp(t_ns.astype(float), common.astype(float), q[:, k]) for k in range(4)])
+    qi /= np.linalg.norm(qi, axis=1, keepdims=True)
+    return np.asarray(dcm_from_quaternion(qi), dtype=np.float64)
+
+
+def _quat_multiply(p: FloatArray, q: FloatArray) -> FloatArray:
+    """Hamilton product p ⊗ q, scalar first, row-wise."""
+    p0, p1, p2, p3 = p.T
+    q0, q1, q2, q3 = q.T
+    return np.column_stack(
+        [
+            p0 * q0 - p1 * q1 - p2 * q2 - p3 * q3,
+            p0 * q1 + p1 * q0 + p2 * q3 - p3 * q2,
+            p0 * q2 - p1 * q3 + p2 * q0 + p3 * q1,
+            p0 * q3 + p1 * q2 - p2 * q1 + p3 * q0,
+        ]
+    )
+
+
+def inject_strikes(
+    samples: pd.DataFrame,
+    spacecraft: Spacecraft,
+    strikes: list[InjectedStrike],
+    *,
+    settle_s: float = 10.0,
+    seed: int = 0,
+) -> pd.DataFrame:
+    """Raw samples (mnemonic, time, value) with the strikes' responses added in native units."""
+    if spacecraft.flight is None or not strikes:
+        return samples
+    flight = spacecraft.flight
+    out = samples.copy()
+    t_all = out["time"].to_numpy().astype("datetime64[ns]").astype(np.int64)
+    mnem = out["mnemonic"].astype(str).to_numpy()
+    values = out["value"].to_numpy(np.float64).copy()
+    j_inv = np.linalg.inv(spacecraft.inertia_kgm2)
+    js_g = spacecraft.wheel_axes * spacecraft.wheel_spin_inertias_kgm2[None, :]
+    wheel_pinv = np.linalg.pinv(js_g)  # minimum-norm distribution
+    rng = np.random.default_rng(seed)
+    horizon_ns = int(20 * settle_s * NS)
+
+    def bn_at(t: np.ndarray) -> FloatArray:
+        return _attitude_at(samples, spacecraft, t)
+
+    for s in strikes:
+        bn0 = bn_at(np.array([s.time_ns]))[0]
+        dw0 = j_inv @ (bn0 @ s.dH_N_Nms)
+        # Body rates (gyro channels).
+        for c in flight.of("body_rate"):
+            sel = np.flatnonzero((mnem == c.mnemonic) & (t_all >= s.time_ns) & (t_all < s.time_ns + horizon_ns))
+            tau = (t_all[sel] - s.time_ns) / NS
+            values[sel] += dw0[c.component] * rate_response(tau, settle_s) / c.to_si
+        # Attitude: q_BN of the perturbed body = δq(δθ) ⊗ q_BN, δθ in body axes.
+        qch = flight.of("quaternion")
+        sel0 = np.flatnonzero((mnem == qch[0].mnemonic) & (t_all >= s.time_ns) & (t_all < s.time_ns + horizon_ns))
+        if sel0.size:
+            t_q = t_all[sel0]
+            idx = [np.flatnonzero(mnem == c.mnemonic) for c in qch]
+            rows = []
+            for ix in idx:
+                pos = np.searchsorted(t_all[ix], t_q)
+                pos = np.clip(pos, 0, ix.size - 1)
+                rows.append(ix[pos])
+            rows_arr = np.column_stack(rows)
+            ok = np.all(t_all[rows_arr] == t_q[:, None], axis=1)
+            rows_arr = rows_arr[ok]
+            tau = (t_q[ok] - s.time_ns) / NS
+            dth = dw0[None, :] * angle_response(tau, settle_s)[:, None]
+            half = 0.5 * np.linalg.norm(dth, axis=1)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                axis = np.where(half[:, None] > 0, dth / (2 * half[:, None]), 0.0)
+            dq = np.column_stack([np.cos(half), axis * np.sin(half)[:, None]])
+            q = values[rows_arr]
+            q_new = _quat_multiply(q, dq)  # q_BN ⊗ δq: δθ about body axes
+            flip = (q_new[:, 0] < 0) & (q[:, 0] >= 0)  # keep the archive's q0 >= 0 convention
+            values[rows_arr] = q_new * np.where(flip, -1.0, 1.0)[:, None]
+        # Wheels: Σ J_s ΔΩ ĝ = [BN(t)] ΔH_N − J Δω(t), from the strike on (ᴺH conserved after it).
+        for c in flight.of("wheel_speed"):
+            sel = np.flatnonzero((mnem == c.mnemonic) & (t_all >= s.time_ns - int(2 * NS)))
+            if sel.size == 0:
+                continue
+            t_w = t_all[sel]
+            gate = c.tachometer.gate_s if c.tachometer is not None else 0.0
+            # Gate mean of ΔΩ over [t − gate, t] by sub-sampling the gate (10 points).
+            k_sub = 10 if gate > 0 else 1
+            offs = np.linspace(-gate, 0.0, k_sub) if gate > 0 else np.zeros(1)
+            t_sub = (t_w[:, None] + (offs * NS).astype(np.int64)[None, :]).ravel()
+            tau = (t_sub - s.time_ns) / NS
+            after = tau >= 0
+            d_omega = np.zeros(t_sub.size)
+            if after.any():
+                bn = bn_at(t_sub[after])
+                h_b = np.einsum("nij,j->ni", bn, s.dH_N_Nms)
+                h_b -= (spacecraft.inertia_kgm2 @ dw0)[None, :] * rate_response(tau[after], settle_s)[:, None]
+                d_omega[after] = (h_b @ wheel_pinv.T)[:, c.component]
+            d_mean = d_omega.reshape(-1, k_sub).mean(axis=1)
+            if c.tachometer is not None:
+                # Regenerate counts from the cumulative pulse phase (Harris §3.5: tach counts regenerated).
+                ppr = c.tachometer.pulses_per_rev
+                d_phase = np.cumsum(d_mean * c.tachometer.gate_s) * ppr / (2.0 * math.pi)
+                phi0 = rng.uniform()
+                n_new = np.floor(phi0 + d_phase)
+                n_prev = np.concatenate([[math.floor(phi0)], n_new[:-1]])
+                d_counts = n_new - n_prev
+                step = 1.0 if c.unit == "counts" else c.tachometer.quantum_rad_s / c.to_si
+                values[sel] += d_counts * step
+            else:
+                values[sel] += d_mean / c.to_si
+    out["value"] = values
+    return out

@@ -1,0 +1,134 @@
+"""Parquet store of pseudonymised raw telemetry samples, partitioned by spacecraft and UTC day.
+
+Layout (Harris et al. 2025 §3.3: one file per spacecraft-day, pseudonymised names only)::
+
+    STORE/spacecraft=SC-A/day=2026-03-10/samples.parquet   columns mnemonic, time (UTC ns), value
+    STORE/spacecraft=SC-A/day=2026-03-10/ingest.json       the day's ingest report
+
+Samples are raw (as telemetered, artifacts removed); synchronisation onto a grid happens later
+(:mod:`abrupt.series.timetable`), so the store never depends on a processing choice. Re-ingesting
+the same archive merges into the partition without duplicating rows.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from abrupt.errors import InputError
+
+SAFE_NAME = re.compile(r"^[A-Za-z0-9_.+-]+$")
+
+
+class TelemetryStore:
+    """A directory of raw samples: one Parquet file and one ingest report per spacecraft-day."""
+
+    def __init__(self, root: str | Path) -> None:
+        self.root = Path(root)
+
+    def _dir(self, spacecraft: str, day: str) -> Path:
+        if not SAFE_NAME.match(spacecraft):
+            raise InputError(f"spacecraft pseudonym {spacecraft!r} is not a safe directory name", file=self.root)
+        return self.root / f"spacecraft={spacecraft}" / f"day={day}"
+
+    def spacecraft(self) -> list[str]:
+        """Pseudonyms of the spacecraft in the store."""
+        return sorted(p.name.split("=", 1)[1] for p in self.root.glob("spacecraft=*") if p.is_dir())
+
+    def days(self, spacecraft: str) -> list[str]:
+        """ISO days (``YYYY-MM-DD``) stored for a spacecraft, in order."""
+        base = self.root / f"spacecraft={spacecraft}"
+        return sorted(p.name.split("=", 1)[1] for p in base.glob("day=*") if (p / "samples.parquet").exists())
+
+    def write_day(self, spacecraft: str, day: str, samples: pd.DataFrame, report: dict[str, Any]) -> int:
+        """Merge ``samples`` (mnemonic, time, value) into the partition; return rows added."""
+        d = self._dir(spacecraft, day)
+        d.mkdir(parents=True, exist_ok=True)
+        path = d / "samples.parquet"
+        new = samples[["mnemonic", "time", "value"]].copy()
+        new["mnemonic"] = new["mnemonic"].astype(str)
+        added = len(new)
+        if path.exists():
+            old = self.read_day(spacecraft, day)
+            old["mnemonic"] = old["mnemonic"].astype(str)
+            old["time"] = old["time"].dt.tz_localize("UTC")
+            both = pd.concat([old, new], ignore_index=True)
+            both = both.drop_duplicates(["mnemonic", "time", "value"], keep="first")
+            added = len(both) - len(old)
+            new = both
+            prev = self.report(spacecraft, day)
+            report = _merge_reports(prev, report) if prev else report
+        new = new.sort_values(["mnemonic", "time"], kind="stable").reset_index(drop=True)
+        table = pa.table(
+            {
+                "mnemonic": pa.array(new["mnemonic"].to_numpy(dtype=object), pa.string()).dictionary_encode(),
+                "time": pa.array(new["time"], pa.timestamp("ns", tz="UTC")),
+                "value": pa.array(new["value"].to_numpy(np.float64), pa.float64()),
+            }
+        )
+        tmp = path.with_suffix(".tmp")
+        pq.write_table(table, tmp, compression="zstd")
+        tmp.replace(path)
+        report = {**report, "rows_stored": len(new)}
+        (d / "ingest.json").write_text(json.dumps(report, indent=1, sort_keys=True))
+        return added
+
+    def read_day(self, spacecraft: str, day: str, mnemonics: Iterable[str] | None = None) -> pd.DataFrame:
+        """Samples of one day (mnemonic, time, value); empty frame if the day is not stored."""
+        path = self._dir(spacecraft, day) / "samples.parquet"
+        if not path.exists():
+            return pd.DataFrame(
+                {"mnemonic": pd.Series([], dtype=str), "time": pd.Series([], dtype="datetime64[ns]"), "value": []}
+            )
+        filt = None
+        if mnemonics is not None:
+            filt = [("mnemonic", "in", list(mnemonics))]
+        table = pq.read_table(path, filters=filt)
+        # Naive datetime64[ns] holding UTC: tz-aware columns turn into Python objects on to_numpy.
+        time_idx = table.schema.get_field_index("time")
+        table = table.set_column(time_idx, "time", table.column("time").cast(pa.timestamp("ns")))
+        return table.to_pandas()
+
+    def read_range(
+        self, spacecraft: str, start: np.datetime64, end: np.datetime64, mnemonics: Iterable[str] | None = None
+    ) -> pd.DataFrame:
+        """Samples with start <= time < end from every day partition the interval touches."""
+        mn = list(mnemonics) if mnemonics is not None else None
+        d0 = start.astype("datetime64[D]")
+        d1 = (end - np.timedelta64(1, "ns")).astype("datetime64[D]")
+        frames = []
+        for d in np.arange(d0, d1 + np.timedelta64(1, "D"), dtype="datetime64[D]"):
+            f = self.read_day(spacecraft, str(d), mn)
+            if len(f):
+                frames.append(f)
+        if not frames:
+            return self.read_day(spacecraft, "0000-00-00", mn)
+        frame = pd.concat(frames, ignore_index=True) if len(frames) > 1 else frames[0]
+        t = frame["time"].to_numpy()
+        sel = (t >= start.astype("datetime64[ns]")) & (t < end.astype("datetime64[ns]"))
+        return frame.loc[sel].reset_index(drop=True)
+
+    def report(self, spacecraft: str, day: str) -> dict[str, Any]:
+        """The ingest report of a day ({} when absent)."""
+        path = self._dir(spacecraft, day) / "ingest.json"
+        return dict(json.loads(path.read_text())) if path.exists() else {}
+
+
+def _merge_reports(a: dict[str, Any], b: dict[str, Any]) -> dict[str, Any]:
+    out = dict(a)
+    for key in ("removed", "reported", "samples_per_channel"):
+        merged = dict(a.get(key, {}))
+        for k, v in b.get(key, {}).items():
+            merged[k] = merged.get(k, 0) + v
+        out[key] = merged
+    out["rows_kept"] = a.get("rows_kept", 0) + b.get("rows_kept", 0)
+    out["sources"] = sorted(set(a.get("sources", [])) | set(b.get("sources", [])))
+    return out

@@ -1,0 +1,213 @@
+"""SIMSAT reproduction (Dabrowski 2003), particle swarm, mass-change detector and the mass CLI (issue 13)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from abrupt.detect.base import get_detector
+from abrupt.detect.mass_change import InertiaChangeDetector
+from abrupt.massprops.pso import particle_swarm
+from abrupt.massprops.simsat import (
+    MOI_CONFIGS,
+    Maneuver,
+    SimsatParams,
+    aggregate,
+    estimate_run_i33,
+    min_detectable_mass,
+    min_detectable_mass_over_box,
+    momentum_exchange_estimate,
+    simulate_simsat,
+)
+from abrupt.massprops.track import InertiaTrack
+from abrupt.thresholds import FalseAlarmBudget
+
+
+# ------------------------------------------------------------------------------------------ SIMSAT
+def test_overshoot_grows_with_amplitude_as_in_the_thesis():
+    p = SimsatParams()
+    over = []
+    for amp in (0.5, 1.0, 2.0):
+        m = Maneuver.thesis(amp)
+        s = simulate_simsat(p, m)
+        t = s["t_s"]
+        seg = (t >= 15) & (t < 15 + m.step_period_s)
+        over.append(100 * (s["yaw_true_rad"][seg, 0].max() / math.radians(amp) - 1))
+    assert over[0] < 0.5 and 2.0 < over[1] < 6.0 and 15.0 < over[2] < 30.0  # spec §4.1-4.2: 0%, ~4%, ~20%
+
+
+@pytest.mark.parametrize("i_true", [MOI_CONFIGS[0], MOI_CONFIGS[1], MOI_CONFIGS[4]])
+def test_grid_search_recovers_injected_moi_on_noise_free_data(i_true):
+    p = SimsatParams()
+    m = Maneuver.thesis(1.0)
+    y = simulate_simsat(p, m, i_true)["yaw_meas_rad"][:, 0]
+    est, cost = estimate_run_i33(p, m, y, tol=1e-6)
+    assert est == pytest.approx(i_true, rel=1e-4)  # spec §8.1 acceptance
+    assert cost < 1e-7
+
+
+def test_momentum_exchange_is_exact_without_noise_and_ignores_the_wheel_gain():
+    p = SimsatParams()
+    m = Maneuver.thesis(2.0)
+    s = simulate_simsat(p, m, MOI_CONFIGS[3], wheel_gain=0.8)  # a wheel the model does not know
+    est = momentum_exchange_estimate(s["t_s"], s["yaw_meas_rad"][:, 0], s["wheel_speed_rad_s"][:, 0], m)
+    assert est == pytest.approx(MOI_CONFIGS[3], rel=1e-6)
+
+
+def test_gps_iir_minimum_detectable_parasite_is_8_2_kg():
+    d = min_detectable_mass((1725.0, 782.0, 2020.0), (0.8, 0.0, 0.0), 0.0067)
+    assert d.minimum_kg == pytest.approx(8.19, abs=0.01)  # spec §7, Eq. 4.4 via axis 2
+    assert math.isnan(d.per_axis_kg[0])
+    box = min_detectable_mass_over_box((1725.0, 782.0, 2020.0), (0.8, 0.8, 0.8), 0.0067, n=5)
+    assert box.worst_minimum_kg >= d.minimum_kg
+
+
+def test_aggregation_methods():
+    x, e = [1.0, 1.1, 0.9, 1.2], [1.0, 2.0, 1.0, 4.0]
+    assert aggregate(x, e, 1) == pytest.approx(1.05)
+    assert aggregate(x, e, 2) == pytest.approx(0.95)
+    w = np.array([1, 0.5, 1, 0.25])
+    assert aggregate(x, e, 3) == pytest.approx(float(np.sum(w * np.array(x)) / w.sum()))
+
+
+def test_particle_swarm_finds_the_minimum_of_a_quadratic():
+    res = particle_swarm(lambda x: float(np.sum((x - 0.3) ** 2)), [-1, -1, -1], [1, 1, 1], n_iterations=60, seed=2)
+    np.testing.assert_allclose(res.best, 0.3, atol=1e-3)
+
+
+# ------------------------------------------------------------------------------------------ detector
+def _track(n: int, step_at: int | None, dj: float, rng: np.random.Generator, sigma: float = 0.3) -> InertiaTrack:
+    base = np.array([900.0, 700.0, 1000.0, 5.0, -3.0, 2.0])
+    p = base + sigma * rng.standard_normal((n, 6))
+    if step_at is not None:
+        p[step_at:, 1] += dj
+        p[step_at:, 2] += dj
+    t0 = np.arange(n) * 86400.0
+    cov = np.broadcast_to(np.eye(6) * sigma**2, (n, 6, 6)).copy()
+    return InertiaTrack("SC-T", "2026-01-01T00:00:00", t0, t0 + 86400.0, p, cov, np.ones((n, 6), bool))
+
+
+def test_detector_is_registered_by_name():
+    assert get_detector("mass.inertia_change") is InertiaChangeDetector
+
+
+def test_a_docking_step_is_detected_with_its_mass_and_bracket():
+    rng = np.random.default_rng(1)
+    res = InertiaChangeDetector(attachment_radius_m=1.0).detect(_track(12, 6, 4.975, rng), FalseAlarmBudget(1, "year"))
+    assert len(res.events) == 1
+    ev = res.events.iloc[0]
+    assert ev["kind"] == "mass_change"
+    assert ev["dm_kg"] == pytest.approx(4.975, abs=3 * ev["dm_sigma_kg"])
+    assert ev["time_bracket_start_utc"] <= "2026-01-07" <= ev["time_bracket_end_utc"]
+
+
+def test_false_alarm_rate_on_unchanged_inertia_is_within_budget():
+    rng = np.random.default_rng(2)
+    det = InertiaChangeDetector()
+    budget = FalseAlarmBudget(12, "year")  # 1 per month, so the test can measure it
+    n_tracks, n_windows = 200, 30
+    alarms = sum(len(det.detect(_track(n_windows, None, 0.0, rng), budget).events) for _ in range(n_tracks))
+    expected = budget.per_day * n_windows * n_tracks  # at most one alarm per track
+    assert alarms <= 2 * expected + 3
+
+
+def test_detector_links_an_attitude_event_inside_the_bracket():
+    import pandas as pd
+
+    rng = np.random.default_rng(3)
+    att = pd.DataFrame({"event_id": ["abc"], "time_utc": ["2026-01-07T03:00:00Z"]})
+    res = InertiaChangeDetector(attitude_events=att).detect(_track(12, 6, 5.0, rng), FalseAlarmBudget(1, "year"))
+    assert res.events.iloc[0]["linked_event_id"] == "abc"
+
+
+# ------------------------------------------------------------------------------------------ command line
+def test_cli_simulate_docking_then_estimate_inertia(tmp_path):
+    from abrupt.cli.main import cli
+    from abrupt.model.spacecraft import load_spacecraft
+
+    sc = tmp_path / "sc.toml"
+    sc.write_text(
+        'name = "SC-D"\nmass_kg = 1000.0\ninertia_kgm2 = [[900.0, 5.0, -3.0], [5.0, 700.0, 2.0], [-3.0, 2.0, 1000.0]]\n'
+        + "".join(
+            f'[[wheels]]\nname = "rw{i}"\naxis = {a}\nspin_inertia_kgm2 = 0.12\nmax_torque_Nm = 0.2\n'
+            for i, a in enumerate([[1, 1, 1], [-1, 1, 1], [-1, -1, 1], [1, -1, 1]])
+        )
+    )
+    runner = CliRunner()
+    out = tmp_path / "sim"
+    r = runner.invoke(
+        cli,
+        ["simulate", "docking", "--spacecraft", str(sc), "--out", str(out), "--days", "0.25", "--docking-day", "-1"],
+    )
+    assert r.exit_code == 0, r.output
+    truth = json.loads((out / "docking_truth.json").read_text())
+    assert truth["docking_time_s"] is None
+    upd = tmp_path / "updated.toml"
+    r = runner.invoke(
+        cli,
+        [
+            "estimate",
+            "inertia",
+            "--store",
+            str(out),
+            "--spacecraft",
+            str(sc),
+            "--out",
+            str(upd),
+            "--orbit-period",
+            "5926.4",
+            "--bootstrap",
+            "20",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    assert "principal" in r.output
+    new = load_spacecraft(upd)
+    np.testing.assert_allclose(new.inertia_kgm2, truth["inertia_before_kgm2"], atol=10.0)  # 1%: 6 h of data
+    report = json.loads(upd.with_suffix(".json").read_text())
+    assert report["spacecraft"] == "SC-D"
+
+
+def test_cli_refuses_a_non_physical_catalogue(tmp_path):
+    from abrupt.cli.main import main
+
+    sc = tmp_path / "bad.toml"
+    sc.write_text('name = "x"\ninertia_kgm2 = [100.0, 100.0, 300.0]\n')
+    tel = tmp_path / "t.csv"
+    tel.write_text("time\n")
+    with pytest.raises(SystemExit) as exc:
+        main(["estimate", "inertia", str(tel), "--spacecraft", str(sc), "--out", str(tmp_path / "o.toml")])
+    assert exc.value.code == 2
+
+
+@pytest.mark.slow
+def test_cli_detect_mass_change_runs_on_simulated_docking(tmp_path):
+    from abrupt.cli.main import cli
+
+    sc = tmp_path / "sc.toml"
+    sc.write_text(
+        'name = "SC-E"\nmass_kg = 1000.0\ninertia_kgm2 = [[900.0, 5.0, -3.0], [5.0, 700.0, 2.0], [-3.0, 2.0, 1000.0]]\n'
+        + "".join(
+            f'[[wheels]]\nname = "rw{i}"\naxis = {a}\nspin_inertia_kgm2 = 0.12\nmax_torque_Nm = 0.2\n'
+            for i, a in enumerate([[1, 1, 1], [-1, 1, 1], [-1, -1, 1], [1, -1, 1]])
+        )
+    )
+    runner = CliRunner()
+    out = tmp_path / "sim"
+    args = ["simulate", "docking", "--spacecraft", str(sc), "--out", str(out), "--days", "0.4", "--docking-day", "0.2"]
+    args += ["--mass", "50", "--seed", "5"]
+    r = runner.invoke(cli, args)
+    assert r.exit_code == 0, r.output
+    events = tmp_path / "ev.csv"
+    r = runner.invoke(
+        cli,
+        ["detect", "mass-change", "--store", str(out), "--spacecraft", str(sc), "--orbit-period", "5926.4",
+         "--window", "4320", "--false-alarms", "1/year", "--out", str(events), "--catalog", str(tmp_path / "c.sqlite")],
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    assert "windows; GLR statistic max" in r.output
+    assert events.exists()
