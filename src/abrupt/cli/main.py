@@ -9,6 +9,7 @@ import click
 from abrupt.cli import (  # noqa: F401  (registration)
     attitude,
     catalog_commands,
+    density,
     detectors,
     fleet,
     flight,

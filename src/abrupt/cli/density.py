@@ -1,0 +1,107 @@
+"""``abrupt density tle|meteors``: thermospheric density from drag and from meteoroid ablation."""
+
+from __future__ import annotations
+
+import click
+
+from abrupt.cli.groups import cli
+
+
+@cli.group("density")
+def density() -> None:
+    """Thermospheric density: from TLE decay across a constellation, or from meteor head echoes."""
+
+
+@density.command("tle")
+@click.argument("paths", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False))
+@click.option("--out", type=click.Path(dir_okay=False), required=True, help="Windows table (.csv or .parquet).")
+@click.option(
+    "--platforms",
+    type=click.Path(exists=True, dir_okay=False),
+    default=None,
+    help="CSV: object, shape_class, min_area_m2, max_area_m2, mass_kg (or one row '*,similar').",
+)
+@click.option("--interval-days", type=float, default=1.0, show_default=True, help="Window length.")
+@click.option(
+    "--maneuvers",
+    type=click.Choice(["detect", "none"]),
+    default="detect",
+    show_default=True,
+    help="Remove maneuver gaps found by abrupt's TLE maneuver detector (orbit rises are always cut).",
+)
+@click.option("--no-model", is_flag=True, help="Single object: skip NRLMSIS along the orbit (faster).")
+@click.option(
+    "--space-weather",
+    type=click.Path(exists=True, dir_okay=False),
+    default=None,
+    help="Space-weather table (CelesTrak SW format or CSV); default: the one shipped offline.",
+)
+@click.option("--kappa", type=float, default=1e-4, show_default=True, help="Smoothness weight of the B inversion.")
+@click.option("--workers", type=int, default=1, show_default=True, help="Processes for many objects.")
+@click.option("--report", type=click.Path(dir_okay=False), default=None, help="PNG: density vs NRLMSIS per band.")
+def density_tle(
+    paths: tuple[str, ...],
+    out: str,
+    platforms: str | None,
+    interval_days: float,
+    maneuvers: str,
+    no_model: bool,
+    space_weather: str | None,
+    kappa: float,
+    workers: int,
+    report: str | None,
+) -> None:
+    """ρB per window from element-set histories; with several objects, density by order statistics."""
+    from abrupt.density.constellation import ConstellationConfig
+    from abrupt.density.tle_drag import TleDragConfig
+    from abrupt.pipelines.density import tle_density, write_table
+
+    if interval_days <= 0:
+        raise click.BadParameter("must be > 0", param_hint="--interval-days")
+    res = tle_density(
+        list(paths),
+        platforms=platforms,
+        config=TleDragConfig(interval_days=interval_days, with_model=not no_model or len(paths) > 1),
+        constellation=ConstellationConfig(kappa=kappa),
+        maneuvers=maneuvers,
+        space_weather=space_weather,
+        workers=workers,
+    )
+    write_table(res.windows, out)
+    for src, log in res.repairs.items():
+        for kind, n in log.counts.items():
+            click.echo(f"{src}: {kind}: {n}", err=True)
+    for msg in res.warnings:
+        click.echo(f"warning: {msg}", err=True)
+    ok = int((res.windows["status"] == "ok").sum()) if len(res.windows) else 0
+    click.echo(f"{ok} window(s) of {len(paths)} object(s) written to {out}")
+    if report:
+        from abrupt.density.report import plot_density_bands
+
+        plot_density_bands(res.windows, report, title="density from TLE decay")
+        click.echo(f"report: {report}")
+
+
+@density.command("meteors")
+@click.argument("radar", type=click.Path(exists=True, dir_okay=False))
+@click.option("--out", type=click.Path(dir_okay=False), required=True, help="Ratios table (.csv or .parquet).")
+@click.option("--report", type=click.Path(dir_okay=False), default=None, help="PNG of the ratio profile.")
+def density_meteors(radar: str, out: str, report: str | None) -> None:
+    """Density ratios between altitude levels from head echoes.
+
+    RADAR columns: meteor_id, altitude_km, velocity_mps, deceleration_mps2.
+    """
+    from abrupt.density.meteors import estimate_density_ratios, read_radar_csv
+    from abrupt.pipelines.density import write_table
+
+    res = estimate_density_ratios(read_radar_csv(radar))
+    write_table(res.ratios, out)
+    click.echo(
+        f"{len(res.ratios)} ratio(s) from {res.n_equations} equation(s), {len(res.d_s2_m2)} meteoroid(s); "
+        f"residual RMS {res.residual_rms:.3f}; written to {out}"
+    )
+    if report:
+        from abrupt.density.report import plot_meteor_profile
+
+        plot_meteor_profile(res.ratios, report)
+        click.echo(f"report: {report}")

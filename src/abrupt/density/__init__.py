@@ -1,0 +1,1 @@
+"""Thermospheric density from satellite drag and meteoroid ablation (Close & Li 2015)."""

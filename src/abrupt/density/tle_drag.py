@@ -1,0 +1,425 @@
+"""ρB (density × ballistic coefficient) from a history of SGP4 mean element sets.
+
+Close & Li 2015, slide "Data" (after Picone et al. 2005, JGR 110, A03301): drag changes the mean
+mean motion by
+
+    Δn̄ = (3/2) μ^(−2/3) ∫ n̄^(1/3) ρ B v³ F dt,
+
+so over an interval the v³F-weighted mean of ρ times B is
+
+    K = ρ̄B̄ ≅ 2 μ^(2/3) Δn̄ / (3 ∫ n̄^(1/3) v³ F dt),          (slide "Data", last line)
+
+with B = C_D A/m (m²/kg), v the inertial speed and F = |v_rel| (v_rel·v̂)/v² the wind factor of the
+atmosphere co-rotating with the Earth (v_rel = v − ω⊕ × r). The along-track drag acceleration is
+−½ρBv²F; with it, dn/dt = −(3/2)(n/a) da/dt gives exactly the Δn̄ line above. (The slide's line
+da/dt = 2a²Bv³F/μ lacks ρ and the factor −½: an erratum; the Δn̄ line is the one used.)
+
+Implementation:
+
+* every element set initialises an SGP4 record (through abrupt's TLE reader); between consecutive
+  sets the orbit is propagated with SGP4 from the earlier set on a grid (``step_s``) and the
+  integral I(t) = ∫ n̄^(1/3) v³ F dt is accumulated (trapezoid rule);
+* K on a window of sets is the least-squares slope of n̄_j against (3/2) μ^(−2/3) I(t_j): with two
+  sets this is the slide's formula exactly, with more it uses every set of the window;
+* its standard error comes from the history's own mean-motion noise σ_n̄, estimated robustly
+  (1.4826·MAD) from each set's residual to the line through its two neighbours;
+* element sets whose residual exceeds ``outlier_sigma`` σ (bad fits) are rejected and counted;
+* windows that contain a maneuver (abrupt's TLE maneuver detector, or given epochs), a gap longer
+  than ``max_gap_days`` or too few sets are not formed (counted); a significantly negative K
+  (n̄ falling: orbit raising or a bad history, "negative decay") is rejected and counted.
+
+Optionally the v³F-weighted NRLMSIS density along the same SGP4 orbit, ρ̄_M, is integrated on the
+same grid, so K/ρ̄_M = B·(ρ/ρ_M) can be compared across altitudes (see ``constellation``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from abrupt.errors import RepairLog
+from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
+from abrupt.types import FloatArray
+
+EARTH_ROTATION_RAD_S = 7.292115e-5  # [rad/s]
+SECONDS_PER_DAY = 86400.0
+J1970_JD = 2440587.5
+
+WINDOW_COLUMNS: tuple[str, ...] = (
+    "object",
+    "norad_id",
+    "window_start_utc",
+    "window_end_utc",
+    "span_start_utc",
+    "span_end_utc",
+    "n_sets",
+    "rho_b_per_m",
+    "rho_b_sigma_per_m",
+    "altitude_km",
+    "wind_factor",
+    "model_density_kg_m3",
+    "status",
+)
+
+
+@dataclass(frozen=True)
+class TleDragConfig:
+    """Settings of :func:`rho_b_from_history` (units in the names)."""
+
+    interval_days: float = 1.0
+    step_s: float = 600.0
+    max_gap_days: float = 3.0
+    min_sets: int = 2
+    min_span_fraction: float = 0.5
+    outlier_sigma: float = 6.0
+    negative_sigma: float = 3.0
+    thrust_sigma: float = 4.0
+    with_model: bool = False
+    model_stride: int = 2
+    origin_utc: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.interval_days <= 0:
+            raise ValueError("interval_days must be > 0")
+        if self.step_s <= 0:
+            raise ValueError("step_s must be > 0")
+        if self.min_sets < 2:
+            raise ValueError("min_sets must be >= 2")
+
+
+@dataclass
+class DragIntegrals:
+    """Per element set: time (s from the first set), n̄ (rad/s) and cumulative integrals at its epoch.
+
+    ``weight_integral`` is I(t) = ∫ n̄^(1/3) v³ F dt (m³ s⁻³ · s · rad^(1/3) s^(−1/3)); with a model,
+    ``model_integral`` is ∫ n̄^(1/3) v³ F ρ_M dt. ``altitude_km`` and ``wind_factor`` are means over the
+    gap that ends at the set (the first set gets its following gap's values).
+    """
+
+    t_s: FloatArray
+    n_rad_s: FloatArray
+    weight_integral: FloatArray
+    model_integral: FloatArray | None
+    altitude_km: FloatArray
+    wind_factor: FloatArray
+
+
+@dataclass
+class RhoBResult:
+    """Windows of one object (:data:`WINDOW_COLUMNS`) with the repairs and rejections counted."""
+
+    windows: pd.DataFrame
+    sigma_n_rad_s: float
+    repairs: RepairLog = field(default_factory=RepairLog)
+    maneuver_epochs_utc: list[Any] = field(default_factory=list)
+
+
+def wind_factor(position_m: FloatArray, velocity_mps: FloatArray) -> FloatArray:
+    """F = |v_rel| (v_rel·v̂)/v² with v_rel = v − ω⊕ × r (co-rotating atmosphere; Picone et al. 2005)."""
+    r = np.asarray(position_m)
+    v = np.asarray(velocity_mps)
+    v_rel = v.copy()
+    v_rel[..., 0] += EARTH_ROTATION_RAD_S * r[..., 1]
+    v_rel[..., 1] -= EARTH_ROTATION_RAD_S * r[..., 0]
+    speed = np.linalg.norm(v, axis=-1)
+    rel = np.linalg.norm(v_rel, axis=-1)
+    return np.asarray(rel * np.sum(v_rel * v, axis=-1) / speed**3, dtype=np.float64)
+
+
+def drag_integrals(
+    history: ElementHistory, step_s: float = 600.0, *, space_weather: Any = None, model_stride: int = 2
+) -> DragIntegrals:
+    """Accumulate I(t) = ∫ n̄^(1/3) v³ F dt between consecutive sets by SGP4 (module docstring).
+
+    With ``space_weather`` (a :class:`abrupt.model.atmosphere.SpaceWeather`) the NRLMSIS density is
+    integrated with the same weight (``model_integral``).
+    """
+    el = history.elements
+    n_sets = len(el)
+    epochs = el["epoch_utc"].to_numpy(dtype="datetime64[ns]")
+    t = (epochs - epochs[0]).astype(np.int64) * 1e-9
+    n_bar = el["n_rad_s"].to_numpy(dtype=float)
+    jd0 = np.array([s.jdsatepoch for s in history.satrecs])
+    jf0 = np.array([s.jdsatepochF for s in history.satrecs])
+    cum_w = np.zeros(n_sets)
+    cum_m = np.zeros(n_sets) if space_weather is not None else None
+    alt = np.full(n_sets, np.nan)
+    wf = np.full(n_sets, np.nan)
+    # Build every gap's grid at once, propagate gap by gap (each from its earlier set).
+    gaps = np.diff(t)
+    counts = np.maximum(2, np.ceil(gaps / step_s).astype(np.int64) + 1)
+    offsets = np.concatenate([[0], np.cumsum(counts)])
+    frac_all = np.concatenate([np.linspace(0.0, 1.0, c) for c in counts]) if n_sets > 1 else np.zeros(0)
+    tau_all = frac_all * np.repeat(gaps, counts)  # s since the gap's first set
+    pos = np.empty((tau_all.size, 3))
+    vel = np.empty((tau_all.size, 3))
+    errors = np.zeros(tau_all.size, dtype=np.int64)
+    for g in range(n_sets - 1):
+        sl = slice(offsets[g], offsets[g + 1])
+        tau_days = tau_all[sl] / SECONDS_PER_DAY
+        e, r, v = history.satrecs[g].sgp4_array(np.full(tau_days.size, jd0[g]), jf0[g] + tau_days)
+        pos[sl] = r
+        vel[sl] = v
+        errors[sl] = e
+    pos *= 1e3
+    vel *= 1e3
+    speed = np.linalg.norm(vel, axis=1)
+    f_all = wind_factor(pos, vel)
+    gap_index = np.repeat(np.arange(max(n_sets - 1, 0)), counts)
+    integrand = np.cbrt(n_bar[gap_index]) * speed**3 * f_all
+    if np.any(errors != 0):
+        integrand[errors != 0] = 0.0  # SGP4 failed (decayed record): no contribution
+    rho_all: FloatArray | None = None
+    if space_weather is not None:
+        from abrupt.model.atmosphere import msis_density, teme_to_geodetic
+
+        # NRLMSIS on every ``model_stride``-th node (it costs ~10-30 µs a point); log ρ is interpolated
+        # in time between them (the nodes of consecutive gaps are consecutive in time).
+        when = epochs[gap_index] + (tau_all * 1e9).astype("timedelta64[ns]")
+        sample = np.zeros(tau_all.size, dtype=bool)
+        sample[:: max(1, model_stride)] = True
+        sample[-1:] = True
+        sample &= errors == 0
+        lat, lon, h_km = teme_to_geodetic(when[sample], pos[sample])
+        rho_s = np.asarray(msis_density(when[sample], lat, lon, h_km, space_weather))
+        good = np.isfinite(rho_s) & (rho_s > 0)
+        t_abs = (when - when[0]).astype(np.int64) * 1e-9
+        rho_all = np.exp(np.interp(t_abs, t_abs[sample][good], np.log(rho_s[good])))
+    radius = np.linalg.norm(pos, axis=1)
+    for g in range(n_sets - 1):
+        sl = slice(offsets[g], offsets[g + 1])
+        x = tau_all[sl]
+        y = integrand[sl]
+        cum_w[g + 1] = cum_w[g] + float(np.trapezoid(y, x))
+        if cum_m is not None and rho_all is not None:
+            cum_m[g + 1] = cum_m[g] + float(np.trapezoid(y * rho_all[sl], x))
+        alt[g + 1] = (float(np.mean(radius[sl])) - 6378137.0) / 1e3
+        wf[g + 1] = float(np.mean(f_all[sl]))
+    if n_sets > 1:
+        alt[0] = alt[1]
+        wf[0] = wf[1]
+    return DragIntegrals(t, n_bar, cum_w, cum_m, alt, wf)
+
+
+def neighbour_residuals(n_bar: FloatArray, integral: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Residual of each interior set's n̄ to the line (in I) through its neighbours, and its noise factor.
+
+    For white noise σ on n̄, Var(r_j) = σ²(1 + w² + (1 − w)²) with w the interpolation weight; the
+    second array is that square-root factor. End sets get NaN.
+    """
+    r = np.full(n_bar.size, np.nan)
+    factor = np.full(n_bar.size, np.nan)
+    if n_bar.size < 3:
+        return r, factor
+    di = integral[2:] - integral[:-2]
+    w = np.where(di > 0, (integral[1:-1] - integral[:-2]) / np.where(di > 0, di, 1.0), 0.5)
+    r[1:-1] = n_bar[1:-1] - (n_bar[:-2] + w * (n_bar[2:] - n_bar[:-2]))
+    factor[1:-1] = np.sqrt(1.0 + w**2 + (1.0 - w) ** 2)
+    return r, factor
+
+
+def robust_sigma(values: FloatArray) -> float:
+    """1.4826 × median absolute deviation about the median (Hampel 1974), NaNs ignored."""
+    from abrupt.clean.noise import robust_scale
+
+    v = values[np.isfinite(values)]
+    if v.size == 0:
+        return float("nan")
+    return float(robust_scale(v))
+
+
+def maneuver_epochs(history: ElementHistory) -> list[pd.Timestamp]:
+    """Maneuver times from abrupt's TLE maneuver detector (its public API), as UTC timestamps."""
+    from abrupt.detect.tle_maneuvers import detect_tle_maneuvers
+
+    events = detect_tle_maneuvers(history)
+    if len(events) == 0:
+        return []
+    return [
+        pd.Timestamp(t).tz_localize(None) if pd.Timestamp(t).tzinfo else pd.Timestamp(t) for t in events["time_utc"]
+    ]
+
+
+def rho_b_from_history(
+    history: ElementHistory,
+    config: TleDragConfig | None = None,
+    *,
+    maneuvers: str | list[Any] = "detect",
+    space_weather: Any = None,
+    name: str | None = None,
+) -> RhoBResult:
+    """K = ρ̄B̄ (1/m) per time window from one element-set history (module docstring).
+
+    ``maneuvers``: "detect" (abrupt's TLE maneuver detector), "none", or a list of UTC times.
+    ``space_weather`` is needed only with ``config.with_model`` (NRLMSIS ρ̄_M per window).
+    """
+    cfg = config or TleDragConfig()
+    label = name or (history.name or f"NORAD-{history.norad_id}")
+    repairs = RepairLog(source=history.source)
+    if len(history) < cfg.min_sets:
+        return RhoBResult(_empty_windows(), float("nan"), repairs)
+    sw = space_weather
+    if cfg.with_model and sw is None:
+        from abrupt.model.atmosphere import read_space_weather
+
+        sw = read_space_weather()
+    integ = drag_integrals(
+        history, cfg.step_s, space_weather=sw if cfg.with_model else None, model_stride=cfg.model_stride
+    )
+    epochs = history.elements["epoch_utc"].to_numpy(dtype="datetime64[ns]")
+    mu = MU_EARTH_WGS72_M3_S2
+    x_all = 1.5 * mu ** (-2.0 / 3.0) * integ.weight_integral  # n̄ = c + K·x
+    # Maneuvers cut the history into segments; windows never straddle a cut.
+    if isinstance(maneuvers, str):
+        if maneuvers == "detect":
+            man_times = maneuver_epochs(history)
+        elif maneuvers == "none":
+            man_times = []
+        else:
+            raise ValueError(f"maneuvers must be 'detect', 'none' or a list of times, got {maneuvers!r}")
+    else:
+        man_times = [pd.Timestamp(m) for m in maneuvers]
+    man64 = np.array([m.to_datetime64() for m in man_times], dtype="datetime64[ns]")
+    segment_id = np.searchsorted(man64, epochs, side="right") if man64.size else np.zeros(len(epochs), dtype=np.int64)
+    # Gaps longer than max_gap_days also cut.
+    long_gap = np.concatenate([[False], np.diff(integ.t_s) > cfg.max_gap_days * SECONDS_PER_DAY])
+    segment_id = segment_id * (len(epochs) + 1) + np.cumsum(long_gap)
+    # Bad fits: residual to the neighbours' line within a segment; a rise of the orbit between two
+    # sets (n̄ falling beyond noise: thrust the detector missed; drag only raises n̄) also cuts.
+    keep = np.ones(len(epochs), dtype=bool)
+    thrust_cuts = 0
+    for _ in range(3):
+        sigma = robust_sigma(_noise_samples(integ, x_all, segment_id, keep))
+        if not np.isfinite(sigma) or sigma <= 0:
+            break
+        kept_idx0 = np.flatnonzero(keep)
+        dn = np.diff(integ.n_rad_s[kept_idx0])
+        same = np.diff(segment_id[kept_idx0]) == 0
+        rise = same & (dn < -cfg.thrust_sigma * math.sqrt(2.0) * sigma)
+        if np.any(rise):
+            thrust_cuts += int(np.sum(rise))
+            bump = np.zeros(len(epochs), dtype=np.int64)
+            bump[kept_idx0[1:][rise]] = 1
+            segment_id = segment_id * 2 + np.cumsum(bump)  # new segment after each cut, order kept
+        r = np.full(len(epochs), np.nan)
+        fac = np.full(len(epochs), np.nan)
+        for seg in np.unique(segment_id):
+            idx = np.flatnonzero((segment_id == seg) & keep)
+            rr, ff = neighbour_residuals(integ.n_rad_s[idx], x_all[idx])
+            r[idx] = rr
+            fac[idx] = ff
+        z = r / fac
+        bad = np.abs(z) > cfg.outlier_sigma * sigma
+        # Reject only the worst of neighbouring flagged sets (an outlier also disturbs its neighbours).
+        az = np.nan_to_num(np.abs(z), nan=0.0)
+        worst = bad & (az >= np.roll(az, 1)) & (az >= np.roll(az, -1))
+        if not np.any(worst) and not np.any(rise):
+            break
+        keep &= ~worst
+    sigma_n = robust_sigma(_noise_samples(integ, x_all, segment_id, keep))
+    repairs.record("gaps with a rise of the orbit (undetected thrust) cut", thrust_cuts)
+    repairs.record("element sets with bad fits rejected", int(np.sum(~keep)))
+    # Windows on a common UTC grid.
+    origin = (
+        np.asarray([pd.Timestamp(cfg.origin_utc).to_datetime64()], dtype="datetime64[ns]")[0]
+        if cfg.origin_utc
+        else np.asarray(epochs[:1]).astype("datetime64[D]").astype("datetime64[ns]")[0]
+    )
+    width = np.timedelta64(round(cfg.interval_days * SECONDS_PER_DAY * 1e9), "ns")
+    n_windows = int(np.ceil((epochs[-1] - origin) / width)) + 1
+    rows: list[tuple[Any, ...]] = []
+    counts = {"straddle": 0, "few": 0, "negative": 0}
+    kept_idx = np.flatnonzero(keep)
+    k_epochs = epochs[kept_idx]
+    for w in range(max(n_windows, 0)):
+        b0 = origin + w * width
+        b1 = b0 + width
+        lo = int(np.searchsorted(k_epochs, b0, side="right")) - 1  # last set at or before b0
+        hi = int(np.searchsorted(k_epochs, b1, side="left"))  # first set at or after b1
+        lo = max(lo, 0)
+        hi = min(hi, kept_idx.size - 1)
+        if hi <= lo:
+            continue
+        idx = kept_idx[lo : hi + 1]
+        span0, span1 = epochs[idx[0]], epochs[idx[-1]]
+        if span1 <= b0 or span0 >= b1:
+            continue  # no data touching this window
+        overlap = (min(span1, b1) - max(span0, b0)) / width
+        if idx.size < cfg.min_sets or overlap < cfg.min_span_fraction:
+            counts["few"] += 1
+            continue
+        # Gaps holding a maneuver (or an orbit rise, or a long gap) are removed: one n̄ offset per
+        # segment, one common K (with two sets in one segment this is the slide's formula).
+        seg = segment_id[idx]
+        x = x_all[idx]
+        y = integ.n_rad_s[idx]
+        xc = np.empty_like(x)
+        yc = np.empty_like(y)
+        used = np.zeros(idx.size, dtype=bool)
+        n_seg = 0
+        for sv in np.unique(seg):
+            m = seg == sv
+            if np.sum(m) < 2:
+                continue
+            n_seg += 1
+            used |= m
+            xc[m] = x[m] - x[m].mean()
+            yc[m] = y[m] - y[m].mean()
+        if n_seg > 1 or np.unique(seg).size > 1:
+            counts["straddle"] += 1
+        sxx = float(np.sum(xc[used] ** 2)) if np.any(used) else 0.0
+        if sxx <= 0 or np.sum(used) < cfg.min_sets:
+            counts["few"] += 1
+            continue
+        k_val = float(np.sum(xc[used] * yc[used]) / sxx)
+        k_sig = float(sigma_n / math.sqrt(sxx)) if np.isfinite(sigma_n) else float("nan")
+        dof = int(np.sum(used)) - n_seg - 1
+        if dof >= 2:
+            # Correlated TLE errors: never claim less than the window's own residual scatter.
+            resid = yc[used] - k_val * xc[used]
+            k_sig = max(k_sig, float(math.sqrt(np.sum(resid**2) / dof / sxx)))
+        status = "ok"
+        if np.isfinite(k_sig) and k_val < -cfg.negative_sigma * k_sig:
+            counts["negative"] += 1
+            status = "negative decay"
+        i0, i1 = idx[0], idx[-1]
+        dw = integ.weight_integral[i1] - integ.weight_integral[i0]
+        model = (
+            float((integ.model_integral[i1] - integ.model_integral[i0]) / dw)
+            if integ.model_integral is not None and dw > 0
+            else float("nan")
+        )
+        alt = float(np.nanmean(integ.altitude_km[idx[1:]])) if idx.size > 1 else float(integ.altitude_km[idx[0]])
+        wfac = float(np.nanmean(integ.wind_factor[idx[1:]])) if idx.size > 1 else float(integ.wind_factor[idx[0]])
+        rows.append(
+            (label, history.norad_id, b0, b1, span0, span1, int(idx.size), k_val, k_sig, alt, wfac, model, status)
+        )
+    repairs.record(
+        "windows holding a maneuver, orbit rise or gap (fitted with one offset per segment)", counts["straddle"]
+    )
+    repairs.record("windows with too few element sets or too short a span", counts["few"])
+    repairs.record("windows with negative decay rejected", counts["negative"])
+    frame = pd.DataFrame(rows, columns=list(WINDOW_COLUMNS)) if rows else _empty_windows()
+    return RhoBResult(frame, sigma_n, repairs, list(man_times))
+
+
+def _noise_samples(integ: DragIntegrals, x_all: FloatArray, segment_id: Any, keep: Any) -> FloatArray:
+    out = []
+    for seg in np.unique(segment_id):
+        idx = np.flatnonzero((segment_id == seg) & keep)
+        rr, ff = neighbour_residuals(integ.n_rad_s[idx], x_all[idx])
+        out.append(rr / ff)
+    return np.concatenate(out) if out else np.zeros(0)
+
+
+def _empty_windows() -> pd.DataFrame:
+    frame = pd.DataFrame({c: pd.Series(dtype=float) for c in WINDOW_COLUMNS})
+    for c in ("window_start_utc", "window_end_utc", "span_start_utc", "span_end_utc"):
+        frame[c] = pd.Series(dtype="datetime64[ns]")
+    frame["object"] = pd.Series(dtype=str)
+    frame["status"] = pd.Series(dtype=str)
+    return frame
