@@ -50,6 +50,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from abrupt.clean.noise import MAD_TO_SIGMA, robust_scale
 from abrupt.events import Event, config_hash, empty_frame, events_frame, new_run_id
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
 from abrupt.thresholds import Threshold
@@ -224,8 +225,8 @@ def _robust_scale_rolling(
     s = pd.Series(d)
     med = s.rolling(2 * half + 1, center=True, min_periods=5).median()
     mad = (s - med).abs().rolling(2 * half + 1, center=True, min_periods=5).median()
-    scale = (1.4826 * mad / math.sqrt(2.0)).to_numpy()
-    glob = 1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(2.0)
+    scale = (MAD_TO_SIGMA * mad / math.sqrt(2.0)).to_numpy()
+    glob = float(robust_scale(d)) / math.sqrt(2.0)
     scale = np.where(np.isfinite(scale), scale, glob)
     floor = max(glob * 0.25, 1e-15)
     scale = np.maximum(scale, floor)
@@ -255,7 +256,7 @@ def drift_noise_rate(t: NDArray[np.float64], y: NDArray[np.float64], half: int =
         return 0.0
 
     def robust_var(x: NDArray[np.float64]) -> float:
-        return float((1.4826 * np.median(np.abs(x - np.median(x)))) ** 2)
+        return float(robust_scale(x)) ** 2
 
     v_s, v_l = robust_var(r[short & ok]), robust_var(r[long & ok])
     span = float(np.mean(dt[long & ok]) - np.mean(dt[short & ok]))
@@ -569,7 +570,7 @@ def event_free_mask(stat: NDArray[np.float64], guard: int) -> NDArray[np.bool_]:
     if finite.sum() < 20:
         return keep
     med = float(np.median(stat[finite]))
-    level = med + 8.0 * 1.4826 * float(np.median(np.abs(stat[finite] - med)))
+    level = med + 8.0 * float(robust_scale(stat[finite]))
     for g in local_peaks(np.where(finite, stat, -np.inf), 1, level):
         keep[max(0, g - guard) : g + guard + 1] = False
     return keep
