@@ -292,3 +292,13 @@ def test_oem_round_trip(eph: Ephemeris, form: str, time_system: str) -> None:
     # half the writer's grid, plus double rounding of the km <-> m conversion at 36,000 km (a few nm)
     np.testing.assert_allclose(back.position_m, eph.position_m, rtol=1e-15, atol=0.5e-6)
     np.testing.assert_allclose(back.velocity_mps, eph.velocity_mps, rtol=1e-15, atol=0.5e-9)
+
+
+def test_oem_in_gps_time_past_the_leap_second_table_round_trips() -> None:
+    # Found by the derandomized CI run: ERFA's "dubious year" warning escaped the writer's conversion.
+    t = np.array(["2028-12-30T23:59:55", "2028-12-31T00:00:00"], dtype="datetime64[ns]")
+    eph = Ephemeris("L51", t, np.array([[0.0, 0.0, 6.6e6]] * 2), np.array([[1000.0, 0.0, 0.0]] * 2), "ITRF")
+    path = TMP / "future_gps.oem"
+    write_oem(eph, path, form="kvn", time_system="GPS")
+    back = read_ephemeris(path)
+    assert np.abs((back.times_utc - t).astype(np.int64)).max() <= 1000

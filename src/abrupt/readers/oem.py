@@ -442,9 +442,9 @@ def _from_utc(t_utc: NDArray[np.datetime64], time_system: str) -> NDArray[np.dat
     from abrupt.model.timescales import offline_astropy
 
     offline_astropy()
-    tt = Time(t_utc, scale="utc", format="datetime64")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", erfa.ErfaWarning)  # beyond the leap-second table: TAI-UTC held
+        tt = Time(t_utc, scale="utc", format="datetime64")
         if time_system == "GPS":
             tai = np.asarray(tt.tai.datetime64, dtype="datetime64[ns]")
             gps: NDArray[np.datetime64] = (tai.astype(np.int64) - 19_000_000_000).astype("datetime64[ns]")
