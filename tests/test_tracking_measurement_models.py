@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from abrupt.model.light_time import SPEED_OF_LIGHT_MPS, shapiro_delay_m, two_way_range_m
+from abrupt.model.light_time import shapiro_delay_m, two_way_range_m
+from abrupt.model.orbit.constants import SPEED_OF_LIGHT_MPS
 from abrupt.model.station_motion import (
     eccentricity_ecef_m,
     plate_motion,

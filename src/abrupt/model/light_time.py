@@ -24,10 +24,8 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import ArrayLike
 
+from abrupt.model.orbit.constants import MU_EARTH_M3_S2, SPEED_OF_LIGHT_MPS
 from abrupt.types import FloatArray
-
-SPEED_OF_LIGHT_MPS = 299_792_458.0  # [m/s] exact
-GM_EARTH_M3_S2 = 3.986004418e14  # [m³/s²] IERS Conventions 2010, Table 1.1
 
 PositionFunction = Callable[[FloatArray], FloatArray]
 
@@ -37,7 +35,7 @@ def shapiro_delay_m(r1_m: FloatArray, r2_m: FloatArray) -> FloatArray:
     a = np.linalg.norm(r1_m, axis=-1)
     b = np.linalg.norm(r2_m, axis=-1)
     rho = np.linalg.norm(r2_m - r1_m, axis=-1)
-    return np.asarray(2.0 * GM_EARTH_M3_S2 / SPEED_OF_LIGHT_MPS**2 * np.log((a + b + rho) / (a + b - rho)))
+    return np.asarray(2.0 * MU_EARTH_M3_S2 / SPEED_OF_LIGHT_MPS**2 * np.log((a + b + rho) / (a + b - rho)))
 
 
 def two_way_range_m(

@@ -33,7 +33,7 @@ import numpy as np
 import pandas as pd
 
 from abrupt.errors import RepairLog
-from abrupt.model.light_time import SPEED_OF_LIGHT_MPS, shapiro_delay_m
+from abrupt.model.light_time import shapiro_delay_m, two_way_range_m
 from abrupt.model.orbit import OMEGA_EARTH_RAD_S
 from abrupt.model.station_motion import eccentricity_ecef_m, solid_tide_displacement_m, sun_moon_ecef_m
 from abrupt.model.tracking_measurements import as_datetime64_ns, earth_rotation_matrices
@@ -172,23 +172,8 @@ def model_two_way_ranges(
 
     r_sta_r = station(t_r)
     if model.light_time:
-        t_b = t_r.copy()
-        for _ in range(iterations):
-            r_b = satellite_position(t_b)
-            down = np.linalg.norm(r_b - r_sta_r, axis=1)
-            if model.shapiro:
-                down = down + shapiro_delay_m(r_b, r_sta_r)
-            t_b = t_r - down / SPEED_OF_LIGHT_MPS
+        rng, t_b = two_way_range_m(t_r, satellite_position, station, shapiro=model.shapiro, iterations=iterations)
         r_b = satellite_position(t_b)
-        down = np.linalg.norm(r_b - r_sta_r, axis=1) + (shapiro_delay_m(r_b, r_sta_r) if model.shapiro else 0.0)
-        t_t = t_b - down / SPEED_OF_LIGHT_MPS
-        for _ in range(iterations):
-            r_sta_t = station(t_t)
-            up = np.linalg.norm(r_b - r_sta_t, axis=1)
-            if model.shapiro:
-                up = up + shapiro_delay_m(r_b, r_sta_t)
-            t_t = t_b - up / SPEED_OF_LIGHT_MPS
-        rng = 0.5 * SPEED_OF_LIGHT_MPS * (t_r - t_t)
     else:
         t_b = t_r.copy()
         r_b = satellite_position(t_b)

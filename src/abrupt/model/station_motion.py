@@ -18,13 +18,10 @@ import erfa
 import numpy as np
 from numpy.typing import ArrayLike
 
+from abrupt.model.orbit.constants import MU_EARTH_M3_S2, MU_MOON_M3_S2, MU_SUN_M3_S2
 from abrupt.types import FloatArray
 
-GM_EARTH_M3_S2 = 3.986004418e14  # [m³/s²]
-GM_SUN_M3_S2 = 1.32712442099e20  # [m³/s²] IERS Conventions 2010, Table 1.1
-GM_MOON_M3_S2 = GM_EARTH_M3_S2 * 0.0123000371  # [m³/s²] Moon/Earth mass ratio, IERS 2010 Table 1.1
 EARTH_RADIUS_M = 6378136.6  # [m] IERS 2010
-AU_M = 149_597_870_700.0  # [m]
 SECONDS_PER_YEAR = 365.25 * 86400.0
 
 
@@ -67,23 +64,25 @@ def eccentricity_ecef_m(marker_ecef_m: ArrayLike, eccentricity_m: ArrayLike, *, 
 
 
 def sun_moon_ecef_m(epoch_utc: ArrayLike) -> tuple[FloatArray, FloatArray]:
-    """Geocentric positions (m) of the Sun and the Moon in ECEF at UTC epochs (ERFA ephemerides).
+    """Geocentric Sun and Moon positions (m) in ECEF at UTC epochs.
 
-    Vectorised: ``epoch_utc`` may be one ``datetime64`` (returns (3,) arrays) or an array (returns (n, 3)).
+    GCRF positions from the one orbit model (:func:`abrupt.model.orbit.bodies.sun_moon_gcrf`, ERFA) turned
+    into ECEF with the tracking filters' Earth orientation. ``epoch_utc`` may be one ``datetime64``
+    (returns (3,) arrays) or an array (returns (n, 3)).
     """
-    from astropy.time import Time
-    from astropy.utils import iers
+    from abrupt.model.orbit.bodies import sun_moon_gcrf
+    from abrupt.model.tracking_measurements import earth_rotation_matrices
 
-    iers.conf.auto_download = False
-    t = Time(np.asarray(epoch_utc, dtype="datetime64[ns]"), scale="utc")
-    tt, tdb, ut1 = t.tt, t.tdb, t.ut1
-    pvh, _ = erfa.epv00(tdb.jd1, tdb.jd2)
-    sun_gcrs = -np.asarray(pvh["p"], dtype=float) * AU_M  # Earth→Sun, BCRS-aligned (aberration neglected)
-    moon_gcrs = np.asarray(erfa.moon98(tt.jd1, tt.jd2)["p"], dtype=float) * AU_M
-    c2t = erfa.c2t06a(tt.jd1, tt.jd2, ut1.jd1, ut1.jd2, 0.0, 0.0)
-    sun = np.einsum("...ij,...j->...i", c2t, sun_gcrs)
-    moon = np.einsum("...ij,...j->...i", c2t, moon_gcrs)
-    return np.asarray(sun), np.asarray(moon)
+    t = np.asarray(epoch_utc, dtype="datetime64[ns]")
+    flat = t.reshape(-1)
+    sun, moon = sun_moon_gcrf(flat)
+    t_s = (flat - flat[0]).astype(np.int64) / 1e9
+    c_fi = earth_rotation_matrices(t_s, model="iers", epoch_utc=flat[0])
+    sun_f = np.einsum("nij,nj->ni", c_fi, sun)
+    moon_f = np.einsum("nij,nj->ni", c_fi, moon)
+    if t.ndim == 0:
+        return sun_f[0], moon_f[0]
+    return sun_f, moon_f
 
 
 def solid_tide_displacement_m(station_ecef_m: ArrayLike, sun_ecef_m: ArrayLike, moon_ecef_m: ArrayLike) -> FloatArray:
@@ -101,14 +100,14 @@ def solid_tide_displacement_m(station_ecef_m: ArrayLike, sun_ecef_m: ArrayLike, 
     l2 = 0.0847 + 0.0002 * p2
     h3, l3 = 0.292, 0.015
     out = np.zeros(np.broadcast_shapes(np.shape(sun_ecef_m), (3,)))
-    for body, gm in ((sun_ecef_m, GM_SUN_M3_S2), (moon_ecef_m, GM_MOON_M3_S2)):
+    for body, gm in ((sun_ecef_m, MU_SUN_M3_S2), (moon_ecef_m, MU_MOON_M3_S2)):
         b = np.asarray(body, dtype=float)
         rj = np.linalg.norm(b, axis=-1, keepdims=True)
         bhat = b / rj
         c = bhat @ rhat
         c = c[..., None]
-        f2 = gm / GM_EARTH_M3_S2 * r**4 / rj**3
+        f2 = gm / MU_EARTH_M3_S2 * r**4 / rj**3
         out += f2 * (h2 * rhat * (1.5 * c**2 - 0.5) + 3.0 * l2 * c * (bhat - c * rhat))
-        f3 = gm / GM_EARTH_M3_S2 * r**5 / rj**4
+        f3 = gm / MU_EARTH_M3_S2 * r**5 / rj**4
         out += f3 * (h3 * rhat * (2.5 * c**3 - 1.5 * c) + l3 * (7.5 * c**2 - 1.5) * (bhat - c * rhat))
     return out

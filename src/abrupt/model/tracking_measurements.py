@@ -33,7 +33,6 @@ from abrupt.model.orbit import OMEGA_EARTH_RAD_S
 
 MEASUREMENT_COLUMNS = ("range_m", "azimuth_rad", "elevation_rad", "range_rate_mps")
 EarthRotationModel = Literal["simple", "iers"]
-SPEED_OF_LIGHT_MPS = 299792458.0
 
 
 def as_datetime64_ns(t: object) -> np.datetime64:

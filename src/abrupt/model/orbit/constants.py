@@ -7,6 +7,7 @@ explicitly by the caller.
 
 from __future__ import annotations
 
+SPEED_OF_LIGHT_MPS = 299_792_458.0  # [m/s] exact (SI definition)
 MU_EARTH_M3_S2 = 3.986004418e14  # [m^3/s^2] IERS 2010 / WGS-84 (Bennett 2022 §4.9 constants)
 MU_KADERALI_M3_S2 = 3.986e14  # [m^3/s^2] Kaderali 2021 Table 4.1 (398600 km^3/s^2)
 R_EARTH_M = 6378137.0  # [m] equatorial radius (WGS-84)
