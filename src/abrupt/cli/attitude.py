@@ -297,22 +297,27 @@ def run_attitude_detection(
     return sc, tel, cfg, result
 
 
+def telemetry_or_store_options(f: Any) -> Any:
+    """TELEMETRY, or ``--store`` with ``--days`` and ``--no-clean``: the input of detect and report attitude."""
+    f = click.option(
+        "--no-clean",
+        multiple=True,
+        type=click.Choice(FLIGHT_STAGES),
+        help="With --store: switch a cleaning stage off (repeatable; 'all' for none).",
+    )(f)
+    f = click.option("--days", multiple=True, help="With --store: days (YYYY-MM-DD or A..B); default all.")(f)
+    f = click.option(
+        "--store",
+        "store_dir",
+        default=None,
+        type=click.Path(exists=True, file_okay=False),
+        help="Flight pipeline: read a store written by `abrupt ingest` instead of TELEMETRY.",
+    )(f)
+    return click.argument("telemetry", required=False, type=click.Path(exists=True, dir_okay=False))(f)
+
+
 @detect.command("attitude")
-@click.argument("telemetry", required=False, type=click.Path(exists=True, dir_okay=False))
-@click.option(
-    "--store",
-    "store_dir",
-    default=None,
-    type=click.Path(exists=True, file_okay=False),
-    help="Flight pipeline: read a store written by `abrupt ingest` instead of TELEMETRY.",
-)
-@click.option("--days", multiple=True, help="With --store: days (YYYY-MM-DD or A..B); default all.")
-@click.option(
-    "--no-clean",
-    multiple=True,
-    type=click.Choice(FLIGHT_STAGES),
-    help="With --store: switch a cleaning stage off (repeatable; 'all' for none).",
-)
+@telemetry_or_store_options
 @click.option(
     "--spacecraft",
     "spacecraft_path",
@@ -389,21 +394,7 @@ def detect_attitude_cmd(
 
 
 @report.command("attitude")
-@click.argument("telemetry", required=False, type=click.Path(exists=True, dir_okay=False))
-@click.option(
-    "--store",
-    "store_dir",
-    default=None,
-    type=click.Path(exists=True, file_okay=False),
-    help="Flight pipeline: read a store written by `abrupt ingest` instead of TELEMETRY.",
-)
-@click.option("--days", multiple=True, help="With --store: days (YYYY-MM-DD or A..B); default all.")
-@click.option(
-    "--no-clean",
-    multiple=True,
-    type=click.Choice(FLIGHT_STAGES),
-    help="With --store: switch a cleaning stage off (repeatable; 'all' for none).",
-)
+@telemetry_or_store_options
 @click.option("--spacecraft", "spacecraft_path", type=click.Path(exists=True, dir_okay=False), required=True)
 @_with_options(detector_options)
 @click.option(
