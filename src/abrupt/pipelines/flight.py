@@ -22,6 +22,7 @@ Every stage is local in time and anchored at absolute times, so chunks processed
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass, field, replace
@@ -41,6 +42,7 @@ from abrupt.model.flight_config import FlightConfig
 from abrupt.model.flight_momentum import timetable_momentum, wheel_scale_from_conservation
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.readers.archive import read_archive, read_decoder
+from abrupt.scale import Executor
 from abrupt.series.timetable import NS, Timetable, build_timetable
 from abrupt.store import TelemetryStore
 from abrupt.thresholds import Threshold
@@ -152,7 +154,7 @@ class FlightRunConfig:
     guard_s: float = 20.0
     false_alarms_per_day: float = 1.0
     block_s: float = 600.0
-    chunk_s: float = 86_400.0
+    chunk_s: float = 3 * 86_400.0
     cleaning: CleaningConfig = field(default_factory=CleaningConfig)
     peak_floor: float = 3.0
 
@@ -264,25 +266,28 @@ def locate_step(h: FloatArray, ok: BoolArray, peak: int, win: WindowConfig, m: i
     Searches junction peak − pre .. peak + guard + post inside the peak's gap-free segment.
     """
     n = h.shape[0]
-    a, b = peak, peak
-    while a > 0 and ok[a - 1]:
-        a -= 1
-    while b < n and ok[b]:
-        b += 1
+    # The peak's gap-free segment [a, b), looked for only as far as the search reaches.
+    reach = win.pre + win.guard + win.post + 2 * win.span + m + 2
+    w0, w1 = max(0, peak - reach), min(n, peak + reach)
+    bad_before = np.flatnonzero(~ok[w0:peak])
+    a = w0 + int(bad_before[-1]) + 1 if bad_before.size else w0
+    bad_after = np.flatnonzero(~ok[peak:w1])
+    b = peak + int(bad_after[0]) if bad_after.size else w1
     lo = max(a + m, peak - win.pre)
     hi = min(b - m, peak + win.guard + win.post)
     if hi <= lo:
         return int(np.clip(peak + win.guard // 2, a, b - 1))
-    x = h[a:b]
     # Noise from a window around the peak, not the whole segment: a segment can reach the edge of a
     # chunk's margin, and the result must not depend on where the chunk was cut.
     near = h[max(a, peak - 2 * win.span) : min(b, peak + 2 * win.span)]
     sigma = robust_noise_sigma(near)
     sigma = np.where(sigma > 0, sigma, 1.0)
+    x0 = lo - m  # only the samples the mean differences read
+    x = h[x0 : hi + m]
     c = np.vstack([np.zeros((1, 3)), np.cumsum(x, axis=0)])
-    taus = np.arange(lo, hi) - a
+    taus = np.arange(lo, hi) - x0
     d = (c[taus + m] - c[taus]) / m - (c[taus] - c[taus - m]) / m
-    return int(a + taus[np.argmax(np.sum((d / sigma) ** 2, axis=1))])
+    return int(x0 + taus[np.argmax(np.sum((d / sigma) ** 2, axis=1))])
 
 
 def local_step(h: FloatArray, ok: BoolArray, tau: int, half: int, guard: int) -> FloatArray:
@@ -374,6 +379,37 @@ def process_chunk(
 
     ``samples_hook`` may change the raw samples before synchronisation (synthetic strike injection).
     """
+    return process_span(
+        store,
+        spacecraft,
+        start_ns,
+        end_ns,
+        config,
+        inertia_kgm2=inertia_kgm2,
+        keep_series=keep_series,
+        samples_hook=samples_hook,
+        split_days=False,
+    )[0]
+
+
+def process_span(
+    store: TelemetryStore,
+    spacecraft: Spacecraft,
+    start_ns: int,
+    end_ns: int,
+    config: FlightRunConfig,
+    *,
+    inertia_kgm2: FloatArray | None = None,
+    keep_series: bool = False,
+    samples_hook: Callable[[pd.DataFrame], pd.DataFrame] | None = None,
+    split_days: bool = True,
+) -> list[ChunkResult]:
+    """Process [start, end) (one or several days) with the margin of :func:`chunk_margin_s`.
+
+    Returns the results of the core, one per UTC day it touches when ``split_days`` (daily
+    statistics), else one. A long span costs its margin once: a day processed alone reads and
+    cleans ``2 × chunk_margin_s`` more than the day.
+    """
     flight = _flight(spacecraft)
     c = config.cleaning
     if not c.savgol:
@@ -413,8 +449,10 @@ def process_chunk(
     hc = h_n
     stat = np.full(g.size, np.nan)
     info: dict[str, float] = {"harmonics_mean": 0.0}
+    fit_cache: dict[tuple[float, ...], Any] = {}
+    h_ok = np.where(ok[:, None], h_n, 0.0)
     for _ in range(max(1, c.passes)):
-        model, info = smooth_model(np.where(ok[:, None], h_n, 0.0), t_s, ok, period, c.comb_config, steps)
+        model, info = smooth_model(h_ok, t_s, ok, period, c.comb_config, steps, cache=fit_cache)
         hc = np.where(ok[:, None], h_n - np.nan_to_num(model), np.nan)
         stat = glr_statistic(hc, ok, win)
         if not (c.comb or c.trend):
@@ -425,17 +463,7 @@ def process_chunk(
             break
         steps = new_steps
     core = (g >= start_ns) & (g < end_ns)
-    # Block maxima for calibration, blocks anchored at absolute multiples of block_s.
-    block_ns = int(config.block_s * NS)
-    blocks: dict[int, float] = {}
-    if core.any():
-        bidx = g[core] // block_ns
-        sc = stat[core]
-        for b in np.unique(bidx):
-            v = sc[bidx == b]
-            if np.isfinite(v).sum() >= 0.5 * config.block_s / dt:
-                blocks[int(b)] = float(np.nanmax(v))
-    peaks = []
+    peaks: list[tuple[int, Peak]] = []
     for i in _local_peaks(stat, config.peak_floor, win.span):
         if not core[i]:
             continue
@@ -448,33 +476,54 @@ def process_chunk(
         sig = float(np.sqrt(np.sum((sigma * d_h / mag) ** 2))) if mag > 0 else float("nan")
         time_sigma = max(dt / math.sqrt(12.0), 3.0 * dt * (sig / mag) ** 2) if mag > 0 else dt * win.guard
         t_event = int(g[tau]) - int(0.5 * dt * NS)
-        peaks.append(Peak(t_event, float(stat[i]), d_h, float(time_sigma)))
-    series = None
-    if keep_series:
-        series = {
-            "time_ns": g[core],
-            "H_N_raw": h_n[core],
-            "H_N_clean": hc[core],
-            "valid": valid[core],
-            "event_mask": ev[core],
-            "slew_mask": sl[core],
-            "statistic": stat[core],
-        }
-    return ChunkResult(
-        start_ns=start_ns,
-        end_ns=end_ns,
-        n_grid=int(core.sum()),
-        n_valid=int((valid & core).sum()),
-        n_event_masked=int((ev & valid & core).sum()),
-        n_slew_masked=int((sl & ~ev & valid & core).sum()),
-        n_analysed=int((np.isfinite(stat) & core).sum()),
-        noise_sigma_Nms=np.asarray(robust_noise_sigma(hc[ok & core]) if (ok & core).sum() > 3 else np.full(3, np.nan)),
-        block_maxima=blocks,
-        peaks=peaks,
-        missing_channels=table.missing_channels,
-        harmonics_mean=float(info.get("harmonics_mean", 0.0)),
-        series=series,
-    )
+        peaks.append((i, Peak(t_event, float(stat[i]), d_h, float(time_sigma))))
+    edges = [start_ns, end_ns]
+    if split_days:
+        d_first = -(-start_ns // DAY_NS) * DAY_NS
+        edges = [start_ns, *range(d_first if d_first > start_ns else d_first + DAY_NS, end_ns, DAY_NS), end_ns]
+    block_ns = int(config.block_s * NS)
+    out: list[ChunkResult] = []
+    for p0, p1 in itertools.pairwise(edges):
+        piece = (g >= p0) & (g < p1)
+        # Block maxima for calibration, blocks anchored at absolute multiples of block_s.
+        blocks: dict[int, float] = {}
+        if piece.any():
+            bidx = g[piece] // block_ns
+            sp = stat[piece]
+            for b in np.unique(bidx):
+                v = sp[bidx == b]
+                if np.isfinite(v).sum() >= 0.5 * config.block_s / dt:
+                    blocks[int(b)] = float(np.nanmax(v))
+        series = None
+        if keep_series:
+            series = {
+                "time_ns": g[piece],
+                "H_N_raw": h_n[piece],
+                "H_N_clean": hc[piece],
+                "valid": valid[piece],
+                "event_mask": ev[piece],
+                "slew_mask": sl[piece],
+                "statistic": stat[piece],
+            }
+        good = ok & piece
+        out.append(
+            ChunkResult(
+                start_ns=p0,
+                end_ns=p1,
+                n_grid=int(piece.sum()),
+                n_valid=int((valid & piece).sum()),
+                n_event_masked=int((ev & valid & piece).sum()),
+                n_slew_masked=int((sl & ~ev & valid & piece).sum()),
+                n_analysed=int((np.isfinite(stat) & piece).sum()),
+                noise_sigma_Nms=np.asarray(robust_noise_sigma(hc[good]) if good.sum() > 3 else np.full(3, np.nan)),
+                block_maxima=blocks,
+                peaks=[pk for i, pk in peaks if p0 <= g[i] < p1],
+                missing_channels=table.missing_channels,
+                harmonics_mean=float(info.get("harmonics_mean", 0.0)),
+                series=series,
+            )
+        )
+    return out
 
 
 # ------------------------------------------------------------------------------------------------
@@ -524,29 +573,35 @@ def run_flight(
     progress: Callable[[str], None] | None = None,
     samples_hook: Callable[[pd.DataFrame], pd.DataFrame] | None = None,
     run_id: str | None = None,
+    executor: Executor | None = None,
 ) -> FlightResult:
-    """Process the stored days chunk by chunk, calibrate the threshold, and return events and daily stats."""
+    """Process the stored days chunk by chunk, calibrate the threshold, and return events and daily stats.
+
+    Chunks (:func:`chunk_spans`) are independent tasks: ``executor`` runs them on worker processes
+    (:mod:`abrupt.scale`); the events are the same wherever they ran. Memory is bounded by one chunk
+    per worker (only per-day summaries are kept unless ``keep_series``).
+    """
     config = config or FlightRunConfig()
     store = TelemetryStore(store_root)
     day_list = day_range(store, spacecraft.name, days)
-    chunk_ns = int(config.chunk_s * NS)
+    spans = chunk_spans(day_list, config.chunk_s)
+    task = _SpanTask(str(store.root), spacecraft, config, inertia_kgm2, keep_series, samples_hook)
     chunks: list[ChunkResult] = []
-    for day in day_list:
-        d0 = int(np.datetime64(day, "D").astype("datetime64[ns]").astype(np.int64))
-        for c0 in range(d0, d0 + DAY_NS, chunk_ns):
+    if executor is None or executor.in_process:
+        for a, b in spans:
             if progress is not None:
-                progress(day)
-            r = process_chunk(
-                store,
-                spacecraft,
-                c0,
-                min(c0 + chunk_ns, d0 + DAY_NS),
-                config,
-                inertia_kgm2=inertia_kgm2,
-                keep_series=keep_series,
-                samples_hook=samples_hook,
-            )
-            chunks.append(r)
+                progress(str(np.datetime64(a, "ns").astype("datetime64[D]")))
+            chunks.extend(task((a, b)))
+    else:
+        from abrupt.scale import TaskResult, run_tasks
+
+        def arrived(r: TaskResult[tuple[int, int], list[ChunkResult]]) -> None:
+            if progress is not None:
+                for piece in r.result:
+                    progress(str(np.datetime64(piece.start_ns, "ns").astype("datetime64[D]")))
+
+        for part in run_tasks(task, spans, executor=executor, on_result=arrived, desc="chunks", unit="chunk"):
+            chunks.extend(part)
     maxima = np.array([v for r in chunks for v in r.block_maxima.values()])
     warnings = []
     if threshold is None:
@@ -566,6 +621,50 @@ def run_flight(
     events = events_from_peaks(peaks, threshold, spacecraft.name, run_id, cfg_hash)
     daily = daily_table(chunks, events, threshold)
     return FlightResult(events, threshold, daily, peaks, chunks if keep_series else [], run_id, cfg_hash, warnings)
+
+
+def chunk_spans(days: Sequence[str], chunk_s: float) -> list[tuple[int, int]]:
+    """[start, end) in ns of the chunks covering ``days``: ``chunk_s`` pieces of each day when
+    ``chunk_s`` < 1 day, else runs of up to ``chunk_s / 1 day`` consecutive days (a run of days pays
+    the chunk margin once)."""
+    starts = sorted({int(np.datetime64(d, "D").astype("datetime64[ns]").astype(np.int64)) for d in days})
+    chunk_ns = int(chunk_s * NS)
+    spans: list[tuple[int, int]] = []
+    if chunk_ns < DAY_NS:
+        for d0 in starts:
+            spans.extend((c0, min(c0 + chunk_ns, d0 + DAY_NS)) for c0 in range(d0, d0 + DAY_NS, chunk_ns))
+        return spans
+    per = max(1, chunk_ns // DAY_NS)
+    for d0 in starts:
+        if spans and spans[-1][1] == d0 and (spans[-1][1] - spans[-1][0]) < per * DAY_NS:
+            spans[-1] = (spans[-1][0], d0 + DAY_NS)
+        else:
+            spans.append((d0, d0 + DAY_NS))
+    return spans
+
+
+@dataclass(frozen=True)
+class _SpanTask:
+    """One chunk of a run as a picklable task (for :func:`abrupt.scale.run_tasks`)."""
+
+    store_root: str
+    spacecraft: Spacecraft
+    config: FlightRunConfig
+    inertia_kgm2: FloatArray | None
+    keep_series: bool
+    samples_hook: Callable[[pd.DataFrame], pd.DataFrame] | None
+
+    def __call__(self, span: tuple[int, int]) -> list[ChunkResult]:
+        return process_span(
+            TelemetryStore(self.store_root),
+            self.spacecraft,
+            span[0],
+            span[1],
+            self.config,
+            inertia_kgm2=self.inertia_kgm2,
+            keep_series=self.keep_series,
+            samples_hook=self.samples_hook,
+        )
 
 
 def _grid_hz(spacecraft: Spacecraft) -> float:
