@@ -100,21 +100,55 @@ class TelemetryStore:
     def read_range(
         self, spacecraft: str, start: np.datetime64, end: np.datetime64, mnemonics: Iterable[str] | None = None
     ) -> pd.DataFrame:
-        """Samples with start <= time < end from every day partition the interval touches."""
+        """Samples with start <= time < end from every day partition the interval touches.
+
+        Columns ``mnemonic`` (categorical), ``time`` (naive datetime64[ns] holding UTC) and ``value``;
+        rows sorted by mnemonic, then time (each day is stored that way). Read column-wise through
+        pyarrow straight into numpy (no per-row Python work).
+        """
         mn = list(mnemonics) if mnemonics is not None else None
         d0 = start.astype("datetime64[D]")
         d1 = (end - np.timedelta64(1, "ns")).astype("datetime64[D]")
-        frames = []
+        t_lo = int(start.astype("datetime64[ns]").astype(np.int64))
+        t_hi = int(end.astype("datetime64[ns]").astype(np.int64))
+        names: list[str] = []
+        index: dict[str, int] = {}
+        codes_l, t_l, v_l = [], [], []
         for d in np.arange(d0, d1 + np.timedelta64(1, "D"), dtype="datetime64[D]"):
-            f = self.read_day(spacecraft, str(d), mn)
-            if len(f):
-                frames.append(f)
-        if not frames:
+            path = self._dir(spacecraft, str(d)) / "samples.parquet"
+            if not path.exists():
+                continue
+            table = pq.read_table(path, columns=["mnemonic", "time", "value"])
+            mcol = table.column("mnemonic").combine_chunks()
+            if not pa.types.is_dictionary(mcol.type):
+                mcol = mcol.dictionary_encode()
+            day_names = mcol.dictionary.to_pylist()
+            remap = np.array([index.setdefault(str(x), len(index)) for x in day_names] + [-1], dtype=np.int32)
+            for x in day_names:
+                if str(x) not in names:
+                    names.append(str(x))
+            codes = remap[np.asarray(mcol.indices.fill_null(len(day_names)).to_numpy(zero_copy_only=False))]
+            t = np.asarray(table.column("time").cast(pa.int64()).to_numpy(), dtype=np.int64)
+            v = np.asarray(table.column("value").to_numpy(), dtype=np.float64)
+            keep = (t >= t_lo) & (t < t_hi)
+            if mn is not None:
+                wanted = np.zeros(len(index) + 1, bool)
+                for x in mn:
+                    if x in index:
+                        wanted[index[x]] = True
+                keep &= wanted[codes]
+            codes_l.append(codes[keep])
+            t_l.append(t[keep])
+            v_l.append(v[keep])
+        if not codes_l:
             return self.read_day(spacecraft, "0000-00-00", mn)
-        frame = pd.concat(frames, ignore_index=True) if len(frames) > 1 else frames[0]
-        t = frame["time"].to_numpy()
-        sel = (t >= start.astype("datetime64[ns]")) & (t < end.astype("datetime64[ns]"))
-        return frame.loc[sel].reset_index(drop=True)
+        codes = np.concatenate(codes_l)
+        t = np.concatenate(t_l)
+        v = np.concatenate(v_l)
+        # Sorted by mnemonic, then time: a stable sort on the codes keeps each day's time order.
+        order = np.lexsort((t, codes))
+        cats = pd.Categorical.from_codes(codes[order], categories=pd.Index(names, dtype=object), validate=False)
+        return pd.DataFrame({"mnemonic": cats, "time": t[order].view("datetime64[ns]"), "value": v[order]})
 
     def report(self, spacecraft: str, day: str) -> dict[str, Any]:
         """The ingest report of a day ({} when absent)."""

@@ -183,17 +183,32 @@ def continuous_quaternion(q: FloatArray) -> FloatArray:
     return np.asarray(q * sign[:, None], dtype=np.float64)
 
 
-def _series(samples: pd.DataFrame, mnemonic: str) -> tuple[np.ndarray, FloatArray]:
-    sub = samples.loc[samples["mnemonic"] == mnemonic] if "mnemonic" in samples else samples
-    tcol = sub["time"]
+def _by_mnemonic(samples: pd.DataFrame) -> dict[str, tuple[np.ndarray, FloatArray]]:
+    """(times ns, values) of each mnemonic, time-sorted, from one sort of the mnemonic codes."""
+    if not len(samples):
+        return {}
+    cats = samples["mnemonic"].astype("category")
+    codes = np.asarray(cats.cat.codes.to_numpy(), dtype=np.int64)
+    tcol = samples["time"]
     if isinstance(tcol.dtype, pd.DatetimeTZDtype):
         tcol = tcol.dt.tz_convert("UTC").dt.tz_localize(None)
-    t = tcol.to_numpy().astype("datetime64[ns]").astype(np.int64)
-    v = sub["value"].to_numpy(np.float64)
-    if t.size > 1 and np.any(np.diff(t) < 0):
-        o = np.argsort(t, kind="stable")
-        t, v = t[o], v[o]
-    return t, v
+    t_all = tcol.to_numpy().astype("datetime64[ns]").astype(np.int64)
+    v_all = samples["value"].to_numpy(np.float64)
+    if codes.size > 1 and np.any(codes[1:] < codes[:-1]):
+        order = np.argsort(codes, kind="stable")
+        codes, t_all, v_all = codes[order], t_all[order], v_all[order]
+    out = {}
+    edges = np.searchsorted(codes, np.arange(len(cats.cat.categories) + 1))
+    for k, name in enumerate(cats.cat.categories):
+        a, b = int(edges[k]), int(edges[k + 1])
+        if b <= a:
+            continue
+        t, v = t_all[a:b], v_all[a:b]
+        if t.size > 1 and np.any(np.diff(t) < 0):
+            o = np.argsort(t, kind="stable")
+            t, v = t[o], v[o]
+        out[str(name)] = (t, v)
+    return out
 
 
 def build_timetable(
@@ -207,21 +222,22 @@ def build_timetable(
     g = grid(start_ns, end_ns, flight.grid_hz)
     step = round(NS / flight.grid_hz)
     n = g.size
-    by_name = {m: grp for m, grp in samples.groupby("mnemonic", observed=True, sort=False)} if len(samples) else {}
+    by_name = _by_mnemonic(samples)
     channel_valid: dict[str, np.ndarray] = {}
     missing = []
 
     def get(m: str) -> tuple[np.ndarray, FloatArray]:
         if m not in by_name:
             return np.empty(0, np.int64), np.empty(0)
-        return _series(by_name[m], m)
+        return by_name[m]
 
     # Quaternion: the components share stamps; keep stamps present in all four.
     qch = flight.of("quaternion")
     series = [get(c.mnemonic) for c in qch]
     common = series[0][0]
     for t, _ in series[1:]:
-        common = np.intersect1d(common, t, assume_unique=False)
+        if not np.array_equal(common, t):  # the components usually share every stamp
+            common = np.intersect1d(common, t, assume_unique=False)
     qs = np.column_stack([v[np.searchsorted(t, common)] for t, v in series]) if common.size else np.empty((0, 4))
     if common.size:
         good = np.isfinite(qs).all(axis=1) & (np.linalg.norm(qs, axis=1) > 0.5)
