@@ -53,10 +53,11 @@ class TelemetryStore:
         d = self._dir(spacecraft, day)
         d.mkdir(parents=True, exist_ok=True)
         path = d / "samples.parquet"
-        new = samples[["mnemonic", "time", "value"]].copy()
-        new["mnemonic"] = new["mnemonic"].astype(str)
+        new = samples[["mnemonic", "time", "value"]]
         added = len(new)
         if path.exists():
+            new = new.copy()
+            new["mnemonic"] = new["mnemonic"].astype(str)
             old = self.read_day(spacecraft, day)
             old["mnemonic"] = old["mnemonic"].astype(str)
             old["time"] = old["time"].dt.tz_localize("UTC")
@@ -66,14 +67,7 @@ class TelemetryStore:
             new = both
             prev = self.report(spacecraft, day)
             report = _merge_reports(prev, report) if prev else report
-        new = new.sort_values(["mnemonic", "time"], kind="stable").reset_index(drop=True)
-        table = pa.table(
-            {
-                "mnemonic": pa.array(new["mnemonic"].to_numpy(dtype=object), pa.string()).dictionary_encode(),
-                "time": pa.array(new["time"], pa.timestamp("ns", tz="UTC")),
-                "value": pa.array(new["value"].to_numpy(np.float64), pa.float64()),
-            }
-        )
+        table = _sorted_table(new)
         tmp = path.with_suffix(".tmp")
         pq.write_table(table, tmp, compression="zstd")
         tmp.replace(path)
@@ -154,6 +148,32 @@ class TelemetryStore:
         """The ingest report of a day ({} when absent)."""
         path = self._dir(spacecraft, day) / "ingest.json"
         return dict(json.loads(path.read_text())) if path.exists() else {}
+
+
+def _sorted_table(frame: pd.DataFrame) -> pa.Table:
+    """The stored table: dictionary-encoded mnemonic, UTC time, value; sorted by mnemonic name, then time."""
+    mn = frame["mnemonic"].astype("category")
+    names = np.asarray(mn.cat.categories.astype(str), dtype=object)
+    rank = np.empty(names.size, np.int32)
+    rank[np.argsort(names, kind="stable")] = np.arange(names.size, dtype=np.int32)
+    key = rank[mn.cat.codes.to_numpy()] if names.size else np.empty(0, np.int32)
+    t = pd.DatetimeIndex(frame["time"])
+    if t.tz is not None:
+        t = t.tz_convert("UTC").tz_localize(None)
+    t_ns = t.asi8
+    v = frame["value"].to_numpy(np.float64)
+    ordered = key.size < 2 or bool(np.all((key[1:] > key[:-1]) | ((key[1:] == key[:-1]) & (t_ns[1:] >= t_ns[:-1]))))
+    if not ordered:
+        o = np.lexsort((t_ns, key))
+        key, t_ns, v = key[o], t_ns[o], v[o]
+    sorted_names = pa.array(np.sort(names).tolist() if names.size else [], pa.string())
+    return pa.table(
+        {
+            "mnemonic": pa.DictionaryArray.from_arrays(pa.array(key, pa.int32()), sorted_names),
+            "time": pa.array(t_ns, pa.int64()).cast(pa.timestamp("ns", tz="UTC")),
+            "value": pa.array(v, pa.float64()),
+        }
+    )
 
 
 def _merge_reports(a: dict[str, Any], b: dict[str, Any]) -> dict[str, Any]:

@@ -89,9 +89,13 @@ def ingest_archives(
         chunk = read_archive(path, decoder, layout=layout, assume_utc=assume_utc)
         summary.files[safe] = dict(chunk.file_counts)
         samples = chunk.samples
-        day_idx = samples["time"].dt.tz_convert("UTC").dt.tz_localize(None).to_numpy().astype("datetime64[D]")
+        day_idx = pd.DatetimeIndex(samples["time"]).asi8 // DAY_NS
+        sc_cat = samples["spacecraft"].astype("category")
+        sc_codes = sc_cat.cat.codes.to_numpy()
+        sc_code = {str(name): k for k, name in enumerate(sc_cat.cat.categories)}
         for (sc, day), report in sorted(chunk.per_day.items()):
-            sel = (samples["spacecraft"].astype(str).to_numpy() == sc) & (day_idx == np.datetime64(day, "D"))
+            d_int = int(np.datetime64(day, "D").astype(np.int64))
+            sel = (sc_codes == sc_code.get(sc, -2)) & (day_idx == d_int)
             if sc == "unattributed" or not sel.any():
                 summary.days.append(report.as_dict())
                 continue

@@ -164,18 +164,53 @@ def _read_raw(path: Path) -> pa.Table:
             return pq.read_table(path)
         with open(path, "rb") as fh:
             gz = fh.read(2) == b"\x1f\x8b"
-        # Only the empty field is null: the text "NaN" is a placeholder and is counted as such.
-        opts = pacsv.ConvertOptions(null_values=[""], strings_can_be_null=True, quoted_strings_can_be_null=True)
         read = pacsv.ReadOptions(block_size=1 << 24)
         parse = pacsv.ParseOptions(ignore_empty_lines=True)
-        if gz:
-            with pa.CompressedInputStream(pa.OSFile(str(path)), "gzip") as stream:
-                return pacsv.read_csv(stream, read_options=read, parse_options=parse, convert_options=opts)
-        return pacsv.read_csv(str(path), read_options=read, parse_options=parse, convert_options=opts)
+
+        def csv_with(opts: pacsv.ConvertOptions) -> pa.Table:
+            if gz:
+                with pa.CompressedInputStream(pa.OSFile(str(path)), "gzip") as stream:
+                    return pacsv.read_csv(stream, read_options=read, parse_options=parse, convert_options=opts)
+            return pacsv.read_csv(str(path), read_options=read, parse_options=parse, convert_options=opts)
+
+        # Only the empty field is null: the text "NaN" parses as a float NaN and is counted as a placeholder.
+        header = _header(path, gz)
+        lower = [h.strip().lower() for h in header]
+        if len(header) == 3 and lower[0] in TIME_NAMES and lower[1:] == ["mnemonic", "value"]:
+            # The usual long export, typed while parsing (UTC times, dictionary-encoded names, float
+            # values): no Python strings per row. Anything it cannot type (a time without a zone, an
+            # unparseable value) is read again the general way below, which names or counts it.
+            typed = pacsv.ConvertOptions(
+                column_types={
+                    header[0]: pa.timestamp("ns", tz="UTC"),
+                    header[1]: pa.dictionary(pa.int32(), pa.string()),
+                    header[2]: pa.float64(),
+                },
+                null_values=[""],
+                strings_can_be_null=True,
+                quoted_strings_can_be_null=True,
+            )
+            try:
+                return csv_with(typed)
+            except pa.ArrowInvalid:
+                pass
+        return csv_with(
+            pacsv.ConvertOptions(null_values=[""], strings_can_be_null=True, quoted_strings_can_be_null=True)
+        )
     except pa.ArrowInvalid as exc:
         raise InputError(f"not a readable table: {str(exc).splitlines()[0]}", file=path) from None
     except OSError as exc:
         raise InputError(f"cannot read archive: {exc}", file=path) from None
+
+
+def _header(path: Path, gz: bool) -> list[str]:
+    """Column names of a CSV file's first line ([] if unreadable)."""
+    opener = gzip.open if gz else open
+    try:
+        with opener(path, "rt", encoding="utf-8-sig", errors="replace") as fh:
+            return next(csv.reader([fh.readline()]), [])
+    except (OSError, EOFError):
+        return []
 
 
 def _line_of_first(path: Path, predicate_text: str) -> int | None:
@@ -332,7 +367,12 @@ def _read_archive(
     mnem_arr = table.column("mnemonic")
 
     # Pseudonyms at the door: map real mnemonic -> pseudonym through a dictionary encoding.
-    enc = mnem_arr.combine_chunks().dictionary_encode() if mnem_arr.num_chunks else pa.array([], pa.string())
+    if pa.types.is_dictionary(mnem_arr.type):
+        enc = mnem_arr.unify_dictionaries().combine_chunks() if mnem_arr.num_chunks else pa.array([], pa.string())
+        if not mnem_arr.num_chunks:
+            enc = enc.dictionary_encode()
+    else:
+        enc = mnem_arr.combine_chunks().dictionary_encode() if mnem_arr.num_chunks else pa.array([], pa.string())
     dictionary = enc.dictionary.to_pylist()
     codes = np.asarray(enc.indices.fill_null(-1).to_numpy(zero_copy_only=False), dtype=np.int64)
     pseudo_of_code = [decoder.mnemonics.get(str(name).strip()) for name in dictionary]
@@ -400,72 +440,74 @@ def _read_archive(
     if unknown_names:
         counts.update({f"rows of a name not in the decoder ({k})": v for k, v in unknown_names.items()})
 
+    # Categories sorted by name: sorting by mnemonic code groups each spacecraft's mnemonics
+    # (names sharing the prefix "SC-A." are contiguous) and orders them by name.
+    pseudo_names = sorted({p for p in pseudo_of_code if p is not None})
+    sc_names = sorted({decoder.spacecraft_of(p) for p in pseudo_names})
+    p_index = {p: i for i, p in enumerate(pseudo_names)}
+    code_to_pseudo = np.array([p_index[p] if p is not None else -1 for p in pseudo_of_code] + [-1], dtype=np.int64)
+    pseudo_to_sc = np.array([sc_names.index(decoder.spacecraft_of(p)) for p in pseudo_names], dtype=np.int64)
     idx = np.flatnonzero(keep)
-    frame = pd.DataFrame(
-        {
-            "spacecraft": pd.Categorical(sc_pseudo[codes_safe[idx]]),
-            "mnemonic": pd.Categorical(pseudo_arr[codes_safe[idx]]),
-            "time_ns": t_int[idx],
-            "value": values[idx],
-            "order": idx,
-        }
-    )
-    frame = _dedupe(frame, per_day, report)
-    for (sc, d), grp in frame.groupby(["spacecraft", frame["time_ns"] // day_ns], observed=True, sort=False):
-        r = report(str(sc), int(d))  # type: ignore[call-overload]
-        r.rows_kept += len(grp)
-        for m, n in grp["mnemonic"].value_counts().items():
-            if n:
-                r.channels[str(m)] = r.channels.get(str(m), 0) + int(n)
-    frame["time"] = pd.to_datetime(frame.pop("time_ns"), utc=True)
-    frame = frame.drop(columns="order")
-    return ArchiveChunk(samples=frame.reset_index(drop=True), per_day=per_day, file_counts=counts)
+    m_codes = code_to_pseudo[codes_safe[idx]]
+    t_k = t_int[idx]
+    v_k = values[idx]
+    del values, t_int, codes, codes_safe, idx
 
+    def count(mask: np.ndarray, m: np.ndarray, t: np.ndarray, label: str, *, reported: bool) -> None:
+        if not mask.any():
+            return
+        pairs = zip(pseudo_to_sc[m[mask]].tolist(), (t[mask] // day_ns).tolist(), strict=True)
+        for (sc, d), n in Counter(pairs).items():
+            r = report(sc_names[sc], d)
+            (r.reported if reported else r.removed)[label] += n
 
-def _dedupe(frame: pd.DataFrame, per_day: dict[tuple[str, str], DayReport], report: object) -> pd.DataFrame:
-    """Remove exact duplicates, report conflicting duplicates and time reversals; sort by time."""
-    day_ns = 86_400 * 1_000_000_000
-    rep = report  # callable (sc, day_index) -> DayReport
-    codes = frame["mnemonic"].cat.codes.to_numpy()
-    sc_codes = frame["spacecraft"].cat.codes.to_numpy()
-    t = frame["time_ns"].to_numpy()
     # Time reversals: within one mnemonic in file order, a time earlier than the previous one.
-    key = sc_codes.astype(np.int64) * 1_000_003 + codes
-    order_file = np.lexsort((frame["order"].to_numpy(), key))
-    k_sorted = key[order_file]
-    t_sorted = t[order_file]
-    rev = np.zeros(len(t), bool)
-    if len(t) > 1:
-        same = k_sorted[1:] == k_sorted[:-1]
-        back = same & (t_sorted[1:] < t_sorted[:-1])
-        rev[order_file[1:][back]] = True
-    _count(frame, rev, "time reversals (sorted)", rep, day_ns, reported=True)
-    # Sort by key, time, file order (stable).
-    order = np.lexsort((frame["order"].to_numpy(), t, key))
-    frame = frame.iloc[order].reset_index(drop=True)
-    key = key[order]
-    t = t[order]
-    v = frame["value"].to_numpy()
-    if len(t) > 1:
-        same_t = np.concatenate([[False], (key[1:] == key[:-1]) & (t[1:] == t[:-1])])
-        same_v = np.concatenate([[False], v[1:] == v[:-1]])
-        exact = same_t & same_v
-        # A conflicting duplicate differs from the first row of its (key, time) group.
-        first_of_group = ~same_t
-        group_first_value = v[np.maximum.accumulate(np.where(first_of_group, np.arange(len(v)), 0))]
-        conflict = same_t & (v != group_first_value)
+    order = np.argsort(m_codes, kind="stable")
+    k_sorted, t_sorted = m_codes[order], t_k[order]
+    back = (k_sorted[1:] == k_sorted[:-1]) & (t_sorted[1:] < t_sorted[:-1])
+    if back.any():
+        rev = np.zeros(m_codes.size, bool)
+        rev[order[1:][back]] = True
+        count(rev, m_codes, t_k, "time reversals (sorted)", reported=True)
+        order = np.lexsort((t_k, m_codes))  # stable: equal (mnemonic, time) stay in file order
+    m_codes, t_k, v_k = m_codes[order], t_k[order], v_k[order]
+    del order, k_sorted, t_sorted
+    if m_codes.size > 1:
+        same_t = np.concatenate([[False], (m_codes[1:] == m_codes[:-1]) & (t_k[1:] == t_k[:-1])])
+        first = np.maximum.accumulate(np.where(~same_t, np.arange(m_codes.size), 0))
+        conflict = same_t & (v_k != v_k[first])
         exact = same_t & ~conflict
     else:
-        exact = conflict = np.zeros(len(t), bool)
-    _count(frame, exact, "exact duplicate rows", rep, day_ns, reported=False)
-    _count(frame, conflict, "conflicting duplicates (first value kept)", rep, day_ns, reported=True)
-    return frame.loc[~(exact | conflict)].reset_index(drop=True)
-
-
-def _count(frame: pd.DataFrame, mask: np.ndarray, label: str, rep: object, day_ns: int, *, reported: bool) -> None:
-    if not mask.any():
-        return
-    sub = frame.loc[mask]
-    for (sc, d), n in Counter(zip(sub["spacecraft"].astype(str), sub["time_ns"] // day_ns, strict=True)).items():
-        r = rep(sc, int(d))  # type: ignore[operator]
-        (r.reported if reported else r.removed)[label] += n
+        exact = conflict = np.zeros(m_codes.size, bool)
+    count(exact, m_codes, t_k, "exact duplicate rows", reported=False)
+    # A conflicting duplicate differs from the first row of its (mnemonic, time) group.
+    count(conflict, m_codes, t_k, "conflicting duplicates (first value kept)", reported=True)
+    if exact.any() or conflict.any():
+        keep_rows = ~(exact | conflict)
+        m_codes, t_k, v_k = m_codes[keep_rows], t_k[keep_rows], v_k[keep_rows]
+    # Rows kept and samples per channel, per spacecraft-day.
+    if m_codes.size:
+        d_k = t_k // day_ns
+        d_min = int(d_k.min())
+        combo = m_codes * (int(d_k.max()) - d_min + 1) + (d_k - d_min)
+        uniq, n_rows = np.unique(combo, return_counts=True)
+        span = int(d_k.max()) - d_min + 1
+        for u, n in zip(uniq.tolist(), n_rows.tolist(), strict=True):
+            m, d = divmod(u, span)
+            r = report(sc_names[pseudo_to_sc[m]], d + d_min)
+            r.rows_kept += n
+            name = pseudo_names[m]
+            r.channels[name] = r.channels.get(name, 0) + n
+    frame = pd.DataFrame(
+        {
+            "spacecraft": pd.Categorical.from_codes(pseudo_to_sc[m_codes], categories=sc_names, validate=False)
+            if pseudo_names
+            else pd.Categorical([]),
+            "mnemonic": pd.Categorical.from_codes(m_codes, categories=pseudo_names, validate=False)
+            if pseudo_names
+            else pd.Categorical([]),
+            "time": pd.Series(t_k.view("datetime64[ns]")).dt.tz_localize("UTC"),
+            "value": v_k,
+        }
+    )
+    return ArchiveChunk(samples=frame, per_day=per_day, file_counts=counts)
