@@ -139,8 +139,10 @@ class TelemetryStore:
         codes = np.concatenate(codes_l)
         t = np.concatenate(t_l)
         v = np.concatenate(v_l)
-        # Sorted by mnemonic, then time: a stable sort on the codes keeps each day's time order.
-        order = np.lexsort((t, codes))
+        # Sorted by mnemonic, then time: each day is stored so and days come in time order, so a
+        # stable sort on the codes (radix sort on 16-bit codes) keeps the time order.
+        small = codes.astype(np.int16) if len(index) < 32_000 else codes
+        order = np.argsort(small, kind="stable")
         cats = pd.Categorical.from_codes(codes[order], categories=pd.Index(names, dtype=object), validate=False)
         return pd.DataFrame({"mnemonic": cats, "time": t[order].view("datetime64[ns]"), "value": v[order]})
 

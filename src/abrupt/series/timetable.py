@@ -237,7 +237,9 @@ def build_timetable(
     common = series[0][0]
     for t, _ in series[1:]:
         if not np.array_equal(common, t):  # the components usually share every stamp
-            common = np.intersect1d(common, t, assume_unique=False)
+            # Both sorted: keep the stamps of `common` found in t (a sorted lookup, no hashing).
+            j = np.clip(np.searchsorted(t, common), 0, max(t.size - 1, 0))
+            common = common[(t[j] == common)] if t.size else common[:0]
     qs = np.column_stack([v[np.searchsorted(t, common)] for t, v in series]) if common.size else np.empty((0, 4))
     if common.size:
         good = np.isfinite(qs).all(axis=1) & (np.linalg.norm(qs, axis=1) > 0.5)
