@@ -177,6 +177,35 @@ def test_chunked_six_hour_chunks_equal_the_whole_run(tmp_path: Path) -> None:
     np.testing.assert_allclose(chunked.events["dH_Nms"], whole.events["dH_Nms"], rtol=1e-6)
 
 
+def test_kestrel_six_hour_chunks_give_the_events_of_the_whole_run(shared_data: Path, tmp_path: Path) -> None:
+    """Issue 9 item 2 on the shared flight-like data: 6-hour chunks (each with its margin) against one
+    chunk of both days; the events are the same and are the truth's strikes."""
+    import json
+
+    data = shared_data / "flight-like"
+    if not data.is_dir():
+        pytest.skip("flight-like data not found")
+    ingest_archives(sorted((data / "telemetry").glob("*.csv.gz")), data / "decoder.csv", tmp_path / "store")
+    sc = load_spacecraft(Path(__file__).resolve().parent.parent / "examples" / "spacecraft" / "kestrel.toml")
+    whole = run_flight(tmp_path / "store", sc, FlightRunConfig(chunk_s=2 * 86_400.0))
+    chunked = run_flight(tmp_path / "store", sc, FlightRunConfig(chunk_s=6 * 3600.0))
+    assert chunked.threshold.value == pytest.approx(whole.threshold.value, rel=1e-9)
+    assert chunked.events["time_utc"].tolist() == whole.events["time_utc"].tolist()
+    np.testing.assert_allclose(chunked.events["statistic"], whole.events["statistic"], rtol=1e-6)
+    np.testing.assert_allclose(chunked.events["dH_Nms"], whole.events["dH_Nms"], rtol=1e-6, atol=1e-9)
+    # Every peak, not only those above the threshold (what the calibration and reports see).
+    assert sorted(round(p.time_ns / 1e9, 3) for p in chunked.peaks) == sorted(
+        round(p.time_ns / 1e9, 3) for p in whole.peaks
+    )
+    # And they are the strikes: all of >= 0.1 N m s within 10 s (the truth, not the pipeline, decides).
+    t0 = np.datetime64("2026-03-10T00:00:00", "ns")
+    t_ev = (pd.to_datetime(whole.events["time_utc"]).dt.tz_localize(None).to_numpy() - t0) / np.timedelta64(1, "s")
+    strikes = json.loads((data / "truth_strikes.json").read_text())["strikes"]
+    big = [s["time_s"] for s in strikes if s["H_mag_Nms"] >= 0.1]
+    assert len(big) >= 5
+    assert all(np.min(np.abs(t_ev - ts)) <= 10.0 for ts in big)
+
+
 def test_leak_scan_of_every_output_of_the_chain(
     synth: tuple[Path, object], tmp_path: Path, capfd: pytest.CaptureFixture[str]
 ) -> None:
