@@ -150,17 +150,23 @@ def part_memory(store: Path, n_days: int = 8) -> None:
     rss: list[tuple[int, float]] = []
     seen: set[str] = set()
 
-    def tick(day: str) -> None:
+    def tick(day: str) -> None:  # called at the start of each chunk
         if day not in seen:
             seen.add(day)
             rss.append((len(seen) - 1, proc.memory_info().rss / 2**20))
 
     t = time.time()
-    run_flight(dst, sc, FlightRunConfig(), days=[f"2026-04-01..2026-04-{n_days:02d}"], progress=tick)
+    c = time.process_time()
+    last = str(np.datetime64("2026-04-01") + np.timedelta64(n_days - 1, "D"))
+    res = run_flight(dst, sc, FlightRunConfig(), days=[f"2026-04-01..{last}"], progress=tick)
     rss.append((len(seen), proc.memory_info().rss / 2**20))
-    print(f"\nmemory over {n_days} days ({time.time() - t:.0f} s, {(time.time() - t) / n_days:.1f} s/day):")
+    print(
+        f"\nmemory over {n_days} days ({time.time() - t:.0f} s wall,"
+        f" {(time.process_time() - c) / n_days:.1f} s CPU/day;"
+        f" chunks of {FlightRunConfig().chunk_s / 86400:.0f} days; {len(res.events)} events):"
+    )
     for k, m in rss:
-        print(f"  after {k} days: RSS {m:.0f} MiB")
+        print(f"  chunk starting after {k * FlightRunConfig().chunk_s / 86400:.0f} days: RSS {m:.0f} MiB")
 
 
 def part_speed(store: Path) -> None:
@@ -313,5 +319,7 @@ if __name__ == "__main__":
     for p in args.parts.split(","):
         if p == "year":
             part_year(store, args.days, args.workers)
+        elif p == "memory":
+            part_memory(store, args.days if args.days != 365 else 30)
         else:
             globals()[f"part_{p}"](store)

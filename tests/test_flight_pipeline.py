@@ -171,7 +171,8 @@ def test_chunked_six_hour_chunks_equal_the_whole_run(tmp_path: Path) -> None:
     chunked = run_flight(tmp_path / "store", sc, FlightRunConfig(cleaning=CleaningConfig(passes=2), chunk_s=6 * 3600.0))
     t_ev = (pd.to_datetime(whole.events["time_utc"]).dt.tz_localize(None).to_numpy() - a.start) / np.timedelta64(1, "s")
     assert all(np.min(np.abs(t_ev - ts)) < 5.0 for ts, _ in a.strikes)
-    assert chunked.threshold.value == pytest.approx(whole.threshold.value, rel=1e-9)
+    # Equal to rounding: sums over a chunk start at another element (SIMD and cumulative-sum order).
+    assert chunked.threshold.value == pytest.approx(whole.threshold.value, rel=1e-7)
     assert chunked.events["time_utc"].tolist() == whole.events["time_utc"].tolist()
     np.testing.assert_allclose(chunked.events["statistic"], whole.events["statistic"], rtol=1e-6)
     np.testing.assert_allclose(chunked.events["dH_Nms"], whole.events["dH_Nms"], rtol=1e-6)
@@ -189,7 +190,8 @@ def test_kestrel_six_hour_chunks_give_the_events_of_the_whole_run(shared_data: P
     sc = load_spacecraft(Path(__file__).resolve().parent.parent / "examples" / "spacecraft" / "kestrel.toml")
     whole = run_flight(tmp_path / "store", sc, FlightRunConfig(chunk_s=2 * 86_400.0))
     chunked = run_flight(tmp_path / "store", sc, FlightRunConfig(chunk_s=6 * 3600.0))
-    assert chunked.threshold.value == pytest.approx(whole.threshold.value, rel=1e-9)
+    # Equal to rounding: sums over a chunk start at another element (SIMD and cumulative-sum order).
+    assert chunked.threshold.value == pytest.approx(whole.threshold.value, rel=1e-7)
     assert chunked.events["time_utc"].tolist() == whole.events["time_utc"].tolist()
     np.testing.assert_allclose(chunked.events["statistic"], whole.events["statistic"], rtol=1e-6)
     np.testing.assert_allclose(chunked.events["dH_Nms"], whole.events["dH_Nms"], rtol=1e-6, atol=1e-9)
