@@ -10,7 +10,7 @@ Harris et al. 2025 §3.3-3.5, §3.7 and Bennett 2022 ch. 4, driven entirely by t
    masks event-flag firings and slews (:mod:`abrupt.clean.masks`), removes the slow external-torque
    trend and the orbit comb (:mod:`abrupt.clean.comb`) in ``passes`` iterations, the candidate steps of
    one pass entering the next pass's fits as free steps so that strikes are not absorbed, and runs
-   the GLR change detector (Bennett 2022 §2.4.2; :func:`abrupt.detect.change_detection.sliding_statistic`)
+   the GLR statistic of the registered ``attitude.glr`` detector (Bennett 2022 §2.4.2; ``get_detector``)
    on the cleaned ᴺH.
 3. :func:`run_flight` runs chunk by chunk (memory flat in the number of days), calibrates the
    threshold on the spacecraft's own statistic at the stated false-alarm rate per day (robust Gumbel fit
@@ -35,7 +35,8 @@ import pandas as pd
 from abrupt.clean.comb import CombConfig, smooth_model
 from abrupt.clean.flight_masks import SlewMaskConfig, event_mask, flag_intervals, slew_mask
 from abrupt.clean.noise import robust_noise_sigma
-from abrupt.detect.change_detection import WindowConfig, sliding_statistic
+from abrupt.detect.base import get_detector
+from abrupt.detect.change_detection import WindowConfig
 from abrupt.errors import ConfigError, InputError
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc, new_run_id
 from abrupt.model.flight_config import FlightConfig
@@ -239,12 +240,20 @@ def _segments(ok: BoolArray) -> list[tuple[int, int]]:
 
 
 def glr_statistic(h: FloatArray, ok: BoolArray, win: WindowConfig) -> FloatArray:
-    """GLR statistic (Mahalanobis distance of pre/post means) per gap-free segment of ``ok``."""
-    stat = np.full(h.shape[0], np.nan)
-    for a, b in _segments(ok):
-        if b - a >= win.span:
-            stat[a:b] = sliding_statistic("glr", h[a:b], win)[:, 0]
-    return stat
+    """GLR statistic of the registered ``attitude.glr`` detector (Mahalanobis distance of the pre/post
+    means, Bennett 2022 §2.4.2) on each gap-free segment of ``ok`` at least one window span long.
+
+    The detector class comes from the registry (``get_detector``), so the flight pipeline and
+    ``abrupt detect attitude`` share one statistic; calibration (robust block maxima of the
+    spacecraft's own statistic) and the step estimate on cleaned ᴺH stay here.
+    """
+    from abrupt.detect.attitude import MomentumChangeDetector
+
+    cls = get_detector(DETECTOR_NAME)
+    if not issubclass(cls, MomentumChangeDetector):
+        raise TypeError(f"{DETECTOR_NAME} is not a momentum change detector")
+    segments = [(a, b) for a, b in _segments(ok) if b - a >= win.span]
+    return np.asarray(cls(windows=win).statistic(h, segments), dtype=np.float64)
 
 
 def _local_peaks(stat: FloatArray, floor: float, sep: int) -> list[int]:

@@ -29,6 +29,7 @@ import hashlib
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -498,14 +499,17 @@ def _read_archive(
             r.rows_kept += n
             name = pseudo_names[m]
             r.channels[name] = r.channels.get(name, 0) + n
+    sc_cat: Any
+    mn_cat: Any
+    if pseudo_names:
+        sc_cat = pd.Categorical.from_codes(pseudo_to_sc[m_codes], categories=pd.Index(sc_names), validate=False)
+        mn_cat = pd.Categorical.from_codes(m_codes, categories=pd.Index(pseudo_names), validate=False)
+    else:
+        sc_cat = mn_cat = pd.Categorical([])
     frame = pd.DataFrame(
         {
-            "spacecraft": pd.Categorical.from_codes(pseudo_to_sc[m_codes], categories=sc_names, validate=False)
-            if pseudo_names
-            else pd.Categorical([]),
-            "mnemonic": pd.Categorical.from_codes(m_codes, categories=pseudo_names, validate=False)
-            if pseudo_names
-            else pd.Categorical([]),
+            "spacecraft": sc_cat,
+            "mnemonic": mn_cat,
             "time": pd.Series(t_k.view("datetime64[ns]")).dt.tz_localize("UTC"),
             "value": v_k,
         }
