@@ -160,6 +160,22 @@ def test_synthetic_strikes_found_with_their_size_and_no_false_alarm(synth: tuple
     assert res.daily["event_masked_fraction"].iloc[0] > 0
 
 
+def test_orbit_period_estimated_from_the_attitude_when_the_file_has_none(
+    synth: tuple[Path, object], tmp_path: Path
+) -> None:
+    d, a = synth
+    text = Path(a.spacecraft).read_text()  # type: ignore[attr-defined]
+    no_orbit = tmp_path / "no_orbit.toml"
+    no_orbit.write_text(text.replace("[orbit]\nperiod_s = 3000.0\n", ""))
+    sc = load_spacecraft(no_orbit)
+    assert sc.orbit is None
+    res = run_flight(d / "store", sc, FAST)
+    note = next(w for w in res.warnings if "orbit period estimated" in w)
+    period = float(note.rsplit(":", 1)[1].split()[0])
+    assert period == pytest.approx(3000.0, rel=0.01)  # the generator turns the body once per 3000 s
+    assert len(res.events) == len(a.strikes)  # type: ignore[attr-defined]
+
+
 @pytest.mark.slow
 def test_chunked_six_hour_chunks_equal_the_whole_run(tmp_path: Path) -> None:
     a = make_archive(

@@ -95,7 +95,7 @@ def estimate_period(
     for k in range(h.shape[1]):
         y = h[sel, k][::step]
         y = y - np.polyval(np.polyfit(t - t.mean(), y, 1), t - t.mean())
-        power += lombscargle(t - t.mean(), y, freqs, precenter=True)
+        power += lombscargle(t - t.mean(), y - y.mean(), freqs)
     return float(2.0 * np.pi / freqs[int(np.argmax(power))])
 
 

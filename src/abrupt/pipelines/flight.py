@@ -153,7 +153,11 @@ class CleaningConfig:
 
 @dataclass(frozen=True)
 class FlightRunConfig:
-    """Detection on cleaned ᴺH: GLR windows [s], guard [s], false-alarm budget, calibration blocks [s]."""
+    """Detection on cleaned ᴺH: GLR windows [s], guard [s], false-alarm budget, calibration blocks [s].
+
+    ``orbit_period_s`` overrides the spacecraft file's orbit (set by :func:`run_flight` from the data
+    when the file has no ``[orbit]``).
+    """
 
     window_s: float = 300.0
     guard_s: float = 20.0
@@ -162,16 +166,49 @@ class FlightRunConfig:
     chunk_s: float = 3 * 86_400.0
     cleaning: CleaningConfig = field(default_factory=CleaningConfig)
     peak_floor: float = 3.0
+    orbit_period_s: float | None = None
 
     def windows(self, dt_s: float) -> WindowConfig:
         n = max(2, round(self.window_s / dt_s))
         return WindowConfig(pre=n, post=n, guard=max(0, round(self.guard_s / dt_s)))
 
 
-def orbit_period_s(spacecraft: Spacecraft) -> float:
+def orbit_period_s(spacecraft: Spacecraft, config: FlightRunConfig | None = None) -> float:
+    """Orbit period [s]: the run's (estimated from the data, :func:`estimate_orbit_period_s`) or the file's."""
+    if config is not None and config.orbit_period_s is not None:
+        return float(config.orbit_period_s)
     if spacecraft.orbit is None:
         raise ConfigError("the comb filter needs [orbit] period_s or altitude_km", file=spacecraft.source, key="orbit")
     return spacecraft.orbit.period_s
+
+
+def estimate_orbit_period_s(spacecraft: Spacecraft, table: Timetable) -> tuple[float, str]:
+    """Orbit period [s] from the telemetry, for a spacecraft file without ``[orbit]``; (period, method).
+
+    An Earth-pointing spacecraft turns once per orbit, so its attitude rate is 2π/P: when the median
+    rotation rate between star-tracker attitudes 300 s apart corresponds to a period of 40 min - 2 days
+    and is steady (robust spread < 5% of it), P = 2π/median rate.
+    Otherwise (inertial pointing) the strongest period of ᴺH between 80 and 800 min (Lomb-Scargle,
+    :func:`abrupt.clean.comb.estimate_period`). NaN when neither applies.
+    """
+    from abrupt.clean.comb import estimate_period
+    from abrupt.clean.noise import robust_scale
+
+    # Rotation angle between attitudes m samples apart, 2 arccos|q(t+m)·q(t)| (free of gyro bias).
+    q = table.quaternion_BN
+    m = max(1, round(300.0 / table.dt_s)) if len(table) > 1 else 1
+    if len(table) > 10 * m:
+        ok = table.valid[m:] & table.valid[:-m] & np.all(np.isfinite(q[m:]) & np.isfinite(q[:-m]), axis=1)
+        dots = np.abs(np.einsum("ij,ij->i", q[m:][ok], q[:-m][ok]))
+        if dots.size > 100:
+            rate = 2.0 * np.arccos(np.clip(dots, 0.0, 1.0)) / (m * table.dt_s)
+            med = float(np.median(rate))
+            spread = float(robust_scale(rate))
+            if 2 * math.pi / 172_800.0 <= med <= 2 * math.pi / 2_400.0 and spread < 0.05 * med:
+                return 2 * math.pi / med, "attitude rate (Earth pointing: one turn per orbit)"
+    h_n, _ = timetable_momentum(spacecraft, table, None)
+    period = estimate_period(h_n, table.time_ns.astype(np.float64) / NS, table.valid)
+    return period, "periodogram of total momentum"
 
 
 def chunk_margin_s(spacecraft: Spacecraft, config: FlightRunConfig) -> float:
@@ -181,7 +218,11 @@ def chunk_margin_s(spacecraft: Spacecraft, config: FlightRunConfig) -> float:
     the slew mask on half its nominal-rate window; Savitzky-Golay on half its window.
     """
     c = config.cleaning
-    period = spacecraft.orbit.period_s if spacecraft.orbit is not None else 0.0
+    period = (
+        config.orbit_period_s
+        if config.orbit_period_s is not None
+        else (spacecraft.orbit.period_s if spacecraft.orbit is not None else 0.0)
+    )
     fit = (c.spacing_orbits + c.half_width_orbits) * period if (c.comb or c.trend) else 0.0
     span = 2 * config.window_s + config.guard_s
     per_pass = fit + 2 * span
@@ -457,7 +498,7 @@ def process_span(
     ok = valid & ~ev & ~sl
     win = config.windows(dt)
     t_s = g.astype(np.float64) / NS
-    period = orbit_period_s(spacecraft) if (c.comb or c.trend) else 1.0
+    period = orbit_period_s(spacecraft, config) if (c.comb or c.trend) else 1.0
     steps = np.empty(0)
     hc = h_n
     stat = np.full(g.size, np.nan)
@@ -597,6 +638,26 @@ def run_flight(
     config = config or FlightRunConfig()
     store = TelemetryStore(store_root)
     day_list = day_range(store, spacecraft.name, days)
+    warnings: list[str] = []
+    c = config.cleaning
+    if spacecraft.orbit is None and config.orbit_period_s is None and (c.comb or c.trend):
+        # One period for the whole run (from its first day), so that every chunk uses the same one.
+        d0 = int(np.datetime64(day_list[0], "D").astype("datetime64[ns]").astype(np.int64))
+        samples = store.read_range(
+            spacecraft.name, np.datetime64(d0, "ns"), np.datetime64(d0 + DAY_NS, "ns"), _flight(spacecraft).mnemonics
+        )
+        table = build_timetable(
+            samples, _flight(spacecraft), tuple(a.name for a in spacecraft.appendages), d0, d0 + DAY_NS
+        )
+        period, how = estimate_orbit_period_s(spacecraft, table)
+        if not (math.isfinite(period) and period > 0):
+            raise ConfigError(
+                "no [orbit] in the spacecraft file and no orbit period in the data; give [orbit] period_s",
+                file=spacecraft.source,
+                key="orbit",
+            )
+        config = replace(config, orbit_period_s=period)
+        warnings.append(f"orbit period estimated from the data ({how}) on {day_list[0]}: {period:.1f} s")
     spans = chunk_spans(day_list, config.chunk_s)
     task = _SpanTask(str(store.root), spacecraft, config, inertia_kgm2, keep_series, samples_hook)
     chunks: list[ChunkResult] = []
@@ -616,7 +677,6 @@ def run_flight(
         for part in run_tasks(task, spans, executor=executor, on_result=arrived, desc="chunks", unit="chunk"):
             chunks.extend(part)
     maxima = np.array([v for r in chunks for v in r.block_maxima.values()])
-    warnings = []
     if threshold is None:
         if maxima.size < 8:
             raise InputError("too little analysable telemetry to calibrate a threshold (< 8 blocks)", file=store.root)
