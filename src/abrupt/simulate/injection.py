@@ -17,9 +17,11 @@ the attitude error δθ(t) = ∫Δω; wheel speeds as tachometer counts regenera
 pulse phase (counts c'_k = c_k + ⌊φ₀ + Δφ_k⌋ − ⌊φ₀ + Δφ_{k−1}⌋ with Δφ the added wheel angle in pulses
 and φ₀ a random phase), or as gate means when no tachometer is declared.
 
-This is not the full nonlinear simulator (`simulate/attitude.py`): the control transient's shape is
-a stand-in with time constant ``settle_s``, which only affects the first tens of seconds; detection
-on total momentum does not depend on it.
+By default (``response="simulated"``) the transient is Harris's: the closed-loop simulator of
+:mod:`abrupt.simulate.attitude` (``simulate_pointing``) follows the telemetry's own attitude with and
+without the strike for ``window_s`` and the difference is added; after the window the wheels hold
+[BN(t)]ΔH_N. ``response="linear"`` keeps the stand-in above (time constant ``settle_s``). Detection on
+total momentum depends on the transient only through the first tens of seconds.
 """
 
 from __future__ import annotations
@@ -92,6 +94,64 @@ def _quat_multiply(p: FloatArray, q: FloatArray) -> FloatArray:
     )
 
 
+@dataclass(frozen=True)
+class StrikeResponse:
+    """Difference (with − without the strike) of a closed-loop simulation along the telemetry's attitude.
+
+    ``tau_s`` time since the strike [s]; ``d_omega_B`` body-rate change [rad/s] (n, 3); ``d_theta_B``
+    attitude error [rad] in body axes (n, 3); ``d_wheel`` wheel-speed change [rad/s] (n, N).
+    """
+
+    tau_s: FloatArray
+    d_omega_B: FloatArray
+    d_theta_B: FloatArray
+    d_wheel: FloatArray
+
+
+def simulated_response(
+    samples: pd.DataFrame,
+    spacecraft: Spacecraft,
+    strike: InjectedStrike,
+    *,
+    window_s: float = 300.0,
+    lead_s: float = 20.0,
+    sim_rate_hz: float = 50.0,
+) -> StrikeResponse:
+    """Harris et al. 2025 §3.5: simulate the spacecraft following the telemetry's own attitude
+    (``ReferenceTrajectory.from_telemetry``) with and without the strike and return the difference.
+
+    Closed-loop rigid body + wheels (:func:`abrupt.simulate.attitude.simulate_pointing`, RK4, MRP
+    tracking law with the simulator's gains, which the spacecraft file does not carry), noise off, from
+    ``lead_s`` before the strike to ``window_s`` after it; the wheel-speed change comes from the
+    controller's own torque distribution.
+    """
+    from abrupt.simulate.attitude import AttitudeSimConfig, PointingScenario, ReferenceTrajectory, simulate_pointing
+
+    t0 = strike.time_ns - int(lead_s * NS)
+    t_ref = t0 + np.arange(-5, int(window_s + lead_s) + 6, dtype=np.int64) * NS
+    bn = _attitude_at(samples, spacecraft, t_ref)
+    from abrupt.model.rotations import quaternion_from_dcm
+
+    reference = ReferenceTrajectory.from_telemetry((t_ref - t0) / NS, quaternion_from_dcm(bn))
+    config = AttitudeSimConfig(
+        duration_s=window_s + lead_s, sim_rate_hz=sim_rate_hz, telemetry_rate_hz=10.0, noise=False, seed=0
+    )
+    scenario = PointingScenario(reference=reference, gravity_gradient=False)
+    dh = tuple(float(x) for x in strike.dH_N_Nms)
+    with_strike = simulate_pointing(spacecraft, config, scenario, strikes_N=[(lead_s, dh)])
+    without = simulate_pointing(spacecraft, config, scenario)
+    q_w, q_o = with_strike.true_q_BN, without.true_q_BN
+    conj = q_o * np.array([1.0, -1.0, -1.0, -1.0])
+    dq = _quat_multiply(conj, q_w)  # q_with = q_without ⊗ δq: δθ about body axes
+    dq *= np.where(dq[:, :1] < 0, -1.0, 1.0)
+    return StrikeResponse(
+        tau_s=np.asarray(with_strike.t_s - lead_s, dtype=np.float64),
+        d_omega_B=np.asarray(with_strike.true_omega_B_rad_s - without.true_omega_B_rad_s, dtype=np.float64),
+        d_theta_B=np.asarray(2.0 * dq[:, 1:], dtype=np.float64),
+        d_wheel=np.asarray(with_strike.true_wheel_speed_rad_s - without.true_wheel_speed_rad_s, dtype=np.float64),
+    )
+
+
 def inject_strikes(
     samples: pd.DataFrame,
     spacecraft: Spacecraft,
@@ -99,8 +159,16 @@ def inject_strikes(
     *,
     settle_s: float = 10.0,
     seed: int = 0,
+    response: str = "simulated",
+    window_s: float = 300.0,
 ) -> pd.DataFrame:
-    """Raw samples (mnemonic, time, value) with the strikes' responses added in native units."""
+    """Raw samples (mnemonic, time, value) with the strikes' responses added in native units.
+
+    ``response="simulated"`` (default): the body-rate, attitude and wheel transients come from the
+    closed-loop simulation of :func:`simulated_response` for ``window_s`` after each strike, and after it
+    the wheels hold [BN(t)]ΔH_N (ᴺH conserved). ``"linear"``: the stand-in transient of time constant
+    ``settle_s`` (module docstring).
+    """
     if spacecraft.flight is None or not strikes:
         return samples
     flight = spacecraft.flight
@@ -120,11 +188,33 @@ def inject_strikes(
     for s in strikes:
         bn0 = bn_at(np.array([s.time_ns]))[0]
         dw0 = j_inv @ (bn0 @ s.dH_N_Nms)
+        sim = simulated_response(samples, spacecraft, s, window_s=window_s) if response == "simulated" else None
+        null_offset = np.zeros(wheel_pinv.shape[0])
+        if sim is not None:
+            horizon_ns = int(window_s * NS)
+            # After the window the wheels hold [BN(t)]ΔH_N; the controller's distribution may differ from
+            # the minimum-norm one by a null-space vector (no momentum): keep it, so speeds are continuous.
+            bn_end = bn_at(np.array([s.time_ns + int(sim.tau_s[-1] * NS)]))[0]
+            null_offset = sim.d_wheel[-1] - wheel_pinv @ (bn_end @ s.dH_N_Nms)
+
+        def d_rate(tau: FloatArray, k: int, sim: StrikeResponse | None = sim, dw0: FloatArray = dw0) -> FloatArray:
+            if sim is None:
+                return np.asarray(dw0[k] * rate_response(tau, settle_s), dtype=np.float64)
+            inside = (tau >= 0) & (tau <= sim.tau_s[-1])
+            return np.where(inside, np.interp(tau, sim.tau_s, sim.d_omega_B[:, k]), 0.0)
+
+        def d_angle(tau: FloatArray, sim: StrikeResponse | None = sim, dw0: FloatArray = dw0) -> FloatArray:
+            if sim is None:
+                return np.asarray(dw0[None, :] * angle_response(tau, settle_s)[:, None], dtype=np.float64)
+            inside = ((tau >= 0) & (tau <= sim.tau_s[-1]))[:, None]
+            cols = [np.interp(tau, sim.tau_s, sim.d_theta_B[:, k]) for k in range(3)]
+            return np.asarray(np.where(inside, np.column_stack(cols), 0.0), dtype=np.float64)
+
         # Body rates (gyro channels).
         for c in flight.of("body_rate"):
             sel = np.flatnonzero((mnem == c.mnemonic) & (t_all >= s.time_ns) & (t_all < s.time_ns + horizon_ns))
             tau = (t_all[sel] - s.time_ns) / NS
-            values[sel] += dw0[c.component] * rate_response(tau, settle_s) / c.to_si
+            values[sel] += d_rate(tau, c.component) / c.to_si
         # Attitude: q_BN of the perturbed body = δq(δθ) ⊗ q_BN, δθ in body axes.
         qch = flight.of("quaternion")
         sel0 = np.flatnonzero((mnem == qch[0].mnemonic) & (t_all >= s.time_ns) & (t_all < s.time_ns + horizon_ns))
@@ -140,7 +230,7 @@ def inject_strikes(
             ok = np.all(t_all[rows_arr] == t_q[:, None], axis=1)
             rows_arr = rows_arr[ok]
             tau = (t_q[ok] - s.time_ns) / NS
-            dth = dw0[None, :] * angle_response(tau, settle_s)[:, None]
+            dth = d_angle(tau)
             half = 0.5 * np.linalg.norm(dth, axis=1)
             with np.errstate(invalid="ignore", divide="ignore"):
                 axis = np.where(half[:, None] > 0, dth / (2 * half[:, None]), 0.0)
@@ -166,8 +256,13 @@ def inject_strikes(
             if after.any():
                 bn = bn_at(t_sub[after])
                 h_b = np.einsum("nij,j->ni", bn, s.dH_N_Nms)
-                h_b -= (spacecraft.inertia_kgm2 @ dw0)[None, :] * rate_response(tau[after], settle_s)[:, None]
-                d_omega[after] = (h_b @ wheel_pinv.T)[:, c.component]
+                if sim is None:
+                    h_b -= (spacecraft.inertia_kgm2 @ dw0)[None, :] * rate_response(tau[after], settle_s)[:, None]
+                d_omega[after] = (h_b @ wheel_pinv.T)[:, c.component] + null_offset[c.component]
+                if sim is not None:  # the simulated transient, then ᴺH conserved by the wheels
+                    inside = tau[after] <= sim.tau_s[-1]
+                    k = c.component
+                    d_omega[np.flatnonzero(after)[inside]] = np.interp(tau[after][inside], sim.tau_s, sim.d_wheel[:, k])
             d_mean = d_omega.reshape(-1, k_sub).mean(axis=1)
             if c.tachometer is not None:
                 # Regenerate counts from the cumulative pulse phase (Harris §3.5: tach counts regenerated).
