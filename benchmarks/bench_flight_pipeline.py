@@ -150,7 +150,7 @@ def part_memory(store: Path, n_days: int = 8) -> None:
     rss: list[tuple[int, float]] = []
     seen: set[str] = set()
 
-    def tick(day: str) -> None:  # called at the start of each chunk
+    def tick(day: str) -> None:  # called for each day once its chunk is processed
         if day not in seen:
             seen.add(day)
             rss.append((len(seen) - 1, proc.memory_info().rss / 2**20))
@@ -166,7 +166,7 @@ def part_memory(store: Path, n_days: int = 8) -> None:
         f" chunks of {FlightRunConfig().chunk_s / 86400:.0f} days; {len(res.events)} events):"
     )
     for k, m in rss:
-        print(f"  chunk starting after {k * FlightRunConfig().chunk_s / 86400:.0f} days: RSS {m:.0f} MiB")
+        print(f"  after {k} days: RSS {m:.0f} MiB")
 
 
 def part_speed(store: Path) -> None:

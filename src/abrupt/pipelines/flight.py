@@ -663,9 +663,11 @@ def run_flight(
     chunks: list[ChunkResult] = []
     if executor is None or executor.in_process:
         for a, b in spans:
-            if progress is not None:
-                progress(str(np.datetime64(a, "ns").astype("datetime64[D]")))
-            chunks.extend(task((a, b)))
+            pieces = task((a, b))
+            chunks.extend(pieces)
+            if progress is not None:  # once per day (a chunk may hold several)
+                for piece in pieces:
+                    progress(str(np.datetime64(piece.start_ns, "ns").astype("datetime64[D]")))
     else:
         from abrupt.scale import TaskResult, run_tasks
 
