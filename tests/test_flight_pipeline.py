@@ -6,6 +6,7 @@ from __future__ import annotations
 import gzip
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -372,6 +373,41 @@ def test_comb_removes_orbit_harmonics_and_keeps_a_candidate_step() -> None:
     np.testing.assert_allclose(after, step, atol=1e-3)
     assert np.std(r[t < 14000] - r[t < 14000].mean(axis=0), axis=0).max() < 1.5e-3
     assert info["harmonics_mean"] >= 2
+
+
+def test_binned_comb_fit_equals_the_per_sample_fit_to_a_small_fraction_of_the_noise() -> None:
+    """10-s bin means (weighted) against every sample: the reference is the per-sample least squares."""
+    t = 1.7e9 + np.arange(0.0, 40000.0, 1.0)
+    p = 5926.4
+    rng = np.random.default_rng(3)
+    sig = 4e-3
+    x = 0.05 * np.sin(2 * np.pi * t / p) + 0.02 * np.cos(6 * np.pi * t / p + 0.3)
+    h = np.column_stack([x, -x, 1e-5 * (t - t[0])]) + sig * rng.normal(size=(t.size, 3))
+    h += np.outer(t >= t[0] + 20000.3, [0.03, -0.02, 0.01])
+    ok = np.ones(t.size, bool)
+    ok[5000:5400] = False  # a masked interval (free step) inside a bin boundary
+    ok[12345:12352] = False
+    steps = np.array([t[0] + 20000.3])
+    cached: dict[tuple[float, ...], Any] = {}
+    m_bins, _ = smooth_model(h, t, ok, p, CombConfig(bin_s=10.0), steps, cache=cached)
+    m_all, _ = smooth_model(h, t, ok, p, CombConfig(bin_s=0.0), steps)
+    both = np.isfinite(m_bins).all(axis=1) & np.isfinite(m_all).all(axis=1)
+    assert both.mean() > 0.9
+    assert np.max(np.abs(m_bins[both] - m_all[both])) < 0.1 * sig
+    # A second pass from the cache gives the same model.
+    m_again, _ = smooth_model(h, t, ok, p, CombConfig(bin_s=10.0), steps, cache=cached)
+    np.testing.assert_array_equal(m_again, m_bins)
+
+
+def test_chunk_spans_cover_the_days_once() -> None:
+    from abrupt.pipelines.flight import DAY_NS, chunk_spans
+
+    days = ["2026-03-10", "2026-03-11", "2026-03-12", "2026-03-13", "2026-03-20"]
+    d0 = int(np.datetime64("2026-03-10", "D").astype("datetime64[ns]").astype(np.int64))
+    spans = chunk_spans(days, 3 * 86_400.0)
+    assert spans == [(d0, d0 + 3 * DAY_NS), (d0 + 3 * DAY_NS, d0 + 4 * DAY_NS), (d0 + 10 * DAY_NS, d0 + 11 * DAY_NS)]
+    six = chunk_spans(days[:1], 6 * 3600.0)
+    assert six == [(d0 + k * DAY_NS // 4, d0 + (k + 1) * DAY_NS // 4) for k in range(4)]
 
 
 def test_robust_gumbel_threshold_against_scipy() -> None:

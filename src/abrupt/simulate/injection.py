@@ -137,7 +137,7 @@ def simulated_response(
         duration_s=window_s + lead_s, sim_rate_hz=sim_rate_hz, telemetry_rate_hz=10.0, noise=False, seed=0
     )
     scenario = PointingScenario(reference=reference, gravity_gradient=False)
-    dh = tuple(float(x) for x in strike.dH_N_Nms)
+    dh = (float(strike.dH_N_Nms[0]), float(strike.dH_N_Nms[1]), float(strike.dH_N_Nms[2]))
     with_strike = simulate_pointing(spacecraft, config, scenario, strikes_N=[(lead_s, dh)])
     without = simulate_pointing(spacecraft, config, scenario)
     q_w, q_o = with_strike.true_q_BN, without.true_q_BN
