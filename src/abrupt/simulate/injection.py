@@ -27,6 +27,7 @@ total momentum depends on the transient only through the first tens of seconds.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -62,22 +63,36 @@ def angle_response(tau_s: FloatArray, settle_s: float) -> FloatArray:
     return np.where(tau_s >= 0, t * np.exp(-t / settle_s), 0.0)
 
 
+class _Attitude:
+    """[BN](t) from the telemetered quaternion (sign-continuous, nlerp); the series is read once."""
+
+    def __init__(self, samples: pd.DataFrame, spacecraft: Spacecraft) -> None:
+        assert spacecraft.flight is not None
+        mnem = samples["mnemonic"].to_numpy()
+        t_all = samples["time"].to_numpy().astype("datetime64[ns]").astype(np.int64)
+        v_all = samples["value"].to_numpy(float)
+        series = []
+        for c in spacecraft.flight.of("quaternion"):
+            sel = mnem == c.mnemonic
+            t, v = t_all[sel], v_all[sel]
+            o = np.argsort(t, kind="stable")
+            series.append((t[o], v[o]))
+        common = series[0][0]
+        for t, _ in series[1:]:
+            common = np.intersect1d(common, t)
+        q = np.column_stack([v[np.searchsorted(t, common)] for t, v in series])
+        self.t = common.astype(np.float64)
+        self.q = continuous_quaternion(q)
+
+    def __call__(self, t_ns: np.ndarray) -> FloatArray:
+        qi = np.column_stack([np.interp(t_ns.astype(float), self.t, self.q[:, k]) for k in range(4)])
+        qi /= np.linalg.norm(qi, axis=1, keepdims=True)
+        return np.asarray(dcm_from_quaternion(qi), dtype=np.float64)
+
+
 def _attitude_at(samples: pd.DataFrame, spacecraft: Spacecraft, t_ns: np.ndarray) -> FloatArray:
     """[BN] at times t_ns from the telemetered quaternion (sign-continuous, nlerp)."""
-    assert spacecraft.flight is not None
-    qch = spacecraft.flight.of("quaternion")
-    series = []
-    for c in qch:
-        sub = samples.loc[samples["mnemonic"] == c.mnemonic]
-        series.append((sub["time"].to_numpy().astype("datetime64[ns]").astype(np.int64), sub["value"].to_numpy(float)))
-    common = series[0][0]
-    for t, _ in series[1:]:
-        common = np.intersect1d(common, t)
-    q = np.column_stack([v[np.searchsorted(t, common)] for t, v in series])
-    q = continuous_quaternion(q)
-    qi = np.column_stack([np.interp(t_ns.astype(float), common.astype(float), q[:, k]) for k in range(4)])
-    qi /= np.linalg.norm(qi, axis=1, keepdims=True)
-    return np.asarray(dcm_from_quaternion(qi), dtype=np.float64)
+    return _Attitude(samples, spacecraft)(t_ns)
 
 
 def _quat_multiply(p: FloatArray, q: FloatArray) -> FloatArray:
@@ -116,6 +131,7 @@ def simulated_response(
     window_s: float = 300.0,
     lead_s: float = 20.0,
     sim_rate_hz: float = 50.0,
+    attitude: Callable[[np.ndarray], FloatArray] | None = None,
 ) -> StrikeResponse:
     """Harris et al. 2025 §3.5: simulate the spacecraft following the telemetry's own attitude
     (``ReferenceTrajectory.from_telemetry``) with and without the strike and return the difference.
@@ -129,7 +145,7 @@ def simulated_response(
 
     t0 = strike.time_ns - int(lead_s * NS)
     t_ref = t0 + np.arange(-5, int(window_s + lead_s) + 6, dtype=np.int64) * NS
-    bn = _attitude_at(samples, spacecraft, t_ref)
+    bn = (attitude or _Attitude(samples, spacecraft))(t_ref)
     from abrupt.model.rotations import quaternion_from_dcm
 
     reference = ReferenceTrajectory.from_telemetry((t_ref - t0) / NS, quaternion_from_dcm(bn))
@@ -182,13 +198,25 @@ def inject_strikes(
     rng = np.random.default_rng(seed)
     horizon_ns = int(20 * settle_s * NS)
 
-    def bn_at(t: np.ndarray) -> FloatArray:
-        return _attitude_at(samples, spacecraft, t)
+    bn_at = _Attitude(samples, spacecraft)
+    rows_of = {str(name): np.flatnonzero(mnem == name) for name in np.unique(mnem)}
+    no_rows = np.empty(0, dtype=np.int64)
+
+    def rows(name: str, lo_ns: int, hi_ns: int | None = None) -> np.ndarray:
+        r = rows_of.get(name, no_rows)
+        keep = t_all[r] >= lo_ns
+        if hi_ns is not None:
+            keep &= t_all[r] < hi_ns
+        return r[keep]
 
     for s in strikes:
         bn0 = bn_at(np.array([s.time_ns]))[0]
         dw0 = j_inv @ (bn0 @ s.dH_N_Nms)
-        sim = simulated_response(samples, spacecraft, s, window_s=window_s) if response == "simulated" else None
+        sim = (
+            simulated_response(samples, spacecraft, s, window_s=window_s, attitude=bn_at)
+            if response == "simulated"
+            else None
+        )
         null_offset = np.zeros(wheel_pinv.shape[0])
         if sim is not None:
             horizon_ns = int(window_s * NS)
@@ -212,21 +240,21 @@ def inject_strikes(
 
         # Body rates (gyro channels).
         for c in flight.of("body_rate"):
-            sel = np.flatnonzero((mnem == c.mnemonic) & (t_all >= s.time_ns) & (t_all < s.time_ns + horizon_ns))
+            sel = rows(c.mnemonic, s.time_ns, s.time_ns + horizon_ns)
             tau = (t_all[sel] - s.time_ns) / NS
             values[sel] += d_rate(tau, c.component) / c.to_si
         # Attitude: q_BN of the perturbed body = δq(δθ) ⊗ q_BN, δθ in body axes.
         qch = flight.of("quaternion")
-        sel0 = np.flatnonzero((mnem == qch[0].mnemonic) & (t_all >= s.time_ns) & (t_all < s.time_ns + horizon_ns))
+        sel0 = rows(qch[0].mnemonic, s.time_ns, s.time_ns + horizon_ns)
         if sel0.size:
             t_q = t_all[sel0]
-            idx = [np.flatnonzero(mnem == c.mnemonic) for c in qch]
-            rows = []
+            idx = [rows_of.get(c.mnemonic, no_rows) for c in qch]
+            q_rows = []
             for ix in idx:
                 pos = np.searchsorted(t_all[ix], t_q)
                 pos = np.clip(pos, 0, ix.size - 1)
-                rows.append(ix[pos])
-            rows_arr = np.column_stack(rows)
+                q_rows.append(ix[pos])
+            rows_arr = np.column_stack(q_rows)
             ok = np.all(t_all[rows_arr] == t_q[:, None], axis=1)
             rows_arr = rows_arr[ok]
             tau = (t_q[ok] - s.time_ns) / NS
@@ -241,7 +269,7 @@ def inject_strikes(
             values[rows_arr] = q_new * np.where(flip, -1.0, 1.0)[:, None]
         # Wheels: Σ J_s ΔΩ ĝ = [BN(t)] ΔH_N − J Δω(t), from the strike on (ᴺH conserved after it).
         for c in flight.of("wheel_speed"):
-            sel = np.flatnonzero((mnem == c.mnemonic) & (t_all >= s.time_ns - int(2 * NS)))
+            sel = rows(c.mnemonic, s.time_ns - int(2 * NS))
             if sel.size == 0:
                 continue
             t_w = t_all[sel]
