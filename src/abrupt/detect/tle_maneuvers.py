@@ -643,7 +643,13 @@ def null_threshold(stat: NDArray[np.float64], guard: int, p_fa: float, method: s
 
 
 def refine_burn_time(
-    history: ElementHistory, gap: int, window_sets: int, *, search_sets_before: int = 2, geo: bool = False
+    history: ElementHistory,
+    gap: int,
+    window_sets: int,
+    *,
+    search_sets_before: int = 2,
+    geo: bool = False,
+    bounds: tuple[int, int] | None = None,
 ) -> tuple[float, bool]:
     """Burn time (s from the first epoch) by along-track position continuity (module docstring, step 4).
 
@@ -653,6 +659,11 @@ def refine_burn_time(
     often still fitted to pre-burn tracking, so the step in the elements shows late while the
     change of along-track drift (the hinge) does not. Returns ``(t_m, refined)``; ``refined`` is
     False when the fit was not usable and the gap middle was returned instead.
+
+    ``bounds`` (set indices ``[lo, hi)``, from the neighbouring accepted maneuvers) keep the fit and
+    the search inside this maneuver's segment when it holds two sets each side: in a campaign the
+    along-track drift changes at every burn, and a window reaching over the previous burn would put
+    this one's hinge there.
     """
     el = history.elements
     t = (el["epoch_utc"] - el["epoch_utc"].iloc[0]).dt.total_seconds().to_numpy(dtype=float)
@@ -660,6 +671,8 @@ def refine_burn_time(
     mid = 0.5 * (t[gap] + t[gap + 1])
     lo = max(0, gap - window_sets + 1)
     hi = min(n, gap + 1 + window_sets)
+    if bounds is not None and gap - max(lo, bounds[0]) >= 2 and min(hi, bounds[1]) - (gap + 1) >= 2:
+        lo, hi = max(lo, bounds[0]), min(hi, bounds[1])  # else too few sets inside: the whole window
     if gap - lo < 2 or hi - (gap + 1) < 2:
         return mid, False
 
@@ -850,6 +863,7 @@ def run_tle_detector(
     steps, accepted, _ = segment(history, cfg, threshold, model=model, first=model_first)
     stat = steps.statistic
     candidates = np.sort(np.asarray(accepted, dtype=np.int64))
+    change_points = sorted(int(g) for g in candidates if stat[g] >= threshold)
     timed: list[tuple[int, float, bool]] = []
     for g in candidates:
         if not all_candidates and stat[g] < threshold:
@@ -861,6 +875,9 @@ def run_tle_detector(
                 cfg.time_window_sets,
                 search_sets_before=cfg.time_search_sets_before,
                 geo=regime == "geo",
+                # LEO campaigns: stay inside this burn's segment; GEO burns are weeks apart and the
+                # mean-longitude kink needs the full window (bounded: 2 of 70 FY times > 1 day off)
+                bounds=_bounds(int(g), change_points, len(history)) if regime == "leo" else None,
             )
         else:
             t_m, refined = 0.5 * (steps.t_before_s[g] + steps.t_after_s[g]), False
