@@ -37,12 +37,19 @@ Method (each step cites its source; the combination is abrupt's own):
    (2Δv_t)²))`` (Gauss variational equations for near-circular orbits, Vallado 2013 §9.3,
    Eqs. 9-24). The type is the largest component. Signs of ``dv_r`` and ``dv_n`` are not observable
    from mean elements without the burn's argument of latitude: those columns hold magnitudes.
+
+6. **Campaign events.** Burns inside one gap between element sets make one step (ΔV the sum), and
+   a set fitted across a burn spreads it over two gaps. Each event states the interval its burn(s)
+   fall in (``interval_start_utc``, ``interval_end_utc``: from the satellite's own TLE lag before
+   the set preceding the step to the set after it, widened over merged neighbours) and
+   ``burns_max = 1 + ⌊interval / cadence⌋`` with the satellite's own burn cadence inside campaigns
+   (:func:`campaign_cadence_s`).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from functools import lru_cache
 from typing import Any
 
@@ -96,7 +103,7 @@ class TleDetectorConfig:
     min_side_sets: int = 3
     regime: str = "auto"
     campaign_days: float = 3.0
-    campaign_min_side_sets: int = 2
+    campaign_min_side_sets: int | None = None  # None: by regime (CAMPAIGN_SIDE_SETS)
     time_search_sets_before: int = 3
     group_gain: tuple[float, float, float] = (1.0, 0.2, 0.2)
 
@@ -155,6 +162,11 @@ def chi2_as_normal(z: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 GEO_MEAN_MOTION_RANGE_REV_DAY = (0.9, 1.1)
+# Sets a side needs between two accepted maneuvers. LEO campaigns (orbit raising, frozen-orbit
+# control) put burns two daily element sets apart; GEO station-keeping burns are weeks apart and
+# its sparser sets make a two-set level fragile. Chosen on the shared histories: every LEO history
+# scores the same or better with 2, every GEO history the same or better with 3 (docs/tle.md).
+CAMPAIGN_SIDE_SETS = {"leo": 2, "geo": 3}
 
 
 def orbit_regime(history: ElementHistory) -> str:
@@ -514,10 +526,11 @@ def segment(
         for k in range(max(0, g - reach), min(n_gaps, g + reach + 1)):
             if not blocked[k]:
                 _fill(cur, model, k, cps)
-    if cfg.campaign_min_side_sets < cfg.min_side_sets and accepted:
+    side = cfg.campaign_min_side_sets if cfg.campaign_min_side_sets is not None else cfg.min_side_sets
+    if side < cfg.min_side_sets and accepted:
         # Campaigns: near an accepted maneuver, a further burn may be only one or two sets away.
         # Between accepted change points a side of fewer sets is allowed, at the same threshold.
-        model.min_side = cfg.campaign_min_side_sets
+        model.min_side = side
         near = np.zeros(n_gaps, dtype=bool)
         for a in accepted:
             near[max(0, a - reach) : a + reach + 1] = True
@@ -840,6 +853,9 @@ def run_tle_detector(
 
     cfg = config or TleDetectorConfig()
     run_id = run_id or new_run_id()
+    if cfg.campaign_min_side_sets is None and len(history):
+        regime_of = orbit_regime(history) if cfg.regime == "auto" else cfg.regime
+        cfg = replace(cfg, campaign_min_side_sets=CAMPAIGN_SIDE_SETS[regime_of])
     cfg_hash = config_hash(asdict(cfg))
     name = spacecraft or history.name or (f"NORAD-{history.norad_id}" if len(history) else "unknown")
     fa_per_day = cfg.false_alarms_per_year / DAYS_PER_YEAR
