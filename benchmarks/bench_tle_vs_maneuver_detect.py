@@ -142,6 +142,14 @@ def evaluate(events: pd.DataFrame, truth: pd.DataFrame, start: Any, end: Any, si
     # burns it says it may hold (largest first); false alarms are counted as above, unchanged
     covered = found | campaign_covered(at_op, truth, in_span.to_numpy())
     big_camp_found = sum(1 for j in np.flatnonzero(big.to_numpy()) if j in covered)
+    # calibration of the stated intervals: matched maneuvers (at the budget) inside their event's interval
+    in_iv = []
+    if "interval_start_utc" in events and res.pairs:
+        det = events.reset_index(drop=True)  # pairs hold row positions of the events frame
+        for i, j, _ in res.pairs:
+            lo_i = pd.Timestamp(det["interval_start_utc"].iloc[i]).tz_localize(None)
+            hi_i = pd.Timestamp(det["interval_end_utc"].iloc[i]).tz_localize(None)
+            in_iv.append(lo_i <= pd.Timestamp(truth["time_utc"].iloc[j]) <= hi_i)
     ratios, iso = delta_v_ratios(events, truth, res.pairs, signed)
     dts = np.array([abs(p[2]) for p in res.pairs]) / 3600.0
     return {
@@ -166,6 +174,7 @@ def evaluate(events: pd.DataFrame, truth: pd.DataFrame, start: Any, end: Any, si
         "big_res_found": big_res_found,
         "recall_big_res_at_1fa": big_res_found / n_big_res if n_big_res else float("nan"),
         "median_abs_dt_h": float(np.median(dts)) if dts.size else float("nan"),
+        "in_interval": float(np.mean(in_iv)) if in_iv else float("nan"),
         "dv_isolated_n": int(iso.sum()),
         "dv_isolated_within_2x": float(((ratios > 0.5) & (ratios < 2.0))[iso].mean()) if iso.any() else float("nan"),
         "dv_median_ratio": float(np.median(ratios)) if ratios.size else float("nan"),
@@ -467,6 +476,7 @@ def main() -> None:
         "n_big_res",
         "recall_big_res_at_1fa",
         "median_abs_dt_h",
+        "in_interval",
         "min_dv_t_cm_s",
         "min_dv_n_cm_s",
         "dv_isolated_n",
