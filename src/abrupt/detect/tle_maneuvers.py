@@ -921,9 +921,10 @@ def run_tle_detector(
         # the burn(s) behind this step: from the estimated burn time (earlier than the set before
         # the step when that set was still fitted to pre-burn tracking) to the set after the step
         timed.append((int(g), t_m, refined, min(float(t_m), float(model.t[int(g)]))))
-    # One maneuver per TLE cadence: candidates at neighbouring gaps closer in time than the median
-    # gap between element sets are the same maneuver seen twice (e.g. through a set fitted across
-    # the burn); keep the strongest, whose interval then covers both.
+    # One maneuver per TLE cadence: candidates closer in time than the median gap between element
+    # sets are the same maneuver seen twice (e.g. through a set fitted across the burn); keep the
+    # strongest, whose interval then covers both (merging only neighbouring gaps was tried: more
+    # false alarms on every shared history).
     merge_s = float(np.median(np.diff(model.t))) if model.t.size > 1 else 0.0
     kept: list[tuple[int, float, bool, float]] = []
     span_of: dict[int, list[float]] = {}
@@ -952,7 +953,7 @@ def run_tle_detector(
     events: list[Event] = []
     for g, t_m, refined, _ in kept:
         t_lo, t_hi = span_of[g]
-        sigma = (steps.t_after_s[g] - t_lo) / math.sqrt(12.0)  # uniform over the bracket
+        sigma = (t_hi - t_lo) / math.sqrt(12.0)  # uniform over the stated interval
         burns_max = 1 + int((t_hi - t_lo) // cadence_s) if math.isfinite(cadence_s) and cadence_s > 0 else 1
         a_ref = float(el["a_m"].iloc[g])
         w = steps.weights
