@@ -274,3 +274,17 @@ def test_campaign_cadence_is_the_median_spacing_inside_campaigns() -> None:
     day = 86400.0
     assert campaign_cadence_s(np.array([0.0, 1.0, 2.5, 4.5, 30.0]) * day, 3.0) == pytest.approx(1.5 * day)
     assert math.isinf(campaign_cadence_s(np.array([0.0, 1.0, 2.0, 40.0]) * day, 3.0))  # two spacings only
+
+
+def test_sparse_history_with_many_burns_keeps_its_threshold_off_the_maneuvers(tmp_path: Path) -> None:
+    """Element sets every 3 days and eight burns in 500 days: the burns' test windows cover most gaps,
+    leaving too few event-free gaps for a tail fit. The threshold must not be taken from the whole
+    statistic (it sat on the maneuvers' own plateaus and hid 7 of 8 burns of 2-5 cm/s, 80-200 σ)."""
+    burns = (*((d, 0.02) for d in (50.1, 120.7, 200.2, 260.9, 330.4)), (400.0, 0.05), (407.0, 0.05))
+    text, truth = synthetic_tle_text(days=500, cadence_days=3.0, burns=burns, seed=11)
+    path = tmp_path / "sparse.tle"
+    path.write_text(text)
+    events = detect_tle_maneuvers(read_tle(path))
+    res = score_events(events, pd.DataFrame({"time_utc": [t for t, _, _ in truth]}), tolerance_s=1.5 * 86400.0)
+    assert res.true_positives >= 6, events[["time_utc", "statistic", "threshold"]]
+    assert res.false_positives <= 2  # budget 1 per satellite-year over 1.4 years
