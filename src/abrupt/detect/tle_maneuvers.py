@@ -653,7 +653,7 @@ def null_threshold(stat: NDArray[np.float64], guard: int, p_fa: float, method: s
     if null.size < 50:
         # Too few gaps away from maneuvers for a tail fit (sparse sets, many burns: their windows
         # cover the history). The whole statistic would put the threshold on the maneuvers'
-        # plateaus; the largest event-free value is kept instead, and the caller's Gaussian floor
+        # plateaus; the largest event-free value is returned instead, and the caller's Gaussian floor
         # (Bonferroni over the groups) holds the budget.
         return float(np.max(null)) if null.size else 0.0
     try:
