@@ -105,6 +105,21 @@ def platform_minimum_b(row: Mapping[Any, Any], flow: FlowConditions, alphas: Flo
     )
 
 
+def platform_b_range(row: Mapping[Any, Any], flow: FlowConditions, alphas: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """(B_min, B_max) of one platform for each accommodation α: extremes of B(θ) of the turning box.
+
+    Same platform model as :func:`platform_minimum_b`; without an area range B_min = B_max = C_D(0)A/m.
+    """
+    a_min, a_max, mass = float(row["min_area_m2"]), float(row["max_area_m2"]), float(row["mass_kg"])
+    if a_max <= a_min:
+        b = minimum_ballistic_coefficient(a_min, mass, flow, alphas)
+        return b, b.copy()
+    a_side = math.sqrt(a_max**2 - a_min**2)
+    theta = np.radians(np.linspace(0.0, 90.0, 361))
+    curves = [box_ballistic_coefficient(theta, (1.0, a_min, a_side), mass, flow, float(al)) for al in alphas]
+    return np.array([float(np.min(c)) for c in curves]), np.array([float(np.max(c)) for c in curves])
+
+
 @dataclass(frozen=True)
 class ConstellationConfig:
     """Settings of :func:`estimate_constellation_density`."""

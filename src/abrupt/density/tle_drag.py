@@ -106,6 +106,29 @@ class DragIntegrals:
     model_integral: FloatArray | None
     altitude_km: FloatArray
     wind_factor: FloatArray
+    grid_utc: Any = None  # datetime64[ns] integration nodes (gaps concatenated; shared ends repeated)
+    grid_weight: FloatArray | None = None  # n̄^(1/3) v³ F on the nodes (0 where SGP4 failed)
+    grid_rho_model: FloatArray | None = None  # NRLMSIS density on the nodes (with a model)
+    set_grid_index: Any = None  # node index of each set's epoch
+
+
+@dataclass
+class DecayTrack:
+    """What the joint constellation fit needs of one object (:mod:`abrupt.density.joint`).
+
+    The kept element sets (epoch, n̄, segment: maneuvers, orbit rises and long gaps cut segments) and
+    the integration nodes with the weight n̄^(1/3) v³ F and the NRLMSIS density along the SGP4 orbit.
+    """
+
+    name: str
+    set_utc: Any
+    n_rad_s: FloatArray
+    segment: Any
+    set_grid_index: Any
+    grid_utc: Any
+    grid_weight: FloatArray
+    grid_rho_model: FloatArray
+    altitude_km: float
 
 
 @dataclass
@@ -116,6 +139,7 @@ class RhoBResult:
     sigma_n_rad_s: float
     repairs: RepairLog = field(default_factory=RepairLog)
     maneuver_epochs_utc: list[Any] = field(default_factory=list)
+    track: DecayTrack | None = None
 
 
 def wind_factor(position_m: FloatArray, velocity_mps: FloatArray) -> FloatArray:
@@ -174,12 +198,12 @@ def drag_integrals(
     if np.any(errors != 0):
         integrand[errors != 0] = 0.0  # SGP4 failed (decayed record): no contribution
     rho_all: FloatArray | None = None
+    when = epochs[gap_index] + (tau_all * 1e9).astype("timedelta64[ns]")
     if space_weather is not None:
         from abrupt.model.atmosphere import msis_density, teme_to_geodetic
 
         # NRLMSIS on every ``model_stride``-th node (it costs ~10-30 µs a point); log ρ is interpolated
         # in time between them (the nodes of consecutive gaps are consecutive in time).
-        when = epochs[gap_index] + (tau_all * 1e9).astype("timedelta64[ns]")
         sample = np.zeros(tau_all.size, dtype=bool)
         sample[:: max(1, model_stride)] = True
         sample[-1:] = True
@@ -202,7 +226,8 @@ def drag_integrals(
     if n_sets > 1:
         alt[0] = alt[1]
         wf[0] = wf[1]
-    return DragIntegrals(t, n_bar, cum_w, cum_m, alt, wf)
+    set_index = np.concatenate([offsets[:-1], [offsets[-1] - 1]]) if n_sets > 1 else np.zeros(1, dtype=np.int64)
+    return DragIntegrals(t, n_bar, cum_w, cum_m, alt, wf, when, integrand, rho_all, set_index)
 
 
 def neighbour_residuals(n_bar: FloatArray, integral: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -404,7 +429,20 @@ def rho_b_from_history(
     repairs.record("windows with too few element sets or too short a span", counts["few"])
     repairs.record("windows with negative decay rejected", counts["negative"])
     frame = pd.DataFrame(rows, columns=list(WINDOW_COLUMNS)) if rows else _empty_windows()
-    return RhoBResult(frame, sigma_n, repairs, list(man_times))
+    track = None
+    if integ.grid_rho_model is not None and integ.grid_weight is not None:
+        track = DecayTrack(
+            label,
+            epochs[keep],
+            integ.n_rad_s[keep],
+            segment_id[keep],
+            integ.set_grid_index[keep],
+            integ.grid_utc,
+            integ.grid_weight,
+            integ.grid_rho_model,
+            float(np.nanmedian(integ.altitude_km)),
+        )
+    return RhoBResult(frame, sigma_n, repairs, list(man_times), track)
 
 
 def _noise_samples(integ: DragIntegrals, x_all: FloatArray, segment_id: Any, keep: Any) -> FloatArray:
