@@ -239,7 +239,7 @@ def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: Joint
         if cfg.smoothing is None and (it <= 6 or lam is None):
             lam = _gcv_lambda(normal + ridge, rhs, penalty, rss0, n_obs - len(params), scale_n)
         assert lam is not None
-        s_new: FloatArray = np.linalg.solve(normal + ridge + lam * penalty, rhs)
+        s_new = np.asarray(np.linalg.solve(normal + ridge + lam * penalty, rhs), dtype=np.float64)
         norm = float(np.mean(s_new[has_data])) if np.any(has_data) else 1.0
         if not norm > 0:
             raise ValueError("the joint fit found no net decay (mean density scale <= 0)")
