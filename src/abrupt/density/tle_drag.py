@@ -140,6 +140,7 @@ class RhoBResult:
     repairs: RepairLog = field(default_factory=RepairLog)
     maneuver_epochs_utc: list[Any] = field(default_factory=list)
     track: DecayTrack | None = None
+    integrals: DragIntegrals | None = None
 
 
 def wind_factor(position_m: FloatArray, velocity_mps: FloatArray) -> FloatArray:
@@ -212,7 +213,7 @@ def drag_integrals(
         rho_s = np.asarray(msis_density(when[sample], lat, lon, h_km, space_weather))
         good = np.isfinite(rho_s) & (rho_s > 0)
         t_abs = (when - when[0]).astype(np.int64) * 1e-9
-        rho_all = np.exp(np.interp(t_abs, t_abs[sample][good], np.log(rho_s[good])))
+        rho_all = np.exp(interpolate_log_density(t_abs, t_abs[sample][good], np.log(rho_s[good])))
     radius = np.linalg.norm(pos, axis=1)
     for g in range(n_sets - 1):
         sl = slice(offsets[g], offsets[g + 1])
@@ -228,6 +229,24 @@ def drag_integrals(
         wf[0] = wf[1]
     set_index = np.concatenate([offsets[:-1], [offsets[-1] - 1]]) if n_sets > 1 else np.zeros(1, dtype=np.int64)
     return DragIntegrals(t, n_bar, cum_w, cum_m, alt, wf, when, integrand, rho_all, set_index)
+
+
+def interpolate_log_density(t_s: FloatArray, t_known_s: FloatArray, log_rho: FloatArray) -> FloatArray:
+    """log ρ at ``t_s`` from samples along the orbit: a cubic spline in time (not-a-knot).
+
+    Along an orbit log ρ oscillates at the orbital period (day/night bulge, latitude); sampled every
+    1200 s (4.6 samples a revolution) a linear interpolation cuts the peaks (error (hω)²/8 ≈ 23 % of
+    the oscillation, a 1-2 % low bias of the mean density) while the cubic's is (hω)⁴/384 ≈ 1 %.
+    Repeated sample times (gap ends) are merged; extrapolation holds the end values.
+    """
+    from scipy.interpolate import CubicSpline
+
+    tk, first = np.unique(t_known_s, return_index=True)
+    yk = np.asarray(log_rho)[first]
+    if tk.size < 4:
+        return np.interp(t_s, tk, yk)
+    spline = CubicSpline(tk, yk)
+    return np.asarray(spline(np.clip(t_s, tk[0], tk[-1])), dtype=np.float64)
 
 
 def neighbour_residuals(n_bar: FloatArray, integral: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -276,8 +295,12 @@ def rho_b_from_history(
     maneuvers: str | list[Any] = "detect",
     space_weather: Any = None,
     name: str | None = None,
+    integrals: DragIntegrals | None = None,
 ) -> RhoBResult:
     """K = ρ̄B̄ (1/m) per time window from one element-set history (module docstring).
+
+    ``integrals``: the :class:`DragIntegrals` of this history from an earlier call (same step and
+    model), e.g. to form windows of another length without propagating again (``RhoBResult.integrals``).
 
     ``maneuvers``: "detect" (abrupt's TLE maneuver detector), "none", or a list of UTC times.
     ``space_weather`` is needed only with ``config.with_model`` (NRLMSIS ρ̄_M per window).
@@ -292,7 +315,7 @@ def rho_b_from_history(
         from abrupt.model.atmosphere import read_space_weather
 
         sw = read_space_weather()
-    integ = drag_integrals(
+    integ = integrals or drag_integrals(
         history, cfg.step_s, space_weather=sw if cfg.with_model else None, model_stride=cfg.model_stride
     )
     epochs = history.elements["epoch_utc"].to_numpy(dtype="datetime64[ns]")
@@ -442,7 +465,7 @@ def rho_b_from_history(
             integ.grid_rho_model,
             float(np.nanmedian(integ.altitude_km)),
         )
-    return RhoBResult(frame, sigma_n, repairs, list(man_times), track)
+    return RhoBResult(frame, sigma_n, repairs, list(man_times), track, integ)
 
 
 def _noise_samples(integ: DragIntegrals, x_all: FloatArray, segment_id: Any, keep: Any) -> FloatArray:

@@ -52,7 +52,10 @@ def _one_object(args: tuple[str, TleDragConfig, str, str | None, int]) -> tuple[
             replace(cfg, interval_days=cfg.interval_days * dist_factor),
             maneuvers=res.maneuver_epochs_utc,
             space_weather=sw,
+            integrals=res.integrals,
         )
+        longer.integrals = None
+    res.integrals = None  # not needed by the caller: keep what crosses processes small
     return res, longer
 
 
