@@ -12,7 +12,8 @@ def plot_density_bands(windows: pd.DataFrame, out: str | Path, *, band_km: float
     """Time series per altitude band: estimate (mean, with 1σ band) and NRLMSIS along the same orbits.
 
     Uses ``density_joint_kg_m3`` (joint fit) or ``density_mean_kg_m3`` (order statistics) when
-    present, else ρB scaled by the median of ρB/ρ_MSIS of each object ("ρB / B̂", single objects: the shape of the series, B unknown).
+    present, else ρB scaled by the median of ρB/ρ_MSIS of each object ("ρB / B̂", single objects:
+    the shape of the series, B unknown).
     """
     import matplotlib
 
