@@ -109,19 +109,24 @@ def tle_density(
         sw = read_space_weather(sw_path)
         ok_windows = windows[windows["status"] == "ok"]
         flow = flow_from_windows(ok_windows, sw) if len(ok_windows) else None
-        result = estimate_constellation_density(
-            windows,
-            plat,
-            distribution_windows=dist,
-            flow=flow,
-            config=constellation,
-            space_weather=sw,
-        )
-        warnings.extend(result.warnings)
+        try:
+            result = estimate_constellation_density(
+                windows,
+                plat,
+                distribution_windows=dist,
+                flow=flow,
+                config=constellation,
+                space_weather=sw,
+            )
+            warnings.extend(result.warnings)
+            ok_windows = result.windows
+        except ValueError as exc:  # e.g. too few epochs for the ratio inversion of the slides
+            warnings.append(f"order-statistics estimate skipped: {exc}")
+            ok_windows = ok_windows.reset_index(drop=True)
         tracks = [r[0].track for r in results if r[0].track is not None]
         if len(tracks) >= 3:
             joint_result = joint_constellation_density(
-                tracks, result.windows, plat, cfg.origin_utc, flow=flow, config=joint
+                tracks, ok_windows, plat, cfg.origin_utc, flow=flow, config=joint
             )
             warnings.extend(joint_result.warnings)
             return TleDensityResult(joint_result.windows, result, repairs, warnings, joint_result)
