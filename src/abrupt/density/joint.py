@@ -16,7 +16,8 @@ estimated robustly from its own residuals; gross errors are down-weighted (Huber
 
 (1) is bilinear (B_j·s_m): it is solved by alternating weighted least squares — B_j given s in
 closed form, s given B with a second-difference penalty λ‖D₂s‖² chosen by generalised
-cross-validation (Craven & Wahba 1979). This weights every object by its own noise and by how
+cross-validation (Craven & Wahba 1979), reweighted towards ℓ1 trend filtering (Kim et al. 2009) so
+that s may bend sharply where a storm starts and ends. This weights every object by its own noise and by how
 long and well covered its intervals are, and it resolves s(t) at the node spacing rather than at
 window length, which is what the per-window ratio method loses on a storm's edges.
 
@@ -27,14 +28,15 @@ B_max,j of its own platform (:func:`platform_b_range`); with x_j = (c·b_j − B
 estimation noise, c, a and b are found by maximum likelihood. A box turning about an axis normal
 to the flow has a stationary maximum of B(θ), so x piles up under 1 (a 1/√(1−x) density) and the
 largest B_j of even 20 platforms sits within a fraction of a per cent of B_max: the upper order
-statistics fix c far better than the minimum, whose density at the edge is finite. The
+statistics fix c far better than the minimum, whose density at the edge is finite (the likelihood
+uses both edges, so platforms that cluster at the minimum fix c from below). The
 uncertainty of the accommodation α is propagated by refitting c at the ends of its prior.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -60,6 +62,7 @@ class JointConfig:
     iterations: int = 200
     reweightings: int = 12
     huber: float = 2.5
+    l1_floor: float = 0.003  # ℓ1 trend filtering of s (0: plain quadratic penalty)
     tolerance: float = 1e-7
 
     def __post_init__(self) -> None:
@@ -137,11 +140,13 @@ def _segment_design(
     return np.cumsum(inc, axis=0), col0
 
 
-def _second_difference(n: int) -> FloatArray:
-    """DᵀD for the second-difference operator D (n − 2 rows of 1, −2, 1): pentadiagonal."""
+def _second_difference(n: int, weights: FloatArray | None = None) -> FloatArray:
+    """DᵀWD for the second-difference operator D (n − 2 rows of 1, −2, 1): pentadiagonal."""
+    w = np.ones(max(n - 2, 0)) if weights is None else np.asarray(weights, dtype=float)
     out = np.zeros((n, n))
+    stencil = np.outer((1.0, -2.0, 1.0), (1.0, -2.0, 1.0))
     for i in range(n - 2):
-        out[i : i + 3, i : i + 3] += np.outer((1.0, -2.0, 1.0), (1.0, -2.0, 1.0))
+        out[i : i + 3, i : i + 3] += w[i] * stencil
     return out
 
 
@@ -237,6 +242,12 @@ def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: Joint
             vecs[sg.param][o : o + k] += gc.T @ (w * yc)
             yy += float(w @ (yc * yc))
         s_prev_outer = s.copy()
+        if cfg.l1_floor > 0 and outer > 1:
+            # ℓ1 trend filtering by reweighting (Kim et al. 2009, SIAM Rev. 51): weights 1/|D₂s| let
+            # s(t) bend sharply at a storm's onset and end instead of rounding them off.
+            d2 = s[:-2] - 2.0 * s[1:-1] + s[2:]
+            wd = 1.0 / np.maximum(np.abs(d2), cfg.l1_floor)
+            penalty = _second_difference(n_nodes, wd / np.mean(wd))
         for inner in range(cfg.iterations):
             it += 1
             sp = [s[p_lo[q] : p_hi[q]] for q in range(n_par)]
@@ -250,7 +261,7 @@ def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: Joint
                 rhs[p_lo[q] : p_hi[q]] += b[q] * vecs[q]
             scale_n = float(np.trace(normal)) / max(float(np.trace(penalty)), 1e-300)
             normal[np.diag_indices(n_nodes)] += 1e-10 * scale_n
-            if cfg.smoothing is None and inner == 0 and (outer <= 3 or lam is None):
+            if cfg.smoothing is None and inner == 0 and (outer <= 6 or lam is None):
                 lam = _gcv_lambda(normal, rhs, penalty, yy, n_obs - n_par, scale_n, bandwidth)
             assert lam is not None
             s_new = _solve_spd(normal + lam * penalty, rhs, bandwidth)
@@ -524,6 +535,8 @@ def joint_constellation_density(
     the scale's statistical and accommodation uncertainty), ``model_factor_joint`` (ρ̂/ρ_M over the
     window, relative when there is no geometry) and ``b_joint_m2_kg`` (the object's B in that block).
     The accommodation α is taken at the middle of its prior; the ends give the systematic part.
+    ``flow``: one :class:`FlowConditions` for all, or one per object name (each platform's C_D at
+    its own altitude's temperature and molar mass).
     """
     from abrupt.density.constellation import platform_b_range
 
@@ -537,7 +550,13 @@ def joint_constellation_density(
     if platforms is not None and "min_area_m2" in platforms.columns and flow is not None:
         rows = platforms.set_index(platforms["object"].astype(str)).to_dict(orient="index")
         alphas = (accommodation_range[0], 0.5 * sum(accommodation_range), accommodation_range[1])
-        ranges = [platform_b_range(rows[str(o)], flow, np.asarray(alphas)) for o in br["object"]]
+
+        def flow_of(obj: str) -> Any:
+            if isinstance(flow, Mapping):
+                return flow.get(obj) or next(iter(flow.values()))
+            return flow
+
+        ranges = [platform_b_range(rows[str(o)], flow_of(str(o)), np.asarray(alphas)) for o in br["object"]]
         for i, al in enumerate(alphas):
             lo = np.array([r[0][i] for r in ranges])
             hi = np.array([r[1][i] for r in ranges])

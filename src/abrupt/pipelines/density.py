@@ -125,8 +125,10 @@ def tle_density(
             ok_windows = ok_windows.reset_index(drop=True)
         tracks = [r[0].track for r in results if r[0].track is not None]
         if len(tracks) >= 3:
+            # Each platform's flat-plate C_D at its own altitude (temperature, molar mass, speed).
+            flows = {str(o): flow_from_windows(g, sw) for o, g in ok_windows.groupby("object") if len(g)}
             joint_result = joint_constellation_density(
-                tracks, ok_windows, plat, cfg.origin_utc, flow=flow, config=joint
+                tracks, ok_windows, plat, cfg.origin_utc, flow=flows or flow, config=joint
             )
             warnings.extend(joint_result.warnings)
             return TleDensityResult(joint_result.windows, result, repairs, warnings, joint_result)
