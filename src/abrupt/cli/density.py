@@ -51,6 +51,11 @@ def density() -> None:
     show_default=True,
     help="Joint fit: each object's B is one value per block this long.",
 )
+@click.option(
+    "--no-order-statistics",
+    is_flag=True,
+    help="Skip the slides' per-epoch estimates (density_mean/min; about a minute of ratio inversion).",
+)
 @click.option("--workers", type=int, default=1, show_default=True, help="Processes for many objects.")
 @click.option("--report", type=click.Path(dir_okay=False), default=None, help="PNG: density vs NRLMSIS per band.")
 def density_tle(
@@ -64,6 +69,7 @@ def density_tle(
     kappa: float,
     node_days: float,
     block_days: float,
+    no_order_statistics: bool,
     workers: int,
     report: str | None,
 ) -> None:
@@ -89,6 +95,7 @@ def density_tle(
         space_weather=space_weather,
         workers=workers,
         joint=JointConfig(node_days=node_days, block_days=block_days),
+        order_statistics=not no_order_statistics,
     )
     write_table(res.windows, out)
     for src, log in res.repairs.items():

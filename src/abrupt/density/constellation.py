@@ -225,6 +225,7 @@ def estimate_constellation_density(
         w["naive_density_kg_m3"] = np.nan
     ybar = dist.mean_ratio
     epoch_rows = []
+    y_min_cache: dict[int, float] = {}
     for t_k, g in w.groupby("window_start_utc"):
         vals = g["k_norm"].to_numpy()
         n_k = int(vals.size)
@@ -241,7 +242,9 @@ def estimate_constellation_density(
         s_mean = mean_k / (b_min * ybar)
         rel_stat = float(np.std(vals, ddof=1) * math.sqrt(np.sum(wts**2)) / mean_k)
         rel_mean = math.sqrt(rel_stat**2 + b_min_rel_sigma**2 + ybar_rel_sigma**2)
-        y_min = dist.expected_minimum_ratio(n_k)
+        if n_k not in y_min_cache:
+            y_min_cache[n_k] = dist.expected_minimum_ratio(n_k)
+        y_min = y_min_cache[n_k]
         s_min = float(np.min(vals)) / (b_min * y_min)
         rel_min = math.sqrt((dist.sigma_y / y_min) ** 2 + b_min_rel_sigma**2 + ybar_rel_sigma**2)
         epoch_rows.append((t_k, n_k, s_mean, s_mean * rel_mean, s_min, s_min * rel_min, mean_k))

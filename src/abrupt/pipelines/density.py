@@ -70,12 +70,15 @@ def tle_density(
     distribution_interval_factor: int = 10,
     workers: int = 1,
     joint: JointConfig | None = None,
+    order_statistics: bool = True,
 ) -> TleDensityResult:
     """ρB windows of every file and, for two or more objects, the constellation density.
 
     ``distribution_interval_factor``: the B distribution is fitted on windows this many times longer
     (less estimation noise in the ratios); 1 uses the same windows. With two or more objects the
     joint fit of :mod:`abrupt.density.joint` adds ``density_joint_kg_m3`` (the recommended estimate).
+    ``order_statistics=False`` skips the slides' per-epoch estimates (their ratio inversion with its
+    bootstrap costs about a minute whatever the span).
     """
     cfg = config or TleDragConfig(with_model=True)
     sw_path = str(space_weather) if space_weather is not None else None
@@ -110,6 +113,8 @@ def tle_density(
         ok_windows = windows[windows["status"] == "ok"]
         flow = flow_from_windows(ok_windows, sw) if len(ok_windows) else None
         try:
+            if not order_statistics:
+                raise ValueError("not requested")
             result = estimate_constellation_density(
                 windows,
                 plat,
