@@ -45,6 +45,7 @@ import pandas as pd
 from scipy.optimize import minimize
 from scipy.special import betainc, ndtr
 
+from abrupt.clean.noise import MAD_TO_SIGMA, robust_scale
 from abrupt.density.tle_drag import DecayTrack
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2
 from abrupt.types import FloatArray
@@ -202,7 +203,7 @@ def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: Joint
     for j in range(n_obj):
         ys = [np.diff(sg.y, 2) for sg in segments if sg.obj == j]
         v = np.concatenate(ys) if ys else np.zeros(0)
-        sigma[j] = float(np.median(np.abs(v - np.median(v))) * 1.4826 / math.sqrt(6.0)) if v.size else 1.0
+        sigma[j] = float(robust_scale(v)) / math.sqrt(6.0) if v.size else 1.0
         sigma[j] = sigma[j] if sigma[j] > 0 else 1e-12
     n_par = len(params)
     has_data = np.zeros(n_nodes, dtype=bool)
@@ -281,7 +282,7 @@ def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: Joint
             s = s_new
             if change < cfg.tolerance:
                 break
-        # Residuals → σ_j (1.4826·MAD) and Huber weights (c = ``huber``).
+        # Residuals → σ_j (robust scale about zero: the offsets centre them) and Huber weights.
         res_by_obj: list[list[FloatArray]] = [[] for _ in range(n_obj)]
         resid_seg = []
         for sg in segments:
@@ -293,7 +294,7 @@ def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: Joint
         for j in range(n_obj):
             if res_by_obj[j]:
                 v = np.concatenate(res_by_obj[j])
-                mad = float(np.median(np.abs(v))) * 1.4826
+                mad = float(MAD_TO_SIGMA * np.median(np.abs(v)))
                 sigma[j] = mad if mad > 0 else sigma[j]
         for sg, r in zip(segments, resid_seg, strict=True):
             z = np.abs(r) / sigma[sg.obj]
