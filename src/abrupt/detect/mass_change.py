@@ -7,7 +7,7 @@ newest window n and every candidate change window τ ≤ n,
     S(τ, n) = (n_b n_a / (n_b + n_a)) (x̄_after − x̄_before)ᵀ Σ⁻¹ (x̄_after − x̄_before),
 
 with x the observable inertia parameters, n_b/n_a the windows before/after τ and Σ the covariance of one
-window's estimate. Σ is the data's own noise model: the shape of the estimator's bootstrap covariance,
+window's estimate. Σ is the data's own noise model: the shape of the estimator's covariance,
 scaled by c ≥ 1 estimated from the differences of windows 1, 2 and 3 apart (robust median, so a step
 does not inflate it; the largest lag's spread is kept, so a slow drift of the estimates is not taken
 for a step). With an estimated scale, S/c follows d·F(d, ν) (Hotelling's T²), and the threshold is
