@@ -237,7 +237,8 @@ def interpolate_log_density(t_s: FloatArray, t_known_s: FloatArray, log_rho: Flo
     Along an orbit log ρ oscillates at the orbital period (day/night bulge, latitude); sampled every
     1200 s (4.6 samples a revolution) a linear interpolation cuts the peaks (error (hω)²/8 ≈ 23 % of
     the oscillation, a 1-2 % low bias of the mean density) while the cubic's is (hω)⁴/384 ≈ 1 %.
-    Repeated sample times (gap ends) are merged; extrapolation holds the end values.
+    Repeated sample times (gap ends) are merged; extrapolation holds the end values; between samples
+    further apart than 1.5 times the usual spacing (missing samples) the interpolation is linear.
     """
     from scipy.interpolate import CubicSpline
 
@@ -245,8 +246,15 @@ def interpolate_log_density(t_s: FloatArray, t_known_s: FloatArray, log_rho: Flo
     yk = np.asarray(log_rho)[first]
     if tk.size < 4:
         return np.interp(t_s, tk, yk)
-    spline = CubicSpline(tk, yk)
-    return np.asarray(spline(np.clip(t_s, tk[0], tk[-1])), dtype=np.float64)
+    tt = np.clip(t_s, tk[0], tk[-1])
+    out = np.asarray(CubicSpline(tk, yk)(tt), dtype=np.float64)
+    # Where samples are missing (SGP4 failures, gaps) a cubic swings wildly: linear there, and
+    step = np.diff(tk)
+    k = np.clip(np.searchsorted(tk, tt, side="right") - 1, 0, tk.size - 2)
+    wide = step[k] > 1.5 * float(np.median(step))
+    if np.any(wide):
+        out[wide] = np.interp(tt[wide], tk, yk)
+    return out
 
 
 def neighbour_residuals(n_bar: FloatArray, integral: FloatArray) -> tuple[FloatArray, FloatArray]:
