@@ -234,9 +234,15 @@ def fit_orbit(
             integrator=cfg.integrator,
         )
         resid, jac = _residuals(data, states, dmat, bias, bias_keys, cfg.estimate_acceleration, n_imp, row_i, row_c)
-        if cfg.outlier_sigma is not None and 3 <= it <= 5:  # re-select outliers, then freeze the set
-            used = np.abs(resid) <= cfg.outlier_sigma
         cost = float(np.sum(resid[used] ** 2))
+        near = it >= 2 and abs(prev_cost - cost) <= 0.1 * max(cost, 1.0)
+        if cfg.outlier_sigma is not None and 3 <= it <= 5 and near:  # re-select outliers, then freeze the set
+            # only once the fit has settled (cost changing by < 10%), and never most of the data: far from
+            # the solution every residual exceeds the limit and the fit would "converge" on no data
+            keep = np.abs(resid) <= cfg.outlier_sigma
+            if keep.sum() >= 0.8 * resid.size:
+                used = keep
+            cost = float(np.sum(resid[used] ** 2))
         a = jac[used]
         normal = a.T @ a
         try:

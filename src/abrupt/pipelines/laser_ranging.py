@@ -121,9 +121,11 @@ def detect_laser_ranging(
     fcfg = replace(fcfg, force=ForceContext.build(model_f, epoch, -86400.0, t_end + 86400.0))
     gcfg = GlrtConfig(false_alarms_per_day=budget.per_day, max_maneuvers=max_maneuvers)
 
-    def build(source: BatchFit | FloatArray, scale: dict[str, float]) -> TrackingArrays:
+    t_rel = (np.asarray(measurements["time_utc"], dtype="datetime64[ns]") - epoch) / np.timedelta64(1, "s")
+
+    def build(source: BatchFit | FloatArray, scale: dict[str, float], t_max_s: float = math.inf) -> TrackingArrays:
         reduced = reduce_ranges(
-            measurements,
+            measurements if not math.isfinite(t_max_s) else measurements.loc[t_rel <= t_max_s],
             sites,
             _positions(source, t_end, fcfg),
             model,
@@ -136,7 +138,17 @@ def detect_laser_ranging(
 
     scale: dict[str, float] = {}
     data = build(np.asarray(x0_apriori, float), scale)
-    fit = fit_orbit(data, np.asarray(x0_apriori, float), config=fcfg)
+    # Grow the arc (1, 2, 4, ... days): Gauss-Newton with the two-body STM converges from an a-priori
+    # tens of metres off over a day, not over a week (the along-track error of a 2 cm/s velocity error
+    # is kilometres after 7 days).
+    x_start = np.asarray(x0_apriori, float)
+    span_days = 1.0
+    while span_days * 86400.0 < t_end:
+        if int(np.sum(t_rel <= span_days * 86400.0)) > 20:
+            part = build(x_start, scale, span_days * 86400.0)
+            x_start = fit_orbit(part, x_start, config=fcfg).x0
+        span_days *= 2.0
+    fit = fit_orbit(data, x_start, config=fcfg)
     data = build(fit, scale)
     fit = fit_orbit(data, fit.x0, config=fcfg, initial_range_bias_m=fit.range_bias_m)
     detections: list[GlrtDetection] = []
