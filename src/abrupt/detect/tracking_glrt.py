@@ -77,6 +77,21 @@ class BatchFit:
     states: NDArray[np.float64]
     config: BatchFitConfig
 
+    def propagate(self, t_out_s: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """States and parameter sensitivities of the fitted trajectory (impulses included) at sorted
+        ``t_out_s`` ≥ ``t0_s`` (:func:`trajectory`)."""
+        return trajectory(
+            self.x0,
+            self.t0_s,
+            np.asarray(t_out_s, dtype=float),
+            force=self.config.force,
+            accel_mps2=self.acceleration_mps2,
+            impulse_times_s=self.impulse_times_s,
+            impulse_dv_rsw=self.impulse_dv_rsw_mps,
+            max_step_s=self.config.max_step_s,
+            integrator=self.config.integrator,
+        )
+
     @property
     def rms_white(self) -> float:
         r = self.residuals_white[self.used]
@@ -361,17 +376,7 @@ class GlrtScan:
 def glrt_scan(data: TrackingArrays, fit: BatchFit, t_candidates_s: NDArray[np.float64]) -> GlrtScan:
     """Linearised GLRT for one impulse at each candidate epoch, on the residuals of ``fit`` (module doc)."""
     cand = np.asarray(t_candidates_s, dtype=float)
-    states_c, d_c = trajectory(
-        fit.x0,
-        fit.t0_s,
-        cand,
-        force=fit.config.force,
-        accel_mps2=fit.acceleration_mps2,
-        impulse_times_s=fit.impulse_times_s,
-        impulse_dv_rsw=fit.impulse_dv_rsw_mps,
-        max_step_s=fit.config.max_step_s,
-        integrator=fit.config.integrator,
-    )
+    states_c, d_c = fit.propagate(cand)
     used = fit.used
     r = fit.residuals_white[used]
     j0 = fit.jacobian_white[used]

@@ -292,18 +292,7 @@ def _apriori_at(x0: FloatArray, epoch: np.datetime64, dt_s: float, cfg: BatchFit
 
 def _propagated_apriori(result: LaserRangingResult, dt_s: float) -> FloatArray:
     """State ``dt_s`` after the arc epoch on the previous arc's fitted trajectory (impulses included)."""
-    fit = result.fit
-    states, _ = trajectory(
-        fit.x0,
-        0.0,
-        np.array([dt_s]),
-        force=fit.config.force,
-        accel_mps2=fit.acceleration_mps2,
-        impulse_times_s=fit.impulse_times_s,
-        impulse_dv_rsw=fit.impulse_dv_rsw_mps,
-        max_step_s=fit.config.max_step_s,
-        integrator=fit.config.integrator,
-    )
+    states, _ = result.fit.propagate(np.array([dt_s]))
     return states[0]
 
 
