@@ -67,7 +67,8 @@ def main() -> None:
         rms = ", ".join(f"{k} {v * 1000:.1f}" for k, v in res.residual_rms_m.items())
         print(f"  null run {seed}: {len(res.detections)} alarm(s); post-fit RMS mm: {rms}")
     days = args.runs * args.days
-    print(f"false alarms: {alarms} in {days:g} days = {alarms / days:.3f}/day (budget 0.1/day; target: none)")
+    if days:
+        print(f"false alarms: {alarms} in {days:g} days = {alarms / days:.3f}/day (budget 0.1/day; target: none)")
 
     found = within = 0
     rng = np.random.default_rng(2024)
@@ -89,11 +90,14 @@ def main() -> None:
             )
         else:
             print(f"  maneuver run {seed}: MISSED ({len(res.detections)} other alarm(s))")
-    print(
-        f"{args.dv_mps * 100:g} cm/s maneuvers found: {found}/{args.runs}; "
-        f"|ΔV| within 20%: {within}/{args.runs} (target ≥ 90%)"
-    )
-
+    if args.runs:
+        print(
+            f"{args.dv_mps * 100:g} cm/s maneuvers found: {found}/{args.runs}; "
+            f"|ΔV| within 20%: {within}/{args.runs} (target ≥ 90%)"
+        )
+    if not args.ablation_runs:
+        print(f"total {time.perf_counter() - t_start:.0f} s")
+        return
     print("ablation (each term left out of the filter; truth keeps it):")
     for term in RANGE_MODEL_TERMS:
         n_alarm = 0
