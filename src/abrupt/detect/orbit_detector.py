@@ -46,6 +46,8 @@ from abrupt.thresholds import Threshold, fit_threshold, gpd_return_level_upper, 
 from abrupt.types import FloatArray
 
 SECONDS_PER_WEEK = 7 * 86400.0
+#: statistics distributed as a (scaled) chi-square, not its square root, under no event
+CHI_SQUARE_STATISTICS = frozenset({"glr"})
 ONE_PER_WEEK = 1.0 / 7.0  # [false alarms per day]
 
 DETECTOR_NAME = "orbit"
@@ -222,12 +224,18 @@ def self_calibrate(
     iterations: int = 3,
     names: tuple[str, ...] | None = None,
     confidence_z: float = 1.0,
+    transform: str = "wilson_hilferty",
 ) -> dict[str, Threshold]:
     """Thresholds from the arc itself when no event-free reference exists (real data).
 
     Procedure (documented in docs/orbit.md; nothing depends on a particular satellite):
-    1. robust location and scale: median and the normal-consistent MAD of the statistic over the valid epochs — of
-       its logarithm when the statistic is positive (the statistics are skewed, chi-like);
+    1. robust location and scale: median and the normal-consistent MAD of the statistic over the valid
+       epochs, after a transform that makes a positive statistic nearly normal: the Wilson-Hilferty cube
+       root of its chi-square form (Wilson & Hilferty 1931; ``glr`` is χ²₃-like under no jump: s^(1/3);
+       the others are norms, χ-like: s^(2/3)). ``transform="log"`` (used before) compresses the upper
+       tail so much that a chi-square statistic must exceed ~400 × its median to count as an outlier:
+       a 0.35 m/s reboost at GLR 344 then stayed in the tail sample and lifted its own threshold to
+       ~10⁴ (a missed ISS-like reboost);
     2. leave-out: around every value above median + ``outlier_sigma``·scale, the whole excursion that
        contains it (the contiguous epochs above median + ``episode_sigma``·scale, so a long post-event
        hump goes with its peak) and ``leave_out_s`` (default 1800 s) either side of it are removed
@@ -245,6 +253,8 @@ def self_calibrate(
        1987): with the default z = 1 the false-alarm rate is at most the budget with ~84 % confidence.
        ``confidence_z = 0`` gives the plain point estimate.
     """
+    if transform not in ("wilson_hilferty", "log"):
+        raise ValueError("transform must be 'wilson_hilferty' or 'log'")
     rate = analysis.sample_rate_hz
     if leave_out_s is None:
         leave_out_s = 1800.0
@@ -257,7 +267,15 @@ def self_calibrate(
         if keep.sum() < 100:
             continue
         positive = bool(np.all(s[keep] > 0))
-        z = np.log(np.where(keep, s, 1.0)) if positive else s
+        if positive and transform == "log":
+            z = np.log(np.where(keep, s, 1.0))
+        elif positive:
+            # Wilson-Hilferty: the cube root of a chi-square variable is nearly normal (χ²-like GLR: s^(1/3);
+            # the norms, χ-like: (s²)^(1/3)); a fixed multiple of a robust scale then means the same tail
+            # probability for every statistic, and is invariant to the null's own inflation factor
+            z = np.where(keep, s, 0.0) ** (1.0 / 3.0 if name in CHI_SQUARE_STATISTICS else 2.0 / 3.0)
+        else:
+            z = s
         for _ in range(iterations):
             if keep.sum() < 100:
                 break
