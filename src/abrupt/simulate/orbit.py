@@ -17,9 +17,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from abrupt.model.frames import Ephemeris
-from abrupt.model.orbit import R_EARTH_M, FiniteBurn, ForceContext, ForceModel, kepler_to_cartesian, rtn_matrix
+from abrupt.model.orbit import (
+    R_EARTH_M,
+    FiniteBurn,
+    ForceContext,
+    ForceModel,
+    kepler_to_cartesian,
+    propagate_deviation,
+    rtn_matrix,
+)
 from abrupt.model.orbit import propagate as propagate_orbit
-from abrupt.model.orbit import propagate_deviation
 from abrupt.types import FloatArray
 
 #: Thesis default ΔV: 2 × 0.2 g × 12 km/s / 200 kg (Table 3.1, Eqs. 3.1-3.2).

@@ -282,9 +282,7 @@ def _rk4_state(x: FloatArray, t: float, dt: float, max_step: float, args: tuple)
 
 
 @nb.njit(cache=True)
-def _deviation_kernel(
-    t: FloatArray, ref: FloatArray, delta0: FloatArray, max_step: float, args: tuple
-) -> FloatArray:
+def _deviation_kernel(t: FloatArray, ref: FloatArray, delta0: FloatArray, max_step: float, args: tuple) -> FloatArray:
     n = t.size
     out = np.empty((n, 6))
     out[0] = delta0
