@@ -227,3 +227,28 @@ def test_finite_reboost_burn_in_a_full_force_truth_is_found_with_its_dv_directio
     assert math.degrees(math.acos(est[1] / np.linalg.norm(est))) < 5.0
     assert e.duration_s == pytest.approx(duration, rel=0.2)
     assert e.detector == "orbit.glr" and e.kind == "maneuver"
+
+
+def test_cli_allow_truncated_reads_a_truncated_sp3_and_counts_the_missing_epochs(
+    tmp_path: Path, shared_data: Path
+) -> None:
+    """An SP3 that ends before the epochs its header announces is an error naming the file; with
+    ``--allow-truncated`` it is analysed and the missing epochs are reported as a counted repair."""
+    from abrupt.errors import InputError
+
+    src = shared_data / "sp3" / "ssas3a20.b18358.e19003.DG_.sp3"
+    lines = src.read_text().splitlines(keepends=True)
+    starts = [i for i, line in enumerate(lines) if line.startswith("*")]
+    kept = 360
+    short = tmp_path / "short.sp3"
+    short.write_text("".join(lines[: starts[kept]]))
+    announced = int(lines[0][32:39])
+    args = ["detect", "orbit", str(short), "--out", str(tmp_path / "e.csv"), "--catalog", str(tmp_path / "c.sqlite")]
+    runner = CliRunner()
+    res = runner.invoke(cli, args)
+    assert isinstance(res.exception, InputError)  # the command line prints it as one located line
+    assert "short.sp3" in str(res.exception) and "truncated" in str(res.exception)
+    res = runner.invoke(cli, [*args, "--allow-truncated"])
+    assert res.exit_code == 0, res.output
+    assert f"{announced - kept}" in res.output and "truncated" in res.output
+    assert "orbit fit" in res.output and f"{kept} epochs" in res.output
