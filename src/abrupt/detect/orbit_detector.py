@@ -141,9 +141,8 @@ def analyse(ephemeris: Ephemeris, config: OrbitDetectorConfig | None = None) -> 
     fc = config.filter
     ctx = fc.force_context(eph.times_utc[0], float(t[0]), float(t[-1]))
     with_glr = config.glr_window_samples > 0
-    fwd = run_forward(
-        t, eph.position_m, eph.velocity_mps, config.sigma_pos_m, config.sigma_vel_mps, fc, context=ctx, store_gains=with_glr
-    )
+    s_pos, s_vel = config.sigma_pos_m, config.sigma_vel_mps
+    fwd = run_forward(t, eph.position_m, eph.velocity_mps, s_pos, s_vel, fc, context=ctx, store_gains=with_glr)
     bwd = run_backward(
         t,
         eph.position_m,

@@ -210,9 +210,7 @@ def glr_statistic_from_run(t_s: FloatArray, forward: FilterRun, horizon_s: float
     horizon = max(2, round(horizon_s / dt_nom))
     step = np.r_[dt_nom, np.diff(t_s)]
     lead = np.ascontiguousarray(0.5 * step) if dt_nom > 2.0 else np.zeros(t_s.size)
-    return glr_sliding_kernel(
-        forward.phis, forward.gains, forward.sinvs, np.ascontiguousarray(innovs), horizon, lead
-    )
+    return glr_sliding_kernel(forward.phis, forward.gains, forward.sinvs, np.ascontiguousarray(innovs), horizon, lead)
 
 
 def glr_statistic(
