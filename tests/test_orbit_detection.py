@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -252,3 +253,43 @@ def test_cli_allow_truncated_reads_a_truncated_sp3_and_counts_the_missing_epochs
     assert res.exit_code == 0, res.output
     assert f"{announced - kept}" in res.output and "truncated" in res.output
     assert "orbit fit" in res.output and f"{kept} epochs" in res.output
+
+
+def test_position_only_cpf_prediction_of_lageos_is_a_quiet_no_maneuver_control(shared_data: Path) -> None:
+    """An ILRS CPF prediction (LAGEOS-1, positions only, 300 s, two days; passive sphere, no maneuver) is
+    analysed with the default detector: auto tuning takes starting velocities from the positions, the
+    threshold is set, and nothing is flagged at one false alarm per week."""
+    from abrupt.pipelines.orbit import detect_orbit
+
+    run = detect_orbit(shared_data / "tracking" / "ilrs-corpus" / "lageos1_cpf_180613_16401.hts", budget="1/week")
+    assert not np.isfinite(run.ephemeris.velocity_mps).any()
+    assert "glr" in run.thresholds and np.isfinite(run.thresholds["glr"].value)
+    assert run.summary["residual_rms_pos_m"] < 0.1
+    assert len(run.events) == 0
+
+
+def test_velocities_from_positions_match_a_kepler_orbit() -> None:
+    """9-point polynomial derivatives of positions sampled every 60 s reproduce the analytic two-body
+    velocity (LEO, e = 0.01) to < 1e-6 m/s, ends included; a gap gives NaN instead of a wrong value."""
+    from abrupt.detect.orbit_detector import velocities_from_positions
+    from abrupt.model.orbit import MU_EARTH_M3_S2, kepler_to_cartesian
+
+    a, e = 7.0e6, 0.01
+    n = math.sqrt(MU_EARTH_M3_S2 / a**3)
+    t = np.arange(200) * 60.0
+    t = np.delete(t, np.arange(100, 110))  # a 11-minute gap
+    pos, vel = [], []
+    for tk in t:
+        m_anom = n * tk
+        ecc = m_anom
+        for _ in range(30):
+            ecc = m_anom + e * math.sin(ecc)
+        nu = 2 * math.atan2(math.sqrt(1 + e) * math.sin(ecc / 2), math.sqrt(1 - e) * math.cos(ecc / 2))
+        r, v = kepler_to_cartesian(a, e, 0.9, 0.3, 0.2, nu)
+        pos.append(r)
+        vel.append(v)
+    est = velocities_from_positions(t, np.array(pos))
+    ok = np.isfinite(est).all(axis=1)
+    assert ok.sum() > 150
+    assert not ok[np.searchsorted(t, 6000.0) - 1]  # window across the gap
+    assert np.max(np.abs(est[ok] - np.array(vel)[ok])) < 1e-6
