@@ -4,9 +4,9 @@ Truth: 400 km, 51.6°, ISS-like area-to-mass (420 t, 2000 m² for drag and SRP: 
 EGM2008 ``--truth-degree`` × same, Sun, Moon, SRP with conical shadow, exponential drag, integrated
 with DOP853; burns of 0.3-2 m/s prograde lasting 4-15 min held in the orbit frame (as ISS reboosts are
 flown), one per 2-day arc at a random time in the middle day; navigation-like data every 60 s with
-0.5 m / 0.5 mm/s white noise. Detection: ``detect_orbit`` with its defaults (auto tuning, EGM2008
-40×40 + Sun/Moon filter without drag or SRP, self-calibrated GLR threshold at one false alarm per
-week). Nothing here is tuned to these cases.
+0.5 m / 0.5 mm/s white noise (``--step-s 240`` for NASA's ISS OEM sampling). Detection:
+``detect_orbit`` with its defaults (auto tuning, EGM2008 40×40 + Sun/Moon filter without drag or SRP,
+self-calibrated GLR threshold at one false alarm per week). Nothing here is tuned to these cases.
 
 Targets: every reboost found, |ΔV| within 10 %, direction within 5°, start time within 60 s; and no
 other event in the arc.
@@ -35,6 +35,7 @@ def main() -> None:
     parser.add_argument("--trials", type=int, default=12)
     parser.add_argument("--truth-degree", type=int, default=20)
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--step-s", type=float, default=60.0, help="sampling (NASA's ISS OEM files: 240 s)")
     args = parser.parse_args()
     truth = ForceModel(
         gravity_degree=args.truth_degree,
@@ -48,7 +49,10 @@ def main() -> None:
     )
     rng = np.random.default_rng(args.seed)
     rows = []
-    print(f"truth EGM2008 {args.truth_degree}x{args.truth_degree} + Sun/Moon + SRP + drag; {args.trials} reboosts")
+    print(
+        f"truth EGM2008 {args.truth_degree}x{args.truth_degree} + Sun/Moon + SRP + drag; {args.trials} reboosts; "
+        f"data every {args.step_s:g} s"
+    )
     for trial in range(args.trials):
         dv = rng.uniform(0.3, 2.0)
         dur = rng.uniform(240.0, 900.0)
@@ -57,7 +61,7 @@ def main() -> None:
             altitude_m=400e3,
             inclination_deg=51.6,
             duration_s=2 * 86400.0,
-            rate_hz=1 / 60.0,
+            rate_hz=1 / args.step_s,
             sigma_pos_m=0.5,
             sigma_vel_mps=5e-4,
             epoch_utc=EPOCH,

@@ -71,7 +71,7 @@ def main() -> None:
     arc_s = args.arc_days * 86400.0
     n5 = 10 if args.quick else 30
     n_per = 6 if args.quick else 15
-    mags = [0.0005, 0.001, 0.0015, 0.002, 0.003]
+    mags = [0.0001, 0.0002, 0.0003, 0.0005, 0.001, 0.0015, 0.002, 0.003]
     for label, path in ARCS.items():
         if args.arc != "all" and ("Jason" in label) != (args.arc == "jason1"):
             continue
