@@ -41,7 +41,7 @@ from abrupt.detect.orbit_statistics import (
 )
 from abrupt.events import Event, config_hash, empty_frame, events_frame
 from abrupt.model.frames import Ephemeris
-from abrupt.model.orbit import ForceContext, rtn_matrix
+from abrupt.model.orbit import MU_EARTH_M3_S2, ForceContext, rtn_matrix
 from abrupt.thresholds import Threshold, fit_threshold, gpd_return_level_upper, p_fa_per_sample
 from abrupt.types import FloatArray
 
@@ -545,10 +545,30 @@ def interval_jump(analysis: OrbitAnalysis, k_first: int, k_last: int | None = No
     dx_last = np.r_[xb[0:3] - x_pred[0:3], xb[3:6] - x_pred[3:6]]
     dx0 = np.linalg.solve(phi[:6, :6], dx_last)
     t0 = float(t[k_first - 1])
+    # Starting guess: the epoch of the span where the mapped position offset is smallest (it vanishes at
+    # the jump: Φ(t, t_c)[0; ΔV] has no position part at t = t_c), then free-flight iterations from there.
+    # The free-flight relation Δr = ΔV (t − t_c) alone holds only over a small part of an orbit; from the
+    # span's start it put the centroid of a reboost sampled every 240 s (span ~1 orbit) 10 min early,
+    # and the ΔV mapped there was 3× too large and mostly radial.
     t_c = t0 - float(dx0[:3] @ dx0[3:]) / max(float(dx0[3:] @ dx0[3:]), 1e-300)
+    if k_last > k_first:
+        phi_acc = np.eye(9)
+        phi_k = np.empty((9, 9))
+        x_k = xf.copy()
+        best_r = float(np.linalg.norm(dx0[:3]))
+        for j in range(k_first, k_last + 1):
+            step_j = float(t[j] - t[j - 1])
+            x_k = propagate_state(x_k, float(t[j - 1]), step_j, 1e12, ctx.kernel_args, fc.max_step_s, phi_k)
+            phi_acc = phi_k @ phi_acc
+            dx_j = phi_acc[:6, :6] @ dx0
+            r_j = float(np.linalg.norm(dx_j[:3]))
+            if r_j < best_r:
+                best_r = r_j
+                lead = float(dx_j[:3] @ dx_j[3:]) / max(float(dx_j[3:] @ dx_j[3:]), 1e-300)
+                t_c = float(t[j]) - float(np.clip(lead, -step_j, step_j))
     dv, dr = dx0[3:], dx0[:3]
     phi_c = np.empty((9, 9))
-    for _ in range(2):
+    for _ in range(3):
         tau_c = min(max(t_c - t0, 0.0), dt)
         propagate_state(xf, t0, tau_c, 1e12, ctx.kernel_args, fc.max_step_s, phi_c)
         dx_c = phi_c[:6, :6] @ dx0
@@ -627,6 +647,16 @@ def locate_burn(
     g0, g1 = episode if episode is not None else (k, k)
     lo = max(1, min(g0, k) - margin)
     hi = min(n - 1, max(g1, k) + margin)
+    # at most half an orbit: the state difference across the span is mapped through the filter's STM
+    # (two-body + J2, Lear RK2), which over more than an orbit is too coarse (a reboost sampled every
+    # 240 s: span 1.2 orbits, ΔV 60 % too large); at 60 s sampling the 40-interval cap is the smaller
+    xk = analysis.forward.x[k]
+    rk, vk = float(np.linalg.norm(xk[:3])), float(np.linalg.norm(xk[3:6]))
+    energy = 0.5 * vk * vk - MU_EARTH_M3_S2 / rk
+    step_k = float(np.median(np.diff(t[max(0, k - 5) : k + 6])))
+    if energy < 0:
+        period = 2.0 * np.pi * np.sqrt((-MU_EARTH_M3_S2 / (2.0 * energy)) ** 3 / MU_EARTH_M3_S2)
+        max_intervals = max(2 * margin + 1, min(max_intervals, int(0.5 * period / step_k)))
     if hi - lo + 1 > max_intervals:  # keep the span around the located interval
         lo = max(1, k - max_intervals // 2)
         hi = min(n - 1, lo + max_intervals - 1)
