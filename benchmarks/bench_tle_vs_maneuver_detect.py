@@ -67,8 +67,10 @@ SATELLITES: dict[str, tuple[str, str]] = {
     "Fengyun-2E": ("manFY2E.txt.fy", "GEO"),
 }
 GAINS = (0.2, 0.5, 1.0)  # gain of the e-vector and orbit-normal groups (the a group has gain 1)
-CAMPAIGN_SIDES = (3,)  # sets a side needs near an accepted maneuver (2 was tried: LOSO results identical)
-GRID = tuple((g, c) for g in GAINS for c in CAMPAIGN_SIDES)
+# sets a side needs between accepted maneuvers: tuned LOSO for GEO; LEO fixed at 2 (every LEO history
+# scores the same or better with 2 than with 3, so LOSO picks 2 for each; left out to keep < 2 min)
+CAMPAIGN_SIDES = {"LEO": (2,), "GEO": (2, 3)}
+GRID = {cls: tuple((g, c) for g in GAINS for c in sides) for cls, sides in CAMPAIGN_SIDES.items()}
 BUDGET = FalseAlarmBudget(1.0, "year")
 TOLERANCE_S = 86400.0
 BIG_BURN_MPS = 0.05
@@ -136,6 +138,18 @@ def evaluate(events: pd.DataFrame, truth: pd.DataFrame, start: Any, end: Any, si
     big_res = big.to_numpy() & alone
     n_big_res = int(big_res.sum())
     big_res_found = sum(1 for j in np.flatnonzero(big_res) if j in found)
+    # campaign level: an event also covers the burns inside its stated interval, up to the number of
+    # burns it says it may hold (largest first); false alarms are counted as above, unchanged
+    covered = found | campaign_covered(at_op, truth, in_span.to_numpy())
+    big_camp_found = sum(1 for j in np.flatnonzero(big.to_numpy()) if j in covered)
+    # calibration of the stated intervals: matched maneuvers (at the budget) inside their event's interval
+    in_iv = []
+    if "interval_start_utc" in events and res.pairs:
+        det = events.reset_index(drop=True)  # pairs hold row positions of the events frame
+        for i, j, _ in res.pairs:
+            lo_i = pd.Timestamp(det["interval_start_utc"].iloc[i]).tz_localize(None)
+            hi_i = pd.Timestamp(det["interval_end_utc"].iloc[i]).tz_localize(None)
+            in_iv.append(lo_i <= pd.Timestamp(truth["time_utc"].iloc[j]) <= hi_i)
     ratios, iso = delta_v_ratios(events, truth, res.pairs, signed)
     dts = np.array([abs(p[2]) for p in res.pairs]) / 3600.0
     return {
@@ -154,14 +168,114 @@ def evaluate(events: pd.DataFrame, truth: pd.DataFrame, start: Any, end: Any, si
         "n_big": n_big,
         "big_found": big_found,
         "recall_big_at_1fa": big_found / n_big if n_big else float("nan"),
+        "big_camp_found": big_camp_found,
+        "recall_big_campaign_at_1fa": big_camp_found / n_big if n_big else float("nan"),
         "n_big_res": n_big_res,
         "big_res_found": big_res_found,
         "recall_big_res_at_1fa": big_res_found / n_big_res if n_big_res else float("nan"),
         "median_abs_dt_h": float(np.median(dts)) if dts.size else float("nan"),
+        "in_interval": float(np.mean(in_iv)) if in_iv else float("nan"),
         "dv_isolated_n": int(iso.sum()),
         "dv_isolated_within_2x": float(((ratios > 0.5) & (ratios < 2.0))[iso].mean()) if iso.any() else float("nan"),
         "dv_median_ratio": float(np.median(ratios)) if ratios.size else float("nan"),
     }
+
+
+def missed_big_burns(
+    sat: str, events: pd.DataFrame, truth: pd.DataFrame, start: Any, end: Any, noise_model: dict[str, Any]
+) -> pd.DataFrame:
+    """Every operator maneuver >= 5 cm/s not found at the 1 FA/yr operating point, with its cause.
+
+    ``z_t_exp`` is the in-track statistic the operator's ΔV would give through vis-viva
+    (``Δa = 2a Δv_t / v``) against the satellite's own median step noise (``|Δv_t| / σ(Δv_t)``),
+    ``z_n_exp`` the cross-track one before the group gain; ``S`` the statistic of the candidate
+    at the maneuver's element-set gap (±1 gap), ``cut`` the 1 FA/yr cut.
+    """
+    op = recall_at_false_alarm_rate(
+        events, truth, false_alarms_per_year=1.0, start=start, end=end, tolerance_s=TOLERANCE_S
+    )
+    cut = op.score_cut
+    events = events.reset_index(drop=True)
+    keep = events["statistic"].to_numpy() >= cut
+    at_op_pos = np.flatnonzero(keep)
+    r_op = score_events(events.loc[keep], truth, tolerance_s=TOLERANCE_S, start=start, end=end, apply_threshold=False)
+    tru = truth.reset_index(drop=True)
+    found = {j for _, j, _ in r_op.pairs}
+    matched = {int(at_op_pos[i]) for i, _, _ in r_op.pairs}
+    epochs = elset_epochs(events, start, end)
+    tt = tru["time_utc"].to_numpy(dtype="datetime64[ns]")
+    gap_of = np.searchsorted(epochs, tt) - 1
+    ev_gap = np.searchsorted(epochs, pd.to_datetime(events["elset_epoch_before_utc"]).to_numpy(dtype="datetime64[ns]"))
+    ev_t = pd.to_datetime(events["time_utc"], utc=True).dt.tz_localize(None).to_numpy(dtype="datetime64[ns]")
+    in_span = (tru["time_utc"] >= start) & (tru["time_utc"] <= end)
+    covered = campaign_covered(events.loc[keep], tru, in_span.to_numpy())
+    sig_t = float(noise_model.get("dv_t_sigma_mps", float("nan")))
+    sig_n = float(noise_model.get("dv_n_sigma_mps", float("nan")))
+    rows = []
+    for j in np.flatnonzero(in_span.to_numpy()):
+        ref = tru.iloc[j]
+        if not ref["dv_mps"] >= BIG_BURN_MPS or j in found:
+            continue
+        g = int(gap_of[j])
+        same = int(((gap_of == g) & in_span.to_numpy()).sum()) - 1
+        cand = np.flatnonzero(np.abs(ev_gap - g) <= 1)
+        best = int(cand[np.argmax(events["statistic"].to_numpy()[cand])]) if cand.size else -1
+        s_best = float(events["statistic"].iloc[best]) if best >= 0 else float("nan")
+        if same:
+            cause = f"shares its element-set gap with {same} other maneuver(s)"
+        elif g < 2 or g > len(epochs) - 4:
+            cause = f"edge of the history ({g + 1} set(s) before)"
+        elif best < 0:
+            others = int(((np.abs(gap_of - g) <= 6) & in_span.to_numpy()).sum()) - 1
+            cause = "no candidate at its gap (S < 3)" + (
+                f"; {others} other maneuver(s) within 6 sets" if others else "; no other maneuver within 6 sets"
+            )
+        elif s_best < cut:
+            cause = "statistic below the 1 FA/yr cut"
+        else:
+            dt_h = abs(float((ev_t[best] - tt[j]) / np.timedelta64(1, "h")))
+            if best in matched:
+                cause = f"its event matched another maneuver ({dt_h:.0f} h away)"
+            else:
+                cause = f"event at its gap timed {dt_h:.0f} h off"
+        if abs(ref["dv_t_mps"]) < 0.2 * ref["dv_mps"] and abs(ref["dv_n_mps"]) < 0.2 * ref["dv_mps"]:
+            cause += "; net in-track/cross-track ΔV ~0 (opposed pair)"
+        rows.append(
+            {
+                "satellite": sat,
+                "time_utc": str(ref["time_utc"])[:16],
+                "burns": int(ref["n_burns"]),
+                "dv_cm_s": 100 * ref["dv_mps"],
+                "dv_t_cm_s": 100 * ref["dv_t_mps"],
+                "dv_n_cm_s": 100 * ref["dv_n_mps"],
+                "gap_d": float((epochs[g + 1] - epochs[g]) / np.timedelta64(1, "D"))
+                if 0 <= g < len(epochs) - 1
+                else np.nan,
+                "z_t_exp": abs(ref["dv_t_mps"]) / sig_t,
+                "z_n_exp": abs(ref["dv_n_mps"]) / sig_n,
+                "S": s_best,
+                "cut": cut,
+                "in_campaign_event": j in covered,
+                "cause": cause,
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def campaign_covered(at_op: pd.DataFrame, truth: pd.DataFrame, in_span: np.ndarray) -> set[int]:
+    """Truth rows inside the stated interval of an event at the operating point, at most the event's
+    ``burns_max`` per event (largest ΔV first): the campaign-level credit."""
+    covered: set[int] = set()
+    if "interval_start_utc" not in at_op or not len(at_op):
+        return covered
+    tt = truth["time_utc"].to_numpy(dtype="datetime64[ns]")
+    lo = pd.to_datetime(at_op["interval_start_utc"], utc=True).dt.tz_localize(None).to_numpy(dtype="datetime64[ns]")
+    hi = pd.to_datetime(at_op["interval_end_utc"], utc=True).dt.tz_localize(None).to_numpy(dtype="datetime64[ns]")
+    order = np.argsort(-truth["dv_mps"].fillna(0.0).to_numpy(), kind="stable")
+    for a, b, k in zip(lo, hi, at_op["burns_max"].to_numpy(), strict=True):
+        inside = [int(j) for j in order if in_span[j] and a <= tt[j] <= b]
+        covered.update(inside[: int(k)])
+    return covered
 
 
 _EPOCHS: dict[tuple[str, str], np.ndarray] = {}
@@ -219,6 +333,7 @@ def pooled(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "recall_at_1fa": sum(r["tp_at_1fa"] for r in rows) / n_truth if n_truth else float("nan"),
         "n_big": n_big,
         "recall_big_at_1fa": sum(r["big_found"] for r in rows) / n_big if n_big else float("nan"),
+        "recall_big_campaign_at_1fa": sum(r["big_camp_found"] for r in rows) / n_big if n_big else float("nan"),
         "n_big_res": sum(r["n_big_res"] for r in rows),
         "recall_big_res_at_1fa": sum(r["big_res_found"] for r in rows) / max(sum(r["n_big_res"] for r in rows), 1),
     }
@@ -286,7 +401,11 @@ def main() -> None:
     sats = list(SATELLITES)
     truth = {s: read_maneuver_file(DATA / "maneuvers" / SATELLITES[s][0]) for s in sats}
     spans = {s: span(s) for s in sats}
-    jobs = [(s, g) for s in sorted(sats, key=lambda x: -(DATA / "tle" / f"{x}.tle").stat().st_size) for g in GRID]
+    jobs = [
+        (s, g)
+        for s in sorted(sats, key=lambda x: -(DATA / "tle" / f"{x}.tle").stat().st_size)
+        for g in GRID[SATELLITES[s][1]]
+    ]
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
         results = list(pool.map(detect_one, jobs))
     runs = {(s, g): (ev, nm, sec) for s, g, ev, nm, sec in results}
@@ -296,7 +415,7 @@ def main() -> None:
     for sat in sats:
         cls = SATELLITES[sat][1]
         train = [o for o in sats if o != sat and SATELLITES[o][1] == cls]
-        best = max(GRID, key=lambda g: (pooled([scores[(o, g)] for o in train])["f1"], -abs(g[0] - 0.5), g[1]))
+        best = max(GRID[cls], key=lambda g: (pooled([scores[(o, g)] for o in train])["f1"], -abs(g[0] - 0.5), g[1]))
         ev, nm, sec = runs[(sat, best)]
         rows.append(
             {
@@ -311,6 +430,20 @@ def main() -> None:
                 **scores[(sat, best)],
             }
         )
+    misses = pd.concat(
+        [
+            missed_big_burns(
+                r["satellite"],
+                runs[(r["satellite"], r["gain"])][0],
+                truth[r["satellite"]],
+                *spans[r["satellite"]],
+                runs[(r["satellite"], r["gain"])][1],
+            )
+            for r in rows
+            if r["class"] == "LEO"
+        ],
+        ignore_index=True,
+    )
     base_note = "skipped"
     if not args.no_baseline:
         frames, version, base_note = baseline_events(
@@ -339,9 +472,11 @@ def main() -> None:
         "recall_at_1fa",
         "n_big",
         "recall_big_at_1fa",
+        "recall_big_campaign_at_1fa",
         "n_big_res",
         "recall_big_res_at_1fa",
         "median_abs_dt_h",
+        "in_interval",
         "min_dv_t_cm_s",
         "min_dv_n_cm_s",
         "dv_isolated_n",
@@ -368,6 +503,9 @@ def main() -> None:
                     pooled_rows.append({"class": cls, "detector": sel[0]["detector"].split(" tle.")[0], **pooled(sel)})
         ptable = pd.DataFrame(pooled_rows)
         print(ptable.to_string(index=False))
+    with pd.option_context("display.width", 250, "display.max_colwidth", 90, "display.float_format", "{:.1f}".format):
+        print(f"\nabrupt (held out): the {len(misses)} LEO maneuvers >= 5 cm/s missed at 1 FA/yr, and why")
+        print(misses.to_string(index=False) if len(misses) else "  none")
     print("\nAcceptance (issue 11): LOSO pooled F1 >= 0.6 per class; recall >= 0.9 of burns >= 5 cm/s at <= 1 FA/yr")
     for r in pooled_rows:
         if r["detector"] != "abrupt":
@@ -382,7 +520,8 @@ def main() -> None:
             print(
                 f"; recall of {r['n_big']} burns >= 5 cm/s at 1 FA/yr {r['recall_big_at_1fa']:.2f} "
                 f"-> {'MET' if okb else 'NOT MET'} ({r['n_big_res']} of them alone between two element sets: "
-                f"{r['recall_big_res_at_1fa']:.2f})",
+                f"{r['recall_big_res_at_1fa']:.2f}; campaign level, an event also covering the burns in its "
+                f"stated interval up to its burns_max, false alarms unchanged: {r['recall_big_campaign_at_1fa']:.2f})",
                 end="",
             )
         print()

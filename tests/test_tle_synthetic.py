@@ -16,7 +16,7 @@ import pytest
 from click.testing import CliRunner
 
 from abrupt.cli.main import cli
-from abrupt.detect.tle_maneuvers import TleDetectorConfig, characterise, detect_tle_maneuvers
+from abrupt.detect.tle_maneuvers import TleDetectorConfig, campaign_cadence_s, characterise, detect_tle_maneuvers
 from abrupt.events import EVENT_COLUMNS, read_events
 from abrupt.readers.tle import read_tle
 from abrupt.score import score_events
@@ -245,3 +245,46 @@ def test_single_outlier_element_set_is_not_a_maneuver(tmp_path: Path) -> None:
     events = detect_tle_maneuvers(read_tle(path))
     near = pd.to_datetime(events["time_utc"]).dt.tz_localize(None) - (EPOCH0 + pd.Timedelta(days=100))
     assert not (near.abs() < pd.Timedelta(days=3)).any()
+
+
+def test_campaign_burns_three_sets_apart_are_each_found_and_a_shared_gap_is_one_event(tmp_path: Path) -> None:
+    """A campaign of burns every 2.9 days (three element sets apart) is found burn by burn, each timed
+    inside its own segment; two burns inside one gap between element sets give one event whose
+    stated interval holds both (Gauss: Δa = 2aΔv/v, 5 cm/s ≈ 100 m against σ_a = 0.5 m)."""
+    campaign = ((100.0, 0.05), (102.9, 0.05), (105.8, -0.05))
+    pair = ((250.95, 0.05), (251.05, 0.05))  # between the sets near day 250.5 and day 251.5
+    text, truth = synthetic_tle_text(days=365, burns=campaign + pair, seed=5)
+    path = tmp_path / "campaign.tle"
+    path.write_text(text)
+    events = detect_tle_maneuvers(read_tle(path))
+    times = [t for t, _, _ in truth]
+    res = score_events(events, pd.DataFrame({"time_utc": times[:3]}), tolerance_s=86400.0)
+    assert res.true_positives == 3, events[["time_utc", "statistic", "elset_epoch_before_utc"]]
+    matched = events.iloc[[i for i, _, _ in res.pairs]]
+    assert matched["campaign_id"].nunique() == 1 and (matched["campaign_size"] == 3).all()
+    lo = pd.to_datetime(events["interval_start_utc"]).dt.tz_localize(None)
+    hi = pd.to_datetime(events["interval_end_utc"]).dt.tz_localize(None)
+    holds_pair = (lo <= times[3]) & (hi >= times[4])
+    assert holds_pair.sum() == 1
+    assert events.loc[holds_pair, "dv_t_mps"].iloc[0] == pytest.approx(0.10, rel=0.2)  # the sum of both burns
+    assert (events["burns_max"] >= 1).all()
+
+
+def test_campaign_cadence_is_the_median_spacing_inside_campaigns() -> None:
+    day = 86400.0
+    assert campaign_cadence_s(np.array([0.0, 1.0, 2.5, 4.5, 30.0]) * day, 3.0) == pytest.approx(1.5 * day)
+    assert math.isinf(campaign_cadence_s(np.array([0.0, 1.0, 2.0, 40.0]) * day, 3.0))  # two spacings only
+
+
+def test_sparse_history_with_many_burns_keeps_its_threshold_off_the_maneuvers(tmp_path: Path) -> None:
+    """Element sets every 3 days and eight burns in 500 days: the burns' test windows cover most gaps,
+    leaving too few event-free gaps for a tail fit. The threshold must not be taken from the whole
+    statistic (it sat on the maneuvers' own plateaus and hid 7 of 8 burns of 2-5 cm/s, 80-200 σ)."""
+    burns = (*((d, 0.02) for d in (50.1, 120.7, 200.2, 260.9, 330.4)), (400.0, 0.05), (407.0, 0.05))
+    text, truth = synthetic_tle_text(days=500, cadence_days=3.0, burns=burns, seed=11)
+    path = tmp_path / "sparse.tle"
+    path.write_text(text)
+    events = detect_tle_maneuvers(read_tle(path))
+    res = score_events(events, pd.DataFrame({"time_utc": [t for t, _, _ in truth]}), tolerance_s=1.5 * 86400.0)
+    assert res.true_positives >= 6, events[["time_utc", "statistic", "threshold"]]
+    assert res.false_positives <= 2  # budget 1 per satellite-year over 1.4 years

@@ -125,9 +125,13 @@ def detect_tle(
         for line in h.repairs.summary():
             click.echo(f"repaired: {line}", err=True)
         nm = sat.noise_model
-        n_det = int((sat.events["statistic"] >= sat.events["threshold"]).sum()) if len(sat.events) else 0
+        found = sat.events.loc[sat.events["statistic"] >= sat.events["threshold"]] if len(sat.events) else sat.events
+        n_det = len(found)
+        multi = int((found["burns_max"] > 1).sum()) if "burns_max" in found else 0
         click.echo(
-            f"{satellite_label(h)}: {len(h)} element sets, {sat.detector}, {n_det} maneuver(s); "
+            f"{satellite_label(h)}: {len(h)} element sets, {sat.detector}, {n_det} maneuver(s)"
+            + (f" ({multi} with an interval long enough for several burns at its campaign cadence)" if multi else "")
+            + "; "
             f"smallest detectable ΔV in-track {nm.get('min_detectable_dv_t_mps', float('nan')) * 100:.2g} cm/s, "
             f"cross-track {nm.get('min_detectable_dv_n_mps', float('nan')) * 100:.2g} cm/s",
             err=True,
