@@ -1,8 +1,10 @@
-"""Benchmark-only reader of the flight-like raw archive (long format ``time,mnemonic,value``).
+"""Flight-like archive to the inertia estimator's input, for the mass benchmarks.
 
-Not a public reader: the flight-telemetry pipeline (issue 9, ``abrupt ingest``) owns archive reading.
-It drops the archiver artefacts the README lists (blank lines, empty values, ``-999999``, ``NaN``,
-duplicates) and converts each channel to SI using ``spacecraft.json``.
+Default path: the flight pipeline's ingest (``abrupt.pipelines.flight.ingest_archives``, what
+``abrupt ingest`` runs: pseudonymisation with ``decoder.csv``, archive artefacts removed and counted,
+one store day per UTC day), then ``TelemetryStore.read_day``; each channel of ``spacecraft.json`` is
+found under its pseudonym and converted to SI. ``read_archive`` (pandas, benchmark-only) is the
+earlier direct reader, kept for comparison.
 """
 
 from __future__ import annotations
@@ -30,10 +32,38 @@ def read_archive(path: Path, epoch: pd.Timestamp) -> dict[str, tuple[np.ndarray,
     return {m: (g["t"].to_numpy(), g["v"].to_numpy()) for m, g in df.groupby("mnemonic")}
 
 
-def load_day(folder: Path, day: str, epoch: str = "2026-03-10") -> MomentumBalanceData:
+def ingest(folder: Path, store_root: Path) -> object:
+    """``abrupt ingest`` of every archive file of the folder into ``store_root``; returns the store."""
+    from abrupt.pipelines.flight import ingest_archives
+    from abrupt.store import TelemetryStore
+
+    files = sorted((folder / "telemetry").glob("*.csv*"))
+    ingest_archives(files, folder / "decoder.csv", store_root)
+    return TelemetryStore(store_root)
+
+
+def channels_from_store(store: object, folder: Path, day: str, epoch: pd.Timestamp) -> dict[str, tuple]:
+    """Channels of one store day keyed by their *real* mnemonic (looked up through the decoder)."""
+    from abrupt.readers.archive import read_decoder
+
+    decoder = read_decoder(folder / "decoder.csv")
+    sc = json.loads((folder / "spacecraft.json").read_text())
+    pseudo_sc = decoder.spacecraft[sc["spacecraft"]]
+    wanted = {decoder.mnemonics[c["mnemonic"]]: c["mnemonic"] for c in sc["telemetry"]["channels"]
+              if c["mnemonic"] in decoder.mnemonics}  # fmt: skip
+    frame = store.read_day(pseudo_sc, day, mnemonics=list(wanted))  # type: ignore[attr-defined]
+    t = (pd.to_datetime(frame["time"]) - epoch.tz_localize(None)).dt.total_seconds().to_numpy()
+    frame = frame.assign(t=t).sort_values("t", kind="stable")
+    return {wanted[m]: (g["t"].to_numpy(), g["value"].to_numpy(dtype=float)) for m, g in frame.groupby("mnemonic")}
+
+
+def load_day(folder: Path, day: str, epoch: str = "2026-03-10", store: object | None = None) -> MomentumBalanceData:
     sc = json.loads((folder / "spacecraft.json").read_text())
     name = sc["spacecraft"]
-    ch = read_archive(folder / "telemetry" / f"{name}_{day}.csv.gz", pd.Timestamp(epoch))
+    if store is None:
+        ch = read_archive(folder / "telemetry" / f"{name}_{day}.csv.gz", pd.Timestamp(epoch))
+    else:
+        ch = channels_from_store(store, folder, day, pd.Timestamp(epoch))
     by_key = {c["key"]: c for c in sc["telemetry"]["channels"]}
 
     def get(key: str) -> tuple[np.ndarray, np.ndarray]:

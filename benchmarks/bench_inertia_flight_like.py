@@ -9,10 +9,12 @@
 * independently simulated spacecraft (other inertia, wheel layout, orbit) from our simulator;
 * speed: one day of 1 Hz telemetry to an estimate, on one core.
 
-The archive is read by the benchmark-only loader ``_flight_like_loader.py`` (the flight pipeline's
-``abrupt ingest`` is issue 9). Nothing is tuned on these files: the estimator's defaults were chosen on
+The archive goes through the flight pipeline's ingest (what ``abrupt ingest`` runs) into a temporary
+store, and each day is read back from the store (``_flight_like_loader.py``; ``--pandas-loader``: the
+earlier direct reader). Nothing is tuned on these files: the estimator's defaults were chosen on
 day 2026-03-10 and simulated spacecraft; the day-by-day rows are the held-out check.
-Run: ``OMP_NUM_THREADS=1 PYTHONPATH=src nice python benchmarks/bench_inertia_flight_like.py [--no-pso]``.
+Run: ``OMP_NUM_THREADS=1 PYTHONPATH=src nice python benchmarks/bench_inertia_flight_like.py [--no-pso]
+[--pandas-loader]``.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-from _flight_like_loader import catalogue, load_day
+from _flight_like_loader import catalogue, ingest, load_day
 from abrupt.massprops.inertia import axis_errors_deg, params_from_inertia, principal_axes
 from abrupt.massprops.momentum_balance import (
     MomentumBalanceData,
@@ -91,10 +93,19 @@ def main() -> None:
     j_cat = catalogue(FOLDER)
     events = json.loads((FOLDER / "truth_events.json").read_text())  # scoring only
     days = {}
+    import tempfile
+
+    tmp = tempfile.TemporaryDirectory()
+    store = None
+    if "--pandas-loader" not in sys.argv:
+        t0 = time.perf_counter()
+        store = ingest(FOLDER, Path(tmp.name))
+        print(f"abrupt ingest (pipelines.flight.ingest_archives) of both days: {time.perf_counter() - t0:.1f} s")
     for day in ("2026-03-10", "2026-03-11"):
         t0 = time.perf_counter()
-        days[day] = load_day(FOLDER, day)
-        print(f"read + synchronise {day}: {time.perf_counter() - t0:.1f} s (benchmark loader)")
+        days[day] = load_day(FOLDER, day, store=store)
+        how = "store day" if store else "archive (pandas)"
+        print(f"read {how} + synchronise {day}: {time.perf_counter() - t0:.1f} s")
     print(f"threads: OMP_NUM_THREADS={os.environ.get('OMP_NUM_THREADS', 'unset')}")
     cat_score = score(
         "catalogue",

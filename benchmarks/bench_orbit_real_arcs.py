@@ -66,12 +66,15 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="10 injections at 5 mm/s, 6 per curve point")
     parser.add_argument("--arc-days", type=float, default=2.0)
     parser.add_argument("--seed", type=int, default=2026)
+    parser.add_argument("--arc", choices=["all", "s3a", "jason1"], default="all", help="which arc(s) to run")
     args = parser.parse_args()
     arc_s = args.arc_days * 86400.0
     n5 = 10 if args.quick else 30
     n_per = 6 if args.quick else 15
-    mags = [0.0005, 0.001, 0.0015, 0.002, 0.003]
+    mags = [0.0001, 0.0002, 0.0003, 0.0005, 0.001, 0.0015, 0.002, 0.003]
     for label, path in ARCS.items():
+        if args.arc != "all" and ("Jason" in label) != (args.arc == "jason1"):
+            continue
         eph = read_sp3(path).to_frame("GCRF")
         days = eph.seconds[-1] / 86400.0
         t0 = time.perf_counter()

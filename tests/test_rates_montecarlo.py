@@ -108,7 +108,7 @@ def test_dask_scheduler_gives_the_same_results_as_in_process() -> None:
     variables = [("mass_model", ["al_sphere", "socit"])]
     local = run_trade(base, variables)
     with distributed.LocalCluster(
-        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0"
     ) as cluster:
         remote = run_trade(base, variables, scheduler=cluster.scheduler_address)
     for a, b in zip(local, remote, strict=True):

@@ -83,7 +83,9 @@ def test_two_way_range_matches_the_closed_form_for_uniform_motion() -> None:
     def sta(t: np.ndarray) -> np.ndarray:
         return np.broadcast_to(s, (np.size(t), 3)).copy()
 
-    t_r = np.array([0.0, 10.0])
+    # receive times a second and a week after the epoch: absolute times of ~6e5 s carry 1e-10 s of
+    # rounding, so a range taken as c·(t_r − t_t)/2 was centimetres off there
+    t_r = np.array([0.0, 10.0, 7 * 86400.0 + 0.25])
     rng, t_b = two_way_range_m(t_r, sat, sta, shapiro=False)
     c = SPEED_OF_LIGHT_MPS
     for k, tr in enumerate(t_r):
@@ -93,7 +95,7 @@ def test_two_way_range_matches_the_closed_form_for_uniform_motion() -> None:
         tau_d = (-b - np.sqrt(b * b - 4 * a * cc)) / (2 * a)
         rb = p0 + v * (tr - tau_d)
         tau_u = np.linalg.norm(rb - s) / c
-        assert rng[k] == pytest.approx(0.5 * c * (tau_d + tau_u), abs=1e-6)
+        assert rng[k] == pytest.approx(0.5 * c * (tau_d + tau_u), abs=1e-6)  # [m] micrometre
         assert t_b[k] == pytest.approx(tr - tau_d, abs=1e-12)
     # Against the instantaneous geometric range the difference is of order v·τ (tens of metres here).
     assert np.all(np.abs(rng - np.linalg.norm(sat(t_r) - s, axis=1)) > 1.0)

@@ -81,7 +81,7 @@ def dask_client(executor: Executor) -> Iterator[Any]:
             n_workers=executor.workers,
             threads_per_worker=executor.threads_per_worker,
             processes=True,
-            dashboard_address=None,
+            dashboard_address=":0",  # any free port: None means the configured :8787, taken by a second run
             silence_logs=logging.ERROR,
         ) as cluster,
         Client(cluster) as client,

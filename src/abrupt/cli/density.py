@@ -37,6 +37,25 @@ def density() -> None:
     help="Space-weather table (CelesTrak SW format or CSV); default: the one shipped offline.",
 )
 @click.option("--kappa", type=float, default=1e-4, show_default=True, help="Smoothness weight of the B inversion.")
+@click.option(
+    "--node-days",
+    type=float,
+    default=0.25,
+    show_default=True,
+    help="Joint fit: spacing of the density-scale nodes (time resolution of storms).",
+)
+@click.option(
+    "--block-days",
+    type=float,
+    default=30.0,
+    show_default=True,
+    help="Joint fit: each object's B is one value per block this long.",
+)
+@click.option(
+    "--no-order-statistics",
+    is_flag=True,
+    help="Skip the slides' per-epoch estimates (density_mean/min; about a minute of ratio inversion).",
+)
 @click.option("--workers", type=int, default=1, show_default=True, help="Processes for many objects.")
 @click.option("--report", type=click.Path(dir_okay=False), default=None, help="PNG: density vs NRLMSIS per band.")
 def density_tle(
@@ -48,16 +67,25 @@ def density_tle(
     no_model: bool,
     space_weather: str | None,
     kappa: float,
+    node_days: float,
+    block_days: float,
+    no_order_statistics: bool,
     workers: int,
     report: str | None,
 ) -> None:
-    """ρB per window from element-set histories; with several objects, density by order statistics."""
+    """ρB per window from element-set histories; with several objects, density by order statistics.
+
+    With three or more objects the joint fit adds density_joint_kg_m3 (the recommended estimate).
+    """
     from abrupt.density.constellation import ConstellationConfig
+    from abrupt.density.joint import JointConfig
     from abrupt.density.tle_drag import TleDragConfig
     from abrupt.pipelines.density import tle_density, write_table
 
     if interval_days <= 0:
         raise click.BadParameter("must be > 0", param_hint="--interval-days")
+    if node_days <= 0 or block_days <= 0:
+        raise click.BadParameter("must be > 0", param_hint="--node-days/--block-days")
     res = tle_density(
         list(paths),
         platforms=platforms,
@@ -66,6 +94,8 @@ def density_tle(
         maneuvers=maneuvers,
         space_weather=space_weather,
         workers=workers,
+        joint=JointConfig(node_days=node_days, block_days=block_days),
+        order_statistics=not no_order_statistics,
     )
     write_table(res.windows, out)
     for src, log in res.repairs.items():

@@ -37,7 +37,14 @@ TERMS = ("light_time", "troposphere", "shapiro", "plate_motion", "eccentricity",
     type=click.Choice(TERMS),
     help="Leave a range-model term out (repeatable), to see what it costs.",
 )
-@click.option("--max-maneuvers", default=3, show_default=True, type=click.IntRange(min=1))
+@click.option("--max-maneuvers", default=3, show_default=True, type=click.IntRange(min=1), help="Per arc.")
+@click.option(
+    "--arc-days",
+    default=7.0,
+    show_default=True,
+    type=click.FloatRange(min=0.5),
+    help="Fit longer files in overlapping arcs of this length (1-day overlaps), as ILRS analyses do.",
+)
 @click.option("--spacecraft", default=None, help="Pseudonym for the events (default: the CRD target name).")
 @click.option("--fit-out", default=None, type=click.Path(dir_okay=False), help="Write the fit summary (JSON).")
 @click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Events (.csv or .parquet).")
@@ -49,6 +56,7 @@ def detect_laser_command(
     apriori_path: str,
     without: tuple[str, ...],
     max_maneuvers: int,
+    arc_days: float,
     spacecraft: str | None,
     fit_out: str | None,
     out: str,
@@ -77,6 +85,7 @@ def detect_laser_command(
         range_model=model,
         spacecraft=spacecraft,
         max_maneuvers=max_maneuvers,
+        arc_days=arc_days,
     )
     for line in run.summary_lines():
         click.echo(line, err=True)

@@ -52,7 +52,16 @@ _gate = click.option(
 @click.option(
     "--report", "report_path", default=None, callback=check_suffix(".json"), help="Report (default: OUT.json)."
 )
-@click.option("--bootstrap", type=int, default=200, show_default=True, help="Bootstrap replicates for 1-sigma.")
+@click.option(
+    "--uncertainty",
+    type=click.Choice(["jackknife", "bootstrap"]),
+    default="jackknife",
+    show_default=True,
+    help="1-sigma from a delete-a-block jackknife (checked by Monte Carlo) or the wild block bootstrap.",
+)
+@click.option(
+    "--bootstrap", type=int, default=200, show_default=True, help="Bootstrap replicates (0: no 1-sigma at all)."
+)
 def estimate_inertia_cmd(
     telemetry: tuple[str, ...],
     store: str | None,
@@ -61,6 +70,7 @@ def estimate_inertia_cmd(
     tachometer_gate_s: float,
     out_toml: str,
     report_path: str | None,
+    uncertainty: str,
     bootstrap: int,
 ) -> None:
     """Estimate the inertia tensor from the momentum balance of routine telemetry (slews, orbit rate).
@@ -85,6 +95,7 @@ def estimate_inertia_cmd(
         spacecraft_file,
         _options(orbit_period_s, tachometer_gate_s),
         bootstrap=bootstrap,
+        uncertainty=uncertainty,
     )
     click.echo(est.summary())
     Path(out_toml).parent.mkdir(parents=True, exist_ok=True)

@@ -73,6 +73,13 @@ def _filter_options(f: Any) -> Any:
             help="Degree and order of the EGM2008 field with --dynamics field.",
         ),
         click.option("--satellite", default=None, help="Satellite id in the file (SP3 id, OEM OBJECT_ID, CSV)."),
+        click.option(
+            "--allow-truncated",
+            is_flag=True,
+            default=False,
+            help="Read an SP3/CPF file that ends before the epochs its header announces (the missing epochs are "
+            "counted and reported); without it such a file is an error.",
+        ),
     ]
     for opt in reversed(options):
         f = opt(f)
@@ -218,6 +225,7 @@ def detect_orbit_command(
     dynamics: str | None,
     gravity_degree: int,
     satellite: str | None,
+    allow_truncated: bool,
     detector_name: str | None,
     statistic: str | None,
     false_alarms: str | None,
@@ -261,6 +269,7 @@ def detect_orbit_command(
             budget=budget,
             satellite=satellite,
             null=null_file,
+            allow_truncated=allow_truncated,
             tuning=tuning,
             tau_s=tau_s,
             q_m2_s5=q_m2_s5,
@@ -324,6 +333,12 @@ def detect_orbit_command(
 )
 @click.option("--satellite", default=None, help="Satellite id in the file.")
 @click.option(
+    "--allow-truncated",
+    is_flag=True,
+    default=False,
+    help="Read an SP3/CPF file that ends before the epochs its header announces (missing epochs counted).",
+)
+@click.option(
     "--out",
     "out",
     required=True,
@@ -331,7 +346,7 @@ def detect_orbit_command(
     help="File to write, in the input's format (SP3, OEM KVN/XML); a name ending in .csv gives navigation CSV.",
 )
 def inject_orbit_command(
-    file: str, time_utc: str, dv_rtn: str, duration_s: float, satellite: str | None, out: str
+    file: str, time_utc: str, dv_rtn: str, duration_s: float, satellite: str | None, allow_truncated: bool, out: str
 ) -> None:
     """Add the effect of a ΔV (impulse or finite burn) at a chosen time to a real ephemeris."""
     from abrupt.pipelines.orbit import inject_orbit
@@ -339,12 +354,19 @@ def inject_orbit_command(
 
     try:
         out_eph = inject_orbit(
-            file, time_utc, _parse_vector(dv_rtn, "dv-rtn"), duration_s=duration_s, satellite=satellite
+            file,
+            time_utc,
+            _parse_vector(dv_rtn, "dv-rtn"),
+            duration_s=duration_s,
+            satellite=satellite,
+            allow_truncated=allow_truncated,
         )
     except ConfigError:
         raise  # already names its option (a ConfigError is a ValueError: do not wrap it twice)
     except ValueError as exc:
         raise ConfigError(str(exc), key="time") from None
+    for line in out_eph.repairs.summary():
+        click.echo(f"repaired: {line}", err=True)
     fmt = write_ephemeris(out_eph, out, like=file)
     click.echo(
         f"ΔV {dv_rtn} m/s (RTN) injected at {time_utc} into {len(out_eph)} epochs; written to {out} ({fmt})", err=True
@@ -368,6 +390,7 @@ def report_orbit_command(
     dynamics: str | None,
     gravity_degree: int,
     satellite: str | None,
+    allow_truncated: bool,
     events_file: str | None,
     false_alarms_per_week: float,
 ) -> None:
@@ -382,6 +405,7 @@ def report_orbit_command(
         detector="glr" if tuning == "auto" else "mcr_w",
         budget=FalseAlarmBudget(false_alarms_per_week, "week"),
         satellite=satellite,
+        allow_truncated=allow_truncated,
         tuning=tuning,
         tau_s=tau_s,
         q_m2_s5=q_m2_s5,

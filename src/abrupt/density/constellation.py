@@ -105,6 +105,21 @@ def platform_minimum_b(row: Mapping[Any, Any], flow: FlowConditions, alphas: Flo
     )
 
 
+def platform_b_range(row: Mapping[Any, Any], flow: FlowConditions, alphas: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """(B_min, B_max) of one platform for each accommodation α: extremes of B(θ) of the turning box.
+
+    Same platform model as :func:`platform_minimum_b`; without an area range B_min = B_max = C_D(0)A/m.
+    """
+    a_min, a_max, mass = float(row["min_area_m2"]), float(row["max_area_m2"]), float(row["mass_kg"])
+    if a_max <= a_min:
+        b = minimum_ballistic_coefficient(a_min, mass, flow, alphas)
+        return b, b.copy()
+    a_side = math.sqrt(a_max**2 - a_min**2)
+    theta = np.radians(np.linspace(0.0, 90.0, 361))
+    curves = [box_ballistic_coefficient(theta, (1.0, a_min, a_side), mass, flow, float(al)) for al in alphas]
+    return np.array([float(np.min(c)) for c in curves]), np.array([float(np.max(c)) for c in curves])
+
+
 @dataclass(frozen=True)
 class ConstellationConfig:
     """Settings of :func:`estimate_constellation_density`."""
@@ -210,6 +225,7 @@ def estimate_constellation_density(
         w["naive_density_kg_m3"] = np.nan
     ybar = dist.mean_ratio
     epoch_rows = []
+    y_min_cache: dict[int, float] = {}
     for t_k, g in w.groupby("window_start_utc"):
         vals = g["k_norm"].to_numpy()
         n_k = int(vals.size)
@@ -226,7 +242,9 @@ def estimate_constellation_density(
         s_mean = mean_k / (b_min * ybar)
         rel_stat = float(np.std(vals, ddof=1) * math.sqrt(np.sum(wts**2)) / mean_k)
         rel_mean = math.sqrt(rel_stat**2 + b_min_rel_sigma**2 + ybar_rel_sigma**2)
-        y_min = dist.expected_minimum_ratio(n_k)
+        if n_k not in y_min_cache:
+            y_min_cache[n_k] = dist.expected_minimum_ratio(n_k)
+        y_min = y_min_cache[n_k]
         s_min = float(np.min(vals)) / (b_min * y_min)
         rel_min = math.sqrt((dist.sigma_y / y_min) ** 2 + b_min_rel_sigma**2 + ybar_rel_sigma**2)
         epoch_rows.append((t_k, n_k, s_mean, s_mean * rel_mean, s_min, s_min * rel_min, mean_k))

@@ -11,8 +11,9 @@ import pandas as pd
 def plot_density_bands(windows: pd.DataFrame, out: str | Path, *, band_km: float = 50.0, title: str = "") -> None:
     """Time series per altitude band: estimate (mean, with 1σ band) and NRLMSIS along the same orbits.
 
-    Uses ``density_mean_kg_m3`` (constellation) when present, else ρB scaled by the median of
-    ρB/ρ_MSIS of each object ("ρB / B̂", single objects: the shape of the series, B unknown).
+    Uses ``density_joint_kg_m3`` (joint fit) or ``density_mean_kg_m3`` (order statistics) when
+    present, else ρB scaled by the median of ρB/ρ_MSIS of each object ("ρB / B̂", single objects:
+    the shape of the series, B unknown).
     """
     import matplotlib
 
@@ -20,7 +21,11 @@ def plot_density_bands(windows: pd.DataFrame, out: str | Path, *, band_km: float
     import matplotlib.pyplot as plt
 
     w = windows[windows["status"] == "ok"].copy()
-    if "density_mean_kg_m3" in w.columns and w["density_mean_kg_m3"].notna().any():
+    if "density_joint_kg_m3" in w.columns and w["density_joint_kg_m3"].notna().any():
+        w["est"] = w["density_joint_kg_m3"]
+        w["est_sigma"] = w["density_joint_sigma_kg_m3"]
+        label = "estimate (joint fit of density and every B)"
+    elif "density_mean_kg_m3" in w.columns and w["density_mean_kg_m3"].notna().any():
         w["est"] = w["density_mean_kg_m3"]
         w["est_sigma"] = w["density_mean_sigma_kg_m3"]
         label = "estimate (order statistics, mean)"

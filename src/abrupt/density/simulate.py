@@ -64,6 +64,29 @@ def storm_profile(t_days: FloatArray, start_day: float, length_days: float, ampl
     return np.asarray(1.0 + amplitude * up * down, dtype=np.float64)
 
 
+def _satrec(satnum: int, epoch_jd: float, inc_rad: float, u_rad: float, raan_rad: float, a_mean_m: float) -> Any:
+    """Near-circular SGP4 record (WGS-72, e = 1e-4) with mean motion from ``a_mean_m``."""
+    from sgp4.api import WGS72, Satrec
+
+    sat = Satrec()
+    sat.sgp4init(
+        WGS72,
+        "i",
+        satnum,
+        epoch_jd - 2433281.5,
+        1e-4,
+        0.0,
+        0.0,
+        0.001,
+        0.0,
+        inc_rad,
+        float(np.mod(u_rad, 2 * np.pi)),
+        math.sqrt(MU_EARTH_WGS72_M3_S2 / a_mean_m**3) * 60.0,
+        float(np.mod(raan_rad, 2 * np.pi)),
+    )
+    return sat
+
+
 def simulate_constellation(
     n_objects: int = 30,
     *,
@@ -79,7 +102,6 @@ def simulate_constellation(
     space_weather: Any = None,
 ) -> SyntheticConstellation:
     """Simulate the constellation (module docstring); deterministic for a given ``seed``."""
-    from sgp4.api import WGS72, Satrec
     from sgp4.exporter import export_tle
 
     from abrupt.model.atmosphere import msis_density, read_space_weather, teme_to_geodetic
@@ -154,23 +176,25 @@ def simulate_constellation(
         raan_ep = np.interp(ep, tau, raan0 - 1.5 * n * J2_WGS72 * (EARTH_RADIUS_WGS72_M / a) ** 2 * math.cos(inc) * tau)
         lines = [name]
         jd_epoch0 = (t0.astype("datetime64[ns]").astype(np.int64) * 1e-9) / 86400.0 + 2440587.5
+        epoch_jd = jd_epoch0 + ep / 86400.0
+
+        # SGP4's mean motion is a Kozai mean element and its radius carries J2 terms: the radius it
+        # gives averaged over one revolution differs from the mean semi-major axis by a few km
+        # (inclination-dependent), i.e. several per cent of density. The element set is the one
+        # whose SGP4 orbit-mean radius equals the simulated orbit's radius (one correction, at a
+        # few epochs, interpolated), as a fit of elements to the true orbit would give.
+        probe = np.unique(np.linspace(0, ep.size - 1, 4).astype(int))
+        offsets = []
+        for k in probe:
+            sat = _satrec(satnum, epoch_jd[k], inc, float(u_ep[k]), float(raan_ep[k]), float(a_ep[k]))
+            period_min = 2 * np.pi / sat.no_kozai
+            tm = np.linspace(0.0, period_min, 48, endpoint=False)
+            _e, r_km, _v = sat.sgp4_array(np.full(tm.size, sat.jdsatepoch), sat.jdsatepochF + tm / 1440.0)
+            offsets.append(float(np.mean(np.linalg.norm(r_km, axis=1))) * 1e3 - float(a_ep[k]))
+        radius_offset = np.interp(np.arange(ep.size), probe, offsets)
         for k in range(ep.size):
-            sat = Satrec()
-            n_rad_min = math.sqrt(mu / a_ep[k] ** 3) * 60.0
-            sat.sgp4init(
-                WGS72,
-                "i",
-                satnum,
-                jd_epoch0 + ep[k] / 86400.0 - 2433281.5,
-                1e-4,
-                0.0,
-                0.0,
-                0.001,
-                0.0,
-                inc,
-                float(np.mod(u_ep[k], 2 * np.pi)),
-                n_rad_min,
-                float(np.mod(raan_ep[k], 2 * np.pi)),
+            sat = _satrec(
+                satnum, epoch_jd[k], inc, float(u_ep[k]), float(raan_ep[k]), float(a_ep[k] - radius_offset[k])
             )
             sat.classification = "U"
             sat.intldesg = "18001A"

@@ -7,13 +7,23 @@ newest window n and every candidate change window τ ≤ n,
     S(τ, n) = (n_b n_a / (n_b + n_a)) (x̄_after − x̄_before)ᵀ Σ⁻¹ (x̄_after − x̄_before),
 
 with x the observable inertia parameters, n_b/n_a the windows before/after τ and Σ the covariance of one
-window's estimate. Σ is the data's own noise model: the shape of the estimator's bootstrap covariance,
+window's estimate (in the code, generalised least-squares means with each window's own size of the
+median covariance shape, so a poorly excited day weighs less: the daily 1σ varied threefold over a
+simulated year). Σ is the data's own noise model: the shape of the estimator's covariance,
 scaled by c ≥ 1 estimated from the differences of windows 1, 2 and 3 apart (robust median, so a step
 does not inflate it; the largest lag's spread is kept, so a slow drift of the estimates is not taken
 for a step). With an estimated scale, S/c follows d·F(d, ν) (Hotelling's T²), and the threshold is
 that quantile at the per-test level of the false-alarm budget (one test per window), Bonferroni-
 corrected over the candidate change times. A change must persist for ``min_windows_after`` windows
 (default 2), so one bad window cannot raise an alarm.
+
+Window-limited (Willsky & Jones 1976; Lai 1998, "Information bounds and quick detection of parameter
+changes in stochastic systems", §3): only changes in the last ``max_change_age`` windows are tested,
+against the mean of at most ``max_windows_before`` windows before τ. A GLR over the whole history
+turns a slow drift of the estimates (a systematic of a few 0.1% of the docking signal over months,
+seen in a simulated year) into an alarm, since its
+sensitivity grows without bound with the history; the window keeps it at that of ~30 days, still
+hundreds of σ for a 5 kg docking. The Bonferroni count is then fixed at the number of candidate τ.
 
 An alarm gives one ``mass_change`` event: the change time bracketed by the windows on either side of
 τ̂, ΔJ with its 1σ, and the implied mass for an assumed attachment radius r: a point mass m at distance
@@ -65,6 +75,8 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
         attachment_radius_m: float = 1.0,
         min_windows_before: int = 3,
         min_windows_after: int = 2,
+        max_windows_before: int = 30,
+        max_change_age: int = 10,
         attitude_events: pd.DataFrame | None = None,
         run_id: str = "",
         config_hash: str = "",
@@ -78,6 +90,10 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
         if min_windows_after < 1:
             raise ValueError("min_windows_after must be at least 1")
         self.min_windows_after = int(min_windows_after)
+        if max_windows_before < min_windows_before or max_change_age < min_windows_after:
+            raise ValueError("need max_windows_before >= min_windows_before and max_change_age >= min_windows_after")
+        self.max_windows_before = int(max_windows_before)
+        self.max_change_age = int(max_change_age)
         self._attitude_events = attitude_events
         self.run_id = run_id
         self.config_hash = config_hash
@@ -101,10 +117,9 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
             boot = _robust_cov(x)
         if not np.all(np.isfinite(boot)):
             return DetectionResult.empty(warnings=("fewer than 4 windows and no estimator covariance",))
-        inv_b = np.linalg.pinv(boot)
         window_s = float(np.median(series.t_end_s - series.t_start_s))
         tests_per_day = 86400.0 / window_s
-        n_candidates = max(1, k - self.min_windows_before - self.min_windows_after + 1)
+        n_candidates = max(1, min(k - self.min_windows_before, self.max_change_age) - self.min_windows_after + 1)
         p_test = budget.per_test(tests_per_day) / n_candidates
         # Scale factor c_n ≥ 1 of the covariance from consecutive differences of windows 0..n-1:
         # m_j = Δxᵀ (2 Σ_b)⁻¹ Δx / d is χ²_d / d under no change; the median ignores the one difference
@@ -113,17 +128,30 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
         # Lags 1..3: under white window noise every lag has the same spread; a slow drift of the
         # estimates (a systematic that varies over days) shows up as a spread growing with the lag,
         # and the largest is used, so slow drifts are not taken for a step.
+        # Each window's own covariance (the days differ: a day with poor slews has a larger error); where
+        # a window has none, the median shape. Weights W_i = Σ_i⁻¹ (generalised least-squares means).
+        # Per-window scale on the median shape: a jackknife from few blocks is rank-deficient, so each
+        # window's own matrix is used only through its size relative to the median (trace in the
+        # median's metric).
+        inv_b = np.linalg.pinv(boot, hermitian=True)
+        own = series.covariance[:, idx][:, :, idx]
+        good = np.all(np.isfinite(own.reshape(k, -1)), axis=1)
+        size = np.where(good, np.einsum("ij,tji->t", inv_b, np.where(good[:, None, None], own, 0.0)) / d, 1.0)
+        cov_w = np.clip(size, 0.1, 100.0)[:, None, None] * boot[None, :, :]
+        w_i = np.linalg.pinv(cov_w, hermitian=True)
         lag_m = []
         for lag in (1, 2, 3):
             dl = x[lag:] - x[:-lag]
-            lag_m.append(np.einsum("ti,ij,tj->t", dl, inv_b, dl) / (2.0 * d))
+            inv_pair = np.linalg.pinv(cov_w[lag:] + cov_w[:-lag], hermitian=True)
+            lag_m.append(np.einsum("ti,tij,tj->t", dl, inv_pair, dl) / d)
         med_chi = float(stats.chi2.median(d)) / d
         stat = np.full(k, np.nan)
         thr = np.full(k, np.nan)
         scale = np.full(k, np.nan)
         best_tau = np.full(k, -1)
         alarm_at = -1
-        cs = np.concatenate([np.zeros((1, d)), np.cumsum(x, axis=0)])
+        cw = np.concatenate([np.zeros((1, d, d)), np.cumsum(w_i, axis=0)])
+        cwx = np.concatenate([np.zeros((1, d)), np.cumsum(np.einsum("tij,tj->ti", w_i, x), axis=0)])
         first = self.min_windows_before + self.min_windows_after
         for n in range(first, k + 1):  # windows 0..n-1 available
             c_n = 1.0
@@ -132,10 +160,15 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
                     c_n = max(c_n, float(np.median(ml[: n - lag])) / med_chi)
             nu = max(1.0, (n - 1) * d * 2.0 / math.pi)
             h_n = d * float(stats.f.isf(p_test, d, nu))
-            taus = np.arange(self.min_windows_before, n - self.min_windows_after + 1)
-            nb, na = taus.astype(np.float64), (n - taus).astype(np.float64)
-            diff = (cs[n] - cs[taus]) / na[:, None] - cs[taus] / nb[:, None]
-            s_all = nb * na / (nb + na) * np.einsum("ti,ij,tj->t", diff, inv_b, diff) / c_n
+            taus = np.arange(max(self.min_windows_before, n - self.max_change_age), n - self.min_windows_after + 1)
+            lo = np.maximum(taus - self.max_windows_before, 0)
+            # GLS means before/after τ, Δ and its covariance (Σ W_b)⁻¹ + (Σ W_a)⁻¹.
+            inf_b, inf_a = cw[taus] - cw[lo], cw[n] - cw[taus]
+            cov_b, cov_a = np.linalg.pinv(inf_b, hermitian=True), np.linalg.pinv(inf_a, hermitian=True)
+            mean_b = np.einsum("tij,tj->ti", cov_b, cwx[taus] - cwx[lo])
+            mean_a = np.einsum("tij,tj->ti", cov_a, cwx[n] - cwx[taus])
+            diff = mean_a - mean_b
+            s_all = np.einsum("ti,tij,tj->t", diff, np.linalg.pinv(cov_b + cov_a, hermitian=True), diff) / c_n
             j = int(np.argmax(s_all))
             stat[n - 1], best_tau[n - 1], thr[n - 1], scale[n - 1] = float(s_all[j]), int(taus[j]), h_n, c_n
             if s_all[j] > h_n and alarm_at < 0:
@@ -162,11 +195,14 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
         # Characterise with every window after the change (not only up to the alarm).
         tau = int(best_tau[alarm_at])
         full_stats = []
-        for cand in range(self.min_windows_before, k):
-            diff = x[cand:].mean(axis=0) - x[:cand].mean(axis=0)
-            full_stats.append(cand * (k - cand) / k * float(diff @ inv @ diff))
-        tau = self.min_windows_before + int(np.argmax(full_stats)) if full_stats else tau
-        before, after = series.params[:tau], series.params[tau:]
+        first_cand = max(self.min_windows_before, alarm_at + 1 - self.max_change_age)
+        for cand in range(first_cand, k):
+            lo_c = max(0, cand - self.max_windows_before)
+            diff = x[cand:].mean(axis=0) - x[lo_c:cand].mean(axis=0)
+            n_b = cand - lo_c
+            full_stats.append(n_b * (k - cand) / (n_b + k - cand) * float(diff @ inv @ diff))
+        tau = first_cand + int(np.argmax(full_stats)) if full_stats else tau
+        before, after = series.params[max(0, tau - self.max_windows_before) : tau], series.params[tau:]
         dj = after.mean(axis=0) - before.mean(axis=0)
         dj_cov_obs = sigma * (1.0 / before.shape[0] + 1.0 / after.shape[0])
         dj_sig = np.full(6, np.nan)

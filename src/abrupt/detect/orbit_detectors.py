@@ -47,6 +47,7 @@ from abrupt.thresholds import FalseAlarmBudget, Threshold
 
 TUNINGS = ("auto", "thesis")
 DYNAMICS = {"two-body": 0, "j2": 2, "j3": 3, "j4": 4, "field": -1}
+SETTLE_CAP_S = 6 * 3600.0  # [s] longest settling time excluded at each end of an arc
 DEFAULT_GRAVITY_DEGREE = 40  # chosen from benchmarks/bench_orbit_forces.py (post-fit residuals, S3A and Jason-1)
 
 
@@ -111,7 +112,9 @@ class OrbitDetector(Detector[Ephemeris]):
         degree = self.gravity_degree if dyn == "field" else 0
         if self.tuning == "auto":
             fc, s_pos, s_vel = auto_tune(eph, zonal_degree=zonal, gravity_degree=degree, third_body=degree > 0)
-            settle = max(20.0 * fc.tau_s, 30.0 * eph.nominal_step_s)
+            # the filters converge within ~20 τ; capped at 6 h so that sparse arcs (CPF predictions at
+            # 5-15 min, τ = 10 steps) keep most of their epochs (unchanged for 60 s data: 20 τ = 3.3 h)
+            settle = max(min(20.0 * fc.tau_s, SETTLE_CAP_S), 30.0 * eph.nominal_step_s)
         else:
             fc = FilterConfig(zonal_degree=zonal, gravity_degree=degree, third_body=degree > 0)
             s_pos, s_vel, settle = 10.0, 0.25, 1800.0

@@ -112,12 +112,17 @@ class FilterConfig:
 
 @dataclass
 class FilterRun:
-    """Output of one filter pass: states (n, 9), covariances (n, 9, 9), innovations (n, 6), NIS (n)."""
+    """Output of one filter pass: states (n, 9), covariances (n, 9, 9), innovations (n, 6), NIS (n); from a
+    forward pass with ``store_gains`` also the STMs (n, 9, 9), gains (n, 9, 6) and inverse innovation
+    covariances (n, 6, 6) of every step (empty otherwise)."""
 
     x: FloatArray
     p: FloatArray
     innovation: FloatArray = field(default_factory=lambda: np.zeros((0, 6)))
     nis: FloatArray = field(default_factory=lambda: np.zeros(0))
+    phis: FloatArray = field(default_factory=lambda: np.zeros((0, 9, 9)))
+    gains: FloatArray = field(default_factory=lambda: np.zeros((0, 9, 6)))
+    sinvs: FloatArray = field(default_factory=lambda: np.zeros((0, 6, 6)))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -375,13 +380,20 @@ def forward_kernel(
     q_rtn: FloatArray,
     max_step: float,
     args: tuple,
-) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-    """Forward EKF-DMC: a-posteriori states/covariances at every epoch (Bennett 2022 §3.2.1-3.2.5)."""
+    store: bool = False,
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Forward EKF-DMC: a-posteriori states/covariances at every epoch (Bennett 2022 §3.2.1-3.2.5), the
+    innovations and NIS; with ``store`` also, per step k ≥ 1, the STM Φ_k, the gain K_k and the inverse
+    innovation covariance S_k⁻¹ (what the GLR needs, :mod:`abrupt.detect.orbit_glr`; empty otherwise)."""
     n = t.size
     xs = np.empty((n, 9))
     ps = np.empty((n, 9, 9))
     innovs = np.full((n, 6), np.nan)
     nis = np.full(n, np.nan)
+    m = n if store else 0
+    phis = np.zeros((m, 9, 9))
+    gains = np.zeros((m, 9, 6))
+    sinvs = np.zeros((m, 6, 6))
     x = x0.copy()
     p = p0.copy()
     phi = np.empty((9, 9))
@@ -395,11 +407,26 @@ def forward_kernel(
             x = propagate_state(x, t[i - 1], dt, tau, args, max_step, phi)
             _time_update_cov(p, phi, s, 1.0, pbar)
             p[:, :] = pbar
+            if store:
+                phis[i] = phi
+                smat = np.empty((6, 6))
+                for a in range(6):
+                    for b in range(6):
+                        smat[a, b] = p[a, b]
+                    smat[a, a] += rdiag[i, a]
+                sinv = np.linalg.inv(smat)
+                sinvs[i] = sinv
+                for a in range(9):
+                    for b in range(6):
+                        acc = 0.0
+                        for c in range(6):
+                            acc += p[a, c] * sinv[c, b]
+                        gains[i, a, b] = acc
         nis[i] = measurement_update(x, p, y[i], rdiag[i], innov)
         innovs[i] = innov
         xs[i] = x
         ps[i] = p
-    return xs, ps, innovs, nis
+    return xs, ps, innovs, nis, phis, gains, sinvs
 
 
 @nb.njit(cache=True)
@@ -484,11 +511,12 @@ def run_forward(
     *,
     context: ForceContext | None = None,
     epoch_utc: np.datetime64 | None = None,
+    store_gains: bool = False,
 ) -> FilterRun:
     """Forward EKF-DMC over the measurements (inertial frame). Seeds with the first measurement.
 
     ``t_s`` are seconds from ``epoch_utc`` (needed when the forces depend on time) or from the epoch of
-    ``context``."""
+    ``context``. ``store_gains`` keeps every step's STM, gain and S⁻¹ (for the GLR statistic)."""
     t = np.ascontiguousarray(t_s, dtype=np.float64)
     ctx = resolve_context(config, t, context, epoch_utc)
     y = measurement_vectors(position_m, velocity_mps)
@@ -501,10 +529,10 @@ def run_forward(
     else:
         rdiag0 = sigma_vel_m_s**2
     p0 = np.diag(np.r_[np.full(3, sigma_pos_m**2), np.full(3, rdiag0), np.full(3, config.w0_sigma() ** 2)])
-    xs, ps, innov, nis = forward_kernel(
-        t, y, rdiag, x0, p0, config.tau_s, config.q_array(), config.max_step_s, ctx.kernel_args
+    xs, ps, innov, nis, phis, gains, sinvs = forward_kernel(
+        t, y, rdiag, x0, p0, config.tau_s, config.q_array(), config.max_step_s, ctx.kernel_args, store_gains
     )
-    return FilterRun(xs, ps, innov, nis)
+    return FilterRun(xs, ps, innov, nis, phis, gains, sinvs)
 
 
 def run_backward(

@@ -23,6 +23,7 @@ import numpy as np
 
 from abrupt.detect.orbit_ekf import (
     FilterConfig,
+    FilterRun,
     forward_kernel_detailed,
     measurement_variances,
     measurement_vectors,
@@ -196,6 +197,20 @@ def glr_sliding_kernel(
             mm = mm - gains[k] @ g
         ell[theta] = d @ np.linalg.solve(cc, d)
     return ell
+
+
+def glr_statistic_from_run(t_s: FloatArray, forward: FilterRun, horizon_s: float) -> FloatArray:
+    """The sliding GLR of :func:`glr_statistic` from a forward pass that stored its gains
+    (``run_forward(..., store_gains=True)``): the same numbers without a second filter pass."""
+    if forward.phis.shape[0] != t_s.size:
+        raise ValueError("the forward run did not store its gains (run_forward(..., store_gains=True))")
+    innovs = np.where(np.isfinite(forward.innovation), forward.innovation, 0.0)
+    innovs[0] = 0.0
+    dt_nom = float(np.median(np.diff(t_s)))
+    horizon = max(2, round(horizon_s / dt_nom))
+    step = np.r_[dt_nom, np.diff(t_s)]
+    lead = np.ascontiguousarray(0.5 * step) if dt_nom > 2.0 else np.zeros(t_s.size)
+    return glr_sliding_kernel(forward.phis, forward.gains, forward.sinvs, np.ascontiguousarray(innovs), horizon, lead)
 
 
 def glr_statistic(

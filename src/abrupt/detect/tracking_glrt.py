@@ -46,6 +46,7 @@ class BatchFitConfig:
     max_iterations: int = 25
     tolerance: float = 1e-4  # relative change of the weighted residual sum of squares
     max_step_s: float = 10.0
+    integrator: str = "rk4"  # "rk8" for long arcs (model.orbit.propagate_with_stm)
     outlier_sigma: float | None = 6.0  # Orekit-style rejection from the 3rd iteration on
     elevation_mask_deg: float | None = None
 
@@ -75,6 +76,21 @@ class BatchFit:
     stm_x0: NDArray[np.float64]  # (n_meas, 6, 6): d state(t_k) / d x0
     states: NDArray[np.float64]
     config: BatchFitConfig
+
+    def propagate(self, t_out_s: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """States and parameter sensitivities of the fitted trajectory (impulses included) at sorted
+        ``t_out_s`` ≥ ``t0_s`` (:func:`trajectory`)."""
+        return trajectory(
+            self.x0,
+            self.t0_s,
+            np.asarray(t_out_s, dtype=float),
+            force=self.config.force,
+            accel_mps2=self.acceleration_mps2,
+            impulse_times_s=self.impulse_times_s,
+            impulse_dv_rsw=self.impulse_dv_rsw_mps,
+            max_step_s=self.config.max_step_s,
+            integrator=self.config.integrator,
+        )
 
     @property
     def rms_white(self) -> float:
@@ -112,6 +128,7 @@ def trajectory(
     impulse_times_s: Sequence[float] = (),
     impulse_dv_rsw: NDArray[np.float64] | None = None,
     max_step_s: float = 10.0,
+    integrator: str = "rk4",
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """States (n,6) and D = ∂state/∂(x0, accel, Δv₁..Δv_m) (n,6,9+3m) at sorted ``t_out_s`` ≥ t0.
 
@@ -138,7 +155,13 @@ def trajectory(
         t_eval = np.concatenate([times, extra]) if extra else times
         if t_eval.size:
             st, phi, sens = propagate_with_stm(
-                x_start, t_start, t_eval, force=force, accel_mps2=accel_mps2, max_step_s=max_step_s
+                x_start,
+                t_start,
+                t_eval,
+                force=force,
+                accel_mps2=accel_mps2,
+                max_step_s=max_step_s,
+                method=integrator,
             )
             d_all = np.einsum("nij,jk->nik", phi, d_start)
             d_all[:, :, 6:9] += sens
@@ -223,11 +246,18 @@ def fit_orbit(
             impulse_times_s=impulse_times_s,
             impulse_dv_rsw=dv,
             max_step_s=cfg.max_step_s,
+            integrator=cfg.integrator,
         )
         resid, jac = _residuals(data, states, dmat, bias, bias_keys, cfg.estimate_acceleration, n_imp, row_i, row_c)
-        if cfg.outlier_sigma is not None and 3 <= it <= 5:  # re-select outliers, then freeze the set
-            used = np.abs(resid) <= cfg.outlier_sigma
         cost = float(np.sum(resid[used] ** 2))
+        near = it >= 2 and abs(prev_cost - cost) <= 0.1 * max(cost, 1.0)
+        if cfg.outlier_sigma is not None and 3 <= it <= 5 and near:  # re-select outliers, then freeze the set
+            # only once the fit has settled (cost changing by < 10%), and never most of the data: far from
+            # the solution every residual exceeds the limit and the fit would "converge" on no data
+            keep = np.abs(resid) <= cfg.outlier_sigma
+            if keep.sum() >= 0.8 * resid.size:
+                used = keep
+            cost = float(np.sum(resid[used] ** 2))
         a = jac[used]
         normal = a.T @ a
         try:
@@ -346,16 +376,7 @@ class GlrtScan:
 def glrt_scan(data: TrackingArrays, fit: BatchFit, t_candidates_s: NDArray[np.float64]) -> GlrtScan:
     """Linearised GLRT for one impulse at each candidate epoch, on the residuals of ``fit`` (module doc)."""
     cand = np.asarray(t_candidates_s, dtype=float)
-    states_c, d_c = trajectory(
-        fit.x0,
-        fit.t0_s,
-        cand,
-        force=fit.config.force,
-        accel_mps2=fit.acceleration_mps2,
-        impulse_times_s=fit.impulse_times_s,
-        impulse_dv_rsw=fit.impulse_dv_rsw_mps,
-        max_step_s=fit.config.max_step_s,
-    )
+    states_c, d_c = fit.propagate(cand)
     used = fit.used
     r = fit.residuals_white[used]
     j0 = fit.jacobian_white[used]
@@ -364,28 +385,50 @@ def glrt_scan(data: TrackingArrays, fit: BatchFit, t_candidates_s: NDArray[np.fl
     # whitened ∂y/∂x0 per row: J0[:, :6] (with impulses in the fit this is W H Φ(t_k, t0) through them)
     jx = j0[:, :6]
     t_rows = data.t_s[fit.row_index[used]]
+    # An impulse at τ enters row i (t_i > τ) as J_v,i = jx_i M(τ), M = Φ(τ)⁻¹ [0; C_RSW]. With
+    # J_v⊥ = (I − Q Qᵀ) J_v the statistic needs only sums over the rows after τ:
+    #   g = J_vᵀ r⊥ = Mᵀ Σ jx_iᵀ r⊥_i,   J_v⊥ᵀ J_v⊥ = Mᵀ (Σ jx_iᵀ jx_i − Pᵀ P) M,  P = Σ q_iᵀ jx_i,
+    # so suffix sums over time-sorted rows make the scan O(rows + candidates) instead of their product.
+    order = np.argsort(t_rows, kind="stable")
+    t_sorted = t_rows[order]
+    jx_s, q_s, r_s = jx[order], q0[order], r_perp[order]
+
+    def suffix(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        out = np.zeros((x.shape[0] + 1, *x.shape[1:]))
+        out[:-1] = np.cumsum(x[::-1], axis=0)[::-1]
+        return out
+
+    s_g = suffix(jx_s * r_s[:, None])  # (n+1, 6)
+    s_jj = suffix(jx_s[:, :, None] * jx_s[:, None, :])  # (n+1, 6, 6)
+    s_qj = suffix(q_s[:, :, None] * jx_s[:, None, :])  # (n+1, p, 6)
+    first_after = np.searchsorted(t_sorted, cand, side="right")
+    n_after = t_sorted.size - first_after
+    phi_c = d_c[:, :, :6]
+    finite = np.all(np.isfinite(phi_c), axis=(1, 2)) & np.all(np.isfinite(states_c), axis=1)
+    ok = (n_after >= 6) & (first_after >= 6) & finite
+    ok[ok] &= np.abs(np.linalg.det(phi_c[ok])) > 0
     stat = np.full(cand.size, np.nan)
     dvs = np.full((cand.size, 3), np.nan)
     covs = np.full((cand.size, 3, 3), np.nan)
-    for k, tau in enumerate(cand):
-        after = t_rows > tau
-        if after.sum() < 6 or (~after).sum() < 6:
-            continue
-        phi_tau = d_c[k, :, :6]
-        m = np.linalg.solve(phi_tau, np.vstack([np.zeros((3, 3)), rsw_basis(states_c[k])]))
-        jv = np.zeros((r.size, 3))
-        jv[after] = jx[after] @ m
-        jv_perp = jv - q0 @ (q0.T @ jv)
-        info = jv_perp.T @ jv_perp
-        try:
-            cov = np.linalg.inv(info)
-        except np.linalg.LinAlgError:
-            continue
-        g = jv_perp.T @ r_perp
-        dv = cov @ g
-        stat[k] = float(g @ dv)
-        dvs[k] = dv
-        covs[k] = cov
+    if not ok.any():
+        return GlrtScan(cand, stat, dvs, covs)
+    k_ok = np.flatnonzero(ok)
+    rhs = np.zeros((k_ok.size, 6, 3))
+    rhs[:, 3:, :] = np.stack([rsw_basis(states_c[k]) for k in k_ok])
+    m = np.linalg.solve(phi_c[k_ok], rhs)  # (K, 6, 3)
+    idx = first_after[k_ok]
+    p_k = s_qj[idx]  # (K, p, 6)
+    a6 = s_jj[idx] - np.einsum("kpi,kpj->kij", p_k, p_k)
+    info = np.einsum("kia,kij,kjb->kab", m, a6, m)
+    g = np.einsum("kia,ki->ka", m, s_g[idx])
+    det = np.linalg.det(info)
+    good = np.isfinite(det) & (np.abs(det) > 0)
+    cov = np.full_like(info, np.nan)
+    cov[good] = np.linalg.inv(info[good])
+    dv = np.einsum("kab,kb->ka", cov, g)
+    stat[k_ok[good]] = np.einsum("ka,ka->k", g[good], dv[good])
+    dvs[k_ok[good]] = dv[good]
+    covs[k_ok[good]] = cov[good]
     return GlrtScan(cand, stat, dvs, covs)
 
 
@@ -521,12 +564,33 @@ def detect_maneuvers_glrt(
                 if t_first < tau < t_last:
                     refit(float(tau))
             best_tau = min(tried, key=lambda t: tried[t].chi2)
+        # Parabolic refinement of the epoch: χ²(τ) is smooth near its minimum, and with precise ranging a
+        # few seconds of epoch error leave Δv·δτ (centimetres for 1 cm/s) that a second "impulse" would
+        # otherwise absorb. The curvature c gives the epoch's 1σ, 1/√c (Δχ² = 1).
+        curvature = math.nan
+        for _ in range(6):
+            lo_t, hi_t = best_tau - width, best_tau + width
+            if not (t_first < lo_t and hi_t < t_last):
+                break
+            c_lo, c_0, c_hi = refit(float(lo_t)).chi2, tried[best_tau].chi2, refit(float(hi_t)).chi2
+            curvature = (c_lo - 2.0 * c_0 + c_hi) / (2.0 * width**2)
+            if not curvature > 0:
+                break
+            shift = -(c_hi - c_lo) / (4.0 * curvature * width)
+            shift = float(np.clip(shift, -width, width))
+            if abs(shift) < 1e-3:
+                break
+            refit(float(best_tau + shift))
+            best_tau = min(tried, key=lambda t: tried[t].chi2)
+            width = max(min(width, 4.0 * abs(shift)), 1e-2)
         best = tried[best_tau]
         lr = chi2_null - best.chi2
         if lr <= threshold:
             break
         ok = [t for t, f in tried.items() if f.chi2 <= best.chi2 + 1.0]
         time_sigma = max(0.5 * (max(ok) - min(ok)), width / math.sqrt(3.0))
+        if curvature > 0:
+            time_sigma = max(1.0 / math.sqrt(curvature), 1e-3)
         # A cross-track impulse only fixes the new plane (node line and tilt r·Δv/h): epochs half an orbit
         # apart fit almost equally, with Δv scaled by r(τ). Report such alternatives (chi² within 9).
         alt: list[tuple[float, NDArray[np.float64]]] = []

@@ -290,8 +290,16 @@ def momentum_exchange_estimate(
     ``maneuver``, so only the fast momentum exchange at each step informs I33. Least squares
     Δψ = a Δθ_w + Σ_k (c_k + h_k t) Δt, I33 = −I_rw (1 + a) / a.
     """
-    dt = np.diff(t_s)
     dpsi = np.diff(yaw_meas_rad)
+    x = _momentum_design(t_s, wheel_speed_rad_s, maneuver)
+    coef, *_ = np.linalg.lstsq(x, dpsi, rcond=None)
+    a = coef[0]
+    return float(-i_rw_kgm2 * (1.0 + a) / a)
+
+
+def _momentum_design(t_s: FloatArray, wheel_speed_rad_s: FloatArray, maneuver: Maneuver | None) -> FloatArray:
+    """Columns of :func:`momentum_exchange_estimate`: Δθ_w, then (Δt, (t − t_k) Δt) per step period."""
+    dt = np.diff(t_s)
     dtheta = 0.5 * (wheel_speed_rad_s[1:] + wheel_speed_rad_s[:-1]) * dt
     tm = 0.5 * (t_s[1:] + t_s[:-1])
     if maneuver is None:
@@ -302,10 +310,31 @@ def momentum_exchange_estimate(
     for lo, hi in itertools.pairwise(edges):
         inside = ((tm >= lo) & (tm < hi)).astype(np.float64)
         cols += [inside * dt, inside * (tm - lo) * dt]
-    x = np.column_stack(cols)
-    coef, *_ = np.linalg.lstsq(x, dpsi, rcond=None)
-    a = coef[0]
-    return float(-i_rw_kgm2 * (1.0 + a) / a)
+    return np.column_stack(cols)
+
+
+def momentum_exchange_crb(
+    t_s: FloatArray,
+    wheel_speed_rad_s: FloatArray,
+    maneuver: Maneuver | None,
+    i33_kgm2: float,
+    rate_noise_rad_s: float,
+    i_rw_kgm2: float = I_RW,
+) -> float:
+    """Cramér-Rao 1σ of I33 [kg m²] from one run when white rate-gyro noise is the only error.
+
+    In the differenced balance Δψ_k = a Δθ_w,k + nuisance + ε_k with ε_k white of SD σ = σ_rate Δt
+    (the gyro sample's noise over one step), var(â) = σ² / Σ x⊥² with x⊥ the wheel increments after
+    the nuisance columns are projected out (Gauss-Markov: least squares attains the bound), and
+    I33 = −I_rw (1 + a)/a gives σ_I33 = I_rw σ_a / a². Any unbiased estimator from the same
+    recorded yaw, the same wheel speeds and the same nuisance model has at least this error.
+    """
+    x = _momentum_design(t_s, wheel_speed_rad_s, maneuver)
+    nuis = x[:, 1:]
+    xp = x[:, 0] - nuis @ np.linalg.lstsq(nuis, x[:, 0], rcond=None)[0]
+    sigma = rate_noise_rad_s * float(np.median(np.diff(t_s)))
+    a = -i_rw_kgm2 / (i33_kgm2 + i_rw_kgm2)
+    return float(i_rw_kgm2 / a**2 * sigma / math.sqrt(float(np.sum(xp**2))))
 
 
 # ------------------------------------------------------------------------------------------ mass inference

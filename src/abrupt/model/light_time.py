@@ -72,4 +72,6 @@ def two_way_range_m(
         if shapiro:
             up = up + shapiro_delay_m(r_sat_b, r_sta_t)
         t_t = t_b - up / SPEED_OF_LIGHT_MPS
-    return np.asarray(0.5 * SPEED_OF_LIGHT_MPS * (t_r - t_t)), t_b
+    # Half the round trip from the two legs, not 0.5·c·(t_r − t_t): absolute times days after the epoch
+    # carry ~1e-10 s of rounding each, i.e. centimetres of range after a week (found on 7-day LAGEOS arcs).
+    return np.asarray(0.5 * (down + up)), t_b

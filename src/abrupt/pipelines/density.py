@@ -21,6 +21,7 @@ from abrupt.density.constellation import (
     estimate_constellation_density,
     read_platforms,
 )
+from abrupt.density.joint import JointConfig, JointDensity, joint_constellation_density
 from abrupt.density.tle_drag import RhoBResult, TleDragConfig, rho_b_from_history
 from abrupt.errors import RepairLog
 
@@ -33,6 +34,7 @@ class TleDensityResult:
     constellation: ConstellationResult | None
     repairs: dict[str, RepairLog] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
+    joint: JointDensity | None = None
 
 
 def _one_object(args: tuple[str, TleDragConfig, str, str | None, int]) -> tuple[RhoBResult, RhoBResult | None]:
@@ -50,7 +52,10 @@ def _one_object(args: tuple[str, TleDragConfig, str, str | None, int]) -> tuple[
             replace(cfg, interval_days=cfg.interval_days * dist_factor),
             maneuvers=res.maneuver_epochs_utc,
             space_weather=sw,
+            integrals=res.integrals,
         )
+        longer.integrals = None
+    res.integrals = None  # not needed by the caller: keep what crosses processes small
     return res, longer
 
 
@@ -64,11 +69,16 @@ def tle_density(
     space_weather: str | Path | None = None,
     distribution_interval_factor: int = 10,
     workers: int = 1,
+    joint: JointConfig | None = None,
+    order_statistics: bool = True,
 ) -> TleDensityResult:
     """ρB windows of every file and, for two or more objects, the constellation density.
 
     ``distribution_interval_factor``: the B distribution is fitted on windows this many times longer
-    (less estimation noise in the ratios); 1 uses the same windows.
+    (less estimation noise in the ratios); 1 uses the same windows. With two or more objects the
+    joint fit of :mod:`abrupt.density.joint` adds ``density_joint_kg_m3`` (the recommended estimate).
+    ``order_statistics=False`` skips the slides' per-epoch estimates (their ratio inversion with its
+    bootstrap costs about a minute whatever the span).
     """
     cfg = config or TleDragConfig(with_model=True)
     sw_path = str(space_weather) if space_weather is not None else None
@@ -96,16 +106,37 @@ def tle_density(
             warnings.append("no --platforms file: densities are relative (B_min unknown)")
         long_frames = [r[1].windows for r in results if r[1] is not None and len(r[1].windows)]
         dist = pd.concat(long_frames, ignore_index=True) if long_frames else None
+        from abrupt.density.constellation import flow_from_windows
         from abrupt.model.atmosphere import read_space_weather
 
-        result = estimate_constellation_density(
-            windows,
-            plat,
-            distribution_windows=dist,
-            config=constellation,
-            space_weather=read_space_weather(sw_path),
-        )
-        warnings.extend(result.warnings)
+        sw = read_space_weather(sw_path)
+        ok_windows = windows[windows["status"] == "ok"]
+        flow = flow_from_windows(ok_windows, sw) if len(ok_windows) else None
+        try:
+            if not order_statistics:
+                raise ValueError("not requested")
+            result = estimate_constellation_density(
+                windows,
+                plat,
+                distribution_windows=dist,
+                flow=flow,
+                config=constellation,
+                space_weather=sw,
+            )
+            warnings.extend(result.warnings)
+            ok_windows = result.windows
+        except ValueError as exc:  # e.g. too few epochs for the ratio inversion of the slides
+            warnings.append(f"order-statistics estimate skipped: {exc}")
+            ok_windows = ok_windows.reset_index(drop=True)
+        tracks = [r[0].track for r in results if r[0].track is not None]
+        if len(tracks) >= 3:
+            # Each platform's flat-plate C_D at its own altitude (temperature, molar mass, speed).
+            flows = {str(o): flow_from_windows(g, sw) for o, g in ok_windows.groupby("object") if len(g)}
+            joint_result = joint_constellation_density(
+                tracks, ok_windows, plat, cfg.origin_utc, flow=flows or flow, config=joint
+            )
+            warnings.extend(joint_result.warnings)
+            return TleDensityResult(joint_result.windows, result, repairs, warnings, joint_result)
     return TleDensityResult(windows if result is None else result.windows, result, repairs, warnings)
 
 

@@ -17,7 +17,8 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import math
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -34,7 +35,7 @@ from abrupt.detect.tracking_glrt import (
     trajectory,
 )
 from abrupt.errors import RepairLog
-from abrupt.model.orbit import ForceContext, ForceModel
+from abrupt.model.orbit import ForceContext, ForceModel, propagate
 from abrupt.model.range_reduction import RangeModel, StationSite, reduce_ranges
 from abrupt.model.stations import Station
 from abrupt.model.tracking_measurements import TrackingArrays, as_datetime64_ns
@@ -42,6 +43,9 @@ from abrupt.readers.sinex import SinexStation
 from abrupt.simulate.slr import trajectory_interpolator
 from abrupt.thresholds import FalseAlarmBudget
 from abrupt.types import FloatArray
+
+LASER_FIT_CONFIG = BatchFitConfig(estimate_range_bias=True, integrator="rk8", max_step_s=60.0)
+"""Default fit: range biases estimated; eighth-order integration at 60 s (millimetres over a month)."""
 
 
 @dataclass
@@ -84,6 +88,7 @@ def _positions(
         impulse_times_s=imp_t,
         impulse_dv_rsw=imp_dv,
         max_step_s=force_cfg.max_step_s,
+        integrator=force_cfg.integrator,
     )
     # two nodes before the epoch for light times that reach back (linear extrapolation is ample)
     for k in np.flatnonzero(~fwd)[::-1]:
@@ -107,7 +112,7 @@ def detect_laser_ranging(
     """Run the pipeline of the module docstring; ``x0_apriori`` is the GCRF state at ``epoch_utc``."""
     budget = budget or FalseAlarmBudget(0.1, "day")
     model = range_model or RangeModel()
-    fcfg = fit_config or BatchFitConfig(estimate_range_bias=True)
+    fcfg = fit_config or LASER_FIT_CONFIG
     epoch = as_datetime64_ns(epoch_utc)
     # The Sun and Moon of the force model are anchored at the data's own epoch (t = 0 of the fit).
     repairs = RepairLog("laser ranging")
@@ -116,9 +121,11 @@ def detect_laser_ranging(
     fcfg = replace(fcfg, force=ForceContext.build(model_f, epoch, -86400.0, t_end + 86400.0))
     gcfg = GlrtConfig(false_alarms_per_day=budget.per_day, max_maneuvers=max_maneuvers)
 
-    def build(source: BatchFit | FloatArray, scale: dict[str, float]) -> TrackingArrays:
+    t_rel = (np.asarray(measurements["time_utc"], dtype="datetime64[ns]") - epoch) / np.timedelta64(1, "s")
+
+    def build(source: BatchFit | FloatArray, scale: dict[str, float], t_max_s: float = math.inf) -> TrackingArrays:
         reduced = reduce_ranges(
-            measurements,
+            measurements if not math.isfinite(t_max_s) else measurements.loc[t_rel <= t_max_s],
             sites,
             _positions(source, t_end, fcfg),
             model,
@@ -131,7 +138,17 @@ def detect_laser_ranging(
 
     scale: dict[str, float] = {}
     data = build(np.asarray(x0_apriori, float), scale)
-    fit = fit_orbit(data, np.asarray(x0_apriori, float), config=fcfg)
+    # Grow the arc (1, 2, 4, ... days): Gauss-Newton with the two-body STM converges from an a-priori
+    # tens of metres off over a day, not over a week (the along-track error of a 2 cm/s velocity error
+    # is kilometres after 7 days).
+    x_start = np.asarray(x0_apriori, float)
+    span_days = 1.0
+    while span_days * 86400.0 < t_end:
+        if int(np.sum(t_rel <= span_days * 86400.0)) > 20:
+            part = build(x_start, scale, span_days * 86400.0)
+            x_start = fit_orbit(part, x_start, config=fcfg).x0
+        span_days *= 2.0
+    fit = fit_orbit(data, x_start, config=fcfg)
     data = build(fit, scale)
     fit = fit_orbit(data, fit.x0, config=fcfg, initial_range_bias_m=fit.range_bias_m)
     detections: list[GlrtDetection] = []
@@ -145,6 +162,138 @@ def detect_laser_ranging(
         data = build(fit, scale)
     rms = _station_rms_m(data, fit)
     return LaserRangingResult(detections, fit, rms, scale, data, repairs)
+
+
+@dataclass
+class LaserArc:
+    """One arc of a long campaign: its epoch, the span it owns (s from the campaign epoch) and its result."""
+
+    epoch_utc: np.datetime64
+    owned_s: tuple[float, float]
+    result: LaserRangingResult
+
+
+@dataclass
+class LaserArcsResult:
+    """Detections of a campaign cut into overlapping arcs (times in s from the campaign epoch)."""
+
+    epoch_utc: np.datetime64
+    arcs: list[LaserArc]
+    detections: list[GlrtDetection]
+    repairs: RepairLog = field(default_factory=RepairLog)
+
+    @property
+    def residual_rms_m(self) -> dict[str, float]:
+        """Worst per-station post-fit RMS (m) over the arcs."""
+        out: dict[str, float] = {}
+        for arc in self.arcs:
+            for name, v in arc.result.residual_rms_m.items():
+                out[name] = max(out.get(name, 0.0), v)
+        return out
+
+
+def arc_bounds_s(span_s: float, arc_days: float, overlap_days: float) -> list[tuple[float, float]]:
+    """Equal overlapping arcs of at most ``arc_days`` covering [0, span_s] (s), consecutive arcs sharing
+    ``overlap_days``; one arc when the span fits."""
+    arc, overlap = arc_days * 86400.0, overlap_days * 86400.0
+    if not 0.0 <= overlap < arc:
+        raise ValueError(f"overlap ({overlap_days} d) must be non-negative and shorter than the arc ({arc_days} d)")
+    if span_s <= arc:
+        return [(0.0, span_s)]
+    n = math.ceil((span_s - overlap) / (arc - overlap))
+    step = (span_s - overlap) / n
+    return [(k * step, k * step + step + overlap) for k in range(n)]
+
+
+def detect_laser_ranging_arcs(
+    measurements: pd.DataFrame,
+    sites: dict[str, StationSite],
+    stations: dict[str, Station],
+    apriori: FloatArray | Callable[[np.datetime64], FloatArray | None],
+    epoch_utc: np.datetime64,
+    *,
+    arc_days: float = 7.0,
+    overlap_days: float = 1.0,
+    budget: FalseAlarmBudget | None = None,
+    range_model: RangeModel | None = None,
+    fit_config: BatchFitConfig | None = None,
+    max_maneuvers: int = 3,
+    weight_by_residuals: bool = True,
+    min_ranges_per_arc: int = 30,
+) -> LaserArcsResult:
+    """Long campaigns in overlapping arcs (ILRS analyses fit LAGEOS in 7-day arcs), each run through
+    :func:`detect_laser_ranging`.
+
+    ``apriori`` is the GCRF state at ``epoch_utc`` (later arcs start from the previous arc's fitted
+    trajectory, impulses included) or a function of the arc epoch (e.g. from a CPF prediction) that may
+    return None outside its coverage (then the previous arc's trajectory is used). Each arc
+    owns the part of its span up to the middle of its overlaps, and only detections in the owned part are
+    kept, so a maneuver near an arc end is judged by the arc that has data on both sides of it. The
+    budget of each arc is scaled by owned/arc length, so the campaign's false-alarm rate stays at the
+    stated rate per day. Arcs with fewer than ``min_ranges_per_arc`` ranges are skipped and counted.
+    """
+    budget = budget or FalseAlarmBudget(0.1, "day")
+    epoch = as_datetime64_ns(epoch_utc)
+    t_meas = (np.asarray(measurements["time_utc"], dtype="datetime64[ns]") - epoch) / np.timedelta64(1, "s")
+    bounds = arc_bounds_s(float(np.max(t_meas)), arc_days, overlap_days)
+    repairs = RepairLog("laser ranging arcs")
+    arcs: list[LaserArc] = []
+    detections: list[GlrtDetection] = []
+    previous: tuple[LaserRangingResult, float] | None = None
+    for k, (a, b) in enumerate(bounds):
+        lo = a if k == 0 else 0.5 * (a + bounds[k - 1][1])
+        hi = b if k == len(bounds) - 1 else 0.5 * (b + bounds[k + 1][0])
+        sel = (t_meas >= a) & (t_meas <= b)
+        if int(sel.sum()) < min_ranges_per_arc:
+            repairs.record(f"arcs skipped (fewer than {min_ranges_per_arc} ranges)")
+            continue
+        arc_epoch = epoch + np.timedelta64(round(a * 1e9), "ns")
+        given = apriori(arc_epoch) if callable(apriori) else (np.asarray(apriori, float) if k == 0 else None)
+        if given is not None:
+            x0 = np.asarray(given, float)
+        elif previous is not None:
+            x0 = _propagated_apriori(previous[0], a - previous[1])
+        elif not callable(apriori):
+            x0 = _apriori_at(np.asarray(apriori, float), epoch, a, fit_config or LASER_FIT_CONFIG)
+        else:
+            raise ValueError(f"no a-priori state for the arc starting {arc_epoch}")
+        arc_budget = FalseAlarmBudget(budget.per_day * (hi - lo) / max(b - a, 1.0), "day")
+        result = detect_laser_ranging(
+            measurements.loc[sel].reset_index(drop=True),
+            sites,
+            stations,
+            x0,
+            arc_epoch,
+            budget=arc_budget,
+            range_model=range_model,
+            fit_config=fit_config,
+            max_maneuvers=max_maneuvers,
+            weight_by_residuals=weight_by_residuals,
+        )
+        arcs.append(LaserArc(arc_epoch, (lo, hi), result))
+        for kind, count in result.repairs.counts.items():
+            repairs.record(kind, count)
+        for det in result.detections:
+            t_abs = det.t_s + a
+            if lo <= t_abs < hi or (k == len(bounds) - 1 and t_abs == hi):
+                detections.append(replace(det, t_s=t_abs, alternatives=[(t + a, v) for t, v in det.alternatives]))
+        previous = (result, a)
+    return LaserArcsResult(epoch, arcs, detections, repairs)
+
+
+def _apriori_at(x0: FloatArray, epoch: np.datetime64, dt_s: float, cfg: BatchFitConfig) -> FloatArray:
+    """The a-priori state ``dt_s`` after ``epoch`` (DOP853 with the fit's force model)."""
+    if dt_s == 0.0:
+        return x0
+    model_f = cfg.force.model if isinstance(cfg.force, ForceContext) else cfg.force
+    ctx = ForceContext.build(model_f, epoch, -86400.0, dt_s + 86400.0)
+    return np.asarray(propagate(x0, np.array([dt_s]), force=ctx)[0], float)
+
+
+def _propagated_apriori(result: LaserRangingResult, dt_s: float) -> FloatArray:
+    """State ``dt_s`` after the arc epoch on the previous arc's fitted trajectory (impulses included)."""
+    states, _ = result.fit.propagate(np.array([dt_s]))
+    return states[0]
 
 
 def _station_rms_white(data: TrackingArrays, fit: BatchFit) -> dict[str, float]:
@@ -221,15 +370,17 @@ class LaserRangingRun:
     """Events (the frozen schema), the fit summary lines and the run identifiers of one file run."""
 
     events: pd.DataFrame
-    result: LaserRangingResult
+    result: LaserArcsResult
     summary: dict[str, object]
     run_id: str
     config_hash: str
 
     def summary_lines(self) -> list[str]:
         lines = [f"post-fit range RMS per station (mm): {self.summary['residual_rms_mm']}"]
-        lines.append(f"station sigma scale (post-fit / stated): {self.summary['sigma_scale']}")
-        lines.append(f"range biases (mm): {self.summary['range_bias_mm']}")
+        lines.append(f"station sigma scale (post-fit / stated, last arc): {self.summary['sigma_scale']}")
+        lines.append(f"range biases (mm, last arc): {self.summary['range_bias_mm']}")
+        arcs = self.summary.get("arcs", [])
+        lines.append(f"arcs fitted: {len(arcs) if isinstance(arcs, list) else arcs}")
         lines += [f"repaired: {k} ({n})" for k, n in self.result.repairs.counts.items()]
         return lines
 
@@ -269,12 +420,16 @@ def run_laser_ranging_files(
     range_model: RangeModel | None = None,
     spacecraft: str | None = None,
     max_maneuvers: int = 3,
-    step_s: float = 5.0,
+    step_s: float = 60.0,
+    arc_days: float = 7.0,
+    overlap_days: float = 1.0,
 ) -> LaserRangingRun:
     """Read CRD normal points, SINEX sites and an a-priori ephemeris; detect maneuvers; build events.
 
-    The force model is two-body + J2 + Sun and Moon (``abrupt.model.orbit.ForceModel``);
-    per-station range biases absorb the satellite's centre-of-mass offset.
+    The force model is two-body + J2 + Sun and Moon (``abrupt.model.orbit.ForceModel``), integrated
+    with the eighth-order fixed-step Runge-Kutta at ``step_s`` (s); per-station range biases absorb the
+    satellite's centre-of-mass offset. Files longer than ``arc_days`` are fitted in overlapping arcs
+    (:func:`detect_laser_ranging_arcs`), each started from the ephemeris where it covers the arc epoch.
     """
     from abrupt.detect.tracking_glrt import glrt_events
     from abrupt.events import config_hash, empty_frame, events_frame, new_run_id
@@ -308,14 +463,39 @@ def run_laser_ranging_files(
             sigma_range_rate_mps=1.0,
         )
     ephemeris = read_ephemeris(apriori_path)
-    x0 = apriori_state_gcrf(ephemeris, epoch)
+    eph_times = np.asarray(ephemeris.times_utc, dtype="datetime64[ns]")
+
+    def apriori(arc_epoch: np.datetime64) -> FloatArray | None:
+        if eph_times.min() <= arc_epoch <= eph_times.max():
+            return apriori_state_gcrf(ephemeris, arc_epoch)
+        return None
+
+    if apriori(epoch) is None:
+        raise ValueError(f"{apriori_path}: the ephemeris does not cover the first range epoch {epoch}")
     force = ForceModel(mu_m3_s2=3.986004418e14, zonal_degree=2, sun=True, moon=True)
-    cfg = BatchFitConfig(force=force, estimate_range_bias=True, max_step_s=step_s)
-    result = detect_laser_ranging(
-        meas, sites, stations, x0, epoch, budget=budget, range_model=model, fit_config=cfg, max_maneuvers=max_maneuvers
+    cfg = replace(LASER_FIT_CONFIG, force=force, max_step_s=step_s)
+    result = detect_laser_ranging_arcs(
+        meas,
+        sites,
+        stations,
+        apriori,
+        epoch,
+        arc_days=arc_days,
+        overlap_days=min(overlap_days, arc_days / 4.0),
+        budget=budget,
+        range_model=model,
+        fit_config=cfg,
+        max_maneuvers=max_maneuvers,
     )
     name = spacecraft or str(meas["satellite"].iloc[0] if "satellite" in meas else "satellite")
-    settings = {"range_model": model.__dict__, "budget": str(budget), "step_s": step_s, "max_maneuvers": max_maneuvers}
+    settings = {
+        "range_model": model.__dict__,
+        "budget": str(budget),
+        "step_s": step_s,
+        "max_maneuvers": max_maneuvers,
+        "arc_days": arc_days,
+        "overlap_days": overlap_days,
+    }
     cfg_hash = config_hash(settings)
     run_id = new_run_id()
     events = glrt_events(
@@ -330,8 +510,17 @@ def run_laser_ranging_files(
     frame = events_frame(events) if events else empty_frame()
     summary: dict[str, object] = {
         "residual_rms_mm": {k: round(v * 1000, 2) for k, v in result.residual_rms_m.items()},
-        "sigma_scale": {k: round(v, 2) for k, v in result.sigma_scale.items()},
-        "range_bias_mm": {k: round(v * 1000, 1) for k, v in result.fit.range_bias_m.items()},
+        "sigma_scale": {k: round(v, 2) for k, v in result.arcs[-1].result.sigma_scale.items()},
+        "range_bias_mm": {k: round(v * 1000, 1) for k, v in result.arcs[-1].result.fit.range_bias_m.items()},
+        "arcs": [
+            {
+                "epoch_utc": str(arc.epoch_utc),
+                "owned_s": list(arc.owned_s),
+                "residual_rms_mm": {k: round(v * 1000, 2) for k, v in arc.result.residual_rms_m.items()},
+                "range_bias_mm": {k: round(v * 1000, 1) for k, v in arc.result.fit.range_bias_m.items()},
+            }
+            for arc in result.arcs
+        ],
         "n_ranges": len(meas),
         "repairs": dict(result.repairs.counts) | dict(repairs.counts),
     }

@@ -251,3 +251,39 @@ def simulate_docking_run(spacecraft_file: str | Path, out_dir: str | Path, scena
     (out / "docking_truth.json").write_text(json.dumps(truth, indent=1))
     written.append(out / "docking_truth.json")
     return written
+
+
+def simulated_inertia_track(
+    spacecraft: Spacecraft,
+    scenario: object,
+    *,
+    epoch_utc: str = "2026-01-01T00:00:00Z",
+    progress: object = None,
+    **estimator_options: object,
+) -> InertiaTrack:
+    """One inertia estimate per simulated day of :func:`~abrupt.simulate.docking.docking_days` (days are
+    simulated, estimated and dropped one at a time: memory does not grow with the number of days).
+
+    Used to check the mass-change detector's false-alarm rate over a simulated year. ``progress`` is an
+    optional callable ``(day_index, estimate)``.
+    """
+    from abrupt.massprops.telemetry import momentum_data_from_simulation
+    from abrupt.simulate.docking import DockingScenario, docking_days
+
+    assert isinstance(scenario, DockingScenario)
+    j_cat = check_catalogue(spacecraft)
+    rows = []
+    for d, day in enumerate(docking_days(spacecraft, scenario)):
+        data = momentum_data_from_simulation(
+            day,
+            spacecraft.wheel_axes,
+            spacecraft.wheel_spin_inertias_kgm2,
+            orbit_period_s=scenario.orbit.period_s,
+            appendage_axis_B=scenario.appendage_axis_B,
+            appendage_spin_inertia_kgm2=scenario.appendage_spin_inertia_kgm2,
+        )
+        est = estimate_inertia(data, j_cat, **estimator_options)  # type: ignore[arg-type]
+        rows.append((float(day.t_s[0]), float(day.t_s[-1]), est))
+        if callable(progress):
+            progress(d, est)
+    return InertiaTrack.from_estimates(spacecraft.name, epoch_utc, rows)

@@ -64,12 +64,17 @@ def detector_class_name(name: str) -> str:
     return name if "." in name else f"orbit.{name}"
 
 
-def load_ephemeris(source: str | Path | Ephemeris, satellite: str | None = None) -> Ephemeris:
+def load_ephemeris(
+    source: str | Path | Ephemeris, satellite: str | None = None, *, allow_truncated: bool = False
+) -> Ephemeris:
+    """An ephemeris from a file (any supported format) or as given. ``allow_truncated``: an SP3/CPF file
+    ending before the epochs its header announces is read and the missing epochs counted in its repair
+    log (otherwise it is an :class:`~abrupt.errors.InputError`)."""
     if isinstance(source, Ephemeris):
         return source
     from abrupt.readers.ephemeris import read_ephemeris
 
-    return read_ephemeris(source, satellite)
+    return read_ephemeris(source, satellite, allow_truncated=allow_truncated)
 
 
 def detect_orbit(
@@ -79,6 +84,7 @@ def detect_orbit(
     budget: FalseAlarmBudget | str | float = "1/week",
     satellite: str | None = None,
     null: str | Path | Ephemeris | None = None,
+    allow_truncated: bool = False,
     **settings: Any,
 ) -> OrbitRun:
     """Detect impulsive and finite ΔVs in an ephemeris (SP3, OEM, CSV or an :class:`Ephemeris`).
@@ -86,10 +92,11 @@ def detect_orbit(
     ``detector`` is a registered orbit detector (``orbit.glr`` default; ``orbit.mcr_w``...);
     ``settings`` are its constructor keywords (``tuning``, ``tau_s``, ``q_m2_s5``, ``sigma_pos_m``,
     ``sigma_vel_mps``, ``dynamics``, ``gravity_degree``, ``confidence_z``, ``kind``, ``spacecraft``,
-    ``run_id``). ``null``: event-free data of the same satellite for the thresholds.
+    ``run_id``). ``null``: event-free data of the same satellite for the thresholds. ``allow_truncated``:
+    read files that end before the epochs their header announces (counted repair, :func:`load_ephemeris`).
     """
-    eph = load_ephemeris(source, satellite)
-    null_eph = load_ephemeris(null, satellite) if null is not None else None
+    eph = load_ephemeris(source, satellite, allow_truncated=allow_truncated)
+    null_eph = load_ephemeris(null, satellite, allow_truncated=allow_truncated) if null is not None else None
     cls = get_detector(detector_class_name(detector), "orbit")
     if not issubclass(cls, OrbitDetector):
         raise KeyError(f"{detector!r} is not an orbit filter detector")
@@ -177,13 +184,14 @@ def inject_orbit(
     *,
     duration_s: float = 0.0,
     satellite: str | None = None,
+    allow_truncated: bool = False,
 ) -> Ephemeris:
     """The ephemeris with a ΔV (orbit frame at its start) injected at ``time_utc``: an impulse or a finite
     burn of ``duration_s`` (:func:`abrupt.simulate.orbit.inject_impulse`)."""
     from abrupt.errors import ConfigError
     from abrupt.simulate.orbit import inject_impulse
 
-    eph = load_ephemeris(source, satellite)
+    eph = load_ephemeris(source, satellite, allow_truncated=allow_truncated)
     try:
         t = np.datetime64(str(time_utc).rstrip("Z"), "ns")
     except ValueError:

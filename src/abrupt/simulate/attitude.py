@@ -729,11 +729,16 @@ class ReferenceTrajectory:
 
     @classmethod
     def nadir(
-        cls, orbit: CircularOrbit, duration_s: float, slews: Sequence[Slew] = (), step_s: float = 1.0
+        cls,
+        orbit: CircularOrbit,
+        duration_s: float,
+        slews: Sequence[Slew] = (),
+        step_s: float = 1.0,
+        start_s: float = 0.0,
     ) -> ReferenceTrajectory:
         from abrupt.model.rotations import quaternion_from_dcm
 
-        t = np.arange(0.0, duration_s + 2 * step_s, step_s)
+        t = np.arange(start_s, start_s + duration_s + 2 * step_s, step_s)
         rn = orbit.hill_dcm_RN(t)
         for slew in slews:
             ang = slew.angle_rad(t)
@@ -803,9 +808,11 @@ class AppendageMotion:
         eclipse_fraction: float = 0.35,
         rewind_factor: float = 1.8,
         transition_s: float = 30.0,
+        start_s: float = 0.0,
     ) -> AppendageMotion:
-        """Turns at orbit rate while sunlit and rewinds ``rewind_factor`` times faster in eclipse."""
-        t = np.arange(0.0, duration_s + 10.0, 5.0)
+        """Turns at orbit rate while sunlit and rewinds ``rewind_factor`` times faster in eclipse
+        (profile from ``start_s`` to ``start_s + duration_s``)."""
+        t = np.arange(start_s, start_s + duration_s + 10.0, 5.0)
         n = orbit.mean_motion_rad_s
         phase = (t / orbit.period_s) % 1.0
         target = np.where(phase < 1 - eclipse_fraction, n, -rewind_factor * n)

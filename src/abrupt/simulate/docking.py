@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -96,52 +97,42 @@ def random_slews(
     return out
 
 
-def simulate_docking(
+def docking_days(
     spacecraft: Spacecraft, scenario: DockingScenario = DockingScenario(), noise: AttitudeSimConfig | None = None
-) -> DockingSimulation:
-    """Simulate ``scenario.days`` days of routine telemetry with a docking (or none if its time is None).
+) -> Iterator[PointingSimResult]:
+    """Simulate ``scenario.days`` days of routine telemetry with a docking (or none if its time is None),
+    yielding one day at a time: the reference, array profile and state of one day only are in memory,
+    so a simulated year runs in constant memory.
 
     ``noise`` supplies the telemetry noise (defaults: 7 arcsec star tracker, 5e-6 rad/s gyro, wheel
     speeds quantised to 0.098 rad/s). The catalogue inertia is the spacecraft file's; the truth is
-    ``scenario.truth_inertia_kgm2`` (default the same).
+    ``scenario.truth_inertia_kgm2`` (default the same); after the docking it is
+    :func:`~abrupt.massprops.inertia.inertia_after_docking` and the contact is a strike ρ × m v.
     """
     rng = np.random.default_rng(scenario.seed)
-    j0 = (
-        np.asarray(spacecraft.inertia_kgm2, dtype=np.float64)
-        if scenario.truth_inertia_kgm2 is None
-        else np.asarray(scenario.truth_inertia_kgm2, dtype=np.float64)
-    )
-    mass = spacecraft.mass_kg if math.isfinite(spacecraft.mass_kg) else 1000.0
-    j1 = inertia_after_docking(j0, mass, scenario.parasite_mass_kg, scenario.attachment_B_m)
-    rho = np.asarray(scenario.attachment_B_m, dtype=np.float64)
-    dh_b = np.cross(rho, scenario.parasite_mass_kg * np.asarray(scenario.approach_velocity_B_mps, dtype=np.float64))
+    j0, j1, dh_b = _docking_truth(spacecraft, scenario)
     total = scenario.days * SECONDS_PER_DAY
     n_days = math.ceil(scenario.days - 1e-9)
-    slews: list[Slew] = []
-    for d in range(n_days):
-        span = min(SECONDS_PER_DAY, total - d * SECONDS_PER_DAY)
-        slews += random_slews(
-            rng,
-            d * SECONDS_PER_DAY,
-            int(rng.integers(scenario.slews_per_day[0], scenario.slews_per_day[1] + 1)),
-            scenario.slew_angle_deg,
-            span,
-        )
-    ref = ReferenceTrajectory.nadir(scenario.orbit, total, slews, step_s=1.0)
-    app = AppendageMotion.sun_tracking(
-        scenario.appendage_axis_B, scenario.appendage_spin_inertia_kgm2, scenario.orbit, total
-    )
     base = noise or AttitudeSimConfig(
         telemetry_noise_quaternion=3.4e-5,
         telemetry_noise_rate_rad_s=5e-6,
         telemetry_noise_wheel_rad_s=0.0,
         wheel_speed_resolution_rad_s=2 * math.pi / 64,
     )
-    days: list[PointingSimResult] = []
     state: FloatArray | None = None
-    contact_n = np.full(3, np.nan)
     for d in range(n_days):
         t0, t1 = d * SECONDS_PER_DAY, min((d + 1) * SECONDS_PER_DAY, total)
+        slews = random_slews(
+            rng,
+            t0,
+            int(rng.integers(scenario.slews_per_day[0], scenario.slews_per_day[1] + 1)),
+            scenario.slew_angle_deg,
+            t1 - t0,
+        )
+        ref = ReferenceTrajectory.nadir(scenario.orbit, t1 - t0, slews, step_s=1.0, start_s=t0)
+        app = AppendageMotion.sun_tracking(
+            scenario.appendage_axis_B, scenario.appendage_spin_inertia_kgm2, scenario.orbit, t1 - t0, start_s=t0
+        )
         cuts = [t0, t1]
         dock = scenario.docking_time_s
         if dock is not None and t0 < dock < t1:
@@ -183,7 +174,38 @@ def simulate_docking(
         day = parts[0]
         for p in parts[1:]:
             day = _concat(day, p)
-        days.append(day)
+        yield day
+
+
+def _docking_truth(spacecraft: Spacecraft, scenario: DockingScenario) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Truth inertia before and after the docking, and the contact impulse in body axes [N m s]."""
+    j0 = (
+        np.asarray(spacecraft.inertia_kgm2, dtype=np.float64)
+        if scenario.truth_inertia_kgm2 is None
+        else np.asarray(scenario.truth_inertia_kgm2, dtype=np.float64)
+    )
+    mass = spacecraft.mass_kg if math.isfinite(spacecraft.mass_kg) else 1000.0
+    j1 = inertia_after_docking(j0, mass, scenario.parasite_mass_kg, scenario.attachment_B_m)
+    rho = np.asarray(scenario.attachment_B_m, dtype=np.float64)
+    dh_b = np.cross(rho, scenario.parasite_mass_kg * np.asarray(scenario.approach_velocity_B_mps, dtype=np.float64))
+    return j0, np.asarray(j1, dtype=np.float64), dh_b
+
+
+def simulate_docking(
+    spacecraft: Spacecraft, scenario: DockingScenario = DockingScenario(), noise: AttitudeSimConfig | None = None
+) -> DockingSimulation:
+    """All days of :func:`docking_days` in memory, with the truth (inertia before/after, contact impulse in N)."""
+    days = list(docking_days(spacecraft, scenario, noise))
+    j0, j1, dh_b = _docking_truth(spacecraft, scenario)
+    contact_n = np.full(3, np.nan)
+    if scenario.docking_time_s is not None and days:
+        from abrupt.model.rotations import dcm_from_quaternion
+
+        for day in days:
+            k = int(np.searchsorted(day.t_s, np.floor(scenario.docking_time_s)))
+            if 0 < k < day.t_s.size:
+                contact_n = dcm_from_quaternion(day.true_q_BN[k - 1]).T @ dh_b
+                break
     return DockingSimulation(days, j0, j1, scenario.docking_time_s, contact_n)
 
 

@@ -17,7 +17,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from abrupt.model.frames import Ephemeris
-from abrupt.model.orbit import R_EARTH_M, FiniteBurn, ForceContext, ForceModel, kepler_to_cartesian, rtn_matrix
+from abrupt.model.orbit import (
+    R_EARTH_M,
+    FiniteBurn,
+    ForceContext,
+    ForceModel,
+    kepler_to_cartesian,
+    propagate_deviation,
+    rtn_matrix,
+)
 from abrupt.model.orbit import propagate as propagate_orbit
 from abrupt.types import FloatArray
 
@@ -174,12 +182,17 @@ def inject_impulse(
 ) -> Ephemeris:
     """Add the effect of a ΔV (orbit frame at its start: radial, along-track, cross-track; m/s) starting at
     ``time_utc`` to a real ephemeris: an impulse (``duration_s`` = 0) or a finite burn of constant
-    acceleration ΔV/duration fixed in inertial space at onset. The state of the last epoch before the
-    start is propagated with and without the ΔV and the difference is added to every later epoch (in
-    GCRF, then converted back to the ephemeris' frame). The force model (default two-body + J2-J4) only
-    shapes the difference, so its errors are second order.
+    acceleration ΔV/duration fixed in inertial space at onset.
+
+    Across the burn, the state of the last epoch before its start is propagated with and without the ΔV
+    (DOP853) up to the first epoch at or after its end; the difference is the deviation there. From then
+    on the deviation is carried along the real trajectory, re-anchored on the ephemeris at every epoch
+    (:func:`abrupt.model.orbit.propagate_deviation`), so the injected orbit obeys δ̈ = a(r + δ) − a(r)
+    about the real orbit r for days and hundreds of km of drift. The difference is added in GCRF and the
+    result converted back to the ephemeris' frame. ``forces`` (default EGM2008 40×40 + Sun + Moon, the
+    detector's own model) shape only the deviation, so their absolute error does not enter.
     """
-    forces = forces or ForceModel(zonal_degree=4)
+    forces = forces or ForceModel(gravity_degree=40, sun=True, moon=True)
     gcrf = ephemeris.to_frame("GCRF")
     t_imp = _to_ns(time_utc)
     sec = gcrf.seconds
@@ -192,16 +205,25 @@ def inject_impulse(
     state0 = np.r_[gcrf.position_m[k0], gcrf.velocity_mps[k0]]
     if not np.isfinite(state0).all():
         raise ValueError("the epoch before the injection time has no velocity; choose another time")
-    after = np.flatnonzero(sec > t_imp_s)
-    t_eval = sec[after]
+    ctx = ForceContext.build(forces, gcrf.times_utc[0], float(sec[0]), float(sec[-1]))
     burn = FiniteBurn(t_imp_s, float(duration_s), tuple(float(x) for x in np.asarray(dv_rtn_mps)))  # type: ignore[arg-type]
-    nominal = propagate(sec[k0], state0, t_eval, forces, gcrf.times_utc[0])
-    kicked = propagate(sec[k0], state0, t_eval, forces, gcrf.times_utc[0], burns=[burn])
-    delta = kicked - nominal
-    pos = gcrf.position_m.copy()
-    vel = gcrf.velocity_mps.copy()
-    pos[after] += delta[:, :3]
-    vel[after] += delta[:, 3:]
+    # through the burn: two DOP853 propagations from the last epoch before it
+    k_end = min(int(np.searchsorted(sec, t_imp_s + float(duration_s), side="left")), sec.size - 1)
+    k_end = max(k_end, k0 + 1)
+    t_burn = sec[k0 + 1 : k_end + 1]
+    nominal = propagate_orbit(state0, t_burn, force=ctx, t0_s=float(sec[k0]))
+    kicked = propagate_orbit(state0, t_burn, force=ctx, t0_s=float(sec[k0]), burns=[burn])
+    delta = np.zeros((sec.size, 6))
+    delta[k0 + 1 : k_end + 1] = kicked - nominal
+    # after it: the deviation carried along the real trajectory
+    ref = np.hstack([gcrf.position_m, gcrf.velocity_mps])
+    if k_end + 1 < sec.size:
+        anchor = ref[k_end] if np.isfinite(ref[k_end]).all() else kicked[-1] - delta[k_end]
+        ref_tail = ref[k_end:].copy()
+        ref_tail[0] = anchor
+        delta[k_end:] = propagate_deviation(sec[k_end:], ref_tail, delta[k_end], force=ctx)
+    pos = gcrf.position_m + delta[:, :3]
+    vel = gcrf.velocity_mps + delta[:, 3:]
     from dataclasses import replace
 
     out = replace(gcrf, position_m=pos, velocity_mps=vel, source=f"{ephemeris.source} + injected ΔV")

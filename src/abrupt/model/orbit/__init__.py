@@ -27,7 +27,7 @@ from abrupt.model.orbit.elements import (
 )
 from abrupt.model.orbit.forces import ForceContext, ForceModel, acceleration
 from abrupt.model.orbit.frames import rsw_basis, rtn_matrix
-from abrupt.model.orbit.propagation import FiniteBurn, propagate, propagate_with_stm
+from abrupt.model.orbit.propagation import FiniteBurn, propagate, propagate_deviation, propagate_with_stm
 
 __all__ = [
     "J2",
@@ -48,6 +48,7 @@ __all__ = [
     "orbit_period_s",
     "orbital_constants",
     "propagate",
+    "propagate_deviation",
     "propagate_with_stm",
     "rsw_basis",
     "rtn_matrix",
