@@ -54,6 +54,8 @@ def main() -> None:
     ap.add_argument("--dv-mps", type=float, default=0.01)
     ap.add_argument("--step-s", type=float, default=60.0, help="filter integration step (RK8) [s]")
     ap.add_argument("--ablation-runs", type=int, default=1)
+    ap.add_argument("--null-runs", type=int, default=None, help="maneuver-free runs (default: --runs)")
+    ap.add_argument("--first-run", type=int, default=0, help="index of the first maneuver run (to split runs)")
     ap.add_argument("--arc-days", type=float, default=7.0, help="arc length; 1-day overlaps")
     args = ap.parse_args()
     budget = FalseAlarmBudget(0.1, "day")
@@ -61,21 +63,24 @@ def main() -> None:
     print(f"LAGEOS-like laser ranging, {args.days:g} days, 4 stations, budget {budget}")
 
     alarms = 0
-    for seed in range(args.runs):
+    null_runs = args.runs if args.null_runs is None else args.null_runs
+    for seed in range(null_runs):
         res = run(SlrScenario(duration_days=args.days), seed, RangeModel(), budget, args.step_s, args.arc_days)
         alarms += len(res.detections)
         rms = ", ".join(f"{k} {v * 1000:.1f}" for k, v in res.residual_rms_m.items())
         print(f"  null run {seed}: {len(res.detections)} alarm(s); post-fit RMS mm: {rms}")
-    days = args.runs * args.days
+    days = null_runs * args.days
     if days:
         print(f"false alarms: {alarms} in {days:g} days = {alarms / days:.3f}/day (budget 0.1/day; target: none)")
 
     found = within = 0
     rng = np.random.default_rng(2024)
-    for seed in range(args.runs):
+    for seed in range(args.first_run + args.runs):
         direction = rng.normal(size=3)
         dv = args.dv_mps * direction / np.linalg.norm(direction)
         t_man = float(rng.uniform(0.2, 0.8) * args.days * 86400.0)
+        if seed < args.first_run:  # the same draws as an unsplit run
+            continue
         scenario = SlrScenario(duration_days=args.days, maneuver_t_s=t_man, maneuver_dv_rsw_mps=tuple(dv))
         res = run(scenario, 100 + seed, RangeModel(), budget, args.step_s, args.arc_days)
         near = [d for d in res.detections if abs(d.t_s - (t_man + 0.5)) < max(3 * d.time_sigma_s, 600.0)]
