@@ -566,17 +566,20 @@ def detect_maneuvers_glrt(
             best_tau = min(tried, key=lambda t: tried[t].chi2)
         # Parabolic refinement of the epoch: χ²(τ) is smooth near its minimum, and with precise ranging a
         # few seconds of epoch error leave Δv·δτ (centimetres for 1 cm/s) that a second "impulse" would
-        # otherwise absorb. The curvature c gives the epoch's 1σ, 1/√c (Δχ² = 1).
+        # otherwise absorb. The curvature c gives the epoch's 1σ, 1/√c (Δχ² = 1); it is taken on the
+        # first, widest bracket, where Δχ² stands above the refits' own convergence noise.
         curvature = math.nan
         for _ in range(6):
             lo_t, hi_t = best_tau - width, best_tau + width
             if not (t_first < lo_t and hi_t < t_last):
                 break
             c_lo, c_0, c_hi = refit(float(lo_t)).chi2, tried[best_tau].chi2, refit(float(hi_t)).chi2
-            curvature = (c_lo - 2.0 * c_0 + c_hi) / (2.0 * width**2)
-            if not curvature > 0:
+            c_here = (c_lo - 2.0 * c_0 + c_hi) / (2.0 * width**2)
+            if math.isnan(curvature):
+                curvature = c_here
+            if not c_here > 0:
                 break
-            shift = -(c_hi - c_lo) / (4.0 * curvature * width)
+            shift = -(c_hi - c_lo) / (4.0 * c_here * width)
             shift = float(np.clip(shift, -width, width))
             if abs(shift) < 1e-3:
                 break
@@ -588,9 +591,11 @@ def detect_maneuvers_glrt(
         if lr <= threshold:
             break
         ok = [t for t, f in tried.items() if f.chi2 <= best.chi2 + 1.0]
-        time_sigma = max(0.5 * (max(ok) - min(ok)), width / math.sqrt(3.0))
+        spread = 0.5 * (max(ok) - min(ok))  # epochs that fit within Δχ² = 1 (wide in a data gap)
         if curvature > 0:
-            time_sigma = max(1.0 / math.sqrt(curvature), 1e-3)
+            time_sigma = max(1.0 / math.sqrt(curvature), spread, 1e-3)
+        else:
+            time_sigma = max(spread, width / math.sqrt(3.0))
         # A cross-track impulse only fixes the new plane (node line and tilt r·Δv/h): epochs half an orbit
         # apart fit almost equally, with Δv scaled by r(τ). Report such alternatives (chi² within 9).
         alt: list[tuple[float, NDArray[np.float64]]] = []

@@ -152,12 +152,18 @@ def detect_laser_ranging(
     data = build(fit, scale)
     fit = fit_orbit(data, fit.x0, config=fcfg, initial_range_bias_m=fit.range_bias_m)
     detections: list[GlrtDetection] = []
-    for _ in range(2):
+    for it in range(4):
         if weight_by_residuals:
-            scale = {n: scale.get(n, 1.0) * s for n, s in _station_rms_white(data, fit).items()}
+            # relative to the stated sigmas and never below them; it comes back down once a detected
+            # maneuver is in the fit (the first weighting sees its residuals as noise), so after a
+            # detection the weights and the scan are repeated until the weights settle (within 20 %)
+            new = {n: max(1.0, scale.get(n, 1.0) * s) for n, s in _station_rms_white(data, fit).items()}
+            if it > 0 and all(abs(v / scale.get(n, 1.0) - 1.0) < 0.2 for n, v in new.items()):
+                break
+            scale = new
             data = build(fit, scale)
         detections, fit, _ = detect_maneuvers_glrt(data, fit.x0, fit_config=fcfg, config=gcfg)
-        if not detections:
+        if not detections or not weight_by_residuals:
             break
         data = build(fit, scale)
     rms = _station_rms_m(data, fit)
@@ -228,7 +234,8 @@ def detect_laser_ranging_arcs(
     trajectory, impulses included) or a function of the arc epoch (e.g. from a CPF prediction) that may
     return None outside its coverage (then the previous arc's trajectory is used). Each arc
     owns the part of its span up to the middle of its overlaps, and only detections in the owned part are
-    kept, so a maneuver near an arc end is judged by the arc that has data on both sides of it. The
+    kept, so a maneuver near an arc end is judged by the arc that has data on both sides of it; the next
+    arc then starts just after such a maneuver, from the trajectory that carries it. The
     budget of each arc is scaled by owned/arc length, so the campaign's false-alarm rate stays at the
     stated rate per day. Arcs with fewer than ``min_ranges_per_arc`` ranges are skipped and counted.
     """
@@ -243,12 +250,21 @@ def detect_laser_ranging_arcs(
     for k, (a, b) in enumerate(bounds):
         lo = a if k == 0 else 0.5 * (a + bounds[k - 1][1])
         hi = b if k == len(bounds) - 1 else 0.5 * (b + bounds[k + 1][0])
+        # A maneuver the previous arc found in the shared part (and owns) would sit unmodelled near this
+        # arc's start, with too few ranges before it for this arc to fit it: start after it instead,
+        # from the previous arc's trajectory, which carries it.
+        shared = [d.t_s for d in detections if a <= d.t_s < lo]
+        after_maneuver = bool(shared) and previous is not None
+        if after_maneuver:
+            a = max(shared) + 1.0
         sel = (t_meas >= a) & (t_meas <= b)
         if int(sel.sum()) < min_ranges_per_arc:
             repairs.record(f"arcs skipped (fewer than {min_ranges_per_arc} ranges)")
             continue
         arc_epoch = epoch + np.timedelta64(round(a * 1e9), "ns")
-        given = apriori(arc_epoch) if callable(apriori) else (np.asarray(apriori, float) if k == 0 else None)
+        given = None if after_maneuver else (apriori(arc_epoch) if callable(apriori) else None)
+        if k == 0 and not callable(apriori):
+            given = np.asarray(apriori, float)
         if given is not None:
             x0 = np.asarray(given, float)
         elif previous is not None:
@@ -297,12 +313,12 @@ def _propagated_apriori(result: LaserRangingResult, dt_s: float) -> FloatArray:
 
 
 def _station_rms_white(data: TrackingArrays, fit: BatchFit) -> dict[str, float]:
-    """RMS of the normalised residuals per station (at least 1: sigmas are only ever widened)."""
+    """RMS of the normalised residuals per station (the caller keeps sigmas at or above the stated ones)."""
     names = np.asarray(data.station_names)[fit.row_index]
     out = {}
     for n in sorted(set(names)):
         sel = (names == n) & fit.used
-        out[str(n)] = max(1.0, float(np.sqrt(np.mean(fit.residuals_white[sel] ** 2)))) if sel.any() else 1.0
+        out[str(n)] = float(np.sqrt(np.mean(fit.residuals_white[sel] ** 2))) if sel.any() else 1.0
     return out
 
 
