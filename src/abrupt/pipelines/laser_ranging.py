@@ -71,25 +71,21 @@ def _positions(
     fit_or_x0: BatchFit | FloatArray, t_end_s: float, force_cfg: BatchFitConfig, step_s: float = 30.0
 ) -> CubicHermiteSpline:
     """GCRF positions of the fitted (or a-priori) trajectory as a function of time, for the reduction."""
-    if isinstance(fit_or_x0, BatchFit):
-        x0, accel = fit_or_x0.x0, fit_or_x0.acceleration_mps2
-        imp_t, imp_dv = fit_or_x0.impulse_times_s, fit_or_x0.impulse_dv_rsw_mps
-    else:
-        x0, accel, imp_t, imp_dv = np.asarray(fit_or_x0, float), np.zeros(3), [], None
     grid = np.arange(-2 * step_s, t_end_s + 3 * step_s, step_s)
     fwd = grid >= 0
     states = np.empty((grid.size, 6))
-    states[fwd], _ = trajectory(
-        x0,
-        0.0,
-        grid[fwd],
-        force=force_cfg.force,
-        accel_mps2=accel,
-        impulse_times_s=imp_t,
-        impulse_dv_rsw=imp_dv,
-        max_step_s=force_cfg.max_step_s,
-        integrator=force_cfg.integrator,
-    )
+    if isinstance(fit_or_x0, BatchFit):
+        states[fwd] = fit_or_x0.propagate(grid[fwd])[0]
+    else:
+        states[fwd], _ = trajectory(
+            np.asarray(fit_or_x0, float),
+            0.0,
+            grid[fwd],
+            force=force_cfg.force,
+            accel_mps2=np.zeros(3),
+            max_step_s=force_cfg.max_step_s,
+            integrator=force_cfg.integrator,
+        )
     # two nodes before the epoch for light times that reach back (linear extrapolation is ample)
     for k in np.flatnonzero(~fwd)[::-1]:
         states[k] = states[k + 1] - (grid[k + 1] - grid[k]) * np.concatenate([states[k + 1, 3:], np.zeros(3)])
