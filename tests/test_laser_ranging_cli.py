@@ -81,9 +81,9 @@ def write_sinex(sim: SlrSimulation, path: Path, drop: str | None = None) -> None
     path.write_text("\n".join(out) + "\n")
 
 
-def write_apriori(sim: SlrSimulation, path: Path) -> None:
+def write_apriori(sim: SlrSimulation, path: Path, start_s: float = -600.0) -> None:
     """The true orbit, shifted by 50 m, in ITRF (as a CPF prediction would give it), written as OEM."""
-    t = np.arange(-600.0, sim.scenario.duration_days * 86400.0 + 600.0, 120.0)
+    t = np.arange(start_s, sim.scenario.duration_days * 86400.0 + 600.0, 120.0)
     states = propagate(sim.x0, t[t >= 0], force=sim.force)
     back = propagate(sim.x0, np.array([0.0]), force=sim.force)
     states = np.vstack([np.repeat(back, int((t < 0).sum()), axis=0), states])
@@ -100,10 +100,12 @@ def files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     sim = simulate_slr(SlrScenario(duration_days=1.0, noise_m=0.003), seed=21)
     d = tmp_path_factory.mktemp("laser")
     paths = {"crd": d / "lageos1.npt", "snx": d / "sites.snx", "oem": d / "apriori.oem", "bad_snx": d / "missing.snx"}
+    paths["late_oem"] = d / "late.oem"
     write_crd(sim, paths["crd"])
     write_sinex(sim, paths["snx"])
     write_sinex(sim, paths["bad_snx"], drop="GRZL")
     write_apriori(sim, paths["oem"])
+    write_apriori(sim, paths["late_oem"], start_s=6 * 3600.0)  # starts hours after the first range
     return paths
 
 
@@ -129,3 +131,18 @@ def test_detect_laser_names_the_station_missing_from_sinex(files: dict[str, Path
     with pytest.raises(SystemExit) as exc:
         main(args)
     assert exc.value.code == 2
+
+
+def test_detect_laser_names_an_apriori_ephemeris_that_starts_after_the_ranges(
+    files: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from abrupt.cli.main import main
+
+    args = ["detect", "laser", str(files["crd"]), "--sinex", str(files["snx"]), "--apriori", str(files["late_oem"])]
+    args += ["--out", str(tmp_path / "e.csv"), "--catalog", str(tmp_path / "c.sqlite")]
+    with pytest.raises(SystemExit) as exc:
+        main(args)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "late.oem" in err and "does not cover" in err
+    assert len(err.strip().splitlines()) == 1
