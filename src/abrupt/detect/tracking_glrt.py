@@ -30,7 +30,12 @@ from numpy.typing import NDArray
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc
 from abrupt.model.orbit import MU_KADERALI_M3_S2, ForceContext, ForceModel, propagate_with_stm, rsw_basis
-from abrupt.model.tracking_measurements import TrackingArrays, predict_measurement, wrap_angle
+from abrupt.model.tracking_measurements import (
+    TrackingArrays,
+    predict_measurement,
+    predict_measurement_light_time,
+    wrap_angle,
+)
 from abrupt.series.tracking import TrackingSeries
 from abrupt.thresholds import FalseAlarmBudget, Threshold, chi2_threshold
 
@@ -49,6 +54,9 @@ class BatchFitConfig:
     integrator: str = "rk4"  # "rk8" for long arcs (model.orbit.propagate_with_stm)
     outlier_sigma: float | None = 6.0  # Orekit-style rejection from the 3rd iteration on
     elevation_mask_deg: float | None = None
+    light_time: bool = False  # two-way range and downleg angles timed at reception (real data)
+    troposphere: bool = False  # radio range delay: Saastamoinen zenith delays, Chao mapping, standard weather
+    estimate_time_bias: bool | tuple[str, ...] = False  # per-station epoch offset of the range time tags
 
 
 @dataclass
@@ -59,6 +67,7 @@ class BatchFit:
     t0_s: float
     range_bias_m: dict[str, float]
     angle_bias_rad: dict[str, tuple[float, float]]
+    time_bias_s: dict[str, float]
     acceleration_mps2: NDArray[np.float64]
     impulse_times_s: list[float]
     impulse_dv_rsw_mps: NDArray[np.float64]
@@ -103,14 +112,17 @@ class BatchFit:
 
 
 def _bias_keys(data: TrackingArrays, cfg: BatchFitConfig) -> list[tuple[str, int]]:
-    """(station, component) pairs whose bias is estimated: range (0), azimuth (1), elevation (2)."""
+    """(station, component) pairs whose bias is estimated: range (0), azimuth (1), elevation (2), and
+    the time tag of the ranges (3)."""
     keys: list[tuple[str, int]] = []
     for comp, setting in (
         (0, cfg.estimate_range_bias),
         (1, cfg.estimate_angle_bias),
         (2, cfg.estimate_angle_bias),
+        (3, cfg.estimate_time_bias),
     ):
-        have = sorted({s for s, y in zip(data.station_names, data.y[:, comp], strict=True) if np.isfinite(y)})
+        column = data.y[:, 0 if comp == 3 else comp]
+        have = sorted({s for s, y in zip(data.station_names, column, strict=True) if np.isfinite(y)})
         if setting is True:
             keys += [(s, comp) for s in have]
         elif setting:
@@ -202,7 +214,7 @@ def fit_orbit(
     n = len(data)
     bias_keys = _bias_keys(data, cfg)
     n_imp = len(impulse_times_s)
-    label = {0: "range_bias", 1: "azimuth_bias", 2: "elevation_bias"}
+    label = {0: "range_bias", 1: "azimuth_bias", 2: "elevation_bias", 3: "time_bias"}
     names = ["x", "y", "z", "vx", "vy", "vz", *[f"{label[c]}[{s}]" for s, c in bias_keys]]
     if cfg.estimate_acceleration:
         names += ["accel_x", "accel_y", "accel_z"]
@@ -214,6 +226,7 @@ def fit_orbit(
         bias[(s, 0)] = (initial_range_bias_m or {}).get(s, data.stations[s].range_bias_m)
         bias[(s, 1)] = (initial_angle_bias_rad or {}).get(s, (0.0, 0.0))[0]
         bias[(s, 2)] = (initial_angle_bias_rad or {}).get(s, (0.0, 0.0))[1]
+        bias[(s, 3)] = 0.0
     accel = np.zeros(3) if initial_acceleration_mps2 is None else np.asarray(initial_acceleration_mps2, float).copy()
     dv = (
         np.zeros((n_imp, 3))
@@ -248,7 +261,19 @@ def fit_orbit(
             max_step_s=cfg.max_step_s,
             integrator=cfg.integrator,
         )
-        resid, jac = _residuals(data, states, dmat, bias, bias_keys, cfg.estimate_acceleration, n_imp, row_i, row_c)
+        resid, jac = _residuals(
+            data,
+            states,
+            dmat,
+            bias,
+            bias_keys,
+            cfg.estimate_acceleration,
+            n_imp,
+            row_i,
+            row_c,
+            cfg.light_time,
+            cfg.troposphere,
+        )
         cost = float(np.sum(resid[used] ** 2))
         near = it >= 2 and abs(prev_cost - cost) <= 0.1 * max(cost, 1.0)
         if cfg.outlier_sigma is not None and 3 <= it <= 5 and near:  # re-select outliers, then freeze the set
@@ -285,7 +310,8 @@ def fit_orbit(
         x0=x,
         t0_s=t0_s,
         range_bias_m={s: bias[(s, c)] for s, c in bias_keys if c == 0},
-        angle_bias_rad={s: (bias[(s, 1)], bias[(s, 2)]) for s in {s for s, c in bias_keys if c > 0}},
+        angle_bias_rad={s: (bias[(s, 1)], bias[(s, 2)]) for s in {s for s, c in bias_keys if c in (1, 2)}},
+        time_bias_s={s: bias[(s, 3)] for s, c in bias_keys if c == 3},
         acceleration_mps2=accel,
         impulse_times_s=list(impulse_times_s),
         impulse_dv_rsw_mps=dv,
@@ -316,10 +342,17 @@ def _residuals(
     n_imp: int,
     row_i: NDArray[np.int64],
     row_c: NDArray[np.int64],
+    light_time: bool = False,
+    troposphere: bool = False,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    y_hat, h = _predict_all(data.c_fi, data.site, data.c_sf, states)
+    y_hat, h = _predict_all(data.c_fi, data.site, data.c_sf, states, light_time)
+    if troposphere:
+        y_hat[:, 0] += radio_range_delay_m(data, y_hat[:, 2])
+    range_rate = y_hat[:, 3].copy()
     for c in range(3):
         y_hat[:, c] += np.array([bias.get((name, c), 0.0) for name in data.station_names])
+    # a station whose time tags run late by δt sees ρ(t_tag − δt) ≈ ρ(t_tag) − ρ̇ δt
+    y_hat[:, 0] -= range_rate * np.array([bias.get((name, 3), 0.0) for name in data.station_names])
     d = data.y[row_i, row_c] - y_hat[row_i, row_c]
     az = row_c == 1
     d[az] = wrap_angle(d[az])
@@ -337,9 +370,36 @@ def _residuals(
         jac[:, col:] = hd[:, 9:] / sig[:, None]
     names = np.asarray(data.station_names)[row_i]
     for k, (st, c) in enumerate(bias_keys):
-        sel = (row_c == c) & (names == st)
-        jac[sel, 6 + k] = 1.0 / sig[sel]
+        if c == 3:
+            sel = (row_c == 0) & (names == st)
+            jac[sel, 6 + k] = -range_rate[row_i[sel]] / sig[sel]
+        else:
+            sel = (row_c == c) & (names == st)
+            jac[sel, 6 + k] = 1.0 / sig[sel]
     return resid, jac
+
+
+def radio_range_delay_m(data: TrackingArrays, elevation_rad: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Tropospheric delay (m) of each radio range row at the predicted ``elevation_rad``.
+
+    Saastamoinen zenith delays with the Chao mapping (:func:`abrupt.model.troposphere.radio_delay_m`) in
+    the standard atmosphere at the station height (no meteorology comes with radio tracking files);
+    the delay's dependence on the state is neglected in the Jacobian (millimetres per milliradian).
+    Elevations below 3° use 3° (the mapping function is not meant for the horizon).
+    """
+    from abrupt.model.range_reduction import standard_meteorology
+    from abrupt.model.troposphere import radio_delay_m, water_vapour_pressure_hpa
+
+    lat = np.empty(len(data))
+    height = np.empty(len(data))
+    for name, st in data.stations.items():
+        sel = np.asarray(data.station_names) == name
+        lat[sel] = math.radians(st.latitude_deg)
+        height[sel] = st.altitude_m
+    weather = np.array([standard_meteorology(float(h)) for h in height]).reshape(-1, 3)
+    vapour = water_vapour_pressure_hpa(weather[:, 1], weather[:, 2])
+    el = np.maximum(np.asarray(elevation_rad, dtype=float), math.radians(3.0))
+    return np.asarray(radio_delay_m(el, lat, height, weather[:, 0], weather[:, 1], vapour))
 
 
 @numba.njit(cache=True)
@@ -348,12 +408,18 @@ def _predict_all(
     site: NDArray[np.float64],
     c_sf: NDArray[np.float64],
     states: NDArray[np.float64],
+    light_time: bool,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     n = states.shape[0]
     y = np.empty((n, 4))
     h = np.empty((n, 4, 6))
     for i in range(n):
-        yi, hi = predict_measurement(states[i].copy(), c_fi[i].copy(), site[i].copy(), c_sf[i].copy())
+        if light_time:
+            yi, hi = predict_measurement_light_time(
+                states[i].copy(), c_fi[i].copy(), site[i].copy(), c_sf[i].copy()
+            )
+        else:
+            yi, hi = predict_measurement(states[i].copy(), c_fi[i].copy(), site[i].copy(), c_sf[i].copy())
         y[i] = yi
         h[i] = hi
     return y, h
