@@ -20,7 +20,7 @@ passes' residuals. This module
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numba
@@ -30,6 +30,7 @@ from numpy.typing import NDArray
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc
 from abrupt.model.orbit import MU_KADERALI_M3_S2, ForceContext, ForceModel, propagate_with_stm, rsw_basis
+from abrupt.model.orbit.forces import F_DRAG_SCALE, F_SRP_SCALE
 from abrupt.model.tracking_measurements import (
     TrackingArrays,
     predict_measurement,
@@ -57,6 +58,7 @@ class BatchFitConfig:
     light_time: bool = False  # two-way range and downleg angles timed at reception (real data)
     troposphere: bool = False  # radio range delay: Saastamoinen zenith delays, Chao mapping, standard weather
     estimate_time_bias: bool | tuple[str, ...] = False  # per-station epoch offset of the range time tags
+    estimate_scales: tuple[str, ...] = ()  # force-model scale factors: "drag_scale", "srp_scale"
 
 
 @dataclass
@@ -68,6 +70,7 @@ class BatchFit:
     range_bias_m: dict[str, float]
     angle_bias_rad: dict[str, tuple[float, float]]
     time_bias_s: dict[str, float]
+    scale_factors: dict[str, float]
     acceleration_mps2: NDArray[np.float64]
     impulse_times_s: list[float]
     impulse_dv_rsw_mps: NDArray[np.float64]
@@ -93,8 +96,9 @@ class BatchFit:
             self.x0,
             self.t0_s,
             np.asarray(t_out_s, dtype=float),
-            force=self.config.force,
+            force=scaled_force(self.config.force, self.scale_factors),
             accel_mps2=self.acceleration_mps2,
+            scale_parameters=tuple(self.scale_factors),
             impulse_times_s=self.impulse_times_s,
             impulse_dv_rsw=self.impulse_dv_rsw_mps,
             max_step_s=self.config.max_step_s,
@@ -130,6 +134,24 @@ def _bias_keys(data: TrackingArrays, cfg: BatchFitConfig) -> list[tuple[str, int
     return keys
 
 
+def scaled_force(force: ForceModel | ForceContext, scales: Mapping[str, float]) -> ForceModel | ForceContext:
+    """``force`` with its ``drag_scale``/``srp_scale`` set to ``scales`` (a resolved context keeps its
+    tables: only the two numbers the kernel reads change)."""
+    if not scales:
+        return force
+    drag = float(
+        scales.get("drag_scale", force.model.drag_scale if isinstance(force, ForceContext) else force.drag_scale)
+    )
+    srp = float(scales.get("srp_scale", force.model.srp_scale if isinstance(force, ForceContext) else force.srp_scale))
+    if isinstance(force, ForceModel):
+        return replace(force, drag_scale=drag, srp_scale=srp)
+    floats = force.kernel_args[1].copy()
+    floats[F_DRAG_SCALE] = drag
+    floats[F_SRP_SCALE] = srp
+    args = (force.kernel_args[0], floats, *force.kernel_args[2:])
+    return replace(force, model=replace(force.model, drag_scale=drag, srp_scale=srp), kernel_args=args)
+
+
 def trajectory(
     x0: NDArray[np.float64],
     t0_s: float,
@@ -137,18 +159,22 @@ def trajectory(
     *,
     force: ForceModel | ForceContext,
     accel_mps2: NDArray[np.float64],
+    scale_parameters: Sequence[str] = (),
     impulse_times_s: Sequence[float] = (),
     impulse_dv_rsw: NDArray[np.float64] | None = None,
     max_step_s: float = 10.0,
     integrator: str = "rk4",
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """States (n,6) and D = ∂state/∂(x0, accel, Δv₁..Δv_m) (n,6,9+3m) at sorted ``t_out_s`` ≥ t0.
+    """States (n,6) and D = ∂state/∂(x0, accel, scales, Δv₁..Δv_m) (n,6,9+p+3m) at sorted ``t_out_s`` ≥ t0.
 
-    Impulses are applied in the RSW frame of the state at their epoch; ∂C_RSW/∂x is neglected.
+    ``scale_parameters`` (p of ``drag_scale``, ``srp_scale``) are the force model's scale factors whose
+    sensitivities :func:`~abrupt.model.orbit.propagate_with_stm` integrates (Montenbruck & Gill 2000,
+    Eq. 7.6). Impulses are applied in the RSW frame of the state at their epoch; ∂C_RSW/∂x is neglected.
     """
     n_imp = len(impulse_times_s)
     dv = np.zeros((n_imp, 3)) if impulse_dv_rsw is None else np.asarray(impulse_dv_rsw, float).reshape(n_imp, 3)
-    n_p = 9 + 3 * n_imp
+    n_scale = len(scale_parameters)
+    n_p = 9 + n_scale + 3 * n_imp
     order = np.argsort(impulse_times_s) if n_imp else np.array([], dtype=int)
     breaks = [float(impulse_times_s[k]) for k in order]
     t_out = np.asarray(t_out_s, dtype=float)
@@ -174,9 +200,10 @@ def trajectory(
                 accel_mps2=accel_mps2,
                 max_step_s=max_step_s,
                 method=integrator,
+                parameters=tuple(scale_parameters),
             )
             d_all = np.einsum("nij,jk->nik", phi, d_start)
-            d_all[:, :, 6:9] += sens
+            d_all[:, :, 6 : 9 + n_scale] += sens
             states[i0:i1] = st[: times.size]
             dmat[i0:i1] = d_all[: times.size]
             if extra:
@@ -187,7 +214,7 @@ def trajectory(
         k = int(order[seg])
         c = rsw_basis(x_start)
         x_start[3:6] += c @ dv[k]
-        d_start[3:6, 9 + 3 * k : 12 + 3 * k] += c
+        d_start[3:6, 9 + n_scale + 3 * k : 12 + n_scale + 3 * k] += c
         t_start = t_edge
         i0 = i1
     return states, dmat
@@ -204,6 +231,7 @@ def fit_orbit(
     initial_impulse_dv_rsw: NDArray[np.float64] | None = None,
     initial_acceleration_mps2: NDArray[np.float64] | None = None,
     initial_angle_bias_rad: dict[str, tuple[float, float]] | None = None,
+    initial_scale_factors: Mapping[str, float] | None = None,
 ) -> BatchFit:
     """Weighted Gauss-Newton fit of the orbit (and biases, acceleration, impulses) to all measurements.
 
@@ -218,6 +246,14 @@ def fit_orbit(
     names = ["x", "y", "z", "vx", "vy", "vz", *[f"{label[c]}[{s}]" for s, c in bias_keys]]
     if cfg.estimate_acceleration:
         names += ["accel_x", "accel_y", "accel_z"]
+    unknown = set(cfg.estimate_scales) - {"drag_scale", "srp_scale"}
+    if unknown or len(set(cfg.estimate_scales)) != len(cfg.estimate_scales):
+        raise ValueError(f"estimate_scales: distinct names from ('drag_scale', 'srp_scale'), got {cfg.estimate_scales}")
+    base_model = cfg.force.model if isinstance(cfg.force, ForceContext) else cfg.force
+    scales = {
+        name: float((initial_scale_factors or {}).get(name, getattr(base_model, name))) for name in cfg.estimate_scales
+    }
+    names += list(cfg.estimate_scales)
     for k in range(n_imp):
         names += [f"dv{k}_r", f"dv{k}_s", f"dv{k}_w"]
     x = np.asarray(x0, float).copy()
@@ -247,15 +283,16 @@ def fit_orbit(
     resid = np.zeros(n_rows)
     jac = np.zeros((n_rows, len(names)))
     states = np.empty((n, 6))
-    dmat = np.empty((n, 6, 9 + 3 * n_imp))
+    dmat = np.empty((n, 6, 9 + len(scales) + 3 * n_imp))
     cov = np.full((len(names), len(names)), np.nan)
     for it in range(1, cfg.max_iterations + 1):
         states, dmat = trajectory(
             x,
             t0_s,
             data.t_s,
-            force=cfg.force,
+            force=scaled_force(cfg.force, scales),
             accel_mps2=accel,
+            scale_parameters=cfg.estimate_scales,
             impulse_times_s=impulse_times_s,
             impulse_dv_rsw=dv,
             max_step_s=cfg.max_step_s,
@@ -268,6 +305,7 @@ def fit_orbit(
             bias,
             bias_keys,
             cfg.estimate_acceleration,
+            len(scales),
             n_imp,
             row_i,
             row_c,
@@ -303,6 +341,9 @@ def fit_orbit(
         if cfg.estimate_acceleration:
             accel = accel + step[k : k + 3]
             k += 3
+        for name in scales:
+            scales[name] += step[k]
+            k += 1
         for j in range(n_imp):
             dv[j] += step[k : k + 3]
             k += 3
@@ -312,6 +353,7 @@ def fit_orbit(
         range_bias_m={s: bias[(s, c)] for s, c in bias_keys if c == 0},
         angle_bias_rad={s: (bias[(s, 1)], bias[(s, 2)]) for s in {s for s, c in bias_keys if c in (1, 2)}},
         time_bias_s={s: bias[(s, 3)] for s, c in bias_keys if c == 3},
+        scale_factors=scales,
         acceleration_mps2=accel,
         impulse_times_s=list(impulse_times_s),
         impulse_dv_rsw_mps=dv,
@@ -339,6 +381,7 @@ def _residuals(
     bias: dict[tuple[str, int], float],
     bias_keys: list[tuple[str, int]],
     with_accel: bool,
+    n_scale: int,
     n_imp: int,
     row_i: NDArray[np.int64],
     row_c: NDArray[np.int64],
@@ -359,14 +402,14 @@ def _residuals(
     sig = data.sigma[row_i, row_c]
     resid = d / sig
     hd = np.einsum("rk,rkp->rp", h[row_i, row_c], dmat[row_i])
-    n_par = 6 + len(bias_keys) + (3 if with_accel else 0) + 3 * n_imp
+    n_par = 6 + len(bias_keys) + (3 if with_accel else 0) + n_scale + 3 * n_imp
     jac = np.zeros((row_i.size, n_par))
     jac[:, :6] = hd[:, :6] / sig[:, None]
     col = 6 + len(bias_keys)
     if with_accel:
         jac[:, col : col + 3] = hd[:, 6:9] / sig[:, None]
         col += 3
-    if n_imp:
+    if n_scale or n_imp:
         jac[:, col:] = hd[:, 9:] / sig[:, None]
     names = np.asarray(data.station_names)[row_i]
     for k, (st, c) in enumerate(bias_keys):
@@ -377,6 +420,25 @@ def _residuals(
             sel = (row_c == c) & (names == st)
             jac[sel, 6 + k] = 1.0 / sig[sel]
     return resid, jac
+
+
+def model_corrections(data: TrackingArrays, fit: BatchFit) -> NDArray[np.float64]:
+    """(n,4) what the fit's measurement model adds to the instantaneous geometric prediction at each row:
+    light time, tropospheric delay and the station time biases, evaluated on the fitted trajectory.
+
+    Subtracting it from the measurements "reduces" them to instantaneous geometry, so that a filter
+    with the instantaneous model (Kaderali's EKF) sees the same data the fit explained.
+    """
+    cfg = fit.config
+    instant, _ = _predict_all(data.c_fi, data.site, data.c_sf, fit.states, False)
+    full, _ = _predict_all(data.c_fi, data.site, data.c_sf, fit.states, cfg.light_time)
+    if cfg.troposphere:
+        full[:, 0] += radio_range_delay_m(data, full[:, 2])
+    full[:, 0] -= instant[:, 3] * np.array([fit.time_bias_s.get(name, 0.0) for name in data.station_names])
+    out = full - instant
+    out[:, 3] = 0.0
+    out[:, 1] = wrap_angle(out[:, 1])
+    return np.asarray(out)
 
 
 def radio_range_delay_m(data: TrackingArrays, elevation_rad: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -415,9 +477,7 @@ def _predict_all(
     h = np.empty((n, 4, 6))
     for i in range(n):
         if light_time:
-            yi, hi = predict_measurement_light_time(
-                states[i].copy(), c_fi[i].copy(), site[i].copy(), c_sf[i].copy()
-            )
+            yi, hi = predict_measurement_light_time(states[i].copy(), c_fi[i].copy(), site[i].copy(), c_sf[i].copy())
         else:
             yi, hi = predict_measurement(states[i].copy(), c_fi[i].copy(), site[i].copy(), c_sf[i].copy())
         y[i] = yi
@@ -614,6 +674,7 @@ def detect_maneuvers_glrt(
                     initial_impulse_dv_rsw=dv0,
                     initial_acceleration_mps2=_fit.acceleration_mps2,
                     initial_angle_bias_rad=_fit.angle_bias_rad,
+                    initial_scale_factors=_fit.scale_factors,
                 )
             return tried[tau]
 

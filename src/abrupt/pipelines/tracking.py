@@ -118,6 +118,7 @@ def read_tracking_series(
         max_step_s=max_step,
         elevation_mask_deg=settings.elevation_mask_deg,
         light_time=real if settings.light_time is None else settings.light_time,
+        estimate_scales=setup_estimated_scales(setup, force.model),
         troposphere=setup.range_troposphere and real if settings.troposphere is None else settings.troposphere,
     )
     series = TrackingSeries(data, np.asarray(setup.initial_state, float), fit_cfg, name=name or Path(file).stem)
@@ -167,6 +168,23 @@ def setup_force_model(setup: Any, span_s: float = 0.0) -> tuple[ForceContext, np
     else:
         model = ForceModel(mu_m3_s2=setup.mu_m3_s2, zonal_degree=2 if degree >= 2 else 0, sun=third, moon=third)
     return ForceContext.build(model, epoch, -86400.0, span_s + 86400.0), epoch
+
+
+def setup_estimated_scales(setup: Any, model: ForceModel) -> tuple[str, ...]:
+    """Force-model scale factors the set-up estimates: ``drag_scale`` when ``drag.cd.estimated`` (the
+    fitted drag coefficient is C_D × scale), ``srp_scale`` when ``solar.radiation.pressure.cr.estimated``,
+    each only when the force is in the model."""
+    extra = setup.extra
+
+    def flag(key: str) -> bool:
+        return str(extra.get(key, "false")).strip().rstrip(";").lower() == "true"
+
+    out = []
+    if model.drag == "exponential" and flag("drag.cd.estimated"):
+        out.append("drag_scale")
+    if model.srp and flag("solar.radiation.pressure.cr.estimated"):
+        out.append("srp_scale")
+    return tuple(out)
 
 
 def detect_tracking(
@@ -278,6 +296,7 @@ def fit_summary(fit: BatchFit, force: ForceModel, sun_m: Any) -> dict[str, Any]:
         },
         "light_time": fit.config.light_time,
         "troposphere": fit.config.troposphere,
+        "scale_factors": {k: [float(v), fit.sigma(k)] for k, v in fit.scale_factors.items()},
     }
     if "accel_x" in fit.parameter_names:
         a = np.asarray(fit.acceleration_mps2, float)
@@ -303,8 +322,15 @@ def fit_summary_lines(summary: dict[str, Any]) -> list[str]:
         f"in {summary['iterations']} iterations with {summary['n_impulses']} impulse(s), "
         f"{summary['n_observations']} observations, weighted RMS {summary['weighted_rms']:.3f}"
     ]
+    fm = summary.get("force_model", {})
+    lines.append(
+        f"  model: field degree {fm.get('gravity_degree', 0)}, Sun/Moon {fm.get('sun_moon')}, SRP {fm.get('srp')}, "
+        f"drag {fm.get('drag')}; light time {summary.get('light_time')}, troposphere {summary.get('troposphere')}"
+    )
     for st, (b, s) in summary["range_bias_m"].items():
         lines.append(f"  range bias {st}: {b:.1f} ± {s:.1f} m")
+    for name, (v, s) in summary.get("scale_factors", {}).items():
+        lines.append(f"  {name}: {v:.3f} ± {s:.3f}")
     acc = summary.get("unmodelled_acceleration")
     if acc:
         lines.append(
