@@ -18,8 +18,8 @@ from click.testing import CliRunner
 
 from abrupt.cli.main import cli
 from abrupt.model.orbit import propagate
-from abrupt.pipelines.laser_ranging import LASER_FORCE
 from abrupt.model.tracking_measurements import earth_rotation_matrices
+from abrupt.pipelines.laser_ranging import LASER_FORCE
 from abrupt.readers.ephemeris import write_ephemeris
 from abrupt.series.ephemeris import Ephemeris
 from abrupt.simulate.slr import SlrScenario, SlrSimulation, simulate_slr

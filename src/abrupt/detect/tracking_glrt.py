@@ -285,6 +285,9 @@ def fit_orbit(
     states = np.empty((n, 6))
     dmat = np.empty((n, 6, 9 + len(scales) + 3 * n_imp))
     cov = np.full((len(names), len(names)), np.nan)
+    base: _Parameters | None = None
+    last_step = np.zeros(len(names))
+    halvings = 0
     for it in range(1, cfg.max_iterations + 1):
         states, dmat = trajectory(
             x,
@@ -313,6 +316,14 @@ def fit_orbit(
             cfg.troposphere,
         )
         cost = float(np.sum(resid[used] ** 2))
+        if base is not None and halvings < 8 and (not math.isfinite(cost) or cost > 1.5 * prev_cost + 10.0):
+            # Gauss-Newton overshot (far from the minimum the linearisation fails, e.g. an a-priori
+            # orbit kilometres off over a long arc): go back and take half the step (step halving,
+            # Dennis & Schnabel 1983 §6.3); a converging fit never gets here
+            halvings += 1
+            x, bias, accel, scales, dv = _apply_step(base, last_step, 0.5**halvings, bias_keys, n_imp)
+            continue
+        halvings = 0
         near = it >= 2 and abs(prev_cost - cost) <= 0.1 * max(cost, 1.0)
         if cfg.outlier_sigma is not None and 3 <= it <= 5 and near:  # re-select outliers, then freeze the set
             # only once the fit has settled (cost changing by < 10%), and never most of the data: far from
@@ -333,20 +344,9 @@ def fit_orbit(
             converged = True
             break
         prev_cost = cost
-        x = x + step[:6]
-        k = 6
-        for key in bias_keys:
-            bias[key] += step[k]
-            k += 1
-        if cfg.estimate_acceleration:
-            accel = accel + step[k : k + 3]
-            k += 3
-        for name in scales:
-            scales[name] += step[k]
-            k += 1
-        for j in range(n_imp):
-            dv[j] += step[k : k + 3]
-            k += 3
+        base = (x.copy(), dict(bias), accel.copy(), dict(scales), dv.copy(), cfg.estimate_acceleration)
+        last_step = step
+        x, bias, accel, scales, dv = _apply_step(base, step, 1.0, bias_keys, n_imp)
     return BatchFit(
         x0=x,
         t0_s=t0_s,
@@ -372,6 +372,44 @@ def fit_orbit(
         states=states,
         config=cfg,
     )
+
+
+_Parameters = tuple[
+    NDArray[np.float64],
+    dict[tuple[str, int], float],
+    NDArray[np.float64],
+    dict[str, float],
+    NDArray[np.float64],
+    bool,
+]
+
+
+def _apply_step(
+    base: _Parameters, step: NDArray[np.float64], factor: float, bias_keys: list[tuple[str, int]], n_imp: int
+) -> tuple[
+    NDArray[np.float64], dict[tuple[str, int], float], NDArray[np.float64], dict[str, float], NDArray[np.float64]
+]:
+    """``base`` parameters (state, biases, acceleration, scales, impulses) plus ``factor`` × ``step``."""
+    x0, bias0, accel0, scales0, dv0, with_accel = base
+    x = x0 + factor * step[:6]
+    bias = dict(bias0)
+    k = 6
+    for key in bias_keys:
+        bias[key] += factor * step[k]
+        k += 1
+    accel = accel0.copy()
+    if with_accel:
+        accel = accel0 + factor * step[k : k + 3]
+        k += 3
+    scales = dict(scales0)
+    for name in scales:
+        scales[name] += factor * step[k]
+        k += 1
+    dv = dv0.copy()
+    for j in range(n_imp):
+        dv[j] += factor * step[k : k + 3]
+        k += 3
+    return x, bias, accel, scales, dv
 
 
 def _residuals(
