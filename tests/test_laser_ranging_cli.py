@@ -152,3 +152,19 @@ def test_detect_laser_names_an_apriori_ephemeris_that_starts_after_the_ranges(
     err = capsys.readouterr().err
     assert "late.oem" in err and "does not cover" in err
     assert len(err.strip().splitlines()) == 1
+
+
+def test_detect_laser_estimates_station_time_biases_near_zero_when_there_are_none(
+    files: dict[str, Path], tmp_path: Path
+) -> None:
+    out = tmp_path / "events.csv"
+    args = ["detect", "laser", str(files["crd"]), "--sinex", str(files["snx"]), "--apriori", str(files["oem"])]
+    args += ["--time-biases", "--out", str(out), "--catalog", str(tmp_path / "c.sqlite")]
+    args += ["--fit-out", str(tmp_path / "fit.json")]
+    result = CliRunner().invoke(cli, args, catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    assert len(pd.read_csv(out)) == 0
+    fit = pd.read_json(tmp_path / "fit.json", typ="series")
+    biases = fit["time_bias_us"]
+    assert set(biases) == set(CDP)
+    assert max(abs(v) for v in biases.values()) < 5.0  # µs; 3 mm at a few km/s of range rate is ~1 µs

@@ -67,6 +67,12 @@ TERMS = ("light_time", "troposphere", "shapiro", "plate_motion", "eccentricity",
     show_default=True,
     help="Exponential-atmosphere drag with an estimated scale (satellites below ~1,500 km, e.g. Stella).",
 )
+@click.option(
+    "--time-biases/--no-time-biases",
+    default=False,
+    show_default=True,
+    help="Estimate each station's time-tag offset (a common offset of all stations is not observable).",
+)
 @click.option("--spacecraft", default=None, help="Pseudonym for the events (default: the CRD target name).")
 @click.option("--fit-out", default=None, type=click.Path(dir_okay=False), help="Write the fit summary (JSON).")
 @click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Events (.csv or .parquet).")
@@ -82,6 +88,7 @@ def detect_laser_command(
     gravity_degree: int,
     area_to_mass_m2_per_kg: float,
     drag: bool,
+    time_biases: bool,
     spacecraft: str | None,
     fit_out: str | None,
     out: str,
@@ -111,6 +118,7 @@ def detect_laser_command(
         spacecraft=spacecraft,
         max_maneuvers=max_maneuvers,
         arc_days=arc_days,
+        time_biases=time_biases,
         force=replace(
             LASER_FORCE,
             gravity_degree=gravity_degree,

@@ -411,6 +411,10 @@ class LaserRangingRun:
         lines = [f"post-fit range RMS per station (mm): {self.summary['residual_rms_mm']}"]
         lines.append(f"station sigma scale (post-fit / stated, last arc): {self.summary['sigma_scale']}")
         lines.append(f"range biases (mm, last arc): {self.summary['range_bias_mm']}")
+        if self.summary.get("scale_factors"):
+            lines.append(f"force scale factors (last arc): {self.summary['scale_factors']}")
+        if self.summary.get("time_bias_us"):
+            lines.append(f"time biases (µs, last arc): {self.summary['time_bias_us']}")
         arcs = self.summary.get("arcs", [])
         lines.append(f"arcs fitted: {len(arcs) if isinstance(arcs, list) else arcs}")
         lines += [f"repaired: {k} ({n})" for k, n in self.result.repairs.counts.items()]
@@ -456,6 +460,7 @@ def run_laser_ranging_files(
     arc_days: float = 7.0,
     overlap_days: float = 1.0,
     force: ForceModel | None = None,
+    time_biases: bool = False,
 ) -> LaserRangingRun:
     """Read CRD normal points, SINEX sites and an a-priori ephemeris; detect maneuvers; build events.
 
@@ -463,7 +468,8 @@ def run_laser_ranging_files(
     Moon and solar radiation pressure with a conical shadow, its scale estimated per arc; one orbit
     model, :mod:`abrupt.model.orbit`), integrated with the eighth-order fixed-step Runge-Kutta at
     ``step_s`` (s); a force with drag also gets its drag scale estimated. Per-station range biases
-    absorb the satellite's centre-of-mass offset. Files longer than ``arc_days`` are fitted in overlapping arcs
+    absorb the satellite's centre-of-mass offset; with ``time_biases`` each station's time-tag offset is
+    estimated too (∂ρ/∂δt = −ρ̇). Files longer than ``arc_days`` are fitted in overlapping arcs
     (:func:`detect_laser_ranging_arcs`), each started from the ephemeris where it covers the arc epoch.
     """
     from abrupt.detect.tracking_glrt import glrt_events
@@ -508,7 +514,13 @@ def run_laser_ranging_files(
     if apriori(epoch) is None:
         raise ValueError(f"{apriori_path}: the ephemeris does not cover the first range epoch {epoch}")
     force = force or LASER_FORCE
-    cfg = replace(LASER_FIT_CONFIG, force=force, max_step_s=step_s, estimate_scales=estimated_scales(force))
+    cfg = replace(
+        LASER_FIT_CONFIG,
+        force=force,
+        max_step_s=step_s,
+        estimate_scales=estimated_scales(force),
+        estimate_time_bias=time_biases,
+    )
     result = detect_laser_ranging_arcs(
         meas,
         sites,
@@ -526,6 +538,7 @@ def run_laser_ranging_files(
     settings = {
         "range_model": model.__dict__,
         "force": repr(force),
+        "time_biases": time_biases,
         "budget": str(budget),
         "step_s": step_s,
         "max_maneuvers": max_maneuvers,
@@ -549,6 +562,7 @@ def run_laser_ranging_files(
         "sigma_scale": {k: round(v, 2) for k, v in result.arcs[-1].result.sigma_scale.items()},
         "range_bias_mm": {k: round(v * 1000, 1) for k, v in result.arcs[-1].result.fit.range_bias_m.items()},
         "scale_factors": {k: round(v, 4) for k, v in result.arcs[-1].result.fit.scale_factors.items()},
+        "time_bias_us": {k: round(v * 1e6, 2) for k, v in result.arcs[-1].result.fit.time_bias_s.items()},
         "arcs": [
             {
                 "epoch_utc": str(arc.epoch_utc),
