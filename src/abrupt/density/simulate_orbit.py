@@ -51,7 +51,7 @@ def simulate_precise_orbit(
 ) -> SyntheticPreciseOrbit:
     """``len(drag_scales)`` days of a near-circular orbit with the drag of ``force`` times each day's
     scale (its ``srp_scale`` is the SRP truth). Returns the ephemeris and the truth per day."""
-    epoch = np.datetime64(epoch_utc, "ns")
+    epoch = np.asarray(epoch_utc, dtype="datetime64[ns]").reshape(-1)[0]
     rng = np.random.default_rng(seed)
     x = coe_to_rv(
         R_EARTH_M + altitude_km * 1e3,
