@@ -131,6 +131,7 @@ def density_tle(
 )
 @click.option("--gravity-degree", type=int, default=40, show_default=True, help="EGM2008 degree and order.")
 @click.option("--no-srp-fit", is_flag=True, help="Keep the SRP scale at 1 instead of fitting it.")
+@click.option("--no-empirical", is_flag=True, help="Do not fit once-per-rev along/cross-track empirical accelerations.")
 @click.option(
     "--space-weather",
     type=click.Path(exists=True, dir_okay=False),
@@ -152,6 +153,7 @@ def density_orbit(
     density_model: str,
     gravity_degree: int,
     no_srp_fit: bool,
+    no_empirical: bool,
     space_weather: str | None,
     allow_truncated: bool,
     report: str | None,
@@ -178,6 +180,7 @@ def density_orbit(
         window_days=window_days,
         gravity_degree=gravity_degree,
         fit_srp=not no_srp_fit,
+        empirical=() if no_empirical else base.empirical,
         density_model=density_model,
         mass_kg=mass,
         drag_area_m2=area,

@@ -6,12 +6,15 @@ model and a free drag factor. For each window (one day by default) the positions
 by Gauss-Newton batch least squares (Montenbruck & Gill 2000, §8.1-8.2; Tapley, Schutz & Born 2004,
 §4.3) of
 
-    p = (r₀, v₀, k_D, k_SRP),     r(t) = propagated with a = a_grav + a_3body + k_D a_D + k_SRP a_SRP,
+    p = (r₀, v₀, k_D, k_SRP, C),   r(t) = propagated with a = a_grav + a_3body + k_D a_D + k_SRP a_SRP + a_CPR,
 
 with the one orbit model of abrupt (:mod:`abrupt.model.orbit`: spherical-harmonic field with IERS
 orientation, Sun and Moon, cannonball SRP with conical shadow, drag −½ C_D A/m ρ |v_rel| v_rel) and
 the partials from the variational equations (:func:`abrupt.model.orbit.propagate_with_stm` with
-``parameters=("drag_scale", "srp_scale")``). k_D multiplies the drag of the reference density ρ_ref
+``parameters=("drag_scale", "srp_scale", ...)``); C are once-per-revolution empirical accelerations
+(along-track and cross-track, cos u and sin u of the argument of latitude u; Montenbruck & Gill 2000
+§3.7.3), which absorb what repeats every revolution (SRP of a box-wing, the day/night density
+bulge) but not the orbit-mean along-track drag. k_D multiplies the drag of the reference density ρ_ref
 (NRLMSIS 2.1 tabulated along the observed orbit when the kernels support it, else the exponential
 model) with the nominal ballistic coefficient B₀ = C_D A/m, so the window's drag-weighted
 
@@ -36,7 +39,14 @@ import numpy as np
 import pandas as pd
 
 from abrupt.errors import RepairLog
-from abrupt.model.orbit import ForceContext, ForceModel, propagate_with_stm
+from abrupt.model.orbit import (
+    EMPIRICAL_PARAMETERS,
+    ESTIMABLE_PARAMETERS,
+    SCALE_PARAMETERS,
+    ForceContext,
+    ForceModel,
+    propagate_with_stm,
+)
 from abrupt.model.orbit.constants import MU_EARTH_M3_S2, OMEGA_EARTH_RAD_S
 from abrupt.model.orbit.forces import F_DRAG_SCALE, F_SRP_SCALE, I_DRAG
 from abrupt.series.ephemeris import Ephemeris
@@ -77,6 +87,9 @@ class OrbitDensityConfig:
     columns are left empty (only ρB, which does not depend on the nominal B₀, is meaningful).
     ``density_model``: "msis" (NRLMSIS along the observed orbit inside the kernels, when available)
     or "exponential" (Vallado Table 8-4). ``window_days``: length of each fit; ``max_step_s``: RK8 step.
+    ``empirical``: once-per-revolution accelerations estimated with the drag (default along-track and
+    cross-track cos u, sin u: they absorb SRP-shape and density day/night errors that repeat every
+    revolution, and are orthogonal to the orbit-mean along-track drag that K measures).
     """
 
     window_days: float = 1.0
@@ -96,6 +109,7 @@ class OrbitDensityConfig:
     tolerance_m: float = 1e-3
     min_fraction: float = 0.6
     period_lags: float = 1.0
+    empirical: tuple[str, ...] = ("cpr_t_cos", "cpr_t_sin", "cpr_n_cos", "cpr_n_sin")
 
     def __post_init__(self) -> None:
         if self.window_days <= 0:
@@ -104,6 +118,14 @@ class OrbitDensityConfig:
             raise ValueError(f"density_model must be 'msis' or 'exponential', got {self.density_model!r}")
         if self.mass_kg <= 0 or self.drag_area_m2 <= 0 or self.drag_coefficient <= 0:
             raise ValueError("mass_kg, drag_area_m2 and drag_coefficient must be positive")
+        bad = [p for p in self.empirical if p not in EMPIRICAL_PARAMETERS]
+        if bad:
+            raise ValueError(f"empirical terms must be among {EMPIRICAL_PARAMETERS}, got {bad}")
+
+    @property
+    def parameters(self) -> tuple[str, ...]:
+        """The force parameters estimated besides the state, in column order."""
+        return ("drag_scale", *(("srp_scale",) if self.fit_srp else ()), *self.empirical)
 
     @property
     def ballistic_coefficient_m2_kg(self) -> float:
@@ -129,19 +151,37 @@ class OrbitDensityConfig:
 
 @dataclass
 class WindowFit:
-    """One window's batch fit: estimated parameters, their covariance (sandwich) and residuals."""
+    """One window's batch fit: the state at the first epoch, every force parameter's value (those not
+    estimated at their fixed value), the covariance (sandwich) and formal covariance of the estimated
+    ``parameters`` (state first), and the residuals (m, GCRF)."""
 
     epoch_utc: np.datetime64
     t_s: FloatArray
     state0: FloatArray
-    drag_scale: float
-    srp_scale: float
+    parameters: tuple[str, ...]
+    values: dict[str, float]
     covariance: FloatArray
     formal_covariance: FloatArray
     residual_m: FloatArray
     iterations: int
     converged: bool
     reference_density: str
+
+    @property
+    def drag_scale(self) -> float:
+        return self.values["drag_scale"]
+
+    @property
+    def srp_scale(self) -> float:
+        return self.values["srp_scale"]
+
+    def sigma(self, name: str, *, formal: bool = False) -> float:
+        """1σ of an estimated parameter (NaN when it was not estimated)."""
+        if name not in self.parameters:
+            return math.nan
+        i = self.parameters.index(name)
+        c = self.formal_covariance if formal else self.covariance
+        return math.sqrt(max(float(c[i, i]), 0.0))
 
 
 @dataclass
@@ -195,70 +235,72 @@ def fit_window(
     ctx: ForceContext,
     config: OrbitDensityConfig,
 ) -> WindowFit:
-    """Gauss-Newton batch fit of (r₀, v₀, k_D[, k_SRP]) to positions ``r_obs_m`` (n, 3, GCRF) at ``t_s``
-    (s from the context epoch; the state is at ``t_s[0]``). ``v_guess_mps`` starts the iteration."""
-    params = ("drag_scale", "srp_scale") if config.fit_srp else ("drag_scale",)
+    """Gauss-Newton batch fit of (r₀, v₀, k_D[, k_SRP][, CPR coefficients]) to positions ``r_obs_m``
+    (n, 3, GCRF) at ``t_s`` (s from the context epoch; the state is at ``t_s[0]``). ``v_guess_mps``
+    starts the iteration."""
+    params = config.parameters
     n_p = 6 + len(params)
     x0 = np.concatenate([r_obs_m[0], v_guess_mps])
-    scales = np.array([1.0, 1.0])
+    values = {p: (1.0 if p in SCALE_PARAMETERS else 0.0) for p in ESTIMABLE_PARAMETERS}
     t0 = float(t_s[0])
     period_s = 2 * math.pi * math.sqrt(float(np.linalg.norm(r_obs_m[0])) ** 3 / MU_EARTH_M3_S2)
     step = float(np.median(np.diff(t_s))) if t_s.size > 1 else 60.0
     lags = max(1, round(config.period_lags * period_s / step))
     jac = np.zeros((t_s.size, 3, n_p))
-    res = np.zeros((t_s.size, 3))
-    converged = False
-    it = 0
-    normal = np.eye(n_p)
-    for it in range(1, config.max_iterations + 1):  # noqa: B007 (the count is reported)
-        c = _with_scales(ctx, float(scales[0]), float(scales[1]))
+
+    def evaluate() -> FloatArray:
+        c = _with_scales(ctx, values["drag_scale"], values["srp_scale"])
+        emp = [values[p] for p in EMPIRICAL_PARAMETERS]
         states, stm, sens = propagate_with_stm(
-            x0, t0, t_s, force=c, max_step_s=config.max_step_s, method="rk8", parameters=params
+            x0, t0, t_s, force=c, max_step_s=config.max_step_s, method="rk8", parameters=params, empirical_mps2=emp
         )
-        res = r_obs_m - states[:, :3]
         jac[:, :, :6] = stm[:, :3, :]
         jac[:, :, 6:] = sens[:, :3, 3:]
+        return np.asarray(r_obs_m - states[:, :3])
+
+    converged = False
+    it = 0
+    for it in range(1, config.max_iterations + 1):  # noqa: B007 (the count is reported)
+        res = evaluate()
         a = jac.reshape(-1, n_p)
         col = np.linalg.norm(a, axis=0)
         col[col == 0] = 1.0
-        dx, *_ = np.linalg.lstsq(a / col, res.reshape(-1), rcond=None)
+        an = a / col
+        dx, *_ = np.linalg.lstsq(an, res.reshape(-1), rcond=None)
+        # formal σ of each parameter with this iteration's residual variance
+        sig = np.sqrt(np.diag(np.linalg.pinv(an.T @ an)) * float(np.mean(res**2)) * 3.0) / col
         dx /= col
         x0 = x0 + dx[:6]
-        scales[: len(params)] += dx[6:]
-        # the change of the fitted positions this step (first-order), to stop on
-        if float(np.sqrt(np.mean((a @ dx) ** 2))) < config.tolerance_m:
+        for p, d in zip(params, dx[6:], strict=True):
+            values[p] += float(d)
+        # stop when the fitted positions move less than the tolerance and every parameter less than
+        # 1 % of its σ (nearly degenerate pairs, SRP and CPR, creep on after the positions settle)
+        moved = float(np.sqrt(np.mean((a @ dx) ** 2)))
+        if moved < config.tolerance_m and bool(np.all(np.abs(dx) < 0.01 * np.maximum(sig, 1e-300))):
             converged = True
             break
-    c = _with_scales(ctx, float(scales[0]), float(scales[1]))
-    states, stm, sens = propagate_with_stm(
-        x0, t0, t_s, force=c, max_step_s=config.max_step_s, method="rk8", parameters=params
-    )
-    res = r_obs_m - states[:, :3]
-    jac[:, :, :6] = stm[:, :3, :]
-    jac[:, :, 6:] = sens[:, :3, 3:]
+    res = evaluate()
     a = jac.reshape(-1, n_p)
-    normal = a.T @ a
-    inv = np.linalg.pinv(normal)
+    col = np.linalg.norm(a, axis=0)
+    col[col == 0] = 1.0
+    an = a / col  # columns of m/(m/s²) and m/1: invert the equilibrated normal matrix
+    inv = np.linalg.pinv(an.T @ an) / np.outer(col, col)
     dof = max(1, a.shape[0] - n_p)
-    sigma2 = float(np.sum(res**2)) / dof
-    formal = inv * sigma2
+    formal = np.asarray(inv * (float(np.sum(res**2)) / dof), dtype=np.float64)
     cov = inv @ _hac_meat(jac, res, lags) @ inv
     # never state less than the formal error (a sandwich from one short arc is itself noisy):
     # rescale rows and columns so each variance is at least the formal one, correlations kept
     sd = np.sqrt(np.maximum(np.diag(cov), 1e-300))
-    cov = cov * np.outer(np.maximum(sd, np.sqrt(np.diag(formal))) / sd, np.maximum(sd, np.sqrt(np.diag(formal))) / sd)
-    full = np.zeros((8, 8))
-    full_f = np.zeros((8, 8))
-    full[:n_p, :n_p] = cov
-    full_f[:n_p, :n_p] = formal
+    f = np.maximum(sd, np.sqrt(np.diag(formal))) / sd
+    cov = cov * np.outer(f, f)
     return WindowFit(
         epoch_utc=ctx.epoch_utc,
         t_s=t_s,
         state0=x0,
-        drag_scale=float(scales[0]),
-        srp_scale=float(scales[1]),
-        covariance=full,
-        formal_covariance=full_f,
+        parameters=("x", "y", "z", "vx", "vy", "vz", *params),
+        values=values,
+        covariance=cov,
+        formal_covariance=formal,
         residual_m=res,
         iterations=it,
         converged=converged,
@@ -353,19 +395,19 @@ def fit_orbit_density(
         rho_model = float(np.sum(rho_msis * w3) / np.sum(w3))
         rho_ref = _reference_density(fit.reference_density, r, rho_msis)
         ref_mean = float(np.sum(rho_ref * w3) / np.sum(w3))
-        k, sk = fit.drag_scale, math.sqrt(fit.covariance[6, 6])
+        k, sk = fit.drag_scale, fit.sigma("drag_scale")
         rho_b = k * b0 * ref_mean
         row.update(
             drag_scale=k,
             drag_scale_sigma=sk,
             srp_scale=fit.srp_scale if cfg.fit_srp else np.nan,
-            srp_scale_sigma=math.sqrt(fit.covariance[7, 7]) if cfg.fit_srp else np.nan,
+            srp_scale_sigma=fit.sigma("srp_scale"),
             rho_b_per_m=rho_b,
             rho_b_sigma_per_m=sk * b0 * ref_mean,
             model_density_kg_m3=rho_model,
             altitude_km=float(np.mean(h_km)),
             residual_rms_m=float(np.sqrt(np.mean(np.sum(fit.residual_m**2, axis=1)))),
-            formal_drag_scale_sigma=math.sqrt(fit.formal_covariance[6, 6]),
+            formal_drag_scale_sigma=fit.sigma("drag_scale", formal=True),
             iterations=fit.iterations,
             reference_density=fit.reference_density,
             status="ok" if fit.converged else "not_converged",
