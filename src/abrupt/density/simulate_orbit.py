@@ -18,7 +18,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pandas as pd
 
-from abrupt.model.orbit import ForceContext, ForceModel, coe_to_rv, propagate
+from abrupt.model.orbit import ForceContext, ForceModel, coe_to_rv, propagate, propagate_with_stm
 from abrupt.model.orbit.constants import MU_EARTH_M3_S2, OMEGA_EARTH_RAD_S, R_EARTH_M
 from abrupt.model.orbit.forces import EXPONENTIAL_ATMOSPHERE, exponential_density, msis_density
 from abrupt.series.ephemeris import Ephemeris
@@ -48,9 +48,14 @@ def simulate_precise_orbit(
     noise_m: float = 0.02,
     seed: int = 0,
     satellite: str = "L99",
+    integrator: str = "dop853",
 ) -> SyntheticPreciseOrbit:
     """``len(drag_scales)`` days of a near-circular orbit with the drag of ``force`` times each day's
-    scale (its ``srp_scale`` is the SRP truth). Returns the ephemeris and the truth per day."""
+    scale (its ``srp_scale`` is the SRP truth). Returns the ephemeris and the truth per day.
+
+    ``integrator``: "dop853" (adaptive with steps of at most 10 s, any density model) or "rk8" (fixed
+    5 s steps, densities the kernels hold: exponential). Uncapped DOP853 steps straddle the ~10 s
+    penumbra and left decimetres of SRP error a day: 3.6 % of the drag at 800 km on one day of three."""
     epoch = np.asarray(epoch_utc, dtype="datetime64[ns]").reshape(-1)[0]
     rng = np.random.default_rng(seed)
     x = coe_to_rv(
@@ -69,7 +74,12 @@ def simulate_precise_orbit(
     for d, k in enumerate(drag_scales):
         ctx = ForceContext.build(replace(force, drag_scale=k), epoch, -3600.0, n_days * SECONDS_PER_DAY + 3600.0)
         t = np.arange(d * SECONDS_PER_DAY, (d + 1) * SECONDS_PER_DAY + 0.5 * step_s, step_s)
-        st = propagate(x, t, force=ctx, t0_s=float(t[0]), rtol=1e-12)
+        if integrator == "rk8":
+            if force.drag == "msis":
+                raise ValueError("rk8 truth needs a density the numba kernels hold (exponential)")
+            st, _, _ = propagate_with_stm(x, float(t[0]), t, force=ctx, max_step_s=5.0, method="rk8")
+        else:
+            st = propagate(x, t, force=ctx, t0_s=float(t[0]), rtol=1e-12, max_step_s=10.0)
         x = st[-1]
         t, st = t[:-1], st[:-1]
         rho = np.array([_density(force, ctx0, float(tk), sk[:3]) for tk, sk in zip(t, st, strict=True)]) * k

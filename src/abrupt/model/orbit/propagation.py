@@ -88,10 +88,15 @@ def propagate(
     burns: Sequence[FiniteBurn] = (),
     rtol: float = 1e-12,
     atol_m: float = 1e-6,
+    max_step_s: float = math.inf,
 ) -> FloatArray:
     """States (n, 6) at ``t_out_s`` (s from the force context's epoch; sorted, ≥ ``t0_s``) from ``state0``
     at ``t0_s``, with inertial impulses [(t_s, dv)] and finite burns on the way. An output time equal to
-    an impulse time gets the state after the impulse (a measurement at that epoch sees it)."""
+    an impulse time gets the state after the impulse (a measurement at that epoch sees it).
+
+    ``max_step_s`` caps DOP853's steps: with SRP its error control does not see the ~10 s penumbra
+    (a kink in the force), and steps of minutes that straddle it leave decimetres a day; 10 s steps
+    resolve it (as fixed-step RK8 at 5-20 s does)."""
     t_out = np.asarray(t_out_s, dtype=np.float64)
     if t_out.size == 0:
         return np.empty((0, 6))
@@ -140,18 +145,18 @@ def propagate(
 
         last = j == len(edges) - 2
         sel = (t_out >= ta) & ((t_out < tb) | (last & (t_out <= tb)))
-        sol = solve_segment(rhs, ta, tb, state, rtol, atol_m)
+        sol = solve_segment(rhs, ta, tb, state, rtol, atol_m, max_step_s)
         if sel.any():
             out[sel] = sol.sol(t_out[sel]).T
         state = sol.y[:, -1]
     return out
 
 
-def solve_segment(rhs, ta: float, tb: float, state: FloatArray, rtol: float, atol: float):
+def solve_segment(rhs, ta: float, tb: float, state: FloatArray, rtol: float, atol: float, max_step: float = math.inf):
     """DOP853 over [ta, tb] with dense output; raises RuntimeError when the integrator fails."""
     from scipy.integrate import solve_ivp
 
-    sol = solve_ivp(rhs, (ta, tb), state, method="DOP853", rtol=rtol, atol=atol, dense_output=True)
+    sol = solve_ivp(rhs, (ta, tb), state, method="DOP853", rtol=rtol, atol=atol, dense_output=True, max_step=max_step)
     if not sol.success:
         raise RuntimeError(f"orbit propagation failed: {sol.message}")
     return sol
