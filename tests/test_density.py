@@ -473,7 +473,7 @@ def test_cli_constellation_joint_density_against_simulated_truth(tmp_path: Path)
 
 
 def test_cli_density_orbit_recovers_known_drag_and_counts_a_short_window(tmp_path: Path) -> None:
-    """Slide "From ranging data": two days of a simulated 450 km orbit (DOP853 truth, EGM2008 8×8, Sun,
+    """Slide "From ranging data": two days of a simulated 450 km orbit (RK8 truth at 5 s, EGM2008 8×8, Sun,
     Moon, SRP ×1.1, drag ×1.3 then ×1.8 of the exponential density) sampled every 60 s with 2 cm noise
     and written as SP3; `abrupt density orbit` fits each day by batch least squares. The drag scale,
     the density (ρ̄ of the truth along the true orbit) and ρB are recovered within the stated σ; a
@@ -497,7 +497,7 @@ def test_cli_density_orbit_recovers_known_drag_and_counts_a_short_window(tmp_pat
         srp_area_m2=5.0,
         srp_scale=1.1,
     )
-    sim = simulate_precise_orbit(force, "2018-12-24T00:00:00", [1.3, 1.8, 1.0], seed=3)
+    sim = simulate_precise_orbit(force, "2018-12-24T00:00:00", [1.3, 1.8, 1.0], seed=3, integrator="rk8")
     eph = sim.ephemeris
     keep = eph.times_utc < np.datetime64("2018-12-26T10:00:00")  # the third day is 10 h long
     path = tmp_path / "sim.sp3"
