@@ -759,6 +759,7 @@ def refine_burn_time(
     search_sets_before: int = 2,
     geo: bool = False,
     bounds: tuple[int, int] | None = None,
+    t_s: NDArray[np.float64] | None = None,
 ) -> tuple[float, bool]:
     """Burn time (s from the first epoch) by along-track position continuity (module docstring, step 4).
 
@@ -777,13 +778,18 @@ def refine_burn_time(
     then often timed on a neighbour's hinge and merged with it).
     """
     el = history.elements
-    t = elapsed_si_seconds(el["epoch_utc"])  # SI seconds: a leap second is 7 km along-track
+    # SI seconds (a leap second is 7 km along-track); ``t_s`` when the caller has them already
+    t = elapsed_si_seconds(el["epoch_utc"]) if t_s is None else t_s
     n = t.size
     mid = 0.5 * (t[gap] + t[gap + 1])
     lo = max(0, gap - window_sets + 1)
     hi = min(n, gap + 1 + window_sets)
     if bounds is not None and gap - max(lo, bounds[0]) >= 2 and min(hi, bounds[1]) - (gap + 1) >= 2:
         lo, hi = max(lo, bounds[0]), min(hi, bounds[1])  # else too few sets inside: the whole window
+    elif bounds is not None and TWO_SET_TIMING:
+        t_two = two_set_burn_time(history, t, gap, search_sets_before)
+        if t_two is not None:
+            return t_two, True
     if gap - lo < 2 or hi - (gap + 1) < 2:
         return mid, False
 
@@ -822,6 +828,53 @@ def is_phasing(steps: StepSeries, g: int, significance: float = 5.0) -> bool:
     w = steps.weights
     others = max(w[0] * float(steps.z_a[g]), w[1] * float(steps.z_e[g]), w[2] * float(steps.z_n[g]))
     return steps.weight_u * float(steps.z_u[g]) >= significance and others < significance
+
+
+TWO_SET_TIMING = True
+
+
+def two_set_burn_time(history: ElementHistory, t: NDArray[np.float64], gap: int, sets_before: int = 3) -> float | None:
+    """Burn time from the two element sets that bracket the step alone (s, same origin as ``t``).
+
+    With the sets' SGP4 mean-argument-of-latitude rates ``u̇_g``, ``u̇_{g+1}`` (their change Δu̇ is
+    the burn's drift-rate change) the phase innovation across the gap is
+    ``δ = wrap(u_{g+1} − u_g − ½(u̇_g + u̇_{g+1}) Δt) = −Δu̇ (t_b − t_g − Δt/2)``, hence
+    ``t_b = t_g + Δt/2 − δ/Δu̇`` (one impulse; Vallado 2013 Eq. 9-41 integrated over the gap).
+    Used inside campaigns, where a longer window holds the neighbouring burns' hinges. ``None`` when
+    the time falls outside ``[t_{g−sets_before}, t_{g+1}]`` (TLE lag may put a burn before the set
+    preceding the step, never after the set following it) or the rate did not change.
+    """
+    sats = history.satrecs
+
+    def innovation(k: int) -> tuple[float, float, float]:
+        a, b = sats[k], sats[k + 1]
+        r_a, r_b = (a.argpdot + a.mdot) / 60.0, (b.argpdot + b.mdot) / 60.0  # [rad/s]
+        dt_k = float(t[k + 1] - t[k])
+        return (
+            math.remainder((b.argpo + b.mo) - (a.argpo + a.mo) - 0.5 * (r_a + r_b) * dt_k, 2 * math.pi),
+            r_b - r_a,
+            dt_k,
+        )
+
+    raw, d_rate, dt = innovation(gap)
+    if not abs(d_rate) * dt > 1e-6:
+        return None
+    # the phase drift the SGP4 rates leave unexplained around the gap (drag-model mismatch): the
+    # median innovation rate of the quiet gaps among five each side (mean-motion change < 1/10 of
+    # this one's, so campaign neighbours are left out), removed when at least three are quiet
+    near = [innovation(k) for k in range(max(0, gap - 5), min(len(sats) - 1, gap + 6)) if k != gap]
+    quiet = [d / max(dtk, 60.0) for d, dr, dtk in near if abs(dr) < 0.1 * abs(d_rate)]
+    if len(quiet) >= 3:
+        raw -= float(np.median(quiet)) * dt
+    t_lo = float(t[max(0, gap - sets_before)])
+    best: float | None = None
+    best_k = 0
+    for k in range(-3, 4):  # phase ambiguity: the branch that puts the burn in the allowed span
+        delta = math.remainder(raw, 2.0 * math.pi) + 2.0 * math.pi * k
+        t_b = float(t[gap]) + 0.5 * dt - delta / d_rate
+        if t_lo <= t_b <= float(t[gap + 1]) and (best is None or abs(k) < abs(best_k)):
+            best, best_k = t_b, k
+    return best
 
 
 def characterise(
@@ -1025,6 +1078,7 @@ def run_tle_detector(
                 search_sets_before=cfg.time_search_sets_before,
                 geo=regime == "geo",
                 bounds=seg if regime == "leo" else None,
+                t_s=model.t,
             )
         else:
             t_m, refined = 0.5 * (steps.t_before_s[g] + steps.t_after_s[g]), False
@@ -1036,10 +1090,17 @@ def run_tle_detector(
     # strongest, whose interval then covers both (merging only neighbouring gaps was tried: more
     # false alarms on every shared history).
     merge_s = float(np.median(np.diff(model.t))) if model.t.size > 1 else 0.0
+
+    def out_of_order(x: tuple[int, float, bool, float], y: tuple[int, float, bool, float]) -> bool:
+        # Steps in neighbouring gaps (≤ 2 apart) whose burn times run against the gaps' order are
+        # one burn spread by a set fitted across it (its partial mean motion times the later step
+        # before the earlier one), not two burns.
+        return 0 < abs(x[0] - y[0]) <= 2 and (x[0] - y[0]) * (x[1] - y[1]) < 0
+
     kept: list[tuple[int, float, bool, float]] = []
     span_of: dict[int, list[float]] = {}
     for item in sorted(timed, key=lambda it: -stat[it[0]]):
-        near = [k for k in kept if abs(item[1] - k[1]) < merge_s]
+        near = [k for k in kept if abs(item[1] - k[1]) < merge_s or out_of_order(item, k)]
         if not near:
             kept.append(item)
             span_of[item[0]] = [item[3], float(steps.t_after_s[item[0]])]
