@@ -100,13 +100,19 @@ print(json.dumps({"version": maneuver_detect.__version__, "rows": rows}))
 
 # ---------------------------------------------------------------------------------------------- abrupt
 def detect_one(
-    args: tuple[str, tuple[float, int]],
+    args: tuple[str, tuple[float, int], float],
 ) -> tuple[str, tuple[float, int], pd.DataFrame, dict[str, Any], float]:
     """Run the regime's detector on one satellite with one setting (all candidates kept)."""
-    sat, (gain, sides) = args
+    sat, (gain, sides), along = args
     history = read_tle(DATA / "tle" / f"{sat}.tle")
     cls = TleGeoStationKeeping if SATELLITES[sat][1] == "GEO" else TleMeanElements
-    det = cls(group_gain=(1.0, gain, gain), campaign_min_side_sets=sides, all_candidates=True, spacecraft=sat)
+    det = cls(
+        group_gain=(1.0, gain, gain),
+        campaign_min_side_sets=sides,
+        along_track_gain=along,
+        all_candidates=True,
+        spacecraft=sat,
+    )
     t0 = time.perf_counter()
     run = det.run(history, BUDGET)
     return sat, (gain, sides), run.events, run.noise_model, time.perf_counter() - t0
@@ -460,6 +466,12 @@ def main() -> None:
     parser.add_argument("--cache-dir", default="/tmp/abrupt_bench_cache", help="maneuver-detect output cache")
     parser.add_argument("--no-cache", action="store_true", help="re-run maneuver-detect")
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument(
+        "--along-track-gain",
+        type=float,
+        default=1.0,
+        help="gain of the along-track phase group (LEO; 0 switches it off: the sensitivity run in docs/tle.md)",
+    )
     args = parser.parse_args()
     t_start = time.perf_counter()
     sats = list(SATELLITES)
@@ -471,7 +483,7 @@ def main() -> None:
         for g in GRID[SATELLITES[s][1]]
     ]
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
-        results = list(pool.map(detect_one, jobs))
+        results = list(pool.map(detect_one, [(s, g, args.along_track_gain) for s, g in jobs]))
     runs = {(s, g): (ev, nm, sec) for s, g, ev, nm, sec in results}
     scores = {(s, g): evaluate(runs[(s, g)][0], truth[s], *spans[s], signed=True) for s, g in jobs}
 
