@@ -12,7 +12,8 @@ were its only error).
 The testbed noise (``TestbedNoise``) was calibrated on the thesis's 1° single-run SD only; the 0.5° and
 2° figures are predictions. ``--groups K`` runs K ten-run groups per configuration (4K ten-run means per
 amplitude; the thesis layout is K = 1) and prints each method's mean error with its standard error.
-Run: ``PYTHONPATH=src nice python benchmarks/bench_dabrowski.py [--quick] [--groups K] [--amplitudes 0.5,1,2]``.
+Run: ``PYTHONPATH=src nice python benchmarks/bench_dabrowski.py [--quick] [--groups K] [--amplitudes 0.5,1,2]
+[--seed S]``.
 """
 
 from __future__ import annotations
@@ -55,8 +56,10 @@ def _mean_and_se(x: list[float]) -> tuple[float, float]:
     return float(a.mean()), float(a.std(ddof=1) / math.sqrt(a.size)) if a.size > 1 else math.nan
 
 
-def main(quick: bool = False, groups: int = 1, amplitudes: tuple[float, ...] = (0.5, 1.0, 2.0)) -> None:
-    rng = np.random.default_rng(2003)
+def main(
+    quick: bool = False, groups: int = 1, amplitudes: tuple[float, ...] = (0.5, 1.0, 2.0), seed: int = 2003
+) -> None:
+    rng = np.random.default_rng(seed)
     params = SimsatParams()
     n_runs = 5 if quick else 10 * groups
     t0 = time.time()
@@ -151,5 +154,6 @@ if __name__ == "__main__":
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--groups", type=int, default=1, help="ten-run groups per configuration")
     ap.add_argument("--amplitudes", default="0.5,1,2", help="comma-separated maneuver amplitudes [deg]")
+    ap.add_argument("--seed", type=int, default=2003)
     args = ap.parse_args()
-    main(args.quick, args.groups, tuple(float(a) for a in args.amplitudes.split(",")))
+    main(args.quick, args.groups, tuple(float(a) for a in args.amplitudes.split(",")), args.seed)
