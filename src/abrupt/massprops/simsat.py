@@ -19,7 +19,10 @@ gyro wander (60-120 s period); the controller flies the gyro-integrated attitude
 
 Beyond the thesis, :func:`momentum_exchange_estimate` fits I33 from the same maneuver's telemetry by the
 momentum balance (I33 + I_rw) ψ + I_rw θ_w = H₀ t + c (the integral of Eq. 2.19c; Eq. 3.1 generalised
-to closed loop), which does not depend on the wheel's non-repeatable gain at all.
+to closed loop), which does not depend on the wheel's non-repeatable gain at all, and
+:func:`momentum_exchange_ml` fits the same balance by maximum likelihood with a gyro-error model fitted on
+the baseline runs (:func:`fit_gyro_error_model`); its spread equals :func:`white_noise_floor`, the
+Cramér-Rao bound when the gyro's white noise is the only error.
 """
 
 from __future__ import annotations
