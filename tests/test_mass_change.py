@@ -345,3 +345,20 @@ def test_ml_momentum_estimate_states_an_honest_sigma_under_the_full_testbed_nois
     z = np.array(z)
     assert 0.85 < math.sqrt(np.mean(z**2)) < 1.15
     assert 0.92 < np.mean(np.abs(z) < 2.0) < 0.98
+
+
+def test_gyro_error_model_self_calibrates_on_runs_of_unknown_inertia():
+    # With I33 unknown (each run's a a further fixed effect in the REML) the fitted white rate noise is the
+    # simulated one, and the ML estimates with that model have the same spread and an honest σ.
+    from abrupt.massprops.simsat import TestbedNoise, fit_gyro_error_model, momentum_exchange_ml, testbed_runs
+
+    noise = TestbedNoise(wheel_gain_sd=0.025, wander_deg=0.06, rate_noise_deg_s=0.07)
+    man, i_true = Maneuver.thesis(0.5), MOI_CONFIGS[3]
+    runs = testbed_runs(SimsatParams(), man, i_true, 110, noise, np.random.default_rng(13))
+    t, yaw, w = runs["t_s"], runs["yaw_meas_rad"], runs["wheel_speed_meas_rad_s"]
+    model = fit_gyro_error_model(t, yaw[:, :10], w[:, :10], None)
+    assert model.white_rate_rad_s == pytest.approx(math.radians(0.07), rel=0.03)
+    fits = [momentum_exchange_ml(t, yaw[:, k], w[:, k], model) for k in range(10, 110)]
+    z = np.array([(f.i33_kgm2 - i_true) / f.sigma_kgm2 for f in fits])
+    assert 0.8 < math.sqrt(np.mean(z**2)) < 1.2
+    assert abs(np.mean(z)) < 3.0 / math.sqrt(z.size)

@@ -420,35 +420,43 @@ class ReducedRankCovariance:
         return np.asarray(db - corr / (self.d if b.ndim == 1 else self.d[:, None]), dtype=np.float64)
 
 
-def _restricted_neg_loglik(cov: ReducedRankCovariance, resid: FloatArray, fixed: FloatArray) -> float:
-    """−log restricted likelihood (REML; Harville 1977) of residual columns with ``fixed`` effects removed."""
-    ci_f = cov.solve(fixed)
-    ff = fixed.T @ ci_f
+def _restricted_neg_loglik(cov: ReducedRankCovariance, resid: FloatArray, fixed: Sequence[FloatArray]) -> float:
+    """−log restricted likelihood (REML; Harville 1977) of residual columns, run r with fixed effects ``fixed[r]``.
+
+    For one run with fixed-effect design F: ½ (rᵀC⁻¹r − rᵀC⁻¹F (FᵀC⁻¹F)⁻¹ FᵀC⁻¹r + log|C| + log|FᵀC⁻¹F|).
+    """
     ci_r = cov.solve(resid)
-    fr = fixed.T @ ci_r
-    quad = np.sum(resid * ci_r, axis=0) - np.sum(fr * np.linalg.solve(ff, fr), axis=0)
-    _, logdet_ff = np.linalg.slogdet(ff)
-    return 0.5 * float(np.sum(quad) + resid.shape[1] * (cov.logdet + logdet_ff))
+    total = resid.shape[1] * cov.logdet
+    for k, f in enumerate(fixed):
+        ff = f.T @ cov.solve(f)
+        fr = f.T @ ci_r[:, k]
+        total += float(resid[:, k] @ ci_r[:, k] - fr @ np.linalg.solve(ff, fr)) + float(np.linalg.slogdet(ff)[1])
+    return 0.5 * total
 
 
 def fit_gyro_error_model(
     t_s: FloatArray,
     yaw_meas_rad: FloatArray,
     wheel_speed_rad_s: FloatArray,
-    i33_kgm2: float,
+    i33_kgm2: float | None,
     i_rw_kgm2: float = I_RW,
 ) -> GyroErrorModel:
-    """Fit the :class:`GyroErrorModel` to baseline runs (columns) whose I33 is known (REML, Nelder-Mead).
+    """Fit the :class:`GyroErrorModel` to runs (columns) by restricted maximum likelihood (Nelder-Mead).
 
-    With I33 known the momentum balance gives the gyro's error increments directly,
+    With I33 known (baseline runs) the momentum balance gives the gyro's error increments directly,
     Δψ − a Δθ_w (a = −I_rw/(I33 + I_rw)); their restricted likelihood (the bias removed as a fixed effect;
     Harville 1977) is maximised over the three parameters. This is the noise-model analogue of the
     thesis's Phase A (tune on the baseline runs, spec §5.3): the same baseline runs, a different use.
+    With ``i33_kgm2=None`` each run's a is a further fixed effect, so the model is fitted on runs whose
+    I33 is unknown (self-calibration; each run then costs one more degree of freedom).
     """
     dtheta, dpsi, tm, dt = _increments(t_s, np.atleast_2d(yaw_meas_rad.T).T, np.atleast_2d(wheel_speed_rad_s.T).T)
-    a0 = -i_rw_kgm2 / (i33_kgm2 + i_rw_kgm2)
-    resid = dpsi - a0 * dtheta
-    fixed = dt[:, None]
+    if i33_kgm2 is None:
+        resid = dpsi
+        fixed = [np.column_stack([dtheta[:, k], dt]) for k in range(dpsi.shape[1])]
+    else:
+        resid = dpsi - (-i_rw_kgm2 / (i33_kgm2 + i_rw_kgm2)) * dtheta
+        fixed = [dt[:, None]] * dpsi.shape[1]
     # Start: the white level from the median absolute successive difference (robust), a wander 5% of it.
     white0 = float(np.median(np.abs(np.diff(resid, axis=0)))) / (0.6745 * math.sqrt(2.0) * float(np.median(dt)))
 
