@@ -131,7 +131,7 @@ def test_detect_laser_reads_crd_sinex_and_oem_and_stays_quiet(files: dict[str, P
     assert not math.isnan(float(next(iter(fit["range_bias_mm"].values()))))
     assert fit["scale_factors"]["srp_scale"] == pytest.approx(1.2, abs=0.1)
     biases = fit["time_bias_us"]
-    assert set(biases) == set(CDP)
+    assert len(biases) == len(CDP) - 1 and set(biases) < set(CDP)  # relative to the busiest station
     assert max(abs(v) for v in biases.values()) < 5.0  # µs; 3 mm at a few km/s of range rate is ~1 µs
 
 
