@@ -266,3 +266,99 @@ def test_momentum_exchange_spread_attains_its_cramer_rao_bound_under_white_rate_
     assert np.std(est, ddof=1) == pytest.approx(crb, rel=0.2)
     # (Its mean is about 0.8% low: the controller feeds the gyro noise back into the wheel, and the
     # per-period nuisance lines make the regressor depend on later noise; see docs/mass-properties.md.)
+
+
+def test_reduced_rank_gyro_error_covariance_solves_like_the_dense_matrix():
+    # The Hilbert-space reduced-rank form (Solin & Särkkä 2020) against numpy's dense solve and slogdet,
+    # for a wander that is smooth, one that is nearly white, and one longer than the record.
+    from abrupt.massprops.simsat import GyroErrorModel, ReducedRankCovariance, gyro_error_covariance
+
+    t = np.arange(0.0, 55.025, 0.05)
+    tm, dt = 0.5 * (t[1:] + t[:-1]), np.diff(t)
+    b = np.random.default_rng(0).standard_normal((tm.size, 2))
+    for model in (GyroErrorModel(1.2e-3, 2e-5, 9.0), GyroErrorModel(1.2e-3, 1e-4, 1.0),
+                  GyroErrorModel(1.2e-3, 2e-5, 200.0)):  # fmt: skip
+        dense = gyro_error_covariance(tm, dt, model)
+        rr = ReducedRankCovariance(tm, dt, model)
+        exact = np.linalg.solve(dense, b)
+        assert np.max(np.abs(rr.solve(b) - exact)) < 1e-5 * np.max(np.abs(exact))
+        assert rr.logdet == pytest.approx(np.linalg.slogdet(dense)[1], abs=1e-3)
+
+
+def test_ml_momentum_estimate_is_unbiased_in_closed_loop_and_attains_the_white_noise_floor():
+    # White rate-gyro noise only (the controller flies it, so the wheel responds to earlier noise). The
+    # per-step-period least squares is biased low by this feedback (fixed effects, Nickell 1981); the
+    # maximum-likelihood estimate with a noise model fitted on baseline runs is not, its spread equals the
+    # Cramér-Rao floor of the white noise alone (everything else known), and its stated σ is that spread.
+    from abrupt.massprops.simsat import (
+        I33_BASELINE,
+        TestbedNoise,
+        fit_gyro_error_model,
+        momentum_exchange_ml,
+        testbed_runs,
+        white_noise_floor,
+    )
+
+    noise = TestbedNoise(wheel_gain_sd=0.0, gyro_bias_deg_min=0.0, gyro_bias_sd_deg_min=0.0, wander_deg=0.0,
+                         encoder_noise_rad_s=0.0, rate_noise_deg_s=0.07)  # fmt: skip
+    man, rng, i_true, n = Maneuver.thesis(0.5), np.random.default_rng(4), MOI_CONFIGS[2], 300
+    base = testbed_runs(SimsatParams(), man, I33_BASELINE, 10, noise, rng)
+    model = fit_gyro_error_model(base["t_s"], base["yaw_meas_rad"], base["wheel_speed_meas_rad_s"], I33_BASELINE)
+    assert model.white_rate_rad_s == pytest.approx(math.radians(0.07), rel=0.03)
+    runs = testbed_runs(SimsatParams(), man, i_true, n, noise, rng)
+    t, yaw, w = runs["t_s"], runs["yaw_meas_rad"], runs["wheel_speed_meas_rad_s"]
+    fits = [momentum_exchange_ml(t, yaw[:, k], w[:, k], model) for k in range(n)]
+    ml = np.array([f.i33_kgm2 for f in fits]) / i_true - 1.0
+    old = np.array([momentum_exchange_estimate(t, yaw[:, k], w[:, k], man) for k in range(n)]) / i_true - 1.0
+    floor = np.mean([white_noise_floor(t, runs["wheel_speed_rad_s"][:, k], i_true, math.radians(0.07))
+                     for k in range(n)]) / i_true  # fmt: skip
+    se = np.std(ml, ddof=1) / math.sqrt(n)
+    assert abs(np.mean(ml)) < 3 * se
+    assert np.mean(old) < -3 * np.std(old, ddof=1) / math.sqrt(n)
+    assert np.std(ml, ddof=1) == pytest.approx(floor, rel=0.1)
+    assert np.mean([f.sigma_kgm2 for f in fits]) / i_true == pytest.approx(np.std(ml, ddof=1), rel=0.1)
+
+
+def test_ml_momentum_estimate_states_an_honest_sigma_under_the_full_testbed_noise():
+    # Bias, wander, wheel-gain and encoder noise as in the Dabrowski benchmark: z = (Î − I)/σ̂ over runs
+    # at the four added-mass configurations has unit RMS, and the truth is inside 2σ̂ about 95% of the time.
+    from abrupt.massprops.simsat import (
+        I33_BASELINE,
+        TestbedNoise,
+        fit_gyro_error_model,
+        momentum_exchange_ml,
+        testbed_runs,
+    )
+
+    noise = TestbedNoise(wheel_gain_sd=0.025, wander_deg=0.06, rate_noise_deg_s=0.07)
+    man, rng = Maneuver.thesis(0.5), np.random.default_rng(12)
+    base = testbed_runs(SimsatParams(), man, I33_BASELINE, 10, noise, rng)
+    model = fit_gyro_error_model(base["t_s"], base["yaw_meas_rad"], base["wheel_speed_meas_rad_s"], I33_BASELINE)
+    z = []
+    for i_true in MOI_CONFIGS[1:]:
+        runs = testbed_runs(SimsatParams(), man, i_true, 60, noise, rng)
+        for k in range(60):
+            f = momentum_exchange_ml(
+                runs["t_s"], runs["yaw_meas_rad"][:, k], runs["wheel_speed_meas_rad_s"][:, k], model
+            )
+            z.append((f.i33_kgm2 - i_true) / f.sigma_kgm2)
+    z = np.array(z)
+    assert 0.85 < math.sqrt(np.mean(z**2)) < 1.15
+    assert 0.92 < np.mean(np.abs(z) < 2.0) < 0.98
+
+
+def test_gyro_error_model_self_calibrates_on_runs_of_unknown_inertia():
+    # With I33 unknown (each run's a a further fixed effect in the REML) the fitted white rate noise is the
+    # simulated one, and the ML estimates with that model have the same spread and an honest σ.
+    from abrupt.massprops.simsat import TestbedNoise, fit_gyro_error_model, momentum_exchange_ml, testbed_runs
+
+    noise = TestbedNoise(wheel_gain_sd=0.025, wander_deg=0.06, rate_noise_deg_s=0.07)
+    man, i_true = Maneuver.thesis(0.5), MOI_CONFIGS[3]
+    runs = testbed_runs(SimsatParams(), man, i_true, 110, noise, np.random.default_rng(13))
+    t, yaw, w = runs["t_s"], runs["yaw_meas_rad"], runs["wheel_speed_meas_rad_s"]
+    model = fit_gyro_error_model(t, yaw[:, :10], w[:, :10], None)
+    assert model.white_rate_rad_s == pytest.approx(math.radians(0.07), rel=0.03)
+    fits = [momentum_exchange_ml(t, yaw[:, k], w[:, k], model) for k in range(10, 110)]
+    z = np.array([(f.i33_kgm2 - i_true) / f.sigma_kgm2 for f in fits])
+    assert 0.8 < math.sqrt(np.mean(z**2)) < 1.2
+    assert abs(np.mean(z)) < 3.0 / math.sqrt(z.size)
