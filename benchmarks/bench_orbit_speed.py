@@ -47,7 +47,7 @@ def filterpy_forward(t: np.ndarray, y: np.ndarray, sigma_pos: float, sigma_vel: 
     _ = (_GL_NODES, _GL_WEIGHTS)
     for i in range(1, t.size):
         dt = t[i] - t[i - 1]
-        _process_noise(ekf.x, dt, cfg.tau_s, q, s)
+        _process_noise(ekf.x, dt, cfg.tau_s, q, cfg.nuisance_psd(), s)
         ekf.x = propagate_state(ekf.x, 0.0, dt, cfg.tau_s, args, cfg.max_step_s, phi)
         ekf.F = phi.copy()
         ekf.Q = s.copy()

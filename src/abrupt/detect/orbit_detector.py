@@ -139,7 +139,8 @@ def analyse(ephemeris: Ephemeris, config: OrbitDetectorConfig | None = None) -> 
     if np.any(np.diff(t) <= 0):
         raise ValueError("epochs must be strictly increasing")
     fc = config.filter
-    ctx = fc.force_context(eph.times_utc[0], float(t[0]), float(t[-1]))
+    # the observed orbit is the reference along which MSIS density is tabulated (when the model has it)
+    ctx = fc.force_context(eph.times_utc[0], float(t[0]), float(t[-1]), reference=(t, eph.position_m))
     with_glr = config.glr_window_samples > 0
     s_pos, s_vel = config.sigma_pos_m, config.sigma_vel_mps
     fwd = run_forward(t, eph.position_m, eph.velocity_mps, s_pos, s_vel, fc, context=ctx, store_gains=with_glr)
@@ -174,7 +175,8 @@ def analyse(ephemeris: Ephemeris, config: OrbitDetectorConfig | None = None) -> 
     if with_glr:
         stats["glr"] = glr_statistic_from_run(t, fwd, config.glr_window_samples * eph.nominal_step_s)
         # the stored gains are needed only for the statistic
-        fwd.phis, fwd.gains, fwd.sinvs = (np.zeros((0, 9, 9)), np.zeros((0, 9, 6)), np.zeros((0, 6, 6)))
+        ns = fc.n_states
+        fwd.phis, fwd.gains, fwd.sinvs = (np.zeros((0, ns, ns)), np.zeros((0, ns, 6)), np.zeros((0, 6, 6)))
     else:
         stats["glr"] = np.full(t.size, np.nan)
     valid = (t - t[0] >= config.settle_s) & (t[-1] - t >= config.settle_s)
@@ -536,7 +538,8 @@ def interval_jump(analysis: OrbitAnalysis, k_first: int, k_last: int | None = No
         xf[6:9] = 0.0
     dt = float(t[k_last] - t[k_first - 1])
     ctx = _context_of(analysis)
-    phi = np.empty((9, 9))
+    ns = xf.size
+    phi = np.empty((ns, ns))
     x_pred = propagate_state(xf, float(t[k_first - 1]), dt, 1e12, ctx.kernel_args, fc.max_step_s, phi)
     p_pred = phi @ pf @ phi.T
     # The state difference at t_last maps back through the STM to the equivalent offset at t_first−1;
@@ -552,8 +555,8 @@ def interval_jump(analysis: OrbitAnalysis, k_first: int, k_last: int | None = No
     # and the ΔV mapped there was 3× too large and mostly radial.
     t_c = t0 - float(dx0[:3] @ dx0[3:]) / max(float(dx0[3:] @ dx0[3:]), 1e-300)
     if k_last > k_first:
-        phi_acc = np.eye(9)
-        phi_k = np.empty((9, 9))
+        phi_acc = np.eye(ns)
+        phi_k = np.empty((ns, ns))
         x_k = xf.copy()
         best_r = float(np.linalg.norm(dx0[:3]))
         for j in range(k_first, k_last + 1):
@@ -567,7 +570,7 @@ def interval_jump(analysis: OrbitAnalysis, k_first: int, k_last: int | None = No
                 lead = float(dx_j[:3] @ dx_j[3:]) / max(float(dx_j[3:] @ dx_j[3:]), 1e-300)
                 t_c = float(t[j]) - float(np.clip(lead, -step_j, step_j))
     dv, dr = dx0[3:], dx0[:3]
-    phi_c = np.empty((9, 9))
+    phi_c = np.empty((ns, ns))
     for _ in range(3):
         tau_c = min(max(t_c - t0, 0.0), dt)
         propagate_state(xf, t0, tau_c, 1e12, ctx.kernel_args, fc.max_step_s, phi_c)
@@ -699,7 +702,7 @@ def locate_burn(
 
 
 def state_at(analysis: OrbitAnalysis, time_s: float) -> FloatArray:
-    """The forward filter's state (9) at ``time_s``: the a-posteriori state of the last epoch at or before it,
+    """The forward filter's state (9 or 17) at ``time_s``: the a-posteriori state of the last epoch at or before it,
     propagated with the filter's dynamics to that time (the orbit frame of a burn's centroid: taking the
     next epoch's frame instead turns it by n·Δt, up to 3.6° at 60 s sampling in LEO)."""
     t = analysis.t_s
@@ -708,7 +711,7 @@ def state_at(analysis: OrbitAnalysis, time_s: float) -> FloatArray:
     dt = float(time_s - t[k])
     if dt <= 0.0:
         return x
-    phi = np.empty((9, 9))
+    phi = np.empty((x.size, x.size))
     ctx = _context_of(analysis)
     fc = analysis.config.filter
     return np.asarray(propagate_state(x, float(t[k]), dt, fc.tau_s, ctx.kernel_args, fc.max_step_s, phi))

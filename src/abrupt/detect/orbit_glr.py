@@ -6,7 +6,7 @@ The GLR of Willsky & Jones (1976, "A generalized likelihood ratio approach to th
 estimation of jumps in linear systems", IEEE TAC 21(1)) is the maximum-likelihood estimate of the jump
 time θ and vector ν for a filter that does not model the jump:
 
-    ē_k^J = M_k ν,  M_θ = B = [0; I₃; 0],  G_k = H M_k,  M_{k+1} = Φ_{k+1} (I − K_k H) M_k,
+    ē_k^J = M_k ν,  M_θ = B = [0; I₃; 0] (zeros for the DMC and any nuisance states),  G_k = H M_k,  M_{k+1} = Φ_{k+1} (I − K_k H) M_k,
     d(θ) = Σ_k G_kᵀ S_k⁻¹ γ_k,  C(θ) = Σ_k G_kᵀ S_k⁻¹ G_k,  ν̂ = C⁻¹ d,  ℓ(θ) = dᵀ C⁻¹ d,
 
 summed over the same data for every candidate (from θ to the end of the search window plus a
@@ -70,7 +70,7 @@ def glr_kernel(
         theta = first + c
         if theta < 1 or theta >= n:
             continue
-        mm = np.zeros((9, 3))
+        mm = np.zeros((phis.shape[1], 3))
         for a in range(3):
             mm[3 + a, a] = 1.0
             mm[a, a] = lead_s[theta]
@@ -128,6 +128,7 @@ def localise_jump(
         p_post[start].copy(),
         config.tau_s,
         config.q_array(),
+        config.nuisance_psd(),
         config.max_step_s,
         ctx.kernel_args,
     )
@@ -181,7 +182,7 @@ def glr_sliding_kernel(
     n = innovs.shape[0]
     ell = np.full(n, np.nan)
     for theta in range(1, n - horizon + 1):
-        mm = np.zeros((9, 3))
+        mm = np.zeros((phis.shape[1], 3))
         for a in range(3):
             mm[3 + a, a] = 1.0
             mm[a, a] = lead_s[theta]
@@ -239,6 +240,7 @@ def glr_statistic(
         p0,
         config.tau_s,
         config.q_array(),
+        config.nuisance_psd(),
         config.max_step_s,
         ctx.kernel_args,
     )
