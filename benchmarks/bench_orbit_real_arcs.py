@@ -40,7 +40,7 @@ ARCS = {
 }
 
 
-SETTINGS: dict[str, bool] = {}
+SETTINGS: dict[str, object] = {}
 
 
 def one_injection(eph: Ephemeris, rng: np.random.Generator, dv_mps: float, arc_s: float) -> dict[str, float]:
@@ -73,8 +73,11 @@ def main() -> None:
     parser.add_argument(
         "--nuisance", action="store_true", help="estimate drag/SRP scales and once-per-rev accelerations (MSIS drag)"
     )
+    parser.add_argument("--sigma-pos-m", type=float, default=None, help="override the auto-tuned position sigma")
     args = parser.parse_args()
     SETTINGS["nuisance"] = args.nuisance
+    if args.sigma_pos_m is not None:
+        SETTINGS["sigma_pos_m"] = args.sigma_pos_m
     arc_s = args.arc_days * 86400.0
     n5 = 10 if args.quick else 30
     n_per = 6 if args.quick else 15

@@ -696,9 +696,31 @@ def locate_burn(
         mid = float(t[k]) - 0.5 * step_k
         sigma_k = float(np.hypot(step_k / np.sqrt(12.0), interval_sigma_s))
         return replace(single, centroid_s=mid, start_s=mid, centroid_sigma_s=sigma_k)
+    # the 10-90 % crossings of the piecewise-linear profile over-estimate D by up to a sampling interval
+    # when the sampling is coarse (the interpolant starts rising at the sample before the burn): +100 to
+    # +200 s for 4-15 min burns sampled every 240 s. The ramp fitted to the sampled profile with the
+    # centroid fixed (known to seconds from the position jump) has no such bias.
+    duration = ramp_duration(pt, pv, whole.centroid_s, max(duration, step))
     start = whole.centroid_s - 0.5 * duration
     sigma = float(np.hypot(whole.centroid_sigma_s, 0.25 * step))
     return replace(whole, start_s=start, duration_s=duration, centroid_sigma_s=sigma)
+
+
+def ramp_duration(t_s: FloatArray, fraction: FloatArray, centroid_s: float, d_max_s: float) -> float:
+    """Duration D (s) of a constant-acceleration burn centred on ``centroid_s`` whose cumulative ΔV fraction
+    f(t) = clip((t − t_c)/D + ½, 0, 1) best fits (least squares) the sampled ``fraction`` at ``t_s``: a
+    1-s grid over [0, 2·``d_max_s``], refined to 0.1 s. Exact for noise-free samples of any spacing."""
+    t = np.asarray(t_s, dtype=np.float64)
+    f = np.asarray(fraction, dtype=np.float64)
+
+    def cost(d: FloatArray) -> FloatArray:
+        model = np.clip((t[None, :] - centroid_s) / np.maximum(d[:, None], 1e-9) + 0.5, 0.0, 1.0)
+        return np.sum((model - f[None, :]) ** 2, axis=1)
+
+    grid = np.arange(0.0, 2.0 * d_max_s + 1.0, 1.0)
+    best = float(grid[int(np.argmin(cost(grid)))])
+    fine = np.arange(max(0.0, best - 1.0), best + 1.0, 0.1)
+    return float(fine[int(np.argmin(cost(fine)))])
 
 
 def state_at(analysis: OrbitAnalysis, time_s: float) -> FloatArray:

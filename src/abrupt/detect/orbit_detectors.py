@@ -43,9 +43,9 @@ from abrupt.detect.orbit_detector import (
     self_calibrate,
 )
 from abrupt.detect.orbit_ekf import FilterConfig, NuisanceConfig
-from abrupt.model.orbit import ForceModel
 from abrupt.events import config_hash
 from abrupt.model.frames import Ephemeris
+from abrupt.model.orbit import ForceModel
 from abrupt.thresholds import FalseAlarmBudget, Threshold
 
 TUNINGS = ("auto", "thesis")

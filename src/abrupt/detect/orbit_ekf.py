@@ -23,7 +23,8 @@ random walk (zero dynamics, driving PSD q_p): a random constant with a slow drif
 columns are ∂a/∂δk = the drag/SRP acceleration at scale 1 and ∂a/∂C_j = ê_j cos u (S_j: sin u);
 the dependence of a_emp on r, v is neglected (second order). H stays [I₆ 0].
 
-All kernels are numba-compiled with explicit loops over the state dimension (9, or 17 with nuisance); the Python wrappers take and return plain
+All kernels are numba-compiled with explicit loops over the state dimension (9, or 17 with nuisance);
+the Python wrappers take and return plain
 arrays. Process-noise γ coefficients use the closed forms of Eqs. 3.11-3.21 when |Δt/τ| ≥ 0.1 and
 Gauss-Legendre quadrature of the same integrals otherwise (the closed forms cancel catastrophically
 for Δt ≪ τ).
@@ -52,7 +53,16 @@ _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(16)
 N_CORE = 9  # r, v, w
 N_NUISANCE = 8  # δk_D, δk_SR, C_R, S_R, C_T, S_T, C_N, S_N
 I_DRAG_SCALE, I_SRP_SCALE, I_EMPIRICAL = 9, 10, 11
-NUISANCE_NAMES = ("drag_scale", "srp_scale", "emp_r_cos", "emp_r_sin", "emp_t_cos", "emp_t_sin", "emp_n_cos", "emp_n_sin")
+NUISANCE_NAMES = (
+    "drag_scale",
+    "srp_scale",
+    "emp_r_cos",
+    "emp_r_sin",
+    "emp_t_cos",
+    "emp_t_sin",
+    "emp_n_cos",
+    "emp_n_sin",
+)
 
 
 @dataclass(frozen=True)
@@ -251,7 +261,9 @@ def fogm_gammas(dt: float, tau: float, nodes: FloatArray, weights: FloatArray) -
 
 
 @nb.njit(cache=True)
-def _process_noise(x: FloatArray, dt: float, tau: float, q_rtn: FloatArray, q_nuis: FloatArray, out: FloatArray) -> None:
+def _process_noise(
+    x: FloatArray, dt: float, tau: float, q_rtn: FloatArray, q_nuis: FloatArray, out: FloatArray
+) -> None:
     """S = γ ⊗ Q̃ (9×9 DMC block) with Q̃ = M diag(q_rtn) Mᵀ, M the RTN→inertial DCM at the state x; the
     nuisance random walks add q_p·|Δt| on their diagonal with the sign of τ (the mirrored backward filter
     subtracts S, so its random walks, like its FOGM, still gain variance going backward)."""
@@ -321,9 +333,7 @@ def orbit_frame_and_latitude(r: FloatArray, v: FloatArray) -> tuple[FloatArray, 
 
 
 @nb.njit(cache=True)
-def nuisance_acceleration(
-    x: FloatArray, t: float, args: tuple, partials: FloatArray
-) -> FloatArray:
+def nuisance_acceleration(x: FloatArray, t: float, args: tuple, partials: FloatArray) -> FloatArray:
     """Acceleration (m/s², inertial) of the nuisance states of x (zero for a 9-state x), and their
     Jacobian columns ∂a/∂p (3, n − 9) in ``partials``."""
     a = np.zeros(3)

@@ -6,11 +6,12 @@ The GLR of Willsky & Jones (1976, "A generalized likelihood ratio approach to th
 estimation of jumps in linear systems", IEEE TAC 21(1)) is the maximum-likelihood estimate of the jump
 time θ and vector ν for a filter that does not model the jump:
 
-    ē_k^J = M_k ν,  M_θ = B = [0; I₃; 0] (zeros for the DMC and any nuisance states),  G_k = H M_k,  M_{k+1} = Φ_{k+1} (I − K_k H) M_k,
+    ē_k^J = M_k ν,  M_θ = B = [0; I₃; 0],  G_k = H M_k,  M_{k+1} = Φ_{k+1} (I − K_k H) M_k,
     d(θ) = Σ_k G_kᵀ S_k⁻¹ γ_k,  C(θ) = Σ_k G_kᵀ S_k⁻¹ G_k,  ν̂ = C⁻¹ d,  ℓ(θ) = dᵀ C⁻¹ d,
 
 summed over the same data for every candidate (from θ to the end of the search window plus a
-horizon). θ̂ maximises ℓ; ν̂(θ̂) is the ΔV (inertial, m/s) with covariance C⁻¹;
+horizon; B has zeros for the DMC and any nuisance states). θ̂ maximises ℓ;
+ν̂(θ̂) is the ΔV (inertial, m/s) with covariance C⁻¹;
 the 1σ time interval is where ℓ ≥ ℓ_max − 1.
 """
 

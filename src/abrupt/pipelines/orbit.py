@@ -138,7 +138,7 @@ def fit_summary(run: OrbitRun) -> dict[str, Any]:
         # the forward estimate at the last epoch has seen the whole arc (random-walk states: their value now)
         last = an.forward.x[-1, 9:]
         sig = np.sqrt(np.diag(an.forward.p[-1])[9:])
-        nuisance = {name: [float(v), float(e)] for name, v, e in zip(NUISANCE_NAMES, last, sig)}
+        nuisance = {name: [float(v), float(e)] for name, v, e in zip(NUISANCE_NAMES, last, sig, strict=True)}
     return {
         "satellite": eph.satellite,
         "epochs": len(eph),

@@ -570,6 +570,16 @@ def msis_density(t_s: float, r: FloatArray, context: ForceContext) -> float:
     return float(np.asarray(out).ravel()[0])
 
 
+@nb.njit(cache=True)
+def _earth_fixed_positions(
+    t: FloatArray, r: FloatArray, floats: FloatArray, c2i: FloatArray, pom: FloatArray, dut1: FloatArray
+) -> FloatArray:
+    out = np.empty_like(r)
+    for k in range(t.size):
+        out[k] = earth_fixed_rotation(t[k], floats, c2i, pom, dut1) @ r[k]
+    return out
+
+
 def msis_density_table(
     model: ForceModel,
     epoch_utc: np.datetime64,
@@ -599,9 +609,12 @@ def msis_density_table(
     t, pos = t[ok], pos[ok]
     if t.size < 2:
         raise ValueError("a density table needs at least two reference positions")
-    n = max(2, int(math.ceil((t[-1] - t[0]) / step_s)) + 1)
+    n = max(2, math.ceil((t[-1] - t[0]) / step_s) + 1)
     grid = np.linspace(t[0], t[-1], n)
-    r_grid = CubicSpline(t, pos, axis=0)(grid) if t.size >= 4 else np.array([np.interp(grid, t, pos[:, i]) for i in range(3)]).T
+    if t.size >= 4:
+        r_grid = CubicSpline(t, pos, axis=0)(grid)
+    else:
+        r_grid = np.array([np.interp(grid, t, pos[:, i]) for i in range(3)]).T
     eop = earth_orientation_table(epoch_utc, float(grid[0]), float(grid[-1]))
     floats = np.zeros(19)
     floats[F_EOP_T0], floats[F_EOP_STEP], floats[F_ERA0], floats[F_ERA_RATE] = (
@@ -610,9 +623,7 @@ def msis_density_table(
         eop.era0_rad,
         era_rate_rad_s(),
     )
-    r_ef = np.array(
-        [earth_fixed_rotation(float(tk), floats, eop.c2i, eop.polar_motion, eop.dut1_s) @ rk for tk, rk in zip(grid, r_grid)]
-    )
+    r_ef = _earth_fixed_positions(grid, np.ascontiguousarray(r_grid), floats, eop.c2i, eop.polar_motion, eop.dut1_s)
     loc = EarthLocation.from_geocentric(r_ef[:, 0], r_ef[:, 1], r_ef[:, 2], unit=u.m)
     geo = loc.to_geodetic("WGS84")
     times = epoch_utc + (grid * 1e9).astype("timedelta64[ns]")
