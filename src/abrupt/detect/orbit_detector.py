@@ -689,6 +689,16 @@ def locate_burn(
     single = interval_jump(analysis, k)
     sd_total = float(np.sqrt(max(float(u @ whole.dv_cov @ u), 0.0)))
     impulse = duration < step or float(np.linalg.norm(single.dv_inertial_mps - total)) < max(0.2 * mag, 3.0 * sd_total)
+    fit = burn_duration_from_positions(analysis, lo, hi, total, whole.centroid_s, room_s=_room(t, k, whole.centroid_s))
+    if impulse and fit is not None:
+        # a burn that straddles an epoch can leave most of its ΔV in one interval (a 328 s burn sampled every
+        # 240 s: 86 %), which the test above takes for an impulse and loses the rest (−14 %); the positions
+        # across it say whether the change fits inside the interval. Overruled only when a longer burn fits
+        # the positions better by more than 5σ (Δχ² > 25 with the filter's position sigma).
+        d_fit, gain = fit
+        room = _room(t, k, whole.centroid_s)
+        if d_fit > room + 0.25 * float(t[k] - t[k - 1]) and gain > 25.0 * analysis.config.sigma_pos_m**2:
+            impulse = False
     if impulse:  # the located interval alone holds the change
         step_k = float(t[k] - t[k - 1])
         if single.centroid_sigma_s < step_k / 10.0 and t[k - 1] <= single.centroid_s <= t[k]:
@@ -696,31 +706,137 @@ def locate_burn(
         mid = float(t[k]) - 0.5 * step_k
         sigma_k = float(np.hypot(step_k / np.sqrt(12.0), interval_sigma_s))
         return replace(single, centroid_s=mid, start_s=mid, centroid_sigma_s=sigma_k)
-    # the 10-90 % crossings of the piecewise-linear profile over-estimate D by up to a sampling interval
-    # when the sampling is coarse (the interpolant starts rising at the sample before the burn): +100 to
-    # +200 s for 4-15 min burns sampled every 240 s. The ramp fitted to the sampled profile with the
-    # centroid fixed (known to seconds from the position jump) has no such bias.
-    duration = ramp_duration(pt, pv, whole.centroid_s, max(duration, step))
+    # The 10-90 % crossings of the profile over-estimate D when few samples fall inside the burn (the
+    # linear interpolant starts rising at the sample before it: +100 to +200 s for 4-15 min burns sampled
+    # every 240 s), and the profile's inner points carry the filters' Gauss-Markov states, which absorb
+    # part of the burn. The positions measured inside the burn, against the pre-burn orbit, do not.
+    if fit is not None:
+        duration = fit[0]
     start = whole.centroid_s - 0.5 * duration
     sigma = float(np.hypot(whole.centroid_sigma_s, 0.25 * step))
     return replace(whole, start_s=start, duration_s=duration, centroid_sigma_s=sigma)
 
 
-def ramp_duration(t_s: FloatArray, fraction: FloatArray, centroid_s: float, d_max_s: float) -> float:
-    """Duration D (s) of a constant-acceleration burn centred on ``centroid_s`` whose cumulative ΔV fraction
-    f(t) = clip((t − t_c)/D + ½, 0, 1) best fits (least squares) the sampled ``fraction`` at ``t_s``: a
-    1-s grid over [0, 2·``d_max_s``], refined to 0.1 s. Exact for noise-free samples of any spacing."""
-    t = np.asarray(t_s, dtype=np.float64)
-    f = np.asarray(fraction, dtype=np.float64)
+def burn_duration_from_positions(
+    analysis: OrbitAnalysis,
+    lo: int,
+    hi: int,
+    dv_inertial_mps: FloatArray,
+    centroid_s: float,
+    *,
+    sub_step_s: float = 10.0,
+    room_s: float = 0.0,
+    centroid_search_s: float | None = None,
+) -> tuple[float, float] | None:
+    """Duration D (s) of a constant-thrust burn (thrust held fixed in the orbit frame) near ``centroid_s``,
+    from the positions measured across it (epochs ``lo − 1`` … ``hi``).
 
-    def cost(d: FloatArray) -> FloatArray:
-        model = np.clip((t[None, :] - centroid_s) / np.maximum(d[:, None], 1e-9) + 0.5, 0.0, 1.0)
-        return np.sum((model - f[None, :]) ** 2, axis=1)
+    The forward state at lo − 1 (pre-burn) is propagated over the span with the filter's dynamics (its
+    Gauss-Markov acceleration held constant) in sub-steps of at most ``sub_step_s``, keeping the STM.
+    A burn [t_c − D/2, t_c + D/2] with acceleration M(τ) ΔV_rtn/D (M the orbit frame) displaces the
+    position at epoch t_h by G_h(D, t_c) ΔV_rtn = Φ_r(t_h, t₀) Σ_j Φ(τ_j, t₀)⁻¹ [0; M(τ_j)] L_j/D ΔV_rtn
+    over the sub-steps j before t_h (L_j the part of sub-step j inside the burn): first-order
+    variational equations (Montenbruck & Gill 2000 §7.1). For each (D, t_c) on a grid, ΔV_rtn is solved
+    by linear least squares from the measured positions less the pre-burn orbit, and (D, t_c) minimise
+    the misfit: a small error of the centroid or of |ΔV| then does not masquerade as a duration (the
+    along-track drift after a prograde burn grows as t², and dominates a misfit with both held fixed).
+    ``dv_inertial_mps`` only sets the direction of the orbit frame's reference (unused otherwise).
+    t_c is searched within ± ``centroid_search_s`` (default one sampling interval). Returns (D, gain),
+    gain the misfit (m²) of the best D no longer than ``room_s`` less the best misfit; None when the
+    span has no usable positions."""
+    t = analysis.t_s
+    eph = analysis.ephemeris
+    ctx = _context_of(analysis)
+    epochs = np.arange(lo, hi + 1)
+    pos = eph.position_m[epochs]
+    if not np.isfinite(pos).all() or hi <= lo:
+        return None
+    del dv_inertial_mps
+    x = analysis.forward.x[lo - 1].copy()
+    ns = x.size
+    t0 = float(t[lo - 1])
+    phi_acc = np.eye(ns)
+    phi_k = np.empty((ns, ns))
+    taus: list[tuple[float, float]] = []  # (start, end) of each sub-step
+    columns: list[FloatArray] = []  # Φ(τ_mid, t0)⁻¹ [0; M(τ_mid)] (6, 3)
+    phi_at: list[FloatArray] = []  # Φ_r(t_h, t0) (3, 6) at each epoch
+    n_before: list[int] = []  # sub-steps before each epoch
+    d_obs: list[FloatArray] = []
+    tc = t0
+    for h in epochs:
+        th = float(t[h])
+        nsub = max(1, int(np.ceil((th - tc) / sub_step_s - 1e-9)))
+        hstep = (th - tc) / nsub
+        for _ in range(nsub):
+            x_mid = propagate_state(x, tc, 0.5 * hstep, 1e12, ctx.kernel_args, hstep, phi_k)
+            phi_mid = phi_k[:6, :6] @ phi_acc[:6, :6]
+            kick = np.zeros((6, 3))
+            kick[3:] = rtn_matrix(x_mid[:3], x_mid[3:6])[0]
+            columns.append(np.asarray(np.linalg.solve(phi_mid, kick), dtype=np.float64))
+            taus.append((tc, tc + hstep))
+            x = propagate_state(x, tc, hstep, 1e12, ctx.kernel_args, hstep, phi_k)
+            phi_acc = phi_k @ phi_acc
+            tc += hstep
+        phi_at.append(phi_acc[:3, :6].copy())
+        n_before.append(len(taus) - 1)
+        d_obs.append(pos[h - lo] - x[:3])
+    ta = np.array(taus)
+    cols = np.array(columns)  # (nsub, 6, 3)
+    phis = np.array(phi_at)  # (H, 3, 6)
+    idx = np.array(n_before)
+    d = np.array(d_obs).reshape(-1)  # (3H,)
+    step = float(np.median(np.diff(t[lo - 1 : hi + 1])))
+    search = step if centroid_search_s is None else centroid_search_s
 
-    grid = np.arange(0.0, 2.0 * d_max_s + 1.0, 1.0)
-    best = float(grid[int(np.argmin(cost(grid)))])
-    fine = np.arange(max(0.0, best - 1.0), best + 1.0, 0.1)
-    return float(fine[int(np.argmin(cost(fine)))])
+    def misfits(durations: FloatArray, centroid: float) -> FloatArray:
+        start = centroid - 0.5 * durations[:, None]
+        end = centroid + 0.5 * durations[:, None]
+        inside = np.clip(np.minimum(end, ta[None, :, 1]) - np.maximum(start, ta[None, :, 0]), 0.0, None)
+        impulse = durations < 1e-6
+        w = inside / np.where(impulse, 1.0, durations)[:, None]
+        if impulse.any():
+            w[impulse] = ((ta[:, 0] <= centroid) & (centroid < ta[:, 1])).astype(np.float64)
+        cum = np.cumsum(w[:, :, None, None] * cols[None], axis=1)[:, idx]  # (nD, H, 6, 3)
+        g = np.einsum("hij,dhjk->dhik", phis, cum).reshape(durations.size, -1, 3)  # (nD, 3H, 3)
+        gtg = np.einsum("dni,dnj->dij", g, g)
+        gtd = np.einsum("dni,n->di", g, d)
+        out = np.full(durations.size, np.inf)
+        for i in range(durations.size):
+            try:
+                sol = np.linalg.solve(gtg[i], gtd[i])
+            except np.linalg.LinAlgError:
+                continue
+            out[i] = float(np.sum((d - g[i] @ sol) ** 2))
+        return out
+
+    t_lo, t_hi = float(t[lo - 1]), float(t[hi])
+
+    def best_over(durations: FloatArray, centroids: FloatArray) -> tuple[float, float, float]:
+        best = (np.inf, 0.0, centroid_s)
+        for c in centroids:
+            room = 2.0 * min(c - t_lo, t_hi - c)
+            ok = durations[durations <= room]
+            if ok.size == 0:
+                continue
+            m = misfits(ok, float(c))
+            i = int(np.argmin(m))
+            if m[i] < best[0]:
+                best = (float(m[i]), float(ok[i]), float(c))
+        return best
+
+    d_max = 2.0 * min(centroid_s + search - t_lo, t_hi - centroid_s + search)
+    if d_max <= 0:
+        return None
+    coarse = best_over(np.arange(0.0, d_max + 1e-9, 20.0), centroid_s + np.arange(-search, search + 1e-9, 10.0))
+    _, d0, c0 = coarse
+    fine = best_over(np.arange(max(0.0, d0 - 20.0), d0 + 20.0 + 1e-9, 1.0), c0 + np.arange(-10.0, 10.0 + 1e-9, 1.0))
+    within = best_over(np.r_[np.arange(0.0, max(room_s, 0.0), 5.0), max(room_s, 0.0)], np.array([centroid_s]))
+    return fine[1], float(within[0] - fine[0])
+
+
+def _room(t: FloatArray, k: int, centroid_s: float) -> float:
+    """The longest burn centred on ``centroid_s`` that fits inside the interval (t_{k−1}, t_k) (s)."""
+    return float(max(0.0, 2.0 * min(centroid_s - t[k - 1], t[k] - centroid_s)))
 
 
 def state_at(analysis: OrbitAnalysis, time_s: float) -> FloatArray:
