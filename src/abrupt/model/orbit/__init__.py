@@ -27,7 +27,13 @@ from abrupt.model.orbit.elements import (
 )
 from abrupt.model.orbit.forces import ForceContext, ForceModel, acceleration
 from abrupt.model.orbit.frames import rsw_basis, rtn_matrix
-from abrupt.model.orbit.propagation import FiniteBurn, propagate, propagate_deviation, propagate_with_stm
+from abrupt.model.orbit.propagation import (
+    SCALE_PARAMETERS,
+    FiniteBurn,
+    propagate,
+    propagate_deviation,
+    propagate_with_stm,
+)
 
 __all__ = [
     "J2",
@@ -39,6 +45,7 @@ __all__ = [
     "MU_SUN_M3_S2",
     "OMEGA_EARTH_RAD_S",
     "R_EARTH_M",
+    "SCALE_PARAMETERS",
     "FiniteBurn",
     "ForceContext",
     "ForceModel",

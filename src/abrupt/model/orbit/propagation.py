@@ -8,8 +8,11 @@ filters and batch fits.
   A burn is a constant acceleration ΔV/duration, fixed in the inertial frame at burn onset (Kaderali
   2021 §4.1) or following the orbit frame (``rotating``).
 * :func:`propagate_with_stm`: fixed-step RK4 or RK8 (numba) of the state, the STM (Kaderali 2021
-  Eqs. 3.3-3.4) and the sensitivity to a constant acceleration. The STM uses the two-body gradient
-  (Eq. 3.4), plus the J2 gradient when the force model has a field of degree ≥ 2.
+  Eqs. 3.3-3.4), the sensitivity to a constant acceleration and, on request, to the force model's
+  scale factors ``drag_scale`` and ``srp_scale`` (∂a/∂k = the drag or SRP acceleration at k = 1;
+  Montenbruck & Gill 2000, Eqs. 7.5-7.6 and §7.2.3). The variational equations use the two-body
+  gradient (Eq. 3.4), the J2 gradient when the force model has a field of degree ≥ 2, and the drag
+  partials ∂a/∂r, ∂a/∂v when the kernel has drag.
 * :func:`propagate_deviation`: the deviation of a displaced orbit from a given reference trajectory
   (a real ephemeris), re-anchored on the reference at every epoch (used to inject ΔV into real data).
 """
@@ -25,7 +28,11 @@ import numba as nb
 import numpy as np
 
 from abrupt.model.orbit.forces import (
+    F_DRAG_SCALE,
+    F_SRP_SCALE,
     I_DEGREE,
+    I_DRAG,
+    I_SRP,
     I_ZONAL,
     ForceContext,
     ForceModel,
@@ -176,19 +183,59 @@ def _j2_gradient(r: FloatArray) -> FloatArray:
     return g
 
 
+#: Force-model scale factors :func:`propagate_with_stm` can give sensitivities for, in column order.
+SCALE_PARAMETERS = ("drag_scale", "srp_scale")
+N_BASE = 60  # state (6) + STM (36) + constant-acceleration sensitivity (18)
+
+
 @nb.njit(cache=True)
-def _stm_derivative(y: FloatArray, t_s: float, a_const: FloatArray, args: tuple) -> FloatArray:
-    """State (6) + STM (36) + constant-acceleration sensitivity (18), flattened row-major."""
-    out = np.empty(60)
+def _stm_derivative(
+    y: FloatArray,
+    t_s: float,
+    a_const: FloatArray,
+    args: tuple,
+    use_drag: bool,
+    drag_args: tuple,
+    use_srp: bool,
+    srp_args: tuple,
+) -> FloatArray:
+    """State (6) + STM (36) + constant-acceleration sensitivity (18) + scale-factor sensitivities
+    (6 each for drag_scale, srp_scale when used), flattened row-major.
+
+    The sensitivity S_k = ∂x/∂k of a force scale factor obeys Ṡ_k = [S_k,v ; G S_k,r + ∂a/∂k]
+    (Montenbruck & Gill 2000, Eq. 7.6), with ∂a/∂k the acceleration of that force at k = 1 (it is linear
+    in k): evaluated by the same kernel with only that force switched on (``drag_args``/``srp_args``).
+    """
+    n_par = int(use_drag) + int(use_srp)
+    out = np.empty(N_BASE + 6 * n_par)
     r = y[0:3]
-    out[0:3] = y[3:6]
-    out[3:6] = acceleration_kernel(t_s, r, y[3:6], *args) + a_const
+    v = y[3:6]
+    out[0:3] = v
+    out[3:6] = acceleration_kernel(t_s, r, v, *args) + a_const
     lam = _two_body_gradient(r, args[1][0])
     ints = args[0]
     if ints[I_ZONAL] >= 2 or ints[I_DEGREE] >= 2:
         # J2 in the variational equations: over multi-day arcs the two-body STM misses the nodal and
         # apsidal drift, and Gauss-Newton with that Jacobian settles off the least-squares minimum
         lam += _j2_gradient(r)
+    drag_on = drag_args[0][I_DRAG] != 0
+    lam_v = np.zeros((3, 3))
+    if drag_on:
+        # drag partials ∂a/∂r (density gradient, co-rotation) and ∂a/∂v (Montenbruck & Gill 2000,
+        # Eqs. 7.81-7.84) by central differences of the drag-only kernel: over a day in LEO the decay
+        # raises the density by ~1 %, which the gravity gradient alone leaves out of ∂x/∂k
+        k_drag = args[1][F_DRAG_SCALE]
+        for j in range(3):
+            dr = np.zeros(3)
+            dr[j] = 1.0
+            ap = acceleration_kernel(t_s, r + dr, v, *drag_args)
+            am = acceleration_kernel(t_s, r - dr, v, *drag_args)
+            lam[:, j] += k_drag * (ap - am) / 2.0
+            dv = np.zeros(3)
+            dv[j] = 1e-2
+            ap = acceleration_kernel(t_s, r, v + dv, *drag_args)
+            am = acceleration_kernel(t_s, r, v - dv, *drag_args)
+            lam_v[:, j] = k_drag * (ap - am) / 2e-2
     phi = y[6:42].reshape(6, 6)
     sens = y[42:60].reshape(6, 3)
     dphi = np.empty((6, 6))
@@ -197,10 +244,25 @@ def _stm_derivative(y: FloatArray, t_s: float, a_const: FloatArray, args: tuple)
     dsens = np.empty((6, 3))
     dsens[0:3, :] = sens[3:6, :]
     dsens[3:6, :] = lam @ np.ascontiguousarray(sens[0:3, :])
+    if drag_on:
+        dphi[3:6, :] += lam_v @ np.ascontiguousarray(phi[3:6, :])
+        dsens[3:6, :] += lam_v @ np.ascontiguousarray(sens[3:6, :])
     for j in range(3):
         dsens[3 + j, j] += 1.0
     out[6:42] = dphi.reshape(36)
     out[42:60] = dsens.reshape(18)
+    col = N_BASE
+    for p in range(2):
+        if (p == 0 and not use_drag) or (p == 1 and not use_srp):
+            continue
+        sk = y[col : col + 6]
+        if p == 0:
+            dadk = acceleration_kernel(t_s, r, v, *drag_args)
+        else:
+            dadk = acceleration_kernel(t_s, r, v, *srp_args)
+        out[col : col + 3] = sk[3:6]
+        out[col + 3 : col + 6] = lam @ np.ascontiguousarray(sk[0:3]) + lam_v @ np.ascontiguousarray(sk[3:6]) + dadk
+        col += 6
     return out
 
 
@@ -240,17 +302,23 @@ def _rk_stm(
     rk_a: FloatArray,
     rk_b: FloatArray,
     rk_c: FloatArray,
+    use_drag: bool,
+    drag_args: tuple,
+    use_srp: bool,
+    srp_args: tuple,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     n = t_eval_s.shape[0]
     n_stage = rk_b.shape[0]
+    n_par = int(use_drag) + int(use_srp)
+    n_y = N_BASE + 6 * n_par
     states = np.empty((n, 6))
     stms = np.empty((n, 6, 6))
-    sens = np.empty((n, 6, 3))
-    y = np.zeros(60)
+    sens = np.empty((n, 6, 3 + n_par))
+    y = np.zeros(n_y)
     y[0:6] = x0
     for j in range(6):
         y[6 + 7 * j] = 1.0
-    k = np.empty((n_stage, 60))
+    k = np.empty((n_stage, n_y))
     t = t0_s
     for i in range(n):
         dt_total = t_eval_s[i] - t
@@ -262,7 +330,7 @@ def _rk_stm(
                 for m in range(s):
                     if rk_a[s, m] != 0.0:
                         ys += (h * rk_a[s, m]) * k[m]
-                k[s] = _stm_derivative(ys, t + rk_c[s] * h, a_const, args)
+                k[s] = _stm_derivative(ys, t + rk_c[s] * h, a_const, args, use_drag, drag_args, use_srp, srp_args)
             for s in range(n_stage):
                 if rk_b[s] != 0.0:
                     y += (h * rk_b[s]) * k[s]
@@ -270,12 +338,28 @@ def _rk_stm(
         t = t_eval_s[i]
         states[i] = y[0:6]
         stms[i] = y[6:42].reshape(6, 6)
-        sens[i] = y[42:60].reshape(6, 3)
+        sens[i, :, 0:3] = y[42:60].reshape(6, 3)
+        for p in range(n_par):
+            sens[i, :, 3 + p] = y[N_BASE + 6 * p : N_BASE + 6 * p + 6]
         if reset_stm:
-            y[6:60] = 0.0
+            y[6:] = 0.0
             for j in range(6):
                 y[6 + 7 * j] = 1.0
     return states, stms, sens
+
+
+def _single_force_args(ctx: ForceContext, parameter: str) -> tuple[FloatArray, ...]:
+    """Kernel arguments under which :func:`acceleration_kernel` returns only the force that
+    ``parameter`` scales, at scale 1: ∂a/∂k (the acceleration is linear in its scale factor)."""
+    ints = np.zeros_like(ctx.kernel_args[0])
+    floats = ctx.kernel_args[1].copy()
+    if parameter == "drag_scale":
+        ints[I_DRAG] = ctx.kernel_args[0][I_DRAG]
+        floats[F_DRAG_SCALE] = 1.0
+    else:
+        ints[I_SRP] = ctx.kernel_args[0][I_SRP]
+        floats[F_SRP_SCALE] = 1.0
+    return (ints, floats, *ctx.kernel_args[2:])
 
 
 def propagate_with_stm(
@@ -288,21 +372,38 @@ def propagate_with_stm(
     max_step_s: float = 5.0,
     step_wise: bool = False,
     method: str = "rk4",
+    parameters: Sequence[str] = (),
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """States (n,6), STMs (n,6,6) and constant-acceleration sensitivities (n,6,3) at ``t_eval_s``.
+    """States (n,6), STMs (n,6,6) and sensitivities (n,6,3+p) at ``t_eval_s``.
+
+    The sensitivities' first three columns are ∂x/∂a for a constant inertial acceleration
+    ``accel_mps2``; then one column per name in ``parameters`` (from :data:`SCALE_PARAMETERS`:
+    ``drag_scale``, ``srp_scale``), ∂x/∂k for the force model's scale factor k, whose force
+    derivative is that force's acceleration at k = 1 (Montenbruck & Gill 2000, Eq. 7.6). A parameter
+    whose force is off in the model (no kernel drag, no SRP) has a zero column. Drag from NRLMSIS
+    (``drag="msis"``) is not in the numba kernel, so neither in the states nor in its column.
 
     Fixed-step Runge-Kutta (``method`` ``rk4``, or ``rk8``: eighth order, 12 stages, for long arcs:
     over 30 days of a LAGEOS orbit rk8 at 60 s stays within a millimetre of the DOP853 truth where rk4
-    needs 5 s) with at most ``max_step_s`` per step. With ``step_wise`` the STM is Φ(t_i, t_{i-1}) (reset
-    every output, as in the EKF, Kaderali 2021 Appendix A step 2); otherwise Φ(t_i, t0). The STM uses
-    the two-body gradient (Eq. 3.4), plus J2's when the force model has a field of degree ≥ 2.
+    needs 5 s) with at most ``max_step_s`` per step. With ``step_wise`` the STM and the sensitivities
+    are over the last interval, Φ(t_i, t_{i-1}) (reset every output, as in the EKF, Kaderali 2021
+    Appendix A step 2); otherwise Φ(t_i, t0). The variational equations use the two-body gradient
+    (Eq. 3.4), plus J2's when the force model has a field of degree ≥ 2, plus the drag partials with
+    respect to position and velocity (central differences of the kernel's drag) when it has drag.
     """
+    unknown = [p for p in parameters if p not in SCALE_PARAMETERS]
+    if unknown or len(set(parameters)) != len(parameters):
+        raise ValueError(f"parameters must be distinct names from {SCALE_PARAMETERS}, got {tuple(parameters)}")
     t_eval = np.ascontiguousarray(np.asarray(t_eval_s, dtype=np.float64))
     lo = min(float(t0_s), float(t_eval.min())) if t_eval.size else float(t0_s)
     hi = max(float(t0_s), float(t_eval.max())) if t_eval.size else float(t0_s)
     ctx = _context(force, lo, hi)
     rk_a, rk_b, rk_c = _tableau(method)
-    return _rk_stm(
+    drag_args = _single_force_args(ctx, "drag_scale")
+    srp_args = _single_force_args(ctx, "srp_scale")
+    use_drag = "drag_scale" in parameters
+    use_srp = "srp_scale" in parameters
+    states, stms, sens = _rk_stm(
         np.ascontiguousarray(np.asarray(x0, dtype=np.float64)),
         float(t0_s),
         t_eval,
@@ -313,7 +414,14 @@ def propagate_with_stm(
         rk_a,
         rk_b,
         rk_c,
+        use_drag,
+        drag_args,
+        use_srp,
+        srp_args,
     )
+    if use_drag and use_srp and list(parameters).index("srp_scale") < list(parameters).index("drag_scale"):
+        sens = sens[:, :, [0, 1, 2, 4, 3]]
+    return states, stms, sens
 
 
 # ----------------------------------------------------------------------------------------------
