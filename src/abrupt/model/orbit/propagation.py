@@ -381,7 +381,9 @@ def propagate_with_stm(
     ``drag_scale``, ``srp_scale``), ∂x/∂k for the force model's scale factor k, whose force
     derivative is that force's acceleration at k = 1 (Montenbruck & Gill 2000, Eq. 7.6). A parameter
     whose force is off in the model (no kernel drag, no SRP) has a zero column. Drag from NRLMSIS
-    (``drag="msis"``) is not in the numba kernel, so neither in the states nor in its column.
+    (``drag="msis"``) is in the numba kernel, the states and its column only when ``force`` is a
+    context built with a reference trajectory (``ForceContext.build(..., reference=(t, r))``: density
+    tabulated along it); otherwise in neither.
 
     Fixed-step Runge-Kutta (``method`` ``rk4``, or ``rk8``: eighth order, 12 stages, for long arcs:
     over 30 days of a LAGEOS orbit rk8 at 60 s stays within a millimetre of the DOP853 truth where rk4
