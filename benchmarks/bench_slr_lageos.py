@@ -57,6 +57,7 @@ def main() -> None:
     ap.add_argument("--null-runs", type=int, default=None, help="maneuver-free runs (default: --runs)")
     ap.add_argument("--first-run", type=int, default=0, help="index of the first maneuver run (to split runs)")
     ap.add_argument("--arc-days", type=float, default=7.0, help="arc length; 1-day overlaps")
+    ap.add_argument("--terms", nargs="*", default=list(RANGE_MODEL_TERMS), help="ablation terms (default: all)")
     args = ap.parse_args()
     budget = FalseAlarmBudget(0.1, "day")
     t_start = time.perf_counter()
@@ -104,7 +105,7 @@ def main() -> None:
         print(f"total {time.perf_counter() - t_start:.0f} s")
         return
     print("ablation (each term left out of the filter; truth keeps it):")
-    for term in RANGE_MODEL_TERMS:
+    for term in args.terms:
         n_alarm = 0
         rms_max = 0.0
         for seed in range(args.ablation_runs):

@@ -8,6 +8,7 @@ read them back, stay quiet on a maneuver-free day, and name the station a SINEX 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +19,7 @@ from click.testing import CliRunner
 from abrupt.cli.main import cli
 from abrupt.model.orbit import propagate
 from abrupt.model.tracking_measurements import earth_rotation_matrices
+from abrupt.pipelines.laser_ranging import LASER_FORCE
 from abrupt.readers.ephemeris import write_ephemeris
 from abrupt.series.ephemeris import Ephemeris
 from abrupt.simulate.slr import SlrScenario, SlrSimulation, simulate_slr
@@ -97,7 +99,10 @@ def write_apriori(sim: SlrSimulation, path: Path, start_s: float = -600.0) -> No
 
 @pytest.fixture(scope="module")
 def files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
-    sim = simulate_slr(SlrScenario(duration_days=1.0, noise_m=0.003), seed=21)
+    # the truth has the real-data force model (20×20 field, Sun, Moon, SRP) with 20 % more radiation
+    # pressure than the command's a-priori C_R: the fitted SRP scale must absorb it
+    truth = replace(LASER_FORCE, srp_coefficient=1.2 * LASER_FORCE.srp_coefficient)
+    sim = simulate_slr(SlrScenario(duration_days=1.0, noise_m=0.003, force=truth), seed=21)
     d = tmp_path_factory.mktemp("laser")
     paths = {"crd": d / "lageos1.npt", "snx": d / "sites.snx", "oem": d / "apriori.oem", "bad_snx": d / "missing.snx"}
     paths["late_oem"] = d / "late.oem"
@@ -121,6 +126,7 @@ def test_detect_laser_reads_crd_sinex_and_oem_and_stays_quiet(files: dict[str, P
     fit = pd.read_json(tmp_path / "fit.json", typ="series")
     assert max(fit["residual_rms_mm"].values()) < 3 * 3.0  # mm, against 3 mm normal points
     assert not math.isnan(float(next(iter(fit["range_bias_mm"].values()))))
+    assert fit["scale_factors"]["srp_scale"] == pytest.approx(1.2, abs=0.1)
 
 
 def test_detect_laser_names_the_station_missing_from_sinex(files: dict[str, Path], tmp_path: Path) -> None:
@@ -146,3 +152,19 @@ def test_detect_laser_names_an_apriori_ephemeris_that_starts_after_the_ranges(
     err = capsys.readouterr().err
     assert "late.oem" in err and "does not cover" in err
     assert len(err.strip().splitlines()) == 1
+
+
+def test_detect_laser_estimates_station_time_biases_near_zero_when_there_are_none(
+    files: dict[str, Path], tmp_path: Path
+) -> None:
+    out = tmp_path / "events.csv"
+    args = ["detect", "laser", str(files["crd"]), "--sinex", str(files["snx"]), "--apriori", str(files["oem"])]
+    args += ["--time-biases", "--out", str(out), "--catalog", str(tmp_path / "c.sqlite")]
+    args += ["--fit-out", str(tmp_path / "fit.json")]
+    result = CliRunner().invoke(cli, args, catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    assert len(pd.read_csv(out)) == 0
+    fit = pd.read_json(tmp_path / "fit.json", typ="series")
+    biases = fit["time_bias_us"]
+    assert set(biases) == set(CDP)
+    assert max(abs(v) for v in biases.values()) < 5.0  # µs; 3 mm at a few km/s of range rate is ~1 µs

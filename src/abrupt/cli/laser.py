@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -45,6 +46,33 @@ TERMS = ("light_time", "troposphere", "shapiro", "plate_motion", "eccentricity",
     type=click.FloatRange(min=0.5),
     help="Fit longer files in overlapping arcs of this length (1-day overlaps), as ILRS analyses do.",
 )
+@click.option(
+    "--gravity-degree",
+    default=20,
+    show_default=True,
+    type=click.IntRange(min=2, max=120),
+    help="Degree and order of the EGM2008 field in the fit (LAGEOS/Etalon: 20; LEO: 60 or more).",
+)
+@click.option(
+    "--area-to-mass",
+    "area_to_mass_m2_per_kg",
+    default=0.2827 / 406.965,
+    show_default=True,
+    type=click.FloatRange(min=0.0, min_open=True),
+    help="A-priori cross-section per mass [m²/kg] for radiation pressure (and drag); its scale is estimated.",
+)
+@click.option(
+    "--drag/--no-drag",
+    default=False,
+    show_default=True,
+    help="Exponential-atmosphere drag with an estimated scale (satellites below ~1,500 km, e.g. Stella).",
+)
+@click.option(
+    "--time-biases/--no-time-biases",
+    default=False,
+    show_default=True,
+    help="Estimate each station's time-tag offset (a common offset of all stations is not observable).",
+)
 @click.option("--spacecraft", default=None, help="Pseudonym for the events (default: the CRD target name).")
 @click.option("--fit-out", default=None, type=click.Path(dir_okay=False), help="Write the fit summary (JSON).")
 @click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Events (.csv or .parquet).")
@@ -57,6 +85,10 @@ def detect_laser_command(
     without: tuple[str, ...],
     max_maneuvers: int,
     arc_days: float,
+    gravity_degree: int,
+    area_to_mass_m2_per_kg: float,
+    drag: bool,
+    time_biases: bool,
     spacecraft: str | None,
     fit_out: str | None,
     out: str,
@@ -71,7 +103,7 @@ def detect_laser_command(
     stated false-alarm budget (docs/tracking.md, "Laser ranging").
     """
     from abrupt.model.range_reduction import RangeModel
-    from abrupt.pipelines.laser_ranging import run_laser_ranging_files
+    from abrupt.pipelines.laser_ranging import LASER_FORCE, run_laser_ranging_files
 
     budget = pop_budget(budget_args, "0.1/day")
     model = RangeModel()
@@ -86,6 +118,14 @@ def detect_laser_command(
         spacecraft=spacecraft,
         max_maneuvers=max_maneuvers,
         arc_days=arc_days,
+        time_biases=time_biases,
+        force=replace(
+            LASER_FORCE,
+            gravity_degree=gravity_degree,
+            srp_area_m2=area_to_mass_m2_per_kg * LASER_FORCE.mass_kg,
+            drag="exponential" if drag else "none",
+            drag_area_m2=area_to_mass_m2_per_kg * LASER_FORCE.mass_kg,
+        ),
     )
     for line in run.summary_lines():
         click.echo(line, err=True)

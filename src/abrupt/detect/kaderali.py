@@ -586,13 +586,17 @@ class KaderaliManeuverDetector(Detector[TrackingSeries]):
         self.seed = int(seed)
         self.psi_detection_threshold = psi_detection_threshold
 
-    def filter_config(self, series: TrackingSeries, accel_mps2: NDArray[np.float64]) -> KaderaliConfig:
+    def filter_config(
+        self, series: TrackingSeries, accel_mps2: NDArray[np.float64], scales: dict[str, float] | None = None
+    ) -> KaderaliConfig:
+        from abrupt.detect.tracking_glrt import scaled_force
+
         period = series.orbit_period_s()
         return KaderaliConfig(
             psi_threshold=self.psi_threshold,
             eta_threshold_km=self.eta_threshold_km,
             elevation_mask_deg=self.elevation_mask_deg,
-            force=series.fit_config.force,
+            force=scaled_force(series.fit_config.force, scales or {}),
             max_step_s=float(min(60.0, max(5.0, period / 1000.0))),
             accel_mps2=tuple(float(v) for v in accel_mps2),  # type: ignore[arg-type]
         )
@@ -608,7 +612,7 @@ class KaderaliManeuverDetector(Detector[TrackingSeries]):
         else:
             fit = series.orbit_fit()
         data = series.bias_corrected()
-        kcfg = self.filter_config(series, np.asarray(fit.acceleration_mps2, dtype=np.float64))
+        kcfg = self.filter_config(series, np.asarray(fit.acceleration_mps2, dtype=np.float64), fit.scale_factors)
         result = run_kaderali_filter(data, fit.x0, config=kcfg)
         if self.psi_detection_threshold is not None:
             thr = Threshold(float(self.psi_detection_threshold), float("nan"), "fixed", 0, budget.per_day)

@@ -152,6 +152,42 @@ def predict_measurement(
     return y, h
 
 
+@numba.njit(cache=True)
+def predict_measurement_light_time(
+    x_inertial: NDArray[np.float64],
+    c_fi: NDArray[np.float64],
+    site_ecef_m: NDArray[np.float64],
+    c_sf: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """:func:`predict_measurement` for a measurement time-tagged at reception, with the light time.
+
+    Range is two-way: ρ₂ = c (t_r − t_t)/2 = ρ(t_b) + O(τ²) with the bounce time t_b = t_r − τ, τ = ρ/c
+    (the station's inertial motion cancels between the up- and downleg to first order; Montenbruck &
+    Gill 2000 §6.2.2), so ρ₂ ≈ ρ − ρ̇ ρ/c, with ρ̇ the instantaneous range rate. Angles are one-way
+    (downleg): the direction from the station at t_r to the satellite at t_b, r_I(t_b) ≈ r_I − v_I τ in
+    the Earth-fixed frame at t_r (this includes the diurnal aberration, ω×r τ). The neglected terms are
+    below a millimetre and a microdegree for LEO to GEO. The range-rate row stays instantaneous.
+    Orekit's ``Range(station, twoWay=true, ...)`` and ``AngularAzEl`` solve the same geometry exactly.
+    """
+    c_light = 299_792_458.0
+    y, h = predict_measurement(x_inertial, c_fi, site_ecef_m, c_sf)
+    tau = y[0] / c_light
+    shifted = x_inertial.copy()
+    shifted[0:3] = x_inertial[0:3] - tau * x_inertial[3:6]
+    ya, ha = predict_measurement(shifted, c_fi, site_ecef_m, c_sf)
+    out = y.copy()
+    hout = h.copy()
+    out[0] = y[0] - y[3] * tau
+    for k in range(6):
+        hout[0, k] = h[0, k] * (1.0 - y[3] / c_light) - tau * h[3, k]
+    for row in (1, 2):
+        out[row] = ya[row]
+        for k in range(3):
+            hout[row, k] = ha[row, k]
+            hout[row, 3 + k] = ha[row, 3 + k] - tau * ha[row, k]
+    return out, hout
+
+
 def predict_many(
     states: NDArray[np.float64],
     c_fi: NDArray[np.float64],

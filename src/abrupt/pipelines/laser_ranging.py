@@ -47,6 +47,26 @@ from abrupt.types import FloatArray
 LASER_FIT_CONFIG = BatchFitConfig(estimate_range_bias=True, integrator="rk8", max_step_s=60.0)
 """Default fit: range biases estimated; eighth-order integration at 60 s (millimetres over a month)."""
 
+LASER_FORCE = ForceModel(
+    mu_m3_s2=3.986004418e14,
+    gravity_degree=20,
+    sun=True,
+    moon=True,
+    srp=True,
+    srp_coefficient=1.13,
+    srp_area_m2=0.2827,
+    mass_kg=406.965,
+)
+"""Real-data force model: EGM2008 20×20, Sun, Moon, solar radiation pressure (conical shadow) with a
+priori LAGEOS-1 values (C_R 1.13, 0.2827 m², 406.965 kg); the SRP scale is estimated, so only the
+product C_R·A/m's order of magnitude matters. At LAGEOS height degree 20 leaves ~(R/r)^21 ≈ 1e-6 of
+the field's effect; lower satellites need a higher ``--gravity-degree``."""
+
+
+def estimated_scales(force: ForceModel) -> tuple[str, ...]:
+    """The scale factors a laser fit estimates: ``srp_scale`` with SRP, ``drag_scale`` with drag."""
+    return tuple(name for name, on in (("drag_scale", force.drag != "none"), ("srp_scale", force.srp)) if on)
+
 
 @dataclass
 class LaserRangingResult:
@@ -391,6 +411,10 @@ class LaserRangingRun:
         lines = [f"post-fit range RMS per station (mm): {self.summary['residual_rms_mm']}"]
         lines.append(f"station sigma scale (post-fit / stated, last arc): {self.summary['sigma_scale']}")
         lines.append(f"range biases (mm, last arc): {self.summary['range_bias_mm']}")
+        if self.summary.get("scale_factors"):
+            lines.append(f"force scale factors (last arc): {self.summary['scale_factors']}")
+        if self.summary.get("time_bias_us"):
+            lines.append(f"time biases (µs, last arc): {self.summary['time_bias_us']}")
         arcs = self.summary.get("arcs", [])
         lines.append(f"arcs fitted: {len(arcs) if isinstance(arcs, list) else arcs}")
         lines += [f"repaired: {k} ({n})" for k, n in self.result.repairs.counts.items()]
@@ -435,12 +459,17 @@ def run_laser_ranging_files(
     step_s: float = 60.0,
     arc_days: float = 7.0,
     overlap_days: float = 1.0,
+    force: ForceModel | None = None,
+    time_biases: bool = False,
 ) -> LaserRangingRun:
     """Read CRD normal points, SINEX sites and an a-priori ephemeris; detect maneuvers; build events.
 
-    The force model is two-body + J2 + Sun and Moon (``abrupt.model.orbit.ForceModel``), integrated
-    with the eighth-order fixed-step Runge-Kutta at ``step_s`` (s); per-station range biases absorb the
-    satellite's centre-of-mass offset. Files longer than ``arc_days`` are fitted in overlapping arcs
+    The force model is ``force`` (default :data:`LASER_FORCE`: the EGM2008 field to degree 20, Sun,
+    Moon and solar radiation pressure with a conical shadow, its scale estimated per arc; one orbit
+    model, :mod:`abrupt.model.orbit`), integrated with the eighth-order fixed-step Runge-Kutta at
+    ``step_s`` (s); a force with drag also gets its drag scale estimated. Per-station range biases
+    absorb the satellite's centre-of-mass offset; with ``time_biases`` each station's time-tag offset is
+    estimated too (∂ρ/∂δt = −ρ̇). Files longer than ``arc_days`` are fitted in overlapping arcs
     (:func:`detect_laser_ranging_arcs`), each started from the ephemeris where it covers the arc epoch.
     """
     from abrupt.detect.tracking_glrt import glrt_events
@@ -484,8 +513,14 @@ def run_laser_ranging_files(
 
     if apriori(epoch) is None:
         raise ValueError(f"{apriori_path}: the ephemeris does not cover the first range epoch {epoch}")
-    force = ForceModel(mu_m3_s2=3.986004418e14, zonal_degree=2, sun=True, moon=True)
-    cfg = replace(LASER_FIT_CONFIG, force=force, max_step_s=step_s)
+    force = force or LASER_FORCE
+    cfg = replace(
+        LASER_FIT_CONFIG,
+        force=force,
+        max_step_s=step_s,
+        estimate_scales=estimated_scales(force),
+        estimate_time_bias=time_biases,
+    )
     result = detect_laser_ranging_arcs(
         meas,
         sites,
@@ -502,6 +537,8 @@ def run_laser_ranging_files(
     name = spacecraft or str(meas["satellite"].iloc[0] if "satellite" in meas else "satellite")
     settings = {
         "range_model": model.__dict__,
+        "force": repr(force),
+        "time_biases": time_biases,
         "budget": str(budget),
         "step_s": step_s,
         "max_maneuvers": max_maneuvers,
@@ -524,6 +561,8 @@ def run_laser_ranging_files(
         "residual_rms_mm": {k: round(v * 1000, 2) for k, v in result.residual_rms_m.items()},
         "sigma_scale": {k: round(v, 2) for k, v in result.arcs[-1].result.sigma_scale.items()},
         "range_bias_mm": {k: round(v * 1000, 1) for k, v in result.arcs[-1].result.fit.range_bias_m.items()},
+        "scale_factors": {k: round(v, 4) for k, v in result.arcs[-1].result.fit.scale_factors.items()},
+        "time_bias_us": {k: round(v * 1e6, 2) for k, v in result.arcs[-1].result.fit.time_bias_s.items()},
         "arcs": [
             {
                 "epoch_utc": str(arc.epoch_utc),

@@ -40,6 +40,8 @@ class TrackingSettings:
     estimate_biases: bool | None = None
     estimate_acceleration: bool | None = None
     refraction: bool | None = None
+    light_time: bool | None = None  # None: on for real-data set-ups (Orekit's two-way Range, AngularAzEl)
+    troposphere: bool | None = None  # None: as the set-up's range.tropospheric.correction says
     max_maneuvers: int = 3
     kaderali_threshold: Literal["simulated", "chi2"] = "simulated"
 
@@ -115,6 +117,9 @@ def read_tracking_series(
         estimate_acceleration=accel,
         max_step_s=max_step,
         elevation_mask_deg=settings.elevation_mask_deg,
+        light_time=real if settings.light_time is None else settings.light_time,
+        estimate_scales=setup_estimated_scales(setup, force.model),
+        troposphere=setup.range_troposphere and real if settings.troposphere is None else settings.troposphere,
     )
     series = TrackingSeries(data, np.asarray(setup.initial_state, float), fit_cfg, name=name or Path(file).stem)
     return TrackingInputs(series, force, use_refraction, biases, accel, repairs, epoch)
@@ -124,14 +129,62 @@ def setup_force_model(setup: Any, span_s: float = 0.0) -> tuple[ForceContext, np
     """The fit's force model from an Orekit set-up file, resolved for ``span_s`` seconds (± one day)
     after the set-up epoch, and that epoch (UTC).
 
-    Two-body with the set-up's μ; J2 when ``central.body.degree`` is at least 2; Sun and Moon (ERFA)
-    when ``third.body.sun`` or ``third.body.moon`` is true (the one orbit model, :mod:`abrupt.model.orbit`).
+    The one orbit model (:mod:`abrupt.model.orbit`): the central body's field to
+    ``central.body.degree``/``order`` (EGM2008 coefficients; J2 alone for degree 2, two-body below),
+    Sun and Moon when ``third.body.sun``/``moon`` say so, solar radiation pressure
+    (``solar.radiation.pressure.cr``, ``.area``, conical shadow) and exponential-atmosphere drag
+    (``drag.cd``, ``drag.area``) when switched on, with the spacecraft ``mass`` (Orekit's default
+    1000 kg). Set-ups without central- or third-body keys (simulation set-ups) keep two-body + J2 with the
+    set-up's μ, as in Kaderali's reproduction.
     """
-    degree = int(float(setup.extra.get("central.body.degree", "0") or 0))
-    third = any(setup.extra.get(k, "false").lower() == "true" for k in ("third.body.sun", "third.body.moon"))
+    extra = setup.extra
+    degree = int(float(extra.get("central.body.degree", "0") or 0))
+    order = int(float(extra.get("central.body.order", degree) or degree))
+
+    def flag(key: str) -> bool:
+        return str(extra.get(key, "false")).strip().rstrip(";").lower() == "true"
+
+    def number(key: str, default: float) -> float:
+        value = str(extra.get(key, default)).strip().rstrip(";")
+        return float(value) if value else default
+
+    third = flag("third.body.sun") or flag("third.body.moon")
     epoch = np.asarray(setup.epoch_utc, dtype="datetime64[ns]").reshape(-1)[0]
-    model = ForceModel(mu_m3_s2=setup.mu_m3_s2, zonal_degree=2 if degree >= 2 else 0, sun=third, moon=third)
+    if degree > 2:
+        model = ForceModel(
+            mu_m3_s2=setup.mu_m3_s2,
+            gravity_degree=degree,
+            gravity_order=min(order, degree),
+            sun=flag("third.body.sun"),
+            moon=flag("third.body.moon"),
+            srp=flag("solar.radiation.pressure"),
+            srp_coefficient=number("solar.radiation.pressure.cr", 1.3),
+            srp_area_m2=number("solar.radiation.pressure.area", 1.0),
+            drag="exponential" if flag("drag") else "none",
+            drag_coefficient=number("drag.cd", 2.2),
+            drag_area_m2=number("drag.area", 1.0),
+            mass_kg=number("mass", 1000.0),
+        )
+    else:
+        model = ForceModel(mu_m3_s2=setup.mu_m3_s2, zonal_degree=2 if degree >= 2 else 0, sun=third, moon=third)
     return ForceContext.build(model, epoch, -86400.0, span_s + 86400.0), epoch
+
+
+def setup_estimated_scales(setup: Any, model: ForceModel) -> tuple[str, ...]:
+    """Force-model scale factors the set-up estimates: ``drag_scale`` when ``drag.cd.estimated`` (the
+    fitted drag coefficient is C_D × scale), ``srp_scale`` when ``solar.radiation.pressure.cr.estimated``,
+    each only when the force is in the model."""
+    extra = setup.extra
+
+    def flag(key: str) -> bool:
+        return str(extra.get(key, "false")).strip().rstrip(";").lower() == "true"
+
+    out = []
+    if model.drag == "exponential" and flag("drag.cd.estimated"):
+        out.append("drag_scale")
+    if model.srp and flag("solar.radiation.pressure.cr.estimated"):
+        out.append("srp_scale")
+    return tuple(out)
 
 
 def detect_tracking(
@@ -156,7 +209,9 @@ def detect_tracking(
         "biases": inputs.biases,
         "accel": inputs.acceleration,
         "refraction": inputs.refraction,
-        "force": [force.model.mu_m3_s2, force.model.zonal_degree >= 2, force.model.sun],
+        "force": repr(force.model),
+        "light_time": inputs.series.fit_config.light_time,
+        "troposphere": inputs.series.fit_config.troposphere,
         "max_maneuvers": settings.max_maneuvers,
         "kaderali_threshold": settings.kaderali_threshold,
     }
@@ -231,7 +286,17 @@ def fit_summary(fit: BatchFit, force: ForceModel, sun_m: Any) -> dict[str, Any]:
         "x0_m_mps": [float(v) for v in fit.x0],
         "range_bias_m": {k: [float(v), fit.sigma(f"range_bias[{k}]")] for k, v in fit.range_bias_m.items()},
         "angle_bias_deg": {k: [math.degrees(v[0]), math.degrees(v[1])] for k, v in fit.angle_bias_rad.items()},
-        "force_model": {"mu_m3_s2": force.mu_m3_s2, "j2": force.zonal_degree >= 2, "sun_moon": force.sun},
+        "force_model": {
+            "mu_m3_s2": force.mu_m3_s2,
+            "j2": force.zonal_degree >= 2 or force.gravity_degree >= 2,
+            "gravity_degree": force.gravity_degree,
+            "sun_moon": force.sun,
+            "srp": force.srp,
+            "drag": force.drag,
+        },
+        "light_time": fit.config.light_time,
+        "troposphere": fit.config.troposphere,
+        "scale_factors": {k: [float(v), fit.sigma(k)] for k, v in fit.scale_factors.items()},
     }
     if "accel_x" in fit.parameter_names:
         a = np.asarray(fit.acceleration_mps2, float)
@@ -257,8 +322,15 @@ def fit_summary_lines(summary: dict[str, Any]) -> list[str]:
         f"in {summary['iterations']} iterations with {summary['n_impulses']} impulse(s), "
         f"{summary['n_observations']} observations, weighted RMS {summary['weighted_rms']:.3f}"
     ]
+    fm = summary.get("force_model", {})
+    lines.append(
+        f"  model: field degree {fm.get('gravity_degree', 0)}, Sun/Moon {fm.get('sun_moon')}, SRP {fm.get('srp')}, "
+        f"drag {fm.get('drag')}; light time {summary.get('light_time')}, troposphere {summary.get('troposphere')}"
+    )
     for st, (b, s) in summary["range_bias_m"].items():
         lines.append(f"  range bias {st}: {b:.1f} ± {s:.1f} m")
+    for name, (v, s) in summary.get("scale_factors", {}).items():
+        lines.append(f"  {name}: {v:.3f} ± {s:.3f}")
     acc = summary.get("unmodelled_acceleration")
     if acc:
         lines.append(

@@ -44,6 +44,7 @@ class OrbitDeterminationSetup:
     mu_m3_s2: float = MU_EARTH_M3_S2
     elevation_mask_deg: float | None = None
     refraction_correction: bool = False
+    range_troposphere: bool = False
     extra: dict[str, str] = field(default_factory=dict)
 
 
@@ -160,6 +161,10 @@ def read_od_input(path: str | Path) -> OrbitDeterminationSetup:
         src.get("ground.station.elevation.refraction.correction", ("false", 0))[0].lower() == "true"
         for src in indexed.values()
     )
+    range_troposphere = any(
+        src.get("ground.station.range.tropospheric.correction", ("false", 0))[0].lower() == "true"
+        for src in indexed.values()
+    )
     rot = plain.get("abrupt.earth.rotation", ("iers", 0))[0].lower()
     if rot not in ("iers", "simple"):
         raise InputError(
@@ -178,6 +183,7 @@ def read_od_input(path: str | Path) -> OrbitDeterminationSetup:
         mu_m3_s2=mu,
         elevation_mask_deg=None if mask is None else float(mask[0]),
         refraction_correction=refraction,
+        range_troposphere=range_troposphere,
         extra={k: v for k, (v, _) in plain.items()},
     )
 

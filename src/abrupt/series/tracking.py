@@ -80,12 +80,17 @@ class TrackingSeries:
         """A copy of the measurements with the fitted station range and angle biases applied.
 
         Range biases replace the model's (the filter adds them to the predicted range); angle biases are
-        subtracted from the measured azimuth and elevation. The series' own arrays are not changed.
+        subtracted from the measured azimuth and elevation. When the fit's model has light time,
+        troposphere or time biases, their effect on the fitted trajectory is subtracted too, so the
+        instantaneous model of Kaderali's filter sees reduced measurements. The series' own arrays are
+        not changed.
         """
+        from abrupt.detect.tracking_glrt import model_corrections
+
         fit = self.orbit_fit()
         data = copy.copy(self.data)
         data.range_bias_m = self.data.range_bias_m.copy()
-        data.y = self.data.y.copy()
+        data.y = self.data.y - model_corrections(self.data, fit)
         for k, st in enumerate(data.station_names):
             if st in fit.range_bias_m:
                 data.range_bias_m[k] = fit.range_bias_m[st]
