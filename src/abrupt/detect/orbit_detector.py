@@ -689,7 +689,7 @@ def locate_burn(
     single = interval_jump(analysis, k)
     sd_total = float(np.sqrt(max(float(u @ whole.dv_cov @ u), 0.0)))
     impulse = duration < step or float(np.linalg.norm(single.dv_inertial_mps - total)) < max(0.2 * mag, 3.0 * sd_total)
-    fit = burn_duration_from_positions(analysis, lo, hi, total, whole.centroid_s, room_s=_room(t, k, whole.centroid_s))
+    fit = burn_duration_from_positions(analysis, lo, hi, whole.centroid_s, room_s=_room(t, k, whole.centroid_s))
     if impulse and fit is not None:
         # a burn that straddles an epoch can leave most of its ΔV in one interval (a 328 s burn sampled every
         # 240 s: 70-86 %), which the test above takes for an impulse and loses the rest (−14 %); the positions
@@ -724,7 +724,6 @@ def burn_duration_from_positions(
     analysis: OrbitAnalysis,
     lo: int,
     hi: int,
-    dv_inertial_mps: FloatArray,
     centroid_s: float,
     *,
     sub_step_s: float = 10.0,
@@ -743,7 +742,6 @@ def burn_duration_from_positions(
     by linear least squares from the measured positions less the pre-burn orbit, and (D, t_c) minimise
     the misfit: a small error of the centroid or of |ΔV| then does not masquerade as a duration (the
     along-track drift after a prograde burn grows as t², and dominates a misfit with both held fixed).
-    ``dv_inertial_mps`` only sets the direction of the orbit frame's reference (unused otherwise).
     t_c is searched within ± ``centroid_search_s`` (default one sampling interval). Returns (D, gain),
     gain the misfit (m²) of the best D no longer than ``room_s`` less the best misfit; None when the
     span has no usable positions."""
@@ -754,7 +752,6 @@ def burn_duration_from_positions(
     pos = eph.position_m[epochs]
     if not np.isfinite(pos).all() or hi <= lo:
         return None
-    del dv_inertial_mps
     x = analysis.forward.x[lo - 1].copy()
     ns = x.size
     t0 = float(t[lo - 1])
