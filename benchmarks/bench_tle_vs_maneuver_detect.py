@@ -40,6 +40,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
+import math
 import subprocess
 import sys
 import tempfile
@@ -99,13 +100,19 @@ print(json.dumps({"version": maneuver_detect.__version__, "rows": rows}))
 
 # ---------------------------------------------------------------------------------------------- abrupt
 def detect_one(
-    args: tuple[str, tuple[float, int]],
+    args: tuple[str, tuple[float, int], float],
 ) -> tuple[str, tuple[float, int], pd.DataFrame, dict[str, Any], float]:
     """Run the regime's detector on one satellite with one setting (all candidates kept)."""
-    sat, (gain, sides) = args
+    sat, (gain, sides), along = args
     history = read_tle(DATA / "tle" / f"{sat}.tle")
     cls = TleGeoStationKeeping if SATELLITES[sat][1] == "GEO" else TleMeanElements
-    det = cls(group_gain=(1.0, gain, gain), campaign_min_side_sets=sides, all_candidates=True, spacecraft=sat)
+    det = cls(
+        group_gain=(1.0, gain, gain),
+        campaign_min_side_sets=sides,
+        along_track_gain=along,
+        all_candidates=True,
+        spacecraft=sat,
+    )
     t0 = time.perf_counter()
     run = det.run(history, BUDGET)
     return sat, (gain, sides), run.events, run.noise_model, time.perf_counter() - t0
@@ -262,6 +269,69 @@ def missed_big_burns(
     return pd.DataFrame(rows)
 
 
+def one_step_ceiling(
+    sat: str, truth: pd.DataFrame, start: Any, end: Any, lag_days: float = 2.0, carry_fraction: float = 0.25
+) -> tuple[int, int, list[dict[str, Any]]]:
+    """Upper bound on the burns >= 5 cm/s any detector can match one-to-one when it states one maneuver
+    per element-set step (independent of abrupt's detector).
+
+    Two in-track burns whose effects reach the element sets in the same gap are indistinguishable:
+    after the gap the orbit depends only on the sum of their Δa and the along-track drift only on
+    their Δa-weighted mean time (two numbers for four unknowns), so the same step would be seen for
+    one burn and a detector that states two maneuvers there also states two for every lone burn.
+    Burns are grouped where their windows (from the gap holding the burn to ``lag_days`` later: TLE
+    lag) overlap; in each group the gaps that *carry* in-track change (|Δa| between consecutive sets
+    >= ``carry_fraction`` of the smallest burn's expected Δa = 2aΔv_t/v, noise and blended sets
+    included, so generous) bound the matches: min(in-track burns, carrying gaps). Other burns
+    (cross-track, opposed pairs) count as matchable. Returns (bound, n_big, groups with a loss).
+    """
+    el = read_tle(DATA / "tle" / f"{sat}.tle").elements
+    ep = el["epoch_utc"].to_numpy(dtype="datetime64[ns]")
+    a = el["a_m"].to_numpy(dtype=float)
+    tr = truth.loc[(truth["time_utc"] >= start) & (truth["time_utc"] <= end)].reset_index(drop=True)
+    tt = tr["time_utc"].to_numpy(dtype="datetime64[ns]")
+    if not len(tr):
+        return 0, 0, []
+    big = (tr["dv_mps"] >= BIG_BURN_MPS).to_numpy()
+    intrack = (tr["dv_t_mps"].abs() >= 0.5 * tr["dv_mps"]).to_numpy()
+    lag = np.timedelta64(int(lag_days * 86400), "s")
+    g0 = np.searchsorted(ep, tt) - 1
+    g1 = np.searchsorted(ep, tt + lag)
+    group = np.zeros(len(tt), dtype=int)
+    for j in range(1, len(tt)):
+        group[j] = group[j - 1] if g0[j] < g1[:j].max() else group[j - 1] + 1
+    bound, losses = 0, []
+    mu = 398600.8e9  # [m^3/s^2] WGS-72, as SGP4
+    for c in np.unique(group):
+        js = np.flatnonzero(group == c)
+        b_in = [int(j) for j in js if big[j] and intrack[j]]
+        bound += sum(1 for j in js if big[j] and not intrack[j])
+        if len(b_in) <= 1:
+            bound += len(b_in)
+            continue
+        lo, hi = max(int(g0[js].min()), 0), min(int(g1[js].max()), len(ep) - 1)
+        v = math.sqrt(mu / a[lo])
+        da_exp = 2.0 * a[lo] * tr["dv_t_mps"].to_numpy()[b_in] / v
+        da_obs = np.diff(a)[lo:hi]
+        carrying = int((np.abs(da_obs) >= carry_fraction * np.abs(da_exp).min()).sum())
+        best = min(len(b_in), carrying)
+        bound += best
+        if best < len(b_in):
+            losses.append(
+                {
+                    "satellite": sat,
+                    "first_burn_utc": str(tt[js[0]])[:16],
+                    "in_track_burns": len(b_in),
+                    "gaps": hi - lo,
+                    "carrying_gaps": carrying,
+                    "sum_da_expected_m": float(da_exp.sum()),
+                    "sum_da_observed_m": float(da_obs.sum()),
+                    "at_most": best,
+                }
+            )
+    return bound, int(big.sum()), losses
+
+
 def campaign_covered(at_op: pd.DataFrame, truth: pd.DataFrame, in_span: np.ndarray) -> set[int]:
     """Truth rows inside the stated interval of an event at the operating point, at most the event's
     ``burns_max`` per event (largest ΔV first): the campaign-level credit."""
@@ -396,6 +466,12 @@ def main() -> None:
     parser.add_argument("--cache-dir", default="/tmp/abrupt_bench_cache", help="maneuver-detect output cache")
     parser.add_argument("--no-cache", action="store_true", help="re-run maneuver-detect")
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument(
+        "--along-track-gain",
+        type=float,
+        default=1.0,
+        help="gain of the along-track phase group (LEO; 0 switches it off: the sensitivity run in docs/tle.md)",
+    )
     args = parser.parse_args()
     t_start = time.perf_counter()
     sats = list(SATELLITES)
@@ -407,7 +483,7 @@ def main() -> None:
         for g in GRID[SATELLITES[s][1]]
     ]
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
-        results = list(pool.map(detect_one, jobs))
+        results = list(pool.map(detect_one, [(s, g, args.along_track_gain) for s, g in jobs]))
     runs = {(s, g): (ev, nm, sec) for s, g, ev, nm, sec in results}
     scores = {(s, g): evaluate(runs[(s, g)][0], truth[s], *spans[s], signed=True) for s, g in jobs}
 
@@ -444,6 +520,19 @@ def main() -> None:
         ],
         ignore_index=True,
     )
+    ceiling_rows = []
+    ceiling_losses: list[dict[str, Any]] = []
+    for lag_days, frac in ((2.0, 0.25), (1.0, 0.25), (3.0, 0.10)):
+        b_sum = n_sum = 0
+        for r in rows:
+            if r["class"] != "LEO":
+                continue
+            sat_r = r["satellite"]
+            b, n, losses = one_step_ceiling(sat_r, truth[sat_r], *spans[sat_r], lag_days, frac)
+            b_sum, n_sum = b_sum + b, n_sum + n
+            if (lag_days, frac) == (2.0, 0.25):
+                ceiling_losses += losses
+        ceiling_rows.append((lag_days, frac, b_sum, n_sum))
     base_note = "skipped"
     if not args.no_baseline:
         frames, version, base_note = baseline_events(
@@ -506,6 +595,14 @@ def main() -> None:
     with pd.option_context("display.width", 250, "display.max_colwidth", 90, "display.float_format", "{:.1f}".format):
         print(f"\nabrupt (held out): the {len(misses)} LEO maneuvers >= 5 cm/s missed at 1 FA/yr, and why")
         print(misses.to_string(index=False) if len(misses) else "  none")
+    print("\nCeiling of burn-level recall (one maneuver per element-set step, one_step_ceiling): groups losing burns")
+    with pd.option_context("display.width", 250, "display.float_format", "{:.0f}".format):
+        print(pd.DataFrame(ceiling_losses).to_string(index=False) if ceiling_losses else "  none")
+    for lag_days, frac, b_sum, n_sum in ceiling_rows:
+        print(
+            f"  LEO ceiling (TLE lag {lag_days:.0f} d, carrying step >= {frac:.2f} of the smallest burn's da): "
+            f"{b_sum}/{n_sum} = {b_sum / max(n_sum, 1):.3f}"
+        )
     print("\nAcceptance (issue 11): LOSO pooled F1 >= 0.6 per class; recall >= 0.9 of burns >= 5 cm/s at <= 1 FA/yr")
     for r in pooled_rows:
         if r["detector"] != "abrupt":

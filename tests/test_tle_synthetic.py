@@ -288,3 +288,50 @@ def test_sparse_history_with_many_burns_keeps_its_threshold_off_the_maneuvers(tm
     res = score_events(events, pd.DataFrame({"time_utc": [t for t, _, _ in truth]}), tolerance_s=1.5 * 86400.0)
     assert res.true_positives >= 6, events[["time_utc", "statistic", "threshold"]]
     assert res.false_positives <= 2  # budget 1 per satellite-year over 1.4 years
+
+
+def test_opposed_in_track_pair_is_found_from_its_along_track_phase_step(tmp_path: Path) -> None:
+    """+3 cm/s then −3 cm/s 0.2 day apart, inside one gap: ``a`` and e are unchanged, the along-track
+    phase moves by 3 Δv Δt_s ≈ 1.6 km (Vallado 2013 Eq. 6-39 with Δa = 2Δv/n); one event, typed as
+    phasing, within a day of the pair."""
+    burns = ((200.75, 0.03), (200.95, -0.03))
+    text, truth = synthetic_tle_text(days=400, burns=burns, seed=11)
+    path = tmp_path / "phasing.tle"
+    path.write_text(text)
+    events = detect_tle_maneuvers(read_tle(path))
+    t_pair = truth[0][0]
+    dt = (pd.to_datetime(events["time_utc"]).dt.tz_localize(None) - t_pair).abs()
+    near = events.loc[dt < pd.Timedelta(days=1)]
+    assert len(near) == 1
+    assert near["maneuver_type"].iloc[0] == "along-track phasing"
+    assert abs(float(near["delta_u_m"].iloc[0])) == pytest.approx(3 * 0.03 * 0.2 * 86400.0, rel=0.25)
+    assert len(events) - len(near) <= 2  # budget: 1 per satellite-year
+
+
+def test_elapsed_seconds_count_the_leap_second_as_astropy_does() -> None:
+    from astropy.time import Time
+
+    from abrupt.detect.tle_maneuvers import elapsed_si_seconds
+
+    stamps = ["2016-12-31T12:00:00", "2016-12-31T23:59:00", "2017-01-01T00:01:00", "2017-01-02T12:00:00"]
+    got = elapsed_si_seconds(pd.Series(pd.to_datetime(stamps)))
+    tai = Time(stamps, scale="utc").tai
+    want = (tai - tai[0]).to_value("s")
+    np.testing.assert_allclose(got, want, atol=1e-6)
+    assert got[2] - got[1] == pytest.approx(121.0)  # two minutes and the leap second
+
+
+def test_two_set_burn_time_recovers_the_burn_inside_its_gap(maneuvering) -> None:
+    """The phase innovation across the gap times one impulse (t_b = t_g + Δt/2 − δ/Δu̇)."""
+    from abrupt.detect.tle_maneuvers import elapsed_si_seconds, two_set_burn_time
+
+    path, truth = maneuvering
+    history = read_tle(path)
+    epochs = history.elements["epoch_utc"]
+    t = elapsed_si_seconds(epochs)
+    t_burn, _, _ = truth[-1]  # 1 cm/s on day 300.6
+    g = int(np.searchsorted(epochs.to_numpy(dtype="datetime64[ns]"), np.datetime64(t_burn))) - 1
+    t_b = two_set_burn_time(history, t, g)
+    assert t_b is not None
+    t_true = (t_burn - epochs.iloc[0]).total_seconds()
+    assert abs(t_b - t_true) < 2 * 3600.0

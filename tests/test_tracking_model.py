@@ -257,3 +257,41 @@ def test_drag_and_srp_scale_sensitivities_match_finite_differences() -> None:
     np.testing.assert_allclose(total, sens[-1, :, 3], rtol=1e-6, atol=1e-6 * np.max(np.abs(sens[-1, :, 3])))
     with pytest.raises(ValueError, match="parameters"):
         propagate_with_stm(x0, 0.0, t, force=ctx, parameters=("cd",))
+
+
+def test_once_per_rev_empirical_accelerations_and_their_sensitivities() -> None:
+    """The CPR terms C cos u / C sin u along R, T, N: at the start the sensitivity is ½t² times the
+    basis vector, whose u agrees with the argument of latitude of rv_to_coe; over three hours the
+    columns match central differences of the propagated state with the coefficient changed."""
+    from abrupt.model.orbit import EMPIRICAL_PARAMETERS
+
+    x0 = coe_to_rv(7.0e6, 0.001, math.radians(60), math.radians(40), math.radians(30), 1.0, MU)
+    force = ForceModel(mu_m3_s2=MU, zonal_degree=2)
+    coe = rv_to_coe(x0, MU)
+    u = math.radians(coe["argp_deg"] + coe["nu_deg"])
+    basis = rsw_basis(x0)  # columns R, S (transverse), W (normal)
+    h = 2.0
+    _, _, s0 = propagate_with_stm(x0, 0.0, np.array([h]), force=force, max_step_s=1.0, parameters=EMPIRICAL_PARAMETERS)
+    for j in range(6):
+        trig = math.cos(u) if j % 2 == 0 else math.sin(u)
+        np.testing.assert_allclose(s0[0, :3, 3 + j] / (0.5 * h * h), trig * basis[:, j // 2], atol=2e-3)
+    t = np.arange(0.0, 3 * 3600.0 + 1, 600.0)
+    emp = np.array([1e-7, -2e-7, 3e-7, 1e-7, -1e-7, 2e-7])
+    names = ("cpr_t_sin", "cpr_r_cos", "cpr_n_cos")
+    st, _, sens = propagate_with_stm(
+        x0, 0.0, t, force=force, max_step_s=20.0, method="rk8", parameters=names, empirical_mps2=emp
+    )
+    plain, _, _ = propagate_with_stm(x0, 0.0, t, force=force, max_step_s=20.0, method="rk8")
+    assert np.max(np.abs(st[:, :3] - plain[:, :3])) > 1.0  # the accelerations act (metres in 3 h)
+    for col, name in enumerate(names, start=3):
+        j = EMPIRICAL_PARAMETERS.index(name)
+        d = 1e-7
+        ends = []
+        for sign in (1.0, -1.0):
+            e = emp.copy()
+            e[j] += sign * d
+            ends.append(propagate_with_stm(x0, 0.0, t, force=force, max_step_s=20.0, method="rk8", empirical_mps2=e)[0])
+        fd = (ends[0] - ends[1]) / (2 * d)
+        # (∂a_emp/∂x, ~C/r, is left out of the variational equations: a few 1e-6 of the column)
+        np.testing.assert_allclose(sens[:, :3, col], fd[:, :3], atol=2e-5 * np.max(np.abs(fd[:, :3])))
+        np.testing.assert_allclose(sens[:, 3:, col], fd[:, 3:], atol=2e-5 * np.max(np.abs(fd[:, 3:])))

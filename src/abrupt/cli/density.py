@@ -1,4 +1,4 @@
-"""``abrupt density tle|meteors``: thermospheric density from drag and from meteoroid ablation."""
+"""``abrupt density tle|orbit|meteors``: thermospheric density from drag and from meteoroid ablation."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from abrupt.cli.groups import cli
 
 @cli.group("density")
 def density() -> None:
-    """Thermospheric density: from TLE decay across a constellation, or from meteor head echoes."""
+    """Thermospheric density: from TLE decay across a constellation, precise orbits, or meteor head echoes."""
 
 
 @density.command("tle")
@@ -109,6 +109,103 @@ def density_tle(
         from abrupt.density.report import plot_density_bands
 
         plot_density_bands(res.windows, report, title="density from TLE decay")
+        click.echo(f"report: {report}")
+
+
+@density.command("orbit")
+@click.argument("paths", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False))
+@click.option("--out", type=click.Path(dir_okay=False), required=True, help="Windows table (.csv or .parquet).")
+@click.option("--satellite", default=None, help="Satellite id in a multi-satellite file (SP3 'L74').")
+@click.option("--window-days", type=float, default=1.0, show_default=True, help="Length of each batch fit.")
+@click.option("--mass-kg", type=float, default=None, help="Spacecraft mass; with --drag-area-m2 gives density.")
+@click.option("--drag-area-m2", type=float, default=None, help="Drag reference area.")
+@click.option("--cd", "drag_coefficient", type=float, default=2.2, show_default=True, help="Drag coefficient.")
+@click.option("--srp-area-m2", type=float, default=None, help="SRP area (default: the drag area).")
+@click.option("--cr", "srp_coefficient", type=float, default=1.3, show_default=True, help="SRP coefficient.")
+@click.option(
+    "--density-model",
+    type=click.Choice(["msis", "exponential"]),
+    default="msis",
+    show_default=True,
+    help="Density the fitted drag scale multiplies (NRLMSIS along the observed orbit, or exponential).",
+)
+@click.option("--gravity-degree", type=int, default=40, show_default=True, help="EGM2008 degree and order.")
+@click.option("--no-srp-fit", is_flag=True, help="Keep the SRP scale at 1 instead of fitting it.")
+@click.option("--no-empirical", is_flag=True, help="Do not fit once-per-rev along/cross-track empirical accelerations.")
+@click.option(
+    "--space-weather",
+    type=click.Path(exists=True, dir_okay=False),
+    default=None,
+    help="Space-weather table (CelesTrak SW format or CSV); default: the one shipped offline.",
+)
+@click.option("--allow-truncated", is_flag=True, help="Read SP3 files that end early (counted repair).")
+@click.option("--report", type=click.Path(dir_okay=False), default=None, help="PNG: density vs NRLMSIS.")
+def density_orbit(
+    paths: tuple[str, ...],
+    out: str,
+    satellite: str | None,
+    window_days: float,
+    mass_kg: float | None,
+    drag_area_m2: float | None,
+    drag_coefficient: float,
+    srp_area_m2: float | None,
+    srp_coefficient: float,
+    density_model: str,
+    gravity_degree: int,
+    no_srp_fit: bool,
+    no_empirical: bool,
+    space_weather: str | None,
+    allow_truncated: bool,
+    report: str | None,
+) -> None:
+    """ρB per window from precise orbits (SP3, OEM, CSV): batch least squares for the state and drag scale.
+
+    With --mass-kg and --drag-area-m2 also the density (density_kg_m3) beside NRLMSIS along the orbit.
+    """
+    from abrupt.density.precise_orbit import OrbitDensityConfig
+    from abrupt.pipelines.density import orbit_density, write_table
+
+    if window_days <= 0:
+        raise click.BadParameter("must be > 0", param_hint="--window-days")
+    for name, value in (("--mass-kg", mass_kg), ("--drag-area-m2", drag_area_m2), ("--srp-area-m2", srp_area_m2)):
+        if value is not None and value <= 0:
+            raise click.BadParameter("must be > 0", param_hint=name)
+    if gravity_degree < 2:
+        raise click.BadParameter("must be >= 2", param_hint="--gravity-degree")
+    known = mass_kg is not None and drag_area_m2 is not None
+    base = OrbitDensityConfig()
+    mass = mass_kg if mass_kg is not None else base.mass_kg
+    area = drag_area_m2 if drag_area_m2 is not None else base.drag_area_m2
+    cfg = OrbitDensityConfig(
+        window_days=window_days,
+        gravity_degree=gravity_degree,
+        fit_srp=not no_srp_fit,
+        empirical=() if no_empirical else base.empirical,
+        density_model=density_model,
+        mass_kg=mass,
+        drag_area_m2=area,
+        drag_coefficient=drag_coefficient,
+        srp_area_m2=srp_area_m2 if srp_area_m2 is not None else area,
+        srp_coefficient=srp_coefficient,
+        spacecraft_known=known,
+    )
+    run = orbit_density(
+        list(paths), cfg, satellite=satellite, space_weather=space_weather, allow_truncated=allow_truncated
+    )
+    write_table(run.windows, out)
+    for src, log in run.repairs.items():
+        for kind, n in log.counts.items():
+            click.echo(f"{src}: {kind}: {n}", err=True)
+    for msg in run.warnings:
+        click.echo(f"warning: {msg}", err=True)
+    if not known:
+        click.echo("no --mass-kg/--drag-area-m2: density columns left empty (rho_b_per_m is given)", err=True)
+    ok = int((run.windows["status"] == "ok").sum()) if len(run.windows) else 0
+    click.echo(f"{ok} window(s) of {len(paths)} file(s) written to {out}")
+    if report:
+        from abrupt.density.report import plot_density_bands
+
+        plot_density_bands(run.windows, report, title="density from precise orbits")
         click.echo(f"report: {report}")
 
 

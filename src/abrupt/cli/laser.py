@@ -71,7 +71,7 @@ TERMS = ("light_time", "troposphere", "shapiro", "plate_motion", "eccentricity",
     "--time-biases/--no-time-biases",
     default=False,
     show_default=True,
-    help="Estimate each station's time-tag offset (a common offset of all stations is not observable).",
+    help="Estimate each station's time-tag offset relative to the station with the most ranges.",
 )
 @click.option("--spacecraft", default=None, help="Pseudonym for the events (default: the CRD target name).")
 @click.option("--fit-out", default=None, type=click.Path(dir_okay=False), help="Write the fit summary (JSON).")

@@ -416,22 +416,35 @@ class ScaleEstimate:
     c_upper_bound: float  # min_j B_max,j / b_j (every B below its platform's B_max)
 
 
+#: Bins of the Beta mass, dense near both edges where a, b < 1 put singular mass.
+_BIN_EDGES = 0.5 - 0.5 * np.cos(np.pi * np.linspace(0.0, 1.0, 161))
+
+
 def _beta_noise_logpdf(x: FloatArray, sig: FloatArray, a: float, b: float) -> FloatArray:
     """log of [Beta(a, b) * N(0, σ_j)](x_j): the exact Beta mass of 160 bins convolved with a Gaussian."""
-    # Bins dense near both edges, where a, b < 1 put singular mass.
-    edges = 0.5 - 0.5 * np.cos(np.pi * np.linspace(0.0, 1.0, 161))
+    edges = _BIN_EDGES
     mass = np.diff(betainc(a, b, edges))
-    lo, hi = edges[:-1][None, :], edges[1:][None, :]
-    xx, ss = x[:, None], np.maximum(sig, 1e-6)[:, None]
-    # Uniform within each bin, convolved exactly with the Gaussian.
-    width = hi - lo
-    p = (ndtr((xx - lo) / ss) - ndtr((xx - hi) / ss)) / width
+    # Uniform within each bin, convolved exactly with the Gaussian: Φ at the 161 shared edges once.
+    cdf = ndtr((x[:, None] - edges[None, :]) / np.maximum(sig, 1e-6)[:, None])
+    p = (cdf[:, :-1] - cdf[:, 1:]) / np.diff(edges)[None, :]
     dens = p @ mass
     return np.log(np.maximum(dens, 1e-300))
 
 
-def estimate_scale(b_rel: FloatArray, b_rel_sigma: FloatArray, b_min: FloatArray, b_max: FloatArray) -> ScaleEstimate:
-    """Maximum-likelihood c (module docstring) for object-blocks with relative b and physical range."""
+def estimate_scale(
+    b_rel: FloatArray,
+    b_rel_sigma: FloatArray,
+    b_min: FloatArray,
+    b_max: FloatArray,
+    *,
+    start: ScaleEstimate | None = None,
+    with_sigma: bool = True,
+) -> ScaleEstimate:
+    """Maximum-likelihood c (module docstring) for object-blocks with relative b and physical range.
+
+    Six Nelder-Mead starts (c at both bounds and between, two Beta shapes) unless ``start`` gives
+    one (a neighbouring problem's optimum: the accommodation-range ends); ``with_sigma`` adds the
+    profile-likelihood curvature (two more minimisations) for ``c_sigma`` (NaN without)."""
     b_all = np.asarray(b_rel, dtype=float)
     ok = np.isfinite(b_all) & (b_all > 0) & (np.asarray(b_max) > np.asarray(b_min))
     b_rel = b_all[ok]
@@ -453,14 +466,18 @@ def estimate_scale(b_rel: FloatArray, b_rel_sigma: FloatArray, b_min: FloatArray
 
     best = None
     mid = math.sqrt(c_lo * c_hi) if c_hi > c_lo else 0.5 * (c_lo + c_hi)
-    for c0 in (c_lo, mid, c_hi):
-        for a0, b0 in ((0.5, 0.5), (1.5, 1.5)):
-            p0 = np.array([math.log(c0), math.log(a0), math.log(b0)])
-            r = minimize(nll, p0, method="Nelder-Mead", options={"xatol": 1e-5, "fatol": 1e-7, "maxiter": 2000})
-            if best is None or r.fun < best.fun:
-                best = r
+    starts = [(c0, a0, b0) for c0 in (c_lo, mid, c_hi) for a0, b0 in ((0.5, 0.5), (1.5, 1.5))]
+    if start is not None:
+        starts = [(start.c, start.beta_a, start.beta_b)]
+    for c0, a0, b0 in starts:
+        p0 = np.array([math.log(c0), math.log(a0), math.log(b0)])
+        r = minimize(nll, p0, method="Nelder-Mead", options={"xatol": 1e-5, "fatol": 1e-7, "maxiter": 2000})
+        if best is None or r.fun < best.fun:
+            best = r
     assert best is not None
     c = math.exp(best.x[0])
+    if not with_sigma:
+        return ScaleEstimate(c, float("nan"), math.exp(best.x[1]), math.exp(best.x[2]), c_lo, c_hi)
     # Curvature of the profile likelihood in log c → σ.
     h = 2e-3
     f0 = best.fun
@@ -578,7 +595,7 @@ def joint_constellation_density(
             return flow
 
         ranges = [platform_b_range(rows[str(o)], flow_of(str(o)), np.asarray(alphas)) for o in br["object"]]
-        for i, al in enumerate(alphas):
+        for i in (1, 0, 2):  # the middle α first: its optimum starts the two ends' (one start each)
             lo = np.array([r[0][i] for r in ranges])
             hi = np.array([r[1][i] for r in ranges])
             if not np.any(hi > lo):
@@ -586,8 +603,11 @@ def joint_constellation_density(
                 cc = float(np.median(lo / br["b_rel"].to_numpy()))
                 est = ScaleEstimate(cc, 0.0, float("nan"), float("nan"), cc, cc)
             else:
-                est = estimate_scale(br["b_rel"].to_numpy(), br["b_rel_sigma"].to_numpy(), lo, hi)
-            by_alpha[float(al)] = est.c
+                warm = scale if scale is not None and math.isfinite(scale.beta_a) else None
+                est = estimate_scale(
+                    br["b_rel"].to_numpy(), br["b_rel_sigma"].to_numpy(), lo, hi, start=warm, with_sigma=i == 1
+                )
+            by_alpha[float(alphas[i])] = est.c
             if i == 1:
                 scale = est
         assert scale is not None

@@ -11,9 +11,10 @@ import pandas as pd
 def plot_density_bands(windows: pd.DataFrame, out: str | Path, *, band_km: float = 50.0, title: str = "") -> None:
     """Time series per altitude band: estimate (mean, with 1σ band) and NRLMSIS along the same orbits.
 
-    Uses ``density_joint_kg_m3`` (joint fit) or ``density_mean_kg_m3`` (order statistics) when
-    present, else ρB scaled by the median of ρB/ρ_MSIS of each object ("ρB / B̂", single objects:
-    the shape of the series, B unknown).
+    Uses ``density_joint_kg_m3`` (joint fit), ``density_mean_kg_m3`` (order statistics) or
+    ``density_kg_m3`` (precise-orbit fit with the spacecraft given) when present, else ρB scaled by
+    the median of ρB/ρ_MSIS of each object ("ρB / B̂", single objects: the shape of the series, B
+    unknown).
     """
     import matplotlib
 
@@ -29,6 +30,10 @@ def plot_density_bands(windows: pd.DataFrame, out: str | Path, *, band_km: float
         w["est"] = w["density_mean_kg_m3"]
         w["est_sigma"] = w["density_mean_sigma_kg_m3"]
         label = "estimate (order statistics, mean)"
+    elif "density_kg_m3" in w.columns and w["density_kg_m3"].notna().any():
+        w["est"] = w["density_kg_m3"]
+        w["est_sigma"] = w["density_sigma_kg_m3"]
+        label = "estimate (precise-orbit fit, given B)"
     else:
         scale = (w["rho_b_per_m"] / w["model_density_kg_m3"]).groupby(w["object"]).transform("median")
         w["est"] = w["rho_b_per_m"] / scale

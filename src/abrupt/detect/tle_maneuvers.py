@@ -83,6 +83,8 @@ EXTRA_COLUMNS: tuple[str, ...] = (
     "interval_start_utc",
     "interval_end_utc",
     "burns_max",
+    "z_u",
+    "delta_u_m",
 )
 
 
@@ -106,6 +108,7 @@ class TleDetectorConfig:
     campaign_min_side_sets: int | None = None  # None: by regime (CAMPAIGN_SIDE_SETS)
     time_search_sets_before: int = 3
     group_gain: tuple[float, float, float] = (1.0, 0.2, 0.2)
+    along_track_gain: float = 1.0
 
     def __post_init__(self) -> None:
         if self.window_sets < 2:
@@ -118,6 +121,8 @@ class TleDetectorConfig:
             raise ValueError(f"regime must be auto, leo or geo, got {self.regime!r}")
         if any(not (g >= 0 and math.isfinite(g)) for g in self.group_gain) or len(self.group_gain) != 3:
             raise ValueError("group_gain must be three finite non-negative numbers")
+        if not (self.along_track_gain >= 0 and math.isfinite(self.along_track_gain)):
+            raise ValueError("along_track_gain must be a finite non-negative number")
 
 
 @dataclass
@@ -136,15 +141,22 @@ class StepSeries:
     sigma_n_rad: NDArray[np.float64] | None = None  # raw step noise of one orbit-normal component
     weights: tuple[float, float, float] = (1.0, 1.0, 1.0)
     group_gain: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    # along-track phase (module docstring, step 2b): step (m), z-score, tail weight and gain
+    delta_u_m: NDArray[np.float64] | None = None
+    z_u: NDArray[np.float64] | None = None
+    weight_u: float = 1.0
+    gain_u: float = 0.0
 
     @property
     def statistic(self) -> NDArray[np.float64]:
-        """Combined S = sqrt(Σ (w_k z_k)²) with the per-group tail weights (module docstring, step 3)."""
+        """Combined S: the largest of the groups' gained, tail-weighted scores as |N(0,1)| values
+        (module docstring, step 3)."""
         wa, we, wn = self.weights
         ga, ge, gn = self.group_gain
-        return np.maximum.reduce(
-            [ga * wa * self.z_a, ge * chi2_as_normal(we * self.z_e), gn * chi2_as_normal(wn * self.z_n)]
-        )
+        parts = [ga * wa * self.z_a, ge * chi2_as_normal(we * self.z_e), gn * chi2_as_normal(wn * self.z_n)]
+        if self.z_u is not None and self.gain_u > 0:
+            parts.append(self.gain_u * self.weight_u * self.z_u)
+        return np.maximum.reduce(parts)
 
 
 def chi2_as_normal(z: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -180,8 +192,54 @@ def orbit_regime(history: ElementHistory) -> str:
     return "geo" if lo <= rev_day <= hi and float(np.median(el["e"])) < 0.1 else "leo"
 
 
+def elapsed_si_seconds(epochs_utc: pd.Series) -> NDArray[np.float64]:
+    """Elapsed SI seconds from the first epoch, leap seconds included (TAI−UTC from ERFA's table).
+
+    A plain UTC difference is one second short across a leap second; at 7 km/s that second is a
+    7 km along-track jump in every history that spans 2016-12-31 (a false phase step).
+    """
+    import warnings
+
+    import erfa
+
+    ts = pd.DatetimeIndex(pd.to_datetime(epochs_utc)).tz_localize(None)
+    if ts.size == 0:
+        return np.zeros(0)
+    t_utc = (ts - ts[0]).total_seconds().to_numpy(dtype=float)
+    frac = (ts - ts.normalize()).total_seconds().to_numpy(dtype=float) / SECONDS_PER_DAY
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # ERFA: years past its table are "dubious" (TAI−UTC held)
+        dat = np.asarray(erfa.dat(ts.year.to_numpy(), ts.month.to_numpy(), ts.day.to_numpy(), frac), dtype=float)
+    return np.asarray(t_utc + (dat - dat[0]), dtype=float)
+
+
+def along_track_phase_m(history: ElementHistory, t_s: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Along-track phase residual (m): cumulative set-to-set innovation of the mean argument of latitude.
+
+    ``δu_k = wrap(u_{k+1} − u_k − ½(u̇_k + u̇_{k+1}) Δt_k)`` with ``u = ω + M`` and ``u̇`` the SGP4
+    secular rate (mean motion with the J2 terms, Hoots & Roehrich 1980) as a running median over five
+    sets, which keeps a burn's step in the rate (a median filter preserves edges, Tukey 1977) and
+    removes a lone bad set's (whose rate error would otherwise integrate into a permanent phase
+    step); the trapezoid integrates the drag decay of the mean motion. The sum times ``a`` is flat
+    under the null; an in-track burn changes it by ``Δn(Δt/2 − (t_b − t_k))·a`` and a pair of opposed
+    in-track burns Δt_s apart, which leaves ``a`` unchanged, by ``3 Δv Δt_s`` (the phasing they
+    were made for; Vallado 2013 §6.6, Eq. 6-39 with Δa = 2Δv/n).
+    """
+    n = len(history)
+    if n < 2:
+        return np.zeros(n)
+    sats = history.satrecs
+    u = np.array([s.argpo + s.mo for s in sats], dtype=float)
+    rate = np.array([(s.argpdot + s.mdot) / 60.0 for s in sats], dtype=float)  # [rad/s] (SGP4: rad/min)
+    rate = pd.Series(rate).rolling(5, center=True, min_periods=1).median().to_numpy(dtype=float)
+    innov = np.angle(np.exp(1j * (np.diff(u) - 0.5 * (rate[1:] + rate[:-1]) * np.diff(t_s))))
+    a = history.elements["a_m"].to_numpy(dtype=float)
+    return np.concatenate([[0.0], np.cumsum(innov * 0.5 * (a[1:] + a[:-1]))])
+
+
 def mean_element_series(history: ElementHistory, regime: str = "leo") -> dict[str, NDArray[np.float64]]:
-    """Detector series: time (s from the first epoch), a (m), e-vector, and two orbit-normal angles (rad).
+    """Detector series: time (SI s from the first epoch), a (m), e-vector, two orbit-normal angles
+    (rad) and, for LEO, the along-track phase residual ``u_m`` (m, :func:`along_track_phase_m`).
 
     ``leo``: e-vector ``e(cos ω, sin ω)``; normal = (``i``, ``sin i`` × RAAN minus the SGP4 secular J2
     drift, accumulated set to set). ``geo``: the equinoctial vectors that stay defined at small
@@ -191,7 +249,7 @@ def mean_element_series(history: ElementHistory, regime: str = "leo") -> dict[st
     components in both regimes.
     """
     el = history.elements
-    t = (el["epoch_utc"] - el["epoch_utc"].iloc[0]).dt.total_seconds().to_numpy(dtype=float)
+    t = elapsed_si_seconds(el["epoch_utc"])
     e = el["e"].to_numpy(dtype=float)
     w = el["argp_rad"].to_numpy(dtype=float)
     inc = el["i_rad"].to_numpy(dtype=float)
@@ -205,6 +263,7 @@ def mean_element_series(history: ElementHistory, regime: str = "leo") -> dict[st
             "ey": e * np.sin(varpi),
             "i_rad": inc * np.sin(raan),
             "raan_resid_sin_i_rad": -inc * np.cos(raan),
+            "u_m": np.zeros_like(t),  # GEO: the mean longitude's kink times burns (step 4), not tested
         }
     rate = el["raan_rate_rad_s"].to_numpy(dtype=float)
     incr = np.zeros_like(raan)
@@ -219,6 +278,7 @@ def mean_element_series(history: ElementHistory, regime: str = "leo") -> dict[st
         "ey": e * np.sin(w),
         "i_rad": inc,
         "raan_resid_sin_i_rad": raan_resid * np.sin(inc),
+        "u_m": along_track_phase_m(history, t),
     }
 
 
@@ -327,7 +387,7 @@ def _steps_all(
 class _StepModel:
     """Per-gap robust step test with windows that may be cut at accepted change points."""
 
-    NAMES = ("a_m", "ex", "ey", "i_rad", "raan_resid_sin_i_rad")
+    NAMES = ("a_m", "ex", "ey", "i_rad", "raan_resid_sin_i_rad", "u_m")
 
     def __init__(self, history: ElementHistory, cfg: TleDetectorConfig) -> None:
         self.cfg = cfg
@@ -372,7 +432,9 @@ class _StepModel:
         steps = {k: float(v) for k, v in zip(self.NAMES, values, strict=True)}
         return steps, math.sqrt(math.pi / 2.0) * math.sqrt(1.0 / n1 + 1.0 / n2)
 
-    def localise(self, g: int, lo_bound: int, hi_bound: int, weights: tuple[float, float, float]) -> int:
+    def localise(
+        self, g: int, lo_bound: int, hi_bound: int, weights: tuple[float, float, float], weight_u: float = 0.0
+    ) -> int:
         """The gap near ``g`` (±2) that splits the surrounding sets best (least weighted L1 cost).
 
         The median step test has a plateau: the same step is seen a few gaps either side of the true
@@ -388,6 +450,7 @@ class _StepModel:
             "ey": weights[1],
             "i_rad": weights[2],
             "raan_resid_sin_i_rad": weights[2],
+            "u_m": weight_u,
         }
         best, best_cost = g, math.inf
         for c in range(g - 2, g + 3):
@@ -395,6 +458,8 @@ class _StepModel:
                 continue
             cost = 0.0
             for k in self.NAMES:
+                if wmap[k] == 0.0:
+                    continue
                 y = self.s[k]
                 sc = self.scales[k][c]
                 for side in (slice(lo, c + 1), slice(c + 1, hi)):
@@ -411,12 +476,30 @@ class _StepModel:
         dt_gap = float(self.t[g + 1] - self.t[g])
         return {k: math.sqrt((self.scales[k][g] * factor) ** 2 + self.drift_q[k] * dt_gap) for k in self.NAMES}
 
-    def z(self, g: int, steps: dict[str, float], factor: float) -> tuple[float, float, float]:
+    def z(self, g: int, steps: dict[str, float], factor: float) -> tuple[float, float, float, float]:
+        """z-scores of the a, e-vector, orbit-normal and along-track phase steps at gap g."""
         sc = self.step_sigmas(g, factor)
         z_a = abs(steps["a_m"]) / sc["a_m"]
         z_e = math.hypot(steps["ex"] / sc["ex"], steps["ey"] / sc["ey"])
         z_n = math.hypot(steps["i_rad"] / sc["i_rad"], steps["raan_resid_sin_i_rad"] / sc["raan_resid_sin_i_rad"])
-        return z_a, z_e, z_n
+        z_u = abs(self.unexplained_phase_m(g, steps)) / sc["u_m"]
+        return z_a, z_e, z_n, z_u
+
+    def unexplained_phase_m(self, g: int, steps: dict[str, float]) -> float:
+        """The along-track phase step at gap g that the step in ``a`` cannot explain (m).
+
+        An in-track burn at t_b changes the phase residual by ``Δn·a·(Δt/2 − (t_b − t_g))`` with
+        ``Δn = −(3/2) n Δa/a`` (:func:`along_track_phase_m`); for any t_b from one TLE lag (a day)
+        before the gap to its end that is at most ``(3/4) n |Δa| (Δt + 1 day)``. What is left is a
+        phase change at constant ``a``: opposed burns, the phasing pair of collision avoidance and
+        ground-track control.
+        """
+        du = steps["u_m"]
+        a = float(self.s["a_m"][g])
+        n = math.sqrt(MU_EARTH_WGS72_M3_S2 / a**3)
+        dt_gap = float(self.t[g + 1] - self.t[g])
+        allowance = 0.75 * n * abs(steps["a_m"]) * (dt_gap + SECONDS_PER_DAY)
+        return math.copysign(max(0.0, abs(du) - allowance), du)
 
 
 def step_statistics(
@@ -460,6 +543,8 @@ def _empty_steps(t: NDArray[np.float64], n_gaps: int) -> StepSeries:
         z_n=np.zeros(n_gaps),
         sigma_a_m=np.full(n_gaps, np.nan),
         sigma_n_rad=np.full(n_gaps, np.nan),
+        delta_u_m=np.zeros(n_gaps),
+        z_u=np.zeros(n_gaps),
     )
 
 
@@ -469,10 +554,12 @@ def _fill(out: StepSeries, model: _StepModel, g: int, cps: list[int]) -> None:
     out.delta_a_m[g] = steps["a_m"]
     out.delta_e[g] = (steps["ex"], steps["ey"])
     out.delta_normal_rad[g] = (steps["i_rad"], steps["raan_resid_sin_i_rad"])
+    assert out.delta_u_m is not None and out.z_u is not None
+    out.delta_u_m[g] = model.unexplained_phase_m(g, steps) if not math.isinf(factor) else 0.0
     if math.isinf(factor):
-        out.z_a[g] = out.z_e[g] = out.z_n[g] = 0.0
+        out.z_a[g] = out.z_e[g] = out.z_n[g] = out.z_u[g] = 0.0
     else:
-        out.z_a[g], out.z_e[g], out.z_n[g] = model.z(g, steps, factor)
+        out.z_a[g], out.z_e[g], out.z_n[g], out.z_u[g] = model.z(g, steps, factor)
         sc = model.step_sigmas(g, factor)
         assert out.sigma_a_m is not None and out.sigma_n_rad is not None
         out.sigma_a_m[g] = sc["a_m"]
@@ -505,7 +592,9 @@ def segment(
     cur = _empty_steps(model.t, n_gaps)
     cur.weights = first.weights
     cur.group_gain = first.group_gain
-    for name in ("delta_a_m", "delta_e", "delta_normal_rad", "z_a", "z_e", "z_n", "sigma_a_m", "sigma_n_rad"):
+    cur.weight_u, cur.gain_u = first.weight_u, first.gain_u
+    names = ("delta_a_m", "delta_e", "delta_normal_rad", "z_a", "z_e", "z_n", "sigma_a_m", "sigma_n_rad")
+    for name in (*names, "delta_u_m", "z_u"):
         setattr(cur, name, getattr(first, name).copy())
     accepted: list[int] = []
     blocked = np.zeros(n_gaps, dtype=bool)
@@ -516,7 +605,7 @@ def segment(
         if not np.isfinite(stat[g]) or stat[g] < max(cut_level, cfg.min_statistic):
             break
         lo_b, hi_b = _bounds(g, sorted(accepted), model.n)
-        g_loc = model.localise(g, lo_b, hi_b, cur.weights)
+        g_loc = model.localise(g, lo_b, hi_b, cur.weights, cur.weight_u if cur.gain_u > 0 else 0.0)
         if g_loc != g and not blocked[g_loc]:
             _fill(cur, model, g_loc, sorted(accepted))
             g = g_loc
@@ -670,6 +759,7 @@ def refine_burn_time(
     search_sets_before: int = 2,
     geo: bool = False,
     bounds: tuple[int, int] | None = None,
+    t_s: NDArray[np.float64] | None = None,
 ) -> tuple[float, bool]:
     """Burn time (s from the first epoch) by along-track position continuity (module docstring, step 4).
 
@@ -688,13 +778,18 @@ def refine_burn_time(
     then often timed on a neighbour's hinge and merged with it).
     """
     el = history.elements
-    t = (el["epoch_utc"] - el["epoch_utc"].iloc[0]).dt.total_seconds().to_numpy(dtype=float)
+    # SI seconds (a leap second is 7 km along-track); ``t_s`` when the caller has them already
+    t = elapsed_si_seconds(el["epoch_utc"]) if t_s is None else t_s
     n = t.size
     mid = 0.5 * (t[gap] + t[gap + 1])
     lo = max(0, gap - window_sets + 1)
     hi = min(n, gap + 1 + window_sets)
     if bounds is not None and gap - max(lo, bounds[0]) >= 2 and min(hi, bounds[1]) - (gap + 1) >= 2:
         lo, hi = max(lo, bounds[0]), min(hi, bounds[1])  # else too few sets inside: the whole window
+    elif bounds is not None and TWO_SET_TIMING:
+        t_two = two_set_burn_time(history, t, gap, search_sets_before)
+        if t_two is not None:
+            return t_two, True
     if gap - lo < 2 or hi - (gap + 1) < 2:
         return mid, False
 
@@ -719,6 +814,67 @@ def refine_burn_time(
     r = du[None, :] - np.einsum("gsk,gk->gs", A, coef)
     cost = np.sum(np.abs(r), axis=1)  # L1: one poor set does not move the time
     return float(grid[int(np.argmin(cost))]), True
+
+
+def is_phasing(steps: StepSeries, g: int, significance: float = 5.0) -> bool:
+    """Only the along-track phase moved at gap g (weighted z ≥ ``significance``; a, e-vector and
+    orbit normal below it): opposed in-track burns that leave ``a`` unchanged (a phasing pair).
+
+    Their ΔV is not observable from mean elements (the phase step is ``3 Δv Δt_s`` with the pair's
+    unknown spacing Δt_s) and there is no drift-rate hinge to time them: the gap is the estimate.
+    """
+    if steps.z_u is None or steps.gain_u <= 0:
+        return False
+    w = steps.weights
+    others = max(w[0] * float(steps.z_a[g]), w[1] * float(steps.z_e[g]), w[2] * float(steps.z_n[g]))
+    return steps.weight_u * float(steps.z_u[g]) >= significance and others < significance
+
+
+TWO_SET_TIMING = True
+
+
+def two_set_burn_time(history: ElementHistory, t: NDArray[np.float64], gap: int, sets_before: int = 3) -> float | None:
+    """Burn time from the two element sets that bracket the step alone (s, same origin as ``t``).
+
+    With the sets' SGP4 mean-argument-of-latitude rates ``u̇_g``, ``u̇_{g+1}`` (their change Δu̇ is
+    the burn's drift-rate change) the phase innovation across the gap is
+    ``δ = wrap(u_{g+1} − u_g − ½(u̇_g + u̇_{g+1}) Δt) = −Δu̇ (t_b − t_g − Δt/2)``, hence
+    ``t_b = t_g + Δt/2 − δ/Δu̇`` (one impulse; Vallado 2013 Eq. 9-41 integrated over the gap).
+    Used inside campaigns, where a longer window holds the neighbouring burns' hinges. ``None`` when
+    the time falls outside ``[t_{g−sets_before}, t_{g+1}]`` (TLE lag may put a burn before the set
+    preceding the step, never after the set following it) or the rate did not change.
+    """
+    sats = history.satrecs
+
+    def innovation(k: int) -> tuple[float, float, float]:
+        a, b = sats[k], sats[k + 1]
+        r_a, r_b = (a.argpdot + a.mdot) / 60.0, (b.argpdot + b.mdot) / 60.0  # [rad/s]
+        dt_k = float(t[k + 1] - t[k])
+        return (
+            math.remainder((b.argpo + b.mo) - (a.argpo + a.mo) - 0.5 * (r_a + r_b) * dt_k, 2 * math.pi),
+            r_b - r_a,
+            dt_k,
+        )
+
+    raw, d_rate, dt = innovation(gap)
+    if not abs(d_rate) * dt > 1e-6:
+        return None
+    # the phase drift the SGP4 rates leave unexplained around the gap (drag-model mismatch): the
+    # median innovation rate of the quiet gaps among five each side (mean-motion change < 1/10 of
+    # this one's, so campaign neighbours are left out), removed when at least three are quiet
+    near = [innovation(k) for k in range(max(0, gap - 5), min(len(sats) - 1, gap + 6)) if k != gap]
+    quiet = [d / max(dtk, 60.0) for d, dr, dtk in near if abs(dr) < 0.1 * abs(d_rate)]
+    if len(quiet) >= 3:
+        raw -= float(np.median(quiet)) * dt
+    t_lo = float(t[max(0, gap - sets_before)])
+    best: float | None = None
+    best_k = 0
+    for k in range(-3, 4):  # phase ambiguity: the branch that puts the burn in the allowed span
+        delta = math.remainder(raw, 2.0 * math.pi) + 2.0 * math.pi * k
+        t_b = float(t[gap]) + 0.5 * dt - delta / d_rate
+        if t_lo <= t_b <= float(t[gap + 1]) and (best is None or abs(k) < abs(best_k)):
+            best, best_k = t_b, k
+    return best
 
 
 def characterise(
@@ -889,6 +1045,9 @@ def run_tle_detector(
         _fill(model_first, model, g, [])
     model_first.weights = component_weights(model_first, cfg.window_sets + 2)
     model_first.group_gain = cfg.group_gain
+    if regime == "leo" and model_first.z_u is not None:
+        model_first.weight_u = robust_group_weight(model_first.z_u, float(stats.chi.ppf(0.5, 1)), cfg.window_sets + 2)
+        model_first.gain_u = cfg.along_track_gain
     if cfg.threshold is not None:
         threshold, method = float(cfg.threshold), "fixed"
     else:
@@ -911,7 +1070,7 @@ def run_tle_detector(
         # LEO campaigns: stay inside this burn's segment; GEO burns are weeks apart and the
         # mean-longitude kink needs the full window (bounded: 2 of 70 FY times > 1 day off)
         seg = _bounds(int(g), change_points, len(history)) if regime == "leo" else (0, len(history))
-        if cfg.refine_time:
+        if cfg.refine_time and not is_phasing(steps, int(g)):
             t_m, refined = refine_burn_time(
                 history,
                 int(g),
@@ -919,6 +1078,7 @@ def run_tle_detector(
                 search_sets_before=cfg.time_search_sets_before,
                 geo=regime == "geo",
                 bounds=seg if regime == "leo" else None,
+                t_s=model.t,
             )
         else:
             t_m, refined = 0.5 * (steps.t_before_s[g] + steps.t_after_s[g]), False
@@ -930,10 +1090,17 @@ def run_tle_detector(
     # strongest, whose interval then covers both (merging only neighbouring gaps was tried: more
     # false alarms on every shared history).
     merge_s = float(np.median(np.diff(model.t))) if model.t.size > 1 else 0.0
+
+    def out_of_order(x: tuple[int, float, bool, float], y: tuple[int, float, bool, float]) -> bool:
+        # Steps in neighbouring gaps (≤ 2 apart) whose burn times run against the gaps' order are
+        # one burn spread by a set fitted across it (its partial mean motion times the later step
+        # before the earlier one), not two burns.
+        return 0 < abs(x[0] - y[0]) <= 2 and (x[0] - y[0]) * (x[1] - y[1]) < 0
+
     kept: list[tuple[int, float, bool, float]] = []
     span_of: dict[int, list[float]] = {}
     for item in sorted(timed, key=lambda it: -stat[it[0]]):
-        near = [k for k in kept if abs(item[1] - k[1]) < merge_s]
+        near = [k for k in kept if abs(item[1] - k[1]) < merge_s or out_of_order(item, k)]
         if not near:
             kept.append(item)
             span_of[item[0]] = [item[3], float(steps.t_after_s[item[0]])]
@@ -966,6 +1133,9 @@ def run_tle_detector(
         v = circular_speed_mps(a_ref)
         assert steps.sigma_a_m is not None and steps.sigma_n_rad is not None
         kind = str(ch["maneuver_type"])
+        assert steps.z_u is not None and steps.delta_u_m is not None
+        if is_phasing(steps, g):
+            kind = "along-track phasing"
         if regime == "geo":
             kind = "north-south" if kind == "cross-track" else "east-west"
         camp = campaign.get(g, (-1, 0))
@@ -987,6 +1157,8 @@ def run_tle_detector(
             "interval_start_utc": (epoch0 + pd.Timedelta(seconds=float(t_lo))).isoformat(),
             "interval_end_utc": (epoch0 + pd.Timedelta(seconds=float(t_hi))).isoformat(),
             "burns_max": int(burns_max),
+            "z_u": float(steps.z_u[g]),
+            "delta_u_m": float(steps.delta_u_m[g]),
         }
         events.append(
             Event(

@@ -127,6 +127,14 @@ def _bias_keys(data: TrackingArrays, cfg: BatchFitConfig) -> list[tuple[str, int
     ):
         column = data.y[:, 0 if comp == 3 else comp]
         have = sorted({s for s, y in zip(data.station_names, column, strict=True) if np.isfinite(y)})
+        if comp == 3 and setting and have:
+            # a time offset common to all stations is an along-track shift of the orbit: the station
+            # with the most ranges is the time reference (its offset fixed at zero)
+            names = np.asarray(data.station_names)[np.isfinite(column)]
+            reference = max(have, key=lambda st: (int(np.sum(names == st)), st))
+            chosen = have if setting is True else [st for st in have if st in set(setting or ())]
+            if set(chosen) == set(have):
+                have = [st for st in have if st != reference]
         if setting is True:
             keys += [(s, comp) for s in have]
         elif setting:

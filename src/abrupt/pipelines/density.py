@@ -22,6 +22,7 @@ from abrupt.density.constellation import (
     read_platforms,
 )
 from abrupt.density.joint import JointConfig, JointDensity, joint_constellation_density
+from abrupt.density.precise_orbit import OrbitDensityConfig
 from abrupt.density.tle_drag import RhoBResult, TleDragConfig, rho_b_from_history
 from abrupt.errors import RepairLog
 
@@ -140,12 +141,73 @@ def tle_density(
     return TleDensityResult(windows if result is None else result.windows, result, repairs, warnings)
 
 
+@dataclass
+class OrbitDensityRun:
+    """``abrupt density orbit``: all windows of all files, and each file's repairs and warnings."""
+
+    windows: pd.DataFrame
+    repairs: dict[str, RepairLog] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
+
+
+def orbit_density(
+    sources: list[str | Path],
+    config: OrbitDensityConfig | None = None,
+    *,
+    satellite: str | None = None,
+    space_weather: str | Path | None = None,
+    allow_truncated: bool = False,
+) -> OrbitDensityRun:
+    """ρB (and density, with the spacecraft given) per window from precise ephemerides (SP3, OEM, CSV;
+    abrupt's readers): batch least squares for the state, a drag scale and an SRP scale per window with
+    the one orbit model (:mod:`abrupt.density.precise_orbit`), and NRLMSIS along the same orbit."""
+    from abrupt.density.precise_orbit import fit_orbit_density
+    from abrupt.model.atmosphere import read_space_weather
+    from abrupt.pipelines.orbit import load_ephemeris
+
+    sw = read_space_weather(space_weather) if space_weather is not None else read_space_weather()
+    frames: list[pd.DataFrame] = []
+    repairs: dict[str, RepairLog] = {}
+    warnings: list[str] = []
+    for src in sources:
+        eph = load_ephemeris(src, satellite, allow_truncated=allow_truncated)
+        res = fit_orbit_density(eph, config, space_weather=sw)
+        frames.append(res.windows.assign(source=str(src)))
+        log = RepairLog()
+        for part in (eph.repairs, res.repairs):
+            for kind, n in part.as_dict().items():
+                log.record(kind, n)
+        repairs[str(src)] = log
+        warnings.extend(res.warnings)
+    windows = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+    return OrbitDensityRun(windows, repairs, warnings)
+
+
 def _common_origin(paths: list[str | Path]) -> str:
     """UTC midnight of the earliest epoch over all files (windows must align across objects)."""
+    first = min(_first_epoch(p) for p in paths)
+    return str(pd.Timestamp(first).normalize())
+
+
+def _first_epoch(path: str | Path) -> pd.Timestamp:
+    """The earliest element-set epoch of a file: from the epoch field (columns 19-32, YYDDD.DDDDDDDD)
+    of every TLE line 1 when the file is TLE/3LE text (initialising SGP4 for every set of 50 objects
+    took 10 s just for this), else from the whole file (OMM)."""
     from abrupt.readers.omm import read_elements
 
-    first = min(read_elements(p).elements["epoch_utc"].iloc[0] for p in paths)
-    return str(pd.Timestamp(first).normalize())
+    days: list[float] = []
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        for line in fh:
+            if line.startswith("1 ") and len(line) >= 32:
+                try:
+                    yy, doy = int(line[18:20]), float(line[20:32])
+                except ValueError:
+                    continue
+                year = 1900 + yy if yy >= 57 else 2000 + yy  # the TLE convention
+                days.append((pd.Timestamp(year=year, month=1, day=1) - pd.Timestamp(0)).days + doy - 1.0)
+    if days:
+        return pd.Timestamp(0) + pd.Timedelta(days=min(days))
+    return pd.Timestamp(read_elements(path).elements["epoch_utc"].iloc[0])
 
 
 def write_table(frame: pd.DataFrame, path: str | Path) -> None:
@@ -157,5 +219,5 @@ def write_table(frame: pd.DataFrame, path: str | Path) -> None:
         frame.to_csv(p, index=False)
 
 
-__all__ = ["TleDensityResult", "tle_density", "write_table"]
+__all__ = ["OrbitDensityRun", "TleDensityResult", "orbit_density", "tle_density", "write_table"]
 _ = Any

@@ -28,6 +28,8 @@ from abrupt.model.orbit.elements import (
 from abrupt.model.orbit.forces import ForceContext, ForceModel, acceleration
 from abrupt.model.orbit.frames import rsw_basis, rtn_matrix
 from abrupt.model.orbit.propagation import (
+    EMPIRICAL_PARAMETERS,
+    ESTIMABLE_PARAMETERS,
     SCALE_PARAMETERS,
     FiniteBurn,
     propagate,
@@ -36,6 +38,8 @@ from abrupt.model.orbit.propagation import (
 )
 
 __all__ = [
+    "EMPIRICAL_PARAMETERS",
+    "ESTIMABLE_PARAMETERS",
     "J2",
     "J3",
     "J4",

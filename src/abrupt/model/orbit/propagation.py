@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numba as nb
 import numpy as np
+from numpy.typing import NDArray
 
 from abrupt.model.orbit.forces import (
     F_DRAG_SCALE,
@@ -87,10 +88,15 @@ def propagate(
     burns: Sequence[FiniteBurn] = (),
     rtol: float = 1e-12,
     atol_m: float = 1e-6,
+    max_step_s: float = math.inf,
 ) -> FloatArray:
     """States (n, 6) at ``t_out_s`` (s from the force context's epoch; sorted, ≥ ``t0_s``) from ``state0``
     at ``t0_s``, with inertial impulses [(t_s, dv)] and finite burns on the way. An output time equal to
-    an impulse time gets the state after the impulse (a measurement at that epoch sees it)."""
+    an impulse time gets the state after the impulse (a measurement at that epoch sees it).
+
+    ``max_step_s`` caps DOP853's steps: with SRP its error control does not see the ~10 s penumbra
+    (a kink in the force), and steps of minutes that straddle it leave decimetres a day; 10 s steps
+    resolve it (as fixed-step RK8 at 5-20 s does)."""
     t_out = np.asarray(t_out_s, dtype=np.float64)
     if t_out.size == 0:
         return np.empty((0, 6))
@@ -139,18 +145,18 @@ def propagate(
 
         last = j == len(edges) - 2
         sel = (t_out >= ta) & ((t_out < tb) | (last & (t_out <= tb)))
-        sol = solve_segment(rhs, ta, tb, state, rtol, atol_m)
+        sol = solve_segment(rhs, ta, tb, state, rtol, atol_m, max_step_s)
         if sel.any():
             out[sel] = sol.sol(t_out[sel]).T
         state = sol.y[:, -1]
     return out
 
 
-def solve_segment(rhs, ta: float, tb: float, state: FloatArray, rtol: float, atol: float):
+def solve_segment(rhs, ta: float, tb: float, state: FloatArray, rtol: float, atol: float, max_step: float = math.inf):
     """DOP853 over [ta, tb] with dense output; raises RuntimeError when the integrator fails."""
     from scipy.integrate import solve_ivp
 
-    sol = solve_ivp(rhs, (ta, tb), state, method="DOP853", rtol=rtol, atol=atol, dense_output=True)
+    sol = solve_ivp(rhs, (ta, tb), state, method="DOP853", rtol=rtol, atol=atol, dense_output=True, max_step=max_step)
     if not sol.success:
         raise RuntimeError(f"orbit propagation failed: {sol.message}")
     return sol
@@ -185,7 +191,44 @@ def _j2_gradient(r: FloatArray) -> FloatArray:
 
 #: Force-model scale factors :func:`propagate_with_stm` can give sensitivities for, in column order.
 SCALE_PARAMETERS = ("drag_scale", "srp_scale")
+#: Once-per-revolution empirical accelerations (m/s²) in the orbit frame: C cos u and C sin u per axis
+#: (radial, transverse, normal), u the argument of latitude (Montenbruck & Gill 2000 §3.7.3; the
+#: "CPR" accelerations of reduced-dynamic orbit determination).
+EMPIRICAL_PARAMETERS = ("cpr_r_cos", "cpr_r_sin", "cpr_t_cos", "cpr_t_sin", "cpr_n_cos", "cpr_n_sin")
+ESTIMABLE_PARAMETERS = SCALE_PARAMETERS + EMPIRICAL_PARAMETERS
 N_BASE = 60  # state (6) + STM (36) + constant-acceleration sensitivity (18)
+
+
+@nb.njit(cache=True)
+def _cpr_basis(r: FloatArray, v: FloatArray) -> FloatArray:
+    """(3, 6) accelerations (GCRF, per unit coefficient) of the six once-per-rev terms: columns
+    R cos u, R sin u, T cos u, T sin u, N cos u, N sin u (R̂ = r/|r|, N̂ = h/|h|, T̂ = N̂ × R̂; u from the
+    ascending node ẑ × N̂, or from x̂ for an equatorial orbit)."""
+    rn = math.sqrt(r[0] ** 2 + r[1] ** 2 + r[2] ** 2)
+    rh = r / rn
+    h = np.array([r[1] * v[2] - r[2] * v[1], r[2] * v[0] - r[0] * v[2], r[0] * v[1] - r[1] * v[0]])
+    nh = h / math.sqrt(h[0] ** 2 + h[1] ** 2 + h[2] ** 2)
+    th = np.array([nh[1] * rh[2] - nh[2] * rh[1], nh[2] * rh[0] - nh[0] * rh[2], nh[0] * rh[1] - nh[1] * rh[0]])
+    node = np.array([-nh[1], nh[0], 0.0])
+    nn = math.sqrt(node[0] ** 2 + node[1] ** 2)
+    if nn < 1e-9:
+        node = np.array([1.0, 0.0, 0.0])
+    else:
+        node = node / nn
+    m = np.array(
+        [nh[1] * node[2] - nh[2] * node[1], nh[2] * node[0] - nh[0] * node[2], nh[0] * node[1] - nh[1] * node[0]]
+    )
+    cu = rh[0] * node[0] + rh[1] * node[1] + rh[2] * node[2]
+    su = rh[0] * m[0] + rh[1] * m[1] + rh[2] * m[2]
+    out = np.empty((3, 6))
+    for j in range(3):
+        out[j, 0] = cu * rh[j]
+        out[j, 1] = su * rh[j]
+        out[j, 2] = cu * th[j]
+        out[j, 3] = su * th[j]
+        out[j, 4] = cu * nh[j]
+        out[j, 5] = su * nh[j]
+    return out
 
 
 @nb.njit(cache=True)
@@ -194,24 +237,37 @@ def _stm_derivative(
     t_s: float,
     a_const: FloatArray,
     args: tuple,
-    use_drag: bool,
+    use: NDArray[np.bool_],
     drag_args: tuple,
-    use_srp: bool,
     srp_args: tuple,
+    empirical: FloatArray,
 ) -> FloatArray:
-    """State (6) + STM (36) + constant-acceleration sensitivity (18) + scale-factor sensitivities
-    (6 each for drag_scale, srp_scale when used), flattened row-major.
+    """State (6) + STM (36) + constant-acceleration sensitivity (18) + one 6-vector per estimated
+    parameter flagged in ``use`` (order of :data:`ESTIMABLE_PARAMETERS`), flattened row-major.
 
-    The sensitivity S_k = ∂x/∂k of a force scale factor obeys Ṡ_k = [S_k,v ; G S_k,r + ∂a/∂k]
-    (Montenbruck & Gill 2000, Eq. 7.6), with ∂a/∂k the acceleration of that force at k = 1 (it is linear
-    in k): evaluated by the same kernel with only that force switched on (``drag_args``/``srp_args``).
+    The sensitivity S_p = ∂x/∂p obeys Ṡ_p = [S_p,v ; G S_p,r + G_v S_p,v + ∂a/∂p] (Montenbruck & Gill
+    2000, Eq. 7.6): for a scale factor ∂a/∂k is that force at k = 1, evaluated by the same kernel with
+    only that force switched on (``drag_args``/``srp_args``); for an empirical coefficient, its basis
+    vector. ``empirical`` holds the six once-per-rev coefficients added to the dynamics.
     """
-    n_par = int(use_drag) + int(use_srp)
+    n_par = 0
+    for p in range(use.shape[0]):
+        if use[p]:
+            n_par += 1
     out = np.empty(N_BASE + 6 * n_par)
     r = y[0:3]
     v = y[3:6]
     out[0:3] = v
-    out[3:6] = acceleration_kernel(t_s, r, v, *args) + a_const
+    acc = acceleration_kernel(t_s, r, v, *args) + a_const
+    any_emp = False
+    for j in range(6):
+        if empirical[j] != 0.0 or use[2 + j]:
+            any_emp = True
+    basis = np.zeros((3, 6))
+    if any_emp:
+        basis = _cpr_basis(r, v)
+        acc += basis @ empirical
+    out[3:6] = acc
     lam = _two_body_gradient(r, args[1][0])
     ints = args[0]
     if ints[I_ZONAL] >= 2 or ints[I_DEGREE] >= 2:
@@ -252,16 +308,18 @@ def _stm_derivative(
     out[6:42] = dphi.reshape(36)
     out[42:60] = dsens.reshape(18)
     col = N_BASE
-    for p in range(2):
-        if (p == 0 and not use_drag) or (p == 1 and not use_srp):
+    for p in range(use.shape[0]):
+        if not use[p]:
             continue
         sk = y[col : col + 6]
         if p == 0:
-            dadk = acceleration_kernel(t_s, r, v, *drag_args)
+            dadp = acceleration_kernel(t_s, r, v, *drag_args)
+        elif p == 1:
+            dadp = acceleration_kernel(t_s, r, v, *srp_args)
         else:
-            dadk = acceleration_kernel(t_s, r, v, *srp_args)
+            dadp = np.ascontiguousarray(basis[:, p - 2])
         out[col : col + 3] = sk[3:6]
-        out[col + 3 : col + 6] = lam @ np.ascontiguousarray(sk[0:3]) + lam_v @ np.ascontiguousarray(sk[3:6]) + dadk
+        out[col + 3 : col + 6] = lam @ np.ascontiguousarray(sk[0:3]) + lam_v @ np.ascontiguousarray(sk[3:6]) + dadp
         col += 6
     return out
 
@@ -302,14 +360,17 @@ def _rk_stm(
     rk_a: FloatArray,
     rk_b: FloatArray,
     rk_c: FloatArray,
-    use_drag: bool,
+    use: NDArray[np.bool_],
     drag_args: tuple,
-    use_srp: bool,
     srp_args: tuple,
+    empirical: FloatArray,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     n = t_eval_s.shape[0]
     n_stage = rk_b.shape[0]
-    n_par = int(use_drag) + int(use_srp)
+    n_par = 0
+    for p in range(use.shape[0]):
+        if use[p]:
+            n_par += 1
     n_y = N_BASE + 6 * n_par
     states = np.empty((n, 6))
     stms = np.empty((n, 6, 6))
@@ -330,7 +391,7 @@ def _rk_stm(
                 for m in range(s):
                     if rk_a[s, m] != 0.0:
                         ys += (h * rk_a[s, m]) * k[m]
-                k[s] = _stm_derivative(ys, t + rk_c[s] * h, a_const, args, use_drag, drag_args, use_srp, srp_args)
+                k[s] = _stm_derivative(ys, t + rk_c[s] * h, a_const, args, use, drag_args, srp_args, empirical)
             for s in range(n_stage):
                 if rk_b[s] != 0.0:
                     y += (h * rk_b[s]) * k[s]
@@ -373,17 +434,18 @@ def propagate_with_stm(
     step_wise: bool = False,
     method: str = "rk4",
     parameters: Sequence[str] = (),
+    empirical_mps2: Sequence[float] | FloatArray | None = None,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """States (n,6), STMs (n,6,6) and sensitivities (n,6,3+p) at ``t_eval_s``.
 
     The sensitivities' first three columns are ∂x/∂a for a constant inertial acceleration
-    ``accel_mps2``; then one column per name in ``parameters`` (from :data:`SCALE_PARAMETERS`:
-    ``drag_scale``, ``srp_scale``), ∂x/∂k for the force model's scale factor k, whose force
-    derivative is that force's acceleration at k = 1 (Montenbruck & Gill 2000, Eq. 7.6). A parameter
-    whose force is off in the model (no kernel drag, no SRP) has a zero column. Drag from NRLMSIS
-    (``drag="msis"``) is in the numba kernel, the states and its column only when ``force`` is a
-    context built with a reference trajectory (``ForceContext.build(..., reference=(t, r))``: density
-    tabulated along it); otherwise in neither.
+    ``accel_mps2``; then one column per name in ``parameters``, in that order, from
+    :data:`ESTIMABLE_PARAMETERS`: ``drag_scale`` and ``srp_scale``, ∂x/∂k for the force model's scale
+    factor k, whose force derivative is that force's acceleration at k = 1 (Montenbruck & Gill 2000,
+    Eq. 7.6; a force the model leaves out gives a zero column; drag from NRLMSIS is in the kernels
+    only when tabulated along a reference trajectory); and the once-per-revolution empirical
+    accelerations of :data:`EMPIRICAL_PARAMETERS` (m/s², orbit frame, cos u and sin u), whose values
+    ``empirical_mps2`` (six, that order; default zero) are added to the dynamics.
 
     Fixed-step Runge-Kutta (``method`` ``rk4``, or ``rk8``: eighth order, 12 stages, for long arcs:
     over 30 days of a LAGEOS orbit rk8 at 60 s stays within a millimetre of the DOP853 truth where rk4
@@ -393,18 +455,19 @@ def propagate_with_stm(
     (Eq. 3.4), plus J2's when the force model has a field of degree ≥ 2, plus the drag partials with
     respect to position and velocity (central differences of the kernel's drag) when it has drag.
     """
-    unknown = [p for p in parameters if p not in SCALE_PARAMETERS]
-    if unknown or len(set(parameters)) != len(parameters):
-        raise ValueError(f"parameters must be distinct names from {SCALE_PARAMETERS}, got {tuple(parameters)}")
+    names = list(parameters)
+    unknown = [p for p in names if p not in ESTIMABLE_PARAMETERS]
+    if unknown or len(set(names)) != len(names):
+        raise ValueError(f"parameters must be distinct names from {ESTIMABLE_PARAMETERS}, got {tuple(names)}")
+    emp = np.zeros(6) if empirical_mps2 is None else np.asarray(empirical_mps2, dtype=np.float64).reshape(-1)
+    if emp.shape != (6,):
+        raise ValueError("empirical_mps2 must have six values (EMPIRICAL_PARAMETERS order)")
     t_eval = np.ascontiguousarray(np.asarray(t_eval_s, dtype=np.float64))
     lo = min(float(t0_s), float(t_eval.min())) if t_eval.size else float(t0_s)
     hi = max(float(t0_s), float(t_eval.max())) if t_eval.size else float(t0_s)
     ctx = _context(force, lo, hi)
     rk_a, rk_b, rk_c = _tableau(method)
-    drag_args = _single_force_args(ctx, "drag_scale")
-    srp_args = _single_force_args(ctx, "srp_scale")
-    use_drag = "drag_scale" in parameters
-    use_srp = "srp_scale" in parameters
+    use = np.array([p in names for p in ESTIMABLE_PARAMETERS], dtype=np.bool_)
     states, stms, sens = _rk_stm(
         np.ascontiguousarray(np.asarray(x0, dtype=np.float64)),
         float(t0_s),
@@ -416,13 +479,14 @@ def propagate_with_stm(
         rk_a,
         rk_b,
         rk_c,
-        use_drag,
-        drag_args,
-        use_srp,
-        srp_args,
+        use,
+        _single_force_args(ctx, "drag_scale"),
+        _single_force_args(ctx, "srp_scale"),
+        np.ascontiguousarray(emp),
     )
-    if use_drag and use_srp and list(parameters).index("srp_scale") < list(parameters).index("drag_scale"):
-        sens = sens[:, :, [0, 1, 2, 4, 3]]
+    computed = [p for p in ESTIMABLE_PARAMETERS if p in names]  # the kernel's column order
+    if computed != names:
+        sens = sens[:, :, [0, 1, 2, *(3 + computed.index(p) for p in names)]]
     return states, stms, sens
 
 
