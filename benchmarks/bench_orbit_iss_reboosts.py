@@ -36,6 +36,9 @@ def main() -> None:
     parser.add_argument("--truth-degree", type=int, default=20)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--step-s", type=float, default=60.0, help="sampling (NASA's ISS OEM files: 240 s)")
+    parser.add_argument(
+        "--nuisance", action="store_true", help="estimate drag/SRP scales and once-per-rev accelerations (MSIS drag)"
+    )
     args = parser.parse_args()
     truth = ForceModel(
         gravity_degree=args.truth_degree,
@@ -71,7 +74,7 @@ def main() -> None:
         )
         sim = simulate_orbit(cfg)
         tic = time.perf_counter()
-        run = detect_orbit(sim.ephemeris("ISS"), budget="1/week", kind="maneuver")
+        run = detect_orbit(sim.ephemeris("ISS"), budget="1/week", kind="maneuver", nuisance=args.nuisance)
         elapsed = time.perf_counter() - tic
         ev = run.events
         t_burn = np.datetime64(EPOCH, "ns") + np.timedelta64(round(t0 * 1e9), "ns")

@@ -40,6 +40,9 @@ ARCS = {
 }
 
 
+SETTINGS: dict[str, object] = {}
+
+
 def one_injection(eph: Ephemeris, rng: np.random.Generator, dv_mps: float, arc_s: float) -> dict[str, float]:
     sec = eph.seconds
     t_imp_s = rng.uniform(sec[0] + arc_s / 2, sec[-1] - arc_s / 2)
@@ -47,7 +50,7 @@ def one_injection(eph: Ephemeris, rng: np.random.Generator, dv_mps: float, arc_s
     d = rng.normal(size=3)
     d = dv_mps * d / np.linalg.norm(d)
     t_imp = eph.times_utc[0] + np.timedelta64(round(t_imp_s * 1e9), "ns")
-    run = detect_orbit(inject_impulse(sub, t_imp, d), budget="1/week")
+    run = detect_orbit(inject_impulse(sub, t_imp, d), budget="1/week", **SETTINGS)
     ev = run.events
     if len(ev) == 0:
         return {"found": 0.0, "terr": np.nan, "tsig": np.nan, "dv": np.nan}
@@ -67,7 +70,14 @@ def main() -> None:
     parser.add_argument("--arc-days", type=float, default=2.0)
     parser.add_argument("--seed", type=int, default=2026)
     parser.add_argument("--arc", choices=["all", "s3a", "jason1"], default="all", help="which arc(s) to run")
+    parser.add_argument(
+        "--nuisance", action="store_true", help="estimate drag/SRP scales and once-per-rev accelerations (MSIS drag)"
+    )
+    parser.add_argument("--sigma-pos-m", type=float, default=None, help="override the auto-tuned position sigma")
     args = parser.parse_args()
+    SETTINGS["nuisance"] = args.nuisance
+    if args.sigma_pos_m is not None:
+        SETTINGS["sigma_pos_m"] = args.sigma_pos_m
     arc_s = args.arc_days * 86400.0
     n5 = 10 if args.quick else 30
     n_per = 6 if args.quick else 15
@@ -78,7 +88,7 @@ def main() -> None:
         eph = read_sp3(path).to_frame("GCRF")
         days = eph.seconds[-1] / 86400.0
         t0 = time.perf_counter()
-        whole = detect_orbit(eph, budget="1/week")
+        whole = detect_orbit(eph, budget="1/week", **SETTINGS)
         print(f"\n{label}: {path.name}, {len(eph)} epochs, {days:.1f} days ({time.perf_counter() - t0:.1f} s)")
         for line in (
             f"  fit: {whole.summary['force_model']}; post-fit RMS {whole.summary['residual_rms_pos_m']:.3g} m, "
@@ -91,7 +101,7 @@ def main() -> None:
         counts = []
         for start in np.arange(0.0, sec[-1] - arc_s + 1, arc_s):
             sub = eph.select((sec >= start) & (sec < start + arc_s))
-            counts.append(len(detect_orbit(sub, budget="1/week").events))
+            counts.append(len(detect_orbit(sub, budget="1/week", **SETTINGS).events))
         print(
             f"     {len(counts)} non-overlapping {args.arc_days:g}-day sub-arcs: {counts} "
             f"(total {sum(counts)}, budget {len(counts) * args.arc_days / 7:.2f})"

@@ -71,7 +71,7 @@ def test_forward_gammas_at_minus_tau_equal_the_backward_formulas(dt: float, tau:
 def test_jacobian_gravity_block_is_symmetric_and_matches_finite_differences() -> None:
     x = np.r_[7.0e6, 1.2e6, -0.8e6, 100.0, 7400.0, 300.0, 0.0, 0.0, 0.0]
     a = np.empty((9, 9))
-    _jacobian(x, 5.0, MU_EARTH_M3_S2, False, a)
+    _jacobian(x, 0.0, 5.0, TWO_BODY, MU_EARTH_M3_S2, False, a)
     g = a[3:6, 0:3]
     np.testing.assert_allclose(g, g.T, rtol=1e-12)
     h = 1.0

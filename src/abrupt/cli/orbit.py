@@ -72,6 +72,13 @@ def _filter_options(f: Any) -> Any:
             show_default=True,
             help="Degree and order of the EGM2008 field with --dynamics field.",
         ),
+        click.option(
+            "--nuisance",
+            is_flag=True,
+            default=False,
+            help="Also estimate drag and radiation-pressure scale factors and once-per-revolution empirical "
+            "accelerations as filter states (NRLMSIS drag along the observed orbit, offline space weather).",
+        ),
         click.option("--satellite", default=None, help="Satellite id in the file (SP3 id, OEM OBJECT_ID, CSV)."),
         click.option(
             "--allow-truncated",
@@ -224,6 +231,7 @@ def detect_orbit_command(
     sigma_vel_mps: float | None,
     dynamics: str | None,
     gravity_degree: int,
+    nuisance: bool,
     satellite: str | None,
     allow_truncated: bool,
     detector_name: str | None,
@@ -277,6 +285,7 @@ def detect_orbit_command(
             sigma_vel_mps=sigma_vel_mps,
             dynamics=dynamics,
             gravity_degree=gravity_degree,
+            nuisance=nuisance,
             confidence_z=confidence_z,
             kind=kind,
             spacecraft=pseudonym,
@@ -389,6 +398,7 @@ def report_orbit_command(
     sigma_vel_mps: float | None,
     dynamics: str | None,
     gravity_degree: int,
+    nuisance: bool,
     satellite: str | None,
     allow_truncated: bool,
     events_file: str | None,
@@ -413,6 +423,7 @@ def report_orbit_command(
         sigma_vel_mps=sigma_vel_mps,
         dynamics=dynamics,
         gravity_degree=gravity_degree,
+        nuisance=nuisance,
     )
     assert run.analysis is not None
     events = read_events(events_file) if events_file else None

@@ -200,7 +200,7 @@ def _context(model: ForceModel, epoch: np.datetime64, t: FloatArray, r: FloatArr
     lo, hi = float(t[0]) - 600.0, float(t[-1]) + 600.0
     if model.drag == "msis":
         try:
-            ctx = ForceContext.build(model, epoch, lo, hi, reference=(t, r), space_weather=space_weather)  # type: ignore[call-arg]
+            ctx = ForceContext.build(model, epoch, lo, hi, reference=(t, r), space_weather=space_weather)
         except TypeError:  # a force model without in-kernel MSIS: fall back to the exponential density
             return ForceContext.build(replace(model, drag="exponential"), epoch, lo, hi)
         return ctx

@@ -19,7 +19,9 @@ the full force model; "thesis": Table 3.1, two-body), overrides ``tau_s``, ``q_m
 ``sigma_pos_m``, ``sigma_vel_mps``, ``dynamics`` ("two-body", "j2".."j4", "field"),
 ``gravity_degree``, ``null`` (an event-free :class:`~abrupt.model.frames.Ephemeris` of the same
 satellite for thresholds; default: the arc itself with leave-out), ``confidence_z`` (standard errors
-added to a self-calibrated level) and ``kind``.
+added to a self-calibrated level), ``kind`` and ``nuisance`` (estimate drag and SRP scale factors and
+once-per-revolution empirical accelerations as filter states, with NRLMSIS drag tabulated along the
+observed orbit; :class:`~abrupt.detect.orbit_ekf.NuisanceConfig`).
 """
 
 from __future__ import annotations
@@ -40,15 +42,37 @@ from abrupt.detect.orbit_detector import (
     innovation_scale,
     self_calibrate,
 )
-from abrupt.detect.orbit_ekf import FilterConfig
+from abrupt.detect.orbit_ekf import FilterConfig, NuisanceConfig
 from abrupt.events import config_hash
 from abrupt.model.frames import Ephemeris
+from abrupt.model.orbit import ForceModel
 from abrupt.thresholds import FalseAlarmBudget, Threshold
 
 TUNINGS = ("auto", "thesis")
 DYNAMICS = {"two-body": 0, "j2": 2, "j3": 3, "j4": 4, "field": -1}
 SETTLE_CAP_S = 6 * 3600.0  # [s] longest settling time excluded at each end of an arc
 DEFAULT_GRAVITY_DEGREE = 40  # chosen from benchmarks/bench_orbit_forces.py (post-fit residuals, S3A and Jason-1)
+#: nominal spacecraft of the nuisance model: area-to-mass 0.01 m²/kg (typical of LEO satellites,
+#: 0.005-0.02); the estimated scale factors absorb the actual value
+NOMINAL_MASS_KG = 1000.0
+NOMINAL_AREA_M2 = 10.0
+
+
+def nuisance_force_model(gravity_degree: int, third_body: bool, zonal_degree: int = 0) -> ForceModel:
+    """The filter's force model when nuisance parameters are estimated: the gravity of the plain filter plus
+    NRLMSIS drag (tabulated along the observed orbit) and cannonball SRP with a conical shadow, both for
+    the nominal spacecraft (their scale factors are filter states)."""
+    return ForceModel(
+        zonal_degree=zonal_degree,
+        gravity_degree=gravity_degree,
+        sun=third_body,
+        moon=third_body,
+        drag="msis",
+        srp=True,
+        mass_kg=NOMINAL_MASS_KG,
+        drag_area_m2=NOMINAL_AREA_M2,
+        srp_area_m2=NOMINAL_AREA_M2,
+    )
 
 
 class OrbitDetector(Detector[Ephemeris]):
@@ -73,6 +97,7 @@ class OrbitDetector(Detector[Ephemeris]):
         kind: str | None = None,
         spacecraft: str | None = None,
         run_id: str = "",
+        nuisance: bool = False,
     ) -> None:
         if tuning not in TUNINGS:
             raise ValueError(f"tuning must be one of {TUNINGS}, got {tuning!r}")
@@ -90,6 +115,7 @@ class OrbitDetector(Detector[Ephemeris]):
         self.dynamics = dynamics
         self.gravity_degree = gravity_degree
         self.confidence_z = confidence_z
+        self.nuisance = nuisance
         self.event_kind = kind or type(self).kind
         self.spacecraft = spacecraft
         self.run_id = run_id
@@ -122,6 +148,9 @@ class OrbitDetector(Detector[Ephemeris]):
             fc = replace(fc, tau_s=self.tau_s)
         if self.q_m2_s5 is not None:
             fc = replace(fc, q_rtn_m2_s5=(self.q_m2_s5,) * 3)
+        if self.nuisance:
+            forces = nuisance_force_model(degree, degree > 0, zonal)
+            fc = replace(fc, forces=forces, nuisance=NuisanceConfig())
         return OrbitDetectorConfig(
             filter=fc,
             sigma_pos_m=self.sigma_pos_m if self.sigma_pos_m is not None else float(s_pos),

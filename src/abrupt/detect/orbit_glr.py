@@ -10,7 +10,8 @@ time θ and vector ν for a filter that does not model the jump:
     d(θ) = Σ_k G_kᵀ S_k⁻¹ γ_k,  C(θ) = Σ_k G_kᵀ S_k⁻¹ G_k,  ν̂ = C⁻¹ d,  ℓ(θ) = dᵀ C⁻¹ d,
 
 summed over the same data for every candidate (from θ to the end of the search window plus a
-horizon). θ̂ maximises ℓ; ν̂(θ̂) is the ΔV (inertial, m/s) with covariance C⁻¹;
+horizon; B has zeros for the DMC and any nuisance states). θ̂ maximises ℓ;
+ν̂(θ̂) is the ΔV (inertial, m/s) with covariance C⁻¹;
 the 1σ time interval is where ℓ ≥ ℓ_max − 1.
 """
 
@@ -70,7 +71,7 @@ def glr_kernel(
         theta = first + c
         if theta < 1 or theta >= n:
             continue
-        mm = np.zeros((9, 3))
+        mm = np.zeros((phis.shape[1], 3))
         for a in range(3):
             mm[3 + a, a] = 1.0
             mm[a, a] = lead_s[theta]
@@ -128,6 +129,7 @@ def localise_jump(
         p_post[start].copy(),
         config.tau_s,
         config.q_array(),
+        config.nuisance_psd(),
         config.max_step_s,
         ctx.kernel_args,
     )
@@ -181,7 +183,7 @@ def glr_sliding_kernel(
     n = innovs.shape[0]
     ell = np.full(n, np.nan)
     for theta in range(1, n - horizon + 1):
-        mm = np.zeros((9, 3))
+        mm = np.zeros((phis.shape[1], 3))
         for a in range(3):
             mm[3 + a, a] = 1.0
             mm[a, a] = lead_s[theta]
@@ -239,6 +241,7 @@ def glr_statistic(
         p0,
         config.tau_s,
         config.q_array(),
+        config.nuisance_psd(),
         config.max_step_s,
         ctx.kernel_args,
     )

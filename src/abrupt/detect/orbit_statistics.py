@@ -201,9 +201,15 @@ def fusion_kernel(
 
 
 def fuse(xf: FloatArray, pf: FloatArray, xb: FloatArray, pb: FloatArray) -> FusionResult:
-    """Fuse forward a-posteriori and backward a-priori estimates; compute TS1-TS4."""
+    """Fuse forward a-posteriori and backward a-priori estimates; compute TS1-TS4.
+
+    Only the 9 states of the thesis (r, v, w) are fused: with estimated nuisance parameters (17 states)
+    their marginal estimates are combined, so every statistic keeps its meaning and its χ law."""
     xs, ps_diag, dv, dv_cov, mcr, scal, wmag = fusion_kernel(
-        np.ascontiguousarray(xf), np.ascontiguousarray(pf), np.ascontiguousarray(xb), np.ascontiguousarray(pb)
+        np.ascontiguousarray(xf[:, :9]),
+        np.ascontiguousarray(pf[:, :9, :9]),
+        np.ascontiguousarray(xb[:, :9]),
+        np.ascontiguousarray(pb[:, :9, :9]),
     )
     stats = {
         "dv_fb": np.linalg.norm(dv, axis=1),
@@ -283,7 +289,7 @@ def propagated_reference_statistic(
         return float("nan")
     sig = np.r_[np.full(3, sigma_pos_m), np.full(3, sigma_vel_m_s)]
     args = (context or config.force_context(None, float(t_s[0]), float(t_s[-1]))).kernel_args
-    phi = np.empty((9, 9))
+    phi = np.empty((x_forward.shape[1], x_forward.shape[1]))
     chi = 0.0
     count = 0
     x = x_forward[index - 1].copy()

@@ -20,6 +20,7 @@ import pandas as pd
 from abrupt.detect.base import DetectionResult, get_detector
 from abrupt.detect.orbit_detector import OrbitAnalysis, innovation_scale
 from abrupt.detect.orbit_detectors import OrbitDetector
+from abrupt.detect.orbit_ekf import NUISANCE_NAMES
 from abrupt.model.frames import Ephemeris
 from abrupt.thresholds import FalseAlarmBudget, Threshold
 
@@ -132,6 +133,12 @@ def fit_summary(run: OrbitRun) -> dict[str, Any]:
     if model.sun or model.moon:
         forces += " + Sun/Moon (ERFA)"
     w = an.fusion.x_smoothed[ok, 6:9]
+    nuisance: dict[str, list[float]] = {}
+    if an.forward.x.shape[1] > 9:
+        # the forward estimate at the last epoch has seen the whole arc (random-walk states: their value now)
+        last = an.forward.x[-1, 9:]
+        sig = np.sqrt(np.diag(an.forward.p[-1])[9:])
+        nuisance = {name: [float(v), float(e)] for name, v, e in zip(NUISANCE_NAMES, last, sig, strict=True)}
     return {
         "satellite": eph.satellite,
         "epochs": len(eph),
@@ -146,6 +153,7 @@ def fit_summary(run: OrbitRun) -> dict[str, Any]:
         "residual_rms_vel_mps": float(np.sqrt(np.mean(np.sum(vel**2, axis=1)))) if len(vel) else float("nan"),
         "dmc_accel_rms_mps2": float(np.sqrt(np.mean(np.sum(w**2, axis=1)))) if len(w) else float("nan"),
         "innovation_scale": innovation_scale(an),
+        "nuisance": nuisance,
         "budget": str(run.budget),
         "statistic": run.detector.statistic,
         "thresholds": {k: {"value": v.value, "method": v.method, "n": v.n_samples} for k, v in run.thresholds.items()},
@@ -167,8 +175,14 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
         f"  estimated        τ = {s['tau_s']:g} s, q = {s['q_m2_s5']:.3g} m²/s⁵, σ_pos = {s['sigma_pos_m']:.3g} m,"
         f" σ_vel = {s['sigma_vel_mps']:.3g} m/s; DMC acceleration RMS {s['dmc_accel_rms_mps2']:.3g} m/s²;"
         f" innovation scale {s['innovation_scale']:.3g}",
-        f"  thresholds at {s['budget']}:",
     ]
+    if s.get("nuisance"):
+        nu = s["nuisance"]
+        scales = ", ".join(f"{k} {1.0 + v[0]:.3g} ± {v[1]:.2g}" for k, v in nu.items() if k.endswith("scale"))
+        emp = ", ".join(f"{k[4:]} {v[0]:.3g} ± {v[1]:.2g}" for k, v in nu.items() if k.startswith("emp_"))
+        lines.append(f"  nuisance (end)   {scales} (× nominal A/m 0.01 m²/kg)")
+        lines.append(f"  once-per-rev     {emp} m/s²")
+    lines.append(f"  thresholds at {s['budget']}:")
     for name, th in s["thresholds"].items():
         mark = "  <- raises events" if name == s["statistic"] else ""
         lines.append(f"    {name:<20} {th['value']:<12.4g} ({th['method']}, {th['n']} samples){mark}")

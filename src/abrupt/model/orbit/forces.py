@@ -15,8 +15,11 @@ Forces (each switchable in :class:`ForceModel`):
   (penumbra) Earth shadow (Montenbruck & Gill 2000, Eqs. 3.75, 3.79-3.85), scaled by ``srp_scale``;
 - atmospheric drag a = −½ C_D A/m ρ |v_rel| v_rel, v_rel = v − ω⊕ × r (Vallado 2013 Eq. 8-32; Bennett
   2022 §3.4.4), scaled by ``drag_scale``, density from the exponential model (Vallado 2013 Table 8-4,
-  numba, the built-in model the filters use) or NRLMSIS 2.1 (``pymsis``, explicit F10.7/F10.7a/Ap,
-  simulator only).
+  numba) or NRLMSIS 2.1 (``pymsis``). MSIS runs in the numba kernels as a density tabulated in time
+  along a reference trajectory (:func:`msis_density_table`: for a filter that follows a precise orbit,
+  the observed ephemeris gives the position, so ρ(t) there is what the filter needs to centimetres;
+  the indices come from the offline space-weather table of :mod:`abrupt.model.atmosphere`); without
+  a reference, MSIS is evaluated point by point in Python with explicit F10.7/F10.7a/Ap (simulator).
 
 Solid Earth tides are not modelled (their ~1e-7 m/s² in LEO is left to the filters' Gauss-Markov
 accelerations).
@@ -30,6 +33,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numba as nb
 import numpy as np
@@ -165,14 +169,18 @@ class ForceModel:
 I_TWO_BODY, I_ZONAL, I_J3_ONLY, I_DEGREE, I_ORDER, I_DRAG, I_SRP, I_SUN, I_MOON = range(9)
 F_MU, F_GM, F_RADIUS, F_MASS, F_CD, F_AREA, F_ARRAY, F_CR, F_SRP_AREA = range(9)
 F_EOP_T0, F_EOP_STEP, F_BODY_T0, F_BODY_STEP, F_ERA0, F_ERA_RATE, F_DRAG_SCALE, F_SRP_SCALE = range(9, 17)
+F_RHO_T0, F_RHO_STEP = range(17, 19)
+#: values of ints[I_DRAG]: no drag in the kernel, exponential density, density tabulated in time
+DRAG_KERNEL_NONE, DRAG_KERNEL_EXPONENTIAL, DRAG_KERNEL_TABLE = 0, 1, 2
 
 
 @dataclass(frozen=True)
 class ForceContext:
     """A :class:`ForceModel` resolved for one arc: arrays the numba kernels read.
 
-    ``kernel_args`` is the tuple (ints, floats, C, S, c2i, polar_motion, dut1, sun, moon, atmosphere)
-    passed to :func:`acceleration_kernel`.
+    ``kernel_args`` is the tuple (ints, floats, C, S, c2i, polar_motion, dut1, sun, moon, atmosphere,
+    density) passed to :func:`acceleration_kernel`; ``density`` is the MSIS density (kg/m³) tabulated in
+    time along a reference trajectory (one element, unused, otherwise).
     """
 
     model: ForceModel
@@ -186,21 +194,29 @@ class ForceContext:
         epoch_utc: np.datetime64 | str | None = None,
         t_from_s: float = 0.0,
         t_to_s: float = 86400.0,
+        *,
+        reference: tuple[FloatArray, FloatArray] | None = None,
+        space_weather: Any = None,
     ) -> ForceContext:
-        """Resolve ``model`` for times [t_from_s, t_to_s] seconds after ``epoch_utc`` (UTC)."""
+        """Resolve ``model`` for times [t_from_s, t_to_s] seconds after ``epoch_utc`` (UTC).
+
+        ``reference`` = (t_s, r_gcrf_m): a trajectory the motion follows closely (an observed precise
+        orbit); with ``drag="msis"`` the NRLMSIS density is then tabulated along it
+        (:func:`msis_density_table`, indices from ``space_weather`` or the bundled table) and drag runs
+        inside the numba kernels. Without it MSIS drag is Python-side only (:func:`acceleration`)."""
         if model.needs_time and epoch_utc is None:
             raise ValueError("this force model depends on time: give the arc's epoch (UTC)")
         epoch = np.asarray(epoch_utc if epoch_utc is not None else "2000-01-01T12:00:00", dtype="datetime64[ns]")
         epoch = epoch.reshape(-1)[0]
         lo, hi = min(t_from_s, t_to_s), max(t_from_s, t_to_s)
         ints = np.zeros(9, dtype=np.int64)
-        floats = np.zeros(17)
+        floats = np.zeros(19)
         ints[I_TWO_BODY] = int(model.two_body)
         ints[I_ZONAL] = model.zonal_degree
         ints[I_J3_ONLY] = int(model.j3_only)
         ints[I_DEGREE] = model.gravity_degree
         ints[I_ORDER] = model.gravity_degree if model.gravity_order is None else model.gravity_order
-        ints[I_DRAG] = 1 if model.drag == "exponential" else 0
+        ints[I_DRAG] = DRAG_KERNEL_EXPONENTIAL if model.drag == "exponential" else DRAG_KERNEL_NONE
         ints[I_SRP] = (1 if model.shadow == "cylindrical" else 2) if model.srp else 0
         ints[I_SUN] = int(model.sun)
         ints[I_MOON] = int(model.moon)
@@ -236,7 +252,15 @@ class ForceContext:
         else:
             floats[F_BODY_STEP] = 1.0
             sun = moon = np.zeros((1, 3))
-        args = (ints, floats, c, s, c2i, pom, dut1, sun, moon, EXPONENTIAL_ATMOSPHERE)
+        density = np.zeros(1)
+        floats[F_RHO_STEP] = 1.0
+        if model.drag == "msis" and reference is not None:
+            t_ref, rho = msis_density_table(model, epoch, reference[0], reference[1], space_weather)
+            ints[I_DRAG] = DRAG_KERNEL_TABLE
+            floats[F_RHO_T0] = t_ref[0]
+            floats[F_RHO_STEP] = t_ref[1] - t_ref[0] if t_ref.size > 1 else 1.0
+            density = rho
+        args = (ints, floats, c, s, c2i, pom, dut1, sun, moon, EXPONENTIAL_ATMOSPHERE, density)
         return cls(model, epoch, tuple(np.ascontiguousarray(a) for a in args))
 
     def covers(self, t_from_s: float, t_to_s: float) -> bool:
@@ -411,6 +435,7 @@ def acceleration_kernel(
     sun_t: FloatArray,
     moon_t: FloatArray,
     atmosphere: FloatArray,
+    density_t: FloatArray,
 ) -> FloatArray:
     """Total acceleration (m/s², GCRF) at ``t`` s from the context epoch (arguments: ForceContext.kernel_args)."""
     a = np.zeros(3)
@@ -425,9 +450,8 @@ def acceleration_kernel(
             a += two_body_acceleration(r, floats[F_MU])
         if ints[I_ZONAL] > 0 or ints[I_J3_ONLY]:
             a += zonal_acceleration(r, ints[I_ZONAL], ints[I_J3_ONLY] == 1)
-    if ints[I_DRAG] == 1:
-        rn = math.sqrt(r[0] ** 2 + r[1] ** 2 + r[2] ** 2)
-        rho = exponential_density(rn - R_EARTH_M, atmosphere)
+    if ints[I_DRAG] != DRAG_KERNEL_NONE:
+        rho = kernel_density(t, r, ints, floats, atmosphere, density_t)
         a += floats[F_DRAG_SCALE] * drag_acceleration(
             r, v, rho, floats[F_CD], floats[F_AREA], floats[F_ARRAY], floats[F_MASS]
         )
@@ -443,6 +467,50 @@ def acceleration_kernel(
                 r, sun, floats[F_CR], floats[F_SRP_AREA], floats[F_MASS], ints[I_SRP]
             )
     return a
+
+
+@nb.njit(cache=True)
+def kernel_density(
+    t: float, r: FloatArray, ints: FloatArray, floats: FloatArray, atmosphere: FloatArray, density_t: FloatArray
+) -> float:
+    """Density (kg/m³) the kernels use: the exponential model at the altitude of ``r``, or the MSIS
+    table interpolated linearly in time (clamped at its ends)."""
+    if ints[I_DRAG] == DRAG_KERNEL_TABLE:
+        return _interp_row(density_t.reshape(-1, 1), floats[F_RHO_T0], floats[F_RHO_STEP], t)[0]
+    if ints[I_DRAG] == DRAG_KERNEL_EXPONENTIAL:
+        rn = math.sqrt(r[0] ** 2 + r[1] ** 2 + r[2] ** 2)
+        return exponential_density(rn - R_EARTH_M, atmosphere)
+    return 0.0
+
+
+@nb.njit(cache=True)
+def scale_partials(
+    t: float,
+    r: FloatArray,
+    v: FloatArray,
+    ints: FloatArray,
+    floats: FloatArray,
+    c: FloatArray,
+    s: FloatArray,
+    c2i: FloatArray,
+    pom: FloatArray,
+    dut1: FloatArray,
+    sun_t: FloatArray,
+    moon_t: FloatArray,
+    atmosphere: FloatArray,
+    density_t: FloatArray,
+) -> FloatArray:
+    """∂a/∂(drag_scale) and ∂a/∂(srp_scale) (m/s², GCRF; a (2, 3) array): the drag and SRP
+    accelerations of the context at scale 1 (zero for a force the model leaves out). These are the
+    columns an estimated scale factor adds to the dynamics' Jacobian (Montenbruck & Gill 2000 §7.2.2)."""
+    out = np.zeros((2, 3))
+    if ints[I_DRAG] != DRAG_KERNEL_NONE:
+        rho = kernel_density(t, r, ints, floats, atmosphere, density_t)
+        out[0] = drag_acceleration(r, v, rho, floats[F_CD], floats[F_AREA], floats[F_ARRAY], floats[F_MASS])
+    if ints[I_SRP]:
+        sun = _interp_row(sun_t, floats[F_BODY_T0], floats[F_BODY_STEP], t)
+        out[1] = srp_acceleration(r, sun, floats[F_CR], floats[F_SRP_AREA], floats[F_MASS], ints[I_SRP])
+    return out
 
 
 @nb.njit(cache=True)
@@ -502,6 +570,76 @@ def msis_density(t_s: float, r: FloatArray, context: ForceContext) -> float:
     return float(np.asarray(out).ravel()[0])
 
 
+@nb.njit(cache=True)
+def _earth_fixed_positions(
+    t: FloatArray, r: FloatArray, floats: FloatArray, c2i: FloatArray, pom: FloatArray, dut1: FloatArray
+) -> FloatArray:
+    out = np.empty_like(r)
+    for k in range(t.size):
+        out[k] = earth_fixed_rotation(t[k], floats, c2i, pom, dut1) @ r[k]
+    return out
+
+
+def msis_density_table(
+    model: ForceModel,
+    epoch_utc: np.datetime64,
+    t_s: FloatArray,
+    position_gcrf_m: FloatArray,
+    space_weather: Any = None,
+    *,
+    step_s: float = 60.0,
+    repairs: Any = None,
+) -> tuple[FloatArray, FloatArray]:
+    """NRLMSIS 2.1 density (kg/m³) along a reference trajectory, on a uniform time grid (s from
+    ``epoch_utc``) of at most ``step_s`` spacing: the positions are interpolated (cubic) to the grid,
+    rotated to the Earth-fixed frame (IAU 2006/2000A with IERS data, :mod:`abrupt.model.orbit.frames`)
+    and converted to geodetic coordinates (WGS84, astropy); the indices are the observed ones of the
+    offline space-weather table (:func:`abrupt.model.atmosphere.msis_density`). Dates the table does not
+    cover use the model's explicit ``f107_sfu``/``f107a_sfu``/``ap``, counted in ``repairs`` (a
+    :class:`~abrupt.errors.RepairLog`; nothing is downloaded)."""
+    from astropy import units as u
+    from astropy.coordinates import EarthLocation
+    from scipy.interpolate import CubicSpline
+
+    from abrupt.model.atmosphere import SpaceWeatherFallback, msis_density
+
+    t = np.asarray(t_s, dtype=np.float64)
+    pos = np.asarray(position_gcrf_m, dtype=np.float64)
+    ok = np.isfinite(pos).all(axis=1) & np.isfinite(t)
+    t, pos = t[ok], pos[ok]
+    if t.size < 2:
+        raise ValueError("a density table needs at least two reference positions")
+    n = max(2, math.ceil((t[-1] - t[0]) / step_s) + 1)
+    grid = np.linspace(t[0], t[-1], n)
+    if t.size >= 4:
+        r_grid = CubicSpline(t, pos, axis=0)(grid)
+    else:
+        r_grid = np.array([np.interp(grid, t, pos[:, i]) for i in range(3)]).T
+    eop = earth_orientation_table(epoch_utc, float(grid[0]), float(grid[-1]))
+    floats = np.zeros(19)
+    floats[F_EOP_T0], floats[F_EOP_STEP], floats[F_ERA0], floats[F_ERA_RATE] = (
+        eop.t0_s,
+        eop.step_s,
+        eop.era0_rad,
+        era_rate_rad_s(),
+    )
+    r_ef = _earth_fixed_positions(grid, np.ascontiguousarray(r_grid), floats, eop.c2i, eop.polar_motion, eop.dut1_s)
+    loc = EarthLocation.from_geocentric(r_ef[:, 0], r_ef[:, 1], r_ef[:, 2], unit=u.m)
+    geo = loc.to_geodetic("WGS84")
+    times = epoch_utc + (grid * 1e9).astype("timedelta64[ns]")
+    fallback = SpaceWeatherFallback(model.f107_sfu, model.f107a_sfu, model.ap)
+    rho = msis_density(
+        times,
+        np.asarray(geo.lat.deg),
+        np.asarray(geo.lon.deg),
+        np.asarray(geo.height.to_value(u.km)),
+        space_weather,
+        fallback=fallback,
+        repairs=repairs,
+    )
+    return grid, np.asarray(rho, dtype=np.float64)
+
+
 def earth_rotation_angle(context: ForceContext, t_s: float) -> float:
     """Earth rotation angle (rad) at ``t_s`` s from the context epoch (from the EOP table when present,
     else from UTC ≈ UT1, IAU 2000 formula)."""
@@ -518,7 +656,7 @@ def acceleration(t_s: float, r: FloatArray, v: FloatArray, context: ForceContext
         float(t_s), np.asarray(r, dtype=np.float64), np.asarray(v, dtype=np.float64), *context.kernel_args
     )
     model = context.model
-    if model.drag == "msis":
+    if model.drag == "msis" and context.kernel_args[0][I_DRAG] == DRAG_KERNEL_NONE:
         rho = msis_density(t_s, r, context)
         a = a + model.drag_scale * drag_acceleration(
             np.asarray(r, dtype=np.float64),
