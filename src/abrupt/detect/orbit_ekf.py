@@ -535,6 +535,25 @@ def measurement_update(x: FloatArray, p: FloatArray, y: FloatArray, rdiag: Float
 
 
 @nb.njit(cache=True)
+def _gain_and_inverse(p: FloatArray, rdiag_i: FloatArray, gain: FloatArray) -> FloatArray:
+    """S⁻¹ = (P_pos + R)⁻¹ of a position-velocity update, and the gain K = P[:, :6] S⁻¹ written into
+    ``gain`` (ns, 6); H selects the first six states."""
+    smat = np.empty((6, 6))
+    for a in range(6):
+        for b in range(6):
+            smat[a, b] = p[a, b]
+        smat[a, a] += rdiag_i[a]
+    sinv = np.asarray(np.linalg.inv(smat), dtype=np.float64)
+    for a in range(gain.shape[0]):
+        for b in range(6):
+            acc = 0.0
+            for m in range(6):
+                acc += p[a, m] * sinv[m, b]
+            gain[a, b] = acc
+    return sinv
+
+
+@nb.njit(cache=True)
 def forward_kernel(
     t: FloatArray,
     y: FloatArray,
@@ -576,19 +595,7 @@ def forward_kernel(
             p[:, :] = pbar
             if store:
                 phis[i] = phi
-                smat = np.empty((6, 6))
-                for a in range(6):
-                    for b in range(6):
-                        smat[a, b] = p[a, b]
-                    smat[a, a] += rdiag[i, a]
-                sinv = np.linalg.inv(smat)
-                sinvs[i] = sinv
-                for a in range(ns):
-                    for b in range(6):
-                        acc = 0.0
-                        for c in range(6):
-                            acc += p[a, c] * sinv[c, b]
-                        gains[i, a, b] = acc
+                sinvs[i] = _gain_and_inverse(p, rdiag[i], gains[i])
         nis[i] = measurement_update(x, p, y[i], rdiag[i], innov)
         innovs[i] = innov
         xs[i] = x
@@ -783,19 +790,7 @@ def forward_kernel_detailed(
         _time_update_cov(p, phi, s, 1.0, pbar)
         p[:, :] = pbar
         phis[i] = phi
-        smat = np.empty((6, 6))
-        for a in range(6):
-            for b in range(6):
-                smat[a, b] = p[a, b]
-            smat[a, a] += rdiag[i, a]
-        sinv = np.linalg.inv(smat)
-        sinvs[i] = sinv
-        for a in range(ns):
-            for b in range(6):
-                acc = 0.0
-                for m in range(6):
-                    acc += p[a, m] * sinv[m, b]
-                gains[i, a, b] = acc
+        sinvs[i] = _gain_and_inverse(p, rdiag[i], gains[i])
         innov = np.empty(6)
         measurement_update(x, p, y[i], rdiag[i], innov)
         innovs[i] = innov
