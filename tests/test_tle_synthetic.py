@@ -335,3 +335,26 @@ def test_two_set_burn_time_recovers_the_burn_inside_its_gap(maneuvering) -> None
     assert t_b is not None
     t_true = (t_burn - epochs.iloc[0]).total_seconds()
     assert abs(t_b - t_true) < 2 * 3600.0
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_burns_in_consecutive_gaps_are_two_events_with_a_one_set_side(tmp_path: Path, seed: int) -> None:
+    """Sets every 2 days; +5 cm/s at day 99.5 and −3 cm/s at day 101.9 fall in consecutive gaps
+    (one element set between them, Δa = 2aΔv/v ≈ 100 m and −60 m against σ_a = 0.5 m). With a campaign
+    side of one set (``campaign_min_side_sets=1``) the step next to the first is tested on the one set
+    between them: two events, each within a day of its burn, signed as the burns. A single burn stays
+    one event and a burn-free history stays quiet."""
+    burns = ((99.5, 0.05), (101.9, -0.03))
+    cfg = TleDetectorConfig(campaign_min_side_sets=1)
+    text, truth = synthetic_tle_text(days=400, cadence_days=2.0, burns=burns, seed=seed)
+    path = tmp_path / "pair.tle"
+    path.write_text(text)
+    events = detect_tle_maneuvers(read_tle(path), cfg)
+    res = score_events(events, pd.DataFrame({"time_utc": [t for t, _, _ in truth]}), tolerance_s=86400.0)
+    assert (res.true_positives, res.false_positives) == (2, 0), events[["time_utc", "statistic", "dv_t_mps"]]
+    matched = events.iloc[[i for i, _, _ in sorted(res.pairs, key=lambda p: p[1])]]
+    assert list(np.sign(matched["dv_t_mps"])) == [1.0, -1.0]
+    for single, expect in ((burns[:1], 1), ((), 0)):
+        text, _ = synthetic_tle_text(days=400, cadence_days=2.0, burns=single, seed=seed)
+        path.write_text(text)
+        assert len(detect_tle_maneuvers(read_tle(path), cfg)) == expect

@@ -623,19 +623,29 @@ def segment(
         near = np.zeros(n_gaps, dtype=bool)
         for a in accepted:
             near[max(0, a - reach) : a + reach + 1] = True
+        # a side of one set: the gaps next to an accepted step are tested too (burns in consecutive
+        # gaps); only the accepted gaps themselves stay blocked
+        tested = blocked.copy()
+        if side == 1:
+            tested[:] = False
+            tested[accepted] = True
         cps = sorted(accepted)
-        for kk in np.flatnonzero(near & ~blocked):
+        for kk in np.flatnonzero(near & ~tested):
             _fill(cur, model, int(kk), cps)
         while True:
-            stat = np.where(blocked | ~near, -np.inf, cur.statistic)
+            stat = np.where(tested | ~near, -np.inf, cur.statistic)
             g = int(np.argmax(stat))
             if not np.isfinite(stat[g]) or stat[g] < max(cut_level, cfg.min_statistic):
                 break
             accepted.append(g)
             blocked[max(0, g - cfg.peak_half_width + 1) : g + cfg.peak_half_width] = True
+            if side == 1:
+                tested[g] = True
+            else:
+                tested = blocked.copy()
             cps = sorted(accepted)
             for k in range(max(0, g - reach), min(n_gaps, g + reach + 1)):
-                if not blocked[k] and near[k]:
+                if not tested[k] and near[k]:
                     _fill(cur, model, k, cps)
         model.min_side = cfg.min_side_sets
     rest = np.where(blocked, -np.inf, cur.statistic)
@@ -1097,10 +1107,26 @@ def run_tle_detector(
         # before the earlier one), not two burns.
         return 0 < abs(x[0] - y[0]) <= 2 and (x[0] - y[0]) * (x[1] - y[1]) < 0
 
+    # Steps in consecutive gaps (a side of one set, campaign_min_side_sets = 1): the weaker is a
+    # second burn only if its own along-track time falls inside its bracket, from the satellite's
+    # TLE lag (learned from the other detections, as below) before the set preceding it to the set
+    # after it; a step that the element sets' convergence spreads over several sets is timed
+    # days before its gap (its hinge is the first step's) and is merged into its neighbour.
+    cp_set = set(change_points)
+    lag0 = [float(model.t[it[0]]) - it[1] for it in timed if it[2] and stat[it[0]] >= threshold]
+    lag0_s = float(np.quantile(np.maximum(lag0, 0.0), 0.9)) if len(lag0) >= 5 else 0.0
+
+    def secondary_outside(x: tuple[int, float, bool, float]) -> bool:
+        g_x = x[0]
+        stronger = [g_y for g_y in (g_x - 1, g_x + 1) if g_y in cp_set and stat[g_y] > stat[g_x]]
+        return bool(stronger) and not (float(model.t[g_x]) - lag0_s <= x[1] <= float(model.t[g_x + 1]))
+
     kept: list[tuple[int, float, bool, float]] = []
     span_of: dict[int, list[float]] = {}
     for item in sorted(timed, key=lambda it: -stat[it[0]]):
         near = [k for k in kept if abs(item[1] - k[1]) < merge_s or out_of_order(item, k)]
+        if not near and secondary_outside(item):
+            near = [k for k in kept if abs(k[0] - item[0]) == 1]
         if not near:
             kept.append(item)
             span_of[item[0]] = [item[3], float(steps.t_after_s[item[0]])]
