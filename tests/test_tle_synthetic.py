@@ -34,6 +34,7 @@ def synthetic_tle_text(
     a0_m: float = 7_200_000.0,
     seed: int = 1,
     norad: int = 99001,
+    blend_fraction: float | None = None,
 ) -> tuple[str, list[tuple[pd.Timestamp, float, float]]]:
     """TLE text of a near-circular LEO history with in-track burns ``(day, dv_t m/s)``.
 
@@ -70,6 +71,8 @@ def synthetic_tle_text(
         j = int(np.searchsorted(starts, td, side="right") - 1)
         d0, a_start = segs[j]
         a = a_start - decay * (td - d0)
+        if blend_fraction is not None and j > 0 and (k == 0 or t_days[k - 1] < d0):
+            a -= (1.0 - blend_fraction) * truth[j - 1][2]
         # phase: integrate piecewise mean motion from day 0
         u = 0.3
         for jj in range(j + 1):
@@ -358,3 +361,22 @@ def test_burns_in_consecutive_gaps_are_two_events_with_a_one_set_side(tmp_path: 
         text, _ = synthetic_tle_text(days=400, cadence_days=2.0, burns=single, seed=seed)
         path.write_text(text)
         assert len(detect_tle_maneuvers(read_tle(path), cfg)) == expect
+
+
+@pytest.mark.parametrize("seed", [1, 3, 5])
+def test_a_set_fitted_across_a_burn_leaves_one_event(tmp_path: Path, seed: int) -> None:
+    """The first set after each burn carries only part of its Δa (a producer's fit straddling the
+    burn), so ``a`` steps over two gaps, while its along-track position is on the post-burn orbit.
+    The sets between the two steps lie on one burn's along-track trajectory
+    (:func:`middle_set_phase_z`), so each burn is one event, within a day of it, whether a side of
+    one or two sets is allowed between accepted steps."""
+    burns = ((99.5, 0.05), (201.3, -0.04), (300.9, 0.06))
+    for fraction in (0.3, 0.5):
+        text, truth = synthetic_tle_text(days=400, burns=burns, seed=seed, blend_fraction=fraction)
+        path = tmp_path / f"blend_{fraction}.tle"
+        path.write_text(text)
+        history = read_tle(path)
+        for side in (1, 2):
+            events = detect_tle_maneuvers(history, TleDetectorConfig(campaign_min_side_sets=side))
+            res = score_events(events, pd.DataFrame({"time_utc": [t for t, _, _ in truth]}), tolerance_s=86400.0)
+            assert (res.true_positives, res.false_positives) == (3, 0), (fraction, side, events["time_utc"])

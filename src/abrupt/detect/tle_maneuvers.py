@@ -826,6 +826,64 @@ def refine_burn_time(
     return float(grid[int(np.argmin(cost))]), True
 
 
+def middle_set_phase_z(
+    history: ElementHistory,
+    t: NDArray[np.float64],
+    g1: int,
+    g2: int,
+    bounds: tuple[int, int],
+    sigma_u_m: float,
+    window_sets: int = 8,
+) -> tuple[float, float]:
+    """Are the sets between steps in gaps ``g1 < g2`` on a single burn's trajectory? (z-score, time)
+
+    Steps one or two gaps apart are either two burns or one burn whose first sets after it were
+    fitted across it (blends: compromise mean motions, so ``a`` steps over several gaps). The
+    along-track position of the sets tells which: one impulse bends the along-track angle once,
+    ``c₀ + c₁τ + c₂τ² + β·max(0, t − t_b)`` (Vallado 2013 Eq. 9-41); a second burn after the middle
+    sets bends it again. The model is fitted (L1; hinge time on a coarse then a fine grid from three
+    sets before the first step to the set after the second) to every set of the window but the
+    middle ones (sets ``g1+1 … g2``); their largest deviation from that one-burn trajectory over the
+    satellite's own per-set phase noise ``sigma_u_m`` (m) is returned with the fit's hinge time (s,
+    origin of ``t``: the burn time if it is one burn). Two burns a day apart move the middle set by
+    ~``Δn·Δt·a`` (kilometres for 5 cm/s); blends stay within their noise. NaN (and the middle of
+    the span) when fewer than three sets before or two after remain inside ``bounds``.
+    """
+    lo = max(bounds[0], g1 - window_sets + 1)
+    hi = min(bounds[1], g2 + 2 + window_sets)
+    if g1 + 1 - lo < 3 or hi - (g2 + 1) < 2 or not sigma_u_m > 0:
+        return float("nan"), 0.5 * float(t[g1] + t[g2 + 1])
+    sats = history.satrecs
+    ref = sats[g1]
+    rate = (ref.argpdot + ref.mdot) / 60.0  # [rad/s]
+    idx = np.arange(lo, hi)
+    u = np.array([sats[k].argpo + sats[k].mo for k in idx], dtype=float)
+    du = np.unwrap(np.angle(np.exp(1j * (u - (ref.argpo + ref.mo) - rate * (t[idx] - t[g1])))))
+    du -= du[g1 - lo]
+    tau = (t[idx] - t[g1]) / SECONDS_PER_DAY
+    middle = (idx > g1) & (idx <= g2)
+    fit = ~middle
+    base3 = np.column_stack([np.ones_like(tau), tau, tau**2])
+
+    def fit_on(grid: NDArray[np.float64]) -> tuple[NDArray[np.float64], int]:
+        hinge = np.maximum(0.0, (t[idx][None, :] - grid[:, None]) / SECONDS_PER_DAY)
+        base = np.broadcast_to(base3, (grid.size, tau.size, 3))
+        design = np.concatenate([base, hinge[:, :, None]], axis=2)  # (grid, sets, 4)
+        coef = np.linalg.pinv(design[:, fit, :]) @ du[fit]
+        resid = du[None, :] - np.einsum("gsk,gk->gs", design, coef)
+        return resid, int(np.argmin(np.sum(np.abs(resid[:, fit]), axis=1)))
+
+    # hinge time: a coarse grid, then a fine one around its best (a 5 cm/s burn drifts 0.15 m/s:
+    # an hour's error is 0.5 km, more than a good history's per-set phase noise)
+    grid = np.linspace(t[max(lo, g1 - 3)], t[g2 + 1], 97)
+    _, best = fit_on(grid)
+    step = float(grid[1] - grid[0])
+    grid = np.linspace(grid[best] - step, grid[best] + step, 61)
+    resid, best = fit_on(grid)
+    a_m = float(history.elements["a_m"].iloc[g1 + 1])
+    return float(np.max(np.abs(resid[best, middle])) * a_m / sigma_u_m), float(grid[best])
+
+
 def is_phasing(steps: StepSeries, g: int, significance: float = 5.0) -> bool:
     """Only the along-track phase moved at gap g (weighted z ≥ ``significance``; a, e-vector and
     orbit normal below it): opposed in-track burns that leave ``a`` unchanged (a phasing pair).
@@ -841,6 +899,7 @@ def is_phasing(steps: StepSeries, g: int, significance: float = 5.0) -> bool:
 
 
 TWO_SET_TIMING = True
+MIDDLE_SET_TEST = True
 
 
 def two_set_burn_time(history: ElementHistory, t: NDArray[np.float64], gap: int, sets_before: int = 3) -> float | None:
@@ -1116,17 +1175,41 @@ def run_tle_detector(
     lag0 = [float(model.t[it[0]]) - it[1] for it in timed if it[2] and stat[it[0]] >= threshold]
     lag0_s = float(np.quantile(np.maximum(lag0, 0.0), 0.9)) if len(lag0) >= 5 else 0.0
 
-    def secondary_outside(x: tuple[int, float, bool, float]) -> bool:
+    def secondary_outside(x: tuple[int, float, bool, float]) -> tuple[bool, float | None]:
+        """(merge into the stronger neighbour?, the one burn's time when the middle-set test says so)"""
         g_x = x[0]
-        stronger = [g_y for g_y in (g_x - 1, g_x + 1) if g_y in cp_set and stat[g_y] > stat[g_x]]
-        return bool(stronger) and not (float(model.t[g_x]) - lag0_s <= x[1] <= float(model.t[g_x + 1]))
+        reach_sets = 2 if MIDDLE_SET_TEST and regime == "leo" else 1
+        stronger = [
+            g_y
+            for g_y in range(g_x - reach_sets, g_x + reach_sets + 1)
+            if g_y != g_x and g_y in cp_set and stat[g_y] > stat[g_x]
+        ]
+        if not stronger:
+            return False, None
+        g_y = min(stronger, key=lambda c: abs(c - g_x))
+        if MIDDLE_SET_TEST and regime == "leo":
+            g1, g2 = min(g_x, g_y), max(g_x, g_y)
+            seg_pair = _bounds(g1, [c for c in change_points if c not in (g1, g2)], len(history))
+            z_mid, t_one = middle_set_phase_z(history, model.t, g1, g2, seg_pair, float(model.scales["u_m"][g1 + 1]))
+            if math.isfinite(z_mid):
+                # the middle sets on one burn's trajectory: one burn, timed by that trajectory
+                return (True, t_one) if z_mid < threshold else (False, None)
+        if abs(g_y - g_x) > 1:
+            return False, None
+        return not (float(model.t[g_x]) - lag0_s <= x[1] <= float(model.t[g_x + 1])), None
 
     kept: list[tuple[int, float, bool, float]] = []
     span_of: dict[int, list[float]] = {}
     for item in sorted(timed, key=lambda it: -stat[it[0]]):
         near = [k for k in kept if abs(item[1] - k[1]) < merge_s or out_of_order(item, k)]
-        if not near and secondary_outside(item):
-            near = [k for k in kept if abs(k[0] - item[0]) == 1]
+        if not near:
+            merge, t_one = secondary_outside(item)
+            if merge:
+                near = sorted((k for k in kept if 0 < abs(k[0] - item[0]) <= 2), key=lambda k: abs(k[0] - item[0]))
+                if near and t_one is not None:
+                    host_item = near[0]
+                    kept[kept.index(host_item)] = (host_item[0], t_one, True, min(host_item[3], t_one))
+                    near = [kept[kept.index((host_item[0], t_one, True, min(host_item[3], t_one)))]]
         if not near:
             kept.append(item)
             span_of[item[0]] = [item[3], float(steps.t_after_s[item[0]])]
