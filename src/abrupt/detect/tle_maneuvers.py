@@ -43,7 +43,8 @@ Method (each step cites its source; the combination is abrupt's own):
    fall in (``interval_start_utc``, ``interval_end_utc``: from the satellite's own TLE lag before
    the set preceding the step to the set after it, widened over merged neighbours) and
    ``burns_max = 1 + ⌊interval / cadence⌋`` with the satellite's own burn cadence inside campaigns
-   (:func:`campaign_cadence_s`).
+   (:func:`campaign_cadence_s`). Steps one or two gaps apart are one burn when the sets between
+   them lie on one burn's along-track trajectory (:func:`middle_set_phase_z`), else two.
 """
 
 from __future__ import annotations
