@@ -1167,11 +1167,14 @@ def run_tle_detector(
         # before the earlier one), not two burns.
         return 0 < abs(x[0] - y[0]) <= 2 and (x[0] - y[0]) * (x[1] - y[1]) < 0
 
-    # Steps in consecutive gaps (a side of one set, campaign_min_side_sets = 1): the weaker is a
-    # second burn only if its own along-track time falls inside its bracket, from the satellite's
-    # TLE lag (learned from the other detections, as below) before the set preceding it to the set
-    # after it; a step that the element sets' convergence spreads over several sets is timed
-    # days before its gap (its hinge is the first step's) and is merged into its neighbour.
+    # A step one or two gaps from a stronger accepted one: one burn whose first sets after it were
+    # fitted across it, or a second burn? LEO: the sets between them decide (on one burn's
+    # along-track trajectory: merged into the stronger and timed by that trajectory;
+    # middle_set_phase_z). Where the segment is too short for that test, a step in the gap next to
+    # the stronger (a side of one set, campaign_min_side_sets = 1) is a second burn only if its own
+    # along-track time falls inside its bracket, from the satellite's TLE lag (learned from the
+    # other detections, as below) before the set preceding it to the set after it: a step that
+    # the sets' convergence spreads is timed days before its gap (its hinge is the first step's).
     cp_set = set(change_points)
     lag0 = [float(model.t[it[0]]) - it[1] for it in timed if it[2] and stat[it[0]] >= threshold]
     lag0_s = float(np.quantile(np.maximum(lag0, 0.0), 0.9)) if len(lag0) >= 5 else 0.0
@@ -1207,10 +1210,11 @@ def run_tle_detector(
             merge, t_one = secondary_outside(item)
             if merge:
                 near = sorted((k for k in kept if 0 < abs(k[0] - item[0]) <= 2), key=lambda k: abs(k[0] - item[0]))
-                if near and t_one is not None:
-                    host_item = near[0]
-                    kept[kept.index(host_item)] = (host_item[0], t_one, True, min(host_item[3], t_one))
-                    near = [kept[kept.index((host_item[0], t_one, True, min(host_item[3], t_one)))]]
+                if near and t_one is not None:  # one burn: timed by its one-burn trajectory
+                    retimed = (near[0][0], t_one, True, min(near[0][3], t_one))
+                    kept[kept.index(near[0])] = retimed
+                    span_of[retimed[0]][0] = min(span_of[retimed[0]][0], t_one)
+                    near = [retimed]
         if not near:
             kept.append(item)
             span_of[item[0]] = [item[3], float(steps.t_after_s[item[0]])]
