@@ -1,0 +1,384 @@
+"""Maneuver-free element-set histories for calibrating the TLE detectors' false-alarm rate.
+
+Two generators, both returning an :class:`~abrupt.readers.tle.ElementHistory` of SGP4 records
+(WGS-72) whose *detector series* (:func:`abrupt.detect.tle_maneuvers.mean_element_series`: mean
+semi-major axis, eccentricity vector, orbit normal or inclination vector, along-track phase) are
+a smooth maneuver-free orbit plus noise:
+
+``simulate_null_history``   parametric: the smooth orbit of the regime (LEO: drag decay modulated
+                            by the 11-year solar cycle and the 27-day solar rotation, an
+                            eccentricity vector circling its frozen point, a slow luni-solar
+                            inclination drift; GEO: the longitude libration that the Earth's
+                            triaxiality drives in ``a``, the yearly solar-radiation-pressure circle
+                            of the eccentricity vector, the luni-solar drift of the inclination
+                            vector, ~0.85°/year, with its 13.66-day lunar and 182.6-day solar
+                            terms) plus heavy-tailed (Student-t), serially correlated (AR(1) in
+                            time) set-to-set noise, occasional bad sets (gross errors in every
+                            element), irregular cadence and long gaps without sets.
+``bootstrap_null_history``  the *real* noise of a history: residuals of its detector series about
+                            a running median, taken in blocks of consecutive sets (with their real
+                            gaps) from its quiet stretches (away from every maneuver the caller
+                            names), laid end to end on a fresh parametric smooth orbit. Heavy tails,
+                            serial correlation, bad sets and cadence are the satellite's own; its
+                            maneuvers are not in the blocks.
+
+Neither generator knows the detector; the detector is run on their output and its events are all
+false alarms (``benchmarks/bench_tle_null_calibration.py``, docs/tle.md "Null calibration").
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+
+from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory, RawElementSet, history_from_sets
+
+SECONDS_PER_DAY = 86400.0
+DAYS_PER_YEAR = 365.25
+EARTH_RADIUS_M = 6378135.0  # WGS-72, as SGP4
+EARTH_ROTATION_RAD_S = 7.2921158553e-5
+GEO_A_M = (MU_EARTH_WGS72_M3_S2 / EARTH_ROTATION_RAD_S**2) ** (1.0 / 3.0)
+EPOCH0 = pd.Timestamp("2012-01-01T00:00:00")
+SERIES = ("a_m", "ex", "ey", "n1_rad", "n2_rad", "u_m")
+
+
+@dataclass(frozen=True)
+class NullHistorySpec:
+    """A maneuver-free history to simulate (units in the names).
+
+    ``sigma`` are the robust (1.4826·MAD) per-set noise levels of the six detector series: ``a``
+    (m), the two eccentricity-vector components, the two orbit-normal angles (LEO: ``i`` and
+    ``sin i`` × RAAN residual; GEO: the inclination vector; rad) and the along-track phase (m; GEO:
+    the mean longitude times ``a``). Defaults are of the order of the shared histories' own
+    (docs/tle.md): LEO a 0.1-0.4 m, e 1e-6, normal 2e-6 rad, phase 20-70 m; GEO a 30-50 m,
+    e 4e-6, inclination vector 8e-6 rad.
+    """
+
+    regime: str = "leo"
+    years: float = 3.0
+    sets_per_day: float = 1.0
+    altitude_km: float = 800.0  # LEO
+    inclination_deg: float = 98.0  # LEO; GEO: the initial inclination-vector length is 1-3°
+    sigma: tuple[float, float, float, float, float, float] | None = None
+    noise_scale: float = 1.0
+    t_dof: float = 3.0  # Student-t degrees of freedom of the noise (heavy tails)
+    correlation_days: float = 1.5  # AR(1) time constant of the noise (adjacent sets' fits overlap)
+    bad_set_probability: float = 0.003  # a set with a gross error in every element
+    long_gap_probability: float = 0.004  # per set: a gap of 3-10 days follows
+    solar_cycle_amplitude: float = 0.8  # LEO drag decay × (1 + amp·sin(2π t / 11 y))
+    seed: int = 0
+
+    def noise_sigmas(self) -> tuple[float, ...]:
+        if self.sigma is not None:
+            base: tuple[float, ...] = self.sigma
+        elif self.regime == "geo":
+            base = (35.0, 4e-6, 4e-6, 8e-6, 8e-6, 400.0)
+        else:
+            base = (0.2, 1e-6, 1e-6, 2e-6, 2e-6, 30.0)
+        return tuple(self.noise_scale * s for s in base)
+
+
+def _epochs_days(spec: NullHistorySpec, rng: np.random.Generator) -> NDArray[np.float64]:
+    """Irregular epochs (days): Gamma(4) spacing about the cadence, and occasional 3-10 day gaps."""
+    span = spec.years * DAYS_PER_YEAR
+    mean_gap = 1.0 / spec.sets_per_day
+    n_max = int(span * spec.sets_per_day * 1.5) + 10
+    gaps = mean_gap * rng.gamma(4.0, 0.25, n_max)
+    long = rng.random(n_max) < spec.long_gap_probability
+    gaps[long] += rng.uniform(3.0, 10.0, int(long.sum()))
+    t = np.concatenate([[0.0], np.cumsum(gaps)])
+    return np.asarray(t[t <= span], dtype=float)
+
+
+def _noise(
+    t_days: NDArray[np.float64], sigma: float, spec: NullHistorySpec, rng: np.random.Generator
+) -> NDArray[np.float64]:
+    """AR(1) in time (correlation exp(−Δt/τ)) driven by Student-t innovations, robust σ = ``sigma``."""
+    from scipy import stats
+
+    n = t_days.size
+    nu = spec.t_dof
+    eps = rng.standard_t(nu, n)
+    eps /= float(stats.t.ppf(0.75, nu) / stats.norm.ppf(0.75))  # robust σ (1.4826·MAD) of 1
+    rho = np.exp(-np.diff(t_days, prepend=t_days[0] - 1e9) / max(spec.correlation_days, 1e-6))
+    out = np.empty(n)
+    prev = 0.0
+    for k in range(n):
+        prev = rho[k] * prev + math.sqrt(1.0 - rho[k] ** 2) * eps[k]
+        out[k] = prev
+    return sigma * out
+
+
+def _smooth_orbit(spec: NullHistorySpec, t_days: NDArray[np.float64], rng: np.random.Generator) -> dict[str, NDArray]:
+    """The maneuver-free smooth detector series of the regime (module docstring)."""
+    zero = np.zeros_like(t_days)
+    if spec.regime == "geo":
+        a = (
+            GEO_A_M
+            + rng.uniform(-3e3, 3e3)
+            + 8e3 * np.sin(2 * math.pi * t_days / rng.uniform(700, 1100) + rng.uniform(0, 6.3))
+        )
+        ph = rng.uniform(0, 2 * math.pi)
+        rho = rng.uniform(1e-4, 3e-4)
+        e0 = rng.uniform(-1e-4, 1e-4, 2)
+        ex = e0[0] + rho * np.cos(2 * math.pi * t_days / DAYS_PER_YEAR + ph)
+        ey = e0[1] + rho * np.sin(2 * math.pi * t_days / DAYS_PER_YEAR + ph)
+        i0 = math.radians(rng.uniform(1.0, 3.0))
+        d0 = rng.uniform(0, 2 * math.pi)
+        drift = math.radians(0.85) / DAYS_PER_YEAR * t_days  # [rad] luni-solar drift of the i-vector
+        lunar = 5e-5 * np.sin(2 * math.pi * t_days / 13.66 + rng.uniform(0, 6.3))
+        solar = 1.5e-4 * np.sin(2 * math.pi * t_days / 182.6 + rng.uniform(0, 6.3))
+        n1 = i0 * math.cos(d0) + drift + lunar
+        n2 = i0 * math.sin(d0) + 0.3 * drift + solar
+        return {"a_m": a, "ex": ex, "ey": ey, "n1_rad": n1, "n2_rad": n2, "u_m": zero}
+    h_km = spec.altitude_km
+    decay0 = 15.0 * math.exp(-(h_km - 500.0) / 70.0)  # [m/day] drag decay of a at solar mean
+    phase = rng.uniform(0, 2 * math.pi)
+    rate = decay0 * (1.0 + spec.solar_cycle_amplitude * np.sin(2 * math.pi * t_days / (11 * DAYS_PER_YEAR) + phase))
+    rate *= 1.0 + 0.15 * np.sin(2 * math.pi * t_days / 27.0 + rng.uniform(0, 6.3))
+    dt = np.diff(t_days, prepend=t_days[0])
+    a = EARTH_RADIUS_M + 1e3 * h_km - np.cumsum(0.5 * (rate + np.roll(rate, 1)) * dt)
+    ef = rng.uniform(5e-4, 1.2e-3)
+    circ = rng.uniform(5e-5, 2e-4)
+    w = 2 * math.pi * t_days / rng.uniform(80, 200) + rng.uniform(0, 6.3)
+    ex = circ * np.cos(w)
+    ey = ef + circ * np.sin(w)
+    n1 = math.radians(spec.inclination_deg) + 1e-8 * t_days + 2e-6 * np.sin(2 * math.pi * t_days / 13.66)
+    return {"a_m": a, "ex": ex, "ey": ey, "n1_rad": n1, "n2_rad": zero, "u_m": zero}
+
+
+def history_from_series(
+    t_days: NDArray[np.float64], series: dict[str, NDArray[np.float64]], regime: str, *, norad: int = 99900
+) -> ElementHistory:
+    """SGP4 records whose detector series are ``series`` (keys :data:`SERIES`) at ``t_days`` after
+    :data:`EPOCH0`.
+
+    ``a`` is matched through SGP4's Kozai-to-Brouwer conversion (the mean motion is iterated until
+    the record's ``a`` is the target); the node (LEO), perigee and mean anomaly are accumulated with
+    the records' own secular rates so the detector's residual series (the RAAN residual, the
+    along-track phase with its five-set running median of the rate) reproduce the targets.
+    """
+    from sgp4.api import WGS72, Satrec
+
+    n = t_days.size
+    a_t = series["a_m"]
+    e = np.hypot(series["ex"], series["ey"])
+    varpi = np.arctan2(series["ey"], series["ex"])
+    if regime == "geo":
+        inc = np.hypot(series["n1_rad"], series["n2_rad"])
+        raan = np.arctan2(series["n1_rad"], -series["n2_rad"])  # i-vector (i sin Ω, −i cos Ω)
+        argp = varpi - raan
+    else:
+        inc = series["n1_rad"]
+        argp = varpi
+    epoch_1949 = (EPOCH0 - pd.Timestamp("1949-12-31")).total_seconds() / SECONDS_PER_DAY + t_days
+    sats = []
+    rates = np.zeros((n, 3))  # nodedot, argpdot, mdot [rad/s]
+    for k in range(n):
+        no = math.sqrt(MU_EARTH_WGS72_M3_S2 / a_t[k] ** 3) * 60.0  # [rad/min] first guess
+        sat = Satrec()
+        for _ in range(4):
+            sat.sgp4init(WGS72, "i", norad, epoch_1949[k], 1e-5, 0.0, 0.0, e[k], argp[k], inc[k], 0.0, no, 0.0)
+            no *= (sat.a * EARTH_RADIUS_M / a_t[k]) ** 1.5
+        sats.append(no)
+        rates[k] = (sat.nodedot / 60.0, sat.argpdot / 60.0, sat.mdot / 60.0)
+    from abrupt.detect.tle_maneuvers import elapsed_si_seconds
+
+    # elapsed SI seconds, as the detector reads them (a leap second is 7 km along-track in LEO)
+    epochs = pd.Series(EPOCH0 + pd.to_timedelta(np.round(t_days * SECONDS_PER_DAY * 1e6), unit="us"))
+    dt_s = np.diff(elapsed_si_seconds(epochs))
+    a_mid = 0.5 * (a_t[1:] + a_t[:-1])
+    if regime == "geo":
+        raan_k = raan
+        # mean longitude Ω + ω + M accumulated with the records' rates, plus the phase series
+        lam_rate = rates.sum(axis=1)
+        lam = np.concatenate([[0.0], np.cumsum(0.5 * (lam_rate[1:] + lam_rate[:-1]) * dt_s)])
+        lam += series["u_m"] / a_t
+        mo = lam - raan_k - argp
+    else:
+        node_rate = rates[:, 0]
+        raan_k = 1.0 + np.concatenate([[0.0], np.cumsum(0.5 * (node_rate[1:] + node_rate[:-1]) * dt_s)])
+        raan_k += series["n2_rad"] / np.sin(inc)
+        u_rate = pd.Series(rates[:, 1] + rates[:, 2]).rolling(5, center=True, min_periods=1).median().to_numpy()
+        du = 0.5 * (u_rate[1:] + u_rate[:-1]) * dt_s + np.diff(series["u_m"]) / a_mid
+        u = 0.3 + np.concatenate([[0.0], np.cumsum(du)])
+        mo = u - argp
+    raw = []
+    for k in range(n):
+        sat = Satrec()
+        sat.sgp4init(
+            WGS72,
+            "i",
+            norad,
+            epoch_1949[k],
+            1e-5,
+            0.0,
+            0.0,
+            e[k],
+            float(np.mod(argp[k], 2 * math.pi)),
+            inc[k],
+            float(np.mod(mo[k], 2 * math.pi)),
+            sats[k],
+            float(np.mod(raan_k[k], 2 * math.pi)),
+        )
+        raw.append(RawElementSet(sat, norad, k + 1, 2 * k + 1, f"null-{norad}-{k}"))
+    return history_from_sets(raw, source=f"<null {regime} {norad}>")
+
+
+def simulate_null_history(spec: NullHistorySpec) -> ElementHistory:
+    """A parametric maneuver-free history (module docstring)."""
+    rng = np.random.default_rng(spec.seed)
+    t = _epochs_days(spec, rng)
+    smooth = _smooth_orbit(spec, t, rng)
+    sig = spec.noise_sigmas()
+    bad = rng.random(t.size) < spec.bad_set_probability
+    out = {}
+    for name, s in zip(SERIES, sig, strict=True):
+        y = smooth[name] + _noise(t, s, spec, rng)
+        y[bad] += s * rng.choice([-1.0, 1.0], int(bad.sum())) * rng.uniform(20.0, 300.0, int(bad.sum()))
+        out[name] = y
+    if spec.regime != "geo":
+        out["n1_rad"] = np.clip(out["n1_rad"], 1e-3, math.pi - 1e-3)
+    return history_from_series(t, out, spec.regime, norad=99900 + spec.seed % 99)
+
+
+def detector_residuals(history: ElementHistory, regime: str, median_sets: int = 31) -> dict[str, NDArray[np.float64]]:
+    """Residuals of a history's detector series about a centred running median of ``median_sets``
+    sets (the slow orbit evolution; longer than the detector's 12-set window, so the noise the step
+    test sees is kept). GEO's ``u_m`` is the mean longitude's along-track phase (m)."""
+    from abrupt.detect.tle_maneuvers import mean_element_series
+
+    s = mean_element_series(history, regime)
+    names = {"a_m": "a_m", "ex": "ex", "ey": "ey", "n1_rad": "i_rad", "n2_rad": "raan_resid_sin_i_rad", "u_m": "u_m"}
+    out: dict[str, NDArray[np.float64]] = {}
+    for key, src in names.items():
+        y = np.asarray(s[src], dtype=float)
+        if key == "u_m" and regime == "geo":
+            y = _geo_phase_m(history, s["t_s"])
+        # a running median leaves zero residuals on a trend steeper than the noise: the trend (the
+        # running median of the set-to-set rates) is integrated out first
+        t = s["t_s"]
+        dt = np.diff(t)
+        rate = pd.Series(np.diff(y) / np.maximum(dt, 60.0)).rolling(median_sets, center=True, min_periods=3).median()
+        rate_v = rate.to_numpy()
+        trend = np.concatenate([[0.0], np.cumsum(np.nan_to_num(rate_v) * dt)])
+        flat = y - trend
+        med = pd.Series(flat).rolling(median_sets, center=True, min_periods=3).median().to_numpy()
+        out[key] = flat - med
+    return out
+
+
+def _geo_phase_m(history: ElementHistory, t_s: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Along-track phase of the mean longitude Ω + ω + M (m), as :func:`along_track_phase_m` for LEO."""
+    sats = history.satrecs
+    lam = np.array([s.nodeo + s.argpo + s.mo for s in sats])
+    rate = np.array([(s.nodedot + s.argpdot + s.mdot) / 60.0 for s in sats])
+    rate = pd.Series(rate).rolling(5, center=True, min_periods=1).median().to_numpy()
+    innov = np.angle(np.exp(1j * (np.diff(lam) - 0.5 * (rate[1:] + rate[:-1]) * np.diff(t_s))))
+    a = history.elements["a_m"].to_numpy(dtype=float)
+    return np.concatenate([[0.0], np.cumsum(innov * 0.5 * (a[1:] + a[:-1]))])
+
+
+def quiet_mask(
+    epochs_utc: pd.Series, maneuvers_utc: Sequence[pd.Timestamp], *, before_days: float = 3.0, after_days: float = 12.0
+) -> NDArray[np.bool_]:
+    """Sets farther than ``before_days`` before and ``after_days`` after every maneuver (the TLE lag
+    and the fit spans that straddle a burn stay out)."""
+    t = pd.to_datetime(epochs_utc).to_numpy(dtype="datetime64[ns]")
+    keep = np.ones(t.size, dtype=bool)
+    for m in maneuvers_utc:
+        m64 = np.datetime64(pd.Timestamp(m).tz_localize(None) if pd.Timestamp(m).tzinfo else pd.Timestamp(m), "ns")
+        lo = m64 - np.timedelta64(int(before_days * 86400), "s")
+        hi = m64 + np.timedelta64(int(after_days * 86400), "s")
+        keep &= ~((t >= lo) & (t <= hi))
+    return keep
+
+
+def bootstrap_null_history(
+    history: ElementHistory,
+    quiet: NDArray[np.bool_],
+    *,
+    regime: str,
+    years: float,
+    block_sets: int = 40,
+    seed: int = 0,
+    altitude_km: float | None = None,
+    median_sets: int = 31,
+) -> tuple[ElementHistory, NDArray[np.int64]]:
+    """A maneuver-free history with ``history``'s own noise (module docstring), and the junctions:
+    the index of the first set of every block but the first.
+
+    Blocks of ``block_sets`` consecutive sets (fewer where a quiet stretch is shorter, at least 12)
+    are drawn at random from the stretches where ``quiet`` holds, with their residuals
+    (:func:`detector_residuals`) and their gaps between sets; the first ``median_sets/2`` sets of
+    each stretch's ends are left out (the running median is one-sided there). Each block's residuals
+    are centred on their median (its level is the running median's, zero); a junction still joins
+    two unrelated stretches of slowly correlated noise, an artificial step that a null count should
+    not include: gaps whose test windows reach over a junction are left out of the exposure
+    (``benchmarks/bench_tle_null_calibration.py``).
+    """
+    rng = np.random.default_rng(seed)
+    res = detector_residuals(history, regime, median_sets)
+    t_real = pd.to_datetime(history.elements["epoch_utc"]) - pd.to_datetime(history.elements["epoch_utc"]).iloc[0]
+    t_real_d = t_real.dt.total_seconds().to_numpy() / SECONDS_PER_DAY
+    ok = quiet & np.all(np.isfinite(np.stack([res[k] for k in SERIES])), axis=0)
+    ok[:15] = ok[-15:] = False
+    # starts of blocks lying entirely inside quiet stretches
+    runs: list[tuple[int, int]] = []
+    k = 0
+    while k < ok.size:
+        if ok[k]:
+            j = k
+            while j < ok.size and ok[j]:
+                j += 1
+            if j - k >= 12:
+                runs.append((k, j))
+            k = j
+        else:
+            k += 1
+    if not runs:
+        raise ValueError("no quiet stretch of at least 12 element sets to draw noise blocks from")
+    weights = np.array([r[1] - r[0] for r in runs], dtype=float)
+    span = years * DAYS_PER_YEAR
+    idx: list[int] = []
+    starts: list[int] = []
+    t_out = [0.0]
+    while t_out[-1] < span:
+        lo, hi = runs[int(rng.choice(len(runs), p=weights / weights.sum()))]
+        length = min(block_sets, hi - lo)
+        start = int(rng.integers(lo, hi - length + 1))
+        block = list(range(start, start + length))
+        gaps = np.diff(t_real_d[block])
+        if idx:  # the junction gap: a gap drawn from the block's own
+            t_out.append(t_out[-1] + float(rng.choice(gaps)))
+        else:
+            t_out[-1] = 0.0
+        for g in gaps:
+            t_out.append(t_out[-1] + float(g))
+        starts.append(len(idx))
+        idx += block
+    t = np.asarray(t_out[: len(idx)], dtype=float)
+    keep = t <= span
+    t = t[keep]
+    if regime == "geo":
+        spec = NullHistorySpec(regime="geo", seed=seed)
+    else:
+        h_km = altitude_km if altitude_km is not None else float(np.median(history.elements["a_m"])) / 1e3 - 6378.135
+        inc = math.degrees(float(np.median(history.elements["i_rad"])))
+        spec = NullHistorySpec(regime="leo", altitude_km=h_km, inclination_deg=inc, seed=seed)
+    smooth = _smooth_orbit(spec, t, rng)
+    bounds = [*starts, len(idx)]
+    out: dict[str, NDArray[np.float64]] = {}
+    for name in SERIES:
+        noise = res[name][np.asarray(idx)].copy()
+        for b0, b1 in itertools.pairwise(bounds):
+            noise[b0:b1] -= np.median(noise[b0:b1])
+        out[name] = smooth[name] + noise[keep]
+    junctions = np.asarray([j for j in starts[1:] if j < t.size], dtype=np.int64)
+    return history_from_series(t, out, regime, norad=99800 + seed % 99), junctions
