@@ -113,6 +113,9 @@ def run_one(job: tuple[str, dict[str, Any]]) -> list[dict[str, Any]]:
                 "false_alarms": int(counted[gap].sum()),
                 "counted_fraction": float(counted.mean()),
                 "threshold": run.threshold.value,
+                "w_a": run.noise_model["group_weights"][0],
+                "w_e": run.noise_model["group_weights"][1],
+                "w_n": run.noise_model["group_weights"][2],
             }
         )
     return rows
@@ -142,6 +145,7 @@ def summarise(frame: pd.DataFrame, keys: list[str]) -> pd.DataFrame:
                 "95%_lo": lo,
                 "95%_hi": hi,
                 "threshold_median": float(g["threshold"].median()),
+                "weights_a_e_n": "/".join(f"{g[c].median():.2g}" for c in ("w_a", "w_e", "w_n")),
             }
         )
     return pd.DataFrame(rows)
@@ -210,6 +214,12 @@ def main() -> None:
                 f"  cells: realised/budget from {cells['ratio'].min():.2f} to {cells['ratio'].max():.2f}; "
                 f"cells whose 95% interval lies above 2x the budget: {int((cells['95%_lo'] > 2 * budget).sum())}"
             )
+    print("\nGroup weights (a/e/n) the detector learns from each real history itself (bootstrap cells above: the same")
+    print("noise should give similar weights; far-off weights mean the bootstrap changed the noise structure):")
+    for sat in REAL:
+        real = read_tle(DATA / "tle" / f"{sat}.tle")
+        w = detector_for(real).run(real, BUDGETS[0]).noise_model["group_weights"]
+        print(f"  {sat}: " + "/".join(f"{x:.2g}" for x in w))
     print(
         f"\n{len(todo)} histories, {frame['years'].sum() / len(BUDGETS):.0f} satellite-years per budget; "
         f"{time.perf_counter() - t0:.0f} s"
