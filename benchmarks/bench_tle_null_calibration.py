@@ -8,9 +8,10 @@ Every history here is maneuver-free, so every event is a false alarm. Two ensemb
   noise at the shared histories' level and 4× it; Student-t (3 dof) AR(1) noise, bad sets,
   irregular cadence and 3-10 day gaps;
 * **bootstrap**: the real noise of each shared history (residuals about a running median, in blocks
-  of 40 consecutive sets with their real gaps) from its quiet stretches, on a fresh smooth orbit;
-  false alarms and exposure are counted only at gaps whose step windows hold no junction between
-  blocks (a junction joins two unrelated stretches of slowly correlated noise: an artificial step).
+  of 60 consecutive sets with their real gaps) from its quiet stretches, on a fresh smooth orbit;
+  false alarms and exposure are counted only at gaps whose test (slope windows of 12 sets each
+  side, ±2-gap localisation) holds no junction between blocks (a junction joins two unrelated
+  stretches of slowly correlated noise: an artificial step).
   Quiet = farther than 3 days before / 12 days after every operator maneuver and every maneuver seen
   in the elements but absent from the operator file (:data:`UNLISTED`, docs/tle.md "GEO false
   alarms"): the operator files only keep maneuvers *out of* the noise blocks.
@@ -65,6 +66,7 @@ UNLISTED: dict[str, tuple[str, ...]] = {
     ),
 }
 BUDGETS = (FalseAlarmBudget(1.0, "year"), FalseAlarmBudget(12.0, "year"))
+BLOCK_SETS = 60  # bootstrap block length (sets); shorter quiet stretches give shorter blocks
 
 
 def run_one(job: tuple[str, dict[str, Any]]) -> list[dict[str, Any]]:
@@ -84,18 +86,21 @@ def run_one(job: tuple[str, dict[str, Any]]) -> list[dict[str, Any]]:
         times = [*truth["time_utc"], *(pd.Timestamp(x) for x in UNLISTED.get(sat, ()))]
         quiet = quiet_mask(real.elements["epoch_utc"], times)
         regime = REAL[sat][1]
-        history, junctions = bootstrap_null_history(real, quiet, regime=regime, years=p["years"], seed=p["seed"])
+        history, junctions = bootstrap_null_history(
+            real, quiet, regime=regime, years=p["years"], seed=p["seed"], block_sets=BLOCK_SETS
+        )
         label = f"{regime.upper()} bootstrap of {sat}"
     el = history.elements
     years = (el["epoch_utc"].iloc[-1] - el["epoch_utc"].iloc[0]).total_seconds() / 86400.0 / 365.25
     det = detector_for(history)
-    # gaps whose step windows (window_sets each side) hold no junction between noise blocks
+    # gaps whose test holds no junction between noise blocks: the slope windows (2 × window_sets
+    # sets each side) and the ±2-gap localisation of a change point
     n_gaps = len(el) - 1
-    w = det.settings.window_sets
+    reach = 2 * det.settings.window_sets + 3
     counted = np.ones(n_gaps, dtype=bool)
     if kind == "bootstrap":
         for j in junctions:  # sets j-1 and j come from different blocks
-            counted[max(0, j - w - 1) : j + w] = False
+            counted[max(0, j - reach - 1) : j + reach] = False
     years *= counted.mean()
     epochs = el["epoch_utc"].to_numpy(dtype="datetime64[ns]")
     rows = []

@@ -248,29 +248,45 @@ def simulate_null_history(spec: NullHistorySpec) -> ElementHistory:
     return history_from_series(t, out, spec.regime, norad=99900 + spec.seed % 99)
 
 
-def detector_residuals(history: ElementHistory, regime: str, median_sets: int = 31) -> dict[str, NDArray[np.float64]]:
+def detector_residuals(
+    history: ElementHistory,
+    regime: str,
+    median_sets: int = 31,
+    stretches: Sequence[tuple[int, int]] | None = None,
+) -> dict[str, NDArray[np.float64]]:
     """Residuals of a history's detector series about a centred running median of ``median_sets``
     sets (the slow orbit evolution; longer than the detector's 12-set window, so the noise the step
-    test sees is kept). GEO's ``u_m`` is the mean longitude's along-track phase (m)."""
+    test sees is kept). GEO's ``u_m`` is the mean longitude's along-track phase (m).
+
+    With ``stretches`` (set ranges ``[lo, hi)``) each stretch is detrended on its own sets only and
+    the residuals are NaN elsewhere: a running median that reached over a maneuver next to a quiet
+    stretch would put part of its step into the stretch's residuals.
+    """
     from abrupt.detect.tle_maneuvers import mean_element_series
 
     s = mean_element_series(history, regime)
+    t_all = s["t_s"]
     names = {"a_m": "a_m", "ex": "ex", "ey": "ey", "n1_rad": "i_rad", "n2_rad": "raan_resid_sin_i_rad", "u_m": "u_m"}
+    spans = list(stretches) if stretches is not None else [(0, t_all.size)]
     out: dict[str, NDArray[np.float64]] = {}
     for key, src in names.items():
-        y = np.asarray(s[src], dtype=float)
+        y_all = np.asarray(s[src], dtype=float)
         if key == "u_m" and regime == "geo":
-            y = _geo_phase_m(history, s["t_s"])
-        # a running median leaves zero residuals on a trend steeper than the noise: the trend (the
-        # running median of the set-to-set rates) is integrated out first
-        t = s["t_s"]
-        dt = np.diff(t)
-        rate = pd.Series(np.diff(y) / np.maximum(dt, 60.0)).rolling(median_sets, center=True, min_periods=3).median()
-        rate_v = rate.to_numpy()
-        trend = np.concatenate([[0.0], np.cumsum(np.nan_to_num(rate_v) * dt)])
-        flat = y - trend
-        med = pd.Series(flat).rolling(median_sets, center=True, min_periods=3).median().to_numpy()
-        out[key] = flat - med
+            y_all = _geo_phase_m(history, t_all)
+        res = np.full(t_all.size, np.nan)
+        for lo, hi in spans:
+            y, t = y_all[lo:hi], t_all[lo:hi]
+            if y.size < 3:
+                continue
+            # a running median leaves zero residuals on a trend steeper than the noise: the trend
+            # (the running median of the set-to-set rates) is integrated out first
+            dt = np.diff(t)
+            rate = pd.Series(np.diff(y) / np.maximum(dt, 60.0)).rolling(median_sets, center=True, min_periods=3)
+            trend = np.concatenate([[0.0], np.cumsum(np.nan_to_num(rate.median().to_numpy()) * dt)])
+            flat = y - trend
+            med = pd.Series(flat).rolling(median_sets, center=True, min_periods=3).median().to_numpy()
+            res[lo:hi] = flat - med
+        out[key] = res
     return out
 
 
@@ -306,7 +322,7 @@ def bootstrap_null_history(
     *,
     regime: str,
     years: float,
-    block_sets: int = 40,
+    block_sets: int = 60,
     seed: int = 0,
     altitude_km: float | None = None,
     median_sets: int = 31,
@@ -316,26 +332,23 @@ def bootstrap_null_history(
 
     Blocks of ``block_sets`` consecutive sets (fewer where a quiet stretch is shorter, at least 12)
     are drawn at random from the stretches where ``quiet`` holds, with their residuals
-    (:func:`detector_residuals`) and their gaps between sets; the first ``median_sets/2`` sets of
-    each stretch's ends are left out (the running median is one-sided there). Each block's residuals
+    (:func:`detector_residuals`, each stretch detrended on its own sets) and their gaps between
+    sets. Each block's residuals
     are centred on their median (its level is the running median's, zero); a junction still joins
     two unrelated stretches of slowly correlated noise, an artificial step that a null count should
     not include: gaps whose test windows reach over a junction are left out of the exposure
     (``benchmarks/bench_tle_null_calibration.py``).
     """
     rng = np.random.default_rng(seed)
-    res = detector_residuals(history, regime, median_sets)
     t_real = pd.to_datetime(history.elements["epoch_utc"]) - pd.to_datetime(history.elements["epoch_utc"]).iloc[0]
     t_real_d = t_real.dt.total_seconds().to_numpy() / SECONDS_PER_DAY
-    ok = quiet & np.all(np.isfinite(np.stack([res[k] for k in SERIES])), axis=0)
-    ok[:15] = ok[-15:] = False
-    # starts of blocks lying entirely inside quiet stretches
+    # quiet stretches of at least 12 sets; each is detrended on its own sets
     runs: list[tuple[int, int]] = []
     k = 0
-    while k < ok.size:
-        if ok[k]:
+    while k < quiet.size:
+        if quiet[k]:
             j = k
-            while j < ok.size and ok[j]:
+            while j < quiet.size and quiet[j]:
                 j += 1
             if j - k >= 12:
                 runs.append((k, j))
@@ -344,6 +357,7 @@ def bootstrap_null_history(
             k += 1
     if not runs:
         raise ValueError("no quiet stretch of at least 12 element sets to draw noise blocks from")
+    res = detector_residuals(history, regime, median_sets, runs)
     weights = np.array([r[1] - r[0] for r in runs], dtype=float)
     span = years * DAYS_PER_YEAR
     idx: list[int] = []
