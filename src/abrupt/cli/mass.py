@@ -23,7 +23,12 @@ def _options(orbit_period_s: float | None, tachometer_gate_s: float) -> Momentum
     return MomentumOptions(orbit_period_s=orbit_period_s, tachometer_gate_s=tachometer_gate_s)
 
 
-_store = click.option("--store", type=click.Path(file_okay=False), default=None, help="Folder of telemetry files.")
+_store = click.option(
+    "--store",
+    type=click.Path(file_okay=False),
+    default=None,
+    help="The ingest store (abrupt ingest), or a folder of telemetry files.",
+)
 _spacecraft = click.option("--spacecraft", "spacecraft_file", required=True, type=click.Path(dir_okay=False))
 _orbit = click.option(
     "--orbit-period",
@@ -84,12 +89,12 @@ def estimate_inertia_cmd(
     from abrupt.pipelines.mass import (
         estimate_inertia_run,
         inertia_report,
-        telemetry_paths,
+        telemetry_input,
         updated_spacecraft_toml,
         write_report,
     )
 
-    paths = telemetry_paths(store, telemetry)
+    paths = telemetry_input(store, telemetry)
     est, sc, repairs = estimate_inertia_run(
         paths,
         spacecraft_file,
@@ -132,11 +137,11 @@ def detect_mass_change_cmd(
 ) -> None:
     """Track the inertia window by window and report a mass change (GLR at the false-alarm budget)."""
     from abrupt.events import config_hash, new_run_id, read_events
-    from abrupt.pipelines.mass import detect_mass_change_run, telemetry_paths
+    from abrupt.pipelines.mass import detect_mass_change_run, telemetry_input
     from abrupt.thresholds import FalseAlarmBudget
 
     budget = FalseAlarmBudget.parse(budget_text)
-    paths = telemetry_paths(store, telemetry)
+    paths = telemetry_input(store, telemetry)
     att = read_events(attitude_events) if attitude_events else None
     run_id = new_run_id()
     cfg = config_hash({"window_s": window_s, "budget": str(budget), "radius_m": radius_m, "sc": spacecraft_file})
