@@ -57,7 +57,12 @@ def track(days: float, docking_day: float | None, seed: int, sim_rate_hz: float)
         seed=seed,
     )
     t0 = time.perf_counter()
-    tr = simulated_inertia_track(SPACECRAFT, scen)
+    dumps: list = []
+    tr = simulated_inertia_track(SPACECRAFT, scen, dumps_out=dumps)
+    print(
+        f"    {len(dumps)} momentum dumps (system momentum above {scen.dump_threshold_Nms} N m s at the start of"
+        f" a day), on days {[round(t / 86400.0, 2) for t, _ in dumps]}"
+    )
     return tr, time.perf_counter() - t0
 
 

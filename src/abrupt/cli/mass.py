@@ -194,6 +194,14 @@ def detect_mass_change_cmd(
     help="Attachment point from the CoM, body axes [m].",
 )
 @click.option("--orbit-period", "orbit_period_s", type=float, default=5926.4, show_default=True)
+@click.option(
+    "--dump-threshold",
+    "dump_threshold_Nms",
+    type=float,
+    default=0.5,
+    show_default=True,
+    help="Momentum dump when the system momentum exceeds this at the start of a day [N m s]; <=0: no dumps.",
+)
 @click.option("--seed", type=int, default=0, show_default=True)
 def simulate_docking_cmd(
     spacecraft_file: str,
@@ -203,9 +211,11 @@ def simulate_docking_cmd(
     mass_kg: float,
     attachment: tuple[float, float, float],
     orbit_period_s: float,
+    dump_threshold_Nms: float,
     seed: int,
 ) -> None:
-    """Simulate routine telemetry (nadir pointing, slews) with a parasite docking; one CSV per day."""
+    """Simulate routine telemetry (nadir pointing, slews, momentum dumps) with a parasite docking; one CSV
+    per day (the dumps are listed in docking_truth.json)."""
     from abrupt.pipelines.mass import simulate_docking_run
     from abrupt.simulate.attitude import CircularOrbit
     from abrupt.simulate.docking import DockingScenario
@@ -216,6 +226,7 @@ def simulate_docking_cmd(
         parasite_mass_kg=mass_kg,
         attachment_B_m=attachment,
         orbit=CircularOrbit(period_s=orbit_period_s),
+        dump_threshold_Nms=dump_threshold_Nms if dump_threshold_Nms > 0 else None,
         seed=seed,
     )
     paths = simulate_docking_run(spacecraft_file, out_dir, scenario)

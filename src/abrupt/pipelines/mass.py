@@ -395,6 +395,7 @@ def simulate_docking_run(spacecraft_file: str | Path, out_dir: str | Path, scena
         "inertia_before_kgm2": sim.inertia_before_kgm2.tolist(),
         "inertia_after_kgm2": sim.inertia_after_kgm2.tolist(),
         "contact_dH_N_Nms": [None if not math.isfinite(v) else v for v in sim.contact_dH_N_Nms.tolist()],
+        "momentum_dumps": [{"time_s": t, "dH_N_Nms": dh.tolist()} for t, dh in sim.dumps],
     }
     (out / "docking_truth.json").write_text(json.dumps(truth, indent=1))
     written.append(out / "docking_truth.json")
@@ -407,13 +408,14 @@ def simulated_inertia_track(
     *,
     epoch_utc: str = "2026-01-01T00:00:00Z",
     progress: object = None,
+    dumps_out: list[tuple[float, np.ndarray]] | None = None,
     **estimator_options: object,
 ) -> InertiaTrack:
     """One inertia estimate per simulated day of :func:`~abrupt.simulate.docking.docking_days` (days are
     simulated, estimated and dropped one at a time: memory does not grow with the number of days).
 
     Used to check the mass-change detector's false-alarm rate over a simulated year. ``progress`` is an
-    optional callable ``(day_index, estimate)``.
+    optional callable ``(day_index, estimate)``; the momentum dumps are appended to ``dumps_out``.
     """
     from abrupt.massprops.telemetry import momentum_data_from_simulation
     from abrupt.simulate.docking import DockingScenario, docking_days
@@ -421,7 +423,14 @@ def simulated_inertia_track(
     assert isinstance(scenario, DockingScenario)
     j_cat = check_catalogue(spacecraft)
     rows = []
-    for d, day in enumerate(docking_days(spacecraft, scenario)):
+    dumps: list[tuple[float, np.ndarray]] = [] if dumps_out is None else dumps_out
+    for d, day in enumerate(docking_days(spacecraft, scenario, dumps_out=dumps)):
+        # The thruster flag of the day's dumps (the flight telemetry's dump flag): on for the firing.
+        fired = [t for t, _ in dumps if day.t_s[0] <= t <= day.t_s[-1]]
+        flag = None
+        if fired:
+            t_f = np.array([day.t_s[0], *[x for t in fired for x in (t, t + scenario.dump_duration_s)]])
+            flag = (t_f, np.array([0.0, *[x for _ in fired for x in (1.0, 0.0)]]))
         data = momentum_data_from_simulation(
             day,
             spacecraft.wheel_axes,
@@ -429,6 +438,7 @@ def simulated_inertia_track(
             orbit_period_s=scenario.orbit.period_s,
             appendage_axis_B=scenario.appendage_axis_B,
             appendage_spin_inertia_kgm2=scenario.appendage_spin_inertia_kgm2,
+            thruster_flag=flag,
         )
         est = estimate_inertia(data, j_cat, **estimator_options)  # type: ignore[arg-type]
         rows.append((float(day.t_s[0]), float(day.t_s[-1]), est))
