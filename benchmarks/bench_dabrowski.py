@@ -9,11 +9,15 @@ baseline runs Phase A uses (``fit_gyro_error_model`` + ``momentum_exchange_ml``)
 it prints the white-noise floor (``white_noise_floor``: the Cramér-Rao bound if the gyro's white noise
 were its only error).
 
-The testbed noise (``TestbedNoise``) was calibrated on the thesis's 1° single-run SD only; the 0.5° and
-2° figures are predictions. ``--groups K`` runs K ten-run groups per configuration (4K ten-run means per
-amplitude; the thesis layout is K = 1) and prints each method's mean error with its standard error.
-Run: ``PYTHONPATH=src nice python benchmarks/bench_dabrowski.py [--quick] [--groups K] [--amplitudes 0.5,1,2]
-[--seed S]``.
+The testbed noise is ``THESIS_TESTBED`` (session 4: tracked gyro drift chosen by Table 4.4's Method 1
+errors with one amplitude held out, white rate noise and wheel gain fitted to the six single-run SDs of
+Tables 4.3-4.4; ``calibrate_dabrowski_noise.py``); ``--session3-noise`` is session 3's (1° SD only),
+``--noise WG_SD,RATE_DEG_S,DRIFT_DEG_MIN`` another, ``--gyro-scale-sd`` adds a run-to-run gyro scale error.
+``--experiments E`` runs E independent thesis-layout experiments per amplitude (each with its own Phase A)
+and prints means with 95% bootstrap intervals over experiments and the percentile of the thesis's
+value; ``--groups K`` (session 3) runs K ten-run groups per configuration sharing one Phase A.
+Run: ``PYTHONPATH=src nice python benchmarks/bench_dabrowski.py [--experiments 30] [--groups K]
+[--amplitudes 0.5,1,2] [--seed S]``.
 """
 
 from __future__ import annotations
@@ -28,6 +32,7 @@ import numpy as np
 from abrupt.massprops.simsat import (
     I33_BASELINE,
     MOI_CONFIGS,
+    THESIS_TESTBED,
     Maneuver,
     SimsatParams,
     TestbedNoise,
@@ -44,9 +49,7 @@ from abrupt.massprops.simsat import (
 )
 
 NOISE_SESSION3 = TestbedNoise(wheel_gain_sd=0.025, wander_deg=0.06, rate_noise_deg_s=0.07)
-NOISE = TestbedNoise(
-    wheel_gain_sd=0.023, gyro_bias_deg_min=-2.5, gyro_bias_sd_deg_min=0.0, wander_deg=0.06, rate_noise_deg_s=0.040
-)
+NOISE = THESIS_TESTBED  # calibrated by benchmarks/calibrate_dabrowski_noise.py and --experiments (docs)
 THESIS = {  # Table 4.4 / 4.3: mean error, mean range, mean SD (Method 1); baseline SD
     0.5: (0.03518, 0.2398, 0.07733, 0.0416),
     1.0: (0.01160, 0.1094, 0.03351, 0.0313),
@@ -264,12 +267,15 @@ if __name__ == "__main__":
     ap.add_argument("--experiments", type=int, default=0, help="independent thesis-layout experiments instead")
     ap.add_argument("--noise", default="", help="wheel_gain_sd,rate_noise_deg_s,gyro_bias_deg_min (else NOISE)")
     ap.add_argument("--session3-noise", action="store_true", help="the testbed noise of session 3")
+    ap.add_argument("--gyro-scale-sd", type=float, default=0.0, help="run-to-run gyro scale-factor SD (relative)")
     args = ap.parse_args()
     if args.noise:
         wg_sd, rate, drift = (float(v) for v in args.noise.split(","))
         NOISE = replace(NOISE, wheel_gain_sd=wg_sd, rate_noise_deg_s=rate, gyro_bias_deg_min=drift)
     if args.session3_noise:
         NOISE = NOISE_SESSION3
+    if args.gyro_scale_sd:
+        NOISE = replace(NOISE, gyro_scale_sd=args.gyro_scale_sd)
     amps = tuple(float(a) for a in args.amplitudes.split(","))
     if args.experiments:
         experiments(args.experiments, amps, args.seed, NOISE)

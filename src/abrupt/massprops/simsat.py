@@ -108,8 +108,10 @@ class TestbedNoise:
     recorded attitude; the controller flies it); ``deadband_max_rad_s``: the motor ignores a commanded
     change of wheel speed smaller than a per-run dead band drawn uniformly in [0, this] (friction against
     a motor loop without integral action, thesis Table 3.3 and App. B); ``torque_sd_nm``: a constant
-    external yaw torque per run (air-bearing and air-current torques), normal with this SD. The last two
-    draw random numbers only when non-zero, so the other sources' draws do not change.
+    external yaw torque per run (air-bearing and air-current torques), normal with this SD;
+    ``gyro_scale_sd``: relative SD of the rate gyro's scale factor from run to run (temperature; Table 3.1
+    quotes a 3% accuracy at half range). The last three draw random numbers only when non-zero, so the
+    other sources' draws do not change.
     """
 
     wheel_gain_sd: float = 0.03
@@ -122,6 +124,7 @@ class TestbedNoise:
     rate_noise_deg_s: float = 0.0
     deadband_max_rad_s: float = 0.0
     torque_sd_nm: float = 0.0
+    gyro_scale_sd: float = 0.0
 
 
 # The synthetic testbed calibrated on the thesis (benchmarks/calibrate_dabrowski_noise.py and
@@ -148,6 +151,7 @@ def simulate_simsat(
     lut_slope_per_s: ArrayLike | None = None,
     deadband_rad_s: ArrayLike | None = None,
     external_torque_nm: ArrayLike | None = None,
+    gyro_scale: ArrayLike | None = None,
 ) -> dict[str, FloatArray]:
     """Simulate a batch of runs (columns) of the closed-loop yaw response.
 
@@ -155,14 +159,15 @@ def simulate_simsat(
     true yaw to give the measured (gyro-integrated) attitude the controller flies and the telemetry
     records. ``deadband_rad_s`` (m,): the motor ignores the part of a commanded wheel-speed change inside
     this band; ``external_torque_nm`` (m,): a constant yaw torque on the body (the momentum
-    (I33 + I_rw) Ω + I_rw ω then grows at exactly this rate). Returns ``t_s`` (n,), ``command_rad`` (n,),
+    (I33 + I_rw) Ω + I_rw ω then grows at exactly this rate); ``gyro_scale`` (m,): the gyro reads
+    this factor times the true rate (default 1). Returns ``t_s`` (n,), ``command_rad`` (n,),
     ``yaw_meas_rad``, ``yaw_true_rad``, ``wheel_speed_rad_s`` and ``body_rate_rad_s`` (n, m).
     """
     t = maneuver.times(params.dt_s)
     n = t.size
     i33 = np.atleast_1d(np.asarray(params.i33_kgm2 if i33_kgm2 is None else i33_kgm2, dtype=np.float64))
     wg = np.atleast_1d(np.asarray(params.wheel_gain if wheel_gain is None else wheel_gain, dtype=np.float64))
-    sizes = [np.size(v) for v in (lut_slope_per_s, deadband_rad_s, external_torque_nm) if v is not None]
+    sizes = [np.size(v) for v in (lut_slope_per_s, deadband_rad_s, external_torque_nm, gyro_scale) if v is not None]
     m = max(i33.size, wg.size, 1 if gyro_error_rad is None else gyro_error_rad.shape[1], *sizes)
     i33 = np.broadcast_to(i33, (m,))
     wg = np.broadcast_to(wg, (m,))
@@ -172,6 +177,7 @@ def simulate_simsat(
     )
     dead = np.broadcast_to(np.asarray(0.0 if deadband_rad_s is None else deadband_rad_s, dtype=np.float64), (m,))
     tau = np.broadcast_to(np.asarray(0.0 if external_torque_nm is None else external_torque_nm, dtype=np.float64), (m,))
+    scale = np.broadcast_to(np.asarray(1.0 if gyro_scale is None else gyro_scale, dtype=np.float64), (m,))
     err_rate = np.gradient(err, params.dt_s, axis=0)
     cmd = maneuver.command_rad(t)
     dt = params.dt_s
@@ -185,10 +191,10 @@ def simulate_simsat(
     out_w = np.empty((n, m))
     out_om = np.empty((n, m))
     for k in range(n):
-        meas = psi + err[k]
+        meas = scale * psi + err[k]
         out_psi[k], out_meas[k], out_w[k], out_om[k] = psi, meas, w, om
         e = cmd[k] - meas
-        w_cmd = -(params.gain_kp * e + params.gain_kd * (-(om + err_rate[k])))
+        w_cmd = -(params.gain_kp * e + params.gain_kd * (-(scale * om + err_rate[k])))
         queue.append(w_cmd)
         w_cmd_delayed = queue.pop(0)
         dw = w_cmd_delayed - w
@@ -230,7 +236,10 @@ def testbed_runs(
     k_lut = params.k_lut_per_s * (1.0 + noise.lut_slope_sd * rng.standard_normal(n_runs))
     dead = noise.deadband_max_rad_s * rng.uniform(0.0, 1.0, n_runs) if noise.deadband_max_rad_s > 0 else None
     tau = noise.torque_sd_nm * rng.standard_normal(n_runs) if noise.torque_sd_nm > 0 else None
-    sim = simulate_simsat(params, maneuver, i33_kgm2, wg, err, k_lut, deadband_rad_s=dead, external_torque_nm=tau)
+    scale = 1.0 + noise.gyro_scale_sd * rng.standard_normal(n_runs) if noise.gyro_scale_sd > 0 else None
+    sim = simulate_simsat(
+        params, maneuver, i33_kgm2, wg, err, k_lut, deadband_rad_s=dead, external_torque_nm=tau, gyro_scale=scale
+    )
     sim["wheel_speed_meas_rad_s"] = sim["wheel_speed_rad_s"] + noise.encoder_noise_rad_s * rng.standard_normal(
         sim["wheel_speed_rad_s"].shape
     )
