@@ -523,7 +523,9 @@ def test_docking_simulator_dumps_momentum_and_the_estimate_is_unaffected():
     from abrupt.simulate.docking import DockingScenario, simulate_docking
 
     sc = spacecraft_from_dict(tomllib.loads(_SC_FLIGHT))
-    scen = DockingScenario(days=2.0, docking_time_s=None, torque_N_Nm=(3e-5, -2e-5, 1e-5), sim_rate_hz=1.0, seed=3)
+    scen = DockingScenario(
+        days=2.0, docking_time_s=None, torque_N_Nm=(3e-5, -2e-5, 1e-5), sim_rate_hz=1.0, seed=3, dump_threshold_Nms=0.5
+    )
     sim = simulate_docking(sc, scen)
     assert len(sim.dumps) == 1
     t_dump, dh = sim.dumps[0]
