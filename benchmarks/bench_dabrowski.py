@@ -9,11 +9,15 @@ baseline runs Phase A uses (``fit_gyro_error_model`` + ``momentum_exchange_ml``)
 it prints the white-noise floor (``white_noise_floor``: the Cramér-Rao bound if the gyro's white noise
 were its only error).
 
-The testbed noise (``TestbedNoise``) was calibrated on the thesis's 1° single-run SD only; the 0.5° and
-2° figures are predictions. ``--groups K`` runs K ten-run groups per configuration (4K ten-run means per
-amplitude; the thesis layout is K = 1) and prints each method's mean error with its standard error.
-Run: ``PYTHONPATH=src nice python benchmarks/bench_dabrowski.py [--quick] [--groups K] [--amplitudes 0.5,1,2]
-[--seed S]``.
+The testbed noise is ``THESIS_TESTBED`` (session 4: tracked gyro drift chosen by Table 4.4's Method 1
+errors with one amplitude held out, white rate noise and wheel gain fitted to the six single-run SDs of
+Tables 4.3-4.4; ``calibrate_dabrowski_noise.py``); ``--session3-noise`` is session 3's (1° SD only),
+``--noise WG_SD,RATE_DEG_S,DRIFT_DEG_MIN`` another, ``--gyro-scale-sd`` adds a run-to-run gyro scale error.
+``--experiments E`` runs E independent thesis-layout experiments per amplitude (each with its own Phase A)
+and prints means with 95% bootstrap intervals over experiments and the percentile of the thesis's
+value; ``--groups K`` (session 3) runs K ten-run groups per configuration sharing one Phase A.
+Run: ``PYTHONPATH=src nice python benchmarks/bench_dabrowski.py [--experiments 30] [--groups K]
+[--amplitudes 0.5,1,2] [--seed S]``.
 """
 
 from __future__ import annotations
@@ -21,17 +25,19 @@ from __future__ import annotations
 import argparse
 import math
 import time
+from dataclasses import replace
 
 import numpy as np
 
 from abrupt.massprops.simsat import (
     I33_BASELINE,
     MOI_CONFIGS,
+    THESIS_TESTBED,
     Maneuver,
     SimsatParams,
     TestbedNoise,
     aggregate,
-    estimate_run_i33,
+    estimate_runs_i33,
     fit_gyro_error_model,
     min_detectable_mass,
     min_detectable_mass_over_box,
@@ -42,7 +48,8 @@ from abrupt.massprops.simsat import (
     white_noise_floor,
 )
 
-NOISE = TestbedNoise(wheel_gain_sd=0.025, wander_deg=0.06, rate_noise_deg_s=0.07)
+NOISE_SESSION3 = TestbedNoise(wheel_gain_sd=0.025, wander_deg=0.06, rate_noise_deg_s=0.07)
+NOISE = THESIS_TESTBED  # calibrated by benchmarks/calibrate_dabrowski_noise.py and --experiments (docs)
 THESIS = {  # Table 4.4 / 4.3: mean error, mean range, mean SD (Method 1); baseline SD
     0.5: (0.03518, 0.2398, 0.07733, 0.0416),
     1.0: (0.01160, 0.1094, 0.03351, 0.0313),
@@ -76,7 +83,7 @@ def main(
         tuned = phase_a(params, man, [base["yaw_meas_rad"][:, k] for k in range(n_base)])
         # The same baseline runs fit the gyro's error model (the ML method's analogue of Phase A).
         gyro = fit_gyro_error_model(base["t_s"], base["yaw_meas_rad"], base["wheel_speed_meas_rad_s"], I33_BASELINE)
-        base_est = np.array([estimate_run_i33(tuned, man, base["yaw_meas_rad"][:, k])[0] for k in range(n_base)])
+        base_est, _ = estimate_runs_i33(tuned, man, base["yaw_meas_rad"])
         base_norm = base_est / I33_BASELINE
         yb, wb = base["yaw_meas_rad"], base["wheel_speed_meas_rad_s"]
         base_ml = [momentum_exchange_ml(base["t_s"], yb[:, k], wb[:, k], gyro).i33_kgm2 for k in range(n_base)]
@@ -86,9 +93,8 @@ def main(
         for i_true in MOI_CONFIGS[1:]:
             runs = testbed_runs(params, man, i_true, n_runs, NOISE, rng)
             y, w = runs["yaw_meas_rad"], runs["wheel_speed_meas_rad_s"]
-            fits = [estimate_run_i33(tuned, man, y[:, k]) for k in range(n_runs)]
-            est = np.array([f[0] for f in fits]) / i_true
-            mean_err = np.array([f[1] for f in fits])
+            est, mean_err = estimate_runs_i33(tuned, man, y)
+            est = est / i_true
             ls = np.array([momentum_exchange_estimate(runs["t_s"], y[:, k], w[:, k], man) for k in range(n_runs)])
             ml_fits = [momentum_exchange_ml(runs["t_s"], y[:, k], w[:, k], gyro) for k in range(n_runs)]
             ml = np.array([f.i33_kgm2 for f in ml_fits])
@@ -153,11 +159,125 @@ def main(
     print(f"elapsed {time.time() - t0:.0f} s")
 
 
+def one_experiment(amp: float, rng: np.random.Generator, noise: TestbedNoise) -> dict[str, float]:
+    """One thesis-layout experiment at ``amp``: its own Phase A, four added-mass configurations of 10 runs.
+
+    Returns Table 4.3/4.4's statistics for Method 1 (mean error and mean SD over the four configurations,
+    baseline SD), the ML momentum method's mean error on the same runs and the white-noise floor's
+    expected ten-run error, and how many of the four changes each method detects.
+    """
+    params, man = SimsatParams(), Maneuver.thesis(amp)
+    n_base = 25 if amp == 1.0 else 10
+    base = testbed_runs(params, man, I33_BASELINE, n_base, noise, rng)
+    tuned = phase_a(params, man, [base["yaw_meas_rad"][:, k] for k in range(n_base)])
+    gyro = fit_gyro_error_model(base["t_s"], base["yaw_meas_rad"], base["wheel_speed_meas_rad_s"], I33_BASELINE)
+    base_est, _ = estimate_runs_i33(tuned, man, base["yaw_meas_rad"])
+    s0 = float(np.std(base_est / I33_BASELINE, ddof=1))
+    yb, wb = base["yaw_meas_rad"], base["wheel_speed_meas_rad_s"]
+    base_ml = [momentum_exchange_ml(base["t_s"], yb[:, k], wb[:, k], gyro).i33_kgm2 for k in range(n_base)]
+    s0_ml = float(np.std(base_ml, ddof=1)) / I33_BASELINE
+    out = {"base_sd": s0, "m1": 0.0, "sd": 0.0, "range": 0.0, "ml": 0.0, "ml_sd": 0.0, "floor": 0.0}
+    out |= {"det_m1": 0.0, "det_ml": 0.0, "bias_m1": 0.0}
+    rate = math.radians(noise.rate_noise_deg_s)
+    for i_true in MOI_CONFIGS[1:]:
+        runs = testbed_runs(params, man, i_true, 10, noise, rng)
+        y, w = runs["yaw_meas_rad"], runs["wheel_speed_meas_rad_s"]
+        est, _ = estimate_runs_i33(tuned, man, y)
+        x = est / i_true
+        ml = np.array([momentum_exchange_ml(runs["t_s"], y[:, k], w[:, k], gyro).i33_kgm2 for k in range(10)])
+        floor = [
+            white_noise_floor(runs["t_s"], runs["wheel_speed_rad_s"][:, k], i_true, rate) / i_true for k in range(10)
+        ]
+        out["m1"] += abs(float(np.mean(x)) - 1.0) / 4
+        out["bias_m1"] += (float(np.mean(x)) - 1.0) / 4
+        out["sd"] += float(np.std(x, ddof=1)) / 4
+        out["range"] += float(np.ptp(x)) / 4
+        out["ml"] += abs(float(np.mean(ml)) / i_true - 1.0) / 4
+        out["ml_sd"] += float(np.std(ml / i_true, ddof=1)) / 4
+        # Expected |error| of a ten-run mean at the floor: E|N(0, σ²/10)| = σ/√10 · √(2/π).
+        out["floor"] += float(np.mean(floor)) / math.sqrt(10) * math.sqrt(2 / math.pi) / 4
+        out["det_m1"] += float(np.mean(est) / I33_BASELINE - 1 > 2.326 * s0 / math.sqrt(10))
+        out["det_ml"] += float(np.mean(ml) / I33_BASELINE - 1 > 2.326 * s0_ml / math.sqrt(10))
+    return out
+
+
+def _boot(x: np.ndarray, stat: object, rng: np.random.Generator, n: int = 4000) -> tuple[float, float]:
+    """Percentile bootstrap 95% interval of ``stat`` over rows (independent experiments)."""
+    idx = rng.integers(0, x.shape[0], (n, x.shape[0]))
+    vals = np.array([stat(x[i]) for i in idx])  # type: ignore[operator]
+    return float(np.quantile(vals, 0.025)), float(np.quantile(vals, 0.975))
+
+
+def experiments(n_exp: int, amplitudes: tuple[float, ...], seed: int, noise: TestbedNoise) -> None:
+    """``n_exp`` independent thesis-layout experiments per amplitude; bootstrap intervals over experiments."""
+    t0 = time.time()
+    print(f"{n_exp} independent experiments per amplitude (thesis layout), seed {seed}; noise {noise}")
+    boot_rng = np.random.default_rng(seed + 1)
+    best_ml = {}
+    for amp in amplitudes:
+        rng = np.random.default_rng([seed, round(100 * amp)])
+        rows = [one_experiment(amp, rng, noise) for _ in range(n_exp)]
+        keys = list(rows[0])
+        x = np.array([[r[k] for k in keys] for r in rows])
+        col = {k: x[:, i] for i, k in enumerate(keys)}
+        th = THESIS[amp]
+
+        def ci(k: str, col: dict[str, np.ndarray] = col) -> str:
+            lo, hi = _boot(col[k][:, None], lambda v: float(np.mean(v)), boot_rng)
+            return f"{100 * col[k].mean():.2f}% ({100 * lo:.2f}-{100 * hi:.2f}; SD {100 * col[k].std(ddof=1):.2f})"
+
+        def pct(k: str, v: float, col: dict[str, np.ndarray] = col) -> str:
+            return f"{100 * float(np.mean(col[k] <= v)):.0f}th pct"
+
+        i1, i2 = keys.index("m1"), keys.index("ml")
+        ratio = float(col["m1"].mean() / col["ml"].mean())
+        rlo, rhi = _boot(x, lambda v, i1=i1, i2=i2: float(np.mean(v[:, i1]) / np.mean(v[:, i2])), boot_rng)
+        best_ml[amp] = float(col["ml"].mean())
+        print(
+            f"{amp:.1f}°: M1 mean error {ci('m1')} [thesis {100 * th[0]:.2f}%, {pct('m1', th[0])}],"
+            f" single-run SD {ci('sd')} [thesis {100 * th[2]:.2f}%, {pct('sd', th[2])}],"
+            f" range {100 * col['range'].mean():.1f}% [thesis {100 * th[1]:.1f}%],"
+            f" baseline SD {ci('base_sd')} [thesis {100 * th[3]:.2f}%, {pct('base_sd', th[3])}],"
+            f" M1 signed bias {100 * col['bias_m1'].mean():+.2f}%"
+        )
+        print(
+            f"      ML mean error {ci('ml')}, single-run SD {100 * col['ml_sd'].mean():.2f}%;"
+            f" white-noise floor's ten-run error {100 * col['floor'].mean():.2f}%;"
+            f" ratio M1/ML {ratio:.2f}x (95% {rlo:.2f}-{rhi:.2f});"
+            f" M1/floor {col['m1'].mean() / col['floor'].mean():.2f}x;"
+            f" changes detected M1 {col['det_m1'].sum():.0f}/{4 * n_exp}, ML {col['det_ml'].sum():.0f}/{4 * n_exp}",
+            flush=True,
+        )
+    if 2.0 in best_ml:
+        gps = min_detectable_mass(GPS_I, (0.8, 0.0, 0.0), best_ml[2.0])
+        box = min_detectable_mass_over_box(GPS_I, (0.8, 0.8, 0.8), best_ml[2.0])
+        print(
+            f"GPS-IIR with the ML method's 2° mean error {100 * best_ml[2.0]:.3f}%: {gps.minimum_kg:.2f} kg at"
+            f" rho=[0.8,0,0] (thesis 8.2 kg at 0.67%); worst point of the 1.6 m cube {box.worst_minimum_kg:.2f} kg"
+        )
+    print(f"elapsed {time.time() - t0:.0f} s")
+
+
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--groups", type=int, default=1, help="ten-run groups per configuration")
     ap.add_argument("--amplitudes", default="0.5,1,2", help="comma-separated maneuver amplitudes [deg]")
     ap.add_argument("--seed", type=int, default=2003)
+    ap.add_argument("--experiments", type=int, default=0, help="independent thesis-layout experiments instead")
+    ap.add_argument("--noise", default="", help="wheel_gain_sd,rate_noise_deg_s,gyro_bias_deg_min (else NOISE)")
+    ap.add_argument("--session3-noise", action="store_true", help="the testbed noise of session 3")
+    ap.add_argument("--gyro-scale-sd", type=float, default=0.0, help="run-to-run gyro scale-factor SD (relative)")
     args = ap.parse_args()
-    main(args.quick, args.groups, tuple(float(a) for a in args.amplitudes.split(",")), args.seed)
+    if args.noise:
+        wg_sd, rate, drift = (float(v) for v in args.noise.split(","))
+        NOISE = replace(NOISE, wheel_gain_sd=wg_sd, rate_noise_deg_s=rate, gyro_bias_deg_min=drift)
+    if args.session3_noise:
+        NOISE = NOISE_SESSION3
+    if args.gyro_scale_sd:
+        NOISE = replace(NOISE, gyro_scale_sd=args.gyro_scale_sd)
+    amps = tuple(float(a) for a in args.amplitudes.split(","))
+    if args.experiments:
+        experiments(args.experiments, amps, args.seed, NOISE)
+    else:
+        main(args.quick, args.groups, amps, args.seed)

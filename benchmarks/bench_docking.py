@@ -15,7 +15,9 @@ day (days are simulated, estimated and dropped one at a time), the ``mass.inerti
   independent days) and the detector run on each: false alarms per year with a 95% interval.
 
 Seeds differ from every test.
-Run: ``OMP_NUM_THREADS=1 PYTHONPATH=src nice python benchmarks/bench_docking.py [--year]``.
+``--dumps``: the simulator dumps momentum (system momentum above 0.5 N m s at the start of a day is removed
+by a flagged thruster impulse that day; session 4).
+Run: ``OMP_NUM_THREADS=1 PYTHONPATH=src nice python benchmarks/bench_docking.py [--year] [--dumps]``.
 """
 
 from __future__ import annotations
@@ -55,9 +57,15 @@ def track(days: float, docking_day: float | None, seed: int, sim_rate_hz: float)
         truth_inertia_kgm2=tuple(map(tuple, J_TRUE)),
         sim_rate_hz=sim_rate_hz,
         seed=seed,
+        dump_threshold_Nms=0.5 if "--dumps" in sys.argv else None,
     )
     t0 = time.perf_counter()
-    tr = simulated_inertia_track(SPACECRAFT, scen)
+    dumps: list = []
+    tr = simulated_inertia_track(SPACECRAFT, scen, dumps_out=dumps)
+    print(
+        f"    {len(dumps)} momentum dumps (system momentum above {scen.dump_threshold_Nms} N m s at the start of"
+        f" a day), on days {[round(t / 86400.0, 2) for t, _ in dumps]}"
+    )
     return tr, time.perf_counter() - t0
 
 

@@ -23,7 +23,12 @@ def _options(orbit_period_s: float | None, tachometer_gate_s: float) -> Momentum
     return MomentumOptions(orbit_period_s=orbit_period_s, tachometer_gate_s=tachometer_gate_s)
 
 
-_store = click.option("--store", type=click.Path(file_okay=False), default=None, help="Folder of telemetry files.")
+_store = click.option(
+    "--store",
+    type=click.Path(file_okay=False),
+    default=None,
+    help="The ingest store (abrupt ingest), or a folder of telemetry files.",
+)
 _spacecraft = click.option("--spacecraft", "spacecraft_file", required=True, type=click.Path(dir_okay=False))
 _orbit = click.option(
     "--orbit-period",
@@ -84,12 +89,12 @@ def estimate_inertia_cmd(
     from abrupt.pipelines.mass import (
         estimate_inertia_run,
         inertia_report,
-        telemetry_paths,
+        telemetry_input,
         updated_spacecraft_toml,
         write_report,
     )
 
-    paths = telemetry_paths(store, telemetry)
+    paths = telemetry_input(store, telemetry)
     est, sc, repairs = estimate_inertia_run(
         paths,
         spacecraft_file,
@@ -132,11 +137,11 @@ def detect_mass_change_cmd(
 ) -> None:
     """Track the inertia window by window and report a mass change (GLR at the false-alarm budget)."""
     from abrupt.events import config_hash, new_run_id, read_events
-    from abrupt.pipelines.mass import detect_mass_change_run, telemetry_paths
+    from abrupt.pipelines.mass import detect_mass_change_run, telemetry_input
     from abrupt.thresholds import FalseAlarmBudget
 
     budget = FalseAlarmBudget.parse(budget_text)
-    paths = telemetry_paths(store, telemetry)
+    paths = telemetry_input(store, telemetry)
     att = read_events(attitude_events) if attitude_events else None
     run_id = new_run_id()
     cfg = config_hash({"window_s": window_s, "budget": str(budget), "radius_m": radius_m, "sc": spacecraft_file})
@@ -189,6 +194,14 @@ def detect_mass_change_cmd(
     help="Attachment point from the CoM, body axes [m].",
 )
 @click.option("--orbit-period", "orbit_period_s", type=float, default=5926.4, show_default=True)
+@click.option(
+    "--dump-threshold",
+    "dump_threshold_Nms",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="Momentum dump when the system momentum exceeds this at the start of a day [N m s] (e.g. 0.5); 0: none.",
+)
 @click.option("--seed", type=int, default=0, show_default=True)
 def simulate_docking_cmd(
     spacecraft_file: str,
@@ -198,9 +211,11 @@ def simulate_docking_cmd(
     mass_kg: float,
     attachment: tuple[float, float, float],
     orbit_period_s: float,
+    dump_threshold_Nms: float,
     seed: int,
 ) -> None:
-    """Simulate routine telemetry (nadir pointing, slews) with a parasite docking; one CSV per day."""
+    """Simulate routine telemetry (nadir pointing, slews, momentum dumps) with a parasite docking; one CSV
+    per day (the dumps are listed in docking_truth.json)."""
     from abrupt.pipelines.mass import simulate_docking_run
     from abrupt.simulate.attitude import CircularOrbit
     from abrupt.simulate.docking import DockingScenario
@@ -211,6 +226,7 @@ def simulate_docking_cmd(
         parasite_mass_kg=mass_kg,
         attachment_B_m=attachment,
         orbit=CircularOrbit(period_s=orbit_period_s),
+        dump_threshold_Nms=dump_threshold_Nms if dump_threshold_Nms > 0 else None,
         seed=seed,
     )
     paths = simulate_docking_run(spacecraft_file, out_dir, scenario)

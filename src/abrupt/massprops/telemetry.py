@@ -223,11 +223,13 @@ def momentum_data_from_simulation(
     appendage_axis_B: ArrayLike | None = None,
     appendage_spin_inertia_kgm2: float = 0.0,
     nadir_axis_B: ArrayLike = (0.0, 0.0, 1.0),
+    thruster_flag: tuple[FloatArray, FloatArray] | None = None,
     source: str = "<simulation>",
 ) -> MomentumBalanceData:
     """Estimator input from a :class:`~abrupt.simulate.attitude.PointingSimResult` (all channels at one rate).
 
-    The appendage rate is re-derived from the telemetered (wrapped) angle, as from flight telemetry.
+    The appendage rate is re-derived from the telemetered (wrapped) angle, as from flight telemetry;
+    ``thruster_flag`` (t, 0/1 written on change) marks momentum dumps.
     """
     r = result
     t = np.asarray(r.t_s, dtype=np.float64)  # type: ignore[attr-defined]
@@ -240,6 +242,7 @@ def momentum_data_from_simulation(
         appendage_angle=(t, r.appendage_angle_rad) if appendage_spin_inertia_kgm2 > 0 else None,  # type: ignore[attr-defined]
         appendage_axis_B=appendage_axis_B,
         appendage_spin_inertia_kgm2=appendage_spin_inertia_kgm2,
+        thruster_flag=thruster_flag,
         orbit_period_s=orbit_period_s,
         nadir_axis_B=nadir_axis_B,
         rate_average_s=0.0,

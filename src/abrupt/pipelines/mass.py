@@ -21,6 +21,7 @@ from abrupt.massprops.inertia import INERTIA_ELEMENTS, physical_violations, prin
 from abrupt.massprops.momentum_balance import InertiaEstimate, MomentumBalanceData, estimate_inertia
 from abrupt.massprops.telemetry import momentum_data_from_channels
 from abrupt.massprops.track import InertiaTrack, track_inertia
+from abrupt.model.flight_config import FlightChannel
 from abrupt.model.spacecraft import Spacecraft, load_spacecraft
 from abrupt.readers.telemetry import read_telemetry
 from abrupt.thresholds import FalseAlarmBudget
@@ -48,6 +49,127 @@ def telemetry_paths(store: str | Path | None, files: tuple[str, ...]) -> list[Pa
     if not files:
         raise InputError("give telemetry files or --store DIR")
     return [Path(f) for f in files]
+
+
+def is_ingest_store(root: str | Path) -> bool:
+    """True when ``root`` is the flight pipeline's store (``spacecraft=*/day=*/samples.parquet``)."""
+    return any(Path(root).glob("spacecraft=*/day=*/samples.parquet"))
+
+
+def load_momentum_data_from_store(
+    root: str | Path,
+    spacecraft: Spacecraft,
+    options: MomentumOptions = MomentumOptions(),
+    days: tuple[str, ...] | None = None,
+) -> tuple[MomentumBalanceData, RepairLog]:
+    """Read the spacecraft's days from the flight pipeline's Parquet store (what ``abrupt ingest`` writes).
+
+    The raw samples are used as telemetered (each channel on its own stamps, not the flight grid): the
+    ``[flight]`` channels of the spacecraft file name them by pseudonym and unit. Quaternion components
+    0-3 (scalar first) are joined on their common stamps, as are the three rate components; the wheel
+    components are the ``[[wheels]]`` in order, a tachometer's gate comes from its channel; the
+    ``appendage_angle`` channel drives its ``[[appendages]]`` entry; ``event_flag`` channels (thruster
+    dumps) are OR-ed into the thruster flag. The orbit period is ``--orbit-period`` or ``[orbit]``.
+    Archive repairs were counted at ingest (``ingest.json``); they are carried into the repair log.
+    """
+    from abrupt.pipelines.flight import day_range
+    from abrupt.store import TelemetryStore
+
+    if spacecraft.flight is None:
+        raise ConfigError(
+            "no [flight] table: reading the ingest store needs the channel pseudonyms and units",
+            file=spacecraft.source,
+            key="flight",
+        )
+    if not spacecraft.wheels:
+        raise ConfigError("the spacecraft file has no [[wheels]]: the momentum balance needs them", key="wheels")
+    flight = spacecraft.flight
+    store = TelemetryStore(root)
+    day_list = day_range(store, spacecraft.name, days)
+    repairs = RepairLog(f"{Path(root)}/spacecraft={spacecraft.name}")
+    for d in day_list:
+        for kind, count in store.report(spacecraft.name, d).get("repairs", {}).items():
+            if isinstance(count, int | float):
+                repairs.record(str(kind), int(count))
+    start = np.datetime64(day_list[0], "D")
+    end = np.datetime64(day_list[-1], "D") + np.timedelta64(1, "D")
+    samples = store.read_range(spacecraft.name, start, end, flight.mnemonics)
+    t0_ns = int(start.astype("datetime64[ns]").astype(np.int64))
+    groups = {str(m): g for m, g in samples.groupby("mnemonic", observed=True)}
+
+    def channel(c: FlightChannel) -> tuple[np.ndarray, np.ndarray]:
+        g = groups.get(c.mnemonic)
+        if g is None or g.empty:
+            raise InputError(
+                f"channel {c.mnemonic!r} ({c.quantity} {c.component}) has no samples in the store",
+                file=repairs.source,
+                column=c.mnemonic,
+            )
+        t = (g["time"].to_numpy().astype("datetime64[ns]").astype(np.int64) - t0_ns) / 1e9
+        v = g["value"].to_numpy(dtype=np.float64) * c.to_si
+        order = np.argsort(t, kind="stable")
+        return t[order], v[order]
+
+    def joined(quantity: str, n: int) -> tuple[np.ndarray, np.ndarray]:
+        chans = flight.of(quantity)
+        if [c.component for c in chans] != list(range(n)):
+            raise ConfigError(
+                f"[flight] needs {quantity} components 0..{n - 1}, got {[c.component for c in chans]}",
+                file=spacecraft.source,
+                key="flight.channels",
+            )
+        series = [channel(c) for c in chans]
+        common = series[0][0]
+        for t, _ in series[1:]:
+            common = np.intersect1d(common, t)
+        return common, np.column_stack([v[np.searchsorted(t, common)] for t, v in series])
+
+    wheel_chans = flight.of("wheel_speed")
+    if len(wheel_chans) != len(spacecraft.wheels):
+        raise InputError(
+            f"{len(wheel_chans)} wheel-speed channels in [flight] for {len(spacecraft.wheels)} wheels; "
+            "the momentum balance needs every wheel",
+            file=spacecraft.source,
+            column="wheel_speed",
+        )
+    gates = {c.tachometer.gate_s for c in wheel_chans if c.tachometer is not None}
+    gate = gates.pop() if len(gates) == 1 else options.tachometer_gate_s
+    app_angle, app_axis, app_j = None, None, 0.0
+    for c in flight.of("appendage_angle"):
+        app = next((a for a in spacecraft.appendages if a.name == c.appendage), None)
+        if app is not None and len(app.gimbal_axes) == 1:
+            app_angle, app_axis, app_j = channel(c), app.gimbal_axes[0], app.drive_inertia_kgm2
+            break
+    flag = None
+    flags = [channel(c) for c in flight.of("event_flag") if c.mnemonic in groups]
+    if flags:
+        t_f = np.unique(np.concatenate([t for t, _ in flags]))
+        on = np.zeros(t_f.size, bool)
+        for t, v in flags:  # each flag holds its last value (written on change)
+            k = np.searchsorted(t, t_f, side="right") - 1
+            on |= (k >= 0) & (v[np.clip(k, 0, None)] > 0.5)
+        flag = (t_f, on.astype(np.float64))
+    period = options.orbit_period_s
+    if period is None and spacecraft.orbit is not None:
+        period = spacecraft.orbit.period_s
+    data = momentum_data_from_channels(
+        joined("quaternion", 4),
+        joined("body_rate", 3),
+        [channel(c) for c in wheel_chans],
+        spacecraft.wheel_axes,
+        spacecraft.wheel_spin_inertias_kgm2,
+        tachometer_gate_s=gate,
+        appendage_angle=app_angle,
+        appendage_axis_B=app_axis,
+        appendage_spin_inertia_kgm2=app_j,
+        thruster_flag=flag,
+        orbit_period_s=period,
+        nadir_axis_B=options.nadir_axis_B,
+        epoch_utc=f"{day_list[0]}T00:00:00Z",
+        source=repairs.source,
+        repairs=repairs,
+    )
+    return data, repairs
 
 
 def load_momentum_data(
@@ -110,6 +232,29 @@ def load_momentum_data(
     return data, repairs
 
 
+@dataclass(frozen=True)
+class StoreInput:
+    """The flight pipeline's Parquet store as input (``--store DIR`` when DIR was written by ``abrupt ingest``)."""
+
+    root: Path
+    days: tuple[str, ...] | None = None
+
+
+def telemetry_input(store: str | Path | None, files: tuple[str, ...]) -> list[Path] | StoreInput:
+    """``--store DIR``: the ingest store when DIR is one, else every CSV/Parquet file under DIR; or the files."""
+    if store is not None and Path(store).is_dir() and is_ingest_store(store):
+        return StoreInput(Path(store))
+    return telemetry_paths(store, files)
+
+
+def _load(
+    source: list[Path] | StoreInput, spacecraft: Spacecraft, options: MomentumOptions
+) -> tuple[MomentumBalanceData, RepairLog]:
+    if isinstance(source, StoreInput):
+        return load_momentum_data_from_store(source.root, spacecraft, options, source.days)
+    return load_momentum_data(source, spacecraft, options)
+
+
 def check_catalogue(spacecraft: Spacecraft) -> np.ndarray:
     """The spacecraft file's inertia, or an error naming every physical condition it violates."""
     reasons = physical_violations(spacecraft.inertia_kgm2)
@@ -119,12 +264,15 @@ def check_catalogue(spacecraft: Spacecraft) -> np.ndarray:
 
 
 def estimate_inertia_run(
-    paths: list[Path], spacecraft_file: str | Path, options: MomentumOptions = MomentumOptions(), **kwargs: object
+    paths: list[Path] | StoreInput,
+    spacecraft_file: str | Path,
+    options: MomentumOptions = MomentumOptions(),
+    **kwargs: object,
 ) -> tuple[InertiaEstimate, Spacecraft, RepairLog]:
     """Read, synchronise and estimate J (see :func:`~abrupt.massprops.momentum_balance.estimate_inertia`)."""
     sc = load_spacecraft(spacecraft_file)
     j_cat = check_catalogue(sc)
-    data, repairs = load_momentum_data(paths, sc, options)
+    data, repairs = _load(paths, sc, options)
     est = estimate_inertia(data, j_cat, gravity_gradient=data.nadir_N is not None, **kwargs)  # type: ignore[arg-type]
     return est, sc, repairs
 
@@ -188,7 +336,7 @@ def write_report(report: dict[str, object], path: str | Path) -> None:
 
 
 def detect_mass_change_run(
-    paths: list[Path],
+    paths: list[Path] | StoreInput,
     spacecraft_file: str | Path,
     budget: FalseAlarmBudget,
     *,
@@ -202,7 +350,7 @@ def detect_mass_change_run(
     """Inertia per window, then the ``mass.inertia_change`` detector (linked to attitude events if given)."""
     sc = load_spacecraft(spacecraft_file)
     j_cat = check_catalogue(sc)
-    data, _ = load_momentum_data(paths, sc, options)
+    data, _ = _load(paths, sc, options)
     track = track_inertia(
         data, j_cat, spacecraft=sc.name, window_s=window_s, gravity_gradient=data.nadir_N is not None, bootstrap=100
     )
@@ -247,6 +395,7 @@ def simulate_docking_run(spacecraft_file: str | Path, out_dir: str | Path, scena
         "inertia_before_kgm2": sim.inertia_before_kgm2.tolist(),
         "inertia_after_kgm2": sim.inertia_after_kgm2.tolist(),
         "contact_dH_N_Nms": [None if not math.isfinite(v) else v for v in sim.contact_dH_N_Nms.tolist()],
+        "momentum_dumps": [{"time_s": t, "dH_N_Nms": dh.tolist()} for t, dh in sim.dumps],
     }
     (out / "docking_truth.json").write_text(json.dumps(truth, indent=1))
     written.append(out / "docking_truth.json")
@@ -259,13 +408,14 @@ def simulated_inertia_track(
     *,
     epoch_utc: str = "2026-01-01T00:00:00Z",
     progress: object = None,
+    dumps_out: list[tuple[float, np.ndarray]] | None = None,
     **estimator_options: object,
 ) -> InertiaTrack:
     """One inertia estimate per simulated day of :func:`~abrupt.simulate.docking.docking_days` (days are
     simulated, estimated and dropped one at a time: memory does not grow with the number of days).
 
     Used to check the mass-change detector's false-alarm rate over a simulated year. ``progress`` is an
-    optional callable ``(day_index, estimate)``.
+    optional callable ``(day_index, estimate)``; the momentum dumps are appended to ``dumps_out``.
     """
     from abrupt.massprops.telemetry import momentum_data_from_simulation
     from abrupt.simulate.docking import DockingScenario, docking_days
@@ -273,7 +423,14 @@ def simulated_inertia_track(
     assert isinstance(scenario, DockingScenario)
     j_cat = check_catalogue(spacecraft)
     rows = []
-    for d, day in enumerate(docking_days(spacecraft, scenario)):
+    dumps: list[tuple[float, np.ndarray]] = [] if dumps_out is None else dumps_out
+    for d, day in enumerate(docking_days(spacecraft, scenario, dumps_out=dumps)):
+        # The thruster flag of the day's dumps (the flight telemetry's dump flag): on for the firing.
+        fired = [t for t, _ in dumps if day.t_s[0] <= t <= day.t_s[-1]]
+        flag = None
+        if fired:
+            t_f = np.array([day.t_s[0], *[x for t in fired for x in (t, t + scenario.dump_duration_s)]])
+            flag = (t_f, np.array([0.0, *[x for _ in fired for x in (1.0, 0.0)]]))
         data = momentum_data_from_simulation(
             day,
             spacecraft.wheel_axes,
@@ -281,6 +438,7 @@ def simulated_inertia_track(
             orbit_period_s=scenario.orbit.period_s,
             appendage_axis_B=scenario.appendage_axis_B,
             appendage_spin_inertia_kgm2=scenario.appendage_spin_inertia_kgm2,
+            thruster_flag=flag,
         )
         est = estimate_inertia(data, j_cat, **estimator_options)  # type: ignore[arg-type]
         rows.append((float(day.t_s[0]), float(day.t_s[-1]), est))

@@ -4,7 +4,9 @@ Day by day with :func:`~abrupt.simulate.attitude.simulate_pointing` (state carri
 day about random axes (15-45°, smooth ramps), gravity gradient, a sun-tracking array, a small constant
 inertial torque; at ``docking_time_s`` the truth inertia becomes the point-mass update of
 :func:`~abrupt.massprops.inertia.inertia_after_docking` and the contact gives an angular impulse
-ρ × m v (Dabrowski 2003 Eq. 2.35) as a strike.
+ρ × m v (Dabrowski 2003 Eq. 2.35) as a strike. Momentum dumps (off by default): when the system momentum
+exceeds ``dump_threshold_Nms`` at the start of a day, thrusters remove it at a quiet time of that day (an
+impulse −H_N, which the wheels then shed; its time is recorded as a thruster-flag interval).
 """
 
 from __future__ import annotations
@@ -51,6 +53,8 @@ class DockingScenario:
     appendage_axis_B: tuple[float, float, float] = (0.0, 1.0, 0.0)
     appendage_spin_inertia_kgm2: float = 18.0
     sim_rate_hz: float = 5.0
+    dump_threshold_Nms: float | None = None
+    dump_duration_s: float = 10.0
     gain_K_Nm: float = 10.0
     gain_P_Nms: float = 150.0
     seed: int = 0
@@ -65,6 +69,7 @@ class DockingSimulation:
     inertia_after_kgm2: FloatArray
     docking_time_s: float | None
     contact_dH_N_Nms: FloatArray
+    dumps: list[tuple[float, FloatArray]] = field(default_factory=list)
 
 
 def _concat(a: PointingSimResult, b: PointingSimResult) -> PointingSimResult:
@@ -97,8 +102,21 @@ def random_slews(
     return out
 
 
+def dump_time(rng: np.random.Generator, day_start_s: float, slews: list[Slew], span_s: float) -> float:
+    """A quiet time for a momentum dump: 0.8 h into an hour of the day that holds no slew start (slews
+    start 0.1-0.6 h into their hour and last at most 9 min, so a dump never overlaps one)."""
+    busy = {int((s.start_s - day_start_s) // 3600) for s in slews}
+    free = [h for h in range(int(span_s // 3600)) if h not in busy and (h + 0.8) * 3600.0 < span_s - 60.0]
+    if not free:
+        return float("nan")
+    return float(day_start_s + (int(rng.choice(free)) + 0.8) * 3600.0)
+
+
 def docking_days(
-    spacecraft: Spacecraft, scenario: DockingScenario = DockingScenario(), noise: AttitudeSimConfig | None = None
+    spacecraft: Spacecraft,
+    scenario: DockingScenario = DockingScenario(),
+    noise: AttitudeSimConfig | None = None,
+    dumps_out: list[tuple[float, FloatArray]] | None = None,
 ) -> Iterator[PointingSimResult]:
     """Simulate ``scenario.days`` days of routine telemetry with a docking (or none if its time is None),
     yielding one day at a time: the reference, array profile and state of one day only are in memory,
@@ -108,6 +126,7 @@ def docking_days(
     speeds quantised to 0.098 rad/s). The catalogue inertia is the spacecraft file's; the truth is
     ``scenario.truth_inertia_kgm2`` (default the same); after the docking it is
     :func:`~abrupt.massprops.inertia.inertia_after_docking` and the contact is a strike ρ × m v.
+    Each momentum dump is appended to ``dumps_out`` as (time [s], impulse ΔH_N [N m s]).
     """
     rng = np.random.default_rng(scenario.seed)
     j0, j1, dh_b = _docking_truth(spacecraft, scenario)
@@ -120,6 +139,7 @@ def docking_days(
         wheel_speed_resolution_rad_s=2 * math.pi / 64,
     )
     state: FloatArray | None = None
+    h_now = np.zeros(3)
     for d in range(n_days):
         t0, t1 = d * SECONDS_PER_DAY, min((d + 1) * SECONDS_PER_DAY, total)
         slews = random_slews(
@@ -138,6 +158,12 @@ def docking_days(
         if dock is not None and t0 < dock < t1:
             dock = float(np.floor(dock))
             cuts = [t0, dock, t1]
+        dump = None
+        if scenario.dump_threshold_Nms is not None and float(np.linalg.norm(h_now)) > scenario.dump_threshold_Nms:
+            td = dump_time(rng, t0, slews, t1 - t0)
+            if math.isfinite(td) and td not in cuts:
+                dump = float(np.floor(td))
+                cuts = sorted({*cuts, dump})
         parts = []
         for a, b in itertools.pairwise(cuts):
             after = dock is not None and a >= dock
@@ -155,12 +181,17 @@ def docking_days(
                 seed=int(rng.integers(2**31)),
             )
             strikes = []
+            if dump is not None and a == dump:  # the thrusters remove the momentum the system has now
+                dump_dh = -h_now
+                strikes.append((a + 0.5, (float(dump_dh[0]), float(dump_dh[1]), float(dump_dh[2]))))
+                if dumps_out is not None:
+                    dumps_out.append((a + 0.5, dump_dh.copy()))
             if after and a == dock:
                 from abrupt.model.rotations import dcm_from_quaternion
 
                 q = state[:4] if state is not None else ref.sample(np.array([a, a + 1.0]))[0][0]
                 contact_n = dcm_from_quaternion(q).T @ dh_b
-                strikes = [(a + 0.5, (float(contact_n[0]), float(contact_n[1]), float(contact_n[2])))]
+                strikes.append((a + 0.5, (float(contact_n[0]), float(contact_n[1]), float(contact_n[2]))))
             res = simulate_pointing(
                 spacecraft,
                 cfg,
@@ -170,6 +201,7 @@ def docking_days(
                 initial_state=state,
             )
             state = res.final_state
+            h_now = np.asarray(res.true_H_N_Nms[-1], dtype=np.float64)
             parts.append(res)
         day = parts[0]
         for p in parts[1:]:
@@ -195,7 +227,8 @@ def simulate_docking(
     spacecraft: Spacecraft, scenario: DockingScenario = DockingScenario(), noise: AttitudeSimConfig | None = None
 ) -> DockingSimulation:
     """All days of :func:`docking_days` in memory, with the truth (inertia before/after, contact impulse in N)."""
-    days = list(docking_days(spacecraft, scenario, noise))
+    dumps: list[tuple[float, FloatArray]] = []
+    days = list(docking_days(spacecraft, scenario, noise, dumps))
     j0, j1, dh_b = _docking_truth(spacecraft, scenario)
     contact_n = np.full(3, np.nan)
     if scenario.docking_time_s is not None and days:
@@ -206,7 +239,7 @@ def simulate_docking(
             if 0 < k < day.t_s.size:
                 contact_n = dcm_from_quaternion(day.true_q_BN[k - 1]).T @ dh_b
                 break
-    return DockingSimulation(days, j0, j1, scenario.docking_time_s, contact_n)
+    return DockingSimulation(days, j0, j1, scenario.docking_time_s, contact_n, dumps)
 
 
 def docking_inertia_change(
