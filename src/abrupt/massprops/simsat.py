@@ -312,37 +312,41 @@ def grid_search_batch(
     return best, j_min
 
 
-def estimate_runs_i33(
-    params: SimsatParams, maneuver: Maneuver, y_meas: FloatArray, tol: float = 1e-4
+def _fit_runs_batch(
+    params: SimsatParams, maneuver: Maneuver, y_meas: FloatArray, free: str, tol: float
 ) -> tuple[FloatArray, FloatArray]:
-    """Phase B for runs (columns of ``y_meas``) at once: :func:`estimate_run_i33` vectorised over runs."""
+    """Grid search of ``free`` (``"i33"`` or ``"wheel_gain"``) for every run (column of ``y_meas``) at once."""
     t = maneuver.times(params.dt_s)
     mask = maneuver.match_mask(t)
     y = np.atleast_2d(y_meas.T).T
     n_runs = y.shape[1]
 
     def cost(grid: FloatArray) -> FloatArray:
-        sim = simulate_simsat(params, maneuver, grid.ravel())
+        values = grid.ravel()
+        sim = (
+            simulate_simsat(params, maneuver, values, None)
+            if free == "i33"
+            else simulate_simsat(params, maneuver, None, values)
+        )
         y_rep = np.tile(y, (1, grid.shape[0]))  # column j*n_runs + r is run r
         return l1_cost(y_rep, sim["yaw_meas_rad"], mask).reshape(grid.shape)
 
-    return grid_search_batch(cost, params.i33_kgm2, n_runs, tol=tol)
+    center = params.i33_kgm2 if free == "i33" else params.wheel_gain
+    return grid_search_batch(cost, center, n_runs, tol=tol)
+
+
+def estimate_runs_i33(
+    params: SimsatParams, maneuver: Maneuver, y_meas: FloatArray, tol: float = 1e-4
+) -> tuple[FloatArray, FloatArray]:
+    """Phase B for runs (columns of ``y_meas``) at once: :func:`estimate_run_i33` vectorised over runs."""
+    return _fit_runs_batch(params, maneuver, y_meas, "i33", tol)
 
 
 def tune_wheel_gains(
     params: SimsatParams, maneuver: Maneuver, y_meas: FloatArray, tol: float = 1e-5
 ) -> tuple[FloatArray, FloatArray]:
     """Phase A fits for baseline runs (columns) at once: :func:`tune_wheel_gain` vectorised over runs."""
-    t = maneuver.times(params.dt_s)
-    mask = maneuver.match_mask(t)
-    y = np.atleast_2d(y_meas.T).T
-    n_runs = y.shape[1]
-
-    def cost(grid: FloatArray) -> FloatArray:
-        sim = simulate_simsat(params, maneuver, None, grid.ravel())
-        return l1_cost(np.tile(y, (1, grid.shape[0])), sim["yaw_meas_rad"], mask).reshape(grid.shape)
-
-    return grid_search_batch(cost, params.wheel_gain, n_runs, tol=tol)
+    return _fit_runs_batch(params, maneuver, y_meas, "wheel_gain", tol)
 
 
 def estimate_run_i33(
