@@ -11,7 +11,13 @@ Method (each step cites its source; the combination is abrupt's own):
 2. **Two-sided robust step test at every gap** between consecutive element sets. On ``W`` sets
    before and ``W`` after the gap, a common local slope (median of the two sides' Theil-Sen slopes,
    Sen 1968) absorbs drag decay, J2/J3 eccentricity motion and luni-solar inclination drift; the step
-   is the difference of the two sides' medians of the detrended values. It is divided by the local
+   is the difference of the two sides' medians of the detrended values. In low LEO, where drag
+   changes with solar and geomagnetic activity faster than a straight line over the window follows,
+   ``a`` is first freed of the decay the element sets themselves state (``drag_trend="ndot"``: each
+   set's ndot, the fitted mean-motion rate, as ``ȧ = −(2/3)·a·ṅ/n``, running median over five sets,
+   integrated across the gaps; Hoots & Roehrich 1980, Vallado 2013 §9.6; :func:`drag_trend_m`). It is
+   used only where ``a`` decays at least ``drag_min_decay_m_day`` and the stated decay agrees with
+   it within a factor of two: above ~700 km the ndot field is fit noise and bias. It is divided by the local
    noise of the element (1.4826·MAD of first differences, Hampel 1974, in a ±``noise_half_window``
    rolling window, divided by √2) times the standard error factor of a median,
    ``sqrt(π/2)·sqrt(1/n₁ + 1/n₂)``, to give a z-score per element group:
@@ -110,6 +116,9 @@ class TleDetectorConfig:
     time_search_sets_before: int = 3
     group_gain: tuple[float, float, float] = (1.0, 0.2, 0.2)
     along_track_gain: float = 1.0
+    drag_trend: str = "ndot"  # LEO a: "ndot" removes the sets' own stated decay (drag_trend_m)
+    drag_median_sets: int = 5
+    drag_min_decay_m_day: float = 2.0  # the drag trend only where a decays at least this fast
 
     def __post_init__(self) -> None:
         if self.window_sets < 2:
@@ -122,6 +131,10 @@ class TleDetectorConfig:
             raise ValueError(f"regime must be auto, leo or geo, got {self.regime!r}")
         if any(not (g >= 0 and math.isfinite(g)) for g in self.group_gain) or len(self.group_gain) != 3:
             raise ValueError("group_gain must be three finite non-negative numbers")
+        if self.drag_trend not in ("none", "ndot"):
+            raise ValueError(f"drag_trend must be none or ndot, got {self.drag_trend!r}")
+        if self.drag_median_sets < 1:
+            raise ValueError("drag_median_sets must be >= 1")
         if not (self.along_track_gain >= 0 and math.isfinite(self.along_track_gain)):
             raise ValueError("along_track_gain must be a finite non-negative number")
 
@@ -283,6 +296,56 @@ def mean_element_series(history: ElementHistory, regime: str = "leo") -> dict[st
     }
 
 
+def stated_decay_m_s(history: ElementHistory) -> NDArray[np.float64]:
+    """The rate of the mean semi-major axis each element set states (m/s), from its own ndot.
+
+    The TLE's first derivative field is ``ṅ/2`` (rev/day², read by SGP4 as rad/min²); in an
+    18 SDS/SGP4 history it is the mean-motion rate fitted with the set (Hoots & Roehrich 1980;
+    Vallado 2013 §2.2 and §9.6), the drag decay seen by the tracking. Kepler's third law turns it
+    into ``ȧ = −(2/3)·a·ṅ/n``.
+    """
+    el = history.elements
+    if len(el) == 0:
+        return np.zeros(0)
+    sats = history.satrecs
+    n_rad_s = np.array([s.no_kozai for s in sats], dtype=float) / 60.0
+    ndot_rad_s2 = np.array([2.0 * s.ndot for s in sats], dtype=float) / 3600.0
+    a = el["a_m"].to_numpy(dtype=float)
+    out = -(2.0 / 3.0) * a * ndot_rad_s2 / np.maximum(n_rad_s, 1e-12)
+    return np.asarray(np.where(np.isfinite(out), out, 0.0), dtype=float)
+
+
+def drag_trend_m(t_s: NDArray[np.float64], adot_m_s: NDArray[np.float64], median_sets: int = 5) -> NDArray[np.float64]:
+    """The decay of ``a`` (m, zero at the first set) that the sets' own stated rates integrate to.
+
+    ``D_k = Σ ½(ȧ_j + ȧ_{j+1})·Δt_j`` (trapezoid) over the running median of ``median_sets`` sets
+    of the stated rates (:func:`stated_decay_m_s`): a lone set whose ndot absorbed a burn or a bad
+    fit does not bend the trend (a median filter keeps the edges of a real change in drag, Tukey
+    1977). ``a − D`` is flat under drag that changes with solar and geomagnetic activity, up to a
+    constant bias of the stated rates, which the step test's local slope absorbs.
+    """
+    if t_s.size < 2:
+        return np.zeros_like(t_s)
+    r = pd.Series(adot_m_s).rolling(median_sets, center=True, min_periods=1).median().to_numpy(dtype=float)
+    return np.concatenate([[0.0], np.cumsum(0.5 * (r[1:] + r[:-1]) * np.diff(t_s))])
+
+
+def drag_decay_m_day(
+    t_s: NDArray[np.float64], a_m: NDArray[np.float64], adot_m_s: NDArray[np.float64]
+) -> tuple[float, float]:
+    """The history's decay of ``a`` (m/day, negative when decaying): (observed, stated).
+
+    Observed: the median of the set-to-set rates of ``a`` itself (robust to the few maneuver gaps);
+    stated: the median of the sets' own rates (:func:`stated_decay_m_s`).
+    """
+    if t_s.size < 3:
+        return 0.0, 0.0
+    dt = np.diff(t_s)
+    ok = dt > 60.0
+    observed = float(np.median(np.diff(a_m)[ok] / dt[ok])) if ok.any() else 0.0
+    return observed * SECONDS_PER_DAY, float(np.median(adot_m_s)) * SECONDS_PER_DAY
+
+
 def _robust_scale_rolling(
     y: NDArray[np.float64], half: int, t: NDArray[np.float64] | None = None
 ) -> NDArray[np.float64]:
@@ -394,6 +457,16 @@ class _StepModel:
         self.cfg = cfg
         self.regime = orbit_regime(history) if cfg.regime == "auto" else cfg.regime
         self.s = mean_element_series(history, self.regime)
+        self.a_raw_m = self.s["a_m"].copy()
+        self.drag_trend_used = False
+        if self.regime == "leo" and cfg.drag_trend == "ndot":
+            # the step test on a minus the decay the sets state (module docstring, step 2), where
+            # a decays fast (low LEO) and the sets state that decay (within a factor of two)
+            adot = stated_decay_m_s(history)
+            observed, stated = drag_decay_m_day(self.s["t_s"], self.a_raw_m, adot)
+            if -observed >= cfg.drag_min_decay_m_day and 0.5 <= stated / observed <= 2.0:
+                self.s["a_m"] = self.a_raw_m - drag_trend_m(self.s["t_s"], adot, cfg.drag_median_sets)
+                self.drag_trend_used = True
         self.stack = np.stack([self.s[k] for k in self.NAMES])  # (series, sets)
         self.min_side = cfg.min_side_sets
         self.t = self.s["t_s"]
@@ -496,7 +569,7 @@ class _StepModel:
         ground-track control.
         """
         du = steps["u_m"]
-        a = float(self.s["a_m"][g])
+        a = float(self.a_raw_m[g])
         n = math.sqrt(MU_EARTH_WGS72_M3_S2 / a**3)
         dt_gap = float(self.t[g + 1] - self.t[g])
         allowance = 0.75 * n * abs(steps["a_m"]) * (dt_gap + SECONDS_PER_DAY)

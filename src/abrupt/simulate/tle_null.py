@@ -14,12 +14,15 @@ a smooth maneuver-free orbit plus noise:
                             vector, ~0.85°/year, with its 13.66-day lunar and 182.6-day solar
                             terms) plus heavy-tailed (Student-t), serially correlated (AR(1) in
                             time) set-to-set noise, occasional bad sets (gross errors in every
-                            element), irregular cadence and long gaps without sets.
+                            element), irregular cadence and long gaps without sets. Each LEO set
+                            states its decay in its ndot, as an 18 SDS fit does: the simulated drag
+                            rate with a scale error, a bias and heavy-tailed noise.
 ``bootstrap_null_history``  the *real* noise of a history: residuals of its detector series about
                             a running median, taken in blocks of consecutive sets (with their real
                             gaps) from its quiet stretches (away from every maneuver the caller
                             names), laid end to end on a fresh parametric smooth orbit. Heavy tails,
-                            serial correlation, bad sets and cadence are the satellite's own; its
+                            serial correlation, bad sets and cadence are the satellite's own (so
+                            is its ndot's scatter and bias against its elements' decay); its
                             maneuvers are not in the blocks.
 
 Neither generator knows the detector; the detector is run on their output and its events are all
@@ -72,6 +75,14 @@ class NullHistorySpec:
     bad_set_probability: float = 0.003  # a set with a gross error in every element
     long_gap_probability: float = 0.004  # per set: a gap of 3-10 days follows
     solar_cycle_amplitude: float = 0.8  # LEO drag decay × (1 + amp·sin(2π t / 11 y))
+    # The decay rate each set states (ndot, docs/tle.md "Drag-consistent trend"): the true rate of
+    # a × (1 + a per-history scale error, uniform ±``ndot_scale_error``) + a per-history bias
+    # (uniform ±``ndot_bias_m_day``) + per-set Student-t noise of robust σ
+    # ``ndot_noise_m_day`` + ``ndot_relative_noise`` × |rate|; bad sets get a gross error too.
+    ndot_noise_m_day: float = 0.1
+    ndot_relative_noise: float = 0.1
+    ndot_scale_error: float = 0.2
+    ndot_bias_m_day: float = 0.3
     seed: int = 0
 
     def noise_sigmas(self) -> tuple[float, ...]:
@@ -136,7 +147,7 @@ def _smooth_orbit(spec: NullHistorySpec, t_days: NDArray[np.float64], rng: np.ra
         solar = 1.5e-4 * np.sin(2 * math.pi * t_days / 182.6 + rng.uniform(0, 6.3))
         n1 = i0 * math.cos(d0) + drift + lunar
         n2 = i0 * math.sin(d0) + 0.3 * drift + solar
-        return {"a_m": a, "ex": ex, "ey": ey, "n1_rad": n1, "n2_rad": n2, "u_m": zero}
+        return {"a_m": a, "ex": ex, "ey": ey, "n1_rad": n1, "n2_rad": n2, "u_m": zero, "adot_m_s": zero}
     h_km = spec.altitude_km
     decay0 = 15.0 * math.exp(-(h_km - 500.0) / 70.0)  # [m/day] drag decay of a at solar mean
     phase = rng.uniform(0, 2 * math.pi)
@@ -150,7 +161,8 @@ def _smooth_orbit(spec: NullHistorySpec, t_days: NDArray[np.float64], rng: np.ra
     ex = circ * np.cos(w)
     ey = ef + circ * np.sin(w)
     n1 = math.radians(spec.inclination_deg) + 1e-8 * t_days + 2e-6 * np.sin(2 * math.pi * t_days / 13.66)
-    return {"a_m": a, "ex": ex, "ey": ey, "n1_rad": n1, "n2_rad": zero, "u_m": zero}
+    adot = -rate / SECONDS_PER_DAY  # [m/s] the drag rate of a that the element sets' ndot states
+    return {"a_m": a, "ex": ex, "ey": ey, "n1_rad": n1, "n2_rad": zero, "u_m": zero, "adot_m_s": adot}
 
 
 def history_from_series(
@@ -162,7 +174,10 @@ def history_from_series(
     ``a`` is matched through SGP4's Kozai-to-Brouwer conversion (the mean motion is iterated until
     the record's ``a`` is the target); the node (LEO), perigee and mean anomaly are accumulated with
     the records' own secular rates so the detector's residual series (the RAAN residual, the
-    along-track phase with its five-set running median of the rate) reproduce the targets.
+    along-track phase with its five-set running median of the rate) reproduce the targets. With the
+    key ``adot_m_s`` (the rate of ``a`` each set states, m/s) the records' ndot is the mean-motion
+    rate it implies, ``ṅ = −(3/2)(n/a)·ȧ`` (Kepler's third law), stored as the TLE field ``ṅ/2``
+    (Hoots & Roehrich 1980; Vallado 2013 §2.2); without it ndot is 0.
     """
     from sgp4.api import WGS72, Satrec
 
@@ -178,6 +193,7 @@ def history_from_series(
         inc = series["n1_rad"]
         argp = varpi
     epoch_1949 = (EPOCH0 - pd.Timestamp("1949-12-31")).total_seconds() / SECONDS_PER_DAY + t_days
+    adot = series.get("adot_m_s", np.zeros(n))
     sats = []
     rates = np.zeros((n, 3))  # nodedot, argpdot, mdot [rad/s]
     for k in range(n):
@@ -218,7 +234,7 @@ def history_from_series(
             norad,
             epoch_1949[k],
             1e-5,
-            0.0,
+            float(-0.75 * sats[k] / a_t[k] * adot[k] * 60.0),  # ṅ/2 [rad/min²], ȧ in m/min
             0.0,
             e[k],
             float(np.mod(argp[k], 2 * math.pi)),
@@ -231,11 +247,45 @@ def history_from_series(
     return history_from_sets(raw, source=f"<null {regime} {norad}>")
 
 
-def simulate_null_history(spec: NullHistorySpec) -> ElementHistory:
-    """A parametric maneuver-free history (module docstring)."""
+def _stated_decay_m_s(
+    adot_m_s: NDArray[np.float64], spec: NullHistorySpec, bad: NDArray[np.bool_], rng: np.random.Generator
+) -> NDArray[np.float64]:
+    """The rate of ``a`` each set states through its ndot (m/s): the true rate with the history's
+    scale error and bias and per-set heavy-tailed noise (:class:`NullHistorySpec`); zero in GEO."""
+    from scipy import stats
+
+    if spec.regime == "geo":
+        return np.zeros_like(adot_m_s)
+    per_day = adot_m_s * SECONDS_PER_DAY
+    scale = 1.0 + rng.uniform(-spec.ndot_scale_error, spec.ndot_scale_error)
+    bias = rng.uniform(-spec.ndot_bias_m_day, spec.ndot_bias_m_day)
+    eps = rng.standard_t(spec.t_dof, per_day.size) / float(stats.t.ppf(0.75, spec.t_dof) / stats.norm.ppf(0.75))
+    sig = spec.ndot_noise_m_day + spec.ndot_relative_noise * np.abs(per_day)
+    stated = per_day * scale + bias + sig * eps
+    stated[bad] += sig[bad] * rng.choice([-1.0, 1.0], int(bad.sum())) * rng.uniform(20.0, 300.0, int(bad.sum()))
+    return np.asarray(stated / SECONDS_PER_DAY, dtype=float)
+
+
+def simulate_null_history(spec: NullHistorySpec, burns: Sequence[tuple[float, float]] = ()) -> ElementHistory:
+    """A parametric maneuver-free history (module docstring).
+
+    ``burns`` (LEO, for recall checks on the same history): (day, in-track ΔV in m/s) pairs, each a
+    step ``Δa = 2aΔv/v`` (vis-viva, near-circular) in ``a`` from the first set after the day on; that
+    set was fitted across the burn, so the decay it states carries the step as a rate over a day.
+    The noise and the stated decay are drawn exactly as without burns.
+    """
     rng = np.random.default_rng(spec.seed)
     t = _epochs_days(spec, rng)
     smooth = _smooth_orbit(spec, t, rng)
+    first_after: list[tuple[int, float]] = []
+    for day, dv_mps in burns:
+        k = int(np.searchsorted(t, day))
+        if spec.regime == "geo" or k >= t.size:
+            raise ValueError(f"burn at day {day}: only LEO burns inside the history are simulated")
+        a_k = float(smooth["a_m"][k])
+        da = 2.0 * a_k * dv_mps / math.sqrt(MU_EARTH_WGS72_M3_S2 / a_k)
+        smooth["a_m"][k:] += da
+        first_after.append((k, da / SECONDS_PER_DAY))
     sig = spec.noise_sigmas()
     bad = rng.random(t.size) < spec.bad_set_probability
     out = {}
@@ -245,6 +295,9 @@ def simulate_null_history(spec: NullHistorySpec) -> ElementHistory:
         out[name] = y
     if spec.regime != "geo":
         out["n1_rad"] = np.clip(out["n1_rad"], 1e-3, math.pi - 1e-3)
+    out["adot_m_s"] = _stated_decay_m_s(smooth["adot_m_s"], spec, bad, rng)
+    for k, rate_m_s in first_after:
+        out["adot_m_s"][k] += rate_m_s
     return history_from_series(t, out, spec.regime, norad=99900 + spec.seed % 99)
 
 
@@ -262,7 +315,7 @@ def detector_residuals(
     the residuals are NaN elsewhere: a running median that reached over a maneuver next to a quiet
     stretch would put part of its step into the stretch's residuals.
     """
-    from abrupt.detect.tle_maneuvers import mean_element_series
+    from abrupt.detect.tle_maneuvers import mean_element_series, stated_decay_m_s
 
     s = mean_element_series(history, regime)
     t_all = s["t_s"]
@@ -287,6 +340,23 @@ def detector_residuals(
             med = pd.Series(flat).rolling(median_sets, center=True, min_periods=3).median().to_numpy()
             res[lo:hi] = flat - med
         out[key] = res
+    # the decay rate the sets state (ndot): its residuals about a running median within each stretch,
+    # and its bias against the rate of the elements' own a (median over the stretches)
+    adot = stated_decay_m_s(history)
+    res_d = np.full(t_all.size, np.nan)
+    bias = []
+    for lo, hi in spans:
+        if hi - lo < 3:
+            continue
+        d = pd.Series(adot[lo:hi])
+        res_d[lo:hi] = (d - d.rolling(median_sets, center=True, min_periods=3).median()).to_numpy()
+        t, y = t_all[lo:hi], np.asarray(s["a_m"][lo:hi], dtype=float)
+        rate = pd.Series(np.diff(y) / np.maximum(np.diff(t), 60.0)).rolling(median_sets, center=True, min_periods=3)
+        bias.append(adot[lo + 1 : hi] - rate.median().to_numpy())
+    out["adot_m_s"] = res_d
+    both = np.concatenate(bias) if bias else np.zeros(0)
+    both = both[np.isfinite(both)]
+    out["adot_bias_m_s"] = np.full(1, float(np.median(both)) if both.size else 0.0)
     return out
 
 
@@ -389,10 +459,12 @@ def bootstrap_null_history(
     smooth = _smooth_orbit(spec, t, rng)
     bounds = [*starts, len(idx)]
     out: dict[str, NDArray[np.float64]] = {}
-    for name in SERIES:
+    for name in (*SERIES, "adot_m_s"):
         noise = res[name][np.asarray(idx)].copy()
         for b0, b1 in itertools.pairwise(bounds):
             noise[b0:b1] -= np.median(noise[b0:b1])
         out[name] = smooth[name] + noise[keep]
+    if regime != "geo":  # the history's own bias of its stated decay against its elements' decay
+        out["adot_m_s"] += res["adot_bias_m_s"][0]
     junctions = np.asarray([j for j in starts[1:] if j < t.size], dtype=np.int64)
     return history_from_series(t, out, regime, norad=99800 + seed % 99), junctions
