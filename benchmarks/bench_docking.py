@@ -15,9 +15,9 @@ day (days are simulated, estimated and dropped one at a time), the ``mass.inerti
   independent days) and the detector run on each: false alarms per year with a 95% interval.
 
 Seeds differ from every test.
-``--dumps``: the simulator dumps momentum (system momentum above 0.5 N m s at the start of a day is removed
-by a flagged thruster impulse that day; session 4).
-Run: ``OMP_NUM_THREADS=1 PYTHONPATH=src nice python benchmarks/bench_docking.py [--year] [--dumps]``.
+Momentum dumps are on (the simulator's default since session 4: system momentum above 0.5 N m s at the
+start of a day is removed by a flagged thruster impulse that day); ``--no-dumps`` turns them off.
+Run: ``OMP_NUM_THREADS=1 PYTHONPATH=src nice python benchmarks/bench_docking.py [--year] [--no-dumps]``.
 """
 
 from __future__ import annotations
@@ -57,7 +57,7 @@ def track(days: float, docking_day: float | None, seed: int, sim_rate_hz: float)
         truth_inertia_kgm2=tuple(map(tuple, J_TRUE)),
         sim_rate_hz=sim_rate_hz,
         seed=seed,
-        dump_threshold_Nms=0.5 if "--dumps" in sys.argv else None,
+        dump_threshold_Nms=None if "--no-dumps" in sys.argv else 0.5,
     )
     t0 = time.perf_counter()
     dumps: list = []
