@@ -15,9 +15,12 @@ day (days are simulated, estimated and dropped one at a time), the ``mass.inerti
   independent days) and the detector run on each: false alarms per year with a 95% interval.
 
 Seeds differ from every test.
-``--dumps``: the simulator dumps momentum (system momentum above 0.5 N m s at the start of a day is removed
-by a flagged thruster impulse that day; session 4).
-Run: ``OMP_NUM_THREADS=1 PYTHONPATH=src nice python benchmarks/bench_docking.py [--year] [--dumps]``.
+Momentum dumps are on (the simulator's default since session 4: system momentum above 0.5 N m s at the
+start of a day is removed by a flagged thruster impulse that day); ``--no-dumps`` turns them off.
+``--year`` saves the year's daily track (``/tmp/inertia_track_null_year[_nodumps].npz``); ``--track FILE``
+re-runs only the detector on such a file (the year's report and resampled years in about a minute).
+Run: ``OMP_NUM_THREADS=1 PYTHONPATH=src nice python benchmarks/bench_docking.py [--year] [--no-dumps]
+[--track FILE]``.
 """
 
 from __future__ import annotations
@@ -57,7 +60,7 @@ def track(days: float, docking_day: float | None, seed: int, sim_rate_hz: float)
         truth_inertia_kgm2=tuple(map(tuple, J_TRUE)),
         sim_rate_hz=sim_rate_hz,
         seed=seed,
-        dump_threshold_Nms=0.5 if "--dumps" in sys.argv else None,
+        dump_threshold_Nms=None if "--no-dumps" in sys.argv else 0.5,
     )
     t0 = time.perf_counter()
     dumps: list = []
@@ -124,11 +127,24 @@ def report(tr: InertiaTrack, docking_day: float | None, elapsed: float) -> None:
         print("    no event")
 
 
+def load_track(path: str) -> InertiaTrack:
+    """A daily track saved by ``--year`` (windows of one day from 2026-01-01)."""
+    z = np.load(path)
+    k = z["params"].shape[0]
+    return InertiaTrack(SPACECRAFT.name, "2026-01-01T00:00:00Z", np.arange(k) * 86400.0, np.arange(1, k + 1) * 86400.0,
+                        z["params"], z["covariance"], z["observable"])  # fmt: skip
+
+
 if __name__ == "__main__":
-    if "--year" in sys.argv:
+    if "--track" in sys.argv:
+        tr = load_track(sys.argv[sys.argv.index("--track") + 1])
+        report(tr, None, 0.0)
+        resampled_years(tr, 200)
+    elif "--year" in sys.argv:
         days = float(sys.argv[sys.argv.index("--days") + 1]) if "--days" in sys.argv else 365.0
         tr, dt = track(days, None, seed=2026, sim_rate_hz=1.0)
-        np.savez("/tmp/inertia_track_null_year.npz", params=tr.params, covariance=tr.covariance,
+        suffix = "_nodumps" if "--no-dumps" in sys.argv else ""
+        np.savez(f"/tmp/inertia_track_null_year{suffix}.npz", params=tr.params, covariance=tr.covariance,
                  observable=tr.observable)  # fmt: skip
         report(tr, None, dt)
         resampled_years(tr, 200)

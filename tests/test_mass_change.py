@@ -116,6 +116,57 @@ def test_false_alarm_rate_on_unchanged_inertia_is_within_budget():
     assert alarms <= 2 * expected + 3
 
 
+def _heterogeneous_track(n: int, rng: np.random.Generator, step_at: int | None = None, dj: float = 0.0) -> InertiaTrack:
+    """Windows with the covariances of a dumping spacecraft, stated exactly: a common shape times a
+    size from 0.3 to 3, and on 30% of the windows one random direction 200 times worse (a day cut by a
+    momentum dump). The estimates are drawn from exactly these covariances, so the analytic truth is
+    a Gaussian GLR with known covariances.
+    """
+    a = rng.standard_normal((6, 6))
+    shape = 0.05 * (a @ a.T / 6 + np.eye(6))
+    size = np.exp(rng.uniform(math.log(0.3), math.log(3.0), n))
+    u = rng.standard_normal((n, 6))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    worse = (rng.random(n) < 0.3) * 200.0 * size * np.einsum("ti,ij,tj->t", u, shape, u)
+    cov = size[:, None, None] * shape + worse[:, None, None] * np.einsum("ti,tj->tij", u, u)
+    noise = np.einsum("tij,tj->ti", np.linalg.cholesky(cov), rng.standard_normal((n, 6)))
+    p = np.array([900.0, 700.0, 1000.0, 5.0, -3.0, 2.0]) + noise
+    if step_at is not None:
+        p[step_at:, 1] += dj
+        p[step_at:, 2] += dj
+    t0 = np.arange(n) * 86400.0
+    return InertiaTrack("SC-T", "2026-01-01T00:00:00", t0, t0 + 86400.0, p, cov, np.ones((n, 6), bool))
+
+
+def test_glr_on_windows_of_very_different_covariance_keeps_its_budget_and_finds_a_step():
+    from abrupt.detect.mass_change import covering_covariance
+
+    rng = np.random.default_rng(5)
+    # The per-window covariance covers both the size-scaled shape and the window's own matrix.
+    tr = _heterogeneous_track(20, rng)
+    shape = np.median(tr.covariance, axis=0)
+    size = np.full(20, 1.7)
+    cov_w = covering_covariance(shape, tr.covariance, size)
+    assert np.linalg.eigvalsh(cov_w - tr.covariance).min() > -1e-9 * np.abs(cov_w).max()
+    assert np.linalg.eigvalsh(cov_w - size[:, None, None] * shape).min() > -1e-9 * np.abs(cov_w).max()
+    # No change: windows over the 1/week threshold at most the budgeted count, and not far below it.
+    budget = FalseAlarmBudget(1, "week")
+    n_tracks, n_windows, over, tested = 40, 60, 0, 0
+    for _ in range(n_tracks):
+        diag = InertiaChangeDetector().detect(_heterogeneous_track(n_windows, rng), budget).diagnostic("inertia_glr")
+        ok = np.isfinite(diag.statistic)
+        over += int(np.sum(diag.statistic[ok] > diag.extra["threshold_per_window"][ok]))
+        tested += int(ok.sum())
+    expected = tested * budget.per_day
+    assert expected / 10 <= over <= expected + 3 * math.sqrt(expected)
+    # A step of 1 kg m² in Jyy and Jzz (tr ΔJ / 2 = 1 kg at r = 1 m) after window 6 is found and sized.
+    res = InertiaChangeDetector().detect(_heterogeneous_track(12, rng, 6, 1.0), FalseAlarmBudget(1, "year"))
+    assert len(res.events) == 1
+    ev = res.events.iloc[0]
+    assert ev["dm_kg"] == pytest.approx(1.0, abs=3 * ev["dm_sigma_kg"])
+    assert ev["time_bracket_start_utc"] <= "2026-01-07" <= ev["time_bracket_end_utc"]
+
+
 def test_detector_links_an_attitude_event_inside_the_bracket():
     import pandas as pd
 

@@ -198,9 +198,9 @@ def detect_mass_change_cmd(
     "--dump-threshold",
     "dump_threshold_Nms",
     type=float,
-    default=0.0,
+    default=0.5,
     show_default=True,
-    help="Momentum dump when the system momentum exceeds this at the start of a day [N m s] (e.g. 0.5); 0: none.",
+    help="Momentum dump when the system momentum exceeds this at the start of a day [N m s]; 0: no dumps.",
 )
 @click.option("--seed", type=int, default=0, show_default=True)
 def simulate_docking_cmd(

@@ -7,9 +7,13 @@ newest window n and every candidate change window τ ≤ n,
     S(τ, n) = (n_b n_a / (n_b + n_a)) (x̄_after − x̄_before)ᵀ Σ⁻¹ (x̄_after − x̄_before),
 
 with x the observable inertia parameters, n_b/n_a the windows before/after τ and Σ the covariance of one
-window's estimate (in the code, generalised least-squares means with each window's own size of the
-median covariance shape, so a poorly excited day weighs less: the daily 1σ varied threefold over a
-simulated year). Σ is the data's own noise model: the shape of the estimator's covariance,
+window's estimate. In the code the windows are independent Gaussians with their own covariances Σ_i and
+the GLR uses generalised least-squares means on each side, Δ = x̄_a − x̄_b with covariance
+(Σ_b Σ_i⁻¹)⁻¹ + (Σ_a Σ_i⁻¹)⁻¹ (the statistic above when every Σ_i is equal). Σ_i is the median covariance
+shape times the window's own size, enlarged to cover the window's own (jackknife) covariance in every
+direction (:func:`covering_covariance`): the daily 1σ varies threefold over a simulated year, and a day
+cut by a momentum dump is poorly determined along one direction of its own that the median shape misses.
+Σ is the data's own noise model: the shape of the estimator's covariance,
 scaled by c ≥ 1 estimated from the differences of windows 1, 2 and 3 apart (robust median, so a step
 does not inflate it; the largest lag's spread is kept, so a slow drift of the estimates is not taken
 for a step). With an estimated scale, S/c follows d·F(d, ν) (Hotelling's T²), and the threshold is
@@ -59,6 +63,24 @@ def _robust_cov(x: np.ndarray) -> np.ndarray:
     corr = np.nan_to_num(corr, nan=0.0)
     np.fill_diagonal(corr, 1.0)
     return np.asarray(np.outer(mad, mad) * corr / 2.0, dtype=np.float64)
+
+
+def covering_covariance(shape: np.ndarray, own: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """Per-window covariance (k, d, d) at least ``size``·``shape`` and at least ``own`` in every direction.
+
+    In the metric of A_t = size_t · shape, the window's own matrix has eigenvalues μ_i along
+    directions v_i; the result keeps the directions and takes max(μ_i, 1). It is ≥ A_t and ≥ own_t in
+    the Loewner order (the smallest such matrix sharing these directions), so a window is never weighted
+    more than either its pooled-shape model or its own stated covariance allows.
+    """
+    w, v = np.linalg.eigh(shape)
+    w = np.clip(w, max(float(w.max()), 0.0) * 1e-12 + 1e-300, None)
+    root = v * np.sqrt(w)  # root @ root.T = shape
+    root_inv = (v / np.sqrt(w)).T
+    rel = np.einsum("ij,tjk,lk->til", root_inv, own, root_inv) / size[:, None, None]
+    mu, vv = np.linalg.eigh(0.5 * (rel + np.swapaxes(rel, 1, 2)))
+    rel = np.einsum("tij,tj,tkj->tik", vv, np.maximum(mu, 1.0), vv)
+    return np.asarray(size[:, None, None] * np.einsum("ij,tjk,lk->til", root, rel, root), dtype=np.float64)
 
 
 class InertiaChangeDetector(Detector[InertiaTrack]):
@@ -130,14 +152,17 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
         # and the largest is used, so slow drifts are not taken for a step.
         # Each window's own covariance (the days differ: a day with poor slews has a larger error); where
         # a window has none, the median shape. Weights W_i = Σ_i⁻¹ (generalised least-squares means).
-        # Per-window scale on the median shape: a jackknife from few blocks is rank-deficient, so each
-        # window's own matrix is used only through its size relative to the median (trace in the
-        # median's metric).
+        # Per-window covariance: a jackknife from few blocks is rank-deficient and noisy in its small
+        # directions, so each window's own matrix sets a size relative to the median (trace in the
+        # median's metric), and then also covers the window's own matrix in every direction (session 4:
+        # a day cut by a momentum dump is poorly determined along one direction of its own; the median
+        # shape, however scaled, misses that direction and the day's error along it became alarms).
         inv_b = np.linalg.pinv(boot, hermitian=True)
         own = series.covariance[:, idx][:, :, idx]
         good = np.all(np.isfinite(own.reshape(k, -1)), axis=1)
-        size = np.where(good, np.einsum("ij,tji->t", inv_b, np.where(good[:, None, None], own, 0.0)) / d, 1.0)
-        cov_w = np.clip(size, 0.1, 100.0)[:, None, None] * boot[None, :, :]
+        own = np.where(good[:, None, None], own, boot[None])
+        size = np.where(good, np.einsum("ij,tji->t", inv_b, own) / d, 1.0)
+        cov_w = covering_covariance(boot, own, np.clip(size, 0.1, None))
         w_i = np.linalg.pinv(cov_w, hermitian=True)
         lag_m = []
         for lag in (1, 2, 3):
@@ -179,7 +204,6 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
             float(scale[alarm_at]) if alarm_at >= 0 else float(np.nanmax(scale)) if np.isfinite(scale).any() else 1.0
         )
         sigma = boot * c_final
-        inv = np.linalg.pinv(sigma)
         diag = Diagnostics(
             name="inertia_glr",
             time_s=series.t_end_s,
@@ -194,20 +218,26 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
             return DetectionResult.empty(diagnostics=(diag,), warnings=tuple(warnings))
         # Characterise with every window after the change (not only up to the alarm).
         tau = int(best_tau[alarm_at])
-        full_stats = []
+        # GLS means on either side, as in the statistic (a window poorly determined along one direction
+        # weighs little along it), with the covariance scale c at the alarm.
         first_cand = max(self.min_windows_before, alarm_at + 1 - self.max_change_age)
-        for cand in range(first_cand, k):
-            lo_c = max(0, cand - self.max_windows_before)
-            diff = x[cand:].mean(axis=0) - x[lo_c:cand].mean(axis=0)
-            n_b = cand - lo_c
-            full_stats.append(n_b * (k - cand) / (n_b + k - cand) * float(diff @ inv @ diff))
-        tau = first_cand + int(np.argmax(full_stats)) if full_stats else tau
-        before, after = series.params[max(0, tau - self.max_windows_before) : tau], series.params[tau:]
-        dj = after.mean(axis=0) - before.mean(axis=0)
-        dj_cov_obs = sigma * (1.0 / before.shape[0] + 1.0 / after.shape[0])
+        cands = np.arange(first_cand, k)
+        if cands.size == 0:
+            cands = np.array([tau])
+        lo_c = np.maximum(cands - self.max_windows_before, 0)
+        cov_bc = np.linalg.pinv(cw[cands] - cw[lo_c], hermitian=True)
+        cov_ac = np.linalg.pinv(cw[k] - cw[cands], hermitian=True)
+        diff_c = np.einsum("tij,tj->ti", cov_ac, cwx[k] - cwx[cands]) - np.einsum(
+            "tij,tj->ti", cov_bc, cwx[cands] - cwx[lo_c]
+        )
+        full_stats = np.einsum("ti,tij,tj->t", diff_c, np.linalg.pinv(cov_bc + cov_ac, hermitian=True), diff_c)
+        j_c = int(np.argmax(full_stats))
+        tau = int(cands[j_c])
+        dj_cov_obs = c_final * (cov_bc[j_c] + cov_ac[j_c])
+        dj = np.full(6, np.nan)
+        dj[idx] = diff_c[j_c]
         dj_sig = np.full(6, np.nan)
         dj_sig[idx] = np.sqrt(np.diag(dj_cov_obs))
-        dj = np.where(obs, dj, np.nan)
         trace_idx = [i for i in range(3) if obs[i]]
         r2 = self.attachment_radius_m**2
         if len(trace_idx) == 3:

@@ -4,9 +4,10 @@ Day by day with :func:`~abrupt.simulate.attitude.simulate_pointing` (state carri
 day about random axes (15-45°, smooth ramps), gravity gradient, a sun-tracking array, a small constant
 inertial torque; at ``docking_time_s`` the truth inertia becomes the point-mass update of
 :func:`~abrupt.massprops.inertia.inertia_after_docking` and the contact gives an angular impulse
-ρ × m v (Dabrowski 2003 Eq. 2.35) as a strike. Momentum dumps (off by default): when the system momentum
-exceeds ``dump_threshold_Nms`` at the start of a day, thrusters remove it at a quiet time of that day (an
-impulse −H_N, which the wheels then shed; its time is recorded as a thruster-flag interval).
+ρ × m v (Dabrowski 2003 Eq. 2.35) as a strike. Momentum dumps (on by default since session 4;
+``dump_threshold_Nms=None`` turns them off): when the system momentum exceeds ``dump_threshold_Nms`` at
+the start of a day, thrusters remove it at a quiet time of that day (an impulse −H_N, which the wheels
+then shed; its time is recorded as a thruster-flag interval).
 """
 
 from __future__ import annotations
@@ -53,7 +54,7 @@ class DockingScenario:
     appendage_axis_B: tuple[float, float, float] = (0.0, 1.0, 0.0)
     appendage_spin_inertia_kgm2: float = 18.0
     sim_rate_hz: float = 5.0
-    dump_threshold_Nms: float | None = None
+    dump_threshold_Nms: float | None = 0.5
     dump_duration_s: float = 10.0
     gain_K_Nm: float = 10.0
     gain_P_Nms: float = 150.0
