@@ -266,18 +266,17 @@ def grid_search(
     ``cost`` maps an array of candidate values to an array of costs (vectorised over the grid).
     Returns (best value, its cost).
     """
-    lo, hi = range_lo * center, range_hi * center
-    step = (hi - lo) / n_intervals
-    best, j_min = center, math.inf
-    while step > tol:
-        grid = lo + step * np.arange(n_intervals + 1)
-        costs = np.asarray(cost(grid))  # type: ignore[operator]
-        k = int(np.argmin(costs))
-        if costs[k] < j_min:
-            j_min, best = float(costs[k]), float(grid[k])
-        lo, hi = best - shrink_half_width_steps * step, best + shrink_half_width_steps * step
-        step = (hi - lo) / n_intervals
-    return best, j_min
+    best, j_min = grid_search_batch(
+        lambda grid: np.asarray(cost(grid[:, 0]))[:, None],  # type: ignore[operator]
+        center,
+        1,
+        range_lo=range_lo,
+        range_hi=range_hi,
+        n_intervals=n_intervals,
+        shrink_half_width_steps=shrink_half_width_steps,
+        tol=tol,
+    )
+    return float(best[0]), float(j_min[0])
 
 
 def grid_search_batch(
