@@ -6,6 +6,7 @@ import json
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 from click.testing import CliRunner
 
@@ -620,3 +621,37 @@ def test_estimate_inertia_from_the_ingested_flight_like_store(shared_data, tmp_p
     moments = principal_axes(np.asarray(truth["J_true_kgm2"])).moments_kgm2
     np.testing.assert_allclose(est.moments_kgm2, moments, rtol=0.005)
     np.testing.assert_allclose(est.inertia_kgm2, truth["J_true_kgm2"], atol=3.0)
+
+
+def test_simulated_docking_files_flag_their_dumps_and_the_reader_turns_them_into_impulse_windows(tmp_path):
+    # The wide CSVs of `abrupt simulate docking` carry a thruster_flag column; reading them back gives
+    # one impulse window at each dump of docking_truth.json (10-s firings at 1 Hz telemetry).
+    from abrupt.cli.main import cli
+    from abrupt.model.spacecraft import load_spacecraft
+    from abrupt.pipelines.mass import THRUSTER_FLAG_COLUMN, load_momentum_data
+
+    sc_path = tmp_path / "sc.toml"
+    sc_path.write_text(
+        'name = "SC-F"\nmass_kg = 1000.0\ninertia_kgm2 = [[900.0, 25.0, -13.0], [25.0, 700.0, 12.0], [-13.0, 12.0, 1000.0]]\n'
+        + "".join(
+            f'[[wheels]]\nname = "rw{i}"\naxis = {a}\nspin_inertia_kgm2 = 0.12\nmax_torque_Nm = 0.2\n'
+            for i, a in enumerate([[1, 1, 1], [-1, 1, 1], [-1, -1, 1], [1, -1, 1]])
+        )
+    )
+    out = tmp_path / "sim"
+    args = ["simulate", "docking", "--spacecraft", str(sc_path), "--out", str(out), "--days", "2"]
+    r = CliRunner().invoke(cli, [*args, "--docking-day", "-1", "--dump-threshold", "0.01"])
+    assert r.exit_code == 0, r.output
+    truth = json.loads((out / "docking_truth.json").read_text())
+    dumps_s = [d["time_s"] for d in truth["momentum_dumps"]]
+    assert dumps_s, "a 0.01 N m s threshold must dump at the start of day 1"
+    day1 = sorted(out.glob("*_day001.csv"))
+    frame = pd.read_csv(day1[0])
+    assert frame[THRUSTER_FLAG_COLUMN].sum() > 0
+    sc = load_spacecraft(sc_path)
+    data, _ = load_momentum_data(day1, sc)
+    t0 = (pd.Timestamp(frame.iloc[0, 0]) - pd.Timestamp(truth["epoch_utc"])).total_seconds()
+    windows = data.impulse_windows_s
+    for t_dump in (t for t in dumps_s if t >= t0):
+        assert any(a - 1.0 <= t_dump - t0 <= b + 1.0 for a, b in windows), (t_dump - t0, windows)
+    assert len(windows) == sum(t >= t0 for t in dumps_s)

@@ -1252,8 +1252,9 @@ def run_tle_detector(
     lag0 = [float(model.t[it[0]]) - it[1] for it in timed if it[2] and stat[it[0]] >= threshold]
     lag0_s = float(np.quantile(np.maximum(lag0, 0.0), 0.9)) if len(lag0) >= 5 else 0.0
 
-    def secondary_outside(x: tuple[int, float, bool, float]) -> tuple[bool, float | None]:
-        """(merge into the stronger neighbour?, the one burn's time when the middle-set test says so)"""
+    def secondary_outside(x: tuple[int, float, bool, float]) -> tuple[bool, float | None, int]:
+        """(merge into the stronger neighbour?, the one burn's time when the middle-set test says so,
+        the stronger neighbour's gap)"""
         g_x = x[0]
         reach_sets = 2 if MIDDLE_SET_TEST and regime == "leo" else 1
         stronger = [
@@ -1262,7 +1263,7 @@ def run_tle_detector(
             if g_y != g_x and g_y in cp_set and stat[g_y] > stat[g_x]
         ]
         if not stronger:
-            return False, None
+            return False, None, -1
         g_y = min(stronger, key=lambda c: abs(c - g_x))
         if MIDDLE_SET_TEST and regime == "leo":
             g1, g2 = min(g_x, g_y), max(g_x, g_y)
@@ -1270,20 +1271,26 @@ def run_tle_detector(
             z_mid, t_one = middle_set_phase_z(history, model.t, g1, g2, seg_pair, float(model.scales["u_m"][g1 + 1]))
             if math.isfinite(z_mid):
                 # the middle sets on one burn's trajectory: one burn, timed by that trajectory
-                return (True, t_one) if z_mid < threshold else (False, None)
+                return (True, t_one, g_y) if z_mid < threshold else (False, None, g_y)
         if abs(g_y - g_x) > 1:
-            return False, None
-        return not (float(model.t[g_x]) - lag0_s <= x[1] <= float(model.t[g_x + 1])), None
+            return False, None, g_y
+        return not (float(model.t[g_x]) - lag0_s <= x[1] <= float(model.t[g_x + 1])), None, g_y
 
     kept: list[tuple[int, float, bool, float]] = []
     span_of: dict[int, list[float]] = {}
     for item in sorted(timed, key=lambda it: -stat[it[0]]):
         near = [k for k in kept if abs(item[1] - k[1]) < merge_s or out_of_order(item, k)]
         if not near:
-            merge, t_one = secondary_outside(item)
+            merge, t_one, g_host = secondary_outside(item)
             if merge:
-                near = sorted((k for k in kept if 0 < abs(k[0] - item[0]) <= 2), key=lambda k: abs(k[0] - item[0]))
-                if near and t_one is not None:  # one burn: timed by its one-burn trajectory
+                # the stronger neighbour the test paired it with; if that one was itself merged into
+                # another event, the nearest kept event no farther away
+                exact = [k for k in kept if k[0] == g_host]
+                reach = abs(g_host - item[0])
+                near = exact or sorted(
+                    (k for k in kept if 0 < abs(k[0] - item[0]) <= reach), key=lambda k: abs(k[0] - item[0])
+                )
+                if exact and t_one is not None:  # one burn: timed by its one-burn trajectory
                     retimed = (near[0][0], t_one, True, min(near[0][3], t_one))
                     kept[kept.index(near[0])] = retimed
                     span_of[retimed[0]][0] = min(span_of[retimed[0]][0], t_one)

@@ -172,6 +172,38 @@ def load_momentum_data_from_store(
     return data, repairs
 
 
+THRUSTER_FLAG_COLUMN = "thruster_flag"
+"""Optional column of wide telemetry files: 1 while the thrusters fire (a momentum dump), else 0."""
+
+
+def _extra_column(
+    paths: list[Path], spacecraft: Spacecraft, column: str, epoch: pd.Timestamp, repairs: RepairLog
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """An optional column of the wide files as its own channel (s from ``epoch``, value), on the files' own
+    time stamps (so rows the telemetry reader repaired or dropped do not shift it). None when no file has
+    it; files without it, and rows with an unreadable time or value, are counted in ``repairs``."""
+    ts, vs, missing, bad = [], [], 0, 0
+    for p in paths:
+        frame = pd.read_parquet(p) if p.suffix == ".parquet" else pd.read_csv(p)
+        if column not in frame.columns:
+            missing += 1
+            continue
+        time = pd.to_datetime(frame[spacecraft.telemetry.time], utc=True, errors="coerce", format="ISO8601")
+        value = pd.to_numeric(frame[column], errors="coerce").to_numpy(dtype=np.float64)
+        t_s = (time.dt.tz_localize(None) - epoch).dt.total_seconds().to_numpy(dtype=np.float64)
+        ok = np.isfinite(t_s) & np.isfinite(value)
+        bad += int((~ok).sum())
+        ts.append(t_s[ok])
+        vs.append(value[ok])
+    if not ts:
+        return None
+    repairs.record(f"files without a {column!r} column (read as absent there)", missing)
+    repairs.record(f"rows with an unreadable time or {column!r} value skipped for that column", bad)
+    t_all, v_all = np.concatenate(ts), np.concatenate(vs)
+    order = np.argsort(t_all, kind="stable")
+    return t_all[order], v_all[order]
+
+
 def load_momentum_data(
     paths: list[Path], spacecraft: Spacecraft, options: MomentumOptions = MomentumOptions()
 ) -> tuple[MomentumBalanceData, RepairLog]:
@@ -196,22 +228,18 @@ def load_momentum_data(
     w = np.concatenate([x.body_rate_rad_s for x in parts])
     wheels = np.concatenate([x.wheel_speed_rad_s for x in parts])
     app_angle = None
+    app_axis = None
+    app_j = 0.0
     app = spacecraft.appendages[0] if spacecraft.appendages else None
     if app is not None and len(app.gimbal_axes) == 1:
-        cols = []
-        for p in paths:
-            frame = pd.read_parquet(p) if p.suffix == ".parquet" else pd.read_csv(p)
-            if app.angle_columns[0] in frame.columns:
-                cols.append(frame[app.angle_columns[0]].to_numpy(dtype=np.float64))
-        if len(cols) == len(paths):
-            from abrupt.model.spacecraft import ANGLE_UNITS
+        from abrupt.model.spacecraft import ANGLE_UNITS
 
-            app_angle = (t, np.concatenate(cols)[: t.size] * ANGLE_UNITS[app.angle_unit])
-    app_j = 0.0
-    app_axis = None
-    if app_angle is not None and app is not None:
-        app_axis = app.gimbal_axes[0]
-        app_j = float(app_axis @ app.inertia_kgm2 @ app_axis)
+        angle = _extra_column(paths, spacecraft, app.angle_columns[0], epoch, repairs)
+        if angle is not None:
+            app_angle = (angle[0], angle[1] * ANGLE_UNITS[app.angle_unit])
+            app_axis = app.gimbal_axes[0]
+            app_j = app.drive_inertia_kgm2
+    flag = _extra_column(paths, spacecraft, THRUSTER_FLAG_COLUMN, epoch, repairs)
     data = momentum_data_from_channels(
         (t, q),
         (t, w),
@@ -222,6 +250,7 @@ def load_momentum_data(
         appendage_angle=app_angle,
         appendage_axis_B=app_axis,
         appendage_spin_inertia_kgm2=app_j,
+        thruster_flag=flag,
         orbit_period_s=options.orbit_period_s,
         nadir_axis_B=options.nadir_axis_B,
         rate_average_s=0.0,
@@ -383,6 +412,10 @@ def simulate_docking_run(spacecraft_file: str | Path, out_dir: str | Path, scena
 
             app = sc.appendages[0]
             frame[app.angle_columns[0]] = day.appendage_angle_rad / ANGLE_UNITS[app.angle_unit]
+        firing = np.zeros(day.t_s.size, dtype=np.int8)
+        for t_dump, _ in sim.dumps:
+            firing |= ((day.t_s >= t_dump) & (day.t_s <= t_dump + scenario.dump_duration_s)).astype(np.int8)
+        frame[THRUSTER_FLAG_COLUMN] = firing
         frame[frame.columns[0]] = frame[frame.columns[0]].dt.strftime("%Y-%m-%dT%H:%M:%S.%fZ")
         path = out / f"{sc.name}_day{d:03d}.csv"
         frame.to_csv(path, index=False, float_format="%.10g")
