@@ -42,7 +42,13 @@ from scipy import stats
 from abrupt.detect.tle_detectors import detector_for
 from abrupt.readers.fengyun import read_maneuver_file
 from abrupt.readers.tle import read_tle
-from abrupt.simulate.tle_null import NullHistorySpec, bootstrap_null_history, quiet_mask, simulate_null_history
+from abrupt.simulate.tle_null import (
+    NullHistorySpec,
+    bootstrap_null_history,
+    gaps_clear_of_junctions,
+    quiet_mask,
+    simulate_null_history,
+)
 from abrupt.thresholds import FalseAlarmBudget
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -93,14 +99,9 @@ def run_one(job: tuple[str, dict[str, Any]]) -> list[dict[str, Any]]:
     el = history.elements
     years = (el["epoch_utc"].iloc[-1] - el["epoch_utc"].iloc[0]).total_seconds() / 86400.0 / 365.25
     det = detector_for(history)
-    # gaps whose test holds no junction between noise blocks: the slope windows (2 × window_sets
-    # sets each side) and the ±2-gap localisation of a change point
+    # gaps whose test holds no junction between noise blocks (bootstrap histories only)
     n_gaps = len(el) - 1
-    reach = 2 * det.settings.window_sets + 3
-    counted = np.ones(n_gaps, dtype=bool)
-    if kind == "bootstrap":
-        for j in junctions:  # sets j-1 and j come from different blocks
-            counted[max(0, j - reach - 1) : j + reach] = False
+    counted = gaps_clear_of_junctions(n_gaps, junctions if kind == "bootstrap" else [], det.settings.window_sets)
     years *= counted.mean()
     epochs = el["epoch_utc"].to_numpy(dtype="datetime64[ns]")
     rows = []

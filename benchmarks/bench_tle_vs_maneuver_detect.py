@@ -609,8 +609,8 @@ def main() -> None:
         "dv_isolated_within_2x",
         "dv_median_ratio",
     ]
-    fmt = {"display.width": 250, "display.max_columns": 40, "display.float_format": "{:.2f}".format}
-    with pd.option_context(fmt):
+    fmt = ("display.width", 250, "display.max_columns", 40, "display.float_format", "{:.2f}".format)
+    with pd.option_context(*fmt):
         print("Per satellite (abrupt: leave-one-satellite-out gain; ±1 day one-to-one; budget 1/year)")
         print(table[[c for c in cols if c in table]].to_string(index=False))
         print("\nGain chosen for each held-out satellite, tuned on:")

@@ -632,7 +632,8 @@ def test_simulated_docking_files_flag_their_dumps_and_the_reader_turns_them_into
 
     sc_path = tmp_path / "sc.toml"
     sc_path.write_text(
-        'name = "SC-F"\nmass_kg = 1000.0\ninertia_kgm2 = [[900.0, 25.0, -13.0], [25.0, 700.0, 12.0], [-13.0, 12.0, 1000.0]]\n'
+        'name = "SC-F"\nmass_kg = 1000.0\n'
+        + "inertia_kgm2 = [[900.0, 25.0, -13.0], [25.0, 700.0, 12.0], [-13.0, 12.0, 1000.0]]\n"
         + "".join(
             f'[[wheels]]\nname = "rw{i}"\naxis = {a}\nspin_inertia_kgm2 = 0.12\nmax_torque_Nm = 0.2\n'
             for i, a in enumerate([[1, 1, 1], [-1, 1, 1], [-1, -1, 1], [1, -1, 1]])

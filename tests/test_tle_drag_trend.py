@@ -76,3 +76,25 @@ def test_a_5_cm_s_burn_under_changing_drag_is_found(spec: NullHistorySpec) -> No
     near = events[dt_days.to_numpy() < 1.0]
     assert len(near) == 1
     assert math.isclose(abs(float(near["dv_t_mps"].iloc[0])), BURN_DV_MPS, rel_tol=0.2)
+
+
+def test_stated_decay_of_a_hand_written_element_set_matches_the_hand_computed_rate(tmp_path) -> None:
+    # The ISS set of the TLE format's usual example: first-derivative field -.00002182 = ṅ/2 (rev/day²),
+    # n = 15.72125391 rev/day. By hand: ṅ/n = -4.364e-5/15.72125391 per day, a from Kepler's third law
+    # (WGS-72 μ), ȧ = -(2/3) a ṅ/n = +12.4 m/day (this set states a slowing mean motion, so a grows).
+    # Independent of the null generator, which writes ndot with the same reader's convention.
+    from abrupt.readers.omm import read_element_histories
+
+    path = tmp_path / "iss.tle"
+    path.write_text(
+        "ISS (ZARYA)\n"
+        "1 25544U 98067A   08264.51782528 -.00002182  00000-0 -11606-4 0  2927\n"
+        "2 25544  51.6416 247.4627 0006703 130.5360 325.0288 15.72125391563537\n"
+    )
+    history = read_element_histories(path)[0]
+    n_rad_s = 15.72125391 * 2.0 * math.pi / 86400.0
+    a_m = (398600.8e9 / n_rad_s**2) ** (1.0 / 3.0)
+    adot_m_day = -(2.0 / 3.0) * a_m * (2.0 * -0.00002182 / 15.72125391)
+    assert adot_m_day == pytest.approx(12.4, abs=0.1)
+    stated = stated_decay_m_s(history)[0] * 86400.0
+    assert stated == pytest.approx(adot_m_day, rel=0.01)

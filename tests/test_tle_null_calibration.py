@@ -70,7 +70,7 @@ def test_bootstrap_of_real_noise_keeps_the_budget(shared_data, satellite: str, o
     junctions, at most twice the budget (benchmark: 0.23 and 0.00 per year)."""
     from abrupt.readers.fengyun import read_maneuver_file
     from abrupt.readers.tle import read_tle
-    from abrupt.simulate.tle_null import bootstrap_null_history, quiet_mask
+    from abrupt.simulate.tle_null import bootstrap_null_history, gaps_clear_of_junctions, quiet_mask
 
     real = read_tle(shared_data / "tle" / f"{satellite}.tle")
     truth = read_maneuver_file(shared_data / "maneuvers" / operator_file)
@@ -81,10 +81,7 @@ def test_bootstrap_of_real_noise_keeps_the_budget(shared_data, satellite: str, o
         history, junctions = bootstrap_null_history(real, quiet, regime=regime, years=5.0, seed=seed)
         detector = detector_for(history)
         n_gaps = len(history) - 1
-        reach = 2 * detector.settings.window_sets + 3
-        counted = np.ones(n_gaps, dtype=bool)
-        for j in junctions:
-            counted[max(0, j - reach - 1) : j + reach] = False
+        counted = gaps_clear_of_junctions(n_gaps, junctions, detector.settings.window_sets)
         epochs = history.elements["epoch_utc"].to_numpy(dtype="datetime64[ns]")
         events = detector.run(history, FalseAlarmBudget(1.0, "year")).events
         before = events["elset_epoch_before_utc"].astype("datetime64[ns]").to_numpy()

@@ -135,6 +135,8 @@ class TleDetectorConfig:
             raise ValueError(f"drag_trend must be none or ndot, got {self.drag_trend!r}")
         if self.drag_median_sets < 1:
             raise ValueError("drag_median_sets must be >= 1")
+        if not (self.drag_min_decay_m_day > 0 and math.isfinite(self.drag_min_decay_m_day)):
+            raise ValueError("drag_min_decay_m_day must be a finite positive number")
         if not (self.along_track_gain >= 0 and math.isfinite(self.along_track_gain)):
             raise ValueError("along_track_gain must be a finite non-negative number")
 
@@ -915,8 +917,9 @@ def middle_set_phase_z(
     fitted across it (blends: compromise mean motions, so ``a`` steps over several gaps). The
     along-track position of the sets tells which: one impulse bends the along-track angle once,
     ``c₀ + c₁τ + c₂τ² + β·max(0, t − t_b)`` (Vallado 2013 Eq. 9-41); a second burn after the middle
-    sets bends it again. The model is fitted (L1; hinge time on a coarse then a fine grid from three
-    sets before the first step to the set after the second) to every set of the window but the
+    sets bends it again. The model is fitted (least squares per hinge time; the hinge with the smallest
+    L1 residual, on a coarse then a fine grid from three sets before the first step to the set after
+    the second) to every set of the window but the
     middle ones (sets ``g1+1 … g2``); their largest deviation from that one-burn trajectory over the
     satellite's own per-set phase noise ``sigma_u_m`` (m) is returned with the fit's hinge time (s,
     origin of ``t``: the burn time if it is one burn). Two burns a day apart move the middle set by
@@ -1104,6 +1107,7 @@ def noise_summary(
         "robust_sigma_a_m": sig_a / wa if wa > 0 else math.inf,
         "drift_q_a_m2_per_day": model.drift_q["a_m"] * SECONDS_PER_DAY,
         "gaps_per_year": gaps_per_year,
+        "drag_trend_used": bool(getattr(model, "drag_trend_used", False)),
         # 1σ of an in-track / cross-track ΔV at the median gap (the step noise through vis-viva)
         "dv_t_sigma_mps": v * sig_a / (wa * 2.0 * a_ref_m) if wa > 0 else math.inf,
         "dv_n_sigma_mps": v * sig_n / wn if wn > 0 else math.inf,

@@ -15,8 +15,9 @@ coarse-to-fine grid search of Appendix C (§5.4; L1 cost over the match windows)
 
 Synthetic testbed (§8.1 item 11; :data:`THESIS_TESTBED`, calibrated by
 ``benchmarks/calibrate_dabrowski_noise.py`` and ``benchmarks/bench_dabrowski.py``): per-run wheel
-non-repeatability (random wheel gain), a gyro drift that the satellite tracks (thesis §4.1, about
-−2.5°/min; with a PD loop it leaves a steady attitude error proportional to I33), white rate-gyro noise
+non-repeatability (random wheel gain), a gyro drift that the satellite tracks (thesis §4.1: "about
+−2.5°/min" typical; −2°/min in the testbed, chosen leave-one-amplitude-out; with a PD loop it leaves a
+steady attitude error proportional to I33), white rate-gyro noise
 and a long-period gyro wander (60-120 s period); the controller flies the gyro-integrated attitude, which
 is what is recorded. Candidate sources that the calibration did not select (motor dead band, external
 torque, run-to-run drift) are available in :class:`TestbedNoise`.
@@ -102,7 +103,8 @@ class TestbedNoise:
     ``wheel_gain_sd``: relative SD of the wheel gain from run to run; ``lut_slope_sd``: relative SD of the
     look-up table's slope (the unsaturated part) from run to run (§8.1 item 11); ``gyro_bias_deg_min``: mean residual
     drift after the operator's zeroing (App. F) and ``gyro_bias_sd_deg_min`` its run-to-run SD [deg/min]
-    (the raw −2.5°/min of §3.3 is calibrated out before a test); ``wander_deg``: amplitude of the long-period
+    (``THESIS_TESTBED``: −2°/min that the satellite tracks, thesis §4.1; the default −0.1 is the
+    residual of a zeroed gyro, App. F); ``wander_deg``: amplitude of the long-period
     gyro wander (period uniform in ``wander_period_s``); ``encoder_noise_rad_s`` wheel-speed noise;
     ``rate_noise_deg_s`` white noise of each rate-gyro sample (its integral is a random walk of the
     recorded attitude; the controller flies it); ``deadband_max_rad_s``: the motor ignores a commanded

@@ -119,9 +119,18 @@ def load_momentum_data_from_store(
                 key="flight.channels",
             )
         series = [channel(c) for c in chans]
-        common = series[0][0]
+        common = np.unique(series[0][0])
         for t, _ in series[1:]:
             common = np.intersect1d(common, t)
+        lost = sum(t.size for t, _ in series) - n * common.size
+        if common.size < 0.5 * max(t.size for t, _ in series):
+            raise InputError(
+                f"{quantity} components {[c.mnemonic for c in chans]} share only {common.size} of "
+                f"{max(t.size for t, _ in series)} time stamps: the components must be sampled together",
+                file=repairs.source,
+                column=chans[0].mnemonic,
+            )
+        repairs.record(f"{quantity} samples without every component at their stamp dropped", lost)
         return common, np.column_stack([v[np.searchsorted(t, common)] for t, v in series])
 
     wheel_chans = flight.of("wheel_speed")

@@ -468,3 +468,14 @@ def bootstrap_null_history(
         out["adot_m_s"] += res["adot_bias_m_s"][0]
     junctions = np.asarray([j for j in starts[1:] if j < t.size], dtype=np.int64)
     return history_from_series(t, out, regime, norad=99800 + seed % 99), junctions
+
+
+def gaps_clear_of_junctions(n_gaps: int, junctions: Sequence[int], window_sets: int) -> NDArray[np.bool_]:
+    """Gaps whose step test holds no junction between bootstrap noise blocks (sets ``j-1`` and ``j`` of a
+    junction ``j`` come from different blocks): outside the slope windows (2 × ``window_sets`` sets each
+    side) and the ±2-gap localisation of a change point. Only these gaps count as null tests."""
+    reach = 2 * window_sets + 3
+    counted = np.ones(n_gaps, dtype=bool)
+    for j in junctions:
+        counted[max(0, j - reach - 1) : j + reach] = False
+    return counted
