@@ -253,34 +253,6 @@ def l1_cost(y_meas: FloatArray, y_model: FloatArray, mask: FloatArray) -> FloatA
     return np.asarray(np.sum(np.abs(y_meas - y_model) * mask[:, None], axis=0) / mask.sum(), dtype=np.float64)
 
 
-def grid_search(
-    cost: object,
-    center: float,
-    *,
-    range_lo: float = 0.5,
-    range_hi: float = 2.0,
-    n_intervals: int = 20,
-    shrink_half_width_steps: float = 2.5,
-    tol: float = 1e-6,
-) -> tuple[float, float]:
-    """Coarse-to-fine grid search of App. C (spec §5.4): 21 points, range → best ± 2.5 steps, until step ≤ tol.
-
-    ``cost`` maps an array of candidate values to an array of costs (vectorised over the grid).
-    Returns (best value, its cost).
-    """
-    best, j_min = grid_search_batch(
-        lambda grid: np.asarray(cost(grid[:, 0]))[:, None],  # type: ignore[operator]
-        center,
-        1,
-        range_lo=range_lo,
-        range_hi=range_hi,
-        n_intervals=n_intervals,
-        shrink_half_width_steps=shrink_half_width_steps,
-        tol=tol,
-    )
-    return float(best[0]), float(j_min[0])
-
-
 def grid_search_batch(
     cost: object,
     center: float,
@@ -292,7 +264,9 @@ def grid_search_batch(
     shrink_half_width_steps: float = 2.5,
     tol: float = 1e-6,
 ) -> tuple[FloatArray, FloatArray]:
-    """:func:`grid_search` for ``n_problems`` independent problems in lockstep (the same result per problem).
+    """Coarse-to-fine grid search of App. C (spec §5.4) for ``n_problems`` independent problems in lockstep:
+    21 points over [range_lo, range_hi] × ``center``, then the range shrinks to best ± 2.5 steps, until
+    the step is ≤ ``tol``.
 
     ``cost`` maps a grid of shape (n_intervals + 1, n_problems) to costs of the same shape; every problem
     starts from the same range, so all take the same refinement steps. Returns (best values, their costs).
@@ -354,28 +328,16 @@ def estimate_run_i33(
     params: SimsatParams, maneuver: Maneuver, y_meas: FloatArray, tol: float = 1e-4
 ) -> tuple[float, float]:
     """Phase B for one run: grid search on I33 with all other parameters frozen (spec §5.4)."""
-    t = maneuver.times(params.dt_s)
-    mask = maneuver.match_mask(t)
-
-    def cost(grid: FloatArray) -> FloatArray:
-        sim = simulate_simsat(params, maneuver, grid)
-        return l1_cost(y_meas[:, None], sim["yaw_meas_rad"], mask)
-
-    return grid_search(cost, params.i33_kgm2, tol=tol)
+    est, cost = estimate_runs_i33(params, maneuver, np.asarray(y_meas)[:, None], tol=tol)
+    return float(est[0]), float(cost[0])
 
 
 def tune_wheel_gain(
     params: SimsatParams, maneuver: Maneuver, y_meas: FloatArray, tol: float = 1e-5
 ) -> tuple[float, float]:
     """Phase A for one baseline run: the wheel gain that best fits it with the known I33 (spec §5.3)."""
-    t = maneuver.times(params.dt_s)
-    mask = maneuver.match_mask(t)
-
-    def cost(grid: FloatArray) -> FloatArray:
-        sim = simulate_simsat(params, maneuver, None, grid)
-        return l1_cost(y_meas[:, None], sim["yaw_meas_rad"], mask)
-
-    return grid_search(cost, params.wheel_gain, tol=tol)
+    wg, cost = tune_wheel_gains(params, maneuver, np.asarray(y_meas)[:, None], tol=tol)
+    return float(wg[0]), float(cost[0])
 
 
 def aggregate(estimates: ArrayLike, mean_errors: ArrayLike, method: int = 1) -> float:
