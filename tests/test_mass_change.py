@@ -546,6 +546,20 @@ def test_store_input_errors_name_the_missing_table_and_channel(tmp_path):
     assert load_spacecraft(bad).flight is not None
     with pytest.raises(InputError, match=r"SC-D\.ch99"):
         estimate_inertia_run(src, bad)
+    # Quaternion components not sampled together (one component's stamps shifted by 0.3 s): the join
+    # on common stamps would drop nearly everything, so it is an error naming the components.
+    from abrupt.store import TelemetryStore
+
+    old, shifted = TelemetryStore(store), TelemetryStore(tmp_path / "shifted")
+    for day in old.days("SC-D"):
+        samples = old.read_day("SC-D", day)
+        samples["mnemonic"] = samples["mnemonic"].astype(str)
+        moved = samples["mnemonic"] == "SC-D.ch01"
+        samples.loc[moved, "time"] += pd.Timedelta(milliseconds=300)
+        samples["time"] = samples["time"].dt.tz_localize("UTC")
+        shifted.write_day("SC-D", day, samples, {})
+    with pytest.raises(InputError, match=r"quaternion components .*SC-D\.ch01.* share only"):
+        estimate_inertia_run(StoreInput(tmp_path / "shifted"), sc)
 
 
 @pytest.mark.slow

@@ -82,7 +82,11 @@ def load_momentum_data_from_store(
             key="flight",
         )
     if not spacecraft.wheels:
-        raise ConfigError("the spacecraft file has no [[wheels]]: the momentum balance needs them", key="wheels")
+        raise ConfigError(
+            "the spacecraft file has no [[wheels]]: the momentum balance needs them",
+            file=spacecraft.source,
+            key="wheels",
+        )
     flight = spacecraft.flight
     store = TelemetryStore(root)
     day_list = day_range(store, spacecraft.name, days)
@@ -146,7 +150,7 @@ def load_momentum_data_from_store(
     app_angle, app_axis, app_j = None, None, 0.0
     for c in flight.of("appendage_angle"):
         app = next((a for a in spacecraft.appendages if a.name == c.appendage), None)
-        if app is not None and len(app.gimbal_axes) == 1:
+        if app is not None and len(app.gimbal_axes) == 1:  # the loader checked the name (flight_config)
             app_angle, app_axis, app_j = channel(c), app.gimbal_axes[0], app.drive_inertia_kgm2
             break
     flag = None
@@ -222,7 +226,11 @@ def load_momentum_data(
     from the columns the spacecraft file names (``[[appendages]] angle_columns``) when present.
     """
     if not spacecraft.wheels:
-        raise ConfigError("the spacecraft file has no [[wheels]]: the momentum balance needs them", key="wheels")
+        raise ConfigError(
+            "the spacecraft file has no [[wheels]]: the momentum balance needs them",
+            file=spacecraft.source,
+            key="wheels",
+        )
     repairs = RepairLog(",".join(p.name for p in paths))
     parts = []
     for p in paths:
