@@ -58,8 +58,10 @@ def test_changing_drag_stays_within_twice_the_budget(null_histories) -> None:
     """Ten maneuver-free satellite-years at 450 km: at most twice the budget with the drag trend
     (without it the local straight-line trend gives more than twice: the defect it fixes)."""
     years = sum(_years(h) for h in null_histories)
-    with_trend = sum(len(TleMeanElements().run(h, BUDGET).events) for h in null_histories)
+    runs = [TleMeanElements().run(h, BUDGET) for h in null_histories]
+    with_trend = sum(len(r.events) for r in runs)
     without = sum(len(TleMeanElements(drag_trend="none").run(h, BUDGET).events) for h in null_histories)
+    assert all(r.noise_model["drag_trend_used"] for r in runs)  # 450 km: ~30 m/day, gate open
     assert years > 9.0
     assert with_trend / years <= 2.0 * BUDGET.per_year
     assert without / years > 2.0 * BUDGET.per_year
@@ -98,3 +100,9 @@ def test_stated_decay_of_a_hand_written_element_set_matches_the_hand_computed_ra
     assert adot_m_day == pytest.approx(12.4, abs=0.1)
     stated = stated_decay_m_s(history)[0] * 86400.0
     assert stated == pytest.approx(adot_m_day, rel=0.01)
+
+
+def test_drag_trend_stays_off_where_drag_is_slow() -> None:
+    """At 1300 km ``a`` decays far below 2 m/day: the gate keeps the straight-line trend alone."""
+    history = simulate_null_history(NullHistorySpec(altitude_km=1300.0, sets_per_day=1.0, years=1.0, seed=7))
+    assert not TleMeanElements().run(history, BUDGET).noise_model["drag_trend_used"]

@@ -1107,7 +1107,7 @@ def noise_summary(
         "robust_sigma_a_m": sig_a / wa if wa > 0 else math.inf,
         "drift_q_a_m2_per_day": model.drift_q["a_m"] * SECONDS_PER_DAY,
         "gaps_per_year": gaps_per_year,
-        "drag_trend_used": bool(getattr(model, "drag_trend_used", False)),
+        "drag_trend_used": model.drag_trend_used,
         # 1σ of an in-track / cross-track ΔV at the median gap (the step noise through vis-viva)
         "dv_t_sigma_mps": v * sig_a / (wa * 2.0 * a_ref_m) if wa > 0 else math.inf,
         "dv_n_sigma_mps": v * sig_n / wn if wn > 0 else math.inf,
