@@ -919,8 +919,8 @@ def middle_set_phase_z(
     ``c₀ + c₁τ + c₂τ² + β·max(0, t − t_b)`` (Vallado 2013 Eq. 9-41); a second burn after the middle
     sets bends it again. The model is fitted (least squares per hinge time; the hinge with the smallest
     L1 residual, on a coarse then a fine grid from three sets before the first step to the set after
-    the second) to every set of the window but the
-    middle ones (sets ``g1+1 … g2``); their largest deviation from that one-burn trajectory over the
+    the second) to every set of the window but the middle ones (sets ``g1+1 … g2``); their largest
+    deviation from that one-burn trajectory over the
     satellite's own per-set phase noise ``sigma_u_m`` (m) is returned with the fit's hinge time (s,
     origin of ``t``: the burn time if it is one burn). Two burns a day apart move the middle set by
     ~``Δn·Δt·a`` (kilometres for 5 cm/s); blends stay within their noise. NaN (and the middle of
