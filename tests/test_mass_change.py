@@ -670,3 +670,11 @@ def test_simulated_docking_files_flag_their_dumps_and_the_reader_turns_them_into
     for t_dump in (t for t in dumps_s if t >= t0):
         assert any(a - 1.0 <= t_dump - t0 <= b + 1.0 for a, b in windows), (t_dump - t0, windows)
     assert len(windows) == sum(t >= t0 for t in dumps_s)
+    # A garbled flag value is skipped for that column and counted, not fatal.
+    frame[THRUSTER_FLAG_COLUMN] = frame[THRUSTER_FLAG_COLUMN].astype(object)
+    frame.loc[5, THRUSTER_FLAG_COLUMN] = "on?"
+    frame.to_csv(day1[0], index=False)
+    _, repairs = load_momentum_data(day1, sc)
+    assert (
+        repairs.counts[f"rows with an unreadable time or {THRUSTER_FLAG_COLUMN!r} value skipped for that column"] == 1
+    )

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pyarrow.parquet as pq
 
 from abrupt.detect.base import DetectionResult
 from abrupt.detect.mass_change import InertiaChangeDetector
@@ -196,8 +197,13 @@ def _extra_column(
     time stamps (so rows the telemetry reader repaired or dropped do not shift it). None when no file has
     it; files without it, and rows with an unreadable time or value, are counted in ``repairs``."""
     ts, vs, missing, bad = [], [], 0, 0
+    wanted = (spacecraft.telemetry.time, column)
     for p in paths:
-        frame = pd.read_parquet(p) if p.suffix == ".parquet" else pd.read_csv(p)
+        if p.suffix == ".parquet":
+            names = pq.read_schema(p).names
+            frame = pd.read_parquet(p, columns=[c for c in wanted if c in names])
+        else:  # only the two columns; as text first, so a garbled value is counted, not a mixed dtype
+            frame = pd.read_csv(p, usecols=lambda c: c in wanted, dtype=str)
         if column not in frame.columns:
             missing += 1
             continue
