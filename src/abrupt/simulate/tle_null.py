@@ -162,7 +162,7 @@ def _smooth_orbit(spec: NullHistorySpec, t_days: NDArray[np.float64], rng: np.ra
     ey = ef + circ * np.sin(w)
     n1 = math.radians(spec.inclination_deg) + 1e-8 * t_days + 2e-6 * np.sin(2 * math.pi * t_days / 13.66)
     adot = -rate / SECONDS_PER_DAY  # [m/s] the drag rate of a that the element sets' ndot states
-    return {"a_m": a, "ex": ex, "ey": ey, "n1_rad": n1, "n2_rad": zero, "u_m": zero, "adot_m_s": adot}
+    return {"a_m": a, "ex": ex, "ey": ey, "n1_rad": n1, "n2_rad": zero.copy(), "u_m": zero.copy(), "adot_m_s": adot}
 
 
 def history_from_series(
@@ -266,26 +266,63 @@ def _stated_decay_m_s(
     return np.asarray(stated / SECONDS_PER_DAY, dtype=float)
 
 
-def simulate_null_history(spec: NullHistorySpec, burns: Sequence[tuple[float, float]] = ()) -> ElementHistory:
+def _inject_burns(
+    t_days: NDArray[np.float64],
+    smooth: dict[str, NDArray[np.float64]],
+    burns: Sequence[tuple[float, ...]],
+    seed: int,
+) -> list[tuple[int, float]]:
+    """Add impulsive LEO burns to the smooth series in place; return (first set after, its ndot rate).
+
+    Each burn is ``(day, Δv_t)`` or ``(day, Δv_t, Δv_n)`` (m/s) at ``day`` exactly:
+
+    * in-track: ``Δa = 2aΔv_t/v`` (vis-viva, near-circular) in ``a`` from the first set after the
+      burn on, and the along-track phase bends at the burn, not at the element sets' gap: the
+      records' rates integrate the mean motion as a trapezoid over the gap (hinge at its middle), so
+      the sets from the first after the burn on get ``a·Δn·(t_k − t_b − Δt/2)`` with
+      ``Δn = −(3/2)·n·Δa/a`` (Kepler's third law); the first set after was fitted across the burn, so
+      the decay it states carries the step as a rate over a day;
+    * cross-track: the orbit normal turns by ``Δv_n/v`` (Gauss, near-circular, Vallado 2013 §9.3)
+      at an argument of latitude drawn uniformly (its own generator, seeded by ``seed``, so the noise
+      is drawn as without burns): ``Δi = (Δv_n/v)·cos u``, ``sin i·ΔΩ = (Δv_n/v)·sin u``.
+    """
+    rng_u = np.random.default_rng([seed, 7])
+    first_after: list[tuple[int, float]] = []
+    for burn in burns:
+        day, dv_t = float(burn[0]), float(burn[1])
+        dv_n = float(burn[2]) if len(burn) > 2 else 0.0
+        k = int(np.searchsorted(t_days, day))
+        if k >= t_days.size or k == 0:
+            raise ValueError(f"burn at day {day}: only burns between the first and the last element set are simulated")
+        a_k = float(smooth["a_m"][k])
+        v = math.sqrt(MU_EARTH_WGS72_M3_S2 / a_k)
+        da = 2.0 * a_k * dv_t / v
+        smooth["a_m"][k:] += da
+        n_k = v / a_k
+        dn = -1.5 * n_k * da / a_k  # [rad/s]
+        gap_s = (t_days[k] - t_days[k - 1]) * SECONDS_PER_DAY
+        smooth["u_m"][k:] = smooth["u_m"][k:] + a_k * dn * ((t_days[k] - day) * SECONDS_PER_DAY - 0.5 * gap_s)
+        if dv_n:
+            u = rng_u.uniform(0.0, 2.0 * math.pi)
+            smooth["n1_rad"][k:] += dv_n / v * math.cos(u)
+            smooth["n2_rad"][k:] += dv_n / v * math.sin(u)
+        first_after.append((k, da / SECONDS_PER_DAY))
+    return first_after
+
+
+def simulate_null_history(spec: NullHistorySpec, burns: Sequence[tuple[float, ...]] = ()) -> ElementHistory:
     """A parametric maneuver-free history (module docstring).
 
-    ``burns`` (LEO, for recall checks on the same history): (day, in-track ΔV in m/s) pairs, each a
-    step ``Δa = 2aΔv/v`` (vis-viva, near-circular) in ``a`` from the first set after the day on; that
-    set was fitted across the burn, so the decay it states carries the step as a rate over a day.
-    The noise and the stated decay are drawn exactly as without burns.
+    ``burns`` (LEO, for recall checks on the same history): ``(day, in-track ΔV)`` or ``(day,
+    in-track ΔV, cross-track ΔV)`` (m/s), impulsive at ``day`` (:func:`_inject_burns`). The noise
+    and the stated decay are drawn exactly as without burns.
     """
     rng = np.random.default_rng(spec.seed)
     t = _epochs_days(spec, rng)
     smooth = _smooth_orbit(spec, t, rng)
-    first_after: list[tuple[int, float]] = []
-    for day, dv_mps in burns:
-        k = int(np.searchsorted(t, day))
-        if spec.regime == "geo" or k >= t.size:
-            raise ValueError(f"burn at day {day}: only LEO burns inside the history are simulated")
-        a_k = float(smooth["a_m"][k])
-        da = 2.0 * a_k * dv_mps / math.sqrt(MU_EARTH_WGS72_M3_S2 / a_k)
-        smooth["a_m"][k:] += da
-        first_after.append((k, da / SECONDS_PER_DAY))
+    if burns and spec.regime == "geo":
+        raise ValueError("only LEO burns are simulated")
+    first_after = _inject_burns(t, smooth, burns, spec.seed)
     sig = spec.noise_sigmas()
     bad = rng.random(t.size) < spec.bad_set_probability
     out = {}
@@ -396,6 +433,7 @@ def bootstrap_null_history(
     seed: int = 0,
     altitude_km: float | None = None,
     median_sets: int = 31,
+    burns: Sequence[tuple[float, ...]] = (),
 ) -> tuple[ElementHistory, NDArray[np.int64]]:
     """A maneuver-free history with ``history``'s own noise (module docstring), and the junctions:
     the index of the first set of every block but the first.
@@ -408,6 +446,10 @@ def bootstrap_null_history(
     two unrelated stretches of slowly correlated noise, an artificial step that a null count should
     not include: gaps whose test windows reach over a junction are left out of the exposure
     (``benchmarks/bench_tle_null_calibration.py``).
+
+    ``burns`` (LEO): impulsive burns added to the smooth orbit, as in :func:`simulate_null_history`
+    (:func:`_inject_burns`), for recall on the satellite's own noise
+    (``benchmarks/bench_tle_injection_recall.py``).
     """
     rng = np.random.default_rng(seed)
     t_real = pd.to_datetime(history.elements["epoch_utc"]) - pd.to_datetime(history.elements["epoch_utc"]).iloc[0]
@@ -457,6 +499,9 @@ def bootstrap_null_history(
         inc = math.degrees(float(np.median(history.elements["i_rad"])))
         spec = NullHistorySpec(regime="leo", altitude_km=h_km, inclination_deg=inc, seed=seed)
     smooth = _smooth_orbit(spec, t, rng)
+    if burns and regime == "geo":
+        raise ValueError("only LEO burns are simulated")
+    first_after = _inject_burns(t, smooth, burns, seed)
     bounds = [*starts, len(idx)]
     out: dict[str, NDArray[np.float64]] = {}
     for name in (*SERIES, "adot_m_s"):
@@ -466,6 +511,8 @@ def bootstrap_null_history(
         out[name] = smooth[name] + noise[keep]
     if regime != "geo":  # the history's own bias of its stated decay against its elements' decay
         out["adot_m_s"] += res["adot_bias_m_s"][0]
+        for k, rate_m_s in first_after:
+            out["adot_m_s"][k] += rate_m_s
     junctions = np.asarray([j for j in starts[1:] if j < t.size], dtype=np.int64)
     return history_from_series(t, out, regime, norad=99800 + seed % 99), junctions
 

@@ -1,0 +1,298 @@
+"""Recall of injected burns on noise the detector was not tuned on, against the ΔV it says it can see.
+
+The LEO detector is tuned (leave one satellite out) on three real histories; the issue asks for
+recall ≥ 0.9 of burns ≥ 5 cm/s at one false alarm per satellite-year, and will judge abrupt on
+satellites it has not seen. The operator files cannot separate what the detector cannot see from
+what the element sets do not resolve (several burns in one gap between sets, docs/tle.md "What
+stands in the way of 0.9"). Here every burn is alone between element sets and the truth is exact:
+
+* **parametric** histories (:func:`abrupt.simulate.tle_null.simulate_null_history`): 450, 800 and
+  1300 km, 0.3, 1 and 3 element sets per day, noise at the shared histories' level and 4× it
+  (Student-t, serially correlated, bad sets, irregular cadence and long gaps, drag with the solar
+  cycle and the sets' own stated decay);
+* **bootstrap** histories (:func:`~abrupt.simulate.tle_null.bootstrap_null_history`): the real
+  noise of Jason-3, Sentinel-3A and CryoSat-2 in blocks from their quiet stretches; burns and false
+  alarms are counted only at gaps whose test holds no junction between blocks.
+
+Impulsive burns (:func:`~abrupt.simulate.tle_null._inject_burns`) every 30-50 days, alternately
+in-track (0.5-50 cm/s, random sign) and cross-track (5-200 cm/s, random direction of the normal's
+turn). The detector runs with its default settings (those leave-one-satellite-out chose) at a
+budget of 1 false alarm per satellite-year. Scoring: one-to-one within ±1 day. Per cell: the
+realised false alarms per year (events more than a day from every burn), the recall per ΔV, the
+recall of in-track burns ≥ 5 cm/s, and the ΔV the detector states it can see
+(``min_detectable_dv_t_mps``, ``min_detectable_dv_n_mps``: the threshold times the satellite's own
+step noise) beside the smallest injected ΔV found at least 90 % of the time.
+
+What this does not model: element sets fitted across a burn (the real TLE lag of 1-2 days beyond
+the first set's stated decay) and several burns in one gap; those are what the real histories
+add (bench_tle_vs_maneuver_detect.py).
+
+Usage::
+
+    python benchmarks/bench_tle_injection_recall.py               # ~1-2 min on 2 processes
+    python benchmarks/bench_tle_injection_recall.py --seeds 1 --years 3
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from concurrent.futures import ProcessPoolExecutor
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+
+from abrupt.detect.tle_detectors import detector_for
+from abrupt.readers.fengyun import read_maneuver_file
+from abrupt.readers.tle import read_tle
+from abrupt.score import match_times
+from abrupt.simulate.tle_null import (
+    EPOCH0,
+    NullHistorySpec,
+    bootstrap_null_history,
+    gaps_clear_of_junctions,
+    quiet_mask,
+    simulate_null_history,
+)
+from abrupt.thresholds import FalseAlarmBudget
+from bench_tle_null_calibration import BLOCK_SETS, DATA, REAL, UNLISTED
+
+BUDGET = FalseAlarmBudget(1.0, "year")
+IN_TRACK_CM_S = (0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0)
+CROSS_TRACK_CM_S = (5.0, 10.0, 20.0, 50.0, 100.0, 200.0)
+BIG_CM_S = 5.0
+TOLERANCE_S = 86400.0
+
+
+def burn_schedule(
+    years: float, seed: int, allowed: NDArray[np.float64] | None = None
+) -> list[tuple[float, float, float]]:
+    """(day, Δv_t, Δv_n) in m/s: every 30-50 days, alternately in-track and cross-track, the ΔV
+    ladders shuffled so every size meets every season of the history. With ``allowed`` (sorted days
+    a burn may take: the middles of gaps clear of bootstrap junctions) each burn moves to the first
+    allowed day at or after its draw."""
+    rng = np.random.default_rng([seed, 11])
+    span = years * 365.25
+    days = []
+    d = 25.0 + rng.uniform(0.0, 10.0)
+    while d < span - 25.0:
+        if allowed is not None:
+            k = int(np.searchsorted(allowed, d))
+            if k >= allowed.size or allowed[k] >= span - 25.0:
+                break
+            d = float(allowed[k])
+        days.append(d)
+        d += rng.uniform(30.0, 50.0)
+    t_ladder = list(rng.permutation(np.tile(IN_TRACK_CM_S, len(days) // len(IN_TRACK_CM_S) + 1)))
+    n_ladder = list(rng.permutation(np.tile(CROSS_TRACK_CM_S, len(days) // len(CROSS_TRACK_CM_S) + 1)))
+    out = []
+    for k, day in enumerate(days):
+        if k % 2 == 0:
+            out.append((day, float(t_ladder.pop()) / 100.0 * rng.choice([-1.0, 1.0]), 0.0))
+        else:
+            out.append((day, 0.0, float(n_ladder.pop()) / 100.0))
+    return out
+
+
+def burn_gaps_clear(n_gaps: int, junctions: Any, window_sets: int) -> NDArray[np.bool_]:
+    """Gaps where a burn's test (slope windows of ``window_sets`` sets each side, ±3 gaps of
+    localisation) and every gap counted for its false alarms hold no junction between bootstrap
+    noise blocks."""
+    counted = gaps_clear_of_junctions(n_gaps, junctions, window_sets)
+    reach = window_sets + 3
+    padded = np.concatenate([np.zeros(reach, bool), counted, np.zeros(reach, bool)])
+    windows = np.lib.stride_tricks.sliding_window_view(padded, 2 * reach + 1)
+    return np.asarray(windows.all(axis=1), dtype=bool)
+
+
+def run_one(job: tuple[str, dict[str, Any]]) -> dict[str, Any]:
+    kind, p = job
+    if kind == "parametric":
+        burns = burn_schedule(p["years"], p["seed"])
+        spec = NullHistorySpec(**p)
+        history = simulate_null_history(spec, burns=burns)
+        junctions: Any = []
+        label = f"LEO {spec.altitude_km:.0f} km, {spec.sets_per_day:g}/day, noise ×{spec.noise_scale:g}"
+    else:
+        sat = p["satellite"]
+        real = read_tle(DATA / "tle" / f"{sat}.tle")
+        truth = read_maneuver_file(DATA / "maneuvers" / REAL[sat][0])
+        times = [*truth["time_utc"], *(pd.Timestamp(x) for x in UNLISTED.get(sat, ()))]
+        quiet = quiet_mask(real.elements["epoch_utc"], times)
+        kw = {"regime": "leo", "years": p["years"], "seed": p["seed"], "block_sets": BLOCK_SETS}
+        # the same draw twice (the burns do not touch the generator of the blocks): first to find
+        # the gaps whose test windows hold no junction, then with burns only there
+        plain, junctions = bootstrap_null_history(real, quiet, **kw)
+        t_plain = (pd.to_datetime(plain.elements["epoch_utc"]) - EPOCH0).dt.total_seconds().to_numpy() / 86400.0
+        clear = burn_gaps_clear(t_plain.size - 1, junctions, detector_for(plain).settings.window_sets)
+        mids = 0.5 * (t_plain[1:] + t_plain[:-1])
+        burns = burn_schedule(p["years"], p["seed"], allowed=mids[clear])
+        history, junctions = bootstrap_null_history(real, quiet, burns=burns, **kw)
+        label = f"bootstrap of {sat}"
+    el = history.elements
+    det = detector_for(history)
+    run = det.run(history, BUDGET)
+    n_gaps = len(el) - 1
+    counted = gaps_clear_of_junctions(n_gaps, junctions, det.settings.window_sets)
+    t_days = (pd.to_datetime(el["epoch_utc"]) - EPOCH0).dt.total_seconds().to_numpy() / 86400.0
+    burn_days = np.array([b[0] for b in burns])
+    burn_gap = np.clip(np.searchsorted(t_days, burn_days) - 1, 0, n_gaps - 1)
+    ev = run.events
+    ev_t = pd.to_datetime(ev["time_utc"]).dt.tz_localize(None).to_numpy(dtype="datetime64[ns]").astype(np.int64)
+    burn_t = (EPOCH0 + pd.to_timedelta(burn_days, unit="D")).to_numpy(dtype="datetime64[ns]").astype(np.int64)
+    pairs = match_times(ev_t, burn_t, TOLERANCE_S)
+    found = {j for _, j, _ in pairs}
+    matched_ev = {i for i, _, _ in pairs}
+    epochs = el["epoch_utc"].to_numpy(dtype="datetime64[ns]")
+    before = pd.to_datetime(ev["elset_epoch_before_utc"]).to_numpy(dtype="datetime64[ns]")
+    ev_gap = np.clip(np.searchsorted(epochs, before), 0, n_gaps - 1)
+    # a false alarm: an event matched to no burn, at a gap whose test holds no junction; an echo is a
+    # false alarm within 3 days of a burn (a burn seen twice, or timed more than a day off)
+    unmatched = [i for i in range(len(ev)) if i not in matched_ev and counted[ev_gap[i]]]
+    fa = len(unmatched)
+    echoes = sum(1 for i in unmatched if np.any(np.abs(ev_t[i] - burn_t) < 3 * 86400 * 1_000_000_000))
+    # burns whose gap and test windows hold no junction (all of them in parametric histories)
+    clear = burn_gaps_clear(n_gaps, junctions, det.settings.window_sets)
+    nm = run.noise_model
+    rows = []
+    for j, (_, dv_t, dv_n) in enumerate(burns):
+        if not clear[int(burn_gap[j])]:
+            continue
+        kind_j = "in-track" if dv_t else "cross-track"
+        stated = nm.get("min_detectable_dv_t_mps" if dv_t else "min_detectable_dv_n_mps", np.nan)
+        rows.append(
+            {
+                "kind": kind_j,
+                "dv_cm_s": round(100 * abs(dv_t if dv_t else dv_n), 1),
+                "ratio_to_stated": abs(dv_t if dv_t else dv_n) / float(stated),
+                "found": j in found,
+            }
+        )
+    years = (el["epoch_utc"].iloc[-1] - el["epoch_utc"].iloc[0]).total_seconds() / 86400.0 / 365.25
+    return {
+        "ensemble": kind,
+        "cell": label,
+        "years": years * float(counted.mean()),
+        "false_alarms": fa,
+        "echoes": echoes,
+        "burns": rows,
+        "min_dv_t_cm_s": 100 * float(nm.get("min_detectable_dv_t_mps", np.nan)),
+        "min_dv_n_cm_s": 100 * float(nm.get("min_detectable_dv_n_mps", np.nan)),
+    }
+
+
+def jobs(seeds: int, years: float) -> list[tuple[str, dict[str, Any]]]:
+    out: list[tuple[str, dict[str, Any]]] = []
+    for seed in range(seeds):
+        for noise in (1.0, 4.0):
+            for cadence in (0.3, 1.0, 3.0):
+                for alt in (450.0, 800.0, 1300.0):
+                    out.append(
+                        (
+                            "parametric",
+                            {
+                                "regime": "leo",
+                                "altitude_km": alt,
+                                "sets_per_day": cadence,
+                                "noise_scale": noise,
+                                "years": years,
+                                "seed": 5000 + 1000 * seed + int(alt) + int(10 * cadence) + int(noise),
+                            },
+                        )
+                    )
+    for sat, (_, regime) in REAL.items():
+        if regime == "leo":
+            for seed in range(2 * seeds):
+                out.append(("bootstrap", {"satellite": sat, "years": years, "seed": 50 + seed}))
+    return out
+
+
+def smallest_reliable_cm_s(burns: pd.DataFrame, kind: str, level: float = 0.9) -> float:
+    """The smallest injected ΔV of ``kind`` from which every larger size is found ≥ ``level`` of the time."""
+    b = burns[burns["kind"] == kind]
+    if b.empty:
+        return float("nan")
+    rate = b.groupby("dv_cm_s")["found"].mean().sort_index()
+    ok = rate >= level
+    best = float("nan")
+    for dv in rate.index[::-1]:
+        if not ok[dv]:
+            break
+        best = float(dv)
+    return best
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--seeds", type=int, default=2, help="histories per parametric cell (bootstrap: twice)")
+    parser.add_argument("--years", type=float, default=6.0, help="length of each history")
+    parser.add_argument("--workers", type=int, default=2)
+    args = parser.parse_args()
+    t0 = time.perf_counter()
+    with ProcessPoolExecutor(max_workers=args.workers) as pool:
+        results = list(pool.map(run_one, jobs(args.seeds, args.years)))
+    rows = []
+    all_burns = []
+    for cell in dict.fromkeys(r["cell"] for r in results):
+        rs = [r for r in results if r["cell"] == cell]
+        burns = pd.DataFrame([b for r in rs for b in r["burns"]])
+        all_burns.append(burns.assign(ensemble=rs[0]["ensemble"]))
+        big = burns[(burns["kind"] == "in-track") & (burns["dv_cm_s"] >= BIG_CM_S)]
+        yrs = sum(r["years"] for r in rs)
+        fa = sum(r["false_alarms"] for r in rs)
+        cross = burns[(burns["kind"] == "cross-track") & (burns["dv_cm_s"] >= 100.0)]
+        rows.append(
+            {
+                "cell": cell,
+                "sat_years": yrs,
+                "FA_per_year": fa / yrs,
+                "echoes": sum(r["echoes"] for r in rs),
+                "in_track_burns": int((burns["kind"] == "in-track").sum()),
+                "recall_t_ge_5cm_s": float(big["found"].mean()) if len(big) else float("nan"),
+                "stated_min_dv_t_cm_s": float(np.median([r["min_dv_t_cm_s"] for r in rs])),
+                "found_90pct_from_t_cm_s": smallest_reliable_cm_s(burns, "in-track"),
+                "recall_n_ge_100cm_s": float(cross["found"].mean()) if len(cross) else float("nan"),
+                "stated_min_dv_n_cm_s": float(np.median([r["min_dv_n_cm_s"] for r in rs])),
+                "found_90pct_from_n_cm_s": smallest_reliable_cm_s(burns, "cross-track"),
+            }
+        )
+    table = pd.DataFrame(rows)
+    pd.set_option("display.width", 250)
+    print(f"Injected burns, each alone between element sets; detector defaults, budget {BUDGET.per_year:g}/year")
+    print(table.to_string(index=False, float_format=lambda x: f"{x:.2f}"))
+    burns = pd.concat(all_burns, ignore_index=True)
+    print("\nRecall per injected ΔV (all cells of each ensemble)")
+    per = burns.groupby(["ensemble", "kind", "dv_cm_s"])["found"].agg(["mean", "size"]).unstack("dv_cm_s")
+    print(per.to_string(float_format=lambda x: f"{x:.2f}"))
+    print("\nRecall against the ΔV the detector states it sees half the time (min_detectable_dv_*), all cells")
+    bins = pd.cut(burns["ratio_to_stated"], [0.0, 0.5, 1.0, 2.0, 4.0, np.inf], right=False)
+    cal = burns.groupby(["ensemble", "kind", bins], observed=True)["found"].agg(["mean", "size"]).unstack(2)
+    print(cal.to_string(float_format=lambda x: f"{x:.2f}"))
+    big = burns[(burns["kind"] == "in-track") & (burns["dv_cm_s"] >= BIG_CM_S)]
+    yrs = sum(r["years"] for r in results)
+    fa = sum(r["false_alarms"] for r in results)
+    echoes = sum(r["echoes"] for r in results)
+    for ens in ("parametric", "bootstrap"):
+        b = big[big["ensemble"] == ens]
+        e_yrs = sum(r["years"] for r in results if r["ensemble"] == ens)
+        e_fa = sum(r["false_alarms"] for r in results if r["ensemble"] == ens)
+        print(
+            f"{ens}: in-track burns >= {BIG_CM_S:g} cm/s found {int(b['found'].sum())}/{len(b)} "
+            f"({b['found'].mean():.3f}) at {e_fa / e_yrs:.2f} false alarms per satellite-year ({e_fa} in {e_yrs:.0f})"
+        )
+        above = b[b["ratio_to_stated"] >= 1.0]
+        print(
+            f"{ens}: of those, at or above the stated 50 % size: {int(above['found'].sum())}/{len(above)} "
+            f"({above['found'].mean():.3f})"
+        )
+    print(
+        f"all: {int(big['found'].sum())}/{len(big)} ({big['found'].mean():.3f}) at {fa / yrs:.2f} FA/sat-yr "
+        f"({echoes} of the {fa} within 3 days of a burn); "
+        f"{time.perf_counter() - t0:.0f} s"
+    )
+
+
+if __name__ == "__main__":
+    main()
