@@ -60,14 +60,18 @@ from abrupt.thresholds import FalseAlarmBudget
 from bench_tle_null_calibration import BLOCK_SETS, DATA, REAL, UNLISTED
 
 BUDGET = FalseAlarmBudget(1.0, "year")
-IN_TRACK_CM_S = (0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0)
-CROSS_TRACK_CM_S = (5.0, 10.0, 20.0, 50.0, 100.0, 200.0)
+# ΔV ladders (cm/s): in-track / cross-track (LEO), east-west / north-south (GEO station keeping)
+LADDERS = {
+    "leo": ((0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0), (5.0, 10.0, 20.0, 50.0, 100.0, 200.0)),
+    "geo": ((1.0, 2.0, 5.0, 10.0, 20.0, 50.0), (10.0, 20.0, 50.0, 100.0, 200.0, 500.0)),
+}
+KIND = {"leo": ("in-track", "cross-track"), "geo": ("east-west", "north-south")}
 BIG_CM_S = 5.0
 TOLERANCE_S = 86400.0
 
 
 def burn_schedule(
-    years: float, seed: int, allowed: NDArray[np.float64] | None = None
+    years: float, seed: int, allowed: NDArray[np.float64] | None = None, regime: str = "leo"
 ) -> list[tuple[float, float, float]]:
     """(day, Δv_t, Δv_n) in m/s: every 30-50 days, alternately in-track and cross-track, the ΔV
     ladders shuffled so every size meets every season of the history. With ``allowed`` (sorted days
@@ -85,8 +89,9 @@ def burn_schedule(
             d = float(allowed[k])
         days.append(d)
         d += rng.uniform(30.0, 50.0)
-    t_ladder = list(rng.permutation(np.tile(IN_TRACK_CM_S, len(days) // len(IN_TRACK_CM_S) + 1)))
-    n_ladder = list(rng.permutation(np.tile(CROSS_TRACK_CM_S, len(days) // len(CROSS_TRACK_CM_S) + 1)))
+    lad_t, lad_n = LADDERS[regime]
+    t_ladder = list(rng.permutation(np.tile(lad_t, len(days) // len(lad_t) + 1)))
+    n_ladder = list(rng.permutation(np.tile(lad_n, len(days) // len(lad_n) + 1)))
     out = []
     for k, day in enumerate(days):
         if k % 2 == 0:
@@ -110,25 +115,29 @@ def burn_gaps_clear(n_gaps: int, junctions: Any, window_sets: int) -> NDArray[np
 def run_one(job: tuple[str, dict[str, Any]]) -> dict[str, Any]:
     kind, p = job
     if kind == "parametric":
-        burns = burn_schedule(p["years"], p["seed"])
+        regime = p["regime"]
+        burns = burn_schedule(p["years"], p["seed"], regime=regime)
         spec = NullHistorySpec(**p)
         history = simulate_null_history(spec, burns=burns)
         junctions: Any = []
-        label = f"LEO {spec.altitude_km:.0f} km, {spec.sets_per_day:g}/day, noise ×{spec.noise_scale:g}"
+        label = (f"LEO {spec.altitude_km:.0f} km" if regime == "leo" else "GEO") + (
+            f", {spec.sets_per_day:g}/day, noise ×{spec.noise_scale:g}"
+        )
     else:
         sat = p["satellite"]
         real = read_tle(DATA / "tle" / f"{sat}.tle")
         truth = read_maneuver_file(DATA / "maneuvers" / REAL[sat][0])
         times = [*truth["time_utc"], *(pd.Timestamp(x) for x in UNLISTED.get(sat, ()))]
         quiet = quiet_mask(real.elements["epoch_utc"], times)
-        kw = {"regime": "leo", "years": p["years"], "seed": p["seed"], "block_sets": BLOCK_SETS}
+        regime = REAL[sat][1]
+        kw = {"regime": regime, "years": p["years"], "seed": p["seed"], "block_sets": BLOCK_SETS}
         # the same draw twice (the burns do not touch the generator of the blocks): first to find
         # the gaps whose test windows hold no junction, then with burns only there
         plain, junctions = bootstrap_null_history(real, quiet, **kw)
         t_plain = (pd.to_datetime(plain.elements["epoch_utc"]) - EPOCH0).dt.total_seconds().to_numpy() / 86400.0
         clear = burn_gaps_clear(t_plain.size - 1, junctions, detector_for(plain).settings.window_sets)
         mids = 0.5 * (t_plain[1:] + t_plain[:-1])
-        burns = burn_schedule(p["years"], p["seed"], allowed=mids[clear])
+        burns = burn_schedule(p["years"], p["seed"], allowed=mids[clear], regime=regime)
         history, junctions = bootstrap_null_history(real, quiet, burns=burns, **kw)
         label = f"bootstrap of {sat}"
     el = history.elements
@@ -160,7 +169,7 @@ def run_one(job: tuple[str, dict[str, Any]]) -> dict[str, Any]:
     for j, (_, dv_t, dv_n) in enumerate(burns):
         if not clear[int(burn_gap[j])]:
             continue
-        kind_j = "in-track" if dv_t else "cross-track"
+        kind_j = KIND[regime][0] if dv_t else KIND[regime][1]
         stated = nm.get("min_detectable_dv_t_mps" if dv_t else "min_detectable_dv_n_mps", np.nan)
         rows.append(
             {
@@ -173,6 +182,7 @@ def run_one(job: tuple[str, dict[str, Any]]) -> dict[str, Any]:
     years = (el["epoch_utc"].iloc[-1] - el["epoch_utc"].iloc[0]).total_seconds() / 86400.0 / 365.25
     return {
         "ensemble": kind,
+        "regime": regime,
         "cell": label,
         "years": years * float(counted.mean()),
         "false_alarms": fa,
@@ -202,10 +212,21 @@ def jobs(seeds: int, years: float) -> list[tuple[str, dict[str, Any]]]:
                             },
                         )
                     )
-    for sat, (_, regime) in REAL.items():
-        if regime == "leo":
-            for seed in range(2 * seeds):
-                out.append(("bootstrap", {"satellite": sat, "years": years, "seed": 50 + seed}))
+                out.append(
+                    (
+                        "parametric",
+                        {
+                            "regime": "geo",
+                            "sets_per_day": cadence,
+                            "noise_scale": noise,
+                            "years": years,
+                            "seed": 5000 + 1000 * seed + 7 + int(10 * cadence) + int(noise),
+                        },
+                    )
+                )
+    for sat in REAL:
+        for seed in range(2 * seeds):
+            out.append(("bootstrap", {"satellite": sat, "years": years, "seed": 50 + seed}))
     return out
 
 
@@ -238,24 +259,25 @@ def main() -> None:
     for cell in dict.fromkeys(r["cell"] for r in results):
         rs = [r for r in results if r["cell"] == cell]
         burns = pd.DataFrame([b for r in rs for b in r["burns"]])
-        all_burns.append(burns.assign(ensemble=rs[0]["ensemble"]))
-        big = burns[(burns["kind"] == "in-track") & (burns["dv_cm_s"] >= BIG_CM_S)]
+        all_burns.append(burns.assign(ensemble=rs[0]["ensemble"], regime=rs[0]["regime"].upper()))
+        k_t, k_n = KIND[rs[0]["regime"]]
+        big = burns[(burns["kind"] == k_t) & (burns["dv_cm_s"] >= BIG_CM_S)]
         yrs = sum(r["years"] for r in rs)
         fa = sum(r["false_alarms"] for r in rs)
-        cross = burns[(burns["kind"] == "cross-track") & (burns["dv_cm_s"] >= 100.0)]
+        cross = burns[(burns["kind"] == k_n) & (burns["dv_cm_s"] >= 100.0)]
         rows.append(
             {
                 "cell": cell,
                 "sat_years": yrs,
                 "FA_per_year": fa / yrs,
                 "echoes": sum(r["echoes"] for r in rs),
-                "in_track_burns": int((burns["kind"] == "in-track").sum()),
+                "t_burns": int((burns["kind"] == k_t).sum()),
                 "recall_t_ge_5cm_s": float(big["found"].mean()) if len(big) else float("nan"),
                 "stated_min_dv_t_cm_s": float(np.median([r["min_dv_t_cm_s"] for r in rs])),
-                "found_90pct_from_t_cm_s": smallest_reliable_cm_s(burns, "in-track"),
+                "found_90pct_from_t_cm_s": smallest_reliable_cm_s(burns, k_t),
                 "recall_n_ge_100cm_s": float(cross["found"].mean()) if len(cross) else float("nan"),
                 "stated_min_dv_n_cm_s": float(np.median([r["min_dv_n_cm_s"] for r in rs])),
-                "found_90pct_from_n_cm_s": smallest_reliable_cm_s(burns, "cross-track"),
+                "found_90pct_from_n_cm_s": smallest_reliable_cm_s(burns, k_n),
             }
         )
     table = pd.DataFrame(rows)
@@ -264,34 +286,29 @@ def main() -> None:
     print(table.to_string(index=False, float_format=lambda x: f"{x:.2f}"))
     burns = pd.concat(all_burns, ignore_index=True)
     print("\nRecall per injected ΔV (all cells of each ensemble)")
-    per = burns.groupby(["ensemble", "kind", "dv_cm_s"])["found"].agg(["mean", "size"]).unstack("dv_cm_s")
+    per = burns.groupby(["regime", "ensemble", "kind", "dv_cm_s"])["found"].agg(["mean", "size"]).unstack("dv_cm_s")
     print(per.to_string(float_format=lambda x: f"{x:.2f}"))
     print("\nRecall against the ΔV the detector states it sees half the time (min_detectable_dv_*), all cells")
     bins = pd.cut(burns["ratio_to_stated"], [0.0, 0.5, 1.0, 2.0, 4.0, np.inf], right=False)
-    cal = burns.groupby(["ensemble", "kind", bins], observed=True)["found"].agg(["mean", "size"]).unstack(2)
+    cal = burns.groupby(["regime", "ensemble", "kind", bins], observed=True)["found"].agg(["mean", "size"]).unstack(3)
     print(cal.to_string(float_format=lambda x: f"{x:.2f}"))
-    big = burns[(burns["kind"] == "in-track") & (burns["dv_cm_s"] >= BIG_CM_S)]
-    yrs = sum(r["years"] for r in results)
-    fa = sum(r["false_alarms"] for r in results)
-    echoes = sum(r["echoes"] for r in results)
-    for ens in ("parametric", "bootstrap"):
-        b = big[big["ensemble"] == ens]
-        e_yrs = sum(r["years"] for r in results if r["ensemble"] == ens)
-        e_fa = sum(r["false_alarms"] for r in results if r["ensemble"] == ens)
-        print(
-            f"{ens}: in-track burns >= {BIG_CM_S:g} cm/s found {int(b['found'].sum())}/{len(b)} "
-            f"({b['found'].mean():.3f}) at {e_fa / e_yrs:.2f} false alarms per satellite-year ({e_fa} in {e_yrs:.0f})"
-        )
-        above = b[b["ratio_to_stated"] >= 1.0]
-        print(
-            f"{ens}: of those, at or above the stated 50 % size: {int(above['found'].sum())}/{len(above)} "
-            f"({above['found'].mean():.3f})"
-        )
-    print(
-        f"all: {int(big['found'].sum())}/{len(big)} ({big['found'].mean():.3f}) at {fa / yrs:.2f} FA/sat-yr "
-        f"({echoes} of the {fa} within 3 days of a burn); "
-        f"{time.perf_counter() - t0:.0f} s"
-    )
+    for regime in ("leo", "geo"):
+        k_t = KIND[regime][0]
+        big = burns[(burns["kind"] == k_t) & (burns["dv_cm_s"] >= BIG_CM_S) & (burns["regime"] == regime.upper())]
+        for ens in ("parametric", "bootstrap"):
+            b = big[big["ensemble"] == ens]
+            sel = [r for r in results if r["ensemble"] == ens and r["regime"] == regime]
+            e_yrs = sum(r["years"] for r in sel)
+            e_fa = sum(r["false_alarms"] for r in sel)
+            e_echo = sum(r["echoes"] for r in sel)
+            above = b[b["ratio_to_stated"] >= 1.0]
+            print(
+                f"{regime.upper()} {ens}: {k_t} burns >= {BIG_CM_S:g} cm/s found {int(b['found'].sum())}/{len(b)} "
+                f"({b['found'].mean():.3f}); at or above the stated 50 % size {int(above['found'].sum())}/"
+                f"{len(above)} ({above['found'].mean():.3f}); {e_fa / e_yrs:.2f} false alarms per satellite-year "
+                f"({e_fa} in {e_yrs:.0f}, {e_echo} within 3 days of a burn)"
+            )
+    print(f"{time.perf_counter() - t0:.0f} s")
 
 
 if __name__ == "__main__":

@@ -94,8 +94,32 @@ def test_drift_hinge_gate_reads_the_weighted_in_track_score() -> None:
     assert not has_drift_hinge(steps, 1)  # 2.0
 
 
+def test_geo_east_west_and_north_south_burns_are_found_and_typed() -> None:
+    """GEO station keeping: a 5 cm/s east-west burn (Δa = 2aΔv/v ≈ 1.4 km, the eccentricity vector
+    by 2Δv/v) is dated within 6 hours by the mean longitude's kink with its ΔV within 20 %; a 5 m/s
+    north-south burn (the inclination vector moves by Δv/v ≈ 0.093°) is typed north-south, dated
+    inside its gap, |Δv_n| within 15 %."""
+    from abrupt.detect.tle_detectors import TleGeoStationKeeping
+
+    spec = NullHistorySpec(regime="geo", sets_per_day=1.0, years=2.0, seed=21)
+    ew_day, ns_day = 300.5, 420.6  # gaps of ~1 day (the generator also draws 3-10 day gaps)
+    history = simulate_null_history(spec, burns=[(ew_day, 0.05), (ns_day, 0.0, 5.0)])
+    events = TleGeoStationKeeping().run(history, BUDGET).events
+    ew, ns = _near(events, ew_day), _near(events, ns_day)
+    assert len(ew) == 1 and len(ns) == 1
+    assert ew["maneuver_type"].iloc[0] == "east-west"
+    assert abs(float(ew["dt_days"].iloc[0])) < 0.25
+    assert abs(float(ew["dv_t_mps"].iloc[0])) == pytest.approx(0.05, rel=0.2)
+    ev = ns.iloc[0]
+    assert ev["maneuver_type"] == "north-south"
+    assert float(ev["dv_n_mps"]) == pytest.approx(5.0, rel=0.15)
+    before = pd.Timestamp(ev["elset_epoch_before_utc"]).tz_localize(None)
+    after = pd.Timestamp(ev["elset_epoch_after_utc"]).tz_localize(None)
+    assert before <= EPOCH0 + pd.Timedelta(days=ns_day) <= after
+
+
 def test_burns_outside_the_history_are_refused() -> None:
     with pytest.raises(ValueError, match="between the first and the last"):
         simulate_null_history(SPEC, burns=[(5000.0, 0.1)])
-    with pytest.raises(ValueError, match="only LEO"):
-        simulate_null_history(NullHistorySpec(regime="geo", years=1.0), burns=[(100.0, 0.1)])
+    with pytest.raises(ValueError, match="between the first and the last"):
+        simulate_null_history(SPEC, burns=[(-1.0, 0.0, 1.0)])

@@ -11,12 +11,13 @@ a smooth maneuver-free orbit plus noise:
                             inclination drift; GEO: the longitude libration that the Earth's
                             triaxiality drives in ``a``, the yearly solar-radiation-pressure circle
                             of the eccentricity vector, the luni-solar drift of the inclination
-                            vector, ~0.85°/year, with its 13.66-day lunar and 182.6-day solar
-                            terms) plus heavy-tailed (Student-t), serially correlated (AR(1) in
-                            time) set-to-set noise, occasional bad sets (gross errors in every
-                            element), irregular cadence and long gaps without sets. Each LEO set
-                            states its decay in its ndot, as an 18 SDS fit does: the simulated drag
-                            rate with a scale error, a bias and heavy-tailed noise.
+                            vector, ~0.85°/year, with what SDP4's mean elements keep of its
+                            13.66-day lunar and 182.6-day solar terms) plus heavy-tailed
+                            (Student-t), serially correlated (AR(1) in time) set-to-set noise,
+                            occasional bad sets (gross errors in every element), irregular
+                            cadence and long gaps without sets. Each LEO set states its decay in
+                            its ndot, as an 18 SDS fit does: the simulated drag rate with a scale
+                            error, a bias and heavy-tailed noise.
 ``bootstrap_null_history``  the *real* noise of a history: residuals of its detector series about
                             a running median, taken in blocks of consecutive sets (with their real
                             gaps) from its quiet stretches (away from every maneuver the caller
@@ -143,11 +144,16 @@ def _smooth_orbit(spec: NullHistorySpec, t_days: NDArray[np.float64], rng: np.ra
         i0 = math.radians(rng.uniform(1.0, 3.0))
         d0 = rng.uniform(0, 2 * math.pi)
         drift = math.radians(0.85) / DAYS_PER_YEAR * t_days  # [rad] luni-solar drift of the i-vector
-        lunar = 5e-5 * np.sin(2 * math.pi * t_days / 13.66 + rng.uniform(0, 6.3))
-        solar = 1.5e-4 * np.sin(2 * math.pi * t_days / 182.6 + rng.uniform(0, 6.3))
+        # What is left of the 13.66-day lunar and 182.6-day solar terms in *mean* elements: SDP4's
+        # deep-space periodics (Hoots & Roehrich 1980, dpper) take out most of their osculating
+        # 5e-5 / 1.5e-4 rad; the Fengyun-2D/2E histories keep 1-4e-6 / ~1-2.5e-5 rad (session 5:
+        # amplitudes fitted after a 61-set running median). Session 4 used the osculating sizes,
+        # which hid north-south burns below ~5 m/s (docs/tle.md "Injected burns").
+        lunar = 4e-6 * np.sin(2 * math.pi * t_days / 13.66 + rng.uniform(0, 6.3))
+        solar = 2.5e-5 * np.sin(2 * math.pi * t_days / 182.6 + rng.uniform(0, 6.3))
         n1 = i0 * math.cos(d0) + drift + lunar
         n2 = i0 * math.sin(d0) + 0.3 * drift + solar
-        return {"a_m": a, "ex": ex, "ey": ey, "n1_rad": n1, "n2_rad": n2, "u_m": zero, "adot_m_s": zero}
+        return {"a_m": a, "ex": ex, "ey": ey, "n1_rad": n1, "n2_rad": n2, "u_m": zero.copy(), "adot_m_s": zero.copy()}
     h_km = spec.altitude_km
     decay0 = 15.0 * math.exp(-(h_km - 500.0) / 70.0)  # [m/day] drag decay of a at solar mean
     phase = rng.uniform(0, 2 * math.pi)
@@ -272,19 +278,23 @@ def _inject_burns(
     burns: Sequence[tuple[float, ...]],
     seed: int,
 ) -> list[tuple[int, float]]:
-    """Add impulsive LEO burns to the smooth series in place; return (first set after, its ndot rate).
+    """Add impulsive burns to the smooth series in place; return (first set after, its ndot rate).
 
-    Each burn is ``(day, Δv_t)`` or ``(day, Δv_t, Δv_n)`` (m/s) at ``day`` exactly:
+    Each burn is ``(day, Δv_t)`` or ``(day, Δv_t, Δv_n)`` (m/s) at ``day`` exactly, at an argument
+    of latitude (LEO) or sidereal angle (GEO) ``u`` drawn uniformly from its own generator (seeded by
+    ``seed``, so the noise is drawn as without burns). Gauss's equations for a near-circular orbit
+    (Vallado 2013 §9.3):
 
-    * in-track: ``Δa = 2aΔv_t/v`` (vis-viva, near-circular) in ``a`` from the first set after the
-      burn on, and the along-track phase bends at the burn, not at the element sets' gap: the
-      records' rates integrate the mean motion as a trapezoid over the gap (hinge at its middle), so
-      the sets from the first after the burn on get ``a·Δn·(t_k − t_b − Δt/2)`` with
-      ``Δn = −(3/2)·n·Δa/a`` (Kepler's third law); the first set after was fitted across the burn, so
-      the decay it states carries the step as a rate over a day;
-    * cross-track: the orbit normal turns by ``Δv_n/v`` (Gauss, near-circular, Vallado 2013 §9.3)
-      at an argument of latitude drawn uniformly (its own generator, seeded by ``seed``, so the noise
-      is drawn as without burns): ``Δi = (Δv_n/v)·cos u``, ``sin i·ΔΩ = (Δv_n/v)·sin u``.
+    * in-track (LEO in-track, GEO east-west): ``Δa = 2aΔv_t/v`` in ``a`` and ``Δe = (2Δv_t/v)(cos u,
+      sin u)`` in the eccentricity vector from the first set after the burn on; the along-track
+      phase (LEO: argument of latitude, GEO: mean longitude, both × a) bends at the burn, not at the
+      element sets' gap: the records' rates integrate the mean motion as a trapezoid over the gap
+      (hinge at its middle), so the sets from the first after the burn on get
+      ``a·Δn·(t_k − t_b − Δt/2)`` with ``Δn = −(3/2)·n·Δa/a`` (Kepler's third law). The first set
+      after was fitted across the burn, so the decay it states carries the step as a rate over a day;
+    * cross-track (LEO cross-track, GEO north-south): the orbit normal turns by ``Δv_n/v``: LEO
+      ``Δi = (Δv_n/v)·cos u``, ``sin i·ΔΩ = (Δv_n/v)·sin u``; GEO the inclination vector moves by
+      ``Δv_n/v`` in the direction ``u``.
     """
     rng_u = np.random.default_rng([seed, 7])
     first_after: list[tuple[int, float]] = []
@@ -294,18 +304,19 @@ def _inject_burns(
         k = int(np.searchsorted(t_days, day))
         if k >= t_days.size or k == 0:
             raise ValueError(f"burn at day {day}: only burns between the first and the last element set are simulated")
+        u = rng_u.uniform(0.0, 2.0 * math.pi)
         a_k = float(smooth["a_m"][k])
         v = math.sqrt(MU_EARTH_WGS72_M3_S2 / a_k)
         da = 2.0 * a_k * dv_t / v
         smooth["a_m"][k:] += da
+        smooth["ex"][k:] += 2.0 * dv_t / v * math.cos(u)
+        smooth["ey"][k:] += 2.0 * dv_t / v * math.sin(u)
         n_k = v / a_k
         dn = -1.5 * n_k * da / a_k  # [rad/s]
         gap_s = (t_days[k] - t_days[k - 1]) * SECONDS_PER_DAY
         smooth["u_m"][k:] = smooth["u_m"][k:] + a_k * dn * ((t_days[k] - day) * SECONDS_PER_DAY - 0.5 * gap_s)
-        if dv_n:
-            u = rng_u.uniform(0.0, 2.0 * math.pi)
-            smooth["n1_rad"][k:] += dv_n / v * math.cos(u)
-            smooth["n2_rad"][k:] += dv_n / v * math.sin(u)
+        smooth["n1_rad"][k:] += dv_n / v * math.cos(u)
+        smooth["n2_rad"][k:] += dv_n / v * math.sin(u)
         first_after.append((k, da / SECONDS_PER_DAY))
     return first_after
 
@@ -313,15 +324,13 @@ def _inject_burns(
 def simulate_null_history(spec: NullHistorySpec, burns: Sequence[tuple[float, ...]] = ()) -> ElementHistory:
     """A parametric maneuver-free history (module docstring).
 
-    ``burns`` (LEO, for recall checks on the same history): ``(day, in-track ΔV)`` or ``(day,
-    in-track ΔV, cross-track ΔV)`` (m/s), impulsive at ``day`` (:func:`_inject_burns`). The noise
-    and the stated decay are drawn exactly as without burns.
+    ``burns`` (for recall checks on the same history): ``(day, in-track ΔV)`` or ``(day, in-track
+    ΔV, cross-track ΔV)`` (m/s; GEO: east-west, north-south), impulsive at ``day``
+    (:func:`_inject_burns`). The noise and the stated decay are drawn exactly as without burns.
     """
     rng = np.random.default_rng(spec.seed)
     t = _epochs_days(spec, rng)
     smooth = _smooth_orbit(spec, t, rng)
-    if burns and spec.regime == "geo":
-        raise ValueError("only LEO burns are simulated")
     first_after = _inject_burns(t, smooth, burns, spec.seed)
     sig = spec.noise_sigmas()
     bad = rng.random(t.size) < spec.bad_set_probability
@@ -447,7 +456,7 @@ def bootstrap_null_history(
     not include: gaps whose test windows reach over a junction are left out of the exposure
     (``benchmarks/bench_tle_null_calibration.py``).
 
-    ``burns`` (LEO): impulsive burns added to the smooth orbit, as in :func:`simulate_null_history`
+    ``burns``: impulsive burns added to the smooth orbit, as in :func:`simulate_null_history`
     (:func:`_inject_burns`), for recall on the satellite's own noise
     (``benchmarks/bench_tle_injection_recall.py``).
     """
@@ -499,8 +508,6 @@ def bootstrap_null_history(
         inc = math.degrees(float(np.median(history.elements["i_rad"])))
         spec = NullHistorySpec(regime="leo", altitude_km=h_km, inclination_deg=inc, seed=seed)
     smooth = _smooth_orbit(spec, t, rng)
-    if burns and regime == "geo":
-        raise ValueError("only LEO burns are simulated")
     first_after = _inject_burns(t, smooth, burns, seed)
     bounds = [*starts, len(idx)]
     out: dict[str, NDArray[np.float64]] = {}
