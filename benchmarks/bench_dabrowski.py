@@ -16,6 +16,8 @@ Tables 4.3-4.4; ``calibrate_dabrowski_noise.py``); ``--session3-noise`` is sessi
 ``--experiments E`` runs E independent thesis-layout experiments per amplitude (each with its own Phase A)
 and prints means with 95% bootstrap intervals over experiments and the percentile of the thesis's
 value; ``--groups K`` (session 3) runs K ten-run groups per configuration sharing one Phase A.
+``--center-on-previous-run`` and ``--center-on-actual`` reproduce App. C's grid centring (each run's grid on
+the previous run's last grid value; each set's first grid on its actual MOI; spec §5.4 [C]), for ``--experiments``.
 Run: ``PYTHONPATH=src nice python benchmarks/bench_dabrowski.py [--experiments 30] [--groups K]
 [--amplitudes 0.5,1,2] [--seed S]``.
 """
@@ -159,19 +161,24 @@ def main(
     print(f"elapsed {time.time() - t0:.0f} s")
 
 
-def one_experiment(amp: float, rng: np.random.Generator, noise: TestbedNoise) -> dict[str, float]:
+def one_experiment(
+    amp: float, rng: np.random.Generator, noise: TestbedNoise, chain: bool = False, center_actual: bool = False
+) -> dict[str, float]:
     """One thesis-layout experiment at ``amp``: its own Phase A, four added-mass configurations of 10 runs.
 
     Returns Table 4.3/4.4's statistics for Method 1 (mean error and mean SD over the four configurations,
     baseline SD), the ML momentum method's mean error on the same runs and the white-noise floor's
-    expected ten-run error, and how many of the four changes each method detects.
+    expected ten-run error, and how many of the four changes each method detects. ``chain``: Phase B
+    centres each run's grid on the previous run's last grid value (App. C's loop-variable quirk, spec
+    §5.4 [C]); ``center_actual``: each set's first grid is centred on the set's actual MOI, as App. C
+    sets ``I33`` before the loop (else on the nominal, spec §5.4 [R]).
     """
     params, man = SimsatParams(), Maneuver.thesis(amp)
     n_base = 25 if amp == 1.0 else 10
     base = testbed_runs(params, man, I33_BASELINE, n_base, noise, rng)
     tuned = phase_a(params, man, [base["yaw_meas_rad"][:, k] for k in range(n_base)])
     gyro = fit_gyro_error_model(base["t_s"], base["yaw_meas_rad"], base["wheel_speed_meas_rad_s"], I33_BASELINE)
-    base_est, _ = estimate_runs_i33(tuned, man, base["yaw_meas_rad"])
+    base_est, _ = estimate_runs_i33(tuned, man, base["yaw_meas_rad"], center_on_previous_run=chain)
     s0 = float(np.std(base_est / I33_BASELINE, ddof=1))
     yb, wb = base["yaw_meas_rad"], base["wheel_speed_meas_rad_s"]
     base_ml = [momentum_exchange_ml(base["t_s"], yb[:, k], wb[:, k], gyro).i33_kgm2 for k in range(n_base)]
@@ -182,7 +189,8 @@ def one_experiment(amp: float, rng: np.random.Generator, noise: TestbedNoise) ->
     for i_true in MOI_CONFIGS[1:]:
         runs = testbed_runs(params, man, i_true, 10, noise, rng)
         y, w = runs["yaw_meas_rad"], runs["wheel_speed_meas_rad_s"]
-        est, _ = estimate_runs_i33(tuned, man, y)
+        center = i_true if center_actual else None
+        est, _ = estimate_runs_i33(tuned, man, y, center_kgm2=center, center_on_previous_run=chain)
         x = est / i_true
         ml = np.array([momentum_exchange_ml(runs["t_s"], y[:, k], w[:, k], gyro).i33_kgm2 for k in range(10)])
         floor = [
@@ -208,15 +216,23 @@ def _boot(x: np.ndarray, stat: object, rng: np.random.Generator, n: int = 4000) 
     return float(np.quantile(vals, 0.025)), float(np.quantile(vals, 0.975))
 
 
-def experiments(n_exp: int, amplitudes: tuple[float, ...], seed: int, noise: TestbedNoise) -> None:
+def experiments(
+    n_exp: int,
+    amplitudes: tuple[float, ...],
+    seed: int,
+    noise: TestbedNoise,
+    chain: bool = False,
+    center_actual: bool = False,
+) -> None:
     """``n_exp`` independent thesis-layout experiments per amplitude; bootstrap intervals over experiments."""
     t0 = time.time()
     print(f"{n_exp} independent experiments per amplitude (thesis layout), seed {seed}; noise {noise}")
+    print(f"Phase B grid: centred on previous run {chain}, first run on the actual MOI {center_actual}")
     boot_rng = np.random.default_rng(seed + 1)
     best_ml = {}
     for amp in amplitudes:
         rng = np.random.default_rng([seed, round(100 * amp)])
-        rows = [one_experiment(amp, rng, noise) for _ in range(n_exp)]
+        rows = [one_experiment(amp, rng, noise, chain, center_actual) for _ in range(n_exp)]
         keys = list(rows[0])
         x = np.array([[r[k] for k in keys] for r in rows])
         col = {k: x[:, i] for i, k in enumerate(keys)}
@@ -268,6 +284,10 @@ if __name__ == "__main__":
     ap.add_argument("--noise", default="", help="wheel_gain_sd,rate_noise_deg_s,gyro_bias_deg_min (else NOISE)")
     ap.add_argument("--session3-noise", action="store_true", help="the testbed noise of session 3")
     ap.add_argument("--gyro-scale-sd", type=float, default=0.0, help="run-to-run gyro scale-factor SD (relative)")
+    ap.add_argument(
+        "--center-on-previous-run", action="store_true", help="App. C quirk: each run's grid on the previous run's"
+    )
+    ap.add_argument("--center-on-actual", action="store_true", help="App. C: each set's first grid on its actual MOI")
     args = ap.parse_args()
     if args.noise:
         wg_sd, rate, drift = (float(v) for v in args.noise.split(","))
@@ -278,6 +298,6 @@ if __name__ == "__main__":
         NOISE = replace(NOISE, gyro_scale_sd=args.gyro_scale_sd)
     amps = tuple(float(a) for a in args.amplitudes.split(","))
     if args.experiments:
-        experiments(args.experiments, amps, args.seed, NOISE)
+        experiments(args.experiments, amps, args.seed, NOISE, args.center_on_previous_run, args.center_on_actual)
     else:
         main(args.quick, args.groups, amps, args.seed)

@@ -678,3 +678,40 @@ def test_simulated_docking_files_flag_their_dumps_and_the_reader_turns_them_into
     assert (
         repairs.counts[f"rows with an unreadable time or {THRUSTER_FLAG_COLUMN!r} value skipped for that column"] == 1
     )
+
+
+def test_simsat_phase_b_center_on_previous_run_chains_the_grid_centres(monkeypatch):
+    # App. C quirk (spec §5.4 [C]): the loop variable I33 is reused, so each run's grid after the first
+    # spans [0.5, 2] x the last grid value the previous run's search evaluated; the first run's grid is
+    # centred on the given centre. Default (spec [R]): every run on the same centre, in lockstep.
+    import abrupt.massprops.simsat as simsat
+
+    centres: list[float] = []
+    last_points: list[float] = []
+    real = simsat.grid_search_batch
+
+    def spy(cost, center, n_problems, **kw):
+        tops: list[float] = []
+
+        def cost_spy(grid):
+            tops.append(float(grid[-1, 0]))
+            return cost(grid)
+
+        centres.append(float(center))
+        out = real(cost_spy, center, n_problems, **kw)
+        last_points.append(tops[-1])
+        return out
+
+    monkeypatch.setattr(simsat, "grid_search_batch", spy)
+    p, man = SimsatParams(), Maneuver.thesis(1.0)
+    truth = np.array(MOI_CONFIGS[1:4])
+    y = simulate_simsat(p, man, truth)["yaw_meas_rad"]
+    est, _ = simsat.estimate_runs_i33(p, man, y, tol=1e-3, center_kgm2=40.0, center_on_previous_run=True)
+    assert centres[0] == 40.0
+    assert centres[1:] == last_points[:-1]  # each run starts from the previous run's last grid point
+    # ... the top of its last grid, the estimate + 2.5 steps of the refinement before (< 4 * 4 * tol each)
+    assert np.allclose(centres[1:], est[:-1], atol=2.5 * 16 * 1e-3)
+    assert est == pytest.approx(truth, abs=2e-3)  # noise-free: the chain does not change the minimum
+    centres.clear()
+    simsat.estimate_runs_i33(p, man, y, tol=1e-3)
+    assert centres == [p.i33_kgm2]  # default: one lockstep search from the nominal

@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -287,34 +287,80 @@ def grid_search_batch(
     return best, j_min
 
 
+def _recording_top(cost: Callable[[FloatArray], FloatArray], tops: list[float]) -> Callable[[FloatArray], FloatArray]:
+    """``cost`` that also appends the top of every grid it evaluates (first column) to ``tops``."""
+
+    def recording(grid: FloatArray) -> FloatArray:
+        tops.append(float(grid[-1, 0]))
+        return cost(grid)
+
+    return recording
+
+
 def _fit_runs_batch(
-    params: SimsatParams, maneuver: Maneuver, y_meas: FloatArray, free: str, tol: float
+    params: SimsatParams,
+    maneuver: Maneuver,
+    y_meas: FloatArray,
+    free: str,
+    tol: float,
+    center: float | None = None,
+    center_on_previous_run: bool = False,
 ) -> tuple[FloatArray, FloatArray]:
-    """Grid search of ``free`` (``"i33"`` or ``"wheel_gain"``) for every run (column of ``y_meas``) at once."""
+    """Grid search of ``free`` (``"i33"`` or ``"wheel_gain"``) for every run (column of ``y_meas``).
+
+    All runs at once (lockstep) from the grid centre ``center`` (default: the model's own value), or, with
+    ``center_on_previous_run``, one run after another, each run's grid centred on the last value the
+    previous run's search evaluated (App. C's loop variable; see :func:`estimate_runs_i33`).
+    """
     t = maneuver.times(params.dt_s)
     mask = maneuver.match_mask(t)
     y = np.atleast_2d(y_meas.T).T
     n_runs = y.shape[1]
 
-    def cost(grid: FloatArray) -> FloatArray:
-        values = grid.ravel()
-        sim = (
-            simulate_simsat(params, maneuver, values, None)
-            if free == "i33"
-            else simulate_simsat(params, maneuver, None, values)
-        )
-        y_rep = np.tile(y, (1, grid.shape[0]))  # column j*n_runs + r is run r
-        return l1_cost(y_rep, sim["yaw_meas_rad"], mask).reshape(grid.shape)
+    def cost_of(y_runs: FloatArray) -> Callable[[FloatArray], FloatArray]:
+        def cost(grid: FloatArray) -> FloatArray:
+            values = grid.ravel()
+            sim = (
+                simulate_simsat(params, maneuver, values, None)
+                if free == "i33"
+                else simulate_simsat(params, maneuver, None, values)
+            )
+            y_rep = np.tile(y_runs, (1, grid.shape[0]))  # column j*n_runs + r is run r
+            return l1_cost(y_rep, sim["yaw_meas_rad"], mask).reshape(grid.shape)
 
-    center = params.i33_kgm2 if free == "i33" else params.wheel_gain
-    return grid_search_batch(cost, center, n_runs, tol=tol)
+        return cost
+
+    c0 = float(center) if center is not None else (params.i33_kgm2 if free == "i33" else params.wheel_gain)
+    if not center_on_previous_run:
+        return grid_search_batch(cost_of(y), c0, n_runs, tol=tol)
+    best, j_min = np.empty(n_runs), np.empty(n_runs)
+    c = c0
+    for r in range(n_runs):
+        tops: list[float] = []  # MATLAB leaves the loop variable at the last grid point evaluated
+        b, j = grid_search_batch(_recording_top(cost_of(y[:, r : r + 1]), tops), c, 1, tol=tol)
+        best[r], j_min[r] = b[0], j[0]
+        c = tops[-1]
+    return best, j_min
 
 
 def estimate_runs_i33(
-    params: SimsatParams, maneuver: Maneuver, y_meas: FloatArray, tol: float = 1e-4
+    params: SimsatParams,
+    maneuver: Maneuver,
+    y_meas: FloatArray,
+    tol: float = 1e-4,
+    *,
+    center_kgm2: float | None = None,
+    center_on_previous_run: bool = False,
 ) -> tuple[FloatArray, FloatArray]:
-    """Phase B for runs (columns of ``y_meas``) at once: :func:`estimate_run_i33` vectorised over runs."""
-    return _fit_runs_batch(params, maneuver, y_meas, "i33", tol)
+    """Phase B for runs (columns of ``y_meas``) at once: :func:`estimate_run_i33` vectorised over runs.
+
+    The grid spans [0.5, 2] × ``center_kgm2`` (default ``params.i33_kgm2``, the nominal: spec §5.4 [R]).
+    ``center_on_previous_run=True`` reproduces App. C's code quirk (spec §5.4 [C], §11 item 12): the loop
+    variable ``I33`` is reused, so every run after the first is searched on [0.5, 2] × the last grid value
+    of the previous run's search (≈ its estimate), in file order; the first run uses ``center_kgm2``
+    (App. C sets ``I33`` to the configuration's MOI before the loop). The runs are then fitted one at a time.
+    """
+    return _fit_runs_batch(params, maneuver, y_meas, "i33", tol, center_kgm2, center_on_previous_run)
 
 
 def tune_wheel_gains(
