@@ -57,7 +57,7 @@ from abrupt.simulate.tle_null import (
     simulate_null_history,
 )
 from abrupt.thresholds import FalseAlarmBudget
-from bench_tle_null_calibration import BLOCK_SETS, DATA, REAL, UNLISTED
+from bench_tle_null_calibration import BLOCK_SETS, DATA, REAL, UNLISTED, parametric_cells
 
 BUDGET = FalseAlarmBudget(1.0, "year")
 # ΔV ladders (cm/s): in-track / cross-track (LEO), east-west / north-south (GEO station keeping)
@@ -194,36 +194,7 @@ def run_one(job: tuple[str, dict[str, Any]]) -> dict[str, Any]:
 
 
 def jobs(seeds: int, years: float) -> list[tuple[str, dict[str, Any]]]:
-    out: list[tuple[str, dict[str, Any]]] = []
-    for seed in range(seeds):
-        for noise in (1.0, 4.0):
-            for cadence in (0.3, 1.0, 3.0):
-                for alt in (450.0, 800.0, 1300.0):
-                    out.append(
-                        (
-                            "parametric",
-                            {
-                                "regime": "leo",
-                                "altitude_km": alt,
-                                "sets_per_day": cadence,
-                                "noise_scale": noise,
-                                "years": years,
-                                "seed": 5000 + 1000 * seed + int(alt) + int(10 * cadence) + int(noise),
-                            },
-                        )
-                    )
-                out.append(
-                    (
-                        "parametric",
-                        {
-                            "regime": "geo",
-                            "sets_per_day": cadence,
-                            "noise_scale": noise,
-                            "years": years,
-                            "seed": 5000 + 1000 * seed + 7 + int(10 * cadence) + int(noise),
-                        },
-                    )
-                )
+    out: list[tuple[str, dict[str, Any]]] = [("parametric", p) for p in parametric_cells(seeds, years, 5000)]
     for sat in REAL:
         for seed in range(2 * seeds):
             out.append(("bootstrap", {"satellite": sat, "years": years, "seed": 50 + seed}))

@@ -157,37 +157,38 @@ def summarise(frame: pd.DataFrame, keys: list[str]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def jobs(seeds: int, years: float) -> list[tuple[str, dict[str, Any]]]:
-    out: list[tuple[str, dict[str, Any]]] = []
+def parametric_cells(seeds: int, years: float, seed_base: int = 0) -> list[dict[str, Any]]:
+    """The parametric ensemble's :class:`NullHistorySpec` arguments: LEO 450/800/1300 km and GEO, 0.3/1/3
+    sets per day, noise ×1/×4, ``seeds`` histories per cell (also used by bench_tle_injection_recall.py)."""
+    out: list[dict[str, Any]] = []
     for seed in range(seeds):
         for noise in (1.0, 4.0):
             for cadence in (0.3, 1.0, 3.0):
                 for alt in (450.0, 800.0, 1300.0):
                     out.append(
-                        (
-                            "parametric",
-                            {
-                                "regime": "leo",
-                                "altitude_km": alt,
-                                "sets_per_day": cadence,
-                                "noise_scale": noise,
-                                "years": years,
-                                "seed": 1000 * seed + int(alt) + int(10 * cadence) + int(noise),
-                            },
-                        )
-                    )
-                out.append(
-                    (
-                        "parametric",
                         {
-                            "regime": "geo",
+                            "regime": "leo",
+                            "altitude_km": alt,
                             "sets_per_day": cadence,
                             "noise_scale": noise,
                             "years": years,
-                            "seed": 1000 * seed + 7 + int(10 * cadence) + int(noise),
-                        },
+                            "seed": seed_base + 1000 * seed + int(alt) + int(10 * cadence) + int(noise),
+                        }
                     )
+                out.append(
+                    {
+                        "regime": "geo",
+                        "sets_per_day": cadence,
+                        "noise_scale": noise,
+                        "years": years,
+                        "seed": seed_base + 1000 * seed + 7 + int(10 * cadence) + int(noise),
+                    }
                 )
+    return out
+
+
+def jobs(seeds: int, years: float) -> list[tuple[str, dict[str, Any]]]:
+    out: list[tuple[str, dict[str, Any]]] = [("parametric", p) for p in parametric_cells(seeds, years)]
     for sat in REAL:
         for seed in range(2 * seeds):
             out.append(("bootstrap", {"satellite": sat, "years": years, "seed": seed}))
