@@ -125,22 +125,17 @@ def test_burns_outside_the_history_are_refused() -> None:
         simulate_null_history(SPEC, burns=[(-1.0, 0.0, 1.0)])
 
 
-def test_five_cm_s_burns_in_jason_3_real_noise_are_found_at_the_budget() -> None:
+def test_five_cm_s_burns_in_jason_3_real_noise_are_found_at_the_budget(shared_data) -> None:
     """Blocks of Jason-3's own quiet-time noise (bootstrap) with ten 5 cm/s in-track burns, at least
     30 days apart, each in a gap whose test holds no junction between blocks: at one false alarm per
     satellite-year all ten are found within a day (the detector states a 50 % size of ~0.05 cm/s
     there), and at most one other event falls at a counted gap."""
-    from pathlib import Path
-
     from abrupt.readers.fengyun import read_maneuver_file
     from abrupt.readers.tle import read_tle
     from abrupt.simulate.tle_null import bootstrap_null_history, gaps_clear_of_junctions, quiet_mask
 
-    data = Path(__file__).resolve().parents[2] / "shared" / "data"
-    if not (data / "tle" / "Jason-3.tle").exists():
-        pytest.skip("shared data not present")
-    real = read_tle(data / "tle" / "Jason-3.tle")
-    maneuvers = list(read_maneuver_file(data / "maneuvers" / "ja3man.txt")["time_utc"])
+    real = read_tle(shared_data / "tle" / "Jason-3.tle")
+    maneuvers = list(read_maneuver_file(shared_data / "maneuvers" / "ja3man.txt")["time_utc"])
     quiet = quiet_mask(real.elements["epoch_utc"], maneuvers)
     kw = {"regime": "leo", "years": 2.5, "seed": 4}
     plain, junctions = bootstrap_null_history(real, quiet, **kw)

@@ -1231,7 +1231,7 @@ def run_tle_detector(
         # LEO campaigns: stay inside this burn's segment; GEO burns are weeks apart and the
         # mean-longitude kink needs the full window (bounded: 2 of 70 FY times > 1 day off)
         seg = _bounds(int(g), change_points, len(history)) if regime == "leo" else (0, len(history))
-        if cfg.refine_time and has_drift_hinge(steps, int(g)) and not is_phasing(steps, int(g)):
+        if cfg.refine_time and has_drift_hinge(steps, int(g), cfg.min_statistic) and not is_phasing(steps, int(g)):
             t_m, refined = refine_burn_time(
                 history,
                 int(g),

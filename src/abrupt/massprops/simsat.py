@@ -339,7 +339,7 @@ def _fit_runs_batch(
         tops: list[float] = []  # MATLAB leaves the loop variable at the last grid point evaluated
         b, j = grid_search_batch(_recording_top(cost_of(y[:, r : r + 1]), tops), c, 1, tol=tol)
         best[r], j_min[r] = b[0], j[0]
-        c = tops[-1]
+        c = tops[-1] if tops else c  # no grid when tol is above the first step: the centre stays
     return best, j_min
 
 

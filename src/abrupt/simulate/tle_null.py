@@ -146,9 +146,8 @@ def _smooth_orbit(spec: NullHistorySpec, t_days: NDArray[np.float64], rng: np.ra
         drift = math.radians(0.85) / DAYS_PER_YEAR * t_days  # [rad] luni-solar drift of the i-vector
         # What is left of the 13.66-day lunar and 182.6-day solar terms in *mean* elements: SDP4's
         # deep-space periodics (Hoots & Roehrich 1980, dpper) take out most of their osculating
-        # 5e-5 / 1.5e-4 rad; the Fengyun-2D/2E histories keep 1-4e-6 / ~1-2.5e-5 rad (session 5:
-        # amplitudes fitted after a 61-set running median). Session 4 used the osculating sizes,
-        # which hid north-south burns below ~5 m/s (docs/tle.md "Injected burns").
+        # 5e-5 / 1.5e-4 rad; the Fengyun-2D/2E histories keep 1-4e-6 / ~1-2.5e-5 rad (amplitudes
+        # fitted after a 61-set running median; docs/tle.md "Injected burns").
         lunar = 4e-6 * np.sin(2 * math.pi * t_days / 13.66 + rng.uniform(0, 6.3))
         solar = 2.5e-5 * np.sin(2 * math.pi * t_days / 182.6 + rng.uniform(0, 6.3))
         n1 = i0 * math.cos(d0) + drift + lunar
@@ -277,6 +276,7 @@ def _inject_burns(
     smooth: dict[str, NDArray[np.float64]],
     burns: Sequence[tuple[float, ...]],
     seed: int,
+    regime: str = "leo",
 ) -> list[tuple[int, float]]:
     """Add impulsive burns to the smooth series in place; return (first set after, its ndot rate).
 
@@ -293,8 +293,9 @@ def _inject_burns(
       ``a·Δn·(t_k − t_b − Δt/2)`` with ``Δn = −(3/2)·n·Δa/a`` (Kepler's third law). The first set
       after was fitted across the burn, so the decay it states carries the step as a rate over a day;
     * cross-track (LEO cross-track, GEO north-south): the orbit normal turns by ``Δv_n/v``: LEO
-      ``Δi = (Δv_n/v)·cos u``, ``sin i·ΔΩ = (Δv_n/v)·sin u``; GEO the inclination vector moves by
-      ``Δv_n/v`` in the direction ``u``.
+      ``Δi = (Δv_n/v)·cos u``, ``sin i·ΔΩ = (Δv_n/v)·sin u``, and the argument of latitude (counted
+      from the node that moved) by ``−cos i·ΔΩ``; GEO the inclination vector
+      ``i(sin Ω, −cos Ω)`` moves by ``Δv_n/v`` (its direction drawn uniformly, as ``u``).
     """
     rng_u = np.random.default_rng([seed, 7])
     first_after: list[tuple[int, float]] = []
@@ -317,6 +318,11 @@ def _inject_burns(
         smooth["u_m"][k:] = smooth["u_m"][k:] + a_k * dn * ((t_days[k] - day) * SECONDS_PER_DAY - 0.5 * gap_s)
         smooth["n1_rad"][k:] += dv_n / v * math.cos(u)
         smooth["n2_rad"][k:] += dv_n / v * math.sin(u)
+        if regime != "geo" and dv_n:
+            # the node turns by ΔΩ = (Δv_n/v)·sin u / sin i while the satellite stays put, so the
+            # argument of latitude, counted from the node, moves by −cos i·ΔΩ
+            inc = float(smooth["n1_rad"][k])
+            smooth["u_m"][k:] -= a_k * math.cos(inc) * dv_n / v * math.sin(u) / math.sin(inc)
         first_after.append((k, da / SECONDS_PER_DAY))
     return first_after
 
@@ -331,7 +337,7 @@ def simulate_null_history(spec: NullHistorySpec, burns: Sequence[tuple[float, ..
     rng = np.random.default_rng(spec.seed)
     t = _epochs_days(spec, rng)
     smooth = _smooth_orbit(spec, t, rng)
-    first_after = _inject_burns(t, smooth, burns, spec.seed)
+    first_after = _inject_burns(t, smooth, burns, spec.seed, spec.regime)
     sig = spec.noise_sigmas()
     bad = rng.random(t.size) < spec.bad_set_probability
     out = {}
@@ -342,8 +348,9 @@ def simulate_null_history(spec: NullHistorySpec, burns: Sequence[tuple[float, ..
     if spec.regime != "geo":
         out["n1_rad"] = np.clip(out["n1_rad"], 1e-3, math.pi - 1e-3)
     out["adot_m_s"] = _stated_decay_m_s(smooth["adot_m_s"], spec, bad, rng)
-    for k, rate_m_s in first_after:
-        out["adot_m_s"][k] += rate_m_s
+    if spec.regime != "geo":  # as bootstrap_null_history: ndot carries the step in LEO only
+        for k, rate_m_s in first_after:
+            out["adot_m_s"][k] += rate_m_s
     return history_from_series(t, out, spec.regime, norad=99900 + spec.seed % 99)
 
 
@@ -508,7 +515,7 @@ def bootstrap_null_history(
         inc = math.degrees(float(np.median(history.elements["i_rad"])))
         spec = NullHistorySpec(regime="leo", altitude_km=h_km, inclination_deg=inc, seed=seed)
     smooth = _smooth_orbit(spec, t, rng)
-    first_after = _inject_burns(t, smooth, burns, seed)
+    first_after = _inject_burns(t, smooth, burns, seed, regime)
     bounds = [*starts, len(idx)]
     out: dict[str, NDArray[np.float64]] = {}
     for name in (*SERIES, "adot_m_s"):
