@@ -43,17 +43,21 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-from numpy.typing import NDArray
 
 from abrupt.detect.tle_detectors import detector_for
 from abrupt.readers.fengyun import read_maneuver_file
 from abrupt.readers.tle import read_tle
-from abrupt.score import match_times
+from abrupt.simulate.tle_injection import (
+    KINDS,
+    burn_gaps_clear,
+    burn_schedule,
+    score_injected,
+    smallest_reliable_cm_s,
+)
 from abrupt.simulate.tle_null import (
     EPOCH0,
     NullHistorySpec,
     bootstrap_null_history,
-    gaps_clear_of_junctions,
     quiet_mask,
     simulate_null_history,
 )
@@ -61,56 +65,8 @@ from abrupt.thresholds import FalseAlarmBudget
 from bench_tle_null_calibration import BLOCK_SETS, DATA, REAL, UNLISTED, parametric_cells
 
 BUDGET = FalseAlarmBudget(1.0, "year")
-# ΔV ladders (cm/s): in-track / cross-track (LEO), east-west / north-south (GEO station keeping)
-LADDERS = {
-    "leo": ((0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0), (5.0, 10.0, 20.0, 50.0, 100.0, 200.0)),
-    "geo": ((1.0, 2.0, 5.0, 10.0, 20.0, 50.0), (10.0, 20.0, 50.0, 100.0, 200.0, 500.0)),
-}
-KIND = {"leo": ("in-track", "cross-track"), "geo": ("east-west", "north-south")}
 BIG_CM_S = 5.0
 TOLERANCE_S = 86400.0
-
-
-def burn_schedule(
-    years: float, seed: int, allowed: NDArray[np.float64] | None = None, regime: str = "leo"
-) -> list[tuple[float, float, float]]:
-    """(day, Δv_t, Δv_n) in m/s: every 30-50 days, alternately in-track and cross-track, the ΔV
-    ladders shuffled so every size meets every season of the history. With ``allowed`` (sorted days
-    a burn may take: the middles of gaps clear of bootstrap junctions) each burn moves to the first
-    allowed day at or after its draw."""
-    rng = np.random.default_rng([seed, 11])
-    span = years * 365.25
-    days = []
-    d = 25.0 + rng.uniform(0.0, 10.0)
-    while d < span - 25.0:
-        if allowed is not None:
-            k = int(np.searchsorted(allowed, d))
-            if k >= allowed.size or allowed[k] >= span - 25.0:
-                break
-            d = float(allowed[k])
-        days.append(d)
-        d += rng.uniform(30.0, 50.0)
-    lad_t, lad_n = LADDERS[regime]
-    t_ladder = list(rng.permutation(np.tile(lad_t, len(days) // len(lad_t) + 1)))
-    n_ladder = list(rng.permutation(np.tile(lad_n, len(days) // len(lad_n) + 1)))
-    out = []
-    for k, day in enumerate(days):
-        if k % 2 == 0:
-            out.append((day, float(t_ladder.pop()) / 100.0 * rng.choice([-1.0, 1.0]), 0.0))
-        else:
-            out.append((day, 0.0, float(n_ladder.pop()) / 100.0))
-    return out
-
-
-def burn_gaps_clear(n_gaps: int, junctions: Any, window_sets: int) -> NDArray[np.bool_]:
-    """Gaps where a burn's test (slope windows of ``window_sets`` sets each side, ±3 gaps of
-    localisation) and every gap counted for its false alarms hold no junction between bootstrap
-    noise blocks."""
-    counted = gaps_clear_of_junctions(n_gaps, junctions, window_sets)
-    reach = window_sets + 3
-    padded = np.concatenate([np.zeros(reach, bool), counted, np.zeros(reach, bool)])
-    windows = np.lib.stride_tricks.sliding_window_view(padded, 2 * reach + 1)
-    return np.asarray(windows.all(axis=1), dtype=bool)
 
 
 def run_one(job: tuple[str, dict[str, Any]]) -> dict[str, Any]:
@@ -141,54 +97,20 @@ def run_one(job: tuple[str, dict[str, Any]]) -> dict[str, Any]:
         burns = burn_schedule(p["years"], p["seed"], allowed=mids[clear], regime=regime)
         history, junctions = bootstrap_null_history(real, quiet, burns=burns, **kw)
         label = f"bootstrap of {sat}"
-    el = history.elements
     det = detector_for(history)
     run = det.run(history, BUDGET)
-    n_gaps = len(el) - 1
-    counted = gaps_clear_of_junctions(n_gaps, junctions, det.settings.window_sets)
-    t_days = (pd.to_datetime(el["epoch_utc"]) - EPOCH0).dt.total_seconds().to_numpy() / 86400.0
-    burn_days = np.array([b[0] for b in burns])
-    burn_gap = np.clip(np.searchsorted(t_days, burn_days) - 1, 0, n_gaps - 1)
-    ev = run.events
-    ev_t = pd.to_datetime(ev["time_utc"]).dt.tz_localize(None).to_numpy(dtype="datetime64[ns]").astype(np.int64)
-    burn_t = (EPOCH0 + pd.to_timedelta(burn_days, unit="D")).to_numpy(dtype="datetime64[ns]").astype(np.int64)
-    pairs = match_times(ev_t, burn_t, TOLERANCE_S)
-    found = {j for _, j, _ in pairs}
-    matched_ev = {i for i, _, _ in pairs}
-    epochs = el["epoch_utc"].to_numpy(dtype="datetime64[ns]")
-    before = pd.to_datetime(ev["elset_epoch_before_utc"]).to_numpy(dtype="datetime64[ns]")
-    ev_gap = np.clip(np.searchsorted(epochs, before), 0, n_gaps - 1)
-    # a false alarm: an event matched to no burn, at a gap whose test holds no junction; an echo is a
-    # false alarm within 3 days of a burn (a burn seen twice, or timed more than a day off)
-    unmatched = [i for i in range(len(ev)) if i not in matched_ev and counted[ev_gap[i]]]
-    fa = len(unmatched)
-    echoes = sum(1 for i in unmatched if np.any(np.abs(ev_t[i] - burn_t) < 3 * 86400 * 1_000_000_000))
-    # burns whose gap and test windows hold no junction (all of them in parametric histories)
-    clear = burn_gaps_clear(n_gaps, junctions, det.settings.window_sets)
+    scored = score_injected(
+        history, run.events, run.noise_model, burns, junctions, det.settings.window_sets, regime, TOLERANCE_S
+    )
     nm = run.noise_model
-    rows = []
-    for j, (_, dv_t, dv_n) in enumerate(burns):
-        if not clear[int(burn_gap[j])]:
-            continue
-        kind_j = KIND[regime][0] if dv_t else KIND[regime][1]
-        stated = nm.get("min_detectable_dv_t_mps" if dv_t else "min_detectable_dv_n_mps", np.nan)
-        rows.append(
-            {
-                "kind": kind_j,
-                "dv_cm_s": round(100 * abs(dv_t if dv_t else dv_n), 1),
-                "ratio_to_stated": abs(dv_t if dv_t else dv_n) / float(stated),
-                "found": j in found,
-            }
-        )
-    years = (el["epoch_utc"].iloc[-1] - el["epoch_utc"].iloc[0]).total_seconds() / 86400.0 / 365.25
     return {
         "ensemble": kind,
         "regime": regime,
         "cell": label,
-        "years": years * float(counted.mean()),
-        "false_alarms": fa,
-        "echoes": echoes,
-        "burns": rows,
+        "years": scored["years"],
+        "false_alarms": scored["false_alarms"],
+        "echoes": scored["echoes"],
+        "burns": scored["burns"],
         "min_dv_t_cm_s": 100 * float(nm.get("min_detectable_dv_t_mps", np.nan)),
         "min_dv_n_cm_s": 100 * float(nm.get("min_detectable_dv_n_mps", np.nan)),
     }
@@ -200,21 +122,6 @@ def jobs(seeds: int, years: float) -> list[tuple[str, dict[str, Any]]]:
         for seed in range(2 * seeds):
             out.append(("bootstrap", {"satellite": sat, "years": years, "seed": 50 + seed}))
     return out
-
-
-def smallest_reliable_cm_s(burns: pd.DataFrame, kind: str, level: float = 0.9) -> float:
-    """The smallest injected ΔV of ``kind`` from which every larger size is found ≥ ``level`` of the time."""
-    b = burns[burns["kind"] == kind]
-    if b.empty:
-        return float("nan")
-    rate = b.groupby("dv_cm_s")["found"].mean().sort_index()
-    ok = rate >= level
-    best = float("nan")
-    for dv in rate.index[::-1]:
-        if not ok[dv]:
-            break
-        best = float(dv)
-    return best
 
 
 def main() -> None:
@@ -232,7 +139,7 @@ def main() -> None:
         rs = [r for r in results if r["cell"] == cell]
         burns = pd.DataFrame([b for r in rs for b in r["burns"]])
         all_burns.append(burns.assign(ensemble=rs[0]["ensemble"], regime=rs[0]["regime"].upper()))
-        k_t, k_n = KIND[rs[0]["regime"]]
+        k_t, k_n = KINDS[rs[0]["regime"]]
         big = burns[(burns["kind"] == k_t) & (burns["dv_cm_s"] >= BIG_CM_S)]
         yrs = sum(r["years"] for r in rs)
         fa = sum(r["false_alarms"] for r in rs)
@@ -265,7 +172,7 @@ def main() -> None:
     cal = burns.groupby(["regime", "ensemble", "kind", bins], observed=True)["found"].agg(["mean", "size"]).unstack(3)
     print(cal.to_string(float_format=lambda x: f"{x:.2f}"))
     for regime in ("leo", "geo"):
-        k_t = KIND[regime][0]
+        k_t = KINDS[regime][0]
         big = burns[(burns["kind"] == k_t) & (burns["dv_cm_s"] >= BIG_CM_S) & (burns["regime"] == regime.upper())]
         for ens in ("parametric", "bootstrap"):
             b = big[big["ensemble"] == ens]

@@ -160,3 +160,76 @@ def test_five_cm_s_burns_in_jason_3_real_noise_are_found_at_the_budget(shared_da
     gap = np.searchsorted(epochs, pd.to_datetime(events["elset_epoch_before_utc"]).to_numpy(dtype="datetime64[ns]"))
     far = np.array([min(abs(x - d) for d in days) > 1.0 for x in ev_days])
     assert int((far & counted[np.clip(gap, 0, t.size - 2)]).sum()) <= 1
+
+
+def test_injection_recall_checks_the_stated_size_on_the_satellites_own_noise(shared_data) -> None:
+    """On Sentinel-3A's own noise, burns at 1/4 to 8 times the detector's stated 50 % size: below
+    half the stated size at most 20 % are found, at twice it or more at least 90 % (the truth: the
+    injected ΔV), with the false alarms of those histories within twice the budget."""
+    from abrupt.readers.fengyun import read_maneuver_file
+    from abrupt.readers.tle import read_tle
+    from abrupt.simulate.tle_injection import injection_recall, ladder_around
+
+    real = read_tle(shared_data / "tle" / "Sentinel-3A.tle")
+    known = list(read_maneuver_file(shared_data / "maneuvers" / "s3aman.txt")["time_utc"])
+    stated = 100.0 * TleMeanElements().run(real, BUDGET).noise_model["min_detectable_dv_t_mps"]
+    ladders = (ladder_around(stated), (1000.0,))
+    burns, summary = injection_recall(real, known, BUDGET, years=4.0, seeds=(0, 1), ladders_cm_s=ladders)
+    in_track = burns[burns["kind"] == "in-track"]
+    assert len(in_track) >= 20
+    small = in_track[in_track["ratio_to_stated"] < 0.5]
+    large = in_track[in_track["ratio_to_stated"] >= 2.0]
+    assert len(small) >= 4 and len(large) >= 8
+    assert small["found"].mean() <= 0.2
+    assert large["found"].mean() >= 0.9
+    assert summary["false_alarms_per_year"] <= 2.0 * BUDGET.per_year
+    assert summary["regime"] == "leo"
+
+
+def test_ladder_brackets_the_stated_size_and_refuses_nonsense() -> None:
+    from abrupt.simulate.tle_injection import ladder_around
+
+    assert ladder_around(0.84) == (0.21, 0.42, 0.84, 1.7, 3.4, 6.7)
+    for bad in (0.0, -1.0, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="finite positive"):
+            ladder_around(bad)
+
+
+def test_inject_tle_command(shared_data, tmp_path) -> None:
+    """``abrupt inject tle``: a table per kind and a CSV of every burn; bad options and a file with
+    several satellites are one-line errors."""
+    from click.testing import CliRunner
+
+    from abrupt.cli.main import cli
+    from abrupt.errors import InputError
+
+    runner = CliRunner()
+    tle = shared_data / "tle" / "Jason-3.tle"
+    out = tmp_path / "burns.csv"
+    args = ["inject", "tle", str(tle), "--maneuvers", str(shared_data / "maneuvers" / "ja3man.txt")]
+    r = runner.invoke(cli, [*args, "--seeds", "1", "--years", "2", "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "in-track:" in r.output and "cross-track:" in r.output and "false alarms:" in r.output
+    frame = pd.read_csv(out)
+    assert set(frame.columns) >= {"kind", "dv_cm_s", "ratio_to_stated", "found", "seed"}
+    assert len(frame) >= 5
+    for bad, hint in (
+        (["--seeds", "0"], "seeds"),
+        (["--years", "0.5"], "years"),
+        (["--out", str(tmp_path / "b.txt")], ".csv"),
+    ):
+        r = runner.invoke(cli, [*args, *bad])
+        assert r.exit_code != 0 and hint in r.output, r.output
+    two = tmp_path / "two.tle"
+    lines = tle.read_text().splitlines()
+
+    def renumbered(line: str) -> str:  # catalogue number 99999, checksum recomputed (column 69)
+        body = line[:2] + "99999" + line[7:68]
+        return body + str(sum(int(c) if c.isdigit() else c == "-" for c in body) % 10)
+
+    other = [renumbered(ln) if ln[:2] in ("1 ", "2 ") else ln for ln in lines[:40]]
+    two.write_text("\n".join(lines + other) + "\n")
+    r = runner.invoke(cli, ["inject", "tle", str(two), "--seeds", "1", "--years", "2"])
+    assert isinstance(r.exception, InputError) and "2 satellites" in str(r.exception)  # main(): one line, exit 2
+    r = runner.invoke(cli, ["inject", "tle", str(two), "--norad", "99999", "--seeds", "1", "--years", "2"])
+    assert isinstance(r.exception, InputError) and "too few" in str(r.exception)  # 20 sets: no noise to draw

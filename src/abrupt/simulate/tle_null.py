@@ -531,7 +531,9 @@ def bootstrap_null_history(
     return history_from_series(t, out, regime, norad=99800 + seed % 99), junctions
 
 
-def gaps_clear_of_junctions(n_gaps: int, junctions: Sequence[int], window_sets: int) -> NDArray[np.bool_]:
+def gaps_clear_of_junctions(
+    n_gaps: int, junctions: Sequence[int] | NDArray[np.int64], window_sets: int
+) -> NDArray[np.bool_]:
     """Gaps whose step test holds no junction between bootstrap noise blocks (sets ``j-1`` and ``j`` of a
     junction ``j`` come from different blocks): outside the slope windows (2 × ``window_sets`` sets each
     side) and the ±2-gap localisation of a change point. Only these gaps count as null tests."""
