@@ -207,8 +207,10 @@ def test_inject_tle_command(shared_data, tmp_path) -> None:
     tle = shared_data / "tle" / "Jason-3.tle"
     out = tmp_path / "burns.csv"
     args = ["inject", "tle", str(tle), "--maneuvers", str(shared_data / "maneuvers" / "ja3man.txt")]
-    r = runner.invoke(cli, [*args, "--seeds", "1", "--years", "2", "--out", str(out)])
+    fig = tmp_path / "recall.png"
+    r = runner.invoke(cli, [*args, "--seeds", "1", "--years", "2", "--out", str(out), "--report", str(fig)])
     assert r.exit_code == 0, r.output
+    assert fig.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "in-track:" in r.output and "cross-track:" in r.output and "false alarms:" in r.output
     frame = pd.read_csv(out)
     assert set(frame.columns) >= {"kind", "dv_cm_s", "ratio_to_stated", "found", "seed"}

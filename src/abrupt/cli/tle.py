@@ -375,6 +375,7 @@ def score(
 @click.option("--seeds", type=int, default=4, show_default=True, help="Simulated histories (different noise draws).")
 @click.option("--out", type=click.Path(dir_okay=False), default=None, help="Every injected burn, found or not (.csv).")
 @click.option("--strict", is_flag=True, help="A malformed element set is an error (default: skipped and reported).")
+@report_option
 def inject_tle(
     path: str,
     norad_id: int | None,
@@ -384,6 +385,7 @@ def inject_tle(
     seeds: int,
     out: str | None,
     strict: bool,
+    report_path: str | None,
 ) -> None:
     """What the detector sees on this satellite: burns of known ΔV injected into its own noise.
 
@@ -408,6 +410,8 @@ def inject_tle(
         raise click.BadParameter(f"{years} years: give 1 to 50", param_hint="--years")
     if not (1 <= seeds <= 100):
         raise click.BadParameter(f"{seeds} seeds: give 1 to 100", param_hint="--seeds")
+    if out and not str(out).lower().endswith(".csv"):
+        raise click.BadParameter(f"{out}: write a .csv", param_hint="--out")
     result = detect_tle_file(path, budget, norad_id=norad_id, strict=strict)
     if len(result.satellites) != 1:
         raise InputError(f"{len(result.satellites)} satellites in the file: select one with --norad", file=path, line=1)
@@ -461,8 +465,11 @@ def inject_tle(
         f"({summary['false_alarms_per_year']:.2f} per year; {summary['echoes']} within 3 days of a burn)"
     )
     if out:
-        check_csv = str(out).lower().endswith(".csv")
-        if not check_csv:
-            raise click.BadParameter(f"{out}: write a .csv", param_hint="--out")
         burns.to_csv(out, index=False)
         click.echo(f"burns written to {out}", err=True)
+    if report_path:
+        from abrupt.report.tle import plot_injection_recall
+
+        label = f"{satellite_label(sat.history)}: injected burns"
+        target = plot_injection_recall(burns, summary, report_path, title=label)
+        click.echo(f"report written to {target}", err=True)

@@ -117,3 +117,49 @@ def plot_tle_report(
         pad=14,  # room for the truth triangles on the panel's top edge
     )
     return save_figure(fig, out)
+
+
+def plot_injection_recall(
+    burns: pd.DataFrame, summary: dict[str, Any], out: str | Path, *, title: str | None = None
+) -> Path:
+    """Recall of injected burns against their ΔV (log axis), one panel per kind, with the detector's
+    stated 50 % size (dashed) and each size's binomial 68 % interval (Wilson); ``burns`` and
+    ``summary`` are :func:`abrupt.simulate.tle_injection.injection_recall`'s."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import NullFormatter
+
+    kinds = [k for k in dict.fromkeys(burns["kind"])] if len(burns) else []
+    fig, axes = plt.subplots(1, max(len(kinds), 1), figsize=(5.0 * max(len(kinds), 1), 3.6), squeeze=False)
+    for ax, kind in zip(axes[0], kinds, strict=False):
+        g = burns[burns["kind"] == kind].groupby("dv_cm_s")["found"].agg(["sum", "size"]).sort_index()
+        n = g["size"].to_numpy(dtype=float)
+        p = g["sum"].to_numpy(dtype=float) / n
+        z = 1.0
+        centre = (p + z**2 / (2 * n)) / (1 + z**2 / n)
+        half = z * np.sqrt(p * (1 - p) / n + z**2 / (4 * n**2)) / (1 + z**2 / n)
+        dv = g.index.to_numpy(dtype=float)
+        yerr = np.clip([p - (centre - half), (centre + half) - p], 0.0, None)  # the interval holds p (rounding)
+        ax.errorbar(dv, p, yerr=yerr, fmt="o-", capsize=3, label="found / injected")
+        for x, k, m in zip(dv, g["sum"], g["size"], strict=True):
+            ax.annotate(f"{int(k)}/{int(m)}", (x, 0.03), ha="center", fontsize=7)
+        stated = summary.get("stated_min_dv_cm_s", {}).get(kind, float("nan"))
+        if np.isfinite(stated):
+            ax.axvline(stated, color="k", ls="--", lw=1, label=f"stated 50 % size {stated:.2g} cm/s")
+        ax.axhline(0.9, color="0.6", lw=0.8)
+        ax.set_xscale("log")
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set_ylim(0.0, 1.05)
+        ax.set_xlabel(f"{kind} ΔV (cm/s)")
+        ax.set_ylabel("fraction found (±1 d)")
+        ax.legend(loc="center right", fontsize=8)
+        ax.grid(alpha=0.3)
+    exposure = (
+        f"{summary.get('sat_years', 0):.1f} satellite-years of its own noise, "
+        f"{summary.get('false_alarms_per_year', float('nan')):.2f} false alarms per year"
+    )
+    fig.suptitle(f"{title or 'Burns injected into the satellite’s own noise'}\n{exposure}", fontsize=10)
+    fig.tight_layout()
+    return save_figure(fig, out)
