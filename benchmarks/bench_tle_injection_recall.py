@@ -49,18 +49,12 @@ from abrupt.readers.fengyun import read_maneuver_file
 from abrupt.readers.tle import read_tle
 from abrupt.simulate.tle_injection import (
     KINDS,
-    burn_gaps_clear,
     burn_schedule,
+    injection_recall,
     score_injected,
     smallest_reliable_cm_s,
 )
-from abrupt.simulate.tle_null import (
-    EPOCH0,
-    NullHistorySpec,
-    bootstrap_null_history,
-    quiet_mask,
-    simulate_null_history,
-)
+from abrupt.simulate.tle_null import NullHistorySpec, simulate_null_history
 from abrupt.thresholds import FalseAlarmBudget
 from bench_tle_null_calibration import BLOCK_SETS, DATA, REAL, UNLISTED, parametric_cells
 
@@ -71,36 +65,37 @@ TOLERANCE_S = 86400.0
 
 def run_one(job: tuple[str, dict[str, Any]]) -> dict[str, Any]:
     kind, p = job
-    if kind == "parametric":
-        regime = p["regime"]
-        burns = burn_schedule(p["years"], p["seed"], regime=regime)
-        spec = NullHistorySpec(**p)
-        history = simulate_null_history(spec, burns=burns)
-        junctions: Any = []
-        label = (f"LEO {spec.altitude_km:.0f} km" if regime == "leo" else "GEO") + (
-            f", {spec.sets_per_day:g}/day, noise ×{spec.noise_scale:g}"
-        )
-    else:
+    if kind == "bootstrap":  # the satellite's own noise: abrupt.simulate.tle_injection, one seed
         sat = p["satellite"]
         real = read_tle(DATA / "tle" / f"{sat}.tle")
         truth = read_maneuver_file(DATA / "maneuvers" / REAL[sat][0])
         times = [*truth["time_utc"], *(pd.Timestamp(x) for x in UNLISTED.get(sat, ()))]
-        quiet = quiet_mask(real.elements["epoch_utc"], times)
-        regime = REAL[sat][1]
-        kw = {"regime": regime, "years": p["years"], "seed": p["seed"], "block_sets": BLOCK_SETS}
-        # the same draw twice (the burns do not touch the generator of the blocks): first to find
-        # the gaps whose test windows hold no junction, then with burns only there
-        plain, junctions = bootstrap_null_history(real, quiet, **kw)
-        t_plain = (pd.to_datetime(plain.elements["epoch_utc"]) - EPOCH0).dt.total_seconds().to_numpy() / 86400.0
-        clear = burn_gaps_clear(t_plain.size - 1, junctions, detector_for(plain).settings.window_sets)
-        mids = 0.5 * (t_plain[1:] + t_plain[:-1])
-        burns = burn_schedule(p["years"], p["seed"], allowed=mids[clear], regime=regime)
-        history, junctions = bootstrap_null_history(real, quiet, burns=burns, **kw)
-        label = f"bootstrap of {sat}"
+        frame, summary = injection_recall(
+            real, times, BUDGET, years=p["years"], seeds=(p["seed"],), block_sets=BLOCK_SETS, tolerance_s=TOLERANCE_S
+        )
+        stated = list(summary["stated_min_dv_cm_s"].values())
+        return {
+            "ensemble": kind,
+            "regime": summary["regime"],
+            "cell": f"bootstrap of {sat}",
+            "years": summary["sat_years"],
+            "false_alarms": summary["false_alarms"],
+            "echoes": summary["echoes"],
+            "burns": frame.drop(columns="seed").to_dict("records"),
+            "min_dv_t_cm_s": stated[0],
+            "min_dv_n_cm_s": stated[1],
+        }
+    regime = p["regime"]
+    burns = burn_schedule(p["years"], p["seed"], regime=regime)
+    spec = NullHistorySpec(**p)
+    history = simulate_null_history(spec, burns=burns)
+    label = (f"LEO {spec.altitude_km:.0f} km" if regime == "leo" else "GEO") + (
+        f", {spec.sets_per_day:g}/day, noise ×{spec.noise_scale:g}"
+    )
     det = detector_for(history)
     run = det.run(history, BUDGET)
     scored = score_injected(
-        history, run.events, run.noise_model, burns, junctions, det.settings.window_sets, regime, TOLERANCE_S
+        history, run.events, run.noise_model, burns, [], det.settings.window_sets, regime, TOLERANCE_S
     )
     nm = run.noise_model
     return {

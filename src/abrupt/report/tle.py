@@ -131,7 +131,7 @@ def plot_injection_recall(
     import matplotlib.pyplot as plt
     from matplotlib.ticker import NullFormatter
 
-    kinds = [k for k in dict.fromkeys(burns["kind"])] if len(burns) else []
+    kinds = list(dict.fromkeys(burns["kind"])) if len(burns) else []
     fig, axes = plt.subplots(1, max(len(kinds), 1), figsize=(5.0 * max(len(kinds), 1), 3.6), squeeze=False)
     for ax, kind in zip(axes[0], kinds, strict=False):
         g = burns[burns["kind"] == kind].groupby("dv_cm_s")["found"].agg(["sum", "size"]).sort_index()

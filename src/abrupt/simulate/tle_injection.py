@@ -6,9 +6,9 @@ satellite's own history, without its truth: blocks of the history's quiet stretc
 about a running median, with their real gaps, :func:`abrupt.simulate.tle_null.bootstrap_null_history`)
 are laid on a fresh smooth orbit and impulsive burns of known time and ΔV are injected
 (:func:`abrupt.simulate.tle_null._inject_burns`); the detector runs at the user's budget and every
-burn found within ``tolerance_s`` (one-to-one) counts. "Quiet" keeps ``before_days`` /
-``after_days`` away from the maneuvers the caller names: the operator's, or, without them, the
-detector's own detections on the real history.
+burn found within ``tolerance_s`` (one-to-one) counts. "Quiet" keeps 3 days before and 12 days after
+every maneuver the caller names (:func:`~abrupt.simulate.tle_null.quiet_mask`): the operator's, or,
+without them, the detector's own detections on the real history.
 
 Burns go every 30-50 days, alternately in-track (GEO: east-west) and cross-track (GEO: north-south),
 sizes from a ladder (:data:`LADDERS_CM_S`) shuffled over the history, each into a gap whose test
