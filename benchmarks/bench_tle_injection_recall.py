@@ -1,4 +1,4 @@
-"""Recall of injected burns on noise the detector was not tuned on, against the ΔV it says it can see.
+"""Recall of injected burns of exact time and ΔV, against the ΔV the detector says it can see.
 
 The TLE detectors are tuned (leave one satellite out) on five real histories; the issue asks for
 recall ≥ 0.9 of LEO burns ≥ 5 cm/s at one false alarm per satellite-year, and will judge abrupt on
@@ -13,7 +13,8 @@ stands in the way of 0.9"). Here every burn is alone between element sets and th
 * **bootstrap** histories (:func:`~abrupt.simulate.tle_null.bootstrap_null_history`): the real
   noise of Jason-3, Sentinel-3A, CryoSat-2, Fengyun-2D and Fengyun-2E in blocks from their quiet
   stretches; burns and false alarms are counted only at gaps whose test holds no junction between
-  blocks.
+  blocks. These reuse the noise of the satellites the settings were chosen on (leave one out); the
+  parametric histories were never used for tuning.
 
 Impulsive burns (:func:`~abrupt.simulate.tle_null._inject_burns`) every 30-50 days, alternately
 in-track (LEO 0.5-50 cm/s, GEO east-west 1-50 cm/s, random sign) and cross-track (LEO 5-200 cm/s,
