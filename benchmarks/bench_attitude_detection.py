@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
-from abrupt.detect.attitude import AttitudeDetectionConfig, MomentumChangeDetector, attitude_detector_class
-from abrupt.detect.change_detection import WindowConfig, sliding_statistic
+from abrupt.detect.attitude.change_detection import WindowConfig, sliding_statistic
+from abrupt.detect.attitude.momentum import AttitudeDetectionConfig, MomentumChangeDetector, attitude_detector_class
 from abrupt.model.momentum import system_momentum
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 from abrupt.readers.telemetry import telemetry_from_frame

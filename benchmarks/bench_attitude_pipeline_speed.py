@@ -12,7 +12,7 @@ from __future__ import annotations
 import argparse
 import time
 
-from abrupt.detect.attitude import AttitudeDetectionConfig
+from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 from abrupt.pipelines.attitude import detect_attitude
 from abrupt.readers.telemetry import telemetry_from_frame

@@ -18,7 +18,7 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 import numpy as np
 import psutil
 
-from abrupt.detect.change_detection import StreamingStatistic, WindowConfig, sliding_statistic
+from abrupt.detect.attitude.change_detection import StreamingStatistic, WindowConfig, sliding_statistic
 
 
 def throughput(n: int) -> None:

@@ -31,7 +31,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from abrupt.massprops.simsat import (
+from reproductions.simsat import (
     I33_BASELINE,
     MOI_CONFIGS,
     THESIS_TESTBED,

@@ -20,9 +20,9 @@ from pathlib import Path
 import numpy as np
 
 from abrupt.density.constellation import ConstellationConfig, relative_errors
-from abrupt.density.simulate import simulate_constellation
 from abrupt.density.tle_drag import TleDragConfig
 from abrupt.pipelines.density import tle_density
+from reproductions.density_constellation import simulate_constellation
 
 
 def main() -> None:

@@ -23,9 +23,9 @@ import numpy as np
 import pandas as pd
 
 from abrupt.density.precise_orbit import OrbitDensityConfig, fit_orbit_density
-from abrupt.density.simulate_orbit import simulate_precise_orbit
 from abrupt.model.orbit import ForceModel
 from abrupt.pipelines.orbit import load_ephemeris
+from reproductions.density_orbit import simulate_precise_orbit
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "sp3"
 COLS = ["window_start_utc", "drag_scale", "drag_scale_sigma", "formal_drag_scale_sigma", "srp_scale"]

@@ -19,12 +19,12 @@ import resource
 import time
 from pathlib import Path
 
-import abrupt.detect.tle_maneuvers  # noqa: F401  (imports outside the clocks)
-from abrupt.density.simulate import simulate_constellation
+import abrupt.detect.tle.maneuvers  # noqa: F401  (imports outside the clocks)
 from abrupt.density.tle_drag import TleDragConfig, rho_b_from_history
 from abrupt.model.atmosphere import read_space_weather
 from abrupt.pipelines.density import tle_density
 from abrupt.readers.tle import read_tle
+from reproductions.density_constellation import simulate_constellation
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "tle"
 

@@ -30,7 +30,7 @@ import time
 
 import numpy as np
 
-from abrupt.detect.mass_change import InertiaChangeDetector
+from abrupt.detect.mass.inertia_change import InertiaChangeDetector
 from abrupt.massprops.inertia import inertia_from_principal, perturb_inertia
 from abrupt.massprops.track import InertiaTrack
 from abrupt.model.spacecraft import spacecraft_from_dict

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from abrupt.detect.attitude import AttitudeDetectionConfig
+from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 from abrupt.pipelines.fleet import detect_attitude_fleet, read_manifest
 from abrupt.scale import Executor, dask_client

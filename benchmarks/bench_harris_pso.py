@@ -21,7 +21,6 @@ import numpy as np
 
 from abrupt.massprops.inertia import axis_errors_deg, inertia_from_principal, perturb_inertia, principal_axes
 from abrupt.massprops.momentum_balance import estimate_inertia
-from abrupt.massprops.pso import SlewWindow, find_slews, harris_objective, inertia_from_correction, two_pass_swarm
 from abrupt.massprops.telemetry import momentum_data_from_simulation
 from abrupt.model.momentum import body_momentum
 from abrupt.model.rotations import dcm_from_quaternion
@@ -35,6 +34,7 @@ from abrupt.simulate.attitude import (
     Slew,
     simulate_pointing,
 )
+from reproductions.pso import SlewWindow, find_slews, harris_objective, inertia_from_correction, two_pass_swarm
 
 PYRAMID = [
     [0.57735, 0.57735, 0.57735],

@@ -1,6 +1,6 @@
 """Monte Carlo check of the direct estimator's stated uncertainty (issue 13 acceptance 1: truth in 2σ).
 
-N independent flight-like days from :func:`abrupt.simulate.routine_telemetry.simulate_routine_day`
+N independent flight-like days from :func:`reproductions.routine_telemetry.simulate_routine_day`
 (three spacecraft, random catalogue error of up to 6 % and 6°, random slews, strikes, a loss-of-signal
 gap, gated tachometers, drifting gyro bias). For each day the estimator's 1σ (delete-a-block
 jackknife, the default; and the earlier wild block bootstrap for comparison) is compared with the actual
@@ -19,7 +19,7 @@ import numpy as np
 from abrupt.massprops.inertia import axis_errors_deg, params_from_inertia, principal_axes
 from abrupt.massprops.momentum_balance import estimate_inertia
 from abrupt.massprops.telemetry import momentum_data_from_channels
-from abrupt.simulate.routine_telemetry import simulate_routine_day
+from reproductions.routine_telemetry import simulate_routine_day
 
 METHODS = ("jackknife", "bootstrap")
 

@@ -169,8 +169,8 @@ def main() -> None:
 
 
 def pso_side_by_side(d: MomentumBalanceData, j_cat: np.ndarray, j_true: np.ndarray, est) -> None:  # type: ignore[no-untyped-def]
-    from abrupt.massprops.pso import SlewWindow, find_slews, harris_objective, inertia_from_correction, two_pass_swarm
     from abrupt.model.spacecraft import spacecraft_from_dict
+    from reproductions.pso import SlewWindow, find_slews, harris_objective, inertia_from_correction, two_pass_swarm
 
     sj = json.loads((FOLDER / "spacecraft.json").read_text())
     sc = spacecraft_from_dict(

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-from abrupt.detect.matched_filter import (
+from abrupt.detect.attitude.matched_filter import (
     NMS_PER_MG,
     CombinedFilter,
     WaveletSet,
@@ -322,7 +322,7 @@ def throughput(n_samples: int) -> None:
     """Batch and streaming speed of one 250-tap filter, and the streaming memory peak (tracemalloc)."""
     import tracemalloc
 
-    from abrupt.detect.matched_filter import MatchedFilterStream, matched_filter_statistic
+    from abrupt.detect.attitude.matched_filter import MatchedFilterStream, matched_filter_statistic
 
     rng = np.random.default_rng(0)
     s = np.exp(-np.arange(250) / 30.0)
@@ -353,7 +353,7 @@ def throughput(n_samples: int) -> None:
 
 def timing_calibration(runs: int) -> None:
     """Joint filter through detect_strikes: strike-time error over the reported time_sigma_s."""
-    from abrupt.detect.matched_filter import detect_strikes
+    from abrupt.detect.attitude.matched_filter import detect_strikes
 
     sc = load_spacecraft(bundled_spacecraft_path("thesis"))
     wav = build_wavelets(sc, sample_rate_hz=RATE_HZ, bank_size=4)

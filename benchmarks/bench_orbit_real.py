@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from abrupt.detect.orbit_detector import (
+from abrupt.detect.orbit.analysis import (
     OrbitAnalysis,
     OrbitDetectorConfig,
     analyse,

@@ -15,7 +15,7 @@ import time
 
 import numpy as np
 
-from abrupt.detect.orbit_ekf import (
+from abrupt.detect.orbit.ekf import (
     _GL_NODES,
     _GL_WEIGHTS,
     FilterConfig,
@@ -24,7 +24,7 @@ from abrupt.detect.orbit_ekf import (
     run_backward,
     run_forward,
 )
-from abrupt.detect.orbit_statistics import fuse, orbital_constant_statistics
+from abrupt.detect.orbit.statistics import fuse, orbital_constant_statistics
 from abrupt.simulate.orbit import OrbitSimulationConfig, simulate_orbit
 
 
@@ -119,9 +119,9 @@ def real_arc_speed(path: str, nuisance: bool = False) -> None:
     tabulated along the arc (the table's construction is inside the timed analysis)."""
     from dataclasses import replace
 
-    from abrupt.detect.orbit_detector import OrbitDetectorConfig, analyse, auto_tune, find_events, self_calibrate
-    from abrupt.detect.orbit_detectors import nuisance_force_model
-    from abrupt.detect.orbit_ekf import NuisanceConfig
+    from abrupt.detect.orbit.analysis import OrbitDetectorConfig, analyse, auto_tune, find_events, self_calibrate
+    from abrupt.detect.orbit.detectors import nuisance_force_model
+    from abrupt.detect.orbit.ekf import NuisanceConfig
     from abrupt.readers.sp3 import read_sp3
 
     def with_nuisance(f: FilterConfig) -> FilterConfig:

@@ -45,7 +45,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from abrupt.detect.tle_detectors import detector_for
+from abrupt.detect.tle.detectors import detector_for
 from abrupt.readers.fengyun import read_maneuver_file
 from abrupt.readers.tle import read_tle
 from abrupt.simulate.tle_injection import (

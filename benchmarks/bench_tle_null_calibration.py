@@ -39,7 +39,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from abrupt.detect.tle_detectors import detector_for
+from abrupt.detect.tle.detectors import detector_for
 from abrupt.readers.fengyun import read_maneuver_file
 from abrupt.readers.tle import read_tle
 from abrupt.simulate.tle_null import (

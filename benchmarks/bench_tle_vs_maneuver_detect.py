@@ -52,7 +52,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from abrupt.detect.tle_detectors import TleGeoStationKeeping, TleMeanElements
+from abrupt.detect.tle.detectors import TleGeoStationKeeping, TleMeanElements
 from abrupt.readers.fengyun import read_maneuver_file
 from abrupt.readers.tle import read_tle
 from abrupt.score import recall_at_false_alarm_rate, score_events

@@ -16,8 +16,8 @@ import time
 
 import numpy as np
 
-from abrupt.detect.kaderali import calibrate_psi_threshold, run_kaderali_filter
-from abrupt.detect.tracking_glrt import GlrtConfig, detect_maneuvers_glrt
+from abrupt.detect.tracking.glrt import GlrtConfig, detect_maneuvers_glrt
+from abrupt.detect.tracking.kaderali import calibrate_psi_threshold, run_kaderali_filter
 from abrupt.model.stations import ascension
 from abrupt.model.tracking_measurements import TrackingArrays
 from abrupt.simulate.tracking import TrackingScenario, simulate_tracking, thesis_burn

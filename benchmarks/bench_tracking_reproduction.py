@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 
-from abrupt.detect.kaderali import KaderaliConfig, KaderaliResult, fit_characterisation, run_kaderali_filter
+from abrupt.detect.tracking.kaderali import KaderaliConfig, KaderaliResult, fit_characterisation, run_kaderali_filter
 from abrupt.model.stations import ascension
 from abrupt.model.tracking_measurements import TrackingArrays
 from abrupt.simulate.tracking import TrackingScenario, simulate_tracking, thesis_burn

@@ -25,7 +25,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.optimize import nnls
 
-from abrupt.massprops.simsat import (
+from reproductions.simsat import (
     I33_BASELINE,
     MOI_CONFIGS,
     Maneuver,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -20,6 +21,8 @@ if os.environ.get("CI"):
 
 PROJECT_ROOT = Path(__file__).resolve().parent.parent
 SHARED_DATA = PROJECT_ROOT.parent / "shared" / "data"
+# The reproduction testbeds (benchmarks/reproductions) are tested as the benchmarks import them.
+sys.path.insert(0, str(PROJECT_ROOT / "benchmarks"))
 
 
 @pytest.fixture(scope="session")

@@ -13,7 +13,7 @@ from abrupt.catalog import Catalog
 from abrupt.clean.noise import momentum_noise_model
 from abrupt.cli.groups import cli
 from abrupt.cli.main import main
-from abrupt.detect.attitude import AttitudeDetectionConfig
+from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
 from abrupt.events import EVENT_COLUMNS
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 from abrupt.pipelines.attitude import detect_attitude

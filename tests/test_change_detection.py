@@ -5,7 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from abrupt.detect.change_detection import STATISTICS, StreamingStatistic, WindowConfig, sliding_statistic
+from abrupt.detect.attitude.change_detection import (
+    STATISTICS,
+    StreamingStatistic,
+    WindowConfig,
+    sliding_statistic,
+)
 
 CFG = WindowConfig(pre=50, post=40, cusum_delta_mu_Nms=0.1)
 RNG = np.random.default_rng(7)

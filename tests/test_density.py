@@ -336,8 +336,8 @@ def _synthetic_tracks(
     density; n̄ is the exact cumulative integral (trapezoid on a grid ten times finer than the
     fit's nodes) plus white noise of ``noise_rel`` times one day's decay.
     """
-    from abrupt.density.simulate import storm_profile
     from abrupt.density.tle_drag import DecayTrack
+    from reproductions.density_constellation import storm_profile
 
     rng = np.random.default_rng(seed)
     origin = np.datetime64("2014-10-01T00:00", "ns")
@@ -425,14 +425,14 @@ def test_scale_from_platform_ranges_recovers_known_factor() -> None:
 def test_cli_constellation_joint_density_against_simulated_truth(tmp_path: Path) -> None:
     """`abrupt density tle` on a small simulated constellation: the joint estimate follows the truth.
 
-    Sixteen CubeSats over 12 days with a +50 % storm on days 6-8 (abrupt.density.simulate, NRLMSIS truth
+    Sixteen CubeSats over 12 days with a +50 % storm on days 6-8 (reproductions.density_constellation, NRLMSIS truth
     along the simulated orbits); no object's B is given, only the platform geometry.
     """
     from click.testing import CliRunner
 
     import abrupt.cli.main  # noqa: F401  (registers every command group)
     from abrupt.cli.groups import cli
-    from abrupt.density.simulate import simulate_constellation
+    from reproductions.density_constellation import simulate_constellation
 
     sim = simulate_constellation(16, days=12.0, seed=31, storm_start_day=6.0, step_s=600.0)
     paths = []
@@ -482,9 +482,9 @@ def test_cli_density_orbit_recovers_known_drag_and_counts_a_short_window(tmp_pat
 
     import abrupt.cli.main  # noqa: F401  (registers every command group)
     from abrupt.cli.groups import cli
-    from abrupt.density.simulate_orbit import simulate_precise_orbit
     from abrupt.model.orbit import ForceModel
     from abrupt.readers.sp3 import write_sp3
+    from reproductions.density_orbit import simulate_precise_orbit
 
     force = ForceModel(
         gravity_degree=8,

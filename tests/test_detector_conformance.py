@@ -140,7 +140,7 @@ def _define_plugin() -> type[Detector[AttitudeSeries]]:
 
 
 def test_a_detector_defined_in_a_test_runs_through_the_pipeline() -> None:
-    from abrupt.detect.attitude import AttitudeDetectionConfig
+    from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
     from abrupt.pipelines.attitude import detect_attitude
 
     _define_plugin()

@@ -16,7 +16,7 @@ import pytest
 
 import abrupt
 from abrupt.catalog import Catalog
-from abrupt.detect.attitude import AttitudeDetectionConfig
+from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
 from abrupt.events import read_events
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 from abrupt.pipelines.fleet import detect_attitude_fleet, fleet_run_key, read_manifest

@@ -11,9 +11,11 @@ import pytest
 from click.testing import CliRunner
 
 from abrupt.detect.base import get_detector
-from abrupt.detect.mass_change import InertiaChangeDetector
-from abrupt.massprops.pso import particle_swarm
-from abrupt.massprops.simsat import (
+from abrupt.detect.mass.inertia_change import InertiaChangeDetector
+from abrupt.massprops.track import InertiaTrack
+from abrupt.thresholds import FalseAlarmBudget
+from reproductions.pso import particle_swarm
+from reproductions.simsat import (
     MOI_CONFIGS,
     Maneuver,
     SimsatParams,
@@ -25,8 +27,6 @@ from abrupt.massprops.simsat import (
     momentum_exchange_estimate,
     simulate_simsat,
 )
-from abrupt.massprops.track import InertiaTrack
-from abrupt.thresholds import FalseAlarmBudget
 
 
 # ------------------------------------------------------------------------------------------ SIMSAT
@@ -140,7 +140,7 @@ def _heterogeneous_track(n: int, rng: np.random.Generator, step_at: int | None =
 
 
 def test_glr_on_windows_of_very_different_covariance_keeps_its_budget_and_finds_a_step():
-    from abrupt.detect.mass_change import covering_covariance
+    from abrupt.detect.mass.inertia_change import covering_covariance
 
     rng = np.random.default_rng(5)
     # The per-window covariance covers both the size-scaled shape and the window's own matrix.
@@ -304,7 +304,7 @@ def test_five_kg_docking_detector_stays_quiet_for_a_simulated_year_and_finds_the
 def test_momentum_exchange_spread_attains_its_cramer_rao_bound_under_white_rate_noise():
     # With white rate-gyro noise as the only error, the least-squares momentum method's run-to-run SD
     # equals the Cramér-Rao bound computed from the design (Gauss-Markov), within Monte Carlo error.
-    from abrupt.massprops.simsat import I33_BASELINE, TestbedNoise, testbed_runs
+    from reproductions.simsat import I33_BASELINE, TestbedNoise, testbed_runs
 
     noise = TestbedNoise(wheel_gain_sd=0.0, gyro_bias_deg_min=0.0, gyro_bias_sd_deg_min=0.0, wander_deg=0.0,
                          encoder_noise_rad_s=0.0, rate_noise_deg_s=0.07)  # fmt: skip
@@ -323,7 +323,7 @@ def test_momentum_exchange_spread_attains_its_cramer_rao_bound_under_white_rate_
 def test_reduced_rank_gyro_error_covariance_solves_like_the_dense_matrix():
     # The Hilbert-space reduced-rank form (Solin & Särkkä 2020) against numpy's dense solve and slogdet,
     # for a wander that is smooth, one that is nearly white, and one longer than the record.
-    from abrupt.massprops.simsat import GyroErrorModel, ReducedRankCovariance, gyro_error_covariance
+    from reproductions.simsat import GyroErrorModel, ReducedRankCovariance, gyro_error_covariance
 
     t = np.arange(0.0, 55.025, 0.05)
     tm, dt = 0.5 * (t[1:] + t[:-1]), np.diff(t)
@@ -342,7 +342,7 @@ def test_ml_momentum_estimate_is_unbiased_in_closed_loop_and_attains_the_white_n
     # per-step-period least squares is biased low by this feedback (fixed effects, Nickell 1981); the
     # maximum-likelihood estimate with a noise model fitted on baseline runs is not, its spread equals the
     # Cramér-Rao floor of the white noise alone (everything else known), and its stated σ is that spread.
-    from abrupt.massprops.simsat import (
+    from reproductions.simsat import (
         I33_BASELINE,
         TestbedNoise,
         fit_gyro_error_model,
@@ -376,7 +376,7 @@ def test_ml_momentum_estimate_states_an_honest_sigma_under_the_full_testbed_nois
     # Drift, wander, wheel-gain and encoder noise as in the Dabrowski benchmark (session 3's testbed, and the
     # testbed calibrated on Tables 4.3-4.4 with the −2°/min drift the satellite tracks): z = (Î − I)/σ̂ over
     # runs at the four added-mass configurations has unit RMS, and the truth is inside 2σ̂ about 95% of the time.
-    from abrupt.massprops.simsat import (
+    from reproductions.simsat import (
         I33_BASELINE,
         THESIS_TESTBED,
         TestbedNoise,
@@ -408,7 +408,7 @@ def test_ml_momentum_estimate_states_an_honest_sigma_under_the_full_testbed_nois
 def test_gyro_error_model_self_calibrates_on_runs_of_unknown_inertia():
     # With I33 unknown (each run's a a further fixed effect in the REML) the fitted white rate noise is the
     # simulated one, and the ML estimates with that model have the same spread and an honest σ.
-    from abrupt.massprops.simsat import TestbedNoise, fit_gyro_error_model, momentum_exchange_ml, testbed_runs
+    from reproductions.simsat import TestbedNoise, fit_gyro_error_model, momentum_exchange_ml, testbed_runs
 
     noise = TestbedNoise(wheel_gain_sd=0.025, wander_deg=0.06, rate_noise_deg_s=0.07)
     man, i_true = Maneuver.thesis(0.5), MOI_CONFIGS[3]
@@ -424,7 +424,7 @@ def test_gyro_error_model_self_calibrates_on_runs_of_unknown_inertia():
 
 def test_batched_phase_a_and_b_equal_the_appendix_c_search_run_by_run():
     # The lockstep grid search over many runs returns exactly what the one-run App. C search returns.
-    from abrupt.massprops.simsat import TestbedNoise, estimate_runs_i33, testbed_runs, tune_wheel_gain, tune_wheel_gains
+    from reproductions.simsat import TestbedNoise, estimate_runs_i33, testbed_runs, tune_wheel_gain, tune_wheel_gains
 
     p, man = SimsatParams(), Maneuver.thesis(0.5)
     noise = TestbedNoise(wheel_gain_sd=0.03, wander_deg=0.06, rate_noise_deg_s=0.05)
@@ -684,7 +684,7 @@ def test_simsat_phase_b_center_on_previous_run_chains_the_grid_centres(monkeypat
     # App. C quirk (spec §5.4 [C]): the loop variable I33 is reused, so each run's grid after the first
     # spans [0.5, 2] x the last grid value the previous run's search evaluated; the first run's grid is
     # centred on the given centre. Default (spec [R]): every run on the same centre, in lockstep.
-    import abrupt.massprops.simsat as simsat
+    import reproductions.simsat as simsat
 
     centres: list[float] = []
     last_points: list[float] = []

@@ -327,7 +327,7 @@ def test_stated_two_sigma_covers_the_truth_on_independent_flight_like_days():
     # Acceptance 1 (honest uncertainty): on independently simulated flight-like half-days (three spacecraft,
     # gated tachometers, drifting gyro bias, a loss-of-signal gap, strikes), about 95% of the parameter
     # errors lie inside the stated 2σ; the wild block bootstrap, for comparison, covers clearly less.
-    from abrupt.simulate.routine_telemetry import simulate_routine_day
+    from reproductions.routine_telemetry import simulate_routine_day
 
     z_jack, z_boot = [], []
     for k in range(12):

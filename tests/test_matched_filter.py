@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 from scipy import stats
 
-from abrupt.detect.matched_filter import (
+from abrupt.detect.attitude.matched_filter import (
     MatchedFilterStream,
     WaveletSet,
     analytic_output_sd,
@@ -260,7 +260,7 @@ def test_largest_unsaturated_strike_matches_thesis_estimate() -> None:
 
 
 def test_combined_stream_matches_batch() -> None:
-    from abrupt.detect.matched_filter import CombinedFilter, CombinedFilterStream
+    from abrupt.detect.attitude.matched_filter import CombinedFilter, CombinedFilterStream
 
     rng = np.random.default_rng(9)
     wav = _synthetic_wavelets()
@@ -277,7 +277,7 @@ def test_combined_stream_matches_batch() -> None:
 
 
 def test_combined_statistic_is_chi2_3_in_white_noise() -> None:
-    from abrupt.detect.matched_filter import CombinedFilter
+    from abrupt.detect.attitude.matched_filter import CombinedFilter
 
     rng = np.random.default_rng(10)
     wav = _synthetic_wavelets()
@@ -299,7 +299,7 @@ def test_combined_statistic_is_chi2_3_in_white_noise() -> None:
 @pytest.fixture(scope="module")
 def thesis_wavelets():  # type: ignore[no-untyped-def]
     pytest.importorskip("abrupt.simulate.attitude")
-    from abrupt.detect.matched_filter import build_wavelets
+    from abrupt.detect.attitude.matched_filter import build_wavelets
     from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 
     sc = load_spacecraft(bundled_spacecraft_path("thesis"))
@@ -375,7 +375,7 @@ def test_thesis_attitude_filter_detects_60mg_random_directions(thesis_wavelets) 
 
 
 def test_detect_strikes_sets_thresholds_from_the_series_and_finds_the_strike() -> None:
-    from abrupt.detect.matched_filter import detect_strikes
+    from abrupt.detect.attitude.matched_filter import detect_strikes
 
     rng = np.random.default_rng(12)
     wav = _synthetic_wavelets()
@@ -396,7 +396,7 @@ def test_detect_strikes_sets_thresholds_from_the_series_and_finds_the_strike() -
 
 
 def test_detect_strikes_rejects_wrong_sample_rate() -> None:
-    from abrupt.detect.matched_filter import detect_strikes
+    from abrupt.detect.attitude.matched_filter import detect_strikes
 
     wav = _synthetic_wavelets()
     n = 1000
@@ -425,7 +425,7 @@ def test_simulated_strike_momentum_ends_in_the_wheels(thesis_wavelets) -> None: 
 
 
 def test_joint_filter_with_wheels_detects_a_5mg_strike(thesis_wavelets) -> None:  # type: ignore[no-untyped-def]
-    from abrupt.detect.matched_filter import detect_strikes
+    from abrupt.detect.attitude.matched_filter import detect_strikes
     from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude_batch
 
     sc, wav = thesis_wavelets
@@ -458,7 +458,7 @@ def test_attitude_error_ignores_quaternion_scale_and_sign() -> None:
 
 
 def test_empty_or_too_short_telemetry_gives_a_clear_error() -> None:
-    from abrupt.detect.matched_filter import detect_strikes
+    from abrupt.detect.attitude.matched_filter import detect_strikes
 
     wav = _synthetic_wavelets()
     with pytest.raises(ValueError, match="at least 10 finite"):

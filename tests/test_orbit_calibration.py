@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from abrupt.detect.orbit_detector import (
+from abrupt.detect.orbit.analysis import (
     OrbitDetectorConfig,
     analyse,
     auto_tune,

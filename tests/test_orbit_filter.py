@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from abrupt.detect.orbit_ekf import (
+from abrupt.detect.orbit.ekf import (
     _GL_NODES,
     _GL_WEIGHTS,
     FilterConfig,
@@ -19,7 +19,7 @@ from abrupt.detect.orbit_ekf import (
     run_backward,
     run_forward,
 )
-from abrupt.detect.orbit_statistics import fuse
+from abrupt.detect.orbit.statistics import fuse
 from abrupt.model.orbit import MU_EARTH_M3_S2, kepler_to_cartesian
 from abrupt.simulate.orbit import OrbitSimulationConfig, simulate_orbit
 

@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from abrupt.detect.attitude import AttitudeDetectionConfig
+from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 from abrupt.pipelines.attitude import detect_attitude
 from abrupt.readers.telemetry import read_telemetry

@@ -7,7 +7,7 @@ import pytest
 from scipy import stats
 
 from abrupt.clean.noise import robust_noise_sigma, robust_scale
-from abrupt.detect.change_detection import WindowConfig, sliding_statistic
+from abrupt.detect.attitude.change_detection import WindowConfig, sliding_statistic
 from abrupt.errors import RepairLog
 from abrupt.series import Chunk, Telemetry, chunk_rows, split_at_gaps, telemetry_chunks
 

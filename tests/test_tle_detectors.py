@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from abrupt.detect.base import detector_names, get_detector
-from abrupt.detect.tle_detectors import TleGeoStationKeeping, TleMeanElements, detector_for
+from abrupt.detect.tle.detectors import TleGeoStationKeeping, TleMeanElements, detector_for
 from abrupt.pipelines.tle import detect_tle_file
 from abrupt.readers.tle import read_tle
 from abrupt.score import score_events

@@ -14,8 +14,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from abrupt.detect.tle_detectors import TleMeanElements
-from abrupt.detect.tle_maneuvers import has_drift_hinge, mean_element_series
+from abrupt.detect.tle.detectors import TleMeanElements
+from abrupt.detect.tle.maneuvers import has_drift_hinge, mean_element_series
 from abrupt.simulate.tle_null import EPOCH0, NullHistorySpec, simulate_null_history
 from abrupt.thresholds import FalseAlarmBudget
 
@@ -74,7 +74,7 @@ def test_cross_track_burn_is_timed_in_its_gap_not_on_a_noise_hinge() -> None:
 
 def test_drift_hinge_gate_reads_the_weighted_in_track_score() -> None:
     """The gate is the in-track group's tail-weighted z against the statistic's floor of 3."""
-    from abrupt.detect.tle_maneuvers import StepSeries
+    from abrupt.detect.tle.maneuvers import StepSeries
 
     z = np.array([1.0, 10.0])
     steps = StepSeries(
@@ -99,7 +99,7 @@ def test_geo_east_west_and_north_south_burns_are_found_and_typed() -> None:
     by 2Δv/v) is dated within 6 hours by the mean longitude's kink with its ΔV within 20 %; a 5 m/s
     north-south burn (the inclination vector moves by Δv/v ≈ 0.093°) is typed north-south, dated
     inside its gap, |Δv_n| within 15 %."""
-    from abrupt.detect.tle_detectors import TleGeoStationKeeping
+    from abrupt.detect.tle.detectors import TleGeoStationKeeping
 
     spec = NullHistorySpec(regime="geo", sets_per_day=1.0, years=2.0, seed=21)
     ew_day, ns_day = 300.5, 420.6  # gaps of ~1 day (the generator also draws 3-10 day gaps)

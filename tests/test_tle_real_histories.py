@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from abrupt.detect.tle_detectors import detector_for
+from abrupt.detect.tle.detectors import detector_for
 from abrupt.readers.fengyun import read_maneuver_file
 from abrupt.readers.tle import read_tle
 from abrupt.score import recall_at_false_alarm_rate, score_events

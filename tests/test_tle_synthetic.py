@@ -16,7 +16,7 @@ import pytest
 from click.testing import CliRunner
 
 from abrupt.cli.main import cli
-from abrupt.detect.tle_maneuvers import TleDetectorConfig, campaign_cadence_s, characterise, detect_tle_maneuvers
+from abrupt.detect.tle.maneuvers import TleDetectorConfig, campaign_cadence_s, characterise, detect_tle_maneuvers
 from abrupt.events import EVENT_COLUMNS, read_events
 from abrupt.readers.tle import read_tle
 from abrupt.score import score_events
@@ -314,7 +314,7 @@ def test_opposed_in_track_pair_is_found_from_its_along_track_phase_step(tmp_path
 def test_elapsed_seconds_count_the_leap_second_as_astropy_does() -> None:
     from astropy.time import Time
 
-    from abrupt.detect.tle_maneuvers import elapsed_si_seconds
+    from abrupt.detect.tle.maneuvers import elapsed_si_seconds
 
     stamps = ["2016-12-31T12:00:00", "2016-12-31T23:59:00", "2017-01-01T00:01:00", "2017-01-02T12:00:00"]
     got = elapsed_si_seconds(pd.Series(pd.to_datetime(stamps)))
@@ -326,7 +326,7 @@ def test_elapsed_seconds_count_the_leap_second_as_astropy_does() -> None:
 
 def test_two_set_burn_time_recovers_the_burn_inside_its_gap(maneuvering) -> None:
     """The phase innovation across the gap times one impulse (t_b = t_g + Δt/2 − δ/Δu̇)."""
-    from abrupt.detect.tle_maneuvers import elapsed_si_seconds, two_set_burn_time
+    from abrupt.detect.tle.maneuvers import elapsed_si_seconds, two_set_burn_time
 
     path, truth = maneuvering
     history = read_tle(path)

@@ -90,7 +90,7 @@ def test_two_way_range_and_downleg_angles_match_the_iterative_solution() -> None
 def test_radio_troposphere_is_the_saastamoinen_zenith_delay_mapped_to_the_elevation() -> None:
     import pandas as pd
 
-    from abrupt.detect.tracking_glrt import radio_range_delay_m
+    from abrupt.detect.tracking.glrt import radio_range_delay_m
     from abrupt.model.range_reduction import standard_meteorology
     from abrupt.model.tracking_measurements import TrackingArrays
     from abrupt.model.troposphere import saastamoinen_zenith_delay_m, water_vapour_pressure_hpa
@@ -125,7 +125,7 @@ def test_a_station_time_bias_is_recovered_by_the_batch_fit() -> None:
     recovers the offset within its stated σ; without the parameter the residuals are far from white."""
     import pandas as pd
 
-    from abrupt.detect.tracking_glrt import BatchFitConfig, fit_orbit
+    from abrupt.detect.tracking.glrt import BatchFitConfig, fit_orbit
     from abrupt.model.stations import ascension
     from abrupt.model.tracking_measurements import TrackingArrays
     from abrupt.simulate.tracking import TrackingScenario, simulate_tracking
@@ -155,7 +155,7 @@ def test_the_batch_fit_estimates_a_drag_scale_factor() -> None:
     the scale fixed at 1 the residuals are not."""
     import pandas as pd
 
-    from abrupt.detect.tracking_glrt import BatchFitConfig, fit_orbit
+    from abrupt.detect.tracking.glrt import BatchFitConfig, fit_orbit
     from abrupt.model.tracking_measurements import TrackingArrays
 
     model = ForceModel(mu_m3_s2=MU, zonal_degree=2, drag="exponential", drag_area_m2=4.0, mass_kg=100.0)
@@ -196,7 +196,7 @@ def test_the_batch_fit_estimates_a_drag_scale_factor() -> None:
 def test_the_fit_converges_from_an_apriori_orbit_twenty_kilometres_off() -> None:
     """Plain Gauss-Newton overshoots from 20 km / 20 m/s off (the linearisation fails and the iteration
     blows up to NaN); with step halving the fit reaches the same solution as from a close start."""
-    from abrupt.detect.tracking_glrt import BatchFitConfig, fit_orbit
+    from abrupt.detect.tracking.glrt import BatchFitConfig, fit_orbit
     from abrupt.model.stations import ascension
     from abrupt.model.tracking_measurements import TrackingArrays
     from abrupt.simulate.tracking import TrackingScenario, simulate_tracking

@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from abrupt.detect.tracking_glrt import BatchFitConfig, GlrtConfig, detect_maneuvers_glrt, fit_orbit
+from abrupt.detect.tracking.glrt import BatchFitConfig, GlrtConfig, detect_maneuvers_glrt, fit_orbit
 from abrupt.model.stations import ascension
 from abrupt.model.tracking_measurements import TrackingArrays
 from abrupt.simulate.tracking import TrackingScenario, simulate_tracking, thesis_burn
@@ -45,7 +45,7 @@ def test_glrt_is_quiet_without_a_maneuver() -> None:
 
 
 def glrt_threshold_for(n: int, data: TrackingArrays) -> float:
-    from abrupt.detect.tracking_glrt import glrt_threshold
+    from abrupt.detect.tracking.glrt import glrt_threshold
 
     return glrt_threshold(n, (data.t_s.max() - data.t_s.min()) / 86400.0, 0.1)
 
@@ -241,7 +241,7 @@ def test_cli_detect_tracking_runs_on_w3b_and_reports_the_unmodelled_acceleration
 def test_glrt_scan_equals_the_direct_projection_at_every_candidate() -> None:
     """The suffix-sum scan against the definition: for each τ build J_v (rows after τ), project it and the
     residuals off the fitted parameters' column space, and solve the 3×3 normal equations directly."""
-    from abrupt.detect.tracking_glrt import glrt_scan, trajectory
+    from abrupt.detect.tracking.glrt import glrt_scan, trajectory
     from abrupt.model.orbit import rsw_basis
 
     burn = thesis_burn("apogee", "S", 0.02)

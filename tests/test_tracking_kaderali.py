@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from abrupt.detect.kaderali import (
+from abrupt.detect.tracking.kaderali import (
     KaderaliConfig,
     fit_characterisation,
     invert_characterisation,
@@ -116,7 +116,7 @@ def test_inversion_round_trips_and_flags_non_monotonic_or_below_floor() -> None:
 
 
 def test_simulated_psi_threshold_holds_its_false_alarm_rate_on_independent_null_arcs() -> None:
-    from abrupt.detect.kaderali import calibrate_psi_threshold
+    from abrupt.detect.tracking.kaderali import calibrate_psi_threshold
 
     sim = simulate_tracking(TrackingScenario(), seed=11)
     data = TrackingArrays(sim.measurements, {}, epoch_utc=sim.epoch_utc)

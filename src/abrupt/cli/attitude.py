@@ -155,8 +155,8 @@ def _detection_config(
     null_samples: int,
 ) -> Any:
     """The run configuration; detector names are checked against the registry now (plug-ins included)."""
-    from abrupt.detect.attitude import AttitudeDetectionConfig, attitude_detector_names
-    from abrupt.detect.change_detection import WindowConfig
+    from abrupt.detect.attitude.change_detection import WindowConfig
+    from abrupt.detect.attitude.momentum import AttitudeDetectionConfig, attitude_detector_names
 
     names = attitude_detector_names()
     if "all" in detectors:
@@ -250,7 +250,7 @@ def _with_options(options: list[Any]) -> Any:
 
 def _stage_count(cfg: Any) -> int:
     """Progress stages of the pipeline: calibrate and run per change detector, one for the others."""
-    from abrupt.detect.attitude import MomentumChangeDetector, attitude_detector_class
+    from abrupt.detect.attitude.momentum import MomentumChangeDetector, attitude_detector_class
 
     n_change = sum(1 for d in cfg.detectors if issubclass(attitude_detector_class(d), MomentumChangeDetector))
     return 2 * n_change + (1 if n_change < len(cfg.detectors) else 0)
@@ -457,7 +457,7 @@ def demo(out_dir: str, duration_s: float, seed: int) -> None:
     import numpy as np
     import pandas as pd
 
-    from abrupt.detect.attitude import AttitudeDetectionConfig
+    from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
     from abrupt.pipelines.attitude import detect_attitude
     from abrupt.readers.telemetry import read_telemetry
     from abrupt.report.attitude import write_attitude_report

@@ -89,7 +89,7 @@ def detect_fleet_cmd(
     """
     from pathlib import Path
 
-    from abrupt.detect.attitude import AttitudeDetectionConfig
+    from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
     from abrupt.events import write_events
     from abrupt.pipelines.fleet import detect_attitude_fleet, read_manifest
 

@@ -107,7 +107,7 @@ def detect_tle(
         else:
             budget = FalseAlarmBudget.parse(false_alarms or "1/year")
         settings: dict[str, Any] = {"window_sets": window_sets, "threshold": threshold}
-        from abrupt.detect.tle_maneuvers import TleDetectorConfig
+        from abrupt.detect.tle.maneuvers import TleDetectorConfig
 
         TleDetectorConfig(window_sets=window_sets, threshold=threshold)  # validate before reading
     except ValueError as exc:
@@ -206,7 +206,7 @@ def report_tle(
     norad_id: int | None,
 ) -> None:
     """Element series of a TLE/OMM history with detected maneuvers and (optionally) the operator's."""
-    from abrupt.detect.tle_maneuvers import detect_tle_maneuvers
+    from abrupt.detect.tle.maneuvers import detect_tle_maneuvers
     from abrupt.events import read_events
     from abrupt.readers.omm import read_elements
     from abrupt.report.tle import plot_tle_report

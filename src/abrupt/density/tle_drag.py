@@ -286,7 +286,7 @@ def robust_sigma(values: FloatArray) -> float:
 
 def maneuver_epochs(history: ElementHistory) -> list[pd.Timestamp]:
     """Maneuver times from abrupt's TLE maneuver detector (its public API), as UTC timestamps."""
-    from abrupt.detect.tle_maneuvers import detect_tle_maneuvers
+    from abrupt.detect.tle.maneuvers import detect_tle_maneuvers
 
     events = detect_tle_maneuvers(history)
     if len(events) == 0:

@@ -4,10 +4,10 @@ A new capability adds its detector module here (one line); a detector defined an
 plug-in, a test) registers as soon as its class is defined.
 """
 
-import abrupt.detect.attitude  # attitude.glr, cusum, summation, shiryaev
-import abrupt.detect.kaderali  # tracking.kaderali_k
-import abrupt.detect.mass_change  # mass.inertia_change
-import abrupt.detect.matched_filter.detectors  # attitude.mf_attitude, mf_rate, mf_joint
-import abrupt.detect.orbit_detectors  # orbit.glr, orbit.mcr_w, orbit.accel_smoothed, ...
-import abrupt.detect.tle_detectors  # tle.mean_elements, tle.geo_station_keeping
-import abrupt.detect.tracking_glrt  # noqa: F401  tracking.glrt
+import abrupt.detect.attitude.matched_filter.detectors
+import abrupt.detect.attitude.momentum
+import abrupt.detect.mass.inertia_change
+import abrupt.detect.orbit.detectors
+import abrupt.detect.tle.detectors
+import abrupt.detect.tracking.glrt
+import abrupt.detect.tracking.kaderali  # noqa: F401  tracking.kaderali_k

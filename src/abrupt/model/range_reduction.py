@@ -1,6 +1,6 @@
 """Reduction of two-way ranges to instantaneous geometric ranges, term by term and switchable.
 
-The orbit fits of :mod:`abrupt.detect.tracking_glrt` and :mod:`abrupt.detect.kaderali` predict an
+The orbit fits of :mod:`abrupt.detect.tracking.glrt` and :mod:`abrupt.detect.tracking.kaderali` predict an
 *instantaneous geometric* range |r_sat(t) − r_site(t)| from a nominal station site. A laser or radio
 range is not that: it is half a round-trip light time timed at the station (receive epoch t_r), through
 the troposphere, bent by the Earth's field, from an instrument that sits off its marker, on a plate that

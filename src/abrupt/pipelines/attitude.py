@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from abrupt.detect.attitude import (
+from abrupt.detect.attitude.momentum import (
     ATTITUDE_EVENT_COLUMNS,
     AttitudeDetectionConfig,
     MomentumChangeDetector,

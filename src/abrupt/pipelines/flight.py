@@ -35,8 +35,8 @@ import pandas as pd
 from abrupt.clean.comb import CombConfig, smooth_model
 from abrupt.clean.flight_masks import SlewMaskConfig, event_mask, flag_intervals, slew_mask
 from abrupt.clean.noise import robust_noise_sigma
+from abrupt.detect.attitude.change_detection import WindowConfig
 from abrupt.detect.base import get_detector
-from abrupt.detect.change_detection import WindowConfig
 from abrupt.errors import ConfigError, InputError
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc, new_run_id
 from abrupt.model.flight_config import FlightConfig
@@ -288,7 +288,7 @@ def glr_statistic(h: FloatArray, ok: BoolArray, win: WindowConfig) -> FloatArray
     ``abrupt detect attitude`` share one statistic; calibration (robust block maxima of the
     spacecraft's own statistic) and the step estimate on cleaned ᴺH stay here.
     """
-    from abrupt.detect.attitude import MomentumChangeDetector
+    from abrupt.detect.attitude.momentum import MomentumChangeDetector
 
     cls = get_detector(DETECTOR_NAME)
     if not issubclass(cls, MomentumChangeDetector):

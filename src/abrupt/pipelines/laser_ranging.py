@@ -5,12 +5,12 @@
    meteorology, Shapiro delay, plate motion, eccentricity, solid tides), evaluated on the current
    trajectory (first the a-priori orbit, then the fitted one).
 2. **Fit** the orbit and per-station range biases by weighted least squares
-   (:func:`abrupt.detect.tracking_glrt.fit_orbit`).
+   (:func:`abrupt.detect.tracking.glrt.fit_orbit`).
 3. **Weight by the data's own residuals**: each station's range sigma is scaled by the RMS of its
    normalised post-fit residuals (a variance-component estimate, Koch 1999 §3.6), so the GLRT threshold
    accounts for what the models leave unexplained, not only the stated normal-point precision.
 4. **Scan** for impulses between and during passes with the GLRT of
-   :func:`abrupt.detect.tracking_glrt.detect_maneuvers_glrt`, threshold from the false-alarm budget.
+   :func:`abrupt.detect.tracking.glrt.detect_maneuvers_glrt`, threshold from the false-alarm budget.
 5. **Re-reduce** on the trajectory with the detected impulses and run steps 2-4 once more, so that the
    corrections of the ranges after a maneuver are computed on the right orbit.
 """
@@ -25,7 +25,7 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import CubicHermiteSpline
 
-from abrupt.detect.tracking_glrt import (
+from abrupt.detect.tracking.glrt import (
     BatchFit,
     BatchFitConfig,
     GlrtConfig,
@@ -472,7 +472,7 @@ def run_laser_ranging_files(
     estimated too (∂ρ/∂δt = −ρ̇). Files longer than ``arc_days`` are fitted in overlapping arcs
     (:func:`detect_laser_ranging_arcs`), each started from the ephemeris where it covers the arc epoch.
     """
-    from abrupt.detect.tracking_glrt import glrt_events
+    from abrupt.detect.tracking.glrt import glrt_events
     from abrupt.events import config_hash, empty_frame, events_frame, new_run_id
     from abrupt.model.stations import Station
     from abrupt.readers.crd import read_crd

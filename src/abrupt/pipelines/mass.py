@@ -16,7 +16,7 @@ import pandas as pd
 import pyarrow.parquet as pq
 
 from abrupt.detect.base import DetectionResult
-from abrupt.detect.mass_change import InertiaChangeDetector
+from abrupt.detect.mass.inertia_change import InertiaChangeDetector
 from abrupt.errors import ConfigError, InputError, RepairLog
 from abrupt.massprops.inertia import INERTIA_ELEMENTS, physical_violations, principal_axes
 from abrupt.massprops.momentum_balance import InertiaEstimate, MomentumBalanceData, estimate_inertia

@@ -18,9 +18,9 @@ import numpy as np
 import pandas as pd
 
 from abrupt.detect.base import DetectionResult, get_detector
-from abrupt.detect.orbit_detector import OrbitAnalysis, innovation_scale
-from abrupt.detect.orbit_detectors import OrbitDetector
-from abrupt.detect.orbit_ekf import NUISANCE_NAMES
+from abrupt.detect.orbit.analysis import OrbitAnalysis, innovation_scale
+from abrupt.detect.orbit.detectors import OrbitDetector
+from abrupt.detect.orbit.ekf import NUISANCE_NAMES
 from abrupt.model.frames import Ephemeris
 from abrupt.thresholds import FalseAlarmBudget, Threshold
 

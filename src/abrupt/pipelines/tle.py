@@ -15,7 +15,7 @@ from typing import Any
 import pandas as pd
 
 from abrupt.detect.base import DetectionResult, Detector, get_detector
-from abrupt.detect.tle_detectors import TleMeanElements, detector_for, result_from_run
+from abrupt.detect.tle.detectors import TleMeanElements, detector_for, result_from_run
 from abrupt.errors import InputError
 from abrupt.events import empty_frame, new_run_id
 from abrupt.readers.omm import read_element_histories

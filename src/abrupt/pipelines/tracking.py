@@ -18,8 +18,8 @@ from typing import Any, Literal
 import numpy as np
 import pandas as pd
 
-from abrupt.detect.kaderali import KaderaliManeuverDetector
-from abrupt.detect.tracking_glrt import BatchFit, BatchFitConfig, GlrtManeuverDetector
+from abrupt.detect.tracking.glrt import BatchFit, BatchFitConfig, GlrtManeuverDetector
+from abrupt.detect.tracking.kaderali import KaderaliManeuverDetector
 from abrupt.errors import RepairLog
 from abrupt.events import config_hash, empty_frame, new_run_id, restamp
 from abrupt.model.orbit import ForceContext, ForceModel

@@ -13,7 +13,7 @@ from numpy.typing import NDArray
 from abrupt.report.style import detector_colour, save_figure
 
 if TYPE_CHECKING:
-    from abrupt.detect.orbit_detector import OrbitAnalysis
+    from abrupt.detect.orbit.analysis import OrbitAnalysis
     from abrupt.thresholds import Threshold
 
 PANEL_STATISTICS = ("glr", "dv_fb", "mahalanobis_v", "accel_smoothed", "mcr_w", "mcr_scalar", "d_sma")
@@ -33,7 +33,7 @@ def plot_orbit_report(
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from abrupt.detect.orbit_statistics import STATISTIC_UNITS
+    from abrupt.detect.orbit.statistics import STATISTIC_UNITS
 
     hours = analysis.t_s / 3600.0
     names = [s for s in statistics if s in analysis.statistics]

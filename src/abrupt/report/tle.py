@@ -39,7 +39,7 @@ def plot_tle_report(
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from abrupt.detect.tle_maneuvers import (
+    from abrupt.detect.tle.maneuvers import (
         TleDetectorConfig,
         component_weights,
         mean_element_series,

@@ -18,7 +18,7 @@ import numpy as np
 from abrupt.types import FloatArray
 
 if TYPE_CHECKING:
-    from abrupt.detect.tracking_glrt import BatchFit, BatchFitConfig, GlrtConfig, GlrtDetection, GlrtScan
+    from abrupt.detect.tracking.glrt import BatchFit, BatchFitConfig, GlrtConfig, GlrtDetection, GlrtScan
     from abrupt.model.tracking_measurements import TrackingArrays
 
 
@@ -61,7 +61,7 @@ class TrackingSeries:
     def orbit_fit(self) -> BatchFit:
         """The batch least-squares orbit fit without maneuvers (biases, unmodelled acceleration)."""
         if "fit" not in self._cache:
-            from abrupt.detect.tracking_glrt import fit_orbit
+            from abrupt.detect.tracking.glrt import fit_orbit
 
             self._cache["fit"] = fit_orbit(self.data, self.x0_apriori_m_mps, config=self.fit_config)
         return self._cache["fit"]
@@ -70,7 +70,7 @@ class TrackingSeries:
         """The GLRT's greedy impulse search from the orbit fit: detections, the maneuver-aware fit, scans."""
         key = ("glrt", config)
         if key not in self._cache:
-            from abrupt.detect.tracking_glrt import detect_maneuvers_glrt
+            from abrupt.detect.tracking.glrt import detect_maneuvers_glrt
 
             x0 = self.orbit_fit().x0
             self._cache[key] = detect_maneuvers_glrt(self.data, x0, fit_config=self.fit_config, config=config)
@@ -85,7 +85,7 @@ class TrackingSeries:
         instantaneous model of Kaderali's filter sees reduced measurements. The series' own arrays are
         not changed.
         """
-        from abrupt.detect.tracking_glrt import model_corrections
+        from abrupt.detect.tracking.glrt import model_corrections
 
         fit = self.orbit_fit()
         data = copy.copy(self.data)

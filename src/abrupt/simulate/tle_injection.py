@@ -163,8 +163,8 @@ def injection_recall(
     median over the seeds) and, per kind, the smallest injected ΔV from which every larger size was
     found at least 90 % of the time (``found_90pct_from_cm_s``).
     """
-    from abrupt.detect.tle_detectors import detector_for
-    from abrupt.detect.tle_maneuvers import orbit_regime
+    from abrupt.detect.tle.detectors import detector_for
+    from abrupt.detect.tle.maneuvers import orbit_regime
 
     if len(history) < MIN_ELEMENT_SETS:
         raise ValueError(

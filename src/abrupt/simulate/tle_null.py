@@ -1,7 +1,7 @@
 """Maneuver-free element-set histories for calibrating the TLE detectors' false-alarm rate.
 
 Two generators, both returning an :class:`~abrupt.readers.tle.ElementHistory` of SGP4 records
-(WGS-72) whose *detector series* (:func:`abrupt.detect.tle_maneuvers.mean_element_series`: mean
+(WGS-72) whose *detector series* (:func:`abrupt.detect.tle.maneuvers.mean_element_series`: mean
 semi-major axis, eccentricity vector, orbit normal or inclination vector, along-track phase) are
 a smooth maneuver-free orbit plus noise:
 
@@ -209,7 +209,7 @@ def history_from_series(
             no *= (sat.a * EARTH_RADIUS_M / a_t[k]) ** 1.5
         sats.append(no)
         rates[k] = (sat.nodedot / 60.0, sat.argpdot / 60.0, sat.mdot / 60.0)
-    from abrupt.detect.tle_maneuvers import elapsed_si_seconds
+    from abrupt.detect.tle.maneuvers import elapsed_si_seconds
 
     # elapsed SI seconds, as the detector reads them (a leap second is 7 km along-track in LEO)
     epochs = pd.Series(EPOCH0 + pd.to_timedelta(np.round(t_days * SECONDS_PER_DAY * 1e6), unit="us"))
@@ -368,7 +368,7 @@ def detector_residuals(
     the residuals are NaN elsewhere: a running median that reached over a maneuver next to a quiet
     stretch would put part of its step into the stretch's residuals.
     """
-    from abrupt.detect.tle_maneuvers import mean_element_series, stated_decay_m_s
+    from abrupt.detect.tle.maneuvers import mean_element_series, stated_decay_m_s
 
     s = mean_element_series(history, regime)
     t_all = s["t_s"]

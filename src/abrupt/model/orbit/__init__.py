@@ -1,8 +1,8 @@
 """The one orbit model of abrupt: constants, elements, frames, forces and propagation.
 
 Used by the orbit simulator (:mod:`abrupt.simulate.orbit`), the orbit filters
-(:mod:`abrupt.detect.orbit_ekf`), the tracking filters (:mod:`abrupt.detect.kaderali`,
-:mod:`abrupt.detect.tracking_glrt`) and the tracking simulator. Sun and Moon come from ERFA, time
+(:mod:`abrupt.detect.orbit.ekf`), the tracking filters (:mod:`abrupt.detect.tracking.kaderali`,
+:mod:`abrupt.detect.tracking.glrt`) and the tracking simulator. Sun and Moon come from ERFA, time
 scales and Earth orientation from astropy's bundled tables, the gravity field from the coefficients
 shipped by ``brahe``; nothing is downloaded.
 """

@@ -569,7 +569,7 @@ def forward_kernel(
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
     """Forward EKF-DMC: a-posteriori states/covariances at every epoch (Bennett 2022 §3.2.1-3.2.5), the
     innovations and NIS; with ``store`` also, per step k ≥ 1, the STM Φ_k, the gain K_k and the inverse
-    innovation covariance S_k⁻¹ (what the GLR needs, :mod:`abrupt.detect.orbit_glr`; empty otherwise)."""
+    innovation covariance S_k⁻¹ (what the GLR needs, :mod:`abrupt.detect.orbit.glr`; empty otherwise)."""
     n = t.size
     ns = x0.size
     xs = np.empty((n, ns))

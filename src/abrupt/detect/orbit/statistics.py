@@ -24,7 +24,7 @@ Statistics (names used as keys throughout abrupt):
                     conventionally tuned forward filter (q × 100; §3.3.6, Eqs. 3.61-3.63).
 
 ``glr``             beyond the thesis: sliding generalised likelihood ratio of a velocity jump in the
-                    forward innovations (Willsky & Jones 1976; :mod:`abrupt.detect.orbit_glr`).
+                    forward innovations (Willsky & Jones 1976; :mod:`abrupt.detect.orbit.glr`).
 
 TS5 (residuals against propagated reference orbits, §3.3.5) is evaluated only at candidate epochs:
 :func:`propagated_reference_statistic`.
@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 import numba as nb
 import numpy as np
 
-from abrupt.detect.orbit_ekf import FilterConfig, propagate_state
+from abrupt.detect.orbit.ekf import FilterConfig, propagate_state
 from abrupt.model.orbit import MU_EARTH_M3_S2, ForceContext, orbital_constants
 from abrupt.types import FloatArray
 

@@ -10,7 +10,7 @@ Each detector is one registered class (:class:`abrupt.detect.base.Detector`) rea
 ``attitude.shiryaev``   multi-hypothesis Shiryaev size estimate on each axis (Eqs. 2.14-2.17).
 
 The matched filters ``attitude.mf_attitude|mf_rate|mf_joint`` are in
-:mod:`abrupt.detect.matched_filter.detectors`. Running several detectors on a file, with progress,
+:mod:`abrupt.detect.attitude.matched_filter.detectors`. Running several detectors on a file, with progress,
 warnings and one run record, is :mod:`abrupt.pipelines.attitude`.
 
 A threshold is set for a :class:`~abrupt.thresholds.FalseAlarmBudget` by fitting the statistic on
@@ -29,8 +29,13 @@ from typing import Any, ClassVar
 import numpy as np
 
 from abrupt.clean.noise import MomentumNoiseModel, robust_noise_sigma
+from abrupt.detect.attitude.change_detection import (
+    ANCHOR,
+    WindowConfig,
+    pre_window_mean_std,
+    sliding_statistic,
+)
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics, detector_names, get_detector
-from abrupt.detect.change_detection import ANCHOR, WindowConfig, pre_window_mean_std, sliding_statistic
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.attitude import AttitudeSeries
@@ -183,7 +188,7 @@ class Calibration:
 class MomentumChangeDetector(Detector[AttitudeSeries]):
     """A sliding pre/post-window statistic on total angular momentum ᴺH, alarmed per episode.
 
-    Subclasses set ``statistic_name`` (a kernel of :mod:`abrupt.detect.change_detection`),
+    Subclasses set ``statistic_name`` (a kernel of :mod:`abrupt.detect.attitude.change_detection`),
     ``unit`` and, when the per-axis values need combining differently, :meth:`combined_statistic`.
     Settings: ``windows`` (default :attr:`default_windows`), ``threshold_method`` (a fit of
     :mod:`abrupt.thresholds`; ``gev`` sets episodes per day), ``null_samples`` and ``seed`` of the

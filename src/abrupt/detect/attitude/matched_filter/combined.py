@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from abrupt.detect.matched_filter.filters import MatchedFilterStream, matched_filter_statistic
+from abrupt.detect.attitude.matched_filter.filters import MatchedFilterStream, matched_filter_statistic
 from abrupt.model.rotations import attitude_error_vector
 from abrupt.model.strike_response import WaveletSet
 from abrupt.types import FloatArray

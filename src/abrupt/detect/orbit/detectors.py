@@ -1,6 +1,6 @@
 """Orbit detectors as :class:`~abrupt.detect.base.Detector` classes: one per statistic, ``orbit.<statistic>``.
 
-All share the same machinery (:mod:`abrupt.detect.orbit_detector`: forward EKF-DMC with the one orbit
+All share the same machinery (:mod:`abrupt.detect.orbit.analysis`: forward EKF-DMC with the one orbit
 model, mirrored backward filter, Fraser-Potter fusion, statistics, thresholds, events; Bennett 2022
 ch. 3) and differ in the statistic that raises events:
 
@@ -21,7 +21,7 @@ the full force model; "thesis": Table 3.1, two-body), overrides ``tau_s``, ``q_m
 satellite for thresholds; default: the arc itself with leave-out), ``confidence_z`` (standard errors
 added to a self-calibrated level), ``kind`` and ``nuisance`` (estimate drag and SRP scale factors and
 once-per-revolution empirical accelerations as filter states, with NRLMSIS drag tabulated along the
-observed orbit; :class:`~abrupt.detect.orbit_ekf.NuisanceConfig`).
+observed orbit; :class:`~abrupt.detect.orbit.ekf.NuisanceConfig`).
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
-from abrupt.detect.orbit_detector import (
+from abrupt.detect.orbit.analysis import (
     OrbitAnalysis,
     OrbitDetectorConfig,
     analyse,
@@ -42,7 +42,7 @@ from abrupt.detect.orbit_detector import (
     innovation_scale,
     self_calibrate,
 )
-from abrupt.detect.orbit_ekf import FilterConfig, NuisanceConfig
+from abrupt.detect.orbit.ekf import FilterConfig, NuisanceConfig
 from abrupt.events import config_hash
 from abrupt.model.frames import Ephemeris
 from abrupt.model.orbit import ForceModel

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
-from abrupt.detect.orbit_ekf import (
+from abrupt.detect.orbit.ekf import (
     FilterConfig,
     FilterRun,
     forward_kernel_detailed,

@@ -14,10 +14,10 @@ linear in the strike). The statistic therefore has units of N·m·s, one per bod
 Pieces, all plain functions on arrays, by concern:
 
 * :mod:`abrupt.model.strike_response`: the wavelets (the noise-free closed-loop response);
-* :mod:`abrupt.detect.matched_filter.filters`: correlation, streaming, bank size estimate;
-* :mod:`abrupt.detect.matched_filter.combined`: the joint GLRT filter beyond the thesis;
-* :mod:`abrupt.detect.matched_filter.detection`: thresholds, detections and events;
-* :mod:`abrupt.detect.matched_filter.detectors`: the registered detectors ``attitude.mf_attitude``,
+* :mod:`abrupt.detect.attitude.matched_filter.filters`: correlation, streaming, bank size estimate;
+* :mod:`abrupt.detect.attitude.matched_filter.combined`: the joint GLRT filter beyond the thesis;
+* :mod:`abrupt.detect.attitude.matched_filter.detection`: thresholds, detections and events;
+* :mod:`abrupt.detect.attitude.matched_filter.detectors`: the registered detectors ``attitude.mf_attitude``,
   ``attitude.mf_rate``, ``attitude.mf_joint``.
 
 In more detail:
@@ -45,13 +45,13 @@ Gaps are NaN rows: a filter output whose window touches a NaN sample is NaN (not
 Telemetry must be uniformly sampled at the wavelet set's rate.
 """
 
-from abrupt.detect.matched_filter.combined import (
+from abrupt.detect.attitude.matched_filter.combined import (
     CombinedFilter,
     CombinedFilterStream,
     combined_channels,
     refine_strike,
 )
-from abrupt.detect.matched_filter.detection import (
+from abrupt.detect.attitude.matched_filter.detection import (
     DEFAULT_BASELINE_S,
     DETECTION_COLUMNS,
     detect_combined,
@@ -62,7 +62,7 @@ from abrupt.detect.matched_filter.detection import (
     resolve_baseline,
     robust_gaussian_thresholds,
 )
-from abrupt.detect.matched_filter.filters import (
+from abrupt.detect.attitude.matched_filter.filters import (
     SIZE_METRICS,
     MatchedFilterStream,
     SizeMetric,

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 from scipy import stats
 
 from abrupt.clean.noise import robust_scale
-from abrupt.detect.orbit_ekf import (
+from abrupt.detect.orbit.ekf import (
     FilterConfig,
     FilterRun,
     measurement_update,
@@ -32,8 +32,8 @@ from abrupt.detect.orbit_ekf import (
     run_backward,
     run_forward,
 )
-from abrupt.detect.orbit_glr import JumpEstimate, glr_statistic_from_run, localise_jump
-from abrupt.detect.orbit_statistics import (
+from abrupt.detect.orbit.glr import JumpEstimate, glr_statistic_from_run, localise_jump
+from abrupt.detect.orbit.statistics import (
     STATISTIC_NAMES,
     FusionResult,
     fuse,
@@ -66,7 +66,7 @@ class OrbitDetectorConfig:
     ±``glr_search_s`` around the statistic's peak (default: only the interval before the peak for the sliding ``glr``,
     1200 s for the thesis statistics) with ``glr_horizon_s`` of data after the window (the sliding
     statistic's own window when the event statistic is ``glr``)
-    (:mod:`abrupt.detect.orbit_glr`); "peak" uses the ``mcr_w`` peak.
+    (:mod:`abrupt.detect.orbit.glr`); "peak" uses the ``mcr_w`` peak.
     ``glr_window_samples``: length of the sliding GLR statistic's data window (0 disables it).
     ``dv_estimate``: "interval" (default) the velocity jump across the located sampling interval from
     the forward state before it and the backward state after it, with the mean of the two filters' DMC

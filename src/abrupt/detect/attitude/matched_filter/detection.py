@@ -19,8 +19,12 @@ import pandas as pd
 from numpy.typing import ArrayLike
 
 from abrupt.clean.noise import robust_noise_sigma
-from abrupt.detect.matched_filter.combined import CombinedFilter, combined_channels, refine_strike
-from abrupt.detect.matched_filter.filters import SizeMetric, estimate_strike_size, matched_filter_bank_statistics
+from abrupt.detect.attitude.matched_filter.combined import CombinedFilter, combined_channels, refine_strike
+from abrupt.detect.attitude.matched_filter.filters import (
+    SizeMetric,
+    estimate_strike_size,
+    matched_filter_bank_statistics,
+)
 from abrupt.model.rotations import attitude_error_vector, dcm_from_quaternion
 from abrupt.model.strike_response import KINDS, Kind, WaveletSet
 from abrupt.thresholds import (

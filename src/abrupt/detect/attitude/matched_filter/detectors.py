@@ -14,8 +14,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from abrupt.detect.attitude.matched_filter.detection import detect_strikes, detections_to_events
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
-from abrupt.detect.matched_filter.detection import detect_strikes, detections_to_events
 from abrupt.events import config_hash, empty_frame, events_frame
 from abrupt.model.strike_response import WaveletSet, build_wavelets
 from abrupt.series.attitude import AttitudeSeries

@@ -2,7 +2,7 @@
 
 ``tle.mean_elements``        LEO (and any non-geosynchronous orbit): steps in the SGP4 mean
                              semi-major axis, eccentricity vector and orbit normal
-                             (:mod:`abrupt.detect.tle_maneuvers`);
+                             (:mod:`abrupt.detect.tle.maneuvers`);
 ``tle.geo_station_keeping``  geosynchronous orbits: east-west burns from the semi-major axis
                              (longitude drift) and the equinoctial eccentricity vector, north-south
                              burns from the inclination vector; burn time from the kink of the
@@ -20,7 +20,7 @@ from dataclasses import asdict, fields, replace
 from typing import Any, ClassVar
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
-from abrupt.detect.tle_maneuvers import TleDetectorConfig, TleRun, orbit_regime, run_tle_detector
+from abrupt.detect.tle.maneuvers import TleDetectorConfig, TleRun, orbit_regime, run_tle_detector
 from abrupt.readers.tle import ElementHistory
 from abrupt.thresholds import FalseAlarmBudget
 
@@ -30,7 +30,7 @@ _SETTING_NAMES = {f.name for f in fields(TleDetectorConfig)} - {"false_alarms_pe
 class TleMeanElements(Detector[ElementHistory]):
     """Maneuvers from steps in the mean elements of a LEO history (see the module docstring).
 
-    Settings are the :class:`~abrupt.detect.tle_maneuvers.TleDetectorConfig` fields (except the
+    Settings are the :class:`~abrupt.detect.tle.maneuvers.TleDetectorConfig` fields (except the
     budget and the regime), plus ``all_candidates`` (also return sub-threshold local peaks).
     """
 

@@ -589,7 +589,7 @@ class KaderaliManeuverDetector(Detector[TrackingSeries]):
     def filter_config(
         self, series: TrackingSeries, accel_mps2: NDArray[np.float64], scales: dict[str, float] | None = None
     ) -> KaderaliConfig:
-        from abrupt.detect.tracking_glrt import scaled_force
+        from abrupt.detect.tracking.glrt import scaled_force
 
         period = series.orbit_period_s()
         return KaderaliConfig(
@@ -604,7 +604,7 @@ class KaderaliManeuverDetector(Detector[TrackingSeries]):
     def detect(self, series: TrackingSeries, budget: FalseAlarmBudget) -> DetectionResult:
         if len(series) == 0:
             return DetectionResult.empty(warnings=("no tracking measurements",))
-        from abrupt.detect.tracking_glrt import GlrtConfig
+        from abrupt.detect.tracking.glrt import GlrtConfig
 
         if self.start == "maneuver_fit":
             glrt = GlrtConfig(false_alarms_per_day=budget.per_day, max_maneuvers=self.max_maneuvers)
