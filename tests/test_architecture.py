@@ -77,4 +77,4 @@ def test_the_robust_scale_constant_is_written_once() -> None:
         if rel not in PENDING
         and any(isinstance(n, ast.Constant) and n.value == 1.4826 for n in ast.walk(ast.parse((SRC / rel).read_text())))
     ]
-    assert holders == ["clean/noise.py"], holders
+    assert holders == ["thresholds/noise.py"], holders

@@ -10,7 +10,6 @@ import pytest
 from click.testing import CliRunner
 
 from abrupt.catalog import Catalog
-from abrupt.clean.noise import momentum_noise_model
 from abrupt.cli.groups import cli
 from abrupt.cli.main import main
 from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
@@ -19,6 +18,7 @@ from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 from abrupt.pipelines.attitude import detect_attitude
 from abrupt.readers.telemetry import telemetry_from_frame
 from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude
+from abrupt.thresholds.noise import momentum_noise_model
 
 SC = load_spacecraft(bundled_spacecraft_path())
 FAST = AttitudeDetectionConfig(detectors=("glr", "cusum", "summation"), null_samples=1_000_000)

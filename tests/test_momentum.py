@@ -48,7 +48,7 @@ def test_a_known_rotation_maps_body_momentum_to_inertial_axes() -> None:
 
 
 def test_robust_noise_sigma_recovers_white_noise_despite_a_step_and_nans() -> None:
-    from abrupt.clean.noise import robust_noise_sigma
+    from abrupt.thresholds.noise import robust_noise_sigma
 
     rng = np.random.default_rng(2)
     x = rng.normal(0.0, [0.13, 0.05], size=(20000, 2))

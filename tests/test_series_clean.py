@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from abrupt.clean.noise import robust_noise_sigma, robust_scale
 from abrupt.detect.attitude.change_detection import WindowConfig, sliding_statistic
 from abrupt.errors import RepairLog
 from abrupt.series import Chunk, Telemetry, chunk_rows, split_at_gaps, telemetry_chunks
+from abrupt.thresholds.noise import robust_noise_sigma, robust_scale
 
 
 def _telemetry(n: int, rate_hz: float = 10.0, gap_at: int | None = None) -> Telemetry:

@@ -2,7 +2,7 @@
 
 :mod:`abrupt.clean.masks`   intervals of planned events (thruster firings, momentum dumps, slews)
                             blanked from a telemetry's segments;
-:mod:`abrupt.clean.noise`   robust scale (1.4826·MAD) and the white-noise level of a sampled signal
+:mod:`abrupt.thresholds.noise`   robust scale (1.4826·MAD) and the white-noise level of a sampled signal
                             from its first differences; the white + random-walk noise model of
                             total angular momentum (Allan variances).
 
@@ -13,7 +13,7 @@ grid), :mod:`abrupt.clean.comb` (local comb filter and slow external-torque tren
 """
 
 from abrupt.clean.masks import MaskInterval, apply_mask, read_mask
-from abrupt.clean.noise import (
+from abrupt.thresholds.noise import (
     MAD_TO_SIGMA,
     MomentumNoiseModel,
     momentum_noise_model,

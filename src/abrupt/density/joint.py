@@ -45,12 +45,11 @@ import pandas as pd
 from scipy.optimize import minimize
 from scipy.special import betainc, ndtr
 
-from abrupt.clean.noise import MAD_TO_SIGMA, robust_scale
 from abrupt.density.tle_drag import DecayTrack
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2
+from abrupt.thresholds.noise import MAD_TO_SIGMA, robust_scale
 from abrupt.types import FloatArray
-
-SECONDS_PER_DAY = 86400.0
+from abrupt.units import SECONDS_PER_DAY
 
 
 @dataclass(frozen=True)

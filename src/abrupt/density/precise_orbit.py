@@ -51,8 +51,7 @@ from abrupt.model.orbit.constants import MU_EARTH_M3_S2, OMEGA_EARTH_RAD_S
 from abrupt.model.orbit.forces import F_DRAG_SCALE, F_SRP_SCALE, I_DRAG
 from abrupt.series.ephemeris import Ephemeris
 from abrupt.types import FloatArray
-
-SECONDS_PER_DAY = 86400.0
+from abrupt.units import SECONDS_PER_DAY
 
 ORBIT_WINDOW_COLUMNS: tuple[str, ...] = (
     "object",

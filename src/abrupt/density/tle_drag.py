@@ -44,9 +44,9 @@ import pandas as pd
 from abrupt.errors import RepairLog
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
 from abrupt.types import FloatArray
+from abrupt.units import SECONDS_PER_DAY
 
 EARTH_ROTATION_RAD_S = 7.292115e-5  # [rad/s]
-SECONDS_PER_DAY = 86400.0
 J1970_JD = 2440587.5
 
 WINDOW_COLUMNS: tuple[str, ...] = (
@@ -276,7 +276,7 @@ def neighbour_residuals(n_bar: FloatArray, integral: FloatArray) -> tuple[FloatA
 
 def robust_sigma(values: FloatArray) -> float:
     """1.4826 × median absolute deviation about the median (Hampel 1974), NaNs ignored."""
-    from abrupt.clean.noise import robust_scale
+    from abrupt.thresholds.noise import robust_scale
 
     v = values[np.isfinite(values)]
     if v.size == 0:

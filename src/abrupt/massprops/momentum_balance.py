@@ -55,7 +55,6 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import ArrayLike
 
-from abrupt.clean.noise import robust_scale
 from abrupt.errors import InputError
 from abrupt.massprops.inertia import (
     INERTIA_ELEMENTS,
@@ -67,6 +66,7 @@ from abrupt.massprops.inertia import (
     principal_axes,
 )
 from abrupt.model.rotations import dcm_from_quaternion, skew
+from abrupt.thresholds.noise import robust_scale
 from abrupt.types import BoolArray, FloatArray
 
 __all__ = [

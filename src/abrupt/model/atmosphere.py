@@ -33,11 +33,11 @@ from numpy.typing import NDArray
 
 from abrupt.errors import AbruptError, InputError, RepairLog
 from abrupt.types import FloatArray
+from abrupt.units import SECONDS_PER_DAY
 
 logger = logging.getLogger(__name__)
 
 MSIS_VERSION = 2.1
-SECONDS_PER_DAY = 86400.0
 #: pymsis needs 57 h of 3-hourly ap before the time and the previous day's F10.7.
 HISTORY_DAYS_NEEDED = 3
 

@@ -34,7 +34,6 @@ import pandas as pd
 
 from abrupt.clean.comb import CombConfig, smooth_model
 from abrupt.clean.flight_masks import SlewMaskConfig, event_mask, flag_intervals, slew_mask
-from abrupt.clean.noise import robust_noise_sigma
 from abrupt.detect.attitude.change_detection import WindowConfig
 from abrupt.detect.base import get_detector
 from abrupt.errors import ConfigError, InputError
@@ -47,6 +46,7 @@ from abrupt.scale import Executor
 from abrupt.series.timetable import NS, Timetable, build_timetable
 from abrupt.store import TelemetryStore
 from abrupt.thresholds import Threshold
+from abrupt.thresholds.noise import robust_noise_sigma
 from abrupt.thresholds.robust import robust_block_maxima_threshold
 from abrupt.types import BoolArray, FloatArray
 
@@ -192,7 +192,7 @@ def estimate_orbit_period_s(spacecraft: Spacecraft, table: Timetable) -> tuple[f
     :func:`abrupt.clean.comb.estimate_period`). NaN when neither applies.
     """
     from abrupt.clean.comb import estimate_period
-    from abrupt.clean.noise import robust_scale
+    from abrupt.thresholds.noise import robust_scale
 
     # Rotation angle between attitudes m samples apart, 2 arccos|q(t+m)·q(t)| (free of gyro bias).
     q = table.quaternion_BN

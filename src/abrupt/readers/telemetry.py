@@ -37,10 +37,10 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from abrupt.clean.noise import robust_noise_sigma
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.spacecraft import RATE_UNITS, WHEEL_SPEED_UNITS, Spacecraft
 from abrupt.series.telemetry import GAP_FACTOR, Telemetry, split_at_gaps
+from abrupt.thresholds.noise import robust_noise_sigma
 
 QUATERNION_NORM_ERROR = 0.1  # relative norm deviation above which a quaternion is rejected
 QUATERNION_NORM_REPAIR = 1e-6  # relative deviation above which a renormalisation is counted

@@ -17,9 +17,9 @@ from abrupt.series.telemetry import Telemetry
 from abrupt.types import FloatArray
 
 if TYPE_CHECKING:
-    from abrupt.clean.noise import MomentumNoiseModel
     from abrupt.model.momentum import MomentumSeries
     from abrupt.model.spacecraft import Spacecraft
+    from abrupt.thresholds.noise import MomentumNoiseModel
 
 
 @dataclass(frozen=True, eq=False)
@@ -57,12 +57,12 @@ class AttitudeSeries:
 
         From the ``calibration`` telemetry when given; otherwise ``null_samples`` simulated from the
         white + random-walk noise model measured on the input itself
-        (:func:`abrupt.clean.noise.momentum_noise_model`). Computed once per (null_samples, seed).
+        (:func:`abrupt.thresholds.noise.momentum_noise_model`). Computed once per (null_samples, seed).
         """
         key = ("event_free", null_samples, seed)
         if key not in self._cache:
-            from abrupt.clean.noise import momentum_noise_model
             from abrupt.model.momentum import system_momentum
+            from abrupt.thresholds.noise import momentum_noise_model
 
             if self.calibration is not None:
                 cal = self.calibration

@@ -33,8 +33,7 @@ from abrupt.simulate.attitude import (
     simulate_pointing,
 )
 from abrupt.types import FloatArray
-
-SECONDS_PER_DAY = 86400.0
+from abrupt.units import SECONDS_PER_DAY
 
 
 @dataclass(frozen=True)

@@ -42,8 +42,8 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory, RawElementSet, history_from_sets
+from abrupt.units import SECONDS_PER_DAY
 
-SECONDS_PER_DAY = 86400.0
 DAYS_PER_YEAR = 365.25
 EARTH_RADIUS_M = 6378135.0  # WGS-72, as SGP4
 EARTH_ROTATION_RAD_S = 7.2921158553e-5

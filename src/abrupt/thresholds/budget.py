@@ -22,9 +22,10 @@ from typing import ClassVar, Literal
 
 import numpy as np
 
+from abrupt.units import SECONDS_PER_DAY
+
 BudgetUnit = Literal["day", "week", "year"]
 
-SECONDS_PER_DAY = 86400.0
 DAYS_PER_YEAR = 365.25
 
 

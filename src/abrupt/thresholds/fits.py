@@ -302,7 +302,7 @@ def robust_gaussian_threshold(
     samples, so the median and MAD are those of the event-free statistic. ``z`` is the Gaussian upper
     ``p_fa/2`` point (two-sided) or ``p_fa`` point. ``p_fa`` is per sample.
     """
-    from abrupt.clean.noise import robust_scale
+    from abrupt.thresholds.noise import robust_scale
 
     x = np.asarray(statistic, dtype=np.float64).ravel()
     x = x[np.isfinite(x)]

@@ -20,8 +20,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from abrupt.thresholds.fits import Threshold
+from abrupt.units import SECONDS_PER_DAY
 
-SECONDS_PER_DAY = 86_400.0
 _LL25 = math.log(-math.log(0.25))
 _LL75 = math.log(-math.log(0.75))
 

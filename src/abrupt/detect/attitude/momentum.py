@@ -28,7 +28,6 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from abrupt.clean.noise import MomentumNoiseModel, robust_noise_sigma
 from abrupt.detect.attitude.change_detection import (
     ANCHOR,
     WindowConfig,
@@ -40,6 +39,7 @@ from abrupt.events import Event, config_hash, empty_frame, events_frame, format_
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.attitude import AttitudeSeries
 from abrupt.thresholds import FalseAlarmBudget, Threshold, block_maxima, fit_block_maxima_threshold, fit_threshold
+from abrupt.thresholds.noise import MomentumNoiseModel, robust_noise_sigma
 from abrupt.types import FloatArray
 
 #: Extra event columns every attitude detector fills.

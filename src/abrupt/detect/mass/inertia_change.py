@@ -45,12 +45,12 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from abrupt.clean.noise import robust_scale
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.events import Event, events_frame, format_time_utc
 from abrupt.massprops.inertia import INERTIA_ELEMENTS
 from abrupt.massprops.track import InertiaTrack
 from abrupt.thresholds import FalseAlarmBudget, Threshold
+from abrupt.thresholds.noise import robust_scale
 
 
 def _robust_cov(x: np.ndarray) -> np.ndarray:

@@ -21,7 +21,6 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy import stats
 
-from abrupt.clean.noise import robust_scale
 from abrupt.detect.orbit.ekf import (
     FilterConfig,
     FilterRun,
@@ -43,6 +42,7 @@ from abrupt.events import Event, config_hash, empty_frame, events_frame
 from abrupt.model.frames import Ephemeris
 from abrupt.model.orbit import MU_EARTH_M3_S2, ForceContext, rtn_matrix
 from abrupt.thresholds import Threshold, fit_threshold, gpd_return_level_upper, p_fa_per_sample
+from abrupt.thresholds.noise import robust_scale
 from abrupt.types import FloatArray
 
 SECONDS_PER_WEEK = 7 * 86400.0

@@ -64,13 +64,13 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from abrupt.clean.noise import MAD_TO_SIGMA, robust_scale
 from abrupt.events import Event, config_hash, empty_frame, events_frame, new_run_id
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
 from abrupt.thresholds import Threshold
+from abrupt.thresholds.noise import MAD_TO_SIGMA, robust_scale
+from abrupt.units import SECONDS_PER_DAY
 
 DETECTOR_NAME = "tle_mean_element_steps"
-SECONDS_PER_DAY = 86400.0
 DAYS_PER_YEAR = 365.25
 
 EXTRA_COLUMNS: tuple[str, ...] = (

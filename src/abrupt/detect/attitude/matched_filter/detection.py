@@ -18,7 +18,6 @@ import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike
 
-from abrupt.clean.noise import robust_noise_sigma
 from abrupt.detect.attitude.matched_filter.combined import CombinedFilter, combined_channels, refine_strike
 from abrupt.detect.attitude.matched_filter.filters import (
     SizeMetric,
@@ -36,6 +35,7 @@ from abrupt.thresholds import (
     fit_threshold,
     robust_gaussian_threshold,
 )
+from abrupt.thresholds.noise import robust_noise_sigma
 from abrupt.types import FloatArray
 
 
@@ -284,7 +284,7 @@ def detect_combined(
     ``wheel_speed_rad_s`` (n, N; relative to the body) the wheel channels join the filter (detector
     ``mf_joint``; a baseline is then always used, 120 s unless given), otherwise the six attitude and
     rate channels (``mf_combined``). ``noise_sd`` defaults to
-    :func:`abrupt.clean.noise.robust_noise_sigma` of the channels.
+    :func:`abrupt.thresholds.noise.robust_noise_sigma` of the channels.
     The strike estimate is the least-squares dH_hat, not the bank (``dH_B_*`` = ``dH_ls_B_*``).
     """
     q = np.asarray(q_BN, dtype=np.float64)
