@@ -31,11 +31,8 @@ sys.path.insert(0, str(Path(__file__).parent))
 
 from _flight_like_loader import catalogue, ingest, load_day
 from abrupt.massprops.inertia import axis_errors_deg, params_from_inertia, principal_axes
-from abrupt.massprops.momentum_balance import (
-    MomentumBalanceData,
-    estimate_inertia,
-    nadir_from_attitude,
-)
+from abrupt.massprops.attitude_reference import nadir_from_attitude
+from abrupt.massprops.momentum_balance import MomentumBalanceData, estimate_inertia
 from abrupt.model.momentum import body_momentum
 from abrupt.model.rotations import dcm_from_quaternion
 
