@@ -162,7 +162,11 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
         k = series.n_windows
         needed = self.min_windows_before + self.min_windows_after
         if k < needed:
-            return _untested(series, f"{k} window(s): need {needed} to test a change")
+            return _untested(
+                series,
+                f"{k} window(s): a change needs {self.min_windows_before} windows before it and "
+                f"{self.min_windows_after} after it ({needed} in all); nothing was tested",
+            )
         obs = np.all(series.observable, axis=0)
         idx = np.flatnonzero(obs)
         if idx.size == 0:
