@@ -380,10 +380,10 @@ def test_ml_momentum_estimate_is_unbiased_in_closed_loop_and_attains_the_white_n
     assert np.mean([f.sigma_kgm2 for f in fits]) / i_true == pytest.approx(np.std(ml, ddof=1), rel=0.1)
 
 
-@pytest.mark.parametrize("calibration", ["wander only", "thesis testbed"])
+@pytest.mark.parametrize("calibration", ["zeroed gyro", "thesis testbed"])
 def test_ml_momentum_estimate_states_an_honest_sigma_under_the_full_testbed_noise(calibration):
-    # Drift, wander, wheel-gain and encoder noise as in the Dabrowski benchmark (a testbed with gyro wander and no
-    # drift, and the testbed calibrated on Tables 4.3-4.4 with the −2°/min drift the satellite tracks): z = (Î − I)/σ̂ over
+    # Drift, wander, wheel-gain and encoder noise as in the Dabrowski benchmark (a testbed with a zeroed gyro, and
+    # the testbed calibrated on Tables 4.3-4.4 with the −2°/min drift the satellite tracks): z = (Î − I)/σ̂ over
     # runs at the four added-mass configurations has unit RMS, and the truth is inside 2σ̂ about 95% of the time.
     from reproductions.simsat import (
         I33_BASELINE,
@@ -394,7 +394,7 @@ def test_ml_momentum_estimate_states_an_honest_sigma_under_the_full_testbed_nois
         testbed_runs,
     )
 
-    if calibration == "wander only":
+    if calibration == "zeroed gyro":
         noise = TestbedNoise(wheel_gain_sd=0.025, wander_deg=0.06, rate_noise_deg_s=0.07)
     else:
         noise = THESIS_TESTBED
