@@ -19,7 +19,6 @@ interpolated across a loss of signal; dropped stamps are counted in the returned
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -207,7 +206,8 @@ def momentum_data_from_channels(
     one (t, Ω [rad/s]) per wheel in the order of ``wheel_axes`` (3, N); ``appendage_angle`` (t, θ [rad],
     wrapped or not) about ``appendage_axis_B`` with spin inertia ``appendage_spin_inertia_kgm2``;
     ``thruster_flag`` (t, 0/1) written on change; ``orbit_period_s`` enables the gravity-gradient term
-    for a nadir-pointing spacecraft (the orbit is fitted to the attitude, :func:`nadir_from_attitude`).
+    for a nadir-pointing spacecraft (the orbit is fitted to the attitude,
+    :func:`~abrupt.massprops.attitude_reference.nadir_from_attitude`).
     """
     repairs = repairs if repairs is not None else RepairLog(source)
     axes = np.asarray(wheel_axes, dtype=np.float64)
@@ -255,14 +255,6 @@ def momentum_data_from_channels(
         epoch_utc=epoch_utc,
         source=source,
     )
-
-
-def channels_by_key(frame_groups: Mapping[str, Channel], keys: list[str]) -> list[Channel]:
-    """The channels named ``keys`` from a mapping, with an error naming the first missing one."""
-    missing = [k for k in keys if k not in frame_groups]
-    if missing:
-        raise InputError(f"missing telemetry channel(s) {missing}", column=missing[0])
-    return [frame_groups[k] for k in keys]
 
 
 def momentum_data_from_simulation(
