@@ -42,9 +42,12 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from scipy.linalg import solveh_banded
 from scipy.optimize import minimize
 from scipy.special import betainc, ndtr
+from threadpoolctl import threadpool_limits
 
+from abrupt.density.constellation import platform_b_range
 from abrupt.density.tle_drag import DecayTrack
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2
 from abrupt.thresholds.noise import MAD_TO_SIGMA, robust_scale
@@ -159,8 +162,6 @@ def fit_joint_density(
 
     The many small dense solves run on one BLAS thread (threads only contend at this size).
     """
-    from threadpoolctl import threadpool_limits
-
     with threadpool_limits(limits=1, user_api="blas"):
         return _fit_joint_density(tracks, origin_utc, config or JointConfig())
 
@@ -342,8 +343,6 @@ def _solve_spd(mat: FloatArray, rhs: FloatArray, bandwidth: int) -> FloatArray:
     n = mat.shape[0]
     if n <= 3 * bandwidth or n <= 300:
         return np.asarray(np.linalg.solve(mat, rhs), dtype=np.float64)
-    from scipy.linalg import solveh_banded
-
     ab = np.zeros((bandwidth + 1, n))
     for k in range(bandwidth + 1):
         ab[bandwidth - k, k:] = np.diagonal(mat, k)
@@ -575,8 +574,6 @@ def joint_constellation_density(
     ``flow``: one :class:`FlowConditions` for all, or one per object name (each platform's C_D at
     its own altitude's temperature and molar mass).
     """
-    from abrupt.density.constellation import platform_b_range
-
     fit = fit_joint_density(tracks, origin_utc, config)
     warnings = list(fit.warnings)
     br = fit.b_relative
