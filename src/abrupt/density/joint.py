@@ -166,12 +166,74 @@ def fit_joint_density(
         return _fit_joint_density(tracks, origin_utc, config or JointConfig())
 
 
+@dataclass
+class _Layout:
+    """Where each object-block's parameters sit among the nodes, and the fit's fixed matrices."""
+
+    n_nodes: int
+    p_lo: Any  # first node column of each object-block
+    p_hi: Any  # one past its last node column
+    bandwidth: int
+    has_data: Any  # nodes with any set's weight on them
+    param_obj: Any  # object-block → object index (folds for choosing λ)
+    n_folds: int
+
+
 def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: JointConfig) -> JointFit:
     origin: Any = pd.Timestamp(origin_utc).to_datetime64().astype("datetime64[ns]")
     step_s = cfg.node_days * SECONDS_PER_DAY
-    block_s = cfg.block_days * SECONDS_PER_DAY
     end = max(float(_seconds(tr.grid_utc[-1:], origin)[0]) for tr in tracks if len(tr.grid_utc))
     n_nodes = math.ceil(end / step_s) + 2
+    segments, params = _segments(tracks, origin, cfg, n_nodes)
+    if not segments:
+        raise ValueError("no object has a segment of three or more element sets: nothing to fit")
+    n_obj = len(tracks)
+    sigma = _initial_sigma(segments, n_obj)
+    layout = _layout(segments, params, n_nodes)
+    n_par = len(params)
+    penalty = _second_difference(n_nodes)
+    s: FloatArray = np.ones(n_nodes)
+    b: FloatArray = np.zeros(n_par)
+    lam = cfg.smoothing
+    normal = np.zeros((n_nodes, n_nodes))
+    it = 0
+    converged = False
+    warnings: list[str] = []
+    for outer in range(1, cfg.reweightings + 1):
+        mats, vecs, yyq = _sufficient_statistics(segments, sigma, layout)
+        s_prev_outer = s.copy()
+        if cfg.l1_floor > 0 and outer > 1:
+            # ℓ1 trend filtering by reweighting (Kim et al. 2009, SIAM Rev. 51): weights 1/|D₂s| let
+            # s(t) bend sharply at a storm's onset and end instead of rounding them off.
+            d2 = s[:-2] - 2.0 * s[1:-1] + s[2:]
+            wd = 1.0 / np.maximum(np.abs(d2), cfg.l1_floor)
+            penalty = _second_difference(n_nodes, wd / np.mean(wd))
+        s, b, lam, n_it = _scale_iterations(s, b, lam, normal, penalty, mats, vecs, yyq, layout, cfg, outer)
+        it += n_it
+        _reweight(segments, sigma, b, s, cfg.huber)
+        # Converged when the reweighting moves s by < 0.3 % RMS (the end nodes, barely constrained,
+        # keep jittering with the Huber weights and are not looked at).
+        if outer > 2 and float(np.sqrt(np.mean((s - s_prev_outer)[layout.has_data] ** 2))) < 3e-3:
+            converged = True
+            break
+    if not converged:
+        warnings.append(f"joint fit: s(t) still changing after {cfg.reweightings} reweightings")
+    assert lam is not None
+    cov = _solve_spd(normal + lam * penalty, np.eye(n_nodes), layout.bandwidth)
+    cov *= 1.0 / float(np.mean(s[layout.has_data])) ** 2
+    frame = _b_frame(tracks, segments, params, mats, s, b, layout)
+    s_out = np.where(layout.has_data, s, np.nan)
+    sigmas = {tr.name: float(sigma[j]) for j, tr in enumerate(tracks)}
+    return JointFit(origin, cfg.node_days, s_out, cov, frame, sigmas, float(lam), it, warnings)
+
+
+def _segments(
+    tracks: Sequence[DecayTrack], origin: Any, cfg: JointConfig, n_nodes: int
+) -> tuple[list[_Segment], list[tuple[int, int]]]:
+    """Each object's kept sets cut at its segments and B blocks (three sets or more), with their
+    design rows, and the object-blocks (object index, block number) they belong to."""
+    step_s = cfg.node_days * SECONDS_PER_DAY
+    block_s = cfg.block_days * SECONDS_PER_DAY
     coef = 1.5 * MU_EARTH_WGS72_M3_S2 ** (-2.0 / 3.0)
     segments: list[_Segment] = []
     params: list[tuple[int, int]] = []
@@ -195,16 +257,21 @@ def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: Joint
                 param_index[pk] = len(params)
                 params.append(pk)
             segments.append(_Segment(j, param_index[pk], tr.n_rad_s[idx].astype(float), g, col0, np.ones(idx.size)))
-    if not segments:
-        raise ValueError("no object has a segment of three or more element sets: nothing to fit")
-    n_obj = len(tracks)
+    return segments, params
+
+
+def _initial_sigma(segments: list[_Segment], n_obj: int) -> FloatArray:
+    """Initial σ_j from each object's neighbour residual scatter (any positive guess works)."""
     sigma = np.ones(n_obj)
-    # Initial σ_j from each object's neighbour residual scatter (any positive guess works).
     for j in range(n_obj):
         ys = [np.diff(sg.y, 2) for sg in segments if sg.obj == j]
         v = np.concatenate(ys) if ys else np.zeros(0)
         sigma[j] = float(robust_scale(v)) / math.sqrt(6.0) if v.size else 1.0
         sigma[j] = sigma[j] if sigma[j] > 0 else 1e-12
+    return sigma
+
+
+def _layout(segments: list[_Segment], params: list[tuple[int, int]], n_nodes: int) -> _Layout:
     n_par = len(params)
     has_data = np.zeros(n_nodes, dtype=bool)
     for sg in segments:
@@ -216,106 +283,129 @@ def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: Joint
         p_lo[sg.param] = min(p_lo[sg.param], sg.col0)
         p_hi[sg.param] = max(p_hi[sg.param], sg.col0 + sg.g.shape[1])
     bandwidth = max(2, int(np.max(p_hi - p_lo)) - 1)
-    penalty = _second_difference(n_nodes)
     # Objects → folds for choosing λ (object-wise cross-validation: an object left out is predicted
     # by the density scale the others give, with its own B and offsets refitted).
     obj_ids = np.array([params[q][0] for q in range(n_par)])
     order = {o: i for i, o in enumerate(np.unique(obj_ids))}
     param_obj = np.array([order[o] for o in obj_ids])
-    n_folds = min(5, len(order))
-    s: FloatArray = np.ones(n_nodes)
-    b: FloatArray = np.zeros(n_par)
-    lam = cfg.smoothing
-    normal = np.zeros((n_nodes, n_nodes))
+    return _Layout(n_nodes, p_lo, p_hi, bandwidth, has_data, param_obj, min(5, len(order)))
+
+
+def _sufficient_statistics(
+    segments: list[_Segment], sigma: FloatArray, layout: _Layout
+) -> tuple[list[FloatArray], list[FloatArray], FloatArray]:
+    """Sufficient statistics of each object-block for the current weights: with the offsets profiled
+    out (weighted centring per segment), n̄ − n0 = b·G s gives b = sᵀr/sᵀMs and the s-step normal
+    matrix Σ b² M (Gauss-Markov; the offsets cost one degree of freedom each)."""
+    p_lo, p_hi = layout.p_lo, layout.p_hi
+    n_par = p_lo.size
+    mats = [np.zeros((int(p_hi[q] - p_lo[q]),) * 2) for q in range(n_par)]
+    vecs = [np.zeros(int(p_hi[q] - p_lo[q])) for q in range(n_par)]
+    yyq = np.zeros(n_par)
+    for sg in segments:
+        w = sg.weight / sigma[sg.obj] ** 2
+        sw = float(np.sum(w))
+        gc = sg.g - (w @ sg.g) / sw
+        yc = sg.y - float(w @ sg.y) / sw
+        o = sg.col0 - int(p_lo[sg.param])
+        k = sg.g.shape[1]
+        mats[sg.param][o : o + k, o : o + k] += gc.T @ (w[:, None] * gc)
+        vecs[sg.param][o : o + k] += gc.T @ (w * yc)
+        yyq[sg.param] += float(w @ (yc * yc))
+    return mats, vecs, yyq
+
+
+def _scale_iterations(
+    s: FloatArray,
+    b: FloatArray,
+    lam: float | None,
+    normal: FloatArray,
+    penalty: FloatArray,
+    mats: list[FloatArray],
+    vecs: list[FloatArray],
+    yyq: FloatArray,
+    layout: _Layout,
+    cfg: JointConfig,
+    outer: int,
+) -> tuple[FloatArray, FloatArray, float | None, int]:
+    """Alternate b (closed form given s) and s (penalised normal equations) at fixed weights; λ by
+    object-wise cross-validation on the first iterations. ``normal`` is filled in place (the last
+    iteration's is the covariance's). Returns s, b, λ and the iterations run."""
+    p_lo, p_hi, n_nodes, has_data = layout.p_lo, layout.p_hi, layout.n_nodes, layout.has_data
+    n_par = p_lo.size
     it = 0
-    converged = False
-    warnings: list[str] = []
-    for outer in range(1, cfg.reweightings + 1):
-        # Sufficient statistics of each object-block for the current weights: with the offsets
-        # profiled out (weighted centring per segment), n̄ − n0 = b·G s gives b = sᵀr/sᵀMs and the
-        # s-step normal matrix Σ b² M (Gauss-Markov; the offsets cost one degree of freedom each).
-        mats = [np.zeros((int(p_hi[q] - p_lo[q]),) * 2) for q in range(n_par)]
-        vecs = [np.zeros(int(p_hi[q] - p_lo[q])) for q in range(n_par)]
-        yyq = np.zeros(n_par)
-        for sg in segments:
-            w = sg.weight / sigma[sg.obj] ** 2
-            sw = float(np.sum(w))
-            gc = sg.g - (w @ sg.g) / sw
-            yc = sg.y - float(w @ sg.y) / sw
-            o = sg.col0 - int(p_lo[sg.param])
-            k = sg.g.shape[1]
-            mats[sg.param][o : o + k, o : o + k] += gc.T @ (w[:, None] * gc)
-            vecs[sg.param][o : o + k] += gc.T @ (w * yc)
-            yyq[sg.param] += float(w @ (yc * yc))
-        s_prev_outer = s.copy()
-        if cfg.l1_floor > 0 and outer > 1:
-            # ℓ1 trend filtering by reweighting (Kim et al. 2009, SIAM Rev. 51): weights 1/|D₂s| let
-            # s(t) bend sharply at a storm's onset and end instead of rounding them off.
-            d2 = s[:-2] - 2.0 * s[1:-1] + s[2:]
-            wd = 1.0 / np.maximum(np.abs(d2), cfg.l1_floor)
-            penalty = _second_difference(n_nodes, wd / np.mean(wd))
-        for inner in range(cfg.iterations):
-            it += 1
-            sp = [s[p_lo[q] : p_hi[q]] for q in range(n_par)]
-            den = np.array([float(x @ m @ x) for x, m in zip(sp, mats, strict=True)])
-            num = np.array([float(x @ v) for x, v in zip(sp, vecs, strict=True)])
-            b = np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
-            normal.fill(0.0)
-            rhs = np.zeros(n_nodes)
-            for q in range(n_par):
-                normal[p_lo[q] : p_hi[q], p_lo[q] : p_hi[q]] += b[q] ** 2 * mats[q]
-                rhs[p_lo[q] : p_hi[q]] += b[q] * vecs[q]
-            scale_n = float(np.trace(normal)) / max(float(np.trace(penalty)), 1e-300)
-            normal[np.diag_indices(n_nodes)] += 1e-10 * scale_n
-            if cfg.smoothing is None and inner == 0 and (outer <= 3 or lam is None):
-                folds = [np.flatnonzero(param_obj % n_folds == f) for f in range(n_folds)]
-                stats = _FitStatistics(normal, rhs, penalty, mats, vecs, yyq, b, p_lo, p_hi, bandwidth)
-                lam = _cross_validated_lambda(stats, folds, scale_n)
-            assert lam is not None
-            s_new = _solve_spd(normal + lam * penalty, rhs, bandwidth)
-            norm = float(np.mean(s_new[has_data])) if np.any(has_data) else 1.0
-            if not norm > 0:
-                raise ValueError("the joint fit found no net decay (mean density scale <= 0)")
-            s_new = s_new / norm
-            b = b * norm
-            change = float(np.max(np.abs(s_new - s)[has_data]))
-            s = s_new
-            if change < cfg.tolerance:
-                break
-        # Residuals → σ_j (robust scale about zero: the offsets centre them) and Huber weights.
-        res_by_obj: list[list[FloatArray]] = [[] for _ in range(n_obj)]
-        resid_seg = []
-        for sg in segments:
-            w = sg.weight / sigma[sg.obj] ** 2
-            r = sg.y - b[sg.param] * (sg.g @ s[sg.col0 : sg.col0 + sg.g.shape[1]])
-            r = r - float(w @ r) / float(np.sum(w))
-            resid_seg.append(r)
-            res_by_obj[sg.obj].append(r)
-        for j in range(n_obj):
-            if res_by_obj[j]:
-                v = np.concatenate(res_by_obj[j])
-                mad = float(MAD_TO_SIGMA * np.median(np.abs(v)))
-                sigma[j] = mad if mad > 0 else sigma[j]
-        for sg, r in zip(segments, resid_seg, strict=True):
-            z = np.abs(r) / sigma[sg.obj]
-            sg.weight = np.minimum(1.0, cfg.huber / np.maximum(z, 1e-12))
-        # Converged when the reweighting moves s by < 0.3 % RMS (the end nodes, barely constrained,
-        # keep jittering with the Huber weights and are not looked at).
-        if outer > 2 and float(np.sqrt(np.mean((s - s_prev_outer)[has_data] ** 2))) < 3e-3:
-            converged = True
+    for inner in range(cfg.iterations):
+        it += 1
+        sp = [s[p_lo[q] : p_hi[q]] for q in range(n_par)]
+        den = np.array([float(x @ m @ x) for x, m in zip(sp, mats, strict=True)])
+        num = np.array([float(x @ v) for x, v in zip(sp, vecs, strict=True)])
+        b = np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
+        normal.fill(0.0)
+        rhs = np.zeros(n_nodes)
+        for q in range(n_par):
+            normal[p_lo[q] : p_hi[q], p_lo[q] : p_hi[q]] += b[q] ** 2 * mats[q]
+            rhs[p_lo[q] : p_hi[q]] += b[q] * vecs[q]
+        scale_n = float(np.trace(normal)) / max(float(np.trace(penalty)), 1e-300)
+        normal[np.diag_indices(n_nodes)] += 1e-10 * scale_n
+        if cfg.smoothing is None and inner == 0 and (outer <= 3 or lam is None):
+            folds = [np.flatnonzero(layout.param_obj % layout.n_folds == f) for f in range(layout.n_folds)]
+            stats = _FitStatistics(normal, rhs, penalty, mats, vecs, yyq, b, p_lo, p_hi, layout.bandwidth)
+            lam = _cross_validated_lambda(stats, folds, scale_n)
+        assert lam is not None
+        s_new = _solve_spd(normal + lam * penalty, rhs, layout.bandwidth)
+        norm = float(np.mean(s_new[has_data])) if np.any(has_data) else 1.0
+        if not norm > 0:
+            raise ValueError("the joint fit found no net decay (mean density scale <= 0)")
+        s_new = s_new / norm
+        b = b * norm
+        change = float(np.max(np.abs(s_new - s)[has_data]))
+        s = s_new
+        if change < cfg.tolerance:
             break
-    if not converged:
-        warnings.append(f"joint fit: s(t) still changing after {cfg.reweightings} reweightings")
-    assert lam is not None
-    cov = _solve_spd(normal + lam * penalty, np.eye(n_nodes), bandwidth)
-    cov *= 1.0 / float(np.mean(s[has_data])) ** 2
-    # B uncertainty (per object-block), given s: 1/√(sᵀ M s) (weights include 1/σ_j²).
+    return s, b, lam, it
+
+
+def _reweight(segments: list[_Segment], sigma: FloatArray, b: FloatArray, s: FloatArray, huber: float) -> None:
+    """Residuals → σ_j (robust scale about zero: the offsets centre them, updated in place) and the
+    segments' Huber weights."""
+    n_obj = sigma.size
+    res_by_obj: list[list[FloatArray]] = [[] for _ in range(n_obj)]
+    resid_seg = []
+    for sg in segments:
+        w = sg.weight / sigma[sg.obj] ** 2
+        r = sg.y - b[sg.param] * (sg.g @ s[sg.col0 : sg.col0 + sg.g.shape[1]])
+        r = r - float(w @ r) / float(np.sum(w))
+        resid_seg.append(r)
+        res_by_obj[sg.obj].append(r)
+    for j in range(n_obj):
+        if res_by_obj[j]:
+            v = np.concatenate(res_by_obj[j])
+            mad = float(MAD_TO_SIGMA * np.median(np.abs(v)))
+            sigma[j] = mad if mad > 0 else sigma[j]
+    for sg, r in zip(segments, resid_seg, strict=True):
+        z = np.abs(r) / sigma[sg.obj]
+        sg.weight = np.minimum(1.0, huber / np.maximum(z, 1e-12))
+
+
+def _b_frame(
+    tracks: Sequence[DecayTrack],
+    segments: list[_Segment],
+    params: list[tuple[int, int]],
+    mats: list[FloatArray],
+    s: FloatArray,
+    b: FloatArray,
+    layout: _Layout,
+) -> pd.DataFrame:
+    """Each object-block's relative B, its uncertainty given s, 1/√(sᵀ M s) (weights include 1/σ_j²),
+    and its number of sets."""
+    p_lo, p_hi = layout.p_lo, layout.p_hi
+    n_par = len(params)
     den = np.array([float(s[p_lo[q] : p_hi[q]] @ mats[q] @ s[p_lo[q] : p_hi[q]]) for q in range(n_par)])
     nsets = np.zeros(n_par, dtype=np.int64)
     for sg in segments:
         nsets[sg.param] += sg.y.size
     b_sig = 1.0 / np.sqrt(np.where(den > 0, den, np.nan))
-    frame = pd.DataFrame(
+    return pd.DataFrame(
         {
             "object": [tracks[j].name for j, _ in params],
             "block": [bk for _, bk in params],
@@ -323,18 +413,6 @@ def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: Joint
             "b_rel_sigma": b_sig,
             "n_sets": nsets,
         }
-    )
-    s_out = np.where(has_data, s, np.nan)
-    return JointFit(
-        origin,
-        cfg.node_days,
-        s_out,
-        cov,
-        frame,
-        {tr.name: float(sigma[j]) for j, tr in enumerate(tracks)},
-        float(lam),
-        it,
-        warnings,
     )
 
 
