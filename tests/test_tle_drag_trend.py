@@ -15,7 +15,7 @@ import pandas as pd
 import pytest
 
 from abrupt.detect.tle.detectors import TleMeanElements
-from abrupt.detect.tle.maneuvers import drag_trend_m, mean_element_series, stated_decay_m_s
+from abrupt.detect.tle.elements import drag_trend_m, mean_element_series, stated_decay_m_s
 from abrupt.simulate.tle_null import EPOCH0, NullHistorySpec, simulate_null_history
 from abrupt.thresholds import FalseAlarmBudget
 

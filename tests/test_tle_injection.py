@@ -15,7 +15,8 @@ import pandas as pd
 import pytest
 
 from abrupt.detect.tle.detectors import TleMeanElements
-from abrupt.detect.tle.maneuvers import has_drift_hinge, mean_element_series
+from abrupt.detect.tle.elements import mean_element_series
+from abrupt.detect.tle.timing import has_drift_hinge
 from abrupt.simulate.tle_null import EPOCH0, NullHistorySpec, simulate_null_history
 from abrupt.thresholds import FalseAlarmBudget
 
@@ -74,7 +75,7 @@ def test_cross_track_burn_is_timed_in_its_gap_not_on_a_noise_hinge() -> None:
 
 def test_drift_hinge_gate_reads_the_weighted_in_track_score() -> None:
     """The gate is the in-track group's tail-weighted z against the statistic's floor of 3."""
-    from abrupt.detect.tle.maneuvers import StepSeries
+    from abrupt.detect.tle.steps import StepSeries
 
     z = np.array([1.0, 10.0])
     steps = StepSeries(

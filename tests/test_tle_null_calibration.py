@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from abrupt.detect.tle.detectors import detector_for
-from abrupt.detect.tle.maneuvers import mean_element_series
+from abrupt.detect.tle.elements import mean_element_series
 from abrupt.simulate.tle_null import NullHistorySpec, detector_residuals, simulate_null_history
 from abrupt.thresholds import FalseAlarmBudget
 

@@ -53,7 +53,6 @@ from abrupt.types import FloatArray
 from abrupt.units import SECONDS_PER_DAY
 
 EARTH_ROTATION_RAD_S = 7.292115e-5  # [rad/s]
-J1970_JD = 2440587.5
 
 WINDOW_COLUMNS: tuple[str, ...] = (
     "object",
