@@ -28,7 +28,7 @@ from abrupt.cli.groups import (
     spacecraft_name_option,
 )
 from abrupt.cli.options import budget_options, pop_budget
-from abrupt.detect.tle.config import TleDetectorConfig
+from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET, TleDetectorConfig
 from abrupt.detect.tle.detectors import detector_for
 from abrupt.errors import InputError
 from abrupt.events import config_hash, new_run_id, read_events
@@ -39,7 +39,7 @@ from abrupt.report.tle import plot_injection_recall, plot_tle_report
 from abrupt.score import recall_at_false_alarm_rate, score_events
 from abrupt.simulate.tle_injection import KINDS, MIN_ELEMENT_SETS, injection_recall, ladder_around
 
-TLE_BUDGET = "1/year"  # per satellite-year: a TLE history has a few hundred element sets a year
+TLE_BUDGET = str(DEFAULT_TLE_BUDGET)  # "1/year"
 
 norad_option = click.option(
     "--norad",

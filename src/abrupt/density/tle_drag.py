@@ -43,6 +43,7 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import CubicSpline
 
+from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET
 from abrupt.detect.tle.detectors import detector_for
 from abrupt.errors import RepairLog
 from abrupt.model.atmosphere import msis_density, read_space_weather, teme_to_geodetic
@@ -86,7 +87,7 @@ class TleDragConfig:
     with_model: bool = False
     model_stride: int = 2
     origin_utc: str | None = None
-    maneuver_budget: FalseAlarmBudget = field(default_factory=lambda: FalseAlarmBudget(1.0, "year"))
+    maneuver_budget: FalseAlarmBudget = DEFAULT_TLE_BUDGET  # of the maneuver detector
 
     def __post_init__(self) -> None:
         if self.interval_days <= 0:
@@ -287,7 +288,7 @@ def robust_sigma(values: FloatArray) -> float:
 def maneuver_epochs(history: ElementHistory, budget: FalseAlarmBudget | None = None) -> list[pd.Timestamp]:
     """Maneuver times (UTC timestamps) from the registered TLE maneuver detector of the history's orbit
     (``tle.mean_elements`` or ``tle.geo_station_keeping``) at ``budget`` (default 1 per satellite-year)."""
-    budget = budget or FalseAlarmBudget(1.0, "year")
+    budget = budget or DEFAULT_TLE_BUDGET
     events = detector_for(history).detect(history, budget).events
     if len(events) == 0:
         return []

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from typing import Any
 
 from abrupt.thresholds import FalseAlarmBudget
@@ -35,6 +35,9 @@ EXTRA_COLUMNS: tuple[str, ...] = (
 # scores the same or better with 2, every GEO history the same or better with 3 (docs/tle.md).
 CAMPAIGN_SIDE_SETS = {"leo": 2, "geo": 3}
 
+# A TLE history has a few hundred element sets a year: its budget is stated per satellite-year.
+DEFAULT_TLE_BUDGET = FalseAlarmBudget(1.0, "year")
+
 
 @dataclass(frozen=True)
 class TleDetectorConfig:
@@ -45,7 +48,7 @@ class TleDetectorConfig:
     max_window_days: float = 20.0
     noise_half_window: int = 40
     peak_half_width: int = 2
-    budget: FalseAlarmBudget = field(default_factory=lambda: FalseAlarmBudget(1.0, "year"))
+    budget: FalseAlarmBudget = DEFAULT_TLE_BUDGET
     threshold: float | None = None
     threshold_method: str = "gpd"
     min_statistic: float = 3.0
