@@ -159,7 +159,7 @@ def detect_mean_elements(
     span_days = (el["epoch_utc"].iloc[-1] - el["epoch_utc"].iloc[0]).total_seconds() / SECONDS_PER_DAY
     n_gaps = len(history) - 1
     gaps_per_year = n_gaps / max(span_days / DAYS_PER_YEAR, 1e-9)
-    p_fa = min(0.5, cfg.budget.per_year / gaps_per_year)
+    p_fa = min(0.5, cfg.budget.per_year / gaps_per_year)  # per gap: the yearly budget over the gaps a year
     model, first = first_pass(history, cfg, regime)
     threshold, method = operating_threshold(cfg, first, p_fa)
     steps, accepted, _ = segment(history, cfg, threshold, model=model, first=first)
