@@ -34,8 +34,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from abrupt.detect.orbit.analysis import OrbitDetectorConfig, analyse, calibrate_thresholds, tau_q_grid
+from abrupt.detect.orbit.analysis import OrbitDetectorConfig, analyse
+from abrupt.detect.orbit.calibration import calibrate_thresholds
 from abrupt.detect.orbit.ekf import FilterConfig, run_backward, run_forward
+from abrupt.detect.orbit.tuning import tau_q_grid
 from abrupt.model.orbit import MU_EARTH_M3_S2, ForceModel
 from abrupt.simulate.orbit import THESIS_DV_MPS, Impulse, OrbitSimulationConfig, SimulatedOrbit, simulate_orbit
 

@@ -15,15 +15,8 @@ import time
 
 import numpy as np
 
-from abrupt.detect.orbit.ekf import (
-    _GL_NODES,
-    _GL_WEIGHTS,
-    FilterConfig,
-    _process_noise,
-    propagate_state,
-    run_backward,
-    run_forward,
-)
+from abrupt.detect.orbit.ekf import FilterConfig, run_backward, run_forward
+from abrupt.detect.orbit.kernels import _GL_NODES, _GL_WEIGHTS, _process_noise, propagate_state
 from abrupt.detect.orbit.statistics import fuse, orbital_constant_statistics
 from abrupt.simulate.orbit import OrbitSimulationConfig, simulate_orbit
 
@@ -119,9 +112,12 @@ def real_arc_speed(path: str, nuisance: bool = False) -> None:
     tabulated along the arc (the table's construction is inside the timed analysis)."""
     from dataclasses import replace
 
-    from abrupt.detect.orbit.analysis import OrbitDetectorConfig, analyse, auto_tune, find_events, self_calibrate
+    from abrupt.detect.orbit.analysis import OrbitDetectorConfig, analyse
+    from abrupt.detect.orbit.calibration import self_calibrate
     from abrupt.detect.orbit.detectors import nuisance_force_model
     from abrupt.detect.orbit.ekf import NuisanceConfig
+    from abrupt.detect.orbit.events import find_events
+    from abrupt.detect.orbit.tuning import auto_tune
     from abrupt.readers.sp3 import read_sp3
 
     def with_nuisance(f: FilterConfig) -> FilterConfig:

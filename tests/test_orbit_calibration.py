@@ -7,13 +7,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from abrupt.detect.orbit.analysis import (
-    OrbitDetectorConfig,
-    analyse,
-    auto_tune,
-    find_events,
-    self_calibrate,
-)
+from abrupt.detect.orbit.analysis import OrbitDetectorConfig, analyse
+from abrupt.detect.orbit.calibration import self_calibrate
+from abrupt.detect.orbit.events import find_events
+from abrupt.detect.orbit.tuning import auto_tune
 
 SP3 = "sp3/ssas3a20.b18358.e19003.DG_.sp3"
 

@@ -38,7 +38,8 @@ from dataclasses import dataclass, field
 import numba as nb
 import numpy as np
 
-from abrupt.detect.orbit.ekf import FilterConfig, propagate_state
+from abrupt.detect.orbit.ekf import FilterConfig
+from abrupt.detect.orbit.kernels import propagate_state
 from abrupt.model.orbit import MU_EARTH_M3_S2, ForceContext, orbital_constants
 from abrupt.types import FloatArray
 
