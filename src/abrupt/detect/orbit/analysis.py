@@ -23,9 +23,10 @@ from abrupt.detect.orbit.glr import glr_statistic_from_run
 from abrupt.detect.orbit.statistics import STATISTIC_NAMES, FusionResult, fuse, orbital_constant_statistics
 from abrupt.model.frames import Ephemeris
 from abrupt.model.orbit import ForceContext
+from abrupt.thresholds import FalseAlarmBudget
 from abrupt.types import FloatArray
 
-ONE_PER_WEEK = 1.0 / 7.0  # [false alarms per day]
+ONE_PER_WEEK = FalseAlarmBudget(1.0, "week")
 
 
 @dataclass(frozen=True)
@@ -57,7 +58,7 @@ class OrbitDetectorConfig:
     sigma_pos_m: float = 10.0
     sigma_vel_mps: float = 0.25
     statistic: str = "accel_smoothed"
-    false_alarms_per_day: float = ONE_PER_WEEK
+    budget: FalseAlarmBudget = ONE_PER_WEEK
     settle_s: float = 300.0
     merge_s: float = 600.0
     oc_q_factor: float = 100.0
@@ -72,8 +73,6 @@ class OrbitDetectorConfig:
     def __post_init__(self) -> None:
         if self.statistic not in STATISTIC_NAMES:
             raise ValueError(f"unknown statistic {self.statistic!r}; choose from {STATISTIC_NAMES}")
-        if self.false_alarms_per_day <= 0:
-            raise ValueError("false_alarms_per_day must be positive")
         if self.sigma_pos_m <= 0 or self.sigma_vel_mps <= 0:
             raise ValueError("measurement sigmas must be positive")
         if self.dv_estimate not in ("fb", "glr", "interval"):

@@ -14,7 +14,7 @@ import numpy as np
 from scipy import stats
 
 from abrupt.detect.orbit.analysis import ONE_PER_WEEK, OrbitAnalysis
-from abrupt.thresholds import Threshold, fit_threshold, gpd_return_level_upper, p_fa_per_sample
+from abrupt.thresholds import FalseAlarmBudget, Threshold, fit_threshold, gpd_return_level_upper
 from abrupt.thresholds.noise import robust_scale
 from abrupt.types import FloatArray
 
@@ -26,7 +26,7 @@ def calibrate_thresholds(
     null_statistics: Mapping[str, FloatArray],
     *,
     sample_rate_hz: float,
-    false_alarms_per_day: float = ONE_PER_WEEK,
+    budget: FalseAlarmBudget = ONE_PER_WEEK,
     method: str = "kde",
 ) -> dict[str, Threshold]:
     """Thresholds from event-free statistics at a false-alarm budget (Bennett 2022 §3.4.1: KDE fit, one
@@ -39,7 +39,7 @@ def calibrate_thresholds(
             continue
         out[name] = fit_threshold(
             x,
-            false_alarms_per_day=false_alarms_per_day,
+            budget=budget,
             sample_rate_hz=sample_rate_hz,
             method=method,  # type: ignore[arg-type]
         )
@@ -49,7 +49,7 @@ def calibrate_thresholds(
 def self_calibrate(
     analysis: OrbitAnalysis,
     *,
-    false_alarms_per_day: float | None = None,
+    budget: FalseAlarmBudget | None = None,
     leave_out_s: float | None = None,
     outlier_sigma: float = 6.0,
     episode_sigma: float = 3.0,
@@ -75,7 +75,7 @@ def self_calibrate(
     3. the remaining values are fitted with a generalised Pareto tail (peaks over the 98 % quantile,
        or the top 40 values on short arcs)
        and the threshold is the value exceeded with probability P_fa per sample for the budget
-       ``false_alarms_per_day`` at the data rate;
+       ``budget`` (default the configuration's) at the data rate;
     4. that return level is an estimate, uncertain by an amount that grows as the arc shrinks or the tail
        gets heavier, and an under-estimate raises false alarms. The threshold is therefore the upper
        one-sided bound return level + ``confidence_z`` × its standard error (delta method with the
@@ -90,7 +90,8 @@ def self_calibrate(
     rate = analysis.sample_rate_hz
     if leave_out_s is None:
         leave_out_s = 1800.0
-    fa = false_alarms_per_day if false_alarms_per_day is not None else analysis.config.false_alarms_per_day
+    budget = budget if budget is not None else analysis.config.budget
+    fa = budget.per_day
     out: dict[str, Threshold] = {}
     t = analysis.t_s
     for name in names or tuple(analysis.statistics):
@@ -131,7 +132,7 @@ def self_calibrate(
         if keep.sum() < 100:
             continue
         x = s[keep]
-        p_fa = p_fa_per_sample(fa, rate)
+        p_fa = budget.per_sample(rate)
         # peaks over threshold: the upper 2 % (at least 40 samples) of the kept values
         tail = min(0.5, max(0.02, 40.0 / x.size))
         value = gpd_return_level_upper(x, p_fa, tail_fraction=tail, z=confidence_z)

@@ -151,7 +151,7 @@ class OrbitDetector(Detector[Ephemeris]):
             sigma_vel_mps=self.sigma_vel_mps if self.sigma_vel_mps is not None else float(s_vel),
             settle_s=settle,
             statistic=self.statistic,
-            false_alarms_per_day=budget.per_day,
+            budget=budget,
             kind=self.event_kind,
             orbital_constants=self.statistic in ("d_sma", "d_ecc", "d_hdir"),
         )
@@ -164,11 +164,9 @@ class OrbitDetector(Detector[Ephemeris]):
         analysis = analyse(series, cfg)
         if self._null is not None:
             null = analyse(self._null, cfg)
-            thresholds = calibrate_thresholds(
-                null.statistics, sample_rate_hz=null.sample_rate_hz, false_alarms_per_day=budget.per_day
-            )
+            thresholds = calibrate_thresholds(null.statistics, sample_rate_hz=null.sample_rate_hz, budget=budget)
         else:
-            thresholds = self_calibrate(analysis, false_alarms_per_day=budget.per_day, confidence_z=self.confidence_z)
+            thresholds = self_calibrate(analysis, budget=budget, confidence_z=self.confidence_z)
         warnings: tuple[str, ...] = ()
         if self.statistic not in thresholds:
             warnings = (

@@ -196,9 +196,7 @@ def tau_q_grid(
             fc = replace(base.filter, tau_s=tau, q_rtn_m2_s5=(q, q, q))
             cfg = replace(base, filter=fc)
             null = analyse(null_ephemeris, cfg)
-            thr = calibrate_thresholds(
-                null.statistics, sample_rate_hz=null.sample_rate_hz, false_alarms_per_day=cfg.false_alarms_per_day
-            )
+            thr = calibrate_thresholds(null.statistics, sample_rate_hz=null.sample_rate_hz, budget=cfg.budget)
             snr: dict[str, list[float]] = {k: [] for k in thr}
             for eph, t_strike in strike_cases:
                 an = analyse(eph, cfg)
