@@ -33,7 +33,7 @@ def test_real_arc_without_maneuver_gives_at_most_one_false_alarm_per_week_thresh
     eph = read_sp3(shared_data / SP3, "L74").to_frame("GCRF")
     an = analyse(eph, _real_config(eph))
     events = find_events(an, self_calibrate(an, names=("glr",)))
-    assert len(events) <= 1  # issue 3 acceptance 3 (9.1 days; 1.3 expected at exactly one per week)
+    assert len(events) <= 1  # 9.1 days: 1.3 expected at exactly one per week
 
 
 def test_interval_dv_recovers_injected_impulses_on_real_data_within_five_percent(shared_data: Path) -> None:

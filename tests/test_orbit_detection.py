@@ -192,9 +192,9 @@ def test_finite_reboost_burn_in_a_full_force_truth_is_found_with_its_dv_directio
     t0: float, duration: float, dv: float, days: float, step_s: float
 ) -> None:
     """ISS-like reboosts (400 km, heavy drag, prograde, held in the orbit frame) in a truth with a 20×20
-    field, Sun, Moon, SRP and drag: found, |ΔV| within 10 %, direction within 5°, start within 60 s
-    (issue 10, acceptance 2). The small long one was missed while the self-calibration's leave-out
-    worked on log(GLR): its own GLR values stayed in the tail sample and lifted the threshold to ~10⁴.
+    field, Sun, Moon, SRP and drag: found, |ΔV| within 10 %, direction within 5°, start within 60 s.
+    The small long one is missed when the self-calibration's leave-out works on log(GLR): its own GLR
+    values then stay in the tail sample and lift the threshold to ~10⁴.
     At 240 s (NASA ISS OEM sampling) the 328 s burn straddles an epoch with 70 % of it in one interval:
     it was taken for an impulse there (|ΔV| −14 %, start +124 s) until the duration came from the
     positions across the burn."""

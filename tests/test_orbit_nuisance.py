@@ -1,5 +1,4 @@
-"""Estimated nuisance parameters in the orbit EKF and NRLMSIS drag inside the numba kernels (issue 10,
-build item 2)."""
+"""Estimated nuisance parameters in the orbit EKF and NRLMSIS drag inside the numba kernels."""
 
 from __future__ import annotations
 

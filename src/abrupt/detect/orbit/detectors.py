@@ -208,7 +208,7 @@ class OrbitDetector(Detector[Ephemeris]):
         return tuple(out)
 
 
-#: The registered orbit detectors: one per statistic that can raise events, with its summary.
+#: The statistics that raise events, each the registered detector ``orbit.<statistic>``, with its summary.
 STATISTIC_SUMMARIES: dict[str, str] = {
     "glr": "sliding GLR of a velocity jump in the forward filter's innovations (default)",
     "accel_smoothed": "smoothed unmodelled acceleration (Bennett 2022 TS3)",
