@@ -42,7 +42,6 @@ from abrupt.types import FloatArray
 #: km² reading, erratum noted in the spec, reproduces the ~50 min re-convergence of §3.2.5).
 THESIS_TAU_S = 1.0  # [s]
 THESIS_Q_M2_S5 = 2.15e-11  # [m^2/s^5]
-THESIS_Q_INITIAL_M2_S5 = 2.0e-12  # [m^2/s^5] before tuning (τ = 10 s)
 
 N_CORE = 9  # r, v, w
 N_NUISANCE = 8  # δk_D, δk_SR, C_R, S_R, C_T, S_T, C_N, S_N
