@@ -51,13 +51,7 @@ from abrupt.model.orbit import (
     propagate_with_stm,
 )
 from abrupt.model.orbit.constants import MU_EARTH_M3_S2, OMEGA_EARTH_RAD_S, R_EARTH_M
-from abrupt.model.orbit.forces import (
-    EXPONENTIAL_ATMOSPHERE,
-    F_DRAG_SCALE,
-    F_SRP_SCALE,
-    I_DRAG,
-    exponential_density,
-)
+from abrupt.model.orbit.forces import EXPONENTIAL_ATMOSPHERE, F_DRAG_SCALE, F_SRP_SCALE, I_DRAG, exponential_density
 from abrupt.series.ephemeris import Ephemeris
 from abrupt.types import FloatArray
 from abrupt.units import SECONDS_PER_DAY
