@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -150,7 +151,7 @@ def fit_efficiency(dH_Nms: ArrayLike, found: ArrayLike, *, fit_plateau: bool = F
 def exposure_frame(rows: Sequence[dict[str, object]] | pd.DataFrame) -> pd.DataFrame:
     """Check and coerce exposure rows to :data:`EXPOSURE_COLUMNS` (one-line error naming row and column)."""
     frame = pd.DataFrame(rows).copy()
-    defaults: dict[str, object] = {"efficiency_max": 1.0, "epoch_year": float("nan"), "attitude": "unknown"}
+    defaults: dict[str, Any] = {"efficiency_max": 1.0, "epoch_year": float("nan"), "attitude": "unknown"}
     defaults.update({"detector": "", "config_hash": "", "spacecraft_file": "", "run_id": ""})
     for name, value in defaults.items():
         if name not in frame.columns:
@@ -194,8 +195,8 @@ def exposure_frame(rows: Sequence[dict[str, object]] | pd.DataFrame) -> pd.DataF
 def store_exposure(catalog: Catalog, rows: pd.DataFrame) -> int:
     """Write exposure rows into the catalog's ``exposure`` table (replacing rows with the same key)."""
     frame = exposure_frame(rows)
-    records = [
-        {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in rec.items()}
+    records: list[dict[str, Any]] = [
+        {str(k): (None if isinstance(v, float) and math.isnan(v) else v) for k, v in rec.items()}
         for rec in frame.to_dict("records")
     ]
     with catalog.engine.begin() as conn:

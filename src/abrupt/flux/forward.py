@@ -161,7 +161,7 @@ def smoothed_cumulative(
         minlength=grid.size,
     ).astype(np.float64)
     if width > 0:
-        half = int(math.ceil(4 * width / step))
+        half = math.ceil(4 * width / step)
         x = np.arange(-half, half + 1) * step
         kernel = np.exp(-0.5 * (x / width) ** 2)
         hist = np.convolve(hist, kernel / kernel.sum(), mode="same")

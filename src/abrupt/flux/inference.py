@@ -49,7 +49,7 @@ SCALES: tuple[str, ...] = ("debris_scale", "meteoroid_scale")
 DEFAULT_BETA_GRID = np.exp(np.linspace(math.log(0.1), math.log(100.0), 161))
 
 
-def case_of(row: Mapping[str, Any]) -> OrbitCase:
+def case_of(row: Mapping[Any, Any]) -> OrbitCase:
     """The template key of an exposure row."""
     epoch = float(row["epoch_year"])
     return OrbitCase(
@@ -301,11 +301,11 @@ def fit(
     s, ll = lik.maximise(scale_fixed)
     logb = np.log(lik.beta_grid)
     if lik.beta_grid.size > 1:
-        xb, ll_max, i = _refine_max(logb, ll)
+        xb, ll_max, _ = _refine_max(logb, ll)
         beta_hat = math.exp(xb)
         s_hat = np.array([np.interp(xb, logb, s[:, p]) for p in range(s.shape[1])])
     else:
-        beta_hat, ll_max, i, s_hat = float(lik.beta_grid[0]), float(ll[0]), 0, s[0]
+        beta_hat, ll_max, s_hat = float(lik.beta_grid[0]), float(ll[0]), s[0]
     estimates = {"debris_scale": float(s_hat[0]), "meteoroid_scale": float(s_hat[1]), "beta": beta_hat}
     half = 0.5 * float(stats.chi2.ppf(confidence, 1))
     intervals: dict[str, tuple[float, float]] = {}

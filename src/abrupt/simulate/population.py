@@ -54,7 +54,7 @@ class FleetSpec:
 
 def fleet_exposure(spec: FleetSpec) -> pd.DataFrame:
     """Exposure rows (one per spacecraft-day) of a simulated fleet."""
-    n_days = int(round(spec.years * DAYS_PER_YEAR))
+    n_days = round(spec.years * DAYS_PER_YEAR)
     days = pd.date_range(spec.start_day, periods=n_days, freq="D").strftime("%Y-%m-%d")
     names = [f"{spec.name_prefix}-{i + 1:03d}" for i in range(spec.n_spacecraft)]
     frame = pd.DataFrame(
