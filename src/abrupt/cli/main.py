@@ -13,6 +13,7 @@ from abrupt.cli import (  # noqa: F401  (registration)
     detectors,
     fleet,
     flight,
+    flux,
     laser,
     mass,
     orbit,

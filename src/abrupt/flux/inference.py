@@ -66,6 +66,7 @@ class FluxData:
 
     templates: list[Template]
     exposure_years: NDArray[np.float64]  # (G, K) Σ_d f_d ε_d(x_k) / 365.25 per template group
+    analysed_years: NDArray[np.float64]  # (G,) Σ_d f_d / 365.25 per template group
     background_bins: NDArray[np.float64]  # (K,) expected false alarms per bin (all days)
     event_group: NDArray[np.int64]
     event_bin: NDArray[np.int64]
@@ -133,6 +134,7 @@ def prepare(
     return FluxData(
         templates=tlist,
         exposure_years=exposure_years,
+        analysed_years=np.bincount(group, weights=f, minlength=len(keys)) / DAYS_PER_YEAR,
         background_bins=bg_day.sum(axis=0),
         event_group=group[rows_a],
         event_bin=kbin,

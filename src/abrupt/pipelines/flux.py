@@ -9,16 +9,16 @@ measured cumulative rate against |ΔH| that the report draws.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 import pandas as pd
+import sqlalchemy as sa
 from scipy import stats
 
-from abrupt.catalog import Catalog
+from abrupt.catalog import Catalog, coverage_table
 from abrupt.errors import InputError
 from abrupt.events import new_run_id
 from abrupt.flux.exposure import exposure_summary, exposure_years, load_exposure, store_exposure
@@ -88,38 +88,40 @@ def templates_for(
 
 
 def cumulative_rate(
-    data: FluxData, events_dh: np.ndarray, lik: Likelihood, params: Mapping[str, Mapping[str, float]], cl: float = 0.9
+    data: FluxData, events_dh: np.ndarray, params: Mapping[str, Mapping[str, float]], cl: float = 0.9
 ) -> pd.DataFrame:
-    """Measured rate of strikes with |ΔH| >= x per spacecraft-year (exposure-corrected), with a band,
-    and each model's curve (expected detections >= x divided by the efficiency-weighted exposure)."""
+    """Rate of strikes with |ΔH| >= x per spacecraft-year: measured (each event weighted by 1/exposure at
+    its size, expected false alarms removed, with a Garwood band) where the efficiency-weighted exposure is
+    at least 10 % of the analysed time, and each model's true rate Σ_p s_p G_p(x/β) (fleet average)."""
     cfg = data.templates[0].config
-    edges = cfg.edges_Nms[:-1]
-    expo_k = data.exposure_years.sum(axis=0)  # (K,) efficiency-weighted years at each bin centre
-    centres = cfg.centres_Nms
+    x = cfg.edges_Nms[:-1]
+    expo = data.exposure_years.sum(axis=0)
+    logc = np.log(cfg.centres_Nms)
     with np.errstate(divide="ignore", invalid="ignore"):
-        w_ev = 1.0 / np.interp(np.log(events_dh), np.log(centres), expo_k)
-    out: dict[str, Any] = {"dH_Nms": edges}
-    counts = np.array([(events_dh >= x).sum() for x in edges])
-    bg = np.cumsum(data.background_bins[::-1])[::-1]
+        w_ev = 1.0 / np.interp(np.log(events_dh), logc, expo)
+        expo_x = np.interp(np.log(x), logc, expo)
+    counts = np.array([(events_dh >= v).sum() for v in x])
     mean_w = np.array(
-        [
-            w_ev[events_dh >= x].mean() if n else 1.0 / max(expo_k[i], 1e-300)
-            for i, (x, n) in enumerate(zip(edges, counts, strict=True))
-        ]
+        [w_ev[events_dh >= v].mean() if n else 1.0 / max(e, 1e-300) for v, n, e in zip(x, counts, expo_x, strict=True)]
     )
+    bg = np.cumsum(data.background_bins[::-1])[::-1]
     a = 1.0 - cl
     lo = np.where(counts > 0, stats.chi2.ppf(a / 2, 2 * counts) / 2, 0.0)
     hi = stats.chi2.ppf(1 - a / 2, 2 * counts + 2) / 2
-    out["events_above"] = counts
-    out["rate_per_year"] = np.maximum(counts - bg, 0.0) * mean_w
-    out["rate_lo_per_year"] = np.maximum(lo - bg, 0.0) * mean_w
-    out["rate_hi_per_year"] = np.maximum(hi - bg, 0.0) * mean_w
+    valid = expo_x >= 0.1 * data.analysed_years.sum()
+    out: dict[str, Any] = {"dH_Nms": x, "events_above": counts, "measured": valid}
+    out["rate_per_year"] = np.where(valid, np.maximum(counts - bg, 0.0) * mean_w, np.nan)
+    out["rate_lo_per_year"] = np.where(valid, np.maximum(lo - bg, 0.0) * mean_w, np.nan)
+    out["rate_hi_per_year"] = np.where(valid, np.maximum(hi - bg, 0.0) * mean_w, np.nan)
+    share = data.analysed_years / data.analysed_years.sum()
     for name, p in params.items():
-        b = int(np.argmin(np.abs(np.log(lik.beta_grid) - math.log(p["beta"]))))
-        sig = np.einsum("pk,p->k", lik.bin_signal[b], [p["debris_scale"], p["meteoroid_scale"]])
-        tail = np.cumsum(sig[::-1])[::-1]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            out[f"model:{name}"] = tail / np.maximum(expo_k, 1e-300) * (expo_k > 0)
+        scales = (p["debris_scale"], p["meteoroid_scale"])
+        total = np.zeros(x.size)
+        for g, tpl in enumerate(data.templates):
+            cum = tpl.cumulative.sum(axis=1)  # (P, H)
+            for k in range(len(POPULATIONS)):
+                total += share[g] * scales[k] * np.interp(np.log(x / p["beta"]), tpl.log_h_grid, cum[k])
+        out[f"model:{name}"] = total
     return pd.DataFrame(out)
 
 
@@ -163,7 +165,7 @@ def infer_flux(
     curves = {name: {**p, "beta": reference_beta} for name, p in NAMED_MODELS.items()}
     curves["fitted"] = dict(best)
     ev_dh = _matched_sizes(events, exposure, config)
-    cumulative = cumulative_rate(data, ev_dh, lik, curves)
+    cumulative = cumulative_rate(data, ev_dh, curves)
     doy, showers = shower_association(exposure, events)
     notes = [
         "The |ΔH| spectrum constrains s_p·β^α_p (α_p the local slope of population p); β alone is "
@@ -225,6 +227,23 @@ def simulate_population(
     store_exposure(catalog, exposure)
     catalog.finish_run(run_id, n_found=len(events), n_new=added.events)
     return events, exposure
+
+
+def covered_days(catalog: Catalog, spacecraft: str) -> tuple[str, ...]:
+    """Days (YYYY-MM-DD) a spacecraft's runs covered (coverage records), and days with its events."""
+    ev = catalog.events(spacecraft=spacecraft)
+    days = {str(t)[:10] for t in ev["time_utc"]}
+    with catalog.engine.connect() as conn:
+        cov = pd.read_sql(
+            sa.select(coverage_table.c.start_utc, coverage_table.c.end_utc).where(
+                coverage_table.c.spacecraft == spacecraft
+            ),
+            conn,
+        )
+    for s, e in zip(cov["start_utc"], cov["end_utc"], strict=True):
+        end = pd.Timestamp(e) - pd.Timedelta(microseconds=1)
+        days |= set(pd.date_range(pd.Timestamp(s).normalize(), end, freq="D").strftime("%Y-%m-%d"))
+    return tuple(sorted(days))
 
 
 def exposure_at(exposure: pd.DataFrame, dH_Nms: Sequence[float]) -> np.ndarray:
