@@ -60,6 +60,14 @@ def case_of(row: Mapping[Any, Any]) -> OrbitCase:
     )
 
 
+def case_groups(exposure: pd.DataFrame) -> tuple[list[OrbitCase], NDArray[np.int64]]:
+    """The distinct template keys of exposure rows (in order of appearance) and each row's index into them."""
+    cols = ["spacecraft_file", "altitude_km", "inclination_deg", "epoch_year"]
+    codes = exposure.groupby(cols, sort=False, dropna=False).ngroup().to_numpy()
+    keys = [case_of(rec) for rec in exposure.drop_duplicates(cols).to_dict("records")]
+    return keys, np.asarray(codes, dtype=np.int64)
+
+
 @dataclass
 class FluxData:
     """Arrays of one inference: per-event coefficients and per-template exposure, ready for the likelihood."""
@@ -94,8 +102,7 @@ def prepare(
     exp = exposure_frame(exposure)
     if len(exp) == 0:
         raise InputError("no exposure rows: the catalog holds no analysed spacecraft-days for the flux")
-    cases = [case_of(r) for r in exp.to_dict("records")]
-    keys = list(dict.fromkeys(cases))
+    keys, group = case_groups(exp)
     missing = [k for k in keys if k not in templates]
     if missing:
         raise ConfigError(f"no forward-model template for {missing[0]}", key="templates")
@@ -103,27 +110,31 @@ def prepare(
     config = tlist[0].config
     centres = config.centres_Nms
     edges = config.edges_Nms
-    group = np.array([keys.index(c) for c in cases], dtype=np.int64)
     f = exp["analysed_fraction"].to_numpy()
-    p50, k, emax = (exp[c].to_numpy()[:, None] for c in ("dH50_Nms", "efficiency_slope", "efficiency_max"))
-    eff = logistic_efficiency(centres[None, :], p50, k, emax)  # (D, K)
-    coef = f[:, None] * eff / DAYS_PER_YEAR
-    exposure_years = np.zeros((len(keys), centres.size))
-    np.add.at(exposure_years, group, coef)
-    cdf = logistic_efficiency(edges[None, :-1], p50, k, 1.0)
-    share = np.diff(np.concatenate([cdf, np.ones((len(exp), 1))], axis=1), axis=1)
-    share = share / np.maximum(share.sum(axis=1, keepdims=True), 1e-300)
-    bg_day = (exp["false_alarms_per_day"].to_numpy() * f)[:, None] * share  # (D, K)
-    day_index = {(s, d): i for i, (s, d) in enumerate(zip(exp["spacecraft"], exp["day"], strict=True))}
+    # days share a few efficiency curves: evaluate each distinct curve once
+    curves, curve_of = np.unique(
+        exp.loc[:, ["dH50_Nms", "efficiency_slope", "efficiency_max"]].to_numpy(), axis=0, return_inverse=True
+    )
+    curve_of = curve_of.ravel()
+    eff_u = logistic_efficiency(centres[None, :], curves[:, :1], curves[:, 1:2], curves[:, 2:3])  # (U, K)
+    cdf = logistic_efficiency(edges[None, :-1], curves[:, :1], curves[:, 1:2], 1.0)
+    share_u = np.diff(np.concatenate([cdf, np.ones((len(curves), 1))], axis=1), axis=1)
+    share_u = share_u / np.maximum(share_u.sum(axis=1, keepdims=True), 1e-300)
+    n_u = len(curves)
+    weight = np.bincount(group * n_u + curve_of, weights=f, minlength=len(keys) * n_u).reshape(len(keys), n_u)
+    exposure_years = weight @ eff_u / DAYS_PER_YEAR  # (G, K)
+    fa = exp["false_alarms_per_day"].to_numpy() * f
+    background_bins = np.bincount(curve_of, weights=fa, minlength=n_u) @ share_u
     ev = events[events["kind"].astype(str) == "strike"] if "kind" in events else events
     days = pd.to_datetime(ev["time_utc"].astype(str), utc=True).dt.strftime("%Y-%m-%d")
-    rows = [day_index.get((str(s), str(d)), -1) for s, d in zip(ev["spacecraft"], days, strict=True)]
+    exp_keys = pd.Index(exp["spacecraft"].astype(str) + "|" + exp["day"].astype(str))
+    ev_keys = ev["spacecraft"].astype(str).to_numpy(dtype=object) + "|" + days.to_numpy(dtype=object)
+    rows_a = np.asarray(exp_keys.get_indexer(pd.Index(ev_keys)), dtype=np.int64)
     dh = pd.to_numeric(ev["dH_Nms"], errors="coerce").to_numpy()
     vec = np.full((len(ev), 3), np.nan)
     if use_direction and all(c in ev.columns for c in ORBIT_FRAME_COLUMNS):
         vec = ev.loc[:, list(ORBIT_FRAME_COLUMNS)].apply(pd.to_numeric, errors="coerce").to_numpy()
     cls = direction_class(vec)
-    rows_a = np.asarray(rows, dtype=np.int64)
     if len(ev):
         known_att = exp["attitude"].to_numpy()[np.maximum(rows_a, 0)] == "orbit"
         cls = np.where(known_att, cls, -1)
@@ -131,16 +142,17 @@ def prepare(
     keep = (rows_a >= 0) & np.isfinite(dh) & (kbin >= 0) & (kbin < centres.size)
     rows_a, kbin, cls = rows_a[keep], kbin[keep], cls[keep]
     nc = len(DIRECTION_CLASSES)
+    u_ev = curve_of[rows_a]
     return FluxData(
         templates=tlist,
         exposure_years=exposure_years,
         analysed_years=np.bincount(group, weights=f, minlength=len(keys)) / DAYS_PER_YEAR,
-        background_bins=bg_day.sum(axis=0),
+        background_bins=background_bins,
         event_group=group[rows_a],
         event_bin=kbin,
         event_class=cls,
-        event_coef=coef[rows_a, kbin],
-        event_background=bg_day[rows_a, kbin] / np.where(cls >= 0, nc, 1),
+        event_coef=f[rows_a] * eff_u[u_ev, kbin] / DAYS_PER_YEAR,
+        event_background=fa[rows_a] * share_u[u_ev, kbin] / np.where(cls >= 0, nc, 1),
         observed_bins=np.bincount(kbin, minlength=centres.size).astype(np.int64),
         n_dropped=int((~keep).sum()),
         n_days=len(exp),
@@ -172,14 +184,31 @@ class Likelihood:
         self.bg_events = data.event_background
         self.bg_total = float(data.background_bins.sum())
 
+    def subset(self, keep: NDArray[np.bool_]) -> Likelihood:
+        """The same likelihood on part of the β grid (arrays shared, not recomputed)."""
+        out = object.__new__(Likelihood)
+        out.data, out.beta_grid = self.data, self.beta_grid[keep]
+        out.a, out.totals, out.bin_signal = self.a[keep], self.totals[keep], self.bin_signal[keep]
+        out.bg_events, out.bg_total = self.bg_events, self.bg_total
+        return out
+
+    def _mu(self, scales: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Expected count in each event's (day, class, bin) at every β: Σ_p s_p a_p + background."""
+        mu = self.bg_events[None, :] + self.a[:, :, 0] * scales[:, 0:1]
+        for p in range(1, self.a.shape[2]):
+            mu = mu + self.a[:, :, p] * scales[:, p : p + 1]
+        return np.asarray(mu, dtype=np.float64)
+
     def loglike(self, scales: NDArray[np.float64]) -> NDArray[np.float64]:
         """ln L for scales (nb, P) at every β of the grid."""
-        mu = np.einsum("bep,bp->be", self.a, scales) + self.bg_events[None, :]
+        mu = self._mu(scales)
         with np.errstate(divide="ignore"):
             ev = np.log(mu).sum(axis=1)
         return np.asarray(ev - (scales * self.totals).sum(axis=1) - self.bg_total, dtype=np.float64)
 
-    def maximise(self, fixed: Mapping[str, float], *, iterations: int = 60) -> tuple[NDArray[Any], NDArray[Any]]:
+    def maximise(
+        self, fixed: Mapping[str, float], *, iterations: int = 60, em_iterations: int = 5
+    ) -> tuple[NDArray[Any], NDArray[Any]]:
         """Scales (nb, P) maximising ln L at each β with some scales fixed; returns (scales, ln L)."""
         nb, npop = self.beta_grid.size, len(POPULATIONS)
         free = np.array([SCALES[p] not in fixed for p in range(npop)])
@@ -192,24 +221,36 @@ class Likelihood:
             start = n_ev / np.maximum(self.totals[:, free].sum(axis=1), 1e-300)
             s[:, free] = np.clip(start, 1e-6, 1e9)[:, None]
         idx = np.flatnonzero(free)
-        for _ in range(iterations if idx.size else 0):
-            mu = np.einsum("bep,bp->be", self.a, s) + self.bg_events[None, :]
-            mu = np.maximum(mu, 1e-300)
-            af = self.a[:, :, idx]
-            grad = (af / mu[:, :, None]).sum(axis=1) - self.totals[:, idx]
-            hess = -np.einsum("bei,bej->bij", af / mu[:, :, None], af / mu[:, :, None])
-            hess -= 1e-12 * np.eye(idx.size)[None]
+        if idx.size == 0:
+            return s, self.loglike(s)
+        for _ in range(em_iterations):  # EM (Richardson-Lucy): monotone, keeps scales >= 0
+            mu = np.maximum(self._mu(s), 1e-300)
+            ratio = (self.a[:, :, idx] / mu[:, :, None]).sum(axis=1) / np.maximum(self.totals[:, idx], 1e-300)
+            s[:, idx] *= ratio
+        ll = self.loglike(s)
+        for _ in range(iterations):  # Newton with backtracking, projected on scales >= 0
+            mu = np.maximum(self._mu(s), 1e-300)
+            af = self.a[:, :, idx] / mu[:, :, None]
+            grad = af.sum(axis=1) - self.totals[:, idx]
+            hess = -np.einsum("bei,bej->bij", af, af) - 1e-12 * np.eye(idx.size)[None]
             step = -np.linalg.solve(hess, grad[:, :, None])[:, :, 0]
-            cur = s[:, idx]
-            # at the boundary with the gradient pointing out, stay there
-            stuck = (cur <= 0) & (grad < 0)
-            step = np.where(stuck, 0.0, step)
-            new = cur + step
-            neg = new < 0
-            if neg.any():  # halve toward the bound instead of crossing it
-                new = np.where(neg, np.where(cur > 0, cur * 0.1, 0.0), new)
-            s[:, idx] = new
-            if np.all(np.abs(step) <= 1e-9 * (1.0 + np.abs(cur))):
+            cur = s[:, idx].copy()
+            step = np.where((cur <= 0) & (grad < 0), 0.0, step)  # at the bound, pushing out: stay
+            t = np.ones(self.beta_grid.size)
+            improved = np.zeros(self.beta_grid.size, dtype=bool)
+            for _half in range(30):
+                trial = s.copy()
+                trial[:, idx] = np.maximum(cur + t[:, None] * step, 0.0)
+                ll_t = self.loglike(trial)
+                ok = (ll_t >= ll - 1e-10 * (1.0 + np.abs(ll))) & ~improved
+                s[ok] = trial[ok]
+                ll = np.where(ok, ll_t, ll)
+                improved |= ok
+                if improved.all():
+                    break
+                t = np.where(improved, t, 0.5 * t)
+            moved = np.abs(s[:, idx] - cur).max(axis=1)
+            if np.all(moved <= 1e-10 * (1.0 + np.abs(cur).max(axis=1))):
                 break
         return s, self.loglike(s)
 
@@ -314,10 +355,15 @@ def fit(
     notes: list[str] = []
     if "beta" not in fixed:
         intervals["beta"] = _beta_interval(logb, ll, ll_max - half, notes)
+    # a β whose profile is below the interval's level cannot hold a boundary of a scale's interval
+    near = lik
+    if ll.size > 3:
+        relevant = np.convolve((ll >= ll_max - half - 0.5).astype(float), np.ones(3), mode="same") > 0
+        near = lik.subset(relevant) if relevant.sum() >= 3 else lik
     for p, name in enumerate(SCALES):
         if name in fixed:
             continue
-        intervals[name] = _scale_interval(lik, name, float(s_hat[p]), scale_fixed, ll_max - half)
+        intervals[name] = _scale_interval(near, name, float(s_hat[p]), scale_fixed, ll_max - half)
     b = int(np.argmin(np.abs(logb - math.log(beta_hat))))
     expected = {pop: float(s_hat[p] * lik.totals[b, p]) for p, pop in enumerate(POPULATIONS)}
     expected["false_alarms"] = lik.bg_total
@@ -367,7 +413,7 @@ def _scale_interval(
 
     lo = 0.0
     if s_hat > 0 and f(0.0) < 0:
-        lo = float(optimize.brentq(f, 0.0, s_hat, xtol=1e-6 * max(s_hat, 1e-12), rtol=1e-6))
+        lo = float(optimize.brentq(f, 0.0, s_hat, xtol=1e-5 * max(s_hat, 1e-12), rtol=1e-4))
     hi_b = max(s_hat, 1e-3) * 2.0
     for _ in range(80):
         if f(hi_b) < 0:
@@ -375,7 +421,7 @@ def _scale_interval(
         hi_b *= 2.0
     else:
         return lo, math.inf
-    hi = float(optimize.brentq(f, max(s_hat, 0.0), hi_b, xtol=1e-6 * hi_b, rtol=1e-6))
+    hi = float(optimize.brentq(f, max(s_hat, 0.0), hi_b, xtol=1e-5 * hi_b, rtol=1e-4))
     return lo, hi
 
 

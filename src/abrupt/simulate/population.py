@@ -24,7 +24,7 @@ import pandas as pd
 from abrupt.events import EVENT_COLUMNS, config_hash, make_event_id, normalise_frame
 from abrupt.flux.exposure import DAYS_PER_YEAR, exposure_frame, logistic_efficiency
 from abrupt.flux.forward import ORBIT_FRAME_COLUMNS, POPULATIONS, OrbitCase, Template
-from abrupt.flux.inference import case_of
+from abrupt.flux.inference import case_groups
 
 DETECTOR = "simulate.population"
 
@@ -101,9 +101,7 @@ def draw_population(
     beta = float(truth["beta"])
     scales = [float(truth["debris_scale"]), float(truth["meteoroid_scale"])]
     parts: list[pd.DataFrame] = []
-    cases = [case_of(r) for r in exp.to_dict("records")]
-    keys = list(dict.fromkeys(cases))
-    case_idx = np.array([keys.index(c) for c in cases])
+    keys, case_idx = case_groups(exp)
     f = exp["analysed_fraction"].to_numpy()
     x50, k, emax = (exp[c].to_numpy() for c in ("dH50_Nms", "efficiency_slope", "efficiency_max"))
     for i_key, key in enumerate(keys):
