@@ -29,14 +29,14 @@ def shower_calendar(path: str | Path = CALENDAR_PATH) -> pd.DataFrame:
     """The shower table with day-of-year of start, peak and end (non-leap year)."""
     table = pd.read_csv(path, comment="#")
     for col in ("start", "peak", "end"):
-        table[f"{col}_doy"] = pd.to_datetime("2001-" + table[f"{col}_mmdd"], format="%Y-%m-%d").dt.dayofyear
+        table[f"{col}_doy"] = pd.to_datetime("2001-" + table[f"{col}_mmdd"], format="%Y-%m-%d").dt.day_of_year
     return table
 
 
 def _doy(days: pd.Series) -> np.ndarray:
     """Day of year 1..365 (29 February counted with 28 February)."""
     d = pd.to_datetime(days.astype(str).str[:10], format="%Y-%m-%d")
-    doy = d.dt.dayofyear.to_numpy()
+    doy = d.dt.day_of_year.to_numpy()
     leap = d.dt.is_leap_year.to_numpy() & (doy > 59)
     return np.asarray(doy - leap, dtype=np.int64)
 
