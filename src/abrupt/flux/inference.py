@@ -112,10 +112,9 @@ def prepare(
     edges = config.edges_Nms
     f = exp["analysed_fraction"].to_numpy()
     # days share a few efficiency curves: evaluate each distinct curve once
-    curves, curve_of = np.unique(
-        exp.loc[:, ["dH50_Nms", "efficiency_slope", "efficiency_max"]].to_numpy(), axis=0, return_inverse=True
-    )
-    curve_of = curve_of.ravel()
+    eff_cols = ["dH50_Nms", "efficiency_slope", "efficiency_max"]
+    curve_of = np.asarray(exp.groupby(eff_cols, sort=False).ngroup().to_numpy(), dtype=np.int64)
+    curves = exp.drop_duplicates(eff_cols).loc[:, eff_cols].to_numpy(dtype=np.float64)
     eff_u = logistic_efficiency(centres[None, :], curves[:, :1], curves[:, 1:2], curves[:, 2:3])  # (U, K)
     cdf = logistic_efficiency(edges[None, :-1], curves[:, :1], curves[:, 1:2], 1.0)
     share_u = np.diff(np.concatenate([cdf, np.ones((len(curves), 1))], axis=1), axis=1)
