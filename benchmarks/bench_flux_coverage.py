@@ -107,6 +107,8 @@ def main() -> None:
                 ("C", ("debris_scale", "meteoroid_scale", "beta")),
             ):
                 for p in params:
+                    if not rows[fit_name]:
+                        continue
                     cov, bias, mbias, width = interval_stats(rows[fit_name], p, truth[p])
                     summary.append((label, fit_name, p, cov, bias, mbias, width))
                     print(

@@ -149,24 +149,29 @@ def direction_class(dH_vec: NDArray[np.float64]) -> NDArray[np.int64]:
 def smoothed_cumulative(
     log_h: NDArray[np.float64], rate: NDArray[np.float64], grid: NDArray[np.float64], width: float
 ) -> NDArray[np.float64]:
-    """Σ_i rate_i Φ((ln h_i − ln h)/w) on a grid of ln h: the cumulative rate >= h, kernel-smoothed.
+    """Cumulative rate G(h) = Σ_{h_i >= h} rate_i on a grid of ln h, with ln G smoothed in ln h.
 
-    The importance-weighted draws are few where |ΔH| is large; a kernel of width w in ln|ΔH| (about the
-    relative error of a measured |ΔH|) makes the template, and the likelihood, smooth in β.
+    The importance-weighted draws are few where |ΔH| is large; a Gaussian kernel of width w in ln|ΔH|
+    applied to ln G (normalised over the grid points where G > 0) makes the template, and the likelihood,
+    smooth in β without biasing a power law (ln G linear in ln h is unchanged by the kernel; smoothing G
+    itself would raise a power law of slope α by exp(α²w²/2)).
     """
     step = float(grid[1] - grid[0])
-    hist = np.bincount(
-        np.clip(np.round((log_h - grid[0]) / step).astype(np.int64), 0, grid.size - 1),
-        weights=rate,
-        minlength=grid.size,
-    ).astype(np.float64)
-    if width > 0:
-        half = math.ceil(4 * width / step)
-        x = np.arange(-half, half + 1) * step
-        kernel = np.exp(-0.5 * (x / width) ** 2)
-        hist = np.convolve(hist, kernel / kernel.sum(), mode="same")
-    tail = np.cumsum(hist[::-1])[::-1]
-    return np.asarray(tail, dtype=np.float64)
+    idx = np.floor((log_h - grid[0]) / step).astype(np.int64)  # node j holds draws in [g_j, g_j+1)
+    keep = idx >= 0
+    hist = np.bincount(np.minimum(idx[keep], grid.size - 1), weights=rate[keep], minlength=grid.size)
+    tail = np.cumsum(hist[::-1])[::-1].astype(np.float64)  # exact at every node: draws with ln h >= g_j
+    if width <= 0:
+        return np.asarray(tail, dtype=np.float64)
+    half = math.ceil(4 * width / step)
+    x = np.arange(-half, half + 1) * step
+    kernel = np.exp(-0.5 * (x / width) ** 2)
+    valid = tail > 0
+    log_g = np.where(valid, np.log(np.where(valid, tail, 1.0)), 0.0)
+    num = np.convolve(log_g, kernel, mode="same")
+    den = np.convolve(valid.astype(np.float64), kernel, mode="same")
+    out = np.where(valid, np.exp(num / np.maximum(den, 1e-300)), 0.0)
+    return np.asarray(out, dtype=np.float64)
 
 
 def build_template(case: OrbitCase, config: ForwardConfig, *, n_grid: int = 400) -> Template:
