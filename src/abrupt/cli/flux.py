@@ -13,7 +13,7 @@ import pandas as pd
 from abrupt.catalog import Catalog
 from abrupt.cli.groups import DEFAULT_CATALOG, cli, note, simulate
 from abrupt.errors import ConfigError
-from abrupt.flux.exposure import EfficiencyCurve, exposure_frame, fit_efficiency, store_exposure
+from abrupt.flux.exposure import EfficiencyCurve, efficiency_per_day, exposure_frame, store_exposure
 from abrupt.flux.forward import ForwardConfig
 from abrupt.flux.inference import PARAMS
 from abrupt.pipelines.flux import covered_days, infer_flux, simulate_population
@@ -121,7 +121,9 @@ def infer(
 @click.option("--altitude-km", type=float, required=True)
 @click.option("--inclination-deg", type=float, required=True)
 @click.option("--epoch", "epoch_year", type=float, default=2020.0, show_default=True)
-@click.option("--analysed-fraction", type=float, default=1.0, show_default=True)
+@click.option(
+    "--analysed-fraction", default="1.0", show_default=True, help="One value, or one per day (comma-separated)."
+)
 @click.option("--false-alarms-per-day", type=float, required=True, help="Rate the threshold was set for.")
 @click.option(
     "--recovery",
@@ -141,7 +143,7 @@ def exposure_command(
     altitude_km: float,
     inclination_deg: float,
     epoch_year: float,
-    analysed_fraction: float,
+    analysed_fraction: str,
     false_alarms_per_day: float,
     recovery_csv: str | None,
     dh90: float | None,
@@ -150,41 +152,44 @@ def exposure_command(
 ) -> None:
     """Store exposure rows (one per spacecraft-day) in a catalog, beside its events."""
     cat = Catalog(catalog_target, create=False)
-    if recovery_csv:
-        inj = pd.read_csv(recovery_csv)
-        curve = fit_efficiency(inj["dH_Nms"].to_numpy(), inj["found"].astype(bool).to_numpy())
-    elif dh90:
-        curve = EfficiencyCurve.from_dH90(dh90, slope)
-    else:
-        raise click.UsageError("give --recovery CSV or --dH90")
     if not days:
         days = covered_days(cat, spacecraft)
     if not days:
         raise click.UsageError(f"no days found for {spacecraft} in {catalog_target}; give --days")
+    if recovery_csv:
+        curves = efficiency_per_day(pd.read_csv(recovery_csv), days, source=recovery_csv)
+    elif dh90:
+        curves = dict.fromkeys(days, EfficiencyCurve.from_dH90(dh90, slope))
+    else:
+        raise click.UsageError("give --recovery CSV or --dH90")
+    fractions = [float(x) for x in str(analysed_fraction).split(",")]
+    if len(fractions) not in (1, len(days)):
+        raise click.UsageError(f"--analysed-fraction: give one value or one per day ({len(days)})")
     rows = exposure_frame(
         [
             {
                 "spacecraft": spacecraft,
                 "day": d,
                 "detector": detector,
-                "analysed_fraction": analysed_fraction,
+                "analysed_fraction": fractions[i % len(fractions)],
                 "false_alarms_per_day": false_alarms_per_day,
-                "dH50_Nms": curve.dH50_Nms,
-                "efficiency_slope": curve.slope,
-                "efficiency_max": curve.max_efficiency,
+                "dH50_Nms": curves[d].dH50_Nms,
+                "efficiency_slope": curves[d].slope,
+                "efficiency_max": curves[d].max_efficiency,
                 "altitude_km": altitude_km,
                 "inclination_deg": inclination_deg,
                 "epoch_year": epoch_year,
                 "spacecraft_file": str(Path(spacecraft_file).resolve()),
                 "attitude": attitude,
             }
-            for d in days
+            for i, d in enumerate(days)
         ]
     )
     n = store_exposure(cat, rows)
-    click.echo(
-        f"stored {n} exposure rows for {spacecraft} ({days[0]} .. {days[-1]}); ΔH90 = {curve.dH90_Nms:.4g} N·m·s"
-    )
+    for d in days:
+        c = curves[d]
+        click.echo(f"{spacecraft} {d}: x50 {c.dH50_Nms:.4g} N·m·s, slope {c.slope:.3g}, plateau {c.max_efficiency:.3f}")
+    click.echo(f"stored {n} exposure rows for {spacecraft} ({days[0]} .. {days[-1]}) in {cat.name}")
 
 
 @simulate.command("population")

@@ -148,6 +148,32 @@ def fit_efficiency(dH_Nms: ArrayLike, found: ArrayLike, *, fit_plateau: bool = F
     return EfficiencyCurve(float(math.exp(res.x[0])), float(math.exp(res.x[1])), float(emax))
 
 
+def efficiency_per_day(
+    injections: pd.DataFrame, days: Sequence[str], *, source: str = "recovery table"
+) -> dict[str, EfficiencyCurve]:
+    """Efficiency curve per day from an injection-recovery table (``dH_Nms``, ``found``, optional ``day``).
+
+    Each day with injections that bracket the threshold gets its own fit (plateau included); a day
+    without (no injections, or all or none recovered) gets the fit of all days pooled.
+    """
+    for col in ("dH_Nms", "found"):
+        if col not in injections.columns:
+            raise InputError(f"{source}: no column {col!r} (expected dH_Nms, found[, day])")
+    found = injections["found"].astype(str).str.lower().isin(("true", "1", "yes"))
+    sizes = pd.to_numeric(injections["dH_Nms"], errors="coerce").to_numpy()
+    pooled = fit_efficiency(sizes, found.to_numpy(), fit_plateau=True)
+    out: dict[str, EfficiencyCurve] = {}
+    for day in days:
+        out[day] = pooled
+        if "day" in injections.columns:
+            sel = (injections["day"].astype(str) == day).to_numpy()
+            try:
+                out[day] = fit_efficiency(sizes[sel], found.to_numpy()[sel], fit_plateau=True)
+            except InputError:
+                pass  # too few or unbracketed injections on this day: the pooled curve
+    return out
+
+
 def exposure_frame(rows: Sequence[dict[str, object]] | pd.DataFrame) -> pd.DataFrame:
     """Check and coerce exposure rows to :data:`EXPOSURE_COLUMNS` (one-line error naming row and column)."""
     frame = pd.DataFrame(rows).copy()
