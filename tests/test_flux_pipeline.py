@@ -125,3 +125,52 @@ def test_shower_calendar_is_documented_and_consistent() -> None:
         s, p, e = rec["start_doy"], rec["peak_doy"], rec["end_doy"]
         span, at = (e - s) % 365, (p - s) % 365
         assert at <= span, rec["code"]
+
+
+def test_efficiency_per_day_fits_each_bracketed_day_and_pools_the_others() -> None:
+    from abrupt.flux.exposure import EfficiencyCurve, efficiency_per_day
+
+    rng = np.random.default_rng(4)
+    truth = EfficiencyCurve(0.01, 6.0)
+    sizes = np.exp(rng.uniform(math.log(1e-3), math.log(0.1), 3000))
+    table = pd.DataFrame({"day": "2026-01-01", "dH_Nms": sizes, "found": rng.random(sizes.size) < truth(sizes)})
+    easy = pd.DataFrame({"day": "2026-01-02", "dH_Nms": [0.05, 0.08, 0.1], "found": [True, True, True]})
+    curves = efficiency_per_day(pd.concat([table, easy]), ["2026-01-01", "2026-01-02", "2026-01-03"])
+    assert curves["2026-01-01"].dH50_Nms == pytest.approx(0.01, rel=0.08)
+    assert curves["2026-01-02"] == curves["2026-01-03"]  # all found / no injections: the pooled fit
+
+
+def test_flux_exposure_command_stores_one_row_per_covered_day(tmp_path) -> None:
+    from abrupt.catalog import Catalog
+    from abrupt.flux.exposure import load_exposure
+
+    cat = Catalog(tmp_path / "c.sqlite")
+    ev = pd.DataFrame(
+        {
+            "event_id": ["a", "b"],
+            "spacecraft": "SC-X",
+            "kind": "strike",
+            "detector": "attitude.glr",
+            "time_utc": ["2026-03-10T01:00:00Z", "2026-03-12T01:00:00Z"],
+            "run_id": "r",
+            "config_hash": "h",
+        }
+    )
+    from abrupt.events import EVENT_COLUMNS
+
+    for c in EVENT_COLUMNS:
+        if c not in ev:
+            ev[c] = np.nan
+    cat.store_events(ev)
+    r = CliRunner().invoke(
+        cli,
+        [
+            "flux", "exposure", "--catalog", str(tmp_path / "c.sqlite"), "--spacecraft", "SC-X",
+            "--spacecraft-file", FERMI, "--altitude-km", "550", "--inclination-deg", "28.5",
+            "--false-alarms-per-day", "0.5", "--dH90", "0.02",
+        ],
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    rows = load_exposure(Catalog(tmp_path / "c.sqlite", create=False))
+    assert list(rows["day"]) == ["2026-03-10", "2026-03-12"]
+    assert rows["false_alarms_per_day"].tolist() == [0.5, 0.5]
