@@ -10,7 +10,14 @@ import pytest
 from scipy import stats
 
 from abrupt.catalog import Catalog
-from abrupt.flux.exposure import DAYS_PER_YEAR, EfficiencyCurve, fit_efficiency, load_exposure, store_exposure
+from abrupt.flux.exposure import (
+    DAYS_PER_YEAR,
+    EfficiencyCurve,
+    exposure_years,
+    fit_efficiency,
+    load_exposure,
+    store_exposure,
+)
 from abrupt.flux.forward import DIRECTION_CLASSES, ForwardConfig, OrbitCase, Template
 from abrupt.flux.inference import fit, goodness_of_fit, poisson_upper_limit, prepare, upper_limit
 from abrupt.simulate.population import FleetSpec, fleet_exposure
@@ -162,6 +169,8 @@ def test_exposure_round_trips_through_the_catalog(tmp_path) -> None:
     assert store_exposure(cat, exp) == len(exp)  # replaced, not duplicated
     back = load_exposure(cat)
     assert len(back) == len(exp)
+    # efficiency ≈ 1 at 0.1 N·m·s on every full day: the exposure is the analysed time in years
+    assert exposure_years(back, [0.1])[0] == pytest.approx(len(exp) / DAYS_PER_YEAR, rel=1e-9)
     pd.testing.assert_frame_equal(back.reset_index(drop=True), exp.reset_index(drop=True), check_dtype=False)
 
 

@@ -204,11 +204,6 @@ def build_template(case: OrbitCase, config: ForwardConfig, *, n_grid: int = 400)
     return Template(case, config, grid, cum, total, samples)
 
 
-def nominal_params(beta: float = 1.0) -> dict[str, float]:
-    """The published models: both scales 1 and a given β."""
-    return {"debris_scale": 1.0, "meteoroid_scale": 1.0, "beta": beta}
-
-
 def with_seed(config: ForwardConfig, seed: int) -> ForwardConfig:
     """The same model with another Monte Carlo seed (an independent template)."""
     return replace(config, seed=seed)

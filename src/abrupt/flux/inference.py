@@ -303,11 +303,6 @@ class FitResult:
         }
 
 
-def profile_beta(lik: Likelihood, fixed: Mapping[str, float]) -> tuple[NDArray[Any], NDArray[Any]]:
-    """ln L profiled over the free scales at each β of the grid (β fixed: only that β)."""
-    return lik.maximise(fixed)
-
-
 def _profile_value(lik: Likelihood, fixed: Mapping[str, float]) -> float:
     """max over β and the free scales of ln L with some scales fixed."""
     _, ll = lik.maximise(fixed)

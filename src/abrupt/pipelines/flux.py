@@ -21,7 +21,7 @@ from scipy import stats
 from abrupt.catalog import Catalog, coverage_table
 from abrupt.errors import InputError
 from abrupt.events import new_run_id
-from abrupt.flux.exposure import exposure_summary, exposure_years, load_exposure, store_exposure
+from abrupt.flux.exposure import exposure_summary, load_exposure, store_exposure
 from abrupt.flux.forward import POPULATIONS, ForwardConfig, OrbitCase, Template, build_template, with_seed
 from abrupt.flux.inference import (
     FitResult,
@@ -244,8 +244,3 @@ def covered_days(catalog: Catalog, spacecraft: str) -> tuple[str, ...]:
         end = pd.Timestamp(e) - pd.Timedelta(microseconds=1)
         days |= set(pd.date_range(pd.Timestamp(s).normalize(), end, freq="D").strftime("%Y-%m-%d"))
     return tuple(sorted(days))
-
-
-def exposure_at(exposure: pd.DataFrame, dH_Nms: Sequence[float]) -> np.ndarray:
-    """Efficiency-weighted exposure [years] of all rows at some |ΔH| (for reports)."""
-    return exposure_years(exposure, np.asarray(dH_Nms, dtype=np.float64))
