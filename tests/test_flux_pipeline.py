@@ -174,3 +174,24 @@ def test_flux_exposure_command_stores_one_row_per_covered_day(tmp_path) -> None:
     rows = load_exposure(Catalog(tmp_path / "c.sqlite", create=False))
     assert list(rows["day"]) == ["2026-03-10", "2026-03-12"]
     assert rows["false_alarms_per_day"].tolist() == [0.5, 0.5]
+
+
+@pytest.mark.parametrize("slope", [4.0, 40.0])
+def test_no_detections_on_three_simulated_spacecraft_years_bound_the_flux_at_2_996_events(slope: float) -> None:
+    """Acceptance: a simulated fleet (3 Fermi-like spacecraft × 1 year) with no detections. The 95 % upper
+    limit times the expected detections at scale 1, the latter integrated independently on a fine grid
+    (20 000 points of ε(x) dG), equals −ln 0.05 = 2.996 within 1 %, for a gentle and a step-like efficiency."""
+    from abrupt.flux.exposure import logistic_efficiency
+    from abrupt.flux.inference import upper_limit
+
+    spec = FleetSpec(FERMI, n_spacecraft=3, years=1.0, dH50_Nms=0.01, efficiency_slope=slope, false_alarms_per_day=0)
+    tpl = build_template(spec.case, ForwardConfig(n_draws=50_000))
+    exp = fleet_exposure(spec)
+    no_events = pd.DataFrame({"spacecraft": [], "kind": [], "time_utc": [], "dH_Nms": []})
+    ul = upper_limit(prepare(exp, no_events, {spec.case: tpl}), "debris", beta=1.0, other_scale=0.0)
+    assert ul["n_observed"] == 0
+    lg = np.linspace(math.log(1e-4), math.log(1e3), 20_000)
+    cum = np.exp(np.interp(lg, tpl.log_h_grid, np.log(np.maximum(tpl.cumulative[0].sum(axis=0), 1e-300))))
+    eps = logistic_efficiency(np.exp(0.5 * (lg[1:] + lg[:-1])), 0.01, slope)
+    signal = float(np.sum(eps * -np.diff(cum))) * exp["analysed_fraction"].sum() / DAYS_PER_YEAR
+    assert ul["scale_upper_limit"] * signal == pytest.approx(-math.log(0.05), rel=0.01)

@@ -60,6 +60,20 @@ def case_of(row: Mapping[Any, Any]) -> OrbitCase:
     )
 
 
+def bin_efficiency(edges: NDArray[np.float64], curves: NDArray[np.float64], n_sub: int = 16) -> NDArray[np.float64]:
+    """Mean efficiency over each |ΔH| bin (points uniform in ln|ΔH|; the open top bin over one bin width),
+    for curves (U, 3) of (x50, slope, plateau), so that steep curves are not sampled at the centre only."""
+    lo = np.log(edges[:-1])
+    upper = np.append(edges[1:-1], edges[-2] * (edges[-2] / edges[-3]))
+    hi = np.log(upper)
+    t = (np.arange(n_sub) + 0.5) / n_sub
+    x = np.exp(lo[:, None] + (hi - lo)[:, None] * t[None, :])  # (K, S)
+    eff = logistic_efficiency(
+        x[None, :, :], curves[:, 0, None, None], curves[:, 1, None, None], curves[:, 2, None, None]
+    )
+    return np.asarray(eff.mean(axis=2), dtype=np.float64)
+
+
 def case_groups(exposure: pd.DataFrame) -> tuple[list[OrbitCase], NDArray[np.int64]]:
     """The distinct template keys of exposure rows (in order of appearance) and each row's index into them."""
     cols = ["spacecraft_file", "altitude_km", "inclination_deg", "epoch_year"]
@@ -115,7 +129,7 @@ def prepare(
     eff_cols = ["dH50_Nms", "efficiency_slope", "efficiency_max"]
     curve_of = np.asarray(exp.groupby(eff_cols, sort=False).ngroup().to_numpy(), dtype=np.int64)
     curves = exp.drop_duplicates(eff_cols).loc[:, eff_cols].to_numpy(dtype=np.float64)
-    eff_u = logistic_efficiency(centres[None, :], curves[:, :1], curves[:, 1:2], curves[:, 2:3])  # (U, K)
+    eff_u = bin_efficiency(edges, curves)  # (U, K)
     cdf = logistic_efficiency(edges[None, :-1], curves[:, :1], curves[:, 1:2], 1.0)
     share_u = np.diff(np.concatenate([cdf, np.ones((len(curves), 1))], axis=1), axis=1)
     share_u = share_u / np.maximum(share_u.sum(axis=1, keepdims=True), 1e-300)
