@@ -68,7 +68,7 @@ LAZY_THIRD_PARTY: dict[str, tuple[str, ...] | None] = {
 
 #: Modules allowed to import by name at run time (``importlib.import_module``): the command line's lazy
 #: sub-command loader, so that ``abrupt --help`` does not import every capability.
-DYNAMIC_IMPORTERS = frozenset({"cli/groups.py"})
+DYNAMIC_IMPORTERS = frozenset({"cli/commands.py"})
 
 MAX_MODULE_LINES = 700
 MAX_FUNCTION_LINES = 120

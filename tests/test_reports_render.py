@@ -135,8 +135,8 @@ def test_tracking_log_axis_has_several_labelled_ticks_over_a_narrow_span(tmp_pat
 
 
 def test_rate_plot_uncertainty_is_the_binomial_standard_error() -> None:
-    from abrupt.rates.plots import detectable_rate_sigma
     from abrupt.rates.trades import CaseResult
+    from abrupt.report.rates import detectable_rate_sigma
 
     rng = np.random.default_rng(1)
     dh = rng.lognormal(0.0, 1.0, 4000)
