@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from abrupt.errors import InputError
 from abrupt.model.orbit import MU_EARTH_M3_S2, coe_to_rv
@@ -213,7 +214,6 @@ def write_od_input(
     mu_m3_s2: float = MU_EARTH_M3_S2,
 ) -> None:
     """Write an Orekit-style input file that :func:`read_od_input` reads back (used by the simulator)."""
-    import pandas as pd
 
     lines = [
         "## written by abrupt simulate tracking (Orekit orbit-determination input syntax)",

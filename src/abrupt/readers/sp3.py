@@ -41,11 +41,15 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import erfa
 import numpy as np
+from astropy.time import Time
 from numpy.typing import NDArray
 
 from abrupt.errors import InputError, RepairLog
+from abrupt.model.timescales import offline_astropy
 from abrupt.readers.compression import read_bytes
+from abrupt.readers.timesystems import to_utc_counted
 from abrupt.series.ephemeris import Ephemeris
 
 #: Offsets of SP3 time systems from TAI (s): t_TAI = t_sys + offset (GPS ICD, Galileo OS SIS ICD,
@@ -193,7 +197,6 @@ def _resolve_rollover(
 
 
 def _to_utc(t_sys: NDArray[np.datetime64], time_system: str, log: RepairLog) -> NDArray[np.datetime64]:
-    from abrupt.readers.timesystems import to_utc_counted
 
     if time_system == "UTC":
         return t_sys
@@ -206,15 +209,12 @@ def _to_utc(t_sys: NDArray[np.datetime64], time_system: str, log: RepairLog) -> 
 
 def _from_utc(t_utc: NDArray[np.datetime64], time_system: str) -> NDArray[np.datetime64]:
     """Inverse of :func:`_to_utc` (for the writer)."""
-    from abrupt.model.timescales import offline_astropy
 
     if time_system == "UTC":
         return t_utc
     if time_system == "GLO":
         return t_utc + np.timedelta64(3, "h")
     offline_astropy()
-    import erfa
-    from astropy.time import Time
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", erfa.ErfaWarning)  # beyond the leap-second table: TAI-UTC held
@@ -661,9 +661,6 @@ def write_sp3(
         smallest = int(steps_ns.min())
         if smallest > 0 and np.all(steps_ns % smallest == 0):
             step_s = smallest * 1e-9
-    from astropy.time import Time
-
-    from abrupt.model.timescales import offline_astropy
 
     offline_astropy()
     t0 = all_t[0]
