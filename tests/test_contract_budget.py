@@ -30,6 +30,12 @@ def test_per_block_is_the_poisson_probability_of_at_least_one_alarm() -> None:
     assert b.per_block(43200.0) == pytest.approx(1 - math.exp(-1.0))
 
 
+def test_per_block_first_order_is_the_expected_count_in_a_block() -> None:
+    b = FalseAlarmBudget(1, "week")
+    assert b.per_block_first_order(600.0) == (1 / 7) * 600.0 / 86400.0
+    assert b.per_block(600.0) == pytest.approx(b.per_block_first_order(600.0), rel=1e-3)
+
+
 def test_bonferroni_split_keeps_the_total_rate() -> None:
     b = FalseAlarmBudget(1, "week").bonferroni(4)
     assert b.per_day * 4 == pytest.approx(1 / 7)

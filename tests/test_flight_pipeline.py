@@ -21,6 +21,7 @@ from abrupt.pipelines.flight import CleaningConfig, FlightRunConfig, ingest_arch
 from abrupt.readers.archive import read_archive, read_decoder
 from abrupt.series.timetable import channel_on_grid, continuous_quaternion, grid
 from abrupt.store import TelemetryStore
+from abrupt.thresholds import FalseAlarmBudget
 from abrupt.thresholds.robust import gumbel_quantile_fit, robust_block_maxima_threshold
 from flight_synth import REAL, make_archive
 
@@ -416,7 +417,7 @@ def test_robust_gumbel_threshold_against_scipy() -> None:
     m, b = gumbel_quantile_fit(x)
     assert m == pytest.approx(mu, abs=0.05) and b == pytest.approx(beta, rel=0.08)
     contaminated = np.concatenate([x, np.full(40, 500.0)])  # 1% of blocks with strikes
-    thr = robust_block_maxima_threshold(contaminated, block_s=600.0, false_alarms_per_day=1.0)
+    thr = robust_block_maxima_threshold(contaminated, block_s=600.0, budget=FalseAlarmBudget(1.0, "day"))
     expected = stats.gumbel_r.isf(600.0 / 86400.0, loc=mu, scale=beta)
     assert thr.value == pytest.approx(expected, rel=0.03)
 

@@ -40,6 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, special, stats
 
 from abrupt.thresholds.budget import SECONDS_PER_DAY, FalseAlarmBudget
+from abrupt.thresholds.noise import robust_scale
 
 FitMethod = Literal["gaussian", "gamma", "kde", "empirical", "gpd", "gev"]
 FIT_METHODS: tuple[str, ...] = ("gaussian", "gamma", "kde", "empirical", "gpd", "gev")
@@ -302,8 +303,6 @@ def robust_gaussian_threshold(
     samples, so the median and MAD are those of the event-free statistic. ``z`` is the Gaussian upper
     ``p_fa/2`` point (two-sided) or ``p_fa`` point. ``p_fa`` is per sample.
     """
-    from abrupt.thresholds.noise import robust_scale
-
     x = np.asarray(statistic, dtype=np.float64).ravel()
     x = x[np.isfinite(x)]
     if x.size < 10:
