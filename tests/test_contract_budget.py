@@ -79,3 +79,16 @@ def test_bad_detector_names_are_refused() -> None:
 def test_unknown_detector_lists_the_registered_ones() -> None:
     with pytest.raises(KeyError, match="unknown detector"):
         get_detector("no_such_detector", capability="attitude")
+
+
+def test_a_run_config_hash_is_the_hash_of_name_settings_and_budget() -> None:
+    from abrupt.detect.base import get_detector
+    from abrupt.events import config_hash, run_config_hash
+
+    budget = FalseAlarmBudget(1, "week")
+    settings = {"null_samples": 200_000}
+    assert run_config_hash(settings, budget, detector="attitude.cusum") == config_hash(
+        {"detector": "attitude.cusum", **settings, "budget": "1/week"}
+    )
+    detector = get_detector("attitude.cusum")(null_samples=200_000)
+    assert detector.config_hash_for(budget) == run_config_hash(detector.config(), budget, detector="attitude.cusum")

@@ -64,6 +64,13 @@ def config_hash(config: Mapping[str, Any] | Any) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
+def run_config_hash(settings: Mapping[str, Any], budget: object, *, detector: str | None = None) -> str:
+    """The ``config_hash`` of ``settings`` run at a false-alarm ``budget`` (by ``detector`` if named):
+    ``config_hash({"detector": detector, **settings, "budget": str(budget)})``, spelled once."""
+    named = {"detector": detector} if detector is not None else {}
+    return config_hash({**named, **settings, "budget": str(budget)})
+
+
 def _json_default(obj: Any) -> Any:
     if isinstance(obj, np.ndarray):
         return obj.tolist()
