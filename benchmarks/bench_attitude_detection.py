@@ -246,4 +246,8 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    name = "bench_attitude_false_alarms" if variant({"--part=c": "c"}) else "bench_attitude_detection"
+    with write_results(name, variant({"--quick": "quick"})):
+        main()

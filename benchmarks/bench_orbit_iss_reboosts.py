@@ -119,4 +119,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results("bench_orbit_iss_reboosts", variant({"--step-s=240": "240s"})):
+        main()

@@ -530,4 +530,9 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results(
+        "bench_orbit_montecarlo", variant({"--only-perturbed": "perturbed", "--tuned": "tuned", "--quick": "quick"})
+    ):
+        main()

@@ -164,4 +164,7 @@ def analyse_cached(an: OrbitAnalysis, name: str, dv_estimate: str | None = None)
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results("bench_orbit_real", variant({"--arc-days=2": "2day", "--quick": "quick"})):
+        main()

@@ -135,4 +135,9 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results(
+        "bench_orbit_real_arcs", variant({"--arc=s3a": "s3a", "--arc=jason1": "jason1", "--quick": "quick"})
+    ):
+        main()

@@ -170,13 +170,15 @@ def real_arc_speed(path: str, nuisance: bool = False) -> None:
 
 if __name__ == "__main__":
     import sys
+    from pathlib import Path
 
-    if "--real-only" not in sys.argv:
-        main()
-    if "--real" in sys.argv or "--real-only" in sys.argv:
-        from pathlib import Path
+    from _results import variant, write_results
 
-        real_arc_speed(
-            str(Path(__file__).resolve().parents[1].parent / "shared/data/sp3/ssas3a20.b18358.e19003.DG_.sp3"),
-            nuisance="--nuisance" in sys.argv,
-        )
+    with write_results("bench_orbit_speed", variant({"--real-only": "real", "--nuisance": "nuisance"})):
+        if "--real-only" not in sys.argv:
+            main()
+        if "--real" in sys.argv or "--real-only" in sys.argv:
+            real_arc_speed(
+                str(Path(__file__).resolve().parents[1].parent / "shared/data/sp3/ssas3a20.b18358.e19003.DG_.sp3"),
+                nuisance="--nuisance" in sys.argv,
+            )
