@@ -1,4 +1,4 @@
-"""Attitude change detection: thesis reproduction (issue 2, acceptance 2) and power curves (acceptance 3).
+"""Attitude change detection: thesis reproduction and power curves.
 
 Run:  python benchmarks/bench_attitude_detection.py [--quick] [--runs N] [--plot PATH]
 

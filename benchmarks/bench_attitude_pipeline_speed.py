@@ -1,4 +1,4 @@
-"""Wall time of the attitude pipeline (issue 8: the refactoring must not slow detection down).
+"""Wall time of the attitude pipeline (the refactoring must not slow detection down).
 
 Simulates one hour of 10 Hz telemetry of the thesis spacecraft with one strike, runs
 ``abrupt.pipelines.attitude.detect_attitude`` with glr, cusum and summation (thresholds from 2e6

@@ -1,4 +1,4 @@
-"""Attitude simulator: physics checks, agreement with Basilisk and speed (issue 2, acceptance 1 and 4).
+"""Attitude simulator: physics checks, agreement with Basilisk and speed.
 
 Prints, beside the issue's targets:
 

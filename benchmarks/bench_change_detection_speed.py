@@ -1,4 +1,4 @@
-"""Change-detector throughput on one core and streaming memory over a long stream (issue 2, acceptance 4).
+"""Change-detector throughput on one core and streaming memory over a long stream.
 
 Run:  python benchmarks/bench_change_detection_speed.py [--quick]
 

@@ -1,4 +1,4 @@
-"""Acceptance 3 and 4a (issue 14): ρB from real TLE histories against NRLMSIS along the same orbits.
+"""ρB from real TLE histories against NRLMSIS along the same orbits.
 
 For CryoSat-2 (~720 km, 2010-2022) and Sentinel-3A (815 km, 2016-2022): 30-day windows, maneuvers
 removed with abrupt's TLE maneuver detector; prints the correlation of log(ρB) with log(ρ_MSIS), the

@@ -2,7 +2,7 @@
 
 Prints the wall time in-process and on a two-worker ``distributed.LocalCluster`` (cluster start-up
 shown apart), the speed-up, the peak memory of each worker process and of the in-process run, and
-checks the events are identical. Target (issue 12): a speed-up close to the number of cores for
+checks the events are identical. Target: a speed-up close to the number of cores for
 independent (spacecraft, day) tasks, memory per worker bounded by one task's telemetry.
 
     python benchmarks/bench_fleet_scale.py            # 8 spacecraft-days, 10 M null samples per task

@@ -1,4 +1,4 @@
-"""Flight-telemetry pipeline on kestrel (issue 9): detection vs truth, baseline without cleaning,
+"""Flight-telemetry pipeline on kestrel: detection vs truth, baseline without cleaning,
 chunked vs whole, memory against days, injection/recovery, speed.
 
     PYTHONPATH=$PWD/src nice python benchmarks/bench_flight_pipeline.py [--store DIR] [--parts detect,...]

@@ -1,4 +1,4 @@
-"""Inertia from routine telemetry on the flight-like set (issue 13 acceptance 1 and 4).
+"""Inertia from routine telemetry on the flight-like set.
 
 * direct momentum-balance estimator on both days, and leave-one-day-out (each day alone);
 * principal moments and axes against ``truth_inertia.json`` (read here for scoring only, never passed

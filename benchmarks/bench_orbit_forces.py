@@ -1,4 +1,4 @@
-"""Post-fit residuals of real precise orbits with each force model (issue 10, acceptance 3), and the
+"""Post-fit residuals of real precise orbits with each force model, and the
 choice of the default gravity degree; plus the one-step model error the filter's Gauss-Markov states
 must absorb and the cost per filter step.
 

@@ -1,5 +1,4 @@
-"""Real precise orbit (Sentinel-3A DORIS SP3, 9.1 days, no maneuver): false alarms and injected ΔVs
-(issue 3, acceptance 3).
+"""Real precise orbit (Sentinel-3A DORIS SP3, 9.1 days, no maneuver): false alarms and injected ΔVs.
 
 1. The whole arc through the default pipeline (auto tuning from the data, McReynolds-acceleration
    statistic, thresholds self-calibrated on the arc with leave-out at one false alarm per week):

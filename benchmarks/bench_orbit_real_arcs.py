@@ -1,4 +1,4 @@
-"""Real precise orbits with the full force model (issue 10, acceptance 1): false alarms per arc next to the
+"""Real precise orbits with the full force model: false alarms per arc next to the
 budget, 5 mm/s burns injected at random times and directions, and the 90 %-detectable ΔV, on two
 satellites.
 

@@ -1,4 +1,4 @@
-"""Speed of the orbit detector on one day of 1 Hz navigation data (issue 3, acceptance 4).
+"""Speed of the orbit detector on one day of 1 Hz navigation data.
 
 Times forward filter, mirrored backward filter, fusion and the statistics (all but TS5, the
 propagated-reference residuals) on 86 400 epochs, one core, and compares the forward filter with a
@@ -113,7 +113,7 @@ def main() -> None:
 
 
 def real_arc_speed(path: str, nuisance: bool = False) -> None:
-    """Issue 10 acceptance 4: a 10-day SP3 arc at 60 s with the full force model (EGM2008 40×40, Sun,
+    """A 10-day SP3 arc at 60 s with the full force model (EGM2008 40×40, Sun,
     Moon), forward + backward + statistics, timed by stage on one core, and the cost per filter step
     against the J2-J4 filter. ``nuisance``: with the 8 estimated nuisance states and NRLMSIS drag
     tabulated along the arc (the table's construction is inside the timed analysis)."""

@@ -651,7 +651,7 @@ def main() -> None:
             f"recall @ 1 FA/yr {ps['recall_at_1fa']:.3f}, burns >= 5 cm/s @ 1 FA/yr {ps['recall_big_at_1fa']:.3f} "
             f"({sum(x['big_found'] for x in sens[key])}/{ps['n_big']})"
         )
-    print("\nAcceptance (issue 11): LOSO pooled F1 >= 0.6 per class; recall >= 0.9 of burns >= 5 cm/s at <= 1 FA/yr")
+    print("\nTargets: LOSO pooled F1 >= 0.6 per class; recall >= 0.9 of burns >= 5 cm/s at <= 1 FA/yr")
     for r in pooled_rows:
         if r["detector"] != "abrupt":
             continue

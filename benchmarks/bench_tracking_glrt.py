@@ -4,7 +4,7 @@ One station (Ascension, 1° mask), thesis noise (5 m, 0.02 rad, 0.5 m/s), 5 s ca
 100 s burns at perigee (2T) or apogee (2.5T) — both outside every pass — in R, S or W. The filter starts from
 the true state perturbed by 50 m / 5 cm/s. For each cell: the fraction of runs detected (threshold set for
 0.1 false alarms per day, Bonferroni over candidate epochs) and the Δv magnitude error. Null runs measure
-the actual false-alarm rate. Target (issue 5): 5 cm/s detected in ≥ 90 % anywhere, magnitude within 20 %.
+the actual false-alarm rate. Target: 5 cm/s detected in ≥ 90 % anywhere, magnitude within 20 %.
 
     python benchmarks/bench_tracking_glrt.py [--quick] [--runs N]
 """

@@ -1,4 +1,4 @@
-"""Flight-telemetry pipeline (issue 9): ingest and its bad inputs, leak scan, timetable, cleaning,
+"""Flight-telemetry pipeline: ingest and its bad inputs, leak scan, timetable, cleaning,
 detection on a synthetic archive with known truth, chunked = whole, injection, thresholds."""
 
 from __future__ import annotations
@@ -197,7 +197,7 @@ def test_chunked_six_hour_chunks_equal_the_whole_run(tmp_path: Path) -> None:
 
 
 def test_kestrel_six_hour_chunks_give_the_events_of_the_whole_run(shared_data: Path, tmp_path: Path) -> None:
-    """Issue 9 item 2 on the shared flight-like data: 6-hour chunks (each with its margin) against one
+    """On the shared flight-like data: 6-hour chunks (each with its margin) against one
     chunk of both days; the events are the same and are the truth's strikes."""
     import json
 
