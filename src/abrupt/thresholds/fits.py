@@ -18,8 +18,8 @@ with the false-alarm rate it was set for. Supported fits of the event-free ("nul
                (:func:`robust_gaussian_threshold`).
 
 Every fit takes the false-alarm budget either as a :class:`~abrupt.thresholds.FalseAlarmBudget`
-(``budget=``, the one conversion to per-sample and per-block levels) or, for older callers, as
-``false_alarms_per_day`` or a per-sample ``p_fa``.
+(``budget=``, the one conversion to per-sample and per-block levels), as ``false_alarms_per_day``
+(read as a budget per day) or as a per-sample ``p_fa``.
 
 Probability per sample follows Bennett 2022 §2.5.1 step 4: one false alarm per day at 10 Hz is
 ``p_fa = 1 / 864000``. :func:`episode_rate` counts distinct exceedance episodes, which is what an
