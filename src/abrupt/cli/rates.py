@@ -166,7 +166,6 @@ def _scenario_options(func: Callable[..., Any]) -> Callable[..., Any]:
 
 
 def _report(results: Sequence[Any], kw: dict[str, Any]) -> None:
-
     metrics = list(kw["metric"]) or ["dH", "dV", "da"]
     frame = rate_table(results, metrics, kw["thresholds"])
     for r in results:

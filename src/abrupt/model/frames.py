@@ -57,7 +57,6 @@ def _utc_to_jd_parts(times_utc: NDArray[np.datetime64]) -> tuple[FloatArray, Flo
 
 
 def _polar_motion_rad(times_utc: NDArray[np.datetime64]) -> tuple[FloatArray, FloatArray]:
-
     offline_astropy()
 
     t = Time(np.asarray(times_utc, dtype="datetime64[ns]"), scale="utc", format="datetime64")

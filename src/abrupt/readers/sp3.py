@@ -120,7 +120,6 @@ def _resolve_rollover(
 
 
 def _to_utc(t_sys: NDArray[np.datetime64], time_system: str, log: RepairLog) -> NDArray[np.datetime64]:
-
     if time_system == "UTC":
         return t_sys
     if time_system == "GLO":

@@ -65,7 +65,6 @@ class EarthOrientationTable:
 
 
 def _astropy_time(times_utc: np.ndarray):
-
     offline_astropy()
 
     return Time(np.asarray(times_utc, dtype="datetime64[ns]"), scale="utc", format="datetime64")
