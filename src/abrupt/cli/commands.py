@@ -15,7 +15,7 @@ import importlib.util
 import logging
 from collections.abc import Mapping
 from functools import cache
-from typing import Any
+from typing import Any, TypeGuard
 
 import click
 from click.utils import make_default_short_help
@@ -102,7 +102,7 @@ def source_help(target: str) -> str | None:
     return None
 
 
-def _is_command_decorator(node: ast.expr) -> bool:
+def _is_command_decorator(node: ast.expr) -> TypeGuard[ast.Call]:
     """``@group.command(...)``/``@group.group(...)`` (not ``@click.option(..., help=...)``)."""
     if not isinstance(node, ast.Call) or not isinstance(node.func, ast.Attribute):
         return False
