@@ -18,6 +18,9 @@ import pandas as pd
 
 from abrupt.massprops.momentum_balance import MomentumBalanceData
 from abrupt.massprops.telemetry import momentum_data_from_channels
+from abrupt.pipelines.flight import ingest_archives
+from abrupt.readers.archive import read_decoder
+from abrupt.store import TelemetryStore
 
 UNITS = {"deg/s": math.pi / 180, "rpm": 2 * math.pi / 60, "deg": math.pi / 180, "-": 1.0, "flag": 1.0, "V": 1.0}
 
@@ -34,9 +37,6 @@ def read_archive(path: Path, epoch: pd.Timestamp) -> dict[str, tuple[np.ndarray,
 
 def ingest(folder: Path, store_root: Path) -> object:
     """``abrupt ingest`` of every archive file of the folder into ``store_root``; returns the store."""
-    from abrupt.pipelines.flight import ingest_archives
-    from abrupt.store import TelemetryStore
-
     files = sorted((folder / "telemetry").glob("*.csv*"))
     ingest_archives(files, folder / "decoder.csv", store_root)
     return TelemetryStore(store_root)
@@ -44,8 +44,6 @@ def ingest(folder: Path, store_root: Path) -> object:
 
 def channels_from_store(store: object, folder: Path, day: str, epoch: pd.Timestamp) -> dict[str, tuple]:
     """Channels of one store day keyed by their *real* mnemonic (looked up through the decoder)."""
-    from abrupt.readers.archive import read_decoder
-
     decoder = read_decoder(folder / "decoder.csv")
     sc = json.loads((folder / "spacecraft.json").read_text())
     pseudo_sc = decoder.spacecraft[sc["spacecraft"]]

@@ -29,6 +29,7 @@ import sys
 import time
 
 import numpy as np
+from scipy import stats
 
 from abrupt.detect.mass.inertia_change import InertiaChangeDetector
 from abrupt.massprops.inertia import inertia_from_principal, perturb_inertia
@@ -74,8 +75,6 @@ def track(days: float, docking_day: float | None, seed: int, sim_rate_hz: float)
 
 def resampled_years(tr: InertiaTrack, n_years: int, seed: int = 1) -> None:
     """False alarms per year over ``n_years`` synthetic years of days resampled from ``tr``."""
-    from scipy import stats
-
     rng = np.random.default_rng(seed)
     det = InertiaChangeDetector(attachment_radius_m=1.0)
     budget = FalseAlarmBudget(1, "year")

@@ -22,6 +22,7 @@ from __future__ import annotations
 import json
 import os
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -30,14 +31,29 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).parent))
 
 from _flight_like_loader import catalogue, ingest, load_day
-from abrupt.massprops.inertia import axis_errors_deg, params_from_inertia, principal_axes
-from abrupt.massprops.momentum_balance import (
-    MomentumBalanceData,
-    estimate_inertia,
-    nadir_from_attitude,
+from abrupt.massprops.attitude_reference import nadir_from_attitude
+from abrupt.massprops.inertia import (
+    axis_errors_deg,
+    inertia_from_principal,
+    params_from_inertia,
+    perturb_inertia,
+    principal_axes,
 )
+from abrupt.massprops.momentum_balance import MomentumBalanceData, estimate_inertia
+from abrupt.massprops.telemetry import momentum_data_from_simulation
 from abrupt.model.momentum import body_momentum
 from abrupt.model.rotations import dcm_from_quaternion
+from abrupt.model.spacecraft import spacecraft_from_dict
+from abrupt.simulate.attitude import (
+    AppendageMotion,
+    AttitudeSimConfig,
+    CircularOrbit,
+    PointingScenario,
+    ReferenceTrajectory,
+    simulate_pointing,
+)
+from abrupt.simulate.docking import random_slews
+from reproductions.pso import SlewWindow, find_slews, harris_objective, inertia_from_correction, two_pass_swarm
 
 FOLDER = Path(__file__).resolve().parents[2] / "shared" / "data" / "flight-like"
 
@@ -93,8 +109,6 @@ def main() -> None:
     j_cat = catalogue(FOLDER)
     events = json.loads((FOLDER / "truth_events.json").read_text())  # scoring only
     days = {}
-    import tempfile
-
     tmp = tempfile.TemporaryDirectory()
     store = None
     if "--pandas-loader" not in sys.argv:
@@ -169,9 +183,6 @@ def main() -> None:
 
 
 def pso_side_by_side(d: MomentumBalanceData, j_cat: np.ndarray, j_true: np.ndarray, est) -> None:  # type: ignore[no-untyped-def]
-    from abrupt.model.spacecraft import spacecraft_from_dict
-    from reproductions.pso import SlewWindow, find_slews, harris_objective, inertia_from_correction, two_pass_swarm
-
     sj = json.loads((FOLDER / "spacecraft.json").read_text())
     sc = spacecraft_from_dict(
         {
@@ -238,19 +249,6 @@ def pso_side_by_side(d: MomentumBalanceData, j_cat: np.ndarray, j_true: np.ndarr
 
 
 def simulated_spacecraft() -> None:
-    from abrupt.massprops.inertia import inertia_from_principal, perturb_inertia
-    from abrupt.massprops.telemetry import momentum_data_from_simulation
-    from abrupt.model.spacecraft import spacecraft_from_dict
-    from abrupt.simulate.attitude import (
-        AppendageMotion,
-        AttitudeSimConfig,
-        CircularOrbit,
-        PointingScenario,
-        ReferenceTrajectory,
-        simulate_pointing,
-    )
-    from abrupt.simulate.docking import random_slews
-
     cases = [
         (
             "3 orthogonal + skew wheels, 53°",

@@ -20,7 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from abrupt.detect.orbit.ekf import FilterConfig, propagate_state
+from abrupt.detect.orbit.ekf import FilterConfig
+from abrupt.detect.orbit.kernels import propagate_state
 from abrupt.model.frames import Ephemeris
 from abrupt.model.orbit import ForceContext, ForceModel, propagate_with_stm
 from abrupt.readers.sp3 import read_sp3

@@ -34,8 +34,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from abrupt.detect.orbit.analysis import OrbitDetectorConfig, analyse, calibrate_thresholds, tau_q_grid
+from abrupt.detect.orbit.analysis import ONE_PER_WEEK, OrbitDetectorConfig, analyse
+from abrupt.detect.orbit.calibration import calibrate_thresholds
 from abrupt.detect.orbit.ekf import FilterConfig, run_backward, run_forward
+from abrupt.detect.orbit.tuning import tau_q_grid
 from abrupt.model.orbit import MU_EARTH_M3_S2, ForceModel
 from abrupt.simulate.orbit import THESIS_DV_MPS, Impulse, OrbitSimulationConfig, SimulatedOrbit, simulate_orbit
 
@@ -193,7 +195,7 @@ def perturbed(mags: list[float], n_null: int, n_curve: int, two_body_dv90: dict[
         )
     for label, cfg in configs:
         null_p = null_statistics(n_null // 2, pert, 400e3, 0.001, seed=300, cfg=cfg)
-        thr_p = calibrate_thresholds(null_p, sample_rate_hz=1.0, false_alarms_per_day=1 / 7)
+        thr_p = calibrate_thresholds(null_p, sample_rate_hz=1.0, budget=ONE_PER_WEEK)
         curve_p = power_curve(mags, n_curve, thr_p, pert, 400e3, 0.001, seed=13, cfg=cfg)
         print(f"   {label}")
         print("   |dV| (mm/s): " + " ".join(f"{m * 1e3:6.2f}" for m in mags))
@@ -296,7 +298,7 @@ def tune_small_strikes(
                 for s in TUNE_STATS:
                     pooled[s].append(an.statistics[s][an.valid])
             thr = calibrate_thresholds(
-                {s: np.concatenate(v) for s, v in pooled.items()}, sample_rate_hz=1.0, false_alarms_per_day=1 / 7
+                {s: np.concatenate(v) for s, v in pooled.items()}, sample_rate_hz=1.0, budget=ONE_PER_WEEK
             )
             snr: dict[str, list[float]] = {s: [] for s in TUNE_STATS}
             for eph, t_strike in cases:
@@ -433,7 +435,7 @@ def tuned_comparison(mags: list[float], n_null: int, n_curve: int, quick: bool) 
         # event-free runs as long as the strike runs: with little process noise the filters converge
         # for hours, and a threshold from 24 h runs would not describe the statistics of a 3 h run
         null = null_statistics(n_null, two_body, 800e3, 0.0, seed=100, cfg=cfg, run_s=RUN_S)
-        thr = calibrate_thresholds(null, sample_rate_hz=1.0, false_alarms_per_day=1 / 7)
+        thr = calibrate_thresholds(null, sample_rate_hz=1.0, budget=ONE_PER_WEEK)
         curves[key] = power_curve(mags, n_curve, thr, two_body, 800e3, 0.0, seed=11, cfg=cfg)
         fresh[key] = fresh_false_alarms(thr, cfg, fresh_days)
         print(
@@ -497,7 +499,7 @@ def main() -> None:
     two_body = ForceModel()
     print("1. Reproduction, thesis defaults (Table 3.1), two-body truth and filter")
     null = null_statistics(n_null, two_body, 800e3, 0.0, seed=100)
-    thr = calibrate_thresholds(null, sample_rate_hz=1.0, false_alarms_per_day=1 / 7)
+    thr = calibrate_thresholds(null, sample_rate_hz=1.0, budget=ONE_PER_WEEK)
     print(f"   thresholds at one false alarm per week (KDE, {null['mcr_w'].size} event-free points):")
     for s in STATS:
         if s in thr:

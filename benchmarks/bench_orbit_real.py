@@ -21,14 +21,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from abrupt.detect.orbit.analysis import (
-    OrbitAnalysis,
-    OrbitDetectorConfig,
-    analyse,
-    auto_tune,
-    find_events,
-    self_calibrate,
-)
+from abrupt.detect.orbit.analysis import OrbitAnalysis, OrbitDetectorConfig, analyse
+from abrupt.detect.orbit.calibration import self_calibrate
+from abrupt.detect.orbit.events import find_events
+from abrupt.detect.orbit.tuning import auto_tune
 from abrupt.model.frames import Ephemeris
 from abrupt.readers.sp3 import read_sp3
 from abrupt.simulate.orbit import inject_impulse

@@ -11,20 +11,22 @@ Joseph update). Target: < 2 s for the whole chain.
 from __future__ import annotations
 
 import argparse
+import sys
 import time
+from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
-from abrupt.detect.orbit.ekf import (
-    _GL_NODES,
-    _GL_WEIGHTS,
-    FilterConfig,
-    _process_noise,
-    propagate_state,
-    run_backward,
-    run_forward,
-)
+from abrupt.detect.orbit.analysis import OrbitDetectorConfig, analyse
+from abrupt.detect.orbit.calibration import self_calibrate
+from abrupt.detect.orbit.detectors import nuisance_force_model
+from abrupt.detect.orbit.ekf import FilterConfig, NuisanceConfig, run_backward, run_forward
+from abrupt.detect.orbit.events import find_events
+from abrupt.detect.orbit.kernels import _GL_NODES, _GL_WEIGHTS, _process_noise, propagate_state
 from abrupt.detect.orbit.statistics import fuse, orbital_constant_statistics
+from abrupt.detect.orbit.tuning import auto_tune
+from abrupt.readers.sp3 import read_sp3
 from abrupt.simulate.orbit import OrbitSimulationConfig, simulate_orbit
 
 
@@ -117,12 +119,6 @@ def real_arc_speed(path: str, nuisance: bool = False) -> None:
     Moon), forward + backward + statistics, timed by stage on one core, and the cost per filter step
     against the J2-J4 filter. ``nuisance``: with the 8 estimated nuisance states and NRLMSIS drag
     tabulated along the arc (the table's construction is inside the timed analysis)."""
-    from dataclasses import replace
-
-    from abrupt.detect.orbit.analysis import OrbitDetectorConfig, analyse, auto_tune, find_events, self_calibrate
-    from abrupt.detect.orbit.detectors import nuisance_force_model
-    from abrupt.detect.orbit.ekf import NuisanceConfig
-    from abrupt.readers.sp3 import read_sp3
 
     def with_nuisance(f: FilterConfig) -> FilterConfig:
         if not nuisance:
@@ -169,9 +165,6 @@ def real_arc_speed(path: str, nuisance: bool = False) -> None:
 
 
 if __name__ == "__main__":
-    import sys
-    from pathlib import Path
-
     from _results import variant, write_results
 
     with write_results("bench_orbit_speed", variant({"--real-only": "real", "--nuisance": "nuisance"})):

@@ -94,11 +94,11 @@ def run_one(job: tuple[str, dict[str, Any]]) -> dict[str, Any]:
         f", {spec.sets_per_day:g}/day, noise ×{spec.noise_scale:g}"
     )
     det = detector_for(history)
-    run = det.run(history, BUDGET)
+    run = det.detect(history, BUDGET)
     scored = score_injected(
-        history, run.events, run.noise_model, burns, [], det.settings.window_sets, regime, TOLERANCE_S
+        history, run.events, run.diagnostics[0].noise_model, burns, [], det.settings.window_sets, regime, TOLERANCE_S
     )
-    nm = run.noise_model
+    nm = run.diagnostics[0].noise_model
     return {
         "ensemble": kind,
         "regime": regime,

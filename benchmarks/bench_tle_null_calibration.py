@@ -106,7 +106,7 @@ def run_one(job: tuple[str, dict[str, Any]]) -> list[dict[str, Any]]:
     epochs = el["epoch_utc"].to_numpy(dtype="datetime64[ns]")
     rows = []
     for budget in BUDGETS:
-        run = det.run(history, budget)
+        run = det.detect(history, budget)
         before = pd.to_datetime(run.events["elset_epoch_before_utc"]).to_numpy(dtype="datetime64[ns]")
         gap = np.clip(np.searchsorted(epochs, before), 0, n_gaps - 1)
         rows.append(
@@ -119,9 +119,9 @@ def run_one(job: tuple[str, dict[str, Any]]) -> list[dict[str, Any]]:
                 "false_alarms": int(counted[gap].sum()),
                 "counted_fraction": float(counted.mean()),
                 "threshold": run.threshold.value,
-                "w_a": run.noise_model["group_weights"][0],
-                "w_e": run.noise_model["group_weights"][1],
-                "w_n": run.noise_model["group_weights"][2],
+                "w_a": run.diagnostics[0].noise_model["group_weights"][0],
+                "w_e": run.diagnostics[0].noise_model["group_weights"][1],
+                "w_n": run.diagnostics[0].noise_model["group_weights"][2],
             }
         )
     return rows
@@ -225,7 +225,7 @@ def main() -> None:
     print("noise should give similar weights; far-off weights mean the bootstrap changed the noise structure):")
     for sat in REAL:
         real = read_tle(DATA / "tle" / f"{sat}.tle")
-        w = detector_for(real).run(real, BUDGETS[0]).noise_model["group_weights"]
+        w = detector_for(real).detect(real, BUDGETS[0]).diagnostics[0].noise_model["group_weights"]
         print(f"  {sat}: " + "/".join(f"{x:.2g}" for x in w))
     print(
         f"\n{len(todo)} histories, {frame['years'].sum() / len(BUDGETS):.0f} satellite-years per budget; "

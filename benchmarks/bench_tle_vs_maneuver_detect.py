@@ -115,8 +115,8 @@ def detect_one(
         spacecraft=sat,
     )
     t0 = time.perf_counter()
-    run = det.run(history, BUDGET)
-    return sat, (gain, sides), run.events, run.noise_model, time.perf_counter() - t0
+    run = det.detect(history, BUDGET)
+    return sat, (gain, sides), run.events, run.diagnostics[0].noise_model, time.perf_counter() - t0
 
 
 def span(sat: str) -> tuple[pd.Timestamp, pd.Timestamp]:

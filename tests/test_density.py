@@ -391,8 +391,8 @@ def test_joint_fit_recovers_storm_and_ballistic_ratios() -> None:
 
 def test_scale_from_platform_ranges_recovers_known_factor() -> None:
     """c of B = c·b from turning boxes with random attitudes: ML over the platforms' B ranges."""
+    from abrupt.density.absolute_scale import estimate_scale
     from abrupt.density.constellation import platform_b_range
-    from abrupt.density.joint import estimate_scale
 
     rng = np.random.default_rng(5)
     flow = FlowConditions(7600.0, 900.0, 0.016)

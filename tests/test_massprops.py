@@ -1,4 +1,4 @@
-"""Mass properties (issue 13): inertia algebra, simulator support, direct estimator, bad input, SIMSAT, PSO."""
+"""Mass properties: inertia algebra, simulator support, direct estimator, bad input, SIMSAT, PSO."""
 
 from __future__ import annotations
 
@@ -22,6 +22,7 @@ from abrupt.massprops.inertia import (
     physical_violations,
     principal_axes,
 )
+from abrupt.massprops.least_squares import integrated_correlation_time, jackknife_replicates, solve_balance
 from abrupt.massprops.momentum_balance import InsufficientExcitationError, estimate_inertia
 from abrupt.massprops.telemetry import momentum_data_from_channels, momentum_data_from_simulation
 from abrupt.model.momentum import body_momentum
@@ -289,8 +290,6 @@ def test_non_physical_catalogue_inertia_is_refused(routine):
 
 def test_integrated_correlation_time_of_ar1_matches_the_analytic_value():
     # AR(1) x_t = φ x_{t-1} + e_t has τ_int = (1 + φ) / (1 − φ) (Sokal 1997, Eq. 3.2 with ρ(l) = φ^l).
-    from abrupt.massprops.momentum_balance import integrated_correlation_time
-
     rng = np.random.default_rng(3)
     for phi in (0.0, 0.5, 0.9):
         e = rng.standard_normal((200_000, 2))
@@ -304,8 +303,6 @@ def test_integrated_correlation_time_of_ar1_matches_the_analytic_value():
 
 def test_jackknife_replicates_equal_refits_with_each_block_left_out():
     # The rank-update jackknife against brute force: a least-squares refit without the block's rows.
-    from abrupt.massprops import momentum_balance as mb
-
     rng = np.random.default_rng(5)
     n, q = 600, 4
     a_p = rng.standard_normal((n, 3, 6))
@@ -313,12 +310,12 @@ def test_jackknife_replicates_equal_refits_with_each_block_left_out():
     p_true = np.array([900.0, 700.0, 1100.0, 10.0, -5.0, 3.0])
     y = np.einsum("nak,k->na", a_p, p_true) + rng.standard_normal((n, 3))
     p0 = p_true + 1.0
-    sol = mb._solve(a_p, x_nuis, y, p0, None)
+    sol = solve_balance(a_p, x_nuis, y, p0, None)
     block_of = np.arange(n) // 100
-    reps = mb._jackknife(sol, block_of, 6)
+    reps = jackknife_replicates(sol, block_of, 6)
     for b in range(6):
         keep = block_of != b
-        brute = mb._solve(a_p[keep], x_nuis[keep], y[keep], p0, None).p
+        brute = solve_balance(a_p[keep], x_nuis[keep], y[keep], p0, None).p
         assert np.allclose(reps[b], brute, rtol=0, atol=1e-8)
 
 

@@ -7,13 +7,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from abrupt.detect.orbit.analysis import (
-    OrbitDetectorConfig,
-    analyse,
-    auto_tune,
-    find_events,
-    self_calibrate,
-)
+from abrupt.detect.orbit.analysis import OrbitDetectorConfig, analyse
+from abrupt.detect.orbit.calibration import self_calibrate
+from abrupt.detect.orbit.events import find_events
+from abrupt.detect.orbit.tuning import auto_tune
 
 SP3 = "sp3/ssas3a20.b18358.e19003.DG_.sp3"
 
@@ -36,7 +33,7 @@ def test_real_arc_without_maneuver_gives_at_most_one_false_alarm_per_week_thresh
     eph = read_sp3(shared_data / SP3, "L74").to_frame("GCRF")
     an = analyse(eph, _real_config(eph))
     events = find_events(an, self_calibrate(an, names=("glr",)))
-    assert len(events) <= 1  # issue 3 acceptance 3 (9.1 days; 1.3 expected at exactly one per week)
+    assert len(events) <= 1  # 9.1 days: 1.3 expected at exactly one per week
 
 
 def test_interval_dv_recovers_injected_impulses_on_real_data_within_five_percent(shared_data: Path) -> None:

@@ -12,15 +12,10 @@ from click.testing import CliRunner
 
 import abrupt.cli.orbit  # noqa: F401  (registers the orbit commands)
 from abrupt.cli.groups import cli
-from abrupt.detect.orbit.analysis import (
-    OrbitDetectorConfig,
-    analyse,
-    auto_tune,
-    calibrate_thresholds,
-    find_events,
-    self_calibrate,
-    stream_statistics,
-)
+from abrupt.detect.orbit.analysis import OrbitDetectorConfig, analyse, stream_statistics
+from abrupt.detect.orbit.calibration import calibrate_thresholds, self_calibrate
+from abrupt.detect.orbit.events import find_events
+from abrupt.detect.orbit.tuning import auto_tune
 from abrupt.events import EVENT_COLUMNS, read_events
 from abrupt.model.frames import rtn_matrix
 from abrupt.readers.navigation_csv import write_navigation_csv
@@ -173,7 +168,7 @@ def test_real_sp3_injected_5_mm_s_is_detected_in_time_with_its_magnitude(shared_
 
 
 def test_tau_q_grid_reports_snr_of_each_statistic_at_each_grid_point() -> None:
-    from abrupt.detect.orbit.analysis import tau_q_grid
+    from abrupt.detect.orbit.tuning import tau_q_grid
 
     null = simulate_orbit(OrbitSimulationConfig(duration_s=7200.0, seed=21)).ephemeris()
     strike = simulate_orbit(
@@ -197,9 +192,9 @@ def test_finite_reboost_burn_in_a_full_force_truth_is_found_with_its_dv_directio
     t0: float, duration: float, dv: float, days: float, step_s: float
 ) -> None:
     """ISS-like reboosts (400 km, heavy drag, prograde, held in the orbit frame) in a truth with a 20×20
-    field, Sun, Moon, SRP and drag: found, |ΔV| within 10 %, direction within 5°, start within 60 s
-    (issue 10, acceptance 2). The small long one was missed while the self-calibration's leave-out
-    worked on log(GLR): its own GLR values stayed in the tail sample and lifted the threshold to ~10⁴.
+    field, Sun, Moon, SRP and drag: found, |ΔV| within 10 %, direction within 5°, start within 60 s.
+    The small long one is missed when the self-calibration's leave-out works on log(GLR): its own GLR
+    values then stay in the tail sample and lift the threshold to ~10⁴.
     At 240 s (NASA ISS OEM sampling) the 328 s burn straddles an epoch with 70 % of it in one interval:
     it was taken for an impulse there (|ΔV| −14 %, start +124 s) until the duration came from the
     positions across the burn."""
@@ -274,7 +269,7 @@ def test_position_only_cpf_prediction_of_lageos_is_a_quiet_no_maneuver_control(s
 def test_velocities_from_positions_match_a_kepler_orbit() -> None:
     """9-point polynomial derivatives of positions sampled every 60 s reproduce the analytic two-body
     velocity (LEO, e = 0.01) to < 1e-6 m/s, ends included; a gap gives NaN instead of a wrong value."""
-    from abrupt.detect.orbit.analysis import velocities_from_positions
+    from abrupt.detect.orbit.tuning import velocities_from_positions
     from abrupt.model.orbit import MU_EARTH_M3_S2, kepler_to_cartesian
 
     a, e = 7.0e6, 0.01

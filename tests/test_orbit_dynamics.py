@@ -242,7 +242,7 @@ def test_injected_large_burn_keeps_obeying_the_dynamics_days_later() -> None:
     still obey the true dynamics from epoch to epoch (no spurious jump days later). The truth has
     J2-J4 + Sun + Moon, the injection model J2-J4 only: the deviation is carried about the real
     trajectory, so the model's own drift (km per day without the third bodies) does not enter."""
-    from abrupt.detect.orbit.ekf import propagate_state
+    from abrupt.detect.orbit.kernels import propagate_state
 
     epoch = "2020-03-01T00:00:00"
     truth = ForceModel(zonal_degree=4, sun=True, moon=True)

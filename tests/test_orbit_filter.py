@@ -9,16 +9,8 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from abrupt.detect.orbit.ekf import (
-    _GL_NODES,
-    _GL_WEIGHTS,
-    FilterConfig,
-    _jacobian,
-    fogm_gammas,
-    propagate_state,
-    run_backward,
-    run_forward,
-)
+from abrupt.detect.orbit.ekf import FilterConfig, run_backward, run_forward
+from abrupt.detect.orbit.kernels import _GL_NODES, _GL_WEIGHTS, _jacobian, fogm_gammas, propagate_state
 from abrupt.detect.orbit.statistics import fuse
 from abrupt.model.orbit import MU_EARTH_M3_S2, kepler_to_cartesian
 from abrupt.simulate.orbit import OrbitSimulationConfig, simulate_orbit

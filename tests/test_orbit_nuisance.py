@@ -1,22 +1,12 @@
-"""Estimated nuisance parameters in the orbit EKF and NRLMSIS drag inside the numba kernels (issue 10,
-build item 2)."""
+"""Estimated nuisance parameters in the orbit EKF and NRLMSIS drag inside the numba kernels."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from abrupt.detect.orbit.ekf import (
-    I_DRAG_SCALE,
-    I_EMPIRICAL,
-    I_SRP_SCALE,
-    FilterConfig,
-    NuisanceConfig,
-    _deriv,
-    orbit_frame_and_latitude,
-    propagate_state,
-    run_forward,
-)
+from abrupt.detect.orbit.ekf import I_DRAG_SCALE, I_EMPIRICAL, I_SRP_SCALE, FilterConfig, NuisanceConfig, run_forward
+from abrupt.detect.orbit.kernels import _deriv, orbit_frame_and_latitude, propagate_state
 from abrupt.model.orbit import ForceModel
 from abrupt.model.orbit.forces import (
     DRAG_KERNEL_TABLE,
@@ -51,7 +41,7 @@ def test_nuisance_jacobian_columns_match_finite_differences_of_the_dynamics() ->
     x[I_DRAG_SCALE] = 0.3
     x[I_SRP_SCALE] = -0.2
     x[I_EMPIRICAL:] = np.array([1.0, -2.0, 0.5, 3.0, -1.0, 2.0]) * 1e-8
-    from abrupt.detect.orbit.ekf import _jacobian
+    from abrupt.detect.orbit.kernels import _jacobian
 
     a = np.empty((17, 17))
     _jacobian(x, 100.0, 600.0, ctx.kernel_args, LEO.mu_m3_s2, True, a)

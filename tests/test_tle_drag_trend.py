@@ -15,7 +15,7 @@ import pandas as pd
 import pytest
 
 from abrupt.detect.tle.detectors import TleMeanElements
-from abrupt.detect.tle.maneuvers import drag_trend_m, mean_element_series, stated_decay_m_s
+from abrupt.detect.tle.elements import drag_trend_m, mean_element_series, stated_decay_m_s
 from abrupt.simulate.tle_null import EPOCH0, NullHistorySpec, simulate_null_history
 from abrupt.thresholds import FalseAlarmBudget
 
@@ -58,10 +58,10 @@ def test_changing_drag_stays_within_twice_the_budget(null_histories) -> None:
     """Ten maneuver-free satellite-years at 450 km: at most twice the budget with the drag trend
     (without it the local straight-line trend gives more than twice: the defect it fixes)."""
     years = sum(_years(h) for h in null_histories)
-    runs = [TleMeanElements().run(h, BUDGET) for h in null_histories]
+    runs = [TleMeanElements().detect(h, BUDGET) for h in null_histories]
     with_trend = sum(len(r.events) for r in runs)
-    without = sum(len(TleMeanElements(drag_trend="none").run(h, BUDGET).events) for h in null_histories)
-    assert all(r.noise_model["drag_trend_used"] for r in runs)  # 450 km: ~30 m/day, gate open
+    without = sum(len(TleMeanElements(drag_trend="none").detect(h, BUDGET).events) for h in null_histories)
+    assert all(r.diagnostics[0].noise_model["drag_trend_used"] for r in runs)  # 450 km: ~30 m/day, gate open
     assert years > 9.0
     assert with_trend / years <= 2.0 * BUDGET.per_year
     assert without / years > 2.0 * BUDGET.per_year
@@ -72,7 +72,7 @@ def test_a_5_cm_s_burn_under_changing_drag_is_found(spec: NullHistorySpec) -> No
     """The same histories with one 5 cm/s in-track burn (its first set's ndot carries the step):
     found within a day, with its in-track ΔV within 20 %."""
     history = simulate_null_history(spec, burns=[(BURN_DAY, BURN_DV_MPS)])
-    events = TleMeanElements().run(history, BUDGET).events
+    events = TleMeanElements().detect(history, BUDGET).events
     burn = EPOCH0 + pd.Timedelta(days=BURN_DAY)
     dt_days = (pd.to_datetime(events["time_utc"]).dt.tz_localize(None) - burn).abs().dt.total_seconds() / 86400.0
     near = events[dt_days.to_numpy() < 1.0]
@@ -105,4 +105,4 @@ def test_stated_decay_of_a_hand_written_element_set_matches_the_hand_computed_ra
 def test_drag_trend_stays_off_where_drag_is_slow() -> None:
     """At 1300 km ``a`` decays far below 2 m/day: the gate keeps the straight-line trend alone."""
     history = simulate_null_history(NullHistorySpec(altitude_km=1300.0, sets_per_day=1.0, years=1.0, seed=7))
-    assert not TleMeanElements().run(history, BUDGET).noise_model["drag_trend_used"]
+    assert not TleMeanElements().detect(history, BUDGET).diagnostics[0].noise_model["drag_trend_used"]

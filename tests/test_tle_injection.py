@@ -15,7 +15,8 @@ import pandas as pd
 import pytest
 
 from abrupt.detect.tle.detectors import TleMeanElements
-from abrupt.detect.tle.maneuvers import has_drift_hinge, mean_element_series
+from abrupt.detect.tle.elements import mean_element_series
+from abrupt.detect.tle.timing import has_drift_hinge
 from abrupt.simulate.tle_null import EPOCH0, NullHistorySpec, simulate_null_history
 from abrupt.thresholds import FalseAlarmBudget
 
@@ -46,7 +47,7 @@ def test_in_track_burn_bends_the_phase_at_the_burn_and_is_timed_there() -> None:
     # moving the burn 0.4 gaps earlier adds 0.4 gaps of the new drift to every later set's phase
     shift = a * dn * (day - day_early) * 86400.0
     assert float(np.median(u[day_early][k + 5 : k + 50] - u[day][k + 5 : k + 50])) == pytest.approx(shift, rel=0.02)
-    events = TleMeanElements().run(burned[day_early], BUDGET).events
+    events = TleMeanElements().detect(burned[day_early], BUDGET).events
     near = _near(events, day_early)
     assert len(near) == 1
     assert abs(float(near["dt_days"].iloc[0])) < 3.0 / 24.0
@@ -59,7 +60,7 @@ def test_cross_track_burn_is_timed_in_its_gap_not_on_a_noise_hinge() -> None:
     that holds it (before the in-track gate the along-track fit put such burns up to 3 days early)."""
     day = 300.3
     history = simulate_null_history(SPEC, burns=[(day, 0.0, 2.0)])
-    events = TleMeanElements().run(history, BUDGET).events
+    events = TleMeanElements().detect(history, BUDGET).events
     near = _near(events, day)
     assert len(near) == 1
     ev = near.iloc[0]
@@ -74,7 +75,7 @@ def test_cross_track_burn_is_timed_in_its_gap_not_on_a_noise_hinge() -> None:
 
 def test_drift_hinge_gate_reads_the_weighted_in_track_score() -> None:
     """The gate is the in-track group's tail-weighted z against the statistic's floor of 3."""
-    from abrupt.detect.tle.maneuvers import StepSeries
+    from abrupt.detect.tle.steps import StepSeries
 
     z = np.array([1.0, 10.0])
     steps = StepSeries(
@@ -104,7 +105,7 @@ def test_geo_east_west_and_north_south_burns_are_found_and_typed() -> None:
     spec = NullHistorySpec(regime="geo", sets_per_day=1.0, years=2.0, seed=21)
     ew_day, ns_day = 300.5, 420.6  # gaps of ~1 day (the generator also draws 3-10 day gaps)
     history = simulate_null_history(spec, burns=[(ew_day, 0.05), (ns_day, 0.0, 5.0)])
-    events = TleGeoStationKeeping().run(history, BUDGET).events
+    events = TleGeoStationKeeping().detect(history, BUDGET).events
     ew, ns = _near(events, ew_day), _near(events, ns_day)
     assert len(ew) == 1 and len(ns) == 1
     assert ew["maneuver_type"].iloc[0] == "east-west"
@@ -153,7 +154,7 @@ def test_five_cm_s_burns_in_jason_3_real_noise_are_found_at_the_budget(shared_da
     burns = [(d, 0.05 * (-1) ** i) for i, d in enumerate(days)]
     history, junctions_again = bootstrap_null_history(real, quiet, burns=burns, **kw)
     assert np.array_equal(junctions, junctions_again)  # the burns do not touch the blocks' draw
-    events = TleMeanElements().run(history, BUDGET).events
+    events = TleMeanElements().detect(history, BUDGET).events
     assert sum(len(_near(events, d, within_days=1.0)) == 1 for d in days) == 10
     ev_days = (pd.to_datetime(events["time_utc"]).dt.tz_localize(None) - EPOCH0).dt.total_seconds() / 86400.0
     epochs = history.elements["epoch_utc"].to_numpy(dtype="datetime64[ns]")
@@ -172,7 +173,7 @@ def test_injection_recall_checks_the_stated_size_on_the_satellites_own_noise(sha
 
     real = read_tle(shared_data / "tle" / "Sentinel-3A.tle")
     known = list(read_maneuver_file(shared_data / "maneuvers" / "s3aman.txt")["time_utc"])
-    stated = 100.0 * TleMeanElements().run(real, BUDGET).noise_model["min_detectable_dv_t_mps"]
+    stated = 100.0 * TleMeanElements().detect(real, BUDGET).diagnostics[0].noise_model["min_detectable_dv_t_mps"]
     ladders = (ladder_around(stated), (1000.0,))
     burns, summary = injection_recall(real, known, BUDGET, years=4.0, seeds=(0, 1), ladders_cm_s=ladders)
     in_track = burns[burns["kind"] == "in-track"]

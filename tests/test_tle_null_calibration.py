@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from abrupt.detect.tle.detectors import detector_for
-from abrupt.detect.tle.maneuvers import mean_element_series
+from abrupt.detect.tle.elements import mean_element_series
 from abrupt.simulate.tle_null import NullHistorySpec, detector_residuals, simulate_null_history
 from abrupt.thresholds import FalseAlarmBudget
 
@@ -56,7 +56,7 @@ def test_realised_false_alarm_rate_is_within_a_factor_of_two_of_the_budget(histo
     for history in histories:
         el = history.elements
         years += (el["epoch_utc"].iloc[-1] - el["epoch_utc"].iloc[0]).total_seconds() / 86400.0 / 365.25
-        alarms += len(detector_for(history).run(history, budget).events)
+        alarms += len(detector_for(history).detect(history, budget).events)
     rate = alarms / years
     assert rate <= 2.0 * budget.per_year
 
@@ -83,7 +83,7 @@ def test_bootstrap_of_real_noise_keeps_the_budget(shared_data, satellite: str, o
         n_gaps = len(history) - 1
         counted = gaps_clear_of_junctions(n_gaps, junctions, detector.settings.window_sets)
         epochs = history.elements["epoch_utc"].to_numpy(dtype="datetime64[ns]")
-        events = detector.run(history, FalseAlarmBudget(1.0, "year")).events
+        events = detector.detect(history, FalseAlarmBudget(1.0, "year")).events
         before = events["elset_epoch_before_utc"].astype("datetime64[ns]").to_numpy()
         gaps = np.clip(np.searchsorted(epochs, before), 0, n_gaps - 1)
         alarms += int(counted[gaps].sum())

@@ -1,4 +1,4 @@
-"""Real TLE histories scored against the operators' maneuver files (issue 11).
+"""Real TLE histories scored against the operators' maneuver files.
 
 ±1 day one-to-one matching, truth limited to the history's span, operator window starts in UTC.
 The comparison figures are maneuver-detect 0.3.0's classical detector run on the same files

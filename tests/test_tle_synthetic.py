@@ -16,10 +16,15 @@ import pytest
 from click.testing import CliRunner
 
 from abrupt.cli.main import cli
-from abrupt.detect.tle.maneuvers import TleDetectorConfig, campaign_cadence_s, characterise, detect_tle_maneuvers
+from abrupt.detect.tle.burns import campaign_cadence_s, characterise
+from abrupt.detect.tle.config import TleDetectorConfig
+from abrupt.detect.tle.elements import elapsed_si_seconds
+from abrupt.detect.tle.maneuvers import detect_tle_maneuvers
+from abrupt.detect.tle.timing import two_set_burn_time
 from abrupt.events import EVENT_COLUMNS, read_events
 from abrupt.readers.tle import read_tle
 from abrupt.score import score_events
+from abrupt.thresholds import FalseAlarmBudget
 
 MU = 398600.8e9  # [m^3/s^2] WGS-72, as SGP4
 EPOCH0 = pd.Timestamp("2020-01-01T00:00:00")
@@ -132,7 +137,7 @@ def test_maneuver_free_history_stays_quiet(tmp_path: Path) -> None:
     text, _ = synthetic_tle_text(days=730, seed=7)
     path = tmp_path / "quiet.tle"
     path.write_text(text)
-    events = detect_tle_maneuvers(read_tle(path), TleDetectorConfig(false_alarms_per_year=1.0))
+    events = detect_tle_maneuvers(read_tle(path), TleDetectorConfig(budget=FalseAlarmBudget(1.0, "year")))
     # budget 1 per satellite-year over 2 years; allow sampling scatter (Poisson 95% bound of mean 2 is 5)
     assert len(events) <= 5
 
@@ -314,8 +319,6 @@ def test_opposed_in_track_pair_is_found_from_its_along_track_phase_step(tmp_path
 def test_elapsed_seconds_count_the_leap_second_as_astropy_does() -> None:
     from astropy.time import Time
 
-    from abrupt.detect.tle.maneuvers import elapsed_si_seconds
-
     stamps = ["2016-12-31T12:00:00", "2016-12-31T23:59:00", "2017-01-01T00:01:00", "2017-01-02T12:00:00"]
     got = elapsed_si_seconds(pd.Series(pd.to_datetime(stamps)))
     tai = Time(stamps, scale="utc").tai
@@ -326,8 +329,6 @@ def test_elapsed_seconds_count_the_leap_second_as_astropy_does() -> None:
 
 def test_two_set_burn_time_recovers_the_burn_inside_its_gap(maneuvering) -> None:
     """The phase innovation across the gap times one impulse (t_b = t_g + Δt/2 − δ/Δu̇)."""
-    from abrupt.detect.tle.maneuvers import elapsed_si_seconds, two_set_burn_time
-
     path, truth = maneuvering
     history = read_tle(path)
     epochs = history.elements["epoch_utc"]

@@ -24,9 +24,12 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from sgp4.api import WGS72, Satrec
+from sgp4.exporter import export_tle
 
 from abrupt.density.drag_coefficient import FlowConditions, box_ballistic_coefficient
 from abrupt.density.tle_drag import EARTH_ROTATION_RAD_S, wind_factor
+from abrupt.model.atmosphere import msis_density, read_space_weather, teme_to_geodetic
 from abrupt.readers.tle import EARTH_RADIUS_WGS72_M, MU_EARTH_WGS72_M3_S2
 from abrupt.types import FloatArray
 
@@ -66,8 +69,6 @@ def storm_profile(t_days: FloatArray, start_day: float, length_days: float, ampl
 
 def _satrec(satnum: int, epoch_jd: float, inc_rad: float, u_rad: float, raan_rad: float, a_mean_m: float) -> Any:
     """Near-circular SGP4 record (WGS-72, e = 1e-4) with mean motion from ``a_mean_m``."""
-    from sgp4.api import WGS72, Satrec
-
     sat = Satrec()
     sat.sgp4init(
         WGS72,
@@ -102,10 +103,6 @@ def simulate_constellation(
     space_weather: Any = None,
 ) -> SyntheticConstellation:
     """Simulate the constellation (module docstring); deterministic for a given ``seed``."""
-    from sgp4.exporter import export_tle
-
-    from abrupt.model.atmosphere import msis_density, read_space_weather, teme_to_geodetic
-
     sw = space_weather if space_weather is not None else read_space_weather()
     rng = np.random.default_rng(seed)
     mu = MU_EARTH_WGS72_M3_S2

@@ -16,9 +16,13 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
+from scipy.ndimage import median_filter
 
 from abrupt.massprops.inertia import perturb_inertia
+from abrupt.model.momentum import body_momentum
+from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import Spacecraft
+from abrupt.simulate.attitude import AttitudeSimConfig, PointingScenario, ReferenceTrajectory, simulate_pointing
 from abrupt.types import FloatArray
 
 
@@ -104,8 +108,6 @@ def find_slews(
     t_s: FloatArray, omega_B_rad_s: FloatArray, threshold_rad_s: float = 5e-4, pad_s: float = 60.0
 ) -> list[tuple[float, float]]:
     """Intervals where the body rate departs from its 10-minute running median by more than the threshold."""
-    from scipy.ndimage import median_filter
-
     dt = float(np.median(np.diff(t_s)))
     size = max(3, int(600.0 / dt) | 1)
     base = median_filter(omega_B_rad_s, size=(size, 1), mode="nearest")
@@ -151,10 +153,6 @@ def harris_objective(
     starting from the measured rate and wheel speeds. Both momenta are taken relative to their value at
     the start of the window, so the objective sees only the slew-induced error pattern of Fig. 5.
     """
-    from abrupt.model.momentum import body_momentum
-    from abrupt.model.rotations import dcm_from_quaternion
-    from abrupt.simulate.attitude import AttitudeSimConfig, PointingScenario, ReferenceTrajectory, simulate_pointing
-
     sc = spacecraft
     j_cat = np.asarray(sc.inertia_kgm2, dtype=np.float64)
     prepared = []

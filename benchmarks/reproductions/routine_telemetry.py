@@ -1,4 +1,4 @@
-"""A day of routine attitude telemetry written the way a flight archive delivers it (issue 13 checks).
+"""A day of routine attitude telemetry written the way a flight archive delivers it.
 
 :func:`simulate_routine_day` runs :func:`~abrupt.simulate.attitude.simulate_pointing` noise-free at 5 Hz
 (nadir pointing, 2-4 slews of 15-45° about random axes, gravity gradient, a sun-tracking array, a small

@@ -2,9 +2,22 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import click
 
 from abrupt.cli.groups import cli
+from abrupt.cli.options import budget_options, pop_budget
+from abrupt.density.constellation import ConstellationConfig
+from abrupt.density.joint import JointConfig
+from abrupt.density.meteors import estimate_density_ratios, read_radar_csv
+from abrupt.density.precise_orbit import OrbitDensityConfig
+from abrupt.density.report import plot_density_bands, plot_meteor_profile
+from abrupt.density.tle_drag import TleDragConfig
+from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET
+from abrupt.pipelines.density import orbit_density, tle_density, write_table
+
+TLE_BUDGET = str(DEFAULT_TLE_BUDGET)  # "1/year", the maneuver detector's
 
 
 @cli.group("density")
@@ -29,6 +42,7 @@ def density() -> None:
     show_default=True,
     help="Remove maneuver gaps found by abrupt's TLE maneuver detector (orbit rises are always cut).",
 )
+@budget_options(TLE_BUDGET)
 @click.option("--no-model", is_flag=True, help="Single object: skip NRLMSIS along the orbit (faster).")
 @click.option(
     "--space-weather",
@@ -72,16 +86,14 @@ def density_tle(
     no_order_statistics: bool,
     workers: int,
     report: str | None,
+    **budget: Any,
 ) -> None:
     """ρB per window from element-set histories; with several objects, density by order statistics.
 
     With three or more objects the joint fit adds density_joint_kg_m3 (the recommended estimate).
+    --false-alarms is the budget of the maneuver detector (per satellite-year by default).
     """
-    from abrupt.density.constellation import ConstellationConfig
-    from abrupt.density.joint import JointConfig
-    from abrupt.density.tle_drag import TleDragConfig
-    from abrupt.pipelines.density import tle_density, write_table
-
+    maneuver_budget = pop_budget(budget, TLE_BUDGET)
     if interval_days <= 0:
         raise click.BadParameter("must be > 0", param_hint="--interval-days")
     if node_days <= 0 or block_days <= 0:
@@ -89,7 +101,11 @@ def density_tle(
     res = tle_density(
         list(paths),
         platforms=platforms,
-        config=TleDragConfig(interval_days=interval_days, with_model=not no_model or len(paths) > 1),
+        config=TleDragConfig(
+            interval_days=interval_days,
+            with_model=not no_model or len(paths) > 1,
+            maneuver_budget=maneuver_budget,
+        ),
         constellation=ConstellationConfig(kappa=kappa),
         maneuvers=maneuvers,
         space_weather=space_weather,
@@ -106,8 +122,6 @@ def density_tle(
     ok = int((res.windows["status"] == "ok").sum()) if len(res.windows) else 0
     click.echo(f"{ok} window(s) of {len(paths)} object(s) written to {out}")
     if report:
-        from abrupt.density.report import plot_density_bands
-
         plot_density_bands(res.windows, report, title="density from TLE decay")
         click.echo(f"report: {report}")
 
@@ -162,9 +176,6 @@ def density_orbit(
 
     With --mass-kg and --drag-area-m2 also the density (density_kg_m3) beside NRLMSIS along the orbit.
     """
-    from abrupt.density.precise_orbit import OrbitDensityConfig
-    from abrupt.pipelines.density import orbit_density, write_table
-
     if window_days <= 0:
         raise click.BadParameter("must be > 0", param_hint="--window-days")
     for name, value in (("--mass-kg", mass_kg), ("--drag-area-m2", drag_area_m2), ("--srp-area-m2", srp_area_m2)):
@@ -203,8 +214,6 @@ def density_orbit(
     ok = int((run.windows["status"] == "ok").sum()) if len(run.windows) else 0
     click.echo(f"{ok} window(s) of {len(paths)} file(s) written to {out}")
     if report:
-        from abrupt.density.report import plot_density_bands
-
         plot_density_bands(run.windows, report, title="density from precise orbits")
         click.echo(f"report: {report}")
 
@@ -218,9 +227,6 @@ def density_meteors(radar: str, out: str, report: str | None) -> None:
 
     RADAR columns: meteor_id, altitude_km, velocity_mps, deceleration_mps2.
     """
-    from abrupt.density.meteors import estimate_density_ratios, read_radar_csv
-    from abrupt.pipelines.density import write_table
-
     res = estimate_density_ratios(read_radar_csv(radar))
     write_table(res.ratios, out)
     click.echo(
@@ -228,7 +234,5 @@ def density_meteors(radar: str, out: str, report: str | None) -> None:
         f"residual RMS {res.residual_rms:.3f}; written to {out}"
     )
     if report:
-        from abrupt.density.report import plot_meteor_profile
-
         plot_meteor_profile(res.ratios, report)
         click.echo(f"report: {report}")

@@ -2,14 +2,32 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from pathlib import Path
+from typing import Any
 
 import click
+import numpy as np
 
 from abrupt.cli.groups import catalog_option, check_suffix, cli, detect, record_run, simulate
+from abrupt.cli.options import budget_options, pop_budget
+from abrupt.detect.base import DetectionResult
+from abrupt.events import config_hash, new_run_id, read_events
+from abrupt.massprops.track import InertiaTrack
+from abrupt.pipelines.mass import (
+    MomentumOptions,
+    detect_mass_change_run,
+    estimate_inertia_run,
+    inertia_report,
+    simulate_docking_run,
+    telemetry_input,
+    updated_spacecraft_toml,
+    write_report,
+)
+from abrupt.simulate.attitude import CircularOrbit
+from abrupt.simulate.docking import DockingScenario
 
-if TYPE_CHECKING:
-    from abrupt.pipelines.mass import MomentumOptions
+#: The mass-change detector's default false-alarm budget: one per satellite-year (daily windows).
+MASS_CHANGE_BUDGET = "1/year"
 
 
 @cli.group("estimate")
@@ -18,8 +36,6 @@ def estimate() -> None:
 
 
 def _options(orbit_period_s: float | None, tachometer_gate_s: float) -> MomentumOptions:
-    from abrupt.pipelines.mass import MomentumOptions
-
     return MomentumOptions(orbit_period_s=orbit_period_s, tachometer_gate_s=tachometer_gate_s)
 
 
@@ -84,16 +100,6 @@ def estimate_inertia_cmd(
     updated spacecraft file and a JSON report. Parameters the telemetry cannot determine are named and
     kept at the catalogue value.
     """
-    from pathlib import Path
-
-    from abrupt.pipelines.mass import (
-        estimate_inertia_run,
-        inertia_report,
-        telemetry_input,
-        updated_spacecraft_toml,
-        write_report,
-    )
-
     paths = telemetry_input(store, telemetry)
     est, sc, repairs = estimate_inertia_run(
         paths,
@@ -117,7 +123,7 @@ def estimate_inertia_cmd(
 @_orbit
 @_gate
 @click.option("--window", "window_s", type=float, default=86400.0, show_default=True, help="Window length [s].")
-@click.option("--false-alarms", "budget_text", default="1/year", show_default=True, help="Budget, e.g. 1/year.")
+@budget_options(MASS_CHANGE_BUDGET)
 @click.option("--radius", "radius_m", type=float, default=1.0, show_default=True, help="Assumed attachment radius [m].")
 @click.option("--attitude-events", type=click.Path(dir_okay=False), default=None, help="Events file to link with.")
 @click.option("--out", default=None, callback=check_suffix(".csv", ".parquet"), help="Events file.")
@@ -129,18 +135,14 @@ def detect_mass_change_cmd(
     orbit_period_s: float | None,
     tachometer_gate_s: float,
     window_s: float,
-    budget_text: str,
     radius_m: float,
     attitude_events: str | None,
     out: str | None,
     catalog_target: str,
+    **budget_args: Any,
 ) -> None:
     """Track the inertia window by window and report a mass change (GLR at the false-alarm budget)."""
-    from abrupt.events import config_hash, new_run_id, read_events
-    from abrupt.pipelines.mass import detect_mass_change_run, telemetry_input
-    from abrupt.thresholds import FalseAlarmBudget
-
-    budget = FalseAlarmBudget.parse(budget_text)
+    budget = pop_budget(budget_args, MASS_CHANGE_BUDGET)
     paths = telemetry_input(store, telemetry)
     att = read_events(attitude_events) if attitude_events else None
     run_id = new_run_id()
@@ -156,11 +158,7 @@ def detect_mass_change_cmd(
         run_id=run_id,
         config_hash=cfg,
     )
-    diag = result.diagnostic("inertia_glr")
-    click.echo(
-        f"{track.n_windows} windows; GLR statistic max {float(max(diag.statistic, default=0)):.1f}, "
-        f"threshold {diag.threshold.value if diag.threshold else float('nan'):.1f} ({budget})"
-    )
+    click.echo(_glr_summary(result, track, str(budget)))
     for w in result.warnings:
         click.echo(f"warning: {w}", err=True)
     for _, ev in result.events.iterrows():
@@ -176,6 +174,18 @@ def detect_mass_change_cmd(
         config_hash=cfg,
         run_id=run_id,
         out=out,
+    )
+
+
+def _glr_summary(result: DetectionResult, track: InertiaTrack, budget: str) -> str:
+    """One line: windows, the largest GLR statistic and the threshold (or that no change could be tested)."""
+    diag = result.diagnostic("inertia_glr")
+    tested = diag.statistic[np.isfinite(diag.statistic)]
+    if diag.threshold is None or tested.size == 0:
+        return f"{track.n_windows} windows; no change tested, no events ({budget})"
+    return (
+        f"{track.n_windows} windows; GLR statistic max {float(tested.max()):.1f}, "
+        f"threshold {diag.threshold.value:.1f} ({budget})"
     )
 
 
@@ -216,10 +226,6 @@ def simulate_docking_cmd(
 ) -> None:
     """Simulate routine telemetry (nadir pointing, slews, momentum dumps) with a parasite docking; one CSV
     per day (the dumps are listed in docking_truth.json)."""
-    from abrupt.pipelines.mass import simulate_docking_run
-    from abrupt.simulate.attitude import CircularOrbit
-    from abrupt.simulate.docking import DockingScenario
-
     scenario = DockingScenario(
         days=days,
         docking_time_s=None if docking_day < 0 else docking_day * 86400.0,

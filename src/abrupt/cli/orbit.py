@@ -1,15 +1,16 @@
 """Command-line commands of the orbit-side impulse detector (registered on the shared groups).
 
 ``abrupt simulate orbit``, ``abrupt detect orbit``, ``abrupt inject orbit``, ``abrupt report orbit``.
-Heavy imports happen inside the commands so ``abrupt --help`` stays fast.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import click
+import pandas as pd
 
 from abrupt.cli.groups import (
     catalog_option,
@@ -21,19 +22,19 @@ from abrupt.cli.groups import (
     simulate,
     spacecraft_name_option,
 )
+from abrupt.cli.options import budget_options, pop_budget
+from abrupt.detect.orbit.detectors import STATISTIC_SUMMARIES
 from abrupt.errors import ConfigError
+from abrupt.events import config_hash, new_run_id, read_events
+from abrupt.model.orbit import ForceModel
+from abrupt.pipelines.orbit import detect_orbit, inject_orbit, summary_lines
+from abrupt.readers.ephemeris import write_ephemeris
+from abrupt.readers.navigation_csv import write_navigation_csv
+from abrupt.report.orbit import plot_orbit_report
+from abrupt.simulate.orbit import Impulse, OrbitSimulationConfig, simulate_orbit
 
-STATISTIC_CHOICES = (
-    "glr",
-    "dv_fb",
-    "mahalanobis_v",
-    "accel_smoothed",
-    "mcr_w",
-    "mcr_scalar",
-    "d_sma",
-    "d_ecc",
-    "d_hdir",
-)
+#: the statistics ``--statistic`` accepts (each is the registered detector ``orbit.<statistic>``)
+STATISTIC_CHOICES = tuple(STATISTIC_SUMMARIES)
 
 
 def _parse_vector(text: str, what: str) -> tuple[float, float, float]:
@@ -132,12 +133,6 @@ def simulate_orbit_command(
     seed: int,
 ) -> None:
     """Simulate a truth orbit with impulsive ΔVs and GNSS-like navigation solutions (Bennett 2022 §3.1)."""
-    from dataclasses import replace
-
-    from abrupt.model.orbit import ForceModel
-    from abrupt.readers.navigation_csv import write_navigation_csv
-    from abrupt.simulate.orbit import Impulse, OrbitSimulationConfig, simulate_orbit
-
     kicks = []
     for text in impulses:
         if ":" not in text:
@@ -191,13 +186,7 @@ def simulate_orbit_command(
     default=None,
     help="Alias of --detector orbit.STATISTIC (default: glr with auto tuning, mcr_w with thesis tuning).",
 )
-@click.option(
-    "--false-alarms",
-    "false_alarms",
-    default=None,
-    help="False-alarm budget, e.g. '1/week' (default), '0.5/day', '2/year'.",
-)
-@click.option("--false-alarms-per-week", type=float, default=None, help="Alias: --false-alarms N/week.")
+@budget_options("1/week")
 @click.option(
     "--null",
     "null_file",
@@ -236,8 +225,6 @@ def detect_orbit_command(
     allow_truncated: bool,
     detector_name: str | None,
     statistic: str | None,
-    false_alarms: str | None,
-    false_alarms_per_week: float | None,
     null_file: str | None,
     confidence_z: float,
     kind: str,
@@ -245,6 +232,7 @@ def detect_orbit_command(
     pseudonym: str | None,
     catalog_target: str,
     report_path: str | None,
+    **budget_args: Any,
 ) -> None:
     """Detect impulsive and finite velocity changes in navigation data (SP3, OEM or CSV) and write events.
 
@@ -252,20 +240,7 @@ def detect_orbit_command(
     backward filter, Fraser-Potter fusion and test statistics (Bennett 2022 ch. 3); thresholds at the
     false-alarm budget (default one per week).
     """
-    from abrupt.events import new_run_id
-    from abrupt.pipelines.orbit import detect_orbit, summary_lines
-    from abrupt.thresholds import FalseAlarmBudget
-
-    if false_alarms is not None and false_alarms_per_week is not None:
-        raise ConfigError("give --false-alarms or --false-alarms-per-week, not both", key="false-alarms")
-    try:
-        budget = (
-            FalseAlarmBudget(false_alarms_per_week, "week")
-            if false_alarms_per_week is not None
-            else FalseAlarmBudget.parse(false_alarms or "1/week")
-        )
-    except ValueError as exc:
-        raise ConfigError(str(exc), key="false-alarms") from None
+    budget = pop_budget(budget_args, "1/week")
     if detector_name is not None and statistic is not None:
         raise ConfigError("give --detector or --statistic, not both", key="detector")
     name = detector_name or statistic or ("glr" if tuning == "auto" else "mcr_w")
@@ -297,11 +272,9 @@ def detect_orbit_command(
         click.echo(f"repaired: {line}", err=True)
     for warning in run.result.warnings:
         click.echo(f"warning: {warning}", err=True)
-    # The fit (residual RMS, estimated parameters, thresholds) is printed on every run (issue 10 item 6).
+    # the fit (residual RMS, estimated parameters, thresholds) is printed on every run
     click.echo("\n".join(summary_lines(run.summary)), err=True)
     if statistics_out and run.analysis is not None:
-        import pandas as pd
-
         frame = pd.DataFrame({"time_utc": run.analysis.ephemeris.times_utc, **run.analysis.statistics})
         Path(statistics_out).parent.mkdir(parents=True, exist_ok=True)
         if statistics_out.endswith(".csv"):
@@ -311,8 +284,6 @@ def detect_orbit_command(
     events = run.events
     chash = str(events["config_hash"].iloc[0]) if len(events) else ""
     if not chash:
-        from abrupt.events import config_hash
-
         chash = config_hash({**run.detector.config(), "budget": str(budget)})
     record_run(
         catalog_target=catalog_target,
@@ -325,12 +296,9 @@ def detect_orbit_command(
         details={k: v for k, v in run.summary.items() if k != "warnings"}
         | {"repairs": run.ephemeris.repairs.as_dict()},
     )
-    if report_path:
-        from abrupt.report.orbit import plot_orbit_report
-
-        if run.analysis is not None:
-            path = plot_orbit_report(run.analysis, run.thresholds, events, report_path)
-            click.echo(f"report written to {path}", err=True)
+    if report_path and run.analysis is not None:
+        path = plot_orbit_report(run.analysis, run.thresholds, events, report_path)
+        click.echo(f"report written to {path}", err=True)
 
 
 @inject.command("orbit")
@@ -358,9 +326,6 @@ def inject_orbit_command(
     file: str, time_utc: str, dv_rtn: str, duration_s: float, satellite: str | None, allow_truncated: bool, out: str
 ) -> None:
     """Add the effect of a ΔV (impulse or finite burn) at a chosen time to a real ephemeris."""
-    from abrupt.pipelines.orbit import inject_orbit
-    from abrupt.readers.ephemeris import write_ephemeris
-
     try:
         out_eph = inject_orbit(
             file,
@@ -387,7 +352,7 @@ def inject_orbit_command(
 @click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="PNG to write.")
 @_filter_options
 @click.option("--events", "events_file", type=click.Path(exists=True, dir_okay=False), default=None)
-@click.option("--false-alarms-per-week", type=float, default=1.0, show_default=True)
+@budget_options("1/week")
 def report_orbit_command(
     file: str,
     out: str,
@@ -402,18 +367,13 @@ def report_orbit_command(
     satellite: str | None,
     allow_truncated: bool,
     events_file: str | None,
-    false_alarms_per_week: float,
+    **budget_args: Any,
 ) -> None:
     """Report panels: filter residuals, each statistic with its threshold, and events."""
-    from abrupt.events import read_events
-    from abrupt.pipelines.orbit import detect_orbit
-    from abrupt.report.orbit import plot_orbit_report
-    from abrupt.thresholds import FalseAlarmBudget
-
     run = detect_orbit(
         file,
         detector="glr" if tuning == "auto" else "mcr_w",
-        budget=FalseAlarmBudget(false_alarms_per_week, "week"),
+        budget=pop_budget(budget_args, "1/week"),
         satellite=satellite,
         allow_truncated=allow_truncated,
         tuning=tuning,

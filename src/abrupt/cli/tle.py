@@ -9,10 +9,13 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any
 
 import click
+import pandas as pd
+from scipy.stats import binom
 
 from abrupt.cli.groups import (
     catalog_option,
@@ -24,7 +27,19 @@ from abrupt.cli.groups import (
     report_option,
     spacecraft_name_option,
 )
+from abrupt.cli.options import budget_options, pop_budget
+from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET, TleDetectorConfig
+from abrupt.detect.tle.detectors import detector_for
 from abrupt.errors import InputError
+from abrupt.events import config_hash, new_run_id, read_events
+from abrupt.pipelines.tle import detect_tle_file, satellite_label
+from abrupt.readers.fengyun import read_maneuver_file
+from abrupt.readers.omm import read_elements
+from abrupt.report.tle import plot_injection_recall, plot_tle_report
+from abrupt.score import recall_at_false_alarm_rate, score_events
+from abrupt.simulate.tle_injection import KINDS, MIN_ELEMENT_SETS, injection_recall, ladder_around
+
+TLE_BUDGET = str(DEFAULT_TLE_BUDGET)  # "1/year"
 
 norad_option = click.option(
     "--norad",
@@ -40,18 +55,7 @@ norad_option = click.option(
 @click.option("--out", type=click.Path(dir_okay=False), default=None, help="Events file (.csv or .parquet).")
 @norad_option
 @spacecraft_name_option
-@click.option(
-    "--false-alarms",
-    "false_alarms",
-    default=None,
-    help="False-alarm budget, e.g. '1/year' (per satellite-year; also '/week', '/day').  [default: 1/year]",
-)
-@click.option(
-    "--false-alarms-per-year",
-    type=float,
-    default=None,
-    help="Alias of --false-alarms N/year (kept for old scripts).",
-)
+@budget_options(TLE_BUDGET)
 @click.option(
     "--detector",
     type=click.Choice(["auto", "tle.mean_elements", "tle.geo_station_keeping"]),
@@ -81,8 +85,6 @@ def detect_tle(
     out: str | None,
     norad_id: int | None,
     pseudonym: str | None,
-    false_alarms: str | None,
-    false_alarms_per_year: float | None,
     detector: str,
     threshold: float | None,
     window_sets: int,
@@ -90,25 +92,15 @@ def detect_tle(
     strict: bool,
     catalog_target: str,
     report_path: str | None,
+    **budget_given: Any,
 ) -> None:
     """Detect maneuvers in a TLE, 3LE or OMM (XML, KVN, JSON, CSV) history; every satellite of the file.
 
     Example: abrupt detect tle Jason-3.tle --out jason3_events.csv --false-alarms 1/year
     """
-    from abrupt.events import config_hash, new_run_id
-    from abrupt.pipelines.tle import detect_tle_file, satellite_label
-    from abrupt.thresholds import FalseAlarmBudget
-
-    if false_alarms is not None and false_alarms_per_year is not None:
-        raise click.BadParameter("give --false-alarms or its alias --false-alarms-per-year, not both")
+    budget = pop_budget(budget_given, TLE_BUDGET)
     try:
-        if false_alarms_per_year is not None:
-            budget = FalseAlarmBudget(false_alarms_per_year, "year")
-        else:
-            budget = FalseAlarmBudget.parse(false_alarms or "1/year")
         settings: dict[str, Any] = {"window_sets": window_sets, "threshold": threshold}
-        from abrupt.detect.tle.maneuvers import TleDetectorConfig
-
         TleDetectorConfig(window_sets=window_sets, threshold=threshold)  # validate before reading
     except ValueError as exc:
         raise click.BadParameter(str(exc)) from None
@@ -170,8 +162,6 @@ def detect_tle(
         details=details,
     )
     if report_path:
-        from abrupt.report.tle import plot_tle_report
-
         for sat in result.satellites:  # one figure per satellite: NAME.png, or NAME_<norad>.png for several
             target = Path(report_path)
             if len(result.satellites) > 1:
@@ -197,6 +187,7 @@ def detect_tle(
 @click.option("--tolerance-days", type=float, default=1.0, show_default=True)
 @click.option("--out", type=click.Path(dir_okay=False), required=True, help="Figure file (.png, .svg, .pdf).")
 @norad_option
+@budget_options(TLE_BUDGET)
 def report_tle(
     path: str,
     events_path: str | None,
@@ -204,15 +195,15 @@ def report_tle(
     tolerance_days: float,
     out: str,
     norad_id: int | None,
+    **budget_given: Any,
 ) -> None:
-    """Element series of a TLE/OMM history with detected maneuvers and (optionally) the operator's."""
-    from abrupt.detect.tle.maneuvers import detect_tle_maneuvers
-    from abrupt.events import read_events
-    from abrupt.readers.omm import read_elements
-    from abrupt.report.tle import plot_tle_report
+    """Element series of a TLE/OMM history with detected maneuvers and (optionally) the operator's.
 
+    Without --events the detector of the orbit runs now at --false-alarms.
+    """
+    budget = pop_budget(budget_given, TLE_BUDGET)
     history = read_elements(path, norad_id=norad_id)
-    events = read_events(events_path) if events_path else detect_tle_maneuvers(history)
+    events = read_events(events_path) if events_path else detector_for(history).detect(history, budget).events
     truth_frame = _read_truth(truth) if truth else None
     written = plot_tle_report(history, events, out, truth=truth_frame, tolerance_s=tolerance_days * 86400.0)
     click.echo(f"report written to {written}", err=True)
@@ -221,9 +212,6 @@ def report_tle(
 def _read_truth(path: str) -> Any:
     """Truth list: an events file (.csv/.parquet with the event columns) or an operator maneuver file
     (IDS ``*man.txt``, TAI epochs; Fengyun ``.fy``, China Standard Time)."""
-    from abrupt.events import read_events
-    from abrupt.readers.fengyun import read_maneuver_file
-
     if path.lower().endswith((".parquet", ".pq")):
         return read_events(path)
     with open(path, encoding="utf-8", errors="replace") as fh:
@@ -236,10 +224,6 @@ def _read_truth(path: str) -> Any:
 def chance_matches(n_det: int, n_truth: int, tolerance_s: float, start: Any, end: Any, events: Any) -> float:
     """Matches expected by chance: detections spread uniformly over the span, each truth matched when a
     detection falls within ± tolerance (Poisson: 1 − exp(−n_det·2·tol/span) per truth)."""
-    import math
-
-    import pandas as pd
-
     if start is None or end is None:
         if len(events) < 2:
             return 0.0
@@ -304,14 +288,9 @@ def score(
 
     Example: abrupt score jason3_events.csv --truth ja3man.txt --elements Jason-3.tle
     """
-    from abrupt.events import read_events
-    from abrupt.score import recall_at_false_alarm_rate, score_events
-
     events = read_events(events_path)
     truth_frame = _read_truth(truth)
     if elements:
-        from abrupt.readers.omm import read_elements
-
         el = read_elements(elements).elements
         start, end = str(el["epoch_utc"].iloc[0]), str(el["epoch_utc"].iloc[-1])
     if len(truth_frame) == 0:
@@ -322,8 +301,6 @@ def score(
         raise InputError("no truth maneuver inside the observed span: nothing to score against", file=truth)
     chance = chance_matches(result.n_detections, result.n_truth, tol, start, end, events)
     if result.n_truth >= 5:
-        from scipy.stats import binom
-
         p_chance = float(binom.sf(result.true_positives - 1, result.n_truth, chance / result.n_truth))
         if p_chance > 0.01:  # as many matches as random times would give: likely another satellite's file
             click.echo(
@@ -370,7 +347,7 @@ def score(
     help="Known maneuvers (events file or operator file) kept out of the noise; default: the detector's own "
     "detections on the history.",
 )
-@click.option("--false-alarms", "false_alarms", default="1/year", show_default=True, help="False-alarm budget.")
+@budget_options(TLE_BUDGET)
 @click.option("--years", type=float, default=6.0, show_default=True, help="Length of each simulated history.")
 @click.option("--seeds", type=int, default=4, show_default=True, help="Simulated histories (different noise draws).")
 @click.option("--out", type=click.Path(dir_okay=False), default=None, help="Every injected burn, found or not (.csv).")
@@ -380,12 +357,12 @@ def inject_tle(
     path: str,
     norad_id: int | None,
     maneuvers_path: str | None,
-    false_alarms: str,
     years: float,
     seeds: int,
     out: str | None,
     strict: bool,
     report_path: str | None,
+    **budget_given: Any,
 ) -> None:
     """What the detector sees on this satellite: burns of known ΔV injected into its own noise.
 
@@ -396,16 +373,7 @@ def inject_tle(
 
     Example: abrupt inject tle Jason-3.tle --maneuvers ja3man.txt --seeds 4
     """
-    import pandas as pd
-
-    from abrupt.pipelines.tle import detect_tle_file, satellite_label
-    from abrupt.simulate.tle_injection import KINDS, MIN_ELEMENT_SETS, injection_recall, ladder_around
-    from abrupt.thresholds import FalseAlarmBudget
-
-    try:
-        budget = FalseAlarmBudget.parse(false_alarms)
-    except ValueError as exc:
-        raise click.BadParameter(str(exc), param_hint="--false-alarms") from None
+    budget = pop_budget(budget_given, TLE_BUDGET)
     if not (years >= 1.0 and years <= 50.0):
         raise click.BadParameter(f"{years} years: give 1 to 50", param_hint="--years")
     if not (1 <= seeds <= 100):
@@ -468,8 +436,6 @@ def inject_tle(
         burns.to_csv(out, index=False)
         click.echo(f"burns written to {out}", err=True)
     if report_path:
-        from abrupt.report.tle import plot_injection_recall
-
         label = f"{satellite_label(sat.history)}: injected burns"
         target = plot_injection_recall(burns, summary, report_path, title=label)
         click.echo(f"report written to {target}", err=True)

@@ -39,6 +39,7 @@ import pandas as pd
 from abrupt.density.drag_coefficient import FlowConditions, box_ballistic_coefficient, minimum_ballistic_coefficient
 from abrupt.density.order_statistics import BallisticDistribution, fit_ballistic_distribution, ratios_to_minimum
 from abrupt.errors import InputError
+from abrupt.model.atmosphere import msis_density, read_space_weather
 from abrupt.types import FloatArray
 
 PLATFORM_COLUMNS = ("object", "shape_class", "min_area_m2", "max_area_m2", "mass_kg")
@@ -146,8 +147,6 @@ class ConstellationResult:
 
 def flow_from_windows(windows: pd.DataFrame, space_weather: Any) -> FlowConditions:
     """Typical flow (speed, temperature, molar mass) at the constellation's median altitude (NRLMSIS)."""
-    from abrupt.model.atmosphere import msis_density
-
     alt = float(np.nanmedian(windows["altitude_km"]))
     mids = windows["window_start_utc"].drop_duplicates().to_numpy(dtype="datetime64[ns]")
     mids = mids[:: max(1, mids.size // 30)]
@@ -204,8 +203,6 @@ def estimate_constellation_density(
     if have_geometry:
         assert platforms is not None
         if flow is None:
-            from abrupt.model.atmosphere import read_space_weather
-
             flow = flow_from_windows(w, space_weather if space_weather is not None else read_space_weather())
         alphas = np.linspace(*cfg.accommodation_range, cfg.n_accommodation)
         per_obj = np.stack([platform_minimum_b(r, flow, alphas) for r in platforms.to_dict(orient="records")])

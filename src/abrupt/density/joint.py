@@ -1,4 +1,4 @@
-"""Joint fit of a common density scale s(t) and every object's ballistic coefficient (issue 14).
+"""Joint fit of a common density scale s(t) and every object's ballistic coefficient.
 
 Close & Li 2015 separate density from B with order statistics of per-epoch ratios. When the same
 platforms are seen for weeks, their B_j are nearly constant (fixed or slowly changing attitudes) and
@@ -42,9 +42,11 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-from scipy.optimize import minimize
-from scipy.special import betainc, ndtr
+from scipy.linalg import solveh_banded
+from threadpoolctl import threadpool_limits
 
+from abrupt.density.absolute_scale import ScaleEstimate, estimate_scale
+from abrupt.density.constellation import platform_b_range
 from abrupt.density.tle_drag import DecayTrack
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2
 from abrupt.thresholds.noise import MAD_TO_SIGMA, robust_scale
@@ -159,18 +161,78 @@ def fit_joint_density(
 
     The many small dense solves run on one BLAS thread (threads only contend at this size).
     """
-    from threadpoolctl import threadpool_limits
-
     with threadpool_limits(limits=1, user_api="blas"):
         return _fit_joint_density(tracks, origin_utc, config or JointConfig())
+
+
+@dataclass
+class _Layout:
+    """Where each object-block's parameters sit among the nodes, and the fit's fixed matrices."""
+
+    n_nodes: int
+    p_lo: Any  # first node column of each object-block
+    p_hi: Any  # one past its last node column
+    bandwidth: int
+    has_data: Any  # nodes with any set's weight on them
+    param_obj: Any  # object-block → object index (folds for choosing λ)
+    n_folds: int
 
 
 def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: JointConfig) -> JointFit:
     origin: Any = pd.Timestamp(origin_utc).to_datetime64().astype("datetime64[ns]")
     step_s = cfg.node_days * SECONDS_PER_DAY
-    block_s = cfg.block_days * SECONDS_PER_DAY
     end = max(float(_seconds(tr.grid_utc[-1:], origin)[0]) for tr in tracks if len(tr.grid_utc))
     n_nodes = math.ceil(end / step_s) + 2
+    segments, params = _segments(tracks, origin, cfg, n_nodes)
+    if not segments:
+        raise ValueError("no object has a segment of three or more element sets: nothing to fit")
+    n_obj = len(tracks)
+    sigma = _initial_sigma(segments, n_obj)
+    layout = _layout(segments, params, n_nodes)
+    n_par = len(params)
+    penalty = _second_difference(n_nodes)
+    s: FloatArray = np.ones(n_nodes)
+    b: FloatArray = np.zeros(n_par)
+    lam = cfg.smoothing
+    normal = np.zeros((n_nodes, n_nodes))
+    it = 0
+    converged = False
+    warnings: list[str] = []
+    for outer in range(1, cfg.reweightings + 1):
+        mats, vecs, yyq = _sufficient_statistics(segments, sigma, layout)
+        s_prev_outer = s.copy()
+        if cfg.l1_floor > 0 and outer > 1:
+            # ℓ1 trend filtering by reweighting (Kim et al. 2009, SIAM Rev. 51): weights 1/|D₂s| let
+            # s(t) bend sharply at a storm's onset and end instead of rounding them off.
+            d2 = s[:-2] - 2.0 * s[1:-1] + s[2:]
+            wd = 1.0 / np.maximum(np.abs(d2), cfg.l1_floor)
+            penalty = _second_difference(n_nodes, wd / np.mean(wd))
+        s, b, lam, n_it = _scale_iterations(s, b, lam, normal, penalty, mats, vecs, yyq, layout, cfg, outer)
+        it += n_it
+        _reweight(segments, sigma, b, s, cfg.huber)
+        # Converged when the reweighting moves s by < 0.3 % RMS (the end nodes, barely constrained,
+        # keep jittering with the Huber weights and are not looked at).
+        if outer > 2 and float(np.sqrt(np.mean((s - s_prev_outer)[layout.has_data] ** 2))) < 3e-3:
+            converged = True
+            break
+    if not converged:
+        warnings.append(f"joint fit: s(t) still changing after {cfg.reweightings} reweightings")
+    assert lam is not None
+    cov = _solve_spd(normal + lam * penalty, np.eye(n_nodes), layout.bandwidth)
+    cov *= 1.0 / float(np.mean(s[layout.has_data])) ** 2
+    frame = _b_frame(tracks, segments, params, mats, s, b, layout)
+    s_out = np.where(layout.has_data, s, np.nan)
+    sigmas = {tr.name: float(sigma[j]) for j, tr in enumerate(tracks)}
+    return JointFit(origin, cfg.node_days, s_out, cov, frame, sigmas, float(lam), it, warnings)
+
+
+def _segments(
+    tracks: Sequence[DecayTrack], origin: Any, cfg: JointConfig, n_nodes: int
+) -> tuple[list[_Segment], list[tuple[int, int]]]:
+    """Each object's kept sets cut at its segments and B blocks (three sets or more), with their
+    design rows, and the object-blocks (object index, block number) they belong to."""
+    step_s = cfg.node_days * SECONDS_PER_DAY
+    block_s = cfg.block_days * SECONDS_PER_DAY
     coef = 1.5 * MU_EARTH_WGS72_M3_S2 ** (-2.0 / 3.0)
     segments: list[_Segment] = []
     params: list[tuple[int, int]] = []
@@ -194,16 +256,21 @@ def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: Joint
                 param_index[pk] = len(params)
                 params.append(pk)
             segments.append(_Segment(j, param_index[pk], tr.n_rad_s[idx].astype(float), g, col0, np.ones(idx.size)))
-    if not segments:
-        raise ValueError("no object has a segment of three or more element sets: nothing to fit")
-    n_obj = len(tracks)
+    return segments, params
+
+
+def _initial_sigma(segments: list[_Segment], n_obj: int) -> FloatArray:
+    """Initial σ_j from each object's neighbour residual scatter (any positive guess works)."""
     sigma = np.ones(n_obj)
-    # Initial σ_j from each object's neighbour residual scatter (any positive guess works).
     for j in range(n_obj):
         ys = [np.diff(sg.y, 2) for sg in segments if sg.obj == j]
         v = np.concatenate(ys) if ys else np.zeros(0)
         sigma[j] = float(robust_scale(v)) / math.sqrt(6.0) if v.size else 1.0
         sigma[j] = sigma[j] if sigma[j] > 0 else 1e-12
+    return sigma
+
+
+def _layout(segments: list[_Segment], params: list[tuple[int, int]], n_nodes: int) -> _Layout:
     n_par = len(params)
     has_data = np.zeros(n_nodes, dtype=bool)
     for sg in segments:
@@ -215,106 +282,129 @@ def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: Joint
         p_lo[sg.param] = min(p_lo[sg.param], sg.col0)
         p_hi[sg.param] = max(p_hi[sg.param], sg.col0 + sg.g.shape[1])
     bandwidth = max(2, int(np.max(p_hi - p_lo)) - 1)
-    penalty = _second_difference(n_nodes)
     # Objects → folds for choosing λ (object-wise cross-validation: an object left out is predicted
     # by the density scale the others give, with its own B and offsets refitted).
     obj_ids = np.array([params[q][0] for q in range(n_par)])
     order = {o: i for i, o in enumerate(np.unique(obj_ids))}
     param_obj = np.array([order[o] for o in obj_ids])
-    n_folds = min(5, len(order))
-    s: FloatArray = np.ones(n_nodes)
-    b: FloatArray = np.zeros(n_par)
-    lam = cfg.smoothing
-    normal = np.zeros((n_nodes, n_nodes))
+    return _Layout(n_nodes, p_lo, p_hi, bandwidth, has_data, param_obj, min(5, len(order)))
+
+
+def _sufficient_statistics(
+    segments: list[_Segment], sigma: FloatArray, layout: _Layout
+) -> tuple[list[FloatArray], list[FloatArray], FloatArray]:
+    """Sufficient statistics of each object-block for the current weights: with the offsets profiled
+    out (weighted centring per segment), n̄ − n0 = b·G s gives b = sᵀr/sᵀMs and the s-step normal
+    matrix Σ b² M (Gauss-Markov; the offsets cost one degree of freedom each)."""
+    p_lo, p_hi = layout.p_lo, layout.p_hi
+    n_par = p_lo.size
+    mats = [np.zeros((int(p_hi[q] - p_lo[q]),) * 2) for q in range(n_par)]
+    vecs = [np.zeros(int(p_hi[q] - p_lo[q])) for q in range(n_par)]
+    yyq = np.zeros(n_par)
+    for sg in segments:
+        w = sg.weight / sigma[sg.obj] ** 2
+        sw = float(np.sum(w))
+        gc = sg.g - (w @ sg.g) / sw
+        yc = sg.y - float(w @ sg.y) / sw
+        o = sg.col0 - int(p_lo[sg.param])
+        k = sg.g.shape[1]
+        mats[sg.param][o : o + k, o : o + k] += gc.T @ (w[:, None] * gc)
+        vecs[sg.param][o : o + k] += gc.T @ (w * yc)
+        yyq[sg.param] += float(w @ (yc * yc))
+    return mats, vecs, yyq
+
+
+def _scale_iterations(
+    s: FloatArray,
+    b: FloatArray,
+    lam: float | None,
+    normal: FloatArray,
+    penalty: FloatArray,
+    mats: list[FloatArray],
+    vecs: list[FloatArray],
+    yyq: FloatArray,
+    layout: _Layout,
+    cfg: JointConfig,
+    outer: int,
+) -> tuple[FloatArray, FloatArray, float | None, int]:
+    """Alternate b (closed form given s) and s (penalised normal equations) at fixed weights; λ by
+    object-wise cross-validation on the first iterations. ``normal`` is filled in place (the last
+    iteration's is the covariance's). Returns s, b, λ and the iterations run."""
+    p_lo, p_hi, n_nodes, has_data = layout.p_lo, layout.p_hi, layout.n_nodes, layout.has_data
+    n_par = p_lo.size
     it = 0
-    converged = False
-    warnings: list[str] = []
-    for outer in range(1, cfg.reweightings + 1):
-        # Sufficient statistics of each object-block for the current weights: with the offsets
-        # profiled out (weighted centring per segment), n̄ − n0 = b·G s gives b = sᵀr/sᵀMs and the
-        # s-step normal matrix Σ b² M (Gauss-Markov; the offsets cost one degree of freedom each).
-        mats = [np.zeros((int(p_hi[q] - p_lo[q]),) * 2) for q in range(n_par)]
-        vecs = [np.zeros(int(p_hi[q] - p_lo[q])) for q in range(n_par)]
-        yyq = np.zeros(n_par)
-        for sg in segments:
-            w = sg.weight / sigma[sg.obj] ** 2
-            sw = float(np.sum(w))
-            gc = sg.g - (w @ sg.g) / sw
-            yc = sg.y - float(w @ sg.y) / sw
-            o = sg.col0 - int(p_lo[sg.param])
-            k = sg.g.shape[1]
-            mats[sg.param][o : o + k, o : o + k] += gc.T @ (w[:, None] * gc)
-            vecs[sg.param][o : o + k] += gc.T @ (w * yc)
-            yyq[sg.param] += float(w @ (yc * yc))
-        s_prev_outer = s.copy()
-        if cfg.l1_floor > 0 and outer > 1:
-            # ℓ1 trend filtering by reweighting (Kim et al. 2009, SIAM Rev. 51): weights 1/|D₂s| let
-            # s(t) bend sharply at a storm's onset and end instead of rounding them off.
-            d2 = s[:-2] - 2.0 * s[1:-1] + s[2:]
-            wd = 1.0 / np.maximum(np.abs(d2), cfg.l1_floor)
-            penalty = _second_difference(n_nodes, wd / np.mean(wd))
-        for inner in range(cfg.iterations):
-            it += 1
-            sp = [s[p_lo[q] : p_hi[q]] for q in range(n_par)]
-            den = np.array([float(x @ m @ x) for x, m in zip(sp, mats, strict=True)])
-            num = np.array([float(x @ v) for x, v in zip(sp, vecs, strict=True)])
-            b = np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
-            normal.fill(0.0)
-            rhs = np.zeros(n_nodes)
-            for q in range(n_par):
-                normal[p_lo[q] : p_hi[q], p_lo[q] : p_hi[q]] += b[q] ** 2 * mats[q]
-                rhs[p_lo[q] : p_hi[q]] += b[q] * vecs[q]
-            scale_n = float(np.trace(normal)) / max(float(np.trace(penalty)), 1e-300)
-            normal[np.diag_indices(n_nodes)] += 1e-10 * scale_n
-            if cfg.smoothing is None and inner == 0 and (outer <= 3 or lam is None):
-                folds = [np.flatnonzero(param_obj % n_folds == f) for f in range(n_folds)]
-                stats = _FitStatistics(normal, rhs, penalty, mats, vecs, yyq, b, p_lo, p_hi, bandwidth)
-                lam = _cross_validated_lambda(stats, folds, scale_n)
-            assert lam is not None
-            s_new = _solve_spd(normal + lam * penalty, rhs, bandwidth)
-            norm = float(np.mean(s_new[has_data])) if np.any(has_data) else 1.0
-            if not norm > 0:
-                raise ValueError("the joint fit found no net decay (mean density scale <= 0)")
-            s_new = s_new / norm
-            b = b * norm
-            change = float(np.max(np.abs(s_new - s)[has_data]))
-            s = s_new
-            if change < cfg.tolerance:
-                break
-        # Residuals → σ_j (robust scale about zero: the offsets centre them) and Huber weights.
-        res_by_obj: list[list[FloatArray]] = [[] for _ in range(n_obj)]
-        resid_seg = []
-        for sg in segments:
-            w = sg.weight / sigma[sg.obj] ** 2
-            r = sg.y - b[sg.param] * (sg.g @ s[sg.col0 : sg.col0 + sg.g.shape[1]])
-            r = r - float(w @ r) / float(np.sum(w))
-            resid_seg.append(r)
-            res_by_obj[sg.obj].append(r)
-        for j in range(n_obj):
-            if res_by_obj[j]:
-                v = np.concatenate(res_by_obj[j])
-                mad = float(MAD_TO_SIGMA * np.median(np.abs(v)))
-                sigma[j] = mad if mad > 0 else sigma[j]
-        for sg, r in zip(segments, resid_seg, strict=True):
-            z = np.abs(r) / sigma[sg.obj]
-            sg.weight = np.minimum(1.0, cfg.huber / np.maximum(z, 1e-12))
-        # Converged when the reweighting moves s by < 0.3 % RMS (the end nodes, barely constrained,
-        # keep jittering with the Huber weights and are not looked at).
-        if outer > 2 and float(np.sqrt(np.mean((s - s_prev_outer)[has_data] ** 2))) < 3e-3:
-            converged = True
+    for inner in range(cfg.iterations):
+        it += 1
+        sp = [s[p_lo[q] : p_hi[q]] for q in range(n_par)]
+        den = np.array([float(x @ m @ x) for x, m in zip(sp, mats, strict=True)])
+        num = np.array([float(x @ v) for x, v in zip(sp, vecs, strict=True)])
+        b = np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
+        normal.fill(0.0)
+        rhs = np.zeros(n_nodes)
+        for q in range(n_par):
+            normal[p_lo[q] : p_hi[q], p_lo[q] : p_hi[q]] += b[q] ** 2 * mats[q]
+            rhs[p_lo[q] : p_hi[q]] += b[q] * vecs[q]
+        scale_n = float(np.trace(normal)) / max(float(np.trace(penalty)), 1e-300)
+        normal[np.diag_indices(n_nodes)] += 1e-10 * scale_n
+        if cfg.smoothing is None and inner == 0 and (outer <= 3 or lam is None):
+            folds = [np.flatnonzero(layout.param_obj % layout.n_folds == f) for f in range(layout.n_folds)]
+            stats = _FitStatistics(normal, rhs, penalty, mats, vecs, yyq, b, p_lo, p_hi, layout.bandwidth)
+            lam = _cross_validated_lambda(stats, folds, scale_n)
+        assert lam is not None
+        s_new = _solve_spd(normal + lam * penalty, rhs, layout.bandwidth)
+        norm = float(np.mean(s_new[has_data])) if np.any(has_data) else 1.0
+        if not norm > 0:
+            raise ValueError("the joint fit found no net decay (mean density scale <= 0)")
+        s_new = s_new / norm
+        b = b * norm
+        change = float(np.max(np.abs(s_new - s)[has_data]))
+        s = s_new
+        if change < cfg.tolerance:
             break
-    if not converged:
-        warnings.append(f"joint fit: s(t) still changing after {cfg.reweightings} reweightings")
-    assert lam is not None
-    cov = _solve_spd(normal + lam * penalty, np.eye(n_nodes), bandwidth)
-    cov *= 1.0 / float(np.mean(s[has_data])) ** 2
-    # B uncertainty (per object-block), given s: 1/√(sᵀ M s) (weights include 1/σ_j²).
+    return s, b, lam, it
+
+
+def _reweight(segments: list[_Segment], sigma: FloatArray, b: FloatArray, s: FloatArray, huber: float) -> None:
+    """Residuals → σ_j (robust scale about zero: the offsets centre them, updated in place) and the
+    segments' Huber weights."""
+    n_obj = sigma.size
+    res_by_obj: list[list[FloatArray]] = [[] for _ in range(n_obj)]
+    resid_seg = []
+    for sg in segments:
+        w = sg.weight / sigma[sg.obj] ** 2
+        r = sg.y - b[sg.param] * (sg.g @ s[sg.col0 : sg.col0 + sg.g.shape[1]])
+        r = r - float(w @ r) / float(np.sum(w))
+        resid_seg.append(r)
+        res_by_obj[sg.obj].append(r)
+    for j in range(n_obj):
+        if res_by_obj[j]:
+            v = np.concatenate(res_by_obj[j])
+            mad = float(MAD_TO_SIGMA * np.median(np.abs(v)))
+            sigma[j] = mad if mad > 0 else sigma[j]
+    for sg, r in zip(segments, resid_seg, strict=True):
+        z = np.abs(r) / sigma[sg.obj]
+        sg.weight = np.minimum(1.0, huber / np.maximum(z, 1e-12))
+
+
+def _b_frame(
+    tracks: Sequence[DecayTrack],
+    segments: list[_Segment],
+    params: list[tuple[int, int]],
+    mats: list[FloatArray],
+    s: FloatArray,
+    b: FloatArray,
+    layout: _Layout,
+) -> pd.DataFrame:
+    """Each object-block's relative B, its uncertainty given s, 1/√(sᵀ M s) (weights include 1/σ_j²),
+    and its number of sets."""
+    p_lo, p_hi = layout.p_lo, layout.p_hi
+    n_par = len(params)
     den = np.array([float(s[p_lo[q] : p_hi[q]] @ mats[q] @ s[p_lo[q] : p_hi[q]]) for q in range(n_par)])
     nsets = np.zeros(n_par, dtype=np.int64)
     for sg in segments:
         nsets[sg.param] += sg.y.size
     b_sig = 1.0 / np.sqrt(np.where(den > 0, den, np.nan))
-    frame = pd.DataFrame(
+    return pd.DataFrame(
         {
             "object": [tracks[j].name for j, _ in params],
             "block": [bk for _, bk in params],
@@ -323,18 +413,6 @@ def _fit_joint_density(tracks: Sequence[DecayTrack], origin_utc: Any, cfg: Joint
             "n_sets": nsets,
         }
     )
-    s_out = np.where(has_data, s, np.nan)
-    return JointFit(
-        origin,
-        cfg.node_days,
-        s_out,
-        cov,
-        frame,
-        {tr.name: float(sigma[j]) for j, tr in enumerate(tracks)},
-        float(lam),
-        it,
-        warnings,
-    )
 
 
 def _solve_spd(mat: FloatArray, rhs: FloatArray, bandwidth: int) -> FloatArray:
@@ -342,8 +420,6 @@ def _solve_spd(mat: FloatArray, rhs: FloatArray, bandwidth: int) -> FloatArray:
     n = mat.shape[0]
     if n <= 3 * bandwidth or n <= 300:
         return np.asarray(np.linalg.solve(mat, rhs), dtype=np.float64)
-    from scipy.linalg import solveh_banded
-
     ab = np.zeros((bandwidth + 1, n))
     for k in range(bandwidth + 1):
         ab[bandwidth - k, k:] = np.diagonal(mat, k)
@@ -400,98 +476,6 @@ def _cross_validated_lambda(st: _FitStatistics, folds: list[Any], scale: float) 
 
 
 # --------------------------------------------------------------------------------------------
-# Absolute scale from the platforms' physical B range (order statistics at both edges).
-
-
-@dataclass
-class ScaleEstimate:
-    """c with B_j = c·b_j (m²/kg per unit of b), its 1σ, and the fitted Beta shape of x."""
-
-    c: float
-    c_sigma: float
-    beta_a: float
-    beta_b: float
-    c_lower_bound: float  # max_j B_min,j / b_j (every B above its platform's B_min)
-    c_upper_bound: float  # min_j B_max,j / b_j (every B below its platform's B_max)
-
-
-#: Bins of the Beta mass, dense near both edges where a, b < 1 put singular mass.
-_BIN_EDGES = 0.5 - 0.5 * np.cos(np.pi * np.linspace(0.0, 1.0, 161))
-
-
-def _beta_noise_logpdf(x: FloatArray, sig: FloatArray, a: float, b: float) -> FloatArray:
-    """log of [Beta(a, b) * N(0, σ_j)](x_j): the exact Beta mass of 160 bins convolved with a Gaussian."""
-    edges = _BIN_EDGES
-    mass = np.diff(betainc(a, b, edges))
-    # Uniform within each bin, convolved exactly with the Gaussian: Φ at the 161 shared edges once.
-    cdf = ndtr((x[:, None] - edges[None, :]) / np.maximum(sig, 1e-6)[:, None])
-    p = (cdf[:, :-1] - cdf[:, 1:]) / np.diff(edges)[None, :]
-    dens = p @ mass
-    return np.log(np.maximum(dens, 1e-300))
-
-
-def estimate_scale(
-    b_rel: FloatArray,
-    b_rel_sigma: FloatArray,
-    b_min: FloatArray,
-    b_max: FloatArray,
-    *,
-    start: ScaleEstimate | None = None,
-    with_sigma: bool = True,
-) -> ScaleEstimate:
-    """Maximum-likelihood c (module docstring) for object-blocks with relative b and physical range.
-
-    Six Nelder-Mead starts (c at both bounds and between, two Beta shapes) unless ``start`` gives
-    one (a neighbouring problem's optimum: the accommodation-range ends); ``with_sigma`` adds the
-    profile-likelihood curvature (two more minimisations) for ``c_sigma`` (NaN without)."""
-    b_all = np.asarray(b_rel, dtype=float)
-    ok = np.isfinite(b_all) & (b_all > 0) & (np.asarray(b_max) > np.asarray(b_min))
-    b_rel = b_all[ok]
-    rel_sig = np.asarray(b_rel_sigma, dtype=float)[ok] / b_rel
-    lo_b, hi_b = np.asarray(b_min, dtype=float)[ok], np.asarray(b_max, dtype=float)[ok]
-    if b_rel.size < 3:
-        raise ValueError("need three or more objects with a platform B range to fix the density scale")
-    c_lo = float(np.max(lo_b / b_rel))
-    c_hi = float(np.min(hi_b / b_rel))
-    span = hi_b - lo_b
-
-    def nll(p: FloatArray) -> float:
-        c = math.exp(p[0])
-        a, bb = math.exp(p[1]), math.exp(p[2])
-        x = (c * b_rel - lo_b) / span
-        sx = c * b_rel * np.maximum(rel_sig, 1e-4) / span
-        ll = _beta_noise_logpdf(x, sx, a, bb) + np.log(c * b_rel / span)
-        return -float(np.sum(ll))
-
-    best = None
-    mid = math.sqrt(c_lo * c_hi) if c_hi > c_lo else 0.5 * (c_lo + c_hi)
-    starts = [(c0, a0, b0) for c0 in (c_lo, mid, c_hi) for a0, b0 in ((0.5, 0.5), (1.5, 1.5))]
-    if start is not None:
-        starts = [(start.c, start.beta_a, start.beta_b)]
-    for c0, a0, b0 in starts:
-        p0 = np.array([math.log(c0), math.log(a0), math.log(b0)])
-        r = minimize(nll, p0, method="Nelder-Mead", options={"xatol": 1e-5, "fatol": 1e-7, "maxiter": 2000})
-        if best is None or r.fun < best.fun:
-            best = r
-    assert best is not None
-    c = math.exp(best.x[0])
-    if not with_sigma:
-        return ScaleEstimate(c, float("nan"), math.exp(best.x[1]), math.exp(best.x[2]), c_lo, c_hi)
-    # Curvature of the profile likelihood in log c → σ.
-    h = 2e-3
-    f0 = best.fun
-
-    def prof(lc: float) -> float:
-        r = minimize(
-            lambda q: nll(np.array([lc, q[0], q[1]])), best.x[1:], method="Nelder-Mead", options={"xatol": 1e-5}
-        )
-        return float(r.fun)
-
-    curv = (prof(best.x[0] + h) - 2.0 * f0 + prof(best.x[0] - h)) / h**2
-    c_sig = c / math.sqrt(curv) if curv > 0 else float("nan")
-    return ScaleEstimate(c, c_sig, math.exp(best.x[1]), math.exp(best.x[2]), c_lo, c_hi)
-
-
 def window_densities(
     fit: JointFit, tracks: Sequence[DecayTrack], windows: pd.DataFrame, scale: float, scale_rel_sigma: float
 ) -> pd.DataFrame:
@@ -575,8 +559,6 @@ def joint_constellation_density(
     ``flow``: one :class:`FlowConditions` for all, or one per object name (each platform's C_D at
     its own altitude's temperature and molar mass).
     """
-    from abrupt.density.constellation import platform_b_range
-
     fit = fit_joint_density(tracks, origin_utc, config)
     warnings = list(fit.warnings)
     br = fit.b_relative

@@ -34,6 +34,7 @@ from scipy import sparse
 from scipy.optimize import lsq_linear
 
 from abrupt.errors import InputError
+from abrupt.model.atmosphere import msis_density
 from abrupt.types import FloatArray
 
 RADAR_COLUMNS = ("meteor_id", "altitude_km", "velocity_mps", "deceleration_mps2")
@@ -55,8 +56,6 @@ def msis_profile(
     altitudes_km: FloatArray, when_utc: str = "2007-11-08T19:00", lat_deg: float = 9.0, lon_deg: float = 167.0
 ) -> FloatArray:
     """NRLMSIS 2.1 density profile (kg/m³) over the ALTAIR radar (9°N, 167°E; slide "Results")."""
-    from abrupt.model.atmosphere import msis_density
-
     h = np.asarray(altitudes_km, dtype=float)
     t = np.full(h.size, np.datetime64(when_utc, "ns"))
     return np.asarray(msis_density(t, np.full(h.size, lat_deg), np.full(h.size, lon_deg), h))

@@ -35,10 +35,13 @@ import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 
+import erfa
 import numpy as np
 import pandas as pd
+from scipy.interpolate import CubicSpline
 
 from abrupt.errors import RepairLog
+from abrupt.model.atmosphere import msis_density, read_space_weather
 from abrupt.model.orbit import (
     EMPIRICAL_PARAMETERS,
     ESTIMABLE_PARAMETERS,
@@ -47,8 +50,8 @@ from abrupt.model.orbit import (
     ForceModel,
     propagate_with_stm,
 )
-from abrupt.model.orbit.constants import MU_EARTH_M3_S2, OMEGA_EARTH_RAD_S
-from abrupt.model.orbit.forces import F_DRAG_SCALE, F_SRP_SCALE, I_DRAG
+from abrupt.model.orbit.constants import MU_EARTH_M3_S2, OMEGA_EARTH_RAD_S, R_EARTH_M
+from abrupt.model.orbit.forces import EXPONENTIAL_ATMOSPHERE, F_DRAG_SCALE, F_SRP_SCALE, I_DRAG, exponential_density
 from abrupt.series.ephemeris import Ephemeris
 from abrupt.types import FloatArray
 from abrupt.units import SECONDS_PER_DAY
@@ -311,14 +314,10 @@ def _velocity_guess(t: FloatArray, r: FloatArray, v: FloatArray) -> FloatArray:
     """The velocity at the first epoch: the ephemeris' own when finite, else from a cubic spline."""
     if np.isfinite(v[0]).all():
         return v[0].copy()
-    from scipy.interpolate import CubicSpline
-
     return np.asarray(CubicSpline(t[:8], r[:8], axis=0)(t[0], 1))
 
 
 def _geodetic(times: np.ndarray, r_itrf: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-    import erfa
-
     lon, lat, h = erfa.gc2gd(1, np.ascontiguousarray(r_itrf))
     return np.degrees(lat), np.degrees(lon), np.asarray(h) * 1e-3
 
@@ -336,8 +335,6 @@ def fit_orbit_density(
     converge is reported with status ``not_converged``. The NRLMSIS comparison density is the
     |v_rel|³-weighted mean along the observed orbit (indices from ``space_weather`` or the offline
     table)."""
-    from abrupt.model.atmosphere import msis_density, read_space_weather
-
     cfg = config or OrbitDensityConfig()
     repairs = RepairLog()
     warnings: list[str] = []
@@ -427,8 +424,5 @@ def _reference_density(kind: str, r_gcrf: FloatArray, rho_msis: FloatArray) -> F
     kernels used the MSIS table, else the exponential model at each position's geocentric altitude."""
     if kind == "msis":
         return rho_msis
-    from abrupt.model.orbit.constants import R_EARTH_M
-    from abrupt.model.orbit.forces import EXPONENTIAL_ATMOSPHERE, exponential_density
-
     rn = np.linalg.norm(r_gcrf, axis=1)
     return np.array([exponential_density(float(x) - R_EARTH_M, EXPONENTIAL_ATMOSPHERE) for x in rn])

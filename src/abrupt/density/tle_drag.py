@@ -24,7 +24,8 @@ Implementation:
 * its standard error comes from the history's own mean-motion noise σ_n̄, estimated robustly
   (1.4826·MAD) from each set's residual to the line through its two neighbours;
 * element sets whose residual exceeds ``outlier_sigma`` σ (bad fits) are rejected and counted;
-* windows that contain a maneuver (abrupt's TLE maneuver detector, or given epochs), a gap longer
+* windows that contain a maneuver (abrupt's registered TLE maneuver detector at
+  ``maneuver_budget``, or given epochs), a gap longer
   than ``max_gap_days`` or too few sets are not formed (counted); a significantly negative K
   (n̄ falling: orbit raising or a bad history, "negative decay") is rejected and counted.
 
@@ -40,14 +41,19 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from scipy.interpolate import CubicSpline
 
+from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET
+from abrupt.detect.tle.detectors import detector_for
 from abrupt.errors import RepairLog
+from abrupt.model.atmosphere import msis_density, read_space_weather, teme_to_geodetic
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
+from abrupt.thresholds import FalseAlarmBudget
+from abrupt.thresholds.noise import robust_scale
 from abrupt.types import FloatArray
 from abrupt.units import SECONDS_PER_DAY
 
 EARTH_ROTATION_RAD_S = 7.292115e-5  # [rad/s]
-J1970_JD = 2440587.5
 
 WINDOW_COLUMNS: tuple[str, ...] = (
     "object",
@@ -81,6 +87,7 @@ class TleDragConfig:
     with_model: bool = False
     model_stride: int = 2
     origin_utc: str | None = None
+    maneuver_budget: FalseAlarmBudget = DEFAULT_TLE_BUDGET  # of the maneuver detector
 
     def __post_init__(self) -> None:
         if self.interval_days <= 0:
@@ -201,8 +208,6 @@ def drag_integrals(
     rho_all: FloatArray | None = None
     when = epochs[gap_index] + (tau_all * 1e9).astype("timedelta64[ns]")
     if space_weather is not None:
-        from abrupt.model.atmosphere import msis_density, teme_to_geodetic
-
         # NRLMSIS on every ``model_stride``-th node (it costs ~10-30 µs a point); log ρ is interpolated
         # in time between them (the nodes of consecutive gaps are consecutive in time).
         sample = np.zeros(tau_all.size, dtype=bool)
@@ -240,8 +245,6 @@ def interpolate_log_density(t_s: FloatArray, t_known_s: FloatArray, log_rho: Flo
     Repeated sample times (gap ends) are merged; extrapolation holds the end values; between samples
     further apart than 1.5 times the usual spacing (missing samples) the interpolation is linear.
     """
-    from scipy.interpolate import CubicSpline
-
     tk, first = np.unique(t_known_s, return_index=True)
     yk = np.asarray(log_rho)[first]
     if tk.size < 4:
@@ -276,24 +279,32 @@ def neighbour_residuals(n_bar: FloatArray, integral: FloatArray) -> tuple[FloatA
 
 def robust_sigma(values: FloatArray) -> float:
     """1.4826 × median absolute deviation about the median (Hampel 1974), NaNs ignored."""
-    from abrupt.thresholds.noise import robust_scale
-
     v = values[np.isfinite(values)]
     if v.size == 0:
         return float("nan")
     return float(robust_scale(v))
 
 
-def maneuver_epochs(history: ElementHistory) -> list[pd.Timestamp]:
-    """Maneuver times from abrupt's TLE maneuver detector (its public API), as UTC timestamps."""
-    from abrupt.detect.tle.maneuvers import detect_tle_maneuvers
-
-    events = detect_tle_maneuvers(history)
+def maneuver_epochs(history: ElementHistory, budget: FalseAlarmBudget | None = None) -> list[pd.Timestamp]:
+    """Maneuver times (UTC timestamps) from the registered TLE maneuver detector of the history's orbit
+    (``tle.mean_elements`` or ``tle.geo_station_keeping``) at ``budget`` (default 1 per satellite-year)."""
+    budget = budget or DEFAULT_TLE_BUDGET
+    events = detector_for(history).detect(history, budget).events
     if len(events) == 0:
         return []
     return [
         pd.Timestamp(t).tz_localize(None) if pd.Timestamp(t).tzinfo else pd.Timestamp(t) for t in events["time_utc"]
     ]
+
+
+def _maneuver_times(history: ElementHistory, maneuvers: str | list[Any], budget: FalseAlarmBudget) -> list[Any]:
+    if not isinstance(maneuvers, str):
+        return [pd.Timestamp(m) for m in maneuvers]
+    if maneuvers == "detect":
+        return maneuver_epochs(history, budget)
+    if maneuvers == "none":
+        return []
+    raise ValueError(f"maneuvers must be 'detect', 'none' or a list of times, got {maneuvers!r}")
 
 
 def rho_b_from_history(
@@ -310,8 +321,9 @@ def rho_b_from_history(
     ``integrals``: the :class:`DragIntegrals` of this history from an earlier call (same step and
     model), e.g. to form windows of another length without propagating again (``RhoBResult.integrals``).
 
-    ``maneuvers``: "detect" (abrupt's TLE maneuver detector), "none", or a list of UTC times.
-    ``space_weather`` is needed only with ``config.with_model`` (NRLMSIS ρ̄_M per window).
+    ``maneuvers``: "detect" (abrupt's TLE maneuver detector at ``config.maneuver_budget``), "none",
+    or a list of UTC times. ``space_weather`` is needed only with ``config.with_model`` (NRLMSIS ρ̄_M
+    per window).
     """
     cfg = config or TleDragConfig()
     label = name or (history.name or f"NORAD-{history.norad_id}")
@@ -320,8 +332,6 @@ def rho_b_from_history(
         return RhoBResult(_empty_windows(), float("nan"), repairs)
     sw = space_weather
     if cfg.with_model and sw is None:
-        from abrupt.model.atmosphere import read_space_weather
-
         sw = read_space_weather()
     integ = integrals or drag_integrals(
         history, cfg.step_s, space_weather=sw if cfg.with_model else None, model_stride=cfg.model_stride
@@ -330,23 +340,51 @@ def rho_b_from_history(
     mu = MU_EARTH_WGS72_M3_S2
     x_all = 1.5 * mu ** (-2.0 / 3.0) * integ.weight_integral  # n̄ = c + K·x
     # Maneuvers cut the history into segments; windows never straddle a cut.
-    if isinstance(maneuvers, str):
-        if maneuvers == "detect":
-            man_times = maneuver_epochs(history)
-        elif maneuvers == "none":
-            man_times = []
-        else:
-            raise ValueError(f"maneuvers must be 'detect', 'none' or a list of times, got {maneuvers!r}")
-    else:
-        man_times = [pd.Timestamp(m) for m in maneuvers]
+    man_times = _maneuver_times(history, maneuvers, cfg.maneuver_budget)
     man64 = np.array([m.to_datetime64() for m in man_times], dtype="datetime64[ns]")
     segment_id = np.searchsorted(man64, epochs, side="right") if man64.size else np.zeros(len(epochs), dtype=np.int64)
     # Gaps longer than max_gap_days also cut.
     long_gap = np.concatenate([[False], np.diff(integ.t_s) > cfg.max_gap_days * SECONDS_PER_DAY])
     segment_id = segment_id * (len(epochs) + 1) + np.cumsum(long_gap)
-    # Bad fits: residual to the neighbours' line within a segment; a rise of the orbit between two
-    # sets (n̄ falling beyond noise: thrust the detector missed; drag only raises n̄) also cuts.
-    keep = np.ones(len(epochs), dtype=bool)
+    segment_id, keep, thrust_cuts = reject_bad_sets(integ, x_all, segment_id, cfg)
+    sigma_n = robust_sigma(_noise_samples(integ, x_all, segment_id, keep))
+    repairs.record("gaps with a rise of the orbit (undetected thrust) cut", thrust_cuts)
+    repairs.record("element sets with bad fits rejected", int(np.sum(~keep)))
+    rows, counts = _windows(history, label, integ, x_all, epochs, segment_id, keep, sigma_n, cfg)
+    repairs.record(
+        "windows holding a maneuver, orbit rise or gap (fitted with one offset per segment)", counts["straddle"]
+    )
+    repairs.record("windows with too few element sets or too short a span", counts["few"])
+    repairs.record("windows with negative decay rejected", counts["negative"])
+    frame = pd.DataFrame(rows, columns=list(WINDOW_COLUMNS)) if rows else _empty_windows()
+    track = None
+    if integ.grid_rho_model is not None and integ.grid_weight is not None:
+        track = DecayTrack(
+            label,
+            epochs[keep],
+            integ.n_rad_s[keep],
+            segment_id[keep],
+            integ.set_grid_index[keep],
+            integ.grid_utc,
+            integ.grid_weight,
+            integ.grid_rho_model,
+            float(np.nanmedian(integ.altitude_km)),
+        )
+    return RhoBResult(frame, sigma_n, repairs, list(man_times), track, integ)
+
+
+def reject_bad_sets(
+    integ: DragIntegrals, x_all: FloatArray, segment_id: Any, cfg: TleDragConfig
+) -> tuple[Any, Any, int]:
+    """Bad fits and orbit rises: (segment ids with a cut after each rise, the kept sets, the cuts).
+
+    A set whose residual to its neighbours' line within a segment exceeds ``cfg.outlier_sigma`` is
+    rejected (only the worst of neighbouring flagged sets: an outlier also disturbs its neighbours);
+    a rise of the orbit between two sets (n̄ falling beyond noise: thrust the detector missed; drag
+    only raises n̄) cuts the segment. Three passes.
+    """
+    n = len(segment_id)
+    keep = np.ones(n, dtype=bool)
     thrust_cuts = 0
     for _ in range(3):
         sigma = robust_sigma(_noise_samples(integ, x_all, segment_id, keep))
@@ -358,11 +396,11 @@ def rho_b_from_history(
         rise = same & (dn < -cfg.thrust_sigma * math.sqrt(2.0) * sigma)
         if np.any(rise):
             thrust_cuts += int(np.sum(rise))
-            bump = np.zeros(len(epochs), dtype=np.int64)
+            bump = np.zeros(n, dtype=np.int64)
             bump[kept_idx0[1:][rise]] = 1
             segment_id = segment_id * 2 + np.cumsum(bump)  # new segment after each cut, order kept
-        r = np.full(len(epochs), np.nan)
-        fac = np.full(len(epochs), np.nan)
+        r = np.full(n, np.nan)
+        fac = np.full(n, np.nan)
         for seg in np.unique(segment_id):
             idx = np.flatnonzero((segment_id == seg) & keep)
             rr, ff = neighbour_residuals(integ.n_rad_s[idx], x_all[idx])
@@ -370,16 +408,26 @@ def rho_b_from_history(
             fac[idx] = ff
         z = r / fac
         bad = np.abs(z) > cfg.outlier_sigma * sigma
-        # Reject only the worst of neighbouring flagged sets (an outlier also disturbs its neighbours).
         az = np.nan_to_num(np.abs(z), nan=0.0)
         worst = bad & (az >= np.roll(az, 1)) & (az >= np.roll(az, -1))
         if not np.any(worst) and not np.any(rise):
             break
         keep &= ~worst
-    sigma_n = robust_sigma(_noise_samples(integ, x_all, segment_id, keep))
-    repairs.record("gaps with a rise of the orbit (undetected thrust) cut", thrust_cuts)
-    repairs.record("element sets with bad fits rejected", int(np.sum(~keep)))
-    # Windows on a common UTC grid.
+    return segment_id, keep, thrust_cuts
+
+
+def _windows(
+    history: ElementHistory,
+    label: str,
+    integ: DragIntegrals,
+    x_all: FloatArray,
+    epochs: Any,
+    segment_id: Any,
+    keep: Any,
+    sigma_n: float,
+    cfg: TleDragConfig,
+) -> tuple[list[tuple[Any, ...]], dict[str, int]]:
+    """The rows of :data:`WINDOW_COLUMNS` on a common UTC grid, and the windows skipped, by reason."""
     origin = (
         np.asarray([pd.Timestamp(cfg.origin_utc).to_datetime64()], dtype="datetime64[ns]")[0]
         if cfg.origin_utc
@@ -408,36 +456,11 @@ def rho_b_from_history(
         if idx.size < cfg.min_sets or overlap < cfg.min_span_fraction:
             counts["few"] += 1
             continue
-        # Gaps holding a maneuver (or an orbit rise, or a long gap) are removed: one n̄ offset per
-        # segment, one common K (with two sets in one segment this is the slide's formula).
-        seg = segment_id[idx]
-        x = x_all[idx]
-        y = integ.n_rad_s[idx]
-        xc = np.empty_like(x)
-        yc = np.empty_like(y)
-        used = np.zeros(idx.size, dtype=bool)
-        n_seg = 0
-        for sv in np.unique(seg):
-            m = seg == sv
-            if np.sum(m) < 2:
-                continue
-            n_seg += 1
-            used |= m
-            xc[m] = x[m] - x[m].mean()
-            yc[m] = y[m] - y[m].mean()
-        if n_seg > 1 or np.unique(seg).size > 1:
-            counts["straddle"] += 1
-        sxx = float(np.sum(xc[used] ** 2)) if np.any(used) else 0.0
-        if sxx <= 0 or np.sum(used) < cfg.min_sets:
+        k_val, k_sig, straddles = _window_fit(x_all[idx], integ.n_rad_s[idx], segment_id[idx], sigma_n, cfg.min_sets)
+        counts["straddle"] += straddles
+        if k_val is None:
             counts["few"] += 1
             continue
-        k_val = float(np.sum(xc[used] * yc[used]) / sxx)
-        k_sig = float(sigma_n / math.sqrt(sxx)) if np.isfinite(sigma_n) else float("nan")
-        dof = int(np.sum(used)) - n_seg - 1
-        if dof >= 2:
-            # Correlated TLE errors: never claim less than the window's own residual scatter.
-            resid = yc[used] - k_val * xc[used]
-            k_sig = max(k_sig, float(math.sqrt(np.sum(resid**2) / dof / sxx)))
         status = "ok"
         if np.isfinite(k_sig) and k_val < -cfg.negative_sigma * k_sig:
             counts["negative"] += 1
@@ -454,26 +477,39 @@ def rho_b_from_history(
         rows.append(
             (label, history.norad_id, b0, b1, span0, span1, int(idx.size), k_val, k_sig, alt, wfac, model, status)
         )
-    repairs.record(
-        "windows holding a maneuver, orbit rise or gap (fitted with one offset per segment)", counts["straddle"]
-    )
-    repairs.record("windows with too few element sets or too short a span", counts["few"])
-    repairs.record("windows with negative decay rejected", counts["negative"])
-    frame = pd.DataFrame(rows, columns=list(WINDOW_COLUMNS)) if rows else _empty_windows()
-    track = None
-    if integ.grid_rho_model is not None and integ.grid_weight is not None:
-        track = DecayTrack(
-            label,
-            epochs[keep],
-            integ.n_rad_s[keep],
-            segment_id[keep],
-            integ.set_grid_index[keep],
-            integ.grid_utc,
-            integ.grid_weight,
-            integ.grid_rho_model,
-            float(np.nanmedian(integ.altitude_km)),
-        )
-    return RhoBResult(frame, sigma_n, repairs, list(man_times), track, integ)
+    return rows, counts
+
+
+def _window_fit(
+    x: FloatArray, y: FloatArray, seg: Any, sigma_n: float, min_sets: int
+) -> tuple[float | None, float, int]:
+    """K and its standard error on one window: one n̄ offset per segment, one common K (with two sets
+    in one segment this is the slide's formula); the third value is 1 when the window straddles a
+    cut (a maneuver, an orbit rise or a long gap), else 0. K is None with too few sets."""
+    xc = np.empty_like(x)
+    yc = np.empty_like(y)
+    used = np.zeros(x.size, dtype=bool)
+    n_seg = 0
+    for sv in np.unique(seg):
+        m = seg == sv
+        if np.sum(m) < 2:
+            continue
+        n_seg += 1
+        used |= m
+        xc[m] = x[m] - x[m].mean()
+        yc[m] = y[m] - y[m].mean()
+    straddles = int(n_seg > 1 or np.unique(seg).size > 1)
+    sxx = float(np.sum(xc[used] ** 2)) if np.any(used) else 0.0
+    if sxx <= 0 or np.sum(used) < min_sets:
+        return None, float("nan"), straddles
+    k_val = float(np.sum(xc[used] * yc[used]) / sxx)
+    k_sig = float(sigma_n / math.sqrt(sxx)) if np.isfinite(sigma_n) else float("nan")
+    dof = int(np.sum(used)) - n_seg - 1
+    if dof >= 2:
+        # Correlated TLE errors: never claim less than the window's own residual scatter.
+        resid = yc[used] - k_val * xc[used]
+        k_sig = max(k_sig, float(math.sqrt(np.sum(resid**2) / dof / sxx)))
+    return k_val, k_sig, straddles
 
 
 def _noise_samples(integ: DragIntegrals, x_all: FloatArray, segment_id: Any, keep: Any) -> FloatArray:

@@ -1,11 +1,15 @@
-"""Mass properties from attitude telemetry: inertia estimation and mass-change inference (issue 13).
+"""Mass properties from attitude telemetry: the inertia tensor and its estimate from routine telemetry.
 
 * :mod:`abrupt.massprops.inertia`: the inertia tensor, its six parameters, principal moments and axes,
-  Harris-style perturbations (scaled principal moments, rotated principal axes) and physical checks;
+  Harris-style perturbations (scaled principal moments, rotated principal axes), physical checks and
+  the point-mass docking update;
 * :mod:`abrupt.massprops.momentum_balance`: the direct estimator from the integrated inertial momentum
   balance (linear in J and the torque parameters), with an excitation check and delete-a-block jackknife errors;
-* :mod:`reproductions.pso`: the particle-swarm simulate-and-match reproduction of Harris et al. 2025 §3.2;
-* :mod:`reproductions.simsat`: the SIMSAT single-axis reproduction of Dabrowski 2003 (grid search,
-  aggregation methods 1-3, parasite mass ΔI = m ρ², minimum detectable mass);
-* :mod:`abrupt.massprops.parasite`: mass inference from an inertia change.
+* :mod:`abrupt.massprops.least_squares`: the balance's least-squares solve and the statistics of its errors;
+* :mod:`abrupt.massprops.attitude_reference`: gyro bias and nadir direction from the attitude itself;
+* :mod:`abrupt.massprops.telemetry`: separately sampled channels → the estimator's input;
+* :mod:`abrupt.massprops.track`: one estimate per window, the series the mass-change detector reads.
+
+The reproductions of Harris et al. 2025 §3.2 (particle swarm) and Dabrowski 2003 (SIMSAT) live in
+``benchmarks/reproductions``.
 """

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
+from scipy.optimize import minimize
 
 from abrupt.errors import ConfigError
 from abrupt.types import FloatArray
@@ -181,8 +182,6 @@ def nearest_physical(j: ArrayLike, *, margin: float = 1e-6) -> FloatArray:
     Keeps the principal axes and projects the principal moments onto {I_k > 0, I_a + I_b >= I_c}
     (a small quadratic programme solved exactly by scipy's SLSQP).
     """
-    from scipy.optimize import minimize
-
     j = np.asarray(j, dtype=np.float64)
     w, v = np.linalg.eigh(0.5 * (j + j.T))
     if not physical_violations(j):

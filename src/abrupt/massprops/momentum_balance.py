@@ -1,4 +1,4 @@
-"""Direct inertia estimator from the integrated inertial momentum balance (issue 13, "beyond").
+"""Direct inertia estimator from the integrated inertial momentum balance.
 
 Momentum (DESIGN.md; flight-like README; Bennett 2022 Eqs. 2.6-2.7 with appendages, Harris 2025 §3.1)::
 
@@ -42,7 +42,7 @@ One linear least-squares problem (three rows per sample) gives J; no simulation,
   the fitted residual there is shrunk by their leverage, which is why residual-resampling schemes
   (wild block bootstrap, Newey-West) understate the error on telemetry by 30-100%. Checked by Monte
   Carlo on independently simulated flight-like days (``benchmarks/bench_inertia_coverage.py``).
-  ``uncertainty="bootstrap"`` keeps the earlier wild block bootstrap for comparison.
+  ``uncertainty="bootstrap"`` gives the wild block bootstrap for comparison.
 """
 
 from __future__ import annotations
@@ -56,14 +56,26 @@ import numpy.typing as npt
 from numpy.typing import ArrayLike
 
 from abrupt.errors import InputError
+from abrupt.massprops.attitude_reference import gyro_bias_from_attitude
 from abrupt.massprops.inertia import (
     INERTIA_ELEMENTS,
+    PrincipalAxes,
     inertia_from_params,
     inertia_regressor,
     nearest_physical,
     params_from_inertia,
     physical_violations,
     principal_axes,
+)
+from abrupt.massprops.least_squares import (
+    BalanceSolution,
+    correlation_inflation,
+    integrated_correlation_time,
+    jackknife_replicates,
+    longest_run,
+    profiled_information,
+    score_contributions,
+    solve_balance,
 )
 from abrupt.model.rotations import dcm_from_quaternion, skew
 from abrupt.thresholds.noise import robust_scale
@@ -74,9 +86,6 @@ __all__ = [
     "InsufficientExcitationError",
     "MomentumBalanceData",
     "estimate_inertia",
-    "gyro_bias_from_attitude",
-    "integrated_correlation_time",
-    "nadir_from_attitude",
     "observability",
 ]
 
@@ -206,84 +215,6 @@ class InertiaEstimate:
         return "\n".join(lines)
 
 
-# ---------------------------------------------------------------------------------------------- helpers
-def gyro_bias_from_attitude(
-    t_s: ArrayLike, q_BN: ArrayLike, omega_B_rad_s: ArrayLike, window_s: float = 3600.0
-) -> FloatArray:
-    """Slowly varying gyro bias (n, 3) [rad/s]: low-pass of (gyro − rate from successive attitudes).
-
-    The body rate implied by two star-tracker attitudes ``[BN]_k`` and ``[BN]_{k+1}`` is the rotation
-    vector of ``[BN]_k [BN]_{k+1}ᵀ`` over Δt (small-angle, Schaub & Junkins Eq. 3.25). It is noisy
-    (a few 1e-5 rad/s) but unbiased; its running mean over ``window_s`` against the gyro's gives the bias
-    to a few 1e-7 rad/s, a complementary filter that keeps the gyro's low noise.
-    """
-    t = np.asarray(t_s, dtype=np.float64)
-    c = dcm_from_quaternion(np.asarray(q_BN, dtype=np.float64))
-    w = np.asarray(omega_B_rad_s, dtype=np.float64)
-    dt = np.diff(t)
-    rel = np.einsum("nij,nkj->nik", c[:-1], c[1:])  # [BN]_k [BN]_{k+1}ᵀ = [B_k B_{k+1}]
-    # [B_{k+1} B_k] ≈ I − [φ×] ⇒ [B_k B_{k+1}] ≈ I + [φ×]; φ = vee of the antisymmetric part.
-    phi = 0.5 * np.stack(
-        [rel[:, 2, 1] - rel[:, 1, 2], rel[:, 0, 2] - rel[:, 2, 0], rel[:, 1, 0] - rel[:, 0, 1]], axis=-1
-    )
-    w_att = phi / dt[:, None]
-    ok = dt < 5.0
-    diff = 0.5 * (w[:-1] + w[1:]) - w_att
-    tm = 0.5 * (t[:-1] + t[1:])
-    bias = np.zeros_like(w)
-    for axis in range(3):
-        bias[:, axis] = _running_mean(tm[ok], diff[ok, axis], t, window_s)
-    return bias
-
-
-def _running_mean(tx: FloatArray, y: FloatArray, t_out: FloatArray, window_s: float) -> FloatArray:
-    """Mean of ``y`` over ``|tx − t| <= window/2`` at each ``t_out`` (prefix sums; robust to outliers by clipping)."""
-    if tx.size == 0:
-        return np.zeros_like(t_out)
-    med = np.median(y)
-    mad = float(robust_scale(y)) + 1e-15
-    y = np.clip(y, med - 5 * mad, med + 5 * mad)
-    cs = np.concatenate([[0.0], np.cumsum(y)])
-    lo = np.searchsorted(tx, t_out - window_s / 2)
-    hi = np.searchsorted(tx, t_out + window_s / 2)
-    cnt = np.maximum(hi - lo, 1)
-    return np.asarray((cs[hi] - cs[lo]) / cnt, dtype=np.float64)
-
-
-def nadir_from_attitude(
-    t_s: ArrayLike,
-    q_BN: ArrayLike,
-    orbit_period_s: float,
-    nadir_axis_B: ArrayLike = (0.0, 0.0, 1.0),
-    max_off_nadir_deg: float = 1.0,
-) -> FloatArray:
-    """Unit vector to the Earth's centre in N (n, 3) for a nadir-pointing spacecraft on a circular orbit.
-
-    Fits ``r̂_nadir(t) = cos(n t) (P + P' t) + sin(n t) (Q + Q' t)`` (a circle in a slowly precessing
-    plane) to the body's nadir axis in N, iteratively ignoring samples more than ``max_off_nadir_deg``
-    off the fit (slews), so the orbit is carried through off-nadir slews. Linear least squares.
-    """
-    t = np.asarray(t_s, dtype=np.float64)
-    c = dcm_from_quaternion(np.asarray(q_BN, dtype=np.float64))
-    axis = np.asarray(nadir_axis_B, dtype=np.float64)
-    z_n = np.einsum("nji,j->ni", c, axis / np.linalg.norm(axis))
-    n = 2 * math.pi / orbit_period_s
-    tc = (t - t.mean()) / 86400.0
-    basis = np.stack([np.cos(n * t), np.sin(n * t), np.cos(n * t) * tc, np.sin(n * t) * tc], axis=-1)
-    keep = np.ones(t.size, dtype=bool)
-    fit = z_n
-    for _ in range(4):
-        coef, *_ = np.linalg.lstsq(basis[keep], z_n[keep], rcond=None)
-        fit = basis @ coef
-        fit /= np.linalg.norm(fit, axis=1, keepdims=True)
-        ang = np.degrees(np.arccos(np.clip(np.sum(fit * z_n, axis=1), -1, 1)))
-        new_keep = ang < max(max_off_nadir_deg, 3 * float(np.median(ang[keep])))
-        if new_keep.sum() < 20 or np.array_equal(new_keep, keep):
-            break
-        keep = new_keep
-    return np.asarray(fit, dtype=np.float64)
-
-
 def _cumtrapz(t: FloatArray, y: FloatArray) -> FloatArray:
     """Cumulative trapezoid of y (n, ...) over t (n,), starting at 0."""
     dt = np.diff(t).reshape(-1, *([1] * (y.ndim - 1)))
@@ -320,7 +251,6 @@ def observability(information: FloatArray, scale_kgm2: float, rel_sigma: float) 
     return observable, basis, msg
 
 
-# ---------------------------------------------------------------------------------------------- estimator
 def _find_steps(
     t: FloatArray, resid: FloatArray, quiet: BoolArray, window_s: float, threshold: float, min_sep_s: float
 ) -> list[float]:
@@ -359,40 +289,37 @@ def _find_steps(
     return sorted(steps)
 
 
-def estimate_inertia(
-    data: MomentumBalanceData,
-    catalogue_kgm2: ArrayLike,
-    *,
-    torque_model: str = "linear",
-    gravity_gradient: bool = True,
-    wheel_scale: bool = False,
-    gyro_bias: bool = True,
-    find_steps: bool = True,
-    step_threshold: float = 8.0,
-    step_window_s: float = 120.0,
-    max_gap_s: float = 30.0,
-    excitation_rel_sigma: float = 0.01,
-    bootstrap: int = 200,
-    block_s: float | None = None,
-    bin_s: float = 5.0,
-    uncertainty: str = "jackknife",
-    seed: int = 0,
-) -> InertiaEstimate:
-    """Estimate J (and nuisance torques, impulses, optional wheel scale factors) from the momentum balance.
+@dataclass(frozen=True)
+class _Balance:
+    """The linear balance ``A p + X θ = y`` (three rows per sample, or per bin), with what the fit needs.
 
-    ``torque_model``: ``"constant"`` (τ_c in N), ``"linear"`` (τ_c + τ' t) or ``"none"``;
-    ``gravity_gradient`` needs ``data.nadir_N`` and ``data.orbit_rate_rad_s``; ``wheel_scale`` adds one
-    scale factor per wheel (relative to the catalogue spin inertia); ``gyro_bias`` removes the slowly
-    varying gyro bias with :func:`gyro_bias_from_attitude`; ``find_steps`` adds an unknown impulse at each
-    momentum step found in the residual (strikes); ``bin_s`` averages the balance over bins of that
-    length before the fit (0: every sample); ``uncertainty``: ``"jackknife"`` (delete-a-block, the
-    default; see the module docstring) or ``"bootstrap"`` (wild block bootstrap with ``bootstrap``
-    replicates); ``bootstrap=0`` skips the uncertainty; ``block_s``: the block length (None: from the
-    data, module docstring); ``excitation_rel_sigma``: a direction of p is reported
-    only if its 1σ is below this fraction of the mean principal moment. Raises
-    :class:`InsufficientExcitationError` when no direction at all is determined.
+    ``t`` (n,) [s]; ``seg`` (n,) the segment of each row (a new one after each gap and impulse window);
+    ``seg_t0`` (n,) the start of that segment [s]; ``a_p`` (n, 3, 6) the regressors of p; ``y`` (n, 3)
+    [N m s]; ``wheel_cols`` (n, 3, N) the wheel scale-factor regressors (None: not estimated);
+    ``quiet_fraction`` (n,) the fraction of samples not slewing; ``inv_count_sum`` Σ 1/(samples per
+    row), for the regressor-noise Gram; ``sigma_w`` the gyro noise [rad/s].
     """
-    j_cat = np.asarray(catalogue_kgm2, dtype=np.float64)
+
+    t: FloatArray
+    seg: npt.NDArray[np.int64]
+    seg_t0: FloatArray
+    n_seg: int
+    a_p: FloatArray
+    y: FloatArray
+    wheel_cols: FloatArray | None
+    quiet_fraction: FloatArray
+    inv_count_sum: float
+    sigma_w: float
+
+    @property
+    def quiet(self) -> BoolArray:
+        """Rows not slewing (for the step search and the block length)."""
+        return np.asarray(self.quiet_fraction > 0.99, dtype=bool)
+
+
+def _check_arguments(
+    data: MomentumBalanceData, j_cat: FloatArray, torque_model: str, gravity_gradient: bool, uncertainty: str
+) -> None:
     reasons = physical_violations(j_cat)
     if reasons:
         raise InputError("catalogue inertia is not physical: " + "; ".join(reasons), file=data.source)
@@ -402,10 +329,23 @@ def estimate_inertia(
         raise ValueError(f"torque_model must be 'constant', 'linear' or 'none', got {torque_model!r}")
     if gravity_gradient and (data.nadir_N is None or data.orbit_rate_rad_s is None):
         raise InputError("gravity gradient needs nadir_N and orbit_rate_rad_s", file=data.source)
-    p_cat = params_from_inertia(j_cat)
-    scale = float(np.trace(j_cat) / 3.0)
-    warnings: list[str] = []
 
+
+def _segment_edges(t: FloatArray, windows: list[tuple[float, float]], max_gap_s: float) -> list[int]:
+    """Row indices where segments start and end: a new segment after each gap and each impulse window."""
+    n = t.size
+    breaks: set[int] = {int(b) for b in np.flatnonzero(np.diff(t) > max_gap_s) + 1}
+    for a, _b in windows:
+        k = int(np.searchsorted(t, a))
+        if 0 < k < n:
+            breaks.add(k)
+    return [0, *sorted(breaks), n]
+
+
+def _build_balance(
+    data: MomentumBalanceData, *, gyro_bias: bool, gravity_gradient: bool, wheel_scale: bool, max_gap_s: float
+) -> _Balance:
+    """The balance at every sample outside the impulse windows (module docstring)."""
     t_all = data.t_s
     keep = np.ones(t_all.size, dtype=bool)
     windows = sorted(data.impulse_windows_s)
@@ -422,17 +362,10 @@ def estimate_inertia(
     else:
         h_known_b = h_w_b
     n = t.size
-    # Segments: a new one after each gap and after each impulse window.
-    breaks: set[int] = {int(b) for b in np.flatnonzero(np.diff(t) > max_gap_s) + 1}
-    for a, _b in windows:
-        k = int(np.searchsorted(t, a))
-        if 0 < k < n:
-            breaks.add(k)
-    edges = [0, *sorted(breaks), n]
+    edges = _segment_edges(t, windows, max_gap_s)
     seg = np.zeros(n, dtype=np.int64)
     for s, (lo, hi) in enumerate(itertools.pairwise(edges)):
         seg[lo:hi] = s
-    n_seg = len(edges) - 1
     seg_t0 = t[np.asarray(edges[:-1])][seg]
 
     # Regressors of p: [NB] M(ω) minus the integrated gravity-gradient torque (both linear in p).
@@ -460,102 +393,107 @@ def estimate_inertia(
     # Gyro noise from the telemetry itself (second differences), for the EIV correction.
     d2 = np.diff(w, n=2, axis=0)
     sigma_w = float(np.median(robust_scale(d2, axis=0))) / math.sqrt(6.0)
+    return _Balance(t, seg, seg_t0, len(edges) - 1, a_p, y, wheel_cols, quiet_f, float(n), sigma_w)
 
-    # Bin-average the (linear) balance over ``bin_s`` inside each segment: the same equations with
-    # averaged regressors, fewer rows and less tachometer-quantisation noise per row.
-    inv_count_sum = float(n)
-    if bin_s > 0:
-        bid = seg * 10_000_000 + np.floor((t - seg_t0) / bin_s).astype(np.int64)
-        _, first, inv, counts = np.unique(bid, return_index=True, return_inverse=True, return_counts=True)
 
-        def bmean(x: FloatArray) -> FloatArray:
-            flat = x.reshape(x.shape[0], -1)
-            out = np.column_stack([np.bincount(inv, weights=flat[:, k]) for k in range(flat.shape[1])])
-            return np.asarray((out / counts[:, None]).reshape(counts.size, *x.shape[1:]), dtype=np.float64)
+def _binned(bal: _Balance, bin_s: float) -> _Balance:
+    """The balance averaged over bins of ``bin_s`` inside each segment.
 
-        a_p = bmean(a_p)
-        y = bmean(y)
-        if wheel_cols is not None:
-            wheel_cols = bmean(wheel_cols)
-        quiet_f = bmean(quiet_f[:, None])[:, 0]
-        seg = seg[first]
-        seg_t0 = seg_t0[first]
-        t = bmean(t[:, None])[:, 0]
-        inv_count_sum = float(np.sum(1.0 / counts))
-        n = t.size
-    quiet = quiet_f > 0.99
+    The same equations with averaged regressors: fewer rows and less tachometer-quantisation noise per row.
+    """
+    bid = bal.seg * 10_000_000 + np.floor((bal.t - bal.seg_t0) / bin_s).astype(np.int64)
+    _, first, inv, counts = np.unique(bid, return_index=True, return_inverse=True, return_counts=True)
 
-    def nuisance(step_times: list[float]) -> FloatArray:
-        cols = []
-        eye = np.broadcast_to(np.eye(3), (n, 3, 3))
-        for s in range(n_seg):
-            cols.append(eye * (seg == s)[:, None, None])  # H_s
-        if torque_model in ("constant", "linear"):
-            cols.append(eye * (t - seg_t0)[:, None, None])
-        if torque_model == "linear":
-            tm = 0.5 * ((t - t[0]) ** 2 - (seg_t0 - t[0]) ** 2)
-            cols.append(eye * tm[:, None, None] / 86400.0)
-        for ts in step_times:
-            same_seg = seg == seg[min(int(np.searchsorted(t, ts)), n - 1)]
-            cols.append(eye * ((t > ts) & same_seg)[:, None, None])
-        if wheel_cols is not None:
-            cols.append(wheel_cols)
-        return np.concatenate(cols, axis=2)
+    def bmean(x: FloatArray) -> FloatArray:
+        flat = x.reshape(x.shape[0], -1)
+        out = np.column_stack([np.bincount(inv, weights=flat[:, k]) for k in range(flat.shape[1])])
+        return np.asarray((out / counts[:, None]).reshape(counts.size, *x.shape[1:]), dtype=np.float64)
 
+    return _Balance(
+        t=bmean(bal.t[:, None])[:, 0],
+        seg=bal.seg[first],
+        seg_t0=bal.seg_t0[first],
+        n_seg=bal.n_seg,
+        a_p=bmean(bal.a_p),
+        y=bmean(bal.y),
+        wheel_cols=None if bal.wheel_cols is None else bmean(bal.wheel_cols),
+        quiet_fraction=bmean(bal.quiet_fraction[:, None])[:, 0],
+        inv_count_sum=float(np.sum(1.0 / counts)),
+        sigma_w=bal.sigma_w,
+    )
+
+
+def _nuisance(bal: _Balance, torque_model: str, step_times: list[float]) -> FloatArray:
+    """Nuisance regressors X (n, 3, m): H_s per segment, the torque model, steps, wheel scale factors."""
+    t, seg, seg_t0 = bal.t, bal.seg, bal.seg_t0
+    n = t.size
+    cols = []
+    eye = np.broadcast_to(np.eye(3), (n, 3, 3))
+    for s in range(bal.n_seg):
+        cols.append(eye * (seg == s)[:, None, None])  # H_s
+    if torque_model in ("constant", "linear"):
+        cols.append(eye * (t - seg_t0)[:, None, None])
+    if torque_model == "linear":
+        tm = 0.5 * ((t - t[0]) ** 2 - (seg_t0 - t[0]) ** 2)
+        cols.append(eye * tm[:, None, None] / 86400.0)
+    for ts in step_times:
+        same_seg = seg == seg[min(int(np.searchsorted(t, ts)), n - 1)]
+        cols.append(eye * ((t > ts) & same_seg)[:, None, None])
+    if bal.wheel_cols is not None:
+        cols.append(bal.wheel_cols)
+    return np.concatenate(cols, axis=2)
+
+
+def _fit_with_steps(
+    bal: _Balance,
+    p_cat: FloatArray,
+    torque_model: str,
+    *,
+    find_steps: bool,
+    step_window_s: float,
+    step_threshold: float,
+) -> tuple[list[float], BalanceSolution]:
+    """Fit, look for momentum steps in the residual, refit with them (at most four rounds)."""
     steps: list[float] = []
-    sol = _solve(a_p, nuisance(steps), y, p_cat, None)
+    sol = solve_balance(bal.a_p, _nuisance(bal, torque_model, steps), bal.y, p_cat, None)
     for _ in range(4):
         if not find_steps:
             break
-        new = _find_steps(t, sol.resid, quiet, step_window_s, step_threshold, 2 * step_window_s)
+        new = _find_steps(bal.t, sol.resid, bal.quiet, step_window_s, step_threshold, 2 * step_window_s)
         new = [s for s in new if all(abs(s - o) > 2 * step_window_s for o in steps)]
         if not new:
             break
         steps = sorted(steps + new)
-        sol = _solve(a_p, nuisance(steps), y, p_cat, None)
+        sol = solve_balance(bal.a_p, _nuisance(bal, torque_model, steps), bal.y, p_cat, None)
+    return steps, sol
 
-    # Excitation: profiled information with the residual noise level, inflated for correlated residuals.
-    x_nuis = nuisance(steps)
-    sigma_res = float(np.std(sol.resid))
-    info = _profiled_information(a_p, x_nuis) / max(sigma_res, 1e-12) ** 2
-    info /= _correlation_inflation(sol.resid, t, 300.0)
-    observable, basis, msg = observability(info, scale, excitation_rel_sigma)
-    if basis.shape[1] == 0:
-        raise InsufficientExcitationError(
-            "the telemetry does not determine any inertia parameter: " + msg.split(": ", 1)[-1], file=data.source
-        )
-    if msg:
-        warnings.append(msg)
-    # Errors in variables: regressor noise Gram, E[M(δω)ᵀ M(δω)] = σ² Σ_j M(e_j)ᵀ M(e_j) per sample.
-    m_e = inertia_regressor(np.eye(3))  # (3, 3, 6)
-    noise_gram = sigma_w**2 * np.einsum("jai,jak->ik", m_e, m_e) * inv_count_sum
-    p_ls = _solve(a_p, x_nuis, y, p_cat, basis).p
-    sol = _solve(a_p, x_nuis, y, p_cat, basis, noise_gram)
-    p, coef_nuis, resid = sol.p, sol.nuisance, sol.resid
-    eiv = float(np.linalg.norm(p - p_ls) / np.linalg.norm(p_ls))
 
-    j_est = inertia_from_params(p)
-    projected = False
-    if physical_violations(j_est):
-        j_est = nearest_physical(j_est)
-        p = params_from_inertia(j_est)
-        projected = True
-        warnings.append("estimate was not physical and was projected onto the nearest physical inertia")
-
-    # Uncertainty from blocks of the binned balance (module docstring).
+def _uncertainty(
+    sol: BalanceSolution,
+    p: FloatArray,
+    bal: _Balance,
+    *,
+    block_s: float | None,
+    bootstrap: int,
+    uncertainty: str,
+    seed: int,
+) -> tuple[FloatArray, FloatArray]:
+    """(replicates of p (r, 6), Cov(p) (6, 6)) from blocks of the binned balance (module docstring)."""
+    t = bal.t
+    n = t.size
     boot = np.zeros((0, 6))
     dt_bin = max(float(np.median(np.diff(t))), 1e-9)
     if block_s is None:
-        tau = integrated_correlation_time(_scores(sol)[:, : sol.basis.shape[1]])
-        block = max(round(300.0 / dt_bin), math.ceil(10.0 * tau), 2 * _longest_run(~quiet))
+        tau = integrated_correlation_time(score_contributions(sol)[:, : sol.basis.shape[1]])
+        block = max(round(300.0 / dt_bin), math.ceil(10.0 * tau), 2 * longest_run(~bal.quiet))
     else:
         block = max(1, round(block_s / dt_bin))
     block_of = np.minimum(np.arange(n) // block, max(n // block, 1) - 1)
     n_blocks = int(block_of[-1]) + 1
     if bootstrap > 0 and uncertainty == "jackknife" and n_blocks >= 3:
-        boot = _jackknife(sol, block_of, n_blocks)
+        boot = jackknife_replicates(sol, block_of, n_blocks)
         cov = (n_blocks - 1) / n_blocks * (boot - boot.mean(axis=0)).T @ (boot - boot.mean(axis=0))
-        # Pseudo-replicates with the jackknife covariance, for the moment and axis spreads below.
+        # Pseudo-replicates with the jackknife covariance, for the moment and axis spreads.
         boot = p + math.sqrt(n_blocks - 1) * (boot - boot.mean(axis=0))
     elif bootstrap > 0 and uncertainty == "bootstrap":
         rng = np.random.default_rng(seed)
@@ -563,16 +501,16 @@ def estimate_inertia(
         for _ in range(bootstrap):
             # Wild block bootstrap (Shao 2011): each block keeps its residual, sign flipped at random.
             signs = rng.choice(np.array([-1.0, 1.0]), n_blocks)[block_of]
-            reps.append(sol.p_from(sol.fitted + (resid * signs[:, None]).reshape(-1)))
+            reps.append(sol.p_from(sol.fitted + (sol.resid * signs[:, None]).reshape(-1)))
         boot = np.asarray(reps)
         cov = np.cov(boot.T)
     else:
         cov = np.full((6, 6), np.nan)
-    sig = np.sqrt(np.maximum(np.diag(cov), 0.0))
-    sig = np.where(observable, sig, np.nan)
+    return boot, cov
 
-    cat_pa = principal_axes(j_cat)
-    est_pa = principal_axes(j_est, reference=cat_pa.dcm_PB)
+
+def _principal_spread(boot: FloatArray, est_pa: PrincipalAxes) -> tuple[FloatArray, FloatArray]:
+    """1σ of the principal moments [kg m²] and axis directions [deg] over the replicates of p."""
     m_sig = np.full(3, np.nan)
     a_sig = np.full(3, np.nan)
     if boot.shape[0] > 1:
@@ -584,11 +522,102 @@ def estimate_inertia(
             angles.append(np.degrees(np.arccos(cosang)))
         m_sig = np.sqrt(np.mean((np.asarray(moments) - est_pa.moments_kgm2) ** 2, axis=0))
         a_sig = np.sqrt(np.mean(np.asarray(angles) ** 2, axis=0))
+    return m_sig, a_sig
 
+
+def _torque_and_steps(
+    coef_nuis: FloatArray, n_seg: int, torque_model: str, steps: list[float]
+) -> tuple[FloatArray, tuple[tuple[float, FloatArray], ...]]:
+    """The constant inertial torque and the (time, ΔH_N) of each step from the nuisance coefficients."""
     n_nuis_fixed = 3 * n_seg
     torque = coef_nuis[n_nuis_fixed : n_nuis_fixed + 3] if torque_model != "none" else np.zeros(3)
     k0 = n_nuis_fixed + (3 if torque_model != "none" else 0) + (3 if torque_model == "linear" else 0)
     step_out = tuple((ts, coef_nuis[k0 + 3 * i : k0 + 3 * i + 3].copy()) for i, ts in enumerate(steps))
+    return np.asarray(torque, dtype=np.float64), step_out
+
+
+def estimate_inertia(
+    data: MomentumBalanceData,
+    catalogue_kgm2: ArrayLike,
+    *,
+    torque_model: str = "linear",
+    gravity_gradient: bool = True,
+    wheel_scale: bool = False,
+    gyro_bias: bool = True,
+    find_steps: bool = True,
+    step_threshold: float = 8.0,
+    step_window_s: float = 120.0,
+    max_gap_s: float = 30.0,
+    excitation_rel_sigma: float = 0.01,
+    bootstrap: int = 200,
+    block_s: float | None = None,
+    bin_s: float = 5.0,
+    uncertainty: str = "jackknife",
+    seed: int = 0,
+) -> InertiaEstimate:
+    """Estimate J (and nuisance torques, impulses, optional wheel scale factors) from the momentum balance.
+
+    ``torque_model``: ``"constant"`` (τ_c in N), ``"linear"`` (τ_c + τ' t) or ``"none"``;
+    ``gravity_gradient`` needs ``data.nadir_N`` and ``data.orbit_rate_rad_s``; ``wheel_scale`` adds one
+    scale factor per wheel (relative to the catalogue spin inertia); ``gyro_bias`` removes the slowly
+    varying gyro bias with :func:`~abrupt.massprops.attitude_reference.gyro_bias_from_attitude`;
+    ``find_steps`` adds an unknown impulse at each momentum step found in the residual (strikes);
+    ``bin_s`` averages the balance over bins of that length before the fit (0: every sample);
+    ``uncertainty``: ``"jackknife"`` (delete-a-block, the default; see the module docstring) or
+    ``"bootstrap"`` (wild block bootstrap with ``bootstrap`` replicates); ``bootstrap=0`` skips the
+    uncertainty; ``block_s``: the block length (None: from the data, module docstring);
+    ``excitation_rel_sigma``: a direction of p is reported only if its 1σ is below this fraction of the
+    mean principal moment. Raises :class:`InsufficientExcitationError` when no direction at all is
+    determined.
+    """
+    j_cat = np.asarray(catalogue_kgm2, dtype=np.float64)
+    _check_arguments(data, j_cat, torque_model, gravity_gradient, uncertainty)
+    p_cat = params_from_inertia(j_cat)
+    scale = float(np.trace(j_cat) / 3.0)
+    warnings: list[str] = []
+    bal = _build_balance(
+        data, gyro_bias=gyro_bias, gravity_gradient=gravity_gradient, wheel_scale=wheel_scale, max_gap_s=max_gap_s
+    )
+    if bin_s > 0:
+        bal = _binned(bal, bin_s)
+    steps, sol = _fit_with_steps(
+        bal, p_cat, torque_model, find_steps=find_steps, step_window_s=step_window_s, step_threshold=step_threshold
+    )
+
+    # Excitation: profiled information with the residual noise level, inflated for correlated residuals.
+    x_nuis = _nuisance(bal, torque_model, steps)
+    sigma_res = float(np.std(sol.resid))
+    info = profiled_information(bal.a_p, x_nuis) / max(sigma_res, 1e-12) ** 2
+    info /= correlation_inflation(sol.resid, bal.t, 300.0)
+    observable, basis, msg = observability(info, scale, excitation_rel_sigma)
+    if basis.shape[1] == 0:
+        raise InsufficientExcitationError(
+            "the telemetry does not determine any inertia parameter: " + msg.split(": ", 1)[-1], file=data.source
+        )
+    if msg:
+        warnings.append(msg)
+    # Errors in variables: regressor noise Gram, E[M(δω)ᵀ M(δω)] = σ² Σ_j M(e_j)ᵀ M(e_j) per sample.
+    m_e = inertia_regressor(np.eye(3))  # (3, 3, 6)
+    noise_gram = bal.sigma_w**2 * np.einsum("jai,jak->ik", m_e, m_e) * bal.inv_count_sum
+    p_ls = solve_balance(bal.a_p, x_nuis, bal.y, p_cat, basis).p
+    sol = solve_balance(bal.a_p, x_nuis, bal.y, p_cat, basis, noise_gram)
+    p = sol.p
+    eiv = float(np.linalg.norm(p - p_ls) / np.linalg.norm(p_ls))
+
+    j_est = inertia_from_params(p)
+    projected = False
+    if physical_violations(j_est):
+        j_est = nearest_physical(j_est)
+        p = params_from_inertia(j_est)
+        projected = True
+        warnings.append("estimate was not physical and was projected onto the nearest physical inertia")
+
+    boot, cov = _uncertainty(sol, p, bal, block_s=block_s, bootstrap=bootstrap, uncertainty=uncertainty, seed=seed)
+    sig = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    sig = np.where(observable, sig, np.nan)
+    est_pa = principal_axes(j_est, reference=principal_axes(j_cat).dcm_PB)
+    m_sig, a_sig = _principal_spread(boot, est_pa)
+    torque, step_out = _torque_and_steps(sol.nuisance, bal.n_seg, torque_model, steps)
     return InertiaEstimate(
         inertia_kgm2=j_est,
         catalogue_kgm2=j_cat,
@@ -601,149 +630,15 @@ def estimate_inertia(
         axes_sigma_deg=a_sig,
         observable=observable,
         unobservable=msg,
-        torque_N_Nm=np.asarray(torque, dtype=np.float64),
+        torque_N_Nm=torque,
         steps=step_out,
-        residual_rms_Nms=np.sqrt(np.mean(resid**2, axis=0)),
-        n_samples=n,
+        residual_rms_Nms=np.sqrt(np.mean(sol.resid**2, axis=0)),
+        n_samples=bal.t.size,
         eiv_correction=eiv,
         projected_to_physical=projected,
         warnings=tuple(warnings),
         bootstrap_params=boot,
     )
-
-
-@dataclass(frozen=True)
-class _Solution:
-    p: FloatArray
-    nuisance: FloatArray
-    resid: FloatArray  # (n, 3)
-    fitted: FloatArray  # (3n,) of the (offset) observation
-    design: FloatArray  # (3n, m) scaled design [A B | X]
-    solve_map: FloatArray  # (m, m): θ_scaled = solve_map @ designᵀ y'
-    p0: FloatArray
-    basis: FloatArray
-    col_scale: FloatArray
-    gram: FloatArray  # (m, m) normal matrix of the scaled design, EIV-corrected
-    noise_gram: FloatArray  # (m, m) the EIV correction subtracted from it (zeros without one)
-    y_prime: FloatArray  # (3n,) observation with the offset A p0 removed
-
-    def p_from(self, y_prime: FloatArray) -> FloatArray:
-        """p for another observation vector y' (3n,) (the offset A p0 already removed): the bootstrap."""
-        theta = self.solve_map @ (self.design.T @ y_prime)
-        k = self.basis.shape[1]
-        return np.asarray(self.p0 + self.basis @ (theta[:k] * self.col_scale[:k]), dtype=np.float64)
-
-
-def _solve(
-    a_p: FloatArray,
-    x_nuis: FloatArray,
-    y: FloatArray,
-    p0: FloatArray,
-    basis: FloatArray | None,
-    noise_gram: FloatArray | None = None,
-) -> _Solution:
-    """Least squares for p = p0 + B α (B = I when ``basis`` is None) and the nuisance parameters.
-
-    Normal equations on column-scaled regressors (the design has ~50 columns and ~10⁵ rows, so the Gram
-    matrix is cheap and well conditioned after scaling). ``noise_gram`` (6, 6), the expected Gram of
-    the regressor noise, is subtracted from the p block: bias-compensated least squares for errors in
-    variables (Söderström 2007 §4).
-    """
-    n = y.shape[0]
-    b = np.eye(6) if basis is None else basis
-    k = b.shape[1]
-    a2 = a_p.reshape(3 * n, 6)
-    y2 = y.reshape(-1) - a2 @ p0
-    design = np.concatenate([a2 @ b, x_nuis.reshape(3 * n, -1)], axis=1)
-    norms = np.linalg.norm(design, axis=0)
-    col_scale = 1.0 / np.where(norms > 0, norms, 1.0)
-    design *= col_scale
-    gram = design.T @ design
-    eiv = np.zeros_like(gram)
-    if noise_gram is not None:
-        eiv[:k, :k] = (b.T @ noise_gram @ b) * np.outer(col_scale[:k], col_scale[:k])
-        gram -= eiv
-    solve_map = np.linalg.pinv(gram, rcond=1e-13, hermitian=True)
-    theta = solve_map @ (design.T @ y2)
-    fitted = design @ theta
-    resid = (y2 - fitted).reshape(n, 3)
-    coef = theta * col_scale
-    p = p0 + b @ coef[:k]
-    return _Solution(p, coef[k:], resid, fitted, design, solve_map, p0, b, col_scale, gram, eiv, y2)
-
-
-def _scores(sol: _Solution) -> FloatArray:
-    """Per-row score contributions dᵢᵀ eᵢ (n, m) of the scaled design (three equations per row)."""
-    n = sol.resid.shape[0]
-    return np.asarray(np.einsum("nam,na->nm", sol.design.reshape(n, 3, -1), sol.resid), dtype=np.float64)
-
-
-def _jackknife(sol: _Solution, block_of: npt.NDArray[np.int64], n_blocks: int) -> FloatArray:
-    """p re-estimated with each block left out (n_blocks, 6): rank updates of the normal equations.
-
-    The errors-in-variables correction is removed in proportion to the rows left out.
-    """
-    n = sol.resid.shape[0]
-    d3 = sol.design.reshape(n, 3, -1)
-    y3 = sol.y_prime.reshape(n, 3)
-    dty = sol.design.T @ sol.y_prime
-    k = sol.basis.shape[1]
-    counts = np.bincount(block_of, minlength=n_blocks)
-    reps = np.empty((n_blocks, 6))
-    for b in range(n_blocks):
-        sel = block_of == b
-        db = d3[sel].reshape(-1, d3.shape[2])
-        gram_b = sol.gram - db.T @ db + sol.noise_gram * (counts[b] / n)
-        rhs = dty - db.T @ y3[sel].reshape(-1)
-        theta = np.linalg.lstsq(gram_b, rhs, rcond=1e-13)[0]
-        reps[b] = sol.p0 + sol.basis @ (theta[:k] * sol.col_scale[:k])
-    return reps
-
-
-def integrated_correlation_time(x: FloatArray, max_lag: int = 5000) -> float:
-    """Largest integrated autocorrelation time (in samples) over the columns of x (n, m).
-
-    τ = 1 + 2 Σ_{l=1}^{M} ρ(l) with Sokal's automatic window M ≥ 5 τ (Sokal 1997, "Monte Carlo methods in
-    statistical mechanics", §3); ρ from the FFT of the mean-removed column.
-    """
-    x = np.asarray(x, dtype=np.float64)
-    n = x.shape[0]
-    if n < 8:
-        return 1.0
-    xc = x - x.mean(axis=0)
-    f = np.fft.rfft(xc, 2 * n, axis=0)
-    ac = np.fft.irfft(f * np.conj(f), axis=0)[: min(max_lag, n // 2)]
-    var0 = np.where(ac[0] > 0, ac[0], 1.0)
-    rho = ac / var0
-    taus = 1.0 + 2.0 * np.cumsum(rho[1:], axis=0)  # τ(M) for M = 1..
-    best = 1.0
-    for c in range(x.shape[1]):
-        m = np.arange(1, taus.shape[0] + 1)
-        ok = np.flatnonzero(m >= 5.0 * taus[:, c])
-        tau_c = float(taus[ok[0], c]) if ok.size else float(taus[-1, c])
-        best = max(best, tau_c)
-    return best
-
-
-def _longest_run(mask: BoolArray) -> int:
-    """Length of the longest run of True in ``mask``."""
-    if not mask.any():
-        return 0
-    padded = np.concatenate([[0], mask.astype(np.int8), [0]])
-    d = np.diff(padded)
-    return int(np.max(np.flatnonzero(d == -1) - np.flatnonzero(d == 1)))
-
-
-def _profiled_information(a_p: FloatArray, x_nuis: FloatArray) -> FloatArray:
-    """AᵀA − AᵀX (XᵀX)⁺ XᵀA: the information about p left after the nuisances are fitted (unit noise)."""
-    n = a_p.shape[0]
-    a2 = a_p.reshape(3 * n, 6)
-    x2 = x_nuis.reshape(3 * n, -1)
-    xs = 1.0 / np.maximum(np.linalg.norm(x2, axis=0), 1e-300)
-    x2 = x2 * xs
-    xtx = x2.T @ x2
-    xta = x2.T @ a2
-    return np.asarray(a2.T @ a2 - xta.T @ np.linalg.pinv(xtx, rcond=1e-13, hermitian=True) @ xta, dtype=np.float64)
 
 
 def _running_median_vec(t: FloatArray, x: FloatArray, window_s: float) -> FloatArray:
@@ -761,15 +656,3 @@ def _running_median_vec(t: FloatArray, x: FloatArray, window_s: float) -> FloatA
         ok = np.isfinite(med[:, a])
         out[:, a] = np.interp(t, grid[ok], med[ok, a])
     return out
-
-
-def _correlation_inflation(resid: FloatArray, t: FloatArray, block_s: float) -> float:
-    """Var(block means) / (σ² / block size): how much correlated residuals inflate a white-noise variance."""
-    dt = float(np.median(np.diff(t)))
-    m = max(2, int(block_s / max(dt, 1e-9)))
-    nb = resid.shape[0] // m
-    if nb < 4:
-        return 1.0
-    blocks = resid[: nb * m].reshape(nb, m, 3).mean(axis=1)
-    ratio = float(np.mean(np.var(blocks, axis=0, ddof=1) / (np.var(resid, axis=0) / m)))
-    return max(1.0, ratio)

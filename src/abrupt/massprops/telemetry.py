@@ -19,15 +19,15 @@ interpolated across a loss of signal; dropped stamps are counted in the returned
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from abrupt.errors import InputError, RepairLog
-from abrupt.massprops.momentum_balance import MomentumBalanceData, nadir_from_attitude
+from abrupt.massprops.attitude_reference import nadir_from_attitude
+from abrupt.massprops.momentum_balance import MomentumBalanceData
 from abrupt.model.rotations import normalise_quaternion
-from abrupt.types import FloatArray
+from abrupt.types import BoolArray, FloatArray
 
 Channel = tuple[FloatArray, FloatArray]  # (t_s, value) in SI units
 
@@ -58,6 +58,128 @@ def _sorted(ch: Channel, name: str, source: str) -> Channel:
     return t[keep], v[keep]
 
 
+def _attitude(quaternion: Channel, repairs: RepairLog) -> Channel:
+    """Star-tracker stamps and unit quaternions, sorted, one per stamp; far-from-unit samples dropped."""
+    tq = np.asarray(quaternion[0], dtype=np.float64)
+    q = np.asarray(quaternion[1], dtype=np.float64).reshape(-1, 4)
+    ok = np.all(np.isfinite(q), axis=1)
+    norm = np.linalg.norm(q, axis=1)
+    bad_norm = ok & (np.abs(norm - 1.0) > 0.01)
+    if bad_norm.any():
+        repairs.record("quaternion samples with |q| far from 1 dropped", int(bad_norm.sum()))
+    ok &= ~bad_norm
+    tq, q = tq[ok], normalise_quaternion(q[ok])
+    order = np.argsort(tq, kind="stable")
+    tq, q = tq[order], q[order]
+    first = np.concatenate([[True], np.diff(tq) > 0])
+    return tq[first], q[first]
+
+
+def _body_rate(body_rate: Channel, source: str) -> Channel:
+    """Gyro stamps and rates (m, 3) [rad/s], finite and sorted; an error for a likely unit mistake."""
+    tr = np.asarray(body_rate[0], dtype=np.float64)
+    wr = np.asarray(body_rate[1], dtype=np.float64).reshape(-1, 3)
+    rok = np.all(np.isfinite(wr), axis=1)
+    tr, wr = tr[rok], wr[rok]
+    o = np.argsort(tr, kind="stable")
+    tr, wr = tr[o], wr[o]
+    if tr.size < 2:
+        raise InputError("body-rate channel has fewer than 2 samples", file=source, column="body_rate")
+    if float(np.percentile(np.abs(wr), 99)) > 1.0:
+        raise InputError(
+            "body rates above 1 rad/s in 1% of samples: wrong unit (deg/s read as rad/s?)",
+            file=source,
+            column="body_rate",
+        )
+    return tr, wr
+
+
+def _rate_at_stamps(
+    tq: FloatArray,
+    rate: Channel,
+    first_wheel: Channel | None,
+    tachometer_gate_s: float,
+    rate_average_s: float,
+) -> FloatArray:
+    """The body rate (n, 3) at the attitude stamps: the gyro mean over ``±rate_average_s``, or over each
+    tachometer gate when the wheels are gated."""
+    tr, wr = rate
+    omega = np.column_stack([_window_mean(tr, wr[:, a], tq, rate_average_s) for a in range(3)])
+    if tachometer_gate_s > 0 and first_wheel is not None:
+        # Rate filtered exactly like the wheel speeds: the gyro mean over each tachometer gate (of the first
+        # wheel), placed at the gate centre and interpolated to the attitude stamps. Smoothing the wheel
+        # momentum more than J ω shrinks the wheel's share of each slew and biases J low (about 1e-4
+        # relative on simulated flight-like days: small, but many times the statistical 1σ).
+        tw0 = np.sort(np.asarray(first_wheel[0], dtype=np.float64))
+        tw0 = tw0[(tw0 - tachometer_gate_s >= tr[0]) & (tw0 <= tr[-1])]
+        if tw0.size >= 2:
+            gate_mean = np.column_stack(
+                [_window_mean(tr, wr[:, a], tw0 - tachometer_gate_s / 2.0, tachometer_gate_s / 2.0) for a in range(3)]
+            )
+            omega = np.column_stack([np.interp(tq, tw0 - tachometer_gate_s / 2.0, gate_mean[:, a]) for a in range(3)])
+    return omega
+
+
+def _wheel_speeds_at_stamps(
+    tq: FloatArray, wheel_speeds: list[Channel], tachometer_gate_s: float, max_hold_s: float, source: str
+) -> tuple[FloatArray, BoolArray]:
+    """Wheel speeds (n, N) at the attitude stamps (gate-centred), and the stamps near a sample of each."""
+    keep = np.ones(tq.size, dtype=bool)
+    wheel = np.empty((tq.size, len(wheel_speeds)))
+    for i, ch in enumerate(wheel_speeds):
+        tw, vw = _sorted(ch, f"wheel {i + 1}", source)
+        fin = np.isfinite(vw)
+        tw, vw = tw[fin], vw[fin]
+        if tw.size < 2:
+            raise InputError(f"wheel {i + 1} speed channel is empty", file=source, column=f"wheel {i + 1}")
+        tw = tw - tachometer_gate_s / 2.0
+        keep &= _nearest_distance(tq, tw) <= max_hold_s
+        wheel[:, i] = np.interp(tq, tw, vw)
+    return wheel, keep
+
+
+def _appendage_momentum(
+    tq: FloatArray,
+    angle: Channel,
+    axis_B: ArrayLike,
+    spin_inertia_kgm2: float,
+    max_hold_s: float,
+    source: str,
+) -> tuple[FloatArray, BoolArray]:
+    """``I_app θ̇ a`` (n, 3) [N m s] at the attitude stamps, and the stamps near an angle sample."""
+    ta, va = _sorted(angle, "appendage angle", source)
+    fin = np.isfinite(va)
+    ta, va = ta[fin], np.unwrap(va[fin])
+    rate = np.gradient(va, ta)
+    ax = np.asarray(axis_B, dtype=np.float64)
+    ax = ax / np.linalg.norm(ax)
+    near = _nearest_distance(tq, ta) <= max(max_hold_s, 2.5 * float(np.median(np.diff(ta))))
+    return spin_inertia_kgm2 * np.interp(tq, ta, rate)[:, None] * ax[None, :], near
+
+
+def _thruster_windows(thruster_flag: Channel, source: str) -> list[tuple[float, float]]:
+    """Firing intervals (flag 1 → 0) [s]; firings closer than a minute merged into one window."""
+    tf, vf = _sorted(thruster_flag, "thruster flag", source)
+    windows: list[tuple[float, float]] = []
+    on = None
+    for ti, vi in zip(tf, vf, strict=True):
+        if vi > 0.5 and on is None:
+            on = float(ti)
+        elif vi <= 0.5 and on is not None:
+            windows.append((on, float(ti)))
+            on = None
+    if on is not None:
+        windows.append((on, on + 60.0))
+    # Pulses of one dump are seconds apart: merge firings closer than a minute into one window.
+    merged: list[tuple[float, float]] = []
+    for a, b in windows:
+        if merged and a - merged[-1][1] < 60.0:
+            merged[-1] = (merged[-1][0], b)
+        else:
+            merged.append((a, b))
+    return merged
+
+
 def momentum_data_from_channels(
     quaternion: tuple[FloatArray, FloatArray],
     body_rate: tuple[FloatArray, FloatArray],
@@ -84,7 +206,8 @@ def momentum_data_from_channels(
     one (t, Ω [rad/s]) per wheel in the order of ``wheel_axes`` (3, N); ``appendage_angle`` (t, θ [rad],
     wrapped or not) about ``appendage_axis_B`` with spin inertia ``appendage_spin_inertia_kgm2``;
     ``thruster_flag`` (t, 0/1) written on change; ``orbit_period_s`` enables the gravity-gradient term
-    for a nadir-pointing spacecraft (the orbit is fitted to the attitude, :func:`nadir_from_attitude`).
+    for a nadir-pointing spacecraft (the orbit is fitted to the attitude,
+    :func:`~abrupt.massprops.attitude_reference.nadir_from_attitude`).
     """
     repairs = repairs if repairs is not None else RepairLog(source)
     axes = np.asarray(wheel_axes, dtype=np.float64)
@@ -96,94 +219,22 @@ def momentum_data_from_channels(
             file=source,
             column="wheel_speed",
         )
-    tq = np.asarray(quaternion[0], dtype=np.float64)
-    q = np.asarray(quaternion[1], dtype=np.float64).reshape(-1, 4)
-    ok = np.all(np.isfinite(q), axis=1)
-    norm = np.linalg.norm(q, axis=1)
-    bad_norm = ok & (np.abs(norm - 1.0) > 0.01)
-    if bad_norm.any():
-        repairs.record("quaternion samples with |q| far from 1 dropped", int(bad_norm.sum()))
-    ok &= ~bad_norm
-    tq, q = tq[ok], normalise_quaternion(q[ok])
-    order = np.argsort(tq, kind="stable")
-    tq, q = tq[order], q[order]
-    first = np.concatenate([[True], np.diff(tq) > 0])
-    tq, q = tq[first], q[first]
-
-    tr = np.asarray(body_rate[0], dtype=np.float64)
-    wr = np.asarray(body_rate[1], dtype=np.float64).reshape(-1, 3)
-    rok = np.all(np.isfinite(wr), axis=1)
-    tr, wr = tr[rok], wr[rok]
-    o = np.argsort(tr, kind="stable")
-    tr, wr = tr[o], wr[o]
-    if tr.size < 2:
-        raise InputError("body-rate channel has fewer than 2 samples", file=source, column="body_rate")
-    if float(np.percentile(np.abs(wr), 99)) > 1.0:
-        raise InputError(
-            "body rates above 1 rad/s in 1% of samples: wrong unit (deg/s read as rad/s?)",
-            file=source,
-            column="body_rate",
-        )
+    tq, q = _attitude(quaternion, repairs)
+    tr, wr = _body_rate(body_rate, source)
     keep = _nearest_distance(tq, tr) <= max_hold_s
-    omega = np.column_stack([_window_mean(tr, wr[:, a], tq, rate_average_s) for a in range(3)])
-    if tachometer_gate_s > 0 and wheel_speeds:
-        # Rate filtered exactly like the wheel speeds: the gyro mean over each tachometer gate (of the first
-        # wheel), placed at the gate centre and interpolated to the attitude stamps. Smoothing the wheel
-        # momentum more than J ω shrinks the wheel's share of each slew and biases J low (about 1e-4
-        # relative on simulated flight-like days: small, but many times the statistical 1σ).
-        tw0 = np.sort(np.asarray(wheel_speeds[0][0], dtype=np.float64))
-        tw0 = tw0[(tw0 - tachometer_gate_s >= tr[0]) & (tw0 <= tr[-1])]
-        if tw0.size >= 2:
-            gate_mean = np.column_stack(
-                [_window_mean(tr, wr[:, a], tw0 - tachometer_gate_s / 2.0, tachometer_gate_s / 2.0) for a in range(3)]
-            )
-            omega = np.column_stack([np.interp(tq, tw0 - tachometer_gate_s / 2.0, gate_mean[:, a]) for a in range(3)])
-
-    wheel = np.empty((tq.size, len(wheel_speeds)))
-    for i, ch in enumerate(wheel_speeds):
-        tw, vw = _sorted(ch, f"wheel {i + 1}", source)
-        fin = np.isfinite(vw)
-        tw, vw = tw[fin], vw[fin]
-        if tw.size < 2:
-            raise InputError(f"wheel {i + 1} speed channel is empty", file=source, column=f"wheel {i + 1}")
-        tw = tw - tachometer_gate_s / 2.0
-        keep &= _nearest_distance(tq, tw) <= max_hold_s
-        wheel[:, i] = np.interp(tq, tw, vw)
-
+    omega = _rate_at_stamps(tq, (tr, wr), wheel_speeds[0] if wheel_speeds else None, tachometer_gate_s, rate_average_s)
+    wheel, near_wheels = _wheel_speeds_at_stamps(tq, wheel_speeds, tachometer_gate_s, max_hold_s, source)
+    keep &= near_wheels
     h_app = None
     if appendage_angle is not None and appendage_axis_B is not None and appendage_spin_inertia_kgm2 > 0:
-        ta, va = _sorted(appendage_angle, "appendage angle", source)
-        fin = np.isfinite(va)
-        ta, va = ta[fin], np.unwrap(va[fin])
-        rate = np.gradient(va, ta)
-        ax = np.asarray(appendage_axis_B, dtype=np.float64)
-        ax = ax / np.linalg.norm(ax)
-        keep &= _nearest_distance(tq, ta) <= max(max_hold_s, 2.5 * float(np.median(np.diff(ta))))
-        h_app = appendage_spin_inertia_kgm2 * np.interp(tq, ta, rate)[:, None] * ax[None, :]
-
+        h_app, near_angle = _appendage_momentum(
+            tq, appendage_angle, appendage_axis_B, appendage_spin_inertia_kgm2, max_hold_s, source
+        )
+        keep &= near_angle
     dropped = int((~keep).sum())
     if dropped:
         repairs.record("attitude stamps without a nearby sample of every channel dropped", dropped)
-    windows: list[tuple[float, float]] = []
-    if thruster_flag is not None:
-        tf, vf = _sorted(thruster_flag, "thruster flag", source)
-        on = None
-        for ti, vi in zip(tf, vf, strict=True):
-            if vi > 0.5 and on is None:
-                on = float(ti)
-            elif vi <= 0.5 and on is not None:
-                windows.append((on, float(ti)))
-                on = None
-        if on is not None:
-            windows.append((on, on + 60.0))
-        # Pulses of one dump are seconds apart: merge firings closer than a minute into one window.
-        merged: list[tuple[float, float]] = []
-        for a, b in windows:
-            if merged and a - merged[-1][1] < 60.0:
-                merged[-1] = (merged[-1][0], b)
-            else:
-                merged.append((a, b))
-        windows = merged
+    windows = _thruster_windows(thruster_flag, source) if thruster_flag is not None else []
     t_k, q_k = tq[keep], q[keep]
     nadir = None
     rate_orbit = None
@@ -204,14 +255,6 @@ def momentum_data_from_channels(
         epoch_utc=epoch_utc,
         source=source,
     )
-
-
-def channels_by_key(frame_groups: Mapping[str, Channel], keys: list[str]) -> list[Channel]:
-    """The channels named ``keys`` from a mapping, with an error naming the first missing one."""
-    missing = [k for k in keys if k not in frame_groups]
-    if missing:
-        raise InputError(f"missing telemetry channel(s) {missing}", column=missing[0])
-    return [frame_groups[k] for k in keys]
 
 
 def momentum_data_from_simulation(

@@ -53,11 +53,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from abrupt.errors import ConfigError
-from abrupt.model.flight_config import FlightConfig, OrbitInfo, parse_flight, parse_orbit
+from abrupt.model.flight_config import (
+    ANGLE_UNITS,
+    RATE_UNITS,
+    FlightConfig,
+    OrbitInfo,
+    parse_flight,
+    parse_orbit,
+)
 
-RATE_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0, "arcsec/s": math.pi / 180.0 / 3600.0}
 WHEEL_SPEED_UNITS = {"rad/s": 1.0, "rpm": 2.0 * math.pi / 60.0, "rps": 2.0 * math.pi}
-ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180.0}
 
 _TOP_KEYS = {
     "name",
@@ -278,17 +283,7 @@ def _channel(table: Any, where: str, file: str, units: dict[str, float] | None, 
     return ChannelMap(tuple(cols), unit, order)
 
 
-def spacecraft_from_dict(data: dict[str, Any], *, source: str = "<memory>") -> Spacecraft:
-    """Validate a parsed spacecraft description; raise :class:`ConfigError` naming the key."""
-    file = source
-    _check_keys(data, _TOP_KEYS, "", file)
-    name = _require(data, "name", "", file)
-    if not isinstance(name, str) or not name:
-        raise ConfigError("name must be a non-empty string", file=file, key="name")
-    inertia = _inertia(_require(data, "inertia_kgm2", "", file), "inertia_kgm2", file)
-    mass = _positive(data["mass_kg"], "mass_kg", file) if "mass_kg" in data else float("nan")
-    lever = _positive(data.get("lever_arm_m", 1.0), "lever_arm_m", file)
-
+def _wheels(data: dict[str, Any], file: str) -> tuple[Wheel, ...]:
     wheels = []
     for i, w in enumerate(data.get("wheels", [])):
         where = f"wheels[{i}]"
@@ -308,73 +303,74 @@ def spacecraft_from_dict(data: dict[str, Any], *, source: str = "<memory>") -> S
         g = np.column_stack([w.axis for w in wheels])
         if np.linalg.matrix_rank(g) < 3:
             raise ConfigError("wheel axes do not span three dimensions", file=file, key="wheels")
+    return tuple(wheels)
 
-    appendages = []
-    for i, a in enumerate(data.get("appendages", [])):
-        where = f"appendages[{i}]"
-        a = _check_keys(a, _APPENDAGE_KEYS, where, file)
-        axes = _require(a, "gimbal_axes", where, file)
-        axes_arr = np.array([_unit_vector(ax, f"{where}.gimbal_axes[{k}]", file) for k, ax in enumerate(axes)])
-        cols = tuple(_require(a, "angle_columns", where, file))
-        if len(cols) != len(axes_arr):
-            raise ConfigError("one angle column per gimbal axis", file=file, key=f"{where}.angle_columns")
-        unit = a.get("angle_unit", "rad")
-        if unit not in ANGLE_UNITS:
-            raise ConfigError(f"unknown unit {unit!r}", file=file, key=f"{where}.angle_unit")
-        # With spin_inertia_kgm2 (momentum-only description) the full inertia and hinge are optional.
-        spin = (
-            _positive(a["spin_inertia_kgm2"], f"{where}.spin_inertia_kgm2", file)
-            if "spin_inertia_kgm2" in a
-            else float("nan")
-        )
-        needs_full = not math.isfinite(spin)
-        inertia_a = (
-            _inertia(_require(a, "inertia_kgm2", where, file), f"{where}.inertia_kgm2", file)
-            if needs_full or "inertia_kgm2" in a
-            else np.diag([spin, spin, spin])
-        )
-        hinge = (
-            _vector(_require(a, "hinge_m", where, file), 3, f"{where}.hinge_m", file)
-            if needs_full or "hinge_m" in a
-            else np.zeros(3)
-        )
-        appendages.append(
-            Appendage(
-                name=str(a.get("name", f"appendage{i + 1}")),
-                mass_kg=_positive(_require(a, "mass_kg", where, file), f"{where}.mass_kg", file),
-                inertia_kgm2=inertia_a,
-                hinge_m=hinge,
-                gimbal_axes=axes_arr,
-                angle_columns=cols,
-                angle_unit=unit,
-                spin_inertia_kgm2=spin,
-            )
-        )
 
-    surfaces = []
-    for i, s in enumerate(data.get("surfaces", [])):
-        where = f"surfaces[{i}]"
-        s = _check_keys(s, _SURFACE_KEYS, where, file)
-        shape = _require(s, "shape", where, file)
-        kind = s.get("kind", "bus" if shape == "box" else "solar_array")
-        if kind not in ("bus", "solar_array"):
-            raise ConfigError("kind must be 'bus' or 'solar_array'", file=file, key=f"{where}.kind")
-        center = _vector(s.get("center_m", [0.0, 0.0, 0.0]), 3, f"{where}.center_m", file)
-        if shape == "box":
-            size = _vector(_require(s, "size_m", where, file), 3, f"{where}.size_m", file)
-            normal = u_axis = None
-        elif shape == "panel":
-            size = _vector(_require(s, "size_m", where, file), 2, f"{where}.size_m", file)
-            normal = _unit_vector(_require(s, "normal", where, file), f"{where}.normal", file)
-            u_axis = _unit_vector(_require(s, "u_axis", where, file), f"{where}.u_axis", file)
-            if abs(float(normal @ u_axis)) > 1e-6:
-                raise ConfigError("u_axis must be perpendicular to normal", file=file, key=f"{where}.u_axis")
-        else:
-            raise ConfigError(f"shape must be 'box' or 'panel', got {shape!r}", file=file, key=f"{where}.shape")
-        if np.any(size <= 0):
-            raise ConfigError("sizes must be positive", file=file, key=f"{where}.size_m")
-        surfaces.append(Surface(str(s.get("name", f"surface{i + 1}")), shape, size, center, normal, u_axis, kind))
+def _appendage(a: Any, i: int, file: str) -> Appendage:
+    where = f"appendages[{i}]"
+    a = _check_keys(a, _APPENDAGE_KEYS, where, file)
+    axes = _require(a, "gimbal_axes", where, file)
+    axes_arr = np.array([_unit_vector(ax, f"{where}.gimbal_axes[{k}]", file) for k, ax in enumerate(axes)])
+    cols = tuple(_require(a, "angle_columns", where, file))
+    if len(cols) != len(axes_arr):
+        raise ConfigError("one angle column per gimbal axis", file=file, key=f"{where}.angle_columns")
+    unit = a.get("angle_unit", "rad")
+    if unit not in ANGLE_UNITS:
+        raise ConfigError(f"unknown unit {unit!r}", file=file, key=f"{where}.angle_unit")
+    # With spin_inertia_kgm2 (momentum-only description) the full inertia and hinge are optional.
+    spin = (
+        _positive(a["spin_inertia_kgm2"], f"{where}.spin_inertia_kgm2", file)
+        if "spin_inertia_kgm2" in a
+        else float("nan")
+    )
+    needs_full = not math.isfinite(spin)
+    inertia_a = (
+        _inertia(_require(a, "inertia_kgm2", where, file), f"{where}.inertia_kgm2", file)
+        if needs_full or "inertia_kgm2" in a
+        else np.diag([spin, spin, spin])
+    )
+    hinge = (
+        _vector(_require(a, "hinge_m", where, file), 3, f"{where}.hinge_m", file)
+        if needs_full or "hinge_m" in a
+        else np.zeros(3)
+    )
+    return Appendage(
+        name=str(a.get("name", f"appendage{i + 1}")),
+        mass_kg=_positive(_require(a, "mass_kg", where, file), f"{where}.mass_kg", file),
+        inertia_kgm2=inertia_a,
+        hinge_m=hinge,
+        gimbal_axes=axes_arr,
+        angle_columns=cols,
+        angle_unit=unit,
+        spin_inertia_kgm2=spin,
+    )
 
+
+def _surface(s: Any, i: int, file: str) -> Surface:
+    where = f"surfaces[{i}]"
+    s = _check_keys(s, _SURFACE_KEYS, where, file)
+    shape = _require(s, "shape", where, file)
+    kind = s.get("kind", "bus" if shape == "box" else "solar_array")
+    if kind not in ("bus", "solar_array"):
+        raise ConfigError("kind must be 'bus' or 'solar_array'", file=file, key=f"{where}.kind")
+    center = _vector(s.get("center_m", [0.0, 0.0, 0.0]), 3, f"{where}.center_m", file)
+    if shape == "box":
+        size = _vector(_require(s, "size_m", where, file), 3, f"{where}.size_m", file)
+        normal = u_axis = None
+    elif shape == "panel":
+        size = _vector(_require(s, "size_m", where, file), 2, f"{where}.size_m", file)
+        normal = _unit_vector(_require(s, "normal", where, file), f"{where}.normal", file)
+        u_axis = _unit_vector(_require(s, "u_axis", where, file), f"{where}.u_axis", file)
+        if abs(float(normal @ u_axis)) > 1e-6:
+            raise ConfigError("u_axis must be perpendicular to normal", file=file, key=f"{where}.u_axis")
+    else:
+        raise ConfigError(f"shape must be 'box' or 'panel', got {shape!r}", file=file, key=f"{where}.shape")
+    if np.any(size <= 0):
+        raise ConfigError("sizes must be positive", file=file, key=f"{where}.size_m")
+    return Surface(str(s.get("name", f"surface{i + 1}")), shape, size, center, normal, u_axis, kind)
+
+
+def _telemetry_map(data: dict[str, Any], wheels: tuple[Wheel, ...], file: str) -> TelemetryMap:
     telemetry = TelemetryMap()
     if "telemetry" in data:
         t = _check_keys(data["telemetry"], _TELEMETRY_KEYS, "telemetry", file)
@@ -398,6 +394,23 @@ def spacecraft_from_dict(data: dict[str, Any], *, source: str = "<memory>") -> S
     dup = sorted({c for c in mapped if mapped.count(c) > 1})
     if dup:
         raise ConfigError(f"column(s) {dup} mapped to more than one quantity", file=file, key="telemetry")
+    return telemetry
+
+
+def spacecraft_from_dict(data: dict[str, Any], *, source: str = "<memory>") -> Spacecraft:
+    """Validate a parsed spacecraft description; raise :class:`ConfigError` naming the key."""
+    file = source
+    _check_keys(data, _TOP_KEYS, "", file)
+    name = _require(data, "name", "", file)
+    if not isinstance(name, str) or not name:
+        raise ConfigError("name must be a non-empty string", file=file, key="name")
+    inertia = _inertia(_require(data, "inertia_kgm2", "", file), "inertia_kgm2", file)
+    mass = _positive(data["mass_kg"], "mass_kg", file) if "mass_kg" in data else float("nan")
+    lever = _positive(data.get("lever_arm_m", 1.0), "lever_arm_m", file)
+    wheels = _wheels(data, file)
+    appendages = tuple(_appendage(a, i, file) for i, a in enumerate(data.get("appendages", [])))
+    surfaces = tuple(_surface(s, i, file) for i, s in enumerate(data.get("surfaces", [])))
+    telemetry = _telemetry_map(data, wheels, file)
     orbit = parse_orbit(data["orbit"], file) if "orbit" in data else None
     flight = (
         parse_flight(data["flight"], file, len(wheels), tuple(a.name for a in appendages)) if "flight" in data else None
@@ -407,11 +420,11 @@ def spacecraft_from_dict(data: dict[str, Any], *, source: str = "<memory>") -> S
         orbit=orbit,
         flight=flight,
         inertia_kgm2=inertia,
-        wheels=tuple(wheels),
+        wheels=wheels,
         mass_kg=mass,
         lever_arm_m=lever,
-        appendages=tuple(appendages),
-        surfaces=tuple(surfaces),
+        appendages=appendages,
+        surfaces=surfaces,
         telemetry=telemetry,
         source=source,
     )

@@ -11,7 +11,6 @@ from __future__ import annotations
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
 
 import pandas as pd
 
@@ -19,12 +18,16 @@ from abrupt.density.constellation import (
     ConstellationConfig,
     ConstellationResult,
     estimate_constellation_density,
+    flow_from_windows,
     read_platforms,
 )
 from abrupt.density.joint import JointConfig, JointDensity, joint_constellation_density
-from abrupt.density.precise_orbit import OrbitDensityConfig
+from abrupt.density.precise_orbit import OrbitDensityConfig, fit_orbit_density
 from abrupt.density.tle_drag import RhoBResult, TleDragConfig, rho_b_from_history
 from abrupt.errors import RepairLog
+from abrupt.model.atmosphere import read_space_weather
+from abrupt.pipelines.orbit import load_ephemeris
+from abrupt.readers.omm import read_elements
 
 
 @dataclass
@@ -40,9 +43,6 @@ class TleDensityResult:
 
 def _one_object(args: tuple[str, TleDragConfig, str, str | None, int]) -> tuple[RhoBResult, RhoBResult | None]:
     path, cfg, maneuvers, sw_path, dist_factor = args
-    from abrupt.model.atmosphere import read_space_weather
-    from abrupt.readers.omm import read_elements
-
     history = read_elements(path)
     sw = read_space_weather(sw_path) if cfg.with_model else None
     res = rho_b_from_history(history, cfg, maneuvers=maneuvers, space_weather=sw)
@@ -107,9 +107,6 @@ def tle_density(
             warnings.append("no --platforms file: densities are relative (B_min unknown)")
         long_frames = [r[1].windows for r in results if r[1] is not None and len(r[1].windows)]
         dist = pd.concat(long_frames, ignore_index=True) if long_frames else None
-        from abrupt.density.constellation import flow_from_windows
-        from abrupt.model.atmosphere import read_space_weather
-
         sw = read_space_weather(sw_path)
         ok_windows = windows[windows["status"] == "ok"]
         flow = flow_from_windows(ok_windows, sw) if len(ok_windows) else None
@@ -161,10 +158,6 @@ def orbit_density(
     """ρB (and density, with the spacecraft given) per window from precise ephemerides (SP3, OEM, CSV;
     abrupt's readers): batch least squares for the state, a drag scale and an SRP scale per window with
     the one orbit model (:mod:`abrupt.density.precise_orbit`), and NRLMSIS along the same orbit."""
-    from abrupt.density.precise_orbit import fit_orbit_density
-    from abrupt.model.atmosphere import read_space_weather
-    from abrupt.pipelines.orbit import load_ephemeris
-
     sw = read_space_weather(space_weather) if space_weather is not None else read_space_weather()
     frames: list[pd.DataFrame] = []
     repairs: dict[str, RepairLog] = {}
@@ -193,8 +186,6 @@ def _first_epoch(path: str | Path) -> pd.Timestamp:
     """The earliest element-set epoch of a file: from the epoch field (columns 19-32, YYDDD.DDDDDDDD)
     of every TLE line 1 when the file is TLE/3LE text (initialising SGP4 for every set of 50 objects
     took 10 s just for this), else from the whole file (OMM)."""
-    from abrupt.readers.omm import read_elements
-
     days: list[float] = []
     with open(path, encoding="utf-8", errors="replace") as fh:
         for line in fh:
@@ -220,4 +211,3 @@ def write_table(frame: pd.DataFrame, path: str | Path) -> None:
 
 
 __all__ = ["OrbitDensityRun", "TleDensityResult", "orbit_density", "tle_density", "write_table"]
-_ = Any

@@ -6,7 +6,7 @@ Harris et al. 2025 §3.3-3.5, §3.7 and Bennett 2022 ch. 4, driven entirely by t
 1. :func:`ingest_archives` reads archive dumps, replaces names by pseudonyms at the door, removes
    archiver artifacts and stores raw samples per spacecraft-day (:class:`abrupt.store.TelemetryStore`).
 2. :func:`process_chunk` reads one chunk (with a margin) from the store, synchronises it
-   (:mod:`abrupt.series.timetable`), computes ᴺH with appendages (:mod:`abrupt.model.flight_momentum`),
+   (:mod:`abrupt.series.timetable`), computes ᴺH with appendages (:mod:`abrupt.series.timetable_momentum`),
    masks event-flag firings and slews (:mod:`abrupt.clean.masks`), removes the slow external-torque
    trend and the orbit comb (:mod:`abrupt.clean.comb`) in ``passes`` iterations, the candidate steps of
    one pass entering the next pass's fits as free steps so that strikes are not absorbed, and runs
@@ -39,11 +39,11 @@ from abrupt.detect.base import get_detector
 from abrupt.errors import ConfigError, InputError
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc, new_run_id
 from abrupt.model.flight_config import FlightConfig
-from abrupt.model.flight_momentum import timetable_momentum, wheel_scale_from_conservation
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.readers.archive import read_archive, read_decoder
 from abrupt.scale import Executor
 from abrupt.series.timetable import NS, Timetable, build_timetable
+from abrupt.series.timetable_momentum import timetable_momentum, wheel_scale_from_conservation
 from abrupt.store import TelemetryStore
 from abrupt.thresholds import Threshold
 from abrupt.thresholds.noise import robust_noise_sigma

@@ -20,11 +20,15 @@ from abrupt.detect.mass.inertia_change import InertiaChangeDetector
 from abrupt.errors import ConfigError, InputError, RepairLog
 from abrupt.massprops.inertia import INERTIA_ELEMENTS, physical_violations, principal_axes
 from abrupt.massprops.momentum_balance import InertiaEstimate, MomentumBalanceData, estimate_inertia
-from abrupt.massprops.telemetry import momentum_data_from_channels
+from abrupt.massprops.telemetry import momentum_data_from_channels, momentum_data_from_simulation
 from abrupt.massprops.track import InertiaTrack, track_inertia
-from abrupt.model.flight_config import FlightChannel
-from abrupt.model.spacecraft import Spacecraft, load_spacecraft
+from abrupt.model.flight_config import FlightChannel, FlightConfig
+from abrupt.model.spacecraft import ANGLE_UNITS, Spacecraft, load_spacecraft
+from abrupt.pipelines.flight import day_range
 from abrupt.readers.telemetry import read_telemetry
+from abrupt.simulate.attitude import telemetry_frame
+from abrupt.simulate.docking import DockingScenario, docking_days, simulate_docking
+from abrupt.store import TelemetryStore
 from abrupt.thresholds import FalseAlarmBudget
 
 
@@ -57,6 +61,93 @@ def is_ingest_store(root: str | Path) -> bool:
     return any(Path(root).glob("spacecraft=*/day=*/samples.parquet"))
 
 
+@dataclass(frozen=True)
+class _StoreSamples:
+    """The raw samples of the spacecraft's ``[flight]`` channels, grouped by mnemonic, times from ``t0_ns``."""
+
+    groups: dict[str, pd.DataFrame]
+    t0_ns: int
+    spacecraft: Spacecraft
+    repairs: RepairLog
+
+    def channel(self, c: FlightChannel) -> tuple[np.ndarray, np.ndarray]:
+        """(t [s], value [SI]) of one channel, sorted; an error naming it when the store has none."""
+        g = self.groups.get(c.mnemonic)
+        if g is None or g.empty:
+            raise InputError(
+                f"channel {c.mnemonic!r} ({c.quantity} {c.component}) has no samples in the store",
+                file=self.repairs.source,
+                column=c.mnemonic,
+            )
+        t = (g["time"].to_numpy().astype("datetime64[ns]").astype(np.int64) - self.t0_ns) / 1e9
+        v = g["value"].to_numpy(dtype=np.float64) * c.to_si
+        order = np.argsort(t, kind="stable")
+        return t[order], v[order]
+
+    def joined(self, quantity: str, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """Components 0..n-1 of a vector quantity joined on their common stamps (n columns)."""
+        assert self.spacecraft.flight is not None
+        chans = self.spacecraft.flight.of(quantity)
+        if [c.component for c in chans] != list(range(n)):
+            raise ConfigError(
+                f"[flight] needs {quantity} components 0..{n - 1}, got {[c.component for c in chans]}",
+                file=self.spacecraft.source,
+                key="flight.channels",
+            )
+        series = [self.channel(c) for c in chans]
+        common = np.unique(series[0][0])
+        for t, _ in series[1:]:
+            common = np.intersect1d(common, t)
+        lost = sum(t.size for t, _ in series) - n * common.size
+        if common.size < 0.5 * max(t.size for t, _ in series):
+            raise InputError(
+                f"{quantity} components {[c.mnemonic for c in chans]} share only {common.size} of "
+                f"{max(t.size for t, _ in series)} time stamps: the components must be sampled together",
+                file=self.repairs.source,
+                column=chans[0].mnemonic,
+            )
+        self.repairs.record(f"{quantity} samples without every component at their stamp dropped", lost)
+        return common, np.column_stack([v[np.searchsorted(t, common)] for t, v in series])
+
+    def appendage(self) -> tuple[tuple[np.ndarray, np.ndarray] | None, np.ndarray | None, float]:
+        """(angle channel, drive axis, drive inertia) of the first single-axis appendage with an angle channel."""
+        assert self.spacecraft.flight is not None
+        for c in self.spacecraft.flight.of("appendage_angle"):
+            app = next((a for a in self.spacecraft.appendages if a.name == c.appendage), None)
+            if app is not None and len(app.gimbal_axes) == 1:  # the loader checked the name (flight_config)
+                return self.channel(c), app.gimbal_axes[0], app.drive_inertia_kgm2
+        return None, None, 0.0
+
+    def thruster_flag(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The ``event_flag`` channels OR-ed into one flag (each holds its last value, written on change)."""
+        assert self.spacecraft.flight is not None
+        flags = [self.channel(c) for c in self.spacecraft.flight.of("event_flag") if c.mnemonic in self.groups]
+        if not flags:
+            return None
+        t_f = np.unique(np.concatenate([t for t, _ in flags]))
+        on = np.zeros(t_f.size, bool)
+        for t, v in flags:
+            k = np.searchsorted(t, t_f, side="right") - 1
+            on |= (k >= 0) & (v[np.clip(k, 0, None)] > 0.5)
+        return t_f, on.astype(np.float64)
+
+
+def _require_flight_and_wheels(spacecraft: Spacecraft) -> FlightConfig:
+    if spacecraft.flight is None:
+        raise ConfigError(
+            "no [flight] table: reading the ingest store needs the channel pseudonyms and units",
+            file=spacecraft.source,
+            key="flight",
+        )
+    if not spacecraft.wheels:
+        raise ConfigError(
+            "the spacecraft file has no [[wheels]]: the momentum balance needs them",
+            file=spacecraft.source,
+            key="wheels",
+        )
+    return spacecraft.flight
+
+
 def load_momentum_data_from_store(
     root: str | Path,
     spacecraft: Spacecraft,
@@ -73,22 +164,7 @@ def load_momentum_data_from_store(
     dumps) are OR-ed into the thruster flag. The orbit period is ``--orbit-period`` or ``[orbit]``.
     Archive repairs were counted at ingest (``ingest.json``); they are carried into the repair log.
     """
-    from abrupt.pipelines.flight import day_range
-    from abrupt.store import TelemetryStore
-
-    if spacecraft.flight is None:
-        raise ConfigError(
-            "no [flight] table: reading the ingest store needs the channel pseudonyms and units",
-            file=spacecraft.source,
-            key="flight",
-        )
-    if not spacecraft.wheels:
-        raise ConfigError(
-            "the spacecraft file has no [[wheels]]: the momentum balance needs them",
-            file=spacecraft.source,
-            key="wheels",
-        )
-    flight = spacecraft.flight
+    flight = _require_flight_and_wheels(spacecraft)
     store = TelemetryStore(root)
     day_list = day_range(store, spacecraft.name, days)
     repairs = RepairLog(f"{Path(root)}/spacecraft={spacecraft.name}")
@@ -98,46 +174,13 @@ def load_momentum_data_from_store(
                 repairs.record(str(kind), int(count))
     start = np.datetime64(day_list[0], "D")
     end = np.datetime64(day_list[-1], "D") + np.timedelta64(1, "D")
-    samples = store.read_range(spacecraft.name, start, end, flight.mnemonics)
-    t0_ns = int(start.astype("datetime64[ns]").astype(np.int64))
-    groups = {str(m): g for m, g in samples.groupby("mnemonic", observed=True)}
-
-    def channel(c: FlightChannel) -> tuple[np.ndarray, np.ndarray]:
-        g = groups.get(c.mnemonic)
-        if g is None or g.empty:
-            raise InputError(
-                f"channel {c.mnemonic!r} ({c.quantity} {c.component}) has no samples in the store",
-                file=repairs.source,
-                column=c.mnemonic,
-            )
-        t = (g["time"].to_numpy().astype("datetime64[ns]").astype(np.int64) - t0_ns) / 1e9
-        v = g["value"].to_numpy(dtype=np.float64) * c.to_si
-        order = np.argsort(t, kind="stable")
-        return t[order], v[order]
-
-    def joined(quantity: str, n: int) -> tuple[np.ndarray, np.ndarray]:
-        chans = flight.of(quantity)
-        if [c.component for c in chans] != list(range(n)):
-            raise ConfigError(
-                f"[flight] needs {quantity} components 0..{n - 1}, got {[c.component for c in chans]}",
-                file=spacecraft.source,
-                key="flight.channels",
-            )
-        series = [channel(c) for c in chans]
-        common = np.unique(series[0][0])
-        for t, _ in series[1:]:
-            common = np.intersect1d(common, t)
-        lost = sum(t.size for t, _ in series) - n * common.size
-        if common.size < 0.5 * max(t.size for t, _ in series):
-            raise InputError(
-                f"{quantity} components {[c.mnemonic for c in chans]} share only {common.size} of "
-                f"{max(t.size for t, _ in series)} time stamps: the components must be sampled together",
-                file=repairs.source,
-                column=chans[0].mnemonic,
-            )
-        repairs.record(f"{quantity} samples without every component at their stamp dropped", lost)
-        return common, np.column_stack([v[np.searchsorted(t, common)] for t, v in series])
-
+    frame = store.read_range(spacecraft.name, start, end, flight.mnemonics)
+    samples = _StoreSamples(
+        groups={str(m): g for m, g in frame.groupby("mnemonic", observed=True)},
+        t0_ns=int(start.astype("datetime64[ns]").astype(np.int64)),
+        spacecraft=spacecraft,
+        repairs=repairs,
+    )
     wheel_chans = flight.of("wheel_speed")
     if len(wheel_chans) != len(spacecraft.wheels):
         raise InputError(
@@ -148,28 +191,15 @@ def load_momentum_data_from_store(
         )
     gates = {c.tachometer.gate_s for c in wheel_chans if c.tachometer is not None}
     gate = gates.pop() if len(gates) == 1 else options.tachometer_gate_s
-    app_angle, app_axis, app_j = None, None, 0.0
-    for c in flight.of("appendage_angle"):
-        app = next((a for a in spacecraft.appendages if a.name == c.appendage), None)
-        if app is not None and len(app.gimbal_axes) == 1:  # the loader checked the name (flight_config)
-            app_angle, app_axis, app_j = channel(c), app.gimbal_axes[0], app.drive_inertia_kgm2
-            break
-    flag = None
-    flags = [channel(c) for c in flight.of("event_flag") if c.mnemonic in groups]
-    if flags:
-        t_f = np.unique(np.concatenate([t for t, _ in flags]))
-        on = np.zeros(t_f.size, bool)
-        for t, v in flags:  # each flag holds its last value (written on change)
-            k = np.searchsorted(t, t_f, side="right") - 1
-            on |= (k >= 0) & (v[np.clip(k, 0, None)] > 0.5)
-        flag = (t_f, on.astype(np.float64))
+    app_angle, app_axis, app_j = samples.appendage()
+    flag = samples.thruster_flag()
     period = options.orbit_period_s
     if period is None and spacecraft.orbit is not None:
         period = spacecraft.orbit.period_s
     data = momentum_data_from_channels(
-        joined("quaternion", 4),
-        joined("body_rate", 3),
-        [channel(c) for c in wheel_chans],
+        samples.joined("quaternion", 4),
+        samples.joined("body_rate", 3),
+        [samples.channel(c) for c in wheel_chans],
         spacecraft.wheel_axes,
         spacecraft.wheel_spin_inertias_kgm2,
         tachometer_gate_s=gate,
@@ -255,8 +285,6 @@ def load_momentum_data(
     app_j = 0.0
     app = spacecraft.appendages[0] if spacecraft.appendages else None
     if app is not None and len(app.gimbal_axes) == 1:
-        from abrupt.model.spacecraft import ANGLE_UNITS
-
         angle = _extra_column(paths, spacecraft, app.angle_columns[0], epoch, repairs)
         if angle is not None:
             app_angle = (angle[0], angle[1] * ANGLE_UNITS[app.angle_unit])
@@ -412,14 +440,10 @@ def detect_mass_change_run(
     return detector.detect(track, budget), track
 
 
-def simulate_docking_run(spacecraft_file: str | Path, out_dir: str | Path, scenario: object) -> list[Path]:
+def simulate_docking_run(spacecraft_file: str | Path, out_dir: str | Path, scenario: DockingScenario) -> list[Path]:
     """Simulate a docking (:func:`~abrupt.simulate.docking.simulate_docking`) and write one wide CSV per
     day (the spacecraft file's columns and units, plus the first appendage's angle column) and
     ``docking_truth.json`` (inertia before/after, docking time, contact impulse)."""
-    from abrupt.simulate.attitude import telemetry_frame
-    from abrupt.simulate.docking import DockingScenario, simulate_docking
-
-    assert isinstance(scenario, DockingScenario)
     sc = load_spacecraft(spacecraft_file)
     check_catalogue(sc)
     sim = simulate_docking(sc, scenario)
@@ -431,8 +455,6 @@ def simulate_docking_run(spacecraft_file: str | Path, out_dir: str | Path, scena
         times = pd.DatetimeIndex(epoch + pd.to_timedelta(np.round(day.t_s * 1e9).astype("int64"), unit="ns"))
         frame = telemetry_frame(sc, times, day.q_BN, day.omega_B_rad_s, day.wheel_speed_rad_s)
         if sc.appendages:
-            from abrupt.model.spacecraft import ANGLE_UNITS
-
             app = sc.appendages[0]
             frame[app.angle_columns[0]] = day.appendage_angle_rad / ANGLE_UNITS[app.angle_unit]
         firing = np.zeros(day.t_s.size, dtype=np.int8)
@@ -460,7 +482,7 @@ def simulate_docking_run(spacecraft_file: str | Path, out_dir: str | Path, scena
 
 def simulated_inertia_track(
     spacecraft: Spacecraft,
-    scenario: object,
+    scenario: DockingScenario,
     *,
     epoch_utc: str = "2026-01-01T00:00:00Z",
     progress: object = None,
@@ -473,10 +495,6 @@ def simulated_inertia_track(
     Used to check the mass-change detector's false-alarm rate over a simulated year. ``progress`` is an
     optional callable ``(day_index, estimate)``; the momentum dumps are appended to ``dumps_out``.
     """
-    from abrupt.massprops.telemetry import momentum_data_from_simulation
-    from abrupt.simulate.docking import DockingScenario, docking_days
-
-    assert isinstance(scenario, DockingScenario)
     j_cat = check_catalogue(spacecraft)
     rows = []
     dumps: list[tuple[float, np.ndarray]] = [] if dumps_out is None else dumps_out

@@ -19,13 +19,13 @@ import pandas as pd
 
 from abrupt.detect.base import DetectionResult, get_detector
 from abrupt.detect.orbit.analysis import OrbitAnalysis, innovation_scale
-from abrupt.detect.orbit.detectors import OrbitDetector
+from abrupt.detect.orbit.detectors import OrbitDetector, orbit_analysis, orbit_thresholds
 from abrupt.detect.orbit.ekf import NUISANCE_NAMES
+from abrupt.errors import ConfigError
 from abrupt.model.frames import Ephemeris
+from abrupt.readers.ephemeris import read_ephemeris
+from abrupt.simulate.orbit import inject_impulse
 from abrupt.thresholds import FalseAlarmBudget, Threshold
-
-#: Old statistic names accepted where a detector name is expected (``--statistic glr``).
-STATISTICS = ("glr", "accel_smoothed", "mcr_w", "mcr_scalar", "mahalanobis_v", "dv_fb", "d_sma", "d_ecc", "d_hdir")
 
 
 @dataclass
@@ -44,11 +44,13 @@ class OrbitRun:
 
     @property
     def analysis(self) -> OrbitAnalysis | None:
-        return self.detector.last_analysis
+        """The filters, fusion and statistics of the run (from the result's diagnostics)."""
+        return orbit_analysis(self.result)
 
     @property
     def thresholds(self) -> dict[str, Threshold]:
-        return self.detector.last_thresholds
+        """Every statistic's threshold (from the result's diagnostics)."""
+        return orbit_thresholds(self.result)
 
 
 def as_budget(budget: FalseAlarmBudget | str | float) -> FalseAlarmBudget:
@@ -61,7 +63,8 @@ def as_budget(budget: FalseAlarmBudget | str | float) -> FalseAlarmBudget:
 
 
 def detector_class_name(name: str) -> str:
-    """``glr`` → ``orbit.glr``; full names pass through."""
+    """A statistic name (``glr``, as ``--statistic`` takes it) → its detector ``orbit.glr``; full names pass
+    through."""
     return name if "." in name else f"orbit.{name}"
 
 
@@ -73,8 +76,6 @@ def load_ephemeris(
     log (otherwise it is an :class:`~abrupt.errors.InputError`)."""
     if isinstance(source, Ephemeris):
         return source
-    from abrupt.readers.ephemeris import read_ephemeris
-
     return read_ephemeris(source, satellite, allow_truncated=allow_truncated)
 
 
@@ -202,9 +203,6 @@ def inject_orbit(
 ) -> Ephemeris:
     """The ephemeris with a ΔV (orbit frame at its start) injected at ``time_utc``: an impulse or a finite
     burn of ``duration_s`` (:func:`abrupt.simulate.orbit.inject_impulse`)."""
-    from abrupt.errors import ConfigError
-    from abrupt.simulate.orbit import inject_impulse
-
     eph = load_ephemeris(source, satellite, allow_truncated=allow_truncated)
     try:
         t = np.datetime64(str(time_utc).rstrip("Z"), "ns")

@@ -15,7 +15,7 @@ from typing import Any
 import pandas as pd
 
 from abrupt.detect.base import DetectionResult, Detector, get_detector
-from abrupt.detect.tle.detectors import TleMeanElements, detector_for, result_from_run
+from abrupt.detect.tle.detectors import TleMeanElements, detector_for
 from abrupt.errors import InputError
 from abrupt.events import empty_frame, new_run_id
 from abrupt.readers.omm import read_element_histories
@@ -103,13 +103,11 @@ def detect_tle_file(
         kwargs.update(all_candidates=all_candidates, spacecraft=name)
         det: Detector[Any]
         if detector == "auto":
-            det = detector_for(history, **kwargs)
+            det = detector_for(history, run_id=run_id, **kwargs)
         else:
             cls = get_detector(detector, "tle")
+            if issubclass(cls, TleMeanElements):  # a plug-in tle detector may not take a run_id
+                kwargs["run_id"] = run_id
             det = cls(**kwargs)
-        if isinstance(det, TleMeanElements):
-            result = result_from_run(det.name, det.run(history, budget, run_id=run_id))
-        else:  # a plug-in tle detector
-            result = det.detect(history, budget)
-        out.satellites.append(SatelliteResult(history, det.name, result))
+        out.satellites.append(SatelliteResult(history, det.name, det.detect(history, budget)))
     return out

@@ -19,8 +19,19 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
+from sgp4 import omm
+from sgp4.api import Satrec
+
 from abrupt.errors import InputError, RepairLog
-from abrupt.readers.tle import ElementHistory, RawElementSet, history_from_sets, split_by_satellite
+from abrupt.readers.tle import (
+    ElementHistory,
+    RawElementSet,
+    history_from_sets,
+    is_tle_text,
+    read_tle,
+    read_tle_histories,
+    split_by_satellite,
+)
 
 REQUIRED = (
     "EPOCH",
@@ -75,9 +86,6 @@ def record_to_set(
     ``index`` is the 1-based record number, named in messages when no ``line`` is known or ``label``
     (JSON and XML, where several records may share a line).
     """
-    from sgp4 import omm
-    from sgp4.api import Satrec
-
     where = "" if line is not None and not label else f"record {index}: "
     rec = {str(k).strip().upper(): ("" if v is None else str(v).strip()) for k, v in record.items()}
     missing = [k for k in REQUIRED if not rec.get(k)]
@@ -303,8 +311,6 @@ def read_omm_histories(path: str | Path, *, fmt: str | None = None, strict: bool
 
 
 def _is_tle(path: Path) -> bool:
-    from abrupt.readers.tle import is_tle_text
-
     if not path.is_file():
         raise InputError("no such file", file=path)
     with open(path, encoding="utf-8", errors="replace") as fh:
@@ -314,8 +320,6 @@ def _is_tle(path: Path) -> bool:
 
 def read_elements(path: str | Path, *, norad_id: int | None = None, strict: bool = False) -> ElementHistory:
     """Read a TLE/3LE or OMM file, chosen by its content (one satellite; see :func:`read_element_histories`)."""
-    from abrupt.readers.tle import read_tle
-
     path = Path(path)
     if _is_tle(path):
         return read_tle(path, norad_id=norad_id, strict=strict)
@@ -324,8 +328,6 @@ def read_elements(path: str | Path, *, norad_id: int | None = None, strict: bool
 
 def read_element_histories(path: str | Path, *, strict: bool = False) -> list[ElementHistory]:
     """Every satellite of a TLE/3LE file or OMM batch, one history each, chosen by content."""
-    from abrupt.readers.tle import read_tle_histories
-
     path = Path(path)
     if _is_tle(path):
         return read_tle_histories(path, strict=strict)

@@ -37,6 +37,7 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from sgp4.api import WGS72, Satrec
 
 from abrupt.errors import InputError, RepairLog
 
@@ -202,8 +203,6 @@ def parse_tle_pair(line1: str, line2: str, *, file: str = "<input>", line_no: in
 
     ``line_no`` is the 1-based file line of ``line1``. Raises :class:`InputError` on any defect.
     """
-    from sgp4.api import WGS72, Satrec
-
     l1 = _check_line(line1, "1", file, line_no)
     l2 = _check_line(line2, "2", file, line_no + 1)
     try:

@@ -4,17 +4,17 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
+from scipy.ndimage import uniform_filter1d
 
+from abrupt.detect.orbit.analysis import OrbitAnalysis
+from abrupt.detect.orbit.statistics import STATISTIC_UNITS
+from abrupt.model.orbit import MU_EARTH_M3_S2
 from abrupt.report.style import detector_colour, save_figure
-
-if TYPE_CHECKING:
-    from abrupt.detect.orbit.analysis import OrbitAnalysis
-    from abrupt.thresholds import Threshold
+from abrupt.thresholds import Threshold
 
 PANEL_STATISTICS = ("glr", "dv_fb", "mahalanobis_v", "accel_smoothed", "mcr_w", "mcr_scalar", "d_sma")
 
@@ -32,8 +32,6 @@ def plot_orbit_report(
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
-    from abrupt.detect.orbit.statistics import STATISTIC_UNITS
 
     hours = analysis.t_s / 3600.0
     names = [s for s in statistics if s in analysis.statistics]
@@ -82,18 +80,15 @@ def plot_orbit_report(
 
 def _orbit_period_samples(analysis: OrbitAnalysis) -> int:
     """Samples in one orbital period, T = 2π √(a³/μ) with a the mean radius (near-circular orbits)."""
-    mu = 3.986004418e14  # Earth's GM [m³/s²] (IERS 2010)
     r = np.linalg.norm(np.asarray(analysis.ephemeris.position_m, dtype=np.float64), axis=1)
     dt = np.median(np.diff(analysis.t_s)) if analysis.t_s.size > 1 else 0.0
     if not (r.size and dt > 0):
         return 0
-    period = 2 * np.pi * np.sqrt(float(np.mean(r)) ** 3 / mu)
+    period = 2 * np.pi * np.sqrt(float(np.mean(r)) ** 3 / MU_EARTH_M3_S2)
     return round(period / dt)
 
 
 def _running_mean(y: NDArray[np.float64], n: int) -> NDArray[np.float64]:
-    from scipy.ndimage import uniform_filter1d
-
     ok = np.isfinite(y)
     total = uniform_filter1d(np.where(ok, y, 0.0), size=n, mode="nearest")
     count = uniform_filter1d(ok.astype(np.float64), size=n, mode="nearest")

@@ -16,8 +16,12 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from abrupt.detect.tle.config import TleDetectorConfig
+from abrupt.detect.tle.elements import mean_element_series, orbit_regime
+from abrupt.detect.tle.steps import component_weights, step_statistics
 from abrupt.readers.tle import ElementHistory
 from abrupt.report.style import clip_with_markers, save_figure
+from abrupt.score import score_events
 
 
 def _utc(values: Any) -> pd.DatetimeIndex:
@@ -38,15 +42,6 @@ def plot_tle_report(
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
-    from abrupt.detect.tle.maneuvers import (
-        TleDetectorConfig,
-        component_weights,
-        mean_element_series,
-        orbit_regime,
-        step_statistics,
-    )
-    from abrupt.score import score_events
 
     regime = orbit_regime(history)
     geo = regime == "geo"

@@ -1,10 +1,10 @@
-"""A docking in routine operations: days of nadir pointing with routine slews, a parasite docks (issue 13).
+"""A docking in routine operations: days of nadir pointing with routine slews, a parasite docks.
 
 Day by day with :func:`~abrupt.simulate.attitude.simulate_pointing` (state carried over), 2-4 slews a
 day about random axes (15-45°, smooth ramps), gravity gradient, a sun-tracking array, a small constant
 inertial torque; at ``docking_time_s`` the truth inertia becomes the point-mass update of
 :func:`~abrupt.massprops.inertia.inertia_after_docking` and the contact gives an angular impulse
-ρ × m v (Dabrowski 2003 Eq. 2.35) as a strike. Momentum dumps (on by default since session 4;
+ρ × m v (Dabrowski 2003 Eq. 2.35) as a strike. Momentum dumps (on by default;
 ``dump_threshold_Nms=None`` turns them off): when the system momentum exceeds ``dump_threshold_Nms`` at
 the start of a day, thrusters remove it at a quiet time of that day (an impulse −H_N, which the wheels
 then shed; its time is recorded as a thruster-flag interval).
@@ -18,9 +18,9 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import ArrayLike
 
 from abrupt.massprops.inertia import inertia_after_docking
+from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.simulate.attitude import (
     AppendageMotion,
@@ -187,8 +187,6 @@ def docking_days(
                 if dumps_out is not None:
                     dumps_out.append((a + 0.5, dump_dh.copy()))
             if after and a == dock:
-                from abrupt.model.rotations import dcm_from_quaternion
-
                 q = state[:4] if state is not None else ref.sample(np.array([a, a + 1.0]))[0][0]
                 contact_n = dcm_from_quaternion(q).T @ dh_b
                 strikes.append((a + 0.5, (float(contact_n[0]), float(contact_n[1]), float(contact_n[2]))))
@@ -232,19 +230,9 @@ def simulate_docking(
     j0, j1, dh_b = _docking_truth(spacecraft, scenario)
     contact_n = np.full(3, np.nan)
     if scenario.docking_time_s is not None and days:
-        from abrupt.model.rotations import dcm_from_quaternion
-
         for day in days:
             k = int(np.searchsorted(day.t_s, np.floor(scenario.docking_time_s)))
             if 0 < k < day.t_s.size:
                 contact_n = dcm_from_quaternion(day.true_q_BN[k - 1]).T @ dh_b
                 break
     return DockingSimulation(days, j0, j1, scenario.docking_time_s, contact_n, dumps)
-
-
-def docking_inertia_change(
-    inertia_kgm2: ArrayLike, host_mass_kg: float, parasite_mass_kg: float, rho_B_m: ArrayLike
-) -> FloatArray:
-    """ΔJ of a docking (convenience for reports)."""
-    j = np.asarray(inertia_kgm2, dtype=np.float64)
-    return np.asarray(inertia_after_docking(j, host_mass_kg, parasite_mass_kg, rho_B_m) - j, dtype=np.float64)

@@ -26,6 +26,8 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from abrupt.detect.tle.detectors import detector_for
+from abrupt.detect.tle.elements import orbit_regime
 from abrupt.readers.tle import ElementHistory
 from abrupt.score import match_times
 from abrupt.simulate.tle_null import EPOCH0, bootstrap_null_history, gaps_clear_of_junctions, quiet_mask
@@ -163,9 +165,6 @@ def injection_recall(
     median over the seeds) and, per kind, the smallest injected ΔV from which every larger size was
     found at least 90 % of the time (``found_90pct_from_cm_s``).
     """
-    from abrupt.detect.tle.detectors import detector_for
-    from abrupt.detect.tle.maneuvers import orbit_regime
-
     if len(history) < MIN_ELEMENT_SETS:
         raise ValueError(
             f"{len(history)} element sets: too few to draw noise blocks from (at least {MIN_ELEMENT_SETS})"
@@ -187,16 +186,23 @@ def injection_recall(
         burns = burn_schedule(years, int(seed), allowed=mids[clear], regime=regime, ladders_cm_s=ladders_cm_s)
         # the same draw (the burns do not touch the generator of the blocks), now with the burns
         injected, junctions = bootstrap_null_history(history, quiet, burns=burns, **kw)
-        run = det.run(injected, budget)
+        run = det.detect(injected, budget)
         scored = score_injected(
-            injected, run.events, run.noise_model, burns, junctions, window, regime, tolerance_s=tolerance_s
+            injected,
+            run.events,
+            run.diagnostics[0].noise_model,
+            burns,
+            junctions,
+            window,
+            regime,
+            tolerance_s=tolerance_s,
         )
         frames.append(pd.DataFrame(scored["burns"]).assign(seed=int(seed)))
         fa += scored["false_alarms"]
         echoes += scored["echoes"]
         exposure += scored["years"]
-        stated_t.append(100.0 * float(run.noise_model.get("min_detectable_dv_t_mps", np.nan)))
-        stated_n.append(100.0 * float(run.noise_model.get("min_detectable_dv_n_mps", np.nan)))
+        stated_t.append(100.0 * float(run.diagnostics[0].noise_model.get("min_detectable_dv_t_mps", np.nan)))
+        stated_n.append(100.0 * float(run.diagnostics[0].noise_model.get("min_detectable_dv_n_mps", np.nan)))
     burns_frame = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
     summary: dict[str, Any] = {
         "regime": regime,

@@ -1,7 +1,7 @@
 """Maneuver-free element-set histories for calibrating the TLE detectors' false-alarm rate.
 
 Two generators, both returning an :class:`~abrupt.readers.tle.ElementHistory` of SGP4 records
-(WGS-72) whose *detector series* (:func:`abrupt.detect.tle.maneuvers.mean_element_series`: mean
+(WGS-72) whose *detector series* (:func:`abrupt.detect.tle.elements.mean_element_series`: mean
 semi-major axis, eccentricity vector, orbit normal or inclination vector, along-track phase) are
 a smooth maneuver-free orbit plus noise:
 
@@ -40,11 +40,14 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
+from scipy import stats
+from sgp4.api import WGS72, Satrec
 
+from abrupt.detect.tle.elements import elapsed_si_seconds, mean_element_series, stated_decay_m_s
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory, RawElementSet, history_from_sets
+from abrupt.thresholds import DAYS_PER_YEAR
 from abrupt.units import SECONDS_PER_DAY
 
-DAYS_PER_YEAR = 365.25
 EARTH_RADIUS_M = 6378135.0  # WGS-72, as SGP4
 EARTH_ROTATION_RAD_S = 7.2921158553e-5
 GEO_A_M = (MU_EARTH_WGS72_M3_S2 / EARTH_ROTATION_RAD_S**2) ** (1.0 / 3.0)
@@ -112,8 +115,6 @@ def _noise(
     t_days: NDArray[np.float64], sigma: float, spec: NullHistorySpec, rng: np.random.Generator
 ) -> NDArray[np.float64]:
     """AR(1) in time (correlation exp(−Δt/τ)) driven by Student-t innovations, robust σ = ``sigma``."""
-    from scipy import stats
-
     n = t_days.size
     nu = spec.t_dof
     eps = rng.standard_t(nu, n)
@@ -184,8 +185,6 @@ def history_from_series(
     rate it implies, ``ṅ = −(3/2)(n/a)·ȧ`` (Kepler's third law), stored as the TLE field ``ṅ/2``
     (Hoots & Roehrich 1980; Vallado 2013 §2.2); without it ndot is 0.
     """
-    from sgp4.api import WGS72, Satrec
-
     n = t_days.size
     a_t = series["a_m"]
     e = np.hypot(series["ex"], series["ey"])
@@ -209,8 +208,6 @@ def history_from_series(
             no *= (sat.a * EARTH_RADIUS_M / a_t[k]) ** 1.5
         sats.append(no)
         rates[k] = (sat.nodedot / 60.0, sat.argpdot / 60.0, sat.mdot / 60.0)
-    from abrupt.detect.tle.maneuvers import elapsed_si_seconds
-
     # elapsed SI seconds, as the detector reads them (a leap second is 7 km along-track in LEO)
     epochs = pd.Series(EPOCH0 + pd.to_timedelta(np.round(t_days * SECONDS_PER_DAY * 1e6), unit="us"))
     dt_s = np.diff(elapsed_si_seconds(epochs))
@@ -257,8 +254,6 @@ def _stated_decay_m_s(
 ) -> NDArray[np.float64]:
     """The rate of ``a`` each set states through its ndot (m/s): the true rate with the history's
     scale error and bias and per-set heavy-tailed noise (:class:`NullHistorySpec`); zero in GEO."""
-    from scipy import stats
-
     if spec.regime == "geo":
         return np.zeros_like(adot_m_s)
     per_day = adot_m_s * SECONDS_PER_DAY
@@ -368,8 +363,6 @@ def detector_residuals(
     the residuals are NaN elsewhere: a running median that reached over a maneuver next to a quiet
     stretch would put part of its step into the stretch's residuals.
     """
-    from abrupt.detect.tle.maneuvers import mean_element_series, stated_decay_m_s
-
     s = mean_element_series(history, regime)
     t_all = s["t_s"]
     names = {"a_m": "a_m", "ex": "ex", "ey": "ey", "n1_rad": "i_rad", "n2_rad": "raan_resid_sin_i_rad", "u_m": "u_m"}

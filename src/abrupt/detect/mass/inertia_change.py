@@ -1,4 +1,4 @@
-"""Mass-change detector: a change in the inertia tensor between windows of routine telemetry (issue 13).
+"""Mass-change detector: a change in the inertia tensor between windows of routine telemetry.
 
 Series: an :class:`~abrupt.massprops.track.InertiaTrack` (one estimate of J per window, e.g. per day).
 Statistic (GLR for a step in the mean of Gaussian vectors, Basseville & Nikiforov 1993 §2.4): for the
@@ -39,6 +39,7 @@ observable from attitude telemetry alone (not reported).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
@@ -51,6 +52,7 @@ from abrupt.massprops.inertia import INERTIA_ELEMENTS
 from abrupt.massprops.track import InertiaTrack
 from abrupt.thresholds import FalseAlarmBudget, Threshold
 from abrupt.thresholds.noise import robust_scale
+from abrupt.units import SECONDS_PER_DAY
 
 
 def _robust_cov(x: np.ndarray) -> np.ndarray:
@@ -59,7 +61,7 @@ def _robust_cov(x: np.ndarray) -> np.ndarray:
     if d.shape[0] < 3:
         return np.full((x.shape[1], x.shape[1]), np.nan)
     mad = robust_scale(d, axis=0)
-    corr = np.corrcoef(d.T) if d.shape[0] > 2 else np.eye(x.shape[1])
+    corr = np.corrcoef(d.T)
     corr = np.nan_to_num(corr, nan=0.0)
     np.fill_diagonal(corr, 1.0)
     return np.asarray(np.outer(mad, mad) * corr / 2.0, dtype=np.float64)
@@ -81,6 +83,42 @@ def covering_covariance(shape: np.ndarray, own: np.ndarray, size: np.ndarray) ->
     mu, vv = np.linalg.eigh(0.5 * (rel + np.swapaxes(rel, 1, 2)))
     rel = np.einsum("tij,tj,tkj->tik", vv, np.maximum(mu, 1.0), vv)
     return np.asarray(size[:, None, None] * np.einsum("ij,tjk,lk->til", root, rel, root), dtype=np.float64)
+
+
+def _window_covariances(series: InertiaTrack, idx: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """(median covariance shape Σ (d, d), per-window covariances Σ_i (k, d, d)); None without either.
+
+    Each window's own covariance sets a size relative to the median shape (trace in the median's metric)
+    and is then covered in every direction (:func:`covering_covariance`): a jackknife from few blocks is
+    rank-deficient and noisy in its small directions, and a day cut by a momentum dump is poorly
+    determined along one direction of its own that the median shape, however scaled, misses. Where a
+    window has no covariance, the median shape.
+    """
+    k, d = x.shape
+    boot = np.nanmedian(series.covariance[:, idx][:, :, idx], axis=0)
+    if not np.all(np.isfinite(boot)):
+        boot = _robust_cov(x)
+    if not np.all(np.isfinite(boot)):
+        return None
+    inv_b = np.linalg.pinv(boot, hermitian=True)
+    own = series.covariance[:, idx][:, :, idx]
+    good = np.all(np.isfinite(own.reshape(k, -1)), axis=1)
+    own = np.where(good[:, None, None], own, boot[None])
+    size = np.where(good, np.einsum("ij,tji->t", inv_b, own) / d, 1.0)
+    return boot, covering_covariance(boot, own, np.clip(size, 0.1, None))
+
+
+@dataclass(frozen=True)
+class _Scan:
+    """The window-limited GLR evaluated after each window (NaN where not evaluated)."""
+
+    stat: np.ndarray  # (k,) S / c_n
+    thr: np.ndarray  # (k,) threshold d F(d, ν)
+    scale: np.ndarray  # (k,) covariance scale c_n
+    best_tau: np.ndarray  # (k,) the change window that maximises S
+    alarm_at: int  # first window over the threshold, -1 for none
+    cw: np.ndarray  # (k + 1, d, d) cumulative weights Σ W_i
+    cwx: np.ndarray  # (k + 1, d) cumulative weighted estimates Σ W_i x_i
 
 
 class InertiaChangeDetector(Detector[InertiaTrack]):
@@ -122,47 +160,63 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
 
     def detect(self, series: InertiaTrack, budget: FalseAlarmBudget) -> DetectionResult:
         k = series.n_windows
-        if k < self.min_windows_before + self.min_windows_after:
-            return DetectionResult.empty(
-                warnings=(f"{k} window(s): need {self.min_windows_before + self.min_windows_after} to test a change",)
+        needed = self.min_windows_before + self.min_windows_after
+        if k < needed:
+            return _untested(
+                series,
+                f"{k} window(s): a change needs {self.min_windows_before} windows before it and "
+                f"{self.min_windows_after} after it ({needed} in all); nothing was tested",
             )
         obs = np.all(series.observable, axis=0)
         idx = np.flatnonzero(obs)
-        warnings: list[str] = []
         if idx.size == 0:
-            return DetectionResult.empty(warnings=("no inertia parameter is observable in every window",))
+            return _untested(series, "no inertia parameter is observable in every window")
         x = series.params[:, idx]
         d = idx.size
-        # Shape of one window's covariance from the estimator; its scale from the data (below).
-        boot = np.nanmedian(series.covariance[:, idx][:, :, idx], axis=0)
-        if not np.all(np.isfinite(boot)):
-            boot = _robust_cov(x)
-        if not np.all(np.isfinite(boot)):
-            return DetectionResult.empty(warnings=("fewer than 4 windows and no estimator covariance",))
+        covariances = _window_covariances(series, idx, x)
+        if covariances is None:
+            return _untested(series, "fewer than 4 windows and no estimator covariance")
+        boot, cov_w = covariances
         window_s = float(np.median(series.t_end_s - series.t_start_s))
-        tests_per_day = 86400.0 / window_s
+        tests_per_day = SECONDS_PER_DAY / window_s
         n_candidates = max(1, min(k - self.min_windows_before, self.max_change_age) - self.min_windows_after + 1)
         p_test = budget.per_test(tests_per_day) / n_candidates
-        # Scale factor c_n ≥ 1 of the covariance from consecutive differences of windows 0..n-1:
-        # m_j = Δxᵀ (2 Σ_b)⁻¹ Δx / d is χ²_d / d under no change; the median ignores the one difference
-        # that spans a step. The statistic S / c_n is then compared with d F(d, ν), ν the degrees of
-        # freedom of c_n (median efficiency 2/π), Hotelling's T² with an estimated scale.
-        # Lags 1..3: under white window noise every lag has the same spread; a slow drift of the
-        # estimates (a systematic that varies over days) shows up as a spread growing with the lag,
-        # and the largest is used, so slow drifts are not taken for a step.
-        # Each window's own covariance (the days differ: a day with poor slews has a larger error); where
-        # a window has none, the median shape. Weights W_i = Σ_i⁻¹ (generalised least-squares means).
-        # Per-window covariance: a jackknife from few blocks is rank-deficient and noisy in its small
-        # directions, so each window's own matrix sets a size relative to the median (trace in the
-        # median's metric), and then also covers the window's own matrix in every direction (session 4:
-        # a day cut by a momentum dump is poorly determined along one direction of its own; the median
-        # shape, however scaled, misses that direction and the day's error along it became alarms).
-        inv_b = np.linalg.pinv(boot, hermitian=True)
-        own = series.covariance[:, idx][:, :, idx]
-        good = np.all(np.isfinite(own.reshape(k, -1)), axis=1)
-        own = np.where(good[:, None, None], own, boot[None])
-        size = np.where(good, np.einsum("ij,tji->t", inv_b, own) / d, 1.0)
-        cov_w = covering_covariance(boot, own, np.clip(size, 0.1, None))
+        scan = self._scan(x, cov_w, p_test)
+        alarm_at = scan.alarm_at
+        thr, scale = scan.thr, scan.scale
+        h = float(thr[alarm_at]) if alarm_at >= 0 else float(thr[-1]) if np.isfinite(thr[-1]) else math.nan
+        threshold = Threshold(h, p_test, f"{d}F(d={d},nu)/bonferroni({n_candidates})", k, budget.per_day)
+        c_final = (
+            float(scale[alarm_at]) if alarm_at >= 0 else float(np.nanmax(scale)) if np.isfinite(scale).any() else 1.0
+        )
+        diag = Diagnostics(
+            name="inertia_glr",
+            time_s=series.t_end_s,
+            statistic=scan.stat,
+            threshold=threshold,
+            epoch_utc=_epoch_datetime64(series),
+            unit="chi2",
+            noise_model={"window_covariance_kgm2_sq": boot * c_final, "parameters": [INERTIA_ELEMENTS[i] for i in idx]},
+            extra={"best_change_window": scan.best_tau, "threshold_per_window": thr, "covariance_scale": scale},
+        )
+        if alarm_at < 0:
+            return DetectionResult.empty(diagnostics=(diag,))
+        warnings: list[str] = []
+        event = self._event(series, scan, idx, obs, c_final, h, budget, warnings)
+        return DetectionResult(events_frame([event]), (diag,), tuple(warnings))
+
+    def _scan(self, x: np.ndarray, cov_w: np.ndarray, p_test: float) -> _Scan:
+        """The GLR after each window n against the threshold at ``p_test`` (module docstring).
+
+        The scale c_n ≥ 1 of the covariance comes from the differences of windows 0..n-1 at lags 1..3:
+        m_j = Δxᵀ (Σ_i + Σ_j)⁻¹ Δx / d is χ²_d / d under no change; the median ignores the one difference
+        that spans a step, and under white window noise every lag has the same spread, while a slow
+        drift of the estimates shows as a spread growing with the lag: the largest is used, so slow
+        drifts are not taken for a step. S / c_n is compared with d F(d, ν), ν the degrees of freedom of
+        c_n (median efficiency 2/π): Hotelling's T² with an estimated scale. Weights W_i = Σ_i⁻¹
+        (generalised least-squares means on each side of τ).
+        """
+        k, d = x.shape
         w_i = np.linalg.pinv(cov_w, hermitian=True)
         lag_m = []
         for lag in (1, 2, 3):
@@ -198,29 +252,18 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
             stat[n - 1], best_tau[n - 1], thr[n - 1], scale[n - 1] = float(s_all[j]), int(taus[j]), h_n, c_n
             if s_all[j] > h_n and alarm_at < 0:
                 alarm_at = n - 1
-        h = float(thr[alarm_at]) if alarm_at >= 0 else float(thr[-1]) if np.isfinite(thr[-1]) else math.nan
-        threshold = Threshold(h, p_test, f"{d}F(d={d},nu)/bonferroni({n_candidates})", k, budget.per_day)
-        c_final = (
-            float(scale[alarm_at]) if alarm_at >= 0 else float(np.nanmax(scale)) if np.isfinite(scale).any() else 1.0
-        )
-        sigma = boot * c_final
-        diag = Diagnostics(
-            name="inertia_glr",
-            time_s=series.t_end_s,
-            statistic=stat,
-            threshold=threshold,
-            epoch_utc=np.datetime64(pd.Timestamp(series.epoch_utc or "1970-01-01").tz_localize(None)),
-            unit="chi2",
-            noise_model={"window_covariance_kgm2_sq": sigma, "parameters": [INERTIA_ELEMENTS[i] for i in idx]},
-            extra={"best_change_window": best_tau, "threshold_per_window": thr, "covariance_scale": scale},
-        )
-        if alarm_at < 0:
-            return DetectionResult.empty(diagnostics=(diag,), warnings=tuple(warnings))
-        # Characterise with every window after the change (not only up to the alarm).
-        tau = int(best_tau[alarm_at])
-        # GLS means on either side, as in the statistic (a window poorly determined along one direction
-        # weighs little along it), with the covariance scale c at the alarm.
-        first_cand = max(self.min_windows_before, alarm_at + 1 - self.max_change_age)
+        return _Scan(stat, thr, scale, best_tau, alarm_at, cw, cwx)
+
+    def _change(self, scan: _Scan, idx: np.ndarray, c_final: float) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
+        """(τ, ΔJ (6,), its 1σ (6,), Cov of the observable ΔJ) with every window after the change.
+
+        GLS means on either side, as in the statistic (a window poorly determined along one direction
+        weighs little along it), with the covariance scale c at the alarm; not only up to the alarm.
+        """
+        cw, cwx = scan.cw, scan.cwx
+        k = cw.shape[0] - 1
+        tau = int(scan.best_tau[scan.alarm_at])
+        first_cand = max(self.min_windows_before, scan.alarm_at + 1 - self.max_change_age)
         cands = np.arange(first_cand, k)
         if cands.size == 0:
             cands = np.array([tau])
@@ -238,17 +281,38 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
         dj[idx] = diff_c[j_c]
         dj_sig = np.full(6, np.nan)
         dj_sig[idx] = np.sqrt(np.diag(dj_cov_obs))
+        return tau, dj, dj_sig, dj_cov_obs
+
+    def _implied_mass(
+        self, dj: np.ndarray, dj_cov_obs: np.ndarray, idx: np.ndarray, obs: np.ndarray, warnings: list[str]
+    ) -> tuple[float, float]:
+        """m = tr(ΔJ) / (2 r²) [kg] and its 1σ (module docstring); NaN unless every moment is observable."""
         trace_idx = [i for i in range(3) if obs[i]]
         r2 = self.attachment_radius_m**2
-        if len(trace_idx) == 3:
-            dm = float(np.sum(dj[:3]) / (2 * r2))
-            w = np.zeros(d)
-            for i in trace_idx:
-                w[[int(v) for v in idx].index(i)] = 1.0 / (2 * r2)
-            dm_sig = float(math.sqrt(w @ dj_cov_obs @ w))
-        else:
-            dm, dm_sig = math.nan, math.nan
+        if len(trace_idx) != 3:
             warnings.append("not every principal moment is observable: implied mass not reported")
+            return math.nan, math.nan
+        dm = float(np.sum(dj[:3]) / (2 * r2))
+        w = np.zeros(idx.size)
+        for i in trace_idx:
+            w[[int(v) for v in idx].index(i)] = 1.0 / (2 * r2)
+        return dm, float(math.sqrt(w @ dj_cov_obs @ w))
+
+    def _event(
+        self,
+        series: InertiaTrack,
+        scan: _Scan,
+        idx: np.ndarray,
+        obs: np.ndarray,
+        c_final: float,
+        h: float,
+        budget: FalseAlarmBudget,
+        warnings: list[str],
+    ) -> Event:
+        """The ``mass_change`` event: bracket, ΔJ with 1σ, implied mass, linked attitude event."""
+        tau, dj, dj_sig, dj_cov_obs = self._change(scan, idx, c_final)
+        dm, dm_sig = self._implied_mass(dj, dj_cov_obs, idx, obs, warnings)
+        alarm_at = scan.alarm_at
         t_mid = 0.5 * (series.t_end_s[tau - 1] + series.t_start_s[tau])
         epoch = pd.Timestamp(series.epoch_utc or "1970-01-01")
         epoch = epoch.tz_localize("UTC") if epoch.tzinfo is None else epoch
@@ -274,12 +338,12 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
                 j = inside[np.argmin(np.abs(times[inside] - t_mid))]
                 extra["linked_event_id"] = str(ev["event_id"].iloc[j])
                 t_mid = float(times[j])
-        event = Event(
+        return Event(
             spacecraft=series.spacecraft,
             kind="mass_change",
             detector=self.name,
             time_utc=format_time_utc(epoch + pd.Timedelta(seconds=float(t_mid))),
-            statistic=float(stat[alarm_at]),
+            statistic=float(scan.stat[alarm_at]),
             threshold=h,
             false_alarms_per_day=budget.per_day,
             run_id=self.run_id,
@@ -287,4 +351,20 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
             time_sigma_s=float((end - start) / math.sqrt(12.0)),
             extra=extra,
         )
-        return DetectionResult(events_frame([event]), (diag,), tuple(warnings))
+
+
+def _epoch_datetime64(series: InertiaTrack) -> np.datetime64:
+    return np.datetime64(pd.Timestamp(series.epoch_utc or "1970-01-01").tz_localize(None))
+
+
+def _untested(series: InertiaTrack, reason: str) -> DetectionResult:
+    """No events, the reason as a warning, and the statistic's diagnostics with nothing evaluated."""
+    diag = Diagnostics(
+        name="inertia_glr",
+        time_s=series.t_end_s,
+        statistic=np.full(series.n_windows, np.nan),
+        threshold=None,
+        epoch_utc=_epoch_datetime64(series),
+        unit="chi2",
+    )
+    return DetectionResult.empty(warnings=(reason,), diagnostics=(diag,))

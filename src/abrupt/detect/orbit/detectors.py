@@ -1,6 +1,7 @@
 """Orbit detectors as :class:`~abrupt.detect.base.Detector` classes: one per statistic, ``orbit.<statistic>``.
 
-All share the same machinery (:mod:`abrupt.detect.orbit.analysis`: forward EKF-DMC with the one orbit
+One class, :class:`OrbitDetector`, registered once per statistic. All share the same machinery
+(:mod:`abrupt.detect.orbit.analysis` and the modules beside it: forward EKF-DMC with the one orbit
 model, mirrored backward filter, Fraser-Potter fusion, statistics, thresholds, events; Bennett 2022
 ch. 3) and differ in the statistic that raises events:
 
@@ -32,17 +33,11 @@ from typing import Any, ClassVar
 import numpy as np
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
-from abrupt.detect.orbit.analysis import (
-    OrbitAnalysis,
-    OrbitDetectorConfig,
-    analyse,
-    auto_tune,
-    calibrate_thresholds,
-    find_events,
-    innovation_scale,
-    self_calibrate,
-)
+from abrupt.detect.orbit.analysis import OrbitAnalysis, OrbitDetectorConfig, analyse, innovation_scale
+from abrupt.detect.orbit.calibration import calibrate_thresholds, self_calibrate
 from abrupt.detect.orbit.ekf import FilterConfig, NuisanceConfig
+from abrupt.detect.orbit.events import find_events
+from abrupt.detect.orbit.tuning import auto_tune
 from abrupt.events import config_hash
 from abrupt.model.frames import Ephemeris
 from abrupt.model.orbit import ForceModel
@@ -76,7 +71,10 @@ def nuisance_force_model(gravity_degree: int, third_body: bool, zonal_degree: in
 
 
 class OrbitDetector(Detector[Ephemeris]):
-    """Base of the orbit detectors; subclasses set ``name`` and ``statistic``."""
+    """The orbit detector; registered once per statistic (:data:`ORBIT_DETECTORS`), which sets ``name``
+    and ``statistic``. The detection result's first diagnostics carry, in ``extra``, the whole
+    :class:`~abrupt.detect.orbit.analysis.OrbitAnalysis` (``"analysis"``) and every statistic's threshold
+    (``"thresholds"``): read them with :func:`orbit_analysis` and :func:`orbit_thresholds`."""
 
     series_type: ClassVar[type] = Ephemeris
     kind: ClassVar[str] = "unknown"
@@ -120,13 +118,9 @@ class OrbitDetector(Detector[Ephemeris]):
         self.spacecraft = spacecraft
         self.run_id = run_id
         self._null = null
-        self.last_analysis: OrbitAnalysis | None = None
-        self.last_thresholds: dict[str, Threshold] = {}
 
     def config(self) -> dict[str, Any]:
         out = super().config()
-        out.pop("last_analysis", None)
-        out.pop("last_thresholds", None)
         out["null"] = self._null is not None
         return out
 
@@ -157,7 +151,7 @@ class OrbitDetector(Detector[Ephemeris]):
             sigma_vel_mps=self.sigma_vel_mps if self.sigma_vel_mps is not None else float(s_vel),
             settle_s=settle,
             statistic=self.statistic,
-            false_alarms_per_day=budget.per_day,
+            budget=budget,
             kind=self.event_kind,
             orbital_constants=self.statistic in ("d_sma", "d_ecc", "d_hdir"),
         )
@@ -170,13 +164,9 @@ class OrbitDetector(Detector[Ephemeris]):
         analysis = analyse(series, cfg)
         if self._null is not None:
             null = analyse(self._null, cfg)
-            thresholds = calibrate_thresholds(
-                null.statistics, sample_rate_hz=null.sample_rate_hz, false_alarms_per_day=budget.per_day
-            )
+            thresholds = calibrate_thresholds(null.statistics, sample_rate_hz=null.sample_rate_hz, budget=budget)
         else:
-            thresholds = self_calibrate(analysis, false_alarms_per_day=budget.per_day, confidence_z=self.confidence_z)
-        self.last_analysis = analysis
-        self.last_thresholds = thresholds
+            thresholds = self_calibrate(analysis, budget=budget, confidence_z=self.confidence_z)
         warnings: tuple[str, ...] = ()
         if self.statistic not in thresholds:
             warnings = (
@@ -209,6 +199,7 @@ class OrbitDetector(Detector[Ephemeris]):
                 epoch_utc=epoch,
                 unit="",
                 noise_model=noise,
+                extra={"analysis": analysis, "thresholds": dict(thresholds)},
             )
         ]
         for key, values in analysis.statistics.items():
@@ -217,55 +208,44 @@ class OrbitDetector(Detector[Ephemeris]):
         return tuple(out)
 
 
-class OrbitGlr(OrbitDetector):
-    name = "orbit.glr"
-    statistic = "glr"
-    summary = "sliding GLR of a velocity jump in the forward filter's innovations (default)"
+#: The statistics that raise events, each the registered detector ``orbit.<statistic>``, with its summary.
+STATISTIC_SUMMARIES: dict[str, str] = {
+    "glr": "sliding GLR of a velocity jump in the forward filter's innovations (default)",
+    "accel_smoothed": "smoothed unmodelled acceleration (Bennett 2022 TS3)",
+    "mcr_w": "McReynolds consistency of the acceleration states (Bennett 2022 TS4)",
+    "mcr_scalar": "scalar McReynolds consistency (Bennett 2022 TS4)",
+    "mahalanobis_v": "velocity Mahalanobis distance (Bennett 2022 TS2)",
+    "dv_fb": "forward-backward velocity difference (Bennett 2022 TS1)",
+    "d_sma": "change of semi-major axis (Bennett 2022 TS6)",
+    "d_ecc": "change of eccentricity vector (Bennett 2022 TS6)",
+    "d_hdir": "change of angular-momentum direction (Bennett 2022 TS6)",
+}
+
+#: ``orbit.<statistic>`` → its class: :class:`OrbitDetector` with the statistic set (defining each
+#: subclass registers it).
+ORBIT_DETECTORS: dict[str, type[OrbitDetector]] = {
+    f"orbit.{statistic}": type(
+        f"OrbitDetector_{statistic}",
+        (OrbitDetector,),
+        {"name": f"orbit.{statistic}", "statistic": statistic, "summary": summary, "__module__": __name__},
+    )
+    for statistic, summary in STATISTIC_SUMMARIES.items()
+}
 
 
-class OrbitAccelSmoothed(OrbitDetector):
-    name = "orbit.accel_smoothed"
-    statistic = "accel_smoothed"
-    summary = "smoothed unmodelled acceleration (Bennett 2022 TS3)"
+def orbit_analysis(result: DetectionResult) -> OrbitAnalysis | None:
+    """The filters, fusion and statistics an orbit detector computed (None when it had too few epochs)."""
+    for d in result.diagnostics:
+        analysis = d.extra.get("analysis")
+        if isinstance(analysis, OrbitAnalysis):
+            return analysis
+    return None
 
 
-class OrbitMcrW(OrbitDetector):
-    name = "orbit.mcr_w"
-    statistic = "mcr_w"
-    summary = "McReynolds consistency of the acceleration states (Bennett 2022 TS4)"
-
-
-class OrbitMcrScalar(OrbitDetector):
-    name = "orbit.mcr_scalar"
-    statistic = "mcr_scalar"
-    summary = "scalar McReynolds consistency (Bennett 2022 TS4)"
-
-
-class OrbitMahalanobisV(OrbitDetector):
-    name = "orbit.mahalanobis_v"
-    statistic = "mahalanobis_v"
-    summary = "velocity Mahalanobis distance (Bennett 2022 TS2)"
-
-
-class OrbitDvFb(OrbitDetector):
-    name = "orbit.dv_fb"
-    statistic = "dv_fb"
-    summary = "forward-backward velocity difference (Bennett 2022 TS1)"
-
-
-class OrbitDSma(OrbitDetector):
-    name = "orbit.d_sma"
-    statistic = "d_sma"
-    summary = "change of semi-major axis (Bennett 2022 TS6)"
-
-
-class OrbitDEcc(OrbitDetector):
-    name = "orbit.d_ecc"
-    statistic = "d_ecc"
-    summary = "change of eccentricity vector (Bennett 2022 TS6)"
-
-
-class OrbitDHdir(OrbitDetector):
-    name = "orbit.d_hdir"
-    statistic = "d_hdir"
-    summary = "change of angular-momentum direction (Bennett 2022 TS6)"
+def orbit_thresholds(result: DetectionResult) -> dict[str, Threshold]:
+    """Every statistic's threshold, in the order they were set (empty when none could be set)."""
+    for d in result.diagnostics:
+        thresholds = d.extra.get("thresholds")
+        if isinstance(thresholds, dict):
+            return dict(thresholds)
+    return {}

@@ -22,14 +22,8 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
-from abrupt.detect.orbit.ekf import (
-    FilterConfig,
-    FilterRun,
-    forward_kernel_detailed,
-    measurement_variances,
-    measurement_vectors,
-    resolve_context,
-)
+from abrupt.detect.orbit.ekf import FilterConfig, FilterRun, measurement_variances, measurement_vectors, resolve_context
+from abrupt.detect.orbit.kernels import forward_kernel
 from abrupt.model.orbit import ForceContext
 from abrupt.types import FloatArray
 
@@ -121,7 +115,8 @@ def localise_jump(
     y = measurement_vectors(position_m[sl], velocity_mps[sl])
     rdiag = measurement_variances(velocity_mps[sl], sigma_pos_m, sigma_vel_mps, stop - start)
     ctx = resolve_context(config, t_s, context, None)
-    phis, gains, sinvs, innovs = forward_kernel_detailed(
+    # the forward filter from its a-posteriori state at ``start``, keeping every step's STM, gain and S⁻¹
+    _, _, innovs, _, phis, gains, sinvs = forward_kernel(
         np.ascontiguousarray(t_s[sl]),
         y,
         rdiag,
@@ -132,7 +127,10 @@ def localise_jump(
         config.nuisance_psd(),
         config.max_step_s,
         ctx.kernel_args,
+        True,
+        False,
     )
+    innovs[0] = 0.0  # no measurement update at the seed epoch
     lo = max(1, first - start)
     hi = min(stop - start - 1, last - start)
     end = min(stop - start, hi + horizon)
@@ -202,8 +200,9 @@ def glr_sliding_kernel(
 
 
 def glr_statistic_from_run(t_s: FloatArray, forward: FilterRun, horizon_s: float) -> FloatArray:
-    """The sliding GLR of :func:`glr_statistic` from a forward pass that stored its gains
-    (``run_forward(..., store_gains=True)``): the same numbers without a second filter pass."""
+    """Sliding GLR ℓ(θ) (chi-square with 3 degrees of freedom for a matched model, no jump) at every epoch,
+    the jump placed mid-interval before θ, from a forward pass that stored its gains
+    (``run_forward(..., store_gains=True)``)."""
     if forward.phis.shape[0] != t_s.size:
         raise ValueError("the forward run did not store its gains (run_forward(..., store_gains=True))")
     innovs = np.where(np.isfinite(forward.innovation), forward.innovation, 0.0)
@@ -213,40 +212,3 @@ def glr_statistic_from_run(t_s: FloatArray, forward: FilterRun, horizon_s: float
     step = np.r_[dt_nom, np.diff(t_s)]
     lead = np.ascontiguousarray(0.5 * step) if dt_nom > 2.0 else np.zeros(t_s.size)
     return glr_sliding_kernel(forward.phis, forward.gains, forward.sinvs, np.ascontiguousarray(innovs), horizon, lead)
-
-
-def glr_statistic(
-    t_s: FloatArray,
-    position_m: FloatArray,
-    velocity_mps: FloatArray,
-    sigma_pos_m: float,
-    sigma_vel_mps: float,
-    config: FilterConfig,
-    x0: FloatArray,
-    p0: FloatArray,
-    horizon_s: float,
-    *,
-    context: ForceContext | None = None,
-) -> FloatArray:
-    """Sliding GLR ℓ(θ) (chi-square with 3 degrees of freedom for a matched model, no jump) at every epoch,
-    the jump placed mid-interval before θ. Computed from a forward pass started at (x0, p0) at t_s[0]."""
-    y = measurement_vectors(position_m, velocity_mps)
-    rdiag = measurement_variances(velocity_mps, sigma_pos_m, sigma_vel_mps, t_s.size)
-    ctx = resolve_context(config, t_s, context, None)
-    phis, gains, sinvs, innovs = forward_kernel_detailed(
-        np.ascontiguousarray(t_s),
-        y,
-        rdiag,
-        x0,
-        p0,
-        config.tau_s,
-        config.q_array(),
-        config.nuisance_psd(),
-        config.max_step_s,
-        ctx.kernel_args,
-    )
-    dt_nom = float(np.median(np.diff(t_s)))
-    horizon = max(2, round(horizon_s / dt_nom))
-    step = np.r_[dt_nom, np.diff(t_s)]
-    lead = np.ascontiguousarray(0.5 * step) if dt_nom > 2.0 else np.zeros(t_s.size)
-    return glr_sliding_kernel(phis, gains, sinvs, innovs, horizon, lead)

@@ -26,8 +26,7 @@ Statistics (names used as keys throughout abrupt):
 ``glr``             beyond the thesis: sliding generalised likelihood ratio of a velocity jump in the
                     forward innovations (Willsky & Jones 1976; :mod:`abrupt.detect.orbit.glr`).
 
-TS5 (residuals against propagated reference orbits, §3.3.5) is evaluated only at candidate epochs:
-:func:`propagated_reference_statistic`.
+TS5 (residuals against propagated reference orbits, §3.3.5; two propagations per epoch) is not computed.
 """
 
 from __future__ import annotations
@@ -38,8 +37,7 @@ from dataclasses import dataclass, field
 import numba as nb
 import numpy as np
 
-from abrupt.detect.orbit.ekf import FilterConfig, propagate_state
-from abrupt.model.orbit import MU_EARTH_M3_S2, ForceContext, orbital_constants
+from abrupt.model.orbit import MU_EARTH_M3_S2, orbital_constants
 from abrupt.types import FloatArray
 
 STATISTIC_NAMES: tuple[str, ...] = (
@@ -261,51 +259,3 @@ def orbital_constant_statistics(
         "d_ecc": np.linalg.norm(d_e, axis=1),
         "d_hdir": np.linalg.norm(d_ang, axis=1),
     }
-
-
-def propagated_reference_statistic(
-    t_s: FloatArray,
-    position_m: FloatArray,
-    velocity_mps: FloatArray,
-    x_forward: FloatArray,
-    x_backward_prior: FloatArray,
-    index: int,
-    config: FilterConfig,
-    sigma_pos_m: float,
-    sigma_vel_m_s: float,
-    span: int = 60,
-    *,
-    context: ForceContext | None = None,
-) -> float:
-    """TS5 (§3.3.5): residuals of propagated reference orbits against the data on the other side.
-
-    The forward state at ``index − 1`` is propagated forward over ``span`` samples and the backward
-    state at ``index`` backward over ``span`` samples; the statistic is the log-likelihood ratio
-    Σ (normalised residuals²) − 6·(2·span), i.e. the excess over what white measurement noise of
-    the stated sigmas explains. Slow (two propagations per epoch): evaluate at candidates only.
-    """
-    n = t_s.size
-    if index < 1 or index >= n:
-        return float("nan")
-    sig = np.r_[np.full(3, sigma_pos_m), np.full(3, sigma_vel_m_s)]
-    args = (context or config.force_context(None, float(t_s[0]), float(t_s[-1]))).kernel_args
-    phi = np.empty((x_forward.shape[1], x_forward.shape[1]))
-    chi = 0.0
-    count = 0
-    x = x_forward[index - 1].copy()
-    x[6:9] = 0.0
-    for k in range(index, min(n, index + span)):
-        x = propagate_state(x, t_s[k - 1], t_s[k] - t_s[k - 1], config.tau_s, args, config.max_step_s, phi)
-        res = np.r_[position_m[k], velocity_mps[k]] - x[:6]
-        ok = np.isfinite(res)
-        chi += float(np.sum((res[ok] / sig[ok]) ** 2))
-        count += int(ok.sum())
-    x = x_backward_prior[index].copy()
-    x[6:9] = 0.0
-    for k in range(index - 1, max(-1, index - 1 - span), -1):
-        x = propagate_state(x, t_s[k + 1], t_s[k] - t_s[k + 1], -config.tau_s, args, config.max_step_s, phi)
-        res = np.r_[position_m[k], velocity_mps[k]] - x[:6]
-        ok = np.isfinite(res)
-        chi += float(np.sum((res[ok] / sig[ok]) ** 2))
-        count += int(ok.sum())
-    return chi - count

@@ -1,0 +1,91 @@
+"""Settings of the mean-element maneuver detector and the extra columns of its events."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any
+
+from abrupt.thresholds import FalseAlarmBudget
+
+EXTRA_COLUMNS: tuple[str, ...] = (
+    "maneuver_type",
+    "z_a",
+    "z_e",
+    "z_n",
+    "delta_a_m",
+    "elset_epoch_before_utc",
+    "elset_epoch_after_utc",
+    "time_method",
+    "regime",
+    "dv_t_sigma_mps",
+    "dv_n_sigma_mps",
+    "campaign_id",
+    "campaign_size",
+    "interval_start_utc",
+    "interval_end_utc",
+    "burns_max",
+    "z_u",
+    "delta_u_m",
+)
+
+# Sets a side needs between two accepted maneuvers. LEO campaigns (orbit raising, frozen-orbit
+# control) put burns two daily element sets apart; GEO station-keeping burns are weeks apart and
+# its sparser sets make a two-set level fragile. Chosen on the shared histories: every LEO history
+# scores the same or better with 2, every GEO history the same or better with 3 (docs/tle.md).
+CAMPAIGN_SIDE_SETS = {"leo": 2, "geo": 3}
+
+# A TLE history has a few hundred element sets a year: its budget is stated per satellite-year.
+DEFAULT_TLE_BUDGET = FalseAlarmBudget(1.0, "year")
+
+
+@dataclass(frozen=True)
+class TleDetectorConfig:
+    """Settings of the mean-element detector (units in the names); ``budget`` is the false-alarm budget
+    (per satellite-year by default) the threshold is set for."""
+
+    window_sets: int = 6
+    max_window_days: float = 20.0
+    noise_half_window: int = 40
+    peak_half_width: int = 2
+    budget: FalseAlarmBudget = DEFAULT_TLE_BUDGET
+    threshold: float | None = None
+    threshold_method: str = "gpd"
+    min_statistic: float = 3.0
+    refine_time: bool = True
+    time_window_sets: int = 8
+    min_side_sets: int = 3
+    regime: str = "auto"
+    campaign_days: float = 3.0
+    campaign_min_side_sets: int | None = None  # None: by regime (CAMPAIGN_SIDE_SETS)
+    time_search_sets_before: int = 3
+    group_gain: tuple[float, float, float] = (1.0, 0.2, 0.2)
+    along_track_gain: float = 1.0
+    drag_trend: str = "ndot"  # LEO a: "ndot" removes the sets' own stated decay (drag_trend_m)
+    drag_median_sets: int = 5
+    drag_min_decay_m_day: float = 2.0  # the drag trend only where a decays at least this fast
+
+    def __post_init__(self) -> None:
+        if self.window_sets < 2:
+            raise ValueError("window_sets must be >= 2")
+        if self.peak_half_width < 1:
+            raise ValueError("peak_half_width must be >= 1")
+        if self.regime not in ("auto", "leo", "geo"):
+            raise ValueError(f"regime must be auto, leo or geo, got {self.regime!r}")
+        if any(not (g >= 0 and math.isfinite(g)) for g in self.group_gain) or len(self.group_gain) != 3:
+            raise ValueError("group_gain must be three finite non-negative numbers")
+        if self.drag_trend not in ("none", "ndot"):
+            raise ValueError(f"drag_trend must be none or ndot, got {self.drag_trend!r}")
+        if self.drag_median_sets < 1:
+            raise ValueError("drag_median_sets must be >= 1")
+        if not (self.drag_min_decay_m_day > 0 and math.isfinite(self.drag_min_decay_m_day)):
+            raise ValueError("drag_min_decay_m_day must be a finite positive number")
+        if not (self.along_track_gain >= 0 and math.isfinite(self.along_track_gain)):
+            raise ValueError("along_track_gain must be a finite non-negative number")
+
+    def hash_fields(self) -> dict[str, Any]:
+        """The settings as the events' ``config_hash`` reads them: the budget as its rate per year."""
+        out = asdict(self)
+        del out["budget"]
+        out["false_alarms_per_year"] = self.budget.per_year
+        return out

@@ -1,0 +1,166 @@
+"""Noise of the mean-element series and the threshold of the step statistic (method steps 2-3 of
+:mod:`abrupt.detect.tle.maneuvers`): rolling robust scales, the random-walk rate, local peaks, the
+per-group weights and the tail fit on the event-free gaps."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+from scipy import special
+
+from abrupt.thresholds import fit_threshold
+from abrupt.thresholds.noise import MAD_TO_SIGMA, robust_scale
+
+
+def chi2_as_normal(z: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The |N(0,1)| value with the same tail probability as a χ₂ magnitude ``z`` (P = exp(−z²/2))."""
+    z = np.asarray(z, dtype=float)
+    log_p = -0.5 * z**2  # survival of a χ₂ magnitude
+    # two-sided normal: P(|N| > x) = erfc(x/√2) → x = √2·erfcinv(P); for tiny P use the asymptote
+    p = np.exp(log_p)
+    out = np.sqrt(2.0) * special.erfcinv(np.clip(p, 1e-300, 1.0))
+    tiny = p < 1e-280
+    out[tiny] = np.sqrt(np.maximum(z[tiny] ** 2 - np.log(np.maximum(z[tiny] ** 2, 1.0)), 0.0))
+    return np.asarray(out, dtype=float)
+
+
+def robust_scale_rolling(
+    y: NDArray[np.float64], half: int, t: NDArray[np.float64] | None = None
+) -> NDArray[np.float64]:
+    """Per-gap noise of a series: rolling 1.4826·MAD of first differences / √2 (Hampel 1974).
+
+    With the epochs ``t`` the differences are first detrended by the rolling median rate × gap, so
+    a secular drift (drag decay, an unmodelled nodal rate) seen over uneven gaps is not noise.
+    """
+    d = np.diff(y)
+    if d.size == 0:
+        return np.full_like(y, np.nan)
+    if t is not None:
+        dt = np.diff(t)
+        rate = pd.Series(d / np.maximum(dt, 60.0)).rolling(2 * half + 1, center=True, min_periods=5).median()
+        d = d - np.nan_to_num(rate.to_numpy()) * dt
+    s = pd.Series(d)
+    med = s.rolling(2 * half + 1, center=True, min_periods=5).median()
+    mad = (s - med).abs().rolling(2 * half + 1, center=True, min_periods=5).median()
+    scale = (MAD_TO_SIGMA * mad / math.sqrt(2.0)).to_numpy()
+    glob = float(robust_scale(d)) / math.sqrt(2.0)
+    scale = np.where(np.isfinite(scale), scale, glob)
+    floor = max(glob * 0.25, 1e-15)
+    scale = np.maximum(scale, floor)
+    # per gap g (between sets g and g+1): the scale of difference g
+    return scale
+
+
+def drift_noise_rate(t: NDArray[np.float64], y: NDArray[np.float64], half: int = 40) -> float:
+    """Random-walk rate q (units²/s) of a mean-element series, learned from its own history.
+
+    Set-to-set differences, with a rolling median drift removed, have variance ``2σ² + q·Δt`` (white
+    fit noise σ plus unmodelled drag/luni-solar wander that accumulates over the gap Δt). The robust
+    variances (1.4826·MAD)² of short gaps (≤ median) and long gaps (≥ 2 × median) give q (≥ 0);
+    q = 0 when fewer than 20 long gaps exist. The step test adds q·Δt_gap to a gap's variance, so
+    a long gap between element sets needs a larger step.
+    """
+    d = np.diff(y)
+    dt = np.diff(t)
+    if d.size < 40:
+        return 0.0
+    rate = pd.Series(d / np.maximum(dt, 60.0)).rolling(2 * half + 1, center=True, min_periods=5).median()
+    r = d - rate.to_numpy() * dt
+    med_dt = float(np.median(dt))
+    short, long = dt <= med_dt, dt >= 2.0 * med_dt
+    ok = np.isfinite(r)
+    if (long & ok).sum() < 20 or (short & ok).sum() < 20:
+        return 0.0
+
+    def robust_var(x: NDArray[np.float64]) -> float:
+        return float(robust_scale(x)) ** 2
+
+    v_s, v_l = robust_var(r[short & ok]), robust_var(r[long & ok])
+    span = float(np.mean(dt[long & ok]) - np.mean(dt[short & ok]))
+    return max(0.0, (v_l - v_s) / span) if span > 0 else 0.0
+
+
+def local_peaks(stat: NDArray[np.float64], half_width: int, minimum: float) -> NDArray[np.int64]:
+    """Indices of local maxima of ``stat`` within ±``half_width`` samples, at least ``minimum``.
+
+    Ties keep the first index. Peaks are found greedily from the largest down, so a strong event
+    suppresses its own flanks but not a separate event ``half_width + 1`` samples away.
+    """
+    order = np.argsort(-stat, kind="stable")
+    taken = np.zeros(stat.size, dtype=bool)
+    peaks = []
+    for g in order:
+        if not np.isfinite(stat[g]) or stat[g] < minimum:
+            break
+        if taken[max(0, g - half_width) : g + half_width + 1].any():
+            continue
+        peaks.append(g)
+        taken[g] = True
+    return np.sort(np.asarray(peaks, dtype=np.int64))
+
+
+def event_free_mask(stat: NDArray[np.float64], guard: int) -> NDArray[np.bool_]:
+    """Gaps outside ±``guard`` of every local peak above a robust outlier level of ``stat``.
+
+    The level is median + 8·1.4826·MAD (Hampel 1974): maneuvers and their window flanks are removed so
+    they do not fit their own threshold or noise model.
+    """
+    finite = np.isfinite(stat)
+    keep = finite.copy()
+    if finite.sum() < 20:
+        return keep
+    med = float(np.median(stat[finite]))
+    level = med + 8.0 * float(robust_scale(stat[finite]))
+    for g in local_peaks(np.where(finite, stat, -np.inf), 1, level):
+        keep[max(0, g - guard) : g + guard + 1] = False
+    return keep
+
+
+def robust_group_weight(z: NDArray[np.float64], ref: float, guard: int, quantile: float = 0.5) -> float:
+    """``ref / quantile(z)`` over gaps away from maneuvers, found by iterated rejection (Hampel 1974).
+
+    Each pass rescales ``z`` by the current weight and removes ±``guard`` gaps around every local peak
+    above 6 (robust σ units); three passes converge on histories where a quarter of the gaps are
+    flanks of maneuvers.
+    """
+    finite = np.isfinite(z) & (z > 0)
+    if finite.sum() < 50:
+        return 1.0
+    keep = finite.copy()
+    w = 1.0
+    for _ in range(4):
+        sample = z[keep]
+        if sample.size < 50:
+            break
+        q = float(np.quantile(sample, quantile))
+        if not q > 0:
+            break
+        w = ref / q
+        peaks = local_peaks(np.where(finite, w * z, -np.inf), 1, 6.0)
+        keep = finite.copy()
+        for g in peaks:
+            keep[max(0, g - guard) : g + guard + 1] = False
+    return w
+
+
+def null_threshold(stat: NDArray[np.float64], guard: int, p_fa: float, method: str) -> float:
+    """Threshold on S for a per-gap false-alarm probability, fitted on the event-free part of S
+    (:func:`event_free_mask`) with :func:`abrupt.thresholds.fit_threshold`."""
+    finite = np.isfinite(stat)
+    if finite.sum() < 20:
+        return math.inf
+    keep = event_free_mask(stat, guard)
+    null = stat[keep]
+    if null.size < 50:
+        # Too few gaps away from maneuvers for a tail fit (sparse sets, many burns: their windows
+        # cover the history). The whole statistic would put the threshold on the maneuvers'
+        # plateaus; the largest event-free value is returned instead, and the caller's Gaussian floor
+        # (Bonferroni over the groups) holds the budget.
+        return float(np.max(null)) if null.size else 0.0
+    try:
+        return float(fit_threshold(null, p_fa=p_fa, method=method).value)  # type: ignore[arg-type]
+    except ValueError:  # too few tail samples for the chosen fit: the plain sample quantile
+        return float(fit_threshold(null, p_fa=p_fa, method="empirical").value)
