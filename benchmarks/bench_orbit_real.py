@@ -25,8 +25,8 @@ from abrupt.detect.orbit.analysis import OrbitAnalysis, OrbitDetectorConfig, ana
 from abrupt.detect.orbit.calibration import self_calibrate
 from abrupt.detect.orbit.events import find_events
 from abrupt.detect.orbit.tuning import auto_tune
-from abrupt.model.frames import Ephemeris
 from abrupt.readers.sp3 import read_sp3
+from abrupt.series.ephemeris import Ephemeris
 from abrupt.simulate.orbit import inject_impulse
 
 DEFAULT_SP3 = Path(__file__).resolve().parents[1].parent / "shared/data/sp3/ssas3a20.b18358.e19003.DG_.sp3"

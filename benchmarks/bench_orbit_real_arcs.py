@@ -28,9 +28,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from abrupt.model.frames import Ephemeris
 from abrupt.pipelines.orbit import detect_orbit
 from abrupt.readers.sp3 import read_sp3
+from abrupt.series.ephemeris import Ephemeris
 from abrupt.simulate.orbit import inject_impulse
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared/data/sp3"
