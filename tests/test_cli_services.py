@@ -168,3 +168,18 @@ def test_the_top_level_help_imports_no_capability() -> None:
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert "detect" in out and out.strip().splitlines()[-1] == "['abrupt.cli.commands', 'abrupt.cli.main']"
+
+
+def test_every_command_is_in_the_lazy_tables() -> None:
+    """A command a capability module defines but the lazy tables do not name would never be found."""
+    import importlib
+    import pkgutil
+
+    import abrupt.cli
+    from abrupt.cli.commands import LazyGroup, cli
+
+    for info in pkgutil.iter_modules(abrupt.cli.__path__):
+        importlib.import_module(f"abrupt.cli.{info.name}")
+    for group in [cli, *(g for g in cli.commands.values() if isinstance(g, LazyGroup))]:
+        missing = sorted(set(group.commands) - set(group.lazy_commands) - {"simulate", "detect", "inject", "report"})
+        assert not missing, f"commands of {group.name!r} not in its lazy table: {missing}"
