@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from abrupt.density.report import plot_density_bands
 from abrupt.density.tle_drag import TleDragConfig, rho_b_from_history
 from abrupt.readers.tle import read_tle
+from abrupt.report.density import plot_density_bands
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "tle"
 OUT = Path(__file__).resolve().parents[1] / "docs" / "results" / "density_real.png"
