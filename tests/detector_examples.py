@@ -94,7 +94,7 @@ def _attitude_settings() -> dict[str, dict[str, Any]]:
 @cache
 def tracking_example() -> Any:
     """Ten hours of 20 s range/angles/range-rate from Ascension of the thesis orbit with a 2 m/s apogee burn."""
-    from abrupt.detect.tracking.glrt import BatchFitConfig
+    from abrupt.model.orbit.batch_fit import BatchFitConfig
     from abrupt.model.stations import ascension
     from abrupt.model.tracking_measurements import TrackingArrays
     from abrupt.series.tracking import TrackingSeries
