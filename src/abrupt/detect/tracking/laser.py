@@ -30,6 +30,7 @@ from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.detect.tracking.glrt import (
     GlrtConfig,
     GlrtDetection,
+    GlrtScan,
     detect_maneuvers_glrt,
     glrt_events,
     glrt_threshold_fit,
@@ -74,7 +75,7 @@ class LaserGlrtDetector(Detector[LaserRangingSeries]):
         scale: dict[str, float] = {}
         data, fit = _initial_fit(series, repairs)
         detections: list[GlrtDetection] = []
-        scans = []
+        scans: list[GlrtScan] = []
         for it in range(4):
             if self.weight_by_residuals:
                 # relative to the stated sigmas and never below them; it comes back down once a detected

@@ -421,9 +421,9 @@ def _normal_equations(
     """Covariance (AᵀA)⁻¹ (pseudo-inverse when singular) and the Gauss-Newton step (AᵀA)⁻¹ Aᵀ r."""
     normal = a.T @ a
     try:
-        cov = np.linalg.inv(normal)
+        cov = np.asarray(np.linalg.inv(normal), dtype=np.float64)
     except np.linalg.LinAlgError:
-        cov = np.linalg.pinv(normal)
+        cov = np.asarray(np.linalg.pinv(normal), dtype=np.float64)
     return cov, cov @ (a.T @ r)
 
 
