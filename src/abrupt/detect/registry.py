@@ -10,4 +10,5 @@ import abrupt.detect.mass.inertia_change
 import abrupt.detect.orbit.detectors
 import abrupt.detect.tle.detectors
 import abrupt.detect.tracking.glrt
-import abrupt.detect.tracking.kaderali  # noqa: F401  tracking.kaderali_k
+import abrupt.detect.tracking.kaderali
+import abrupt.detect.tracking.laser  # noqa: F401  tracking.laser_glrt
