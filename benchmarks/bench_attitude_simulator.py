@@ -21,13 +21,8 @@ import numpy as np
 
 from abrupt.model.momentum import system_momentum
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
-from abrupt.simulate.attitude import (
-    AttitudeSimConfig,
-    Strike,
-    simulate_attitude,
-    simulate_attitude_basilisk,
-    simulate_attitude_batch,
-)
+from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude, simulate_attitude_batch
+from abrupt.simulate.attitude_basilisk import simulate_attitude_basilisk
 
 
 def main() -> None:

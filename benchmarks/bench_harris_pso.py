@@ -25,9 +25,9 @@ from abrupt.massprops.telemetry import momentum_data_from_simulation
 from abrupt.model.momentum import body_momentum
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import spacecraft_from_dict
-from abrupt.simulate.attitude import (
+from abrupt.simulate.attitude import AttitudeSimConfig
+from abrupt.simulate.pointing import (
     AppendageMotion,
-    AttitudeSimConfig,
     CircularOrbit,
     PointingScenario,
     ReferenceTrajectory,

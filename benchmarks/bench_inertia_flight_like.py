@@ -241,15 +241,15 @@ def simulated_spacecraft() -> None:
     from abrupt.massprops.inertia import inertia_from_principal, perturb_inertia
     from abrupt.massprops.telemetry import momentum_data_from_simulation
     from abrupt.model.spacecraft import spacecraft_from_dict
-    from abrupt.simulate.attitude import (
+    from abrupt.simulate.attitude import AttitudeSimConfig
+    from abrupt.simulate.docking import random_slews
+    from abrupt.simulate.pointing import (
         AppendageMotion,
-        AttitudeSimConfig,
         CircularOrbit,
         PointingScenario,
         ReferenceTrajectory,
         simulate_pointing,
     )
-    from abrupt.simulate.docking import random_slews
 
     cases = [
         (

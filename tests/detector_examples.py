@@ -88,6 +88,28 @@ def _attitude_settings() -> dict[str, dict[str, Any]]:
     return fast
 
 
+@cache
+def cleaned_momentum_example() -> Any:
+    """Six hours of cleaned ᴺH at 1 Hz (white noise, 1e-3 N·m·s) with a 0.05 N·m·s step at 3 h, a 20 min gap."""
+    from abrupt.series.attitude import CleanedMomentum
+
+    n = 6 * 3600
+    rng = np.random.default_rng(5)
+    h = 1e-3 * rng.standard_normal((n, 3))
+    h[3 * 3600 :] += np.array([0.03, -0.03, 0.028])
+    ok = np.ones(n, bool)
+    ok[5000:6200] = False
+    h[~ok] = np.nan
+    t0 = int(np.datetime64("2026-01-01T00:00:00", "ns").astype(np.int64))
+    return CleanedMomentum(t0 + np.arange(n, dtype=np.int64) * 1_000_000_000, h, ok, 1.0, name="example-sat")
+
+
+def empty_cleaned_momentum() -> Any:
+    from abrupt.series.attitude import CleanedMomentum
+
+    return CleanedMomentum(np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros(0, bool), 1.0, name="example-sat")
+
+
 # ---------------------------------------------------------------------------------------------- tracking
 
 
@@ -189,7 +211,7 @@ def tle_example() -> Any:
 def _examples() -> dict[type, SeriesExample]:
     from abrupt.massprops.track import InertiaTrack
     from abrupt.readers.tle import ElementHistory
-    from abrupt.series.attitude import AttitudeSeries
+    from abrupt.series.attitude import AttitudeSeries, CleanedMomentum
     from abrupt.series.ephemeris import Ephemeris
     from abrupt.series.tracking import TrackingSeries
 
@@ -224,6 +246,12 @@ def _examples() -> dict[type, SeriesExample]:
             empty=empty_attitude,
             shift=lambda s, seconds: s.shifted(seconds),
             settings=_attitude_settings(),
+        ),
+        CleanedMomentum: SeriesExample(
+            make=cleaned_momentum_example,
+            empty=empty_cleaned_momentum,
+            shift=lambda s, seconds: s.shifted(seconds),
+            notes="blocks of the threshold fit start at the first sample, so a shift moves them too",
         ),
     }
 

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from abrupt.model.spacecraft import Spacecraft, bundled_spacecraft_path, load_spacecraft
-from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude, simulate_attitude_basilisk
+from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude
+from abrupt.simulate.attitude_basilisk import simulate_attitude_basilisk
 
 try:
     import Basilisk  # noqa: F401

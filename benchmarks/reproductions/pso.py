@@ -153,7 +153,8 @@ def harris_objective(
     """
     from abrupt.model.momentum import body_momentum
     from abrupt.model.rotations import dcm_from_quaternion
-    from abrupt.simulate.attitude import AttitudeSimConfig, PointingScenario, ReferenceTrajectory, simulate_pointing
+    from abrupt.simulate.attitude import AttitudeSimConfig
+    from abrupt.simulate.pointing import PointingScenario, ReferenceTrajectory, simulate_pointing
 
     sc = spacecraft
     j_cat = np.asarray(sc.inertia_kgm2, dtype=np.float64)

@@ -25,15 +25,15 @@ import numpy as np
 from abrupt.massprops.inertia import inertia_from_principal, perturb_inertia
 from abrupt.model.rotations import quaternion_multiply
 from abrupt.model.spacecraft import Spacecraft, spacecraft_from_dict
-from abrupt.simulate.attitude import (
+from abrupt.simulate.attitude import AttitudeSimConfig
+from abrupt.simulate.docking import random_slews
+from abrupt.simulate.pointing import (
     AppendageMotion,
-    AttitudeSimConfig,
     CircularOrbit,
     PointingScenario,
     ReferenceTrajectory,
     simulate_pointing,
 )
-from abrupt.simulate.docking import random_slews
 from abrupt.types import FloatArray
 
 __all__ = ["ROUTINE_SPACECRAFT", "RoutineDay", "RoutineSpacecraft", "simulate_routine_day"]

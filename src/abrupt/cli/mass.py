@@ -217,8 +217,8 @@ def simulate_docking_cmd(
     """Simulate routine telemetry (nadir pointing, slews, momentum dumps) with a parasite docking; one CSV
     per day (the dumps are listed in docking_truth.json)."""
     from abrupt.pipelines.mass import simulate_docking_run
-    from abrupt.simulate.attitude import CircularOrbit
     from abrupt.simulate.docking import DockingScenario
+    from abrupt.simulate.pointing import CircularOrbit
 
     scenario = DockingScenario(
         days=days,

@@ -22,9 +22,9 @@ from numpy.typing import ArrayLike
 
 from abrupt.massprops.inertia import inertia_after_docking
 from abrupt.model.spacecraft import Spacecraft
-from abrupt.simulate.attitude import (
+from abrupt.simulate.attitude import AttitudeSimConfig
+from abrupt.simulate.pointing import (
     AppendageMotion,
-    AttitudeSimConfig,
     CircularOrbit,
     PointingScenario,
     PointingSimResult,
