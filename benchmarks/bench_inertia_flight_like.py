@@ -240,8 +240,8 @@ def pso_side_by_side(d: MomentumBalanceData, j_cat: np.ndarray, j_true: np.ndarr
 def simulated_spacecraft() -> None:
     from abrupt.massprops.inertia import inertia_from_principal, perturb_inertia
     from abrupt.massprops.telemetry import momentum_data_from_simulation
+    from abrupt.model.attitude_dynamics import AttitudeSimConfig
     from abrupt.model.spacecraft import spacecraft_from_dict
-    from abrupt.simulate.attitude import AttitudeSimConfig
     from abrupt.simulate.docking import random_slews
     from abrupt.simulate.pointing import (
         AppendageMotion,

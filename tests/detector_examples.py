@@ -50,10 +50,11 @@ class SeriesExample:
 @cache
 def attitude_example() -> Any:
     """Ten minutes of 10 Hz telemetry of the thesis spacecraft with one 0.3 N·m·s strike at 300 s."""
+    from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike
     from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
     from abrupt.readers.telemetry import telemetry_from_frame
     from abrupt.series.attitude import AttitudeSeries
-    from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude
+    from abrupt.simulate.attitude import simulate_attitude
 
     sc = load_spacecraft(bundled_spacecraft_path("thesis"))
     sim = simulate_attitude(sc, AttitudeSimConfig(duration_s=600.0, seed=11), [Strike(300.0, (0.2, -0.15, 0.17))])

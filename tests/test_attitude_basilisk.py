@@ -10,8 +10,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike
 from abrupt.model.spacecraft import Spacecraft, bundled_spacecraft_path, load_spacecraft
-from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude
+from abrupt.simulate.attitude import simulate_attitude
 from abrupt.simulate.attitude_basilisk import simulate_attitude_basilisk
 
 try:

@@ -14,10 +14,11 @@ from abrupt.cli.groups import cli
 from abrupt.cli.main import main
 from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
 from abrupt.events import EVENT_COLUMNS
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 from abrupt.pipelines.attitude import detect_attitude
 from abrupt.readers.telemetry import telemetry_from_frame
-from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude
+from abrupt.simulate.attitude import simulate_attitude
 from abrupt.thresholds.noise import momentum_noise_model
 
 SC = load_spacecraft(bundled_spacecraft_path())

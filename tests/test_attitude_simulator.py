@@ -10,16 +10,11 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from abrupt.errors import ConfigError
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike, simulate_attitude_batch
 from abrupt.model.momentum import system_momentum
 from abrupt.model.rotations import dcm_from_quaternion, normalise_quaternion
 from abrupt.model.spacecraft import Spacecraft, bundled_spacecraft_path, load_spacecraft, spacecraft_from_dict
-from abrupt.simulate.attitude import (
-    AttitudeSimConfig,
-    Strike,
-    simulate_attitude,
-    simulate_attitude_batch,
-    write_telemetry,
-)
+from abrupt.simulate.attitude import simulate_attitude, write_telemetry
 
 
 @pytest.fixture(scope="module")

@@ -18,10 +18,11 @@ import abrupt
 from abrupt.catalog import Catalog
 from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
 from abrupt.events import read_events
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 from abrupt.pipelines.fleet import detect_attitude_fleet, fleet_run_key, read_manifest
 from abrupt.scale import Executor, run_tasks
-from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude, write_telemetry
+from abrupt.simulate.attitude import simulate_attitude, write_telemetry
 
 DAY_S = 86_400.0
 CONFIG = AttitudeDetectionConfig(detectors=("glr", "cusum"), null_samples=100_000)

@@ -24,10 +24,10 @@ from abrupt.massprops.inertia import (
 )
 from abrupt.massprops.momentum_balance import InsufficientExcitationError, estimate_inertia
 from abrupt.massprops.telemetry import momentum_data_from_channels, momentum_data_from_simulation
+from abrupt.model.attitude_dynamics import AttitudeSimConfig
 from abrupt.model.momentum import body_momentum
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import spacecraft_from_dict
-from abrupt.simulate.attitude import AttitudeSimConfig
 from abrupt.simulate.pointing import (
     AppendageMotion,
     CircularOrbit,

@@ -329,7 +329,7 @@ def test_simulated_bank_is_linear_below_saturation(thesis_wavelets) -> None:  # 
 
 
 def test_simulated_strike_is_detected_with_time_and_size(thesis_wavelets) -> None:  # type: ignore[no-untyped-def]
-    from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude_batch
+    from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike, simulate_attitude_batch
 
     sc, wav = thesis_wavelets
     cfg = AttitudeSimConfig(duration_s=600.0, telemetry_rate_hz=10.0)
@@ -354,7 +354,7 @@ def test_simulated_strike_is_detected_with_time_and_size(thesis_wavelets) -> Non
 @pytest.mark.slow
 def test_thesis_attitude_filter_detects_60mg_random_directions(thesis_wavelets) -> None:  # type: ignore[no-untyped-def]
     """Acceptance 2 (Bennett 2022 §2.4.1.4): >= 90% of 60 mg strikes at alpha = 1e-4."""
-    from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude_batch
+    from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike, simulate_attitude_batch
 
     sc, wav = thesis_wavelets
     rng = np.random.default_rng(11)
@@ -426,7 +426,7 @@ def test_simulated_strike_momentum_ends_in_the_wheels(thesis_wavelets) -> None: 
 
 def test_joint_filter_with_wheels_detects_a_5mg_strike(thesis_wavelets) -> None:  # type: ignore[no-untyped-def]
     from abrupt.detect.attitude.matched_filter import detect_strikes
-    from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude_batch
+    from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike, simulate_attitude_batch
 
     sc, wav = thesis_wavelets
     dh_b = 0.04 * np.array([0.6, -0.64, 0.48])  # 5 mg, |dH| = 0.04 N·m·s

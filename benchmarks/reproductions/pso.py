@@ -151,9 +151,9 @@ def harris_objective(
     starting from the measured rate and wheel speeds. Both momenta are taken relative to their value at
     the start of the window, so the objective sees only the slew-induced error pattern of Fig. 5.
     """
+    from abrupt.model.attitude_dynamics import AttitudeSimConfig
     from abrupt.model.momentum import body_momentum
     from abrupt.model.rotations import dcm_from_quaternion
-    from abrupt.simulate.attitude import AttitudeSimConfig
     from abrupt.simulate.pointing import PointingScenario, ReferenceTrajectory, simulate_pointing
 
     sc = spacecraft

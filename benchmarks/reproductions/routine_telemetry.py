@@ -23,9 +23,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from abrupt.massprops.inertia import inertia_from_principal, perturb_inertia
+from abrupt.model.attitude_dynamics import AttitudeSimConfig
 from abrupt.model.rotations import quaternion_multiply
 from abrupt.model.spacecraft import Spacecraft, spacecraft_from_dict
-from abrupt.simulate.attitude import AttitudeSimConfig
 from abrupt.simulate.docking import random_slews
 from abrupt.simulate.pointing import (
     AppendageMotion,

@@ -22,7 +22,7 @@ from abrupt.cli.groups import (
 from abrupt.cli.options import budget_options, pop_budget
 
 if TYPE_CHECKING:
-    from abrupt.simulate.attitude import Strike
+    from abrupt.model.attitude_dynamics import Strike
 
 FLIGHT_STAGES = ("event-masks", "slew-masks", "savgol", "comb", "trend", "all")  # abrupt.cli.flight
 
@@ -35,7 +35,7 @@ def _spacecraft(path: str | None) -> Any:
 
 def parse_strike(text: str) -> Strike:
     """``TIME_S:DHX,DHY,DHZ`` (seconds from start; angular impulse in body axes, N·m·s)."""
-    from abrupt.simulate.attitude import Strike
+    from abrupt.model.attitude_dynamics import Strike
 
     try:
         time_part, vec_part = text.split(":")
@@ -51,7 +51,7 @@ def random_strikes(n: int, duration_s: float, dh_min: float, dh_max: float, seed
     """n strikes, evenly spaced with random jitter, log-uniform |ΔH| in [dh_min, dh_max], random directions."""
     import numpy as np
 
-    from abrupt.simulate.attitude import Strike
+    from abrupt.model.attitude_dynamics import Strike
 
     rng = np.random.default_rng(seed + 1)
     spacing = duration_s / (n + 1)
@@ -123,7 +123,8 @@ def simulate_attitude_cmd(
 
     Writes the telemetry and, beside it, <name>_truth.csv with each strike's time and ΔH.
     """
-    from abrupt.simulate.attitude import AttitudeSimConfig, simulate_attitude, write_telemetry
+    from abrupt.model.attitude_dynamics import AttitudeSimConfig
+    from abrupt.simulate.attitude import simulate_attitude, write_telemetry
 
     sc = _spacecraft(spacecraft_path)
     strike_list = [parse_strike(s) for s in strikes]
@@ -458,10 +459,11 @@ def demo(out_dir: str, duration_s: float, seed: int) -> None:
     import pandas as pd
 
     from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
+    from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike
     from abrupt.pipelines.attitude import detect_attitude
     from abrupt.readers.telemetry import read_telemetry
     from abrupt.report.attitude import write_attitude_report
-    from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude, write_telemetry
+    from abrupt.simulate.attitude import simulate_attitude, write_telemetry
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

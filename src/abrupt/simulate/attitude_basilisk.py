@@ -14,9 +14,9 @@ from typing import Any
 
 import numpy as np
 
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, PreparedDynamics, Strike, prepare_dynamics, strike_arrays
 from abrupt.model.rotations import quaternion_from_mrp
 from abrupt.model.spacecraft import Spacecraft
-from abrupt.simulate.attitude import AttitudeSimConfig, PreparedDynamics, Strike, prepare_dynamics, strike_arrays
 from abrupt.types import FloatArray
 
 

@@ -21,8 +21,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from abrupt.massprops.inertia import inertia_after_docking
+from abrupt.model.attitude_dynamics import AttitudeSimConfig
 from abrupt.model.spacecraft import Spacecraft
-from abrupt.simulate.attitude import AttitudeSimConfig
 from abrupt.simulate.pointing import (
     AppendageMotion,
     CircularOrbit,

@@ -34,11 +34,11 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from abrupt.model.attitude_dynamics import AttitudeSimConfig
 from abrupt.model.flight_config import FlightChannel
 from abrupt.model.rotations import dcm_from_quaternion, quaternion_from_dcm
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.timetable import NS, continuous_quaternion
-from abrupt.simulate.attitude import AttitudeSimConfig
 from abrupt.simulate.pointing import PointingScenario, ReferenceTrajectory, simulate_pointing
 from abrupt.types import FloatArray
 

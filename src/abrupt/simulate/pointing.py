@@ -6,7 +6,7 @@ Harris et al. 2025 §3.1.2.
 :class:`CircularOrbit` with optional :class:`Slew` s, or an attitude history from telemetry) with the
 MRP tracking law and the catalogue inertia, while the dynamics use the true inertia, gravity gradient,
 an :class:`AppendageMotion` and strikes (RK4 in the numba kernel
-:func:`abrupt.simulate._attitude_kernels.simulate_tracking`). Used by the inertia estimation studies and
+:func:`abrupt.model.attitude_kernels.simulate_tracking`). Used by the inertia estimation studies and
 the flight-telemetry injection (:mod:`abrupt.simulate.injection`).
 """
 
@@ -22,10 +22,10 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from abrupt.errors import ConfigError
 from abrupt.massprops.inertia import require_physical
+from abrupt.model import attitude_kernels as kern
+from abrupt.model.attitude_dynamics import AttitudeSimConfig
 from abrupt.model.rotations import dcm_from_quaternion, quaternion_from_dcm, quaternion_from_mrp, quaternion_multiply
 from abrupt.model.spacecraft import Spacecraft
-from abrupt.simulate import _attitude_kernels as kern
-from abrupt.simulate.attitude import AttitudeSimConfig
 from abrupt.types import FloatArray
 
 
