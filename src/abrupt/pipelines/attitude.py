@@ -23,6 +23,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from abrupt.clean.masks import apply_mask, read_mask
 from abrupt.detect.attitude.momentum import (
     ATTITUDE_EVENT_COLUMNS,
     AttitudeDetectionConfig,
@@ -33,7 +34,9 @@ from abrupt.detect.attitude.momentum import (
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.errors import InputError
 from abrupt.events import config_hash, empty_frame, new_run_id, normalise_frame, restamp
-from abrupt.model.spacecraft import Spacecraft
+from abrupt.model.spacecraft import Spacecraft, bundled_spacecraft_path
+from abrupt.model.spacecraft import load_spacecraft as load_spacecraft_file
+from abrupt.readers.telemetry import read_telemetry
 from abrupt.series.attitude import AttitudeSeries
 from abrupt.series.telemetry import Telemetry
 from abrupt.thresholds import FalseAlarmBudget, Threshold
@@ -80,9 +83,7 @@ class AttitudeRun:
 
 def load_spacecraft(path: str | Path | None) -> Spacecraft:
     """The spacecraft file at ``path``, or the bundled thesis spacecraft (Bennett 2022 Table 2.1)."""
-    from abrupt.model import spacecraft
-
-    return spacecraft.load_spacecraft(path or spacecraft.bundled_spacecraft_path("thesis"))
+    return load_spacecraft_file(path or bundled_spacecraft_path("thesis"))
 
 
 def read_attitude_inputs(
@@ -93,9 +94,6 @@ def read_attitude_inputs(
     mask_path: str | Path | None = None,
 ) -> tuple[Spacecraft, Telemetry, Telemetry | None]:
     """Read telemetry (CSV/Parquet) mapped by the spacecraft file, mask planned events, read calibration."""
-    from abrupt.clean.masks import apply_mask, read_mask
-    from abrupt.readers.telemetry import read_telemetry
-
     sc = load_spacecraft(spacecraft_path)
     tel = read_telemetry(telemetry_path, sc)
     if mask_path:
