@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -206,7 +207,6 @@ def test_tachometer_discretisation_quantises_wheel_telemetry(thesis: Spacecraft)
 
 def test_telemetry_is_written_in_the_spacecraft_files_units_and_convention() -> None:
     text = Path(bundled_spacecraft_path("thesis")).read_text()
-    import tomllib
 
     data = tomllib.loads(text)
     data["telemetry"]["wheel_speed"]["unit"] = "rpm"

@@ -1,9 +1,10 @@
-"""Flight-telemetry pipeline (issue 9): ingest and its bad inputs, leak scan, timetable, cleaning,
+"""Flight-telemetry pipeline: ingest and its bad inputs, leak scan, timetable, cleaning,
 detection on a synthetic archive with known truth, chunked = whole, injection, thresholds."""
 
 from __future__ import annotations
 
 import gzip
+import json
 import math
 from pathlib import Path
 from typing import Any
@@ -14,12 +15,22 @@ import pytest
 from scipy import stats
 
 from abrupt.clean.comb import CombConfig, comb_subtract, smooth_model
+from abrupt.cli.main import main
 from abrupt.errors import ConfigError, InputError
 from abrupt.model.flight_config import FlightChannel
 from abrupt.model.spacecraft import load_spacecraft, spacecraft_from_dict
-from abrupt.pipelines.flight import CleaningConfig, FlightRunConfig, ingest_archives, process_chunk, run_flight
+from abrupt.pipelines.flight import (
+    DAY_NS,
+    CleaningConfig,
+    FlightRunConfig,
+    chunk_spans,
+    ingest_archives,
+    process_chunk,
+    run_flight,
+)
 from abrupt.readers.archive import read_archive, read_decoder
 from abrupt.series.timetable import channel_on_grid, continuous_quaternion, grid
+from abrupt.simulate.injection import InjectedStrike, inject_strikes
 from abrupt.store import TelemetryStore
 from abrupt.thresholds.robust import gumbel_quantile_fit, robust_block_maxima_threshold
 from flight_synth import REAL, make_archive
@@ -196,9 +207,8 @@ def test_chunked_six_hour_chunks_equal_the_whole_run(tmp_path: Path) -> None:
 
 
 def test_kestrel_six_hour_chunks_give_the_events_of_the_whole_run(shared_data: Path, tmp_path: Path) -> None:
-    """Issue 9 item 2 on the shared flight-like data: 6-hour chunks (each with its margin) against one
+    """On the shared flight-like data: 6-hour chunks (each with its margin) against one
     chunk of both days; the events are the same and are the truth's strikes."""
-    import json
 
     data = shared_data / "flight-like"
     if not data.is_dir():
@@ -228,7 +238,6 @@ def test_kestrel_six_hour_chunks_give_the_events_of_the_whole_run(shared_data: P
 def test_leak_scan_of_every_output_of_the_chain(
     synth: tuple[Path, object], tmp_path: Path, capfd: pytest.CaptureFixture[str]
 ) -> None:
-    from abrupt.cli.main import main
 
     _, a = synth
     out = tmp_path / "out"
@@ -294,7 +303,6 @@ def test_rpm_declared_as_rad_s_is_caught_by_the_tachometer_quantum(synth: tuple[
 
 
 def test_injected_strike_changes_momentum_by_its_size_in_native_units(synth: tuple[Path, object]) -> None:
-    from abrupt.simulate.injection import InjectedStrike, inject_strikes
 
     d, a = synth
     sc = load_spacecraft(a.spacecraft)  # type: ignore[attr-defined]
@@ -400,7 +408,6 @@ def test_binned_comb_fit_equals_the_per_sample_fit_to_a_small_fraction_of_the_no
 
 
 def test_chunk_spans_cover_the_days_once() -> None:
-    from abrupt.pipelines.flight import DAY_NS, chunk_spans
 
     days = ["2026-03-10", "2026-03-11", "2026-03-12", "2026-03-13", "2026-03-20"]
     d0 = int(np.datetime64("2026-03-10", "D").astype("datetime64[ns]").astype(np.int64))
