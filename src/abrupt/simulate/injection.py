@@ -94,11 +94,6 @@ class _Attitude:
         return np.asarray(dcm_from_quaternion(qi), dtype=np.float64)
 
 
-def _attitude_at(samples: pd.DataFrame, spacecraft: Spacecraft, t_ns: np.ndarray) -> FloatArray:
-    """[BN] at times t_ns from the telemetered quaternion (sign-continuous, nlerp)."""
-    return _Attitude(samples, spacecraft)(t_ns)
-
-
 def _quat_multiply(p: FloatArray, q: FloatArray) -> FloatArray:
     """Hamilton product p ⊗ q, scalar first, row-wise."""
     p0, p1, p2, p3 = p.T
