@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import logging
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -204,6 +205,12 @@ def _parse_times(raw_time: pd.Series, path: Path, is_csv: bool, column: str) -> 
 _Rows = tuple[NDArray[np.datetime64], FloatArray, FloatArray, FloatArray, NDArray[np.int64]]
 
 
+def _take(rows: _Rows, sel: NDArray[Any]) -> _Rows:
+    """The rows selected by a boolean mask or an index array."""
+    time_ns, q, w, omega, lines = rows
+    return time_ns[sel], q[sel], w[sel], omega[sel], lines[sel]
+
+
 def _repair_rows(rows: _Rows, repairs: RepairLog, path: Path) -> _Rows:
     """Remove rows with empty cells, sort by time and drop duplicate times (first kept), counting each repair.
 
@@ -213,7 +220,7 @@ def _repair_rows(rows: _Rows, repairs: RepairLog, path: Path) -> _Rows:
     finite = np.all(np.isfinite(q), axis=1) & np.all(np.isfinite(w), axis=1) & np.all(np.isfinite(omega), axis=1)
     if not finite.all():
         repairs.record("rows with empty or NaN values removed", int((~finite).sum()))
-        rows = tuple(x[finite] for x in rows)  # type: ignore[assignment]
+        rows = _take(rows, finite)
     time_ns = rows[0]
     if time_ns.size == 0:
         raise InputError("no complete data rows (every row has an empty value)", file=path)
@@ -221,7 +228,7 @@ def _repair_rows(rows: _Rows, repairs: RepairLog, path: Path) -> _Rows:
     if np.any(order != np.arange(order.size)):
         n_out = int(np.count_nonzero(np.diff(time_ns.astype(np.int64)) < 0))
         repairs.record("timestamps out of order (rows sorted)", n_out)
-        rows = tuple(x[order] for x in rows)  # type: ignore[assignment]
+        rows = _take(rows, order)
     time_ns, q, w, omega, _ = rows
     dup = np.concatenate([[False], np.diff(time_ns.astype(np.int64)) == 0])
     if dup.any():
@@ -233,7 +240,7 @@ def _repair_rows(rows: _Rows, repairs: RepairLog, path: Path) -> _Rows:
         )
         repairs.record("duplicate timestamps with identical values removed", int(same.sum()))
         repairs.record("duplicate timestamps with conflicting values (first row kept)", int((~same).sum()))
-        rows = tuple(x[~dup] for x in rows)  # type: ignore[assignment]
+        rows = _take(rows, ~dup)
     return rows
 
 

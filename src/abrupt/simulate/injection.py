@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -190,7 +191,7 @@ class _Transient:
 class _Rows:
     """Rows of the raw samples by mnemonic, selected by time."""
 
-    def __init__(self, t_all: NDArray[np.int64], mnem: NDArray[np.str_]) -> None:
+    def __init__(self, t_all: NDArray[np.int64], mnem: NDArray[Any]) -> None:
         self.t_all = t_all
         self.of = {str(name): np.flatnonzero(mnem == name) for name in np.unique(mnem)}
         self.none = np.empty(0, dtype=np.int64)
@@ -238,8 +239,8 @@ def _wheel_change(
     spacecraft: Spacecraft,
     bn_at: Callable[[np.ndarray], FloatArray],
     tr: _Transient,
-    wheel_pinv: FloatArray,
-    null_offset: FloatArray,
+    wheel_pinv: NDArray[np.floating[Any]],
+    null_offset: NDArray[np.floating[Any]],
 ) -> FloatArray:
     """Gate mean of ΔΩ of one wheel [rad/s] at times ``t_w``: Σ J_s ΔΩ ĝ = [BN(t)] ΔH_N − J Δω(t).
 
