@@ -172,7 +172,7 @@ def _detection_config(
         detectors=chosen,
         windows=WindowConfig(pre=pre, post=post),
         glr_windows=WindowConfig(pre=glr_window, post=glr_window),
-        false_alarms_per_day=budget.per_day,
+        budget=budget,
         threshold_method=method,
         null_samples=null_samples,
     )
@@ -358,7 +358,7 @@ def detect_attitude_cmd(
     """Detect strikes in attitude TELEMETRY (CSV or Parquet), or in a --store; write events and the catalog."""
     if store_dir is not None:  # flight-telemetry pipeline (abrupt.pipelines.flight)
         budget = pop_budget(settings, "1/day")
-        detect_from_store(store_dir, spacecraft_path, days, budget.per_day, no_clean, catalog_target, out, report_path)
+        detect_from_store(store_dir, spacecraft_path, days, budget, no_clean, catalog_target, out, report_path)
         return
     if telemetry is None:
         raise click.UsageError("give TELEMETRY or --store DIR")
@@ -419,7 +419,7 @@ def report_attitude_cmd(
     """Draw the attitude report: momentum, contributions, raw channels, statistics, thresholds, events."""
     if store_dir is not None:  # flight pipeline: cleaning stages before/after and daily statistics
         budget = pop_budget(settings, "1/day")
-        detect_from_store(store_dir, spacecraft_path, days, budget.per_day, no_clean, None, None, out)
+        detect_from_store(store_dir, spacecraft_path, days, budget, no_clean, None, None, out)
         return
     if telemetry is None:
         raise click.UsageError("give TELEMETRY or --store DIR")

@@ -88,7 +88,7 @@ def detect_fleet_cmd(
     members = read_manifest(manifest)
     executor = executor_from(workers, scheduler)
     config = AttitudeDetectionConfig(
-        detectors=tuple(dict.fromkeys(detectors)), false_alarms_per_day=budget.per_day, null_samples=null_samples
+        detectors=tuple(dict.fromkeys(detectors)), budget=budget, null_samples=null_samples
     )
     note(f"{len(members)} task(s) (spacecraft, file) on {executor.describe()}")
     result = detect_attitude_fleet(

@@ -22,6 +22,7 @@ from abrupt.pipelines.flight_injection import injection_recovery
 from abrupt.report.flight import write_flight_report
 from abrupt.simulate.injection import InjectedStrike, inject_strikes
 from abrupt.store import TelemetryStore
+from abrupt.thresholds import FalseAlarmBudget
 
 
 def _progress(total: int, label: str) -> Any:
@@ -77,7 +78,7 @@ def detect_from_store(
     store_dir: str,
     spacecraft_path: str,
     days: tuple[str, ...],
-    false_alarms_per_day: float,
+    budget: FalseAlarmBudget,
     no_clean: tuple[str, ...],
     catalog_target: str | None,
     out: str | None,
@@ -86,7 +87,7 @@ def detect_from_store(
 ) -> None:
     """``abrupt detect attitude --store``: run the flight pipeline on stored days; write events and reports."""
     sc = load_spacecraft(spacecraft_path)
-    cfg = FlightRunConfig(false_alarms_per_day=false_alarms_per_day, cleaning=_cleaning(no_clean))
+    cfg = FlightRunConfig(budget=budget, cleaning=_cleaning(no_clean))
     day_list = day_range(TelemetryStore(store_dir), sc.name, days or None)
     bar = _progress(len(day_list), "detect")
     seen: set[str] = set()
@@ -189,7 +190,7 @@ def inject_attitude_cmd(
             dst.write_day(sc.name, day, frame, report)
         click.echo(f"{len(parsed)} strike(s) injected; store written to {out_store}")
     if recovery:
-        cfg = FlightRunConfig(false_alarms_per_day=pop_budget(budget).per_day)
+        cfg = FlightRunConfig(budget=pop_budget(budget))
         base = run_flight(store_dir, sc, cfg, days=days or None)
         rec = injection_recovery(store_dir, sc, cfg, base.threshold, days=days or None, seed=seed)
         click.echo(rec.per_day.to_string(index=False))

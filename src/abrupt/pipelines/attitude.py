@@ -15,7 +15,7 @@ false-alarm budget and returns an :class:`AttitudeRun`: the events of the run, s
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -135,13 +135,13 @@ def detect_attitude(
 ) -> AttitudeRun:
     """Detect strikes in ``telemetry`` with every detector of ``config``; one event per detection.
 
-    ``budget`` (default ``config.false_alarms_per_day`` per day) sets every threshold;
+    ``budget`` (default ``config.budget``) sets every threshold;
     ``thresholds`` (by detector name, e.g. from a previous calibration) skips their fit.
     """
     config = config or AttitudeDetectionConfig()
     if budget is not None:
-        config = replace(config, false_alarms_per_day=budget.per_day)
-    budget = budget or config.budget
+        config = replace(config, budget=budget)
+    budget = config.budget
     run_id = run_id or new_run_id()
     if calibration is not None:
         ratio = calibration.sample_interval_s / telemetry.sample_interval_s
@@ -153,7 +153,7 @@ def detect_attitude(
             )
     cfg_hash = config_hash(
         {
-            "attitude": asdict(config),
+            "attitude": config.hash_fields(),
             "spacecraft": spacecraft_fingerprint(spacecraft),
             "calibration": None
             if calibration is None

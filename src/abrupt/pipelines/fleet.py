@@ -15,7 +15,7 @@ from __future__ import annotations
 import csv
 import hashlib
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -143,7 +143,7 @@ def fleet_run_key(members: Sequence[FleetMember], config: Any) -> str:
         f"{m.spacecraft}:{Path(m.telemetry).name}:{_file_digest(m.telemetry)}:{_file_digest(m.spacecraft_file)}"
         for m in members
     )
-    return run_key("detect attitude fleet", config_hash(asdict(config)), *parts)
+    return run_key("detect attitude fleet", config_hash(config.hash_fields()), *parts)
 
 
 def detect_attitude_fleet(
@@ -169,7 +169,7 @@ def detect_attitude_fleet(
     tasks = [AttitudeTask(m, config, run_id) for m in members]
     todo = [t for t in tasks if t.key not in done]
     if cat is not None:
-        cat.start_run(run_id, command, config_hash=config_hash(asdict(config)), details={"tasks": len(tasks)})
+        cat.start_run(run_id, command, config_hash=config_hash(config.hash_fields()), details={"tasks": len(tasks)})
     outputs: dict[str, TaskOutput] = {}
 
     def store(res: TaskResult[AttitudeTask, TaskOutput]) -> None:

@@ -39,9 +39,10 @@ from abrupt.clean.flight_masks import SlewMaskConfig, event_mask, flag_intervals
 from abrupt.detect.attitude.flight_glr import MIN_BLOCKS, FlightGlrDetector, Peak
 from abrupt.errors import ConfigError, InputError
 from abrupt.events import config_hash, new_run_id
-from abrupt.model.flight_config import WHEEL_UNITS, FlightConfig
-from abrupt.model.flight_momentum import timetable_momentum, wheel_scale_from_conservation
+from abrupt.model.flight_config import FlightConfig
+from abrupt.model.flight_momentum import timetable_momentum
 from abrupt.model.spacecraft import Spacecraft
+from abrupt.pipelines.flight_checks import check_tachometer_units, check_wheel_units, flight_channels
 from abrupt.readers.archive import pseudonymise_text, read_archive, read_decoder
 from abrupt.scale import Executor, TaskResult, run_tasks
 from abrupt.series.timetable import NS, Timetable, build_timetable
@@ -158,16 +159,20 @@ class FlightRunConfig:
 
     window_s: float = 300.0
     guard_s: float = 20.0
-    false_alarms_per_day: float = 1.0
+    budget: FalseAlarmBudget = field(default_factory=lambda: FalseAlarmBudget(1.0, "day"))
     block_s: float = 600.0
     chunk_s: float = 3 * 86_400.0
     cleaning: CleaningConfig = field(default_factory=CleaningConfig)
     peak_floor: float = 3.0
     orbit_period_s: float | None = None
 
-    @property
-    def budget(self) -> FalseAlarmBudget:
-        return FalseAlarmBudget.per_day_rate(self.false_alarms_per_day)
+    def hash_fields(self) -> dict[str, Any]:
+        """The settings as they enter the run's ``config_hash``: the budget as its rate per day, so that one
+        budget written per day or per week hashes the same."""
+        fields = asdict(self)
+        fields.pop("budget")
+        fields["false_alarms_per_day"] = self.budget.per_day
+        return fields
 
     def detector(self, threshold: Threshold | None = None) -> FlightGlrDetector:
         """The ``attitude.flight_glr`` detector with this run's windows, blocks and peak floor."""
@@ -230,14 +235,8 @@ def chunk_margin_s(spacecraft: Spacecraft, config: FlightRunConfig) -> float:
     fit = (c.spacing_orbits + c.half_width_orbits) * period if (c.comb or c.trend) else 0.0
     span = 2 * config.window_s + config.guard_s
     per_pass = fit + 2 * span
-    sg = max((ch.savgol_window_s for ch in _flight(spacecraft).channels), default=0.0)
+    sg = max((ch.savgol_window_s for ch in flight_channels(spacecraft).channels), default=0.0)
     return c.passes * per_pass + c.slew.nominal_window_s / 2 + c.slew.window_s + sg + 60.0
-
-
-def _flight(spacecraft: Spacecraft) -> FlightConfig:
-    if spacecraft.flight is None:
-        raise ConfigError("no [flight] table: declare the telemetry channels", file=spacecraft.source, key="flight")
-    return spacecraft.flight
 
 
 # ------------------------------------------------------------------------------------------------
@@ -262,60 +261,6 @@ class ChunkResult:
     missing_channels: tuple[str, ...]
     harmonics_mean: float
     series: dict[str, np.ndarray] | None = None
-
-
-def check_wheel_units(spacecraft: Spacecraft, table: Timetable) -> None:
-    """Raise if conservation of ᴺH says the wheel speeds are in another unit than declared.
-
-    The wheel scale that makes ᴺH most nearly constant (:func:`wheel_scale_from_conservation`) is 1 for
-    the right unit; rpm declared as rad/s gives ≈ 0.105 (2π/60), rad/s declared as rpm ≈ 9.5. Only
-    decided when the fit explains most of the wheel term's variance (the wheels moved).
-    """
-    scale, explained = wheel_scale_from_conservation(spacecraft, table)
-    if not (math.isfinite(scale) and explained > 0.5) or 1 / 3 < scale < 3:
-        return
-    flight = _flight(spacecraft)
-    k = next(i for i, c in enumerate(flight.channels) if c.quantity == "wheel_speed")
-    unit = flight.channels[k].unit
-    raise ConfigError(
-        f"wheel speeds declared in {unit!r} but conservation of angular momentum fits them {scale:.3g} times "
-        f"larger/smaller (rpm read as rad/s gives 0.105, rad/s read as rpm 9.55); check the unit",
-        file=spacecraft.source,
-        key=f"flight.channels[{k}].unit",
-    )
-
-
-def check_tachometer_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> None:
-    """Raise if a tachometer channel's values step in the quantum of another unit than declared.
-
-    A tachometer counting P pulses per revolution over a gate T reports speeds in multiples of
-    2π/(P T) rad/s = 60/(P T) rpm; the unit whose quantum makes the speed differences integers is the
-    unit the values are in.
-    """
-    flight = _flight(spacecraft)
-    for k, ch in enumerate(flight.channels):
-        if ch.quantity != "wheel_speed" or ch.tachometer is None or ch.unit == "counts":
-            continue
-        v = samples.loc[samples["mnemonic"] == ch.mnemonic, "value"].to_numpy(np.float64)
-        d = np.abs(np.diff(v))
-        d = d[d > 0][:5000]
-        if d.size < 20:
-            continue
-
-        def on_grid(unit: str, d: np.ndarray = d, quantum: float = ch.tachometer.quantum_rad_s) -> float:
-            q = quantum / WHEEL_UNITS[unit]
-            r = d / q
-            return float(np.mean(np.abs(r - np.round(r)) < 0.02))
-
-        declared = on_grid(ch.unit)
-        best = max((u for u in WHEEL_UNITS if u != "counts"), key=on_grid)
-        if declared < 0.5 and on_grid(best) > 0.9 and best != ch.unit:
-            raise ConfigError(
-                f"wheel speeds declared in {ch.unit!r} step in multiples of the tachometer quantum in {best!r} "
-                f"({ch.tachometer.quantum_rad_s / WHEEL_UNITS[best]:.5g} {best}): the values are in {best!r}",
-                file=spacecraft.source,
-                key=f"flight.channels[{k}].unit",
-            )
 
 
 def process_chunk(
@@ -348,7 +293,7 @@ def process_chunk(
 
 def _channels_for(spacecraft: Spacecraft, cleaning: CleaningConfig) -> FlightConfig:
     """The spacecraft's channels, with Savitzky-Golay replaced by linear interpolation when it is off."""
-    flight = _flight(spacecraft)
+    flight = flight_channels(spacecraft)
     if cleaning.savgol:
         return flight
     return replace(
@@ -554,10 +499,13 @@ def run_flight(
         # One period for the whole run (from its first day), so that every chunk uses the same one.
         d0 = int(np.datetime64(day_list[0], "D").astype("datetime64[ns]").astype(np.int64))
         samples = store.read_range(
-            spacecraft.name, np.datetime64(d0, "ns"), np.datetime64(d0 + DAY_NS, "ns"), _flight(spacecraft).mnemonics
+            spacecraft.name,
+            np.datetime64(d0, "ns"),
+            np.datetime64(d0 + DAY_NS, "ns"),
+            flight_channels(spacecraft).mnemonics,
         )
         table = build_timetable(
-            samples, _flight(spacecraft), tuple(a.name for a in spacecraft.appendages), d0, d0 + DAY_NS
+            samples, flight_channels(spacecraft), tuple(a.name for a in spacecraft.appendages), d0, d0 + DAY_NS
         )
         period, how = estimate_orbit_period_s(spacecraft, table)
         if not (math.isfinite(period) and period > 0):
@@ -596,9 +544,11 @@ def run_flight(
             )
         if maxima.size < 144:
             warnings.append(f"threshold calibrated on {maxima.size} blocks (< one day): uncertain")
-    threshold = detector.fit_threshold(maxima, config.budget, _flight(spacecraft).grid_hz)
+    threshold = detector.fit_threshold(maxima, config.budget, flight_channels(spacecraft).grid_hz)
     run_id = run_id or new_run_id()
-    cfg_hash = config_hash({"flight": asdict(config), "spacecraft": spacecraft.name, "threshold": threshold.as_dict()})
+    cfg_hash = config_hash(
+        {"flight": config.hash_fields(), "spacecraft": spacecraft.name, "threshold": threshold.as_dict()}
+    )
     peaks = [p for r in chunks for p in r.peaks]
     events = detector.events(peaks, threshold, spacecraft.name, run_id, cfg_hash)
     daily = daily_table(chunks, events, threshold)

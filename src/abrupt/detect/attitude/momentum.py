@@ -23,7 +23,7 @@ the pre/post mean difference (Bennett 2022 §2.4.2.7).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
@@ -62,7 +62,7 @@ class AttitudeDetectionConfig:
     detectors: tuple[str, ...] = ("glr",)
     windows: WindowConfig = field(default_factory=WindowConfig)
     glr_windows: WindowConfig = field(default_factory=lambda: WindowConfig(pre=1000, post=1000))
-    false_alarms_per_day: float = 1.0
+    budget: FalseAlarmBudget = field(default_factory=lambda: FalseAlarmBudget(1.0, "day"))
     threshold_method: str = "gev"
     null_samples: int = 10_000_000
     seed: int = 0
@@ -72,12 +72,14 @@ class AttitudeDetectionConfig:
             raise ValueError(f"give at least one detector; registered: {attitude_detector_names()}")
         for name in self.detectors:
             attitude_detector_class(name)  # raises with the list of registered detectors
-        if self.false_alarms_per_day <= 0:
-            raise ValueError("false_alarms_per_day must be positive")
 
-    @property
-    def budget(self) -> FalseAlarmBudget:
-        return FalseAlarmBudget.per_day_rate(self.false_alarms_per_day)
+    def hash_fields(self) -> dict[str, Any]:
+        """The settings as they enter a run's ``config_hash``: the budget as its rate per day, so that one
+        budget written per day or per week hashes the same."""
+        fields = asdict(self)
+        fields.pop("budget")
+        fields["false_alarms_per_day"] = self.budget.per_day
+        return fields
 
 
 def attitude_detector_names() -> tuple[str, ...]:
