@@ -51,10 +51,11 @@ class SeriesExample:
 @cache
 def attitude_example() -> Any:
     """Ten minutes of 10 Hz telemetry of the thesis spacecraft with one 0.3 N·m·s strike at 300 s."""
+    from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike
     from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
     from abrupt.readers.telemetry import telemetry_from_frame
     from abrupt.series.attitude import AttitudeSeries
-    from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude
+    from abrupt.simulate.attitude import simulate_attitude
 
     sc = load_spacecraft(bundled_spacecraft_path("thesis"))
     sim = simulate_attitude(sc, AttitudeSimConfig(duration_s=600.0, seed=11), [Strike(300.0, (0.2, -0.15, 0.17))])
@@ -87,6 +88,28 @@ def _attitude_settings() -> dict[str, dict[str, Any]]:
     # Shiryaev costs 21 likelihoods per sample and window: a short simulated null and its maximum.
     fast["attitude.shiryaev"] = {"null_samples": 10_000, "threshold_method": "empirical"}
     return fast
+
+
+@cache
+def cleaned_momentum_example() -> Any:
+    """Six hours of cleaned ᴺH at 1 Hz (white noise, 1e-3 N·m·s) with a 0.05 N·m·s step at 3 h, a 20 min gap."""
+    from abrupt.series.attitude import CleanedMomentum
+
+    n = 6 * 3600
+    rng = np.random.default_rng(5)
+    h = 1e-3 * rng.standard_normal((n, 3))
+    h[3 * 3600 :] += np.array([0.03, -0.03, 0.028])
+    ok = np.ones(n, bool)
+    ok[5000:6200] = False
+    h[~ok] = np.nan
+    t0 = int(np.datetime64("2026-01-01T00:00:00", "ns").astype(np.int64))
+    return CleanedMomentum(t0 + np.arange(n, dtype=np.int64) * 1_000_000_000, h, ok, 1.0, name="example-sat")
+
+
+def empty_cleaned_momentum() -> Any:
+    from abrupt.series.attitude import CleanedMomentum
+
+    return CleanedMomentum(np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros(0, bool), 1.0, name="example-sat")
 
 
 # ---------------------------------------------------------------------------------------------- tracking
@@ -210,7 +233,7 @@ def tle_example() -> Any:
 def _examples() -> dict[type, SeriesExample]:
     from abrupt.massprops.track import InertiaTrack
     from abrupt.readers.tle import ElementHistory
-    from abrupt.series.attitude import AttitudeSeries
+    from abrupt.series.attitude import AttitudeSeries, CleanedMomentum
     from abrupt.series.ephemeris import Ephemeris
     from abrupt.series.tracking import LaserRangingSeries, TrackingSeries
 
@@ -252,6 +275,12 @@ def _examples() -> dict[type, SeriesExample]:
             empty=empty_attitude,
             shift=lambda s, seconds: s.shifted(seconds),
             settings=_attitude_settings(),
+        ),
+        CleanedMomentum: SeriesExample(
+            make=cleaned_momentum_example,
+            empty=empty_cleaned_momentum,
+            shift=lambda s, seconds: s.shifted(seconds),
+            notes="blocks of the threshold fit start at the first sample, so a shift moves them too",
         ),
     }
 

@@ -4,6 +4,7 @@ A new capability adds its detector module here (one line); a detector defined an
 plug-in, a test) registers as soon as its class is defined.
 """
 
+import abrupt.detect.attitude.flight_glr
 import abrupt.detect.attitude.matched_filter.detectors
 import abrupt.detect.attitude.momentum
 import abrupt.detect.mass.inertia_change
