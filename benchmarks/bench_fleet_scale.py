@@ -20,10 +20,11 @@ from pathlib import Path
 import pandas as pd
 
 from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 from abrupt.pipelines.fleet import detect_attitude_fleet, read_manifest
 from abrupt.scale import Executor, dask_client
-from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude, write_telemetry
+from abrupt.simulate.attitude import simulate_attitude, write_telemetry
 
 
 def make_fleet(folder: Path, n_days: int) -> Path:

@@ -21,6 +21,7 @@ import pandas as pd
 
 from abrupt.model.spacecraft import load_spacecraft
 from abrupt.pipelines.flight import CleaningConfig, FlightRunConfig, ingest_archives, run_flight
+from abrupt.pipelines.flight_injection import injection_recovery
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT.parent / "shared" / "data" / "flight-like"
@@ -102,8 +103,6 @@ def part_detect(store: Path) -> None:
 
 
 def part_inject(store: Path) -> None:
-    from abrupt.pipelines.flight import injection_recovery
-
     sc = load_spacecraft(KESTREL)
     cfg = FlightRunConfig()
     t = time.time()

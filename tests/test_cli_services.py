@@ -105,8 +105,9 @@ def test_nested_option_errors_print_one_clean_line(
 
 @pytest.fixture(scope="module")
 def short_telemetry(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike
     from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
-    from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude
+    from abrupt.simulate.attitude import simulate_attitude
 
     sc = load_spacecraft(bundled_spacecraft_path("thesis"))
     sim = simulate_attitude(sc, AttitudeSimConfig(duration_s=1200.0, seed=4), [Strike(600.0, (0.3, 0.0, 0.0))])

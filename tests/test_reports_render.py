@@ -14,12 +14,13 @@ import pandas as pd
 import pytest
 
 from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 from abrupt.pipelines.attitude import detect_attitude
 from abrupt.readers.telemetry import read_telemetry
 from abrupt.report.attitude import attitude_figure, write_attitude_report
 from abrupt.report.style import PALETTE, clip_with_markers, detector_colour, robust_baseline
-from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude, write_telemetry
+from abrupt.simulate.attitude import simulate_attitude, write_telemetry
 
 
 @pytest.fixture(scope="module")

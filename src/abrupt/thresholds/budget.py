@@ -81,6 +81,10 @@ class FalseAlarmBudget:
         """Expected number of false alarms in ``duration_s`` seconds of event-free data."""
         return self.per_second * duration_s
 
+    def expected_in_days(self, days: float) -> float:
+        """Expected number of false alarms in ``days`` days of event-free data."""
+        return self.per_day * days
+
     # ------------------------------------------------------------------ test levels
     def per_sample(self, sample_rate_hz: float) -> float:
         """Per-sample exceedance probability at ``sample_rate_hz`` (Bennett 2022 §2.5.1 step 4)."""
