@@ -27,8 +27,8 @@ from __future__ import annotations
 from abrupt.catalog import Catalog
 from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics, detector_names, get_detector
-from abrupt.detect.tracking.glrt import BatchFitConfig
 from abrupt.events import EVENT_COLUMNS, Event, events_frame, read_events, write_events
+from abrupt.model.orbit.batch_fit import BatchFitConfig
 from abrupt.model.spacecraft import Spacecraft, bundled_spacecraft_path, load_spacecraft
 from abrupt.model.stations import ascension
 from abrupt.model.tracking_measurements import TrackingArrays

@@ -165,9 +165,7 @@ class FlightGlrDetector(Detector[CleanedMomentum]):
         """The fixed threshold, or the robust Gumbel fit of ``maxima`` at ``budget``."""
         if self.threshold is not None:
             return self.threshold
-        return robust_block_maxima_threshold(
-            maxima, block_s=self.block_s, false_alarms_per_day=budget.per_day, sample_rate_hz=sample_rate_hz
-        )
+        return robust_block_maxima_threshold(maxima, block_s=self.block_s, budget=budget, sample_rate_hz=sample_rate_hz)
 
     # ------------------------------------------------------------------ events
     def events(
