@@ -76,8 +76,8 @@ MAX_FUNCTION_LINES = 120
 #: Numba kernels that are one time-stepping loop and read best unbroken (file, function).
 LONG_KERNELS = frozenset(
     {
-        ("simulate/_attitude_kernels.py", "simulate_one"),
-        ("simulate/_attitude_kernels.py", "simulate_tracking"),
+        ("model/attitude_kernels.py", "simulate_one"),
+        ("model/attitude_kernels.py", "simulate_tracking"),
     }
 )
 
@@ -332,14 +332,14 @@ def test_no_module_is_longer_than_the_limit() -> None:
 
 
 def test_no_function_is_longer_than_the_limit() -> None:
+    """Counted from ``def`` to the last line: decorators (a command's list of options) are declarations."""
     bad = []
     seen_kernels = set()
     for rel, tree in _modules():
         for node in ast.walk(tree):
             if not isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
                 continue
-            first = min([node.lineno, *(d.lineno for d in node.decorator_list)])
-            n = (node.end_lineno or node.lineno) - first + 1
+            n = (node.end_lineno or node.lineno) - node.lineno + 1
             if (rel, node.name) in LONG_KERNELS:
                 seen_kernels.add((rel, node.name))
                 continue
