@@ -92,3 +92,12 @@ def test_a_run_config_hash_is_the_hash_of_name_settings_and_budget() -> None:
     )
     detector = get_detector("attitude.cusum")(null_samples=200_000)
     assert detector.config_hash_for(budget) == run_config_hash(detector.config(), budget, detector="attitude.cusum")
+
+
+def test_the_config_hash_does_not_change_from_run_to_run() -> None:
+    from abrupt.detect.base import get_detector
+
+    budget = FalseAlarmBudget(1, "week")
+    orbit = get_detector("orbit.glr")
+    assert "run_id" not in orbit(run_id="r1").config()
+    assert orbit(run_id="r1").config_hash_for(budget) == orbit(run_id="r2").config_hash_for(budget)

@@ -123,8 +123,9 @@ class Detector(ABC, Generic[SeriesT]):
         return self.name.split(".", 1)[0]
 
     def config(self) -> dict[str, Any]:
-        """The detector's settings (by default its public instance attributes)."""
-        return {k: v for k, v in vars(self).items() if not k.startswith("_")}
+        """The detector's settings: by default its public instance attributes, except ``run_id`` (the run
+        a detector works for is not a setting, and the configuration hash must not change between runs)."""
+        return {k: v for k, v in vars(self).items() if not k.startswith("_") and k != "run_id"}
 
     def config_hash_for(self, budget: FalseAlarmBudget) -> str:
         """The ``config_hash`` of this detector's settings at ``budget`` (name, settings and budget)."""
