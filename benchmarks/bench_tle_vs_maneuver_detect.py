@@ -101,16 +101,17 @@ print(json.dumps({"version": maneuver_detect.__version__, "rows": rows}))
 
 # ---------------------------------------------------------------------------------------------- abrupt
 def detect_one(
-    args: tuple[str, tuple[float, int], float],
+    args: tuple[str, tuple[float, int], float, str],
 ) -> tuple[str, tuple[float, int], pd.DataFrame, dict[str, Any], float]:
     """Run the regime's detector on one satellite with one setting (all candidates kept)."""
-    sat, (gain, sides), along = args
+    sat, (gain, sides), along, follow = args
     history = read_tle(DATA / "tle" / f"{sat}.tle")
     cls = TleGeoStationKeeping if SATELLITES[sat][1] == "GEO" else TleMeanElements
     det = cls(
         group_gain=(1.0, gain, gain),
         campaign_min_side_sets=sides,
         along_track_gain=along,
+        threshold_follow=follow,
         all_candidates=True,
         spacecraft=sat,
     )
@@ -493,6 +494,12 @@ def main() -> None:
     parser.add_argument("--no-cache", action="store_true", help="re-run maneuver-detect")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument(
+        "--threshold-follow",
+        default="raise",
+        choices=("none", "raise", "follow"),
+        help="per-block threshold of the history (TleDetectorConfig.threshold_follow)",
+    )
+    parser.add_argument(
         "--along-track-gain",
         type=float,
         default=1.0,
@@ -509,7 +516,7 @@ def main() -> None:
         for g in GRID[SATELLITES[s][1]]
     ]
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
-        results = list(pool.map(detect_one, [(s, g, args.along_track_gain) for s, g in jobs]))
+        results = list(pool.map(detect_one, [(s, g, args.along_track_gain, args.threshold_follow) for s, g in jobs]))
     runs = {(s, g): (ev, nm, sec) for s, g, ev, nm, sec in results}
     scores = {(s, g): evaluate(runs[(s, g)][0], truth[s], *spans[s], signed=True) for s, g in jobs}
 

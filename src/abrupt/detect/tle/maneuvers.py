@@ -74,12 +74,13 @@ from abrupt.detect.base import DetectionResult, Diagnostics
 from abrupt.detect.tle.burns import campaign_cadence_s, characterise, label_campaigns
 from abrupt.detect.tle.config import CAMPAIGN_SIDE_SETS, EXTRA_COLUMNS, TleDetectorConfig
 from abrupt.detect.tle.elements import circular_speed_mps, orbit_regime
-from abrupt.detect.tle.noise import null_threshold, robust_group_weight
+from abrupt.detect.tle.noise import block_thresholds, null_threshold, robust_group_weight
 from abrupt.detect.tle.segmentation import segment
 from abrupt.detect.tle.steps import (
     StepModel,
     StepSeries,
     component_weights,
+    detectable_by_year,
     empty_steps,
     fill_gap,
     noise_summary,
@@ -162,6 +163,7 @@ def detect_mean_elements(
     p_fa = min(0.5, cfg.budget.per_year / gaps_per_year)  # per gap: the yearly budget over the gaps a year
     model, first = first_pass(history, cfg, regime)
     threshold, method = operating_threshold(cfg, first, p_fa)
+    first.scale = block_scale(cfg, first, model.t, threshold)
     steps, accepted, _ = segment(history, cfg, threshold, model=model, first=first)
     stat = steps.statistic
     candidates = np.sort(np.asarray(accepted, dtype=np.int64))
@@ -191,6 +193,7 @@ def detect_mean_elements(
     frame = events_frame(events, extra_columns=EXTRA_COLUMNS) if events else empty_frame(EXTRA_COLUMNS)
     a_med = float(np.median(el["a_m"]))
     noise = noise_summary(steps, model, threshold, a_med, gaps_per_year)
+    noise["detectable_by_year"] = detectable_by_year(steps, model, threshold, a_med, epoch0)
     fitted = Threshold(threshold, p_fa, method, n_gaps, fa_per_day)
     diag = _diagnostics(
         detector_name, 0.5 * (steps.t_before_s + steps.t_after_s), stat, fitted, epoch0_np, noise, regime
@@ -246,6 +249,29 @@ def operating_threshold(cfg: TleDetectorConfig, first: StepSeries, p_fa: float) 
         null_threshold(first.statistic, cfg.window_sets + 2, p_fa, cfg.threshold_method),
     )
     return threshold, cfg.threshold_method
+
+
+def block_scale(
+    cfg: TleDetectorConfig, first: StepSeries, t_s: NDArray[np.float64], threshold: float
+) -> NDArray[np.float64] | None:
+    """Per-gap factor ``threshold / block threshold`` (:func:`block_thresholds`) that lets one cut on
+    the statistic hold the threshold of each block of the history; None with a fixed threshold or
+    ``threshold_follow="none"``. ``"raise"`` never lowers a block below the whole-history threshold."""
+    if cfg.threshold is not None or cfg.threshold_follow == "none":
+        return None
+    local, _ = block_thresholds(
+        first.statistic,
+        t_s,
+        cfg.window_sets + 2,
+        cfg.budget.per_year,
+        cfg.threshold_method,
+        cfg.threshold_block_days,
+        cfg.threshold_reach_days,
+    )
+    local = np.maximum(local, cfg.min_statistic)
+    if cfg.threshold_follow == "raise":
+        local = np.maximum(local, threshold)
+    return np.asarray(threshold / local, dtype=float)
 
 
 def time_candidates(run: StepRun, candidates: NDArray[np.int64], all_candidates: bool) -> list[Candidate]:
