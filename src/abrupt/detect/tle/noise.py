@@ -4,6 +4,7 @@ per-group weights and the tail fit on the event-free gaps."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -174,7 +175,7 @@ def block_edges(t_s: NDArray[np.float64], block_days: float) -> NDArray[np.int64
         return np.asarray([0, n_gaps], dtype=np.int64)
     mid = 0.5 * (t_s[:-1] + t_s[1:])
     span = float(mid[-1] - mid[0])
-    n_blocks = max(1, int(round(span / (block_days * 86400.0))))
+    n_blocks = max(1, round(span / (block_days * 86400.0)))
     cuts = np.searchsorted(mid, mid[0] + span * np.arange(1, n_blocks) / n_blocks)
     return np.unique(np.concatenate(([0], cuts, [n_gaps]))).astype(np.int64)
 
@@ -202,7 +203,7 @@ def block_thresholds(
     mid = 0.5 * (t_s[:-1] + t_s[1:])
     # event footprints from the whole history (a block's own peaks would be too few to find)
     free = event_free_mask(stat, guard)
-    for lo, hi in zip(edges[:-1], edges[1:], strict=True):
+    for lo, hi in itertools.pairwise(edges):
         t_lo, t_hi = mid[lo] - reach_days * 86400.0, mid[hi - 1] + reach_days * 86400.0
         sel = (mid >= t_lo) & (mid <= t_hi)
         years = max(float(mid[sel][-1] - mid[sel][0]) / (DAYS_PER_YEAR * 86400.0), 1.0 / DAYS_PER_YEAR)

@@ -387,9 +387,8 @@ def detectable_by_year(
     for year in np.unique(years):
         sel = years == year
         t_year = float(np.median(local_t[sel]))
-        dv_t, dv_n = min_detectable_dv(
-            steps, t_year, float(np.nanmedian(steps.sigma_a_m[sel])), float(np.nanmedian(steps.sigma_n_rad[sel])), a_ref_m
-        )
+        sig_a, sig_n = float(np.nanmedian(steps.sigma_a_m[sel])), float(np.nanmedian(steps.sigma_n_rad[sel]))
+        dv_t, dv_n = min_detectable_dv(steps, t_year, sig_a, sig_n, a_ref_m)
         out.append(
             {
                 "year": int(year),
