@@ -257,7 +257,7 @@ def block_scale(
     """Per-gap factor ``threshold / block threshold`` (:func:`block_thresholds`) that lets one cut on
     the statistic hold the threshold of each block of the history; None with a fixed threshold or
     ``threshold_follow="none"``. ``"raise"`` never lowers a block below the whole-history threshold."""
-    if cfg.threshold is not None or cfg.threshold_follow == "none":
+    if cfg.threshold is not None or cfg.threshold_follow == "none" or not math.isfinite(threshold):
         return None
     local, _ = block_thresholds(
         first.statistic,
