@@ -112,7 +112,7 @@ def run_one(job: dict[str, Any]) -> dict[str, Any]:
     for follow in ("raise", "none"):
         run = detector_for(history, threshold_follow=follow).detect(history, BUDGET)
         ev = run.events
-        found = ev.loc[ev["statistic"] >= ev["threshold"]] if len(ev) else ev
+        found = ev.loc[(ev["statistic"] >= ev["threshold"]) & (ev["kind"] != "maneuver_campaign")] if len(ev) else ev
         if truth is not None:
             res = score_events(found, truth, tolerance_s=TOLERANCE_S, start=t0, end=t1)
             unmatched = res.false_positives

@@ -141,11 +141,15 @@ def detect_tle(
             click.echo(f"repaired: {line}", err=True)
         nm = sat.noise_model
         found = sat.events.loc[sat.events["statistic"] >= sat.events["threshold"]] if len(sat.events) else sat.events
+        camps = found.loc[found["kind"] == "maneuver_campaign"] if len(found) else found
+        found = found.loc[found["kind"] != "maneuver_campaign"] if len(found) else found
         n_det = len(found)
         multi = int((found["burns_max"] > 1).sum()) if "burns_max" in found else 0
+        n_burns = int(camps["burn_count"].sum()) if len(camps) else 0
         click.echo(
             f"{satellite_label(h)}: {len(h)} element sets, {sat.detector}, {n_det} maneuver(s)"
             + (f" ({multi} with an interval long enough for several burns at its campaign cadence)" if multi else "")
+            + (f", {len(camps)} campaign(s) of {n_burns} burns in all" if len(camps) else "")
             + "; "
             f"smallest detectable ΔV in-track {nm.get('min_detectable_dv_t_mps', float('nan')) * 100:.2g} cm/s, "
             f"cross-track {nm.get('min_detectable_dv_n_mps', float('nan')) * 100:.2g} cm/s",

@@ -100,7 +100,8 @@ def own_null_rate(
         exposure += span_s / SECONDS_PER_DAY / DAYS_PER_YEAR * float(counted.mean())
         ev = run.events
         if len(ev):
-            found = ev.loc[ev["statistic"] >= ev["threshold"]]
+            # every maneuver is a false alarm here; campaign rows summarise them
+            found = ev.loc[(ev["statistic"] >= ev["threshold"]) & (ev["kind"] != "maneuver_campaign")]
             epochs = el["epoch_utc"].to_numpy(dtype="datetime64[ns]")
             before = pd.to_datetime(found["elset_epoch_before_utc"]).to_numpy(dtype="datetime64[ns]")
             gap = np.clip(np.searchsorted(epochs, before), 0, n_gaps - 1)

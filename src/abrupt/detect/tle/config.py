@@ -27,6 +27,7 @@ EXTRA_COLUMNS: tuple[str, ...] = (
     "burns_max",
     "z_u",
     "delta_u_m",
+    "burn_count",
 )
 
 # Sets a side needs between two accepted maneuvers. LEO campaigns (orbit raising, frozen-orbit
@@ -57,6 +58,7 @@ class TleDetectorConfig:
     min_side_sets: int = 3
     regime: str = "auto"
     campaign_days: float = 3.0
+    campaign_chain_days: float = 7.0  # maneuver_campaign events: detections chained this close
     campaign_min_side_sets: int | None = None  # None: by regime (CAMPAIGN_SIDE_SETS)
     time_search_sets_before: int = 3
     group_gain: tuple[float, float, float] = (1.0, 0.2, 0.2)
