@@ -15,8 +15,9 @@ steps (whose sides of two or three sets hold the neighbouring burns' levels):
   in-track burn at argument of latitude ``u`` moves the eccentricity vector by
   ``(2Δv_t/v)(cos u, sin u)``, so ``r = a|Δe| / |Δa| = 1`` (Gauss's equations, near-circular orbit),
   while burns at different ``u`` in one gap give ``r < 1`` (``r < 0.7``: at least two burns); and a
-  gap whose step is ``k ≥ 1.75`` times the campaign's median carrying step counts ``round(k)`` burns
-  (the burns of one campaign are of similar size: an assumption, stated). The count is never below
+  gap whose step is ``k ≥ 1.75`` times the largest step another gap of the campaign shows for one
+  burn (``r ≥ 0.7``) counts ``round(k)`` burns (the burns of one campaign are of similar size: an
+  assumption, stated). The count is never below
   the number of member maneuvers. Burns in one gap at nearly the same ``u`` and of different sizes
   are not separable (``docs/tle.md``).
 """
@@ -36,6 +37,7 @@ from abrupt.detect.tle.steps import StepModel, theil_sen_slope
 # (smaller steps over the noise level are TLE noise, the tail of a set fitted across a burn, or drag)
 CARRYING_FRACTION = 0.1
 MAX_BURNS_PER_GAP = 4
+SINGLE_BURN_R = 0.7  # a|Δe|/|Δa| of a gap at least this: one in-track burn
 # a detection joins a campaign when its ΔV is at least this fraction of the largest member's
 MEMBER_DV_FRACTION = 0.02
 
@@ -112,12 +114,13 @@ def burns_in_gaps(model: StepModel, first_gap: int, last_gap: int, slope: float,
         return 0
     biggest = max(r[0] for r in rows)
     carrying = [r for r in rows if r[0] >= CARRYING_FRACTION * biggest]
-    typical = float(np.median([r[0] for r in carrying]))
     n = 0
-    for da, r in carrying:
-        size = da / typical
+    for k, (da, r) in enumerate(carrying):
+        # the largest step another gap shows for one burn (its e-vector says one burn)
+        single = [d for j, (d, rr) in enumerate(carrying) if j != k and rr >= SINGLE_BURN_R]
+        size = da / max(single) if single else 1.0
         by_size = min(MAX_BURNS_PER_GAP, round(size)) if size >= 1.75 else 1
-        n += max(1 if r >= 0.7 else 2, by_size)
+        n += max(1 if r >= SINGLE_BURN_R else 2, by_size)
     return n
 
 
