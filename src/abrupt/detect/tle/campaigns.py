@@ -134,16 +134,18 @@ def find_campaigns(
     window: int,
 ) -> list[Campaign]:
     """Campaigns among detections at ``gaps`` with burn times ``times_s`` and ΔV magnitudes ``dv_mps``
-    (all sorted by time). A chain's detections below :data:`MEMBER_DV_FRACTION` of its largest ΔV are
-    left out (steps of TLE noise beside the campaign stay maneuvers of their own) and the rest
-    re-chained. The members' gaps are widened by one each side (a step in a campaign is localised
-    within a gap of its burn), not over the neighbouring detections."""
+    (all sorted by time). A chain's detections below :data:`MEMBER_DV_FRACTION` of its largest ΔV do
+    not extend it (steps of TLE noise beside a campaign stay maneuvers of their own): the rest are
+    re-chained, and the small ones between a chain's first and last gap join it. The members' gaps
+    are widened by one each side (a step in a campaign is localised within a gap of its burn), not
+    over the neighbouring detections."""
     out: list[Campaign] = []
     dv = np.nan_to_num(np.asarray(dv_mps, dtype=float))
     for first_chain in chain(np.asarray(times_s, dtype=float), gaps, chain_days, window):
         big = [k for k in first_chain if dv[k] >= MEMBER_DV_FRACTION * dv[first_chain].max()]
         for sub in chain(np.asarray(times_s, dtype=float)[big], gaps[big], chain_days, window):
-            members = [big[k] for k in sub]
+            lo, hi = gaps[[big[k] for k in sub]].min(), gaps[[big[k] for k in sub]].max()
+            members = [k for k in first_chain if lo <= gaps[k] <= hi]  # small steps between are members
             out.append(_campaign(model, gaps, members, threshold, window))
     return out
 
