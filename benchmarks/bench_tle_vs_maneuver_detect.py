@@ -449,6 +449,31 @@ def pooled(rows: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
+def print_leave_one_regime_out(
+    sats: list[str], scores: dict[tuple[str, tuple[float, int]], dict[str, Any]], spans: dict[str, Any]
+) -> None:
+    """Leave one regime out: the gain chosen on the GEO satellites plus one other LEO satellite (pooled
+    F1; campaign sides at the class defaults, LEO 2 and GEO 3), the held-out LEO satellite scored
+    with it; its unmatched detections per satellite-year beside the budget."""
+    leo = [x for x in sats if SATELLITES[x][1] == "LEO"]
+    geo = [x for x in sats if SATELLITES[x][1] == "GEO"]
+    side = {"LEO": 2, "GEO": 3}
+    print("\nLeave one regime out (train: GEO + one LEO; test: another LEO; budget 1/year)")
+    for test in leo:
+        for partner in (x for x in leo if x != test):
+            train = [*geo, partner]
+            gain = max(
+                GAINS,
+                key=lambda g: (pooled([scores[(o, (g, side[SATELLITES[o][1]]))] for o in train])["f1"], -abs(g - 0.5)),
+            )
+            r = scores[(test, (gain, side["LEO"]))]
+            print(
+                f"  {test} (trained on {'+'.join(train)}): gain {gain:g}, F1 {r['f1']:.2f}, "
+                f"unmatched {r['fp']} = {r['fa_per_year']:.2f} per satellite-year, "
+                f"{r['fa_per_year'] / BUDGET.per_year:.2f}x the budget"
+            )
+
+
 # ---------------------------------------------------------------------------------------------- baseline
 def ensure_venv(venv: Path) -> Path:
     """Create the baseline's virtual environment if needed; return its python."""
@@ -691,6 +716,7 @@ def main() -> None:
                 end="",
             )
         print()
+    print_leave_one_regime_out(sats, scores, spans)
     print(f"\nmaneuver-detect: {base_note}; total benchmark time {time.perf_counter() - t_start:.0f} s")
 
 
