@@ -249,14 +249,14 @@ MASS_SPACECRAFT = (
 
 
 def case_mass_docking(tmp: Path) -> set[str]:
-    """``abrupt simulate docking`` (50 kg) then ``abrupt detect mass-change`` on its telemetry: the whole chain."""
+    """``abrupt simulate docking`` (100 kg) then ``abrupt detect mass-change`` on its telemetry: the whole chain."""
     sc = tmp / "sc.toml"
     sc.write_text(MASS_SPACECRAFT)
     sim = tmp / "sim"
-    _invoke(["simulate", "docking", "--spacecraft", str(sc), "--out", str(sim), "--days", "0.4",
-             "--docking-day", "0.2", "--mass", "50", "--seed", "5"])  # fmt: skip
+    _invoke(["simulate", "docking", "--spacecraft", str(sc), "--out", str(sim), "--days", "1.0",
+             "--docking-day", "0.5", "--mass", "100", "--seed", "5"])  # fmt: skip
     args = ["detect", "mass-change", "--store", str(sim), "--spacecraft", str(sc), "--orbit-period", "5926.4"]
-    return _cli_names([*args, "--window", "4320", "--false-alarms", "1/year"], tmp)
+    return _cli_names([*args, "--window", "10800", "--false-alarms", "1/week"], tmp)
 
 
 def case_demo(tmp: Path) -> set[str]:
