@@ -17,6 +17,7 @@ from abrupt.flux.exposure import EfficiencyCurve, efficiency_per_day, exposure_f
 from abrupt.flux.forward import ForwardConfig
 from abrupt.flux.inference import PARAMS
 from abrupt.pipelines.flux import covered_days, infer_flux, simulate_population
+from abrupt.report.flux import write_flux_report
 from abrupt.simulate.population import DETECTOR, FleetSpec
 
 
@@ -104,8 +105,6 @@ def infer(
         Path(out_path).write_text(json.dumps(result.as_dict(), indent=1, default=float))
         note(f"wrote {out_path}")
     if report_path:
-        from abrupt.report.flux import write_flux_report  # matplotlib only when a report is asked for
-
         write_flux_report(report_path, result)
         note(f"wrote {report_path}")
 

@@ -22,8 +22,8 @@ from abrupt.detect.orbit.analysis import OrbitAnalysis, innovation_scale
 from abrupt.detect.orbit.detectors import OrbitDetector, orbit_analysis, orbit_thresholds
 from abrupt.detect.orbit.ekf import NUISANCE_NAMES
 from abrupt.errors import ConfigError
-from abrupt.model.frames import Ephemeris
 from abrupt.readers.ephemeris import read_ephemeris
+from abrupt.series.ephemeris import Ephemeris
 from abrupt.simulate.orbit import inject_impulse
 from abrupt.thresholds import FalseAlarmBudget, Threshold
 
