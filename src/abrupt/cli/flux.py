@@ -12,6 +12,7 @@ import pandas as pd
 
 from abrupt.catalog import Catalog
 from abrupt.cli.groups import DEFAULT_CATALOG, cli, note, simulate
+from abrupt.cli.options import budget_options, pop_budget
 from abrupt.errors import ConfigError
 from abrupt.flux.exposure import EfficiencyCurve, efficiency_per_day, exposure_frame, store_exposure
 from abrupt.flux.forward import ForwardConfig
@@ -123,7 +124,7 @@ def infer(
 @click.option(
     "--analysed-fraction", default="1.0", show_default=True, help="One value, or one per day (comma-separated)."
 )
-@click.option("--false-alarms-per-day", type=float, required=True, help="Rate the threshold was set for.")
+@budget_options("1/day")
 @click.option(
     "--recovery",
     "recovery_csv",
@@ -143,13 +144,20 @@ def exposure_command(
     inclination_deg: float,
     epoch_year: float,
     analysed_fraction: str,
-    false_alarms_per_day: float,
     recovery_csv: str | None,
     dh90: float | None,
     slope: float,
     attitude: str,
+    **budget_text: Any,
 ) -> None:
-    """Store exposure rows (one per spacecraft-day) in a catalog, beside its events."""
+    """Store exposure rows (one per spacecraft-day) in a catalog, beside its events.
+
+    The false-alarm budget is the one the detection threshold was set for (``--false-alarms``); it
+    must be stated, since the inference subtracts it as background.
+    """
+    if all(v is None for v in budget_text.values()):
+        raise click.UsageError("give --false-alarms: the rate the detection threshold was set for (e.g. 1/day)")
+    false_alarms_per_day = pop_budget(budget_text).per_day
     cat = Catalog(catalog_target, create=False)
     if not days:
         days = covered_days(cat, spacecraft)
@@ -203,7 +211,7 @@ def exposure_command(
 @click.option("--beta", type=float, default=1.0, show_default=True, help="Truth: momentum-enhancement factor.")
 @click.option("--dH90", "dh90", type=float, default=0.02, show_default=True, help="ΔH90 [N·m·s] of every day.")
 @click.option("--slope", type=float, default=4.0, show_default=True)
-@click.option("--false-alarms-per-day", type=float, default=0.01, show_default=True)
+@budget_options("0.01/day")
 @click.option("--analysed-fraction", type=float, default=0.9, show_default=True)
 @click.option("--dH-error", "dh_error", type=float, default=0.0, show_default=True, help="Relative |ΔH| error.")
 @click.option("--catalog", "catalog_target", default=DEFAULT_CATALOG, show_default=True)
@@ -222,7 +230,6 @@ def population(
     beta: float,
     dh90: float,
     slope: float,
-    false_alarms_per_day: float,
     analysed_fraction: float,
     dh_error: float,
     catalog_target: str,
@@ -231,6 +238,7 @@ def population(
     **model: Any,
 ) -> None:
     """Draw a fleet's detected strikes from a flux truth; store events and exposure in a catalog."""
+    false_alarms_per_day = pop_budget(model, "0.01/day").per_day
     curve = EfficiencyCurve.from_dH90(dh90, slope)
     spec = FleetSpec(
         str(Path(spacecraft_file).resolve()),
