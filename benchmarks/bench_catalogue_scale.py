@@ -3,7 +3,7 @@ public catalogue (abrupt.simulate.tle_catalogue: the catalogue's mix of orbits a
 ~1 element set per object per day), streamed from disk on local worker processes.
 
     PYTHONPATH=$PWD/src nice python benchmarks/bench_catalogue_scale.py \
-        [--objects 100,200,400] [--density-objects 50,100] [--workers 2] [--kill] [--baseline /work/baseline/src]
+        [--objects 50,100,200] [--density-objects 25,50] [--workers 2] [--kill] [--baseline /work/baseline/src]
 
 For each N it times the command (wall, as a subprocess), samples the resident memory of the command
 and all its worker processes every 0.1 s (peak printed), fits wall = a + b·N over the N measured and
@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -54,18 +55,35 @@ def catalogue(folder: Path, n: int) -> Path:
     return listing
 
 
-def run_measured(args: list[str], kill_when: Path | None = None, kill_after: int = 0) -> tuple[float, float, int]:
-    """Wall seconds, peak resident memory (GB) of the process tree, return code (−9 when killed)."""
+def fresh(path: Path) -> Path:
+    """``path`` with no file and no parts folder of an earlier run (a timed run must not resume)."""
+    path.unlink(missing_ok=True)
+    shutil.rmtree(path.with_name(path.name + ".parts"), ignore_errors=True)
+    return path
+
+
+def run_measured(
+    args: list[str], kill_when: Path | None = None, kill_after: int = 0
+) -> tuple[float, float, int, float]:
+    """Wall seconds, peak resident memory (GB) of the process tree, return code (−9 when killed) and the
+    CPU seconds of the tree (user + system of every process seen, sampled every 0.1 s)."""
     env = {**os.environ, "PYTHONPATH": str(SRC)}
     cmd = [sys.executable, "-m", "abrupt.cli.main", "--quiet", *args]
     t0 = time.perf_counter()
     proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     root = psutil.Process(proc.pid)
     peak = 0
+    cpu: dict[int, float] = {}
     while proc.poll() is None:
         try:
             procs = [root, *root.children(recursive=True)]
-            peak = max(peak, sum(p.memory_info().rss for p in procs if p.is_running()))
+            rss = 0
+            for p in procs:
+                with p.oneshot():
+                    rss += p.memory_info().rss
+                    times = p.cpu_times()
+                    cpu[p.pid] = times.user + times.system
+            peak = max(peak, rss)
         except psutil.Error:
             pass
         if kill_when is not None and len(list(kill_when.glob("*/*.parquet"))) >= kill_after:
@@ -80,7 +98,7 @@ def run_measured(args: list[str], kill_when: Path | None = None, kill_after: int
         proc.stderr.close()
     if proc.returncode not in (0, -9):
         raise SystemExit(f"command failed ({proc.returncode}): {' '.join(args)}\n{err[-2000:]}")
-    return time.perf_counter() - t0, peak / 1e9, proc.returncode
+    return time.perf_counter() - t0, peak / 1e9, proc.returncode, sum(cpu.values())
 
 
 REFERENCE = """
@@ -122,16 +140,17 @@ def part(
     label: str, ns: list[int], folder: Path, command: list[str], target_min: float, workers: int, events: dict
 ) -> None:
     print(f"\n[{label}] {' '.join(command)} ... --workers {workers}   ({load()})")
-    walls, peaks = [], []
+    walls, peaks, cpus = [], [], []
     for n in ns:
         listing = catalogue(folder, n)
-        out = folder / f"{label}-{n}.parquet"
+        out = fresh(folder / f"{label}-{n}.parquet")
         args = [*command, "--paths-from", str(listing), "--out", str(out), "--workers", str(workers)]
         if label == "maneuvers":
-            args += ["--catalog", str(folder / f"catalog-{n}.sqlite")]
+            args += ["--catalog", str(fresh(folder / f"catalog-{n}.sqlite"))]
         else:
             args += ["--maneuvers-from", str(events[n])]
-        wall, peak, _ = run_measured(args)
+        wall, peak, _, cpu = run_measured(args)
+        cpus.append(cpu)
         rows = len(pd.read_parquet(out))
         if label == "maneuvers":
             events[n] = out
@@ -140,12 +159,19 @@ def part(
         sets = sum(1 for p in listing.read_text().split() for _ in open(p)) // 2
         print(
             f"  N = {n:5d} objects ({sets:,} element sets, {rows} rows): {wall:6.1f} s wall, "
-            f"{n / wall:6.1f} objects/s, peak memory {peak:.2f} GB   ({load()})"
+            f"{n / wall:6.1f} objects/s, {cpu:6.1f} CPU-s ({1e3 * cpu / n:.0f} ms/object), peak memory {peak:.2f} GB"
+            f"   ({load()})"
         )
     a, b, t25k = extrapolate(ns, walls)
     print(
         f"  fit wall = {a:.1f} s + {1e3 * b:.1f} ms × N;  EXTRAPOLATED to {CATALOGUE_OBJECTS:,} objects: "
         f"{t25k / 60:.1f} min (target < {target_min:g} min) — measured under the load above"
+    )
+    ca, cb, c25k = extrapolate(ns, cpus)
+    print(
+        f"  fit CPU = {ca:.1f} s + {1e3 * cb:.1f} ms × N;  EXTRAPOLATED CPU for {CATALOGUE_OBJECTS:,} objects "
+        f"{c25k / 60:.0f} CPU-min, i.e. {c25k / 120:.1f} min of wall on two otherwise idle cores "
+        f"(projection from CPU time; target < {target_min:g} min)"
     )
     slope = (peaks[-1] - peaks[0]) / max(ns[-1] - ns[0], 1) * 1000
     print(
@@ -157,14 +183,14 @@ def part(
 def kill_and_resume(folder: Path, n: int, workers: int) -> None:
     listing = catalogue(folder, n)
     whole = folder / f"maneuvers-{n}.parquet"
-    out = folder / f"killed-{n}.parquet"
+    out = fresh(folder / f"killed-{n}.parquet")
     parts = out.with_name(out.name + ".parts")
     n_files = len(listing.read_text().split())
     args = ["detect", "tle-batch", "--paths-from", str(listing), "--out", str(out), "--workers", str(workers)]
-    args += ["--catalog", str(folder / f"killed-{n}.sqlite")]
-    _, _, rc = run_measured(args, kill_when=parts, kill_after=max(1, n_files // 3))
+    args += ["--catalog", str(fresh(folder / f"killed-{n}.sqlite"))]
+    _, _, rc, _ = run_measured(args, kill_when=parts, kill_after=max(1, n_files // 3))
     done = len(list(parts.glob("*/*.parquet")))
-    wall, _, _ = run_measured(args)
+    wall, _, _, _ = run_measured(args)
     a, b = pd.read_parquet(whole), pd.read_parquet(out)
     key = ["spacecraft", "time_utc", "detector"]
     merged = a[key].merge(b[key], how="outer", indicator=True)
@@ -179,8 +205,8 @@ def kill_and_resume(folder: Path, n: int, workers: int) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--objects", default="100,200,400")
-    ap.add_argument("--density-objects", default="50,100")
+    ap.add_argument("--objects", default="50,100,200")
+    ap.add_argument("--density-objects", default="25,50")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--folder", default=None, help="Where the simulated catalogue is cached.")
     ap.add_argument("--baseline", default="/work/baseline/src", help="src folder of the previous release.")
