@@ -173,10 +173,13 @@ def part(
         f"{c25k / 60:.0f} CPU-min, i.e. {c25k / 120:.1f} min of wall on two otherwise idle cores "
         f"(projection from CPU time; target < {target_min:g} min)"
     )
-    slope = (peaks[-1] - peaks[0]) / max(ns[-1] - ns[0], 1) * 1000
+    steps = ", ".join(
+        f"{n0}→{n1}: {1e3 * (p1 - p0):+.0f} MB" for n0, n1, p0, p1 in zip(ns, ns[1:], peaks, peaks[1:], strict=False)
+    )
     print(
-        f"  peak memory {min(peaks):.2f}-{max(peaks):.2f} GB over N = {ns[0]}-{ns[-1]} "
-        f"({slope * 1e3:+.0f} MB per 1,000 objects; target < 4 GB, flat)"
+        f"  peak memory {min(peaks):.2f}-{max(peaks):.2f} GB over N = {ns[0]}-{ns[-1]} ({steps}; "
+        f"{1e3 * (peaks[-1] - peaks[-2]) / max(ns[-1] - ns[-2], 1) * 1000 if len(ns) > 1 else 0.0:+.0f} MB per "
+        f"1,000 objects over the last step; target < 4 GB, flat)"
     )
 
 
