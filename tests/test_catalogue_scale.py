@@ -154,3 +154,61 @@ def test_catalogue_on_a_two_worker_cluster_equals_in_process(catalogue: list[Pat
     run_catalogue(catalogue, "maneuvers", settings, tmp_path / "a.parquet")
     run_catalogue(catalogue, "maneuvers", settings, tmp_path / "b.parquet", executor=Executor(workers=2))
     pd.testing.assert_frame_equal(pd.read_parquet(tmp_path / "a.parquet"), pd.read_parquet(tmp_path / "b.parquet"))
+
+
+def test_density_cli_windows_only_takes_the_maneuvers_of_tle_batch(tmp_path: Path) -> None:
+    paths = write_catalogue(tmp_path / "tle", 4, objects_per_file=2, years=0.5, seed=5)
+    listing = tmp_path / "list.txt"
+    listing.write_text("\n".join(p.name for p in paths) + "\n")  # relative to the list file
+    (tmp_path / "tle" / "list.txt").write_text(listing.read_text())
+    runner = CliRunner()
+    ev = tmp_path / "ev.parquet"
+    res = runner.invoke(
+        cli,
+        [
+            "detect",
+            "tle-batch",
+            "--paths-from",
+            str(tmp_path / "tle" / "list.txt"),
+            "--out",
+            str(ev),
+            "--catalog",
+            str(tmp_path / "c.sqlite"),
+            "--false-alarms",
+            "20/year",
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    events = read_events(str(ev))
+    assert len(events) > 0  # a generous budget, so that some cuts are taken over
+    win = tmp_path / "win.parquet"
+    res = runner.invoke(
+        cli,
+        [
+            "density",
+            "tle",
+            "--windows-only",
+            "--no-model",
+            *map(str, paths),
+            "--maneuvers-from",
+            str(ev),
+            "--out",
+            str(win),
+            "--interval-days",
+            "3",
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    got = pd.read_parquet(win)
+    cfg = TleDragConfig(interval_days=3.0)
+    want = []
+    for p in paths:
+        for h in read_element_histories(p):
+            label = f"NORAD-{h.norad_id}"
+            mine = events[(events["spacecraft"] == label) & (events["statistic"] >= events["threshold"])]
+            times = list(pd.to_datetime(mine["time_utc"].astype(str), utc=True).dt.tz_localize(None))
+            want.append(rho_b_from_history(h, cfg, maneuvers=times).windows)
+    expected = pd.concat(want, ignore_index=True)
+    assert len(got) == len(expected)
+    np.testing.assert_allclose(got["rho_b_per_m"].to_numpy(), expected["rho_b_per_m"].to_numpy())
+    assert got["window_start_utc"].tolist() == expected["window_start_utc"].tolist()
