@@ -40,6 +40,7 @@ import pandas as pd
 from sgp4.api import WGS72, Satrec
 
 from abrupt.errors import InputError, RepairLog
+from abrupt.readers.compression import read_bytes
 
 logger = logging.getLogger(__name__)
 
@@ -443,14 +444,21 @@ def elements_frame(sets: Sequence[RawElementSet]) -> pd.DataFrame:
     return frame
 
 
-def _read_text(path: Path) -> list[str]:
-    data = path.read_bytes()
+def read_element_text(path: Path) -> str:
+    """A TLE/OMM file's text, gunzipped or uncompressed (``.gz``/``.Z``) when it is compressed."""
     try:
-        text = data.decode("utf-8")
+        data = read_bytes(path)
+    except InputError as exc:  # corrupt compressed data: the element readers name a line (the first)
+        raise InputError(exc.reason, file=path, line=exc.line or 1) from None
+    try:
+        return data.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = data[: exc.start].count(b"\n") + 1
         raise InputError(f"not a UTF-8/ASCII text file (byte {exc.start})", file=path, line=line) from None
-    return text.splitlines()
+
+
+def _read_text(path: Path) -> list[str]:
+    return read_element_text(path).splitlines()
 
 
 def read_tle(path: str | Path, *, norad_id: int | None = None, strict: bool = False) -> ElementHistory:
