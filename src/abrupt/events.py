@@ -231,10 +231,9 @@ def format_time_columns(frame: pd.DataFrame) -> pd.DataFrame:
 def write_events(frame: pd.DataFrame, path: str) -> None:
     """Write events to CSV or Parquet, chosen by the file suffix (``.csv``, ``.parquet``/``.pq``).
 
-    Parquet stores ``time_utc`` as a typed UTC timestamp (microseconds); CSV as ISO-8601 text. Every
-    other ``*_utc`` column is written as ISO-8601 UTC text with a ``Z`` (:func:`format_time_columns`).
+    Parquet stores ``time_utc`` as a typed UTC timestamp (microseconds); CSV as ISO-8601 text.
     """
-    frame = format_time_columns(normalise_frame(frame))
+    frame = normalise_frame(frame)
     lower = str(path).lower()
     if lower.endswith((".parquet", ".pq")):
         typed = frame.copy()

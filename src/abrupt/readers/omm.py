@@ -28,7 +28,7 @@ from abrupt.readers.tle import (
     RawElementSet,
     history_from_sets,
     is_tle_text,
-    read_element_text,
+    read_element_bytes,
     read_tle,
     read_tle_histories,
     split_by_satellite,
@@ -274,7 +274,10 @@ def iter_omm_sets(
 
 
 def _omm_sets(path: Path, fmt: str | None, strict: bool) -> tuple[list[RawElementSet], list[InputError]]:
-    text = read_element_text(path)
+    try:
+        text = read_element_bytes(path).decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(f"not a UTF-8 text file (byte {exc.start})", file=path, line=1) from None
     skipped: list[InputError] = []
     try:
         sets = list(iter_omm_sets(text, file=str(path), fmt=fmt, strict=strict, skipped=skipped))
@@ -313,7 +316,7 @@ def _is_tle(path: Path) -> bool:
     another kind (SP3) is an :class:`InputError` that says what the file is."""
     if not path.is_file():
         raise InputError("no such file", file=path)
-    head = read_element_text(path)[:4000]
+    head = read_element_bytes(path)[:4000].decode("utf-8", errors="replace")
     if not head.strip():
         raise InputError("the file is empty: no TLE/3LE or OMM element sets", file=path, line=1)
     first = head.lstrip("\ufeff").split("\n", 1)[0]

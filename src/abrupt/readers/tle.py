@@ -444,21 +444,22 @@ def elements_frame(sets: Sequence[RawElementSet]) -> pd.DataFrame:
     return frame
 
 
-def read_element_text(path: Path) -> str:
-    """A TLE/OMM file's text, gunzipped or uncompressed (``.gz``/``.Z``) when it is compressed."""
+def read_element_bytes(path: Path) -> bytes:
+    """A TLE/OMM file's bytes, gunzipped or uncompressed (``.gz``/``.Z``, by content) when compressed."""
     try:
-        data = read_bytes(path)
+        return read_bytes(path)
     except InputError as exc:  # corrupt compressed data: the element readers name a line (the first)
         raise InputError(exc.reason, file=path, line=exc.line or 1) from None
-    try:
-        return data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        line = data[: exc.start].count(b"\n") + 1
-        raise InputError(f"not a UTF-8/ASCII text file (byte {exc.start})", file=path, line=line) from None
 
 
 def _read_text(path: Path) -> list[str]:
-    return read_element_text(path).splitlines()
+    data = read_element_bytes(path)
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data[: exc.start].count(b"\n") + 1
+        raise InputError(f"not a UTF-8/ASCII text file (byte {exc.start})", file=path, line=line) from None
+    return text.splitlines()
 
 
 def read_tle(path: str | Path, *, norad_id: int | None = None, strict: bool = False) -> ElementHistory:
