@@ -1,7 +1,8 @@
 """Every ``abrupt`` command line shown in README.md and docs/*.md parses against the real command tree.
 
 A command line is taken from the fenced shell blocks (``console``, ``bash``, plain) and from inline code
-spans that start with ``abrupt``; continuation lines (``\\``) are joined, ``$`` prompts and ``#``
+spans that start with ``abrupt`` (those only for their sub-command and options: prose names commands
+without their required options); continuation lines (``\\``) are joined, ``$`` prompts and ``#``
 comments dropped, and optional parts written ``[--option VALUE]`` kept without their brackets. Each
 line is resolved through the groups to its command and parsed by click's own option parser: an
 unknown sub-command, an unknown option, an option missing its value, or an extra argument fails the
@@ -29,8 +30,9 @@ INLINE = re.compile(r"`(abrupt [^`]+)`")
 SUMMARY = re.compile(r"[|(){}<>]|\.\.\.\s*$|\s\.\.\.\s| / ")
 
 
-def _command_lines(text: str) -> list[str]:
-    lines: list[str] = []
+def _command_lines(text: str) -> list[tuple[str, bool]]:
+    """(command line, whether it stands in a fenced block: a line to type, not a reference in prose)."""
+    lines: list[tuple[str, bool]] = []
     for lang, body in FENCE.findall(text):
         if lang not in ("", "console", "bash", "sh", "shell"):
             continue
@@ -38,28 +40,30 @@ def _command_lines(text: str) -> list[str]:
         for line in joined.splitlines():
             line = line.strip().removeprefix("$ ").strip()
             if line.startswith("abrupt "):
-                lines.append(line)
-    lines += [m for m in INLINE.findall(text) if "\n" not in m]
+                lines.append((line, True))
+    lines += [(m, False) for m in INLINE.findall(text) if "\n" not in m]
     return lines
 
 
-def _doc_commands() -> list[tuple[str, str]]:
+def _doc_commands() -> list[tuple[str, str, bool]]:
     out = []
     for doc in DOCS:
-        for line in _command_lines(doc.read_text()):
+        for line, fenced in _command_lines(doc.read_text()):
             for part in re.split(r"\s(?:&&|;|then)\s", line):
                 part = part.strip()
                 if part.startswith("abrupt ") and not SUMMARY.search(part.split(" #")[0]):
-                    out.append((doc.name, part))
+                    out.append((doc.name, part, fenced))
     return out
 
 
 COMMANDS = _doc_commands()
 
 
-def parse_only(line: str) -> None:
-    """Resolve ``line`` to its command and run click's option parser on it (no conversion, no run)."""
-    tokens = [t for t in shlex.split(line.replace("[", " ").replace("]", " "), comments=True) if t not in GLOBAL_FLAGS]
+def parse_only(line: str, *, complete: bool = False) -> None:
+    """Resolve ``line`` to its command and run click's option parser on it (no conversion, no run);
+    with ``complete`` every required option and argument must be given too."""
+    words = shlex.split(line.replace("[", " ").replace("]", " "), comments=True)
+    tokens = [t for t in words if t not in GLOBAL_FLAGS and t != "..."]  # "..." marks a repeatable part
     assert tokens[0] == "abrupt"
     command: click.Command = cli
     ctx = click.Context(cli, info_name="abrupt")
@@ -75,21 +79,26 @@ def parse_only(line: str) -> None:
     if "--help" in args or "-h" in args:
         return
     parser = command.make_parser(ctx)
-    _, rest, _ = parser.parse_args(args=list(args))
+    given, rest, _ = parser.parse_args(args=list(args))
     if rest and not ctx.allow_extra_args:
         raise click.UsageError(f"unexpected extra argument(s) {rest}")
+    missing = [p.opts[0] for p in command.params if p.required and given.get(p.name) in (None, ())]
+    if complete and missing:
+        raise click.UsageError(f"missing required {', '.join(missing)}")
 
 
 def test_the_docs_show_commands_of_every_capability() -> None:
-    verbs = {" ".join(line.split()[1:3]) for _, line in COMMANDS}
+    verbs = {" ".join(line.split()[1:3]) for _, line, _ in COMMANDS}
     for needed in ("detect attitude", "detect orbit", "detect tle", "detect laser", "density tle", "catalog export"):
         assert needed in verbs
 
 
-@pytest.mark.parametrize(("doc", "line"), COMMANDS, ids=[f"{d}:{i}" for i, (d, _) in enumerate(COMMANDS)])
-def test_documented_command_line_parses(doc: str, line: str) -> None:
+@pytest.mark.parametrize(("doc", "line", "fenced"), COMMANDS, ids=[f"{c[0]}:{i}" for i, c in enumerate(COMMANDS)])
+def test_documented_command_line_parses(doc: str, line: str, fenced: bool) -> None:
+    """A line in a shell block is complete (required options given); a command named in prose is
+    checked for its sub-command and options only."""
     try:
-        parse_only(line)
+        parse_only(line, complete=fenced)
     except click.ClickException as exc:
         pytest.fail(f"{doc}: `{line}`: {exc.format_message()}")
 
@@ -101,3 +110,5 @@ def test_the_parser_check_catches_a_stale_option() -> None:
         parse_only("abrupt detect orbit orbit.sp3 --out e.csv --report --false-alarms 1/week extra")
     with pytest.raises(click.UsageError, match="no such command"):
         parse_only("abrupt detect nothing x")
+    with pytest.raises(click.UsageError, match="missing required --out"):
+        parse_only("abrupt detect orbit orbit.sp3", complete=True)
