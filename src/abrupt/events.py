@@ -215,6 +215,26 @@ def restamp(frame: pd.DataFrame, *, run_id: str, config_hash: str) -> pd.DataFra
     return out
 
 
+def _format_time_cell(value: Any) -> Any:
+    """One cell of a ``*_utc`` detail column in the export format (``;``-separated lists item by item)."""
+    if value is None or (isinstance(value, float) and math.isnan(value)) or value is pd.NaT:
+        return value
+    try:
+        return ";".join(format_time_utc(part) for part in str(value).split(";")) if str(value) else value
+    except (ValueError, TypeError):
+        return value
+
+
+def format_time_columns(frame: pd.DataFrame) -> pd.DataFrame:
+    """Every ``*_utc`` column of ``frame`` (detail columns too) in the one export time format,
+    ISO-8601 UTC with a ``Z`` (:func:`format_time_utc`); a cell that is not a time is left as it is."""
+    out = frame.copy()
+    for col in out.columns:
+        if str(col).endswith("_utc") and col != "time_utc":
+            out[col] = [_format_time_cell(v) for v in out[col]]
+    return out
+
+
 def write_events(frame: pd.DataFrame, path: str) -> None:
     """Write events to CSV or Parquet, chosen by the file suffix (``.csv``, ``.parquet``/``.pq``).
 
