@@ -69,14 +69,19 @@ def detector_class_name(name: str) -> str:
 
 
 def load_ephemeris(
-    source: str | Path | Ephemeris, satellite: str | None = None, *, allow_truncated: bool = False
+    source: str | Path | Ephemeris,
+    satellite: str | None = None,
+    *,
+    allow_truncated: bool = False,
+    strict: bool = False,
 ) -> Ephemeris:
     """An ephemeris from a file (any supported format) or as given. ``allow_truncated``: an SP3/CPF file
     ending before the epochs its header announces is read and the missing epochs counted in its repair
-    log (otherwise it is an :class:`~abrupt.errors.InputError`)."""
+    log (otherwise it is an :class:`~abrupt.errors.InputError`). ``strict``: an SP3 header count that
+    complete records do not match is an error (otherwise a counted repair naming both counts)."""
     if isinstance(source, Ephemeris):
         return source
-    return read_ephemeris(source, satellite, allow_truncated=allow_truncated)
+    return read_ephemeris(source, satellite, allow_truncated=allow_truncated, strict=strict)
 
 
 def detect_orbit(
@@ -87,6 +92,7 @@ def detect_orbit(
     satellite: str | None = None,
     null: str | Path | Ephemeris | None = None,
     allow_truncated: bool = False,
+    strict: bool = False,
     **settings: Any,
 ) -> OrbitRun:
     """Detect impulsive and finite ΔVs in an ephemeris (SP3, OEM, CSV or an :class:`Ephemeris`).
@@ -95,10 +101,13 @@ def detect_orbit(
     ``settings`` are its constructor keywords (``tuning``, ``tau_s``, ``q_m2_s5``, ``sigma_pos_m``,
     ``sigma_vel_mps``, ``dynamics``, ``gravity_degree``, ``confidence_z``, ``kind``, ``spacecraft``,
     ``run_id``). ``null``: event-free data of the same satellite for the thresholds. ``allow_truncated``:
-    read files that end before the epochs their header announces (counted repair, :func:`load_ephemeris`).
+    read files that end before the epochs their header announces (counted repair, :func:`load_ephemeris`);
+    ``strict``: header counts the records do not match are errors.
     """
-    eph = load_ephemeris(source, satellite, allow_truncated=allow_truncated)
-    null_eph = load_ephemeris(null, satellite, allow_truncated=allow_truncated) if null is not None else None
+    eph = load_ephemeris(source, satellite, allow_truncated=allow_truncated, strict=strict)
+    null_eph = (
+        load_ephemeris(null, satellite, allow_truncated=allow_truncated, strict=strict) if null is not None else None
+    )
     cls = get_detector(detector_class_name(detector), "orbit")
     if not issubclass(cls, OrbitDetector):
         raise KeyError(f"{detector!r} is not an orbit filter detector")
@@ -200,10 +209,11 @@ def inject_orbit(
     duration_s: float = 0.0,
     satellite: str | None = None,
     allow_truncated: bool = False,
+    strict: bool = False,
 ) -> Ephemeris:
     """The ephemeris with a ΔV (orbit frame at its start) injected at ``time_utc``: an impulse or a finite
     burn of ``duration_s`` (:func:`abrupt.simulate.orbit.inject_impulse`)."""
-    eph = load_ephemeris(source, satellite, allow_truncated=allow_truncated)
+    eph = load_ephemeris(source, satellite, allow_truncated=allow_truncated, strict=strict)
     try:
         t = np.datetime64(str(time_utc).rstrip("Z"), "ns")
     except ValueError:

@@ -23,7 +23,15 @@ Documented repairs (counted in the :class:`~abrupt.errors.RepairLog` of each eph
 - an epoch repeated with identical states is dropped; epochs out of order are sorted; gaps against the
   header interval are counted (the filter propagates across them);
 - records of a satellite missing from the header list are read and counted;
-- a file truncated before the number of epochs its header announces is an **error**; with
+- a header count that the body does not match — the number of epochs on the first line, the number
+  of satellites on the first ``+`` line — is repaired when the records themselves are complete: the
+  file ends with ``EOF`` (or, holding more epochs than announced, its last epoch has a full set of
+  records and its last line is whole). The file is read as found and
+  the repair names both counts ("header announces 5041 epochs, the file holds 5040 complete ones
+  (read as found)"; "header announces 27 satellites but lists 26 (the list is used)").
+  ``strict=True`` makes either mismatch an error, as Orekit does;
+- a file without ``EOF`` that holds fewer epochs than its header announces (a cut file: nothing shows
+  that its last epoch is whole) is an **error**; with
   ``allow_truncated=True`` it is read and the missing epochs are counted.
 
 Errors (:class:`~abrupt.errors.InputError`, ``file:line:column: reason``): unsupported version, a
@@ -224,8 +232,11 @@ def _from_utc(t_utc: NDArray[np.datetime64], time_system: str) -> NDArray[np.dat
     return out
 
 
-def _parse_header(lines: Sequence[str], file: str, repairs: RepairLog) -> tuple[Sp3Header, int]:
-    """Parse the header; returns it and the index of the first body line."""
+def _parse_header(
+    lines: Sequence[str], file: str, repairs: RepairLog, *, strict: bool = False
+) -> tuple[Sp3Header, int]:
+    """Parse the header; returns it and the index of the first body line. ``strict``: a satellite list
+    of another length than the count announced is an error (else the list is used, and counted)."""
     if not lines or len(lines[0]) < 3 or lines[0][0] != "#" or lines[0][1] in "#":
         raise InputError("first line must start with '#a', '#c' or '#d' (SP3 version)", file=file, line=1, column=1)
     head = lines[0]
@@ -287,7 +298,7 @@ def _parse_header(lines: Sequence[str], file: str, repairs: RepairLog) -> tuple[
                     )
             for k in range(17):
                 sid = normalise_satellite_id(line[9 + 3 * k : 12 + 3 * k])
-                if sid and sid not in ("G00",) and len(sats) < n_sats:
+                if sid and sid not in ("G00",):
                     sats.append(sid)
             continue
         if line.startswith("%c"):
@@ -321,7 +332,9 @@ def _parse_header(lines: Sequence[str], file: str, repairs: RepairLog) -> tuple[
     if n_sats is None:
         raise InputError("no satellite list ('+' lines) in the header", file=file, line=3, column=1)
     if len(sats) != n_sats:
-        raise InputError(f"header announces {n_sats} satellites but lists {len(sats)}", file=file, line=3, column=4)
+        if strict or not sats:
+            raise InputError(f"header announces {n_sats} satellites but lists {len(sats)}", file=file, line=3, column=4)
+        repairs.record(f"header announces {n_sats} satellites but lists {len(sats)} (the list is used)")
     if len(set(sats)) != len(sats):
         raise InputError("satellite list names a satellite twice", file=file, line=3, column=10)
     if version in "ab" or time_system in (None, "CCC", ""):
@@ -361,12 +374,41 @@ def _read_lines(path: str | Path) -> list[str]:
     return lines
 
 
-def parse_sp3(path: str | Path, *, allow_truncated: bool = False, repairs: RepairLog | None = None) -> Sp3File:
-    """Read every satellite of an SP3 file (see the module docstring for repairs and errors)."""
+def _last_epoch_complete(lines: Sequence[str], body: int, header: Sp3Header) -> bool:
+    """Whether the records of the last epoch are whole in a file without ``EOF``: as many position
+    (and velocity) records as the epoch before it holds (the header's satellite count when there is
+    one epoch), and a last line as long as the record before it."""
+    blocks: list[Counter[str]] = []
+    lengths: dict[str, list[int]] = {"P": [0, 0], "V": [0, 0]}  # per record type: previous, last
+    last_tag = "P"
+    for line in lines[body:]:
+        if line.startswith("*"):
+            blocks.append(Counter())
+        elif line[:1] in ("P", "V") and blocks:
+            last_tag = line[0]
+            blocks[-1][last_tag] += 1
+            lengths[last_tag] = [lengths[last_tag][1], len(line.rstrip())]
+    if not blocks:
+        return False
+    wanted = blocks[-2] if len(blocks) > 1 else Counter({"P": len(header.satellites)})
+    if header.has_velocity and len(blocks) == 1:
+        wanted["V"] = len(header.satellites)
+    full = all(blocks[-1][k] >= n for k, n in wanted.items())
+    previous, last = lengths[last_tag]
+    return full and last >= previous
+
+
+def parse_sp3(
+    path: str | Path, *, allow_truncated: bool = False, strict: bool = False, repairs: RepairLog | None = None
+) -> Sp3File:
+    """Read every satellite of an SP3 file (see the module docstring for repairs and errors).
+
+    ``strict``: a header count the body does not match (epochs, satellites) is an error even when the
+    records are complete; ``allow_truncated``: a file cut before its announced epochs is read."""
     file = str(path)
     log = repairs if repairs is not None else RepairLog(source=file)
     lines = _read_lines(path)
-    header, body = _parse_header(lines, file, log)
+    header, body = _parse_header(lines, file, log, strict=strict)
     sats = set(header.satellites)
     epochs: list[np.datetime64] = []
     epoch_lines: list[int] = []
@@ -472,15 +514,23 @@ def parse_sp3(path: str | Path, *, allow_truncated: bool = False, repairs: Repai
         log.record("malformed ephemeris record skipped", len(bad))
     if n_epoch_lines != header.n_epochs:
         missing = header.n_epochs - n_epoch_lines
-        where = len(lines)
-        if missing > 0 and allow_truncated:
+        # complete records: the writer reached EOF; without EOF a file short of epochs is a cut file,
+        # one with more epochs than announced must end with a full last epoch
+        complete = seen_eof or (missing < 0 and _last_epoch_complete(lines, body, header))
+        if complete and not strict:
+            log.record(
+                f"header announces {header.n_epochs} epochs, the file holds {n_epoch_lines} complete ones "
+                "(read as found)",
+                abs(missing),
+            )
+        elif missing > 0 and allow_truncated:
             log.record("file truncated: announced epochs missing", missing)
         else:
             raise InputError(
                 f"header announces {header.n_epochs} epochs but the file holds {n_epoch_lines}"
-                + (" (truncated file?)" if missing > 0 else ""),
+                + (" (truncated file?)" if missing > 0 and not complete else ""),
                 file=file,
-                line=where,
+                line=len(lines),
             )
     if not epochs:
         raise InputError("no valid epochs in the file", file=file)
@@ -583,13 +633,14 @@ def read_sp3(
     *,
     repairs: RepairLog | None = None,
     allow_truncated: bool = False,
+    strict: bool = False,
 ) -> Ephemeris:
     """Read one satellite's ephemeris from an SP3 file (frame of the file, ITRF unless inertial; UTC).
 
     ``satellite`` is the SP3 id (``"L74"``; ``"1"`` or ``"G1"`` also name ``G01``); it may be omitted
     when the file holds one satellite. Raises :class:`InputError` naming file:line and the reason.
     """
-    content = parse_sp3(path, allow_truncated=allow_truncated, repairs=repairs)
+    content = parse_sp3(path, allow_truncated=allow_truncated, strict=strict, repairs=repairs)
     sats = content.header.satellites
     if satellite is None:
         if len(content.ephemerides) != 1:
@@ -607,9 +658,9 @@ def read_sp3(
     return content.ephemerides[sid]
 
 
-def read_sp3_all(path: str | Path, *, allow_truncated: bool = False) -> dict[str, Ephemeris]:
+def read_sp3_all(path: str | Path, *, allow_truncated: bool = False, strict: bool = False) -> dict[str, Ephemeris]:
     """Every satellite's ephemeris in an SP3 file, by SP3 id."""
-    return parse_sp3(path, allow_truncated=allow_truncated).ephemerides
+    return parse_sp3(path, allow_truncated=allow_truncated, strict=strict).ephemerides
 
 
 def _fmt_epoch(t: np.datetime64) -> str:
