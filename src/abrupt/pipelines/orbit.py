@@ -10,7 +10,7 @@ Python API both call these functions.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -19,10 +19,17 @@ import pandas as pd
 
 from abrupt.detect.base import DetectionResult, get_detector
 from abrupt.detect.orbit.analysis import OrbitAnalysis, innovation_scale
-from abrupt.detect.orbit.detectors import OrbitDetector, orbit_analysis, orbit_thresholds
+from abrupt.detect.orbit.detectors import (
+    OrbitDetector,
+    orbit_analysis,
+    orbit_product_boundaries,
+    orbit_thresholds,
+)
 from abrupt.detect.orbit.ekf import NUISANCE_NAMES
+from abrupt.detect.orbit.sensitivity import detectable_dv
 from abrupt.errors import ConfigError
 from abrupt.model.frames import Ephemeris
+from abrupt.pipelines.orbit_sequence import resolve_sequence
 from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.simulate.orbit import inject_impulse
 from abrupt.thresholds import FalseAlarmBudget, Threshold
@@ -93,6 +100,7 @@ def detect_orbit(
     null: str | Path | Ephemeris | None = None,
     allow_truncated: bool = False,
     strict: bool = False,
+    sequences: bool = True,
     **settings: Any,
 ) -> OrbitRun:
     """Detect impulsive and finite ΔVs in an ephemeris (SP3, OEM, CSV or an :class:`Ephemeris`).
@@ -102,7 +110,9 @@ def detect_orbit(
     ``sigma_vel_mps``, ``dynamics``, ``gravity_degree``, ``confidence_z``, ``kind``, ``spacecraft``,
     ``run_id``). ``null``: event-free data of the same satellite for the thresholds. ``allow_truncated``:
     read files that end before the epochs their header announces (counted repair, :func:`load_ephemeris`);
-    ``strict``: header counts the records do not match are errors.
+    ``strict``: header counts the records do not match are errors. ``sequences``: after a detection, remove
+    the burns found and scan again, so that burns close in time are each found with their own ΔV
+    (:func:`abrupt.pipelines.orbit_sequence.resolve_sequence`).
     """
     eph = load_ephemeris(source, satellite, allow_truncated=allow_truncated, strict=strict)
     null_eph = (
@@ -114,6 +124,9 @@ def detect_orbit(
     det = cls(null=null_eph, **settings)
     fa = as_budget(budget)
     result = det.detect(eph, fa)
+    if sequences and len(result.events):
+        events, notes = resolve_sequence(det, eph, fa, result)
+        result = replace(result, events=events, warnings=(*result.warnings, *notes))
     run = OrbitRun(eph, det, result, fa)
     run.summary = fit_summary(run)
     return run
@@ -169,7 +182,18 @@ def fit_summary(run: OrbitRun) -> dict[str, Any]:
         "thresholds": {k: {"value": v.value, "method": v.method, "n": v.n_samples} for k, v in run.thresholds.items()},
         "events": len(run.events),
         "warnings": list(run.result.warnings),
+        "product_boundaries": orbit_product_boundaries(run.result),
+        **_detectable(run),
     }
+
+
+def _detectable(run: OrbitRun) -> dict[str, float]:
+    """The 90 %-detectable |ΔV| of the sliding GLR at its threshold (median over the evaluated epochs)."""
+    th = run.thresholds.get("glr")
+    if run.analysis is None or th is None or run.detector.statistic != "glr":
+        return {}
+    det = detectable_dv(run.analysis, th.value, 0.9)
+    return {"dv90_mps": det.median_worst_mps, "dv90_best_mps": det.median_best_mps, "glr_inflation": det.inflation}
 
 
 def summary_lines(summary: dict[str, Any]) -> list[str]:
@@ -196,6 +220,24 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
     for name, th in s["thresholds"].items():
         mark = "  <- raises events" if name == s["statistic"] else ""
         lines.append(f"    {name:<20} {th['value']:<12.4g} ({th['method']}, {th['n']} samples){mark}")
+    if "dv90_mps" in s:
+        lines.append(
+            f"  90 % detectable  |ΔV| {1e3 * s['dv90_mps']:.3g} mm/s in the worst direction, "
+            f"{1e3 * s['dv90_best_mps']:.3g} mm/s in the best (median over the arc; a quiet result means no "
+            "impulse above this)"
+        )
+    bounds = s.get("product_boundaries") or []
+    if bounds:
+        nuisance = [b for b in bounds if not b["raised"]]
+        lines.append(
+            f"  product          discontinuous at its day boundaries: {len(nuisance)} of {len(bounds)} treated as "
+            "nuisance (not events), the others left to the event search"
+        )
+        lines.extend(
+            f"    {b['time_utc'][:19]}  peak {b['peak']:.4g}  bound {b['bound']:.4g}"
+            f"{'  -> searched' if b['raised'] else ''}"
+            for b in bounds
+        )
     lines.append(f"  events           {s['events']}")
     lines.extend(f"  warning          {w}" for w in s["warnings"])
     return lines
