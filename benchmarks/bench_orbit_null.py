@@ -14,8 +14,13 @@ Pass rule per class (acceptance): the observed count is at most the upper end of
 Poisson interval of the count expected at the stated rate, and the observed rate is at most 2 × the
 stated one. The realised rate is printed with its exact (Garwood) 95 % interval beside the stated rate.
 
+No long geodetic (passive laser-ranging) arc is in ``../shared``; two daily-arc products are simulated
+(:mod:`abrupt.simulate.products`, seeds other than those the boundary rule was developed on) and
+pooled as their own class, labelled as simulated.
+
 Held out: nothing in the detector was tuned on the GNSS or geodetic files; the self-calibration rules
-were set on Sentinel-3A (docs/orbit.md), so Sentinel-3A is in-sample and every other file held out.
+were set on Sentinel-3A (docs/orbit.md), so Sentinel-3A is in-sample and every other file held out. The
+boundary rule was developed on simulated products with seeds 0 and 1; the benchmark uses seeds 3 and 4.
 
     nice python benchmarks/bench_orbit_null.py [--max-sats N] [--budget 1/week]
 """
@@ -34,10 +39,15 @@ from abrupt.errors import InputError
 from abrupt.pipelines.orbit import detect_orbit
 from abrupt.readers.sp3 import parse_sp3
 from abrupt.series.ephemeris import Ephemeris
+from abrupt.simulate.products import DailyArcProduct, simulate_daily_arcs
 from abrupt.thresholds import FalseAlarmBudget
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared/data/sp3"
 GNSS_PREFIXES = ("G", "R", "E", "C", "J", "I")
+SIMULATED = {
+    "simulated LAGEOS-like, 4 days at 2 min": DailyArcProduct(days=4, step_s=120.0, seed=3),
+    "simulated Etalon-like, 7 days at 15 min": DailyArcProduct(days=7, step_s=900.0, altitude_m=19.1e6, seed=4),
+}
 MIN_SPAN_H = 6.0  # shorter arcs: the filters settle for up to a few hours at each end
 
 
@@ -70,6 +80,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--max-sats", type=int, default=0, help="analyse at most N satellites per file (0: all)")
     parser.add_argument("--budget", default="1/week")
+    parser.add_argument("--no-simulated", dest="simulated", action="store_false", help="skip the simulated products")
     args = parser.parse_args()
     budget = FalseAlarmBudget.parse(args.budget)
     files = sorted(p for p in DATA.rglob("*") if ".sp3" in p.name)
@@ -126,6 +137,23 @@ def main() -> None:
             )
         for note in notes:
             print(f"    event: {note}")
+    if args.simulated:
+        # no long real geodetic arc is in ../shared: the daily-arc products that made the detector fail
+        # on real ILRS orbits are simulated (abrupt.simulate.products) and pooled as their own class
+        total = tallies.setdefault("geodetic (simulated daily arcs)", ClassTally())
+        for name, cfg in SIMULATED.items():
+            eph = simulate_daily_arcs(cfg)
+            run = detect_orbit(eph, budget=budget)
+            days = float(eph.seconds[-1] - eph.seconds[0]) / 86400.0
+            total.satellites += 1
+            total.sat_days += days
+            total.events += len(run.events)
+            nuisance = sum(not b["raised"] for b in run.summary.get("product_boundaries", []))
+            dv90 = 1e3 * float(run.summary.get("dv90_mps", np.nan))
+            print(
+                f"{name:44s} {'geodetic':8s} {1:5d} {days:8.2f} {len(run.events):6d} "
+                f"{budget.per_day * days:8.2f}  {dv90:.3g}  [{nuisance} day boundaries treated as nuisance]"
+            )
     print(f"\nstated rate {budget.per_day:.4g} per satellite-day ({args.budget}); {time.time() - t_start:.0f} s")
     print(
         f"{'class':9s} {'sats':>5s} {'sat-days':>8s} {'events':>6s} {'expected':>8s} {'95% of expected':>16s} "

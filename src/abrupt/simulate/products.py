@@ -63,7 +63,7 @@ def simulate_daily_arcs(config: DailyArcProduct) -> Ephemeris:
     states = []
     for day in range(config.days):
         t0 = day * DAY_S
-        t_eval = t0 + np.arange(per_day + 1) * config.step_s
+        t_eval = t0 + np.arange(per_day + 1, dtype=np.float64) * config.step_s
         empirical = rng.normal(0.0, config.sigma_empirical_mps2, 6)
         x, _, _ = propagate_with_stm(
             state, t0, t_eval, force=ctx, empirical_mps2=empirical, method="rk8", max_step_s=min(config.step_s, 120.0)
