@@ -213,6 +213,13 @@ def simulate_orbit_command(
     help="Self-calibrated thresholds: standard errors of the fitted level added to it "
     "(1: the false-alarm rate stays within the budget with ~84 % confidence; 0: point estimate).",
 )
+@click.option(
+    "--sequences/--no-sequences",
+    default=True,
+    show_default=True,
+    help="After a detection, remove the burns found from the data and scan again, so that burns close in "
+    "time (pairs 30-90 min apart) are each found with their own ΔV.",
+)
 @click.option("--kind", type=click.Choice(["unknown", "maneuver", "strike"]), default="unknown", show_default=True)
 @click.option(
     "--statistics-out", type=click.Path(dir_okay=False), default=None, help="Per-epoch statistics (.parquet/.csv)."
@@ -238,6 +245,7 @@ def detect_orbit_command(
     statistic: str | None,
     null_file: str | None,
     confidence_z: float,
+    sequences: bool,
     kind: str,
     statistics_out: str | None,
     pseudonym: str | None,
@@ -265,6 +273,7 @@ def detect_orbit_command(
             null=null_file,
             allow_truncated=allow_truncated,
             strict=strict,
+            sequences=sequences,
             tuning=tuning,
             tau_s=tau_s,
             q_m2_s5=q_m2_s5,

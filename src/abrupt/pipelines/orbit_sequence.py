@@ -17,11 +17,14 @@ raises that residual at the same epoch; it is recognised by its time and not rep
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 
 from abrupt.detect.base import DetectionResult
 from abrupt.detect.orbit.detectors import OrbitDetector, orbit_product_boundaries
+from abrupt.detect.orbit.tuning import velocities_from_positions
 from abrupt.model.frames import Ephemeris
 from abrupt.simulate.orbit import inject_impulse
 from abrupt.thresholds import FalseAlarmBudget
@@ -36,8 +39,13 @@ def _times(events: pd.DataFrame) -> np.ndarray:
 
 def remove_burns(eph: Ephemeris, events: pd.DataFrame) -> Ephemeris:
     """The ephemeris with each event's estimated ΔV taken out (an impulse, or a finite burn of the event's
-    ``duration_s``), in time order."""
+    ``duration_s``), in time order. Epochs without velocity (positions-only files) get one from the
+    positions for the propagation and stay without it."""
+    missing = np.asarray(~np.isfinite(eph.velocity_mps).all(axis=1), dtype=bool).reshape(-1)
     out = eph
+    if missing.any():
+        filled = velocities_from_positions(eph.seconds, eph.position_m)
+        out = replace(eph, velocity_mps=np.where(missing[:, None], filled, eph.velocity_mps))
     times = _times(events)
     for k in np.argsort(times):
         row = events.iloc[int(k)]
@@ -49,6 +57,8 @@ def remove_burns(eph: Ephemeris, events: pd.DataFrame) -> Ephemeris:
         if not (out.times_utc[0] <= t < out.times_utc[-1]):
             continue
         out = inject_impulse(out, t, dv, duration_s=dur)
+    if missing.any():
+        out = replace(out, velocity_mps=np.where(missing[:, None], np.nan, out.velocity_mps))
     return out
 
 
