@@ -23,16 +23,10 @@ Documented repairs (counted in the :class:`~abrupt.errors.RepairLog` of each eph
 - an epoch repeated with identical states is dropped; epochs out of order are sorted; gaps against the
   header interval are counted (the filter propagates across them);
 - records of a satellite missing from the header list are read and counted;
-- a header count that the body does not match — the number of epochs on the first line, the number
-  of satellites on the first ``+`` line — is repaired when the records themselves are complete: the
-  file ends with ``EOF`` (or, holding more epochs than announced, its last epoch has a full set of
-  records and its last line is whole). The file is read as found and
-  the repair names both counts ("header announces 5041 epochs, the file holds 5040 complete ones
-  (read as found)"; "header announces 27 satellites but lists 26 (the list is used)").
-  ``strict=True`` makes either mismatch an error, as Orekit does;
-- a file without ``EOF`` that holds fewer epochs than its header announces (a cut file: nothing shows
-  that its last epoch is whole) is an **error**; with
-  ``allow_truncated=True`` it is read and the missing epochs are counted.
+- a header count the body does not match (epochs, satellites) with complete records (``EOF``
+  reached, or a whole last epoch when more epochs than announced) is read as found, the repair naming
+  both counts; ``strict=True`` makes it an error, as Orekit does. A file without ``EOF`` short of its
+  announced epochs is an **error**; ``allow_truncated=True`` reads it and counts the missing epochs.
 
 Errors (:class:`~abrupt.errors.InputError`, ``file:line:column: reason``): unsupported version, a
 malformed header line (first line, ``##``, satellite list, ``%c``/``%f`` lines, unknown header
@@ -54,6 +48,7 @@ from numpy.typing import NDArray
 
 from abrupt.errors import InputError, RepairLog
 from abrupt.readers.compression import read_bytes
+from abrupt.readers.sp3_records import last_epoch_complete
 from abrupt.series.ephemeris import Ephemeris
 
 #: Offsets of SP3 time systems from TAI (s): t_TAI = t_sys + offset (GPS ICD, Galileo OS SIS ICD,
@@ -374,30 +369,6 @@ def _read_lines(path: str | Path) -> list[str]:
     return lines
 
 
-def _last_epoch_complete(lines: Sequence[str], body: int, header: Sp3Header) -> bool:
-    """Whether the records of the last epoch are whole in a file without ``EOF``: as many position
-    (and velocity) records as the epoch before it holds (the header's satellite count when there is
-    one epoch), and a last line as long as the record before it."""
-    blocks: list[Counter[str]] = []
-    lengths: dict[str, list[int]] = {"P": [0, 0], "V": [0, 0]}  # per record type: previous, last
-    last_tag = "P"
-    for line in lines[body:]:
-        if line.startswith("*"):
-            blocks.append(Counter())
-        elif line[:1] in ("P", "V") and blocks:
-            last_tag = line[0]
-            blocks[-1][last_tag] += 1
-            lengths[last_tag] = [lengths[last_tag][1], len(line.rstrip())]
-    if not blocks:
-        return False
-    wanted = blocks[-2] if len(blocks) > 1 else Counter({"P": len(header.satellites)})
-    if header.has_velocity and len(blocks) == 1:
-        wanted["V"] = len(header.satellites)
-    full = all(blocks[-1][k] >= n for k, n in wanted.items())
-    previous, last = lengths[last_tag]
-    return full and last >= previous
-
-
 def parse_sp3(
     path: str | Path, *, allow_truncated: bool = False, strict: bool = False, repairs: RepairLog | None = None
 ) -> Sp3File:
@@ -516,7 +487,9 @@ def parse_sp3(
         missing = header.n_epochs - n_epoch_lines
         # complete records: the writer reached EOF; without EOF a file short of epochs is a cut file,
         # one with more epochs than announced must end with a full last epoch
-        complete = seen_eof or (missing < 0 and _last_epoch_complete(lines, body, header))
+        complete = seen_eof or (
+            missing < 0 and last_epoch_complete(lines[body:], header.satellites, header.has_velocity)
+        )
         if complete and not strict:
             log.record(
                 f"header announces {header.n_epochs} epochs, the file holds {n_epoch_lines} complete ones "
