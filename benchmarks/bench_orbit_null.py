@@ -14,7 +14,9 @@ Pass rule per class (acceptance): the observed count is at most the upper end of
 Poisson interval of the count expected at the stated rate, and the observed rate is at most 2 × the
 stated one. The realised rate is printed with its exact (Garwood) 95 % interval beside the stated rate.
 
-No long geodetic (passive laser-ranging) arc is in ``../shared``; two daily-arc products are simulated
+The two ILRS CPF predictions of ``../shared/data/tracking/ilrs-corpus`` (LAGEOS-1, Galileo 212; real,
+positions only) are added to their classes. No long geodetic (passive laser-ranging) SP3 arc is in
+``../shared``; two daily-arc products are simulated
 (:mod:`abrupt.simulate.products`, seeds other than those the boundary rule was developed on) and
 pooled as their own class, labelled as simulated.
 
@@ -37,6 +39,7 @@ from scipy import stats
 
 from abrupt.errors import InputError
 from abrupt.pipelines.orbit import detect_orbit
+from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.readers.sp3 import parse_sp3
 from abrupt.series.ephemeris import Ephemeris
 from abrupt.simulate.products import DailyArcProduct, simulate_daily_arcs
@@ -66,7 +69,9 @@ def orbit_class(eph: Ephemeris) -> str:
     alt_km = float(np.median(np.linalg.norm(eph.position_m, axis=1))) / 1e3 - 6378.137
     if alt_km < 2000.0:
         return "LEO"
-    if eph.satellite[:1] in GNSS_PREFIXES and eph.satellite[1:].isdigit() and alt_km > 15000.0:
+    sid = eph.satellite.lower()
+    named = sid.startswith(("galileo", "glonass", "gps", "beidou", "compass", "qzs", "irnss"))
+    if alt_km > 15000.0 and (named or (eph.satellite[:1] in GNSS_PREFIXES and eph.satellite[1:].isdigit())):
         return "GNSS"
     return "geodetic"
 
@@ -137,6 +142,22 @@ def main() -> None:
             )
         for note in notes:
             print(f"    event: {note}")
+    # real ILRS predictions (CPF, positions only) of a passive geodetic and a GNSS satellite: no SP3, but
+    # real orbits of the two classes the SP3 folder holds only briefly
+    for path in sorted((DATA.parent / "tracking" / "ilrs-corpus").glob("*_cpf_*")):
+        eph = read_ephemeris(path)
+        cls = orbit_class(eph)
+        total = tallies.setdefault(cls, ClassTally())
+        run = detect_orbit(eph, budget=budget)
+        days = float(eph.seconds[-1] - eph.seconds[0]) / 86400.0
+        total.satellites += 1
+        total.sat_days += days
+        total.events += len(run.events)
+        dv90 = 1e3 * float(run.summary.get("dv90_mps", np.nan))
+        print(
+            f"{path.name:44s} {cls:8s} {1:5d} {days:8.2f} {len(run.events):6d} {budget.per_day * days:8.2f}  "
+            f"{dv90:.3g}  [ILRS CPF prediction, positions only]"
+        )
     if args.simulated:
         # no long real geodetic arc is in ../shared: the daily-arc products that made the detector fail
         # on real ILRS orbits are simulated (abrupt.simulate.products) and pooled as their own class

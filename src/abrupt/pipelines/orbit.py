@@ -112,7 +112,7 @@ def detect_orbit(
     read files that end before the epochs their header announces (counted repair, :func:`load_ephemeris`);
     ``strict``: header counts the records do not match are errors. ``sequences``: after a detection, remove
     the burns found and scan again, so that burns close in time are each found with their own ΔV
-    (:func:`abrupt.pipelines.orbit_sequence.resolve_sequence`).
+    (:func:`abrupt.pipelines.orbit_sequence.resolve_sequence`; with the ``glr`` statistic).
     """
     eph = load_ephemeris(source, satellite, allow_truncated=allow_truncated, strict=strict)
     null_eph = (
@@ -124,7 +124,8 @@ def detect_orbit(
     det = cls(null=null_eph, **settings)
     fa = as_budget(budget)
     result = det.detect(eph, fa)
-    if sequences and len(result.events):
+    # the removal needs the sharp time of the GLR; the thesis statistics' broad humps would re-raise
+    if sequences and det.statistic == "glr" and len(result.events):
         events, notes = resolve_sequence(det, eph, fa, result)
         result = replace(result, events=events, warnings=(*result.warnings, *notes))
     run = OrbitRun(eph, det, result, fa)
