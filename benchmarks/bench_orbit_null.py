@@ -22,7 +22,9 @@ pooled as their own class, labelled as simulated.
 
 Held out: nothing in the detector was tuned on the GNSS or geodetic files; the self-calibration rules
 were set on Sentinel-3A (docs/orbit.md), so Sentinel-3A is in-sample and every other file held out. The
-boundary rule was developed on simulated products with seeds 0 and 1; the benchmark uses seeds 3 and 4.
+boundary rule was developed on simulated products with seeds 0 and 1, and its pattern level relaxed from
+10⁻³ to 5 % after seeds 3 and 4 (the Etalon-like seed 4 kept 2 boundary events); the benchmark now uses
+seeds 5 and 6, not seen before.
 
     nice python benchmarks/bench_orbit_null.py [--max-sats N] [--budget 1/week]
 """
@@ -48,8 +50,8 @@ from abrupt.thresholds import FalseAlarmBudget
 DATA = Path(__file__).resolve().parents[1].parent / "shared/data/sp3"
 GNSS_PREFIXES = ("G", "R", "E", "C", "J", "I")
 SIMULATED = {
-    "simulated LAGEOS-like, 4 days at 2 min": DailyArcProduct(days=4, step_s=120.0, seed=3),
-    "simulated Etalon-like, 7 days at 15 min": DailyArcProduct(days=7, step_s=900.0, altitude_m=19.1e6, seed=4),
+    "simulated LAGEOS-like, 4 days at 2 min": DailyArcProduct(days=4, step_s=120.0, seed=5),
+    "simulated Etalon-like, 7 days at 15 min": DailyArcProduct(days=7, step_s=900.0, altitude_m=19.1e6, seed=6),
 }
 MIN_SPAN_H = 6.0  # shorter arcs: the filters settle for up to a few hours at each end
 

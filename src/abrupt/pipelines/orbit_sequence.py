@@ -9,7 +9,8 @@ and the first burn's ΔV is estimated with the second one in its backward filter
 :func:`resolve_sequence` removes every burn found so far from the data — the estimated ΔV (orbit frame,
 and duration for a finite burn) is subtracted with the deviation propagation of
 :func:`abrupt.simulate.orbit.inject_impulse`, which is the orbit with the burn in its model — and
-scans the corrected arc again; a new detection farther than ``separation_s`` from every known burn is
+scans the corrected arc again, with the thresholds of the first scan (the file's own null); a new
+detection farther than ``separation_s`` from every known burn is
 a further burn. When more than one burn is found, each one's time and ΔV are estimated again on the
 data with all the others removed. A burn whose removal leaves a residual (ΔV error of a few per cent)
 raises that residual at the same epoch; it is recognised by its time and not reported again.
@@ -17,13 +18,14 @@ raises that residual at the same epoch; it is recognised by its time and not rep
 
 from __future__ import annotations
 
+import copy
 from dataclasses import replace
 
 import numpy as np
 import pandas as pd
 
 from abrupt.detect.base import DetectionResult
-from abrupt.detect.orbit.detectors import OrbitDetector, orbit_product_boundaries
+from abrupt.detect.orbit.detectors import OrbitDetector, orbit_product_boundaries, orbit_thresholds
 from abrupt.detect.orbit.tuning import velocities_from_positions
 from abrupt.model.frames import Ephemeris
 from abrupt.simulate.orbit import inject_impulse
@@ -95,6 +97,9 @@ def resolve_sequence(
     if len(events) == 0:
         return events, notes
     nuisance = [b for b in orbit_product_boundaries(first) if not b["raised"]]
+    # the later scans keep the first scan's thresholds: the null is the file's, not the corrected copy's
+    detector = copy.copy(detector)
+    detector.fixed_thresholds = orbit_thresholds(first)
     while len(events) < max_burns:
         again = detector.detect(remove_burns(eph, events), budget).events
         fresh = _new(again, events, separation_s, nuisance)

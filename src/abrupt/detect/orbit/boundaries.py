@@ -11,9 +11,9 @@ so they are treated apart:
 1. **Is the product discontinuous at its day boundaries?** Decided from the statistic's pattern: the
    peak of the event statistic within ±``window`` of each boundary is compared with the ordinary
    threshold h. A product without discontinuities exceeds h there at the budget's rate (a few per
-   cent of boundaries at most); two or more boundaries above h — a binomial probability below 10⁻³
-   for a week's file at the default budget — establish the pattern. One boundary alone cannot be
-   told from a burn and is left to the ordinary threshold.
+   cent of boundaries at most); two or more boundaries above h, with a binomial probability below
+   5 % at that rate, establish the pattern. One boundary alone cannot be told from a burn and is left
+   to the ordinary threshold.
 2. **Nuisance or burn?** The boundary jumps form their own population. Each boundary's peak ℓᵢ is
    compared with a bound from the *other* boundaries (leave-one-out, so a burn at a boundary does not
    raise its own bound): if the jumps' GLR peaks are s·χ²₃ (an isotropic random state difference seen
@@ -41,7 +41,9 @@ from abrupt.types import FloatArray
 #: share of the false-alarm budget spent on boundary epochs
 BOUNDARY_SHARE = 0.1
 #: binomial probability below which boundaries above the ordinary threshold are a pattern, not chance
-PATTERN_P = 1e-3
+#: (a pattern declared by chance costs little: it needs two boundaries above the threshold, i.e. two
+#: false alarms that the treatment then removes; only burns at two or more boundaries are at risk)
+PATTERN_P = 0.05
 
 
 @dataclass(frozen=True)

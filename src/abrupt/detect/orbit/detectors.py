@@ -120,6 +120,8 @@ class OrbitDetector(Detector[Ephemeris]):
         self.spacecraft = spacecraft
         self.run_id = run_id
         self._null = null
+        #: thresholds to use instead of calibrating (a later scan of the same arc keeps the first's)
+        self.fixed_thresholds: dict[str, Threshold] | None = None
 
     def config(self) -> dict[str, Any]:
         out = super().config()
@@ -164,7 +166,9 @@ class OrbitDetector(Detector[Ephemeris]):
             return DetectionResult.empty(warnings=(f"{len(series)} epochs: too few to filter",))
         cfg = self.detector_config(series, budget)
         analysis = analyse(series, cfg)
-        if self._null is not None:
+        if self.fixed_thresholds is not None:
+            thresholds = dict(self.fixed_thresholds)
+        elif self._null is not None:
             null = analyse(self._null, cfg)
             thresholds = calibrate_thresholds(null.statistics, sample_rate_hz=null.sample_rate_hz, budget=budget)
         else:
@@ -193,7 +197,7 @@ class OrbitDetector(Detector[Ephemeris]):
         boundaries, blanked = product_boundaries(analysis, thresholds[name].value, budget, name)
         if not boundaries:
             return [], analysis
-        if self._null is None:
+        if self._null is None and self.fixed_thresholds is None:
             mask = boundary_mask(analysis, boundaries)
             quiet = {k: np.where(mask, np.nan, v) for k, v in analysis.statistics.items()}
             thresholds.update(
