@@ -1,4 +1,4 @@
-"""Attitude change detection: thesis reproduction (issue 2, acceptance 2) and power curves (acceptance 3).
+"""Attitude change detection: thesis reproduction and power curves.
 
 Run:  python benchmarks/bench_attitude_detection.py [--quick] [--runs N] [--plot PATH]
 
@@ -25,11 +25,12 @@ from scipy import stats
 
 from abrupt.detect.attitude.change_detection import WindowConfig, sliding_statistic
 from abrupt.detect.attitude.momentum import AttitudeDetectionConfig, MomentumChangeDetector, attitude_detector_class
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike, simulate_attitude_batch
 from abrupt.model.momentum import system_momentum
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 from abrupt.readers.telemetry import telemetry_from_frame
 from abrupt.series.attitude import AttitudeSeries
-from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude, simulate_attitude_batch
+from abrupt.simulate.attitude import simulate_attitude
 from abrupt.thresholds import fit_threshold
 
 SC = load_spacecraft(bundled_spacecraft_path())
@@ -246,4 +247,8 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    name = "bench_attitude_false_alarms" if variant({"--part=c": "c"}) else "bench_attitude_detection"
+    with write_results(name, variant({"--quick": "quick"})):
+        main()

@@ -1,4 +1,4 @@
-"""Wall time of the attitude pipeline (issue 8: the refactoring must not slow detection down).
+"""Wall time of the attitude pipeline (the refactoring must not slow detection down).
 
 Simulates one hour of 10 Hz telemetry of the thesis spacecraft with one strike, runs
 ``abrupt.pipelines.attitude.detect_attitude`` with glr, cusum and summation (thresholds from 2e6
@@ -13,10 +13,11 @@ import argparse
 import time
 
 from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 from abrupt.pipelines.attitude import detect_attitude
 from abrupt.readers.telemetry import telemetry_from_frame
-from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude
+from abrupt.simulate.attitude import simulate_attitude
 
 
 def main() -> None:

@@ -1,4 +1,4 @@
-"""Attitude simulator: physics checks, agreement with Basilisk and speed (issue 2, acceptance 1 and 4).
+"""Attitude simulator: physics checks, agreement with Basilisk and speed.
 
 Prints, beside the issue's targets:
 
@@ -19,15 +19,11 @@ import time
 
 import numpy as np
 
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike, simulate_attitude_batch
 from abrupt.model.momentum import system_momentum
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
-from abrupt.simulate.attitude import (
-    AttitudeSimConfig,
-    Strike,
-    simulate_attitude,
-    simulate_attitude_basilisk,
-    simulate_attitude_batch,
-)
+from abrupt.simulate.attitude import simulate_attitude
+from abrupt.simulate.attitude_basilisk import simulate_attitude_basilisk
 
 
 def main() -> None:

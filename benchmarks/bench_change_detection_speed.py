@@ -1,4 +1,4 @@
-"""Change-detector throughput on one core and streaming memory over a long stream (issue 2, acceptance 4).
+"""Change-detector throughput on one core and streaming memory over a long stream.
 
 Run:  python benchmarks/bench_change_detection_speed.py [--quick]
 
@@ -74,4 +74,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results("bench_change_detection_speed", variant({"--quick": "quick"})):
+        main()

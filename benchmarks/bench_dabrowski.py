@@ -9,13 +9,14 @@ baseline runs Phase A uses (``fit_gyro_error_model`` + ``momentum_exchange_ml``)
 it prints the white-noise floor (``white_noise_floor``: the Cramér-Rao bound if the gyro's white noise
 were its only error).
 
-The testbed noise is ``THESIS_TESTBED`` (session 4: tracked gyro drift chosen by Table 4.4's Method 1
-errors with one amplitude held out, white rate noise and wheel gain fitted to the six single-run SDs of
-Tables 4.3-4.4; ``calibrate_dabrowski_noise.py``); ``--session3-noise`` is session 3's (1° SD only),
+The testbed noise is ``THESIS_TESTBED`` (tracked gyro drift chosen by Table 4.4's Method 1 errors with
+one amplitude held out, white rate noise and wheel gain fitted to the six single-run SDs of Tables
+4.3-4.4; ``calibrate_dabrowski_noise.py``); ``--drift-free-noise`` is the simpler testbed without gyro
+drift (fitted to the 1° SD only),
 ``--noise WG_SD,RATE_DEG_S,DRIFT_DEG_MIN`` another, ``--gyro-scale-sd`` adds a run-to-run gyro scale error.
 ``--experiments E`` runs E independent thesis-layout experiments per amplitude (each with its own Phase A)
 and prints means with 95% bootstrap intervals over experiments and the percentile of the thesis's
-value; ``--groups K`` (session 3) runs K ten-run groups per configuration sharing one Phase A.
+value; ``--groups K`` runs K ten-run groups per configuration sharing one Phase A.
 ``--center-on-previous-run`` and ``--center-on-actual`` reproduce App. C's grid centring (each run's grid on
 the previous run's last grid value; each set's first grid on its actual MOI; spec §5.4 [C]), for ``--experiments``.
 Run: ``PYTHONPATH=src nice python benchmarks/bench_dabrowski.py [--experiments 30] [--groups K]
@@ -50,7 +51,7 @@ from reproductions.simsat import (
     white_noise_floor,
 )
 
-NOISE_SESSION3 = TestbedNoise(wheel_gain_sd=0.025, wander_deg=0.06, rate_noise_deg_s=0.07)
+NOISE_DRIFT_FREE = TestbedNoise(wheel_gain_sd=0.025, wander_deg=0.06, rate_noise_deg_s=0.07)
 NOISE = THESIS_TESTBED  # calibrated by benchmarks/calibrate_dabrowski_noise.py and --experiments (docs)
 THESIS = {  # Table 4.4 / 4.3: mean error, mean range, mean SD (Method 1); baseline SD
     0.5: (0.03518, 0.2398, 0.07733, 0.0416),
@@ -282,7 +283,7 @@ if __name__ == "__main__":
     ap.add_argument("--seed", type=int, default=2003)
     ap.add_argument("--experiments", type=int, default=0, help="independent thesis-layout experiments instead")
     ap.add_argument("--noise", default="", help="wheel_gain_sd,rate_noise_deg_s,gyro_bias_deg_min (else NOISE)")
-    ap.add_argument("--session3-noise", action="store_true", help="the testbed noise of session 3")
+    ap.add_argument("--drift-free-noise", action="store_true", help="the testbed noise without gyro drift")
     ap.add_argument("--gyro-scale-sd", type=float, default=0.0, help="run-to-run gyro scale-factor SD (relative)")
     ap.add_argument(
         "--center-on-previous-run", action="store_true", help="App. C quirk: each run's grid on the previous run's"
@@ -292,8 +293,8 @@ if __name__ == "__main__":
     if args.noise:
         wg_sd, rate, drift = (float(v) for v in args.noise.split(","))
         NOISE = replace(NOISE, wheel_gain_sd=wg_sd, rate_noise_deg_s=rate, gyro_bias_deg_min=drift)
-    if args.session3_noise:
-        NOISE = NOISE_SESSION3
+    if args.drift_free_noise:
+        NOISE = NOISE_DRIFT_FREE
     if args.gyro_scale_sd:
         NOISE = replace(NOISE, gyro_scale_sd=args.gyro_scale_sd)
     amps = tuple(float(a) for a in args.amplitudes.split(","))

@@ -1,4 +1,4 @@
-"""Acceptance 1 (issue 14): synthetic CubeSat constellation → density without any object's B.
+"""Synthetic CubeSat constellation → density without any object's B.
 
 Prints the RMS relative density error of the joint estimate (abrupt.density.joint: one weighted
 least-squares fit of s(t) and every B_j, scale from the platforms' B range by order statistics), of

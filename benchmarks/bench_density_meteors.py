@@ -1,4 +1,4 @@
-"""Acceptance 2 (issue 14): density ratios from 500 synthetic head echoes at 80-120 km.
+"""Density ratios from 500 synthetic head echoes at 80-120 km.
 
 Prints the RMS relative error of the density ratios between consecutive 5 km levels (target
 < 12 %, goal 6 %) beside the slides' figure (12 %, ALTAIR, slide "Conclusions"). The simulator obeys

@@ -1,4 +1,4 @@
-"""Build item 2 (issue 14): ρB and density from precise orbits (``abrupt density orbit``).
+"""ρB and density from precise orbits (``abrupt density orbit``).
 
 1. Simulated truth: days of a precise orbit (DOP853, EGM2008 40×40, Sun, Moon, SRP ×1.1) whose true
    density is NRLMSIS 2.1 (explicit indices, point by point along the true orbit) times a known factor

@@ -1,4 +1,4 @@
-"""Acceptance 3 and 4a (issue 14): ρB from real TLE histories against NRLMSIS along the same orbits.
+"""ρB from real TLE histories against NRLMSIS along the same orbits.
 
 For CryoSat-2 (~720 km, 2010-2022) and Sentinel-3A (815 km, 2016-2022): 30-day windows, maneuvers
 removed with abrupt's TLE maneuver detector; prints the correlation of log(ρB) with log(ρ_MSIS), the
@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from abrupt.density.report import plot_density_bands
 from abrupt.density.tle_drag import TleDragConfig, rho_b_from_history
 from abrupt.readers.tle import read_tle
+from abrupt.report.density import plot_density_bands
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "tle"
 OUT = Path(__file__).resolve().parents[1] / "docs" / "results" / "density_real.png"

@@ -1,4 +1,4 @@
-"""Acceptance 4 (issue 14): speed of the density pipeline, printed beside the targets.
+"""Speed of the density pipeline, printed beside the targets.
 
 * ten years of one object's element sets → ρB series: target < 10 s (CryoSat-2 from the shared
   data, 1-day windows; with and without abrupt's TLE maneuver detector, and with NRLMSIS along the
@@ -117,4 +117,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import write_results
+
+    with write_results("bench_density_speed"):
+        main()

@@ -1,4 +1,4 @@
-"""A 5 kg parasite docking at 1 m from the CoM of a 1,000 kg spacecraft, routine slews only (issue 13, acceptance 3).
+"""A 5 kg parasite docking at 1 m from the CoM of a 1,000 kg spacecraft, routine slews only.
 
 Days of simulated routine telemetry (nadir pointing, 2-4 slews a day about random axes, gravity gradient,
 sun-tracking array, star tracker 7", gyro 5e-6 rad/s, 64-pulse tachometers), one inertia estimate per
@@ -15,7 +15,7 @@ day (days are simulated, estimated and dropped one at a time), the ``mass.inerti
   independent days) and the detector run on each: false alarms per year with a 95% interval.
 
 Seeds differ from every test.
-Momentum dumps are on (the simulator's default since session 4: system momentum above 0.5 N m s at the
+Momentum dumps are on (the simulator's default: system momentum above 0.5 N m s at the
 start of a day is removed by a flagged thruster impulse that day); ``--no-dumps`` turns them off.
 ``--year`` saves the year's daily track (``/tmp/inertia_track_null_year[_nodumps].npz``); ``--track FILE``
 re-runs only the detector on such a file (the year's report and resampled years in about a minute).

@@ -2,7 +2,7 @@
 
 Prints the wall time in-process and on a two-worker ``distributed.LocalCluster`` (cluster start-up
 shown apart), the speed-up, the peak memory of each worker process and of the in-process run, and
-checks the events are identical. Target (issue 12): a speed-up close to the number of cores for
+checks the events are identical. Target: a speed-up close to the number of cores for
 independent (spacecraft, day) tasks, memory per worker bounded by one task's telemetry.
 
     python benchmarks/bench_fleet_scale.py            # 8 spacecraft-days, 10 M null samples per task
@@ -20,10 +20,11 @@ from pathlib import Path
 import pandas as pd
 
 from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 from abrupt.pipelines.fleet import detect_attitude_fleet, read_manifest
 from abrupt.scale import Executor, dask_client
-from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude, write_telemetry
+from abrupt.simulate.attitude import simulate_attitude, write_telemetry
 
 
 def make_fleet(folder: Path, n_days: int) -> Path:

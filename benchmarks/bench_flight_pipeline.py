@@ -1,4 +1,4 @@
-"""Flight-telemetry pipeline on kestrel (issue 9): detection vs truth, baseline without cleaning,
+"""Flight-telemetry pipeline on kestrel: detection vs truth, baseline without cleaning,
 chunked vs whole, memory against days, injection/recovery, speed.
 
     PYTHONPATH=$PWD/src nice python benchmarks/bench_flight_pipeline.py [--store DIR] [--parts detect,...]
@@ -21,6 +21,7 @@ import pandas as pd
 
 from abrupt.model.spacecraft import load_spacecraft
 from abrupt.pipelines.flight import CleaningConfig, FlightRunConfig, ingest_archives, run_flight
+from abrupt.pipelines.flight_injection import injection_recovery
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT.parent / "shared" / "data" / "flight-like"
@@ -102,8 +103,6 @@ def part_detect(store: Path) -> None:
 
 
 def part_inject(store: Path) -> None:
-    from abrupt.pipelines.flight import injection_recovery
-
     sc = load_spacecraft(KESTREL)
     cfg = FlightRunConfig()
     t = time.time()

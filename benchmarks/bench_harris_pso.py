@@ -22,12 +22,12 @@ import numpy as np
 from abrupt.massprops.inertia import axis_errors_deg, inertia_from_principal, perturb_inertia, principal_axes
 from abrupt.massprops.momentum_balance import estimate_inertia
 from abrupt.massprops.telemetry import momentum_data_from_simulation
+from abrupt.model.attitude_dynamics import AttitudeSimConfig
 from abrupt.model.momentum import body_momentum
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import spacecraft_from_dict
-from abrupt.simulate.attitude import (
+from abrupt.simulate.pointing import (
     AppendageMotion,
-    AttitudeSimConfig,
     CircularOrbit,
     PointingScenario,
     ReferenceTrajectory,

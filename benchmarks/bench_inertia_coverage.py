@@ -1,4 +1,4 @@
-"""Monte Carlo check of the direct estimator's stated uncertainty (issue 13 acceptance 1: truth in 2σ).
+"""Monte Carlo check of the direct estimator's stated uncertainty.
 
 N independent flight-like days from :func:`reproductions.routine_telemetry.simulate_routine_day`
 (three spacecraft, random catalogue error of up to 6 % and 6°, random slews, strikes, a loss-of-signal

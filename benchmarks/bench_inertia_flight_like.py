@@ -1,4 +1,4 @@
-"""Inertia from routine telemetry on the flight-like set (issue 13 acceptance 1 and 4).
+"""Inertia from routine telemetry on the flight-like set.
 
 * direct momentum-balance estimator on both days, and leave-one-day-out (each day alone);
 * principal moments and axes against ``truth_inertia.json`` (read here for scoring only, never passed
@@ -41,18 +41,18 @@ from abrupt.massprops.inertia import (
 )
 from abrupt.massprops.momentum_balance import MomentumBalanceData, estimate_inertia
 from abrupt.massprops.telemetry import momentum_data_from_simulation
+from abrupt.model.attitude_dynamics import AttitudeSimConfig
 from abrupt.model.momentum import body_momentum
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import spacecraft_from_dict
-from abrupt.simulate.attitude import (
+from abrupt.simulate.docking import random_slews
+from abrupt.simulate.pointing import (
     AppendageMotion,
-    AttitudeSimConfig,
     CircularOrbit,
     PointingScenario,
     ReferenceTrajectory,
     simulate_pointing,
 )
-from abrupt.simulate.docking import random_slews
 from reproductions.pso import SlewWindow, find_slews, harris_objective, inertia_from_correction, two_pass_swarm
 
 FOLDER = Path(__file__).resolve().parents[2] / "shared" / "data" / "flight-like"

@@ -40,8 +40,8 @@ from abrupt.detect.attitude.matched_filter import (
     fit_matched_filter_thresholds,
     matched_filter_bank_statistics,
 )
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike, simulate_attitude_batch
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
-from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude_batch
 from abrupt.thresholds import fit_threshold, neyman_pearson_threshold, p_fa_per_sample
 
 RATE_HZ = 10.0

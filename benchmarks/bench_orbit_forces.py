@@ -1,4 +1,4 @@
-"""Post-fit residuals of real precise orbits with each force model (issue 10, acceptance 3), and the
+"""Post-fit residuals of real precise orbits with each force model, and the
 choice of the default gravity degree; plus the one-step model error the filter's Gauss-Markov states
 must absorb and the cost per filter step.
 
@@ -22,9 +22,9 @@ import numpy as np
 
 from abrupt.detect.orbit.ekf import FilterConfig
 from abrupt.detect.orbit.kernels import propagate_state
-from abrupt.model.frames import Ephemeris
 from abrupt.model.orbit import ForceContext, ForceModel, propagate_with_stm
 from abrupt.readers.sp3 import read_sp3
+from abrupt.series.ephemeris import Ephemeris
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared/data/sp3"
 ARCS = {

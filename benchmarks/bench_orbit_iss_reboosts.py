@@ -1,4 +1,4 @@
-"""ISS-like reboosts in a full-force-model truth (issue 10, acceptance 2).
+"""ISS-like reboosts in a full-force-model truth.
 
 Truth: 400 km, 51.6°, ISS-like area-to-mass (420 t, 2000 m² for drag and SRP: A/m 0.0048 m²/kg),
 EGM2008 ``--truth-degree`` × same, Sun, Moon, SRP with conical shadow, exponential drag, integrated
@@ -119,4 +119,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results("bench_orbit_iss_reboosts", variant({"--step-s=240": "240s"})):
+        main()

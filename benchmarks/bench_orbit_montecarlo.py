@@ -1,4 +1,4 @@
-"""Monte Carlo reproduction of Bennett 2022 ch. 3 and detection-power curves (issue 3, acceptance 1-2).
+"""Monte Carlo reproduction of Bennett 2022 ch. 3 and detection-power curves.
 
 Thesis defaults (Table 3.1): 200 kg, 800 km circular, i = 40°, σ_pos = 10 m, σ_vel = 0.25 m/s, 1 Hz,
 two-body truth and filter, τ = 1 s, q = 2.15e-11 m²/s⁵. Thresholds at one false alarm per week
@@ -532,4 +532,9 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results(
+        "bench_orbit_montecarlo", variant({"--only-perturbed": "perturbed", "--tuned": "tuned", "--quick": "quick"})
+    ):
+        main()

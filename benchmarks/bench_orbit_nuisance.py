@@ -1,4 +1,4 @@
-"""Estimated nuisance parameters on the real arcs (issue 10, build item 2): post-fit residuals, whiteness
+"""Estimated nuisance parameters on the real arcs: post-fit residuals, whiteness
 of the null and the estimates, with and without the nuisance states.
 
 For each real SP3 arc in ../shared/data/sp3 (Sentinel-3A 9.1 days, Jason-1 9.9 days, 60 s) the default
@@ -97,4 +97,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import write_results
+
+    with write_results("bench_orbit_nuisance"):
+        main()

@@ -1,5 +1,4 @@
-"""Real precise orbit (Sentinel-3A DORIS SP3, 9.1 days, no maneuver): false alarms and injected ΔVs
-(issue 3, acceptance 3).
+"""Real precise orbit (Sentinel-3A DORIS SP3, 9.1 days, no maneuver): false alarms and injected ΔVs.
 
 1. The whole arc through the default pipeline (auto tuning from the data, McReynolds-acceleration
    statistic, thresholds self-calibrated on the arc with leave-out at one false alarm per week):
@@ -26,8 +25,8 @@ from abrupt.detect.orbit.analysis import OrbitAnalysis, OrbitDetectorConfig, ana
 from abrupt.detect.orbit.calibration import self_calibrate
 from abrupt.detect.orbit.events import find_events
 from abrupt.detect.orbit.tuning import auto_tune
-from abrupt.model.frames import Ephemeris
 from abrupt.readers.sp3 import read_sp3
+from abrupt.series.ephemeris import Ephemeris
 from abrupt.simulate.orbit import inject_impulse
 
 DEFAULT_SP3 = Path(__file__).resolve().parents[1].parent / "shared/data/sp3/ssas3a20.b18358.e19003.DG_.sp3"
@@ -160,4 +159,7 @@ def analyse_cached(an: OrbitAnalysis, name: str, dv_estimate: str | None = None)
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results("bench_orbit_real", variant({"--arc-days=2": "2day", "--quick": "quick"})):
+        main()

@@ -165,10 +165,13 @@ def real_arc_speed(path: str, nuisance: bool = False) -> None:
 
 
 if __name__ == "__main__":
-    if "--real-only" not in sys.argv:
-        main()
-    if "--real" in sys.argv or "--real-only" in sys.argv:
-        real_arc_speed(
-            str(Path(__file__).resolve().parents[1].parent / "shared/data/sp3/ssas3a20.b18358.e19003.DG_.sp3"),
-            nuisance="--nuisance" in sys.argv,
-        )
+    from _results import variant, write_results
+
+    with write_results("bench_orbit_speed", variant({"--real-only": "real", "--nuisance": "nuisance"})):
+        if "--real-only" not in sys.argv:
+            main()
+        if "--real" in sys.argv or "--real-only" in sys.argv:
+            real_arc_speed(
+                str(Path(__file__).resolve().parents[1].parent / "shared/data/sp3/ssas3a20.b18358.e19003.DG_.sp3"),
+                nuisance="--nuisance" in sys.argv,
+            )

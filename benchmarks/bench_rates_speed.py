@@ -1,4 +1,4 @@
-"""Throughput of the strike-rate Monte Carlo, strike location included (issue 4, acceptance 5).
+"""Throughput of the strike-rate Monte Carlo, strike location included.
 
 Target: one million draws (size, speed, direction, array angle, silhouette strike location, mass, MEF,
 ΔP, ΔH, ΔV, Δa) in under 5 s on one core. Run with ``nice python benchmarks/bench_rates_speed.py``;

@@ -23,8 +23,8 @@ import numpy as np
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 from abrupt.rates.montecarlo import RateConfig
-from abrupt.rates.plots import plot_dh_dv_scatter, plot_rate_curves
 from abrupt.rates.trades import CaseResult, Scenario, run_trade, spread
+from abrupt.report.rates import plot_dh_dv_scatter, plot_rate_curves
 
 ROOT = Path(__file__).resolve().parent.parent
 SC = ROOT / "examples" / "spacecraft"

@@ -1,8 +1,8 @@
 """Laser ranging of a LAGEOS-like orbit: quiet without maneuvers, 1 cm/s maneuvers found, what each term costs.
 
-Issue 15 acceptance 1-2. Simulates ``--days`` of two-minute normal points from four stations with the
-full range model in the truth (simulate/slr.py), runs the laser-ranging pipeline (reduce, fit, weight by
-post-fit residuals, GLRT at 0.1 false alarms per day) and prints
+Simulates ``--days`` of two-minute normal points from four stations with the full range model in the
+truth (simulate/slr.py), runs the laser-ranging pipeline (detector ``tracking.laser_glrt``: reduce,
+fit, weight by post-fit residuals, GLRT at 0.1 false alarms per day) and prints
 
 * false alarms on maneuver-free campaigns against the budget (acceptance: none at 0.1/day);
 * detection of a 1 cm/s impulse in a random direction at a random time (acceptance: ≥ 90% found with
@@ -125,4 +125,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import write_results
+
+    with write_results("bench_slr_lageos"):
+        main()

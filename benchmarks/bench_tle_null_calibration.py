@@ -107,7 +107,8 @@ def run_one(job: tuple[str, dict[str, Any]]) -> list[dict[str, Any]]:
     rows = []
     for budget in BUDGETS:
         run = det.detect(history, budget)
-        before = pd.to_datetime(run.events["elset_epoch_before_utc"]).to_numpy(dtype="datetime64[ns]")
+        maneuvers = run.events.loc[run.events["kind"] != "maneuver_campaign"]  # campaigns summarise them
+        before = pd.to_datetime(maneuvers["elset_epoch_before_utc"]).to_numpy(dtype="datetime64[ns]")
         gap = np.clip(np.searchsorted(epochs, before), 0, n_gaps - 1)
         rows.append(
             {

@@ -1,14 +1,13 @@
-"""Compare two event files column by column, ignoring ``run_id`` (issue 8, acceptance 2).
+"""Compare two event files column by column, ignoring ``run_id``.
 
     python benchmarks/compare_events.py BEFORE.csv AFTER.csv [--rtol 0] [--rename OLD=NEW ...]
 
 Prints the rows and columns that differ and exits with status 1 if any do. Text columns must be
 equal; float columns equal (or within ``--rtol``; NaN equals NaN). ``--rename`` maps an old
-detector name to its new one (issue 8 gave every detector one naming scheme, ``kaderali_k`` became
-``tracking.kaderali_k``); the old event identifiers are then recomputed with the new name, which
-checks that nothing else in the identity (spacecraft, kind, time, configuration hash) changed. Used
-to show that the refactoring of issue 8 leaves the events of ``abrupt demo`` and of the real W3B
-tracking arc unchanged.
+detector name to its new one (``kaderali_k`` to ``tracking.kaderali_k``, say); the old event
+identifiers are then recomputed with the new name, which checks that nothing else in the identity
+(spacecraft, kind, time, configuration hash) changed. Used to show that a refactoring leaves the
+events of ``abrupt demo`` and of the real tracking arcs unchanged.
 """
 
 from __future__ import annotations

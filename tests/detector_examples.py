@@ -10,7 +10,8 @@ so a capability that registers detectors adds its example here (one function and
 
 ``make()`` returns a short series holding at least one event every detector of that type should
 find at the test budget (:data:`BUDGET`, 2/week); ``empty()`` the same type with no samples;
-``shift(series, seconds)`` the series with every time stamp moved by ``seconds``. A detector that
+``shift(series, seconds)`` the series with every time stamp moved by ``seconds`` (None for a series
+whose physics is tied to absolute time; the time-invariance check is then skipped). A detector that
 needs a different example of the same type (a GEO history for a GEO detector) has an entry in
 :data:`EXAMPLES_BY_DETECTOR`. Settings that keep
 a detector fast on the example (fewer simulated event-free samples, ...) go in :data:`FAST_SETTINGS`
@@ -20,7 +21,7 @@ by detector name; they must not be needed for correctness. Examples are built on
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cache
 from typing import Any
 
@@ -39,7 +40,7 @@ class SeriesExample:
 
     make: Callable[[], Any]
     empty: Callable[[], Any]
-    shift: Callable[[Any, float], Any]
+    shift: Callable[[Any, float], Any] | None  # None: the series is tied to absolute time (notes say why)
     notes: str = ""
     settings: dict[str, dict[str, Any]] = field(default_factory=dict)
 
@@ -50,10 +51,11 @@ class SeriesExample:
 @cache
 def attitude_example() -> Any:
     """Ten minutes of 10 Hz telemetry of the thesis spacecraft with one 0.3 N·m·s strike at 300 s."""
+    from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike
     from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
     from abrupt.readers.telemetry import telemetry_from_frame
     from abrupt.series.attitude import AttitudeSeries
-    from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude
+    from abrupt.simulate.attitude import simulate_attitude
 
     sc = load_spacecraft(bundled_spacecraft_path("thesis"))
     sim = simulate_attitude(sc, AttitudeSimConfig(duration_s=600.0, seed=11), [Strike(300.0, (0.2, -0.15, 0.17))])
@@ -88,13 +90,35 @@ def _attitude_settings() -> dict[str, dict[str, Any]]:
     return fast
 
 
+@cache
+def cleaned_momentum_example() -> Any:
+    """Six hours of cleaned ᴺH at 1 Hz (white noise, 1e-3 N·m·s) with a 0.05 N·m·s step at 3 h, a 20 min gap."""
+    from abrupt.series.attitude import CleanedMomentum
+
+    n = 6 * 3600
+    rng = np.random.default_rng(5)
+    h = 1e-3 * rng.standard_normal((n, 3))
+    h[3 * 3600 :] += np.array([0.03, -0.03, 0.028])
+    ok = np.ones(n, bool)
+    ok[5000:6200] = False
+    h[~ok] = np.nan
+    t0 = int(np.datetime64("2026-01-01T00:00:00", "ns").astype(np.int64))
+    return CleanedMomentum(t0 + np.arange(n, dtype=np.int64) * 1_000_000_000, h, ok, 1.0, name="example-sat")
+
+
+def empty_cleaned_momentum() -> Any:
+    from abrupt.series.attitude import CleanedMomentum
+
+    return CleanedMomentum(np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros(0, bool), 1.0, name="example-sat")
+
+
 # ---------------------------------------------------------------------------------------------- tracking
 
 
 @cache
 def tracking_example() -> Any:
     """Ten hours of 20 s range/angles/range-rate from Ascension of the thesis orbit with a 2 m/s apogee burn."""
-    from abrupt.detect.tracking.glrt import BatchFitConfig
+    from abrupt.model.orbit.batch_fit import BatchFitConfig
     from abrupt.model.stations import ascension
     from abrupt.model.tracking_measurements import TrackingArrays
     from abrupt.series.tracking import TrackingSeries
@@ -114,6 +138,26 @@ def empty_tracking() -> Any:
     full = tracking_example()
     data = TrackingArrays(empty_measurements(), {}, epoch_utc=full.data.epoch_utc)
     return TrackingSeries(data, full.x0_apriori_m_mps, full.fit_config, name=full.name)
+
+
+@cache
+def laser_example() -> Any:
+    """One day of simulated LAGEOS normal points (four stations, 3 mm) with a 1 cm/s impulse at 14 h."""
+    from abrupt.pipelines.laser_ranging import LASER_FIT_CONFIG, laser_series
+    from abrupt.simulate.slr import SlrScenario, simulate_slr
+
+    scenario = SlrScenario(
+        duration_days=1.0, pass_probability=1.0, maneuver_t_s=50000.0, maneuver_dv_rsw_mps=(0.003, 0.008, -0.005)
+    )
+    sim = simulate_slr(scenario, seed=11)
+    x0 = sim.x0 + np.array([80.0, -60.0, 40.0, 0.02, -0.03, 0.01])  # an a-priori 110 m and 4 cm/s off
+    cfg = replace(LASER_FIT_CONFIG, force=scenario.force)
+    return laser_series(sim.measurements, sim.sites, sim.stations, x0, sim.epoch_utc, fit_config=cfg)
+
+
+def empty_laser() -> Any:
+    full = laser_example()
+    return replace(full, measurements=full.measurements.iloc[:0])
 
 
 # ---------------------------------------------------------------------------------------------- orbit
@@ -189,9 +233,9 @@ def tle_example() -> Any:
 def _examples() -> dict[type, SeriesExample]:
     from abrupt.massprops.track import InertiaTrack
     from abrupt.readers.tle import ElementHistory
-    from abrupt.series.attitude import AttitudeSeries
+    from abrupt.series.attitude import AttitudeSeries, CleanedMomentum
     from abrupt.series.ephemeris import Ephemeris
-    from abrupt.series.tracking import TrackingSeries
+    from abrupt.series.tracking import LaserRangingSeries, TrackingSeries
 
     return {
         InertiaTrack: SeriesExample(
@@ -212,6 +256,13 @@ def _examples() -> dict[type, SeriesExample]:
             notes="earth_rotation='simple', so a shift in time leaves the geometry unchanged",
             settings={"tracking.glrt": {"max_maneuvers": 1}, "tracking.kaderali_k": {"n_null_runs": 4}},
         ),
+        LaserRangingSeries: SeriesExample(
+            make=laser_example,
+            empty=empty_laser,
+            shift=None,
+            notes="laser ranges are reduced with Earth orientation, Sun, Moon and tides at their absolute dates",
+            settings={"tracking.laser_glrt": {"max_maneuvers": 1}},
+        ),
         Ephemeris: SeriesExample(
             make=orbit_example,
             empty=empty_orbit,
@@ -224,6 +275,12 @@ def _examples() -> dict[type, SeriesExample]:
             empty=empty_attitude,
             shift=lambda s, seconds: s.shifted(seconds),
             settings=_attitude_settings(),
+        ),
+        CleanedMomentum: SeriesExample(
+            make=cleaned_momentum_example,
+            empty=empty_cleaned_momentum,
+            shift=lambda s, seconds: s.shifted(seconds),
+            notes="blocks of the threshold fit start at the first sample, so a shift moves them too",
         ),
     }
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -10,16 +11,11 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from abrupt.errors import ConfigError
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike, simulate_attitude_batch
 from abrupt.model.momentum import system_momentum
 from abrupt.model.rotations import dcm_from_quaternion, normalise_quaternion
 from abrupt.model.spacecraft import Spacecraft, bundled_spacecraft_path, load_spacecraft, spacecraft_from_dict
-from abrupt.simulate.attitude import (
-    AttitudeSimConfig,
-    Strike,
-    simulate_attitude,
-    simulate_attitude_batch,
-    write_telemetry,
-)
+from abrupt.simulate.attitude import simulate_attitude, write_telemetry
 
 
 @pytest.fixture(scope="module")
@@ -211,7 +207,6 @@ def test_tachometer_discretisation_quantises_wheel_telemetry(thesis: Spacecraft)
 
 def test_telemetry_is_written_in_the_spacecraft_files_units_and_convention() -> None:
     text = Path(bundled_spacecraft_path("thesis")).read_text()
-    import tomllib
 
     data = tomllib.loads(text)
     data["telemetry"]["wheel_speed"]["unit"] = "rpm"

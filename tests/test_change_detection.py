@@ -11,6 +11,7 @@ from abrupt.detect.attitude.change_detection import (
     WindowConfig,
     sliding_statistic,
 )
+from abrupt.detect.attitude.steps import episode_peaks, local_peaks, mean_difference_step
 
 CFG = WindowConfig(pre=50, post=40, cusum_delta_mu_Nms=0.1)
 RNG = np.random.default_rng(7)
@@ -128,3 +129,28 @@ def test_cusum_does_not_lose_precision_on_a_large_offset() -> None:
     base = sliding_statistic("cusum", X[:, :1], CFG)
     shifted = sliding_statistic("cusum", X[:, :1] + 50.0, CFG)  # |H| of a biased-wheel spacecraft
     np.testing.assert_allclose(shifted, base, atol=1e-4)
+
+
+def test_episode_peaks_are_the_largest_sample_of_each_run_above_the_threshold() -> None:
+    stat = np.array([0.0, 2.0, 3.0, 2.0, 0.0, 0.0, 5.0, np.nan, 4.0, 0.0, 0.0, 0.0, 0.0, 2.5])
+    # Runs closer than 2 samples join: (1..3), (6..8) joined across the NaN, then 13 alone.
+    assert episode_peaks(stat, 1.0, 2) == [(1, 4, 2), (6, 9, 6), (13, 14, 13)]
+    # The same groups as splitting the above-threshold indices where they are more than `merge` apart.
+    above = np.flatnonzero(np.nan_to_num(stat, nan=-np.inf) > 1.0)
+    groups = np.split(above, np.flatnonzero(np.diff(above) > 2) + 1)
+    assert [p for _, _, p in episode_peaks(stat, 1.0, 2)] == [int(g[np.argmax(stat[g])]) for g in groups]
+
+
+def test_local_peaks_keep_the_largest_maximum_within_the_separation() -> None:
+    stat = np.array([0.0, 5.0, 4.0, 0.0, 0.0, 0.0, 3.0, 0.0, 6.0, np.nan])
+    assert local_peaks(stat, 1.0, 2) == [1, 8]
+    assert local_peaks(stat, 1.0, 1) == [1, 6, 8]
+
+
+def test_mean_difference_step_finds_the_step_sample_whatever_the_cumulative_sum_origin() -> None:
+    rng = np.random.default_rng(4)
+    h = 0.01 * rng.standard_normal((400, 3))
+    h[230:] += np.array([0.2, -0.1, 0.05])
+    sigma = np.full(3, 0.01)
+    assert mean_difference_step(h, 0, 400, 50, 350, 30, sigma) == 230
+    assert mean_difference_step(h, 150, 300, 180, 270, 30, sigma) == 230

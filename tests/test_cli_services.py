@@ -105,8 +105,9 @@ def test_nested_option_errors_print_one_clean_line(
 
 @pytest.fixture(scope="module")
 def short_telemetry(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike
     from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
-    from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude
+    from abrupt.simulate.attitude import simulate_attitude
 
     sc = load_spacecraft(bundled_spacecraft_path("thesis"))
     sim = simulate_attitude(sc, AttitudeSimConfig(duration_s=1200.0, seed=4), [Strike(600.0, (0.3, 0.0, 0.0))])
@@ -142,3 +143,44 @@ def test_null_samples_minimum_works_and_repairs_print_once(
     assert "[1]" not in err  # stages are a progress bar with a total, not numbered prints
     code, _, err = _run(["--quiet", *argv], capsys)
     assert code == 0 and "repaired" not in err and "event(s) found" not in err
+
+
+def test_every_lazy_sub_command_resolves_to_the_command_it_names() -> None:
+    from abrupt.cli.commands import LazyGroup, cli, load_command, source_help
+
+    groups = [cli, *(g for g in cli.commands.values() if isinstance(g, LazyGroup))]
+    for group in groups:
+        for name, target in group.lazy_commands.items():
+            command = load_command(target)
+            assert command.name == name, target
+            assert group.commands[name] is command, f"{target} is not registered on {group.name}"
+            assert source_help(target), f"no help found in the source of {target}"
+
+
+def test_the_top_level_help_imports_no_capability() -> None:
+    import subprocess
+    import sys
+
+    code = (
+        "import sys\n"
+        "from abrupt.cli.main import main\n"
+        "try:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
+        "print(sorted(m for m in sys.modules if m.startswith(('abrupt.cli.', 'pandas', 'numba'))))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert "detect" in out and out.strip().splitlines()[-1] == "['abrupt.cli.commands', 'abrupt.cli.main']"
+
+
+def test_every_command_is_in_the_lazy_tables() -> None:
+    """A command a capability module defines but the lazy tables do not name would never be found."""
+    import importlib
+    import pkgutil
+
+    import abrupt.cli
+    from abrupt.cli.commands import LazyGroup, cli
+
+    for info in pkgutil.iter_modules(abrupt.cli.__path__):
+        importlib.import_module(f"abrupt.cli.{info.name}")
+    for group in [cli, *(g for g in cli.commands.values() if isinstance(g, LazyGroup))]:
+        missing = sorted(set(group.commands) - set(group.lazy_commands) - {"simulate", "detect", "inject", "report"})
+        assert not missing, f"commands of {group.name!r} not in its lazy table: {missing}"

@@ -30,6 +30,12 @@ def test_per_block_is_the_poisson_probability_of_at_least_one_alarm() -> None:
     assert b.per_block(43200.0) == pytest.approx(1 - math.exp(-1.0))
 
 
+def test_per_block_first_order_is_the_expected_count_in_a_block() -> None:
+    b = FalseAlarmBudget(1, "week")
+    assert b.per_block_first_order(600.0) == (1 / 7) * 600.0 / 86400.0
+    assert b.per_block(600.0) == pytest.approx(b.per_block_first_order(600.0), rel=1e-3)
+
+
 def test_bonferroni_split_keeps_the_total_rate() -> None:
     b = FalseAlarmBudget(1, "week").bonferroni(4)
     assert b.per_day * 4 == pytest.approx(1 / 7)
@@ -73,3 +79,25 @@ def test_bad_detector_names_are_refused() -> None:
 def test_unknown_detector_lists_the_registered_ones() -> None:
     with pytest.raises(KeyError, match="unknown detector"):
         get_detector("no_such_detector", capability="attitude")
+
+
+def test_a_run_config_hash_is_the_hash_of_name_settings_and_budget() -> None:
+    from abrupt.detect.base import get_detector
+    from abrupt.events import config_hash, run_config_hash
+
+    budget = FalseAlarmBudget(1, "week")
+    settings = {"null_samples": 200_000}
+    assert run_config_hash(settings, budget, detector="attitude.cusum") == config_hash(
+        {"detector": "attitude.cusum", **settings, "budget": "1/week"}
+    )
+    detector = get_detector("attitude.cusum")(null_samples=200_000)
+    assert detector.config_hash_for(budget) == run_config_hash(detector.config(), budget, detector="attitude.cusum")
+
+
+def test_the_config_hash_does_not_change_from_run_to_run() -> None:
+    from abrupt.detect.base import get_detector
+
+    budget = FalseAlarmBudget(1, "week")
+    orbit = get_detector("orbit.glr")
+    assert "run_id" not in orbit(run_id="r1").config()
+    assert orbit(run_id="r1").config_hash_for(budget) == orbit(run_id="r2").config_hash_for(budget)

@@ -18,10 +18,12 @@ import abrupt
 from abrupt.catalog import Catalog
 from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
 from abrupt.events import read_events
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
-from abrupt.pipelines.fleet import detect_attitude_fleet, fleet_run_key, read_manifest
+from abrupt.pipelines.fleet import detect_attitude_fleet, detect_tle_batch, fleet_run_key, read_manifest
 from abrupt.scale import Executor, run_tasks
-from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude, write_telemetry
+from abrupt.simulate.attitude import simulate_attitude, write_telemetry
+from abrupt.thresholds import FalseAlarmBudget
 
 DAY_S = 86_400.0
 CONFIG = AttitudeDetectionConfig(detectors=("glr", "cusum"), null_samples=100_000)
@@ -167,8 +169,6 @@ def test_killed_at_any_moment_then_resumed(
 
 @pytest.mark.slow
 def test_tle_histories_on_a_two_worker_cluster_equal_in_process(shared_data: Path) -> None:
-    from abrupt.pipelines.fleet import detect_tle_batch
-    from abrupt.thresholds import FalseAlarmBudget
 
     paths = sorted((shared_data / "tle").glob("*.tle"))
     budget = FalseAlarmBudget.parse("1/year")

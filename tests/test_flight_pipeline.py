@@ -1,9 +1,10 @@
-"""Flight-telemetry pipeline (issue 9): ingest and its bad inputs, leak scan, timetable, cleaning,
+"""Flight-telemetry pipeline: ingest and its bad inputs, leak scan, timetable, cleaning,
 detection on a synthetic archive with known truth, chunked = whole, injection, thresholds."""
 
 from __future__ import annotations
 
 import gzip
+import json
 import math
 from pathlib import Path
 from typing import Any
@@ -14,13 +15,27 @@ import pytest
 from scipy import stats
 
 from abrupt.clean.comb import CombConfig, comb_subtract, smooth_model
+from abrupt.cli.main import main
+from abrupt.detect.attitude.flight_glr import FlightGlrDetector
+from abrupt.detect.base import detector_names
 from abrupt.errors import ConfigError, InputError
 from abrupt.model.flight_config import FlightChannel
 from abrupt.model.spacecraft import load_spacecraft, spacecraft_from_dict
-from abrupt.pipelines.flight import CleaningConfig, FlightRunConfig, ingest_archives, process_chunk, run_flight
+from abrupt.pipelines.flight import (
+    DAY_NS,
+    CleaningConfig,
+    FlightRunConfig,
+    chunk_spans,
+    ingest_archives,
+    process_chunk,
+    run_flight,
+)
 from abrupt.readers.archive import read_archive, read_decoder
+from abrupt.series.attitude import CleanedMomentum
 from abrupt.series.timetable import channel_on_grid, continuous_quaternion, grid
+from abrupt.simulate.injection import InjectedStrike, inject_strikes
 from abrupt.store import TelemetryStore
+from abrupt.thresholds import FalseAlarmBudget
 from abrupt.thresholds.robust import gumbel_quantile_fit, robust_block_maxima_threshold
 from flight_synth import REAL, make_archive
 
@@ -159,6 +174,32 @@ def test_synthetic_strikes_found_with_their_size_and_no_false_alarm(synth: tuple
         assert np.linalg.norm(est - dh) < 0.1 * np.linalg.norm(dh) + 2e-3
     # The dump is masked by its flag: no event there.
     assert res.daily["event_masked_fraction"].iloc[0] > 0
+    # Every event carries the registered detector that found it.
+    assert set(res.events["detector"]) == {FlightGlrDetector.name}
+    assert FlightGlrDetector.name in detector_names()
+
+
+def test_flight_detector_on_cleaned_momentum_finds_the_step_with_its_size_and_time() -> None:
+    """One 0.05 N·m·s step at 3 h in six hours of white momentum noise (1 Hz) and a gap."""
+    rng = np.random.default_rng(2)
+    n, k = 6 * 3600, 3 * 3600
+    h = 1e-3 * rng.standard_normal((n, 3))
+    step = np.array([0.03, -0.03, 0.028])
+    h[k:] += step
+    ok = np.ones(n, bool)
+    ok[8000:9000] = False
+    h[~ok] = np.nan
+    t0 = int(np.datetime64("2026-05-01T00:00:00", "ns").astype(np.int64))
+    series = CleanedMomentum(t0 + np.arange(n, dtype=np.int64) * 1_000_000_000, h, ok, 1.0, name="sat")
+    result = FlightGlrDetector().detect(series, FalseAlarmBudget(1.0, "day"))
+    ev = result.events
+    assert len(ev) == 1 and ev["detector"].iloc[0] == "attitude.flight_glr"
+    t_event = pd.Timestamp(str(ev["time_utc"].iloc[0])).tz_localize(None)
+    # The step is between samples k-1 and k: the event time is their midpoint.
+    assert abs((t_event - pd.Timestamp("2026-05-01T03:00:00")).total_seconds() + 0.5) <= 2.0
+    est = ev[["dH_N_x_Nms", "dH_N_y_Nms", "dH_N_z_Nms"]].to_numpy(float)[0]
+    assert np.linalg.norm(est - step) < 0.1 * np.linalg.norm(step)
+    assert result.diagnostics[0].threshold is not None and ev["statistic"].iloc[0] > ev["threshold"].iloc[0]
 
 
 def test_orbit_period_estimated_from_the_attitude_when_the_file_has_none(
@@ -196,9 +237,8 @@ def test_chunked_six_hour_chunks_equal_the_whole_run(tmp_path: Path) -> None:
 
 
 def test_kestrel_six_hour_chunks_give_the_events_of_the_whole_run(shared_data: Path, tmp_path: Path) -> None:
-    """Issue 9 item 2 on the shared flight-like data: 6-hour chunks (each with its margin) against one
+    """On the shared flight-like data: 6-hour chunks (each with its margin) against one
     chunk of both days; the events are the same and are the truth's strikes."""
-    import json
 
     data = shared_data / "flight-like"
     if not data.is_dir():
@@ -228,7 +268,6 @@ def test_kestrel_six_hour_chunks_give_the_events_of_the_whole_run(shared_data: P
 def test_leak_scan_of_every_output_of_the_chain(
     synth: tuple[Path, object], tmp_path: Path, capfd: pytest.CaptureFixture[str]
 ) -> None:
-    from abrupt.cli.main import main
 
     _, a = synth
     out = tmp_path / "out"
@@ -294,7 +333,6 @@ def test_rpm_declared_as_rad_s_is_caught_by_the_tachometer_quantum(synth: tuple[
 
 
 def test_injected_strike_changes_momentum_by_its_size_in_native_units(synth: tuple[Path, object]) -> None:
-    from abrupt.simulate.injection import InjectedStrike, inject_strikes
 
     d, a = synth
     sc = load_spacecraft(a.spacecraft)  # type: ignore[attr-defined]
@@ -400,7 +438,6 @@ def test_binned_comb_fit_equals_the_per_sample_fit_to_a_small_fraction_of_the_no
 
 
 def test_chunk_spans_cover_the_days_once() -> None:
-    from abrupt.pipelines.flight import DAY_NS, chunk_spans
 
     days = ["2026-03-10", "2026-03-11", "2026-03-12", "2026-03-13", "2026-03-20"]
     d0 = int(np.datetime64("2026-03-10", "D").astype("datetime64[ns]").astype(np.int64))
@@ -416,7 +453,7 @@ def test_robust_gumbel_threshold_against_scipy() -> None:
     m, b = gumbel_quantile_fit(x)
     assert m == pytest.approx(mu, abs=0.05) and b == pytest.approx(beta, rel=0.08)
     contaminated = np.concatenate([x, np.full(40, 500.0)])  # 1% of blocks with strikes
-    thr = robust_block_maxima_threshold(contaminated, block_s=600.0, false_alarms_per_day=1.0)
+    thr = robust_block_maxima_threshold(contaminated, block_s=600.0, budget=FalseAlarmBudget(1.0, "day"))
     expected = stats.gumbel_r.isf(600.0 / 86400.0, loc=mu, scale=beta)
     assert thr.value == pytest.approx(expected, rel=0.03)
 

@@ -16,7 +16,7 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
-from abrupt.cli.main import cli
+from abrupt.cli.main import cli, main
 from abrupt.model.orbit import propagate
 from abrupt.model.tracking_measurements import earth_rotation_matrices
 from abrupt.pipelines.laser_ranging import LASER_FORCE
@@ -136,8 +136,6 @@ def test_detect_laser_reads_crd_sinex_and_oem_and_stays_quiet(files: dict[str, P
 
 
 def test_detect_laser_names_the_station_missing_from_sinex(files: dict[str, Path], tmp_path: Path) -> None:
-    from abrupt.cli.main import main
-
     args = ["detect", "laser", str(files["crd"]), "--sinex", str(files["bad_snx"]), "--apriori", str(files["oem"])]
     args += ["--out", str(tmp_path / "e.csv"), "--catalog", str(tmp_path / "c.sqlite")]
     with pytest.raises(SystemExit) as exc:
@@ -148,7 +146,6 @@ def test_detect_laser_names_the_station_missing_from_sinex(files: dict[str, Path
 def test_detect_laser_names_an_apriori_ephemeris_that_starts_after_the_ranges(
     files: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from abrupt.cli.main import main
 
     args = ["detect", "laser", str(files["crd"]), "--sinex", str(files["snx"]), "--apriori", str(files["late_oem"])]
     args += ["--out", str(tmp_path / "e.csv"), "--catalog", str(tmp_path / "c.sqlite")]

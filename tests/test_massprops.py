@@ -25,12 +25,12 @@ from abrupt.massprops.inertia import (
 from abrupt.massprops.least_squares import integrated_correlation_time, jackknife_replicates, solve_balance
 from abrupt.massprops.momentum_balance import InsufficientExcitationError, estimate_inertia
 from abrupt.massprops.telemetry import momentum_data_from_channels, momentum_data_from_simulation
+from abrupt.model.attitude_dynamics import AttitudeSimConfig
 from abrupt.model.momentum import body_momentum
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import spacecraft_from_dict
-from abrupt.simulate.attitude import (
+from abrupt.simulate.pointing import (
     AppendageMotion,
-    AttitudeSimConfig,
     CircularOrbit,
     PointingScenario,
     ReferenceTrajectory,
@@ -222,7 +222,7 @@ def _inertial_pointing_data(slew_axis: tuple[float, float, float] | None):
     t = np.arange(0.0, duration + 2)
     rn = np.broadcast_to(np.eye(3), (t.size, 3, 3)).copy()
     from abrupt.model.rotations import quaternion_from_dcm
-    from abrupt.simulate.attitude import _rotation_dcm  # test-only use of the helper
+    from abrupt.simulate.pointing import _rotation_dcm  # test-only use of the helper
 
     slews = (
         [] if slew_axis is None else [Slew(200.0, 30.0, slew_axis, 120, 200), Slew(1000.0, -25.0, slew_axis, 100, 150)]

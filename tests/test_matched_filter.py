@@ -15,11 +15,15 @@ import pytest
 from scipy import stats
 
 from abrupt.detect.attitude.matched_filter import (
+    CombinedFilter,
+    CombinedFilterStream,
     MatchedFilterStream,
     WaveletSet,
     analytic_output_sd,
     attitude_error_vector,
+    build_wavelets,
     detect_matched_filter,
+    detect_strikes,
     detections_to_events,
     estimate_strike_size,
     fit_matched_filter_thresholds,
@@ -27,7 +31,9 @@ from abrupt.detect.attitude.matched_filter import (
     matched_filter_bank_statistics,
     matched_filter_statistic,
 )
-from abrupt.model.rotations import quaternion_from_mrp
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike, simulate_attitude_batch
+from abrupt.model.rotations import quaternion_from_mrp, quaternion_multiply
+from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 
 RATE_HZ = 10.0
 LENGTH = 250
@@ -191,7 +197,6 @@ def test_attitude_error_vector_is_half_angle_about_body_axis() -> None:
     phi = 1e-3
     ref = quaternion_from_mrp(np.array([0.1, -0.2, 0.05]))
     # q_BN = q_BR ⊗ q_RN with q_BR a small rotation about body y.
-    from abrupt.model.rotations import quaternion_multiply
 
     q_br = np.array([math.cos(phi / 2), 0.0, math.sin(phi / 2), 0.0])
     q = quaternion_multiply(q_br, ref)[None, :]
@@ -252,7 +257,6 @@ def test_wavelet_set_round_trips_through_npz(tmp_path) -> None:  # type: ignore[
 
 def test_largest_unsaturated_strike_matches_thesis_estimate() -> None:
     """Spec §2.1: with P = 1080 N·m·s the largest unsaturated x strike is about 80-90 mg (0.64-0.72)."""
-    from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 
     sc = load_spacecraft(bundled_spacecraft_path("thesis"))
     dh = largest_unsaturated_strike_Nms(sc, 0)
@@ -260,7 +264,6 @@ def test_largest_unsaturated_strike_matches_thesis_estimate() -> None:
 
 
 def test_combined_stream_matches_batch() -> None:
-    from abrupt.detect.attitude.matched_filter import CombinedFilter, CombinedFilterStream
 
     rng = np.random.default_rng(9)
     wav = _synthetic_wavelets()
@@ -277,7 +280,6 @@ def test_combined_stream_matches_batch() -> None:
 
 
 def test_combined_statistic_is_chi2_3_in_white_noise() -> None:
-    from abrupt.detect.attitude.matched_filter import CombinedFilter
 
     rng = np.random.default_rng(10)
     wav = _synthetic_wavelets()
@@ -299,8 +301,6 @@ def test_combined_statistic_is_chi2_3_in_white_noise() -> None:
 @pytest.fixture(scope="module")
 def thesis_wavelets():  # type: ignore[no-untyped-def]
     pytest.importorskip("abrupt.simulate.attitude")
-    from abrupt.detect.attitude.matched_filter import build_wavelets
-    from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 
     sc = load_spacecraft(bundled_spacecraft_path("thesis"))
     return sc, build_wavelets(sc, bank_size=16)
@@ -329,7 +329,6 @@ def test_simulated_bank_is_linear_below_saturation(thesis_wavelets) -> None:  # 
 
 
 def test_simulated_strike_is_detected_with_time_and_size(thesis_wavelets) -> None:  # type: ignore[no-untyped-def]
-    from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude_batch
 
     sc, wav = thesis_wavelets
     cfg = AttitudeSimConfig(duration_s=600.0, telemetry_rate_hz=10.0)
@@ -354,7 +353,6 @@ def test_simulated_strike_is_detected_with_time_and_size(thesis_wavelets) -> Non
 @pytest.mark.slow
 def test_thesis_attitude_filter_detects_60mg_random_directions(thesis_wavelets) -> None:  # type: ignore[no-untyped-def]
     """Acceptance 2 (Bennett 2022 §2.4.1.4): >= 90% of 60 mg strikes at alpha = 1e-4."""
-    from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude_batch
 
     sc, wav = thesis_wavelets
     rng = np.random.default_rng(11)
@@ -375,7 +373,6 @@ def test_thesis_attitude_filter_detects_60mg_random_directions(thesis_wavelets) 
 
 
 def test_detect_strikes_sets_thresholds_from_the_series_and_finds_the_strike() -> None:
-    from abrupt.detect.attitude.matched_filter import detect_strikes
 
     rng = np.random.default_rng(12)
     wav = _synthetic_wavelets()
@@ -396,7 +393,6 @@ def test_detect_strikes_sets_thresholds_from_the_series_and_finds_the_strike() -
 
 
 def test_detect_strikes_rejects_wrong_sample_rate() -> None:
-    from abrupt.detect.attitude.matched_filter import detect_strikes
 
     wav = _synthetic_wavelets()
     n = 1000
@@ -425,8 +421,6 @@ def test_simulated_strike_momentum_ends_in_the_wheels(thesis_wavelets) -> None: 
 
 
 def test_joint_filter_with_wheels_detects_a_5mg_strike(thesis_wavelets) -> None:  # type: ignore[no-untyped-def]
-    from abrupt.detect.attitude.matched_filter import detect_strikes
-    from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude_batch
 
     sc, wav = thesis_wavelets
     dh_b = 0.04 * np.array([0.6, -0.64, 0.48])  # 5 mg, |dH| = 0.04 N·m·s
@@ -458,7 +452,6 @@ def test_attitude_error_ignores_quaternion_scale_and_sign() -> None:
 
 
 def test_empty_or_too_short_telemetry_gives_a_clear_error() -> None:
-    from abrupt.detect.attitude.matched_filter import detect_strikes
 
     wav = _synthetic_wavelets()
     with pytest.raises(ValueError, match="at least 10 finite"):

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from abrupt.errors import InputError
-from abrupt.readers.navigation_csv import read_ephemeris, read_navigation_csv, write_navigation_csv
+from abrupt.readers.ephemeris import read_ephemeris
+from abrupt.readers.navigation_csv import read_navigation_csv, write_navigation_csv
 from abrupt.readers.oem import read_oem
 from abrupt.readers.sp3 import list_satellites, read_sp3
 

@@ -38,7 +38,8 @@ SPACECRAFT = load_spacecraft(bundled_spacecraft_path("thesis"))
 
 
 def _valid_telemetry_csv() -> bytes:
-    from abrupt.simulate.attitude import AttitudeSimConfig, simulate_attitude
+    from abrupt.model.attitude_dynamics import AttitudeSimConfig
+    from abrupt.simulate.attitude import simulate_attitude
 
     sim = simulate_attitude(SPACECRAFT, AttitudeSimConfig(duration_s=30.0, seed=1), [])
     return sim.telemetry.head(120).to_csv(index=False).encode()
@@ -198,7 +199,8 @@ def test_regression_inputs(path: Path) -> None:
 
 def test_rates_in_deg_per_s_declared_as_rad_per_s_are_caught(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
     """An inertially pointing spacecraft: the gyro cannot show more rotation than its attitude does."""
-    from abrupt.simulate.attitude import AttitudeSimConfig, simulate_attitude
+    from abrupt.model.attitude_dynamics import AttitudeSimConfig
+    from abrupt.simulate.attitude import simulate_attitude
 
     sim = simulate_attitude(SPACECRAFT, AttitudeSimConfig(duration_s=900.0, seed=3), [])
     good = sim.telemetry

@@ -14,12 +14,13 @@ import pandas as pd
 import pytest
 
 from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 from abrupt.pipelines.attitude import detect_attitude
 from abrupt.readers.telemetry import read_telemetry
 from abrupt.report.attitude import attitude_figure, write_attitude_report
 from abrupt.report.style import PALETTE, clip_with_markers, detector_colour, robust_baseline
-from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude, write_telemetry
+from abrupt.simulate.attitude import simulate_attitude, write_telemetry
 
 
 @pytest.fixture(scope="module")
@@ -135,8 +136,8 @@ def test_tracking_log_axis_has_several_labelled_ticks_over_a_narrow_span(tmp_pat
 
 
 def test_rate_plot_uncertainty_is_the_binomial_standard_error() -> None:
-    from abrupt.rates.plots import detectable_rate_sigma
     from abrupt.rates.trades import CaseResult
+    from abrupt.report.rates import detectable_rate_sigma
 
     rng = np.random.default_rng(1)
     dh = rng.lognormal(0.0, 1.0, 4000)

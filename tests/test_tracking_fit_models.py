@@ -1,4 +1,4 @@
-"""Light time, troposphere, time biases, scale factors and robustness of the tracking fit (issue 15, Build 1-2).
+"""Light time, troposphere, time biases, scale factors and robustness of the tracking fit.
 
 The radio fit's two-way range and downleg angles (:func:`predict_measurement_light_time`, a first-order
 closed form) are checked against the iterative two-way light-time solution of the laser reduction
@@ -11,16 +11,23 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
+from scipy.interpolate import CubicSpline
 
 from abrupt.model.light_time import two_way_range_m
 from abrupt.model.orbit import ForceModel, coe_to_rv, propagate
-from abrupt.model.stations import Station
+from abrupt.model.orbit.batch_fit import BatchFitConfig, fit_orbit, radio_range_delay_m
+from abrupt.model.range_reduction import standard_meteorology
+from abrupt.model.stations import Station, ascension
 from abrupt.model.tracking_measurements import (
+    TrackingArrays,
     earth_rotation_matrices,
     predict_measurement,
     predict_measurement_light_time,
 )
+from abrupt.model.troposphere import saastamoinen_zenith_delay_m, water_vapour_pressure_hpa
+from abrupt.simulate.tracking import TrackingScenario, simulate_tracking
 
 MU = 3.986004418e14
 TWO_BODY = ForceModel(mu_m3_s2=MU)
@@ -49,7 +56,6 @@ def _interpolate(t_fine, states, t):  # type: ignore[no-untyped-def]
 
 def test_two_way_range_and_downleg_angles_match_the_iterative_solution() -> None:
     t_fine, states, receive = _geometry()
-    from scipy.interpolate import CubicSpline
 
     spline = CubicSpline(t_fine, states[:, :3], axis=0)
 
@@ -88,13 +94,6 @@ def test_two_way_range_and_downleg_angles_match_the_iterative_solution() -> None
 
 
 def test_radio_troposphere_is_the_saastamoinen_zenith_delay_mapped_to_the_elevation() -> None:
-    import pandas as pd
-
-    from abrupt.detect.tracking.glrt import radio_range_delay_m
-    from abrupt.model.range_reduction import standard_meteorology
-    from abrupt.model.tracking_measurements import TrackingArrays
-    from abrupt.model.troposphere import saastamoinen_zenith_delay_m, water_vapour_pressure_hpa
-
     meas = pd.DataFrame(
         {
             "time_utc": pd.to_datetime(["2010-11-02T03:00:00", "2010-11-02T03:01:00"]),
@@ -123,12 +122,6 @@ def test_a_station_time_bias_is_recovered_by_the_batch_fit() -> None:
     """One of two stations tags its measurements 20 ms late (tens of metres of range on a LEO pass; a
     common offset of all stations is an along-track shift of the orbit and cannot be seen). The fit
     recovers the offset within its stated σ; without the parameter the residuals are far from white."""
-    import pandas as pd
-
-    from abrupt.detect.tracking.glrt import BatchFitConfig, fit_orbit
-    from abrupt.model.stations import ascension
-    from abrupt.model.tracking_measurements import TrackingArrays
-    from abrupt.simulate.tracking import TrackingScenario, simulate_tracking
 
     malindi = Station("MALINDI", -2.99, 40.19, 12.0, elevation_mask_deg=1.0)
     sim = simulate_tracking(TrackingScenario(stations=(ascension(1.0), malindi), cadence_s=10.0), seed=4)
@@ -153,10 +146,6 @@ def test_the_batch_fit_estimates_a_drag_scale_factor() -> None:
     """Ranges from two stations to a 350 km orbit whose drag is 1.5 times the model's: the fit with
     ``estimate_scales=("drag_scale",)`` recovers 1.5 within its σ, and its residuals are white; with
     the scale fixed at 1 the residuals are not."""
-    import pandas as pd
-
-    from abrupt.detect.tracking.glrt import BatchFitConfig, fit_orbit
-    from abrupt.model.tracking_measurements import TrackingArrays
 
     model = ForceModel(mu_m3_s2=MU, zonal_degree=2, drag="exponential", drag_area_m2=4.0, mass_kg=100.0)
     truth = ForceModel(**{**model.__dict__, "drag_scale": 1.5})
@@ -196,10 +185,6 @@ def test_the_batch_fit_estimates_a_drag_scale_factor() -> None:
 def test_the_fit_converges_from_an_apriori_orbit_twenty_kilometres_off() -> None:
     """Plain Gauss-Newton overshoots from 20 km / 20 m/s off (the linearisation fails and the iteration
     blows up to NaN); with step halving the fit reaches the same solution as from a close start."""
-    from abrupt.detect.tracking.glrt import BatchFitConfig, fit_orbit
-    from abrupt.model.stations import ascension
-    from abrupt.model.tracking_measurements import TrackingArrays
-    from abrupt.simulate.tracking import TrackingScenario, simulate_tracking
 
     sim = simulate_tracking(TrackingScenario(stations=(ascension(1.0),), cadence_s=10.0), seed=4)
     data = TrackingArrays(sim.measurements, {}, epoch_utc=sim.epoch_utc)

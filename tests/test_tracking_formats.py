@@ -4,14 +4,16 @@
 
 from __future__ import annotations
 
+import gzip
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from abrupt.errors import InputError
+from abrupt.errors import InputError, RepairLog
 from abrupt.readers.crd import SPEED_OF_LIGHT_MPS, read_crd
 from abrupt.readers.sinex import SECONDS_PER_JULIAN_YEAR, parse_sinex_epoch, read_sinex, sinex_station
+from abrupt.readers.tracking import read_tracking, sniff_tracking_format
 
 CORPUS = "tracking/ilrs-corpus"
 DATA = Path(__file__).parent / "data" / "formats"
@@ -59,8 +61,6 @@ def test_crd_corpus_file_is_rejected_with_a_one_line_error(shared_data: Path, na
 
 
 def test_crd_truncated_file_reads_with_the_option_and_counts_the_repair(shared_data: Path) -> None:
-    from abrupt.errors import RepairLog
-
     log = RepairLog()
     table = read_crd(shared_data / CORPUS / "crd_unexpected_end_of_file.v2C", allow_truncated=True, repairs=log)
     assert len(table) == 6 and log.counts["file truncated: missing H8/H9"] == 1
@@ -132,8 +132,6 @@ def test_crd_unknown_station_is_an_error_naming_it_and_the_known_ones(tmp_path: 
 
 
 def test_crd_noise_returns_are_skipped_and_counted(tmp_path: Path) -> None:
-    from abrupt.errors import RepairLog
-
     text = _crd_text(1, [0.040, 0.041, 0.042]).replace(
         "10 7210.000000 0.041000000000 std 2 2", "10 7210.000000 0.041000000000 std 2 1"
     )
@@ -197,10 +195,6 @@ def test_sinex_malformed_input(tmp_path: Path) -> None:
 
 
 def test_tracking_files_are_recognised_by_content(shared_data: Path, tmp_path: Path) -> None:
-    import gzip
-
-    from abrupt.readers.tracking import read_tracking, sniff_tracking_format
-
     assert sniff_tracking_format(shared_data / "tracking/W3B.aer") == "aer"
     crd = tmp_path / "pass.frd.gz"
     crd.write_bytes(gzip.compress((shared_data / CORPUS / "lageos1-test.npt").read_bytes()))

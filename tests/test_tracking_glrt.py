@@ -2,17 +2,24 @@
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
+from click.testing import CliRunner
 
-from abrupt.detect.tracking.glrt import BatchFitConfig, GlrtConfig, detect_maneuvers_glrt, fit_orbit
+from abrupt.cli.main import cli, main
+from abrupt.detect.tracking.glrt import GlrtConfig, detect_maneuvers_glrt, glrt_scan, glrt_threshold_fit
+from abrupt.model.orbit import rsw_basis
+from abrupt.model.orbit.batch_fit import BatchFitConfig, fit_orbit, trajectory
 from abrupt.model.stations import ascension
 from abrupt.model.tracking_measurements import TrackingArrays
+from abrupt.pipelines.tracking import TrackingSettings, read_tracking_series
 from abrupt.simulate.tracking import TrackingScenario, simulate_tracking, thesis_burn
+from abrupt.thresholds import FalseAlarmBudget
 
 
 def _data(burn=None, seed: int = 4, cadence: float = 10.0):
@@ -45,9 +52,7 @@ def test_glrt_is_quiet_without_a_maneuver() -> None:
 
 
 def glrt_threshold_for(n: int, data: TrackingArrays) -> float:
-    from abrupt.detect.tracking.glrt import glrt_threshold
-
-    return glrt_threshold(n, (data.t_s.max() - data.t_s.min()) / 86400.0, 0.1)
+    return glrt_threshold_fit(n, (data.t_s.max() - data.t_s.min()) / 86400.0, FalseAlarmBudget(0.1, "day")).value
 
 
 @pytest.mark.parametrize(("location", "direction"), [("apogee", "R"), ("perigee", "S")])
@@ -78,10 +83,6 @@ def test_glrt_detects_an_out_of_view_normal_burn_whose_epoch_is_ambiguous_by_hal
 
 
 def test_cli_simulate_detect_report_end_to_end(tmp_path: Path) -> None:
-    from click.testing import CliRunner
-
-    from abrupt.cli.main import cli
-
     runner = CliRunner()
     sim = tmp_path / "sim.tdm"
     r = runner.invoke(
@@ -151,8 +152,6 @@ def test_cli_simulate_detect_report_end_to_end(tmp_path: Path) -> None:
 
 
 def test_cli_reports_unknown_station_as_a_clear_error(tmp_path: Path) -> None:
-    from abrupt.cli.main import main
-
     (tmp_path / "a.aer").write_text("2024-01-01T00:00:00 RANGE Nowhere 2000.0\n")
     (tmp_path / "s.in").write_text(
         "orbit.date = 2024-01-01T00:00:00\norbit.cartesian.px = 7378137\n"
@@ -183,7 +182,6 @@ def test_w3b_real_tracking_fit_estimates_biases_and_an_unmodelled_acceleration(s
     ``KalmanNumericalOrbitDeterminationTest.testW3B*``) within 3 of our stated σ; the drag
     coefficient comes out far below the a-priori 2, inside the span of Orekit's estimators
     (−0.22 batch, −0.02 unscented, 0.19 extended Kalman); the leak acceleration is ~1e-5 m/s²."""
-    from abrupt.pipelines.tracking import TrackingSettings, read_tracking_series
 
     orekit_batch_station_bias_m = {
         "CastleRock": 11274.4677,
@@ -214,12 +212,6 @@ def test_w3b_real_tracking_fit_estimates_biases_and_an_unmodelled_acceleration(s
 def test_cli_detect_tracking_runs_on_w3b_and_reports_the_unmodelled_acceleration(
     shared_data: Path, tmp_path: Path
 ) -> None:
-    import json
-
-    from click.testing import CliRunner
-
-    from abrupt.cli.main import cli
-
     r = CliRunner().invoke(
         cli,
         [
@@ -241,8 +233,6 @@ def test_cli_detect_tracking_runs_on_w3b_and_reports_the_unmodelled_acceleration
 def test_glrt_scan_equals_the_direct_projection_at_every_candidate() -> None:
     """The suffix-sum scan against the definition: for each τ build J_v (rows after τ), project it and the
     residuals off the fitted parameters' column space, and solve the 3×3 normal equations directly."""
-    from abrupt.detect.tracking.glrt import glrt_scan, trajectory
-    from abrupt.model.orbit import rsw_basis
 
     burn = thesis_burn("apogee", "S", 0.02)
     data, sim = _data(burn)

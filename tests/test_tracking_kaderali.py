@@ -7,6 +7,7 @@ import pytest
 
 from abrupt.detect.tracking.kaderali import (
     KaderaliConfig,
+    calibrate_psi_threshold,
     fit_characterisation,
     invert_characterisation,
     k_db,
@@ -18,6 +19,7 @@ from abrupt.detect.tracking.kaderali import (
 from abrupt.model.stations import ascension
 from abrupt.model.tracking_measurements import TrackingArrays
 from abrupt.simulate.tracking import TrackingScenario, simulate_tracking, thesis_burn
+from abrupt.thresholds import FalseAlarmBudget
 
 
 def _run(burn=None, mask: float = -90.0, seed: int = 1, config: KaderaliConfig | None = None):
@@ -116,13 +118,13 @@ def test_inversion_round_trips_and_flags_non_monotonic_or_below_floor() -> None:
 
 
 def test_simulated_psi_threshold_holds_its_false_alarm_rate_on_independent_null_arcs() -> None:
-    from abrupt.detect.tracking.kaderali import calibrate_psi_threshold
-
     sim = simulate_tracking(TrackingScenario(), seed=11)
     data = TrackingArrays(sim.measurements, {}, epoch_utc=sim.epoch_utc)
     rate_hz = (len(data) - 1) / float(np.ptp(data.t_s))
     per_day = 0.035 * rate_hz * 86400.0  # budget equivalent to 3.5 % of samples
-    th, null_psi = calibrate_psi_threshold(data, sim.initial_state, false_alarms_per_day=per_day, n_runs=4, seed=3)
+    th, null_psi = calibrate_psi_threshold(
+        data, sim.initial_state, budget=FalseAlarmBudget(per_day, "day"), n_runs=4, seed=3
+    )
     assert null_psi.size == 4 * len(data)
     fresh = np.concatenate([_run(mask=1.0, seed=s)[0].psi for s in (21, 22)])
     assert 0.02 < np.mean(fresh > th) < 0.05

@@ -6,10 +6,15 @@ import math
 
 import numpy as np
 import pytest
+from astropy import units as u
+from astropy.coordinates import GCRS, ITRS, CartesianRepresentation, EarthLocation
+from astropy.time import Time
 
 from abrupt.model.orbit import (
+    EMPIRICAL_PARAMETERS,
     MU_KADERALI_M3_S2,
     FiniteBurn,
+    ForceContext,
     ForceModel,
     coe_to_rv,
     orbit_period_s,
@@ -93,7 +98,6 @@ def test_rk4_state_and_stm_match_dop853_and_finite_differences() -> None:
 def test_rk8_keeps_a_lageos_orbit_within_millimetres_for_a_week_at_60_s_steps() -> None:
     """Eighth-order fixed steps of 60 s against the DOP853 truth at rtol 1e-13 (J2, Sun, Moon), where RK4
     at the same step is metres off; the STM of the RK8 path matches central differences of the truth."""
-    from abrupt.model.orbit import ForceContext
 
     force = ForceModel(mu_m3_s2=3.986004418e14, zonal_degree=2, sun=True, moon=True)
     ctx = ForceContext.build(force, np.datetime64("2024-03-01T00:00:00", "ns"), -86400.0, 8 * 86400.0)
@@ -117,9 +121,6 @@ def test_rk8_keeps_a_lageos_orbit_within_millimetres_for_a_week_at_60_s_steps() 
 
 
 def test_station_site_vector_matches_astropy_geodetic_conversion() -> None:
-    from astropy import units as u
-    from astropy.coordinates import EarthLocation
-
     st = Station("X", 41.9774962512, 13.6004229863, 671.354)
     loc = EarthLocation.from_geodetic(st.longitude_deg * u.deg, st.latitude_deg * u.deg, st.altitude_m * u.m, "WGS84")
     ref = np.array([q.to_value(u.m) for q in loc.geocentric])
@@ -172,10 +173,6 @@ def test_analytic_measurement_jacobian_matches_finite_differences(model: str) ->
 
 
 def test_iers_rotation_matches_astropy_gcrs_to_itrs() -> None:
-    from astropy import units as u
-    from astropy.coordinates import GCRS, ITRS, CartesianRepresentation
-    from astropy.time import Time
-
     epoch = np.datetime64("2010-11-02T02:56:15.690", "ns")
     c = earth_rotation_matrices(np.array([3600.0]), model="iers", epoch_utc=epoch)[0]
     r = np.array([-4.05e7, -1.0e7, 1.6e5])
@@ -197,7 +194,6 @@ def test_drag_and_srp_scale_sensitivities_match_finite_differences() -> None:
     """∂x(t)/∂k for the drag and SRP scale factors (Montenbruck & Gill 2000, Eq. 7.6) against central
     differences of the propagated state over one day of a 400 km orbit (J2, Sun, conical shadow), and
     against the DOP853 truth integrator; a parameter order and an unknown name are honoured/refused."""
-    from abrupt.model.orbit import ForceContext
 
     force = ForceModel(
         mu_m3_s2=3.986004418e14,
@@ -263,7 +259,6 @@ def test_once_per_rev_empirical_accelerations_and_their_sensitivities() -> None:
     """The CPR terms C cos u / C sin u along R, T, N: at the start the sensitivity is ½t² times the
     basis vector, whose u agrees with the argument of latitude of rv_to_coe; over three hours the
     columns match central differences of the propagated state with the coefficient changed."""
-    from abrupt.model.orbit import EMPIRICAL_PARAMETERS
 
     x0 = coe_to_rv(7.0e6, 0.001, math.radians(60), math.radians(40), math.radians(30), 1.0, MU)
     force = ForceModel(mu_m3_s2=MU, zonal_degree=2)

@@ -19,10 +19,11 @@ from numpy.typing import ArrayLike
 from scipy.ndimage import median_filter
 
 from abrupt.massprops.inertia import perturb_inertia
+from abrupt.model.attitude_dynamics import AttitudeSimConfig
 from abrupt.model.momentum import body_momentum
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import Spacecraft
-from abrupt.simulate.attitude import AttitudeSimConfig, PointingScenario, ReferenceTrajectory, simulate_pointing
+from abrupt.simulate.pointing import PointingScenario, ReferenceTrajectory, simulate_pointing
 from abrupt.types import FloatArray
 
 

@@ -23,17 +23,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from abrupt.massprops.inertia import inertia_from_principal, perturb_inertia
+from abrupt.model.attitude_dynamics import AttitudeSimConfig
 from abrupt.model.rotations import quaternion_multiply
 from abrupt.model.spacecraft import Spacecraft, spacecraft_from_dict
-from abrupt.simulate.attitude import (
+from abrupt.simulate.docking import random_slews
+from abrupt.simulate.pointing import (
     AppendageMotion,
-    AttitudeSimConfig,
     CircularOrbit,
     PointingScenario,
     ReferenceTrajectory,
     simulate_pointing,
 )
-from abrupt.simulate.docking import random_slews
 from abrupt.types import FloatArray
 
 __all__ = ["ROUTINE_SPACECRAFT", "RoutineDay", "RoutineSpacecraft", "simulate_routine_day"]

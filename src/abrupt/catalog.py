@@ -47,7 +47,7 @@ import sqlalchemy as sa
 
 from abrupt import __version__
 from abrupt.errors import AbruptError
-from abrupt.events import EVENT_COLUMNS, FLOAT_COLUMNS, format_time_utc, normalise_frame
+from abrupt.events import EVENT_COLUMNS, FLOAT_COLUMNS, format_time_utc, normalise_frame, write_events
 
 SCHEMA_VERSION = 2
 #: Key of the PostgreSQL advisory lock that serialises catalog writers (any fixed 64-bit integer).
@@ -532,8 +532,6 @@ class Catalog:
 
         Parquet stores ``time_utc`` as a UTC timestamp.
         """
-        from abrupt.events import write_events
-
         frame = self.events(**filters)
         write_events(frame, str(path))
         return len(frame)

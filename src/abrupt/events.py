@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-EVENT_KINDS = ("strike", "maneuver", "mass_change", "unknown")
+EVENT_KINDS = ("strike", "maneuver", "mass_change", "unknown", "maneuver_campaign")
 
 EVENT_COLUMNS: tuple[str, ...] = (
     "event_id",
@@ -50,7 +50,6 @@ EVENT_COLUMNS: tuple[str, ...] = (
 #: Schema columns holding text (identifiers, names, ISO-8601 times); the others are float64.
 TEXT_COLUMNS: tuple[str, ...] = ("event_id", "spacecraft", "kind", "detector", "time_utc", "run_id", "config_hash")
 FLOAT_COLUMNS: tuple[str, ...] = tuple(c for c in EVENT_COLUMNS if c not in TEXT_COLUMNS)
-_TEXT_COLUMNS = TEXT_COLUMNS  # older spelling, kept while other branches still use it
 _FLOAT_COLUMNS = FLOAT_COLUMNS
 
 NAN = float("nan")
@@ -62,6 +61,13 @@ def config_hash(config: Mapping[str, Any] | Any) -> str:
         config = asdict(config)
     text = json.dumps(config, sort_keys=True, default=_json_default)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def run_config_hash(settings: Mapping[str, Any], budget: object, *, detector: str | None = None) -> str:
+    """The ``config_hash`` of ``settings`` run at a false-alarm ``budget`` (by ``detector`` if named):
+    ``config_hash({"detector": detector, **settings, "budget": str(budget)})``, spelled once."""
+    named = {"detector": detector} if detector is not None else {}
+    return config_hash({**named, **settings, "budget": str(budget)})
 
 
 def _json_default(obj: Any) -> Any:
@@ -176,7 +182,7 @@ def normalise_frame(frame: pd.DataFrame) -> pd.DataFrame:
         out[name] = pd.to_numeric(out[name], errors="raise").astype("float64")
     if pd.api.types.is_datetime64_any_dtype(out["time_utc"]):  # typed timestamps (Parquet) to the ISO text form
         out["time_utc"] = [format_time_utc(t) for t in out["time_utc"]]
-    for name in _TEXT_COLUMNS:
+    for name in TEXT_COLUMNS:
         out[name] = out[name].astype("string")
     bad = ~out["kind"].isin(EVENT_KINDS)
     if bad.any():
@@ -228,7 +234,7 @@ def read_events(path: str) -> pd.DataFrame:
         # identifiers stay text: a hash like "12345e67" or a pseudonym "007" must not become a number
         frame = pd.read_csv(
             path,
-            dtype={c: str for c in _TEXT_COLUMNS},
+            dtype={c: str for c in TEXT_COLUMNS},
             keep_default_na=False,
             na_values={c: [""] for c in _FLOAT_COLUMNS},
         )

@@ -17,6 +17,7 @@ that a two-worker cluster gives the same events as in-process.
 from __future__ import annotations
 
 import logging
+import sys
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -103,8 +104,6 @@ def run_tasks(
 
     ``show_progress`` defaults to showing a bar when standard error is a terminal.
     """
-    import sys
-
     from tqdm import tqdm
 
     executor = executor or Executor()

@@ -26,6 +26,16 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 
+# event kinds that summarise other events (a campaign of maneuvers): not detections of their own
+SUMMARY_KINDS = ("maneuver_campaign",)
+
+
+def _without_summaries(detections: pd.DataFrame) -> pd.DataFrame:
+    if len(detections) and "kind" in detections:
+        return detections.loc[~detections["kind"].isin(SUMMARY_KINDS)]
+    return detections
+
+
 DAYS_PER_YEAR = 365.25
 
 
@@ -124,7 +134,7 @@ def score_events(
     With ``apply_threshold`` and a ``threshold`` column, only rows with ``statistic >= threshold``
     count as detections (frames from ``--all-candidates`` runs carry sub-threshold rows).
     """
-    det = detections.reset_index(drop=True)
+    det = _without_summaries(detections).reset_index(drop=True)
     if apply_threshold and len(det) and "threshold" in det and "statistic" in det:
         det = det.loc[det["statistic"] >= det["threshold"]]
     tru, outside = _restrict_truth(truth, truth_time_column, start, end)
@@ -189,7 +199,8 @@ def recall_at_false_alarm_rate(
         raise ValueError("recall at a false-alarm rate needs the observed span (start < end)")
     allowed = false_alarms_per_year * years
     tru, _ = _restrict_truth(truth, truth_time_column, start, end)
-    det = detections.sort_values(score_column, ascending=False, kind="stable").reset_index(drop=True)
+    det = _without_summaries(detections).sort_values(score_column, ascending=False, kind="stable")
+    det = det.reset_index(drop=True)
     det_ns = _times_ns(det, time_column)
     tru_ns = _times_ns(tru, truth_time_column)
     best = OperatingPoint(

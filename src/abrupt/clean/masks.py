@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from abrupt.errors import InputError, RepairLog
+from abrupt.readers.telemetry import read_table
 from abrupt.series.telemetry import Telemetry
 
 MaskInterval = tuple[np.datetime64, np.datetime64, str]
@@ -24,8 +25,6 @@ def read_mask(path: str | Path) -> list[MaskInterval]:
 
     Times are ISO-8601 UTC; an interval whose end precedes its start is an error naming the line.
     """
-    from abrupt.readers.telemetry import read_table  # the reader imports clean.noise: import here
-
     path = Path(path)
     frame = read_table(path)
     for col in ("start_utc", "end_utc"):

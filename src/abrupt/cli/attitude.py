@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import click
+import numpy as np
+import pandas as pd
 
+from abrupt.cli.flight import CLEANING_STAGES, detect_from_store
 from abrupt.cli.groups import (
     StageProgress,
     catalog_option,
@@ -20,22 +23,26 @@ from abrupt.cli.groups import (
     warn,
 )
 from abrupt.cli.options import budget_options, pop_budget
-
-if TYPE_CHECKING:
-    from abrupt.simulate.attitude import Strike
-
-FLIGHT_STAGES = ("event-masks", "slew-masks", "savgol", "comb", "trend", "all")  # abrupt.cli.flight
+from abrupt.detect.attitude.change_detection import WindowConfig
+from abrupt.detect.attitude.momentum import (
+    AttitudeDetectionConfig,
+    MomentumChangeDetector,
+    attitude_detector_class,
+    attitude_detector_names,
+)
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike
+from abrupt.pipelines.attitude import detect_attitude, load_spacecraft, read_attitude_inputs
+from abrupt.readers.telemetry import read_telemetry
+from abrupt.report.attitude import write_attitude_report
+from abrupt.simulate.attitude import simulate_attitude, write_telemetry
 
 
 def _spacecraft(path: str | None) -> Any:
-    from abrupt.pipelines.attitude import load_spacecraft
-
     return load_spacecraft(path)
 
 
 def parse_strike(text: str) -> Strike:
     """``TIME_S:DHX,DHY,DHZ`` (seconds from start; angular impulse in body axes, N·m·s)."""
-    from abrupt.simulate.attitude import Strike
 
     try:
         time_part, vec_part = text.split(":")
@@ -49,9 +56,6 @@ def parse_strike(text: str) -> Strike:
 
 def random_strikes(n: int, duration_s: float, dh_min: float, dh_max: float, seed: int) -> list[Strike]:
     """n strikes, evenly spaced with random jitter, log-uniform |ΔH| in [dh_min, dh_max], random directions."""
-    import numpy as np
-
-    from abrupt.simulate.attitude import Strike
 
     rng = np.random.default_rng(seed + 1)
     spacing = duration_s / (n + 1)
@@ -123,7 +127,6 @@ def simulate_attitude_cmd(
 
     Writes the telemetry and, beside it, <name>_truth.csv with each strike's time and ΔH.
     """
-    from abrupt.simulate.attitude import AttitudeSimConfig, simulate_attitude, write_telemetry
 
     sc = _spacecraft(spacecraft_path)
     strike_list = [parse_strike(s) for s in strikes]
@@ -155,8 +158,6 @@ def _detection_config(
     null_samples: int,
 ) -> Any:
     """The run configuration; detector names are checked against the registry now (plug-ins included)."""
-    from abrupt.detect.attitude.change_detection import WindowConfig
-    from abrupt.detect.attitude.momentum import AttitudeDetectionConfig, attitude_detector_names
 
     names = attitude_detector_names()
     if "all" in detectors:
@@ -171,7 +172,7 @@ def _detection_config(
         detectors=chosen,
         windows=WindowConfig(pre=pre, post=post),
         glr_windows=WindowConfig(pre=glr_window, post=glr_window),
-        false_alarms_per_day=budget.per_day,
+        budget=budget,
         threshold_method=method,
         null_samples=null_samples,
     )
@@ -250,7 +251,6 @@ def _with_options(options: list[Any]) -> Any:
 
 def _stage_count(cfg: Any) -> int:
     """Progress stages of the pipeline: calibrate and run per change detector, one for the others."""
-    from abrupt.detect.attitude.momentum import MomentumChangeDetector, attitude_detector_class
 
     n_change = sum(1 for d in cfg.detectors if issubclass(attitude_detector_class(d), MomentumChangeDetector))
     return 2 * n_change + (1 if n_change < len(cfg.detectors) else 0)
@@ -265,7 +265,6 @@ def run_attitude_detection(
     mask: str | None = None,
 ) -> tuple[Any, Any, Any, Any]:
     """Call the attitude pipeline, with a progress line per stage. Returns (sc, telemetry, config, run)."""
-    from abrupt.pipelines.attitude import detect_attitude, read_attitude_inputs
 
     budget = pop_budget(settings, "1/day")
     sc, tel, cal = read_attitude_inputs(telemetry_path, spacecraft_path, calibration_path=calibration, mask_path=mask)
@@ -302,7 +301,7 @@ def telemetry_or_store_options(f: Any) -> Any:
     f = click.option(
         "--no-clean",
         multiple=True,
-        type=click.Choice(FLIGHT_STAGES),
+        type=click.Choice(CLEANING_STAGES),
         help="With --store: switch a cleaning stage off (repeatable; 'all' for none).",
     )(f)
     f = click.option("--days", multiple=True, help="With --store: days (YYYY-MM-DD or A..B); default all.")(f)
@@ -358,10 +357,8 @@ def detect_attitude_cmd(
 ) -> None:
     """Detect strikes in attitude TELEMETRY (CSV or Parquet), or in a --store; write events and the catalog."""
     if store_dir is not None:  # flight-telemetry pipeline (abrupt.pipelines.flight)
-        from abrupt.cli.flight import detect_from_store
-
         budget = pop_budget(settings, "1/day")
-        detect_from_store(store_dir, spacecraft_path, days, budget.per_day, no_clean, catalog_target, out, report_path)
+        detect_from_store(store_dir, spacecraft_path, days, budget, no_clean, catalog_target, out, report_path)
         return
     if telemetry is None:
         raise click.UsageError("give TELEMETRY or --store DIR")
@@ -387,8 +384,6 @@ def detect_attitude_cmd(
     for k, thr in result.thresholds.items():
         note(f"threshold {k}: {thr.value:.4g} ({thr.false_alarms_per_day:g} false alarms/day, {thr.method})")
     if report_path:
-        from abrupt.report.attitude import write_attitude_report
-
         write_attitude_report(report_path, tel, result)
         click.echo(f"report: {report_path}", err=True)
 
@@ -423,16 +418,11 @@ def report_attitude_cmd(
 ) -> None:
     """Draw the attitude report: momentum, contributions, raw channels, statistics, thresholds, events."""
     if store_dir is not None:  # flight pipeline: cleaning stages before/after and daily statistics
-        from abrupt.cli.flight import detect_from_store
-
         budget = pop_budget(settings, "1/day")
-        detect_from_store(store_dir, spacecraft_path, days, budget.per_day, no_clean, None, None, out)
+        detect_from_store(store_dir, spacecraft_path, days, budget, no_clean, None, None, out)
         return
     if telemetry is None:
         raise click.UsageError("give TELEMETRY or --store DIR")
-    import pandas as pd
-
-    from abrupt.report.attitude import write_attitude_report
 
     mask = settings.pop("mask")
     _, tel, _, result = run_attitude_detection(telemetry, spacecraft_path, calibration, None, settings, mask)
@@ -454,14 +444,6 @@ def report_attitude_cmd(
 @click.option("--seed", type=int, default=7, show_default=True)
 def demo(out_dir: str, duration_s: float, seed: int) -> None:
     """Simulate telemetry of the thesis spacecraft with strikes, detect them, write catalog and report."""
-    import numpy as np
-    import pandas as pd
-
-    from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
-    from abrupt.pipelines.attitude import detect_attitude
-    from abrupt.readers.telemetry import read_telemetry
-    from abrupt.report.attitude import write_attitude_report
-    from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude, write_telemetry
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

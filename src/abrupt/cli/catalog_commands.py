@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import click
+import pandas as pd
 
+from abrupt.catalog import Catalog
 from abrupt.cli.groups import catalog_option, cli
 
 #: Width the default view fits in (characters).
@@ -39,8 +42,6 @@ def _filter_options(f: Any) -> Any:
 
 
 def _filters(kw: dict[str, Any]) -> dict[str, Any]:
-    import pandas as pd
-
     for key in ("since", "until"):
         if kw[key] is not None:
             try:
@@ -56,8 +57,6 @@ def _filters(kw: dict[str, Any]) -> dict[str, Any]:
 @_filter_options
 def export(catalog_target: str, out: str, **filters: Any) -> None:
     """Export events to OUT (.csv or .parquet; Parquet keeps times as UTC timestamps)."""
-    from abrupt.catalog import Catalog
-
     if not out.lower().endswith((".csv", ".parquet", ".pq")):
         raise click.BadParameter(f"{out!r} must end in .csv or .parquet", param_hint="OUT")
     n = Catalog(catalog_target, create=False).export(out, **_filters(filters))
@@ -66,8 +65,6 @@ def export(catalog_target: str, out: str, **filters: Any) -> None:
 
 def narrow_view(frame: Any) -> list[str]:
     """Events as lines of at most :data:`VIEW_WIDTH` characters: time, spacecraft, kind, detector, size, margin."""
-    import math
-
     header = (
         f"{'time (UTC)':<23} {'spacecraft':<16} {'kind':<11} {'detector':<24} {'size':>16} {'stat/thr':>8} {'event':>8}"
     )
@@ -94,10 +91,6 @@ def narrow_view(frame: Any) -> list[str]:
 @click.option("--wide", is_flag=True, help="Every column (wide lines) instead of the narrow view.")
 def list_(catalog_target: str, runs: bool, wide: bool, **filters: Any) -> None:
     """Print the events (or run records) in the catalog; the latest configuration by default."""
-    import pandas as pd
-
-    from abrupt.catalog import Catalog
-
     cat = Catalog(catalog_target, create=False)
     if runs:
         frame = cat.runs()

@@ -12,10 +12,10 @@ from abrupt.density.constellation import ConstellationConfig
 from abrupt.density.joint import JointConfig
 from abrupt.density.meteors import estimate_density_ratios, read_radar_csv
 from abrupt.density.precise_orbit import OrbitDensityConfig
-from abrupt.density.report import plot_density_bands, plot_meteor_profile
 from abrupt.density.tle_drag import TleDragConfig
 from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET
 from abrupt.pipelines.density import orbit_density, tle_density, write_table
+from abrupt.report.density import plot_density_bands, plot_meteor_profile
 
 TLE_BUDGET = str(DEFAULT_TLE_BUDGET)  # "1/year", the maneuver detector's
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import click
 
 from abrupt.cli.groups import cli
+from abrupt.detect.base import detector_names, get_detector
 
 
 @cli.command("detectors")
@@ -14,8 +15,6 @@ def list_detectors(capability: str | None) -> None:
 
     A detector is found by this name by `abrupt detect ... --detector NAME`.
     """
-    from abrupt.detect.base import detector_names, get_detector
-
     for name in detector_names(capability):
         cls = get_detector(name)
         click.echo(f"{name:28s} {cls.kind:12s} {cls.series_type.__name__:16s} {cls.summary}")

@@ -2,11 +2,17 @@
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import click
 
-from abrupt.cli.groups import catalog_option, check_suffix, detect, note, progress_hidden, warn
+from abrupt.cli.groups import catalog_option, check_suffix, detect, note, progress_hidden, record_run, warn
+from abrupt.cli.options import budget_options, pop_budget
+from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
+from abrupt.events import config_hash, new_run_id, write_events
+from abrupt.pipelines.fleet import detect_attitude_fleet, detect_tle_batch, read_manifest
+from abrupt.scale import Executor
 
 executor_options = [
     click.option(
@@ -31,8 +37,6 @@ def with_executor_options(f: Any) -> Any:
 
 
 def executor_from(workers: int | None, scheduler: str | None) -> Any:
-    from abrupt.scale import Executor
-
     return Executor(workers=workers, scheduler=scheduler)
 
 
@@ -47,14 +51,7 @@ def executor_from(workers: int | None, scheduler: str | None) -> Any:
     show_default=True,
     help="Attitude detector(s); repeatable.",
 )
-@click.option(
-    "--false-alarms-per-day",
-    "fa_per_day",
-    type=click.FloatRange(min=0.0, min_open=True),
-    default=1.0,
-    show_default=True,
-    help="False-alarm budget per spacecraft-day the thresholds are set for.",
-)
+@budget_options("1/day")
 @click.option(
     "--null-samples",
     type=click.IntRange(min=100_000),
@@ -74,29 +71,24 @@ def executor_from(workers: int | None, scheduler: str | None) -> Any:
 def detect_fleet_cmd(
     manifest: str,
     detectors: tuple[str, ...],
-    fa_per_day: float,
     null_samples: int,
     workers: int | None,
     scheduler: str | None,
     catalog_target: str,
     out: str,
+    **budget_args: Any,
 ) -> None:
     """Detect strikes in every telemetry file listed in MANIFEST (CSV: spacecraft,telemetry,spacecraft_file).
 
     One task per row (spacecraft, file), each calibrated on its own noise. Finished tasks are stored in
     the catalog as they end: a run that was stopped or killed resumes where it stopped when started
-    again with the same inputs and settings.
+    again with the same inputs and settings. The budget is per spacecraft.
     """
-    from pathlib import Path
-
-    from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
-    from abrupt.events import write_events
-    from abrupt.pipelines.fleet import detect_attitude_fleet, read_manifest
-
+    budget = pop_budget(budget_args, "1/day")
     members = read_manifest(manifest)
     executor = executor_from(workers, scheduler)
     config = AttitudeDetectionConfig(
-        detectors=tuple(dict.fromkeys(detectors)), false_alarms_per_day=fa_per_day, null_samples=null_samples
+        detectors=tuple(dict.fromkeys(detectors)), budget=budget, null_samples=null_samples
     )
     note(f"{len(members)} task(s) (spacecraft, file) on {executor.describe()}")
     result = detect_attitude_fleet(
@@ -120,12 +112,7 @@ def detect_fleet_cmd(
 
 @detect.command("tle-batch")
 @click.argument("paths", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False))
-@click.option(
-    "--false-alarms",
-    default="1/year",
-    show_default=True,
-    help="False-alarm budget per satellite (RATE/day, /week or /year).",
-)
+@budget_options("1/year")
 @with_executor_options
 @catalog_option
 @click.option(
@@ -137,22 +124,17 @@ def detect_fleet_cmd(
 )
 def detect_tle_batch_cmd(
     paths: tuple[str, ...],
-    false_alarms: str,
     workers: int | None,
     scheduler: str | None,
     catalog_target: str,
     out: str,
+    **budget_args: Any,
 ) -> None:
-    """Detect maneuvers in many TLE/OMM histories (PATHS), one task per file, in-process or on Dask."""
-    from abrupt.cli.groups import record_run
-    from abrupt.events import config_hash, new_run_id
-    from abrupt.pipelines.fleet import detect_tle_batch
-    from abrupt.thresholds import FalseAlarmBudget
+    """Detect maneuvers in many TLE/OMM histories (PATHS), one task per file, in-process or on Dask.
 
-    try:
-        budget = FalseAlarmBudget.parse(false_alarms)
-    except ValueError as exc:
-        raise click.BadParameter(str(exc), param_hint="--false-alarms") from None
+    The budget is per satellite.
+    """
+    budget = pop_budget(budget_args, "1/year")
     executor = executor_from(workers, scheduler)
     note(f"{len(paths)} TLE/OMM file(s) on {executor.describe()}")
     run_id = new_run_id()

@@ -4,12 +4,25 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import click
+import numpy as np
 
 from abrupt.cli.groups import cli, inject, record_run
+from abrupt.cli.options import budget_options, pop_budget
+from abrupt.detect.attitude.flight_glr import FlightGlrDetector
+from abrupt.errors import InputError
+from abrupt.events import write_events
+from abrupt.model.spacecraft import load_spacecraft
+from abrupt.pipelines.flight import CleaningConfig, FlightRunConfig, day_range, ingest_archives, run_flight
+from abrupt.pipelines.flight_injection import injection_recovery
+from abrupt.report.flight import write_flight_report
+from abrupt.simulate.injection import InjectedStrike, inject_strikes
+from abrupt.store import TelemetryStore
+from abrupt.thresholds import FalseAlarmBudget
 
 
 def _progress(total: int, label: str) -> Any:
@@ -32,8 +45,6 @@ def _progress(total: int, label: str) -> Any:
 @click.option("--assume-utc", is_flag=True, help="Read times without a zone as UTC (counted in the report).")
 def ingest_cmd(archives: tuple[str, ...], decoder_path: str, store_dir: str, layout: str, assume_utc: bool) -> None:
     """Ingest archive dumps (long or wide; CSV, CSV.gz, Parquet) into a pseudonymised store, one report per day."""
-    from abrupt.pipelines.flight import ingest_archives
-
     bar = _progress(len(archives), "ingest")
     summary = ingest_archives(
         archives, decoder_path, store_dir, layout=layout, assume_utc=assume_utc, progress=lambda s: bar.update(1)
@@ -53,10 +64,6 @@ def ingest_cmd(archives: tuple[str, ...], decoder_path: str, store_dir: str, lay
 
 
 def _cleaning(no_clean: tuple[str, ...]) -> Any:
-    from dataclasses import replace
-
-    from abrupt.pipelines.flight import CleaningConfig
-
     c = CleaningConfig()
     if "all" in no_clean:
         return CleaningConfig.off()
@@ -71,7 +78,7 @@ def detect_from_store(
     store_dir: str,
     spacecraft_path: str,
     days: tuple[str, ...],
-    false_alarms_per_day: float,
+    budget: FalseAlarmBudget,
     no_clean: tuple[str, ...],
     catalog_target: str | None,
     out: str | None,
@@ -79,13 +86,8 @@ def detect_from_store(
     daily_path: str | None = None,
 ) -> None:
     """``abrupt detect attitude --store``: run the flight pipeline on stored days; write events and reports."""
-    from abrupt.events import write_events
-    from abrupt.model.spacecraft import load_spacecraft
-    from abrupt.pipelines.flight import FlightRunConfig, day_range, run_flight
-    from abrupt.store import TelemetryStore
-
     sc = load_spacecraft(spacecraft_path)
-    cfg = FlightRunConfig(false_alarms_per_day=false_alarms_per_day, cleaning=_cleaning(no_clean))
+    cfg = FlightRunConfig(budget=budget, cleaning=_cleaning(no_clean))
     day_list = day_range(TelemetryStore(store_dir), sc.name, days or None)
     bar = _progress(len(day_list), "detect")
     seen: set[str] = set()
@@ -114,7 +116,7 @@ def detect_from_store(
                 "daily": result.daily.to_dict("records"),
             },
             spacecraft=sc.name,
-            detectors=["attitude.glr"],
+            detectors=[FlightGlrDetector.name],
         )
     click.echo(result.daily.to_string(index=False), err=True)
     click.echo(
@@ -127,8 +129,6 @@ def detect_from_store(
     if daily_path:
         result.daily.to_csv(daily_path, index=False)
     if report_path:
-        from abrupt.report.flight import write_flight_report
-
         write_flight_report(report_path, result)
         click.echo(f"report: {report_path}", err=True)
 
@@ -145,14 +145,7 @@ def detect_from_store(
 @click.option("--strike", "strikes", multiple=True, help="TIME_UTC:DHX,DHY,DHZ (inertial axes, N·m·s); repeatable.")
 @click.option("--recovery", is_flag=True, help="Injection-recovery study: 90%-detectable ΔH per day.")
 @click.option("--days", multiple=True, help="Days (YYYY-MM-DD or A..B); default all stored days.")
-@click.option(
-    "--false-alarms",
-    "false_alarms_per_day",
-    type=float,
-    default=1.0,
-    show_default=True,
-    help="False alarms per day the threshold is set for.",
-)
+@budget_options()
 @click.option("--seed", type=int, default=0, show_default=True)
 @click.option("--out", default=None, type=click.Path(dir_okay=False), help="Recovery table (.csv).")
 def inject_attitude_cmd(
@@ -162,19 +155,11 @@ def inject_attitude_cmd(
     strikes: tuple[str, ...],
     recovery: bool,
     days: tuple[str, ...],
-    false_alarms_per_day: float,
     seed: int,
     out: str | None,
+    **budget: Any,
 ) -> None:
     """Add synthetic strikes to stored telemetry (Harris et al. 2025 §3.5), or measure detectable ΔH per day."""
-    import numpy as np
-
-    from abrupt.errors import InputError
-    from abrupt.model.spacecraft import load_spacecraft
-    from abrupt.pipelines.flight import FlightRunConfig, day_range, injection_recovery, run_flight
-    from abrupt.simulate.injection import InjectedStrike, inject_strikes
-    from abrupt.store import TelemetryStore
-
     sc = load_spacecraft(spacecraft_path)
     store = TelemetryStore(store_dir)
     if strikes:
@@ -205,7 +190,7 @@ def inject_attitude_cmd(
             dst.write_day(sc.name, day, frame, report)
         click.echo(f"{len(parsed)} strike(s) injected; store written to {out_store}")
     if recovery:
-        cfg = FlightRunConfig(false_alarms_per_day=false_alarms_per_day)
+        cfg = FlightRunConfig(budget=pop_budget(budget))
         base = run_flight(store_dir, sc, cfg, days=days or None)
         rec = injection_recovery(store_dir, sc, cfg, base.threshold, days=days or None, seed=seed)
         click.echo(rec.per_day.to_string(index=False))
@@ -218,6 +203,4 @@ def inject_attitude_cmd(
 
 def ingest_report_json(store_dir: str, spacecraft: str, day: str) -> str:
     """The ingest report of one stored day, as JSON text."""
-    from abrupt.store import TelemetryStore
-
     return json.dumps(TelemetryStore(store_dir).report(spacecraft, day), indent=1)

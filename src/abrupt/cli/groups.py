@@ -1,12 +1,16 @@
-"""Command groups shared by every capability module, and helpers common to all commands.
+"""Helpers every command shares: the catalog and report options, notes and warnings, progress bars,
+and recording a run's events in the catalog.
 
-Capability modules (``abrupt.cli.attitude``, ``abrupt.cli.orbit`` ...) add their commands to the
-groups defined here; :mod:`abrupt.cli.main` imports them all.
+The command groups themselves (``cli``, ``simulate``, ``detect``, ``inject``, ``report``) are defined
+in :mod:`abrupt.cli.commands`, which loads each capability module only when its command is used;
+they are re-exported here so that a capability module finds everything it decorates and calls in one
+place.
 """
 
 from __future__ import annotations
 
 import hashlib
+import logging
 import sys
 from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
@@ -14,78 +18,46 @@ from typing import Any, TypeVar
 
 import click
 
-from abrupt import __version__
+from abrupt.catalog import Catalog, coverage_of
+from abrupt.cli.commands import GLOBAL_FLAGS, State, cli, detect, hoist_global_flags, inject, report, simulate
+from abrupt.events import write_events
+
+__all__ = [
+    "DEFAULT_CATALOG",
+    "GLOBAL_FLAGS",
+    "StageProgress",
+    "catalog_option",
+    "check_suffix",
+    "cli",
+    "detect",
+    "file_hash",
+    "hoist_global_flags",
+    "inject",
+    "note",
+    "progress",
+    "progress_hidden",
+    "record_run",
+    "report",
+    "report_option",
+    "simulate",
+    "spacecraft_name_option",
+    "warn",
+]
 
 T = TypeVar("T")
 
 DEFAULT_CATALOG = "abrupt_catalog.sqlite"
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 110})
-@click.version_option(__version__, prog_name="abrupt")
-@click.option("-v", "--verbose", count=True, help="More log output (-v info, -vv debug); also after the sub-command.")
-@click.option("-q", "--quiet", is_flag=True, help="No progress bars or notes; errors and results only.")
-def cli(verbose: int, quiet: bool) -> None:
-    """Find abrupt, unexpected momentum changes in satellite telemetry and tracking data.
-
-    Start with `abrupt demo --out DIR`: it simulates telemetry of the thesis spacecraft with strikes,
-    detects them, writes the catalog, the events and a report.
-    """
-    import logging
-
-    global QUIET
-    QUIET = quiet
-    level = logging.WARNING if quiet else logging.WARNING - 10 * min(verbose, 2)  # warnings even when quiet
-    logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s", force=True)
-
-
-#: Set by ``abrupt --quiet``: no progress bars, no notes on standard error.
-QUIET = False
-
-#: Global options accepted anywhere on the command line (moved before the sub-command by ``main``).
-GLOBAL_FLAGS = frozenset({"-v", "-vv", "-vvv", "--verbose", "-q", "--quiet"})
-
-
-def hoist_global_flags(argv: list[str]) -> list[str]:
-    """Move ``-v``/``--quiet`` given after a sub-command to the front, where click expects them."""
-    if "--" in argv:
-        cut = argv.index("--")
-        head, tail = argv[:cut], argv[cut:]
-    else:
-        head, tail = argv, []
-    flags = [a for a in head if a in GLOBAL_FLAGS]
-    return [*flags, *(a for a in head if a not in GLOBAL_FLAGS), *tail]
-
-
 def note(message: str) -> None:
     """A note for the user on standard error (progress stages, summaries); silent with ``--quiet``."""
-    if not QUIET:
+    if not State.quiet:
         click.echo(message, err=True)
 
 
 def warn(message: str) -> None:
     """A warning on standard error; shown even with ``--quiet``."""
     click.echo(f"warning: {message}", err=True)
-
-
-@cli.group()
-def simulate() -> None:
-    """Simulate data with known truth (attitude telemetry, orbits, ground tracking)."""
-
-
-@cli.group()
-def detect() -> None:
-    """Detect abrupt momentum changes in a data file and write events."""
-
-
-@cli.group()
-def inject() -> None:
-    """Inject synthetic events into real data to measure what can be detected."""
-
-
-@cli.group()
-def report() -> None:
-    """Draw report figures (PNG or HTML) of data, statistics, thresholds and events."""
 
 
 catalog_option = click.option(
@@ -144,7 +116,7 @@ def progress(iterable: Iterable[T], *, total: int | None = None, desc: str = "",
 
 def progress_hidden() -> bool:
     """True when progress bars are not shown (``--quiet``, or standard error is not a terminal)."""
-    return QUIET or not sys.stderr.isatty()
+    return State.quiet or not sys.stderr.isatty()
 
 
 class StageProgress:
@@ -162,9 +134,7 @@ class StageProgress:
             self.bar.update(1)
         self.started = True
         self.bar.set_postfix_str(stage)
-        if progress_hidden() and not QUIET:
-            import logging
-
+        if progress_hidden() and not State.quiet:
             logging.getLogger("abrupt").info("%s: %s", self.desc, stage)
 
     def close(self) -> None:
@@ -193,9 +163,6 @@ def record_run(
     show), so the catalog's latest view can tell an event no longer found from one never looked for.
     Returns the number of events that were new to the catalog.
     """
-    from abrupt.catalog import Catalog, coverage_of
-    from abrupt.events import write_events
-
     catalog = Catalog(catalog_target)  # open (and check) the catalog before writing anything
     if out is not None:  # then the file: a bad path must not leave events in the catalog only
         Path(out).parent.mkdir(parents=True, exist_ok=True)

@@ -11,8 +11,10 @@ import click
 
 from abrupt.cli.groups import catalog_option, detect, record_run
 from abrupt.cli.options import budget_options, pop_budget
+from abrupt.model.range_reduction import RANGE_MODEL_TERMS, RangeModel
+from abrupt.pipelines.laser_ranging import LASER_FORCE, run_laser_ranging_files
 
-TERMS = ("light_time", "troposphere", "shapiro", "plate_motion", "eccentricity", "solid_tides")
+TERMS = RANGE_MODEL_TERMS
 
 
 @detect.command("laser")
@@ -100,11 +102,8 @@ def detect_laser_command(
     Ranges are reduced with light time, Mendes-Pavlis troposphere from the files' meteorology, Shapiro
     delay, plate motion and eccentricities from SINEX, and solid tides; the orbit and per-station biases
     are fitted, each station weighted by its own post-fit residuals, and a GLRT scans for impulses at the
-    stated false-alarm budget (docs/tracking.md, "Laser ranging").
+    stated false-alarm budget (detector ``tracking.laser_glrt``; docs/tracking.md, "Laser ranging").
     """
-    from abrupt.model.range_reduction import RangeModel
-    from abrupt.pipelines.laser_ranging import LASER_FORCE, run_laser_ranging_files
-
     budget = pop_budget(budget_args, "0.1/day")
     model = RangeModel()
     for term in without:

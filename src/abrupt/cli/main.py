@@ -1,4 +1,8 @@
-"""Entry point of the ``abrupt`` command: imports every capability module so it registers its commands."""
+"""Entry point of the ``abrupt`` command.
+
+Only the command tree (:mod:`abrupt.cli.commands`) is imported here; a capability's module is imported
+when its command runs or its help is shown, so ``abrupt --help`` stays fast.
+"""
 
 from __future__ import annotations
 
@@ -6,21 +10,7 @@ import sys
 
 import click
 
-from abrupt.cli import (  # noqa: F401  (registration)
-    attitude,
-    catalog_commands,
-    density,
-    detectors,
-    fleet,
-    flight,
-    laser,
-    mass,
-    orbit,
-    rates,
-    tle,
-    tracking,
-)
-from abrupt.cli.groups import cli, hoist_global_flags
+from abrupt.cli.commands import cli, hoist_global_flags
 from abrupt.errors import AbruptError
 
 

@@ -23,8 +23,8 @@ from abrupt.pipelines.mass import (
     updated_spacecraft_toml,
     write_report,
 )
-from abrupt.simulate.attitude import CircularOrbit
 from abrupt.simulate.docking import DockingScenario
+from abrupt.simulate.pointing import CircularOrbit
 
 #: The mass-change detector's default false-alarm budget: one per satellite-year (daily windows).
 MASS_CHANGE_BUDGET = "1/year"

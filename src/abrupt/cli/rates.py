@@ -7,9 +7,18 @@ from pathlib import Path
 from typing import Any
 
 import click
+import numpy as np
 
 from abrupt.cli.fleet import executor_from, with_executor_options
 from abrupt.cli.groups import cli, progress_hidden
+from abrupt.errors import ConfigError
+from abrupt.pipelines.rates import METRIC_UNITS, build_scenario, metric_thresholds, parse_vary, rate_table
+from abrupt.rates import flux as fx
+from abrupt.rates import tables
+from abrupt.rates.ordem import describe_mapping, import_ordem, read_numeric_table
+from abrupt.rates.tables import write_flux_table
+from abrupt.rates.trades import run_case, run_trade
+from abrupt.report.rates import plot_dh_dv_scatter, plot_rate_curves
 
 
 @cli.group()
@@ -25,138 +34,138 @@ def rates() -> None:
     """
 
 
+#: The options of a rate scenario, shared by ``rates run`` and ``rates trade``.
+SCENARIO_OPTIONS = [
+    click.option(
+        "--spacecraft",
+        "spacecraft",
+        type=click.Path(dir_okay=False),
+        required=True,
+        help="Spacecraft TOML file with [[surfaces]] and mass_kg.",
+    ),
+    click.option(
+        "--altitude-km",
+        type=float,
+        default=550.0,
+        show_default=True,
+        help="Circular-orbit altitude [km].",
+    ),
+    click.option("--inclination-deg", type=float, default=28.5, show_default=True, help="Inclination [deg]."),
+    click.option(
+        "--epoch",
+        "epoch_year",
+        type=float,
+        default=2020.0,
+        show_default=True,
+        help="Epoch [decimal year].",
+    ),
+    click.option(
+        "--solar-flux",
+        "solar_flux_sfu",
+        type=float,
+        default=100.0,
+        show_default=True,
+        help="NASA-90: smoothed F10.7 of the previous year [sfu].",
+    ),
+    click.option(
+        "--flux",
+        "flux_model",
+        default="nasa90",
+        show_default=True,
+        help="nasa90, grun, nasa90+grun, or a flux-table manifest .toml (joined with '+').",
+    ),
+    click.option(
+        "--flux-sigma-factor",
+        type=float,
+        default=0.0,
+        show_default=True,
+        help="Analytic models: 1-sigma as a fraction of the flux (for --flux-bound).",
+    ),
+    click.option(
+        "--flux-bound",
+        type=float,
+        default=0.0,
+        show_default=True,
+        help="Shift flux by this many sigma (e.g. -2, 2).",
+    ),
+    click.option(
+        "--mass-model",
+        default="al_sphere",
+        show_default=True,
+        help="al_sphere, ordem_sphere, socit, socit_literal, socit_no_steel, debrisat.",
+    ),
+    click.option(
+        "--mef",
+        default="const2",
+        show_default=True,
+        help="const1, const2, const3, const:<x>, nysmith_denardo, rembor, rembor_array.",
+    ),
+    click.option("--lc-min-m", type=float, default=3e-5, show_default=True, help="Lower Lc truncation [m]."),
+    click.option(
+        "--draws",
+        "n_draws",
+        type=int,
+        default=10_000,
+        show_default=True,
+        help="Monte Carlo draws per case.",
+    ),
+    click.option(
+        "--size-sampling",
+        type=click.Choice(["log_uniform", "population"]),
+        default="log_uniform",
+        show_default=True,
+        help="Lc draws: importance-weighted log-uniform, or the population itself (thesis).",
+    ),
+    click.option("--seed", type=int, default=0, show_default=True, help="Random seed (reproducible)."),
+    click.option(
+        "--location",
+        type=click.Choice(["silhouette", "point_cloud"]),
+        default="silhouette",
+        show_default=True,
+        help="Strike-location method.",
+    ),
+    click.option(
+        "--grid-spacing-m",
+        type=float,
+        default=None,
+        help="Point-cloud grid spacing [m] (default 1/6 smallest dimension).",
+    ),
+    click.option(
+        "--area",
+        type=click.Choice(["thesis", "silhouette"]),
+        default="thesis",
+        show_default=True,
+        help="Effective area: thesis Eqs. 5.15-5.18 or mean silhouette.",
+    ),
+    click.option(
+        "--metric",
+        type=click.Choice(["dH", "dV", "da"]),
+        multiple=True,
+        help="Metric(s) for the table and plot (default: all for the table, dH for the plot).",
+    ),
+    click.option(
+        "--thresholds",
+        default=None,
+        help="Comma-separated thresholds in SI units (N m s, m/s, m) for the first metric.",
+    ),
+    click.option("--out", type=click.Path(dir_okay=False), default=None, help="Write the rate table (.csv)."),
+    click.option(
+        "--plot",
+        type=click.Path(dir_okay=False),
+        default=None,
+        help="Write the rate-vs-threshold plot (PNG).",
+    ),
+    click.option("--scatter", type=click.Path(dir_okay=False), default=None, help="Write the ΔH-ΔV scatter (PNG)."),
+]
+
+
 def _scenario_options(func: Callable[..., Any]) -> Callable[..., Any]:
-    options = [
-        click.option(
-            "--spacecraft",
-            "spacecraft",
-            type=click.Path(dir_okay=False),
-            required=True,
-            help="Spacecraft TOML file with [[surfaces]] and mass_kg.",
-        ),
-        click.option(
-            "--altitude-km",
-            type=float,
-            default=550.0,
-            show_default=True,
-            help="Circular-orbit altitude [km].",
-        ),
-        click.option("--inclination-deg", type=float, default=28.5, show_default=True, help="Inclination [deg]."),
-        click.option(
-            "--epoch",
-            "epoch_year",
-            type=float,
-            default=2020.0,
-            show_default=True,
-            help="Epoch [decimal year].",
-        ),
-        click.option(
-            "--solar-flux",
-            "solar_flux_sfu",
-            type=float,
-            default=100.0,
-            show_default=True,
-            help="NASA-90: smoothed F10.7 of the previous year [sfu].",
-        ),
-        click.option(
-            "--flux",
-            "flux_model",
-            default="nasa90",
-            show_default=True,
-            help="nasa90, grun, nasa90+grun, or a flux-table manifest .toml (joined with '+').",
-        ),
-        click.option(
-            "--flux-sigma-factor",
-            type=float,
-            default=0.0,
-            show_default=True,
-            help="Analytic models: 1-sigma as a fraction of the flux (for --flux-bound).",
-        ),
-        click.option(
-            "--flux-bound",
-            type=float,
-            default=0.0,
-            show_default=True,
-            help="Shift flux by this many sigma (e.g. -2, 2).",
-        ),
-        click.option(
-            "--mass-model",
-            default="al_sphere",
-            show_default=True,
-            help="al_sphere, ordem_sphere, socit, socit_literal, socit_no_steel, debrisat.",
-        ),
-        click.option(
-            "--mef",
-            default="const2",
-            show_default=True,
-            help="const1, const2, const3, const:<x>, nysmith_denardo, rembor, rembor_array.",
-        ),
-        click.option("--lc-min-m", type=float, default=3e-5, show_default=True, help="Lower Lc truncation [m]."),
-        click.option(
-            "--draws",
-            "n_draws",
-            type=int,
-            default=10_000,
-            show_default=True,
-            help="Monte Carlo draws per case.",
-        ),
-        click.option(
-            "--size-sampling",
-            type=click.Choice(["log_uniform", "population"]),
-            default="log_uniform",
-            show_default=True,
-            help="Lc draws: importance-weighted log-uniform, or the population itself (thesis).",
-        ),
-        click.option("--seed", type=int, default=0, show_default=True, help="Random seed (reproducible)."),
-        click.option(
-            "--location",
-            type=click.Choice(["silhouette", "point_cloud"]),
-            default="silhouette",
-            show_default=True,
-            help="Strike-location method.",
-        ),
-        click.option(
-            "--grid-spacing-m",
-            type=float,
-            default=None,
-            help="Point-cloud grid spacing [m] (default 1/6 smallest dimension).",
-        ),
-        click.option(
-            "--area",
-            type=click.Choice(["thesis", "silhouette"]),
-            default="thesis",
-            show_default=True,
-            help="Effective area: thesis Eqs. 5.15-5.18 or mean silhouette.",
-        ),
-        click.option(
-            "--metric",
-            type=click.Choice(["dH", "dV", "da"]),
-            multiple=True,
-            help="Metric(s) for the table and plot (default: all for the table, dH for the plot).",
-        ),
-        click.option(
-            "--thresholds",
-            default=None,
-            help="Comma-separated thresholds in SI units (N m s, m/s, m) for the first metric.",
-        ),
-        click.option("--out", type=click.Path(dir_okay=False), default=None, help="Write the rate table (.csv)."),
-        click.option(
-            "--plot",
-            type=click.Path(dir_okay=False),
-            default=None,
-            help="Write the rate-vs-threshold plot (PNG).",
-        ),
-        click.option("--scatter", type=click.Path(dir_okay=False), default=None, help="Write the ΔH-ΔV scatter (PNG)."),
-    ]
-    for opt in reversed(options):
+    for opt in reversed(SCENARIO_OPTIONS):
         func = opt(func)
     return func
 
 
 def _report(results: Sequence[Any], kw: dict[str, Any]) -> None:
-
-    from abrupt.pipelines.rates import METRIC_UNITS, metric_thresholds, rate_table
-
     metrics = list(kw["metric"]) or ["dH", "dV", "da"]
     frame = rate_table(results, metrics, kw["thresholds"])
     for r in results:
@@ -173,10 +182,6 @@ def _report(results: Sequence[Any], kw: dict[str, Any]) -> None:
         frame.to_csv(kw["out"], index=False)
         click.echo(f"table written to {kw['out']}", err=True)
     if kw["plot"]:
-        import numpy as np
-
-        from abrupt.rates.plots import plot_rate_curves
-
         m = metrics[0]
         thr_plot = None
         if kw["thresholds"]:
@@ -184,8 +189,6 @@ def _report(results: Sequence[Any], kw: dict[str, Any]) -> None:
         plot_rate_curves(results, m, kw["plot"], thresholds=thr_plot)
         click.echo(f"plot written to {kw['plot']}", err=True)
     if kw["scatter"]:
-        from abrupt.rates.plots import plot_dh_dv_scatter
-
         plot_dh_dv_scatter(results, kw["scatter"])
         click.echo(f"scatter written to {kw['scatter']}", err=True)
 
@@ -194,9 +197,6 @@ def _report(results: Sequence[Any], kw: dict[str, Any]) -> None:
 @_scenario_options
 def run_command(**kw: Any) -> None:
     """One Monte Carlo: expected detectable strikes per year against threshold."""
-    from abrupt.pipelines.rates import build_scenario
-    from abrupt.rates.trades import run_case
-
     base = build_scenario(kw)
     _report([run_case(base)], kw)
 
@@ -215,9 +215,6 @@ def run_command(**kw: Any) -> None:
 @with_executor_options
 def trade_command(vary: tuple[str, ...], workers: int | None, scheduler: str | None, **kw: Any) -> None:
     """A trade over one or two variables; one Monte Carlo per case (Dask-parallel with --workers/--scheduler)."""
-    from abrupt.pipelines.rates import build_scenario, parse_vary
-    from abrupt.rates.trades import run_trade
-
     variables = parse_vary(vary)
     base = build_scenario(kw)
     results = run_trade(
@@ -254,12 +251,6 @@ def flux_command(
     write_table: str | None,
 ) -> None:
     """Cumulative flux against size of an analytic model for an orbit (tumbling-plate and cross-section)."""
-    import numpy as np
-
-    from abrupt.errors import ConfigError
-    from abrupt.rates import flux as fx
-    from abrupt.rates import tables
-
     try:
         sizes = np.array([float(s) for s in sizes_m.split(",")])
     except ValueError:
@@ -338,9 +329,6 @@ def import_ordem_command(
     intact_class: str,
 ) -> None:
     """Convert ORDEM 3.x spacecraft-mode size and igloo tables into an abrupt flux table."""
-    from abrupt.rates.ordem import describe_mapping, import_ordem, read_numeric_table
-    from abrupt.rates.tables import write_flux_table
-
     header, _, _ = read_numeric_table(Path(size_file))
     for col, meaning in describe_mapping(header).items():
         click.echo(f"  {col}: {meaning}", err=True)

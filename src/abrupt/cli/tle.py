@@ -32,12 +32,14 @@ from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET, TleDetectorConfig
 from abrupt.detect.tle.detectors import detector_for
 from abrupt.errors import InputError
 from abrupt.events import config_hash, new_run_id, read_events
-from abrupt.pipelines.tle import detect_tle_file, satellite_label
+from abrupt.pipelines.tle import burns_below_detectable, detect_tle_file, satellite_label
 from abrupt.readers.fengyun import read_maneuver_file
 from abrupt.readers.omm import read_elements
 from abrupt.report.tle import plot_injection_recall, plot_tle_report
 from abrupt.score import recall_at_false_alarm_rate, score_events
 from abrupt.simulate.tle_injection import KINDS, MIN_ELEMENT_SETS, injection_recall, ladder_around
+from abrupt.simulate.tle_own_null import own_null_rate
+from abrupt.thresholds import DAYS_PER_YEAR, FalseAlarmBudget
 
 TLE_BUDGET = str(DEFAULT_TLE_BUDGET)  # "1/year"
 
@@ -78,6 +80,15 @@ norad_option = click.option(
     "'statistic >= threshold' selects detections.",
 )
 @click.option("--strict", is_flag=True, help="A malformed element set is an error (default: skipped and reported).")
+@click.option(
+    "--null-seeds",
+    type=click.IntRange(0, 100),
+    default=2,
+    show_default=True,
+    help="Bootstrapped maneuver-free histories of each satellite's own quiet noise on which the realised "
+    "false-alarm rate is measured beside the budget (0: skip).",
+)
+@click.option("--null-years", type=click.FloatRange(1.0, 50.0), default=4.0, show_default=True, help="Length of each.")
 @catalog_option
 @report_option
 def detect_tle(
@@ -90,6 +101,8 @@ def detect_tle(
     window_sets: int,
     all_candidates: bool,
     strict: bool,
+    null_seeds: int,
+    null_years: float,
     catalog_target: str,
     report_path: str | None,
     **budget_given: Any,
@@ -128,16 +141,30 @@ def detect_tle(
             click.echo(f"repaired: {line}", err=True)
         nm = sat.noise_model
         found = sat.events.loc[sat.events["statistic"] >= sat.events["threshold"]] if len(sat.events) else sat.events
+        camps = found.loc[found["kind"] == "maneuver_campaign"] if len(found) else found
+        found = found.loc[found["kind"] != "maneuver_campaign"] if len(found) else found
         n_det = len(found)
         multi = int((found["burns_max"] > 1).sum()) if "burns_max" in found else 0
+        n_burns = int(camps["burn_count"].sum()) if len(camps) else 0
         click.echo(
             f"{satellite_label(h)}: {len(h)} element sets, {sat.detector}, {n_det} maneuver(s)"
             + (f" ({multi} with an interval long enough for several burns at its campaign cadence)" if multi else "")
+            + (f", {len(camps)} campaign(s) of {n_burns} burns in all" if len(camps) else "")
             + "; "
             f"smallest detectable ΔV in-track {nm.get('min_detectable_dv_t_mps', float('nan')) * 100:.2g} cm/s, "
             f"cross-track {nm.get('min_detectable_dv_n_mps', float('nan')) * 100:.2g} cm/s",
             err=True,
         )
+        for row in nm.get("detectable_by_year", []):
+            click.echo(
+                f"  {row['year']}: smallest detectable ΔV in-track {row['min_detectable_dv_t_mps'] * 100:.2g} cm/s, "
+                f"cross-track {row['min_detectable_dv_n_mps'] * 100:.2g} cm/s "
+                f"(threshold {row['threshold']:.3g}, {row['gaps']} gaps)",
+                err=True,
+            )
+        own_null = _own_null(sat, budget, null_seeds, null_years, settings)
+        if own_null is not None:
+            nm = {**nm, "own_null": own_null}
         details["satellites"].append(
             {
                 "norad_id": h.norad_id,
@@ -207,6 +234,32 @@ def report_tle(
     truth_frame = _read_truth(truth) if truth else None
     written = plot_tle_report(history, events, out, truth=truth_frame, tolerance_s=tolerance_days * 86400.0)
     click.echo(f"report written to {written}", err=True)
+
+
+def _own_null(sat: Any, budget: Any, seeds: int, years: float, settings: dict[str, Any]) -> dict[str, Any] | None:
+    """Measure and print the false-alarm rate realised on the satellite's own bootstrapped quiet noise
+    (quiet: away from its detections) beside the budget; None when skipped or impossible."""
+    if seeds == 0:
+        return None
+    if len(sat.history) < MIN_ELEMENT_SETS:
+        click.echo(f"  own null: {len(sat.history)} element sets, too few (at least {MIN_ELEMENT_SETS})", err=True)
+        return None
+    found = sat.events.loc[sat.events["statistic"] >= sat.events["threshold"]] if len(sat.events) else sat.events
+    known = list(pd.to_datetime(found["time_utc"].astype(str), utc=True).dt.tz_localize(None)) if len(found) else []
+    kw = {k: v for k, v in settings.items() if v is not None}
+    try:
+        rate = own_null_rate(sat.history, known, budget, years=years, seeds=range(seeds), **kw)
+    except ValueError as exc:
+        click.echo(f"  own null: not measured ({exc})", err=True)
+        return None
+    lo, hi = rate.interval_per_year()
+    click.echo(
+        f"  own null: {rate.false_alarms} false alarm(s) in {rate.sat_years:.1f} satellite-years of its own quiet "
+        f"noise ({rate.histories} bootstrapped histories): {rate.rate_per_year:.2f} per year "
+        f"(95 % {lo:.2f}-{hi:.2f}) against the budget {budget} ({rate.ratio:.2f}x)",
+        err=True,
+    )
+    return rate.as_dict()
 
 
 def _read_truth(path: str) -> Any:
@@ -332,8 +385,37 @@ def score(
             out["operating_points"].append(op.__dict__)
     else:
         click.echo("recall at a false-alarm rate needs the observed span: give --elements or --start/--end", err=True)
+    if elements:
+        out["below_detectable"] = _flag_undetectable(elements, events, truth_frame, start, end)
     if json_out:
         Path(json_out).write_text(json.dumps(out, indent=2, default=str))
+
+
+def _flag_undetectable(elements: str, events: Any, truth: Any, start: Any, end: Any) -> dict[str, Any]:
+    """Compare the truth's burns with the smallest ΔV the history's element sets resolve per year (at the
+    events' budget) and flag a history whose listed burns are mostly below it."""
+    per_day = events["false_alarms_per_day"].dropna() if "false_alarms_per_day" in events else pd.Series([])
+    budget = FalseAlarmBudget(float(per_day.iloc[0]) * DAYS_PER_YEAR, "year") if len(per_day) else DEFAULT_TLE_BUDGET
+    history = read_elements(elements)
+    by_year = detector_for(history).detect(history, budget).diagnostics[0].noise_model.get("detectable_by_year", [])
+    times = pd.to_datetime(truth["time_utc"].astype(str), utc=True)
+    inside = truth.loc[(times >= pd.Timestamp(start, tz="UTC")) & (times <= pd.Timestamp(end, tz="UTC"))]
+    below, total = burns_below_detectable(inside, by_year)
+    if total == 0:
+        click.echo("detectable ΔV: the truth file states no ΔV; burns below what the element sets resolve unknown")
+        return {"burns_with_dv": 0, "below": 0, "flagged": False}
+    flagged = below > total / 2
+    click.echo(
+        f"detectable ΔV: {below} of {total} truth burns with a stated ΔV are below the smallest ΔV the element "
+        f"sets resolve in their year at {budget}"
+        + (
+            " -> FLAG: most listed burns cannot be seen in these element sets; recall here measures the "
+            "element sets, not the detector"
+            if flagged
+            else ""
+        )
+    )
+    return {"burns_with_dv": total, "below": below, "flagged": flagged}
 
 
 @inject.command("tle")

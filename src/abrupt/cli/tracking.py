@@ -8,9 +8,19 @@ from pathlib import Path
 from typing import Any
 
 import click
+import numpy as np
+import pandas as pd
 
 from abrupt.cli.groups import catalog_option, detect, progress, record_run, report, report_option, simulate
 from abrupt.cli.options import budget_options, pop_budget
+from abrupt.errors import ConfigError
+from abrupt.events import read_events, write_events
+from abrupt.model.stations import ascension
+from abrupt.pipelines.tracking import TrackingSettings, detect_tracking, read_tracking_series
+from abrupt.readers.orekit_od_input import write_od_input
+from abrupt.readers.tdm import write_tdm
+from abrupt.report.tracking import plot_tracking_report
+from abrupt.simulate.tracking import CASE1, CASE2, TrackingScenario, simulate_tracking, thesis_burn
 
 
 @simulate.command("tracking")
@@ -100,13 +110,6 @@ def simulate_tracking_command(
     orbits at the chosen location. Writes the measurements, an a-priori/station file for
     `abrupt detect tracking --setup`, and optionally the truth events.
     """
-    from abrupt.errors import ConfigError
-    from abrupt.events import write_events
-    from abrupt.model.stations import ascension
-    from abrupt.readers.orekit_od_input import write_od_input
-    from abrupt.readers.tdm import write_tdm
-    from abrupt.simulate.tracking import CASE1, CASE2, TrackingScenario, simulate_tracking, thesis_burn
-
     if cadence_s <= 0 or burn_s <= 0 or noise_scale < 0:
         raise ConfigError("cadence, burn duration must be > 0 and noise scale >= 0", key="simulate tracking")
     case = CASE1 if orbit == "case1" else CASE2
@@ -147,9 +150,6 @@ def simulate_tracking_command(
 
 
 def _write_aer(measurements: Any, path: Path) -> None:
-    import numpy as np
-    import pandas as pd
-
     lines = []
     for _, row in measurements.iterrows():
         t = pd.Timestamp(row["time_utc"]).strftime("%Y-%m-%dT%H:%M:%S.%f")
@@ -244,8 +244,6 @@ def detect_tracking_command(
     Fits the orbit (with station biases and, for real data, a constant unmodelled acceleration), then
     runs the Kaderali EKF (Ψ, K) and the out-of-view GLRT. Events go to the catalog and --out.
     """
-    from abrupt.pipelines.tracking import TrackingSettings, detect_tracking, read_tracking_series
-
     budget = pop_budget(budget_args, "0.1/day")
     settings = TrackingSettings(
         method=method,  # type: ignore[arg-type]
@@ -277,10 +275,6 @@ def detect_tracking_command(
         details={"settings": run.settings, "fit": run.fit_summary},
     )
     if report_path and len(run.diagnostics):
-        import pandas as pd
-
-        from abrupt.report.tracking import plot_tracking_report
-
         diag = run.diagnostics.copy()
         diag["time_utc"] = pd.to_datetime(diag["time_utc"])
         plot_tracking_report(diag, events=run.events, path=report_path)
@@ -300,11 +294,6 @@ def detect_tracking_command(
 @click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Figure (.png/.pdf/.svg).")
 def report_tracking_command(diagnostics: str, events_path: str | None, truth_path: str | None, out: str) -> None:
     """Ψ and K against time (Kaderali 2021 Figs. 3.2-3.4) and the GLRT statistic, with events and truth."""
-    import pandas as pd
-
-    from abrupt.events import read_events
-    from abrupt.report.tracking import plot_tracking_report
-
     diag = pd.read_csv(diagnostics, parse_dates=["time_utc"])
     events = read_events(events_path) if events_path else None
     truth = read_events(truth_path) if truth_path else None

@@ -35,7 +35,7 @@ from typing import Any, ClassVar, Generic, TypeVar
 import numpy as np
 import pandas as pd
 
-from abrupt.events import EVENT_COLUMNS, EVENT_KINDS, empty_frame
+from abrupt.events import EVENT_COLUMNS, EVENT_KINDS, empty_frame, run_config_hash
 from abrupt.thresholds import FalseAlarmBudget, Threshold
 from abrupt.types import FloatArray
 
@@ -123,8 +123,13 @@ class Detector(ABC, Generic[SeriesT]):
         return self.name.split(".", 1)[0]
 
     def config(self) -> dict[str, Any]:
-        """The detector's settings (by default its public instance attributes)."""
-        return {k: v for k, v in vars(self).items() if not k.startswith("_")}
+        """The detector's settings: by default its public instance attributes, except ``run_id`` (the run
+        a detector works for is not a setting, and the configuration hash must not change between runs)."""
+        return {k: v for k, v in vars(self).items() if not k.startswith("_") and k != "run_id"}
+
+    def config_hash_for(self, budget: FalseAlarmBudget) -> str:
+        """The ``config_hash`` of this detector's settings at ``budget`` (name, settings and budget)."""
+        return run_config_hash(self.config(), budget, detector=self.name)
 
     @abstractmethod
     def detect(self, series: SeriesT, budget: FalseAlarmBudget) -> DetectionResult:

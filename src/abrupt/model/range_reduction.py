@@ -1,6 +1,6 @@
 """Reduction of two-way ranges to instantaneous geometric ranges, term by term and switchable.
 
-The orbit fits of :mod:`abrupt.detect.tracking.glrt` and :mod:`abrupt.detect.tracking.kaderali` predict an
+The batch orbit fit (:mod:`abrupt.model.orbit.batch_fit`) and Kaderali's filter predict an
 *instantaneous geometric* range |r_sat(t) − r_site(t)| from a nominal station site. A laser or radio
 range is not that: it is half a round-trip light time timed at the station (receive epoch t_r), through
 the troposphere, bent by the Earth's field, from an instrument that sits off its marker, on a plate that
@@ -31,6 +31,7 @@ from typing import Literal
 import erfa
 import numpy as np
 import pandas as pd
+from scipy.interpolate import CubicHermiteSpline, CubicSpline
 
 from abrupt.errors import RepairLog
 from abrupt.model.light_time import shapiro_delay_m, two_way_range_m
@@ -106,14 +107,17 @@ class StationSite:
         return x
 
 
+def trajectory_interpolator(t_grid_s: FloatArray, states: FloatArray) -> CubicHermiteSpline:
+    """Cubic Hermite interpolation of positions from states (positions and velocities) on a grid."""
+    return CubicHermiteSpline(t_grid_s, states[:, :3], states[:, 3:6], axis=0)
+
+
 def tide_displacements_m(site_ecef_m: FloatArray, times_utc: np.ndarray, step_s: float = 1800.0) -> FloatArray:
     """Solid-tide displacements (n, 3) at ``times_utc``: nodes every ``step_s`` and a cubic spline.
 
     The tide varies with periods of 12 h and longer, so half-hour nodes and a cubic spline are good to a
     few micrometres while keeping the Sun/Moon ephemeris evaluations few (one vectorised call).
     """
-    from scipy.interpolate import CubicSpline
-
     t = np.asarray(times_utc, dtype="datetime64[ns]")
     if t.size == 0:
         return np.empty((0, 3))

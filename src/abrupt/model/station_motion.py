@@ -18,7 +18,9 @@ import erfa
 import numpy as np
 from numpy.typing import ArrayLike
 
+from abrupt.model.orbit.bodies import sun_moon_gcrf
 from abrupt.model.orbit.constants import MU_EARTH_M3_S2, MU_MOON_M3_S2, MU_SUN_M3_S2
+from abrupt.model.tracking_measurements import earth_rotation_matrices
 from abrupt.types import FloatArray
 
 EARTH_RADIUS_M = 6378136.6  # [m] IERS 2010
@@ -70,9 +72,6 @@ def sun_moon_ecef_m(epoch_utc: ArrayLike) -> tuple[FloatArray, FloatArray]:
     into ECEF with the tracking filters' Earth orientation. ``epoch_utc`` may be one ``datetime64``
     (returns (3,) arrays) or an array (returns (n, 3)).
     """
-    from abrupt.model.orbit.bodies import sun_moon_gcrf
-    from abrupt.model.tracking_measurements import earth_rotation_matrices
-
     t = np.asarray(epoch_utc, dtype="datetime64[ns]")
     flat = t.reshape(-1)
     sun, moon = sun_moon_gcrf(flat)

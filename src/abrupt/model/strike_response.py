@@ -4,8 +4,8 @@ A debris strike excites a known, short control transient: a spike in body rate t
 controller removes in about 25 s, and a drift and correction of the attitude. :func:`build_wavelets`
 records it for each body axis (the response to the largest strike about that axis that does not
 saturate the wheels) and a bank of strike sizes for the size estimate (§2.2.4), from the noise-free
-rigid-body + reaction-wheel + MRP-controller dynamics (run in batch by the attitude simulator's
-kernels). Detectors read the :class:`WaveletSet`; they do not run the simulator themselves.
+rigid-body + reaction-wheel + MRP-controller dynamics (:mod:`abrupt.model.attitude_dynamics`, in
+batch). Detectors read the :class:`WaveletSet`; they do not run the simulator themselves.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike, simulate_attitude_batch
 from abrupt.model.rotations import attitude_error_vector
 from abrupt.types import FloatArray
 
@@ -112,8 +113,6 @@ def strike_responses(
     initial attitude as the reference; with ``return_wheels`` also the wheel speeds relative to their
     pre-strike value (m, L, N) [rad/s]. Runs the attitude simulator in batch mode.
     """
-    from abrupt.simulate.attitude import AttitudeSimConfig, Strike, simulate_attitude_batch
-
     dh = np.atleast_2d(np.asarray(dH_B_Nms, dtype=np.float64))
     n = round(duration_s * sample_rate_hz)
     config = AttitudeSimConfig(

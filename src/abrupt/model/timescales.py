@@ -9,6 +9,8 @@ from __future__ import annotations
 from typing import Literal
 
 import numpy as np
+from astropy.time import Time
+from astropy.utils import iers
 from numpy.typing import NDArray
 
 TimeScale = Literal["utc", "tai", "gps", "tt"]
@@ -20,7 +22,6 @@ def offline_astropy() -> None:
     global _CONFIGURED
     if _CONFIGURED:
         return
-    from astropy.utils import iers
 
     iers.conf.auto_download = False
     iers.conf.auto_max_age = None
@@ -37,7 +38,6 @@ def to_utc(times: NDArray[np.datetime64] | list[str], scale: TimeScale) -> NDArr
     if scale == "utc":
         return arr
     offline_astropy()
-    from astropy.time import Time
 
     if scale == "gps":
         arr = arr + np.timedelta64(19, "s")

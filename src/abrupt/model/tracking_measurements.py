@@ -19,17 +19,19 @@ from __future__ import annotations
 
 import math
 import warnings
-from typing import TYPE_CHECKING, Literal
+from typing import Literal
 
+import erfa
 import numba
 import numpy as np
 import pandas as pd
+from astropy.time import Time
 from numpy.typing import NDArray
 
-if TYPE_CHECKING:
-    from abrupt.model.stations import Station
-
+from abrupt.errors import InputError
 from abrupt.model.orbit import OMEGA_EARTH_RAD_S
+from abrupt.model.stations import Station, lookup_station
+from abrupt.model.timescales import offline_astropy
 
 MEASUREMENT_COLUMNS = ("range_m", "azimuth_rad", "elevation_rad", "range_rate_mps")
 EarthRotationModel = Literal["simple", "iers"]
@@ -76,11 +78,6 @@ def earth_rotation_matrices(
         raise ValueError(f"unknown Earth rotation model {model!r}")
     if epoch_utc is None:
         raise ValueError("the 'iers' Earth rotation model needs epoch_utc")
-    import erfa
-    from astropy.time import Time
-
-    from abrupt.model.timescales import offline_astropy
-
     offline_astropy()
     times = as_datetime64_ns(epoch_utc) + (t * 1e9).astype("timedelta64[ns]")
     tt = Time(times, scale="utc", format="datetime64")
@@ -237,9 +234,6 @@ class TrackingArrays:
         theta0_rad: float = 0.0,
         source: str = "<measurements>",
     ) -> None:
-        from abrupt.errors import InputError
-        from abrupt.model.stations import lookup_station
-
         meas = measurements.sort_values("time_utc", kind="stable").reset_index(drop=True)
         times = np.asarray(meas["time_utc"], dtype="datetime64[ns]")
         self.epoch_utc = as_datetime64_ns(epoch_utc if epoch_utc is not None else times[0])

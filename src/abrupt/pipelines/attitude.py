@@ -15,7 +15,7 @@ false-alarm budget and returns an :class:`AttitudeRun`: the events of the run, s
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +23,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from abrupt.clean.masks import apply_mask, read_mask
 from abrupt.detect.attitude.momentum import (
     ATTITUDE_EVENT_COLUMNS,
     AttitudeDetectionConfig,
@@ -33,7 +34,9 @@ from abrupt.detect.attitude.momentum import (
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.errors import InputError
 from abrupt.events import config_hash, empty_frame, new_run_id, normalise_frame, restamp
-from abrupt.model.spacecraft import Spacecraft
+from abrupt.model.spacecraft import Spacecraft, bundled_spacecraft_path
+from abrupt.model.spacecraft import load_spacecraft as load_spacecraft_file
+from abrupt.readers.telemetry import read_telemetry
 from abrupt.series.attitude import AttitudeSeries
 from abrupt.series.telemetry import Telemetry
 from abrupt.thresholds import FalseAlarmBudget, Threshold
@@ -80,9 +83,7 @@ class AttitudeRun:
 
 def load_spacecraft(path: str | Path | None) -> Spacecraft:
     """The spacecraft file at ``path``, or the bundled thesis spacecraft (Bennett 2022 Table 2.1)."""
-    from abrupt.model import spacecraft
-
-    return spacecraft.load_spacecraft(path or spacecraft.bundled_spacecraft_path("thesis"))
+    return load_spacecraft_file(path or bundled_spacecraft_path("thesis"))
 
 
 def read_attitude_inputs(
@@ -93,9 +94,6 @@ def read_attitude_inputs(
     mask_path: str | Path | None = None,
 ) -> tuple[Spacecraft, Telemetry, Telemetry | None]:
     """Read telemetry (CSV/Parquet) mapped by the spacecraft file, mask planned events, read calibration."""
-    from abrupt.clean.masks import apply_mask, read_mask
-    from abrupt.readers.telemetry import read_telemetry
-
     sc = load_spacecraft(spacecraft_path)
     tel = read_telemetry(telemetry_path, sc)
     if mask_path:
@@ -137,13 +135,13 @@ def detect_attitude(
 ) -> AttitudeRun:
     """Detect strikes in ``telemetry`` with every detector of ``config``; one event per detection.
 
-    ``budget`` (default ``config.false_alarms_per_day`` per day) sets every threshold;
+    ``budget`` (default ``config.budget``) sets every threshold;
     ``thresholds`` (by detector name, e.g. from a previous calibration) skips their fit.
     """
     config = config or AttitudeDetectionConfig()
     if budget is not None:
-        config = replace(config, false_alarms_per_day=budget.per_day)
-    budget = budget or config.budget
+        config = replace(config, budget=budget)
+    budget = config.budget
     run_id = run_id or new_run_id()
     if calibration is not None:
         ratio = calibration.sample_interval_s / telemetry.sample_interval_s
@@ -155,7 +153,7 @@ def detect_attitude(
             )
     cfg_hash = config_hash(
         {
-            "attitude": asdict(config),
+            "attitude": config.hash_fields(),
             "spacecraft": spacecraft_fingerprint(spacecraft),
             "calibration": None
             if calibration is None

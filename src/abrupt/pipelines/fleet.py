@@ -15,7 +15,7 @@ from __future__ import annotations
 import csv
 import hashlib
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -23,7 +23,9 @@ import pandas as pd
 
 from abrupt.catalog import Catalog, Coverage, run_key
 from abrupt.errors import InputError
-from abrupt.events import config_hash, empty_frame, format_time_utc
+from abrupt.events import config_hash, empty_frame, format_time_utc, new_run_id
+from abrupt.pipelines.attitude import detect_attitude, read_attitude_inputs
+from abrupt.pipelines.tle import detect_tle_file
 from abrupt.scale import Executor, TaskResult, run_tasks
 
 MANIFEST_COLUMNS = ("spacecraft", "telemetry", "spacecraft_file")
@@ -115,8 +117,6 @@ def read_manifest(path: str | Path) -> list[FleetMember]:
 
 def detect_attitude_task(task: AttitudeTask) -> TaskOutput:
     """Run one task: read, calibrate on the file's own noise, detect (a pure function of the task)."""
-    from abrupt.pipelines.attitude import detect_attitude, read_attitude_inputs
-
     sc, tel, _ = read_attitude_inputs(task.member.telemetry, task.member.spacecraft_file)
     result = detect_attitude(tel, sc, task.config, run_id=task.run_id, spacecraft_name=task.member.spacecraft)
     coverage: tuple[Coverage, ...] = ()
@@ -143,7 +143,7 @@ def fleet_run_key(members: Sequence[FleetMember], config: Any) -> str:
         f"{m.spacecraft}:{Path(m.telemetry).name}:{_file_digest(m.telemetry)}:{_file_digest(m.spacecraft_file)}"
         for m in members
     )
-    return run_key("detect attitude fleet", config_hash(asdict(config)), *parts)
+    return run_key("detect attitude fleet", config_hash(config.hash_fields()), *parts)
 
 
 def detect_attitude_fleet(
@@ -169,7 +169,7 @@ def detect_attitude_fleet(
     tasks = [AttitudeTask(m, config, run_id) for m in members]
     todo = [t for t in tasks if t.key not in done]
     if cat is not None:
-        cat.start_run(run_id, command, config_hash=config_hash(asdict(config)), details={"tasks": len(tasks)})
+        cat.start_run(run_id, command, config_hash=config_hash(config.hash_fields()), details={"tasks": len(tasks)})
     outputs: dict[str, TaskOutput] = {}
 
     def store(res: TaskResult[AttitudeTask, TaskOutput]) -> None:
@@ -228,8 +228,6 @@ class TleTask:
 
 def detect_tle_task(task: TleTask) -> pd.DataFrame:
     """Run the TLE pipeline on one file (a pure function of the task)."""
-    from abrupt.pipelines.tle import detect_tle_file
-
     return detect_tle_file(task.path, task.budget, run_id=task.run_id).events
 
 
@@ -242,8 +240,6 @@ def detect_tle_batch(
     show_progress: bool | None = None,
 ) -> pd.DataFrame:
     """Maneuvers in many TLE/OMM histories, one task per file, on the executor (docs/scale.md)."""
-    from abrupt.events import new_run_id
-
     run_id = run_id or new_run_id()
     tasks = [TleTask(str(p), budget, run_id) for p in paths]
     frames = run_tasks(

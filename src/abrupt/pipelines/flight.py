@@ -9,12 +9,14 @@ Harris et al. 2025 §3.3-3.5, §3.7 and Bennett 2022 ch. 4, driven entirely by t
    (:mod:`abrupt.series.timetable`), computes ᴺH with appendages (:mod:`abrupt.series.timetable_momentum`),
    masks event-flag firings and slews (:mod:`abrupt.clean.masks`), removes the slow external-torque
    trend and the orbit comb (:mod:`abrupt.clean.comb`) in ``passes`` iterations, the candidate steps of
-   one pass entering the next pass's fits as free steps so that strikes are not absorbed, and runs
-   the GLR statistic of the registered ``attitude.glr`` detector (Bennett 2022 §2.4.2; ``get_detector``)
-   on the cleaned ᴺH.
-3. :func:`run_flight` runs chunk by chunk (memory flat in the number of days), calibrates the
+   one pass entering the next pass's fits as free steps so that strikes are not absorbed, and scans
+   the cleaned ᴺH with the registered detector ``attitude.flight_glr``
+   (:mod:`abrupt.detect.attitude.flight_glr`: the step GLR of Bennett 2022 §2.4.2, its peaks and steps).
+3. :func:`run_flight` runs chunk by chunk (memory flat in the number of days); the detector fits the
    threshold on the spacecraft's own statistic at the stated false-alarm rate per day (robust Gumbel fit
-   of block maxima, :mod:`abrupt.thresholds.robust`), and returns events and daily statistics.
+   of block maxima) and writes the events; daily statistics come with them.
+
+Injection and recovery of synthetic strikes is :mod:`abrupt.pipelines.flight_injection`.
 
 Every stage is local in time and anchored at absolute times, so chunks processed with the margin of
 :func:`chunk_margin_s` give the same events as the whole run.
@@ -32,26 +34,24 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from abrupt.clean.comb import CombConfig, smooth_model
+from abrupt.clean.comb import CombConfig, estimate_period, smooth_model
 from abrupt.clean.flight_masks import SlewMaskConfig, event_mask, flag_intervals, slew_mask
-from abrupt.detect.attitude.change_detection import WindowConfig
-from abrupt.detect.base import get_detector
+from abrupt.detect.attitude.flight_glr import MIN_BLOCKS, FlightGlrDetector, Peak
 from abrupt.errors import ConfigError, InputError
-from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc, new_run_id
+from abrupt.events import config_hash, new_run_id
 from abrupt.model.flight_config import FlightConfig
 from abrupt.model.spacecraft import Spacecraft
-from abrupt.readers.archive import read_archive, read_decoder
-from abrupt.scale import Executor
+from abrupt.pipelines.flight_checks import check_tachometer_units, check_wheel_units, flight_channels
+from abrupt.readers.archive import pseudonymise_text, read_archive, read_decoder
+from abrupt.scale import Executor, TaskResult, run_tasks
 from abrupt.series.timetable import NS, Timetable, build_timetable
-from abrupt.series.timetable_momentum import timetable_momentum, wheel_scale_from_conservation
+from abrupt.series.timetable_momentum import timetable_momentum
 from abrupt.store import TelemetryStore
-from abrupt.thresholds import Threshold
-from abrupt.thresholds.noise import robust_noise_sigma
-from abrupt.thresholds.robust import robust_block_maxima_threshold
+from abrupt.thresholds import FalseAlarmBudget, Threshold
+from abrupt.thresholds.noise import robust_noise_sigma, robust_scale
 from abrupt.types import BoolArray, FloatArray
 
 DAY_NS = 86_400 * NS
-DETECTOR_NAME = "attitude.glr"
 
 
 # ------------------------------------------------------------------------------------------------
@@ -78,8 +78,6 @@ def ingest_archives(
     progress: Callable[[str], None] | None = None,
 ) -> IngestSummary:
     """Read archive files, pseudonymise, remove artifacts and write the store (one report per day)."""
-    from abrupt.readers.archive import pseudonymise_text
-
     decoder = read_decoder(decoder_path)
     store = TelemetryStore(store_root)
     summary = IngestSummary()
@@ -161,16 +159,30 @@ class FlightRunConfig:
 
     window_s: float = 300.0
     guard_s: float = 20.0
-    false_alarms_per_day: float = 1.0
+    budget: FalseAlarmBudget = field(default_factory=lambda: FalseAlarmBudget(1.0, "day"))
     block_s: float = 600.0
     chunk_s: float = 3 * 86_400.0
     cleaning: CleaningConfig = field(default_factory=CleaningConfig)
     peak_floor: float = 3.0
     orbit_period_s: float | None = None
 
-    def windows(self, dt_s: float) -> WindowConfig:
-        n = max(2, round(self.window_s / dt_s))
-        return WindowConfig(pre=n, post=n, guard=max(0, round(self.guard_s / dt_s)))
+    def hash_fields(self) -> dict[str, Any]:
+        """The settings as they enter the run's ``config_hash``: the budget as its rate per day, so that one
+        budget written per day or per week hashes the same."""
+        fields = asdict(self)
+        fields.pop("budget")
+        fields["false_alarms_per_day"] = self.budget.per_day
+        return fields
+
+    def detector(self, threshold: Threshold | None = None) -> FlightGlrDetector:
+        """The ``attitude.flight_glr`` detector with this run's windows, blocks and peak floor."""
+        return FlightGlrDetector(
+            window_s=self.window_s,
+            guard_s=self.guard_s,
+            block_s=self.block_s,
+            peak_floor=self.peak_floor,
+            threshold=threshold,
+        )
 
 
 def orbit_period_s(spacecraft: Spacecraft, config: FlightRunConfig | None = None) -> float:
@@ -191,9 +203,6 @@ def estimate_orbit_period_s(spacecraft: Spacecraft, table: Timetable) -> tuple[f
     Otherwise (inertial pointing) the strongest period of ᴺH between 80 and 800 min (Lomb-Scargle,
     :func:`abrupt.clean.comb.estimate_period`). NaN when neither applies.
     """
-    from abrupt.clean.comb import estimate_period
-    from abrupt.thresholds.noise import robust_scale
-
     # Rotation angle between attitudes m samples apart, 2 arccos|q(t+m)·q(t)| (free of gyro bias).
     q = table.quaternion_BN
     m = max(1, round(300.0 / table.dt_s)) if len(table) > 1 else 1
@@ -226,29 +235,13 @@ def chunk_margin_s(spacecraft: Spacecraft, config: FlightRunConfig) -> float:
     fit = (c.spacing_orbits + c.half_width_orbits) * period if (c.comb or c.trend) else 0.0
     span = 2 * config.window_s + config.guard_s
     per_pass = fit + 2 * span
-    sg = max((ch.savgol_window_s for ch in _flight(spacecraft).channels), default=0.0)
+    sg = max((ch.savgol_window_s for ch in flight_channels(spacecraft).channels), default=0.0)
     return c.passes * per_pass + c.slew.nominal_window_s / 2 + c.slew.window_s + sg + 60.0
-
-
-def _flight(spacecraft: Spacecraft) -> FlightConfig:
-    if spacecraft.flight is None:
-        raise ConfigError("no [flight] table: declare the telemetry channels", file=spacecraft.source, key="flight")
-    return spacecraft.flight
 
 
 # ------------------------------------------------------------------------------------------------
 # One chunk
 # ------------------------------------------------------------------------------------------------
-
-
-@dataclass
-class Peak:
-    """A local maximum of the statistic: time [ns], value, step ΔH_N [N·m·s], its time σ [s]."""
-
-    time_ns: int
-    value: float
-    dH_N_Nms: FloatArray
-    time_sigma_s: float
 
 
 @dataclass
@@ -268,154 +261,6 @@ class ChunkResult:
     missing_channels: tuple[str, ...]
     harmonics_mean: float
     series: dict[str, np.ndarray] | None = None
-
-
-def _segments(ok: BoolArray) -> list[tuple[int, int]]:
-    idx = np.flatnonzero(ok)
-    if idx.size == 0:
-        return []
-    br = np.flatnonzero(np.diff(idx) > 1)
-    starts = np.concatenate([[idx[0]], idx[br + 1]])
-    ends = np.concatenate([idx[br], [idx[-1]]]) + 1
-    return [(int(a), int(b)) for a, b in zip(starts, ends, strict=True)]
-
-
-def glr_statistic(h: FloatArray, ok: BoolArray, win: WindowConfig) -> FloatArray:
-    """GLR statistic of the registered ``attitude.glr`` detector (Mahalanobis distance of the pre/post
-    means, Bennett 2022 §2.4.2) on each gap-free segment of ``ok`` at least one window span long.
-
-    The detector class comes from the registry (``get_detector``), so the flight pipeline and
-    ``abrupt detect attitude`` share one statistic; calibration (robust block maxima of the
-    spacecraft's own statistic) and the step estimate on cleaned ᴺH stay here.
-    """
-    from abrupt.detect.attitude.momentum import MomentumChangeDetector
-
-    cls = get_detector(DETECTOR_NAME)
-    if not issubclass(cls, MomentumChangeDetector):
-        raise TypeError(f"{DETECTOR_NAME} is not a momentum change detector")
-    segments = [(a, b) for a, b in _segments(ok) if b - a >= win.span]
-    return np.asarray(cls(windows=win).statistic(h, segments), dtype=np.float64)
-
-
-def _local_peaks(stat: FloatArray, floor: float, sep: int) -> list[int]:
-    """Greedy non-maximum suppression: indices of maxima above ``floor`` at least ``sep`` apart."""
-    x = np.where(np.isfinite(stat), stat, -np.inf)
-    cand = np.flatnonzero(x > floor)
-    if cand.size == 0:
-        return []
-    order = cand[np.argsort(-x[cand], kind="stable")]
-    taken = np.zeros(stat.size, bool)
-    out = []
-    for i in order:
-        if taken[i]:
-            continue
-        out.append(int(i))
-        taken[max(0, i - sep) : i + sep + 1] = True
-    return sorted(out)
-
-
-def locate_step(h: FloatArray, ok: BoolArray, peak: int, win: WindowConfig, m: int = 30) -> int:
-    """Sample where ᴺH steps near a GLR peak: maximum of the noise-weighted mean difference over ±m.
-
-    Searches junction peak − pre .. peak + guard + post inside the peak's gap-free segment.
-    """
-    n = h.shape[0]
-    # The peak's gap-free segment [a, b), looked for only as far as the search reaches.
-    reach = win.pre + win.guard + win.post + 2 * win.span + m + 2
-    w0, w1 = max(0, peak - reach), min(n, peak + reach)
-    bad_before = np.flatnonzero(~ok[w0:peak])
-    a = w0 + int(bad_before[-1]) + 1 if bad_before.size else w0
-    bad_after = np.flatnonzero(~ok[peak:w1])
-    b = peak + int(bad_after[0]) if bad_after.size else w1
-    lo = max(a + m, peak - win.pre)
-    hi = min(b - m, peak + win.guard + win.post)
-    if hi <= lo:
-        return int(np.clip(peak + win.guard // 2, a, b - 1))
-    # Noise from a window around the peak, not the whole segment: a segment can reach the edge of a
-    # chunk's margin, and the result must not depend on where the chunk was cut.
-    near = h[max(a, peak - 2 * win.span) : min(b, peak + 2 * win.span)]
-    sigma = robust_noise_sigma(near)
-    sigma = np.where(sigma > 0, sigma, 1.0)
-    x0 = lo - m  # only the samples the mean differences read
-    x = h[x0 : hi + m]
-    c = np.vstack([np.zeros((1, 3)), np.cumsum(x, axis=0)])
-    taus = np.arange(lo, hi) - x0
-    d = (c[taus + m] - c[taus]) / m - (c[taus] - c[taus - m]) / m
-    return int(x0 + taus[np.argmax(np.sum((d / sigma) ** 2, axis=1))])
-
-
-def local_step(h: FloatArray, ok: BoolArray, tau: int, half: int, guard: int) -> FloatArray:
-    """ΔH at sample τ by least squares of a + b (t − τ) + s·1(t ≥ τ) over ±``half`` samples.
-
-    Samples within [τ − guard/2, τ + guard) are left out (the controller transient and tachometer
-    gate lag); the linear term absorbs what is left of the slow signal. Returns s [N·m·s], (3,).
-    """
-    n = h.shape[0]
-    idx = np.arange(max(0, tau - half), min(n, tau + half))
-    keep = ok[idx] & np.all(np.isfinite(h[idx]), axis=1) & ((idx < tau - guard // 2) | (idx >= tau + guard))
-    idx = idx[keep]
-    if idx.size < 10 or not (idx < tau).any() or not (idx >= tau).any():
-        return np.full(3, np.nan)
-    u = (idx - tau).astype(np.float64) / half
-    design = np.column_stack([np.ones(idx.size), u, (idx >= tau).astype(np.float64)])
-    coef, *_ = np.linalg.lstsq(design, h[idx], rcond=None)
-    return np.asarray(coef[2], dtype=np.float64)
-
-
-def check_wheel_units(spacecraft: Spacecraft, table: Timetable) -> None:
-    """Raise if conservation of ᴺH says the wheel speeds are in another unit than declared.
-
-    The wheel scale that makes ᴺH most nearly constant (:func:`wheel_scale_from_conservation`) is 1 for
-    the right unit; rpm declared as rad/s gives ≈ 0.105 (2π/60), rad/s declared as rpm ≈ 9.5. Only
-    decided when the fit explains most of the wheel term's variance (the wheels moved).
-    """
-    scale, explained = wheel_scale_from_conservation(spacecraft, table)
-    if not (math.isfinite(scale) and explained > 0.5) or 1 / 3 < scale < 3:
-        return
-    flight = _flight(spacecraft)
-    k = next(i for i, c in enumerate(flight.channels) if c.quantity == "wheel_speed")
-    unit = flight.channels[k].unit
-    raise ConfigError(
-        f"wheel speeds declared in {unit!r} but conservation of angular momentum fits them {scale:.3g} times "
-        f"larger/smaller (rpm read as rad/s gives 0.105, rad/s read as rpm 9.55); check the unit",
-        file=spacecraft.source,
-        key=f"flight.channels[{k}].unit",
-    )
-
-
-def check_tachometer_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> None:
-    """Raise if a tachometer channel's values step in the quantum of another unit than declared.
-
-    A tachometer counting P pulses per revolution over a gate T reports speeds in multiples of
-    2π/(P T) rad/s = 60/(P T) rpm; the unit whose quantum makes the speed differences integers is the
-    unit the values are in.
-    """
-    from abrupt.model.flight_config import WHEEL_UNITS
-
-    flight = _flight(spacecraft)
-    for k, ch in enumerate(flight.channels):
-        if ch.quantity != "wheel_speed" or ch.tachometer is None or ch.unit == "counts":
-            continue
-        v = samples.loc[samples["mnemonic"] == ch.mnemonic, "value"].to_numpy(np.float64)
-        d = np.abs(np.diff(v))
-        d = d[d > 0][:5000]
-        if d.size < 20:
-            continue
-
-        def on_grid(unit: str, d: np.ndarray = d, quantum: float = ch.tachometer.quantum_rad_s) -> float:
-            q = quantum / WHEEL_UNITS[unit]
-            r = d / q
-            return float(np.mean(np.abs(r - np.round(r)) < 0.02))
-
-        declared = on_grid(ch.unit)
-        best = max((u for u in WHEEL_UNITS if u != "counts"), key=on_grid)
-        if declared < 0.5 and on_grid(best) > 0.9 and best != ch.unit:
-            raise ConfigError(
-                f"wheel speeds declared in {ch.unit!r} step in multiples of the tachometer quantum in {best!r} "
-                f"({ch.tachometer.quantum_rad_s / WHEEL_UNITS[best]:.5g} {best}): the values are in {best!r}",
-                file=spacecraft.source,
-                key=f"flight.channels[{k}].unit",
-            )
 
 
 def process_chunk(
@@ -446,6 +291,69 @@ def process_chunk(
     )[0]
 
 
+def _channels_for(spacecraft: Spacecraft, cleaning: CleaningConfig) -> FlightConfig:
+    """The spacecraft's channels, with Savitzky-Golay replaced by linear interpolation when it is off."""
+    flight = flight_channels(spacecraft)
+    if cleaning.savgol:
+        return flight
+    return replace(
+        flight,
+        channels=tuple(replace(ch, method="linear") if ch.method == "savgol" else ch for ch in flight.channels),
+    )
+
+
+def _masks(
+    samples: pd.DataFrame, table: Timetable, flight: FlightConfig, c: CleaningConfig, dt: float
+) -> tuple[BoolArray, BoolArray]:
+    """Event-flag mask (thruster firings with the channel's margins) and slew mask on the grid."""
+    g = table.time_ns
+    ev = np.zeros(g.size, bool)
+    if c.event_masks:
+        for ch in flight.of("event_flag"):
+            sub = samples.loc[samples["mnemonic"] == ch.mnemonic]
+            t = sub["time"].to_numpy().astype("datetime64[ns]").astype(np.int64)
+            ev |= event_mask(g, flag_intervals(t, sub["value"].to_numpy(np.float64)), ch.mask_before_s, ch.mask_after_s)
+    sl = np.zeros(g.size, bool)
+    if c.slew_masks and g.size:
+        valid = table.valid
+        sl = slew_mask(np.where(valid[:, None], table.body_rate_rad_s, np.nan), dt, c.slew) & valid
+    return ev, sl
+
+
+def _clean_and_scan(
+    h_n: FloatArray,
+    ok: BoolArray,
+    t_s: FloatArray,
+    dt: float,
+    period: float,
+    c: CleaningConfig,
+    detector: FlightGlrDetector,
+) -> tuple[FloatArray, FloatArray, dict[str, float]]:
+    """Remove trend and orbit comb in ``c.passes`` passes; the steps one pass finds enter the next as free steps.
+
+    Returns the cleaned ᴺH (NaN where not ``ok``), the detector's statistic on it and the fit's summary.
+    """
+    win = detector.windows(dt)
+    steps = np.empty(0)
+    hc = h_n
+    stat = np.full(t_s.size, np.nan)
+    info: dict[str, float] = {"harmonics_mean": 0.0}
+    fit_cache: dict[tuple[float, ...], Any] = {}
+    h_ok = np.where(ok[:, None], h_n, 0.0)
+    for _ in range(max(1, c.passes)):
+        model, info = smooth_model(h_ok, t_s, ok, period, c.comb_config, steps, cache=fit_cache)
+        hc = np.where(ok[:, None], h_n - np.nan_to_num(model), np.nan)
+        stat = detector.statistic(hc, ok, win)
+        if not (c.comb or c.trend):
+            break
+        taus = detector.step_candidates(hc, ok, stat, win, c.candidate_sigma)
+        new_steps = np.array([t_s[tau] - 0.5 * dt for tau in taus])
+        if new_steps.size == steps.size and np.array_equal(new_steps, steps):
+            break
+        steps = new_steps
+    return hc, stat, info
+
+
 def process_span(
     store: TelemetryStore,
     spacecraft: Spacecraft,
@@ -464,13 +372,8 @@ def process_span(
     statistics), else one. A long span costs its margin once: a day processed alone reads and
     cleans ``2 × chunk_margin_s`` more than the day.
     """
-    flight = _flight(spacecraft)
     c = config.cleaning
-    if not c.savgol:
-        flight = replace(
-            flight,
-            channels=tuple(replace(ch, method="linear") if ch.method == "savgol" else ch for ch in flight.channels),
-        )
+    flight = _channels_for(spacecraft, c)
     margin = int(chunk_margin_s(spacecraft, config) * NS)
     lo, hi = start_ns - margin, end_ns + margin
     samples = store.read_range(
@@ -478,76 +381,27 @@ def process_span(
     )
     if samples_hook is not None:
         samples = samples_hook(samples)
-    names = tuple(a.name for a in spacecraft.appendages)
-    table = build_timetable(samples, flight, names, lo, hi)
+    table = build_timetable(samples, flight, tuple(a.name for a in spacecraft.appendages), lo, hi)
     g = table.time_ns
     dt = table.dt_s if len(table) > 1 else 1.0 / flight.grid_hz
     check_wheel_units(spacecraft, table)
     check_tachometer_units(spacecraft, samples)
     h_n, _ = timetable_momentum(spacecraft, table, inertia_kgm2)
     valid = table.valid.copy()
-    ev = np.zeros(g.size, bool)
-    if c.event_masks:
-        for ch in flight.of("event_flag"):
-            sub = samples.loc[samples["mnemonic"] == ch.mnemonic]
-            t = sub["time"].to_numpy().astype("datetime64[ns]").astype(np.int64)
-            ev |= event_mask(g, flag_intervals(t, sub["value"].to_numpy(np.float64)), ch.mask_before_s, ch.mask_after_s)
-    sl = np.zeros(g.size, bool)
-    if c.slew_masks and g.size:
-        sl = slew_mask(np.where(valid[:, None], table.body_rate_rad_s, np.nan), dt, c.slew) & valid
+    ev, sl = _masks(samples, table, flight, c, dt)
     ok = valid & ~ev & ~sl
-    win = config.windows(dt)
-    t_s = g.astype(np.float64) / NS
+    detector = config.detector()
     period = orbit_period_s(spacecraft, config) if (c.comb or c.trend) else 1.0
-    steps = np.empty(0)
-    hc = h_n
-    stat = np.full(g.size, np.nan)
-    info: dict[str, float] = {"harmonics_mean": 0.0}
-    fit_cache: dict[tuple[float, ...], Any] = {}
-    h_ok = np.where(ok[:, None], h_n, 0.0)
-    for _ in range(max(1, c.passes)):
-        model, info = smooth_model(h_ok, t_s, ok, period, c.comb_config, steps, cache=fit_cache)
-        hc = np.where(ok[:, None], h_n - np.nan_to_num(model), np.nan)
-        stat = glr_statistic(hc, ok, win)
-        if not (c.comb or c.trend):
-            break
-        cand = _local_peaks(stat, c.candidate_sigma, win.span)
-        new_steps = np.array([t_s[locate_step(hc, ok, i, win)] - 0.5 * dt for i in cand])
-        if new_steps.size == steps.size and np.array_equal(new_steps, steps):
-            break
-        steps = new_steps
+    hc, stat, info = _clean_and_scan(h_n, ok, g.astype(np.float64) / NS, dt, period, c, detector)
     core = (g >= start_ns) & (g < end_ns)
-    peaks: list[tuple[int, Peak]] = []
-    for i in _local_peaks(stat, config.peak_floor, win.span):
-        if not core[i]:
-            continue
-        near = hc[max(0, i - 2 * win.span) : i + 2 * win.span]
-        near = near[np.all(np.isfinite(near), axis=1)]
-        sigma = robust_noise_sigma(near) if near.shape[0] > 3 else np.full(3, np.nan)
-        tau = locate_step(hc, ok, i, win)
-        d_h = local_step(hc, ok, tau, win.pre, win.guard)
-        mag = float(np.linalg.norm(d_h))
-        sig = float(np.sqrt(np.sum((sigma * d_h / mag) ** 2))) if mag > 0 else float("nan")
-        time_sigma = max(dt / math.sqrt(12.0), 3.0 * dt * (sig / mag) ** 2) if mag > 0 else dt * win.guard
-        t_event = int(g[tau]) - int(0.5 * dt * NS)
-        peaks.append((i, Peak(t_event, float(stat[i]), d_h, float(time_sigma))))
+    peaks = detector.find_peaks(hc, ok, stat, g, dt, detector.windows(dt), keep=core)
     edges = [start_ns, end_ns]
     if split_days:
         d_first = -(-start_ns // DAY_NS) * DAY_NS
         edges = [start_ns, *range(d_first if d_first > start_ns else d_first + DAY_NS, end_ns, DAY_NS), end_ns]
-    block_ns = int(config.block_s * NS)
     out: list[ChunkResult] = []
     for p0, p1 in itertools.pairwise(edges):
         piece = (g >= p0) & (g < p1)
-        # Block maxima for calibration, blocks anchored at absolute multiples of block_s.
-        blocks: dict[int, float] = {}
-        if piece.any():
-            bidx = g[piece] // block_ns
-            sp = stat[piece]
-            for b in np.unique(bidx):
-                v = sp[bidx == b]
-                if np.isfinite(v).sum() >= 0.5 * config.block_s / dt:
-                    blocks[int(b)] = float(np.nanmax(v))
         series = None
         if keep_series:
             series = {
@@ -570,7 +424,8 @@ def process_span(
                 n_slew_masked=int((sl & ~ev & valid & piece).sum()),
                 n_analysed=int((np.isfinite(stat) & piece).sum()),
                 noise_sigma_Nms=np.asarray(robust_noise_sigma(hc[good]) if good.sum() > 3 else np.full(3, np.nan)),
-                block_maxima=blocks,
+                # Block maxima for calibration, blocks anchored at absolute multiples of block_s.
+                block_maxima=detector.block_maxima(g[piece], stat[piece], dt) if piece.any() else {},
                 peaks=[pk for i, pk in peaks if p0 <= g[i] < p1],
                 missing_channels=table.missing_channels,
                 harmonics_mean=float(info.get("harmonics_mean", 0.0)),
@@ -644,10 +499,13 @@ def run_flight(
         # One period for the whole run (from its first day), so that every chunk uses the same one.
         d0 = int(np.datetime64(day_list[0], "D").astype("datetime64[ns]").astype(np.int64))
         samples = store.read_range(
-            spacecraft.name, np.datetime64(d0, "ns"), np.datetime64(d0 + DAY_NS, "ns"), _flight(spacecraft).mnemonics
+            spacecraft.name,
+            np.datetime64(d0, "ns"),
+            np.datetime64(d0 + DAY_NS, "ns"),
+            flight_channels(spacecraft).mnemonics,
         )
         table = build_timetable(
-            samples, _flight(spacecraft), tuple(a.name for a in spacecraft.appendages), d0, d0 + DAY_NS
+            samples, flight_channels(spacecraft), tuple(a.name for a in spacecraft.appendages), d0, d0 + DAY_NS
         )
         period, how = estimate_orbit_period_s(spacecraft, table)
         if not (math.isfinite(period) and period > 0):
@@ -669,7 +527,6 @@ def run_flight(
                 for piece in pieces:
                     progress(str(np.datetime64(piece.start_ns, "ns").astype("datetime64[D]")))
     else:
-        from abrupt.scale import TaskResult, run_tasks
 
         def arrived(r: TaskResult[tuple[int, int], list[ChunkResult]]) -> None:
             if progress is not None:
@@ -679,21 +536,21 @@ def run_flight(
         for part in run_tasks(task, spans, executor=executor, on_result=arrived, desc="chunks", unit="chunk"):
             chunks.extend(part)
     maxima = np.array([v for r in chunks for v in r.block_maxima.values()])
+    detector = config.detector(threshold)
     if threshold is None:
-        if maxima.size < 8:
-            raise InputError("too little analysable telemetry to calibrate a threshold (< 8 blocks)", file=store.root)
-        threshold = robust_block_maxima_threshold(
-            maxima,
-            block_s=config.block_s,
-            false_alarms_per_day=config.false_alarms_per_day,
-            sample_rate_hz=_grid_hz(spacecraft),
-        )
+        if maxima.size < MIN_BLOCKS:
+            raise InputError(
+                f"too little analysable telemetry to calibrate a threshold (< {MIN_BLOCKS} blocks)", file=store.root
+            )
         if maxima.size < 144:
             warnings.append(f"threshold calibrated on {maxima.size} blocks (< one day): uncertain")
+    threshold = detector.fit_threshold(maxima, config.budget, flight_channels(spacecraft).grid_hz)
     run_id = run_id or new_run_id()
-    cfg_hash = config_hash({"flight": asdict(config), "spacecraft": spacecraft.name, "threshold": threshold.as_dict()})
+    cfg_hash = config_hash(
+        {"flight": config.hash_fields(), "spacecraft": spacecraft.name, "threshold": threshold.as_dict()}
+    )
     peaks = [p for r in chunks for p in r.peaks]
-    events = events_from_peaks(peaks, threshold, spacecraft.name, run_id, cfg_hash)
+    events = detector.events(peaks, threshold, spacecraft.name, run_id, cfg_hash)
     daily = daily_table(chunks, events, threshold)
     return FlightResult(events, threshold, daily, peaks, chunks if keep_series else [], run_id, cfg_hash, warnings)
 
@@ -742,41 +599,6 @@ class _SpanTask:
         )
 
 
-def _grid_hz(spacecraft: Spacecraft) -> float:
-    return _flight(spacecraft).grid_hz
-
-
-def events_from_peaks(
-    peaks: list[Peak], threshold: Threshold, spacecraft: str, run_id: str, cfg_hash: str
-) -> pd.DataFrame:
-    """Events (frozen schema) for the peaks above the threshold."""
-    events = []
-    for p in peaks:
-        if not p.value > threshold.value:
-            continue
-        d = p.dH_N_Nms
-        events.append(
-            Event(
-                spacecraft=spacecraft,
-                kind="strike",
-                detector=DETECTOR_NAME,
-                time_utc=format_time_utc(np.datetime64(p.time_ns, "ns")),
-                time_sigma_s=p.time_sigma_s,
-                statistic=p.value,
-                threshold=threshold.value,
-                false_alarms_per_day=threshold.false_alarms_per_day,
-                dH_N_x_Nms=float(d[0]),
-                dH_N_y_Nms=float(d[1]),
-                dH_N_z_Nms=float(d[2]),
-                run_id=run_id,
-                config_hash=cfg_hash,
-                extra={"statistic_units": "sigma (Mahalanobis)", "threshold_method": threshold.method},
-            )
-        )
-    frame = events_frame(events) if events else empty_frame(["statistic_units", "threshold_method"])
-    return frame.sort_values("time_utc").reset_index(drop=True) if len(frame) else frame
-
-
 def daily_table(chunks: list[ChunkResult], events: pd.DataFrame, threshold: Threshold) -> pd.DataFrame:
     """Per day: analysed and masked fractions, noise floor, events and the false-alarm budget."""
     rows: dict[str, dict[str, Any]] = {}
@@ -823,127 +645,3 @@ def daily_table(chunks: list[ChunkResult], events: pd.DataFrame, threshold: Thre
             }
         )
     return pd.DataFrame(out)
-
-
-# ------------------------------------------------------------------------------------------------
-# Injection and recovery (Harris et al. 2025 §3.5)
-# ------------------------------------------------------------------------------------------------
-
-
-@dataclass
-class RecoveryResult:
-    """Injections per day (size, found) and the 90%-detectable ΔH per day with a bootstrap spread."""
-
-    injections: pd.DataFrame
-    per_day: pd.DataFrame
-
-
-def detectable_dh90(sizes: FloatArray, found: np.ndarray) -> float:
-    """ΔH at 90% detection [N·m·s] from a logistic fit of found vs log size (NaN if not bracketed)."""
-    from scipy.optimize import minimize
-
-    x = np.log(np.asarray(sizes, float))
-    y = np.asarray(found, float)
-    if y.all():
-        return float(np.exp(x.min()))
-    if not y.any():
-        return float("nan")
-
-    def nll(p: FloatArray) -> float:
-        z = np.clip(p[1] * (x - p[0]), -30, 30)
-        pr = 1.0 / (1.0 + np.exp(-z))
-        return -float(np.sum(y * np.log(pr + 1e-12) + (1 - y) * np.log(1 - pr + 1e-12)))
-
-    res = minimize(nll, np.array([np.median(x), 5.0]), method="Nelder-Mead")
-    x50, k = res.x
-    if k <= 0:
-        return float("nan")
-    return float(np.exp(x50 + math.log(9.0) / k))
-
-
-def injection_recovery(
-    store_root: str | Path,
-    spacecraft: Spacecraft,
-    config: FlightRunConfig,
-    threshold: Threshold,
-    *,
-    days: Iterable[str] | None = None,
-    sizes_Nms: Sequence[float] = (0.005, 0.01, 0.015, 0.02, 0.03, 0.05, 0.08),
-    per_run: int = 14,
-    runs_per_day: int = 3,
-    separation_s: float = 1800.0,
-    tolerance_s: float = 10.0,
-    inertia_kgm2: FloatArray | None = None,
-    seed: int = 0,
-    progress: Callable[[str], None] | None = None,
-) -> RecoveryResult:
-    """Inject synthetic strikes (random directions, sizes cycled) into each stored day and recover them.
-
-    Injection times are drawn in the day's analysed time (GLR defined ±``separation_s``/2 around them,
-    from a run without injections), at least ``separation_s`` apart. A strike is recovered if an event
-    above ``threshold`` lies within ``tolerance_s`` of it and no event was there without injection.
-    """
-    from abrupt.simulate.injection import InjectedStrike, inject_strikes
-
-    store = TelemetryStore(store_root)
-    rng = np.random.default_rng(seed)
-    rows = []
-    for day in day_range(store, spacecraft.name, days):
-        d0 = int(np.datetime64(day, "D").astype("datetime64[ns]").astype(np.int64))
-        base = process_chunk(store, spacecraft, d0, d0 + DAY_NS, config, inertia_kgm2=inertia_kgm2, keep_series=True)
-        assert base.series is not None
-        g = base.series["time_ns"]
-        analysed = np.isfinite(base.series["statistic"])
-        half = int(separation_s / 2 / max((g[1] - g[0]) / NS, 1e-9)) if g.size > 1 else 0
-        ok = np.convolve(analysed.astype(float), np.ones(2 * half + 1), mode="same") >= 2 * half + 1 - 1e-9
-        base_times = np.array([p.time_ns for p in base.peaks if p.value > threshold.value], dtype=np.int64)
-        pool = np.flatnonzero(ok)
-        for run in range(runs_per_day):
-            if progress is not None:
-                progress(f"{day} injection run {run + 1}/{runs_per_day}")
-            picks: list[int] = []
-            for i in rng.permutation(pool):
-                if all(abs(int(g[i]) - int(g[j])) >= separation_s * NS for j in picks):
-                    picks.append(int(i))
-                if len(picks) >= per_run:
-                    break
-            strikes = []
-            for k, i in enumerate(sorted(picks)):
-                size = float(sizes_Nms[(k + run * per_run) % len(sizes_Nms)])
-                u = rng.normal(size=3)
-                t_inj = int(g[i]) + int(rng.uniform(0, 1) * NS)
-                strikes.append(InjectedStrike(t_inj, size * u / np.linalg.norm(u)))
-
-            def hook(s: pd.DataFrame, strikes: list[InjectedStrike] = strikes, r: int = run) -> pd.DataFrame:
-                return inject_strikes(s, spacecraft, strikes, seed=seed + r)
-
-            res = process_chunk(
-                store, spacecraft, d0, d0 + DAY_NS, config, inertia_kgm2=inertia_kgm2, samples_hook=hook
-            )
-            ev = [p for p in res.peaks if p.value > threshold.value]
-            for s in strikes:
-                match = [p for p in ev if abs(p.time_ns - s.time_ns) <= tolerance_s * NS]
-                pre_existing = bool(base_times.size) and bool(
-                    np.any(np.abs(base_times - s.time_ns) <= tolerance_s * NS)
-                )
-                found = bool(match) and not pre_existing
-                err = float("nan")
-                if found:
-                    best = min(match, key=lambda p: abs(p.time_ns - s.time_ns))
-                    err = float(np.linalg.norm(best.dH_N_Nms) / s.magnitude_Nms - 1.0)
-                rows.append(
-                    {"day": day, "time_ns": s.time_ns, "dH_Nms": s.magnitude_Nms, "found": found, "rel_err": err}
-                )
-    inj = pd.DataFrame(rows)
-    out: list[dict[str, Any]] = []
-    for day_key, grp in inj.groupby("day") if len(inj) else []:
-        day = str(day_key)
-        dh90 = detectable_dh90(grp["dH_Nms"].to_numpy(), grp["found"].to_numpy())
-        boots = []
-        for _ in range(200):
-            b = grp.sample(len(grp), replace=True, random_state=int(rng.integers(1 << 31)))
-            boots.append(detectable_dh90(b["dH_Nms"].to_numpy(), b["found"].to_numpy()))
-        boots_arr = np.array(boots, float)
-        lo, hi = np.nanpercentile(boots_arr, [16, 84]) if np.isfinite(boots_arr).any() else (np.nan, np.nan)
-        out.append({"day": day, "injections": len(grp), "dH90_Nms": dh90, "dH90_lo_Nms": lo, "dH90_hi_Nms": hi})
-    return RecoveryResult(injections=inj, per_day=pd.DataFrame(out))

@@ -1,18 +1,12 @@
-"""Maneuver detection from laser (or precise radio) ranging: reduce, fit, weight, scan, re-reduce.
+"""Maneuver detection from laser (or precise radio) ranging files: read, reduce, detect in arcs, record.
 
-1. **Reduce** every two-way range to an instantaneous geometric range at its bounce epoch with the
-   switchable model of :mod:`abrupt.model.range_reduction` (light time, troposphere from the pass's own
-   meteorology, Shapiro delay, plate motion, eccentricity, solid tides), evaluated on the current
-   trajectory (first the a-priori orbit, then the fitted one).
-2. **Fit** the orbit and per-station range biases by weighted least squares
-   (:func:`abrupt.detect.tracking.glrt.fit_orbit`).
-3. **Weight by the data's own residuals**: each station's range sigma is scaled by the RMS of its
-   normalised post-fit residuals (a variance-component estimate, Koch 1999 §3.6), so the GLRT threshold
-   accounts for what the models leave unexplained, not only the stated normal-point precision.
-4. **Scan** for impulses between and during passes with the GLRT of
-   :func:`abrupt.detect.tracking.glrt.detect_maneuvers_glrt`, threshold from the false-alarm budget.
-5. **Re-reduce** on the trajectory with the detected impulses and run steps 2-4 once more, so that the
-   corrections of the ranges after a maneuver are computed on the right orbit.
+The pipeline reads CRD normal points (:func:`ranges_from_crd`), SINEX station sites
+(:func:`sites_from_sinex`) and an a-priori ephemeris (:func:`apriori_state_gcrf`), builds one
+:class:`~abrupt.series.tracking.LaserRangingSeries` per arc (:func:`laser_series`: the ranges with
+the range-reduction model and the fit's force model resolved for the arc) and runs the registered
+detector ``tracking.laser_glrt`` (:class:`~abrupt.detect.tracking.laser.LaserGlrtDetector`: reduce,
+fit, weight by residuals, GLRT scan, re-reduce) on each. Long campaigns are cut into overlapping arcs
+(:func:`detect_laser_ranging_arcs`); the events of the campaign carry the detector's name.
 """
 
 from __future__ import annotations
@@ -23,24 +17,21 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
-from scipy.interpolate import CubicHermiteSpline
+from scipy.interpolate import CubicSpline
 
-from abrupt.detect.tracking.glrt import (
-    BatchFit,
-    BatchFitConfig,
-    GlrtConfig,
-    GlrtDetection,
-    detect_maneuvers_glrt,
-    fit_orbit,
-    trajectory,
-)
-from abrupt.errors import RepairLog
-from abrupt.model.orbit import ForceContext, ForceModel, propagate
-from abrupt.model.range_reduction import RangeModel, StationSite, reduce_ranges
+from abrupt.detect.tracking.glrt import DEFAULT_BUDGET, GlrtDetection, glrt_events
+from abrupt.detect.tracking.laser import LaserGlrtDetector
+from abrupt.errors import InputError, RepairLog
+from abrupt.events import config_hash, empty_frame, events_frame, new_run_id
+from abrupt.model.orbit import OMEGA_EARTH_RAD_S, ForceContext, ForceModel, propagate
+from abrupt.model.orbit.batch_fit import BatchFit, BatchFitConfig
+from abrupt.model.range_reduction import RangeModel, StationSite
 from abrupt.model.stations import Station
-from abrupt.model.tracking_measurements import TrackingArrays, as_datetime64_ns
-from abrupt.readers.sinex import SinexStation
-from abrupt.simulate.slr import trajectory_interpolator
+from abrupt.model.tracking_measurements import TrackingArrays, as_datetime64_ns, earth_rotation_matrices
+from abrupt.readers.crd import read_crd
+from abrupt.readers.ephemeris import read_ephemeris
+from abrupt.readers.sinex import SinexStation, read_sinex, sinex_station
+from abrupt.series.tracking import LaserRangingSeries
 from abrupt.thresholds import FalseAlarmBudget
 from abrupt.types import FloatArray
 
@@ -80,36 +71,26 @@ class LaserRangingResult:
     repairs: RepairLog = field(default_factory=RepairLog)
 
 
-def jd_tt(epoch_utc: np.datetime64) -> float:
-    """Julian date (TT) of a UTC epoch (astropy/ERFA, leap seconds from the library)."""
-    from astropy.time import Time
-
-    return float(Time(np.asarray(epoch_utc, dtype="datetime64[ns]"), scale="utc").tt.jd)
-
-
-def _positions(
-    fit_or_x0: BatchFit | FloatArray, t_end_s: float, force_cfg: BatchFitConfig, step_s: float = 30.0
-) -> CubicHermiteSpline:
-    """GCRF positions of the fitted (or a-priori) trajectory as a function of time, for the reduction."""
-    grid = np.arange(-2 * step_s, t_end_s + 3 * step_s, step_s)
-    fwd = grid >= 0
-    states = np.empty((grid.size, 6))
-    if isinstance(fit_or_x0, BatchFit):
-        states[fwd] = fit_or_x0.propagate(grid[fwd])[0]
-    else:
-        states[fwd], _ = trajectory(
-            np.asarray(fit_or_x0, float),
-            0.0,
-            grid[fwd],
-            force=force_cfg.force,
-            accel_mps2=np.zeros(3),
-            max_step_s=force_cfg.max_step_s,
-            integrator=force_cfg.integrator,
-        )
-    # two nodes before the epoch for light times that reach back (linear extrapolation is ample)
-    for k in np.flatnonzero(~fwd)[::-1]:
-        states[k] = states[k + 1] - (grid[k + 1] - grid[k]) * np.concatenate([states[k + 1, 3:], np.zeros(3)])
-    return trajectory_interpolator(grid, states)
+def laser_series(
+    measurements: pd.DataFrame,
+    sites: dict[str, StationSite],
+    stations: dict[str, Station],
+    x0_apriori: FloatArray,
+    epoch_utc: np.datetime64,
+    *,
+    range_model: RangeModel | None = None,
+    fit_config: BatchFitConfig | None = None,
+) -> LaserRangingSeries:
+    """The series of one arc; the Sun and Moon of the force model are anchored at the data's own epoch
+    (t = 0 of the fit) and resolved for the arc (± one day)."""
+    fcfg = fit_config or LASER_FIT_CONFIG
+    epoch = as_datetime64_ns(epoch_utc)
+    t_end = float((np.asarray(measurements["time_utc"]).max() - epoch) / np.timedelta64(1, "s"))
+    model_f = fcfg.force.model if isinstance(fcfg.force, ForceContext) else fcfg.force
+    fcfg = replace(fcfg, force=ForceContext.build(model_f, epoch, -86400.0, t_end + 86400.0))
+    return LaserRangingSeries(
+        measurements, sites, stations, np.asarray(x0_apriori, float), epoch, fcfg, range_model or RangeModel()
+    )
 
 
 def detect_laser_ranging(
@@ -125,65 +106,20 @@ def detect_laser_ranging(
     max_maneuvers: int = 3,
     weight_by_residuals: bool = True,
 ) -> LaserRangingResult:
-    """Run the pipeline of the module docstring; ``x0_apriori`` is the GCRF state at ``epoch_utc``."""
-    budget = budget or FalseAlarmBudget(0.1, "day")
-    model = range_model or RangeModel()
-    fcfg = fit_config or LASER_FIT_CONFIG
-    epoch = as_datetime64_ns(epoch_utc)
-    # The Sun and Moon of the force model are anchored at the data's own epoch (t = 0 of the fit).
-    repairs = RepairLog("laser ranging")
-    t_end = float((np.asarray(measurements["time_utc"]).max() - epoch) / np.timedelta64(1, "s"))
-    model_f = fcfg.force.model if isinstance(fcfg.force, ForceContext) else fcfg.force
-    fcfg = replace(fcfg, force=ForceContext.build(model_f, epoch, -86400.0, t_end + 86400.0))
-    gcfg = GlrtConfig(false_alarms_per_day=budget.per_day, max_maneuvers=max_maneuvers)
-
-    t_rel = (np.asarray(measurements["time_utc"], dtype="datetime64[ns]") - epoch) / np.timedelta64(1, "s")
-
-    def build(source: BatchFit | FloatArray, scale: dict[str, float], t_max_s: float = math.inf) -> TrackingArrays:
-        reduced = reduce_ranges(
-            measurements if not math.isfinite(t_max_s) else measurements.loc[t_rel <= t_max_s],
-            sites,
-            _positions(source, t_end, fcfg),
-            model,
-            epoch_utc=epoch,
-            nominal_ecef_m={n: s.position_ecef_m for n, s in stations.items()},
-            repairs=repairs,
-        )
-        scaled = {n: replace(s, sigma_range_m=s.sigma_range_m * scale.get(n, 1.0)) for n, s in stations.items()}
-        return TrackingArrays(reduced, scaled, epoch_utc=epoch, earth_rotation="iers")
-
-    scale: dict[str, float] = {}
-    data = build(np.asarray(x0_apriori, float), scale)
-    # Grow the arc (1, 2, 4, ... days): Gauss-Newton with the two-body STM converges from an a-priori
-    # tens of metres off over a day, not over a week (the along-track error of a 2 cm/s velocity error
-    # is kilometres after 7 days).
-    x_start = np.asarray(x0_apriori, float)
-    span_days = 1.0
-    while span_days * 86400.0 < t_end:
-        if int(np.sum(t_rel <= span_days * 86400.0)) > 20:
-            part = build(x_start, scale, span_days * 86400.0)
-            x_start = fit_orbit(part, x_start, config=fcfg).x0
-        span_days *= 2.0
-    fit = fit_orbit(data, x_start, config=fcfg)
-    data = build(fit, scale)
-    fit = fit_orbit(data, fit.x0, config=fcfg, initial_range_bias_m=fit.range_bias_m)
-    detections: list[GlrtDetection] = []
-    for it in range(4):
-        if weight_by_residuals:
-            # relative to the stated sigmas and never below them; it comes back down once a detected
-            # maneuver is in the fit (the first weighting sees its residuals as noise), so after a
-            # detection the weights and the scan are repeated until the weights settle (within 20 %)
-            new = {n: max(1.0, scale.get(n, 1.0) * s) for n, s in _station_rms_white(data, fit).items()}
-            if it > 0 and all(abs(v / scale.get(n, 1.0) - 1.0) < 0.2 for n, v in new.items()):
-                break
-            scale = new
-            data = build(fit, scale)
-        detections, fit, _ = detect_maneuvers_glrt(data, fit.x0, fit_config=fcfg, config=gcfg)
-        if not detections or not weight_by_residuals:
-            break
-        data = build(fit, scale)
-    rms = _station_rms_m(data, fit)
-    return LaserRangingResult(detections, fit, rms, scale, data, repairs)
+    """``tracking.laser_glrt`` on one arc; ``x0_apriori`` is the GCRF state at ``epoch_utc``."""
+    series = laser_series(
+        measurements, sites, stations, x0_apriori, epoch_utc, range_model=range_model, fit_config=fit_config
+    )
+    detector = LaserGlrtDetector(max_maneuvers=max_maneuvers, weight_by_residuals=weight_by_residuals)
+    extra = detector.detect(series, budget or DEFAULT_BUDGET).diagnostic(detector.name).extra
+    return LaserRangingResult(
+        extra["detections"],
+        extra["fit"],
+        extra["residual_rms_m"],
+        extra["sigma_scale"],
+        extra["data"],
+        extra["repairs"],
+    )
 
 
 @dataclass
@@ -255,7 +191,7 @@ def detect_laser_ranging_arcs(
     budget of each arc is scaled by owned/arc length, so the campaign's false-alarm rate stays at the
     stated rate per day. Arcs with fewer than ``min_ranges_per_arc`` ranges are skipped and counted.
     """
-    budget = budget or FalseAlarmBudget(0.1, "day")
+    budget = budget or DEFAULT_BUDGET
     epoch = as_datetime64_ns(epoch_utc)
     t_meas = (np.asarray(measurements["time_utc"], dtype="datetime64[ns]") - epoch) / np.timedelta64(1, "s")
     bounds = arc_bounds_s(float(np.max(t_meas)), arc_days, overlap_days)
@@ -328,22 +264,6 @@ def _propagated_apriori(result: LaserRangingResult, dt_s: float) -> FloatArray:
     return states[0]
 
 
-def _station_rms_white(data: TrackingArrays, fit: BatchFit) -> dict[str, float]:
-    """RMS of the normalised residuals per station (the caller keeps sigmas at or above the stated ones)."""
-    names = np.asarray(data.station_names)[fit.row_index]
-    out = {}
-    for n in sorted(set(names)):
-        sel = (names == n) & fit.used
-        out[str(n)] = float(np.sqrt(np.mean(fit.residuals_white[sel] ** 2))) if sel.any() else 1.0
-    return out
-
-
-def _station_rms_m(data: TrackingArrays, fit: BatchFit) -> dict[str, float]:
-    names = np.asarray(data.station_names)[fit.row_index]
-    resid_m = fit.residuals_white * data.sigma[fit.row_index, fit.row_component]
-    return {str(n): float(np.sqrt(np.mean(resid_m[(names == n) & fit.used] ** 2))) for n in sorted(set(names))}
-
-
 # ---------------------------------------------------------------------------------------------- real files
 CRD_RECEIVE_OFFSET = {0: 0.0, 1: 0.5, 2: 1.0}  # epoch event → fraction of the time of flight to the receive time
 
@@ -376,9 +296,6 @@ def sites_from_sinex(
     stations_sinex: Mapping[str, SinexStation], codes: list[str], epoch_utc: np.datetime64, *, file: str | None = None
 ) -> dict[str, StationSite]:
     """Precise sites for the station codes of a CRD file from a SINEX solution (position, velocity, eccentricity)."""
-    from abrupt.errors import InputError
-    from abrupt.readers.sinex import sinex_station
-
     out = {}
     for code in codes:
         st = sinex_station(dict(stations_sinex), code, file=file)
@@ -428,11 +345,6 @@ def apriori_state_gcrf(ephemeris: object, epoch_utc: np.datetime64) -> FloatArra
     orientation (ERFA, :func:`abrupt.model.tracking_measurements.earth_rotation_matrices`) and the velocity
     gains ω_E × r.
     """
-    from scipy.interpolate import CubicSpline
-
-    from abrupt.model.orbit import OMEGA_EARTH_RAD_S
-    from abrupt.model.tracking_measurements import earth_rotation_matrices
-
     times = np.asarray(ephemeris.times_utc, dtype="datetime64[ns]")  # type: ignore[attr-defined]
     t = (times - epoch_utc).astype(np.int64) / 1e9
     pos = np.asarray(ephemeris.position_m, dtype=np.float64)  # type: ignore[attr-defined]
@@ -472,13 +384,6 @@ def run_laser_ranging_files(
     estimated too (∂ρ/∂δt = −ρ̇). Files longer than ``arc_days`` are fitted in overlapping arcs
     (:func:`detect_laser_ranging_arcs`), each started from the ephemeris where it covers the arc epoch.
     """
-    from abrupt.detect.tracking.glrt import glrt_events
-    from abrupt.events import config_hash, empty_frame, events_frame, new_run_id
-    from abrupt.model.stations import Station
-    from abrupt.readers.crd import read_crd
-    from abrupt.readers.ephemeris import read_ephemeris
-    from abrupt.readers.sinex import read_sinex
-
     model = range_model or RangeModel()
     repairs = RepairLog(", ".join(crd_paths))
     tables = [read_crd(p, repairs=repairs) for p in crd_paths]
@@ -488,21 +393,7 @@ def run_laser_ranging_files(
     meas["station"] = meas["station_id"].astype(str)
     epoch = as_datetime64_ns(pd.Timestamp(meas["time_utc"].min()).floor("s"))
     sites = sites_from_sinex(read_sinex(sinex_path), sorted(meas["station"].unique()), epoch, file=sinex_path)
-    stations = {}
-    for name, site in sites.items():
-        lat, lon, h = site.geodetic
-        bins = meas.loc[meas["station"] == name, "bin_rms_s"] if "bin_rms_s" in meas else pd.Series(dtype=float)
-        sigma = float(np.nanmedian(bins)) * 299_792_458.0 / 2 if np.isfinite(bins).any() else 0.01
-        stations[name] = Station(
-            name,
-            np.degrees(lat),
-            np.degrees(lon),
-            h,
-            sigma_range_m=max(sigma, 0.002),
-            sigma_azimuth_rad=1.0,
-            sigma_elevation_rad=1.0,
-            sigma_range_rate_mps=1.0,
-        )
+    stations = laser_stations(sites, meas)
     ephemeris = read_ephemeris(apriori_path)
     eph_times = np.asarray(ephemeris.times_utc, dtype="datetime64[ns]")
 
@@ -554,15 +445,43 @@ def run_laser_ranging_files(
         run_id=run_id,
         config_hash=cfg_hash,
         false_alarms_per_day=budget.per_day,
-        detector="tracking.glrt",  # the registered GLRT; the laser reduction is a model stage before it
+        detector=LaserGlrtDetector.name,
     )
     frame = events_frame(events) if events else empty_frame()
-    summary: dict[str, object] = {
+    summary = _run_summary(result, len(meas), repairs)
+    return LaserRangingRun(frame, result, summary, run_id, cfg_hash)
+
+
+def laser_stations(sites: Mapping[str, StationSite], meas: pd.DataFrame) -> dict[str, Station]:
+    """The fit's stations at the SINEX markers; the range sigma is the median normal-point bin RMS (as a
+    one-way range, at least 2 mm; 1 cm when the file gives none)."""
+    stations = {}
+    for name, site in sites.items():
+        lat, lon, h = site.geodetic
+        bins = meas.loc[meas["station"] == name, "bin_rms_s"] if "bin_rms_s" in meas else pd.Series(dtype=float)
+        sigma = float(np.nanmedian(bins)) * 299_792_458.0 / 2 if np.isfinite(bins).any() else 0.01
+        stations[name] = Station(
+            name,
+            np.degrees(lat),
+            np.degrees(lon),
+            h,
+            sigma_range_m=max(sigma, 0.002),
+            sigma_azimuth_rad=1.0,
+            sigma_elevation_rad=1.0,
+            sigma_range_rate_mps=1.0,
+        )
+    return stations
+
+
+def _run_summary(result: LaserArcsResult, n_ranges: int, repairs: RepairLog) -> dict[str, object]:
+    """The fit summary of a file run (JSON-ready): residual RMS, weights, biases and scales per arc."""
+    last = result.arcs[-1].result
+    return {
         "residual_rms_mm": {k: round(v * 1000, 2) for k, v in result.residual_rms_m.items()},
-        "sigma_scale": {k: round(v, 2) for k, v in result.arcs[-1].result.sigma_scale.items()},
-        "range_bias_mm": {k: round(v * 1000, 1) for k, v in result.arcs[-1].result.fit.range_bias_m.items()},
-        "scale_factors": {k: round(v, 4) for k, v in result.arcs[-1].result.fit.scale_factors.items()},
-        "time_bias_us": {k: round(v * 1e6, 2) for k, v in result.arcs[-1].result.fit.time_bias_s.items()},
+        "sigma_scale": {k: round(v, 2) for k, v in last.sigma_scale.items()},
+        "range_bias_mm": {k: round(v * 1000, 1) for k, v in last.fit.range_bias_m.items()},
+        "scale_factors": {k: round(v, 4) for k, v in last.fit.scale_factors.items()},
+        "time_bias_us": {k: round(v * 1e6, 2) for k, v in last.fit.time_bias_s.items()},
         "arcs": [
             {
                 "epoch_utc": str(arc.epoch_utc),
@@ -572,7 +491,6 @@ def run_laser_ranging_files(
             }
             for arc in result.arcs
         ],
-        "n_ranges": len(meas),
+        "n_ranges": n_ranges,
         "repairs": dict(result.repairs.counts) | dict(repairs.counts),
     }
-    return LaserRangingRun(frame, result, summary, run_id, cfg_hash)

@@ -28,9 +28,9 @@ from abrupt.detect.orbit.detectors import (
 from abrupt.detect.orbit.ekf import NUISANCE_NAMES
 from abrupt.detect.orbit.sensitivity import detectable_dv
 from abrupt.errors import ConfigError
-from abrupt.model.frames import Ephemeris
 from abrupt.pipelines.orbit_sequence import resolve_sequence
 from abrupt.readers.ephemeris import read_ephemeris
+from abrupt.series.ephemeris import Ephemeris
 from abrupt.simulate.orbit import inject_impulse
 from abrupt.thresholds import FalseAlarmBudget, Threshold
 

@@ -27,7 +27,7 @@ import pandas as pd
 from abrupt.detect.base import DetectionResult
 from abrupt.detect.orbit.detectors import OrbitDetector, orbit_product_boundaries, orbit_thresholds
 from abrupt.detect.orbit.tuning import velocities_from_positions
-from abrupt.model.frames import Ephemeris
+from abrupt.series.ephemeris import Ephemeris
 from abrupt.simulate.orbit import inject_impulse
 from abrupt.thresholds import FalseAlarmBudget
 

@@ -13,6 +13,8 @@ from typing import Any
 import pandas as pd
 
 from abrupt.errors import ConfigError
+from abrupt.rates.montecarlo import RateConfig
+from abrupt.rates.trades import Scenario
 
 #: Thresholds tabulated when none are given, per metric (Bennett 2022 ch. 5 trade points).
 DEFAULT_THRESHOLDS: dict[str, list[float]] = {
@@ -23,11 +25,8 @@ DEFAULT_THRESHOLDS: dict[str, list[float]] = {
 METRIC_UNITS = {"dH": "N m s", "dV": "m/s", "da": "m"}
 
 
-def build_scenario(settings: Mapping[str, Any]) -> Any:
+def build_scenario(settings: Mapping[str, Any]) -> Scenario:
     """The base :class:`~abrupt.rates.trades.Scenario` from ``abrupt rates`` settings (names as the options)."""
-    from abrupt.rates.montecarlo import RateConfig
-    from abrupt.rates.trades import Scenario
-
     config = RateConfig(
         mass_model=settings["mass_model"],
         mef_model=settings["mef"],

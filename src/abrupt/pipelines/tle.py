@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from abrupt.detect.base import DetectionResult, Detector, get_detector
@@ -111,3 +112,24 @@ def detect_tle_file(
             det = cls(**kwargs)
         out.satellites.append(SatelliteResult(history, det.name, det.detect(history, budget)))
     return out
+
+
+def burns_below_detectable(truth: pd.DataFrame, detectable_by_year: list[dict[str, Any]]) -> tuple[int, int]:
+    """How many of the operator burns with a stated ΔV lie below what the element sets resolve in their
+    year: (burns below, burns with a ΔV in a year of the history). A burn is below when its in-track
+    |ΔV| is under the year's smallest detectable in-track ΔV and its cross-track |ΔV| under the
+    cross-track one (``noise_model["detectable_by_year"]`` of the TLE detectors)."""
+    if not detectable_by_year or "dv_t_mps" not in truth or "dv_n_mps" not in truth:
+        return 0, 0
+    by_year = {int(r["year"]): r for r in detectable_by_year}
+    below = total = 0
+    times = pd.to_datetime(truth["time_utc"].astype(str), utc=True)
+    for t, dv_t, dv_n in zip(times, truth["dv_t_mps"], truth["dv_n_mps"], strict=True):
+        row = by_year.get(int(t.year))
+        if row is None or not (np.isfinite(dv_t) or np.isfinite(dv_n)):
+            continue
+        total += 1
+        t_ok = not np.isfinite(dv_t) or abs(dv_t) < row["min_detectable_dv_t_mps"]
+        n_ok = not np.isfinite(dv_n) or abs(dv_n) < row["min_detectable_dv_n_mps"]
+        below += int(t_ok and n_ok)
+    return below, total

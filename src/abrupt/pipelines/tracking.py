@@ -18,11 +18,17 @@ from typing import Any, Literal
 import numpy as np
 import pandas as pd
 
-from abrupt.detect.tracking.glrt import BatchFit, BatchFitConfig, GlrtManeuverDetector
+from abrupt.detect.tracking.glrt import GlrtManeuverDetector
 from abrupt.detect.tracking.kaderali import KaderaliManeuverDetector
 from abrupt.errors import RepairLog
 from abrupt.events import config_hash, empty_frame, new_run_id, restamp
 from abrupt.model.orbit import ForceContext, ForceModel
+from abrupt.model.orbit.batch_fit import BatchFit, BatchFitConfig
+from abrupt.model.orbit.bodies import sun_moon_gcrf
+from abrupt.model.timescales import offline_astropy
+from abrupt.model.tracking_measurements import TrackingArrays, correct_refraction
+from abrupt.readers.orekit_od_input import read_od_input
+from abrupt.readers.tracking import read_tracking
 from abrupt.series.tracking import TrackingSeries
 from abrupt.thresholds import FalseAlarmBudget
 
@@ -84,11 +90,6 @@ def read_tracking_series(
     ``settings`` says); for real-data set-ups (central/third-body keys present) a constant unmodelled
     acceleration and angle biases are estimated too.
     """
-    from abrupt.model.timescales import offline_astropy
-    from abrupt.model.tracking_measurements import TrackingArrays, correct_refraction
-    from abrupt.readers.orekit_od_input import read_od_input
-    from abrupt.readers.tracking import read_tracking
-
     offline_astropy()
     setup = read_od_input(setup_path)
     repairs = RepairLog(str(file))
@@ -196,8 +197,6 @@ def detect_tracking(
     run_id: str | None = None,
 ) -> TrackingRun:
     """Fit the orbit, run the chosen detectors and collect events, fit summary and diagnostics."""
-    from abrupt.model.orbit.bodies import sun_moon_gcrf
-
     series, force = inputs.series, inputs.force
     run_settings = {
         "file": file_name,
@@ -224,7 +223,8 @@ def detect_tracking(
     if settings.method in ("both", "glrt"):
         glrt = GlrtManeuverDetector(max_maneuvers=settings.max_maneuvers)
         result = glrt.detect(series, budget)
-        _, final_fit, _ = series.maneuver_fit(glrt.glrt_config(budget))
+        if result.diagnostics:
+            final_fit = result.diagnostics[0].extra["fit"]
         frames.append(result.events)
         for d in result.diagnostics:
             first = result.events["threshold"].iloc[0] if len(result.events) else np.nan

@@ -4,5 +4,5 @@ Modules: :mod:`~abrupt.rates.flux` (NASA-90/91 debris, Grün meteoroids with Ear
 :mod:`~abrupt.rates.tables` (flux-table format and analytic builders), :mod:`~abrupt.rates.ordem`
 (ORDEM 3.x importer), :mod:`~abrupt.rates.mass_models`, :mod:`~abrupt.rates.mef`,
 :mod:`~abrupt.rates.geometry` (strike location, effective area), :mod:`~abrupt.rates.montecarlo`,
-:mod:`~abrupt.rates.trades` (scenarios, trades, Dask) and :mod:`~abrupt.rates.plots`.
+:mod:`~abrupt.rates.trades` (scenarios, trades, Dask); figures are drawn by :mod:`abrupt.report.rates`.
 """

@@ -31,7 +31,7 @@ from abrupt.rates.geometry import (
 )
 from abrupt.rates.mass_models import CLASS_NAMES, MASS_MODELS, particle_mass_kg
 from abrupt.rates.mef import momentum_enhancement
-from abrupt.rates.tables import DirectionBins, FluxTable
+from abrupt.rates.tables import DirectionBins, FluxTable, loglog_interp
 
 METRICS = {"dH": "dH_Nms", "dV": "dV_mps", "da": "da_m"}
 
@@ -189,8 +189,6 @@ def sample_sizes(
 
 
 def _interp_cum(table: FluxTable, c: int, x: float) -> float:
-    from abrupt.rates.tables import loglog_interp
-
     return loglog_interp(x, table.sizes_m, table.cumulative_flux[c])
 
 

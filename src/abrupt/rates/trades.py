@@ -17,7 +17,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,12 +25,11 @@ from numpy.typing import NDArray
 from abrupt.errors import ConfigError
 from abrupt.model.spacecraft import load_spacecraft
 from abrupt.rates import flux as fx
+from abrupt.rates import montecarlo
 from abrupt.rates.geometry import geometry_from_spacecraft
 from abrupt.rates.montecarlo import RateConfig, StrikeSample, simulate_strikes
 from abrupt.rates.tables import FluxTable, grun_table, nasa90_table, read_flux_table
-
-if TYPE_CHECKING:
-    from abrupt.scale import Executor
+from abrupt.scale import Executor, run_tasks
 
 TRADE_VARIABLES = (
     "spacecraft",
@@ -83,12 +82,10 @@ class CaseResult:
     def detectable_per_year(
         self, metric: str, thresholds: Sequence[float] | NDArray[np.float64]
     ) -> NDArray[np.float64]:
-        from abrupt.rates.montecarlo import detectable_per_year
-
         values = {"dH": self.dH_Nms, "dV": self.dV_mps, "da": self.da_m}
         if metric not in values:
             raise ConfigError(f"unknown metric {metric!r}; choose dH, dV or da", key="metric")
-        return detectable_per_year(values[metric], self.strikes_per_year, thresholds, self.weight)
+        return montecarlo.detectable_per_year(values[metric], self.strikes_per_year, thresholds, self.weight)
 
 
 @functools.lru_cache(maxsize=64)
@@ -240,8 +237,6 @@ def run_trade(
 ) -> list[CaseResult]:
     """Run every case of a trade on ``executor`` (:mod:`abrupt.scale`: in-process, a local Dask
     cluster or a scheduler; ``scheduler`` is shorthand for ``Executor(scheduler=...)``)."""
-    from abrupt.scale import Executor, run_tasks
-
     if executor is None:
         executor = Executor(scheduler=scheduler)
     scenarios = trade_scenarios(base, variables)

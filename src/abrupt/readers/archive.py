@@ -321,20 +321,11 @@ def read_archive(
         ) from None
 
 
-def _read_archive(
-    path: str | Path,
-    decoder: Decoder,
-    *,
-    layout: str = "auto",
-    placeholders: tuple[float, ...] = DEFAULT_PLACEHOLDERS,
-    assume_utc: bool = False,
-) -> ArchiveChunk:
-    """Read one archive file, replace real names by pseudonyms and remove archiver artifacts.
+DAY_NS = 86_400 * 1_000_000_000
 
-    Returns pseudonymised samples (``spacecraft``, ``mnemonic`` pseudonyms, ``time`` UTC, ``value``)
-    sorted by spacecraft, mnemonic and time, with per-day counts of everything removed or reported.
-    """
-    path = Path(path)
+
+def _long_table(path: Path, layout: str) -> pa.Table:
+    """The file as a long table ``time, mnemonic, value`` (wide tables are melted)."""
     table = _read_raw(path)
     cols = [c.strip() for c in table.column_names]
     table = table.rename_columns(cols)
@@ -347,27 +338,14 @@ def _read_archive(
         if not is_long:
             raise InputError("long layout needs columns time,mnemonic,value", file=path, line=1)
         table = table.select([time_col, cols[lower.index("mnemonic")], cols[lower.index("value")]])
-        table = table.rename_columns(["time", "mnemonic", "value"])
-    elif layout in ("wide", "auto"):
-        table = _long_from_wide(table, time_col)
-    else:
-        raise ConfigError(f"layout must be 'auto', 'long' or 'wide', got {layout!r}", key="layout")
+        return table.rename_columns(["time", "mnemonic", "value"])
+    if layout in ("wide", "auto"):
+        return _long_from_wide(table, time_col)
+    raise ConfigError(f"layout must be 'auto', 'long' or 'wide', got {layout!r}", key="layout")
 
-    counts: Counter[str] = Counter()
-    n0 = table.num_rows
-    # Rows that are entirely empty (",,") are blank-line artifacts.
-    mnem = table.column("mnemonic")
-    all_empty = pc.and_(pc.is_null(table.column("time")), pc.is_null(mnem))
-    all_empty = pc.and_(all_empty, pc.is_null(table.column("value")))
-    n_blank = int(pc.sum(all_empty).as_py() or 0)
-    if n_blank:
-        table = table.filter(pc.invert(all_empty))
-    times = _parse_times(table.column("time"), path, assume_utc, counts)
-    values, bad_values = _parse_values(table.column("value"))
-    value_null = np.asarray(table.column("value").is_null().to_numpy(zero_copy_only=False), dtype=bool)
-    mnem_arr = table.column("mnemonic")
 
-    # Pseudonyms at the door: map real mnemonic -> pseudonym through a dictionary encoding.
+def _mnemonic_codes(mnem_arr: pa.ChunkedArray, decoder: Decoder) -> tuple[list[Any], np.ndarray, list[str | None]]:
+    """Pseudonyms at the door: (real names, code of each row (-1: none), pseudonym of each code or None)."""
     if pa.types.is_dictionary(mnem_arr.type):
         enc = mnem_arr.unify_dictionaries().combine_chunks() if mnem_arr.num_chunks else pa.array([], pa.string())
         if not mnem_arr.num_chunks:
@@ -376,23 +354,146 @@ def _read_archive(
         enc = mnem_arr.combine_chunks().dictionary_encode() if mnem_arr.num_chunks else pa.array([], pa.string())
     dictionary = enc.dictionary.to_pylist()
     codes = np.asarray(enc.indices.fill_null(-1).to_numpy(zero_copy_only=False), dtype=np.int64)
-    pseudo_of_code = [decoder.mnemonics.get(str(name).strip()) for name in dictionary]
+    return dictionary, codes, [decoder.mnemonics.get(str(name).strip()) for name in dictionary]
+
+
+class _DayReports:
+    """Reports per (spacecraft, day), created on first use in the order they are met."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+        self.per_day: dict[tuple[str, str], DayReport] = {}
+
+    def __call__(self, sc: str, d: int) -> DayReport:
+        key = (sc, str(np.datetime64(int(d), "D")))
+        if key not in self.per_day:
+            self.per_day[key] = DayReport(spacecraft=key[0], day=key[1], sources=[self.source])
+        return self.per_day[key]
+
+
+@dataclass
+class _Channels:
+    """Kept rows by pseudonymised channel: names sorted, so that channel codes group each spacecraft."""
+
+    names: list[str]
+    spacecraft: list[str]
+    spacecraft_of: np.ndarray  # channel code -> spacecraft index
+    reports: _DayReports
+
+    def count(self, mask: np.ndarray, m: np.ndarray, t: np.ndarray, label: str, *, reported: bool) -> None:
+        """Add the rows of ``mask`` (channel codes ``m``, times ``t`` [ns]) under ``label`` per spacecraft-day."""
+        if not mask.any():
+            return
+        pairs = zip(self.spacecraft_of[m[mask]].tolist(), (t[mask] // DAY_NS).tolist(), strict=True)
+        for (sc, d), n in Counter(pairs).items():
+            r = self.reports(self.spacecraft[sc], d)
+            (r.reported if reported else r.removed)[label] += n
+
+
+def _sort_and_dedupe(
+    m_codes: np.ndarray, t_k: np.ndarray, v_k: np.ndarray, ch: _Channels
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Sort by (channel, time), reporting time reversals; drop exact duplicates and conflicting ones (first kept)."""
+    # Time reversals: within one mnemonic in file order, a time earlier than the previous one.
+    order = np.argsort(m_codes, kind="stable")
+    k_sorted, t_sorted = m_codes[order], t_k[order]
+    back = (k_sorted[1:] == k_sorted[:-1]) & (t_sorted[1:] < t_sorted[:-1])
+    if back.any():
+        rev = np.zeros(m_codes.size, bool)
+        rev[order[1:][back]] = True
+        ch.count(rev, m_codes, t_k, "time reversals (sorted)", reported=True)
+        order = np.lexsort((t_k, m_codes))  # stable: equal (mnemonic, time) stay in file order
+    m_codes, t_k, v_k = m_codes[order], t_k[order], v_k[order]
+    del order, k_sorted, t_sorted
+    if m_codes.size > 1:
+        same_t = np.concatenate([[False], (m_codes[1:] == m_codes[:-1]) & (t_k[1:] == t_k[:-1])])
+        first = np.maximum.accumulate(np.where(~same_t, np.arange(m_codes.size), 0))
+        conflict = same_t & (v_k != v_k[first])
+        exact = same_t & ~conflict
+    else:
+        exact = conflict = np.zeros(m_codes.size, bool)
+    ch.count(exact, m_codes, t_k, "exact duplicate rows", reported=False)
+    # A conflicting duplicate differs from the first row of its (mnemonic, time) group.
+    ch.count(conflict, m_codes, t_k, "conflicting duplicates (first value kept)", reported=True)
+    if exact.any() or conflict.any():
+        keep_rows = ~(exact | conflict)
+        m_codes, t_k, v_k = m_codes[keep_rows], t_k[keep_rows], v_k[keep_rows]
+    return m_codes, t_k, v_k
+
+
+def _count_kept(m_codes: np.ndarray, t_k: np.ndarray, ch: _Channels) -> None:
+    """Rows kept and samples per channel, per spacecraft-day."""
+    if not m_codes.size:
+        return
+    d_k = t_k // DAY_NS
+    d_min = int(d_k.min())
+    combo = m_codes * (int(d_k.max()) - d_min + 1) + (d_k - d_min)
+    uniq, n_rows = np.unique(combo, return_counts=True)
+    span = int(d_k.max()) - d_min + 1
+    for u, n in zip(uniq.tolist(), n_rows.tolist(), strict=True):
+        m, d = divmod(u, span)
+        r = ch.reports(ch.spacecraft[ch.spacecraft_of[m]], d + d_min)
+        r.rows_kept += n
+        name = ch.names[m]
+        r.channels[name] = r.channels.get(name, 0) + n
+
+
+def _samples_frame(m_codes: np.ndarray, t_k: np.ndarray, v_k: np.ndarray, ch: _Channels) -> pd.DataFrame:
+    sc_cat: Any
+    mn_cat: Any
+    if ch.names:
+        sc_cat = pd.Categorical.from_codes(
+            ch.spacecraft_of[m_codes], categories=pd.Index(ch.spacecraft), validate=False
+        )
+        mn_cat = pd.Categorical.from_codes(m_codes, categories=pd.Index(ch.names), validate=False)
+    else:
+        sc_cat = mn_cat = pd.Categorical([])
+    return pd.DataFrame(
+        {
+            "spacecraft": sc_cat,
+            "mnemonic": mn_cat,
+            "time": pd.Series(t_k.view("datetime64[ns]")).dt.tz_localize("UTC"),
+            "value": v_k,
+        }
+    )
+
+
+def _read_archive(
+    path: str | Path,
+    decoder: Decoder,
+    *,
+    layout: str = "auto",
+    placeholders: tuple[float, ...] = DEFAULT_PLACEHOLDERS,
+    assume_utc: bool = False,
+) -> ArchiveChunk:
+    """:func:`read_archive` without the pseudonymisation of error messages."""
+    path = Path(path)
+    table = _long_table(path, layout)
+    counts: Counter[str] = Counter()
+    n0 = table.num_rows
+    # Rows that are entirely empty (",,") are blank-line artifacts.
+    all_empty = pc.and_(pc.is_null(table.column("time")), pc.is_null(table.column("mnemonic")))
+    all_empty = pc.and_(all_empty, pc.is_null(table.column("value")))
+    n_blank = int(pc.sum(all_empty).as_py() or 0)
+    if n_blank:
+        table = table.filter(pc.invert(all_empty))
+    times = _parse_times(table.column("time"), path, assume_utc, counts)
+    values, bad_values = _parse_values(table.column("value"))
+    value_null = np.asarray(table.column("value").is_null().to_numpy(zero_copy_only=False), dtype=bool)
+    dictionary, codes, pseudo_of_code = _mnemonic_codes(table.column("mnemonic"), decoder)
     unknown_codes = [i for i, p in enumerate(pseudo_of_code) if p is None]
     known_code = np.array([p is not None for p in pseudo_of_code] + [False], dtype=bool)
     codes_safe = np.where(codes < 0, len(pseudo_of_code), codes)
     row_known = known_code[codes_safe]
-    del table, enc, mnem_arr
+    del table
 
-    t_null = np.asarray(times.is_null().to_numpy(zero_copy_only=False), dtype=bool)
-    t_valid = ~t_null
+    t_valid = ~np.asarray(times.is_null().to_numpy(zero_copy_only=False), dtype=bool)
     t_int = np.where(t_valid, np.asarray(times.cast(pa.int64()).fill_null(0).to_numpy(), np.int64), 0)
-
     no_name = codes < 0
     is_placeholder = np.isin(values, np.asarray(placeholders, dtype=np.float64)) | (np.isnan(values) & ~value_null)
-    empty_value = value_null
     # Order of judgement: missing time or name -> empty value -> placeholder -> name not in decoder.
     drop_missing = ~t_valid | no_name
-    drop_empty = ~drop_missing & empty_value
+    drop_empty = ~drop_missing & value_null
     drop_placeholder = ~drop_missing & ~drop_empty & is_placeholder
     drop_unknown = ~drop_missing & ~drop_empty & ~drop_placeholder & ~row_known
     keep = ~(drop_missing | drop_empty | drop_placeholder | drop_unknown)
@@ -407,18 +508,9 @@ def _read_archive(
             unknown_names[name_token(str(dictionary[c]))] += n_c
 
     pseudo_arr = np.array([p if p is not None else "" for p in pseudo_of_code] + [""], dtype=object)
-    day_ns = 86_400 * 1_000_000_000
-    day_idx = np.where(t_valid, t_int // day_ns, -1)
+    day_idx = np.where(t_valid, t_int // DAY_NS, -1)
     sc_pseudo = np.array([decoder.spacecraft_of(p) if p else "" for p in pseudo_arr], dtype=object)
-
-    per_day: dict[tuple[str, str], DayReport] = {}
-
-    def report(sc: str, d: int) -> DayReport:
-        key = (sc, str(np.datetime64(int(d), "D")))
-        if key not in per_day:
-            per_day[key] = DayReport(spacecraft=key[0], day=key[1], sources=[pseudonymise_text(path.name, decoder)])
-        return per_day[key]
-
+    reports = _DayReports(pseudonymise_text(path.name, decoder))
     # Per-day counts of artifacts that have a day and a spacecraft.
     for label, mask in (
         ("empty values", drop_empty),
@@ -428,10 +520,8 @@ def _read_archive(
         sel = mask & t_valid
         if not sel.any():
             continue
-        sc_rows = sc_pseudo[codes_safe[sel]]
-        days = day_idx[sel]
-        for (sc, d), n in Counter(zip(sc_rows, days, strict=True)).items():
-            report(sc or "unattributed", d).removed[label] += n
+        for (sc, d), n in Counter(zip(sc_pseudo[codes_safe[sel]], day_idx[sel], strict=True)).items():
+            reports(sc or "unattributed", d).removed[label] += n
     missing_time_rows = int(np.count_nonzero(~t_valid))
     if missing_time_rows:
         counts["rows without a time"] += missing_time_rows
@@ -448,70 +538,10 @@ def _read_archive(
     p_index = {p: i for i, p in enumerate(pseudo_names)}
     code_to_pseudo = np.array([p_index[p] if p is not None else -1 for p in pseudo_of_code] + [-1], dtype=np.int64)
     pseudo_to_sc = np.array([sc_names.index(decoder.spacecraft_of(p)) for p in pseudo_names], dtype=np.int64)
+    ch = _Channels(pseudo_names, sc_names, pseudo_to_sc, reports)
     idx = np.flatnonzero(keep)
-    m_codes = code_to_pseudo[codes_safe[idx]]
-    t_k = t_int[idx]
-    v_k = values[idx]
+    m_codes, t_k, v_k = code_to_pseudo[codes_safe[idx]], t_int[idx], values[idx]
     del values, t_int, codes, codes_safe, idx
-
-    def count(mask: np.ndarray, m: np.ndarray, t: np.ndarray, label: str, *, reported: bool) -> None:
-        if not mask.any():
-            return
-        pairs = zip(pseudo_to_sc[m[mask]].tolist(), (t[mask] // day_ns).tolist(), strict=True)
-        for (sc, d), n in Counter(pairs).items():
-            r = report(sc_names[sc], d)
-            (r.reported if reported else r.removed)[label] += n
-
-    # Time reversals: within one mnemonic in file order, a time earlier than the previous one.
-    order = np.argsort(m_codes, kind="stable")
-    k_sorted, t_sorted = m_codes[order], t_k[order]
-    back = (k_sorted[1:] == k_sorted[:-1]) & (t_sorted[1:] < t_sorted[:-1])
-    if back.any():
-        rev = np.zeros(m_codes.size, bool)
-        rev[order[1:][back]] = True
-        count(rev, m_codes, t_k, "time reversals (sorted)", reported=True)
-        order = np.lexsort((t_k, m_codes))  # stable: equal (mnemonic, time) stay in file order
-    m_codes, t_k, v_k = m_codes[order], t_k[order], v_k[order]
-    del order, k_sorted, t_sorted
-    if m_codes.size > 1:
-        same_t = np.concatenate([[False], (m_codes[1:] == m_codes[:-1]) & (t_k[1:] == t_k[:-1])])
-        first = np.maximum.accumulate(np.where(~same_t, np.arange(m_codes.size), 0))
-        conflict = same_t & (v_k != v_k[first])
-        exact = same_t & ~conflict
-    else:
-        exact = conflict = np.zeros(m_codes.size, bool)
-    count(exact, m_codes, t_k, "exact duplicate rows", reported=False)
-    # A conflicting duplicate differs from the first row of its (mnemonic, time) group.
-    count(conflict, m_codes, t_k, "conflicting duplicates (first value kept)", reported=True)
-    if exact.any() or conflict.any():
-        keep_rows = ~(exact | conflict)
-        m_codes, t_k, v_k = m_codes[keep_rows], t_k[keep_rows], v_k[keep_rows]
-    # Rows kept and samples per channel, per spacecraft-day.
-    if m_codes.size:
-        d_k = t_k // day_ns
-        d_min = int(d_k.min())
-        combo = m_codes * (int(d_k.max()) - d_min + 1) + (d_k - d_min)
-        uniq, n_rows = np.unique(combo, return_counts=True)
-        span = int(d_k.max()) - d_min + 1
-        for u, n in zip(uniq.tolist(), n_rows.tolist(), strict=True):
-            m, d = divmod(u, span)
-            r = report(sc_names[pseudo_to_sc[m]], d + d_min)
-            r.rows_kept += n
-            name = pseudo_names[m]
-            r.channels[name] = r.channels.get(name, 0) + n
-    sc_cat: Any
-    mn_cat: Any
-    if pseudo_names:
-        sc_cat = pd.Categorical.from_codes(pseudo_to_sc[m_codes], categories=pd.Index(sc_names), validate=False)
-        mn_cat = pd.Categorical.from_codes(m_codes, categories=pd.Index(pseudo_names), validate=False)
-    else:
-        sc_cat = mn_cat = pd.Categorical([])
-    frame = pd.DataFrame(
-        {
-            "spacecraft": sc_cat,
-            "mnemonic": mn_cat,
-            "time": pd.Series(t_k.view("datetime64[ns]")).dt.tz_localize("UTC"),
-            "value": v_k,
-        }
-    )
-    return ArchiveChunk(samples=frame, per_day=per_day, file_counts=counts)
+    m_codes, t_k, v_k = _sort_and_dedupe(m_codes, t_k, v_k, ch)
+    _count_kept(m_codes, t_k, ch)
+    return ArchiveChunk(samples=_samples_frame(m_codes, t_k, v_k, ch), per_day=reports.per_day, file_counts=counts)

@@ -15,6 +15,8 @@ import gzip
 import zlib
 from pathlib import Path
 
+import unlzw3
+
 from abrupt.errors import InputError
 
 GZIP_MAGIC = b"\x1f\x8b"
@@ -36,8 +38,6 @@ def read_bytes(path: str | Path) -> bytes:
         except (OSError, EOFError, zlib.error) as exc:
             raise InputError(f"corrupt or truncated gzip data ({exc})", file=path) from None
     if raw[:2] == COMPRESS_MAGIC:
-        import unlzw3
-
         try:
             return bytes(unlzw3.unlzw(raw))
         except (ValueError, IndexError, TypeError, RuntimeError) as exc:

@@ -25,6 +25,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from abrupt.errors import InputError, RepairLog
 from abrupt.readers.compression import read_text
@@ -32,6 +33,36 @@ from abrupt.series.ephemeris import Ephemeris
 
 BAD_RECORD_FRACTION = 0.01
 MJD_EPOCH = np.datetime64("1858-11-17", "ns")
+
+
+def _header2(parts: list[str], file: str, no: int) -> tuple[str, str]:
+    """The ILRS id and the frame (ITRF or GCRF) of an H2 record; true-of-date is an error."""
+    if len(parts) < 20:
+        raise InputError(f"H2 needs at least 19 fields, got {len(parts) - 1}", file=file, line=no)
+    ref = parts[19]
+    if ref not in ("0", "1", "2"):
+        raise InputError(f"H2 reference frame {ref!r} is not 0, 1 or 2", file=file, line=no)
+    if ref == "1":
+        raise InputError("true-of-date inertial frame (H2 frame 1) is not supported", file=file, line=no)
+    return parts[1], "ITRF" if ref == "0" else "GCRF"
+
+
+def _sorted_unique(
+    t: NDArray[np.datetime64], st: NDArray[np.float64], nos: NDArray[np.int64], file: str, log: RepairLog
+) -> tuple[NDArray[np.datetime64], NDArray[np.float64], NDArray[np.bool_]]:
+    """Epochs sorted (counted) and a mask dropping repeated epochs with the same state (counted);
+    a repeated epoch with another state is an error."""
+    order = np.argsort(t, kind="stable")
+    if np.any(np.diff(order) < 0):
+        log.record("epochs sorted", int(np.count_nonzero(np.diff(t) < np.timedelta64(0))))
+        t, st, nos = t[order], st[order], nos[order]
+    keep = np.ones(t.size, dtype=bool)
+    for i in np.flatnonzero(np.diff(t) == np.timedelta64(0)):
+        if not np.allclose(np.nan_to_num(st[i]), np.nan_to_num(st[i + 1]), rtol=0, atol=1e-6):
+            raise InputError(f"epoch {t[i]} appears twice with different positions", file=file, line=int(nos[i + 1]))
+        keep[i + 1] = False
+    log.record("duplicate epoch dropped", int((~keep).sum()))
+    return t, st, keep
 
 
 def read_cpf(path: str | Path, satellite: str | None = None, *, allow_truncated: bool = False) -> Ephemeris:
@@ -73,15 +104,7 @@ def read_cpf(path: str | Path, satellite: str | None = None, *, allow_truncated:
             break
         if rec == "H2":
             seen_h2 = True
-            if len(parts) < 20:
-                raise InputError(f"H2 needs at least 19 fields, got {len(parts) - 1}", file=file, line=no)
-            ilrs_id = parts[1]
-            ref = parts[19]
-            if ref not in ("0", "1", "2"):
-                raise InputError(f"H2 reference frame {ref!r} is not 0, 1 or 2", file=file, line=no)
-            if ref == "1":
-                raise InputError("true-of-date inertial frame (H2 frame 1) is not supported", file=file, line=no)
-            frame = "ITRF" if ref == "0" else "GCRF"
+            ilrs_id, frame = _header2(parts, file, no)
             continue
         if rec == "10":
             n_records += 1
@@ -130,19 +153,9 @@ def read_cpf(path: str | Path, satellite: str | None = None, *, allow_truncated:
     log.record("malformed record skipped", len(bad))
     if not epochs:
         raise InputError("no position records ('10')", file=file)
-    t = np.array(epochs, dtype="datetime64[ns]")
-    st = np.array(states, dtype=np.float64)
-    nos = np.array(line_nos)
-    order = np.argsort(t, kind="stable")
-    if np.any(np.diff(order) < 0):
-        log.record("epochs sorted", int(np.count_nonzero(np.diff(t) < np.timedelta64(0))))
-        t, st, nos = t[order], st[order], nos[order]
-    keep = np.ones(t.size, dtype=bool)
-    for i in np.flatnonzero(np.diff(t) == np.timedelta64(0)):
-        if not np.allclose(np.nan_to_num(st[i]), np.nan_to_num(st[i + 1]), rtol=0, atol=1e-6):
-            raise InputError(f"epoch {t[i]} appears twice with different positions", file=file, line=int(nos[i + 1]))
-        keep[i + 1] = False
-    log.record("duplicate epoch dropped", int((~keep).sum()))
+    t, st, keep = _sorted_unique(
+        np.array(epochs, dtype="datetime64[ns]"), np.array(states, dtype=np.float64), np.array(line_nos), file, log
+    )
     name = satellite or target or ilrs_id or "CPF"
     if satellite is not None and satellite not in (target, ilrs_id):
         raise InputError(f"satellite {satellite!r} is not in the file; it holds {target} ({ilrs_id})", file=file)

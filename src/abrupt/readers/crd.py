@@ -165,11 +165,7 @@ def read_crd(
     """
     file = str(path)
     log = repairs if repairs is not None else RepairLog(source=file)
-    lines = read_bytes(path).decode("latin-1").splitlines()
-    for no, line in enumerate(lines, start=1):
-        if not line.isascii() and not line.startswith("00"):  # free text is allowed in comments
-            col = next(i for i, ch in enumerate(line) if not ch.isascii()) + 1
-            raise InputError(f"not an ASCII CRD file (byte 0x{ord(line[col - 1]):02x})", file=file, line=no, column=col)
+    lines = _read_lines(path)
     known = None if known_stations is None else {str(s).upper(): str(s) for s in known_stations}
     blocks: list[_Block] = []
     block: _Block | None = None
@@ -222,18 +218,7 @@ def read_crd(
                 block = None
                 continue
             if rec == "h2":
-                if len(tokens) < 6:
-                    raise InputError(f"H2 needs 5 fields, got {len(tokens) - 1}", file=file, line=no)
-                block.station, block.station_id, block.station_line = tokens[1], tokens[2], no
-                if known is not None and tokens[1].upper() not in known and tokens[2].upper() not in known:
-                    raise InputError(
-                        f"unknown station {tokens[1]!r} (pad {tokens[2]}); known: {', '.join(sorted(known.values()))}",
-                        file=file,
-                        line=no,
-                        column=4,
-                    )
-                if known is not None:
-                    block.station = known.get(tokens[1].upper()) or known[tokens[2].upper()]
+                _header2(block, tokens, known, file, no)
                 continue
             if rec == "h3":
                 if len(tokens) < 5:
@@ -247,54 +232,11 @@ def read_crd(
             if block.start is None and rec in ("10", "11", "20", "40"):
                 raise InputError(f"data record {tokens[0]!r} before the H4 record", file=file, line=no, column=1)
             if rec == "c0":
-                if len(tokens) >= 4:
-                    try:
-                        block.wavelengths[tokens[3]] = float(tokens[2])
-                    except ValueError:
-                        raise InputError(
-                            f"C0 wavelength {tokens[2]!r} is not a number", file=file, line=no, column=3
-                        ) from None
+                _wavelength(block, tokens, file, no)
                 continue
-            if rec in ("10", "11"):
+            if rec in ("10", "11", "20", "40"):
                 n_records += 1
-                sod = _num(tokens, 1, "seconds of day")
-                tof = _num(tokens, 2, "time of flight (s)")
-                if not 0.0 < tof < 10.0:
-                    raise _Bad(f"time of flight {tof} s is not in (0, 10) s", 3)
-                row: dict[str, object] = {
-                    "t": block.epoch(sod),
-                    "tof": tof,
-                    "config": tokens[3] if len(tokens) > 3 else "",
-                    "event": _int(tokens, 4, "epoch event") if len(tokens) > 4 else -1,
-                    "line": no,
-                    "rms_s": math.nan,
-                }
-                if rec == "10":
-                    flag = _int(tokens, 5, "filter flag") if len(tokens) > 5 else 0
-                    if flag == 1:
-                        log.record("noise returns skipped (filter flag 1)", 1)
-                        continue
-                else:
-                    rms_ps = _num(tokens, 7, "bin RMS (ps)") if len(tokens) > 7 and tokens[7] != "na" else math.nan
-                    row["rms_s"] = rms_ps * 1e-12 if rms_ps >= 0 else math.nan
-                block.ranges.append(row)
-                continue
-            if rec == "20":
-                n_records += 1
-                t = block.epoch(_num(tokens, 1, "seconds of day"))
-                p = _num(tokens, 2, "pressure (mbar)")
-                temp = _num(tokens, 3, "temperature (K)")
-                rh = _num(tokens, 4, "relative humidity (%)")
-                if not (500.0 <= p <= 1100.0 and 180.0 <= temp <= 340.0 and 0.0 <= rh <= 100.0):
-                    raise _Bad(f"meteorology {p} mbar, {temp} K, {rh} % out of the plausible range", 3)
-                block.meteo.append((t, p, temp, rh))
-                continue
-            if rec == "40":
-                n_records += 1
-                delay = _num(tokens, 7, "system delay (ps)")
-                config = tokens[3] if len(tokens) > 3 else ""
-                _int(tokens, 2, "type of data")
-                block.delays_ps.setdefault(config, []).append(delay)
+                _data_record(block, rec, tokens, no, log)
                 continue
             if rec in _IGNORED or rec.startswith("9") or rec.startswith("c"):
                 continue
@@ -322,6 +264,81 @@ def read_crd(
         if not blocks:
             raise InputError(f"no data block for satellite {satellite!r}", file=file)
     return _table(blocks, file, log)
+
+
+def _read_lines(path: str | Path) -> list[str]:
+    """Lines of the (possibly compressed) file; non-ASCII bytes are allowed only in ``00`` comments."""
+    lines = read_bytes(path).decode("latin-1").splitlines()
+    for no, line in enumerate(lines, start=1):
+        if not line.isascii() and not line.startswith("00"):  # free text is allowed in comments
+            col = next(i for i, ch in enumerate(line) if not ch.isascii()) + 1
+            byte = ord(line[col - 1])
+            raise InputError(f"not an ASCII CRD file (byte 0x{byte:02x})", file=str(path), line=no, column=col)
+    return lines
+
+
+def _header2(block: _Block, tokens: list[str], known: Mapping[str, str] | None, file: str, no: int) -> None:
+    """The station record: name, pad id; a station outside ``known`` is an error naming the known ones."""
+    if len(tokens) < 6:
+        raise InputError(f"H2 needs 5 fields, got {len(tokens) - 1}", file=file, line=no)
+    block.station, block.station_id, block.station_line = tokens[1], tokens[2], no
+    if known is not None and tokens[1].upper() not in known and tokens[2].upper() not in known:
+        raise InputError(
+            f"unknown station {tokens[1]!r} (pad {tokens[2]}); known: {', '.join(sorted(known.values()))}",
+            file=file,
+            line=no,
+            column=4,
+        )
+    if known is not None:
+        block.station = known.get(tokens[1].upper()) or known[tokens[2].upper()]
+
+
+def _wavelength(block: _Block, tokens: list[str], file: str, no: int) -> None:
+    """A C0 (system configuration) record: the wavelength of a configuration."""
+    if len(tokens) >= 4:
+        try:
+            block.wavelengths[tokens[3]] = float(tokens[2])
+        except ValueError:
+            raise InputError(f"C0 wavelength {tokens[2]!r} is not a number", file=file, line=no, column=3) from None
+
+
+def _data_record(block: _Block, rec: str, tokens: list[str], no: int, log: RepairLog) -> None:
+    """A range (10 full rate, 11 normal point), meteorology (20) or calibration (40) record."""
+    if rec in ("10", "11"):
+        sod = _num(tokens, 1, "seconds of day")
+        tof = _num(tokens, 2, "time of flight (s)")
+        if not 0.0 < tof < 10.0:
+            raise _Bad(f"time of flight {tof} s is not in (0, 10) s", 3)
+        row: dict[str, object] = {
+            "t": block.epoch(sod),
+            "tof": tof,
+            "config": tokens[3] if len(tokens) > 3 else "",
+            "event": _int(tokens, 4, "epoch event") if len(tokens) > 4 else -1,
+            "line": no,
+            "rms_s": math.nan,
+        }
+        if rec == "10":
+            flag = _int(tokens, 5, "filter flag") if len(tokens) > 5 else 0
+            if flag == 1:
+                log.record("noise returns skipped (filter flag 1)", 1)
+                return
+        else:
+            rms_ps = _num(tokens, 7, "bin RMS (ps)") if len(tokens) > 7 and tokens[7] != "na" else math.nan
+            row["rms_s"] = rms_ps * 1e-12 if rms_ps >= 0 else math.nan
+        block.ranges.append(row)
+    elif rec == "20":
+        t = block.epoch(_num(tokens, 1, "seconds of day"))
+        p = _num(tokens, 2, "pressure (mbar)")
+        temp = _num(tokens, 3, "temperature (K)")
+        rh = _num(tokens, 4, "relative humidity (%)")
+        if not (500.0 <= p <= 1100.0 and 180.0 <= temp <= 340.0 and 0.0 <= rh <= 100.0):
+            raise _Bad(f"meteorology {p} mbar, {temp} K, {rh} % out of the plausible range", 3)
+        block.meteo.append((t, p, temp, rh))
+    else:
+        delay = _num(tokens, 7, "system delay (ps)")
+        config = tokens[3] if len(tokens) > 3 else ""
+        _int(tokens, 2, "type of data")
+        block.delays_ps.setdefault(config, []).append(delay)
 
 
 def _header4(block: _Block, tokens: list[str], file: str, no: int) -> None:

@@ -11,8 +11,14 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Literal
 
+import numpy as np
+
 from abrupt.errors import InputError
 from abrupt.readers.compression import read_bytes
+from abrupt.readers.cpf import read_cpf
+from abrupt.readers.navigation_csv import read_navigation_csv, write_navigation_csv
+from abrupt.readers.oem import TIME_SYSTEMS, read_oem, read_opm, write_oem
+from abrupt.readers.sp3 import KNOWN_TIME_SYSTEMS, read_sp3, write_sp3
 from abrupt.series.ephemeris import Ephemeris
 
 EphemerisFormat = Literal["sp3", "oem-kvn", "oem-xml", "opm", "cpf", "csv"]
@@ -50,23 +56,13 @@ def read_ephemeris(
     SP3 header count the body does not match is an error even when the records are complete."""
     fmt = sniff_format(path)
     if fmt == "sp3":
-        from abrupt.readers.sp3 import read_sp3
-
         return read_sp3(path, satellite, allow_truncated=allow_truncated, strict=strict)
     if fmt in ("oem-kvn", "oem-xml"):
-        from abrupt.readers.oem import read_oem
-
         return read_oem(path, satellite)
     if fmt == "opm":
-        from abrupt.readers.oem import read_opm
-
         return read_opm(path, satellite)
     if fmt == "cpf":
-        from abrupt.readers.cpf import read_cpf
-
         return read_cpf(path, satellite, allow_truncated=allow_truncated)
-    from abrupt.readers.navigation_csv import read_navigation_csv
-
     return read_navigation_csv(path, satellite)
 
 
@@ -83,21 +79,13 @@ def write_ephemeris(
     if fmt is None:
         fmt = "csv" if Path(path).suffix.lower() == ".csv" or like is None else sniff_format(like)
     if fmt in ("opm", "cpf"):
-        import numpy as np
-
         fmt = "oem-kvn" if np.all(np.isfinite(ephemeris.velocity_mps)) else "sp3"
     if fmt == "sp3":
-        from abrupt.readers.sp3 import KNOWN_TIME_SYSTEMS, write_sp3
-
         ts = ephemeris.time_system if ephemeris.time_system in KNOWN_TIME_SYSTEMS else "GPS"
         write_sp3(ephemeris, path, time_system=ts)
     elif fmt in ("oem-kvn", "oem-xml"):
-        from abrupt.readers.oem import TIME_SYSTEMS, write_oem
-
         ts = ephemeris.time_system if ephemeris.time_system in TIME_SYSTEMS else "UTC"
         write_oem(ephemeris, path, form="xml" if fmt == "oem-xml" else "kvn", time_system=ts)
     else:
-        from abrupt.readers.navigation_csv import write_navigation_csv
-
         write_navigation_csv(ephemeris, path)
     return fmt

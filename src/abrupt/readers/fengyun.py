@@ -26,7 +26,7 @@ import numpy as np
 import pandas as pd
 
 from abrupt.errors import InputError, RepairLog
-from abrupt.readers.ids_maneuvers import MANEUVER_COLUMNS
+from abrupt.readers.ids_maneuvers import MANEUVER_COLUMNS, read_ids_maneuvers
 
 CST_OFFSET = np.timedelta64(8, "h")  # China Standard Time = UTC + 8 h
 
@@ -122,7 +122,6 @@ def read_fengyun_maneuvers(path: str | Path, *, repairs: RepairLog | None = None
 
 def read_maneuver_file(path: str | Path, *, repairs: RepairLog | None = None) -> pd.DataFrame:
     """An operator maneuver file of either kind: Fengyun ``.fy`` (by content) or IDS ``*man.txt``."""
-    from abrupt.readers.ids_maneuvers import read_ids_maneuvers
 
     path = Path(path)
     with open(path, "rb") as fh:

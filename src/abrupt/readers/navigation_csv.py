@@ -153,10 +153,3 @@ def write_navigation_csv(ephemeris: Ephemeris, path: str | Path) -> None:
     )
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     df.to_csv(path, index=False, float_format="%.6f")
-
-
-def read_ephemeris(path: str | Path, satellite: str | None = None) -> Ephemeris:
-    """Read any supported orbit file; see :func:`abrupt.readers.ephemeris.read_ephemeris`."""
-    from abrupt.readers.ephemeris import read_ephemeris as read_any
-
-    return read_any(path, satellite)

@@ -28,12 +28,17 @@ import xml.parsers.expat
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
+from xml.sax.saxutils import escape
 
+import erfa
 import numpy as np
+from astropy.time import Time
 from numpy.typing import NDArray
 
 from abrupt.errors import InputError, RepairLog
+from abrupt.model.timescales import offline_astropy
 from abrupt.readers.compression import read_bytes
+from abrupt.readers.timesystems import to_utc_counted
 from abrupt.series.ephemeris import Ephemeris
 
 GCRF_NAMES = {"GCRF", "ICRF", "EME2000", "J2000"}
@@ -382,7 +387,6 @@ def _to_ephemeris(segments: list[_Segment], satellite: str | None, file: str, lo
     frame_name = frames.pop()
     if frame_name in ("EME2000", "J2000"):
         log.record("EME2000 treated as GCRF (frame bias 23 mas ignored)", 1)
-    from abrupt.readers.timesystems import to_utc_counted
 
     ts = systems.pop()
     return Ephemeris(
@@ -436,10 +440,6 @@ def _fmt_time(t: np.datetime64) -> str:
 def _from_utc(t_utc: NDArray[np.datetime64], time_system: str) -> NDArray[np.datetime64]:
     if time_system == "UTC":
         return t_utc
-    import erfa
-    from astropy.time import Time
-
-    from abrupt.model.timescales import offline_astropy
 
     offline_astropy()
     with warnings.catch_warnings():
@@ -502,7 +502,6 @@ def write_oem(
         ]
         Path(path).write_text("\n".join(out) + "\n", encoding="utf-8")
         return
-    from xml.sax.saxutils import escape
 
     out = [
         '<?xml version="1.0" encoding="UTF-8"?>',

@@ -22,11 +22,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from abrupt.errors import InputError
 from abrupt.model.orbit import MU_EARTH_M3_S2, coe_to_rv
 from abrupt.model.stations import WGS84_A_M, Station
 from abrupt.readers.aer import parse_utc
+from abrupt.types import FloatArray
 
 _KEY = re.compile(r"^(?P<key>[A-Za-z0-9_.]+)\s*(\[\s*(?P<index>\d+)\s*\])?$")
 
@@ -52,11 +54,13 @@ def _normalise(key: str) -> str:
     return key.strip().lower().replace("_", ".")
 
 
-def read_od_input(path: str | Path) -> OrbitDeterminationSetup:
-    """Read an Orekit orbit-determination input file (see the module docstring)."""
-    path = Path(path)
-    plain: dict[str, tuple[str, int]] = {}
-    indexed: dict[int, dict[str, tuple[str, int]]] = {}
+Entries = dict[str, tuple[str, int]]  # key -> (value, line number)
+
+
+def _entries(path: Path) -> tuple[Entries, dict[int, Entries]]:
+    """The ``key = value`` lines of the file: plain keys, and indexed keys (``key[k]``) by index."""
+    plain: Entries = {}
+    indexed: dict[int, Entries] = {}
     for lineno, raw in enumerate(path.read_text().splitlines(), start=1):
         line = raw.strip()
         if not line or line.startswith("#"):
@@ -78,21 +82,28 @@ def read_od_input(path: str | Path) -> OrbitDeterminationSetup:
             if key in plain:
                 raise InputError(f"key {key} given twice (first on line {plain[key][1]})", file=path, line=lineno)
             plain[key] = (value, lineno)
+    return plain, indexed
 
-    def num(src: dict[str, tuple[str, int]], key: str, default: float | None = None) -> float:
-        if key not in src:
-            if default is None:
-                raise InputError(f"missing key {key}", file=path)
-            return default
-        value, lineno = src[key]
-        try:
-            v = float(value)
-        except ValueError:
-            raise InputError(f"{key}: {value!r} is not a number", file=path, line=lineno) from None
-        if not math.isfinite(v):
-            raise InputError(f"{key}: {value!r} is not finite", file=path, line=lineno)
-        return v
 
+def _number(path: Path, src: Entries, key: str, default: float | None = None) -> float:
+    """The finite number under ``key`` (or ``default``; a missing key without default is an error)."""
+    if key not in src:
+        if default is None:
+            raise InputError(f"missing key {key}", file=path)
+        return default
+    value, lineno = src[key]
+    try:
+        v = float(value)
+    except ValueError:
+        raise InputError(f"{key}: {value!r} is not a number", file=path, line=lineno) from None
+    if not math.isfinite(v):
+        raise InputError(f"{key}: {value!r} is not finite", file=path, line=lineno)
+    return v
+
+
+def _orbit(path: Path, plain: Entries) -> tuple[np.datetime64, FloatArray, float]:
+    """The a-priori epoch (UTC), state (GCRF, m and m/s, from Cartesian or Keplerian keys) and the
+    gravitational parameter (m³/s²) the Keplerian elements are read with."""
     if "orbit.date" not in plain:
         raise InputError("missing key orbit.date", file=path)
     try:
@@ -101,9 +112,9 @@ def read_od_input(path: str | Path) -> OrbitDeterminationSetup:
         raise InputError(
             f"orbit.date: cannot parse {plain['orbit.date'][0]!r}", file=path, line=plain["orbit.date"][1]
         ) from None
-    mu = num(plain, "abrupt.mu", MU_EARTH_M3_S2)
+    mu = _number(path, plain, "abrupt.mu", MU_EARTH_M3_S2)
     if "orbit.cartesian.px" in plain:
-        state = np.array([num(plain, f"orbit.cartesian.{k}") for k in ("px", "py", "pz", "vx", "vy", "vz")])
+        state = np.array([_number(path, plain, f"orbit.cartesian.{k}") for k in ("px", "py", "pz", "vx", "vy", "vz")])
         if np.linalg.norm(state[:3]) < 6.0e6:
             raise InputError(
                 f"orbit.cartesian position norm {np.linalg.norm(state[:3]):.1f} m is inside the Earth (km given?)",
@@ -111,16 +122,21 @@ def read_od_input(path: str | Path) -> OrbitDeterminationSetup:
                 line=plain["orbit.cartesian.px"][1],
             )
     elif "orbit.keplerian.a" in plain:
-        a = num(plain, "orbit.keplerian.a")
-        e = num(plain, "orbit.keplerian.e")
-        angles = [math.radians(num(plain, f"orbit.keplerian.{k}")) for k in ("i", "raan", "pa", "anomaly")]
+        a = _number(path, plain, "orbit.keplerian.a")
+        e = _number(path, plain, "orbit.keplerian.e")
+        angles = [math.radians(_number(path, plain, f"orbit.keplerian.{k}")) for k in ("i", "raan", "pa", "anomaly")]
         kind = plain.get("orbit.angle.type", ("MEAN", 0))[0].upper()
         nu = _true_anomaly(angles[3], e, kind)
         state = coe_to_rv(a, e, angles[0], angles[1], angles[2], nu, mu)
     else:
         raise InputError("no orbit: give orbit.cartesian.* or orbit.keplerian.*", file=path)
-    radius = num(plain, "body.equatorial.radius", WGS84_A_M)
-    inv_f = num(plain, "body.inverse.flattening", 298.257223563)
+    return epoch, state, mu
+
+
+def _stations(path: Path, plain: Entries, indexed: dict[int, Entries]) -> tuple[dict[str, Station], dict[str, bool]]:
+    """The ground stations (``ground.station.*[k]``) and whether each one's range bias is estimated."""
+    radius = _number(path, plain, "body.equatorial.radius", WGS84_A_M)
+    inv_f = _number(path, plain, "body.inverse.flattening", 298.257223563)
     f = 1.0 / inv_f
     ecc = math.sqrt(f * (2.0 - f))
     stations: dict[str, Station] = {}
@@ -136,15 +152,15 @@ def read_od_input(path: str | Path) -> OrbitDeterminationSetup:
         try:
             st = Station(
                 name=name,
-                latitude_deg=num(src, "ground.station.latitude"),
-                longitude_deg=num(src, "ground.station.longitude"),
-                altitude_m=num(src, "ground.station.altitude"),
-                elevation_mask_deg=num(plain, "abrupt.elevation.mask", 0.0),
-                sigma_range_m=num(src, "ground.station.range.sigma", 20.0),
-                sigma_azimuth_rad=num(src, "ground.station.azimuth.sigma", 0.02) * deg,
-                sigma_elevation_rad=num(src, "ground.station.elevation.sigma", 0.02) * deg,
-                sigma_range_rate_mps=num(src, "ground.station.range.rate.sigma", 0.001),
-                range_bias_m=num(src, "ground.station.range.bias", 0.0),
+                latitude_deg=_number(path, src, "ground.station.latitude"),
+                longitude_deg=_number(path, src, "ground.station.longitude"),
+                altitude_m=_number(path, src, "ground.station.altitude"),
+                elevation_mask_deg=_number(path, plain, "abrupt.elevation.mask", 0.0),
+                sigma_range_m=_number(path, src, "ground.station.range.sigma", 20.0),
+                sigma_azimuth_rad=_number(path, src, "ground.station.azimuth.sigma", 0.02) * deg,
+                sigma_elevation_rad=_number(path, src, "ground.station.elevation.sigma", 0.02) * deg,
+                sigma_range_rate_mps=_number(path, src, "ground.station.range.rate.sigma", 0.001),
+                range_bias_m=_number(path, src, "ground.station.range.bias", 0.0),
                 equatorial_radius_m=radius,
                 eccentricity=ecc,
             )
@@ -157,6 +173,15 @@ def read_od_input(path: str | Path) -> OrbitDeterminationSetup:
         estimated[name] = flag == "true"
     if not stations:
         raise InputError("no ground.station.name[k] entries", file=path)
+    return stations, estimated
+
+
+def read_od_input(path: str | Path) -> OrbitDeterminationSetup:
+    """Read an Orekit orbit-determination input file (see the module docstring)."""
+    path = Path(path)
+    plain, indexed = _entries(path)
+    epoch, state, mu = _orbit(path, plain)
+    stations, estimated = _stations(path, plain, indexed)
     refraction = any(
         src.get("ground.station.elevation.refraction.correction", ("false", 0))[0].lower() == "true"
         for src in indexed.values()
@@ -179,7 +204,7 @@ def read_od_input(path: str | Path) -> OrbitDeterminationSetup:
         stations=stations,
         range_bias_estimated=estimated,
         earth_rotation=rot,
-        theta0_rad=math.radians(num(plain, "abrupt.earth.rotation.theta0", 0.0)),
+        theta0_rad=math.radians(_number(path, plain, "abrupt.earth.rotation.theta0", 0.0)),
         mu_m3_s2=mu,
         elevation_mask_deg=None if mask is None else float(mask[0]),
         refraction_correction=refraction,
@@ -213,7 +238,6 @@ def write_od_input(
     mu_m3_s2: float = MU_EARTH_M3_S2,
 ) -> None:
     """Write an Orekit-style input file that :func:`read_od_input` reads back (used by the simulator)."""
-    import pandas as pd
 
     lines = [
         "## written by abrupt simulate tracking (Orekit orbit-determination input syntax)",

@@ -1,5 +1,8 @@
 """Reader and writer of SP3 precise orbit files, versions a, b, c and d (positions km, velocities dm/s).
 
+The header and the epoch lines are read by :mod:`abrupt.readers.sp3_header`; this module reads the
+ephemeris records, checks them and writes SP3.
+
 Standards: Remondi (1989) "Extending the National Geodetic Survey standard GPS orbit formats" (SP3-a),
 Hilla (2002) "The Extended Standard Product 3 Orbit Format (SP3-c)", Hilla (2016) "SP3-d" (IGS).
 Plain, gzip (``.gz``) and Unix-compress (``.Z``) files are read; compression is recognised from the
@@ -43,46 +46,34 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import erfa
 import numpy as np
+from astropy.time import Time
 from numpy.typing import NDArray
 
 from abrupt.errors import InputError, RepairLog
+from abrupt.model.timescales import offline_astropy
 from abrupt.readers.compression import read_bytes
+from abrupt.readers.sp3_header import (
+    KNOWN_TIME_SYSTEMS,
+    TAI_MINUS_SYSTEM_S,
+    BadRecord,
+    Sp3Header,
+    epoch_fields,
+    epoch_from_fields,
+    normalise_satellite_id,
+    parse_header,
+)
 from abrupt.readers.sp3_records import last_epoch_complete
+from abrupt.readers.timesystems import to_utc_counted
 from abrupt.series.ephemeris import Ephemeris
 
-#: Offsets of SP3 time systems from TAI (s): t_TAI = t_sys + offset (GPS ICD, Galileo OS SIS ICD,
-#: BeiDou ICD). UTC and GLONASS (UTC + 3 h) go through the leap-second table instead.
-TAI_MINUS_SYSTEM_S = {"GPS": 19.0, "GAL": 19.0, "QZS": 19.0, "IRN": 19.0, "BDT": 33.0, "TAI": 0.0}
-KNOWN_TIME_SYSTEMS = (*TAI_MINUS_SYSTEM_S, "UTC", "GLO")
-SUPPORTED_VERSIONS = "abcd"
-MAX_SATELLITES = {"a": 85, "b": 85, "c": 85, "d": 999}
 INERTIAL_FRAMES = ("GCRF", "ICRF", "J2000", "EME2000", "EME00", "ICRS")
 
 BAD_VALUE_MARKER = 999999.999999  # [km or dm/s] the SP3 "bad or absent value" marker
 MIN_RADIUS_KM = 6000.0  # [km] smallest plausible orbit radius
 MAX_RADIUS_KM = 2.0e6  # [km] largest plausible geocentric radius (beyond the Moon)
-MAX_INTERVAL_S = 30 * 86400.0  # [s] longest plausible epoch interval
 BAD_RECORD_FRACTION = 0.01  # more malformed records than this (and more than one) is an error
-
-
-@dataclass
-class Sp3Header:
-    """Header fields of an SP3 file (values as written; times in the file's time system)."""
-
-    version: str
-    has_velocity: bool
-    start: np.datetime64
-    n_epochs: int
-    data_used: str
-    coordinate_system: str
-    orbit_type: str
-    agency: str
-    interval_s: float
-    satellites: list[str]
-    time_system: str
-    file_type: str = "G"
-    comments: list[str] = field(default_factory=list)
 
 
 @dataclass
@@ -94,82 +85,18 @@ class Sp3File:
     repairs: RepairLog
 
 
-def normalise_satellite_id(text: str) -> str:
-    """SP3 satellite id in the form ``G01`` (SP3-a ``' 1'`` and ``'G 1'`` become ``G01``)."""
-    s = text.strip()
-    if not s:
-        return ""
-    if s.isdigit():
-        return f"G{int(s):02d}"
-    system, number = s[0], s[1:].strip()
-    if system == " ":
-        system = "G"
-    if number.isdigit():
-        return f"{system}{int(number):02d}"
-    return s.replace(" ", "0")
-
-
 def _is_marker(value: float) -> bool:
     return abs(abs(value) - BAD_VALUE_MARKER) < 1e-4
-
-
-class _BadRecord(Exception):
-    """A malformed ephemeris record (skipped and counted, up to the limit)."""
-
-    def __init__(self, reason: str, column: int | None = None) -> None:
-        super().__init__(reason)
-        self.reason = reason
-        self.column = column
 
 
 def _number(text: str, column: int, what: str) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise _BadRecord(f"{what}: cannot read number {text.strip()!r}", column) from None
+        raise BadRecord(f"{what}: cannot read number {text.strip()!r}", column) from None
     if not (math.isfinite(value) and abs(value) < 1e12):
-        raise _BadRecord(f"{what}: {text.strip()!r} is not finite or absurdly large", column)
+        raise BadRecord(f"{what}: {text.strip()!r} is not finite or absurdly large", column)
     return value
-
-
-def _epoch_fields(text: str) -> tuple[int, int, int, int, int, float]:
-    parts = text[1:].split()
-    if len(parts) < 6:
-        raise _BadRecord(f"epoch line needs 6 fields (year month day hour minute second), got {len(parts)}", 2)
-    try:
-        year, month, day, hour, minute = (int(p) for p in parts[:5])
-        second = float(parts[5])
-    except ValueError:
-        raise _BadRecord(f"epoch line is malformed: {text.strip()!r}", 2) from None
-    if not (
-        1900 <= year <= 2200
-        and 1 <= month <= 12
-        and 0 <= day <= 31
-        and 0 <= hour <= 24
-        and 0 <= minute <= 60
-        and 0.0 <= second < 61.0
-        and math.isfinite(second)
-    ):
-        raise _BadRecord(f"epoch {' '.join(parts[:6])!r} is out of range", 2)
-    return year, month, day, hour, minute, second
-
-
-def epoch_from_fields(
-    year: int, month: int, day: int, hour: int, minute: int, second: float
-) -> tuple[np.datetime64, bool]:
-    """Calendar fields as ``datetime64[ns]``; rollover values (minute 60, hour 24, second ≥ 60, day 0)
-    carry into the next field. Returns the epoch and whether a rollover was normalised."""
-    base = np.datetime64(f"{year:04d}-{month:02d}-01", "ns")
-    ns = round(second * 1e9)
-    t = (
-        base
-        + np.timedelta64(day - 1, "D")
-        + np.timedelta64(hour, "h")
-        + np.timedelta64(minute, "m")
-        + np.timedelta64(ns, "ns")
-    )
-    rolled = day == 0 or hour == 24 or minute == 60 or second >= 60.0
-    return t, rolled
 
 
 def _resolve_rollover(
@@ -196,8 +123,6 @@ def _resolve_rollover(
 
 
 def _to_utc(t_sys: NDArray[np.datetime64], time_system: str, log: RepairLog) -> NDArray[np.datetime64]:
-    from abrupt.readers.timesystems import to_utc_counted
-
     if time_system == "UTC":
         return t_sys
     if time_system == "GLO":
@@ -209,15 +134,12 @@ def _to_utc(t_sys: NDArray[np.datetime64], time_system: str, log: RepairLog) -> 
 
 def _from_utc(t_utc: NDArray[np.datetime64], time_system: str) -> NDArray[np.datetime64]:
     """Inverse of :func:`_to_utc` (for the writer)."""
-    from abrupt.model.timescales import offline_astropy
 
     if time_system == "UTC":
         return t_utc
     if time_system == "GLO":
         return t_utc + np.timedelta64(3, "h")
     offline_astropy()
-    import erfa
-    from astropy.time import Time
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", erfa.ErfaWarning)  # beyond the leap-second table: TAI-UTC held
@@ -225,138 +147,6 @@ def _from_utc(t_utc: NDArray[np.datetime64], time_system: str) -> NDArray[np.dat
     offset_ns = round(TAI_MINUS_SYSTEM_S[time_system] * 1e9)
     out: NDArray[np.datetime64] = (tai.astype(np.int64) - offset_ns).astype("datetime64[ns]")
     return out
-
-
-def _parse_header(
-    lines: Sequence[str], file: str, repairs: RepairLog, *, strict: bool = False
-) -> tuple[Sp3Header, int]:
-    """Parse the header; returns it and the index of the first body line. ``strict``: a satellite list
-    of another length than the count announced is an error (else the list is used, and counted)."""
-    if not lines or len(lines[0]) < 3 or lines[0][0] != "#" or lines[0][1] in "#":
-        raise InputError("first line must start with '#a', '#c' or '#d' (SP3 version)", file=file, line=1, column=1)
-    head = lines[0]
-    version = head[1]
-    if version not in SUPPORTED_VERSIONS:
-        raise InputError(f"unsupported SP3 version {version!r} (supported: a, b, c, d)", file=file, line=1, column=2)
-    if head[2] not in "PV":
-        raise InputError(f"position/velocity flag {head[2]!r} must be 'P' or 'V'", file=file, line=1, column=3)
-    try:
-        start_fields = _epoch_fields("*" + head[3:31])
-    except _BadRecord as bad:
-        raise InputError(f"start epoch: {bad.reason}", file=file, line=1, column=4) from None
-    start, _ = epoch_from_fields(*start_fields)
-    count = head[31:39].strip()
-    if not count.isdigit():
-        raise InputError(f"number of epochs {count!r} is not an integer", file=file, line=1, column=33)
-    if len(lines) < 2 or not lines[1].startswith("##"):
-        raise InputError("second line must start with '##' (GPS week, interval)", file=file, line=2, column=1)
-    try:
-        interval_s = float(lines[1][24:38])
-    except ValueError:
-        raise InputError(
-            "epoch interval (third field of '##' line) is not a number", file=file, line=2, column=25
-        ) from None
-    if not (math.isfinite(interval_s) and 0.0 <= interval_s <= MAX_INTERVAL_S):
-        raise InputError(
-            f"epoch interval {interval_s:g} s is not in [0, {MAX_INTERVAL_S:g}] s", file=file, line=2, column=25
-        )
-    sats: list[str] = []
-    n_sats: int | None = None
-    n_plus = 0
-    time_system: str | None = None
-    file_type = "G"
-    n_pct_c = 0
-    comments: list[str] = []
-    ts_line = 3
-    for idx in range(2, len(lines)):
-        line = lines[idx]
-        no = idx + 1
-        if line.startswith("*"):
-            body = idx
-            break
-        if line.startswith("++"):
-            continue
-        if line.startswith("+"):
-            n_plus += 1
-            if n_sats is None:
-                text = line[1:6].strip()
-                if not text.isdigit():
-                    raise InputError(f"number of satellites {text!r} is not an integer", file=file, line=no, column=4)
-                n_sats = int(text)
-                if n_sats > MAX_SATELLITES[version]:
-                    raise InputError(
-                        f"SP3-{version} lists at most {MAX_SATELLITES[version]} satellites; "
-                        f"the header announces {n_sats}",
-                        file=file,
-                        line=no,
-                        column=4,
-                    )
-            for k in range(17):
-                sid = normalise_satellite_id(line[9 + 3 * k : 12 + 3 * k])
-                if sid and sid not in ("G00",):
-                    sats.append(sid)
-            continue
-        if line.startswith("%c"):
-            n_pct_c += 1
-            if n_pct_c == 1:
-                file_type = line[3:5].strip() or "G"
-                time_system = line[9:12].strip().upper()
-                ts_line = no
-            continue
-        if line.startswith("%f"):
-            for lo, hi, what in ((3, 13, "pos/vel accuracy base"), (14, 26, "clock accuracy base")):
-                text = line[lo:hi].strip()
-                if text:
-                    try:
-                        float(text)
-                    except ValueError:
-                        raise InputError(
-                            f"{what} {text!r} is not a number", file=file, line=no, column=lo + 1
-                        ) from None
-            continue
-        if line.startswith(("%i", "%/")):
-            continue
-        if line.startswith("/*"):
-            comments.append(line[3:].rstrip())
-            continue
-        if not line.strip():
-            continue
-        raise InputError(f"unknown header record {line[:2]!r}", file=file, line=no, column=1)
-    else:
-        raise InputError("no epoch records ('*' lines) in the file", file=file, line=len(lines))
-    if n_sats is None:
-        raise InputError("no satellite list ('+' lines) in the header", file=file, line=3, column=1)
-    if len(sats) != n_sats:
-        if strict or not sats:
-            raise InputError(f"header announces {n_sats} satellites but lists {len(sats)}", file=file, line=3, column=4)
-        repairs.record(f"header announces {n_sats} satellites but lists {len(sats)} (the list is used)")
-    if len(set(sats)) != len(sats):
-        raise InputError("satellite list names a satellite twice", file=file, line=3, column=10)
-    if version in "ab" or time_system in (None, "CCC", ""):
-        time_system = "GPS"
-    if time_system not in KNOWN_TIME_SYSTEMS:
-        raise InputError(
-            f"unknown time system {time_system!r}; known: {', '.join(KNOWN_TIME_SYSTEMS)}",
-            file=file,
-            line=ts_line,
-            column=10,
-        )
-    header = Sp3Header(
-        version=version,
-        has_velocity=head[2] == "V",
-        start=start,
-        n_epochs=int(count),
-        data_used=head[39:45].strip(),
-        coordinate_system=head[45:51].strip(),
-        orbit_type=head[51:55].strip(),
-        agency=head[55:60].strip(),
-        interval_s=interval_s,
-        satellites=sats,
-        time_system=time_system,
-        file_type=file_type,
-        comments=comments,
-    )
-    return header, body
 
 
 def _read_lines(path: str | Path) -> list[str]:
@@ -369,130 +159,148 @@ def _read_lines(path: str | Path) -> list[str]:
     return lines
 
 
-def parse_sp3(
-    path: str | Path, *, allow_truncated: bool = False, strict: bool = False, repairs: RepairLog | None = None
-) -> Sp3File:
-    """Read every satellite of an SP3 file (see the module docstring for repairs and errors).
+@dataclass
+class _Body:
+    """What the ephemeris records of an SP3 file hold, with the counts the repairs report."""
 
-    ``strict``: a header count the body does not match (epochs, satellites) is an error even when the
-    records are complete; ``allow_truncated``: a file cut before its announced epochs is read."""
-    file = str(path)
-    log = repairs if repairs is not None else RepairLog(source=file)
-    lines = _read_lines(path)
-    header, body = _parse_header(lines, file, log, strict=strict)
-    sats = set(header.satellites)
-    epochs: list[np.datetime64] = []
-    epoch_lines: list[int] = []
-    # per satellite: epoch index, position km (3), velocity dm/s (3), line number
-    states: dict[str, dict[int, list[float]]] = defaultdict(dict)
-    state_lines: dict[str, dict[int, int]] = defaultdict(dict)
-    bad: list[tuple[int, _BadRecord]] = []
-    n_records = 0
-    n_rolled = 0
-    missing_pos: Counter[str] = Counter()
-    missing_vel: Counter[str] = Counter()
-    unlisted: set[str] = set()
-    n_epoch_lines = 0
+    epochs: list[np.datetime64] = field(default_factory=list)
+    epoch_lines: list[int] = field(default_factory=list)
+    # per satellite: epoch index -> [x, y, z km, vx, vy, vz dm/s], and the line of the position record
+    states: dict[str, dict[int, list[float]]] = field(default_factory=lambda: defaultdict(dict))
+    state_lines: dict[str, dict[int, int]] = field(default_factory=lambda: defaultdict(dict))
+    bad: list[tuple[int, BadRecord]] = field(default_factory=list)
+    n_records: int = 0
+    n_rolled: int = 0
+    n_epoch_lines: int = 0
+    lines_after_eof: int = 0
+    seen_eof: bool = False
+    missing_pos: Counter[str] = field(default_factory=Counter)
+    missing_vel: Counter[str] = field(default_factory=Counter)
+    unlisted: set[str] = field(default_factory=set)
+
+
+def _epoch_record(body: _Body, line: str, no: int, header: Sp3Header) -> int:
+    """An epoch line (``*``): append its time; returns its index."""
+    body.n_epoch_lines += 1
+    fields = epoch_fields(line)
+    t, rolled = epoch_from_fields(*fields)
+    if rolled:
+        body.n_rolled += 1
+        t = _resolve_rollover(t, fields, body.epochs[-1] if body.epochs else None, header.interval_s)
+    body.epochs.append(t)
+    body.epoch_lines.append(no)
+    return len(body.epochs) - 1
+
+
+def _state_record(body: _Body, line: str, no: int, current: int | None, satellites: set[str]) -> None:
+    """A position (``P``, km) or velocity (``V``, dm/s) record of the epoch ``current``."""
+    tag = line[0]
+    if len(line) < 46:
+        raise BadRecord(f"{'position' if tag == 'P' else 'velocity'} record truncated (need 46 columns)", len(line) + 1)
+    sid = normalise_satellite_id(line[1:4])
+    if not sid:
+        raise BadRecord("record without a satellite id", 2)
+    if current is None:
+        return  # record of a skipped (bad) epoch: skipped with it
+    what = "position (km)" if tag == "P" else "velocity (dm/s)"
+    xyz = [_number(line[4 + 14 * k : 18 + 14 * k], 5 + 14 * k, what) for k in range(3)]
+    if tag == "P":
+        if any(_is_marker(c) for c in xyz) or all(c == 0.0 for c in xyz):
+            body.missing_pos[sid] += 1
+            body.states[sid].pop(current, None)
+            return
+        radius = math.sqrt(sum(c * c for c in xyz))
+        if not MIN_RADIUS_KM <= radius <= MAX_RADIUS_KM:
+            raise BadRecord(f"position magnitude {radius:.6g} km is not an orbit radius (positions must be in km)", 5)
+        if sid not in satellites:
+            body.unlisted.add(sid)
+        body.states[sid][current] = [*xyz, math.nan, math.nan, math.nan]
+        body.state_lines[sid][current] = no
+        return
+    row = body.states.get(sid, {}).get(current)
+    if row is None:
+        return  # velocity of a position that was missing: dropped with it
+    if any(_is_marker(c) for c in xyz) or all(c == 0.0 for c in xyz):
+        body.missing_vel[sid] += 1
+        return
+    speed_kms = math.sqrt(sum(c * c for c in xyz)) * 1e-4
+    if not 0.05 <= speed_kms <= 15.0:
+        raise BadRecord(f"velocity magnitude {speed_kms:.6g} km/s is implausible (velocities must be in dm/s)", 5)
+    row[3:6] = xyz
+
+
+def _read_body(lines: Sequence[str], start: int, header: Sp3Header) -> _Body:
+    """Every record from the first epoch line to ``EOF``; malformed records are collected, not raised."""
+    body = _Body()
+    satellites = set(header.satellites)
     current: int | None = None  # index into epochs, None while the epoch line is bad
     seen_eof = False
-    lines_after_eof = 0
-    for idx in range(body, len(lines)):
+    for idx in range(start, len(lines)):
         line = lines[idx]
         no = idx + 1
         if seen_eof:
             if line.strip():
-                lines_after_eof += 1
+                body.lines_after_eof += 1
             continue
         if not line.strip() or line.startswith("/*"):
             continue
         if line.startswith("EOF"):
-            seen_eof = True
+            seen_eof = body.seen_eof = True
             continue
-        n_records += 1
+        body.n_records += 1
         try:
             tag = line[0]
             if tag == "*":
-                n_epoch_lines += 1
                 current = None
-                fields = _epoch_fields(line)
-                t, rolled = epoch_from_fields(*fields)
-                if rolled:
-                    n_rolled += 1
-                    t = _resolve_rollover(t, fields, epochs[-1] if epochs else None, header.interval_s)
-                epochs.append(t)
-                epoch_lines.append(no)
-                current = len(epochs) - 1
+                current = _epoch_record(body, line, no, header)
             elif tag in ("P", "V"):
-                if len(line) < 46:
-                    raise _BadRecord(
-                        f"{'position' if tag == 'P' else 'velocity'} record truncated (need 46 columns)", len(line) + 1
-                    )
-                sid = normalise_satellite_id(line[1:4])
-                if not sid:
-                    raise _BadRecord("record without a satellite id", 2)
-                if current is None:
-                    continue  # record of a skipped (bad) epoch: skipped with it
-                what = "position (km)" if tag == "P" else "velocity (dm/s)"
-                xyz = [_number(line[4 + 14 * k : 18 + 14 * k], 5 + 14 * k, what) for k in range(3)]
-                if tag == "P":
-                    if any(_is_marker(c) for c in xyz) or all(c == 0.0 for c in xyz):
-                        missing_pos[sid] += 1
-                        states[sid].pop(current, None)
-                        continue
-                    radius = math.sqrt(sum(c * c for c in xyz))
-                    if not MIN_RADIUS_KM <= radius <= MAX_RADIUS_KM:
-                        raise _BadRecord(
-                            f"position magnitude {radius:.6g} km is not an orbit radius (positions must be in km)", 5
-                        )
-                    if sid not in sats:
-                        unlisted.add(sid)
-                    states[sid][current] = [*xyz, math.nan, math.nan, math.nan]
-                    state_lines[sid][current] = no
-                else:
-                    row = states.get(sid, {}).get(current)
-                    if row is None:
-                        continue  # velocity of a position that was missing: dropped with it
-                    if any(_is_marker(c) for c in xyz) or all(c == 0.0 for c in xyz):
-                        missing_vel[sid] += 1
-                        continue
-                    speed_kms = math.sqrt(sum(c * c for c in xyz)) * 1e-4
-                    if not 0.05 <= speed_kms <= 15.0:
-                        raise _BadRecord(
-                            f"velocity magnitude {speed_kms:.6g} km/s is implausible (velocities must be in dm/s)", 5
-                        )
-                    row[3:6] = xyz
+                _state_record(body, line, no, current, satellites)
             elif tag == "E" and line[1:2] in ("P", "V"):
                 continue  # correlation records (SP3-c/d), not used
             elif line.startswith(("#", "+", "%")):
-                raise _BadRecord(f"header line {line[:2]!r} among the ephemeris records", 1)
+                raise BadRecord(f"header line {line[:2]!r} among the ephemeris records", 1)
             else:
-                raise _BadRecord(f"unknown record type {line[:2]!r}", 1)
-        except _BadRecord as exc:
-            bad.append((no, exc))
-    if lines_after_eof:
-        log.record("lines after EOF ignored", lines_after_eof)
-    limit = int(BAD_RECORD_FRACTION * n_records)
-    if len(bad) > limit:
-        first_no, first = bad[0]
-        extra = f" ({len(bad)} malformed records, more than the {limit} that would be skipped)" if limit else ""
+                raise BadRecord(f"unknown record type {line[:2]!r}", 1)
+        except BadRecord as exc:
+            body.bad.append((no, exc))
+    return body
+
+
+def _check_body(
+    body: _Body,
+    header: Sp3Header,
+    lines: Sequence[str],
+    start: int,
+    file: str,
+    log: RepairLog,
+    flags: tuple[bool, bool],
+) -> NDArray[np.datetime64]:
+    """The limits on malformed records and the epoch count, and the sampling grid; returns the epochs."""
+    if body.lines_after_eof:
+        log.record("lines after EOF ignored", body.lines_after_eof)
+    limit = int(BAD_RECORD_FRACTION * body.n_records)
+    if len(body.bad) > limit:
+        first_no, first = body.bad[0]
+        extra = f" ({len(body.bad)} malformed records, more than the {limit} that would be skipped)" if limit else ""
         raise InputError(
             first.reason + extra,
             file=file,
             line=first_no,
             column=first.column,
         )
-    if bad:
-        log.record("malformed ephemeris record skipped", len(bad))
-    if n_epoch_lines != header.n_epochs:
-        missing = header.n_epochs - n_epoch_lines
+    if body.bad:
+        log.record("malformed ephemeris record skipped", len(body.bad))
+    allow_truncated, strict = flags
+    if body.n_epoch_lines != header.n_epochs:
+        missing = header.n_epochs - body.n_epoch_lines
         # complete records: the writer reached EOF; without EOF a file short of epochs is a cut file,
         # one with more epochs than announced must end with a full last epoch
-        complete = seen_eof or (
-            missing < 0 and last_epoch_complete(lines[body:], header.satellites, header.has_velocity)
+        complete = body.seen_eof or (
+            missing < 0 and last_epoch_complete(lines[start:], header.satellites, header.has_velocity)
         )
         if complete and not strict:
             log.record(
-                f"header announces {header.n_epochs} epochs, the file holds {n_epoch_lines} complete ones "
+                f"header announces {header.n_epochs} epochs, the file holds {body.n_epoch_lines} complete ones "
                 "(read as found)",
                 abs(missing),
             )
@@ -500,17 +308,17 @@ def parse_sp3(
             log.record("file truncated: announced epochs missing", missing)
         else:
             raise InputError(
-                f"header announces {header.n_epochs} epochs but the file holds {n_epoch_lines}"
+                f"header announces {header.n_epochs} epochs but the file holds {body.n_epoch_lines}"
                 + (" (truncated file?)" if missing > 0 and not complete else ""),
                 file=file,
                 line=len(lines),
             )
-    if not epochs:
+    if not body.epochs:
         raise InputError("no valid epochs in the file", file=file)
-    log.record("epoch field at rollover value normalised (minute 60, hour 24, second 60, day 0)", n_rolled)
-    if unlisted:
-        log.record("satellite not in the header list (read anyway)", len(unlisted))
-    t_all = np.array(epochs, dtype="datetime64[ns]")
+    log.record("epoch field at rollover value normalised (minute 60, hour 24, second 60, day 0)", body.n_rolled)
+    if body.unlisted:
+        log.record("satellite not in the header list (read anyway)", len(body.unlisted))
+    t_all = np.array(body.epochs, dtype="datetime64[ns]")
     if header.interval_s > 0 and t_all.size > 1:
         step_ns = round(header.interval_s * 1e9)
         offset = (t_all - t_all[0]).astype(np.int64) % step_ns
@@ -521,33 +329,46 @@ def parse_sp3(
                 f"epoch {t_all[i]} is not on the header's {header.interval_s:g} s sampling grid "
                 f"from the first epoch {t_all[0]}",
                 file=file,
-                line=epoch_lines[i],
+                line=body.epoch_lines[i],
                 column=2,
             )
+    return t_all
+
+
+def parse_sp3(
+    path: str | Path, *, allow_truncated: bool = False, strict: bool = False, repairs: RepairLog | None = None
+) -> Sp3File:
+    """Read every satellite of an SP3 file (see the module docstring for repairs and errors). ``strict``:
+    a header count the complete records do not match is an error."""
+    file = str(path)
+    log = repairs if repairs is not None else RepairLog(source=file)
+    lines = _read_lines(path)
+    header, start = parse_header(lines, file, log, strict=strict)
+    body = _read_body(lines, start, header)
+    t_all = _check_body(body, header, lines, start, file, log, (allow_truncated, strict))
     frame = "GCRF" if header.coordinate_system.upper() in INERTIAL_FRAMES else "ITRF"
     ephemerides: dict[str, Ephemeris] = {}
-    order_sats = header.satellites + sorted(unlisted)
-    for sid in order_sats:
-        rows = states.get(sid)
+    for sid in header.satellites + sorted(body.unlisted):
+        rows = body.states.get(sid)
         if not rows:
             continue
         idx_arr = np.array(sorted(rows), dtype=np.int64)
         sat_log = RepairLog(source=f"{file}[{sid}]")
         sat_log.counts.update(log.counts)
-        sat_log.record("missing position marker (epoch removed)", missing_pos[sid])
-        sat_log.record("missing velocity marker (velocity set to NaN)", missing_vel[sid])
+        sat_log.record("missing position marker (epoch removed)", body.missing_pos[sid])
+        sat_log.record("missing velocity marker (velocity set to NaN)", body.missing_vel[sid])
         ephemerides[sid] = _finish(
             sid,
             t_all[idx_arr],
             np.array([rows[i] for i in idx_arr], dtype=np.float64),
-            np.array([state_lines[sid][i] for i in idx_arr]),
+            np.array([body.state_lines[sid][i] for i in idx_arr]),
             header,
             frame,
             file,
             sat_log,
         )
-    log.record("missing position marker (epoch removed)", sum(missing_pos.values()))
-    log.record("missing velocity marker (velocity set to NaN)", sum(missing_vel.values()))
+    log.record("missing position marker (epoch removed)", sum(body.missing_pos.values()))
+    log.record("missing velocity marker (velocity set to NaN)", sum(body.missing_vel.values()))
     return Sp3File(header=header, ephemerides=ephemerides, repairs=log)
 
 
@@ -597,7 +418,7 @@ def list_satellites(path: str | Path) -> list[str]:
     """Satellite identifiers named in the header of an SP3 file."""
     file = str(path)
     lines = _read_lines(path)
-    return _parse_header(lines, file, RepairLog(source=file))[0].satellites
+    return parse_header(lines, file, RepairLog(source=file))[0].satellites
 
 
 def read_sp3(
@@ -685,9 +506,6 @@ def write_sp3(
         smallest = int(steps_ns.min())
         if smallest > 0 and np.all(steps_ns % smallest == 0):
             step_s = smallest * 1e-9
-    from astropy.time import Time
-
-    from abrupt.model.timescales import offline_astropy
 
     offline_astropy()
     t0 = all_t[0]

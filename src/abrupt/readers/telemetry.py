@@ -32,15 +32,18 @@ from __future__ import annotations
 
 import logging
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
 from abrupt.errors import InputError, RepairLog
-from abrupt.model.spacecraft import RATE_UNITS, WHEEL_SPEED_UNITS, Spacecraft
+from abrupt.model.rotations import quaternion_conjugate, quaternion_multiply
+from abrupt.model.spacecraft import RATE_UNITS, WHEEL_SPEED_UNITS, Spacecraft, TelemetryMap
 from abrupt.series.telemetry import GAP_FACTOR, Telemetry, split_at_gaps
 from abrupt.thresholds.noise import robust_noise_sigma
+from abrupt.types import FloatArray
 
 QUATERNION_NORM_ERROR = 0.1  # relative norm deviation above which a quaternion is rejected
 QUATERNION_NORM_REPAIR = 1e-6  # relative deviation above which a renormalisation is counted
@@ -112,8 +115,6 @@ def _check_rates_against_attitude(
     any other factor outside [0.5, 2] means a wrong unit, axis order or quaternion convention. For an
     inertially pointing spacecraft the attitude rate is at noise level and the check stays silent.
     """
-    from abrupt.model.rotations import quaternion_conjugate, quaternion_multiply
-
     num = den = 0.0
     signal: list[float] = []
     noise: list[float] = []
@@ -171,15 +172,9 @@ def _check_rates_against_attitude(
     )
 
 
-def telemetry_from_frame(
-    frame: pd.DataFrame, spacecraft: Spacecraft, *, source: str | Path = "<memory>", is_csv: bool = False
-) -> Telemetry:
-    """Map, convert and check a telemetry table (see the module docstring for every rule)."""
-    path = Path(str(source))
-    repairs = RepairLog(str(source))
+def _check_columns(frame: pd.DataFrame, spacecraft: Spacecraft, path: Path) -> None:
+    """Raise unless every column the spacecraft file maps is present."""
     tmap = spacecraft.telemetry
-    if frame.shape[0] == 0:
-        raise InputError("no data rows", file=path)
     keys = {
         tmap.time: "telemetry.time",
         **{c: "telemetry.quaternion" for c in tmap.quaternion.columns},
@@ -195,53 +190,46 @@ def telemetry_from_frame(
                 column=col,
             )
 
-    # Time: ISO-8601 UTC (or datetime64 in Parquet).
-    raw_time = frame[tmap.time]
+
+def _parse_times(raw_time: pd.Series, path: Path, is_csv: bool, column: str) -> NDArray[np.datetime64]:
+    """ISO-8601 UTC (or datetime64 in Parquet) as datetime64[ns] UTC without a zone."""
     times = pd.to_datetime(raw_time, utc=True, errors="coerce", format="ISO8601")
     if times.isna().any():
         row = int(np.flatnonzero(times.isna().to_numpy())[0])
         raise InputError(
-            f"not an ISO-8601 time: {raw_time.iloc[row]!r}",
-            file=path,
-            line=_line(row, is_csv),
-            column=tmap.time,
+            f"not an ISO-8601 time: {raw_time.iloc[row]!r}", file=path, line=_line(row, is_csv), column=column
         )
-    time_ns = times.dt.tz_localize(None).to_numpy(dtype="datetime64[ns]")
+    return times.dt.tz_localize(None).to_numpy(dtype="datetime64[ns]")
 
-    q = np.column_stack([_numeric(frame, c, path, is_csv) for c in tmap.quaternion.columns])
-    w = np.column_stack([_numeric(frame, c, path, is_csv) for c in tmap.body_rate.columns])
-    if tmap.wheel_speed.columns:
-        omega = np.column_stack([_numeric(frame, c, path, is_csv) for c in tmap.wheel_speed.columns])
-    else:
-        omega = np.zeros((len(frame), 0))
-    line_of_row = np.arange(len(frame))
 
-    # Empty cells: remove the row, count it.
+_Rows = tuple[NDArray[np.datetime64], FloatArray, FloatArray, FloatArray, NDArray[np.int64]]
+
+
+def _take(rows: _Rows, sel: NDArray[Any]) -> _Rows:
+    """The rows selected by a boolean mask or an index array."""
+    time_ns, q, w, omega, lines = rows
+    return time_ns[sel], q[sel], w[sel], omega[sel], lines[sel]
+
+
+def _repair_rows(rows: _Rows, repairs: RepairLog, path: Path) -> _Rows:
+    """Remove rows with empty cells, sort by time and drop duplicate times (first kept), counting each repair.
+
+    ``rows`` are (time, q, ω, Ω, line of each row).
+    """
+    time_ns, q, w, omega, _ = rows
     finite = np.all(np.isfinite(q), axis=1) & np.all(np.isfinite(w), axis=1) & np.all(np.isfinite(omega), axis=1)
     if not finite.all():
         repairs.record("rows with empty or NaN values removed", int((~finite).sum()))
-        time_ns, q, w, omega, line_of_row = (
-            time_ns[finite],
-            q[finite],
-            w[finite],
-            omega[finite],
-            line_of_row[finite],
-        )
+        rows = _take(rows, finite)
+    time_ns = rows[0]
     if time_ns.size == 0:
         raise InputError("no complete data rows (every row has an empty value)", file=path)
-
-    # Order and duplicates.
     order = np.argsort(time_ns, kind="stable")
     if np.any(order != np.arange(order.size)):
         n_out = int(np.count_nonzero(np.diff(time_ns.astype(np.int64)) < 0))
         repairs.record("timestamps out of order (rows sorted)", n_out)
-        time_ns, q, w, omega, line_of_row = (
-            time_ns[order],
-            q[order],
-            w[order],
-            omega[order],
-            line_of_row[order],
-        )
+        rows = _take(rows, order)
+    time_ns, q, w, omega, _ = rows
     dup = np.concatenate([[False], np.diff(time_ns.astype(np.int64)) == 0])
     if dup.any():
         prev = np.flatnonzero(dup) - 1
@@ -252,10 +240,14 @@ def telemetry_from_frame(
         )
         repairs.record("duplicate timestamps with identical values removed", int(same.sum()))
         repairs.record("duplicate timestamps with conflicting values (first row kept)", int((~same).sum()))
-        keep = ~dup
-        time_ns, q, w, omega, line_of_row = time_ns[keep], q[keep], w[keep], omega[keep], line_of_row[keep]
+        rows = _take(rows, ~dup)
+    return rows
 
-    # Units and conventions.
+
+def _to_q_BN(
+    q: FloatArray, tmap: TelemetryMap, repairs: RepairLog, lines: NDArray[np.int64], path: Path, is_csv: bool
+) -> FloatArray:
+    """Quaternions as q_BN, scalar first, unit norm (renormalised and counted), q0 >= 0."""
     order_spec = tmap.quaternion.order or "scalar_first,q_BN"
     if order_spec.startswith("scalar_last"):
         q = q[:, [3, 0, 1, 2]]
@@ -267,7 +259,7 @@ def telemetry_from_frame(
             f"quaternion norm {norm[row]:.6g} is not 1 (more than {QUATERNION_NORM_ERROR:.0%} off): "
             "wrong scaling or wrong columns?",
             file=path,
-            line=_line(int(line_of_row[row]), is_csv),
+            line=_line(int(lines[row]), is_csv),
             column=",".join(tmap.quaternion.columns),
         )
     n_fix = int(np.count_nonzero(dev > QUATERNION_NORM_REPAIR))
@@ -275,8 +267,14 @@ def telemetry_from_frame(
     q = q / norm[:, None]
     if order_spec.endswith("q_NB"):
         q[:, 1:] *= -1.0
-    q = np.where(q[:, :1] < 0, -q, q)
+    return np.asarray(np.where(q[:, :1] < 0, -q, q), dtype=np.float64)
 
+
+def _to_si_rates(
+    w: FloatArray, omega: FloatArray, spacecraft: Spacecraft, lines: NDArray[np.int64], path: Path, is_csv: bool
+) -> tuple[FloatArray, FloatArray]:
+    """Body rates and wheel speeds in rad/s, checked against plausible limits (a wrong unit is an error)."""
+    tmap = spacecraft.telemetry
     w = w * RATE_UNITS[tmap.body_rate.unit or "rad/s"]
     rate_mag = np.linalg.norm(w, axis=1)
     if np.any(rate_mag > MAX_BODY_RATE_RAD_S):
@@ -285,7 +283,7 @@ def telemetry_from_frame(
             f"body rate {rate_mag[row]:.4g} rad/s exceeds {MAX_BODY_RATE_RAD_S} rad/s after conversion from "
             f"{tmap.body_rate.unit!r}: is the unit in the spacecraft file right?",
             file=path,
-            line=_line(int(line_of_row[row]), is_csv),
+            line=_line(int(lines[row]), is_csv),
             column=",".join(tmap.body_rate.columns),
         )
     omega = omega * WHEEL_SPEED_UNITS[tmap.wheel_speed.unit or "rad/s"]
@@ -299,10 +297,32 @@ def telemetry_from_frame(
                 f"wheel speed {omega[row, wheel]:.6g} rad/s exceeds {WHEEL_OVERSPEED_FACTOR} x the wheel's maximum "
                 f"{spacecraft.wheel_max_speeds_rad_s[wheel]:.6g} rad/s with unit {tmap.wheel_speed.unit!r}{hint}",
                 file=path,
-                line=_line(int(line_of_row[row]), is_csv),
+                line=_line(int(lines[row]), is_csv),
                 column=tmap.wheel_speed.columns[wheel],
             )
+    return w, omega
 
+
+def telemetry_from_frame(
+    frame: pd.DataFrame, spacecraft: Spacecraft, *, source: str | Path = "<memory>", is_csv: bool = False
+) -> Telemetry:
+    """Map, convert and check a telemetry table (see the module docstring for every rule)."""
+    path = Path(str(source))
+    repairs = RepairLog(str(source))
+    tmap = spacecraft.telemetry
+    if frame.shape[0] == 0:
+        raise InputError("no data rows", file=path)
+    _check_columns(frame, spacecraft, path)
+    time_ns = _parse_times(frame[tmap.time], path, is_csv, tmap.time)
+    q = np.column_stack([_numeric(frame, c, path, is_csv) for c in tmap.quaternion.columns])
+    w = np.column_stack([_numeric(frame, c, path, is_csv) for c in tmap.body_rate.columns])
+    if tmap.wheel_speed.columns:
+        omega = np.column_stack([_numeric(frame, c, path, is_csv) for c in tmap.wheel_speed.columns])
+    else:
+        omega = np.zeros((len(frame), 0))
+    time_ns, q, w, omega, lines = _repair_rows((time_ns, q, w, omega, np.arange(len(frame))), repairs, path)
+    q = _to_q_BN(q, tmap, repairs, lines, path, is_csv)
+    w, omega = _to_si_rates(w, omega, spacecraft, lines, path, is_csv)
     if time_ns.size < 2:
         raise InputError(f"need at least 2 samples with distinct times, got {time_ns.size}", file=path)
     t_ns = time_ns.astype(np.int64)

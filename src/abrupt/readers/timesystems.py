@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import warnings
 
+import erfa
 import numpy as np
 from numpy.typing import NDArray
 
@@ -19,7 +20,6 @@ from abrupt.model.timescales import TimeScale, to_utc
 
 def to_utc_counted(times: NDArray[np.datetime64], scale: TimeScale, repairs: RepairLog) -> NDArray[np.datetime64]:
     """:func:`to_utc`, recording "epochs outside the leap-second table" in ``repairs`` when ERFA doubts."""
-    import erfa
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

@@ -15,7 +15,10 @@ from typing import Literal
 import pandas as pd
 
 from abrupt.errors import RepairLog
+from abrupt.readers.aer import read_aer
 from abrupt.readers.compression import read_bytes
+from abrupt.readers.crd import read_crd
+from abrupt.readers.tdm import read_tdm
 
 TrackingFormat = Literal["crd", "tdm", "aer"]
 
@@ -41,13 +44,8 @@ def read_tracking(
     """Read a CRD, TDM or ``.aer`` file; stations outside ``known_stations`` are an error (CRD, .aer)."""
     fmt = sniff_tracking_format(path)
     if fmt == "crd":
-        from abrupt.readers.crd import read_crd
-
         return read_crd(path, known_stations=known_stations, repairs=repairs)
     if fmt == "tdm":
-        from abrupt.readers.tdm import read_tdm
-
         return read_tdm(path, repairs=repairs)
-    from abrupt.readers.aer import read_aer
 
     return read_aer(path, known_stations=known_stations, repairs=repairs)

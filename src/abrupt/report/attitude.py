@@ -24,6 +24,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
+from scipy import stats
+from scipy.ndimage import uniform_filter1d
 
 from abrupt.pipelines.attitude import AttitudeRun, display_name
 from abrupt.report.style import (
@@ -42,8 +44,6 @@ SMOOTHING_S = 30.0  # [s] running mean drawn over the noisy momentum
 
 
 def _running_mean(y: NDArray[np.float64], n: int) -> NDArray[np.float64]:
-    from scipy.ndimage import uniform_filter1d
-
     return np.asarray(uniform_filter1d(y, size=n, mode="nearest"), dtype=np.float64) if n > 1 else y
 
 
@@ -178,8 +178,6 @@ def qq_figure(result: AttitudeRun) -> plt.Figure | None:
     Points on the diagonal mean the extreme-value fit that set the threshold describes the data; the
     dashed line marks the threshold.
     """
-    from scipy import stats
-
     fitted = [d for d in result.diagnostics if d.null_sample is not None and d.threshold is not None]
     if not fitted:
         return None

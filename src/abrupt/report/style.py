@@ -10,6 +10,7 @@ name so the same detector has the same colour in every report.
 from __future__ import annotations
 
 import base64
+import html
 import io
 import zlib
 from collections.abc import Iterable, Mapping, Sequence
@@ -147,7 +148,6 @@ def figure_png_base64(fig: Any, *, dpi: int = 110) -> str:
 
 def html_page(title: str, body: str) -> str:
     """A self-contained HTML page (inline style, images as data: URLs, no network access)."""
-    import html
 
     return (
         '<!doctype html><html><head><meta charset="utf-8">'

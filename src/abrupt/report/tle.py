@@ -75,6 +75,8 @@ def plot_tle_report(
     if len(events) and "threshold" in events:
         axes[4].axhline(float(events["threshold"].iloc[0]), color="tab:red", ls="--", lw=1, label="threshold")
         axes[4].legend(loc="upper right", fontsize=8)
+    if len(events) and "kind" in events:  # campaign rows summarise maneuvers drawn already
+        events = events.loc[events["kind"] != "maneuver_campaign"]
     events = events.reset_index(drop=True)
     matched: set[int] = set()
     if truth is not None and len(truth):

@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from abrupt.errors import RepairLog
+from abrupt.model.frames import gcrf_to_itrf, itrf_to_gcrf
 from abrupt.types import FloatArray
 
 Frame = Literal["ITRF", "GCRF"]
@@ -65,7 +66,6 @@ class Ephemeris:
         """The same states expressed in ``frame``."""
         if frame == self.frame:
             return self
-        from abrupt.model.frames import gcrf_to_itrf, itrf_to_gcrf
 
         if frame == "GCRF":
             r, v = itrf_to_gcrf(self.times_utc, self.position_m, self.velocity_mps)

@@ -2,24 +2,37 @@
 
 A ground-tracking detector (``tracking.glrt``, ``tracking.kaderali_k``) needs the measurements
 (:class:`~abrupt.model.tracking_measurements.TrackingArrays`, one row per station and epoch), the
-a-priori state at the data epoch and the settings of the batch orbit fit (force model, which biases
-and accelerations to estimate). The fits every detector of a run shares, the plain orbit fit and the
-maneuver-aware fit of the GLRT, are computed once per series and kept.
+a-priori state at the data epoch and the settings of the batch orbit fit
+(:mod:`abrupt.model.orbit.batch_fit`: force model, which biases and accelerations to estimate). The
+plain orbit fit is computed once per series and kept; :meth:`TrackingSeries.cached` keeps what the
+detectors of one run share (the GLRT's maneuver-aware fit).
+
+Laser ranging (``tracking.laser_glrt``) reads a :class:`LaserRangingSeries`: two-way ranges not yet
+reduced, with the precise station sites and the range model that reduce them
+(:mod:`abrupt.model.range_reduction`) on whatever trajectory the detector has estimated so far.
 """
 
 from __future__ import annotations
 
 import copy
+import math
+from collections.abc import Callable, Hashable, Mapping
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any
+from typing import Any, TypeVar
 
 import numpy as np
+import pandas as pd
+from scipy.interpolate import CubicHermiteSpline
 
+from abrupt.errors import RepairLog
+from abrupt.model.orbit import ForceContext, orbit_period_s
+from abrupt.model.orbit.batch_fit import BatchFit, BatchFitConfig, fit_orbit, model_corrections, trajectory
+from abrupt.model.range_reduction import RangeModel, StationSite, reduce_ranges, trajectory_interpolator
+from abrupt.model.stations import Station
+from abrupt.model.tracking_measurements import TrackingArrays
 from abrupt.types import FloatArray
 
-if TYPE_CHECKING:
-    from abrupt.detect.tracking.glrt import BatchFit, BatchFitConfig, GlrtConfig, GlrtDetection, GlrtScan
-    from abrupt.model.tracking_measurements import TrackingArrays
+T = TypeVar("T")
 
 
 @dataclass(frozen=True, eq=False)
@@ -50,31 +63,22 @@ class TrackingSeries:
 
     def orbit_period_s(self) -> float:
         """Keplerian period of the a-priori state [s] (one day for an unbound state)."""
-        from abrupt.model.orbit import ForceContext, orbit_period_s
-
         x = np.asarray(self.x0_apriori_m_mps, dtype=np.float64)
         force = self.fit_config.force
         mu = (force.model if isinstance(force, ForceContext) else force).mu_m3_s2
         energy = float(np.dot(x[3:], x[3:])) / 2 - mu / float(np.linalg.norm(x[:3]))
         return 86400.0 if energy >= 0 else orbit_period_s(-mu / (2 * energy), mu)
 
+    def cached(self, key: Hashable, compute: Callable[[], T]) -> T:
+        """``compute()`` the first time ``key`` is asked for on this series, the kept value after."""
+        if key not in self._cache:
+            self._cache[key] = compute()
+        result: T = self._cache[key]
+        return result
+
     def orbit_fit(self) -> BatchFit:
         """The batch least-squares orbit fit without maneuvers (biases, unmodelled acceleration)."""
-        if "fit" not in self._cache:
-            from abrupt.detect.tracking.glrt import fit_orbit
-
-            self._cache["fit"] = fit_orbit(self.data, self.x0_apriori_m_mps, config=self.fit_config)
-        return self._cache["fit"]
-
-    def maneuver_fit(self, config: GlrtConfig) -> tuple[list[GlrtDetection], BatchFit, list[GlrtScan]]:
-        """The GLRT's greedy impulse search from the orbit fit: detections, the maneuver-aware fit, scans."""
-        key = ("glrt", config)
-        if key not in self._cache:
-            from abrupt.detect.tracking.glrt import detect_maneuvers_glrt
-
-            x0 = self.orbit_fit().x0
-            self._cache[key] = detect_maneuvers_glrt(self.data, x0, fit_config=self.fit_config, config=config)
-        return self._cache[key]
+        return self.cached("fit", lambda: fit_orbit(self.data, self.x0_apriori_m_mps, config=self.fit_config))
 
     def bias_corrected(self) -> TrackingArrays:
         """A copy of the measurements with the fitted station range and angle biases applied.
@@ -85,8 +89,6 @@ class TrackingSeries:
         instantaneous model of Kaderali's filter sees reduced measurements. The series' own arrays are
         not changed.
         """
-        from abrupt.detect.tracking.glrt import model_corrections
-
         fit = self.orbit_fit()
         data = copy.copy(self.data)
         data.range_bias_m = self.data.range_bias_m.copy()
@@ -110,3 +112,92 @@ class TrackingSeries:
         data.epoch_utc = self.data.epoch_utc + delta
         data.times_utc = self.data.times_utc + delta
         return replace(self, data=data)
+
+
+@dataclass(frozen=True, eq=False)
+class LaserRangingSeries:
+    """Two-way ranges of one arc with what reduces them, ready for ``tracking.laser_glrt``.
+
+    ``measurements`` are receive-time tagged ranges with meteorology in the convention of
+    :func:`~abrupt.model.range_reduction.reduce_ranges`; ``sites`` the precise station reference points
+    (SINEX); ``stations`` the fit's stations (stated range sigmas); ``x0_apriori_m_mps`` the a-priori
+    GCRF state (m, m/s) at ``epoch_utc`` (t = 0 s); ``fit_config`` the batch fit's settings with its
+    force model resolved for the arc; ``range_model`` the reduction's switchable terms.
+    """
+
+    measurements: pd.DataFrame
+    sites: dict[str, StationSite]
+    stations: dict[str, Station]
+    x0_apriori_m_mps: FloatArray
+    epoch_utc: np.datetime64
+    fit_config: BatchFitConfig
+    range_model: RangeModel = field(default_factory=RangeModel)
+    name: str = "laser"
+
+    def __len__(self) -> int:
+        return len(self.measurements)
+
+    @property
+    def spacecraft_name(self) -> str:
+        return self.name
+
+    @property
+    def t_s(self) -> FloatArray:
+        """Receive times of the ranges [s from ``epoch_utc``]."""
+        times = np.asarray(self.measurements["time_utc"], dtype="datetime64[ns]")
+        return np.asarray((times - self.epoch_utc) / np.timedelta64(1, "s"), dtype=np.float64)
+
+    @property
+    def end_s(self) -> float:
+        """Time of the last range [s from ``epoch_utc``]."""
+        return float((np.asarray(self.measurements["time_utc"]).max() - self.epoch_utc) / np.timedelta64(1, "s"))
+
+    def reduced(
+        self,
+        source: BatchFit | FloatArray,
+        sigma_scale: Mapping[str, float],
+        *,
+        t_max_s: float = math.inf,
+        repairs: RepairLog | None = None,
+    ) -> TrackingArrays:
+        """The ranges up to ``t_max_s`` reduced to instantaneous geometry on the trajectory of ``source``
+        (a fit, or an a-priori state at the epoch), each station's sigma multiplied by ``sigma_scale``."""
+        t_rel = self.t_s
+        reduced = reduce_ranges(
+            self.measurements if not math.isfinite(t_max_s) else self.measurements.loc[t_rel <= t_max_s],
+            self.sites,
+            trajectory_positions(source, self.end_s, self.fit_config),
+            self.range_model,
+            epoch_utc=self.epoch_utc,
+            nominal_ecef_m={n: s.position_ecef_m for n, s in self.stations.items()},
+            repairs=repairs,
+        )
+        scaled = {
+            n: replace(s, sigma_range_m=s.sigma_range_m * sigma_scale.get(n, 1.0)) for n, s in self.stations.items()
+        }
+        return TrackingArrays(reduced, scaled, epoch_utc=self.epoch_utc, earth_rotation="iers")
+
+
+def trajectory_positions(
+    source: BatchFit | FloatArray, t_end_s: float, fit_config: BatchFitConfig, step_s: float = 30.0
+) -> CubicHermiteSpline:
+    """GCRF positions of a fitted trajectory (or of an a-priori state's) as a function of time [s]."""
+    grid = np.arange(-2 * step_s, t_end_s + 3 * step_s, step_s)
+    fwd = grid >= 0
+    states = np.empty((grid.size, 6))
+    if isinstance(source, BatchFit):
+        states[fwd] = source.propagate(grid[fwd])[0]
+    else:
+        states[fwd], _ = trajectory(
+            np.asarray(source, float),
+            0.0,
+            grid[fwd],
+            force=fit_config.force,
+            accel_mps2=np.zeros(3),
+            max_step_s=fit_config.max_step_s,
+            integrator=fit_config.integrator,
+        )
+    # two nodes before the epoch for light times that reach back (linear extrapolation is ample)
+    for k in np.flatnonzero(~fwd)[::-1]:
+        states[k] = states[k + 1] - (grid[k + 1] - grid[k]) * np.concatenate([states[k + 1, 3:], np.zeros(3)])
+    return trajectory_interpolator(grid, states)

@@ -20,11 +20,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from abrupt.massprops.inertia import inertia_after_docking
+from abrupt.model.attitude_dynamics import AttitudeSimConfig
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import Spacecraft
-from abrupt.simulate.attitude import (
+from abrupt.simulate.pointing import (
     AppendageMotion,
-    AttitudeSimConfig,
     CircularOrbit,
     PointingScenario,
     PointingSimResult,

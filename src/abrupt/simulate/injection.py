@@ -18,7 +18,7 @@ pulse phase (counts c'_k = c_k + ⌊φ₀ + Δφ_k⌋ − ⌊φ₀ + Δφ_{k−1
 and φ₀ a random phase), or as gate means when no tachometer is declared.
 
 By default (``response="simulated"``) the transient is Harris's: the closed-loop simulator of
-:mod:`abrupt.simulate.attitude` (``simulate_pointing``) follows the telemetry's own attitude with and
+:mod:`abrupt.simulate.pointing` (``simulate_pointing``) follows the telemetry's own attitude with and
 without the strike for ``window_s`` and the difference is added; after the window the wheels hold
 [BN(t)]ΔH_N. ``response="linear"`` keeps the stand-in above (time constant ``settle_s``). Detection on
 total momentum depends on the transient only through the first tens of seconds.
@@ -29,13 +29,18 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
-from abrupt.model.rotations import dcm_from_quaternion
+from abrupt.model.attitude_dynamics import AttitudeSimConfig
+from abrupt.model.flight_config import FlightChannel
+from abrupt.model.rotations import dcm_from_quaternion, quaternion_from_dcm
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.timetable import NS, continuous_quaternion
+from abrupt.simulate.pointing import PointingScenario, ReferenceTrajectory, simulate_pointing
 from abrupt.types import FloatArray
 
 
@@ -90,11 +95,6 @@ class _Attitude:
         return np.asarray(dcm_from_quaternion(qi), dtype=np.float64)
 
 
-def _attitude_at(samples: pd.DataFrame, spacecraft: Spacecraft, t_ns: np.ndarray) -> FloatArray:
-    """[BN] at times t_ns from the telemetered quaternion (sign-continuous, nlerp)."""
-    return _Attitude(samples, spacecraft)(t_ns)
-
-
 def _quat_multiply(p: FloatArray, q: FloatArray) -> FloatArray:
     """Hamilton product p ⊗ q, scalar first, row-wise."""
     p0, p1, p2, p3 = p.T
@@ -136,18 +136,14 @@ def simulated_response(
     """Harris et al. 2025 §3.5: simulate the spacecraft following the telemetry's own attitude
     (``ReferenceTrajectory.from_telemetry``) with and without the strike and return the difference.
 
-    Closed-loop rigid body + wheels (:func:`abrupt.simulate.attitude.simulate_pointing`, RK4, MRP
+    Closed-loop rigid body + wheels (:func:`abrupt.simulate.pointing.simulate_pointing`, RK4, MRP
     tracking law with the simulator's gains, which the spacecraft file does not carry), noise off, from
     ``lead_s`` before the strike to ``window_s`` after it; the wheel-speed change comes from the
     controller's own torque distribution.
     """
-    from abrupt.simulate.attitude import AttitudeSimConfig, PointingScenario, ReferenceTrajectory, simulate_pointing
-
     t0 = strike.time_ns - int(lead_s * NS)
     t_ref = t0 + np.arange(-5, int(window_s + lead_s) + 6, dtype=np.int64) * NS
     bn = (attitude or _Attitude(samples, spacecraft))(t_ref)
-    from abrupt.model.rotations import quaternion_from_dcm
-
     reference = ReferenceTrajectory.from_telemetry((t_ref - t0) / NS, quaternion_from_dcm(bn))
     config = AttitudeSimConfig(
         duration_s=window_s + lead_s, sim_rate_hz=sim_rate_hz, telemetry_rate_hz=10.0, noise=False, seed=0
@@ -166,6 +162,123 @@ def simulated_response(
         d_theta_B=np.asarray(2.0 * dq[:, 1:], dtype=np.float64),
         d_wheel=np.asarray(with_strike.true_wheel_speed_rad_s - without.true_wheel_speed_rad_s, dtype=np.float64),
     )
+
+
+@dataclass(frozen=True)
+class _Transient:
+    """Body-rate and attitude-error response to one strike: simulated, or the linear stand-in."""
+
+    sim: StrikeResponse | None
+    dw0: FloatArray
+    settle_s: float
+
+    def rate(self, tau: FloatArray, k: int) -> FloatArray:
+        """Δω about body axis ``k`` [rad/s] at ``tau`` seconds after the strike."""
+        if self.sim is None:
+            return np.asarray(self.dw0[k] * rate_response(tau, self.settle_s), dtype=np.float64)
+        inside = (tau >= 0) & (tau <= self.sim.tau_s[-1])
+        return np.where(inside, np.interp(tau, self.sim.tau_s, self.sim.d_omega_B[:, k]), 0.0)
+
+    def angle(self, tau: FloatArray) -> FloatArray:
+        """δθ (n, 3) about body axes [rad] at ``tau`` seconds after the strike."""
+        if self.sim is None:
+            return np.asarray(self.dw0[None, :] * angle_response(tau, self.settle_s)[:, None], dtype=np.float64)
+        inside = ((tau >= 0) & (tau <= self.sim.tau_s[-1]))[:, None]
+        cols = [np.interp(tau, self.sim.tau_s, self.sim.d_theta_B[:, k]) for k in range(3)]
+        return np.asarray(np.where(inside, np.column_stack(cols), 0.0), dtype=np.float64)
+
+
+class _Rows:
+    """Rows of the raw samples by mnemonic, selected by time."""
+
+    def __init__(self, t_all: NDArray[np.int64], mnem: NDArray[Any]) -> None:
+        self.t_all = t_all
+        self.of = {str(name): np.flatnonzero(mnem == name) for name in np.unique(mnem)}
+        self.none = np.empty(0, dtype=np.int64)
+
+    def __call__(self, name: str, lo_ns: int, hi_ns: int | None = None) -> NDArray[np.int64]:
+        r = self.of.get(name, self.none)
+        keep = self.t_all[r] >= lo_ns
+        if hi_ns is not None:
+            keep &= self.t_all[r] < hi_ns
+        return r[keep]
+
+
+def _add_attitude_error(
+    values: FloatArray, rows: _Rows, qch: list[FlightChannel], s: InjectedStrike, horizon_ns: int, tr: _Transient
+) -> None:
+    """Rotate the telemetered q_BN of the perturbed body: δq(δθ) ⊗ q_BN, δθ in body axes."""
+    t_all = rows.t_all
+    sel0 = rows(qch[0].mnemonic, s.time_ns, s.time_ns + horizon_ns)
+    if not sel0.size:
+        return
+    t_q = t_all[sel0]
+    q_rows = []
+    for ix in (rows.of.get(c.mnemonic, rows.none) for c in qch):
+        pos = np.searchsorted(t_all[ix], t_q)
+        pos = np.clip(pos, 0, ix.size - 1)
+        q_rows.append(ix[pos])
+    rows_arr = np.column_stack(q_rows)
+    ok = np.all(t_all[rows_arr] == t_q[:, None], axis=1)
+    rows_arr = rows_arr[ok]
+    dth = tr.angle((t_q[ok] - s.time_ns) / NS)
+    half = 0.5 * np.linalg.norm(dth, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        axis = np.where(half[:, None] > 0, dth / (2 * half[:, None]), 0.0)
+    dq = np.column_stack([np.cos(half), axis * np.sin(half)[:, None]])
+    q = values[rows_arr]
+    q_new = _quat_multiply(q, dq)  # q_BN ⊗ δq: δθ about body axes
+    flip = (q_new[:, 0] < 0) & (q[:, 0] >= 0)  # keep the archive's q0 >= 0 convention
+    values[rows_arr] = q_new * np.where(flip, -1.0, 1.0)[:, None]
+
+
+def _wheel_change(
+    c: FlightChannel,
+    t_w: NDArray[np.int64],
+    s: InjectedStrike,
+    spacecraft: Spacecraft,
+    bn_at: Callable[[np.ndarray], FloatArray],
+    tr: _Transient,
+    wheel_pinv: NDArray[np.floating[Any]],
+    null_offset: NDArray[np.floating[Any]],
+) -> FloatArray:
+    """Gate mean of ΔΩ of one wheel [rad/s] at times ``t_w``: Σ J_s ΔΩ ĝ = [BN(t)] ΔH_N − J Δω(t).
+
+    The gate [t − gate, t] is sub-sampled at 10 points.
+    """
+    gate = c.tachometer.gate_s if c.tachometer is not None else 0.0
+    k_sub = 10 if gate > 0 else 1
+    offs = np.linspace(-gate, 0.0, k_sub) if gate > 0 else np.zeros(1)
+    t_sub = (t_w[:, None] + (offs * NS).astype(np.int64)[None, :]).ravel()
+    tau = (t_sub - s.time_ns) / NS
+    after = tau >= 0
+    d_omega = np.zeros(t_sub.size)
+    sim = tr.sim
+    if after.any():
+        bn = bn_at(t_sub[after])
+        h_b = np.einsum("nij,j->ni", bn, s.dH_N_Nms)
+        if sim is None:
+            h_b -= (spacecraft.inertia_kgm2 @ tr.dw0)[None, :] * rate_response(tau[after], tr.settle_s)[:, None]
+        d_omega[after] = (h_b @ wheel_pinv.T)[:, c.component] + null_offset[c.component]
+        if sim is not None:  # the simulated transient, then ᴺH conserved by the wheels
+            inside = tau[after] <= sim.tau_s[-1]
+            d_omega[np.flatnonzero(after)[inside]] = np.interp(
+                tau[after][inside], sim.tau_s, sim.d_wheel[:, c.component]
+            )
+    return np.asarray(d_omega.reshape(-1, k_sub).mean(axis=1), dtype=np.float64)
+
+
+def _native_wheel_change(c: FlightChannel, d_mean: FloatArray, rng: np.random.Generator) -> FloatArray:
+    """ΔΩ in the channel's native unit; tachometer counts regenerated from the cumulative pulse phase."""
+    if c.tachometer is None:
+        return np.asarray(d_mean / c.to_si, dtype=np.float64)
+    ppr = c.tachometer.pulses_per_rev
+    d_phase = np.cumsum(d_mean * c.tachometer.gate_s) * ppr / (2.0 * math.pi)
+    phi0 = rng.uniform()
+    n_new = np.floor(phi0 + d_phase)
+    n_prev = np.concatenate([[math.floor(phi0)], n_new[:-1]])
+    step = 1.0 if c.unit == "counts" else c.tachometer.quantum_rad_s / c.to_si
+    return np.asarray((n_new - n_prev) * step, dtype=np.float64)
 
 
 def inject_strikes(
@@ -190,25 +303,14 @@ def inject_strikes(
     flight = spacecraft.flight
     out = samples.copy()
     t_all = out["time"].to_numpy().astype("datetime64[ns]").astype(np.int64)
-    mnem = out["mnemonic"].astype(str).to_numpy()
     values = out["value"].to_numpy(np.float64).copy()
     j_inv = np.linalg.inv(spacecraft.inertia_kgm2)
     js_g = spacecraft.wheel_axes * spacecraft.wheel_spin_inertias_kgm2[None, :]
     wheel_pinv = np.linalg.pinv(js_g)  # minimum-norm distribution
     rng = np.random.default_rng(seed)
     horizon_ns = int(20 * settle_s * NS)
-
     bn_at = _Attitude(samples, spacecraft)
-    rows_of = {str(name): np.flatnonzero(mnem == name) for name in np.unique(mnem)}
-    no_rows = np.empty(0, dtype=np.int64)
-
-    def rows(name: str, lo_ns: int, hi_ns: int | None = None) -> np.ndarray:
-        r = rows_of.get(name, no_rows)
-        keep = t_all[r] >= lo_ns
-        if hi_ns is not None:
-            keep &= t_all[r] < hi_ns
-        return r[keep]
-
+    rows = _Rows(t_all, out["mnemonic"].astype(str).to_numpy())
     for s in strikes:
         bn0 = bn_at(np.array([s.time_ns]))[0]
         dw0 = j_inv @ (bn0 @ s.dH_N_Nms)
@@ -224,85 +326,16 @@ def inject_strikes(
             # the minimum-norm one by a null-space vector (no momentum): keep it, so speeds are continuous.
             bn_end = bn_at(np.array([s.time_ns + int(sim.tau_s[-1] * NS)]))[0]
             null_offset = sim.d_wheel[-1] - wheel_pinv @ (bn_end @ s.dH_N_Nms)
-
-        def d_rate(tau: FloatArray, k: int, sim: StrikeResponse | None = sim, dw0: FloatArray = dw0) -> FloatArray:
-            if sim is None:
-                return np.asarray(dw0[k] * rate_response(tau, settle_s), dtype=np.float64)
-            inside = (tau >= 0) & (tau <= sim.tau_s[-1])
-            return np.where(inside, np.interp(tau, sim.tau_s, sim.d_omega_B[:, k]), 0.0)
-
-        def d_angle(tau: FloatArray, sim: StrikeResponse | None = sim, dw0: FloatArray = dw0) -> FloatArray:
-            if sim is None:
-                return np.asarray(dw0[None, :] * angle_response(tau, settle_s)[:, None], dtype=np.float64)
-            inside = ((tau >= 0) & (tau <= sim.tau_s[-1]))[:, None]
-            cols = [np.interp(tau, sim.tau_s, sim.d_theta_B[:, k]) for k in range(3)]
-            return np.asarray(np.where(inside, np.column_stack(cols), 0.0), dtype=np.float64)
-
-        # Body rates (gyro channels).
-        for c in flight.of("body_rate"):
+        tr = _Transient(sim, dw0, settle_s)
+        for c in flight.of("body_rate"):  # gyro channels
             sel = rows(c.mnemonic, s.time_ns, s.time_ns + horizon_ns)
-            tau = (t_all[sel] - s.time_ns) / NS
-            values[sel] += d_rate(tau, c.component) / c.to_si
-        # Attitude: q_BN of the perturbed body = δq(δθ) ⊗ q_BN, δθ in body axes.
-        qch = flight.of("quaternion")
-        sel0 = rows(qch[0].mnemonic, s.time_ns, s.time_ns + horizon_ns)
-        if sel0.size:
-            t_q = t_all[sel0]
-            idx = [rows_of.get(c.mnemonic, no_rows) for c in qch]
-            q_rows = []
-            for ix in idx:
-                pos = np.searchsorted(t_all[ix], t_q)
-                pos = np.clip(pos, 0, ix.size - 1)
-                q_rows.append(ix[pos])
-            rows_arr = np.column_stack(q_rows)
-            ok = np.all(t_all[rows_arr] == t_q[:, None], axis=1)
-            rows_arr = rows_arr[ok]
-            tau = (t_q[ok] - s.time_ns) / NS
-            dth = d_angle(tau)
-            half = 0.5 * np.linalg.norm(dth, axis=1)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                axis = np.where(half[:, None] > 0, dth / (2 * half[:, None]), 0.0)
-            dq = np.column_stack([np.cos(half), axis * np.sin(half)[:, None]])
-            q = values[rows_arr]
-            q_new = _quat_multiply(q, dq)  # q_BN ⊗ δq: δθ about body axes
-            flip = (q_new[:, 0] < 0) & (q[:, 0] >= 0)  # keep the archive's q0 >= 0 convention
-            values[rows_arr] = q_new * np.where(flip, -1.0, 1.0)[:, None]
-        # Wheels: Σ J_s ΔΩ ĝ = [BN(t)] ΔH_N − J Δω(t), from the strike on (ᴺH conserved after it).
-        for c in flight.of("wheel_speed"):
+            values[sel] += tr.rate((t_all[sel] - s.time_ns) / NS, c.component) / c.to_si
+        _add_attitude_error(values, rows, flight.of("quaternion"), s, horizon_ns, tr)
+        for c in flight.of("wheel_speed"):  # from the strike on (ᴺH conserved after it)
             sel = rows(c.mnemonic, s.time_ns - int(2 * NS))
             if sel.size == 0:
                 continue
-            t_w = t_all[sel]
-            gate = c.tachometer.gate_s if c.tachometer is not None else 0.0
-            # Gate mean of ΔΩ over [t − gate, t] by sub-sampling the gate (10 points).
-            k_sub = 10 if gate > 0 else 1
-            offs = np.linspace(-gate, 0.0, k_sub) if gate > 0 else np.zeros(1)
-            t_sub = (t_w[:, None] + (offs * NS).astype(np.int64)[None, :]).ravel()
-            tau = (t_sub - s.time_ns) / NS
-            after = tau >= 0
-            d_omega = np.zeros(t_sub.size)
-            if after.any():
-                bn = bn_at(t_sub[after])
-                h_b = np.einsum("nij,j->ni", bn, s.dH_N_Nms)
-                if sim is None:
-                    h_b -= (spacecraft.inertia_kgm2 @ dw0)[None, :] * rate_response(tau[after], settle_s)[:, None]
-                d_omega[after] = (h_b @ wheel_pinv.T)[:, c.component] + null_offset[c.component]
-                if sim is not None:  # the simulated transient, then ᴺH conserved by the wheels
-                    inside = tau[after] <= sim.tau_s[-1]
-                    k = c.component
-                    d_omega[np.flatnonzero(after)[inside]] = np.interp(tau[after][inside], sim.tau_s, sim.d_wheel[:, k])
-            d_mean = d_omega.reshape(-1, k_sub).mean(axis=1)
-            if c.tachometer is not None:
-                # Regenerate counts from the cumulative pulse phase (Harris §3.5: tach counts regenerated).
-                ppr = c.tachometer.pulses_per_rev
-                d_phase = np.cumsum(d_mean * c.tachometer.gate_s) * ppr / (2.0 * math.pi)
-                phi0 = rng.uniform()
-                n_new = np.floor(phi0 + d_phase)
-                n_prev = np.concatenate([[math.floor(phi0)], n_new[:-1]])
-                d_counts = n_new - n_prev
-                step = 1.0 if c.unit == "counts" else c.tachometer.quantum_rad_s / c.to_si
-                values[sel] += d_counts * step
-            else:
-                values[sel] += d_mean / c.to_si
+            d_mean = _wheel_change(c, t_all[sel], s, spacecraft, bn_at, tr, wheel_pinv, null_offset)
+            values[sel] += _native_wheel_change(c, d_mean, rng)
     out["value"] = values
     return out

@@ -12,11 +12,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from abrupt.model.frames import Ephemeris
 from abrupt.model.orbit import (
     R_EARTH_M,
     FiniteBurn,
@@ -27,6 +26,7 @@ from abrupt.model.orbit import (
     rtn_matrix,
 )
 from abrupt.model.orbit import propagate as propagate_orbit
+from abrupt.series.ephemeris import Ephemeris
 from abrupt.types import FloatArray
 
 #: Thesis default ΔV: 2 × 0.2 g × 12 km/s / 200 kg (Table 3.1, Eqs. 3.1-3.2).
@@ -224,7 +224,6 @@ def inject_impulse(
         delta[k_end:] = propagate_deviation(sec[k_end:], ref_tail, delta[k_end], force=ctx)
     pos = gcrf.position_m + delta[:, :3]
     vel = gcrf.velocity_mps + delta[:, 3:]
-    from dataclasses import replace
 
     out = replace(gcrf, position_m=pos, velocity_mps=vel, source=f"{ephemeris.source} + injected ΔV")
     return out.to_frame(ephemeris.frame)

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from abrupt.model.frames import Ephemeris
+from abrupt.series.ephemeris import Ephemeris
 from abrupt.model.orbit import R_EARTH_M, ForceContext, ForceModel, kepler_to_cartesian, propagate_with_stm
 
 DAY_S = 86400.0

@@ -15,12 +15,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import erfa
 import numpy as np
 import pandas as pd
-from scipy.interpolate import CubicHermiteSpline
 
 from abrupt.model.orbit import FiniteBurn, ForceContext, ForceModel, coe_to_rv, propagate
-from abrupt.model.range_reduction import RangeModel, StationSite, model_two_way_ranges
+from abrupt.model.range_reduction import RangeModel, StationSite, model_two_way_ranges, trajectory_interpolator
 from abrupt.model.stations import Station
 from abrupt.model.tracking_measurements import earth_rotation_matrices
 from abrupt.types import FloatArray
@@ -45,8 +45,6 @@ def site_from_geodetic(
     ecc: tuple[float, float, float],
     reference_epoch: np.datetime64,
 ) -> StationSite:
-    import erfa
-
     xyz = erfa.gd2gc(1, math.radians(lon_deg), math.radians(lat_deg), h_m)
     return StationSite(name, (float(xyz[0]), float(xyz[1]), float(xyz[2])), reference_epoch, velocity, ecc)
 
@@ -105,11 +103,6 @@ class SlrSimulation:
     range_bias_m: dict[str, float]
     scenario: SlrScenario
     force: ForceContext  # the truth's force model, Sun and Moon (ERFA) at the campaign's own dates
-
-
-def trajectory_interpolator(t_grid_s: FloatArray, states: FloatArray) -> CubicHermiteSpline:
-    """Cubic Hermite interpolation of positions from states (positions and velocities) on a grid."""
-    return CubicHermiteSpline(t_grid_s, states[:, :3], states[:, 3:6], axis=0)
 
 
 def simulate_slr(scenario: SlrScenario, *, seed: int = 0, grid_step_s: float = 20.0) -> SlrSimulation:

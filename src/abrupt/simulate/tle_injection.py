@@ -109,6 +109,8 @@ def score_injected(
     days of a burn) with the satellite-years they were counted over."""
     el = history.elements
     n_gaps = len(el) - 1
+    if len(events) and "kind" in events:  # campaign rows summarise maneuvers already in the frame
+        events = events.loc[events["kind"] != "maneuver_campaign"].reset_index(drop=True)
     counted = gaps_clear_of_junctions(n_gaps, junctions, window_sets)
     clear = burn_gaps_clear(n_gaps, junctions, window_sets)
     burn_days = np.array([b[0] for b in burns], dtype=float)

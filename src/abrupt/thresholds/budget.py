@@ -8,6 +8,7 @@ satellite-year; the conversions below turn it into the level a threshold fit nee
                                  (Bennett 2022 §2.5.1 step 4: 1/day at 10 Hz is 1/864000);
 ``per_block(block_s)``           probability that the maximum over a block exceeds it,
                                  1 − exp(−rate·block) (GEV block maxima, Coles 2001 §3);
+``per_block_first_order(block_s)`` rate·block, its first-order value (robust Gumbel fits);
 ``per_test(tests_per_day)``      probability per independent test when tests come at a known rate
                                  (a TLE gap, a tracking pass, a window of routine telemetry);
 ``bonferroni(n)``                the budget split evenly over ``n`` parallel statistics.
@@ -80,6 +81,10 @@ class FalseAlarmBudget:
         """Expected number of false alarms in ``duration_s`` seconds of event-free data."""
         return self.per_second * duration_s
 
+    def expected_in_days(self, days: float) -> float:
+        """Expected number of false alarms in ``days`` days of event-free data."""
+        return self.per_day * days
+
     # ------------------------------------------------------------------ test levels
     def per_sample(self, sample_rate_hz: float) -> float:
         """Per-sample exceedance probability at ``sample_rate_hz`` (Bennett 2022 §2.5.1 step 4)."""
@@ -94,6 +99,13 @@ class FalseAlarmBudget:
         # 1 - exp(-λT) written as the GEV fit always computed it (numpy's exp), so thresholds are
         # bit-identical to those published before the budget existed.
         return float(1.0 - np.exp(-self.per_day * block_s / SECONDS_PER_DAY))
+
+    def per_block_first_order(self, block_s: float) -> float:
+        """λT, the expected number of alarms in a block of ``block_s`` seconds: the per-block
+        probability to first order (robust block-maxima fits use it; :meth:`per_block` is exact)."""
+        if not block_s > 0:
+            raise ValueError(f"block_s must be positive, got {block_s}")
+        return self.per_day * block_s / SECONDS_PER_DAY
 
     def per_test(self, tests_per_day: float) -> float:
         """Probability per test when independent tests come at ``tests_per_day``."""

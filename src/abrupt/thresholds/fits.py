@@ -18,8 +18,8 @@ with the false-alarm rate it was set for. Supported fits of the event-free ("nul
                (:func:`robust_gaussian_threshold`).
 
 Every fit takes the false-alarm budget either as a :class:`~abrupt.thresholds.FalseAlarmBudget`
-(``budget=``, the one conversion to per-sample and per-block levels) or, for older callers, as
-``false_alarms_per_day`` or a per-sample ``p_fa``.
+(``budget=``, the one conversion to per-sample and per-block levels), as ``false_alarms_per_day``
+(read as a budget per day) or as a per-sample ``p_fa``.
 
 Probability per sample follows Bennett 2022 §2.5.1 step 4: one false alarm per day at 10 Hz is
 ``p_fa = 1 / 864000``. :func:`episode_rate` counts distinct exceedance episodes, which is what an
@@ -40,6 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, special, stats
 
 from abrupt.thresholds.budget import SECONDS_PER_DAY, FalseAlarmBudget
+from abrupt.thresholds.noise import robust_scale
 
 FitMethod = Literal["gaussian", "gamma", "kde", "empirical", "gpd", "gev"]
 FIT_METHODS: tuple[str, ...] = ("gaussian", "gamma", "kde", "empirical", "gpd", "gev")
@@ -302,8 +303,6 @@ def robust_gaussian_threshold(
     samples, so the median and MAD are those of the event-free statistic. ``z`` is the Gaussian upper
     ``p_fa/2`` point (two-sided) or ``p_fa`` point. ``p_fa`` is per sample.
     """
-    from abrupt.thresholds.noise import robust_scale
-
     x = np.asarray(statistic, dtype=np.float64).ravel()
     x = x[np.isfinite(x)]
     if x.size < 10:

@@ -8,8 +8,9 @@ quantiles does not: with Q(p) = μ − β ln(−ln p),
     β = (Q(0.75) − Q(0.25)) / (ln(−ln 0.25) − ln(−ln 0.75)),   μ = Q(0.5) + β ln(ln 2),
 
 which moves by less than one block-quantile step as long as fewer than a quarter of the blocks are
-contaminated. The threshold for a false-alarm rate r per day with blocks of B seconds is the Gumbel
-quantile at per-block exceedance p = r B / 86400 (one alarm at most per block).
+contaminated. The threshold for a false-alarm budget of r per day with blocks of B seconds is the
+Gumbel quantile at per-block exceedance p = r B / 86400 (one alarm at most per block;
+:meth:`~abrupt.thresholds.budget.FalseAlarmBudget.per_block_first_order`).
 """
 
 from __future__ import annotations
@@ -19,8 +20,8 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
+from abrupt.thresholds.budget import FalseAlarmBudget
 from abrupt.thresholds.fits import Threshold
-from abrupt.units import SECONDS_PER_DAY
 
 _LL25 = math.log(-math.log(0.25))
 _LL75 = math.log(-math.log(0.75))
@@ -40,14 +41,14 @@ def gumbel_quantile_fit(block_maxima: ArrayLike) -> tuple[float, float]:
 
 
 def robust_block_maxima_threshold(
-    block_maxima: ArrayLike, *, block_s: float, false_alarms_per_day: float, sample_rate_hz: float = float("nan")
+    block_maxima: ArrayLike, *, block_s: float, budget: FalseAlarmBudget, sample_rate_hz: float = float("nan")
 ) -> Threshold:
-    """Threshold at ``false_alarms_per_day`` from block maxima of ``block_s`` seconds (robust Gumbel fit)."""
-    if false_alarms_per_day <= 0 or block_s <= 0:
-        raise ValueError("false_alarms_per_day and block_s must be positive")
+    """Threshold for ``budget`` from block maxima of ``block_s`` seconds (robust Gumbel fit)."""
+    if block_s <= 0:
+        raise ValueError("block_s must be positive")
     x = np.asarray(block_maxima, dtype=np.float64)
     mu, beta = gumbel_quantile_fit(x)
-    p_block = min(false_alarms_per_day * block_s / SECONDS_PER_DAY, 0.5)
+    p_block = min(budget.per_block_first_order(block_s), 0.5)
     value = mu - beta * math.log(-math.log1p(-p_block))
     p_sample = p_block / (block_s * sample_rate_hz) if math.isfinite(sample_rate_hz) else float("nan")
     return Threshold(
@@ -55,6 +56,6 @@ def robust_block_maxima_threshold(
         p_fa=float(p_sample),
         method="gumbel-quantiles",
         n_samples=int(np.isfinite(x).sum()),
-        false_alarms_per_day=float(false_alarms_per_day),
+        false_alarms_per_day=float(budget.per_day),
         sample_rate_hz=float(sample_rate_hz),
     )

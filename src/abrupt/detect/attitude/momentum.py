@@ -23,7 +23,7 @@ the pre/post mean difference (Bennett 2022 §2.4.2.7).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
@@ -34,6 +34,7 @@ from abrupt.detect.attitude.change_detection import (
     pre_window_mean_std,
     sliding_statistic,
 )
+from abrupt.detect.attitude.steps import episode_peaks, locate_step_in_segment
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics, detector_names, get_detector
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc
 from abrupt.model.spacecraft import Spacecraft
@@ -61,7 +62,7 @@ class AttitudeDetectionConfig:
     detectors: tuple[str, ...] = ("glr",)
     windows: WindowConfig = field(default_factory=WindowConfig)
     glr_windows: WindowConfig = field(default_factory=lambda: WindowConfig(pre=1000, post=1000))
-    false_alarms_per_day: float = 1.0
+    budget: FalseAlarmBudget = field(default_factory=lambda: FalseAlarmBudget(1.0, "day"))
     threshold_method: str = "gev"
     null_samples: int = 10_000_000
     seed: int = 0
@@ -71,12 +72,14 @@ class AttitudeDetectionConfig:
             raise ValueError(f"give at least one detector; registered: {attitude_detector_names()}")
         for name in self.detectors:
             attitude_detector_class(name)  # raises with the list of registered detectors
-        if self.false_alarms_per_day <= 0:
-            raise ValueError("false_alarms_per_day must be positive")
 
-    @property
-    def budget(self) -> FalseAlarmBudget:
-        return FalseAlarmBudget.per_day_rate(self.false_alarms_per_day)
+    def hash_fields(self) -> dict[str, Any]:
+        """The settings as they enter a run's ``config_hash``: the budget as its rate per day, so that one
+        budget written per day or per week hashes the same."""
+        fields = asdict(self)
+        fields.pop("budget")
+        fields["false_alarms_per_day"] = self.budget.per_day
+        return fields
 
 
 def attitude_detector_names() -> tuple[str, ...]:
@@ -113,61 +116,6 @@ def _per_segment(segments: list[tuple[int, int]], n: int, fn: Callable[[int, int
     for a, b in segments:
         out[a:b] = fn(a, b)
     return out
-
-
-def _episodes(stat: FloatArray, threshold: float, merge: int) -> list[tuple[int, int]]:
-    above = np.flatnonzero(np.nan_to_num(stat, nan=-np.inf) > threshold)
-    if above.size == 0:
-        return []
-    breaks = np.flatnonzero(np.diff(above) > merge)
-    starts = np.concatenate([[above[0]], above[breaks + 1]])
-    ends = np.concatenate([above[breaks], [above[-1]]])
-    return [(int(a), int(b) + 1) for a, b in zip(starts, ends, strict=True)]
-
-
-def _window_mean(h: FloatArray, a: int, b: int) -> FloatArray:
-    return np.asarray(h[max(a, 0) : max(b, 0)].mean(axis=0), dtype=np.float64)
-
-
-def locate_step(
-    h_total: FloatArray, lo: int, hi: int, segment: tuple[int, int], win: WindowConfig, sigma: FloatArray
-) -> tuple[int, float, FloatArray]:
-    """Sample τ in [lo, hi) where total ᴺH steps, its projected noise σ and the step ΔH [N·m·s].
-
-    τ maximises the noise-weighted squared pre/post mean difference with windows of m = min(pre, post)
-    samples (both inside the segment); ΔH is then the mean difference over the detector's own windows
-    around τ, clipped to the segment. Total momentum is conserved through the control transient, so it
-    steps at the strike sample. ``sigma`` is the per-axis white noise of the segment [N·m·s].
-    """
-    s0, s1 = segment
-    m = max(2, min(win.pre, win.post))
-    lo = max(lo, s0 + m)
-    hi = min(hi, s1 - m)
-    x = h_total[s0:s1]
-    sigma = np.where(sigma > 0, sigma, 1.0)
-    if hi <= lo:
-        tau = int(np.clip((lo + hi) // 2, s0, s1 - 1))
-    else:
-        c = np.vstack([np.zeros((1, 3)), np.cumsum(x, axis=0)])
-        taus = np.arange(lo, hi) - s0
-        d = (c[taus + m] - c[taus]) / m - (c[taus] - c[taus - m]) / m
-        tau = s0 + int(taus[np.argmax(np.sum((d / sigma) ** 2, axis=1))])
-    d_h = _window_mean(h_total, tau, min(s1, tau + win.post)) - _window_mean(h_total, max(s0, tau - win.pre), tau)
-    mag = float(np.linalg.norm(d_h))
-    if mag > 0:
-        # Refine by maximum likelihood for a step of the estimated size along û: τ minimises the
-        # cumulative sum of (h·û − mid) over ±m, mid the midpoint of the two levels.
-        u = d_h / mag
-        r0, r1 = max(s0 + 1, tau - m), min(s1 - 1, tau + m)
-        proj = h_total[r0 - 1 : r1] @ u
-        mid = float(_window_mean(h_total, max(s0, tau - win.pre), tau) @ u) + mag / 2.0
-        csum = np.concatenate([[0.0], np.cumsum(proj - mid)])
-        tau = r0 - 1 + int(np.argmin(csum))
-        tau = int(np.clip(tau, s0 + 1, s1 - 1))
-        d_h = _window_mean(h_total, tau, min(s1, tau + win.post)) - _window_mean(h_total, max(s0, tau - win.pre), tau)
-        mag = float(np.linalg.norm(d_h))
-    sig = float(np.sqrt(np.sum((sigma * d_h / mag) ** 2))) if mag > 0 else float("nan")
-    return tau, sig, d_h
 
 
 def _max_over_axes(raw: FloatArray) -> FloatArray:
@@ -314,8 +262,7 @@ class MomentumChangeDetector(Detector[AttitudeSeries]):
         events: list[Event] = []
         taus: list[int] = []
         merged = 0
-        for a, b in _episodes(stat, thr.value, merge=max(1, win.span // 10)):
-            peak = a + int(np.nanargmax(stat[a:b]))
+        for a, b, peak in episode_peaks(stat, thr.value, merge=max(1, win.span // 10)):
             seg = next((sg for sg in tel.segments if sg[0] <= peak < sg[1]), (0, n))
             # The step is where total ᴺH (conserved through the control transient) changes most: search
             # the whole episode widened by the windows, since some statistics (CUSUM, Shiryaev) peak
@@ -324,7 +271,7 @@ class MomentumChangeDetector(Detector[AttitudeSeries]):
             hi = min(seg[1], b + win.post + win.guard)
             if seg not in segment_sigma:  # per-axis noise, computed once per segment
                 segment_sigma[seg] = robust_noise_sigma(h[seg[0] : seg[1]])
-            tau, sig, d_h = locate_step(h, lo, hi, seg, win, segment_sigma[seg])
+            tau, sig, d_h = locate_step_in_segment(h, lo, hi, seg, win, segment_sigma[seg])
             if any(abs(tau - t_prev) < win.post for t_prev in taus):
                 merged += 1  # same step seen by two episodes
                 continue

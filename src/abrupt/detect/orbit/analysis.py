@@ -21,8 +21,8 @@ from scipy import stats
 from abrupt.detect.orbit.ekf import FilterConfig, FilterRun, run_backward, run_forward
 from abrupt.detect.orbit.glr import glr_statistic_and_information
 from abrupt.detect.orbit.statistics import STATISTIC_NAMES, FusionResult, fuse, orbital_constant_statistics
-from abrupt.model.frames import Ephemeris
 from abrupt.model.orbit import ForceContext
+from abrupt.series.ephemeris import Ephemeris
 from abrupt.thresholds import FalseAlarmBudget
 from abrupt.types import FloatArray
 

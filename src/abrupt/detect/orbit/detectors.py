@@ -18,7 +18,7 @@ ch. 3) and differ in the statistic that raises events:
 Settings (constructor keywords): ``tuning`` ("auto": τ, q and measurement sigmas from the data with
 the full force model; "thesis": Table 3.1, two-body), overrides ``tau_s``, ``q_m2_s5``,
 ``sigma_pos_m``, ``sigma_vel_mps``, ``dynamics`` ("two-body", "j2".."j4", "field"),
-``gravity_degree``, ``null`` (an event-free :class:`~abrupt.model.frames.Ephemeris` of the same
+``gravity_degree``, ``null`` (an event-free :class:`~abrupt.series.ephemeris.Ephemeris` of the same
 satellite for thresholds; default: the arc itself with leave-out), ``confidence_z`` (standard errors
 added to a self-calibrated level), ``kind`` and ``nuisance`` (estimate drag and SRP scale factors and
 once-per-revolution empirical accelerations as filter states, with NRLMSIS drag tabulated along the
@@ -41,8 +41,8 @@ from abrupt.detect.orbit.ekf import FilterConfig, NuisanceConfig
 from abrupt.detect.orbit.events import find_events
 from abrupt.detect.orbit.tuning import auto_tune
 from abrupt.events import config_hash
-from abrupt.model.frames import Ephemeris
 from abrupt.model.orbit import ForceModel
+from abrupt.series.ephemeris import Ephemeris
 from abrupt.thresholds import FalseAlarmBudget, Threshold
 
 TUNINGS = ("auto", "thesis")

@@ -13,7 +13,7 @@ from abrupt.detect.orbit.analysis import OrbitDetectorConfig, analyse
 from abrupt.detect.orbit.calibration import calibrate_thresholds
 from abrupt.detect.orbit.ekf import FilterConfig, run_forward
 from abrupt.detect.orbit.kernels import propagate_state
-from abrupt.model.frames import Ephemeris
+from abrupt.series.ephemeris import Ephemeris
 from abrupt.thresholds.noise import robust_scale
 from abrupt.types import FloatArray
 

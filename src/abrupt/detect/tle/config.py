@@ -27,6 +27,7 @@ EXTRA_COLUMNS: tuple[str, ...] = (
     "burns_max",
     "z_u",
     "delta_u_m",
+    "burn_count",
 )
 
 # Sets a side needs between two accepted maneuvers. LEO campaigns (orbit raising, frozen-orbit
@@ -57,6 +58,7 @@ class TleDetectorConfig:
     min_side_sets: int = 3
     regime: str = "auto"
     campaign_days: float = 3.0
+    campaign_chain_days: float = 7.0  # maneuver_campaign events: detections chained this close
     campaign_min_side_sets: int | None = None  # None: by regime (CAMPAIGN_SIDE_SETS)
     time_search_sets_before: int = 3
     group_gain: tuple[float, float, float] = (1.0, 0.2, 0.2)
@@ -64,6 +66,12 @@ class TleDetectorConfig:
     drag_trend: str = "ndot"  # LEO a: "ndot" removes the sets' own stated decay (drag_trend_m)
     drag_median_sets: int = 5
     drag_min_decay_m_day: float = 2.0  # the drag trend only where a decays at least this fast
+    # the threshold per block of the history (cadence, drag and noise change over a mission):
+    # "raise" (default) keeps the whole-history threshold where a block's own is lower, "follow"
+    # uses each block's own, "none" one threshold for the whole history
+    threshold_follow: str = "raise"
+    threshold_block_days: float = 365.25
+    threshold_reach_days: float = 182.625
 
     def __post_init__(self) -> None:
         if self.window_sets < 2:
@@ -76,6 +84,10 @@ class TleDetectorConfig:
             raise ValueError("group_gain must be three finite non-negative numbers")
         if self.drag_trend not in ("none", "ndot"):
             raise ValueError(f"drag_trend must be none or ndot, got {self.drag_trend!r}")
+        if self.threshold_follow not in ("none", "raise", "follow"):
+            raise ValueError(f"threshold_follow must be none, raise or follow, got {self.threshold_follow!r}")
+        if not (self.threshold_block_days > 0 and self.threshold_reach_days >= 0):
+            raise ValueError("threshold_block_days must be positive and threshold_reach_days non-negative")
         if self.drag_median_sets < 1:
             raise ValueError("drag_median_sets must be >= 1")
         if not (self.drag_min_decay_m_day > 0 and math.isfinite(self.drag_min_decay_m_day)):

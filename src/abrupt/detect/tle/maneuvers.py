@@ -72,14 +72,16 @@ from scipy import stats
 
 from abrupt.detect.base import DetectionResult, Diagnostics
 from abrupt.detect.tle.burns import campaign_cadence_s, characterise, label_campaigns
+from abrupt.detect.tle.campaigns import find_campaigns
 from abrupt.detect.tle.config import CAMPAIGN_SIDE_SETS, EXTRA_COLUMNS, TleDetectorConfig
 from abrupt.detect.tle.elements import circular_speed_mps, orbit_regime
-from abrupt.detect.tle.noise import null_threshold, robust_group_weight
+from abrupt.detect.tle.noise import block_thresholds, null_threshold, robust_group_weight
 from abrupt.detect.tle.segmentation import segment
 from abrupt.detect.tle.steps import (
     StepModel,
     StepSeries,
     component_weights,
+    detectable_by_year,
     empty_steps,
     fill_gap,
     noise_summary,
@@ -162,6 +164,7 @@ def detect_mean_elements(
     p_fa = min(0.5, cfg.budget.per_year / gaps_per_year)  # per gap: the yearly budget over the gaps a year
     model, first = first_pass(history, cfg, regime)
     threshold, method = operating_threshold(cfg, first, p_fa)
+    first.scale = block_scale(cfg, first, model.t, threshold)
     steps, accepted, _ = segment(history, cfg, threshold, model=model, first=first)
     stat = steps.statistic
     candidates = np.sort(np.asarray(accepted, dtype=np.int64))
@@ -173,24 +176,25 @@ def detect_mean_elements(
     lag_s = tle_lag_s(run, detected)
     for g in span_of:
         span_of[g][0] = min(span_of[g][0], float(model.t[g]) - lag_s)
+    base: dict[str, Any] = {"spacecraft": name, "detector": detector_name, "threshold": threshold}
+    base |= {"false_alarms_per_day": fa_per_day}
+    base |= {"run_id": run_id, "config_hash": cfg_hash}
+    fields_of = dict(zip((it.gap for it in kept), event_fields(run, kept, span_of, detected, epoch0), strict=True))
     events = [
         Event(
-            spacecraft=name,
             kind="maneuver",
-            detector=detector_name,
             time_utc=(epoch0 + pd.Timedelta(seconds=float(t_m))).isoformat(),
             statistic=float(stat[g]),
-            threshold=threshold,
-            false_alarms_per_day=fa_per_day,
-            run_id=run_id,
-            config_hash=cfg_hash,
-            **fields,
+            **base,
+            **fields_of[g],
         )
-        for (g, t_m, _, _), fields in zip(kept, event_fields(run, kept, span_of, detected, epoch0), strict=True)
+        for g, t_m, _, _ in kept
     ]
+    events += campaign_events(run, detected, span_of, fields_of, epoch0, base)
     frame = events_frame(events, extra_columns=EXTRA_COLUMNS) if events else empty_frame(EXTRA_COLUMNS)
     a_med = float(np.median(el["a_m"]))
     noise = noise_summary(steps, model, threshold, a_med, gaps_per_year)
+    noise["detectable_by_year"] = detectable_by_year(steps, model, threshold, a_med, epoch0)
     fitted = Threshold(threshold, p_fa, method, n_gaps, fa_per_day)
     diag = _diagnostics(
         detector_name, 0.5 * (steps.t_before_s + steps.t_after_s), stat, fitted, epoch0_np, noise, regime
@@ -248,6 +252,29 @@ def operating_threshold(cfg: TleDetectorConfig, first: StepSeries, p_fa: float) 
     return threshold, cfg.threshold_method
 
 
+def block_scale(
+    cfg: TleDetectorConfig, first: StepSeries, t_s: NDArray[np.float64], threshold: float
+) -> NDArray[np.float64] | None:
+    """Per-gap factor ``threshold / block threshold`` (:func:`block_thresholds`) that lets one cut on
+    the statistic hold the threshold of each block of the history; None with a fixed threshold or
+    ``threshold_follow="none"``. ``"raise"`` never lowers a block below the whole-history threshold."""
+    if cfg.threshold is not None or cfg.threshold_follow == "none" or not math.isfinite(threshold):
+        return None
+    local, _ = block_thresholds(
+        first.statistic,
+        t_s,
+        cfg.window_sets + 2,
+        cfg.budget.per_year,
+        cfg.threshold_method,
+        cfg.threshold_block_days,
+        cfg.threshold_reach_days,
+    )
+    local = np.maximum(local, cfg.min_statistic)
+    if cfg.threshold_follow == "raise":
+        local = np.maximum(local, threshold)
+    return np.asarray(threshold / local, dtype=float)
+
+
 def time_candidates(run: StepRun, candidates: NDArray[np.int64], all_candidates: bool) -> list[Candidate]:
     """The burn time of every candidate gap (above the threshold unless ``all_candidates``)."""
     cfg, steps, model, history = run.cfg, run.steps, run.model, run.history
@@ -275,6 +302,71 @@ def time_candidates(run: StepRun, candidates: NDArray[np.int64], all_candidates:
         # the step when that set was still fitted to pre-burn tracking) to the set after the step
         timed.append(Candidate(int(g), t_m, refined, min(float(t_m), float(model.t[int(g)]))))
     return timed
+
+
+DV_KEYS = ("dv_r_mps", "dv_t_mps", "dv_n_mps")
+
+
+def campaign_events(
+    run: StepRun,
+    detected: list[Candidate],
+    span_of: dict[int, list[float]],
+    fields_of: dict[int, dict[str, Any]],
+    epoch0: pd.Timestamp,
+    base: dict[str, Any],
+) -> list[Event]:
+    """One ``maneuver_campaign`` event per chain of detections (:mod:`abrupt.detect.tle.campaigns`): at
+    its first member's time, over the members' joint interval, with the burn count, the net in-track
+    ΔV across the campaign and the members' summed cross-track ΔV. The members stay events of their own
+    (kind ``maneuver``); scoring one maneuver per event leaves the campaign rows out.
+
+    Small detections beside a campaign (below a fiftieth of its largest burn, within the reach of the
+    step test's windows) are kept as maneuvers: dropping them as the campaign's leak into its
+    neighbours' tests was measured to lose real trim burns on the shared histories (docs/tle.md)."""
+    if len(detected) < 2:
+        return []
+    el = run.history.elements
+    gaps = np.asarray([it.gap for it in detected], dtype=np.int64)
+    dv = np.asarray([math.hypot(*(float(fields_of[it.gap][k]) for k in DV_KEYS)) for it in detected])
+    times = np.asarray([it.time_s for it in detected], dtype=float)
+    window = run.cfg.window_sets
+    camps = find_campaigns(run.model, gaps, times, dv, run.cfg.campaign_chain_days, run.threshold, window)
+    out: list[Event] = []
+    for c in camps:
+        mem = [detected[k] for k in c.members]
+        t_lo = min(span_of[it.gap][0] for it in mem)
+        t_hi = max(span_of[it.gap][1] for it in mem)
+        dv_n = float(sum(float(fields_of[it.gap]["dv_n_mps"]) for it in mem))
+        dv_t = c.dv_t_mps if math.isfinite(c.dv_t_mps) else float(sum(fields_of[it.gap]["dv_t_mps"] for it in mem))
+        first = fields_of[mem[0].gap]["extra"]
+        extra = {
+            "maneuver_type": "campaign",
+            "regime": run.regime,
+            "delta_a_m": c.delta_a_m,
+            "elset_epoch_before_utc": str(el["epoch_utc"].iloc[c.first_gap]),
+            "elset_epoch_after_utc": str(el["epoch_utc"].iloc[c.last_gap + 1]),
+            "time_method": "first member",
+            "campaign_id": int(first["campaign_id"]),
+            "campaign_size": len(mem),
+            "interval_start_utc": (epoch0 + pd.Timedelta(seconds=float(t_lo))).isoformat(),
+            "interval_end_utc": (epoch0 + pd.Timedelta(seconds=float(t_hi))).isoformat(),
+            "burns_max": c.burn_count,
+            "burn_count": c.burn_count,
+        }
+        out.append(
+            Event(
+                kind="maneuver_campaign",
+                time_utc=(epoch0 + pd.Timedelta(seconds=float(mem[0].time_s))).isoformat(),
+                statistic=float(max(run.stat[it.gap] for it in mem)),
+                time_sigma_s=(t_hi - t_lo) / math.sqrt(12.0),
+                dv_t_mps=dv_t,
+                dv_n_mps=dv_n,
+                dv_mps=abs(dv_t) + dv_n,
+                extra=extra,
+                **base,
+            )
+        )
+    return out
 
 
 def tle_lag_s(run: StepRun, items: list[Candidate]) -> float:
@@ -422,6 +514,7 @@ def event_fields(
             "burns_max": int(burns_max),
             "z_u": float(steps.z_u[g]),
             "delta_u_m": float(steps.delta_u_m[g]),
+            "burn_count": 1,
         }
         out.append(
             {

@@ -4,6 +4,7 @@ per-group weights and the tail fit on the event-free gaps."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -11,7 +12,7 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy import special
 
-from abrupt.thresholds import fit_threshold
+from abrupt.thresholds import DAYS_PER_YEAR, fit_threshold
 from abrupt.thresholds.noise import MAD_TO_SIGMA, robust_scale
 
 
@@ -163,4 +164,63 @@ def null_threshold(stat: NDArray[np.float64], guard: int, p_fa: float, method: s
     try:
         return float(fit_threshold(null, p_fa=p_fa, method=method).value)  # type: ignore[arg-type]
     except ValueError:  # too few tail samples for the chosen fit: the plain sample quantile
+        return float(fit_threshold(null, p_fa=p_fa, method="empirical").value)
+
+
+def block_edges(t_s: NDArray[np.float64], block_days: float) -> NDArray[np.int64]:
+    """Gap indices where consecutive blocks of about ``block_days`` start (the first is 0, the last is
+    the number of gaps); a final block shorter than half ``block_days`` joins the one before."""
+    n_gaps = max(t_s.size - 1, 0)
+    if n_gaps == 0 or not block_days > 0:
+        return np.asarray([0, n_gaps], dtype=np.int64)
+    mid = 0.5 * (t_s[:-1] + t_s[1:])
+    span = float(mid[-1] - mid[0])
+    n_blocks = max(1, round(span / (block_days * 86400.0)))
+    cuts = np.searchsorted(mid, mid[0] + span * np.arange(1, n_blocks) / n_blocks)
+    return np.unique(np.concatenate(([0], cuts, [n_gaps]))).astype(np.int64)
+
+
+def block_thresholds(
+    stat: NDArray[np.float64],
+    t_s: NDArray[np.float64],
+    guard: int,
+    budget_per_year: float,
+    method: str,
+    block_days: float,
+    reach_days: float,
+) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """Per-gap threshold that follows the history's changes of cadence and noise: the history is cut
+    into blocks of about ``block_days``; each block's threshold is the tail fit (:func:`null_threshold`)
+    of the event-free statistic of the gaps within ``reach_days`` of the block, for the per-gap
+    probability the budget gives at the block's own cadence (budget per year / the block's gaps per
+    year), floored at the Bonferroni level of three Gaussian groups. Returns (threshold per gap,
+    block edges)."""
+    edges = block_edges(t_s, block_days)
+    n_gaps = max(t_s.size - 1, 0)
+    out = np.full(n_gaps, math.inf)
+    if n_gaps == 0:
+        return out, edges
+    mid = 0.5 * (t_s[:-1] + t_s[1:])
+    # event footprints from the whole history (a block's own peaks would be too few to find)
+    free = event_free_mask(stat, guard)
+    for lo, hi in itertools.pairwise(edges):
+        t_lo, t_hi = mid[lo] - reach_days * 86400.0, mid[hi - 1] + reach_days * 86400.0
+        sel = (mid >= t_lo) & (mid <= t_hi)
+        years = max(float(mid[sel][-1] - mid[sel][0]) / (DAYS_PER_YEAR * 86400.0), 1.0 / DAYS_PER_YEAR)
+        p_fa = min(0.5, budget_per_year / (int(sel.sum()) / years))
+        local = np.where(sel & free, stat, np.nan)
+        level = null_threshold_masked(local, p_fa, method)
+        out[lo:hi] = max(level, float(special.ndtri(1.0 - p_fa / 6.0)))
+    return out, edges
+
+
+def null_threshold_masked(stat: NDArray[np.float64], p_fa: float, method: str) -> float:
+    """Tail fit of the finite values of ``stat`` (already event-free) for ``p_fa``; with fewer than 50
+    values the largest of them (the caller's Gaussian floor then holds the budget)."""
+    null = stat[np.isfinite(stat)]
+    if null.size < 50:
+        return float(np.max(null)) if null.size else 0.0
+    try:
+        return float(fit_threshold(null, p_fa=p_fa, method=method).value)  # type: ignore[arg-type]
+    except ValueError:
         return float(fit_threshold(null, p_fa=p_fa, method="empirical").value)

@@ -38,6 +38,7 @@ def segment(
     cur.weights = first.weights
     cur.group_gain = first.group_gain
     cur.weight_u, cur.gain_u = first.weight_u, first.gain_u
+    cur.scale = first.scale
     names = ("delta_a_m", "delta_e", "delta_normal_rad", "z_a", "z_e", "z_n", "sigma_a_m", "sigma_n_rad")
     for name in (*names, "delta_u_m", "z_u"):
         setattr(cur, name, getattr(first, name).copy())

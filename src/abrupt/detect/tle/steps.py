@@ -10,6 +10,7 @@ from functools import lru_cache
 from typing import Any
 
 import numpy as np
+import pandas as pd
 from numpy.typing import NDArray
 from scipy import special, stats
 
@@ -48,6 +49,9 @@ class StepSeries:
     z_u: NDArray[np.float64] | None = None
     weight_u: float = 1.0
     gain_u: float = 0.0
+    # per-gap factor (global threshold / the gap's block threshold): one cut on S holds a threshold
+    # that follows the history's cadence and noise (:func:`abrupt.detect.tle.noise.block_thresholds`)
+    scale: NDArray[np.float64] | None = None
 
     @property
     def statistic(self) -> NDArray[np.float64]:
@@ -58,7 +62,8 @@ class StepSeries:
         parts = [ga * wa * self.z_a, ge * chi2_as_normal(we * self.z_e), gn * chi2_as_normal(wn * self.z_n)]
         if self.z_u is not None and self.gain_u > 0:
             parts.append(self.gain_u * self.weight_u * self.z_u)
-        return np.maximum.reduce(parts)
+        combined = np.maximum.reduce(parts)
+        return combined * self.scale if self.scale is not None else combined
 
 
 def theil_sen_slope(t: NDArray[np.float64], y: NDArray[np.float64]) -> float:
@@ -329,14 +334,10 @@ def noise_summary(
     ``Δv = v |Δn|``. These are 50 %-detection sizes (a step of that size is found half the time).
     """
     wa, _, wn = steps.weights
-    ga, _, gn = steps.group_gain
     sig_a = float(np.nanmedian(steps.sigma_a_m)) if steps.sigma_a_m is not None else float("nan")
     sig_n = float(np.nanmedian(steps.sigma_n_rad)) if steps.sigma_n_rad is not None else float("nan")
     v = circular_speed_mps(a_ref_m)
-    da_min = threshold * sig_a / (ga * wa) if ga * wa > 0 else math.inf
-    p_n = float(special.erfc(threshold / gn / math.sqrt(2.0))) if gn > 0 else 0.0
-    zn_min = math.sqrt(-2.0 * math.log(max(p_n, 1e-300)))
-    dn_min = zn_min * sig_n / wn if wn > 0 else math.inf
+    dv_t_min, dv_n_min = min_detectable_dv(steps, threshold, sig_a, sig_n, a_ref_m)
     return {
         "regime": model.regime,
         "group_weights": steps.weights,
@@ -350,6 +351,51 @@ def noise_summary(
         # 1σ of an in-track / cross-track ΔV at the median gap (the step noise through vis-viva)
         "dv_t_sigma_mps": v * sig_a / (wa * 2.0 * a_ref_m) if wa > 0 else math.inf,
         "dv_n_sigma_mps": v * sig_n / wn if wn > 0 else math.inf,
-        "min_detectable_dv_t_mps": v * da_min / (2.0 * a_ref_m),
-        "min_detectable_dv_n_mps": v * dn_min,
+        "min_detectable_dv_t_mps": dv_t_min,
+        "min_detectable_dv_n_mps": dv_n_min,
     }
+
+
+def min_detectable_dv(
+    steps: StepSeries, threshold: float, sig_a: float, sig_n: float, a_ref_m: float
+) -> tuple[float, float]:
+    """The in-track and cross-track ΔV (m/s) whose step reaches ``threshold`` with step noises ``sig_a``
+    (m) and ``sig_n`` (rad) (:func:`noise_summary`)."""
+    wa, _, wn = steps.weights
+    ga, _, gn = steps.group_gain
+    v = circular_speed_mps(a_ref_m)
+    da_min = threshold * sig_a / (ga * wa) if ga * wa > 0 else math.inf
+    p_n = float(special.erfc(threshold / gn / math.sqrt(2.0))) if gn > 0 else 0.0
+    zn_min = math.sqrt(-2.0 * math.log(max(p_n, 1e-300)))
+    dn_min = zn_min * sig_n / wn if wn > 0 else math.inf
+    return v * da_min / (2.0 * a_ref_m), v * dn_min
+
+
+def detectable_by_year(
+    steps: StepSeries, model: StepModel, threshold: float, a_ref_m: float, epoch0: Any
+) -> list[dict[str, Any]]:
+    """Per calendar year of the history: the smallest detectable in-track and cross-track ΔV (m/s, the
+    50 %-detection sizes of :func:`noise_summary`) from that year's median step noise and its own
+    threshold (the block threshold where it follows the history: ``threshold / scale``), the gaps
+    tested and the threshold."""
+    if steps.sigma_a_m is None or steps.sigma_n_rad is None or steps.t_before_s.size == 0:
+        return []
+    mid_s = 0.5 * (steps.t_before_s + steps.t_after_s)
+    years = (pd.Timestamp(epoch0) + pd.to_timedelta(mid_s, unit="s")).year.to_numpy()
+    local_t = threshold / steps.scale if steps.scale is not None else np.full(mid_s.size, threshold)
+    out: list[dict[str, Any]] = []
+    for year in np.unique(years):
+        sel = years == year
+        t_year = float(np.median(local_t[sel]))
+        sig_a, sig_n = float(np.nanmedian(steps.sigma_a_m[sel])), float(np.nanmedian(steps.sigma_n_rad[sel]))
+        dv_t, dv_n = min_detectable_dv(steps, t_year, sig_a, sig_n, a_ref_m)
+        out.append(
+            {
+                "year": int(year),
+                "gaps": int(sel.sum()),
+                "threshold": t_year,
+                "min_detectable_dv_t_mps": dv_t,
+                "min_detectable_dv_n_mps": dv_n,
+            }
+        )
+    return out

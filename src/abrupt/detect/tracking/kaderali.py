@@ -28,11 +28,13 @@ from numpy.typing import NDArray
 from scipy.optimize import curve_fit
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
+from abrupt.detect.tracking.glrt import DEFAULT_BUDGET, GlrtConfig, maneuver_search
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc
 from abrupt.model.orbit import MU_KADERALI_M3_S2, ForceContext, ForceModel, propagate_with_stm
+from abrupt.model.orbit.batch_fit import scaled_force
 from abrupt.model.tracking_measurements import TrackingArrays, wrap_angle
 from abrupt.series.tracking import TrackingSeries
-from abrupt.thresholds import FalseAlarmBudget, Threshold, chi2_threshold
+from abrupt.thresholds import FalseAlarmBudget, Threshold, chi2_threshold, fit_threshold
 
 # Thesis Table 3.1 (spec Table 6.1): Ψ lower bound, q_r (km²), q_v (km²/s²)
 THESIS_Q_TABLE_KM: tuple[tuple[float, float, float], ...] = (
@@ -490,7 +492,7 @@ def calibrate_psi_threshold(
     *,
     t0_s: float = 0.0,
     config: KaderaliConfig | None = None,
-    false_alarms_per_day: float = 0.1,
+    budget: FalseAlarmBudget = DEFAULT_BUDGET,
     n_runs: int = 8,
     seed: int = 0,
 ) -> tuple[float, NDArray[np.float64]]:
@@ -499,7 +501,7 @@ def calibrate_psi_threshold(
     The orbit from ``x0`` (with the configured forces and constant acceleration) is sampled at the data's
     epochs, stations and measurement types; noise with the station sigmas is added; the filter runs
     ``n_runs`` times and a generalised-Pareto tail (``abrupt.thresholds.fit_threshold``, method ``gpd``) of
-    the pooled Ψ gives the value exceeded ``false_alarms_per_day`` times per day. Returns the threshold and
+    the pooled Ψ gives the value exceeded at the false-alarm ``budget``. Returns the threshold and
     the pooled null Ψ (for Q-Q checks). Falls back to the empirical quantile when the tail is too short.
     """
     cfg = config or KaderaliConfig()
@@ -522,7 +524,7 @@ def calibrate_psi_threshold(
         simulated.y = noisy
         pooled.append(run_kaderali_filter(simulated, x0, t0_s=t0_s, config=cfg).psi)
     psi = np.concatenate(pooled)
-    return simulated_null_threshold(psi, n_runs, data, FalseAlarmBudget.per_day_rate(false_alarms_per_day)).value, psi
+    return simulated_null_threshold(psi, n_runs, data, budget).value, psi
 
 
 def simulated_null_threshold(
@@ -532,8 +534,6 @@ def simulated_null_threshold(
 
     The rate of tests is the number of filter updates per run over the arc's length.
     """
-    from abrupt.thresholds import fit_threshold
-
     arc_s = float(np.ptp(data.t_s)) if len(data) > 1 else 1.0
     rate_hz = max(psi.size / n_runs - 1, 1) / max(arc_s, 1.0)
     try:
@@ -589,8 +589,6 @@ class KaderaliManeuverDetector(Detector[TrackingSeries]):
     def filter_config(
         self, series: TrackingSeries, accel_mps2: NDArray[np.float64], scales: dict[str, float] | None = None
     ) -> KaderaliConfig:
-        from abrupt.detect.tracking.glrt import scaled_force
-
         period = series.orbit_period_s()
         return KaderaliConfig(
             psi_threshold=self.psi_threshold,
@@ -604,11 +602,8 @@ class KaderaliManeuverDetector(Detector[TrackingSeries]):
     def detect(self, series: TrackingSeries, budget: FalseAlarmBudget) -> DetectionResult:
         if len(series) == 0:
             return DetectionResult.empty(warnings=("no tracking measurements",))
-        from abrupt.detect.tracking.glrt import GlrtConfig
-
         if self.start == "maneuver_fit":
-            glrt = GlrtConfig(false_alarms_per_day=budget.per_day, max_maneuvers=self.max_maneuvers)
-            _, fit, _ = series.maneuver_fit(glrt)
+            _, fit, _ = maneuver_search(series, GlrtConfig(budget=budget, max_maneuvers=self.max_maneuvers))
         else:
             fit = series.orbit_fit()
         data = series.bias_corrected()
@@ -622,7 +617,7 @@ class KaderaliManeuverDetector(Detector[TrackingSeries]):
             thr = chi2_threshold(m, budget=budget, sample_rate_hz=rate_hz)
         else:
             psi_null, _ = calibrate_psi_threshold(
-                data, fit.x0, config=kcfg, false_alarms_per_day=budget.per_day, n_runs=self.n_null_runs, seed=self.seed
+                data, fit.x0, config=kcfg, budget=budget, n_runs=self.n_null_runs, seed=self.seed
             )
             thr = Threshold(psi_null, float("nan"), "gpd (simulated null)", 0, budget.per_day)
         cfg_hash = config_hash({"detector": self.name, **self.config(), "budget": str(budget)})

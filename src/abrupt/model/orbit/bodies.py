@@ -12,9 +12,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import erfa
 import numpy as np
+from astropy.time import Time
 
 from abrupt.model.orbit.constants import AU_M
+from abrupt.model.timescales import offline_astropy
 from abrupt.types import FloatArray
 
 
@@ -30,10 +33,8 @@ class BodyTable:
 
 def tt_julian_dates(times_utc: np.ndarray) -> tuple[FloatArray, FloatArray]:
     """Two-part TT Julian dates of UTC ``datetime64`` times (astropy leap-second table, offline)."""
-    from abrupt.model.timescales import offline_astropy
 
     offline_astropy()
-    from astropy.time import Time
 
     t = Time(np.asarray(times_utc, dtype="datetime64[ns]"), scale="utc", format="datetime64").tt
     return np.asarray(t.jd1, dtype=np.float64), np.asarray(t.jd2, dtype=np.float64)
@@ -41,7 +42,6 @@ def tt_julian_dates(times_utc: np.ndarray) -> tuple[FloatArray, FloatArray]:
 
 def sun_moon_gcrf(times_utc: np.ndarray) -> tuple[FloatArray, FloatArray]:
     """Geocentric Sun and Moon positions (m, GCRF), each (n, 3), at UTC ``datetime64`` times."""
-    import erfa
 
     jd1, jd2 = tt_julian_dates(np.atleast_1d(times_utc))
     pvh, _ = erfa.epv00(jd1, jd2)

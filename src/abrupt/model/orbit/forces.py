@@ -37,7 +37,12 @@ from typing import Any
 
 import numba as nb
 import numpy as np
+import pymsis
+from astropy import units as u
+from astropy.coordinates import EarthLocation
+from scipy.interpolate import CubicSpline
 
+from abrupt.model import atmosphere
 from abrupt.model.orbit.bodies import body_table
 from abrupt.model.orbit.constants import (
     AU_M,
@@ -549,7 +554,6 @@ def gravity_gradient(r: FloatArray, mu: float, with_j2: bool) -> FloatArray:
 def msis_density(t_s: float, r: FloatArray, context: ForceContext) -> float:
     """NRLMSIS 2.1 total mass density (kg/m³) via ``pymsis`` with the model's explicit space-weather
     indices, at geodetic-free geocentric latitude and the longitude from the Earth rotation angle."""
-    import pymsis
 
     model = context.model
     rn = float(np.linalg.norm(r))
@@ -597,11 +601,6 @@ def msis_density_table(
     offline space-weather table (:func:`abrupt.model.atmosphere.msis_density`). Dates the table does not
     cover use the model's explicit ``f107_sfu``/``f107a_sfu``/``ap``, counted in ``repairs`` (a
     :class:`~abrupt.errors.RepairLog`; nothing is downloaded)."""
-    from astropy import units as u
-    from astropy.coordinates import EarthLocation
-    from scipy.interpolate import CubicSpline
-
-    from abrupt.model.atmosphere import SpaceWeatherFallback, msis_density
 
     t = np.asarray(t_s, dtype=np.float64)
     pos = np.asarray(position_gcrf_m, dtype=np.float64)
@@ -627,8 +626,8 @@ def msis_density_table(
     loc = EarthLocation.from_geocentric(r_ef[:, 0], r_ef[:, 1], r_ef[:, 2], unit=u.m)
     geo = loc.to_geodetic("WGS84")
     times = epoch_utc + (grid * 1e9).astype("timedelta64[ns]")
-    fallback = SpaceWeatherFallback(model.f107_sfu, model.f107a_sfu, model.ap)
-    rho = msis_density(
+    fallback = atmosphere.SpaceWeatherFallback(model.f107_sfu, model.f107a_sfu, model.ap)
+    rho = atmosphere.msis_density(
         times,
         np.asarray(geo.lat.deg),
         np.asarray(geo.lon.deg),

@@ -17,9 +17,13 @@ import math
 import warnings
 from dataclasses import dataclass
 
+import erfa
 import numpy as np
+from astropy.time import Time
+from astropy.utils import iers
 
 from abrupt.model.orbit.constants import EARTH_ROTATION_PER_UT1_DAY
+from abrupt.model.timescales import offline_astropy
 from abrupt.types import FloatArray
 
 
@@ -61,10 +65,7 @@ class EarthOrientationTable:
 
 
 def _astropy_time(times_utc: np.ndarray):
-    from abrupt.model.timescales import offline_astropy
-
     offline_astropy()
-    from astropy.time import Time
 
     return Time(np.asarray(times_utc, dtype="datetime64[ns]"), scale="utc", format="datetime64")
 
@@ -73,8 +74,6 @@ def earth_orientation_table(
     epoch_utc: np.datetime64, t_from_s: float, t_to_s: float, step_s: float = 3600.0
 ) -> EarthOrientationTable:
     """GCRF→ITRF pieces on a grid covering [t_from_s, t_to_s] (s from ``epoch_utc``) plus one step."""
-    import erfa
-    from astropy.utils import iers
 
     epoch = np.asarray(epoch_utc, dtype="datetime64[ns]").reshape(-1)[0]
     n = max(2, math.ceil((t_to_s - t_from_s) / step_s) + 2)

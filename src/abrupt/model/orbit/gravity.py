@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from functools import lru_cache
 
+import brahe
 import numba as nb
 import numpy as np
 
@@ -36,7 +37,6 @@ def gravity_coefficients(model: str = "EGM2008", degree: int = 120) -> tuple[Flo
         raise ValueError(f"gravity model must be one of {GRAVITY_MODELS}, got {model!r}")
     if not 2 <= degree <= min(MAX_DEGREE[model], 150):
         raise ValueError(f"{model} degree must be 2..{min(MAX_DEGREE[model], 150)}, got {degree}")
-    import brahe
 
     kind = {
         "EGM2008": brahe.GravityModelType.EGM2008_120,

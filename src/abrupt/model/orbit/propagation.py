@@ -27,6 +27,8 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 from numpy.typing import NDArray
+from scipy.integrate import solve_ivp
+from scipy.integrate._ivp import dop853_coefficients as dop
 
 from abrupt.model.orbit.forces import (
     F_DRAG_SCALE,
@@ -154,7 +156,6 @@ def propagate(
 
 def solve_segment(rhs, ta: float, tb: float, state: FloatArray, rtol: float, atol: float, max_step: float = math.inf):
     """DOP853 over [ta, tb] with dense output; raises RuntimeError when the integrator fails."""
-    from scipy.integrate import solve_ivp
 
     sol = solve_ivp(rhs, (ta, tb), state, method="DOP853", rtol=rtol, atol=atol, dense_output=True, max_step=max_step)
     if not sol.success:
@@ -337,8 +338,6 @@ def _tableau(method: str) -> tuple[FloatArray, FloatArray, FloatArray]:
         a[3, 2] = 1.0
         return a, np.array([1.0, 2.0, 2.0, 1.0]) / 6.0, np.array([0.0, 0.5, 0.5, 1.0])
     if method == "rk8":
-        from scipy.integrate._ivp import dop853_coefficients as dop
-
         n = dop.N_STAGES
         return (
             np.ascontiguousarray(dop.A[:n, :n], dtype=np.float64),

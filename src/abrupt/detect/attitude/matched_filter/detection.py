@@ -24,6 +24,8 @@ from abrupt.detect.attitude.matched_filter.filters import (
     estimate_strike_size,
     matched_filter_bank_statistics,
 )
+from abrupt.detect.attitude.steps import episode_peaks
+from abrupt.events import Event
 from abrupt.model.rotations import attitude_error_vector, dcm_from_quaternion
 from abrupt.model.strike_response import KINDS, Kind, WaveletSet
 from abrupt.thresholds import (
@@ -178,53 +180,49 @@ def detect_matched_filter(
     with np.errstate(invalid="ignore"):
         ratio = np.abs(stat) / thr
     best = np.where(np.isfinite(ratio), ratio, -np.inf).max(axis=1)
-    above = np.flatnonzero(best > 1.0)
     rows: list[dict[str, Any]] = []
-    if above.size:
-        length = wavelets.length
-        breaks = np.flatnonzero(np.diff(above) > length) + 1
-        for group in np.split(above, breaks):
-            i = int(group[np.argmax(best[group])])
-            axis = int(np.argmax(np.where(np.isfinite(ratio[i]), ratio[i], -np.inf)))
-            seg = ch[i : i + length]
-            if baseline_samples > 0:
-                seg = seg - np.nanmean(ch[i - baseline_samples : i], axis=0)
-            dh_b = (
-                estimate_strike_size(kind, seg, wavelets, metric=size_metric)
-                if seg.shape[0] == length and np.all(np.isfinite(seg))
-                else np.full(3, np.nan)
-            )
-            qi = q[i]
-            dh_n = dcm_from_quaternion(qi).T @ dh_b if np.all(np.isfinite(qi)) else np.full(3, np.nan)
-            th = thresholds[axis]
-            rows.append(
-                {
-                    "index": i,
-                    "time": t[i],
-                    "time_sigma_s": _time_sigma_s(
-                        wavelets.wavelet(kind, axis),
-                        abs(stat[i, axis]) / wavelets.dH_Nms[axis],
-                        float(noise_sd[axis]),
-                        wavelets.sample_rate_hz,
-                    ),
-                    "detector": f"mf_{kind}",
-                    "axis": axis,
-                    "statistic": float(abs(stat[i, axis])),
-                    "threshold": float(th.value),
-                    "p_fa": float(th.p_fa),
-                    "false_alarms_per_day": float(th.false_alarms_per_day) * 3.0,
-                    "dH_B_x_Nms": dh_b[0],
-                    "dH_B_y_Nms": dh_b[1],
-                    "dH_B_z_Nms": dh_b[2],
-                    "dH_ls_B_x_Nms": float(stat[i, 0]),
-                    "dH_ls_B_y_Nms": float(stat[i, 1]),
-                    "dH_ls_B_z_Nms": float(stat[i, 2]),
-                    "dH_N_x_Nms": dh_n[0],
-                    "dH_N_y_Nms": dh_n[1],
-                    "dH_N_z_Nms": dh_n[2],
-                    "dH_Nms": float(np.linalg.norm(dh_b)),
-                }
-            )
+    length = wavelets.length
+    for _, _, i in episode_peaks(best, 1.0, length):
+        axis = int(np.argmax(np.where(np.isfinite(ratio[i]), ratio[i], -np.inf)))
+        seg = ch[i : i + length]
+        if baseline_samples > 0:
+            seg = seg - np.nanmean(ch[i - baseline_samples : i], axis=0)
+        dh_b = (
+            estimate_strike_size(kind, seg, wavelets, metric=size_metric)
+            if seg.shape[0] == length and np.all(np.isfinite(seg))
+            else np.full(3, np.nan)
+        )
+        qi = q[i]
+        dh_n = dcm_from_quaternion(qi).T @ dh_b if np.all(np.isfinite(qi)) else np.full(3, np.nan)
+        th = thresholds[axis]
+        rows.append(
+            {
+                "index": i,
+                "time": t[i],
+                "time_sigma_s": _time_sigma_s(
+                    wavelets.wavelet(kind, axis),
+                    abs(stat[i, axis]) / wavelets.dH_Nms[axis],
+                    float(noise_sd[axis]),
+                    wavelets.sample_rate_hz,
+                ),
+                "detector": f"mf_{kind}",
+                "axis": axis,
+                "statistic": float(abs(stat[i, axis])),
+                "threshold": float(th.value),
+                "p_fa": float(th.p_fa),
+                "false_alarms_per_day": float(th.false_alarms_per_day) * 3.0,
+                "dH_B_x_Nms": dh_b[0],
+                "dH_B_y_Nms": dh_b[1],
+                "dH_B_z_Nms": dh_b[2],
+                "dH_ls_B_x_Nms": float(stat[i, 0]),
+                "dH_ls_B_y_Nms": float(stat[i, 1]),
+                "dH_ls_B_z_Nms": float(stat[i, 2]),
+                "dH_N_x_Nms": dh_n[0],
+                "dH_N_y_Nms": dh_n[1],
+                "dH_N_z_Nms": dh_n[2],
+                "dH_Nms": float(np.linalg.norm(dh_b)),
+            }
+        )
     return pd.DataFrame(rows, columns=DETECTION_COLUMNS)
 
 
@@ -302,37 +300,33 @@ def detect_combined(
     filt = CombinedFilter.from_wavelets(wavelets, sd, use_wheels=use_wheels)
     stat, _ = filt.statistic(ch, baseline_samples=baseline_samples)
     score = np.where(np.isfinite(stat), stat, -np.inf)
-    above = np.flatnonzero(score > threshold.value)
     rows: list[dict[str, Any]] = []
-    if above.size:
-        breaks = np.flatnonzero(np.diff(above) > wavelets.length) + 1
-        for group in np.split(above, breaks):
-            peak = int(group[np.argmax(score[group])])
-            i, dh_b, sigma_samples = refine_strike(ch, peak, filt, baseline_samples)
-            dh_n = dcm_from_quaternion(q[i]).T @ dh_b if np.all(np.isfinite(q[i])) else np.full(3, np.nan)
-            rows.append(
-                {
-                    "index": i,
-                    "time": t[i],
-                    "time_sigma_s": sigma_samples / wavelets.sample_rate_hz,
-                    "detector": "mf_joint" if use_wheels else "mf_combined",
-                    "axis": int(np.argmax(np.abs(dh_b))),
-                    "statistic": float(stat[peak]),  # the alarm value, before time refinement
-                    "threshold": float(threshold.value),
-                    "p_fa": float(threshold.p_fa),
-                    "false_alarms_per_day": float(threshold.false_alarms_per_day),
-                    "dH_B_x_Nms": dh_b[0],
-                    "dH_B_y_Nms": dh_b[1],
-                    "dH_B_z_Nms": dh_b[2],
-                    "dH_ls_B_x_Nms": dh_b[0],
-                    "dH_ls_B_y_Nms": dh_b[1],
-                    "dH_ls_B_z_Nms": dh_b[2],
-                    "dH_N_x_Nms": dh_n[0],
-                    "dH_N_y_Nms": dh_n[1],
-                    "dH_N_z_Nms": dh_n[2],
-                    "dH_Nms": float(np.linalg.norm(dh_b)),
-                }
-            )
+    for _, _, peak in episode_peaks(score, threshold.value, wavelets.length):
+        i, dh_b, sigma_samples = refine_strike(ch, peak, filt, baseline_samples)
+        dh_n = dcm_from_quaternion(q[i]).T @ dh_b if np.all(np.isfinite(q[i])) else np.full(3, np.nan)
+        rows.append(
+            {
+                "index": i,
+                "time": t[i],
+                "time_sigma_s": sigma_samples / wavelets.sample_rate_hz,
+                "detector": "mf_joint" if use_wheels else "mf_combined",
+                "axis": int(np.argmax(np.abs(dh_b))),
+                "statistic": float(stat[peak]),  # the alarm value, before time refinement
+                "threshold": float(threshold.value),
+                "p_fa": float(threshold.p_fa),
+                "false_alarms_per_day": float(threshold.false_alarms_per_day),
+                "dH_B_x_Nms": dh_b[0],
+                "dH_B_y_Nms": dh_b[1],
+                "dH_B_z_Nms": dh_b[2],
+                "dH_ls_B_x_Nms": dh_b[0],
+                "dH_ls_B_y_Nms": dh_b[1],
+                "dH_ls_B_z_Nms": dh_b[2],
+                "dH_N_x_Nms": dh_n[0],
+                "dH_N_y_Nms": dh_n[1],
+                "dH_N_z_Nms": dh_n[2],
+                "dH_Nms": float(np.linalg.norm(dh_b)),
+            }
+        )
     return pd.DataFrame(rows, columns=DETECTION_COLUMNS)
 
 
@@ -348,8 +342,6 @@ def detections_to_events(
 
     ``time`` must be datetime64 UTC (or anything :func:`abrupt.events.format_time_utc` reads).
     """
-    from abrupt.events import Event
-
     events = []
     for row in detections.to_dict("records"):
         events.append(

@@ -46,6 +46,69 @@ def _dcm_bn(q: np.ndarray, out: np.ndarray) -> None:
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def _kinematics(x: np.ndarray, dx: np.ndarray) -> None:
+    """Eq. 2.1: quaternion kinematics q̇ = ½ q ⊗ (0, ω) into ``dx[:4]``."""
+    q0, q1, q2, q3 = x[0], x[1], x[2], x[3]
+    wx, wy, wz = x[4], x[5], x[6]
+    dx[0] = 0.5 * (-q1 * wx - q2 * wy - q3 * wz)
+    dx[1] = 0.5 * (q0 * wx - q3 * wy + q2 * wz)
+    dx[2] = 0.5 * (q3 * wx + q0 * wy - q1 * wz)
+    dx[3] = 0.5 * (-q2 * wx + q1 * wy + q0 * wz)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _momentum_and_wheel_torque(
+    x: np.ndarray,
+    u: np.ndarray,
+    inertia: np.ndarray,
+    axes: np.ndarray,
+    spin_inertia: np.ndarray,
+    extra_hx: float,
+    extra_hy: float,
+    extra_hz: float,
+) -> tuple[float, float, float, float, float, float]:
+    """Total body momentum H = J ω + (extra) + G Js Ω [N m s] and the wheel torque reaction G u [N m]."""
+    wx, wy, wz = x[4], x[5], x[6]
+    hx = inertia[0, 0] * wx + inertia[0, 1] * wy + inertia[0, 2] * wz + extra_hx
+    hy = inertia[1, 0] * wx + inertia[1, 1] * wy + inertia[1, 2] * wz + extra_hy
+    hz = inertia[2, 0] * wx + inertia[2, 1] * wy + inertia[2, 2] * wz + extra_hz
+    gux = 0.0
+    guy = 0.0
+    guz = 0.0
+    for i in range(axes.shape[1]):
+        hs = spin_inertia[i] * x[7 + i]
+        hx += axes[0, i] * hs
+        hy += axes[1, i] * hs
+        hz += axes[2, i] * hs
+        gux += axes[0, i] * u[i]
+        guy += axes[1, i] * u[i]
+        guz += axes[2, i] * u[i]
+    return hx, hy, hz, gux, guy, guz
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _rates(
+    rx: float,
+    ry: float,
+    rz: float,
+    u: np.ndarray,
+    m_inv: np.ndarray,
+    axes: np.ndarray,
+    spin_inertia: np.ndarray,
+    dx: np.ndarray,
+) -> None:
+    """ω̇ = M⁻¹ r and Ω̇ = u / Js − Gᵀ ω̇ into ``dx[4:]`` (M = J − G Js Gᵀ)."""
+    dwx = m_inv[0, 0] * rx + m_inv[0, 1] * ry + m_inv[0, 2] * rz
+    dwy = m_inv[1, 0] * rx + m_inv[1, 1] * ry + m_inv[1, 2] * rz
+    dwz = m_inv[2, 0] * rx + m_inv[2, 1] * ry + m_inv[2, 2] * rz
+    dx[4] = dwx
+    dx[5] = dwy
+    dx[6] = dwz
+    for i in range(axes.shape[1]):
+        dx[7 + i] = u[i] / spin_inertia[i] - (axes[0, i] * dwx + axes[1, i] * dwy + axes[2, i] * dwz)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def _derivative(
     x: np.ndarray,
     u: np.ndarray,
@@ -63,29 +126,10 @@ def _derivative(
     ``dh_n_rate`` is the strike torque expressed in N [N m] (ΔH_N / Δt); it is rotated into the body with
     the attitude of each RK4 stage, so the inertial momentum steps by exactly ΔH_N (Eqs. 2.8-2.9).
     """
-    n_w = axes.shape[1]
     q0, q1, q2, q3 = x[0], x[1], x[2], x[3]
     wx, wy, wz = x[4], x[5], x[6]
-    # Eq. 2.1: quaternion kinematics.
-    dx[0] = 0.5 * (-q1 * wx - q2 * wy - q3 * wz)
-    dx[1] = 0.5 * (q0 * wx - q3 * wy + q2 * wz)
-    dx[2] = 0.5 * (q3 * wx + q0 * wy - q1 * wz)
-    dx[3] = 0.5 * (-q2 * wx + q1 * wy + q0 * wz)
-    # Total body momentum H = J ω + G Js Ω and the wheel torque reaction G u.
-    hx = inertia[0, 0] * wx + inertia[0, 1] * wy + inertia[0, 2] * wz
-    hy = inertia[1, 0] * wx + inertia[1, 1] * wy + inertia[1, 2] * wz
-    hz = inertia[2, 0] * wx + inertia[2, 1] * wy + inertia[2, 2] * wz
-    gux = 0.0
-    guy = 0.0
-    guz = 0.0
-    for i in range(n_w):
-        hs = spin_inertia[i] * x[7 + i]
-        hx += axes[0, i] * hs
-        hy += axes[1, i] * hs
-        hz += axes[2, i] * hs
-        gux += axes[0, i] * u[i]
-        guy += axes[1, i] * u[i]
-        guz += axes[2, i] * u[i]
+    _kinematics(x, dx)
+    hx, hy, hz, gux, guy, guz = _momentum_and_wheel_torque(x, u, inertia, axes, spin_inertia, 0.0, 0.0, 0.0)
     rx = -(wy * hz - wz * hy) - gux
     ry = -(wz * hx - wx * hz) - guy
     rz = -(wx * hy - wy * hx) - guz
@@ -101,14 +145,7 @@ def _derivative(
                 ry += lb
             else:
                 rz += lb
-    dwx = m_inv[0, 0] * rx + m_inv[0, 1] * ry + m_inv[0, 2] * rz
-    dwy = m_inv[1, 0] * rx + m_inv[1, 1] * ry + m_inv[1, 2] * rz
-    dwz = m_inv[2, 0] * rx + m_inv[2, 1] * ry + m_inv[2, 2] * rz
-    dx[4] = dwx
-    dx[5] = dwy
-    dx[6] = dwz
-    for i in range(n_w):
-        dx[7 + i] = u[i] / spin_inertia[i] - (axes[0, i] * dwx + axes[1, i] * dwy + axes[2, i] * dwz)
+    _rates(rx, ry, rz, u, m_inv, axes, spin_inertia, dx)
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -288,38 +325,15 @@ def _tracking_derivative(
 
     H_B = J ω + G Js Ω + h_app;  (J − G Js Gᵀ) ω̇ = −ω × H_B − G u − ḣ_app + L_ext  (L_ext in B).
     """
-    n_w = axes.shape[1]
-    q0, q1, q2, q3 = x[0], x[1], x[2], x[3]
     wx, wy, wz = x[4], x[5], x[6]
-    dx[0] = 0.5 * (-q1 * wx - q2 * wy - q3 * wz)
-    dx[1] = 0.5 * (q0 * wx - q3 * wy + q2 * wz)
-    dx[2] = 0.5 * (q3 * wx + q0 * wy - q1 * wz)
-    dx[3] = 0.5 * (-q2 * wx + q1 * wy + q0 * wz)
-    hx = inertia[0, 0] * wx + inertia[0, 1] * wy + inertia[0, 2] * wz + app_h_b[0]
-    hy = inertia[1, 0] * wx + inertia[1, 1] * wy + inertia[1, 2] * wz + app_h_b[1]
-    hz = inertia[2, 0] * wx + inertia[2, 1] * wy + inertia[2, 2] * wz + app_h_b[2]
-    gux = 0.0
-    guy = 0.0
-    guz = 0.0
-    for i in range(n_w):
-        hs = spin_inertia[i] * x[7 + i]
-        hx += axes[0, i] * hs
-        hy += axes[1, i] * hs
-        hz += axes[2, i] * hs
-        gux += axes[0, i] * u[i]
-        guy += axes[1, i] * u[i]
-        guz += axes[2, i] * u[i]
+    _kinematics(x, dx)
+    hx, hy, hz, gux, guy, guz = _momentum_and_wheel_torque(
+        x, u, inertia, axes, spin_inertia, app_h_b[0], app_h_b[1], app_h_b[2]
+    )
     rx = -(wy * hz - wz * hy) - gux - app_hdot_b[0] + torque_b[0]
     ry = -(wz * hx - wx * hz) - guy - app_hdot_b[1] + torque_b[1]
     rz = -(wx * hy - wy * hx) - guz - app_hdot_b[2] + torque_b[2]
-    dwx = m_inv[0, 0] * rx + m_inv[0, 1] * ry + m_inv[0, 2] * rz
-    dwy = m_inv[1, 0] * rx + m_inv[1, 1] * ry + m_inv[1, 2] * rz
-    dwz = m_inv[2, 0] * rx + m_inv[2, 1] * ry + m_inv[2, 2] * rz
-    dx[4] = dwx
-    dx[5] = dwy
-    dx[6] = dwz
-    for i in range(n_w):
-        dx[7 + i] = u[i] / spin_inertia[i] - (axes[0, i] * dwx + axes[1, i] * dwy + axes[2, i] * dwz)
+    _rates(rx, ry, rz, u, m_inv, axes, spin_inertia, dx)
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -1,0 +1,205 @@
+"""The command tree: the root ``abrupt`` group, its verb groups, and where each sub-command lives.
+
+Every group is a :class:`LazyGroup`: it maps a command name to ``"module:attribute"`` and imports the
+module only when that command runs or its own help is shown, so ``abrupt --help`` and
+``abrupt detect --help`` read the one-line summaries from the modules' source instead of importing
+every capability (and numba, pandas, astropy behind them). Capability modules import these groups
+from :mod:`abrupt.cli.groups` and decorate their commands onto them as usual.
+"""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import importlib.util
+import logging
+from collections.abc import Mapping
+from functools import cache
+from typing import Any, TypeGuard
+
+import click
+from click.utils import make_default_short_help
+
+from abrupt import __version__
+
+#: Global options accepted anywhere on the command line (moved before the sub-command by ``main``).
+GLOBAL_FLAGS = frozenset({"-v", "-vv", "-vvv", "--verbose", "-q", "--quiet"})
+
+
+class State:
+    """Settings of the root group that every command reads (``--quiet``)."""
+
+    quiet = False
+
+
+#: Where the commands of each group live, as ``"module:attribute"`` (the attribute is the click command).
+TOP_COMMANDS = {
+    "catalog": "abrupt.cli.catalog_commands:catalog_group",
+    "demo": "abrupt.cli.attitude:demo",
+    "density": "abrupt.cli.density:density",
+    "detectors": "abrupt.cli.detectors:list_detectors",
+    "estimate": "abrupt.cli.mass:estimate",
+    "ingest": "abrupt.cli.flight:ingest_cmd",
+    "rates": "abrupt.cli.rates:rates",
+    "score": "abrupt.cli.tle:score",
+}
+SIMULATE_COMMANDS = {
+    "attitude": "abrupt.cli.attitude:simulate_attitude_cmd",
+    "docking": "abrupt.cli.mass:simulate_docking_cmd",
+    "orbit": "abrupt.cli.orbit:simulate_orbit_command",
+    "tracking": "abrupt.cli.tracking:simulate_tracking_command",
+}
+DETECT_COMMANDS = {
+    "attitude": "abrupt.cli.attitude:detect_attitude_cmd",
+    "fleet": "abrupt.cli.fleet:detect_fleet_cmd",
+    "laser": "abrupt.cli.laser:detect_laser_command",
+    "mass-change": "abrupt.cli.mass:detect_mass_change_cmd",
+    "orbit": "abrupt.cli.orbit:detect_orbit_command",
+    "tle": "abrupt.cli.tle:detect_tle",
+    "tle-batch": "abrupt.cli.fleet:detect_tle_batch_cmd",
+    "tracking": "abrupt.cli.tracking:detect_tracking_command",
+}
+INJECT_COMMANDS = {
+    "attitude": "abrupt.cli.flight:inject_attitude_cmd",
+    "orbit": "abrupt.cli.orbit:inject_orbit_command",
+    "tle": "abrupt.cli.tle:inject_tle",
+}
+REPORT_COMMANDS = {
+    "attitude": "abrupt.cli.attitude:report_attitude_cmd",
+    "orbit": "abrupt.cli.orbit:report_orbit_command",
+    "tle": "abrupt.cli.tle:report_tle",
+    "tracking": "abrupt.cli.tracking:report_tracking_command",
+}
+
+
+def load_command(target: str) -> click.Command:
+    """Import ``"module:attribute"`` and return the click command it names."""
+    module, _, attribute = target.partition(":")
+    command = getattr(importlib.import_module(module), attribute)
+    if not isinstance(command, click.Command):
+        raise TypeError(f"{target} is not a click command")
+    return command
+
+
+@cache
+def source_help(target: str) -> str | None:
+    """The help text of the command ``"module:attribute"`` read from its source without importing it:
+    the ``short_help=``/``help=`` of its decorator if written as a literal, else its docstring."""
+    module, _, attribute = target.partition(":")
+    spec = importlib.util.find_spec(module)
+    if spec is None or spec.origin is None:
+        return None
+    with open(spec.origin, encoding="utf-8") as fh:
+        tree = ast.parse(fh.read())
+    for node in tree.body:
+        if isinstance(node, ast.FunctionDef) and node.name == attribute:
+            for decorator in node.decorator_list:
+                if _is_command_decorator(decorator):
+                    for keyword in decorator.keywords:
+                        if keyword.arg in ("short_help", "help") and isinstance(keyword.value, ast.Constant):
+                            return str(keyword.value.value)
+            return ast.get_docstring(node)
+    return None
+
+
+def _is_command_decorator(node: ast.expr) -> TypeGuard[ast.Call]:
+    """``@group.command(...)``/``@group.group(...)`` (not ``@click.option(..., help=...)``)."""
+    if not isinstance(node, ast.Call) or not isinstance(node.func, ast.Attribute):
+        return False
+    return node.func.attr in ("command", "group")
+
+
+class LazyGroup(click.Group):
+    """A click group whose sub-commands are imported on first use (click's documented LazyGroup pattern)."""
+
+    def __init__(self, *args: Any, lazy_commands: Mapping[str, str] | None = None, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.lazy_commands = dict(lazy_commands or {})
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return sorted(set(super().list_commands(ctx)) | set(self.lazy_commands))
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        if cmd_name not in self.commands and cmd_name in self.lazy_commands:
+            command = load_command(self.lazy_commands[cmd_name])  # its decorator registers it here
+            self.commands.setdefault(cmd_name, command)
+        return super().get_command(ctx, cmd_name)
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        """The "Commands" section, with summaries of commands not yet imported read from their source."""
+        rows: list[tuple[str, click.Command | str]] = []
+        for name in self.list_commands(ctx):
+            if name in self.commands:
+                if not self.commands[name].hidden:
+                    rows.append((name, self.commands[name]))
+                continue
+            text = source_help(self.lazy_commands[name])
+            if text is None:  # not found in the source: import it after all
+                command = self.get_command(ctx, name)
+                if command is not None and not command.hidden:
+                    rows.append((name, command))
+            else:
+                rows.append((name, text.split("\f", 1)[0]))
+        if not rows:
+            return
+        limit = formatter.width - 6 - max(len(name) for name, _ in rows)
+        lines = [
+            (name, item.get_short_help_str(limit) if isinstance(item, click.Command) else _short(item, limit))
+            for name, item in rows
+        ]
+        with formatter.section("Commands"):
+            formatter.write_dl(lines)
+
+
+def _short(text: str, limit: int) -> str:
+    return make_default_short_help(text, limit).strip()
+
+
+@click.group(
+    cls=LazyGroup,
+    lazy_commands=TOP_COMMANDS,
+    context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 110},
+)
+@click.version_option(__version__, prog_name="abrupt")
+@click.option("-v", "--verbose", count=True, help="More log output (-v info, -vv debug); also after the sub-command.")
+@click.option("-q", "--quiet", is_flag=True, help="No progress bars or notes; errors and results only.")
+def cli(verbose: int, quiet: bool) -> None:
+    """Find abrupt, unexpected momentum changes in satellite telemetry and tracking data.
+
+    Start with `abrupt demo --out DIR`: it simulates telemetry of the thesis spacecraft with strikes,
+    detects them, writes the catalog, the events and a report.
+    """
+    State.quiet = quiet
+    level = logging.WARNING if quiet else logging.WARNING - 10 * min(verbose, 2)  # warnings even when quiet
+    logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s", force=True)
+
+
+def hoist_global_flags(argv: list[str]) -> list[str]:
+    """Move ``-v``/``--quiet`` given after a sub-command to the front, where click expects them."""
+    if "--" in argv:
+        cut = argv.index("--")
+        head, tail = argv[:cut], argv[cut:]
+    else:
+        head, tail = argv, []
+    flags = [a for a in head if a in GLOBAL_FLAGS]
+    return [*flags, *(a for a in head if a not in GLOBAL_FLAGS), *tail]
+
+
+@cli.group(cls=LazyGroup, lazy_commands=SIMULATE_COMMANDS)
+def simulate() -> None:
+    """Simulate data with known truth (attitude telemetry, orbits, ground tracking)."""
+
+
+@cli.group(cls=LazyGroup, lazy_commands=DETECT_COMMANDS)
+def detect() -> None:
+    """Detect abrupt momentum changes in a data file and write events."""
+
+
+@cli.group(cls=LazyGroup, lazy_commands=INJECT_COMMANDS)
+def inject() -> None:
+    """Inject synthetic events into real data to measure what can be detected."""
+
+
+@cli.group(cls=LazyGroup, lazy_commands=REPORT_COMMANDS)
+def report() -> None:
+    """Draw report figures (PNG or HTML) of data, statistics, thresholds and events."""

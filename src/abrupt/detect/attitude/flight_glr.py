@@ -1,0 +1,229 @@
+"""``attitude.flight_glr``: the step GLR on cleaned flight momentum, thresholded on the spacecraft's own statistic.
+
+The statistic is that of ``attitude.glr`` (the Mahalanobis distance of the pre/post means of ᴺH,
+Bennett 2022 §2.4.2) on each gap-free run of analysable samples. What differs is what real flight
+telemetry needs (Harris et al. 2025 §3.4-3.5), so it is its own detector rather than a setting of
+``attitude.glr``:
+
+* peaks: greedy non-maximum suppression above a low floor (:func:`~abrupt.detect.attitude.steps.local_peaks`),
+  so that a long run can be scanned chunk by chunk before its threshold is known;
+* the step: located near the peak with the noise of its neighbourhood
+  (:func:`~abrupt.detect.attitude.steps.locate_step_near_peak`) and sized by a local least-squares
+  step with a linear term, leaving out the controller transient
+  (:func:`~abrupt.detect.attitude.steps.local_step`): no result depends on where a chunk was cut;
+* the threshold: a robust Gumbel fit of block maxima of the statistic of the data itself, blocks
+  anchored at absolute multiples of ``block_s`` (:func:`abrupt.thresholds.robust.robust_block_maxima_threshold`),
+  not of simulated event-free momentum (flight noise is not white).
+
+:meth:`FlightGlrDetector.detect` runs all of it on one :class:`~abrupt.series.attitude.CleanedMomentum`;
+the flight pipeline calls the same steps chunk by chunk (:meth:`~FlightGlrDetector.scan`) and fits
+one threshold for the whole run (:meth:`~FlightGlrDetector.fit_threshold`, :meth:`~FlightGlrDetector.events`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from abrupt.detect.attitude.change_detection import WindowConfig
+from abrupt.detect.attitude.momentum import ATTITUDE_EVENT_COLUMNS, GlrDetector
+from abrupt.detect.attitude.steps import gap_free_segments, local_peaks, local_step, locate_step_near_peak
+from abrupt.detect.base import DetectionResult, Detector, Diagnostics
+from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc
+from abrupt.series.attitude import CleanedMomentum
+from abrupt.thresholds import FalseAlarmBudget, Threshold
+from abrupt.thresholds.noise import robust_noise_sigma
+from abrupt.thresholds.robust import robust_block_maxima_threshold
+from abrupt.types import BoolArray, FloatArray, IntArray
+
+NS = 1_000_000_000
+
+#: Fewest block maxima a threshold is fitted on.
+MIN_BLOCKS = 8
+
+
+@dataclass
+class Peak:
+    """A local maximum of the statistic: time [ns], value, step ΔH_N [N·m·s], its time σ [s]."""
+
+    time_ns: int
+    value: float
+    dH_N_Nms: FloatArray
+    time_sigma_s: float
+
+
+@dataclass(frozen=True)
+class Scan:
+    """The statistic of a stretch of cleaned ᴺH and its peaks (sample index, peak) before any threshold."""
+
+    statistic: FloatArray
+    peaks: list[tuple[int, Peak]]
+
+
+class FlightGlrDetector(Detector[CleanedMomentum]):
+    """Step GLR on cleaned ᴺH with local peaks, local step fits and a threshold from the data's own maxima.
+
+    Settings: ``window_s`` pre/post windows [s], ``guard_s`` guard [s], ``block_s`` blocks of the
+    threshold fit [s], ``peak_floor`` the statistic value below which no peak is kept, and an optional
+    fixed ``threshold``.
+    """
+
+    name = "attitude.flight_glr"
+    series_type = CleanedMomentum
+    kind = "strike"
+    summary = "step GLR on cleaned flight momentum, threshold from its own block maxima (flight pipeline)"
+    unit = "sigma (Mahalanobis)"
+
+    def __init__(
+        self,
+        *,
+        window_s: float = 300.0,
+        guard_s: float = 20.0,
+        block_s: float = 600.0,
+        peak_floor: float = 3.0,
+        threshold: Threshold | None = None,
+    ) -> None:
+        if window_s <= 0 or guard_s < 0 or block_s <= 0:
+            raise ValueError("window_s and block_s must be positive and guard_s not negative")
+        self.window_s = float(window_s)
+        self.guard_s = float(guard_s)
+        self.block_s = float(block_s)
+        self.peak_floor = float(peak_floor)
+        self.threshold = threshold
+
+    def windows(self, dt_s: float) -> WindowConfig:
+        """Pre/post windows and guard in samples of ``dt_s`` seconds."""
+        n = max(2, round(self.window_s / dt_s))
+        return WindowConfig(pre=n, post=n, guard=max(0, round(self.guard_s / dt_s)))
+
+    # ------------------------------------------------------------------ statistic and peaks
+    @staticmethod
+    def statistic(h: FloatArray, ok: BoolArray, win: WindowConfig) -> FloatArray:
+        """The ``attitude.glr`` statistic on each gap-free run of ``ok`` at least one window span long."""
+        segments = [(a, b) for a, b in gap_free_segments(ok) if b - a >= win.span]
+        return np.asarray(GlrDetector(windows=win).statistic(h, segments), dtype=np.float64)
+
+    @staticmethod
+    def step_candidates(h: FloatArray, ok: BoolArray, stat: FloatArray, win: WindowConfig, floor: float) -> list[int]:
+        """Samples where ᴺH steps at the local peaks of ``stat`` above ``floor`` (free steps of a model fit)."""
+        return [locate_step_near_peak(h, ok, i, win) for i in local_peaks(stat, floor, win.span)]
+
+    def scan(self, h: FloatArray, ok: BoolArray, time_ns: IntArray, dt: float, keep: BoolArray | None = None) -> Scan:
+        """Statistic and peaks (those at samples where ``keep``, default all) of cleaned ᴺH ``h``."""
+        win = self.windows(dt)
+        stat = self.statistic(h, ok, win)
+        return Scan(stat, self.find_peaks(h, ok, stat, time_ns, dt, win, keep))
+
+    def find_peaks(
+        self,
+        h: FloatArray,
+        ok: BoolArray,
+        stat: FloatArray,
+        time_ns: IntArray,
+        dt: float,
+        win: WindowConfig,
+        keep: BoolArray | None = None,
+    ) -> list[tuple[int, Peak]]:
+        """Local peaks of ``stat`` above the floor with the step of ᴺH at each (time, ΔH, time σ)."""
+        found: list[tuple[int, Peak]] = []
+        for i in local_peaks(stat, self.peak_floor, win.span):
+            if keep is not None and not keep[i]:
+                continue
+            near = h[max(0, i - 2 * win.span) : i + 2 * win.span]
+            near = near[np.all(np.isfinite(near), axis=1)]
+            sigma = robust_noise_sigma(near) if near.shape[0] > 3 else np.full(3, np.nan)
+            tau = locate_step_near_peak(h, ok, i, win)
+            d_h = local_step(h, ok, tau, win.pre, win.guard)
+            mag = float(np.linalg.norm(d_h))
+            sig = float(np.sqrt(np.sum((sigma * d_h / mag) ** 2))) if mag > 0 else float("nan")
+            # Change-point location error grows as (σ/Δ)² samples (Hinkley 1970).
+            time_sigma = max(dt / math.sqrt(12.0), 3.0 * dt * (sig / mag) ** 2) if mag > 0 else dt * win.guard
+            t_event = int(time_ns[tau]) - int(0.5 * dt * NS)
+            found.append((i, Peak(t_event, float(stat[i]), d_h, float(time_sigma))))
+        return found
+
+    # ------------------------------------------------------------------ threshold
+    def block_maxima(self, time_ns: IntArray, stat: FloatArray, dt: float, origin_ns: int = 0) -> dict[int, float]:
+        """Largest statistic per block of ``block_s`` (blocks anchored at ``origin_ns`` + k ``block_s``).
+
+        Only blocks with at least half their samples analysed count.
+        """
+        block_ns = int(self.block_s * NS)
+        blocks: dict[int, float] = {}
+        if len(time_ns):
+            bidx = (time_ns - origin_ns) // block_ns
+            for b in np.unique(bidx):
+                v = stat[bidx == b]
+                if np.isfinite(v).sum() >= 0.5 * self.block_s / dt:
+                    blocks[int(b)] = float(np.nanmax(v))
+        return blocks
+
+    def fit_threshold(self, maxima: FloatArray, budget: FalseAlarmBudget, sample_rate_hz: float) -> Threshold:
+        """The fixed threshold, or the robust Gumbel fit of ``maxima`` at ``budget``."""
+        if self.threshold is not None:
+            return self.threshold
+        return robust_block_maxima_threshold(maxima, block_s=self.block_s, budget=budget, sample_rate_hz=sample_rate_hz)
+
+    # ------------------------------------------------------------------ events
+    def events(
+        self, peaks: list[Peak], threshold: Threshold, spacecraft: str, run_id: str, cfg_hash: str
+    ) -> pd.DataFrame:
+        """Events (frozen schema, by time) for the peaks above the threshold."""
+        events = []
+        for p in peaks:
+            if not p.value > threshold.value:
+                continue
+            d = p.dH_N_Nms
+            events.append(
+                Event(
+                    spacecraft=spacecraft,
+                    kind=self.kind,
+                    detector=self.name,
+                    time_utc=format_time_utc(np.datetime64(p.time_ns, "ns")),
+                    time_sigma_s=p.time_sigma_s,
+                    statistic=p.value,
+                    threshold=threshold.value,
+                    false_alarms_per_day=threshold.false_alarms_per_day,
+                    dH_N_x_Nms=float(d[0]),
+                    dH_N_y_Nms=float(d[1]),
+                    dH_N_z_Nms=float(d[2]),
+                    run_id=run_id,
+                    config_hash=cfg_hash,
+                    extra={"statistic_units": self.unit, "threshold_method": threshold.method},
+                )
+            )
+        frame = events_frame(events) if events else empty_frame(ATTITUDE_EVENT_COLUMNS)
+        return frame.sort_values("time_utc").reset_index(drop=True) if len(frame) else frame
+
+    def detect(self, series: CleanedMomentum, budget: FalseAlarmBudget) -> DetectionResult:
+        """Events in one stretch of cleaned ᴺH; blocks of the threshold fit start at its first sample."""
+        if len(series) < 2 or not series.analysable.any():
+            return DetectionResult(empty_frame(ATTITUDE_EVENT_COLUMNS), warnings=("no analysable samples",))
+        dt = series.sample_interval_s
+        g = series.time_ns
+        scan = self.scan(series.H_N_Nms, series.analysable, g, dt)
+        maxima = np.array(list(self.block_maxima(g, scan.statistic, dt, origin_ns=int(g[0])).values()))
+        if self.threshold is None and maxima.size < MIN_BLOCKS:
+            return DetectionResult(
+                empty_frame(ATTITUDE_EVENT_COLUMNS),
+                warnings=(
+                    f"too little analysable data to fit a threshold (< {MIN_BLOCKS} blocks of {self.block_s:g} s)",
+                ),
+            )
+        thr = self.fit_threshold(maxima, budget, 1.0 / dt)
+        cfg_hash = config_hash({"detector": self.name, **self.config(), "budget": str(budget)})
+        frame = self.events([p for _, p in scan.peaks], thr, series.spacecraft_name, "", cfg_hash)
+        diagnostics = Diagnostics(
+            name=self.name,
+            time_s=(g - g[0]).astype(np.float64) / NS,
+            statistic=scan.statistic,
+            threshold=thr,
+            epoch_utc=np.datetime64(int(g[0]), "ns"),
+            unit=self.unit,
+            null_sample=maxima,
+            extra={"analysed_fraction": float(np.isfinite(scan.statistic).mean())},
+        )
+        return DetectionResult(frame, (diagnostics,))

@@ -1,0 +1,92 @@
+"""Campaigns of burns within a few element sets: one ``maneuver_campaign`` event with its burn count
+and total ΔV beside the member maneuvers (full study: ``benchmarks/bench_tle_campaigns.py``).
+
+Independent truth: burns injected with exact times and ΔV (Gauss's equations for a near-circular
+orbit, :func:`abrupt.simulate.tle_null._inject_burns`), whose in-track ΔV sum is known.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from abrupt.detect.tle.campaigns import chain
+from abrupt.detect.tle.detectors import TleMeanElements
+from abrupt.readers.fengyun import read_maneuver_file
+from abrupt.readers.tle import read_tle
+from abrupt.score import score_events
+from abrupt.simulate.tle_campaign import acquisition_burns, campaign_trial
+from abrupt.simulate.tle_null import EPOCH0, NullHistorySpec, simulate_null_history
+from abrupt.thresholds import FalseAlarmBudget
+
+BUDGET = FalseAlarmBudget(1.0, "year")
+DAY = 86400.0
+
+
+def _days(events: pd.DataFrame) -> np.ndarray:
+    t = pd.to_datetime(events["time_utc"]).dt.tz_localize(None)
+    return ((t - EPOCH0).dt.total_seconds() / DAY).to_numpy()
+
+
+def test_chain_joins_detections_close_in_time_or_in_sets() -> None:
+    t = np.array([0.0, 2.0, 4.5, 20.0, 30.0, 31.0]) * DAY
+    gaps = np.array([0, 2, 4, 40, 50, 60])
+    assert chain(t, gaps, 3.0, 6) == [[0, 1, 2], [4, 5]]
+    assert chain(t, gaps, 0.5, 1) == []
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_acquisition_phase_is_one_campaign_with_its_burns_counted_and_summed(seed: int) -> None:
+    """Six raising burns of 0.5-3 m/s within ten days on a simulated LEO history (800 km, a set a day):
+    one campaign event overlapping them, its burn count within ±1 of six, its in-track ΔV within 20 %
+    of the injected sum, and every other event near the burns one of its member maneuvers."""
+    burns = acquisition_burns(seed, start_day=200.0)
+    h = simulate_null_history(NullHistorySpec(altitude_km=800.0, sets_per_day=1.0, years=1.5, seed=seed), burns=burns)
+    ev = TleMeanElements().detect(h, BUDGET).events
+    ev = ev.loc[ev["statistic"] >= ev["threshold"]]
+    near = ev.loc[(_days(ev) > burns[0][0] - 10.0) & (_days(ev) < burns[-1][0] + 10.0)]
+    camps = near.loc[near["kind"] == "maneuver_campaign"]
+    assert len(camps) == 1
+    camp = camps.iloc[0]
+    total = sum(dv for _, dv in burns)
+    assert abs(int(camp["burn_count"]) - len(burns)) <= 1
+    assert float(camp["dv_t_mps"]) == pytest.approx(total, rel=0.2)
+    members = near.loc[near["kind"] == "maneuver"]
+    lo = pd.to_datetime(str(camp["interval_start_utc"]), utc=True)
+    hi = pd.to_datetime(str(camp["interval_end_utc"]), utc=True)
+    assert pd.to_datetime(members["time_utc"].astype(str), utc=True).between(lo, hi).all()
+    assert int(camp["campaign_size"]) == len(members)
+
+
+def test_isolated_burns_make_no_campaign() -> None:
+    """Burns 60 days apart are maneuvers, each alone: no campaign event."""
+    burns = [(100.0 + 60.0 * k, 0.2) for k in range(5)]
+    h = simulate_null_history(NullHistorySpec(altitude_km=800.0, sets_per_day=1.0, years=1.5, seed=4), burns=burns)
+    ev = TleMeanElements().detect(h, BUDGET).events
+    assert (ev["kind"] == "maneuver_campaign").sum() == 0
+    assert (ev["kind"] == "maneuver").sum() >= 5
+
+
+def test_one_to_one_scoring_leaves_campaign_rows_out() -> None:
+    """A campaign row at a truth time does not add a match or a false alarm to the one-to-one score."""
+    truth = pd.DataFrame({"time_utc": pd.to_datetime(["2020-01-01T00:00", "2020-01-03T00:00"])})
+    det = pd.DataFrame(
+        {
+            "time_utc": ["2020-01-01T01:00Z", "2020-01-03T01:00Z", "2020-01-01T01:00Z"],
+            "kind": ["maneuver", "maneuver", "maneuver_campaign"],
+            "statistic": [9.0, 9.0, 9.0],
+            "threshold": [5.0, 5.0, 5.0],
+        }
+    )
+    res = score_events(det, truth)
+    assert (res.true_positives, res.false_positives, res.n_detections) == (2, 0, 2)
+
+
+def test_acquisition_phase_in_sentinel_3a_real_quiet_noise(shared_data) -> None:
+    """The same acquisition phase laid in blocks of Sentinel-3A's own quiet noise: found as one
+    campaign, burn count ±1, total ΔV within 20 %, nothing else within ±10 days, in 3 of 3 trials."""
+    real = read_tle(shared_data / "tle" / "Sentinel-3A.tle")
+    truth = read_maneuver_file(shared_data / "maneuvers" / "s3aman.txt")
+    rows = [campaign_trial(real, list(truth["time_utc"]), BUDGET, seed) for seed in range(3)]
+    assert all(r["ok"] for r in rows), rows
