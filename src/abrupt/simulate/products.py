@@ -21,8 +21,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from abrupt.series.ephemeris import Ephemeris
 from abrupt.model.orbit import R_EARTH_M, ForceContext, ForceModel, kepler_to_cartesian, propagate_with_stm
+from abrupt.series.ephemeris import Ephemeris
 
 DAY_S = 86400.0
 
