@@ -76,6 +76,9 @@ READ_UNLIKE_OREKIT = {
     "too-many-comments-a.sp3": "comments are not used",
     "too-long-comment-a.sp3": "comments are not used",
     "too-long-comment-d.sp3": "comments are not used",
+    # Orekit: SP3_NUMBER_OF_EPOCH_MISMATCH (2 found, 192 announced). Both epochs are complete and the file
+    # ends with EOF: the records are read and the mismatch is a counted repair; --strict refuses it.
+    "wrong-number-of-epochs.sp3": "header epoch count wrong, records complete",
 }
 
 #: Files rejected, with the one-line error abrupt gives (Orekit rejects each of them too).
@@ -92,8 +95,6 @@ REJECTED = {
     "unsupported-version.sp3": r"unsupported-version.sp3:1:2: unsupported SP3 version 'z'",
     # Orekit: UNABLE_TO_PARSE_LINE_IN_FILE line 13
     "wrong-line-identifier.sp3": r"wrong-line-identifier.sp3:13:1: unknown header record '@@'",
-    # Orekit: SP3_NUMBER_OF_EPOCH_MISMATCH (2 found, 192 announced)
-    "wrong-number-of-epochs.sp3": r"header announces 192 epochs but the file holds 2",
     # Orekit: SP3_INVALID_HEADER_ENTRY "data used" 'v'. abrupt does not use the data-used field, but the
     # file is an SP3-c file listing 87 satellites, which the version cannot hold (5 lines of 17).
     "gbm19500_wrong_data_used.sp3": r":3:4: SP3-c lists at most 85 satellites; the header announces 87",
@@ -120,6 +121,19 @@ def test_corpus_file_is_rejected_with_a_one_line_error(shared_data: Path, name: 
     with pytest.raises(InputError, match=REJECTED[name]) as info:
         parse_sp3(shared_data / CORPUS / name)
     assert "\n" not in str(info.value)
+
+
+def test_epoch_count_mismatch_with_complete_records_is_a_counted_repair(shared_data: Path) -> None:
+    path = shared_data / CORPUS / "wrong-number-of-epochs.sp3"
+    content = parse_sp3(path)
+    kinds = [k for k in content.repairs.counts if "header announces" in k]
+    assert kinds == ["header announces 192 epochs, the file holds 2 complete ones (read as found)"]
+    assert content.repairs.counts[kinds[0]] == 190
+    # every epoch line of the file is read (2001-08-08 00:00 and 2001-08-09 23:45 GPS, 13 s after UTC)
+    epochs = np.unique(np.concatenate([e.times_utc for e in content.ephemerides.values()]))
+    assert list(epochs) == [np.datetime64("2001-08-07T23:59:47", "ns"), np.datetime64("2001-08-09T23:44:47", "ns")]
+    with pytest.raises(InputError, match=r"header announces 192 epochs but the file holds 2$"):
+        parse_sp3(path, strict=True)
 
 
 def _at(eph, t: str) -> int:  # type: ignore[no-untyped-def]

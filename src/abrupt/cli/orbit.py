@@ -24,7 +24,7 @@ from abrupt.cli.groups import (
 )
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.detect.orbit.detectors import STATISTIC_SUMMARIES
-from abrupt.errors import ConfigError
+from abrupt.errors import ConfigError, InputError
 from abrupt.events import config_hash, new_run_id, read_events
 from abrupt.model.orbit import ForceModel
 from abrupt.pipelines.orbit import detect_orbit, inject_orbit, summary_lines
@@ -45,6 +45,15 @@ def _parse_vector(text: str, what: str) -> tuple[float, float, float]:
     if len(parts) != 3:
         raise ConfigError(f"{what} must have three components, got {len(parts)}", key=what)
     return parts
+
+
+_STRICT_OPTION = click.option(
+    "--strict",
+    is_flag=True,
+    default=False,
+    help="An SP3 header count (epochs, satellites) that complete records do not match is an error; without "
+    "it the file is read as found and the mismatch reported with both counts.",
+)
 
 
 def _filter_options(f: Any) -> Any:
@@ -88,6 +97,7 @@ def _filter_options(f: Any) -> Any:
             help="Read an SP3/CPF file that ends before the epochs its header announces (the missing epochs are "
             "counted and reported); without it such a file is an error.",
         ),
+        _STRICT_OPTION,
     ]
     for opt in reversed(options):
         f = opt(f)
@@ -203,6 +213,13 @@ def simulate_orbit_command(
     help="Self-calibrated thresholds: standard errors of the fitted level added to it "
     "(1: the false-alarm rate stays within the budget with ~84 % confidence; 0: point estimate).",
 )
+@click.option(
+    "--sequences/--no-sequences",
+    default=True,
+    show_default=True,
+    help="After a detection, remove the burns found from the data and scan again, so that burns close in "
+    "time (pairs 30-90 min apart) are each found with their own ΔV.",
+)
 @click.option("--kind", type=click.Choice(["unknown", "maneuver", "strike"]), default="unknown", show_default=True)
 @click.option(
     "--statistics-out", type=click.Path(dir_okay=False), default=None, help="Per-epoch statistics (.parquet/.csv)."
@@ -223,10 +240,12 @@ def detect_orbit_command(
     nuisance: bool,
     satellite: str | None,
     allow_truncated: bool,
+    strict: bool,
     detector_name: str | None,
     statistic: str | None,
     null_file: str | None,
     confidence_z: float,
+    sequences: bool,
     kind: str,
     statistics_out: str | None,
     pseudonym: str | None,
@@ -253,6 +272,8 @@ def detect_orbit_command(
             satellite=satellite,
             null=null_file,
             allow_truncated=allow_truncated,
+            strict=strict,
+            sequences=sequences,
             tuning=tuning,
             tau_s=tau_s,
             q_m2_s5=q_m2_s5,
@@ -315,6 +336,7 @@ def detect_orbit_command(
     default=False,
     help="Read an SP3/CPF file that ends before the epochs its header announces (missing epochs counted).",
 )
+@_STRICT_OPTION
 @click.option(
     "--out",
     "out",
@@ -323,7 +345,14 @@ def detect_orbit_command(
     help="File to write, in the input's format (SP3, OEM KVN/XML); a name ending in .csv gives navigation CSV.",
 )
 def inject_orbit_command(
-    file: str, time_utc: str, dv_rtn: str, duration_s: float, satellite: str | None, allow_truncated: bool, out: str
+    file: str,
+    time_utc: str,
+    dv_rtn: str,
+    duration_s: float,
+    satellite: str | None,
+    allow_truncated: bool,
+    strict: bool,
+    out: str,
 ) -> None:
     """Add the effect of a ΔV (impulse or finite burn) at a chosen time to a real ephemeris."""
     try:
@@ -334,9 +363,10 @@ def inject_orbit_command(
             duration_s=duration_s,
             satellite=satellite,
             allow_truncated=allow_truncated,
+            strict=strict,
         )
-    except ConfigError:
-        raise  # already names its option (a ConfigError is a ValueError: do not wrap it twice)
+    except (ConfigError, InputError):
+        raise  # already names its option or file:line (both are ValueErrors: do not wrap them as --time)
     except ValueError as exc:
         raise ConfigError(str(exc), key="time") from None
     for line in out_eph.repairs.summary():
@@ -366,6 +396,7 @@ def report_orbit_command(
     nuisance: bool,
     satellite: str | None,
     allow_truncated: bool,
+    strict: bool,
     events_file: str | None,
     **budget_args: Any,
 ) -> None:
@@ -376,6 +407,7 @@ def report_orbit_command(
         budget=pop_budget(budget_args, "1/week"),
         satellite=satellite,
         allow_truncated=allow_truncated,
+        strict=strict,
         tuning=tuning,
         tau_s=tau_s,
         q_m2_s5=q_m2_s5,

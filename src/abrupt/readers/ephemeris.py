@@ -49,11 +49,14 @@ def sniff_format(path: str | Path) -> EphemerisFormat:
     )
 
 
-def read_ephemeris(path: str | Path, satellite: str | None = None, *, allow_truncated: bool = False) -> Ephemeris:
-    """Read one satellite's ephemeris from any supported orbit file (UTC times, SI units)."""
+def read_ephemeris(
+    path: str | Path, satellite: str | None = None, *, allow_truncated: bool = False, strict: bool = False
+) -> Ephemeris:
+    """Read one satellite's ephemeris from any supported orbit file (UTC times, SI units). ``strict``: an
+    SP3 header count the body does not match is an error even when the records are complete."""
     fmt = sniff_format(path)
     if fmt == "sp3":
-        return read_sp3(path, satellite, allow_truncated=allow_truncated)
+        return read_sp3(path, satellite, allow_truncated=allow_truncated, strict=strict)
     if fmt in ("oem-kvn", "oem-xml"):
         return read_oem(path, satellite)
     if fmt == "opm":

@@ -26,8 +26,10 @@ Documented repairs (counted in the :class:`~abrupt.errors.RepairLog` of each eph
 - an epoch repeated with identical states is dropped; epochs out of order are sorted; gaps against the
   header interval are counted (the filter propagates across them);
 - records of a satellite missing from the header list are read and counted;
-- a file truncated before the number of epochs its header announces is an **error**; with
-  ``allow_truncated=True`` it is read and the missing epochs are counted.
+- a header count the body does not match (epochs, satellites) with complete records (``EOF``
+  reached, or a whole last epoch when more epochs than announced) is read as found, the repair naming
+  both counts; ``strict=True`` makes it an error, as Orekit does. A file without ``EOF`` short of its
+  announced epochs is an **error**; ``allow_truncated=True`` reads it and counts the missing epochs.
 
 Errors (:class:`~abrupt.errors.InputError`, ``file:line:column: reason``): unsupported version, a
 malformed header line (first line, ``##``, satellite list, ``%c``/``%f`` lines, unknown header
@@ -62,6 +64,7 @@ from abrupt.readers.sp3_header import (
     normalise_satellite_id,
     parse_header,
 )
+from abrupt.readers.sp3_records import last_epoch_complete
 from abrupt.readers.timesystems import to_utc_counted
 from abrupt.series.ephemeris import Ephemeris
 
@@ -170,6 +173,7 @@ class _Body:
     n_rolled: int = 0
     n_epoch_lines: int = 0
     lines_after_eof: int = 0
+    seen_eof: bool = False
     missing_pos: Counter[str] = field(default_factory=Counter)
     missing_vel: Counter[str] = field(default_factory=Counter)
     unlisted: set[str] = field(default_factory=set)
@@ -241,7 +245,7 @@ def _read_body(lines: Sequence[str], start: int, header: Sp3Header) -> _Body:
         if not line.strip() or line.startswith("/*"):
             continue
         if line.startswith("EOF"):
-            seen_eof = True
+            seen_eof = body.seen_eof = True
             continue
         body.n_records += 1
         try:
@@ -263,7 +267,13 @@ def _read_body(lines: Sequence[str], start: int, header: Sp3Header) -> _Body:
 
 
 def _check_body(
-    body: _Body, header: Sp3Header, file: str, n_lines: int, log: RepairLog, allow_truncated: bool
+    body: _Body,
+    header: Sp3Header,
+    lines: Sequence[str],
+    start: int,
+    file: str,
+    log: RepairLog,
+    flags: tuple[bool, bool],
 ) -> NDArray[np.datetime64]:
     """The limits on malformed records and the epoch count, and the sampling grid; returns the epochs."""
     if body.lines_after_eof:
@@ -280,16 +290,28 @@ def _check_body(
         )
     if body.bad:
         log.record("malformed ephemeris record skipped", len(body.bad))
+    allow_truncated, strict = flags
     if body.n_epoch_lines != header.n_epochs:
         missing = header.n_epochs - body.n_epoch_lines
-        if missing > 0 and allow_truncated:
+        # complete records: the writer reached EOF; without EOF a file short of epochs is a cut file,
+        # one with more epochs than announced must end with a full last epoch
+        complete = body.seen_eof or (
+            missing < 0 and last_epoch_complete(lines[start:], header.satellites, header.has_velocity)
+        )
+        if complete and not strict:
+            log.record(
+                f"header announces {header.n_epochs} epochs, the file holds {body.n_epoch_lines} complete ones "
+                "(read as found)",
+                abs(missing),
+            )
+        elif missing > 0 and allow_truncated:
             log.record("file truncated: announced epochs missing", missing)
         else:
             raise InputError(
                 f"header announces {header.n_epochs} epochs but the file holds {body.n_epoch_lines}"
-                + (" (truncated file?)" if missing > 0 else ""),
+                + (" (truncated file?)" if missing > 0 and not complete else ""),
                 file=file,
-                line=n_lines,
+                line=len(lines),
             )
     if not body.epochs:
         raise InputError("no valid epochs in the file", file=file)
@@ -313,14 +335,17 @@ def _check_body(
     return t_all
 
 
-def parse_sp3(path: str | Path, *, allow_truncated: bool = False, repairs: RepairLog | None = None) -> Sp3File:
-    """Read every satellite of an SP3 file (see the module docstring for repairs and errors)."""
+def parse_sp3(
+    path: str | Path, *, allow_truncated: bool = False, strict: bool = False, repairs: RepairLog | None = None
+) -> Sp3File:
+    """Read every satellite of an SP3 file (see the module docstring for repairs and errors). ``strict``:
+    a header count the complete records do not match is an error."""
     file = str(path)
     log = repairs if repairs is not None else RepairLog(source=file)
     lines = _read_lines(path)
-    header, start = parse_header(lines, file, log)
+    header, start = parse_header(lines, file, log, strict=strict)
     body = _read_body(lines, start, header)
-    t_all = _check_body(body, header, file, len(lines), log, allow_truncated)
+    t_all = _check_body(body, header, lines, start, file, log, (allow_truncated, strict))
     frame = "GCRF" if header.coordinate_system.upper() in INERTIAL_FRAMES else "ITRF"
     ephemerides: dict[str, Ephemeris] = {}
     for sid in header.satellites + sorted(body.unlisted):
@@ -402,13 +427,14 @@ def read_sp3(
     *,
     repairs: RepairLog | None = None,
     allow_truncated: bool = False,
+    strict: bool = False,
 ) -> Ephemeris:
     """Read one satellite's ephemeris from an SP3 file (frame of the file, ITRF unless inertial; UTC).
 
     ``satellite`` is the SP3 id (``"L74"``; ``"1"`` or ``"G1"`` also name ``G01``); it may be omitted
     when the file holds one satellite. Raises :class:`InputError` naming file:line and the reason.
     """
-    content = parse_sp3(path, allow_truncated=allow_truncated, repairs=repairs)
+    content = parse_sp3(path, allow_truncated=allow_truncated, strict=strict, repairs=repairs)
     sats = content.header.satellites
     if satellite is None:
         if len(content.ephemerides) != 1:
@@ -426,9 +452,9 @@ def read_sp3(
     return content.ephemerides[sid]
 
 
-def read_sp3_all(path: str | Path, *, allow_truncated: bool = False) -> dict[str, Ephemeris]:
+def read_sp3_all(path: str | Path, *, allow_truncated: bool = False, strict: bool = False) -> dict[str, Ephemeris]:
     """Every satellite's ephemeris in an SP3 file, by SP3 id."""
-    return parse_sp3(path, allow_truncated=allow_truncated).ephemerides
+    return parse_sp3(path, allow_truncated=allow_truncated, strict=strict).ephemerides
 
 
 def _fmt_epoch(t: np.datetime64) -> str:

@@ -153,7 +153,7 @@ def header_records(lines: Sequence[str], file: str, version: str) -> HeaderRecor
                     )
             for k in range(17):
                 sid = normalise_satellite_id(line[9 + 3 * k : 12 + 3 * k])
-                if sid and sid not in ("G00",) and len(sats) < n_sats:
+                if sid and sid not in ("G00",):
                     sats.append(sid)
             continue
         if line.startswith("%c"):
@@ -187,8 +187,9 @@ def header_records(lines: Sequence[str], file: str, version: str) -> HeaderRecor
     return HeaderRecords(sats, n_sats, time_system, ts_line, file_type, comments, body)
 
 
-def parse_header(lines: Sequence[str], file: str, repairs: RepairLog) -> tuple[Sp3Header, int]:
-    """Parse the header; returns it and the index of the first body line."""
+def parse_header(lines: Sequence[str], file: str, repairs: RepairLog, *, strict: bool = False) -> tuple[Sp3Header, int]:
+    """Parse the header; returns it and the index of the first body line. ``strict``: a satellite list of
+    another length than the count announced is an error (else the list is used, and counted)."""
     if not lines or len(lines[0]) < 3 or lines[0][0] != "#" or lines[0][1] in "#":
         raise InputError("first line must start with '#a', '#c' or '#d' (SP3 version)", file=file, line=1, column=1)
     head = lines[0]
@@ -222,7 +223,9 @@ def parse_header(lines: Sequence[str], file: str, repairs: RepairLog) -> tuple[S
     if n_sats is None:
         raise InputError("no satellite list ('+' lines) in the header", file=file, line=3, column=1)
     if len(sats) != n_sats:
-        raise InputError(f"header announces {n_sats} satellites but lists {len(sats)}", file=file, line=3, column=4)
+        if strict or not sats:
+            raise InputError(f"header announces {n_sats} satellites but lists {len(sats)}", file=file, line=3, column=4)
+        repairs.record(f"header announces {n_sats} satellites but lists {len(sats)} (the list is used)")
     if len(set(sats)) != len(sats):
         raise InputError("satellite list names a satellite twice", file=file, line=3, column=10)
     if version in "ab" or time_system in (None, "CCC", ""):

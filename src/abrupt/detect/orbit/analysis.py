@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 from scipy import stats
 
 from abrupt.detect.orbit.ekf import FilterConfig, FilterRun, run_backward, run_forward
-from abrupt.detect.orbit.glr import glr_statistic_from_run
+from abrupt.detect.orbit.glr import glr_statistic_and_information
 from abrupt.detect.orbit.statistics import STATISTIC_NAMES, FusionResult, fuse, orbital_constant_statistics
 from abrupt.model.orbit import ForceContext
 from abrupt.series.ephemeris import Ephemeris
@@ -94,6 +94,9 @@ class OrbitAnalysis:
     valid: NDArray[np.bool_]
     config: OrbitDetectorConfig
     context: ForceContext | None = None
+    #: per epoch, the information C(θ) (3×3, (m/s)⁻²) of a velocity jump for the sliding GLR (NaN where
+    #: not formed); None without the GLR statistic
+    glr_information: FloatArray | None = None
 
     @property
     def sample_rate_hz(self) -> float:
@@ -150,8 +153,9 @@ def analyse(ephemeris: Ephemeris, config: OrbitDetectorConfig | None = None) -> 
     else:
         for name in ("d_sma", "d_ecc", "d_hdir"):
             stats[name] = np.full(t.size, np.nan)
+    info = None
     if with_glr:
-        stats["glr"] = glr_statistic_from_run(t, fwd, config.glr_window_samples * eph.nominal_step_s)
+        stats["glr"], info = glr_statistic_and_information(t, fwd, config.glr_window_samples * eph.nominal_step_s)
         # the stored gains are needed only for the statistic
         ns = fc.n_states
         fwd.phis, fwd.gains, fwd.sinvs = (np.zeros((0, ns, ns)), np.zeros((0, ns, 6)), np.zeros((0, 6, 6)))
@@ -160,7 +164,7 @@ def analyse(ephemeris: Ephemeris, config: OrbitDetectorConfig | None = None) -> 
     valid = (t - t[0] >= config.settle_s) & (t[-1] - t >= config.settle_s)
     for name in stats:
         stats[name] = np.where(valid, stats[name], np.nan)
-    return OrbitAnalysis(eph, t, fwd, bwd, fusion, stats, valid, config, ctx)
+    return OrbitAnalysis(eph, t, fwd, bwd, fusion, stats, valid, config, ctx, info)
 
 
 def innovation_scale(analysis: OrbitAnalysis) -> float:

@@ -27,6 +27,7 @@ observed orbit; :class:`~abrupt.detect.orbit.ekf.NuisanceConfig`).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import replace
 from typing import Any, ClassVar
 
@@ -34,6 +35,7 @@ import numpy as np
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.detect.orbit.analysis import OrbitAnalysis, OrbitDetectorConfig, analyse, innovation_scale
+from abrupt.detect.orbit.boundaries import ProductBoundary, boundary_mask, product_boundaries
 from abrupt.detect.orbit.calibration import calibrate_thresholds, self_calibrate
 from abrupt.detect.orbit.ekf import FilterConfig, NuisanceConfig
 from abrupt.detect.orbit.events import find_events
@@ -118,6 +120,8 @@ class OrbitDetector(Detector[Ephemeris]):
         self.spacecraft = spacecraft
         self.run_id = run_id
         self._null = null
+        #: thresholds to use instead of calibrating (a later scan of the same arc keeps the first's)
+        self.fixed_thresholds: dict[str, Threshold] | None = None
 
     def config(self) -> dict[str, Any]:
         out = super().config()
@@ -162,7 +166,9 @@ class OrbitDetector(Detector[Ephemeris]):
             return DetectionResult.empty(warnings=(f"{len(series)} epochs: too few to filter",))
         cfg = self.detector_config(series, budget)
         analysis = analyse(series, cfg)
-        if self._null is not None:
+        if self.fixed_thresholds is not None:
+            thresholds = dict(self.fixed_thresholds)
+        elif self._null is not None:
             null = analyse(self._null, cfg)
             thresholds = calibrate_thresholds(null.statistics, sample_rate_hz=null.sample_rate_hz, budget=budget)
         else:
@@ -174,13 +180,35 @@ class OrbitDetector(Detector[Ephemeris]):
                 "give a longer arc or event-free data (null)",
             )
             return DetectionResult.empty(warnings=warnings, diagnostics=self._diagnostics(analysis, thresholds))
+        boundaries, searched = self._boundaries(analysis, thresholds, budget)
         chash = config_hash({**self.config(), "budget": str(budget)})
         events = find_events(
-            analysis, thresholds, spacecraft=self.spacecraft or series.satellite, run_id=self.run_id, cfg_hash=chash
+            searched, thresholds, spacecraft=self.spacecraft or series.satellite, run_id=self.run_id, cfg_hash=chash
         )
-        return DetectionResult(events, self._diagnostics(analysis, thresholds), warnings)
+        return DetectionResult(events, self._diagnostics(analysis, thresholds, boundaries), warnings)
 
-    def _diagnostics(self, analysis: OrbitAnalysis, thresholds: dict[str, Threshold]) -> tuple[Diagnostics, ...]:
+    def _boundaries(
+        self, analysis: OrbitAnalysis, thresholds: dict[str, Threshold], budget: FalseAlarmBudget
+    ) -> tuple[list[ProductBoundary], OrbitAnalysis]:
+        """Day boundaries of the product treated as nuisance (:mod:`abrupt.detect.orbit.boundaries`), and
+        the analysis to search for events (the nuisance windows blanked). When the product shows the
+        pattern, the self-calibrated thresholds are set again without the boundary windows (in place)."""
+        name = self.statistic
+        boundaries, blanked = product_boundaries(analysis, thresholds[name].value, budget, name)
+        if not boundaries:
+            return [], analysis
+        if self._null is None and self.fixed_thresholds is None:
+            mask = boundary_mask(analysis, boundaries)
+            quiet = {k: np.where(mask, np.nan, v) for k, v in analysis.statistics.items()}
+            thresholds.update(
+                self_calibrate(replace(analysis, statistics=quiet), budget=budget, confidence_z=self.confidence_z)
+            )
+            boundaries, blanked = product_boundaries(analysis, thresholds[name].value, budget, name)
+        return boundaries, replace(analysis, statistics={**analysis.statistics, name: blanked})
+
+    def _diagnostics(
+        self, analysis: OrbitAnalysis, thresholds: dict[str, Threshold], boundaries: Sequence[ProductBoundary] = ()
+    ) -> tuple[Diagnostics, ...]:
         cfg = analysis.config
         noise = {
             "tau_s": cfg.filter.tau_s,
@@ -199,7 +227,11 @@ class OrbitDetector(Detector[Ephemeris]):
                 epoch_utc=epoch,
                 unit="",
                 noise_model=noise,
-                extra={"analysis": analysis, "thresholds": dict(thresholds)},
+                extra={
+                    "analysis": analysis,
+                    "thresholds": dict(thresholds),
+                    "product_boundaries": [b.as_dict() for b in boundaries],
+                },
             )
         ]
         for key, values in analysis.statistics.items():
@@ -249,3 +281,13 @@ def orbit_thresholds(result: DetectionResult) -> dict[str, Threshold]:
         if isinstance(thresholds, dict):
             return dict(thresholds)
     return {}
+
+
+def orbit_product_boundaries(result: DetectionResult) -> list[dict[str, object]]:
+    """The product's day boundaries the detector treated (time, peak, bound, raised); empty when the
+    product shows no discontinuity pattern."""
+    for d in result.diagnostics:
+        found = d.extra.get("product_boundaries")
+        if isinstance(found, list):
+            return list(found)
+    return []

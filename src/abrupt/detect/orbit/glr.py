@@ -176,10 +176,12 @@ def localise_jump(
 @nb.njit(cache=True)
 def glr_sliding_kernel(
     phis: FloatArray, gains: FloatArray, sinvs: FloatArray, innovs: FloatArray, horizon: int, lead_s: FloatArray
-) -> FloatArray:
-    """ℓ(θ) at every epoch θ with the innovations θ … θ+horizon−1 (a sliding GLR statistic)."""
+) -> tuple[FloatArray, FloatArray]:
+    """ℓ(θ) at every epoch θ with the innovations θ … θ+horizon−1 (a sliding GLR statistic), and the
+    information C(θ) of the jump vector over the same window (ν̂ has covariance C⁻¹)."""
     n = innovs.shape[0]
     ell = np.full(n, np.nan)
+    info = np.full((n, 3, 3), np.nan)
     for theta in range(1, n - horizon + 1):
         mm = np.zeros((phis.shape[1], 3))
         for a in range(3):
@@ -196,13 +198,22 @@ def glr_sliding_kernel(
             cc += gs @ g
             mm = mm - gains[k] @ g
         ell[theta] = d @ np.linalg.solve(cc, d)
-    return ell
+        info[theta] = cc
+    return ell, info
 
 
 def glr_statistic_from_run(t_s: FloatArray, forward: FilterRun, horizon_s: float) -> FloatArray:
     """Sliding GLR ℓ(θ) (chi-square with 3 degrees of freedom for a matched model, no jump) at every epoch,
     the jump placed mid-interval before θ, from a forward pass that stored its gains
     (``run_forward(..., store_gains=True)``)."""
+    return glr_statistic_and_information(t_s, forward, horizon_s)[0]
+
+
+def glr_statistic_and_information(
+    t_s: FloatArray, forward: FilterRun, horizon_s: float
+) -> tuple[FloatArray, FloatArray]:
+    """:func:`glr_statistic_from_run` and, per epoch, the information C(θ) (3×3, (m/s)⁻²) of a jump there:
+    a jump ν gives ℓ a non-central χ²₃ law with non-centrality νᵀC(θ)ν."""
     if forward.phis.shape[0] != t_s.size:
         raise ValueError("the forward run did not store its gains (run_forward(..., store_gains=True))")
     innovs = np.where(np.isfinite(forward.innovation), forward.innovation, 0.0)

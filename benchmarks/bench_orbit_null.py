@@ -1,0 +1,200 @@
+"""False alarms of ``abrupt detect orbit`` on every complete real ephemeris in ``../shared/data/sp3``
+(every satellite of the multi-satellite files), at the default budget of one per week: events per
+satellite-day against the stated rate with a Poisson interval, pooled per orbit class (LEO, GNSS,
+geodetic), and the 90 %-detectable ΔV per file.
+
+Every file of the folder and of ``orekit-corpus/`` is read as a user would (``parse_sp3``; files the
+reader refuses are listed with their one-line error). A satellite is analysed when it has an arc the
+detector can calibrate itself on; shorter ones are counted as "too short" and add no exposure. Every
+event found on these products is treated as false: the two DORIS arcs have no manoeuvre, the GNSS
+day has been checked against no list (a BeiDou GEO/IGSO station-keeping burn is possible; any event is
+printed with its time so that it can be looked up).
+
+Pass rule per class (acceptance): the observed count is at most the upper end of the two-sided 95 %
+Poisson interval of the count expected at the stated rate, and the observed rate is at most 2 × the
+stated one. The realised rate is printed with its exact (Garwood) 95 % interval beside the stated rate.
+
+The two ILRS CPF predictions of ``../shared/data/tracking/ilrs-corpus`` (LAGEOS-1, Galileo 212; real,
+positions only) are added to their classes. No long geodetic (passive laser-ranging) SP3 arc is in
+``../shared``; two daily-arc products are simulated
+(:mod:`abrupt.simulate.products`, seeds other than those the boundary rule was developed on) and
+pooled as their own class, labelled as simulated.
+
+Held out: nothing in the detector was tuned on the GNSS or geodetic files; the self-calibration rules
+were set on Sentinel-3A (docs/orbit.md), so Sentinel-3A is in-sample and every other file held out. The
+boundary rule was developed on simulated products with seeds 0 and 1, and its pattern level relaxed from
+10⁻³ to 5 % after seeds 3 and 4 (the Etalon-like seed 4 kept 2 boundary events); the benchmark now uses
+seeds 5 and 6, not seen before.
+
+    nice python benchmarks/bench_orbit_null.py [--max-sats N] [--budget 1/week]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy import stats
+
+from abrupt.errors import InputError
+from abrupt.pipelines.orbit import detect_orbit
+from abrupt.readers.ephemeris import read_ephemeris
+from abrupt.readers.sp3 import parse_sp3
+from abrupt.series.ephemeris import Ephemeris
+from abrupt.simulate.products import DailyArcProduct, simulate_daily_arcs
+from abrupt.thresholds import FalseAlarmBudget
+
+DATA = Path(__file__).resolve().parents[1].parent / "shared/data/sp3"
+GNSS_PREFIXES = ("G", "R", "E", "C", "J", "I")
+SIMULATED = {
+    "simulated LAGEOS-like, 4 days at 2 min": DailyArcProduct(days=4, step_s=120.0, seed=5),
+    "simulated Etalon-like, 7 days at 15 min": DailyArcProduct(days=7, step_s=900.0, altitude_m=19.1e6, seed=6),
+}
+MIN_SPAN_H = 6.0  # shorter arcs: the filters settle for up to a few hours at each end
+
+
+@dataclass
+class ClassTally:
+    sat_days: float = 0.0
+    events: int = 0
+    satellites: int = 0
+    too_short: int = 0
+    files: set[str] = field(default_factory=set)
+
+
+def orbit_class(eph: Ephemeris) -> str:
+    """LEO below 2000 km; GNSS: a GNSS system letter and a navigation-satellite altitude (MEO, IGSO, GEO);
+    geodetic: the rest (passive laser-ranging satellites such as LAGEOS at 5900 km)."""
+    alt_km = float(np.median(np.linalg.norm(eph.position_m, axis=1))) / 1e3 - 6378.137
+    if alt_km < 2000.0:
+        return "LEO"
+    sid = eph.satellite.lower()
+    named = sid.startswith(("galileo", "glonass", "gps", "beidou", "compass", "qzs", "irnss"))
+    if alt_km > 15000.0 and (named or (eph.satellite[:1] in GNSS_PREFIXES and eph.satellite[1:].isdigit())):
+        return "GNSS"
+    return "geodetic"
+
+
+def garwood(n: int, alpha: float = 0.05) -> tuple[float, float]:
+    lo = 0.0 if n == 0 else float(stats.chi2.ppf(alpha / 2, 2 * n)) / 2
+    return lo, float(stats.chi2.ppf(1 - alpha / 2, 2 * n + 2)) / 2
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--max-sats", type=int, default=0, help="analyse at most N satellites per file (0: all)")
+    parser.add_argument("--budget", default="1/week")
+    parser.add_argument("--no-simulated", dest="simulated", action="store_false", help="skip the simulated products")
+    args = parser.parse_args()
+    budget = FalseAlarmBudget.parse(args.budget)
+    files = sorted(p for p in DATA.rglob("*") if ".sp3" in p.name)
+    tallies: dict[str, ClassTally] = {}
+    seen: set[bytes] = set()
+    print(f"{'file':44s} {'class':8s} {'sats':>5s} {'sat-days':>8s} {'events':>6s} {'expected':>8s}  ΔV90 (mm/s)")
+    t_start = time.time()
+    for path in files:
+        try:
+            content = parse_sp3(path)
+        except InputError as exc:
+            print(f"{path.name:44s} refused: {str(exc).split(': ', 1)[-1]}")
+            continue
+        per_class: dict[str, ClassTally] = {}
+        dv90: list[float] = []
+        notes: list[str] = []
+        sats = list(content.ephemerides.items())
+        if args.max_sats:
+            sats = sats[:: max(1, len(sats) // args.max_sats)][: args.max_sats]
+        for sid, eph in sats:
+            cls = orbit_class(eph)
+            tally = per_class.setdefault(cls, ClassTally())
+            span_h = float(eph.seconds[-1] - eph.seconds[0]) / 3600.0 if len(eph) > 1 else 0.0
+            key = eph.position_m.tobytes()  # corpus files repeat the same records under other names
+            if span_h < MIN_SPAN_H or key in seen:
+                tally.too_short += span_h < MIN_SPAN_H
+                continue
+            seen.add(key)
+            run = detect_orbit(eph, budget=budget)
+            if "glr" not in run.summary.get("thresholds", {}):
+                tally.too_short += 1
+                continue
+            tally.satellites += 1
+            tally.sat_days += span_h / 24.0
+            tally.events += len(run.events)
+            for t, dv in zip(run.events["time_utc"], run.events["dv_mps"], strict=True):
+                notes.append(f"{sid} {str(t)[:19]} {1e3 * dv:.3g} mm/s")
+            if np.isfinite(run.summary.get("dv90_mps", np.nan)):
+                dv90.append(1e3 * float(run.summary["dv90_mps"]))
+        for cls, tally in per_class.items():
+            total = tallies.setdefault(cls, ClassTally())
+            total.sat_days += tally.sat_days
+            total.events += tally.events
+            total.satellites += tally.satellites
+            total.too_short += tally.too_short
+            if tally.satellites:
+                total.files.add(path.name)
+            exp = budget.per_day * tally.sat_days
+            dv_txt = f"{np.median(dv90):.3g} (median; {min(dv90):.3g}-{max(dv90):.3g})" if dv90 else "-"
+            short = f"  [{tally.too_short} too short]" if tally.too_short else ""
+            print(
+                f"{path.name:44s} {cls:8s} {tally.satellites:5d} {tally.sat_days:8.2f} {tally.events:6d} "
+                f"{exp:8.2f}  {dv_txt}{short}"
+            )
+        for note in notes:
+            print(f"    event: {note}")
+    # real ILRS predictions (CPF, positions only) of a passive geodetic and a GNSS satellite: no SP3, but
+    # real orbits of the two classes the SP3 folder holds only briefly
+    for path in sorted((DATA.parent / "tracking" / "ilrs-corpus").glob("*_cpf_*")):
+        eph = read_ephemeris(path)
+        cls = orbit_class(eph)
+        total = tallies.setdefault(cls, ClassTally())
+        run = detect_orbit(eph, budget=budget)
+        days = float(eph.seconds[-1] - eph.seconds[0]) / 86400.0
+        total.satellites += 1
+        total.sat_days += days
+        total.events += len(run.events)
+        dv90 = 1e3 * float(run.summary.get("dv90_mps", np.nan))
+        print(
+            f"{path.name:44s} {cls:8s} {1:5d} {days:8.2f} {len(run.events):6d} {budget.per_day * days:8.2f}  "
+            f"{dv90:.3g}  [ILRS CPF prediction, positions only]"
+        )
+    if args.simulated:
+        # no long real geodetic arc is in ../shared: the daily-arc products that made the detector fail
+        # on real ILRS orbits are simulated (abrupt.simulate.products) and pooled as their own class
+        total = tallies.setdefault("geodetic (simulated daily arcs)", ClassTally())
+        for name, cfg in SIMULATED.items():
+            eph = simulate_daily_arcs(cfg)
+            run = detect_orbit(eph, budget=budget)
+            days = float(eph.seconds[-1] - eph.seconds[0]) / 86400.0
+            total.satellites += 1
+            total.sat_days += days
+            total.events += len(run.events)
+            nuisance = sum(not b["raised"] for b in run.summary.get("product_boundaries", []))
+            dv90 = 1e3 * float(run.summary.get("dv90_mps", np.nan))
+            print(
+                f"{name:44s} {'geodetic':8s} {1:5d} {days:8.2f} {len(run.events):6d} "
+                f"{budget.per_day * days:8.2f}  {dv90:.3g}  [{nuisance} day boundaries treated as nuisance]"
+            )
+    print(f"\nstated rate {budget.per_day:.4g} per satellite-day ({args.budget}); {time.time() - t_start:.0f} s")
+    print(
+        f"{'class':9s} {'sats':>5s} {'sat-days':>8s} {'events':>6s} {'expected':>8s} {'95% of expected':>16s} "
+        f"{'realised rate (95%)':>26s}  pass"
+    )
+    for cls, tally in sorted(tallies.items()):
+        exp = budget.per_day * tally.sat_days
+        lo_e, hi_e = (float(stats.poisson.ppf(0.025, exp)), float(stats.poisson.ppf(0.975, exp))) if exp else (0, 0)
+        lo, hi = garwood(tally.events)
+        rate = tally.events / tally.sat_days if tally.sat_days else float("nan")
+        ok = tally.events <= hi_e and (tally.events == 0 or rate <= 2 * budget.per_day)
+        realised = f"{rate:.3g} [{lo / tally.sat_days:.3g}, {hi / tally.sat_days:.3g}]" if tally.sat_days else "-"
+        note = "  (below the interval: conservative)" if tally.events < lo_e else ""
+        print(
+            f"{cls:9s} {tally.satellites:5d} {tally.sat_days:8.2f} {tally.events:6d} {exp:8.2f} "
+            f"{f'[{lo_e:.0f}, {hi_e:.0f}]':>16s} {realised:>26s}  {'PASS' if ok else 'FAIL'}{note}"
+        )
+
+
+if __name__ == "__main__":
+    main()
