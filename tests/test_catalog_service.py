@@ -133,6 +133,16 @@ def test_filters(catalog_target: str) -> None:
     ]
 
 
+def test_a_detector_filter_is_a_name_never_a_like_pattern(catalog_target: str) -> None:
+    cat = Catalog(catalog_target)
+    cat.add_events(
+        events_frame([_event("2026-01-01T00:00:00"), _event("2026-01-03T00:00:00", det="attitude.cusum")])
+    )
+    for pattern in ("%", "_", "att%", "%lr", "g_r", "attitud_"):
+        assert cat.events(detector=pattern).empty, pattern
+    assert len(cat.events(detector="cusum")) == 1
+
+
 def test_parquet_export_has_typed_utc_times_and_round_trips(catalog_target: str, tmp_path: Path) -> None:
     cat = Catalog(catalog_target)
     cat.add_events(events_frame([_event("2026-01-01T00:10:00.123456")]))

@@ -492,7 +492,13 @@ class Catalog:
             if "." in detector:
                 query = query.where(c.detector == detector)
             else:  # a capability (attitude) or a method (glr)
-                query = query.where(sa.or_(c.detector.like(f"{detector}.%"), c.detector.like(f"%.{detector}")))
+                # autoescape: a "%" or "_" in the name is a character, not a LIKE wildcard
+                query = query.where(
+                    sa.or_(
+                        c.detector.startswith(f"{detector}.", autoescape=True),
+                        c.detector.endswith(f".{detector}", autoescape=True),
+                    )
+                )
         if since is not None:
             query = query.where(c.time_utc >= _to_naive_utc(since))
         if until is not None:

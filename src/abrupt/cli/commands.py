@@ -21,6 +21,7 @@ import click
 from click.utils import make_default_short_help
 
 from abrupt import __version__
+from abrupt.cli.outputs import guard_outputs
 
 #: Global options accepted anywhere on the command line (moved before the sub-command by ``main``).
 GLOBAL_FLAGS = frozenset({"-v", "-vv", "-vvv", "--verbose", "-q", "--quiet"})
@@ -123,7 +124,8 @@ class LazyGroup(click.Group):
         if cmd_name not in self.commands and cmd_name in self.lazy_commands:
             command = load_command(self.lazy_commands[cmd_name])  # its decorator registers it here
             self.commands.setdefault(cmd_name, command)
-        return super().get_command(ctx, cmd_name)
+        found = super().get_command(ctx, cmd_name)
+        return guard_outputs(found) if found is not None else None
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         """The "Commands" section, with summaries of commands not yet imported read from their source."""

@@ -40,6 +40,7 @@ import pandas as pd
 from sgp4.api import WGS72, Satrec
 
 from abrupt.errors import InputError, RepairLog
+from abrupt.readers.tle_checks import check_element_history
 
 logger = logging.getLogger(__name__)
 
@@ -382,6 +383,7 @@ def history_from_sets(
         by_epoch[key_ms] = unique[k]
     repairs.record("same-epoch element sets replaced", replaced)
     final = [by_epoch[k] for k in sorted(by_epoch)]
+    check_element_history(final, source, repairs)
     name = next((s.name for s in final if s.name), None)
     return ElementHistory(elements_frame(final), [s.satrec for s in final], source, name, repairs, list(skipped))
 

@@ -1,0 +1,145 @@
+"""Plausible or refused: mutations of real files that once gave silently wrong results.
+
+Each test mutates a real file from ``../shared/data`` as a careless producer or a hostile user would,
+and asserts against the unmutated file (the independent truth): the damage is either refused with a
+one-line ``file:line: reason`` error or repaired and counted, never read as different data.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from abrupt.errors import InputError
+from abrupt.readers.sp3 import SP3_DOUBLED, SP3_NO_VELOCITY, SP3_ORPHAN_VELOCITY, parse_sp3
+from abrupt.readers.sp3_checks import check_position_velocity
+from abrupt.readers.tle import read_tle, tle_checksum
+
+JASON1_SP3 = "sp3/ssaja102.b03007.e03017.DGS.sp3"  # Jason-1 (L08), 60 s, positions and velocities
+N_EPOCHS = 240
+
+
+def _short_sp3(shared_data: Path) -> list[str]:
+    """The first N_EPOCHS epochs of the Jason-1 file, with the header's epoch count set to match."""
+    lines = (shared_data / JASON1_SP3).read_text(encoding="ascii").splitlines()
+    starts = [i for i, line in enumerate(lines) if line.startswith("*")]
+    out = [*lines[: starts[N_EPOCHS]], "EOF"]
+    out[0] = out[0][:32] + f"{N_EPOCHS:7d}" + out[0][39:]
+    return out
+
+
+def _write(tmp_path: Path, lines: list[str], name: str = "m.sp3") -> Path:
+    path = tmp_path / name
+    path.write_text("\n".join(lines) + "\n", encoding="ascii")
+    return path
+
+
+def _record_index(lines: list[str], tag: str, epoch: int) -> int:
+    starts = [i for i, line in enumerate(lines) if line.startswith("*")]
+    return next(i for i in range(starts[epoch], len(lines)) if lines[i].startswith(tag))
+
+
+def test_two_position_records_in_one_epoch_remove_the_epoch(shared_data: Path, tmp_path: Path) -> None:
+    clean = _short_sp3(shared_data)
+    truth = parse_sp3(_write(tmp_path, clean, "clean.sp3")).ephemerides["L08"]
+    lines = list(clean)
+    k = 100
+    v_k, p_next = _record_index(lines, "V", k), _record_index(lines, "P", k + 1)
+    lines[v_k], lines[p_next] = lines[p_next], lines[v_k]  # swapped lines: two P in epoch k, two V in k+1
+    content = parse_sp3(_write(tmp_path, lines))
+    eph = content.ephemerides["L08"]
+    assert content.repairs.counts[SP3_DOUBLED] == 1
+    assert content.repairs.counts[SP3_ORPHAN_VELOCITY] == 2
+    assert eph.times_utc.size == truth.times_utc.size - 2
+    kept = np.isin(truth.times_utc, eph.times_utc)
+    assert not kept[k] and not kept[k + 1]
+    np.testing.assert_array_equal(eph.position_m, truth.position_m[kept])  # no position moved in time
+    np.testing.assert_array_equal(eph.velocity_mps, truth.velocity_mps[kept])
+
+
+@pytest.mark.parametrize("damage", ["deleted", "inf"])
+def test_an_epoch_without_its_velocity_is_removed_and_counted(damage: str, shared_data: Path, tmp_path: Path) -> None:
+    clean = _short_sp3(shared_data)
+    truth = parse_sp3(_write(tmp_path, clean, "clean.sp3")).ephemerides["L08"]
+    lines = list(clean)
+    k = 150
+    v_k = _record_index(lines, "V", k)
+    if damage == "deleted":
+        del lines[v_k]
+    else:
+        lines[v_k] = lines[v_k][:4] + f"{'inf':>14s}" + lines[v_k][18:]
+    content = parse_sp3(_write(tmp_path, lines))
+    eph = content.ephemerides["L08"]
+    assert content.repairs.counts[SP3_NO_VELOCITY] == 1
+    assert np.isfinite(eph.velocity_mps).all()
+    kept = np.isin(truth.times_utc, eph.times_utc)
+    assert np.flatnonzero(~kept).tolist() == [k]
+    np.testing.assert_array_equal(eph.position_m, truth.position_m[kept])
+
+
+@pytest.mark.parametrize("factor", [0.1, 0.5, -1.0])
+def test_velocities_in_the_wrong_unit_are_refused(factor: float, shared_data: Path, tmp_path: Path) -> None:
+    lines = []
+    for line in _short_sp3(shared_data):
+        if line.startswith("V"):  # dm/s written as m/s (x0.1), as cm/s... (x0.5 for a halved value), flipped
+            vals = [float(line[4 + 14 * j : 18 + 14 * j]) * factor for j in range(3)]
+            line = line[:4] + "".join(f"{v:14.6f}" for v in vals) + line[46:]
+        lines.append(line)
+    path = _write(tmp_path, lines)
+    with pytest.raises(InputError) as info:
+        parse_sp3(path)
+    message = str(info.value)
+    assert "\n" not in message and f"{path}:" in message
+    assert "L08" in message and "derivative of its positions" in message
+
+
+def test_the_unmutated_file_passes_the_position_velocity_check(shared_data: Path) -> None:
+    eph = parse_sp3(shared_data / JASON1_SP3).ephemerides["L08"]
+    t = eph.times_utc.astype("datetime64[ns]").astype(np.int64)
+    ratio = check_position_velocity("L08", t, eph.position_m / 1e3, eph.velocity_mps * 10.0, np.arange(t.size), "x")
+    # the chord of a 60 s step is shorter than the arc by (n h)^2/6 = 7e-4 at the mean motion of Jason-1
+    n = 2 * np.pi / (112.4 * 60)
+    assert ratio is not None and abs(ratio - (1 - (n * 60) ** 2 / 6)) < 2e-4
+
+
+JASON3_TLE = "tle/Jason-3.tle"
+
+
+def _tle_sets(shared_data: Path, n_sets: int = 300) -> list[list[str]]:
+    lines = (shared_data / JASON3_TLE).read_text(encoding="ascii").splitlines()
+    starts = [i for i, line in enumerate(lines) if line.startswith("1 ")][:n_sets]
+    return [lines[i : i + 2] for i in starts]
+
+
+def _mean_motion_in_rad_per_min(line2: str) -> str:
+    rev_per_day = float(line2[52:63])
+    body = line2[:52] + f"{rev_per_day * 2 * np.pi / 1440:11.8f}" + line2[63:68]
+    return body + str(tle_checksum(body))
+
+
+def test_a_tle_history_with_mean_motion_in_rad_per_min_is_refused(shared_data: Path, tmp_path: Path) -> None:
+    sets = _tle_sets(shared_data)
+    clean = tmp_path / "clean.tle"
+    clean.write_text("\n".join(line for pair in sets for line in pair) + "\n", encoding="ascii")
+    assert len(read_tle(clean)) == len(sets)  # the unmutated sets pass the same checks
+    mutated = tmp_path / "radmin.tle"
+    mutated.write_text(
+        "\n".join(f"{l1}\n{_mean_motion_in_rad_per_min(l2)}" for l1, l2 in sets) + "\n", encoding="ascii"
+    )
+    with pytest.raises(InputError) as info:
+        read_tle(mutated)
+    message = str(info.value)
+    assert f"{mutated}:1:" in message and "rev/day" in message and "\n" not in message
+
+
+def test_one_tle_set_with_mean_motion_in_rad_per_min_is_refused(shared_data: Path, tmp_path: Path) -> None:
+    sets = _tle_sets(shared_data)
+    k = 120
+    sets[k][1] = _mean_motion_in_rad_per_min(sets[k][1])
+    path = tmp_path / "one.tle"
+    path.write_text("\n".join(line for pair in sets for line in pair) + "\n", encoding="ascii")
+    with pytest.raises(InputError) as info:
+        read_tle(path)
+    assert f"{path}:{2 * k + 1}:" in str(info.value)
