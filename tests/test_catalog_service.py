@@ -135,9 +135,7 @@ def test_filters(catalog_target: str) -> None:
 
 def test_a_detector_filter_is_a_name_never_a_like_pattern(catalog_target: str) -> None:
     cat = Catalog(catalog_target)
-    cat.add_events(
-        events_frame([_event("2026-01-01T00:00:00"), _event("2026-01-03T00:00:00", det="attitude.cusum")])
-    )
+    cat.add_events(events_frame([_event("2026-01-01T00:00:00"), _event("2026-01-03T00:00:00", det="attitude.cusum")]))
     for pattern in ("%", "_", "att%", "%lr", "g_r", "attitud_"):
         assert cat.events(detector=pattern).empty, pattern
     assert len(cat.events(detector="cusum")) == 1

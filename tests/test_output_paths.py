@@ -30,7 +30,9 @@ def _tle(shared_data: Path, tmp_path: Path) -> Path:
     return path
 
 
-def test_out_equal_to_the_input_is_refused(shared_data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_out_equal_to_the_input_is_refused(
+    shared_data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     tle = _tle(shared_data, tmp_path)
     before = _digest(tle)
     code, err = _run(["detect", "tle", str(tle), "--out", str(tle)], capsys)
