@@ -143,3 +143,32 @@ def test_one_tle_set_with_mean_motion_in_rad_per_min_is_refused(shared_data: Pat
     with pytest.raises(InputError) as info:
         read_tle(path)
     assert f"{path}:{2 * k + 1}:" in str(info.value)
+
+
+def test_infinite_and_absurd_telemetry_values_are_removed_and_counted_at_ingest(
+    shared_data: Path, tmp_path: Path
+) -> None:
+    import gzip
+
+    from abrupt.readers.archive import ARCHIVE_ABSURD, read_archive, read_decoder
+
+    folder = shared_data / "flight-like"
+    with gzip.open(folder / "telemetry" / "KESTREL2_2026-03-10.csv.gz", "rt", encoding="ascii") as fh:
+        lines = [next(fh) for _ in range(4000)]
+    decoder = read_decoder(folder / "decoder.csv")
+    clean = tmp_path / "KESTREL2_clean.csv"
+    clean.write_text("".join(lines), encoding="ascii")
+    truth = read_archive(clean, decoder).samples
+    bad_rows = {1000: "1e300", 2000: "inf", 3000: "-inf"}
+    for row, text in bad_rows.items():
+        time, name, _ = lines[row].rstrip("\n").split(",")
+        lines[row] = f"{time},{name},{text}\n"
+    mutated = tmp_path / "KESTREL2_mutated.csv"
+    mutated.write_text("".join(lines), encoding="ascii")
+    chunk = read_archive(mutated, decoder)
+    assert sum(r.removed[ARCHIVE_ABSURD] for r in chunk.per_day.values()) == len(bad_rows)
+    assert np.isfinite(chunk.samples["value"]).all()
+    assert len(chunk.samples) == len(truth) - len(bad_rows)
+    merged = chunk.samples.merge(truth, on=["spacecraft", "mnemonic", "time"], suffixes=("", "_truth"))
+    assert len(merged) == len(chunk.samples)
+    np.testing.assert_array_equal(merged["value"], merged["value_truth"])
