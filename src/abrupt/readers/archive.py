@@ -5,9 +5,9 @@ spacecraft name and every mnemonic by the pseudonyms of a decoder file (``real_n
 nothing downstream of this module ever sees the decoder or a real name. Archiver artifacts are then
 removed and counted (they are not data): blank rows, rows with an empty field, placeholder values
 (``-999999``, the text ``NaN``), infinite or absurd values (``inf``, ``1e300``: beyond 1e20, above
-any 64-bit counter; counter "infinite or absurd values (|v| > 1e20)"), exact duplicate rows. Conflicting duplicates (same time and mnemonic,
-different values) and time reversals are reported and resolved by keeping the first value in file
-order and sorting by time.
+any 64-bit counter; counter "infinite or absurd values (|v| > 1e20)"), exact duplicate rows.
+Conflicting duplicates (same time and mnemonic, different values) and time reversals are reported
+and resolved by keeping the first value in file order and sorting by time.
 
 Layouts:
 
