@@ -20,6 +20,11 @@ Documented repairs (counted in the :class:`~abrupt.errors.RepairLog` of each eph
   analysis centres) — is normalised ("epoch field at rollover value normalised");
 - a position given as 0.000000 or 999999.999999 (the SP3 "bad or absent" markers) removes that epoch
   for that satellite; such a velocity becomes NaN;
+- two ``P`` (or two ``V``) records of a satellite in one epoch remove that epoch for it; a ``V`` record
+  without its ``P`` is dropped; when a satellite has velocities at most epochs, an epoch without a
+  usable velocity (missing, malformed, marker) is removed (:func:`_epoch_structure`);
+- positions against velocities (:mod:`abrupt.readers.sp3_checks`): a satellite whose velocities are
+  not the derivative of its positions (a unit error) is an error naming it;
 - a malformed ephemeris record (unreadable number, truncated ``P``/``V`` line, unknown record type,
   implausible radius, malformed epoch line) in a long file is skipped and counted, up to 1 % of the
   records (so none in a file of fewer than 100 records); more is an error naming the first bad line;
