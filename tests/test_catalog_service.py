@@ -269,3 +269,23 @@ def test_narrow_view_fits_120_columns(tmp_path: Path, capsys: pytest.CaptureFixt
     out = capsys.readouterr().out
     assert "a-very-long-spac" in out
     assert max(len(line) for line in out.splitlines()) <= 120
+
+
+@pytest.mark.parametrize("rows", [0, 2])
+def test_another_programs_tables_are_refused_and_left_untouched(tmp_path: Path, rows: int) -> None:
+    path = tmp_path / "other.sqlite"
+    with sqlite3.connect(path) as conn:
+        conn.execute("CREATE TABLE events (id INTEGER PRIMARY KEY, title TEXT, start TEXT)")
+        conn.execute("CREATE TABLE runs (id INTEGER PRIMARY KEY, note TEXT)")
+        conn.executemany("INSERT INTO events (title, start) VALUES (?, ?)", [("party", "2026-01-01")] * rows)
+    before = path.read_bytes()
+    with pytest.raises(CatalogError) as info:
+        Catalog(path)
+    message = str(info.value)
+    assert "'events'" in message and "did not create" in message and "other.sqlite" in message
+    assert "\n" not in message
+    assert path.read_bytes() == before  # neither dropped, migrated nor given abrupt's tables
+    with sqlite3.connect(path) as conn:
+        assert conn.execute("SELECT count(*) FROM events").fetchone()[0] == rows
+        tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type='table'")}
+    assert tables == {"events", "runs"}

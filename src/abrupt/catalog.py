@@ -46,6 +46,7 @@ import pandas as pd
 import sqlalchemy as sa
 
 from abrupt import __version__
+from abrupt.catalog_foreign import foreign_table
 from abrupt.errors import AbruptError
 from abrupt.events import EVENT_COLUMNS, FLOAT_COLUMNS, format_time_utc, normalise_frame, write_events
 
@@ -274,6 +275,8 @@ class Catalog:
         self.dialect = self.engine.dialect.name
         if create:
             with self._writing() as conn:
+                if foreign := foreign_table(conn, (coverage_table, tasks_table), schema_table.name):
+                    raise CatalogError(f"{self.name}: {foreign}; abrupt never alters it: choose another --catalog")
                 _migrate_v1(conn)
                 _metadata.create_all(conn)
                 if conn.execute(sa.select(sa.func.count()).select_from(schema_table)).scalar_one() == 0:
