@@ -289,3 +289,32 @@ def test_another_programs_tables_are_refused_and_left_untouched(tmp_path: Path, 
         assert conn.execute("SELECT count(*) FROM events").fetchone()[0] == rows
         tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type='table'")}
     assert tables == {"events", "runs"}
+
+
+def test_texts_too_long_for_the_catalog_are_refused_alike_on_every_database(catalog_target: str) -> None:
+    cat = Catalog(catalog_target)
+    long_name = "s" * 250
+    with pytest.raises(CatalogError) as info:
+        cat.store_events(events_frame([_event("2026-01-01T00:00:00", sc=long_name)]))
+    assert "250 characters" in str(info.value) and "at most 200" in str(info.value)
+    assert cat.events().empty
+    cat.store_events(events_frame([_event("2026-01-01T00:00:00", sc="s" * 200)]))  # at the limit: stored
+    assert len(cat.events()) == 1
+
+
+def test_a_name_too_long_writes_neither_the_file_nor_a_run(
+    shared_data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    lines = (shared_data / "tle" / "Jason-3.tle").read_text(encoding="ascii").splitlines()[:400]
+    tle = tmp_path / "j3.tle"
+    tle.write_text("\n".join(lines) + "\n", encoding="ascii")
+    out, catalog = tmp_path / "events.csv", tmp_path / "c.sqlite"
+    argv = ["detect", "tle", str(tle), "--out", str(out), "--catalog", str(catalog), "--name", "x" * 250]
+    with pytest.raises(SystemExit) as exit_info:
+        main(argv)
+    assert exit_info.value.code == 2
+    error = capsys.readouterr().err.strip().splitlines()[-1]  # after the detection's own summary lines
+    assert error.startswith("error: ") and "at most 200" in error
+    assert not out.exists()
+    with sqlite3.connect(catalog) as conn:
+        assert conn.execute("SELECT count(*) FROM runs").fetchone()[0] == 0

@@ -46,7 +46,7 @@ import pandas as pd
 import sqlalchemy as sa
 
 from abrupt import __version__
-from abrupt.catalog_foreign import foreign_table
+from abrupt.catalog_foreign import foreign_table, too_long_text
 from abrupt.errors import AbruptError
 from abrupt.events import EVENT_COLUMNS, FLOAT_COLUMNS, format_time_utc, normalise_frame, write_events
 
@@ -383,9 +383,15 @@ class Catalog:
         return self.store_events(frame).events
 
     @_one_line_errors
+    def check_fits(self, frame: pd.DataFrame) -> None:
+        """Refuse texts longer than the catalog's columns (the same limit on SQLite and PostgreSQL)."""
+        if reason := too_long_text(normalise_frame(frame), events_table):
+            raise CatalogError(f"{self.name}: {reason}")
+
     def store_events(self, frame: pd.DataFrame) -> Added:
         """Store detections not yet in the catalog; new detections join existing events where they match."""
         frame = normalise_frame(frame)
+        self.check_fits(frame)
         if frame.empty:
             return Added(0, 0)
         with self._writing() as conn:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+import pandas as pd
 import sqlalchemy as sa
 
 V1_COLUMNS = {
@@ -34,4 +35,21 @@ def foreign_table(conn: sa.Connection, later_tables: Sequence[sa.Table], marker:
             if missing:
                 first = sorted(missing)[0]
                 return f"holds a table {table!r} that abrupt did not create (no column {first!r}, no {marker} table)"
+    return None
+
+
+def too_long_text(frame: pd.DataFrame, table: sa.Table) -> str | None:
+    """The first text of ``frame`` longer than its column of ``table`` allows, or None.
+
+    SQLite stores a longer text without a word, PostgreSQL refuses it mid-run: the same limit is
+    checked on both, before anything is written.
+    """
+    for column in table.c:
+        limit = getattr(column.type, "length", None)
+        if limit is None or column.name not in frame or not len(frame):
+            continue
+        lengths = frame[column.name].astype("string").str.len().fillna(0)
+        if (lengths > limit).any():
+            value = str(frame[column.name].astype("string")[lengths > limit].iloc[0])
+            return f"{column.name} {value[:40]!r}… has {len(value)} characters; the catalog holds at most {limit}"
     return None
