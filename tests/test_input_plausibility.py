@@ -172,3 +172,40 @@ def test_infinite_and_absurd_telemetry_values_are_removed_and_counted_at_ingest(
     merged = chunk.samples.merge(truth, on=["spacecraft", "mnemonic", "time"], suffixes=("", "_truth"))
     assert len(merged) == len(chunk.samples)
     np.testing.assert_array_equal(merged["value"], merged["value_truth"])
+
+
+def test_a_very_long_line_in_a_tle_file_is_an_error_quoting_80_characters(shared_data: Path, tmp_path: Path) -> None:
+    sets = _tle_sets(shared_data, 50)
+    lines = [line for pair in sets for line in pair]
+    lines.insert(40, "JASON 3 " + "x" * 2_000_000)  # read as a 3LE name line today
+    path = tmp_path / "long.tle"
+    path.write_text("\n".join(lines) + "\n", encoding="ascii")
+    with pytest.raises(InputError) as info:
+        read_tle(path)
+    message = str(info.value)
+    assert f"{path}:41:" in message and "2000008 characters" in message
+    assert len(message) < len(str(path)) + 250
+
+
+def test_a_non_utf8_byte_in_an_orekit_setup_file_names_its_line(shared_data: Path, tmp_path: Path) -> None:
+    from abrupt.readers.orekit_od_input import read_od_input
+
+    data = (shared_data / "tracking" / "od_test_W3.in").read_bytes().splitlines(keepends=True)
+    data[5] = b"# station named Cr\xe9teil\n"
+    path = tmp_path / "setup.in"
+    path.write_bytes(b"".join(data))
+    with pytest.raises(InputError) as info:
+        read_od_input(path)
+    assert f"{path}:6:" in str(info.value) and "0xe9" in str(info.value)
+
+
+def test_an_aer_error_quotes_at_most_80_characters_of_a_long_line(shared_data: Path, tmp_path: Path) -> None:
+    from abrupt.readers.aer import read_aer
+
+    lines = (shared_data / "tracking" / "W3B.aer").read_text(encoding="ascii").splitlines()[:50]
+    lines.insert(20, "2010-11-02T03:00:13.3851 RANGE " + "9" * 1_000_000)
+    path = tmp_path / "long.aer"
+    path.write_text("\n".join(lines) + "\n", encoding="ascii")
+    with pytest.raises(InputError) as info:
+        read_aer(path)
+    assert f"{path}:21:" in str(info.value) and len(str(info.value)) < len(str(path)) + 300
