@@ -209,3 +209,24 @@ def test_an_aer_error_quotes_at_most_80_characters_of_a_long_line(shared_data: P
     with pytest.raises(InputError) as info:
         read_aer(path)
     assert f"{path}:21:" in str(info.value) and len(str(info.value)) < len(str(path)) + 300
+
+
+def test_real_names_are_replaced_whatever_their_case(shared_data: Path, tmp_path: Path) -> None:
+    import gzip
+
+    from abrupt.readers.archive import pseudonymise_text, read_archive, read_decoder
+
+    folder = shared_data / "flight-like"
+    decoder = read_decoder(folder / "decoder.csv")
+    real = next(iter(decoder.spacecraft))  # the spacecraft's real name, as the decoder spells it
+    pseudo = decoder.spacecraft[real]
+    for spelling in (real, real.lower(), real.title()):
+        out = pseudonymise_text(f"{spelling}_lower.csv holds {spelling}", decoder)
+        assert real.lower() not in out.lower() and out == f"{pseudo}_lower.csv holds {pseudo}"
+    with gzip.open(folder / "telemetry" / "KESTREL2_2026-03-10.csv.gz", "rt", encoding="ascii") as fh:
+        lines = [next(fh) for _ in range(200)]
+    path = tmp_path / f"{real.lower()}_lower.csv"
+    path.write_text("".join(lines), encoding="ascii")
+    chunk = read_archive(path, decoder)
+    sources = [s for report in chunk.per_day.values() for s in report.sources]
+    assert sources and all(real.lower() not in s.lower() for s in sources)

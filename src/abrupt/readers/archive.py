@@ -27,6 +27,7 @@ from __future__ import annotations
 import csv
 import gzip
 import hashlib
+import re
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -154,12 +155,15 @@ class ArchiveChunk:
 
 
 def pseudonymise_text(text: str, decoder: Decoder) -> str:
-    """``text`` with every real name of the decoder replaced by its pseudonym (longest names first)."""
-    pairs = sorted({**decoder.spacecraft, **decoder.mnemonics}.items(), key=lambda kv: -len(kv[0]))
-    for real, pseudo in pairs:
-        if real in text:
-            text = text.replace(real, pseudo)
-    return text
+    """``text`` with every real name of the decoder replaced by its pseudonym, whatever its case
+    (``kestrel2_dump.csv`` as well as ``KESTREL2``); the longest name wins where names overlap."""
+    by_lower: dict[str, str] = {}
+    for real, pseudo in {**decoder.spacecraft, **decoder.mnemonics}.items():
+        by_lower.setdefault(real.lower(), pseudo)
+    if not by_lower or not text:
+        return text
+    pattern = re.compile("|".join(re.escape(r) for r in sorted(by_lower, key=len, reverse=True)), re.IGNORECASE)
+    return pattern.sub(lambda m: by_lower[m.group(0).lower()], text)
 
 
 def _read_raw(path: Path) -> pa.Table:
