@@ -230,3 +230,20 @@ def test_real_names_are_replaced_whatever_their_case(shared_data: Path, tmp_path
     chunk = read_archive(path, decoder)
     sources = [s for report in chunk.per_day.values() for s in report.sources]
     assert sources and all(real.lower() not in s.lower() for s in sources)
+
+
+def test_a_missing_archive_is_named_by_its_pseudonym(
+    shared_data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from abrupt.cli.main import main
+    from abrupt.readers.archive import read_decoder
+
+    decoder_path = shared_data / "flight-like" / "decoder.csv"
+    real = next(iter(read_decoder(decoder_path).spacecraft))
+    for name in (f"{real}_2026-03-10.csv", f"{real.lower()}_lower.csv"):
+        argv = ["ingest", str(tmp_path / name), "--decoder", str(decoder_path), "--store", str(tmp_path / "s")]
+        with pytest.raises(SystemExit) as info:
+            main(argv)
+        err = capsys.readouterr().err
+        assert info.value.code == 2 and "does not exist" in err
+        assert real.lower() not in err.lower()
