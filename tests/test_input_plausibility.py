@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from abrupt.errors import InputError
 from abrupt.readers.sp3 import SP3_DOUBLED, SP3_NO_VELOCITY, SP3_ORPHAN_VELOCITY, parse_sp3
@@ -98,9 +100,12 @@ def test_velocities_in_the_wrong_unit_are_refused(factor: float, shared_data: Pa
 def test_the_unmutated_file_passes_the_position_velocity_check(shared_data: Path) -> None:
     eph = parse_sp3(shared_data / JASON1_SP3).ephemerides["L08"]
     t = eph.times_utc.astype("datetime64[ns]").astype(np.int64)
-    ratio = check_position_velocity("L08", t, eph.position_m / 1e3, eph.velocity_mps * 10.0, np.arange(t.size), "x")
+    ratio, suspect = check_position_velocity(
+        "L08", t, eph.position_m / 1e3, eph.velocity_mps * 10.0, np.arange(t.size), "x"
+    )
     # the chord of a 60 s step is shorter than the arc by (n h)^2/6 = 7e-4 at the mean motion of Jason-1
     n = 2 * np.pi / (112.4 * 60)
+    assert not suspect.any()
     assert ratio is not None and abs(ratio - (1 - (n * 60) ** 2 / 6)) < 2e-4
 
 
@@ -247,3 +252,39 @@ def test_a_missing_archive_is_named_by_its_pseudonym(
         err = capsys.readouterr().err
         assert info.value.code == 2 and "does not exist" in err
         assert real.lower() not in err.lower()
+
+
+@settings(max_examples=60, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
+@given(data=st.data())
+def test_sp3_line_mutations_are_refused_or_leave_every_kept_state_true(
+    shared_data: Path, tmp_path_factory: pytest.TempPathFactory, data: st.DataObject
+) -> None:
+    """Swapped, deleted and duplicated ephemeris lines: an error, or every epoch kept holds its true state."""
+    clean = _short_sp3(shared_data)
+    folder = tmp_path_factory.mktemp("sp3mut")
+    truth = parse_sp3(_write(folder, clean, "clean.sp3")).ephemerides["L08"]
+    body = [i for i, line in enumerate(clean) if line[:1] in ("*", "P", "V")]
+    lines = list(clean)
+    kind = data.draw(st.sampled_from(["swap", "swap near", "delete", "duplicate"]))
+    a = data.draw(st.sampled_from(body))
+    if kind == "swap":
+        b = data.draw(st.sampled_from(body))
+        lines[a], lines[b] = lines[b], lines[a]
+    elif kind == "swap near":
+        b = min(a + data.draw(st.integers(1, 4)), body[-1])
+        lines[a], lines[b] = lines[b], lines[a]
+    elif kind == "delete":
+        del lines[a]
+        lines[0] = lines[0][:32] + f"{sum(line.startswith('*') for line in lines):7d}" + lines[0][39:]
+    else:
+        lines.insert(a, lines[a])
+        lines[0] = lines[0][:32] + f"{sum(line.startswith('*') for line in lines):7d}" + lines[0][39:]
+    try:
+        eph = parse_sp3(_write(folder, lines)).ephemerides["L08"]
+    except InputError as exc:
+        assert "\n" not in str(exc)
+        return
+    at = np.searchsorted(truth.times_utc, eph.times_utc)
+    assert np.all(truth.times_utc[np.minimum(at, truth.times_utc.size - 1)] == eph.times_utc)
+    np.testing.assert_array_equal(eph.position_m, truth.position_m[at])
+    np.testing.assert_array_equal(eph.velocity_mps, truth.velocity_mps[at])

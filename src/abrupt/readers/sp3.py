@@ -79,6 +79,7 @@ MAX_RADIUS_KM = 2.0e6  # [km] largest plausible geocentric radius (beyond the Mo
 BAD_RECORD_FRACTION = 0.01  # more malformed records than this (and more than one) is an error
 SP3_DOUBLED = "two P or two V records of a satellite in one epoch (epoch removed)"
 SP3_ORPHAN_VELOCITY = "velocity record without its position record (dropped)"
+SP3_PV_MISMATCH = "epoch whose position or velocity disagrees with its neighbours (removed with them)"
 SP3_NO_VELOCITY = "epoch without a usable velocity in a file with velocities (epoch removed)"
 
 
@@ -430,7 +431,9 @@ def _finish(
     log.record("duplicate epoch dropped", int(np.count_nonzero(~keep)))
     t_sys, st, lines = t_sys[keep], st[keep], lines[keep]
     if header.has_velocity:
-        check_position_velocity(sid, t_sys.astype(np.int64), st[:, :3], st[:, 3:6], lines, file)
+        _, suspect = check_position_velocity(sid, t_sys.astype(np.int64), st[:, :3], st[:, 3:6], lines, file)
+        log.record(SP3_PV_MISMATCH, int(np.count_nonzero(suspect)))
+        t_sys, st, lines = t_sys[~suspect], st[~suspect], lines[~suspect]
     if t_sys.size >= 2 and header.interval_s > 0:
         step = np.diff(t_sys).astype(np.float64) * 1e-9
         n_missing = int(np.sum(np.maximum(np.round(step / header.interval_s) - 1, 0)))

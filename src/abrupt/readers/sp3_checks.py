@@ -20,6 +20,7 @@ from abrupt.model.orbit.constants import MU_EARTH_M3_S2, OMEGA_EARTH_RAD_S
 
 PV_TRUNCATION_LIMIT = 0.01  # central differences used only where their error bound is below 1 % of |v|
 PV_RATIO_RANGE = (0.8, 1.25)  # accepted median ratio of the derivative of the positions to the velocities
+PV_EPOCH_LIMIT = 0.05  # one epoch's derivative and velocity differ by more than this fraction of |v|
 PV_MIN_EPOCHS = 3  # fewer usable epochs: the check is not made
 
 
@@ -30,15 +31,19 @@ def check_position_velocity(
     velocity_dms: NDArray[np.float64],
     lines: NDArray[np.int64],
     file: str,
-) -> float | None:
+) -> tuple[float | None, NDArray[np.bool_]]:
     """Refuse a satellite whose velocities are not the derivative of its positions.
 
     Returns the median ratio ``|d r/dt| / |v|`` (None when fewer than :data:`PV_MIN_EPOCHS` epochs
-    allow the comparison). Raises :class:`InputError` naming the satellite and the first line used.
+    allow the comparison) and the mask of epochs to remove: where the derivative and the velocity
+    differ by more than :data:`PV_EPOCH_LIMIT` of the speed, the epoch and both its neighbours (a
+    misplaced position spoils the differences on either side of it, a misplaced velocity its own).
+    Raises :class:`InputError` naming the satellite and the first line used.
     """
     n = t_ns.size
+    suspect = np.zeros(n, dtype=bool)
     if n < 3:
-        return None
+        return None, suspect
     h1 = (t_ns[1:-1] - t_ns[:-2]).astype(np.float64) * 1e-9
     h2 = (t_ns[2:] - t_ns[1:-1]).astype(np.float64) * 1e-9
     r = position_km * 1e3
@@ -60,7 +65,7 @@ def check_position_velocity(
             & (bound < PV_TRUNCATION_LIMIT * speed)
         )
     if np.count_nonzero(usable) < PV_MIN_EPOCHS:
-        return None
+        return None, suspect
     ratio = np.linalg.norm(derivative[usable], axis=1) / speed[usable]
     cosine = np.einsum("ij,ij->i", derivative[usable], v[usable]) / (
         np.linalg.norm(derivative[usable], axis=1) * speed[usable]
@@ -76,4 +81,8 @@ def check_position_velocity(
             file=file,
             line=first,
         )
-    return median
+    with np.errstate(invalid="ignore"):
+        residual = np.linalg.norm(derivative - v, axis=1) / speed
+    for i in np.flatnonzero(usable & (residual > PV_EPOCH_LIMIT)):
+        suspect[i : i + 3] = True  # centre i + 1 of the full arrays and its two neighbours
+    return median, suspect
