@@ -261,7 +261,44 @@ class _IngestOne:
         return time.process_time() - c
 
 
-def part_year(store: Path, n_days: int = 365, workers: int = 2) -> None:
+REFERENCE = """
+import sys, tempfile, time
+from pathlib import Path
+from abrupt.model.spacecraft import load_spacecraft
+from abrupt.pipelines.flight import FlightRunConfig, ingest_archives, run_flight
+files, decoder, sc = [Path(p) for p in sys.argv[3:]], sys.argv[1], load_spacecraft(sys.argv[2])
+with tempfile.TemporaryDirectory() as tmp:
+    w, c = time.perf_counter(), time.process_time()
+    ingest_archives(files, decoder, Path(tmp) / "s")
+    res = run_flight(Path(tmp) / "s", sc, FlightRunConfig())
+    print(time.perf_counter() - w, time.process_time() - c, len(res.events))
+"""
+
+
+def same_run_reference(files: list[Path], sc_path: Path, baseline: Path) -> None:
+    """The previous release and this tree, one process each, one after the other, on the same days."""
+    import os
+    import subprocess
+
+    out = {}
+    for label, src in (("previous release", baseline), ("this tree", ROOT / "src")):
+        env = {**os.environ, "PYTHONPATH": str(src), "OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS", "")}
+        env = {k: v for k, v in env.items() if v != ""}
+        args = [sys.executable, "-c", REFERENCE, str(DATA / "decoder.csv"), str(sc_path), *map(str, files)]
+        run = subprocess.run(args, env=env, capture_output=True, text=True)
+        if run.returncode != 0:
+            print(f"  reference ({label}) failed: {run.stderr.strip().splitlines()[-1:]}")
+            return
+        wall, cpu, n = run.stdout.split()
+        out[label] = (float(wall), float(cpu), int(n))
+        print(
+            f"  {label}: {len(files)} days in one process, {float(wall):.1f} s wall, {float(cpu):.1f} s CPU, {n} events"
+        )
+    (wp, cp, _), (wt, ct, _) = out["previous release"], out["this tree"]
+    print(f"  ratio this/previous: wall {wt / wp:.2f}, CPU {ct / cp:.2f}   (load average {os.getloadavg()})")
+
+
+def part_year(store: Path, n_days: int = 365, workers: int = 2, baseline: Path | None = None) -> None:
     """Ingest + detection of n_days of 1 Hz telemetry (>= 12 channels) on `workers` processes."""
     import os
     import resource
@@ -328,6 +365,9 @@ def part_year(store: Path, n_days: int = 365, workers: int = 2) -> None:
         f" ({int((fa & ~at_seam).sum()) / len(files):.2f}/day elsewhere)"
     )
     print(res.daily[["analysed_fraction", "noise_floor_Nms", "events"]].describe().to_string())
+    if baseline is not None and baseline.is_dir():
+        print("  same-run reference (the first two archive days):")
+        same_run_reference(files[:2], base / "kestrel-year.toml", baseline)
 
 
 if __name__ == "__main__":
@@ -336,6 +376,7 @@ if __name__ == "__main__":
     ap.add_argument("--parts", default="detect")
     ap.add_argument("--days", type=int, default=365, help="days of the year part")
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--baseline", default="/work/baseline/src", help="src of the previous release (year part)")
     args = ap.parse_args()
     if not DATA.exists():
         sys.exit("../shared/data/flight-like not found")
@@ -343,7 +384,7 @@ if __name__ == "__main__":
     ensure_store(store)
     for p in args.parts.split(","):
         if p == "year":
-            part_year(store, args.days, args.workers)
+            part_year(store, args.days, args.workers, Path(args.baseline))
         elif p == "memory":
             part_memory(store, args.days if args.days != 365 else 30)
         else:

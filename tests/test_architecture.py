@@ -41,6 +41,7 @@ LAYERS: dict[str, int] = {
     "massprops": 6,
     "rates": 6,
     "detect": 7,
+    "flux": 7,
     "simulate": 8,
     "density": 8,
     "pipelines": 9,

@@ -48,7 +48,14 @@ import sqlalchemy as sa
 from abrupt import __version__
 from abrupt.catalog_foreign import foreign_table, too_long_text
 from abrupt.errors import AbruptError
-from abrupt.events import EVENT_COLUMNS, FLOAT_COLUMNS, format_time_utc, normalise_frame, write_events
+from abrupt.events import (
+    EVENT_COLUMNS,
+    FLOAT_COLUMNS,
+    format_time_columns,
+    format_time_utc,
+    normalise_frame,
+    write_events,
+)
 
 SCHEMA_VERSION = 2
 #: Key of the PostgreSQL advisory lock that serialises catalog writers (any fixed 64-bit integer).
@@ -545,9 +552,10 @@ class Catalog:
     def export(self, path: str | Path, **filters: Any) -> int:
         """Export events (filters as :meth:`events`) to CSV or Parquet (by suffix); return the row count.
 
-        Parquet stores ``time_utc`` as a UTC timestamp.
+        Parquet stores ``time_utc`` as a UTC timestamp; every other ``*_utc`` column (the detectors'
+        details) is ISO-8601 UTC text with a ``Z``, the format of ``time_utc`` in CSV.
         """
-        frame = self.events(**filters)
+        frame = format_time_columns(self.events(**filters))
         write_events(frame, str(path))
         return len(frame)
 

@@ -99,34 +99,59 @@ def run_tasks(
     desc: str = "tasks",
     unit: str = "task",
     show_progress: bool | None = None,
+    keep_results: bool = True,
+    max_in_flight: int | None = None,
 ) -> list[R]:
     """``[fn(t) for t in tasks]`` on the executor; ``on_result`` sees each result as it arrives.
 
-    ``show_progress`` defaults to showing a bar when standard error is a terminal.
+    ``show_progress`` defaults to showing a bar when standard error is a terminal. For long task lists
+    (a catalogue of objects) ``keep_results=False`` hands each result to ``on_result`` only (the
+    returned list holds ``None``), and at most ``max_in_flight`` tasks (default: four per worker on
+    a local cluster, 64 on a scheduler) are submitted at once, so memory does not grow with the number
+    of tasks.
     """
     from tqdm import tqdm
 
     executor = executor or Executor()
     hidden = not sys.stderr.isatty() if show_progress is None else not show_progress
     results: list[Any] = [None] * len(tasks)
+
+    def take(i: int, result: R) -> None:
+        if keep_results:
+            results[i] = result
+        if on_result is not None:
+            on_result(TaskResult(i, tasks[i], result))
+
     with tqdm(total=len(tasks), desc=desc, unit=unit, disable=hidden, leave=False) as bar:
         if executor.in_process or not tasks:
             for i, task in enumerate(tasks):
-                results[i] = fn(task)
-                if on_result is not None:
-                    on_result(TaskResult(i, task, results[i]))
+                take(i, fn(task))
                 bar.update(1)
             return results
         from distributed import as_completed
 
+        limit = max_in_flight or (4 * executor.workers if executor.workers else 64)
         with dask_client(executor) as client:
-            futures = client.map(fn, list(tasks), pure=False)
-            index = {f.key: i for i, f in enumerate(futures)}
-            for future in as_completed(futures):
-                i = index[future.key]
-                results[i] = future.result()
+            index: dict[str, int] = {}
+            pending = iter(range(len(tasks)))
+
+            def submit() -> Any:
+                i = next(pending, None)
+                if i is None:
+                    return None
+                future = client.submit(fn, tasks[i], pure=False)
+                index[future.key] = i
+                return future
+
+            first = [f for f in (submit() for _ in range(min(limit, len(tasks)))) if f is not None]
+            queue = as_completed(first)
+            for future in queue:
+                i = index.pop(future.key)
+                result = future.result()
                 future.release()
-                if on_result is not None:
-                    on_result(TaskResult(i, tasks[i], results[i]))
+                take(i, result)
                 bar.update(1)
+                nxt = submit()
+                if nxt is not None:
+                    queue.add(nxt)
     return results

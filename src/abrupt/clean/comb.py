@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.signal import lombscargle
+from threadpoolctl import threadpool_limits
 
 from abrupt.types import BoolArray, FloatArray
 
@@ -207,6 +208,9 @@ class _Bins:
         return np.asarray(after / self.n[b0:b1, None], dtype=np.float64)
 
 
+# Hundreds of ≤ 30-column normal equations per day: threaded BLAS only adds synchronisation (on a
+# loaded two-core machine it made the fits 6× slower: docs/performance.md), so one thread here.
+@threadpool_limits.wrap(limits=1, user_api="blas")
 def smooth_model(
     h: FloatArray,
     t_s: FloatArray,

@@ -44,12 +44,14 @@ TOP_COMMANDS = {
     "estimate": "abrupt.cli.mass:estimate",
     "ingest": "abrupt.cli.flight:ingest_cmd",
     "rates": "abrupt.cli.rates:rates",
+    "flux": "abrupt.cli.flux:flux",
     "score": "abrupt.cli.tle:score",
 }
 SIMULATE_COMMANDS = {
     "attitude": "abrupt.cli.attitude:simulate_attitude_cmd",
     "docking": "abrupt.cli.mass:simulate_docking_cmd",
     "orbit": "abrupt.cli.orbit:simulate_orbit_command",
+    "population": "abrupt.cli.flux:population",
     "tracking": "abrupt.cli.tracking:simulate_tracking_command",
 }
 DETECT_COMMANDS = {

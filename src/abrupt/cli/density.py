@@ -6,7 +6,8 @@ from typing import Any
 
 import click
 
-from abrupt.cli.groups import cli
+from abrupt.cli.fleet import gather_paths, with_parts_options
+from abrupt.cli.groups import cli, progress_hidden
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.density.constellation import ConstellationConfig
 from abrupt.density.joint import JointConfig
@@ -14,8 +15,11 @@ from abrupt.density.meteors import estimate_density_ratios, read_radar_csv
 from abrupt.density.precise_orbit import OrbitDensityConfig
 from abrupt.density.tle_drag import TleDragConfig
 from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET
+from abrupt.events import read_events
+from abrupt.pipelines.catalogue import file_key, maneuver_times_by_object, run_catalogue
 from abrupt.pipelines.density import orbit_density, tle_density, write_table
 from abrupt.report.density import plot_density_bands, plot_meteor_profile
+from abrupt.scale import Executor
 
 TLE_BUDGET = str(DEFAULT_TLE_BUDGET)  # "1/year", the maneuver detector's
 
@@ -26,7 +30,7 @@ def density() -> None:
 
 
 @density.command("tle")
-@click.argument("paths", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False))
+@click.argument("paths", nargs=-1, required=False, type=click.Path(exists=True, dir_okay=False))
 @click.option("--out", type=click.Path(dir_okay=False), required=True, help="Windows table (.csv or .parquet).")
 @click.option(
     "--platforms",
@@ -72,6 +76,20 @@ def density() -> None:
 )
 @click.option("--workers", type=int, default=1, show_default=True, help="Processes for many objects.")
 @click.option("--report", type=click.Path(dir_okay=False), default=None, help="PNG: density vs NRLMSIS per band.")
+@click.option(
+    "--windows-only",
+    is_flag=True,
+    help="Catalogue screening: only each object's ρB windows (no constellation fit), streamed file by file, "
+    "resumable, on --workers local processes or --scheduler; files may hold many objects.",
+)
+@click.option("--scheduler", default=None, help="With --windows-only: the Dask cluster at this scheduler address.")
+@click.option(
+    "--maneuvers-from",
+    type=click.Path(exists=True, dir_okay=False),
+    default=None,
+    help="With --windows-only: maneuver events of 'abrupt detect tle-batch' (not detected again).",
+)
+@with_parts_options
 def density_tle(
     paths: tuple[str, ...],
     out: str,
@@ -86,6 +104,12 @@ def density_tle(
     no_order_statistics: bool,
     workers: int,
     report: str | None,
+    windows_only: bool,
+    scheduler: str | None,
+    maneuvers_from: str | None,
+    paths_from: str | None,
+    parts: str | None,
+    keep_parts: bool,
     **budget: Any,
 ) -> None:
     """ρB per window from element-set histories; with several objects, density by order statistics.
@@ -98,6 +122,26 @@ def density_tle(
         raise click.BadParameter("must be > 0", param_hint="--interval-days")
     if node_days <= 0 or block_days <= 0:
         raise click.BadParameter("must be > 0", param_hint="--node-days/--block-days")
+    files = gather_paths(paths, paths_from)
+    if windows_only:
+        _windows_only(
+            files,
+            out,
+            interval_days,
+            maneuvers,
+            maneuver_budget,
+            no_model,
+            space_weather,
+            workers,
+            scheduler,
+            maneuvers_from,
+            parts,
+            keep_parts,
+        )
+        return
+    if maneuvers_from or scheduler:
+        raise click.UsageError("--maneuvers-from and --scheduler go with --windows-only")
+    paths = tuple(files)
     res = tle_density(
         list(paths),
         platforms=platforms,
@@ -236,3 +280,51 @@ def density_meteors(radar: str, out: str, report: str | None) -> None:
     if report:
         plot_meteor_profile(res.ratios, report)
         click.echo(f"report: {report}")
+
+
+def _windows_only(
+    files: list[str],
+    out: str,
+    interval_days: float,
+    maneuvers: str,
+    maneuver_budget: Any,
+    no_model: bool,
+    space_weather: str | None,
+    workers: int,
+    scheduler: str | None,
+    maneuvers_from: str | None,
+    parts: str | None,
+    keep_parts: bool,
+) -> None:
+    """``density tle --windows-only``: every object's ρB windows, resumable, on the executor."""
+    if not out.lower().endswith((".parquet", ".csv")):
+        raise click.BadParameter(f"{out!r} must end in .parquet or .csv", param_hint="--out")
+    executor = Executor(workers=workers if workers > 1 else None, scheduler=scheduler)
+    cfg = TleDragConfig(interval_days=interval_days, with_model=not no_model, maneuver_budget=maneuver_budget)
+    settings: dict[str, Any] = {
+        "interval_days": interval_days,
+        "with_model": not no_model,
+        "maneuvers": maneuvers,
+        "budget": str(maneuver_budget),
+        "space_weather": space_weather,
+        "drag_object": cfg,
+    }
+    if maneuvers_from:
+        settings["maneuvers_from"] = file_key(maneuvers_from)
+        settings["maneuver_times_object"] = maneuver_times_by_object(read_events(maneuvers_from))
+    click.echo(f"{len(files)} element file(s) on {executor.describe()}", err=True)
+    run = run_catalogue(
+        files,
+        "density",
+        settings,
+        out,
+        parts=parts,
+        executor=executor,
+        show_progress=not progress_hidden(),
+        keep_parts=keep_parts,
+    )
+    if run.n_resumed:
+        click.echo(f"{run.n_resumed} of {run.n_files} file(s) finished earlier, resumed", err=True)
+    for line in run.skipped[:20]:
+        click.echo(f"skipped: {line}", err=True)
+    click.echo(f"{run.rows} window(s) of {run.n_files} file(s) written to {out}")

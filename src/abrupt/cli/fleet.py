@@ -10,8 +10,10 @@ import click
 from abrupt.cli.groups import catalog_option, check_suffix, detect, note, progress_hidden, record_run, warn
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
-from abrupt.events import config_hash, new_run_id, write_events
-from abrupt.pipelines.fleet import detect_attitude_fleet, detect_tle_batch, read_manifest
+from abrupt.errors import InputError
+from abrupt.events import config_hash, empty_frame, normalise_frame, write_events
+from abrupt.pipelines.catalogue import read_table, remove_parts, run_catalogue
+from abrupt.pipelines.fleet import detect_attitude_fleet, read_manifest
 from abrupt.scale import Executor
 
 executor_options = [
@@ -110,10 +112,55 @@ def detect_fleet_cmd(
     note(f"{len(result.events)} event(s) from {result.n_tasks} task(s){resumed}; run {result.run_id}; written to {out}")
 
 
+paths_from_option = click.option(
+    "--paths-from",
+    type=click.Path(exists=True, dir_okay=False),
+    default=None,
+    help="A text file listing input files, one a line (relative to it); for catalogues too long for a command line.",
+)
+
+
+def gather_paths(paths: tuple[str, ...], paths_from: str | None) -> list[str]:
+    """PATHS plus the files listed in ``--paths-from`` (each must exist)."""
+    out = list(paths)
+    if paths_from:
+        base = Path(paths_from).parent
+        for lineno, line in enumerate(Path(paths_from).read_text().splitlines(), start=1):
+            name = line.strip()
+            if not name or name.startswith("#"):
+                continue
+            p = Path(name) if Path(name).is_absolute() else base / name
+            if not p.is_file():
+                raise InputError(f"no such file {name!r}", file=paths_from, line=lineno)
+            out.append(str(p))
+    if not out:
+        raise click.UsageError("give input files as PATHS or with --paths-from")
+    return out
+
+
+parts_options = [
+    click.option(
+        "--parts",
+        type=click.Path(file_okay=False),
+        default=None,
+        help="Folder of finished files' results, for resuming a killed run (default: OUT.parts).",
+    ),
+    click.option("--keep-parts", is_flag=True, help="Keep the parts folder after the output is written."),
+]
+
+
+def with_parts_options(f: Any) -> Any:
+    """Add ``--paths-from``, ``--parts`` and ``--keep-parts`` to a command."""
+    for opt in reversed([paths_from_option, *parts_options]):
+        f = opt(f)
+    return f
+
+
 @detect.command("tle-batch")
-@click.argument("paths", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False))
+@click.argument("paths", nargs=-1, required=False, type=click.Path(exists=True, dir_okay=False))
 @budget_options("1/year")
 @with_executor_options
+@with_parts_options
 @catalog_option
 @click.option(
     "--out",
@@ -126,25 +173,50 @@ def detect_tle_batch_cmd(
     paths: tuple[str, ...],
     workers: int | None,
     scheduler: str | None,
+    paths_from: str | None,
+    parts: str | None,
+    keep_parts: bool,
     catalog_target: str,
     out: str,
     **budget_args: Any,
 ) -> None:
     """Detect maneuvers in many TLE/OMM histories (PATHS), one task per file, in-process or on Dask.
 
-    The budget is per satellite.
+    The budget is per satellite. Files are streamed: memory holds only the files in flight. Each
+    finished file's events are kept in a parts folder, so a killed run started again with the same
+    files and settings resumes where it stopped (nothing lost, nothing twice); the events go to
+    --out and to the catalog at the end.
     """
     budget = pop_budget(budget_args, "1/year")
     executor = executor_from(workers, scheduler)
-    note(f"{len(paths)} TLE/OMM file(s) on {executor.describe()}")
-    run_id = new_run_id()
-    events = detect_tle_batch(paths, budget, executor=executor, run_id=run_id, show_progress=not progress_hidden())
+    files = gather_paths(paths, paths_from)
+    settings = {"budget": str(budget), "detector": "auto", "budget_object": budget}
+    note(f"{len(files)} TLE/OMM file(s) on {executor.describe()}")
+    run = run_catalogue(
+        files,
+        "maneuvers",
+        settings,
+        out,
+        parts=parts,
+        executor=executor,
+        show_progress=not progress_hidden(),
+        keep_parts=True,
+    )
+    if run.n_resumed:
+        note(f"{run.n_resumed} of {run.n_files} file(s) finished earlier, resumed")
+    for line in run.skipped[:20]:
+        note(f"skipped: {line}")
+    events = read_table(out)
+    events = normalise_frame(events) if len(events) else empty_frame()
+    events = events.sort_values(["spacecraft", "time_utc", "detector"]).reset_index(drop=True)
     record_run(
         catalog_target=catalog_target,
-        command="detect tle-batch " + " ".join(paths),
+        command="detect tle-batch " + (f"--paths-from {paths_from} " if paths_from else "") + " ".join(paths),
         events=events,
         config_hash=config_hash({"budget": str(budget), "detector": "auto"}),
-        run_id=run_id,
+        run_id=run.run_id,
         out=out,
-        details={"files": list(paths), "budget": str(budget)},
+        details={"files": len(files), "budget": str(budget), "resumed_files": run.n_resumed},
     )
+    if not keep_parts:
+        remove_parts(run.parts)

@@ -22,9 +22,10 @@ TERMS = RANGE_MODEL_TERMS
 @click.option(
     "--sinex",
     "sinex_path",
-    required=True,
+    default=None,
     type=click.Path(exists=True, dir_okay=False),
-    help="SINEX file with the stations' positions, velocities and eccentricities.",
+    help="SINEX file with the stations' positions, velocities and eccentricities "
+    "[default: the bundled ILRS SLRF2014 coordinates].",
 )
 @click.option(
     "--apriori",
@@ -82,7 +83,7 @@ TERMS = RANGE_MODEL_TERMS
 @catalog_option
 def detect_laser_command(
     crd_files: tuple[str, ...],
-    sinex_path: str,
+    sinex_path: str | None,
     apriori_path: str,
     without: tuple[str, ...],
     max_maneuvers: int,

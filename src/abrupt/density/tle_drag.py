@@ -439,6 +439,10 @@ def _windows(
     counts = {"straddle": 0, "few": 0, "negative": 0}
     kept_idx = np.flatnonzero(keep)
     k_epochs = epochs[kept_idx]
+    norad = history.norad_id  # a pandas lookup: once, not per window
+    # np.mean where nothing is missing (the same sum as np.nanmean, without its copies)
+    mean_alt = np.mean if np.all(np.isfinite(integ.altitude_km)) else np.nanmean
+    mean_wf = np.mean if np.all(np.isfinite(integ.wind_factor)) else np.nanmean
     for w in range(max(n_windows, 0)):
         b0 = origin + w * width
         b1 = b0 + width
@@ -472,11 +476,9 @@ def _windows(
             if integ.model_integral is not None and dw > 0
             else float("nan")
         )
-        alt = float(np.nanmean(integ.altitude_km[idx[1:]])) if idx.size > 1 else float(integ.altitude_km[idx[0]])
-        wfac = float(np.nanmean(integ.wind_factor[idx[1:]])) if idx.size > 1 else float(integ.wind_factor[idx[0]])
-        rows.append(
-            (label, history.norad_id, b0, b1, span0, span1, int(idx.size), k_val, k_sig, alt, wfac, model, status)
-        )
+        alt = float(mean_alt(integ.altitude_km[idx[1:]])) if idx.size > 1 else float(integ.altitude_km[idx[0]])
+        wfac = float(mean_wf(integ.wind_factor[idx[1:]])) if idx.size > 1 else float(integ.wind_factor[idx[0]])
+        rows.append((label, norad, b0, b1, span0, span1, int(idx.size), k_val, k_sig, alt, wfac, model, status))
     return rows, counts
 
 
@@ -486,19 +488,22 @@ def _window_fit(
     """K and its standard error on one window: one n̄ offset per segment, one common K (with two sets
     in one segment this is the slide's formula); the third value is 1 when the window straddles a
     cut (a maneuver, an orbit rise or a long gap), else 0. K is None with too few sets."""
-    xc = np.empty_like(x)
-    yc = np.empty_like(y)
-    used = np.zeros(x.size, dtype=bool)
-    n_seg = 0
-    for sv in np.unique(seg):
-        m = seg == sv
-        if np.sum(m) < 2:
-            continue
-        n_seg += 1
-        used |= m
-        xc[m] = x[m] - x[m].mean()
-        yc[m] = y[m] - y[m].mean()
-    straddles = int(n_seg > 1 or np.unique(seg).size > 1)
+    if x.size >= 2 and np.all(seg == seg[0]):  # most windows: one segment, no loop over segments
+        xc, yc, used, n_seg, straddles = x - x.mean(), y - y.mean(), np.ones(x.size, dtype=bool), 1, 0
+    else:
+        xc = np.empty_like(x)
+        yc = np.empty_like(y)
+        used = np.zeros(x.size, dtype=bool)
+        n_seg = 0
+        for sv in np.unique(seg):
+            m = seg == sv
+            if np.sum(m) < 2:
+                continue
+            n_seg += 1
+            used |= m
+            xc[m] = x[m] - x[m].mean()
+            yc[m] = y[m] - y[m].mean()
+        straddles = int(n_seg > 1 or np.unique(seg).size > 1)
     sxx = float(np.sum(xc[used] ** 2)) if np.any(used) else 0.0
     if sxx <= 0 or np.sum(used) < min_sets:
         return None, float("nan"), straddles

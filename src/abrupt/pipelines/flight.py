@@ -461,12 +461,16 @@ def day_range(store: TelemetryStore, spacecraft: str, days: Iterable[str] | None
     if days is None:
         return stored
     out: list[str] = []
+    held = f"it holds {len(stored)} day(s), {stored[0]}..{stored[-1]}"
     for d in days:
         if ".." in d:
             a, b = d.split("..", 1)
-            out.extend(x for x in stored if a <= x <= b)
+            chosen = [x for x in stored if a <= x <= b]
         else:
-            out.append(d)
+            chosen = [d] if d in stored else []
+        if not chosen:
+            raise InputError(f"day {d} is not in the store for spacecraft {spacecraft!r} ({held})", file=store.root)
+        out.extend(chosen)
     return sorted(set(out))
 
 

@@ -30,7 +30,7 @@ from abrupt.model.stations import Station
 from abrupt.model.tracking_measurements import TrackingArrays, as_datetime64_ns, earth_rotation_matrices
 from abrupt.readers.crd import read_crd
 from abrupt.readers.ephemeris import read_ephemeris
-from abrupt.readers.sinex import SinexStation, read_sinex, sinex_station
+from abrupt.readers.sinex import SinexStation, bundled_ilrs_sinex, read_sinex, sinex_station
 from abrupt.series.tracking import LaserRangingSeries
 from abrupt.thresholds import FalseAlarmBudget
 from abrupt.types import FloatArray
@@ -361,7 +361,7 @@ def apriori_state_gcrf(ephemeris: object, epoch_utc: np.datetime64) -> FloatArra
 
 def run_laser_ranging_files(
     crd_paths: list[str],
-    sinex_path: str,
+    sinex_path: str | None,
     apriori_path: str,
     *,
     budget: FalseAlarmBudget,
@@ -375,6 +375,8 @@ def run_laser_ranging_files(
     time_biases: bool = False,
 ) -> LaserRangingRun:
     """Read CRD normal points, SINEX sites and an a-priori ephemeris; detect maneuvers; build events.
+
+    ``sinex_path`` None: the ILRS station coordinates bundled with abrupt (:func:`bundled_ilrs_sinex`).
 
     The force model is ``force`` (default :data:`LASER_FORCE`: the EGM2008 field to degree 20, Sun,
     Moon and solar radiation pressure with a conical shadow, its scale estimated per arc; one orbit
@@ -392,7 +394,8 @@ def run_laser_ranging_files(
         raise ValueError(f"{crd_paths[0]}: no two-way ranges to analyse")
     meas["station"] = meas["station_id"].astype(str)
     epoch = as_datetime64_ns(pd.Timestamp(meas["time_utc"].min()).floor("s"))
-    sites = sites_from_sinex(read_sinex(sinex_path), sorted(meas["station"].unique()), epoch, file=sinex_path)
+    sinex_file = str(sinex_path or bundled_ilrs_sinex())
+    sites = sites_from_sinex(read_sinex(sinex_file), sorted(meas["station"].unique()), epoch, file=sinex_file)
     stations = laser_stations(sites, meas)
     ephemeris = read_ephemeris(apriori_path)
     eph_times = np.asarray(ephemeris.times_utc, dtype="datetime64[ns]")

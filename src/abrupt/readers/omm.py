@@ -28,6 +28,7 @@ from abrupt.readers.tle import (
     RawElementSet,
     history_from_sets,
     is_tle_text,
+    read_element_bytes,
     read_tle,
     read_tle_histories,
     split_by_satellite,
@@ -274,7 +275,7 @@ def iter_omm_sets(
 
 def _omm_sets(path: Path, fmt: str | None, strict: bool) -> tuple[list[RawElementSet], list[InputError]]:
     try:
-        text = path.read_bytes().decode("utf-8")
+        text = read_element_bytes(path).decode("utf-8")
     except UnicodeDecodeError as exc:
         raise InputError(f"not a UTF-8 text file (byte {exc.start})", file=path, line=1) from None
     skipped: list[InputError] = []
@@ -311,10 +312,20 @@ def read_omm_histories(path: str | Path, *, fmt: str | None = None, strict: bool
 
 
 def _is_tle(path: Path) -> bool:
+    """Whether the file (plain or compressed) holds TLE/3LE text; an empty file or an orbit file of
+    another kind (SP3) is an :class:`InputError` that says what the file is."""
     if not path.is_file():
         raise InputError("no such file", file=path)
-    with open(path, encoding="utf-8", errors="replace") as fh:
-        head = fh.read(4000)
+    head = read_element_bytes(path)[:4000].decode("utf-8", errors="replace")
+    if not head.strip():
+        raise InputError("the file is empty: no TLE/3LE or OMM element sets", file=path, line=1)
+    first = head.lstrip("\ufeff").split("\n", 1)[0]
+    if re.match(r"#[a-d][PV ]?\d{4}", first):
+        raise InputError(
+            "this is an SP3 precise orbit file, not TLE/3LE or OMM elements (use `abrupt detect orbit`)",
+            file=path,
+            line=1,
+        )
     return is_tle_text(head)
 
 

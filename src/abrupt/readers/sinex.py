@@ -11,16 +11,25 @@ Standard: "SINEX — Solution (Software/technique) INdependent EXchange Format, 
 - ``SITE/ECCENTRICITY``: the offset of the instrument reference point from the marker, ``UNE`` (up, north,
   east) or ``XYZ`` (m), with its validity interval.
 
-SINEX epochs are ``YY:DDD:SSSSS`` (YY ≤ 50 → 20YY); ``00:000:00000`` means "open". Positions at an epoch
+SINEX epochs are ``YY:DDD:SSSSS`` (YY ≤ 50 → 20YY); ``00:000:00000`` means "open", and so does a day of
+year ``000`` with any year (e.g. ``30:000:00000``, the "no end" of the ILRS SLRF files). Positions at an epoch
 t are r₀ + v·(t − t₀) (linear plate motion; ITRF convention). Errors (:class:`InputError`, file:line):
 no ``%=SNX`` header line, a block not closed, malformed estimate lines, a requested station that is not
-in the file (the message lists the stations it holds), a station without all three coordinates.
+in the file (the message lists the stations it holds and how to give its coordinates), a station without
+all three coordinates. The format is ASCII, but real files carry names with accents in their free-text
+blocks (``FILE/COMMENT``): the text is read as Latin-1 (every byte decodes) and the fields that are
+parsed are plain ASCII, so a binary file still fails at the header check.
+
+The ILRS station coordinates (SLRF2014, release 2020-04-28: positions and velocities of the 179 SLR
+stations ever operated) come with abrupt: :func:`bundled_ilrs_sinex` gives the file's path
+(``abrupt/data/ilrs/``, with its licence and provenance in ``README.md`` beside it).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -31,20 +40,29 @@ from abrupt.readers.compression import read_text
 
 SECONDS_PER_JULIAN_YEAR = 365.25 * 86400.0
 OPEN_EPOCH = "00:000:00000"
+BUNDLED_ILRS_SINEX = "SLRF2014_POS+VEL_2030.0_200428.snx.gz"
+MISSING_STATION_HINT = "give a SINEX file that holds its position and velocity (abrupt detect laser --sinex FILE)"
+
+
+def bundled_ilrs_sinex() -> Path:
+    """Path of the ILRS station coordinates shipped with abrupt (SLRF2014 SINEX, gzip)."""
+    return Path(str(resources.files("abrupt") / "data" / "ilrs" / BUNDLED_ILRS_SINEX))
 
 
 def parse_sinex_epoch(text: str) -> np.datetime64 | None:
-    """``YY:DDD:SSSSS`` → ``datetime64[ns]`` (None for ``00:000:00000``). Raises ``ValueError``."""
+    """``YY:DDD:SSSSS`` → ``datetime64[ns]`` (None for ``00:000:00000`` or day ``000``). Raises ``ValueError``."""
     text = text.strip()
     if text == OPEN_EPOCH:
         return None
     parts = text.split(":")
     if len(parts) != 3 or not all(p.isdigit() for p in parts):
-        raise ValueError(text)
+        raise ValueError(f"epoch {text!r} is not YY:DDD:SSSSS")
+    if int(parts[1]) == 0 and int(parts[2]) == 0:
+        return None
     yy, doy, sod = int(parts[0]), int(parts[1]), int(parts[2])
     year = yy + (2000 if yy <= 50 else 1900) if len(parts[0]) == 2 else yy
     if not (1 <= doy <= 366 and 0 <= sod <= 86400):
-        raise ValueError(text)
+        raise ValueError(f"epoch {text!r}: day of year or seconds of day out of range")
     return np.datetime64(f"{year:04d}-01-01", "ns") + np.timedelta64(doy - 1, "D") + np.timedelta64(sod, "s")
 
 
@@ -105,10 +123,11 @@ class SinexStation:
         return "UNE", np.zeros(3)
 
 
-def read_sinex(path: str | Path) -> dict[str, SinexStation]:
-    """Stations of a SINEX file by site code (see the module docstring)."""
+def read_sinex(path: str | Path | None = None) -> dict[str, SinexStation]:
+    """Stations of a SINEX file by site code (see the module docstring); ``None``: the bundled ILRS file."""
+    path = bundled_ilrs_sinex() if path is None else path
     file = str(path)
-    lines = read_text(path, what="SINEX").splitlines()
+    lines = read_text(path, encoding="latin-1", what="SINEX").splitlines()
     if not lines or not lines[0].startswith("%=SNX"):
         raise InputError("first line must start with '%=SNX' (SINEX header)", file=file, line=1, column=1)
     stations: dict[str, SinexStation] = {}
@@ -197,9 +216,15 @@ def read_sinex(path: str | Path) -> dict[str, SinexStation]:
     return {code: st for code, st in stations.items() if st.solutions}
 
 
-def sinex_station(stations: dict[str, SinexStation], code: str, *, file: str | Path | None = None) -> SinexStation:
+def sinex_station(
+    stations: dict[str, SinexStation],
+    code: str,
+    *,
+    file: str | Path | None = None,
+    hint: str = MISSING_STATION_HINT,
+) -> SinexStation:
     """The station ``code`` (CDP pad id or 4-character site code), or an :class:`InputError` listing the
-    stations the SINEX file holds."""
+    stations the SINEX file holds and saying (``hint``) how to give the missing one."""
     key = code.strip()
     if key in stations:
         return stations[key]
@@ -207,4 +232,4 @@ def sinex_station(stations: dict[str, SinexStation], code: str, *, file: str | P
     if key.upper() in by_upper:
         return by_upper[key.upper()]
     held = ", ".join(sorted(stations)[:20]) + (" …" if len(stations) > 20 else "")
-    raise InputError(f"station {code!r} is not in the SINEX file (it holds {held or 'no station'})", file=file)
+    raise InputError(f"station {code!r} is not in the SINEX file (it holds {held or 'no station'}); {hint}", file=file)

@@ -40,6 +40,7 @@ import pandas as pd
 from sgp4.api import WGS72, Satrec
 
 from abrupt.errors import InputError, RepairLog, quote
+from abrupt.readers.compression import read_bytes
 from abrupt.readers.tle_checks import check_element_history
 
 logger = logging.getLogger(__name__)
@@ -447,8 +448,16 @@ def elements_frame(sets: Sequence[RawElementSet]) -> pd.DataFrame:
     return frame
 
 
+def read_element_bytes(path: Path) -> bytes:
+    """A TLE/OMM file's bytes, gunzipped or uncompressed (``.gz``/``.Z``, by content) when compressed."""
+    try:
+        return read_bytes(path)
+    except InputError as exc:  # corrupt compressed data: the element readers name a line (the first)
+        raise InputError(exc.reason, file=path, line=exc.line or 1) from None
+
+
 def _read_text(path: Path) -> list[str]:
-    data = path.read_bytes()
+    data = read_element_bytes(path)
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:

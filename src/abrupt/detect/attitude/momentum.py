@@ -256,7 +256,7 @@ class MomentumChangeDetector(Detector[AttitudeSeries]):
         h = series.momentum.H_N_Nms
         stat = self.statistic(h, tel.segments)
         warnings = self.warnings_for(thr)
-        cfg_hash = config_hash({"detector": self.name, **self.config(), "budget": str(budget)})
+        cfg_hash = self.config_hash_for(budget)
         t_ns = tel.time.astype("datetime64[ns]").astype(np.int64)
         segment_sigma: dict[tuple[int, int], FloatArray] = {}
         events: list[Event] = []

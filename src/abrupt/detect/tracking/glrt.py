@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
-from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc
+from abrupt.events import Event, empty_frame, events_frame, format_time_utc
 from abrupt.model.orbit import ForceContext, rsw_basis
 from abrupt.model.orbit.batch_fit import BatchFit, BatchFitConfig, fit_orbit
 from abrupt.model.tracking_measurements import TrackingArrays
@@ -467,7 +467,7 @@ class GlrtManeuverDetector(Detector[TrackingSeries]):
             return DetectionResult.empty(warnings=("no tracking measurements",))
         detections, fit, scans = maneuver_search(series, self.glrt_config(budget))
         data = series.data
-        cfg_hash = config_hash({"detector": self.name, **self.config(), "budget": str(budget)})
+        cfg_hash = self.config_hash_for(budget)
         events = glrt_events(
             detections,
             epoch_utc=data.epoch_utc,

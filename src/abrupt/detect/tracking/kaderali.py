@@ -29,7 +29,7 @@ from scipy.optimize import curve_fit
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.detect.tracking.glrt import DEFAULT_BUDGET, GlrtConfig, maneuver_search
-from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc
+from abrupt.events import Event, empty_frame, events_frame, format_time_utc
 from abrupt.model.orbit import MU_KADERALI_M3_S2, ForceContext, ForceModel, propagate_with_stm
 from abrupt.model.orbit.batch_fit import scaled_force
 from abrupt.model.tracking_measurements import TrackingArrays, wrap_angle
@@ -620,7 +620,7 @@ class KaderaliManeuverDetector(Detector[TrackingSeries]):
                 data, fit.x0, config=kcfg, budget=budget, n_runs=self.n_null_runs, seed=self.seed
             )
             thr = Threshold(psi_null, float("nan"), "gpd (simulated null)", 0, budget.per_day)
-        cfg_hash = config_hash({"detector": self.name, **self.config(), "budget": str(budget)})
+        cfg_hash = self.config_hash_for(budget)
         events = kaderali_events(
             result,
             epoch_utc=data.epoch_utc,

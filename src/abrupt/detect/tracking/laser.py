@@ -36,7 +36,7 @@ from abrupt.detect.tracking.glrt import (
     glrt_threshold_fit,
 )
 from abrupt.errors import RepairLog
-from abrupt.events import config_hash, empty_frame, events_frame
+from abrupt.events import empty_frame, events_frame
 from abrupt.model.orbit.batch_fit import BatchFit, fit_orbit
 from abrupt.model.tracking_measurements import TrackingArrays
 from abrupt.series.tracking import LaserRangingSeries
@@ -90,7 +90,7 @@ class LaserGlrtDetector(Detector[LaserRangingSeries]):
             if not detections or not self.weight_by_residuals:
                 break
             data = series.reduced(fit, scale, repairs=repairs)
-        cfg_hash = config_hash({"detector": self.name, **self.config(), "budget": str(budget)})
+        cfg_hash = self.config_hash_for(budget)
         events = glrt_events(
             detections,
             epoch_utc=series.epoch_utc,

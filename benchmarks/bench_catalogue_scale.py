@@ -1,0 +1,249 @@
+"""Catalogue scale: `abrupt detect tle-batch` and `abrupt density tle --windows-only` over a simulated
+public catalogue (abrupt.simulate.tle_catalogue: the catalogue's mix of orbits and cadences, one year,
+~1 element set per object per day), streamed from disk on local worker processes.
+
+    PYTHONPATH=$PWD/src nice python benchmarks/bench_catalogue_scale.py \
+        [--objects 50,100,200] [--density-objects 25,50] [--workers 2] [--kill] [--baseline /work/baseline/src]
+
+For each N it times the command (wall, as a subprocess), samples the resident memory of the command
+and all its worker processes every 0.1 s (peak printed), fits wall = a + b·N over the N measured and
+*extrapolates* to 25,000 objects (printed as extrapolated: nothing here ran 25,000 objects). The
+same-run reference: the previous release of abrupt (``--baseline``, e.g. a temporary worktree of the
+last release) and this tree, each detecting on the same files in one process, one after the other; the
+ratio this/previous is printed beside the absolute times and the machine's load average. ``--kill``
+kills a run once a third of its files are done and starts it again: the events must equal an
+uninterrupted run's (lost and duplicated rows printed).
+
+Targets (issue: two cores): maneuvers 25,000 objects × 1 year < 10 min, drag density < 15 min, peak
+memory < 4 GB, flat in N.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import psutil
+
+ROOT = Path(__file__).resolve().parent.parent
+SRC = ROOT / "src"
+CATALOGUE_OBJECTS = 25_000
+OBJECTS_PER_FILE = 25
+
+
+def load() -> str:
+    return "load average " + " ".join(f"{x:.2f}" for x in os.getloadavg()) + f" on {os.cpu_count()} cores"
+
+
+def catalogue(folder: Path, n: int) -> Path:
+    """The first ``n`` objects of the simulated catalogue as TLE files and a list file (cached; not timed)."""
+    from abrupt.simulate.tle_catalogue import write_catalogue
+
+    listing = folder / f"objects-{n}.txt"
+    if not listing.exists():
+        paths = write_catalogue(folder / f"n{n}", n, objects_per_file=OBJECTS_PER_FILE, seed=0)
+        listing.write_text("\n".join(str(p) for p in paths) + "\n")
+    return listing
+
+
+def fresh(path: Path) -> Path:
+    """``path`` with no file and no parts folder of an earlier run (a timed run must not resume)."""
+    path.unlink(missing_ok=True)
+    shutil.rmtree(path.with_name(path.name + ".parts"), ignore_errors=True)
+    return path
+
+
+def run_measured(
+    args: list[str], kill_when: Path | None = None, kill_after: int = 0
+) -> tuple[float, float, int, float]:
+    """Wall seconds, peak resident memory (GB) of the process tree, return code (−9 when killed) and the
+    CPU seconds of the tree (user + system of every process seen, sampled every 0.1 s)."""
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    cmd = [sys.executable, "-m", "abrupt.cli.main", "--quiet", *args]
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    root = psutil.Process(proc.pid)
+    peak = 0
+    cpu: dict[int, float] = {}
+    while proc.poll() is None:
+        try:
+            procs = [root, *root.children(recursive=True)]
+            rss = 0
+            for p in procs:
+                with p.oneshot():
+                    rss += p.memory_info().rss
+                    times = p.cpu_times()
+                    cpu[p.pid] = times.user + times.system
+            peak = max(peak, rss)
+        except psutil.Error:
+            pass
+        if kill_when is not None and len(list(kill_when.glob("*/*.parquet"))) >= kill_after:
+            for p in root.children(recursive=True):
+                p.send_signal(signal.SIGKILL)
+            proc.send_signal(signal.SIGKILL)
+            proc.wait()
+            break
+        time.sleep(0.1)
+    err = proc.stderr.read().decode() if proc.stderr else ""
+    if proc.stderr:
+        proc.stderr.close()
+    if proc.returncode not in (0, -9):
+        raise SystemExit(f"command failed ({proc.returncode}): {' '.join(args)}\n{err[-2000:]}")
+    return time.perf_counter() - t0, peak / 1e9, proc.returncode, sum(cpu.values())
+
+
+REFERENCE = """
+import sys, time
+from pathlib import Path
+from abrupt.pipelines.tle import detect_tle_file
+from abrupt.thresholds import FalseAlarmBudget
+budget = FalseAlarmBudget.parse("1/year")
+paths = [p for p in Path(sys.argv[1]).read_text().split()][: int(sys.argv[2])]
+detect_tle_file(paths[0], budget)
+t, c = time.perf_counter(), time.process_time()
+n = 0
+for p in paths:
+    n += len(detect_tle_file(p, budget).events)
+print(time.perf_counter() - t, time.process_time() - c, n)
+"""
+
+
+def reference(listing: Path, n_files: int, src: Path) -> tuple[float, float, int]:
+    env = {**os.environ, "PYTHONPATH": str(src)}
+    out = subprocess.run(
+        [sys.executable, "-c", REFERENCE, str(listing), str(n_files)], env=env, capture_output=True, text=True
+    )
+    if out.returncode != 0:
+        raise SystemExit(f"reference run failed with PYTHONPATH={src}:\n{out.stderr[-2000:]}")
+    wall, cpu, n = out.stdout.split()
+    return float(wall), float(cpu), int(n)
+
+
+def extrapolate(ns: list[int], walls: list[float]) -> tuple[float, float, float]:
+    """Fit wall = a + b·N; return a, b and the extrapolated wall at the catalogue's size."""
+    if len(ns) == 1:
+        return 0.0, walls[0] / ns[0], walls[0] / ns[0] * CATALOGUE_OBJECTS
+    b, a = np.polyfit(np.array(ns, float), np.array(walls, float), 1)
+    return float(a), float(b), float(a + b * CATALOGUE_OBJECTS)
+
+
+def part(
+    label: str, ns: list[int], folder: Path, command: list[str], target_min: float, workers: int, events: dict
+) -> None:
+    print(f"\n[{label}] {' '.join(command)} ... --workers {workers}   ({load()})")
+    walls, peaks, cpus = [], [], []
+    for n in ns:
+        listing = catalogue(folder, n)
+        out = fresh(folder / f"{label}-{n}.parquet")
+        args = [*command, "--paths-from", str(listing), "--out", str(out), "--workers", str(workers)]
+        if label == "maneuvers":
+            args += ["--catalog", str(fresh(folder / f"catalog-{n}.sqlite"))]
+        else:
+            args += ["--maneuvers-from", str(events[n])]
+        wall, peak, _, cpu = run_measured(args)
+        cpus.append(cpu)
+        rows = len(pd.read_parquet(out))
+        if label == "maneuvers":
+            events[n] = out
+        walls.append(wall)
+        peaks.append(peak)
+        sets = sum(1 for p in listing.read_text().split() for _ in open(p)) // 2
+        print(
+            f"  N = {n:5d} objects ({sets:,} element sets, {rows} rows): {wall:6.1f} s wall, "
+            f"{n / wall:6.1f} objects/s, {cpu:6.1f} CPU-s ({1e3 * cpu / n:.0f} ms/object), peak memory {peak:.2f} GB"
+            f"   ({load()})"
+        )
+    a, b, t25k = extrapolate(ns, walls)
+    if b > 0:
+        print(
+            f"  fit wall = {a:.1f} s + {1e3 * b:.1f} ms × N;  EXTRAPOLATED to {CATALOGUE_OBJECTS:,} objects: "
+            f"{t25k / 60:.1f} min (target < {target_min:g} min) — measured under the load above"
+        )
+    else:
+        print("  wall time did not grow with N beyond the load's noise: no wall extrapolation")
+    ca, cb, c25k = extrapolate(ns, cpus)
+    print(
+        f"  fit CPU = {ca:.1f} s + {1e3 * cb:.1f} ms × N;  EXTRAPOLATED CPU for {CATALOGUE_OBJECTS:,} objects "
+        f"{c25k / 60:.0f} CPU-min, i.e. {c25k / 120:.1f} min of wall on two otherwise idle cores "
+        f"(projection from CPU time; target < {target_min:g} min)"
+    )
+    steps = ", ".join(
+        f"{n0}→{n1}: {1e3 * (p1 - p0):+.0f} MB" for n0, n1, p0, p1 in zip(ns, ns[1:], peaks, peaks[1:], strict=False)
+    )
+    print(
+        f"  peak memory {min(peaks):.2f}-{max(peaks):.2f} GB over N = {ns[0]}-{ns[-1]} ({steps}; "
+        f"{1e3 * (peaks[-1] - peaks[-2]) / max(ns[-1] - ns[-2], 1) * 1000 if len(ns) > 1 else 0.0:+.0f} MB per "
+        f"1,000 objects over the last step; target < 4 GB, flat)"
+    )
+
+
+def kill_and_resume(folder: Path, n: int, workers: int) -> None:
+    listing = catalogue(folder, n)
+    whole = folder / f"maneuvers-{n}.parquet"
+    out = fresh(folder / f"killed-{n}.parquet")
+    parts = out.with_name(out.name + ".parts")
+    n_files = len(listing.read_text().split())
+    args = ["detect", "tle-batch", "--paths-from", str(listing), "--out", str(out), "--workers", str(workers)]
+    args += ["--catalog", str(fresh(folder / f"killed-{n}.sqlite"))]
+    _, _, rc, _ = run_measured(args, kill_when=parts, kill_after=max(1, n_files // 3))
+    done = len(list(parts.glob("*/*.parquet")))
+    wall, _, _, _ = run_measured(args)
+    a, b = pd.read_parquet(whole), pd.read_parquet(out)
+    key = ["spacecraft", "time_utc", "detector"]
+    merged = a[key].merge(b[key], how="outer", indicator=True)
+    lost = int((merged["_merge"] == "left_only").sum())
+    extra = int((merged["_merge"] == "right_only").sum())
+    dup = int(b.duplicated(key).sum())
+    print(
+        f"\n[kill] N = {n}: killed (code {rc}) with {done}/{n_files} files done, rerun {wall:.1f} s: "
+        f"{len(b)} events vs {len(a)} uninterrupted; lost {lost}, extra {extra}, duplicated {dup} (target 0, 0, 0)"
+    )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--objects", default="50,100,200")
+    ap.add_argument("--density-objects", default="25,50")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--folder", default=None, help="Where the simulated catalogue is cached.")
+    ap.add_argument("--baseline", default="/work/baseline/src", help="src folder of the previous release.")
+    ap.add_argument("--reference-files", type=int, default=4, help="Files (of 25 objects) in the reference.")
+    ap.add_argument("--kill", action="store_true")
+    ap.add_argument("--no-model", action="store_true", help="Density without NRLMSIS along the orbits.")
+    args = ap.parse_args()
+    folder = Path(args.folder or Path(tempfile.gettempdir()) / "abrupt-catalogue")
+    folder.mkdir(parents=True, exist_ok=True)
+    ns = [int(x) for x in args.objects.split(",")]
+    dns = [int(x) for x in args.density_objects.split(",")]
+    print(f"catalogue scale, {load()}; simulated catalogue cached in {folder}")
+    events: dict[int, Path] = {}
+    part("maneuvers", sorted(set(ns) | set(dns)), folder, ["detect", "tle-batch"], 10.0, args.workers, events)
+    density = ["density", "tle", "--windows-only"] + (["--no-model"] if args.no_model else [])
+    part("density", dns, folder, density, 15.0, args.workers, events)
+    listing = catalogue(folder, max(ns))
+    k = args.reference_files
+    if Path(args.baseline).is_dir():
+        t_prev, c_prev, n_prev = reference(listing, k, Path(args.baseline))
+        t_this, c_this, n_this = reference(listing, k, SRC)
+        print(
+            f"\n[reference] {k * OBJECTS_PER_FILE} objects detected in one process: this tree {t_this:.2f} s wall, "
+            f"{c_this:.2f} s CPU ({n_this} events); previous release {t_prev:.2f} s wall, {c_prev:.2f} s CPU "
+            f"({n_prev} events): ratio this/previous wall {t_this / t_prev:.2f}, CPU {c_this / c_prev:.2f}   ({load()})"
+        )
+    else:
+        print(f"\n[reference] no previous release at {args.baseline}: ratio not measured")
+    if args.kill:
+        kill_and_resume(folder, max(ns), args.workers)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,93 @@
+"""Speed of the flux inference on 1 000 spacecraft-years (issue: flux inference, acceptance 5).
+
+Target: inference (match events to days, exposure sums, likelihood on the β grid, maximum likelihood,
+profile-likelihood intervals of all three parameters, upper limits, goodness of fit) under 10 s on two
+cores for 1 000 spacecraft-years of exposure rows and their events. The fleet: 4 orbit cases (Fermi-like
+and 200 kg spacecraft at 550 km / 28.5° and 800 km / 98°), 250 spacecraft × 4 years in all (365 250
+spacecraft-days), ΔH90 = 10 mN·m·s, 0.01 false alarms per day. The forward-model templates (one rates
+Monte Carlo per orbit case and population) and the event draws are timed apart: they are not inference.
+
+Run: ``nice python benchmarks/bench_flux_speed.py [--draws 400000]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from abrupt.flux.forward import ForwardConfig, build_template, with_seed
+from abrupt.flux.inference import Likelihood, fit, goodness_of_fit, prepare, upper_limit
+from abrupt.simulate.population import FleetSpec, draw_population, fleet_exposure
+
+ROOT = Path(__file__).resolve().parent.parent
+TARGET_S = 10.0
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--draws", type=int, default=400_000)
+    args = parser.parse_args()
+    base = FleetSpec(
+        str(ROOT / "examples" / "spacecraft" / "fermi_like.toml"),
+        n_spacecraft=250 // 4,
+        years=4.0,
+        dH50_Nms=0.01 * np.exp(-np.log(9.0) / 4.0),
+        false_alarms_per_day=0.01,
+    )
+    specs = []
+    for k, (sc, alt, inc) in enumerate(
+        [
+            ("fermi_like", 550.0, 28.5),
+            ("fermi_like", 800.0, 98.0),
+            ("smallsat200", 550.0, 28.5),
+            ("smallsat200", 800.0, 98.0),
+        ]
+    ):
+        path = str(ROOT / "examples" / "spacecraft" / f"{sc}.toml")
+        specs.append(replace(base, spacecraft_file=path, altitude_km=alt, inclination_deg=inc, name_prefix=f"F{k}"))
+    cfg = ForwardConfig(n_draws=args.draws)
+    t = time.perf_counter()
+    fit_tpl = {s.case: build_template(s.case, cfg) for s in specs}
+    draw_tpl = {s.case: build_template(s.case, with_seed(cfg, 1000)) for s in specs}
+    t_tpl = time.perf_counter() - t
+    exposure = pd.concat([fleet_exposure(s) for s in specs], ignore_index=True)
+    truth = {"debris_scale": 1.0, "meteoroid_scale": 1.0, "beta": 2.0}
+    t = time.perf_counter()
+    events = draw_population(exposure, draw_tpl, truth, seed=1)
+    t_draw = time.perf_counter() - t
+    years = exposure["analysed_fraction"].sum() / 365.25
+    print(
+        f"{len(exposure)} spacecraft-days ({len(exposure) / 365.25:.0f} spacecraft-years, {years:.0f} analysed), "
+        f"{len(events)} events; templates {t_tpl:.1f} s, draws {t_draw:.1f} s (not inference)"
+    )
+    t0, c0 = time.perf_counter(), time.process_time()
+    data = prepare(exposure, events, fit_tpl)
+    t1 = time.perf_counter()
+    lik = Likelihood(data)
+    t2 = time.perf_counter()
+    res = fit(data, likelihood=lik)
+    t3 = time.perf_counter()
+    res_prior = fit(data, fixed={"meteoroid_scale": 1.0})
+    limits = [upper_limit(data, p, beta=2.0, other_scale=0.0) for p in ("debris", "meteoroid")]
+    gof = goodness_of_fit(data, res.estimates)
+    t4, c4 = time.perf_counter(), time.process_time()
+    total = t4 - t0
+    print(f"prepare (match events, exposure sums)       {t1 - t0:6.2f} s")
+    print(f"likelihood tables on the β grid             {t2 - t1:6.2f} s")
+    print(f"free fit + profile intervals (3 parameters) {t3 - t2:6.2f} s")
+    print(f"prior fit, upper limits, goodness of fit    {t4 - t3:6.2f} s")
+    print(f"inference total                             {total:6.2f} s   (target < {TARGET_S:.0f} s)")
+    print(f"inference CPU time (all threads)            {c4 - c0:6.2f} s   (wall time above depends on the load)")
+    print(f"free fit: {res.estimates}  intervals {res.intervals}")
+    print(f"with meteoroid scale 1: {res_prior.estimates}  intervals {res_prior.intervals}")
+    uls = [round(u["scale_upper_limit"], 3) for u in limits]
+    print(f"truth {truth}; deviance p = {gof['deviance_p_value']:.3f}; 95 % upper limits (other scale 0) {uls}")
+
+
+if __name__ == "__main__":
+    main()

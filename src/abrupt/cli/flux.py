@@ -1,0 +1,265 @@
+"""``abrupt flux`` (infer the debris and meteoroid flux from a catalog, store exposure) and ``abrupt
+simulate population`` (a fleet's detections drawn from a flux truth)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import click
+import pandas as pd
+
+from abrupt.catalog import Catalog
+from abrupt.cli.groups import DEFAULT_CATALOG, cli, note, simulate
+from abrupt.cli.options import budget_options, pop_budget
+from abrupt.errors import ConfigError
+from abrupt.flux.exposure import EfficiencyCurve, efficiency_per_day, exposure_frame, store_exposure
+from abrupt.flux.forward import ForwardConfig
+from abrupt.flux.inference import PARAMS
+from abrupt.pipelines.flux import covered_days, infer_flux, simulate_population
+from abrupt.report.flux import write_flux_report
+from abrupt.simulate.population import DETECTOR, FleetSpec
+
+
+@cli.group()
+def flux() -> None:
+    """Infer the debris and meteoroid flux from detected strikes and exposure (docs/flux-inference.md)."""
+
+
+def _model_options(f: Any) -> Any:
+    f = click.option("--debris-model", default="nasa90", show_default=True, help="nasa90 or a flux-table .toml.")(f)
+    f = click.option("--meteoroid-model", default="grun", show_default=True, help="grun or a flux-table .toml.")(f)
+    f = click.option("--mass-model", default="al_sphere", show_default=True, help="Size-to-mass law.")(f)
+    f = click.option("--draws", type=int, default=400_000, show_default=True, help="Monte Carlo draws per population.")(
+        f
+    )
+    return f
+
+
+def _config(o: dict[str, Any]) -> ForwardConfig:
+    return ForwardConfig(
+        debris_model=o.pop("debris_model"),
+        meteoroid_model=o.pop("meteoroid_model"),
+        mass_model=o.pop("mass_model"),
+        n_draws=o.pop("draws"),
+    )
+
+
+def _parse_fix(items: tuple[str, ...]) -> dict[str, float]:
+    out = {}
+    for item in items:
+        name, _, value = item.partition("=")
+        if name not in PARAMS or not value:
+            raise ConfigError(f"--fix {item!r}: use NAME=VALUE with NAME in {list(PARAMS)}", key="fix")
+        out[name] = float(value)
+    return out
+
+
+@flux.command("infer")
+@click.option("--catalog", "catalog_target", default=DEFAULT_CATALOG, show_default=True, help="Catalog file or URL.")
+@click.option("--spacecraft", multiple=True, help="Only these spacecraft pseudonyms (repeatable).")
+@click.option("--out", "out_path", type=click.Path(dir_okay=False), help="Result as JSON.")
+@click.option("--report", "report_path", type=click.Path(dir_okay=False), help="HTML report (or PNG figure).")
+@click.option("--fix", multiple=True, help="Hold a parameter fixed, e.g. --fix beta=2 (repeatable).")
+@click.option("--confidence", type=float, default=0.9, show_default=True, help="Interval level.")
+@click.option("--no-direction", is_flag=True, help="Ignore the direction of ΔH (|ΔH| only).")
+@click.option("--beta", "reference_beta", type=float, default=1.0, show_default=True, help="β for the model curves.")
+@_model_options
+def infer(
+    catalog_target: str,
+    spacecraft: tuple[str, ...],
+    out_path: str | None,
+    report_path: str | None,
+    fix: tuple[str, ...],
+    confidence: float,
+    no_direction: bool,
+    reference_beta: float,
+    **model: Any,
+) -> None:
+    """Fit flux scales and β to a catalog's strikes and exposure; intervals, upper limits, goodness of fit."""
+    cat = Catalog(catalog_target, create=False)
+    note("building forward-model templates and fitting ...")
+    result = infer_flux(
+        cat,
+        spacecraft=spacecraft,
+        config=_config(model),
+        fixed=_parse_fix(fix),
+        confidence=confidence,
+        use_direction=not no_direction,
+        reference_beta=reference_beta,
+    )
+    for name, f in result.fits.items():
+        parts = []
+        for p, v in f.estimates.items():
+            lo, hi = f.intervals.get(p, (v, v))
+            parts.append(f"{p} = {v:.3g}" + ("" if p in f.fixed else f" [{lo:.3g}, {hi:.3g}]"))
+        click.echo(f"{name}: " + ", ".join(parts) + f"  ({f.n_events} events, {f.n_days} spacecraft-days)")
+    for g in result.goodness:
+        click.echo(
+            f"  {g['model']}: expected {g['expected_events']:.1f}, observed {g['observed_events']}, "
+            f"deviance p = {g['deviance_p_value']:.3g}, count p = {g['count_p_value']:.3g}"
+        )
+    for n in result.notes:
+        note(f"note: {n}")
+    if out_path:
+        Path(out_path).write_text(json.dumps(result.as_dict(), indent=1, default=float))
+        note(f"wrote {out_path}")
+    if report_path:
+        write_flux_report(report_path, result)
+        note(f"wrote {report_path}")
+
+
+@flux.command("exposure")
+@click.option("--catalog", "catalog_target", default=DEFAULT_CATALOG, show_default=True, help="Catalog file or URL.")
+@click.option("--spacecraft", required=True, help="Spacecraft pseudonym of the events.")
+@click.option(
+    "--spacecraft-file", required=True, type=click.Path(exists=True, dir_okay=False), help="TOML with [[surfaces]]."
+)
+@click.option("--days", multiple=True, help="Days YYYY-MM-DD (default: every day the catalog's runs covered).")
+@click.option("--detector", default="", help="Detector name the exposure belongs to.")
+@click.option("--altitude-km", type=float, required=True)
+@click.option("--inclination-deg", type=float, required=True)
+@click.option("--epoch", "epoch_year", type=float, default=2020.0, show_default=True)
+@click.option(
+    "--analysed-fraction", default="1.0", show_default=True, help="One value, or one per day (comma-separated)."
+)
+@budget_options("1/day")
+@click.option(
+    "--recovery",
+    "recovery_csv",
+    type=click.Path(exists=True, dir_okay=False),
+    help="Injection-recovery CSV (columns dH_Nms, found): fit the efficiency curve.",
+)
+@click.option("--dH90", "dh90", type=float, help="ΔH90 [N·m·s] when no recovery table is given.")
+@click.option("--slope", type=float, default=4.0, show_default=True, help="Logistic slope in ln|ΔH| with --dH90.")
+@click.option("--attitude", type=click.Choice(["orbit", "unknown"]), default="unknown", show_default=True)
+def exposure_command(
+    catalog_target: str,
+    spacecraft: str,
+    spacecraft_file: str,
+    days: tuple[str, ...],
+    detector: str,
+    altitude_km: float,
+    inclination_deg: float,
+    epoch_year: float,
+    analysed_fraction: str,
+    recovery_csv: str | None,
+    dh90: float | None,
+    slope: float,
+    attitude: str,
+    **budget_text: Any,
+) -> None:
+    """Store exposure rows (one per spacecraft-day) in a catalog, beside its events.
+
+    The false-alarm budget is the one the detection threshold was set for (``--false-alarms``); it
+    must be stated, since the inference subtracts it as background.
+    """
+    if all(v is None for v in budget_text.values()):
+        raise click.UsageError("give --false-alarms: the rate the detection threshold was set for (e.g. 1/day)")
+    false_alarms_per_day = pop_budget(budget_text).per_day
+    cat = Catalog(catalog_target, create=False)
+    if not days:
+        days = covered_days(cat, spacecraft)
+    if not days:
+        raise click.UsageError(f"no days found for {spacecraft} in {catalog_target}; give --days")
+    if recovery_csv:
+        curves = efficiency_per_day(pd.read_csv(recovery_csv), days, source=recovery_csv)
+    elif dh90:
+        curves = dict.fromkeys(days, EfficiencyCurve.from_dH90(dh90, slope))
+    else:
+        raise click.UsageError("give --recovery CSV or --dH90")
+    fractions = [float(x) for x in str(analysed_fraction).split(",")]
+    if len(fractions) not in (1, len(days)):
+        raise click.UsageError(f"--analysed-fraction: give one value or one per day ({len(days)})")
+    rows = exposure_frame(
+        [
+            {
+                "spacecraft": spacecraft,
+                "day": d,
+                "detector": detector,
+                "analysed_fraction": fractions[i % len(fractions)],
+                "false_alarms_per_day": false_alarms_per_day,
+                "dH50_Nms": curves[d].dH50_Nms,
+                "efficiency_slope": curves[d].slope,
+                "efficiency_max": curves[d].max_efficiency,
+                "altitude_km": altitude_km,
+                "inclination_deg": inclination_deg,
+                "epoch_year": epoch_year,
+                "spacecraft_file": str(Path(spacecraft_file).resolve()),
+                "attitude": attitude,
+            }
+            for i, d in enumerate(days)
+        ]
+    )
+    n = store_exposure(cat, rows)
+    for d in days:
+        c = curves[d]
+        click.echo(f"{spacecraft} {d}: x50 {c.dH50_Nms:.4g} N·m·s, slope {c.slope:.3g}, plateau {c.max_efficiency:.3f}")
+    click.echo(f"stored {n} exposure rows for {spacecraft} ({days[0]} .. {days[-1]}) in {cat.name}")
+
+
+@simulate.command("population")
+@click.option("--spacecraft-file", required=True, type=click.Path(exists=True, dir_okay=False))
+@click.option("--count", "n_spacecraft", type=int, default=10, show_default=True, help="Spacecraft in the fleet.")
+@click.option("--years", type=float, default=1.0, show_default=True)
+@click.option("--altitude-km", type=float, default=550.0, show_default=True)
+@click.option("--inclination-deg", type=float, default=28.5, show_default=True)
+@click.option("--epoch", "epoch_year", type=float, default=2020.0, show_default=True)
+@click.option("--debris-scale", type=float, default=1.0, show_default=True, help="Truth: × the debris model.")
+@click.option("--meteoroid-scale", type=float, default=1.0, show_default=True, help="Truth: × the meteoroid model.")
+@click.option("--beta", type=float, default=1.0, show_default=True, help="Truth: momentum-enhancement factor.")
+@click.option("--dH90", "dh90", type=float, default=0.02, show_default=True, help="ΔH90 [N·m·s] of every day.")
+@click.option("--slope", type=float, default=4.0, show_default=True)
+@budget_options("0.01/day")
+@click.option("--analysed-fraction", type=float, default=0.9, show_default=True)
+@click.option("--dH-error", "dh_error", type=float, default=0.0, show_default=True, help="Relative |ΔH| error.")
+@click.option("--catalog", "catalog_target", default=DEFAULT_CATALOG, show_default=True)
+@click.option("--out", "out_path", type=click.Path(dir_okay=False), help="Events CSV (with the truth label).")
+@click.option("--seed", type=int, default=0, show_default=True)
+@_model_options
+def population(
+    spacecraft_file: str,
+    n_spacecraft: int,
+    years: float,
+    altitude_km: float,
+    inclination_deg: float,
+    epoch_year: float,
+    debris_scale: float,
+    meteoroid_scale: float,
+    beta: float,
+    dh90: float,
+    slope: float,
+    analysed_fraction: float,
+    dh_error: float,
+    catalog_target: str,
+    out_path: str | None,
+    seed: int,
+    **model: Any,
+) -> None:
+    """Draw a fleet's detected strikes from a flux truth; store events and exposure in a catalog."""
+    false_alarms_per_day = pop_budget(model, "0.01/day").per_day
+    curve = EfficiencyCurve.from_dH90(dh90, slope)
+    spec = FleetSpec(
+        str(Path(spacecraft_file).resolve()),
+        n_spacecraft=n_spacecraft,
+        years=years,
+        altitude_km=altitude_km,
+        inclination_deg=inclination_deg,
+        epoch_year=epoch_year,
+        dH50_Nms=curve.dH50_Nms,
+        efficiency_slope=slope,
+        false_alarms_per_day=false_alarms_per_day,
+        analysed_fraction=analysed_fraction,
+    )
+    truth = {"debris_scale": debris_scale, "meteoroid_scale": meteoroid_scale, "beta": beta}
+    cat = Catalog(catalog_target)
+    events, exposure = simulate_population(cat, spec, truth, config=_config(model), seed=seed, dH_rel_sigma=dh_error)
+    counts = events["source"].value_counts().to_dict() if len(events) else {}
+    click.echo(
+        f"{len(events)} detected events ({counts}) on {len(exposure)} spacecraft-days; "
+        f"detector {DETECTOR}; catalog {cat.name}"
+    )
+    if out_path:
+        events.to_csv(out_path, index=False)
+        note(f"wrote {out_path}")

@@ -1,0 +1,551 @@
+"""Poisson inference of the debris and meteoroid flux from detections and exposure.
+
+The likelihood is a product of Poisson terms over every spacecraft-day d, |ΔH| bin k and direction
+class c of the forward model (:mod:`abrupt.flux.forward`):
+
+    ln L(θ) = Σ_events ln μ_{d_i c_i k_i}(θ) − Σ_{d,c,k} μ_dck(θ) + const,
+
+with μ linear in the flux scales and the false-alarm background fixed at the stated rates. Days without
+events enter only through the total expectation, which is a sum over days of f_d ε_d(x_k) (computed once),
+so a thousand spacecraft-years cost no more than a few.
+
+* **Maximum likelihood**: for each β on a log grid the scales are maximised by projected Newton (the
+  problem is concave in the scales); the profile over β is refined by a parabola through the best grid
+  point and its neighbours.
+* **Intervals**: profile likelihood, the set where 2 (ln L_max − ln L_profile) <= χ²₁(CL) (Wilks).
+* **Upper limits** for few or no events: the exact Poisson limit on the number of signal events
+  (Neyman, P(N <= n | s S1 + b) = 1 − CL, or CLs, the same divided by P(N <= n | b)), turned into a
+  flux scale through the exposure S1 (expected detections at scale 1). With no events, both give
+  s S1 = −ln(1 − CL) = 2.996 at 95 % when b = 0, and CLs keeps that value for any b.
+* **Goodness of fit**: Poisson deviance of the |ΔH| histogram against a model, with a p-value from
+  simulated histograms of that model.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+from scipy import optimize, stats
+
+from abrupt.errors import ConfigError, InputError
+from abrupt.flux.exposure import DAYS_PER_YEAR, exposure_frame, logistic_efficiency
+from abrupt.flux.forward import (
+    DIRECTION_CLASSES,
+    ORBIT_FRAME_COLUMNS,
+    POPULATIONS,
+    OrbitCase,
+    Template,
+    direction_class,
+)
+
+PARAMS: tuple[str, ...] = ("debris_scale", "meteoroid_scale", "beta")
+SCALES: tuple[str, ...] = ("debris_scale", "meteoroid_scale")
+DEFAULT_BETA_GRID = np.exp(np.linspace(math.log(0.1), math.log(100.0), 161))
+
+
+def case_of(row: Mapping[Any, Any]) -> OrbitCase:
+    """The template key of an exposure row."""
+    epoch = float(row["epoch_year"])
+    return OrbitCase(
+        str(row["spacecraft_file"]),
+        float(row["altitude_km"]),
+        float(row["inclination_deg"]),
+        2020.0 if not math.isfinite(epoch) else epoch,
+    )
+
+
+def bin_efficiency(edges: NDArray[np.float64], curves: NDArray[np.float64], n_sub: int = 16) -> NDArray[np.float64]:
+    """Mean efficiency over each |ΔH| bin (points uniform in ln|ΔH|; the open top bin over one bin width),
+    for curves (U, 3) of (x50, slope, plateau), so that steep curves are not sampled at the centre only."""
+    lo = np.log(edges[:-1])
+    upper = np.append(edges[1:-1], edges[-2] * (edges[-2] / edges[-3]))
+    hi = np.log(upper)
+    t = (np.arange(n_sub) + 0.5) / n_sub
+    x = np.exp(lo[:, None] + (hi - lo)[:, None] * t[None, :])  # (K, S)
+    eff = logistic_efficiency(
+        x[None, :, :], curves[:, 0, None, None], curves[:, 1, None, None], curves[:, 2, None, None]
+    )
+    return np.asarray(eff.mean(axis=2), dtype=np.float64)
+
+
+def case_groups(exposure: pd.DataFrame) -> tuple[list[OrbitCase], NDArray[np.int64]]:
+    """The distinct template keys of exposure rows (in order of appearance) and each row's index into them."""
+    cols = ["spacecraft_file", "altitude_km", "inclination_deg", "epoch_year"]
+    codes = exposure.groupby(cols, sort=False, dropna=False).ngroup().to_numpy()
+    keys = [case_of(rec) for rec in exposure.drop_duplicates(cols).to_dict("records")]
+    return keys, np.asarray(codes, dtype=np.int64)
+
+
+@dataclass
+class FluxData:
+    """Arrays of one inference: per-event coefficients and per-template exposure, ready for the likelihood."""
+
+    templates: list[Template]
+    exposure_years: NDArray[np.float64]  # (G, K) Σ_d f_d ε_d(x_k) / 365.25 per template group
+    analysed_years: NDArray[np.float64]  # (G,) Σ_d f_d / 365.25 per template group
+    background_bins: NDArray[np.float64]  # (K,) expected false alarms per bin (all days)
+    event_group: NDArray[np.int64]
+    event_bin: NDArray[np.int64]
+    event_class: NDArray[np.int64]  # -1: direction unknown
+    event_coef: NDArray[np.float64]  # f_d ε_d(x_k) / 365.25 of the event's day [yr]
+    event_background: NDArray[np.float64]  # background expectation in the event's (day, class, bin)
+    observed_bins: NDArray[np.int64]  # (K,) events per bin
+    n_dropped: int  # events without an exposure day, or below the lowest bin edge
+    n_days: int
+    n_with_direction: int
+
+    @property
+    def n_events(self) -> int:
+        return int(self.event_bin.size)
+
+
+def prepare(
+    exposure: pd.DataFrame,
+    events: pd.DataFrame,
+    templates: Mapping[OrbitCase, Template],
+    *,
+    use_direction: bool = True,
+) -> FluxData:
+    """Match events to exposure days and precompute the exposure sums (events: schema frame, kind strike)."""
+    exp = exposure_frame(exposure)
+    if len(exp) == 0:
+        raise InputError("no exposure rows: the catalog holds no analysed spacecraft-days for the flux")
+    keys, group = case_groups(exp)
+    missing = [k for k in keys if k not in templates]
+    if missing:
+        raise ConfigError(f"no forward-model template for {missing[0]}", key="templates")
+    tlist = [templates[k] for k in keys]
+    config = tlist[0].config
+    centres = config.centres_Nms
+    edges = config.edges_Nms
+    f = exp["analysed_fraction"].to_numpy()
+    # days share a few efficiency curves: evaluate each distinct curve once
+    eff_cols = ["dH50_Nms", "efficiency_slope", "efficiency_max"]
+    curve_of = np.asarray(exp.groupby(eff_cols, sort=False).ngroup().to_numpy(), dtype=np.int64)
+    curves = exp.drop_duplicates(eff_cols).loc[:, eff_cols].to_numpy(dtype=np.float64)
+    eff_u = bin_efficiency(edges, curves)  # (U, K)
+    cdf = logistic_efficiency(edges[None, :-1], curves[:, :1], curves[:, 1:2], 1.0)
+    share_u = np.diff(np.concatenate([cdf, np.ones((len(curves), 1))], axis=1), axis=1)
+    share_u = share_u / np.maximum(share_u.sum(axis=1, keepdims=True), 1e-300)
+    n_u = len(curves)
+    weight = np.bincount(group * n_u + curve_of, weights=f, minlength=len(keys) * n_u).reshape(len(keys), n_u)
+    exposure_years = weight @ eff_u / DAYS_PER_YEAR  # (G, K)
+    fa = exp["false_alarms_per_day"].to_numpy() * f
+    background_bins = np.bincount(curve_of, weights=fa, minlength=n_u) @ share_u
+    ev = events[events["kind"].astype(str) == "strike"] if "kind" in events else events
+    days = pd.to_datetime(ev["time_utc"].astype(str), utc=True).dt.strftime("%Y-%m-%d")
+    exp_keys = pd.Index(exp["spacecraft"].astype(str) + "|" + exp["day"].astype(str))
+    ev_keys = ev["spacecraft"].astype(str).to_numpy(dtype=object) + "|" + days.to_numpy(dtype=object)
+    rows_a = np.asarray(exp_keys.get_indexer(pd.Index(ev_keys)), dtype=np.int64)
+    dh = pd.to_numeric(ev["dH_Nms"], errors="coerce").to_numpy()
+    vec = np.full((len(ev), 3), np.nan)
+    if use_direction and all(c in ev.columns for c in ORBIT_FRAME_COLUMNS):
+        vec = ev.loc[:, list(ORBIT_FRAME_COLUMNS)].apply(pd.to_numeric, errors="coerce").to_numpy()
+    cls = direction_class(vec)
+    if len(ev):
+        known_att = exp["attitude"].to_numpy()[np.maximum(rows_a, 0)] == "orbit"
+        cls = np.where(known_att, cls, -1)
+    kbin = np.searchsorted(edges, dh, side="right") - 1
+    keep = (rows_a >= 0) & np.isfinite(dh) & (kbin >= 0) & (kbin < centres.size)
+    rows_a, kbin, cls = rows_a[keep], kbin[keep], cls[keep]
+    nc = len(DIRECTION_CLASSES)
+    u_ev = curve_of[rows_a]
+    return FluxData(
+        templates=tlist,
+        exposure_years=exposure_years,
+        analysed_years=np.bincount(group, weights=f, minlength=len(keys)) / DAYS_PER_YEAR,
+        background_bins=background_bins,
+        event_group=group[rows_a],
+        event_bin=kbin,
+        event_class=cls,
+        event_coef=f[rows_a] * eff_u[u_ev, kbin] / DAYS_PER_YEAR,
+        event_background=fa[rows_a] * share_u[u_ev, kbin] / np.where(cls >= 0, nc, 1),
+        observed_bins=np.bincount(kbin, minlength=centres.size).astype(np.int64),
+        n_dropped=int((~keep).sum()),
+        n_days=len(exp),
+        n_with_direction=int((cls >= 0).sum()),
+    )
+
+
+class Likelihood:
+    """ln L(scales, β) on a β grid, with batched maximisation over the free scales."""
+
+    def __init__(self, data: FluxData, beta_grid: NDArray[np.float64] = DEFAULT_BETA_GRID) -> None:
+        self.data = data
+        self.beta_grid = np.asarray(beta_grid, dtype=np.float64)
+        nb, ne, npop = self.beta_grid.size, data.n_events, len(POPULATIONS)
+        self.a = np.zeros((nb, ne, npop))  # per-event signal expectation at unit scales
+        self.totals = np.zeros((nb, npop))  # total signal expectation at unit scales
+        self.bin_signal = np.zeros((nb, npop, data.exposure_years.shape[1]))
+        for b, beta in enumerate(self.beta_grid):
+            for g, tpl in enumerate(data.templates):
+                r = tpl.bin_rates(float(beta))  # (P, C, K)
+                sig = r.sum(axis=1) * data.exposure_years[g][None, :]
+                self.bin_signal[b] += sig
+                sel = data.event_group == g
+                if sel.any():
+                    cls, kb = data.event_class[sel], data.event_bin[sel]
+                    per = np.where(cls[:, None] >= 0, r[:, np.maximum(cls, 0), kb].T, r.sum(axis=1)[:, kb].T)
+                    self.a[b, sel] = per * data.event_coef[sel][:, None]
+            self.totals[b] = self.bin_signal[b].sum(axis=1)
+        self.bg_events = data.event_background
+        self.bg_total = float(data.background_bins.sum())
+
+    def subset(self, keep: NDArray[np.bool_]) -> Likelihood:
+        """The same likelihood on part of the β grid (arrays shared, not recomputed)."""
+        out = object.__new__(Likelihood)
+        out.data, out.beta_grid = self.data, self.beta_grid[keep]
+        out.a, out.totals, out.bin_signal = self.a[keep], self.totals[keep], self.bin_signal[keep]
+        out.bg_events, out.bg_total = self.bg_events, self.bg_total
+        return out
+
+    def _mu(self, scales: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Expected count in each event's (day, class, bin) at every β: Σ_p s_p a_p + background."""
+        mu = self.bg_events[None, :] + self.a[:, :, 0] * scales[:, 0:1]
+        for p in range(1, self.a.shape[2]):
+            mu = mu + self.a[:, :, p] * scales[:, p : p + 1]
+        return np.asarray(mu, dtype=np.float64)
+
+    def loglike(self, scales: NDArray[np.float64]) -> NDArray[np.float64]:
+        """ln L for scales (nb, P) at every β of the grid."""
+        mu = self._mu(scales)
+        with np.errstate(divide="ignore"):
+            ev = np.log(mu).sum(axis=1)
+        return np.asarray(ev - (scales * self.totals).sum(axis=1) - self.bg_total, dtype=np.float64)
+
+    def maximise(
+        self, fixed: Mapping[str, float], *, iterations: int = 60, em_iterations: int = 5
+    ) -> tuple[NDArray[Any], NDArray[Any]]:
+        """Scales (nb, P) maximising ln L at each β with some scales fixed; returns (scales, ln L)."""
+        nb, npop = self.beta_grid.size, len(POPULATIONS)
+        free = np.array([SCALES[p] not in fixed for p in range(npop)])
+        s = np.ones((nb, npop))
+        for p in range(npop):
+            if not free[p]:
+                s[:, p] = fixed[SCALES[p]]
+        n_ev = max(self.data.n_events, 1)
+        if free.any():
+            start = n_ev / np.maximum(self.totals[:, free].sum(axis=1), 1e-300)
+            s[:, free] = np.clip(start, 1e-6, 1e9)[:, None]
+        idx = np.flatnonzero(free)
+        if idx.size == 0:
+            return s, self.loglike(s)
+        for _ in range(em_iterations):  # EM (Richardson-Lucy): monotone, keeps scales >= 0
+            mu = np.maximum(self._mu(s), 1e-300)
+            ratio = (self.a[:, :, idx] / mu[:, :, None]).sum(axis=1) / np.maximum(self.totals[:, idx], 1e-300)
+            s[:, idx] *= ratio
+        ll = self.loglike(s)
+        for _ in range(iterations):  # Newton with backtracking, projected on scales >= 0
+            mu = np.maximum(self._mu(s), 1e-300)
+            af = self.a[:, :, idx] / mu[:, :, None]
+            grad = af.sum(axis=1) - self.totals[:, idx]
+            hess = -np.einsum("bei,bej->bij", af, af) - 1e-12 * np.eye(idx.size)[None]
+            step = -np.linalg.solve(hess, grad[:, :, None])[:, :, 0]
+            cur = s[:, idx].copy()
+            step = np.where((cur <= 0) & (grad < 0), 0.0, step)  # at the bound, pushing out: stay
+            t = np.ones(self.beta_grid.size)
+            improved = np.zeros(self.beta_grid.size, dtype=bool)
+            for _half in range(30):
+                trial = s.copy()
+                trial[:, idx] = np.maximum(cur + t[:, None] * step, 0.0)
+                ll_t = self.loglike(trial)
+                ok = (ll_t >= ll - 1e-10 * (1.0 + np.abs(ll))) & ~improved
+                s[ok] = trial[ok]
+                ll = np.where(ok, ll_t, ll)
+                improved |= ok
+                if improved.all():
+                    break
+                t = np.where(improved, t, 0.5 * t)
+            moved = np.abs(s[:, idx] - cur).max(axis=1)
+            if np.all(moved <= 1e-10 * (1.0 + np.abs(cur).max(axis=1))):
+                break
+        return s, self.loglike(s)
+
+
+def _refine_max(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, float, int]:
+    """Maximum of samples y(x) refined by a parabola through the best point and its neighbours."""
+    i = int(np.nanargmax(y))
+    if 0 < i < x.size - 1 and np.all(np.isfinite(y[i - 1 : i + 2])):
+        x0, x1, x2 = x[i - 1 : i + 2]
+        y0, y1, y2 = y[i - 1 : i + 2]
+        den = (x0 - x1) * (x0 - x2) * (x1 - x2)
+        a = (x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1)) / den
+        b = (x2 * x2 * (y0 - y1) + x1 * x1 * (y2 - y0) + x0 * x0 * (y1 - y2)) / den
+        if a < 0:
+            xm = -b / (2 * a)
+            if x0 <= xm <= x2:
+                c = y1 - a * x1 * x1 - b * x1
+                return float(xm), float(a * xm * xm + b * xm + c), i
+    return float(x[i]), float(y[i]), i
+
+
+@dataclass
+class FitResult:
+    """Maximum-likelihood estimates, profile-likelihood intervals and fit diagnostics."""
+
+    estimates: dict[str, float]
+    intervals: dict[str, tuple[float, float]]
+    confidence: float
+    loglike: float
+    fixed: dict[str, float]
+    n_events: int
+    n_dropped: int
+    n_days: int
+    n_with_direction: int
+    expected_events: dict[str, float] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "estimates": self.estimates,
+            "intervals": {k: list(v) for k, v in self.intervals.items()},
+            "confidence": self.confidence,
+            "loglike": self.loglike,
+            "fixed": self.fixed,
+            "n_events": self.n_events,
+            "n_dropped": self.n_dropped,
+            "n_spacecraft_days": self.n_days,
+            "n_events_with_direction": self.n_with_direction,
+            "expected_events": self.expected_events,
+            "notes": self.notes,
+        }
+
+
+def _profile_value(lik: Likelihood, fixed: Mapping[str, float]) -> float:
+    """max over β and the free scales of ln L with some scales fixed."""
+    _, ll = lik.maximise(fixed)
+    if lik.beta_grid.size == 1:
+        return float(ll[0])
+    return _refine_max(np.log(lik.beta_grid), ll)[1]
+
+
+def fit(
+    data: FluxData,
+    *,
+    fixed: Mapping[str, float] | None = None,
+    confidence: float = 0.9,
+    beta_grid: NDArray[np.float64] | None = None,
+    likelihood: Likelihood | None = None,
+) -> FitResult:
+    """Maximum likelihood and profile-likelihood intervals of the free parameters.
+
+    Args:
+        data: from :func:`prepare`.
+        fixed: parameters held fixed (``debris_scale``, ``meteoroid_scale``, ``beta``).
+        confidence: interval level (0.9: 2 Δln L = 2.706).
+    """
+    fixed = dict(fixed or {})
+    unknown = [k for k in fixed if k not in PARAMS]
+    if unknown:
+        raise ConfigError(f"unknown parameter(s) {unknown}; choose from {list(PARAMS)}", key="fix")
+    if likelihood is None:
+        grid = np.array([fixed["beta"]]) if "beta" in fixed else (DEFAULT_BETA_GRID if beta_grid is None else beta_grid)
+        likelihood = Likelihood(data, grid)
+    lik = likelihood
+    scale_fixed = {k: v for k, v in fixed.items() if k in SCALES}
+    s, ll = lik.maximise(scale_fixed)
+    logb = np.log(lik.beta_grid)
+    if lik.beta_grid.size > 1:
+        xb, ll_max, _ = _refine_max(logb, ll)
+        beta_hat = math.exp(xb)
+        s_hat = np.array([np.interp(xb, logb, s[:, p]) for p in range(s.shape[1])])
+    else:
+        beta_hat, ll_max, s_hat = float(lik.beta_grid[0]), float(ll[0]), s[0]
+    estimates = {"debris_scale": float(s_hat[0]), "meteoroid_scale": float(s_hat[1]), "beta": beta_hat}
+    half = 0.5 * float(stats.chi2.ppf(confidence, 1))
+    intervals: dict[str, tuple[float, float]] = {}
+    notes: list[str] = []
+    if "beta" not in fixed:
+        intervals["beta"] = _beta_interval(logb, ll, ll_max - half, notes)
+    # a β whose profile is below the interval's level cannot hold a boundary of a scale's interval
+    near = lik
+    if ll.size > 3:
+        relevant = np.convolve((ll >= ll_max - half - 0.5).astype(float), np.ones(3), mode="same") > 0
+        near = lik.subset(relevant) if relevant.sum() >= 3 else lik
+    for p, name in enumerate(SCALES):
+        if name in fixed:
+            continue
+        intervals[name] = _scale_interval(near, name, float(s_hat[p]), scale_fixed, ll_max - half)
+    b = int(np.argmin(np.abs(logb - math.log(beta_hat))))
+    expected = {pop: float(s_hat[p] * lik.totals[b, p]) for p, pop in enumerate(POPULATIONS)}
+    expected["false_alarms"] = lik.bg_total
+    return FitResult(
+        estimates,
+        intervals,
+        confidence,
+        float(ll_max),
+        fixed,
+        data.n_events,
+        data.n_dropped,
+        data.n_days,
+        data.n_with_direction,
+        expected,
+        notes,
+    )
+
+
+def _beta_interval(logb: NDArray[Any], ll: NDArray[Any], level: float, notes: list[str]) -> tuple[float, float]:
+    above = ll >= level
+    i = int(np.nanargmax(ll))
+    lo_i, hi_i = i, i
+    while lo_i > 0 and above[lo_i - 1]:
+        lo_i -= 1
+    while hi_i < ll.size - 1 and above[hi_i + 1]:
+        hi_i += 1
+
+    def cross(j_in: int, j_out: int) -> float:
+        y0, y1 = ll[j_in], ll[j_out]
+        if not np.isfinite(y1):
+            return float(math.exp(logb[j_in]))
+        t = (y0 - level) / (y0 - y1)
+        return float(math.exp(logb[j_in] + t * (logb[j_out] - logb[j_in])))
+
+    lo = cross(lo_i, lo_i - 1) if lo_i > 0 else float(math.exp(logb[0]))
+    hi = cross(hi_i, hi_i + 1) if hi_i < ll.size - 1 else float(math.exp(logb[-1]))
+    if lo_i == 0 or hi_i == ll.size - 1:
+        notes.append("beta interval reaches the edge of the beta grid: beta is not bounded by these data there")
+    return lo, hi
+
+
+def _scale_interval(
+    lik: Likelihood, name: str, s_hat: float, scale_fixed: Mapping[str, float], level: float
+) -> tuple[float, float]:
+    def f(v: float) -> float:
+        return _profile_value(lik, {**scale_fixed, name: v}) - level
+
+    lo = 0.0
+    if s_hat > 0 and f(0.0) < 0:
+        lo = float(optimize.brentq(f, 0.0, s_hat, xtol=1e-5 * max(s_hat, 1e-12), rtol=1e-4))
+    hi_b = max(s_hat, 1e-3) * 2.0
+    for _ in range(80):
+        if f(hi_b) < 0:
+            break
+        hi_b *= 2.0
+    else:
+        return lo, math.inf
+    hi = float(optimize.brentq(f, max(s_hat, 0.0), hi_b, xtol=1e-5 * hi_b, rtol=1e-4))
+    return lo, hi
+
+
+# ------------------------------------------------------------------------------------------------
+# Upper limits and goodness of fit
+# ------------------------------------------------------------------------------------------------
+
+
+def poisson_upper_limit(n: int, background: float = 0.0, confidence: float = 0.95, method: str = "cls") -> float:
+    """Upper limit on the expected signal count s for n observed events over background b.
+
+    ``neyman``: P(N <= n | s + b) = 1 − CL (Garwood; with b = 0, s = χ²_{2n+2}(CL)/2).
+    ``cls``: P(N <= n | s + b) / P(N <= n | b) = 1 − CL (never below the b = 0 limit minus b, and equal
+    to −ln(1 − CL) for n = 0 whatever b).
+    """
+    if n < 0 or not (0 < confidence < 1) or background < 0:
+        raise ConfigError("need n >= 0, 0 < confidence < 1, background >= 0", key="upper_limit")
+    alpha = 1.0 - confidence
+    if method == "neyman":
+
+        def g(s: float) -> float:
+            return float(stats.poisson.cdf(n, s + background)) - alpha
+
+    elif method == "cls":
+        p_b = float(stats.poisson.cdf(n, background))
+
+        def g(s: float) -> float:
+            return float(stats.poisson.cdf(n, s + background)) / p_b - alpha
+
+    else:
+        raise ConfigError(f"unknown upper-limit method {method!r}; use cls or neyman", key="method")
+    if g(0.0) <= 0:
+        return 0.0
+    hi = max(10.0, 2.0 * (n + 10))
+    while g(hi) > 0:
+        hi *= 2.0
+    return float(optimize.brentq(g, 0.0, hi, xtol=1e-10, rtol=1e-12))
+
+
+def upper_limit(
+    data: FluxData,
+    population: str,
+    *,
+    beta: float = 1.0,
+    other_scale: float = 1.0,
+    confidence: float = 0.95,
+    method: str = "cls",
+    dH_min_Nms: float = 0.0,
+) -> dict[str, float]:
+    """Upper limit on one population's flux scale at a given β (counting events with |ΔH| >= dH_min).
+
+    The other population (at ``other_scale``) and the false alarms are the background.
+    """
+    if population not in POPULATIONS:
+        raise ConfigError(f"unknown population {population!r}; choose from {list(POPULATIONS)}", key="population")
+    p = POPULATIONS.index(population)
+    lik = Likelihood(data, np.array([beta]))
+    lower_edges = data.templates[0].config.edges_Nms[:-1]
+    use = lower_edges >= dH_min_Nms * (1 - 1e-12)
+    signal = float(lik.bin_signal[0, p, use].sum())
+    other = float(lik.bin_signal[0, 1 - p, use].sum()) * other_scale
+    bg = float(data.background_bins[use].sum()) + other
+    n = int(data.observed_bins[use].sum())
+    s_up = poisson_upper_limit(n, bg, confidence, method)
+    return {
+        "population": float(p),
+        "n_observed": float(n),
+        "background_expected": bg,
+        "signal_per_unit_scale": signal,
+        "signal_upper_limit": s_up,
+        "scale_upper_limit": s_up / signal if signal > 0 else math.inf,
+        "confidence": confidence,
+        "beta": beta,
+        "dH_min_Nms": dH_min_Nms,
+    }
+
+
+def expected_bins(lik: Likelihood, params: Mapping[str, float]) -> NDArray[np.float64]:
+    """Expected detections per |ΔH| bin (all spacecraft-days, classes) at parameters (β on the grid)."""
+    b = int(np.argmin(np.abs(np.log(lik.beta_grid) - math.log(params["beta"]))))
+    s = np.array([params["debris_scale"], params["meteoroid_scale"]])
+    return np.asarray(np.einsum("pk,p->k", lik.bin_signal[b], s) + lik.data.background_bins, dtype=np.float64)
+
+
+def poisson_deviance(n: NDArray[Any], mu: NDArray[Any]) -> NDArray[np.float64]:
+    """Poisson deviance 2 Σ [n ln(n/μ) − (n − μ)] (last axis), the likelihood ratio to the saturated model."""
+    n = np.asarray(n, dtype=np.float64)
+    mu = np.maximum(np.asarray(mu, dtype=np.float64), 1e-300)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(n > 0, n * np.log(n / mu), 0.0)
+    return np.asarray(2.0 * np.sum(t - (n - mu), axis=-1), dtype=np.float64)
+
+
+def goodness_of_fit(
+    data: FluxData, params: Mapping[str, float], *, n_sim: int = 2000, seed: int = 0, name: str = ""
+) -> dict[str, Any]:
+    """Deviance of the observed |ΔH| histogram against a model; p-value from simulated histograms.
+
+    Also the two-sided Poisson p-value of the total count. A model fitted to the same data makes the
+    deviance p-value conservative (the parameters were tuned to these counts).
+    """
+    lik = Likelihood(data, np.array([params["beta"]]))
+    mu = expected_bins(lik, params)
+    n = data.observed_bins
+    dev = float(poisson_deviance(n, mu))
+    rng = np.random.default_rng(seed)
+    sims = poisson_deviance(rng.poisson(mu, size=(n_sim, mu.size)), mu)
+    total_mu, total_n = float(mu.sum()), int(n.sum())
+    p_low = float(stats.poisson.cdf(total_n, total_mu))
+    p_high = float(stats.poisson.sf(total_n - 1, total_mu))
+    return {
+        "model": name,
+        "params": dict(params),
+        "expected_events": total_mu,
+        "observed_events": total_n,
+        "deviance": dev,
+        "deviance_p_value": float((np.sum(sims >= dev) + 1) / (n_sim + 1)),
+        "count_p_value": min(1.0, 2.0 * min(p_low, p_high)),
+    }
