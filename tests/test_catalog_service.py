@@ -133,6 +133,14 @@ def test_filters(catalog_target: str) -> None:
     ]
 
 
+def test_a_detector_filter_is_a_name_never_a_like_pattern(catalog_target: str) -> None:
+    cat = Catalog(catalog_target)
+    cat.add_events(events_frame([_event("2026-01-01T00:00:00"), _event("2026-01-03T00:00:00", det="attitude.cusum")]))
+    for pattern in ("%", "_", "att%", "%lr", "g_r", "attitud_"):
+        assert cat.events(detector=pattern).empty, pattern
+    assert len(cat.events(detector="cusum")) == 1
+
+
 def test_parquet_export_has_typed_utc_times_and_round_trips(catalog_target: str, tmp_path: Path) -> None:
     cat = Catalog(catalog_target)
     cat.add_events(events_frame([_event("2026-01-01T00:10:00.123456")]))
@@ -261,3 +269,52 @@ def test_narrow_view_fits_120_columns(tmp_path: Path, capsys: pytest.CaptureFixt
     out = capsys.readouterr().out
     assert "a-very-long-spac" in out
     assert max(len(line) for line in out.splitlines()) <= 120
+
+
+@pytest.mark.parametrize("rows", [0, 2])
+def test_another_programs_tables_are_refused_and_left_untouched(tmp_path: Path, rows: int) -> None:
+    path = tmp_path / "other.sqlite"
+    with sqlite3.connect(path) as conn:
+        conn.execute("CREATE TABLE events (id INTEGER PRIMARY KEY, title TEXT, start TEXT)")
+        conn.execute("CREATE TABLE runs (id INTEGER PRIMARY KEY, note TEXT)")
+        conn.executemany("INSERT INTO events (title, start) VALUES (?, ?)", [("party", "2026-01-01")] * rows)
+    before = path.read_bytes()
+    with pytest.raises(CatalogError) as info:
+        Catalog(path)
+    message = str(info.value)
+    assert "'events'" in message and "did not create" in message and "other.sqlite" in message
+    assert "\n" not in message
+    assert path.read_bytes() == before  # neither dropped, migrated nor given abrupt's tables
+    with sqlite3.connect(path) as conn:
+        assert conn.execute("SELECT count(*) FROM events").fetchone()[0] == rows
+        tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type='table'")}
+    assert tables == {"events", "runs"}
+
+
+def test_texts_too_long_for_the_catalog_are_refused_alike_on_every_database(catalog_target: str) -> None:
+    cat = Catalog(catalog_target)
+    long_name = "s" * 250
+    with pytest.raises(CatalogError) as info:
+        cat.store_events(events_frame([_event("2026-01-01T00:00:00", sc=long_name)]))
+    assert "250 characters" in str(info.value) and "at most 200" in str(info.value)
+    assert cat.events().empty
+    cat.store_events(events_frame([_event("2026-01-01T00:00:00", sc="s" * 200)]))  # at the limit: stored
+    assert len(cat.events()) == 1
+
+
+def test_a_name_too_long_writes_neither_the_file_nor_a_run(
+    shared_data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    lines = (shared_data / "tle" / "Jason-3.tle").read_text(encoding="ascii").splitlines()[:400]
+    tle = tmp_path / "j3.tle"
+    tle.write_text("\n".join(lines) + "\n", encoding="ascii")
+    out, catalog = tmp_path / "events.csv", tmp_path / "c.sqlite"
+    argv = ["detect", "tle", str(tle), "--out", str(out), "--catalog", str(catalog), "--name", "x" * 250]
+    with pytest.raises(SystemExit) as exit_info:
+        main(argv)
+    assert exit_info.value.code == 2
+    error = capsys.readouterr().err.strip().splitlines()[-1]  # after the detection's own summary lines
+    assert error.startswith("error: ") and "at most 200" in error
+    assert not out.exists()
+    with sqlite3.connect(catalog) as conn:
+        assert conn.execute("SELECT count(*) FROM runs").fetchone()[0] == 0

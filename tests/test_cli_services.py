@@ -12,6 +12,7 @@ import pytest
 from abrupt.cli.groups import hoist_global_flags
 from abrupt.cli.main import main
 from abrupt.events import Event, events_frame, write_events
+from abrupt.readers.omm import read_elements
 
 
 def _run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
@@ -79,6 +80,28 @@ def test_score_rejects_an_empty_truth_file_and_warns_on_another_satellites_file(
     assert code == 0 and "TP 40" in out and "warning" not in err
     code, out, err = _run(["score", str(tmp_path / "mine.csv"), "--truth", str(tmp_path / "other.csv"), *span], capsys)
     assert code == 0 and "same satellite" in err
+
+
+def test_score_refuses_element_sets_of_another_satellite(
+    shared_data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    def cut(name: str) -> Path:
+        lines = (shared_data / "tle" / name).read_text(encoding="ascii").splitlines()[:400]
+        path = tmp_path / name
+        path.write_text("\n".join(lines) + "\n", encoding="ascii")
+        return path
+
+    jason3, sentinel3a = cut("Jason-3.tle"), cut("Sentinel-3A.tle")
+    norad = int(jason3.read_text().splitlines()[0][2:7])
+    epochs = pd.DatetimeIndex(read_elements(jason3).elements["epoch_utc"].iloc[[20, 80, 150]])
+    write_events(_events(epochs, f"NORAD-{norad}"), str(tmp_path / "mine.csv"))
+    write_events(_events(epochs, "truth-sat"), str(tmp_path / "truth.csv"))
+    argv = ["score", str(tmp_path / "mine.csv"), "--truth", str(tmp_path / "truth.csv"), "--elements"]
+    code, out, err = _run([*argv, str(sentinel3a)], capsys)
+    assert code == 2 and f"satellite {norad}" in err and "precision" not in out
+    assert len(err.strip().splitlines()) == 1
+    code, out, _ = _run([*argv, str(jason3)], capsys)
+    assert code == 0 and "TP 3" in out
 
 
 def test_nested_option_errors_print_one_clean_line(

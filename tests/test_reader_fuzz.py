@@ -253,16 +253,22 @@ def _random_ephemeris(draw: st.DrawFn) -> Ephemeris:
     start = np.datetime64("2000-01-01", "ns") + np.timedelta64(draw(st.integers(0, 30 * 365 * 86400)), "s")
     times = start + (gaps * step_s * 1e9).astype("timedelta64[ns]")
     radius = draw(st.floats(6.6e6, 4.5e7))
-    unit = draw(
-        st.lists(st.lists(st.floats(-1, 1), min_size=3, max_size=3), min_size=n, max_size=n).filter(
-            lambda u: all(np.linalg.norm(v) > 0.1 for v in u)
+    # A circular orbit in a random plane, the velocity the exact derivative of the position (the SP3
+    # reader refuses velocities that are not: positions against velocities is one of its checks).
+    axes = draw(
+        st.lists(st.lists(st.floats(-1, 1), min_size=3, max_size=3), min_size=2, max_size=2).filter(
+            lambda a: np.linalg.norm(np.cross(a[0], a[1])) > 0.1 and np.linalg.norm(a[0]) > 0.1
         )
     )
-    u = np.array(unit) / np.linalg.norm(unit, axis=1)[:, None]
-    speed = draw(st.floats(1.0e3, 8.0e3))
-    vel = np.roll(u, 1, axis=1) * speed
+    e1 = np.array(axes[0]) / np.linalg.norm(axes[0])
+    e2 = np.cross(np.cross(e1, axes[1]), e1)
+    e2 /= np.linalg.norm(e2)
+    rate = np.sqrt(3.986004418e14 / radius**3)  # [rad/s] Keplerian mean motion
+    phase = draw(st.floats(0.0, 2 * np.pi)) + rate * (times - times[0]).astype(np.float64) * 1e-9
+    pos = radius * (np.cos(phase)[:, None] * e1 + np.sin(phase)[:, None] * e2)
+    vel = radius * rate * (-np.sin(phase)[:, None] * e1 + np.cos(phase)[:, None] * e2)
     frame = draw(st.sampled_from(["ITRF", "GCRF"]))
-    return Ephemeris("L51", times, u * radius, vel, frame, time_system="UTC")  # type: ignore[arg-type]
+    return Ephemeris("L51", times, pos, vel, frame, time_system="UTC")  # type: ignore[arg-type]
 
 
 ROUND_TRIP = settings(FAST, max_examples=60)

@@ -14,6 +14,23 @@ from pathlib import Path
 logger = logging.getLogger("abrupt")
 
 
+MAX_REASON_CHARS = 400  # an error message quotes at most this much of its reason
+
+
+def quote(text: str, limit: int = 80) -> str:
+    """``repr`` of at most ``limit`` characters of ``text`` (a line of a hostile file can be 200 MB)."""
+    if len(text) <= limit:
+        return repr(text)
+    return f"{text[:limit]!r}… ({len(text)} characters)"
+
+
+def bounded(reason: str) -> str:
+    """A reason cut to :data:`MAX_REASON_CHARS` characters."""
+    if len(reason) <= MAX_REASON_CHARS:
+        return reason
+    return f"{reason[:MAX_REASON_CHARS]}… ({len(reason)} characters)"
+
+
 class AbruptError(Exception):
     """Base class of every error abrupt raises on purpose."""
 
@@ -33,7 +50,7 @@ class InputError(AbruptError, ValueError):
         line: int | None = None,
         column: str | int | None = None,
     ) -> None:
-        self.reason = " ".join(str(reason).split())  # one line, whatever a library's message held
+        self.reason = bounded(" ".join(str(reason).split()))  # one line, whatever a library's message held
         self.file = str(file) if file is not None else None
         self.line = line
         self.column = column
@@ -52,7 +69,7 @@ class ConfigError(AbruptError, ValueError):
     """Invalid configuration (spacecraft file, detector settings); names the key and the reason."""
 
     def __init__(self, reason: str, *, file: str | Path | None = None, key: str | None = None) -> None:
-        self.reason = " ".join(str(reason).split())
+        self.reason = bounded(" ".join(str(reason).split()))
         self.file = str(file) if file is not None else None
         self.key = key
         where = self.file or "<config>"

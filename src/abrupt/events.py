@@ -16,9 +16,11 @@ import functools
 import hashlib
 import json
 import math
+import os
 import uuid
 from collections.abc import Iterable, Mapping
 from dataclasses import asdict, dataclass, field, is_dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -238,18 +240,27 @@ def format_time_columns(frame: pd.DataFrame) -> pd.DataFrame:
 def write_events(frame: pd.DataFrame, path: str) -> None:
     """Write events to CSV or Parquet, chosen by the file suffix (``.csv``, ``.parquet``/``.pq``).
 
-    Parquet stores ``time_utc`` as a typed UTC timestamp (microseconds); CSV as ISO-8601 text.
+    Parquet stores ``time_utc`` as a typed UTC timestamp (microseconds); CSV as ISO-8601 text. The file
+    is written beside ``path`` under a temporary name and renamed over it (an interrupted write leaves
+    the previous file whole; a symbolic link at ``path`` is replaced, not followed).
     """
     frame = normalise_frame(frame)
     lower = str(path).lower()
-    if lower.endswith((".parquet", ".pq")):
-        typed = frame.copy()
-        typed["time_utc"] = pd.to_datetime(typed["time_utc"].astype(str), utc=True).astype("datetime64[us, UTC]")
-        typed.to_parquet(path, index=False)
-    elif lower.endswith(".csv"):
-        frame.to_csv(path, index=False)
-    else:
+    if not lower.endswith((".parquet", ".pq", ".csv")):
         raise ValueError(f"{path}: events file must end in .csv or .parquet")
+    target = Path(path)
+    tmp_name = target.with_name(f".{target.name}.{uuid.uuid4().hex[:12]}.tmp")
+    try:
+        if lower.endswith(".csv"):
+            frame.to_csv(tmp_name, index=False)
+        else:
+            typed = frame.copy()
+            typed["time_utc"] = pd.to_datetime(typed["time_utc"].astype(str), utc=True).astype("datetime64[us, UTC]")
+            typed.to_parquet(tmp_name, index=False)
+        os.replace(tmp_name, target)
+    except BaseException:
+        tmp_name.unlink(missing_ok=True)
+        raise
 
 
 def read_events(path: str) -> pd.DataFrame:

@@ -10,11 +10,14 @@ from :mod:`abrupt.cli.groups` and decorate their commands onto them as usual.
 from __future__ import annotations
 
 import ast
+import functools
 import importlib
 import importlib.util
 import logging
-from collections.abc import Mapping
+import os
+from collections.abc import Callable, Iterator, Mapping
 from functools import cache
+from pathlib import Path
 from typing import Any, TypeGuard
 
 import click
@@ -111,6 +114,78 @@ def _is_command_decorator(node: ast.expr) -> TypeGuard[ast.Call]:
     return node.func.attr in ("command", "group")
 
 
+# ------------------------------------------------------------------ outputs never destroy inputs
+# Every parameter named ``out`` or ``out_*`` (``--out``) is an output. It is refused when it resolves to
+# the same file as any other parameter naming an existing file (an input) or the SQLite catalog
+# (``--catalog``, existing or not), and when it is a symbolic link (not followed: give the real path).
+# Kept here, not in a module of its own, so that ``abrupt --help`` imports no other CLI module.
+
+
+def _is_output(name: str) -> bool:
+    return name == "out" or name.startswith("out_")
+
+
+def _paths(value: Any) -> Iterator[str]:
+    if isinstance(value, str | os.PathLike) and str(value):
+        yield str(value)
+    elif isinstance(value, tuple | list):
+        for item in value:
+            yield from _paths(item)
+
+
+def _same(a: str, b: str) -> bool:
+    try:
+        return Path(a).resolve() == Path(b).resolve()
+    except (OSError, RuntimeError):
+        return False
+
+
+def check_output_paths(params: Mapping[str, Any]) -> None:
+    """Raise :class:`click.BadParameter` when an output would overwrite an input or follow a link."""
+    outputs = [(name, path) for name, value in params.items() if _is_output(name) for path in _paths(value)]
+    if not outputs:
+        return
+    inputs: list[tuple[str, str]] = []
+    for name, value in params.items():
+        if _is_output(name):
+            continue
+        for path in _paths(value):
+            if name == "catalog_target" and ("://" not in path or path.startswith("sqlite:///")):
+                inputs.append((name, path.removeprefix("sqlite:///")))
+            elif "://" not in path and os.path.isfile(path):
+                inputs.append((name, path))
+    for out_name, out in outputs:
+        hint = "--" + out_name.replace("_", "-") if out_name == "out" else "--out"
+        if os.path.islink(out):
+            raise click.BadParameter(f"{out} is a symbolic link (not followed); give the real path", param_hint=hint)
+        for in_name, path in inputs:
+            if _same(out, path):
+                what = "--catalog" if in_name == "catalog_target" else "--" + in_name.replace("_", "-")
+                raise click.BadParameter(
+                    f"{out} is the same file as {what} {path}: writing it would destroy that input", param_hint=hint
+                )
+
+
+def guard_outputs(command: click.Command) -> click.Command:
+    """Make ``command`` check its output paths before its body runs (once per command object)."""
+    if isinstance(command, click.Group):  # its loaded sub-commands (a lazy group guards the others)
+        for sub in command.commands.values():
+            guard_outputs(sub)
+        return command
+    callback: Callable[..., Any] | None = command.callback
+    if callback is None or getattr(callback, "_outputs_guarded", False):
+        return command
+
+    @functools.wraps(callback)
+    def guarded(*args: Any, **kwargs: Any) -> Any:
+        check_output_paths(kwargs)
+        return callback(*args, **kwargs)
+
+    guarded._outputs_guarded = True  # type: ignore[attr-defined]
+    command.callback = guarded
+    return command
+
+
 class LazyGroup(click.Group):
     """A click group whose sub-commands are imported on first use (click's documented LazyGroup pattern)."""
 
@@ -125,7 +200,8 @@ class LazyGroup(click.Group):
         if cmd_name not in self.commands and cmd_name in self.lazy_commands:
             command = load_command(self.lazy_commands[cmd_name])  # its decorator registers it here
             self.commands.setdefault(cmd_name, command)
-        return super().get_command(ctx, cmd_name)
+        found = super().get_command(ctx, cmd_name)
+        return guard_outputs(found) if found is not None else None
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         """The "Commands" section, with summaries of commands not yet imported read from their source."""

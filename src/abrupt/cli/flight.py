@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import json
+import os
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -19,6 +20,7 @@ from abrupt.events import write_events
 from abrupt.model.spacecraft import load_spacecraft
 from abrupt.pipelines.flight import CleaningConfig, FlightRunConfig, day_range, ingest_archives, run_flight
 from abrupt.pipelines.flight_injection import injection_recovery
+from abrupt.readers.archive import pseudonymise_text, read_decoder
 from abrupt.report.flight import write_flight_report
 from abrupt.simulate.injection import InjectedStrike, inject_strikes
 from abrupt.store import TelemetryStore
@@ -32,7 +34,7 @@ def _progress(total: int, label: str) -> Any:
 
 
 @cli.command("ingest")
-@click.argument("archives", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False))
+@click.argument("archives", nargs=-1, required=True, type=click.Path(dir_okay=False))  # checked, pseudonymised
 @click.option(
     "--decoder",
     "decoder_path",
@@ -45,6 +47,11 @@ def _progress(total: int, label: str) -> Any:
 @click.option("--assume-utc", is_flag=True, help="Read times without a zone as UTC (counted in the report).")
 def ingest_cmd(archives: tuple[str, ...], decoder_path: str, store_dir: str, layout: str, assume_utc: bool) -> None:
     """Ingest archive dumps (long or wide; CSV, CSV.gz, Parquet) into a pseudonymised store, one report per day."""
+    decoder = read_decoder(decoder_path)
+    for archive in archives:  # click's own message would print the real name
+        if not Path(archive).is_file() or not os.access(archive, os.R_OK):
+            why = "is not a readable file" if Path(archive).exists() else "does not exist"
+            raise InputError(f"archive {why}", file=pseudonymise_text(archive, decoder))
     bar = _progress(len(archives), "ingest")
     summary = ingest_archives(
         archives, decoder_path, store_dir, layout=layout, assume_utc=assume_utc, progress=lambda s: bar.update(1)

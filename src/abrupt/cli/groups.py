@@ -164,6 +164,7 @@ def record_run(
     Returns the number of events that were new to the catalog.
     """
     catalog = Catalog(catalog_target)  # open (and check) the catalog before writing anything
+    catalog.check_fits(events)  # texts too long for the catalog: refused before the file is written
     if out is not None:  # then the file: a bad path must not leave events in the catalog only
         Path(out).parent.mkdir(parents=True, exist_ok=True)
         write_events(events, str(out))

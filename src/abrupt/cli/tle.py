@@ -288,6 +288,16 @@ def chance_matches(n_det: int, n_truth: int, tolerance_s: float, start: Any, end
     return n_truth * (1.0 - math.exp(-n_det * 2.0 * tolerance_s / span_s))
 
 
+def _same_satellite(events: pd.DataFrame, norad_id: int, events_path: str, elements: str) -> None:
+    """Refuse element sets of another satellite than the events' (named ``NORAD-n`` by ``detect tle``)."""
+    numbers = {int(m) for m in events["spacecraft"].astype(str).str.extract(r"^NORAD-(\d+)$")[0].dropna()}
+    if numbers and norad_id not in numbers:
+        raise InputError(
+            f"the events are of satellite {sorted(numbers)[0]} but --elements {elements} holds satellite {norad_id}",
+            file=events_path,
+        )
+
+
 @cli.command("score")
 @click.argument("events_path", type=click.Path(exists=True, dir_okay=False))
 @click.option(
@@ -344,7 +354,9 @@ def score(
     events = read_events(events_path)
     truth_frame = _read_truth(truth)
     if elements:
-        el = read_elements(elements).elements
+        history = read_elements(elements)
+        _same_satellite(events, history.norad_id, events_path, elements)
+        el = history.elements
         start, end = str(el["epoch_utc"].iloc[0]), str(el["epoch_utc"].iloc[-1])
     if len(truth_frame) == 0:
         raise InputError("truth file lists no maneuvers: nothing to score against", file=truth)

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from abrupt.errors import InputError, RepairLog
+from abrupt.errors import InputError, RepairLog, quote
 from abrupt.model.tracking_measurements import MEASUREMENT_COLUMNS
 from abrupt.readers.text import read_text
 
@@ -80,7 +80,7 @@ def read_aer(
         tokens = line.split()
         if len(tokens) < 4:
             raise InputError(
-                f"expected 'DATE TYPE STATION VALUE...', got {len(tokens)} field(s): {raw.strip()!r}",
+                f"expected 'DATE TYPE STATION VALUE...', got {len(tokens)} field(s): {quote(raw.strip())}",
                 file=path,
                 line=lineno,
             )
@@ -89,18 +89,18 @@ def read_aer(
             t = parse_utc(date_s)
         except (ValueError, TypeError):
             raise InputError(
-                f"cannot parse date {date_s!r} (ISO-8601 UTC expected)", file=path, line=lineno, column=1
+                f"cannot parse date {quote(date_s)} (ISO-8601 UTC expected)", file=path, line=lineno, column=1
             ) from None
         if kind not in _TYPES:
             raise InputError(
-                f"unsupported measurement type {tokens[1]!r} (supported: {', '.join(sorted(_TYPES))})",
+                f"unsupported measurement type {quote(tokens[1])} (supported: {', '.join(sorted(_TYPES))})",
                 file=path,
                 line=lineno,
                 column=2,
             )
         if known is not None and station.upper() not in known:
             raise InputError(
-                f"unknown station {station!r} (known: {', '.join(sorted(known.values()))})",
+                f"unknown station {quote(station)} (known: {', '.join(sorted(known.values()))})",
                 file=path,
                 line=lineno,
                 column=3,
@@ -119,7 +119,7 @@ def read_aer(
                 v = float(text_v)
             except ValueError:
                 raise InputError(
-                    f"{_FILE_COLUMNS[col]} value {text_v!r} is not a number",
+                    f"{_FILE_COLUMNS[col]} value {quote(text_v)} is not a number",
                     file=path,
                     line=lineno,
                     column=4 + k,

@@ -4,9 +4,10 @@ Harris et al. 2025 §3.3 and §3.7: the first thing done to a raw archive export
 spacecraft name and every mnemonic by the pseudonyms of a decoder file (``real_name,pseudonym``);
 nothing downstream of this module ever sees the decoder or a real name. Archiver artifacts are then
 removed and counted (they are not data): blank rows, rows with an empty field, placeholder values
-(``-999999``, the text ``NaN``), exact duplicate rows. Conflicting duplicates (same time and mnemonic,
-different values) and time reversals are reported and resolved by keeping the first value in file
-order and sorting by time.
+(``-999999``, the text ``NaN``), infinite or absurd values (``inf``, ``1e300``: beyond 1e20, above
+any 64-bit counter; counter "infinite or absurd values (|v| > 1e20)"), exact duplicate rows.
+Conflicting duplicates (same time and mnemonic, different values) and time reversals are reported
+and resolved by keeping the first value in file order and sorting by time.
 
 Layouts:
 
@@ -26,6 +27,7 @@ from __future__ import annotations
 import csv
 import gzip
 import hashlib
+import re
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -41,6 +43,9 @@ import pyarrow.parquet as pq
 from abrupt.errors import ConfigError, InputError
 
 DEFAULT_PLACEHOLDERS: tuple[float, ...] = (-999999.0, 999999.0, -99999.0, -9999999.0)
+# Beyond any telemetry value: above the largest 64-bit counter (1.8e19); inf and 1e300 are corruption.
+MAX_ABS_VALUE = 1e20
+ARCHIVE_ABSURD = "infinite or absurd values (|v| > 1e20)"
 TIME_NAMES = ("time", "timestamp", "time_utc", "utc", "datetime")
 
 
@@ -150,12 +155,15 @@ class ArchiveChunk:
 
 
 def pseudonymise_text(text: str, decoder: Decoder) -> str:
-    """``text`` with every real name of the decoder replaced by its pseudonym (longest names first)."""
-    pairs = sorted({**decoder.spacecraft, **decoder.mnemonics}.items(), key=lambda kv: -len(kv[0]))
-    for real, pseudo in pairs:
-        if real in text:
-            text = text.replace(real, pseudo)
-    return text
+    """``text`` with every real name of the decoder replaced by its pseudonym, whatever its case
+    (``kestrel2_dump.csv`` as well as ``KESTREL2``); the longest name wins where names overlap."""
+    by_lower: dict[str, str] = {}
+    for real, pseudo in {**decoder.spacecraft, **decoder.mnemonics}.items():
+        by_lower.setdefault(real.lower(), pseudo)
+    if not by_lower or not text:
+        return text
+    pattern = re.compile("|".join(re.escape(r) for r in sorted(by_lower, key=len, reverse=True)), re.IGNORECASE)
+    return pattern.sub(lambda m: by_lower[m.group(0).lower()], text)
 
 
 def _read_raw(path: Path) -> pa.Table:
@@ -491,19 +499,22 @@ def _read_archive(
     t_int = np.where(t_valid, np.asarray(times.cast(pa.int64()).fill_null(0).to_numpy(), np.int64), 0)
     no_name = codes < 0
     is_placeholder = np.isin(values, np.asarray(placeholders, dtype=np.float64)) | (np.isnan(values) & ~value_null)
-    # Order of judgement: missing time or name -> empty value -> placeholder -> name not in decoder.
+    with np.errstate(invalid="ignore"):
+        is_absurd = ~np.isnan(values) & ~(np.abs(values) <= MAX_ABS_VALUE)  # inf, -inf, 1e300
+    # Order of judgement: missing time or name -> empty value -> placeholder -> absurd -> not in decoder.
     drop_missing = ~t_valid | no_name
     drop_empty = ~drop_missing & value_null
     drop_placeholder = ~drop_missing & ~drop_empty & is_placeholder
-    drop_unknown = ~drop_missing & ~drop_empty & ~drop_placeholder & ~row_known
-    keep = ~(drop_missing | drop_empty | drop_placeholder | drop_unknown)
+    drop_absurd = ~drop_missing & ~drop_empty & ~drop_placeholder & is_absurd
+    drop_unknown = ~drop_missing & ~drop_empty & ~drop_placeholder & ~drop_absurd & ~row_known
+    keep = ~(drop_missing | drop_empty | drop_placeholder | drop_absurd | drop_unknown)
     counts["rows read"] = n0
     counts["blank rows"] += n_blank
     if bad_values:
         counts["unparseable values"] += bad_values
     unknown_names: Counter[str] = Counter()
     for c in unknown_codes:
-        n_c = int(np.count_nonzero((codes == c) & ~drop_missing & ~drop_empty & ~drop_placeholder))
+        n_c = int(np.count_nonzero((codes == c) & ~drop_missing & ~drop_empty & ~drop_placeholder & ~drop_absurd))
         if n_c:
             unknown_names[name_token(str(dictionary[c]))] += n_c
 
@@ -515,6 +526,7 @@ def _read_archive(
     for label, mask in (
         ("empty values", drop_empty),
         ("placeholder values", drop_placeholder),
+        (ARCHIVE_ABSURD, drop_absurd),
         ("names not in the decoder", drop_unknown),
     ):
         sel = mask & t_valid

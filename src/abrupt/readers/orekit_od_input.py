@@ -24,10 +24,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from abrupt.errors import InputError
+from abrupt.errors import InputError, quote
 from abrupt.model.orbit import MU_EARTH_M3_S2, coe_to_rv
 from abrupt.model.stations import WGS84_A_M, Station
 from abrupt.readers.aer import parse_utc
+from abrupt.readers.text import read_text
 from abrupt.types import FloatArray
 
 _KEY = re.compile(r"^(?P<key>[A-Za-z0-9_.]+)\s*(\[\s*(?P<index>\d+)\s*\])?$")
@@ -61,16 +62,16 @@ def _entries(path: Path) -> tuple[Entries, dict[int, Entries]]:
     """The ``key = value`` lines of the file: plain keys, and indexed keys (``key[k]``) by index."""
     plain: Entries = {}
     indexed: dict[int, Entries] = {}
-    for lineno, raw in enumerate(path.read_text().splitlines(), start=1):
+    for lineno, raw in enumerate(read_text(path).splitlines(), start=1):
         line = raw.strip()
         if not line or line.startswith("#"):
             continue
         if "=" not in line:
-            raise InputError(f"expected 'key = value', got {line!r}", file=path, line=lineno)
+            raise InputError(f"expected 'key = value', got {quote(line)}", file=path, line=lineno)
         key_part, value = line.split("=", 1)
         m = _KEY.match(key_part.strip())
         if m is None:
-            raise InputError(f"malformed key {key_part.strip()!r}", file=path, line=lineno, column=1)
+            raise InputError(f"malformed key {quote(key_part.strip())}", file=path, line=lineno, column=1)
         key = _normalise(m.group("key"))
         value = value.strip().rstrip(";").strip()
         if m.group("index") is not None:
@@ -95,7 +96,7 @@ def _number(path: Path, src: Entries, key: str, default: float | None = None) ->
     try:
         v = float(value)
     except ValueError:
-        raise InputError(f"{key}: {value!r} is not a number", file=path, line=lineno) from None
+        raise InputError(f"{key}: {quote(value)} is not a number", file=path, line=lineno) from None
     if not math.isfinite(v):
         raise InputError(f"{key}: {value!r} is not finite", file=path, line=lineno)
     return v

@@ -20,6 +20,11 @@ Documented repairs (counted in the :class:`~abrupt.errors.RepairLog` of each eph
   analysis centres) — is normalised ("epoch field at rollover value normalised");
 - a position given as 0.000000 or 999999.999999 (the SP3 "bad or absent" markers) removes that epoch
   for that satellite; such a velocity becomes NaN;
+- two ``P`` (or two ``V``) records of a satellite in one epoch remove that epoch for it; a ``V`` record
+  without its ``P`` is dropped; when a satellite has velocities at most epochs, an epoch without a
+  usable velocity (missing, malformed, marker) is removed (:func:`_epoch_structure`);
+- positions against velocities (:mod:`abrupt.readers.sp3_checks`): a satellite whose velocities are
+  not the derivative of its positions (a unit error) is an error naming it;
 - a malformed ephemeris record (unreadable number, truncated ``P``/``V`` line, unknown record type,
   implausible radius, malformed epoch line) in a long file is skipped and counted, up to 1 % of the
   records (so none in a file of fewer than 100 records); more is an error naming the first bad line;
@@ -54,6 +59,7 @@ from numpy.typing import NDArray
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.timescales import offline_astropy
 from abrupt.readers.compression import read_bytes
+from abrupt.readers.sp3_checks import check_position_velocity
 from abrupt.readers.sp3_header import (
     KNOWN_TIME_SYSTEMS,
     TAI_MINUS_SYSTEM_S,
@@ -74,6 +80,10 @@ BAD_VALUE_MARKER = 999999.999999  # [km or dm/s] the SP3 "bad or absent value" m
 MIN_RADIUS_KM = 6000.0  # [km] smallest plausible orbit radius
 MAX_RADIUS_KM = 2.0e6  # [km] largest plausible geocentric radius (beyond the Moon)
 BAD_RECORD_FRACTION = 0.01  # more malformed records than this (and more than one) is an error
+SP3_DOUBLED = "two P or two V records of a satellite in one epoch (epoch removed)"
+SP3_ORPHAN_VELOCITY = "velocity record without its position record (dropped)"
+SP3_PV_MISMATCH = "epoch whose position or velocity disagrees with its neighbours (removed with them)"
+SP3_NO_VELOCITY = "epoch without a usable velocity in a file with velocities (epoch removed)"
 
 
 @dataclass
@@ -177,6 +187,11 @@ class _Body:
     missing_pos: Counter[str] = field(default_factory=Counter)
     missing_vel: Counter[str] = field(default_factory=Counter)
     unlisted: set[str] = field(default_factory=set)
+    # per-epoch structure: the (satellite, epoch) pairs with a P and with a V record, doubled pairs
+    p_seen: set[tuple[str, int]] = field(default_factory=set)
+    v_seen: set[tuple[str, int]] = field(default_factory=set)
+    doubled: set[tuple[str, int]] = field(default_factory=set)
+    orphan_vel: Counter[str] = field(default_factory=Counter)
 
 
 def _epoch_record(body: _Body, line: str, no: int, header: Sp3Header) -> int:
@@ -203,6 +218,14 @@ def _state_record(body: _Body, line: str, no: int, current: int | None, satellit
     if current is None:
         return  # record of a skipped (bad) epoch: skipped with it
     what = "position (km)" if tag == "P" else "velocity (dm/s)"
+    if tag == "V" and (sid, current) not in body.p_seen:
+        body.orphan_vel[sid] += 1  # no position record before it in this epoch
+        return
+    seen = body.p_seen if tag == "P" else body.v_seen
+    if (sid, current) in seen:
+        body.doubled.add((sid, current))  # two P (or V) records of one satellite in one epoch
+        return
+    seen.add((sid, current))
     xyz = [_number(line[4 + 14 * k : 18 + 14 * k], 5 + 14 * k, what) for k in range(3)]
     if tag == "P":
         if any(_is_marker(c) for c in xyz) or all(c == 0.0 for c in xyz):
@@ -335,6 +358,34 @@ def _check_body(
     return t_all
 
 
+def _epoch_structure(body: _Body, sid: str, rows: dict[int, list[float]], log: RepairLog) -> dict[str, int]:
+    """One P and one V record per satellite and epoch: the repairs of one satellite's records.
+
+    An epoch with two position (or two velocity) records of the satellite is removed (which record
+    belongs to it cannot be told); a velocity record without its position record is dropped; and when
+    the satellite has velocities at most epochs, an epoch whose velocity is absent, unreadable or the
+    bad-value marker is removed (a position alone would be filtered with a different noise model and
+    can look like a velocity change). Returns the counts by kind.
+    """
+    doubled = [i for i in rows if (sid, i) in body.doubled]
+    for i in doubled:
+        del rows[i]
+    no_vel = [i for i, row in rows.items() if not math.isfinite(row[3])]
+    if rows and len(no_vel) <= 0.5 * len(rows):
+        for i in no_vel:
+            del rows[i]
+    else:
+        no_vel = []
+    counts = {
+        SP3_DOUBLED: len(doubled),
+        SP3_ORPHAN_VELOCITY: body.orphan_vel[sid],
+        SP3_NO_VELOCITY: len(no_vel),
+    }
+    for kind, n in counts.items():
+        log.record(kind, n)
+    return counts
+
+
 def parse_sp3(
     path: str | Path, *, allow_truncated: bool = False, strict: bool = False, repairs: RepairLog | None = None
 ) -> Sp3File:
@@ -348,15 +399,19 @@ def parse_sp3(
     t_all = _check_body(body, header, lines, start, file, log, (allow_truncated, strict))
     frame = "GCRF" if header.coordinate_system.upper() in INERTIAL_FRAMES else "ITRF"
     ephemerides: dict[str, Ephemeris] = {}
+    structure: Counter[str] = Counter()
     for sid in header.satellites + sorted(body.unlisted):
         rows = body.states.get(sid)
         if not rows:
             continue
-        idx_arr = np.array(sorted(rows), dtype=np.int64)
         sat_log = RepairLog(source=f"{file}[{sid}]")
         sat_log.counts.update(log.counts)
         sat_log.record("missing position marker (epoch removed)", body.missing_pos[sid])
-        sat_log.record("missing velocity marker (velocity set to NaN)", body.missing_vel[sid])
+        sat_log.record("missing velocity marker", body.missing_vel[sid])
+        structure.update(_epoch_structure(body, sid, rows, sat_log))
+        if not rows:
+            continue
+        idx_arr = np.array(sorted(rows), dtype=np.int64)
         ephemerides[sid] = _finish(
             sid,
             t_all[idx_arr],
@@ -368,7 +423,9 @@ def parse_sp3(
             sat_log,
         )
     log.record("missing position marker (epoch removed)", sum(body.missing_pos.values()))
-    log.record("missing velocity marker (velocity set to NaN)", sum(body.missing_vel.values()))
+    log.record("missing velocity marker", sum(body.missing_vel.values()))
+    for kind, n in structure.items():
+        log.record(kind, n)
     return Sp3File(header=header, ephemerides=ephemerides, repairs=log)
 
 
@@ -397,7 +454,11 @@ def _finish(
             )
         keep[i + 1] = False
     log.record("duplicate epoch dropped", int(np.count_nonzero(~keep)))
-    t_sys, st = t_sys[keep], st[keep]
+    t_sys, st, lines = t_sys[keep], st[keep], lines[keep]
+    if header.has_velocity:
+        _, suspect = check_position_velocity(sid, t_sys.astype(np.int64), st[:, :3], st[:, 3:6], lines, file)
+        log.record(SP3_PV_MISMATCH, int(np.count_nonzero(suspect)))
+        t_sys, st, lines = t_sys[~suspect], st[~suspect], lines[~suspect]
     if t_sys.size >= 2 and header.interval_s > 0:
         step = np.diff(t_sys).astype(np.float64) * 1e-9
         n_missing = int(np.sum(np.maximum(np.round(step / header.interval_s) - 1, 0)))

@@ -39,8 +39,9 @@ import numpy as np
 import pandas as pd
 from sgp4.api import WGS72, Satrec
 
-from abrupt.errors import InputError, RepairLog
+from abrupt.errors import InputError, RepairLog, quote
 from abrupt.readers.compression import read_bytes
+from abrupt.readers.tle_checks import check_element_history
 
 logger = logging.getLogger(__name__)
 
@@ -128,6 +129,8 @@ def tle_checksum(line: str) -> int:
             total += 1
     return total % 10
 
+
+MAX_TLE_LINE_CHARS = 160  # a TLE line has 69 characters, a 3LE name 24; a longer line is no record
 
 ALPHA5_LETTERS = "ABCDEFGHJKLMNPQRSTUVWXYZ"  # I and O are not used (Space-Track Alpha-5)
 
@@ -383,6 +386,7 @@ def history_from_sets(
         by_epoch[key_ms] = unique[k]
     repairs.record("same-epoch element sets replaced", replaced)
     final = [by_epoch[k] for k in sorted(by_epoch)]
+    check_element_history(final, source, repairs)
     name = next((s.name for s in final if s.name), None)
     return ElementHistory(elements_frame(final), [s.satrec for s in final], source, name, repairs, list(skipped))
 
@@ -459,7 +463,16 @@ def _read_text(path: Path) -> list[str]:
     except UnicodeDecodeError as exc:
         line = data[: exc.start].count(b"\n") + 1
         raise InputError(f"not a UTF-8/ASCII text file (byte {exc.start})", file=path, line=line) from None
-    return text.splitlines()
+    lines = text.splitlines()
+    for no, text_line in enumerate(lines, start=1):
+        if len(text_line) > MAX_TLE_LINE_CHARS:
+            raise InputError(
+                f"a line of {len(text_line)} characters is neither a TLE line (69) nor a satellite name "
+                f"(at most {MAX_TLE_LINE_CHARS}): {quote(text_line)}",
+                file=path,
+                line=no,
+            )
+    return lines
 
 
 def read_tle(path: str | Path, *, norad_id: int | None = None, strict: bool = False) -> ElementHistory:

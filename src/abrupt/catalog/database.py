@@ -34,7 +34,6 @@ import datetime as dt
 import functools
 import hashlib
 import json
-import math
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -46,86 +45,37 @@ import pandas as pd
 import sqlalchemy as sa
 
 from abrupt import __version__
+from abrupt.catalog.foreign import foreign_table, too_long_text
+from abrupt.catalog.schema import (
+    SCHEMA_VERSION,
+    clean_value,
+    coverage_table,
+    event_key,
+    events_table,
+    metadata,
+    migrate_v1,
+    runs_table,
+    schema_table,
+    sqlite_begin_immediate,
+    sqlite_manual_transactions,
+    tasks_table,
+    to_naive_utc,
+)
 from abrupt.errors import AbruptError
 from abrupt.events import (
     EVENT_COLUMNS,
-    FLOAT_COLUMNS,
     format_time_columns,
     format_time_utc,
     normalise_frame,
     write_events,
 )
 
-SCHEMA_VERSION = 2
 #: Key of the PostgreSQL advisory lock that serialises catalog writers (any fixed 64-bit integer).
 _PG_LOCK_KEY = 0x61627275707431
 #: Time tolerance for joining a detection to an existing event: 3 σ of the time estimate, in [1 s, 1 day].
 MATCH_SIGMAS = 3.0
 MATCH_MIN_S = 1.0
 MATCH_MAX_S = 86_400.0
-
-_metadata = sa.MetaData()
-
-
-def _event_column(name: str) -> sa.Column[Any]:
-    if name in FLOAT_COLUMNS:
-        return sa.Column(name, sa.Float, nullable=True)
-    if name == "time_utc":
-        return sa.Column(name, sa.DateTime(timezone=False), nullable=False)  # naive UTC
-    if name == "event_id":
-        return sa.Column(name, sa.String(64), primary_key=True)
-    return sa.Column(name, sa.String(200), nullable=(name == "run_id"))
-
-
-events_table = sa.Table(
-    "events",
-    _metadata,
-    *[_event_column(name) for name in EVENT_COLUMNS],
-    sa.Column("event_key", sa.String(32), nullable=False, index=True),
-    sa.Column("extra_json", sa.Text, nullable=True),
-    sa.Index("ix_events_identity", "spacecraft", "detector", "kind", "time_utc"),
-)
-
-runs_table = sa.Table(
-    "runs",
-    _metadata,
-    sa.Column("run_id", sa.String(64), primary_key=True),
-    sa.Column("command", sa.Text, nullable=False),
-    sa.Column("started_utc", sa.DateTime(timezone=False), nullable=False),
-    sa.Column("finished_utc", sa.DateTime(timezone=False), nullable=True),
-    sa.Column("config_hash", sa.String(64), nullable=True),
-    sa.Column("input_hash", sa.String(64), nullable=True),
-    sa.Column("abrupt_version", sa.String(32), nullable=False),
-    sa.Column("n_events_found", sa.Integer, nullable=True),
-    sa.Column("n_events_new", sa.Integer, nullable=True),
-    sa.Column("details_json", sa.Text, nullable=True),
-)
-
-coverage_table = sa.Table(
-    "coverage",
-    _metadata,
-    sa.Column("run_id", sa.String(64), primary_key=True),
-    sa.Column("spacecraft", sa.String(200), primary_key=True),
-    sa.Column("detector", sa.String(200), primary_key=True),
-    sa.Column("config_hash", sa.String(64), nullable=False),
-    sa.Column("start_utc", sa.DateTime(timezone=False), primary_key=True),
-    sa.Column("end_utc", sa.DateTime(timezone=False), nullable=False),
-    sa.Column("recorded_utc", sa.DateTime(timezone=False), nullable=False),
-)
-
-tasks_table = sa.Table(
-    "tasks",
-    _metadata,
-    sa.Column("run_key", sa.String(64), primary_key=True),
-    sa.Column("task_key", sa.String(400), primary_key=True),
-    sa.Column("spacecraft", sa.String(200), nullable=False),
-    sa.Column("chunk", sa.String(400), nullable=False),
-    sa.Column("run_id", sa.String(64), nullable=False),
-    sa.Column("n_events", sa.Integer, nullable=False),
-    sa.Column("finished_utc", sa.DateTime(timezone=False), nullable=False),
-)
-
-schema_table = sa.Table("abrupt_schema", _metadata, sa.Column("version", sa.Integer, nullable=False))
 
 
 class CatalogError(AbruptError):
@@ -210,30 +160,8 @@ def _one_line_errors(method: F) -> F:
     return wrapper  # type: ignore[return-value]
 
 
-def _clean(value: Any) -> Any:
-    if value is None or value is pd.NA or value is pd.NaT:
-        return None
-    if isinstance(value, float) and math.isnan(value):
-        return None
-    if hasattr(value, "item"):
-        return _clean(value.item())
-    return value
-
-
-def _to_naive_utc(value: Any) -> dt.datetime:
-    ts = pd.Timestamp(value)
-    if ts.tzinfo is not None:
-        ts = ts.tz_convert("UTC").tz_localize(None)
-    return ts.to_pydatetime()
-
-
 def _now() -> dt.datetime:
     return dt.datetime.now(dt.UTC).replace(tzinfo=None)
-
-
-def event_key(spacecraft: str, detector: str, kind: str, time_utc: str) -> str:
-    """Identity of a new event (its first detection's spacecraft, detector, kind and time)."""
-    return hashlib.sha256("|".join((spacecraft, detector, kind, time_utc)).encode()).hexdigest()[:20]
 
 
 def run_key(command: str, *parts: str) -> str:
@@ -273,16 +201,18 @@ class Catalog:
                     )
         if self.url.startswith("sqlite"):
             self.engine = sa.create_engine(self.url, connect_args={"timeout": 60.0}, poolclass=sa.pool.NullPool)
-            sa.event.listen(self.engine, "connect", _sqlite_manual_transactions)
-            sa.event.listen(self.engine, "begin", _sqlite_begin_immediate)
+            sa.event.listen(self.engine, "connect", sqlite_manual_transactions)
+            sa.event.listen(self.engine, "begin", sqlite_begin_immediate)
         else:
             # no pool: a command holds no idle connection to a shared server, and none leaks at exit
             self.engine = sa.create_engine(self.url, poolclass=sa.pool.NullPool)
         self.dialect = self.engine.dialect.name
         if create:
             with self._writing() as conn:
-                _migrate_v1(conn)
-                _metadata.create_all(conn)
+                if foreign := foreign_table(conn, (coverage_table, tasks_table), schema_table.name):
+                    raise CatalogError(f"{self.name}: {foreign}; abrupt never alters it: choose another --catalog")
+                migrate_v1(conn)
+                metadata.create_all(conn)
                 if conn.execute(sa.select(sa.func.count()).select_from(schema_table)).scalar_one() == 0:
                     conn.execute(schema_table.insert().values(version=SCHEMA_VERSION))
         else:
@@ -350,13 +280,13 @@ class Catalog:
 
     def _record_coverage(self, conn: sa.Connection, run_id: str, coverage: Iterable[Coverage]) -> None:
         rows = {
-            (c.spacecraft, c.detector, _to_naive_utc(c.start_utc)): {
+            (c.spacecraft, c.detector, to_naive_utc(c.start_utc)): {
                 "run_id": run_id,
                 "spacecraft": c.spacecraft,
                 "detector": c.detector,
                 "config_hash": c.config_hash,
-                "start_utc": _to_naive_utc(c.start_utc),
-                "end_utc": _to_naive_utc(c.end_utc),
+                "start_utc": to_naive_utc(c.start_utc),
+                "end_utc": to_naive_utc(c.end_utc),
                 "recorded_utc": _now(),
             }
             for c in coverage
@@ -387,9 +317,15 @@ class Catalog:
         return self.store_events(frame).events
 
     @_one_line_errors
+    def check_fits(self, frame: pd.DataFrame) -> None:
+        """Refuse texts longer than the catalog's columns (the same limit on SQLite and PostgreSQL)."""
+        if reason := too_long_text(normalise_frame(frame), events_table):
+            raise CatalogError(f"{self.name}: {reason}")
+
     def store_events(self, frame: pd.DataFrame) -> Added:
         """Store detections not yet in the catalog; new detections join existing events where they match."""
         frame = normalise_frame(frame)
+        self.check_fits(frame)
         if frame.empty:
             return Added(0, 0)
         with self._writing() as conn:
@@ -462,10 +398,10 @@ class Catalog:
         extra_cols = [col for col in new.columns if col not in EVENT_COLUMNS]
         records: list[dict[str, Any]] = []
         for i, new_rec in enumerate(new.to_dict("records")):
-            row = {col: _clean(new_rec[col]) for col in EVENT_COLUMNS}
+            row = {col: clean_value(new_rec[col]) for col in EVENT_COLUMNS}
             row["time_utc"] = times.iloc[i].to_pydatetime()
             row["event_key"] = key_of_row[i]
-            row["extra_json"] = json.dumps({str(col): _clean(new_rec[col]) for col in extra_cols}, default=str)
+            row["extra_json"] = json.dumps({str(col): clean_value(new_rec[col]) for col in extra_cols}, default=str)
             records.append(row)
         conn.execute(events_table.insert(), records)
         return Added(len(records), n_new_events)
@@ -499,11 +435,17 @@ class Catalog:
             if "." in detector:
                 query = query.where(c.detector == detector)
             else:  # a capability (attitude) or a method (glr)
-                query = query.where(sa.or_(c.detector.like(f"{detector}.%"), c.detector.like(f"%.{detector}")))
+                # autoescape: a "%" or "_" in the name is a character, not a LIKE wildcard
+                query = query.where(
+                    sa.or_(
+                        c.detector.startswith(f"{detector}.", autoescape=True),
+                        c.detector.endswith(f".{detector}", autoescape=True),
+                    )
+                )
         if since is not None:
-            query = query.where(c.time_utc >= _to_naive_utc(since))
+            query = query.where(c.time_utc >= to_naive_utc(since))
         if until is not None:
-            query = query.where(c.time_utc <= _to_naive_utc(until))
+            query = query.where(c.time_utc <= to_naive_utc(until))
         query = query.order_by(c.time_utc, c.detector)
         with self.engine.connect() as conn:
             frame = pd.DataFrame(
@@ -651,43 +593,3 @@ def coverage_of(
             cfg = str(sel["config_hash"].iloc[0]) if len(sel) else config_hash
             out.append(Coverage(sc, det, cfg, format_time_utc(start), format_time_utc(end)))
     return out
-
-
-def _sqlite_manual_transactions(dbapi_connection: Any, connection_record: Any) -> None:
-    dbapi_connection.isolation_level = None  # let SQLAlchemy's "begin" event issue BEGIN IMMEDIATE
-
-
-def _sqlite_begin_immediate(conn: sa.Connection) -> None:
-    conn.exec_driver_sql("BEGIN IMMEDIATE")
-
-
-def _migrate_v1(conn: sa.Connection) -> None:
-    """Upgrade a catalog written by abrupt 0.1 (events without ``event_key``, text times) in place."""
-    inspector = sa.inspect(conn)
-    names = set(inspector.get_table_names())
-    if "events" not in names or "event_key" in {c["name"] for c in inspector.get_columns("events")}:
-        return
-    old_events = pd.DataFrame(conn.execute(sa.text("SELECT * FROM events")).mappings().all())
-    old_runs = pd.DataFrame(conn.execute(sa.text("SELECT * FROM runs")).mappings().all()) if "runs" in names else None
-    conn.execute(sa.text("DROP TABLE events"))
-    if old_runs is not None:
-        conn.execute(sa.text("DROP TABLE runs"))
-    _metadata.create_all(conn)
-    if old_runs is not None and len(old_runs):
-        run_rows: list[dict[str, Any]] = []
-        for old in old_runs.to_dict("records"):
-            run = {str(k): _clean(v) for k, v in old.items() if str(k) in runs_table.c}
-            for col in ("started_utc", "finished_utc"):
-                run[col] = _to_naive_utc(run[col]) if run.get(col) else None
-            run_rows.append(run)
-        conn.execute(runs_table.insert(), run_rows)
-    if len(old_events):
-        rows: list[dict[str, Any]] = []
-        for rec in old_events.to_dict("records"):
-            row = {str(k): _clean(v) for k, v in rec.items() if str(k) in events_table.c}
-            row["time_utc"] = _to_naive_utc(rec["time_utc"])
-            row["event_key"] = event_key(
-                str(rec["spacecraft"]), str(rec["detector"]), str(rec["kind"]), format_time_utc(rec["time_utc"])
-            )
-            rows.append(row)
-        conn.execute(events_table.insert(), rows)

@@ -1,0 +1,140 @@
+"""The catalog's tables, their version marker and the upgrade of catalogs written by abrupt 0.1."""
+
+from __future__ import annotations
+
+import datetime as dt
+import hashlib
+import math
+from typing import Any
+
+import pandas as pd
+import sqlalchemy as sa
+
+from abrupt.events import EVENT_COLUMNS, FLOAT_COLUMNS, format_time_utc
+
+SCHEMA_VERSION = 2
+
+metadata = sa.MetaData()
+
+
+def _event_column(name: str) -> sa.Column[Any]:
+    if name in FLOAT_COLUMNS:
+        return sa.Column(name, sa.Float, nullable=True)
+    if name == "time_utc":
+        return sa.Column(name, sa.DateTime(timezone=False), nullable=False)  # naive UTC
+    if name == "event_id":
+        return sa.Column(name, sa.String(64), primary_key=True)
+    return sa.Column(name, sa.String(200), nullable=(name == "run_id"))
+
+
+events_table = sa.Table(
+    "events",
+    metadata,
+    *[_event_column(name) for name in EVENT_COLUMNS],
+    sa.Column("event_key", sa.String(32), nullable=False, index=True),
+    sa.Column("extra_json", sa.Text, nullable=True),
+    sa.Index("ix_events_identity", "spacecraft", "detector", "kind", "time_utc"),
+)
+
+runs_table = sa.Table(
+    "runs",
+    metadata,
+    sa.Column("run_id", sa.String(64), primary_key=True),
+    sa.Column("command", sa.Text, nullable=False),
+    sa.Column("started_utc", sa.DateTime(timezone=False), nullable=False),
+    sa.Column("finished_utc", sa.DateTime(timezone=False), nullable=True),
+    sa.Column("config_hash", sa.String(64), nullable=True),
+    sa.Column("input_hash", sa.String(64), nullable=True),
+    sa.Column("abrupt_version", sa.String(32), nullable=False),
+    sa.Column("n_events_found", sa.Integer, nullable=True),
+    sa.Column("n_events_new", sa.Integer, nullable=True),
+    sa.Column("details_json", sa.Text, nullable=True),
+)
+
+coverage_table = sa.Table(
+    "coverage",
+    metadata,
+    sa.Column("run_id", sa.String(64), primary_key=True),
+    sa.Column("spacecraft", sa.String(200), primary_key=True),
+    sa.Column("detector", sa.String(200), primary_key=True),
+    sa.Column("config_hash", sa.String(64), nullable=False),
+    sa.Column("start_utc", sa.DateTime(timezone=False), primary_key=True),
+    sa.Column("end_utc", sa.DateTime(timezone=False), nullable=False),
+    sa.Column("recorded_utc", sa.DateTime(timezone=False), nullable=False),
+)
+
+tasks_table = sa.Table(
+    "tasks",
+    metadata,
+    sa.Column("run_key", sa.String(64), primary_key=True),
+    sa.Column("task_key", sa.String(400), primary_key=True),
+    sa.Column("spacecraft", sa.String(200), nullable=False),
+    sa.Column("chunk", sa.String(400), nullable=False),
+    sa.Column("run_id", sa.String(64), nullable=False),
+    sa.Column("n_events", sa.Integer, nullable=False),
+    sa.Column("finished_utc", sa.DateTime(timezone=False), nullable=False),
+)
+
+schema_table = sa.Table("abrupt_schema", metadata, sa.Column("version", sa.Integer, nullable=False))
+
+
+def clean_value(value: Any) -> Any:
+    if value is None or value is pd.NA or value is pd.NaT:
+        return None
+    if isinstance(value, float) and math.isnan(value):
+        return None
+    if hasattr(value, "item"):
+        return clean_value(value.item())
+    return value
+
+
+def to_naive_utc(value: Any) -> dt.datetime:
+    ts = pd.Timestamp(value)
+    if ts.tzinfo is not None:
+        ts = ts.tz_convert("UTC").tz_localize(None)
+    return ts.to_pydatetime()
+
+
+def event_key(spacecraft: str, detector: str, kind: str, time_utc: str) -> str:
+    """Identity of a new event (its first detection's spacecraft, detector, kind and time)."""
+    return hashlib.sha256("|".join((spacecraft, detector, kind, time_utc)).encode()).hexdigest()[:20]
+
+
+def sqlite_manual_transactions(dbapi_connection: Any, connection_record: Any) -> None:
+    dbapi_connection.isolation_level = None  # let SQLAlchemy's "begin" event issue BEGIN IMMEDIATE
+
+
+def sqlite_begin_immediate(conn: sa.Connection) -> None:
+    conn.exec_driver_sql("BEGIN IMMEDIATE")
+
+
+def migrate_v1(conn: sa.Connection) -> None:
+    """Upgrade a catalog written by abrupt 0.1 (events without ``event_key``, text times) in place."""
+    inspector = sa.inspect(conn)
+    names = set(inspector.get_table_names())
+    if "events" not in names or "event_key" in {c["name"] for c in inspector.get_columns("events")}:
+        return
+    old_events = pd.DataFrame(conn.execute(sa.text("SELECT * FROM events")).mappings().all())
+    old_runs = pd.DataFrame(conn.execute(sa.text("SELECT * FROM runs")).mappings().all()) if "runs" in names else None
+    conn.execute(sa.text("DROP TABLE events"))
+    if old_runs is not None:
+        conn.execute(sa.text("DROP TABLE runs"))
+    metadata.create_all(conn)
+    if old_runs is not None and len(old_runs):
+        run_rows: list[dict[str, Any]] = []
+        for old in old_runs.to_dict("records"):
+            run = {str(k): clean_value(v) for k, v in old.items() if str(k) in runs_table.c}
+            for col in ("started_utc", "finished_utc"):
+                run[col] = to_naive_utc(run[col]) if run.get(col) else None
+            run_rows.append(run)
+        conn.execute(runs_table.insert(), run_rows)
+    if len(old_events):
+        rows: list[dict[str, Any]] = []
+        for rec in old_events.to_dict("records"):
+            row = {str(k): clean_value(v) for k, v in rec.items() if str(k) in events_table.c}
+            row["time_utc"] = to_naive_utc(rec["time_utc"])
+            row["event_key"] = event_key(
+                str(rec["spacecraft"]), str(rec["detector"]), str(rec["kind"]), format_time_utc(rec["time_utc"])
+            )
+            rows.append(row)
+        conn.execute(events_table.insert(), rows)
