@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-EVENT_KINDS = ("strike", "maneuver", "mass_change", "unknown")
+EVENT_KINDS = ("strike", "maneuver", "mass_change", "unknown", "sensor_fault", "external_non_strike", "internal")
 
 EVENT_COLUMNS: tuple[str, ...] = (
     "event_id",

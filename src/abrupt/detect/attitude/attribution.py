@@ -1,0 +1,120 @@
+"""Is it a strike? A classification of each event from its evidence by physical rules.
+
+The rules read the evidence of :mod:`abrupt.detect.attitude.evidence`; none is fitted to simulations
+(each limit is a noise multiple or a physical scale given in :class:`AttributionRules`). In order:
+
+1. **sensor_fault** when the star tracker and the integrated gyro disagree across the event (real
+   motion moves both): a change of slope of the mismatch is a gyro bias step (channel ``gyro_<axis>``);
+   a jump that an isolated gyro excursion accounts for is a gyro spike; any other jump is the star
+   tracker (channel ``star_tracker``);
+2. **internal** when an appendage drive changed rate abruptly at the event (momentum moved between
+   the hub and the appendage, total conserved);
+3. **sensor_fault** of a wheel when the wheels' momentum changed but the body never felt it (body
+   share small) and the change is not one the minimum-norm controller makes (null-space part, or one
+   wheel carrying it);
+4. **strike** when the sensors agree, the body took the impulse first (body share), the step lasts
+   and is impulsive (its duration interval reaches below ``impulsive_s``);
+5. **external_non_strike** when the sensors agree and the step lasts but it is a ramp or a sequence
+   (duration interval above ``impulsive_s``), or the body share is small (a slow torque the loop kept
+   up with);
+6. **internal** when the sensors agree, the body moved, and nothing lasts (a pulse that returns);
+7. **unknown** otherwise, or when the evidence is missing.
+
+The confidence is the fraction of the kind's supporting tests that pass, each test counting once,
+scaled into [0.5, 0.99]: it says how many independent pieces agree, not a calibrated probability.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from abrupt.detect.attitude.evidence import EventEvidence
+
+ATTRIBUTION_KINDS = ("strike", "sensor_fault", "external_non_strike", "internal", "unknown")
+
+
+@dataclass(frozen=True)
+class AttributionRules:
+    """Limits of the rules (units in the names; ``*_share``/``*_fraction`` are ratios)."""
+
+    impulsive_s: float = 8.0
+    body_share_min: float = 0.35
+    lasting_min: float = 0.5
+    returns_max: float = 0.3
+    wheel_null_min: float = 0.3
+    wheel_single_min: float = 0.7
+    wheel_sigma: float = 5.0
+    spike_z: float = 8.0
+    spike_match: float = 0.5
+    appendage_z: float = 12.0
+    appendage_min_deg: float = 0.2
+
+
+@dataclass(frozen=True)
+class Attribution:
+    """The class of an event, its confidence, the channel (for a sensor fault) and the tests behind it."""
+
+    kind: str
+    confidence: float
+    channel: str = ""
+    reason: str = ""
+
+
+def _finite(*xs: float) -> bool:
+    return all(math.isfinite(x) for x in xs)
+
+
+def _confidence(tests: list[bool]) -> float:
+    return 0.5 + 0.49 * (sum(tests) / len(tests)) if tests else 0.5
+
+
+def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attribution:
+    """Apply the rules of the module docstring to one event's evidence."""
+    r = rules or AttributionRules()
+    axis = "xyz"
+    # 1. Star tracker against gyro.
+    if _finite(ev.st_gyro_slope_rad_s, ev.st_gyro_slope_limit_rad_s) and ev.st_gyro_slope_rad_s > ev.st_gyro_slope_limit_rad_s:
+        tests = [True, not (_finite(ev.body_share) and ev.body_share < r.body_share_min) or False]
+        tests.append(not (_finite(ev.wheel_change_Nms) and ev.wheel_change_Nms > r.wheel_sigma * ev.wheel_change_sigma_Nms))
+        return Attribution("sensor_fault", _confidence(tests), f"gyro_{axis[max(ev.st_gyro_axis, 0)]}", "gyro bias step")
+    if _finite(ev.st_gyro_step_rad, ev.st_gyro_step_limit_rad) and ev.st_gyro_step_rad > ev.st_gyro_step_limit_rad:
+        spike = (
+            _finite(ev.gyro_spike_z, ev.gyro_spike_rad)
+            and ev.gyro_spike_z > r.spike_z
+            and abs(abs(ev.gyro_spike_rad) - ev.st_gyro_step_rad) < r.spike_match * ev.st_gyro_step_rad
+        )
+        quiet_wheels = not (_finite(ev.wheel_change_Nms) and ev.wheel_change_Nms > r.wheel_sigma * ev.wheel_change_sigma_Nms)
+        if spike:
+            return Attribution("sensor_fault", _confidence([True, True, quiet_wheels]), f"gyro_{axis[max(ev.gyro_spike_axis, 0)]}", "gyro spike")
+        return Attribution("sensor_fault", _confidence([True, quiet_wheels]), "star_tracker", "star-tracker jump")
+    # 2. Appendage.
+    if _finite(ev.appendage_z, ev.appendage_excess_deg) and ev.appendage_z > r.appendage_z and ev.appendage_excess_deg > r.appendage_min_deg:
+        tests = [True, _finite(ev.lasting_fraction) and abs(ev.lasting_fraction) < r.lasting_min]
+        return Attribution("internal", _confidence(tests), f"appendage_{ev.appendage_index + 1}", "appendage drive jumped")
+    consistent = _finite(ev.st_gyro_step_rad)
+    body = ev.body_share if _finite(ev.body_share) else float("nan")
+    # 3. Wheel reading.
+    wheels_moved = _finite(ev.wheel_change_Nms, ev.wheel_change_sigma_Nms) and ev.wheel_change_Nms > r.wheel_sigma * ev.wheel_change_sigma_Nms
+    if wheels_moved and _finite(body) and body < r.body_share_min:
+        off_loop = (_finite(ev.wheel_null_fraction) and ev.wheel_null_fraction > r.wheel_null_min) or (
+            _finite(ev.wheel_max_share) and ev.wheel_max_share > r.wheel_single_min
+        )
+        if off_loop:
+            tests = [True, True, _finite(ev.wheel_max_share) and ev.wheel_max_share > r.wheel_single_min]
+            return Attribution("sensor_fault", _confidence(tests), f"wheel_{ev.wheel_max_index + 1}", "wheel reading")
+    if not (consistent and _finite(body, ev.lasting_fraction)):
+        return Attribution("unknown", 0.5, "", "evidence missing")
+    lasting = ev.lasting_fraction >= r.lasting_min
+    impulsive = _finite(ev.duration_lo_s) and ev.duration_lo_s <= r.impulsive_s
+    surface_ok = not (_finite(ev.surface_fraction) and ev.surface_fraction == 0.0)
+    # 4./5. External.
+    if lasting and impulsive and body >= r.body_share_min:
+        return Attribution("strike", _confidence([True, True, True, surface_ok]), "", "impulsive external step")
+    if lasting and (not impulsive or body < r.body_share_min):
+        tests = [True, not impulsive, body < r.body_share_min]
+        return Attribution("external_non_strike", _confidence(tests), "", "ramp or sequence of external torque")
+    # 6. Internal.
+    if abs(ev.lasting_fraction) <= r.returns_max and body >= r.body_share_min:
+        return Attribution("internal", _confidence([True, True]), "", "body moved, nothing lasts")
+    return Attribution("unknown", 0.5, "", "no rule")
