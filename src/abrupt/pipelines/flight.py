@@ -401,7 +401,9 @@ def process_span(
     core = (g >= start_ns) & (g < end_ns)
     peaks = detector.find_peaks(hc, ok, stat, g, dt, detector.windows(dt), keep=core)
     evidence = {
-        pk.time_ns: event_evidence(table, hc, spacecraft, pk.time_ns, pk.dH_N_Nms, inertia_kgm2=inertia_kgm2)
+        pk.time_ns: event_evidence(
+            table, hc, spacecraft, pk.time_ns, pk.dH_N_Nms, inertia_kgm2=inertia_kgm2, raw_H_N=h_n
+        )
         for _, pk in peaks
         if pk.value > config.evidence_floor
     }

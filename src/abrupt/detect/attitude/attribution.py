@@ -12,9 +12,11 @@ The rules read the evidence of :mod:`abrupt.detect.attitude.evidence`; none is f
 3. **sensor_fault** of a wheel when the wheels' momentum changed but the body never felt it (body
    share small) and the change is not one the minimum-norm controller makes (null-space part, or one
    wheel carrying it);
-4. **strike** when the sensors agree, the body took the impulse first (body share), the step lasts
-   and is impulsive (its duration interval reaches below ``impulsive_s``);
-5. **external_non_strike** when the sensors agree and the step lasts but it is a ramp or a sequence
+4. **strike** when the sensors agree, the body took the impulse first (body share), the step lasts,
+   is in the momentum before cleaning too (``raw_step_fraction``) and is impulsive (its duration
+   interval reaches below ``impulsive_s``);
+5. **external_non_strike** when the sensors agree and a step lasts (either sign: the event's own ΔH
+   may be a piece of a longer ramp) but it is a ramp or a sequence
    (duration interval above ``impulsive_s``), or the body share is small (a slow torque the loop kept
    up with);
 6. **internal** when the sensors agree, the body moved, and nothing lasts (a pulse that returns);
@@ -39,7 +41,7 @@ class AttributionRules:
     """Limits of the rules (units in the names; ``*_share``/``*_fraction`` are ratios)."""
 
     impulsive_s: float = 8.0
-    body_share_min: float = 0.35
+    body_share_min: float = 0.15
     lasting_min: float = 0.5
     returns_max: float = 0.3
     wheel_null_min: float = 0.3
@@ -65,6 +67,10 @@ def _finite(*xs: float) -> bool:
     return all(math.isfinite(x) for x in xs)
 
 
+def _ratio(x: float, limit: float) -> float:
+    return x / limit if _finite(x, limit) and limit > 0 else 0.0
+
+
 def _confidence(tests: list[bool]) -> float:
     return 0.5 + 0.49 * (sum(tests) / len(tests)) if tests else 0.5
 
@@ -73,18 +79,20 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
     """Apply the rules of the module docstring to one event's evidence."""
     r = rules or AttributionRules()
     axis = "xyz"
-    # 1. Star tracker against gyro.
-    if _finite(ev.st_gyro_slope_rad_s, ev.st_gyro_slope_limit_rad_s) and ev.st_gyro_slope_rad_s > ev.st_gyro_slope_limit_rad_s:
-        tests = [True, not (_finite(ev.body_share) and ev.body_share < r.body_share_min) or False]
-        tests.append(not (_finite(ev.wheel_change_Nms) and ev.wheel_change_Nms > r.wheel_sigma * ev.wheel_change_sigma_Nms))
-        return Attribution("sensor_fault", _confidence(tests), f"gyro_{axis[max(ev.st_gyro_axis, 0)]}", "gyro bias step")
-    if _finite(ev.st_gyro_step_rad, ev.st_gyro_step_limit_rad) and ev.st_gyro_step_rad > ev.st_gyro_step_limit_rad:
+    # 1. Star tracker against gyro: a change of slope (gyro bias) or a jump (a spike or the tracker).
+    z_slope = _ratio(ev.st_gyro_slope_rad_s, ev.st_gyro_slope_limit_rad_s)
+    z_step = _ratio(ev.st_gyro_step_rad, ev.st_gyro_step_limit_rad)
+    quiet_wheels = not (
+        _finite(ev.wheel_change_Nms) and ev.wheel_change_Nms > r.wheel_sigma * ev.wheel_change_sigma_Nms
+    )
+    if z_slope > 1.0 and z_slope >= z_step:
+        return Attribution("sensor_fault", _confidence([True, quiet_wheels]), f"gyro_{axis[max(ev.st_gyro_axis, 0)]}", "gyro bias step")
+    if z_step > 1.0:
         spike = (
             _finite(ev.gyro_spike_z, ev.gyro_spike_rad)
             and ev.gyro_spike_z > r.spike_z
             and abs(abs(ev.gyro_spike_rad) - ev.st_gyro_step_rad) < r.spike_match * ev.st_gyro_step_rad
         )
-        quiet_wheels = not (_finite(ev.wheel_change_Nms) and ev.wheel_change_Nms > r.wheel_sigma * ev.wheel_change_sigma_Nms)
         if spike:
             return Attribution("sensor_fault", _confidence([True, True, quiet_wheels]), f"gyro_{axis[max(ev.gyro_spike_axis, 0)]}", "gyro spike")
         return Attribution("sensor_fault", _confidence([True, quiet_wheels]), "star_tracker", "star-tracker jump")
@@ -106,12 +114,13 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
     if not (consistent and _finite(body, ev.lasting_fraction)):
         return Attribution("unknown", 0.5, "", "evidence missing")
     lasting = ev.lasting_fraction >= r.lasting_min
+    in_raw = not _finite(ev.raw_step_fraction) or ev.raw_step_fraction >= r.lasting_min
     impulsive = _finite(ev.duration_lo_s) and ev.duration_lo_s <= r.impulsive_s
     surface_ok = not (_finite(ev.surface_fraction) and ev.surface_fraction == 0.0)
     # 4./5. External.
-    if lasting and impulsive and body >= r.body_share_min:
+    if lasting and impulsive and body >= r.body_share_min and in_raw:
         return Attribution("strike", _confidence([True, True, True, surface_ok]), "", "impulsive external step")
-    if lasting and (not impulsive or body < r.body_share_min):
+    if abs(ev.lasting_fraction) >= r.lasting_min and (not impulsive or body < r.body_share_min):
         tests = [True, not impulsive, body < r.body_share_min]
         return Attribution("external_non_strike", _confidence(tests), "", "ramp or sequence of external torque")
     # 6. Internal.

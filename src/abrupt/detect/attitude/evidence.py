@@ -20,7 +20,9 @@ telemetry (:class:`~abrupt.series.timetable.Timetable`) around the event:
   minimum-norm controller never moves momentum there, one wheel's bad reading does) and
   ``wheel_max_share`` the largest single wheel's part of the wheel momentum change;
 * **lasting fraction** (``lasting_fraction``): the step of the cleaned ᴺH along ΔĤ a minute or more
-  after the event over |ΔH| (1 for a step, near 0 for a pulse that returns);
+  after the event (or after the fitted ramp) over |ΔH| (1 for a step, near 0 for a pulse that returns);
+  ``raw_step_fraction`` the same within ±40 s on the momentum before cleaning (a step the cleaning
+  made, not the telemetry, has none);
 * **time profile** (``duration_s`` with ``duration_lo_s``, ``duration_hi_s``): a ramp of duration D
   (D = 0 a step) fitted to the cleaned ᴺH along ΔĤ, with the interval where the fit is within
   Δχ² = 4 of the best (noise from the data's first differences);
@@ -70,6 +72,7 @@ class EventEvidence:
     wheel_max_share: float = NAN
     wheel_max_index: int = -1
     lasting_fraction: float = NAN
+    raw_step_fraction: float = NAN
     duration_s: float = NAN
     duration_lo_s: float = NAN
     duration_hi_s: float = NAN
@@ -134,19 +137,21 @@ def _noise_of(y: FloatArray) -> float:
     return float(np.median(np.abs(d - np.median(d))) / 0.6745 / math.sqrt(2.0))
 
 
-def ramp_duration(tau_s: FloatArray, y: FloatArray, sigma: float) -> tuple[float, float, float]:
-    """Best duration D [s] of y = c + A clip((τ − τ_s)/D, 0, 1) and its Δχ² = 4 interval (lo, hi).
+def ramp_duration(tau_s: FloatArray, y: FloatArray, sigma: float) -> tuple[float, float, float, float]:
+    """Best duration D [s] of y = c + A clip((τ − τ_s)/D, 0, 1), its Δχ² = 4 interval (lo, hi) and onset τ_s.
 
-    Onsets τ_s on the samples, durations 0 (a step) to a quarter of the window on a log grid.
+    Onsets τ_s on the samples of the middle half of the window, durations 0 (a step) to a third of the
+    window on a log grid; the ramp must end inside the window.
     """
     ok = np.isfinite(y)
     t, v = tau_s[ok], y[ok]
     if t.size < 20 or not (sigma > 0):
-        return NAN, NAN, NAN
+        return NAN, NAN, NAN, NAN
     span = float(t[-1] - t[0])
-    durations = np.concatenate([[0.0], np.geomspace(1.0, max(span / 4, 2.0), 24)])
-    onsets = t[(t > t[0] + 0.15 * span) & (t < t[-1] - 0.15 * span)]
+    durations = np.concatenate([[0.0], np.geomspace(1.0, max(span / 3, 2.0), 20)])
+    onsets = t[(t > t[0] + 0.25 * span) & (t < t[-1] - 0.25 * span)][::2]
     best = np.full(durations.size, np.inf)
+    where = np.zeros(durations.size)
     vc = v - v.mean()
     for j, d in enumerate(durations):
         x = np.clip((t[None, :] - onsets[:, None]) / d, 0.0, 1.0) if d > 0 else (t[None, :] >= onsets[:, None]) * 1.0
@@ -155,10 +160,14 @@ def ramp_duration(tau_s: FloatArray, y: FloatArray, sigma: float) -> tuple[float
         sxy = xc @ vc
         with np.errstate(invalid="ignore", divide="ignore"):
             sse = np.sum(vc * vc) - np.where(sxx > 0, sxy**2 / sxx, 0.0)
-        best[j] = float(np.min(sse))
+        sse = np.where(onsets + d < t[-1] - 30.0, sse, np.inf)
+        m = int(np.argmin(sse))
+        best[j], where[j] = float(sse[m]), float(onsets[m])
     k = int(np.argmin(best))
     inside = np.flatnonzero(best <= best[k] + 4.0 * sigma**2)
-    return float(durations[k]), float(durations[inside.min()]), float(durations[inside.max()])
+    # The interval reaches to the grid neighbours of the accepted durations (the grid's own resolution).
+    lo, hi = max(int(inside.min()) - 1, 0), min(int(inside.max()) + 1, durations.size - 1)
+    return float(durations[k]), float(durations[lo]), float(durations[hi]), float(where[k])
 
 
 @dataclass(frozen=True)
@@ -171,7 +180,7 @@ class EvidenceWindows:
     response_s: float = 20.0
     wheel_s: float = 40.0
     lasting_s: tuple[float, float] = (60.0, 150.0)
-    profile_s: float = 400.0
+    profile_s: float = 600.0
     timing_s: float = 0.5
 
 
@@ -190,6 +199,7 @@ def event_evidence(
     *,
     inertia_kgm2: FloatArray | None = None,
     windows: EvidenceWindows | None = None,
+    raw_H_N: FloatArray | None = None,
 ) -> EventEvidence:
     """The evidence of the event at ``time_ns`` with step ``dH_N_Nms`` (module docstring)."""
     w = windows or EvidenceWindows()
@@ -219,13 +229,21 @@ def event_evidence(
         proj = (d_om @ J.T) @ u_b
         proj = np.convolve(proj, np.ones(3) / 3.0, mode="same")
         out["body_share"] = float(np.max(proj) / mag)
-        peak_rate = float(np.max(np.linalg.norm(d_om, axis=1)))
+        # Real motion lasts the loop's settling time; a running median keeps it and drops a sensor spike.
+        peak_rate = float(np.max(np.linalg.norm(median_filter(d_om, size=(5, 1), mode="nearest"), axis=1)))
     out.update(_wheel_evidence(table, spacecraft, i0, dt, w))
     out.update(_consistency(table, i0, dt, w, peak_rate))
     out.update(_gyro_spike(omega, valid, i0, dt))
     out.update(_profile(g, cleaned_H_N, dh_n, i0, dt, w))
     out.update(_appendage(table, i0, dt))
     out.update(surface_evidence(spacecraft, dh_b))
+    if raw_H_N is not None and mag > 0:
+        b = _idx(g, i0, -w.wheel_s, -w.guard_s, dt)
+        a = _idx(g, i0, w.guard_s, w.wheel_s, dt)
+        b, a = b[valid[b]], a[valid[a]]
+        if b.size > 5 and a.size > 5:
+            step = np.median(raw_H_N[a], axis=0) - np.median(raw_H_N[b], axis=0)
+            out["raw_step_fraction"] = float(step @ (dh_n / mag) / mag)
     return EventEvidence(**{k: (int(v) if k.endswith(("_axis", "_index")) else float(v)) for k, v in out.items()})
 
 
@@ -299,7 +317,7 @@ def _gyro_spike(omega: FloatArray, valid: np.ndarray, i0: int, dt: float) -> dic
     med = median_filter(seg, size=(5, 1), mode="nearest")
     r = seg - med
     sig = np.array([_noise_of(seg[:, k]) for k in range(3)])
-    near = slice(max(0, i0 - lo - int(10 / dt)), min(seg.shape[0], i0 - lo + int(10 / dt)))
+    near = slice(max(0, i0 - lo - int(30 / dt)), min(seg.shape[0], i0 - lo + int(30 / dt)))
     z = np.abs(r[near]) / np.maximum(sig, 1e-12)
     j, k = np.unravel_index(int(np.argmax(z)), z.shape)
     big = np.abs(r[near, k]) > 5.0 * sig[k]
@@ -315,16 +333,20 @@ def _profile(
     u = dh_n / mag
     y = hc @ u
     out: dict[str, float] = {}
-    before = _idx(g, i0, -w.lasting_s[1], -w.guard_s, dt)
-    after = _idx(g, i0, w.lasting_s[0], w.lasting_s[1], dt)
-    yb, ya = y[before], y[after]
-    if np.isfinite(yb).sum() > 10 and np.isfinite(ya).sum() > 10:
-        out["lasting_fraction"] = float((np.nanmedian(ya) - np.nanmedian(yb)) / mag)
     span = _idx(g, i0, -w.profile_s, w.profile_s, dt)
     ys = y[span]
     sigma = _noise_of(ys)
-    d, lo, hi = ramp_duration((g[span] - g[i0]) / NS, ys, sigma)
+    d, lo, hi, onset = ramp_duration((g[span] - g[i0]) / NS, ys, sigma)
     out.update({"duration_s": d, "duration_lo_s": lo, "duration_hi_s": hi})
+    # The lasting step: before the event (or the fitted onset) against after it (or the fitted ramp's end).
+    start = min(-w.guard_s, onset - w.guard_s) if math.isfinite(onset) else -w.guard_s
+    end = max(w.lasting_s[0], onset + d + 30.0) if math.isfinite(onset) else w.lasting_s[0]
+    length = w.lasting_s[1] - w.lasting_s[0]
+    before = _idx(g, i0, start - length, start, dt)
+    after = _idx(g, i0, end, end + length, dt)
+    yb, ya = y[before], y[after]
+    if np.isfinite(yb).sum() > 10 and np.isfinite(ya).sum() > 10:
+        out["lasting_fraction"] = float((np.nanmedian(ya) - np.nanmedian(yb)) / mag)
     return out
 
 
