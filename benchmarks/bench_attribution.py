@@ -34,8 +34,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from abrupt.detect.attitude.attribution import classify
 from abrupt.model.spacecraft import load_spacecraft
-from abrupt.pipelines.flight import DAY_NS, FlightRunConfig, ingest_archives, run_flight
+from abrupt.pipelines.flight import DAY_NS, FlightRunConfig, ingest_archives, process_chunk, run_flight
+from abrupt.pipelines.flight_checks import flight_channels
+from abrupt.report.attribution import EventPanel, plot_event_panels
+from abrupt.series.timetable import build_timetable
 from abrupt.simulate.confounders import (
     CONFOUNDER_CLASS,
     CONFOUNDER_KINDS,
@@ -44,6 +48,7 @@ from abrupt.simulate.confounders import (
     inject_confounders,
 )
 from abrupt.simulate.injection import InjectedStrike, inject_strikes
+from abrupt.store import TelemetryStore
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT.parent / "shared" / "data" / "flight-like"
@@ -157,6 +162,7 @@ def main() -> int:
     ap.add_argument("--per-kind", type=int, default=20)
     ap.add_argument("--store", default="/tmp/abrupt_bench_attribution_store")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--figure", default=None, help="Write the example panels (one event of each kind) to this PNG")
     args = ap.parse_args()
     if args.ranges == "eval":
         ranges = EVAL_RANGES
@@ -170,6 +176,9 @@ def main() -> int:
     if not store.exists():
         ingest_archives(sorted((DATA / "telemetry").glob("*.csv*")), DATA / "decoder.csv", store)
     sc = load_spacecraft(KESTREL)
+    if args.figure:
+        figure(store, sc, ranges, args.figure, args.seed)
+        return 0
     rng = np.random.default_rng(args.seed)
     slots = quiet_times(1800.0)
     print(f"ranges: {args.ranges} ({'in-sample: the tests draw from these' if args.ranges == 'tests' else 'held out from the tests'})")
@@ -186,6 +195,43 @@ def main() -> int:
     table = pd.concat(rows, ignore_index=True)
     report(table)
     return 0
+
+
+def figure(store: Path, sc, ranges: ConfounderRanges, path: str, seed: int, verbose: bool = True) -> None:
+    """One real archive strike and one confounder of each kind on 2026-03-10, as the pipeline saw them."""
+    rng = np.random.default_rng(seed)
+    slots = [t for t in quiet_times(3600.0) if t < 86400 - 3600][: len(CONFOUNDER_KINDS)]
+    confs = [draw_confounder(k, T0_NS + int(t * NS), sc, ranges, rng) for k, t in zip(CONFOUNDER_KINDS, slots, strict=False)]
+    captured: dict[str, pd.DataFrame] = {}
+
+    def hook(s: pd.DataFrame) -> pd.DataFrame:
+        captured["s"] = inject_confounders(s, sc, confs, seed=seed)
+        return captured["s"]
+
+    chunk = process_chunk(TelemetryStore(store), sc, T0_NS, T0_NS + DAY_NS, FlightRunConfig(), keep_series=True, samples_hook=hook)
+    assert chunk.series is not None
+    flight = flight_channels(sc)
+    table = build_timetable(captured["s"], flight, tuple(a.name for a in sc.appendages), T0_NS, T0_NS + DAY_NS)
+    hc = np.full((len(table), 3), np.nan)
+    pos = np.searchsorted(table.time_ns, chunk.series["time_ns"])
+    hc[pos] = chunk.series["H_N_clean"]
+    truth = [("strike (archive) 0.14 N·m·s", T0_NS + int(27110.4 * NS), 0)]
+    truth += [(c.kind.replace("_", " "), c.time_ns, c.duration_s) for c in confs]
+    panels = []
+    for title, t_ns, dur in truth:
+        near = [p for p in chunk.peaks if t_ns - 30 * NS <= p.time_ns <= t_ns + int((dur + 60) * NS) and p.value > 6.5]
+        if not near:
+            print(f"figure: {title}: no event")
+            continue
+        p = max(near, key=lambda q: q.value)
+        a = classify(chunk.evidence[p.time_ns])
+        label = f"{title}\n→ {a.kind} {a.channel}".strip()
+        print(f"figure: {title}: {a.kind} {a.channel} ({a.reason})")
+        if verbose:
+            print(chunk.evidence[p.time_ns])
+        panels.append(EventPanel(label, p.time_ns, p.dH_N_Nms))
+    plot_event_panels(path, table, hc, sc, panels)
+    print(f"figure written to {path}")
 
 
 def report(t: pd.DataFrame) -> None:

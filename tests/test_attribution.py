@@ -7,13 +7,16 @@ integral), and the synthetic archive's known strikes and confounders.
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 from scipy.spatial.transform import Rotation
 
+from abrupt.cli.main import main as cli_main
 from abrupt.detect.attitude.attribution import classify
 from abrupt.detect.attitude.evidence import EventEvidence, ramp_duration, st_gyro_mismatch, surface_evidence
 from abrupt.errors import ConfigError
@@ -196,3 +199,30 @@ def test_strike_and_confounders_on_the_synthetic_archive_get_their_own_class(syn
     # No event away from the injections is called a strike.
     others = [(p.time_ns - t0) / NS for p in strong if abs(p.time_ns - strike.time_ns) > 60 * NS and from_rules[p.time_ns].kind == "strike"]
     assert not others, (others, [(p.value, res.evidence[p.time_ns]) for p in strong if (p.time_ns - t0) / NS in others])
+
+
+def test_cli_draws_confounders_injects_them_and_detect_writes_their_class(
+    synth: tuple[Path, object], tmp_path: Path
+) -> None:
+    d, a = synth
+    ranges = tmp_path / "ranges.toml"
+    ranges.write_text("star_tracker_angle_deg = [3.0, 3.5]\nstar_tracker_duration_s = [900.0, 1000.0]\n")
+    plan = tmp_path / "conf.json"
+    t_jump = "2026-01-05T02:00:00"
+    main_args = ["simulate", "confounders", "--spacecraft", str(a.spacecraft), "--confounder",  # type: ignore[attr-defined]
+                 f"star_tracker_jump@{t_jump}", "--confounder-ranges", str(ranges), "--out", str(plan)]  # fmt: skip
+    cli_main(main_args)
+    drawn = json.loads(plan.read_text())
+    assert drawn[0]["kind"] == "star_tracker_jump" and 3.0 <= drawn[0]["params"]["angle_deg"] <= 3.5
+    out_store = tmp_path / "injected"
+    cli_main(["inject", "attitude", "--store", str(d / "store"), "--spacecraft", str(a.spacecraft),  # type: ignore[attr-defined]
+              "--confounders-file", str(plan), "--out-store", str(out_store)])  # fmt: skip
+    events = tmp_path / "ev.csv"
+    cli_main(["detect", "attitude", "--store", str(out_store), "--spacecraft", str(a.spacecraft),  # type: ignore[attr-defined]
+              "--out", str(events)])  # fmt: skip
+    ev = pd.read_csv(events)
+    t = pd.to_datetime(ev["time_utc"].str.rstrip("Z"))
+    at_jump = ev[(t - pd.Timestamp(t_jump)).abs() < pd.Timedelta(seconds=30)]
+    assert len(at_jump) == 1
+    assert at_jump["kind"].iloc[0] == "sensor_fault" and at_jump["kind_channel"].iloc[0] == "star_tracker"
+    assert "ev_st_gyro_step_rad" in ev.columns and (ev["kind"] != "strike").all()

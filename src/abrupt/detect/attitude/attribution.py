@@ -9,9 +9,10 @@ The rules read the evidence of :mod:`abrupt.detect.attitude.evidence`; none is f
    tracker (channel ``star_tracker``);
 2. **internal** when an appendage drive changed rate abruptly at the event (momentum moved between
    the hub and the appendage, total conserved);
-3. **sensor_fault** of a wheel when the wheels' momentum changed but the body never felt it (body
-   share small) and the change is not one the minimum-norm controller makes (null-space part, or one
-   wheel carrying it);
+3. **sensor_fault** of a wheel when one wheel's reading has an isolated spike, or the wheels'
+   momentum changed, while the body never felt it (body share below ``body_share_min`` and below
+   ``body_sigma`` times its noise), and the change is not one the minimum-norm controller makes
+   (null-space part, or one wheel carrying it);
 4. **strike** when the sensors agree, the body took the impulse first (body share), the step lasts,
    is in the momentum before cleaning too (``raw_step_fraction``) and is impulsive (its duration
    interval reaches below ``impulsive_s``);
@@ -42,6 +43,7 @@ class AttributionRules:
 
     impulsive_s: float = 8.0
     body_share_min: float = 0.15
+    body_sigma: float = 5.0
     lasting_min: float = 0.5
     returns_max: float = 0.3
     wheel_null_min: float = 0.3
@@ -102,9 +104,13 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
         return Attribution("internal", _confidence(tests), f"appendage_{ev.appendage_index + 1}", "appendage drive jumped")
     consistent = _finite(ev.st_gyro_step_rad)
     body = ev.body_share if _finite(ev.body_share) else float("nan")
+    body_floor = max(r.body_share_min, r.body_sigma * ev.body_share_sigma if _finite(ev.body_share_sigma) else 0.0)
+    body_moved = _finite(body) and body >= body_floor
     # 3. Wheel reading.
     wheels_moved = _finite(ev.wheel_change_Nms, ev.wheel_change_sigma_Nms) and ev.wheel_change_Nms > r.wheel_sigma * ev.wheel_change_sigma_Nms
-    if wheels_moved and _finite(body) and body < r.body_share_min:
+    if _finite(ev.wheel_spike_z) and ev.wheel_spike_z > r.spike_z and not body_moved:
+        return Attribution("sensor_fault", _confidence([True, True]), f"wheel_{ev.wheel_spike_index + 1}", "wheel reading spike")
+    if wheels_moved and not body_moved:
         off_loop = (_finite(ev.wheel_null_fraction) and ev.wheel_null_fraction > r.wheel_null_min) or (
             _finite(ev.wheel_max_share) and ev.wheel_max_share > r.wheel_single_min
         )
@@ -118,12 +124,12 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
     impulsive = _finite(ev.duration_lo_s) and ev.duration_lo_s <= r.impulsive_s
     surface_ok = not (_finite(ev.surface_fraction) and ev.surface_fraction == 0.0)
     # 4./5. External.
-    if lasting and impulsive and body >= r.body_share_min and in_raw:
+    if lasting and impulsive and body_moved and in_raw:
         return Attribution("strike", _confidence([True, True, True, surface_ok]), "", "impulsive external step")
-    if abs(ev.lasting_fraction) >= r.lasting_min and (not impulsive or body < r.body_share_min):
-        tests = [True, not impulsive, body < r.body_share_min]
+    if abs(ev.lasting_fraction) >= r.lasting_min and (not impulsive or not body_moved):
+        tests = [True, not impulsive, not body_moved]
         return Attribution("external_non_strike", _confidence(tests), "", "ramp or sequence of external torque")
     # 6. Internal.
-    if abs(ev.lasting_fraction) <= r.returns_max and body >= r.body_share_min:
+    if abs(ev.lasting_fraction) <= r.returns_max and body_moved:
         return Attribution("internal", _confidence([True, True]), "", "body moved, nothing lasts")
     return Attribution("unknown", 0.5, "", "no rule")

@@ -18,7 +18,9 @@ telemetry (:class:`~abrupt.series.timetable.Timetable`) around the event:
   (1 for an impulse, near 0 for a slow torque the loop keeps up with, 0 for a wheel-reading fault);
   ``wheel_null_fraction`` the part of the wheel-speed change in the null space of J_s G (a
   minimum-norm controller never moves momentum there, one wheel's bad reading does) and
-  ``wheel_max_share`` the largest single wheel's part of the wheel momentum change;
+  ``wheel_max_share`` the largest single wheel's part of the wheel momentum change; ``wheel_spike_z``
+  the largest isolated excursion of one wheel's reading against its 5-sample running median (in
+  units of its noise); ``body_share_sigma`` the noise of the body share;
 * **lasting fraction** (``lasting_fraction``): the step of the cleaned ᴺH along ΔĤ a minute or more
   after the event (or after the fitted ramp) over |ΔH| (1 for a step, near 0 for a pulse that returns);
   ``raw_step_fraction`` the same within ±40 s on the momentum before cleaning (a step the cleaning
@@ -66,6 +68,9 @@ class EventEvidence:
     gyro_spike_z: float = NAN
     gyro_spike_axis: int = -1
     body_share: float = NAN
+    body_share_sigma: float = NAN
+    wheel_spike_z: float = NAN
+    wheel_spike_index: int = -1
     wheel_change_Nms: float = NAN
     wheel_change_sigma_Nms: float = NAN
     wheel_null_fraction: float = NAN
@@ -152,10 +157,13 @@ def ramp_duration(tau_s: FloatArray, y: FloatArray, sigma: float) -> tuple[float
     onsets = t[(t > t[0] + 0.25 * span) & (t < t[-1] - 0.25 * span)][::2]
     best = np.full(durations.size, np.inf)
     where = np.zeros(durations.size)
-    vc = v - v.mean()
+    # A linear background (slow residual drift) is projected out of the data and of each ramp.
+    basis = np.column_stack([np.ones_like(t), (t - t.mean()) / max(span, 1.0)])
+    proj = basis @ np.linalg.pinv(basis)
+    vc = v - proj @ v
     for j, d in enumerate(durations):
         x = np.clip((t[None, :] - onsets[:, None]) / d, 0.0, 1.0) if d > 0 else (t[None, :] >= onsets[:, None]) * 1.0
-        xc = x - x.mean(axis=1, keepdims=True)
+        xc = x - x @ proj.T
         sxx = np.sum(xc * xc, axis=1)
         sxy = xc @ vc
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -229,6 +237,7 @@ def event_evidence(
         proj = (d_om @ J.T) @ u_b
         proj = np.convolve(proj, np.ones(3) / 3.0, mode="same")
         out["body_share"] = float(np.max(proj) / mag)
+        out["body_share_sigma"] = _noise_of((omega[pre] @ J.T) @ u_b) / math.sqrt(3.0) / mag
         # Real motion lasts the loop's settling time; a running median keeps it and drops a sensor spike.
         peak_rate = float(np.max(np.linalg.norm(median_filter(d_om, size=(5, 1), mode="nearest"), axis=1)))
     out.update(_wheel_evidence(table, spacecraft, i0, dt, w))
@@ -263,6 +272,13 @@ def _wheel_evidence(table: Timetable, sc: Spacecraft, i0: int, dt: float, w: Evi
     h = js * d
     sig = np.array([_noise_of(om[before, k]) for k in range(om.shape[1])]) * js * 1.25 * math.sqrt(2.0 / before.size)
     null = d - np.linalg.pinv(js_g) @ (js_g @ d)
+    # An isolated excursion of one wheel's reading (a tachometer miscount) against a 5-sample median.
+    near = _idx(g, i0, -30.0, 30.0, dt)
+    seg = om[near]
+    z_w = np.abs(seg - median_filter(seg, size=(5, 1), mode="nearest")) / np.maximum(
+        [_noise_of(om[before, k]) for k in range(om.shape[1])], 1e-9
+    )
+    kz = int(np.argmax(np.max(z_w, axis=0)))
     norm_d = float(np.linalg.norm(d))
     k = int(np.argmax(np.abs(h)))
     return {
@@ -271,6 +287,8 @@ def _wheel_evidence(table: Timetable, sc: Spacecraft, i0: int, dt: float, w: Evi
         "wheel_null_fraction": float(np.linalg.norm(null) / norm_d) if norm_d > 0 else NAN,
         "wheel_max_share": float(abs(h[k]) / np.sum(np.abs(h))) if np.any(h) else NAN,
         "wheel_max_index": k,
+        "wheel_spike_z": float(np.max(z_w[:, kz])),
+        "wheel_spike_index": kz,
     }
 
 
