@@ -94,7 +94,9 @@ def quiet_times(spacing_s: float, margin_s: float = 900.0) -> list[float]:
     return out
 
 
-def plan_run(run: int, per_kind: int, runs: int, slots: list[float], rng: np.random.Generator) -> list[tuple[str, float]]:
+def plan_run(
+    run: int, per_kind: int, runs: int, slots: list[float], rng: np.random.Generator
+) -> list[tuple[str, float]]:
     """(kind, seconds) of one run: its share of strikes and of each confounder kind, shuffled over the slots."""
     n_each = math.ceil(per_kind / runs)
     kinds = ["strike"] * (2 * n_each) + [k for k in CONFOUNDER_KINDS for _ in range(n_each)]
@@ -113,7 +115,9 @@ def one_run(store: Path, sc, plan, ranges: ConfounderRanges, rng: np.random.Gene
             size = float(math.exp(rng.uniform(math.log(0.02), math.log(0.6))))
             u = rng.normal(size=3)
             strikes.append(InjectedStrike(t_ns, size * u / np.linalg.norm(u)))
-            truth.append({"kind": "strike", "class": "strike", "t_ns": t_ns, "end_ns": t_ns, "size": size, "near": False})
+            truth.append(
+                {"kind": "strike", "class": "strike", "t_ns": t_ns, "end_ns": t_ns, "size": size, "near": False}
+            )
             continue
         c = draw_confounder(kind, t_ns, sc, ranges, rng)
         confs.append(c)
@@ -181,7 +185,10 @@ def main() -> int:
         return 0
     rng = np.random.default_rng(args.seed)
     slots = quiet_times(1800.0)
-    print(f"ranges: {args.ranges} ({'in-sample: the tests draw from these' if args.ranges == 'tests' else 'held out from the tests'})")
+    print(
+        f"ranges: {args.ranges} "
+        f"({'in-sample: the tests draw from these' if args.ranges == 'tests' else 'held out from the tests'})"
+    )
     print(f"{len(slots)} quiet slots per run over 2 days; {args.runs} runs")
     t_start = time.time()
     rows = []
@@ -201,14 +208,18 @@ def figure(store: Path, sc, ranges: ConfounderRanges, path: str, seed: int, verb
     """One real archive strike and one confounder of each kind on 2026-03-10, as the pipeline saw them."""
     rng = np.random.default_rng(seed)
     slots = [t for t in quiet_times(3600.0) if t < 86400 - 3600][: len(CONFOUNDER_KINDS)]
-    confs = [draw_confounder(k, T0_NS + int(t * NS), sc, ranges, rng) for k, t in zip(CONFOUNDER_KINDS, slots, strict=False)]
+    confs = [
+        draw_confounder(k, T0_NS + int(t * NS), sc, ranges, rng) for k, t in zip(CONFOUNDER_KINDS, slots, strict=False)
+    ]
     captured: dict[str, pd.DataFrame] = {}
 
     def hook(s: pd.DataFrame) -> pd.DataFrame:
         captured["s"] = inject_confounders(s, sc, confs, seed=seed)
         return captured["s"]
 
-    chunk = process_chunk(TelemetryStore(store), sc, T0_NS, T0_NS + DAY_NS, FlightRunConfig(), keep_series=True, samples_hook=hook)
+    chunk = process_chunk(
+        TelemetryStore(store), sc, T0_NS, T0_NS + DAY_NS, FlightRunConfig(), keep_series=True, samples_hook=hook
+    )
     assert chunk.series is not None
     flight = flight_channels(sc)
     table = build_timetable(captured["s"], flight, tuple(a.name for a in sc.appendages), T0_NS, T0_NS + DAY_NS)
@@ -242,9 +253,14 @@ def report(t: pd.DataFrame) -> None:
     s = t[t["kind"] == "strike"].copy()
     s["size_bin"] = pd.cut(s["size"], SIZE_BINS)
     print("\nstrikes by size [N·m·s] (rows) and near a confounder")
-    print(pd.crosstab([s["size_bin"], s["near"]], pd.Categorical(s["got"], categories=classes), dropna=False).to_string())
+    print(
+        pd.crosstab([s["size_bin"], s["near"]], pd.Categorical(s["got"], categories=classes), dropna=False).to_string()
+    )
     big = s[s["size"] >= 0.05]
-    print(f"\nstrikes >= 0.05 N·m·s classified strike: {(big['got'] == 'strike').mean():.1%} of {len(big)} (target >= 95 %)")
+    print(
+        f"\nstrikes >= 0.05 N·m·s classified strike: {(big['got'] == 'strike').mean():.1%} of {len(big)}"
+        " (target >= 95 %)"
+    )
     near = big[big["near"]]
     if len(near):
         print(f"  of which within a minute of a confounder: found {(near['got'] != '(none)').mean():.1%}, "

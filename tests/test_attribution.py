@@ -71,7 +71,7 @@ def test_ramp_duration_recovers_a_ramp_and_a_step() -> None:
     for dur in (0.0, 120.0):
         y = 0.1 * np.clip((t - 20.0) / max(dur, 1e-9), 0, 1) if dur else 0.1 * (t >= 20.0)
         y = y + 0.002 * rng.normal(size=t.size)
-        d, lo, hi, onset = ramp_duration(t, y, 0.002)
+        _d, lo, hi, onset = ramp_duration(t, y, 0.002)
         assert lo <= dur * 1.05 + 1.0 and hi >= dur * 0.95
         assert abs(onset - 20.0) < 0.1 * dur + 3.0
 
@@ -100,7 +100,8 @@ def test_rules_follow_the_physics_of_each_kind() -> None:
 
 def test_surface_evidence_needs_a_point_perpendicular_to_the_step(tmp_path: Path) -> None:
     a = make_archive(tmp_path, hours=0.2)
-    text = a.spacecraft.read_text() + '[[surfaces]]\nshape = "panel"\nsize_m = [0.2, 0.2]\ncenter_m = [0.0, 0.0, 1.0]\nnormal = [0.0, 0.0, 1.0]\nu_axis = [1.0, 0.0, 0.0]\n'  # fmt: skip
+    panel = 'shape = "panel"\nsize_m = [0.2, 0.2]\ncenter_m = [0.0, 0.0, 1.0]\nnormal = [0.0, 0.0, 1.0]\n'
+    text = a.spacecraft.read_text() + "[[surfaces]]\n" + panel + "u_axis = [1.0, 0.0, 0.0]\n"
     a.spacecraft.write_text(text)
     sc = load_spacecraft(a.spacecraft)
     # The panel lies near +Z: r × p is near the XY plane, so a ΔH along X is explainable, along Z not.
@@ -197,7 +198,11 @@ def test_strike_and_confounders_on_the_synthetic_archive_get_their_own_class(syn
         assert all(g.kind != "strike" for g in got), (c.kind, got)
         assert got[0].kind == expected[c.kind], (c.kind, got)
     # No event away from the injections is called a strike.
-    others = [(p.time_ns - t0) / NS for p in strong if abs(p.time_ns - strike.time_ns) > 60 * NS and from_rules[p.time_ns].kind == "strike"]
+    others = [
+        (p.time_ns - t0) / NS
+        for p in strong
+        if abs(p.time_ns - strike.time_ns) > 60 * NS and from_rules[p.time_ns].kind == "strike"
+    ]
     assert not others, (others, [(p.value, res.evidence[p.time_ns]) for p in strong if (p.time_ns - t0) / NS in others])
 
 

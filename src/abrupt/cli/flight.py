@@ -261,7 +261,9 @@ def _confounders(
     for text in specs:
         kind, _, t_text = text.partition("@")
         if kind not in CONFOUNDER_KINDS or not t_text:
-            raise InputError(f"--confounder {text!r}: expected KIND@TIME_UTC with KIND one of {', '.join(CONFOUNDER_KINDS)}")
+            raise InputError(
+                f"--confounder {text!r}: expected KIND@TIME_UTC with KIND one of {', '.join(CONFOUNDER_KINDS)}"
+            )
         kinds.append(kind)
         times.append(_parse_time(t_text, "--confounder"))
     out = draw_confounders(kinds, times, sc, _ranges(ranges_path), seed=seed)
@@ -269,14 +271,20 @@ def _confounders(
         for i, d in enumerate(json.loads(Path(file).read_text())):
             if d.get("kind") not in CONFOUNDER_KINDS:
                 raise InputError(f"confounder {i}: unknown kind {d.get('kind')!r}", file=file)
-            out.append(Confounder(d["kind"], _parse_time(d["time_utc"], f"{file}: confounder {i}"), d.get("channel", ""), d["params"]))
+            out.append(
+                Confounder(
+                    d["kind"], _parse_time(d["time_utc"], f"{file}: confounder {i}"), d.get("channel", ""), d["params"]
+                )
+            )
     return out
 
 
 @simulate.command("confounders")
 @click.option("--spacecraft", "spacecraft_path", required=True, type=click.Path(exists=True, dir_okay=False))
 @click.option("--confounder", "specs", multiple=True, help="KIND@TIME_UTC; repeatable.")
-@click.option("--random", "n_random", type=int, default=0, help="This many more, kinds cycled, times uniform in --span.")
+@click.option(
+    "--random", "n_random", type=int, default=0, help="This many more, kinds cycled, times uniform in --span."
+)
 @click.option("--span", type=(str, str), default=None, help="START END (UTC) of the random confounders.")
 @click.option("--confounder-ranges", default=None, type=click.Path(exists=True, dir_okay=False),
               help="TOML of parameter ranges, name = [low, high].")  # fmt: skip

@@ -165,7 +165,7 @@ def draw_confounder(
         if kind == "gyro_spike":
             p = {
                 "rate_deg_s": sign * _log_uniform(rng, r.gyro_spike_deg_s),
-                "samples": int(round(rng.uniform(*r.gyro_spike_samples))),
+                "samples": round(rng.uniform(*r.gyro_spike_samples)),
                 "axis": axis,
             }
         else:
@@ -198,7 +198,7 @@ def draw_confounder(
         }
         return Confounder(kind, time_ns, "thruster", p)
     if kind == "venting":
-        n = int(round(rng.uniform(*r.vent_pulses)))
+        n = round(rng.uniform(*r.vent_pulses))
         direction = _unit(rng)
         gaps = [float(rng.uniform(*r.vent_interval_s)) for _ in range(n - 1)]
         sizes = [_log_uniform(rng, r.vent_impulse_Nms) for _ in range(n)]
@@ -253,7 +253,7 @@ def _hub_impulses(c: Confounder, spacecraft: Spacecraft) -> tuple[FloatArray, Fl
     if c.kind == "thruster_leak":
         dur = c.duration_s
         step = 1.0
-        k = max(1, int(math.ceil(dur / step)))
+        k = max(1, math.ceil(dur / step))
         offs = (np.arange(k) + 0.5) * dur / k
         tau = np.asarray(c.params["torque_B_Nm"], float)
         return offs, np.tile(tau * dur / k, (k, 1)), True

@@ -88,7 +88,9 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
         _finite(ev.wheel_change_Nms) and ev.wheel_change_Nms > r.wheel_sigma * ev.wheel_change_sigma_Nms
     )
     if z_slope > 1.0 and z_slope >= z_step:
-        return Attribution("sensor_fault", _confidence([True, quiet_wheels]), f"gyro_{axis[max(ev.st_gyro_axis, 0)]}", "gyro bias step")
+        return Attribution(
+            "sensor_fault", _confidence([True, quiet_wheels]), f"gyro_{axis[max(ev.st_gyro_axis, 0)]}", "gyro bias step"
+        )
     if z_step > 1.0:
         spike = (
             _finite(ev.gyro_spike_z, ev.gyro_spike_rad)
@@ -96,20 +98,36 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
             and abs(abs(ev.gyro_spike_rad) - ev.st_gyro_step_rad) < r.spike_match * ev.st_gyro_step_rad
         )
         if spike:
-            return Attribution("sensor_fault", _confidence([True, True, quiet_wheels]), f"gyro_{axis[max(ev.gyro_spike_axis, 0)]}", "gyro spike")
+            return Attribution(
+                "sensor_fault",
+                _confidence([True, True, quiet_wheels]),
+                f"gyro_{axis[max(ev.gyro_spike_axis, 0)]}",
+                "gyro spike",
+            )
         return Attribution("sensor_fault", _confidence([True, quiet_wheels]), "star_tracker", "star-tracker jump")
     # 2. Appendage.
-    if _finite(ev.appendage_z, ev.appendage_excess_deg) and ev.appendage_z > r.appendage_z and ev.appendage_excess_deg > r.appendage_min_deg:
+    if (
+        _finite(ev.appendage_z, ev.appendage_excess_deg)
+        and ev.appendage_z > r.appendage_z
+        and ev.appendage_excess_deg > r.appendage_min_deg
+    ):
         tests = [True, _finite(ev.lasting_fraction) and abs(ev.lasting_fraction) < r.lasting_min]
-        return Attribution("internal", _confidence(tests), f"appendage_{ev.appendage_index + 1}", "appendage drive jumped")
+        return Attribution(
+            "internal", _confidence(tests), f"appendage_{ev.appendage_index + 1}", "appendage drive jumped"
+        )
     consistent = _finite(ev.st_gyro_step_rad)
     body = ev.body_share if _finite(ev.body_share) else float("nan")
     body_floor = max(r.body_share_min, r.body_sigma * ev.body_share_sigma if _finite(ev.body_share_sigma) else 0.0)
     body_moved = _finite(body) and body >= body_floor
     # 3. Wheel reading.
-    wheels_moved = _finite(ev.wheel_change_Nms, ev.wheel_change_sigma_Nms) and ev.wheel_change_Nms > r.wheel_sigma * ev.wheel_change_sigma_Nms
+    wheels_moved = (
+        _finite(ev.wheel_change_Nms, ev.wheel_change_sigma_Nms)
+        and ev.wheel_change_Nms > r.wheel_sigma * ev.wheel_change_sigma_Nms
+    )
     if _finite(ev.wheel_spike_z) and ev.wheel_spike_z > r.spike_z and not body_moved:
-        return Attribution("sensor_fault", _confidence([True, True]), f"wheel_{ev.wheel_spike_index + 1}", "wheel reading spike")
+        return Attribution(
+            "sensor_fault", _confidence([True, True]), f"wheel_{ev.wheel_spike_index + 1}", "wheel reading spike"
+        )
     if wheels_moved and not body_moved:
         off_loop = (_finite(ev.wheel_null_fraction) and ev.wheel_null_fraction > r.wheel_null_min) or (
             _finite(ev.wheel_max_share) and ev.wheel_max_share > r.wheel_single_min

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from typing import Any
 
 import numpy as np
 from scipy.ndimage import median_filter
@@ -193,8 +194,8 @@ class EvidenceWindows:
 
 
 def _idx(g: np.ndarray, i0: int, a_s: float, b_s: float, dt: float) -> np.ndarray:
-    lo = max(0, i0 + int(round(a_s / dt)))
-    hi = min(g.size, i0 + int(round(b_s / dt)) + 1)
+    lo = max(0, i0 + round(a_s / dt))
+    hi = min(g.size, i0 + round(b_s / dt) + 1)
     return np.arange(lo, hi)
 
 
@@ -253,7 +254,8 @@ def event_evidence(
         if b.size > 5 and a.size > 5:
             step = np.median(raw_H_N[a], axis=0) - np.median(raw_H_N[b], axis=0)
             out["raw_step_fraction"] = float(step @ (dh_n / mag) / mag)
-    return EventEvidence(**{k: (int(v) if k.endswith(("_axis", "_index")) else float(v)) for k, v in out.items()})
+    typed: dict[str, Any] = {k: (int(v) if k.endswith(("_axis", "_index")) else float(v)) for k, v in out.items()}
+    return EventEvidence(**typed)
 
 
 def _wheel_evidence(table: Timetable, sc: Spacecraft, i0: int, dt: float, w: EvidenceWindows) -> dict[str, float]:
@@ -313,7 +315,9 @@ def _consistency(table: Timetable, i0: int, dt: float, w: EvidenceWindows, peak_
     sig = np.maximum(r0, r1)
     n_a, n_b = a.sum(), b.sum()
     # σ of an intercept at τ = 0 extrapolated from a line fitted over [τ_a, τ_b]: about 2σ/√n · (1 + ...).
-    lever = 1.0 + abs(w.consistency_after_s[0] + w.consistency_after_s[1]) / max(w.consistency_after_s[1] - w.consistency_after_s[0], 1.0)
+    lever = 1.0 + abs(w.consistency_after_s[0] + w.consistency_after_s[1]) / max(
+        w.consistency_after_s[1] - w.consistency_after_s[0], 1.0
+    )
     step_sig = sig * lever * 2.0 * math.sqrt(1.0 / n_a + 1.0 / n_b)
     slope_sig = sig * math.sqrt(12.0 / n_a) / (n_a * dt) + sig * math.sqrt(12.0 / n_b) / (n_b * dt)
     timing = (peak_rate if math.isfinite(peak_rate) else 0.0) * w.timing_s
@@ -339,7 +343,11 @@ def _gyro_spike(omega: FloatArray, valid: np.ndarray, i0: int, dt: float) -> dic
     z = np.abs(r[near]) / np.maximum(sig, 1e-12)
     j, k = np.unravel_index(int(np.argmax(z)), z.shape)
     big = np.abs(r[near, k]) > 5.0 * sig[k]
-    return {"gyro_spike_rad": float(np.sum(r[near, k][big]) * dt), "gyro_spike_z": float(z[j, k]), "gyro_spike_axis": int(k)}
+    return {
+        "gyro_spike_rad": float(np.sum(r[near, k][big]) * dt),
+        "gyro_spike_z": float(z[j, k]),
+        "gyro_spike_axis": int(k),
+    }
 
 
 def _profile(
