@@ -69,13 +69,20 @@ def plot_event_panels(
         ok = table.valid[sel]
         if ok.all():
             e = st_gyro_mismatch(table.quaternion_BN[sel], table.body_rate_rad_s[sel], dt)
-            e = e - e[pre].mean(axis=0)
+            # The gyro's slowly drifting bias: the line fitted before the event is removed.
+            coef = np.polyfit(tau[pre], e[pre], 1)
+            e = e - (np.outer(tau, coef[0]) + coef[1])
             axes[2, col].plot(tau, np.degrees(np.linalg.norm(e, axis=1)) * 3600, lw=0.7)
         if table.appendage_rate_rad_s.shape[1]:
             axes[3, col].plot(tau, np.degrees(table.appendage_rate_rad_s[sel, 0]), lw=0.7)
         axes[0, col].set_title(p.title, fontsize=8)
         axes[3, col].set_xlabel("s from event")
-    labels = ("cleaned ᴺH·ΔĤ [N·m·s]", "ΔH along ΔĤ_B [N·m·s]", "|star tracker − gyro| [arcsec]", "drive rate [deg/s]")
+    labels = (
+        "cleaned ᴺH·ΔĤ [N·m·s]",
+        "ΔH along ΔĤ_B [N·m·s]",
+        "|star tracker − gyro|, detrended [arcsec]",
+        "drive rate [deg/s]",
+    )
     for row, text in enumerate(labels):
         axes[row, 0].set_ylabel(text, fontsize=8)
     axes[1, 0].legend(fontsize=7)
