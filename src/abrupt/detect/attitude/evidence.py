@@ -159,12 +159,11 @@ def ramp_duration(tau_s: FloatArray, y: FloatArray, sigma: float) -> tuple[float
     best = np.full(durations.size, np.inf)
     where = np.zeros(durations.size)
     # A linear background (slow residual drift) is projected out of the data and of each ramp.
-    basis = np.column_stack([np.ones_like(t), (t - t.mean()) / max(span, 1.0)])
-    proj = basis @ np.linalg.pinv(basis)
-    vc = v - proj @ v
+    basis, _ = np.linalg.qr(np.column_stack([np.ones_like(t), (t - t.mean()) / max(span, 1.0)]))
+    vc = v - basis @ (basis.T @ v)
     for j, d in enumerate(durations):
         x = np.clip((t[None, :] - onsets[:, None]) / d, 0.0, 1.0) if d > 0 else (t[None, :] >= onsets[:, None]) * 1.0
-        xc = x - x @ proj.T
+        xc = x - (x @ basis) @ basis.T
         sxx = np.sum(xc * xc, axis=1)
         sxy = xc @ vc
         with np.errstate(invalid="ignore", divide="ignore"):
