@@ -26,7 +26,16 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-EVENT_KINDS = ("strike", "maneuver", "mass_change", "unknown", "maneuver_campaign")
+EVENT_KINDS = (
+    "strike",
+    "maneuver",
+    "mass_change",
+    "unknown",
+    "maneuver_campaign",
+    "sensor_fault",
+    "external_non_strike",
+    "internal",
+)
 
 EVENT_COLUMNS: tuple[str, ...] = (
     "event_id",

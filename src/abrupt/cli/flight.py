@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import tomllib
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -12,7 +13,7 @@ from typing import Any
 import click
 import numpy as np
 
-from abrupt.cli.groups import cli, inject, record_run
+from abrupt.cli.groups import cli, inject, record_run, simulate
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.detect.attitude.flight_glr import FlightGlrDetector
 from abrupt.errors import InputError
@@ -22,6 +23,13 @@ from abrupt.pipelines.flight import CleaningConfig, FlightRunConfig, day_range, 
 from abrupt.pipelines.flight_injection import injection_recovery
 from abrupt.readers.archive import pseudonymise_text, read_decoder
 from abrupt.report.flight import write_flight_report
+from abrupt.simulate.confounders import (
+    CONFOUNDER_KINDS,
+    Confounder,
+    ConfounderRanges,
+    draw_confounders,
+    inject_confounders,
+)
 from abrupt.simulate.injection import InjectedStrike, inject_strikes
 from abrupt.store import TelemetryStore
 from abrupt.thresholds import FalseAlarmBudget
@@ -150,6 +158,24 @@ def detect_from_store(
     help="Write a copy of the store with the strikes injected (native units).",
 )
 @click.option("--strike", "strikes", multiple=True, help="TIME_UTC:DHX,DHY,DHZ (inertial axes, N·m·s); repeatable.")
+@click.option(
+    "--confounder",
+    "confounders",
+    multiple=True,
+    help=f"KIND@TIME_UTC, parameters drawn from --confounder-ranges; repeatable. Kinds: {', '.join(CONFOUNDER_KINDS)}.",
+)
+@click.option(
+    "--confounders-file",
+    default=None,
+    type=click.Path(exists=True, dir_okay=False),
+    help="Confounders with their parameters (JSON written by `abrupt simulate confounders`).",
+)
+@click.option(
+    "--confounder-ranges",
+    default=None,
+    type=click.Path(exists=True, dir_okay=False),
+    help="TOML of parameter ranges, name = [low, high] (default: the documented ones).",
+)
 @click.option("--recovery", is_flag=True, help="Injection-recovery study: 90%-detectable ΔH per day.")
 @click.option("--days", multiple=True, help="Days (YYYY-MM-DD or A..B); default all stored days.")
 @budget_options()
@@ -160,16 +186,21 @@ def inject_attitude_cmd(
     spacecraft_path: str,
     out_store: str | None,
     strikes: tuple[str, ...],
+    confounders: tuple[str, ...],
+    confounders_file: str | None,
+    confounder_ranges: str | None,
     recovery: bool,
     days: tuple[str, ...],
     seed: int,
     out: str | None,
     **budget: Any,
 ) -> None:
-    """Add synthetic strikes to stored telemetry (Harris et al. 2025 §3.5), or measure detectable ΔH per day."""
+    """Add synthetic strikes and confounders to stored telemetry (Harris et al. 2025 §3.5), or measure
+    detectable ΔH per day."""
     sc = load_spacecraft(spacecraft_path)
     store = TelemetryStore(store_dir)
-    if strikes:
+    conf_list = _confounders(sc, confounders, confounders_file, confounder_ranges, seed)
+    if strikes or conf_list:
         if not out_store:
             raise click.UsageError("--strike needs --out-store")
         parsed = []
@@ -186,7 +217,7 @@ def inject_attitude_cmd(
         dst = TelemetryStore(out_store)
         for day in day_range(store, sc.name, days or None):
             frame = store.read_day(sc.name, day)
-            frame = inject_strikes(frame, sc, parsed, seed=seed)
+            frame = inject_strikes(inject_confounders(frame, sc, conf_list, seed=seed), sc, parsed, seed=seed)
             frame["time"] = frame["time"].dt.tz_localize("UTC")
             report = store.report(sc.name, day)
             report["injected_strikes"] = [
@@ -194,8 +225,11 @@ def inject_attitude_cmd(
                 for s in parsed
                 if str(np.datetime64(s.time_ns, "ns"))[:10] == day
             ]
+            report["injected_confounders"] = [
+                _confounder_json(c) for c in conf_list if str(np.datetime64(c.time_ns, "ns"))[:10] == day
+            ]
             dst.write_day(sc.name, day, frame, report)
-        click.echo(f"{len(parsed)} strike(s) injected; store written to {out_store}")
+        click.echo(f"{len(parsed)} strike(s), {len(conf_list)} confounder(s) injected; store written to {out_store}")
     if recovery:
         cfg = FlightRunConfig(budget=pop_budget(budget))
         base = run_flight(store_dir, sc, cfg, days=days or None)
@@ -204,8 +238,103 @@ def inject_attitude_cmd(
         if out:
             rec.per_day.to_csv(out, index=False)
             Path(out).with_suffix(".injections.csv").write_text(rec.injections.to_csv(index=False))
-    if not strikes and not recovery:
-        raise click.UsageError("give --strike ... --out-store DIR, or --recovery")
+    if not strikes and not conf_list and not recovery:
+        raise click.UsageError("give --strike/--confounder ... --out-store DIR, or --recovery")
+
+
+def _confounder_json(c: Confounder) -> dict[str, Any]:
+    return {"kind": c.kind, "time_utc": str(np.datetime64(c.time_ns, "ns")) + "Z", "channel": c.channel,
+            "expected_class": c.expected_class, "params": dict(c.params)}  # fmt: skip
+
+
+def _ranges(path: str | None) -> ConfounderRanges:
+    if path is None:
+        return ConfounderRanges()
+    return ConfounderRanges.from_mapping(tomllib.loads(Path(path).read_text()))
+
+
+def _parse_time(text: str, what: str) -> int:
+    try:
+        return int(np.datetime64(text.rstrip("Z"), "ns").astype(np.int64))
+    except ValueError:
+        raise InputError(f"{what} {text!r}: expected an ISO-8601 UTC time") from None
+
+
+def _confounders(
+    sc: Any, specs: tuple[str, ...], file: str | None, ranges_path: str | None, seed: int
+) -> list[Confounder]:
+    """Confounders from KIND@TIME specs (parameters drawn) and from a JSON file (parameters given)."""
+    kinds, times = [], []
+    for text in specs:
+        kind, _, t_text = text.partition("@")
+        if kind not in CONFOUNDER_KINDS or not t_text:
+            raise InputError(
+                f"--confounder {text!r}: expected KIND@TIME_UTC with KIND one of {', '.join(CONFOUNDER_KINDS)}"
+            )
+        kinds.append(kind)
+        times.append(_parse_time(t_text, "--confounder"))
+    out = draw_confounders(kinds, times, sc, _ranges(ranges_path), seed=seed)
+    if file:
+        for i, d in enumerate(json.loads(Path(file).read_text())):
+            if d.get("kind") not in CONFOUNDER_KINDS:
+                raise InputError(f"confounder {i}: unknown kind {d.get('kind')!r}", file=file)
+            out.append(
+                Confounder(
+                    d["kind"], _parse_time(d["time_utc"], f"{file}: confounder {i}"), d.get("channel", ""), d["params"]
+                )
+            )
+    return out
+
+
+@simulate.command("confounders")
+@click.option("--spacecraft", "spacecraft_path", required=True, type=click.Path(exists=True, dir_okay=False))
+@click.option("--confounder", "specs", multiple=True, help="KIND@TIME_UTC; repeatable.")
+@click.option(
+    "--random", "n_random", type=int, default=0, help="This many more, kinds cycled, times uniform in --span."
+)
+@click.option("--span", type=(str, str), default=None, help="START END (UTC) of the random confounders.")
+@click.option("--confounder-ranges", default=None, type=click.Path(exists=True, dir_okay=False),
+              help="TOML of parameter ranges, name = [low, high].")  # fmt: skip
+@click.option("--show-ranges", is_flag=True, help="Print the ranges in use (TOML) and exit.")
+@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--out", default=None, type=click.Path(dir_okay=False), help="Confounders with parameters (.json).")
+def simulate_confounders_cmd(
+    spacecraft_path: str,
+    specs: tuple[str, ...],
+    n_random: int,
+    span: tuple[str, str] | None,
+    confounder_ranges: str | None,
+    show_ranges: bool,
+    seed: int,
+    out: str | None,
+) -> None:
+    """Draw confounders (sensor faults, leaks, venting, appendage snaps) with parameters from documented ranges.
+
+    The JSON goes to `abrupt inject attitude --confounders-file` to add them to stored telemetry.
+    """
+    ranges = _ranges(confounder_ranges)
+    if show_ranges:
+        for k, (lo, hi) in ranges.as_dict().items():
+            click.echo(f"{k} = [{lo:g}, {hi:g}]")
+        return
+    sc = load_spacecraft(spacecraft_path)
+    specs = tuple(specs)
+    if n_random:
+        if span is None:
+            raise click.UsageError("--random needs --span START END")
+        lo, hi = _parse_time(span[0], "--span"), _parse_time(span[1], "--span")
+        rng = np.random.default_rng(seed)
+        t = np.sort(rng.uniform(lo, hi, n_random)).astype(np.int64)
+        specs += tuple(
+            f"{CONFOUNDER_KINDS[i % len(CONFOUNDER_KINDS)]}@{np.datetime64(int(x), 'ns')}" for i, x in enumerate(t)
+        )
+    conf = _confounders(sc, specs, None, confounder_ranges, seed)
+    text = json.dumps([_confounder_json(c) for c in conf], indent=1)
+    if out:
+        Path(out).write_text(text + "\n")
+        click.echo(f"{len(conf)} confounder(s) written to {out}")
+    else:
+        click.echo(text)
 
 
 def ingest_report_json(store_dir: str, spacecraft: str, day: str) -> str:

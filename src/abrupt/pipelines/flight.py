@@ -36,11 +36,13 @@ import pandas as pd
 
 from abrupt.clean.comb import CombConfig, estimate_period, smooth_model
 from abrupt.clean.flight_masks import SlewMaskConfig, event_mask, flag_intervals, slew_mask
+from abrupt.detect.attitude.evidence import EventEvidence, event_evidence
 from abrupt.detect.attitude.flight_glr import MIN_BLOCKS, FlightGlrDetector, Peak
 from abrupt.errors import ConfigError, InputError
 from abrupt.events import config_hash, new_run_id
 from abrupt.model.flight_config import FlightConfig
 from abrupt.model.spacecraft import Spacecraft
+from abrupt.pipelines.flight_attribution import attribute_events
 from abrupt.pipelines.flight_checks import check_tachometer_units, check_wheel_units, flight_channels
 from abrupt.readers.archive import pseudonymise_text, read_archive, read_decoder
 from abrupt.scale import Executor, TaskResult, run_tasks
@@ -165,12 +167,14 @@ class FlightRunConfig:
     cleaning: CleaningConfig = field(default_factory=CleaningConfig)
     peak_floor: float = 3.0
     orbit_period_s: float | None = None
+    evidence_floor: float = 5.0
 
     def hash_fields(self) -> dict[str, Any]:
         """The settings as they enter the run's ``config_hash``: the budget as its rate per day, so that one
         budget written per day or per week hashes the same."""
         fields = asdict(self)
         fields.pop("budget")
+        fields.pop("evidence_floor")  # which peaks get evidence: no event changes with it
         fields["false_alarms_per_day"] = self.budget.per_day
         return fields
 
@@ -261,6 +265,7 @@ class ChunkResult:
     missing_channels: tuple[str, ...]
     harmonics_mean: float
     series: dict[str, np.ndarray] | None = None
+    evidence: dict[int, EventEvidence] = field(default_factory=dict)
 
 
 def process_chunk(
@@ -395,6 +400,13 @@ def process_span(
     hc, stat, info = _clean_and_scan(h_n, ok, g.astype(np.float64) / NS, dt, period, c, detector)
     core = (g >= start_ns) & (g < end_ns)
     peaks = detector.find_peaks(hc, ok, stat, g, dt, detector.windows(dt), keep=core)
+    evidence = {
+        pk.time_ns: event_evidence(
+            table, hc, spacecraft, pk.time_ns, pk.dH_N_Nms, inertia_kgm2=inertia_kgm2, raw_H_N=h_n
+        )
+        for _, pk in peaks
+        if pk.value > config.evidence_floor
+    }
     edges = [start_ns, end_ns]
     if split_days:
         d_first = -(-start_ns // DAY_NS) * DAY_NS
@@ -430,6 +442,7 @@ def process_span(
                 missing_channels=table.missing_channels,
                 harmonics_mean=float(info.get("harmonics_mean", 0.0)),
                 series=series,
+                evidence={t: e for t, e in evidence.items() if p0 <= t < p1},
             )
         )
     return out
@@ -555,6 +568,7 @@ def run_flight(
     )
     peaks = [p for r in chunks for p in r.peaks]
     events = detector.events(peaks, threshold, spacecraft.name, run_id, cfg_hash)
+    events = attribute_events(events, {t: e for r in chunks for t, e in r.evidence.items()})
     daily = daily_table(chunks, events, threshold)
     return FlightResult(events, threshold, daily, peaks, chunks if keep_series else [], run_id, cfg_hash, warnings)
 

@@ -68,7 +68,7 @@ def angle_response(tau_s: FloatArray, settle_s: float) -> FloatArray:
     return np.where(tau_s >= 0, t * np.exp(-t / settle_s), 0.0)
 
 
-class _Attitude:
+class InjectionAttitude:
     """[BN](t) from the telemetered quaternion (sign-continuous, nlerp); the series is read once."""
 
     def __init__(self, samples: pd.DataFrame, spacecraft: Spacecraft) -> None:
@@ -95,7 +95,7 @@ class _Attitude:
         return np.asarray(dcm_from_quaternion(qi), dtype=np.float64)
 
 
-def _quat_multiply(p: FloatArray, q: FloatArray) -> FloatArray:
+def quat_multiply(p: FloatArray, q: FloatArray) -> FloatArray:
     """Hamilton product p ⊗ q, scalar first, row-wise."""
     p0, p1, p2, p3 = p.T
     q0, q1, q2, q3 = q.T
@@ -143,7 +143,7 @@ def simulated_response(
     """
     t0 = strike.time_ns - int(lead_s * NS)
     t_ref = t0 + np.arange(-5, int(window_s + lead_s) + 6, dtype=np.int64) * NS
-    bn = (attitude or _Attitude(samples, spacecraft))(t_ref)
+    bn = (attitude or InjectionAttitude(samples, spacecraft))(t_ref)
     reference = ReferenceTrajectory.from_telemetry((t_ref - t0) / NS, quaternion_from_dcm(bn))
     config = AttitudeSimConfig(
         duration_s=window_s + lead_s, sim_rate_hz=sim_rate_hz, telemetry_rate_hz=10.0, noise=False, seed=0
@@ -154,7 +154,7 @@ def simulated_response(
     without = simulate_pointing(spacecraft, config, scenario)
     q_w, q_o = with_strike.true_q_BN, without.true_q_BN
     conj = q_o * np.array([1.0, -1.0, -1.0, -1.0])
-    dq = _quat_multiply(conj, q_w)  # q_with = q_without ⊗ δq: δθ about body axes
+    dq = quat_multiply(conj, q_w)  # q_with = q_without ⊗ δq: δθ about body axes
     dq *= np.where(dq[:, :1] < 0, -1.0, 1.0)
     return StrikeResponse(
         tau_s=np.asarray(with_strike.t_s - lead_s, dtype=np.float64),
@@ -188,7 +188,7 @@ class _Transient:
         return np.asarray(np.where(inside, np.column_stack(cols), 0.0), dtype=np.float64)
 
 
-class _Rows:
+class InjectionRows:
     """Rows of the raw samples by mnemonic, selected by time."""
 
     def __init__(self, t_all: NDArray[np.int64], mnem: NDArray[Any]) -> None:
@@ -205,7 +205,12 @@ class _Rows:
 
 
 def _add_attitude_error(
-    values: FloatArray, rows: _Rows, qch: list[FlightChannel], s: InjectedStrike, horizon_ns: int, tr: _Transient
+    values: FloatArray,
+    rows: InjectionRows,
+    qch: list[FlightChannel],
+    s: InjectedStrike,
+    horizon_ns: int,
+    tr: _Transient,
 ) -> None:
     """Rotate the telemetered q_BN of the perturbed body: δq(δθ) ⊗ q_BN, δθ in body axes."""
     t_all = rows.t_all
@@ -227,7 +232,7 @@ def _add_attitude_error(
         axis = np.where(half[:, None] > 0, dth / (2 * half[:, None]), 0.0)
     dq = np.column_stack([np.cos(half), axis * np.sin(half)[:, None]])
     q = values[rows_arr]
-    q_new = _quat_multiply(q, dq)  # q_BN ⊗ δq: δθ about body axes
+    q_new = quat_multiply(q, dq)  # q_BN ⊗ δq: δθ about body axes
     flip = (q_new[:, 0] < 0) & (q[:, 0] >= 0)  # keep the archive's q0 >= 0 convention
     values[rows_arr] = q_new * np.where(flip, -1.0, 1.0)[:, None]
 
@@ -268,7 +273,7 @@ def _wheel_change(
     return np.asarray(d_omega.reshape(-1, k_sub).mean(axis=1), dtype=np.float64)
 
 
-def _native_wheel_change(c: FlightChannel, d_mean: FloatArray, rng: np.random.Generator) -> FloatArray:
+def native_wheel_change(c: FlightChannel, d_mean: FloatArray, rng: np.random.Generator) -> FloatArray:
     """ΔΩ in the channel's native unit; tachometer counts regenerated from the cumulative pulse phase."""
     if c.tachometer is None:
         return np.asarray(d_mean / c.to_si, dtype=np.float64)
@@ -309,8 +314,8 @@ def inject_strikes(
     wheel_pinv = np.linalg.pinv(js_g)  # minimum-norm distribution
     rng = np.random.default_rng(seed)
     horizon_ns = int(20 * settle_s * NS)
-    bn_at = _Attitude(samples, spacecraft)
-    rows = _Rows(t_all, out["mnemonic"].astype(str).to_numpy())
+    bn_at = InjectionAttitude(samples, spacecraft)
+    rows = InjectionRows(t_all, out["mnemonic"].astype(str).to_numpy())
     for s in strikes:
         bn0 = bn_at(np.array([s.time_ns]))[0]
         dw0 = j_inv @ (bn0 @ s.dH_N_Nms)
@@ -336,6 +341,6 @@ def inject_strikes(
             if sel.size == 0:
                 continue
             d_mean = _wheel_change(c, t_all[sel], s, spacecraft, bn_at, tr, wheel_pinv, null_offset)
-            values[sel] += _native_wheel_change(c, d_mean, rng)
+            values[sel] += native_wheel_change(c, d_mean, rng)
     out["value"] = values
     return out

@@ -1,0 +1,153 @@
+"""Is it a strike? A classification of each event from its evidence by physical rules.
+
+The rules read the evidence of :mod:`abrupt.detect.attitude.evidence`; none is fitted to simulations
+(each limit is a noise multiple or a physical scale given in :class:`AttributionRules`). In order:
+
+1. **sensor_fault** when the star tracker and the integrated gyro disagree across the event (real
+   motion moves both): a change of slope of the mismatch is a gyro bias step (channel ``gyro_<axis>``);
+   a jump that an isolated gyro excursion accounts for is a gyro spike; any other jump is the star
+   tracker (channel ``star_tracker``);
+2. **internal** when an appendage drive changed rate abruptly at the event (momentum moved between
+   the hub and the appendage, total conserved);
+3. **sensor_fault** of a wheel when one wheel's reading has an isolated spike, or the wheels'
+   momentum changed, while the body never felt it (body share below ``body_share_min`` and below
+   ``body_sigma`` times its noise), and the change is not one the minimum-norm controller makes
+   (null-space part, or one wheel carrying it);
+4. **strike** when the sensors agree, the body took the impulse first (body share), the step lasts,
+   is in the momentum before cleaning too (``raw_step_fraction``) and is impulsive (its duration
+   interval reaches below ``impulsive_s``);
+5. **external_non_strike** when the sensors agree and a step lasts (either sign: the event's own ΔH
+   may be a piece of a longer ramp) but it is a ramp or a sequence
+   (duration interval above ``impulsive_s``), or the body share is small (a slow torque the loop kept
+   up with);
+6. **internal** when the sensors agree, the body moved, and nothing lasts (a pulse that returns);
+7. **unknown** otherwise, or when the evidence is missing.
+
+The confidence is the fraction of the kind's supporting tests that pass, each test counting once,
+scaled into [0.5, 0.99]: it says how many independent pieces agree, not a calibrated probability.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from abrupt.detect.attitude.evidence import EventEvidence
+
+ATTRIBUTION_KINDS = ("strike", "sensor_fault", "external_non_strike", "internal", "unknown")
+
+
+@dataclass(frozen=True)
+class AttributionRules:
+    """Limits of the rules (units in the names; ``*_share``/``*_fraction`` are ratios)."""
+
+    impulsive_s: float = 8.0
+    body_share_min: float = 0.15
+    body_sigma: float = 5.0
+    lasting_min: float = 0.5
+    returns_max: float = 0.3
+    wheel_null_min: float = 0.3
+    wheel_single_min: float = 0.7
+    wheel_sigma: float = 5.0
+    spike_z: float = 8.0
+    spike_match: float = 0.5
+    appendage_z: float = 12.0
+    appendage_min_deg: float = 0.2
+
+
+@dataclass(frozen=True)
+class Attribution:
+    """The class of an event, its confidence, the channel (for a sensor fault) and the tests behind it."""
+
+    kind: str
+    confidence: float
+    channel: str = ""
+    reason: str = ""
+
+
+def _finite(*xs: float) -> bool:
+    return all(math.isfinite(x) for x in xs)
+
+
+def _ratio(x: float, limit: float) -> float:
+    return x / limit if _finite(x, limit) and limit > 0 else 0.0
+
+
+def _confidence(tests: list[bool]) -> float:
+    return 0.5 + 0.49 * (sum(tests) / len(tests)) if tests else 0.5
+
+
+def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attribution:
+    """Apply the rules of the module docstring to one event's evidence."""
+    r = rules or AttributionRules()
+    axis = "xyz"
+    # 1. Star tracker against gyro: a change of slope (gyro bias) or a jump (a spike or the tracker).
+    z_slope = _ratio(ev.st_gyro_slope_rad_s, ev.st_gyro_slope_limit_rad_s)
+    z_step = _ratio(ev.st_gyro_step_rad, ev.st_gyro_step_limit_rad)
+    quiet_wheels = not (
+        _finite(ev.wheel_change_Nms) and ev.wheel_change_Nms > r.wheel_sigma * ev.wheel_change_sigma_Nms
+    )
+    if z_slope > 1.0 and z_slope >= z_step:
+        return Attribution(
+            "sensor_fault", _confidence([True, quiet_wheels]), f"gyro_{axis[max(ev.st_gyro_axis, 0)]}", "gyro bias step"
+        )
+    if z_step > 1.0:
+        spike = (
+            _finite(ev.gyro_spike_z, ev.gyro_spike_rad)
+            and ev.gyro_spike_z > r.spike_z
+            and abs(abs(ev.gyro_spike_rad) - ev.st_gyro_step_rad) < r.spike_match * ev.st_gyro_step_rad
+        )
+        if spike:
+            return Attribution(
+                "sensor_fault",
+                _confidence([True, True, quiet_wheels]),
+                f"gyro_{axis[max(ev.gyro_spike_axis, 0)]}",
+                "gyro spike",
+            )
+        return Attribution("sensor_fault", _confidence([True, quiet_wheels]), "star_tracker", "star-tracker jump")
+    # 2. Appendage.
+    if (
+        _finite(ev.appendage_z, ev.appendage_excess_deg)
+        and ev.appendage_z > r.appendage_z
+        and ev.appendage_excess_deg > r.appendage_min_deg
+    ):
+        tests = [True, _finite(ev.lasting_fraction) and abs(ev.lasting_fraction) < r.lasting_min]
+        return Attribution(
+            "internal", _confidence(tests), f"appendage_{ev.appendage_index + 1}", "appendage drive jumped"
+        )
+    consistent = _finite(ev.st_gyro_step_rad)
+    body = ev.body_share if _finite(ev.body_share) else float("nan")
+    body_floor = max(r.body_share_min, r.body_sigma * ev.body_share_sigma if _finite(ev.body_share_sigma) else 0.0)
+    body_moved = _finite(body) and body >= body_floor
+    # 3. Wheel reading.
+    wheels_moved = (
+        _finite(ev.wheel_change_Nms, ev.wheel_change_sigma_Nms)
+        and ev.wheel_change_Nms > r.wheel_sigma * ev.wheel_change_sigma_Nms
+    )
+    if _finite(ev.wheel_spike_z) and ev.wheel_spike_z > r.spike_z and not body_moved:
+        return Attribution(
+            "sensor_fault", _confidence([True, True]), f"wheel_{ev.wheel_spike_index + 1}", "wheel reading spike"
+        )
+    if wheels_moved and not body_moved:
+        off_loop = (_finite(ev.wheel_null_fraction) and ev.wheel_null_fraction > r.wheel_null_min) or (
+            _finite(ev.wheel_max_share) and ev.wheel_max_share > r.wheel_single_min
+        )
+        if off_loop:
+            tests = [True, True, _finite(ev.wheel_max_share) and ev.wheel_max_share > r.wheel_single_min]
+            return Attribution("sensor_fault", _confidence(tests), f"wheel_{ev.wheel_max_index + 1}", "wheel reading")
+    if not (consistent and _finite(body, ev.lasting_fraction)):
+        return Attribution("unknown", 0.5, "", "evidence missing")
+    lasting = ev.lasting_fraction >= r.lasting_min
+    in_raw = not _finite(ev.raw_step_fraction) or ev.raw_step_fraction >= r.lasting_min
+    impulsive = _finite(ev.duration_lo_s) and ev.duration_lo_s <= r.impulsive_s
+    surface_ok = not (_finite(ev.surface_fraction) and ev.surface_fraction == 0.0)
+    # 4./5. External.
+    if lasting and impulsive and body_moved and in_raw:
+        return Attribution("strike", _confidence([True, True, True, surface_ok]), "", "impulsive external step")
+    if abs(ev.lasting_fraction) >= r.lasting_min and (not impulsive or not body_moved):
+        tests = [True, not impulsive, not body_moved]
+        return Attribution("external_non_strike", _confidence(tests), "", "ramp or sequence of external torque")
+    # 6. Internal.
+    if abs(ev.lasting_fraction) <= r.returns_max and body_moved:
+        return Attribution("internal", _confidence([True, True]), "", "body moved, nothing lasts")
+    return Attribution("unknown", 0.5, "", "no rule")

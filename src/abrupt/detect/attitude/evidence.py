@@ -1,0 +1,453 @@
+"""Evidence per event: what the telemetry around a momentum step says about its cause.
+
+A debris strike is an external impulse at one instant; total momentum steps, and every sensor responds
+as the closed attitude loop predicts (Bennett 2022 Eq. 2.7; README of the flight-like set, "Controller
+response"): the body rate first jumps by Δω₀ = J⁻¹ ΔH_B, the attitude measured by the star tracker and
+the attitude integrated from the gyro move together, and the wheels then take the momentum back with
+the controller's own (minimum-norm) distribution. The pieces of evidence, each from the synchronised
+telemetry (:class:`~abrupt.series.timetable.Timetable`) around the event:
+
+* **sensor consistency** (``st_gyro_step_rad``, ``st_gyro_slope_rad_s``): the star-tracker attitude
+  against the attitude integrated from the gyro, e = 2 vec(q_gyro⁻¹ ⊗ q_ST) about body axes, fitted
+  by a line before and after the event; a lasting jump in e means one of the two attitude sensors
+  jumped, a change of slope that the gyro's bias stepped. Real motion leaves e untouched, apart from a
+  transient of the order of the timing error times the rate change, which the test allows for;
+* **gyro spike** (``gyro_spike_rad``): the largest isolated gyro excursion near the event (against a
+  5-sample running median), integrated over its samples;
+* **closed-loop response**: ``body_share`` the peak of J Δω along ΔH_B in the first 20 s over |ΔH|
+  (1 for an impulse, near 0 for a slow torque the loop keeps up with, 0 for a wheel-reading fault);
+  ``wheel_null_fraction`` the part of the wheel-speed change in the null space of J_s G (a
+  minimum-norm controller never moves momentum there, one wheel's bad reading does) and
+  ``wheel_max_share`` the largest single wheel's part of the wheel momentum change; ``wheel_spike_z``
+  the largest isolated excursion of one wheel's reading against its 5-sample running median (in
+  units of its noise); ``body_share_sigma`` the noise of the body share;
+* **lasting fraction** (``lasting_fraction``): the step of the cleaned ᴺH along ΔĤ a minute or more
+  after the event (or after the fitted ramp) over |ΔH| (1 for a step, near 0 for a pulse that returns);
+  ``raw_step_fraction`` the same within ±40 s on the momentum before cleaning (a step the cleaning
+  made, not the telemetry, has none);
+* **time profile** (``duration_s`` with ``duration_lo_s``, ``duration_hi_s``): a ramp of duration D
+  (D = 0 a step) fitted to the cleaned ᴺH along ΔĤ, with the interval where the fit is within
+  Δχ² = 4 of the best (noise from the data's first differences);
+* **appendage** (``appendage_excess_deg``, ``appendage_z``): an abrupt change of a drive's rate
+  (against its 61-s running median), the angle it adds and its significance;
+* **surfaces** (``surface_fraction``, ``min_dv_mps``): when the spacecraft file has surfaces, the
+  fraction of surface sample points r with r ⊥ ΔH_B (within the direction's uncertainty) from which an
+  incoming momentum p, |p| = |ΔH|/|r|, can give ΔH = r × p, and the smallest ΔV a strike giving ΔH
+  must cause (|ΔH| / (m r_max)).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+from scipy.ndimage import median_filter
+
+from abrupt.model.rotations import dcm_from_quaternion
+from abrupt.model.spacecraft import Spacecraft
+from abrupt.series.timetable import NS, Timetable
+from abrupt.types import FloatArray
+
+NAN = float("nan")
+
+
+@dataclass(frozen=True)
+class EventEvidence:
+    """The evidence of one event (module docstring); NaN where the telemetry does not allow it."""
+
+    dH_B_x_Nms: float = NAN
+    dH_B_y_Nms: float = NAN
+    dH_B_z_Nms: float = NAN
+    st_gyro_step_rad: float = NAN
+    st_gyro_step_limit_rad: float = NAN
+    st_gyro_slope_rad_s: float = NAN
+    st_gyro_slope_limit_rad_s: float = NAN
+    st_gyro_axis: int = -1
+    gyro_spike_rad: float = NAN
+    gyro_spike_z: float = NAN
+    gyro_spike_axis: int = -1
+    body_share: float = NAN
+    body_share_sigma: float = NAN
+    wheel_spike_z: float = NAN
+    wheel_spike_index: int = -1
+    wheel_change_Nms: float = NAN
+    wheel_change_sigma_Nms: float = NAN
+    wheel_null_fraction: float = NAN
+    wheel_max_share: float = NAN
+    wheel_max_index: int = -1
+    lasting_fraction: float = NAN
+    raw_step_fraction: float = NAN
+    duration_s: float = NAN
+    duration_lo_s: float = NAN
+    duration_hi_s: float = NAN
+    appendage_excess_deg: float = NAN
+    appendage_z: float = NAN
+    appendage_index: int = -1
+    surface_fraction: float = NAN
+    min_dv_mps: float = NAN
+
+    def as_dict(self) -> dict[str, float]:
+        return {f"ev_{k}": float(v) for k, v in asdict(self).items()}
+
+
+def _hamilton(p: FloatArray, q: FloatArray) -> FloatArray:
+    """Hamilton product p ⊗ q, scalar first (the convention of q_BN in the flight archives)."""
+    p0, p1, p2, p3 = np.moveaxis(p, -1, 0)
+    q0, q1, q2, q3 = np.moveaxis(q, -1, 0)
+    return np.stack(
+        [
+            p0 * q0 - p1 * q1 - p2 * q2 - p3 * q3,
+            p0 * q1 + p1 * q0 + p2 * q3 - p3 * q2,
+            p0 * q2 - p1 * q3 + p2 * q0 + p3 * q1,
+            p0 * q3 + p1 * q2 - p2 * q1 + p3 * q0,
+        ],
+        axis=-1,
+    )
+
+
+def st_gyro_mismatch(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> FloatArray:
+    """e_k = 2 vec(q_gyro,k⁻¹ ⊗ q_ST,k) [rad] about body axes, q_gyro integrated from q_ST,0 with the
+    trapezoidal body rate (q̇ = ½ q ⊗ (0, ω)); sign-continuous input quaternions (n, 4), rates (n, 3)."""
+    n = q_BN.shape[0]
+    w_mid = 0.5 * (omega_B[1:] + omega_B[:-1]) * dt
+    ang = np.linalg.norm(w_mid, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ax = np.where(ang[:, None] > 0, w_mid / ang[:, None], 0.0)
+    dq = np.column_stack([np.cos(ang / 2), ax * np.sin(ang / 2)[:, None]])
+    qg = np.empty((n, 4))
+    qg[0] = q_BN[0] / np.linalg.norm(q_BN[0])
+    for k in range(n - 1):
+        qg[k + 1] = _hamilton(qg[k], dq[k])
+    conj = qg * np.array([1.0, -1.0, -1.0, -1.0])
+    d = _hamilton(conj, q_BN / np.linalg.norm(q_BN, axis=1, keepdims=True))
+    d *= np.where(d[:, :1] < 0, -1.0, 1.0)
+    return np.asarray(2.0 * d[:, 1:], dtype=np.float64)
+
+
+def _line(tau: FloatArray, y: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Least-squares line y = a + b τ per column: (a, b, residual σ)."""
+    a_mat = np.column_stack([np.ones_like(tau), tau])
+    coef, *_ = np.linalg.lstsq(a_mat, y, rcond=None)
+    res = y - a_mat @ coef
+    dof = max(tau.size - 2, 1)
+    return coef[0], coef[1], np.sqrt(np.sum(res**2, axis=0) / dof)
+
+
+def _noise_of(y: FloatArray) -> float:
+    """Robust white-noise σ from first differences (MAD / 0.6745 / √2)."""
+    d = np.diff(y[np.isfinite(y)])
+    if d.size < 4:
+        return NAN
+    return float(np.median(np.abs(d - np.median(d))) / 0.6745 / math.sqrt(2.0))
+
+
+def ramp_duration(tau_s: FloatArray, y: FloatArray, sigma: float) -> tuple[float, float, float, float]:
+    """Best duration D [s] of y = c + A clip((τ − τ_s)/D, 0, 1), its Δχ² = 4 interval (lo, hi) and onset τ_s.
+
+    Onsets τ_s on the samples of the middle half of the window, durations 0 (a step) to a third of the
+    window on a log grid; the ramp must end inside the window.
+    """
+    ok = np.isfinite(y)
+    t, v = tau_s[ok], y[ok]
+    if t.size < 20 or not (sigma > 0):
+        return NAN, NAN, NAN, NAN
+    span = float(t[-1] - t[0])
+    durations = np.concatenate([[0.0], np.geomspace(1.0, max(span / 3, 2.0), 20)])
+    onsets = t[(t > t[0] + 0.25 * span) & (t < t[-1] - 0.25 * span)][::2]
+    best = np.full(durations.size, np.inf)
+    where = np.zeros(durations.size)
+    # A linear background (slow residual drift) is projected out of the data and of each ramp.
+    basis, _ = np.linalg.qr(np.column_stack([np.ones_like(t), (t - t.mean()) / max(span, 1.0)]))
+    vc = v - basis @ (basis.T @ v)
+    for j, d in enumerate(durations):
+        x = np.clip((t[None, :] - onsets[:, None]) / d, 0.0, 1.0) if d > 0 else (t[None, :] >= onsets[:, None]) * 1.0
+        xc = x - (x @ basis) @ basis.T
+        sxx = np.sum(xc * xc, axis=1)
+        sxy = xc @ vc
+        with np.errstate(invalid="ignore", divide="ignore"):
+            sse = np.sum(vc * vc) - np.where(sxx > 0, sxy**2 / sxx, 0.0)
+        sse = np.where(onsets + d < t[-1] - 30.0, sse, np.inf)
+        m = int(np.argmin(sse))
+        best[j], where[j] = float(sse[m]), float(onsets[m])
+    k = int(np.argmin(best))
+    inside = np.flatnonzero(best <= best[k] + 4.0 * sigma**2)
+    # The interval reaches to the grid neighbours of the accepted durations (the grid's own resolution).
+    lo, hi = max(int(inside.min()) - 1, 0), min(int(inside.max()) + 1, durations.size - 1)
+    return float(durations[k]), float(durations[lo]), float(durations[hi]), float(where[k])
+
+
+@dataclass(frozen=True)
+class EvidenceWindows:
+    """Windows around the event [s]: before, after, the early response and the lasting step."""
+
+    pre_s: float = 90.0
+    guard_s: float = 5.0
+    consistency_after_s: tuple[float, float] = (15.0, 75.0)
+    response_s: float = 20.0
+    wheel_s: float = 40.0
+    lasting_s: tuple[float, float] = (60.0, 150.0)
+    profile_s: float = 600.0
+    timing_s: float = 0.5
+
+
+def _idx(g: np.ndarray, i0: int, a_s: float, b_s: float, dt: float) -> np.ndarray:
+    lo = max(0, i0 + round(a_s / dt))
+    hi = min(g.size, i0 + round(b_s / dt) + 1)
+    return np.arange(lo, hi)
+
+
+def event_evidence(
+    table: Timetable,
+    cleaned_H_N: FloatArray,
+    spacecraft: Spacecraft,
+    time_ns: int,
+    dH_N_Nms: FloatArray,
+    *,
+    inertia_kgm2: FloatArray | None = None,
+    windows: EvidenceWindows | None = None,
+    raw_H_N: FloatArray | None = None,
+) -> EventEvidence:
+    """The evidence of the event at ``time_ns`` with step ``dH_N_Nms`` (module docstring)."""
+    w = windows or EvidenceWindows()
+    g = table.time_ns
+    if g.size < 10:
+        return EventEvidence()
+    dt = table.dt_s
+    i0 = int(np.clip(np.searchsorted(g, time_ns), 0, g.size - 1))
+    J = np.asarray(inertia_kgm2 if inertia_kgm2 is not None else spacecraft.inertia_kgm2, dtype=np.float64)
+    valid = table.valid
+    q = table.quaternion_BN
+    bn0 = np.asarray(dcm_from_quaternion(q[i0]), dtype=np.float64)
+    dh_n = np.asarray(dH_N_Nms, dtype=np.float64)
+    mag = float(np.linalg.norm(dh_n))
+    dh_b = bn0 @ dh_n
+    u_b = dh_b / mag if mag > 0 else np.zeros(3)
+    out: dict[str, float | int] = {"dH_B_x_Nms": dh_b[0], "dH_B_y_Nms": dh_b[1], "dH_B_z_Nms": dh_b[2]}
+    # Closed-loop response: the body's share, then the wheels'.
+    omega = table.body_rate_rad_s
+    pre = _idx(g, i0, -w.pre_s, -w.guard_s, dt)
+    pre = pre[valid[pre]]
+    resp = _idx(g, i0, -2.0, w.response_s, dt)
+    resp = resp[valid[resp]]
+    peak_rate = NAN
+    if pre.size > 10 and resp.size > 3 and mag > 0:
+        d_om = omega[resp] - np.median(omega[pre], axis=0)
+        proj = (d_om @ J.T) @ u_b
+        proj = np.convolve(proj, np.ones(3) / 3.0, mode="same")
+        out["body_share"] = float(np.max(proj) / mag)
+        out["body_share_sigma"] = _noise_of((omega[pre] @ J.T) @ u_b) / math.sqrt(3.0) / mag
+        # Real motion lasts the loop's settling time; a running median keeps it and drops a sensor spike.
+        peak_rate = float(np.max(np.linalg.norm(median_filter(d_om, size=(5, 1), mode="nearest"), axis=1)))
+    out.update(_wheel_evidence(table, spacecraft, i0, dt, w))
+    out.update(_consistency(table, i0, dt, w, peak_rate))
+    out.update(_gyro_spike(omega, valid, i0, dt))
+    out.update(_profile(g, cleaned_H_N, dh_n, i0, dt, w))
+    out.update(_appendage(table, i0, dt))
+    out.update(surface_evidence(spacecraft, dh_b))
+    if raw_H_N is not None and mag > 0:
+        b = _idx(g, i0, -w.wheel_s, -w.guard_s, dt)
+        a = _idx(g, i0, w.guard_s, w.wheel_s, dt)
+        b, a = b[valid[b]], a[valid[a]]
+        if b.size > 5 and a.size > 5:
+            step = np.median(raw_H_N[a], axis=0) - np.median(raw_H_N[b], axis=0)
+            out["raw_step_fraction"] = float(step @ (dh_n / mag) / mag)
+    typed: dict[str, Any] = {k: (int(v) if k.endswith(("_axis", "_index")) else float(v)) for k, v in out.items()}
+    return EventEvidence(**typed)
+
+
+def _wheel_evidence(table: Timetable, sc: Spacecraft, i0: int, dt: float, w: EvidenceWindows) -> dict[str, float]:
+    g, valid = table.time_ns, table.valid
+    om = table.wheel_speed_rad_s
+    if om.shape[1] == 0:
+        return {}
+    before = _idx(g, i0, -w.wheel_s, -w.guard_s, dt)
+    after = _idx(g, i0, w.guard_s, w.wheel_s, dt)
+    before, after = before[valid[before]], after[valid[after]]
+    if before.size < 5 or after.size < 5:
+        return {}
+    d = np.median(om[after], axis=0) - np.median(om[before], axis=0)
+    js = sc.wheel_spin_inertias_kgm2
+    js_g = sc.wheel_axes * js[None, :]
+    h = js * d
+    sig = np.array([_noise_of(om[before, k]) for k in range(om.shape[1])]) * js * 1.25 * math.sqrt(2.0 / before.size)
+    null = d - np.linalg.pinv(js_g) @ (js_g @ d)
+    # An isolated excursion of one wheel's reading (a tachometer miscount) against a 5-sample median.
+    near = _idx(g, i0, -30.0, 30.0, dt)
+    seg = om[near]
+    z_w = np.abs(seg - median_filter(seg, size=(5, 1), mode="nearest")) / np.maximum(
+        [_noise_of(om[before, k]) for k in range(om.shape[1])], 1e-9
+    )
+    kz = int(np.argmax(np.max(z_w, axis=0)))
+    norm_d = float(np.linalg.norm(d))
+    k = int(np.argmax(np.abs(h)))
+    return {
+        "wheel_change_Nms": float(np.linalg.norm(js_g @ d)),
+        "wheel_change_sigma_Nms": float(np.sqrt(np.sum(sig**2))),
+        "wheel_null_fraction": float(np.linalg.norm(null) / norm_d) if norm_d > 0 else NAN,
+        "wheel_max_share": float(abs(h[k]) / np.sum(np.abs(h))) if np.any(h) else NAN,
+        "wheel_max_index": k,
+        "wheel_spike_z": float(np.max(z_w[:, kz])),
+        "wheel_spike_index": kz,
+    }
+
+
+def _consistency(table: Timetable, i0: int, dt: float, w: EvidenceWindows, peak_rate: float) -> dict[str, float]:
+    """Star tracker against integrated gyro: the jump and the change of slope of e across the event."""
+    g, valid = table.time_ns, table.valid
+    span = _idx(g, i0, -w.pre_s, w.consistency_after_s[1], dt)
+    if span.size < 20 or not valid[span].all():
+        span = span[valid[span]]
+        if span.size < 20 or np.any(np.diff(span) != 1):
+            return {}
+    e = st_gyro_mismatch(table.quaternion_BN[span], table.body_rate_rad_s[span], dt)
+    tau = (g[span] - g[i0]) / NS
+    b = (tau >= -w.pre_s) & (tau <= -w.guard_s)
+    a = (tau >= w.consistency_after_s[0]) & (tau <= w.consistency_after_s[1])
+    if b.sum() < 10 or a.sum() < 10:
+        return {}
+    a0, s0, r0 = _line(tau[b], e[b])
+    a1, s1, r1 = _line(tau[a], e[a])
+    step = a1 - a0
+    slope = s1 - s0
+    sig = np.maximum(r0, r1)
+    n_a, n_b = a.sum(), b.sum()
+    # σ of an intercept at τ = 0 extrapolated from a line fitted over [τ_a, τ_b]: about 2σ/√n · (1 + ...).
+    lever = 1.0 + abs(w.consistency_after_s[0] + w.consistency_after_s[1]) / max(
+        w.consistency_after_s[1] - w.consistency_after_s[0], 1.0
+    )
+    step_sig = sig * lever * 2.0 * math.sqrt(1.0 / n_a + 1.0 / n_b)
+    slope_sig = sig * math.sqrt(12.0 / n_a) / (n_a * dt) + sig * math.sqrt(12.0 / n_b) / (n_b * dt)
+    timing = (peak_rate if math.isfinite(peak_rate) else 0.0) * w.timing_s
+    k = int(np.argmax(np.abs(step) / np.maximum(step_sig, 1e-12)))
+    return {
+        "st_gyro_step_rad": float(np.linalg.norm(step)),
+        "st_gyro_step_limit_rad": float(8.0 * np.linalg.norm(step_sig) + timing),
+        "st_gyro_slope_rad_s": float(np.linalg.norm(slope)),
+        "st_gyro_slope_limit_rad_s": float(8.0 * np.linalg.norm(slope_sig) + timing / w.consistency_after_s[1]),
+        "st_gyro_axis": k,
+    }
+
+
+def _gyro_spike(omega: FloatArray, valid: np.ndarray, i0: int, dt: float) -> dict[str, float]:
+    lo, hi = max(0, i0 - int(60 / dt)), min(omega.shape[0], i0 + int(60 / dt))
+    seg = omega[lo:hi]
+    if hi - lo < 20 or not valid[lo:hi].all():
+        return {}
+    med = median_filter(seg, size=(5, 1), mode="nearest")
+    r = seg - med
+    sig = np.array([_noise_of(seg[:, k]) for k in range(3)])
+    near = slice(max(0, i0 - lo - int(30 / dt)), min(seg.shape[0], i0 - lo + int(30 / dt)))
+    z = np.abs(r[near]) / np.maximum(sig, 1e-12)
+    j, k = np.unravel_index(int(np.argmax(z)), z.shape)
+    big = np.abs(r[near, k]) > 5.0 * sig[k]
+    return {
+        "gyro_spike_rad": float(np.sum(r[near, k][big]) * dt),
+        "gyro_spike_z": float(z[j, k]),
+        "gyro_spike_axis": int(k),
+    }
+
+
+def _profile(
+    g: np.ndarray, hc: FloatArray, dh_n: FloatArray, i0: int, dt: float, w: EvidenceWindows
+) -> dict[str, float]:
+    mag = float(np.linalg.norm(dh_n))
+    if mag <= 0:
+        return {}
+    u = dh_n / mag
+    y = hc @ u
+    out: dict[str, float] = {}
+    span = _idx(g, i0, -w.profile_s, w.profile_s, dt)
+    ys = y[span]
+    sigma = _noise_of(ys)
+    d, lo, hi, onset = ramp_duration((g[span] - g[i0]) / NS, ys, sigma)
+    out.update({"duration_s": d, "duration_lo_s": lo, "duration_hi_s": hi})
+    # The lasting step: before the event (or the fitted onset) against after it (or the fitted ramp's end).
+    start = min(-w.guard_s, onset - w.guard_s) if math.isfinite(onset) else -w.guard_s
+    end = max(w.lasting_s[0], onset + d + 30.0) if math.isfinite(onset) else w.lasting_s[0]
+    length = w.lasting_s[1] - w.lasting_s[0]
+    before = _idx(g, i0, start - length, start, dt)
+    after = _idx(g, i0, end, end + length, dt)
+    yb, ya = y[before], y[after]
+    if np.isfinite(yb).sum() > 10 and np.isfinite(ya).sum() > 10:
+        out["lasting_fraction"] = float((np.nanmedian(ya) - np.nanmedian(yb)) / mag)
+    return out
+
+
+def _appendage(table: Timetable, i0: int, dt: float) -> dict[str, float]:
+    rates = table.appendage_rate_rad_s
+    if rates.ndim != 2 or rates.shape[1] == 0:
+        return {}
+    lo, hi = max(0, i0 - int(120 / dt)), min(rates.shape[0], i0 + int(120 / dt))
+    best: dict[str, float] = {}
+    for k in range(rates.shape[1]):
+        seg = rates[lo:hi, k]
+        if seg.size < 60 or not np.isfinite(seg).all():
+            continue
+        excess = seg - median_filter(seg, size=int(61 / dt) | 1, mode="nearest")
+        sig = _noise_of(seg)
+        near = slice(max(0, i0 - lo - int(15 / dt)), min(seg.size, i0 - lo + int(25 / dt)))
+        z = float(np.max(np.abs(excess[near])) / max(sig, 1e-9))
+        if not best or z > best["appendage_z"]:
+            best = {
+                "appendage_excess_deg": float(math.degrees(abs(np.sum(excess[near]) * dt))),
+                "appendage_z": z,
+                "appendage_index": k,
+            }
+    return best
+
+
+def surface_evidence(sc: Spacecraft, dh_b: FloatArray, direction_sigma_rad: float = 0.1) -> dict[str, float]:
+    """Fraction of surface points r that can give ΔH_B = r × p with an incoming p; least ΔV [m/s]."""
+    if not sc.surfaces:
+        return {}
+    mag = float(np.linalg.norm(dh_b))
+    if mag <= 0:
+        return {}
+    pts, normals = _surface_points(sc)
+    r = np.linalg.norm(pts, axis=1)
+    cos = np.abs(pts @ dh_b) / np.maximum(r * mag, 1e-12)
+    perp = cos <= math.sin(direction_sigma_rad)
+    # p = ΔH × r / |r|² + λ r̂; incoming (p·n < 0) is reachable by λ unless r ⊥ n and ΔH × r·n > 0.
+    p0 = np.cross(dh_b, pts) / np.maximum(r**2, 1e-12)[:, None]
+    rn = np.einsum("ij,ij->i", pts, normals)
+    incoming = (np.abs(rn) > 1e-9) | (np.einsum("ij,ij->i", p0, normals) < 0)
+    m = sc.mass_kg
+    return {
+        "surface_fraction": float(np.mean(perp & incoming)),
+        "min_dv_mps": float(mag / (m * float(r.max()))) if math.isfinite(m) and m > 0 else NAN,
+    }
+
+
+def _surface_points(sc: Spacecraft, per_side: int = 12) -> tuple[FloatArray, FloatArray]:
+    """Sample points [m] and outward normals on the spacecraft's surfaces (boxes: six faces; panels: both sides)."""
+    pts, nrm = [], []
+    u = (np.arange(per_side) + 0.5) / per_side - 0.5
+    uu, vv = np.meshgrid(u, u)
+    for s in sc.surfaces:
+        c = np.asarray(s.center_m, float)
+        size = np.asarray(s.size_m, float)
+        if s.shape == "box":
+            for ax in range(3):
+                o = [i for i in range(3) if i != ax]
+                for sign in (-1.0, 1.0):
+                    p = np.zeros((uu.size, 3))
+                    p[:, ax] = sign * size[ax] / 2
+                    p[:, o[0]] = uu.ravel() * size[o[0]]
+                    p[:, o[1]] = vv.ravel() * size[o[1]]
+                    n = np.zeros(3)
+                    n[ax] = sign
+                    pts.append(p + c)
+                    nrm.append(np.tile(n, (uu.size, 1)))
+        else:
+            n = np.asarray(s.normal if s.normal is not None else [0, 0, 1], float)
+            n = n / np.linalg.norm(n)
+            ua = np.asarray(s.u_axis if s.u_axis is not None else np.cross(n, [1.0, 0, 0]), float)
+            ua = ua / np.linalg.norm(ua)
+            va = np.cross(n, ua)
+            p = c + np.outer(uu.ravel() * size[0], ua) + np.outer(vv.ravel() * size[1], va)
+            for sign in (-1.0, 1.0):
+                pts.append(p)
+                nrm.append(np.tile(sign * n, (uu.size, 1)))
+    return np.vstack(pts), np.vstack(nrm)
