@@ -51,6 +51,7 @@ SIMULATE_COMMANDS = {
     "attitude": "abrupt.cli.attitude:simulate_attitude_cmd",
     "docking": "abrupt.cli.mass:simulate_docking_cmd",
     "orbit": "abrupt.cli.orbit:simulate_orbit_command",
+    "confounders": "abrupt.cli.flight:simulate_confounders_cmd",
     "population": "abrupt.cli.flux:population",
     "tracking": "abrupt.cli.tracking:simulate_tracking_command",
 }
