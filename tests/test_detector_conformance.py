@@ -1,4 +1,4 @@
-"""Every registered detector keeps the contract (issue 8): schema, budget, time invariance, plug-ins.
+"""Every registered detector keeps the contract: schema, budget, time invariance, plug-ins.
 
 Parametrised over :func:`abrupt.detect.base.detector_names` (every built-in detector module is
 imported by ``abrupt.detect.registry``). Each detector runs on the example series of its

@@ -1,4 +1,4 @@
-"""Hostile input (issue 12 item 4): arbitrary bytes and mutated valid files given to the telemetry
+"""Hostile input: arbitrary bytes and mutated valid files given to the telemetry
 (CSV, Parquet), TDM, .aer, ORDEM and spacecraft-TOML readers either parse or raise abrupt's own error
 naming the file, never another exception and never a hang (hypothesis deadline). A few hundred examples
 each by default; many more with ``-m slow``. Inputs that once broke a reader are kept in
