@@ -21,7 +21,6 @@ from pathlib import Path
 from typing import Any, TypeGuard
 
 import click
-from click.utils import make_default_short_help
 
 from abrupt import __version__
 
@@ -231,7 +230,8 @@ class LazyGroup(click.Group):
 
 
 def _short(text: str, limit: int) -> str:
-    return make_default_short_help(text, limit).strip()
+    """The short help click would show for a command documented by ``text`` (its own rule, any version)."""
+    return click.Command("_", help=text).get_short_help_str(limit).strip()
 
 
 @click.group(
