@@ -647,4 +647,17 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results(
+        "bench_tle_vs_maneuver_detect",
+        variant(
+            {
+                "--no-baseline": "no_baseline",
+                "--threshold-follow=none": "one_threshold",
+                "--threshold-follow=follow": "follow",
+                "--along-track-gain=0": "no_phase",
+            }
+        ),
+    ):
+        main()
