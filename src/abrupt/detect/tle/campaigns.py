@@ -18,9 +18,9 @@ steps (whose sides of two or three sets hold the neighbouring burns' levels):
   shortfall ``|Δa|/a − |Δe|`` (the e-vector's own drift across the gap removed, from the sides'
   Theil-Sen slopes) exceeds :data:`MULTI_BURN_Z` times its noise (the satellite's rolling
   set-to-set scales of ``e`` and ``a``). Burns in one gap at nearly the same ``u`` are one step of
-  their summed ΔV and are counted as one: nothing in the mean elements separates them (a prior on
-  burn sizes would; measured and not used, ``docs/tle.md``). The count is never below the number of
-  member maneuvers.
+  their summed ΔV and are counted as one: nothing in the mean elements separates them (a rule on
+  burn sizes, "a gap k times another's single burn holds k", was measured to overcount campaigns of
+  unequal burns, ``docs/tle.md``). The count is never below the number of member maneuvers.
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ from abrupt.detect.tle.steps import StepModel, theil_sen_slope
 # (smaller steps over the noise level are TLE noise, the tail of a set fitted across a burn, or drag)
 CARRYING_FRACTION = 0.1
 # a gap holds two burns when |Δa|/a − |Δe| exceeds this many times its noise (heavy-tailed TLE noise:
-# single burns in the development trials reach 5, two burns in one gap mostly 6-40)
+# single burns in the development trials reach 5.1, two burns in one gap mostly 6.5-650)
 MULTI_BURN_Z = 6.0
 # a detection joins a campaign when its ΔV is at least this fraction of the largest member's
 MEMBER_DV_FRACTION = 0.02
