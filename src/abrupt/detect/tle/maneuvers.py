@@ -268,6 +268,7 @@ def block_scale(
         cfg.threshold_method,
         cfg.threshold_block_days,
         cfg.threshold_reach_days,
+        candidates_above=threshold,
     )
     local = np.maximum(local, cfg.min_statistic)
     if cfg.threshold_follow == "raise":
