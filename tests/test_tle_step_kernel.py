@@ -120,3 +120,19 @@ def test_checksum_equals_definition() -> None:
     for _ in range(3000):
         line = "".join(rnd.choice(alphabet) for _ in range(rnd.randint(0, 75)))
         assert tle_checksum(line) == _checksum_by_definition(line), repr(line)
+
+
+def test_localise_kernel_equals_numpy(histories: list) -> None:
+    rng = np.random.default_rng(2)
+    compared = 0
+    for history in histories:
+        model = StepModel(history, TleDetectorConfig())
+        n_gaps = model.n - 1
+        for g in range(0, n_gaps, 3):
+            lo, hi = (0, model.n) if g % 2 else segment_bounds(g, [max(0, g - 5), min(n_gaps - 1, g + 6)], model.n)
+            weights = tuple(float(x) for x in rng.uniform(0.3, 2.0, 3))
+            weight_u = float(rng.choice([0.0, 0.8]))
+            fast = model.localise(g, lo, hi, weights, weight_u)  # type: ignore[arg-type]
+            assert fast == model.localise_numpy(g, lo, hi, weights, weight_u), g  # type: ignore[arg-type]
+            compared += 1
+    assert compared > 200

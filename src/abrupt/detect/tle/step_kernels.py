@@ -108,3 +108,86 @@ def gap_steps(
             lq = _median(work, k)
             steps[q, s] = lq - lp
     return steps, n1s, n2s
+
+
+@njit(cache=True)
+def _sum_like_numpy(a: NDArray[np.float64], n: int) -> float:  # pragma: no cover - compiled
+    """``np.sum(a[:n])`` in numpy's own order (pairwise summation: eight partial sums from eight
+    values on; exact for the sizes here, n ≤ 128)."""
+    if n < 8:
+        res = 0.0
+        for i in range(n):
+            res += a[i]
+        return res
+    r = np.empty(8)
+    for j in range(8):
+        r[j] = a[j]
+    i = 8
+    while i < n - (n % 8):
+        for j in range(8):
+            r[j] += a[i + j]
+        i += 8
+    res = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
+    while i < n:
+        res += a[i]
+        i += 1
+    return res
+
+
+@njit(cache=True)
+def _theil_sen(
+    t: NDArray[np.float64], y: NDArray[np.float64], a: int, b: int, work: NDArray[np.float64]
+) -> float:  # pragma: no cover - compiled
+    """Median of the pairwise slopes of sets ``a..b-1`` more than 60 s apart; 0 with none."""
+    m = 0
+    for i in range(a, b):
+        for j in range(i + 1, b):
+            dt = t[j] - t[i]
+            if dt > MIN_PAIR_DT_S:
+                work[m] = (y[j] - y[i]) / dt
+                m += 1
+    if m == 0:
+        return 0.0
+    return _median(work, m)
+
+
+@njit(cache=True)
+def localise_costs(
+    t: NDArray[np.float64],
+    stack: NDArray[np.float64],
+    scales: NDArray[np.float64],
+    weights: NDArray[np.float64],
+    g: int,
+    lo: int,
+    hi: int,
+    min_side: int,
+) -> NDArray[np.float64]:  # pragma: no cover - compiled
+    """L1 cost of one level-plus-slope per side for each split c = g-2..g+2 of sets ``lo..hi-1``
+    (inf where a side has fewer than ``min_side`` sets): Σ over series of weight × Σ|r − median r| /
+    scale at c, r the residuals of the side's Theil-Sen line (``StepModel.localise``)."""
+    costs = np.full(5, np.inf)
+    span = hi - lo + 1
+    pairs = np.empty(span * span)
+    r = np.empty(span)
+    dev = np.empty(span)
+    for q in range(5):
+        c = g - 2 + q
+        if c + 1 - lo < min_side or hi - c - 1 < min_side:
+            continue
+        cost = 0.0
+        for s in range(stack.shape[0]):
+            if weights[s] == 0.0:
+                continue
+            y = stack[s]
+            sc = scales[s, c]
+            for a, b in ((lo, c + 1), (c + 1, hi)):
+                slope = _theil_sen(t, y, a, b, pairs)
+                n = b - a
+                for i in range(n):
+                    r[i] = y[a + i] - slope * t[a + i]
+                med = _median(r, n)
+                for i in range(n):
+                    dev[i] = abs(r[i] - med)
+                cost += weights[s] * _sum_like_numpy(dev, n) / sc
+        costs[q] = cost
+    return costs

@@ -25,7 +25,7 @@ from abrupt.detect.tle.elements import (
     stated_decay_m_s,
 )
 from abrupt.detect.tle.noise import chi2_as_normal, drift_noise_rate, robust_group_weight, robust_scale_rolling
-from abrupt.detect.tle.step_kernels import gap_steps
+from abrupt.detect.tle.step_kernels import gap_steps, localise_costs
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
 from abrupt.units import SECONDS_PER_DAY
 
@@ -139,6 +139,7 @@ class StepModel:
         self.n = self.t.size
         self.scales = {k: robust_scale_rolling(self.s[k], cfg.noise_half_window, self.t) for k in self.NAMES}
         self.drift_q = {k: drift_noise_rate(self.t, self.s[k], cfg.noise_half_window) for k in self.NAMES}
+        self._scale_stack: NDArray[np.float64] | None = None  # the scales as rows of NAMES (built when needed)
 
     def gap(self, g: int, lo_bound: int = 0, hi_bound: int | None = None) -> tuple[dict[str, float], float]:
         """Steps of every series at gap g from sets [max(lo_bound, g+1-W), g], [g+1, min(hi_bound, g+1+W)).
@@ -210,7 +211,34 @@ class StepModel:
         The median step test has a plateau: the same step is seen a few gaps either side of the true
         one. The change point is where one level-plus-slope per side fits best (L1 cost of the
         detrended residuals in noise units; Bai 1995 least-absolute-deviation change-point estimate).
+        Compiled (:func:`abrupt.detect.tle.step_kernels.localise_costs`); the same costs as
+        :meth:`localise_numpy`.
         """
+        lo = max(lo_bound, g + 1 - self.cfg.window_sets - 2)
+        hi = min(hi_bound, g + 1 + self.cfg.window_sets + 2)
+        w = np.array([weights[0], weights[1], weights[1], weights[2], weights[2], weight_u], dtype=np.float64)
+        if self._scale_stack is None:
+            self._scale_stack = np.stack([np.asarray(self.scales[k], dtype=np.float64) for k in self.NAMES])
+        costs = localise_costs(
+            np.asarray(self.t, dtype=np.float64),
+            np.asarray(self.stack, dtype=np.float64),
+            self._scale_stack,
+            w,
+            int(g),
+            int(lo),
+            int(hi),
+            int(self.cfg.min_side_sets),
+        )
+        best, best_cost = g, math.inf
+        for q, cost in enumerate(costs.tolist()):
+            if cost < best_cost:
+                best, best_cost = g - 2 + q, cost
+        return best
+
+    def localise_numpy(
+        self, g: int, lo_bound: int, hi_bound: int, weights: tuple[float, float, float], weight_u: float = 0.0
+    ) -> int:
+        """:meth:`localise` in plain numpy (the reference the compiled kernel is checked against)."""
         t = self.t
         lo = max(lo_bound, g + 1 - self.cfg.window_sets - 2)
         hi = min(hi_bound, g + 1 + self.cfg.window_sets + 2)
