@@ -291,16 +291,20 @@ def main() -> None:
     ap.add_argument("--reference-files", type=int, default=4, help="Files (of 25 objects) in the reference.")
     ap.add_argument("--kill", action="store_true")
     ap.add_argument("--no-model", action="store_true", help="Density without NRLMSIS along the orbits.")
+    ap.add_argument("--parts", default="maneuvers,density", help="maneuvers, density (needs maneuvers) or both")
     args = ap.parse_args()
+    parts = set(args.parts.split(","))
     folder = Path(args.folder or Path(tempfile.gettempdir()) / "abrupt-catalogue")
     folder.mkdir(parents=True, exist_ok=True)
     ns = [int(x) for x in args.objects.split(",")]
     dns = [int(x) for x in args.density_objects.split(",")]
     print(f"catalogue scale, {load()}; simulated catalogue cached in {folder}")
     events: dict[int, Path] = {}
-    part("maneuvers", sorted(set(ns) | set(dns)), folder, ["detect", "tle-batch"], 10.0, args.workers, events)
+    needed = set(ns) | (set(dns) if "density" in parts else set())
+    part("maneuvers", sorted(needed), folder, ["detect", "tle-batch"], 10.0, args.workers, events)
     density = ["density", "tle", "--windows-only"] + (["--no-model"] if args.no_model else [])
-    part("density", dns, folder, density, 15.0, args.workers, events)
+    if "density" in parts:
+        part("density", dns, folder, density, 15.0, args.workers, events)
     listing = catalogue(folder, max(ns))
     k = args.reference_files
     kernel_reference(listing, k)
@@ -321,5 +325,5 @@ def main() -> None:
 if __name__ == "__main__":
     from _results import variant, write_results
 
-    with write_results("bench_catalogue_scale", variant({"--no-model": "nomodel"})):
+    with write_results("bench_catalogue_scale", variant({"--no-model": "nomodel", "--parts=maneuvers": "maneuvers"})):
         main()
