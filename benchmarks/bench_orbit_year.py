@@ -126,7 +126,7 @@ def run_arcs(eph: Any, weeks: int, truth: list[pd.Timestamp]) -> None:
     span_weeks = float(eph.seconds[-1] - eph.seconds[0]) / WEEK_S
     per_week = min(c_all, c_wk) / span_weeks
     year_cpu = 52 * per_week
-    scope = "measured over the whole year" if weeks >= 52 else f"PROJECTED from {weeks} week(s)"
+    scope = "measured over the whole year" if span_weeks >= 52 else f"PROJECTED from {7 * span_weeks:.1f} days"
     print(
         f"  a year: 52 × {per_week:.1f} CPU-s = {year_cpu / 60:.1f} CPU-min → {year_cpu / 120:.1f} min on two idle "
         f"cores (weekly arcs on two processes; {scope}; target < {TARGET_MIN:g} min)"
