@@ -139,7 +139,6 @@ class StepModel:
         self.n = self.t.size
         self.scales = {k: robust_scale_rolling(self.s[k], cfg.noise_half_window, self.t) for k in self.NAMES}
         self.drift_q = {k: drift_noise_rate(self.t, self.s[k], cfg.noise_half_window) for k in self.NAMES}
-        self._scale_stack: NDArray[np.float64] | None = None  # the scales as rows of NAMES (built when needed)
 
     def gap(self, g: int, lo_bound: int = 0, hi_bound: int | None = None) -> tuple[dict[str, float], float]:
         """Steps of every series at gap g from sets [max(lo_bound, g+1-W), g], [g+1, min(hi_bound, g+1+W)).
@@ -217,12 +216,11 @@ class StepModel:
         lo = max(lo_bound, g + 1 - self.cfg.window_sets - 2)
         hi = min(hi_bound, g + 1 + self.cfg.window_sets + 2)
         w = np.array([weights[0], weights[1], weights[1], weights[2], weights[2], weight_u], dtype=np.float64)
-        if self._scale_stack is None:
-            self._scale_stack = np.stack([np.asarray(self.scales[k], dtype=np.float64) for k in self.NAMES])
+        scales = np.stack([np.asarray(self.scales[k], dtype=np.float64) for k in self.NAMES])
         costs = localise_costs(
             np.asarray(self.t, dtype=np.float64),
             np.asarray(self.stack, dtype=np.float64),
-            self._scale_stack,
+            scales,
             w,
             int(g),
             int(lo),
