@@ -131,8 +131,8 @@ def prepare(
     curves = exp.drop_duplicates(eff_cols).loc[:, eff_cols].to_numpy(dtype=np.float64)
     eff_u = bin_efficiency(edges, curves)  # (U, K)
     cdf = logistic_efficiency(edges[None, :-1], curves[:, :1], curves[:, 1:2], 1.0)
+    # share of false alarms per bin; those below the lowest edge are left out like their events
     share_u = np.diff(np.concatenate([cdf, np.ones((len(curves), 1))], axis=1), axis=1)
-    share_u = share_u / np.maximum(share_u.sum(axis=1, keepdims=True), 1e-300)
     n_u = len(curves)
     weight = np.bincount(group * n_u + curve_of, weights=f, minlength=len(keys) * n_u).reshape(len(keys), n_u)
     exposure_years = weight @ eff_u / DAYS_PER_YEAR  # (G, K)
