@@ -257,8 +257,9 @@ class Likelihood:
         for _ in range(iterations):  # Newton with backtracking, projected on scales >= 0
             mu = np.maximum(self._mu(s), 1e-300)
             af = self.a[:, :, idx] / mu[:, :, None]
-            grad = (af * self.weights[None, :, None]).sum(axis=1) - self.totals[:, idx]
-            hess = -np.einsum("bei,bej,e->bij", af, af, self.weights) - 1e-12 * np.eye(idx.size)[None]
+            waf = af * self.weights[None, :, None]
+            grad = waf.sum(axis=1) - self.totals[:, idx]
+            hess = -np.einsum("bei,bej->bij", waf, af) - 1e-12 * np.eye(idx.size)[None]
             step = -np.linalg.solve(hess, grad[:, :, None])[:, :, 0]
             cur = s[:, idx].copy()
             if not signed:
