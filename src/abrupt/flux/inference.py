@@ -132,7 +132,7 @@ def prepare(
     eff_u = bin_efficiency(edges, curves)  # (U, K)
     cdf = logistic_efficiency(edges[None, :-1], curves[:, :1], curves[:, 1:2], 1.0)
     # share of false alarms per bin; those below the lowest edge are left out like their events
-    share_u = np.diff(np.concatenate([cdf, np.ones((len(curves), 1))], axis=1), axis=1)
+    share_u = np.diff(np.concatenate([cdf, np.ones((len(curves), 1))], axis=1), axis=1).astype(np.float64)
     n_u = len(curves)
     weight = np.bincount(group * n_u + curve_of, weights=f, minlength=len(keys) * n_u).reshape(len(keys), n_u)
     exposure_years = weight @ eff_u / DAYS_PER_YEAR  # (G, K)
@@ -285,7 +285,7 @@ class Likelihood:
         return s, self.loglike(s)
 
 
-def _refine_max(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, float, int]:
+def refine_max(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, float, int]:
     """Maximum of samples y(x) refined by a parabola through the best point and its neighbours."""
     i = int(np.nanargmax(y))
     if 0 < i < x.size - 1 and np.all(np.isfinite(y[i - 1 : i + 2])):
@@ -341,7 +341,7 @@ def _profile_value(lik: Likelihood, fixed: Mapping[str, float]) -> float:
     _, ll = lik.maximise(fixed)
     if lik.beta_grid.size == 1:
         return float(ll[0])
-    return _refine_max(np.log(lik.beta_grid), ll)[1]
+    return refine_max(np.log(lik.beta_grid), ll)[1]
 
 
 def fit(
@@ -371,7 +371,7 @@ def fit(
     s, ll = lik.maximise(scale_fixed)
     logb = np.log(lik.beta_grid)
     if lik.beta_grid.size > 1:
-        xb, ll_max, _ = _refine_max(logb, ll)
+        xb, ll_max, _ = refine_max(logb, ll)
         beta_hat = math.exp(xb)
         s_hat = np.array([np.interp(xb, logb, s[:, p]) for p in range(s.shape[1])])
     else:
@@ -422,7 +422,7 @@ def _signed_estimates(lik: Likelihood, scale_fixed: Mapping[str, float]) -> dict
     if lik.beta_grid.size == 1:
         return {"debris_scale": float(s[0, 0]), "meteoroid_scale": float(s[0, 1]), "beta": float(lik.beta_grid[0])}
     logb = np.log(lik.beta_grid)
-    xb, _, _ = _refine_max(logb, ll)
+    xb, _, _ = refine_max(logb, ll)
     return {
         "debris_scale": float(np.interp(xb, logb, s[:, 0])),
         "meteoroid_scale": float(np.interp(xb, logb, s[:, 1])),
