@@ -13,6 +13,7 @@ from abrupt.detect.orbit.events import exceedance_episodes
 from abrupt.detect.orbit.pooled import ArcNull, pooled_thresholds
 from abrupt.pipelines.orbit_product import detect_orbit_product
 from abrupt.pipelines.orbit_sequence import _supported
+from abrupt.readers.sp3 import write_sp3
 from abrupt.simulate.orbit import OrbitSimulationConfig, inject_impulse, simulate_orbit
 from abrupt.thresholds import FalseAlarmBudget, Threshold
 
@@ -115,3 +116,61 @@ def test_product_thresholds_come_from_the_other_satellites_and_a_burn_is_found()
     k = int(np.argmin(np.abs(dt)))
     assert abs(dt[k]) <= 120.0
     assert found["dv_mps"].iloc[k] == pytest.approx(0.01, rel=0.2)
+
+
+def _cli():  # type: ignore[no-untyped-def]
+    import abrupt.cli.main  # noqa: F401  (registers the command groups)
+    from abrupt.cli.groups import cli
+
+    return cli
+
+
+def test_cli_all_satellites_refuses_a_single_satellite_option_and_non_sp3_files(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    from click.testing import CliRunner
+
+    from abrupt.readers.navigation_csv import write_navigation_csv
+
+    cfg = OrbitSimulationConfig(altitude_m=1200e3, duration_s=7200.0, rate_hz=1.0 / 60.0, seed=1)
+    eph = simulate_orbit(cfg).ephemeris("L74")
+    sp3, csv = tmp_path / "one.sp3", tmp_path / "one.csv"
+    write_sp3(eph, sp3)
+    write_navigation_csv(eph, csv)
+    runner = CliRunner()
+    res = runner.invoke(
+        _cli(),
+        ["detect", "orbit", str(sp3), "--out", str(tmp_path / "e.csv"), "--all-satellites", "--satellite", "L74"],
+    )
+    assert res.exit_code != 0 and "--all-satellites" in res.output + str(res.exception)
+    res = runner.invoke(_cli(), ["detect", "orbit", str(csv), "--out", str(tmp_path / "e.csv"), "--all-satellites"])
+    assert res.exit_code != 0 and "one.csv" in res.output + str(res.exception)
+
+
+def test_cli_all_satellites_writes_every_satellites_events(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    from click.testing import CliRunner
+
+    ephs = []
+    for k in range(3):
+        cfg = OrbitSimulationConfig(
+            altitude_m=1200e3,
+            raan_deg=50.0 * k,
+            duration_s=86400.0,
+            rate_hz=1.0 / 120.0,
+            sigma_pos_m=0.01,
+            sigma_vel_mps=1e-5,
+            seed=10 + k,
+        )
+        ephs.append(simulate_orbit(cfg).ephemeris(f"L7{k}"))
+    t_burn = np.datetime64("2020-01-01T12:00:20", "ns")
+    ephs[1] = inject_impulse(ephs[1], t_burn, (0.0, 0.01, 0.0))
+    sp3 = tmp_path / "three.sp3"
+    write_sp3(ephs, sp3)
+    out = tmp_path / "e.csv"
+    args = ["detect", "orbit", str(sp3), "--out", str(out), "--all-satellites", "--dynamics", "two-body"]
+    res = CliRunner().invoke(_cli(), [*args, "--false-alarms", "4/day"])
+    assert res.exit_code == 0, res.output
+    assert "pooled-loso" in res.output
+    events = pd.read_csv(out)
+    times = pd.to_datetime(events["time_utc"]).dt.tz_localize(None).to_numpy().astype("datetime64[ns]")
+    dt = np.abs((times - t_burn).astype(np.float64)) * 1e-9
+    k = int(np.argmin(dt))
+    assert dt[k] <= 120.0 and events["dv_mps"].iloc[k] == pytest.approx(0.01, rel=0.2)
