@@ -189,10 +189,10 @@ def main() -> None:
         total.sat_days += days
         total.events += len(run.events)
         total.methods.add(run.summary.get("thresholds", {}).get("glr", {}).get("method", "-"))
-        dv90 = 1e3 * float(run.summary.get("dv90_mps", np.nan))
+        dv90_one = 1e3 * float(run.summary.get("dv90_mps", np.nan))
         print(
             f"{path.name:44s} {cls:8s} {1:5d} {days:8.2f} {len(run.events):6d} {budget.per_day * days:8.2f}  "
-            f"{dv90:.3g}  [ILRS CPF prediction, positions only]"
+            f"{dv90_one:.3g}  [ILRS CPF prediction, positions only]"
         )
     if args.simulated:
         # no long real geodetic arc is in ../shared: the daily-arc products that made the detector fail
@@ -208,10 +208,10 @@ def main() -> None:
             total.events += len(run.events)
             total.methods.add(run.summary.get("thresholds", {}).get("glr", {}).get("method", "-"))
             nuisance = sum(not b["raised"] for b in run.summary.get("product_boundaries", []))
-            dv90 = 1e3 * float(run.summary.get("dv90_mps", np.nan))
+            dv90_one = 1e3 * float(run.summary.get("dv90_mps", np.nan))
             print(
                 f"{name:44s} {'geodetic':8s} {1:5d} {days:8.2f} {len(run.events):6d} "
-                f"{budget.per_day * days:8.2f}  {dv90:.3g}  [{nuisance} day boundaries treated as nuisance]"
+                f"{budget.per_day * days:8.2f}  {dv90_one:.3g}  [{nuisance} day boundaries treated as nuisance]"
             )
     print(f"\nstated rate {budget.per_day:.4g} per satellite-day ({args.budget}); {time.time() - t_start:.0f} s")
     print("sat-days: searched (the event statistic defined); in brackets the files' span")
@@ -227,9 +227,9 @@ def main() -> None:
         ok = lo_e <= tally.events <= hi_e and (tally.events == 0 or rate <= 2 * budget.per_day)
         realised = f"{rate:.3g} [{lo / tally.sat_days:.3g}, {hi / tally.sat_days:.3g}]" if tally.sat_days else "-"
         note = "  (below the interval: conservative)" if tally.events < lo_e else ""
-        days = f"{tally.sat_days:.2f} ({tally.span_days:.2f})"
+        days_txt = f"{tally.sat_days:.2f} ({tally.span_days:.2f})"
         print(
-            f"{cls:9s} {tally.satellites:5d} {days:>16s} {tally.events:6d} {exp:8.2f} "
+            f"{cls:9s} {tally.satellites:5d} {days_txt:>16s} {tally.events:6d} {exp:8.2f} "
             f"{f'[{lo_e:.0f}, {hi_e:.0f}]':>16s} {realised:>26s}  {'PASS' if ok else 'FAIL'}  "
             f"{', '.join(sorted(tally.methods))}{note}"
         )

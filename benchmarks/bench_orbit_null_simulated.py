@@ -116,15 +116,13 @@ def main() -> None:
             budget = FalseAlarmBudget.parse(text)
             own = [self_calibrate(an, budget=budget, names=("glr",)).get("glr") for an in analyses]
             pooled = pooled_thresholds(arcs, budget, merge_s=cfg.merge_s, suppress_s=suppress)
+            h_own = [th.value if th is not None else np.inf for th in own]
+            h_pool = [th.value if th is not None else h for th, h in zip(pooled, h_own, strict=True)]
             n_own = sum(
-                episodes(a.t_s, a.statistic, th.value, cfg.merge_s, suppress)
-                for a, th in zip(arcs, own, strict=True)
-                if th
+                episodes(a.t_s, a.statistic, h, cfg.merge_s, suppress) for a, h in zip(arcs, h_own, strict=True)
             )
             n_pool = sum(
-                episodes(a.t_s, a.statistic, (th or o).value, cfg.merge_s, suppress)  # type: ignore[union-attr]
-                for a, th, o in zip(arcs, pooled, own, strict=True)
-                if th or o
+                episodes(a.t_s, a.statistic, h, cfg.merge_s, suppress) for a, h in zip(arcs, h_pool, strict=True)
             )
             exp = budget.per_day * days
             lo, hi = stats.poisson.ppf(0.025, exp), stats.poisson.ppf(0.975, exp)

@@ -3,6 +3,9 @@ rule that keeps a removal's residual from being reported as a further burn."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
+import click
 import numpy as np
 import pandas as pd
 import pytest
@@ -23,8 +26,8 @@ STEP_S = 60.0
 def _chi2_arcs(scales: list[float], days: float, seed: int) -> list[ArcNull]:
     rng = np.random.default_rng(seed)
     n = round(days * 86400.0 / STEP_S)
-    t = np.arange(n) * STEP_S
-    return [ArcNull(t, c * rng.chisquare(3, n), STEP_S) for c in scales]
+    t = np.arange(n, dtype=np.float64) * STEP_S
+    return [ArcNull(t, np.asarray(c * rng.chisquare(3, n), dtype=np.float64), STEP_S) for c in scales]
 
 
 def test_leave_one_out_level_is_the_analytic_quantile_of_a_chi2_null() -> None:
@@ -76,7 +79,13 @@ def test_too_few_other_satellites_fall_back_to_the_arc() -> None:
 
 def _first_scan(values: np.ndarray, threshold: float) -> DetectionResult:
     t = np.arange(values.size) * 300.0
-    diag = Diagnostics("orbit.glr", t, values, Threshold(threshold, 1e-4, "test", 100), np.datetime64("2020-01-01"))
+    diag = Diagnostics(
+        "orbit.glr",
+        np.asarray(t, dtype=np.float64),
+        values,
+        Threshold(threshold, 1e-4, "test", 100),
+        np.datetime64("2020-01-01"),
+    )
     return DetectionResult.empty(diagnostics=(diag,))
 
 
@@ -118,14 +127,14 @@ def test_product_thresholds_come_from_the_other_satellites_and_a_burn_is_found()
     assert found["dv_mps"].iloc[k] == pytest.approx(0.01, rel=0.2)
 
 
-def _cli():  # type: ignore[no-untyped-def]
+def _cli() -> click.Group:
     import abrupt.cli.main  # noqa: F401  (registers the command groups)
     from abrupt.cli.groups import cli
 
     return cli
 
 
-def test_cli_all_satellites_refuses_a_single_satellite_option_and_non_sp3_files(tmp_path) -> None:  # type: ignore[no-untyped-def]
+def test_cli_all_satellites_refuses_a_single_satellite_option_and_non_sp3_files(tmp_path: Path) -> None:
     from click.testing import CliRunner
 
     from abrupt.readers.navigation_csv import write_navigation_csv
@@ -145,7 +154,7 @@ def test_cli_all_satellites_refuses_a_single_satellite_option_and_non_sp3_files(
     assert res.exit_code != 0 and "one.csv" in res.output + str(res.exception)
 
 
-def test_cli_all_satellites_writes_every_satellites_events(tmp_path) -> None:  # type: ignore[no-untyped-def]
+def test_cli_all_satellites_writes_every_satellites_events(tmp_path: Path) -> None:
     from click.testing import CliRunner
 
     ephs = []

@@ -33,6 +33,7 @@ from abrupt.readers.ephemeris import write_ephemeris
 from abrupt.readers.navigation_csv import write_navigation_csv
 from abrupt.report.orbit import plot_orbit_report
 from abrupt.simulate.orbit import Impulse, OrbitSimulationConfig, simulate_orbit
+from abrupt.thresholds import FalseAlarmBudget
 
 #: the statistics ``--statistic`` accepts (each is the registered detector ``orbit.<statistic>``)
 STATISTIC_CHOICES = tuple(STATISTIC_SUMMARIES)
@@ -357,7 +358,7 @@ def _detect_all_satellites(
     file: str,
     out: str,
     name: str,
-    budget: str,
+    budget: FalseAlarmBudget,
     allow_truncated: bool,
     strict: bool,
     sequences: bool,
