@@ -430,3 +430,52 @@ def test_hostile_sizes_in_a_child_process(name: str, tmp_path: Path) -> None:
     verdicts = json.loads(out.rsplit("PEAK", 1)[0].strip().splitlines()[-1])
     assert all(v[1] not in ("traceback", "silent wrong") for v in verdicts), verdicts
     assert peak < mh.MEMORY_BOUND_BYTES, f"{name}: peak {peak / 2**20:.0f} MiB"
+
+
+def _counter_names(path: Path) -> list[str]:
+    """Counter names a reader module uses: ``.record(NAME, n)``, the archive's ``counts[NAME]``,
+    ``.removed[NAME]``/``.reported[NAME]``, ``.count(..., NAME, reported=...)`` and its label loop, and
+    module constants named ``SP3_*``/``TLE_*``/``ARCHIVE_*``. An f-string gives its literal parts."""
+    import ast
+
+    tree = ast.parse(path.read_text())
+    consts = {
+        t.id: n.value.value
+        for n in tree.body
+        if isinstance(n, ast.Assign) and isinstance(n.value, ast.Constant) and isinstance(n.value.value, str)
+        for t in n.targets
+        if isinstance(t, ast.Name)
+    }
+    found: list[ast.expr] = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute):
+            if node.func.attr == "record" and node.args:
+                found.append(node.args[0])
+            elif node.func.attr == "count" and len(node.args) >= 4:
+                found.append(node.args[3])
+        elif isinstance(node, ast.Subscript) and isinstance(node.ctx, ast.Load | ast.Store):
+            target = node.value
+            name = target.attr if isinstance(target, ast.Attribute) else getattr(target, "id", "")
+            if name in ("counts", "removed", "reported"):
+                found.append(node.slice)
+        elif isinstance(node, ast.For) and isinstance(node.iter, ast.Tuple):
+            found += [e.elts[0] for e in node.iter.elts if isinstance(e, ast.Tuple) and e.elts]
+    names = [v for k, v in consts.items() if k.startswith(("SP3_", "TLE_", "ARCHIVE_"))]
+    for expr in found:
+        if isinstance(expr, ast.Constant) and isinstance(expr.value, str):
+            names.append(expr.value)
+        elif isinstance(expr, ast.Name) and expr.id in consts:
+            names.append(consts[expr.id])
+        elif isinstance(expr, ast.JoinedStr):
+            names += [v.value for v in expr.values if isinstance(v, ast.Constant) and v.value.strip(" ()")]
+    return names
+
+
+def test_every_repair_counter_is_in_the_formats_page() -> None:
+    doc = (PROJECT / "docs" / "formats.md").read_text().replace("\\|", "|")
+    names = {
+        (p.name, n) for p in sorted((PROJECT / "src" / "abrupt" / "readers").glob("*.py")) for n in _counter_names(p)
+    }
+    assert len(names) >= 60  # the extraction finds the counters (there are more than 60)
+    missing = sorted(f"{module}: {name!r}" for module, name in names if name.strip() not in doc)
+    assert not missing, "counters missing from docs/formats.md:\n" + "\n".join(missing)
