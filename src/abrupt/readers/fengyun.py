@@ -108,7 +108,7 @@ def read_fengyun_maneuvers(path: str | Path, *, repairs: RepairLog | None = None
         )
     repairs.record("duplicate maneuver lines dropped", duplicates)
     if not rows:
-        raise InputError("no station-keeping window (an empty or cut file?)", file=file, line=1)
+        raise InputError("no maneuvers (no station-keeping window: an empty or cut file?)", file=file, line=1)
     frame = pd.DataFrame(rows, columns=list(MANEUVER_COLUMNS))
     for col in ("time_utc", "window_start_utc", "window_end_utc"):
         frame[col] = frame[col].astype("datetime64[ns]")

@@ -176,7 +176,7 @@ def read_ids_maneuvers(path: str | Path, *, repairs: RepairLog | None = None) ->
         )
     repairs.record("duplicate maneuver lines dropped", duplicates)
     if not rows:
-        raise InputError("no maneuver line (an empty or cut file?)", file=file, line=1)
+        raise InputError("no maneuvers (no maneuver line: an empty or cut file?)", file=file, line=1)
     frame = pd.DataFrame(rows, columns=list(MANEUVER_COLUMNS))
     with warnings.catch_warnings():
         # ERFA calls years past its leap-second table "dubious"; TAI−UTC is then held at the last value
