@@ -43,7 +43,12 @@ from abrupt.events import config_hash, new_run_id
 from abrupt.model.flight_config import FlightConfig
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.pipelines.flight_attribution import attribute_events
-from abrupt.pipelines.flight_checks import check_tachometer_units, check_wheel_units, flight_channels
+from abrupt.pipelines.flight_checks import (
+    check_channel_units,
+    check_tachometer_units,
+    check_wheel_units,
+    flight_channels,
+)
 from abrupt.readers.archive import pseudonymise_text, read_archive, read_decoder
 from abrupt.scale import Executor, TaskResult, run_tasks
 from abrupt.series.timetable import NS, Timetable, build_timetable
@@ -389,6 +394,7 @@ def process_span(
     table = build_timetable(samples, flight, tuple(a.name for a in spacecraft.appendages), lo, hi)
     g = table.time_ns
     dt = table.dt_s if len(table) > 1 else 1.0 / flight.grid_hz
+    check_channel_units(spacecraft, samples)
     check_wheel_units(spacecraft, table)
     check_tachometer_units(spacecraft, samples)
     h_n, _ = timetable_momentum(spacecraft, table, inertia_kgm2)
