@@ -79,3 +79,32 @@ def test_an_array_angle_in_degrees_declared_rad_is_refused_naming_the_array(stor
     sc = load_spacecraft(bad)
     with pytest.raises(ConfigError, match=r"flight\.channels\[11\]\.unit.*angle channel SC-A\.ch12"):
         process_chunk(TelemetryStore(store), sc, T0, T0 + HOURS * 3600 * NS, FlightRunConfig())
+
+
+def test_values_beyond_the_spacecraft_files_bounds_are_removed_and_counted_at_ingest(
+    shared_data: Path, tmp_path: Path
+) -> None:
+    """A wheel at 10⁶ rpm (under the ingest's own 1e20 limit) and a gyro at 500 deg/s are no
+    measurements of this spacecraft (wheels ≤ 1.5 × 6000 rpm, rates ≤ 2 rad/s): removed and counted when
+    the spacecraft file is given; every other sample is stored as without it."""
+    src = shared_data / "flight-like" / "telemetry" / "KESTREL2_2026-03-10.csv.gz"
+    if not src.exists():
+        pytest.skip(f"{src} not found")
+    with gzip.open(src, "rt") as f:
+        lines = [next(f) for _ in range(4000)]
+    wheel = next(i for i, line in enumerate(lines) if ".RW2_SPD," in line)
+    gyro = next(i for i, line in enumerate(lines) if ".GYRO_Y," in line and i > 2000)
+    lines[wheel] = lines[wheel].rsplit(",", 1)[0] + ",1000000.0\n"
+    lines[gyro] = lines[gyro].rsplit(",", 1)[0] + ",-500.0\n"
+    archive = tmp_path / "KESTREL2_2026-03-10.csv"
+    archive.write_text("".join(lines))
+    decoder = shared_data / "flight-like" / "decoder.csv"
+    plain = ingest_archives([archive], decoder, tmp_path / "plain")
+    checked = ingest_archives([archive], decoder, tmp_path / "checked", spacecraft=load_spacecraft(KESTREL))
+    (day,) = checked.days
+    assert day["removed"]["values beyond the spacecraft file's physical bounds"] == 2
+    assert checked.rows_added == plain.rows_added - 2
+    kept = TelemetryStore(tmp_path / "checked").read_range(
+        "SC-A", np.datetime64("2026-03-10"), np.datetime64("2026-03-11")
+    )
+    assert kept["value"].abs().max() < 6000.0  # rpm: the wheels' real speeds are all kept

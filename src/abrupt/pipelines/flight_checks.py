@@ -18,6 +18,7 @@ import pandas as pd
 from abrupt.errors import ConfigError
 from abrupt.model.flight_config import RATE_UNITS, WHEEL_UNITS, FlightConfig
 from abrupt.model.spacecraft import Spacecraft
+from abrupt.readers.telemetry import MAX_BODY_RATE_RAD_S, WHEEL_OVERSPEED_FACTOR
 from abrupt.series.timetable import Timetable, by_mnemonic, continuous_quaternion
 from abrupt.series.timetable_momentum import wheel_scale_from_conservation
 
@@ -179,3 +180,35 @@ def check_channel_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> None:
     """The gyro and angle checks above, in that order (the wheel checks need the timetable)."""
     check_gyro_units(spacecraft, samples)
     check_angle_units(spacecraft, samples)
+
+
+BOUNDS_REMOVED = "values beyond the spacecraft file's physical bounds"
+QUATERNION_COMPONENT_BOUND = 1.1  # a unit quaternion's component, with the reader's 10 % norm tolerance
+
+
+def physical_bounds(spacecraft: Spacecraft) -> dict[str, float]:
+    """The largest magnitude each ``[flight]`` channel can take, in its telemetered unit: a quaternion
+    component 1.1; a body rate :data:`MAX_BODY_RATE_RAD_S`; a wheel speed 1.5 × its wheel's
+    ``max_speed_rad_s``. Channels without a physical bound (angles, flags, housekeeping) are absent."""
+    if spacecraft.flight is None:
+        return {}
+    bounds: dict[str, float] = {}
+    for c in spacecraft.flight.channels:
+        if c.quantity == "quaternion":
+            bounds[c.mnemonic] = QUATERNION_COMPONENT_BOUND
+        elif c.quantity == "body_rate" and c.unit in RATE_UNITS:
+            bounds[c.mnemonic] = MAX_BODY_RATE_RAD_S / RATE_UNITS[c.unit]
+        elif c.quantity == "wheel_speed" and 0 <= c.component < len(spacecraft.wheels):
+            to_si = c.to_si
+            if math.isfinite(to_si) and to_si > 0:
+                limit = WHEEL_OVERSPEED_FACTOR * spacecraft.wheels[c.component].max_speed_rad_s
+                bounds[c.mnemonic] = limit / to_si
+    return bounds
+
+
+def beyond_bounds(samples: pd.DataFrame, bounds: dict[str, float]) -> np.ndarray:
+    """Rows of ``samples`` (mnemonic, value) whose magnitude exceeds their channel's bound."""
+    if not bounds or not len(samples):
+        return np.zeros(len(samples), bool)
+    limit = samples["mnemonic"].astype(str).map(bounds).to_numpy(np.float64, na_value=np.inf)
+    return np.asarray(np.abs(samples["value"].to_numpy(np.float64)) > limit)
