@@ -429,6 +429,7 @@ def test_hostile_sizes_in_a_child_process(name: str, tmp_path: Path) -> None:
     peak = int(out.rsplit("PEAK", 1)[1].split()[0])
     verdicts = json.loads(out.rsplit("PEAK", 1)[0].strip().splitlines()[-1])
     assert all(v[1] not in ("traceback", "silent wrong") for v in verdicts), verdicts
+    print(f"{name}: child peak resident memory {peak / 2**20:.0f} MiB; {verdicts}")
     assert peak < mh.MEMORY_BOUND_BYTES, f"{name}: peak {peak / 2**20:.0f} MiB"
 
 
