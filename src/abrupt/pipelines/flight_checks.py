@@ -21,6 +21,7 @@ from abrupt.model.spacecraft import Spacecraft
 from abrupt.readers.telemetry import MAX_BODY_RATE_RAD_S, WHEEL_OVERSPEED_FACTOR
 from abrupt.series.timetable import Timetable, by_mnemonic, continuous_quaternion
 from abrupt.series.timetable_momentum import wheel_scale_from_conservation
+from abrupt.thresholds.noise import robust_noise_sigma
 
 
 def flight_channels(spacecraft: Spacecraft) -> FlightConfig:
@@ -129,7 +130,7 @@ def check_gyro_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> None:
     t_q, w_q = _quaternion_rate(spacecraft, series)
     if t_q.size < 20:
         return
-    scatter = 1.4826 * float(np.median(np.abs(np.diff(w_q) - np.median(np.diff(w_q))))) / math.sqrt(2.0)
+    scatter = float(np.ravel(robust_noise_sigma(w_q))[0])
     signal = float(np.median(w_q))
     if not signal > GYRO_MIN_SIGNAL_TO_NOISE * scatter:
         return
