@@ -114,7 +114,7 @@ def test_cli_simulate_detect_report_and_catalog(tmp_path: Path) -> None:
     ev = pd.read_csv(tmp_path / "ev.csv")
     assert len(ev) == 1 and list(ev.columns[: len(EVENT_COLUMNS)]) == list(EVENT_COLUMNS)
     assert "<img" in (tmp_path / "r.html").read_text()
-    r = runner.invoke(cli, args)  # same input and configuration again
+    r = runner.invoke(cli, [*args, "--overwrite"])  # same input and configuration again (ev.csv exists)
     assert r.exit_code == 0 and "0 new" in r.output
     assert len(Catalog(tmp_path / "cat.sqlite").events()) == 1
     assert len(Catalog(tmp_path / "cat.sqlite").runs()) == 2

@@ -164,7 +164,7 @@ def test_null_samples_minimum_works_and_repairs_print_once(
     repaired = [line for line in err.splitlines() if "repaired" in line]
     assert len(repaired) == 1, err
     assert "[1]" not in err  # stages are a progress bar with a total, not numbered prints
-    code, _, err = _run(["--quiet", *argv], capsys)
+    code, _, err = _run(["--quiet", *argv, "--overwrite"], capsys)  # the first run wrote e.csv
     assert code == 0 and "repaired" not in err and "event(s) found" not in err
 
 

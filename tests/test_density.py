@@ -301,6 +301,9 @@ def test_cli_density_tle_and_meteors(tmp_path: Path) -> None:
     from abrupt.density.meteors import simulate_head_echoes
 
     path = _synthetic_tle(tmp_path, 2e-14, days=6.0)
+    lines = path.read_text().splitlines()
+    k = next(i for i, line in enumerate(lines) if line.startswith("1 "))
+    path.write_text("\n".join([*lines, *lines[k : k + 2]]) + "\n")  # one element set repeated at the end
     out = tmp_path / "w.csv"
     runner = CliRunner()
     res = runner.invoke(
@@ -308,6 +311,7 @@ def test_cli_density_tle_and_meteors(tmp_path: Path) -> None:
         ["density", "tle", str(path), "--out", str(out), "--interval-days", "2", "--no-model", "--maneuvers", "none"],
     )
     assert res.exit_code == 0, res.output
+    assert "duplicate element sets dropped: 1" in res.output  # the reader's repair is printed
     frame = pd.read_csv(out)
     assert {"rho_b_per_m", "rho_b_sigma_per_m", "model_density_kg_m3"} <= set(frame.columns)
     pop = simulate_head_echoes(80, seed=1, deceleration_noise=0.0, velocity_noise=0.0, velocity_floor_mps=0.0)

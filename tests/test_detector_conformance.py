@@ -198,5 +198,5 @@ def test_a_detector_defined_in_a_test_appears_in_the_command_line(tmp_path: Any)
     events = read_events(str(out))
     assert list(events["detector"]) == ["testonly.momentum_jump"]
     assert events["false_alarms_per_day"].iloc[0] == pytest.approx(2.0 / 7.0)
-    bad = runner.invoke(cli, [*args[:6], "no_such_detector", *args[7:]])
+    bad = runner.invoke(cli, [*args[:6], "no_such_detector", *args[7:], "--overwrite"])  # events.csv exists
     assert bad.exit_code != 0 and "testonly.momentum_jump" in bad.output

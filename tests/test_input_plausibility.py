@@ -288,3 +288,33 @@ def test_sp3_line_mutations_are_refused_or_leave_every_kept_state_true(
     assert np.all(truth.times_utc[np.minimum(at, truth.times_utc.size - 1)] == eph.times_utc)
     np.testing.assert_array_equal(eph.position_m, truth.position_m[at])
     np.testing.assert_array_equal(eph.velocity_mps, truth.velocity_mps[at])
+
+
+def _head_sp3(shared_data: Path, tmp_path: Path, n_epochs: int) -> Path:
+    lines = (shared_data / JASON1_SP3).read_text(encoding="ascii").splitlines()
+    starts = [i for i, line in enumerate(lines) if line.startswith("*")]
+    out = [*lines[: starts[n_epochs]], "EOF"]
+    out[0] = out[0][:32] + f"{n_epochs:7d}" + out[0][39:]
+    return _write(tmp_path, out, f"head{n_epochs}.sp3")
+
+
+def test_an_arc_shorter_than_the_filters_settling_is_refused(shared_data: Path, tmp_path: Path) -> None:
+    """6 hours of 60 s data with auto tuning: the filters settle for 20 τ at each end, so no epoch would
+    be tested (the run was quiet and printed a NaN post-fit RMS); an error names the file and the spans."""
+    from abrupt.pipelines.orbit import detect_orbit
+
+    path = _head_sp3(shared_data, tmp_path, 360)
+    with pytest.raises(InputError, match=r"head360\.sp3: the arc spans 5\.98 h but the filter .* to settle"):
+        detect_orbit(path)
+
+
+def test_the_thesis_tuning_on_a_real_arc_is_refused_naming_the_file(shared_data: Path, tmp_path: Path) -> None:
+    """The thesis filter (τ = 1 s, two-body) on two hours of real 60 s positions. Its DMC decay was
+    integrated in 10 s steps, ten times τ, where RK4 is unstable: a singular matrix after 4 epochs with no
+    file named. Sub-stepped to τ, it runs, but two-body dynamics with the thesis' small process noise do
+    not follow a real orbit (post-fit RMS km against σ_pos 10 m): refused, naming the file and the
+    remedy, since its statistics would be meaningless."""
+    from abrupt.pipelines.orbit import detect_orbit
+
+    with pytest.raises(InputError, match=r"head120\.sp3: the orbit filter does not follow .*\(thesis tuning"):
+        detect_orbit(_head_sp3(shared_data, tmp_path, 120), detector="orbit.mcr_w", tuning="thesis")

@@ -118,7 +118,11 @@ def test_detect_laser_reads_crd_sinex_and_oem_and_stays_quiet(files: dict[str, P
     """Quiet on a maneuver-free day; the SRP scale absorbs the truth's 20 % more radiation pressure; the
     station time biases (there are none in the truth) come out near zero."""
     out = tmp_path / "events.csv"
-    args = ["detect", "laser", str(files["crd"]), "--sinex", str(files["snx"]), "--apriori", str(files["oem"])]
+    lines = files["crd"].read_text().splitlines()
+    k = next(i for i, line in enumerate(lines) if line.startswith("11 "))
+    crd = tmp_path / "duplicated.npt"  # one normal point repeated: dropped, counted and printed
+    crd.write_text("\n".join([*lines[: k + 1], lines[k], *lines[k + 1 :]]) + "\n")
+    args = ["detect", "laser", str(crd), "--sinex", str(files["snx"]), "--apriori", str(files["oem"])]
     args += ["--out", str(out), "--catalog", str(tmp_path / "c.sqlite"), "--fit-out", str(tmp_path / "fit.json")]
     args += ["--time-biases"]
     result = CliRunner().invoke(cli, args, catch_exceptions=False)
@@ -126,7 +130,9 @@ def test_detect_laser_reads_crd_sinex_and_oem_and_stays_quiet(files: dict[str, P
     events = pd.read_csv(out)
     assert len(events) == 0
     assert "post-fit range RMS per station" in result.output
+    assert "repaired: identical duplicated ranges dropped (1)" in result.output
     fit = pd.read_json(tmp_path / "fit.json", typ="series")
+    assert fit["repairs"]["identical duplicated ranges dropped"] == 1
     assert max(fit["residual_rms_mm"].values()) < 3 * 3.0  # mm, against 3 mm normal points
     assert not math.isnan(float(next(iter(fit["range_bias_mm"].values()))))
     assert fit["scale_factors"]["srp_scale"] == pytest.approx(1.2, abs=0.1)

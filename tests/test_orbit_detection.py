@@ -238,7 +238,7 @@ def test_cli_allow_truncated_reads_a_truncated_sp3_and_counts_the_missing_epochs
     src = shared_data / "sp3" / "ssas3a20.b18358.e19003.DG_.sp3"
     lines = src.read_text().splitlines(keepends=True)
     starts = [i for i, line in enumerate(lines) if line.startswith("*")]
-    kept = 360
+    kept = 420  # 7 h: more than twice the filter's settling time (3.3 h), so that epochs are tested
     short = tmp_path / "short.sp3"
     short.write_text("".join(lines[: starts[kept]]))
     announced = int(lines[0][32:39])

@@ -76,3 +76,17 @@ def test_write_events_replaces_a_link_and_leaves_no_temporary_file(tmp_path: Pat
     assert sorted(p.name for p in tmp_path.iterdir()) == ["events.csv", "precious.csv"]
     with pytest.raises(ValueError):
         write_events(pd.DataFrame(), str(tmp_path / "x.txt"))
+
+
+def test_an_existing_out_is_replaced_only_with_overwrite(
+    shared_data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    tle = _tle(shared_data, tmp_path)
+    out = tmp_path / "events_out.csv"
+    out.write_text("an earlier result\n")
+    code, err = _run(["detect", "tle", str(tle), "--out", str(out)], capsys)
+    assert code == 2 and "exists" in err and "--overwrite" in err
+    assert out.read_text() == "an earlier result\n"
+    catalog = tmp_path / "catalog.sqlite"
+    main(["detect", "tle", str(tle), "--out", str(out), "--overwrite", "--catalog", str(catalog)])
+    assert len(read_events(out)) >= 1  # the run's events replaced the earlier file

@@ -117,7 +117,8 @@ def _is_command_decorator(node: ast.expr) -> TypeGuard[ast.Call]:
 # ------------------------------------------------------------------ outputs never destroy inputs
 # Every parameter named ``out`` or ``out_*`` (``--out``) is an output. It is refused when it resolves to
 # the same file as any other parameter naming an existing file (an input) or the SQLite catalog
-# (``--catalog``, existing or not), and when it is a symbolic link (not followed: give the real path).
+# (``--catalog``, existing or not), when it is a symbolic link (not followed: give the real path), and when
+# it is an existing file unless ``--overwrite`` (added to every command with an output) is given.
 # Kept here, not in a module of its own, so that ``abrupt --help`` imports no other CLI module.
 
 
@@ -140,8 +141,9 @@ def _same(a: str, b: str) -> bool:
         return False
 
 
-def check_output_paths(params: Mapping[str, Any]) -> None:
-    """Raise :class:`click.BadParameter` when an output would overwrite an input or follow a link."""
+def check_output_paths(params: Mapping[str, Any], *, overwrite: bool = True) -> None:
+    """Raise :class:`click.BadParameter` when an output would overwrite an input or follow a link, or (unless
+    ``overwrite``) when it is an existing file."""
     outputs = [(name, path) for name, value in params.items() if _is_output(name) for path in _paths(value)]
     if not outputs:
         return
@@ -164,6 +166,8 @@ def check_output_paths(params: Mapping[str, Any]) -> None:
                 raise click.BadParameter(
                     f"{out} is the same file as {what} {path}: writing it would destroy that input", param_hint=hint
                 )
+        if not overwrite and os.path.isfile(out):
+            raise click.BadParameter(f"{out} exists; give --overwrite to replace it", param_hint=hint)
 
 
 def guard_outputs(command: click.Command) -> click.Command:
@@ -175,10 +179,14 @@ def guard_outputs(command: click.Command) -> click.Command:
     callback: Callable[..., Any] | None = command.callback
     if callback is None or getattr(callback, "_outputs_guarded", False):
         return command
+    has_output = any(p.name and _is_output(p.name) for p in command.params)
+    if has_output and not any(p.name == "overwrite" for p in command.params):
+        command.params.append(click.Option(["--overwrite"], is_flag=True, help="Replace an existing output file."))
 
     @functools.wraps(callback)
     def guarded(*args: Any, **kwargs: Any) -> Any:
-        check_output_paths(kwargs)
+        overwrite = bool(kwargs.pop("overwrite", False)) if has_output else True
+        check_output_paths(kwargs, overwrite=overwrite)
         return callback(*args, **kwargs)
 
     guarded._outputs_guarded = True  # type: ignore[attr-defined]

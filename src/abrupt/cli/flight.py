@@ -54,16 +54,37 @@ def _progress(total: int, label: str) -> Any:
 @click.option("--store", "store_dir", required=True, type=click.Path(file_okay=False), help="Parquet store directory.")
 @click.option("--layout", type=click.Choice(["auto", "long", "wide"]), default="auto", show_default=True)
 @click.option("--assume-utc", is_flag=True, help="Read times without a zone as UTC (counted in the report).")
-def ingest_cmd(archives: tuple[str, ...], decoder_path: str, store_dir: str, layout: str, assume_utc: bool) -> None:
+@click.option(
+    "--spacecraft",
+    "spacecraft_path",
+    default=None,
+    type=click.Path(exists=True, dir_okay=False),
+    help="Spacecraft file: values beyond the physical bounds of its [flight] channels are removed and counted.",
+)
+def ingest_cmd(
+    archives: tuple[str, ...],
+    decoder_path: str,
+    store_dir: str,
+    layout: str,
+    assume_utc: bool,
+    spacecraft_path: str | None,
+) -> None:
     """Ingest archive dumps (long or wide; CSV, CSV.gz, Parquet) into a pseudonymised store, one report per day."""
     decoder = read_decoder(decoder_path)
+    spacecraft = load_spacecraft(spacecraft_path) if spacecraft_path else None
     for archive in archives:  # click's own message would print the real name
         if not Path(archive).is_file() or not os.access(archive, os.R_OK):
             why = "is not a readable file" if Path(archive).exists() else "does not exist"
             raise InputError(f"archive {why}", file=pseudonymise_text(archive, decoder))
     bar = _progress(len(archives), "ingest")
     summary = ingest_archives(
-        archives, decoder_path, store_dir, layout=layout, assume_utc=assume_utc, progress=lambda s: bar.update(1)
+        archives,
+        decoder_path,
+        store_dir,
+        layout=layout,
+        assume_utc=assume_utc,
+        progress=lambda s: bar.update(1),
+        spacecraft=spacecraft,
     )
     bar.close()
     for d in summary.days:

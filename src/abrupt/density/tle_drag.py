@@ -336,6 +336,7 @@ def rho_b_from_history(
     cfg = config or TleDragConfig()
     label = name or (history.name or f"NORAD-{history.norad_id}")
     repairs = RepairLog(source=history.source)
+    repairs.counts.update(history.repairs.counts)  # the reader's repairs, printed with the windows'
     if len(history) < cfg.min_sets:
         return RhoBResult(_empty_windows(), float("nan"), repairs)
     sw = space_weather

@@ -236,6 +236,17 @@ def _inertia(value: Any, where: str, file: str) -> NDArray[np.float64]:
     return j
 
 
+MAX_WHEEL_SPEED_RAD_S = 2000.0  # about 19 000 rpm; reaction and momentum wheels run below 10 000 rpm
+
+
+def _bounded_positive(value: Any, limit: float, where: str, file: str) -> float:
+    """A positive number not above ``limit`` (a unit slip such as rpm written as rad/s goes beyond it)."""
+    number = _positive(value, where, file)
+    if number > limit:
+        raise ConfigError(f"{number:g} is above {limit:g}: check the unit", file=file, key=where)
+    return number
+
+
 def _positive(value: Any, where: str, file: str) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0 or not math.isfinite(value):
         raise ConfigError(f"expected a positive number, got {value!r}", file=file, key=where)
@@ -296,7 +307,9 @@ def _wheels(data: dict[str, Any], file: str) -> tuple[Wheel, ...]:
                     _require(w, "spin_inertia_kgm2", where, file), f"{where}.spin_inertia_kgm2", file
                 ),
                 max_torque_Nm=_positive(_require(w, "max_torque_Nm", where, file), f"{where}.max_torque_Nm", file),
-                max_speed_rad_s=_positive(w.get("max_speed_rad_s", 630.0), f"{where}.max_speed_rad_s", file),
+                max_speed_rad_s=_bounded_positive(
+                    w.get("max_speed_rad_s", 630.0), MAX_WHEEL_SPEED_RAD_S, f"{where}.max_speed_rad_s", file
+                ),
             )
         )
     if wheels:

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections import Counter
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
@@ -43,8 +44,16 @@ from abrupt.events import config_hash, new_run_id
 from abrupt.model.flight_config import FlightConfig
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.pipelines.flight_attribution import attribute_events
-from abrupt.pipelines.flight_checks import check_tachometer_units, check_wheel_units, flight_channels
-from abrupt.readers.archive import pseudonymise_text, read_archive, read_decoder
+from abrupt.pipelines.flight_checks import (
+    BOUNDS_REMOVED,
+    beyond_bounds,
+    check_channel_units,
+    check_tachometer_units,
+    check_wheel_units,
+    flight_channels,
+    physical_bounds,
+)
+from abrupt.readers.archive import ArchiveChunk, pseudonymise_text, read_archive, read_decoder
 from abrupt.scale import Executor, TaskResult, run_tasks
 from abrupt.series.timetable import NS, Timetable, build_timetable
 from abrupt.series.timetable_momentum import timetable_momentum
@@ -78,9 +87,15 @@ def ingest_archives(
     layout: str = "auto",
     assume_utc: bool = False,
     progress: Callable[[str], None] | None = None,
+    spacecraft: Spacecraft | None = None,
 ) -> IngestSummary:
-    """Read archive files, pseudonymise, remove artifacts and write the store (one report per day)."""
+    """Read archive files, pseudonymise, remove artifacts and write the store (one report per day).
+
+    With ``spacecraft`` (its ``[flight]`` channels), values beyond the physical bounds its file implies
+    (:func:`~abrupt.pipelines.flight_checks.physical_bounds`) are removed and counted per day.
+    """
     decoder = read_decoder(decoder_path)
+    bounds = physical_bounds(spacecraft) if spacecraft is not None else {}
     store = TelemetryStore(store_root)
     summary = IngestSummary()
     for i, path in enumerate(paths):
@@ -89,7 +104,7 @@ def ingest_archives(
             progress(f"ingest {i + 1}/{len(paths)}: {safe}")
         chunk = read_archive(path, decoder, layout=layout, assume_utc=assume_utc)
         summary.files[safe] = dict(chunk.file_counts)
-        samples = chunk.samples
+        samples = _within_bounds(chunk, bounds)
         day_idx = pd.DatetimeIndex(samples["time"]).asi8 // DAY_NS
         sc_cat = samples["spacecraft"].astype("category")
         sc_codes = sc_cat.cat.codes.to_numpy()
@@ -103,6 +118,21 @@ def ingest_archives(
             summary.rows_added += store.write_day(sc, day, samples.loc[sel], report.as_dict())
             summary.days.append(store.report(sc, day))
     return summary
+
+
+def _within_bounds(chunk: ArchiveChunk, bounds: dict[str, float]) -> pd.DataFrame:
+    """The chunk's samples without those beyond ``bounds``, each removed one counted in its day's report."""
+    samples = chunk.samples
+    out = beyond_bounds(samples, bounds)
+    if not out.any():
+        return samples
+    days = pd.DatetimeIndex(samples["time"][out]).strftime("%Y-%m-%d")
+    counts = Counter(zip(samples["spacecraft"][out].astype(str), days, strict=True))
+    for key, n in counts.items():
+        if key in chunk.per_day:
+            chunk.per_day[key].removed[BOUNDS_REMOVED] += n
+            chunk.per_day[key].rows_kept -= n
+    return samples.loc[~out].reset_index(drop=True)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -389,6 +419,7 @@ def process_span(
     table = build_timetable(samples, flight, tuple(a.name for a in spacecraft.appendages), lo, hi)
     g = table.time_ns
     dt = table.dt_s if len(table) > 1 else 1.0 / flight.grid_hz
+    check_channel_units(spacecraft, samples)
     check_wheel_units(spacecraft, table)
     check_tachometer_units(spacecraft, samples)
     h_n, _ = timetable_momentum(spacecraft, table, inertia_kgm2)

@@ -1,7 +1,11 @@
-"""Checks of a spacecraft file's declared wheel-speed units against the flight telemetry itself.
+"""Checks of a spacecraft file's declared units against the flight telemetry itself.
 
-A unit error in the spacecraft file (rpm read as rad/s) scales the wheels' momentum and would pass
-for strikes; these checks raise a :class:`~abrupt.errors.ConfigError` naming the channel instead.
+A unit error in the spacecraft file (rpm read as rad/s, a gyro in deg/s declared rad/s, an array angle
+in degrees declared rad) scales a momentum term and would pass for strikes or for a wrong inertia; these
+checks compare each channel with another that measures the same motion and raise a
+:class:`~abrupt.errors.ConfigError` naming the channel that disagrees: the gyro against the quaternion's
+derivative, the array angle against the range an angle in its unit can have, the wheels against
+conservation of angular momentum (after the other two, so that a wrong gyro is not blamed on the wheels).
 """
 
 from __future__ import annotations
@@ -12,10 +16,12 @@ import numpy as np
 import pandas as pd
 
 from abrupt.errors import ConfigError
-from abrupt.model.flight_config import WHEEL_UNITS, FlightConfig
+from abrupt.model.flight_config import RATE_UNITS, WHEEL_UNITS, FlightConfig
 from abrupt.model.spacecraft import Spacecraft
-from abrupt.series.timetable import Timetable
+from abrupt.readers.telemetry import MAX_BODY_RATE_RAD_S, WHEEL_OVERSPEED_FACTOR
+from abrupt.series.timetable import Timetable, by_mnemonic, continuous_quaternion
 from abrupt.series.timetable_momentum import wheel_scale_from_conservation
+from abrupt.thresholds.noise import robust_noise_sigma
 
 
 def flight_channels(spacecraft: Spacecraft) -> FlightConfig:
@@ -77,3 +83,133 @@ def check_tachometer_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> Non
                 file=spacecraft.source,
                 key=f"flight.channels[{k}].unit",
             )
+
+
+GYRO_RATIO_BOUNDS = (0.5, 2.0)  # gyro rate / quaternion rate; deg/s read as rad/s gives 57.3
+GYRO_MIN_SIGNAL_TO_NOISE = 5.0  # the attitude must move well above the star tracker's noise to decide
+NS = 1_000_000_000
+
+
+def _quaternion_rate(
+    spacecraft: Spacecraft, series: dict[str, tuple[np.ndarray, np.ndarray]]
+) -> tuple[np.ndarray, np.ndarray]:
+    """(times ns, |ω| rad/s) from the quaternion's central differences: |ω| = 2 |q̇| for a unit quaternion,
+    whatever its convention; only differences whose two intervals are both nominal."""
+    chans = sorted(flight_channels(spacecraft).of("quaternion"), key=lambda c: c.component)
+    if len(chans) != 4 or any(c.mnemonic not in series for c in chans):
+        return np.empty(0, np.int64), np.empty(0)
+    t = series[chans[0].mnemonic][0]
+    for c in chans[1:]:
+        t = np.intersect1d(t, series[c.mnemonic][0], assume_unique=True)
+    if t.size < 20:
+        return np.empty(0, np.int64), np.empty(0)
+    q = np.column_stack([series[c.mnemonic][1][np.searchsorted(series[c.mnemonic][0], t)] for c in chans])
+    good = np.isfinite(q).all(axis=1) & (np.abs(np.linalg.norm(q, axis=1) - 1.0) < 0.1)
+    t, q = t[good], continuous_quaternion(q[good] / np.linalg.norm(q[good], axis=1, keepdims=True))
+    dt = np.diff(t).astype(np.float64) / NS
+    step = float(np.median(dt)) if dt.size else float("nan")
+    ok = (dt[:-1] < 1.5 * step) & (dt[1:] < 1.5 * step)
+    qdot = (q[2:] - q[:-2]) / (dt[:-1] + dt[1:])[:, None]
+    return t[1:-1][ok], 2.0 * np.linalg.norm(qdot[ok], axis=1)
+
+
+def check_gyro_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> None:
+    """Raise if the gyro's rate, in its declared unit, is not the rate of the quaternion (module doc).
+
+    The ratio is the median of |ω_gyro| / |ω_quaternion| over the quaternion's stamps (the gyro
+    interpolated there), decided only when the quaternion rate's median is at least
+    :data:`GYRO_MIN_SIGNAL_TO_NOISE` times its own sample-to-sample scatter (the attitude moved).
+    """
+    flight = flight_channels(spacecraft)
+    gyro = sorted(flight.of("body_rate"), key=lambda c: c.component)
+    if len(gyro) != 3:
+        return
+    series = by_mnemonic(samples)
+    if any(c.mnemonic not in series for c in gyro):
+        return
+    t_q, w_q = _quaternion_rate(spacecraft, series)
+    if t_q.size < 20:
+        return
+    scatter = float(np.ravel(robust_noise_sigma(w_q))[0])
+    signal = float(np.median(w_q))
+    if not signal > GYRO_MIN_SIGNAL_TO_NOISE * scatter:
+        return
+    comps = []
+    for c in gyro:
+        t, v = series[c.mnemonic]
+        comps.append(np.interp(t_q, t, v * RATE_UNITS.get(c.unit, 1.0), left=np.nan, right=np.nan))
+    w_g = np.linalg.norm(np.column_stack(comps), axis=1)
+    keep = np.isfinite(w_g) & (w_q > 0)
+    if keep.sum() < 20:
+        return
+    ratio = float(np.median(w_g[keep] / w_q[keep]))
+    lo, hi = GYRO_RATIO_BOUNDS
+    if lo <= ratio <= hi:
+        return
+    k = flight.channels.index(gyro[0])
+    raise ConfigError(
+        f"gyro channel {gyro[0].mnemonic} declared in {gyro[0].unit!r} gives rates {ratio:.3g} times the "
+        f"quaternion's rate (deg/s read as rad/s gives 57.3, rad/s read as deg/s 0.0175); check the unit",
+        file=spacecraft.source,
+        key=f"flight.channels[{k}].unit",
+    )
+
+
+def check_angle_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> None:
+    """Raise if an appendage angle declared in rad takes values no angle in rad takes (beyond ±2π, with 2 %
+    for a wrap convention): degrees read as radians would make the array turn 57.3 times too fast."""
+    flight = flight_channels(spacecraft)
+    series: dict[str, tuple[np.ndarray, np.ndarray]] | None = None
+    for k, c in enumerate(flight.channels):
+        if c.quantity != "appendage_angle" or c.unit != "rad":
+            continue
+        series = series if series is not None else by_mnemonic(samples)
+        if c.mnemonic not in series:
+            continue
+        v = series[c.mnemonic][1]
+        v = v[np.isfinite(v)]
+        if v.size and float(np.max(np.abs(v))) > 2.0 * math.pi * 1.02:
+            raise ConfigError(
+                f"angle channel {c.mnemonic} declared in 'rad' reaches {float(np.max(np.abs(v))):.4g}, beyond 2π: "
+                "the values are degrees?; check the unit",
+                file=spacecraft.source,
+                key=f"flight.channels[{k}].unit",
+            )
+
+
+def check_channel_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> None:
+    """The gyro and angle checks above, in that order (the wheel checks need the timetable)."""
+    check_gyro_units(spacecraft, samples)
+    check_angle_units(spacecraft, samples)
+
+
+BOUNDS_REMOVED = "values beyond the spacecraft file's physical bounds"
+QUATERNION_COMPONENT_BOUND = 1.1  # a unit quaternion's component, with the reader's 10 % norm tolerance
+
+
+def physical_bounds(spacecraft: Spacecraft) -> dict[str, float]:
+    """The largest magnitude each ``[flight]`` channel can take, in its telemetered unit: a quaternion
+    component 1.1; a body rate :data:`MAX_BODY_RATE_RAD_S`; a wheel speed 1.5 × its wheel's
+    ``max_speed_rad_s``. Channels without a physical bound (angles, flags, housekeeping) are absent."""
+    if spacecraft.flight is None:
+        return {}
+    bounds: dict[str, float] = {}
+    for c in spacecraft.flight.channels:
+        if c.quantity == "quaternion":
+            bounds[c.mnemonic] = QUATERNION_COMPONENT_BOUND
+        elif c.quantity == "body_rate" and c.unit in RATE_UNITS:
+            bounds[c.mnemonic] = MAX_BODY_RATE_RAD_S / RATE_UNITS[c.unit]
+        elif c.quantity == "wheel_speed" and 0 <= c.component < len(spacecraft.wheels):
+            to_si = c.to_si
+            if math.isfinite(to_si) and to_si > 0:
+                limit = WHEEL_OVERSPEED_FACTOR * spacecraft.wheels[c.component].max_speed_rad_s
+                bounds[c.mnemonic] = limit / to_si
+    return bounds
+
+
+def beyond_bounds(samples: pd.DataFrame, bounds: dict[str, float]) -> np.ndarray:
+    """Rows of ``samples`` (mnemonic, value) whose magnitude exceeds their channel's bound."""
+    if not bounds or not len(samples):
+        return np.zeros(len(samples), bool)
+    limit = samples["mnemonic"].astype(str).map(bounds).to_numpy(np.float64, na_value=np.inf)
+    return np.asarray(np.abs(samples["value"].to_numpy(np.float64)) > limit)

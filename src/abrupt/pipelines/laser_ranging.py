@@ -334,7 +334,9 @@ class LaserRangingRun:
             lines.append(f"time biases (µs, last arc): {self.summary['time_bias_us']}")
         arcs = self.summary.get("arcs", [])
         lines.append(f"arcs fitted: {len(arcs) if isinstance(arcs, list) else arcs}")
-        lines += [f"repaired: {k} ({n})" for k, n in self.result.repairs.counts.items()]
+        # every repair: the readers' (CRD, a-priori ephemeris) and the fit's, one line per kind
+        repairs = self.summary.get("repairs", {})
+        lines += [f"repaired: {k} ({n})" for k, n in (repairs.items() if isinstance(repairs, dict) else [])]
         return lines
 
 
@@ -398,6 +400,8 @@ def run_laser_ranging_files(
     sites = sites_from_sinex(read_sinex(sinex_file), sorted(meas["station"].unique()), epoch, file=sinex_file)
     stations = laser_stations(sites, meas)
     ephemeris = read_ephemeris(apriori_path)
+    for kind, n in ephemeris.repairs.counts.items():
+        repairs.record(f"a-priori ephemeris: {kind}", n)
     eph_times = np.asarray(ephemeris.times_utc, dtype="datetime64[ns]")
 
     def apriori(arc_epoch: np.datetime64) -> FloatArray | None:

@@ -25,6 +25,7 @@ from abrupt.massprops.track import InertiaTrack, track_inertia
 from abrupt.model.flight_config import FlightChannel, FlightConfig
 from abrupt.model.spacecraft import ANGLE_UNITS, Spacecraft, load_spacecraft
 from abrupt.pipelines.flight import day_range
+from abrupt.pipelines.flight_checks import check_channel_units
 from abrupt.readers.telemetry import read_telemetry
 from abrupt.simulate.attitude import telemetry_frame
 from abrupt.simulate.docking import DockingScenario, docking_days, simulate_docking
@@ -175,6 +176,7 @@ def load_momentum_data_from_store(
     start = np.datetime64(day_list[0], "D")
     end = np.datetime64(day_list[-1], "D") + np.timedelta64(1, "D")
     frame = store.read_range(spacecraft.name, start, end, flight.mnemonics)
+    check_channel_units(spacecraft, frame)
     samples = _StoreSamples(
         groups={str(m): g for m, g in frame.groupby("mnemonic", observed=True)},
         t0_ns=int(start.astype("datetime64[ns]").astype(np.int64)),

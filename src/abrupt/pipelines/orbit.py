@@ -27,7 +27,7 @@ from abrupt.detect.orbit.detectors import (
 )
 from abrupt.detect.orbit.ekf import NUISANCE_NAMES
 from abrupt.detect.orbit.sensitivity import detectable_dv
-from abrupt.errors import ConfigError
+from abrupt.errors import ConfigError, InputError
 from abrupt.pipelines.orbit_sequence import resolve_sequence
 from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.series.ephemeris import Ephemeris
@@ -130,7 +130,23 @@ def detect_orbit(
         result = replace(result, events=events, warnings=(*result.warnings, *notes))
     run = OrbitRun(eph, det, result, fa)
     run.summary = fit_summary(run)
+    _check_fit(run.summary, eph, det)
     return run
+
+
+MAX_RESIDUAL_TO_SIGMA = 10.0  # a post-fit position RMS this many stated σ_pos: the filter is not following
+
+
+def _check_fit(summary: dict[str, Any], eph: Ephemeris, det: OrbitDetector) -> None:
+    """Refuse a run whose filter does not follow the positions (its statistics would be meaningless)."""
+    rms, sigma = summary.get("residual_rms_pos_m", float("nan")), summary.get("sigma_pos_m", float("nan"))
+    if np.isfinite(rms) and np.isfinite(sigma) and rms > MAX_RESIDUAL_TO_SIGMA * sigma:
+        raise InputError(
+            f"the orbit filter does not follow these positions: post-fit RMS {rms:.4g} m is {rms / sigma:.3g} "
+            f"times its σ_pos {sigma:.3g} m ({det.tuning} tuning, {summary.get('force_model')}); the events "
+            "would be meaningless: use --tuning auto",
+            file=eph.source,
+        )
 
 
 def fit_summary(run: OrbitRun) -> dict[str, Any]:

@@ -327,6 +327,11 @@ def read_archive(
             line=exc.line,
             column=pseudonymise_text(exc.column, decoder) if isinstance(exc.column, str) else exc.column,
         ) from None
+    except pa.ArrowInvalid as exc:  # e.g. bytes that are not UTF-8 in a text column
+        raise InputError(
+            pseudonymise_text(f"unreadable data: {str(exc).splitlines()[0]}", decoder),
+            file=pseudonymise_text(str(path), decoder),
+        ) from None
 
 
 DAY_NS = 86_400 * 1_000_000_000

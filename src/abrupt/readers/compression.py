@@ -23,8 +23,8 @@ GZIP_MAGIC = b"\x1f\x8b"
 COMPRESS_MAGIC = b"\x1f\x9d"
 
 
-def read_bytes(path: str | Path) -> bytes:
-    """The file's content, decompressed when it is gzip or Unix-compress data."""
+def read_bytes(path: str | Path, *, decompress: bool = True) -> bytes:
+    """The file's content, decompressed when it is gzip or Unix-compress data (unless not ``decompress``)."""
     path = Path(path)
     try:
         raw = path.read_bytes()
@@ -32,6 +32,10 @@ def read_bytes(path: str | Path) -> bytes:
         raise InputError("file not found", file=path) from None
     except IsADirectoryError:
         raise InputError("is a directory, not a file", file=path) from None
+    except OSError as exc:  # no permission, a device error...
+        raise InputError(f"cannot read file: {exc.strerror or exc}", file=path) from None
+    if not decompress:
+        return raw
     if raw[:2] == GZIP_MAGIC:
         try:
             return gzip.decompress(raw)
@@ -45,12 +49,12 @@ def read_bytes(path: str | Path) -> bytes:
     return raw
 
 
-def read_text(path: str | Path, *, encoding: str = "ascii", what: str = "text") -> str:
+def read_text(path: str | Path, *, encoding: str = "ascii", what: str = "text", decompress: bool = True) -> str:
     """The file's text (decompressed if needed); bytes outside ``encoding`` are an :class:`InputError`.
 
     The error names the line and column of the first undecodable byte.
     """
-    raw = read_bytes(path)
+    raw = read_bytes(path, decompress=decompress)
     try:
         return raw.decode(encoding)
     except UnicodeDecodeError as exc:

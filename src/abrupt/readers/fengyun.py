@@ -26,6 +26,7 @@ import numpy as np
 import pandas as pd
 
 from abrupt.errors import InputError, RepairLog
+from abrupt.readers.compression import read_bytes, read_text
 from abrupt.readers.ids_maneuvers import MANEUVER_COLUMNS, read_ids_maneuvers
 
 CST_OFFSET = np.timedelta64(8, "h")  # China Standard Time = UTC + 8 h
@@ -66,10 +67,7 @@ def read_fengyun_maneuvers(path: str | Path, *, repairs: RepairLog | None = None
     path = Path(path)
     file = str(path)
     repairs = repairs if repairs is not None else RepairLog(source=file)
-    try:
-        text = path.read_bytes().decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise InputError(f"not a UTF-8 text file (byte {exc.start})", file=file, line=1) from None
+    text = read_text(path, encoding="utf-8", what="Fengyun maneuver", decompress=False)
     rows = []
     seen: set[str] = set()
     duplicates = 0
@@ -109,9 +107,9 @@ def read_fengyun_maneuvers(path: str | Path, *, repairs: RepairLog | None = None
             )
         )
     repairs.record("duplicate maneuver lines dropped", duplicates)
+    if not rows:
+        raise InputError("no maneuvers (no station-keeping window: an empty or cut file?)", file=file, line=1)
     frame = pd.DataFrame(rows, columns=list(MANEUVER_COLUMNS))
-    if frame.empty:
-        return frame
     for col in ("time_utc", "window_start_utc", "window_end_utc"):
         frame[col] = frame[col].astype("datetime64[ns]")
     if not frame["time_utc"].is_monotonic_increasing:
@@ -124,8 +122,7 @@ def read_maneuver_file(path: str | Path, *, repairs: RepairLog | None = None) ->
     """An operator maneuver file of either kind: Fengyun ``.fy`` (by content) or IDS ``*man.txt``."""
 
     path = Path(path)
-    with open(path, "rb") as fh:
-        head = fh.read(400).decode("utf-8", errors="replace")
+    head = read_bytes(path, decompress=False)[:400].decode("utf-8", errors="replace")
     first = next((ln for ln in head.splitlines() if ln.strip()), "")
     if path.suffix.lower() == ".fy" or _LINE.match(first.strip()) or '"' in first:
         return read_fengyun_maneuvers(path, repairs=repairs)

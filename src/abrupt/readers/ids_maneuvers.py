@@ -33,6 +33,7 @@ from erfa import ErfaWarning
 
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.timescales import to_utc
+from abrupt.readers.compression import read_text
 
 BURN_TOKENS = 15
 COMPONENT_ORDER: dict[str, tuple[int, int, int]] = {
@@ -74,6 +75,9 @@ def _doy_time(tokens: list[str], file: str, line_no: int, what: str) -> np.datet
     return base + np.timedelta64(offset_ns, "ns")
 
 
+MAX_ABS_VALUE = 1e6  # [s, m/s, m/s^2]: a burn duration, delta-v or acceleration beyond this is no burn
+
+
 def read_ids_maneuvers(path: str | Path, *, repairs: RepairLog | None = None) -> pd.DataFrame:
     """Read an IDS maneuver file: one row per maneuver window, times in UTC.
 
@@ -89,7 +93,9 @@ def read_ids_maneuvers(path: str | Path, *, repairs: RepairLog | None = None) ->
     burn_tai: list[np.datetime64] = []
     seen: set[str] = set()
     duplicates = 0
-    for line_no, raw in enumerate(path.read_text(encoding="ascii", errors="replace").splitlines(), start=1):
+    for line_no, raw in enumerate(
+        read_text(path, encoding="ascii", what="IDS maneuver", decompress=False).splitlines(), start=1
+    ):
         text = raw.strip()
         if not text or text.startswith("#"):
             continue
@@ -135,10 +141,18 @@ def read_ids_maneuvers(path: str | Path, *, repairs: RepairLog | None = None) ->
             try:
                 duration += float(bt[5])
                 comps = np.array([float(x) for x in bt[6:9]])
+                values = [float(x) for x in bt[5:]]
             except ValueError:
                 raise InputError(
-                    f"burn {b + 1}: duration or delta-v is not a number", file=file, line=line_no
+                    f"burn {b + 1}: duration, delta-v or acceleration is not a number", file=file, line=line_no
                 ) from None
+            if not all(abs(v) < MAX_ABS_VALUE for v in values):  # NaN fails the comparison too
+                raise InputError(
+                    f"burn {b + 1}: a duration, delta-v or acceleration that is not finite or beyond "
+                    f"{MAX_ABS_VALUE:g} in magnitude",
+                    file=file,
+                    line=line_no,
+                )
             vec = comps[list(order)]
             dv += vec
             mag += float(np.linalg.norm(vec))
@@ -161,9 +175,9 @@ def read_ids_maneuvers(path: str | Path, *, repairs: RepairLog | None = None) ->
             )
         )
     repairs.record("duplicate maneuver lines dropped", duplicates)
+    if not rows:
+        raise InputError("no maneuvers (no maneuver line: an empty or cut file?)", file=file, line=1)
     frame = pd.DataFrame(rows, columns=list(MANEUVER_COLUMNS))
-    if frame.empty:
-        return frame
     with warnings.catch_warnings():
         # ERFA calls years past its leap-second table "dubious"; TAI−UTC is then held at the last value
         warnings.simplefilter("ignore", ErfaWarning)

@@ -13,6 +13,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
 import re
 import xml.etree.ElementTree as ET
 from collections.abc import Iterable
@@ -103,9 +104,11 @@ def record_to_set(
             rec[k] = v
     for k in NUMERIC:
         try:
-            float(rec[k])
+            value = float(rec[k])
         except ValueError:
             raise InputError(f"{where}{k} {rec[k]!r} is not a number", file=file, line=line, column=k) from None
+        if not math.isfinite(value):
+            raise InputError(f"{where}{k} {rec[k]!r} is not a finite number", file=file, line=line, column=k)
     try:
         norad = int(float(rec["NORAD_CAT_ID"]))
         elnum = int(float(rec["ELEMENT_SET_NO"]))

@@ -198,6 +198,11 @@ def read_sinex(path: str | Path | None = None) -> dict[str, SinexStation]:
         if missing:
             first_line = next(iter(est.values()))[3]
             raise InputError(f"station {code} solution {soln} lacks {', '.join(missing)}", file=file, line=first_line)
+        partial = [k for k in ("VELX", "VELY", "VELZ") if k not in est]
+        if 0 < len(partial) < 3:
+            first_line = next(iter(est.values()))[3]
+            reason = f"station {code} solution {soln} has a velocity without {', '.join(partial)}"
+            raise InputError(reason, file=file, line=first_line)
         pos = np.array([est[k][0] for k in ("STAX", "STAY", "STAZ")])
         sig = np.array([est[k][1] for k in ("STAX", "STAY", "STAZ")])
         vel = np.array(

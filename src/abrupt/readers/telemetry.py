@@ -17,6 +17,7 @@ gyro rates k x the quaternion rate     error when the attitude moves well above 
                                        outside [0.5, 2] (names deg/rad confusion when k ≈ 57.3)
 wheel speed above 1.5 x its maximum    error naming the unit to check (rpm declared as rad/s?)
 empty cells (NaN)                      repair: row removed, counted; leaves a gap
+infinite or |value| > 1e20             repair: row removed, counted; leaves a gap
 duplicate timestamps                   repair: exact duplicates removed; conflicting ones keep the
                                        first row; each counted
 timestamps out of order                repair: stable sort, counted
@@ -49,6 +50,7 @@ QUATERNION_NORM_ERROR = 0.1  # relative norm deviation above which a quaternion 
 QUATERNION_NORM_REPAIR = 1e-6  # relative deviation above which a renormalisation is counted
 MAX_BODY_RATE_RAD_S = 2.0  # [rad/s] above this the rate unit is almost surely wrong
 WHEEL_OVERSPEED_FACTOR = 1.5
+MAX_ABS_VALUE = 1e20  # above any 64-bit counter: a value beyond it is no measurement (as at archive ingest)
 
 
 def read_table(path: Path) -> pd.DataFrame:
@@ -217,10 +219,13 @@ def _repair_rows(rows: _Rows, repairs: RepairLog, path: Path) -> _Rows:
     ``rows`` are (time, q, ω, Ω, line of each row).
     """
     time_ns, q, w, omega, _ = rows
-    finite = np.all(np.isfinite(q), axis=1) & np.all(np.isfinite(w), axis=1) & np.all(np.isfinite(omega), axis=1)
-    if not finite.all():
-        repairs.record("rows with empty or NaN values removed", int((~finite).sum()))
-        rows = _take(rows, finite)
+    values = np.column_stack([q, w, omega])
+    empty = np.any(np.isnan(values), axis=1)
+    absurd = ~empty & np.any(~(np.abs(values) <= MAX_ABS_VALUE), axis=1)
+    if empty.any() or absurd.any():
+        repairs.record("rows with empty or NaN values removed", int(empty.sum()))
+        repairs.record(f"rows with infinite or absurd values (|v| > {MAX_ABS_VALUE:g}) removed", int(absurd.sum()))
+        rows = _take(rows, ~(empty | absurd))
     time_ns = rows[0]
     if time_ns.size == 0:
         raise InputError("no complete data rows (every row has an empty value)", file=path)

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import itertools
 import logging
+import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -244,6 +245,9 @@ def parse_tle_pair(line1: str, line2: str, *, file: str = "<input>", line_no: in
         (53, 63, "mean motion"),
     )
     values = {what: _field(l2, a, b, what, file, line_no + 1) for a, b, what in checks}
+    for a, _b, what in checks:
+        if not math.isfinite(values[what]):
+            raise InputError(f"{what} {values[what]} is not a finite number", file=file, line=line_no + 1, column=a)
     ecc_raw = l2[26:33]
     if not ecc_raw.strip().isdigit():
         raise InputError(f"eccentricity: cannot read {ecc_raw!r}", file=file, line=line_no + 1, column=27)

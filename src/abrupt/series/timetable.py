@@ -183,7 +183,7 @@ def continuous_quaternion(q: FloatArray) -> FloatArray:
     return np.asarray(q * sign[:, None], dtype=np.float64)
 
 
-def _by_mnemonic(samples: pd.DataFrame) -> dict[str, tuple[np.ndarray, FloatArray]]:
+def by_mnemonic(samples: pd.DataFrame) -> dict[str, tuple[np.ndarray, FloatArray]]:
     """(times ns, values) of each mnemonic, time-sorted, from one sort of the mnemonic codes."""
     if not len(samples):
         return {}
@@ -222,7 +222,7 @@ def build_timetable(
     g = grid(start_ns, end_ns, flight.grid_hz)
     step = round(NS / flight.grid_hz)
     n = g.size
-    by_name = _by_mnemonic(samples)
+    by_name = by_mnemonic(samples)
     channel_valid: dict[str, np.ndarray] = {}
     missing = []
 

@@ -40,6 +40,7 @@ from abrupt.detect.orbit.calibration import calibrate_thresholds, self_calibrate
 from abrupt.detect.orbit.ekf import FilterConfig, NuisanceConfig
 from abrupt.detect.orbit.events import find_events
 from abrupt.detect.orbit.tuning import auto_tune
+from abrupt.errors import InputError
 from abrupt.events import config_hash
 from abrupt.model.orbit import ForceModel
 from abrupt.series.ephemeris import Ephemeris
@@ -168,7 +169,25 @@ class OrbitDetector(Detector[Ephemeris]):
 
     def analyse(self, series: Ephemeris, budget: FalseAlarmBudget) -> OrbitAnalysis:
         """The filters, fusion and every statistic of ``series`` with this detector's settings."""
-        return analyse(series, self.detector_config(series, budget))
+        cfg = self.detector_config(series, budget)
+        span_s = float((series.times_utc[-1] - series.times_utc[0]) / np.timedelta64(1, "s"))
+        if span_s < 2.0 * cfg.settle_s + series.nominal_step_s:
+            raise InputError(
+                f"the arc spans {span_s / 3600:.3g} h but the filter ({self.tuning} tuning) needs "
+                f"{cfg.settle_s / 3600:.3g} h to settle at each end: no epoch could be tested; give at least "
+                f"{(2 * cfg.settle_s + series.nominal_step_s) / 3600:.3g} h of data",
+                file=series.source,
+            )
+        try:
+            return analyse(series, cfg)
+        except np.linalg.LinAlgError:
+            dyn = self.dynamics or ("field" if self.tuning == "auto" else "two-body")
+            raise InputError(
+                f"the orbit filter diverged on this arc ({self.tuning} tuning, {dyn} dynamics): its innovation "
+                "covariance became singular, the model cannot follow these positions; try --tuning auto or "
+                "--dynamics field",
+                file=series.source,
+            ) from None
 
     def detect_analysis(self, series: Ephemeris, budget: FalseAlarmBudget, analysis: OrbitAnalysis) -> DetectionResult:
         """Thresholds (``fixed_thresholds``, the null, or the arc itself), product boundaries and events of an

@@ -240,10 +240,13 @@ def propagate_state(
     max_step: float,
     phi: FloatArray,
 ) -> FloatArray:
-    """RK4 propagation of the state (9 or 17) from ``t`` over ``dt`` (sub-stepped to ``max_step``) and the
+    """RK4 propagation of the state (9 or 17) from ``t`` over ``dt`` (sub-stepped to ``max_step`` and τ) and the
     Lear RK2 STM (Eq. 3.8, erratum A7) into ``phi``; ``args`` are :attr:`ForceContext.kernel_args`."""
     n = x.size
-    nsub = max(1, math.ceil(abs(dt) / max_step - 1e-9))
+    # sub-steps no longer than |τ|: the DMC state decays as exp(−t/τ), and RK4 (and the RK2 STM) on that
+    # decay are unstable for steps beyond ~2.8 τ (the thesis τ = 1 s with 60 s data grew 10¹⁴-fold per
+    # step); the mirrored backward pass gives τ < 0
+    nsub = max(1, math.ceil(abs(dt) / min(max_step, abs(tau)) - 1e-9))
     h = dt / nsub
     mu = args[1][0]
     j2 = _with_j2(args)
