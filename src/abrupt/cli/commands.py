@@ -71,6 +71,7 @@ INJECT_COMMANDS = {
 }
 REPORT_COMMANDS = {
     "attitude": "abrupt.cli.attitude:report_attitude_cmd",
+    "catalog": "abrupt.cli.site:report_catalog_command",
     "orbit": "abrupt.cli.orbit:report_orbit_command",
     "tle": "abrupt.cli.tle:report_tle",
     "tracking": "abrupt.cli.tracking:report_tracking_command",

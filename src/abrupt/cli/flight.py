@@ -132,6 +132,7 @@ def detect_from_store(
             },
             spacecraft=sc.name,
             detectors=[FlightGlrDetector.name],
+            span_utc=(f"{day_list[0]}T00:00:00", f"{day_list[-1]}T23:59:59.999999") if day_list else None,
         )
     click.echo(result.daily.to_string(index=False), err=True)
     click.echo(

@@ -143,6 +143,29 @@ class StageProgress:
         self.bar.close()
 
 
+def command_options() -> dict[str, Any]:
+    """The running command's options as stored with its run (``options``), and the absolute path of
+    its report figure (``report_path``), so a catalog site can show a run's configuration and figure."""
+    ctx = click.get_current_context(silent=True)
+    if ctx is None:
+        return {}
+    # the catalog is where the run is stored (and its URL may hold a password): not an option to repeat
+    options = {k: _json_value(v) for k, v in ctx.params.items() if k != "catalog_target"}
+    out: dict[str, Any] = {"options": options}
+    report_path = ctx.params.get("report_path")
+    if isinstance(report_path, str) and report_path:
+        out["report_path"] = str(Path(report_path).resolve())
+    return out
+
+
+def _json_value(value: Any) -> Any:
+    if value is None or isinstance(value, bool | int | float | str):
+        return value
+    if isinstance(value, tuple | list):
+        return [_json_value(v) for v in value]
+    return str(value)
+
+
 def record_run(
     *,
     catalog_target: str,
@@ -163,6 +186,7 @@ def record_run(
     show), so the catalog's latest view can tell an event no longer found from one never looked for.
     Returns the number of events that were new to the catalog.
     """
+    details = {**(details or {}), **command_options()}
     catalog = Catalog(catalog_target)  # open (and check) the catalog before writing anything
     catalog.check_fits(events)  # texts too long for the catalog: refused before the file is written
     if out is not None:  # then the file: a bad path must not leave events in the catalog only
