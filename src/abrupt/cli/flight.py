@@ -13,6 +13,7 @@ from typing import Any
 import click
 import numpy as np
 
+from abrupt import progress
 from abrupt.cli.groups import cli, inject, record_run, simulate
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.detect.attitude.flight_glr import FlightGlrDetector
@@ -35,10 +36,8 @@ from abrupt.store import TelemetryStore
 from abrupt.thresholds import FalseAlarmBudget
 
 
-def _progress(total: int, label: str) -> Any:
-    from tqdm import tqdm
-
-    return tqdm(total=total, desc=label, unit="day", leave=False, disable=None)
+def _progress(total: int, label: str, unit: str = "day") -> Any:
+    return progress.task(label, total, unit)
 
 
 @cli.command("ingest")
@@ -60,7 +59,7 @@ def ingest_cmd(archives: tuple[str, ...], decoder_path: str, store_dir: str, lay
         if not Path(archive).is_file() or not os.access(archive, os.R_OK):
             why = "is not a readable file" if Path(archive).exists() else "does not exist"
             raise InputError(f"archive {why}", file=pseudonymise_text(archive, decoder))
-    bar = _progress(len(archives), "ingest")
+    bar = _progress(len(archives), "ingest", "file")
     summary = ingest_archives(
         archives, decoder_path, store_dir, layout=layout, assume_utc=assume_utc, progress=lambda s: bar.update(1)
     )

@@ -18,6 +18,7 @@ from typing import Any, TypeVar
 
 import click
 
+from abrupt import progress as progress_report
 from abrupt.catalog import Catalog, coverage_of
 from abrupt.cli.commands import GLOBAL_FLAGS, State, cli, detect, hoist_global_flags, inject, report, simulate
 from abrupt.events import write_events
@@ -105,13 +106,9 @@ def file_hash(path: str | Path) -> str:
 
 
 def progress(iterable: Iterable[T], *, total: int | None = None, desc: str = "", unit: str = "it") -> Iterator[T]:
-    """A progress bar with a total on standard error for long work (hidden with ``--quiet`` or when
-    standard error is not a terminal)."""
-    from tqdm import tqdm
-
-    if total is None and hasattr(iterable, "__len__"):
-        total = len(iterable)  # type: ignore[arg-type]
-    yield from tqdm(iterable, total=total, desc=desc, unit=unit, disable=progress_hidden(), leave=False)
+    """Progress with a total for long work (:mod:`abrupt.progress`): a bar on a terminal, a status line
+    every 10 s otherwise, nothing with ``--quiet``."""
+    yield from progress_report.track(iterable, desc, total, unit)
 
 
 def progress_hidden() -> bool:
@@ -123,24 +120,20 @@ class StageProgress:
     """A progress bar over the named stages of one job, with their total (replaces "[1] ..." lines)."""
 
     def __init__(self, total: int, desc: str) -> None:
-        from tqdm import tqdm
-
         self.desc = desc
-        self.bar = tqdm(total=total, desc=desc, unit="stage", disable=progress_hidden(), leave=False)
+        self.task = progress_report.task(desc, total, "stage")
         self.started = False
 
     def __call__(self, stage: str) -> None:
-        if self.started:
-            self.bar.update(1)
+        self.task.update(1 if self.started else 0, status=stage)
         self.started = True
-        self.bar.set_postfix_str(stage)
         if progress_hidden() and not State.quiet:
             logging.getLogger("abrupt").info("%s: %s", self.desc, stage)
 
     def close(self) -> None:
         if self.started:
-            self.bar.update(1)
-        self.bar.close()
+            self.task.update(1)
+        self.task.close()
 
 
 def command_options() -> dict[str, Any]:
