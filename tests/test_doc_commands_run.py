@@ -27,9 +27,9 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
-from test_doc_commands import _doc_commands
 
 from abrupt.cli.main import main
+from test_doc_commands import _doc_commands
 
 ROOT = Path(__file__).resolve().parent.parent
 

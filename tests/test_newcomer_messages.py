@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
-from flight_synth import REAL, make_archive
 
 from abrupt.cli.main import main
 from abrupt.pipelines.density import write_table
+from flight_synth import REAL, make_archive
 
 ISO_Z = re.compile(r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\.\d{6}Z$")
 
