@@ -99,14 +99,14 @@ def plot_orbit_report(
 
 
 def _robust_limits(ax: Any, values: NDArray[np.float64]) -> int:
-    """Y-limits from the 0.5-99.5 % range of the finite values (a start-up transient of the filter does
+    """Y-limits from the 2-98 % range of the finite values (a start-up transient of the filter does
     not set the scale); returns how many samples fall outside."""
     v = np.asarray(values, dtype=np.float64)
     v = v[np.isfinite(v)]
     if v.size < 20:
         return 0
-    lo, hi = np.percentile(v, [0.5, 99.5])
-    pad = 0.15 * max(hi - lo, 1e-12)
+    lo, hi = np.percentile(v, [2.0, 98.0])
+    pad = 0.3 * max(hi - lo, 1e-12)
     ax.set_ylim(lo - pad, hi + pad)
     return int(np.sum((v < lo - pad) | (v > hi + pad)))
 

@@ -1,0 +1,82 @@
+"""Report figures are readable: every panel has labelled axes with units, holds data, threshold lines
+carry a label, and a panel with nothing to show is not drawn (orbit: no Δa panel without Δa, no velocity
+residual panel for a position-only file; tracking: the GLRT threshold is drawn, also without events)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import pytest
+
+
+def _capture(monkeypatch: pytest.MonkeyPatch, module: Any) -> list[Any]:
+    figures: list[Any] = []
+    monkeypatch.setattr(module, "save_figure", lambda fig, path, **kw: figures.append(fig) or Path(path))
+    return figures
+
+
+def assert_readable(fig: Any) -> None:
+    """Every axis: an x label (or one shared with the panel below), a y label with a unit, data in it."""
+    axes = [ax for ax in fig.axes if ax.get_visible()]
+    assert axes
+    for k, ax in enumerate(axes):
+        shared_x = ax.get_shared_x_axes().joined(ax, axes[-1]) and k < len(axes) - 1
+        assert ax.get_xlabel() or shared_x, f"panel {k}: no x label"
+        label = ax.get_ylabel()
+        assert label and "(" in label, f"panel {k}: y label without a unit: {label!r}"
+        assert ax.lines or ax.collections or ax.patches, f"panel {k} ({label}) is empty"
+        for line in ax.lines:
+            xy = line.get_xydata()
+            if len(xy) == 2 and np.allclose(xy[:, 1], xy[0, 1]) and line.get_linestyle() == "--":
+                assert not line.get_label().startswith("_"), f"panel {k}: an unlabelled threshold line"
+
+
+def test_orbit_report_of_a_position_only_file_has_no_velocity_or_empty_panel(
+    shared_data: Path, monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    from abrupt.pipelines.orbit import detect_orbit
+    from abrupt.report import orbit as report
+
+    run = detect_orbit(shared_data / "tracking" / "ilrs-corpus" / "lageos1_cpf_180613_16401.hts", budget="1/week")
+    assert run.analysis is not None
+    figures = _capture(monkeypatch, report)
+    report.plot_orbit_report(run.analysis, run.thresholds, run.events, tmp_path / "r.png")
+    (fig,) = figures
+    labels = [ax.get_ylabel() for ax in fig.axes]
+    assert not any("velocity" in label for label in labels)  # CPF: positions only
+    assert not any(label.startswith("d_sma") for label in labels)  # no Δa series on this arc: no panel
+    assert_readable(fig)
+    # the residual scale is set by the bulk of the samples, not by the filter's start-up transient
+    resid = np.abs(run.analysis.forward.innovation[:, :3])
+    lo, hi = fig.axes[0].get_ylim()
+    assert hi - lo < 0.5 * np.nanmax(resid)
+
+
+def test_tracking_report_draws_the_glrt_threshold_without_events(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    from abrupt.report import tracking as report
+
+    t = pd.date_range("2024-01-01", periods=50, freq="1h")
+    diagnostics = pd.concat(
+        [
+            pd.DataFrame(
+                {"series": "glrt", "time_utc": t, "glrt_statistic": np.linspace(0.5, 9.0, 50), "threshold": 21.3}
+            ),
+            pd.DataFrame(
+                {"series": "kaderali", "time_utc": t, "psi": np.linspace(1.0, 12.0, 50), "k_db": 1.0, "threshold": 30.0}
+            ),
+        ],
+        ignore_index=True,
+    )
+    figures = _capture(monkeypatch, report)
+    report.plot_tracking_report(diagnostics, path=tmp_path / "t.png")
+    (fig,) = figures
+    assert_readable(fig)
+    glrt_ax = next(ax for ax in fig.axes if "T(τ)" in ax.get_ylabel())
+    assert any(line.get_label() == "GLRT threshold T = 21.3" for line in glrt_ax.lines)
+    psi_ax = next(ax for ax in fig.axes if ax.get_ylabel().startswith("Ψ"))
+    assert psi_ax.get_ylim()[1] > 30.0 * 1.5  # the Ψ threshold line inside the panel, not on its edge
