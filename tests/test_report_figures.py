@@ -24,7 +24,10 @@ def assert_readable(fig: Any) -> None:
     assert axes
     for k, ax in enumerate(axes):
         shared_x = ax.get_shared_x_axes().joined(ax, axes[-1]) and k < len(axes) - 1
-        assert ax.get_xlabel() or shared_x, f"panel {k}: no x label"
+        twin = any(  # a twin axis (twinx) shares the x label of the panel it sits on
+            o is not ax and o.get_xlabel() and o.get_position().bounds == ax.get_position().bounds for o in axes
+        )
+        assert ax.get_xlabel() or shared_x or twin, f"panel {k}: no x label"
         label = ax.get_ylabel()
         assert label and "(" in label, f"panel {k}: y label without a unit: {label!r}"
         assert ax.lines or ax.collections or ax.patches, f"panel {k} ({label}) is empty"
@@ -80,3 +83,31 @@ def test_tracking_report_draws_the_glrt_threshold_without_events(
     assert any(line.get_label() == "GLRT threshold T = 21.3" for line in glrt_ax.lines)
     psi_ax = next(ax for ax in fig.axes if ax.get_ylabel().startswith("Ψ"))
     assert psi_ax.get_ylim()[1] > 30.0 * 1.5  # the Ψ threshold line inside the panel, not on its edge
+
+
+def test_flight_report_panels_have_units_and_the_daily_sizes_start_at_zero(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from abrupt.model.spacecraft import load_spacecraft
+    from abrupt.pipelines.flight import FlightRunConfig, ingest_archives, run_flight
+    from abrupt.report import flight as report
+    from flight_synth import make_archive
+
+    archive = make_archive(tmp_path, hours=5.0, strikes=[(7200.0, [0.08, -0.05, 0.03])])
+    ingest_archives([archive.archive], archive.decoder, tmp_path / "store")
+    sc = load_spacecraft(archive.spacecraft)
+    result = run_flight(tmp_path / "store", sc, FlightRunConfig(), keep_series=True)
+    fig = report.flight_figure(result)
+    panels = [ax for ax in fig.axes if ax.get_ylabel() != "noise floor, ΔH90 (mN·m·s)"]
+    assert_readable(fig)
+    assert len(panels) == 5
+    sizes_axis = next(ax for ax in fig.axes if ax.get_ylabel() == "noise floor, ΔH90 (mN·m·s)")
+    assert sizes_axis.get_ylim()[0] == 0.0
+    for ax in fig.axes:  # legends outside the data area
+        legend = ax.get_legend()
+        if legend is not None:
+            assert legend.get_bbox_to_anchor().x0 >= ax.get_window_extent().x1 - 1.0
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    report.write_flight_report(tmp_path / "flight.png", result)
