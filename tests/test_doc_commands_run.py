@@ -87,6 +87,20 @@ INPUTS: dict[str, Callable[[Path, Path], None]] = {
     "decoder.csv": _copy("flight-like/decoder.csv"),
 }
 
+
+def _telemetry(shared: Path, target: Path) -> None:
+    main(["-q", "simulate", "attitude", "--duration", "1200", "--random-strikes", "2", "--out", str(target)])
+
+
+#: Inputs of one document only (the same name means another thing elsewhere).
+DOC_INPUTS: dict[str, dict[str, Callable[[Path, Path], None]]] = {
+    "catalog.md": {
+        "sc.toml": lambda shared, target: shutil.copyfile(ROOT / "examples" / "spacecraft" / "thesis.toml", target),
+        "tel.parquet": _telemetry,
+        "s3a.tle": _tle_years("Sentinel-3A.tle"),
+    },
+}
+
 #: Reductions of study sizes (regular expression -> replacement), applied to the line before it runs.
 SHRINK: list[tuple[str, str]] = [
     (r"--draws \d+", "--draws 3000"),
@@ -118,6 +132,20 @@ NOT_RUN: dict[tuple[str, str], str] = {
 
 #: Documents run in the default suite; the others (minutes of work each) are marked slow.
 FAST_DOCS = {"README.md", "attitude-detection.md", "tle.md", "catalog.md", "rates.md", "tracking.md"}
+#: Documents whose commands need inputs this test does not make yet (placeholders such as STORE, S,
+#: ARCHIVE..., fleet.csv): parsed by tests/test_doc_commands.py, not executed here.
+NOT_EXECUTED_DOCS = {
+    "attribution.md",
+    "density.md",
+    "detectors.md",
+    "flight-pipeline.md",
+    "flux-inference.md",
+    "formats.md",
+    "mass-properties.md",
+    "matched-filter.md",
+    "orbit.md",
+    "scale.md",
+}
 
 
 def _reason(doc: str, line: str) -> str | None:
@@ -148,6 +176,7 @@ def _docs() -> list[object]:
     return [
         pytest.param(doc, lines, id=doc, marks=() if doc in FAST_DOCS else pytest.mark.slow)
         for doc, lines in sorted(by_doc.items())
+        if doc not in NOT_EXECUTED_DOCS
     ]
 
 
@@ -156,9 +185,9 @@ def test_every_command_of_the_doc_runs(
     doc: str, lines: list[str], shared_data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     (tmp_path / "examples").symlink_to(ROOT / "examples")
-    for name, make in INPUTS.items():
-        make(shared_data, tmp_path / name)
     monkeypatch.chdir(tmp_path)
+    for name, make in {**INPUTS, **DOC_INPUTS.get(doc, {})}.items():
+        make(shared_data, tmp_path / name)
     ran, skipped = 0, []
     for line in lines:
         reason = _reason(doc, line)

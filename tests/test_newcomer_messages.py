@@ -64,3 +64,18 @@ def test_an_ingest_error_names_a_file_that_exists_or_its_place_on_the_command_li
         assert "SC-Z_archive.csv" in err and not (tmp_path / "a" / "SC-Z_archive.csv").exists()
     else:
         assert Path(where).is_file(), err  # the real path, which exists
+
+
+def test_demo_truth_matching_uses_the_events_own_timing_tolerance() -> None:
+    """A detection 6.95 s from a strike matches when its time estimate's σ is 3 s (3σ = 9 s), not when
+    it is 1 s (tolerance: the 5 s floor); a detection 4 s away always matches."""
+    from abrupt.cli.attitude import matches_truth
+
+    t_true = pd.Timestamp("2026-01-01T00:10:00")
+    events = pd.DataFrame(
+        {
+            "time_utc": ["2026-01-01T00:10:06.950000Z", "2026-01-01T00:10:06.950000Z", "2026-01-01T00:09:56.000000Z"],
+            "time_sigma_s": [3.0, 1.0, float("nan")],
+        }
+    )
+    assert matches_truth(events, t_true).tolist() == [True, False, True]

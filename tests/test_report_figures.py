@@ -111,3 +111,26 @@ def test_flight_report_panels_have_units_and_the_daily_sizes_start_at_zero(
 
     plt.close(fig)
     report.write_flight_report(tmp_path / "flight.png", result)
+
+
+def test_rate_axes_follow_the_flux_weighted_draws_not_one_giant_draw() -> None:
+    from abrupt.report.rates import default_thresholds, weighted_quantiles
+
+    values = np.array([1.0, 2.0, 3.0, 4.0])
+    weights = np.array([1.0, 1.0, 1.0, 5.0])
+    repeated = np.repeat(values, weights.astype(int))  # the same distribution, unweighted
+    for q in (0.1, 0.3, 0.5, 0.7, 0.9):
+        expected = np.quantile(repeated, q, method="inverted_cdf")
+        assert weighted_quantiles(values, weights, (q,))[0] == expected
+
+    class Draws:
+        def __init__(self, dh: np.ndarray) -> None:
+            self.dH_Nms = dh
+            self.dV_mps = dh
+            self.da_m = dh
+            self.weight = None
+
+    rng = np.random.default_rng(3)
+    dh = np.concatenate([rng.lognormal(-10.0, 1.0, 5000), [1e8]])  # one giant draw among 5000
+    thresholds = default_thresholds([Draws(dh)], "dH")  # type: ignore[list-item]
+    assert thresholds.max() < 1e-1 and thresholds.max() >= np.quantile(dh, 0.99)
