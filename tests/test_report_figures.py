@@ -29,7 +29,7 @@ def assert_readable(fig: Any) -> None:
         )
         assert ax.get_xlabel() or shared_x or twin, f"panel {k}: no x label"
         label = ax.get_ylabel()
-        assert label and "(" in label, f"panel {k}: y label without a unit: {label!r}"
+        assert label and ("(" in label or "[" in label), f"panel {k}: y label without a unit: {label!r}"
         assert ax.lines or ax.collections or ax.patches, f"panel {k} ({label}) is empty"
         for line in ax.lines:
             xy = line.get_xydata()
@@ -134,3 +134,22 @@ def test_rate_axes_follow_the_flux_weighted_draws_not_one_giant_draw() -> None:
     dh = np.concatenate([rng.lognormal(-10.0, 1.0, 5000), [1e8]])  # one giant draw among 5000
     thresholds = default_thresholds([Draws(dh)], "dH")  # type: ignore[list-item]
     assert thresholds.max() < 1e-1 and thresholds.max() >= np.quantile(dh, 0.99)
+
+
+def test_tle_report_panels_have_units_and_data(
+    shared_data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from abrupt.pipelines.tle import detect_tle_file
+    from abrupt.report import tle as report
+    from abrupt.thresholds import FalseAlarmBudget
+
+    lines = (shared_data / "tle" / "Sentinel-3A.tle").read_text().splitlines(keepends=True)
+    pairs = zip(lines[0::2], lines[1::2], strict=True)
+    tle = tmp_path / "s3a.tle"
+    tle.write_text("".join(a + b for a, b in pairs if a[18:20] == "16"))
+    result = detect_tle_file(tle, FalseAlarmBudget.parse("1/year"))
+    (sat,) = result.satellites
+    figures = _capture(monkeypatch, report)
+    report.plot_tle_report(sat.history, sat.events, tmp_path / "t.png")
+    (fig,) = figures
+    assert_readable(fig)
