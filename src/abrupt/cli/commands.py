@@ -261,7 +261,7 @@ def cli(verbose: int, quiet: bool) -> None:
     State.quiet = quiet
     level = logging.WARNING if quiet else logging.WARNING - 10 * min(verbose, 2)  # warnings even when quiet
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s", force=True)
-    if not quiet:  # progress of long work: bars on a terminal, a status line every 10 s otherwise
+    if not quiet:  # progress of long work: bars on a terminal, a status line every 8 s otherwise
         ctx = click.get_current_context()
         mode = "bar" if sys.stderr.isatty() else "log"
         reporter = progress.Reporter(f"abrupt {ctx.invoked_subcommand or ''}".strip(), mode).start()
