@@ -117,6 +117,74 @@ print(time.perf_counter() - t, time.process_time() - c, n)
 """
 
 
+KERNELS = """
+import sys, time
+import numpy as np
+from pathlib import Path
+from abrupt.detect.tle.config import TleDetectorConfig
+from abrupt.detect.tle.steps import StepModel, segment_bounds_all
+from abrupt.readers.omm import read_element_histories
+from abrupt.readers.tle import tle_checksum
+paths = [p for p in Path(sys.argv[1]).read_text().split()][: int(sys.argv[2])]
+models = [StepModel(h, TleDetectorConfig()) for p in paths for h in read_element_histories(p)]
+def compiled():
+    out = []
+    for m in models:
+        gaps = np.arange(m.n - 1)
+        out.append(m.gaps(gaps, *segment_bounds_all(gaps, [], m.n))[0])
+    return out
+def plain():
+    out = []
+    for m in models:
+        rows = [m.gap_numpy(g, 0, m.n)[0] for g in range(m.n - 1)]
+        out.append(np.array([[r[k] for k in m.NAMES] for r in rows]))
+    return out
+def definition(line):
+    total = 0
+    for ch in line[:68]:
+        if ch.isdigit():
+            total += int(ch)
+        elif ch == "-":
+            total += 1
+    return total % 10
+lines = [ln.rstrip() for p in paths for ln in open(p) if ln.strip()]
+compiled()
+gaps = sum(m.n - 1 for m in models)
+c = time.process_time(); fast = compiled(); c_fast = time.process_time() - c
+c = time.process_time(); ref = plain(); c_ref = time.process_time() - c
+same = all(
+    np.array_equal(a[np.isfinite(b).all(axis=1)], b[np.isfinite(b).all(axis=1)], equal_nan=True)
+    for a, b in zip(fast, ref)
+)
+c = time.process_time(); k_fast = [tle_checksum(ln) for ln in lines]; k_fast_s = time.process_time() - c
+c = time.process_time(); k_ref = [definition(ln) for ln in lines]; k_ref_s = time.process_time() - c
+print(len(models), gaps, c_fast, c_ref, int(same), len(lines), k_fast_s, k_ref_s, int(k_fast == k_ref))
+"""
+
+
+def kernel_reference(listing: Path, n_files: int) -> None:
+    """The step test and the checksum against their plain definitions, same run, same objects: the
+    compiled step kernel vs numpy medians gap by gap (``StepModel.gap_numpy``), the bytes checksum vs the
+    column-by-column loop. CPU seconds (process time) and whether the numbers are equal."""
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    out = subprocess.run(
+        [sys.executable, "-c", KERNELS, str(listing), str(n_files)], env=env, capture_output=True, text=True
+    )
+    if out.returncode != 0:
+        raise SystemExit(f"kernel reference failed:\n{out.stderr[-2000:]}")
+    n_obj, gaps, c_fast, c_ref, same, lines, k_fast, k_ref, k_same = out.stdout.split()
+    print(
+        f"\n[kernels] {n_obj} objects, {int(gaps):,} gaps: step test compiled {float(c_fast):.3f} CPU-s, plain numpy "
+        f"(np.median per gap) {float(c_ref):.3f} CPU-s: ratio {float(c_fast) / float(c_ref):.3f} "
+        f"({1e6 * float(c_fast) / int(gaps):.1f} vs {1e6 * float(c_ref) / int(gaps):.0f} µs a gap); "
+        f"bit-identical: {'yes' if same == '1' else 'NO'}   ({load()})"
+    )
+    print(
+        f"[kernels] {int(lines):,} TLE lines: checksum {float(k_fast):.3f} CPU-s, column-by-column loop "
+        f"{float(k_ref):.3f} CPU-s: ratio {float(k_fast) / float(k_ref):.3f}; equal: {'yes' if k_same == '1' else 'NO'}"
+    )
+
+
 def reference(listing: Path, n_files: int, src: Path) -> tuple[float, float, int]:
     env = {**os.environ, "PYTHONPATH": str(src)}
     out = subprocess.run(
@@ -215,22 +283,31 @@ def main() -> None:
     ap.add_argument("--density-objects", default="25,50")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--folder", default=None, help="Where the simulated catalogue is cached.")
-    ap.add_argument("--baseline", default="/work/baseline/src", help="src folder of the previous release.")
+    ap.add_argument(
+        "--baseline",
+        default="/work/baseline/src",
+        help="src folder of the previous code (e.g. `git archive REV src | tar -x -C DIR`, then DIR/src).",
+    )
     ap.add_argument("--reference-files", type=int, default=4, help="Files (of 25 objects) in the reference.")
     ap.add_argument("--kill", action="store_true")
     ap.add_argument("--no-model", action="store_true", help="Density without NRLMSIS along the orbits.")
+    ap.add_argument("--parts", default="maneuvers,density", help="maneuvers, density (needs maneuvers) or both")
     args = ap.parse_args()
+    parts = set(args.parts.split(","))
     folder = Path(args.folder or Path(tempfile.gettempdir()) / "abrupt-catalogue")
     folder.mkdir(parents=True, exist_ok=True)
     ns = [int(x) for x in args.objects.split(",")]
     dns = [int(x) for x in args.density_objects.split(",")]
     print(f"catalogue scale, {load()}; simulated catalogue cached in {folder}")
     events: dict[int, Path] = {}
-    part("maneuvers", sorted(set(ns) | set(dns)), folder, ["detect", "tle-batch"], 10.0, args.workers, events)
+    needed = set(ns) | (set(dns) if "density" in parts else set())
+    part("maneuvers", sorted(needed), folder, ["detect", "tle-batch"], 10.0, args.workers, events)
     density = ["density", "tle", "--windows-only"] + (["--no-model"] if args.no_model else [])
-    part("density", dns, folder, density, 15.0, args.workers, events)
+    if "density" in parts:
+        part("density", dns, folder, density, 15.0, args.workers, events)
     listing = catalogue(folder, max(ns))
     k = args.reference_files
+    kernel_reference(listing, k)
     if Path(args.baseline).is_dir():
         t_prev, c_prev, n_prev = reference(listing, k, Path(args.baseline))
         t_this, c_this, n_this = reference(listing, k, SRC)
@@ -246,4 +323,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results("bench_catalogue_scale", variant({"--no-model": "nomodel", "--parts=maneuvers": "maneuvers"})):
+        main()

@@ -370,7 +370,7 @@ def part_year(store: Path, n_days: int = 365, workers: int = 2, baseline: Path |
         same_run_reference(files[:2], base / "kestrel-year.toml", baseline)
 
 
-if __name__ == "__main__":
+def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--store", default="/tmp/abrupt-flight-bench-store")
     ap.add_argument("--parts", default="detect")
@@ -389,3 +389,11 @@ if __name__ == "__main__":
             part_memory(store, args.days if args.days != 365 else 30)
         else:
             globals()[f"part_{p}"](store)
+
+
+if __name__ == "__main__":
+    from _results import variant, write_results
+
+    flags = {"--parts=year": "year", "--parts=memory": "memory", "--days=6": "6days"}
+    with write_results("bench_flight_pipeline", variant(flags)):
+        main()

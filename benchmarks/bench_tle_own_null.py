@@ -225,4 +225,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results("bench_tle_own_null", variant({"--seeds=2": "seeds2"})):
+        main()

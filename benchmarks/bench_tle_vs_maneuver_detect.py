@@ -107,6 +107,8 @@ def evaluate(events: pd.DataFrame, truth: pd.DataFrame, start: Any, end: Any, si
     is_camp = events["kind"].eq("maneuver_campaign") if "kind" in events else pd.Series(False, index=events.index)
     campaigns, events = events.loc[is_camp], events.loc[~is_camp].reset_index(drop=True)
     res = score_events(events, truth, tolerance_s=TOLERANCE_S, start=start, end=end)
+    # the score with the events' stated intervals (a truth inside an event's interval also pairs)
+    res_iv = score_events(events, truth, tolerance_s=TOLERANCE_S, start=start, end=end, intervals=True)
     op = recall_at_false_alarm_rate(
         events, truth, false_alarms_per_year=1.0, start=start, end=end, tolerance_s=TOLERANCE_S
     )
@@ -169,6 +171,9 @@ def evaluate(events: pd.DataFrame, truth: pd.DataFrame, start: Any, end: Any, si
         "recall_big_res_at_1fa": big_res_found / n_big_res if n_big_res else float("nan"),
         "median_abs_dt_h": float(np.median(dts)) if dts.size else float("nan"),
         "in_interval": float(np.mean(in_iv)) if in_iv else float("nan"),
+        "tp_iv": res_iv.true_positives,
+        "fp_iv": res_iv.false_positives,
+        "f1_intervals": res_iv.f1,
         "dv_isolated_n": int(iso.sum()),
         "dv_isolated_within_2x": float(((ratios > 0.5) & (ratios < 2.0))[iso].mean()) if iso.any() else float("nan"),
         "dv_median_ratio": float(np.median(ratios)) if ratios.size else float("nan"),
@@ -419,6 +424,9 @@ def pooled(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "recall_big_with_campaign_events_at_1fa": sum(r["big_camp_events_found"] for r in rows) / n_big
         if n_big
         else float("nan"),
+        "f1_intervals": 2 * sum(r["tp_iv"] for r in rows) / (sum(r["tp_iv"] + r["fp_iv"] for r in rows) + n_truth)
+        if n_truth
+        else float("nan"),
         "n_big_res": sum(r["n_big_res"] for r in rows),
         "recall_big_res_at_1fa": sum(r["big_res_found"] for r in rows) / max(sum(r["n_big_res"] for r in rows), 1),
     }
@@ -575,6 +583,7 @@ def main() -> None:
         "recall_big_res_at_1fa",
         "median_abs_dt_h",
         "in_interval",
+        "f1_intervals",
         "min_dv_t_cm_s",
         "min_dv_n_cm_s",
         "dv_isolated_n",
@@ -647,4 +656,17 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results(
+        "bench_tle_vs_maneuver_detect",
+        variant(
+            {
+                "--no-baseline": "no_baseline",
+                "--threshold-follow=none": "one_threshold",
+                "--threshold-follow=follow": "follow",
+                "--along-track-gain=0": "no_phase",
+            }
+        ),
+    ):
+        main()

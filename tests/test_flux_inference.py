@@ -19,7 +19,7 @@ from abrupt.flux.exposure import (
     store_exposure,
 )
 from abrupt.flux.forward import DIRECTION_CLASSES, ForwardConfig, OrbitCase, Template
-from abrupt.flux.inference import fit, goodness_of_fit, poisson_upper_limit, prepare, upper_limit
+from abrupt.flux.inference import Likelihood, fit, goodness_of_fit, poisson_upper_limit, prepare, upper_limit
 from abrupt.simulate.population import FleetSpec, fleet_exposure
 
 CASE = OrbitCase("synthetic.toml", 550.0, 28.5, 2020.0)
@@ -112,6 +112,30 @@ def test_single_population_estimate_is_events_over_expected_at_unit_scale() -> N
     lo, hi = (v * unit for v in res.intervals["debris_scale"])
     for mu in (lo, hi):
         assert 2 * (9 * math.log(9 / mu) - (9 - mu)) == pytest.approx(stats.chi2.ppf(0.9, 1), rel=1e-4)
+
+
+def test_signed_estimate_solves_the_score_equation_below_zero_and_weights_count_events() -> None:
+    """One population over a known background that lies in bin 0, n events there: the score equation
+    n S_0 / (s S_0 + b_0) = S gives ŝ = n/S − b_0/S_0 (negative when few events); the bounded fit is 0."""
+    exp = exposure(2, 1.0, false_alarms=0.05)
+    exp["dH50_Nms"] = 1.2e-3  # false alarms just above the lowest edge (1e-3): bin 0 holds 99.9 % of them
+    counts = np.zeros(CONFIG.n_bins, dtype=int)
+    counts[0] = 3
+    data = prepare(exp, events_from_counts(counts, exp), {CASE: power_law_template()})
+    assert data.background_bins[0] == pytest.approx(0.05 * len(exp), rel=2e-3)
+    lik = Likelihood(data, np.array([1.0]))
+    s_bins, b0 = lik.bin_signal[0, 0], float(data.background_bins[0])
+    res = fit(data, fixed={"beta": 1.0, "meteoroid_scale": 0.0})
+    assert res.estimates["debris_scale"] == 0.0
+    signed = 3 / s_bins.sum() - b0 / s_bins[0]
+    assert signed < 0
+    assert res.signed_estimates["debris_scale"] == pytest.approx(signed, rel=1e-6)
+    # an event counted twice is two events: ŝ = Σw / S without background
+    clean = exposure(2, 1.0)
+    data = prepare(clean, events_from_counts(counts, clean), {CASE: power_law_template()})
+    s_hat, _ = Likelihood(data, np.array([1.0])).reweighted(np.full(3, 2.0)).maximise({"meteoroid_scale": 0.0})
+    unit = expected_counts((1.0, 0.0), 1.0, 2 * round(DAYS_PER_YEAR) / DAYS_PER_YEAR).sum()
+    assert s_hat[0, 0] == pytest.approx(6 / unit, rel=1e-6)
 
 
 def test_profile_intervals_cover_the_truth_at_the_wilks_rate() -> None:

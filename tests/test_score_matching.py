@@ -90,3 +90,47 @@ def test_a_second_detection_of_the_same_truth_counts_as_a_false_alarm() -> None:
         det, _frame([10.0]), false_alarms_per_year=0.5, start="2020-01-01", end="2021-01-01"
     )
     assert op.true_positives == 1 and op.false_positives == 0  # the duplicate would exceed 0.5 FA
+
+
+def _with_intervals(days: list[float], spans: list[tuple[float, float] | None]) -> pd.DataFrame:
+    out = _frame(days)
+    t0 = pd.Timestamp("2020-01-01")
+    out["interval_start_utc"] = [None if s is None else (t0 + pd.Timedelta(days=s[0])).isoformat() for s in spans]
+    out["interval_end_utc"] = [None if s is None else (t0 + pd.Timedelta(days=s[1])).isoformat() for s in spans]
+    return out
+
+
+def test_a_truth_inside_an_events_stated_interval_matches_only_with_intervals() -> None:
+    """An event timed 2 days after the truth, whose stated interval holds the truth, pairs with it when
+    the score uses intervals; without them (or with an empty interval) it is a false alarm and a miss."""
+    det = _with_intervals([10.0, 20.0], [(7.5, 10.5), None])
+    truth = _frame([8.0, 17.0])
+    plain = score_events(det, truth, tolerance_s=86400.0)
+    stated = score_events(det, truth, tolerance_s=86400.0, intervals=True)
+    assert (plain.true_positives, stated.true_positives) == (0, 1)
+    assert stated.intervals and not plain.intervals
+    assert stated.pairs[0][:2] == (0, 0) and stated.pairs[0][2] == pytest.approx(2 * 86400.0)
+    # no interval columns: scored as with the tolerance alone
+    assert score_events(_frame([10.0]), truth, intervals=True).true_positives == 0
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_interval_matching_size_equals_brute_force_maximum(seed: int) -> None:
+    """With intervals the pairing is still a maximum one-to-one matching of the allowed pairs."""
+    rng = np.random.default_rng(seed)
+    det = np.sort(rng.uniform(0, 10, 5))
+    lo, hi = det - rng.uniform(0, 3, 5), det + rng.uniform(0, 0.5, 5)
+    tru = rng.uniform(0, 10, 4)
+    allowed = (np.abs(det[:, None] - tru[None, :]) <= 1.0) | ((tru >= lo[:, None]) & (tru <= hi[:, None]))
+    best = 0
+    for k in range(min(5, 4), 0, -1):
+        if any(
+            all(allowed[d, t] for d, t in zip(dsub, perm, strict=True))
+            for dsub in itertools.combinations(range(5), k)
+            for perm in itertools.permutations(range(4), k)
+        ):
+            best = k
+            break
+    spans = ((lo * DAY_NS).astype(np.int64), (hi * DAY_NS).astype(np.int64))
+    got = match_times((det * DAY_NS).astype(np.int64), (tru * DAY_NS).astype(np.int64), 86400.0, spans)
+    assert len(got) == best

@@ -47,6 +47,25 @@ def test_block_threshold_follows_cadence_and_noise_level() -> None:
     assert float(np.median(local[n1 + 10 :])) == pytest.approx(expected_2, rel=0.12)
 
 
+def test_block_threshold_is_not_fitted_on_the_candidates_it_judges() -> None:
+    """Four years of a half-normal statistic (1 sample a day) with twelve small steps of S 5-6 in the
+    second year, above the whole-history threshold: fitted with them, that year's threshold rises to
+    exclude them; with the gaps around every peak at or above the whole-history threshold left out,
+    it stays at the half-normal quantile for the budget (P(|N| > T) = 1/365), within the tail fit's
+    error."""
+    rng = np.random.default_rng(3)
+    t = np.arange(0.0, 4 * 365.25, 1.0) * DAY
+    stat = np.abs(rng.standard_normal(t.size - 1))
+    for k in range(12):
+        stat[400 + 25 * k] = 5.0 + rng.uniform(0.0, 1.0)
+    expected = stats.halfnorm.isf(1.0 / 365.25)
+    with_them, _ = block_thresholds(stat, t, 8, 1.0, "gpd", 365.25, 0.0)
+    without, _ = block_thresholds(stat, t, 8, 1.0, "gpd", 365.25, 0.0, candidates_above=expected)
+    second = slice(380, 700)
+    assert float(np.median(with_them[second])) > 1.2 * expected
+    assert float(np.median(without[second])) == pytest.approx(expected, rel=0.12)
+
+
 def test_threshold_is_raised_where_a_block_is_noisier_and_rate_holds() -> None:
     """A LEO null history whose last year has heavier-tailed noise (the statistic's scale there ×2, as
     end of life or solar maximum would): with the per-block threshold, that year's threshold is

@@ -201,6 +201,9 @@ def test_cli_detect_score_and_report_run_end_to_end(maneuvering, tmp_path: Path)
     r = runner.invoke(cli, ["score", str(out), "--truth", str(truth_file), "--elements", str(path), "--json", str(js)])
     assert r.exit_code == 0, r.output
     assert "recall 1.000" in r.output
+    # the events state intervals, so the score with them is printed beside the ±1 day one
+    assert "with the events' stated intervals" in r.output
+    assert "with_intervals" in js.read_text()
     png = tmp_path / "report.png"
     r = runner.invoke(
         cli, ["report", "tle", str(path), "--events", str(out), "--truth", str(truth_file), "--out", str(png)]

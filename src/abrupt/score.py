@@ -6,6 +6,10 @@ column (``statistic`` by default) can be scored against any truth frame with a t
 * **Matching** is one-to-one and maximises the number of pairs within ``± tolerance``, then
   minimises the total time difference (linear assignment, Kuhn 1955 / scipy
   ``linear_sum_assignment``), so a detection between two truths cannot be counted twice.
+* **Stated intervals** (``intervals=True``): an event that states the interval its burn lies in
+  (``interval_start_utc``/``interval_end_utc``, e.g. the element-set gap of a TLE maneuver widened by
+  the satellite's TLE lag) may also pair with a truth inside that interval, however far from its
+  time; the pairing is still one-to-one and prefers the smallest |Δt|.
 * **Precision, recall, F1** at the detector's own threshold (detections with
   ``statistic >= threshold`` when the frame carries a ``threshold`` column, otherwise all rows).
 * **Recall at a fixed false-alarm rate** per satellite-year (the metric of the maneuver-detect
@@ -28,6 +32,8 @@ from scipy.optimize import linear_sum_assignment
 
 # event kinds that summarise other events (a campaign of maneuvers): not detections of their own
 SUMMARY_KINDS = ("maneuver_campaign",)
+# the interval an event states its time lies in
+INTERVAL_COLUMNS = ("interval_start_utc", "interval_end_utc")
 
 
 def _without_summaries(detections: pd.DataFrame) -> pd.DataFrame:
@@ -59,6 +65,7 @@ class ScoreResult:
     n_truth_outside_span: int = 0
     span_years: float = float("nan")
     false_alarms_per_year: float = float("nan")
+    intervals: bool = False  # pairs also allowed inside the events' stated intervals
     pairs: tuple[tuple[int, int, float], ...] = field(default=(), repr=False)
 
     def as_dict(self) -> dict[str, Any]:
@@ -74,10 +81,29 @@ def _times_ns(frame: pd.DataFrame, column: str) -> NDArray[np.int64]:
     return np.asarray(ts.dt.tz_localize(None).to_numpy(dtype="datetime64[ns]").astype(np.int64))
 
 
+def interval_ns(frame: pd.DataFrame) -> tuple[NDArray[np.int64], NDArray[np.int64]] | None:
+    """(start, end) of every row's stated interval in ns (a row without one: an empty interval), or
+    None when the frame has no interval columns."""
+    if len(frame) == 0 or not all(c in frame for c in INTERVAL_COLUMNS):
+        return None
+    out = []
+    for c in INTERVAL_COLUMNS:
+        ts = pd.to_datetime(frame[c].astype("string"), utc=True, format="ISO8601", errors="coerce")
+        out.append(ts.dt.tz_localize(None).to_numpy(dtype="datetime64[ns]").astype(np.int64))
+    lo, hi = out
+    missing = np.isnat(lo.astype("datetime64[ns]")) | np.isnat(hi.astype("datetime64[ns]"))
+    return np.where(missing, 1, lo), np.where(missing, 0, hi)
+
+
 def match_times(
-    detected_ns: NDArray[np.int64], truth_ns: NDArray[np.int64], tolerance_s: float
+    detected_ns: NDArray[np.int64],
+    truth_ns: NDArray[np.int64],
+    tolerance_s: float,
+    intervals: tuple[NDArray[np.int64], NDArray[np.int64]] | None = None,
 ) -> list[tuple[int, int, float]]:
-    """One-to-one pairs (i_detected, j_truth, Δt s) with ``|Δt| <= tolerance_s``, maximum in number.
+    """One-to-one pairs (i_detected, j_truth, Δt s) with ``|Δt| <= tolerance_s`` (or, with
+    ``intervals`` (start, end in ns per detection), the truth inside the detection's interval),
+    maximum in number.
 
     The assignment cost is a large constant for pairs within tolerance minus nothing, plus the time
     difference as a tie-breaker, so the number of pairs is maximised first and the total |Δt| second.
@@ -85,14 +111,17 @@ def match_times(
     if detected_ns.size == 0 or truth_ns.size == 0:
         return []
     dt = (detected_ns[:, None] - truth_ns[None, :]).astype(np.float64) / 1e9
-    within = np.abs(dt) <= tolerance_s
-    if not within.any():
+    allowed = np.abs(dt) <= tolerance_s
+    if intervals is not None:
+        lo, hi = intervals
+        allowed |= (truth_ns[None, :] >= lo[:, None]) & (truth_ns[None, :] <= hi[:, None])
+    if not allowed.any():
         return []
-    rows = np.flatnonzero(within.any(axis=1))
-    cols = np.flatnonzero(within.any(axis=0))
+    rows = np.flatnonzero(allowed.any(axis=1))
+    cols = np.flatnonzero(allowed.any(axis=0))
     sub = np.abs(dt[np.ix_(rows, cols)])
-    ok = sub <= tolerance_s
-    big = 1e6 * max(tolerance_s, 1.0)
+    ok = allowed[np.ix_(rows, cols)]
+    big = 1e6 * max(tolerance_s, float(sub.max()), 1.0)
     cost = np.where(ok, sub - big, 0.0)
     r, c = linear_sum_assignment(cost)
     return [(int(rows[i]), int(cols[j]), float(dt[rows[i], cols[j]])) for i, j in zip(r, c, strict=True) if ok[i, j]]
@@ -128,17 +157,21 @@ def score_events(
     start: Any = None,
     end: Any = None,
     apply_threshold: bool = True,
+    intervals: bool = False,
 ) -> ScoreResult:
     """Precision, recall and F1 of ``detections`` against ``truth`` with ``± tolerance_s`` matching.
 
     With ``apply_threshold`` and a ``threshold`` column, only rows with ``statistic >= threshold``
-    count as detections (frames from ``--all-candidates`` runs carry sub-threshold rows).
+    count as detections (frames from ``--all-candidates`` runs carry sub-threshold rows). With
+    ``intervals`` a detection also pairs with a truth inside its stated interval (module docstring);
+    a frame without interval columns is scored as without.
     """
     det = _without_summaries(detections).reset_index(drop=True)
     if apply_threshold and len(det) and "threshold" in det and "statistic" in det:
         det = det.loc[det["statistic"] >= det["threshold"]]
     tru, outside = _restrict_truth(truth, truth_time_column, start, end)
-    local = match_times(_times_ns(det, time_column), _times_ns(tru, truth_time_column), tolerance_s)
+    spans = interval_ns(det) if intervals else None
+    local = match_times(_times_ns(det, time_column), _times_ns(tru, truth_time_column), tolerance_s, spans)
     pairs = [(int(det.index[i]), int(tru.index[j]), dt) for i, j, dt in local]
     tp = len(pairs)
     fp = len(det) - tp
@@ -160,6 +193,7 @@ def score_events(
         n_truth_outside_span=outside,
         span_years=years,
         false_alarms_per_year=fp / years if years and np.isfinite(years) and years > 0 else float("nan"),
+        intervals=spans is not None,
         pairs=tuple(pairs),
     )
 

@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 
 from abrupt.cli.flight import CLEANING_STAGES, detect_from_store
+from abrupt.cli.flux import exposure_options
 from abrupt.cli.groups import (
     StageProgress,
     catalog_option,
@@ -342,6 +343,7 @@ def telemetry_or_store_options(f: Any) -> Any:
     callback=check_suffix(".png", ".svg", ".pdf", ".html"),
     help="Also write the report (.png, .svg, .pdf or a self-contained .html page).",
 )
+@exposure_options
 def detect_attitude_cmd(
     telemetry: str,
     spacecraft_path: str,
@@ -353,13 +355,21 @@ def detect_attitude_cmd(
     store_dir: str | None = None,
     days: tuple[str, ...] = (),
     no_clean: tuple[str, ...] = (),
+    exposure_recovery: str | None = None,
+    exposure_dh90: float | None = None,
+    exposure_surfaces: str | None = None,
     **settings: Any,
 ) -> None:
     """Detect strikes in attitude TELEMETRY (CSV or Parquet), or in a --store; write events and the catalog."""
+    exposure = {"recovery": exposure_recovery, "dh90": exposure_dh90, "surfaces": exposure_surfaces}
     if store_dir is not None:  # flight-telemetry pipeline (abrupt.pipelines.flight)
         budget = pop_budget(settings, "1/day")
-        detect_from_store(store_dir, spacecraft_path, days, budget, no_clean, catalog_target, out, report_path)
+        detect_from_store(
+            store_dir, spacecraft_path, days, budget, no_clean, catalog_target, out, report_path, exposure=exposure
+        )
         return
+    if exposure_recovery or exposure_dh90:
+        raise click.UsageError("--exposure-recovery/--exposure-dH90 need --store (the flight pipeline's daily table)")
     if telemetry is None:
         raise click.UsageError("give TELEMETRY or --store DIR")
     mask = settings.pop("mask")

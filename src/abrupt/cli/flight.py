@@ -14,6 +14,7 @@ import click
 import numpy as np
 
 from abrupt import progress
+from abrupt.cli.flux import store_run_exposure
 from abrupt.cli.groups import cli, inject, record_run, simulate
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.detect.attitude.flight_glr import FlightGlrDetector
@@ -98,8 +99,10 @@ def detect_from_store(
     out: str | None,
     report_path: str | None,
     daily_path: str | None = None,
+    exposure: dict[str, Any] | None = None,
 ) -> None:
-    """``abrupt detect attitude --store``: run the flight pipeline on stored days; write events and reports."""
+    """``abrupt detect attitude --store``: run the flight pipeline on stored days; write events and reports
+    (and, with ``exposure`` options and a catalog, the run's exposure rows: :func:`store_run_exposure`)."""
     sc = load_spacecraft(spacecraft_path)
     cfg = FlightRunConfig(budget=budget, cleaning=_cleaning(no_clean))
     day_list = day_range(TelemetryStore(store_dir), sc.name, days or None)
@@ -133,6 +136,19 @@ def detect_from_store(
             detectors=[FlightGlrDetector.name],
             span_utc=(f"{day_list[0]}T00:00:00", f"{day_list[-1]}T23:59:59.999999") if day_list else None,
         )
+        if exposure and (exposure.get("recovery") or exposure.get("dh90")):
+            store_run_exposure(
+                catalog_target,
+                result.daily,
+                sc,
+                false_alarms_per_day=result.threshold.false_alarms_per_day,
+                detector=FlightGlrDetector.name,
+                config_hash=result.config_hash,
+                run_id=result.run_id,
+                recovery=exposure.get("recovery"),
+                dh90=exposure.get("dh90"),
+                surfaces=exposure.get("surfaces") or spacecraft_path,
+            )
     click.echo(result.daily.to_string(index=False), err=True)
     click.echo(
         f"threshold {result.threshold.value:.3g} ({result.threshold.false_alarms_per_day:g} false alarms/day, "

@@ -14,10 +14,17 @@ from abrupt.catalog import Catalog
 from abrupt.cli.groups import DEFAULT_CATALOG, cli, note, simulate
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.errors import ConfigError
-from abrupt.flux.exposure import EfficiencyCurve, efficiency_per_day, exposure_frame, store_exposure
+from abrupt.flux.exposure import (
+    EfficiencyCurve,
+    efficiency_per_day,
+    exposure_frame,
+    store_exposure,
+    store_spacecraft_model,
+)
 from abrupt.flux.forward import ForwardConfig
 from abrupt.flux.inference import PARAMS
-from abrupt.pipelines.flux import covered_days, infer_flux, simulate_population
+from abrupt.model.spacecraft import Spacecraft
+from abrupt.pipelines.flux import covered_days, flight_exposure, infer_flux, simulate_population
 from abrupt.report.flux import write_flux_report
 from abrupt.simulate.population import DETECTOR, FleetSpec
 
@@ -172,6 +179,7 @@ def exposure_command(
     fractions = [float(x) for x in str(analysed_fraction).split(",")]
     if len(fractions) not in (1, len(days)):
         raise click.UsageError(f"--analysed-fraction: give one value or one per day ({len(days)})")
+    model = store_spacecraft_model(cat, spacecraft, spacecraft_file)  # rows name it by the pseudonym
     rows = exposure_frame(
         [
             {
@@ -186,7 +194,7 @@ def exposure_command(
                 "altitude_km": altitude_km,
                 "inclination_deg": inclination_deg,
                 "epoch_year": epoch_year,
-                "spacecraft_file": str(Path(spacecraft_file).resolve()),
+                "spacecraft_file": model,
                 "attitude": attitude,
             }
             for i, d in enumerate(days)
@@ -263,3 +271,67 @@ def population(
     if out_path:
         events.to_csv(out_path, index=False)
         note(f"wrote {out_path}")
+
+
+def exposure_options(f: Any) -> Any:
+    """Options of ``detect attitude --store`` that also store the run's exposure rows in its catalog."""
+    f = click.option(
+        "--surfaces",
+        "exposure_surfaces",
+        type=click.Path(exists=True, dir_okay=False),
+        default=None,
+        help="Spacecraft TOML with [[surfaces]] for the exposure rows (default: --spacecraft).",
+    )(f)
+    f = click.option(
+        "--exposure-dH90",
+        "exposure_dh90",
+        type=float,
+        default=None,
+        help="With --store and --catalog: store exposure rows with this ΔH90 [N·m·s] (slope 4).",
+    )(f)
+    return click.option(
+        "--exposure-recovery",
+        "exposure_recovery",
+        type=click.Path(exists=True, dir_okay=False),
+        default=None,
+        help="With --store and --catalog: store exposure rows, efficiency fitted per day to this "
+        "injection-recovery CSV (dH_Nms, found[, day]; `inject attitude --recovery` writes *.injections.csv).",
+    )(f)
+
+
+def store_run_exposure(
+    catalog_target: str,
+    daily: pd.DataFrame,
+    spacecraft: Spacecraft,
+    *,
+    false_alarms_per_day: float,
+    detector: str,
+    config_hash: str,
+    run_id: str,
+    recovery: str | None,
+    dh90: float | None,
+    surfaces: str,
+) -> int:
+    """Store a detection run's exposure rows (one per analysed day) in its catalog; returns the row count."""
+    days = [str(d) for d in daily["day"]]
+    if recovery:
+        curves = efficiency_per_day(pd.read_csv(recovery), days, source=recovery)
+    elif dh90:
+        curves = dict.fromkeys(days, EfficiencyCurve.from_dH90(dh90))
+    else:
+        raise click.UsageError("give --exposure-recovery CSV or --exposure-dH90 to store exposure")
+    rows = flight_exposure(
+        Catalog(catalog_target, create=False),
+        daily,
+        spacecraft=spacecraft,
+        curves=curves,
+        false_alarms_per_day=false_alarms_per_day,
+        surfaces_file=surfaces,
+        detector=detector,
+        config_hash=config_hash,
+        run_id=run_id,
+    )
+    note(
+        f"stored {len(rows)} exposure rows for {spacecraft.name} (spacecraft model {spacecraft.name!r}) in the catalog"
+    )
+    return len(rows)

@@ -28,10 +28,12 @@ from abrupt.errors import ConfigError, InputError
 from abrupt.events import config_hash, new_run_id, read_events
 from abrupt.model.orbit import ForceModel
 from abrupt.pipelines.orbit import detect_orbit, inject_orbit, summary_lines
+from abrupt.pipelines.orbit_product import detect_orbit_product
 from abrupt.readers.ephemeris import write_ephemeris
 from abrupt.readers.navigation_csv import write_navigation_csv
 from abrupt.report.orbit import plot_orbit_report
 from abrupt.simulate.orbit import Impulse, OrbitSimulationConfig, simulate_orbit
+from abrupt.thresholds import FalseAlarmBudget
 
 #: the statistics ``--statistic`` accepts (each is the registered detector ``orbit.<statistic>``)
 STATISTIC_CHOICES = tuple(STATISTIC_SUMMARIES)
@@ -220,6 +222,13 @@ def simulate_orbit_command(
     help="After a detection, remove the burns found from the data and scan again, so that burns close in "
     "time (pairs 30-90 min apart) are each found with their own ΔV.",
 )
+@click.option(
+    "--all-satellites",
+    is_flag=True,
+    default=False,
+    help="Every satellite of a multi-satellite SP3 file, each satellite's threshold calibrated on the "
+    "other satellites of the file (leave-one-satellite-out; see docs/orbit.md).",
+)
 @click.option("--kind", type=click.Choice(["unknown", "maneuver", "strike"]), default="unknown", show_default=True)
 @click.option(
     "--statistics-out", type=click.Path(dir_okay=False), default=None, help="Per-epoch statistics (.parquet/.csv)."
@@ -246,6 +255,7 @@ def detect_orbit_command(
     null_file: str | None,
     confidence_z: float,
     sequences: bool,
+    all_satellites: bool,
     kind: str,
     statistics_out: str | None,
     pseudonym: str | None,
@@ -264,6 +274,28 @@ def detect_orbit_command(
         raise ConfigError("give --detector or --statistic, not both", key="detector")
     name = detector_name or statistic or ("glr" if tuning == "auto" else "mcr_w")
     run_id = new_run_id()
+    if all_satellites:
+        if satellite is not None or null_file is not None or report_path or statistics_out:
+            raise ConfigError(
+                "--all-satellites takes every satellite of the file with thresholds from the others: "
+                "do not give --satellite, --null, --report or --statistics-out with it",
+                key="all_satellites",
+            )
+        settings = {
+            "tuning": tuning,
+            "tau_s": tau_s,
+            "q_m2_s5": q_m2_s5,
+            "sigma_pos_m": sigma_pos_m,
+            "sigma_vel_mps": sigma_vel_mps,
+            "dynamics": dynamics,
+            "gravity_degree": gravity_degree,
+            "nuisance": nuisance,
+            "confidence_z": confidence_z,
+            "kind": kind,
+            "run_id": run_id,
+        }
+        _detect_all_satellites(file, out, name, budget, allow_truncated, strict, sequences, catalog_target, settings)
+        return
     try:
         run = detect_orbit(
             file,
@@ -320,6 +352,63 @@ def detect_orbit_command(
     if report_path and run.analysis is not None:
         path = plot_orbit_report(run.analysis, run.thresholds, events, report_path)
         click.echo(f"report written to {path}", err=True)
+
+
+def _detect_all_satellites(
+    file: str,
+    out: str,
+    name: str,
+    budget: FalseAlarmBudget,
+    allow_truncated: bool,
+    strict: bool,
+    sequences: bool,
+    catalog_target: str,
+    settings: dict[str, Any],
+) -> None:
+    """``detect orbit --all-satellites``: every satellite of the file, thresholds from the others."""
+    try:
+        runs = detect_orbit_product(
+            file,
+            detector=name,
+            budget=budget,
+            allow_truncated=allow_truncated,
+            strict=strict,
+            sequences=sequences,
+            **settings,
+        )
+    except KeyError as exc:
+        raise ConfigError(str(exc.args[0]), key="detector") from None
+    if not runs:
+        raise InputError("no satellite of the file has enough epochs to filter (at least 10)", file=file)
+    first = next(iter(runs.values()))
+    for line in first.ephemeris.repairs.summary():
+        click.echo(f"repaired: {line}", err=True)
+    click.echo(f"{len(runs)} satellites; threshold of the event statistic, 90 %-detectable |ΔV|, events:", err=True)
+    for sid, run in runs.items():
+        th = run.thresholds.get(run.detector.statistic)
+        th_txt = f"{th.value:.4g} ({th.method})" if th is not None else "none (too few epochs)"
+        dv90 = 1e3 * float(run.summary.get("dv90_mps", float("nan")))
+        click.echo(f"  {sid:<8} {th_txt:<26} {dv90:8.3g} mm/s  {len(run.events)}", err=True)
+        for warning in run.result.warnings:
+            click.echo(f"  {sid:<8} warning: {warning}", err=True)
+    frames = [run.events for run in runs.values() if len(run.events)]
+    events = pd.concat(frames, ignore_index=True) if frames else first.events.iloc[:0]
+    chash = str(events["config_hash"].iloc[0]) if len(events) else config_hash({**first.detector.config()})
+    record_run(
+        catalog_target=catalog_target,
+        command="detect orbit",
+        events=events,
+        config_hash=chash,
+        run_id=str(settings["run_id"]),
+        input_path=file,
+        out=out,
+        details={
+            "satellites": {
+                sid: {k: v for k, v in run.summary.items() if k in ("thresholds", "events", "dv90_mps", "span_days")}
+                for sid, run in runs.items()
+            }
+        },
+    )
 
 
 @inject.command("orbit")

@@ -36,7 +36,7 @@ from abrupt.pipelines.tle import burns_below_detectable, detect_tle_file, satell
 from abrupt.readers.fengyun import read_maneuver_file
 from abrupt.readers.omm import read_elements
 from abrupt.report.tle import plot_injection_recall, plot_tle_report
-from abrupt.score import recall_at_false_alarm_rate, score_events
+from abrupt.score import interval_ns, recall_at_false_alarm_rate, score_events
 from abrupt.simulate.tle_injection import KINDS, MIN_ELEMENT_SETS, injection_recall, ladder_around
 from abrupt.simulate.tle_own_null import own_null_rate
 from abrupt.thresholds import DAYS_PER_YEAR, FalseAlarmBudget
@@ -383,6 +383,14 @@ def score(
         f"TP {result.true_positives}  FP {result.false_positives}  FN {result.false_negatives}  "
         f"precision {result.precision:.3f}  recall {result.recall:.3f}  F1 {result.f1:.3f}"
     )
+    if interval_ns(events) is not None:
+        stated = score_events(events, truth_frame, tolerance_s=tol, start=start, end=end, intervals=True)
+        click.echo(
+            f"with the events' stated intervals (truth inside an event's interval or within ±{tolerance_days:g} d "
+            f"of its time): TP {stated.true_positives}  FP {stated.false_positives}  FN {stated.false_negatives}  "
+            f"F1 {stated.f1:.3f}"
+        )
+        out["with_intervals"] = stated.as_dict()
     if start is not None and end is not None:
         out["operating_points"] = []
         for rate in fa_rates:

@@ -41,6 +41,7 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
 from abrupt import progress
@@ -221,20 +222,27 @@ def drag_integrals(
         t_abs = (when - when[0]).astype(np.int64) * 1e-9
         rho_all = np.exp(interpolate_log_density(t_abs, t_abs[sample][good], np.log(rho_s[good])))
     radius = np.linalg.norm(pos, axis=1)
-    for g in range(n_sets - 1):
-        sl = slice(offsets[g], offsets[g + 1])
-        x = tau_all[sl]
-        y = integrand[sl]
-        cum_w[g + 1] = cum_w[g] + float(np.trapezoid(y, x))
-        if cum_m is not None and rho_all is not None:
-            cum_m[g + 1] = cum_m[g] + float(np.trapezoid(y * rho_all[sl], x))
-        alt[g + 1] = (float(np.mean(radius[sl])) - 6378137.0) / 1e3
-        wf[g + 1] = float(np.mean(f_all[sl]))
     if n_sets > 1:
+        # every gap's trapezoid sum and node means in one pass (sums in node order, not numpy's
+        # pairwise order: the same values to ~1e-15 relative)
+        starts = offsets[:-1]
+        cum_w[1:] = np.cumsum(_gap_trapezoids(tau_all, integrand, starts))
+        if cum_m is not None and rho_all is not None:
+            cum_m[1:] = np.cumsum(_gap_trapezoids(tau_all, integrand * rho_all, starts))
+        alt[1:] = (np.add.reduceat(radius, starts) / counts - 6378137.0) / 1e3
+        wf[1:] = np.add.reduceat(f_all, starts) / counts
         alt[0] = alt[1]
         wf[0] = wf[1]
     set_index = np.concatenate([offsets[:-1], [offsets[-1] - 1]]) if n_sets > 1 else np.zeros(1, dtype=np.int64)
     return DragIntegrals(t, n_bar, cum_w, cum_m, alt, wf, when, integrand, rho_all, set_index)
+
+
+def _gap_trapezoids(x: FloatArray, y: FloatArray, starts: NDArray[np.int64]) -> FloatArray:
+    """Trapezoid integral of ``y`` over ``x`` on each run of nodes beginning at ``starts`` (runs of at
+    least two nodes, back to back)."""
+    seg = np.diff(x) * (y[1:] + y[:-1]) / 2.0
+    seg[starts[1:] - 1] = 0.0  # the step from one run's last node to the next run's first
+    return np.add.reduceat(np.append(seg, 0.0), starts)
 
 
 def interpolate_log_density(t_s: FloatArray, t_known_s: FloatArray, log_rho: FloatArray) -> FloatArray:

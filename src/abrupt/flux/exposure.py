@@ -20,9 +20,12 @@ of a flux measurement.
 
 from __future__ import annotations
 
+import hashlib
 import math
+import tomllib
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -33,6 +36,7 @@ from scipy.optimize import minimize
 
 from abrupt.catalog import Catalog
 from abrupt.errors import ConfigError, InputError
+from abrupt.model.spacecraft import Spacecraft, load_spacecraft, spacecraft_from_dict
 
 DAYS_PER_YEAR = 365.25  # [d] Julian year
 
@@ -73,6 +77,16 @@ exposure_table = sa.Table(
     sa.Column("spacecraft_file", sa.Text, nullable=False),
     sa.Column("attitude", sa.String(16), nullable=False),
     sa.Column("run_id", sa.String(64), nullable=True),
+)
+
+#: Spacecraft descriptions (TOML text) the exposure rows name in their ``spacecraft_file`` column, so that a
+#: catalog carries the strike geometry with its exposure and no row depends on a path on one machine.
+spacecraft_model_table = sa.Table(
+    "spacecraft_models",
+    _metadata,
+    sa.Column("model", sa.String(200), primary_key=True),
+    sa.Column("sha256", sa.String(64), nullable=False),
+    sa.Column("toml", sa.Text, nullable=False),
 )
 
 
@@ -289,3 +303,36 @@ def exposure_summary(exposure: pd.DataFrame) -> pd.DataFrame:
             "inclination_deg": g["inclination_deg"].first(),
         }
     ).reset_index()
+
+
+def store_spacecraft_model(catalog: Catalog, model: str, path: str | Path) -> str:
+    """Store a spacecraft TOML (validated) in the catalog under ``model`` (a spacecraft's name or pseudonym,
+    which exposure rows then give as their ``spacecraft_file``); re-storing a name replaces its text."""
+    if not model:
+        raise ConfigError("a spacecraft model needs a non-empty name", key="model")
+    load_spacecraft(path)  # validate first: a clear error naming the file and key
+    text = Path(path).read_text(encoding="utf-8")
+    digest = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    t = spacecraft_model_table
+    with catalog.engine.begin() as conn:
+        _metadata.create_all(conn)
+        conn.execute(t.delete().where(t.c.model == model))
+        conn.execute(t.insert(), [{"model": model, "sha256": digest, "toml": text}])
+    return model
+
+
+def load_spacecraft_models(catalog: Catalog) -> dict[str, Spacecraft]:
+    """The spacecraft descriptions stored in a catalog, by model name (empty when it holds none)."""
+    if "spacecraft_models" not in sa.inspect(catalog.engine).get_table_names():
+        return {}
+    with catalog.engine.connect() as conn:
+        rows = conn.execute(sa.select(spacecraft_model_table)).mappings().all()
+    out: dict[str, Spacecraft] = {}
+    for row in rows:
+        source = f"{catalog.name}#spacecraft_models/{row['model']}"
+        try:
+            data = tomllib.loads(str(row["toml"]))
+        except tomllib.TOMLDecodeError as exc:
+            raise ConfigError(f"stored spacecraft model is not valid TOML: {exc}", file=source) from None
+        out[str(row["model"])] = spacecraft_from_dict(data, source=source)
+    return out

@@ -38,7 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from abrupt.errors import ConfigError
-from abrupt.model.spacecraft import load_spacecraft
+from abrupt.model.spacecraft import Spacecraft, load_spacecraft
 from abrupt.rates.geometry import geometry_from_spacecraft
 from abrupt.rates.montecarlo import RateConfig, simulate_strikes
 from abrupt.rates.tables import FluxTable, grun_table, nasa90_table, read_flux_table
@@ -174,9 +174,14 @@ def smoothed_cumulative(
     return np.asarray(out, dtype=np.float64)
 
 
-def build_template(case: OrbitCase, config: ForwardConfig, *, n_grid: int = 400) -> Template:
-    """Run the rates Monte Carlo for each population and tabulate the cumulative unit-β |ΔH| rates."""
-    sc = load_spacecraft(case.spacecraft_file)
+def build_template(
+    case: OrbitCase, config: ForwardConfig, *, n_grid: int = 400, spacecraft: Spacecraft | None = None
+) -> Template:
+    """Run the rates Monte Carlo for each population and tabulate the cumulative unit-β |ΔH| rates.
+
+    ``case.spacecraft_file`` names the spacecraft: a model stored in the catalog (pass it as ``spacecraft``)
+    or a TOML file path."""
+    sc = spacecraft if spacecraft is not None else load_spacecraft(case.spacecraft_file)
     geometry = geometry_from_spacecraft(sc)
     grid = np.linspace(math.log(1e-9), math.log(1e3), n_grid)  # 0.069 steps in ln|ΔH|
     cum = np.zeros((len(POPULATIONS), len(DIRECTION_CLASSES), n_grid))

@@ -131,8 +131,8 @@ def prepare(
     curves = exp.drop_duplicates(eff_cols).loc[:, eff_cols].to_numpy(dtype=np.float64)
     eff_u = bin_efficiency(edges, curves)  # (U, K)
     cdf = logistic_efficiency(edges[None, :-1], curves[:, :1], curves[:, 1:2], 1.0)
-    share_u = np.diff(np.concatenate([cdf, np.ones((len(curves), 1))], axis=1), axis=1)
-    share_u = share_u / np.maximum(share_u.sum(axis=1, keepdims=True), 1e-300)
+    # share of false alarms per bin; those below the lowest edge are left out like their events
+    share_u = np.diff(np.concatenate([cdf, np.ones((len(curves), 1))], axis=1), axis=1).astype(np.float64)
     n_u = len(curves)
     weight = np.bincount(group * n_u + curve_of, weights=f, minlength=len(keys) * n_u).reshape(len(keys), n_u)
     exposure_years = weight @ eff_u / DAYS_PER_YEAR  # (G, K)
@@ -196,13 +196,20 @@ class Likelihood:
             self.totals[b] = self.bin_signal[b].sum(axis=1)
         self.bg_events = data.event_background
         self.bg_total = float(data.background_bins.sum())
+        self.weights = np.ones(data.n_events)  # events' multiplicities (a Poisson bootstrap draws them)
+
+    def reweighted(self, weights: NDArray[np.float64]) -> Likelihood:
+        """The same likelihood with each event counted ``weights[i]`` times (arrays shared)."""
+        out = self.subset(np.ones(self.beta_grid.size, dtype=bool))
+        out.weights = np.asarray(weights, dtype=np.float64)
+        return out
 
     def subset(self, keep: NDArray[np.bool_]) -> Likelihood:
         """The same likelihood on part of the β grid (arrays shared, not recomputed)."""
         out = object.__new__(Likelihood)
         out.data, out.beta_grid = self.data, self.beta_grid[keep]
         out.a, out.totals, out.bin_signal = self.a[keep], self.totals[keep], self.bin_signal[keep]
-        out.bg_events, out.bg_total = self.bg_events, self.bg_total
+        out.bg_events, out.bg_total, out.weights = self.bg_events, self.bg_total, self.weights
         return out
 
     def _mu(self, scales: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -215,21 +222,26 @@ class Likelihood:
     def loglike(self, scales: NDArray[np.float64]) -> NDArray[np.float64]:
         """ln L for scales (nb, P) at every β of the grid."""
         mu = self._mu(scales)
-        with np.errstate(divide="ignore"):
-            ev = np.log(mu).sum(axis=1)
+        used = self.weights > 0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ev = np.where(used, self.weights * np.log(np.maximum(mu, 0.0)), 0.0).sum(axis=1)
+        ev = np.where(np.any((mu <= 0) & used, axis=1), -np.inf, ev)  # an observed event needs μ > 0
         return np.asarray(ev - (scales * self.totals).sum(axis=1) - self.bg_total, dtype=np.float64)
 
     def maximise(
-        self, fixed: Mapping[str, float], *, iterations: int = 60, em_iterations: int = 5
+        self, fixed: Mapping[str, float], *, iterations: int = 60, em_iterations: int = 5, signed: bool = False
     ) -> tuple[NDArray[Any], NDArray[Any]]:
-        """Scales (nb, P) maximising ln L at each β with some scales fixed; returns (scales, ln L)."""
+        """Scales (nb, P) maximising ln L at each β with some scales fixed; returns (scales, ln L).
+
+        ``signed``: the scales may go below 0 wherever every event keeps μ > 0 (the unconstrained
+        maximum: no pile-up at the physical bound, hence a mean without the truncation bias)."""
         nb, npop = self.beta_grid.size, len(POPULATIONS)
         free = np.array([SCALES[p] not in fixed for p in range(npop)])
         s = np.ones((nb, npop))
         for p in range(npop):
             if not free[p]:
                 s[:, p] = fixed[SCALES[p]]
-        n_ev = max(self.data.n_events, 1)
+        n_ev = max(float(self.weights.sum()), 1.0)
         if free.any():
             start = n_ev / np.maximum(self.totals[:, free].sum(axis=1), 1e-300)
             s[:, free] = np.clip(start, 1e-6, 1e9)[:, None]
@@ -238,22 +250,27 @@ class Likelihood:
             return s, self.loglike(s)
         for _ in range(em_iterations):  # EM (Richardson-Lucy): monotone, keeps scales >= 0
             mu = np.maximum(self._mu(s), 1e-300)
-            ratio = (self.a[:, :, idx] / mu[:, :, None]).sum(axis=1) / np.maximum(self.totals[:, idx], 1e-300)
+            wa = self.a[:, :, idx] * self.weights[None, :, None]
+            ratio = (wa / mu[:, :, None]).sum(axis=1) / np.maximum(self.totals[:, idx], 1e-300)
             s[:, idx] *= ratio
         ll = self.loglike(s)
         for _ in range(iterations):  # Newton with backtracking, projected on scales >= 0
             mu = np.maximum(self._mu(s), 1e-300)
             af = self.a[:, :, idx] / mu[:, :, None]
-            grad = af.sum(axis=1) - self.totals[:, idx]
-            hess = -np.einsum("bei,bej->bij", af, af) - 1e-12 * np.eye(idx.size)[None]
+            waf = af * self.weights[None, :, None]
+            grad = waf.sum(axis=1) - self.totals[:, idx]
+            hess = -np.einsum("bei,bej->bij", waf, af) - 1e-12 * np.eye(idx.size)[None]
             step = -np.linalg.solve(hess, grad[:, :, None])[:, :, 0]
             cur = s[:, idx].copy()
-            step = np.where((cur <= 0) & (grad < 0), 0.0, step)  # at the bound, pushing out: stay
+            if not signed:
+                step = np.where((cur <= 0) & (grad < 0), 0.0, step)  # at the bound, pushing out: stay
             t = np.ones(self.beta_grid.size)
             improved = np.zeros(self.beta_grid.size, dtype=bool)
             for _half in range(30):
                 trial = s.copy()
-                trial[:, idx] = np.maximum(cur + t[:, None] * step, 0.0)
+                trial[:, idx] = cur + t[:, None] * step
+                if not signed:
+                    trial[:, idx] = np.maximum(trial[:, idx], 0.0)
                 ll_t = self.loglike(trial)
                 ok = (ll_t >= ll - 1e-10 * (1.0 + np.abs(ll))) & ~improved
                 s[ok] = trial[ok]
@@ -268,7 +285,7 @@ class Likelihood:
         return s, self.loglike(s)
 
 
-def _refine_max(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, float, int]:
+def refine_max(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, float, int]:
     """Maximum of samples y(x) refined by a parabola through the best point and its neighbours."""
     i = int(np.nanargmax(y))
     if 0 < i < x.size - 1 and np.all(np.isfinite(y[i - 1 : i + 2])):
@@ -300,6 +317,7 @@ class FitResult:
     n_with_direction: int
     expected_events: dict[str, float] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    signed_estimates: dict[str, float] = field(default_factory=dict)  # scales not bounded at 0
 
     def as_dict(self) -> dict[str, Any]:
         return {
@@ -314,6 +332,7 @@ class FitResult:
             "n_events_with_direction": self.n_with_direction,
             "expected_events": self.expected_events,
             "notes": self.notes,
+            "signed_estimates": self.signed_estimates,
         }
 
 
@@ -322,7 +341,7 @@ def _profile_value(lik: Likelihood, fixed: Mapping[str, float]) -> float:
     _, ll = lik.maximise(fixed)
     if lik.beta_grid.size == 1:
         return float(ll[0])
-    return _refine_max(np.log(lik.beta_grid), ll)[1]
+    return refine_max(np.log(lik.beta_grid), ll)[1]
 
 
 def fit(
@@ -352,7 +371,7 @@ def fit(
     s, ll = lik.maximise(scale_fixed)
     logb = np.log(lik.beta_grid)
     if lik.beta_grid.size > 1:
-        xb, ll_max, _ = _refine_max(logb, ll)
+        xb, ll_max, _ = refine_max(logb, ll)
         beta_hat = math.exp(xb)
         s_hat = np.array([np.interp(xb, logb, s[:, p]) for p in range(s.shape[1])])
     else:
@@ -375,6 +394,7 @@ def fit(
     b = int(np.argmin(np.abs(logb - math.log(beta_hat))))
     expected = {pop: float(s_hat[p] * lik.totals[b, p]) for p, pop in enumerate(POPULATIONS)}
     expected["false_alarms"] = lik.bg_total
+    signed = _signed_estimates(lik, scale_fixed) if data.n_events else dict(estimates)
     return FitResult(
         estimates,
         intervals,
@@ -387,7 +407,27 @@ def fit(
         data.n_with_direction,
         expected,
         notes,
+        signed,
     )
+
+
+def _signed_estimates(lik: Likelihood, scale_fixed: Mapping[str, float]) -> dict[str, float]:
+    """Maximum likelihood with the scales free to go below 0 (every event keeping μ > 0).
+
+    The bounded estimate piles up at s = 0 when a population has few events, which lifts its mean (a
+    truncation bias); the signed one does not. For one bin and a known background it is
+    ŝ = (n − b)/S, exactly unbiased; with several bins and populations it is unbiased to first order.
+    """
+    s, ll = lik.maximise(scale_fixed, signed=True)
+    if lik.beta_grid.size == 1:
+        return {"debris_scale": float(s[0, 0]), "meteoroid_scale": float(s[0, 1]), "beta": float(lik.beta_grid[0])}
+    logb = np.log(lik.beta_grid)
+    xb, _, _ = refine_max(logb, ll)
+    return {
+        "debris_scale": float(np.interp(xb, logb, s[:, 0])),
+        "meteoroid_scale": float(np.interp(xb, logb, s[:, 1])),
+        "beta": math.exp(xb),
+    }
 
 
 def _beta_interval(logb: NDArray[Any], ll: NDArray[Any], level: float, notes: list[str]) -> tuple[float, float]:

@@ -1,7 +1,9 @@
 """Meteoroid shower calendar and the test of association of detections with shower peaks.
 
-The calendar (``abrupt/data/meteor_showers.csv``) lists the major annual showers of the IMO working
-list: activity period, peak date, zenithal hourly rate at the peak and geocentric speed. A shower's
+The calendar (``abrupt/data/meteor_showers.csv``) lists 13 major annual showers as published in the IMO
+Working List of Visual Meteor Showers (source and edition in the file's header): activity period, peak
+date, zenithal hourly rate at the peak (empty where the list gives no fixed rate), geocentric speed and,
+where checked against a published IMO value, the solar longitude of the peak. A shower's
 *peak window* is the peak day ± ``half_width_days`` (default 2): the ZHR falls to a fraction of its peak
 within a few days for most showers.
 

@@ -9,6 +9,7 @@ measured cumulative rate against |ΔH| that the report draws.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -21,7 +22,15 @@ from scipy import stats
 from abrupt.catalog import Catalog, coverage_table
 from abrupt.errors import InputError
 from abrupt.events import new_run_id
-from abrupt.flux.exposure import exposure_summary, load_exposure, store_exposure
+from abrupt.flux.exposure import (
+    EfficiencyCurve,
+    exposure_frame,
+    exposure_summary,
+    load_exposure,
+    load_spacecraft_models,
+    store_exposure,
+    store_spacecraft_model,
+)
 from abrupt.flux.forward import POPULATIONS, ForwardConfig, OrbitCase, Template, build_template, with_seed
 from abrupt.flux.inference import (
     FitResult,
@@ -34,6 +43,7 @@ from abrupt.flux.inference import (
     upper_limit,
 )
 from abrupt.flux.showers import shower_association
+from abrupt.model.spacecraft import Spacecraft, load_spacecraft
 from abrupt.simulate.population import FleetSpec, draw_population, fleet_exposure
 
 #: Flux models tested for goodness of fit: name -> parameters (β = the reference MEF).
@@ -74,16 +84,21 @@ class FluxInference:
 
 
 def templates_for(
-    exposure: pd.DataFrame, config: ForwardConfig, cache: dict[OrbitCase, Template] | None = None
+    exposure: pd.DataFrame,
+    config: ForwardConfig,
+    cache: dict[OrbitCase, Template] | None = None,
+    models: Mapping[str, Spacecraft] | None = None,
 ) -> dict[OrbitCase, Template]:
-    """One forward-model template per (spacecraft file, orbit) in the exposure rows."""
+    """One forward-model template per (spacecraft model, orbit) in the exposure rows; a row's
+    ``spacecraft_file`` is a model stored in the catalog (``models``) or, failing that, a TOML path."""
     out = {} if cache is None else cache
+    models = models or {}
     for row in exposure.drop_duplicates(["spacecraft_file", "altitude_km", "inclination_deg", "epoch_year"]).to_dict(
         "records"
     ):
         case = case_of(row)
         if case not in out:
-            out[case] = build_template(case, config)
+            out[case] = build_template(case, config, spacecraft=models.get(case.spacecraft_file))
     return out
 
 
@@ -146,7 +161,7 @@ def infer_flux(
     events = catalog.events(kind="strike")
     if spacecraft:
         events = events[events["spacecraft"].isin(list(spacecraft))]
-    tpl = templates_for(exposure, config, templates)
+    tpl = templates_for(exposure, config, templates, load_spacecraft_models(catalog))
     data = prepare(exposure, events, tpl, use_direction=use_direction)
     lik = Likelihood(data)
     fits = {"free": fit(data, fixed=fixed, confidence=confidence, likelihood=lik if not fixed else None)}
@@ -224,6 +239,10 @@ def simulate_population(
     events = draw_population(exposure, tpl, truth, seed=seed, dH_rel_sigma=dH_rel_sigma, run_id=run_id)
     catalog.start_run(run_id, "simulate population", details={"truth": dict(truth), "spec": vars(spec)})
     added = catalog.store_events(events)
+    # the catalog carries the spacecraft description; its rows name it, not a path on this machine
+    exposure["spacecraft_file"] = store_spacecraft_model(
+        catalog, load_spacecraft(spec.spacecraft_file).name, spec.spacecraft_file
+    )
     store_exposure(catalog, exposure)
     catalog.finish_run(run_id, n_found=len(events), n_new=added.events)
     return events, exposure
@@ -244,3 +263,66 @@ def covered_days(catalog: Catalog, spacecraft: str) -> tuple[str, ...]:
         end = pd.Timestamp(e) - pd.Timedelta(microseconds=1)
         days |= set(pd.date_range(pd.Timestamp(s).normalize(), end, freq="D").strftime("%Y-%m-%d"))
     return tuple(sorted(days))
+
+
+def altitude_from_period_km(period_s: float) -> float:
+    """Mean altitude [km] of a circular orbit of the given period (Kepler's third law, GM and the
+    equatorial radius of WGS-84)."""
+    gm, radius = 3.986004418e14, 6378137.0  # [m^3/s^2], [m]
+    return float((gm * (period_s / (2.0 * np.pi)) ** 2) ** (1.0 / 3.0) - radius) / 1e3
+
+
+def flight_exposure(
+    catalog: Catalog,
+    daily: pd.DataFrame,
+    *,
+    spacecraft: Spacecraft,
+    curves: Mapping[str, EfficiencyCurve],
+    false_alarms_per_day: float,
+    surfaces_file: str,
+    detector: str,
+    config_hash: str,
+    run_id: str,
+    altitude_km: float | None = None,
+    attitude: str = "unknown",
+) -> pd.DataFrame:
+    """Exposure rows of a detection run, one per analysed day of its daily table (``analysed_fraction``),
+    stored in the catalog beside that run's events; the strike geometry (``surfaces_file``) is stored in
+    the catalog under the spacecraft's pseudonym, which the rows name. The orbit comes from the spacecraft
+    file's ``[orbit]`` (period → altitude, inclination) unless ``altitude_km`` is given."""
+    orbit = spacecraft.orbit
+    if orbit is None or not math.isfinite(orbit.inclination_deg):
+        raise InputError(f"{spacecraft.source}: exposure needs [orbit] inclination_deg (and period_s)")
+    if altitude_km is None:
+        if not math.isfinite(orbit.period_s):
+            raise InputError(f"{spacecraft.source}: exposure needs [orbit] period_s, or give the altitude")
+        altitude_km = altitude_from_period_km(orbit.period_s)
+    model = store_spacecraft_model(catalog, spacecraft.name, surfaces_file)
+    days = [str(d) for d in daily["day"]]
+    missing = [d for d in days if d not in curves]
+    if missing:
+        raise InputError(f"no detection-efficiency curve for day {missing[0]}")
+    rows = exposure_frame(
+        [
+            {
+                "spacecraft": spacecraft.name,
+                "day": d,
+                "detector": detector,
+                "config_hash": config_hash,
+                "analysed_fraction": float(f),
+                "false_alarms_per_day": false_alarms_per_day,
+                "dH50_Nms": curves[d].dH50_Nms,
+                "efficiency_slope": curves[d].slope,
+                "efficiency_max": curves[d].max_efficiency,
+                "altitude_km": altitude_km,
+                "inclination_deg": orbit.inclination_deg,
+                "epoch_year": float(d[:4]),
+                "spacecraft_file": model,
+                "attitude": attitude,
+                "run_id": run_id,
+            }
+            for d, f in zip(days, daily["analysed_fraction"], strict=True)
+        ]
+    )
+    store_exposure(catalog, rows)
+    return rows

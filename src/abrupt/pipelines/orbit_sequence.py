@@ -25,7 +25,13 @@ import numpy as np
 import pandas as pd
 
 from abrupt.detect.base import DetectionResult
-from abrupt.detect.orbit.detectors import OrbitDetector, orbit_product_boundaries, orbit_thresholds
+from abrupt.detect.orbit.boundaries import boundary_window
+from abrupt.detect.orbit.detectors import (
+    OrbitDetector,
+    orbit_analysis,
+    orbit_product_boundaries,
+    orbit_thresholds,
+)
 from abrupt.detect.orbit.tuning import velocities_from_positions
 from abrupt.series.ephemeris import Ephemeris
 from abrupt.simulate.orbit import inject_impulse
@@ -81,6 +87,26 @@ def _new(
     return candidates.iloc[np.flatnonzero(keep)]
 
 
+def _supported(candidates: pd.DataFrame, first: DetectionResult, lead_s: float, lag_s: float) -> pd.DataFrame:
+    """Candidates whose epoch the first scan's statistic already exceeded its threshold near: from
+    ``lead_s`` before to ``lag_s`` after (the sliding GLR at θ holds the innovations θ … θ + window, so a
+    jump raises it over the window before the jump). A burn hidden by a stronger one is merged into, or
+    suppressed by, that one's episode: it still raises the statistic of the first scan. A detection away
+    from every exceedance of the first scan is a residual of a removal (a non-impulsive change such as an
+    Earth-shadow crossing, taken out as an impulse, leaves a jump-like residual later on), not a burn."""
+    diag = first.diagnostics[0] if first.diagnostics else None
+    if len(candidates) == 0 or diag is None or diag.threshold is None:
+        return candidates
+    s = np.nan_to_num(np.asarray(diag.statistic, dtype=np.float64), nan=-np.inf)
+    t_above = np.asarray(diag.time_s, dtype=np.float64)[s > diag.threshold.value]
+    if t_above.size == 0:
+        return candidates.iloc[:0]
+    t_c = (_times(candidates) - np.asarray(diag.epoch_utc, dtype="datetime64[ns]")).astype(np.float64) * 1e-9
+    gap = t_above[None, :] - t_c[:, None]
+    near = ((gap >= -lead_s) & (gap <= lag_s)).any(axis=1)
+    return candidates.iloc[np.flatnonzero(near)]
+
+
 def resolve_sequence(
     detector: OrbitDetector,
     eph: Ephemeris,
@@ -100,9 +126,17 @@ def resolve_sequence(
     # the later scans keep the first scan's thresholds: the null is the file's, not the corrected copy's
     detector = copy.copy(detector)
     detector.fixed_thresholds = orbit_thresholds(first)
+    analysis = orbit_analysis(first)
+    lead_s, lag_s = np.inf, np.inf
+    if analysis is not None:
+        step = analysis.ephemeris.nominal_step_s
+        lead_s, lag_s = boundary_window(analysis), 2.0 * step
+        # two jumps inside one GLR window are not resolved by the data (a 5-minute product's window is
+        # 50 minutes): a further detection that close to a known burn is that burn
+        separation_s = max(separation_s, analysis.config.glr_window_samples * step)
     while len(events) < max_burns:
         again = detector.detect(remove_burns(eph, events), budget).events
-        fresh = _new(again, events, separation_s, nuisance)
+        fresh = _supported(_new(again, events, separation_s, nuisance), first, lead_s, lag_s)
         if len(fresh) == 0:
             break
         events = pd.concat([events, fresh], ignore_index=True)

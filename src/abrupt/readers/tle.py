@@ -119,10 +119,20 @@ class RawElementSet:
     name: str | None = None
 
 
+# bytes.translate table of the checksum: a digit keeps its value, '-' counts as the digit 1, all else
+# is deleted; the sum of what is left minus 48 per character is the sum of the counted values
+_CHECKSUM_TABLE = bytes(range(256)).replace(b"-", b"1", 1)
+_CHECKSUM_DELETE = bytes(b for b in range(256) if not (48 <= b <= 57 or b == 45))
+
+
 def tle_checksum(line: str) -> int:
     """Modulo-10 checksum of the first 68 columns: digits count their value, '-' counts 1."""
-    total = 0
-    for ch in line[:68]:
+    head = line[:68]
+    if head.isascii():
+        kept = head.encode("ascii").translate(_CHECKSUM_TABLE, _CHECKSUM_DELETE)
+        return (sum(kept) - 48 * len(kept)) % 10
+    total = 0  # other Unicode digits count their value too (str.isdigit), as a reader may be given them
+    for ch in head:
         if ch.isdigit():
             total += int(ch)
         elif ch == "-":

@@ -164,12 +164,19 @@ class OrbitDetector(Detector[Ephemeris]):
     def detect(self, series: Ephemeris, budget: FalseAlarmBudget) -> DetectionResult:
         if len(series) < 10:
             return DetectionResult.empty(warnings=(f"{len(series)} epochs: too few to filter",))
-        cfg = self.detector_config(series, budget)
-        analysis = analyse(series, cfg)
+        return self.detect_analysis(series, budget, self.analyse(series, budget))
+
+    def analyse(self, series: Ephemeris, budget: FalseAlarmBudget) -> OrbitAnalysis:
+        """The filters, fusion and every statistic of ``series`` with this detector's settings."""
+        return analyse(series, self.detector_config(series, budget))
+
+    def detect_analysis(self, series: Ephemeris, budget: FalseAlarmBudget, analysis: OrbitAnalysis) -> DetectionResult:
+        """Thresholds (``fixed_thresholds``, the null, or the arc itself), product boundaries and events of an
+        analysis made by :meth:`analyse`."""
         if self.fixed_thresholds is not None:
             thresholds = dict(self.fixed_thresholds)
         elif self._null is not None:
-            null = analyse(self._null, cfg)
+            null = analyse(self._null, analysis.config)
             thresholds = calibrate_thresholds(null.statistics, sample_rate_hz=null.sample_rate_hz, budget=budget)
         else:
             thresholds = self_calibrate(analysis, budget=budget, confidence_z=self.confidence_z)

@@ -11,15 +11,16 @@ steps (whose sides of two or three sets hold the neighbouring burns' levels):
   in-track ΔV, which is the total when the burns share a sign (orbit raising or lowering).
 * **Burn count**: the gaps inside the campaign that carry a step in ``a`` (set-to-set change, the
   local drift removed, over the detection threshold times the set-to-set noise ``√2·σ_a`` and at
-  least a tenth of the campaign's largest), one burn each, or more where the sets say so: a single
-  in-track burn at argument of latitude ``u`` moves the eccentricity vector by
-  ``(2Δv_t/v)(cos u, sin u)``, so ``r = a|Δe| / |Δa| = 1`` (Gauss's equations, near-circular orbit),
-  while burns at different ``u`` in one gap give ``r < 1`` (``r < 0.7``: at least two burns); and a
-  gap whose step is ``k ≥ 1.75`` times the largest step another gap of the campaign shows for one
-  burn (``r ≥ 0.7``) counts ``round(k)`` burns (the burns of one campaign are of similar size: an
-  assumption, stated). The count is never below
-  the number of member maneuvers. Burns in one gap at nearly the same ``u`` and of different sizes
-  are not separable (``docs/tle.md``).
+  least a tenth of the campaign's largest) hold one burn each, or two where the eccentricity vector
+  says so: a single in-track burn at argument of latitude ``u`` moves it by
+  ``(2Δv_t/v)(cos u, sin u)``, so ``|Δe| = |Δa|/a`` (Gauss's equations, near-circular orbit), while
+  burns at different ``u`` in one gap give ``|Δe| < |Δa|/a``. A gap counts two burns when the
+  shortfall ``|Δa|/a − |Δe|`` (the e-vector's own drift across the gap removed, from the sides'
+  Theil-Sen slopes) exceeds :data:`MULTI_BURN_Z` times its noise (the satellite's rolling
+  set-to-set scales of ``e`` and ``a``). Burns in one gap at nearly the same ``u`` are one step of
+  their summed ΔV and are counted as one: nothing in the mean elements separates them (a rule on
+  burn sizes, "a gap k times another's single burn holds k", was measured to overcount campaigns of
+  unequal burns, ``docs/tle.md``). The count is never below the number of member maneuvers.
 """
 
 from __future__ import annotations
@@ -36,8 +37,9 @@ from abrupt.detect.tle.steps import StepModel, theil_sen_slope
 # a gap carries a burn of the campaign when its step in a is at least this fraction of the largest
 # (smaller steps over the noise level are TLE noise, the tail of a set fitted across a burn, or drag)
 CARRYING_FRACTION = 0.1
-MAX_BURNS_PER_GAP = 4
-SINGLE_BURN_R = 0.7  # a|Δe|/|Δa| of a gap at least this: one in-track burn
+# a gap holds two burns when |Δa|/a − |Δe| exceeds this many times its noise (heavy-tailed TLE noise:
+# single burns in the development trials reach 5.1, two burns in one gap mostly 6.5-650)
+MULTI_BURN_Z = 6.0
 # a detection joins a campaign when its ΔV is at least this fraction of the largest member's
 MEMBER_DV_FRACTION = 0.02
 
@@ -98,30 +100,29 @@ def total_step(
     return side_level(ta, ya, slope, t_ref) - side_level(tb, yb, slope, t_ref), slope
 
 
-def burns_in_gaps(model: StepModel, first_gap: int, last_gap: int, slope: float, level: float) -> int:
-    """Burns the gaps ``first_gap .. last_gap`` carry (module docstring)."""
+def burns_in_gaps(
+    model: StepModel, first_gap: int, last_gap: int, slopes: tuple[float, float, float], level: float
+) -> int:
+    """Burns the gaps ``first_gap .. last_gap`` carry (module docstring); ``slopes``: the drift rates
+    of ``a``, ``ex`` and ``ey`` across the campaign (per s)."""
     a, t = model.s["a_m"], model.t
     ex, ey = model.s["ex"], model.s["ey"]
-    scale = model.scales["a_m"]
-    rows: list[tuple[float, float]] = []  # (|Δa|, r) of every gap over the noise level
+    sa, sx, sy = model.scales["a_m"], model.scales["ex"], model.scales["ey"]
+    rows: list[tuple[float, bool]] = []  # (|Δa|, two burns) of every gap over the noise level
     for g in range(max(0, first_gap), min(model.n - 1, last_gap + 1)):
-        da = float(a[g + 1] - a[g] - slope * (t[g + 1] - t[g]))
-        if abs(da) < level * math.sqrt(2.0) * float(scale[min(g, scale.size - 1)]):
+        dt = float(t[g + 1] - t[g])
+        k = min(g, sa.size - 1)
+        da = float(a[g + 1] - a[g] - slopes[0] * dt)
+        if abs(da) < level * math.sqrt(2.0) * float(sa[k]):
             continue
-        de = math.hypot(float(ex[g + 1] - ex[g]), float(ey[g + 1] - ey[g]))
-        rows.append((abs(da), float(a[g]) * de / abs(da)))
+        de = math.hypot(float(ex[g + 1] - ex[g]) - slopes[1] * dt, float(ey[g + 1] - ey[g]) - slopes[2] * dt)
+        a_g = float(a[g])
+        sigma = math.sqrt(2.0) * math.hypot(max(float(sx[k]), float(sy[k])), float(sa[k]) / a_g)
+        rows.append((abs(da), abs(da) / a_g - de > MULTI_BURN_Z * sigma))
     if not rows:
         return 0
     biggest = max(r[0] for r in rows)
-    carrying = [r for r in rows if r[0] >= CARRYING_FRACTION * biggest]
-    n = 0
-    for k, (da, r) in enumerate(carrying):
-        # the largest step another gap shows for one burn (its e-vector says one burn)
-        single = [d for j, (d, rr) in enumerate(carrying) if j != k and rr >= SINGLE_BURN_R]
-        size = da / max(single) if single else 1.0
-        by_size = min(MAX_BURNS_PER_GAP, round(size)) if size >= 1.75 else 1
-        n += max(1 if r >= SINGLE_BURN_R else 2, by_size)
-    return n
+    return sum(2 if two else 1 for da, two in rows if da >= CARRYING_FRACTION * biggest)
 
 
 def find_campaigns(
@@ -158,7 +159,9 @@ def _campaign(model: StepModel, gaps: NDArray[np.int64], members: list[int], thr
     g1 = max(bounds[0], int(min(gaps[members])) - 1)
     g2 = min(bounds[1] - 2, int(max(gaps[members])) + 1)
     da, slope = total_step(model, g1, g2, "a_m", window, bounds)
+    ex_slope = total_step(model, g1, g2, "ex", window, bounds)[1]
+    ey_slope = total_step(model, g1, g2, "ey", window, bounds)[1]
     a_ref = float(model.s["a_m"][g1])
     dv_t = circular_speed_mps(a_ref) * da / (2.0 * a_ref) if math.isfinite(da) else math.nan
-    count = max(len(members), burns_in_gaps(model, g1, g2, slope, threshold))
+    count = max(len(members), burns_in_gaps(model, g1, g2, (slope, ex_slope, ey_slope), threshold))
     return Campaign(tuple(members), g1, g2, float(da), float(dv_t), int(count))

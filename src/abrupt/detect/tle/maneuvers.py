@@ -83,7 +83,7 @@ from abrupt.detect.tle.steps import (
     component_weights,
     detectable_by_year,
     empty_steps,
-    fill_gap,
+    fill_gaps,
     noise_summary,
     segment_bounds,
 )
@@ -228,8 +228,7 @@ def first_pass(history: ElementHistory, cfg: TleDetectorConfig, regime: str) -> 
     model = StepModel(history, cfg)
     n_gaps = len(history) - 1
     first = empty_steps(model.t, n_gaps)
-    for g in range(n_gaps):
-        fill_gap(first, model, g, [])
+    fill_gaps(first, model, np.arange(n_gaps), [])
     first.weights = component_weights(first, cfg.window_sets + 2)
     first.group_gain = cfg.group_gain
     if regime == "leo" and first.z_u is not None:
@@ -268,6 +267,7 @@ def block_scale(
         cfg.threshold_method,
         cfg.threshold_block_days,
         cfg.threshold_reach_days,
+        candidates_above=threshold,
     )
     local = np.maximum(local, cfg.min_statistic)
     if cfg.threshold_follow == "raise":

@@ -188,13 +188,19 @@ def block_thresholds(
     method: str,
     block_days: float,
     reach_days: float,
+    candidates_above: float = math.inf,
 ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """Per-gap threshold that follows the history's changes of cadence and noise: the history is cut
     into blocks of about ``block_days``; each block's threshold is the tail fit (:func:`null_threshold`)
     of the event-free statistic of the gaps within ``reach_days`` of the block, for the per-gap
     probability the budget gives at the block's own cadence (budget per year / the block's gaps per
     year), floored at the Bonferroni level of three Gaussian groups. Returns (threshold per gap,
-    block edges)."""
+    block edges).
+
+    Event-free: away from the robust outliers of :func:`event_free_mask` and from every local peak
+    at or above ``candidates_above`` (the whole-history threshold: the candidates the block threshold
+    is about to judge). A block's tail fitted on its own candidates rises to exclude them: Jason-3's
+    small maneuvers of July 2016 (S 4.8-5.5 against 4.49) set its first year's threshold to 5.43."""
     edges = block_edges(t_s, block_days)
     n_gaps = max(t_s.size - 1, 0)
     out = np.full(n_gaps, math.inf)
@@ -203,6 +209,9 @@ def block_thresholds(
     mid = 0.5 * (t_s[:-1] + t_s[1:])
     # event footprints from the whole history (a block's own peaks would be too few to find)
     free = event_free_mask(stat, guard)
+    if math.isfinite(candidates_above):
+        for g in local_peaks(np.where(np.isfinite(stat), stat, -np.inf), 1, candidates_above):
+            free[max(0, g - guard) : g + guard + 1] = False
     for lo, hi in itertools.pairwise(edges):
         t_lo, t_hi = mid[lo] - reach_days * 86400.0, mid[hi - 1] + reach_days * 86400.0
         sel = (mid >= t_lo) & (mid <= t_hi)

@@ -7,7 +7,7 @@ import numpy as np
 
 from abrupt.detect.tle.config import TleDetectorConfig
 from abrupt.detect.tle.noise import local_peaks
-from abrupt.detect.tle.steps import StepModel, StepSeries, empty_steps, fill_gap, segment_bounds
+from abrupt.detect.tle.steps import StepModel, StepSeries, empty_steps, fill_gap, fill_gaps, segment_bounds
 from abrupt.readers.tle import ElementHistory
 
 
@@ -32,8 +32,7 @@ def segment(
     n_gaps = max(model.n - 1, 0)
     if first is None:
         first = empty_steps(model.t, n_gaps)
-        for g in range(n_gaps):
-            fill_gap(first, model, g, [])
+        fill_gaps(first, model, np.arange(n_gaps), [])
     cur = empty_steps(model.t, n_gaps)
     cur.weights = first.weights
     cur.group_gain = first.group_gain

@@ -5,6 +5,7 @@ noise model it reports."""
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
@@ -24,6 +25,7 @@ from abrupt.detect.tle.elements import (
     stated_decay_m_s,
 )
 from abrupt.detect.tle.noise import chi2_as_normal, drift_noise_rate, robust_group_weight, robust_scale_rolling
+from abrupt.detect.tle.step_kernels import gap_steps, localise_costs
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
 from abrupt.units import SECONDS_PER_DAY
 
@@ -144,6 +146,36 @@ class StepModel:
         Returns the steps and the median standard-error factor; the factor is inf when a side has
         fewer than two sets (no test possible).
         """
+        hi_bound = self.n if hi_bound is None else hi_bound
+        values, n1s, n2s = self.gaps(np.array([g]), np.array([lo_bound]), np.array([hi_bound]))
+        return self._steps_factor(values[0], int(n1s[0]), int(n2s[0]))
+
+    def gaps(
+        self, gaps: NDArray[np.int64], lo_bounds: NDArray[np.int64], hi_bounds: NDArray[np.int64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.int64]]:
+        """Steps (gaps × series, in the order of ``NAMES``) and side sizes at many gaps in one compiled
+        call (:func:`abrupt.detect.tle.step_kernels.gap_steps`; the same numbers as :meth:`gap_numpy`)."""
+        cfg = self.cfg
+        return gap_steps(
+            np.asarray(self.t, dtype=np.float64),
+            np.asarray(self.stack, dtype=np.float64),
+            np.asarray(gaps, dtype=np.int64),
+            np.asarray(lo_bounds, dtype=np.int64),
+            np.asarray(hi_bounds, dtype=np.int64),
+            int(cfg.window_sets),
+            float(cfg.max_window_days * SECONDS_PER_DAY),
+            int(self.min_side),
+        )
+
+    def _steps_factor(self, values: NDArray[np.float64], n1: int, n2: int) -> tuple[dict[str, float], float]:
+        if n1 < self.min_side or n2 < self.min_side:
+            return {k: 0.0 for k in self.NAMES}, math.inf
+        steps = dict(zip(self.NAMES, values.tolist(), strict=True))
+        return steps, math.sqrt(math.pi / 2.0) * math.sqrt(1.0 / n1 + 1.0 / n2)
+
+    def gap_numpy(self, g: int, lo_bound: int = 0, hi_bound: int | None = None) -> tuple[dict[str, float], float]:
+        """:meth:`gap` in plain numpy, one gap a call (the reference the compiled kernel is checked and
+        timed against)."""
         cfg, t = self.cfg, self.t
         hi_bound = self.n if hi_bound is None else hi_bound
         lo = max(lo_bound, g + 1 - cfg.window_sets)
@@ -178,7 +210,33 @@ class StepModel:
         The median step test has a plateau: the same step is seen a few gaps either side of the true
         one. The change point is where one level-plus-slope per side fits best (L1 cost of the
         detrended residuals in noise units; Bai 1995 least-absolute-deviation change-point estimate).
+        Compiled (:func:`abrupt.detect.tle.step_kernels.localise_costs`); the same costs as
+        :meth:`localise_numpy`.
         """
+        lo = max(lo_bound, g + 1 - self.cfg.window_sets - 2)
+        hi = min(hi_bound, g + 1 + self.cfg.window_sets + 2)
+        w = np.array([weights[0], weights[1], weights[1], weights[2], weights[2], weight_u], dtype=np.float64)
+        scales = np.stack([np.asarray(self.scales[k], dtype=np.float64) for k in self.NAMES])
+        costs = localise_costs(
+            np.asarray(self.t, dtype=np.float64),
+            np.asarray(self.stack, dtype=np.float64),
+            scales,
+            w,
+            int(g),
+            int(lo),
+            int(hi),
+            int(self.cfg.min_side_sets),
+        )
+        best, best_cost = g, math.inf
+        for q, cost in enumerate(costs.tolist()):
+            if cost < best_cost:
+                best, best_cost = g - 2 + q, cost
+        return best
+
+    def localise_numpy(
+        self, g: int, lo_bound: int, hi_bound: int, weights: tuple[float, float, float], weight_u: float = 0.0
+    ) -> int:
+        """:meth:`localise` in plain numpy (the reference the compiled kernel is checked against)."""
         t = self.t
         lo = max(lo_bound, g + 1 - self.cfg.window_sets - 2)
         hi = min(hi_bound, g + 1 + self.cfg.window_sets + 2)
@@ -214,9 +272,12 @@ class StepModel:
         dt_gap = float(self.t[g + 1] - self.t[g])
         return {k: math.sqrt((self.scales[k][g] * factor) ** 2 + self.drift_q[k] * dt_gap) for k in self.NAMES}
 
-    def z(self, g: int, steps: dict[str, float], factor: float) -> tuple[float, float, float, float]:
-        """z-scores of the a, e-vector, orbit-normal and along-track phase steps at gap g."""
-        sc = self.step_sigmas(g, factor)
+    def z(
+        self, g: int, steps: dict[str, float], factor: float, sigmas: dict[str, float] | None = None
+    ) -> tuple[float, float, float, float]:
+        """z-scores of the a, e-vector, orbit-normal and along-track phase steps at gap g (``sigmas``:
+        :meth:`step_sigmas` of the gap when already known)."""
+        sc = self.step_sigmas(g, factor) if sigmas is None else sigmas
         z_a = abs(steps["a_m"]) / sc["a_m"]
         z_e = math.hypot(steps["ex"] / sc["ex"], steps["ey"] / sc["ey"])
         z_n = math.hypot(steps["i_rad"] / sc["i_rad"], steps["raan_resid_sin_i_rad"] / sc["raan_resid_sin_i_rad"])
@@ -253,8 +314,7 @@ def step_statistics(
     n_gaps = max(model.n - 1, 0)
     cps = sorted(change_points or [])
     out = empty_steps(model.t, n_gaps)
-    for g in range(n_gaps):
-        fill_gap(out, model, g, cps)
+    fill_gaps(out, model, np.arange(n_gaps), cps)
     return out
 
 
@@ -287,8 +347,35 @@ def empty_steps(t: NDArray[np.float64], n_gaps: int) -> StepSeries:
 
 
 def fill_gap(out: StepSeries, model: StepModel, g: int, cps: list[int]) -> None:
-    lo, hi = segment_bounds(g, cps, model.n)
-    steps, factor = model.gap(g, lo, hi)
+    """Test gap g with windows cut at the change points ``cps`` and store its steps and z-scores."""
+    fill_gaps(out, model, [g], cps)
+
+
+def fill_gaps(out: StepSeries, model: StepModel, gaps: Sequence[int] | NDArray[np.int64], cps: list[int]) -> None:
+    """:func:`fill_gap` for many gaps: the steps of all of them in one compiled call."""
+    g_arr = np.asarray(gaps, dtype=np.int64).reshape(-1)
+    if g_arr.size == 0:
+        return
+    lo_b, hi_b = segment_bounds_all(g_arr, cps, model.n)
+    values, n1s, n2s = model.gaps(g_arr, lo_b, hi_b)
+    for q, g in enumerate(g_arr.tolist()):
+        steps, factor = model._steps_factor(values[q], int(n1s[q]), int(n2s[q]))
+        _store_gap(out, model, g, steps, factor)
+
+
+def segment_bounds_all(gaps: NDArray[np.int64], cps: list[int], n: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """:func:`segment_bounds` of every gap of ``gaps``."""
+    c = np.unique(np.asarray(cps, dtype=np.int64))
+    if c.size == 0:
+        return np.zeros(gaps.size, dtype=np.int64), np.full(gaps.size, n, dtype=np.int64)
+    before = np.searchsorted(c, gaps, side="left")  # change points < g
+    after = np.searchsorted(c, gaps, side="right")  # first change point > g
+    lo = np.where(before > 0, c[np.maximum(before - 1, 0)] + 1, 0)
+    hi = np.where(after < c.size, np.minimum(c[np.minimum(after, c.size - 1)] + 1, n), n)
+    return lo.astype(np.int64), hi.astype(np.int64)
+
+
+def _store_gap(out: StepSeries, model: StepModel, g: int, steps: dict[str, float], factor: float) -> None:
     out.delta_a_m[g] = steps["a_m"]
     out.delta_e[g] = (steps["ex"], steps["ey"])
     out.delta_normal_rad[g] = (steps["i_rad"], steps["raan_resid_sin_i_rad"])
@@ -297,8 +384,8 @@ def fill_gap(out: StepSeries, model: StepModel, g: int, cps: list[int]) -> None:
     if math.isinf(factor):
         out.z_a[g] = out.z_e[g] = out.z_n[g] = out.z_u[g] = 0.0
     else:
-        out.z_a[g], out.z_e[g], out.z_n[g], out.z_u[g] = model.z(g, steps, factor)
         sc = model.step_sigmas(g, factor)
+        out.z_a[g], out.z_e[g], out.z_n[g], out.z_u[g] = model.z(g, steps, factor, sc)
         assert out.sigma_a_m is not None and out.sigma_n_rad is not None
         out.sigma_a_m[g] = sc["a_m"]
         out.sigma_n_rad[g] = math.sqrt(0.5 * (sc["i_rad"] ** 2 + sc["raan_resid_sin_i_rad"] ** 2))
