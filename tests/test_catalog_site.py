@@ -236,3 +236,22 @@ def test_site_figures_have_labelled_axes_and_no_empty_panel(tmp_path: Path) -> N
             assert ax.get_xlabel() and ax.get_ylabel(), ax
             assert ax.lines or ax.patches or ax.collections, ax
         plt.close(fig)
+
+
+def test_detectability_takes_dh90_from_the_exposure_rows_where_the_run_did_not_measure_it() -> None:
+    """ε(x) = 1 / (1 + (x/ΔH50)^-k) is 0.9 at x = ΔH50 · 9^(1/k): with ΔH50 = 0.01 N·m·s and k = 4,
+    ΔH90 = 0.01 · 9^0.25 N·m·s; a day the run measured keeps its own value."""
+    from abrupt.report.site import _with_exposure_dh90
+
+    daily = pd.DataFrame({"day": ["2026-03-10", "2026-03-11"], "dH90_Nms": [np.nan, 0.005]})
+    exposure = pd.DataFrame(
+        {
+            "spacecraft": ["SC-A", "SC-A", "SC-B"],
+            "day": ["2026-03-10", "2026-03-11", "2026-03-10"],
+            "dH50_Nms": [0.01, 0.01, 1.0],
+            "efficiency_slope": [4.0, 4.0, 4.0],
+            "efficiency_max": [1.0, 1.0, 1.0],
+        }
+    )
+    out = _with_exposure_dh90(daily, exposure, "SC-A")
+    assert out["dH90_Nms"].tolist() == pytest.approx([0.01 * 9**0.25, 0.005])

@@ -35,6 +35,7 @@ import sqlalchemy as sa
 from abrupt.catalog import Catalog
 from abrupt.catalog.schema import coverage_table
 from abrupt.events import EVENT_COLUMNS, format_time_utc
+from abrupt.flux.exposure import EfficiencyCurve, load_exposure
 from abrupt.report.site_figures import daily_figure, event_figure, timeline_figure
 
 ASSETS = ("site.css", "site.js")
@@ -73,6 +74,7 @@ class _View:
     runs: pd.DataFrame
     coverage: pd.DataFrame
     details: dict[str, dict[str, Any]]
+    exposure: pd.DataFrame
 
 
 def _esc(value: Any) -> str:
@@ -134,7 +136,7 @@ def load_view(catalog: Catalog) -> _View:
             details[str(row.run_id)] = json.loads(str(row.details_json)) if row.details_json else {}
         except (TypeError, ValueError):
             details[str(row.run_id)] = {"details": str(row.details_json)}
-    return _View(events, runs, coverage, details)
+    return _View(events, runs, coverage, details, load_exposure(catalog))
 
 
 def _size(row: Mapping[Any, Any]) -> tuple[str, float]:
@@ -250,6 +252,23 @@ def _noise_items(details: Mapping[str, Any], spacecraft: str) -> list[tuple[str,
     return items[:24]
 
 
+def _with_exposure_dh90(daily: pd.DataFrame, exposure: pd.DataFrame, spacecraft: str) -> pd.DataFrame:
+    """Fill ΔH90 of the days the run did not measure from the catalog's exposure rows of that spacecraft and
+    day (their efficiency curve: ΔH50, slope), when there are any."""
+    out = daily.copy()
+    if "dH90_Nms" not in out:
+        out["dH90_Nms"] = math.nan
+    rows = exposure.loc[exposure["spacecraft"].astype(str) == spacecraft] if len(exposure) else exposure
+    for rec in rows.to_dict("records"):
+        at = (out["day"].astype(str) == str(rec["day"])) & ~pd.to_numeric(out["dH90_Nms"], errors="coerce").notna()
+        if at.any():
+            curve = EfficiencyCurve(
+                float(rec["dH50_Nms"]), float(rec["efficiency_slope"]), float(rec["efficiency_max"])
+            )
+            out.loc[at, "dH90_Nms"] = curve.dH90_Nms
+    return out
+
+
 def _detectability_page(view: _View, out: Path) -> str:
     parts = []
     shown: set[tuple[str, tuple[str, ...]]] = set()
@@ -261,6 +280,7 @@ def _detectability_page(view: _View, out: Path) -> str:
             continue
         frame = pd.DataFrame(daily)
         spacecraft = ", ".join(_run_spacecraft(view, run_id)) or "?"
+        frame = _with_exposure_dh90(frame, view.exposure, spacecraft)
         days = (spacecraft, tuple(str(d) for d in frame.get("day", [])))
         if days in shown:  # the same days of the same spacecraft: the latest run only
             continue
@@ -312,7 +332,8 @@ def _detectability_page(view: _View, out: Path) -> str:
         cov_rows.append([_esc(name), _esc(details.get("statistic", "–")), "–", "–", "–", _esc(run_id), _esc(noise)])
     head = (
         '<p class="muted">Per day where the run measured it (the flight pipeline: analysed fraction, noise floor, '
-        "threshold, events; ΔH90 where an injection-recovery study measured it). Other runs: the span they "
+        "threshold, events; ΔH90 where an injection-recovery study measured it or the catalog's exposure rows "
+        "give the day's efficiency curve). Other runs: the span they "
         "analysed and the noise and threshold figures they stored.</p>"
     )
     coverage = (
