@@ -255,3 +255,18 @@ def test_detectability_takes_dh90_from_the_exposure_rows_where_the_run_did_not_m
     )
     out = _with_exposure_dh90(daily, exposure, "SC-A")
     assert out["dH90_Nms"].tolist() == pytest.approx([0.01 * 9**0.25, 0.005])
+
+
+def test_report_catalog_bad_inputs_are_one_line_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    missing = tmp_path / "typo.sqlite"
+    with pytest.raises(SystemExit) as exit_:
+        main(["report", "catalog", "--catalog", str(missing), "--out", str(tmp_path / "site")])
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: ") and "typo.sqlite" in err and len(err.splitlines()) == 1
+    assert not missing.exists() and not (tmp_path / "site").exists()  # nothing created
+    a_file = tmp_path / "notes.txt"
+    a_file.write_text("x")
+    with pytest.raises(SystemExit) as exit_:
+        main(["report", "catalog", "--catalog", str(missing), "--out", str(a_file)])
+    assert exit_.value.code == 2 and "notes.txt" in capsys.readouterr().err
