@@ -28,6 +28,7 @@ LAYERS: dict[str, int] = {
     "types": 0,
     "errors": 0,
     "units": 0,
+    "progress": 0,
     "events": 1,
     "thresholds": 1,
     "store": 1,

@@ -23,6 +23,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
 
+from abrupt import progress
 from abrupt.errors import ConfigError
 
 T = TypeVar("T")
@@ -122,11 +123,15 @@ def run_tasks(
         if on_result is not None:
             on_result(TaskResult(i, tasks[i], result))
 
-    with tqdm(total=len(tasks), desc=desc, unit=unit, disable=hidden, leave=False) as bar:
+    with (
+        tqdm(total=len(tasks), desc=desc, unit=unit, disable=hidden, leave=False) as bar,
+        progress.task(desc, len(tasks), unit, bar=False) as status,  # the status line (its bar is this one)
+    ):
         if executor.in_process or not tasks:
             for i, task in enumerate(tasks):
                 take(i, fn(task))
                 bar.update(1)
+                status.update()
             return results
         from distributed import as_completed
 
@@ -151,6 +156,7 @@ def run_tasks(
                 future.release()
                 take(i, result)
                 bar.update(1)
+                status.update()
                 nxt = submit()
                 if nxt is not None:
                     queue.add(nxt)

@@ -15,6 +15,7 @@ import importlib
 import importlib.util
 import logging
 import os
+import sys
 from collections.abc import Callable, Iterator, Mapping
 from functools import cache
 from pathlib import Path
@@ -22,7 +23,7 @@ from typing import Any, TypeGuard
 
 import click
 
-from abrupt import __version__
+from abrupt import __version__, progress
 
 #: Global options accepted anywhere on the command line (moved before the sub-command by ``main``).
 GLOBAL_FLAGS = frozenset({"-v", "-vv", "-vvv", "--verbose", "-q", "--quiet"})
@@ -71,6 +72,7 @@ INJECT_COMMANDS = {
 }
 REPORT_COMMANDS = {
     "attitude": "abrupt.cli.attitude:report_attitude_cmd",
+    "catalog": "abrupt.cli.site:report_catalog_command",
     "orbit": "abrupt.cli.orbit:report_orbit_command",
     "tle": "abrupt.cli.tle:report_tle",
     "tracking": "abrupt.cli.tracking:report_tracking_command",
@@ -211,6 +213,14 @@ class LazyGroup(click.Group):
         found = super().get_command(ctx, cmd_name)
         return guard_outputs(found) if found is not None else None
 
+    def resolve_command(
+        self, ctx: click.Context, args: list[str]
+    ) -> tuple[str | None, click.Command | None, list[str]]:
+        reporter = progress.current()
+        if ctx.parent is not None and reporter is not None and args and not args[0].startswith("-"):
+            reporter.label = f"{reporter.label} {args[0]}"  # "abrupt detect" -> "abrupt detect orbit", before loading
+        return super().resolve_command(ctx, args)
+
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         """The "Commands" section, with summaries of commands not yet imported read from their source."""
         rows: list[tuple[str, click.Command | str]] = []
@@ -259,6 +269,17 @@ def cli(verbose: int, quiet: bool) -> None:
     State.quiet = quiet
     level = logging.WARNING if quiet else logging.WARNING - 10 * min(verbose, 2)  # warnings even when quiet
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s", force=True)
+    if not quiet:  # progress of long work: bars on a terminal, a status line every 8 s otherwise
+        ctx = click.get_current_context()
+        mode = "bar" if sys.stderr.isatty() else "log"
+        reporter = progress.Reporter(f"abrupt {ctx.invoked_subcommand or ''}".strip(), mode).start()
+        previous = progress.install(reporter)
+
+        def stop() -> None:
+            reporter.stop()
+            progress.install(previous)
+
+        ctx.call_on_close(stop)
 
 
 def hoist_global_flags(argv: list[str]) -> list[str]:

@@ -13,6 +13,7 @@ from typing import Any
 import click
 import numpy as np
 
+from abrupt import progress
 from abrupt.cli.flux import store_run_exposure
 from abrupt.cli.groups import cli, inject, record_run, simulate
 from abrupt.cli.options import budget_options, pop_budget
@@ -36,10 +37,8 @@ from abrupt.store import TelemetryStore
 from abrupt.thresholds import FalseAlarmBudget
 
 
-def _progress(total: int, label: str) -> Any:
-    from tqdm import tqdm
-
-    return tqdm(total=total, desc=label, unit="day", leave=False, disable=None)
+def _progress(total: int, label: str, unit: str = "day") -> Any:
+    return progress.task(label, total, unit)
 
 
 @cli.command("ingest")
@@ -76,7 +75,7 @@ def ingest_cmd(
         if not Path(archive).is_file() or not os.access(archive, os.R_OK):
             why = "is not a readable file" if Path(archive).exists() else "does not exist"
             raise InputError(f"archive {why}", file=pseudonymise_text(archive, decoder))
-    bar = _progress(len(archives), "ingest")
+    bar = _progress(len(archives), "ingest", "file")
     summary = ingest_archives(
         archives,
         decoder_path,
@@ -156,6 +155,7 @@ def detect_from_store(
             },
             spacecraft=sc.name,
             detectors=[FlightGlrDetector.name],
+            span_utc=(f"{day_list[0]}T00:00:00", f"{day_list[-1]}T23:59:59.999999") if day_list else None,
         )
         if exposure and (exposure.get("recovery") or exposure.get("dh90")):
             store_run_exposure(

@@ -18,6 +18,7 @@ from typing import Any, TypeVar
 
 import click
 
+from abrupt import progress as progress_report
 from abrupt.catalog import Catalog, coverage_of
 from abrupt.cli.commands import GLOBAL_FLAGS, State, cli, detect, hoist_global_flags, inject, report, simulate
 from abrupt.events import write_events
@@ -105,13 +106,9 @@ def file_hash(path: str | Path) -> str:
 
 
 def progress(iterable: Iterable[T], *, total: int | None = None, desc: str = "", unit: str = "it") -> Iterator[T]:
-    """A progress bar with a total on standard error for long work (hidden with ``--quiet`` or when
-    standard error is not a terminal)."""
-    from tqdm import tqdm
-
-    if total is None and hasattr(iterable, "__len__"):
-        total = len(iterable)  # type: ignore[arg-type]
-    yield from tqdm(iterable, total=total, desc=desc, unit=unit, disable=progress_hidden(), leave=False)
+    """Progress with a total for long work (:mod:`abrupt.progress`): a bar on a terminal, a status line
+    every 10 s otherwise, nothing with ``--quiet``."""
+    yield from progress_report.track(iterable, desc, total, unit)
 
 
 def progress_hidden() -> bool:
@@ -123,24 +120,43 @@ class StageProgress:
     """A progress bar over the named stages of one job, with their total (replaces "[1] ..." lines)."""
 
     def __init__(self, total: int, desc: str) -> None:
-        from tqdm import tqdm
-
         self.desc = desc
-        self.bar = tqdm(total=total, desc=desc, unit="stage", disable=progress_hidden(), leave=False)
+        self.task = progress_report.task(desc, total, "stage")
         self.started = False
 
     def __call__(self, stage: str) -> None:
-        if self.started:
-            self.bar.update(1)
+        self.task.update(1 if self.started else 0, status=stage)
         self.started = True
-        self.bar.set_postfix_str(stage)
         if progress_hidden() and not State.quiet:
             logging.getLogger("abrupt").info("%s: %s", self.desc, stage)
 
     def close(self) -> None:
         if self.started:
-            self.bar.update(1)
-        self.bar.close()
+            self.task.update(1)
+        self.task.close()
+
+
+def command_options() -> dict[str, Any]:
+    """The running command's options as stored with its run (``options``), and the absolute path of
+    its report figure (``report_path``), so a catalog site can show a run's configuration and figure."""
+    ctx = click.get_current_context(silent=True)
+    if ctx is None:
+        return {}
+    # the catalog is where the run is stored (and its URL may hold a password): not an option to repeat
+    options = {k: _json_value(v) for k, v in ctx.params.items() if k != "catalog_target"}
+    out: dict[str, Any] = {"options": options}
+    report_path = ctx.params.get("report_path")
+    if isinstance(report_path, str) and report_path:
+        out["report_path"] = str(Path(report_path).resolve())
+    return out
+
+
+def _json_value(value: Any) -> Any:
+    if value is None or isinstance(value, bool | int | float | str):
+        return value
+    if isinstance(value, tuple | list):
+        return [_json_value(v) for v in value]
+    return str(value)
 
 
 def record_run(
@@ -163,6 +179,7 @@ def record_run(
     show), so the catalog's latest view can tell an event no longer found from one never looked for.
     Returns the number of events that were new to the catalog.
     """
+    details = {**(details or {}), **command_options()}
     catalog = Catalog(catalog_target)  # open (and check) the catalog before writing anything
     catalog.check_fits(events)  # texts too long for the catalog: refused before the file is written
     if out is not None:  # then the file: a bad path must not leave events in the catalog only

@@ -44,6 +44,7 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
+from abrupt import progress
 from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET
 from abrupt.detect.tle.detectors import detector_for
 from abrupt.errors import RepairLog
@@ -452,7 +453,7 @@ def _windows(
     # np.mean where nothing is missing (the same sum as np.nanmean, without its copies)
     mean_alt = np.mean if np.all(np.isfinite(integ.altitude_km)) else np.nanmean
     mean_wf = np.mean if np.all(np.isfinite(integ.wind_factor)) else np.nanmean
-    for w in range(max(n_windows, 0)):
+    for w in progress.track(range(max(n_windows, 0)), f"{label}: density windows", unit="window"):
         b0 = origin + w * width
         b1 = b0 + width
         lo = int(np.searchsorted(k_epochs, b0, side="right")) - 1  # last set at or before b0

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from abrupt import progress
 from abrupt.density.constellation import (
     ConstellationConfig,
     ConstellationResult,
@@ -25,6 +26,7 @@ from abrupt.density.joint import JointConfig, JointDensity, joint_constellation_
 from abrupt.density.precise_orbit import OrbitDensityConfig, fit_orbit_density
 from abrupt.density.tle_drag import RhoBResult, TleDragConfig, rho_b_from_history
 from abrupt.errors import RepairLog
+from abrupt.events import format_time_columns
 from abrupt.model.atmosphere import read_space_weather
 from abrupt.pipelines.orbit import load_ephemeris
 from abrupt.readers.omm import read_elements
@@ -93,7 +95,7 @@ def tle_density(
         with ProcessPoolExecutor(max_workers=workers) as pool:
             results = list(pool.map(_one_object, jobs))
     else:
-        results = [_one_object(j) for j in jobs]
+        results = [_one_object(j) for j in progress.track(jobs, "TLE histories", unit="object")]
     frames = [r[0].windows for r in results if len(r[0].windows)]
     windows = pd.concat(frames, ignore_index=True) if frames else results[0][0].windows
     repairs = {str(p): r[0].repairs for p, r in zip(paths, results, strict=True)}
@@ -202,12 +204,16 @@ def _first_epoch(path: str | Path) -> pd.Timestamp:
 
 
 def write_table(frame: pd.DataFrame, path: str | Path) -> None:
-    """Write a frame as Parquet (``.parquet``) or CSV (anything else)."""
+    """Write a frame as Parquet (``.parquet``) or CSV (anything else); in CSV every ``*_utc`` column is
+    in the one export time format, ISO-8601 UTC with a ``Z`` (days too: ``2015-01-01T00:00:00.000000Z``)."""
     p = Path(path)
     if p.suffix.lower() == ".parquet":
         frame.to_parquet(p, index=False)
     else:
-        frame.to_csv(p, index=False)
+        out = format_time_columns(frame)  # every *_utc column but time_utc (the event schema's own)
+        if "time_utc" in out:
+            out["time_utc"] = format_time_columns(out[["time_utc"]].set_axis(["t_utc"], axis=1))["t_utc"].to_numpy()
+        out.to_csv(p, index=False)
 
 
 __all__ = ["OrbitDensityRun", "TleDensityResult", "orbit_density", "tle_density", "write_table"]

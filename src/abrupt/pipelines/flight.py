@@ -53,7 +53,7 @@ from abrupt.pipelines.flight_checks import (
     flight_channels,
     physical_bounds,
 )
-from abrupt.readers.archive import ArchiveChunk, pseudonymise_text, read_archive, read_decoder
+from abrupt.readers.archive import ArchiveChunk, Decoder, pseudonymise_text, read_archive, read_decoder
 from abrupt.scale import Executor, TaskResult, run_tasks
 from abrupt.series.timetable import NS, Timetable, build_timetable
 from abrupt.series.timetable_momentum import timetable_momentum
@@ -79,6 +79,15 @@ class IngestSummary:
     rows_added: int = 0
 
 
+def archive_label(path: str | Path, index: int, count: int, decoder: Decoder) -> str:
+    """How messages name an archive file: its path when that holds no real name; otherwise its place on
+    the command line with its pseudonymised name, marked as such (that name is not a file on disk)."""
+    safe = pseudonymise_text(str(path), decoder)
+    if safe == str(path):
+        return str(path)
+    return f"archive {index + 1} of {count} (name pseudonymised: {Path(safe).name})"
+
+
 def ingest_archives(
     paths: Sequence[str | Path],
     decoder_path: str | Path,
@@ -99,10 +108,14 @@ def ingest_archives(
     store = TelemetryStore(store_root)
     summary = IngestSummary()
     for i, path in enumerate(paths):
-        safe = pseudonymise_text(Path(path).name, decoder)
+        safe = archive_label(path, i, len(paths), decoder)
         if progress is not None:
             progress(f"ingest {i + 1}/{len(paths)}: {safe}")
-        chunk = read_archive(path, decoder, layout=layout, assume_utc=assume_utc)
+        try:
+            chunk = read_archive(path, decoder, layout=layout, assume_utc=assume_utc)
+        except InputError as exc:  # named as the user can find it, never by a file name that does not exist
+            file = safe if exc.file in (None, pseudonymise_text(str(path), decoder)) else exc.file
+            raise InputError(exc.reason, file=file, line=exc.line, column=exc.column) from None
         summary.files[safe] = dict(chunk.file_counts)
         samples = _within_bounds(chunk, bounds)
         day_idx = pd.DatetimeIndex(samples["time"]).asi8 // DAY_NS

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from abrupt import progress
 from abrupt.detect.base import DetectionResult, Detector, get_detector
 from abrupt.detect.tle.detectors import TleMeanElements, detector_for
 from abrupt.errors import InputError
@@ -98,7 +99,7 @@ def detect_tle_file(
             line=1,
         )
     out = TleRunResult(str(path), run_id)
-    for history in histories:
+    for history in progress.track(histories, "satellites", unit="satellite"):
         name = spacecraft or history.name or f"NORAD-{history.norad_id}"
         kwargs = dict(settings or {})
         kwargs.update(all_candidates=all_candidates, spacecraft=name)

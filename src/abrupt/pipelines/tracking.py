@@ -226,8 +226,12 @@ def detect_tracking(
         if result.diagnostics:
             final_fit = result.diagnostics[0].extra["fit"]
         frames.append(result.events)
+        glrt_thresholds = []
         for d in result.diagnostics:
-            first = result.events["threshold"].iloc[0] if len(result.events) else np.nan
+            # the scan's own threshold (set for the budget), also when nothing exceeds it
+            first = d.threshold.value if d.threshold is not None else np.nan
+            if d.threshold is not None:
+                glrt_thresholds.append(d.threshold.as_dict())
             diag_frames.append(
                 pd.DataFrame(
                     {
@@ -271,6 +275,8 @@ def detect_tracking(
     )
     summary = fit_summary(final_fit, force.model, sun_moon_gcrf(np.array([inputs.epoch_utc]))[0][0])
     summary["repairs"] = inputs.repairs.as_dict()
+    if settings.method in ("both", "glrt"):
+        summary["glrt_threshold"] = glrt_thresholds[0] if glrt_thresholds else None
     diagnostics = pd.concat(diag_frames, ignore_index=True) if diag_frames else pd.DataFrame()
     return TrackingRun(events, summary, diagnostics, cfg_hash, run_id, run_settings)
 

@@ -64,11 +64,13 @@ def flight_figure(result: FlightResult) -> plt.Figure:
                 xx, yy = _decimate(t, y[:, k])
                 ax.plot(xx, yy, lw=0.6, label=f"ᴺH_{c}")
             ax.set_title(title, fontsize=10)
-            ax.legend(loc="upper right", fontsize=8)
+            ax.set_ylabel("ᴺH (N·m·s)")
+            ax.set_xlabel("time (UTC)")
+            ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
         _shade(axes[0], t, s["event_mask"], "tab:red", "event-flag mask")
         _shade(axes[0], t, s["slew_mask"], "tab:purple", "slew mask")
         _shade(axes[0], t, ~s["valid"], "grey", "gap")
-        axes[0].legend(loc="upper right", fontsize=8)
+        axes[0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
         xx, yy = _decimate(t, s["statistic"])
         axes[3].semilogy(xx, np.maximum(yy, 1e-3), lw=0.5, color="k", label="GLR statistic")
         axes[3].axhline(
@@ -80,8 +82,10 @@ def flight_figure(result: FlightResult) -> plt.Figure:
         if len(result.events):
             te = pd.to_datetime(result.events["time_utc"]).dt.tz_localize(None).to_numpy()
             axes[3].plot(te, result.events["statistic"], "v", color="tab:red", label="events")
-        axes[3].legend(loc="upper right", fontsize=8)
-        axes[3].set_title("detection statistic (σ, Mahalanobis)", fontsize=10)
+        axes[3].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
+        axes[3].set_title("detection statistic", fontsize=10)
+        axes[3].set_ylabel("GLR statistic (σ, Mahalanobis)")
+        axes[3].set_xlabel("time (UTC)")
     d = result.daily
     if len(d):
         x = np.arange(len(d))
@@ -90,15 +94,24 @@ def flight_figure(result: FlightResult) -> plt.Figure:
         ax.bar(x, d["event_masked_fraction"] + d["slew_masked_fraction"], width=0.2, label="masked")
         ax.bar(x + 0.2, d["gap_fraction"], width=0.2, label="gaps")
         ax.set_xticks(x, d["day"], rotation=45, fontsize=8)
-        ax.set_ylabel("fraction of day")
+        ax.set_ylabel("fraction of the day (-)")
+        ax.set_xlabel("day (UTC)")
         ax2 = ax.twinx()
-        ax2.plot(x, d["noise_floor_Nms"] * 1e3, "o-", color="k", label="noise floor [mN·m·s]")
+        ax2.plot(x, d["noise_floor_Nms"] * 1e3, "o-", color="k", label="noise floor")
+        sizes = [d["noise_floor_Nms"].to_numpy(dtype=float) * 1e3]
         if d["dH90_Nms"].notna().any():
-            ax2.plot(x, d["dH90_Nms"] * 1e3, "s-", color="tab:green", label="90%-detectable ΔH [mN·m·s]")
+            ax2.plot(x, d["dH90_Nms"] * 1e3, "s-", color="tab:green", label="90%-detectable ΔH")
+            sizes.append(d["dH90_Nms"].to_numpy(dtype=float) * 1e3)
+        finite = np.concatenate(sizes)
+        finite = finite[np.isfinite(finite)]
+        # from zero: a 0.6 % day-to-day change of the noise floor must look small, not dramatic
+        ax2.set_ylim(0.0, float(finite.max()) * 1.25 if finite.size else 1.0)
+        ax2.set_ylabel("noise floor, ΔH90 (mN·m·s)")
         for i, n in enumerate(d["events"]):
             ax.annotate(f"{n} ev", (x[i], 1.02), ha="center", fontsize=8)
-        ax.legend(loc="lower left", fontsize=8)
-        ax2.legend(loc="lower right", fontsize=8)
+        h1, l1 = ax.get_legend_handles_labels()
+        h2, l2 = ax2.get_legend_handles_labels()
+        ax.legend(h1 + h2, l1 + l2, loc="upper left", bbox_to_anchor=(1.06, 1.0), fontsize=8, frameon=False)
         ax.set_title("daily statistics", fontsize=10)
     fig.tight_layout()
     return fig

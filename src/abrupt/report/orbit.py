@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -34,37 +35,56 @@ def plot_orbit_report(
     import matplotlib.pyplot as plt
 
     hours = analysis.t_s / 3600.0
-    names = [s for s in statistics if s in analysis.statistics]
+    # a statistic with no finite value (d_sma of a short arc) would be an empty panel: left out
+    names = [
+        s for s in statistics if s in analysis.statistics and np.isfinite(np.asarray(analysis.statistics[s])).any()
+    ]
+    innov = analysis.forward.innovation
+    # a position-only file (ILRS CPF, some SP3) has no velocity measurements: no velocity residual panel
+    has_velocity = bool(np.isfinite(np.asarray(analysis.ephemeris.velocity_mps, dtype=np.float64)).any())
+    resid_panels = [("position residual (m)", innov[:, :3])]
+    if has_velocity:
+        resid_panels.append(("velocity residual (m/s)", innov[:, 3:6]))
+    n_res = len(resid_panels)
     # constrained layout keeps the title clear of the top panel
     fig, axes = plt.subplots(
-        2 + len(names), 1, figsize=(10, 2.0 * (2 + len(names)) + 0.6), sharex=True, layout="constrained"
+        n_res + len(names), 1, figsize=(11, 2.0 * (n_res + len(names)) + 0.6), sharex=True, layout="constrained"
     )
-    innov = analysis.forward.innovation
-    for j, lab in enumerate("xyz"):
-        axes[0].plot(hours, innov[:, j], lw=0.5, label=lab)
-        axes[1].plot(hours, innov[:, 3 + j], lw=0.5, label=lab)
-    axes[0].set_ylabel("pos. resid. (m)")
-    axes[1].set_ylabel("vel. resid. (m/s)")
-    axes[0].legend(loc="upper right", fontsize=7, ncol=3)
+    axes = np.atleast_1d(axes)
+    for ax, (label, values) in zip(axes[:n_res], resid_panels, strict=True):
+        for j, lab in enumerate("xyz"):
+            ax.plot(hours, values[:, j], lw=0.5, label=lab)
+        ax.set_ylabel(label, fontsize=8)
+        off = _robust_limits(ax, values)
+        if off:
+            ax.plot([], [], " ", label=f"{off} sample(s) off scale")
+        ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=7, frameon=False)
     event_hours: list[float] = []
     if events is not None and len(events):
         t0 = analysis.ephemeris.times_utc[0]
         for tt in pd.to_datetime(events["time_utc"]).dt.tz_localize(None):
             event_hours.append(float((np.datetime64(tt, "ns") - t0).astype(np.float64) * 1e-9 / 3600.0))
     period_samples = _orbit_period_samples(analysis)
-    for ax, name in zip(axes[2:], names, strict=True):
+    for ax, name in zip(axes[n_res:], names, strict=True):
         stat = np.asarray(analysis.statistics[name], dtype=np.float64)
         if name == "d_sma" and period_samples > 2:
             # the osculating Δa oscillates within each revolution (a solid band at this scale): draw it
             # faintly, and its mean over one orbital period, where a step shows
             ax.plot(hours, stat, lw=0.3, color="0.7", label="osculating")
             ax.plot(hours, _running_mean(stat, period_samples), lw=1.0, color="k", label="mean over one orbit")
-            ax.legend(loc="upper left", fontsize=7)
         else:
-            ax.plot(hours, stat, lw=0.6, color="k")
+            ax.plot(hours, stat, lw=0.6, color="k", label=name)
         if name in thresholds:
-            ax.axhline(thresholds[name].value, ls="--", color=detector_colour("orbit." + name), lw=1.0)
+            th = thresholds[name]
+            ax.axhline(
+                th.value,
+                ls="--",
+                color=detector_colour("orbit." + name),
+                lw=1.0,
+                label=f"threshold {th.value:.3g} ({th.false_alarms_per_day:.3g} false alarms/day)",
+            )
         ax.set_ylabel(f"{name}\n({STATISTIC_UNITS.get(name, '-')})", fontsize=8)
+        ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=7, frameon=False)
     for ax in axes:
         for h in event_hours:
             ax.axvline(h, color="tab:orange", lw=0.8, alpha=0.7)
@@ -76,6 +96,19 @@ def plot_orbit_report(
         handle = Line2D([], [], color="tab:orange", lw=1.5, label=f"events: {len(event_hours)}")
         fig.legend(handles=[handle], loc="outside lower center", fontsize=8, frameon=False)
     return save_figure(fig, path)
+
+
+def _robust_limits(ax: Any, values: NDArray[np.float64]) -> int:
+    """Y-limits from the 2-98 % range of the finite values (a start-up transient of the filter does
+    not set the scale); returns how many samples fall outside."""
+    v = np.asarray(values, dtype=np.float64)
+    v = v[np.isfinite(v)]
+    if v.size < 20:
+        return 0
+    lo, hi = np.percentile(v, [2.0, 98.0])
+    pad = 0.3 * max(hi - lo, 1e-12)
+    ax.set_ylim(lo - pad, hi + pad)
+    return int(np.sum((v < lo - pad) | (v > hi + pad)))
 
 
 def _orbit_period_samples(analysis: OrbitAnalysis) -> int:

@@ -64,11 +64,26 @@ def scenario_title(results: Sequence[CaseResult]) -> str:
 def default_thresholds(results: Sequence[CaseResult], metric: str, n: int = 60) -> NDArray[np.float64]:
     """Log-spaced thresholds [SI] spanning the draws' metric values."""
     values = np.concatenate([{"dH": r.dH_Nms, "dV": r.dV_mps, "da": r.da_m}[metric] for r in results])
-    values = values[values > 0]
-    if values.size == 0:
+    weights = np.concatenate([r.weight if r.weight is not None else np.ones(r.dH_Nms.size) for r in results])
+    ok = values > 0
+    if not ok.any():
         return np.logspace(-6, 0, n)
-    lo, hi = np.quantile(values, 0.01), values.max()
-    return np.logspace(np.log10(lo), np.log10(hi), n)
+    # the range of the flux-weighted draws that matter: 1 % to 99.9 % (not the one rare giant draw)
+    lo, hi = weighted_quantiles(values[ok], weights[ok], (0.01, 0.999))
+    return np.logspace(np.log10(lo), np.log10(max(hi, lo * 10.0)), n)
+
+
+def weighted_quantiles(
+    values: NDArray[np.float64], weights: NDArray[np.float64], q: Sequence[float]
+) -> NDArray[np.float64]:
+    """Quantiles of ``values`` under importance ``weights`` (the draws' flux weights): the smallest value
+    whose cumulative weight reaches ``q`` (the inverse of the weighted empirical distribution)."""
+    order = np.argsort(values)
+    v, w = np.asarray(values, dtype=np.float64)[order], np.asarray(weights, dtype=np.float64)[order]
+    cum = np.cumsum(w)
+    cum /= cum[-1]
+    idx = np.searchsorted(cum, np.asarray(q, dtype=np.float64) - 1e-12, side="left")
+    return np.asarray(v[np.minimum(idx, v.size - 1)], dtype=np.float64)
 
 
 def plot_rate_curves(
@@ -113,7 +128,8 @@ def plot_rate_curves(
 
 
 def plot_dh_dv_scatter(results: Sequence[CaseResult], out: str | Path, *, max_points: int = 20_000) -> Path:
-    """Scatter of ΔH [N·m·s] against ΔV [m/s] of the draws, one colour per spacecraft (Fig. 5.11)."""
+    """Scatter of ΔH [N·m·s] against ΔV [m/s] of the draws, one colour per spacecraft (Fig. 5.11); draws
+    are picked in proportion to their flux weight, and the axes span the bulk of the points."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -121,13 +137,29 @@ def plot_dh_dv_scatter(results: Sequence[CaseResult], out: str | Path, *, max_po
 
     fig, ax = plt.subplots(figsize=(7.0, 5.0))
     seen: set[str] = set()
+    rng = np.random.default_rng(0)
+    xs: list[NDArray[np.float64]] = []
+    ys: list[NDArray[np.float64]] = []
     for r in results:
         if r.spacecraft_name in seen:
             continue
         seen.add(r.spacecraft_name)
-        k = min(max_points, r.dH_Nms.size)
-        ok = (r.dH_Nms[:k] > 0) & (r.dV_mps[:k] > 0)
-        ax.loglog(r.dV_mps[:k][ok], r.dH_Nms[:k][ok], ".", ms=2, alpha=0.4, label=r.spacecraft_name)
+        ok = np.flatnonzero((r.dH_Nms > 0) & (r.dV_mps > 0))
+        if ok.size == 0:
+            continue
+        k = min(max_points, ok.size)
+        if r.weight is not None:  # drawn in proportion to the flux weight: the scatter shows the flux
+            w = r.weight[ok] / r.weight[ok].sum()
+            pick = rng.choice(ok, size=k, replace=True, p=w)
+        else:
+            pick = ok[:k]
+        ax.loglog(r.dV_mps[pick], r.dH_Nms[pick], ".", ms=2, alpha=0.4, label=r.spacecraft_name)
+        xs.append(r.dV_mps[pick])
+        ys.append(r.dH_Nms[pick])
+    if xs:  # limits from the bulk of the points (0.1-99.9 %), not from a rare extreme draw
+        for values, setter in ((np.concatenate(xs), ax.set_xlim), (np.concatenate(ys), ax.set_ylim)):
+            lo, hi = np.quantile(values, [0.001, 0.999])
+            setter(lo / 2.0, hi * 2.0)
     ax.set_xlabel("ΔV [m/s]")
     ax.set_ylabel("ΔH [N·m·s]")
     if scenario_title(results):

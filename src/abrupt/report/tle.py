@@ -64,17 +64,19 @@ def plot_tle_report(
     axes[1].plot(t, s["ex"] * 1e3, ".", ms=2, label="e cos ϖ" if geo else "e cos ω")
     axes[1].plot(t, s["ey"] * 1e3, ".", ms=2, label="e sin ϖ" if geo else "e sin ω")
     axes[1].set_ylabel("e-vector [×10⁻³]")
-    axes[1].legend(loc="upper right", fontsize=8)
+    axes[1].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
     axes[2].plot(t, np.degrees(s["i_rad"]), ".", ms=2, color="tab:purple")
     axes[2].set_ylabel("i sin Ω [deg]" if geo else "i [deg]")
     axes[3].plot(t, np.degrees(s["raan_resid_sin_i_rad"]), ".", ms=2, color="tab:brown")
     axes[3].set_ylabel("−i cos Ω [deg]" if geo else "sin i·(Ω − Ω̇ₛ₉ₚ₄ t) [deg]")
     if len(gap_t):
         axes[4].semilogy(gap_t, np.maximum(steps.statistic, 1e-2), lw=0.7, color="0.3")
-    axes[4].set_ylabel("step statistic\n(before segmentation)")
+    axes[4].set_ylabel("step statistic\n(before segmentation)\n(dimensionless)")
+    axes[4].set_xlabel("element-set epoch (UTC)")
     if len(events) and "threshold" in events:
-        axes[4].axhline(float(events["threshold"].iloc[0]), color="tab:red", ls="--", lw=1, label="threshold")
-        axes[4].legend(loc="upper right", fontsize=8)
+        value = float(events["threshold"].iloc[0])
+        axes[4].axhline(value, color="tab:red", ls="--", lw=1, label=f"threshold {value:.3g}")
+        axes[4].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
     if len(events) and "kind" in events:  # campaign rows summarise maneuvers drawn already
         events = events.loc[events["kind"] != "maneuver_campaign"]
     events = events.reset_index(drop=True)
@@ -105,9 +107,11 @@ def plot_tle_report(
             handles.append(
                 Line2D([], [], color="tab:red", lw=1.5, label=f"detection, unmatched: {len(shown) - n_match}")
             )
-        axes[0].add_artist(axes[0].legend(handles=handles, loc="upper left", fontsize=8))
+        axes[0].add_artist(
+            axes[0].legend(handles=handles, loc="upper left", bbox_to_anchor=(1.0, 0.45), fontsize=8, frameon=False)
+        )
     if axes[0].get_legend_handles_labels()[0]:
-        axes[0].legend(loc="upper right", fontsize=8)
+        axes[0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
     axes[0].set_title(
         (title or f"{history.name or 'satellite'} (NORAD {history.norad_id}): {len(shown)} maneuver(s)")
         + (f" — {summary}" if summary else ""),

@@ -35,7 +35,7 @@ def plot_tracking_report(
     panels = (["psi", "k"] if len(kad) else []) + (["glrt"] if len(glrt) else [])
     if not panels:
         raise ValueError("diagnostics hold neither a 'kaderali' nor a 'glrt' series")
-    fig, axes = plt.subplots(len(panels), 1, figsize=(10, 2.8 * len(panels)), sharex=True, squeeze=False)
+    fig, axes = plt.subplots(len(panels), 1, figsize=(12, 2.8 * len(panels)), sharex=True, squeeze=False)
     ax_of = dict(zip(panels, axes[:, 0], strict=True))
     if len(kad):
         t = pd.to_datetime(kad["time_utc"])
@@ -47,13 +47,15 @@ def plot_tracking_report(
         ax.semilogy(t, np.maximum(psi, floor), ".", ms=2, color="tab:blue")
         readable_log_axis(ax)
         ax.axhline(th, color="tab:red", lw=1, label=f"detection Ψ = {th:.1f}")
-        ax.set_ylabel("Ψ = νᵀS⁻¹ν")
-        ax.legend(loc="upper left", fontsize=8)
+        top = max(float(np.nanmax(psi)) if np.isfinite(psi).any() else th, th)
+        ax.set_ylim(top=top * 3.0)  # the threshold line inside the panel, not on its top edge
+        ax.set_ylabel("Ψ = νᵀS⁻¹ν (dimensionless)")
+        ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
         ax = ax_of["k"]
         ax.plot(t, kad["k_db"].to_numpy(dtype=float), ".", ms=2, color="tab:green")
         ax.axhline(20 * np.log10(th + 1), color="tab:red", lw=1, label="detection K")
         ax.set_ylabel("K = 20 log10(Ψ+1) (dB)")
-        ax.legend(loc="upper left", fontsize=8)
+        ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
     if len(glrt):
         ax = ax_of["glrt"]
         ax.plot(
@@ -64,9 +66,10 @@ def plot_tracking_report(
         )
         g_th = glrt["threshold"].to_numpy(dtype=float)
         if np.isfinite(g_th).any():
-            ax.axhline(float(np.nanmax(g_th)), color="tab:red", lw=1, label="GLRT threshold")
-            ax.legend(loc="upper left", fontsize=8)
-        ax.set_ylabel("GLRT T(τ) (χ²₃)")
+            g_value = float(np.nanmax(g_th))
+            ax.axhline(g_value, color="tab:red", lw=1, label=f"GLRT threshold T = {g_value:.1f}")
+            ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
+        ax.set_ylabel("GLRT T(τ) (χ²₃, dimensionless)")
         ax.set_yscale("symlog", linthresh=10.0)
         ax.set_ylim(bottom=0.0)  # T(τ) >= 0: no negative half of the symlog axis
         ax.yaxis.set_major_locator(ticker.SymmetricalLogLocator(base=10, linthresh=10.0, subs=(1.0,)))
@@ -87,7 +90,7 @@ def plot_tracking_report(
                     lw=1,
                     label=label if k == 0 and ax is axes[0, 0] else None,
                 )
-    axes[0, 0].legend(loc="upper left", fontsize=8)
+    axes[0, 0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
     axes[-1, 0].set_xlabel("time (UTC)")
     fig.tight_layout()
     return save_figure(fig, path)

@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from abrupt import progress
 from abrupt.detect.orbit.kernels import backward_kernel, forward_kernel
 from abrupt.model.orbit import MU_EARTH_M3_S2, ForceContext, ForceModel
 from abrupt.types import FloatArray
@@ -247,6 +248,7 @@ def run_forward(
 
     ``t_s`` are seconds from ``epoch_utc`` (needed when the forces depend on time) or from the epoch of
     ``context``. ``store_gains`` keeps every step's STM, gain and S⁻¹ (for the GLR statistic)."""
+    progress.count("orbit filter passes")
     t = np.ascontiguousarray(t_s, dtype=np.float64)
     ctx = resolve_context(config, t, context, epoch_utc)
     y = measurement_vectors(position_m, velocity_mps)
@@ -290,6 +292,7 @@ def run_backward(
     epoch_utc: np.datetime64 | None = None,
 ) -> FilterRun:
     """Backward filter a-priori estimates, seeded at the last epoch with (seed_x, seed_p·backward_p0_scale)."""
+    progress.count("orbit filter passes")
     t = np.ascontiguousarray(t_s, dtype=np.float64)
     ctx = resolve_context(config, t, context, epoch_utc)
     y = measurement_vectors(position_m, velocity_mps)

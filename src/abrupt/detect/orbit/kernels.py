@@ -369,7 +369,7 @@ def _gain_and_inverse(p: FloatArray, rdiag_i: FloatArray, gain: FloatArray) -> F
     return sinv
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, nogil=True)  # without the GIL: progress lines keep coming during a pass
 def forward_kernel(
     t: FloatArray,
     y: FloatArray,
@@ -425,7 +425,7 @@ def forward_kernel(
     return xs, ps, innovs, nis, phis, gains, sinvs
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, nogil=True)  # without the GIL: progress lines keep coming during a pass
 def backward_kernel(
     t: FloatArray,
     y: FloatArray,
