@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections import Counter
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
@@ -45,15 +44,14 @@ from abrupt.model.flight_config import FlightConfig
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.pipelines.flight_attribution import attribute_events
 from abrupt.pipelines.flight_checks import (
-    BOUNDS_REMOVED,
-    beyond_bounds,
     check_channel_units,
     check_tachometer_units,
     check_wheel_units,
     flight_channels,
     physical_bounds,
+    within_bounds,
 )
-from abrupt.readers.archive import ArchiveChunk, Decoder, pseudonymise_text, read_archive, read_decoder
+from abrupt.readers.archive import Decoder, pseudonymise_text, read_archive, read_decoder
 from abrupt.scale import Executor, TaskResult, run_tasks
 from abrupt.series.timetable import NS, Timetable, build_timetable
 from abrupt.series.timetable_momentum import timetable_momentum
@@ -117,7 +115,7 @@ def ingest_archives(
             file = safe if exc.file in (None, pseudonymise_text(str(path), decoder)) else exc.file
             raise InputError(exc.reason, file=file, line=exc.line, column=exc.column) from None
         summary.files[safe] = dict(chunk.file_counts)
-        samples = _within_bounds(chunk, bounds)
+        samples = within_bounds(chunk, bounds)
         day_idx = pd.DatetimeIndex(samples["time"]).asi8 // DAY_NS
         sc_cat = samples["spacecraft"].astype("category")
         sc_codes = sc_cat.cat.codes.to_numpy()
@@ -131,21 +129,6 @@ def ingest_archives(
             summary.rows_added += store.write_day(sc, day, samples.loc[sel], report.as_dict())
             summary.days.append(store.report(sc, day))
     return summary
-
-
-def _within_bounds(chunk: ArchiveChunk, bounds: dict[str, float]) -> pd.DataFrame:
-    """The chunk's samples without those beyond ``bounds``, each removed one counted in its day's report."""
-    samples = chunk.samples
-    out = beyond_bounds(samples, bounds)
-    if not out.any():
-        return samples
-    days = pd.DatetimeIndex(samples["time"][out]).strftime("%Y-%m-%d")
-    counts = Counter(zip(samples["spacecraft"][out].astype(str), days, strict=True))
-    for key, n in counts.items():
-        if key in chunk.per_day:
-            chunk.per_day[key].removed[BOUNDS_REMOVED] += n
-            chunk.per_day[key].rows_kept -= n
-    return samples.loc[~out].reset_index(drop=True)
 
 
 # ------------------------------------------------------------------------------------------------

@@ -11,6 +11,7 @@ conservation of angular momentum (after the other two, so that a wrong gyro is n
 from __future__ import annotations
 
 import math
+from collections import Counter
 
 import numpy as np
 import pandas as pd
@@ -18,6 +19,7 @@ import pandas as pd
 from abrupt.errors import ConfigError
 from abrupt.model.flight_config import RATE_UNITS, WHEEL_UNITS, FlightConfig
 from abrupt.model.spacecraft import Spacecraft
+from abrupt.readers.archive import ArchiveChunk
 from abrupt.readers.telemetry import MAX_BODY_RATE_RAD_S, WHEEL_OVERSPEED_FACTOR
 from abrupt.series.timetable import Timetable, by_mnemonic, continuous_quaternion
 from abrupt.series.timetable_momentum import wheel_scale_from_conservation
@@ -213,3 +215,18 @@ def beyond_bounds(samples: pd.DataFrame, bounds: dict[str, float]) -> np.ndarray
         return np.zeros(len(samples), bool)
     limit = samples["mnemonic"].astype(str).map(bounds).to_numpy(np.float64, na_value=np.inf)
     return np.asarray(np.abs(samples["value"].to_numpy(np.float64)) > limit)
+
+
+def within_bounds(chunk: ArchiveChunk, bounds: dict[str, float]) -> pd.DataFrame:
+    """The chunk's samples without those beyond ``bounds``, each removed one counted in its day's report."""
+    samples = chunk.samples
+    out = beyond_bounds(samples, bounds)
+    if not out.any():
+        return samples
+    days = pd.DatetimeIndex(samples["time"][out]).strftime("%Y-%m-%d")
+    counts = Counter(zip(samples["spacecraft"][out].astype(str), days, strict=True))
+    for key, n in counts.items():
+        if key in chunk.per_day:
+            chunk.per_day[key].removed[BOUNDS_REMOVED] += n
+            chunk.per_day[key].rows_kept -= n
+    return samples.loc[~out].reset_index(drop=True)
