@@ -37,6 +37,7 @@ import numpy as np
 import pandas as pd
 
 from abrupt.detect.attitude.attribution import classify
+from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import load_spacecraft
 from abrupt.pipelines.flight import DAY_NS, FlightRunConfig, ingest_archives, process_chunk, run_flight
 from abrupt.pipelines.flight_checks import flight_channels
@@ -254,6 +255,14 @@ def figure(store: Path, sc, ranges: ConfounderRanges, path: str, seed: int, verb
     panels = []
     for title, t_ns, dur in truth:
         near = [p for p in chunk.peaks if t_ns - 30 * NS <= p.time_ns <= t_ns + int((dur + 60) * NS) and p.value > 6.5]
+        if not near and title == "appendage snap" and sc.appendages:
+            # Total momentum is conserved: no event. Drawn along the drive axis in inertial axes, where the
+            # hub's reaction and the array's momentum cancel.
+            i = int(np.clip(np.searchsorted(table.time_ns, t_ns), 0, len(table) - 1))
+            axis_n = dcm_from_quaternion(table.quaternion_BN[i]).T @ np.asarray(sc.appendages[0].gimbal_axes[0], float)
+            print(f"figure: {title}: no event (total momentum conserved); drawn at its onset")
+            panels.append(EventPanel(f"{title}\n→ no event (ᴺH conserved)", t_ns, 0.01 * axis_n))
+            continue
         if not near:
             print(f"figure: {title}: no event")
             continue
