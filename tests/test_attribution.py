@@ -18,9 +18,18 @@ from scipy.spatial.transform import Rotation
 
 from abrupt.cli.main import main as cli_main
 from abrupt.detect.attitude.attribution import classify
-from abrupt.detect.attitude.evidence import EventEvidence, ramp_duration, st_gyro_mismatch, surface_evidence
+from abrupt.detect.attitude.evidence import (
+    EventEvidence,
+    _sensor_residuals,
+    _wheel_takeup_B,
+    ramp_duration,
+    st_gyro_mismatch,
+    st_gyro_rate_mismatch,
+    surface_evidence,
+)
 from abrupt.errors import ConfigError
 from abrupt.events import EVENT_KINDS
+from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import load_spacecraft
 from abrupt.pipelines.flight import CleaningConfig, FlightRunConfig, ingest_archives, process_chunk
 from abrupt.series.timetable import NS
@@ -65,6 +74,65 @@ def test_star_tracker_and_integrated_gyro_agree_for_real_motion_and_a_jump_shows
     np.testing.assert_allclose(e[-1], truth, rtol=1e-4, atol=1e-9)
 
 
+def test_rate_mismatch_keeps_a_persistent_bias_linear_and_shows_a_jump_as_a_step() -> None:
+    """Σ (ω_gyro − ω_ST) dt: exactly b τ for a constant bias on a turning body (where the attitude
+    mismatch curves: the difference of its slopes over two minutes would read as a new bias step), and
+    a step of −θ for a star-tracker jump θ about body axes (scipy's rotations as the truth)."""
+    dt, w = 1.0, np.array([1e-4, -1.1e-3, 3e-4])
+    q = _spin(300, dt, w)
+    b = np.array([2e-4, 0.0, -1e-4])
+    omega = np.tile(w + b, (300, 1))
+    e = st_gyro_rate_mismatch(q, omega, dt)
+    np.testing.assert_allclose(e, np.outer(np.arange(300) * dt, b), atol=1e-7)  # second order in ω dt
+    att = st_gyro_mismatch(q, omega, dt)
+    slope = lambda y, sl: np.polyfit(np.arange(300)[sl], y[sl], 1)[0]  # noqa: E731
+    curve = [slope(att[:, k], slice(0, 90)) - slope(att[:, k], slice(180, 300)) for k in range(3)]
+    assert np.linalg.norm(curve) > 1e-5  # the attitude mismatch would have "seen" a bias step of that size
+    jump = np.radians(1.5) * np.array([0.0, 0.6, 0.8])
+    qj = q.copy()
+    qj[150:] = (Rotation.from_quat(np.column_stack([q[150:, 1:], q[150:, 0]])) * Rotation.from_rotvec(jump)).as_quat()[
+        :, [3, 0, 1, 2]
+    ]
+    e = st_gyro_rate_mismatch(qj, np.tile(w, (300, 1)), dt)
+    # Across the jump (after it the tracker's axes are turned by θ, so its rate is R(θ)ᵀω: a slope of
+    # |θ × ω| ≈ 3e-5 rad/s that the two samples here leave at 1e-4 rad).
+    np.testing.assert_allclose(e[152] - e[148], -jump, atol=1.5e-4)
+    assert np.linalg.norm(e[152] - e[148] + jump) < 0.01 * np.linalg.norm(jump)
+
+
+def test_a_sensor_fault_explains_its_own_step_and_not_a_strike() -> None:
+    """A gyro bias step Δb makes the step [NB] J Δb, a star-tracker jump θ the step ([BN(q⊗θ)]ᵀ − [BN]ᵀ) H_B
+    (computed here with scipy); a strike of the same size in another direction is explained by neither."""
+    rng = np.random.default_rng(5)
+    q0 = rng.normal(size=4)
+    q0 /= np.linalg.norm(q0)
+    bn = dcm_from_quaternion(q0)
+    J = np.diag([1100.0, 660.0, 1240.0])
+    db = np.array([0.0, 3e-5, 0.0])
+    h_b = np.array([0.4, -0.9, 0.3])
+    raw = np.tile(bn.T @ h_b, (30, 1))
+    pre = np.arange(30)
+    theta = np.radians(2.0) * np.array([0.6, 0.0, 0.8])
+    r_q = Rotation.from_quat([*q0[1:], q0[0]]) * Rotation.from_rotvec(theta)
+    q1 = r_q.as_quat()[[3, 0, 1, 2]]
+    dh_jump = dcm_from_quaternion(q1).T @ h_b - bn.T @ h_b
+    res = _sensor_residuals(q0, bn, J, bn.T @ (J @ db), np.zeros(3), db, raw, pre)
+    assert res["bias_residual"] < 1e-9
+    res = _sensor_residuals(q0, bn, J, dh_jump, -theta, np.zeros(3), raw, pre)
+    assert res["st_jump_residual"] < 1e-3 and res["bias_residual"] > 0.99
+    strike = np.cross(dh_jump, [0.0, 0.0, 1.0])
+    res = _sensor_residuals(q0, bn, J, strike, -theta, db, raw, pre)
+    assert res["bias_residual"] > 0.5 and res["st_jump_residual"] > 0.5
+
+
+def test_wheel_takeup_is_the_step_over_the_bodys_drift() -> None:
+    tau = np.arange(-80.0, 120.0)
+    drift = np.outer(tau, [1e-3, -5e-4, 2e-4])  # ᴮH turning with the body
+    step = np.array([0.03, 0.0, -0.04])
+    hw = drift + np.outer(tau > 0, step) + 1e-4 * np.random.default_rng(1).normal(size=(tau.size, 3))
+    np.testing.assert_allclose(_wheel_takeup_B(hw, tau, (-60.0, -5.0), (30.0, 120.0)), step, atol=2e-4)
+
+
 def test_ramp_duration_recovers_a_ramp_and_a_step() -> None:
     rng = np.random.default_rng(3)
     t = np.arange(-400.0, 400.0)
@@ -96,6 +164,16 @@ def test_rules_follow_the_physics_of_each_kind() -> None:
     snap = EventEvidence(**{**fields, "appendage_z": 40.0, "appendage_excess_deg": 3.0, "lasting_fraction": 0.05})
     assert classify(snap).kind == "internal"
     assert classify(EventEvidence()).kind == "unknown"
+    # A strike next to a gyro bias step or a star-tracker jump: the sensors disagree, but the fault does
+    # not explain the step and the wheels took it up, which only a torque on the body does.
+    near_bias = EventEvidence(**{**fields, "st_gyro_slope_rad_s": 3e-5, "bias_residual": 1.0, "wheel_takeup": 1.0})
+    assert classify(near_bias).kind == "strike"
+    own_bias = EventEvidence(**{**fields, "st_gyro_slope_rad_s": 3e-5, "bias_residual": 0.02, "wheel_takeup": 1.0})
+    assert classify(own_bias).kind == "sensor_fault"
+    near_jump = EventEvidence(**{**fields, "st_gyro_step_rad": 0.03, "wheel_takeup": 0.95})
+    assert classify(near_jump).kind == "strike"
+    jump_alone = EventEvidence(**{**fields, "st_gyro_step_rad": 0.03, "wheel_takeup": 0.02})
+    assert classify(jump_alone).channel == "star_tracker"
 
 
 def test_surface_evidence_needs_a_point_perpendicular_to_the_step(tmp_path: Path) -> None:

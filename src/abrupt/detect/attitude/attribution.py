@@ -53,6 +53,8 @@ class AttributionRules:
     spike_match: float = 0.5
     appendage_z: float = 12.0
     appendage_min_deg: float = 0.2
+    takeup_min: float = 0.5
+    residual_max: float = 0.5
 
 
 @dataclass(frozen=True)
@@ -87,11 +89,20 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
     quiet_wheels = not (
         _finite(ev.wheel_change_Nms) and ev.wheel_change_Nms > r.wheel_sigma * ev.wheel_change_sigma_Nms
     )
-    if z_slope > 1.0 and z_slope >= z_step:
+    # A fault of an attitude sensor next to the event does not make the event a fault when the sensor's
+    # fault cannot have made the step (its own prediction of the step misses) while the wheels took the
+    # step up (only a torque on the body moves the wheels).
+    body = ev.body_share if _finite(ev.body_share) else float("nan")
+    body_floor = max(r.body_share_min, r.body_sigma * ev.body_share_sigma if _finite(ev.body_share_sigma) else 0.0)
+    body_moved = _finite(body) and body >= body_floor
+    takeup = _finite(ev.wheel_takeup) and ev.wheel_takeup >= r.takeup_min
+    torque_seen = takeup and body_moved
+    bias_explains = _finite(ev.bias_residual) and ev.bias_residual < r.residual_max
+    if z_slope > 1.0 and z_slope >= z_step and (bias_explains or not torque_seen):
         return Attribution(
             "sensor_fault", _confidence([True, quiet_wheels]), f"gyro_{axis[max(ev.st_gyro_axis, 0)]}", "gyro bias step"
         )
-    if z_step > 1.0:
+    if z_step > 1.0 and not torque_seen:
         spike = (
             _finite(ev.gyro_spike_z, ev.gyro_spike_rad)
             and ev.gyro_spike_z > r.spike_z
@@ -116,9 +127,6 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
             "internal", _confidence(tests), f"appendage_{ev.appendage_index + 1}", "appendage drive jumped"
         )
     consistent = _finite(ev.st_gyro_step_rad)
-    body = ev.body_share if _finite(ev.body_share) else float("nan")
-    body_floor = max(r.body_share_min, r.body_sigma * ev.body_share_sigma if _finite(ev.body_share_sigma) else 0.0)
-    body_moved = _finite(body) and body >= body_floor
     # 3. Wheel reading.
     wheels_moved = (
         _finite(ev.wheel_change_Nms, ev.wheel_change_sigma_Nms)

@@ -65,6 +65,8 @@ class EventEvidence:
     st_gyro_slope_rad_s: float = NAN
     st_gyro_slope_limit_rad_s: float = NAN
     st_gyro_axis: int = -1
+    bias_residual: float = NAN
+    st_jump_residual: float = NAN
     gyro_spike_rad: float = NAN
     gyro_spike_z: float = NAN
     gyro_spike_axis: int = -1
@@ -74,6 +76,7 @@ class EventEvidence:
     wheel_spike_index: int = -1
     wheel_change_Nms: float = NAN
     wheel_change_sigma_Nms: float = NAN
+    wheel_takeup: float = NAN
     wheel_null_fraction: float = NAN
     wheel_max_share: float = NAN
     wheel_max_index: int = -1
@@ -124,6 +127,27 @@ def st_gyro_mismatch(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> FloatA
     d = _hamilton(conj, q_BN / np.linalg.norm(q_BN, axis=1, keepdims=True))
     d *= np.where(d[:, :1] < 0, -1.0, 1.0)
     return np.asarray(2.0 * d[:, 1:], dtype=np.float64)
+
+
+def st_gyro_rate_mismatch(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> FloatArray:
+    """E_k = Σ (ω_gyro − ω_ST) dt [rad] about body axes: the gyro rate (mean of the two samples) against
+    the rate the star tracker gives between consecutive samples, ω_ST = 2 vec(q_k⁻¹ ⊗ q_k+1) / dt,
+    accumulated from E_0 = 0; shape (n, 3).
+
+    Unlike the mismatch of the attitudes (:func:`st_gyro_mismatch`), a constant gyro bias b makes E
+    exactly b t: the comparison is of rates in the body frame, so the body's rotation does not turn a
+    bias into a curvature (which an earlier, persistent bias step would otherwise read as a new one).
+    A star-tracker jump is one sample of ω_ST, a step of E; a gyro bias step changes E's slope.
+    """
+    qn = q_BN / np.linalg.norm(q_BN, axis=1, keepdims=True)
+    conj = qn[:-1] * np.array([1.0, -1.0, -1.0, -1.0])
+    d = _hamilton(conj, qn[1:])
+    d *= np.where(d[:, :1] < 0, -1.0, 1.0)
+    w_st = 2.0 * d[:, 1:] / dt
+    w_gy = 0.5 * (omega_B[1:] + omega_B[:-1])
+    e = np.zeros((q_BN.shape[0], 3))
+    e[1:] = np.cumsum((w_gy - w_st) * dt, axis=0)
+    return np.asarray(e, dtype=np.float64)
 
 
 def _line(tau: FloatArray, y: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -183,6 +207,7 @@ class EvidenceWindows:
     """Windows around the event [s]: before, after, the early response and the lasting step."""
 
     pre_s: float = 90.0
+    baseline_s: float = 25.0
     guard_s: float = 5.0
     consistency_after_s: tuple[float, float] = (15.0, 75.0)
     response_s: float = 20.0
@@ -229,19 +254,39 @@ def event_evidence(
     omega = table.body_rate_rad_s
     pre = _idx(g, i0, -w.pre_s, -w.guard_s, dt)
     pre = pre[valid[pre]]
+    # The body's rate just before the event is the baseline: a gyro bias that stepped a minute earlier
+    # (or a slow drift) must not count as the body's response.
+    base = _idx(g, i0, -w.baseline_s, -2.0, dt)
+    base = base[valid[base]]
     resp = _idx(g, i0, -2.0, w.response_s, dt)
     resp = resp[valid[resp]]
     peak_rate = NAN
-    if pre.size > 10 and resp.size > 3 and mag > 0:
-        d_om = omega[resp] - np.median(omega[pre], axis=0)
+    if base.size > 10 and resp.size > 3 and mag > 0:
+        d_om = omega[resp] - np.median(omega[base], axis=0)
         proj = (d_om @ J.T) @ u_b
         proj = np.convolve(proj, np.ones(3) / 3.0, mode="same")
-        out["body_share"] = float(np.max(proj) / mag)
+        share = float(np.max(proj) / mag)
+        # The same from the star tracker's rate: real motion shows in both attitude sensors, a spike of
+        # one sensor's reading in one only, so the body share is the smaller of the two.
+        w_st = _st_rate(q, base, resp)
+        if w_st is not None:
+            p_st = np.convolve((w_st @ J.T) @ u_b, np.ones(3) / 3.0, mode="same")
+            share = min(share, float(np.max(p_st) / mag))
+        out["body_share"] = share
         out["body_share_sigma"] = _noise_of((omega[pre] @ J.T) @ u_b) / math.sqrt(3.0) / mag
         # Real motion lasts the loop's settling time; a running median keeps it and drops a sensor spike.
         peak_rate = float(np.max(np.linalg.norm(median_filter(d_om, size=(5, 1), mode="nearest"), axis=1)))
-    out.update(_wheel_evidence(table, spacecraft, i0, dt, w))
-    out.update(_consistency(table, i0, dt, w, peak_rate))
+    wheels = _wheel_evidence(table, spacecraft, i0, dt, w)
+    hw = wheels.pop("_hw_B", None)
+    out.update(wheels)
+    if hw is not None and mag > 0:
+        # The closed loop hands an external step to the wheels within the loop's settling time: the wheels'
+        # momentum change along ΔĤ_B over |ΔH| is ~1 for any external torque, 0 for an attitude-sensor fault.
+        out["wheel_takeup"] = float(np.asarray(hw) @ u_b / mag)
+    cons, step_vec, slope_vec = _consistency(table, i0, dt, w, peak_rate)
+    out.update(cons)
+    if step_vec is not None and slope_vec is not None and mag > 0:
+        out.update(_sensor_residuals(q[i0], bn0, J, dh_n, step_vec, slope_vec, raw_H_N, pre))
     out.update(_gyro_spike(omega, valid, i0, dt))
     out.update(_profile(g, cleaned_H_N, dh_n, i0, dt, w))
     out.update(_appendage(table, i0, dt))
@@ -257,7 +302,42 @@ def event_evidence(
     return EventEvidence(**typed)
 
 
-def _wheel_evidence(table: Timetable, sc: Spacecraft, i0: int, dt: float, w: EvidenceWindows) -> dict[str, float]:
+def _st_rate(q: FloatArray, base: np.ndarray, resp: np.ndarray) -> FloatArray | None:
+    """Body rate change [rad/s] from consecutive star-tracker attitudes over ``resp`` against ``base``."""
+    n = q.shape[0]
+    if base.size < 5 or resp.size < 3 or resp[-1] + 1 >= n or np.any(np.diff(resp) != 1):
+        return None
+
+    def rate(ix: np.ndarray) -> FloatArray:
+        a = q[ix] / np.linalg.norm(q[ix], axis=1, keepdims=True)
+        b = q[ix + 1] / np.linalg.norm(q[ix + 1], axis=1, keepdims=True)
+        d = _hamilton(a * np.array([1.0, -1.0, -1.0, -1.0]), b)
+        d *= np.where(d[:, :1] < 0, -1.0, 1.0)
+        return np.asarray(2.0 * d[:, 1:], dtype=np.float64)
+
+    base = base[base + 1 < n]
+    w_b, w_r = rate(base), rate(resp)
+    if not (np.isfinite(w_b).all() and np.isfinite(w_r).all()):
+        return None
+    return np.asarray(w_r - np.median(w_b, axis=0), dtype=np.float64)
+
+
+def _wheel_takeup_B(
+    hw: FloatArray, tau: FloatArray, before: tuple[float, float], after: tuple[float, float]
+) -> FloatArray:
+    """The step [N·m·s] (3,) of the wheels' body-frame momentum at τ = 0 over a common linear drift.
+
+    The wheels hold the inertial momentum as the body turns (ᴮH rotates at the body's rate), a smooth
+    drift; the fit y = a + b τ + Δ·[τ > 0] over the two windows separates a step from it.
+    """
+    sel = ((tau >= before[0]) & (tau <= before[1])) | ((tau >= after[0]) & (tau <= after[1]))
+    ok = sel & np.isfinite(hw).all(axis=1)
+    a_mat = np.column_stack([np.ones(ok.sum()), tau[ok], (tau[ok] > 0).astype(float)])
+    coef, *_ = np.linalg.lstsq(a_mat, hw[ok], rcond=None)
+    return np.asarray(coef[2], dtype=np.float64)
+
+
+def _wheel_evidence(table: Timetable, sc: Spacecraft, i0: int, dt: float, w: EvidenceWindows) -> dict[str, Any]:
     g, valid = table.time_ns, table.valid
     om = table.wheel_speed_rad_s
     if om.shape[1] == 0:
@@ -282,7 +362,12 @@ def _wheel_evidence(table: Timetable, sc: Spacecraft, i0: int, dt: float, w: Evi
     kz = int(np.argmax(np.max(z_w, axis=0)))
     norm_d = float(np.linalg.norm(d))
     k = int(np.argmax(np.abs(h)))
+    span = _idx(g, i0, -2 * w.wheel_s, 3 * w.wheel_s, dt)
+    span = span[valid[span]]
+    tau = (g[span] - g[i0]) / NS
+    hw_step = _wheel_takeup_B(om[span] @ js_g.T, tau, (-1.5 * w.wheel_s, -w.guard_s), (0.75 * w.wheel_s, 3 * w.wheel_s))
     return {
+        "_hw_B": hw_step,
         "wheel_change_Nms": float(np.linalg.norm(js_g @ d)),
         "wheel_change_sigma_Nms": float(np.sqrt(np.sum(sig**2))),
         "wheel_null_fraction": float(np.linalg.norm(null) / norm_d) if norm_d > 0 else NAN,
@@ -293,20 +378,52 @@ def _wheel_evidence(table: Timetable, sc: Spacecraft, i0: int, dt: float, w: Evi
     }
 
 
-def _consistency(table: Timetable, i0: int, dt: float, w: EvidenceWindows, peak_rate: float) -> dict[str, float]:
-    """Star tracker against integrated gyro: the jump and the change of slope of e across the event."""
+def _sensor_residuals(
+    q0: FloatArray,
+    bn0: FloatArray,
+    J: FloatArray,
+    dh_n: FloatArray,
+    step_vec: FloatArray,
+    slope_vec: FloatArray,
+    raw_H_N: FloatArray | None,
+    pre: np.ndarray,
+) -> dict[str, float]:
+    """How well each attitude sensor's own fault explains the event's step (0: exactly; ≳ 1: not at all).
+
+    A gyro bias step Δb (the slope change of E) adds J Δb to the momentum computed from the gyro, so the
+    step it makes is [NB] J Δb. A star-tracker jump θ (E steps by −θ) rotates the attitude that takes
+    the body-frame momentum H_B to inertial axes, so the step is ([BN(q ⊗ δq(θ))]ᵀ − [BN(q)]ᵀ) H_B.
+    A strike next to either fault leaves a step neither explains.
+    """
+    mag = float(np.linalg.norm(dh_n))
+    out = {"bias_residual": float(np.linalg.norm(dh_n - bn0.T @ (J @ slope_vec)) / mag)}
+    if raw_H_N is not None and pre.size > 5:
+        h_b = bn0 @ np.nanmedian(raw_H_N[pre], axis=0)
+        theta = -np.asarray(step_vec, dtype=np.float64)
+        ang = float(np.linalg.norm(theta))
+        dq = np.concatenate([[math.cos(ang / 2)], (theta / ang if ang > 0 else theta) * math.sin(ang / 2)])
+        q1 = _hamilton(q0 / np.linalg.norm(q0), dq)
+        pred = (np.asarray(dcm_from_quaternion(q1)).T - bn0.T) @ h_b
+        out["st_jump_residual"] = float(np.linalg.norm(dh_n - pred) / mag)
+    return out
+
+
+def _consistency(
+    table: Timetable, i0: int, dt: float, w: EvidenceWindows, peak_rate: float
+) -> tuple[dict[str, float], FloatArray | None, FloatArray | None]:
+    """Star tracker against gyro: the jump and the change of slope of E across the event (and both vectors)."""
     g, valid = table.time_ns, table.valid
     span = _idx(g, i0, -w.pre_s, w.consistency_after_s[1], dt)
     if span.size < 20 or not valid[span].all():
         span = span[valid[span]]
         if span.size < 20 or np.any(np.diff(span) != 1):
-            return {}
-    e = st_gyro_mismatch(table.quaternion_BN[span], table.body_rate_rad_s[span], dt)
+            return {}, None, None
+    e = st_gyro_rate_mismatch(table.quaternion_BN[span], table.body_rate_rad_s[span], dt)
     tau = (g[span] - g[i0]) / NS
     b = (tau >= -w.pre_s) & (tau <= -w.guard_s)
     a = (tau >= w.consistency_after_s[0]) & (tau <= w.consistency_after_s[1])
     if b.sum() < 10 or a.sum() < 10:
-        return {}
+        return {}, None, None
     a0, s0, r0 = _line(tau[b], e[b])
     a1, s1, r1 = _line(tau[a], e[a])
     step = a1 - a0
@@ -321,13 +438,17 @@ def _consistency(table: Timetable, i0: int, dt: float, w: EvidenceWindows, peak_
     slope_sig = sig * math.sqrt(12.0 / n_a) / (n_a * dt) + sig * math.sqrt(12.0 / n_b) / (n_b * dt)
     timing = (peak_rate if math.isfinite(peak_rate) else 0.0) * w.timing_s
     k = int(np.argmax(np.abs(step) / np.maximum(step_sig, 1e-12)))
-    return {
-        "st_gyro_step_rad": float(np.linalg.norm(step)),
-        "st_gyro_step_limit_rad": float(8.0 * np.linalg.norm(step_sig) + timing),
-        "st_gyro_slope_rad_s": float(np.linalg.norm(slope)),
-        "st_gyro_slope_limit_rad_s": float(8.0 * np.linalg.norm(slope_sig) + timing / w.consistency_after_s[1]),
-        "st_gyro_axis": k,
-    }
+    return (
+        {
+            "st_gyro_step_rad": float(np.linalg.norm(step)),
+            "st_gyro_step_limit_rad": float(8.0 * np.linalg.norm(step_sig) + timing),
+            "st_gyro_slope_rad_s": float(np.linalg.norm(slope)),
+            "st_gyro_slope_limit_rad_s": float(8.0 * np.linalg.norm(slope_sig) + timing / w.consistency_after_s[1]),
+            "st_gyro_axis": k,
+        },
+        np.asarray(step, dtype=np.float64),
+        np.asarray(slope, dtype=np.float64),
+    )
 
 
 def _gyro_spike(omega: FloatArray, valid: np.ndarray, i0: int, dt: float) -> dict[str, float]:
