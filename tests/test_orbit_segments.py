@@ -27,16 +27,21 @@ S3A = "sp3/ssas3a20.b18358.e19003.DG_.sp3"
 OFFSETS = ((np.array([0.0003, -0.0005, 0.0004]), 0.004), (np.array([-0.0004, 0.0002, -0.0005]), 0.006))
 
 
-def _write_segments(eph: Ephemeris, starts: list[np.datetime64], path: Path) -> None:
+def _write_segments(eph: Ephemeris, starts: list[np.datetime64], path: Path, xml: bool = False) -> None:
+    """``eph`` as one OEM file (KVN or XML) with a new data segment at each of ``starts``."""
     edges = [eph.times_utc[0], *starts, eph.times_utc[-1] + np.timedelta64(1, "s")]
-    text: list[str] = []
+    parts = []
     for k in range(len(edges) - 1):
         part = path.with_suffix(f".{k}")
-        write_oem(eph.select((eph.times_utc >= edges[k]) & (eph.times_utc < edges[k + 1])), part)
-        lines = part.read_text().splitlines()
-        text += lines if k == 0 else lines[lines.index("META_START") :]
-        text.append("")
-    path.write_text("\n".join(text))
+        sel = eph.select((eph.times_utc >= edges[k]) & (eph.times_utc < edges[k + 1]))
+        write_oem(sel, part, form="xml" if xml else "kvn")
+        parts.append(part.read_text().splitlines())
+    if xml:
+        body = [ln for lines in parts for ln in lines[lines.index("    <segment>") : lines.index("  </body>")]]
+        text = parts[0][: parts[0].index("    <segment>")] + body + ["  </body>", "</oem>"]
+    else:
+        text = [ln for k, lines in enumerate(parts) for ln in (lines if k == 0 else lines[lines.index("META_START") :])]
+    path.write_text("\n".join(text) + "\n")
 
 
 @pytest.fixture(scope="module")
@@ -54,10 +59,11 @@ def joined(shared_data: Path) -> tuple[Ephemeris, list[np.datetime64]]:
     return x, starts
 
 
-def test_the_reader_keeps_the_segment_starts(joined, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+@pytest.mark.parametrize("xml", [False, True])
+def test_the_reader_keeps_the_segment_starts(joined, tmp_path: Path, xml: bool) -> None:  # type: ignore[no-untyped-def]
     x, starts = joined
-    path = tmp_path / "joined.oem"
-    _write_segments(x, starts, path)
+    path = tmp_path / ("joined.xml" if xml else "joined.oem")
+    _write_segments(x, starts, path, xml)
     got = read_ephemeris(path)
     assert len(got) == len(x)
     assert [str(t)[:19] for t in got.segment_starts_utc] == [str(t)[:19] for t in starts]
