@@ -247,11 +247,14 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
     if bounds:
         nuisance = [b for b in bounds if not b["raised"]]
         lines.append(
-            f"  product          discontinuous at its day boundaries: {len(nuisance)} of {len(bounds)} treated as "
+            f"  product          discontinuous at its "
+            f"{' and '.join(sorted({str(b.get('kind', 'day boundary')) + 's' for b in bounds}))}: "
+            f"{len(nuisance)} of {len(bounds)} treated as "
             "nuisance (not events), the others left to the event search"
         )
         lines.extend(
-            f"    {b['time_utc'][:19]}  peak {b['peak']:.4g}  bound {b['bound']:.4g}"
+            f"    {b['time_utc'][:19]}  {b.get('kind', 'day boundary'):<13} peak {b['peak']:.4g}"
+            f"  bound {b['bound']:.4g}"
             f"{'  -> searched' if b['raised'] else ''}"
             for b in bounds
         )

@@ -39,10 +39,26 @@ from abrupt.thresholds import FalseAlarmBudget
 
 #: detections this close (s) to a known burn are that burn (its residual after removal), not another one
 SEPARATION_S = 300.0
+#: share of a known burn's |ΔV| above which a detection left at its epoch after its removal is a further
+#: burn the data do not resolve (removing a single impulse from Sentinel-3A left nothing above the
+#: threshold; two impulses 5 min apart removed as one finite burn left 17 %)
+MERGE_FRACTION = 0.1
 
 
 def _times(events: pd.DataFrame) -> np.ndarray:
     return pd.to_datetime(events["time_utc"]).dt.tz_localize(None).to_numpy().astype("datetime64[ns]")
+
+
+def _centroid_to_start_frame(eph: Ephemeris, t: np.datetime64, dv_rtn: np.ndarray, duration_s: float) -> np.ndarray:
+    """A finite burn's net ΔV, given in the orbit frame at its centroid, in the orbit frame at its start
+    (the frame :func:`inject_impulse` fixes inertially): the frame turns by θ = n·D/2 about the normal
+    in between (n the angular rate at the start, from the nearest epoch)."""
+    gcrf = eph.to_frame("GCRF")
+    k = min(int(np.searchsorted(gcrf.times_utc, t)), len(gcrf) - 1)
+    r, v = gcrf.position_m[k], gcrf.velocity_mps[k]
+    theta = float(np.linalg.norm(np.cross(r, v))) / float(r @ r) * 0.5 * duration_s
+    c, s = np.cos(theta), np.sin(theta)
+    return np.array([c * dv_rtn[0] - s * dv_rtn[1], s * dv_rtn[0] + c * dv_rtn[1], dv_rtn[2]])
 
 
 def remove_burns(eph: Ephemeris, events: pd.DataFrame) -> Ephemeris:
@@ -59,11 +75,11 @@ def remove_burns(eph: Ephemeris, events: pd.DataFrame) -> Ephemeris:
         row = events.iloc[int(k)]
         dv = -np.array([row["dv_r_mps"], row["dv_t_mps"], row["dv_n_mps"]], dtype=np.float64)
         dur = float(row["duration_s"]) if "duration_s" in row and np.isfinite(row["duration_s"]) else 0.0
-        t = times[k]
-        if dur > 0:
-            t = t - np.timedelta64(round(0.5 * dur * 1e9), "ns")  # the event time is the burn's centroid
+        t = times[k]  # the event time is the burn's start
         if not (out.times_utc[0] <= t < out.times_utc[-1]):
             continue
+        if dur > 0:
+            dv = _centroid_to_start_frame(out, t, dv, dur)
         out = inject_impulse(out, t, dv, duration_s=dur)
     if missing.any():
         out = replace(out, velocity_mps=np.where(missing[:, None], np.nan, out.velocity_mps))
@@ -107,6 +123,47 @@ def _supported(candidates: pd.DataFrame, first: DetectionResult, lead_s: float, 
     return candidates.iloc[np.flatnonzero(near)]
 
 
+def _merged(
+    near: pd.DataFrame, events: pd.DataFrame, separation_s: float, step_s: float
+) -> list[tuple[int, pd.DataFrame, bool]]:
+    """Detections of a re-scan within ``separation_s`` of a known burn that are further burns the data do
+    not resolve: left with more than :data:`MERGE_FRACTION` of its |ΔV| after its removal (removing a
+    single burn leaves a few per cent or nothing). Each with the known burn it joins and whether it lies
+    outside that burn's estimated span by more than two samples (its ΔV then adds to the event's; inside
+    the span the event's interval estimate already holds the total)."""
+    out: list[tuple[int, pd.DataFrame, bool]] = []
+    if len(near) == 0 or len(events) == 0:
+        return out
+    t_near, t_old = _times(near), _times(events)
+    for i in range(len(near)):
+        gap = (t_near[i] - t_old).astype(np.float64) * 1e-9
+        j = int(np.argmin(np.abs(gap)))
+        if abs(gap[j]) > separation_s:
+            continue
+        row, known = near.iloc[[i]], events.iloc[j]
+        dur = float(np.nan_to_num(known.get("duration_s", 0.0)))
+        outside = not (-2.0 * step_s <= gap[j] <= dur + 2.0 * step_s)
+        if float(row["dv_mps"].iloc[0]) > MERGE_FRACTION * float(known["dv_mps"]):
+            out.append((j, row, outside))
+    return out
+
+
+def _with_merged(events: pd.DataFrame, extras: list[tuple[int, pd.DataFrame, bool]]) -> pd.DataFrame:
+    """The events with the ΔV of each merged burn outside its event's span added (vector sum) and the
+    number of burns each event holds (``burns_merged``)."""
+    out = events.copy()
+    out["burns_merged"] = 1
+    for j, row, additive in extras:
+        out.loc[out.index[j], "burns_merged"] += 1
+        if additive:
+            for c in ("dv_r_mps", "dv_t_mps", "dv_n_mps"):
+                out.loc[out.index[j], c] += float(row[c].iloc[0])
+    dv = out[["dv_r_mps", "dv_t_mps", "dv_n_mps"]].to_numpy(dtype=np.float64)
+    if extras:
+        out["dv_mps"] = np.where(out["burns_merged"] > 1, np.linalg.norm(dv, axis=1), out["dv_mps"])
+    return out
+
+
 def resolve_sequence(
     detector: OrbitDetector,
     eph: Ephemeris,
@@ -117,7 +174,8 @@ def resolve_sequence(
     separation_s: float = SEPARATION_S,
 ) -> tuple[pd.DataFrame, list[str]]:
     """Events of ``first`` plus the burns found by removing them and scanning again (see the module
-    docstring), each re-estimated with the others removed; and notes for the run's warnings."""
+    docstring), each re-estimated with the others removed; and notes for the run's warnings. Each event
+    has ``burns_merged``: the number of burns it holds that the data do not resolve (1: one burn)."""
     events = first.events
     notes: list[str] = []
     if len(events) == 0:
@@ -127,25 +185,38 @@ def resolve_sequence(
     detector = copy.copy(detector)
     detector.fixed_thresholds = orbit_thresholds(first)
     analysis = orbit_analysis(first)
-    lead_s, lag_s = np.inf, np.inf
+    lead_s, lag_s, step = np.inf, np.inf, 0.0
     if analysis is not None:
         step = analysis.ephemeris.nominal_step_s
         lead_s, lag_s = boundary_window(analysis), 2.0 * step
         # two jumps inside one GLR window are not resolved by the data (a 5-minute product's window is
-        # 50 minutes): a further detection that close to a known burn is that burn
+        # 50 minutes): a further detection that close to a known burn is merged into that burn's event
         separation_s = max(separation_s, analysis.config.glr_window_samples * step)
-    while len(events) < max_burns:
-        again = detector.detect(remove_burns(eph, events), budget).events
-        fresh = _supported(_new(again, events, separation_s, nuisance), first, lead_s, lag_s)
-        if len(fresh) == 0:
+    # merged burns: (event, detection, outside the event's span); those outside are removed and added,
+    # one inside only flags the event (its span estimate holds the total; the detection is a shape residual)
+    extras: list[tuple[int, pd.DataFrame, bool]] = []
+    while len(events) + len(extras) < max_burns:
+        removed = pd.concat([events, *(r for _, r, out in extras if out)], ignore_index=True)
+        scan = detector.detect(remove_burns(eph, removed), budget).events
+        again = _supported(_new(scan, removed, 0.0, nuisance), first, lead_s, lag_s)
+        fresh = _new(again, events, separation_s, [])
+        flagged = {j for j, _, _ in extras}
+        merged = [
+            m for m in _merged(again.drop(index=fresh.index), events, separation_s, step) if m[2] or m[0] not in flagged
+        ]
+        if len(fresh) == 0 and not merged:
             break
-        events = pd.concat([events, fresh], ignore_index=True)
-        notes.append(f"{len(fresh)} further burn(s) found after removing {len(events) - len(fresh)} found before")
+        extras.extend(merged)
+        if len(fresh):
+            events = pd.concat([events, fresh], ignore_index=True)
+            notes.append(f"{len(fresh)} further burn(s) found after removing {len(events) - len(fresh)} found before")
     if len(events) > 1:
         rows = []
         times = _times(events)
         for i in range(len(events)):
-            others = events.drop(index=events.index[i])
+            others = pd.concat(
+                [events.drop(index=events.index[i]), *(r for j, r, out in extras if out and j != i)], ignore_index=True
+            )
             alone = detector.detect(remove_burns(eph, others), budget).events
             if len(alone):
                 gap = np.abs((_times(alone) - times[i]).astype(np.float64)) * 1e-9
@@ -156,5 +227,11 @@ def resolve_sequence(
             rows.append(events.iloc[[i]])
         events = pd.concat(rows, ignore_index=True)
         notes.append(f"{len(events)} burns: each time and ΔV estimated with the other burns removed from the data")
+    events = _with_merged(events, extras)
+    for n, t in zip(events["burns_merged"], events["time_utc"], strict=True):
+        if n > 1:
+            notes.append(
+                f"{n} burns within one GLR window at {str(t)[:19]} not resolved by the data: one event, ΔV their sum"
+            )
     order = np.argsort(_times(events), kind="stable")
     return events.iloc[order].reset_index(drop=True), notes

@@ -389,9 +389,14 @@ def _to_ephemeris(segments: list[_Segment], satellite: str | None, file: str, lo
         log.record("EME2000 treated as GCRF (frame bias 23 mas ignored)", 1)
 
     ts = systems.pop()
+    utc = to_utc_counted(t, TIME_SYSTEMS[ts], log)  # type: ignore[arg-type]
+    # the first epoch of each later segment: a join the file states (known product discontinuity)
+    firsts = np.array([min(s.epochs) for s in chosen if s.epochs], dtype="datetime64[ns]")
+    at = np.searchsorted(t, np.unique(firsts)[1:])
     return Ephemeris(
         satellite=satellite or chosen[0].meta["OBJECT_ID"],
-        times_utc=to_utc_counted(t, TIME_SYSTEMS[ts], log),  # type: ignore[arg-type]
+        times_utc=utc,
+        segment_starts_utc=np.asarray(utc)[at[(at > 0) & (at < t.size)]],
         position_m=st[:, :3] * 1e3,
         velocity_mps=st[:, 3:6] * 1e3,
         frame="GCRF" if frame_name in GCRF_NAMES else "ITRF",

@@ -25,7 +25,9 @@ class Ephemeris:
 
     ``times_utc`` are UTC ``datetime64[ns]``; ``position_m`` and ``velocity_mps`` are (n, 3) arrays in
     ``frame`` (``"ITRF"`` or ``"GCRF"``). A velocity the source did not give is NaN. ``repairs`` counts
-    the documented repairs the reader made; ``source`` names the input.
+    the documented repairs the reader made; ``source`` names the input. ``segment_starts_utc``: the first
+    epoch of every data segment after the first, where the file states that one product segment hands
+    over to the next (OEM segments), i.e. known product discontinuities.
     """
 
     satellite: str
@@ -36,6 +38,7 @@ class Ephemeris:
     source: str = "<memory>"
     time_system: str = "UTC"
     repairs: RepairLog = field(default_factory=RepairLog)
+    segment_starts_utc: NDArray[np.datetime64] = field(default_factory=lambda: np.array([], dtype="datetime64[ns]"))
 
     def __post_init__(self) -> None:
         self.times_utc = np.asarray(self.times_utc, dtype="datetime64[ns]")

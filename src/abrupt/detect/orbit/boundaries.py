@@ -23,8 +23,14 @@ so they are treated apart:
    event search (a burn at the boundary is found); the others are nuisance: the statistic within the
    window is not searched, and the boundary is reported in the diagnostics.
 
-The windows are excluded from the ordinary threshold's null when the pattern is established. Joins of
-predicted segments at other epochs are not yet recognised.
+The windows are excluded from the ordinary threshold's null when the pattern is established.
+
+**Joins the file states.** An OEM file with several data segments (predicted trajectories stitched
+from segments, as NASA publishes the ISS's) states where one segment hands over to the next
+(:attr:`~abrupt.series.ephemeris.Ephemeris.segment_starts_utc`). Those joins are a second population,
+judged as in step 2 without step 1 (the file states them; no pattern is needed): each join's peak
+against the leave-one-out bound of the other joins. A file with a single join is left to the ordinary
+threshold (no population to bound it by).
 """
 
 from __future__ import annotations
@@ -57,6 +63,7 @@ class ProductBoundary:
     bound: float
     raised: bool
     window_s: float
+    kind: str = "day boundary"
 
     def as_dict(self) -> dict[str, object]:
         return {
@@ -65,6 +72,7 @@ class ProductBoundary:
             "bound": self.bound,
             "raised": self.raised,
             "window_s": self.window_s,
+            "kind": self.kind,
         }
 
 
@@ -95,15 +103,28 @@ def _pattern(peaks: FloatArray, threshold: float, p_window: float) -> bool:
     return above >= 2 and float(stats.binom.sf(above - 1, peaks.size, min(1.0, p_window))) < PATTERN_P
 
 
-def product_boundaries(
-    analysis: OrbitAnalysis, threshold: float, budget: FalseAlarmBudget, statistic: str = "glr"
-) -> tuple[list[ProductBoundary], FloatArray]:
-    """The day boundaries treated as nuisance or left to the event search (module docstring), and the
-    statistic with the nuisance windows blanked (NaN). Empty when the product shows no pattern."""
-    s = analysis.statistics[statistic]
-    idx = day_boundary_indices(analysis.ephemeris.times_utc)
-    if len(idx) < 2 or statistic != "glr" or threshold <= 0:
-        return [], s
+def segment_join_indices(analysis: OrbitAnalysis) -> list[int]:
+    """Index of the first epoch at or after each segment start the file states (OEM segments)."""
+    eph = analysis.ephemeris
+    t = np.asarray(eph.times_utc, dtype="datetime64[ns]")
+    at = np.searchsorted(t, np.asarray(eph.segment_starts_utc, dtype="datetime64[ns]"))
+    return sorted({int(k) for k in at if 0 < k < t.size})
+
+
+def _judge(
+    analysis: OrbitAnalysis,
+    s: FloatArray,
+    idx: list[int],
+    threshold: float,
+    budget: FalseAlarmBudget,
+    kind: str,
+    pattern: bool,
+) -> list[ProductBoundary]:
+    """Boundaries of one population (day boundaries, or the stated segment joins) judged nuisance or left to
+    the event search by the leave-one-out bound; ``pattern``: first require the pattern (day boundaries,
+    which a product may or may not carry; a join the file states needs no such evidence)."""
+    if len(idx) < 2:
+        return []
     t = analysis.t_s
     half = boundary_window(analysis)
     windows = [(t >= t[k] - half) & (t <= t[k] + half) for k in idx]
@@ -111,12 +132,11 @@ def product_boundaries(
     ok = np.isfinite(peaks)
     # chance that an ordinary window of this width exceeds h at the budget (one crossing per window)
     p_window = budget.per_day * (2 * half / 86400.0)
-    if ok.sum() < 2 or not _pattern(peaks[ok], threshold, p_window):
-        return [], s
+    if ok.sum() < 2 or (pattern and not _pattern(peaks[ok], threshold, p_window)):
+        return []
     m = int(ok.sum())
     p_b = BOUNDARY_SHARE * budget.per_day  # one boundary per day
     out: list[ProductBoundary] = []
-    blanked = s.copy()
     times = analysis.ephemeris.times_utc
     for i, k in enumerate(idx):
         if not ok[i]:
@@ -125,10 +145,29 @@ def product_boundaries(
         scale = float(np.sum(others)) / (3.0 * others.size)
         bound = 3.0 * scale * float(stats.f.isf(p_b, 3, 3 * (m - 1)))
         level = max(threshold, bound)
-        raised = bool(peaks[i] > level)
-        if not raised:
-            blanked[windows[i]] = np.nan
-        out.append(ProductBoundary(times[k], k, float(peaks[i]), level, raised, half))
+        out.append(ProductBoundary(times[k], k, float(peaks[i]), level, bool(peaks[i] > level), half, kind))
+    return out
+
+
+def product_boundaries(
+    analysis: OrbitAnalysis, threshold: float, budget: FalseAlarmBudget, statistic: str = "glr"
+) -> tuple[list[ProductBoundary], FloatArray]:
+    """The day boundaries and stated segment joins treated as nuisance or left to the event search (module
+    docstring), and the statistic with the nuisance windows blanked (NaN). Day boundaries are empty when
+    the product shows no pattern; joins when the file states fewer than two."""
+    s = analysis.statistics[statistic]
+    if statistic != "glr" or threshold <= 0:
+        return [], s
+    joins = segment_join_indices(analysis)
+    days = [k for k in day_boundary_indices(analysis.ephemeris.times_utc) if k not in joins]
+    out = _judge(analysis, s, days, threshold, budget, "day boundary", True)
+    out += _judge(analysis, s, joins, threshold, budget, "segment join", False)
+    out.sort(key=lambda b: b.index)
+    blanked = s.copy()
+    t = analysis.t_s
+    for b in out:
+        if not b.raised:
+            blanked[(t >= t[b.index] - b.window_s) & (t <= t[b.index] + b.window_s)] = np.nan
     return out, blanked
 
 
