@@ -4,7 +4,7 @@ error or failed request, every link resolves to a file of the site, the table fi
 
 The runs: the flight pipeline on a small flight-like archive with a known strike (tests/flight_synth),
 ``detect tle`` on the first two years of the shared Sentinel-3A history, and ``detect orbit`` on the
-first 240 epochs of the shared Sentinel-3A SP3 arc.
+first 480 epochs (8 h, more than the orbit filter needs to settle at both ends) of the shared Sentinel-3A SP3 arc.
 """
 
 from __future__ import annotations
@@ -58,7 +58,7 @@ def site(tmp_path_factory: pytest.TempPathFactory, shared_data: Path) -> tuple[P
     sp3_lines = (shared_data / "sp3" / "ssas3a20.b18358.e19003.DG_.sp3").read_text().splitlines(keepends=True)
     starts = [i for i, line in enumerate(sp3_lines) if line.startswith("*")]
     sp3 = work / "s3a.sp3"
-    sp3.write_text("".join(sp3_lines[: starts[240]]))
+    sp3.write_text("".join(sp3_lines[: starts[480]]))
     _abrupt(
         "detect", "orbit", str(sp3), "--allow-truncated", "--out", str(work / "orbit.csv"), "--catalog", catalog,
         "--report", str(work / "orbit.png"),

@@ -526,7 +526,7 @@ def test_cli_density_orbit_recovers_known_drag_and_counts_a_short_window(tmp_pat
         assert row["model_density_kg_m3"] > 0  # NRLMSIS along the same orbit, for comparison
     short = tmp_path / "short.sp3"
     write_sp3(eph.select(np.arange(len(eph)) < 5), short)
-    res = CliRunner().invoke(cli, ["density", "orbit", str(short), "--out", str(out)])
+    res = CliRunner().invoke(cli, ["density", "orbit", str(short), "--out", str(tmp_path / "short.csv")])
     assert res.exit_code != 0
     assert "short.sp3" in str(res.exception) + res.output and "too few epochs" in str(res.exception) + res.output
 
