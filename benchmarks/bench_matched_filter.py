@@ -394,4 +394,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results("bench_matched_filter", variant({"--quick": "quick"})):
+        main()
