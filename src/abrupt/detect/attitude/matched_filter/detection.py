@@ -24,7 +24,7 @@ from abrupt.detect.attitude.matched_filter.filters import (
     estimate_strike_size,
     matched_filter_bank_statistics,
 )
-from abrupt.detect.attitude.steps import episode_peaks
+from abrupt.detect.attitude.steps import peaks
 from abrupt.events import Event
 from abrupt.model.rotations import attitude_error_vector, dcm_from_quaternion
 from abrupt.model.strike_response import KINDS, Kind, WaveletSet
@@ -182,7 +182,7 @@ def detect_matched_filter(
     best = np.where(np.isfinite(ratio), ratio, -np.inf).max(axis=1)
     rows: list[dict[str, Any]] = []
     length = wavelets.length
-    for _, _, i in episode_peaks(best, 1.0, length):
+    for _, _, i in peaks(best, 1.0, length):
         axis = int(np.argmax(np.where(np.isfinite(ratio[i]), ratio[i], -np.inf)))
         seg = ch[i : i + length]
         if baseline_samples > 0:
@@ -301,7 +301,7 @@ def detect_combined(
     stat, _ = filt.statistic(ch, baseline_samples=baseline_samples)
     score = np.where(np.isfinite(stat), stat, -np.inf)
     rows: list[dict[str, Any]] = []
-    for _, _, peak in episode_peaks(score, threshold.value, wavelets.length):
+    for _, _, peak in peaks(score, threshold.value, wavelets.length):
         i, dh_b, sigma_samples = refine_strike(ch, peak, filt, baseline_samples)
         dh_n = dcm_from_quaternion(q[i]).T @ dh_b if np.all(np.isfinite(q[i])) else np.full(3, np.nan)
         rows.append(
