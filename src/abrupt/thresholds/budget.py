@@ -52,10 +52,6 @@ class FalseAlarmBudget:
 
     # ------------------------------------------------------------------ constructors
     @classmethod
-    def per_day_rate(cls, rate: float) -> FalseAlarmBudget:
-        return cls(float(rate), "day")
-
-    @classmethod
     def parse(cls, text: str) -> FalseAlarmBudget:
         """Read ``"1/day"``, ``"0.1 per week"``, ``"1/year"`` (satellite-year) or a bare number (per day)."""
         m = re.fullmatch(r"\s*([0-9.eE+-]+)\s*(?:(?:/|per)\s*(?:satellite[- ]?)?(day|week|year|yr|d|w|y))?\s*", text)
@@ -77,16 +73,8 @@ class FalseAlarmBudget:
         return self.rate / self.DAYS[self.per]
 
     @property
-    def per_second(self) -> float:
-        return self.per_day / SECONDS_PER_DAY
-
-    @property
     def per_year(self) -> float:
         return self.per_day * DAYS_PER_YEAR
-
-    def expected_in(self, duration_s: float) -> float:
-        """Expected number of false alarms in ``duration_s`` seconds of event-free data."""
-        return self.per_second * duration_s
 
     def expected_in_days(self, days: float) -> float:
         """Expected number of false alarms in ``days`` days of event-free data."""
