@@ -36,4 +36,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results("bench_attitude_pipeline_speed", variant({})):
+        main()

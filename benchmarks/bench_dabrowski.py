@@ -298,7 +298,10 @@ if __name__ == "__main__":
     if args.gyro_scale_sd:
         NOISE = replace(NOISE, gyro_scale_sd=args.gyro_scale_sd)
     amps = tuple(float(a) for a in args.amplitudes.split(","))
-    if args.experiments:
-        experiments(args.experiments, amps, args.seed, NOISE, args.center_on_previous_run, args.center_on_actual)
-    else:
-        main(args.quick, args.groups, amps, args.seed)
+    from _results import variant, write_results
+
+    with write_results("bench_dabrowski", variant({"--experiments": "experiments", "--quick": "quick"})):
+        if args.experiments:
+            experiments(args.experiments, amps, args.seed, NOISE, args.center_on_previous_run, args.center_on_actual)
+        else:
+            main(args.quick, args.groups, amps, args.seed)

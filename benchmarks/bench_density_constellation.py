@@ -126,4 +126,7 @@ def run(args: argparse.Namespace, seed: int) -> list[float]:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results("bench_density_constellation", variant({})):
+        main()

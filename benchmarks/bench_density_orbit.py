@@ -109,4 +109,10 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results(
+        "bench_density_orbit",
+        variant({"--skip-sim": "nosim", "--skip-real": "noreal", "--density-model=exponential": "exponential"}),
+    ):
+        main()

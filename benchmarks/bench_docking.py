@@ -134,7 +134,7 @@ def load_track(path: str) -> InertiaTrack:
                         z["params"], z["covariance"], z["observable"])  # fmt: skip
 
 
-if __name__ == "__main__":
+def main() -> None:
     if "--track" in sys.argv:
         tr = load_track(sys.argv[sys.argv.index("--track") + 1])
         report(tr, None, 0.0)
@@ -154,3 +154,10 @@ if __name__ == "__main__":
         report(tr, 6.37, dt)
         tr, dt = track(12.0, None, seed=12, sim_rate_hz=5.0)
         report(tr, None, dt)
+
+
+if __name__ == "__main__":
+    from _results import variant, write_results
+
+    with write_results("bench_docking", variant({"--track": "track", "--year": "year", "--no-dumps": "nodumps"})):
+        main()

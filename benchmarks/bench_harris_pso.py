@@ -132,9 +132,16 @@ def swarm(name: str, slews: list[Slew], seed: int) -> None:
     print(f"  direct excitation report: {est.unobservable or 'all six parameters determined'}")
 
 
-if __name__ == "__main__":
+def main() -> None:
     fig5()
     swarm("single-axis slew (about body x)", [Slew(3000.0, 30.0, (1.0, 0.0, 0.0), 120.0, 200.0)], 3)
     swarm("three slews about different axes", [Slew(2000.0, 30.0, (1.0, 0.2, 0.0), 120.0, 200.0),
                                                Slew(6000.0, 30.0, (0.0, 1.0, 0.3), 120.0, 200.0),
                                                Slew(10000.0, 30.0, (0.2, 0.0, 1.0), 120.0, 200.0)], 4)  # fmt: skip
+
+
+if __name__ == "__main__":
+    from _results import write_results
+
+    with write_results("bench_harris_pso"):
+        main()

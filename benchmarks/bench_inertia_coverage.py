@@ -80,4 +80,8 @@ def main(n: int) -> None:
 
 
 if __name__ == "__main__":
-    main(int(sys.argv[1]) if len(sys.argv) > 1 else 40)
+    from _results import write_results
+
+    runs = int(sys.argv[1]) if len(sys.argv) > 1 else 40
+    with write_results("bench_inertia_coverage", "" if runs == 40 else f"{runs}runs"):
+        main(runs)

@@ -323,4 +323,7 @@ def simulated_spacecraft() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results("bench_inertia_flight_like", variant({"--no-pso": "nopso", "--pandas-loader": "pandas"})):
+        main()

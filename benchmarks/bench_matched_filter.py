@@ -42,7 +42,7 @@ from abrupt.detect.attitude.matched_filter import (
 )
 from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike, simulate_attitude_batch
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
-from abrupt.thresholds import fit_threshold, neyman_pearson_threshold, p_fa_per_sample
+from abrupt.thresholds import FalseAlarmBudget, fit_threshold, neyman_pearson_threshold
 
 RATE_HZ = 10.0
 TOL = 10  # detection must peak within +-1 s of the strike sample
@@ -259,19 +259,19 @@ def run(quick: bool) -> None:
                     print(f"    {metric:13s} mean {np.mean(e):+6.2f} mg  sd {np.std(e):5.1f} mg   | {ref_s}")
 
         # ---- Acceptance 3: power curves at one false alarm per day ----
-        p_day = p_fa_per_sample(1.0, RATE_HZ)
+        p_day = FalseAlarmBudget(1.0).per_sample(RATE_HZ)
         thr_day = {
             k: np.array(
                 [
                     t.value
                     for t in fit_matched_filter_thresholds(
-                        null[k], false_alarms_per_day=1.0, sample_rate_hz=RATE_HZ, method="gaussian"
+                        null[k], budget=FalseAlarmBudget(1.0), sample_rate_hz=RATE_HZ, method="gaussian"
                     )
                 ]
             )
             for k in KINDS
         }
-        t_chi = chi2_threshold(false_alarms_per_day=1.0, sample_rate_hz=RATE_HZ)
+        t_chi = chi2_threshold(budget=FalseAlarmBudget(1.0), sample_rate_hz=RATE_HZ)
         t_gam = fit_threshold(null["combined"], p_fa=p_day, method="gamma").value
         thr_day["combined"] = np.array(max(t_chi.value, t_gam))
         t_joint = fit_threshold(null["joint"], p_fa=p_day, method="gamma").value
@@ -394,4 +394,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results("bench_matched_filter", variant({"--quick": "quick"})):
+        main()

@@ -206,4 +206,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import variant, write_results
+
+    with write_results("bench_rates_thesis", variant({"--quick": "quick"})):
+        main()

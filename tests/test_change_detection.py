@@ -11,7 +11,7 @@ from abrupt.detect.attitude.change_detection import (
     WindowConfig,
     sliding_statistic,
 )
-from abrupt.detect.attitude.steps import episode_peaks, local_peaks, mean_difference_step
+from abrupt.detect.attitude.steps import mean_difference_step, peaks
 
 CFG = WindowConfig(pre=50, post=40, cusum_delta_mu_Nms=0.1)
 RNG = np.random.default_rng(7)
@@ -131,20 +131,41 @@ def test_cusum_does_not_lose_precision_on_a_large_offset() -> None:
     np.testing.assert_allclose(shifted, base, atol=1e-4)
 
 
-def test_episode_peaks_are_the_largest_sample_of_each_run_above_the_threshold() -> None:
+def test_peaks_are_the_largest_sample_of_each_run_above_the_threshold() -> None:
     stat = np.array([0.0, 2.0, 3.0, 2.0, 0.0, 0.0, 5.0, np.nan, 4.0, 0.0, 0.0, 0.0, 0.0, 2.5])
     # Runs closer than 2 samples join: (1..3), (6..8) joined across the NaN, then 13 alone.
-    assert episode_peaks(stat, 1.0, 2) == [(1, 4, 2), (6, 9, 6), (13, 14, 13)]
+    assert peaks(stat, 1.0, 2) == [(1, 4, 2), (6, 9, 6), (13, 14, 13)]
     # The same groups as splitting the above-threshold indices where they are more than `merge` apart.
     above = np.flatnonzero(np.nan_to_num(stat, nan=-np.inf) > 1.0)
     groups = np.split(above, np.flatnonzero(np.diff(above) > 2) + 1)
-    assert [p for _, _, p in episode_peaks(stat, 1.0, 2)] == [int(g[np.argmax(stat[g])]) for g in groups]
+    assert [p for _, _, p in peaks(stat, 1.0, 2)] == [int(g[np.argmax(stat[g])]) for g in groups]
 
 
-def test_local_peaks_keep_the_largest_maximum_within_the_separation() -> None:
+def test_peaks_with_a_separation_keep_the_largest_maximum_within_it() -> None:
     stat = np.array([0.0, 5.0, 4.0, 0.0, 0.0, 0.0, 3.0, 0.0, 6.0, np.nan])
-    assert local_peaks(stat, 1.0, 2) == [1, 8]
-    assert local_peaks(stat, 1.0, 1) == [1, 6, 8]
+    assert [p for _, _, p in peaks(stat, 1.0, 2, separation=2)] == [1, 8]
+    assert [p for _, _, p in peaks(stat, 1.0, 1, separation=1)] == [1, 6, 8]
+
+
+def _suppression_over_the_whole_series(stat: np.ndarray, floor: float, sep: int) -> list[int]:
+    """Reference: visit samples above the floor from the largest (earlier first on ties) and keep each one
+    no kept sample lies within ``sep`` of."""
+    cand = [i for i in range(stat.size) if np.isfinite(stat[i]) and stat[i] > floor]
+    kept: list[int] = []
+    for i in sorted(cand, key=lambda j: (-stat[j], j)):
+        if all(abs(i - k) > sep for k in kept):
+            kept.append(i)
+    return sorted(kept)
+
+
+def test_peaks_with_merge_equal_to_the_separation_are_suppression_over_the_whole_series() -> None:
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        stat = np.round(rng.normal(size=int(rng.integers(1, 80))), 1)  # rounding makes ties
+        stat[rng.random(stat.size) < 0.05] = np.nan
+        sep = int(rng.integers(1, 8))
+        got = [p for _, _, p in peaks(stat, 0.3, sep, separation=sep)]
+        assert got == _suppression_over_the_whole_series(stat, 0.3, sep)
 
 
 def test_mean_difference_step_finds_the_step_sample_whatever_the_cumulative_sum_origin() -> None:

@@ -8,7 +8,7 @@ import pytest
 
 from abrupt.detect.base import DetectionResult, Detector, detector_names, get_detector
 from abrupt.events import EVENT_COLUMNS
-from abrupt.thresholds import FalseAlarmBudget, p_fa_per_sample
+from abrupt.thresholds import FalseAlarmBudget
 
 
 def test_budget_units_convert_to_the_same_daily_rate() -> None:
@@ -22,7 +22,8 @@ def test_budget_units_convert_to_the_same_daily_rate() -> None:
 def test_per_sample_matches_bennett_section_2_5_1() -> None:
     # One false alarm per day at 10 Hz is p_fa = 1/864000 (Bennett 2022 §2.5.1 step 4).
     assert FalseAlarmBudget(1, "day").per_sample(10.0) == pytest.approx(1 / 864000)
-    assert FalseAlarmBudget(1, "day").per_sample(10.0) == p_fa_per_sample(1.0, 10.0)
+    # and back: the per-day budget of a per-sample level
+    assert FalseAlarmBudget.from_per_sample(1 / 864000, 10.0).per_day == pytest.approx(1.0)
 
 
 def test_per_block_is_the_poisson_probability_of_at_least_one_alarm() -> None:

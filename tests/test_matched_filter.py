@@ -34,6 +34,7 @@ from abrupt.detect.attitude.matched_filter import (
 from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike, simulate_attitude_batch
 from abrupt.model.rotations import quaternion_from_mrp, quaternion_multiply
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
+from abrupt.thresholds import FalseAlarmBudget
 
 RATE_HZ = 10.0
 LENGTH = 250
@@ -216,7 +217,7 @@ def test_detect_returns_one_row_per_strike_with_time_and_inertial_dh() -> None:
     w[4000 : 4000 + LENGTH] -= _response(0.5, 2)
     q = np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
     null = matched_filter_bank_statistics("rate", rng.normal(scale=sigma, size=(50_000, 3)), wav)
-    thr = fit_matched_filter_thresholds(null, false_alarms_per_day=1.0, sample_rate_hz=RATE_HZ)
+    thr = fit_matched_filter_thresholds(null, budget=FalseAlarmBudget(1.0), sample_rate_hz=RATE_HZ)
     det = detect_matched_filter("rate", t, q, w, wav, thr, reference_q_BN=q[0])
     assert list(det["index"]) == pytest.approx([1000, 4000], abs=1)
     assert list(det["axis"]) == [0, 2]
@@ -235,7 +236,7 @@ def test_detect_finds_nothing_in_noise_and_keeps_columns() -> None:
     w = rng.normal(scale=4e-5, size=(n, 3))
     q = np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
     null = matched_filter_bank_statistics("rate", rng.normal(scale=4e-5, size=(50_000, 3)), wav)
-    thr = fit_matched_filter_thresholds(null, false_alarms_per_day=1.0, sample_rate_hz=RATE_HZ)
+    thr = fit_matched_filter_thresholds(null, budget=FalseAlarmBudget(1.0), sample_rate_hz=RATE_HZ)
     det = detect_matched_filter("rate", np.arange(n) / RATE_HZ, q, w, wav, thr)
     assert det.empty and "dH_N_x_Nms" in det.columns
 
@@ -336,7 +337,7 @@ def test_simulated_strike_is_detected_with_time_and_size(thesis_wavelets) -> Non
     out = simulate_attitude_batch(sc, cfg, [[], [Strike(300.05, tuple(dh_b))]], [1, 2])  # type: ignore[arg-type]
     q0 = np.array([1.0, 0.0, 0.0, 0.0])
     null = matched_filter_bank_statistics("attitude", attitude_error_vector(out["q_BN"][0], q0), wav)
-    thr = fit_matched_filter_thresholds(null, false_alarms_per_day=1.0, sample_rate_hz=10.0)
+    thr = fit_matched_filter_thresholds(null, budget=FalseAlarmBudget(1.0), sample_rate_hz=10.0)
     det = detect_matched_filter(
         "attitude", out["t_s"], out["q_BN"][1], out["omega_B_rad_s"][1], wav, thr, reference_q_BN=q0
     )

@@ -7,13 +7,13 @@ import pytest
 from scipy import stats
 
 from abrupt.thresholds import (
+    FalseAlarmBudget,
     episode_rate,
     fit_block_maxima_threshold,
     fit_threshold,
     gpd_quantile,
     gpd_return_level_upper,
     neyman_pearson_threshold,
-    p_fa_per_sample,
     qq_points,
     roc_curve,
 )
@@ -23,7 +23,8 @@ GAUSS = RNG.normal(2.0, 3.0, size=200_000)
 
 
 def test_one_false_alarm_per_day_at_10_hz_is_1_over_864000() -> None:
-    assert p_fa_per_sample(1.0, 10.0) == pytest.approx(1 / 864000)
+    assert FalseAlarmBudget(1.0).per_sample(10.0) == pytest.approx(1 / 864000)
+    assert FalseAlarmBudget.from_per_sample(1 / 864000, 10.0).per_day == pytest.approx(1.0)
 
 
 def test_gaussian_fit_matches_the_normal_quantile() -> None:
@@ -45,7 +46,7 @@ def test_gamma_fit_matches_the_gamma_quantile() -> None:
 
 
 def test_threshold_records_its_false_alarm_rate() -> None:
-    thr = fit_threshold(GAUSS, false_alarms_per_day=2.0, sample_rate_hz=1.0, method="gaussian")
+    thr = fit_threshold(GAUSS, budget=FalseAlarmBudget(2.0), sample_rate_hz=1.0, method="gaussian")
     assert thr.false_alarms_per_day == pytest.approx(2.0)
     assert thr.p_fa == pytest.approx(2.0 / 86400)
 
@@ -53,7 +54,7 @@ def test_threshold_records_its_false_alarm_rate() -> None:
 def test_gev_threshold_sets_the_episode_rate_of_independent_gaussian_noise() -> None:
     # Independent N(0,1) samples at 1 Hz: P(block max > c) = 1 - Φ(c)^block exactly.
     x = np.random.default_rng(1).normal(size=3_000_000)
-    thr = fit_block_maxima_threshold(x, sample_rate_hz=1.0, false_alarms_per_day=1.0, block_s=3600.0)
+    thr = fit_block_maxima_threshold(x, sample_rate_hz=1.0, budget=FalseAlarmBudget(1.0), block_s=3600.0)
     # one alarm per day with independent samples: per-sample probability 1/86400
     assert thr.value == pytest.approx(stats.norm.isf(1 / 86400), rel=0.03)
 

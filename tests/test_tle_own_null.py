@@ -39,7 +39,7 @@ def test_block_threshold_follows_cadence_and_noise_level() -> None:
     n1 = t1.size  # gaps 0..n1-1 lie in the first part
     stat = np.abs(rng.standard_normal(t.size - 1))
     stat[n1:] *= 2.0
-    local, edges = block_thresholds(stat, t, 8, 1.0, "gpd", 365.25, 0.0)
+    local, edges = block_thresholds(stat, t, 8, FalseAlarmBudget(1.0, "year"), "gpd", 365.25, 0.0)
     assert edges.size == 5  # four yearly blocks
     expected_1 = stats.halfnorm.isf(1.0 / 365.25)
     expected_2 = 2.0 * stats.halfnorm.isf(1.0 / (4 * 365.25))

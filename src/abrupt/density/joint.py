@@ -96,10 +96,6 @@ class JointFit:
     iterations: int
     warnings: list[str] = field(default_factory=list)
 
-    def node_utc(self) -> Any:
-        step = np.timedelta64(round(self.node_days * SECONDS_PER_DAY * 1e9), "ns")
-        return self.origin_utc + np.arange(self.scale.size) * step
-
     def scale_at(self, times_utc: Any) -> FloatArray:
         """s(t) (relative) at UTC times by the piecewise-linear basis."""
         t = _seconds(times_utc, self.origin_utc)

@@ -101,12 +101,6 @@ class BallisticDistribution:
         f = observed_survival(self.y, self.survival, s, u)
         return float(u[0] + np.trapezoid(f**n_platforms, u))
 
-    def quantiles(self, probabilities: FloatArray) -> FloatArray:
-        """Quantiles of B/B_min: y with C_B(y) = p."""
-        cdf = 1.0 - self.survival
-        cdf_u, first = np.unique(cdf, return_index=True)
-        return np.interp(probabilities, cdf_u, self.y[first])
-
 
 def interpolation_matrix(xq: FloatArray, y: FloatArray) -> tuple[FloatArray, FloatArray]:
     """(P, p0) with interp(xq, y, F, left=1, right=0) = P @ F + p0 for any F on ``y``."""

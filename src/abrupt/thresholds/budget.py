@@ -9,9 +9,10 @@ satellite-year; the conversions below turn it into the level a threshold fit nee
 ``per_block(block_s)``           probability that the maximum over a block exceeds it,
                                  1 − exp(−rate·block) (GEV block maxima, Coles 2001 §3);
 ``per_block_first_order(block_s)`` rate·block, its first-order value (robust Gumbel fits);
-``per_test(tests_per_day)``      probability per independent test when tests come at a known rate
+``per_test(tests, per)``         probability per independent test when tests come at a known rate
                                  (a TLE gap, a tracking pass, a window of routine telemetry);
-``bonferroni(n)``                the budget split evenly over ``n`` parallel statistics.
+``bonferroni(n)``                the budget split evenly over ``n`` parallel statistics;
+``from_per_sample(p_fa, hz)``    the other way: the per-day budget a per-sample level stands for.
 """
 
 from __future__ import annotations
@@ -51,10 +52,6 @@ class FalseAlarmBudget:
 
     # ------------------------------------------------------------------ constructors
     @classmethod
-    def per_day_rate(cls, rate: float) -> FalseAlarmBudget:
-        return cls(float(rate), "day")
-
-    @classmethod
     def parse(cls, text: str) -> FalseAlarmBudget:
         """Read ``"1/day"``, ``"0.1 per week"``, ``"1/year"`` (satellite-year) or a bare number (per day)."""
         m = re.fullmatch(r"\s*([0-9.eE+-]+)\s*(?:(?:/|per)\s*(?:satellite[- ]?)?(day|week|year|yr|d|w|y))?\s*", text)
@@ -63,6 +60,12 @@ class FalseAlarmBudget:
         unit = {"d": "day", "w": "week", "y": "year", "yr": "year"}.get(m.group(2) or "day", m.group(2) or "day")
         return cls(float(m.group(1)), unit)  # type: ignore[arg-type]
 
+    @classmethod
+    def from_per_sample(cls, p_fa: float, sample_rate_hz: float) -> FalseAlarmBudget:
+        """The per-day budget of which ``p_fa`` is the per-sample level at ``sample_rate_hz`` (the
+        inverse of :meth:`per_sample` below its cap of 1)."""
+        return cls(p_fa * sample_rate_hz * SECONDS_PER_DAY, "day")
+
     # ------------------------------------------------------------------ rates
     @property
     def per_day(self) -> float:
@@ -70,16 +73,8 @@ class FalseAlarmBudget:
         return self.rate / self.DAYS[self.per]
 
     @property
-    def per_second(self) -> float:
-        return self.per_day / SECONDS_PER_DAY
-
-    @property
     def per_year(self) -> float:
         return self.per_day * DAYS_PER_YEAR
-
-    def expected_in(self, duration_s: float) -> float:
-        """Expected number of false alarms in ``duration_s`` seconds of event-free data."""
-        return self.per_second * duration_s
 
     def expected_in_days(self, days: float) -> float:
         """Expected number of false alarms in ``days`` days of event-free data."""
@@ -96,8 +91,8 @@ class FalseAlarmBudget:
         """Probability that a block of ``block_s`` seconds holds an alarm, for a Poisson rate."""
         if not block_s > 0:
             raise ValueError(f"block_s must be positive, got {block_s}")
-        # 1 - exp(-λT) written as the GEV fit always computed it (numpy's exp), so thresholds are
-        # bit-identical to those published before the budget existed.
+        # 1 - exp(-λT) with numpy's exp (math.exp may differ in the last bit; the thresholds in
+        # docs/results were fitted with numpy's).
         return float(1.0 - np.exp(-self.per_day * block_s / SECONDS_PER_DAY))
 
     def per_block_first_order(self, block_s: float) -> float:
@@ -107,11 +102,13 @@ class FalseAlarmBudget:
             raise ValueError(f"block_s must be positive, got {block_s}")
         return self.per_day * block_s / SECONDS_PER_DAY
 
-    def per_test(self, tests_per_day: float) -> float:
-        """Probability per test when independent tests come at ``tests_per_day``."""
-        if not tests_per_day > 0:
-            raise ValueError(f"tests_per_day must be positive, got {tests_per_day}")
-        return min(1.0, self.per_day / tests_per_day)
+    def per_test(self, tests: float, per: BudgetUnit = "day", *, cap: float = 1.0) -> float:
+        """Probability per test when independent tests come at ``tests`` per ``per`` (day, week or
+        satellite-year): the budget's rate in that unit over the tests, at most ``cap`` (a TLE gap
+        test caps it at 0.5, beyond which a test is no test)."""
+        if not tests > 0:
+            raise ValueError(f"the rate of tests must be positive, got {tests}")
+        return min(cap, self.per_day * self.DAYS[per] / tests)
 
     def bonferroni(self, n: int) -> FalseAlarmBudget:
         """This budget split evenly over ``n`` parallel statistics (the union keeps the total rate)."""

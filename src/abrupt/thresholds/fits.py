@@ -18,8 +18,8 @@ with the false-alarm rate it was set for. Supported fits of the event-free ("nul
                (:func:`robust_gaussian_threshold`).
 
 Every fit takes the false-alarm budget either as a :class:`~abrupt.thresholds.FalseAlarmBudget`
-(``budget=``, the one conversion to per-sample and per-block levels), as ``false_alarms_per_day``
-(read as a budget per day) or as a per-sample ``p_fa``.
+(``budget=``, whose methods are the one conversion to per-sample and per-block levels) or as a
+per-sample ``p_fa``.
 
 Probability per sample follows Bennett 2022 §2.5.1 step 4: one false alarm per day at 10 Hz is
 ``p_fa = 1 / 864000``. :func:`episode_rate` counts distinct exceedance episodes, which is what an
@@ -46,16 +46,9 @@ FitMethod = Literal["gaussian", "gamma", "kde", "empirical", "gpd", "gev"]
 FIT_METHODS: tuple[str, ...] = ("gaussian", "gamma", "kde", "empirical", "gpd", "gev")
 
 
-def p_fa_per_sample(false_alarms_per_day: float, sample_rate_hz: float) -> float:
-    """Per-sample false-alarm probability for a budget in false alarms per day (Bennett 2022 §2.5.1)."""
-    if false_alarms_per_day <= 0 or sample_rate_hz <= 0:
-        raise ValueError("false_alarms_per_day and sample_rate_hz must be positive")
-    return min(1.0, false_alarms_per_day / (sample_rate_hz * SECONDS_PER_DAY))
-
-
-def false_alarms_per_day_from_p_fa(p_fa: float, sample_rate_hz: float) -> float:
-    """Inverse of :func:`p_fa_per_sample`."""
-    return p_fa * sample_rate_hz * SECONDS_PER_DAY
+def _per_day(p_fa: float, sample_rate_hz: float | None) -> float:
+    """The per-day rate a per-sample level stands for (NaN without a sample rate)."""
+    return float("nan") if sample_rate_hz is None else FalseAlarmBudget.from_per_sample(p_fa, sample_rate_hz).per_day
 
 
 @dataclass(frozen=True)
@@ -160,24 +153,20 @@ def fit_threshold(
     null_statistic: ArrayLike,
     *,
     p_fa: float | None = None,
-    false_alarms_per_day: float | None = None,
     sample_rate_hz: float | None = None,
     method: FitMethod = "kde",
     budget: FalseAlarmBudget | None = None,
 ) -> Threshold:
     """Fit the event-free statistic and return the threshold exceeded with probability ``p_fa``.
 
-    Give either ``p_fa`` (per sample), or a ``budget`` (or ``false_alarms_per_day``) with
-    ``sample_rate_hz`` (the rate at which the statistic is evaluated). The statistic is one-sided:
-    large values are alarms.
+    Give either ``p_fa`` (per sample), or a ``budget`` with ``sample_rate_hz`` (the rate at which the
+    statistic is evaluated). The statistic is one-sided: large values are alarms.
     """
     x = _clean_null(null_statistic)
-    if budget is not None:
-        false_alarms_per_day = budget.per_day
     if p_fa is None:
-        if false_alarms_per_day is None or sample_rate_hz is None:
-            raise ValueError("give p_fa, or false_alarms_per_day with sample_rate_hz")
-        p_fa = p_fa_per_sample(false_alarms_per_day, sample_rate_hz)
+        if budget is None or sample_rate_hz is None:
+            raise ValueError("give p_fa, or a budget with sample_rate_hz")
+        p_fa = budget.per_sample(sample_rate_hz)
     if not 0 < p_fa < 1:
         raise ValueError(f"p_fa must be in (0, 1), got {p_fa}")
     if method == "gev":
@@ -186,14 +175,14 @@ def fit_threshold(
         return fit_block_maxima_threshold(
             null_statistic,
             sample_rate_hz=sample_rate_hz,
-            false_alarms_per_day=false_alarms_per_day_from_p_fa(p_fa, sample_rate_hz),
+            budget=FalseAlarmBudget.from_per_sample(p_fa, sample_rate_hz),
         )
     try:
         quantile = UPPER_QUANTILES[method]
     except KeyError:
         raise ValueError(f"unknown threshold method {method!r}; choose one of {FIT_METHODS}") from None
     value = quantile(x, p_fa)
-    rate = float("nan") if sample_rate_hz is None else false_alarms_per_day_from_p_fa(p_fa, sample_rate_hz)
+    rate = _per_day(p_fa, sample_rate_hz)
     return Threshold(
         value=value,
         p_fa=float(p_fa),
@@ -217,21 +206,17 @@ def fit_block_maxima_threshold(
     null_statistic: ArrayLike,
     *,
     sample_rate_hz: float,
-    false_alarms_per_day: float | None = None,
+    budget: FalseAlarmBudget,
     block_s: float = 600.0,
-    budget: FalseAlarmBudget | None = None,
 ) -> Threshold:
     """Threshold for a rate of alarm episodes per day, from a GEV fit to block maxima.
 
     The event-free statistic is cut into blocks of ``block_s`` seconds (longer than the detector's
     window, so block maxima are nearly independent); a generalised extreme-value distribution is
     fitted to the maxima and the threshold is the level exceeded in a block with probability
-    1 − exp(−rate · block length), i.e. a Poisson rate of ``false_alarms_per_day`` episodes.
+    1 − exp(−rate · block length) (:meth:`FalseAlarmBudget.per_block`), i.e. a Poisson rate of
+    ``budget`` episodes.
     """
-    if budget is None:
-        if false_alarms_per_day is None:
-            raise ValueError("give a budget or false_alarms_per_day")
-        budget = FalseAlarmBudget(false_alarms_per_day, "day")
     block = max(2, round(block_s * sample_rate_hz))
     maxima = block_maxima(null_statistic, block)
     if maxima.size < 20:
@@ -250,19 +235,12 @@ def fit_block_maxima_threshold(
     )
 
 
-def _level(
-    p_fa: float | None,
-    false_alarms_per_day: float | None,
-    sample_rate_hz: float | None,
-    budget: FalseAlarmBudget | None,
-) -> float:
-    """Per-sample false-alarm probability from whichever form of the budget was given."""
+def _level(p_fa: float | None, sample_rate_hz: float | None, budget: FalseAlarmBudget | None) -> float:
+    """Per-sample false-alarm probability: ``p_fa`` itself, or the budget's at ``sample_rate_hz``."""
     if p_fa is not None:
         return float(p_fa)
-    if sample_rate_hz is None or (budget is None and false_alarms_per_day is None):
-        raise ValueError("give p_fa, or a budget (or false_alarms_per_day) with sample_rate_hz")
-    if budget is None:
-        budget = FalseAlarmBudget(float(false_alarms_per_day), "day")  # type: ignore[arg-type]
+    if sample_rate_hz is None or budget is None:
+        raise ValueError("give p_fa, or a budget with sample_rate_hz")
     return budget.per_sample(sample_rate_hz)
 
 
@@ -270,7 +248,6 @@ def chi2_threshold(
     dof: int = 3,
     *,
     p_fa: float | None = None,
-    false_alarms_per_day: float | None = None,
     sample_rate_hz: float | None = None,
     budget: FalseAlarmBudget | None = None,
 ) -> Threshold:
@@ -281,15 +258,13 @@ def chi2_threshold(
     """
     if dof < 1:
         raise ValueError(f"a chi-square needs at least one degree of freedom, got {dof}")
-    level = _level(p_fa, false_alarms_per_day, sample_rate_hz, budget)
+    level = _level(p_fa, sample_rate_hz, budget)
     return Threshold(
         value=float(stats.chi2.isf(level, dof)),
         p_fa=level,
         method="chi2",
         n_samples=0,
-        false_alarms_per_day=float("nan")
-        if sample_rate_hz is None
-        else false_alarms_per_day_from_p_fa(level, sample_rate_hz),
+        false_alarms_per_day=_per_day(level, sample_rate_hz),
         sample_rate_hz=float("nan") if sample_rate_hz is None else float(sample_rate_hz),
     )
 
@@ -315,9 +290,7 @@ def robust_gaussian_threshold(
         p_fa=float(p_fa),
         method="robust_gaussian",
         n_samples=int(x.size),
-        false_alarms_per_day=float("nan")
-        if sample_rate_hz is None
-        else false_alarms_per_day_from_p_fa(p_fa, sample_rate_hz),
+        false_alarms_per_day=_per_day(p_fa, sample_rate_hz),
         sample_rate_hz=float("nan") if sample_rate_hz is None else float(sample_rate_hz),
     )
 

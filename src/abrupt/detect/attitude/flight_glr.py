@@ -5,7 +5,8 @@ Bennett 2022 §2.4.2) on each gap-free run of analysable samples. What differs i
 telemetry needs (Harris et al. 2025 §3.4-3.5), so it is its own detector rather than a setting of
 ``attitude.glr``:
 
-* peaks: greedy non-maximum suppression above a low floor (:func:`~abrupt.detect.attitude.steps.local_peaks`),
+* peaks: every local maximum above a low floor, one window span apart (:func:`~abrupt.detect.attitude.steps.peaks`
+  with a separation),
   so that a long run can be scanned chunk by chunk before its threshold is known;
 * the step: located near the peak with the noise of its neighbourhood
   (:func:`~abrupt.detect.attitude.steps.locate_step_near_peak`) and sized by a local least-squares
@@ -30,7 +31,7 @@ import pandas as pd
 
 from abrupt.detect.attitude.change_detection import WindowConfig
 from abrupt.detect.attitude.momentum import ATTITUDE_EVENT_COLUMNS, GlrDetector
-from abrupt.detect.attitude.steps import gap_free_segments, local_peaks, local_step, locate_step_near_peak
+from abrupt.detect.attitude.steps import gap_free_segments, local_step, locate_step_near_peak, peaks
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc
 from abrupt.series.attitude import CleanedMomentum
@@ -109,7 +110,12 @@ class FlightGlrDetector(Detector[CleanedMomentum]):
     @staticmethod
     def step_candidates(h: FloatArray, ok: BoolArray, stat: FloatArray, win: WindowConfig, floor: float) -> list[int]:
         """Samples where ᴺH steps at the local peaks of ``stat`` above ``floor`` (free steps of a model fit)."""
-        return [locate_step_near_peak(h, ok, i, win) for i in local_peaks(stat, floor, win.span)]
+        return [locate_step_near_peak(h, ok, i, win) for i in FlightGlrDetector.peak_samples(stat, floor, win)]
+
+    @staticmethod
+    def peak_samples(stat: FloatArray, floor: float, win: WindowConfig) -> list[int]:
+        """Samples of the local maxima of ``stat`` above ``floor``, at least one window span apart."""
+        return [i for _, _, i in peaks(stat, floor, merge=win.span, separation=win.span)]
 
     def scan(self, h: FloatArray, ok: BoolArray, time_ns: IntArray, dt: float, keep: BoolArray | None = None) -> Scan:
         """Statistic and peaks (those at samples where ``keep``, default all) of cleaned ᴺH ``h``."""
@@ -129,7 +135,7 @@ class FlightGlrDetector(Detector[CleanedMomentum]):
     ) -> list[tuple[int, Peak]]:
         """Local peaks of ``stat`` above the floor with the step of ᴺH at each (time, ΔH, time σ)."""
         found: list[tuple[int, Peak]] = []
-        for i in local_peaks(stat, self.peak_floor, win.span):
+        for i in self.peak_samples(stat, self.peak_floor, win):
             if keep is not None and not keep[i]:
                 continue
             near = h[max(0, i - 2 * win.span) : i + 2 * win.span]

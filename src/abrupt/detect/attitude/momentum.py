@@ -34,7 +34,7 @@ from abrupt.detect.attitude.change_detection import (
     pre_window_mean_std,
     sliding_statistic,
 )
-from abrupt.detect.attitude.steps import episode_peaks, locate_step_in_segment
+from abrupt.detect.attitude.steps import locate_step_in_segment, peaks
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics, detector_names, get_detector
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc
 from abrupt.model.spacecraft import Spacecraft
@@ -262,7 +262,7 @@ class MomentumChangeDetector(Detector[AttitudeSeries]):
         events: list[Event] = []
         taus: list[int] = []
         merged = 0
-        for a, b, peak in episode_peaks(stat, thr.value, merge=max(1, win.span // 10)):
+        for a, b, peak in peaks(stat, thr.value, merge=max(1, win.span // 10)):
             seg = next((sg for sg in tel.segments if sg[0] <= peak < sg[1]), (0, n))
             # The step is where total ᴺH (conserved through the control transient) changes most: search
             # the whole episode widened by the windows, since some statistics (CUSUM, Shiryaev) peak

@@ -1,12 +1,11 @@
 """Peaks of a statistic and steps of total angular momentum: the pickers and step locators of the attitude detectors.
 
-Two ways to turn a statistic into candidate samples:
-
-* :func:`episodes` / :func:`episode_peaks`: runs of samples above a threshold, merged when closer
-  than ``merge`` samples, and the largest sample of each run (the change detectors of
-  :mod:`abrupt.detect.attitude.momentum` and the matched filters);
-* :func:`local_peaks`: greedy non-maximum suppression above a floor (``attitude.flight_glr``, whose
-  threshold is fitted after the whole run has been scanned).
+One picker turns a statistic into candidate samples, :func:`peaks`: the runs of samples above a
+threshold (runs closer than ``merge`` samples join) and, in each run, either its largest sample (the
+change detectors of :mod:`abrupt.detect.attitude.momentum` and the matched filters) or, with a
+``separation``, its maxima at least that far apart by greedy non-maximum suppression
+(``attitude.flight_glr``, which keeps every local peak above a low floor because its threshold is
+fitted after the whole run has been scanned).
 
 And one step locator: :func:`mean_difference_step`, the sample that maximises the noise-weighted
 squared difference of the means of ``m`` samples before and after it. :func:`locate_step_in_segment`
@@ -35,37 +34,38 @@ def gap_free_segments(ok: BoolArray) -> list[tuple[int, int]]:
     return [(int(a), int(b)) for a, b in zip(starts, ends, strict=True)]
 
 
-def episodes(stat: FloatArray, threshold: float, merge: int) -> list[tuple[int, int]]:
-    """[start, end) of the runs of ``stat`` above ``threshold``; runs closer than ``merge`` samples join."""
-    above = np.flatnonzero(np.nan_to_num(stat, nan=-np.inf) > threshold)
+def peaks(stat: FloatArray, threshold: float, merge: int, separation: int | None = None) -> list[tuple[int, int, int]]:
+    """(start, end, peak) of the peaks of ``stat`` above ``threshold``, by sample.
+
+    The samples above ``threshold`` (NaN never is) form runs [start, end); runs closer than ``merge``
+    samples join. Without ``separation`` each run gives one peak, its first largest sample. With a
+    ``separation`` each run gives its maxima at least ``separation + 1`` samples apart, taken greedily
+    from the largest (non-maximum suppression; ties go to the earlier sample). With ``merge`` =
+    ``separation`` no suppression zone reaches into another run, so this is the same as suppression
+    over the whole series.
+    """
+    x = np.where(np.isnan(stat), -np.inf, stat)
+    above = np.flatnonzero(x > threshold)
     if above.size == 0:
         return []
     breaks = np.flatnonzero(np.diff(above) > merge)
     starts = np.concatenate([[above[0]], above[breaks + 1]])
-    ends = np.concatenate([above[breaks], [above[-1]]])
-    return [(int(a), int(b) + 1) for a, b in zip(starts, ends, strict=True)]
-
-
-def episode_peaks(stat: FloatArray, threshold: float, merge: int) -> list[tuple[int, int, int]]:
-    """(start, end, peak) of each episode of :func:`episodes`: the peak is its first largest sample."""
-    return [(a, b, a + int(np.nanargmax(stat[a:b]))) for a, b in episodes(stat, threshold, merge)]
-
-
-def local_peaks(stat: FloatArray, floor: float, sep: int) -> list[int]:
-    """Greedy non-maximum suppression: indices of maxima above ``floor`` at least ``sep`` apart."""
-    x = np.where(np.isfinite(stat), stat, -np.inf)
-    cand = np.flatnonzero(x > floor)
-    if cand.size == 0:
-        return []
-    order = cand[np.argsort(-x[cand], kind="stable")]
-    taken = np.zeros(stat.size, bool)
-    out = []
-    for i in order:
-        if taken[i]:
+    ends = np.concatenate([above[breaks], [above[-1]]]) + 1
+    found: list[tuple[int, int, int]] = []
+    for a, b in zip(starts.tolist(), ends.tolist(), strict=True):
+        if separation is None:
+            found.append((a, b, a + int(np.argmax(x[a:b]))))
             continue
-        out.append(int(i))
-        taken[max(0, i - sep) : i + sep + 1] = True
-    return sorted(out)
+        cand = a + np.flatnonzero(x[a:b] > threshold)
+        order = cand[np.argsort(-x[cand], kind="stable")]
+        taken = np.zeros(b - a, bool)
+        kept = []
+        for i in order.tolist():
+            if not taken[i - a]:
+                kept.append(i)
+                taken[max(0, i - a - separation) : i - a + separation + 1] = True
+        found.extend((a, b, i) for i in sorted(kept))
+    return found
 
 
 def mean_difference_step(h: FloatArray, origin: int, end: int, lo: int, hi: int, m: int, sigma: FloatArray) -> int:

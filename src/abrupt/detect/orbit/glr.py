@@ -202,18 +202,13 @@ def glr_sliding_kernel(
     return ell, info
 
 
-def glr_statistic_from_run(t_s: FloatArray, forward: FilterRun, horizon_s: float) -> FloatArray:
-    """Sliding GLR ℓ(θ) (chi-square with 3 degrees of freedom for a matched model, no jump) at every epoch,
-    the jump placed mid-interval before θ, from a forward pass that stored its gains
-    (``run_forward(..., store_gains=True)``)."""
-    return glr_statistic_and_information(t_s, forward, horizon_s)[0]
-
-
 def glr_statistic_and_information(
     t_s: FloatArray, forward: FilterRun, horizon_s: float
 ) -> tuple[FloatArray, FloatArray]:
-    """:func:`glr_statistic_from_run` and, per epoch, the information C(θ) (3×3, (m/s)⁻²) of a jump there:
-    a jump ν gives ℓ a non-central χ²₃ law with non-centrality νᵀC(θ)ν."""
+    """Sliding GLR ℓ(θ) (chi-square with 3 degrees of freedom for a matched model, no jump) at every epoch,
+    the jump placed mid-interval before θ, from a forward pass that stored its gains
+    (``run_forward(..., store_gains=True)``), and per epoch the information C(θ) (3×3, (m/s)⁻²) of a
+    jump there: a jump ν gives ℓ a non-central χ²₃ law with non-centrality νᵀC(θ)ν."""
     if forward.phis.shape[0] != t_s.size:
         raise ValueError("the forward run did not store its gains (run_forward(..., store_gains=True))")
     innovs = np.where(np.isfinite(forward.innovation), forward.innovation, 0.0)

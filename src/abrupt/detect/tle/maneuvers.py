@@ -161,7 +161,7 @@ def detect_mean_elements(
     span_days = (el["epoch_utc"].iloc[-1] - el["epoch_utc"].iloc[0]).total_seconds() / SECONDS_PER_DAY
     n_gaps = len(history) - 1
     gaps_per_year = n_gaps / max(span_days / DAYS_PER_YEAR, 1e-9)
-    p_fa = min(0.5, cfg.budget.per_year / gaps_per_year)  # per gap: the yearly budget over the gaps a year
+    p_fa = cfg.budget.per_test(gaps_per_year, "year", cap=0.5)  # per gap
     model, first = first_pass(history, cfg, regime)
     threshold, method = operating_threshold(cfg, first, p_fa)
     first.scale = block_scale(cfg, first, model.t, threshold)
@@ -263,7 +263,7 @@ def block_scale(
         first.statistic,
         t_s,
         cfg.window_sets + 2,
-        cfg.budget.per_year,
+        cfg.budget,
         cfg.threshold_method,
         cfg.threshold_block_days,
         cfg.threshold_reach_days,

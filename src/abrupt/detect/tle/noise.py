@@ -12,7 +12,7 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy import special
 
-from abrupt.thresholds import DAYS_PER_YEAR, fit_threshold
+from abrupt.thresholds import DAYS_PER_YEAR, FalseAlarmBudget, fit_threshold
 from abrupt.thresholds.noise import MAD_TO_SIGMA, robust_scale
 
 
@@ -184,7 +184,7 @@ def block_thresholds(
     stat: NDArray[np.float64],
     t_s: NDArray[np.float64],
     guard: int,
-    budget_per_year: float,
+    budget: FalseAlarmBudget,
     method: str,
     block_days: float,
     reach_days: float,
@@ -193,9 +193,9 @@ def block_thresholds(
     """Per-gap threshold that follows the history's changes of cadence and noise: the history is cut
     into blocks of about ``block_days``; each block's threshold is the tail fit (:func:`null_threshold`)
     of the event-free statistic of the gaps within ``reach_days`` of the block, for the per-gap
-    probability the budget gives at the block's own cadence (budget per year / the block's gaps per
-    year), floored at the Bonferroni level of three Gaussian groups. Returns (threshold per gap,
-    block edges).
+    probability the budget gives at the block's own cadence (:meth:`FalseAlarmBudget.per_test` with the
+    block's gaps per year), floored at the Bonferroni level of three Gaussian groups. Returns (threshold
+    per gap, block edges).
 
     Event-free: away from the robust outliers of :func:`event_free_mask` and from every local peak
     at or above ``candidates_above`` (the whole-history threshold: the candidates the block threshold
@@ -216,7 +216,7 @@ def block_thresholds(
         t_lo, t_hi = mid[lo] - reach_days * 86400.0, mid[hi - 1] + reach_days * 86400.0
         sel = (mid >= t_lo) & (mid <= t_hi)
         years = max(float(mid[sel][-1] - mid[sel][0]) / (DAYS_PER_YEAR * 86400.0), 1.0 / DAYS_PER_YEAR)
-        p_fa = min(0.5, budget_per_year / (int(sel.sum()) / years))
+        p_fa = budget.per_test(int(sel.sum()) / years, "year", cap=0.5)
         local = np.where(sel & free, stat, np.nan)
         level = null_threshold_masked(local, p_fa, method)
         out[lo:hi] = max(level, float(special.ndtri(1.0 - p_fa / 6.0)))

@@ -24,7 +24,7 @@ from abrupt.detect.attitude.matched_filter.filters import (
     estimate_strike_size,
     matched_filter_bank_statistics,
 )
-from abrupt.detect.attitude.steps import episode_peaks
+from abrupt.detect.attitude.steps import peaks
 from abrupt.events import Event
 from abrupt.model.rotations import attitude_error_vector, dcm_from_quaternion
 from abrupt.model.strike_response import KINDS, Kind, WaveletSet
@@ -33,12 +33,14 @@ from abrupt.thresholds import (
     FitMethod,
     Threshold,
     chi2_threshold,
-    false_alarms_per_day_from_p_fa,
     fit_threshold,
     robust_gaussian_threshold,
 )
 from abrupt.thresholds.noise import robust_noise_sigma
 from abrupt.types import FloatArray
+
+#: The budget of :func:`detect_strikes` when none is given.
+ONE_PER_DAY = FalseAlarmBudget(1.0, "day")
 
 
 def _two_sided_null(stat: FloatArray) -> FloatArray:
@@ -50,7 +52,6 @@ def fit_matched_filter_thresholds(
     null_statistic: ArrayLike,
     *,
     p_fa: float | None = None,
-    false_alarms_per_day: float | None = None,
     sample_rate_hz: float | None = None,
     method: FitMethod = "gaussian",
     budget: FalseAlarmBudget | None = None,
@@ -58,7 +59,7 @@ def fit_matched_filter_thresholds(
     """Per-axis thresholds on |dH_hat| [N·m·s] from an event-free statistic (n, 3).
 
     The filters are two-sided (strikes of either sign), so each axis' symmetrised output is fitted and
-    the upper ``p_fa / 2`` point taken. A per-day budget is split equally between the three axes so
+    the upper ``p_fa / 2`` point taken. A ``budget`` is split equally between the three axes so
     that the any-axis detector meets it. The matched-filter output is Gaussian in Gaussian noise
     (Bennett 2022 §2.2.2), hence the default ``method="gaussian"``; check it with
     :func:`abrupt.thresholds.qq_points`. The returned thresholds state the budget they were set for
@@ -68,15 +69,16 @@ def fit_matched_filter_thresholds(
     if stat.ndim != 2 or stat.shape[1] != 3:
         raise ValueError("null_statistic must have shape (n, 3)")
     if p_fa is None:
-        if sample_rate_hz is None or (budget is None and false_alarms_per_day is None):
-            raise ValueError("give p_fa, or a budget (or false_alarms_per_day) with sample_rate_hz")
-        budget = budget or FalseAlarmBudget.per_day_rate(false_alarms_per_day)  # type: ignore[arg-type]
+        if sample_rate_hz is None or budget is None:
+            raise ValueError("give p_fa, or a budget with sample_rate_hz")
         p_fa = budget.bonferroni(3).per_sample(sample_rate_hz)
     out = []
     for a in range(3):
         thr = fit_threshold(_two_sided_null(stat[:, a]), p_fa=p_fa / 2.0, sample_rate_hz=sample_rate_hz, method=method)
-        rate = float("nan") if sample_rate_hz is None else false_alarms_per_day_from_p_fa(p_fa, sample_rate_hz)
-        out.append(replace(thr, p_fa=float(p_fa), false_alarms_per_day=rate))
+        per_day = (
+            float("nan") if sample_rate_hz is None else FalseAlarmBudget.from_per_sample(p_fa, sample_rate_hz).per_day
+        )
+        out.append(replace(thr, p_fa=float(p_fa), false_alarms_per_day=per_day))
     return out[0], out[1], out[2]
 
 
@@ -109,9 +111,8 @@ def _as_seconds(time: ArrayLike) -> FloatArray:
 def robust_gaussian_thresholds(
     statistic: ArrayLike,
     *,
-    false_alarms_per_day: float | None = None,
     sample_rate_hz: float,
-    budget: FalseAlarmBudget | None = None,
+    budget: FalseAlarmBudget,
 ) -> tuple[Threshold, Threshold, Threshold]:
     """Per-axis thresholds on |dH_hat| from the series itself (:func:`abrupt.thresholds.robust_gaussian_threshold`).
 
@@ -120,7 +121,6 @@ def robust_gaussian_thresholds(
     Gaussian form follows from the filter output being Gaussian in Gaussian noise (Bennett 2022
     §2.2.2). The budget is split equally between the axes (Bonferroni).
     """
-    budget = budget or FalseAlarmBudget.per_day_rate(false_alarms_per_day)  # type: ignore[arg-type]
     p_fa = budget.bonferroni(3).per_sample(sample_rate_hz)
     st = np.asarray(statistic, dtype=np.float64)
     a, b, c = (robust_gaussian_threshold(st[:, k], p_fa=p_fa, sample_rate_hz=sample_rate_hz) for k in range(3))
@@ -182,7 +182,7 @@ def detect_matched_filter(
     best = np.where(np.isfinite(ratio), ratio, -np.inf).max(axis=1)
     rows: list[dict[str, Any]] = []
     length = wavelets.length
-    for _, _, i in episode_peaks(best, 1.0, length):
+    for _, _, i in peaks(best, 1.0, length):
         axis = int(np.argmax(np.where(np.isfinite(ratio[i]), ratio[i], -np.inf)))
         seg = ch[i : i + length]
         if baseline_samples > 0:
@@ -301,7 +301,7 @@ def detect_combined(
     stat, _ = filt.statistic(ch, baseline_samples=baseline_samples)
     score = np.where(np.isfinite(stat), stat, -np.inf)
     rows: list[dict[str, Any]] = []
-    for _, _, peak in episode_peaks(score, threshold.value, wavelets.length):
+    for _, _, peak in peaks(score, threshold.value, wavelets.length):
         i, dh_b, sigma_samples = refine_strike(ch, peak, filt, baseline_samples)
         dh_n = dcm_from_quaternion(q[i]).T @ dh_b if np.all(np.isfinite(q[i])) else np.full(3, np.nan)
         rows.append(
@@ -374,8 +374,7 @@ def detect_strikes(
     *,
     kinds: Sequence[str] = ("attitude", "rate"),
     wheel_speed_rad_s: ArrayLike | None = None,
-    false_alarms_per_day: float = 1.0,
-    budget: FalseAlarmBudget | None = None,
+    budget: FalseAlarmBudget = ONE_PER_DAY,
     thresholds: dict[str, Any] | None = None,
     reference_q_BN: ArrayLike | None = None,
     baseline_samples: int | None = None,
@@ -388,7 +387,7 @@ def detect_strikes(
     speeds ``wheel_speed_rad_s`` (n, N) [rad/s, relative to the body], the most sensitive).
     ``thresholds`` maps a kind to its thresholds (three :class:`Threshold` for attitude/rate, one on T
     for combined/joint), e.g. fitted on event-free data with :func:`fit_matched_filter_thresholds`;
-    missing kinds are set from the series itself for the ``budget`` (default ``false_alarms_per_day``
+    missing kinds are set from the series itself for the ``budget`` (default one false alarm
     per day; robust Gaussian per axis; chi-square(3) for combined/joint). The time step must match
     ``wavelets.sample_rate_hz`` (build the wavelets at the telemetry rate).
 
@@ -403,7 +402,6 @@ def detect_strikes(
                 f"telemetry step {dt:.6g} s does not match the wavelets' rate {wavelets.sample_rate_hz} Hz; "
                 "build the wavelets at the telemetry rate"
             )
-    budget = budget or FalseAlarmBudget.per_day_rate(false_alarms_per_day)
     used: dict[str, Any] = dict(thresholds or {})
     baseline_samples = resolve_baseline(baseline_samples, reference_q_BN, wavelets.sample_rate_hz)
     frames = []
