@@ -59,8 +59,8 @@ def test_block_threshold_is_not_fitted_on_the_candidates_it_judges() -> None:
     for k in range(12):
         stat[400 + 25 * k] = 5.0 + rng.uniform(0.0, 1.0)
     expected = stats.halfnorm.isf(1.0 / 365.25)
-    with_them, _ = block_thresholds(stat, t, 8, 1.0, "gpd", 365.25, 0.0)
-    without, _ = block_thresholds(stat, t, 8, 1.0, "gpd", 365.25, 0.0, candidates_above=expected)
+    with_them, _ = block_thresholds(stat, t, 8, BUDGET, "gpd", 365.25, 0.0)
+    without, _ = block_thresholds(stat, t, 8, BUDGET, "gpd", 365.25, 0.0, candidates_above=expected)
     second = slice(380, 700)
     assert float(np.median(with_them[second])) > 1.2 * expected
     assert float(np.median(without[second])) == pytest.approx(expected, rel=0.12)
