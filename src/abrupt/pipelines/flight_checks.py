@@ -16,7 +16,7 @@ from collections import Counter
 import numpy as np
 import pandas as pd
 
-from abrupt.errors import ConfigError
+from abrupt.errors import ConfigError, InputError
 from abrupt.model.flight_config import RATE_UNITS, WHEEL_UNITS, FlightConfig
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.readers.archive import ArchiveChunk
@@ -189,6 +189,11 @@ BOUNDS_REMOVED = "values beyond the spacecraft file's physical bounds"
 QUATERNION_COMPONENT_BOUND = 1.1  # a unit quaternion's component, with the reader's 10 % norm tolerance
 
 
+QUATERNION_NORM_REFUSE = 0.01  # median |norm - 1| beyond this (noise: 1e-6): a quaternion channel is scaled
+BOUND_REFUSE_FRACTION = 0.5  # more of a channel's samples beyond its bound than this: the file is wrong
+BOUND_REFUSE_MIN = 10  # ... when at least this many are (a short file's few artifacts stay repairs)
+
+
 def physical_bounds(spacecraft: Spacecraft) -> dict[str, float]:
     """The largest magnitude each ``[flight]`` channel can take, in its telemetered unit: a quaternion
     component 1.1; a body rate :data:`MAX_BODY_RATE_RAD_S`; a wheel speed 1.5 × its wheel's
@@ -209,6 +214,32 @@ def physical_bounds(spacecraft: Spacecraft) -> dict[str, float]:
     return bounds
 
 
+def check_quaternion_norm(samples: pd.DataFrame, spacecraft: Spacecraft | None, file: str) -> None:
+    """Refuse samples whose ``[flight]`` quaternion is not a unit quaternion at most of its epochs.
+
+    The four components telemetered at one time have norm 1 (a star tracker's noise moves it by 1e-6);
+    a scaled channel (values a tenth, a unit or scaling slip) moves it at every epoch. A few epochs off are
+    artifacts the attitude reader renormalises and counts; a median deviation beyond
+    :data:`QUATERNION_NORM_REFUSE` is an error naming the file and the channels."""
+    if spacecraft is None or spacecraft.flight is None or not len(samples):
+        return
+    names = {c.mnemonic: c.component for c in spacecraft.flight.channels if c.quantity == "quaternion"}
+    mine = samples[samples["mnemonic"].astype(str).isin(names)]
+    if len(names) != 4 or not len(mine):
+        return
+    wide = mine.pivot_table(index="time", columns=mine["mnemonic"].astype(str), values="value", aggfunc="first")
+    wide = wide.dropna()
+    if len(wide.columns) != 4 or not len(wide):
+        return
+    deviation = float(np.median(np.abs(np.sqrt((wide.to_numpy(np.float64) ** 2).sum(axis=1)) - 1.0)))
+    if deviation > QUATERNION_NORM_REFUSE:
+        raise InputError(
+            f"the quaternion channels {sorted(names)} have a median norm {1 + deviation:.3g} or "
+            f"{1 - deviation:.3g} over {len(wide)} epochs, not 1: a channel is scaled (check their values)",
+            file=file,
+        )
+
+
 def beyond_bounds(samples: pd.DataFrame, bounds: dict[str, float]) -> np.ndarray:
     """Rows of ``samples`` (mnemonic, value) whose magnitude exceeds their channel's bound."""
     if not bounds or not len(samples):
@@ -217,12 +248,29 @@ def beyond_bounds(samples: pd.DataFrame, bounds: dict[str, float]) -> np.ndarray
     return np.asarray(np.abs(samples["value"].to_numpy(np.float64)) > limit)
 
 
-def within_bounds(chunk: ArchiveChunk, bounds: dict[str, float]) -> pd.DataFrame:
-    """The chunk's samples without those beyond ``bounds``, each removed one counted in its day's report."""
+def within_bounds(
+    chunk: ArchiveChunk, bounds: dict[str, float], file: str = "<archive>", source: str = "<spacecraft>"
+) -> pd.DataFrame:
+    """The chunk's samples without those beyond ``bounds``, each removed one counted in its day's report.
+
+    An artifact is a few samples; a channel of which most samples (at least :data:`BOUND_REFUSE_MIN`)
+    lie beyond its bound is an error instead, naming the archive ``file`` and the spacecraft file
+    ``source`` the bound comes from: the channel's unit or the file's limit is wrong (values a thousand
+    times too large, a wheel limit a tenth of the real one), and removing the channel would silently
+    lose it."""
     samples = chunk.samples
     out = beyond_bounds(samples, bounds)
     if not out.any():
         return samples
+    mnemonics = samples["mnemonic"].astype(str)
+    beyond, total = Counter(mnemonics[out]), Counter(mnemonics)
+    for name, n in sorted(beyond.items()):
+        if n >= BOUND_REFUSE_MIN and n > BOUND_REFUSE_FRACTION * total[name]:
+            raise InputError(
+                f"{n} of {total[name]} samples of channel {name} lie beyond its bound {bounds[name]:g} "
+                f"(from the limits of {source}): the channel's unit or that file's limit is wrong",
+                file=file,
+            )
     days = pd.DatetimeIndex(samples["time"][out]).strftime("%Y-%m-%d")
     counts = Counter(zip(samples["spacecraft"][out].astype(str), days, strict=True))
     for key, n in counts.items():
