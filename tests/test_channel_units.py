@@ -68,10 +68,23 @@ def test_a_gyro_in_deg_s_declared_rad_s_is_refused_naming_the_gyro(store: Path, 
     bad = tmp_path / "gyro.toml"
     bad.write_text(text)
     sc = load_spacecraft(bad)
-    with pytest.raises(ConfigError, match=r"flight\.channels\[4\]\.unit.*gyro channel SC-A\.ch05.*57"):
+    # all three gyro channels are declared rad/s; the Y axis carries the orbit rate, so it is the one named
+    with pytest.raises(ConfigError, match=r"flight\.channels\[5\]\.unit.*gyro channel SC-A\.ch06.*57"):
         process_chunk(TelemetryStore(store), sc, T0, T0 + HOURS * 3600 * NS, FlightRunConfig())
-    with pytest.raises(ConfigError, match=r"flight\.channels\[4\]\.unit.*gyro channel SC-A\.ch05"):
+    with pytest.raises(ConfigError, match=r"flight\.channels\[5\]\.unit.*gyro channel SC-A\.ch06"):
         estimate_inertia_run(StoreInput(store), bad)
+
+
+def test_one_gyro_channel_a_tenth_too_small_is_refused_naming_that_channel(store: Path) -> None:
+    """The gyro's Y axis carries the orbit rate (0.06 deg/s, from the archive); written a tenth too small,
+    |ω_gyro| is a tenth of the quaternion's rate. The per-axis fit of |ω_q|² = Σ s_i² g_i² names that
+    channel, not the first gyro channel; X and Z read only noise, so their scale is not decidable."""
+    sc = load_spacecraft(KESTREL)
+    samples = _samples(store)
+    mnemonic = samples["mnemonic"].astype(str)  # type: ignore[index]
+    samples.loc[mnemonic == "SC-A.ch06", "value"] *= 0.1  # type: ignore[attr-defined]
+    with pytest.raises(ConfigError, match=r"channels\[5\]\.unit.*channel SC-A\.ch06 .* rates 0\.(09|10)\d* times"):
+        check_channel_units(sc, samples)  # type: ignore[arg-type]
 
 
 def test_an_array_angle_in_degrees_declared_rad_is_refused_naming_the_array(store: Path, tmp_path: Path) -> None:

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from abrupt.errors import ConfigError, InputError
-from abrupt.model.flight_config import RATE_UNITS, WHEEL_UNITS, FlightConfig
+from abrupt.model.flight_config import RATE_UNITS, WHEEL_UNITS, FlightChannel, FlightConfig
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.readers.archive import ArchiveChunk
 from abrupt.readers.telemetry import MAX_BODY_RATE_RAD_S, WHEEL_OVERSPEED_FACTOR
@@ -88,6 +88,7 @@ def check_tachometer_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> Non
 
 
 GYRO_RATIO_BOUNDS = (0.5, 2.0)  # gyro rate / quaternion rate; deg/s read as rad/s gives 57.3
+GYRO_AXIS_SHARE = 0.05  # an axis with less of the gyro's squared rate than this cannot show its scale
 GYRO_MIN_SIGNAL_TO_NOISE = 5.0  # the attitude must move well above the star tracker's noise to decide
 NS = 1_000_000_000
 
@@ -140,21 +141,41 @@ def check_gyro_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> None:
     for c in gyro:
         t, v = series[c.mnemonic]
         comps.append(np.interp(t_q, t, v * RATE_UNITS.get(c.unit, 1.0), left=np.nan, right=np.nan))
-    w_g = np.linalg.norm(np.column_stack(comps), axis=1)
-    keep = np.isfinite(w_g) & (w_q > 0)
+    g = np.column_stack(comps)
+    keep = np.isfinite(g).all(axis=1) & (w_q > 0)
     if keep.sum() < 20:
         return
-    ratio = float(np.median(w_g[keep] / w_q[keep]))
+    ratio = float(np.median(np.linalg.norm(g[keep], axis=1) / w_q[keep]))
     lo, hi = GYRO_RATIO_BOUNDS
     if lo <= ratio <= hi:
         return
-    k = flight.channels.index(gyro[0])
+    c, r = _wrong_gyro(gyro, g[keep], w_q[keep], ratio)
+    k = flight.channels.index(c)
     raise ConfigError(
-        f"gyro channel {gyro[0].mnemonic} declared in {gyro[0].unit!r} gives rates {ratio:.3g} times the "
+        f"gyro channel {c.mnemonic} declared in {c.unit!r} gives rates {r:.3g} times the "
         f"quaternion's rate (deg/s read as rad/s gives 57.3, rad/s read as deg/s 0.0175); check the unit",
         file=spacecraft.source,
         key=f"flight.channels[{k}].unit",
     )
+
+
+def _wrong_gyro(gyro: list[FlightChannel], g: np.ndarray, w_q: np.ndarray, ratio: float) -> tuple[FlightChannel, float]:
+    """The gyro channel to blame, and its own ratio to the quaternion's rate.
+
+    |ω_q|² = Σ s_i² g_i² over the stamps gives each axis's scale s_i by least squares, for the axes that
+    carry at least :data:`GYRO_AXIS_SHARE` of the gyro's squared rate (an axis that reads only noise cannot show its
+    scale). The axis whose ratio 1/s_i lies furthest outside the bounds is the one named; with no such
+    axis, the first channel with the overall ratio."""
+    share = np.median(g**2, axis=0) / max(float(np.median((g**2).sum(axis=1))), 1e-300)
+    axes = np.flatnonzero(share >= GYRO_AXIS_SHARE)
+    if axes.size:
+        s2, *_ = np.linalg.lstsq(g[:, axes] ** 2, w_q**2, rcond=None)
+        ratios = np.where(s2 > 0, 1.0 / np.sqrt(np.abs(s2)), np.inf)
+        worst = int(np.argmax(np.abs(np.log(ratios))))
+        lo, hi = GYRO_RATIO_BOUNDS
+        if not lo <= ratios[worst] <= hi:
+            return gyro[int(axes[worst])], float(ratios[worst])
+    return gyro[0], ratio
 
 
 def check_angle_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> None:
