@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from abrupt.errors import ConfigError
+from abrupt.errors import ConfigError, InputError
 from abrupt.model.spacecraft import load_spacecraft
 from abrupt.pipelines.flight import FlightRunConfig, ingest_archives, process_chunk
 from abrupt.pipelines.flight_checks import check_channel_units
@@ -68,10 +68,23 @@ def test_a_gyro_in_deg_s_declared_rad_s_is_refused_naming_the_gyro(store: Path, 
     bad = tmp_path / "gyro.toml"
     bad.write_text(text)
     sc = load_spacecraft(bad)
-    with pytest.raises(ConfigError, match=r"flight\.channels\[4\]\.unit.*gyro channel SC-A\.ch05.*57"):
+    # all three gyro channels are declared rad/s; the Y axis carries the orbit rate, so it is the one named
+    with pytest.raises(ConfigError, match=r"flight\.channels\[5\]\.unit.*gyro channel SC-A\.ch06.*57"):
         process_chunk(TelemetryStore(store), sc, T0, T0 + HOURS * 3600 * NS, FlightRunConfig())
-    with pytest.raises(ConfigError, match=r"flight\.channels\[4\]\.unit.*gyro channel SC-A\.ch05"):
+    with pytest.raises(ConfigError, match=r"flight\.channels\[5\]\.unit.*gyro channel SC-A\.ch06"):
         estimate_inertia_run(StoreInput(store), bad)
+
+
+def test_one_gyro_channel_a_tenth_too_small_is_refused_naming_that_channel(store: Path) -> None:
+    """The gyro's Y axis carries the orbit rate (0.06 deg/s, from the archive); written a tenth too small,
+    |ω_gyro| is a tenth of the quaternion's rate. The per-axis fit of |ω_q|² = Σ s_i² g_i² names that
+    channel, not the first gyro channel; X and Z read only noise, so their scale is not decidable."""
+    sc = load_spacecraft(KESTREL)
+    samples = _samples(store)
+    mnemonic = samples["mnemonic"].astype(str)  # type: ignore[index]
+    samples.loc[mnemonic == "SC-A.ch06", "value"] *= 0.1  # type: ignore[attr-defined]
+    with pytest.raises(ConfigError, match=r"channels\[5\]\.unit.*channel SC-A\.ch06 .* rates 0\.(09|10)\d* times"):
+        check_channel_units(sc, samples)  # type: ignore[arg-type]
 
 
 def test_an_array_angle_in_degrees_declared_rad_is_refused_naming_the_array(store: Path, tmp_path: Path) -> None:
@@ -108,3 +121,76 @@ def test_values_beyond_the_spacecraft_files_bounds_are_removed_and_counted_at_in
         "SC-A", np.datetime64("2026-03-10"), np.datetime64("2026-03-11")
     )
     assert kept["value"].abs().max() < 6000.0  # rpm: the wheels' real speeds are all kept
+
+
+def _archive_head(shared_data: Path, tmp_path: Path, n: int = 3000) -> Path:
+    src = shared_data / "flight-like" / "telemetry" / "KESTREL2_2026-03-10.csv.gz"
+    if not src.exists():
+        pytest.skip(f"{src} not found")
+    with gzip.open(src, "rb") as f:
+        head = b"".join(next(f) for _ in range(n))
+    archive = tmp_path / "KESTREL2_2026-03-10.csv"
+    archive.write_bytes(head)
+    return archive
+
+
+def test_a_wheel_limit_below_the_speeds_the_wheels_reach_is_refused_at_ingest(
+    shared_data: Path, tmp_path: Path
+) -> None:
+    """The archive's wheels spin at 1087-1160 rpm (114-121 rad/s, from the archive itself); a limit of
+    62.83 rad/s (628.3 written a tenth too small) bounds them at 94 rad/s: every wheel sample lies beyond,
+    which is a wrong file, not 128 artifacts. Refused naming the file and the channel; the operator's
+    file ingests the same archive with nothing removed."""
+    archive = _archive_head(shared_data, tmp_path)
+    bad = _spacecraft(tmp_path, "max_speed_rad_s = 628.3      # 6000 rpm", "max_speed_rad_s = 62.83")
+    decoder = shared_data / "flight-like" / "decoder.csv"
+    with pytest.raises(InputError, match=r"128 of 128 samples of channel SC-A\.ch08 .*user\.toml"):
+        ingest_archives([archive], decoder, tmp_path / "bad", spacecraft=load_spacecraft(bad))
+    good = ingest_archives([archive], decoder, tmp_path / "good", spacecraft=load_spacecraft(KESTREL))
+    assert all(not d.get("removed") for d in good.days)
+
+
+def test_a_spacecraft_file_without_its_flight_table_is_refused_at_ingest(shared_data: Path, tmp_path: Path) -> None:
+    """A file cut before its [flight] table is valid TOML and a valid spacecraft, but `ingest --spacecraft`
+    takes its bounds from [flight]: without it nothing would be checked, so it is an error naming the
+    file and the table."""
+    archive = _archive_head(shared_data, tmp_path)
+    cut = tmp_path / "cut.toml"
+    cut.write_text(KESTREL.read_text().split("\n[flight]")[0])
+    with pytest.raises(ConfigError, match=r"cut\.toml: no \[flight\] table") as info:
+        ingest_archives(
+            [archive], shared_data / "flight-like" / "decoder.csv", tmp_path / "s", spacecraft=load_spacecraft(cut)
+        )
+    assert "\n" not in str(info.value)
+
+
+def test_a_left_out_wheel_limit_is_a_printed_default(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    """The documented default (630 rad/s) is used and said, naming the wheel; the operator's file, which
+    gives every limit, takes no default."""
+    bad = _spacecraft(tmp_path, "max_speed_rad_s = 628.3      # 6000 rpm\n", "")
+    with caplog.at_level("WARNING", logger="abrupt"):
+        sc = load_spacecraft(bad)
+    assert sc.defaults == ("wheel rw1 max_speed_rad_s = 630",)
+    assert sc.wheels[0].max_speed_rad_s == 630.0
+    assert "user.toml: documented default(s) used: wheel rw1 max_speed_rad_s = 630" in caplog.text
+    assert load_spacecraft(KESTREL).defaults == ()
+
+
+@pytest.mark.parametrize("scaled", [("ST_Q1",), ("ST_Q0", "ST_Q1", "ST_Q2", "ST_Q3")])
+def test_a_scaled_quaternion_channel_is_refused_at_ingest(
+    shared_data: Path, tmp_path: Path, scaled: tuple[str, ...]
+) -> None:
+    """The four components at one time form a unit quaternion (the archive's own norm deviates from 1 by
+    2e-9 in the median); one channel, or all, written a tenth of their value moves the norm at every epoch:
+    an error naming the archive and the quaternion channels, not a stored attitude that is wrong."""
+    archive = _archive_head(shared_data, tmp_path)
+    lines = archive.read_text().splitlines(keepends=True)
+    for i, line in enumerate(lines):
+        if any(f".{name}," in line for name in scaled):
+            head, value = line.rsplit(",", 1)
+            lines[i] = f"{head},{float(value) * 0.1:.7f}\n"
+    archive.write_text("".join(lines))
+    decoder = shared_data / "flight-like" / "decoder.csv"
+    with pytest.raises(InputError, match=r"SC-A_2026-03-10\.csv.*quaternion channels .*SC-A\.ch01.*not 1"):
+        ingest_archives([archive], decoder, tmp_path / "s", spacecraft=load_spacecraft(KESTREL))
+    ingest_archives([archive], decoder, tmp_path / "plain")  # without the spacecraft file: stored as given

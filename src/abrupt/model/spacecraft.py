@@ -43,6 +43,7 @@ An unknown key anywhere is an error that names the key, so a misspelt key cannot
 
 from __future__ import annotations
 
+import logging
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -178,6 +179,9 @@ class Spacecraft:
     source: str = "<memory>"
     orbit: OrbitInfo | None = None
     flight: FlightConfig | None = None
+    # documented defaults taken for optional physical keys the file leaves out ("key = value"), printed
+    # by the commands that load the file: a deleted line is then a reported default, not a silent one
+    defaults: tuple[str, ...] = ()
 
     @property
     def wheel_axes(self) -> NDArray[np.float64]:
@@ -421,6 +425,11 @@ def spacecraft_from_dict(data: dict[str, Any], *, source: str = "<memory>") -> S
     mass = _positive(data["mass_kg"], "mass_kg", file) if "mass_kg" in data else float("nan")
     lever = _positive(data.get("lever_arm_m", 1.0), "lever_arm_m", file)
     wheels = _wheels(data, file)
+    defaults = [  # the limits that bound telemetry (ingest --spacecraft, the telemetry reader)
+        f"wheel {w.name} max_speed_rad_s = {w.max_speed_rad_s:g}"
+        for w, table in zip(wheels, data.get("wheels", []), strict=True)
+        if "max_speed_rad_s" not in table
+    ]
     appendages = tuple(_appendage(a, i, file) for i, a in enumerate(data.get("appendages", [])))
     surfaces = tuple(_surface(s, i, file) for i, s in enumerate(data.get("surfaces", [])))
     telemetry = _telemetry_map(data, wheels, file)
@@ -440,6 +449,7 @@ def spacecraft_from_dict(data: dict[str, Any], *, source: str = "<memory>") -> S
         surfaces=surfaces,
         telemetry=telemetry,
         source=source,
+        defaults=tuple(defaults),
     )
 
 
@@ -456,7 +466,10 @@ def load_spacecraft(path: str | Path) -> Spacecraft:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"not valid TOML: {exc}", file=path) from None
-    return spacecraft_from_dict(data, source=str(path))
+    sc = spacecraft_from_dict(data, source=str(path))
+    if sc.defaults:
+        logging.getLogger("abrupt").warning("%s: documented default(s) used: %s", path, "; ".join(sc.defaults))
+    return sc
 
 
 def bundled_spacecraft_path(name: str = "thesis") -> Path:

@@ -45,6 +45,7 @@ from abrupt.model.spacecraft import Spacecraft
 from abrupt.pipelines.flight_attribution import attribute_events
 from abrupt.pipelines.flight_checks import (
     check_channel_units,
+    check_quaternion_norm,
     check_tachometer_units,
     check_wheel_units,
     flight_channels,
@@ -102,6 +103,8 @@ def ingest_archives(
     (:func:`~abrupt.pipelines.flight_checks.physical_bounds`) are removed and counted per day.
     """
     decoder = read_decoder(decoder_path)
+    if spacecraft is not None and spacecraft.flight is None:
+        raise ConfigError("no [flight] table: ingest takes each channel's bounds from it", file=spacecraft.source)
     bounds = physical_bounds(spacecraft) if spacecraft is not None else {}
     store = TelemetryStore(store_root)
     summary = IngestSummary()
@@ -115,7 +118,8 @@ def ingest_archives(
             file = safe if exc.file in (None, pseudonymise_text(str(path), decoder)) else exc.file
             raise InputError(exc.reason, file=file, line=exc.line, column=exc.column) from None
         summary.files[safe] = dict(chunk.file_counts)
-        samples = within_bounds(chunk, bounds)
+        samples = within_bounds(chunk, bounds, safe, spacecraft.source if spacecraft else "")
+        check_quaternion_norm(samples, spacecraft, safe)
         day_idx = pd.DatetimeIndex(samples["time"]).asi8 // DAY_NS
         sc_cat = samples["spacecraft"].astype("category")
         sc_codes = sc_cat.cat.codes.to_numpy()

@@ -16,8 +16,8 @@ from collections import Counter
 import numpy as np
 import pandas as pd
 
-from abrupt.errors import ConfigError
-from abrupt.model.flight_config import RATE_UNITS, WHEEL_UNITS, FlightConfig
+from abrupt.errors import ConfigError, InputError
+from abrupt.model.flight_config import RATE_UNITS, WHEEL_UNITS, FlightChannel, FlightConfig
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.readers.archive import ArchiveChunk
 from abrupt.readers.telemetry import MAX_BODY_RATE_RAD_S, WHEEL_OVERSPEED_FACTOR
@@ -88,6 +88,7 @@ def check_tachometer_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> Non
 
 
 GYRO_RATIO_BOUNDS = (0.5, 2.0)  # gyro rate / quaternion rate; deg/s read as rad/s gives 57.3
+GYRO_AXIS_SHARE = 0.05  # an axis with less of the gyro's squared rate than this cannot show its scale
 GYRO_MIN_SIGNAL_TO_NOISE = 5.0  # the attitude must move well above the star tracker's noise to decide
 NS = 1_000_000_000
 
@@ -140,21 +141,41 @@ def check_gyro_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> None:
     for c in gyro:
         t, v = series[c.mnemonic]
         comps.append(np.interp(t_q, t, v * RATE_UNITS.get(c.unit, 1.0), left=np.nan, right=np.nan))
-    w_g = np.linalg.norm(np.column_stack(comps), axis=1)
-    keep = np.isfinite(w_g) & (w_q > 0)
+    g = np.column_stack(comps)
+    keep = np.isfinite(g).all(axis=1) & (w_q > 0)
     if keep.sum() < 20:
         return
-    ratio = float(np.median(w_g[keep] / w_q[keep]))
+    ratio = float(np.median(np.linalg.norm(g[keep], axis=1) / w_q[keep]))
     lo, hi = GYRO_RATIO_BOUNDS
     if lo <= ratio <= hi:
         return
-    k = flight.channels.index(gyro[0])
+    c, r = _wrong_gyro(gyro, g[keep], w_q[keep], ratio)
+    k = flight.channels.index(c)
     raise ConfigError(
-        f"gyro channel {gyro[0].mnemonic} declared in {gyro[0].unit!r} gives rates {ratio:.3g} times the "
+        f"gyro channel {c.mnemonic} declared in {c.unit!r} gives rates {r:.3g} times the "
         f"quaternion's rate (deg/s read as rad/s gives 57.3, rad/s read as deg/s 0.0175); check the unit",
         file=spacecraft.source,
         key=f"flight.channels[{k}].unit",
     )
+
+
+def _wrong_gyro(gyro: list[FlightChannel], g: np.ndarray, w_q: np.ndarray, ratio: float) -> tuple[FlightChannel, float]:
+    """The gyro channel to blame, and its own ratio to the quaternion's rate.
+
+    |ω_q|² = Σ s_i² g_i² over the stamps gives each axis's scale s_i by least squares, for the axes that
+    carry at least :data:`GYRO_AXIS_SHARE` of the gyro's squared rate (an axis that reads only noise cannot show its
+    scale). The axis whose ratio 1/s_i lies furthest outside the bounds is the one named; with no such
+    axis, the first channel with the overall ratio."""
+    share = np.median(g**2, axis=0) / max(float(np.median((g**2).sum(axis=1))), 1e-300)
+    axes = np.flatnonzero(share >= GYRO_AXIS_SHARE)
+    if axes.size:
+        s2, *_ = np.linalg.lstsq(g[:, axes] ** 2, w_q**2, rcond=None)
+        ratios = np.where(s2 > 0, 1.0 / np.sqrt(np.abs(s2)), np.inf)
+        worst = int(np.argmax(np.abs(np.log(ratios))))
+        lo, hi = GYRO_RATIO_BOUNDS
+        if not lo <= ratios[worst] <= hi:
+            return gyro[int(axes[worst])], float(ratios[worst])
+    return gyro[0], ratio
 
 
 def check_angle_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> None:
@@ -189,6 +210,11 @@ BOUNDS_REMOVED = "values beyond the spacecraft file's physical bounds"
 QUATERNION_COMPONENT_BOUND = 1.1  # a unit quaternion's component, with the reader's 10 % norm tolerance
 
 
+QUATERNION_NORM_REFUSE = 0.01  # median |norm - 1| beyond this (noise: 1e-6): a quaternion channel is scaled
+BOUND_REFUSE_FRACTION = 0.5  # more of a channel's samples beyond its bound than this: the file is wrong
+BOUND_REFUSE_MIN = 10  # ... when at least this many are (a short file's few artifacts stay repairs)
+
+
 def physical_bounds(spacecraft: Spacecraft) -> dict[str, float]:
     """The largest magnitude each ``[flight]`` channel can take, in its telemetered unit: a quaternion
     component 1.1; a body rate :data:`MAX_BODY_RATE_RAD_S`; a wheel speed 1.5 × its wheel's
@@ -209,6 +235,32 @@ def physical_bounds(spacecraft: Spacecraft) -> dict[str, float]:
     return bounds
 
 
+def check_quaternion_norm(samples: pd.DataFrame, spacecraft: Spacecraft | None, file: str) -> None:
+    """Refuse samples whose ``[flight]`` quaternion is not a unit quaternion at most of its epochs.
+
+    The four components telemetered at one time have norm 1 (a star tracker's noise moves it by 1e-6);
+    a scaled channel (values a tenth, a unit or scaling slip) moves it at every epoch. A few epochs off are
+    artifacts the attitude reader renormalises and counts; a median deviation beyond
+    :data:`QUATERNION_NORM_REFUSE` is an error naming the file and the channels."""
+    if spacecraft is None or spacecraft.flight is None or not len(samples):
+        return
+    names = {c.mnemonic: c.component for c in spacecraft.flight.channels if c.quantity == "quaternion"}
+    mine = samples[samples["mnemonic"].astype(str).isin(names)]
+    if len(names) != 4 or not len(mine):
+        return
+    wide = mine.pivot_table(index="time", columns=mine["mnemonic"].astype(str), values="value", aggfunc="first")
+    wide = wide.dropna()
+    if len(wide.columns) != 4 or not len(wide):
+        return
+    deviation = float(np.median(np.abs(np.sqrt((wide.to_numpy(np.float64) ** 2).sum(axis=1)) - 1.0)))
+    if deviation > QUATERNION_NORM_REFUSE:
+        raise InputError(
+            f"the quaternion channels {sorted(names)} have a median norm {1 + deviation:.3g} or "
+            f"{1 - deviation:.3g} over {len(wide)} epochs, not 1: a channel is scaled (check their values)",
+            file=file,
+        )
+
+
 def beyond_bounds(samples: pd.DataFrame, bounds: dict[str, float]) -> np.ndarray:
     """Rows of ``samples`` (mnemonic, value) whose magnitude exceeds their channel's bound."""
     if not bounds or not len(samples):
@@ -217,12 +269,29 @@ def beyond_bounds(samples: pd.DataFrame, bounds: dict[str, float]) -> np.ndarray
     return np.asarray(np.abs(samples["value"].to_numpy(np.float64)) > limit)
 
 
-def within_bounds(chunk: ArchiveChunk, bounds: dict[str, float]) -> pd.DataFrame:
-    """The chunk's samples without those beyond ``bounds``, each removed one counted in its day's report."""
+def within_bounds(
+    chunk: ArchiveChunk, bounds: dict[str, float], file: str = "<archive>", source: str = "<spacecraft>"
+) -> pd.DataFrame:
+    """The chunk's samples without those beyond ``bounds``, each removed one counted in its day's report.
+
+    An artifact is a few samples; a channel of which most samples (at least :data:`BOUND_REFUSE_MIN`)
+    lie beyond its bound is an error instead, naming the archive ``file`` and the spacecraft file
+    ``source`` the bound comes from: the channel's unit or the file's limit is wrong (values a thousand
+    times too large, a wheel limit a tenth of the real one), and removing the channel would silently
+    lose it."""
     samples = chunk.samples
     out = beyond_bounds(samples, bounds)
     if not out.any():
         return samples
+    mnemonics = samples["mnemonic"].astype(str)
+    beyond, total = Counter(mnemonics[out]), Counter(mnemonics)
+    for name, n in sorted(beyond.items()):
+        if n >= BOUND_REFUSE_MIN and n > BOUND_REFUSE_FRACTION * total[name]:
+            raise InputError(
+                f"{n} of {total[name]} samples of channel {name} lie beyond its bound {bounds[name]:g} "
+                f"(from the limits of {source}): the channel's unit or that file's limit is wrong",
+                file=file,
+            )
     days = pd.DatetimeIndex(samples["time"][out]).strftime("%Y-%m-%d")
     counts = Counter(zip(samples["spacecraft"][out].astype(str), days, strict=True))
     for key, n in counts.items():
