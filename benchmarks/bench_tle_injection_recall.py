@@ -187,4 +187,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import write_results
+
+    with write_results("bench_tle_injection_recall"):
+        main()

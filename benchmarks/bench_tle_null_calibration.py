@@ -235,4 +235,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import write_results
+
+    with write_results("bench_tle_null_calibration"):
+        main()

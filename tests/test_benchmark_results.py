@@ -35,3 +35,11 @@ def test_the_variant_names_the_flags_given() -> None:
     assert variant(flags, ["--quick", "--tuned"]) == "tuned_quick"
     assert variant(flags, ["--arc-days", "2"]) == "2day"
     assert variant(flags, ["--arc-days", "3"]) == ""
+
+
+def test_every_benchmark_writes_its_own_result_file() -> None:
+    """No hand copies: each ``benchmarks/bench_*.py`` runs its ``main()`` inside ``write_results``."""
+    bench_dir = Path(__file__).resolve().parent.parent / "benchmarks"
+    missing = [p.name for p in sorted(bench_dir.glob("bench_*.py")) if "write_results(" not in p.read_text()]
+    assert missing == []
+
