@@ -42,4 +42,3 @@ def test_every_benchmark_writes_its_own_result_file() -> None:
     bench_dir = Path(__file__).resolve().parent.parent / "benchmarks"
     missing = [p.name for p in sorted(bench_dir.glob("bench_*.py")) if "write_results(" not in p.read_text()]
     assert missing == []
-
