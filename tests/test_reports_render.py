@@ -3,7 +3,6 @@ self-contained HTML pages that render in a headless Chromium (screenshot not bla
 
 from __future__ import annotations
 
-import shutil
 import subprocess
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -21,6 +20,7 @@ from abrupt.readers.telemetry import read_telemetry
 from abrupt.report.attitude import attitude_figure, write_attitude_report
 from abrupt.report.style import PALETTE, clip_with_markers, detector_colour, robust_baseline
 from abrupt.simulate.attitude import simulate_attitude, write_telemetry
+from chromium_cdp import HEADLESS_FLAGS, chromium_path
 
 
 @pytest.fixture(scope="module")
@@ -84,10 +84,6 @@ def test_svg_and_pdf_reports(attitude_case: tuple, tmp_path: Path) -> None:
     assert pdf.read_bytes()[:5] == b"%PDF-"
 
 
-def _chromium() -> str | None:
-    return shutil.which("chromium") or shutil.which("chromium-browser") or shutil.which("google-chrome")
-
-
 def test_html_report_is_self_contained_and_renders_in_headless_chromium(attitude_case: tuple, tmp_path: Path) -> None:
     tel, result, truth = attitude_case
     page = write_attitude_report(tmp_path / "report.html", tel, result, truth=truth, title="render check")
@@ -95,18 +91,13 @@ def test_html_report_is_self_contained_and_renders_in_headless_chromium(attitude
     assert "data:image/png;base64," in text
     for remote in ('src="http', "src='http", 'href="http', "<script src", "<link", "@import", "url(http"):
         assert remote not in text  # nothing fetched from the network
-    browser = _chromium()
+    browser = chromium_path()
     if browser is None:
         pytest.skip("no Chromium installed (apt-get install -y chromium); the page was checked as text only")
     shot = tmp_path / "shot.png"
     args = [
         browser,
-        "--headless",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--disable-background-networking",
-        "--disable-component-update",
-        "--no-first-run",
+        *HEADLESS_FLAGS,
         f"--user-data-dir={tmp_path / 'profile'}",
         "--window-size=1400,1800",
         f"--screenshot={shot}",
