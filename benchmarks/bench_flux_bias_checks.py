@@ -21,7 +21,6 @@ import math
 import os
 import time
 from dataclasses import replace
-from pathlib import Path
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
@@ -33,9 +32,8 @@ import pandas as pd
 from abrupt.flux.exposure import DAYS_PER_YEAR, logistic_efficiency
 from abrupt.flux.forward import DIRECTION_CLASSES, ForwardConfig, build_template, direction_class, with_seed
 from abrupt.flux.inference import FluxData, Likelihood, prepare, refine_max
-from abrupt.simulate.population import FleetSpec, draw_population, fleet_exposure
-
-ROOT = Path(__file__).resolve().parent.parent
+from abrupt.simulate.population import draw_population, fleet_exposure
+from bench_flux_coverage import study_fleet
 
 
 def prior_fit_beta(data: FluxData) -> float:
@@ -50,15 +48,7 @@ def main() -> None:
     parser.add_argument("--big-reps", type=int, default=60, help="fleets of 100 spacecraft-years (check 2)")
     parser.add_argument("--small-reps", type=int, default=200, help="fleets of 10 spacecraft-years (check 3)")
     args = parser.parse_args()
-    spec = FleetSpec(
-        str(ROOT / "examples" / "spacecraft" / "fermi_like.toml"),
-        n_spacecraft=10,
-        years=1.0,
-        dH50_Nms=0.01 * np.exp(-np.log(9.0) / 4.0),
-        efficiency_slope=4.0,
-        false_alarms_per_day=0.01,
-        analysed_fraction=0.9,
-    )
+    spec = study_fleet()
     cfg = ForwardConfig()
     t0 = time.perf_counter()
     fit_tpl = {spec.case: build_template(spec.case, cfg)}
