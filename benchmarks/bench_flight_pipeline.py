@@ -368,6 +368,8 @@ def part_year(store: Path, n_days: int = 365, workers: int = 2, baseline: Path |
     if baseline is not None and baseline.is_dir():
         print("  same-run reference (the first two archive days):")
         same_run_reference(files[:2], base / "kestrel-year.toml", baseline)
+    else:
+        print(f"  same-run reference: not measured (no previous release at {baseline}; give --baseline SRC)")
 
 
 def main() -> None:
