@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -42,3 +43,15 @@ def test_every_benchmark_writes_its_own_result_file() -> None:
     bench_dir = Path(__file__).resolve().parent.parent / "benchmarks"
     missing = [p.name for p in sorted(bench_dir.glob("bench_*.py")) if "write_results(" not in p.read_text()]
     assert missing == []
+
+
+def test_every_result_file_names_its_command_and_commit() -> None:
+    """Every text result under docs/results/ starts as ``write_results`` writes it: the command line, then
+    the commit and date it was produced at. A hand copy has neither."""
+    results = Path(__file__).resolve().parent.parent / "docs" / "results"
+    unstamped = []
+    for path in sorted(results.glob("*.txt")):
+        head = path.read_text(encoding="utf-8").splitlines()[:2]
+        if len(head) < 2 or not head[0].startswith("# ") or not re.match(r"# abrupt [0-9a-f]{7,}", head[1]):
+            unstamped.append(path.name)
+    assert unstamped == []
