@@ -36,9 +36,9 @@ from abrupt.errors import InputError
 from abrupt.model.orbit import MU_EARTH_M3_S2
 from abrupt.model.stations import WGS84_A_M
 from abrupt.model.tracking_measurements import TrackingArrays
+from abrupt.thresholds.noise import robust_scale
 from abrupt.types import FloatArray
 
-ROBUST_SIGMA = 1.4826  # [-] standard deviation / median absolute deviation of a Gaussian
 MEDIAN_EFFICIENCY = 1.2533  # [-] standard error of a Gaussian sample's median × √n / σ (√(π/2))
 SIGMAS = 3.0  # [-] standard errors of the median beyond a bound before a station is refused
 VELOCITY_NOISE = 0.05  # [-] a velocity's noise (stated sigmas) as a fraction of the circular speed
@@ -170,4 +170,4 @@ def _velocities(r: FloatArray, t: FloatArray, noise: FloatArray) -> tuple[FloatA
 def _median_error(x: FloatArray) -> tuple[float, float]:
     """The median of ``x`` and its standard error from the robust spread of ``x``."""
     med = float(np.median(x))
-    return med, MEDIAN_EFFICIENCY * ROBUST_SIGMA * float(np.median(np.abs(x - med))) / float(np.sqrt(x.size))
+    return med, MEDIAN_EFFICIENCY * float(robust_scale(x)) / float(np.sqrt(x.size))
