@@ -31,9 +31,7 @@ RANGE_LINE = re.compile(r"^(\S+\s+RANGE\s+\S+\s+)(\S+)", re.MULTILINE)
 
 def _scaled_ranges(src: Path, dst: Path, factor: float) -> Path:
     """The .aer file with every range multiplied by ``factor`` (angles untouched)."""
-    text = RANGE_LINE.sub(lambda m: f"{m.group(1)}{float(m.group(2)) * factor:.4f}", src.read_text())
-    dst.write_text(text)
-    return dst
+    return _scaled_ranges_text(src.read_text(), dst, factor)
 
 
 def _arrays(path: Path, setup_path: Path) -> TrackingArrays:
@@ -123,3 +121,41 @@ def test_a_low_orbit_with_noisy_angles_passes_and_its_tenth_is_refused(perigee_k
     assert speeds.to_minimum > 1.0 and speeds.to_escape < 1.0 / math.sqrt(2) * 1.05
     with pytest.raises(InputError, match=r"sim\.tdm: .*station ASCENSION.* least speed"):
         check_implied_speeds(_simulated(case, 0.1), "sim.tdm")
+
+
+def _range_only(src: Path, dst: Path, factor: float) -> Path:
+    """The .aer file without its angle lines, every range multiplied by ``factor``."""
+    lines = [line for line in src.read_text().splitlines() if " AZ_EL " not in line]
+    return _scaled_ranges_text("\n".join(lines) + "\n", dst, factor)
+
+
+def _scaled_ranges_text(text: str, dst: Path, factor: float) -> Path:
+    dst.write_text(RANGE_LINE.sub(lambda m: f"{m.group(1)}{float(m.group(2)) * factor:.4f}", text))
+    return dst
+
+
+def test_ranges_without_angles_are_held_against_the_a_priori_orbit(shared_data: Path, tmp_path: Path) -> None:
+    """Without angles no speed can be implied; W3B's ranges alone pass against the set-up's a-priori orbit
+    (two-body from its state predicts them within 0.2 %), a tenth or ten times of them are refused (the fit
+    would otherwise end in an unrelated error about thresholds)."""
+    aer, setup = shared_data / "tracking" / "W3B.aer", shared_data / "tracking" / "od_test_W3.in"
+    data = _arrays(_range_only(aer, tmp_path / "ranges.aer", 1.0), setup)
+    assert implied_speeds(data) == {}  # nothing for the speed check to judge
+    for factor, name in ((0.1, "tenth"), (10.0, "ten")):
+        bad = _range_only(aer, tmp_path / f"ranges_{name}.aer", factor)
+        with pytest.raises(InputError, match=rf"ranges_{name}\.aer: column 'range': station \w+: its ranges are"):
+            _arrays(bad, setup)
+
+
+def test_an_a_priori_of_another_orbit_is_refused(shared_data: Path, tmp_path: Path) -> None:
+    """The same check seen from the other side: W3B's real ranges against a LEO a-priori state."""
+    setup = (shared_data / "tracking" / "od_test_W3.in").read_text()
+    leo = setup.replace("orbit.cartesian.px = -40517522.9", "orbit.cartesian.px = -6878137.0")
+    leo = leo.replace("orbit.cartesian.py = -10003079.9", "orbit.cartesian.py = 0.0")
+    leo = leo.replace("orbit.cartesian.vx = 762.559", "orbit.cartesian.vx = 0.0")
+    leo = leo.replace("orbit.cartesian.vy =  -1474.468", "orbit.cartesian.vy = -7612.6")
+    assert leo != setup
+    (tmp_path / "leo.in").write_text(leo)
+    ranges = _range_only(shared_data / "tracking" / "W3B.aer", tmp_path / "ranges.aer", 1.0)
+    with pytest.raises(InputError, match="a-priori orbit of another satellite"):
+        _arrays(ranges, tmp_path / "leo.in")

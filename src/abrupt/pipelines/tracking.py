@@ -22,7 +22,7 @@ from abrupt.detect.tracking.glrt import GlrtManeuverDetector
 from abrupt.detect.tracking.kaderali import KaderaliManeuverDetector
 from abrupt.errors import RepairLog
 from abrupt.events import config_hash, empty_frame, new_run_id, restamp
-from abrupt.model.implied_orbit import check_implied_speeds
+from abrupt.model.implied_orbit import check_implied_speeds, check_ranges_against_orbit
 from abrupt.model.orbit import ForceContext, ForceModel
 from abrupt.model.orbit.batch_fit import BatchFit, BatchFitConfig
 from abrupt.model.orbit.bodies import sun_moon_gcrf
@@ -122,7 +122,8 @@ def read_tracking_arrays(
     """The measurements of ``file`` (CRD, TDM or ``.aer``, by content) on the set-up's stations and epoch,
     refraction-corrected when asked, after the implied-orbit check
     (:func:`~abrupt.model.implied_orbit.check_implied_speeds`): ranges and angles that place the satellite
-    at a speed no Earth satellite has (a range in the wrong unit) are a one-line error."""
+    at a speed no Earth satellite has (a range in the wrong unit) are a one-line error, as are ranges more
+    than twice as short or long as the a-priori orbit's (a station without angles)."""
     offline_astropy()
     meas = read_tracking(file, known_stations=setup.stations, repairs=repairs)
     if refraction:
@@ -136,6 +137,7 @@ def read_tracking_arrays(
         source=str(file),
     )
     check_implied_speeds(data, file)
+    check_ranges_against_orbit(data, np.asarray(setup.initial_state, float), file, mu_m3_s2=setup.mu_m3_s2)
     return data
 
 
