@@ -22,12 +22,13 @@ from abrupt.detect.tracking.glrt import GlrtManeuverDetector
 from abrupt.detect.tracking.kaderali import KaderaliManeuverDetector
 from abrupt.errors import RepairLog
 from abrupt.events import config_hash, empty_frame, new_run_id, restamp
+from abrupt.model.implied_orbit import check_implied_speeds, check_ranges_against_orbit
 from abrupt.model.orbit import ForceContext, ForceModel
 from abrupt.model.orbit.batch_fit import BatchFit, BatchFitConfig
 from abrupt.model.orbit.bodies import sun_moon_gcrf
 from abrupt.model.timescales import offline_astropy
 from abrupt.model.tracking_measurements import TrackingArrays, correct_refraction
-from abrupt.readers.orekit_od_input import read_od_input
+from abrupt.readers.orekit_od_input import OrbitDeterminationSetup, read_od_input
 from abrupt.readers.tracking import read_tracking
 from abrupt.series.tracking import TrackingSeries
 from abrupt.thresholds import FalseAlarmBudget
@@ -90,21 +91,10 @@ def read_tracking_series(
     ``settings`` says); for real-data set-ups (central/third-body keys present) a constant unmodelled
     acceleration and angle biases are estimated too.
     """
-    offline_astropy()
     setup = read_od_input(setup_path)
     repairs = RepairLog(str(file))
-    meas = read_tracking(file, known_stations=setup.stations, repairs=repairs)  # CRD, TDM or .aer by content
     use_refraction = setup.refraction_correction if settings.refraction is None else settings.refraction
-    if use_refraction:
-        meas = correct_refraction(meas)
-    data = TrackingArrays(
-        meas,
-        setup.stations,
-        epoch_utc=setup.epoch_utc,
-        earth_rotation=setup.earth_rotation,  # type: ignore[arg-type]
-        theta0_rad=setup.theta0_rad,
-        source=str(file),
-    )
+    data = read_tracking_arrays(file, setup, refraction=use_refraction, repairs=repairs)
     real = any(k.startswith("central.body") or k.startswith("third.body") for k in setup.extra)
     force, epoch = setup_force_model(setup, float(np.nanmax(data.t_s)) if len(data.t_s) else 0.0)
     biases = any(setup.range_bias_estimated.values()) if settings.estimate_biases is None else settings.estimate_biases
@@ -124,6 +114,31 @@ def read_tracking_series(
     )
     series = TrackingSeries(data, np.asarray(setup.initial_state, float), fit_cfg, name=name or Path(file).stem)
     return TrackingInputs(series, force, use_refraction, biases, accel, repairs, epoch)
+
+
+def read_tracking_arrays(
+    file: str | Path, setup: OrbitDeterminationSetup, *, refraction: bool, repairs: RepairLog
+) -> TrackingArrays:
+    """The measurements of ``file`` (CRD, TDM or ``.aer``, by content) on the set-up's stations and epoch,
+    refraction-corrected when asked, after the implied-orbit check
+    (:func:`~abrupt.model.implied_orbit.check_implied_speeds`): ranges and angles that place the satellite
+    at a speed no Earth satellite has (a range in the wrong unit) are a one-line error, as are ranges more
+    than twice as short or long as the a-priori orbit's (a station without angles)."""
+    offline_astropy()
+    meas = read_tracking(file, known_stations=setup.stations, repairs=repairs)
+    if refraction:
+        meas = correct_refraction(meas)
+    data = TrackingArrays(
+        meas,
+        setup.stations,
+        epoch_utc=setup.epoch_utc,
+        earth_rotation=setup.earth_rotation,  # type: ignore[arg-type]
+        theta0_rad=setup.theta0_rad,
+        source=str(file),
+    )
+    check_implied_speeds(data, file)
+    check_ranges_against_orbit(data, np.asarray(setup.initial_state, float), file, mu_m3_s2=setup.mu_m3_s2)
+    return data
 
 
 def setup_force_model(setup: Any, span_s: float = 0.0) -> tuple[ForceContext, np.datetime64]:
