@@ -162,6 +162,63 @@ print(len(models), gaps, c_fast, c_ref, int(same), len(lines), k_fast_s, k_ref_s
 """
 
 
+DENSITY = """
+import sys, time
+import numpy as np, pandas as pd
+from pathlib import Path
+from abrupt.density.tle_drag import TleDragConfig, rho_b_from_history
+from abrupt.model.atmosphere import read_space_weather
+from abrupt.readers.omm import read_element_histories
+paths = [p for p in Path(sys.argv[1]).read_text().split()][: int(sys.argv[2])]
+hs = [h for p in paths for h in read_element_histories(p)]
+sw = read_space_weather(None)
+out = {}
+for label, cfg in (
+    ("default", TleDragConfig(with_model=True)),
+    ("auto", TleDragConfig(with_model=True, model_tolerance=float(sys.argv[3]))),
+    ("every", TleDragConfig(with_model=True, model_stride=1)),
+):
+    c = time.process_time()
+    res = [rho_b_from_history(h, cfg, maneuvers=[], space_weather=sw) for h in hs]
+    cpu = time.process_time() - c
+    pts = sum(r.integrals.model_points for r in res)
+    strides = pd.Series([r.integrals.model_stride for r in res]).value_counts().sort_index().to_dict()
+    out[label] = (pd.concat([r.windows for r in res], ignore_index=True), cpu, pts, strides)
+ref = out["default"][0]
+ok = (ref["status"] == "ok") & np.isfinite(ref["model_density_kg_m3"]) & (ref["rho_b_per_m"] != 0)
+rel = (ref["rho_b_sigma_per_m"] / ref["rho_b_per_m"].abs())[ok]
+print(f"objects {len(hs)}; windows {int(ok.sum())}; stated sigma_K/|K| median {rel.median():.3f}, "
+      f"1st percentile {rel.quantile(0.01):.4f}")
+for label in ("auto", "every"):
+    w, cpu, pts, strides = out[label]
+    d = (w["model_density_kg_m3"] / ref["model_density_kg_m3"] - 1.0).abs()[ok]
+    r = d / rel
+    print(f"{label}: CPU {cpu:.2f} s vs default {out['default'][1]:.2f} s (ratio {cpu / out['default'][1]:.2f}); "
+          f"NRLMSIS points {pts} vs {out['default'][2]} ({pts / out['default'][2]:.2f}); strides {strides}; "
+          f"model density change vs the default: median {d.median():.2e}, max {d.max():.2e}; in units of the window's "
+          f"stated sigma_K/|K|: median {r.median():.3f}, 99th percentile {r.quantile(0.99):.3f}, max {r.max():.3f}, "
+          f"windows above 1: {int((r > 1).sum())}")
+"""
+
+
+def density_reference(listing: Path, n_files: int, tolerance: float) -> None:
+    """Same run, same objects, one process: NRLMSIS at the default stride, at the per-object stride of
+    ``--model-tolerance``, and at every node (the default's own sampling error); CPU, points evaluated and
+    the model density change in units of each window's stated relative uncertainty of ρB."""
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    out = subprocess.run(
+        [sys.executable, "-c", DENSITY, str(listing), str(n_files), str(tolerance)],
+        env=env,
+        capture_output=True,
+        text=True,
+    )
+    if out.returncode != 0:
+        raise SystemExit(f"density reference failed:\n{out.stderr[-2000:]}")
+    print(f"\n[density reference] one process, maneuvers none, {load()}")
+    for line in out.stdout.strip().splitlines():
+        print(f"  {line}")
+
+
 def kernel_reference(listing: Path, n_files: int) -> None:
     """The step test and the checksum against their plain definitions, same run, same objects: the
     compiled step kernel vs numpy medians gap by gap (``StepModel.gap_numpy``), the bytes checksum vs the
@@ -292,6 +349,13 @@ def main() -> None:
     ap.add_argument("--kill", action="store_true")
     ap.add_argument("--no-model", action="store_true", help="Density without NRLMSIS along the orbits.")
     ap.add_argument("--parts", default="maneuvers,density", help="maneuvers, density (needs maneuvers) or both")
+    ap.add_argument(
+        "--model-tolerance",
+        type=float,
+        default=None,
+        help="Density: pass --model-tolerance to `density tle` (NRLMSIS stride chosen per object).",
+    )
+    ap.add_argument("--density-reference-files", type=int, default=1, help="Files in the density reference.")
     args = ap.parse_args()
     parts = set(args.parts.split(","))
     folder = Path(args.folder or Path(tempfile.gettempdir()) / "abrupt-catalogue")
@@ -303,8 +367,12 @@ def main() -> None:
     needed = set(ns) | (set(dns) if "density" in parts else set())
     part("maneuvers", sorted(needed), folder, ["detect", "tle-batch"], 10.0, args.workers, events)
     density = ["density", "tle", "--windows-only"] + (["--no-model"] if args.no_model else [])
+    if args.model_tolerance is not None:
+        density += ["--model-tolerance", str(args.model_tolerance)]
     if "density" in parts:
         part("density", dns, folder, density, 15.0, args.workers, events)
+        if not args.no_model:
+            density_reference(catalogue(folder, max(dns)), args.density_reference_files, args.model_tolerance or 1.0)
     listing = catalogue(folder, max(ns))
     k = args.reference_files
     kernel_reference(listing, k)
@@ -325,5 +393,6 @@ def main() -> None:
 if __name__ == "__main__":
     from _results import variant, write_results
 
-    with write_results("bench_catalogue_scale", variant({"--no-model": "nomodel", "--parts=maneuvers": "maneuvers"})):
+    names = {"--no-model": "nomodel", "--parts=maneuvers": "maneuvers", "--model-tolerance": "tolerance"}
+    with write_results("bench_catalogue_scale", variant(names)):
         main()

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from abrupt.detect.tle.config import TleDetectorConfig
+from abrupt.detect.tle.noise import drift_noise_rate, robust_scale_rolling, rolling_rate
 from abrupt.detect.tle.steps import StepModel, empty_steps, fill_gap, fill_gaps, segment_bounds, segment_bounds_all
 from abrupt.readers.omm import read_element_histories
 from abrupt.readers.tle import tle_checksum
@@ -79,16 +80,59 @@ def test_kernel_propagates_nan_like_numpy(histories: list) -> None:
     assert _same(values[ok], ref_values[ok])
 
 
-def test_batch_fill_equals_gap_by_gap(histories: list) -> None:
+def _scalar_store(model: StepModel, g: int, cps: list[int]) -> dict[str, object]:
+    """One gap stored with the per-gap scalar methods (step, sigmas, z, unexplained phase)."""
+    steps, factor = model.gap(g, *segment_bounds(g, cps, model.n))
+    if np.isinf(factor):
+        return {"delta_a_m": 0.0, "delta_u_m": 0.0, "z_a": 0.0, "z_e": 0.0, "z_n": 0.0, "z_u": 0.0}
+    sc = model.step_sigmas(g, factor)
+    z_a, z_e, z_n, z_u = model.z(g, steps, factor, sc)
+    return {
+        "delta_a_m": steps["a_m"],
+        "delta_e": [steps["ex"], steps["ey"]],
+        "delta_normal_rad": [steps["i_rad"], steps["raan_resid_sin_i_rad"]],
+        "delta_u_m": model.unexplained_phase_m(g, steps),
+        "z_a": z_a,
+        "z_e": z_e,
+        "z_n": z_n,
+        "z_u": z_u,
+        "sigma_a_m": sc["a_m"],
+        "sigma_n_rad": (0.5 * (sc["i_rad"] ** 2 + sc["raan_resid_sin_i_rad"] ** 2)) ** 0.5,
+    }
+
+
+@pytest.mark.parametrize("min_side", [3, 1])
+def test_batch_fill_equals_scalar_gap_by_gap(histories: list, min_side: int) -> None:
+    """The array store (one call a pass) against the scalar per-gap formulas, bit for bit."""
     model = StepModel(histories[1], TleDetectorConfig())
+    model.min_side = min_side
     n_gaps = model.n - 1
     cps = [n_gaps // 3, n_gaps // 2]
-    one, many = empty_steps(model.t, n_gaps), empty_steps(model.t, n_gaps)
-    for g in range(n_gaps):
-        fill_gap(one, model, g, cps)
+    many = empty_steps(model.t, n_gaps)
     fill_gaps(many, model, np.arange(n_gaps), cps)
-    for name in ("delta_a_m", "delta_e", "delta_normal_rad", "z_a", "z_e", "z_n", "z_u", "sigma_a_m", "sigma_n_rad"):
-        assert _same(getattr(one, name), getattr(many, name)), name
+    one = empty_steps(model.t, n_gaps)
+    for g in range(0, n_gaps, 2):  # a single-gap fill goes through the same store
+        fill_gap(one, model, g, cps)
+    inf_gaps = 0
+    for g in range(n_gaps):
+        ref = _scalar_store(model, g, cps)
+        inf_gaps += int("sigma_a_m" not in ref)
+        for name, value in ref.items():
+            assert _same(getattr(many, name)[g], np.asarray(value)), (g, name)
+            if g % 2 == 0:
+                assert _same(getattr(one, name)[g], np.asarray(value)), (g, name)
+    if min_side > 1:
+        assert inf_gaps > 0  # the cut windows leave gaps untestable next to the change points
+    assert n_gaps - inf_gaps > 50
+
+
+def test_shared_rolling_rate_equals_recomputed(histories: list) -> None:
+    model = StepModel(histories[2], TleDetectorConfig())
+    for k in model.NAMES:
+        y = model.s[k]
+        rate = rolling_rate(model.t, y, 40)
+        assert _same(robust_scale_rolling(y, 40, model.t, rate), robust_scale_rolling(y, 40, model.t))
+        assert drift_noise_rate(model.t, y, 40, rate) == drift_noise_rate(model.t, y, 40)
 
 
 def test_segment_bounds_all_matches_scalar() -> None:

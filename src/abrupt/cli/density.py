@@ -89,6 +89,14 @@ def density() -> None:
     default=None,
     help="With --windows-only: maneuver events of 'abrupt detect tle-batch' (not detected again).",
 )
+@click.option(
+    "--model-tolerance",
+    type=click.FloatRange(min=0.0, min_open=True),
+    default=None,
+    help="NRLMSIS on fewer nodes per object: the coarsest of every 16th/8th/4th/2nd node whose window "
+    "model densities agree with the next finer within this fraction of each window's stated σ of ρB "
+    "(default: every 2nd node for every object).",
+)
 @with_parts_options
 def density_tle(
     paths: tuple[str, ...],
@@ -107,6 +115,7 @@ def density_tle(
     windows_only: bool,
     scheduler: str | None,
     maneuvers_from: str | None,
+    model_tolerance: float | None,
     paths_from: str | None,
     parts: str | None,
     keep_parts: bool,
@@ -137,6 +146,7 @@ def density_tle(
             maneuvers_from,
             parts,
             keep_parts,
+            model_tolerance,
         )
         return
     if maneuvers_from or scheduler:
@@ -149,6 +159,7 @@ def density_tle(
             interval_days=interval_days,
             with_model=not no_model or len(paths) > 1,
             maneuver_budget=maneuver_budget,
+            model_tolerance=model_tolerance,
         ),
         constellation=ConstellationConfig(kappa=kappa),
         maneuvers=maneuvers,
@@ -295,15 +306,22 @@ def _windows_only(
     maneuvers_from: str | None,
     parts: str | None,
     keep_parts: bool,
+    model_tolerance: float | None = None,
 ) -> None:
     """``density tle --windows-only``: every object's ρB windows, resumable, on the executor."""
     if not out.lower().endswith((".parquet", ".csv")):
         raise click.BadParameter(f"{out!r} must end in .parquet or .csv", param_hint="--out")
     executor = Executor(workers=workers if workers > 1 else None, scheduler=scheduler)
-    cfg = TleDragConfig(interval_days=interval_days, with_model=not no_model, maneuver_budget=maneuver_budget)
+    cfg = TleDragConfig(
+        interval_days=interval_days,
+        with_model=not no_model,
+        maneuver_budget=maneuver_budget,
+        model_tolerance=model_tolerance,
+    )
     settings: dict[str, Any] = {
         "interval_days": interval_days,
         "with_model": not no_model,
+        "model_tolerance": model_tolerance,
         "maneuvers": maneuvers,
         "budget": str(maneuver_budget),
         "space_weather": space_weather,

@@ -41,14 +41,18 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-from numpy.typing import NDArray
-from scipy.interpolate import CubicSpline
 
 from abrupt import progress
+from abrupt.density.model_sampling import (
+    ModelNodes,
+    choose_stride,
+    gap_trapezoids,
+    window_model_density,
+)
 from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET
 from abrupt.detect.tle.detectors import detector_for
 from abrupt.errors import RepairLog
-from abrupt.model.atmosphere import msis_density, read_space_weather, teme_to_geodetic
+from abrupt.model.atmosphere import read_space_weather
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
 from abrupt.thresholds import FalseAlarmBudget
 from abrupt.thresholds.noise import robust_scale
@@ -88,6 +92,10 @@ class TleDragConfig:
     thrust_sigma: float = 4.0
     with_model: bool = False
     model_stride: int = 2
+    # None: NRLMSIS on every ``model_stride``-th node. A number f: per object the coarsest of the
+    # strides 16, 8, 4, 2 (not finer than ``model_stride``) whose window model densities all agree
+    # with the next finer stride's within f × each window's stated σ_K/|K| (density.model_sampling)
+    model_tolerance: float | None = None
     origin_utc: str | None = None
     maneuver_budget: FalseAlarmBudget = DEFAULT_TLE_BUDGET  # of the maneuver detector
 
@@ -119,6 +127,9 @@ class DragIntegrals:
     grid_weight: FloatArray | None = None  # n̄^(1/3) v³ F on the nodes (0 where SGP4 failed)
     grid_rho_model: FloatArray | None = None  # NRLMSIS density on the nodes (with a model)
     set_grid_index: Any = None  # node index of each set's epoch
+    nodes: ModelNodes | None = None  # the nodes' positions and the NRLMSIS values evaluated on them
+    model_stride: int | None = None  # the stride used (chosen per object with ``model_tolerance``)
+    model_points: int = 0  # NRLMSIS evaluations made
 
 
 @dataclass
@@ -209,64 +220,28 @@ def drag_integrals(
         integrand[errors != 0] = 0.0  # SGP4 failed (decayed record): no contribution
     rho_all: FloatArray | None = None
     when = epochs[gap_index] + (tau_all * 1e9).astype("timedelta64[ns]")
-    if space_weather is not None:
-        # NRLMSIS on every ``model_stride``-th node (it costs ~10-30 µs a point); log ρ is interpolated
-        # in time between them (the nodes of consecutive gaps are consecutive in time).
-        sample = np.zeros(tau_all.size, dtype=bool)
-        sample[:: max(1, model_stride)] = True
-        sample[-1:] = True
-        sample &= errors == 0
-        lat, lon, h_km = teme_to_geodetic(when[sample], pos[sample])
-        rho_s = np.asarray(msis_density(when[sample], lat, lon, h_km, space_weather))
-        good = np.isfinite(rho_s) & (rho_s > 0)
-        t_abs = (when - when[0]).astype(np.int64) * 1e-9
-        rho_all = np.exp(interpolate_log_density(t_abs, t_abs[sample][good], np.log(rho_s[good])))
+    starts = offsets[:-1]
+    nodes = ModelNodes(when, pos, errors == 0, tau_all, integrand, starts, space_weather)
+    if space_weather is not None and n_sets > 1:
+        # NRLMSIS on every ``model_stride``-th node (≈ 7 µs a point); log ρ is interpolated in time
+        # between them (the nodes of consecutive gaps are consecutive in time)
+        rho_all, cum = nodes.integral(model_stride)
+        if cum_m is not None:
+            cum_m[1:] = cum
     radius = np.linalg.norm(pos, axis=1)
     if n_sets > 1:
         # every gap's trapezoid sum and node means in one pass (sums in node order, not numpy's
         # pairwise order: the same values to ~1e-15 relative)
-        starts = offsets[:-1]
-        cum_w[1:] = np.cumsum(_gap_trapezoids(tau_all, integrand, starts))
-        if cum_m is not None and rho_all is not None:
-            cum_m[1:] = np.cumsum(_gap_trapezoids(tau_all, integrand * rho_all, starts))
+        cum_w[1:] = np.cumsum(gap_trapezoids(tau_all, integrand, starts))
         alt[1:] = (np.add.reduceat(radius, starts) / counts - 6378137.0) / 1e3
         wf[1:] = np.add.reduceat(f_all, starts) / counts
         alt[0] = alt[1]
         wf[0] = wf[1]
     set_index = np.concatenate([offsets[:-1], [offsets[-1] - 1]]) if n_sets > 1 else np.zeros(1, dtype=np.int64)
-    return DragIntegrals(t, n_bar, cum_w, cum_m, alt, wf, when, integrand, rho_all, set_index)
-
-
-def _gap_trapezoids(x: FloatArray, y: FloatArray, starts: NDArray[np.int64]) -> FloatArray:
-    """Trapezoid integral of ``y`` over ``x`` on each run of nodes beginning at ``starts`` (runs of at
-    least two nodes, back to back)."""
-    seg = np.diff(x) * (y[1:] + y[:-1]) / 2.0
-    seg[starts[1:] - 1] = 0.0  # the step from one run's last node to the next run's first
-    return np.add.reduceat(np.append(seg, 0.0), starts)
-
-
-def interpolate_log_density(t_s: FloatArray, t_known_s: FloatArray, log_rho: FloatArray) -> FloatArray:
-    """log ρ at ``t_s`` from samples along the orbit: a cubic spline in time (not-a-knot).
-
-    Along an orbit log ρ oscillates at the orbital period (day/night bulge, latitude); sampled every
-    1200 s (4.6 samples a revolution) a linear interpolation cuts the peaks (error (hω)²/8 ≈ 23 % of
-    the oscillation, a 1-2 % low bias of the mean density) while the cubic's is (hω)⁴/384 ≈ 1 %.
-    Repeated sample times (gap ends) are merged; extrapolation holds the end values; between samples
-    further apart than 1.5 times the usual spacing (missing samples) the interpolation is linear.
-    """
-    tk, first = np.unique(t_known_s, return_index=True)
-    yk = np.asarray(log_rho)[first]
-    if tk.size < 4:
-        return np.interp(t_s, tk, yk)
-    tt = np.clip(t_s, tk[0], tk[-1])
-    out = np.asarray(CubicSpline(tk, yk)(tt), dtype=np.float64)
-    # Where samples are missing (SGP4 failures, gaps) a cubic swings wildly: linear there, and
-    step = np.diff(tk)
-    k = np.clip(np.searchsorted(tk, tt, side="right") - 1, 0, tk.size - 2)
-    wide = step[k] > 1.5 * float(np.median(step))
-    if np.any(wide):
-        out[wide] = np.interp(tt[wide], tk, yk)
-    return out
+    integ = DragIntegrals(t, n_bar, cum_w, cum_m, alt, wf, when, integrand, rho_all, set_index, nodes)
+    integ.model_points = nodes.n_evaluated
+    integ.model_stride = model_stride if space_weather is not None else None
+    return integ
 
 
 def neighbour_residuals(n_bar: FloatArray, integral: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -343,8 +318,12 @@ def rho_b_from_history(
     sw = space_weather
     if cfg.with_model and sw is None:
         sw = read_space_weather()
+    adaptive = cfg.with_model and cfg.model_tolerance is not None and integrals is None
     integ = integrals or drag_integrals(
-        history, cfg.step_s, space_weather=sw if cfg.with_model else None, model_stride=cfg.model_stride
+        history,
+        cfg.step_s,
+        space_weather=sw if cfg.with_model and not adaptive else None,
+        model_stride=cfg.model_stride,
     )
     epochs = history.elements["epoch_utc"].to_numpy(dtype="datetime64[ns]")
     mu = MU_EARTH_WGS72_M3_S2
@@ -360,13 +339,16 @@ def rho_b_from_history(
     sigma_n = robust_sigma(_noise_samples(integ, x_all, segment_id, keep))
     repairs.record("gaps with a rise of the orbit (undetected thrust) cut", thrust_cuts)
     repairs.record("element sets with bad fits rejected", int(np.sum(~keep)))
-    rows, counts = _windows(history, label, integ, x_all, epochs, segment_id, keep, sigma_n, cfg)
+    rows, counts, bounds = _windows(history, label, integ, x_all, epochs, segment_id, keep, sigma_n, cfg)
     repairs.record(
         "windows holding a maneuver, orbit rise or gap (fitted with one offset per segment)", counts["straddle"]
     )
     repairs.record("windows with too few element sets or too short a span", counts["few"])
     repairs.record("windows with negative decay rejected", counts["negative"])
     frame = pd.DataFrame(rows, columns=list(WINDOW_COLUMNS)) if rows else _empty_windows()
+    if adaptive and integ.nodes is not None:
+        integ.nodes.space_weather = sw
+        sampled_model(integ, frame, bounds, cfg)
     track = None
     if integ.grid_rho_model is not None and integ.grid_weight is not None:
         track = DecayTrack(
@@ -436,8 +418,9 @@ def _windows(
     keep: Any,
     sigma_n: float,
     cfg: TleDragConfig,
-) -> tuple[list[tuple[Any, ...]], dict[str, int]]:
-    """The rows of :data:`WINDOW_COLUMNS` on a common UTC grid, and the windows skipped, by reason."""
+) -> tuple[list[tuple[Any, ...]], dict[str, int], list[tuple[int, int]]]:
+    """The rows of :data:`WINDOW_COLUMNS` on a common UTC grid, the windows skipped, by reason, and the
+    first and last set of each row's window."""
     origin = (
         np.asarray([pd.Timestamp(cfg.origin_utc).to_datetime64()], dtype="datetime64[ns]")[0]
         if cfg.origin_utc
@@ -446,6 +429,7 @@ def _windows(
     width = np.timedelta64(round(cfg.interval_days * SECONDS_PER_DAY * 1e9), "ns")
     n_windows = int(np.ceil((epochs[-1] - origin) / width)) + 1
     rows: list[tuple[Any, ...]] = []
+    bounds: list[tuple[int, int]] = []
     counts = {"straddle": 0, "few": 0, "negative": 0}
     kept_idx = np.flatnonzero(keep)
     k_epochs = epochs[kept_idx]
@@ -489,7 +473,28 @@ def _windows(
         alt = float(mean_alt(integ.altitude_km[idx[1:]])) if idx.size > 1 else float(integ.altitude_km[idx[0]])
         wfac = float(mean_wf(integ.wind_factor[idx[1:]])) if idx.size > 1 else float(integ.wind_factor[idx[0]])
         rows.append((label, norad, b0, b1, span0, span1, int(idx.size), k_val, k_sig, alt, wfac, model, status))
-    return rows, counts
+        bounds.append((int(i0), int(i1)))
+    return rows, counts, bounds
+
+
+def sampled_model(integ: DragIntegrals, frame: pd.DataFrame, bounds: list[tuple[int, int]], cfg: TleDragConfig) -> None:
+    """NRLMSIS at the stride chosen for this object (``cfg.model_tolerance``; :func:`choose_stride`):
+    fills the integrals' model fields and the windows' model density in place."""
+    assert integ.nodes is not None and cfg.model_tolerance is not None
+    i0 = np.array([b[0] for b in bounds], dtype=np.int64)
+    i1 = np.array([b[1] for b in bounds], dtype=np.int64)
+    k = frame["rho_b_per_m"].to_numpy(dtype=float)
+    sig = frame["rho_b_sigma_per_m"].to_numpy(dtype=float)
+    ok = (frame["status"].to_numpy() == "ok") & (k != 0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rel = np.where(ok, sig / np.abs(k), np.nan)
+    stride, rho_all, cum_m, _ = choose_stride(
+        integ.nodes, integ.weight_integral, i0, i1, rel, cfg.model_tolerance, cfg.model_stride
+    )
+    integ.model_integral, integ.grid_rho_model, integ.model_stride = cum_m, rho_all, stride
+    integ.model_points = integ.nodes.n_evaluated
+    if len(frame):
+        frame["model_density_kg_m3"] = window_model_density(cum_m, integ.weight_integral, i0, i1)
 
 
 def _window_fit(

@@ -102,9 +102,11 @@ def catalogue_tasks(
 
 
 def maneuver_task(task: CatalogueTask) -> tuple[pd.DataFrame, list[str]]:
-    """Maneuver events of every object of one file (a pure function of the task)."""
+    """Maneuver events of every object of one file, in the events schema (a pure function of the task;
+    the schema is applied here, in the worker, not in the calling process that only writes parts)."""
     res = detect_tle_file(task.path, task.settings["budget_object"], run_id=task.run_id)
-    return res.events, [str(e) for e in res.skipped[:20]]
+    events = res.events
+    return (normalise_frame(events) if len(events) else empty_frame()), [str(e) for e in res.skipped[:20]]
 
 
 def maneuver_times_by_object(events: pd.DataFrame) -> dict[str, list[Any]]:
@@ -227,8 +229,6 @@ def run_catalogue(
 
     def store(res: TaskResult[CatalogueTask, tuple[pd.DataFrame, list[str]]]) -> None:
         frame, notes = res.result
-        if kind == "maneuvers":
-            frame = normalise_frame(frame) if len(frame) else empty_frame()
         _write_part(folder, res.task.part, frame)
         skipped.extend(f"{res.task.path}: {n}" for n in notes)
         if on_part is not None:

@@ -28,21 +28,33 @@ def chi2_as_normal(z: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.asarray(out, dtype=float)
 
 
+def rolling_rate(t: NDArray[np.float64], y: NDArray[np.float64], half: int) -> NDArray[np.float64]:
+    """Rolling median (±``half`` differences, at least 5) of the set-to-set rate ``Δy / max(Δt, 60 s)``:
+    the drift both :func:`robust_scale_rolling` and :func:`drift_noise_rate` remove (computed once and
+    passed to both by the step model)."""
+    rate = pd.Series(np.diff(y) / np.maximum(np.diff(t), 60.0))
+    return np.asarray(rate.rolling(2 * half + 1, center=True, min_periods=5).median().to_numpy(), dtype=np.float64)
+
+
 def robust_scale_rolling(
-    y: NDArray[np.float64], half: int, t: NDArray[np.float64] | None = None
+    y: NDArray[np.float64],
+    half: int,
+    t: NDArray[np.float64] | None = None,
+    rate: NDArray[np.float64] | None = None,
 ) -> NDArray[np.float64]:
     """Per-gap noise of a series: rolling 1.4826·MAD of first differences / √2 (Hampel 1974).
 
     With the epochs ``t`` the differences are first detrended by the rolling median rate × gap, so
-    a secular drift (drag decay, an unmodelled nodal rate) seen over uneven gaps is not noise.
+    a secular drift (drag decay, an unmodelled nodal rate) seen over uneven gaps is not noise
+    (``rate``: :func:`rolling_rate` of ``t``, ``y``, ``half`` when already known).
     """
     d = np.diff(y)
     if d.size == 0:
         return np.full_like(y, np.nan)
     if t is not None:
         dt = np.diff(t)
-        rate = pd.Series(d / np.maximum(dt, 60.0)).rolling(2 * half + 1, center=True, min_periods=5).median()
-        d = d - np.nan_to_num(rate.to_numpy()) * dt
+        rate = rolling_rate(t, y, half) if rate is None else rate
+        d = d - np.nan_to_num(rate) * dt
     s = pd.Series(d)
     med = s.rolling(2 * half + 1, center=True, min_periods=5).median()
     mad = (s - med).abs().rolling(2 * half + 1, center=True, min_periods=5).median()
@@ -55,21 +67,23 @@ def robust_scale_rolling(
     return scale
 
 
-def drift_noise_rate(t: NDArray[np.float64], y: NDArray[np.float64], half: int = 40) -> float:
+def drift_noise_rate(
+    t: NDArray[np.float64], y: NDArray[np.float64], half: int = 40, rate: NDArray[np.float64] | None = None
+) -> float:
     """Random-walk rate q (units²/s) of a mean-element series, learned from its own history.
 
     Set-to-set differences, with a rolling median drift removed, have variance ``2σ² + q·Δt`` (white
     fit noise σ plus unmodelled drag/luni-solar wander that accumulates over the gap Δt). The robust
     variances (1.4826·MAD)² of short gaps (≤ median) and long gaps (≥ 2 × median) give q (≥ 0);
     q = 0 when fewer than 20 long gaps exist. The step test adds q·Δt_gap to a gap's variance, so
-    a long gap between element sets needs a larger step.
+    a long gap between element sets needs a larger step (``rate``: :func:`rolling_rate` when known).
     """
     d = np.diff(y)
     dt = np.diff(t)
     if d.size < 40:
         return 0.0
-    rate = pd.Series(d / np.maximum(dt, 60.0)).rolling(2 * half + 1, center=True, min_periods=5).median()
-    r = d - rate.to_numpy() * dt
+    rate = rolling_rate(t, y, half) if rate is None else rate
+    r = d - rate * dt
     med_dt = float(np.median(dt))
     short, long = dt <= med_dt, dt >= 2.0 * med_dt
     ok = np.isfinite(r)

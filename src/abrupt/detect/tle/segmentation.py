@@ -56,10 +56,8 @@ def segment(
             g = g_loc
         accepted.append(g)
         blocked[max(0, g - cfg.peak_half_width + 1) : g + cfg.peak_half_width] = True
-        cps = sorted(accepted)
-        for k in range(max(0, g - reach), min(n_gaps, g + reach + 1)):
-            if not blocked[k]:
-                fill_gap(cur, model, k, cps)
+        near_g = np.arange(max(0, g - reach), min(n_gaps, g + reach + 1))
+        fill_gaps(cur, model, near_g[~blocked[near_g]], sorted(accepted))
     side = cfg.campaign_min_side_sets if cfg.campaign_min_side_sets is not None else cfg.min_side_sets
     if side < cfg.min_side_sets and accepted:
         # Campaigns: near an accepted maneuver, a further burn may be only one or two sets away.
@@ -74,9 +72,7 @@ def segment(
         if side == 1:
             tested[:] = False
             tested[accepted] = True
-        cps = sorted(accepted)
-        for kk in np.flatnonzero(near & ~tested):
-            fill_gap(cur, model, int(kk), cps)
+        fill_gaps(cur, model, np.flatnonzero(near & ~tested), sorted(accepted))
         while True:
             stat = np.where(tested | ~near, -np.inf, cur.statistic)
             g = int(np.argmax(stat))
@@ -88,10 +84,8 @@ def segment(
                 tested[g] = True
             else:
                 tested = blocked.copy()
-            cps = sorted(accepted)
-            for k in range(max(0, g - reach), min(n_gaps, g + reach + 1)):
-                if not tested[k] and near[k]:
-                    fill_gap(cur, model, k, cps)
+            near_g = np.arange(max(0, g - reach), min(n_gaps, g + reach + 1))
+            fill_gaps(cur, model, near_g[~tested[near_g] & near[near_g]], sorted(accepted))
         model.min_side = cfg.min_side_sets
     rest = np.where(blocked, -np.inf, cur.statistic)
     for g in local_peaks(rest, cfg.peak_half_width, cfg.min_statistic):

@@ -25,11 +25,11 @@ def _median(x: NDArray[np.float64], n: int) -> float:  # pragma: no cover - comp
     for k in range(n):
         if np.isnan(x[k]):
             return np.nan
-    v = np.sort(x[:n])
     h = n // 2
+    v = np.partition(x[:n], h)  # the h-th smallest in place, the smaller ones before it (a selection, not a sort)
     if n % 2 == 1:
         return v[h]
-    return (v[h - 1] + v[h]) / 2.0
+    return (np.max(v[:h]) + v[h]) / 2.0
 
 
 @njit(cache=True)
@@ -77,6 +77,9 @@ def gap_steps(
     span = 4 * window + 2
     slopes = np.empty(span * span)
     work = np.empty(span)
+    pair_i = np.empty(span * span, dtype=np.int64)
+    pair_j = np.empty(span * span, dtype=np.int64)
+    pair_dt = np.empty(span * span)
     for q in range(n_g):
         g = gaps[q]
         lo, hi, slo, shi = _window(t, g, lo_bounds[q], hi_bounds[q], window, max_win_s)
@@ -85,16 +88,19 @@ def gap_steps(
         if n1 < min_side or n2 < min_side:
             continue
         t0 = 0.5 * (t[g] + t[g + 1])
+        # the pairs of each side more than 60 s apart, found once for all series
+        m = 0
+        for a, b in ((slo, g + 1), (g + 1, shi)):
+            for i in range(a, b):
+                for j in range(i + 1, b):
+                    dt = t[j] - t[i]
+                    if dt > MIN_PAIR_DT_S:
+                        pair_i[m], pair_j[m], pair_dt[m] = i, j, dt
+                        m += 1
         for s in range(n_series):
             y = stack[s]
-            m = 0
-            for a, b in ((slo, g + 1), (g + 1, shi)):
-                for i in range(a, b):
-                    for j in range(i + 1, b):
-                        dt = t[j] - t[i]
-                        if dt > MIN_PAIR_DT_S:
-                            slopes[m] = (y[j] - y[i]) / dt
-                            m += 1
+            for k in range(m):
+                slopes[k] = (y[pair_j[k]] - y[pair_i[k]]) / pair_dt[k]
             slope = _median(slopes, m) if m > 0 else 0.0
             k = 0
             for i in range(lo, g + 1):

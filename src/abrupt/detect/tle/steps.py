@@ -24,7 +24,13 @@ from abrupt.detect.tle.elements import (
     orbit_regime,
     stated_decay_m_s,
 )
-from abrupt.detect.tle.noise import chi2_as_normal, drift_noise_rate, robust_group_weight, robust_scale_rolling
+from abrupt.detect.tle.noise import (
+    chi2_as_normal,
+    drift_noise_rate,
+    robust_group_weight,
+    robust_scale_rolling,
+    rolling_rate,
+)
 from abrupt.detect.tle.step_kernels import gap_steps, localise_costs
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
 from abrupt.units import SECONDS_PER_DAY
@@ -137,8 +143,11 @@ class StepModel:
         self.min_side = cfg.min_side_sets
         self.t = self.s["t_s"]
         self.n = self.t.size
-        self.scales = {k: robust_scale_rolling(self.s[k], cfg.noise_half_window, self.t) for k in self.NAMES}
-        self.drift_q = {k: drift_noise_rate(self.t, self.s[k], cfg.noise_half_window) for k in self.NAMES}
+        half = cfg.noise_half_window
+        rates = {k: rolling_rate(self.t, self.s[k], half) if self.n > 1 else None for k in self.NAMES}
+        self.scales = {k: robust_scale_rolling(self.s[k], half, self.t, rates[k]) for k in self.NAMES}
+        self.drift_q = {k: drift_noise_rate(self.t, self.s[k], half, rates[k]) for k in self.NAMES}
+        self._mean_motion: NDArray[np.float64] | None = None
 
     def gap(self, g: int, lo_bound: int = 0, hi_bound: int | None = None) -> tuple[dict[str, float], float]:
         """Steps of every series at gap g from sets [max(lo_bound, g+1-W), g], [g+1, min(hi_bound, g+1+W)).
@@ -284,6 +293,13 @@ class StepModel:
         z_u = abs(self.unexplained_phase_m(g, steps)) / sc["u_m"]
         return z_a, z_e, z_n, z_u
 
+    def mean_motion(self) -> NDArray[np.float64]:
+        """Mean motion ``sqrt(μ/a³)`` of every set (rad/s; computed once, as ``unexplained_phase_m`` does)."""
+        if self._mean_motion is None:
+            cubes = _pow(np.asarray(self.a_raw_m, dtype=np.float64), 3)
+            self._mean_motion = np.sqrt(MU_EARTH_WGS72_M3_S2 / cubes)
+        return self._mean_motion
+
     def unexplained_phase_m(self, g: int, steps: dict[str, float]) -> float:
         """The along-track phase step at gap g that the step in ``a`` cannot explain (m).
 
@@ -358,9 +374,7 @@ def fill_gaps(out: StepSeries, model: StepModel, gaps: Sequence[int] | NDArray[n
         return
     lo_b, hi_b = segment_bounds_all(g_arr, cps, model.n)
     values, n1s, n2s = model.gaps(g_arr, lo_b, hi_b)
-    for q, g in enumerate(g_arr.tolist()):
-        steps, factor = model._steps_factor(values[q], int(n1s[q]), int(n2s[q]))
-        _store_gap(out, model, g, steps, factor)
+    store_gaps(out, model, g_arr, values, n1s, n2s)
 
 
 def segment_bounds_all(gaps: NDArray[np.int64], cps: list[int], n: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
@@ -375,20 +389,69 @@ def segment_bounds_all(gaps: NDArray[np.int64], cps: list[int], n: int) -> tuple
     return lo.astype(np.int64), hi.astype(np.int64)
 
 
-def _store_gap(out: StepSeries, model: StepModel, g: int, steps: dict[str, float], factor: float) -> None:
-    out.delta_a_m[g] = steps["a_m"]
-    out.delta_e[g] = (steps["ex"], steps["ey"])
-    out.delta_normal_rad[g] = (steps["i_rad"], steps["raan_resid_sin_i_rad"])
+def _pow(x: NDArray[np.float64], e: float) -> NDArray[np.float64]:
+    """``x ** e`` element by element with the C library's ``pow`` (Python's float power), which numpy's
+    vector power does not always equal in the last bit; used where the per-gap Python arithmetic this
+    replaces raised to a power, so the stored values stay bit-identical."""
+    return np.array([v**e for v in x.tolist()], dtype=np.float64)
+
+
+def _hypot(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``math.hypot`` element by element (numpy's ``hypot`` differs from it in the last bit)."""
+    return np.array([math.hypot(a, b) for a, b in zip(x.tolist(), y.tolist(), strict=True)], dtype=np.float64)
+
+
+def store_gaps(
+    out: StepSeries,
+    model: StepModel,
+    gaps: NDArray[np.int64],
+    values: NDArray[np.float64],
+    n1s: NDArray[np.int64],
+    n2s: NDArray[np.int64],
+) -> None:
+    """Store the steps, z-scores and step sigmas of many gaps (the kernel's ``values``, gaps × series).
+
+    Element-wise the same arithmetic as :meth:`StepModel.step_sigmas`, :meth:`StepModel.z` and
+    :meth:`StepModel.unexplained_phase_m` gap by gap (IEEE operations in the same order; powers and
+    hypotenuses through the C library as there), on arrays: bit-identical, without the per-gap Python.
+    A gap with a side shorter than ``model.min_side`` stores zeros and leaves its sigmas as they were.
+    """
+    ok = (n1s >= model.min_side) & (n2s >= model.min_side)
+    g_all = np.asarray(gaps, dtype=np.int64)
+    bad = g_all[~ok]
     assert out.delta_u_m is not None and out.z_u is not None
-    out.delta_u_m[g] = model.unexplained_phase_m(g, steps) if not math.isinf(factor) else 0.0
-    if math.isinf(factor):
-        out.z_a[g] = out.z_e[g] = out.z_n[g] = out.z_u[g] = 0.0
-    else:
-        sc = model.step_sigmas(g, factor)
-        out.z_a[g], out.z_e[g], out.z_n[g], out.z_u[g] = model.z(g, steps, factor, sc)
-        assert out.sigma_a_m is not None and out.sigma_n_rad is not None
-        out.sigma_a_m[g] = sc["a_m"]
-        out.sigma_n_rad[g] = math.sqrt(0.5 * (sc["i_rad"] ** 2 + sc["raan_resid_sin_i_rad"] ** 2))
+    assert out.sigma_a_m is not None and out.sigma_n_rad is not None
+    out.delta_a_m[bad] = 0.0
+    out.delta_e[bad] = 0.0
+    out.delta_normal_rad[bad] = 0.0
+    out.delta_u_m[bad] = 0.0
+    out.z_a[bad] = out.z_e[bad] = out.z_n[bad] = out.z_u[bad] = 0.0
+    g = g_all[ok]
+    if g.size == 0:
+        return
+    v = values[ok]
+    n1, n2 = n1s[ok].astype(np.float64), n2s[ok].astype(np.float64)
+    factor = math.sqrt(math.pi / 2.0) * np.sqrt(1.0 / n1 + 1.0 / n2)
+    dt_gap = model.t[g + 1] - model.t[g]
+    sc = {
+        k: np.sqrt(_pow(np.asarray(model.scales[k], dtype=np.float64)[g] * factor, 2) + model.drift_q[k] * dt_gap)
+        for k in model.NAMES
+    }
+    da, ex, ey, di, dr, du = (v[:, j] for j in range(6))
+    mean_motion = model.mean_motion()[g]
+    allowance = 0.75 * mean_motion * np.abs(da) * (dt_gap + SECONDS_PER_DAY)
+    excess = np.abs(du) - allowance
+    unexplained = np.copysign(np.where(excess > 0.0, excess, 0.0), du)
+    out.delta_a_m[g] = da
+    out.delta_e[g] = np.stack([ex, ey], axis=1)
+    out.delta_normal_rad[g] = np.stack([di, dr], axis=1)
+    out.delta_u_m[g] = unexplained
+    out.z_a[g] = np.abs(da) / sc["a_m"]
+    out.z_e[g] = _hypot(ex / sc["ex"], ey / sc["ey"])
+    out.z_n[g] = _hypot(di / sc["i_rad"], dr / sc["raan_resid_sin_i_rad"])
+    out.z_u[g] = np.abs(unexplained) / sc["u_m"]
+    out.sigma_a_m[g] = sc["a_m"]
+    out.sigma_n_rad[g] = np.sqrt(0.5 * (_pow(sc["i_rad"], 2) + _pow(sc["raan_resid_sin_i_rad"], 2)))
 
 
 def component_weights(first: StepSeries, guard: int, quantile: float = 0.5) -> tuple[float, float, float]:
