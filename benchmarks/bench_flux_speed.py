@@ -85,6 +85,7 @@ def main() -> None:
     print(f"inference CPU time (all threads)            {c4 - c0:6.2f} s   (wall time above depends on the load)")
     print(f"free fit: {res.estimates}  intervals {res.intervals}")
     print(f"with meteoroid scale 1: {res_prior.estimates}  intervals {res_prior.intervals}")
+    print(f"bias-corrected: free {res.corrected_estimates}; meteoroid scale 1 {res_prior.corrected_estimates}")
     uls = [round(u["scale_upper_limit"], 3) for u in limits]
     print(f"truth {truth}; deviance p = {gof['deviance_p_value']:.3f}; 95 % upper limits (other scale 0) {uls}")
 

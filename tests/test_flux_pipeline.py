@@ -76,6 +76,11 @@ def test_simulate_population_then_flux_infer_end_to_end(tmp_path) -> None:
     assert free["n_events"] == len(pd.read_csv(tmp_path / "events.csv"))
     lo, hi = free["intervals"]["debris_scale"]
     assert lo <= free["estimates"]["debris_scale"] <= hi
+    # both point estimates travel: the ML one and the bias-corrected one, printed on its own line
+    prior = result["fits"]["meteoroid_scale=1 (Grün as a prior)"]
+    assert set(prior["corrected_estimates"]) == set(prior["estimates"])
+    assert prior["corrected_estimates"]["meteoroid_scale"] == 1.0
+    assert r.output.count("bias-corrected point estimate") == len(result["fits"])
     assert {g["model"] for g in result["goodness_of_fit"]} >= {"NASA-90/91 + Grün", "Grün only"}
     text = report.read_text()
     assert "data:image/png;base64" in text and "Exposure" in text

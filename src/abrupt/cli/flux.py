@@ -102,6 +102,10 @@ def infer(
             lo, hi = f.intervals.get(p, (v, v))
             parts.append(f"{p} = {v:.3g}" + ("" if p in f.fixed else f" [{lo:.3g}, {hi:.3g}]"))
         click.echo(f"{name}: " + ", ".join(parts) + f"  ({f.n_events} events, {f.n_days} spacecraft-days)")
+        free = [p for p in f.estimates if p not in f.fixed]
+        if f.corrected_estimates and free:
+            corr = ", ".join(f"{p} = {f.corrected_estimates[p]:.3g}" for p in free)
+            click.echo(f"  bias-corrected point estimate (signed ML, Cox-Snell correction of beta): {corr}")
     for g in result.goodness:
         click.echo(
             f"  {g['model']}: expected {g['expected_events']:.1f}, observed {g['observed_events']}, "

@@ -99,6 +99,10 @@ class FluxData:
     n_dropped: int  # events without an exposure day, or below the lowest bin edge
     n_days: int
     n_with_direction: int
+    # (G, 2, K) per template group, attitude (0 unknown, 1 orbit) and bin: Σ_d f_d ε_d(x_k)/365.25 and
+    # the expected false alarms (the cells of the expected information, see ``Likelihood.cell_expectations``)
+    exposure_years_att: NDArray[np.float64] | None = None
+    background_att: NDArray[np.float64] | None = None
 
     @property
     def n_events(self) -> int:
@@ -138,6 +142,10 @@ def prepare(
     exposure_years = weight @ eff_u / DAYS_PER_YEAR  # (G, K)
     fa = exp["false_alarms_per_day"].to_numpy() * f
     background_bins = np.bincount(curve_of, weights=fa, minlength=n_u) @ share_u
+    ga = (group * 2 + (exp["attitude"].to_numpy() == "orbit")) * n_u + curve_of
+    n_ga = len(keys) * 2
+    w_att = np.bincount(ga, weights=f, minlength=n_ga * n_u).reshape(n_ga, n_u)
+    fa_att = np.bincount(ga, weights=fa, minlength=n_ga * n_u).reshape(n_ga, n_u)
     ev = events[events["kind"].astype(str) == "strike"] if "kind" in events else events
     days = pd.to_datetime(ev["time_utc"].astype(str), utc=True).dt.strftime("%Y-%m-%d")
     exp_keys = pd.Index(exp["spacecraft"].astype(str) + "|" + exp["day"].astype(str))
@@ -170,6 +178,8 @@ def prepare(
         n_dropped=int((~keep).sum()),
         n_days=len(exp),
         n_with_direction=int((cls >= 0).sum()),
+        exposure_years_att=(w_att @ eff_u / DAYS_PER_YEAR).reshape(len(keys), 2, -1),
+        background_att=(fa_att @ share_u).reshape(len(keys), 2, -1),
     )
 
 
@@ -284,6 +294,79 @@ class Likelihood:
                 break
         return s, self.loglike(s)
 
+    def cell_expectations(self, beta: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Expected detections at unit scales, (P, N), and false alarms, (N,), in every cell of the data:
+        (template group, bin) for days of unknown attitude, (template group, direction class, bin) else."""
+        d = self.data
+        if d.exposure_years_att is None or d.background_att is None:
+            raise ConfigError("these flux data carry no per-attitude exposure; build them with prepare()", key="data")
+        sig: list[NDArray[np.float64]] = []
+        bg: list[NDArray[np.float64]] = []
+        for g, tpl in enumerate(d.templates):
+            r = tpl.bin_rates(float(beta))  # (P, C, K)
+            n_pop, n_cls, _ = r.shape
+            sig += [r.sum(axis=1) * d.exposure_years_att[g, 0], (r * d.exposure_years_att[g, 1]).reshape(n_pop, -1)]
+            bg += [d.background_att[g, 0], np.tile(d.background_att[g, 1] / n_cls, n_cls)]
+        return np.concatenate(sig, axis=1), np.concatenate(bg)
+
+
+def cox_snell_bias(
+    grad: NDArray[np.float64], hess: NDArray[np.float64], mu: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """First-order bias of the maximum-likelihood estimate for independent Poisson counts with means μ_k(θ)
+    (Cox & Snell 1968): with I = Σ_k ∇μ_k ∇μ_kᵀ / μ_k the expected information,
+
+        b(θ) = −½ I⁻¹ Σ_k (∇μ_k / μ_k) tr(I⁻¹ ∇²μ_k),
+
+    which is κ^{ar} κ^{tu} (κ_{rt,u} + ½ κ_{rtu}) for the Poisson cumulants (zero where μ is linear in θ).
+    grad (N, q), hess (N, q, q), mu (N,)."""
+    info = grad.T @ (grad / mu[:, None])
+    inv = np.linalg.inv(info)
+    trace = np.einsum("kij,ij->k", hess, inv)
+    return np.asarray(-0.5 * inv @ (grad.T @ (trace / mu)), dtype=np.float64)
+
+
+def bias_corrected(lik: Likelihood, fixed: Mapping[str, float], signed: Mapping[str, float]) -> dict[str, float]:
+    """The signed maximum-likelihood estimate with β corrected for its Cox-Snell first-order bias.
+
+    The scales enter μ linearly, so with β fixed the correction is zero and the signed estimate is returned
+    (it is unbiased to first order). With β free, β̃ = β̂ − b_β(θ̂) (derivatives in β by central differences
+    in ln β, step 0.05) and the scales are re-maximised at β̃. Not corrected where β̂ lies on the first or
+    last point of the β grid (no stationary point: the expansion does not apply). The scales' own
+    first-order terms are not applied: where β is weakly identified they are of the order of the scale
+    itself and their sign flips within the sampling spread of β̂ (a scale derived through β has no
+    estimator with a small bias there; see docs/flux-inference.md)."""
+    out = dict(signed)
+    beta = float(signed["beta"])
+    grid = lik.beta_grid
+    if "beta" in fixed or grid.size < 3 or not (grid[1] < beta < grid[-2]):
+        return out
+    free = [p for p, name in enumerate(SCALES) if name not in fixed]
+    s = np.array([float(signed[n]) for n in SCALES])
+    sig0, bg = lik.cell_expectations(beta)
+    h = 0.05
+    up, _ = lik.cell_expectations(beta * math.exp(h))
+    down, _ = lik.cell_expectations(beta * math.exp(-h))
+    d1 = (up - down) / (2 * h * beta)  # ∂A/∂β
+    d2 = ((up - 2 * sig0 + down) / h**2 - (up - down) / (2 * h)) / beta**2  # ∂²A/∂β²
+    q = len(free) + 1
+    grad = np.stack([sig0[p] for p in free] + [s @ d1], axis=1)
+    hess = np.zeros((grad.shape[0], q, q))
+    for i, p in enumerate(free):
+        hess[:, i, q - 1] = hess[:, q - 1, i] = d1[p]
+    hess[:, q - 1, q - 1] = s @ d2
+    mu = s @ sig0 + bg
+    keep = mu > 0
+    try:
+        b_beta = float(cox_snell_bias(grad[keep], hess[keep], mu[keep])[-1])
+    except np.linalg.LinAlgError:
+        return out
+    new_beta = float(np.clip(beta - b_beta, grid[0], grid[-1]))
+    at_new = Likelihood(lik.data, np.array([new_beta]))
+    at_new.weights = lik.weights
+    scales, _ = at_new.maximise({k: v for k, v in fixed.items() if k in SCALES}, signed=True)
+    return {"debris_scale": float(scales[0, 0]), "meteoroid_scale": float(scales[0, 1]), "beta": new_beta}
+
 
 def refine_max(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, float, int]:
     """Maximum of samples y(x) refined by a parabola through the best point and its neighbours."""
@@ -318,6 +401,7 @@ class FitResult:
     expected_events: dict[str, float] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
     signed_estimates: dict[str, float] = field(default_factory=dict)  # scales not bounded at 0
+    corrected_estimates: dict[str, float] = field(default_factory=dict)  # signed minus Cox-Snell bias
 
     def as_dict(self) -> dict[str, Any]:
         return {
@@ -333,6 +417,7 @@ class FitResult:
             "expected_events": self.expected_events,
             "notes": self.notes,
             "signed_estimates": self.signed_estimates,
+            "corrected_estimates": self.corrected_estimates,
         }
 
 
@@ -351,6 +436,7 @@ def fit(
     confidence: float = 0.9,
     beta_grid: NDArray[np.float64] | None = None,
     likelihood: Likelihood | None = None,
+    intervals: bool = True,
 ) -> FitResult:
     """Maximum likelihood and profile-likelihood intervals of the free parameters.
 
@@ -358,6 +444,7 @@ def fit(
         data: from :func:`prepare`.
         fixed: parameters held fixed (``debris_scale``, ``meteoroid_scale``, ``beta``).
         confidence: interval level (0.9: 2 Δln L = 2.706).
+        intervals: False skips the profile intervals (point estimates only, for simulation studies).
     """
     fixed = dict(fixed or {})
     unknown = [k for k in fixed if k not in PARAMS]
@@ -378,26 +465,27 @@ def fit(
         beta_hat, ll_max, s_hat = float(lik.beta_grid[0]), float(ll[0]), s[0]
     estimates = {"debris_scale": float(s_hat[0]), "meteoroid_scale": float(s_hat[1]), "beta": beta_hat}
     half = 0.5 * float(stats.chi2.ppf(confidence, 1))
-    intervals: dict[str, tuple[float, float]] = {}
+    bounds: dict[str, tuple[float, float]] = {}
     notes: list[str] = []
-    if "beta" not in fixed:
-        intervals["beta"] = _beta_interval(logb, ll, ll_max - half, notes)
+    if "beta" not in fixed and intervals:
+        bounds["beta"] = _beta_interval(logb, ll, ll_max - half, notes)
     # a β whose profile is below the interval's level cannot hold a boundary of a scale's interval
     near = lik
     if ll.size > 3:
         relevant = np.convolve((ll >= ll_max - half - 0.5).astype(float), np.ones(3), mode="same") > 0
         near = lik.subset(relevant) if relevant.sum() >= 3 else lik
     for p, name in enumerate(SCALES):
-        if name in fixed:
+        if name in fixed or not intervals:
             continue
-        intervals[name] = _scale_interval(near, name, float(s_hat[p]), scale_fixed, ll_max - half)
+        bounds[name] = _scale_interval(near, name, float(s_hat[p]), scale_fixed, ll_max - half)
     b = int(np.argmin(np.abs(logb - math.log(beta_hat))))
     expected = {pop: float(s_hat[p] * lik.totals[b, p]) for p, pop in enumerate(POPULATIONS)}
     expected["false_alarms"] = lik.bg_total
     signed = _signed_estimates(lik, scale_fixed) if data.n_events else dict(estimates)
+    corrected = bias_corrected(lik, fixed, signed) if data.n_events else dict(estimates)
     return FitResult(
         estimates,
-        intervals,
+        bounds,
         confidence,
         float(ll_max),
         fixed,
@@ -408,6 +496,7 @@ def fit(
         expected,
         notes,
         signed,
+        corrected,
     )
 
 

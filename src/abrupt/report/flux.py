@@ -96,7 +96,8 @@ def fits_table(result: FluxInference) -> pd.DataFrame:
                 {
                     "fit": name,
                     "parameter": p,
-                    "estimate": v,
+                    "estimate (ML)": v,
+                    "bias-corrected": f.corrected_estimates.get(p, float("nan")),
                     f"{f.confidence:.0%} low": lo,
                     f"{f.confidence:.0%} high": hi,
                     "fixed": p in f.fixed,
