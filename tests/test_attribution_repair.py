@@ -126,7 +126,10 @@ def test_a_wheel_reading_fault_is_undone_from_the_null_space_and_a_take_up_is_ke
     rep = repair_wheel(replace(table, wheel_speed_rad_s=bad), sc, 700, 2, 350)
     assert rep is not None and rep.channel == "wheel_3"
     err = rep.table.wheel_speed_rad_s - table.wheel_speed_rad_s
-    assert np.max(np.abs(err[600:1000, 2])) < 0.15  # the 3.1 rad/s offset gone to the readings' noise
+    # The 3.1 rad/s offset is gone to the noise of its estimate (the four readings' noise, 0.02 rad/s each,
+    # projected on the null space and divided by wheel 3's part of it: about 0.04 rad/s).
+    assert abs(np.mean(err[700:900, 2])) < 0.01
+    assert np.max(np.abs(err[600:1000, 2])) < 0.25
     assert np.array_equal(rep.table.wheel_speed_rad_s[:, [0, 1, 3]], bad[:, [0, 1, 3]])
     # The take-up of the real step at 745 (range space) is still in the repaired wheels, as in the clean ones.
     js_g = (sc.wheel_axes * sc.wheel_spin_inertias_kgm2[None, :]).T

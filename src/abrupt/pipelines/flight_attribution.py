@@ -71,9 +71,10 @@ def attribute_events(
     return out
 
 
-#: Where a second event is looked for around a sensor fault's event [s] (a strike "within a minute"),
-#: and how far from the fault's own step it must be [s] (nearer, the two cannot be told apart).
-RESCAN_SPAN_S = (-90.0, 150.0)
+#: Where a second event is looked for around a sensor fault's event [s] (half a window span either side:
+#: a fault that lasts has two edges, and the event may sit on either), and how far from the fault's own
+#: step it must be [s] (nearer, the two cannot be told apart).
+RESCAN_SPAN_S = (-300.0, 300.0)
 RESCAN_APART_S = 10.0
 
 

@@ -140,24 +140,24 @@ def repair_wheel(table: Timetable, sc: Spacecraft, i0: int, wheel: int, half: in
         return None
     seg = w[lo:hi]
     ok = np.isfinite(seg).all(axis=1)
-    c_null = seg @ null
-    c = i0 - lo
-    pre = np.zeros(hi - lo, bool)
-    pre[max(0, c - 300) : max(0, c - 5)] = True
-    pre &= ok
-    if pre.sum() < 30:
+    if ok.sum() < 60:
         return None
-    tau = np.arange(hi - lo, dtype=np.float64)
-    x = np.column_stack([np.ones(int(pre.sum())), tau[pre]])
-    basis = np.column_stack([np.ones_like(tau), tau])
-    coef, *_ = np.linalg.lstsq(x, c_null[pre], rcond=None)
-    dev = c_null - basis @ coef
-    sig = np.array([white_noise_sigma(dev[pre, j]) for j in range(null.shape[1])])
-    # Once more without the pre-window's own outliers (a fault that began before the located event).
-    clean = pre & np.all(np.abs(dev) <= FAULT_SIGMA * np.maximum(sig, 1e-12), axis=1)
-    if clean.sum() >= 30:
-        coef, *_ = np.linalg.lstsq(basis[clean], c_null[clean], rcond=None)
+    c_null = seg @ null
+    # The slow line of the null-space coordinates over the whole span, robustly: from the median (a
+    # reading fault shorter than half the span cannot move it), then refitted on the samples within
+    # 5 σ (σ from first differences, which a step does not inflate) until the inliers settle.
+    basis = np.column_stack([np.ones(hi - lo), np.arange(hi - lo, dtype=np.float64) / max(hi - lo, 1)])
+    coef = np.vstack([np.median(c_null[ok], axis=0), np.zeros(null.shape[1])])
+    sig = np.array([white_noise_sigma(c_null[ok, j]) for j in range(null.shape[1])])
+    inl = ok
+    for _ in range(5):
         dev = c_null - basis @ coef
+        new = ok & np.all(np.abs(dev) <= FAULT_SIGMA * np.maximum(sig, 1e-12), axis=1)
+        if new.sum() < 30 or np.array_equal(new, inl):
+            break
+        inl = new
+        coef, *_ = np.linalg.lstsq(basis[inl], c_null[inl], rcond=None)
+    dev = c_null - basis @ coef
     bad = ok & np.any(np.abs(dev) > FAULT_SIGMA * np.maximum(sig, 1e-12), axis=1)
     if not bad.any():
         return None
