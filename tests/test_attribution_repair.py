@@ -13,6 +13,9 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from abrupt.detect.attitude.attribution import classify
+from abrupt.detect.attitude.evidence import event_evidence
+from abrupt.detect.attitude.flight_glr import FlightGlrDetector
 from abrupt.detect.attitude.repair import (
     repair_gyro_bias,
     repair_gyro_spike,
@@ -20,7 +23,9 @@ from abrupt.detect.attitude.repair import (
     repair_wheel,
 )
 from abrupt.model.spacecraft import load_spacecraft
+from abrupt.pipelines.flight_attribution import rescan_after_faults
 from abrupt.series.timetable import NS, Timetable
+from abrupt.series.timetable_momentum import timetable_momentum
 
 ROOT = Path(__file__).resolve().parent.parent
 KESTREL = ROOT / "examples" / "spacecraft" / "kestrel.toml"
@@ -135,3 +140,67 @@ def test_a_wheel_reading_fault_is_undone_from_the_null_space_and_a_take_up_is_ke
     js_g = (sc.wheel_axes * sc.wheel_spin_inertias_kgm2[None, :]).T
     h, h_true = rep.table.wheel_speed_rad_s @ js_g, table.wheel_speed_rad_s @ js_g
     assert np.max(np.abs(np.median(h[760:840], 0) - np.median(h_true[760:840], 0))) < 0.01
+
+
+def _closed_loop_table(rng: np.random.Generator, strike_at: int, dh_b: np.ndarray) -> Timetable:
+    """3000 s of a body turning slowly, its wheels (minimum-norm, plus a null-space offset) holding ᴺH,
+    and an external impulse ΔH_B at ``strike_at``: the body takes it first (Δω₀ = J⁻¹ ΔH_B, decaying
+    as (1 − τ/τ_c) e^(−τ/τ_c), τ_c = 10 s) and the wheels the rest; total ᴺH steps by [NB] ΔH_B."""
+    sc = load_spacecraft(KESTREL)
+    j = np.asarray(sc.inertia_kgm2, float)
+    n = 3000
+    tau = np.arange(n) - strike_at
+    f = np.where(tau >= 0, (1 - tau / 10.0) * np.exp(-np.clip(tau, 0, None) / 10.0), 0.0)
+    omega = np.array([1e-4, -1.0e-3, 5e-5]) + np.outer(f, np.linalg.solve(j, dh_b))
+    rot, quats = Rotation.identity(), []
+    for k in range(n):
+        quats.append(rot.as_quat())
+        rot = rot * Rotation.from_rotvec(omega[k])
+    qa = np.asarray(quats)
+    bn = Rotation.from_quat(qa).inv().as_matrix()  # [BN]: inertial to body
+    h_n = np.tile([3.0, -2.0, 1.0], (n, 1))
+    h_n[strike_at:] += bn[strike_at].T @ dh_b
+    h_w = np.einsum("nij,nj->ni", bn, h_n) - omega @ j.T
+    js_g = sc.wheel_axes * sc.wheel_spin_inertias_kgm2[None, :]
+    wheels = h_w @ np.linalg.pinv(js_g).T + 150.0 * np.array([1, -1, 1, -1]) * 2 * np.pi / 60
+    q_noisy = (Rotation.from_quat(qa) * Rotation.from_rotvec(rng.normal(0, 2e-6, (n, 3)))).as_quat()
+    return Timetable(
+        time_ns=np.arange(n, dtype=np.int64) * NS,
+        quaternion_BN=np.column_stack([q_noisy[:, 3], q_noisy[:, :3]]),
+        body_rate_rad_s=omega + rng.normal(0, 1e-6, (n, 3)),
+        wheel_speed_rad_s=wheels + rng.normal(0, 0.01, (n, 4)),
+        appendage_rate_rad_s=np.zeros((n, 0)),
+        flags=np.zeros((n, 0)),
+        valid=np.ones(n, bool),
+    )
+
+
+def test_a_strike_covered_by_a_wheel_glitchs_event_is_found_after_the_wheel_is_repaired() -> None:
+    """A 30-rpm glitch of wheel 2 for 300 s (0.38 N·m·s in its reading) with a 0.08 N·m·s strike 40 s
+    after its onset: one event (peaks are a window span apart), a wheel fault; after the repair the
+    strike is an event of its own, at its time, of its size, classified ``strike``."""
+    rng = np.random.default_rng(5)
+    sc = load_spacecraft(KESTREL)
+    dh_b = np.array([0.05, -0.04, 0.05])
+    table = _closed_loop_table(rng, 1240, dh_b)
+    w = table.wheel_speed_rad_s.copy()
+    w[1200:1500, 1] += 30 * 2 * np.pi / 60
+    table = replace(table, wheel_speed_rad_s=w)
+    h_n, _ = timetable_momentum(sc, table)
+    hc = h_n - np.median(h_n[:1000], axis=0)
+    ok = np.ones(len(table), bool)
+    det = FlightGlrDetector()
+    win = det.windows(1.0)
+    stat = det.statistic(hc, ok, win)
+    peaks = [(i, p) for i, p in det.find_peaks(hc, ok, stat, table.time_ns, 1.0, win) if p.value > 5.0]
+    ev = {p.time_ns: event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n) for _, p in peaks}
+    assert len(peaks) == 1
+    first = classify(ev[peaks[0][1].time_ns])
+    assert (first.kind, first.channel) == ("sensor_fault", "wheel_2")
+    found, found_ev = rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)
+    assert len(found) == 1
+    _, p = found[0]
+    assert abs(p.time_ns / NS - 1240) <= 3
+    assert abs(np.linalg.norm(p.dH_N_Nms) - np.linalg.norm(dh_b)) < 0.1 * np.linalg.norm(dh_b)
+    assert classify(found_ev[p.time_ns]).kind == "strike", found_ev[p.time_ns]
+    assert found_ev[p.time_ns].after_fault_s == (p.time_ns - peaks[0][1].time_ns) / NS
