@@ -191,7 +191,7 @@ def match(truth: list[dict], events: pd.DataFrame) -> pd.DataFrame:
         if idx:
             best = max(idx, key=lambda i: events["statistic"].iloc[i])
             got = str(events["kind"].iloc[best])
-            used.add(best)
+            used.add(int(best))
             extra = {c: events[c].iloc[best] for c in (*EVIDENCE_SHOWN, "kind_reason") if c in events}
         rows.append({**tr, "got": got, **extra})
     return pd.DataFrame(rows)
@@ -259,8 +259,8 @@ def archive_figures(events: pd.DataFrame, n_days: int) -> None:
     """The set as it is (its own Basilisk strikes, no injection): found within 10 s, classes, false alarms."""
     strikes = [s["time_s"] for s in json.loads((DATA / "truth_strikes.json").read_text())["strikes"]]
     strikes = [s for s in strikes if s < n_days * 86400]
-    t_ev = pd.to_datetime(events["time_utc"].str.rstrip("Z")).to_numpy().astype("datetime64[ns]").astype(np.int64)
-    t_ev = (t_ev - T0_NS) / NS
+    t_ns = pd.to_datetime(events["time_utc"].str.rstrip("Z")).to_numpy().astype("datetime64[ns]").astype(np.int64)
+    t_ev = (t_ns - T0_NS) / NS
     hit = [int(np.argmin(np.abs(t_ev - s))) for s in strikes if len(t_ev) and np.min(np.abs(t_ev - s)) <= 10]
     kinds = events["kind"].astype(str).to_numpy()
     others = [k for i, k in enumerate(kinds) if i not in set(hit)]
@@ -293,7 +293,7 @@ def figure(store: Path, sc, ranges: ConfounderRanges, path: str, seed: int, verb
     hc = np.full((len(table), 3), np.nan)
     pos = np.searchsorted(table.time_ns, chunk.series["time_ns"])
     hc[pos] = chunk.series["H_N_clean"]
-    truth = [("strike (archive) 0.14 N·m·s", T0_NS + int(27110.4 * NS), 0)]
+    truth: list[tuple[str, int, float]] = [("strike (archive) 0.14 N·m·s", T0_NS + int(27110.4 * NS), 0.0)]
     truth += [(c.kind.replace("_", " "), c.time_ns, c.duration_s) for c in confs]
     panels = []
     for title, t_ns, dur in truth:

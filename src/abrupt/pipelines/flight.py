@@ -438,8 +438,9 @@ def process_span(
         for _, pk in peaks
         if pk.value > config.evidence_floor
     }
-    kw = {"floor": config.evidence_floor, "keep": core, "inertia_kgm2": inertia_kgm2}
-    found, found_ev = rescan_after_faults(table, spacecraft, h_n, hc, ok, detector, peaks, evidence, **kw)
+    found, found_ev = rescan_after_faults(
+        table, spacecraft, h_n, hc, ok, detector, peaks, evidence, config.evidence_floor, core, inertia_kgm2
+    )
     peaks, evidence = peaks + found, {**evidence, **found_ev}
     edges = [start_ns, end_ns]
     if split_days:

@@ -94,7 +94,6 @@ def rescan_after_faults(
     detector: FlightGlrDetector,
     peaks: list[tuple[int, Peak]],
     evidence: Mapping[int, EventEvidence],
-    *,
     floor: float,
     keep: BoolArray | None = None,
     inertia_kgm2: FloatArray | None = None,
