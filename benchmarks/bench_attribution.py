@@ -2,6 +2,7 @@
 
     PYTHONPATH=$PWD/src nice python benchmarks/bench_attribution.py [--ranges eval|widened|tests|FILE.toml]
         [--runs 3] [--per-kind 20] [--store DIR] [--seed 1]
+        [--kinds K1,K2] [--days 1] [--near-fraction 0.25]    # a quick subset while iterating
 
 The two stored days of ../shared/data/flight-like (Basilisk telemetry of kestrel, pseudonym SC-A) get
 synthetic strikes (``abrupt.simulate.injection``, closed-loop response) and confounders of every kind
@@ -94,6 +95,8 @@ EVIDENCE_SHOWN = (
     "ev_duration_lo_s",
     "ev_wheel_spike_z",
     "ev_appendage_z",
+    "ev_gyro_spike_z",
+    "ev_after_fault_s",
 )
 
 
@@ -114,16 +117,31 @@ def quiet_times(spacing_s: float, margin_s: float = 900.0) -> list[float]:
 
 
 def plan_run(
-    run: int, per_kind: int, runs: int, slots: list[float], rng: np.random.Generator
+    run: int,
+    per_kind: int,
+    runs: int,
+    slots: list[float],
+    rng: np.random.Generator,
+    confounder_kinds: tuple[str, ...] = CONFOUNDER_KINDS,
 ) -> list[tuple[str, float]]:
     """(kind, seconds) of one run: its share of strikes and of each confounder kind, shuffled over the slots."""
     n_each = math.ceil(per_kind / runs)
-    kinds = ["strike"] * (2 * n_each) + [k for k in CONFOUNDER_KINDS for _ in range(n_each)]
+    kinds = ["strike"] * (2 * n_each) + [k for k in confounder_kinds for _ in range(n_each)]
     kinds = list(rng.permutation(kinds))[: len(slots)]
     return [(str(k), float(t)) for k, t in zip(kinds, rng.permutation(slots)[: len(kinds)], strict=False)]
 
 
-def one_run(store: Path, sc, plan, ranges: ConfounderRanges, rng: np.random.Generator, run_seed: int, threshold):
+def one_run(
+    store: Path,
+    sc,
+    plan,
+    ranges: ConfounderRanges,
+    rng: np.random.Generator,
+    run_seed: int,
+    threshold,
+    days: list[str] | None = None,
+    near_fraction: float = 0.25,
+):
     """Inject the plan (and near-strikes), run the pipeline, return the truth rows and the events."""
     truth = []
     strikes: list[InjectedStrike] = []
@@ -142,7 +160,7 @@ def one_run(store: Path, sc, plan, ranges: ConfounderRanges, rng: np.random.Gene
         confs.append(c)
         truth.append({"kind": kind, "class": CONFOUNDER_CLASS[kind], "t_ns": t_ns,
                       "end_ns": t_ns + int(c.duration_s * NS), "size": float("nan"), "near": False})  # fmt: skip
-        if rng.uniform() < 0.25:  # a strike 20-60 s after the confounder's onset
+        if rng.uniform() < near_fraction:  # a strike 20-60 s after the confounder's onset
             t2 = t_ns + int(rng.uniform(20, 60) * NS)
             size = float(math.exp(rng.uniform(math.log(0.05), math.log(0.6))))
             u = rng.normal(size=3)
@@ -154,7 +172,7 @@ def one_run(store: Path, sc, plan, ranges: ConfounderRanges, rng: np.random.Gene
         s = inject_confounders(s, sc, confs, seed=run_seed)
         return inject_strikes(s, sc, strikes, seed=run_seed)
 
-    res = run_flight(store, sc, FlightRunConfig(), samples_hook=hook, threshold=threshold)
+    res = run_flight(store, sc, FlightRunConfig(), days=days, samples_hook=hook, threshold=threshold)
     return truth, res.events
 
 
@@ -173,7 +191,7 @@ def match(truth: list[dict], events: pd.DataFrame) -> pd.DataFrame:
         if idx:
             best = max(idx, key=lambda i: events["statistic"].iloc[i])
             got = str(events["kind"].iloc[best])
-            used.add(best)
+            used.add(int(best))
             extra = {c: events[c].iloc[best] for c in (*EVIDENCE_SHOWN, "kind_reason") if c in events}
         rows.append({**tr, "got": got, **extra})
     return pd.DataFrame(rows)
@@ -186,6 +204,9 @@ def main() -> int:
     ap.add_argument("--per-kind", type=int, default=20)
     ap.add_argument("--store", default="/tmp/abrupt_bench_attribution_store")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--kinds", default=None, help="Comma-separated confounder kinds (default: all)")
+    ap.add_argument("--days", type=int, default=2, help="Use the first 1 or both days of the set")
+    ap.add_argument("--near-fraction", type=float, default=0.25, help="Share of confounders with a strike after")
     ap.add_argument("--figure", default=None, help="Write the example panels (one event of each kind) to this PNG")
     args = ap.parse_args()
     if args.ranges == "eval":
@@ -204,21 +225,27 @@ def main() -> int:
         figure(store, sc, ranges, args.figure, args.seed)
         return 0
     rng = np.random.default_rng(args.seed)
-    slots = quiet_times(1800.0)
+    slots = [t for t in quiet_times(1800.0) if t < args.days * 86400 - 2400]
+    days = ["2026-03-10", "2026-03-11"][: args.days] if args.days < 2 else None
+    kinds = tuple(args.kinds.split(",")) if args.kinds else CONFOUNDER_KINDS
+    if unknown := set(kinds) - set(CONFOUNDER_KINDS):
+        ap.error(f"--kinds: unknown confounder kind(s) {sorted(unknown)}; known: {', '.join(CONFOUNDER_KINDS)}")
     print(
         f"ranges: {args.ranges} "
         f"({'in-sample: the tests draw from these' if args.ranges == 'tests' else 'held out from the tests'})"
     )
-    print(f"{len(slots)} quiet slots per run over 2 days; {args.runs} runs")
+    print(f"{len(slots)} quiet slots per run over {args.days} day(s); {args.runs} runs; kinds: {', '.join(kinds)}")
     t_start = time.time()
     # The threshold of the days as they are (1 false alarm/day): days with a confounder every 40 min
     # are no null to calibrate on (their block maxima are the confounders).
-    threshold = run_flight(store, sc, FlightRunConfig()).threshold
+    plain = run_flight(store, sc, FlightRunConfig(), days=days)
+    threshold = plain.threshold
     print(f"threshold {threshold.value:.2f} calibrated on the days without injections")
+    archive_figures(plain.events, args.days)
     rows = []
     for run in range(args.runs):
-        plan = plan_run(run, args.per_kind, args.runs, slots, rng)
-        truth, events = one_run(store, sc, plan, ranges, rng, args.seed + run, threshold)
+        plan = plan_run(run, args.per_kind, args.runs, slots, rng, kinds)
+        truth, events = one_run(store, sc, plan, ranges, rng, args.seed + run, threshold, days, args.near_fraction)
         m = match(truth, events)
         m["run"] = run
         rows.append(m)
@@ -226,6 +253,22 @@ def main() -> int:
     table = pd.concat(rows, ignore_index=True)
     report(table)
     return 0
+
+
+def archive_figures(events: pd.DataFrame, n_days: int) -> None:
+    """The set as it is (its own Basilisk strikes, no injection): found within 10 s, classes, false alarms."""
+    strikes = [s["time_s"] for s in json.loads((DATA / "truth_strikes.json").read_text())["strikes"]]
+    strikes = [s for s in strikes if s < n_days * 86400]
+    t_ns = pd.to_datetime(events["time_utc"].str.rstrip("Z")).to_numpy().astype("datetime64[ns]").astype(np.int64)
+    t_ev = (t_ns - T0_NS) / NS
+    hit = [int(np.argmin(np.abs(t_ev - s))) for s in strikes if len(t_ev) and np.min(np.abs(t_ev - s)) <= 10]
+    kinds = events["kind"].astype(str).to_numpy()
+    others = [k for i, k in enumerate(kinds) if i not in set(hit)]
+    print(
+        f"the set as it is (flight pipeline at its defaults): {len(hit)} of {len(strikes)} strikes found within 10 s, "
+        f"{sum(kinds[i] == 'strike' for i in hit)} classified strike; {len(others)} other event(s) (false alarms): "
+        f"{', '.join(others) or 'none'}"
+    )
 
 
 def figure(store: Path, sc, ranges: ConfounderRanges, path: str, seed: int, verbose: bool = True) -> None:
@@ -250,7 +293,7 @@ def figure(store: Path, sc, ranges: ConfounderRanges, path: str, seed: int, verb
     hc = np.full((len(table), 3), np.nan)
     pos = np.searchsorted(table.time_ns, chunk.series["time_ns"])
     hc[pos] = chunk.series["H_N_clean"]
-    truth = [("strike (archive) 0.14 N·m·s", T0_NS + int(27110.4 * NS), 0)]
+    truth: list[tuple[str, int, float]] = [("strike (archive) 0.14 N·m·s", T0_NS + int(27110.4 * NS), 0.0)]
     truth += [(c.kind.replace("_", " "), c.time_ns, c.duration_s) for c in confs]
     panels = []
     for title, t_ns, dur in truth:
@@ -303,6 +346,16 @@ def report(t: pd.DataFrame) -> None:
     if len(near):
         print(f"  of which within a minute of a confounder: found {(near['got'] != '(none)').mean():.1%}, "
               f"classified strike {(near['got'] == 'strike').mean():.1%} of {len(near)}")  # fmt: skip
+        if "ev_after_fault_s" in near:
+            rescued = near["ev_after_fault_s"].notna()
+            print(f"  found only after the neighbouring fault's channel was repaired: {int(rescued.sum())}, "
+                  f"of which classified strike {int((rescued & (near['got'] == 'strike')).sum())}")  # fmt: skip
+    conf = t[(t["kind"] != "strike") & (t["got"] != "(none)") & (t["got"] != t["class"])]
+    if len(conf):
+        print("\nconfounders given another class: the evidence of the matched event")
+        cols = ["kind", "got", *[c for c in ("kind_reason", *EVIDENCE_SHOWN) if c in conf]]
+        with pd.option_context("display.width", 250, "display.max_columns", 30):
+            print(conf[cols].to_string(float_format=lambda x: f"{x:.3g}"))
     print("\nconfounders: not a strike (target >= 95 %), own class (target >= 80 %), detected at all")
     for kind in CONFOUNDER_KINDS:
         k = t[t["kind"] == kind]

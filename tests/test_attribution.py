@@ -147,8 +147,9 @@ def test_ramp_duration_recovers_a_ramp_and_a_step() -> None:
 def test_rules_follow_the_physics_of_each_kind() -> None:
     strike = EventEvidence(
         st_gyro_step_rad=1e-5, st_gyro_step_limit_rad=3e-4, st_gyro_slope_rad_s=1e-7, st_gyro_slope_limit_rad_s=4e-6,
-        body_share=0.8, wheel_change_Nms=0.1, wheel_change_sigma_Nms=4e-4, wheel_null_fraction=0.01,
-        wheel_max_share=0.4, lasting_fraction=1.0, duration_s=0.0, duration_lo_s=0.0, duration_hi_s=2.0,
+        body_share=0.8, body_share_sigma=0.01, wheel_change_Nms=0.1, wheel_change_sigma_Nms=4e-4,
+        wheel_null_fraction=0.01, wheel_max_share=0.4,
+        lasting_fraction=1.0, duration_s=0.0, duration_lo_s=0.0, duration_hi_s=2.0,
         appendage_z=5.0, appendage_excess_deg=0.01,
     )  # fmt: skip
     assert classify(strike).kind == "strike"
@@ -157,7 +158,9 @@ def test_rules_follow_the_physics_of_each_kind() -> None:
     assert (classify(tracker).kind, classify(tracker).channel) == ("sensor_fault", "star_tracker")
     bias = EventEvidence(**{**fields, "st_gyro_slope_rad_s": 3e-5, "st_gyro_axis": 2})
     assert (classify(bias).kind, classify(bias).channel) == ("sensor_fault", "gyro_z")
-    wheel = EventEvidence(**{**fields, "body_share": 0.02, "wheel_null_fraction": 0.5, "wheel_max_index": 1})
+    wheel = EventEvidence(
+        **{**fields, "body_share": 0.02, "body_share_sigma": 0.006, "wheel_null_fraction": 0.5, "wheel_max_index": 1}
+    )
     assert (classify(wheel).kind, classify(wheel).channel) == ("sensor_fault", "wheel_2")
     ramp = EventEvidence(**{**fields, "body_share": 0.1, "duration_s": 300.0, "duration_lo_s": 250.0})
     assert classify(ramp).kind == "external_non_strike"

@@ -42,7 +42,7 @@ from abrupt.errors import ConfigError, InputError
 from abrupt.events import config_hash, new_run_id
 from abrupt.model.flight_config import FlightConfig
 from abrupt.model.spacecraft import Spacecraft
-from abrupt.pipelines.flight_attribution import attribute_events
+from abrupt.pipelines.flight_attribution import attribute_events, rescan_after_faults
 from abrupt.pipelines.flight_checks import (
     check_channel_units,
     check_quaternion_norm,
@@ -438,6 +438,10 @@ def process_span(
         for _, pk in peaks
         if pk.value > config.evidence_floor
     }
+    found, found_ev = rescan_after_faults(
+        table, spacecraft, h_n, hc, ok, detector, peaks, evidence, config.evidence_floor, core, inertia_kgm2
+    )
+    peaks, evidence = peaks + found, {**evidence, **found_ev}
     edges = [start_ns, end_ns]
     if split_days:
         d_first = -(-start_ns // DAY_NS) * DAY_NS

@@ -7,18 +7,30 @@ this module joins it to the events above the threshold, classifies each
 ``sensor_fault``, ``external_non_strike``, ``internal`` or ``unknown``), ``kind_confidence``,
 ``kind_channel`` (the faulty channel of a sensor fault), ``kind_reason`` and the ``ev_*`` columns.
 The event identifier includes the kind, so it is recomputed.
+
+:func:`rescan_after_faults` looks again where a sensor fault made an event: the faulty channel is
+corrected from the other sensors (:mod:`abrupt.detect.attitude.repair`), ᴺH recomputed, and the step
+statistic rescanned around the event, so that a strike within a minute of the fault (which the
+fault's event covered: peaks are one window span apart) is found and classified as its own event.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import fields, replace
 
 import numpy as np
 import pandas as pd
 
 from abrupt.detect.attitude.attribution import AttributionRules, classify
-from abrupt.detect.attitude.evidence import EventEvidence
+from abrupt.detect.attitude.evidence import EventEvidence, event_evidence
+from abrupt.detect.attitude.flight_glr import FlightGlrDetector, Peak
+from abrupt.detect.attitude.repair import repair_sensor_fault
 from abrupt.events import format_time_utc, make_event_id
+from abrupt.model.spacecraft import Spacecraft
+from abrupt.series.timetable import NS, Timetable
+from abrupt.series.timetable_momentum import timetable_momentum
+from abrupt.types import BoolArray, FloatArray
 
 ATTRIBUTION_COLUMNS = ("kind_confidence", "kind_channel", "kind_reason")
 
@@ -57,3 +69,87 @@ def attribute_events(
     ]
     out["event_id"] = out["event_id"].astype(events["event_id"].dtype)
     return out
+
+
+#: Where a second event is looked for around a sensor fault's event [s] (half a window span either side:
+#: a fault that lasts has two edges, and the event may sit on either), and how far from the fault's own
+#: step it must be [s] (nearer, the two cannot be told apart).
+RESCAN_SPAN_S = (-300.0, 300.0)
+RESCAN_APART_S = 10.0
+
+
+def _rows(table: Timetable, a: int, b: int) -> Timetable:
+    """Rows [a, b) of ``table`` (every per-sample array sliced)."""
+    per_row = {f.name for f in fields(Timetable)} - {"channel_valid", "missing_channels"}
+    sub = {k: getattr(table, k)[a:b] for k in per_row}
+    return replace(table, **sub, channel_valid={k: v[a:b] for k, v in table.channel_valid.items()})
+
+
+def rescan_after_faults(
+    table: Timetable,
+    spacecraft: Spacecraft,
+    raw_H_N: FloatArray,
+    cleaned_H_N: FloatArray,
+    ok: BoolArray,
+    detector: FlightGlrDetector,
+    peaks: list[tuple[int, Peak]],
+    evidence: Mapping[int, EventEvidence],
+    floor: float,
+    keep: BoolArray | None = None,
+    inertia_kgm2: FloatArray | None = None,
+    rules: AttributionRules | None = None,
+) -> tuple[list[tuple[int, Peak]], dict[int, EventEvidence]]:
+    """New peaks (above ``floor``) and their evidence found after repairing each sensor fault's channel.
+
+    For every peak whose evidence the rules call a ``sensor_fault`` with a channel that has a repair
+    model, the channel is corrected, ᴺH recomputed (the cleaning's slow model is kept: cleaned ᴺH moves
+    by exactly what the raw ᴺH moved), and the statistic recomputed around the peak; its strongest
+    peak from ``RESCAN_SPAN_S`` around the fault's step and at least ``RESCAN_APART_S`` from it becomes
+    a new peak, with evidence from the repaired telemetry.
+    """
+    g = table.time_ns
+    dt = table.dt_s
+    win = detector.windows(dt)
+    found: list[tuple[int, Peak]] = []
+    found_ev: dict[int, EventEvidence] = {}
+    half_s = RESCAN_SPAN_S[1] + win.span * dt
+    for _, pk in peaks:
+        ev = evidence.get(pk.time_ns)
+        if ev is None:
+            continue
+        a_ = classify(ev, rules)
+        if a_.kind != "sensor_fault" or not a_.channel:
+            continue
+        i0 = int(np.clip(np.searchsorted(g, pk.time_ns), 0, g.size - 1))
+        rep = repair_sensor_fault(table, spacecraft, i0, a_.channel, a_.reason, half_s)
+        if rep is None:
+            continue
+        a, b = max(0, i0 - round((half_s + 240.0) / dt)), min(g.size, i0 + round((half_s + 240.0) / dt))
+        h_new, _ = timetable_momentum(spacecraft, _rows(rep.table, a, b), inertia_kgm2)
+        hc_sub = np.where(ok[a:b, None], cleaned_H_N[a:b] + (h_new - raw_H_N[a:b]), np.nan)
+        stat = detector.statistic(hc_sub, ok[a:b], win)
+        tau = (g[a:b] - pk.time_ns) / NS
+        look = (tau >= RESCAN_SPAN_S[0]) & (tau <= RESCAN_SPAN_S[1]) & (np.abs(tau) > RESCAN_APART_S)
+        if keep is not None:
+            look &= keep[a:b]
+        stat = np.where(look, stat, np.nan)
+        cands = [
+            (j, p)
+            for j, p in detector.find_peaks(hc_sub, ok[a:b], stat, g[a:b], dt, win)
+            if p.value > floor
+            and RESCAN_APART_S < abs(dt_s := (p.time_ns - pk.time_ns) / NS)
+            and RESCAN_SPAN_S[0] <= dt_s <= RESCAN_SPAN_S[1]
+        ]
+        if not cands:
+            continue
+        j, p = max(cands, key=lambda c: c[1].value)
+        hc_full = cleaned_H_N.copy()
+        hc_full[a:b] = hc_sub
+        raw_full = raw_H_N.copy()
+        raw_full[a:b] = h_new
+        found.append((a + j, p))
+        ev_new = event_evidence(
+            rep.table, hc_full, spacecraft, p.time_ns, p.dH_N_Nms, inertia_kgm2=inertia_kgm2, raw_H_N=raw_full
+        )
+        found_ev[p.time_ns] = replace(ev_new, after_fault_s=(p.time_ns - pk.time_ns) / NS)
+    return found, found_ev

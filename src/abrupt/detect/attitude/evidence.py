@@ -12,8 +12,8 @@ telemetry (:class:`~abrupt.series.timetable.Timetable`) around the event:
   by a line before and after the event; a lasting jump in e means one of the two attitude sensors
   jumped, a change of slope that the gyro's bias stepped. Real motion leaves e untouched, apart from a
   transient of the order of the timing error times the rate change, which the test allows for;
-* **gyro spike** (``gyro_spike_rad``): the largest isolated gyro excursion near the event (against a
-  5-sample running median), integrated over its samples;
+* **gyro spike** (``gyro_spike_rad``): the largest gyro excursion near the event that the star tracker
+  did not see (:func:`gyro_excursions`), integrated over its samples;
 * **closed-loop response**: ``body_share`` the peak of J Δω along ΔH_B in the first 20 s over |ΔH|
   (1 for an impulse, near 0 for a slow torque the loop keeps up with, 0 for a wheel-reading fault);
   ``wheel_null_fraction`` the part of the wheel-speed change in the null space of J_s G (a
@@ -33,7 +33,10 @@ telemetry (:class:`~abrupt.series.timetable.Timetable`) around the event:
 * **surfaces** (``surface_fraction``, ``min_dv_mps``): when the spacecraft file has surfaces, the
   fraction of surface sample points r with r ⊥ ΔH_B (within the direction's uncertainty) from which an
   incoming momentum p, |p| = |ΔH|/|r|, can give ΔH = r × p, and the smallest ΔV a strike giving ΔH
-  must cause (|ΔH| / (m r_max)).
+  must cause (|ΔH| / (m r_max));
+* **after a fault** (``after_fault_s``): for an event found only once a sensor fault's channel was
+  repaired (:func:`abrupt.pipelines.flight_attribution.rescan_after_faults`), its time after the
+  fault's event [s] (NaN for every other event); the evidence is then that of the repaired telemetry.
 """
 
 from __future__ import annotations
@@ -90,12 +93,13 @@ class EventEvidence:
     appendage_index: int = -1
     surface_fraction: float = NAN
     min_dv_mps: float = NAN
+    after_fault_s: float = NAN
 
     def as_dict(self) -> dict[str, float]:
         return {f"ev_{k}": float(v) for k, v in asdict(self).items()}
 
 
-def _hamilton(p: FloatArray, q: FloatArray) -> FloatArray:
+def hamilton_product(p: FloatArray, q: FloatArray) -> FloatArray:
     """Hamilton product p ⊗ q, scalar first (the convention of q_BN in the flight archives)."""
     p0, p1, p2, p3 = np.moveaxis(p, -1, 0)
     q0, q1, q2, q3 = np.moveaxis(q, -1, 0)
@@ -122,9 +126,9 @@ def st_gyro_mismatch(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> FloatA
     qg = np.empty((n, 4))
     qg[0] = q_BN[0] / np.linalg.norm(q_BN[0])
     for k in range(n - 1):
-        qg[k + 1] = _hamilton(qg[k], dq[k])
+        qg[k + 1] = hamilton_product(qg[k], dq[k])
     conj = qg * np.array([1.0, -1.0, -1.0, -1.0])
-    d = _hamilton(conj, q_BN / np.linalg.norm(q_BN, axis=1, keepdims=True))
+    d = hamilton_product(conj, q_BN / np.linalg.norm(q_BN, axis=1, keepdims=True))
     d *= np.where(d[:, :1] < 0, -1.0, 1.0)
     return np.asarray(2.0 * d[:, 1:], dtype=np.float64)
 
@@ -141,7 +145,7 @@ def st_gyro_rate_mismatch(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> F
     """
     qn = q_BN / np.linalg.norm(q_BN, axis=1, keepdims=True)
     conj = qn[:-1] * np.array([1.0, -1.0, -1.0, -1.0])
-    d = _hamilton(conj, qn[1:])
+    d = hamilton_product(conj, qn[1:])
     d *= np.where(d[:, :1] < 0, -1.0, 1.0)
     w_st = 2.0 * d[:, 1:] / dt
     w_gy = 0.5 * (omega_B[1:] + omega_B[:-1])
@@ -159,7 +163,7 @@ def _line(tau: FloatArray, y: FloatArray) -> tuple[FloatArray, FloatArray, Float
     return coef[0], coef[1], np.sqrt(np.sum(res**2, axis=0) / dof)
 
 
-def _noise_of(y: FloatArray) -> float:
+def white_noise_sigma(y: FloatArray) -> float:
     """Robust white-noise σ from first differences (MAD / 0.6745 / √2)."""
     d = np.diff(y[np.isfinite(y)])
     if d.size < 4:
@@ -273,7 +277,7 @@ def event_evidence(
             p_st = np.convolve((w_st @ J.T) @ u_b, np.ones(3) / 3.0, mode="same")
             share = min(share, float(np.max(p_st) / mag))
         out["body_share"] = share
-        out["body_share_sigma"] = _noise_of((omega[pre] @ J.T) @ u_b) / math.sqrt(3.0) / mag
+        out["body_share_sigma"] = white_noise_sigma((omega[pre] @ J.T) @ u_b) / math.sqrt(3.0) / mag
         # Real motion lasts the loop's settling time; a running median keeps it and drops a sensor spike.
         peak_rate = float(np.max(np.linalg.norm(median_filter(d_om, size=(5, 1), mode="nearest"), axis=1)))
     wheels = _wheel_evidence(table, spacecraft, i0, dt, w)
@@ -287,7 +291,7 @@ def event_evidence(
     out.update(cons)
     if step_vec is not None and slope_vec is not None and mag > 0:
         out.update(_sensor_residuals(q[i0], bn0, J, dh_n, step_vec, slope_vec, raw_H_N, pre))
-    out.update(_gyro_spike(omega, valid, i0, dt))
+    out.update(_gyro_spike(q, omega, valid, i0, dt))
     out.update(_profile(g, cleaned_H_N, dh_n, i0, dt, w))
     out.update(_appendage(table, i0, dt))
     out.update(surface_evidence(spacecraft, dh_b))
@@ -311,7 +315,7 @@ def _st_rate(q: FloatArray, base: np.ndarray, resp: np.ndarray) -> FloatArray | 
     def rate(ix: np.ndarray) -> FloatArray:
         a = q[ix] / np.linalg.norm(q[ix], axis=1, keepdims=True)
         b = q[ix + 1] / np.linalg.norm(q[ix + 1], axis=1, keepdims=True)
-        d = _hamilton(a * np.array([1.0, -1.0, -1.0, -1.0]), b)
+        d = hamilton_product(a * np.array([1.0, -1.0, -1.0, -1.0]), b)
         d *= np.where(d[:, :1] < 0, -1.0, 1.0)
         return np.asarray(2.0 * d[:, 1:], dtype=np.float64)
 
@@ -351,13 +355,14 @@ def _wheel_evidence(table: Timetable, sc: Spacecraft, i0: int, dt: float, w: Evi
     js = sc.wheel_spin_inertias_kgm2
     js_g = sc.wheel_axes * js[None, :]
     h = js * d
-    sig = np.array([_noise_of(om[before, k]) for k in range(om.shape[1])]) * js * 1.25 * math.sqrt(2.0 / before.size)
+    noise = np.array([white_noise_sigma(om[before, k]) for k in range(om.shape[1])])
+    sig = noise * js * 1.25 * math.sqrt(2.0 / before.size)
     null = d - np.linalg.pinv(js_g) @ (js_g @ d)
     # An isolated excursion of one wheel's reading (a tachometer miscount) against a 5-sample median.
     near = _idx(g, i0, -30.0, 30.0, dt)
     seg = om[near]
     z_w = np.abs(seg - median_filter(seg, size=(5, 1), mode="nearest")) / np.maximum(
-        [_noise_of(om[before, k]) for k in range(om.shape[1])], 1e-9
+        [white_noise_sigma(om[before, k]) for k in range(om.shape[1])], 1e-9
     )
     kz = int(np.argmax(np.max(z_w, axis=0)))
     norm_d = float(np.linalg.norm(d))
@@ -402,7 +407,7 @@ def _sensor_residuals(
         theta = -np.asarray(step_vec, dtype=np.float64)
         ang = float(np.linalg.norm(theta))
         dq = np.concatenate([[math.cos(ang / 2)], (theta / ang if ang > 0 else theta) * math.sin(ang / 2)])
-        q1 = _hamilton(q0 / np.linalg.norm(q0), dq)
+        q1 = hamilton_product(q0 / np.linalg.norm(q0), dq)
         pred = (np.asarray(dcm_from_quaternion(q1)).T - bn0.T) @ h_b
         out["st_jump_residual"] = float(np.linalg.norm(dh_n - pred) / mag)
     return out
@@ -451,20 +456,47 @@ def _consistency(
     )
 
 
-def _gyro_spike(omega: FloatArray, valid: np.ndarray, i0: int, dt: float) -> dict[str, float]:
+def gyro_excursions(
+    q_BN: FloatArray, omega_B: FloatArray, dt: float, sigma: float = 5.0
+) -> tuple[FloatArray, np.ndarray]:
+    """The gyro's departure from the star tracker's rate, per sample and axis, and where it is a gyro fault.
+
+    The tracker's rate at sample k is the centred difference of its attitudes (the mean of the rates
+    2 vec(q⁻¹ ⊗ q') / dt of the intervals either side). A sample is the gyro's own excursion where the
+    gyro departs both from the tracker (beyond ``sigma`` of that difference's robust noise) and from its
+    own 11-sample running median (beyond ``sigma`` of its noise): real motion moves both sensors, a
+    tracker jump leaves the gyro on its median, a gyro spike of up to five samples does neither.
+    Returns (departure minus its median (n, 3) [rad/s], mask (n, 3)).
+    """
+    n = q_BN.shape[0]
+    qn = q_BN / np.linalg.norm(q_BN, axis=1, keepdims=True)
+    d = hamilton_product(qn[:-1] * np.array([1.0, -1.0, -1.0, -1.0]), qn[1:])
+    d *= np.where(d[:, :1] < 0, -1.0, 1.0)
+    w_st = 2.0 * d[:, 1:] / dt
+    ref = np.empty((n, 3))
+    ref[1:-1] = 0.5 * (w_st[:-1] + w_st[1:])
+    ref[0], ref[-1] = w_st[0], w_st[-1]
+    err = omega_B - ref
+    err = err - np.median(err, axis=0)
+    sig_ref = np.median(np.abs(err), axis=0) / 0.6745
+    r = omega_B - median_filter(omega_B, size=(11, 1), mode="nearest")
+    sig_g = np.array([white_noise_sigma(omega_B[:, k]) for k in range(3)])
+    mask = (np.abs(err) > sigma * np.maximum(sig_ref, 1e-15)) & (np.abs(r) > sigma * np.maximum(sig_g, 1e-15))
+    return np.asarray(err, dtype=np.float64), mask
+
+
+def _gyro_spike(q: FloatArray, omega: FloatArray, valid: np.ndarray, i0: int, dt: float) -> dict[str, float]:
+    """The largest gyro excursion the star tracker did not see within ±30 s: its integral, z and axis."""
     lo, hi = max(0, i0 - int(60 / dt)), min(omega.shape[0], i0 + int(60 / dt))
-    seg = omega[lo:hi]
     if hi - lo < 20 or not valid[lo:hi].all():
         return {}
-    med = median_filter(seg, size=(5, 1), mode="nearest")
-    r = seg - med
-    sig = np.array([_noise_of(seg[:, k]) for k in range(3)])
-    near = slice(max(0, i0 - lo - int(30 / dt)), min(seg.shape[0], i0 - lo + int(30 / dt)))
-    z = np.abs(r[near]) / np.maximum(sig, 1e-12)
+    err, mask = gyro_excursions(q[lo:hi], omega[lo:hi], dt)
+    sig = np.median(np.abs(err), axis=0) / 0.6745
+    near = slice(max(0, i0 - lo - int(30 / dt)), min(hi - lo, i0 - lo + int(30 / dt)))
+    z = np.where(mask[near], np.abs(err[near]) / np.maximum(sig, 1e-15), 0.0)
     j, k = np.unravel_index(int(np.argmax(z)), z.shape)
-    big = np.abs(r[near, k]) > 5.0 * sig[k]
     return {
-        "gyro_spike_rad": float(np.sum(r[near, k][big]) * dt),
+        "gyro_spike_rad": float(np.sum(err[near, k][mask[near, k]]) * dt),
         "gyro_spike_z": float(z[j, k]),
         "gyro_spike_axis": int(k),
     }
@@ -481,7 +513,7 @@ def _profile(
     out: dict[str, float] = {}
     span = _idx(g, i0, -w.profile_s, w.profile_s, dt)
     ys = y[span]
-    sigma = _noise_of(ys)
+    sigma = white_noise_sigma(ys)
     d, lo, hi, onset = ramp_duration((g[span] - g[i0]) / NS, ys, sigma)
     out.update({"duration_s": d, "duration_lo_s": lo, "duration_hi_s": hi})
     # The lasting step: before the event (or the fitted onset) against after it (or the fitted ramp's end).
@@ -507,7 +539,7 @@ def _appendage(table: Timetable, i0: int, dt: float) -> dict[str, float]:
         if seg.size < 60 or not np.isfinite(seg).all():
             continue
         excess = seg - median_filter(seg, size=int(61 / dt) | 1, mode="nearest")
-        sig = _noise_of(seg)
+        sig = white_noise_sigma(seg)
         near = slice(max(0, i0 - lo - int(15 / dt)), min(seg.size, i0 - lo + int(25 / dt)))
         z = float(np.max(np.abs(excess[near])) / max(sig, 1e-9))
         if not best or z > best["appendage_z"]:
