@@ -23,11 +23,11 @@ import re
 import shlex
 from pathlib import Path
 
-import doc_inputs as di
 import pytest
 
+import doc_inputs as di
 from abrupt.cli.main import main
-from test_doc_commands import _doc_commands
+from test_doc_commands import FENCE, _doc_commands
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -101,7 +101,10 @@ SHRINK: list[tuple[str, str]] = [
 ]
 
 #: Optional parts kept (the stand-in of their file is made): by document, the option's text.
-KEEP_OPTIONAL: dict[str, tuple[str, ...]] = {"tracking.md": ("[--sinex ilrs.snx]",)}
+KEEP_OPTIONAL: dict[str, tuple[str, ...]] = {
+    "tracking.md": ("[--sinex ilrs.snx]",),  # the simulated stations are not the ILRS ones
+    "flux-inference.md": ("[--surfaces sc_surfaces.toml]",),  # kestrel.toml has no geometry; the flux needs it
+}
 
 #: Lines not run, by document and a fragment of the line, with the reason. Keep it short.
 NOT_RUN: dict[tuple[str, str], str] = {
@@ -112,6 +115,10 @@ NOT_RUN: dict[tuple[str, str], str] = {
     "normal points at hand; `detect laser` runs simulated ones (tracking.md)",
     ("scale.md", "resumed"): "the resumption of the run killed in the line above (tests/test_fleet_scale.py kills one)",
 }
+
+#: Documents whose fenced blocks are separate runs (each block in a folder of its own): a second block
+#: repeats the first on real data under the same output names.
+BLOCKS_APART = {"flux-inference.md"}
 
 #: Documents run in the default suite (cheap commands); the others are marked slow.
 FAST_DOCS = {"attitude-detection.md", "tle.md", "catalog.md", "rates.md"}
@@ -162,33 +169,59 @@ def _docs() -> list[object]:
     ]
 
 
+def _blocks(doc: str, lines: list[str]) -> list[list[str]]:
+    """The lines grouped by the fenced block they stand in (lines in document order)."""
+    text = (ROOT / doc if doc == "README.md" else ROOT / "docs" / doc).read_text()
+    bodies = [re.sub(r"\\\n\s*", " ", body) for _, body in FENCE.findall(text)]
+    groups: dict[int, list[str]] = {}
+    k = 0
+    for line in lines:
+        while k < len(bodies) - 1 and line not in bodies[k]:
+            k += 1
+        groups.setdefault(k, []).append(line)
+    return list(groups.values())
+
+
+def _make_inputs(doc: str, lines: list[str], folder: Path, shared: Path) -> None:
+    """The stand-ins of the inputs the lines name, made in ``folder``."""
+    (folder / "examples").symlink_to(ROOT / "examples")
+    named = [" ".join(_words(doc).get(word, word) for word in line.split()) for line in lines]
+    for name, make in {**INPUTS, **DOC_INPUTS.get(doc, {})}.items():
+        if _named(name, named):
+            make(shared, folder / name)
+            print(f"{doc}: input {name}: {(make.__doc__ or '').strip().splitlines()[0]}")
+
+
+def _run_line(doc: str, line: str) -> bool:
+    """Run one documented line (False: not run, with its printed reason); fails the test on an error."""
+    reason = _reason(doc, line)
+    if reason is not None:
+        print(f"{doc}: not run: `{line}`: {reason}")
+        return False
+    args = _runnable(doc, line)
+    if args != shlex.split(line.split(" #")[0])[1:]:
+        print(f"{doc}: `{line}` ran as `abrupt {shlex.join(args)}`")
+    try:
+        main(["-q", *args])
+    except SystemExit as exc:
+        if exc.code not in (0, None):
+            pytest.fail(f"{doc}: `{line}` (ran as `abrupt {shlex.join(args)}`) exited with status {exc.code}")
+    return True
+
+
 @pytest.mark.parametrize(("doc", "lines"), _docs())
 def test_every_command_of_the_doc_runs(
     doc: str, lines: list[str], shared_data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Run with ``-s`` to see the stand-ins made and each command as it ran where it differs."""
-    (tmp_path / "examples").symlink_to(ROOT / "examples")
-    monkeypatch.chdir(tmp_path)
-    named = [" ".join(_words(doc).get(word, word) for word in line.split()) for line in lines]
-    for name, make in {**INPUTS, **DOC_INPUTS.get(doc, {})}.items():
-        if _named(name, named):
-            make(shared_data, tmp_path / name)
-            print(f"{doc}: input {name}: {(make.__doc__ or '').strip().splitlines()[0]}")
+    groups = _blocks(doc, lines) if doc in BLOCKS_APART else [lines]
     ran = 0
-    for line in lines:
-        reason = _reason(doc, line)
-        if reason is not None:
-            print(f"{doc}: not run: `{line}`: {reason}")
-            continue
-        args = _runnable(doc, line)
-        if args != shlex.split(line.split(" #")[0])[1:]:
-            print(f"{doc}: `{line}` ran as `abrupt {shlex.join(args)}`")
-        try:
-            main(["-q", *args])
-        except SystemExit as exc:
-            if exc.code not in (0, None):
-                pytest.fail(f"{doc}: `{line}` (ran as `abrupt {shlex.join(args)}`) exited with status {exc.code}")
-        ran += 1
+    for k, group in enumerate(groups):
+        folder = tmp_path / f"block{k}"
+        folder.mkdir()
+        monkeypatch.chdir(folder)
+        _make_inputs(doc, group, folder, shared_data)
+        ran += sum(_run_line(doc, line) for line in group)
     assert ran > 0, doc
 
 
