@@ -110,6 +110,11 @@ def archive_hours(hours: int = ARCHIVE_HOURS) -> Maker:
     return make
 
 
+def folder(shared: Path, target: Path) -> None:
+    """an empty folder (one the user made for the output)"""
+    target.mkdir()
+
+
 def store(shared: Path, target: Path) -> None:
     """an ingest store (pseudonym SC-A) of the flight-like archive's first hours"""
     archive = target.parent / f"_{target.name}_archive" / "KESTREL2_2026-03-10.csv.gz"

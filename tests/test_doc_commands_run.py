@@ -1,19 +1,25 @@
 """Every shell command shown in README.md and docs/*.md is EXECUTED, in the order of its document, in a
-fresh folder per document: a non-zero exit (an unknown option, a missing file, a failure) fails the test
-and names the document and the line. ``tests/test_doc_commands.py`` parses the same lines (and the
-inline ones) against the command tree; this file runs them.
+fresh folder per document (per fenced block where the blocks are separate runs, :data:`BLOCKS_APART`):
+a non-zero exit (an unknown option, a missing file, a failure) fails the test and names the document,
+the line and the command as it ran. ``tests/test_doc_commands.py`` parses the same lines (and the inline
+ones) against the command tree; this file runs them.
 
-Inputs. A doc names its input files as a user has them (``Sentinel-3A.tle``, ``ssas3a20...sp3``). They
-are put into the folder under the same name, made SMALL so the suite stays quick (:data:`INPUTS`, the
-documented mapping): TLE histories cut to two years, the Sentinel-3A SP3 arc cut to its first 240 epochs
-(header count rewritten, so the file is whole), the flight-like archive cut to its first hours, and the
-bundled example spacecraft in ``examples/``. Sizes of studies are reduced where a doc asks for a long
-one (:data:`SHRINK`). Optional parts written ``[--option VALUE]`` are left out (the required form runs).
+Inputs. A doc names its input files as a user has them (``Sentinel-3A.tle``, ``ssas3a20...sp3``,
+``STORE``, ``fleet.csv``). They are put into the folder under the same name, made SMALL so the suite
+stays quick (:data:`INPUTS`, :data:`DOC_INPUTS`; the makers live in ``tests/doc_inputs.py``, each says
+what it makes): slices of ../shared/data (TLE histories cut to two years, SP3 arcs cut to 4-8 hours with
+their header rewritten, the flight-like archive cut to its first hours or, where a doc watches days,
+both days), the bundled example spacecraft, and abrupt's own simulators or the suite's synthetic writers
+where the shared set has no such file (an ISS-like OEM, a meteor radar file, a CubeSat constellation,
+a day of laser normal points with its a-priori orbit and stations, ORDEM-layout tables). Placeholders
+for a list of files (``ARCHIVE...``) are replaced (:data:`WORDS`), study sizes reduced (:data:`SHRINK`),
+and optional parts written ``[--option VALUE]`` left out unless the stand-in needs one
+(:data:`KEEP_OPTIONAL`). ``pytest -s`` prints every stand-in and every command that ran changed.
 
-Not run, each with its reason (:data:`NOT_RUN`): lines that need a server (PostgreSQL, Dask scheduler),
-files that are not distributable or not at hand (ORDEM output, a meteor radar file, NASA's ISS OEM), or
-a placeholder the doc explains (``ARCHIVE...``) when no data of that kind is in the shared set; and lines
-that show a killed run. Whole documents whose commands take minutes are marked ``slow``.
+Not run, each with its reason (:data:`NOT_RUN`, checked against the docs so it cannot go stale): lines
+that need a server (PostgreSQL, a Dask scheduler), the resumption of a killed run, and an Orekit set-up
+for laser normal points. Documents with cheap commands run in the default suite (:data:`FAST_DOCS`);
+the others are marked ``slow``.
 """
 
 from __future__ import annotations
@@ -55,6 +61,7 @@ INPUTS: dict[str, di.Maker] = {
 #: Inputs of one document only (the same name means another thing elsewhere, or costs time to make).
 DOC_INPUTS: dict[str, dict[str, di.Maker]] = {
     "catalog.md": {
+        "runs": di.folder,
         "sc.toml": di.example("thesis.toml"),
         "tel.parquet": di.telemetry,
         "s3a.tle": INPUTS["Sentinel-3A.tle"],
@@ -109,7 +116,6 @@ KEEP_OPTIONAL: dict[str, tuple[str, ...]] = {
 #: Lines not run, by document and a fragment of the line, with the reason. Keep it short.
 NOT_RUN: dict[tuple[str, str], str] = {
     ("catalog.md", "postgresql://"): "needs a PostgreSQL server (tests/test_catalog_service.py starts one)",
-    ("catalog.md", "--catalog runs/cat.sqlite"): "the doc shows the error of a missing folder",
     ("scale.md", "tcp://host:8786"): "needs a Dask scheduler (tests/test_fleet_scale.py runs a local cluster)",
     ("formats.md", "passes.npt.gz --setup stations.in"): "no Orekit set-up (a-priori orbit, stations) for laser "
     "normal points at hand; `detect laser` runs simulated ones (tracking.md)",
@@ -231,6 +237,6 @@ def test_the_not_run_list_names_lines_that_exist() -> None:
     for doc, fragment in NOT_RUN:
         assert any(d == doc and fragment in line for d, line in lines), (doc, fragment)
     for doc, names in DOC_INPUTS.items():
-        doc_lines = [line for d, line in lines if d == doc]
+        doc_lines = [" ".join(_words(doc).get(w, w) for w in line.split()) for d, line in lines if d == doc]
         for name in names:
             assert _named(name, doc_lines), (doc, name)
