@@ -127,7 +127,9 @@ NOT_RUN: dict[tuple[str, str], str] = {
 BLOCKS_APART = {"flux-inference.md"}
 
 #: Documents run in the default suite (cheap commands); the others are marked slow.
-FAST_DOCS = {"attitude-detection.md", "tle.md", "catalog.md", "rates.md"}
+FAST_DOCS = {"attitude-detection.md", "catalog.md", "density.md", "rates.md", "tle.md", "tracking.md"}
+#: Lines of a fast document that run in the slow tier only (by a fragment of the line).
+SLOW_LINES: dict[str, tuple[str, ...]] = {"tracking.md": ("detect laser",)}  # a simulated day of ranges, fitted
 
 
 def _reason(doc: str, line: str) -> str | None:
@@ -164,15 +166,27 @@ def _named(name: str, lines: list[str]) -> bool:
     return any(pattern.search(line) for line in lines)
 
 
+def _slow_line(doc: str, line: str) -> bool:
+    return any(fragment in line for fragment in SLOW_LINES.get(doc, ()))
+
+
 def _docs() -> list[object]:
+    """A document of cheap commands runs by default (without its :data:`SLOW_LINES`, which run with the
+    whole document in the slow tier); the others are slow."""
     by_doc: dict[str, list[str]] = {}
     for doc, line, fenced in _doc_commands():
         if fenced:
             by_doc.setdefault(doc, []).append(line)
-    return [
-        pytest.param(doc, lines, id=doc, marks=() if doc in FAST_DOCS else pytest.mark.slow)
-        for doc, lines in sorted(by_doc.items())
-    ]
+    params = []
+    for doc, lines in sorted(by_doc.items()):
+        cheap = [line for line in lines if not _slow_line(doc, line)]
+        if doc in FAST_DOCS:
+            params.append(pytest.param(doc, cheap, id=doc))
+        if doc not in FAST_DOCS or len(cheap) < len(lines):
+            params.append(
+                pytest.param(doc, lines, id=f"{doc}-all" if doc in FAST_DOCS else doc, marks=pytest.mark.slow)
+            )
+    return params
 
 
 def _blocks(doc: str, lines: list[str]) -> list[list[str]]:
