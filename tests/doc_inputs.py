@@ -11,6 +11,7 @@ a-priori orbit). Every maker says in its first docstring line what it makes; the
 from __future__ import annotations
 
 import contextlib
+import functools
 import gzip
 import io
 import shutil
@@ -18,6 +19,7 @@ from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from abrupt.cli.main import main
@@ -253,17 +255,24 @@ def ordem_igloo(shared: Path, target: Path) -> None:
     target.write_text(ORDEM_IGLOO)
 
 
+@functools.cache
+def _slr_simulation() -> object:
+    """One simulated day of LAGEOS-1 laser ranging for the session (it takes half a minute of CPU)."""
+    from abrupt.simulate.slr import SlrScenario, simulate_slr
+
+    return simulate_slr(SlrScenario(duration_days=1.0, noise_m=0.003), seed=21)
+
+
 def _slr_campaign(folder: Path) -> dict[str, Path]:
     """Simulated LAGEOS-1 normal points of one day (CRD), the stations (SINEX) and an a-priori orbit."""
-    from abrupt.simulate.slr import SlrScenario, simulate_slr
     from test_laser_ranging_cli import write_apriori, write_crd, write_sinex
 
     paths = {"crd": folder / "lageos1.npt", "apriori": folder / "lageos1.cpf", "sinex": folder / "ilrs.snx"}
     if not paths["crd"].exists():
-        sim = simulate_slr(SlrScenario(duration_days=1.0, noise_m=0.003), seed=21)
-        write_crd(sim, paths["crd"])
-        write_apriori(sim, paths["apriori"])
-        write_sinex(sim, paths["sinex"])
+        sim = _slr_simulation()
+        write_crd(sim, paths["crd"])  # type: ignore[arg-type]
+        write_apriori(sim, paths["apriori"])  # type: ignore[arg-type]
+        write_sinex(sim, paths["sinex"])  # type: ignore[arg-type]
     return paths
 
 
@@ -278,3 +287,33 @@ def slr(kind: str) -> Maker:
         "sinex": "the simulated stations' positions and velocities (SINEX)",
     }[kind]
     return make
+
+
+def crd_gz(shared: Path, target: Path) -> None:
+    """the simulated day of LAGEOS-1 normal points (CRD v2), gzipped"""
+    from test_laser_ranging_cli import write_crd
+
+    plain = target.parent / "_passes.npt"
+    write_crd(_slr_simulation(), plain)  # type: ignore[arg-type]
+    target.write_bytes(gzip.compress(plain.read_bytes()))
+
+
+def slr_setup(shared: Path, target: Path) -> None:
+    """an Orekit set-up for those normal points: the simulation's initial state and its four stations"""
+    from abrupt.simulate.slr import DEFAULT_SITES
+
+    sim = _slr_simulation()
+    lines = [f"orbit.date = {np.datetime_as_string(sim.epoch_utc, unit='ms')}", "inertial.frame = EME2000"]  # type: ignore[attr-defined]
+    for key, value in zip(("px", "py", "pz", "vx", "vy", "vz"), sim.x0, strict=True):  # type: ignore[attr-defined]
+        lines.append(f"orbit.cartesian.{key} = {value:.3f}")
+    lines += ["central.body.degree = 20", "central.body.order = 20", "third.body.sun = true", "third.body.moon = true"]
+    for k, (name, lat, lon, height, _, _) in enumerate(DEFAULT_SITES):
+        lines += [
+            f"ground.station.name [{k}] = {name}",
+            f"ground.station.latitude [{k}] = {lat}",
+            f"ground.station.longitude [{k}] = {lon}",
+            f"ground.station.altitude [{k}] = {height}",
+            f"ground.station.range.sigma [{k}] = 1.0",
+            f"ground.station.range.tropospheric.correction [{k}] = true",
+        ]
+    target.write_text("\n".join(lines) + "\n")

@@ -11,15 +11,15 @@ what it makes): slices of ../shared/data (TLE histories cut to two years, SP3 ar
 their header rewritten, the flight-like archive cut to its first hours or, where a doc watches days,
 both days), the bundled example spacecraft, and abrupt's own simulators or the suite's synthetic writers
 where the shared set has no such file (an ISS-like OEM, a meteor radar file, a CubeSat constellation,
-a day of laser normal points with its a-priori orbit and stations, ORDEM-layout tables). Placeholders
+a day of laser normal points with its a-priori orbit, stations and Orekit set-up, ORDEM-layout tables). Placeholders
 for a list of files (``ARCHIVE...``) are replaced (:data:`WORDS`), study sizes reduced (:data:`SHRINK`),
 and optional parts written ``[--option VALUE]`` left out unless the stand-in needs one
 (:data:`KEEP_OPTIONAL`). ``pytest -s`` prints every stand-in and every command that ran changed.
 
 Not run, each with its reason (:data:`NOT_RUN`, checked against the docs so it cannot go stale): lines
-that need a server (PostgreSQL, a Dask scheduler), the resumption of a killed run, and an Orekit set-up
-for laser normal points. Documents with cheap commands run in the default suite (:data:`FAST_DOCS`);
-the others are marked ``slow``.
+that need a server (PostgreSQL, a Dask scheduler) and the resumption of a killed run. Documents with
+cheap commands run in the default suite (:data:`FAST_DOCS`, less their :data:`SLOW_LINES`); the others,
+and those lines, are marked ``slow``.
 """
 
 from __future__ import annotations
@@ -81,7 +81,12 @@ DOC_INPUTS: dict[str, dict[str, di.Maker]] = {
         "sc_surfaces.toml": di.example("kestrel_surfaces.toml"),
     },
     "orbit.md": {"quiet.csv": di.quiet_navigation, "iss.oem": di.iss_like_oem},
-    "formats.md": {"ISS.OEM_J2K_EPH.xml": di.iss_like_oem_xml, "nsgf.orb.lageos2.sp3.gz": di.lageos_sp3_gz},
+    "formats.md": {
+        "passes.npt.gz": di.crd_gz,
+        "stations.in": di.slr_setup,
+        "ISS.OEM_J2K_EPH.xml": di.iss_like_oem_xml,
+        "nsgf.orb.lageos2.sp3.gz": di.lageos_sp3_gz,
+    },
     "density.md": {"cubesats": di.cubesat_folder, "platforms.csv": di.platforms, "radar.csv": di.radar},
     "tle.md": {"catalogue_extract.3le": di.three_line_extract},
     "scale.md": {"fleet.csv": di.fleet_manifest, "tle": di.tle_folder, "catalogue.txt": di.catalogue_list},
@@ -117,8 +122,6 @@ KEEP_OPTIONAL: dict[str, tuple[str, ...]] = {
 NOT_RUN: dict[tuple[str, str], str] = {
     ("catalog.md", "postgresql://"): "needs a PostgreSQL server (tests/test_catalog_service.py starts one)",
     ("scale.md", "tcp://host:8786"): "needs a Dask scheduler (tests/test_fleet_scale.py runs a local cluster)",
-    ("formats.md", "passes.npt.gz --setup stations.in"): "no Orekit set-up (a-priori orbit, stations) for laser "
-    "normal points at hand; `detect laser` runs simulated ones (tracking.md)",
     ("scale.md", "resumed"): "the resumption of the run killed in the line above (tests/test_fleet_scale.py kills one)",
 }
 
