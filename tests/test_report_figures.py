@@ -153,3 +153,76 @@ def test_tle_report_panels_have_units_and_data(
     report.plot_tle_report(sat.history, sat.events, tmp_path / "t.png")
     (fig,) = figures
     assert_readable(fig)
+
+
+def test_density_report_panels_have_units_data_and_legends_outside(
+    shared_data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The figure of `abrupt density tle ... --report` on a year of CryoSat-2 element sets."""
+    from abrupt.cli.main import main
+    from abrupt.report import density as report
+
+    lines = (shared_data / "tle" / "CryoSat-2.tle").read_text().splitlines(keepends=True)
+    pairs = zip(lines[0::2], lines[1::2], strict=True)
+    tle = tmp_path / "cs2.tle"
+    tle.write_text("".join(a + b for a, b in pairs if a[18:20] == "15"))
+    figures = _capture(monkeypatch, report)
+    args = ["density", "tle", str(tle), "--out", str(tmp_path / "w.csv"), "--interval-days", "30"]
+    try:
+        main(["-q", *args, "--report", str(tmp_path / "cs2.png")])
+    except SystemExit as exc:
+        assert exc.code in (0, None), exc
+    (fig,) = figures
+    assert_readable(fig)
+    windows = pd.read_csv(tmp_path / "w.csv")
+    (ax,) = fig.axes  # CryoSat-2 stays in one 50 km band (about 720 km)
+    assert ax.get_title() == "700-750 km"
+    assert ax.get_xlabel() == "window start (UTC)"
+    model = next(line for line in ax.lines if line.get_label().startswith("NRLMSIS"))
+    ok = windows[windows["status"] == "ok"]
+    np.testing.assert_allclose(np.sort(model.get_ydata()), np.sort(ok["model_density_kg_m3"].to_numpy()))
+    legend = ax.get_legend()
+    assert legend.get_bbox_to_anchor().x0 >= ax.get_window_extent().x1 - 1.0
+
+
+def test_density_report_draws_no_panel_for_a_band_without_an_estimate(monkeypatch: pytest.MonkeyPatch) -> None:
+    from abrupt.report import density as report
+
+    t = pd.date_range("2020-01-01", periods=6, freq="30D")
+    rows = []
+    for altitude, sign in ((420.0, 1.0), (530.0, -1.0), (780.0, 1.0)):  # the 500-550 km band: no positive estimate
+        for k, start in enumerate(t):
+            rho = 1e-12 * np.exp(-(altitude - 400.0) / 60.0) * (1 + 0.1 * k)
+            rows.append(
+                {
+                    "object": f"obj{altitude:.0f}",
+                    "status": "ok",
+                    "window_start_utc": start,
+                    "altitude_km": altitude,
+                    "density_kg_m3": sign * rho,
+                    "density_sigma_kg_m3": 0.1 * rho,
+                    "model_density_kg_m3": rho,
+                }
+            )
+    fig = report.density_bands_figure(pd.DataFrame(rows), band_km=50.0)
+    assert [ax.get_title() for ax in fig.axes] == ["400-450 km", "750-800 km"]
+    assert_readable(fig)
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    with pytest.raises(report.NothingToPlot, match="no window with a positive density estimate"):
+        report.density_bands_figure(pd.DataFrame(rows).assign(density_kg_m3=-1.0))
+
+
+def test_meteor_profile_has_units_on_both_axes(monkeypatch: pytest.MonkeyPatch) -> None:
+    from abrupt.density.meteors import estimate_density_ratios, simulate_head_echoes
+    from abrupt.report import density as report
+
+    res = estimate_density_ratios(simulate_head_echoes(80, seed=1).echoes)
+    fig = report.meteor_profile_figure(res.ratios)
+    assert_readable(fig)
+    (ax,) = fig.axes
+    assert "(" in ax.get_xlabel()
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)

@@ -118,6 +118,13 @@ def test_lageos1_stations_come_from_the_bundled_file() -> None:
     katzively = EarthLocation.from_geodetic(33.97011 * u.deg, 44.39317 * u.deg, 68.7 * u.m)
     r = np.array(sites["1893"].position_ecef_m)
     assert np.linalg.norm(r - [katzively.x.value, katzively.y.value, katzively.z.value]) < 50.0
+    # Graz, from the file's SITE/ID block (15 29 36.0 E, 47 04 01.6 N, 540.1 m), a record apart from the
+    # estimates: the station position propagated to 2021 lies within the block's rounding.
+    graz = EarthLocation.from_geodetic(
+        (15 + 29 / 60 + 36.0 / 3600) * u.deg, (47 + 4 / 60 + 1.6 / 3600) * u.deg, 540.1 * u.m
+    )
+    r = np.array(sites["7839"].position_ecef_m)
+    assert np.linalg.norm(r - [graz.x.value, graz.y.value, graz.z.value]) < 50.0
     # The Graz solution valid in 2021 is number 3 (1999 onwards, open end).
     assert read_sinex()["7839"].solution_at(np.datetime64("2021-01-19", "ns")).solution == "3"
 

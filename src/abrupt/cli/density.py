@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import click
@@ -18,7 +19,7 @@ from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET
 from abrupt.events import read_events
 from abrupt.pipelines.catalogue import file_key, maneuver_times_by_object, run_catalogue
 from abrupt.pipelines.density import orbit_density, tle_density, write_table
-from abrupt.report.density import plot_density_bands, plot_meteor_profile
+from abrupt.report.density import NothingToPlot, plot_density_bands, plot_meteor_profile
 from abrupt.scale import Executor
 
 TLE_BUDGET = str(DEFAULT_TLE_BUDGET)  # "1/year", the maneuver detector's
@@ -177,8 +178,7 @@ def density_tle(
     ok = int((res.windows["status"] == "ok").sum()) if len(res.windows) else 0
     click.echo(f"{ok} window(s) of {len(paths)} object(s) written to {out}")
     if report:
-        plot_density_bands(res.windows, report, title="density from TLE decay")
-        click.echo(f"report: {report}")
+        _report(lambda: plot_density_bands(res.windows, report, title="density from TLE decay"), report)
 
 
 @density.command("orbit")
@@ -269,8 +269,7 @@ def density_orbit(
     ok = int((run.windows["status"] == "ok").sum()) if len(run.windows) else 0
     click.echo(f"{ok} window(s) of {len(paths)} file(s) written to {out}")
     if report:
-        plot_density_bands(run.windows, report, title="density from precise orbits")
-        click.echo(f"report: {report}")
+        _report(lambda: plot_density_bands(run.windows, report, title="density from precise orbits"), report)
 
 
 @density.command("meteors")
@@ -289,8 +288,17 @@ def density_meteors(radar: str, out: str, report: str | None) -> None:
         f"residual RMS {res.residual_rms:.3f}; written to {out}"
     )
     if report:
-        plot_meteor_profile(res.ratios, report)
-        click.echo(f"report: {report}")
+        _report(lambda: plot_meteor_profile(res.ratios, report), report)
+
+
+def _report(plot: Callable[[], object], path: str) -> None:
+    """Write a report figure; a table with nothing to plot gets a note instead (the table is written)."""
+    try:
+        plot()
+    except NothingToPlot as exc:
+        click.echo(f"report {path} not written: {exc}", err=True)
+        return
+    click.echo(f"report: {path}")
 
 
 def _windows_only(

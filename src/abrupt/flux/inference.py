@@ -149,6 +149,15 @@ def prepare(
     ev = events[events["kind"].astype(str) == "strike"] if "kind" in events else events
     days = pd.to_datetime(ev["time_utc"].astype(str), utc=True).dt.strftime("%Y-%m-%d")
     exp_keys = pd.Index(exp["spacecraft"].astype(str) + "|" + exp["day"].astype(str))
+    if exp_keys.has_duplicates:  # events are matched to their spacecraft-day: one exposure row each
+        twice = exp[exp_keys.duplicated(keep=False)]
+        first = twice.iloc[0]
+        detectors = sorted({d or "(none)" for d in twice.loc[twice["day"] == first["day"], "detector"]})
+        raise InputError(
+            f"exposure has {int(exp_keys.duplicated().sum()) + 1} rows for spacecraft-day {first['spacecraft']} "
+            f"{first['day']} (detectors {', '.join(detectors)}); keep one exposure per spacecraft-day "
+            "(write another detector's exposure to a catalog of its own)"
+        )
     ev_keys = ev["spacecraft"].astype(str).to_numpy(dtype=object) + "|" + days.to_numpy(dtype=object)
     rows_a = np.asarray(exp_keys.get_indexer(pd.Index(ev_keys)), dtype=np.int64)
     dh = pd.to_numeric(ev["dH_Nms"], errors="coerce").to_numpy()
