@@ -76,7 +76,12 @@ class ProductBoundary:
 
     def span_mask(self, t_s: FloatArray, epoch_utc: np.datetime64) -> NDArray[np.bool_]:
         """True at the epochs (``t_s``: seconds from ``epoch_utc``) inside the window."""
-        t_b = float((self.time_utc - np.datetime64(epoch_utc, "ns")) / np.timedelta64(1, "ns")) * 1e-9
+        t_b = (
+            float(
+                (np.asarray(self.time_utc, "datetime64[ns]") - np.asarray(epoch_utc, "datetime64[ns]")).astype(np.int64)
+            )
+            * 1e-9
+        )
         after = self.window_s if self.after_s is None else self.after_s
         return (t_s >= t_b - self.window_s) & (t_s <= t_b + after)
 
@@ -160,7 +165,7 @@ def eclipse_windows(analysis: OrbitAnalysis) -> list[_Window]:
     for e in found:
         t_in = t0 + np.timedelta64(round(e.start_s * 1e9), "ns")
         t_out = t0 + np.timedelta64(round(e.end_s * 1e9), "ns")
-        k = int(min(np.searchsorted(analysis.t_s, e.start_s), analysis.t_s.size - 1))
+        k = min(int(np.searchsorted(analysis.t_s, e.start_s)), analysis.t_s.size - 1)
         out.append(_Window(t_in, k, before, e.end_s - e.start_s + after, t_out))
     return out
 

@@ -80,8 +80,8 @@ def find_eclipses(
     if not dark.any():
         return out
     edges = np.diff(dark.astype(np.int8))
-    starts = list(np.flatnonzero(edges == 1) + 1)
-    ends = list(np.flatnonzero(edges == -1))
+    starts = [int(k) for k in np.flatnonzero(edges == 1) + 1]
+    ends = [int(k) for k in np.flatnonzero(edges == -1)]
     if dark[0]:
         starts.insert(0, 0)
     if dark[-1]:
