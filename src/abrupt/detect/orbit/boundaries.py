@@ -122,8 +122,12 @@ def boundary_window(analysis: OrbitAnalysis) -> float:
     return (analysis.config.glr_window_samples + 2) * step
 
 
-def _pattern(peaks: FloatArray, threshold: float, p_window: float) -> bool:
+def _pattern(peaks: FloatArray, threshold: float, p_window: float, most: bool = False) -> bool:
+    """Two or more windows above the threshold, unlikely by chance; ``most``: and at least half of them
+    (a systematic effect of every passage, not two events that happen to fall in two of many windows)."""
     above = int(np.count_nonzero(peaks > threshold))
+    if most and 2 * above < peaks.size:
+        return False
     return above >= 2 and float(stats.binom.sf(above - 1, peaks.size, min(1.0, p_window))) < PATTERN_P
 
 
@@ -179,11 +183,15 @@ def _judge(
     pattern: bool,
     rate_per_day: float,
     p_item: float,
+    robust: bool = False,
 ) -> list[ProductBoundary]:
     """Nuisance windows of one population (day boundaries, stated segment joins, or shadow passages) judged
     nuisance or left to the event search by the leave-one-out bound at ``p_item`` per window; ``pattern``:
     first require the pattern (day boundaries and shadow passages, which a product may or may not show; a
-    join the file states needs no such evidence). ``rate_per_day``: the budget's rate (pattern test)."""
+    join the file states needs no such evidence). ``rate_per_day``: the budget's rate (pattern test).
+    ``robust`` (shadow passages, many per arc): the pattern needs at least half of the windows above the
+    threshold, and with three or more others their scale is their median over the χ²₃ median and the
+    bound that scale's χ²₃ quantile (two burns at two passages must not hide each other through the mean)."""
     if len(windows) < 2:
         return []
     t = analysis.t_s
@@ -195,7 +203,7 @@ def _judge(
     # chance that an ordinary window of this width exceeds h at the budget (one crossing per window)
     width = float(np.mean([w.before_s + w.after_s for w in windows]))
     p_window = rate_per_day * width / 86400.0
-    if ok.sum() < 2 or (pattern and not _pattern(peaks[ok], threshold, p_window)):
+    if ok.sum() < 2 or (pattern and not _pattern(peaks[ok], threshold, p_window, most=robust)):
         return []
     m = int(ok.sum())
     out: list[ProductBoundary] = []
@@ -203,8 +211,13 @@ def _judge(
         if not ok[i]:
             continue
         others = peaks[ok & (np.arange(peaks.size) != i)]
-        scale = float(np.sum(others)) / (3.0 * others.size)
-        bound = 3.0 * scale * float(stats.f.isf(min(1.0, p_item), 3, 3 * (m - 1)))
+        if robust and others.size >= 3:
+            # scale from the others' median: a burn at another window does not lift this one's bound
+            scale = float(np.median(others)) / float(stats.chi2.median(3))
+            bound = scale * float(stats.chi2.isf(min(1.0, p_item), 3))
+        else:
+            scale = float(np.sum(others)) / (3.0 * others.size)
+            bound = 3.0 * scale * float(stats.f.isf(min(1.0, p_item), 3, 3 * (m - 1)))
         level = max(threshold, bound)
         raised = bool(peaks[i] > level)
         out.append(
@@ -239,7 +252,7 @@ def product_boundaries(
             span_days = float(analysis.t_s[-1] - analysis.t_s[0]) / 86400.0
             # the share spent on shadow passages is divided among them (GNSS: two a day; LEO: fifteen)
             p_e = BOUNDARY_SHARE * budget.per_day * span_days / len(shadow)
-            out += _judge(analysis, s, shadow, threshold, SHADOW, True, budget.per_day, p_e)
+            out += _judge(analysis, s, shadow, threshold, SHADOW, True, budget.per_day, p_e, robust=True)
     out.sort(key=lambda b: b.index)
     blanked = s.copy()
     epoch = analysis.ephemeris.times_utc[0]
