@@ -54,6 +54,9 @@ BOUNDARY_SHARE = 0.1
 PATTERN_P = 0.05
 #: the kind of a nuisance window at an Earth-shadow passage
 SHADOW = "shadow passage"
+#: fewest passages with a searched epoch for the shadow treatment: each is bounded by the median of at
+#: least three others (with fewer, two events at two passages would make a "pattern" and bound each other)
+MIN_PASSAGES = 4
 
 
 @dataclass(frozen=True)
@@ -189,8 +192,9 @@ def _judge(
     nuisance or left to the event search by the leave-one-out bound at ``p_item`` per window; ``pattern``:
     first require the pattern (day boundaries and shadow passages, which a product may or may not show; a
     join the file states needs no such evidence). ``rate_per_day``: the budget's rate (pattern test).
-    ``robust`` (shadow passages, many per arc): the pattern needs at least half of the windows above the
-    threshold, and with three or more others their scale is their median over the χ²₃ median and the
+    ``robust`` (shadow passages, many per arc): at least ``MIN_PASSAGES`` windows with a searched epoch,
+    the pattern needs at least half of them above the threshold, and with three or more others their
+    scale is their median over the χ²₃ median and the
     bound that scale's χ²₃ quantile (two burns at two passages must not hide each other through the mean)."""
     if len(windows) < 2:
         return []
@@ -203,7 +207,9 @@ def _judge(
     # chance that an ordinary window of this width exceeds h at the budget (one crossing per window)
     width = float(np.mean([w.before_s + w.after_s for w in windows]))
     p_window = rate_per_day * width / 86400.0
-    if ok.sum() < 2 or (pattern and not _pattern(peaks[ok], threshold, p_window, most=robust)):
+    if ok.sum() < (MIN_PASSAGES if robust else 2) or (
+        pattern and not _pattern(peaks[ok], threshold, p_window, most=robust)
+    ):
         return []
     m = int(ok.sum())
     out: list[ProductBoundary] = []
