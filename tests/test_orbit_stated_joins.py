@@ -14,6 +14,7 @@ from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.readers.oem import write_oem
 from abrupt.readers.sp3 import read_sp3
 from abrupt.readers.stated_joins import stated_join_epochs
+from abrupt.series.ephemeris import Ephemeris
 from abrupt.simulate.orbit import inject_impulse
 from test_orbit_segments import OFFSETS  # the join offsets of the segment test
 
@@ -51,7 +52,7 @@ def test_an_sp3_comment_states_a_join_in_the_files_time_system(shared_data: Path
 
 
 @pytest.fixture(scope="module")
-def joined(shared_data: Path) -> tuple[object, list[np.datetime64]]:
+def joined(shared_data: Path) -> tuple[Ephemeris, list[np.datetime64]]:
     eph = read_sp3(shared_data / S3A)
     t0 = np.datetime64("2018-12-27T00:00:00", "ns")
     sub = eph.select((eph.times_utc >= t0) & (eph.times_utc < t0 + np.timedelta64(12, "h")))
@@ -65,7 +66,9 @@ def joined(shared_data: Path) -> tuple[object, list[np.datetime64]]:
     return x, starts
 
 
-def test_joins_stated_in_oem_comments_are_treated_as_segment_joins(joined, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+def test_joins_stated_in_oem_comments_are_treated_as_segment_joins(
+    joined: tuple[Ephemeris, list[np.datetime64]], tmp_path: Path
+) -> None:
     x, starts = joined
     plain = tmp_path / "plain.oem"
     write_oem(x, plain)
