@@ -152,6 +152,10 @@ def _check_fit(summary: dict[str, Any], eph: Ephemeris, det: OrbitDetector) -> N
         )
 
 
+def _plural(kind: str) -> str:
+    return kind[:-1] + "ies" if kind.endswith("y") else kind + "s"
+
+
 def fit_summary(run: OrbitRun) -> dict[str, Any]:
     """What the fit found: post-fit residual RMS (measurement − forward a-posteriori state), the tuning and
     force model, the innovation consistency, and every statistic's threshold."""
@@ -252,7 +256,7 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
         nuisance = [b for b in bounds if not b["raised"]]
         lines.append(
             f"  product          discontinuous at its "
-            f"{' and '.join(sorted({str(b.get('kind', 'day boundary')) + 's' for b in bounds}))}: "
+            f"{' and '.join(sorted({_plural(str(b.get('kind', 'day boundary'))) for b in bounds}))}: "
             f"{len(nuisance)} of {len(bounds)} treated as "
             "nuisance (not events), the others left to the event search"
         )
