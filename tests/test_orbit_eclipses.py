@@ -21,7 +21,7 @@ from abrupt.detect.orbit.detectors import OrbitDetector, orbit_product_boundarie
 from abrupt.model.orbit import MU_EARTH_M3_S2, R_EARTH_M, ForceModel
 from abrupt.model.orbit.bodies import sun_moon_gcrf
 from abrupt.model.orbit.eclipses import find_eclipses
-from abrupt.pipelines.orbit import detect_orbit
+from abrupt.pipelines.orbit import detect_orbit, summary_lines
 from abrupt.series.ephemeris import Ephemeris
 from abrupt.simulate.orbit import OrbitSimulationConfig, inject_impulse, simulate_orbit
 from abrupt.thresholds import FalseAlarmBudget
@@ -129,3 +129,6 @@ def test_an_impulse_at_a_shadow_passage_is_still_found(gnss_like: Ephemeris, edg
     ev = run.events.iloc[0]
     assert abs((pd.Timestamp(ev["time_utc"]).tz_localize(None) - pd.Timestamp(t_imp)).total_seconds()) <= 120.0
     assert ev["dv_mps"] == pytest.approx(0.001, rel=0.2)
+    # the passages are printed with the fit (the raised one marked as searched)
+    printed = [ln for ln in summary_lines(run.summary) if "shadow passage" in ln]
+    assert printed and any("-> searched" in ln for ln in printed)
