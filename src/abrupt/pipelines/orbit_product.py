@@ -83,6 +83,8 @@ def detect_orbit_product(
         if level is not None:
             own = self_calibrate(an, budget=fa, confidence_z=det.confidence_z)
             det.fixed_thresholds = {**own, det.statistic: level}
+            # the pooled null holds the satellites' shadow passages: they are not treated again as nuisance
+            det.eclipses = False
         runs[sid] = _finish(det, eph, fa, an, sequences)
     return runs
 

@@ -98,8 +98,9 @@ def _new(
     gap = np.abs((t_new[:, None] - t_old[None, :]).astype(np.float64)) * 1e-9
     keep = gap.min(axis=1) > separation_s
     for b in nuisance:
-        t_b = np.datetime64(str(b["time_utc"]), "ns")
-        keep &= np.abs((t_new - t_b).astype(np.float64)) * 1e-9 > float(b["window_s"])  # type: ignore[arg-type]
+        offset = (t_new - np.datetime64(str(b["time_utc"]), "ns")).astype(np.float64) * 1e-9
+        after = float(b.get("after_s", b["window_s"]))  # type: ignore[arg-type]
+        keep &= (offset < -float(b["window_s"])) | (offset > after)  # type: ignore[arg-type]
     return candidates.iloc[np.flatnonzero(keep)]
 
 

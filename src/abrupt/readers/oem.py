@@ -25,7 +25,7 @@ import math
 import re
 import warnings
 import xml.parsers.expat
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Literal
 from xml.sax.saxutils import escape
@@ -38,6 +38,7 @@ from numpy.typing import NDArray
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.timescales import offline_astropy
 from abrupt.readers.compression import read_bytes
+from abrupt.readers.stated_joins import stated_join_epochs
 from abrupt.readers.timesystems import to_utc_counted
 from abrupt.series.ephemeris import Ephemeris
 
@@ -334,7 +335,22 @@ def read_oem(path: str | Path, satellite: str | None = None) -> Ephemeris:
         extra = f" ({len(bad)} malformed state lines, more than the {limit} that would be skipped)" if limit else ""
         raise InputError(first.reason + extra, file=file, line=no, column=first.column)
     log.record("malformed state line skipped", len(bad))
-    return _to_ephemeris(segments, satellite, file, log)
+    eph = _to_ephemeris(segments, satellite, file, log)
+    stated = np.array(stated_join_epochs(_comments(raw)), dtype="datetime64[ns]")
+    if stated.size == 0:
+        return eph
+    # joins stated only in COMMENT lines, in the file's time system like its epochs
+    utc = to_utc_counted(stated, TIME_SYSTEMS[eph.time_system], RepairLog(source=file))  # type: ignore[arg-type]
+    starts = np.unique(np.concatenate([eph.segment_starts_utc.astype("datetime64[ns]"), utc]))
+    return replace(eph, segment_starts_utc=starts)
+
+
+def _comments(raw: bytes) -> list[str]:
+    """The text of every COMMENT line (KVN) or ``<COMMENT>`` element (XML)."""
+    text = raw.decode("utf-8", errors="replace")
+    if text.lstrip()[:1] == "<":
+        return re.findall(r"<COMMENT>(.*?)</COMMENT>", text, flags=re.DOTALL)
+    return [ln.strip()[7:] for ln in text.splitlines() if ln.strip().startswith("COMMENT")]
 
 
 def _to_ephemeris(segments: list[_Segment], satellite: str | None, file: str, log: RepairLog) -> Ephemeris:

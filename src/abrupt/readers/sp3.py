@@ -71,6 +71,7 @@ from abrupt.readers.sp3_header import (
     parse_header,
 )
 from abrupt.readers.sp3_records import last_epoch_complete
+from abrupt.readers.stated_joins import stated_join_epochs
 from abrupt.readers.timesystems import to_utc_counted
 from abrupt.series.ephemeris import Ephemeris
 
@@ -463,9 +464,12 @@ def _finish(
         step = np.diff(t_sys).astype(np.float64) * 1e-9
         n_missing = int(np.sum(np.maximum(np.round(step / header.interval_s) - 1, 0)))
         log.record("missing epochs (gaps, propagated across)", n_missing)
+    stated = np.array(stated_join_epochs(header.comments), dtype="datetime64[ns]")
     return Ephemeris(
         satellite=sid,
         times_utc=_to_utc(t_sys, header.time_system, log),
+        # joins stated in the header's comments, in the file's time system like its epochs
+        segment_starts_utc=_to_utc(stated, header.time_system, RepairLog(source=file)),
         position_m=st[:, :3] * 1e3,
         velocity_mps=st[:, 3:6] * 0.1,
         frame=frame,  # type: ignore[arg-type]

@@ -38,9 +38,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy import stats
 
 from abrupt.detect.orbit.analysis import OrbitAnalysis
+from abrupt.model.orbit.eclipses import find_eclipses
 from abrupt.thresholds import FalseAlarmBudget
 from abrupt.types import FloatArray
 
@@ -50,12 +52,20 @@ BOUNDARY_SHARE = 0.1
 #: (a pattern declared by chance costs little: it needs two boundaries above the threshold, i.e. two
 #: false alarms that the treatment then removes; only burns at two or more boundaries are at risk)
 PATTERN_P = 0.05
+#: the kind of a nuisance window at an Earth-shadow passage
+SHADOW = "shadow passage"
+#: fewest passages with a searched epoch for the shadow treatment: each is bounded by the median of at
+#: least three others (with fewer, two events at two passages would make a "pattern" and bound each other)
+MIN_PASSAGES = 4
 
 
 @dataclass(frozen=True)
 class ProductBoundary:
-    """A day boundary of the product: its time, the event statistic's peak within the window, the
-    bound it was compared with, and whether it was left to the event search (``raised``)."""
+    """A known nuisance epoch (a day boundary, a stated segment join, or an Earth-shadow passage): its time,
+    the event statistic's peak within its window, the bound it was compared with, and whether it was left
+    to the event search (``raised``). The window runs from ``window_s`` before ``time_utc`` to ``after_s``
+    after it (None: as long as before); ``index`` is the first epoch at or after ``time_utc``. A shadow
+    passage has its entry as ``time_utc`` and its exit as ``end_utc``."""
 
     time_utc: np.datetime64
     index: int
@@ -64,16 +74,33 @@ class ProductBoundary:
     raised: bool
     window_s: float
     kind: str = "day boundary"
+    after_s: float | None = None
+    end_utc: np.datetime64 | None = None
+
+    def span_mask(self, t_s: FloatArray, epoch_utc: np.datetime64) -> NDArray[np.bool_]:
+        """True at the epochs (``t_s``: seconds from ``epoch_utc``) inside the window."""
+        t_b = (
+            float(
+                (np.asarray(self.time_utc, "datetime64[ns]") - np.asarray(epoch_utc, "datetime64[ns]")).astype(np.int64)
+            )
+            * 1e-9
+        )
+        after = self.window_s if self.after_s is None else self.after_s
+        return (t_s >= t_b - self.window_s) & (t_s <= t_b + after)
 
     def as_dict(self) -> dict[str, object]:
-        return {
+        out: dict[str, object] = {
             "time_utc": str(self.time_utc),
             "peak": self.peak,
             "bound": self.bound,
             "raised": self.raised,
             "window_s": self.window_s,
+            "after_s": self.window_s if self.after_s is None else self.after_s,
             "kind": self.kind,
         }
+        if self.end_utc is not None:
+            out["end_utc"] = str(self.end_utc)
+        return out
 
 
 def day_boundary_indices(times_utc: np.ndarray) -> list[int]:
@@ -98,8 +125,12 @@ def boundary_window(analysis: OrbitAnalysis) -> float:
     return (analysis.config.glr_window_samples + 2) * step
 
 
-def _pattern(peaks: FloatArray, threshold: float, p_window: float) -> bool:
+def _pattern(peaks: FloatArray, threshold: float, p_window: float, most: bool = False) -> bool:
+    """Two or more windows above the threshold, unlikely by chance; ``most``: and at least half of them
+    (a systematic effect of every passage, not two events that happen to fall in two of many windows)."""
     above = int(np.count_nonzero(peaks > threshold))
+    if most and 2 * above < peaks.size:
+        return False
     return above >= 2 and float(stats.binom.sf(above - 1, peaks.size, min(1.0, p_window))) < PATTERN_P
 
 
@@ -111,71 +142,147 @@ def segment_join_indices(analysis: OrbitAnalysis) -> list[int]:
     return sorted({int(k) for k in at if 0 < k < t.size})
 
 
+@dataclass(frozen=True)
+class _Window:
+    """A nuisance window before it is judged: anchor time and index, extent before and after."""
+
+    time_utc: np.datetime64
+    index: int
+    before_s: float
+    after_s: float
+    end_utc: np.datetime64 | None = None
+
+
+def _epoch_windows(analysis: OrbitAnalysis, idx: list[int]) -> list[_Window]:
+    half = boundary_window(analysis)
+    times = analysis.ephemeris.times_utc
+    return [_Window(times[k], k, half, half) for k in idx]
+
+
+def eclipse_windows(analysis: OrbitAnalysis) -> list[_Window]:
+    """One window per Earth-shadow passage of the arc (:func:`~abrupt.model.orbit.eclipses.find_eclipses`):
+    from the GLR's data window plus two samples before the entry (the sliding statistic at θ holds the
+    innovations from θ on, so a change at the entry raises it that far back) to as long after the exit
+    (the filters' transient once sunlight, and the pressure, are back), as for a day boundary."""
+    eph = analysis.ephemeris
+    found = find_eclipses(eph.times_utc, eph.position_m, eph.velocity_mps)
+    before = after = boundary_window(analysis)
+    t0 = np.datetime64(eph.times_utc[0], "ns")
+    out = []
+    for e in found:
+        t_in = t0 + np.timedelta64(round(e.start_s * 1e9), "ns")
+        t_out = t0 + np.timedelta64(round(e.end_s * 1e9), "ns")
+        k = min(int(np.searchsorted(analysis.t_s, e.start_s)), analysis.t_s.size - 1)
+        out.append(_Window(t_in, k, before, e.end_s - e.start_s + after, t_out))
+    return out
+
+
 def _judge(
     analysis: OrbitAnalysis,
     s: FloatArray,
-    idx: list[int],
+    windows: list[_Window],
     threshold: float,
-    budget: FalseAlarmBudget,
     kind: str,
     pattern: bool,
+    rate_per_day: float,
+    p_item: float,
+    robust: bool = False,
 ) -> list[ProductBoundary]:
-    """Boundaries of one population (day boundaries, or the stated segment joins) judged nuisance or left to
-    the event search by the leave-one-out bound; ``pattern``: first require the pattern (day boundaries,
-    which a product may or may not carry; a join the file states needs no such evidence)."""
-    if len(idx) < 2:
+    """Nuisance windows of one population (day boundaries, stated segment joins, or shadow passages) judged
+    nuisance or left to the event search by the leave-one-out bound at ``p_item`` per window; ``pattern``:
+    first require the pattern (day boundaries and shadow passages, which a product may or may not show; a
+    join the file states needs no such evidence). ``rate_per_day``: the budget's rate (pattern test).
+    ``robust`` (shadow passages, many per arc): at least ``MIN_PASSAGES`` windows with a searched epoch,
+    the pattern needs at least half of them above the threshold, and with three or more others their
+    scale is their median over the χ²₃ median and the
+    bound that scale's χ²₃ quantile (two burns at two passages must not hide each other through the mean)."""
+    if len(windows) < 2:
         return []
     t = analysis.t_s
-    half = boundary_window(analysis)
-    windows = [(t >= t[k] - half) & (t <= t[k] + half) for k in idx]
-    peaks = np.array([float(np.nanmax(s[w])) if np.isfinite(s[w]).any() else np.nan for w in windows])
+    epoch = analysis.ephemeris.times_utc[0]
+    masks = [ProductBoundary(w.time_utc, w.index, 0.0, 0.0, False, w.before_s, kind, w.after_s) for w in windows]
+    spans = [m.span_mask(t, epoch) for m in masks]
+    peaks = np.array([float(np.nanmax(s[w])) if np.isfinite(s[w]).any() else np.nan for w in spans])
     ok = np.isfinite(peaks)
     # chance that an ordinary window of this width exceeds h at the budget (one crossing per window)
-    p_window = budget.per_day * (2 * half / 86400.0)
-    if ok.sum() < 2 or (pattern and not _pattern(peaks[ok], threshold, p_window)):
+    width = float(np.mean([w.before_s + w.after_s for w in windows]))
+    p_window = rate_per_day * width / 86400.0
+    if ok.sum() < (MIN_PASSAGES if robust else 2) or (
+        pattern and not _pattern(peaks[ok], threshold, p_window, most=robust)
+    ):
         return []
     m = int(ok.sum())
-    p_b = BOUNDARY_SHARE * budget.per_day  # one boundary per day
     out: list[ProductBoundary] = []
-    times = analysis.ephemeris.times_utc
-    for i, k in enumerate(idx):
+    for i, w in enumerate(windows):
         if not ok[i]:
             continue
         others = peaks[ok & (np.arange(peaks.size) != i)]
-        scale = float(np.sum(others)) / (3.0 * others.size)
-        bound = 3.0 * scale * float(stats.f.isf(p_b, 3, 3 * (m - 1)))
+        if robust and others.size >= 3:
+            # scale from the others' median: a burn at another window does not lift this one's bound
+            scale = float(np.median(others)) / float(stats.chi2.median(3))
+            bound = scale * float(stats.chi2.isf(min(1.0, p_item), 3))
+        else:
+            scale = float(np.sum(others)) / (3.0 * others.size)
+            bound = 3.0 * scale * float(stats.f.isf(min(1.0, p_item), 3, 3 * (m - 1)))
         level = max(threshold, bound)
-        out.append(ProductBoundary(times[k], k, float(peaks[i]), level, bool(peaks[i] > level), half, kind))
+        raised = bool(peaks[i] > level)
+        out.append(
+            ProductBoundary(w.time_utc, w.index, float(peaks[i]), level, raised, w.before_s, kind, w.after_s, w.end_utc)
+        )
     return out
 
 
 def product_boundaries(
-    analysis: OrbitAnalysis, threshold: float, budget: FalseAlarmBudget, statistic: str = "glr"
+    analysis: OrbitAnalysis,
+    threshold: float,
+    budget: FalseAlarmBudget,
+    statistic: str = "glr",
+    *,
+    eclipses: bool = True,
 ) -> tuple[list[ProductBoundary], FloatArray]:
-    """The day boundaries and stated segment joins treated as nuisance or left to the event search (module
-    docstring), and the statistic with the nuisance windows blanked (NaN). Day boundaries are empty when
-    the product shows no pattern; joins when the file states fewer than two."""
+    """The day boundaries, stated segment joins and (``eclipses``) Earth-shadow passages treated as nuisance
+    or left to the event search (module docstring), and the statistic with the nuisance windows blanked
+    (NaN). Day boundaries and shadow passages are empty when the arc shows no pattern at them; joins when
+    the file states fewer than two."""
     s = analysis.statistics[statistic]
     if statistic != "glr" or threshold <= 0:
         return [], s
     joins = segment_join_indices(analysis)
     days = [k for k in day_boundary_indices(analysis.ephemeris.times_utc) if k not in joins]
-    out = _judge(analysis, s, days, threshold, budget, "day boundary", True)
-    out += _judge(analysis, s, joins, threshold, budget, "segment join", False)
+    p_b = BOUNDARY_SHARE * budget.per_day  # one boundary per day
+    out = _judge(analysis, s, _epoch_windows(analysis, days), threshold, "day boundary", True, budget.per_day, p_b)
+    out += _judge(analysis, s, _epoch_windows(analysis, joins), threshold, "segment join", False, budget.per_day, p_b)
+    if eclipses:
+        shadow = eclipse_windows(analysis)
+        if shadow:
+            span_days = float(analysis.t_s[-1] - analysis.t_s[0]) / 86400.0
+            # the share spent on shadow passages is divided among them (GNSS: two a day; LEO: fifteen)
+            p_e = BOUNDARY_SHARE * budget.per_day * span_days / len(shadow)
+            out += _judge(analysis, s, shadow, threshold, SHADOW, True, budget.per_day, p_e, robust=True)
     out.sort(key=lambda b: b.index)
     blanked = s.copy()
-    t = analysis.t_s
+    epoch = analysis.ephemeris.times_utc[0]
     for b in out:
         if not b.raised:
-            blanked[(t >= t[b.index] - b.window_s) & (t <= t[b.index] + b.window_s)] = np.nan
+            blanked[b.span_mask(analysis.t_s, epoch)] = np.nan
     return out, blanked
 
 
-def boundary_mask(analysis: OrbitAnalysis, boundaries: list[ProductBoundary]) -> FloatArray:
+def eclipse_mask(analysis: OrbitAnalysis) -> NDArray[np.bool_]:
+    """True at epochs within the window of any Earth-shadow passage of the arc (judged or not)."""
+    t = analysis.t_s
+    epoch = analysis.ephemeris.times_utc[0]
+    mask = np.zeros(t.size, dtype=bool)
+    for w in eclipse_windows(analysis):
+        mask |= ProductBoundary(w.time_utc, w.index, 0.0, 0.0, False, w.before_s, after_s=w.after_s).span_mask(t, epoch)
+    return mask
+
+
+def boundary_mask(analysis: OrbitAnalysis, boundaries: list[ProductBoundary]) -> NDArray[np.bool_]:
     """True at epochs within the window of any boundary (excluded from the ordinary threshold's null)."""
     t = analysis.t_s
-    half = boundary_window(analysis)
+    epoch = analysis.ephemeris.times_utc[0]
     mask = np.zeros(t.size, dtype=bool)
     for b in boundaries:
-        mask |= (t >= t[b.index] - half) & (t <= t[b.index] + half)
+        mask |= b.span_mask(t, epoch)
     return mask

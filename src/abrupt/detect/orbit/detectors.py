@@ -35,7 +35,13 @@ import numpy as np
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.detect.orbit.analysis import OrbitAnalysis, OrbitDetectorConfig, analyse, innovation_scale
-from abrupt.detect.orbit.boundaries import ProductBoundary, boundary_mask, product_boundaries
+from abrupt.detect.orbit.boundaries import (
+    SHADOW,
+    ProductBoundary,
+    boundary_mask,
+    eclipse_mask,
+    product_boundaries,
+)
 from abrupt.detect.orbit.calibration import calibrate_thresholds, self_calibrate
 from abrupt.detect.orbit.ekf import FilterConfig, NuisanceConfig
 from abrupt.detect.orbit.events import find_events
@@ -45,6 +51,7 @@ from abrupt.events import config_hash
 from abrupt.model.orbit import ForceModel
 from abrupt.series.ephemeris import Ephemeris
 from abrupt.thresholds import FalseAlarmBudget, Threshold
+from abrupt.types import FloatArray
 
 TUNINGS = ("auto", "thesis")
 DYNAMICS = {"two-body": 0, "j2": 2, "j3": 3, "j4": 4, "field": -1}
@@ -123,6 +130,9 @@ class OrbitDetector(Detector[Ephemeris]):
         self._null = null
         #: thresholds to use instead of calibrating (a later scan of the same arc keeps the first's)
         self.fixed_thresholds: dict[str, Threshold] | None = None
+        #: treat the arc's Earth-shadow passages as known nuisance epochs (:mod:`~abrupt.detect.orbit.boundaries`);
+        #: off where the threshold's null already holds them (thresholds pooled over a product's satellites)
+        self.eclipses = True
 
     def config(self) -> dict[str, Any]:
         out = super().config()
@@ -216,20 +226,35 @@ class OrbitDetector(Detector[Ephemeris]):
     def _boundaries(
         self, analysis: OrbitAnalysis, thresholds: dict[str, Threshold], budget: FalseAlarmBudget
     ) -> tuple[list[ProductBoundary], OrbitAnalysis]:
-        """Day boundaries of the product treated as nuisance (:mod:`abrupt.detect.orbit.boundaries`), and
-        the analysis to search for events (the nuisance windows blanked). When the product shows the
-        pattern, the self-calibrated thresholds are set again without the boundary windows (in place)."""
+        """Day boundaries, stated joins and Earth-shadow passages treated as nuisance
+        (:mod:`abrupt.detect.orbit.boundaries`), and the analysis to search for events (the nuisance windows
+        blanked). When the arc shows a pattern, the self-calibrated thresholds are set again without the
+        nuisance windows (in place)."""
         name = self.statistic
-        boundaries, blanked = product_boundaries(analysis, thresholds[name].value, budget, name)
+        calibrating = self._null is None and self.fixed_thresholds is None
+
+        def judged(h: float) -> tuple[list[ProductBoundary], FloatArray]:
+            return product_boundaries(analysis, h, budget, name, eclipses=self.eclipses)
+
+        boundaries, blanked = judged(thresholds[name].value)
+        if calibrating and self.eclipses and not any(b.kind == SHADOW for b in boundaries):
+            # shadow passages inflate a tail fit that holds them: judge them against the level of the rest
+            mask = eclipse_mask(analysis)
+            if mask.any() and not mask.all():
+                quiet = replace(analysis, statistics={name: np.where(mask, np.nan, analysis.statistics[name])})
+                level = self_calibrate(quiet, budget=budget, confidence_z=self.confidence_z, names=(name,)).get(name)
+                trial = judged(level.value) if level is not None else ([], blanked)
+                if any(b.kind == SHADOW for b in trial[0]):
+                    boundaries, blanked = trial
         if not boundaries:
             return [], analysis
-        if self._null is None and self.fixed_thresholds is None:
+        if calibrating:
             mask = boundary_mask(analysis, boundaries)
-            quiet = {k: np.where(mask, np.nan, v) for k, v in analysis.statistics.items()}
+            quiet_all = {k: np.where(mask, np.nan, v) for k, v in analysis.statistics.items()}
             thresholds.update(
-                self_calibrate(replace(analysis, statistics=quiet), budget=budget, confidence_z=self.confidence_z)
+                self_calibrate(replace(analysis, statistics=quiet_all), budget=budget, confidence_z=self.confidence_z)
             )
-            boundaries, blanked = product_boundaries(analysis, thresholds[name].value, budget, name)
+            boundaries, blanked = judged(thresholds[name].value)
         return boundaries, replace(analysis, statistics={**analysis.statistics, name: blanked})
 
     def _diagnostics(
