@@ -16,26 +16,43 @@ for a list of files (``ARCHIVE...``) are replaced (:data:`WORDS`), study sizes r
 and optional parts written ``[--option VALUE]`` left out unless the stand-in needs one
 (:data:`KEEP_OPTIONAL`). ``pytest -s`` prints every stand-in and every command that ran changed.
 
-Not run, each with its reason (:data:`NOT_RUN`, checked against the docs so it cannot go stale): lines
-that need a server (PostgreSQL, a Dask scheduler) and the resumption of a killed run. Documents with
-cheap commands run in the default suite (:data:`FAST_DOCS`, less their :data:`SLOW_LINES`); the others,
-and those lines, are marked ``slow``.
+Servers (:data:`SERVED`): a doc's server address is replaced by a real one started for the test, a
+fresh database on a PostgreSQL server (skipped, saying why, where the server binaries or psycopg are
+missing) or a Dask scheduler with one worker process started in the doc's folder. A run the doc shows
+killed (:data:`KILLED`) runs in a process of its own, SIGKILLed once it has stored a task; the line after
+it must exit 0 and report what the doc quotes, with the tasks stored before the kill as finished earlier.
+Not run, each with its reason (:data:`NOT_RUN`, checked against the docs so it cannot go stale): none
+at present. Documents with cheap commands run in the default suite (:data:`FAST_DOCS`, less their
+:data:`SLOW_LINES`); the others, and those lines, are marked ``slow``.
 """
 
 from __future__ import annotations
 
+import contextlib
 import glob
+import io
+import logging
+import os
 import re
 import shlex
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
+from typing import TypeVar
 
 import pytest
 
+import abrupt
 import doc_inputs as di
 from abrupt.cli.main import main
 from test_doc_commands import FENCE, _doc_commands
 
 ROOT = Path(__file__).resolve().parent.parent
+V = TypeVar("V")
 
 #: The documented mapping: a file name used in the docs -> how its small stand-in is made.
 INPUTS: dict[str, di.Maker] = {
@@ -119,11 +136,17 @@ KEEP_OPTIONAL: dict[str, tuple[str, ...]] = {
 }
 
 #: Lines not run, by document and a fragment of the line, with the reason. Keep it short.
-NOT_RUN: dict[tuple[str, str], str] = {
-    ("catalog.md", "postgresql://"): "needs a PostgreSQL server (tests/test_catalog_service.py starts one)",
-    ("scale.md", "tcp://host:8786"): "needs a Dask scheduler (tests/test_fleet_scale.py runs a local cluster)",
-    ("scale.md", "resumed"): "the resumption of the run killed in the line above (tests/test_fleet_scale.py kills one)",
+NOT_RUN: dict[tuple[str, str], str] = {}
+
+#: A server address of a doc -> the fixture giving a real one to run the line against (by document).
+SERVED: dict[tuple[str, str], str] = {
+    ("catalog.md", "postgresql://analyst@db.example.org/abrupt"): "doc_postgresql_database",
+    ("scale.md", "tcp://host:8786"): "doc_dask_scheduler",
 }
+
+#: Lines the doc shows killed (by document and a fragment of the line) -> how many tasks the run stores
+#: in ``./abrupt_catalog.sqlite`` before it is SIGKILLed.
+KILLED: dict[tuple[str, str], int] = {("scale.md", "killed after"): 1}
 
 #: Documents whose fenced blocks are separate runs (each block in a folder of its own): a second block
 #: repeats the first on real data under the same output names.
@@ -180,7 +203,7 @@ def _docs() -> list[object]:
     for doc, line, fenced in _doc_commands():
         if fenced:
             by_doc.setdefault(doc, []).append(line)
-    params = []
+    params: list[object] = []
     for doc, lines in sorted(by_doc.items()):
         cheap = [line for line in lines if not _slow_line(doc, line)]
         if doc in FAST_DOCS:
@@ -215,13 +238,75 @@ def _make_inputs(doc: str, lines: list[str], folder: Path, shared: Path) -> None
             print(f"{doc}: input {name}: {(make.__doc__ or '').strip().splitlines()[0]}")
 
 
-def _run_line(doc: str, line: str) -> bool:
+@pytest.fixture
+def doc_postgresql_database(postgresql_server_url: str) -> str:
+    """A fresh database on the session's PostgreSQL server (``tests/pg_server.py``)."""
+    from pg_server import new_database
+
+    return new_database(postgresql_server_url)
+
+
+@pytest.fixture
+def doc_dask_scheduler() -> Iterator[str]:
+    """The address of a Dask scheduler with one worker process. Asked for once the test is in the doc's
+    folder: the worker starts there, so the doc's relative paths name the same files for it."""
+    from distributed import LocalCluster
+
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
+    ) as cluster:
+        yield str(cluster.scheduler_address)
+
+
+def _lookup(table: Mapping[tuple[str, str], V], doc: str, line: str) -> list[tuple[str, V]]:
+    return [(fragment, value) for (name, fragment), value in table.items() if name == doc and fragment in line]
+
+
+def _stored_tasks() -> int:
+    """Finished tasks in ``./abrupt_catalog.sqlite`` (0 before the catalog or its table exists)."""
+    try:
+        with sqlite3.connect("file:abrupt_catalog.sqlite?mode=ro", uri=True) as conn:
+            return int(conn.execute("SELECT count(*) FROM tasks").fetchone()[0])
+    except sqlite3.Error:
+        return 0
+
+
+def _run_killed(args: list[str], n_tasks: int, limit_s: float = 300) -> int:
+    """Run ``abrupt ARGS`` in a process of its own; SIGKILL it once it has stored ``n_tasks`` more
+    tasks; return how many it stored. Fails if the run ended before the kill."""
+    before = _stored_tasks()
+    env = {**os.environ, "PYTHONPATH": str(Path(abrupt.__file__).resolve().parents[1])}
+    cmd = [sys.executable, "-m", "abrupt.cli.main", "-q", *args]
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    t0 = time.monotonic()
+    while proc.poll() is None and _stored_tasks() - before < n_tasks and time.monotonic() - t0 < limit_s:
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGKILL)
+    assert proc.wait() == -signal.SIGKILL, f"`abrupt {shlex.join(args)}` ended before it could be killed"
+    return _stored_tasks() - before
+
+
+def _report_pattern(line: str, finished_earlier: int) -> str | None:
+    """The report the doc quotes in the line's comment (``# "..."``) as a pattern: its last number is
+    the count of tasks finished earlier, the others any number."""
+    quoted = re.search(r'#\s*"([^"]+)"', line)
+    if quoted is None:
+        return None
+    parts = re.split(r"\d+", quoted.group(1))
+    numbers = [r"\d+"] * (len(parts) - 2) + [str(finished_earlier)]
+    return "".join(re.escape(part) + (numbers[k] if k < len(numbers) else "") for k, part in enumerate(parts))
+
+
+def _run_line(doc: str, line: str, address: Callable[[str], str]) -> bool:
     """Run one documented line (False: not run, with its printed reason); fails the test on an error."""
     reason = _reason(doc, line)
     if reason is not None:
         print(f"{doc}: not run: `{line}`: {reason}")
         return False
-    args = _runnable(doc, line)
+    served = line
+    for fragment, fixture in _lookup(SERVED, doc, line):
+        served = served.replace(fragment, address(fixture))
+    args = _runnable(doc, served)
     if args != shlex.split(line.split(" #")[0])[1:]:
         print(f"{doc}: `{line}` ran as `abrupt {shlex.join(args)}`")
     try:
@@ -232,9 +317,34 @@ def _run_line(doc: str, line: str) -> bool:
     return True
 
 
+def _run_resumed(doc: str, line: str, finished_earlier: int) -> None:
+    """Run the line after a killed one (with its notes): exit 0 and the report the doc quotes."""
+    args = _runnable(doc, line)
+    root = logging.getLogger()
+    handlers, level = root.handlers[:], root.level  # the command logs to the stream read here; put back
+    with contextlib.redirect_stderr(io.StringIO()) as stream:
+        try:
+            main(args)
+        except SystemExit as exc:
+            if exc.code not in (0, None):
+                pytest.fail(f"{doc}: `{line}` (the run resumed) exited with status {exc.code}")
+        finally:
+            root.handlers[:] = handlers
+            root.setLevel(level)
+    err = stream.getvalue()
+    pattern = _report_pattern(line, finished_earlier)
+    assert pattern is None or re.search(pattern, err), (doc, line, pattern, err)
+    print(f"{doc}: `{line}` resumed {finished_earlier} finished task(s): {err.strip().splitlines()[-1]}")
+
+
 @pytest.mark.parametrize(("doc", "lines"), _docs())
 def test_every_command_of_the_doc_runs(
-    doc: str, lines: list[str], shared_data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    doc: str,
+    lines: list[str],
+    shared_data: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    request: pytest.FixtureRequest,
 ) -> None:
     """Run with ``-s`` to see the stand-ins made and each command as it ran where it differs."""
     groups = _blocks(doc, lines) if doc in BLOCKS_APART else [lines]
@@ -244,14 +354,25 @@ def test_every_command_of_the_doc_runs(
         folder.mkdir()
         monkeypatch.chdir(folder)
         _make_inputs(doc, group, folder, shared_data)
-        ran += sum(_run_line(doc, line) for line in group)
+        killed: int | None = None  # tasks stored by the run killed in the line before
+        for line in group:
+            kill = _lookup(KILLED, doc, line)
+            if killed is not None:
+                _run_resumed(doc, line, killed)
+                killed, ran = None, ran + 1
+            elif kill:
+                killed, ran = _run_killed(_runnable(doc, line), kill[0][1]), ran + 1
+                print(f"{doc}: `{line}` killed after {killed} stored task(s)")
+            else:
+                ran += _run_line(doc, line, request.getfixturevalue)
     assert ran > 0, doc
 
 
 def test_the_not_run_list_names_lines_that_exist() -> None:
-    """A NOT_RUN entry whose line left its document is stale: the list stays as short as it can."""
+    """A NOT_RUN (SERVED, KILLED) entry whose line left its document is stale: the lists stay as short
+    as they can."""
     lines = [(doc, line) for doc, line, fenced in _doc_commands() if fenced]
-    for doc, fragment in NOT_RUN:
+    for doc, fragment in [*NOT_RUN, *SERVED, *KILLED]:
         assert any(d == doc and fragment in line for d, line in lines), (doc, fragment)
     for doc, names in DOC_INPUTS.items():
         doc_lines = [" ".join(_words(doc).get(w, w) for w in line.split()) for d, line in lines if d == doc]
