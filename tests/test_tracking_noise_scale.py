@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
-from abrupt.cli.main import cli
+from abrupt.cli.main import cli, main
 
 
 def _simulate(tmp_path: Path, dv: float, noise_scale: float) -> tuple[Path, Path]:
@@ -56,7 +56,9 @@ def test_right_sigmas_are_left_as_stated(tmp_path: Path) -> None:
     assert fit["noise"]["sigma_scale"] == 1.0
 
 
-def test_a_set_up_whose_station_is_not_the_data_s_is_refused(tmp_path: Path) -> None:
+def test_a_set_up_whose_station_is_not_the_data_s_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """The set-up puts the station 2° (220 km) north of where the simulation had it: no orbit fits the
     ranges and angles, impulses or not; a one-line refusal naming the file and the RMS, no events."""
     tdm, setup = _simulate(tmp_path, 0.0, 1.0)
@@ -65,8 +67,11 @@ def test_a_set_up_whose_station_is_not_the_data_s_is_refused(tmp_path: Path) -> 
     key, value = lat.split("=")
     setup.write_text(text.replace(lat, f"{key}= {float(value) + 2.0!r}"))
     args = ["detect", "tracking", str(tdm), "--setup", str(setup), "--method", "glrt"]
-    r = CliRunner().invoke(cli, [*args, "--out", str(tmp_path / "ev.csv"), "--catalog", str(tmp_path / "c.sqlite")])
-    assert r.exit_code != 0
-    message = r.output.strip().splitlines()[-1]
-    assert tdm.name in message and "weighted RMS" in message and "does not describe the data" in message
+    with pytest.raises(SystemExit) as exc:
+        main([*args, "--out", str(tmp_path / "ev.csv"), "--catalog", str(tmp_path / "c.sqlite")])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    lines = [line for line in err.splitlines() if not line.startswith("abrupt detect tracking:")]
+    assert len(lines) == 1, err
+    assert tdm.name in lines[0] and "weighted RMS" in lines[0] and "does not describe the data" in lines[0]
     assert not (tmp_path / "ev.csv").exists()

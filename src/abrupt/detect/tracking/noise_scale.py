@@ -26,9 +26,8 @@ import numpy as np
 
 from abrupt.model.orbit.batch_fit import BatchFit
 from abrupt.model.tracking_measurements import TrackingArrays
+from abrupt.thresholds.noise import robust_scale
 
-MAD_TO_SIGMA = 1.4826
-"""Normal-consistency factor of the median absolute deviation."""
 MAD_SCALE_SE = 1.166
 """Asymptotic standard error of the MAD scale estimate, in units of σ/√n (37 % efficiency; an
 approximation for the correlated second differences)."""
@@ -72,7 +71,7 @@ def residual_scales(data: TrackingArrays, fit: BatchFit) -> ResidualScales:
     total = float(np.sqrt(np.mean(r**2)))
     if d.size < 10:
         return ResidualScales(math.nan, total, int(d.size), int(r.size))
-    noise = MAD_TO_SIGMA * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(6.0)
+    noise = float(robust_scale(d)) / math.sqrt(6.0)
     return ResidualScales(noise, total, int(d.size), int(r.size))
 
 
