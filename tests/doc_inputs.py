@@ -299,14 +299,17 @@ def crd_gz(shared: Path, target: Path) -> None:
 
 
 def slr_setup(shared: Path, target: Path) -> None:
-    """an Orekit set-up for those normal points: the simulation's initial state and its four stations"""
+    """an Orekit set-up for those normal points: the simulation's initial state, force model and four stations"""
     from abrupt.simulate.slr import DEFAULT_SITES
 
     sim = _slr_simulation()
+    force = sim.scenario.force  # type: ignore[attr-defined]
+    degree = max(force.zonal_degree, force.gravity_degree)  # the simulation's field (J2), not a 20x20 one
     lines = [f"orbit.date = {np.datetime_as_string(sim.epoch_utc, unit='ms')}", "inertial.frame = EME2000"]  # type: ignore[attr-defined]
     for key, value in zip(("px", "py", "pz", "vx", "vy", "vz"), sim.x0, strict=True):  # type: ignore[attr-defined]
         lines.append(f"orbit.cartesian.{key} = {value:.3f}")
-    lines += ["central.body.degree = 20", "central.body.order = 20", "third.body.sun = true", "third.body.moon = true"]
+    lines += [f"central.body.degree = {degree}", f"central.body.order = {degree}"]
+    lines += [f"third.body.sun = {str(force.sun).lower()}", f"third.body.moon = {str(force.moon).lower()}"]
     for k, (name, lat, lon, height, _, _) in enumerate(DEFAULT_SITES):
         lines += [
             f"ground.station.name [{k}] = {name}",

@@ -10,6 +10,7 @@ the events (one ``run_id`` and configuration hash), the fit summary and the diag
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -20,7 +21,8 @@ import pandas as pd
 
 from abrupt.detect.tracking.glrt import GlrtManeuverDetector
 from abrupt.detect.tracking.kaderali import KaderaliManeuverDetector
-from abrupt.errors import RepairLog
+from abrupt.detect.tracking.noise_scale import ResidualScales, calibration_factor, misfit, residual_scales
+from abrupt.errors import InputError, RepairLog
 from abrupt.events import config_hash, empty_frame, new_run_id, restamp
 from abrupt.model.implied_orbit import check_implied_speeds, check_ranges_against_orbit
 from abrupt.model.orbit import ForceContext, ForceModel
@@ -231,6 +233,9 @@ def detect_tracking(
     }
     cfg_hash = config_hash(run_settings)
     run_id = run_id or new_run_id()
+    scales = residual_scales(series.data, series.orbit_fit())
+    sigma_scale = calibration_factor(scales)
+    series = calibrated_series(series, sigma_scale)
     final_fit: BatchFit = series.orbit_fit()
     frames = []
     diag_frames = []
@@ -282,6 +287,14 @@ def detect_tracking(
                 }
             )
         )
+    post = residual_scales(data, final_fit)
+    if misfit(post):
+        raise InputError(
+            f"the orbit fit does not describe the data: post-fit weighted RMS {final_fit.rms_white:.3g} "
+            f"with {len(final_fit.impulse_times_s)} impulse(s), against a noise level "
+            f"of {post.noise:.3g} stated sigmas; check the set-up's force model, stations and frames",
+            file=file_name,
+        )
     found = [f for f in frames if len(f)]
     events = (
         restamp(pd.concat(found, ignore_index=True, sort=False), run_id=run_id, config_hash=cfg_hash)
@@ -290,10 +303,30 @@ def detect_tracking(
     )
     summary = fit_summary(final_fit, force.model, sun_moon_gcrf(np.array([inputs.epoch_utc]))[0][0])
     summary["repairs"] = inputs.repairs.as_dict()
+    summary["noise"] = noise_summary(scales, post, sigma_scale)
     if settings.method in ("both", "glrt"):
         summary["glrt_threshold"] = glrt_thresholds[0] if glrt_thresholds else None
     diagnostics = pd.concat(diag_frames, ignore_index=True) if diag_frames else pd.DataFrame()
     return TrackingRun(events, summary, diagnostics, cfg_hash, run_id, run_settings)
+
+
+def calibrated_series(series: TrackingSeries, sigma_scale: float) -> TrackingSeries:
+    """``series`` with every stated sigma multiplied by ``sigma_scale`` (the series itself when it is 1)."""
+    if sigma_scale == 1.0:
+        return series
+    data = copy.copy(series.data)
+    data.sigma = series.data.sigma * sigma_scale
+    return TrackingSeries(data, series.x0_apriori_m_mps, series.fit_config, name=series.name)
+
+
+def noise_summary(before: ResidualScales, after: ResidualScales, sigma_scale: float) -> dict[str, float]:
+    """The data's own noise level against the stated sigmas, the factor applied, and the post-fit scale."""
+    return {
+        "noise_per_stated_sigma": before.noise,
+        "sigma_scale": sigma_scale,
+        "post_fit_rms": after.total,
+        "post_fit_noise": after.noise,
+    }
 
 
 def fit_summary(fit: BatchFit, force: ForceModel, sun_m: Any) -> dict[str, Any]:
@@ -359,6 +392,12 @@ def fit_summary_lines(summary: dict[str, Any]) -> list[str]:
             f"± {acc['magnitude_sigma_mps2']:.1e} m/s² "
             f"(N frame {', '.join(f'{v:.2e}' for v in acc['vector_mps2'])}), "
             f"{acc['angle_to_anti_sun_deg']:.1f}° from the anti-Sun direction"
+        )
+    noise = summary.get("noise")
+    if noise:
+        lines.append(
+            f"  noise: {noise['noise_per_stated_sigma']:.3g} × the stated sigmas (within-pass second differences); "
+            f"sigmas scaled by {noise['sigma_scale']:.3g} before thresholding"
         )
     for kind, n in summary.get("repairs", {}).items():
         lines.append(f"  repaired: {kind}: {n}")

@@ -1,0 +1,95 @@
+"""The tracking data's own noise level, so that a false-alarm rate does not rest on the stated sigmas.
+
+A set-up file states measurement sigmas that are often wrong. The tracking detectors threshold
+whitened residuals (residual / stated sigma), so sigmas stated k times too small make every statistic
+k² times too large and the false-alarm rate meaningless. :func:`residual_scales` measures two scales of
+an orbit fit's whitened residuals:
+
+* ``noise``: from second differences of consecutive residuals of one station and measurement type
+  within a pass (robust: 1.4826 × MAD / √6). Smooth signatures (a maneuver's, an imperfect force
+  model's: offsets and trends within a pass) nearly cancel in them, so this is the measurement noise
+  in units of the stated sigma, whether or not the fit already holds the maneuvers;
+* ``total``: the RMS of the residuals themselves, noise plus whatever the fit leaves unexplained.
+
+:func:`calibration_factor` turns ``noise`` into the factor the stated sigmas are multiplied by before
+thresholding (never below 1: sigmas stated too large only cost power), and :func:`misfit` says when the
+fit does not describe the data at all (the residuals stand far above the noise: a set-up whose force
+model, stations or frames are not those of the data).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from abrupt.model.orbit.batch_fit import BatchFit
+from abrupt.model.tracking_measurements import TrackingArrays
+from abrupt.thresholds.noise import robust_scale
+
+MAD_SCALE_SE = 1.166
+"""Asymptotic standard error of the MAD scale estimate, in units of σ/√n (37 % efficiency; an
+approximation for the correlated second differences)."""
+PASS_GAP_S = 900.0
+"""Consecutive measurements of one station further apart than this belong to different passes [s]."""
+MISFIT_RATIO = 2.5
+"""The fit does not describe the data when its residuals' scale exceeds this many noise levels."""
+
+
+@dataclass(frozen=True)
+class ResidualScales:
+    """Whitened-residual scales of one fit (units of the stated sigma) and the counts behind them."""
+
+    noise: float
+    total: float
+    n_differences: int
+    n_residuals: int
+
+
+def residual_scales(data: TrackingArrays, fit: BatchFit) -> ResidualScales:
+    """Noise (from within-pass second differences) and RMS of ``fit``'s whitened residuals."""
+    used = fit.used
+    r = fit.residuals_white[used]
+    rows = fit.row_index[used]
+    comp = fit.row_component[used]
+    if r.size == 0:
+        return ResidualScales(math.nan, math.nan, 0, 0)
+    t = data.t_s[rows]
+    station = np.asarray(data.station_names, dtype=object)[rows]
+    codes = np.unique(station, return_inverse=True)[1]
+    order = np.lexsort((t, comp, codes))
+    same = (
+        (np.diff(codes[order]) == 0)
+        & (np.diff(comp[order]) == 0)
+        & (np.diff(t[order]) <= PASS_GAP_S)
+        & (np.diff(t[order]) > 0)
+    )
+    triple = same[:-1] & same[1:]
+    rs = r[order]
+    d = (rs[2:] - 2.0 * rs[1:-1] + rs[:-2])[triple]
+    total = float(np.sqrt(np.mean(r**2)))
+    if d.size < 10:
+        return ResidualScales(math.nan, total, int(d.size), int(r.size))
+    noise = float(robust_scale(d)) / math.sqrt(6.0)
+    return ResidualScales(noise, total, int(d.size), int(r.size))
+
+
+def calibration_factor(scales: ResidualScales) -> float:
+    """Factor for the stated sigmas: the noise scale's lower 2σ bound, at least 1 (1 without differences).
+
+    The lower bound keeps data whose stated sigmas are right (noise ≈ 1 within its sampling error) on
+    their stated sigmas, and removes most of a miscalibration larger than that sampling error.
+    """
+    if not math.isfinite(scales.noise) or scales.n_differences < 10:
+        return 1.0
+    lower = scales.noise * (1.0 - 2.0 * MAD_SCALE_SE / math.sqrt(scales.n_differences))
+    return max(1.0, lower)
+
+
+def misfit(scales: ResidualScales) -> bool:
+    """True when the residuals stand more than :data:`MISFIT_RATIO` times above the noise (and above
+    the stated sigmas): the fit's model does not describe the data."""
+    if not math.isfinite(scales.noise) or not math.isfinite(scales.total):
+        return False
+    return scales.total > MISFIT_RATIO * max(scales.noise, 1.0)
