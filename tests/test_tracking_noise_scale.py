@@ -96,6 +96,7 @@ def test_detectors_called_from_the_api_calibrate_on_the_data_s_noise(name: str) 
     series = _api_series(4.0)
     result = api.get_detector(name)().detect(series, api.FalseAlarmBudget(0.1, "day"))
     assert len(result.events) == 0
+    assert result.warnings == ()
     noise = result.diagnostics[0].extra["noise"]
     assert noise["noise_per_stated_sigma"] == pytest.approx(4.0, rel=0.15)
     assert 1.0 < noise["sigma_scale"] <= noise["noise_per_stated_sigma"]
@@ -107,3 +108,17 @@ def test_a_calibrated_series_is_not_scaled_again() -> None:
     twice = calibrate_noise(once.series)
     assert twice.series is once.series
     np.testing.assert_array_equal(twice.series.data.sigma, series.data.sigma * once.factor)
+
+
+def test_the_api_detector_warns_when_the_set_up_does_not_describe_the_data(tmp_path: Path) -> None:
+    """The station moved 2° north in the set-up (as in the refusal test above), detector called from the
+    API: a one-line warning naming the post-fit RMS instead of trusted events."""
+    tdm, setup = _simulate(tmp_path, 0.0, 1.0)
+    text = setup.read_text()
+    lat = next(line for line in text.splitlines() if line.startswith("ground.station.latitude"))
+    key, value = lat.split("=")
+    setup.write_text(text.replace(lat, f"{key}= {float(value) + 2.0!r}"))
+    series = api.read_tracking_series(tdm, setup, api.TrackingSettings()).series
+    result = api.get_detector("tracking.glrt")().detect(series, api.FalseAlarmBudget(0.1, "day"))
+    assert len(result.warnings) == 1
+    assert "does not describe the data" in result.warnings[0] and "weighted RMS" in result.warnings[0]

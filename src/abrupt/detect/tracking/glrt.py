@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
-from abrupt.detect.tracking.noise_scale import calibrate_noise
+from abrupt.detect.tracking.noise_scale import calibrate_noise, misfit_warnings
 from abrupt.events import Event, empty_frame, events_frame, format_time_utc
 from abrupt.model.orbit import ForceContext, rsw_basis
 from abrupt.model.orbit.batch_fit import BatchFit, BatchFitConfig, fit_orbit
@@ -499,4 +499,4 @@ class GlrtManeuverDetector(Detector[TrackingSeries]):
                 ),
             )
         frame = events_frame(events) if events else empty_frame()
-        return DetectionResult(frame, diagnostics)
+        return DetectionResult(frame, diagnostics, misfit_warnings(data, fit))

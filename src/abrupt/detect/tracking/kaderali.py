@@ -29,7 +29,7 @@ from scipy.optimize import curve_fit
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.detect.tracking.glrt import DEFAULT_BUDGET, GlrtConfig, maneuver_search
-from abrupt.detect.tracking.noise_scale import calibrate_noise
+from abrupt.detect.tracking.noise_scale import calibrate_noise, misfit_warnings
 from abrupt.events import Event, empty_frame, events_frame, format_time_utc
 from abrupt.model.orbit import MU_KADERALI_M3_S2, ForceContext, ForceModel, propagate_with_stm
 from abrupt.model.orbit.batch_fit import scaled_force
@@ -648,4 +648,7 @@ class KaderaliManeuverDetector(Detector[TrackingSeries]):
                 "noise": calibration.as_dict(),
             },
         )
-        return DetectionResult(events_frame(events) if events else empty_frame(), (diagnostics,))
+        frame = events_frame(events) if events else empty_frame()
+        # the plain orbit fit of an arc with a maneuver in it is no misfit: judged only on the maneuver fit
+        warnings = misfit_warnings(series.data, fit) if self.start == "maneuver_fit" else ()
+        return DetectionResult(frame, (diagnostics,), warnings)

@@ -131,3 +131,15 @@ def _calibrate(series: TrackingSeries) -> NoiseCalibration:
     out = NoiseCalibration(scaled, scales, factor)
     scaled.cached("noise_calibration", lambda: out)
     return out
+
+
+def misfit_warnings(data: TrackingArrays, fit: BatchFit) -> tuple[str, ...]:
+    """A one-line warning when ``fit`` (impulses included) does not describe ``data`` (:func:`misfit`)."""
+    scales = residual_scales(data, fit)
+    if not misfit(scales):
+        return ()
+    return (
+        f"the orbit fit does not describe the data: post-fit weighted RMS {fit.rms_white:.3g} with "
+        f"{len(fit.impulse_times_s)} impulse(s), against a noise level of {scales.noise:.3g} stated sigmas; "
+        "events are not to be trusted",
+    )
