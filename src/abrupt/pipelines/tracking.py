@@ -10,7 +10,6 @@ the events (one ``run_id`` and configuration hash), the fit summary and the diag
 
 from __future__ import annotations
 
-import copy
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -21,7 +20,7 @@ import pandas as pd
 
 from abrupt.detect.tracking.glrt import GlrtManeuverDetector
 from abrupt.detect.tracking.kaderali import KaderaliManeuverDetector
-from abrupt.detect.tracking.noise_scale import ResidualScales, calibration_factor, misfit, residual_scales
+from abrupt.detect.tracking.noise_scale import calibrate_noise, misfit, residual_scales
 from abrupt.errors import InputError, RepairLog
 from abrupt.events import config_hash, empty_frame, new_run_id, restamp
 from abrupt.model.implied_orbit import check_implied_speeds, check_ranges_against_orbit
@@ -233,9 +232,8 @@ def detect_tracking(
     }
     cfg_hash = config_hash(run_settings)
     run_id = run_id or new_run_id()
-    scales = residual_scales(series.data, series.orbit_fit())
-    sigma_scale = calibration_factor(scales)
-    series = calibrated_series(series, sigma_scale)
+    calibration = calibrate_noise(series)  # what the detectors run themselves; shared through the series cache
+    series = calibration.series
     final_fit: BatchFit = series.orbit_fit()
     frames = []
     diag_frames = []
@@ -303,30 +301,11 @@ def detect_tracking(
     )
     summary = fit_summary(final_fit, force.model, sun_moon_gcrf(np.array([inputs.epoch_utc]))[0][0])
     summary["repairs"] = inputs.repairs.as_dict()
-    summary["noise"] = noise_summary(scales, post, sigma_scale)
+    summary["noise"] = {**calibration.as_dict(), "post_fit_rms": post.total, "post_fit_noise": post.noise}
     if settings.method in ("both", "glrt"):
         summary["glrt_threshold"] = glrt_thresholds[0] if glrt_thresholds else None
     diagnostics = pd.concat(diag_frames, ignore_index=True) if diag_frames else pd.DataFrame()
     return TrackingRun(events, summary, diagnostics, cfg_hash, run_id, run_settings)
-
-
-def calibrated_series(series: TrackingSeries, sigma_scale: float) -> TrackingSeries:
-    """``series`` with every stated sigma multiplied by ``sigma_scale`` (the series itself when it is 1)."""
-    if sigma_scale == 1.0:
-        return series
-    data = copy.copy(series.data)
-    data.sigma = series.data.sigma * sigma_scale
-    return TrackingSeries(data, series.x0_apriori_m_mps, series.fit_config, name=series.name)
-
-
-def noise_summary(before: ResidualScales, after: ResidualScales, sigma_scale: float) -> dict[str, float]:
-    """The data's own noise level against the stated sigmas, the factor applied, and the post-fit scale."""
-    return {
-        "noise_per_stated_sigma": before.noise,
-        "sigma_scale": sigma_scale,
-        "post_fit_rms": after.total,
-        "post_fit_noise": after.noise,
-    }
 
 
 def fit_summary(fit: BatchFit, force: ForceModel, sun_m: Any) -> dict[str, Any]:

@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
+from abrupt.detect.tracking.noise_scale import calibrate_noise, misfit_warnings
 from abrupt.events import Event, empty_frame, events_frame, format_time_utc
 from abrupt.model.orbit import ForceContext, rsw_basis
 from abrupt.model.orbit.batch_fit import BatchFit, BatchFitConfig, fit_orbit
@@ -465,6 +466,8 @@ class GlrtManeuverDetector(Detector[TrackingSeries]):
     def detect(self, series: TrackingSeries, budget: FalseAlarmBudget) -> DetectionResult:
         if len(series) == 0:
             return DetectionResult.empty(warnings=("no tracking measurements",))
+        calibration = calibrate_noise(series)  # thresholds on the data's own noise, not the stated sigmas
+        series = calibration.series
         detections, fit, scans = maneuver_search(series, self.glrt_config(budget))
         data = series.data
         cfg_hash = self.config_hash_for(budget)
@@ -492,8 +495,8 @@ class GlrtManeuverDetector(Detector[TrackingSeries]):
                     threshold=replace(thr, false_alarms_per_day=budget.per_day),
                     epoch_utc=data.epoch_utc,
                     unit="chi-square (3 dof)",
-                    extra={"fit": fit},
+                    extra={"fit": fit, "noise": calibration.as_dict()},
                 ),
             )
         frame = events_frame(events) if events else empty_frame()
-        return DetectionResult(frame, diagnostics)
+        return DetectionResult(frame, diagnostics, misfit_warnings(data, fit))

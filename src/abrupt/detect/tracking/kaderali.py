@@ -29,6 +29,7 @@ from scipy.optimize import curve_fit
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.detect.tracking.glrt import DEFAULT_BUDGET, GlrtConfig, maneuver_search
+from abrupt.detect.tracking.noise_scale import calibrate_noise, misfit_warnings
 from abrupt.events import Event, empty_frame, events_frame, format_time_utc
 from abrupt.model.orbit import MU_KADERALI_M3_S2, ForceContext, ForceModel, propagate_with_stm
 from abrupt.model.orbit.batch_fit import scaled_force
@@ -602,6 +603,8 @@ class KaderaliManeuverDetector(Detector[TrackingSeries]):
     def detect(self, series: TrackingSeries, budget: FalseAlarmBudget) -> DetectionResult:
         if len(series) == 0:
             return DetectionResult.empty(warnings=("no tracking measurements",))
+        calibration = calibrate_noise(series)  # thresholds on the data's own noise, not the stated sigmas
+        series = calibration.series
         if self.start == "maneuver_fit":
             _, fit, _ = maneuver_search(series, GlrtConfig(budget=budget, max_maneuvers=self.max_maneuvers))
         else:
@@ -638,6 +641,14 @@ class KaderaliManeuverDetector(Detector[TrackingSeries]):
             threshold=replace(thr, false_alarms_per_day=budget.per_day),
             epoch_utc=data.epoch_utc,
             unit="Psi (normalised innovation squared)",
-            extra={"k_db": result.k_db, "trace_p_km": result.trace_p_km, "inflated": result.inflated},
+            extra={
+                "k_db": result.k_db,
+                "trace_p_km": result.trace_p_km,
+                "inflated": result.inflated,
+                "noise": calibration.as_dict(),
+            },
         )
-        return DetectionResult(events_frame(events) if events else empty_frame(), (diagnostics,))
+        frame = events_frame(events) if events else empty_frame()
+        # the plain orbit fit of an arc with a maneuver in it is no misfit: judged only on the maneuver fit
+        warnings = misfit_warnings(series.data, fit) if self.start == "maneuver_fit" else ()
+        return DetectionResult(frame, (diagnostics,), warnings)

@@ -14,11 +14,14 @@ an orbit fit's whitened residuals:
 :func:`calibration_factor` turns ``noise`` into the factor the stated sigmas are multiplied by before
 thresholding (never below 1: sigmas stated too large only cost power), and :func:`misfit` says when the
 fit does not describe the data at all (the residuals stand far above the noise: a set-up whose force
-model, stations or frames are not those of the data).
+model, stations or frames are not those of the data). :func:`calibrate_noise` is the step both tracking
+detectors run at the start of ``detect``: the series with its sigmas scaled, kept on the series so that
+a second detector (or a second call) reuses it and a calibrated series is never scaled again.
 """
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass
 
@@ -26,6 +29,7 @@ import numpy as np
 
 from abrupt.model.orbit.batch_fit import BatchFit
 from abrupt.model.tracking_measurements import TrackingArrays
+from abrupt.series.tracking import TrackingSeries
 from abrupt.thresholds.noise import robust_scale
 
 MAD_SCALE_SE = 1.166
@@ -93,3 +97,49 @@ def misfit(scales: ResidualScales) -> bool:
     if not math.isfinite(scales.noise) or not math.isfinite(scales.total):
         return False
     return scales.total > MISFIT_RATIO * max(scales.noise, 1.0)
+
+
+@dataclass(frozen=True)
+class NoiseCalibration:
+    """A series with its stated sigmas scaled by ``factor``, and the scales measured on the stated sigmas."""
+
+    series: TrackingSeries
+    scales: ResidualScales
+    factor: float
+
+    def as_dict(self) -> dict[str, float]:
+        return {"noise_per_stated_sigma": self.scales.noise, "sigma_scale": self.factor}
+
+
+def calibrate_noise(series: TrackingSeries) -> NoiseCalibration:
+    """``series`` with every stated sigma multiplied by :func:`calibration_factor` of its orbit fit.
+
+    Kept on ``series`` (one orbit fit per series); the calibrated series carries the same calibration,
+    so calibrating it again returns it unchanged (no double scaling).
+    """
+    return series.cached("noise_calibration", lambda: _calibrate(series))
+
+
+def _calibrate(series: TrackingSeries) -> NoiseCalibration:
+    scales = residual_scales(series.data, series.orbit_fit())
+    factor = calibration_factor(scales)
+    if factor == 1.0:
+        return NoiseCalibration(series, scales, factor)
+    data = copy.copy(series.data)
+    data.sigma = series.data.sigma * factor
+    scaled = TrackingSeries(data, series.x0_apriori_m_mps, series.fit_config, name=series.name)
+    out = NoiseCalibration(scaled, scales, factor)
+    scaled.cached("noise_calibration", lambda: out)
+    return out
+
+
+def misfit_warnings(data: TrackingArrays, fit: BatchFit) -> tuple[str, ...]:
+    """A one-line warning when ``fit`` (impulses included) does not describe ``data`` (:func:`misfit`)."""
+    scales = residual_scales(data, fit)
+    if not misfit(scales):
+        return ()
+    return (
+        f"the orbit fit does not describe the data: post-fit weighted RMS {fit.rms_white:.3g} with "
+        f"{len(fit.impulse_times_s)} impulse(s), against a noise level of {scales.noise:.3g} stated sigmas; "
+        "events are not to be trusted",
+    )
