@@ -335,9 +335,7 @@ def detect_orbit_command(
         else:
             frame.to_parquet(statistics_out, index=False)
     events = run.events
-    chash = str(events["config_hash"].iloc[0]) if len(events) else ""
-    if not chash:
-        chash = config_hash({**run.detector.config(), "budget": str(budget)})
+    chash = _config_hash_of(events, run.detector.config(), budget)
     record_run(
         catalog_target=catalog_target,
         command="detect orbit",
@@ -352,6 +350,13 @@ def detect_orbit_command(
     if report_path and run.analysis is not None:
         path = plot_orbit_report(run.analysis, run.thresholds, events, report_path)
         click.echo(f"report written to {path}", err=True)
+
+
+def _config_hash_of(events: pd.DataFrame, detector_config: dict[str, Any], budget: FalseAlarmBudget) -> str:
+    """The run's configuration hash: the events' own, or for a run without events the one they would carry."""
+    if len(events) and str(events["config_hash"].iloc[0]):
+        return str(events["config_hash"].iloc[0])
+    return config_hash({**detector_config, "budget": str(budget)})
 
 
 def _detect_all_satellites(
@@ -393,7 +398,7 @@ def _detect_all_satellites(
             click.echo(f"  {sid:<8} warning: {warning}", err=True)
     frames = [run.events for run in runs.values() if len(run.events)]
     events = pd.concat(frames, ignore_index=True) if frames else first.events.iloc[:0]
-    chash = str(events["config_hash"].iloc[0]) if len(events) else config_hash({**first.detector.config()})
+    chash = _config_hash_of(events, first.detector.config(), budget)
     record_run(
         catalog_target=catalog_target,
         command="detect orbit",
@@ -406,7 +411,8 @@ def _detect_all_satellites(
             "satellites": {
                 sid: {k: v for k, v in run.summary.items() if k in ("thresholds", "events", "dv90_mps", "span_days")}
                 for sid, run in runs.items()
-            }
+            },
+            "repairs": first.ephemeris.repairs.as_dict(),
         },
     )
 
