@@ -12,6 +12,14 @@ import pandas as pd
 import pytest
 
 
+def _one_year(source: Path, year_yy: str, target: Path) -> Path:
+    """The two-line element sets of ``source`` whose epoch year is ``year_yy``, written to ``target``."""
+    lines = source.read_text().splitlines(keepends=True)
+    pairs = zip(lines[0::2], lines[1::2], strict=True)
+    target.write_text("".join(a + b for a, b in pairs if a[18:20] == year_yy))
+    return target
+
+
 def _capture(monkeypatch: pytest.MonkeyPatch, module: Any) -> list[Any]:
     figures: list[Any] = []
     monkeypatch.setattr(module, "save_figure", lambda fig, path, **kw: figures.append(fig) or Path(path))
@@ -143,10 +151,7 @@ def test_tle_report_panels_have_units_and_data(
     from abrupt.report import tle as report
     from abrupt.thresholds import FalseAlarmBudget
 
-    lines = (shared_data / "tle" / "Sentinel-3A.tle").read_text().splitlines(keepends=True)
-    pairs = zip(lines[0::2], lines[1::2], strict=True)
-    tle = tmp_path / "s3a.tle"
-    tle.write_text("".join(a + b for a, b in pairs if a[18:20] == "16"))
+    tle = _one_year(shared_data / "tle" / "Sentinel-3A.tle", "16", tmp_path / "s3a.tle")
     result = detect_tle_file(tle, FalseAlarmBudget.parse("1/year"))
     (sat,) = result.satellites
     figures = _capture(monkeypatch, report)
@@ -162,10 +167,7 @@ def test_density_report_panels_have_units_data_and_legends_outside(
     from abrupt.cli.main import main
     from abrupt.report import density as report
 
-    lines = (shared_data / "tle" / "CryoSat-2.tle").read_text().splitlines(keepends=True)
-    pairs = zip(lines[0::2], lines[1::2], strict=True)
-    tle = tmp_path / "cs2.tle"
-    tle.write_text("".join(a + b for a, b in pairs if a[18:20] == "15"))
+    tle = _one_year(shared_data / "tle" / "CryoSat-2.tle", "15", tmp_path / "cs2.tle")
     figures = _capture(monkeypatch, report)
     args = ["density", "tle", str(tle), "--out", str(tmp_path / "w.csv"), "--interval-days", "30"]
     try:
