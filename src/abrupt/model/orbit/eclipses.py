@@ -45,12 +45,6 @@ def _fractions(r: FloatArray, sun: FloatArray, conical: bool) -> FloatArray:
     return out
 
 
-def shadow_fractions(times_utc: np.ndarray, r_gcrf_m: FloatArray, conical: bool = True) -> FloatArray:
-    """Visible fraction of the solar disc (1 sunlit, 0 umbra) at each epoch of GCRF positions."""
-    sun, _ = sun_moon_gcrf(np.asarray(times_utc, dtype="datetime64[ns]"))
-    return _fractions(np.ascontiguousarray(r_gcrf_m, dtype=np.float64), np.ascontiguousarray(sun), conical)
-
-
 def find_eclipses(
     times_utc: np.ndarray,
     r_gcrf_m: FloatArray,
