@@ -4,13 +4,17 @@ rate on simulated null data, and a long run that finds what its blocks run as se
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
+from click.testing import CliRunner
 
+from abrupt.cli.groups import cli
 from abrupt.pipelines.orbit import detect_orbit
 from abrupt.pipelines.orbit_blocks import arc_test_mask, calibration_blocks, extended_block, part
+from abrupt.readers.navigation_csv import write_navigation_csv
 from abrupt.simulate.orbit import Impulse, OrbitSimulationConfig, simulate_orbit
 from abrupt.thresholds import FalseAlarmBudget
 
@@ -137,3 +141,30 @@ def test_a_long_run_finds_what_its_blocks_run_as_separate_arcs_find() -> None:
     truth = sim.epoch_utc + (np.array([k.time_s for k in kicks]) * 1e9).astype("timedelta64[ns]")
     for t in truth:
         assert np.min(np.abs((_event_times(run.events) - t).astype(np.float64))) * 1e-9 < 60.0
+
+
+def test_cli_runs_a_long_file_in_blocks_and_writes_each_epoch_s_threshold(two_noises, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    nav = tmp_path / "nav.csv"
+    write_navigation_csv(two_noises, nav)
+    stats = tmp_path / "stats.csv"
+    res = CliRunner().invoke(
+        cli,
+        [
+            *("detect", "orbit", str(nav), "--out", str(tmp_path / "ev.csv"), "--dynamics", "two-body"),
+            *("--block-days", "3", "--statistics-out", str(stats), "--catalog", str(tmp_path / "c.sqlite")),
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    assert "calibration blocks (2;" in res.output
+    frame = pd.read_csv(stats)
+    assert len(frame) == len(two_noises)
+    # one threshold per block, changing at the seam three days in
+    seam = pd.to_datetime(frame["time_utc"]) >= pd.Timestamp(str(two_noises.times_utc[0])) + pd.Timedelta(days=3)
+    assert frame["threshold"][~seam].nunique() == 1 and frame["threshold"][seam].nunique() == 1
+    assert frame["threshold"][~seam].iloc[0] != frame["threshold"][seam].iloc[0]
+
+
+def test_cli_refuses_a_negative_block_length(tmp_path: Path) -> None:
+    res = CliRunner().invoke(cli, ["detect", "orbit", str(tmp_path / "x.csv"), "--out", "e.csv", "--block-days", "-1"])
+    assert res.exit_code == 2
+    assert "--block-days" in res.output

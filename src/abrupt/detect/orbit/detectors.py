@@ -145,6 +145,9 @@ class OrbitDetector(Detector[Ephemeris]):
     def config(self) -> dict[str, Any]:
         out = super().config()
         out["null"] = self._null is not None
+        # how a calibration block or a later scan is run, not a setting of the detector
+        out.pop("fixed_config", None)
+        out.pop("calibration_mask", None)
         return out
 
     # ------------------------------------------------------------------ configuration
