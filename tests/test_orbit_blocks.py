@@ -137,6 +137,9 @@ def test_a_long_run_finds_what_its_blocks_run_as_separate_arcs_find() -> None:
     assert np.all(np.abs(dt) < 1.0)
     cols = ["dv_r_mps", "dv_t_mps", "dv_n_mps"]
     np.testing.assert_allclose(run.events[cols].to_numpy(float), weekly[cols].to_numpy(float), atol=1e-5)
+    # the blocks on two processes: the same run
+    parallel = detect_orbit(eph, budget="1/week", block_days=1.0, workers=2, **FAST)
+    pd.testing.assert_frame_equal(parallel.events, run.events)
     # and both find the three impulses, at their times
     truth = sim.epoch_utc + (np.array([k.time_s for k in kicks]) * 1e9).astype("timedelta64[ns]")
     for t in truth:

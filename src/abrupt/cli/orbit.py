@@ -232,6 +232,13 @@ def simulate_orbit_command(
     "calibrated on its own epochs as its own arc would be, the filters crossing the seams (0: one arc).",
 )
 @click.option(
+    "--workers",
+    type=click.IntRange(min=1),
+    default=1,
+    show_default=True,
+    help="Run the calibration blocks of a long span on this many processes.",
+)
+@click.option(
     "--all-satellites",
     is_flag=True,
     default=False,
@@ -265,6 +272,7 @@ def detect_orbit_command(
     confidence_z: float,
     sequences: bool,
     block_days: float,
+    workers: int,
     all_satellites: bool,
     kind: str,
     statistics_out: str | None,
@@ -317,6 +325,7 @@ def detect_orbit_command(
             strict=strict,
             sequences=sequences,
             block_days=block_days,
+            workers=workers,
             tuning=tuning,
             tau_s=tau_s,
             q_m2_s5=q_m2_s5,

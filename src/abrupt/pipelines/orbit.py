@@ -11,6 +11,7 @@ Python API both call these functions.
 from __future__ import annotations
 
 import copy
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -21,6 +22,7 @@ import pandas as pd
 from abrupt.detect.base import DetectionResult, Diagnostics, get_detector
 from abrupt.detect.orbit.analysis import OrbitAnalysis, innovation_scale
 from abrupt.detect.orbit.detectors import (
+    SETTLE_CAP_S,
     OrbitDetector,
     orbit_analysis,
     orbit_product_boundaries,
@@ -116,6 +118,7 @@ def detect_orbit(
     strict: bool = False,
     sequences: bool = True,
     block_days: float | None = DEFAULT_BLOCK_S / 86400.0,
+    workers: int = 1,
     **settings: Any,
 ) -> OrbitRun:
     """Detect impulsive and finite ΔVs in an ephemeris (SP3, OEM, CSV or an :class:`Ephemeris`).
@@ -131,7 +134,8 @@ def detect_orbit(
     ``block_days``: a span of at least 1.5 such blocks is run in calibration blocks (a week by default;
     None or 0: one arc however long), each tuned and calibrated on its own epochs as its own arc would be,
     with the filters running across the seams (:mod:`abrupt.pipelines.orbit_blocks`); the run's diagnostics
-    then hold the whole span's statistic and each block's threshold, not one analysis.
+    then hold the whole span's statistic and each block's threshold, not one analysis. ``workers``: the
+    blocks on that many processes.
     """
     eph = load_ephemeris(source, satellite, allow_truncated=allow_truncated, strict=strict)
     null_eph = (
@@ -144,7 +148,7 @@ def detect_orbit(
     fa = as_budget(budget)
     blocks = calibration_blocks(eph.times_utc, 86400.0 * block_days if block_days else None)
     if len(blocks) > 1:
-        return _detect_blocks(det, eph, fa, sequences, blocks)
+        return _detect_blocks(det, eph, fa, sequences, blocks, workers)
     run = _detect_arc(det, eph, fa, sequences)
     return run
 
@@ -163,45 +167,32 @@ def _detect_arc(det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, sequen
 
 
 def _detect_blocks(
-    det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, sequences: bool, blocks: list[tuple[int, int]]
+    det: OrbitDetector,
+    eph: Ephemeris,
+    fa: FalseAlarmBudget,
+    sequences: bool,
+    blocks: list[tuple[int, int]],
+    workers: int = 1,
 ) -> OrbitRun:
-    """A long span in calibration blocks (:mod:`abrupt.pipelines.orbit_blocks`): each block tuned on its own
-    epochs, its filters run a settling time into each neighbour, its threshold calibrated on the epochs its
-    own arc would test, its events those whose time lies in it."""
+    """A long span in calibration blocks (:mod:`abrupt.pipelines.orbit_blocks`), each by :func:`_block`, on
+    ``workers`` processes."""
     gcrf = eph.to_frame("GCRF")
     times = gcrf.times_utc
-    outcomes: list[BlockOutcome] = []
-    empty = None
+    step = gcrf.nominal_step_s
+    # room for the longest settling time the tuning can choose (the block's own is set inside)
+    room = max(SETTLE_CAP_S, 30.0 * step) + 4.0 * step
+    jobs = []
     for lo, hi in blocks:
-        stop = times[hi] if hi < len(gcrf) else None
-        label = f"block {str(times[lo])[:10]}"
-        arc = part(gcrf, lo, hi)
-        block = copy.copy(det)
-        try:
-            cfg = det.detector_config(arc, fa)
-        except ValueError as exc:  # auto tuning cannot read the block (a data gap leaves too few epochs)
-            outcomes.append(BlockOutcome(times[lo], times[hi - 1], pd.DataFrame(), np.full(hi - lo, np.nan), None))
-            outcomes[-1].warnings = (f"{label}: not tested ({exc})",)
-            continue
-        elo, ehi = extended_block(times, lo, hi, cfg.settle_s + 2.0 * gcrf.nominal_step_s)
-        block.fixed_config = cfg
-        block.calibration_mask = arc_test_mask(arc, cfg.settle_s, ehi - elo, lo - elo)
-        run = _detect_arc(block, part(gcrf, elo, ehi), fa, sequences)
-        empty = run.events.iloc[:0] if empty is None else empty
-        diag = run.result.diagnostics[0] if run.result.diagnostics else None
-        stat = diag.statistic[lo - elo : hi - elo] if diag is not None else np.full(hi - lo, np.nan)
-        outcomes.append(
-            BlockOutcome(
-                times[lo],
-                times[hi - 1],
-                events_in(run.events, times[lo], stop),
-                np.asarray(stat, dtype=np.float64),
-                diag.threshold if diag is not None else None,
-                run.summary,
-                tuple(f"{label}: {w}" for w in run.result.warnings),
-            )
-        )
-    events = joined_events(outcomes, empty if empty is not None else DetectionResult.empty().events)
+        a, b = extended_block(times, lo, hi, room)
+        jobs.append((part(gcrf, a, b), lo - a, hi - a))
+    parts, los, his = (list(x) for x in zip(*jobs, strict=True))
+    n = len(jobs)
+    if workers > 1:
+        with ProcessPoolExecutor(max_workers=min(workers, n)) as pool:
+            outcomes = list(pool.map(_block, [det] * n, parts, los, his, [fa] * n, [sequences] * n))
+    else:
+        outcomes = [_block(det, *job, fa, sequences) for job in jobs]
+    empty = next((o.events.iloc[:0] for o in outcomes if o.events.columns.size), DetectionResult.empty().events)
     sizes = [hi - lo for lo, hi in blocks]
     diag = Diagnostics(
         name=f"orbit.{det.statistic}",
@@ -212,9 +203,41 @@ def _detect_blocks(
         extra={"blocks": [o.record() for o in outcomes], "threshold_per_epoch": per_epoch_thresholds(outcomes, sizes)},
     )
     warnings = tuple(w for o in outcomes for w in o.warnings)
-    run = OrbitRun(eph, det, DetectionResult(events, (diag,), warnings), fa)
+    run = OrbitRun(eph, det, DetectionResult(joined_events(outcomes, empty), (diag,), warnings), fa)
     run.summary = blocks_summary(outcomes, gcrf)
     return run
+
+
+def _block(det: OrbitDetector, ext: Ephemeris, lo: int, hi: int, fa: FalseAlarmBudget, sequences: bool) -> BlockOutcome:
+    """One calibration block, epochs ``lo`` to ``hi`` of ``ext`` (the block with its neighbours' epochs
+    around it): tuned on its own epochs, its filters run a settling time into each neighbour, its threshold
+    calibrated on the epochs its own arc would test, its events those whose time lies in it."""
+    times = ext.times_utc
+    label = f"block {str(times[lo])[:10]}"
+    arc = part(ext, lo, hi)
+    try:
+        cfg = det.detector_config(arc, fa)
+    except ValueError as exc:  # auto tuning cannot read the block (a data gap leaves too few epochs)
+        nothing = np.full(hi - lo, np.nan)
+        return BlockOutcome(
+            times[lo], times[hi - 1], pd.DataFrame(), nothing, None, {}, (f"{label}: not tested ({exc})",)
+        )
+    elo, ehi = extended_block(times, lo, hi, cfg.settle_s + 2.0 * ext.nominal_step_s)
+    block = copy.copy(det)
+    block.fixed_config = cfg
+    block.calibration_mask = arc_test_mask(arc, cfg.settle_s, ehi - elo, lo - elo)
+    run = _detect_arc(block, part(ext, elo, ehi), fa, sequences)
+    diag = run.result.diagnostics[0] if run.result.diagnostics else None
+    stat = diag.statistic[lo - elo : hi - elo] if diag is not None else np.full(hi - lo, np.nan)
+    return BlockOutcome(
+        times[lo],
+        times[hi - 1],
+        events_in(run.events, times[lo], times[hi] if hi < len(ext) else None),
+        np.asarray(stat, dtype=np.float64),
+        diag.threshold if diag is not None else None,
+        run.summary,
+        tuple(f"{label}: {w}" for w in run.result.warnings),
+    )
 
 
 MAX_RESIDUAL_TO_SIGMA = 10.0  # a post-fit position RMS this many stated σ_pos: the filter is not following

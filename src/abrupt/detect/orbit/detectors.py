@@ -142,6 +142,11 @@ class OrbitDetector(Detector[Ephemeris]):
         #: off where the threshold's null already holds them (thresholds pooled over a product's satellites)
         self.eclipses = True
 
+    def __reduce__(self) -> tuple[Any, ...]:
+        # the registered classes are made by ``type`` below, not module attributes: pickle (for the worker
+        # processes of a long run) rebuilds one from its registered name
+        return (_rebuild, (self.name, dict(vars(self))))
+
     def config(self) -> dict[str, Any]:
         out = super().config()
         out["null"] = self._null is not None
@@ -339,6 +344,14 @@ ORBIT_DETECTORS: dict[str, type[OrbitDetector]] = {
     )
     for statistic, summary in STATISTIC_SUMMARIES.items()
 }
+
+
+def _rebuild(name: str, state: dict[str, Any]) -> OrbitDetector:
+    """The detector ``name`` (a key of :data:`ORBIT_DETECTORS`) with the attributes ``state``."""
+    cls = ORBIT_DETECTORS[name]
+    detector = cls.__new__(cls)
+    detector.__dict__.update(state)
+    return detector
 
 
 def orbit_analysis(result: DetectionResult) -> OrbitAnalysis | None:
