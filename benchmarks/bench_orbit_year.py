@@ -163,7 +163,8 @@ def run_arcs(eph: Ephemeris, truth: list[pd.Timestamp]) -> None:
         f"({c_wk / span_weeks:.1f} CPU-s per 7 days)   ({load()}; peak memory {peak_mb():.0f} MB)"
     )
     print(f"  same-run ratio whole span / weekly arcs: CPU {c_all / c_wk:.2f}, wall {w_all / w_wk:.2f}")
-    compare(eph, whole, whole_stat, blocks, arcs)
+    d = whole_run.result.diagnostics[0]
+    compare(eph, whole, whole_stat, d.threshold.value if d.threshold else np.nan, blocks, arcs)
     for label, ev in (("whole", whole), ("weekly", weekly_ev)):
         hit, _, extra, _ = match(pd.Series(truth, dtype="datetime64[ns]"), ev["time_utc"])
         print(f"  {label}: known impulses found {hit}/{len(truth)}, other events {extra}")
@@ -181,7 +182,12 @@ def run_arcs(eph: Ephemeris, truth: list[pd.Timestamp]) -> None:
 
 
 def compare(
-    eph: Ephemeris, whole: pd.DataFrame, whole_stat: np.ndarray, blocks: list[dict[str, Any]], arcs: list[Arc]
+    eph: Ephemeris,
+    whole: pd.DataFrame,
+    whole_stat: np.ndarray,
+    whole_threshold: float,
+    blocks: list[dict[str, Any]],
+    arcs: list[Arc],
 ) -> None:
     """The acceptance's comparison: thresholds and statistic on the epochs both test, events outside the
     arcs' settling windows one to one, and what the whole-span run adds inside them."""
@@ -195,7 +201,7 @@ def compare(
         if both.any() and np.isfinite(a.threshold):
             diff = np.abs(whole_stat[a.lo : a.hi][both] - a.statistic[both]).max() / a.threshold
             worst_stat = max(worst_stat, float(diff))
-    thr_whole = np.array([b["threshold"] for b in blocks]) if blocks else np.array([np.nan])
+    thr_whole = np.array([b["threshold"] for b in blocks]) if blocks else np.array([whole_threshold])
     thr_arcs = np.array([a.threshold for a in arcs])
     if thr_whole.size == thr_arcs.size:
         rel = np.nanmax(np.abs(thr_whole - thr_arcs) / thr_arcs)
