@@ -2,11 +2,18 @@
 
 from __future__ import annotations
 
-import numpy as np
-import pytest
+from pathlib import Path
 
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+
+from abrupt import api
+from abrupt.cli.main import cli
 from abrupt.detect.tracking.kaderali import (
     KaderaliConfig,
+    KaderaliManeuverDetector,
     calibrate_psi_threshold,
     fit_characterisation,
     invert_characterisation,
@@ -128,3 +135,51 @@ def test_simulated_psi_threshold_holds_its_false_alarm_rate_on_independent_null_
     assert null_psi.size == 4 * len(data)
     fresh = np.concatenate([_run(mask=1.0, seed=s)[0].psi for s in (21, 22)])
     assert 0.02 < np.mean(fresh > th) < 0.05
+
+
+def _burn_arc(seed: int) -> tuple[api.TrackingSeries, float]:
+    """A thesis arc (Ascension, 20 s) with a 0.1 m/s transverse apogee burn after 2.5 orbits, and its start [s]."""
+    burn = thesis_burn("apogee", "S", 0.1)
+    sc = TrackingScenario(stations=(ascension(),), cadence_s=20.0, burns=(burn,))
+    sim = simulate_tracking(sc, seed=seed)
+    data = TrackingArrays(sim.measurements, {}, epoch_utc=sim.epoch_utc)
+    return api.TrackingSeries(data, sim.initial_state, api.BatchFitConfig()), burn.t_start_s
+
+
+def _event_s(events: pd.DataFrame, epoch: np.datetime64) -> np.ndarray:
+    t = pd.to_datetime(events["time_utc"], utc=True).dt.tz_localize(None).to_numpy("datetime64[ns]")
+    return (t - np.datetime64(epoch, "ns")) / np.timedelta64(1, "s")
+
+
+def test_a_burn_later_in_the_arc_raises_no_event_before_it() -> None:
+    """The detector as the API calls it starts the filter from the maneuver-aware fit: nothing is raised
+    before the burn (the simulation's truth), and the burn is found within the next pass. Started from
+    the whole-arc fit, which the burn bends (the pre-burn orbit km off), it raises the pass before."""
+    series, t_burn = _burn_arc(1003)
+    budget = api.FalseAlarmBudget(0.1, "day")
+    t = _event_s(api.get_detector("tracking.kaderali_k")().detect(series, budget).events, series.data.epoch_utc)
+    assert t.size >= 1
+    assert np.all(t > t_burn - 1800.0)
+    assert np.any((t > t_burn) & (t < t_burn + 6 * 3600.0))
+    plain = KaderaliManeuverDetector(start="orbit_fit").detect(series, budget).events
+    assert np.any(_event_s(plain, series.data.epoch_utc) < t_burn - 1800.0)
+
+
+def test_the_command_line_s_kaderali_alone_and_with_the_glrt_start_alike(tmp_path: Path) -> None:
+    """``--method kaderali`` and ``--method both`` start the filter from the same maneuver-aware fit: on a
+    burn arc the Kaderali events are the same (before, ``kaderali`` alone refused the arc as a misfit)."""
+    tdm = tmp_path / "b.tdm"
+    args = ["simulate", "tracking", "--out", str(tdm), "--truth-out", str(tmp_path / "truth.csv")]
+    args += ["--location", "apogee", "--direction", "S", "--dv", "0.1", "--cadence", "20", "--seed", "3"]
+    assert CliRunner().invoke(cli, args).exit_code == 0
+    times = {}
+    for method in ("kaderali", "both"):
+        out = tmp_path / f"{method}.csv"
+        args = ["detect", "tracking", str(tdm), "--setup", str(tdm.with_suffix(".in")), "--method", method]
+        r = CliRunner().invoke(cli, [*args, "--out", str(out), "--catalog", str(tmp_path / f"{method}.sqlite")])
+        assert r.exit_code == 0, r.output
+        ev = pd.read_csv(out)
+        times[method] = list(ev.loc[ev["detector"] == "tracking.kaderali_k", "time_utc"])
+    truth = pd.Timestamp(pd.read_csv(tmp_path / "truth.csv")["time_utc"].iloc[0])
+    assert times["kaderali"] and times["kaderali"] == times["both"]
+    assert all(pd.Timestamp(t) > truth - pd.Timedelta(minutes=30) for t in times["kaderali"])

@@ -266,12 +266,13 @@ def detect_tracking(
             eta_threshold_km=settings.eta_threshold_km,
             elevation_mask_deg=settings.elevation_mask_deg,
             threshold_fit=settings.kaderali_threshold,
-            start="maneuver_fit" if settings.method == "both" else "orbit_fit",
             max_maneuvers=settings.max_maneuvers,
         )
         result = kaderali.detect(series, budget)
         frames.append(result.events)
         d = result.diagnostics[0]
+        if settings.method == "kaderali":  # the maneuver-aware fit the filter started from, as with the GLRT's
+            final_fit = d.extra["fit"]
         diag_frames.append(
             pd.DataFrame(
                 {

@@ -546,9 +546,12 @@ def simulated_null_threshold(
 class KaderaliManeuverDetector(Detector[TrackingSeries]):
     """``tracking.kaderali_k``: the Kaderali EKF's Ψ and K (dB) on bias-corrected measurements.
 
-    The filter starts from the orbit fit (``start="orbit_fit"``) or from the GLRT's maneuver-aware fit
-    (``start="maneuver_fit"``, with ``max_maneuvers``), with the fitted station biases applied to a
-    copy of the measurements and the fitted constant acceleration. The Ψ detection threshold is the
+    The filter starts from the GLRT's maneuver-aware fit (``start="maneuver_fit"``, the default, with
+    ``max_maneuvers``): its state at the arc's start is fitted with the impulses the GLRT finds, so a
+    burn later in the arc does not bend it. ``start="orbit_fit"`` (the whole arc fitted as one orbit)
+    lets a burn pull the starting orbit towards the post-burn one, and the filter then flags the passes
+    before the burn. Either way the fitted station biases are applied to a copy of the measurements and
+    the fitted constant acceleration is used. The Ψ detection threshold is the
     GPD tail of Ψ on ``n_null_runs`` event-free simulations of this data set (``threshold_fit=
     "simulated"``) or the χ²_m upper point at the budget's per-update level (``"chi2"``), unless a
     fixed ``psi_detection_threshold`` is given. ``psi_threshold`` and ``eta_threshold_km`` are the
@@ -567,7 +570,7 @@ class KaderaliManeuverDetector(Detector[TrackingSeries]):
         eta_threshold_km: float = 1.0,
         elevation_mask_deg: float | None = None,
         threshold_fit: Literal["simulated", "chi2"] = "simulated",
-        start: Literal["orbit_fit", "maneuver_fit"] = "orbit_fit",
+        start: Literal["orbit_fit", "maneuver_fit"] = "maneuver_fit",
         max_maneuvers: int = 3,
         n_null_runs: int = 8,
         seed: int = 0,
@@ -646,6 +649,7 @@ class KaderaliManeuverDetector(Detector[TrackingSeries]):
                 "trace_p_km": result.trace_p_km,
                 "inflated": result.inflated,
                 "noise": calibration.as_dict(),
+                "fit": fit,  # the fit the filter started from
             },
         )
         frame = events_frame(events) if events else empty_frame()
