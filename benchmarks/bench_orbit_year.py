@@ -240,5 +240,8 @@ def compare(
 if __name__ == "__main__":
     from _results import variant, write_results
 
-    with write_results("bench_orbit_year", variant({"--weeks=1": "1week", "--weeks=2": "2weeks", "--weeks=8": "8weeks", "--sp3": "sp3"})):
+    with write_results(
+        "bench_orbit_year",
+        variant({"--weeks=1": "1week", "--weeks=2": "2weeks", "--weeks=8": "8weeks", "--sp3": "sp3"}),
+    ):
         main()
