@@ -19,6 +19,10 @@ difference on the epochs both test (relative to the threshold). The same-run ref
 run itself (ratio whole span / weekly arcs). A full year is ``--weeks 52``; a shorter span is a
 measurement of that span and a projection of the year, said so in the output. ``--sp3 FILE`` takes a
 real precise orbit instead of the simulation (cut into the same blocks; no impulses are known in it).
+
+The simulation, not the detector, limits the span: ``simulate_orbit`` resolves each orbit-frame impulse
+by propagating the truth from the start to it, so K weekly impulses cost ~K²/2 weeks of propagation
+(2 weeks: 11 CPU-s; 52 weeks: ~1400 weeks of propagation, about an hour of CPU before any detection).
 """
 
 from __future__ import annotations
