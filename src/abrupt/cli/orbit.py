@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import click
+import numpy as np
 import pandas as pd
 
 from abrupt.cli.groups import (
@@ -27,7 +28,7 @@ from abrupt.detect.orbit.detectors import STATISTIC_SUMMARIES
 from abrupt.errors import ConfigError, InputError
 from abrupt.events import config_hash, new_run_id, read_events
 from abrupt.model.orbit import ForceModel
-from abrupt.pipelines.orbit import detect_orbit, inject_orbit, summary_lines
+from abrupt.pipelines.orbit import OrbitRun, detect_orbit, inject_orbit, summary_lines
 from abrupt.pipelines.orbit_product import detect_orbit_product
 from abrupt.readers.ephemeris import write_ephemeris
 from abrupt.readers.navigation_csv import write_navigation_csv
@@ -223,6 +224,21 @@ def simulate_orbit_command(
     "time (pairs 30-90 min apart) are each found with their own ΔV.",
 )
 @click.option(
+    "--block-days",
+    type=click.FloatRange(min=0.0),
+    default=7.0,
+    show_default=True,
+    help="A span of at least 1.5 blocks runs in calibration blocks of this many days, each tuned and "
+    "calibrated on its own epochs as its own arc would be, the filters crossing the seams (0: one arc).",
+)
+@click.option(
+    "--workers",
+    type=click.IntRange(min=1),
+    default=1,
+    show_default=True,
+    help="Run the calibration blocks of a long span on this many processes.",
+)
+@click.option(
     "--all-satellites",
     is_flag=True,
     default=False,
@@ -255,6 +271,8 @@ def detect_orbit_command(
     null_file: str | None,
     confidence_z: float,
     sequences: bool,
+    block_days: float,
+    workers: int,
     all_satellites: bool,
     kind: str,
     statistics_out: str | None,
@@ -306,6 +324,8 @@ def detect_orbit_command(
             allow_truncated=allow_truncated,
             strict=strict,
             sequences=sequences,
+            block_days=block_days,
+            workers=workers,
             tuning=tuning,
             tau_s=tau_s,
             q_m2_s5=q_m2_s5,
@@ -327,8 +347,8 @@ def detect_orbit_command(
         click.echo(f"warning: {warning}", err=True)
     # the fit (residual RMS, estimated parameters, thresholds) is printed on every run
     click.echo("\n".join(summary_lines(run.summary)), err=True)
-    if statistics_out and run.analysis is not None:
-        frame = pd.DataFrame({"time_utc": run.analysis.ephemeris.times_utc, **run.analysis.statistics})
+    if statistics_out and run.result.diagnostics:
+        frame = _statistics_frame(run)
         Path(statistics_out).parent.mkdir(parents=True, exist_ok=True)
         if statistics_out.endswith(".csv"):
             frame.to_csv(statistics_out, index=False)
@@ -347,9 +367,25 @@ def detect_orbit_command(
         details={k: v for k, v in run.summary.items() if k != "warnings"}
         | {"repairs": run.ephemeris.repairs.as_dict()},
     )
+    if report_path and run.analysis is None:
+        click.echo("warning: no report for a run in calibration blocks; give --block-days 0 for one", err=True)
     if report_path and run.analysis is not None:
         path = plot_orbit_report(run.analysis, run.thresholds, events, report_path)
         click.echo(f"report written to {path}", err=True)
+
+
+def _statistics_frame(run: OrbitRun) -> pd.DataFrame:
+    """Per-epoch statistics of a run: every statistic of its analysis, or for a run in calibration blocks
+    the event statistic and each epoch's threshold (its block's)."""
+    if run.analysis is not None:
+        return pd.DataFrame({"time_utc": run.analysis.ephemeris.times_utc, **run.analysis.statistics})
+    d = run.result.diagnostics[0]
+    times = np.asarray(d.epoch_utc, dtype="datetime64[ns]") + (np.asarray(d.time_s) * 1e9).round().astype(
+        "timedelta64[ns]"
+    )
+    return pd.DataFrame(
+        {"time_utc": times, run.detector.statistic: d.statistic, "threshold": d.extra.get("threshold_per_epoch")}
+    )
 
 
 def _config_hash_of(events: pd.DataFrame, detector_config: dict[str, Any], budget: FalseAlarmBudget) -> str:

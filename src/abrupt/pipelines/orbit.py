@@ -10,6 +10,8 @@ Python API both call these functions.
 
 from __future__ import annotations
 
+import copy
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -17,9 +19,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from abrupt.detect.base import DetectionResult, get_detector
+from abrupt.detect.base import DetectionResult, Diagnostics, get_detector
 from abrupt.detect.orbit.analysis import OrbitAnalysis, innovation_scale
 from abrupt.detect.orbit.detectors import (
+    SETTLE_CAP_S,
     OrbitDetector,
     orbit_analysis,
     orbit_product_boundaries,
@@ -28,6 +31,19 @@ from abrupt.detect.orbit.detectors import (
 from abrupt.detect.orbit.ekf import NUISANCE_NAMES
 from abrupt.detect.orbit.sensitivity import detectable_dv
 from abrupt.errors import ConfigError, InputError
+from abrupt.pipelines.orbit_blocks import (
+    DEFAULT_BLOCK_S,
+    BlockOutcome,
+    arc_test_mask,
+    block_lines,
+    blocks_summary,
+    calibration_blocks,
+    events_in,
+    extended_block,
+    joined_events,
+    part,
+    per_epoch_thresholds,
+)
 from abrupt.pipelines.orbit_sequence import resolve_sequence
 from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.series.ephemeris import Ephemeris
@@ -101,6 +117,8 @@ def detect_orbit(
     allow_truncated: bool = False,
     strict: bool = False,
     sequences: bool = True,
+    block_days: float | None = DEFAULT_BLOCK_S / 86400.0,
+    workers: int = 1,
     **settings: Any,
 ) -> OrbitRun:
     """Detect impulsive and finite ΔVs in an ephemeris (SP3, OEM, CSV or an :class:`Ephemeris`).
@@ -113,6 +131,11 @@ def detect_orbit(
     ``strict``: header counts the records do not match are errors. ``sequences``: after a detection, remove
     the burns found and scan again, so that burns close in time are each found with their own ΔV
     (:func:`abrupt.pipelines.orbit_sequence.resolve_sequence`; with the ``glr`` statistic).
+    ``block_days``: a span of at least 1.5 such blocks is run in calibration blocks (a week by default;
+    None or 0: one arc however long), each tuned and calibrated on its own epochs as its own arc would be,
+    with the filters running across the seams (:mod:`abrupt.pipelines.orbit_blocks`); the run's diagnostics
+    then hold the whole span's statistic and each block's threshold, not one analysis. ``workers``: the
+    blocks on that many processes.
     """
     eph = load_ephemeris(source, satellite, allow_truncated=allow_truncated, strict=strict)
     null_eph = (
@@ -123,6 +146,15 @@ def detect_orbit(
         raise KeyError(f"{detector!r} is not an orbit filter detector")
     det = cls(null=null_eph, **settings)
     fa = as_budget(budget)
+    blocks = calibration_blocks(eph.times_utc, 86400.0 * block_days if block_days else None)
+    if len(blocks) > 1:
+        return _detect_blocks(det, eph, fa, sequences, blocks, workers)
+    run = _detect_arc(det, eph, fa, sequences)
+    return run
+
+
+def _detect_arc(det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, sequences: bool) -> OrbitRun:
+    """One arc: detection, burn sequences, the fit summary and its check."""
     result = det.detect(eph, fa)
     # the removal needs the sharp time of the GLR; the thesis statistics' broad humps would re-raise
     if sequences and det.statistic == "glr" and len(result.events):
@@ -132,6 +164,80 @@ def detect_orbit(
     run.summary = fit_summary(run)
     _check_fit(run.summary, eph, det)
     return run
+
+
+def _detect_blocks(
+    det: OrbitDetector,
+    eph: Ephemeris,
+    fa: FalseAlarmBudget,
+    sequences: bool,
+    blocks: list[tuple[int, int]],
+    workers: int = 1,
+) -> OrbitRun:
+    """A long span in calibration blocks (:mod:`abrupt.pipelines.orbit_blocks`), each by :func:`_block`, on
+    ``workers`` processes."""
+    gcrf = eph.to_frame("GCRF")
+    times = gcrf.times_utc
+    step = gcrf.nominal_step_s
+    # room for the longest settling time the tuning can choose (the block's own is set inside)
+    room = max(SETTLE_CAP_S, 30.0 * step) + 4.0 * step
+    jobs = []
+    for lo, hi in blocks:
+        a, b = extended_block(times, lo, hi, room)
+        jobs.append((part(gcrf, a, b), lo - a, hi - a))
+    parts, los, his = (list(x) for x in zip(*jobs, strict=True))
+    n = len(jobs)
+    if workers > 1:
+        with ProcessPoolExecutor(max_workers=min(workers, n)) as pool:
+            outcomes = list(pool.map(_block, [det] * n, parts, los, his, [fa] * n, [sequences] * n))
+    else:
+        outcomes = [_block(det, *job, fa, sequences) for job in jobs]
+    empty = next((o.events.iloc[:0] for o in outcomes if o.events.columns.size), DetectionResult.empty().events)
+    sizes = [hi - lo for lo, hi in blocks]
+    diag = Diagnostics(
+        name=f"orbit.{det.statistic}",
+        time_s=gcrf.seconds,
+        statistic=np.concatenate([o.statistic for o in outcomes]),
+        threshold=None,
+        epoch_utc=times[0],
+        extra={"blocks": [o.record() for o in outcomes], "threshold_per_epoch": per_epoch_thresholds(outcomes, sizes)},
+    )
+    warnings = tuple(w for o in outcomes for w in o.warnings)
+    run = OrbitRun(eph, det, DetectionResult(joined_events(outcomes, empty), (diag,), warnings), fa)
+    run.summary = blocks_summary(outcomes, gcrf)
+    return run
+
+
+def _block(det: OrbitDetector, ext: Ephemeris, lo: int, hi: int, fa: FalseAlarmBudget, sequences: bool) -> BlockOutcome:
+    """One calibration block, epochs ``lo`` to ``hi`` of ``ext`` (the block with its neighbours' epochs
+    around it): tuned on its own epochs, its filters run a settling time into each neighbour, its threshold
+    calibrated on the epochs its own arc would test, its events those whose time lies in it."""
+    times = ext.times_utc
+    label = f"block {str(times[lo])[:10]}"
+    arc = part(ext, lo, hi)
+    try:
+        cfg = det.detector_config(arc, fa)
+    except ValueError as exc:  # auto tuning cannot read the block (a data gap leaves too few epochs)
+        nothing = np.full(hi - lo, np.nan)
+        return BlockOutcome(
+            times[lo], times[hi - 1], pd.DataFrame(), nothing, None, {}, (f"{label}: not tested ({exc})",)
+        )
+    elo, ehi = extended_block(times, lo, hi, cfg.settle_s + 2.0 * ext.nominal_step_s)
+    block = copy.copy(det)
+    block.fixed_config = cfg
+    block.calibration_mask = arc_test_mask(arc, cfg.settle_s, ehi - elo, lo - elo)
+    run = _detect_arc(block, part(ext, elo, ehi), fa, sequences)
+    diag = run.result.diagnostics[0] if run.result.diagnostics else None
+    stat = diag.statistic[lo - elo : hi - elo] if diag is not None else np.full(hi - lo, np.nan)
+    return BlockOutcome(
+        times[lo],
+        times[hi - 1],
+        events_in(run.events, times[lo], times[hi] if hi < len(ext) else None),
+        np.asarray(stat, dtype=np.float64),
+        diag.threshold if diag is not None else None,
+        run.summary,
+        tuple(f"{label}: {w}" for w in run.result.warnings),
+    )
 
 
 MAX_RESIDUAL_TO_SIGMA = 10.0  # a post-fit position RMS this many stated σ_pos: the filter is not following
@@ -241,7 +347,10 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
         emp = ", ".join(f"{k[4:]} {v[0]:.3g} ± {v[1]:.2g}" for k, v in nu.items() if k.startswith("emp_"))
         lines.append(f"  nuisance (end)   {scales} (× nominal A/m 0.01 m²/kg)")
         lines.append(f"  once-per-rev     {emp} m/s²")
-    lines.append(f"  thresholds at {s['budget']}:")
+    if s.get("blocks"):
+        lines.extend(block_lines(s["blocks"]))
+    if s["thresholds"]:
+        lines.append(f"  thresholds at {s['budget']}:")
     for name, th in s["thresholds"].items():
         mark = "  <- raises events" if name == s["statistic"] else ""
         lines.append(f"    {name:<20} {th['value']:<12.4g} ({th['method']}, {th['n']} samples){mark}")

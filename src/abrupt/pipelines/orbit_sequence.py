@@ -14,6 +14,12 @@ detection farther than ``separation_s`` from every known burn is
 a further burn. When more than one burn is found, each one's time and ΔV are estimated again on the
 data with all the others removed. A burn whose removal leaves a residual (ΔV error of a few per cent)
 raises that residual at the same epoch; it is recognised by its time and not reported again.
+
+The later scans are local: a further burn can only be one the first scan's statistic already exceeded
+its threshold near (:func:`_supported`), so each later scan runs the filters only over windows around
+the first scan's exceedances (and the re-estimation around each burn), padded by twice the filters'
+settling time so that every epoch a candidate can lie on is tested with settled filters
+(:func:`scan_windows`). The cost is then that of the burns, not of the span.
 """
 
 from __future__ import annotations
@@ -23,6 +29,7 @@ from dataclasses import replace
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
 from abrupt.detect.base import DetectionResult
 from abrupt.detect.orbit.boundaries import boundary_window
@@ -165,6 +172,65 @@ def _with_merged(events: pd.DataFrame, extras: list[tuple[int, pd.DataFrame, boo
     return out
 
 
+def scan_windows(
+    times_utc: NDArray[np.datetime64], centres: list[tuple[np.datetime64, np.datetime64]], pad_s: float
+) -> list[tuple[int, int]]:
+    """Index ranges ``[lo, hi)`` of the epochs within ``pad_s`` of each interval of ``centres``, overlapping
+    ranges merged."""
+    pad = np.timedelta64(round(pad_s * 1e9), "ns")
+    spans = sorted(
+        (int(np.searchsorted(times_utc, a - pad, side="left")), int(np.searchsorted(times_utc, b + pad, side="right")))
+        for a, b in centres
+    )
+    out: list[tuple[int, int]] = []
+    for lo, hi in spans:
+        if out and lo <= out[-1][1]:
+            out[-1] = (out[-1][0], max(out[-1][1], hi))
+        else:
+            out.append((lo, hi))
+    return out
+
+
+def _local_scan(
+    detector: OrbitDetector,
+    eph: Ephemeris,
+    removed: pd.DataFrame,
+    budget: FalseAlarmBudget,
+    windows: list[tuple[int, int]],
+) -> pd.DataFrame:
+    """Events of ``detector`` (fixed tuning and thresholds) on each window of ``eph`` with the burns of
+    ``removed`` taken out, in time order."""
+    frames = []
+    for lo, hi in windows:
+        part = replace(
+            eph, times_utc=eph.times_utc[lo:hi], position_m=eph.position_m[lo:hi], velocity_mps=eph.velocity_mps[lo:hi]
+        )
+        frames.append(detector.detect(remove_burns(part, removed), budget).events)
+    found = [f for f in frames if len(f)]
+    if not found:
+        return frames[0] if frames else pd.DataFrame(columns=removed.columns).iloc[:0]
+    out = pd.concat(found, ignore_index=True)
+    return out.iloc[np.argsort(_times(out), kind="stable")].reset_index(drop=True)
+
+
+def _exceedances(first: DetectionResult) -> list[tuple[np.datetime64, np.datetime64]]:
+    """The first scan's runs of epochs above its threshold, as (first, last) times."""
+    diag = first.diagnostics[0] if first.diagnostics else None
+    if diag is None or diag.threshold is None or diag.epoch_utc is None:
+        return []
+    above = np.nan_to_num(np.asarray(diag.statistic, dtype=np.float64), nan=-np.inf) > diag.threshold.value
+    idx = np.flatnonzero(above)
+    if idx.size == 0:
+        return []
+    times = np.asarray(diag.epoch_utc, dtype="datetime64[ns]") + (np.asarray(diag.time_s) * 1e9).astype(
+        "timedelta64[ns]"
+    )
+    breaks = np.flatnonzero(np.diff(idx) > 1)
+    starts = np.r_[idx[0], idx[breaks + 1]]
+    stops = np.r_[idx[breaks], idx[-1]]
+    return [(times[a], times[b]) for a, b in zip(starts, stops, strict=True)]
+
+
 def resolve_sequence(
     detector: OrbitDetector,
     eph: Ephemeris,
@@ -186,19 +252,29 @@ def resolve_sequence(
     detector = copy.copy(detector)
     detector.fixed_thresholds = orbit_thresholds(first)
     analysis = orbit_analysis(first)
+    if analysis is not None:
+        # and its tuning: the thresholds belong to the statistic of that filter
+        detector.fixed_config = analysis.config
+    detector.calibration_mask = None
     lead_s, lag_s, step = np.inf, np.inf, 0.0
+    windows = [(0, len(eph))]
+    pad_s = np.inf
     if analysis is not None:
         step = analysis.ephemeris.nominal_step_s
         lead_s, lag_s = boundary_window(analysis), 2.0 * step
         # two jumps inside one GLR window are not resolved by the data (a 5-minute product's window is
         # 50 minutes): a further detection that close to a known burn is merged into that burn's event
         separation_s = max(separation_s, analysis.config.glr_window_samples * step)
+        # a candidate lies within lead/lag of an exceedance; settled filters there need a settling time
+        # before and after it, and the episodes that could suppress it another
+        pad_s = max(lead_s, lag_s) + 2.0 * analysis.config.settle_s + 2.0 * step
+        windows = scan_windows(eph.times_utc, _exceedances(first), pad_s)
     # merged burns: (event, detection, outside the event's span); those outside are removed and added,
     # one inside only flags the event (its span estimate holds the total; the detection is a shape residual)
     extras: list[tuple[int, pd.DataFrame, bool]] = []
     while len(events) + len(extras) < max_burns:
         removed = pd.concat([events, *(r for _, r, out in extras if out)], ignore_index=True)
-        scan = detector.detect(remove_burns(eph, removed), budget).events
+        scan = _local_scan(detector, eph, removed, budget, windows)
         again = _supported(_new(scan, removed, 0.0, nuisance), first, lead_s, lag_s)
         fresh = _new(again, events, separation_s, [])
         flagged = {j for j, _, _ in extras}
@@ -218,7 +294,9 @@ def resolve_sequence(
             others = pd.concat(
                 [events.drop(index=events.index[i]), *(r for j, r, out in extras if out and j != i)], ignore_index=True
             )
-            alone = detector.detect(remove_burns(eph, others), budget).events
+            around = [(times[i], times[i])] if np.isfinite(pad_s) else []
+            near = scan_windows(eph.times_utc, around, pad_s) if around else [(0, len(eph))]
+            alone = _local_scan(detector, eph, others, budget, near)
             if len(alone):
                 gap = np.abs((_times(alone) - times[i]).astype(np.float64)) * 1e-9
                 j = int(np.argmin(gap))

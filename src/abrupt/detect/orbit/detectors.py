@@ -32,6 +32,7 @@ from dataclasses import replace
 from typing import Any, ClassVar
 
 import numpy as np
+from numpy.typing import NDArray
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.detect.orbit.analysis import OrbitAnalysis, OrbitDetectorConfig, analyse, innovation_scale
@@ -130,18 +131,36 @@ class OrbitDetector(Detector[Ephemeris]):
         self._null = null
         #: thresholds to use instead of calibrating (a later scan of the same arc keeps the first's)
         self.fixed_thresholds: dict[str, Threshold] | None = None
+        #: filter tuning and settings to use instead of deriving them from the series (a later scan of the
+        #: same arc keeps the first's; a calibration block of a long span is tuned on the block alone)
+        self.fixed_config: OrbitDetectorConfig | None = None
+        #: epochs (of the series given to :meth:`detect`) whose statistic the self-calibration may use; None:
+        #: every evaluated epoch. A calibration block of a long span calibrates on the epochs its own arc
+        #: would test (:mod:`abrupt.pipelines.orbit_blocks`)
+        self.calibration_mask: NDArray[np.bool_] | None = None
         #: treat the arc's Earth-shadow passages as known nuisance epochs (:mod:`~abrupt.detect.orbit.boundaries`);
         #: off where the threshold's null already holds them (thresholds pooled over a product's satellites)
         self.eclipses = True
 
+    def __reduce__(self) -> tuple[Any, ...]:
+        # the registered classes are made by ``type`` below, not module attributes: pickle (for the worker
+        # processes of a long run) rebuilds one from its registered name
+        return (_rebuild, (self.name, dict(vars(self))))
+
     def config(self) -> dict[str, Any]:
         out = super().config()
         out["null"] = self._null is not None
+        # how a calibration block or a later scan is run, not a setting of the detector
+        out.pop("fixed_config", None)
+        out.pop("calibration_mask", None)
         return out
 
     # ------------------------------------------------------------------ configuration
     def detector_config(self, eph: Ephemeris, budget: FalseAlarmBudget) -> OrbitDetectorConfig:
-        """Filter tuning and detector settings for ``eph`` (auto tuning reads the data itself)."""
+        """Filter tuning and detector settings for ``eph`` (auto tuning reads the data itself), or
+        ``fixed_config`` when set."""
+        if self.fixed_config is not None:
+            return replace(self.fixed_config, budget=budget)
         dyn = self.dynamics or ("field" if self.tuning == "auto" else "two-body")
         zonal = max(0, DYNAMICS[dyn])
         degree = self.gravity_degree if dyn == "field" else 0
@@ -208,7 +227,7 @@ class OrbitDetector(Detector[Ephemeris]):
             null = analyse(self._null, analysis.config)
             thresholds = calibrate_thresholds(null.statistics, sample_rate_hz=null.sample_rate_hz, budget=budget)
         else:
-            thresholds = self_calibrate(analysis, budget=budget, confidence_z=self.confidence_z)
+            thresholds = self_calibrate(self._calibration_view(analysis), budget=budget, confidence_z=self.confidence_z)
         warnings: tuple[str, ...] = ()
         if self.statistic not in thresholds:
             warnings = (
@@ -241,7 +260,8 @@ class OrbitDetector(Detector[Ephemeris]):
             # shadow passages inflate a tail fit that holds them: judge them against the level of the rest
             mask = eclipse_mask(analysis)
             if mask.any() and not mask.all():
-                quiet = replace(analysis, statistics={name: np.where(mask, np.nan, analysis.statistics[name])})
+                own = self._calibration_view(analysis).statistics[name]
+                quiet = replace(analysis, statistics={name: np.where(mask, np.nan, own)})
                 level = self_calibrate(quiet, budget=budget, confidence_z=self.confidence_z, names=(name,)).get(name)
                 trial = judged(level.value) if level is not None else ([], blanked)
                 if any(b.kind == SHADOW for b in trial[0]):
@@ -250,12 +270,22 @@ class OrbitDetector(Detector[Ephemeris]):
             return [], analysis
         if calibrating:
             mask = boundary_mask(analysis, boundaries)
-            quiet_all = {k: np.where(mask, np.nan, v) for k, v in analysis.statistics.items()}
+            own_all = self._calibration_view(analysis).statistics
+            quiet_all = {k: np.where(mask, np.nan, v) for k, v in own_all.items()}
             thresholds.update(
                 self_calibrate(replace(analysis, statistics=quiet_all), budget=budget, confidence_z=self.confidence_z)
             )
             boundaries, blanked = judged(thresholds[name].value)
         return boundaries, replace(analysis, statistics={**analysis.statistics, name: blanked})
+
+    def _calibration_view(self, analysis: OrbitAnalysis) -> OrbitAnalysis:
+        """The analysis with every statistic outside ``calibration_mask`` blanked (as given without one)."""
+        mask = self.calibration_mask
+        if mask is None:
+            return analysis
+        if mask.shape != analysis.t_s.shape:
+            raise ValueError(f"calibration mask has {mask.shape} epochs, the analysis {analysis.t_s.shape}")
+        return replace(analysis, statistics={k: np.where(mask, v, np.nan) for k, v in analysis.statistics.items()})
 
     def _diagnostics(
         self, analysis: OrbitAnalysis, thresholds: dict[str, Threshold], boundaries: Sequence[ProductBoundary] = ()
@@ -314,6 +344,14 @@ ORBIT_DETECTORS: dict[str, type[OrbitDetector]] = {
     )
     for statistic, summary in STATISTIC_SUMMARIES.items()
 }
+
+
+def _rebuild(name: str, state: dict[str, Any]) -> OrbitDetector:
+    """The detector ``name`` (a key of :data:`ORBIT_DETECTORS`) with the attributes ``state``."""
+    cls = ORBIT_DETECTORS[name]
+    detector = cls.__new__(cls)
+    detector.__dict__.update(state)
+    return detector
 
 
 def orbit_analysis(result: DetectionResult) -> OrbitAnalysis | None:
