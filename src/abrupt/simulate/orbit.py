@@ -150,14 +150,26 @@ def simulate_orbit(config: OrbitSimulationConfig) -> SimulatedOrbit:
     n = round(config.duration_s * config.rate_hz) + 1
     t = np.arange(n) / config.rate_hz
     epoch = _to_ns(config.epoch_utc)
-    # Impulses given in RTN are resolved with the no-impulse truth at their time (iteratively in order).
+    # Impulses given in RTN are resolved in order with the truth just before them: the state is carried
+    # from one RTN impulse to the next (with the impulses between), so the cost is linear in their number.
     kicks: list[tuple[float, FloatArray]] = []
+    t_last, s_last = 0.0, np.r_[r0, v0]
     for imp in sorted(config.impulses, key=lambda k: k.time_s):
         dv = np.asarray(imp.dv_mps, dtype=np.float64)
+        t_imp = float(imp.time_s)
         if imp.frame == "rtn":
-            st = propagate(0.0, np.r_[r0, v0], np.array([imp.time_s]), config.forces, epoch, kicks)[0]
-            dv = rtn_matrix(st[:3], st[3:])[0] @ dv
-        kicks.append((float(imp.time_s), dv))
+            if t_imp > t_last:
+                between = [k for k in kicks if t_last < k[0] < t_imp]
+                s_last = propagate(t_last, s_last, np.array([t_imp]), config.forces, epoch, between)[0]
+                for tk, dvk in kicks:
+                    if tk == t_imp:
+                        s_last = s_last + np.r_[np.zeros(3), dvk]
+                t_last = t_imp
+            dv = rtn_matrix(s_last[:3], s_last[3:])[0] @ dv
+            s_last = s_last + np.r_[np.zeros(3), dv]
+        elif t_imp <= t_last:
+            s_last = s_last + np.r_[np.zeros(3), dv]
+        kicks.append((t_imp, dv))
     truth = propagate(0.0, np.r_[r0, v0], t, config.forces, epoch, kicks, burns=config.burns)
     rng = np.random.default_rng(config.seed)
     pos_noise = rng.normal(0.0, config.sigma_pos_m, (n, 3)) if config.sigma_pos_m > 0 else np.zeros((n, 3))

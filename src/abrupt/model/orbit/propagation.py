@@ -106,7 +106,9 @@ def propagate(
         raise ValueError("output times must be increasing and not before t0_s")
     t_end = float(t_out[-1])
     ctx = _context(force, t0_s, t_end)
-    kicks = sorted((float(t), np.asarray(dv, dtype=np.float64)) for t, dv in impulses if t0_s <= t <= t_end)
+    kicks = sorted(
+        ((float(t), np.asarray(dv, dtype=np.float64)) for t, dv in impulses if t0_s <= t <= t_end), key=lambda k: k[0]
+    )
     edges = sorted({t0_s, t_end, *[k[0] for k in kicks], *[b.t_start_s for b in burns], *[b.t_end_s for b in burns]})
     edges = [e for e in edges if t0_s <= e <= t_end]
     out = np.full((t_out.size, 6), np.nan)
