@@ -47,12 +47,14 @@ from abrupt.density.model_sampling import (
     ModelNodes,
     choose_stride,
     gap_trapezoids,
+    shared_grid,
     window_model_density,
 )
 from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET
 from abrupt.detect.tle.detectors import detector_for
 from abrupt.errors import RepairLog
 from abrupt.model.atmosphere import read_space_weather
+from abrupt.model.msis_grid import MsisGrid
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
 from abrupt.thresholds import FalseAlarmBudget
 from abrupt.thresholds.noise import robust_scale
@@ -96,6 +98,10 @@ class TleDragConfig:
     # strides 16, 8, 4, 2 (not finer than ``model_stride``) whose window model densities all agree
     # with the next finer stride's within f × each window's stated σ_K/|K| (density.model_sampling)
     model_tolerance: float | None = None
+    # NRLMSIS from per-slot tables shared by every object of the process (abrupt.model.msis_grid), on
+    # every node; ``model_grid_cache``: a folder where processes share the tables
+    model_grid: bool = False
+    model_grid_cache: str | None = None
     origin_utc: str | None = None
     maneuver_budget: FalseAlarmBudget = DEFAULT_TLE_BUDGET  # of the maneuver detector
 
@@ -106,6 +112,8 @@ class TleDragConfig:
             raise ValueError("step_s must be > 0")
         if self.min_sets < 2:
             raise ValueError("min_sets must be >= 2")
+        if self.model_grid and self.model_tolerance is not None:
+            raise ValueError("model_tolerance chooses the direct NRLMSIS sampling; it does not go with model_grid")
 
 
 @dataclass
@@ -176,12 +184,18 @@ def wind_factor(position_m: FloatArray, velocity_mps: FloatArray) -> FloatArray:
 
 
 def drag_integrals(
-    history: ElementHistory, step_s: float = 600.0, *, space_weather: Any = None, model_stride: int = 2
+    history: ElementHistory,
+    step_s: float = 600.0,
+    *,
+    space_weather: Any = None,
+    model_stride: int = 2,
+    grid: MsisGrid | None = None,
 ) -> DragIntegrals:
     """Accumulate I(t) = ∫ n̄^(1/3) v³ F dt between consecutive sets by SGP4 (module docstring).
 
     With ``space_weather`` (a :class:`abrupt.model.atmosphere.SpaceWeather`) the NRLMSIS density is
-    integrated with the same weight (``model_integral``).
+    integrated with the same weight (``model_integral``); with ``grid`` (a
+    :class:`abrupt.model.msis_grid.MsisGrid`) it is interpolated from the grid on every node.
     """
     el = history.elements
     n_sets = len(el)
@@ -221,7 +235,9 @@ def drag_integrals(
     rho_all: FloatArray | None = None
     when = epochs[gap_index] + (tau_all * 1e9).astype("timedelta64[ns]")
     starts = offsets[:-1]
-    nodes = ModelNodes(when, pos, errors == 0, tau_all, integrand, starts, space_weather)
+    nodes = ModelNodes(when, pos, errors == 0, tau_all, integrand, starts, space_weather, grid)
+    if grid is not None:
+        model_stride = 1
     if space_weather is not None and n_sets > 1:
         # NRLMSIS on every ``model_stride``-th node (≈ 7 µs a point); log ρ is interpolated in time
         # between them (the nodes of consecutive gaps are consecutive in time)
@@ -324,6 +340,7 @@ def rho_b_from_history(
         cfg.step_s,
         space_weather=sw if cfg.with_model and not adaptive else None,
         model_stride=cfg.model_stride,
+        grid=shared_grid(sw, cfg.model_grid_cache) if cfg.with_model and cfg.model_grid else None,
     )
     epochs = history.elements["epoch_utc"].to_numpy(dtype="datetime64[ns]")
     mu = MU_EARTH_WGS72_M3_S2
