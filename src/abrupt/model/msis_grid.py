@@ -45,7 +45,7 @@ from abrupt.types import FloatArray
 SLOT_NS = 3 * 3600 * 10**9  # one 3-hourly ap slot [ns]
 SLOTS_PER_DAY = 8
 TIMES_PER_SLOT = 3  # slot start, middle, end − 1 s
-_DAY_NS = 86400 * 10**9
+TABLE_LAYOUT = "slot, altitude, time, latitude, longitude"
 
 
 @dataclass(frozen=True)
@@ -102,9 +102,10 @@ def slot_times(day: np.datetime64) -> NDArray[np.datetime64]:
 
 
 def day_table(day: np.datetime64, space_weather: SpaceWeather, spec: GridSpec) -> NDArray[np.float32]:
-    """log ρ (kg/m³) of one day: (8 slots, 3 times, longitude, latitude, altitude), float32."""
+    """log ρ (kg/m³) of one day: (8 slots, altitude, 3 times, latitude, longitude), float32."""
     times = slot_times(day)
     f107, f107a, aps = space_weather.msis_drivers(times)
+    # altitude the fastest index: pymsis keeps NRLMSIS's horizontal terms while only altitude changes
     out = pymsis.calculate(
         times.astype("datetime64[ms]"),
         spec.lon_deg,
@@ -118,7 +119,7 @@ def day_table(day: np.datetime64, space_weather: SpaceWeather, spec: GridSpec) -
     )
     rho = np.asarray(out[..., pymsis.Variable.MASS_DENSITY], dtype=np.float64)
     shape = (SLOTS_PER_DAY, TIMES_PER_SLOT, spec.lon_deg.size, spec.lat_deg.size, spec.altitude_km.size)
-    return np.log(rho).reshape(shape).astype(np.float32)
+    return np.ascontiguousarray(np.log(rho).reshape(shape).transpose(0, 4, 1, 3, 2), dtype=np.float32)
 
 
 @nb.njit(cache=True, inline="always")
@@ -154,9 +155,13 @@ def _interpolate(
     du: float,
     out: Any,
 ) -> None:
-    """log ρ at each point from ``table`` (slots × 3 × lon × lat × alt); ``tau`` in [0, 1] in its slot."""
-    n_lon, n_lat, n_alt = table.shape[2], table.shape[3], table.shape[4]
-    slot_deg = 45.0  # the Sun's motion in longitude over one slot [deg]
+    """log ρ at each point from ``table`` (slots × alt × 3 times × lat × lon: the values one point needs
+    lie close together, and the next points of an orbit in the same slot need the same); ``tau`` is the
+    point's time in its slot, 0..1."""
+    n_alt, n_lat, n_lon = table.shape[1], table.shape[3], table.shape[4]
+    slot_deg = 45.0  # [deg]
+    ix = np.empty(3, dtype=np.int64)
+    wx = np.empty((3, 4))
     for p in range(out.size):
         s = slot[p]
         t = tau[p]
@@ -165,20 +170,26 @@ def _interpolate(
         wy = _cubic_weights(y)
         k0, z = _stencil((log_h[p] - u0) / du, n_alt)
         wz = _cubic_weights(z)
-        total = 0.0
+        # the Sun's longitude moves by slot_deg over the slot: at table time k the point's local solar
+        # time is found at lon + slot_deg (t − k/2)
         for k in range(3):
-            lon_k = lon_deg[p] + slot_deg * (t - 0.5 * k)  # same local solar time at the table's time k
-            pos = (lon_k % 360.0) / lon_step
-            i = int(np.floor(pos))
-            wx = _cubic_weights(pos - i)
-            acc = 0.0
+            pos = ((lon_deg[p] + slot_deg * (t - 0.5 * k)) % 360.0) / lon_step
+            ix[k] = int(pos)
+            w = _cubic_weights(pos - ix[k])
             for a in range(4):
-                ii = (i - 1 + a) % n_lon
+                wx[k, a] = w[a]
+        total = 0.0
+        for c in range(4):
+            acc = 0.0
+            for k in range(3):
                 for b in range(4):
-                    row = table[s, k, ii, j0 + b]
-                    col = wz[0] * row[k0] + wz[1] * row[k0 + 1] + wz[2] * row[k0 + 2] + wz[3] * row[k0 + 3]
-                    acc += wx[a] * wy[b] * col
-            total += wt[k] * acc
+                    row = 0.0
+                    for a in range(4):
+                        ii = ix[k] - 1 + a
+                        ii = ii + n_lon if ii < 0 else (ii - n_lon if ii >= n_lon else ii)
+                        row += wx[k, a] * table[s, k0 + c, k, j0 + b, ii]
+                    acc += wt[k] * wy[b] * row
+            total += wz[c] * acc
         out[p] = total
 
 
@@ -191,8 +202,9 @@ class MsisGrid:
         self.space_weather = space_weather
         self.spec = spec or GridSpec()
         self.cache_dir = Path(cache_dir) if cache_dir is not None else None
-        shape = (0, SLOTS_PER_DAY, TIMES_PER_SLOT, self.spec.lon_deg.size, self.spec.lat_deg.size)
-        self.block = np.zeros((*shape, self.spec.altitude_km.size), dtype=np.float32)  # days × table
+        spec = self.spec
+        shape = (0, SLOTS_PER_DAY, spec.altitude_km.size, TIMES_PER_SLOT, spec.lat_deg.size, spec.lon_deg.size)
+        self.block = np.zeros(shape, dtype=np.float32)  # days × day_table
         self.first_day = np.datetime64("NaT", "D")
         self.filled = np.zeros(0, dtype=bool)  # per day of the block
         self.table_values = 0  # NRLMSIS values computed for tables by this process
@@ -201,7 +213,7 @@ class MsisGrid:
 
     def _cache_key(self) -> str:
         sw = self.space_weather
-        h = hashlib.sha256(repr(self.spec).encode())
+        h = hashlib.sha256(f"{TABLE_LAYOUT} {self.spec!r}".encode())
         for arr in (sw.days.astype(np.int64), sw.f107_obs_sfu, sw.f107a_obs_sfu, sw.ap_daily, sw.ap_3h):
             h.update(np.ascontiguousarray(arr).tobytes())
         return h.hexdigest()[:16]
