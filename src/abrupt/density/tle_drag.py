@@ -487,8 +487,8 @@ def _windows(
             if integ.model_integral is not None and dw > 0
             else float("nan")
         )
-        alt = float(mean_alt(integ.altitude_km[idx[1:]])) if idx.size > 1 else float(integ.altitude_km[idx[0]])
-        wfac = float(mean_wf(integ.wind_factor[idx[1:]])) if idx.size > 1 else float(integ.wind_factor[idx[0]])
+        alt = _mean(mean_alt, integ.altitude_km, idx)
+        wfac = _mean(mean_wf, integ.wind_factor, idx)
         rows.append((label, norad, b0, b1, span0, span1, int(idx.size), k_val, k_sig, alt, wfac, model, status))
         bounds.append((int(i0), int(i1)))
     return rows, counts, bounds
@@ -514,12 +514,46 @@ def sampled_model(integ: DragIntegrals, frame: pd.DataFrame, bounds: list[tuple[
         frame["model_density_kg_m3"] = window_model_density(cum_m, integ.weight_integral, i0, i1)
 
 
+SMALL = 8  # below this many values numpy sums in order, as Python's sum does (the same bits)
+
+
+def _mean(mean: Any, values: FloatArray, idx: Any) -> float:
+    """``mean`` of ``values`` over ``idx[1:]`` (or the one value): in Python for the few sets of most
+    windows (the same sum, without numpy's per-call cost; NaN-free inputs only)."""
+    if idx.size == 1:
+        return float(values[idx[0]])
+    if mean is np.mean and idx.size <= SMALL:
+        v = values[idx[1:]].tolist()
+        return sum(v) / len(v)
+    return float(mean(values[idx[1:]]))
+
+
+def _small_fit(x: FloatArray, y: FloatArray, sigma_n: float, min_sets: int) -> tuple[float | None, float, int]:
+    """:func:`_window_fit` of one segment of fewer than :data:`SMALL` sets, in Python floats."""
+    xs, ys = x.tolist(), y.tolist()
+    n = len(xs)
+    mx, my = sum(xs) / n, sum(ys) / n
+    xc = [v - mx for v in xs]
+    yc = [v - my for v in ys]
+    sxx = sum([v * v for v in xc])
+    if sxx <= 0 or n < min_sets:
+        return None, float("nan"), 0
+    k_val = sum([a * b for a, b in zip(xc, yc, strict=True)]) / sxx
+    k_sig = sigma_n / math.sqrt(sxx) if math.isfinite(sigma_n) else float("nan")
+    if n - 2 >= 2:
+        resid = [b - k_val * a for a, b in zip(xc, yc, strict=True)]
+        k_sig = max(k_sig, math.sqrt(sum([r * r for r in resid]) / (n - 2) / sxx))
+    return k_val, k_sig, 0
+
+
 def _window_fit(
     x: FloatArray, y: FloatArray, seg: Any, sigma_n: float, min_sets: int
 ) -> tuple[float | None, float, int]:
     """K and its standard error on one window: one n̄ offset per segment, one common K (with two sets
     in one segment this is the slide's formula); the third value is 1 when the window straddles a
     cut (a maneuver, an orbit rise or a long gap), else 0. K is None with too few sets."""
+    if 2 <= x.size < SMALL and seg[0] == seg[-1] and np.all(seg == seg[0]):
+        return _small_fit(x, y, sigma_n, min_sets)
     if x.size >= 2 and np.all(seg == seg[0]):  # most windows: one segment, no loop over segments
         xc, yc, used, n_seg, straddles = x - x.mean(), y - y.mean(), np.ones(x.size, dtype=bool), 1, 0
     else:

@@ -45,6 +45,7 @@ from abrupt.types import FloatArray
 SLOT_NS = 3 * 3600 * 10**9  # one 3-hourly ap slot [ns]
 SLOTS_PER_DAY = 8
 TIMES_PER_SLOT = 3  # slot start, middle, end − 1 s
+GROW_DAYS = 64  # margin when the block of tables grows [days]
 TABLE_LAYOUT = "slot, altitude, time, latitude, longitude"
 
 
@@ -244,13 +245,16 @@ class MsisGrid:
         return True
 
     def _extend(self, first: np.datetime64, last: np.datetime64) -> None:
-        """Grow the block to hold the days ``first``..``last`` (kept days stay in place)."""
+        """Grow the block to hold the days ``first``..``last`` (kept days stay in place), with a margin of
+        ``GROW_DAYS`` on the side that grows: the block is copied rarely, and days never built cost no
+        memory (zeroed pages are not touched)."""
         if self.filled.size:
-            first = min(first, self.first_day)
-            last = max(last, self.first_day + np.timedelta64(self.filled.size - 1, "D"))
+            end = self.first_day + np.timedelta64(self.filled.size - 1, "D")
+            if first >= self.first_day and last <= end:
+                return
+            first = min(first, self.first_day) - (np.timedelta64(GROW_DAYS, "D") if first < self.first_day else 0)
+            last = max(last, end) + (np.timedelta64(GROW_DAYS, "D") if last > end else 0)
         n = int((last - first) / np.timedelta64(1, "D")) + 1
-        if self.filled.size and first == self.first_day and n == self.filled.size:
-            return
         block = np.zeros((n, *self.block.shape[1:]), dtype=np.float32)
         filled = np.zeros(n, dtype=bool)
         if self.filled.size:
