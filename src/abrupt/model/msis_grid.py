@@ -77,11 +77,11 @@ class GridSpec:
 
     @property
     def lon_deg(self) -> FloatArray:
-        return np.arange(round(360.0 / self.lon_step_deg)) * self.lon_step_deg
+        return np.arange(round(360.0 / self.lon_step_deg), dtype=np.float64) * self.lon_step_deg
 
     @property
     def lat_deg(self) -> FloatArray:
-        return -90.0 + np.arange(round(180.0 / self.lat_step_deg) + 1) * self.lat_step_deg
+        return np.asarray(-90.0 + np.arange(round(180.0 / self.lat_step_deg) + 1) * self.lat_step_deg, dtype=np.float64)
 
     def altitude_coordinate(self, altitude_km: FloatArray) -> FloatArray:
         """ln(h − offset): the coordinate in which the altitude nodes are uniform."""
@@ -96,7 +96,7 @@ class GridSpec:
 
 def slot_times(day: np.datetime64) -> NDArray[np.datetime64]:
     """The table times of one UTC day: for each 3-hour slot its start, middle and end − 1 s."""
-    d0 = np.datetime64(day, "D").astype("datetime64[ns]")
+    d0 = np.asarray(day, dtype="datetime64[D]").astype("datetime64[ns]")
     offsets = np.array([0, SLOT_NS // 2, SLOT_NS - 10**9], dtype=np.int64)
     starts = np.arange(SLOTS_PER_DAY, dtype=np.int64) * SLOT_NS
     return d0 + (starts[:, None] + offsets[None, :]).reshape(-1).astype("timedelta64[ns]")
@@ -206,7 +206,7 @@ class MsisGrid:
         spec = self.spec
         shape = (0, SLOTS_PER_DAY, spec.altitude_km.size, TIMES_PER_SLOT, spec.lat_deg.size, spec.lon_deg.size)
         self.block = np.zeros(shape, dtype=np.float32)  # days × day_table
-        self.first_day = np.datetime64("NaT", "D")
+        self.first_day: Any = np.datetime64("NaT", "D")
         self.filled = np.zeros(0, dtype=bool)  # per day of the block
         self.table_values = 0  # NRLMSIS values computed for tables by this process
         self.direct_points = 0  # points outside the altitude range, evaluated directly
@@ -273,7 +273,7 @@ class MsisGrid:
         todo = [o + k for k in range(n) if not self.filled[o + k]]
         if self.cache_dir is not None and todo:
             self.cache_dir.mkdir(parents=True, exist_ok=True)
-        deferred = []
+        deferred: list[int] = []
         for final in (False, True):
             for k in deferred if final else todo:
                 day = self.first_day + np.timedelta64(k, "D")
