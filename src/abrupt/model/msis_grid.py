@@ -312,7 +312,7 @@ class MsisGrid:
             return out
         ti = t[inside]
         days = ti.astype("datetime64[D]")
-        self.space_weather.msis_drivers(ti[[0, -1]])  # a clear error for dates the table does not cover
+        self.space_weather.msis_drivers(np.array([ti.min(), ti.max()]))  # an error naming the table's span
         self.prepare(days.min(), days.max())
         day_index = ((days - self.first_day) / np.timedelta64(1, "D")).astype(np.int64)
         table = self.block.reshape(-1, *self.block.shape[2:])
