@@ -180,7 +180,7 @@ last = max(h.elements["epoch_utc"].max() for h in hs).to_datetime64().astype("da
 c = time.process_time()
 grid.prepare(first, last)
 print(f"grid tables {first}..{last}: {grid.table_values:,} NRLMSIS values built here in "
-      f"{time.process_time() - c:.1f} CPU-s (0 when read from {cache}), {grid.block.nbytes / 1e6:.0f} MB in memory")
+      f"{time.process_time() - c:.1f} CPU-s (0 when read from {cache}), {grid.nbytes / 1e6:.0f} MB in memory")
 out = {}
 for label, cfg in (
     ("every", TleDragConfig(with_model=True, model_stride=1)),

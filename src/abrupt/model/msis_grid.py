@@ -22,8 +22,9 @@ range are evaluated directly (counted in :attr:`MsisGrid.direct_points`).
 
 pymsis caches NRLMSIS's horizontal terms while only the altitude changes, so a table (altitude the
 fastest index) costs ≈ 0.6 µs a value against ≈ 7 µs a point along an orbit. Tables are built a day
-at a time on first use, kept in memory (float32: ≈ 0.4 MB a day at the default spacing) and, with
-``cache_dir``, written there (atomically) and read back by other processes and later runs.
+at a time on first use and kept in memory (float32, 2.4 MB a day at the default spacing, in one block
+per calendar year of which only the days built are touched) and, with ``cache_dir``, written there
+(atomically) and read back by other processes and later runs.
 """
 
 from __future__ import annotations
@@ -45,7 +46,6 @@ from abrupt.types import FloatArray
 SLOT_NS = 3 * 3600 * 10**9  # one 3-hourly ap slot [ns]
 SLOTS_PER_DAY = 8
 TIMES_PER_SLOT = 3  # slot start, middle, end − 1 s
-GROW_DAYS = 64  # margin when the block of tables grows [days]
 TABLE_LAYOUT = "slot, altitude, time, latitude, longitude"
 
 
@@ -203,11 +203,9 @@ class MsisGrid:
         self.space_weather = space_weather
         self.spec = spec or GridSpec()
         self.cache_dir = Path(cache_dir) if cache_dir is not None else None
-        spec = self.spec
-        shape = (0, SLOTS_PER_DAY, spec.altitude_km.size, TIMES_PER_SLOT, spec.lat_deg.size, spec.lon_deg.size)
-        self.block = np.zeros(shape, dtype=np.float32)  # days × day_table
-        self.first_day: Any = np.datetime64("NaT", "D")
-        self.filled = np.zeros(0, dtype=bool)  # per day of the block
+        # one block per calendar year (day of year × day_table), allocated zeroed: days never built are
+        # never touched and cost no memory, and the block is never copied
+        self.years: dict[int, tuple[NDArray[np.float32], NDArray[np.bool_]]] = {}
         self.table_values = 0  # NRLMSIS values computed for tables by this process
         self.direct_points = 0  # points outside the altitude range, evaluated directly
         self._key = self._cache_key()
@@ -219,10 +217,10 @@ class MsisGrid:
             h.update(np.ascontiguousarray(arr).tobytes())
         return h.hexdigest()[:16]
 
-    def _path(self, day: np.datetime64) -> Path | None:
+    def _path(self, day: Any) -> Path | None:
         return self.cache_dir / f"msis-{self._key}-{day}.npy" if self.cache_dir is not None else None
 
-    def _build(self, day: np.datetime64) -> NDArray[np.float32]:
+    def _build(self, day: Any) -> NDArray[np.float32]:
         table = day_table(day, self.space_weather, self.spec)
         self.table_values += table.size
         path = self._path(day)
@@ -233,7 +231,7 @@ class MsisGrid:
             os.replace(tmp, path)
         return table
 
-    def _claim(self, day: np.datetime64) -> bool:
+    def _claim(self, day: Any) -> bool:
         """Whether this process should build ``day`` now: no cache, or it created the day's claim."""
         path = self._path(day)
         if path is None:
@@ -244,48 +242,45 @@ class MsisGrid:
             return False
         return True
 
-    def _extend(self, first: np.datetime64, last: np.datetime64) -> None:
-        """Grow the block to hold the days ``first``..``last`` (kept days stay in place), with a margin of
-        ``GROW_DAYS`` on the side that grows: the block is copied rarely, and days never built cost no
-        memory (zeroed pages are not touched)."""
-        if self.filled.size:
-            end = self.first_day + np.timedelta64(self.filled.size - 1, "D")
-            if first >= self.first_day and last <= end:
-                return
-            first = min(first, self.first_day) - (np.timedelta64(GROW_DAYS, "D") if first < self.first_day else 0)
-            last = max(last, end) + (np.timedelta64(GROW_DAYS, "D") if last > end else 0)
-        n = int((last - first) / np.timedelta64(1, "D")) + 1
-        block = np.zeros((n, *self.block.shape[1:]), dtype=np.float32)
-        filled = np.zeros(n, dtype=bool)
-        if self.filled.size:
-            o = int((self.first_day - first) / np.timedelta64(1, "D"))
-            block[o : o + self.filled.size] = self.block
-            filled[o : o + self.filled.size] = self.filled
-        self.block, self.filled, self.first_day = block, filled, first
+    def _year(self, year: int) -> tuple[NDArray[np.float32], NDArray[np.bool_]]:
+        if year not in self.years:
+            spec = self.spec
+            shape = (366, SLOTS_PER_DAY, spec.altitude_km.size, TIMES_PER_SLOT, spec.lat_deg.size, spec.lon_deg.size)
+            self.years[year] = (np.zeros(shape, dtype=np.float32), np.zeros(366, dtype=bool))
+        return self.years[year]
 
-    def prepare(self, first: np.datetime64, last: np.datetime64) -> None:
+    def prepare(self, first: Any, last: Any) -> None:
         """Build (or read from ``cache_dir``) the tables of the days ``first``..``last``. With a cache
         each day is claimed by one process (a marker file); days claimed by another are read once it
         has written them, or built here at the end if it has not (a killed run)."""
-        self._extend(first, last)
-        o = int((first - self.first_day) / np.timedelta64(1, "D"))
-        n = int((last - first) / np.timedelta64(1, "D")) + 1
-        todo = [o + k for k in range(n) if not self.filled[o + k]]
+        days = np.arange(np.datetime64(first, "D"), np.datetime64(last, "D") + np.timedelta64(1, "D"))
+        todo = []
+        for day in days:
+            year = int(str(day)[:4])
+            block, filled = self._year(year)
+            k = int((day - np.datetime64(f"{year}-01-01", "D")) / np.timedelta64(1, "D"))
+            if not filled[k]:
+                todo.append((day, block, filled, k))
         if self.cache_dir is not None and todo:
             self.cache_dir.mkdir(parents=True, exist_ok=True)
-        deferred: list[int] = []
+        deferred: list[Any] = []
         for final in (False, True):
-            for k in deferred if final else todo:
-                day = self.first_day + np.timedelta64(k, "D")
+            for item in deferred if final else todo:
+                day, block, filled, k = item
                 path = self._path(day)
                 if path is not None and path.is_file():
-                    self.block[k] = np.load(path)
+                    block[k] = np.load(path)
                 elif final or self._claim(day):
-                    self.block[k] = self._build(day)
+                    block[k] = self._build(day)
                 else:
-                    deferred.append(k)
+                    deferred.append(item)
                     continue
-                self.filled[k] = True
+                filled[k] = True
+
+    @property
+    def nbytes(self) -> int:
+        """Memory of the tables built or read so far."""
+        return sum(int(f.sum()) * b[0].nbytes for b, f in self.years.values())
 
     def density(
         self,
@@ -310,30 +305,40 @@ class MsisGrid:
             )
         if not np.any(inside):
             return out
+        spec = self.spec
         ti = t[inside]
         days = ti.astype("datetime64[D]")
         self.space_weather.msis_drivers(np.array([ti.min(), ti.max()]))  # an error naming the table's span
         self.prepare(days.min(), days.max())
-        day_index = ((days - self.first_day) / np.timedelta64(1, "D")).astype(np.int64)
-        table = self.block.reshape(-1, *self.block.shape[2:])
         ns = (ti - days.astype("datetime64[ns]")).astype(np.int64)
         slot_in_day = np.minimum(ns // SLOT_NS, SLOTS_PER_DAY - 1)
-        slot = day_index * SLOTS_PER_DAY + slot_in_day
         tau = np.clip((ns - slot_in_day * SLOT_NS) / (SLOT_NS - 10**9), 0.0, 1.0)
+        year = days.astype("datetime64[Y]")
+        day_of_year = ((days - year.astype("datetime64[D]")) / np.timedelta64(1, "D")).astype(np.int64)
+        slot = day_of_year * SLOTS_PER_DAY + slot_in_day
+        lon = np.asarray(longitude_deg, dtype=np.float64)[inside]
+        lat = np.asarray(latitude_deg, dtype=np.float64)[inside]
+        coord = spec.altitude_coordinate(h[inside])
+        u0 = float(spec.altitude_coordinate(np.array([spec.min_altitude_km]))[0])
         log_rho = np.empty(ti.size)
-        spec = self.spec
-        _interpolate(
-            table,
-            slot.astype(np.int64),
-            tau,
-            np.asarray(longitude_deg, dtype=np.float64)[inside],
-            np.asarray(latitude_deg, dtype=np.float64)[inside],
-            spec.altitude_coordinate(h[inside]),
-            spec.lon_step_deg,
-            spec.lat_step_deg,
-            float(spec.altitude_coordinate(np.array([spec.min_altitude_km]))[0]),
-            spec.log_altitude_step,
-            log_rho,
-        )
+        for y in np.unique(year):
+            block = self._year(int(str(y)))[0]
+            table = block.reshape(-1, *block.shape[2:])
+            sel = np.flatnonzero(year == y)
+            part = np.empty(sel.size)
+            _interpolate(
+                table,
+                slot[sel],
+                tau[sel],
+                lon[sel],
+                lat[sel],
+                coord[sel],
+                spec.lon_step_deg,
+                spec.lat_step_deg,
+                u0,
+                spec.log_altitude_step,
+                part,
+            )
+            log_rho[sel] = part
         out[inside] = np.exp(log_rho)
         return out
