@@ -10,13 +10,16 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 from click.testing import CliRunner
 
 from abrupt.cli.main import cli
+from abrupt.density import model_sampling
 from abrupt.density.tle_drag import TleDragConfig, rho_b_from_history
 from abrupt.model.atmosphere import SpaceWeatherCoverageError, msis_density, read_space_weather
 from abrupt.model.msis_grid import GridSpec, MsisGrid
+from abrupt.pipelines.catalogue import run_catalogue
 from abrupt.readers.omm import read_element_histories
 from abrupt.simulate.tle_catalogue import write_catalogue
 
@@ -126,3 +129,31 @@ def test_cli_refuses_the_grid_with_a_tolerance_or_without_the_model(tmp_path: Pa
     )
     assert res.exit_code == 2
     assert message in res.output
+
+
+def test_a_resumed_catalogue_run_with_the_grid_equals_the_uninterrupted_run(space_weather, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    paths = write_catalogue(tmp_path / "tle", 4, objects_per_file=2, years=10 / 365.25, seed=8)
+    settings = {"maneuvers": "none", "drag_object": TleDragConfig(with_model=True, model_grid=True)}
+    whole = run_catalogue(paths, "density", settings, tmp_path / "whole.parquet", keep_parts=True)
+    tables = sorted((whole.parts / "msis-grid").glob("msis-*.npy"))
+    assert len(tables) >= 10
+    # as if killed: one part and two days of tables missing, one of them still claimed
+    sorted(whole.parts.glob("*.parquet"))[-1].unlink()
+    tables[0].unlink()
+    tables[-1].unlink()
+    assert tables[0].with_name(f".{tables[0].name}.claim").exists()
+    model_sampling._GRIDS.clear()  # a new process: nothing in memory
+    again = run_catalogue(paths, "density", settings, tmp_path / "whole.parquet", keep_parts=True)
+    assert again.n_resumed == 1
+    assert tables[0].exists()  # the first day, claimed by the killed run, rebuilt for the file redone
+    got = pd.read_parquet(tmp_path / "whole.parquet")
+    direct = pd.concat(
+        [
+            rho_b_from_history(h, TleDragConfig(with_model=True, model_grid=True), maneuvers="none").windows
+            for p in paths
+            for h in read_element_histories(p)
+        ],
+        ignore_index=True,
+    )
+    np.testing.assert_array_equal(got["model_density_kg_m3"].to_numpy(), direct["model_density_kg_m3"].to_numpy())
+    assert len(got) == len(direct) > 0
