@@ -166,48 +166,67 @@ DENSITY = """
 import sys, time
 import numpy as np, pandas as pd
 from pathlib import Path
+from abrupt.density.model_sampling import shared_grid
 from abrupt.density.tle_drag import TleDragConfig, rho_b_from_history
 from abrupt.model.atmosphere import read_space_weather
 from abrupt.readers.omm import read_element_histories
-paths = [p for p in Path(sys.argv[1]).read_text().split()][: int(sys.argv[2])]
+paths = [p for p in Path(sys.argv[1]).read_text().split()][-int(sys.argv[2]):]
 hs = [h for p in paths for h in read_element_histories(p)]
 sw = read_space_weather(None)
+cache = sys.argv[4]
+grid = shared_grid(sw, cache)
+first = min(h.elements["epoch_utc"].min() for h in hs).to_datetime64().astype("datetime64[D]")
+last = max(h.elements["epoch_utc"].max() for h in hs).to_datetime64().astype("datetime64[D]")
+c = time.process_time()
+grid.prepare(first, last)
+print(f"grid tables {first}..{last}: {grid.table_values:,} NRLMSIS values built here in "
+      f"{time.process_time() - c:.1f} CPU-s (0 when read from {cache}), {grid.nbytes / 1e6:.0f} MB in memory")
 out = {}
 for label, cfg in (
+    ("every", TleDragConfig(with_model=True, model_stride=1)),
     ("default", TleDragConfig(with_model=True)),
     ("auto", TleDragConfig(with_model=True, model_tolerance=float(sys.argv[3]))),
-    ("every", TleDragConfig(with_model=True, model_stride=1)),
+    ("grid", TleDragConfig(with_model=True, model_grid=True, model_grid_cache=cache)),
 ):
     c = time.process_time()
     res = [rho_b_from_history(h, cfg, maneuvers=[], space_weather=sw) for h in hs]
     cpu = time.process_time() - c
     pts = sum(r.integrals.model_points for r in res)
-    strides = pd.Series([r.integrals.model_stride for r in res]).value_counts().sort_index().to_dict()
-    out[label] = (pd.concat([r.windows for r in res], ignore_index=True), cpu, pts, strides)
-ref = out["default"][0]
+    rho = np.concatenate([r.integrals.grid_rho_model for r in res])
+    weight = np.concatenate([r.integrals.grid_weight for r in res])
+    out[label] = (pd.concat([r.windows for r in res], ignore_index=True), cpu, pts, rho, weight)
+ref = out["every"][0]
 ok = (ref["status"] == "ok") & np.isfinite(ref["model_density_kg_m3"]) & (ref["rho_b_per_m"] != 0)
 rel = (ref["rho_b_sigma_per_m"] / ref["rho_b_per_m"].abs())[ok]
-print(f"objects {len(hs)}; windows {int(ok.sum())}; stated sigma_K/|K| median {rel.median():.3f}, "
-      f"1st percentile {rel.quantile(0.01):.4f}")
-for label in ("auto", "every"):
-    w, cpu, pts, strides = out[label]
-    d = (w["model_density_kg_m3"] / ref["model_density_kg_m3"] - 1.0).abs()[ok]
-    r = d / rel
-    print(f"{label}: CPU {cpu:.2f} s vs default {out['default'][1]:.2f} s (ratio {cpu / out['default'][1]:.2f}); "
-          f"NRLMSIS points {pts} vs {out['default'][2]} ({pts / out['default'][2]:.2f}); strides {strides}; "
-          f"model density change vs the default: median {d.median():.2e}, max {d.max():.2e}; in units of the window's "
-          f"stated sigma_K/|K|: median {r.median():.3f}, 99th percentile {r.quantile(0.99):.3f}, max {r.max():.3f}, "
+print(f"objects {len(hs)} (the last {len(paths)} file(s) of the listing); windows {int(ok.sum())}; stated sigma_K/|K| "
+      f"median {rel.median():.3f}, 1st percentile {rel.quantile(0.01):.4f}")
+print(f"truth: NRLMSIS evaluated directly on every node, CPU {out['every'][1]:.2f} s, {out['every'][2]} points")
+for label in ("default", "auto", "grid"):
+    w, cpu, pts, rho, weight = out[label]
+    d = (w["model_density_kg_m3"] / ref["model_density_kg_m3"] - 1.0)[ok]
+    r = d.abs() / rel
+    print(f"{label}: CPU {cpu:.2f} s ({1e3 * cpu / len(hs):.0f} ms/object; ratio to the direct default "
+          f"{cpu / out['default'][1]:.2f}); NRLMSIS points evaluated directly {pts}; window model density vs "
+          f"the truth: median |change| {d.abs().median():.2e}, mean {d.mean():+.2e}, max {d.abs().max():.2e}; "
+          f"in units of the window's stated sigma_K/|K|: median {r.median():.3f}, "
+          f"99th percentile {r.quantile(0.99):.3f}, max {r.max():.3f}, "
           f"windows above 1: {int((r > 1).sum())}")
+    use = (weight > 0) & np.isfinite(rho) & np.isfinite(out["every"][3])
+    e = np.log(rho[use] / out["every"][3][use])
+    print(f"  {label}: pointwise log-density error on {use.sum():,} nodes: rms {np.sqrt(np.mean(e**2)):.2e}, "
+          f"mean {e.mean():+.1e}, 99th percentile |e| {np.quantile(np.abs(e), 0.99):.2e}, max {np.abs(e).max():.2e}")
 """
 
 
-def density_reference(listing: Path, n_files: int, tolerance: float) -> None:
-    """Same run, same objects, one process: NRLMSIS at the default stride, at the per-object stride of
-    ``--model-tolerance``, and at every node (the default's own sampling error); CPU, points evaluated and
-    the model density change in units of each window's stated relative uncertainty of ρB."""
+def density_reference(listing: Path, n_files: int, tolerance: float, cache: Path) -> None:
+    """Same run, same objects (the listing's last files: objects the grid's spacing was not chosen on), one
+    process. The truth is NRLMSIS evaluated directly on every integration node; against it: the direct
+    default (every 2nd node, time spline), the per-object stride of ``--model-tolerance`` and the grid
+    (tables kept in ``cache``, built once). CPU, window model densities in units of each window's stated
+    relative uncertainty of ρB, and the pointwise log-density error on the nodes."""
     env = {**os.environ, "PYTHONPATH": str(SRC)}
     out = subprocess.run(
-        [sys.executable, "-c", DENSITY, str(listing), str(n_files), str(tolerance)],
+        [sys.executable, "-c", DENSITY, str(listing), str(n_files), str(tolerance), str(cache)],
         env=env,
         capture_output=True,
         text=True,
@@ -348,7 +367,11 @@ def main() -> None:
     ap.add_argument("--reference-files", type=int, default=4, help="Files (of 25 objects) in the reference.")
     ap.add_argument("--kill", action="store_true")
     ap.add_argument("--no-model", action="store_true", help="Density without NRLMSIS along the orbits.")
-    ap.add_argument("--parts", default="maneuvers,density", help="maneuvers, density (needs maneuvers) or both")
+    ap.add_argument(
+        "--parts",
+        default="maneuvers,density",
+        help="maneuvers, density or both; density alone reuses the maneuver events of an earlier run in --folder",
+    )
     ap.add_argument(
         "--model-tolerance",
         type=float,
@@ -365,14 +388,26 @@ def main() -> None:
     print(f"catalogue scale, {load()}; simulated catalogue cached in {folder}")
     events: dict[int, Path] = {}
     needed = set(ns) | (set(dns) if "density" in parts else set())
-    part("maneuvers", sorted(needed), folder, ["detect", "tle-batch"], 10.0, args.workers, events)
+    cached = {n: folder / f"maneuvers-{n}.parquet" for n in sorted(needed)}
+    if "maneuvers" not in parts and all(p.exists() for p in cached.values()):
+        events.update(cached)
+        print(f"\n[maneuvers] not timed: the events of an earlier run in {folder} are the density's maneuvers")
+    else:
+        part("maneuvers", sorted(needed), folder, ["detect", "tle-batch"], 10.0, args.workers, events)
     density = ["density", "tle", "--windows-only"] + (["--no-model"] if args.no_model else [])
     if args.model_tolerance is not None:
         density += ["--model-tolerance", str(args.model_tolerance)]
     if "density" in parts:
         part("density", dns, folder, density, 15.0, args.workers, events)
         if not args.no_model:
-            density_reference(catalogue(folder, max(dns)), args.density_reference_files, args.model_tolerance or 1.0)
+            density_reference(
+                catalogue(folder, max(dns)),
+                args.density_reference_files,
+                args.model_tolerance or 1.0,
+                folder / "msis-grid",
+            )
+    if "maneuvers" not in parts:
+        return
     listing = catalogue(folder, max(ns))
     k = args.reference_files
     kernel_reference(listing, k)
@@ -393,6 +428,11 @@ def main() -> None:
 if __name__ == "__main__":
     from _results import variant, write_results
 
-    names = {"--no-model": "nomodel", "--parts=maneuvers": "maneuvers", "--model-tolerance": "tolerance"}
+    names = {
+        "--no-model": "nomodel",
+        "--parts=maneuvers": "maneuvers",
+        "--parts=density": "density",
+        "--model-tolerance": "tolerance",
+    }
     with write_results("bench_catalogue_scale", variant(names)):
         main()

@@ -98,6 +98,14 @@ def density() -> None:
     "model densities agree with the next finer within this fraction of each window's stated σ of ρB "
     "(default: every 2nd node for every object).",
 )
+@click.option(
+    "--msis-grid/--msis-direct",
+    "msis_grid",
+    default=None,
+    help="NRLMSIS from tables built once per 3-hour space-weather slot and shared by every object, "
+    "interpolated on every node (default with --windows-only), or evaluated directly on every 2nd node "
+    "(default otherwise).",
+)
 @with_parts_options
 def density_tle(
     paths: tuple[str, ...],
@@ -117,6 +125,7 @@ def density_tle(
     scheduler: str | None,
     maneuvers_from: str | None,
     model_tolerance: float | None,
+    msis_grid: bool | None,
     paths_from: str | None,
     parts: str | None,
     keep_parts: bool,
@@ -133,6 +142,11 @@ def density_tle(
     if node_days <= 0 or block_days <= 0:
         raise click.BadParameter("must be > 0", param_hint="--node-days/--block-days")
     files = gather_paths(paths, paths_from)
+    grid = msis_grid if msis_grid is not None else (windows_only and model_tolerance is None and not no_model)
+    if grid and model_tolerance is not None:
+        raise click.UsageError("--model-tolerance chooses the direct NRLMSIS sampling: give --msis-direct with it")
+    if grid and no_model:
+        raise click.UsageError("--msis-grid goes with the model: drop --no-model")
     if windows_only:
         _windows_only(
             files,
@@ -148,6 +162,7 @@ def density_tle(
             parts,
             keep_parts,
             model_tolerance,
+            grid,
         )
         return
     if maneuvers_from or scheduler:
@@ -161,6 +176,7 @@ def density_tle(
             with_model=not no_model or len(paths) > 1,
             maneuver_budget=maneuver_budget,
             model_tolerance=model_tolerance,
+            model_grid=grid,
         ),
         constellation=ConstellationConfig(kappa=kappa),
         maneuvers=maneuvers,
@@ -315,6 +331,7 @@ def _windows_only(
     parts: str | None,
     keep_parts: bool,
     model_tolerance: float | None = None,
+    model_grid: bool = False,
 ) -> None:
     """``density tle --windows-only``: every object's ρB windows, resumable, on the executor."""
     if not out.lower().endswith((".parquet", ".csv")):
@@ -325,11 +342,13 @@ def _windows_only(
         with_model=not no_model,
         maneuver_budget=maneuver_budget,
         model_tolerance=model_tolerance,
+        model_grid=model_grid,
     )
     settings: dict[str, Any] = {
         "interval_days": interval_days,
         "with_model": not no_model,
         "model_tolerance": model_tolerance,
+        "model_grid": model_grid,
         "maneuvers": maneuvers,
         "budget": str(maneuver_budget),
         "space_weather": space_weather,

@@ -30,10 +30,22 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
-from abrupt.model.atmosphere import msis_density, teme_to_geodetic
+from abrupt.model.atmosphere import SpaceWeather, msis_density, teme_to_geodetic
+from abrupt.model.msis_grid import MsisGrid
 from abrupt.types import FloatArray
 
 AUTO_STRIDES = (16, 8, 4, 2)  # coarse to fine; each stride's nodes are a subset of the next's
+_GRIDS: dict[tuple[int, str | None], MsisGrid] = {}
+
+
+def shared_grid(space_weather: SpaceWeather, cache_dir: str | None = None) -> MsisGrid:
+    """The process's NRLMSIS grid for this space-weather table (one per table and cache folder, kept
+    for the life of the process so that every object of a run shares its tables)."""
+    key = (id(space_weather), cache_dir)
+    grid = _GRIDS.get(key)
+    if grid is None or grid.space_weather is not space_weather:
+        grid = _GRIDS[key] = MsisGrid(space_weather, cache_dir=cache_dir)
+    return grid
 
 
 def interpolate_log_density(t_s: FloatArray, t_known_s: FloatArray, log_rho: FloatArray) -> FloatArray:
@@ -87,6 +99,7 @@ class ModelNodes:
     weight: FloatArray  # n̄^(1/3) v³ F on the nodes
     starts: NDArray[np.int64]  # first node of each gap
     space_weather: Any
+    grid: MsisGrid | None = None  # NRLMSIS from the shared grid instead of direct evaluation
     rho: FloatArray = field(init=False)
     evaluated: NDArray[np.bool_] = field(init=False)
 
@@ -108,7 +121,10 @@ class ModelNodes:
         new = sample & ~self.evaluated
         if np.any(new):
             lat, lon, h_km = teme_to_geodetic(self.when[new], self.position_m[new])
-            self.rho[new] = np.asarray(msis_density(self.when[new], lat, lon, h_km, self.space_weather))
+            if self.grid is not None:
+                self.rho[new] = self.grid.density(self.when[new], lat, lon, h_km)
+            else:
+                self.rho[new] = np.asarray(msis_density(self.when[new], lat, lon, h_km, self.space_weather))
             self.evaluated |= new
         return self.rho[sample]
 
@@ -119,7 +135,12 @@ class ModelNodes:
         rho_s = self.density(sample)
         good = np.isfinite(rho_s) & (rho_s > 0)
         t_abs = self.t_abs
-        rho_all = np.exp(interpolate_log_density(t_abs, t_abs[sample][good], np.log(rho_s[good])))
+        if stride == 1 and np.all(good):
+            rho_all = np.where(sample, self.rho, np.nan)
+            if not np.all(sample):  # nodes where SGP4 failed (no weight): linear in log ρ from the others
+                rho_all[~sample] = np.exp(np.interp(t_abs[~sample], t_abs[sample], np.log(rho_s)))
+        else:
+            rho_all = np.exp(interpolate_log_density(t_abs, t_abs[sample][good], np.log(rho_s[good])))
         cum = np.cumsum(gap_trapezoids(self.tau_s, self.weight * rho_all, self.starts))
         return rho_all, cum
 

@@ -47,12 +47,14 @@ from abrupt.density.model_sampling import (
     ModelNodes,
     choose_stride,
     gap_trapezoids,
+    shared_grid,
     window_model_density,
 )
 from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET
 from abrupt.detect.tle.detectors import detector_for
 from abrupt.errors import RepairLog
 from abrupt.model.atmosphere import read_space_weather
+from abrupt.model.msis_grid import MsisGrid
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
 from abrupt.thresholds import FalseAlarmBudget
 from abrupt.thresholds.noise import robust_scale
@@ -96,6 +98,10 @@ class TleDragConfig:
     # strides 16, 8, 4, 2 (not finer than ``model_stride``) whose window model densities all agree
     # with the next finer stride's within f × each window's stated σ_K/|K| (density.model_sampling)
     model_tolerance: float | None = None
+    # NRLMSIS from per-slot tables shared by every object of the process (abrupt.model.msis_grid), on
+    # every node; ``model_grid_cache``: a folder where processes share the tables
+    model_grid: bool = False
+    model_grid_cache: str | None = None
     origin_utc: str | None = None
     maneuver_budget: FalseAlarmBudget = DEFAULT_TLE_BUDGET  # of the maneuver detector
 
@@ -106,6 +112,8 @@ class TleDragConfig:
             raise ValueError("step_s must be > 0")
         if self.min_sets < 2:
             raise ValueError("min_sets must be >= 2")
+        if self.model_grid and self.model_tolerance is not None:
+            raise ValueError("model_tolerance chooses the direct NRLMSIS sampling; it does not go with model_grid")
 
 
 @dataclass
@@ -176,12 +184,18 @@ def wind_factor(position_m: FloatArray, velocity_mps: FloatArray) -> FloatArray:
 
 
 def drag_integrals(
-    history: ElementHistory, step_s: float = 600.0, *, space_weather: Any = None, model_stride: int = 2
+    history: ElementHistory,
+    step_s: float = 600.0,
+    *,
+    space_weather: Any = None,
+    model_stride: int = 2,
+    grid: MsisGrid | None = None,
 ) -> DragIntegrals:
     """Accumulate I(t) = ∫ n̄^(1/3) v³ F dt between consecutive sets by SGP4 (module docstring).
 
     With ``space_weather`` (a :class:`abrupt.model.atmosphere.SpaceWeather`) the NRLMSIS density is
-    integrated with the same weight (``model_integral``).
+    integrated with the same weight (``model_integral``); with ``grid`` (a
+    :class:`abrupt.model.msis_grid.MsisGrid`) it is interpolated from the grid on every node.
     """
     el = history.elements
     n_sets = len(el)
@@ -198,7 +212,10 @@ def drag_integrals(
     gaps = np.diff(t)
     counts = np.maximum(2, np.ceil(gaps / step_s).astype(np.int64) + 1)
     offsets = np.concatenate([[0], np.cumsum(counts)])
-    frac_all = np.concatenate([np.linspace(0.0, 1.0, c) for c in counts]) if n_sets > 1 else np.zeros(0)
+    # np.linspace(0, 1, c) of every gap at once (the same bits: i · (1/(c − 1)), the last node exactly 1)
+    node_in_gap = np.arange(offsets[-1]) - np.repeat(offsets[:-1], counts)
+    frac_all = node_in_gap * np.repeat(1.0 / (counts - 1), counts) + 0.0
+    frac_all[offsets[1:] - 1] = 1.0
     tau_all = frac_all * np.repeat(gaps, counts)  # s since the gap's first set
     pos = np.empty((tau_all.size, 3))
     vel = np.empty((tau_all.size, 3))
@@ -221,7 +238,9 @@ def drag_integrals(
     rho_all: FloatArray | None = None
     when = epochs[gap_index] + (tau_all * 1e9).astype("timedelta64[ns]")
     starts = offsets[:-1]
-    nodes = ModelNodes(when, pos, errors == 0, tau_all, integrand, starts, space_weather)
+    nodes = ModelNodes(when, pos, errors == 0, tau_all, integrand, starts, space_weather, grid)
+    if grid is not None:
+        model_stride = 1
     if space_weather is not None and n_sets > 1:
         # NRLMSIS on every ``model_stride``-th node (≈ 7 µs a point); log ρ is interpolated in time
         # between them (the nodes of consecutive gaps are consecutive in time)
@@ -324,6 +343,7 @@ def rho_b_from_history(
         cfg.step_s,
         space_weather=sw if cfg.with_model and not adaptive else None,
         model_stride=cfg.model_stride,
+        grid=shared_grid(sw, cfg.model_grid_cache) if cfg.with_model and cfg.model_grid else None,
     )
     epochs = history.elements["epoch_utc"].to_numpy(dtype="datetime64[ns]")
     mu = MU_EARTH_WGS72_M3_S2
@@ -470,8 +490,8 @@ def _windows(
             if integ.model_integral is not None and dw > 0
             else float("nan")
         )
-        alt = float(mean_alt(integ.altitude_km[idx[1:]])) if idx.size > 1 else float(integ.altitude_km[idx[0]])
-        wfac = float(mean_wf(integ.wind_factor[idx[1:]])) if idx.size > 1 else float(integ.wind_factor[idx[0]])
+        alt = _mean(mean_alt, integ.altitude_km, idx)
+        wfac = _mean(mean_wf, integ.wind_factor, idx)
         rows.append((label, norad, b0, b1, span0, span1, int(idx.size), k_val, k_sig, alt, wfac, model, status))
         bounds.append((int(i0), int(i1)))
     return rows, counts, bounds
@@ -497,12 +517,46 @@ def sampled_model(integ: DragIntegrals, frame: pd.DataFrame, bounds: list[tuple[
         frame["model_density_kg_m3"] = window_model_density(cum_m, integ.weight_integral, i0, i1)
 
 
+SMALL = 8  # below this many values numpy sums in order, as Python's sum does (the same bits)
+
+
+def _mean(mean: Any, values: FloatArray, idx: Any) -> float:
+    """``mean`` of ``values`` over ``idx[1:]`` (or the one value): in Python for the few sets of most
+    windows (the same sum, without numpy's per-call cost; NaN-free inputs only)."""
+    if idx.size == 1:
+        return float(values[idx[0]])
+    if mean is np.mean and idx.size <= SMALL:
+        v = values[idx[1:]].tolist()
+        return sum(v) / len(v)
+    return float(mean(values[idx[1:]]))
+
+
+def _small_fit(x: FloatArray, y: FloatArray, sigma_n: float, min_sets: int) -> tuple[float | None, float, int]:
+    """:func:`_window_fit` of one segment of fewer than :data:`SMALL` sets, in Python floats."""
+    xs, ys = x.tolist(), y.tolist()
+    n = len(xs)
+    mx, my = sum(xs) / n, sum(ys) / n
+    xc = [v - mx for v in xs]
+    yc = [v - my for v in ys]
+    sxx = sum([v * v for v in xc])
+    if sxx <= 0 or n < min_sets:
+        return None, float("nan"), 0
+    k_val = sum([a * b for a, b in zip(xc, yc, strict=True)]) / sxx
+    k_sig = sigma_n / math.sqrt(sxx) if math.isfinite(sigma_n) else float("nan")
+    if n - 2 >= 2:
+        resid = [b - k_val * a for a, b in zip(xc, yc, strict=True)]
+        k_sig = max(k_sig, math.sqrt(sum([r * r for r in resid]) / (n - 2) / sxx))
+    return k_val, k_sig, 0
+
+
 def _window_fit(
     x: FloatArray, y: FloatArray, seg: Any, sigma_n: float, min_sets: int
 ) -> tuple[float | None, float, int]:
     """K and its standard error on one window: one n̄ offset per segment, one common K (with two sets
     in one segment this is the slide's formula); the third value is 1 when the window straddles a
     cut (a maneuver, an orbit rise or a long gap), else 0. K is None with too few sets."""
+    if 2 <= x.size < SMALL and seg[0] == seg[-1] and np.all(seg == seg[0]):
+        return _small_fit(x, y, sigma_n, min_sets)
     if x.size >= 2 and np.all(seg == seg[0]):  # most windows: one segment, no loop over segments
         xc, yc, used, n_seg, straddles = x - x.mean(), y - y.mean(), np.ones(x.size, dtype=bool), 1, 0
     else:

@@ -24,7 +24,7 @@ import json
 import os
 import shutil
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -121,6 +121,9 @@ def maneuver_times_by_object(events: pd.DataFrame) -> dict[str, list[Any]]:
 def density_task(task: CatalogueTask) -> tuple[pd.DataFrame, list[str]]:
     """ρB windows of every object of one file (a pure function of the task)."""
     cfg: TleDragConfig = task.settings["drag_object"]
+    if cfg.model_grid and cfg.model_grid_cache is None and task.settings.get("work_dir"):
+        # the run's NRLMSIS tables, shared by its processes and kept for a resumed run
+        cfg = replace(cfg, model_grid_cache=str(Path(task.settings["work_dir"]) / "msis-grid"))
     sw = read_space_weather(task.settings.get("space_weather")) if cfg.with_model else None
     maneuvers: dict[str, list[Any]] | None = task.settings.get("maneuver_times_object")
     frames = []
@@ -224,7 +227,8 @@ def run_catalogue(
     for stale in folder.glob(".*.tmp"):  # a part being written when a run was killed
         stale.unlink()
     done = {p.name for p in folder.glob(f"*{PART_SUFFIX}")}
-    todo = [t for t in tasks if t.part not in done]
+    # the parts folder, for tasks that keep files shared by the run (not part of the run key)
+    todo = [replace(t, settings={**t.settings, "work_dir": str(folder)}) for t in tasks if t.part not in done]
     skipped: list[str] = []
 
     def store(res: TaskResult[CatalogueTask, tuple[pd.DataFrame, list[str]]]) -> None:

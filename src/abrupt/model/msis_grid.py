@@ -1,0 +1,344 @@
+"""NRLMSIS 2.1 on a shared grid: evaluated once per 3-hour space-weather slot, interpolated for every point.
+
+Every object of a catalogue sees the same space weather at a given time: NRLMSIS's drivers (the
+previous day's F10.7, the 81-day mean, the 3-hourly ap history; :mod:`abrupt.model.atmosphere`) are
+constant within each 3-hour ap slot. So the model is tabulated once per slot and every object's
+points are interpolated from the table: the cost is fixed per day of the run, not per object.
+
+The table of a slot holds log ρ on
+
+* three times: the slot's start, its middle and one second before its end (the last slot of a day
+  ends before midnight: NRLMSIS's day of year steps at midnight);
+* longitude every ``lon_step_deg`` (periodic), geodetic latitude every ``lat_step_deg`` (−90..90);
+* altitude on nodes uniform in ln(h − 60 km) between ``min_altitude_km`` and ``max_altitude_km``
+  (spacing ``log_altitude_step`` × (h − 60 km): 3 km at 90 km, 34 km at 400 km, 3600 km at GEO).
+
+A point at time t is interpolated at each of the three times t_k at the longitude where the local
+solar time equals the point's (λ + 15°/h · (t − t_k)): the day-night bulge moves with the Sun, so
+interpolating in time at fixed local time leaves only the model's slow UT/longitude terms to the
+quadratic in time. Longitude, latitude and ln h are interpolated by 4-point Lagrange cubics (the
+stencil shifted inside at the poles and the altitude ends). Points below or above the altitude
+range are evaluated directly (counted in :attr:`MsisGrid.direct_points`).
+
+pymsis caches NRLMSIS's horizontal terms while only the altitude changes, so a table (altitude the
+fastest index) costs ≈ 0.6 µs a value against ≈ 7 µs a point along an orbit. Tables are built a day
+at a time on first use and kept in memory (float32, 2.4 MB a day at the default spacing, in one block
+per calendar year of which only the days built are touched) and, with ``cache_dir``, written there
+(atomically) and read back by other processes and later runs.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numba as nb
+import numpy as np
+import pymsis
+from numpy.typing import NDArray
+
+from abrupt.model.atmosphere import MSIS_VERSION, SpaceWeather, msis_density
+from abrupt.types import FloatArray
+
+SLOT_NS = 3 * 3600 * 10**9  # one 3-hourly ap slot [ns]
+SLOTS_PER_DAY = 8
+TIMES_PER_SLOT = 3  # slot start, middle, end − 1 s
+TABLE_LAYOUT = "slot, altitude, time, latitude, longitude"
+
+
+@dataclass(frozen=True)
+class GridSpec:
+    """Spacing and extent of the table (units in the names)."""
+
+    lon_step_deg: float = 20.0
+    lat_step_deg: float = 10.0
+    log_altitude_step: float = 0.1
+    min_altitude_km: float = 90.0
+    max_altitude_km: float = 45000.0
+    altitude_offset_km: float = 60.0  # nodes uniform in ln(h − offset): dense in the lower thermosphere
+
+    def __post_init__(self) -> None:
+        for name in ("lon_step_deg", "lat_step_deg", "log_altitude_step", "min_altitude_km"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"{name} must be > 0")
+        if not (360.0 / self.lon_step_deg).is_integer() or 360.0 / self.lon_step_deg < 4:
+            raise ValueError("lon_step_deg must divide 360 into at least 4 steps")
+        if not (180.0 / self.lat_step_deg).is_integer() or 180.0 / self.lat_step_deg < 3:
+            raise ValueError("lat_step_deg must divide 180 into at least 3 steps")
+        if not 0 <= self.altitude_offset_km < self.min_altitude_km:
+            raise ValueError("altitude_offset_km must be >= 0 and below min_altitude_km")
+        if self.max_altitude_km <= self.min_altitude_km + (self.min_altitude_km - self.altitude_offset_km) * (
+            np.exp(3 * self.log_altitude_step) - 1.0
+        ):
+            raise ValueError("max_altitude_km must leave at least 4 altitude nodes")
+
+    @property
+    def lon_deg(self) -> FloatArray:
+        return np.arange(round(360.0 / self.lon_step_deg), dtype=np.float64) * self.lon_step_deg
+
+    @property
+    def lat_deg(self) -> FloatArray:
+        return np.asarray(-90.0 + np.arange(round(180.0 / self.lat_step_deg) + 1) * self.lat_step_deg, dtype=np.float64)
+
+    def altitude_coordinate(self, altitude_km: FloatArray) -> FloatArray:
+        """ln(h − offset): the coordinate in which the altitude nodes are uniform."""
+        return np.log(np.asarray(altitude_km, dtype=np.float64) - self.altitude_offset_km)
+
+    @property
+    def altitude_km(self) -> FloatArray:
+        lo, hi = self.altitude_coordinate(np.array([self.min_altitude_km, self.max_altitude_km]))
+        n = int(np.ceil((hi - lo) / self.log_altitude_step)) + 1
+        return np.exp(lo + np.arange(n) * self.log_altitude_step) + self.altitude_offset_km
+
+
+def slot_times(day: np.datetime64) -> NDArray[np.datetime64]:
+    """The table times of one UTC day: for each 3-hour slot its start, middle and end − 1 s."""
+    d0 = np.asarray(day, dtype="datetime64[D]").astype("datetime64[ns]")
+    offsets = np.array([0, SLOT_NS // 2, SLOT_NS - 10**9], dtype=np.int64)
+    starts = np.arange(SLOTS_PER_DAY, dtype=np.int64) * SLOT_NS
+    return d0 + (starts[:, None] + offsets[None, :]).reshape(-1).astype("timedelta64[ns]")
+
+
+def day_table(day: np.datetime64, space_weather: SpaceWeather, spec: GridSpec) -> NDArray[np.float32]:
+    """log ρ (kg/m³) of one day: (8 slots, altitude, 3 times, latitude, longitude), float32."""
+    times = slot_times(day)
+    f107, f107a, aps = space_weather.msis_drivers(times)
+    # altitude the fastest index: pymsis keeps NRLMSIS's horizontal terms while only altitude changes
+    out = pymsis.calculate(
+        times.astype("datetime64[ms]"),
+        spec.lon_deg,
+        spec.lat_deg,
+        spec.altitude_km,
+        f107s=f107,
+        f107as=f107a,
+        aps=aps,
+        version=MSIS_VERSION,
+        geomagnetic_activity=-1,
+    )
+    rho = np.asarray(out[..., pymsis.Variable.MASS_DENSITY], dtype=np.float64)
+    shape = (SLOTS_PER_DAY, TIMES_PER_SLOT, spec.lon_deg.size, spec.lat_deg.size, spec.altitude_km.size)
+    return np.ascontiguousarray(np.log(rho).reshape(shape).transpose(0, 4, 1, 3, 2), dtype=np.float32)
+
+
+@nb.njit(cache=True, inline="always")
+def _cubic_weights(x: float) -> tuple[float, float, float, float]:
+    """Lagrange weights of the nodes −1, 0, 1, 2 at x (0 ≤ x ≤ 1 inside the stencil's middle)."""
+    return (
+        -x * (x - 1.0) * (x - 2.0) / 6.0,
+        (x + 1.0) * (x - 1.0) * (x - 2.0) / 2.0,
+        -(x + 1.0) * x * (x - 2.0) / 2.0,
+        (x + 1.0) * x * (x - 1.0) / 6.0,
+    )
+
+
+@nb.njit(cache=True, inline="always")
+def _stencil(pos: float, n: int) -> tuple[int, float]:
+    """First node of a 4-node stencil in 0..n−1 around ``pos`` and ``pos`` relative to its second node."""
+    i = int(np.floor(pos))
+    first = min(max(i - 1, 0), n - 4)
+    return first, pos - (first + 1)
+
+
+@nb.njit(cache=True)
+def _interpolate(
+    table: Any,
+    slot: Any,
+    tau: Any,
+    lon_deg: Any,
+    lat_deg: Any,
+    log_h: Any,
+    lon_step: float,
+    lat_step: float,
+    u0: float,
+    du: float,
+    out: Any,
+) -> None:
+    """log ρ at each point from ``table`` (slots × alt × 3 times × lat × lon: the values one point needs
+    lie close together, and the next points of an orbit in the same slot need the same); ``tau`` is the
+    point's time in its slot, 0..1."""
+    n_alt, n_lat, n_lon = table.shape[1], table.shape[3], table.shape[4]
+    slot_deg = 45.0  # [deg]
+    ix = np.empty(3, dtype=np.int64)
+    wx = np.empty((3, 4))
+    for p in range(out.size):
+        s = slot[p]
+        t = tau[p]
+        wt = (2.0 * (t - 0.5) * (t - 1.0), -4.0 * t * (t - 1.0), 2.0 * t * (t - 0.5))
+        j0, y = _stencil((lat_deg[p] + 90.0) / lat_step, n_lat)
+        wy = _cubic_weights(y)
+        k0, z = _stencil((log_h[p] - u0) / du, n_alt)
+        wz = _cubic_weights(z)
+        # the Sun's longitude moves by slot_deg over the slot: at table time k the point's local solar
+        # time is found at lon + slot_deg (t − k/2)
+        for k in range(3):
+            pos = ((lon_deg[p] + slot_deg * (t - 0.5 * k)) % 360.0) / lon_step
+            ix[k] = int(pos)
+            w = _cubic_weights(pos - ix[k])
+            for a in range(4):
+                wx[k, a] = w[a]
+        total = 0.0
+        for c in range(4):
+            acc = 0.0
+            for k in range(3):
+                for b in range(4):
+                    row = 0.0
+                    for a in range(4):
+                        ii = ix[k] - 1 + a
+                        ii = ii + n_lon if ii < 0 else (ii - n_lon if ii >= n_lon else ii)
+                        row += wx[k, a] * table[s, k0 + c, k, j0 + b, ii]
+                    acc += wt[k] * wy[b] * row
+            total += wz[c] * acc
+        out[p] = total
+
+
+class MsisGrid:
+    """NRLMSIS density from per-slot tables shared by every object of a run (module docstring)."""
+
+    def __init__(
+        self, space_weather: SpaceWeather, spec: GridSpec | None = None, cache_dir: str | Path | None = None
+    ) -> None:
+        self.space_weather = space_weather
+        self.spec = spec or GridSpec()
+        self.cache_dir = Path(cache_dir) if cache_dir is not None else None
+        # one block per calendar year (day of year × day_table), allocated zeroed: days never built are
+        # never touched and cost no memory, and the block is never copied
+        self.years: dict[int, tuple[NDArray[np.float32], NDArray[np.bool_]]] = {}
+        self.table_values = 0  # NRLMSIS values computed for tables by this process
+        self.direct_points = 0  # points outside the altitude range, evaluated directly
+        self._key = self._cache_key()
+
+    def _cache_key(self) -> str:
+        sw = self.space_weather
+        h = hashlib.sha256(f"{TABLE_LAYOUT} {self.spec!r}".encode())
+        for arr in (sw.days.astype(np.int64), sw.f107_obs_sfu, sw.f107a_obs_sfu, sw.ap_daily, sw.ap_3h):
+            h.update(np.ascontiguousarray(arr).tobytes())
+        return h.hexdigest()[:16]
+
+    def _path(self, day: Any) -> Path | None:
+        return self.cache_dir / f"msis-{self._key}-{day}.npy" if self.cache_dir is not None else None
+
+    def _build(self, day: Any) -> NDArray[np.float32]:
+        table = day_table(day, self.space_weather, self.spec)
+        self.table_values += table.size
+        path = self._path(day)
+        if path is not None:
+            tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+            with tmp.open("wb") as fh:
+                np.save(fh, table)
+            os.replace(tmp, path)
+        return table
+
+    def _claim(self, day: Any) -> bool:
+        """Whether this process should build ``day`` now: no cache, or it created the day's claim."""
+        path = self._path(day)
+        if path is None:
+            return True
+        try:
+            os.close(os.open(path.with_name(f".{path.name}.claim"), os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+        except FileExistsError:
+            return False
+        return True
+
+    def _year(self, year: int) -> tuple[NDArray[np.float32], NDArray[np.bool_]]:
+        if year not in self.years:
+            spec = self.spec
+            shape = (366, SLOTS_PER_DAY, spec.altitude_km.size, TIMES_PER_SLOT, spec.lat_deg.size, spec.lon_deg.size)
+            self.years[year] = (np.zeros(shape, dtype=np.float32), np.zeros(366, dtype=bool))
+        return self.years[year]
+
+    def prepare(self, first: Any, last: Any) -> None:
+        """Build (or read from ``cache_dir``) the tables of the days ``first``..``last``. With a cache
+        each day is claimed by one process (a marker file); days claimed by another are read once it
+        has written them, or built here at the end if it has not (a killed run)."""
+        days = np.arange(np.datetime64(first, "D"), np.datetime64(last, "D") + np.timedelta64(1, "D"))
+        todo = []
+        for day in days:
+            year = int(str(day)[:4])
+            block, filled = self._year(year)
+            k = int((day - np.datetime64(f"{year}-01-01", "D")) / np.timedelta64(1, "D"))
+            if not filled[k]:
+                todo.append((day, block, filled, k))
+        if self.cache_dir is not None and todo:
+            self.cache_dir.mkdir(parents=True, exist_ok=True)
+        deferred: list[Any] = []
+        for final in (False, True):
+            for item in deferred if final else todo:
+                day, block, filled, k = item
+                path = self._path(day)
+                if path is not None and path.is_file():
+                    block[k] = np.load(path)
+                elif final or self._claim(day):
+                    block[k] = self._build(day)
+                else:
+                    deferred.append(item)
+                    continue
+                filled[k] = True
+
+    @property
+    def nbytes(self) -> int:
+        """Memory of the tables built or read so far."""
+        return sum(int(f.sum()) * b[0].nbytes for b, f in self.years.values())
+
+    def density(
+        self,
+        times_utc: NDArray[np.datetime64],
+        latitude_deg: FloatArray,
+        longitude_deg: FloatArray,
+        altitude_km: FloatArray,
+    ) -> FloatArray:
+        """NRLMSIS 2.1 mass density (kg/m³) at each point, as :func:`abrupt.model.atmosphere.msis_density`."""
+        t = np.asarray(times_utc, dtype="datetime64[ns]")
+        h = np.asarray(altitude_km, dtype=np.float64)
+        out = np.full(t.size, np.nan)
+        if t.size == 0:
+            return out
+        ok = np.isfinite(h) & np.isfinite(latitude_deg) & np.isfinite(longitude_deg)
+        inside = ok & (h >= self.spec.min_altitude_km) & (h <= self.spec.max_altitude_km)
+        outside = ok & ~inside
+        if np.any(outside):
+            self.direct_points += int(outside.sum())
+            out[outside] = np.asarray(
+                msis_density(t[outside], latitude_deg[outside], longitude_deg[outside], h[outside], self.space_weather)
+            )
+        if not np.any(inside):
+            return out
+        spec = self.spec
+        ti = t[inside]
+        days = ti.astype("datetime64[D]")
+        self.space_weather.msis_drivers(np.array([ti.min(), ti.max()]))  # an error naming the table's span
+        self.prepare(days.min(), days.max())
+        ns = (ti - days.astype("datetime64[ns]")).astype(np.int64)
+        slot_in_day = np.minimum(ns // SLOT_NS, SLOTS_PER_DAY - 1)
+        tau = np.clip((ns - slot_in_day * SLOT_NS) / (SLOT_NS - 10**9), 0.0, 1.0)
+        year = days.astype("datetime64[Y]")
+        day_of_year = ((days - year.astype("datetime64[D]")) / np.timedelta64(1, "D")).astype(np.int64)
+        slot = day_of_year * SLOTS_PER_DAY + slot_in_day
+        lon = np.asarray(longitude_deg, dtype=np.float64)[inside]
+        lat = np.asarray(latitude_deg, dtype=np.float64)[inside]
+        coord = spec.altitude_coordinate(h[inside])
+        u0 = float(spec.altitude_coordinate(np.array([spec.min_altitude_km]))[0])
+        log_rho = np.empty(ti.size)
+        for y in np.unique(year):
+            block = self._year(int(str(y)))[0]
+            table = block.reshape(-1, *block.shape[2:])
+            sel = np.flatnonzero(year == y)
+            part = np.empty(sel.size)
+            _interpolate(
+                table,
+                slot[sel],
+                tau[sel],
+                lon[sel],
+                lat[sel],
+                coord[sel],
+                spec.lon_step_deg,
+                spec.lat_step_deg,
+                u0,
+                spec.log_altitude_step,
+                part,
+            )
+            log_rho[sel] = part
+        out[inside] = np.exp(log_rho)
+        return out
