@@ -12,6 +12,10 @@ The event identifier includes the kind, so it is recomputed.
 corrected from the other sensors (:mod:`abrupt.detect.attitude.repair`), ᴺH recomputed, and the step
 statistic rescanned around the event, so that a strike within a minute of the fault (which the
 fault's event covered: peaks are one window span apart) is found and classified as its own event.
+Around an external torque's event (a leak, a venting sequence: one body direction) nothing can be
+repaired, since the torque is real; the ramp's body direction is taken out of ᴺH instead
+(:mod:`abrupt.detect.attitude.ramp_step`) and the rest rescanned: a peak there is kept only when its
+evidence says strike (an impulsive step off the torque's direction), not another piece of the torque.
 """
 
 from __future__ import annotations
@@ -158,7 +162,9 @@ def rescan_after_faults(
     model, the channel is corrected, ᴺH recomputed (the cleaning's slow model is kept: cleaned ᴺH moves
     by exactly what the raw ᴺH moved), and the statistic recomputed around the peak; its strongest
     peak from ``RESCAN_SPAN_S`` around the fault's step and at least ``RESCAN_APART_S`` from it becomes
-    a new peak, with evidence from the repaired telemetry.
+    a new peak, with evidence from the repaired telemetry. For every ``external_non_strike`` peak the
+    ramp's body direction is taken out of cleaned ᴺH (:func:`_off_ramp`) and the strongest peak of the
+    rest is kept when its evidence (of the telemetry as it is) is a strike's.
     """
     g = table.time_ns
     dt = table.dt_s
@@ -184,10 +190,13 @@ def rescan_after_faults(
             if best is None:
                 continue
             j, p = best
-            found.append((a + j, p))
             ev_new = event_evidence(
                 table, cleaned_H_N, spacecraft, p.time_ns, p.dH_N_Nms, inertia_kgm2=inertia_kgm2, raw_H_N=raw_H_N
             )
+            # Only an impulse of its own is a second source; another piece of the same torque adds nothing.
+            if classify(ev_new, rules).kind != "strike":
+                continue
+            found.append((a + j, p))
             found_ev[p.time_ns] = replace(ev_new, after_torque_s=(p.time_ns - pk.time_ns) / NS)
             continue
         if a_.kind != "sensor_fault" or not a_.channel:
