@@ -13,7 +13,12 @@ from scipy.spatial.transform import Rotation
 
 from abrupt.detect.attitude.attribution import classify
 from abrupt.detect.attitude.evidence import EventEvidence
-from abrupt.detect.attitude.ramp_step import body_frame_momentum, fit_ramp_step, ramp_step_evidence
+from abrupt.detect.attitude.ramp_step import (
+    body_frame_momentum,
+    fit_ramp_step,
+    from_body_increments,
+    ramp_step_evidence,
+)
 from abrupt.model.rotations import dcm_from_quaternion
 
 T = np.arange(-600.0, 601.0)
@@ -51,15 +56,17 @@ def test_a_venting_sequences_own_pulse_is_not_off_its_direction(seed: int) -> No
     assert ev["ramp_step_off_z"] < 5.0
 
 
-def test_body_frame_momentum_turns_with_the_body() -> None:
-    q_xyzw = Rotation.from_euler("z", np.linspace(0.0, 0.5, T.size)[:, None]).as_quat()
+def test_body_frame_increments_keep_a_body_fixed_sequence_on_one_line_as_the_body_turns() -> None:
+    q_xyzw = Rotation.from_euler("z", np.linspace(0.0, 0.7, T.size)[:, None]).as_quat()
     q = np.column_stack([q_xyzw[:, 3], q_xyzw[:, :3]])  # scalar first
-    h_b = np.array([0.0, 0.05, 0.0])
-    after = T >= 300.0  # a third of the samples: the median (the residual's level) stays at zero
-    h_n = np.einsum("nij,j->ni", np.transpose(dcm_from_quaternion(q), (0, 2, 1)), h_b) * after[:, None]
+    nb = np.transpose(dcm_from_quaternion(q), (0, 2, 1))
+    i_b = np.array([0.02, 0.01, -0.01])
+    pulses = [100, 400, 800]  # each adds [NB(t_k)] i_B to the inertial momentum, which then stays
+    h_n = sum((np.arange(T.size) >= k)[:, None] * (nb[k] @ i_b) for k in pulses)
     y = body_frame_momentum(h_n, q)
-    assert np.allclose(y[after], h_b, atol=1e-12)
-    assert np.allclose(y[~after], 0.0, atol=1e-12)
+    assert np.allclose(y[-1], 3 * i_b, atol=1e-12)
+    assert np.allclose(np.cross(y, i_b), 0.0, atol=1e-12)  # on one line throughout
+    assert np.allclose(from_body_increments(y, q, h_n[0]), h_n, atol=1e-12)
 
 
 def test_rules_call_an_off_direction_step_on_a_ramp_a_strike_and_an_on_direction_one_not() -> None:

@@ -29,10 +29,9 @@ import pandas as pd
 from abrupt.detect.attitude.attribution import AttributionRules, classify
 from abrupt.detect.attitude.evidence import EventEvidence, event_evidence
 from abrupt.detect.attitude.flight_glr import FlightGlrDetector, Peak
-from abrupt.detect.attitude.ramp_step import body_frame_momentum, fit_ramp_step
+from abrupt.detect.attitude.ramp_step import body_frame_momentum, fit_ramp_step, from_body_increments
 from abrupt.detect.attitude.repair import repair_sensor_fault
 from abrupt.events import format_time_utc, make_event_id
-from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.timetable import NS, Timetable
 from abrupt.series.timetable_momentum import timetable_momentum
@@ -137,9 +136,12 @@ def _off_ramp(table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int
     if fit is None or not float(np.linalg.norm(fit.ramp_B)) > RAMP_SIGMA_MIN * fit.ramp_sigma:
         return None
     u_b = fit.ramp_B / float(np.linalg.norm(fit.ramp_B))
-    u_n = np.einsum("nji,j->ni", dcm_from_quaternion(q[a:b]), u_b)  # [NB] û_B per sample
-    h = cleaned_H_N[a:b] - np.nanmedian(cleaned_H_N[a:b], axis=0)
-    return h - np.sum(h * u_n, axis=1)[:, None] * u_n
+    h = cleaned_H_N[a:b]
+    y_b = body_frame_momentum(h, q[a:b])
+    y_off = y_b - (y_b @ u_b)[:, None] * u_b
+    first = int(np.argmax(np.isfinite(h).all(axis=1)))
+    h0 = np.where(np.isfinite(h[first]), h[first], 0.0)
+    return np.where(np.isfinite(h), from_body_increments(y_off, q[a:b], h0), np.nan)
 
 
 def rescan_after_faults(

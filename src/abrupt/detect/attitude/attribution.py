@@ -195,7 +195,7 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
     # is a second source: a strike during a leak or a venting sequence.
     on_ramp = (
         _finite(ev.ramp_step_fraction, ev.ramp_step_off_fraction, ev.ramp_step_off_z)
-        and ev.ramp_step_fraction >= r.lasting_min
+        and r.lasting_min <= ev.ramp_step_fraction <= 1.0 / r.lasting_min
         and ev.ramp_step_off_fraction >= r.ramp_off_min
         and ev.ramp_step_off_z > r.ramp_off_z
     )

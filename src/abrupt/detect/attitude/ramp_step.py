@@ -56,10 +56,26 @@ def _noise_sigma(y: FloatArray) -> float:
 
 
 def body_frame_momentum(h_N: FloatArray, q_BN: FloatArray) -> FloatArray:
-    """ᴺH samples (minus their median: a residual, so the turning body adds no slow term) in body axes."""
+    """ᴺH's increments turned into body axes at their own instants and summed again.
+
+    An external impulse i_B (a strike, a venting pulse) or a body-fixed torque adds [NB(t)] i_B to ᴺH at
+    its time t: each increment is fixed in body axes when it happens, while the level it leaves stays
+    fixed in inertial axes. Σ [BN(t_k)] ΔᴺH_k therefore keeps a venting sequence on one line and a leak on
+    a straight ramp however the body turns (rotating the level instead would turn every earlier step
+    as the body turns). Missing samples add nothing; the series starts at zero.
+    """
     h = np.asarray(h_N, dtype=np.float64)
-    h = h - np.nanmedian(h, axis=0)
-    return np.einsum("nij,nj->ni", dcm_from_quaternion(q_BN), h)
+    d = np.diff(h, axis=0, prepend=h[:1])
+    d = np.where(np.isfinite(d), d, 0.0)
+    y = np.cumsum(np.einsum("nij,nj->ni", dcm_from_quaternion(q_BN), d), axis=0)
+    return np.where(np.isfinite(h), y, np.nan)
+
+
+def from_body_increments(y_B: FloatArray, q_BN: FloatArray, h0_N: FloatArray) -> FloatArray:
+    """The inverse of :func:`body_frame_momentum`: ᴺH from ``h0_N`` and the body-axis increments of ``y_B``."""
+    d = np.diff(np.where(np.isfinite(y_B), y_B, 0.0), axis=0, prepend=np.zeros((1, 3)))
+    dn = np.einsum("nji,nj->ni", dcm_from_quaternion(q_BN), d)
+    return np.asarray(h0_N, dtype=np.float64)[None, :] + np.cumsum(dn, axis=0)
 
 
 def fit_ramp_step(
