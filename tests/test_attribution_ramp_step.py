@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from abrupt.detect.attitude.attribution import classify
+from abrupt.detect.attitude.attribution import AttributionRules, classify
 from abrupt.detect.attitude.evidence import EventEvidence
 from abrupt.detect.attitude.ramp_step import (
     body_frame_momentum,
@@ -69,7 +69,7 @@ def test_body_frame_increments_keep_a_body_fixed_sequence_on_one_line_as_the_bod
     assert np.allclose(from_body_increments(y, q, h_n[0]), h_n, atol=1e-12)
 
 
-def test_rules_call_an_off_direction_step_on_a_ramp_a_strike_and_an_on_direction_one_not() -> None:
+def test_rule_4b_calls_an_off_direction_step_on_a_ramp_a_strike_and_an_on_direction_one_not() -> None:
     common = dict(
         st_gyro_step_rad=1e-5, st_gyro_step_limit_rad=3e-4, st_gyro_slope_rad_s=1e-7, st_gyro_slope_limit_rad_s=4e-6,
         body_share=0.3, body_share_sigma=0.02, wheel_change_Nms=0.1, wheel_change_sigma_Nms=4e-4,
@@ -77,12 +77,14 @@ def test_rules_call_an_off_direction_step_on_a_ramp_a_strike_and_an_on_direction
         lasting_fraction=1.2, duration_s=150.0, duration_lo_s=120.0, duration_hi_s=300.0,
         ramp_step_fraction=0.9,
     )  # fmt: skip
+    on = AttributionRules(step_on_ramp=True)
     off = EventEvidence(**common, ramp_step_off_fraction=0.8, ramp_step_off_z=300.0)  # type: ignore[arg-type]
-    assert classify(off).kind == "strike"
+    assert classify(off, on).kind == "strike"
+    assert classify(off).kind == "external_non_strike"  # the rule is off by default
     along = EventEvidence(**common, ramp_step_off_fraction=0.1, ramp_step_off_z=3.0)  # type: ignore[arg-type]
-    assert classify(along).kind == "external_non_strike"
+    assert classify(along, on).kind == "external_non_strike"
     no_ramp = EventEvidence(**common)  # type: ignore[arg-type]
-    assert classify(no_ramp).kind == "external_non_strike"
+    assert classify(no_ramp, on).kind == "external_non_strike"
 
 
 def test_a_strike_at_a_snaps_time_is_a_strike_and_the_snap_alone_internal() -> None:

@@ -17,8 +17,9 @@ The rules read the evidence of :mod:`abrupt.detect.attitude.evidence`; none is f
    (null-space part, or one wheel carrying it);
 4. **strike** when the sensors agree, the body took the impulse first (body share), the step lasts,
    is in the momentum before cleaning too (``raw_step_fraction``) and is impulsive (its duration
-   interval reaches below ``impulsive_s``), or, inside a ramp or a sequence, the step at the event is
-   impulsive and off the ramp's body direction (a second source: :mod:`abrupt.detect.attitude.ramp_step`);
+   interval reaches below ``impulsive_s``), or (only with ``step_on_ramp``, off by default), inside a
+   ramp or a sequence, the step at the event is impulsive and off the ramp's body direction (a second
+   source: :mod:`abrupt.detect.attitude.ramp_step`);
 5. **external_non_strike** when the sensors agree and a step lasts (either sign: the event's own ΔH
    may be a piece of a longer ramp) but it is a ramp or a sequence
    (duration interval above ``impulsive_s``), or the body share is small (a slow torque the loop kept
@@ -68,6 +69,9 @@ class AttributionRules:
     #: step more than 30° from the ramp's direction).
     ramp_off_min: float = 0.5
     ramp_off_z: float = 8.0
+    #: Rule 4b is off by default: with a strike and a venting pulse both in the window, the fit cannot
+    #: tell which of the two is the second source, and it called venting pulses next to a strike strikes.
+    step_on_ramp: bool = False
 
 
 @dataclass(frozen=True)
@@ -199,7 +203,7 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
         and ev.ramp_step_off_fraction >= r.ramp_off_min
         and ev.ramp_step_off_z > r.ramp_off_z
     )
-    if lasting and on_ramp and body_moved and in_raw:
+    if r.step_on_ramp and lasting and on_ramp and body_moved and in_raw:
         return Attribution(
             "strike", _confidence([True, True, False, surface_ok]), "", "impulsive step on a ramp, off its direction"
         )
