@@ -3,6 +3,7 @@
     PYTHONPATH=$PWD/src nice python benchmarks/bench_attribution.py [--ranges eval|widened|tests|FILE.toml]
         [--runs 3] [--per-kind 20] [--store DIR] [--seed 1]
         [--kinds K1,K2] [--days 1] [--near-fraction 0.25]    # a quick subset while iterating
+        [--dump DIR]                                        # each run's events and matched truth (CSV)
 
 The two stored days of ../shared/data/flight-like (Basilisk telemetry of kestrel, pseudonym SC-A) get
 synthetic strikes (``abrupt.simulate.injection``, closed-loop response) and confounders of every kind
@@ -193,6 +194,7 @@ def match(truth: list[dict], events: pd.DataFrame) -> pd.DataFrame:
             got = str(events["kind"].iloc[best])
             used.add(int(best))
             extra = {c: events[c].iloc[best] for c in (*EVIDENCE_SHOWN, "kind_reason") if c in events}
+            extra["event_index"] = int(best)
         rows.append({**tr, "got": got, **extra})
     return pd.DataFrame(rows)
 
@@ -207,6 +209,7 @@ def main() -> int:
     ap.add_argument("--kinds", default=None, help="Comma-separated confounder kinds (default: all)")
     ap.add_argument("--days", type=int, default=2, help="Use the first 1 or both days of the set")
     ap.add_argument("--near-fraction", type=float, default=0.25, help="Share of confounders with a strike after")
+    ap.add_argument("--dump", default=None, help="Write each run's events and truth as CSV files into this folder")
     ap.add_argument("--figure", default=None, help="Write the example panels (one event of each kind) to this PNG")
     args = ap.parse_args()
     if args.ranges == "eval":
@@ -243,15 +246,28 @@ def main() -> int:
     print(f"threshold {threshold.value:.2f} calibrated on the days without injections")
     archive_figures(plain.events, args.days)
     rows = []
+    unmatched: list[pd.Series] = []
     for run in range(args.runs):
         plan = plan_run(run, args.per_kind, args.runs, slots, rng, kinds)
         truth, events = one_run(store, sc, plan, ranges, rng, args.seed + run, threshold, days, args.near_fraction)
         m = match(truth, events)
         m["run"] = run
+        claimed = set(m["event_index"].dropna().astype(int)) if "event_index" in m else set()
+        spare = events["kind"].astype(str).to_numpy()[[i for i in range(len(events)) if i not in claimed]]
+        unmatched.append(pd.Series(spare).value_counts())
+        if args.dump:
+            Path(args.dump).mkdir(parents=True, exist_ok=True)
+            events.to_csv(Path(args.dump) / f"events_run{run + 1}.csv", index=False)
+            m.to_csv(Path(args.dump) / f"truth_run{run + 1}.csv", index=False)
         rows.append(m)
         print(f"run {run + 1}: {len(plan)} injections, {len(events)} events, {time.time() - t_start:.0f} s", flush=True)
     table = pd.concat(rows, ignore_index=True)
     report(table)
+    spare_all = pd.concat(unmatched, axis=1).fillna(0).sum(axis=1).astype(int) if unmatched else pd.Series()
+    print(
+        f"\nevents claimed by no injection (a long confounder's further events, the days' own events): "
+        f"{int(spare_all.sum())}; by kind: {', '.join(f'{k} {v}' for k, v in spare_all.items()) or 'none'}"
+    )
     return 0
 
 

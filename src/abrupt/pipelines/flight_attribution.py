@@ -12,6 +12,10 @@ The event identifier includes the kind, so it is recomputed.
 corrected from the other sensors (:mod:`abrupt.detect.attitude.repair`), ᴺH recomputed, and the step
 statistic rescanned around the event, so that a strike within a minute of the fault (which the
 fault's event covered: peaks are one window span apart) is found and classified as its own event.
+Around an external torque's event (a leak, a venting sequence: one body direction) nothing can be
+repaired, since the torque is real; the ramp's body direction is taken out of ᴺH instead
+(:mod:`abrupt.detect.attitude.ramp_step`) and the rest rescanned: a peak there is kept only when its
+evidence says strike (an impulsive step off the torque's direction), not another piece of the torque.
 """
 
 from __future__ import annotations
@@ -25,6 +29,7 @@ import pandas as pd
 from abrupt.detect.attitude.attribution import AttributionRules, classify
 from abrupt.detect.attitude.evidence import EventEvidence, event_evidence
 from abrupt.detect.attitude.flight_glr import FlightGlrDetector, Peak
+from abrupt.detect.attitude.ramp_step import body_frame_momentum, fit_ramp_step, from_body_increments
 from abrupt.detect.attitude.repair import repair_sensor_fault
 from abrupt.events import format_time_utc, make_event_id
 from abrupt.model.spacecraft import Spacecraft
@@ -76,6 +81,10 @@ def attribute_events(
 #: step it must be [s] (nearer, the two cannot be told apart).
 RESCAN_SPAN_S = (-300.0, 300.0)
 RESCAN_APART_S = 10.0
+#: The window of the ramp fit around an external torque's event [s] (that of the evidence's time profile),
+#: and how far beyond its noise the ramp must be to have a direction [σ].
+RAMP_WINDOW_S = 600.0
+RAMP_SIGMA_MIN = 5.0
 
 
 def _rows(table: Timetable, a: int, b: int) -> Timetable:
@@ -83,6 +92,56 @@ def _rows(table: Timetable, a: int, b: int) -> Timetable:
     per_row = {f.name for f in fields(Timetable)} - {"channel_valid", "missing_channels"}
     sub = {k: getattr(table, k)[a:b] for k in per_row}
     return replace(table, **sub, channel_valid={k: v[a:b] for k, v in table.channel_valid.items()})
+
+
+def _best_peak(
+    detector: FlightGlrDetector,
+    hc_sub: FloatArray,
+    ok_sub: BoolArray,
+    g_sub: np.ndarray,
+    dt: float,
+    t0_ns: int,
+    floor: float,
+    keep_sub: BoolArray | None,
+) -> tuple[int, Peak] | None:
+    """The strongest peak of the statistic of ``hc_sub`` above ``floor`` within ``RESCAN_SPAN_S`` of
+    ``t0_ns`` and more than ``RESCAN_APART_S`` from it (None when there is none)."""
+    win = detector.windows(dt)
+    stat = detector.statistic(hc_sub, ok_sub, win)
+    tau = (g_sub - t0_ns) / NS
+    look = (tau >= RESCAN_SPAN_S[0]) & (tau <= RESCAN_SPAN_S[1]) & (np.abs(tau) > RESCAN_APART_S)
+    if keep_sub is not None:
+        look &= keep_sub
+    stat = np.where(look, stat, np.nan)
+    cands = [
+        (j, p)
+        for j, p in detector.find_peaks(hc_sub, ok_sub, stat, g_sub, dt, win)
+        if p.value > floor
+        and RESCAN_APART_S < abs(dt_s := (p.time_ns - t0_ns) / NS)
+        and RESCAN_SPAN_S[0] <= dt_s <= RESCAN_SPAN_S[1]
+    ]
+    return max(cands, key=lambda c: c[1].value) if cands else None
+
+
+def _off_ramp(table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int) -> FloatArray | None:
+    """Cleaned ᴺH over rows [a, b) with the component along the body direction of the ramp or sequence
+    around row ``i0`` removed (:func:`~abrupt.detect.attitude.ramp_step.fit_ramp_step`), or None when the
+    window needs no ramp. A leak or a venting sequence keeps one body direction; what steps off it is a
+    second source."""
+    g = table.time_ns
+    half = round(RAMP_WINDOW_S / table.dt_s)
+    lo, hi = max(0, i0 - half), min(g.size, i0 + half + 1)
+    q = table.quaternion_BN
+    fit = fit_ramp_step((g[lo:hi] - g[i0]) / NS, body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi]), 0.0)
+    if fit is None or not float(np.linalg.norm(fit.ramp_B)) > RAMP_SIGMA_MIN * fit.ramp_sigma:
+        return None
+    u_b = fit.ramp_B / float(np.linalg.norm(fit.ramp_B))
+    h = cleaned_H_N[a:b]
+    y_b = body_frame_momentum(h, q[a:b])
+    y_off = y_b - (y_b @ u_b)[:, None] * u_b
+    first = int(np.argmax(np.isfinite(h).all(axis=1)))
+    h0 = np.where(np.isfinite(h[first]), h[first], 0.0)
+    return np.where(np.isfinite(h), from_body_increments(y_off, q[a:b], h0), np.nan)
 
 
 def rescan_after_faults(
@@ -105,7 +164,9 @@ def rescan_after_faults(
     model, the channel is corrected, ᴺH recomputed (the cleaning's slow model is kept: cleaned ᴺH moves
     by exactly what the raw ᴺH moved), and the statistic recomputed around the peak; its strongest
     peak from ``RESCAN_SPAN_S`` around the fault's step and at least ``RESCAN_APART_S`` from it becomes
-    a new peak, with evidence from the repaired telemetry.
+    a new peak, with evidence from the repaired telemetry. For every ``external_non_strike`` peak the
+    ramp's body direction is taken out of cleaned ᴺH (:func:`_off_ramp`) and the strongest peak of the
+    rest is kept when its evidence (of the telemetry as it is) is a strike's.
     """
     g = table.time_ns
     dt = table.dt_s
@@ -118,31 +179,39 @@ def rescan_after_faults(
         if ev is None:
             continue
         a_ = classify(ev, rules)
+        i0 = int(np.clip(np.searchsorted(g, pk.time_ns), 0, g.size - 1))
+        a, b = max(0, i0 - round((half_s + 240.0) / dt)), min(g.size, i0 + round((half_s + 240.0) / dt))
+        if a_.kind == "external_non_strike":
+            hc_sub = _off_ramp(table, cleaned_H_N, i0, a, b)
+            if hc_sub is None:
+                continue
+            hc_sub = np.where(ok[a:b, None], hc_sub, np.nan)
+            best = _best_peak(
+                detector, hc_sub, ok[a:b], g[a:b], dt, pk.time_ns, floor, None if keep is None else keep[a:b]
+            )
+            if best is None:
+                continue
+            j, p = best
+            ev_new = event_evidence(
+                table, cleaned_H_N, spacecraft, p.time_ns, p.dH_N_Nms, inertia_kgm2=inertia_kgm2, raw_H_N=raw_H_N
+            )
+            # Only an impulse of its own is a second source; another piece of the same torque adds nothing.
+            if classify(ev_new, rules).kind != "strike":
+                continue
+            found.append((a + j, p))
+            found_ev[p.time_ns] = replace(ev_new, after_torque_s=(p.time_ns - pk.time_ns) / NS)
+            continue
         if a_.kind != "sensor_fault" or not a_.channel:
             continue
-        i0 = int(np.clip(np.searchsorted(g, pk.time_ns), 0, g.size - 1))
         rep = repair_sensor_fault(table, spacecraft, i0, a_.channel, a_.reason, half_s)
         if rep is None:
             continue
-        a, b = max(0, i0 - round((half_s + 240.0) / dt)), min(g.size, i0 + round((half_s + 240.0) / dt))
         h_new, _ = timetable_momentum(spacecraft, _rows(rep.table, a, b), inertia_kgm2)
         hc_sub = np.where(ok[a:b, None], cleaned_H_N[a:b] + (h_new - raw_H_N[a:b]), np.nan)
-        stat = detector.statistic(hc_sub, ok[a:b], win)
-        tau = (g[a:b] - pk.time_ns) / NS
-        look = (tau >= RESCAN_SPAN_S[0]) & (tau <= RESCAN_SPAN_S[1]) & (np.abs(tau) > RESCAN_APART_S)
-        if keep is not None:
-            look &= keep[a:b]
-        stat = np.where(look, stat, np.nan)
-        cands = [
-            (j, p)
-            for j, p in detector.find_peaks(hc_sub, ok[a:b], stat, g[a:b], dt, win)
-            if p.value > floor
-            and RESCAN_APART_S < abs(dt_s := (p.time_ns - pk.time_ns) / NS)
-            and RESCAN_SPAN_S[0] <= dt_s <= RESCAN_SPAN_S[1]
-        ]
-        if not cands:
+        best = _best_peak(detector, hc_sub, ok[a:b], g[a:b], dt, pk.time_ns, floor, None if keep is None else keep[a:b])
+        if best is None:
             continue
-        j, p = max(cands, key=lambda c: c[1].value)
+        j, p = best
         hc_full = cleaned_H_N.copy()
         hc_full[a:b] = hc_sub
         raw_full = raw_H_N.copy()

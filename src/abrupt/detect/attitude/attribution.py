@@ -9,14 +9,17 @@ The rules read the evidence of :mod:`abrupt.detect.attitude.evidence`; none is f
    tracker (channel ``star_tracker``); and, without a jump, a gyro excursion the tracker did not see
    while neither the body (by the tracker) nor the wheels moved is a gyro spike;
 2. **internal** when an appendage drive changed rate abruptly at the event (momentum moved between
-   the hub and the appendage, total conserved);
+   the hub and the appendage, total conserved), unless ᴺH steps for good, impulsively, with the body's
+   and the wheels' response (a snap cannot: that is a strike at the snap's time);
 3. **sensor_fault** of a wheel when one wheel's reading has an isolated spike, or the wheels'
    momentum changed, while the body never felt it (body share below ``body_share_min`` and below
    ``body_sigma`` times its noise), and the change is not one the minimum-norm controller makes
    (null-space part, or one wheel carrying it);
 4. **strike** when the sensors agree, the body took the impulse first (body share), the step lasts,
    is in the momentum before cleaning too (``raw_step_fraction``) and is impulsive (its duration
-   interval reaches below ``impulsive_s``);
+   interval reaches below ``impulsive_s``), or (only with ``step_on_ramp``, off by default), inside a
+   ramp or a sequence, the step at the event is impulsive and off the ramp's body direction (a second
+   source: :mod:`abrupt.detect.attitude.ramp_step`);
 5. **external_non_strike** when the sensors agree and a step lasts (either sign: the event's own ΔH
    may be a piece of a longer ramp) but it is a ramp or a sequence
    (duration interval above ``impulsive_s``), or the body share is small (a slow torque the loop kept
@@ -61,6 +64,14 @@ class AttributionRules:
     appendage_min_deg: float = 0.2
     takeup_min: float = 0.5
     residual_max: float = 0.5
+    #: A step at the event on top of a ramp/sequence is a second source when its part off the ramp's body
+    #: direction is beyond ``ramp_off_z`` σ of its noise and at least ``ramp_off_min`` of the step (the
+    #: step more than 30° from the ramp's direction).
+    ramp_off_min: float = 0.5
+    ramp_off_z: float = 8.0
+    #: Rule 4b is off by default: with a strike and a venting pulse both in the window, the fit cannot
+    #: tell which of the two is the second source, and it called venting pulses next to a strike strikes.
+    step_on_ramp: bool = False
 
 
 @dataclass(frozen=True)
@@ -83,6 +94,16 @@ def _ratio(x: float, limit: float) -> float:
 
 def _confidence(tests: list[bool]) -> float:
     return 0.5 + 0.49 * (sum(tests) / len(tests)) if tests else 0.5
+
+
+def _lasting_impulse(ev: EventEvidence, r: AttributionRules) -> bool:
+    """The step lasts in cleaned and raw ᴺH and its duration interval reaches below ``impulsive_s``."""
+    return (
+        _finite(ev.lasting_fraction, ev.raw_step_fraction, ev.duration_lo_s)
+        and ev.lasting_fraction >= r.lasting_min
+        and ev.raw_step_fraction >= r.lasting_min
+        and ev.duration_lo_s <= r.impulsive_s
+    )
 
 
 def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attribution:
@@ -135,11 +156,14 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
             f"gyro_{axis[max(ev.gyro_spike_axis, 0)]}",
             "gyro spike (not seen by the star tracker)",
         )
-    # 2. Appendage.
+    # 2. Appendage. A snap moves momentum between hub and array and leaves ᴺH as it was, so a lasting,
+    # impulsive step in ᴺH (cleaned and raw) that the body felt and the wheels took up is not the snap's:
+    # a strike at the snap's time falls through to the rules below.
     if (
         _finite(ev.appendage_z, ev.appendage_excess_deg)
         and ev.appendage_z > r.appendage_z
         and ev.appendage_excess_deg > r.appendage_min_deg
+        and not (_lasting_impulse(ev, r) and body_moved and takeup)
     ):
         tests = [True, _finite(ev.lasting_fraction) and abs(ev.lasting_fraction) < r.lasting_min]
         return Attribution(
@@ -171,6 +195,18 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
     # 4./5. External.
     if lasting and impulsive and body_moved and in_raw:
         return Attribution("strike", _confidence([True, True, True, surface_ok]), "", "impulsive external step")
+    # 4b. A ramp or a sequence keeps one body direction; an impulsive step at the event off that direction
+    # is a second source: a strike during a leak or a venting sequence.
+    on_ramp = (
+        _finite(ev.ramp_step_fraction, ev.ramp_step_off_fraction, ev.ramp_step_off_z)
+        and r.lasting_min <= ev.ramp_step_fraction <= 1.0 / r.lasting_min
+        and ev.ramp_step_off_fraction >= r.ramp_off_min
+        and ev.ramp_step_off_z > r.ramp_off_z
+    )
+    if r.step_on_ramp and lasting and on_ramp and body_moved and in_raw:
+        return Attribution(
+            "strike", _confidence([True, True, False, surface_ok]), "", "impulsive step on a ramp, off its direction"
+        )
     if abs(ev.lasting_fraction) >= r.lasting_min and (not impulsive or not body_moved):
         tests = [True, not impulsive, not body_moved]
         return Attribution("external_non_strike", _confidence(tests), "", "ramp or sequence of external torque")

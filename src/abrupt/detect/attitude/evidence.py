@@ -36,7 +36,12 @@ telemetry (:class:`~abrupt.series.timetable.Timetable`) around the event:
   must cause (|ΔH| / (m r_max));
 * **after a fault** (``after_fault_s``): for an event found only once a sensor fault's channel was
   repaired (:func:`abrupt.pipelines.flight_attribution.rescan_after_faults`), its time after the
-  fault's event [s] (NaN for every other event); the evidence is then that of the repaired telemetry.
+  fault's event [s] (NaN for every other event); the evidence is then that of the repaired telemetry;
+* **step on a ramp** (``ramp_step_fraction``, ``ramp_step_off_fraction``, ``ramp_step_off_z``): the
+  momentum in body axes fitted by a ramp (a leak, a venting sequence: one body direction) plus a step at
+  the event (:mod:`abrupt.detect.attitude.ramp_step`); the step's part off the ramp's direction is a
+  second source (a strike during the torque); ``after_torque_s``: for an event found only once the
+  ramp's direction was taken out around an external torque's event, its time after that event [s].
 """
 
 from __future__ import annotations
@@ -48,6 +53,7 @@ from typing import Any
 import numpy as np
 from scipy.ndimage import median_filter
 
+from abrupt.detect.attitude.ramp_step import body_frame_momentum, fit_ramp_step, ramp_step_evidence
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.timetable import NS, Timetable
@@ -94,6 +100,10 @@ class EventEvidence:
     surface_fraction: float = NAN
     min_dv_mps: float = NAN
     after_fault_s: float = NAN
+    ramp_step_fraction: float = NAN
+    ramp_step_off_fraction: float = NAN
+    ramp_step_off_z: float = NAN
+    after_torque_s: float = NAN
 
     def as_dict(self) -> dict[str, float]:
         return {f"ev_{k}": float(v) for k, v in asdict(self).items()}
@@ -219,6 +229,9 @@ class EvidenceWindows:
     lasting_s: tuple[float, float] = (60.0, 150.0)
     profile_s: float = 600.0
     timing_s: float = 0.5
+    #: The shortest ramp of the step-on-a-ramp fit (an impulse's duration interval reaches below it; the
+    #: fit is made only for events whose interval does not).
+    ramp_min_s: float = 8.0
 
 
 def _idx(g: np.ndarray, i0: int, a_s: float, b_s: float, dt: float) -> np.ndarray:
@@ -293,6 +306,11 @@ def event_evidence(
         out.update(_sensor_residuals(q[i0], bn0, J, dh_n, step_vec, slope_vec, raw_H_N, pre))
     out.update(_gyro_spike(q, omega, valid, i0, dt))
     out.update(_profile(g, cleaned_H_N, dh_n, i0, dt, w))
+    if not float(out.get("duration_lo_s", NAN)) <= w.ramp_min_s:  # an impulse needs no ramp besides it
+        span = _idx(g, i0, -w.profile_s, w.profile_s, dt)
+        y_b = body_frame_momentum(cleaned_H_N[span], q[span])
+        fit = fit_ramp_step((g[span] - g[i0]) / NS, y_b, 0.0, min_ramp_s=w.ramp_min_s)
+        out.update(ramp_step_evidence(fit, mag))
     out.update(_appendage(table, i0, dt))
     out.update(surface_evidence(spacecraft, dh_b))
     if raw_H_N is not None and mag > 0:
