@@ -7,7 +7,8 @@ public catalogue (abrupt.simulate.tle_catalogue: the catalogue's mix of orbits a
 
 For each N it times the command (wall, as a subprocess), samples the resident memory of the command
 and all its worker processes every 0.1 s (peak printed), fits wall = a + b·N over the N measured and
-*extrapolates* to 25,000 objects (printed as extrapolated: nothing here ran 25,000 objects). The
+*extrapolates* to 25,000 objects (printed as extrapolated). A single N is printed as it is: measured when
+it is the whole catalogue (``--objects 25000``), else scaled in proportion and said to be a projection. The
 same-run reference: the previous release of abrupt (``--baseline``, e.g. a temporary worktree of the
 last release) and this tree, each detecting on the same files in one process, one after the other; the
 ratio this/previous is printed beside the absolute times and the machine's load average. ``--kill``
@@ -306,20 +307,29 @@ def part(
             f"{n / wall:6.1f} objects/s, {cpu:6.1f} CPU-s ({1e3 * cpu / n:.0f} ms/object), peak memory {peak:.2f} GB"
             f"   ({load()})"
         )
-    a, b, t25k = extrapolate(ns, walls)
-    if b > 0:
+    if len(ns) == 1:
+        n, cpu = ns[0], cpus[0]
+        kind = "MEASURED" if n >= CATALOGUE_OBJECTS else f"one size; × {CATALOGUE_OBJECTS / n:.1f} PROJECTED"
         print(
-            f"  fit wall = {a:.1f} s + {1e3 * b:.1f} ms × N;  EXTRAPOLATED to {CATALOGUE_OBJECTS:,} objects: "
-            f"{t25k / 60:.1f} min (target < {target_min:g} min) — measured under the load above"
+            f"  {n:,} objects ({kind}): {walls[0] / 60:.1f} min wall under the load above; {cpu / 60:.0f} CPU-min, "
+            f"i.e. {cpu / 120 * CATALOGUE_OBJECTS / n:.1f} min of wall for {CATALOGUE_OBJECTS:,} objects on two "
+            f"otherwise idle cores (from CPU time; target < {target_min:g} min)"
         )
     else:
-        print("  wall time did not grow with N beyond the load's noise: no wall extrapolation")
-    ca, cb, c25k = extrapolate(ns, cpus)
-    print(
-        f"  fit CPU = {ca:.1f} s + {1e3 * cb:.1f} ms × N;  EXTRAPOLATED CPU for {CATALOGUE_OBJECTS:,} objects "
-        f"{c25k / 60:.0f} CPU-min, i.e. {c25k / 120:.1f} min of wall on two otherwise idle cores "
-        f"(projection from CPU time; target < {target_min:g} min)"
-    )
+        a, b, t25k = extrapolate(ns, walls)
+        if b > 0:
+            print(
+                f"  fit wall = {a:.1f} s + {1e3 * b:.1f} ms × N;  EXTRAPOLATED to {CATALOGUE_OBJECTS:,} objects: "
+                f"{t25k / 60:.1f} min (target < {target_min:g} min) — measured under the load above"
+            )
+        else:
+            print("  wall time did not grow with N beyond the load's noise: no wall extrapolation")
+        ca, cb, c25k = extrapolate(ns, cpus)
+        print(
+            f"  fit CPU = {ca:.1f} s + {1e3 * cb:.1f} ms × N;  EXTRAPOLATED CPU for {CATALOGUE_OBJECTS:,} objects "
+            f"{c25k / 60:.0f} CPU-min, i.e. {c25k / 120:.1f} min of wall on two otherwise idle cores "
+            f"(projection from CPU time; target < {target_min:g} min)"
+        )
     steps = ", ".join(
         f"{n0}→{n1}: {1e3 * (p1 - p0):+.0f} MB" for n0, n1, p0, p1 in zip(ns, ns[1:], peaks, peaks[1:], strict=False)
     )
