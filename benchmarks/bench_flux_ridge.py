@@ -145,7 +145,8 @@ def ridge_numbers(lik: Likelihood, truth_s: float, beta: float, years: float) ->
         f"{truth_s * td:.1f}, meteoroid {sig[1].sum():.1f}, false alarms {bg.sum():.1f}; alpha_d = {alpha:.2f}"
     )
     print(
-        f"    Cramer-Rao sd: s_debris {sd_s:.2f}, beta {sd_b:.2f} (relative); corr {cov[0, 1] / math.sqrt(cov[0, 0] * cov[1, 1]):+.3f}"
+        f"    Cramer-Rao sd: s_debris {sd_s:.2f}, beta {sd_b:.2f} (relative); "
+        f"corr {cov[0, 1] / math.sqrt(cov[0, 0] * cov[1, 1]):+.3f}"
     )
     print(
         f"    first-order bias of the MLE (Cox-Snell): s_debris {b[0] / truth_s:+.3f}, beta {b[1] / beta:+.3f}; "
@@ -225,7 +226,10 @@ def main() -> None:
             f"{cpu:.1f} s CPU ({cpu / reps:.3f} s per fleet, all estimators); MLE beta at the 0.1 floor in "
             f"{floor_hits / reps:.3f} of fleets"
         )
-        print(f"  {'estimator':>16} {'s_debris mean':>14} {'± s.e.':>7} {'median':>7} {'beta mean':>10} {'± s.e.':>7} {'median':>7}")
+        print(
+            f"  {'estimator':>16} {'s_debris mean':>14} {'± s.e.':>7} {'median':>7} {'beta mean':>10} "
+            f"{'± s.e.':>7} {'median':>7}"
+        )
         for k in names:
             arr = np.array(est[k])
             s, b = arr[:, 0] / args.debris_scale, arr[:, 1] / args.beta
