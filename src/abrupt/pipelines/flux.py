@@ -22,6 +22,7 @@ from scipy import stats
 from abrupt.catalog import Catalog, coverage_table
 from abrupt.errors import InputError
 from abrupt.events import new_run_id
+from abrupt.flux.days import case_of
 from abrupt.flux.exposure import (
     EfficiencyCurve,
     exposure_frame,
@@ -36,7 +37,6 @@ from abrupt.flux.inference import (
     FitResult,
     FluxData,
     Likelihood,
-    case_of,
     fit,
     goodness_of_fit,
     prepare,
