@@ -10,7 +10,6 @@ import pytest
 from scipy import stats
 
 from abrupt.catalog import Catalog
-from abrupt.errors import InputError
 from abrupt.flux.exposure import (
     DAYS_PER_YEAR,
     EfficiencyCurve,
@@ -204,17 +203,6 @@ def test_bad_exposure_row_names_the_row_and_column() -> None:
     exp.loc[2, "analysed_fraction"] = 1.5
     with pytest.raises(ValueError, match="row 3, column analysed_fraction"):
         prepare(exp, no_events(), {CASE: power_law_template()})
-
-
-def test_two_exposure_rows_of_one_spacecraft_day_are_a_one_line_error() -> None:
-    """Events are matched to their spacecraft-day; a second exposure of that day (another detector's,
-    written by `flux exposure`) would count the day twice: an error naming the day and the detectors."""
-    exp = exposure(1, 0.01)
-    second = exp.iloc[[0]].assign(detector="attitude.flight_glr")
-    with pytest.raises(
-        InputError, match=r"2 rows for spacecraft-day SIM-001 .* \(detectors attitude.flight_glr, simulate.population\)"
-    ):
-        prepare(pd.concat([exp, second], ignore_index=True), no_events(), {CASE: power_law_template()})
 
 
 def test_template_smoothing_leaves_a_power_law_unbiased() -> None:

@@ -34,6 +34,7 @@ from numpy.typing import NDArray
 from scipy import optimize, stats
 
 from abrupt.errors import ConfigError, InputError
+from abrupt.flux.days import bin_efficiency, case_groups, one_exposure_per_day, reference_signal
 from abrupt.flux.exposure import DAYS_PER_YEAR, exposure_frame, logistic_efficiency
 from abrupt.flux.forward import (
     DIRECTION_CLASSES,
@@ -47,39 +48,6 @@ from abrupt.flux.forward import (
 PARAMS: tuple[str, ...] = ("debris_scale", "meteoroid_scale", "beta")
 SCALES: tuple[str, ...] = ("debris_scale", "meteoroid_scale")
 DEFAULT_BETA_GRID = np.exp(np.linspace(math.log(0.1), math.log(100.0), 161))
-
-
-def case_of(row: Mapping[Any, Any]) -> OrbitCase:
-    """The template key of an exposure row."""
-    epoch = float(row["epoch_year"])
-    return OrbitCase(
-        str(row["spacecraft_file"]),
-        float(row["altitude_km"]),
-        float(row["inclination_deg"]),
-        2020.0 if not math.isfinite(epoch) else epoch,
-    )
-
-
-def bin_efficiency(edges: NDArray[np.float64], curves: NDArray[np.float64], n_sub: int = 16) -> NDArray[np.float64]:
-    """Mean efficiency over each |ΔH| bin (points uniform in ln|ΔH|; the open top bin over one bin width),
-    for curves (U, 3) of (x50, slope, plateau), so that steep curves are not sampled at the centre only."""
-    lo = np.log(edges[:-1])
-    upper = np.append(edges[1:-1], edges[-2] * (edges[-2] / edges[-3]))
-    hi = np.log(upper)
-    t = (np.arange(n_sub) + 0.5) / n_sub
-    x = np.exp(lo[:, None] + (hi - lo)[:, None] * t[None, :])  # (K, S)
-    eff = logistic_efficiency(
-        x[None, :, :], curves[:, 0, None, None], curves[:, 1, None, None], curves[:, 2, None, None]
-    )
-    return np.asarray(eff.mean(axis=2), dtype=np.float64)
-
-
-def case_groups(exposure: pd.DataFrame) -> tuple[list[OrbitCase], NDArray[np.int64]]:
-    """The distinct template keys of exposure rows (in order of appearance) and each row's index into them."""
-    cols = ["spacecraft_file", "altitude_km", "inclination_deg", "epoch_year"]
-    codes = exposure.groupby(cols, sort=False, dropna=False).ngroup().to_numpy()
-    keys = [case_of(rec) for rec in exposure.drop_duplicates(cols).to_dict("records")]
-    return keys, np.asarray(codes, dtype=np.int64)
 
 
 @dataclass
@@ -103,6 +71,8 @@ class FluxData:
     # the expected false alarms (the cells of the expected information, see ``Likelihood.cell_expectations``)
     exposure_years_att: NDArray[np.float64] | None = None
     background_att: NDArray[np.float64] | None = None
+    rows_set_aside: int = 0  # exposure rows of a spacecraft-day shared with a detector expected to see more
+    events_set_aside: int = 0  # events of those rows' detectors on those days
 
     @property
     def n_events(self) -> int:
@@ -120,10 +90,16 @@ def prepare(
     exp = exposure_frame(exposure)
     if len(exp) == 0:
         raise InputError("no exposure rows: the catalog holds no analysed spacecraft-days for the flux")
-    keys, group = case_groups(exp)
-    missing = [k for k in keys if k not in templates]
+    missing = [k for k in case_groups(exp)[0] if k not in templates]
     if missing:
         raise ConfigError(f"no forward-model template for {missing[0]}", key="templates")
+    ev = events[events["kind"].astype(str) == "strike"] if "kind" in events else events
+    if "detector" not in ev:
+        ev = ev.assign(detector="")
+    days = pd.to_datetime(ev["time_utc"].astype(str), utc=True).dt.strftime("%Y-%m-%d")
+    chosen = one_exposure_per_day(exp, ev, days, lambda rows: reference_signal(rows, templates))
+    exp, ev, days = chosen.exposure.reset_index(drop=True), chosen.events, days.loc[chosen.events.index]
+    keys, group = case_groups(exp)
     tlist = [templates[k] for k in keys]
     config = tlist[0].config
     centres = config.centres_Nms
@@ -146,18 +122,7 @@ def prepare(
     n_ga = len(keys) * 2
     w_att = np.bincount(ga, weights=f, minlength=n_ga * n_u).reshape(n_ga, n_u)
     fa_att = np.bincount(ga, weights=fa, minlength=n_ga * n_u).reshape(n_ga, n_u)
-    ev = events[events["kind"].astype(str) == "strike"] if "kind" in events else events
-    days = pd.to_datetime(ev["time_utc"].astype(str), utc=True).dt.strftime("%Y-%m-%d")
-    exp_keys = pd.Index(exp["spacecraft"].astype(str) + "|" + exp["day"].astype(str))
-    if exp_keys.has_duplicates:  # events are matched to their spacecraft-day: one exposure row each
-        twice = exp[exp_keys.duplicated(keep=False)]
-        first = twice.iloc[0]
-        detectors = sorted({d or "(none)" for d in twice.loc[twice["day"] == first["day"], "detector"]})
-        raise InputError(
-            f"exposure has {int(exp_keys.duplicated().sum()) + 1} rows for spacecraft-day {first['spacecraft']} "
-            f"{first['day']} (detectors {', '.join(detectors)}); keep one exposure per spacecraft-day "
-            "(write another detector's exposure to a catalog of its own)"
-        )
+    exp_keys = pd.Index(exp["spacecraft"].astype(str) + "|" + exp["day"].astype(str))  # unique after the selection
     ev_keys = ev["spacecraft"].astype(str).to_numpy(dtype=object) + "|" + days.to_numpy(dtype=object)
     rows_a = np.asarray(exp_keys.get_indexer(pd.Index(ev_keys)), dtype=np.int64)
     dh = pd.to_numeric(ev["dH_Nms"], errors="coerce").to_numpy()
@@ -189,6 +154,8 @@ def prepare(
         n_with_direction=int((cls >= 0).sum()),
         exposure_years_att=(w_att @ eff_u / DAYS_PER_YEAR).reshape(len(keys), 2, -1),
         background_att=(fa_att @ share_u).reshape(len(keys), 2, -1),
+        rows_set_aside=chosen.rows_set_aside,
+        events_set_aside=chosen.events_set_aside,
     )
 
 

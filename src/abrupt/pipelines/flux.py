@@ -22,6 +22,7 @@ from scipy import stats
 from abrupt.catalog import Catalog, coverage_table
 from abrupt.errors import InputError
 from abrupt.events import new_run_id
+from abrupt.flux.days import case_of
 from abrupt.flux.exposure import (
     EfficiencyCurve,
     exposure_frame,
@@ -36,7 +37,6 @@ from abrupt.flux.inference import (
     FitResult,
     FluxData,
     Likelihood,
-    case_of,
     fit,
     goodness_of_fit,
     prepare,
@@ -187,6 +187,12 @@ def infer_flux(
         "bounded only through the spectrum's curvature, the two populations' different slopes and their "
         "directions. The fit with the meteoroid scale fixed at Grün (a prior) measures β from the meteoroids."
     ]
+    if data.rows_set_aside:
+        notes.append(
+            f"{data.rows_set_aside} exposure rows of spacecraft-days analysed by several detectors were set aside "
+            f"with their detectors' {data.events_set_aside} events of those days: per spacecraft-day the "
+            "detector expected to see the most strikes is used (docs/flux-inference.md, Exposure)"
+        )
     if data.n_dropped:
         notes.append(
             f"{data.n_dropped} strike events had no exposure day or |ΔH| below the lowest bin and were left out"

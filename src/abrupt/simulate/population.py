@@ -22,9 +22,9 @@ import numpy as np
 import pandas as pd
 
 from abrupt.events import EVENT_COLUMNS, config_hash, make_event_id, normalise_frame
+from abrupt.flux.days import case_groups
 from abrupt.flux.exposure import DAYS_PER_YEAR, exposure_frame, logistic_efficiency
 from abrupt.flux.forward import ORBIT_FRAME_COLUMNS, POPULATIONS, OrbitCase, Template
-from abrupt.flux.inference import case_groups
 
 DETECTOR = "simulate.population"
 
