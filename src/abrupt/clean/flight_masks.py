@@ -15,6 +15,12 @@ of ω over ``nominal_window_s`` (constant in nadir and inertial pointing). A com
 the attitude by degrees per minute; a strike moves it by about ΔH·τ/J (τ the controller's few-second
 rate-removal time): 0.1° for 0.37 N·m·s on kestrel, so the default 1° separates the two for strikes up
 to about 3 N·m·s.
+
+A slew turns the body, so the star tracker sees it too; a gyro bias step of more than 1° a minute
+(0.017 °/s) does not turn it, yet it departs from the gyro's two-hour median for an hour and would mask
+that hour (and any strike in it). Given the attitude quaternions, a sample is a slew's only when the
+tracker's rate (from consecutive attitudes) departs as well; where the tracker has no attitude over the
+window, the gyro decides alone. A tracker jump, seen by the tracker alone, is no slew either.
 """
 
 from __future__ import annotations
@@ -92,9 +98,39 @@ def slew_angle_deg(body_rate_rad_s: FloatArray, dt_s: float, config: SlewMaskCon
     return np.asarray(np.degrees(np.linalg.norm(ang, axis=1)), dtype=np.float64)
 
 
-def slew_mask(body_rate_rad_s: FloatArray, dt_s: float, config: SlewMaskConfig | None = None) -> BoolArray:
-    """Samples during a slew (attitude departs > threshold from its nominal motion), with margins."""
+def tracker_rate_rad_s(quaternion_BN: FloatArray, dt_s: float) -> FloatArray:
+    """Body rate [rad/s] between consecutive attitudes, 2 vec(qₖ⁻¹ ⊗ qₖ₊₁) / dt (Hamilton product, scalar
+    first: the convention of q_BN in the flight archives), on the samples' grid (the last repeats the
+    one before; NaN where an attitude is missing)."""
+    q = np.asarray(quaternion_BN, dtype=np.float64)
+    n = q.shape[0]
+    out = np.full((n, 3), np.nan)
+    if n < 2:
+        return out
+    q = q / np.linalg.norm(q, axis=1, keepdims=True)
+    a0, av, b0, bv = q[:-1, :1], q[:-1, 1:], q[1:, :1], q[1:, 1:]
+    d0 = a0 * b0 + np.sum(av * bv, axis=1, keepdims=True)
+    dv = a0 * bv - b0 * av - np.cross(av, bv)
+    out[:-1] = 2.0 * dv * np.where(d0 < 0, -1.0, 1.0) / dt_s
+    out[-1] = out[-2]
+    return out
+
+
+def slew_mask(
+    body_rate_rad_s: FloatArray,
+    dt_s: float,
+    config: SlewMaskConfig | None = None,
+    quaternion_BN: FloatArray | None = None,
+) -> BoolArray:
+    """Samples during a slew (attitude departs > threshold from its nominal motion), with margins; with
+    ``quaternion_BN``, only where the star tracker's rate departs too (or the tracker has no window)."""
     cfg = config or SlewMaskConfig()
     ang = slew_angle_deg(body_rate_rad_s, dt_s, cfg)
     core = ang > cfg.threshold_deg
+    if quaternion_BN is not None and core.any():
+        w_st = tracker_rate_rad_s(quaternion_BN, dt_s)
+        n_win = max(1, round(cfg.window_s / dt_s))
+        seen = pd.Series(np.isfinite(w_st).all(axis=1).astype(np.float64))
+        covered = seen.rolling(n_win, center=True, min_periods=1).mean().to_numpy() >= 0.9
+        core &= (slew_angle_deg(w_st, dt_s, cfg) > cfg.threshold_deg) | ~covered
     return widen(core, round(cfg.margin_before_s / dt_s), round(cfg.margin_after_s / dt_s))

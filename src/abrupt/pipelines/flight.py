@@ -351,7 +351,7 @@ def _masks(
     sl = np.zeros(g.size, bool)
     if c.slew_masks and g.size:
         valid = table.valid
-        sl = slew_mask(np.where(valid[:, None], table.body_rate_rad_s, np.nan), dt, c.slew) & valid
+        sl = slew_mask(np.where(valid[:, None], table.body_rate_rad_s, np.nan), dt, c.slew, table.quaternion_BN) & valid
     return ev, sl
 
 
