@@ -29,6 +29,10 @@ Implementation:
   than ``max_gap_days`` or too few sets are not formed (counted); a significantly negative K
   (n̄ falling: orbit raising or a bad history, "negative decay") is rejected and counted.
 
+Objects whose drag decay could not rise above their own mean-motion noise even with the largest
+ballistic coefficient at the largest NRLMSIS density (geostationary orbits) are skipped before any
+propagation, and windows implying B above that maximum are refused (:mod:`drag_plausibility`).
+
 Optionally the v³F-weighted NRLMSIS density along the same SGP4 orbit, ρ̄_M, is integrated on the
 same grid, so K/ρ̄_M = B·(ρ/ρ_M) can be compared across altitudes (see ``constellation``).
 """
