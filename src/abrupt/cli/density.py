@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from typing import Any
 
@@ -11,6 +12,7 @@ from abrupt.cli.fleet import gather_paths, with_parts_options
 from abrupt.cli.groups import cli, progress_hidden
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.density.constellation import ConstellationConfig
+from abrupt.density.drag_plausibility import IMPLAUSIBLE_STATUS
 from abrupt.density.joint import JointConfig
 from abrupt.density.meteors import estimate_density_ratios, read_radar_csv
 from abrupt.density.precise_orbit import OrbitDensityConfig
@@ -192,6 +194,9 @@ def density_tle(
     for msg in res.warnings:
         click.echo(f"warning: {msg}", err=True)
     ok = int((res.windows["status"] == "ok").sum()) if len(res.windows) else 0
+    refused = int((res.windows["status"] == IMPLAUSIBLE_STATUS).sum()) if len(res.windows) else 0
+    no_signal = sum(n for log in res.repairs.values() for k, n in log.counts.items() if "no drag signal" in k)
+    click.echo(_plausibility_line(no_signal, refused), err=True)
     click.echo(f"{ok} window(s) of {len(paths)} object(s) written to {out}")
     if report:
         _report(lambda: plot_density_bands(res.windows, report, title="density from TLE decay"), report)
@@ -317,6 +322,16 @@ def _report(plot: Callable[[], object], path: str) -> None:
     click.echo(f"report: {path}")
 
 
+_REFUSED = re.compile(r": (\d+) window\(s\) refused: " + re.escape(IMPLAUSIBLE_STATUS))
+
+
+def _plausibility_line(no_signal: int, refused: int) -> str:
+    return (
+        f"{no_signal} object(s) skipped: no drag signal (density.drag_plausibility); "
+        f"{refused} window(s) refused: {IMPLAUSIBLE_STATUS}"
+    )
+
+
 def _windows_only(
     files: list[str],
     out: str,
@@ -372,4 +387,8 @@ def _windows_only(
         click.echo(f"{run.n_resumed} of {run.n_files} file(s) finished earlier, resumed", err=True)
     for line in run.skipped[:20]:
         click.echo(f"skipped: {line}", err=True)
+    no_signal = sum(1 for line in run.skipped if "skipped: no drag signal" in line)
+    refused = sum(int(m.group(1)) for m in (_REFUSED.search(line) for line in run.skipped) if m)
+    resumed = f" (files run now; {run.n_resumed} resumed file(s) not counted)" if run.n_resumed else ""
+    click.echo(_plausibility_line(no_signal, refused) + resumed, err=True)
     click.echo(f"{run.rows} window(s) of {run.n_files} file(s) written to {out}")

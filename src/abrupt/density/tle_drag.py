@@ -29,6 +29,10 @@ Implementation:
   than ``max_gap_days`` or too few sets are not formed (counted); a significantly negative K
   (n̄ falling: orbit raising or a bad history, "negative decay") is rejected and counted.
 
+Objects whose drag decay could not rise above their own mean-motion noise even with the largest
+ballistic coefficient at the largest NRLMSIS density (geostationary orbits) are skipped before any
+propagation, and windows implying B above that maximum are refused (:mod:`drag_plausibility`).
+
 Optionally the v³F-weighted NRLMSIS density along the same SGP4 orbit, ρ̄_M, is integrated on the
 same grid, so K/ρ̄_M = B·(ρ/ρ_M) can be compared across altitudes (see ``constellation``).
 """
@@ -43,6 +47,12 @@ import numpy as np
 import pandas as pd
 
 from abrupt import progress
+from abrupt.density.drag_plausibility import (
+    MAX_BALLISTIC_COEFFICIENT_M2_KG,
+    lowest_perigee_km,
+    no_drag_signal,
+    refuse_implausible,
+)
 from abrupt.density.model_sampling import (
     ModelNodes,
     choose_stride,
@@ -169,6 +179,7 @@ class RhoBResult:
     maneuver_epochs_utc: list[Any] = field(default_factory=list)
     track: DecayTrack | None = None
     integrals: DragIntegrals | None = None
+    skipped: str | None = None  # why the object has no windows (no drag signal), else None
 
 
 def wind_factor(position_m: FloatArray, velocity_mps: FloatArray) -> FloatArray:
@@ -334,6 +345,11 @@ def rho_b_from_history(
     repairs.counts.update(history.repairs.counts)  # the reader's repairs, printed with the windows'
     if len(history) < cfg.min_sets:
         return RhoBResult(_empty_windows(), float("nan"), repairs)
+    ceiling = no_drag_signal(history, cfg.interval_days, cfg.max_gap_days) if integrals is None else None
+    if ceiling is not None:
+        reason = f"no drag signal above {ceiling:.0f} km (perigee {lowest_perigee_km(history):.0f} km)"
+        repairs.record(f"objects skipped: {reason}", 1)
+        return RhoBResult(_empty_windows(), float("nan"), repairs, skipped=reason)
     sw = space_weather
     if cfg.with_model and sw is None:
         sw = read_space_weather()
@@ -369,6 +385,11 @@ def rho_b_from_history(
     if adaptive and integ.nodes is not None:
         integ.nodes.space_weather = sw
         sampled_model(integ, frame, bounds, cfg)
+    repairs.record(
+        f"windows refused: implausible ballistic coefficient (K - 3 sigma above {MAX_BALLISTIC_COEFFICIENT_M2_KG:g} "
+        "m2/kg x model density)",
+        refuse_implausible(frame),
+    )
     track = None
     if integ.grid_rho_model is not None and integ.grid_weight is not None:
         track = DecayTrack(

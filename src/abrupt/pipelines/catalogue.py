@@ -32,6 +32,7 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from abrupt.density.drag_plausibility import IMPLAUSIBLE_STATUS
 from abrupt.density.tle_drag import TleDragConfig, rho_b_from_history
 from abrupt.errors import InputError
 from abrupt.events import empty_frame, normalise_frame
@@ -134,6 +135,11 @@ def density_task(task: CatalogueTask) -> tuple[pd.DataFrame, list[str]]:
         res = rho_b_from_history(history, cfg, maneuvers=given, space_weather=sw)
         if len(res.windows):
             frames.append(res.windows)
+        if res.skipped:
+            notes.append(f"{label}: skipped: {res.skipped}")
+        refused = int((res.windows["status"] == IMPLAUSIBLE_STATUS).sum()) if len(res.windows) else 0
+        if refused:
+            notes.append(f"{label}: {refused} window(s) refused: {IMPLAUSIBLE_STATUS}")
         notes.extend(str(e) for e in history.skipped[:5])
     windows = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
     return windows, notes
