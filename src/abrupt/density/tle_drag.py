@@ -17,8 +17,12 @@ da/dt = 2a²Bv³F/μ lacks ρ and the factor −½: an erratum; the Δn̄ line i
 Implementation:
 
 * every element set initialises an SGP4 record (through abrupt's TLE reader); between consecutive
-  sets the orbit is propagated with SGP4 from the earlier set on a grid (``step_s``) and the
-  integral I(t) = ∫ n̄^(1/3) v³ F dt is accumulated (trapezoid rule);
+  sets the orbit is propagated with SGP4 from the earlier set on an even grid and the integral
+  I(t) = ∫ n̄^(1/3) v³ F dt is accumulated (trapezoid rule). The grid has ``nodes_per_rev`` nodes per
+  revolution of the earlier set's orbit (2π/n̄), made finer by (1 − e)^(3/2)/(1 + e)^(1/2), the
+  ratio of the time to sweep a radian of anomaly at perigee to the mean (an eccentric orbit's
+  perigee pass, where the drag is, gets the nodes a circular orbit's revolution gets); a fixed
+  ``step_s`` replaces it when set;
 * K on a window of sets is the least-squares slope of n̄_j against (3/2) μ^(−2/3) I(t_j): with two
   sets this is the slide's formula exactly, with more it uses every set of the window;
 * its standard error comes from the history's own mean-motion noise σ_n̄, estimated robustly
@@ -72,6 +76,9 @@ from abrupt.types import FloatArray
 from abrupt.units import SECONDS_PER_DAY
 
 EARTH_ROTATION_RAD_S = 7.292115e-5  # [rad/s]
+# against a 150 s step on simulated catalogue files (docs/density.md "Integration nodes"); a half
+# integer, so that every second node (the direct NRLMSIS sampling) drifts in orbital phase
+DEFAULT_NODES_PER_REV = 9.5
 
 WINDOW_COLUMNS: tuple[str, ...] = (
     "object",
@@ -95,7 +102,10 @@ class TleDragConfig:
     """Settings of :func:`rho_b_from_history` (units in the names)."""
 
     interval_days: float = 1.0
-    step_s: float = 600.0
+    # integration nodes per revolution of each gap's orbit (module docstring); ``step_s`` (s), when
+    # set, is a fixed node spacing instead
+    nodes_per_rev: float = DEFAULT_NODES_PER_REV
+    step_s: float | None = None
     max_gap_days: float = 3.0
     min_sets: int = 2
     min_span_fraction: float = 0.5
@@ -118,8 +128,10 @@ class TleDragConfig:
     def __post_init__(self) -> None:
         if self.interval_days <= 0:
             raise ValueError("interval_days must be > 0")
-        if self.step_s <= 0:
+        if self.step_s is not None and self.step_s <= 0:
             raise ValueError("step_s must be > 0")
+        if self.nodes_per_rev <= 0:
+            raise ValueError("nodes_per_rev must be > 0")
         if self.min_sets < 2:
             raise ValueError("min_sets must be >= 2")
         if self.model_grid and self.model_tolerance is not None:
@@ -194,15 +206,35 @@ def wind_factor(position_m: FloatArray, velocity_mps: FloatArray) -> FloatArray:
     return np.asarray(rel * np.sum(v_rel * v, axis=-1) / speed**3, dtype=np.float64)
 
 
+def gap_node_counts(
+    gaps_s: FloatArray,
+    n_rad_s: FloatArray,
+    eccentricity: FloatArray,
+    nodes_per_rev: float = DEFAULT_NODES_PER_REV,
+    step_s: float | None = None,
+) -> Any:
+    """Nodes (both ends included, at least 2) of each gap's even grid: a spacing of at most
+    ``step_s`` when given, else at most 2π/n̄ / ``nodes_per_rev`` × (1 − e)^(3/2)/(1 + e)^(1/2)
+    (the time a radian of anomaly takes at perigee over its mean: Kepler's second law)."""
+    gaps = np.asarray(gaps_s, dtype=float)
+    if step_s is not None:
+        return np.maximum(2, np.ceil(gaps / step_s).astype(np.int64) + 1)
+    e = np.clip(np.asarray(eccentricity, dtype=float), 0.0, 0.99)
+    step = 2.0 * np.pi / np.asarray(n_rad_s, dtype=float) / nodes_per_rev * (1.0 - e) ** 1.5 / np.sqrt(1.0 + e)
+    return np.maximum(2, np.ceil(gaps / step - 1e-9).astype(np.int64) + 1)
+
+
 def drag_integrals(
     history: ElementHistory,
-    step_s: float = 600.0,
+    step_s: float | None = None,
     *,
+    nodes_per_rev: float = DEFAULT_NODES_PER_REV,
     space_weather: Any = None,
     model_stride: int = 2,
     grid: MsisGrid | None = None,
 ) -> DragIntegrals:
-    """Accumulate I(t) = ∫ n̄^(1/3) v³ F dt between consecutive sets by SGP4 (module docstring).
+    """Accumulate I(t) = ∫ n̄^(1/3) v³ F dt between consecutive sets by SGP4 (module docstring), on
+    ``nodes_per_rev`` nodes a revolution or, with ``step_s``, a node every ``step_s`` seconds.
 
     With ``space_weather`` (a :class:`abrupt.model.atmosphere.SpaceWeather`) the NRLMSIS density is
     integrated with the same weight (``model_integral``); with ``grid`` (a
@@ -221,7 +253,7 @@ def drag_integrals(
     wf = np.full(n_sets, np.nan)
     # Build every gap's grid at once, propagate gap by gap (each from its earlier set).
     gaps = np.diff(t)
-    counts = np.maximum(2, np.ceil(gaps / step_s).astype(np.int64) + 1)
+    counts = gap_node_counts(gaps, n_bar[:-1], el["e"].to_numpy(dtype=float)[:-1], nodes_per_rev, step_s)
     offsets = np.concatenate([[0], np.cumsum(counts)])
     # np.linspace(0, 1, c) of every gap at once (the same bits: i · (1/(c − 1)), the last node exactly 1)
     node_in_gap = np.arange(offsets[-1]) - np.repeat(offsets[:-1], counts)
@@ -332,7 +364,7 @@ def rho_b_from_history(
 ) -> RhoBResult:
     """K = ρ̄B̄ (1/m) per time window from one element-set history (module docstring).
 
-    ``integrals``: the :class:`DragIntegrals` of this history from an earlier call (same step and
+    ``integrals``: the :class:`DragIntegrals` of this history from an earlier call (same nodes and
     model), e.g. to form windows of another length without propagating again (``RhoBResult.integrals``).
 
     ``maneuvers``: "detect" (abrupt's TLE maneuver detector at ``config.maneuver_budget``), "none",
@@ -357,6 +389,7 @@ def rho_b_from_history(
     integ = integrals or drag_integrals(
         history,
         cfg.step_s,
+        nodes_per_rev=cfg.nodes_per_rev,
         space_weather=sw if cfg.with_model and not adaptive else None,
         model_stride=cfg.model_stride,
         grid=shared_grid(sw, cfg.model_grid_cache) if cfg.with_model and cfg.model_grid else None,
