@@ -2,8 +2,9 @@
 v³F-weighted integral is formed from them.
 
 The drag integrals (:func:`abrupt.density.tle_drag.drag_integrals`) put ``nodes_per_rev`` (9.5)
-nodes a revolution, or a node every ``step_s``, between consecutive element sets. NRLMSIS (pymsis, ≈ 7 µs a point) is evaluated on every
-``stride``-th node and log ρ is interpolated in time between them (:func:`interpolate_log_density`);
+nodes a revolution, or a node every ``step_s``, between consecutive element sets. NRLMSIS (pymsis,
+≈ 7 µs a point) is evaluated on every ``stride``-th node and log ρ is interpolated in time between
+them (:func:`interpolate_log_density`);
 the model density of a window is ∫ w ρ_M dt / ∫ w dt over the window (w = n̄^(1/3) v³ F).
 
 :class:`ModelNodes` evaluates a node at most once per object (a cache by node index), so the strides
