@@ -47,9 +47,9 @@ def test_wind_factor_bound_matches_the_corotating_atmosphere() -> None:
         v = math.sqrt(MU_EARTH_WGS72_M3_S2 / r)
         pos = np.array([[r, 0.0, 0.0]])
         vel = np.array([[0.0, v * math.cos(incl), v * math.sin(incl)]])
-        x = dp.EARTH_ROTATION_RAD_S * r / v
+        x = dp.EARTH_ROTATION_RATE_RAD_S * r / v
         assert float(wind_factor(pos, vel)[0]) == pytest.approx(1 - 2 * x * math.cos(incl) + x**2, rel=1e-9)
-    h_geo = (42164.17e3 - dp.EARTH_RADIUS_M) / 1e3
+    h_geo = (42164.17e3 - dp.WGS84_A_M) / 1e3
     geo = float(dp.max_decay_rate(np.array([h_geo]), 0.0)[0])
     polar = float(dp.max_decay_rate(np.array([h_geo]), math.pi / 2)[0])
     assert geo < 1e-6 * polar
@@ -61,9 +61,9 @@ def test_max_decay_rate_is_the_circular_drag_law() -> None:
     h = 500.0
     alts, log_rho = dp.extreme_density_table()
     rho = math.exp(float(np.interp(h, alts, log_rho)))
-    r = dp.EARTH_RADIUS_M + h * 1e3
+    r = dp.WGS84_A_M + h * 1e3
     n, v = math.sqrt(MU_EARTH_WGS72_M3_S2 / r**3), math.sqrt(MU_EARTH_WGS72_M3_S2 / r)
-    x = dp.EARTH_ROTATION_RAD_S * r / v
+    x = dp.EARTH_ROTATION_RATE_RAD_S * r / v
     expected = 1.5 * n * rho * dp.MAX_BALLISTIC_COEFFICIENT_M2_KG * v * (1 + x**2)
     assert float(dp.max_decay_rate(np.array([h]), math.pi / 2)[0]) == pytest.approx(expected, rel=1e-12)
 

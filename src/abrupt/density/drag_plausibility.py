@@ -37,6 +37,8 @@ import pandas as pd
 import pymsis
 
 from abrupt.model.atmosphere import MSIS_VERSION
+from abrupt.model.frames import EARTH_ROTATION_RATE_RAD_S
+from abrupt.model.stations import WGS84_A_M
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
 from abrupt.thresholds.noise import robust_scale
 from abrupt.types import FloatArray
@@ -47,8 +49,6 @@ IMPLAUSIBLE_STATUS = "implausible ballistic coefficient"
 LOWER_BOUND_SIGMA = 3.0  # the window's K − 3σ_K is compared with B_max ρ_M
 EXTREME_F107_SFU = 300.0
 EXTREME_AP = 400.0
-EARTH_RADIUS_M = 6378137.0
-EARTH_ROTATION_RAD_S = 7.292115e-5
 _TABLE_ALTITUDES_KM = np.geomspace(100.0, 100_000.0, 241)
 
 
@@ -84,12 +84,12 @@ def max_decay_rate(
     h = np.asarray(altitude_km, dtype=float)
     alts, log_rho = extreme_density_table()
     rho = np.exp(np.interp(h, alts, log_rho))
-    r_p = EARTH_RADIUS_M + 1e3 * h
+    r_p = WGS84_A_M + 1e3 * h
     a = r_p if a_m is None else np.maximum(np.asarray(a_m, dtype=float), r_p)
     mu = MU_EARTH_WGS72_M3_S2
     n = np.sqrt(mu / a**3)
     v_p = np.sqrt(mu * (2.0 / r_p - 1.0 / a))
-    x = EARTH_ROTATION_RAD_S * r_p / v_p
+    x = EARTH_ROTATION_RATE_RAD_S * r_p / v_p
     wind = np.maximum(1.0 - 2.0 * x * math.cos(inclination_rad) + x**2, 0.0)
     return np.asarray(1.5 * n * v_p * wind * rho * MAX_BALLISTIC_COEFFICIENT_M2_KG, dtype=np.float64)
 
@@ -133,7 +133,7 @@ def lowest_perigee_km(history: ElementHistory) -> float:
     el = history.elements
     a = el["a_m"].to_numpy(dtype=float)
     e = el["e"].to_numpy(dtype=float)
-    return float(np.nanmin(a * (1.0 - e) - EARTH_RADIUS_M) / 1e3)
+    return float(np.nanmin(a * (1.0 - e) - WGS84_A_M) / 1e3)
 
 
 def no_drag_signal(history: ElementHistory, interval_days: float, max_gap_days: float) -> float | None:
