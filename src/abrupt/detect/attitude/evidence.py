@@ -53,6 +53,7 @@ from typing import Any
 import numpy as np
 from scipy.ndimage import median_filter
 
+from abrupt.clean.flight_masks import tracker_rate_rad_s
 from abrupt.detect.attitude.ramp_step import body_frame_momentum, fit_ramp_step, ramp_step_evidence
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import Spacecraft
@@ -153,11 +154,7 @@ def st_gyro_rate_mismatch(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> F
     bias into a curvature (which an earlier, persistent bias step would otherwise read as a new one).
     A star-tracker jump is one sample of ω_ST, a step of E; a gyro bias step changes E's slope.
     """
-    qn = q_BN / np.linalg.norm(q_BN, axis=1, keepdims=True)
-    conj = qn[:-1] * np.array([1.0, -1.0, -1.0, -1.0])
-    d = hamilton_product(conj, qn[1:])
-    d *= np.where(d[:, :1] < 0, -1.0, 1.0)
-    w_st = 2.0 * d[:, 1:] / dt
+    w_st = tracker_rate_rad_s(q_BN, dt)[:-1]
     w_gy = 0.5 * (omega_B[1:] + omega_B[:-1])
     e = np.zeros((q_BN.shape[0], 3))
     e[1:] = np.cumsum((w_gy - w_st) * dt, axis=0)
