@@ -7,7 +7,8 @@ duplicate it: the nearest event within ``MERGE_S`` that is not a strike takes th
 and channel (one channel moved and the physics it must obey did not: a wheel reading with no body
 response, a rate sensor the other did not follow, an appendage drive that jumped), with the finding
 in its ``fault_*`` columns. A strike is never re-classified by a scan (the scans' physical gates
-exclude motion, so a finding beside a strike is a second thing); a finding with no such event nearby
+exclude motion): a finding within ``STRIKE_S`` of a strike's event is written beside it in its
+``fault_*`` columns, and a finding further from it is a second thing; a finding with no event nearby
 becomes an event of its own (detector ``attitude.fault_scan``, its statistic and threshold in σ of
 its channel's noise, the rate its threshold was set for; ΔH empty: a fault changes no momentum).
 """
@@ -34,6 +35,8 @@ __all__ = ["FAULT_COLUMNS", "FaultScan", "merge_fault_findings", "scan_span"]
 #: A finding and an event this close [s] are one thing (the step locator places a fault's event within
 #: a window span of the fault; a strike 20 s after a fault is still found apart: strikes are never merged).
 MERGE_S = 30.0
+#: A finding this close [s] to a strike's event is evidence beside it: never a second event, never its class.
+STRIKE_S = 10.0
 FAULT_DETECTOR = "attitude.fault_scan"
 FAULT_COLUMNS = ("fault_channel", "fault_statistic", "fault_threshold")
 
@@ -74,6 +77,21 @@ def _new_rows(
     return frame
 
 
+def _annotate(out: pd.DataFrame, i: int, f: FaultFinding, kind: bool = False) -> None:
+    """Row ``i`` of ``out`` gets the finding in its ``fault_*`` columns (and its class, when ``kind``)."""
+    row = out.index[i]
+    values: dict[str, str | float] = {
+        "fault_channel": f.channel,
+        "fault_statistic": f.statistic,
+        "fault_threshold": f.threshold,
+    }
+    if kind:
+        values |= {"kind": f.kind, "kind_channel": f.channel, "kind_reason": f"{f.reason} (fault scan)"}
+        values["kind_confidence"] = 0.99
+    for column, value in values.items():
+        out.at[row, column] = value
+
+
 def merge_fault_findings(
     events: pd.DataFrame, findings: Sequence[FaultFinding], spacecraft: str, run_id: str, cfg_hash: str
 ) -> pd.DataFrame:
@@ -88,16 +106,17 @@ def merge_fault_findings(
     taken = np.zeros(len(out), bool)
     new: list[FaultFinding] = []
     for f in sorted(findings, key=lambda f: -f.statistic / max(f.threshold, 1e-12)):
+        at_strike = np.flatnonzero((np.abs(t_ev - f.time_ns) <= STRIKE_S * NS) & (kinds == "strike"))
+        if at_strike.size:  # evidence beside the strike; its class stays
+            _annotate(out, int(at_strike[0]), f)
+            continue
         near = np.flatnonzero((np.abs(t_ev - f.time_ns) <= MERGE_S * NS) & (kinds != "strike"))
         if near.size:
             i = int(near[np.argmin(np.abs(t_ev[near] - f.time_ns))])
             if taken[i]:
                 continue
             taken[i] = True
-            row = out.index[i]
-            out.loc[row, ["kind", "kind_channel", "kind_reason"]] = [f.kind, f.channel, f"{f.reason} (fault scan)"]
-            out.loc[row, "kind_confidence"] = 0.99
-            out.loc[row, list(FAULT_COLUMNS)] = [f.channel, f.statistic, f.threshold]
+            _annotate(out, i, f, kind=True)
             continue
         if any(abs(g.time_ns - f.time_ns) <= MERGE_S * NS for g in new):
             continue

@@ -153,15 +153,19 @@ def clusters(t_ns: np.ndarray, z: FloatArray, above: BoolArray, gap_s: float = C
 
 
 def wheel_jump_statistic(speed_rad_s: FloatArray, quantum_rad_s: float = 0.0) -> tuple[FloatArray, float]:
-    """Jump of each first difference of a wheel's raw speed against its 11-sample running median [σ].
+    """Jumps of a wheel's raw speed against its own noise [σ], element k between samples k and k+1.
 
-    Element k is the jump between samples k and k+1; σ is the robust scale of the jumps, at least
-    q/√6 for a tachometer of quantum q. Returns (|jump| / σ, σ [rad/s]).
+    r is each first difference minus its 11-sample running median; σ its robust scale, at least q/√6
+    for a tachometer of quantum q (the difference of two quantised readings). The statistic is the
+    larger of |r_k| / σ (a step: a reading that moved and stayed) and |r_k − r_k+1| / (√2 σ) (one
+    sample off and back, a miscount: the matched filter of the pair). Returns (statistic, σ [rad/s]).
     """
     d = np.diff(speed_rad_s)
     r = d - median_filter(d, size=11, mode="nearest")
     sigma = max(robust_sigma(r), quantum_rad_s / math.sqrt(6.0), 1e-12)
-    return np.abs(r) / sigma, sigma
+    pair = np.zeros_like(r)
+    pair[:-1] = np.abs(r[:-1] - r[1:]) / math.sqrt(2.0)
+    return np.maximum(np.abs(r), pair) / sigma, sigma
 
 
 def rate_departures(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -190,15 +194,16 @@ def _rate(budget: FalseAlarmBudget, t_ns: np.ndarray) -> tuple[float, float]:
     return (budget.per_day * days / max(t_ns.size, 1), days)
 
 
-def _body_momentum_jump(table: Timetable, J: FloatArray, t_ns: int) -> float:
-    """|J Δω| [N·m·s]: the body rate's median over the 4 s after ``t_ns`` against the 4 s before."""
+def _body_momentum_jump(table: Timetable, J: FloatArray, t_ns: int, axis_B: FloatArray) -> float:
+    """|ĝ · J Δω| [N·m·s]: the body's momentum change along a wheel's axis, its rate's median over the
+    4 s after ``t_ns`` against the 4 s before (a wheel's torque turns the body about its own axis)."""
     g = table.time_ns
     i = int(np.searchsorted(g, t_ns))
     w = table.body_rate_rad_s
     before, after = w[max(0, i - 5) : max(0, i - 1)], w[i : i + 4]
-    if len(before) < 2 or len(after) < 2:
+    if len(before) < 2 or len(after) < 2 or not (np.isfinite(before).all() and np.isfinite(after).all()):
         return float("nan")
-    return float(np.linalg.norm(J @ (np.nanmedian(after, axis=0) - np.nanmedian(before, axis=0))))
+    return float(abs(axis_B @ J @ (np.median(after, axis=0) - np.median(before, axis=0))))
 
 
 def scan_wheels(
@@ -240,8 +245,8 @@ def scan_wheels(
         peaks = clusters(t_jump, z, in_core & (z > thr))
         n_found = 0
         for k in peaks:
-            claimed = js * z[k] * sigma
-            body = _body_momentum_jump(table, J, int(t_jump[k]))
+            claimed = js * z[k] * sigma  # the momentum the reading says the wheel exchanged
+            body = _body_momentum_jump(table, J, int(t_jump[k]), spacecraft.wheel_axes[:, ch.component])
             if not (math.isfinite(body) and body < BODY_SHARE_MAX * claimed):
                 continue
             n_found += 1
@@ -259,7 +264,7 @@ def scan_rate_sensors(table: Timetable, ok: BoolArray, core: tuple[int, int], bu
     dt = float(np.median(np.diff(g))) / NS
     q = np.where(ok[:, None], table.quaternion_BN, np.nan)
     w = np.where(ok[:, None], table.body_rate_rad_s, np.nan)
-    good = np.isfinite(q).all(axis=1) & np.isfinite(w).all(axis=1)
+    good: BoolArray = np.asarray(np.isfinite(q).all(axis=1) & np.isfinite(w).all(axis=1))
     good[1:] &= np.diff(g) < 1.5 * dt * NS  # a run ends at a gap of the grid
     runs = [r for r in contiguous_runs(good) if r.stop - r.start >= 61]
     if not runs:
