@@ -22,8 +22,9 @@ each channel against the physics the other channels must obey:
 Each channel's threshold is set on the day in front of it for a stated false-alarm rate per channel
 (:data:`FAULT_FALSE_ALARMS`): an exponential tail fitted to the exceedance counts of its own
 statistic (:func:`tail_threshold`), which a few faults in the day do not move (the fit uses levels
-that hundreds of samples exceed). The exceedances of each channel are counted and reported beside
-the stated rate (:class:`ChannelCalibration`).
+that hundreds of samples exceed). A channel with fewer than 2 ``TAIL_COUNTS[0]`` analysed samples
+in the day is not scanned (its tail cannot be fitted). The exceedances of each channel are counted
+and reported beside the stated rate (:class:`ChannelCalibration`).
 """
 
 from __future__ import annotations
@@ -236,7 +237,7 @@ def scan_wheels(
         z[gaps | np.r_[False, gaps[:-1]] | np.r_[gaps[1:], False]] = np.nan  # a jump across a gap is no jump
         t_jump = t[1:]
         in_core = (t_jump >= core[0]) & (t_jump < core[1])
-        if in_core.sum() < 2 * TAIL_COUNTS[0]:
+        if np.isfinite(z[in_core]).sum() < 2 * TAIL_COUNTS[0]:
             continue
         p, days = _rate(budget, t_jump[in_core])
         thr = tail_threshold(z[in_core], p)
@@ -278,6 +279,8 @@ def scan_rate_sensors(table: Timetable, ok: BoolArray, core: tuple[int, int], bu
     sig_g = np.array([robust_sigma(e_g[in_core, k]) for k in range(3)])
     sig_t = np.array([robust_sigma(e_t[in_core, k]) for k in range(3)])
     z_err = np.abs(err) / np.maximum(sig_err, 1e-15)
+    if in_core.sum() < 2 * TAIL_COUNTS[0]:
+        return FaultScan([], [])
     gyro_moved = np.abs(e_g) > QUIET_SIGMA * np.maximum(sig_g, 1e-15)
     st_moved = np.abs(e_t) > QUIET_SIGMA * np.maximum(sig_t, 1e-15)
     p, days = _rate(budget, t[in_core])
@@ -322,9 +325,13 @@ def scan_appendages(table: Timetable, ok: BoolArray, core: tuple[int, int], budg
         t = g[idx]
         r = x - median_filter(x, size=61, mode="nearest")
         in_core = (t >= core[0]) & (t < core[1])
+        if in_core.sum() < 2 * TAIL_COUNTS[0]:
+            continue
         z = np.abs(r) / max(robust_sigma(r[in_core]), 1e-12)
         z[np.convolve(np.diff(t, prepend=t[0]) > 1.5 * float(np.median(np.diff(t))), np.ones(61), "same") > 0] = np.nan
         p, days = _rate(budget, t[in_core])
+        if np.isfinite(z[in_core]).sum() < 2 * TAIL_COUNTS[0]:
+            continue
         thr = tail_threshold(z[in_core], p)
         peaks = clusters(t, z, in_core & (z > thr), gap_s=30.0)
         name = f"appendage_{k + 1}"
