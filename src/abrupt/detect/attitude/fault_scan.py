@@ -36,6 +36,7 @@ import numpy as np
 import pandas as pd
 from scipy.ndimage import median_filter
 
+from abrupt.detect.attitude.attribution import AttributionRules
 from abrupt.detect.attitude.evidence import hamilton_product
 from abrupt.model.flight_config import FlightConfig
 from abrupt.model.spacecraft import Spacecraft
@@ -51,6 +52,8 @@ CLUSTER_S = 5.0
 BODY_SHARE_MAX = 0.5
 #: A sensor "stayed on its own median" when its departure is below this many σ of its own noise.
 QUIET_SIGMA = 5.0
+#: Smallest angle [rad] an appendage jump must add to be a snap (the attribution rules' 0.2°).
+SNAP_MIN_RAD = math.radians(AttributionRules().appendage_min_deg)
 #: Fewest exceedances of the lowest and the highest level of the tail fit.
 TAIL_COUNTS = (3000, 300)
 
@@ -135,6 +138,13 @@ def tail_threshold(z: FloatArray, p_sample: float) -> float:
     if not slope < 0:
         return float(v[-1])
     return float(max((math.log(max(p_sample * n, 1e-300)) - icpt) / slope, levels[-1]))
+
+
+def _threshold(z: FloatArray, p_sample: float) -> float:
+    """The tail's level for ``p_sample``, never below ``QUIET_SIGMA``: a channel whose statistic is
+    degenerate (a noiseless or coarsely quantised reading) has no tail to fit, and nothing within
+    ``QUIET_SIGMA`` of its own noise is a fault."""
+    return max(tail_threshold(z, p_sample), QUIET_SIGMA)
 
 
 def contiguous_runs(mask: BoolArray) -> list[slice]:
@@ -240,7 +250,7 @@ def scan_wheels(
         if np.isfinite(z[in_core]).sum() < 2 * TAIL_COUNTS[0]:
             continue
         p, days = _rate(budget, t_jump[in_core])
-        thr = tail_threshold(z[in_core], p)
+        thr = _threshold(z[in_core], p)
         js = float(spacecraft.wheel_spin_inertias_kgm2[ch.component])
         name = f"wheel_{ch.component + 1}"
         peaks = clusters(t_jump, z, in_core & (z > thr))
@@ -288,7 +298,7 @@ def scan_rate_sensors(table: Timetable, ok: BoolArray, core: tuple[int, int], bu
     cals: list[ChannelCalibration] = []
     # Gyro axis k: it left its median, the tracker stayed on its own on every axis.
     for k in range(3):
-        thr = tail_threshold(z_err[in_core, k], p)
+        thr = _threshold(z_err[in_core, k], p)
         peaks = clusters(t, z_err[:, k], in_core & (z_err[:, k] > thr))
         hits = [j for j in peaks if gyro_moved[j, k] and not st_moved[j].any()]
         name = f"gyro_{'xyz'[k]}"
@@ -298,7 +308,7 @@ def scan_rate_sensors(table: Timetable, ok: BoolArray, core: tuple[int, int], bu
         cals.append(ChannelCalibration(name, core[0], thr, budget.per_day, len(peaks), len(hits), days))
     # Star tracker: the 3-axis mismatch; the tracker left its median, the gyro stayed on its own.
     z3 = np.max(z_err, axis=1)
-    thr = tail_threshold(z3[in_core], p * 3.0)  # the largest of three axes: three chances per sample
+    thr = _threshold(z3[in_core], p * 3.0)  # the largest of three axes: three chances per sample
     peaks = clusters(t, z3, in_core & (z3 > thr))
     hits = [j for j in peaks if st_moved[j].any() and not gyro_moved[j].any()]
     for j in hits:
@@ -332,9 +342,13 @@ def scan_appendages(table: Timetable, ok: BoolArray, core: tuple[int, int], budg
         p, days = _rate(budget, t[in_core])
         if np.isfinite(z[in_core]).sum() < 2 * TAIL_COUNTS[0]:
             continue
-        thr = tail_threshold(z[in_core], p)
+        thr = _threshold(z[in_core], p)
         peaks = clusters(t, z, in_core & (z > thr), gap_s=30.0)
         name = f"appendage_{k + 1}"
+        # The angle the jump adds over ±15 s must be beyond the drive's resolution (a physical floor).
+        half = max(1, round(15.0 * NS / float(np.median(np.diff(t)))))
+        step_s = float(np.median(np.diff(t))) / NS
+        peaks = [j for j in peaks if abs(np.nansum(r[max(0, j - half) : j + half + 1])) * step_s > SNAP_MIN_RAD]
         for j in peaks:
             reason = "appendage drive rate jumped against its running median"
             found.append(FaultFinding(int(t[j]), "internal", name, float(z[j]), thr, budget.per_day, reason))
