@@ -98,6 +98,7 @@ EVIDENCE_SHOWN = (
     "ev_appendage_z",
     "ev_gyro_spike_z",
     "ev_after_fault_s",
+    "fault_channel",
 )
 
 
@@ -241,10 +242,11 @@ def main() -> int:
     t_start = time.time()
     # The threshold of the days as they are (1 false alarm/day): days with a confounder every 40 min
     # are no null to calibrate on (their block maxima are the confounders).
-    plain = run_flight(store, sc, FlightRunConfig(), days=days)
+    plain = run_flight(store, sc, FlightRunConfig(), days=days, keep_series=True)
     threshold = plain.threshold
     print(f"threshold {threshold.value:.2f} calibrated on the days without injections")
     archive_figures(plain.events, args.days)
+    scan_rates(plain.chunks)
     rows = []
     unmatched: list[pd.Series] = []
     for run in range(args.runs):
@@ -285,6 +287,28 @@ def archive_figures(events: pd.DataFrame, n_days: int) -> None:
         f"{sum(kinds[i] == 'strike' for i in hit)} classified strike; {len(others)} other event(s) (false alarms): "
         f"{', '.join(others) or 'none'}"
     )
+
+
+def scan_rates(chunks) -> None:
+    """The fault scans on the days without injections: each channel's threshold, stated and realised rate."""
+    cals = [c for r in chunks for c in r.faults.calibrations]
+    if not cals:
+        return
+    t = pd.DataFrame([vars(c) for c in cals]).groupby("channel", sort=False)
+    days = t["days"].sum()
+    print(
+        f"fault scans on the days without injections ({days.max():.2f} analysed days per channel): "
+        f"stated {cals[0].false_alarms_per_day:g} false alarm/day per channel; realised (findings / day, "
+        f"exceedances before the physical gates / day; threshold range in σ):"
+    )
+    for ch, g in t:
+        d = g["days"].sum()
+        lo, hi = g["threshold"].min(), g["threshold"].max()
+        found, over = g["findings"].sum() / d, g["exceedances"].sum() / d
+        print(f"  {ch:13s} {found:5.2f} /day  {over:5.2f} /day  {lo:6.1f}-{hi:.1f}")
+    n_f, n_d = sum(c.findings for c in cals), days.max()
+    stated = len(t) * cals[0].false_alarms_per_day
+    print(f"  all {len(t)} channels: {n_f / n_d:.2f} findings/day (stated {stated:.1f}/day)")
 
 
 def figure(store: Path, sc, ranges: ConfounderRanges, path: str, seed: int, verbose: bool = True) -> None:

@@ -16,11 +16,10 @@ Harris et al. 2025 §3.3-3.5, §3.7 and Bennett 2022 ch. 4, driven entirely by t
    threshold on the spacecraft's own statistic at the stated false-alarm rate per day (robust Gumbel fit
    of block maxima) and writes the events; daily statistics come with them.
 
-Injection and recovery of synthetic strikes is :mod:`abrupt.pipelines.flight_injection`.
-
+Injection and recovery of synthetic strikes is :mod:`abrupt.pipelines.flight_injection`; attribution and
+fault scans are :mod:`abrupt.pipelines.flight_attribution` and :mod:`abrupt.pipelines.flight_faults`.
 Every stage is local in time and anchored at absolute times, so chunks processed with the margin of
-:func:`chunk_margin_s` give the same events as the whole run.
-"""
+:func:`chunk_margin_s` give the same events as the whole run."""
 
 from __future__ import annotations
 
@@ -52,6 +51,7 @@ from abrupt.pipelines.flight_checks import (
     physical_bounds,
     within_bounds,
 )
+from abrupt.pipelines.flight_faults import FaultScan, merge_fault_findings, scan_span
 from abrupt.readers.archive import Decoder, pseudonymise_text, read_archive, read_decoder
 from abrupt.scale import Executor, TaskResult, run_tasks
 from abrupt.series.timetable import NS, Timetable, build_timetable
@@ -210,13 +210,8 @@ class FlightRunConfig:
 
     def detector(self, threshold: Threshold | None = None) -> FlightGlrDetector:
         """The ``attitude.flight_glr`` detector with this run's windows, blocks and peak floor."""
-        return FlightGlrDetector(
-            window_s=self.window_s,
-            guard_s=self.guard_s,
-            block_s=self.block_s,
-            peak_floor=self.peak_floor,
-            threshold=threshold,
-        )
+        return FlightGlrDetector(window_s=self.window_s, guard_s=self.guard_s, block_s=self.block_s,
+                                 peak_floor=self.peak_floor, threshold=threshold)  # fmt: skip
 
 
 def orbit_period_s(spacecraft: Spacecraft, config: FlightRunConfig | None = None) -> float:
@@ -296,6 +291,7 @@ class ChunkResult:
     harmonics_mean: float
     series: dict[str, np.ndarray] | None = None
     evidence: dict[int, EventEvidence] = field(default_factory=dict)
+    faults: FaultScan = field(default_factory=lambda: FaultScan([], []))
 
 
 def process_chunk(
@@ -442,6 +438,7 @@ def process_span(
         table, spacecraft, h_n, hc, ok, detector, peaks, evidence, config.evidence_floor, core, inertia_kgm2
     )
     peaks, evidence = peaks + found, {**evidence, **found_ev}
+    faults = scan_span(samples, flight, table, spacecraft, ok, start_ns, end_ns)
     edges = [start_ns, end_ns]
     if split_days:
         d_first = -(-start_ns // DAY_NS) * DAY_NS
@@ -478,6 +475,7 @@ def process_span(
                 harmonics_mean=float(info.get("harmonics_mean", 0.0)),
                 series=series,
                 evidence={t: e for t, e in evidence.items() if p0 <= t < p1},
+                faults=faults.within(p0, p1),
             )
         )
     return out
@@ -604,6 +602,8 @@ def run_flight(
     peaks = [p for r in chunks for p in r.peaks]
     events = detector.events(peaks, threshold, spacecraft.name, run_id, cfg_hash)
     events = attribute_events(events, {t: e for r in chunks for t, e in r.evidence.items()})
+    events = merge_fault_findings(events, [f for r in chunks for f in r.faults.findings], spacecraft.name, run_id,
+                                  cfg_hash)  # fmt: skip
     daily = daily_table(chunks, events, threshold)
     return FlightResult(events, threshold, daily, peaks, chunks if keep_series else [], run_id, cfg_hash, warnings)
 

@@ -1,0 +1,375 @@
+"""Sensor-consistency scans: faults looked for directly, each channel against its own noise.
+
+The momentum detector (:mod:`abrupt.detect.attitude.flight_glr`) sees what changes the total
+momentum; a fault of one sensor may change it little and is then never an event. These scans test
+each channel against the physics the other channels must obey:
+
+* **wheel tachometer** (channel ``wheel_N``): a wheel's speed changes only through its motor torque,
+  whose reaction turns the body: a real change J_s ΔΩ in one sample is matched by the body's
+  momentum change J Δω (Bennett 2022, Eq. 2.5: H = J ω + Σ J_s Ω ĝ is conserved without external
+  torque). The statistic is the jump of the wheel's raw reading (its first difference against an
+  11-sample running median) over its noise (robust scale, never below the tachometer's quantum
+  q/√6, the standard deviation of the difference of two quantised readings); a jump is a fault when
+  the body's momentum change around it is less than half of the momentum the reading claims;
+* **gyro and star tracker** (channels ``gyro_x/y/z``, ``star_tracker``): real motion moves both rate
+  sensors, so the difference of the gyro's rate and the tracker's (2 vec(q_k⁻¹ ⊗ q_k+1)/dt, centred)
+  stays at its noise. Where it leaves it, the sensor that left its own 11-sample running median while
+  the other stayed on its own is the faulty one; both moving is motion (a strike), never a fault;
+* **appendage drive** (channel ``appendage_N``, class ``internal``): a drive's rate against its own
+  61-sample running median (a sun-tracking drive turns smoothly); a snap or slip moves momentum
+  between hub and array and leaves the total as it was.
+
+Each channel's threshold is set on the day in front of it for a stated false-alarm rate per channel
+(:data:`FAULT_FALSE_ALARMS`): an exponential tail fitted to the exceedance counts of its own
+statistic (:func:`tail_threshold`), which a few faults in the day do not move (the fit uses levels
+that hundreds of samples exceed). A channel with fewer than 2 ``TAIL_COUNTS[0]`` analysed samples
+in the day is not scanned (its tail cannot be fitted). The exceedances of each channel are counted
+and reported beside the stated rate (:class:`ChannelCalibration`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from scipy.ndimage import median_filter
+
+from abrupt.detect.attitude.attribution import AttributionRules
+from abrupt.detect.attitude.evidence import hamilton_product
+from abrupt.model.flight_config import FlightConfig
+from abrupt.model.spacecraft import Spacecraft
+from abrupt.series.timetable import NS, Timetable
+from abrupt.thresholds.budget import FalseAlarmBudget
+from abrupt.types import BoolArray, FloatArray
+
+#: The stated false-alarm rate of each scanned channel.
+FAULT_FALSE_ALARMS = FalseAlarmBudget(0.1, "day")
+#: Exceedances closer than this [s] are one finding (a miscount's two jumps, a spike's samples).
+CLUSTER_S = 5.0
+#: A wheel jump is a fault when the body shows less than this share of the momentum the reading claims.
+BODY_SHARE_MAX = 0.5
+#: A sensor "stayed on its own median" when its departure is below this many σ of its own noise.
+QUIET_SIGMA = 5.0
+#: Smallest angle [rad] an appendage jump must add to be a snap (the attribution rules' 0.2°).
+SNAP_MIN_RAD = math.radians(AttributionRules().appendage_min_deg)
+#: Fewest exceedances of the lowest and the highest level of the tail fit.
+TAIL_COUNTS = (3000, 300)
+
+SECONDS_PER_DAY = 86400.0
+
+
+@dataclass(frozen=True)
+class FaultFinding:
+    """One fault found by a scan: time [ns], class, channel, statistic and its threshold [σ], reason."""
+
+    time_ns: int
+    kind: str
+    channel: str
+    statistic: float
+    threshold: float
+    false_alarms_per_day: float
+    reason: str
+
+
+@dataclass(frozen=True)
+class ChannelCalibration:
+    """A channel's threshold [σ] on one span, its stated rate, and what the span's own data gave.
+
+    ``exceedances`` counts clusters of the statistic above the threshold (before the physical gates);
+    ``findings`` those that passed them; ``days`` the analysed length.
+    """
+
+    channel: str
+    start_ns: int
+    threshold: float
+    false_alarms_per_day: float
+    exceedances: int
+    findings: int
+    days: float
+
+
+@dataclass(frozen=True)
+class FaultScan:
+    """What the scans found on a span, and each channel's calibration on it."""
+
+    findings: list[FaultFinding]
+    calibrations: list[ChannelCalibration]
+
+    def within(self, start_ns: int, end_ns: int) -> FaultScan:
+        """The findings in [start, end) and the calibrations of the days that start there."""
+        return FaultScan(
+            [f for f in self.findings if start_ns <= f.time_ns < end_ns],
+            [c for c in self.calibrations if start_ns <= c.start_ns < end_ns],
+        )
+
+
+def robust_sigma(x: FloatArray) -> float:
+    """σ from the median absolute deviation of the finite values (0 when there are none)."""
+    v = x[np.isfinite(x)]
+    return float(np.median(np.abs(v - np.median(v))) / 0.6745) if v.size else 0.0
+
+
+def tail_threshold(z: FloatArray, p_sample: float) -> float:
+    """The level a sample of ``z`` exceeds with probability ``p_sample``, from an exponential tail.
+
+    log N(z ≥ u) is fitted by a line in u over the levels exceeded by between ``TAIL_COUNTS[0]`` and
+    ``TAIL_COUNTS[1]`` samples (at least three distinct ones: a quantised statistic takes few values,
+    so the range is widened downwards until it has them) and extrapolated to N = p_sample · n. A
+    Laplace tail is exactly exponential; a Gaussian one falls faster, so its realised rate is below
+    the stated one.
+    """
+    v = np.sort(z[np.isfinite(z)])
+    n = v.size
+    if n < 2 * TAIL_COUNTS[0]:
+        raise ValueError(f"need at least {2 * TAIL_COUNTS[0]} samples to fit a tail, got {n}")
+    top = TAIL_COUNTS[0]
+    while True:
+        ranks = np.unique(np.geomspace(top, TAIL_COUNTS[1], 12).astype(int))
+        levels = np.unique(v[n - ranks])
+        if levels.size >= 3 or top >= n // 4:
+            break
+        top *= 4
+    counts = n - np.searchsorted(v, levels, side="left")
+    if levels.size < 2:
+        return float(v[-1])
+    slope, icpt = np.polyfit(levels, np.log(counts), 1)
+    if not slope < 0:
+        return float(v[-1])
+    return float(max((math.log(max(p_sample * n, 1e-300)) - icpt) / slope, levels[-1]))
+
+
+def _threshold(z: FloatArray, p_sample: float) -> float:
+    """The tail's level for ``p_sample``, never below ``QUIET_SIGMA``: a channel whose statistic is
+    degenerate (a noiseless or coarsely quantised reading) has no tail to fit, and nothing within
+    ``QUIET_SIGMA`` of its own noise is a fault."""
+    return max(tail_threshold(z, p_sample), QUIET_SIGMA)
+
+
+def contiguous_runs(mask: BoolArray) -> list[slice]:
+    """The runs of True in ``mask`` as slices."""
+    m = np.concatenate([[False], np.asarray(mask, bool), [False]])
+    edges = np.flatnonzero(np.diff(m.astype(np.int8)))
+    return [slice(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+
+
+def clusters(t_ns: np.ndarray, z: FloatArray, above: BoolArray, gap_s: float = CLUSTER_S) -> list[int]:
+    """Index of the largest ``z`` in each run of ``above`` samples no more than ``gap_s`` apart."""
+    idx = np.flatnonzero(above)
+    if not idx.size:
+        return []
+    breaks = np.flatnonzero(np.diff(t_ns[idx]) > gap_s * NS) + 1
+    return [int(g[np.argmax(z[g])]) for g in np.split(idx, breaks)]
+
+
+def wheel_jump_statistic(speed_rad_s: FloatArray, quantum_rad_s: float = 0.0) -> tuple[FloatArray, float]:
+    """Jumps of a wheel's raw speed against its own noise [σ], element k between samples k and k+1.
+
+    r is each first difference minus its 11-sample running median; σ its robust scale, at least q/√6
+    for a tachometer of quantum q (the difference of two quantised readings). The statistic is the
+    larger of |r_k| / σ (a step: a reading that moved and stayed) and |r_k − r_k+1| / (√2 σ) (one
+    sample off and back, a miscount: the matched filter of the pair). Returns (statistic, σ [rad/s]).
+    """
+    d = np.diff(speed_rad_s)
+    r = d - median_filter(d, size=11, mode="nearest")
+    sigma = max(robust_sigma(r), quantum_rad_s / math.sqrt(6.0), 1e-12)
+    pair = np.zeros_like(r)
+    pair[:-1] = np.abs(r[:-1] - r[1:]) / math.sqrt(2.0)
+    return np.maximum(np.abs(r), pair) / sigma, sigma
+
+
+def rate_departures(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Per sample and axis: gyro − tracker rate against its 31-sample running median (a bias is slow),
+    gyro − its 11-sample running median, tracker − its 11-sample running median.
+
+    The tracker's rate at sample k is the mean of 2 vec(q⁻¹ ⊗ q')/dt over the intervals either side.
+    """
+    qn = q_BN / np.linalg.norm(q_BN, axis=1, keepdims=True)
+    d = hamilton_product(qn[:-1] * np.array([1.0, -1.0, -1.0, -1.0]), qn[1:])
+    d *= np.where(d[:, :1] < 0, -1.0, 1.0)
+    w_st = 2.0 * d[:, 1:] / dt
+    ref = np.empty_like(omega_B)
+    ref[1:-1] = 0.5 * (w_st[:-1] + w_st[1:])
+    ref[0], ref[-1] = w_st[0], w_st[-1]
+    err = omega_B - ref
+    err = err - median_filter(err, size=(31, 1), mode="nearest")  # a gyro bias is slow: taken out
+    e_g = omega_B - median_filter(omega_B, size=(11, 1), mode="nearest")
+    e_t = ref - median_filter(ref, size=(11, 1), mode="nearest")
+    return err, e_g, e_t
+
+
+def _rate(budget: FalseAlarmBudget, t_ns: np.ndarray) -> tuple[float, float]:
+    """(per-sample probability, analysed days) of ``budget`` on samples at times ``t_ns``."""
+    days = t_ns.size * float(np.median(np.diff(t_ns))) / NS / SECONDS_PER_DAY if t_ns.size > 1 else 0.0
+    return (budget.per_day * days / max(t_ns.size, 1), days)
+
+
+def _body_momentum_jump(table: Timetable, J: FloatArray, t_ns: int, axis_B: FloatArray) -> float:
+    """|ĝ · J Δω| [N·m·s]: the body's momentum change along a wheel's axis, its rate's median over the
+    4 s after ``t_ns`` against the 4 s before (a wheel's torque turns the body about its own axis)."""
+    g = table.time_ns
+    i = int(np.searchsorted(g, t_ns))
+    w = table.body_rate_rad_s
+    before, after = w[max(0, i - 5) : max(0, i - 1)], w[i : i + 4]
+    if len(before) < 2 or len(after) < 2 or not (np.isfinite(before).all() and np.isfinite(after).all()):
+        return float("nan")
+    return float(abs(axis_B @ J @ (np.median(after, axis=0) - np.median(before, axis=0))))
+
+
+def scan_wheels(
+    samples: pd.DataFrame,
+    flight: FlightConfig,
+    table: Timetable,
+    spacecraft: Spacecraft,
+    ok: BoolArray,
+    core: tuple[int, int],
+    budget: FalseAlarmBudget,
+) -> FaultScan:
+    """Tachometer scan of every wheel channel on its raw samples (module docstring); jumps where the
+    grid is not ``ok`` (slews, thruster firings, gaps) are not looked at."""
+    J = spacecraft.inertia_kgm2
+    ok_near = np.convolve(~np.asarray(ok, bool), np.ones(13), "same") == 0  # the running median's reach
+    found: list[FaultFinding] = []
+    cals: list[ChannelCalibration] = []
+    for ch in flight.of("wheel_speed"):
+        sub = samples.loc[samples["mnemonic"] == ch.mnemonic]
+        t = sub["time"].to_numpy().astype("datetime64[ns]").astype(np.int64)
+        order = np.argsort(t, kind="stable")
+        t, x = t[order], sub["value"].to_numpy(np.float64)[order] * ch.to_si
+        if t.size < 2 * TAIL_COUNTS[0]:
+            continue
+        quantum = ch.tachometer.quantum_rad_s if ch.tachometer is not None else 0.0
+        z, sigma = wheel_jump_statistic(x, quantum)
+        on_grid = np.clip(np.searchsorted(table.time_ns, t[1:]), 0, max(table.time_ns.size - 1, 0))
+        z[~ok_near[on_grid]] = np.nan
+        gaps = np.diff(t) > 1.5 * np.median(np.diff(t))
+        z[gaps | np.r_[False, gaps[:-1]] | np.r_[gaps[1:], False]] = np.nan  # a jump across a gap is no jump
+        t_jump = t[1:]
+        in_core = (t_jump >= core[0]) & (t_jump < core[1])
+        if np.isfinite(z[in_core]).sum() < 2 * TAIL_COUNTS[0]:
+            continue
+        p, days = _rate(budget, t_jump[in_core])
+        thr = _threshold(z[in_core], p)
+        js = float(spacecraft.wheel_spin_inertias_kgm2[ch.component])
+        name = f"wheel_{ch.component + 1}"
+        peaks = clusters(t_jump, z, in_core & (z > thr))
+        n_found = 0
+        for k in peaks:
+            claimed = js * z[k] * sigma  # the momentum the reading says the wheel exchanged
+            body = _body_momentum_jump(table, J, int(t_jump[k]), spacecraft.wheel_axes[:, ch.component])
+            if not (math.isfinite(body) and body < BODY_SHARE_MAX * claimed):
+                continue
+            n_found += 1
+            reason = f"wheel reading jumped {claimed:.3g} N·m·s, the body {body:.2g}"
+            found.append(FaultFinding(int(t_jump[k]), "sensor_fault", name, float(z[k]), thr, budget.per_day, reason))
+        cals.append(ChannelCalibration(name, core[0], thr, budget.per_day, len(peaks), n_found, days))
+    return FaultScan(found, cals)
+
+
+def scan_rate_sensors(table: Timetable, ok: BoolArray, core: tuple[int, int], budget: FalseAlarmBudget) -> FaultScan:
+    """Gyro (per axis) and star tracker against each other on the grid (module docstring)."""
+    g = table.time_ns
+    if g.size < 2 * TAIL_COUNTS[0]:
+        return FaultScan([], [])
+    dt = float(np.median(np.diff(g))) / NS
+    q = np.where(ok[:, None], table.quaternion_BN, np.nan)
+    w = np.where(ok[:, None], table.body_rate_rad_s, np.nan)
+    good: BoolArray = np.asarray(np.isfinite(q).all(axis=1) & np.isfinite(w).all(axis=1))
+    good[1:] &= np.diff(g) < 1.5 * dt * NS  # a run ends at a gap of the grid
+    runs = [r for r in contiguous_runs(good) if r.stop - r.start >= 61]
+    if not runs:
+        return FaultScan([], [])
+    idx = np.concatenate([np.arange(r.start + 1, r.stop - 1) for r in runs])  # each run's ends: no centred rate
+    parts = [rate_departures(table.quaternion_BN[r], table.body_rate_rad_s[r], dt) for r in runs]
+    err, e_g, e_t = (np.concatenate([p[j][1:-1] for p in parts]) for j in range(3))
+    t = g[idx]
+    in_core = (t >= core[0]) & (t < core[1])
+    sig_err = np.array([robust_sigma(err[in_core, k]) for k in range(3)])
+    sig_g = np.array([robust_sigma(e_g[in_core, k]) for k in range(3)])
+    sig_t = np.array([robust_sigma(e_t[in_core, k]) for k in range(3)])
+    z_err = np.abs(err) / np.maximum(sig_err, 1e-15)
+    if in_core.sum() < 2 * TAIL_COUNTS[0]:
+        return FaultScan([], [])
+    gyro_moved = np.abs(e_g) > QUIET_SIGMA * np.maximum(sig_g, 1e-15)
+    st_moved = np.abs(e_t) > QUIET_SIGMA * np.maximum(sig_t, 1e-15)
+    p, days = _rate(budget, t[in_core])
+    found: list[FaultFinding] = []
+    cals: list[ChannelCalibration] = []
+    # Gyro axis k: it left its median, the tracker stayed on its own on every axis.
+    for k in range(3):
+        thr = _threshold(z_err[in_core, k], p)
+        peaks = clusters(t, z_err[:, k], in_core & (z_err[:, k] > thr))
+        hits = [j for j in peaks if gyro_moved[j, k] and not st_moved[j].any()]
+        name = f"gyro_{'xyz'[k]}"
+        for j in hits:
+            reason = "gyro left the star tracker and its own median; the tracker stayed"
+            found.append(FaultFinding(int(t[j]), "sensor_fault", name, float(z_err[j, k]), thr, budget.per_day, reason))
+        cals.append(ChannelCalibration(name, core[0], thr, budget.per_day, len(peaks), len(hits), days))
+    # Star tracker: the 3-axis mismatch; the tracker left its median, the gyro stayed on its own.
+    z3 = np.max(z_err, axis=1)
+    thr = _threshold(z3[in_core], p * 3.0)  # the largest of three axes: three chances per sample
+    peaks = clusters(t, z3, in_core & (z3 > thr))
+    hits = [j for j in peaks if st_moved[j].any() and not gyro_moved[j].any()]
+    for j in hits:
+        reason = "star tracker left the gyro and its own median; the gyro stayed"
+        found.append(FaultFinding(int(t[j]), "sensor_fault", "star_tracker", float(z3[j]), thr, budget.per_day, reason))
+    cals.append(ChannelCalibration("star_tracker", core[0], thr, budget.per_day, len(peaks), len(hits), days))
+    return FaultScan(found, cals)
+
+
+def scan_appendages(table: Timetable, ok: BoolArray, core: tuple[int, int], budget: FalseAlarmBudget) -> FaultScan:
+    """An abrupt change of each appendage drive's rate against its 61-sample running median."""
+    rates = table.appendage_rate_rad_s
+    g = table.time_ns
+    found: list[FaultFinding] = []
+    cals: list[ChannelCalibration] = []
+    if rates.ndim != 2 or g.size < 2 * TAIL_COUNTS[0]:
+        return FaultScan(found, cals)
+    for k in range(rates.shape[1]):
+        good = ok & np.isfinite(rates[:, k])
+        idx = np.flatnonzero(good)
+        if idx.size < 2 * TAIL_COUNTS[0]:
+            continue
+        x = rates[idx, k]
+        t = g[idx]
+        r = x - median_filter(x, size=61, mode="nearest")
+        in_core = (t >= core[0]) & (t < core[1])
+        if in_core.sum() < 2 * TAIL_COUNTS[0]:
+            continue
+        z = np.abs(r) / max(robust_sigma(r[in_core]), 1e-12)
+        z[np.convolve(np.diff(t, prepend=t[0]) > 1.5 * float(np.median(np.diff(t))), np.ones(61), "same") > 0] = np.nan
+        p, days = _rate(budget, t[in_core])
+        if np.isfinite(z[in_core]).sum() < 2 * TAIL_COUNTS[0]:
+            continue
+        thr = _threshold(z[in_core], p)
+        peaks = clusters(t, z, in_core & (z > thr), gap_s=30.0)
+        name = f"appendage_{k + 1}"
+        # The angle the jump adds over ±15 s must be beyond the drive's resolution (a physical floor).
+        half = max(1, round(15.0 * NS / float(np.median(np.diff(t)))))
+        step_s = float(np.median(np.diff(t))) / NS
+        peaks = [j for j in peaks if abs(np.nansum(r[max(0, j - half) : j + half + 1])) * step_s > SNAP_MIN_RAD]
+        for j in peaks:
+            reason = "appendage drive rate jumped against its running median"
+            found.append(FaultFinding(int(t[j]), "internal", name, float(z[j]), thr, budget.per_day, reason))
+        cals.append(ChannelCalibration(name, core[0], thr, budget.per_day, len(peaks), len(peaks), days))
+    return FaultScan(found, cals)
+
+
+def scan_faults(
+    samples: pd.DataFrame,
+    flight: FlightConfig,
+    table: Timetable,
+    spacecraft: Spacecraft,
+    ok: BoolArray,
+    core: tuple[int, int],
+    budget: FalseAlarmBudget = FAULT_FALSE_ALARMS,
+) -> FaultScan:
+    """Every scan of the module on one span; findings and calibrations for its core [start, end) [ns]."""
+    parts = [
+        scan_wheels(samples, flight, table, spacecraft, ok, core, budget),
+        scan_rate_sensors(table, ok, core, budget),
+        scan_appendages(table, ok, core, budget),
+    ]
+    findings = sorted((f for s in parts for f in s.findings), key=lambda f: f.time_ns)
+    return FaultScan(findings, [c for s in parts for c in s.calibrations])

@@ -1,0 +1,153 @@
+"""The fault scans' findings merged with the flight pipeline's events.
+
+:func:`abrupt.detect.attitude.fault_scan.scan_faults` looks for faults channel by channel; the
+momentum detector's events are attributed from their evidence
+(:mod:`abrupt.pipelines.flight_attribution`). A finding near an event adds to that event, it does not
+duplicate it: the nearest event within ``MERGE_S`` that is not a strike takes the finding's class
+and channel (one channel moved and the physics it must obey did not: a wheel reading with no body
+response, a rate sensor the other did not follow, an appendage drive that jumped), with the finding
+in its ``fault_*`` columns. A strike is never re-classified by a scan (the scans' physical gates
+exclude motion): a finding within ``STRIKE_S`` of a strike's event is written beside it in its
+``fault_*`` columns, and a finding further from it is a second thing; a finding with no event nearby
+becomes an event of its own (detector ``attitude.fault_scan``, its statistic and threshold in σ of
+its channel's noise, the rate its threshold was set for; ΔH empty: a fault changes no momentum).
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
+
+import numpy as np
+import pandas as pd
+
+from abrupt.detect.attitude.fault_scan import FAULT_FALSE_ALARMS, FaultFinding, FaultScan, scan_faults
+from abrupt.events import Event, events_frame, format_time_utc, make_event_id
+from abrupt.model.flight_config import FlightConfig
+from abrupt.model.spacecraft import Spacecraft
+from abrupt.series.timetable import NS, Timetable
+from abrupt.thresholds.budget import FalseAlarmBudget
+from abrupt.types import BoolArray
+
+DAY_NS = 86_400 * NS
+__all__ = ["FAULT_COLUMNS", "FaultScan", "merge_fault_findings", "scan_span"]
+
+#: A finding and an event this close [s] are one thing (the step locator places a fault's event within
+#: a window span of the fault; a strike 20 s after a fault is still found apart: strikes are never merged).
+MERGE_S = 30.0
+#: A finding this close [s] to a strike's event is evidence beside it: never a second event, never its class.
+STRIKE_S = 10.0
+FAULT_DETECTOR = "attitude.fault_scan"
+FAULT_COLUMNS = ("fault_channel", "fault_statistic", "fault_threshold")
+
+
+def _times_ns(events: pd.DataFrame) -> np.ndarray:
+    if not len(events):
+        return np.empty(0, np.int64)
+    t = pd.to_datetime(events["time_utc"].astype(str).str.rstrip("Z"))
+    return np.asarray(t.to_numpy().astype("datetime64[ns]").astype(np.int64))
+
+
+def _new_rows(
+    findings: Sequence[FaultFinding], spacecraft: str, run_id: str, cfg_hash: str, columns: pd.Index
+) -> pd.DataFrame:
+    rows = [
+        Event(
+            spacecraft=spacecraft,
+            kind=f.kind,
+            detector=FAULT_DETECTOR,
+            time_utc=format_time_utc(np.datetime64(f.time_ns, "ns")),
+            time_sigma_s=1.0,
+            statistic=f.statistic,
+            threshold=f.threshold,
+            false_alarms_per_day=f.false_alarms_per_day,
+            run_id=run_id,
+            config_hash=cfg_hash,
+            extra={"statistic_units": "sigma", "threshold_method": "exponential-tail"},
+        )
+        for f in findings
+    ]
+    frame = events_frame(rows)
+    for c in columns:
+        if c not in frame:
+            frame[c] = pd.Series([pd.NA if c in ("kind_channel", "kind_reason") else np.nan] * len(frame))
+    frame["kind_channel"] = [f.channel for f in findings]
+    frame["kind_reason"] = [f"{f.reason} (fault scan)" for f in findings]
+    frame["kind_confidence"] = 0.99
+    return frame
+
+
+def _annotate(out: pd.DataFrame, i: int, f: FaultFinding, kind: bool = False) -> None:
+    """Row ``i`` of ``out`` gets the finding in its ``fault_*`` columns (and its class, when ``kind``)."""
+    row = out.index[i]
+    values: dict[str, str | float] = {
+        "fault_channel": f.channel,
+        "fault_statistic": f.statistic,
+        "fault_threshold": f.threshold,
+    }
+    if kind:
+        values |= {"kind": f.kind, "kind_channel": f.channel, "kind_reason": f"{f.reason} (fault scan)"}
+        values["kind_confidence"] = 0.99
+    for column, value in values.items():
+        out.at[row, column] = value
+
+
+def merge_fault_findings(
+    events: pd.DataFrame, findings: Sequence[FaultFinding], spacecraft: str, run_id: str, cfg_hash: str
+) -> pd.DataFrame:
+    """``events`` with the findings merged in (module docstring), sorted by time, ids recomputed."""
+    out = events.copy()
+    for c in FAULT_COLUMNS:
+        out[c] = pd.Series(dtype="string" if c == "fault_channel" else "float64", index=out.index)
+    if not findings:
+        return out
+    t_ev = _times_ns(out)
+    kinds = out["kind"].astype(str).to_numpy() if len(out) else np.empty(0, str)
+    taken = np.zeros(len(out), bool)
+    new: list[FaultFinding] = []
+    for f in sorted(findings, key=lambda f: -f.statistic / max(f.threshold, 1e-12)):
+        at_strike = np.flatnonzero((np.abs(t_ev - f.time_ns) <= STRIKE_S * NS) & (kinds == "strike"))
+        if at_strike.size:  # evidence beside the strike; its class stays
+            _annotate(out, int(at_strike[0]), f)
+            continue
+        near = np.flatnonzero((np.abs(t_ev - f.time_ns) <= MERGE_S * NS) & (kinds != "strike"))
+        if near.size:
+            i = int(near[np.argmin(np.abs(t_ev[near] - f.time_ns))])
+            if taken[i]:
+                continue
+            taken[i] = True
+            _annotate(out, i, f, kind=True)
+            continue
+        if any(abs(g.time_ns - f.time_ns) <= MERGE_S * NS for g in new):
+            continue
+        new.append(f)
+    if new:
+        extra = _new_rows(new, spacecraft, run_id, cfg_hash, out.columns)
+        extra["fault_channel"] = [f.channel for f in new]
+        extra["fault_statistic"] = [f.statistic for f in new]
+        extra["fault_threshold"] = [f.threshold for f in new]
+        extra = extra.astype({c: out[c].dtype for c in out.columns if c in extra and len(out)}, errors="ignore")
+        out = pd.concat([out, extra[list(out.columns)]], ignore_index=True) if len(out) else extra
+    out["event_id"] = [
+        make_event_id(str(r.spacecraft), str(r.detector), str(r.kind), str(r.time_utc), str(r.config_hash))
+        for r in out.itertuples()
+    ]
+    return out.sort_values("time_utc", kind="stable").reset_index(drop=True)
+
+
+def scan_span(
+    samples: pd.DataFrame,
+    flight: FlightConfig,
+    table: Timetable,
+    spacecraft: Spacecraft,
+    ok: BoolArray,
+    start_ns: int,
+    end_ns: int,
+    budget: FalseAlarmBudget = FAULT_FALSE_ALARMS,
+) -> FaultScan:
+    """The fault scans of [start, end), each UTC day calibrated on its own data (the span's margin is
+    scanned but gives no finding)."""
+    first = -(-start_ns // DAY_NS) * DAY_NS
+    edges = [start_ns, *range(first if first > start_ns else first + DAY_NS, end_ns, DAY_NS), end_ns]
+    parts = [scan_faults(samples, flight, table, spacecraft, ok, (a, b), budget) for a, b in itertools.pairwise(edges)]
+    return FaultScan([f for p in parts for f in p.findings], [c for p in parts for c in p.calibrations])

@@ -1,0 +1,223 @@
+"""Sensor-consistency scans against analytic signals, and their merge with the flight events."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from abrupt.detect.attitude.fault_scan import (
+    FaultFinding,
+    rate_departures,
+    scan_appendages,
+    scan_rate_sensors,
+    scan_wheels,
+    tail_threshold,
+    wheel_jump_statistic,
+)
+from abrupt.events import Event, events_frame
+from abrupt.model.spacecraft import load_spacecraft
+from abrupt.pipelines.flight_checks import flight_channels
+from abrupt.pipelines.flight_faults import FAULT_DETECTOR, merge_fault_findings
+from abrupt.series.timetable import NS, Timetable
+from abrupt.thresholds.budget import FalseAlarmBudget
+
+KESTREL = Path(__file__).resolve().parent.parent / "examples" / "spacecraft" / "kestrel.toml"
+N = 20_000  # samples (1 Hz)
+T0 = 1_700_000_000 * NS
+BUDGET = FalseAlarmBudget(0.1, "day")
+
+
+def _rotation(rate_B: np.ndarray, n: int) -> np.ndarray:
+    """q_BN of a body turning at a constant body rate (exact: q(t) = q0 ⊗ exp(ω t / 2)), scalar first."""
+    ang = np.linalg.norm(rate_B) * np.arange(n)
+    axis = rate_B / np.linalg.norm(rate_B)
+    return np.column_stack([np.cos(ang / 2), np.outer(np.sin(ang / 2), axis)])
+
+
+def _table(n: int = N, rate_B: np.ndarray | None = None, rng: np.random.Generator | None = None) -> Timetable:
+    rng = rng or np.random.default_rng(1)
+    w = np.array([1e-3, -5e-4, 2e-4]) if rate_B is None else rate_B
+    omega = np.tile(w, (n, 1)) + 2e-5 * rng.standard_normal((n, 3))
+    q = _rotation(w, n)
+    return Timetable(
+        time_ns=T0 + np.arange(n, dtype=np.int64) * NS,
+        quaternion_BN=q,
+        body_rate_rad_s=omega,
+        wheel_speed_rad_s=np.zeros((n, 4)),
+        appendage_rate_rad_s=(1e-3 + 1e-5 * rng.standard_normal(n))[:, None],
+        flags=np.zeros((n, 0)),
+        valid=np.ones(n, bool),
+    )
+
+
+def test_tail_threshold_is_the_exact_quantile_of_an_exponential_tail() -> None:
+    # |Laplace(1)| is exponential: P(z > u) = e^-u, so the level exceeded with probability p is -ln p.
+    z = np.abs(np.random.default_rng(3).laplace(size=400_000))
+    for p in (1e-5, 1e-6):
+        assert tail_threshold(z, p) == pytest.approx(-math.log(p), rel=0.05)
+
+
+def test_tail_threshold_of_gaussian_noise_is_conservative_and_of_a_quantised_statistic_finite() -> None:
+    z = np.abs(np.random.default_rng(4).standard_normal(200_000))
+    u = tail_threshold(z, 1e-6)
+    assert u > 4.9  # the Gaussian quantile (an exponential extrapolation falls slower than a Gaussian)
+    q = np.round(np.abs(np.random.default_rng(5).laplace(scale=1.5, size=100_000)))
+    uq = tail_threshold(q, 1e-6)
+    assert math.isfinite(uq) and uq >= np.sort(q)[-300]
+    with pytest.raises(ValueError, match="need at least"):
+        tail_threshold(z[:100], 1e-6)
+
+
+def test_wheel_jump_statistic_of_a_miscount_and_a_step_on_a_quantised_ramp() -> None:
+    q = 0.098  # rad/s per pulse
+    t = np.arange(4000.0)
+    speed = q * np.round((100.0 + 0.01 * t + 1e-6 * t**2) / q)  # a quantised smooth speed
+    sigma_floor = q / math.sqrt(6.0)
+    miscount = speed.copy()
+    miscount[1000] += 12 * q  # one reading off by 12 pulses
+    z, sigma = wheel_jump_statistic(miscount, q)
+    assert sigma == pytest.approx(sigma_floor)
+    assert int(np.argmax(z)) == 999  # the pair of jumps into and out of the sample
+    assert z.max() == pytest.approx(math.sqrt(2.0) * 12 * q / sigma_floor, rel=0.1)
+    step = speed.copy()
+    step[2000:] += 20 * q
+    z2, _ = wheel_jump_statistic(step, q)
+    assert int(np.argmax(z2)) == 1999 and z2.max() == pytest.approx(20 * q / sigma_floor, rel=0.1)
+
+
+def test_rate_departures_real_motion_moves_both_sensors_a_fault_only_one() -> None:
+    n = 600
+    w = np.array([2e-3, 1e-3, -1e-3])
+    q = _rotation(w, n)
+    omega = np.tile(w, (n, 1))
+    err, e_g, e_t = rate_departures(q, omega, 1.0)
+    assert np.max(np.abs(err)) < 1e-9  # constant rotation: the gyro and the tracker agree exactly
+    spiked = omega.copy()
+    spiked[300, 1] += 1e-3
+    err, e_g, e_t = rate_departures(q, spiked, 1.0)
+    assert abs(err[300, 1]) == pytest.approx(1e-3, rel=1e-3) and abs(e_g[300, 1]) == pytest.approx(1e-3, rel=1e-3)
+    assert np.max(np.abs(e_t)) < 1e-9
+    theta = 0.01  # the tracker's attitude turned by 0.01 rad about x from sample 300 on
+    dq = np.array([math.cos(theta / 2), math.sin(theta / 2), 0.0, 0.0])
+    jumped = q.copy()
+    w0, v0 = q[300:, :1], q[300:, 1:]
+    jumped[300:] = np.column_stack(
+        [w0[:, 0] * dq[0] - v0 @ dq[1:], w0 * dq[1:] + dq[0] * v0 + np.cross(v0, np.tile(dq[1:], (n - 300, 1)))]
+    )
+    err, e_g, e_t = rate_departures(jumped, omega, 1.0)
+    assert np.max(np.abs(e_g)) < 1e-9
+    assert abs(e_t[299, 0]) == pytest.approx(theta / 2, rel=0.01) and abs(e_t[300, 0]) == pytest.approx(
+        theta / 2, rel=0.01
+    )
+
+
+def test_rate_sensor_scan_names_the_gyro_axis_and_the_tracker_and_ignores_real_motion() -> None:
+    table = _table()
+    core = (T0, T0 + N * NS)
+    quiet = scan_rate_sensors(table, table.valid, core, BUDGET)
+    assert quiet.findings == []
+    table.body_rate_rad_s[5000, 2] += 2e-3  # a gyro spike on z
+    jump = np.array([math.cos(0.005), math.sin(0.005), 0.0, 0.0])  # the tracker turned by 0.01 rad about x
+    q = table.quaternion_BN[12000:].copy()
+    table.quaternion_BN[12000:, 0] = q[:, 0] * jump[0] - q[:, 1] * jump[1]
+    table.quaternion_BN[12000:, 1:] = q[:, :1] * jump[1:] + jump[0] * q[:, 1:] + np.cross(q[:, 1:], jump[1:])
+    # Real motion: the body's rate steps by 2e-3 rad/s about y, seen by both sensors.
+    res = scan_rate_sensors(table, table.valid, core, BUDGET)
+    got = {(round((f.time_ns - T0) / NS), f.channel) for f in res.findings}
+    assert (5000, "gyro_z") in got
+    assert any(ch == "star_tracker" and abs(t - 12000) <= 1 for t, ch in got)
+    assert len(got) == 2
+    calib = {c.channel: c for c in res.calibrations}
+    assert set(calib) == {"gyro_x", "gyro_y", "gyro_z", "star_tracker"}
+    assert all(c.false_alarms_per_day == 0.1 and c.threshold > 4 for c in calib.values())
+
+
+def test_a_strike_moves_both_rate_sensors_and_no_scan_calls_it_a_fault() -> None:
+    n = N
+    w0 = np.array([1e-3, -5e-4, 2e-4])
+    dw = np.array([0.0, 3e-3, 0.0])  # an impulse: the rate steps and stays (no controller here)
+    rate = np.where(np.arange(n)[:, None] >= 8000, w0 + dw, w0)
+    ang = np.cumsum(np.vstack([np.zeros(3), rate[:-1]]), axis=0)  # small-angle attitude: q ≈ (1, θ/2)
+    table = _table(n, rate_B=w0)
+    table.body_rate_rad_s[:] = rate + 2e-5 * np.random.default_rng(2).standard_normal((n, 3))
+    half = 0.5 * np.linalg.norm(ang, axis=1)
+    axis = ang / np.maximum(np.linalg.norm(ang, axis=1, keepdims=True), 1e-30)
+    table.quaternion_BN[:] = np.column_stack([np.cos(half), axis * np.sin(half)[:, None]])
+    res = scan_rate_sensors(table, table.valid, (T0, T0 + n * NS), BUDGET)
+    assert not [f for f in res.findings if abs(f.time_ns - (T0 + 8000 * NS)) < 30 * NS]
+
+
+def test_appendage_scan_finds_a_snap_of_the_drive() -> None:
+    table = _table()
+    table.appendage_rate_rad_s[7000:7003, 0] += math.radians(2.0) / 3  # 2° more in 3 s
+    res = scan_appendages(table, table.valid, (T0, T0 + N * NS), BUDGET)
+    assert [(f.kind, f.channel) for f in res.findings] == [("internal", "appendage_1")]
+    assert abs(res.findings[0].time_ns - (T0 + 7001 * NS)) <= 2 * NS
+
+
+def _wheel_samples(sc, speeds: np.ndarray) -> pd.DataFrame:
+    flight = flight_channels(sc)
+    rows = []
+    t = pd.to_datetime(T0 + np.arange(speeds.shape[0], dtype=np.int64) * NS)
+    for ch in flight.of("wheel_speed"):
+        q = ch.tachometer.quantum_rad_s if ch.tachometer else 0.0
+        native = np.round(speeds[:, ch.component] / q) * q / ch.to_si
+        rows.append(pd.DataFrame({"mnemonic": ch.mnemonic, "time": t, "value": native}))
+    return pd.concat(rows, ignore_index=True)
+
+
+def test_wheel_scan_calls_a_miscount_a_fault_and_a_real_wheel_torque_not() -> None:
+    sc = load_spacecraft(KESTREL)
+    flight = flight_channels(sc)
+    quantum = 2 * math.pi / 64.0
+    t = np.arange(N, dtype=np.float64)
+    speeds = np.column_stack([150.0 + 0.002 * t + 0.3 * k for k in range(4)])
+    speeds[6000, 2] += 15 * quantum  # wheel 3 reads 15 pulses too many once
+    # Wheel 1 really spins up by 30 quanta in one second: its motor's reaction turns the body about ĝ₁.
+    speeds[14000:, 0] += 30 * quantum
+    table = _table()
+    table.body_rate_rad_s[:] = 0.0
+    dh = -sc.wheel_spin_inertias_kgm2[0] * 30 * quantum * sc.wheel_axes[:, 0]
+    table.body_rate_rad_s[14000:] += np.linalg.solve(sc.inertia_kgm2, dh)
+    res = scan_wheels(_wheel_samples(sc, speeds), flight, table, sc, table.valid, (T0, T0 + N * NS), BUDGET)
+    assert [(f.channel, round((f.time_ns - T0) / NS)) for f in res.findings] == [("wheel_3", 6000)]
+    assert {c.channel for c in res.calibrations} == {"wheel_1", "wheel_2", "wheel_3", "wheel_4"}
+
+
+def _events(times_s: list[float], kinds: list[str]) -> pd.DataFrame:
+    ev = [
+        Event(spacecraft="SC-A", kind=k, detector="attitude.flight_glr", time_utc=np.datetime64(T0 + int(s * NS), "ns"),
+              statistic=50.0, threshold=6.5, false_alarms_per_day=1.0, run_id="r", config_hash="h")
+        for s, k in zip(times_s, kinds, strict=True)
+    ]  # fmt: skip
+    frame = events_frame(ev)
+    frame["kind_channel"] = pd.Series([pd.NA] * len(frame), dtype="string")
+    frame["kind_reason"] = pd.Series(["rule"] * len(frame), dtype="string")
+    frame["kind_confidence"] = 0.7
+    return frame
+
+
+def test_merge_adds_to_a_nearby_event_never_changes_a_strike_and_makes_lone_findings_events() -> None:
+    events = _events([100.0, 1000.0, 5000.0], ["external_non_strike", "strike", "strike"])
+
+    def finding(s: float, channel: str = "wheel_2") -> FaultFinding:
+        return FaultFinding(T0 + int(s * NS), "sensor_fault", channel, 30.0, 9.0, 0.1, "wheel reading jumped")
+
+    out = merge_fault_findings(
+        events, [finding(110.0), finding(1003.0), finding(1030.0), finding(3000.0, "star_tracker")], "SC-A", "r", "h"
+    )
+    assert len(out) == 5  # the lone finding at 3000 s and the one 30 s after a strike are events of their own
+    by_time = {
+        round((pd.Timestamp(t.rstrip("Z")).value - T0) / NS): r
+        for t, r in zip(out["time_utc"], out.itertuples(), strict=True)
+    }
+    assert by_time[100].kind == "sensor_fault" and by_time[100].kind_channel == "wheel_2"
+    assert by_time[1000].kind == "strike" and by_time[1000].fault_channel == "wheel_2"  # evidence beside, class kept
+    assert by_time[1030].detector == FAULT_DETECTOR and by_time[1030].kind == "sensor_fault"
+    assert by_time[3000].detector == FAULT_DETECTOR and by_time[3000].kind_channel == "star_tracker"
+    assert by_time[5000].kind == "strike" and pd.isna(by_time[5000].fault_channel)
+    assert out["event_id"].is_unique
