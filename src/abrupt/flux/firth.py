@@ -94,8 +94,25 @@ def penalised_estimates(
     if (best == rows[0] and best > 0) or (best == rows[-1] and best < lik.beta_grid.size - 1):
         surface = penalised_surface(lik, p, other, s_grid, np.arange(lik.beta_grid.size))
     logb = np.log(lik.beta_grid)
-    prof = surface.max(axis=1)
+    ln_s, prof = row_maxima(np.log(s_grid), surface)
     xb, _, i = refine_max(logb, prof)
-    xs, _, _ = refine_max(np.log(s_grid), surface[i])
+    ok = np.isfinite(prof)
+    xs = float(np.interp(xb, logb[ok], ln_s[ok])) if ok.sum() > 1 else float(ln_s[i])
     out = {SCALES[p]: math.exp(xs), SCALES[1 - p]: other, "beta": math.exp(xb)}
     return {name: out[name] for name in ("debris_scale", "meteoroid_scale", "beta")}
+
+
+def row_maxima(x: NDArray[np.float64], surface: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Per row of ``surface`` sampled at x: the location and value of the maximum, refined by the parabola
+    through the best point and its neighbours (the grid point itself at an edge or where not concave)."""
+    rows = np.arange(surface.shape[0])
+    best = np.argmax(surface, axis=1)
+    j = np.clip(best, 1, x.size - 2)
+    y0, y1, y2 = surface[rows, j - 1], surface[rows, j], surface[rows, j + 1]
+    with np.errstate(invalid="ignore", divide="ignore"):  # rows left at -inf stay there
+        curv = y2 - 2 * y1 + y0
+        t = np.where(curv < 0, 0.5 * (y0 - y2) / curv, np.nan)  # vertex offset in grid steps
+        inside = np.isfinite(t) & (np.abs(t) <= 1.0)
+        loc = np.where(inside, x[j] + np.where(inside, t, 0.0) * (x[1] - x[0]), x[best])
+        val = np.where(inside, y1 - 0.125 * (y2 - y0) ** 2 / np.where(inside, curv, -1.0), surface[rows, best])
+    return loc, val
