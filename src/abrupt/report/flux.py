@@ -98,11 +98,18 @@ def fits_table(result: FluxInference) -> pd.DataFrame:
                     "parameter": p,
                     "estimate (ML)": v,
                     "bias-corrected": f.corrected_estimates.get(p, float("nan")),
+                    "Jeffreys-penalised": f.penalised_estimates.get(p, float("nan")),
                     f"{f.confidence:.0%} low": lo,
                     f"{f.confidence:.0%} high": hi,
                     "fixed": p in f.fixed,
                 }
             )
+        if "beta" not in f.fixed:  # what a β-free fit identifies: each population's expected detections
+            for pop, v in f.expected_events.items():
+                if pop != "false_alarms":
+                    rows.append(
+                        {"fit": name, "parameter": f"expected {pop} detections s·T(β) (identified)", "estimate (ML)": v}
+                    )
     return pd.DataFrame(rows)
 
 
