@@ -164,7 +164,7 @@ def score_controls(
 
 
 def one_fit(data, fixed, lik=None, intervals=True) -> dict[str, float]:  # type: ignore[no-untyped-def]
-    res = fit(data, fixed=fixed, confidence=0.9, likelihood=lik, intervals=intervals)
+    res = fit(data, fixed=fixed, confidence=0.9, likelihood=lik, intervals=intervals, penalised=True)
     out = {"debris_detections_hat": res.expected_events["debris"]}
     for p, v in res.estimates.items():
         out[f"{p}_hat"] = v

@@ -58,7 +58,7 @@ def test_penalised_estimate_equals_the_jeffreys_poisson_closed_form(n_debris: in
     e0 = CONFIG.dH_min_Nms
     unit_d = years * AMPLITUDE[0] * e0 ** -SLOPE[0]  # all bins telescoped, efficiency 1: G_d(e_0) at β = 1
     unit_m = years * AMPLITUDE[1] * e0 ** -SLOPE[1]
-    res = fit(data, fixed={"meteoroid_scale": 1.0}, intervals=False)
+    res = fit(data, fixed={"meteoroid_scale": 1.0}, intervals=False, penalised=True)
     # the ML estimate of the same factorised likelihood: each mean equals its count
     beta_ml = (n_meteoroid / unit_m) ** (1 / SLOPE[1])
     assert res.estimates["beta"] == pytest.approx(beta_ml, rel=2e-3)
@@ -74,5 +74,6 @@ def test_penalised_estimate_equals_the_jeffreys_poisson_closed_form(n_debris: in
 def test_penalised_estimate_is_only_given_with_beta_and_one_scale_free() -> None:
     exp = exposure(2, 1.0).assign(attitude="orbit")
     data = prepare(exp, class_events(exp, 6, 6), {CASE: separated_template()})
-    assert fit(data, fixed={"beta": 1.0}, intervals=False).penalised_estimates == {}
-    assert fit(data, intervals=False).penalised_estimates == {}
+    assert fit(data, fixed={"beta": 1.0}, intervals=False, penalised=True).penalised_estimates == {}
+    assert fit(data, intervals=False, penalised=True).penalised_estimates == {}
+    assert fit(data, fixed={"meteoroid_scale": 1.0}, intervals=False).penalised_estimates == {}  # opt-in

@@ -106,9 +106,6 @@ def infer(
         if f.corrected_estimates and free:
             corr = ", ".join(f"{p} = {f.corrected_estimates[p]:.3g}" for p in free)
             click.echo(f"  bias-corrected point estimate (signed ML, Cox-Snell correction of beta): {corr}")
-        if f.penalised_estimates:
-            pen = ", ".join(f"{p} = {f.penalised_estimates[p]:.3g}" for p in free)
-            click.echo(f"  Jeffreys-penalised point estimate (Firth, in ln s and ln beta): {pen}")
         if "beta" in free:
             ident = ", ".join(f"{k} {v:.3g}" for k, v in f.expected_events.items() if k != "false_alarms")
             click.echo(f"  identified with beta free: expected detections s_p*T_p(beta): {ident}")

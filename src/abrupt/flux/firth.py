@@ -7,9 +7,10 @@ under reparameterisation; here it is taken in φ = (ln s, ln β), where det I_φ
     ln L*(s, β) = ln L(s, β) + ½ ln det I(s, β) + ln s + ln β.
 
 For a Poisson count n with mean μ = T e^φ this gives e^φ̂ = (n + ½)/T, the Jeffreys-penalised estimate of a
-Poisson mean; for μ = T β^α it gives β̂ = ((n + ½)/T)^(1/α). Its use on the β ridge of the flux fit
-(meteoroid scale fixed, debris scale and β free) is empirical: see docs/flux-inference.md (its bias is
-measured by benchmarks/bench_flux_coverage.py against the Cox-Snell corrected estimate).
+Poisson mean; for μ = T β^α it gives β̂ = ((n + ½)/T)^(1/α). On the β ridge of the flux fit (meteoroid
+scale fixed, debris scale and β free) it is not the reported estimate: benchmarks/bench_flux_coverage.py
+measures its bias beside the Cox-Snell corrected one, and its β misses the 5 % bound at one of the
+acceptance truths (docs/flux-inference.md). ``fit(..., penalised=True)`` computes it.
 
 Computed on the likelihood's β grid × a log grid of the free scale, refined by parabolas; only for fits
 with β free and exactly one free scale (the ln parameterisation needs the scale > 0, which it always is at

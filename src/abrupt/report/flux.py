@@ -98,7 +98,6 @@ def fits_table(result: FluxInference) -> pd.DataFrame:
                     "parameter": p,
                     "estimate (ML)": v,
                     "bias-corrected": f.corrected_estimates.get(p, float("nan")),
-                    "Jeffreys-penalised": f.penalised_estimates.get(p, float("nan")),
                     f"{f.confidence:.0%} low": lo,
                     f"{f.confidence:.0%} high": hi,
                     "fixed": p in f.fixed,
