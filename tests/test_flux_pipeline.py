@@ -81,6 +81,11 @@ def test_simulate_population_then_flux_infer_end_to_end(tmp_path) -> None:
     assert set(prior["corrected_estimates"]) == set(prior["estimates"])
     assert prior["corrected_estimates"]["meteoroid_scale"] == 1.0
     assert r.output.count("bias-corrected point estimate") == len(result["fits"])
+    # with β free the identified quantity (expected detections) is named in the output and the JSON
+    assert r.output.count("identified with beta free") == len(result["fits"])
+    assert any("identify s_p·T_p(beta)" in n for n in prior["notes"])
+    assert any("expected debris detections have a mean within" in n for n in result["notes"])
+    assert "expected debris detections s·T(β) (identified)" in report.read_text()
     assert {g["model"] for g in result["goodness_of_fit"]} >= {"NASA-90/91 + Grün", "Grün only"}
     text = report.read_text()
     assert "data:image/png;base64" in text and "Exposure" in text

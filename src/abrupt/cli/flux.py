@@ -106,6 +106,9 @@ def infer(
         if f.corrected_estimates and free:
             corr = ", ".join(f"{p} = {f.corrected_estimates[p]:.3g}" for p in free)
             click.echo(f"  bias-corrected point estimate (signed ML, Cox-Snell correction of beta): {corr}")
+        if "beta" in free:
+            ident = ", ".join(f"{k} {v:.3g}" for k, v in f.expected_events.items() if k != "false_alarms")
+            click.echo(f"  identified with beta free: expected detections s_p*T_p(beta): {ident}")
     for g in result.goodness:
         click.echo(
             f"  {g['model']}: expected {g['expected_events']:.1f}, observed {g['observed_events']}, "

@@ -36,6 +36,7 @@ from scipy import optimize, stats
 from abrupt.errors import ConfigError, InputError
 from abrupt.flux.days import bin_efficiency, case_groups, one_exposure_per_day, reference_signal
 from abrupt.flux.exposure import DAYS_PER_YEAR, exposure_frame, logistic_efficiency
+from abrupt.flux.firth import SCALES, penalised_estimates
 from abrupt.flux.forward import (
     DIRECTION_CLASSES,
     ORBIT_FRAME_COLUMNS,
@@ -44,9 +45,14 @@ from abrupt.flux.forward import (
     Template,
     direction_class,
 )
+from abrupt.flux.grid import refine_max
 
 PARAMS: tuple[str, ...] = ("debris_scale", "meteoroid_scale", "beta")
-SCALES: tuple[str, ...] = ("debris_scale", "meteoroid_scale")
+# what a fit with β free measures well (docs/flux-inference.md, "The debris scale on the β ridge")
+IDENTIFIED_NOTE = (
+    "beta free: the data identify s_p·T_p(beta), the expected detections of each population (expected_events), "
+    "far better than s_p itself, whose estimate inherits beta's spread (its mean is biased high on small exposures)"
+)
 DEFAULT_BETA_GRID = np.exp(np.linspace(math.log(0.1), math.log(100.0), 161))
 
 
@@ -344,23 +350,6 @@ def bias_corrected(lik: Likelihood, fixed: Mapping[str, float], signed: Mapping[
     return {"debris_scale": float(scales[0, 0]), "meteoroid_scale": float(scales[0, 1]), "beta": new_beta}
 
 
-def refine_max(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, float, int]:
-    """Maximum of samples y(x) refined by a parabola through the best point and its neighbours."""
-    i = int(np.nanargmax(y))
-    if 0 < i < x.size - 1 and np.all(np.isfinite(y[i - 1 : i + 2])):
-        x0, x1, x2 = x[i - 1 : i + 2]
-        y0, y1, y2 = y[i - 1 : i + 2]
-        den = (x0 - x1) * (x0 - x2) * (x1 - x2)
-        a = (x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1)) / den
-        b = (x2 * x2 * (y0 - y1) + x1 * x1 * (y2 - y0) + x0 * x0 * (y1 - y2)) / den
-        if a < 0:
-            xm = -b / (2 * a)
-            if x0 <= xm <= x2:
-                c = y1 - a * x1 * x1 - b * x1
-                return float(xm), float(a * xm * xm + b * xm + c), i
-    return float(x[i]), float(y[i]), i
-
-
 @dataclass
 class FitResult:
     """Maximum-likelihood estimates, profile-likelihood intervals and fit diagnostics."""
@@ -378,6 +367,7 @@ class FitResult:
     notes: list[str] = field(default_factory=list)
     signed_estimates: dict[str, float] = field(default_factory=dict)  # scales not bounded at 0
     corrected_estimates: dict[str, float] = field(default_factory=dict)  # signed minus Cox-Snell bias
+    penalised_estimates: dict[str, float] = field(default_factory=dict)  # Jeffreys-penalised in (ln s, ln β)
 
     def as_dict(self) -> dict[str, Any]:
         return {
@@ -394,6 +384,7 @@ class FitResult:
             "notes": self.notes,
             "signed_estimates": self.signed_estimates,
             "corrected_estimates": self.corrected_estimates,
+            "penalised_estimates": self.penalised_estimates,
         }
 
 
@@ -413,6 +404,7 @@ def fit(
     beta_grid: NDArray[np.float64] | None = None,
     likelihood: Likelihood | None = None,
     intervals: bool = True,
+    penalised: bool = False,
 ) -> FitResult:
     """Maximum likelihood and profile-likelihood intervals of the free parameters.
 
@@ -421,6 +413,8 @@ def fit(
         fixed: parameters held fixed (``debris_scale``, ``meteoroid_scale``, ``beta``).
         confidence: interval level (0.9: 2 Δln L = 2.706).
         intervals: False skips the profile intervals (point estimates only, for simulation studies).
+        penalised: also the Jeffreys-penalised estimate (:mod:`abrupt.flux.firth`; a simulation-study
+            alternative, not a reported estimate: its β misses the 5 % bound at an acceptance truth).
     """
     fixed = dict(fixed or {})
     unknown = [k for k in fixed if k not in PARAMS]
@@ -445,6 +439,8 @@ def fit(
     notes: list[str] = []
     if "beta" not in fixed and intervals:
         bounds["beta"] = _beta_interval(logb, ll, ll_max - half, notes)
+    if "beta" not in fixed:
+        notes.append(IDENTIFIED_NOTE)
     # a β whose profile is below the interval's level cannot hold a boundary of a scale's interval
     near = lik
     if ll.size > 3:
@@ -459,6 +455,7 @@ def fit(
     expected["false_alarms"] = lik.bg_total
     signed = _signed_estimates(lik, scale_fixed) if data.n_events else dict(estimates)
     corrected = bias_corrected(lik, fixed, signed) if data.n_events else dict(estimates)
+    pen = penalised_estimates(lik, fixed, estimates) if penalised else {}
     return FitResult(
         estimates,
         bounds,
@@ -473,6 +470,7 @@ def fit(
         notes,
         signed,
         corrected,
+        pen,
     )
 
 

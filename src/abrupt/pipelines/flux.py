@@ -185,7 +185,13 @@ def infer_flux(
     notes = [
         "The |ΔH| spectrum constrains s_p·β^α_p (α_p the local slope of population p); β alone is "
         "bounded only through the spectrum's curvature, the two populations' different slopes and their "
-        "directions. The fit with the meteoroid scale fixed at Grün (a prior) measures β from the meteoroids."
+        "directions. The fit with the meteoroid scale fixed at Grün (a prior) measures β from the meteoroids.",
+        "With beta free the data identify each population's expected detections s_p·T_p(beta) (expected_events "
+        "of each fit), not s_p alone. In the simulation study of docs/flux-inference.md (10 Fermi-like "
+        "spacecraft-years, 8 truths, the prior fit) the ML expected debris detections have a mean within ±5 % "
+        "at 6 of 8 truths (−2.5 to +1.7 %; +6.0 ± 0.5 % and +4.0 ± 0.6 % at the smallest debris flux), while "
+        "the mean of the debris scale itself is +38 to +199 % high (median −1 to +7 %): quote the expected "
+        "detections or the median, or fix beta from independent data.",
     ]
     if data.rows_set_aside:
         notes.append(

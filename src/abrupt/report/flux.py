@@ -103,6 +103,12 @@ def fits_table(result: FluxInference) -> pd.DataFrame:
                     "fixed": p in f.fixed,
                 }
             )
+        if "beta" not in f.fixed:  # what a β-free fit identifies: each population's expected detections
+            for pop, v in f.expected_events.items():
+                if pop != "false_alarms":
+                    rows.append(
+                        {"fit": name, "parameter": f"expected {pop} detections s·T(β) (identified)", "estimate (ML)": v}
+                    )
     return pd.DataFrame(rows)
 
 
