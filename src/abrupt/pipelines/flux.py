@@ -187,11 +187,9 @@ def infer_flux(
         "bounded only through the spectrum's curvature, the two populations' different slopes and their "
         "directions. The fit with the meteoroid scale fixed at Grün (a prior) measures β from the meteoroids.",
         "With beta free the data identify each population's expected detections s_p·T_p(beta) (expected_events "
-        "of each fit), not s_p alone. In the simulation study of docs/flux-inference.md (10 Fermi-like "
-        "spacecraft-years, 8 truths, the prior fit) the ML expected debris detections have a mean within ±5 % "
-        "at 6 of 8 truths (−2.5 to +1.7 %; +6.0 ± 0.5 % and +4.0 ± 0.6 % at the smallest debris flux), while "
-        "the mean of the debris scale itself is +38 to +199 % high (median −1 to +7 %): quote the expected "
-        "detections or the median, or fix beta from independent data.",
+        "of each fit), not s_p alone: on 10 spacecraft-years the mean of the debris scale itself is biased high "
+        "(its median is not), while the expected detections are nearly unbiased; docs/flux-inference.md gives "
+        "the simulation study. Quote the expected detections or the median, or fix beta from independent data.",
     ]
     if data.rows_set_aside:
         notes.append(
