@@ -84,7 +84,7 @@ def test_simulate_population_then_flux_infer_end_to_end(tmp_path) -> None:
     # with β free the identified quantity (expected detections) is named in the output and the JSON
     assert r.output.count("identified with beta free") == len(result["fits"])
     assert any("identify s_p·T_p(beta)" in n for n in prior["notes"])
-    assert any("expected debris detections have a mean within" in n for n in result["notes"])
+    assert any("identify each population's expected detections" in n for n in result["notes"])
     assert "expected debris detections s·T(β) (identified)" in report.read_text()
     assert {g["model"] for g in result["goodness_of_fit"]} >= {"NASA-90/91 + Grün", "Grün only"}
     text = report.read_text()
