@@ -64,6 +64,7 @@ from abrupt.density.model_sampling import (
     shared_grid,
     window_model_density,
 )
+from abrupt.density.window_scan import FEW, FITTED, NUMPY, SMALL, scan_windows
 from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET
 from abrupt.detect.tle.detectors import detector_for
 from abrupt.errors import RepairLog
@@ -262,19 +263,18 @@ def drag_integrals(
     tau_all = frac_all * np.repeat(gaps, counts)  # s since the gap's first set
     pos = np.empty((tau_all.size, 3))
     vel = np.empty((tau_all.size, 3))
-    errors = np.zeros(tau_all.size, dtype=np.int64)
+    errors = np.zeros(tau_all.size, dtype=np.uint8)
+    gap_index = np.repeat(np.arange(max(n_sets - 1, 0)), counts)
+    jd_all = jd0[gap_index]
+    fr_all = jf0[gap_index] + tau_all / SECONDS_PER_DAY
     for g in range(n_sets - 1):
         sl = slice(offsets[g], offsets[g + 1])
-        tau_days = tau_all[sl] / SECONDS_PER_DAY
-        e, r, v = history.satrecs[g].sgp4_array(np.full(tau_days.size, jd0[g]), jf0[g] + tau_days)
-        pos[sl] = r
-        vel[sl] = v
-        errors[sl] = e
+        # ``sgp4_array`` without its copies: SGP4 writes each gap's states into the arrays' rows
+        history.satrecs[g]._sgp4(jd_all[sl], fr_all[sl], errors[sl], pos[sl], vel[sl])
     pos *= 1e3
     vel *= 1e3
     speed = np.linalg.norm(vel, axis=1)
     f_all = wind_factor(pos, vel)
-    gap_index = np.repeat(np.arange(max(n_sets - 1, 0)), counts)
     integrand = np.cbrt(n_bar[gap_index]) * speed**3 * f_all
     if np.any(errors != 0):
         integrand[errors != 0] = 0.0  # SGP4 failed (decayed record): no contribution
@@ -506,35 +506,42 @@ def _windows(
     bounds: list[tuple[int, int]] = []
     counts = {"straddle": 0, "few": 0, "negative": 0}
     kept_idx = np.flatnonzero(keep)
-    k_epochs = epochs[kept_idx]
     norad = history.norad_id  # a pandas lookup: once, not per window
     # np.mean where nothing is missing (the same sum as np.nanmean, without its copies)
     mean_alt = np.mean if np.all(np.isfinite(integ.altitude_km)) else np.nanmean
     mean_wf = np.mean if np.all(np.isfinite(integ.wind_factor)) else np.nanmean
-    for w in progress.track(range(max(n_windows, 0)), f"{label}: density windows", unit="window"):
-        b0 = origin + w * width
-        b1 = b0 + width
-        lo = int(np.searchsorted(k_epochs, b0, side="right")) - 1  # last set at or before b0
-        hi = int(np.searchsorted(k_epochs, b1, side="left"))  # first set at or after b1
-        lo = max(lo, 0)
-        hi = min(hi, kept_idx.size - 1)
-        if hi <= lo:
-            continue
-        idx = kept_idx[lo : hi + 1]
-        span0, span1 = epochs[idx[0]], epochs[idx[-1]]
-        if span1 <= b0 or span0 >= b1:
-            continue  # no data touching this window
-        overlap = (min(span1, b1) - max(span0, b0)) / width
-        if idx.size < cfg.min_sets or overlap < cfg.min_span_fraction:
-            counts["few"] += 1
-            continue
-        k_val, k_sig, straddles = _window_fit(x_all[idx], integ.n_rad_s[idx], segment_id[idx], sigma_n, cfg.min_sets)
-        counts["straddle"] += straddles
-        if k_val is None:
-            counts["few"] += 1
-            continue
+    # the bounding sets of every window and the fits of the usual few-set windows, compiled
+    code, first, last, k_vals, k_sigs, alts, wfs = scan_windows(
+        epochs[kept_idx].astype(np.int64),
+        int(origin.astype(np.int64)),
+        int(width.astype(np.int64)),
+        max(n_windows, 0),
+        x_all[kept_idx],
+        integ.n_rad_s[kept_idx],
+        np.asarray(segment_id)[kept_idx].astype(np.int64),
+        integ.altitude_km[kept_idx],
+        integ.wind_factor[kept_idx],
+        mean_alt is np.mean and mean_wf is np.mean,
+        sigma_n,
+        cfg.min_sets,
+        cfg.min_span_fraction,
+    )
+    counts["few"] += int(np.count_nonzero(code == FEW))
+    for w in progress.track(np.flatnonzero((code == FITTED) | (code == NUMPY)), f"{label}: density windows", "window"):
+        idx = kept_idx[first[w] : last[w] + 1]
+        if code[w] == FITTED:
+            k_val: float | None = float(k_vals[w])
+            k_sig = float(k_sigs[w])
+        else:
+            k_val, k_sig, straddles = _window_fit(
+                x_all[idx], integ.n_rad_s[idx], segment_id[idx], sigma_n, cfg.min_sets
+            )
+            counts["straddle"] += straddles
+            if k_val is None:
+                counts["few"] += 1
+                continue
         status = "ok"
-        if np.isfinite(k_sig) and k_val < -cfg.negative_sigma * k_sig:
+        if math.isfinite(k_sig) and k_val < -cfg.negative_sigma * k_sig:
             counts["negative"] += 1
             status = "negative decay"
         i0, i1 = idx[0], idx[-1]
@@ -544,9 +551,13 @@ def _windows(
             if integ.model_integral is not None and dw > 0
             else float("nan")
         )
-        alt = _mean(mean_alt, integ.altitude_km, idx)
-        wfac = _mean(mean_wf, integ.wind_factor, idx)
-        rows.append((label, norad, b0, b1, span0, span1, int(idx.size), k_val, k_sig, alt, wfac, model, status))
+        if code[w] == FITTED and math.isfinite(alts[w]):
+            alt, wfac = float(alts[w]), float(wfs[w])
+        else:
+            alt, wfac = _mean(mean_alt, integ.altitude_km, idx), _mean(mean_wf, integ.wind_factor, idx)
+        b0 = origin + w * width
+        row = (label, norad, b0, b0 + width, epochs[i0], epochs[i1], int(idx.size), k_val, k_sig, alt, wfac, model)
+        rows.append((*row, status))
         bounds.append((int(i0), int(i1)))
     return rows, counts, bounds
 
@@ -571,9 +582,6 @@ def sampled_model(integ: DragIntegrals, frame: pd.DataFrame, bounds: list[tuple[
         frame["model_density_kg_m3"] = window_model_density(cum_m, integ.weight_integral, i0, i1)
 
 
-SMALL = 8  # below this many values numpy sums in order, as Python's sum does (the same bits)
-
-
 def _mean(mean: Any, values: FloatArray, idx: Any) -> float:
     """``mean`` of ``values`` over ``idx[1:]`` (or the one value): in Python for the few sets of most
     windows (the same sum, without numpy's per-call cost; NaN-free inputs only)."""
@@ -585,32 +593,12 @@ def _mean(mean: Any, values: FloatArray, idx: Any) -> float:
     return float(mean(values[idx[1:]]))
 
 
-def _small_fit(x: FloatArray, y: FloatArray, sigma_n: float, min_sets: int) -> tuple[float | None, float, int]:
-    """:func:`_window_fit` of one segment of fewer than :data:`SMALL` sets, in Python floats."""
-    xs, ys = x.tolist(), y.tolist()
-    n = len(xs)
-    mx, my = sum(xs) / n, sum(ys) / n
-    xc = [v - mx for v in xs]
-    yc = [v - my for v in ys]
-    sxx = sum([v * v for v in xc])
-    if sxx <= 0 or n < min_sets:
-        return None, float("nan"), 0
-    k_val = sum([a * b for a, b in zip(xc, yc, strict=True)]) / sxx
-    k_sig = sigma_n / math.sqrt(sxx) if math.isfinite(sigma_n) else float("nan")
-    if n - 2 >= 2:
-        resid = [b - k_val * a for a, b in zip(xc, yc, strict=True)]
-        k_sig = max(k_sig, math.sqrt(sum([r * r for r in resid]) / (n - 2) / sxx))
-    return k_val, k_sig, 0
-
-
 def _window_fit(
     x: FloatArray, y: FloatArray, seg: Any, sigma_n: float, min_sets: int
 ) -> tuple[float | None, float, int]:
     """K and its standard error on one window: one n̄ offset per segment, one common K (with two sets
     in one segment this is the slide's formula); the third value is 1 when the window straddles a
     cut (a maneuver, an orbit rise or a long gap), else 0. K is None with too few sets."""
-    if 2 <= x.size < SMALL and seg[0] == seg[-1] and np.all(seg == seg[0]):
-        return _small_fit(x, y, sigma_n, min_sets)
     if x.size >= 2 and np.all(seg == seg[0]):  # most windows: one segment, no loop over segments
         xc, yc, used, n_seg, straddles = x - x.mean(), y - y.mean(), np.ones(x.size, dtype=bool), 1, 0
     else:
