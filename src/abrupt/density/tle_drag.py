@@ -408,13 +408,13 @@ def rho_b_from_history(
     sigma_n = robust_sigma(_noise_samples(integ, x_all, segment_id, keep))
     repairs.record("gaps with a rise of the orbit (undetected thrust) cut", thrust_cuts)
     repairs.record("element sets with bad fits rejected", int(np.sum(~keep)))
-    rows, counts, bounds = _windows(history, label, integ, x_all, epochs, segment_id, keep, sigma_n, cfg)
+    found, counts, bounds = _windows(history, label, integ, x_all, epochs, segment_id, keep, sigma_n, cfg)
     repairs.record(
         "windows holding a maneuver, orbit rise or gap (fitted with one offset per segment)", counts["straddle"]
     )
     repairs.record("windows with too few element sets or too short a span", counts["few"])
     repairs.record("windows with negative decay rejected", counts["negative"])
-    frame = pd.DataFrame(rows, columns=list(WINDOW_COLUMNS)) if rows else _empty_windows()
+    frame = found if found is not None else _empty_windows()
     if adaptive and integ.nodes is not None:
         integ.nodes.space_weather = sw
         sampled_model(integ, frame, bounds, cfg)
@@ -492,9 +492,9 @@ def _windows(
     keep: Any,
     sigma_n: float,
     cfg: TleDragConfig,
-) -> tuple[list[tuple[Any, ...]], dict[str, int], list[tuple[int, int]]]:
-    """The rows of :data:`WINDOW_COLUMNS` on a common UTC grid, the windows skipped, by reason, and the
-    first and last set of each row's window."""
+) -> tuple[pd.DataFrame | None, dict[str, int], list[tuple[int, int]]]:
+    """The windows (:data:`WINDOW_COLUMNS`, None without any) on a common UTC grid, the windows skipped,
+    by reason, and the first and last set of each row's window."""
     origin = (
         np.asarray([pd.Timestamp(cfg.origin_utc).to_datetime64()], dtype="datetime64[ns]")[0]
         if cfg.origin_utc
@@ -502,8 +502,6 @@ def _windows(
     )
     width = np.timedelta64(round(cfg.interval_days * SECONDS_PER_DAY * 1e9), "ns")
     n_windows = int(np.ceil((epochs[-1] - origin) / width)) + 1
-    rows: list[tuple[Any, ...]] = []
-    bounds: list[tuple[int, int]] = []
     counts = {"straddle": 0, "few": 0, "negative": 0}
     kept_idx = np.flatnonzero(keep)
     norad = history.norad_id  # a pandas lookup: once, not per window
@@ -526,40 +524,51 @@ def _windows(
         cfg.min_sets,
         cfg.min_span_fraction,
     )
-    counts["few"] += int(np.count_nonzero(code == FEW))
-    for w in progress.track(np.flatnonzero((code == FITTED) | (code == NUMPY)), f"{label}: density windows", "window"):
+    # the windows of many sets or straddling a cut: numpy's sums, as before
+    for w in progress.track(np.flatnonzero(code == NUMPY), f"{label}: density windows", "window"):
         idx = kept_idx[first[w] : last[w] + 1]
-        if code[w] == FITTED:
-            k_val: float | None = float(k_vals[w])
-            k_sig = float(k_sigs[w])
-        else:
-            k_val, k_sig, straddles = _window_fit(
-                x_all[idx], integ.n_rad_s[idx], segment_id[idx], sigma_n, cfg.min_sets
-            )
-            counts["straddle"] += straddles
-            if k_val is None:
-                counts["few"] += 1
-                continue
-        status = "ok"
-        if math.isfinite(k_sig) and k_val < -cfg.negative_sigma * k_sig:
-            counts["negative"] += 1
-            status = "negative decay"
-        i0, i1 = idx[0], idx[-1]
-        dw = integ.weight_integral[i1] - integ.weight_integral[i0]
-        model = (
-            float((integ.model_integral[i1] - integ.model_integral[i0]) / dw)
-            if integ.model_integral is not None and dw > 0
-            else float("nan")
-        )
-        if code[w] == FITTED and math.isfinite(alts[w]):
-            alt, wfac = float(alts[w]), float(wfs[w])
-        else:
-            alt, wfac = _mean(mean_alt, integ.altitude_km, idx), _mean(mean_wf, integ.wind_factor, idx)
-        b0 = origin + w * width
-        row = (label, norad, b0, b0 + width, epochs[i0], epochs[i1], int(idx.size), k_val, k_sig, alt, wfac, model)
-        rows.append((*row, status))
-        bounds.append((int(i0), int(i1)))
-    return rows, counts, bounds
+        y = integ.n_rad_s[idx]
+        k_val, k_sigs[w], straddles = _window_fit(x_all[idx], y, segment_id[idx], sigma_n, cfg.min_sets)
+        counts["straddle"] += straddles
+        if k_val is None:
+            code[w] = FEW
+            continue
+        k_vals[w] = k_val
+        alts[w], wfs[w] = _mean(mean_alt, integ.altitude_km, idx), _mean(mean_wf, integ.wind_factor, idx)
+    for w in np.flatnonzero((code == FITTED) & np.isnan(alts)):  # a value missing: numpy's nanmean
+        idx = kept_idx[first[w] : last[w] + 1]
+        alts[w], wfs[w] = _mean(mean_alt, integ.altitude_km, idx), _mean(mean_wf, integ.wind_factor, idx)
+    counts["few"] += int(np.count_nonzero(code == FEW))
+    ws = np.flatnonzero((code == FITTED) | (code == NUMPY))
+    if ws.size == 0:
+        return None, counts, []
+    i0, i1 = kept_idx[first[ws]], kept_idx[last[ws]]
+    k_val, k_sig = k_vals[ws], k_sigs[ws]
+    negative = np.isfinite(k_sig) & (k_val < -cfg.negative_sigma * k_sig)
+    counts["negative"] += int(np.count_nonzero(negative))
+    dw = integ.weight_integral[i1] - integ.weight_integral[i0]
+    model = np.full(ws.size, np.nan)
+    if integ.model_integral is not None:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            model = np.where(dw > 0, (integ.model_integral[i1] - integ.model_integral[i0]) / dw, np.nan)
+    b0 = origin + ws * width
+    columns = (
+        [label] * ws.size,
+        np.full(ws.size, norad, dtype=np.int64),
+        b0,
+        b0 + width,
+        epochs[i0],
+        epochs[i1],
+        last[ws] - first[ws] + 1,
+        k_val,
+        k_sig,
+        alts[ws],
+        wfs[ws],
+        model,
+        np.where(negative, "negative decay", "ok").tolist(),
+    )
+    frame = pd.DataFrame(dict(zip(WINDOW_COLUMNS, columns, strict=True)))
+    return frame, counts, list(zip(i0.tolist(), i1.tolist(), strict=True))
 
 
 def sampled_model(integ: DragIntegrals, frame: pd.DataFrame, bounds: list[tuple[int, int]], cfg: TleDragConfig) -> None:
