@@ -157,10 +157,11 @@ def _point(
     du: float,
     ix: Any,
     wx: Any,
+    wtb: Any,
 ) -> float:
     """log ρ at one point from ``table`` (slots × alt × 3 times × lat × lon: the values one point needs
     lie close together, and the next points of an orbit in the same slot need the same); ``t`` is the
-    point's time in its slot, 0..1; ``ix`` and ``wx`` (3 × 4) are work space."""
+    point's time in its slot, 0..1; ``ix``, ``wx`` and ``wtb`` (3 × 4) are work space."""
     n_alt, n_lat, n_lon = table.shape[1], table.shape[3], table.shape[4]
     slot_deg = 45.0  # [deg]
     wt = (2.0 * (t - 0.5) * (t - 1.0), -4.0 * t * (t - 1.0), 2.0 * t * (t - 0.5))
@@ -178,16 +179,18 @@ def _point(
             wx[k, a] = w[a]
             ii = i - 1 + a
             ix[k, a] = ii + n_lon if ii < 0 else (ii - n_lon if ii >= n_lon else ii)
+    for k in range(3):
+        for b in range(4):
+            wtb[k, b] = wt[k] * wy[b]
     total = 0.0
     for c in range(4):
         acc = 0.0
         for k in range(3):
+            i0, i1, i2, i3 = ix[k, 0], ix[k, 1], ix[k, 2], ix[k, 3]
+            w0, w1, w2, w3 = wx[k, 0], wx[k, 1], wx[k, 2], wx[k, 3]
             for b in range(4):
                 r = table[s, k0 + c, k, j0 + b]
-                row = 0.0
-                for a in range(4):
-                    row += wx[k, a] * r[ix[k, a]]
-                acc += wt[k] * wy[b] * row
+                acc += wtb[k, b] * ((((0.0 + w0 * r[i0]) + w1 * r[i1]) + w2 * r[i2]) + w3 * r[i3])
         total += wz[c] * acc
     return total
 
@@ -267,6 +270,7 @@ def _interpolate_times(
     day_ns = 86400 * 10**9
     ix = np.empty((3, 4), dtype=np.int64)
     wx = np.empty((3, 4))
+    wtb = np.empty((3, 4))
     for p in range(out.size):
         if not use[p]:
             continue
@@ -276,7 +280,7 @@ def _interpolate_times(
         tau = min(max((in_day - slot_in_day * SLOT_NS) / (SLOT_NS - 10**9), 0.0), 1.0)
         slot = (day - first_day) * SLOTS_PER_DAY + slot_in_day
         log_h = math.log(altitude_km[p] - offset_km)
-        out[p] = _point(table, slot, tau, lon_deg[p], lat_deg[p], log_h, lon_step, lat_step, u0, du, ix, wx)
+        out[p] = _point(table, slot, tau, lon_deg[p], lat_deg[p], log_h, lon_step, lat_step, u0, du, ix, wx, wtb)
 
 
 class MsisGrid:
