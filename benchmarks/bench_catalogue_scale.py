@@ -192,14 +192,16 @@ for label, cfg in (
     c = time.process_time()
     res = [rho_b_from_history(h, cfg, maneuvers=[], space_weather=sw) for h in hs]
     cpu = time.process_time() - c
-    pts = sum(r.integrals.model_points for r in res)
-    rho = np.concatenate([r.integrals.grid_rho_model for r in res])
-    weight = np.concatenate([r.integrals.grid_weight for r in res])
+    done = [r.integrals for r in res if r.integrals is not None]  # not the objects skipped: no drag signal
+    pts = sum(i.model_points for i in done)
+    rho = np.concatenate([i.grid_rho_model for i in done])
+    weight = np.concatenate([i.grid_weight for i in done])
     out[label] = (pd.concat([r.windows for r in res], ignore_index=True), cpu, pts, rho, weight)
 ref = out["every"][0]
 ok = (ref["status"] == "ok") & np.isfinite(ref["model_density_kg_m3"]) & (ref["rho_b_per_m"] != 0)
 rel = (ref["rho_b_sigma_per_m"] / ref["rho_b_per_m"].abs())[ok]
-print(f"objects {len(hs)} (the last {len(paths)} file(s) of the listing); windows {int(ok.sum())}; stated sigma_K/|K| "
+print(f"objects {len(hs)} (the last {len(paths)} file(s) of the listing; {len(hs) - len(done)} skipped: no drag "
+      f"signal); windows {int(ok.sum())}; stated sigma_K/|K| "
       f"median {rel.median():.3f}, 1st percentile {rel.quantile(0.01):.4f}")
 print(f"truth: NRLMSIS evaluated directly on every node, CPU {out['every'][1]:.2f} s, {out['every'][2]} points")
 for label in ("default", "auto", "grid"):

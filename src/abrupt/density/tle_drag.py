@@ -525,7 +525,7 @@ def _windows(
         cfg.min_span_fraction,
     )
     # the windows of many sets or straddling a cut: numpy's sums, as before
-    for w in progress.track(np.flatnonzero(code == NUMPY), f"{label}: density windows", "window"):
+    for w in progress.track(np.flatnonzero(code == NUMPY), f"{label}: density windows", unit="window"):
         idx = kept_idx[first[w] : last[w] + 1]
         y = integ.n_rad_s[idx]
         k_val, k_sigs[w], straddles = _window_fit(x_all[idx], y, segment_id[idx], sigma_n, cfg.min_sets)

@@ -87,8 +87,10 @@ def scan_windows(
     for w in range(n_windows):
         b0 = origin_ns + w * width_ns
         b1 = b0 + width_ns
-        lo = max(np.searchsorted(epochs_ns, b0, side="right") - 1, 0)
-        hi = min(np.searchsorted(epochs_ns, b1, side="left"), n_kept - 1)
+        lo = int(np.searchsorted(epochs_ns, b0, side="right")) - 1  # last set at or before b0
+        hi = int(np.searchsorted(epochs_ns, b1, side="left"))  # first set at or after b1
+        lo = lo if lo > 0 else 0
+        hi = hi if hi < n_kept - 1 else n_kept - 1
         if hi <= lo:
             continue
         span0, span1 = epochs_ns[lo], epochs_ns[hi]
