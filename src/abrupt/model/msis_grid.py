@@ -257,8 +257,7 @@ def _interpolate_times(
     use: Any,
     lon_deg: Any,
     lat_deg: Any,
-    altitude_km: Any,
-    offset_km: float,
+    log_h: Any,
     lon_step: float,
     lat_step: float,
     u0: float,
@@ -279,8 +278,7 @@ def _interpolate_times(
         slot_in_day = min(in_day // SLOT_NS, SLOTS_PER_DAY - 1)
         tau = min(max((in_day - slot_in_day * SLOT_NS) / (SLOT_NS - 10**9), 0.0), 1.0)
         slot = (day - first_day) * SLOTS_PER_DAY + slot_in_day
-        log_h = math.log(altitude_km[p] - offset_km)
-        out[p] = _point(table, slot, tau, lon_deg[p], lat_deg[p], log_h, lon_step, lat_step, u0, du, ix, wx, wtb)
+        out[p] = _point(table, slot, tau, lon_deg[p], lat_deg[p], log_h[p], lon_step, lat_step, u0, du, ix, wx, wtb)
 
 
 class MsisGrid:
@@ -433,6 +431,9 @@ class MsisGrid:
         first, last = span.astype("datetime64[D]")
         self.prepare(first, last)
         u0 = float(spec.altitude_coordinate(np.array([spec.min_altitude_km]))[0])
+        # ln(h − offset) by numpy, as the table's nodes (its log and the compiled one differ in the last bit)
+        log_h = np.zeros(t.size)
+        np.log(h - spec.altitude_offset_km, out=log_h, where=inside)
         log_rho = np.full(t.size, np.nan)
         y0, y1 = (int(str(d)[:4]) for d in (first, last))
         for year in range(y0, y1 + 1):
@@ -449,8 +450,7 @@ class MsisGrid:
                 use,
                 lon,
                 lat,
-                h,
-                spec.altitude_offset_km,
+                log_h,
                 spec.lon_step_deg,
                 spec.lat_step_deg,
                 u0,
