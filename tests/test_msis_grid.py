@@ -78,6 +78,7 @@ def test_density_at_teme_positions_equals_erfa_geodetic_then_the_grid(space_weat
     np.testing.assert_allclose(got, want, rtol=1e-12)
     assert np.all(np.isfinite(got) & (got > 0))
 
+
 def test_points_outside_the_altitude_range_are_evaluated_directly(space_weather) -> None:  # type: ignore[no-untyped-def]
     t = np.array(["2012-03-09T05:00", "2012-03-09T06:00", "2012-03-09T07:00"], dtype="datetime64[ns]")
     lat, lon, alt = np.array([10.0, -20.0, 30.0]), np.array([5.0, 100.0, -60.0]), np.array([70.0, 400.0, 50000.0])
