@@ -64,7 +64,7 @@ from abrupt.density.model_sampling import (
     shared_grid,
     window_model_density,
 )
-from abrupt.density.window_scan import FEW, FITTED, NUMPY, SMALL, scan_windows
+from abrupt.density.window_scan import FEW, FITTED, NUMPY, SMALL, node_speeds, scan_windows
 from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET
 from abrupt.detect.tle.detectors import detector_for
 from abrupt.errors import RepairLog
@@ -197,14 +197,12 @@ class RhoBResult:
 
 def wind_factor(position_m: FloatArray, velocity_mps: FloatArray) -> FloatArray:
     """F = |v_rel| (v_rel·v̂)/v² with v_rel = v − ω⊕ × r (co-rotating atmosphere; Picone et al. 2005)."""
-    r = np.asarray(position_m)
-    v = np.asarray(velocity_mps)
-    v_rel = v.copy()
-    v_rel[..., 0] += EARTH_ROTATION_RAD_S * r[..., 1]
-    v_rel[..., 1] -= EARTH_ROTATION_RAD_S * r[..., 0]
-    speed = np.linalg.norm(v, axis=-1)
-    rel = np.linalg.norm(v_rel, axis=-1)
-    return np.asarray(rel * np.sum(v_rel * v, axis=-1) / speed**3, dtype=np.float64)
+    r = np.asarray(position_m, dtype=np.float64)
+    v = np.asarray(velocity_mps, dtype=np.float64)
+    speed, _, rel, dot = node_speeds(
+        np.ascontiguousarray(r.reshape(-1, 3)), np.ascontiguousarray(v.reshape(-1, 3)), EARTH_ROTATION_RAD_S
+    )
+    return np.asarray(rel * dot / speed**3, dtype=np.float64).reshape(r.shape[:-1])
 
 
 def gap_node_counts(
@@ -273,9 +271,10 @@ def drag_integrals(
         history.satrecs[g]._sgp4(jd_all[sl], fr_all[sl], errors[sl], pos[sl], vel[sl])
     pos *= 1e3
     vel *= 1e3
-    speed = np.linalg.norm(vel, axis=1)
-    f_all = wind_factor(pos, vel)
-    integrand = np.cbrt(n_bar[gap_index]) * speed**3 * f_all
+    speed, radius, rel, dot = node_speeds(pos, vel, EARTH_ROTATION_RAD_S)  # wind_factor's terms, one pass
+    speed3 = speed**3
+    f_all = rel * dot / speed3
+    integrand = np.cbrt(n_bar[gap_index]) * speed3 * f_all
     if np.any(errors != 0):
         integrand[errors != 0] = 0.0  # SGP4 failed (decayed record): no contribution
     rho_all: FloatArray | None = None
@@ -290,7 +289,6 @@ def drag_integrals(
         rho_all, cum = nodes.integral(model_stride)
         if cum_m is not None:
             cum_m[1:] = cum
-    radius = np.linalg.norm(pos, axis=1)
     if n_sets > 1:
         # every gap's trapezoid sum and node means in one pass (sums in node order, not numpy's
         # pairwise order: the same values to ~1e-15 relative)

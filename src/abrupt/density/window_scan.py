@@ -116,3 +116,21 @@ def scan_windows(
             alt[w] = _ordered_mean(altitude_km, lo + 1, hi + 1)
             wf[w] = _ordered_mean(wind_factor, lo + 1, hi + 1)
     return code, first, last, k_val, k_sig, alt, wf
+
+
+@nb.njit(cache=True)
+def node_speeds(position_m: Any, velocity_mps: Any, omega_rad_s: float) -> tuple[Any, Any, Any, Any]:
+    """Per node (rows of n × 3 arrays): |v|, |r|, |v_rel| and v_rel·v with v_rel = v − ω⊕ × r (the
+    co-rotating atmosphere), each sum over the three components in order, as numpy's norms do."""
+    n = position_m.shape[0]
+    speed, radius, rel, dot = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    for p in range(n):
+        rx, ry, rz = position_m[p, 0], position_m[p, 1], position_m[p, 2]
+        vx, vy, vz = velocity_mps[p, 0], velocity_mps[p, 1], velocity_mps[p, 2]
+        wx = vx + omega_rad_s * ry
+        wy = vy - omega_rad_s * rx
+        speed[p] = math.sqrt(vx * vx + vy * vy + vz * vz)
+        radius[p] = math.sqrt(rx * rx + ry * ry + rz * rz)
+        rel[p] = math.sqrt(wx * wx + wy * wy + vz * vz)
+        dot[p] = wx * vx + wy * vy + vz * vz
+    return speed, radius, rel, dot
