@@ -192,14 +192,16 @@ for label, cfg in (
     c = time.process_time()
     res = [rho_b_from_history(h, cfg, maneuvers=[], space_weather=sw) for h in hs]
     cpu = time.process_time() - c
-    pts = sum(r.integrals.model_points for r in res)
-    rho = np.concatenate([r.integrals.grid_rho_model for r in res])
-    weight = np.concatenate([r.integrals.grid_weight for r in res])
+    done = [r.integrals for r in res if r.integrals is not None]  # not the objects skipped: no drag signal
+    pts = sum(i.model_points for i in done)
+    rho = np.concatenate([i.grid_rho_model for i in done])
+    weight = np.concatenate([i.grid_weight for i in done])
     out[label] = (pd.concat([r.windows for r in res], ignore_index=True), cpu, pts, rho, weight)
 ref = out["every"][0]
 ok = (ref["status"] == "ok") & np.isfinite(ref["model_density_kg_m3"]) & (ref["rho_b_per_m"] != 0)
 rel = (ref["rho_b_sigma_per_m"] / ref["rho_b_per_m"].abs())[ok]
-print(f"objects {len(hs)} (the last {len(paths)} file(s) of the listing); windows {int(ok.sum())}; stated sigma_K/|K| "
+print(f"objects {len(hs)} (the last {len(paths)} file(s) of the listing; {len(hs) - len(done)} skipped: no drag "
+      f"signal); windows {int(ok.sum())}; stated sigma_K/|K| "
       f"median {rel.median():.3f}, 1st percentile {rel.quantile(0.01):.4f}")
 print(f"truth: NRLMSIS evaluated directly on every node, CPU {out['every'][1]:.2f} s, {out['every'][2]} points")
 for label in ("default", "auto", "grid"):
@@ -217,6 +219,72 @@ for label in ("default", "auto", "grid"):
     print(f"  {label}: pointwise log-density error on {use.sum():,} nodes: rms {np.sqrt(np.mean(e**2)):.2e}, "
           f"mean {e.mean():+.1e}, 99th percentile |e| {np.quantile(np.abs(e), 0.99):.2e}, max {np.abs(e).max():.2e}")
 """
+
+
+PREVIOUS = """
+import sys, time
+import numpy as np, pandas as pd
+from pathlib import Path
+from abrupt.density.model_sampling import shared_grid
+from abrupt.density.tle_drag import TleDragConfig, rho_b_from_history
+from abrupt.events import read_events
+from abrupt.model.atmosphere import read_space_weather
+from abrupt.pipelines.catalogue import maneuver_times_by_object
+from abrupt.readers.omm import read_element_histories
+listing, n_files, cache, events, out = sys.argv[1:6]
+paths = [p for p in Path(listing).read_text().split()][-int(n_files):]
+sw = read_space_weather(None)
+cfg = TleDragConfig(with_model=True, model_grid=True, model_grid_cache=cache)
+shared_grid(sw, cache).prepare(np.datetime64("2012-01-01"), np.datetime64("2012-12-31"))
+man = maneuver_times_by_object(read_events(events))
+def run(files):
+    frames = []
+    for p in files:
+        for h in read_element_histories(p):
+            name = h.name or f"NORAD-{h.norad_id}"
+            frames.append(rho_b_from_history(h, cfg, maneuvers=man.get(name, []), space_weather=sw).windows)
+    return frames
+run(paths[:1])  # compiled kernels loaded, pages of the tables touched
+c = time.process_time()
+frames = run(paths)
+print(time.process_time() - c, len(frames))
+pd.to_pickle(frames, out)
+"""
+
+
+def density_previous(listing: Path, n_files: int, cache: Path, events: Path, baseline: Path) -> None:
+    """Same run, same objects, one process each: ρB windows with the grid (maneuvers given, tables read
+    from ``cache``) by the previous code (``baseline``, a src folder) and by this tree, alternately twice;
+    CPU per object of each, the ratio, and whether every window is identical (every column, every bit)."""
+    runs: dict[str, list[float]] = {"previous": [], "this": []}
+    frames: dict[str, list[pd.DataFrame]] = {}
+    n = 0
+    with tempfile.TemporaryDirectory() as tmp:
+        for _ in range(2):
+            for label, src in (("previous", baseline), ("this", SRC)):
+                out = Path(tmp) / f"{label}.pkl"
+                args = [str(listing), str(n_files), str(cache), str(events), str(out)]
+                env = {**os.environ, "PYTHONPATH": str(src)}
+                res = subprocess.run([sys.executable, "-c", PREVIOUS, *args], env=env, capture_output=True, text=True)
+                if res.returncode != 0:
+                    raise SystemExit(f"density previous-code reference failed ({src}):\n{res.stderr[-2000:]}")
+                cpu, n_text = res.stdout.split()
+                n = int(n_text)
+                runs[label].append(float(cpu) / n)
+                frames[label] = pd.read_pickle(out)
+    same = len(frames["this"]) == len(frames["previous"])
+    for a, b in zip(frames["this"], frames["previous"], strict=False):
+        try:
+            pd.testing.assert_frame_equal(a, b, check_exact=True)
+        except AssertionError:
+            same = False
+    this, prev = (np.array(runs[k]) * 1e3 for k in ("this", "previous"))
+    print(
+        f"\n[density previous] {n} objects (the last {n_files} file(s) of the listing), grid, maneuvers given, one "
+        f"process each, alternately: this tree {this[0]:.1f} / {this[1]:.1f} ms CPU an object, previous code "
+        f"({baseline}) {prev[0]:.1f} / {prev[1]:.1f}: ratio {this.sum() / prev.sum():.2f}; windows identical "
+        f"(every column, every bit): {'yes' if same else 'NO'}   ({load()})"
+    )
 
 
 def density_reference(listing: Path, n_files: int, tolerance: float, cache: Path) -> None:
@@ -389,6 +457,11 @@ def main() -> None:
         help="Density: pass --model-tolerance to `density tle` (NRLMSIS stride chosen per object).",
     )
     ap.add_argument("--density-reference-files", type=int, default=1, help="Files in the density reference.")
+    ap.add_argument(
+        "--density-baseline",
+        default=None,
+        help="src folder of earlier code: its ρB windows and CPU beside this tree's, same objects, one process.",
+    )
     args = ap.parse_args()
     parts = set(args.parts.split(","))
     folder = Path(args.folder or Path(tempfile.gettempdir()) / "abrupt-catalogue")
@@ -416,6 +489,9 @@ def main() -> None:
                 args.model_tolerance or 1.0,
                 folder / "msis-grid",
             )
+        if args.density_baseline:
+            listing = catalogue(folder, max(dns))
+            density_previous(listing, 2, folder / "msis-grid", events[max(dns)], Path(args.density_baseline))
     if "maneuvers" not in parts:
         return
     listing = catalogue(folder, max(ns))

@@ -18,7 +18,7 @@ from abrupt.cli.main import cli
 from abrupt.density import model_sampling
 from abrupt.density.drag_plausibility import lowest_perigee_km
 from abrupt.density.tle_drag import TleDragConfig, rho_b_from_history
-from abrupt.model.atmosphere import SpaceWeatherCoverageError, msis_density, read_space_weather
+from abrupt.model.atmosphere import SpaceWeatherCoverageError, msis_density, read_space_weather, teme_to_geodetic
 from abrupt.model.msis_grid import GridSpec, MsisGrid
 from abrupt.pipelines.catalogue import run_catalogue
 from abrupt.readers.omm import read_element_histories
@@ -56,6 +56,27 @@ def test_grid_reproduces_pymsis_pointwise(space_weather, points) -> None:  # typ
     coarse = MsisGrid(space_weather, GridSpec(lon_step_deg=45.0, lat_step_deg=30.0, log_altitude_step=0.3))
     err_coarse = np.log(coarse.density(t, lat, lon, alt)) - truth
     assert np.sqrt(np.mean(err_coarse**2)) > 3 * np.sqrt(np.mean(err**2))
+
+
+def test_density_at_teme_positions_equals_erfa_geodetic_then_the_grid(space_weather) -> None:  # type: ignore[no-untyped-def]
+    """The compiled TEME → geodetic pass against ERFA's gc2gd (the reference path, teme_to_geodetic):
+    LEO to GEO radii, both poles, points below and above the table (evaluated directly), two years."""
+    rng = np.random.default_rng(5)
+    n = 3000
+    t = np.datetime64("2012-12-31T06:00", "ns") + rng.integers(0, 2 * 86400 * 10**9, n).astype("timedelta64[ns]")
+    r = rng.normal(size=(n, 3))
+    r[:4, :2] = 0.0  # over the poles
+    r *= (rng.uniform(6.42e6, 4.3e7, n) / np.linalg.norm(r, axis=1))[:, None]
+    r[4] *= 6.40e6 / np.linalg.norm(r[4])  # below the table's lowest altitude
+    r[5] *= 5.8e7 / np.linalg.norm(r[5])  # above its highest
+    lat, lon, alt = teme_to_geodetic(t, r)
+    grid = MsisGrid(space_weather)
+    got = grid.density_teme(t, r)
+    want = MsisGrid(space_weather).density(t, lat, lon, alt)
+    outside = (alt < grid.spec.min_altitude_km) | (alt > grid.spec.max_altitude_km)
+    assert outside[4] and outside[5] and grid.direct_points == outside.sum()
+    np.testing.assert_allclose(got, want, rtol=1e-12)
+    assert np.all(np.isfinite(got) & (got > 0))
 
 
 def test_points_outside_the_altitude_range_are_evaluated_directly(space_weather) -> None:  # type: ignore[no-untyped-def]

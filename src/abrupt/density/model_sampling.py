@@ -120,13 +120,12 @@ class ModelNodes:
     def density(self, sample: NDArray[np.bool_]) -> FloatArray:
         """NRLMSIS at the sampled nodes (evaluating only those not evaluated before)."""
         new = sample & ~self.evaluated
-        if np.any(new):
+        if np.any(new) and self.grid is not None:
+            self.rho[new] = self.grid.density_teme(self.when[new], self.position_m[new])
+        elif np.any(new):
             lat, lon, h_km = teme_to_geodetic(self.when[new], self.position_m[new])
-            if self.grid is not None:
-                self.rho[new] = self.grid.density(self.when[new], lat, lon, h_km)
-            else:
-                self.rho[new] = np.asarray(msis_density(self.when[new], lat, lon, h_km, self.space_weather))
-            self.evaluated |= new
+            self.rho[new] = np.asarray(msis_density(self.when[new], lat, lon, h_km, self.space_weather))
+        self.evaluated |= new
         return self.rho[sample]
 
     def integral(self, stride: int) -> tuple[FloatArray, FloatArray]:

@@ -64,6 +64,7 @@ from abrupt.density.model_sampling import (
     shared_grid,
     window_model_density,
 )
+from abrupt.density.window_scan import FEW, FITTED, NUMPY, SMALL, node_speeds, scan_windows
 from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET
 from abrupt.detect.tle.detectors import detector_for
 from abrupt.errors import RepairLog
@@ -196,14 +197,12 @@ class RhoBResult:
 
 def wind_factor(position_m: FloatArray, velocity_mps: FloatArray) -> FloatArray:
     """F = |v_rel| (v_rel·v̂)/v² with v_rel = v − ω⊕ × r (co-rotating atmosphere; Picone et al. 2005)."""
-    r = np.asarray(position_m)
-    v = np.asarray(velocity_mps)
-    v_rel = v.copy()
-    v_rel[..., 0] += EARTH_ROTATION_RAD_S * r[..., 1]
-    v_rel[..., 1] -= EARTH_ROTATION_RAD_S * r[..., 0]
-    speed = np.linalg.norm(v, axis=-1)
-    rel = np.linalg.norm(v_rel, axis=-1)
-    return np.asarray(rel * np.sum(v_rel * v, axis=-1) / speed**3, dtype=np.float64)
+    r = np.asarray(position_m, dtype=np.float64)
+    v = np.asarray(velocity_mps, dtype=np.float64)
+    speed, _, rel, dot = node_speeds(
+        np.ascontiguousarray(r.reshape(-1, 3)), np.ascontiguousarray(v.reshape(-1, 3)), EARTH_ROTATION_RAD_S
+    )
+    return np.asarray(rel * dot / speed**3, dtype=np.float64).reshape(r.shape[:-1])
 
 
 def gap_node_counts(
@@ -262,20 +261,20 @@ def drag_integrals(
     tau_all = frac_all * np.repeat(gaps, counts)  # s since the gap's first set
     pos = np.empty((tau_all.size, 3))
     vel = np.empty((tau_all.size, 3))
-    errors = np.zeros(tau_all.size, dtype=np.int64)
+    errors = np.zeros(tau_all.size, dtype=np.uint8)
+    gap_index = np.repeat(np.arange(max(n_sets - 1, 0)), counts)
+    jd_all = jd0[gap_index]
+    fr_all = jf0[gap_index] + tau_all / SECONDS_PER_DAY
     for g in range(n_sets - 1):
         sl = slice(offsets[g], offsets[g + 1])
-        tau_days = tau_all[sl] / SECONDS_PER_DAY
-        e, r, v = history.satrecs[g].sgp4_array(np.full(tau_days.size, jd0[g]), jf0[g] + tau_days)
-        pos[sl] = r
-        vel[sl] = v
-        errors[sl] = e
+        # ``sgp4_array`` without its copies: SGP4 writes each gap's states into the arrays' rows
+        history.satrecs[g]._sgp4(jd_all[sl], fr_all[sl], errors[sl], pos[sl], vel[sl])
     pos *= 1e3
     vel *= 1e3
-    speed = np.linalg.norm(vel, axis=1)
-    f_all = wind_factor(pos, vel)
-    gap_index = np.repeat(np.arange(max(n_sets - 1, 0)), counts)
-    integrand = np.cbrt(n_bar[gap_index]) * speed**3 * f_all
+    speed, radius, rel, dot = node_speeds(pos, vel, EARTH_ROTATION_RAD_S)  # wind_factor's terms, one pass
+    speed3 = speed**3
+    f_all = rel * dot / speed3
+    integrand = np.cbrt(n_bar[gap_index]) * speed3 * f_all
     if np.any(errors != 0):
         integrand[errors != 0] = 0.0  # SGP4 failed (decayed record): no contribution
     rho_all: FloatArray | None = None
@@ -290,7 +289,6 @@ def drag_integrals(
         rho_all, cum = nodes.integral(model_stride)
         if cum_m is not None:
             cum_m[1:] = cum
-    radius = np.linalg.norm(pos, axis=1)
     if n_sets > 1:
         # every gap's trapezoid sum and node means in one pass (sums in node order, not numpy's
         # pairwise order: the same values to ~1e-15 relative)
@@ -408,13 +406,13 @@ def rho_b_from_history(
     sigma_n = robust_sigma(_noise_samples(integ, x_all, segment_id, keep))
     repairs.record("gaps with a rise of the orbit (undetected thrust) cut", thrust_cuts)
     repairs.record("element sets with bad fits rejected", int(np.sum(~keep)))
-    rows, counts, bounds = _windows(history, label, integ, x_all, epochs, segment_id, keep, sigma_n, cfg)
+    found, counts, bounds = _windows(history, label, integ, x_all, epochs, segment_id, keep, sigma_n, cfg)
     repairs.record(
         "windows holding a maneuver, orbit rise or gap (fitted with one offset per segment)", counts["straddle"]
     )
     repairs.record("windows with too few element sets or too short a span", counts["few"])
     repairs.record("windows with negative decay rejected", counts["negative"])
-    frame = pd.DataFrame(rows, columns=list(WINDOW_COLUMNS)) if rows else _empty_windows()
+    frame = found if found is not None else _empty_windows()
     if adaptive and integ.nodes is not None:
         integ.nodes.space_weather = sw
         sampled_model(integ, frame, bounds, cfg)
@@ -492,9 +490,9 @@ def _windows(
     keep: Any,
     sigma_n: float,
     cfg: TleDragConfig,
-) -> tuple[list[tuple[Any, ...]], dict[str, int], list[tuple[int, int]]]:
-    """The rows of :data:`WINDOW_COLUMNS` on a common UTC grid, the windows skipped, by reason, and the
-    first and last set of each row's window."""
+) -> tuple[pd.DataFrame | None, dict[str, int], list[tuple[int, int]]]:
+    """The windows (:data:`WINDOW_COLUMNS`, None without any) on a common UTC grid, the windows skipped,
+    by reason, and the first and last set of each row's window."""
     origin = (
         np.asarray([pd.Timestamp(cfg.origin_utc).to_datetime64()], dtype="datetime64[ns]")[0]
         if cfg.origin_utc
@@ -502,53 +500,73 @@ def _windows(
     )
     width = np.timedelta64(round(cfg.interval_days * SECONDS_PER_DAY * 1e9), "ns")
     n_windows = int(np.ceil((epochs[-1] - origin) / width)) + 1
-    rows: list[tuple[Any, ...]] = []
-    bounds: list[tuple[int, int]] = []
     counts = {"straddle": 0, "few": 0, "negative": 0}
     kept_idx = np.flatnonzero(keep)
-    k_epochs = epochs[kept_idx]
     norad = history.norad_id  # a pandas lookup: once, not per window
     # np.mean where nothing is missing (the same sum as np.nanmean, without its copies)
     mean_alt = np.mean if np.all(np.isfinite(integ.altitude_km)) else np.nanmean
     mean_wf = np.mean if np.all(np.isfinite(integ.wind_factor)) else np.nanmean
-    for w in progress.track(range(max(n_windows, 0)), f"{label}: density windows", unit="window"):
-        b0 = origin + w * width
-        b1 = b0 + width
-        lo = int(np.searchsorted(k_epochs, b0, side="right")) - 1  # last set at or before b0
-        hi = int(np.searchsorted(k_epochs, b1, side="left"))  # first set at or after b1
-        lo = max(lo, 0)
-        hi = min(hi, kept_idx.size - 1)
-        if hi <= lo:
-            continue
-        idx = kept_idx[lo : hi + 1]
-        span0, span1 = epochs[idx[0]], epochs[idx[-1]]
-        if span1 <= b0 or span0 >= b1:
-            continue  # no data touching this window
-        overlap = (min(span1, b1) - max(span0, b0)) / width
-        if idx.size < cfg.min_sets or overlap < cfg.min_span_fraction:
-            counts["few"] += 1
-            continue
-        k_val, k_sig, straddles = _window_fit(x_all[idx], integ.n_rad_s[idx], segment_id[idx], sigma_n, cfg.min_sets)
+    # the bounding sets of every window and the fits of the usual few-set windows, compiled
+    code, first, last, k_vals, k_sigs, alts, wfs = scan_windows(
+        epochs[kept_idx].astype(np.int64),
+        int(origin.astype(np.int64)),
+        int(width.astype(np.int64)),
+        max(n_windows, 0),
+        x_all[kept_idx],
+        integ.n_rad_s[kept_idx],
+        np.asarray(segment_id)[kept_idx].astype(np.int64),
+        integ.altitude_km[kept_idx],
+        integ.wind_factor[kept_idx],
+        mean_alt is np.mean and mean_wf is np.mean,
+        sigma_n,
+        cfg.min_sets,
+        cfg.min_span_fraction,
+    )
+    # the windows of many sets or straddling a cut: numpy's sums, as before
+    for w in progress.track(np.flatnonzero(code == NUMPY), f"{label}: density windows", unit="window"):
+        idx = kept_idx[first[w] : last[w] + 1]
+        y = integ.n_rad_s[idx]
+        k_val, k_sigs[w], straddles = _window_fit(x_all[idx], y, segment_id[idx], sigma_n, cfg.min_sets)
         counts["straddle"] += straddles
         if k_val is None:
-            counts["few"] += 1
+            code[w] = FEW
             continue
-        status = "ok"
-        if np.isfinite(k_sig) and k_val < -cfg.negative_sigma * k_sig:
-            counts["negative"] += 1
-            status = "negative decay"
-        i0, i1 = idx[0], idx[-1]
-        dw = integ.weight_integral[i1] - integ.weight_integral[i0]
-        model = (
-            float((integ.model_integral[i1] - integ.model_integral[i0]) / dw)
-            if integ.model_integral is not None and dw > 0
-            else float("nan")
-        )
-        alt = _mean(mean_alt, integ.altitude_km, idx)
-        wfac = _mean(mean_wf, integ.wind_factor, idx)
-        rows.append((label, norad, b0, b1, span0, span1, int(idx.size), k_val, k_sig, alt, wfac, model, status))
-        bounds.append((int(i0), int(i1)))
-    return rows, counts, bounds
+        k_vals[w] = k_val
+        alts[w], wfs[w] = _mean(mean_alt, integ.altitude_km, idx), _mean(mean_wf, integ.wind_factor, idx)
+    for w in np.flatnonzero((code == FITTED) & np.isnan(alts)):  # a value missing: numpy's nanmean
+        idx = kept_idx[first[w] : last[w] + 1]
+        alts[w], wfs[w] = _mean(mean_alt, integ.altitude_km, idx), _mean(mean_wf, integ.wind_factor, idx)
+    counts["few"] += int(np.count_nonzero(code == FEW))
+    ws = np.flatnonzero((code == FITTED) | (code == NUMPY))
+    if ws.size == 0:
+        return None, counts, []
+    i0, i1 = kept_idx[first[ws]], kept_idx[last[ws]]
+    k_val, k_sig = k_vals[ws], k_sigs[ws]
+    negative = np.isfinite(k_sig) & (k_val < -cfg.negative_sigma * k_sig)
+    counts["negative"] += int(np.count_nonzero(negative))
+    dw = integ.weight_integral[i1] - integ.weight_integral[i0]
+    model = np.full(ws.size, np.nan)
+    if integ.model_integral is not None:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            model = np.where(dw > 0, (integ.model_integral[i1] - integ.model_integral[i0]) / dw, np.nan)
+    b0 = origin + ws * width
+    columns = (
+        [label] * ws.size,
+        np.full(ws.size, norad, dtype=np.int64),
+        b0,
+        b0 + width,
+        epochs[i0],
+        epochs[i1],
+        last[ws] - first[ws] + 1,
+        k_val,
+        k_sig,
+        alts[ws],
+        wfs[ws],
+        model,
+        np.where(negative, "negative decay", "ok").tolist(),
+    )
+    frame = pd.DataFrame(dict(zip(WINDOW_COLUMNS, columns, strict=True)))
+    return frame, counts, list(zip(i0.tolist(), i1.tolist(), strict=True))
 
 
 def sampled_model(integ: DragIntegrals, frame: pd.DataFrame, bounds: list[tuple[int, int]], cfg: TleDragConfig) -> None:
@@ -571,9 +589,6 @@ def sampled_model(integ: DragIntegrals, frame: pd.DataFrame, bounds: list[tuple[
         frame["model_density_kg_m3"] = window_model_density(cum_m, integ.weight_integral, i0, i1)
 
 
-SMALL = 8  # below this many values numpy sums in order, as Python's sum does (the same bits)
-
-
 def _mean(mean: Any, values: FloatArray, idx: Any) -> float:
     """``mean`` of ``values`` over ``idx[1:]`` (or the one value): in Python for the few sets of most
     windows (the same sum, without numpy's per-call cost; NaN-free inputs only)."""
@@ -585,32 +600,12 @@ def _mean(mean: Any, values: FloatArray, idx: Any) -> float:
     return float(mean(values[idx[1:]]))
 
 
-def _small_fit(x: FloatArray, y: FloatArray, sigma_n: float, min_sets: int) -> tuple[float | None, float, int]:
-    """:func:`_window_fit` of one segment of fewer than :data:`SMALL` sets, in Python floats."""
-    xs, ys = x.tolist(), y.tolist()
-    n = len(xs)
-    mx, my = sum(xs) / n, sum(ys) / n
-    xc = [v - mx for v in xs]
-    yc = [v - my for v in ys]
-    sxx = sum([v * v for v in xc])
-    if sxx <= 0 or n < min_sets:
-        return None, float("nan"), 0
-    k_val = sum([a * b for a, b in zip(xc, yc, strict=True)]) / sxx
-    k_sig = sigma_n / math.sqrt(sxx) if math.isfinite(sigma_n) else float("nan")
-    if n - 2 >= 2:
-        resid = [b - k_val * a for a, b in zip(xc, yc, strict=True)]
-        k_sig = max(k_sig, math.sqrt(sum([r * r for r in resid]) / (n - 2) / sxx))
-    return k_val, k_sig, 0
-
-
 def _window_fit(
     x: FloatArray, y: FloatArray, seg: Any, sigma_n: float, min_sets: int
 ) -> tuple[float | None, float, int]:
     """K and its standard error on one window: one n̄ offset per segment, one common K (with two sets
     in one segment this is the slide's formula); the third value is 1 when the window straddles a
     cut (a maneuver, an orbit rise or a long gap), else 0. K is None with too few sets."""
-    if 2 <= x.size < SMALL and seg[0] == seg[-1] and np.all(seg == seg[0]):
-        return _small_fit(x, y, sigma_n, min_sets)
     if x.size >= 2 and np.all(seg == seg[0]):  # most windows: one segment, no loop over segments
         xc, yc, used, n_seg, straddles = x - x.mean(), y - y.mean(), np.ones(x.size, dtype=bool), 1, 0
     else:

@@ -327,6 +327,14 @@ def msis_density(
     return rho, temperature, molar_mass
 
 
+def gmst_cos_sin(times_utc: NDArray[np.datetime64]) -> tuple[FloatArray, FloatArray]:
+    """cos and sin of the GMST 1982 angle at UTC times (UT1 ≈ UTC): the TEME → pseudo-Earth-fixed rotation."""
+    t = np.asarray(times_utc, dtype="datetime64[ns]")
+    jd = t.astype(np.int64) * 1e-9 / SECONDS_PER_DAY
+    gmst = erfa.gmst82(2440587.5, jd)
+    return np.cos(gmst), np.sin(gmst)
+
+
 def teme_to_geodetic(times_utc: NDArray[np.datetime64], position_teme_m: FloatArray) -> tuple[FloatArray, ...]:
     """Geodetic latitude (deg), longitude (deg) and altitude (km, WGS-84) of TEME positions (m).
 
@@ -334,10 +342,7 @@ def teme_to_geodetic(times_utc: NDArray[np.datetime64], position_teme_m: FloatAr
     UT1 ≈ UTC and no polar motion: errors of < 1 km on the ground, irrelevant for density.
     """
 
-    t = np.asarray(times_utc, dtype="datetime64[ns]")
-    jd = t.astype(np.int64) * 1e-9 / SECONDS_PER_DAY
-    gmst = erfa.gmst82(2440587.5, jd)
-    c, s = np.cos(gmst), np.sin(gmst)
+    c, s = gmst_cos_sin(times_utc)
     r = np.asarray(position_teme_m, dtype=float)
     x = c * r[:, 0] + s * r[:, 1]
     y = -s * r[:, 0] + c * r[:, 1]

@@ -30,6 +30,7 @@ per calendar year of which only the days built are touched) and, with ``cache_di
 from __future__ import annotations
 
 import hashlib
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,7 +41,7 @@ import numpy as np
 import pymsis
 from numpy.typing import NDArray
 
-from abrupt.model.atmosphere import MSIS_VERSION, SpaceWeather, msis_density
+from abrupt.model.atmosphere import MSIS_VERSION, SpaceWeather, gmst_cos_sin, msis_density
 from abrupt.types import FloatArray
 
 SLOT_NS = 3 * 3600 * 10**9  # one 3-hourly ap slot [ns]
@@ -142,11 +143,118 @@ def _stencil(pos: float, n: int) -> tuple[int, float]:
     return first, pos - (first + 1)
 
 
-@nb.njit(cache=True)
-def _interpolate(
+@nb.njit(cache=True, inline="always")
+def _point(
     table: Any,
-    slot: Any,
-    tau: Any,
+    s: int,
+    t: float,
+    lon_deg: float,
+    lat_deg: float,
+    log_h: float,
+    lon_step: float,
+    lat_step: float,
+    u0: float,
+    du: float,
+    ix: Any,
+    wx: Any,
+    wtb: Any,
+) -> float:
+    """log ρ at one point from ``table`` (slots × alt × 3 times × lat × lon: the values one point needs
+    lie close together, and the next points of an orbit in the same slot need the same); ``t`` is the
+    point's time in its slot, 0..1; ``ix``, ``wx`` and ``wtb`` (3 × 4) are work space."""
+    n_alt, n_lat, n_lon = table.shape[1], table.shape[3], table.shape[4]
+    slot_deg = 45.0  # [deg]
+    wt = (2.0 * (t - 0.5) * (t - 1.0), -4.0 * t * (t - 1.0), 2.0 * t * (t - 0.5))
+    j0, y = _stencil((lat_deg + 90.0) / lat_step, n_lat)
+    wy = _cubic_weights(y)
+    k0, z = _stencil((log_h - u0) / du, n_alt)
+    wz = _cubic_weights(z)
+    # the Sun's longitude moves by slot_deg over the slot: at table time k the point's local solar
+    # time is found at lon + slot_deg (t − k/2); the four longitudes of each k, wrapped, once
+    for k in range(3):
+        pos = ((lon_deg + slot_deg * (t - 0.5 * k)) % 360.0) / lon_step
+        i = int(pos)
+        w = _cubic_weights(pos - i)
+        for a in range(4):
+            wx[k, a] = w[a]
+            ii = i - 1 + a
+            ix[k, a] = ii + n_lon if ii < 0 else (ii - n_lon if ii >= n_lon else ii)
+    for k in range(3):
+        for b in range(4):
+            wtb[k, b] = wt[k] * wy[b]
+    total = 0.0
+    for c in range(4):
+        acc = 0.0
+        for k in range(3):
+            i0, i1, i2, i3 = ix[k, 0], ix[k, 1], ix[k, 2], ix[k, 3]
+            w0, w1, w2, w3 = wx[k, 0], wx[k, 1], wx[k, 2], wx[k, 3]
+            for b in range(4):
+                r = table[s, k0 + c, k, j0 + b]
+                acc += wtb[k, b] * ((((0.0 + w0 * r[i0]) + w1 * r[i1]) + w2 * r[i2]) + w3 * r[i3])
+        total += wz[c] * acc
+    return total
+
+
+@nb.njit(cache=True)
+def _geodetic(cos_gmst: Any, sin_gmst: Any, position_m: Any, lat_deg: Any, lon_deg: Any, altitude_km: Any) -> None:
+    """TEME positions (m) rotated by GMST to geodetic latitude, longitude (deg) and altitude (km) on
+    WGS-84: :func:`abrupt.model.atmosphere.teme_to_geodetic` point by point, with ERFA's ``gc2gde``
+    (Fukushima 2006, one Newton-Halley step) written out."""
+    a = 6378137.0  # [m]
+    f = 1.0 / 298.257223563
+    aeps2 = a * a * 1e-32
+    e2 = (2.0 - f) * f
+    e4t = e2 * e2 * 1.5
+    ec2 = 1.0 - e2
+    ec = math.sqrt(ec2)
+    b_axis = a * ec
+    rad2deg = 180.0 / math.pi
+    for p in range(lat_deg.size):
+        c, s = cos_gmst[p], sin_gmst[p]
+        x = c * position_m[p, 0] + s * position_m[p, 1]
+        y = -s * position_m[p, 0] + c * position_m[p, 1]
+        z = position_m[p, 2]
+        p2 = x * x + y * y
+        elong = math.atan2(y, x) if p2 > 0.0 else 0.0
+        absz = abs(z)
+        if p2 > aeps2:
+            pp = math.sqrt(p2)
+            s0 = absz / a
+            pn = pp / a
+            zc = ec * s0
+            c0 = ec * pn
+            c02 = c0 * c0
+            c03 = c02 * c0
+            s02 = s0 * s0
+            s03 = s02 * s0
+            a02 = c02 + s02
+            a0 = math.sqrt(a02)
+            a03 = a02 * a0
+            d0 = zc * a03 + e2 * s03
+            f0 = pn * a03 - e2 * c03
+            b0 = e4t * s02 * c02 * pn * (a0 - ec)
+            s1 = d0 * f0 - b0 * s0
+            cc = ec * (f0 * f0 - b0 * c0)
+            phi = math.atan(s1 / cc)
+            s12 = s1 * s1
+            cc2 = cc * cc
+            height = (pp * cc + absz * s1 - a * math.sqrt(ec2 * s12 + cc2)) / math.sqrt(s12 + cc2)
+        else:
+            phi = math.pi / 2.0
+            height = absz - b_axis
+        if z < 0:
+            phi = -phi
+        lat_deg[p] = phi * rad2deg
+        lon_deg[p] = elong * rad2deg
+        altitude_km[p] = height * 1e-3
+
+
+@nb.njit(cache=True)
+def _interpolate_times(
+    table: Any,
+    ns: Any,
+    first_day: int,
+    use: Any,
     lon_deg: Any,
     lat_deg: Any,
     log_h: Any,
@@ -156,42 +264,21 @@ def _interpolate(
     du: float,
     out: Any,
 ) -> None:
-    """log ρ at each point from ``table`` (slots × alt × 3 times × lat × lon: the values one point needs
-    lie close together, and the next points of an orbit in the same slot need the same); ``tau`` is the
-    point's time in its slot, 0..1."""
-    n_alt, n_lat, n_lon = table.shape[1], table.shape[3], table.shape[4]
-    slot_deg = 45.0  # [deg]
-    ix = np.empty(3, dtype=np.int64)
+    """log ρ at the points ``use`` of times ``ns`` (ns since 1970) from the tables of the year whose
+    first day (days since 1970) is ``first_day`` (:meth:`MsisGrid.density` in one pass)."""
+    day_ns = 86400 * 10**9
+    ix = np.empty((3, 4), dtype=np.int64)
     wx = np.empty((3, 4))
+    wtb = np.empty((3, 4))
     for p in range(out.size):
-        s = slot[p]
-        t = tau[p]
-        wt = (2.0 * (t - 0.5) * (t - 1.0), -4.0 * t * (t - 1.0), 2.0 * t * (t - 0.5))
-        j0, y = _stencil((lat_deg[p] + 90.0) / lat_step, n_lat)
-        wy = _cubic_weights(y)
-        k0, z = _stencil((log_h[p] - u0) / du, n_alt)
-        wz = _cubic_weights(z)
-        # the Sun's longitude moves by slot_deg over the slot: at table time k the point's local solar
-        # time is found at lon + slot_deg (t − k/2)
-        for k in range(3):
-            pos = ((lon_deg[p] + slot_deg * (t - 0.5 * k)) % 360.0) / lon_step
-            ix[k] = int(pos)
-            w = _cubic_weights(pos - ix[k])
-            for a in range(4):
-                wx[k, a] = w[a]
-        total = 0.0
-        for c in range(4):
-            acc = 0.0
-            for k in range(3):
-                for b in range(4):
-                    row = 0.0
-                    for a in range(4):
-                        ii = ix[k] - 1 + a
-                        ii = ii + n_lon if ii < 0 else (ii - n_lon if ii >= n_lon else ii)
-                        row += wx[k, a] * table[s, k0 + c, k, j0 + b, ii]
-                    acc += wt[k] * wy[b] * row
-            total += wz[c] * acc
-        out[p] = total
+        if not use[p]:
+            continue
+        day = ns[p] // day_ns
+        in_day = ns[p] - day * day_ns
+        slot_in_day = min(in_day // SLOT_NS, SLOTS_PER_DAY - 1)
+        tau = min(max((in_day - slot_in_day * SLOT_NS) / (SLOT_NS - 10**9), 0.0), 1.0)
+        slot = (day - first_day) * SLOTS_PER_DAY + slot_in_day
+        out[p] = _point(table, slot, tau, lon_deg[p], lat_deg[p], log_h[p], lon_step, lat_step, u0, du, ix, wx, wtb)
 
 
 class MsisGrid:
@@ -254,6 +341,8 @@ class MsisGrid:
         each day is claimed by one process (a marker file); days claimed by another are read once it
         has written them, or built here at the end if it has not (a killed run)."""
         days = np.arange(np.datetime64(first, "D"), np.datetime64(last, "D") + np.timedelta64(1, "D"))
+        if self._all_filled(days):
+            return
         todo = []
         for day in days:
             year = int(str(day)[:4])
@@ -277,6 +366,21 @@ class MsisGrid:
                     continue
                 filled[k] = True
 
+    def _all_filled(self, days: NDArray[np.datetime64]) -> bool:
+        """Whether the tables of every day of ``days`` (consecutive) are in memory already."""
+        if days.size == 0:
+            return True
+        years = days.astype("datetime64[Y]")
+        for year in np.unique(years):
+            y = int(year.astype(np.int64)) + 1970
+            if y not in self.years:
+                return False
+            start = int((days[years == year][0] - year.astype("datetime64[D]")).astype(np.int64))
+            n = int(np.count_nonzero(years == year))
+            if not self.years[y][1][start : start + n].all():
+                return False
+        return True
+
     @property
     def nbytes(self) -> int:
         """Memory of the tables built or read so far."""
@@ -290,55 +394,68 @@ class MsisGrid:
         altitude_km: FloatArray,
     ) -> FloatArray:
         """NRLMSIS 2.1 mass density (kg/m³) at each point, as :func:`abrupt.model.atmosphere.msis_density`."""
+        return self._density(
+            np.asarray(times_utc, dtype="datetime64[ns]"),
+            np.ascontiguousarray(latitude_deg, dtype=np.float64),
+            np.ascontiguousarray(longitude_deg, dtype=np.float64),
+            np.ascontiguousarray(altitude_km, dtype=np.float64),
+        )
+
+    def density_teme(self, times_utc: NDArray[np.datetime64], position_teme_m: FloatArray) -> FloatArray:
+        """:meth:`density` at TEME positions (m): :func:`abrupt.model.atmosphere.teme_to_geodetic` and
+        the interpolation in compiled loops over the points, without the intermediate arrays."""
         t = np.asarray(times_utc, dtype="datetime64[ns]")
-        h = np.asarray(altitude_km, dtype=np.float64)
+        lat, lon, h = np.empty(t.size), np.empty(t.size), np.empty(t.size)
+        if t.size:
+            c, s = gmst_cos_sin(t)
+            _geodetic(c, s, np.ascontiguousarray(position_teme_m, dtype=np.float64), lat, lon, h)
+        return self._density(t, lat, lon, h)
+
+    def _density(self, t: NDArray[np.datetime64], lat: FloatArray, lon: FloatArray, h: FloatArray) -> FloatArray:
         out = np.full(t.size, np.nan)
         if t.size == 0:
             return out
-        ok = np.isfinite(h) & np.isfinite(latitude_deg) & np.isfinite(longitude_deg)
-        inside = ok & (h >= self.spec.min_altitude_km) & (h <= self.spec.max_altitude_km)
+        spec = self.spec
+        ok = np.isfinite(h) & np.isfinite(lat) & np.isfinite(lon)
+        inside = ok & (h >= spec.min_altitude_km) & (h <= spec.max_altitude_km)
         outside = ok & ~inside
         if np.any(outside):
             self.direct_points += int(outside.sum())
-            out[outside] = np.asarray(
-                msis_density(t[outside], latitude_deg[outside], longitude_deg[outside], h[outside], self.space_weather)
-            )
+            sw = self.space_weather
+            out[outside] = np.asarray(msis_density(t[outside], lat[outside], lon[outside], h[outside], sw))
         if not np.any(inside):
             return out
-        spec = self.spec
-        ti = t[inside]
-        days = ti.astype("datetime64[D]")
-        self.space_weather.msis_drivers(np.array([ti.min(), ti.max()]))  # an error naming the table's span
-        self.prepare(days.min(), days.max())
-        ns = (ti - days.astype("datetime64[ns]")).astype(np.int64)
-        slot_in_day = np.minimum(ns // SLOT_NS, SLOTS_PER_DAY - 1)
-        tau = np.clip((ns - slot_in_day * SLOT_NS) / (SLOT_NS - 10**9), 0.0, 1.0)
-        year = days.astype("datetime64[Y]")
-        day_of_year = ((days - year.astype("datetime64[D]")) / np.timedelta64(1, "D")).astype(np.int64)
-        slot = day_of_year * SLOTS_PER_DAY + slot_in_day
-        lon = np.asarray(longitude_deg, dtype=np.float64)[inside]
-        lat = np.asarray(latitude_deg, dtype=np.float64)[inside]
-        coord = spec.altitude_coordinate(h[inside])
+        ns = t.astype(np.int64)
+        span = np.array([ns[inside].min(), ns[inside].max()]).astype("datetime64[ns]")
+        self.space_weather.msis_drivers(span)  # an error naming the table's span
+        first, last = span.astype("datetime64[D]")
+        self.prepare(first, last)
         u0 = float(spec.altitude_coordinate(np.array([spec.min_altitude_km]))[0])
-        log_rho = np.empty(ti.size)
-        for y in np.unique(year):
-            block = self._year(int(str(y)))[0]
-            table = block.reshape(-1, *block.shape[2:])
-            sel = np.flatnonzero(year == y)
-            part = np.empty(sel.size)
-            _interpolate(
-                table,
-                slot[sel],
-                tau[sel],
-                lon[sel],
-                lat[sel],
-                coord[sel],
+        # ln(h − offset) by numpy, as the table's nodes (its log and the compiled one differ in the last bit)
+        log_h = np.zeros(t.size)
+        np.log(h - spec.altitude_offset_km, out=log_h, where=inside)
+        log_rho = np.full(t.size, np.nan)
+        y0, y1 = (int(str(d)[:4]) for d in (first, last))
+        for year in range(y0, y1 + 1):
+            start = np.datetime64(f"{year}-01-01", "D")
+            use = inside
+            if y1 > y0:  # the points of this year only
+                end = np.datetime64(f"{year + 1}-01-01", "D")
+                use = inside & (t >= start) & (t < end)
+            block = self._year(year)[0]
+            _interpolate_times(
+                block.reshape(-1, *block.shape[2:]),
+                ns,
+                int(start.astype(np.int64)),
+                use,
+                lon,
+                lat,
+                log_h,
                 spec.lon_step_deg,
                 spec.lat_step_deg,
                 u0,
                 spec.log_altitude_step,
-                part,
+                log_rho,
             )
-            log_rho[sel] = part
-        out[inside] = np.exp(log_rho)
+        out[inside] = np.exp(log_rho[inside])
         return out
