@@ -518,6 +518,7 @@ if __name__ == "__main__":
         "--no-model": "nomodel",
         "--parts=maneuvers": "maneuvers",
         "--parts=density": "density",
+        "--density-objects=25000": "full",
         "--model-tolerance": "tolerance",
     }
     with write_results("bench_catalogue_scale", variant(names)):
