@@ -72,6 +72,9 @@ class AttributionRules:
     #: Rule 4b is off by default: with a strike and a venting pulse both in the window, the fit cannot
     #: tell which of the two is the second source, and it called venting pulses next to a strike strikes.
     step_on_ramp: bool = False
+    #: Rule 4c: an impulsive step that no other step of the window shares the body direction of is a strike
+    #: inside a ramp or a sequence (or next to another source's step).
+    step_alone: bool = True
 
 
 @dataclass(frozen=True)
@@ -192,8 +195,11 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
     in_raw = not _finite(ev.raw_step_fraction) or ev.raw_step_fraction >= r.lasting_min
     impulsive = _finite(ev.duration_lo_s) and ev.duration_lo_s <= r.impulsive_s
     surface_ok = not (_finite(ev.surface_fraction) and ev.surface_fraction == 0.0)
+    # An impulse that other impulses of the window share the direction of (same sign, within 30°) is one of
+    # a sequence: a venting train's pulse, however isolated in time it looks.
+    in_sequence = r.step_alone and _finite(ev.step_sharp_siblings) and ev.step_sharp_siblings > 0
     # 4./5. External.
-    if lasting and impulsive and body_moved and in_raw:
+    if lasting and impulsive and body_moved and in_raw and not in_sequence:
         return Attribution("strike", _confidence([True, True, True, surface_ok]), "", "impulsive external step")
     # 4b. A ramp or a sequence keeps one body direction; an impulsive step at the event off that direction
     # is a second source: a strike during a leak or a venting sequence.
@@ -207,8 +213,21 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
         return Attribution(
             "strike", _confidence([True, True, False, surface_ok]), "", "impulsive step on a ramp, off its direction"
         )
-    if abs(ev.lasting_fraction) >= r.lasting_min and (not impulsive or not body_moved):
-        tests = [True, not impulsive, not body_moved]
+    # 4c. A leak is a ramp and a venting sequence a train of impulses, each along one body direction: the
+    # steps they make point one way. A step at the event that no other step of the window shares the
+    # direction of (within 30°), the event's size and beyond its noise, is an impulse of its own.
+    alone = (
+        _finite(ev.alone_step_fraction, ev.alone_step_z, ev.step_siblings)
+        and r.lasting_min <= ev.alone_step_fraction <= 1.0 / r.lasting_min
+        and ev.alone_step_z > r.ramp_off_z
+        and ev.step_siblings == 0
+    )
+    if r.step_alone and lasting and alone and body_moved and in_raw:
+        return Attribution(
+            "strike", _confidence([True, True, False, surface_ok]), "", "impulsive step, alone in its body direction"
+        )
+    if abs(ev.lasting_fraction) >= r.lasting_min and (not impulsive or not body_moved or in_sequence):
+        tests = [True, not impulsive or in_sequence, not body_moved]
         return Attribution("external_non_strike", _confidence(tests), "", "ramp or sequence of external torque")
     # 6. Internal.
     if abs(ev.lasting_fraction) <= r.returns_max and body_moved:
