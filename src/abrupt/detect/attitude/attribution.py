@@ -17,9 +17,11 @@ The rules read the evidence of :mod:`abrupt.detect.attitude.evidence`; none is f
    (null-space part, or one wheel carrying it);
 4. **strike** when the sensors agree, the body took the impulse first (body share), the step lasts,
    is in the momentum before cleaning too (``raw_step_fraction``) and is impulsive (its duration
-   interval reaches below ``impulsive_s``), or (only with ``step_on_ramp``, off by default), inside a
-   ramp or a sequence, the step at the event is impulsive and off the ramp's body direction (a second
-   source: :mod:`abrupt.detect.attitude.ramp_step`);
+   interval reaches below ``impulsive_s``) and no other impulse of the window shares its body direction
+   (a venting train's pulse has such siblings); or (4b, only with ``step_on_ramp``, off by default),
+   inside a ramp or a sequence, the step at the event is impulsive and off the ramp's body direction;
+   or (4c, ``step_alone``, on), inside a ramp or a sequence, no other step of the window shares the
+   event's step's body direction (:func:`abrupt.detect.attitude.ramp_step.step_siblings`);
 5. **external_non_strike** when the sensors agree and a step lasts (either sign: the event's own ΔH
    may be a piece of a longer ramp) but it is a ramp or a sequence
    (duration interval above ``impulsive_s``), or the body share is small (a slow torque the loop kept
@@ -106,6 +108,27 @@ def _lasting_impulse(ev: EventEvidence, r: AttributionRules) -> bool:
         and ev.lasting_fraction >= r.lasting_min
         and ev.raw_step_fraction >= r.lasting_min
         and ev.duration_lo_s <= r.impulsive_s
+    )
+
+
+def _off_ramp(ev: EventEvidence, r: AttributionRules) -> bool:
+    """Rule 4b's test: the step at the event is the event's size and off the ramp's body direction."""
+    return (
+        _finite(ev.ramp_step_fraction, ev.ramp_step_off_fraction, ev.ramp_step_off_z)
+        and r.lasting_min <= ev.ramp_step_fraction <= 1.0 / r.lasting_min
+        and ev.ramp_step_off_fraction >= r.ramp_off_min
+        and ev.ramp_step_off_z > r.ramp_off_z
+    )
+
+
+def _alone(ev: EventEvidence, r: AttributionRules) -> bool:
+    """Rule 4c's test: the step at the event is the event's size, beyond its noise, and no other step of
+    the window shares its body direction (within 30°, same sign)."""
+    return (
+        _finite(ev.alone_step_fraction, ev.alone_step_z, ev.step_siblings)
+        and r.lasting_min <= ev.alone_step_fraction <= 1.0 / r.lasting_min
+        and ev.alone_step_z > r.ramp_off_z
+        and ev.step_siblings == 0
     )
 
 
@@ -203,26 +226,14 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
         return Attribution("strike", _confidence([True, True, True, surface_ok]), "", "impulsive external step")
     # 4b. A ramp or a sequence keeps one body direction; an impulsive step at the event off that direction
     # is a second source: a strike during a leak or a venting sequence.
-    on_ramp = (
-        _finite(ev.ramp_step_fraction, ev.ramp_step_off_fraction, ev.ramp_step_off_z)
-        and r.lasting_min <= ev.ramp_step_fraction <= 1.0 / r.lasting_min
-        and ev.ramp_step_off_fraction >= r.ramp_off_min
-        and ev.ramp_step_off_z > r.ramp_off_z
-    )
-    if r.step_on_ramp and lasting and on_ramp and body_moved and in_raw:
+    if r.step_on_ramp and lasting and _off_ramp(ev, r) and body_moved and in_raw:
         return Attribution(
             "strike", _confidence([True, True, False, surface_ok]), "", "impulsive step on a ramp, off its direction"
         )
     # 4c. A leak is a ramp and a venting sequence a train of impulses, each along one body direction: the
     # steps they make point one way. A step at the event that no other step of the window shares the
-    # direction of (within 30°), the event's size and beyond its noise, is an impulse of its own.
-    alone = (
-        _finite(ev.alone_step_fraction, ev.alone_step_z, ev.step_siblings)
-        and r.lasting_min <= ev.alone_step_fraction <= 1.0 / r.lasting_min
-        and ev.alone_step_z > r.ramp_off_z
-        and ev.step_siblings == 0
-    )
-    if r.step_alone and lasting and alone and body_moved and in_raw:
+    # direction of is an impulse of its own.
+    if r.step_alone and lasting and _alone(ev, r) and body_moved and in_raw:
         return Attribution(
             "strike", _confidence([True, True, False, surface_ok]), "", "impulsive step, alone in its body direction"
         )
