@@ -130,10 +130,11 @@ def _best_peak(
 
 def _off_ramp(table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int) -> FloatArray | None:
     """Cleaned ᴺH over rows [a, b) with the component along the body direction of the ramp or sequence
-    around row ``i0`` removed, or None when the window needs no ramp: the direction of the event's own
-    step when other impulses share it (a venting train, :func:`~abrupt.detect.attitude.ramp_step.step_siblings`),
-    else the ramp's (:func:`~abrupt.detect.attitude.ramp_step.fit_ramp_step`). A leak or a venting sequence keeps one body direction; what steps off it is a
-    second source."""
+    around row ``i0`` removed, or None when the window needs no ramp. A leak or a venting sequence keeps
+    one body direction; what steps off it is a second source. The direction is that of the event's own
+    step when other impulses share it (a venting train:
+    :func:`~abrupt.detect.attitude.ramp_step.step_siblings`), else the ramp's
+    (:func:`~abrupt.detect.attitude.ramp_step.fit_ramp_step`)."""
     g = table.time_ns
     half = round(RAMP_WINDOW_S / table.dt_s)
     lo, hi = max(0, i0 - half), min(g.size, i0 + half + 1)
