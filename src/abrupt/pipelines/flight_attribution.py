@@ -29,7 +29,12 @@ import pandas as pd
 from abrupt.detect.attitude.attribution import AttributionRules, classify
 from abrupt.detect.attitude.evidence import EventEvidence, event_evidence
 from abrupt.detect.attitude.flight_glr import FlightGlrDetector, Peak
-from abrupt.detect.attitude.ramp_step import body_frame_momentum, fit_ramp_step, from_body_increments
+from abrupt.detect.attitude.ramp_step import (
+    body_frame_momentum,
+    fit_ramp_step,
+    from_body_increments,
+    step_siblings,
+)
 from abrupt.detect.attitude.repair import repair_sensor_fault
 from abrupt.events import format_time_utc, make_event_id
 from abrupt.model.spacecraft import Spacecraft
@@ -125,17 +130,26 @@ def _best_peak(
 
 def _off_ramp(table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int) -> FloatArray | None:
     """Cleaned ᴺH over rows [a, b) with the component along the body direction of the ramp or sequence
-    around row ``i0`` removed (:func:`~abrupt.detect.attitude.ramp_step.fit_ramp_step`), or None when the
-    window needs no ramp. A leak or a venting sequence keeps one body direction; what steps off it is a
-    second source."""
+    around row ``i0`` removed, or None when the window needs no ramp. A leak or a venting sequence keeps
+    one body direction; what steps off it is a second source. The direction is that of the event's own
+    step when other impulses share it (a venting train:
+    :func:`~abrupt.detect.attitude.ramp_step.step_siblings`), else the ramp's
+    (:func:`~abrupt.detect.attitude.ramp_step.fit_ramp_step`)."""
     g = table.time_ns
     half = round(RAMP_WINDOW_S / table.dt_s)
     lo, hi = max(0, i0 - half), min(g.size, i0 + half + 1)
     q = table.quaternion_BN
-    fit = fit_ramp_step((g[lo:hi] - g[i0]) / NS, body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi]), 0.0)
-    if fit is None or not float(np.linalg.norm(fit.ramp_B)) > RAMP_SIGMA_MIN * fit.ramp_sigma:
-        return None
-    u_b = fit.ramp_B / float(np.linalg.norm(fit.ramp_B))
+    tau, y_win = (g[lo:hi] - g[i0]) / NS, body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi])
+    # A train of impulses along the event's own direction is a venting sequence: that direction is the
+    # torque's (the ramp fit would take the largest other step, a strike's, for the ramp).
+    seq = step_siblings(tau, y_win, 0.0)
+    if seq is not None and seq.sharp_siblings > 0:
+        u_b = seq.step_B / float(np.linalg.norm(seq.step_B))
+    else:
+        fit = fit_ramp_step(tau, y_win, 0.0)
+        if fit is None or not float(np.linalg.norm(fit.ramp_B)) > RAMP_SIGMA_MIN * fit.ramp_sigma:
+            return None
+        u_b = fit.ramp_B / float(np.linalg.norm(fit.ramp_B))
     h = cleaned_H_N[a:b]
     y_b = body_frame_momentum(h, q[a:b])
     y_off = y_b - (y_b @ u_b)[:, None] * u_b

@@ -17,9 +17,11 @@ The rules read the evidence of :mod:`abrupt.detect.attitude.evidence`; none is f
    (null-space part, or one wheel carrying it);
 4. **strike** when the sensors agree, the body took the impulse first (body share), the step lasts,
    is in the momentum before cleaning too (``raw_step_fraction``) and is impulsive (its duration
-   interval reaches below ``impulsive_s``), or (only with ``step_on_ramp``, off by default), inside a
-   ramp or a sequence, the step at the event is impulsive and off the ramp's body direction (a second
-   source: :mod:`abrupt.detect.attitude.ramp_step`);
+   interval reaches below ``impulsive_s``) and no other impulse of the window shares its body direction
+   (a venting train's pulse has such siblings); or (4b, only with ``step_on_ramp``, off by default),
+   inside a ramp or a sequence, the step at the event is impulsive and off the ramp's body direction;
+   or (4c, ``step_alone``, on), inside a ramp or a sequence, no other step of the window shares the
+   event's step's body direction (:func:`abrupt.detect.attitude.ramp_step.step_siblings`);
 5. **external_non_strike** when the sensors agree and a step lasts (either sign: the event's own ΔH
    may be a piece of a longer ramp) but it is a ramp or a sequence
    (duration interval above ``impulsive_s``), or the body share is small (a slow torque the loop kept
@@ -72,6 +74,9 @@ class AttributionRules:
     #: Rule 4b is off by default: with a strike and a venting pulse both in the window, the fit cannot
     #: tell which of the two is the second source, and it called venting pulses next to a strike strikes.
     step_on_ramp: bool = False
+    #: Rule 4c: an impulsive step that no other step of the window shares the body direction of is a strike
+    #: inside a ramp or a sequence (or next to another source's step).
+    step_alone: bool = True
 
 
 @dataclass(frozen=True)
@@ -103,6 +108,27 @@ def _lasting_impulse(ev: EventEvidence, r: AttributionRules) -> bool:
         and ev.lasting_fraction >= r.lasting_min
         and ev.raw_step_fraction >= r.lasting_min
         and ev.duration_lo_s <= r.impulsive_s
+    )
+
+
+def _off_ramp(ev: EventEvidence, r: AttributionRules) -> bool:
+    """Rule 4b's test: the step at the event is the event's size and off the ramp's body direction."""
+    return (
+        _finite(ev.ramp_step_fraction, ev.ramp_step_off_fraction, ev.ramp_step_off_z)
+        and r.lasting_min <= ev.ramp_step_fraction <= 1.0 / r.lasting_min
+        and ev.ramp_step_off_fraction >= r.ramp_off_min
+        and ev.ramp_step_off_z > r.ramp_off_z
+    )
+
+
+def _alone(ev: EventEvidence, r: AttributionRules) -> bool:
+    """Rule 4c's test: the step at the event is the event's size, beyond its noise, and no other step of
+    the window shares its body direction (within 30°, same sign)."""
+    return (
+        _finite(ev.alone_step_fraction, ev.alone_step_z, ev.step_siblings)
+        and r.lasting_min <= ev.alone_step_fraction <= 1.0 / r.lasting_min
+        and ev.alone_step_z > r.ramp_off_z
+        and ev.step_siblings == 0
     )
 
 
@@ -192,23 +218,27 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
     in_raw = not _finite(ev.raw_step_fraction) or ev.raw_step_fraction >= r.lasting_min
     impulsive = _finite(ev.duration_lo_s) and ev.duration_lo_s <= r.impulsive_s
     surface_ok = not (_finite(ev.surface_fraction) and ev.surface_fraction == 0.0)
+    # An impulse that other impulses of the window share the direction of (same sign, within 30°) is one of
+    # a sequence: a venting train's pulse, however isolated in time it looks.
+    in_sequence = r.step_alone and _finite(ev.step_sharp_siblings) and ev.step_sharp_siblings > 0
     # 4./5. External.
-    if lasting and impulsive and body_moved and in_raw:
+    if lasting and impulsive and body_moved and in_raw and not in_sequence:
         return Attribution("strike", _confidence([True, True, True, surface_ok]), "", "impulsive external step")
     # 4b. A ramp or a sequence keeps one body direction; an impulsive step at the event off that direction
     # is a second source: a strike during a leak or a venting sequence.
-    on_ramp = (
-        _finite(ev.ramp_step_fraction, ev.ramp_step_off_fraction, ev.ramp_step_off_z)
-        and r.lasting_min <= ev.ramp_step_fraction <= 1.0 / r.lasting_min
-        and ev.ramp_step_off_fraction >= r.ramp_off_min
-        and ev.ramp_step_off_z > r.ramp_off_z
-    )
-    if r.step_on_ramp and lasting and on_ramp and body_moved and in_raw:
+    if r.step_on_ramp and lasting and _off_ramp(ev, r) and body_moved and in_raw:
         return Attribution(
             "strike", _confidence([True, True, False, surface_ok]), "", "impulsive step on a ramp, off its direction"
         )
-    if abs(ev.lasting_fraction) >= r.lasting_min and (not impulsive or not body_moved):
-        tests = [True, not impulsive, not body_moved]
+    # 4c. A leak is a ramp and a venting sequence a train of impulses, each along one body direction: the
+    # steps they make point one way. A step at the event that no other step of the window shares the
+    # direction of is an impulse of its own.
+    if r.step_alone and lasting and _alone(ev, r) and body_moved and in_raw:
+        return Attribution(
+            "strike", _confidence([True, True, False, surface_ok]), "", "impulsive step, alone in its body direction"
+        )
+    if abs(ev.lasting_fraction) >= r.lasting_min and (not impulsive or not body_moved or in_sequence):
+        tests = [True, not impulsive or in_sequence, not body_moved]
         return Attribution("external_non_strike", _confidence(tests), "", "ramp or sequence of external torque")
     # 6. Internal.
     if abs(ev.lasting_fraction) <= r.returns_max and body_moved:

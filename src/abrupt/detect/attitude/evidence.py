@@ -41,7 +41,12 @@ telemetry (:class:`~abrupt.series.timetable.Timetable`) around the event:
   momentum in body axes fitted by a ramp (a leak, a venting sequence: one body direction) plus a step at
   the event (:mod:`abrupt.detect.attitude.ramp_step`); the step's part off the ramp's direction is a
   second source (a strike during the torque); ``after_torque_s``: for an event found only once the
-  ramp's direction was taken out around an external torque's event, its time after that event [s].
+  ramp's direction was taken out around an external torque's event, its time after that event [s];
+* **alone in its direction** (``alone_step_fraction``, ``alone_step_z``, ``step_siblings``): the
+  momentum in body axes fitted by the step at the event plus every other step of the window, found one
+  at a time (:func:`abrupt.detect.attitude.ramp_step.step_siblings`); the number of those others
+  within 30° of the event's body direction (a venting sequence's pulses, a leak's ramp: > 0), and of
+  those the impulses (``step_sharp_siblings``: a venting sequence's pulses).
 """
 
 from __future__ import annotations
@@ -54,7 +59,13 @@ import numpy as np
 from scipy.ndimage import median_filter
 
 from abrupt.clean.flight_masks import tracker_rate_rad_s
-from abrupt.detect.attitude.ramp_step import body_frame_momentum, fit_ramp_step, ramp_step_evidence
+from abrupt.detect.attitude.ramp_step import (
+    body_frame_momentum,
+    fit_ramp_step,
+    ramp_step_evidence,
+    step_siblings,
+    step_siblings_evidence,
+)
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.timetable import NS, Timetable
@@ -105,6 +116,10 @@ class EventEvidence:
     ramp_step_off_fraction: float = NAN
     ramp_step_off_z: float = NAN
     after_torque_s: float = NAN
+    alone_step_fraction: float = NAN
+    alone_step_z: float = NAN
+    step_siblings: float = NAN
+    step_sharp_siblings: float = NAN
 
     def as_dict(self) -> dict[str, float]:
         return {f"ev_{k}": float(v) for k, v in asdict(self).items()}
@@ -308,6 +323,10 @@ def event_evidence(
         y_b = body_frame_momentum(cleaned_H_N[span], q[span])
         fit = fit_ramp_step((g[span] - g[i0]) / NS, y_b, 0.0, min_ramp_s=w.ramp_min_s)
         out.update(ramp_step_evidence(fit, mag))
+    if mag > 0:
+        span = _idx(g, i0, -w.profile_s, w.profile_s, dt)
+        y_b = body_frame_momentum(cleaned_H_N[span], q[span])
+        out.update(step_siblings_evidence(step_siblings((g[span] - g[i0]) / NS, y_b, 0.0), mag))
     out.update(_appendage(table, i0, dt))
     out.update(surface_evidence(spacecraft, dh_b))
     if raw_H_N is not None and mag > 0:

@@ -139,3 +139,132 @@ def ramp_step_evidence(fit: RampStep | None, dh_mag: float, ramp_sigma_min: floa
         out["ramp_step_off_fraction"] = off / s
         out["ramp_step_off_z"] = off / fit.step_sigma
     return out
+
+
+@dataclass(frozen=True)
+class StepSiblings:
+    """The event's step ``S`` [N·m·s, body axes] and its noise σ, fitted with every other step of the window,
+    and how many of those others point along S (``siblings``) out of all found (``others``)."""
+
+    step_B: FloatArray
+    step_sigma: float
+    siblings: int
+    others: int
+    other_tau_s: tuple[float, ...] = ()
+    other_B: FloatArray | None = None
+    #: Siblings that are impulses themselves (a step fits them better than a ramp over 2 ``settle_s``).
+    sharp_siblings: int = 0
+
+
+def step_siblings(
+    tau_s: FloatArray,
+    y_B: FloatArray,
+    step_s: float = 0.0,
+    z_min: float = 8.0,
+    merge_s: float = 10.0,
+    settle_s: float = 30.0,
+    max_steps: int = 12,
+    sibling_deg: float = 30.0,
+    sibling_min: float = 0.1,
+    sharp_chi2: float = 9.0,
+) -> StepSiblings | None:
+    """The step at ``step_s`` and the other steps of the window around it, found one at a time.
+
+    A venting sequence is a train of impulses along one body direction and a leak a ramp along one (a
+    staircase of steps that all point one way); a strike is one impulse in a direction of its own. The
+    body-axis momentum is fitted by c + b τ + Σ_j P_j H(τ − τ_j) with the event's step always in; the
+    next step is the one whose column (orthogonal to those in) takes most of the residual's χ² (each axis
+    in units of its own noise), added while that gain is beyond ``z_min``² and the step is more than
+    ``merge_s`` from every step in (timing and the cleaning spread one impulse over a few samples) and
+    not within ``settle_s`` after the event (the closed loop hands the impulse from the body to the wheels
+    within its settling time, and the two are sampled differently: the total moves a little until then).
+    ``siblings`` counts the other steps within ``sibling_deg`` of S's direction, same sign (a thrust
+    pushes one way; the cleaning's small opposite drift after a large step is no sibling) and at least
+    ``sibling_min`` of |S| (what the loop's settling leaves after a large step is a few per cent of it,
+    in its direction: 4-8 % on the flight-like strikes): > 0 means the
+    event's step is one of a sequence (or a piece of a ramp) along its direction; 0 that it stands alone
+    in its direction, whatever else the window holds (a leak, a venting sequence, a sensor fault's step
+    elsewhere). ``sharp_siblings`` counts those that are impulses themselves: a ramp over 2 ``settle_s``
+    centred on the step fits worse by more than ``sharp_chi2`` (3 σ; a train of pulses; a piece of a
+    leak's ramp or of the cleaning's smooth drift around a large step is not). None when the window
+    is too short or its noise unknown.
+    """
+    ok = np.isfinite(y_B).all(axis=1)
+    t, v = tau_s[ok], y_B[ok]
+    if t.size < 60:
+        return None
+    sig = np.array([_noise_sigma(v[:, k]) for k in range(3)])
+    if not np.all(np.isfinite(sig)) or not np.all(sig > 0):
+        return None
+    span = max(float(t[-1] - t[0]), 1.0)
+    vw = v / sig
+    steps = [step_s]
+    cand = (t > t[0] + merge_s) & (t < t[-1] - merge_s)
+    for _ in range(max_steps):
+        x = np.column_stack([np.ones_like(t), (t - t.mean()) / span, *[(t >= s).astype(np.float64) for s in steps]])
+        basis, _ = np.linalg.qr(x)
+        r = vw - basis @ (basis.T @ vw)
+        free = cand & np.all(np.abs(t[:, None] - np.asarray(steps)[None, :]) > merge_s, axis=1)
+        free &= ~((t >= step_s) & (t <= step_s + settle_s))
+        if not free.any():
+            break
+        # Column H(τ − τ_k) against the residual (already orthogonal to the basis) and its part orthogonal
+        # to the basis, both from sums over the samples from k on.
+        tail_r = np.cumsum(r[::-1], axis=0)[::-1]
+        tail_b = np.cumsum(basis[::-1], axis=0)[::-1]
+        sxx = np.arange(t.size, 0, -1, dtype=np.float64) - np.sum(tail_b**2, axis=1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            gain = np.where(free & (sxx > 1e-9), np.sum(tail_r**2, axis=1) / sxx, 0.0)
+        m = int(np.argmax(gain))
+        if not gain[m] > z_min**2:
+            break
+        steps.append(float(t[m]))
+    cols = [np.ones_like(t), t - t.mean(), *[(t >= s).astype(np.float64) for s in steps]]
+    x = np.column_stack(cols)
+    coef, *_ = np.linalg.lstsq(x, v, rcond=None)
+    cov = np.linalg.pinv(x.T @ x)
+    s_b = coef[2]
+    s_mag = float(np.linalg.norm(s_b))
+    cos_min = math.cos(math.radians(sibling_deg))
+    others = coef[3:]
+    norms = np.linalg.norm(others, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cosines = (others @ s_b) / (norms * s_mag) if s_mag > 0 else np.zeros(len(others))
+    parallel = (cosines >= cos_min) & (norms >= sibling_min * s_mag)
+    sharp = np.array([_sharpness(t, vw, cols, 3 + j, 2 * settle_s) > sharp_chi2 for j in range(len(others))])
+    return StepSiblings(
+        step_B=s_b,
+        step_sigma=float(np.sqrt(np.mean(sig**2))) * math.sqrt(max(cov[2, 2], 0.0)),
+        siblings=int(np.sum(parallel)),
+        others=len(others),
+        other_tau_s=tuple(steps[1:]),
+        other_B=others,
+        sharp_siblings=int(np.sum(parallel & sharp.astype(bool))),
+    )
+
+
+def _chi2(x: FloatArray, vw: FloatArray) -> float:
+    coef, *_ = np.linalg.lstsq(x, vw, rcond=None)
+    return float(np.sum((vw - x @ coef) ** 2))
+
+
+def _sharpness(t: FloatArray, vw: FloatArray, cols: list[FloatArray], j: int, ramp_s: float) -> float:
+    """How much worse (χ², noise units) column ``j``'s step fits as a ramp of ``ramp_s`` centred on it: large
+    for an impulse (a thrust pulse, a strike), about zero for a piece of a smooth drift or a slow ramp."""
+    tau_j = float(t[np.argmax(cols[j] > 0)])
+    ramp = np.clip((t - tau_j) / ramp_s + 0.5, 0.0, 1.0)
+    return _chi2(np.column_stack([*cols[:j], ramp, *cols[j + 1 :]]), vw) - _chi2(np.column_stack(cols), vw)
+
+
+def step_siblings_evidence(fit: StepSiblings | None, dh_mag: float) -> dict[str, float]:
+    """``alone_step_fraction`` |S|/|ΔH|, ``alone_step_z`` |S|/σ_S, ``step_siblings`` and
+    ``step_sharp_siblings`` (counts)."""
+    if fit is None or not dh_mag > 0:
+        return {}
+    s = float(np.linalg.norm(fit.step_B))
+    return {
+        "alone_step_fraction": s / dh_mag,
+        "alone_step_z": s / fit.step_sigma if fit.step_sigma > 0 else NAN,
+        "step_siblings": float(fit.siblings),
+        "step_sharp_siblings": float(fit.sharp_siblings),
+    }
