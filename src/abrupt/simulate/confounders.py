@@ -414,7 +414,11 @@ def inject_confounders(
     settle_s: float = 10.0,
     seed: int = 0,
 ) -> pd.DataFrame:
-    """Raw samples (mnemonic, time, value) with the confounders added in native units (module docstring)."""
+    """Raw samples (mnemonic, time, value) with the confounders added in native units (module docstring).
+
+    Deterministic (the wheels' re-quantisation follows the archive's own pulse phase); ``seed`` is kept
+    for callers.
+    """
     if spacecraft.flight is None or not confounders:
         return samples
     out = samples.copy()
