@@ -39,8 +39,8 @@ from abrupt.series.timetable import NS
 from abrupt.simulate.injection import (
     InjectionAttitude,
     InjectionRows,
+    WheelChanges,
     angle_response,
-    native_wheel_change,
     quat_multiply,
     rate_response,
 )
@@ -246,6 +246,7 @@ class _Samples:
     values: FloatArray
     t_all: np.ndarray
     rows: InjectionRows
+    wheels: WheelChanges
 
 
 def _hub_impulses(c: Confounder, spacecraft: Spacecraft) -> tuple[FloatArray, FloatArray, bool]:
@@ -285,7 +286,6 @@ def _add_dynamic(
     spacecraft: Spacecraft,
     c: Confounder,
     settle_s: float,
-    rng: np.random.Generator,
     bn_at: InjectionAttitude,
 ) -> None:
     """Body rate, attitude and wheel response to the hub impulses of ``c`` (linear closed loop)."""
@@ -329,7 +329,7 @@ def _add_dynamic(
         if (~near).any():  # after the horizon the wheels hold the external momentum, [BN(t)] ΔH_N
             late = bn_at(t_w[~near]) @ imp_N.sum(axis=0)
             d_mean[~near] = (late @ pinv.T)[:, ch.component]
-        s.values[sel] += native_wheel_change(ch, d_mean, rng)
+        s.wheels.add(sel, d_mean)
 
 
 def _rotate_quaternions(s: _Samples, qch: list[Any], lo_ns: int, hi_ns: int, d_theta: Any) -> None:
@@ -414,22 +414,25 @@ def inject_confounders(
     settle_s: float = 10.0,
     seed: int = 0,
 ) -> pd.DataFrame:
-    """Raw samples (mnemonic, time, value) with the confounders added in native units (module docstring)."""
+    """Raw samples (mnemonic, time, value) with the confounders added in native units (module docstring).
+
+    Deterministic (the wheels' re-quantisation follows the archive's own pulse phase); ``seed`` is kept
+    for callers.
+    """
     if spacecraft.flight is None or not confounders:
         return samples
     out = samples.copy()
     t_all = out["time"].to_numpy().astype("datetime64[ns]").astype(np.int64)
-    s = _Samples(
-        out["value"].to_numpy(np.float64).copy(), t_all, InjectionRows(t_all, out["mnemonic"].astype(str).to_numpy())
-    )
-    rng = np.random.default_rng(seed)
+    rows = InjectionRows(t_all, out["mnemonic"].astype(str).to_numpy())
+    s = _Samples(out["value"].to_numpy(np.float64).copy(), t_all, rows, WheelChanges(t_all.size))
     bn_at = InjectionAttitude(samples, spacecraft)
     for c in confounders:
         if CONFOUNDER_CLASS[c.kind] == "sensor_fault":
             _add_sensor_fault(s, spacecraft, c)
         else:
-            _add_dynamic(s, spacecraft, c, settle_s, rng, bn_at)
+            _add_dynamic(s, spacecraft, c, settle_s, bn_at)
             if c.kind == "appendage_snap":
                 _add_appendage_angle(s, spacecraft, c)
+    s.wheels.apply(s.values, rows, spacecraft.flight.of("wheel_speed"))
     out["value"] = s.values
     return out

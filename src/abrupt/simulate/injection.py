@@ -14,8 +14,10 @@ telemetered quaternions), exact in angular momentum:
 
 The differences are added in native units: gyro rates in the channel's unit; quaternions rotated by
 the attitude error δθ(t) = ∫Δω; wheel speeds as tachometer counts regenerated from the cumulative
-pulse phase (counts c'_k = c_k + ⌊φ₀ + Δφ_k⌋ − ⌊φ₀ + Δφ_{k−1}⌋ with Δφ the added wheel angle in pulses
-and φ₀ a random phase), or as gate means when no tachometer is declared.
+pulse phase (counts c'_k = c_k + ⌊u_k + Δφ_k⌋ − ⌊u_{k−1} + Δφ_{k−1}⌋ with Δφ the added wheel angle in
+pulses, summed over all injections of a call, and u_k the fraction of the archive's own pulse phase,
+estimated from its counts: :func:`requantised_wheel`), or as gate means when no tachometer is declared.
+Samples the injections do not change are returned bit for bit.
 
 By default (``response="simulated"``) the transient is Harris's: the closed-loop simulator of
 :mod:`abrupt.simulate.pointing` (``simulate_pointing``) follows the telemetry's own attitude with and
@@ -34,6 +36,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
+from scipy.signal import savgol_filter
 
 from abrupt.model.attitude_dynamics import AttitudeSimConfig
 from abrupt.model.flight_config import FlightChannel
@@ -273,17 +276,50 @@ def _wheel_change(
     return np.asarray(d_omega.reshape(-1, k_sub).mean(axis=1), dtype=np.float64)
 
 
-def native_wheel_change(c: FlightChannel, d_mean: FloatArray, rng: np.random.Generator) -> FloatArray:
-    """ΔΩ in the channel's native unit; tachometer counts regenerated from the cumulative pulse phase."""
+#: Window [samples] and degree of the Savitzky-Golay fit of the cumulative count that estimates the pulse phase.
+PHASE_WINDOW = 33
+PHASE_DEGREE = 2
+
+
+def requantised_wheel(c: FlightChannel, native: FloatArray, d_mean: FloatArray) -> FloatArray:
+    """One wheel channel's samples (native unit, time order) with the gate-mean change ``d_mean`` [rad/s] added.
+
+    Without a tachometer the change is added as it is. With one, the count of sample k is
+    c_k = ⌊P_k⌋ − ⌊P_{k−1}⌋ of the pulse phase P, which is smooth; its fraction u_k = P_k − ⌊P_k⌋ is
+    estimated from the counts themselves (local quadratic fit Ñ of the cumulative count N, u = Ñ + ½ − N,
+    clipped to [0, 1)), and the new count is c_k + ⌊u_k + Δφ_k⌋ − ⌊u_{k−1} + Δφ_{k−1}⌋ with Δφ the added
+    wheel angle in pulses: the archive's own quantisation is kept, not applied a second time, and every
+    sample where Δφ is zero is returned bit for bit.
+    """
     if c.tachometer is None:
-        return np.asarray(d_mean / c.to_si, dtype=np.float64)
-    ppr = c.tachometer.pulses_per_rev
-    d_phase = np.cumsum(d_mean * c.tachometer.gate_s) * ppr / (2.0 * math.pi)
-    phi0 = rng.uniform()
-    n_new = np.floor(phi0 + d_phase)
-    n_prev = np.concatenate([[math.floor(phi0)], n_new[:-1]])
+        return np.asarray(native + d_mean / c.to_si, dtype=np.float64)
     step = 1.0 if c.unit == "counts" else c.tachometer.quantum_rad_s / c.to_si
-    return np.asarray((n_new - n_prev) * step, dtype=np.float64)
+    n_cum = np.cumsum(native / step)
+    if n_cum.size > PHASE_WINDOW:
+        smooth = savgol_filter(n_cum, PHASE_WINDOW, PHASE_DEGREE, mode="interp")
+    else:
+        smooth = np.full(n_cum.size, n_cum.mean())
+    u = np.clip(smooth + 0.5 - n_cum, 0.0, np.nextafter(1.0, 0.0))
+    d_phase = np.cumsum(d_mean * c.tachometer.gate_s) * c.tachometer.pulses_per_rev / (2.0 * math.pi)
+    whole = np.floor(u + d_phase)
+    return np.asarray(native + np.diff(whole, prepend=0.0) * step, dtype=np.float64)
+
+
+class WheelChanges:
+    """Gate-mean wheel-speed changes [rad/s] per raw-sample row, summed over injections, applied once."""
+
+    def __init__(self, n_rows: int) -> None:
+        self.d = np.zeros(n_rows)
+
+    def add(self, rows: NDArray[np.int64], d_mean: FloatArray) -> None:
+        self.d[rows] += d_mean
+
+    def apply(self, values: FloatArray, rows: InjectionRows, channels: list[FlightChannel]) -> None:
+        """Re-quantise each wheel channel once with the summed change (:func:`requantised_wheel`)."""
+        for c in channels:
+            r = rows.of.get(c.mnemonic, rows.none)
+            if r.size and self.d[r].any():
+                values[r] = requantised_wheel(c, values[r], self.d[r])
 
 
 def inject_strikes(
@@ -301,7 +337,7 @@ def inject_strikes(
     ``response="simulated"`` (default): the body-rate, attitude and wheel transients come from the
     closed-loop simulation of :func:`simulated_response` for ``window_s`` after each strike, and after it
     the wheels hold [BN(t)]ΔH_N (ᴺH conserved). ``"linear"``: the stand-in transient of time constant
-    ``settle_s`` (module docstring).
+    ``settle_s`` (module docstring). The injection is deterministic; ``seed`` is kept for callers.
     """
     if spacecraft.flight is None or not strikes:
         return samples
@@ -312,10 +348,10 @@ def inject_strikes(
     j_inv = np.linalg.inv(spacecraft.inertia_kgm2)
     js_g = spacecraft.wheel_axes * spacecraft.wheel_spin_inertias_kgm2[None, :]
     wheel_pinv = np.linalg.pinv(js_g)  # minimum-norm distribution
-    rng = np.random.default_rng(seed)
     horizon_ns = int(20 * settle_s * NS)
     bn_at = InjectionAttitude(samples, spacecraft)
     rows = InjectionRows(t_all, out["mnemonic"].astype(str).to_numpy())
+    wheels = WheelChanges(t_all.size)
     for s in strikes:
         bn0 = bn_at(np.array([s.time_ns]))[0]
         dw0 = j_inv @ (bn0 @ s.dH_N_Nms)
@@ -341,6 +377,7 @@ def inject_strikes(
             if sel.size == 0:
                 continue
             d_mean = _wheel_change(c, t_all[sel], s, spacecraft, bn_at, tr, wheel_pinv, null_offset)
-            values[sel] += native_wheel_change(c, d_mean, rng)
+            wheels.add(sel, d_mean)
+    wheels.apply(values, rows, flight.of("wheel_speed"))
     out["value"] = values
     return out
