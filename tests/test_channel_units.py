@@ -194,3 +194,23 @@ def test_a_scaled_quaternion_channel_is_refused_at_ingest(
     with pytest.raises(InputError, match=r"SC-A_2026-03-10\.csv.*quaternion channels .*SC-A\.ch01.*not 1"):
         ingest_archives([archive], decoder, tmp_path / "s", spacecraft=load_spacecraft(KESTREL))
     ingest_archives([archive], decoder, tmp_path / "plain")  # without the spacecraft file: stored as given
+
+
+def test_a_gyro_bias_step_as_large_as_the_orbit_rate_is_not_a_unit_error(store: Path) -> None:
+    """A gyro bias step (a sensor fault the fault scans report, not a unit) of 3 times the orbit rate on
+    the axis that carries it, from the first quarter of the chunk on: |ω_gyro| / |ω_q| is ≈ 4 over most
+    of the chunk, which bounds of [0.5, 2] refused, but far from deg/s read as rad/s (57.3), so the day is
+    analysed; the same channel a unit off is still refused."""
+    sc = load_spacecraft(KESTREL)
+    samples = _samples(store)
+    mnemonic = samples["mnemonic"].astype(str)  # type: ignore[index]
+    on_y = mnemonic == "SC-A.ch06"
+    y = samples.loc[on_y, "value"]  # type: ignore[attr-defined]
+    after = samples["time"].astype("int64") >= T0 + HOURS * 900 * NS  # type: ignore[index]
+    orbit_rate = float(np.median(np.abs(y)))
+    assert 0.03 < orbit_rate < 0.1  # deg/s: the orbit rate is 0.06 deg/s
+    samples.loc[on_y & after, "value"] += 3.0 * np.sign(np.median(y)) * orbit_rate  # type: ignore[attr-defined]
+    check_channel_units(sc, samples)  # type: ignore[arg-type]
+    samples.loc[on_y, "value"] *= 180.0 / np.pi  # type: ignore[attr-defined]
+    with pytest.raises(ConfigError, match=r"channels\[5\]\.unit.*channel SC-A\.ch06"):
+        check_channel_units(sc, samples)  # type: ignore[arg-type]

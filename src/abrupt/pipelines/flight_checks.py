@@ -87,7 +87,12 @@ def check_tachometer_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> Non
             )
 
 
-GYRO_RATIO_BOUNDS = (0.5, 2.0)  # gyro rate / quaternion rate; deg/s read as rad/s gives 57.3
+_RATE_CONFUSION = min(a / b for a in RATE_UNITS.values() for b in RATE_UNITS.values() if a > b)  # deg/s vs rad/s: 57.3
+# gyro rate / quaternion rate: the check decides which unit the values are in, so its bounds are the geometric
+# midpoints between the declared unit (ratio 1) and the nearest other rate unit (57.3): 0.13-7.6. A gyro bias
+# comparable to a slowly turning body's rate (a bias step, a fault the fault scans report) moves |ω_gyro| / |ω_q|
+# by factors of 2-3 without any unit being wrong; tighter bounds refused such days.
+GYRO_RATIO_BOUNDS = (_RATE_CONFUSION**-0.5, _RATE_CONFUSION**0.5)
 GYRO_AXIS_SHARE = 0.05  # an axis with less of the gyro's squared rate than this cannot show its scale
 GYRO_MIN_SIGNAL_TO_NOISE = 5.0  # the attitude must move well above the star tracker's noise to decide
 NS = 1_000_000_000
