@@ -23,8 +23,9 @@ from abrupt.cli.main import cli
 from abrupt.density.drag_plausibility import lowest_perigee_km
 from abrupt.density.tle_drag import TleDragConfig, rho_b_from_history
 from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET
-from abrupt.events import read_events
-from abrupt.pipelines.catalogue import merge_parts, run_catalogue
+from abrupt.errors import InputError
+from abrupt.events import EVENT_COLUMNS, TEXT_COLUMNS, read_events, write_events
+from abrupt.pipelines.catalogue import file_key, maneuver_times_of, merge_parts, run_catalogue
 from abrupt.pipelines.tle import detect_tle_file
 from abrupt.readers.omm import read_element_histories
 from abrupt.scale import Executor, run_tasks
@@ -216,3 +217,28 @@ def test_density_cli_windows_only_takes_the_maneuvers_of_tle_batch(tmp_path: Pat
     assert len(got) == len(expected)
     np.testing.assert_allclose(got["rho_b_per_m"].to_numpy(), expected["rho_b_per_m"].to_numpy())
     assert got["window_start_utc"].tolist() == expected["window_start_utc"].tolist()
+
+
+def test_a_maneuvers_file_changed_after_the_run_began_is_refused(tmp_path: Path) -> None:
+    """The tasks name the maneuvers file by its key (path, size, mtime), and each worker reads it once:
+    a file rewritten after the run began would give some files the old times and some the new, so it
+    is refused naming the file; the times read are those of the file, object by object."""
+    ev = tmp_path / "ev.csv"
+    given = {
+        "spacecraft": ["NORAD-1", "NORAD-1", "NORAD-2"],
+        "time_utc": ["2024-01-02T00:00:00", "2024-01-05T00:00:00", "2024-01-03T00:00:00"],
+        "statistic": [5.0, 1.0, 9.0],
+        "threshold": [4.0, 4.0, 4.0],
+        "kind": ["maneuver"] * 3,
+    }
+    frame = pd.DataFrame({c: given.get(c, ["x"] * 3 if c in TEXT_COLUMNS else [np.nan] * 3) for c in EVENT_COLUMNS})
+    write_events(frame, str(ev))
+    key = file_key(ev)
+    times = maneuver_times_of(key)
+    assert {k: [str(t) for t in v] for k, v in times.items()} == {
+        "NORAD-1": ["2024-01-02 00:00:00"],
+        "NORAD-2": ["2024-01-03 00:00:00"],
+    }
+    write_events(frame.iloc[:1], str(ev))
+    with pytest.raises(InputError, match=r"ev\.csv.*changed since the run began"):
+        maneuver_times_of(key)

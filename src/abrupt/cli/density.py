@@ -19,7 +19,7 @@ from abrupt.density.precise_orbit import OrbitDensityConfig
 from abrupt.density.tle_drag import TleDragConfig
 from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET
 from abrupt.events import read_events
-from abrupt.pipelines.catalogue import file_key, maneuver_times_by_object, run_catalogue
+from abrupt.pipelines.catalogue import file_key, run_catalogue
 from abrupt.pipelines.density import orbit_density, tle_density, write_table
 from abrupt.report.density import NothingToPlot, plot_density_bands, plot_meteor_profile
 from abrupt.scale import Executor
@@ -370,8 +370,8 @@ def _windows_only(
         "drag_object": cfg,
     }
     if maneuvers_from:
-        settings["maneuvers_from"] = file_key(maneuvers_from)
-        settings["maneuver_times_object"] = maneuver_times_by_object(read_events(maneuvers_from))
+        read_events(maneuvers_from)  # a bad file is refused here, before any task runs
+        settings["maneuvers_from"] = file_key(maneuvers_from)  # each worker reads the times once
     click.echo(f"{len(files)} element file(s) on {executor.describe()}", err=True)
     run = run_catalogue(
         files,

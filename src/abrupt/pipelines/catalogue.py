@@ -19,6 +19,7 @@ are identical to those of an uninterrupted one.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
@@ -35,7 +36,7 @@ import pyarrow.parquet as pq
 from abrupt.density.drag_plausibility import IMPLAUSIBLE_STATUS
 from abrupt.density.tle_drag import TleDragConfig, rho_b_from_history
 from abrupt.errors import InputError
-from abrupt.events import empty_frame, normalise_frame
+from abrupt.events import empty_frame, normalise_frame, read_events
 from abrupt.model.atmosphere import read_space_weather
 from abrupt.pipelines.tle import detect_tle_file
 from abrupt.readers.omm import read_element_histories
@@ -119,6 +120,22 @@ def maneuver_times_by_object(events: pd.DataFrame) -> dict[str, list[Any]]:
     return {str(k): sorted(g.tolist()) for k, g in times.groupby(found["spacecraft"].astype(str))}
 
 
+def maneuver_times_of(key: str) -> dict[str, list[Any]]:
+    """Maneuver times per object from the events file a run names by its :func:`file_key`, read once per
+    process: a task carries the file's key, not the whole catalogue's times (pickled with every task,
+    those grew the run's memory and CPU with files × objects). Raises if the file changed since the run
+    began."""
+    path = key.rsplit(":", 2)[0]
+    if file_key(path) != key:
+        raise InputError("changed since the run began (size or modification time); start the run again", file=path)
+    return _maneuver_times_read(key)
+
+
+@functools.lru_cache(maxsize=2)
+def _maneuver_times_read(key: str) -> dict[str, list[Any]]:
+    return maneuver_times_by_object(read_events(key.rsplit(":", 2)[0]))
+
+
 def density_task(task: CatalogueTask) -> tuple[pd.DataFrame, list[str]]:
     """ρB windows of every object of one file (a pure function of the task)."""
     cfg: TleDragConfig = task.settings["drag_object"]
@@ -126,7 +143,8 @@ def density_task(task: CatalogueTask) -> tuple[pd.DataFrame, list[str]]:
         # the run's NRLMSIS tables, shared by its processes and kept for a resumed run
         cfg = replace(cfg, model_grid_cache=str(Path(task.settings["work_dir"]) / "msis-grid"))
     sw = read_space_weather(task.settings.get("space_weather")) if cfg.with_model else None
-    maneuvers: dict[str, list[Any]] | None = task.settings.get("maneuver_times_object")
+    key = task.settings.get("maneuvers_from")
+    maneuvers = maneuver_times_of(key) if key else None
     frames = []
     notes: list[str] = []
     for history in read_element_histories(task.path):
