@@ -33,8 +33,9 @@ from numpy.typing import NDArray
 from abrupt.flux.forward import ForwardConfig, OrbitCase, Template, build_template, with_seed
 from abrupt.flux.grid import refine_max
 from abrupt.flux.inference import DEFAULT_BETA_GRID, Likelihood, prepare
+from abrupt.flux.linear import linear_estimates
 from abrupt.simulate.population import draw_population, fleet_exposure
-from bench_flux_coverage import exact_cells, study_fleet
+from bench_flux_coverage import control_variate_mean, exact_cells, score_controls, study_fleet
 
 Cells = tuple[NDArray[np.float64], NDArray[np.float64]]
 
@@ -97,6 +98,7 @@ def profile_beta(cells_of_beta: list[Cells], n: NDArray[np.float64], grid: NDArr
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--fleets", type=int, default=20_000, help="cell-space fleets per truth")
+    parser.add_argument("--event-fleets", type=int, default=1000, help="event-level fleets per truth (section 4)")
     args = parser.parse_args()
     spec = study_fleet()
     exposure = fleet_exposure(spec)
@@ -178,7 +180,47 @@ def main() -> None:
                     f"{100 * m[1]:+7.2f} ± {100 * se[1]:4.2f} {sd[0]:9.2f} {sd[1]:9.2f}"
                 )
             print(f"{'':>14} ({time.process_time() - c1:.1f} s CPU)")
+    event_fleets(exposure, draw_tpl, fit_tpls[400_000], args.event_fleets)
     print(f"\ntotal {time.process_time() - c0:.1f} s CPU")
+
+
+def event_fleets(exposure, draw_tpl, fit_tpl, n_fleets: int) -> None:  # type: ignore[no-untyped-def]
+    """Section 4: the library on event-level fleets (draw_population, the coverage benchmark's first seeds),
+    β = 1 known: signed ML against the fixed-weight linear estimate, control-variate means."""
+    print(f"\n4. Event-level fleets (library: prepare, fit B signed ML, linear_estimates), β = 1, {n_fleets} per truth")
+    print("   control-variate mean bias ± s.e. (the score at the truth with the exact cells, as bench_flux_coverage)")
+    beta = 1.0
+    cells = exact_cells(exposure, draw_tpl, beta)
+    up = exact_cells(exposure, draw_tpl, beta * math.exp(0.05))
+    down = exact_cells(exposure, draw_tpl, beta * math.exp(-0.05))
+    n_bins = cells.shape[2]
+    for s_d in (0.3, 1.0, 3.0):
+        truth = {"debris_scale": s_d, "meteoroid_scale": 1.0, "beta": beta}
+        weights = score_controls(cells, truth, up, down)
+        mu = np.einsum("p,pck->ck", np.array([s_d, 1.0, 1.0]), cells).ravel()
+        c1 = time.process_time()
+        est: dict[str, list[list[float]]] = {"signed ML": [], "linear": []}
+        counts = []
+        for rep in range(n_fleets):
+            ev = draw_population(exposure, draw_tpl, truth, seed=10_000 * int(beta) + 100 * int(10 * s_d) + rep)
+            data = prepare(exposure, ev, fit_tpl)
+            counts.append(np.bincount(data.event_class * n_bins + data.event_bin, minlength=mu.size))
+            lik = Likelihood(data, np.array([beta]))
+            s, _ = lik.maximise({}, signed=True)
+            est["signed ML"].append([float(s[0, 0]), float(s[0, 1])])
+            lin = linear_estimates(lik, {})
+            est["linear"].append([lin["debris_scale"], lin["meteoroid_scale"]])
+        controls = (np.array(counts) - mu) @ weights.T
+        for name, rows in est.items():
+            rel = np.array(rows) / np.array([s_d, 1.0]) - 1
+            text = []
+            for j in range(2):
+                m, se = control_variate_mean(rel[:, j], controls)
+                text.append(f"{100 * m:+6.2f} ± {100 * se:4.2f} %")
+            print(
+                f"   s_d={s_d:g} {name:>10}: s_debris {text[0]}, s_meteoroid {text[1]}; s.d. {rel.std(axis=0).round(2)}"
+            )
+        print(f"   ({time.process_time() - c1:.1f} s CPU)")
 
 
 if __name__ == "__main__":

@@ -9,8 +9,10 @@ import pandas as pd
 import pytest
 from scipy import integrate
 
+from abrupt.errors import ConfigError
 from abrupt.flux.exposure import DAYS_PER_YEAR
 from abrupt.flux.inference import DEFAULT_BETA_GRID, Likelihood, fit, prepare
+from abrupt.flux.linear import linear_estimates
 from test_flux_inference import AMPLITUDE, CASE, CONFIG, SLOPE, events_from_counts, exposure, power_law_template
 
 FALSE_ALARMS = 0.02  # per day
@@ -93,3 +95,28 @@ def test_weights_change_the_fit_like_repeated_events() -> None:
     s2, _ = Likelihood(twice, np.array([1.0])).maximise({}, signed=True)
     assert s1[0] == pytest.approx(s2[0], rel=1e-6)
     assert isinstance(exp, pd.DataFrame)
+
+
+@pytest.mark.parametrize("reference", [(1.0, 1.0), (0.2, 5.0)])
+def test_linear_estimate_is_exactly_unbiased_on_unequal_days_with_background(reference: tuple[float, float]) -> None:
+    """E s̃ = s̃(E n) for a statistic linear in the counts: fed each cell's expected count (two spacecraft
+    analysed 40 % and 100 % of each day, a logistic efficiency, false alarms in the bins), the fixed-weight
+    estimate returns the truth for any reference θ₀; one scale held fixed joins the background."""
+    exp = exposure(2, 1.0, false_alarms=FALSE_ALARMS)
+    exp["dH50_Nms"], exp["efficiency_slope"] = DH50, K
+    exp.loc[exp["spacecraft"] == exp["spacecraft"].iloc[0], "analysed_fraction"] = 0.4
+    first = [exp[exp["spacecraft"] == sc].iloc[[0]] for sc in exp["spacecraft"].unique()]
+    ones = np.ones(CONFIG.n_bins, dtype=int)
+    events = pd.concat([events_from_counts(ones, day) for day in first], ignore_index=True)
+    lik = Likelihood(prepare(exp, events, {CASE: power_law_template()}), np.array([1.7]))
+    truth = np.array([0.3, 2.0])
+    days_of = exp["spacecraft"].value_counts()
+    n_days = np.repeat([days_of[day["spacecraft"].iloc[0]] for day in first], CONFIG.n_bins)
+    asimov = n_days * (lik.a[0] @ truth + lik.bg_events)  # every day of a spacecraft alike
+    est = linear_estimates(lik.reweighted(asimov), {}, reference)
+    assert [est["debris_scale"], est["meteoroid_scale"]] == pytest.approx(truth, rel=1e-9)
+    one = linear_estimates(lik.reweighted(asimov), {"meteoroid_scale": 2.0}, reference)
+    assert one["debris_scale"] == pytest.approx(0.3, rel=1e-9)
+    assert one["meteoroid_scale"] == 2.0
+    with pytest.raises(ConfigError, match="beta known"):
+        linear_estimates(Likelihood(lik.data, np.array([1.0, 2.0])), {})
