@@ -9,12 +9,15 @@ estimator's own small-sample bias; fitted with the fit template's cells, both to
 fit with β free (fit A, meteoroid scale fixed at 1) on the library's β grid and on a fine one separates
 the grid refinement from the template. (4) The fixed-weight linear estimator s̃ = I₀⁻¹ Σ_i a_i (n_i −
 B_i)/μ_i(θ₀) with θ₀ the published model (s = 1): exactly unbiased for any θ₀ when a_i are the true
-cells (E n_i = μ_i), shown beside the signed maximum likelihood with its spread.
+cells (E n_i = μ_i), shown beside the signed maximum likelihood with its spread. (5) The library itself
+(``abrupt.flux.linear.linear_estimates`` against fit B's signed maximum likelihood) on event-level fleets
+drawn by ``draw_population`` with the coverage benchmark's seeds, with its control-variate means.
 
 Fleet: the acceptance study's (bench_flux_coverage.study_fleet: 10 Fermi-like spacecraft × 1 year).
 Exact cells: ``bench_flux_coverage.exact_cells`` (sums over the draw template's own Monte Carlo draws).
 Fit cells: ``Likelihood.cell_expectations`` of the fit template. Run: ``nice -n 10 python
-benchmarks/bench_flux_asimov.py`` (about 1 CPU-minute; ``--fleets`` per truth, default 20 000).
+benchmarks/bench_flux_asimov.py`` (about 4 CPU-minutes; ``--fleets`` cell-space fleets per truth, default
+20 000; ``--event-fleets`` event-level ones, default 1 000).
 """
 
 from __future__ import annotations
