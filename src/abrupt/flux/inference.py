@@ -79,6 +79,9 @@ class FluxData:
     background_att: NDArray[np.float64] | None = None
     rows_set_aside: int = 0  # exposure rows of a spacecraft-day shared with a detector expected to see more
     events_set_aside: int = 0  # events of those rows' detectors on those days
+    # per exposure day: template group, whether its cells are (class, bin) (orbit attitude and directions
+    # used) or bins only, efficiency curve, f_d and f_d b_d; per curve: bin efficiency and false-alarm share
+    days: dict[str, NDArray[Any]] = field(default_factory=dict)
 
     @property
     def n_events(self) -> int:
@@ -133,7 +136,8 @@ def prepare(
     rows_a = np.asarray(exp_keys.get_indexer(pd.Index(ev_keys)), dtype=np.int64)
     dh = pd.to_numeric(ev["dH_Nms"], errors="coerce").to_numpy()
     vec = np.full((len(ev), 3), np.nan)
-    if use_direction and all(c in ev.columns for c in ORBIT_FRAME_COLUMNS):
+    directional = use_direction and all(c in ev.columns for c in ORBIT_FRAME_COLUMNS)
+    if directional:
         vec = ev.loc[:, list(ORBIT_FRAME_COLUMNS)].apply(pd.to_numeric, errors="coerce").to_numpy()
     cls = direction_class(vec)
     if len(ev):
@@ -162,6 +166,8 @@ def prepare(
         background_att=(fa_att @ share_u).reshape(len(keys), 2, -1),
         rows_set_aside=chosen.rows_set_aside,
         events_set_aside=chosen.events_set_aside,
+        days={"group": group, "directional": (exp["attitude"].to_numpy() == "orbit") & directional, "curve": curve_of}
+        | {"f": f, "fa": fa, "efficiency": eff_u, "share": share_u},
     )
 
 
