@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy import signal
 
 from abrupt.detect.attitude.torque_scan import jump_share, scan_torque, window_difference
 from abrupt.series.timetable import NS
@@ -73,3 +74,30 @@ def test_realised_rate_on_white_noise_is_near_the_stated_one() -> None:
     for cal in scan.calibrations:
         stated = budget.per_day * cal.days
         assert stated / 2.5 <= cal.exceedances <= stated * 2.5, (cal.channel, cal.exceedances, stated)
+
+
+def test_busy_day_of_steps_and_ramps_in_coloured_noise() -> None:
+    """A day of AR(1)-coloured plus white noise with a step or a ramp every half hour (two steps to a
+    ramp): every finding lies on a ramp (none on a step, none elsewhere), and the large ramps are found."""
+    rng = np.random.default_rng(7)
+    n = 86_400
+    t = T0 + np.arange(n, dtype=np.int64) * NS
+    h = signal.lfilter([1.0], [1.0, -0.995], rng.normal(0.0, 1e-3, (n, 3)), axis=0)
+    h += rng.normal(0.0, SIGMA, (n, 3))
+    x = np.arange(n)
+    ramps = []
+    for k, t0 in enumerate(range(1800, n - 1800, 1800)):
+        u = rng.normal(size=3)
+        u /= np.linalg.norm(u)
+        size = float(np.exp(rng.uniform(np.log(0.01), np.log(0.6))))
+        if k % 3 == 0:
+            dur = float(rng.uniform(60.0, 600.0))
+            h += np.clip((x - t0) / dur, 0.0, 1.0)[:, None] * u * size
+            ramps.append((t0, t0 + dur, size))
+        else:
+            h += (x >= t0)[:, None] * u * size
+    found = scan_torque(t, h, np.ones(n, bool), (int(t[0]), int(t[-1]) + 1)).findings
+    at = [(f.time_ns - T0) / NS for f in found]
+    assert all(any(a - 30 <= s <= b + 30 for a, b, _ in ramps) for s in at), at
+    big = [(a, b) for a, b, size in ramps if size >= 0.1]
+    assert big and all(any(a <= s <= b for s in at) for a, b in big)

@@ -438,7 +438,7 @@ def process_span(
         table, spacecraft, h_n, hc, ok, detector, peaks, evidence, config.evidence_floor, core, inertia_kgm2
     )
     peaks, evidence = peaks + found, {**evidence, **found_ev}
-    faults = scan_span(samples, flight, table, spacecraft, ok, start_ns, end_ns, hc)
+    faults = scan_span(samples, flight, table, spacecraft, ok, start_ns, end_ns)
     edges = [start_ns, end_ns]
     if split_days:
         d_first = -(-start_ns // DAY_NS) * DAY_NS

@@ -144,12 +144,13 @@ def scan_span(
     ok: BoolArray,
     start_ns: int,
     end_ns: int,
-    h_clean: FloatArray | None = None,
     budget: FalseAlarmBudget = FAULT_FALSE_ALARMS,
+    *,
+    h_clean: FloatArray | None = None,
 ) -> FaultScan:
     """The fault scans of [start, end), each UTC day calibrated on its own data (the span's margin is
     scanned but gives no finding); with the cleaned ᴺH ``h_clean`` also the lasting-torque scan
-    (:mod:`abrupt.detect.attitude.torque_scan`, its own stated rate)."""
+    (:mod:`abrupt.detect.attitude.torque_scan`, its own stated rate; the flight pipeline does not pass it)."""
     first = -(-start_ns // DAY_NS) * DAY_NS
     edges = [start_ns, *range(first if first > start_ns else first + DAY_NS, end_ns, DAY_NS), end_ns]
     parts = [scan_faults(samples, flight, table, spacecraft, ok, (a, b), budget) for a, b in itertools.pairwise(edges)]

@@ -60,6 +60,8 @@ MIN_COVER = 0.8
 #: The smallest threshold [σ] of a scale (nothing within this of its own noise is a torque).
 MIN_SIGMA = 5.0
 CHANNEL = "momentum"
+#: Refits of the threshold without the neighbourhoods of what exceeded it.
+TRIM_PASSES = 2
 #: The levels [σ] whose crossings fit the null's rate.
 FIT_LEVELS = np.linspace(1.5, 3.0, 7)
 
@@ -102,6 +104,19 @@ def crossing_threshold(t_ns: np.ndarray, z: FloatArray, use: BoolArray, gap_s: f
     return lo if excess(lo) <= 0 else float(optimize.brentq(excess, lo, 100.0))
 
 
+def trimmed_threshold(t_ns: np.ndarray, z: FloatArray, use: BoolArray, gap_s: float, n: int, expected: float) -> float:
+    """:func:`crossing_threshold` fitted again (``TRIM_PASSES`` times) without the samples within ``n`` of
+    any above the previous threshold: a busy day's strikes and leaks cross every level below their own
+    size and would flatten the fitted tail."""
+    fit = use
+    thr = crossing_threshold(t_ns, z, fit, gap_s, expected)
+    for _ in range(TRIM_PASSES):
+        above = np.convolve((use & (z > thr)).astype(np.int8), np.ones(2 * n + 1, np.int8), "same") > 0
+        fit = use & ~above
+        thr = crossing_threshold(t_ns, z, fit, gap_s, expected * fit.sum() / max(use.sum(), 1))
+    return thr
+
+
 def jump_share(h: FloatArray, ok: BoolArray, j: int, n: int, k: int, change: FloatArray) -> float:
     """The largest change between the ``k`` samples either side of any instant of [j − n, j + n),
     along ``change``, over |change|: near 1 for a step, about k / n for a steady drift."""
@@ -142,7 +157,7 @@ def scan_torque(
             continue
         sig = np.array([max(robust_sigma(d[use, a]), 1e-15) for a in range(d.shape[1])])
         z = np.where(use, np.linalg.norm(d / sig, axis=1), np.nan)
-        thr = max(crossing_threshold(t_ns, z, use, w, budget.per_day * days), floor)
+        thr = max(trimmed_threshold(t_ns, z, use, w, n, budget.per_day * days), floor)
         over = use & (z > thr)
         peaks = clusters(t_ns, np.nan_to_num(z), over, gap_s=w)
         drifts = [j for j in peaks if jump_share(h_clean, ok, j, n, k, d[j]) < JUMP_SHARE_MAX]
