@@ -354,14 +354,15 @@ def figure(store: Path, sc, ranges: ConfounderRanges, path: str, seed: int, verb
         if not near and not scans:
             print(f"figure: {title}: no event")
             continue
-        panels.append(_panel(title, near, scans, chunk, table, hc, verbose))
+        panels.append(_panel(title, near, scans, chunk, table, hc, verbose, sc))
     plot_event_panels(path, table, hc, sc, panels)
     print(f"figure written to {path}")
 
 
-def _panel(title: str, near, scans, chunk, table, hc, verbose: bool) -> EventPanel:
+def _panel(title: str, near, scans, chunk, table, hc, verbose: bool, sc) -> EventPanel:
     """The panel of one injection: its strongest event as the pipeline classifies it (a scan's finding
-    within ``MERGE_S`` gives a non-strike its class, as in the run; a finding with no event is the event)."""
+    within ``MERGE_S`` gives a non-strike its class, as in the run; a finding with no event is the event).
+    A wheel's fault is drawn along that wheel's axis (its reading moved, the body did not)."""
     if near:
         p = max(near, key=lambda q: q.value)
         a = classify(chunk.evidence[p.time_ns])
@@ -379,6 +380,10 @@ def _panel(title: str, near, scans, chunk, table, hc, verbose: bool) -> EventPan
         i = int(np.searchsorted(table.time_ns, t_ns))
         dh = np.nanmean(hc[i : i + 120], axis=0) - np.nanmean(hc[max(0, i - 120) : i], axis=0)
     print(f"figure: {title}: {kind} {channel} ({reason})")
+    if channel.startswith("wheel_"):
+        i = int(np.clip(np.searchsorted(table.time_ns, t_ns), 0, len(table) - 1))
+        axis_b = np.asarray(sc.wheel_axes[:, int(channel.split("_")[1]) - 1], float)
+        dh = 0.01 * dcm_from_quaternion(table.quaternion_BN[i]).T @ axis_b
     return EventPanel(f"{title}\n→ {kind} {channel}".strip(), t_ns, dh)
 
 
