@@ -22,12 +22,13 @@ import numpy as np
 import pandas as pd
 
 from abrupt.detect.attitude.fault_scan import FAULT_FALSE_ALARMS, FaultFinding, FaultScan, scan_faults
+from abrupt.detect.attitude.torque_scan import scan_torque
 from abrupt.events import Event, events_frame, format_time_utc, make_event_id
 from abrupt.model.flight_config import FlightConfig
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.timetable import NS, Timetable
 from abrupt.thresholds.budget import FalseAlarmBudget
-from abrupt.types import BoolArray
+from abrupt.types import BoolArray, FloatArray
 
 DAY_NS = 86_400 * NS
 __all__ = ["FAULT_COLUMNS", "FaultScan", "merge_fault_findings", "scan_span"]
@@ -144,10 +145,15 @@ def scan_span(
     start_ns: int,
     end_ns: int,
     budget: FalseAlarmBudget = FAULT_FALSE_ALARMS,
+    *,
+    h_clean: FloatArray | None = None,
 ) -> FaultScan:
     """The fault scans of [start, end), each UTC day calibrated on its own data (the span's margin is
-    scanned but gives no finding)."""
+    scanned but gives no finding); with the cleaned ᴺH ``h_clean`` also the lasting-torque scan
+    (:mod:`abrupt.detect.attitude.torque_scan`, its own stated rate; the flight pipeline does not pass it)."""
     first = -(-start_ns // DAY_NS) * DAY_NS
     edges = [start_ns, *range(first if first > start_ns else first + DAY_NS, end_ns, DAY_NS), end_ns]
     parts = [scan_faults(samples, flight, table, spacecraft, ok, (a, b), budget) for a, b in itertools.pairwise(edges)]
+    if h_clean is not None:
+        parts += [scan_torque(table.time_ns, h_clean, ok, (a, b)) for a, b in itertools.pairwise(edges)]
     return FaultScan([f for p in parts for f in p.findings], [c for p in parts for c in p.calibrations])
