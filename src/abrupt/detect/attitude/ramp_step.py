@@ -78,10 +78,9 @@ def from_body_increments(y_B: FloatArray, q_BN: FloatArray, h0_N: FloatArray) ->
     return np.asarray(h0_N, dtype=np.float64)[None, :] + np.cumsum(dn, axis=0)
 
 
-def fit_ramp_step(
-    tau_s: FloatArray, y_B: FloatArray, step_s: float, min_ramp_s: float = 8.0, n_durations: int = 16
-) -> RampStep | None:
-    """The fit of the module docstring, or None when the window is too short or its noise unknown."""
+def _finite_window(tau_s: FloatArray, y_B: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray] | None:
+    """The window's finite samples (τ s, y body axes) and each axis's noise σ; None when fewer than 60
+    samples are finite or an axis's noise is unknown or zero."""
     ok = np.isfinite(y_B).all(axis=1)
     t, v = tau_s[ok], y_B[ok]
     if t.size < 60:
@@ -89,6 +88,17 @@ def fit_ramp_step(
     sig = np.array([_noise_sigma(v[:, k]) for k in range(3)])
     if not np.all(np.isfinite(sig)) or not np.all(sig > 0):
         return None
+    return t, v, sig
+
+
+def fit_ramp_step(
+    tau_s: FloatArray, y_B: FloatArray, step_s: float, min_ramp_s: float = 8.0, n_durations: int = 16
+) -> RampStep | None:
+    """The fit of the module docstring, or None when the window is too short or its noise unknown."""
+    window = _finite_window(tau_s, y_B)
+    if window is None:
+        return None
+    t, v, sig = window
     span = float(t[-1] - t[0])
     x_step = (t >= step_s).astype(np.float64)
     basis, _ = np.linalg.qr(np.column_stack([np.ones_like(t), (t - t.mean()) / max(span, 1.0), x_step]))
@@ -189,13 +199,10 @@ def step_siblings(
     leak's ramp or of the cleaning's smooth drift around a large step is not). None when the window
     is too short or its noise unknown.
     """
-    ok = np.isfinite(y_B).all(axis=1)
-    t, v = tau_s[ok], y_B[ok]
-    if t.size < 60:
+    window = _finite_window(tau_s, y_B)
+    if window is None:
         return None
-    sig = np.array([_noise_sigma(v[:, k]) for k in range(3)])
-    if not np.all(np.isfinite(sig)) or not np.all(sig > 0):
-        return None
+    t, v, sig = window
     span = max(float(t[-1] - t[0]), 1.0)
     vw = v / sig
     steps = [step_s]
