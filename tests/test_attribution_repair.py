@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -22,7 +23,7 @@ from abrupt.detect.attitude.repair import (
     repair_sensor_fault,
     repair_wheel,
 )
-from abrupt.model.spacecraft import load_spacecraft
+from abrupt.model.spacecraft import Spacecraft, load_spacecraft
 from abrupt.pipelines.flight_attribution import rescan_after_faults
 from abrupt.series.timetable import NS, Timetable
 from abrupt.series.timetable_momentum import timetable_momentum
@@ -175,6 +176,21 @@ def _closed_loop_table(rng: np.random.Generator, strike_at: int, dh_b: np.ndarra
     )
 
 
+def _glr_peaks(
+    sc: Spacecraft, table: Timetable
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, FlightGlrDetector, list[tuple[int, Any]]]:
+    """ᴺH of the table, ᴺH less the median of its first 1000 s, the all-true mask, the detector and its
+    peaks above 5 (the bare scan the rescan tests start from)."""
+    h_n, _ = timetable_momentum(sc, table)
+    hc = h_n - np.median(h_n[:1000], axis=0)
+    ok = np.ones(len(table), bool)
+    det = FlightGlrDetector()
+    win = det.windows(1.0)
+    stat = det.statistic(hc, ok, win)
+    peaks = [(i, p) for i, p in det.find_peaks(hc, ok, stat, table.time_ns, 1.0, win) if p.value > 5.0]
+    return h_n, hc, ok, det, peaks
+
+
 def test_a_strike_covered_by_a_wheel_glitchs_event_is_found_after_the_wheel_is_repaired() -> None:
     """A 30-rpm glitch of wheel 2 for 300 s (0.38 N·m·s in its reading) with a 0.08 N·m·s strike 40 s
     after its onset: one event (peaks are a window span apart), a wheel fault; after the repair the
@@ -186,13 +202,7 @@ def test_a_strike_covered_by_a_wheel_glitchs_event_is_found_after_the_wheel_is_r
     w = table.wheel_speed_rad_s.copy()
     w[1200:1500, 1] += 30 * 2 * np.pi / 60
     table = replace(table, wheel_speed_rad_s=w)
-    h_n, _ = timetable_momentum(sc, table)
-    hc = h_n - np.median(h_n[:1000], axis=0)
-    ok = np.ones(len(table), bool)
-    det = FlightGlrDetector()
-    win = det.windows(1.0)
-    stat = det.statistic(hc, ok, win)
-    peaks = [(i, p) for i, p in det.find_peaks(hc, ok, stat, table.time_ns, 1.0, win) if p.value > 5.0]
+    h_n, hc, ok, det, peaks = _glr_peaks(sc, table)
     ev = {p.time_ns: event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n) for _, p in peaks}
     assert len(peaks) == 1
     first = classify(ev[peaks[0][1].time_ns])
@@ -217,13 +227,7 @@ def test_a_strike_after_a_large_gyro_bias_step_is_found_beside_what_the_repair_l
     om = table.body_rate_rad_s.copy()
     om[1200:, 0] += np.deg2rad(0.02)
     table = replace(table, body_rate_rad_s=om)
-    h_n, _ = timetable_momentum(sc, table)
-    hc = h_n - np.median(h_n[:1000], axis=0)
-    ok = np.ones(len(table), bool)
-    det = FlightGlrDetector()
-    win = det.windows(1.0)
-    stat = det.statistic(hc, ok, win)
-    peaks = [(i, p) for i, p in det.find_peaks(hc, ok, stat, table.time_ns, 1.0, win) if p.value > 5.0]
+    h_n, hc, ok, det, peaks = _glr_peaks(sc, table)
     # The event: the strongest peak (the bias turns with the body in ᴺH, a slow drift that the flight
     # pipeline's cleaning takes out and this bare median does not).
     peaks = [max(peaks, key=lambda c: c[1].value)]
