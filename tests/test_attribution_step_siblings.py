@@ -90,6 +90,7 @@ COMMON = dict(
     st_gyro_step_rad=1e-5, st_gyro_step_limit_rad=3e-4, st_gyro_slope_rad_s=1e-7, st_gyro_slope_limit_rad_s=4e-6,
     body_share=0.3, body_share_sigma=0.02, wheel_change_Nms=0.1, wheel_change_sigma_Nms=4e-4,
     wheel_null_fraction=0.01, wheel_max_share=0.4, wheel_takeup=0.9, raw_step_fraction=1.0, lasting_fraction=1.1,
+    alone_step_lasting=1.0,
 )  # fmt: skip
 
 

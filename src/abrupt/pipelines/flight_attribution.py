@@ -16,6 +16,9 @@ Around an external torque's event (a leak, a venting sequence: one body directio
 repaired, since the torque is real; the ramp's body direction is taken out of ᴺH instead
 (:mod:`abrupt.detect.attitude.ramp_step`) and the rest rescanned: a peak there is kept only when its
 evidence says strike (an impulsive step off the torque's direction), not another piece of the torque.
+Around a strike whose window also holds a ramp (a leak beside it: one event, at the larger step), the
+strike's fitted step is taken out and the rest rescanned: a peak there is kept when its evidence is an
+external torque's, so the leak gets an event of its own.
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ from abrupt.detect.attitude.attribution import AttributionRules, classify
 from abrupt.detect.attitude.evidence import EventEvidence, event_evidence
 from abrupt.detect.attitude.flight_glr import FlightGlrDetector, Peak
 from abrupt.detect.attitude.ramp_step import (
+    RampStep,
     body_frame_momentum,
     fit_ramp_step,
     from_body_increments,
@@ -37,6 +41,7 @@ from abrupt.detect.attitude.ramp_step import (
 )
 from abrupt.detect.attitude.repair import repair_sensor_fault
 from abrupt.events import format_time_utc, make_event_id
+from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.timetable import NS, Timetable
 from abrupt.series.timetable_momentum import timetable_momentum
@@ -108,22 +113,33 @@ def _best_peak(
     t0_ns: int,
     floor: float,
     keep_sub: BoolArray | None,
+    span_ns: tuple[int, int] | None = None,
+    avoid: tuple[tuple[int, float, float], ...] = (),
+    located: bool = True,
 ) -> tuple[int, Peak] | None:
-    """The strongest peak of the statistic of ``hc_sub`` above ``floor`` within ``RESCAN_SPAN_S`` of
-    ``t0_ns`` and more than ``RESCAN_APART_S`` from it (None when there is none)."""
+    """The strongest peak of the statistic of ``hc_sub`` above ``floor`` within ``span_ns`` (default
+    ``RESCAN_SPAN_S`` around ``t0_ns``), more than ``RESCAN_APART_S`` from ``t0_ns`` and outside each
+    (time [ns], before [s], after [s]) of ``avoid``, both the statistic's peak and (when ``located``) the
+    step located near it (None when there is none)."""
     win = detector.windows(dt)
     stat = detector.statistic(hc_sub, ok_sub, win)
-    tau = (g_sub - t0_ns) / NS
-    look = (tau >= RESCAN_SPAN_S[0]) & (tau <= RESCAN_SPAN_S[1]) & (np.abs(tau) > RESCAN_APART_S)
+    lo, hi = span_ns or (t0_ns + int(RESCAN_SPAN_S[0] * NS), t0_ns + int(RESCAN_SPAN_S[1] * NS))
+    zones = ((t0_ns, RESCAN_APART_S, RESCAN_APART_S), *avoid)
+
+    def free(t: np.ndarray) -> np.ndarray:
+        ok_t = (t >= lo) & (t <= hi)
+        for tz, before, after in zones:
+            ok_t &= ~((t >= tz - int(before * NS)) & (t <= tz + int(after * NS)))
+        return ok_t
+
+    look = free(g_sub)
     if keep_sub is not None:
         look &= keep_sub
     stat = np.where(look, stat, np.nan)
     cands = [
         (j, p)
         for j, p in detector.find_peaks(hc_sub, ok_sub, stat, g_sub, dt, win)
-        if p.value > floor
-        and RESCAN_APART_S < abs(dt_s := (p.time_ns - t0_ns) / NS)
-        and RESCAN_SPAN_S[0] <= dt_s <= RESCAN_SPAN_S[1]
+        if p.value > floor and (not located or free(np.array([p.time_ns]))[0])
     ]
     return max(cands, key=lambda c: c[1].value) if cands else None
 
@@ -158,6 +174,33 @@ def _off_ramp(table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int
     return np.where(np.isfinite(h), from_body_increments(y_off, q[a:b], h0), np.nan)
 
 
+def _without_step(
+    table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int
+) -> tuple[FloatArray, RampStep] | None:
+    """Cleaned ᴺH over rows [a, b) with the step at row ``i0`` taken out, and the fit, when the window
+    around it also holds a ramp beyond its noise (a leak beside a strike); None otherwise. The step is
+    that of the step-on-a-ramp fit (:func:`~abrupt.detect.attitude.ramp_step.fit_ramp_step`), fixed in
+    body axes at ``i0``, so what is left is the ramp and the rest of the window."""
+    g = table.time_ns
+    half = round(RAMP_WINDOW_S / table.dt_s)
+    lo, hi = max(0, i0 - half), min(g.size, i0 + half + 1)
+    q = table.quaternion_BN
+    fit = fit_ramp_step((g[lo:hi] - g[i0]) / NS, body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi]), 0.0)
+    if fit is None or not float(np.linalg.norm(fit.ramp_B)) > RAMP_SIGMA_MIN * fit.ramp_sigma:
+        return None
+    h = cleaned_H_N[a:b]
+    y_b = body_frame_momentum(h, q[a:b])
+    y_b = y_b - (g[a:b] >= g[i0])[:, None] * fit.step_B[None, :]
+    first = int(np.argmax(np.isfinite(h).all(axis=1)))
+    h0 = np.where(np.isfinite(h[first]), h[first], 0.0)
+    return np.where(np.isfinite(h), from_body_increments(y_b, q[a:b], h0), np.nan), fit
+
+
+#: After a strike the closed loop hands the impulse from the body to the wheels within its settling time
+#: [s]: what the fitted step leaves there is the strike's, not a second source.
+SETTLE_S = 30.0
+
+
 def rescan_after_faults(
     table: Timetable,
     spacecraft: Spacecraft,
@@ -180,7 +223,10 @@ def rescan_after_faults(
     peak from ``RESCAN_SPAN_S`` around the fault's step and at least ``RESCAN_APART_S`` from it becomes
     a new peak, with evidence from the repaired telemetry. For every ``external_non_strike`` peak the
     ramp's body direction is taken out of cleaned ᴺH (:func:`_off_ramp`) and the strongest peak of the
-    rest is kept when its evidence (of the telemetry as it is) is a strike's.
+    rest is kept when its evidence (of the telemetry as it is) is a strike's; its look window covers the
+    detector's suppression zone around the torque's peak. For every ``strike`` peak whose window also
+    holds a ramp, the strike's fitted step is taken out and the rest rescanned
+    (:func:`_torque_beside_strike`): a peak there is kept when its evidence is an external torque's.
     """
     g = table.time_ns
     dt = table.dt_s
@@ -188,20 +234,27 @@ def rescan_after_faults(
     found: list[tuple[int, Peak]] = []
     found_ev: dict[int, EventEvidence] = {}
     half_s = RESCAN_SPAN_S[1] + win.span * dt
-    for _, pk in peaks:
+    others = tuple((int(p.time_ns), RESCAN_APART_S, RESCAN_APART_S) for _, p in peaks)
+    for i_pk, pk in peaks:
         ev = evidence.get(pk.time_ns)
         if ev is None:
             continue
         a_ = classify(ev, rules)
         i0 = int(np.clip(np.searchsorted(g, pk.time_ns), 0, g.size - 1))
         a, b = max(0, i0 - round((half_s + 240.0) / dt)), min(g.size, i0 + round((half_s + 240.0) / dt))
+        keep_sub = None if keep is None else keep[a:b]
         if a_.kind == "external_non_strike":
             hc_sub = _off_ramp(table, cleaned_H_N, i0, a, b)
             if hc_sub is None:
                 continue
             hc_sub = np.where(ok[a:b, None], hc_sub, np.nan)
+            # The detector kept one peak per window span around this one: a strike anywhere in that zone
+            # (around the statistic's peak sample, which a ramp's located step may sit far from) was hidden.
+            t_pk = int(g[min(i_pk, g.size - 1)])
+            zone = (min(t_pk - win.span * dt * NS, pk.time_ns + RESCAN_SPAN_S[0] * NS),
+                    max(t_pk + win.span * dt * NS, pk.time_ns + RESCAN_SPAN_S[1] * NS))  # fmt: skip
             best = _best_peak(
-                detector, hc_sub, ok[a:b], g[a:b], dt, pk.time_ns, floor, None if keep is None else keep[a:b]
+                detector, hc_sub, ok[a:b], g[a:b], dt, pk.time_ns, floor, keep_sub, (int(zone[0]), int(zone[1])), others
             )
             if best is None:
                 continue
@@ -215,6 +268,15 @@ def rescan_after_faults(
             found.append((a + j, p))
             found_ev[p.time_ns] = replace(ev_new, after_torque_s=(p.time_ns - pk.time_ns) / NS)
             continue
+        if a_.kind == "strike":
+            got = _torque_beside_strike(
+                table, spacecraft, raw_H_N, cleaned_H_N, ok, detector, pk, (i0, a, b), floor, keep_sub, others,
+                inertia_kgm2, rules,
+            )  # fmt: skip
+            if got is not None:
+                found.append(got[0])
+                found_ev[got[0][1].time_ns] = got[1]
+            continue
         if a_.kind != "sensor_fault" or not a_.channel:
             continue
         rep = repair_sensor_fault(table, spacecraft, i0, a_.channel, a_.reason, half_s)
@@ -222,7 +284,7 @@ def rescan_after_faults(
             continue
         h_new, _ = timetable_momentum(spacecraft, _rows(rep.table, a, b), inertia_kgm2)
         hc_sub = np.where(ok[a:b, None], cleaned_H_N[a:b] + (h_new - raw_H_N[a:b]), np.nan)
-        best = _best_peak(detector, hc_sub, ok[a:b], g[a:b], dt, pk.time_ns, floor, None if keep is None else keep[a:b])
+        best = _best_peak(detector, hc_sub, ok[a:b], g[a:b], dt, pk.time_ns, floor, keep_sub)
         if best is None:
             continue
         j, p = best
@@ -236,3 +298,53 @@ def rescan_after_faults(
         )
         found_ev[p.time_ns] = replace(ev_new, after_fault_s=(p.time_ns - pk.time_ns) / NS)
     return found, found_ev
+
+
+def _torque_beside_strike(
+    table: Timetable,
+    spacecraft: Spacecraft,
+    raw_H_N: FloatArray,
+    cleaned_H_N: FloatArray,
+    ok: BoolArray,
+    detector: FlightGlrDetector,
+    pk: Peak,
+    rows: tuple[int, int, int],
+    floor: float,
+    keep_sub: BoolArray | None,
+    others: tuple[tuple[int, float, float], ...],
+    inertia_kgm2: FloatArray | None,
+    rules: AttributionRules | None,
+) -> tuple[tuple[int, Peak], EventEvidence] | None:
+    """A lasting external torque's own peak beside a strike's event, or None.
+
+    A leak whose onset is within a window span of a strike makes one event, at the (larger) strike: the
+    strike's fitted step (:func:`_without_step`) is taken out of ᴺH (raw and cleaned alike) and the
+    statistic rescanned, outside the loop's settling after the strike. Its strongest peak is kept only
+    when its evidence, from the momentum without the strike, is an external torque's (a ramp or a
+    sequence); it becomes an event, like any other peak, only above the run's threshold.
+    """
+    g, dt = table.time_ns, table.dt_s
+    i0, a, b = rows
+    got = _without_step(table, cleaned_H_N, i0, a, b)
+    if got is None:
+        return None
+    hc_sub, fit = np.where(ok[a:b, None], got[0], np.nan), got[1]
+    zones = ((int(pk.time_ns), RESCAN_APART_S, SETTLE_S), *others)
+    best = _best_peak(detector, hc_sub, ok[a:b], g[a:b], dt, pk.time_ns, floor, keep_sub, avoid=zones, located=False)
+    # The torque's event is at the fitted ramp's onset (a ramp has no step of its own for the locator to put
+    # the event at), apart from the strike and from every other peak; its ΔH is the ramp's, in inertial axes.
+    t_on = int(g[i0]) + int(fit.onset_s * NS)
+    if best is None or any(tz - int(lo * NS) <= t_on <= tz + int(hi * NS) for tz, lo, hi in zones):
+        return None
+    k_on = int(np.clip(np.searchsorted(g, t_on), 0, g.size - 1))
+    k_mid = int(np.clip(np.searchsorted(g, t_on + int(0.5 * fit.duration_s * NS)), 0, g.size - 1))
+    dh_n = dcm_from_quaternion(table.quaternion_BN[k_mid]).T @ fit.ramp_B
+    p = Peak(int(g[k_on]), best[1].value, dh_n, best[1].time_sigma_s)
+    shift = np.nan_to_num(hc_sub - cleaned_H_N[a:b])
+    hc_full, raw_full = cleaned_H_N.copy(), raw_H_N.copy()
+    hc_full[a:b] += shift
+    raw_full[a:b] += shift
+    ev_new = event_evidence(table, hc_full, spacecraft, p.time_ns, dh_n, inertia_kgm2=inertia_kgm2, raw_H_N=raw_full)
+    if classify(ev_new, rules).kind != "external_non_strike":
+        return None
+    return (k_on, p), replace(ev_new, after_strike_s=(p.time_ns - pk.time_ns) / NS)

@@ -8,19 +8,26 @@ and channel (one channel moved and the physics it must obey did not: a wheel rea
 response, a rate sensor the other did not follow, an appendage drive that jumped), with the finding
 in its ``fault_*`` columns. A strike is never re-classified by a scan (the scans' physical gates
 exclude motion): a finding within ``STRIKE_S`` of a strike's event is written beside it in its
-``fault_*`` columns, and a finding further from it is a second thing; a finding with no event nearby
+``fault_*`` columns, and a finding further from it is a second thing (an appendage finding treats an
+event at which total ᴺH stepped the same way: an internal event conserves the total, so that step is
+not the appendage's); a finding with no event nearby
 becomes an event of its own (detector ``attitude.fault_scan``, its statistic and threshold in σ of
 its channel's noise, the rate its threshold was set for; ΔH empty: a fault changes no momentum).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
+import math
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
+from abrupt.detect.attitude.attribution import momentum_stepped
+from abrupt.detect.attitude.evidence import EventEvidence
 from abrupt.detect.attitude.fault_scan import FAULT_FALSE_ALARMS, FaultFinding, FaultScan, scan_faults
 from abrupt.detect.attitude.torque_scan import scan_torque
 from abrupt.events import Event, events_frame, format_time_utc, make_event_id
@@ -93,33 +100,58 @@ def _annotate(out: pd.DataFrame, i: int, f: FaultFinding, kind: bool = False) ->
         out.at[row, column] = value
 
 
+def _stepped(events: pd.DataFrame) -> np.ndarray:
+    """Per event: did total ᴺH step at it (:func:`~abrupt.detect.attitude.attribution.momentum_stepped`,
+    from its ``ev_*`` columns; False where they are missing)?"""
+    names = [f.name for f in dataclasses.fields(EventEvidence) if f"ev_{f.name}" in events and f.type != "int"]
+    out = np.zeros(len(events), bool)
+    for k, row in enumerate(events[[f"ev_{n}" for n in names]].itertuples(index=False)):
+        values: dict[str, Any] = {n: float(v) if pd.notna(v) else math.nan for n, v in zip(names, row, strict=True)}
+        ev = dataclasses.replace(EventEvidence(), **values)
+        out[k] = momentum_stepped(ev)
+    return out
+
+
 def merge_fault_findings(
     events: pd.DataFrame, findings: Sequence[FaultFinding], spacecraft: str, run_id: str, cfg_hash: str
 ) -> pd.DataFrame:
-    """``events`` with the findings merged in (module docstring), sorted by time, ids recomputed."""
+    """``events`` with the findings merged in (module docstring), sorted by time, ids recomputed.
+
+    ``attrs["fault_findings_dropped"]`` counts the findings merged into nothing: a second finding on an
+    event another (stronger) finding already gave its class, or a finding within ``MERGE_S`` of a new
+    event made from a stronger finding.
+    """
     out = events.copy()
     for c in FAULT_COLUMNS:
         out[c] = pd.Series(dtype="string" if c == "fault_channel" else "float64", index=out.index)
+    out.attrs["fault_findings_dropped"] = 0
     if not findings:
         return out
     t_ev = _times_ns(out)
     kinds = out["kind"].astype(str).to_numpy() if len(out) else np.empty(0, str)
+    # An internal event conserves total ᴺH: an event at which it stepped is no appendage's, whatever it was
+    # called; an appendage finding near it is written beside it (or becomes its own event), as at a strike.
+    stepped = _stepped(out) & (kinds != "strike")
     taken = np.zeros(len(out), bool)
     new: list[FaultFinding] = []
+    dropped = 0
     for f in sorted(findings, key=lambda f: -f.statistic / max(f.threshold, 1e-12)):
-        at_strike = np.flatnonzero((np.abs(t_ev - f.time_ns) <= STRIKE_S * NS) & (kinds == "strike"))
+        strike_like = (kinds == "strike") | (stepped & (f.kind == "internal"))
+        at_strike = np.flatnonzero((np.abs(t_ev - f.time_ns) <= STRIKE_S * NS) & strike_like)
         if at_strike.size:  # evidence beside the strike; its class stays
             _annotate(out, int(at_strike[0]), f)
             continue
-        near = np.flatnonzero((np.abs(t_ev - f.time_ns) <= MERGE_S * NS) & (kinds != "strike"))
+        near = np.flatnonzero((np.abs(t_ev - f.time_ns) <= MERGE_S * NS) & ~strike_like)
         if near.size:
             i = int(near[np.argmin(np.abs(t_ev[near] - f.time_ns))])
             if taken[i]:
+                dropped += 1
                 continue
             taken[i] = True
             _annotate(out, i, f, kind=True)
             continue
         if any(abs(g.time_ns - f.time_ns) <= MERGE_S * NS for g in new):
+            dropped += 1
             continue
         new.append(f)
     if new:
@@ -133,7 +165,9 @@ def merge_fault_findings(
         make_event_id(str(r.spacecraft), str(r.detector), str(r.kind), str(r.time_utc), str(r.config_hash))
         for r in out.itertuples()
     ]
-    return out.sort_values("time_utc", kind="stable").reset_index(drop=True)
+    out = out.sort_values("time_utc", kind="stable").reset_index(drop=True)
+    out.attrs["fault_findings_dropped"] = dropped
+    return out
 
 
 def scan_span(

@@ -9,8 +9,9 @@ The rules read the evidence of :mod:`abrupt.detect.attitude.evidence`; none is f
    tracker (channel ``star_tracker``); and, without a jump, a gyro excursion the tracker did not see
    while neither the body (by the tracker) nor the wheels moved is a gyro spike;
 2. **internal** when an appendage drive changed rate abruptly at the event (momentum moved between
-   the hub and the appendage, total conserved), unless ᴺH steps for good, impulsively, with the body's
-   and the wheels' response (a snap cannot: that is a strike at the snap's time);
+   the hub and the appendage, total conserved), unless ᴺH steps for good (impulsively, or the fitted
+   step at the event beyond its noise: :func:`momentum_stepped`), with the body's and the wheels'
+   response (a snap cannot: that is a strike at the snap's time);
 3. **sensor_fault** of a wheel when one wheel's reading has an isolated spike, or the wheels'
    momentum changed, while the body never felt it (body share below ``body_share_min`` and below
    ``body_sigma`` times its noise), and the change is not one the minimum-norm controller makes
@@ -111,6 +112,31 @@ def _lasting_impulse(ev: EventEvidence, r: AttributionRules) -> bool:
     )
 
 
+def momentum_stepped(ev: EventEvidence, r: AttributionRules | None = None) -> bool:
+    """Total ᴺH stepped for good at the event, beyond its noise, with the body's and the wheels' response.
+
+    The step the window's fit puts at the event (every other step of the window fitted beside it:
+    :func:`abrupt.detect.attitude.ramp_step.step_siblings`) is the event's size, beyond ``ramp_off_z`` σ of
+    its noise and lasts (what returns of it within 150 s counted against it), the step is in the raw ᴺH
+    too, the body moved and the wheels took the step up. An
+    internal event (an appendage snap) moves momentum between parts and conserves the total: it cannot
+    do this, whatever its duration looks like.
+    """
+    r = r or AttributionRules()
+    body_moved = _finite(ev.body_share, ev.body_share_sigma) and ev.body_share >= max(
+        r.body_share_min, r.body_sigma * ev.body_share_sigma
+    )
+    return (
+        _finite(ev.alone_step_lasting, ev.raw_step_fraction, ev.alone_step_fraction, ev.alone_step_z, ev.wheel_takeup)
+        and ev.alone_step_lasting >= r.lasting_min
+        and ev.raw_step_fraction >= r.lasting_min
+        and r.lasting_min <= ev.alone_step_fraction <= 1.0 / r.lasting_min
+        and ev.alone_step_z > r.ramp_off_z
+        and ev.wheel_takeup >= r.takeup_min
+        and body_moved
+    )
+
+
 def _off_ramp(ev: EventEvidence, r: AttributionRules) -> bool:
     """Rule 4b's test: the step at the event is the event's size and off the ramp's body direction."""
     return (
@@ -122,11 +148,13 @@ def _off_ramp(ev: EventEvidence, r: AttributionRules) -> bool:
 
 
 def _alone(ev: EventEvidence, r: AttributionRules) -> bool:
-    """Rule 4c's test: the step at the event is the event's size, beyond its noise, and no other step of
-    the window shares its body direction (within 30°, same sign)."""
+    """Rule 4c's test: the step at the event is the event's size, beyond its noise, lasts (judged on the
+    fitted steps: a venting train or a ramp around it swamps a raw before/after balance), and no other
+    step of the window shares its body direction (within 30°, same sign)."""
     return (
-        _finite(ev.alone_step_fraction, ev.alone_step_z, ev.step_siblings)
+        _finite(ev.alone_step_fraction, ev.alone_step_z, ev.step_siblings, ev.alone_step_lasting)
         and r.lasting_min <= ev.alone_step_fraction <= 1.0 / r.lasting_min
+        and ev.alone_step_lasting >= r.lasting_min
         and ev.alone_step_z > r.ramp_off_z
         and ev.step_siblings == 0
     )
@@ -182,14 +210,14 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
             f"gyro_{axis[max(ev.gyro_spike_axis, 0)]}",
             "gyro spike (not seen by the star tracker)",
         )
-    # 2. Appendage. A snap moves momentum between hub and array and leaves ᴺH as it was, so a lasting,
-    # impulsive step in ᴺH (cleaned and raw) that the body felt and the wheels took up is not the snap's:
-    # a strike at the snap's time falls through to the rules below.
+    # 2. Appendage. A snap moves momentum between hub and array and leaves ᴺH as it was, so a lasting step
+    # in ᴺH (cleaned and raw; impulsive, or the fitted step at the event beyond its noise) that the body felt
+    # and the wheels took up is not the snap's: a strike at the snap's time falls through to the rules below.
     if (
         _finite(ev.appendage_z, ev.appendage_excess_deg)
         and ev.appendage_z > r.appendage_z
         and ev.appendage_excess_deg > r.appendage_min_deg
-        and not (_lasting_impulse(ev, r) and body_moved and takeup)
+        and not ((_lasting_impulse(ev, r) and body_moved and takeup) or momentum_stepped(ev, r))
     ):
         tests = [True, _finite(ev.lasting_fraction) and abs(ev.lasting_fraction) < r.lasting_min]
         return Attribution(
@@ -233,7 +261,7 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
     # 4c. A leak is a ramp and a venting sequence a train of impulses, each along one body direction: the
     # steps they make point one way. A step at the event that no other step of the window shares the
     # direction of is an impulse of its own.
-    if r.step_alone and lasting and _alone(ev, r) and body_moved and in_raw:
+    if r.step_alone and _alone(ev, r) and body_moved and in_raw:
         return Attribution(
             "strike", _confidence([True, True, False, surface_ok]), "", "impulsive step, alone in its body direction"
         )

@@ -42,11 +42,15 @@ telemetry (:class:`~abrupt.series.timetable.Timetable`) around the event:
   the event (:mod:`abrupt.detect.attitude.ramp_step`); the step's part off the ramp's direction is a
   second source (a strike during the torque); ``after_torque_s``: for an event found only once the
   ramp's direction was taken out around an external torque's event, its time after that event [s];
+  ``after_strike_s``: for a torque's event found only once a strike's fitted step was taken out beside a
+  ramp, its time after the strike's event [s];
 * **alone in its direction** (``alone_step_fraction``, ``alone_step_z``, ``step_siblings``): the
   momentum in body axes fitted by the step at the event plus every other step of the window, found one
   at a time (:func:`abrupt.detect.attitude.ramp_step.step_siblings`); the number of those others
   within 30° of the event's body direction (a venting sequence's pulses, a leak's ramp: > 0), and of
-  those the impulses (``step_sharp_siblings``: a venting sequence's pulses).
+  those the impulses (``step_sharp_siblings``: a venting sequence's pulses); ``alone_step_lasting``: what
+  lasts of that fitted step (with the other steps within 150 s after it that point back against it)
+  along itself over |ΔH|, judged beside the window's other steps rather than on the raw balance.
 """
 
 from __future__ import annotations
@@ -120,6 +124,8 @@ class EventEvidence:
     alone_step_z: float = NAN
     step_siblings: float = NAN
     step_sharp_siblings: float = NAN
+    alone_step_lasting: float = NAN
+    after_strike_s: float = NAN
 
     def as_dict(self) -> dict[str, float]:
         return {f"ev_{k}": float(v) for k, v in asdict(self).items()}

@@ -164,6 +164,10 @@ class StepSiblings:
     other_B: FloatArray | None = None
     #: Siblings that are impulses themselves (a step fits them better than a ramp over 2 ``settle_s``).
     sharp_siblings: int = 0
+    #: The sum of the other steps within ``return_s`` after the event that point against S (within
+    #: ``sibling_deg`` of −Ŝ): the part of a pulse that returns. S plus this is what lasts of the event's step
+    #: once the window's other steps (a venting train, a ramp cut into steps) are fitted beside it.
+    returns_B: FloatArray | None = None
 
 
 def step_siblings(
@@ -177,6 +181,7 @@ def step_siblings(
     sibling_deg: float = 30.0,
     sibling_min: float = 0.1,
     sharp_chi2: float = 9.0,
+    return_s: float = 150.0,
 ) -> StepSiblings | None:
     """The step at ``step_s`` and the other steps of the window around it, found one at a time.
 
@@ -196,8 +201,9 @@ def step_siblings(
     in its direction, whatever else the window holds (a leak, a venting sequence, a sensor fault's step
     elsewhere). ``sharp_siblings`` counts those that are impulses themselves: a ramp over 2 ``settle_s``
     centred on the step fits worse by more than ``sharp_chi2`` (3 σ; a train of pulses; a piece of a
-    leak's ramp or of the cleaning's smooth drift around a large step is not). None when the window
-    is too short or its noise unknown.
+    leak's ramp or of the cleaning's smooth drift around a large step is not). ``returns_B`` sums the
+    other steps within ``return_s`` after the event that point against S (a pulse that returns). None
+    when the window is too short or its noise unknown.
     """
     window = _finite_window(tau_s, y_B)
     if window is None:
@@ -239,6 +245,8 @@ def step_siblings(
         cosines = (others @ s_b) / (norms * s_mag) if s_mag > 0 else np.zeros(len(others))
     parallel = (cosines >= cos_min) & (norms >= sibling_min * s_mag)
     sharp = np.array([_sharpness(t, vw, cols, 3 + j, 2 * settle_s) > sharp_chi2 for j in range(len(others))])
+    after = (np.asarray(steps[1:]) > step_s) & (np.asarray(steps[1:]) <= step_s + return_s)
+    back = after & (cosines <= -cos_min) if len(others) else np.zeros(0, bool)
     return StepSiblings(
         step_B=s_b,
         step_sigma=float(np.sqrt(np.mean(sig**2))) * math.sqrt(max(cov[2, 2], 0.0)),
@@ -247,6 +255,7 @@ def step_siblings(
         other_tau_s=tuple(steps[1:]),
         other_B=others,
         sharp_siblings=int(np.sum(parallel & sharp.astype(bool))),
+        returns_B=np.sum(others[back], axis=0) if back.any() else np.zeros(3),
     )
 
 
@@ -265,11 +274,15 @@ def _sharpness(t: FloatArray, vw: FloatArray, cols: list[FloatArray], j: int, ra
 
 def step_siblings_evidence(fit: StepSiblings | None, dh_mag: float) -> dict[str, float]:
     """``alone_step_fraction`` |S|/|ΔH|, ``alone_step_z`` |S|/σ_S, ``step_siblings`` and
-    ``step_sharp_siblings`` (counts)."""
+    ``step_sharp_siblings`` (counts), and ``alone_step_lasting`` (S + returns)·Ŝ/|ΔH|: the fitted step that
+    lasts, beside the window's other steps (a raw before/after balance counts them too)."""
     if fit is None or not dh_mag > 0:
         return {}
     s = float(np.linalg.norm(fit.step_B))
+    back = fit.returns_B if fit.returns_B is not None else np.zeros(3)
+    lasting = float((fit.step_B + back) @ fit.step_B) / s / dh_mag if s > 0 else NAN
     return {
+        "alone_step_lasting": lasting,
         "alone_step_fraction": s / dh_mag,
         "alone_step_z": s / fit.step_sigma if fit.step_sigma > 0 else NAN,
         "step_siblings": float(fit.siblings),

@@ -1,0 +1,221 @@
+"""A strike beside a confounder: the leak it hides, the venting that swamps its balance, the snap next to it.
+
+Truths used: the step sizes, directions and times put into analytic signals; a closed-loop body whose
+total ᴺH steps by exactly the strike and ramps by exactly the leak's torque (the wheels hold the rest);
+conservation of total momentum (an internal event cannot step ᴺH); the merge rules on hand-made events.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy.spatial.transform import Rotation
+
+from abrupt.detect.attitude.attribution import classify, momentum_stepped
+from abrupt.detect.attitude.evidence import EventEvidence, event_evidence
+from abrupt.detect.attitude.fault_scan import FaultFinding
+from abrupt.detect.attitude.flight_glr import FlightGlrDetector
+from abrupt.detect.attitude.ramp_step import step_siblings, step_siblings_evidence
+from abrupt.events import Event, events_frame
+from abrupt.model.spacecraft import load_spacecraft
+from abrupt.pipelines.flight_attribution import rescan_after_faults
+from abrupt.pipelines.flight_faults import merge_fault_findings
+from abrupt.series.timetable import NS, Timetable
+from abrupt.series.timetable_momentum import timetable_momentum
+
+ROOT = Path(__file__).resolve().parent.parent
+KESTREL = ROOT / "examples" / "spacecraft" / "kestrel.toml"
+T = np.arange(-600.0, 601.0)
+SIGMA = 2e-4  # [N·m·s] white noise of the momentum
+STRIKE = np.array([0.01, 0.04, -0.02])  # [N·m·s] body axes, 0.046 N·m·s
+T0 = 1_700_000_000 * NS
+
+
+def _h(tau: float) -> np.ndarray:
+    return (T >= tau).astype(np.float64)[:, None]
+
+
+def test_the_fitted_step_lasts_beside_a_venting_train_that_swamps_the_raw_balance() -> None:
+    """Six 0.04 N·m·s pulses 40-70 s apart along one body direction opposite to the strike's projection,
+    two of them within the 60-150 s after the strike: a before/after balance of ᴺH along ΔĤ is negative,
+    while the fitted step at the event lasts (its own size, nothing returning)."""
+    rng = np.random.default_rng(3)
+    u = -STRIKE / np.linalg.norm(STRIKE) + np.array([0.6, -0.2, 0.9])
+    u /= np.linalg.norm(u)
+    assert u @ STRIKE < 0 and np.degrees(np.arccos(-u @ STRIKE / np.linalg.norm(STRIKE))) > 30.0
+    times = np.array([-150.0, -95.0, -40.0, 50.0, 95.0, 140.0])
+    y = _h(0.0) * STRIKE + sum(_h(t) * (0.04 * u) for t in times) + rng.normal(0, SIGMA, (T.size, 3))
+    mag = float(np.linalg.norm(STRIKE))
+    uh = STRIKE / mag
+    raw_balance = (np.median(y[(T >= 60) & (T < 150)] @ uh) - np.median(y[(T >= -90) & (T < -5)] @ uh)) / mag
+    assert raw_balance < 0.5  # the balance the rules used to judge "lasting" on
+    ev = step_siblings_evidence(step_siblings(T, y, 0.0), mag)
+    assert abs(ev["alone_step_lasting"] - 1.0) < 0.1
+    assert ev["step_siblings"] == 0.0
+
+
+def test_a_step_that_returns_does_not_last_on_the_fitted_steps() -> None:
+    """A 0.046 N·m·s step at 0 and its exact return 80 s later: the fitted step is the event's size, but
+    what lasts of it is nothing."""
+    y = _h(0.0) * STRIKE - _h(80.0) * STRIKE + np.random.default_rng(4).normal(0, SIGMA, (T.size, 3))
+    ev = step_siblings_evidence(step_siblings(T, y, 0.0), float(np.linalg.norm(STRIKE)))
+    assert abs(ev["alone_step_fraction"] - 1.0) < 0.1
+    assert abs(ev["alone_step_lasting"]) < 0.1
+
+
+COMMON = dict(
+    st_gyro_step_rad=4e-5, st_gyro_step_limit_rad=3e-4, st_gyro_slope_rad_s=7e-7, st_gyro_slope_limit_rad_s=4.5e-6,
+    body_share=0.3, body_share_sigma=0.02, wheel_change_Nms=0.1, wheel_change_sigma_Nms=4e-4,
+    wheel_null_fraction=0.01, wheel_max_share=0.4, wheel_takeup=0.8, raw_step_fraction=1.0,
+    alone_step_fraction=1.0, alone_step_z=100.0, step_siblings=0.0, step_sharp_siblings=0.0,
+)  # fmt: skip
+
+
+def test_rule_4c_judges_lasting_on_the_fitted_step_not_on_the_swamped_balance() -> None:
+    venting = dict(COMMON, duration_s=250.0, duration_lo_s=213.0, duration_hi_s=400.0, lasting_fraction=-2.9)
+    got = classify(EventEvidence(**venting, alone_step_lasting=0.95))  # type: ignore[arg-type]
+    assert (got.kind, got.reason) == ("strike", "impulsive step, alone in its body direction")
+    # A pulse that returns is no strike, however alone it is in its direction.
+    assert classify(EventEvidence(**venting, alone_step_lasting=0.05)).kind != "strike"  # type: ignore[arg-type]
+
+
+def test_an_appendage_jump_does_not_make_a_step_of_total_momentum_internal() -> None:
+    """A snap conserves ᴺH: with the fitted step of total ᴺH at the event beyond its noise, lasting, taken
+    up by the wheels, the event is no snap's (a strike at the snap's time), impulsive or not."""
+    snap = dict(COMMON, appendage_z=1100.0, appendage_excess_deg=2.0, appendage_index=0)
+    slow = dict(snap, duration_s=40.0, duration_lo_s=23.0, duration_hi_s=80.0, lasting_fraction=1.15)
+    ev = EventEvidence(**slow, alone_step_lasting=1.0)  # type: ignore[arg-type]
+    assert momentum_stepped(ev)
+    assert classify(ev).kind == "strike"
+    # The same jump with ᴺH stepping by no more than its noise (the snap alone) stays internal.
+    alone = EventEvidence(**dict(slow, alone_step_z=3.0, lasting_fraction=0.1), alone_step_lasting=1.0)  # type: ignore[arg-type]
+    assert not momentum_stepped(alone)
+    assert (classify(alone).kind, classify(alone).channel) == ("internal", "appendage_1")
+    # Or with the wheels taking nothing up (no torque reached the body's loop).
+    still = EventEvidence(**dict(slow, wheel_takeup=0.05), alone_step_lasting=1.0)  # type: ignore[arg-type]
+    assert classify(still).kind == "internal"
+
+
+def _event(t_s: float, kind: str, **ev: float) -> pd.DataFrame:
+    t = np.datetime64(T0 + int(t_s * NS), "ns")
+    e = Event(spacecraft="kestrel", kind=kind, detector="attitude.glr", time_utc=t,
+              statistic=50.0, threshold=6.5, false_alarms_per_day=1.0, run_id="r", config_hash="c")  # fmt: skip
+    frame = events_frame([e])
+    frame["kind_channel"] = pd.Series([pd.NA], dtype="string")
+    frame["kind_reason"] = pd.Series(["rule"], dtype="string")
+    frame["kind_confidence"] = 0.7
+    for k, v in ev.items():
+        frame[f"ev_{k}"] = v
+    return frame
+
+
+def _finding(t_s: float, kind: str, channel: str, z: float) -> FaultFinding:
+    return FaultFinding(T0 + int(t_s * NS), kind, channel, z, 10.0, 0.1, "a jump (test)")
+
+
+def test_the_merge_names_no_internal_event_where_total_momentum_stepped_and_counts_what_it_drops() -> None:
+    stepped = dict(
+        lasting_fraction=1.1, raw_step_fraction=1.0, alone_step_fraction=1.0, alone_step_z=100.0,
+        alone_step_lasting=1.0, wheel_takeup=0.9, body_share=0.3, body_share_sigma=0.02,
+    )  # fmt: skip
+    events = pd.concat(
+        [_event(1000.0, "external_non_strike", **stepped), _event(5000.0, "external_non_strike")], ignore_index=True
+    )
+    findings = [
+        _finding(980.0, "internal", "appendage_1", 500.0),  # 20 s before the stepped event: its own event
+        _finding(5005.0, "sensor_fault", "wheel_2", 300.0),  # gives the second event its class
+        _finding(5010.0, "sensor_fault", "wheel_3", 200.0),  # a weaker second finding on it: dropped, counted
+    ]
+    out = merge_fault_findings(events, findings, "kestrel", "r", "c")
+    assert list(out["kind"]) == ["internal", "external_non_strike", "sensor_fault"]
+    assert list(out["detector"]) == ["attitude.fault_scan", "attitude.glr", "attitude.glr"]
+    assert out["kind_channel"].iloc[2] == "wheel_2"
+    assert out.attrs["fault_findings_dropped"] == 1
+    # The same appendage finding next to an event whose ᴺH did not step names it internal.
+    plain = merge_fault_findings(_event(1000.0, "external_non_strike"), findings[:1], "kestrel", "r", "c")
+    assert list(plain["kind"]) == ["internal"] and len(plain) == 1
+    assert plain.attrs["fault_findings_dropped"] == 0
+
+
+def _leak_and_strike_table(rng: np.random.Generator, leak: tuple[int, int], torque_b: np.ndarray,
+                           strike_at: int, dh_b: np.ndarray) -> Timetable:  # fmt: skip
+    """3000 s of a body turning slowly, its wheels holding ᴺH; a body-fixed torque over ``leak`` [s] (a
+    slow ramp the loop keeps up with: the wheels take it) and an impulse ΔH_B at ``strike_at`` (the body
+    takes it first, Δω₀ = J⁻¹ ΔH_B decaying as (1 − τ/τ_c) e^(−τ/τ_c), τ_c = 10 s): total ᴺH ramps by
+    Σ [NB] τ_B dt and steps by [NB] ΔH_B."""
+    sc = load_spacecraft(KESTREL)
+    j = np.asarray(sc.inertia_kgm2, float)
+    n = 3000
+    tau = np.arange(n) - strike_at
+    f = np.where(tau >= 0, (1 - tau / 10.0) * np.exp(-np.clip(tau, 0, None) / 10.0), 0.0)
+    omega = np.array([1e-4, -1.0e-3, 5e-5]) + np.outer(f, np.linalg.solve(j, dh_b))
+    rot, quats = Rotation.identity(), []
+    for k in range(n):
+        quats.append(rot.as_quat())
+        rot = rot * Rotation.from_rotvec(omega[k])
+    qa = np.asarray(quats)
+    bn = Rotation.from_quat(qa).inv().as_matrix()  # [BN]: inertial to body
+    on = ((np.arange(n) >= leak[0]) & (np.arange(n) < leak[1])).astype(float)
+    h_n = np.array([3.0, -2.0, 1.0]) + np.cumsum(on[:, None] * np.einsum("nji,j->ni", bn, torque_b), axis=0)
+    h_n[strike_at:] += bn[strike_at].T @ dh_b
+    h_w = np.einsum("nij,nj->ni", bn, h_n) - omega @ j.T
+    js_g = sc.wheel_axes * sc.wheel_spin_inertias_kgm2[None, :]
+    wheels = h_w @ np.linalg.pinv(js_g).T + 150.0 * np.array([1, -1, 1, -1]) * 2 * np.pi / 60
+    q_noisy = (Rotation.from_quat(qa) * Rotation.from_rotvec(rng.normal(0, 2e-6, (n, 3)))).as_quat()
+    return Timetable(
+        time_ns=np.arange(n, dtype=np.int64) * NS,
+        quaternion_BN=np.column_stack([q_noisy[:, 3], q_noisy[:, :3]]),
+        body_rate_rad_s=omega + rng.normal(0, 1e-6, (n, 3)),
+        wheel_speed_rad_s=wheels + rng.normal(0, 0.01, (n, 4)),
+        appendage_rate_rad_s=np.zeros((n, 0)),
+        flags=np.zeros((n, 0)),
+        valid=np.ones(n, bool),
+    )
+
+
+def table_leak_dir(table: Timetable) -> np.ndarray:
+    """The leak's body z axis in inertial axes at the middle of the leak (1350 s)."""
+    q = table.quaternion_BN[1350]
+    return np.asarray(Rotation.from_quat([q[1], q[2], q[3], q[0]]).apply([0.0, 0.0, 1.0]))
+
+
+def _scan(table: Timetable) -> tuple[np.ndarray, np.ndarray, np.ndarray, FlightGlrDetector, list]:
+    sc = load_spacecraft(KESTREL)
+    h_n, _ = timetable_momentum(sc, table)
+    hc = h_n - np.median(h_n[:1000], axis=0)
+    ok = np.ones(len(table), bool)
+    det = FlightGlrDetector()
+    win = det.windows(1.0)
+    stat = det.statistic(hc, ok, win)
+    peaks = [(i, p) for i, p in det.find_peaks(hc, ok, stat, table.time_ns, 1.0, win) if p.value > 5.0]
+    return h_n, hc, ok, det, peaks
+
+
+def test_a_leak_hidden_by_a_strike_40_s_after_its_onset_gets_an_event_of_its_own() -> None:
+    """A 4e-4 N·m body-fixed torque for 300 s from 1200 s (0.12 N·m·s) and a 0.12 N·m·s strike at 1240 s
+    in another body direction: one event, at the strike, a strike. With the strike's fitted step taken out
+    the leak is found, at its onset, of its size along its torque, classified
+    ``external_non_strike``; and no such event comes out beside a strike with no leak."""
+    rng = np.random.default_rng(11)
+    sc = load_spacecraft(KESTREL)
+    torque_b, dh_b = np.array([0.0, 0.0, 4e-4]), np.array([0.08, -0.06, 0.05])
+    table = _leak_and_strike_table(rng, (1200, 1500), torque_b, 1240, dh_b)
+    h_n, hc, ok, det, peaks = _scan(table)
+    assert len(peaks) == 1 and abs(peaks[0][1].time_ns / NS - 1240) <= 3
+    ev = {p.time_ns: event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n) for _, p in peaks}
+    assert classify(ev[peaks[0][1].time_ns]).kind == "strike"
+    found, found_ev = rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)
+    assert len(found) == 1
+    _, p = found[0]
+    assert abs(p.time_ns / NS - 1200) <= 15  # at the leak's onset
+    assert abs(p.dH_N_Nms @ table_leak_dir(table) - 0.12) < 0.02  # the leak's 4e-4 N·m over 300 s, along it
+    assert classify(found_ev[p.time_ns]).kind == "external_non_strike"
+    assert found_ev[p.time_ns].after_strike_s == (p.time_ns - peaks[0][1].time_ns) / NS
+    # The strike alone: nothing beside it.
+    table = _leak_and_strike_table(np.random.default_rng(12), (0, 0), torque_b, 1240, dh_b)
+    h_n, hc, ok, det, peaks = _scan(table)
+    ev = {p.time_ns: event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n) for _, p in peaks}
+    assert [classify(e).kind for e in ev.values()] == ["strike"]
+    assert rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)[0] == []
