@@ -22,7 +22,9 @@ The rules read the evidence of :mod:`abrupt.detect.attitude.evidence`; none is f
    (a venting train's pulse has such siblings); or (4b, only with ``step_on_ramp``, off by default),
    inside a ramp or a sequence, the step at the event is impulsive and off the ramp's body direction;
    or (4c, ``step_alone``, on), inside a ramp or a sequence, no other step of the window shares the
-   event's step's body direction (:func:`abrupt.detect.attitude.ramp_step.step_siblings`);
+   event's step's body direction (:func:`abrupt.detect.attitude.ramp_step.step_siblings`) and that
+   fitted step lasts (``alone_step_lasting``: judged beside the window's other steps, which a raw
+   before/after balance counts too);
 5. **external_non_strike** when the sensors agree and a step lasts (either sign: the event's own ΔH
    may be a piece of a longer ramp) but it is a ramp or a sequence
    (duration interval above ``impulsive_s``), or the body share is small (a slow torque the loop kept
