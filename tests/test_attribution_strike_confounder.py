@@ -20,6 +20,7 @@ from abrupt.detect.attitude.flight_glr import FlightGlrDetector
 from abrupt.detect.attitude.ramp_step import step_siblings, step_siblings_evidence
 from abrupt.events import Event, events_frame
 from abrupt.model.spacecraft import load_spacecraft
+from abrupt.pipelines import flight_attribution as fa
 from abrupt.pipelines.flight_attribution import rescan_after_faults
 from abrupt.pipelines.flight_faults import merge_fault_findings
 from abrupt.series.timetable import NS, Timetable
@@ -219,3 +220,22 @@ def test_a_leak_hidden_by_a_strike_40_s_after_its_onset_gets_an_event_of_its_own
     ev = {p.time_ns: event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n) for _, p in peaks}
     assert [classify(e).kind for e in ev.values()] == ["strike"]
     assert rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)[0] == []
+
+
+def test_the_rescan_looks_where_the_detector_suppressed_and_never_at_another_peak() -> None:
+    """A 0.05 N·m·s step 305 s after the torque's event, in white noise: outside the first ±300 s look
+    window, inside the zone one window span (620 s) either side that one peak per span hides; excluded
+    when another peak already sits on it."""
+    rng = np.random.default_rng(8)
+    n = 3000
+    g = np.arange(n, dtype=np.int64) * NS
+    hc = rng.normal(0, SIGMA, (n, 3)) + (np.arange(n) >= 1305)[:, None] * np.array([0.03, -0.03, 0.03])
+    ok = np.ones(n, bool)
+    det = FlightGlrDetector()
+    t0 = 1000 * NS
+    assert fa._best_peak(det, hc, ok, g, 1.0, t0, 5.0, None) is None
+    zone = (t0 - 620 * NS, t0 + 620 * NS)
+    best = fa._best_peak(det, hc, ok, g, 1.0, t0, 5.0, None, zone)
+    assert best is not None and abs(best[1].time_ns / NS - 1305) <= 2
+    assert abs(np.linalg.norm(best[1].dH_N_Nms) - 0.052) < 0.005
+    assert fa._best_peak(det, hc, ok, g, 1.0, t0, 5.0, None, zone, ((1305 * NS, 10.0, 10.0),)) is None
