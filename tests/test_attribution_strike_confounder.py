@@ -116,7 +116,7 @@ def _finding(t_s: float, kind: str, channel: str, z: float) -> FaultFinding:
     return FaultFinding(T0 + int(t_s * NS), kind, channel, z, 10.0, 0.1, "a jump (test)")
 
 
-def test_the_merge_names_no_internal_event_where_total_momentum_stepped_and_counts_what_it_drops() -> None:
+def test_the_merge_names_no_fault_where_total_momentum_stepped_and_counts_what_it_drops() -> None:
     stepped = dict(
         lasting_fraction=1.1, raw_step_fraction=1.0, alone_step_fraction=1.0, alone_step_z=100.0,
         alone_step_lasting=1.0, wheel_takeup=0.9, body_share=0.3, body_share_sigma=0.02,
@@ -138,6 +138,15 @@ def test_the_merge_names_no_internal_event_where_total_momentum_stepped_and_coun
     plain = merge_fault_findings(_event(1000.0, "external_non_strike"), findings[:1], "kestrel", "r", "c")
     assert list(plain["kind"]) == ["internal"] and len(plain) == 1
     assert plain.attrs["fault_findings_dropped"] == 0
+    # A wheel finding 5 s from the stepped event is written beside it; its class stays.
+    wheel = merge_fault_findings(events[:1], [_finding(1005.0, "sensor_fault", "wheel_2", 300.0)], "kestrel", "r", "c")
+    assert list(wheel["kind"]) == ["external_non_strike"] and wheel["fault_channel"].iloc[0] == "wheel_2"
+    # Without the body's response (a wheel reading's apparent step) the finding names the event.
+    still = merge_fault_findings(
+        _event(1000.0, "external_non_strike", **dict(stepped, body_share=0.01)),
+        [_finding(1005.0, "sensor_fault", "wheel_2", 300.0)], "kestrel", "r", "c",
+    )  # fmt: skip
+    assert list(still["kind"]) == ["sensor_fault"]
 
 
 def _leak_and_strike_table(rng: np.random.Generator, leak: tuple[int, int], torque_b: np.ndarray,

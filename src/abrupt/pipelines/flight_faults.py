@@ -8,9 +8,9 @@ and channel (one channel moved and the physics it must obey did not: a wheel rea
 response, a rate sensor the other did not follow, an appendage drive that jumped), with the finding
 in its ``fault_*`` columns. A strike is never re-classified by a scan (the scans' physical gates
 exclude motion): a finding within ``STRIKE_S`` of a strike's event is written beside it in its
-``fault_*`` columns, and a finding further from it is a second thing (an appendage finding treats an
-event at which total ᴺH stepped the same way: an internal event conserves the total, so that step is
-not the appendage's); a finding with no event nearby
+``fault_*`` columns, and a finding further from it is a second thing (an event at which total ᴺH
+stepped with the body's and the wheels' response is treated the same way: no one-channel fault makes
+that, and an internal event conserves the total); a finding with no event nearby
 becomes an event of its own (detector ``attitude.fault_scan``, its statistic and threshold in σ of
 its channel's noise, the rate its threshold was set for; ΔH empty: a fault changes no momentum).
 """
@@ -129,14 +129,16 @@ def merge_fault_findings(
         return out
     t_ev = _times_ns(out)
     kinds = out["kind"].astype(str).to_numpy() if len(out) else np.empty(0, str)
-    # An internal event conserves total ᴺH: an event at which it stepped is no appendage's, whatever it was
-    # called; an appendage finding near it is written beside it (or becomes its own event), as at a strike.
+    # A finding is one channel that moved while the physics it must obey did not; an internal event conserves
+    # total ᴺH. An event at which total ᴺH stepped, the body moving and the wheels taking it up, is neither,
+    # whatever the rules called it: a finding near it is written beside it (or becomes its own event), as at
+    # a strike.
     stepped = _stepped(out) & (kinds != "strike")
     taken = np.zeros(len(out), bool)
     new: list[FaultFinding] = []
     dropped = 0
     for f in sorted(findings, key=lambda f: -f.statistic / max(f.threshold, 1e-12)):
-        strike_like = (kinds == "strike") | (stepped & (f.kind == "internal"))
+        strike_like = (kinds == "strike") | stepped
         at_strike = np.flatnonzero((np.abs(t_ev - f.time_ns) <= STRIKE_S * NS) & strike_like)
         if at_strike.size:  # evidence beside the strike; its class stays
             _annotate(out, int(at_strike[0]), f)
