@@ -129,11 +129,13 @@ def test_the_merge_names_no_fault_where_total_momentum_stepped_and_counts_what_i
         _finding(5005.0, "sensor_fault", "wheel_2", 300.0),  # gives the second event its class
         _finding(5010.0, "sensor_fault", "wheel_3", 200.0),  # a weaker second finding on it: dropped, counted
     ]
-    out = merge_fault_findings(events, findings, "kestrel", "r", "c")
+    said: list[str] = []
+    out = merge_fault_findings(events, findings, "kestrel", "r", "c", said)
     assert list(out["kind"]) == ["internal", "external_non_strike", "sensor_fault"]
     assert list(out["detector"]) == ["attitude.fault_scan", "attitude.glr", "attitude.glr"]
     assert out["kind_channel"].iloc[2] == "wheel_2"
     assert out.attrs["fault_findings_dropped"] == 1
+    assert said == ["1 fault-scan finding(s) not merged: a stronger finding already took their event"]
     # The same appendage finding next to an event whose ᴺH did not step names it internal.
     plain = merge_fault_findings(_event(1000.0, "external_non_strike"), findings[:1], "kestrel", "r", "c")
     assert list(plain["kind"]) == ["internal"] and len(plain) == 1

@@ -603,9 +603,7 @@ def run_flight(
     events = detector.events(peaks, threshold, spacecraft.name, run_id, cfg_hash)
     events = attribute_events(events, {t: e for r in chunks for t, e in r.evidence.items()})
     events = merge_fault_findings(events, [f for r in chunks for f in r.faults.findings], spacecraft.name, run_id,
-                                  cfg_hash)  # fmt: skip
-    if n_dropped := int(events.attrs.get("fault_findings_dropped", 0)):
-        warnings.append(f"{n_dropped} fault-scan finding(s) not merged: their event already had a stronger finding")
+                                  cfg_hash, warnings)  # fmt: skip
     daily = daily_table(chunks, events, threshold)
     return FlightResult(events, threshold, daily, peaks, chunks if keep_series else [], run_id, cfg_hash, warnings)
 

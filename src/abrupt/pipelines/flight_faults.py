@@ -113,13 +113,18 @@ def _stepped(events: pd.DataFrame) -> np.ndarray:
 
 
 def merge_fault_findings(
-    events: pd.DataFrame, findings: Sequence[FaultFinding], spacecraft: str, run_id: str, cfg_hash: str
+    events: pd.DataFrame,
+    findings: Sequence[FaultFinding],
+    spacecraft: str,
+    run_id: str,
+    cfg_hash: str,
+    warnings: list[str] | None = None,
 ) -> pd.DataFrame:
     """``events`` with the findings merged in (module docstring), sorted by time, ids recomputed.
 
     ``attrs["fault_findings_dropped"]`` counts the findings merged into nothing: a second finding on an
     event another (stronger) finding already gave its class, or a finding within ``MERGE_S`` of a new
-    event made from a stronger finding.
+    event made from a stronger finding; when there are any, a line saying how many is added to ``warnings``.
     """
     out = events.copy()
     for c in FAULT_COLUMNS:
@@ -169,6 +174,8 @@ def merge_fault_findings(
     ]
     out = out.sort_values("time_utc", kind="stable").reset_index(drop=True)
     out.attrs["fault_findings_dropped"] = dropped
+    if dropped and warnings is not None:
+        warnings.append(f"{dropped} fault-scan finding(s) not merged: a stronger finding already took their event")
     return out
 
 
