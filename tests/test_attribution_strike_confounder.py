@@ -18,7 +18,7 @@ from abrupt.detect.attitude.evidence import EventEvidence, event_evidence
 from abrupt.detect.attitude.fault_scan import FaultFinding
 from abrupt.detect.attitude.flight_glr import FlightGlrDetector
 from abrupt.detect.attitude.ramp_step import step_siblings, step_siblings_evidence
-from abrupt.events import Event, events_frame
+from abrupt.events import Event, events_frame, format_time_utc
 from abrupt.model.spacecraft import load_spacecraft
 from abrupt.pipelines import flight_attribution as fa
 from abrupt.pipelines.flight_attribution import rescan_after_faults
@@ -101,7 +101,7 @@ def test_an_appendage_jump_does_not_make_a_step_of_total_momentum_internal() -> 
 
 def _event(t_s: float, kind: str, **ev: float) -> pd.DataFrame:
     t = np.datetime64(T0 + int(t_s * NS), "ns")
-    e = Event(spacecraft="kestrel", kind=kind, detector="attitude.glr", time_utc=t,
+    e = Event(spacecraft="kestrel", kind=kind, detector="attitude.glr", time_utc=format_time_utc(t),
               statistic=50.0, threshold=6.5, false_alarms_per_day=1.0, run_id="r", config_hash="c")  # fmt: skip
     frame = events_frame([e])
     frame["kind_channel"] = pd.Series([pd.NA], dtype="string")
