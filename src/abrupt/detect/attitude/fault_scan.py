@@ -163,6 +163,18 @@ def clusters(t_ns: np.ndarray, z: FloatArray, above: BoolArray, gap_s: float = C
     return [int(g[np.argmax(z[g])]) for g in np.split(idx, breaks)]
 
 
+def column_median(x: FloatArray, size: int) -> FloatArray:
+    """``median_filter(x, size=(size, 1), mode="nearest")``, computed column by column: the same ranks
+    of the same windows (so the same values), on SciPy's one-dimensional filter, which is about ten
+    times faster than the N-dimensional one. Input with NaN takes the N-dimensional path unchanged."""
+    if x.ndim != 2 or not np.isfinite(x).all():
+        return np.asarray(median_filter(x, size=(size, 1), mode="nearest"), dtype=np.float64)
+    out = np.empty_like(x)
+    for k in range(x.shape[1]):
+        out[:, k] = median_filter(x[:, k], size=size, mode="nearest")
+    return out
+
+
 def wheel_jump_statistic(speed_rad_s: FloatArray, quantum_rad_s: float = 0.0) -> tuple[FloatArray, float]:
     """Jumps of a wheel's raw speed against its own noise [σ], element k between samples k and k+1.
 
@@ -193,9 +205,9 @@ def rate_departures(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> tuple[F
     ref[1:-1] = 0.5 * (w_st[:-1] + w_st[1:])
     ref[0], ref[-1] = w_st[0], w_st[-1]
     err = omega_B - ref
-    err = err - median_filter(err, size=(31, 1), mode="nearest")  # a gyro bias is slow: taken out
-    e_g = omega_B - median_filter(omega_B, size=(11, 1), mode="nearest")
-    e_t = ref - median_filter(ref, size=(11, 1), mode="nearest")
+    err = err - column_median(err, 31)  # a gyro bias is slow: taken out
+    e_g = omega_B - column_median(omega_B, 11)
+    e_t = ref - column_median(ref, 11)
     return err, e_g, e_t
 
 
