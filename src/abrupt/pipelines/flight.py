@@ -371,11 +371,12 @@ def _clean_and_scan(
     info: dict[str, float] = {"harmonics_mean": 0.0}
     fit_cache: dict[tuple[float, ...], Any] = {}
     h_ok = np.where(ok[:, None], h_n, 0.0)
-    for _ in range(max(1, c.passes)):
+    passes = max(1, c.passes)
+    for k in range(passes):
         model, info = smooth_model(h_ok, t_s, ok, period, c.comb_config, steps, cache=fit_cache)
         hc = np.where(ok[:, None], h_n - np.nan_to_num(model), np.nan)
         stat = detector.statistic(hc, ok, win)
-        if not (c.comb or c.trend):
+        if not (c.comb or c.trend) or k == passes - 1:  # the last pass's candidates would enter no fit
             break
         taus = detector.step_candidates(hc, ok, stat, win, c.candidate_sigma)
         new_steps = np.array([t_s[tau] - 0.5 * dt for tau in taus])
