@@ -211,10 +211,18 @@ def ramp_duration(tau_s: FloatArray, y: FloatArray, sigma: float) -> tuple[float
     # A linear background (slow residual drift) is projected out of the data and of each ramp.
     basis, _ = np.linalg.qr(np.column_stack([np.ones_like(t), (t - t.mean()) / max(span, 1.0)]))
     vc = v - basis @ (basis.T @ v)
+    # One set of (onsets × samples) buffers for every duration: a fresh array per step of the loop cost
+    # more in page faults than in arithmetic. The operations are those of the plain expressions.
+    lag = t[None, :] - onsets[:, None]
+    xc, proj, sq = np.empty_like(lag), np.empty_like(lag), np.empty_like(lag)
     for j, d in enumerate(durations):
-        x = np.clip((t[None, :] - onsets[:, None]) / d, 0.0, 1.0) if d > 0 else (t[None, :] >= onsets[:, None]) * 1.0
-        xc = x - (x @ basis) @ basis.T
-        sxx = np.sum(xc * xc, axis=1)
+        if d > 0:
+            np.clip(np.divide(lag, d, out=xc), 0.0, 1.0, out=xc)  # clip((t − τ_s) / D, 0, 1)
+        else:
+            np.greater_equal(t[None, :], onsets[:, None], out=xc)  # the step: 1(t ≥ τ_s)
+        np.matmul(xc @ basis, basis.T, out=proj)
+        np.subtract(xc, proj, out=xc)  # the ramp with the linear background projected out
+        sxx = np.sum(np.multiply(xc, xc, out=sq), axis=1)
         sxy = xc @ vc
         with np.errstate(invalid="ignore", divide="ignore"):
             sse = np.sum(vc * vc) - np.where(sxx > 0, sxy**2 / sxx, 0.0)

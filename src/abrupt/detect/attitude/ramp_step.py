@@ -107,10 +107,15 @@ def fit_ramp_step(
     durations = np.geomspace(min_ramp_s, max(span / 3, 2 * min_ramp_s), n_durations)
     onsets = t[(t > t[0] + 0.25 * span) & (t < t[-1] - 0.25 * span)][::3]
     best = (math.inf, NAN, NAN)
+    # One set of (onsets × samples) buffers for every duration (fresh arrays cost page faults); the
+    # operations are those of xc = x − (x B) Bᵀ, x = clip((t − τ_s) / D, 0, 1).
+    lag = t[None, :] - onsets[:, None]
+    xc, proj, sq = np.empty_like(lag), np.empty_like(lag), np.empty_like(lag)
     for d in durations:
-        x = np.clip((t[None, :] - onsets[:, None]) / d, 0.0, 1.0)
-        xc = x - (x @ basis) @ basis.T
-        sxx = np.sum(xc * xc, axis=1)
+        np.clip(np.divide(lag, d, out=xc), 0.0, 1.0, out=xc)
+        np.matmul(xc @ basis, basis.T, out=proj)
+        np.subtract(xc, proj, out=xc)
+        sxx = np.sum(np.multiply(xc, xc, out=sq), axis=1)
         with np.errstate(invalid="ignore", divide="ignore"):
             gain = np.where(sxx > 0, np.sum((xc @ vc) ** 2, axis=1) / sxx, 0.0)
         gain = np.where(onsets + d < t[-1] - 30.0, gain, -np.inf)
