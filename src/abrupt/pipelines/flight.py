@@ -35,7 +35,7 @@ import pandas as pd
 
 from abrupt.clean.comb import CombConfig, estimate_period, smooth_model
 from abrupt.clean.flight_masks import SlewMaskConfig, event_mask, flag_intervals, slew_mask
-from abrupt.detect.attitude.evidence import EventEvidence, event_evidence
+from abrupt.detect.attitude.evidence import EventEvidence, event_evidence, profile_fits
 from abrupt.detect.attitude.flight_glr import MIN_BLOCKS, FlightGlrDetector, Peak
 from abrupt.errors import ConfigError, InputError
 from abrupt.events import config_hash, new_run_id
@@ -428,15 +428,14 @@ def process_span(
     hc, stat, info = _clean_and_scan(h_n, ok, g.astype(np.float64) / NS, dt, period, c, detector)
     core = (g >= start_ns) & (g < end_ns)
     peaks = detector.find_peaks(hc, ok, stat, g, dt, detector.windows(dt), keep=core)
+    above = {pk.time_ns: pk for _, pk in peaks if pk.value > config.evidence_floor}
+    fits = {t: profile_fits(table, hc, t) for t in above}  # shared by the evidence and the rescan after a ramp
     evidence = {
-        pk.time_ns: event_evidence(
-            table, hc, spacecraft, pk.time_ns, pk.dH_N_Nms, inertia_kgm2=inertia_kgm2, raw_H_N=h_n
-        )
-        for _, pk in peaks
-        if pk.value > config.evidence_floor
+        t: event_evidence(table, hc, spacecraft, t, pk.dH_N_Nms, inertia_kgm2=inertia_kgm2, raw_H_N=h_n, fits=fits[t])
+        for t, pk in above.items()
     }
     found, found_ev = rescan_after_faults(
-        table, spacecraft, h_n, hc, ok, detector, peaks, evidence, config.evidence_floor, core, inertia_kgm2
+        table, spacecraft, h_n, hc, ok, detector, peaks, evidence, config.evidence_floor, core, inertia_kgm2, fits=fits
     )
     peaks, evidence = peaks + found, {**evidence, **found_ev}
     faults = scan_span(samples, flight, table, spacecraft, ok, start_ns, end_ns)

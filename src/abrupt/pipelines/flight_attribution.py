@@ -30,10 +30,9 @@ from abrupt.detect.attitude.attribution import AttributionRules, classify
 from abrupt.detect.attitude.evidence import EventEvidence, event_evidence
 from abrupt.detect.attitude.flight_glr import FlightGlrDetector, Peak
 from abrupt.detect.attitude.ramp_step import (
+    WindowFits,
     body_frame_momentum,
-    fit_ramp_step,
     from_body_increments,
-    step_siblings,
 )
 from abrupt.detect.attitude.repair import repair_sensor_fault
 from abrupt.events import format_time_utc, make_event_id
@@ -128,25 +127,29 @@ def _best_peak(
     return max(cands, key=lambda c: c[1].value) if cands else None
 
 
-def _off_ramp(table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int) -> FloatArray | None:
+def _off_ramp(
+    table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int, fits: WindowFits | None = None
+) -> FloatArray | None:
     """Cleaned ᴺH over rows [a, b) with the component along the body direction of the ramp or sequence
     around row ``i0`` removed, or None when the window needs no ramp. A leak or a venting sequence keeps
     one body direction; what steps off it is a second source. The direction is that of the event's own
     step when other impulses share it (a venting train:
     :func:`~abrupt.detect.attitude.ramp_step.step_siblings`), else the ramp's
-    (:func:`~abrupt.detect.attitude.ramp_step.fit_ramp_step`)."""
+    (:func:`~abrupt.detect.attitude.ramp_step.fit_ramp_step`). ``fits``: the event's evidence fits, used
+    when they are of this window."""
     g = table.time_ns
     half = round(RAMP_WINDOW_S / table.dt_s)
     lo, hi = max(0, i0 - half), min(g.size, i0 + half + 1)
     q = table.quaternion_BN
-    tau, y_win = (g[lo:hi] - g[i0]) / NS, body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi])
+    if fits is None or fits.key != (lo, i0, hi):
+        fits = WindowFits((lo, i0, hi), (g[lo:hi] - g[i0]) / NS, body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi]))
     # A train of impulses along the event's own direction is a venting sequence: that direction is the
     # torque's (the ramp fit would take the largest other step, a strike's, for the ramp).
-    seq = step_siblings(tau, y_win, 0.0)
+    seq = fits.siblings()
     if seq is not None and seq.sharp_siblings > 0:
         u_b = seq.step_B / float(np.linalg.norm(seq.step_B))
     else:
-        fit = fit_ramp_step(tau, y_win, 0.0)
+        fit = fits.ramp()
         if fit is None or not float(np.linalg.norm(fit.ramp_B)) > RAMP_SIGMA_MIN * fit.ramp_sigma:
             return None
         u_b = fit.ramp_B / float(np.linalg.norm(fit.ramp_B))
@@ -171,6 +174,7 @@ def rescan_after_faults(
     keep: BoolArray | None = None,
     inertia_kgm2: FloatArray | None = None,
     rules: AttributionRules | None = None,
+    fits: Mapping[int, WindowFits] | None = None,
 ) -> tuple[list[tuple[int, Peak]], dict[int, EventEvidence]]:
     """New peaks (above ``floor``) and their evidence found after repairing each sensor fault's channel.
 
@@ -180,7 +184,8 @@ def rescan_after_faults(
     peak from ``RESCAN_SPAN_S`` around the fault's step and at least ``RESCAN_APART_S`` from it becomes
     a new peak, with evidence from the repaired telemetry. For every ``external_non_strike`` peak the
     ramp's body direction is taken out of cleaned ᴺH (:func:`_off_ramp`) and the strongest peak of the
-    rest is kept when its evidence (of the telemetry as it is) is a strike's.
+    rest is kept when its evidence (of the telemetry as it is) is a strike's. ``fits``: each peak's
+    :func:`~abrupt.detect.attitude.evidence.profile_fits` as its evidence made them (by peak time).
     """
     g = table.time_ns
     dt = table.dt_s
@@ -196,7 +201,7 @@ def rescan_after_faults(
         i0 = int(np.clip(np.searchsorted(g, pk.time_ns), 0, g.size - 1))
         a, b = max(0, i0 - round((half_s + 240.0) / dt)), min(g.size, i0 + round((half_s + 240.0) / dt))
         if a_.kind == "external_non_strike":
-            hc_sub = _off_ramp(table, cleaned_H_N, i0, a, b)
+            hc_sub = _off_ramp(table, cleaned_H_N, i0, a, b, None if fits is None else fits.get(pk.time_ns))
             if hc_sub is None:
                 continue
             hc_sub = np.where(ok[a:b, None], hc_sub, np.nan)

@@ -280,3 +280,27 @@ def step_siblings_evidence(fit: StepSiblings | None, dh_mag: float) -> dict[str,
         "step_siblings": float(fit.siblings),
         "step_sharp_siblings": float(fit.sharp_siblings),
     }
+
+
+class WindowFits:
+    """The body-frame momentum of one window around an event (``key`` = its grid rows (first, event,
+    end)) and its two fits, :func:`step_siblings` and :func:`fit_ramp_step` at the event (τ = 0), each
+    made once, when first asked: the evidence and the rescan after a ramp both need them on the same
+    window."""
+
+    def __init__(self, key: tuple[int, int, int], tau_s: FloatArray, y_B: FloatArray) -> None:
+        self.key = key
+        self.tau_s = tau_s
+        self.y_B = y_B
+        self._siblings: tuple[StepSiblings | None] | None = None
+        self._ramps: dict[float, RampStep | None] = {}
+
+    def siblings(self) -> StepSiblings | None:
+        if self._siblings is None:
+            self._siblings = (step_siblings(self.tau_s, self.y_B, 0.0),)
+        return self._siblings[0]
+
+    def ramp(self, min_ramp_s: float = 8.0) -> RampStep | None:
+        if min_ramp_s not in self._ramps:
+            self._ramps[min_ramp_s] = fit_ramp_step(self.tau_s, self.y_B, 0.0, min_ramp_s=min_ramp_s)
+        return self._ramps[min_ramp_s]
