@@ -41,7 +41,7 @@ import numpy as np
 import pymsis
 from numpy.typing import NDArray
 
-from abrupt.model.atmosphere import MSIS_VERSION, SpaceWeather, gmst_cos_sin, msis_density
+from abrupt.model.atmosphere import MSIS_VERSION, SpaceWeather, msis_density
 from abrupt.types import FloatArray
 
 SLOT_NS = 3 * 3600 * 10**9  # one 3-hourly ap slot [ns]
@@ -193,6 +193,29 @@ def _point(
                 acc += wtb[k, b] * ((((0.0 + w0 * r[i0]) + w1 * r[i1]) + w2 * r[i2]) + w3 * r[i3])
         total += wz[c] * acc
     return total
+
+
+@nb.njit(cache=True)
+def _gmst82(ns: Any, out: Any) -> None:
+    """GMST 1982 (rad) at times ``ns`` (ns since 1970, UT1 ≈ UTC): ERFA's ``eraGmst82(2440587.5, jd)``
+    written out (the same operations in the same order: the same bits as ``erfa.gmst82``), without
+    the cost of its generic loop (≈ 100 against 5 ns a point)."""
+    a = 24110.54841 - 86400.0 / 2.0  # [s] the IAU 1982 polynomial, A moved by 12 h (JD starts at noon)
+    b = 8640184.812866
+    c = 0.093104
+    d = -6.2e-6
+    d2pi = 6.283185307179586476925287
+    ds2r = 7.272205216643039903848712e-5  # [rad/s of time]
+    for p in range(ns.size):
+        jd = ns[p] * 1e-9 / 86400.0  # days since 1970, the second part of the two-part date
+        if 2440587.5 < jd:
+            d1, d2 = 2440587.5, jd
+        else:
+            d1, d2 = jd, 2440587.5
+        t = (d1 + (d2 - 2451545.0)) / 36525.0
+        f = 86400.0 * (np.fmod(d1, 1.0) + np.fmod(d2, 1.0))
+        w = np.fmod(ds2r * ((a + (b + (c + d * t) * t) * t) + f), d2pi)
+        out[p] = w + d2pi if w < 0 else w
 
 
 @nb.njit(cache=True)
@@ -448,7 +471,9 @@ class MsisGrid:
         t = np.asarray(times_utc, dtype="datetime64[ns]")
         lat, lon, h = np.empty(t.size), np.empty(t.size), np.empty(t.size)
         if t.size:
-            c, s = gmst_cos_sin(t)
+            gmst = np.empty(t.size)
+            _gmst82(t.astype(np.int64), gmst)  # ``gmst_cos_sin``'s angle, compiled
+            c, s = np.cos(gmst), np.sin(gmst)
             _geodetic(c, s, np.ascontiguousarray(position_teme_m, dtype=np.float64), lat, lon, h)
         return self._density(t, lat, lon, h, runs)
 
