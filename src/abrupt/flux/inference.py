@@ -46,6 +46,7 @@ from abrupt.flux.forward import (
     direction_class,
 )
 from abrupt.flux.grid import refine_max
+from abrupt.flux.linear import ESTIMATOR, linear_fit
 
 PARAMS: tuple[str, ...] = ("debris_scale", "meteoroid_scale", "beta")
 # what a fit with β free measures well (docs/flux-inference.md, "The debris scale on the β ridge")
@@ -374,9 +375,23 @@ class FitResult:
     signed_estimates: dict[str, float] = field(default_factory=dict)  # scales not bounded at 0
     corrected_estimates: dict[str, float] = field(default_factory=dict)  # signed minus Cox-Snell bias
     penalised_estimates: dict[str, float] = field(default_factory=dict)  # Jeffreys-penalised in (ln s, ln β)
+    # β known: the fixed-weight linear estimate (exactly unbiased), its standard errors and score intervals
+    linear_estimates: dict[str, float] = field(default_factory=dict)
+    standard_errors: dict[str, float] = field(default_factory=dict)
+    linear_intervals: dict[str, tuple[float, float]] = field(default_factory=dict)
+
+    def reported(self) -> dict[str, Any]:
+        """The estimates to quote: with β known the linear ones and their intervals, else the ML ones."""
+        if self.linear_estimates:
+            est, iv, se = self.linear_estimates, self.linear_intervals, self.standard_errors
+            return {"estimator": ESTIMATOR, "estimates": est, "standard_errors": se, "intervals": iv}
+        ml = "maximum likelihood, profile-likelihood intervals"
+        return {"estimator": ml, "estimates": self.estimates, "standard_errors": {}, "intervals": self.intervals}
 
     def as_dict(self) -> dict[str, Any]:
+        rep = self.reported()
         return {
+            "reported": rep | {"intervals": {k: list(v) for k, v in rep["intervals"].items()}},
             "estimates": self.estimates,
             "intervals": {k: list(v) for k, v in self.intervals.items()},
             "confidence": self.confidence,
@@ -391,6 +406,9 @@ class FitResult:
             "signed_estimates": self.signed_estimates,
             "corrected_estimates": self.corrected_estimates,
             "penalised_estimates": self.penalised_estimates,
+            "linear_estimates": self.linear_estimates,
+            "linear_standard_errors": self.standard_errors,
+            "linear_intervals": {k: list(v) for k, v in self.linear_intervals.items()},
         }
 
 
@@ -412,7 +430,8 @@ def fit(
     intervals: bool = True,
     penalised: bool = False,
 ) -> FitResult:
-    """Maximum likelihood and profile-likelihood intervals of the free parameters.
+    """Maximum likelihood and profile-likelihood intervals of the free parameters; with β fixed also the
+    linear estimates of the scales (:mod:`abrupt.flux.linear`), the reported ones (``FitResult.reported``).
 
     Args:
         data: from :func:`prepare`.
@@ -462,6 +481,7 @@ def fit(
     signed = _signed_estimates(lik, scale_fixed) if data.n_events else dict(estimates)
     corrected = bias_corrected(lik, fixed, signed) if data.n_events else dict(estimates)
     pen = penalised_estimates(lik, fixed, estimates) if penalised else {}
+    lin = linear_fit(lik, scale_fixed, confidence) if "beta" in fixed and lik.beta_grid.size == 1 else None
     return FitResult(
         estimates,
         bounds,
@@ -477,6 +497,9 @@ def fit(
         signed,
         corrected,
         pen,
+        {} if lin is None else lin.estimates,
+        {} if lin is None else lin.standard_errors,
+        {} if lin is None else lin.intervals,
     )
 
 
