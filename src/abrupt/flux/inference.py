@@ -68,7 +68,7 @@ class FluxData:
     event_group: NDArray[np.int64]
     event_bin: NDArray[np.int64]
     event_class: NDArray[np.int64]  # -1: direction unknown
-    event_coef: NDArray[np.float64]  # f_d ε_d(x_k) / 365.25 of the event's day [yr]
+    event_coef: NDArray[np.float64]  # f_d ε_d(x_k) / 365.25 of the event's day [yr], plain bin mean of ε
     event_background: NDArray[np.float64]  # background expectation in the event's (day, class, bin)
     observed_bins: NDArray[np.int64]  # (K,) events per bin
     n_dropped: int  # events without an exposure day, or below the lowest bin edge
@@ -83,6 +83,9 @@ class FluxData:
     # per exposure day: template group, whether its cells are (class, bin) (orbit attitude and directions
     # used) or bins only, efficiency curve, f_d and f_d b_d; per curve: bin efficiency and false-alarm share
     days: dict[str, NDArray[Any]] = field(default_factory=dict)
+    # as exposure_years and event_coef, with ε weighted by each population's spectrum within the bin
+    exposure_years_pop: NDArray[np.float64] | None = None  # (G, P, K)
+    event_coef_pop: NDArray[np.float64] | None = None  # (E, P)
 
     @property
     def n_events(self) -> int:
@@ -120,12 +123,14 @@ def prepare(
     curve_of = np.asarray(exp.groupby(eff_cols, sort=False).ngroup().to_numpy(), dtype=np.int64)
     curves = exp.drop_duplicates(eff_cols).loc[:, eff_cols].to_numpy(dtype=np.float64)
     eff_u = bin_efficiency(edges, curves)  # (U, K)
+    eff_pop = bin_efficiency(edges, curves, slopes=np.stack([t.local_slopes() for t in tlist]))  # (U, G, P, K)
     cdf = logistic_efficiency(edges[None, :-1], curves[:, :1], curves[:, 1:2], 1.0)
     # share of false alarms per bin; those below the lowest edge are left out like their events
     share_u = np.diff(np.concatenate([cdf, np.ones((len(curves), 1))], axis=1), axis=1).astype(np.float64)
     n_u = len(curves)
     weight = np.bincount(group * n_u + curve_of, weights=f, minlength=len(keys) * n_u).reshape(len(keys), n_u)
     exposure_years = weight @ eff_u / DAYS_PER_YEAR  # (G, K)
+    exposure_pop = np.einsum("gu,ugpk->gpk", weight, eff_pop) / DAYS_PER_YEAR
     fa = exp["false_alarms_per_day"].to_numpy() * f
     background_bins = np.bincount(curve_of, weights=fa, minlength=n_u) @ share_u
     ga = (group * 2 + (exp["attitude"].to_numpy() == "orbit")) * n_u + curve_of
@@ -163,12 +168,14 @@ def prepare(
         n_dropped=int((~keep).sum()),
         n_days=len(exp),
         n_with_direction=int((cls >= 0).sum()),
-        exposure_years_att=(w_att @ eff_u / DAYS_PER_YEAR).reshape(len(keys), 2, -1),
+        exposure_years_att=np.einsum("gau,ugpk->gapk", w_att.reshape(len(keys), 2, n_u), eff_pop) / DAYS_PER_YEAR,
         background_att=(fa_att @ share_u).reshape(len(keys), 2, -1),
         rows_set_aside=chosen.rows_set_aside,
         events_set_aside=chosen.events_set_aside,
         days={"group": group, "directional": (exp["attitude"].to_numpy() == "orbit") & directional, "curve": curve_of}
-        | {"f": f, "fa": fa, "efficiency": eff_u, "share": share_u},
+        | {"f": f, "fa": fa, "efficiency": eff_pop, "share": share_u},
+        exposure_years_pop=exposure_pop,
+        event_coef_pop=f[rows_a][:, None] * eff_pop[u_ev, group[rows_a], :, kbin] / DAYS_PER_YEAR,
     )
 
 
@@ -178,6 +185,9 @@ class Likelihood:
     def __init__(self, data: FluxData, beta_grid: NDArray[np.float64] = DEFAULT_BETA_GRID) -> None:
         self.data = data
         self.beta_grid = np.asarray(beta_grid, dtype=np.float64)
+        if data.exposure_years_pop is None or data.event_coef_pop is None:
+            raise ConfigError("these flux data carry no per-population exposure; build them with prepare()", key="data")
+        exp_pop, coef_pop = data.exposure_years_pop, data.event_coef_pop
         nb, ne, npop = self.beta_grid.size, data.n_events, len(POPULATIONS)
         self.a = np.zeros((nb, ne, npop))  # per-event signal expectation at unit scales
         self.totals = np.zeros((nb, npop))  # total signal expectation at unit scales
@@ -185,13 +195,13 @@ class Likelihood:
         for b, beta in enumerate(self.beta_grid):
             for g, tpl in enumerate(data.templates):
                 r = tpl.bin_rates(float(beta))  # (P, C, K)
-                sig = r.sum(axis=1) * data.exposure_years[g][None, :]
+                sig = r.sum(axis=1) * exp_pop[g]
                 self.bin_signal[b] += sig
                 sel = data.event_group == g
                 if sel.any():
                     cls, kb = data.event_class[sel], data.event_bin[sel]
                     per = np.where(cls[:, None] >= 0, r[:, np.maximum(cls, 0), kb].T, r.sum(axis=1)[:, kb].T)
-                    self.a[b, sel] = per * data.event_coef[sel][:, None]
+                    self.a[b, sel] = per * coef_pop[sel]
             self.totals[b] = self.bin_signal[b].sum(axis=1)
         self.bg_events = data.event_background
         self.bg_total = float(data.background_bins.sum())
@@ -294,7 +304,8 @@ class Likelihood:
         for g, tpl in enumerate(d.templates):
             r = tpl.bin_rates(float(beta))  # (P, C, K)
             n_pop, n_cls, _ = r.shape
-            sig += [r.sum(axis=1) * d.exposure_years_att[g, 0], (r * d.exposure_years_att[g, 1]).reshape(n_pop, -1)]
+            att = d.exposure_years_att[g]  # (2, P, K)
+            sig += [r.sum(axis=1) * att[0], (r * att[1][:, None, :]).reshape(n_pop, -1)]
             bg += [d.background_att[g, 0], np.tile(d.background_att[g, 1] / n_cls, n_cls)]
         return np.concatenate(sig, axis=1), np.concatenate(bg)
 

@@ -64,13 +64,13 @@ def _cells(lik: Likelihood, beta: float) -> tuple[NDArray[np.float64], NDArray[n
     rates = [tpl.bin_rates(beta) for tpl in lik.data.templates]  # (P, C, K) per template group
     for (g, directional, u, f, fa), m in zip(uniq, mult, strict=True):
         r = rates[int(g)]
-        eff = f * d["efficiency"][int(u)] / DAYS_PER_YEAR
+        eff = f * d["efficiency"][int(u), int(g)] / DAYS_PER_YEAR  # (P, K)
         share = fa * d["share"][int(u)]
         if directional:
-            sig.append((r * eff[None, None, :]).reshape(r.shape[0], -1))
+            sig.append((r * eff[:, None, :]).reshape(r.shape[0], -1))
             bg.append(np.tile(share / n_cls, n_cls))
         else:
-            sig.append(r.sum(axis=1) * eff[None, :])
+            sig.append(r.sum(axis=1) * eff)
             bg.append(share)
         weight.append(np.full(bg[-1].size, float(m)))
     return np.concatenate(sig, axis=1), np.concatenate(bg), np.concatenate(weight)
