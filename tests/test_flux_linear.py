@@ -11,7 +11,7 @@ from scipy import stats
 
 from abrupt.errors import ConfigError
 from abrupt.flux.exposure import DAYS_PER_YEAR
-from abrupt.flux.inference import Likelihood, fit, prepare
+from abrupt.flux.inference import FitResult, Likelihood, fit, prepare
 from abrupt.flux.linear import linear_fit
 from test_flux_inference import AMPLITUDE, CASE, CONFIG, SLOPE, events_from_counts, exposure, power_law_template
 
@@ -75,3 +75,29 @@ def test_linear_fit_rejects_a_bad_confidence_or_reference() -> None:
         linear_fit(lik, {}, 1.5)
     with pytest.raises(ConfigError, match="reference"):
         linear_fit(lik, {}, 0.9, reference=(0.0, 1.0))
+
+
+def _beta_known_result(linear: dict[str, float], linear_iv: dict[str, tuple[float, float]]) -> FitResult:
+    ml = {"debris_scale": 1.5e3, "meteoroid_scale": 0.0, "beta": 1.0}
+    ml_iv = {"debris_scale": (8e2, 2.2e3), "meteoroid_scale": (0.0, 1.2e3), "beta": (1.0, 1.0)}
+    return FitResult(
+        ml, ml_iv, 0.9, -10.0, {"beta": 1.0}, 11, 0, 2, 11,
+        linear_estimates=linear, standard_errors=dict.fromkeys(linear, 1.0), linear_intervals=linear_iv,
+    )  # fmt: skip
+
+
+def test_linear_scales_out_of_the_physical_range_are_not_reported() -> None:
+    """A negative linear scale (weights far from the data) is no flux: the ML estimates are quoted."""
+    bad = _beta_known_result(
+        {"debris_scale": 1.0e4, "meteoroid_scale": -3.8e4},
+        {"debris_scale": (5.4e3, 1.9e4), "meteoroid_scale": (0.0, 0.0)},
+    )
+    assert not bad.linear_in_range()
+    rep = bad.reported()
+    assert rep["estimates"] is bad.estimates and rep["estimator"].startswith("maximum likelihood")
+    good = _beta_known_result(
+        {"debris_scale": 1.9e3, "meteoroid_scale": 10.0},
+        {"debris_scale": (1.2e3, 3.1e3), "meteoroid_scale": (0.5, 90.0)},
+    )
+    assert good.linear_in_range()
+    assert good.reported()["estimates"] is good.linear_estimates

@@ -86,6 +86,12 @@ def _fit_lines(name: str, f: FitResult) -> list[str]:
     if not f.linear_estimates:
         return [f"{name}: " + _estimates_text(f, f.estimates, f.intervals) + size]
     level = f"{f.confidence:.0%}"
+    if not f.linear_in_range():
+        return [
+            f"{name}: " + _estimates_text(f, f.estimates, f.intervals) + size,
+            f"  reported: {f.reported()['estimator']}",
+            "  linear (diagnostic; out of range): " + _estimates_text(f, f.linear_estimates, f.linear_intervals),
+        ]
     return [
         f"{name}: " + _estimates_text(f, f.linear_estimates, f.linear_intervals) + size,
         f"  reported: {f.reported()['estimator']}; ± standard error, [{level} score interval]",

@@ -92,7 +92,7 @@ def fits_table(result: FluxInference) -> pd.DataFrame:
     nan = float("nan")
     for name, f in result.fits.items():
         rep = f.reported()
-        linear = bool(f.linear_estimates)
+        linear = f.linear_in_range()
         for p, v in f.estimates.items():
             lo, hi = rep["intervals"].get(p, (nan, nan))
             ml_lo, ml_hi = f.intervals.get(p, (nan, nan))
