@@ -174,6 +174,13 @@ def _off_ramp(table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int
     return np.where(np.isfinite(h), from_body_increments(y_off, q[a:b], h0), np.nan)
 
 
+#: The ramp beside a strike may be a leak as long as the window allows (a ramp starts in the window's middle
+#: half and ends 30 s before its end: up to 3/4 of it), on a grid of durations fine enough (ratio 1.1) that
+#: a ramp's length is never so far off that a shift of its onset into the strike's step fits it better.
+LEAK_FRACTION = 0.75
+LEAK_DURATIONS = 48
+
+
 def _without_step(
     table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int
 ) -> tuple[FloatArray, RampStep] | None:
@@ -185,7 +192,9 @@ def _without_step(
     half = round(RAMP_WINDOW_S / table.dt_s)
     lo, hi = max(0, i0 - half), min(g.size, i0 + half + 1)
     q = table.quaternion_BN
-    fit = fit_ramp_step((g[lo:hi] - g[i0]) / NS, body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi]), 0.0)
+    y_win = body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi])
+    tau = (g[lo:hi] - g[i0]) / NS
+    fit = fit_ramp_step(tau, y_win, 0.0, n_durations=LEAK_DURATIONS, max_ramp_fraction=LEAK_FRACTION)
     if fit is None or not float(np.linalg.norm(fit.ramp_B)) > RAMP_SIGMA_MIN * fit.ramp_sigma:
         return None
     h = cleaned_H_N[a:b]

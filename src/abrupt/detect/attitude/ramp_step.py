@@ -92,9 +92,16 @@ def _finite_window(tau_s: FloatArray, y_B: FloatArray) -> tuple[FloatArray, Floa
 
 
 def fit_ramp_step(
-    tau_s: FloatArray, y_B: FloatArray, step_s: float, min_ramp_s: float = 8.0, n_durations: int = 16
+    tau_s: FloatArray,
+    y_B: FloatArray,
+    step_s: float,
+    min_ramp_s: float = 8.0,
+    n_durations: int = 16,
+    max_ramp_fraction: float = 1.0 / 3.0,
 ) -> RampStep | None:
-    """The fit of the module docstring, or None when the window is too short or its noise unknown."""
+    """The fit of the module docstring, or None when the window is too short or its noise unknown.
+
+    Ramps last from ``min_ramp_s`` to ``max_ramp_fraction`` of the window and start in its middle half."""
     window = _finite_window(tau_s, y_B)
     if window is None:
         return None
@@ -104,7 +111,7 @@ def fit_ramp_step(
     basis, _ = np.linalg.qr(np.column_stack([np.ones_like(t), (t - t.mean()) / max(span, 1.0), x_step]))
     w = 1.0 / sig  # each axis in units of its own noise
     vc = (v - basis @ (basis.T @ v)) * w
-    durations = np.geomspace(min_ramp_s, max(span / 3, 2 * min_ramp_s), n_durations)
+    durations = np.geomspace(min_ramp_s, max(max_ramp_fraction * span, 2 * min_ramp_s), n_durations)
     onsets = t[(t > t[0] + 0.25 * span) & (t < t[-1] - 0.25 * span)][::3]
     best = (math.inf, NAN, NAN)
     for d in durations:
