@@ -175,8 +175,8 @@ def _off_ramp(table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int
 
 
 #: The ramp beside a strike may be a leak as long as the window allows (a ramp starts in the window's middle
-#: half and ends 30 s before its end: up to 3/4 of it), on a grid of durations fine enough (ratio 1.1) that
-#: a ramp's length is never so far off that a shift of its onset into the strike's step fits it better.
+#: half and ends 30 s before its end: up to 3/4 of it); its duration is refined to 3 s (the onsets' grid)
+#: so that a ramp's end is never so far off that a shift of its onset into the strike's step fits better.
 LEAK_FRACTION = 0.75
 LEAK_DURATIONS = 48
 
@@ -194,7 +194,7 @@ def _without_step(
     q = table.quaternion_BN
     y_win = body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi])
     tau = (g[lo:hi] - g[i0]) / NS
-    fit = fit_ramp_step(tau, y_win, 0.0, n_durations=LEAK_DURATIONS, max_ramp_fraction=LEAK_FRACTION)
+    fit = fit_ramp_step(tau, y_win, 0.0, n_durations=LEAK_DURATIONS, max_ramp_fraction=LEAK_FRACTION, refine_s=3.0)
     if fit is None or not float(np.linalg.norm(fit.ramp_B)) > RAMP_SIGMA_MIN * fit.ramp_sigma:
         return None
     h = cleaned_H_N[a:b]
