@@ -14,6 +14,9 @@ last release) and this tree, each detecting on the same files in one process, on
 ratio this/previous is printed beside the absolute times and the machine's load average. ``--kill``
 kills a run once a third of its files are done and starts it again: the events must equal an
 uninterrupted run's (lost and duplicated rows printed).
+``--density-baseline SRC --density-baseline-batch`` times the density command with the code in SRC and
+then with this tree, same N, same files, same run (CPU ratio of the whole process trees, tables compared
+to the bit).
 
 Targets (issue: two cores): maneuvers 25,000 objects × 1 year < 10 min, drag density < 15 min, peak
 memory < 4 GB, flat in N.
@@ -64,11 +67,12 @@ def fresh(path: Path) -> Path:
 
 
 def run_measured(
-    args: list[str], kill_when: Path | None = None, kill_after: int = 0
+    args: list[str], kill_when: Path | None = None, kill_after: int = 0, src: Path = SRC
 ) -> tuple[float, float, int, float]:
     """Wall seconds, peak resident memory (GB) of the process tree, return code (−9 when killed) and the
-    CPU seconds of the tree (user + system of every process seen, sampled every 0.1 s)."""
-    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    CPU seconds of the tree (user + system of every process seen, sampled every 0.1 s); ``src``: the
+    code run (PYTHONPATH)."""
+    env = {**os.environ, "PYTHONPATH": str(src)}
     cmd = [sys.executable, "-m", "abrupt.cli.main", "--quiet", *args]
     t0 = time.perf_counter()
     proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
@@ -408,6 +412,35 @@ def part(
     )
 
 
+def density_batch_previous(
+    folder: Path, n: int, command: list[str], workers: int, events: Path, baseline: Path
+) -> None:
+    """The timed command again with the previous code (``baseline``, a src folder), same N, same files, in
+    the same run: CPU of the whole process tree of each, the ratio, and whether the two tables are equal
+    (every row, every column, every bit). Each run builds its year of tables afresh, as a fresh run does."""
+    listing = catalogue(folder, n)
+    outs, cpus = {}, {}
+    for label, src in (("previous", baseline), ("this", SRC)):
+        out = fresh(folder / f"density-{label}-{n}.parquet")
+        args = [*command, "--paths-from", str(listing), "--out", str(out), "--workers", str(workers)]
+        wall, peak, _, cpus[label] = run_measured([*args, "--maneuvers-from", str(events)], src=src)
+        outs[label] = pd.read_parquet(out)
+        print(
+            f"  {label:8s} code: {wall:6.1f} s wall, {cpus[label]:6.1f} CPU-s ({1e3 * cpus[label] / n:.1f} ms/object "
+            f"incl. the year of tables and the start-up), peak memory {peak:.2f} GB   ({load()})"
+        )
+    try:
+        pd.testing.assert_frame_equal(outs["this"], outs["previous"], check_exact=True)
+        same = "yes"
+    except AssertionError:
+        same = "NO"
+    print(
+        f"[density batch previous] N = {n}, {workers} workers, same run: CPU this/previous "
+        f"{cpus['this'] / cpus['previous']:.2f}; {len(outs['this'])} windows identical (every column, every bit): "
+        f"{same}"
+    )
+
+
 def kill_and_resume(folder: Path, n: int, workers: int) -> None:
     listing = catalogue(folder, n)
     whole = folder / f"maneuvers-{n}.parquet"
@@ -462,6 +495,11 @@ def main() -> None:
         default=None,
         help="src folder of earlier code: its ρB windows and CPU beside this tree's, same objects, one process.",
     )
+    ap.add_argument(
+        "--density-baseline-batch",
+        action="store_true",
+        help="With --density-baseline: also time the whole command with that code and again with this tree.",
+    )
     args = ap.parse_args()
     parts = set(args.parts.split(","))
     folder = Path(args.folder or Path(tempfile.gettempdir()) / "abrupt-catalogue")
@@ -492,6 +530,10 @@ def main() -> None:
         if args.density_baseline:
             listing = catalogue(folder, max(dns))
             density_previous(listing, 2, folder / "msis-grid", events[max(dns)], Path(args.density_baseline))
+            if args.density_baseline_batch:
+                print(f"\n[density batch previous] {' '.join(density)} ... with {args.density_baseline}, then this")
+                n = max(dns)
+                density_batch_previous(folder, n, density, args.workers, events[n], Path(args.density_baseline))
     if "maneuvers" not in parts:
         return
     listing = catalogue(folder, max(ns))
@@ -519,6 +561,7 @@ if __name__ == "__main__":
         "--parts=maneuvers": "maneuvers",
         "--parts=density": "density",
         "--density-objects=25000": "full",
+        "--density-objects=1000": "1000",
         "--model-tolerance": "tolerance",
     }
     with write_results("bench_catalogue_scale", variant(names)):

@@ -3,6 +3,9 @@ chunked vs whole, memory against days, injection/recovery, speed.
 
     PYTHONPATH=$PWD/src nice python benchmarks/bench_flight_pipeline.py [--store DIR] [--parts detect,...]
 
+``--parts reference --days 2 --baseline SRC`` runs only the year part's same-run reference (the
+previous release against this tree on the first archive days, ``--rounds`` alternating pairs).
+
 Reads ../shared/data/flight-like (raw archive, decoder, truth). Prints every figure beside its target.
 """
 
@@ -275,27 +278,52 @@ with tempfile.TemporaryDirectory() as tmp:
 """
 
 
-def same_run_reference(files: list[Path], sc_path: Path, baseline: Path) -> None:
-    """The previous release and this tree, one process each, one after the other, on the same days."""
+def same_run_reference(files: list[Path], sc_path: Path, baseline: Path, rounds: int = 1) -> None:
+    """The previous release and this tree, one process each, one after the other, on the same days;
+    with several ``rounds`` the pairs alternate and the median ratio is printed beside each round's."""
     import os
     import subprocess
 
-    out = {}
-    for label, src in (("previous release", baseline), ("this tree", ROOT / "src")):
-        env = {**os.environ, "PYTHONPATH": str(src), "OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS", "")}
-        env = {k: v for k, v in env.items() if v != ""}
-        args = [sys.executable, "-c", REFERENCE, str(DATA / "decoder.csv"), str(sc_path), *map(str, files)]
-        run = subprocess.run(args, env=env, capture_output=True, text=True)
-        if run.returncode != 0:
-            print(f"  reference ({label}) failed: {run.stderr.strip().splitlines()[-1:]}")
-            return
-        wall, cpu, n = run.stdout.split()
-        out[label] = (float(wall), float(cpu), int(n))
-        print(
-            f"  {label}: {len(files)} days in one process, {float(wall):.1f} s wall, {float(cpu):.1f} s CPU, {n} events"
-        )
-    (wp, cp, _), (wt, ct, _) = out["previous release"], out["this tree"]
-    print(f"  ratio this/previous: wall {wt / wp:.2f}, CPU {ct / cp:.2f}   (load average {os.getloadavg()})")
+    ratios: list[tuple[float, float]] = []
+    for r in range(rounds):
+        out = {}
+        for label, src in (("previous release", baseline), ("this tree", ROOT / "src")):
+            env = {**os.environ, "PYTHONPATH": str(src)}
+            env = {k: v for k, v in env.items() if v != ""}
+            args = [sys.executable, "-c", REFERENCE, str(DATA / "decoder.csv"), str(sc_path), *map(str, files)]
+            run = subprocess.run(args, env=env, capture_output=True, text=True)
+            if run.returncode != 0:
+                print(f"  reference ({label}) failed: {run.stderr.strip().splitlines()[-1:]}")
+                return
+            wall, cpu, n = run.stdout.split()
+            out[label] = (float(wall), float(cpu), int(n))
+            print(
+                f"  {label}: {len(files)} days in one process, {float(wall):.1f} s wall, {float(cpu):.1f} s CPU,"
+                f" {n} events" + (f" (round {r + 1})" if rounds > 1 else "")
+            )
+        (wp, cp, _), (wt, ct, _) = out["previous release"], out["this tree"]
+        ratios.append((wt / wp, ct / cp))
+        print(f"  ratio this/previous: wall {wt / wp:.2f}, CPU {ct / cp:.2f}   (load average {os.getloadavg()})")
+    if rounds > 1:
+        w, c = np.median(np.array(ratios), axis=0)
+        print(f"  median of {rounds} rounds: ratio wall {w:.2f}, CPU {c:.2f}")
+
+
+def part_reference(n_days: int = 2, baseline: Path | None = None, rounds: int = 3) -> None:
+    """Only the same-run reference of the year part (its first ``n_days`` archive days), ``rounds`` times:
+    the cheapest run that prints it."""
+    import os
+
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    base = Path(os.environ.get("ABRUPT_YEAR_DIR", "/tmp/abrupt-flight-year"))
+    files = make_year_archive(base / "archive", n_days)
+    year_spacecraft(base)
+    if baseline is None or not baseline.is_dir():
+        print(f"  same-run reference: not measured (no previous release at {baseline}; give --baseline SRC)")
+        return
+    print(f"\n[reference] the first {n_days} archive days of the year part, {rounds} rounds")
+    print(f"  load average before: {os.getloadavg()}")
+    same_run_reference(files, base / "kestrel-year.toml", baseline, rounds)
 
 
 def part_year(store: Path, n_days: int = 365, workers: int = 2, baseline: Path | None = None) -> None:
@@ -378,6 +406,7 @@ def main() -> None:
     ap.add_argument("--parts", default="detect")
     ap.add_argument("--days", type=int, default=365, help="days of the year part")
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--rounds", type=int, default=3, help="alternating pairs of the reference part")
     ap.add_argument("--baseline", default="/work/baseline/src", help="src of the previous release (year part)")
     args = ap.parse_args()
     if not DATA.exists():
@@ -387,6 +416,8 @@ def main() -> None:
     for p in args.parts.split(","):
         if p == "year":
             part_year(store, args.days, args.workers, Path(args.baseline))
+        elif p == "reference":
+            part_reference(args.days if args.days != 365 else 2, Path(args.baseline), args.rounds)
         elif p == "memory":
             part_memory(store, args.days if args.days != 365 else 30)
         else:
@@ -396,6 +427,6 @@ def main() -> None:
 if __name__ == "__main__":
     from _results import variant, write_results
 
-    flags = {"--parts=year": "year", "--parts=memory": "memory", "--days=6": "6days"}
+    flags = {"--parts=year": "year", "--parts=memory": "memory", "--parts=reference": "reference", "--days=6": "6days"}
     with write_results("bench_flight_pipeline", variant(flags)):
         main()

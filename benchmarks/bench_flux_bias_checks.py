@@ -4,7 +4,7 @@ Three checks on the fleet of ``bench_flux_coverage.py`` (10 Fermi-like spacecraf
 0.01 false alarms per day, 90 % analysed; Grün meteoroids, β and the debris scale as stated):
 
 1. Forward model against the simulator: the expected detections per population and direction class of the
-   fit's template (kernel-smoothed, interpolated, bin-averaged efficiency) against the exact sum over the
+   fit's template (kernel-smoothed, interpolated, spectrum-weighted bin efficiency) against the exact sum over the
    simulator's own Monte Carlo draws (each draw's rate × the efficiency at its |ΔH|), for the fit's seed
    and the draw seed. A biased forward model would show here, at any sample size.
 2. Sample size: the prior fit (meteoroid scale 1) on fleets ten times larger (100 spacecraft-years). A
@@ -63,7 +63,7 @@ def main() -> None:
         model = Likelihood(data, np.array([beta]))
         rates = fit_tpl[spec.case].bin_rates(beta)  # (P, C, K)
         for p, pop in enumerate(("debris", "meteoroid")):
-            per_class = (rates[p] * data.exposure_years[0][None, :]).sum(axis=1)
+            per_class = (rates[p] * data.exposure_years_pop[0][p][None, :]).sum(axis=1)  # type: ignore[index]
             for name, tpl in (("fit seed", fit_tpl), ("draw seed", draw_tpl)):
                 smp = tpl[spec.case].samples[pop]
                 mag = beta * np.linalg.norm(smp["dH_vec"], axis=1)

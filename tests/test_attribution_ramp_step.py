@@ -11,13 +11,16 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from abrupt.detect.attitude import ramp_step
 from abrupt.detect.attitude.attribution import AttributionRules, classify
 from abrupt.detect.attitude.evidence import EventEvidence
 from abrupt.detect.attitude.ramp_step import (
+    WindowFits,
     body_frame_momentum,
     fit_ramp_step,
     from_body_increments,
     ramp_step_evidence,
+    step_siblings,
 )
 from abrupt.model.rotations import dcm_from_quaternion
 
@@ -98,3 +101,38 @@ def test_a_strike_at_a_snaps_time_is_a_strike_and_the_snap_alone_internal() -> N
     assert classify(strike).kind == "strike"
     snap = EventEvidence(**common, lasting_fraction=0.05, raw_step_fraction=0.1)  # type: ignore[arg-type]
     assert classify(snap).kind == "internal"
+
+
+def _same(a: object, b: object) -> bool:
+    """Two fit results (dataclasses of floats and arrays) equal field by field, to the last bit."""
+    return (
+        a is not None
+        and b is not None
+        and all(
+            np.array_equal(np.asarray(getattr(a, f)), np.asarray(getattr(b, f)), equal_nan=True)
+            for f in a.__dataclass_fields__  # type: ignore[attr-defined]
+        )
+    )
+
+
+def test_window_fits_are_the_fits_of_their_window_made_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    leak = np.array([0.08, -0.03, 0.0])
+    y = np.clip((T + 40.0) / 300.0, 0.0, 1.0)[:, None] * leak + (T >= 0.0)[:, None] * 0.02 + _noise(5)
+    direct_ramp, direct_siblings = fit_ramp_step(T, y, 0.0), step_siblings(T, y, 0.0)
+    calls = {"fit_ramp_step": 0, "step_siblings": 0}
+
+    def counted(name: str):
+        real = getattr(ramp_step, name)
+
+        def wrapper(*args, **kwargs):
+            calls[name] += 1
+            return real(*args, **kwargs)
+
+        return wrapper
+
+    for name in calls:
+        monkeypatch.setattr(ramp_step, name, counted(name))
+    fits = WindowFits((0, 600, T.size), T, y)
+    for _ in range(2):
+        assert _same(fits.ramp(), direct_ramp) and _same(fits.siblings(), direct_siblings)
+    assert calls == {"fit_ramp_step": 1, "step_siblings": 1}

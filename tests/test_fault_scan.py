@@ -8,11 +8,15 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from scipy.ndimage import median_filter
 
 from abrupt.detect.attitude.fault_scan import (
     FaultFinding,
+    column_median,
     rate_departures,
     scan_appendages,
+    scan_faults,
+    scan_faults_each,
     scan_rate_sensors,
     scan_wheels,
     tail_threshold,
@@ -221,3 +225,31 @@ def test_merge_adds_to_a_nearby_event_never_changes_a_strike_and_makes_lone_find
     assert by_time[3000].detector == FAULT_DETECTOR and by_time[3000].kind_channel == "star_tracker"
     assert by_time[5000].kind == "strike" and pd.isna(by_time[5000].fault_channel)
     assert out["event_id"].is_unique
+
+
+def test_column_median_is_scipys_running_median_of_each_column() -> None:
+    rng = np.random.default_rng(7)
+    x = np.round(rng.standard_normal((5000, 3)), 2)  # ties: the rank, not an average, is taken
+    for size in (11, 31):
+        assert np.array_equal(column_median(x, size), median_filter(x, size=(size, 1), mode="nearest"))
+    x[100, 1] = np.nan  # NaN: the N-dimensional filter itself
+    assert np.array_equal(column_median(x, 11), median_filter(x, size=(11, 1), mode="nearest"), equal_nan=True)
+
+
+def test_fault_scan_of_several_days_is_the_scan_of_each_day() -> None:
+    sc = load_spacecraft(KESTREL)
+    flight = flight_channels(sc)
+    quantum = 2 * math.pi / 64.0
+    speeds = np.column_stack([150.0 + 0.002 * np.arange(N) + 0.3 * k for k in range(4)])
+    speeds[3000, 2] += 15 * quantum  # a miscount in the first core, a snap and a gyro spike in the second
+    table = _table()
+    table.appendage_rate_rad_s[15000:15003, 0] += math.radians(2.0) / 3
+    table.body_rate_rad_s[16000, 0] += 2e-3
+    samples = _wheel_samples(sc, speeds)
+    cores = [(T0, T0 + 9000 * NS), (T0 + 9000 * NS, T0 + N * NS)]
+    each = scan_faults_each(samples, flight, table, sc, table.valid, cores, BUDGET)
+    alone = [scan_faults(samples, flight, table, sc, table.valid, c, BUDGET) for c in cores]
+    assert each == alone
+    found = [(f.channel, round((f.time_ns - T0) / NS)) for s in each for f in s.findings]
+    assert ("wheel_3", 3000) in found and any(ch == "appendage_1" for ch, _ in found)
+    assert [c.start_ns for c in each[1].calibrations] == [cores[1][0]] * len(each[1].calibrations)

@@ -89,6 +89,34 @@ def test_simulate_population_then_flux_infer_end_to_end(tmp_path) -> None:
     assert {g["model"] for g in result["goodness_of_fit"]} >= {"NASA-90/91 + Grün", "Grün only"}
     text = report.read_text()
     assert "data:image/png;base64" in text and "Exposure" in text
+    # β known: the reported scales are the linear ones with standard errors; the ML ones stay as diagnostics
+    out, report = tmp_path / "known.json", tmp_path / "known.html"
+    args = ["--fix", "beta=1", "--out", str(out), "--report", str(report), "--draws", "20000"]
+    r = runner.invoke(cli, ["flux", "infer", "--catalog", str(cat), *args])
+    assert r.exit_code == 0, r.output
+    known_result = json.loads(out.read_text())
+    known = known_result["fits"]["free"]
+    assert any("linear fixed-weight" in n for n in known_result["notes"])
+    assert "linear" in known["reported"]["estimator"]
+    assert known["reported"]["estimates"] == known["linear_estimates"]
+    assert set(known["linear_standard_errors"]) == {"debris_scale", "meteoroid_scale"}
+    for p, (lo, hi) in known["reported"]["intervals"].items():
+        assert 0 <= lo <= max(known["linear_estimates"][p], 0) <= hi
+        assert known["linear_standard_errors"][p] > 0
+    assert set(known["estimates"]) == {"debris_scale", "meteoroid_scale", "beta"}  # the ML ones, kept
+    assert r.output.count("maximum likelihood (diagnostic") == 2  # both fits have β fixed
+    assert "linear, score interval" in report.read_text()
+
+
+@pytest.mark.parametrize("bad", ["beta=abc", "beta=0", "debris_scale=-1", "beta=nan", "gamma=1"])
+def test_flux_infer_rejects_a_bad_fix_in_one_line(tmp_path, bad: str) -> None:  # type: ignore[no-untyped-def]
+    from abrupt.catalog import Catalog
+
+    Catalog(tmp_path / "empty.sqlite")
+    r = CliRunner().invoke(cli, ["flux", "infer", "--catalog", str(tmp_path / "empty.sqlite"), "--fix", bad])
+    assert r.exit_code != 0
+    message = str(r.exception) + r.output
+    assert f"--fix {bad!r}" in message and "\n" not in message.strip()
 
 
 def test_flux_infer_on_a_catalog_without_exposure_is_a_one_line_error(tmp_path) -> None:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import erfa
 import numpy as np
 import pandas as pd
 import pytest
@@ -19,7 +20,7 @@ from abrupt.density import model_sampling
 from abrupt.density.drag_plausibility import lowest_perigee_km
 from abrupt.density.tle_drag import TleDragConfig, rho_b_from_history
 from abrupt.model.atmosphere import SpaceWeatherCoverageError, msis_density, read_space_weather, teme_to_geodetic
-from abrupt.model.msis_grid import GridSpec, MsisGrid
+from abrupt.model.msis_grid import GridSpec, MsisGrid, _gmst82
 from abrupt.pipelines.catalogue import run_catalogue
 from abrupt.readers.omm import read_element_histories
 from abrupt.simulate.tle_catalogue import write_catalogue
@@ -197,3 +198,14 @@ def test_cli_windows_only_takes_the_grid_by_default_and_direct_on_request(tmp_pa
     assert out["grid"].size == out["direct"].size > 0
     assert not np.array_equal(out["grid"], out["direct"])
     np.testing.assert_allclose(out["grid"], out["direct"], rtol=0.05)
+
+
+def test_compiled_gmst_equals_erfa_to_the_bit() -> None:
+    """The grid's GMST (ERFA's gmst82 written out) against erfa itself, 1960-2060 and around 1970."""
+    rng = np.random.default_rng(8)
+    lo, hi = (np.datetime64(d, "ns").astype(np.int64) for d in ("1960-01-01", "2060-01-01"))
+    ns = np.concatenate([rng.integers(lo, hi, 200_000), rng.integers(-(10**15), 10**15, 1000)])
+    got = np.empty(ns.size)
+    _gmst82(ns, got)
+    np.testing.assert_array_equal(got, erfa.gmst82(2440587.5, ns * 1e-9 / 86400.0))
+    assert got.min() >= 0.0 and got.max() < 2 * np.pi

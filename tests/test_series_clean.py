@@ -83,6 +83,20 @@ def test_robust_scale_matches_scipy_normal_mad() -> None:
     assert float(robust_scale(x[:, 0])) == pytest.approx(expected[0], rel=2e-6)
 
 
+def test_robust_scale_is_the_same_number_with_and_without_nan_in_the_data() -> None:
+    # Without NaN the plain median is taken (faster); the result must be numpy's nanmedian one exactly.
+    rng = np.random.default_rng(11)
+    for n in (3, 8, 599, 600, 1001):
+        x = np.round(rng.standard_normal((n, 3)), 2)  # ties, even and odd counts
+        x[0, 0] = np.inf
+        for axis in (None, 0, 1):
+            med = np.nanmedian(x, axis=axis, keepdims=True)
+            expected = 1.4826 * np.nanmedian(np.abs(x - med), axis=axis)
+            assert np.array_equal(robust_scale(x, axis=axis), expected)
+    x[1, 1] = np.nan  # the NaN path: the NaN sample is left out
+    assert robust_scale(x, axis=0)[1] == robust_scale(np.delete(x[:, 1], 1))
+
+
 def test_robust_noise_sigma_is_the_robust_scale_of_differences_over_root_two() -> None:
     x = np.random.default_rng(5).normal(size=(4000, 1)) * 0.2
     assert robust_noise_sigma(x)[0] == pytest.approx(float(robust_scale(np.diff(x[:, 0]))) / np.sqrt(2.0))

@@ -220,7 +220,7 @@ def smooth_model(
     step_times_s: FloatArray | None = None,
     cache: dict[tuple[float, ...], tuple[int, int, FloatArray, int, FloatArray]] | None = None,
 ) -> tuple[FloatArray, dict[str, float]]:
-    """The smooth (trend + comb) model of each column of h on the grid t_s (absolute seconds).
+    """The smooth (trend + comb) model of each column of h on the grid t_s (absolute seconds, increasing).
 
     Every gap in ``valid`` (masked dump, slew, loss of signal) and every time in ``step_times_s``
     (strike candidates) enters the fits as a free step: real momentum changes across a masked dump
@@ -296,9 +296,10 @@ def smooth_model(
                 step_sum[k_extra[0]] += wj * coef[n_poly + j]
                 step_w[k_extra[0]] += wj
     model = np.where(wsum[:, None] > 1e-6, out / np.maximum(wsum, 1e-12)[:, None], np.nan)
-    # The candidate steps stay in the data: add their fitted sizes back as a staircase.
+    # The candidate steps stay in the data: add their fitted sizes back as a staircase (t_s is sorted,
+    # so the samples at or after a step are a slice: the same subtractions, in the same order).
     sizes = step_sum / np.maximum(step_w, 1e-12)[:, None]
     for ts, size, wj in zip(extra, sizes, step_w, strict=True):
         if wj > 0:
-            model[t_s >= ts] -= size
+            model[int(np.searchsorted(t_s, ts, side="left")) :] -= size
     return model, {"harmonics_mean": float(np.mean(ks)) if ks else 0.0, "fits": float(len(ks))}

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from abrupt.clean.rolling_median import running_median
 from abrupt.types import BoolArray, FloatArray
 
 NS = 1_000_000_000
@@ -89,10 +90,10 @@ def event_mask(grid_ns: np.ndarray, intervals: list[tuple[int, int]], before_s: 
 
 def slew_angle_deg(body_rate_rad_s: FloatArray, dt_s: float, config: SlewMaskConfig) -> FloatArray:
     """Attitude departure from the nominal motion over ``window_s`` [deg], per sample (NaN-safe)."""
-    w = pd.DataFrame(body_rate_rad_s)
+    w = np.asarray(body_rate_rad_s, dtype=np.float64)
     n_nom = max(3, round(config.nominal_window_s / dt_s) | 1)
-    nominal = w.rolling(n_nom, center=True, min_periods=max(3, n_nom // 20)).median()
-    dw = (w - nominal).fillna(0.0)
+    nominal = running_median(w, n_nom, max(3, n_nom // 20))  # pandas' rolling median, its numbers
+    dw = pd.DataFrame(w - nominal).fillna(0.0)
     n_win = max(1, round(config.window_s / dt_s))
     ang = dw.rolling(n_win, center=True, min_periods=1).sum().to_numpy() * dt_s
     return np.asarray(np.degrees(np.linalg.norm(ang, axis=1)), dtype=np.float64)

@@ -4,6 +4,7 @@ simulate population`` (a fleet's detections drawn from a flux truth)."""
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -22,7 +23,7 @@ from abrupt.flux.exposure import (
     store_spacecraft_model,
 )
 from abrupt.flux.forward import ForwardConfig
-from abrupt.flux.inference import PARAMS
+from abrupt.flux.inference import PARAMS, FitResult
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.pipelines.flux import covered_days, flight_exposure, infer_flux, simulate_population
 from abrupt.report.flux import write_flux_report
@@ -59,8 +60,37 @@ def _parse_fix(items: tuple[str, ...]) -> dict[str, float]:
         name, _, value = item.partition("=")
         if name not in PARAMS or not value:
             raise ConfigError(f"--fix {item!r}: use NAME=VALUE with NAME in {list(PARAMS)}", key="fix")
-        out[name] = float(value)
+        try:
+            out[name] = float(value)
+        except ValueError:
+            raise ConfigError(f"--fix {item!r}: {value!r} is not a number", key="fix") from None
+        if not math.isfinite(out[name]) or out[name] < 0 or (name == "beta" and out[name] == 0):
+            raise ConfigError(f"--fix {item!r}: beta must be > 0 and a flux scale >= 0 (finite)", key="fix")
     return out
+
+
+def _estimates_text(f: FitResult, estimates: dict[str, float], intervals: dict[str, tuple[float, float]]) -> str:
+    parts = []
+    for p, v in estimates.items():
+        lo, hi = intervals.get(p, (v, v))
+        se = f.standard_errors.get(p) if estimates is f.linear_estimates else None
+        text = f"{p} = {v:.3g}" + ("" if se is None else f" ± {se:.2g}")
+        parts.append(text + (" (fixed)" if p in f.fixed else f" [{lo:.3g}, {hi:.3g}]"))
+    return ", ".join(parts)
+
+
+def _fit_lines(name: str, f: FitResult) -> list[str]:
+    """The printed lines of one fit: the reported estimates first (with β known the linear ones with their
+    standard errors and score intervals, then the maximum-likelihood ones as a diagnostic)."""
+    size = f"  ({f.n_events} events, {f.n_days} spacecraft-days)"
+    if not f.linear_estimates:
+        return [f"{name}: " + _estimates_text(f, f.estimates, f.intervals) + size]
+    level = f"{f.confidence:.0%}"
+    return [
+        f"{name}: " + _estimates_text(f, f.linear_estimates, f.linear_intervals) + size,
+        f"  reported: {f.reported()['estimator']}; ± standard error, [{level} score interval]",
+        "  maximum likelihood (diagnostic; profile intervals): " + _estimates_text(f, f.estimates, f.intervals),
+    ]
 
 
 @flux.command("infer")
@@ -97,13 +127,10 @@ def infer(
         reference_beta=reference_beta,
     )
     for name, f in result.fits.items():
-        parts = []
-        for p, v in f.estimates.items():
-            lo, hi = f.intervals.get(p, (v, v))
-            parts.append(f"{p} = {v:.3g}" + ("" if p in f.fixed else f" [{lo:.3g}, {hi:.3g}]"))
-        click.echo(f"{name}: " + ", ".join(parts) + f"  ({f.n_events} events, {f.n_days} spacecraft-days)")
+        for line in _fit_lines(name, f):
+            click.echo(line)
         free = [p for p in f.estimates if p not in f.fixed]
-        if f.corrected_estimates and free:
+        if f.corrected_estimates and free and not f.linear_estimates:
             corr = ", ".join(f"{p} = {f.corrected_estimates[p]:.3g}" for p in free)
             click.echo(f"  bias-corrected point estimate (signed ML, Cox-Snell correction of beta): {corr}")
         if "beta" in free:

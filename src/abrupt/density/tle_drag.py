@@ -223,6 +223,20 @@ def gap_node_counts(
     return np.maximum(2, np.ceil(gaps / step - 1e-9).astype(np.int64) + 1)
 
 
+@dataclass
+class PropagatedNodes:
+    """One history's integration nodes after SGP4 (:func:`propagate_nodes`), before the integrals
+    (:func:`integrate_nodes`): NRLMSIS may be filled in on ``nodes`` in between, for many objects at once."""
+
+    t_s: FloatArray
+    n_rad_s: FloatArray
+    counts: Any  # nodes of each gap
+    radius_m: FloatArray
+    wind: FloatArray  # F on the nodes
+    nodes: ModelNodes
+    with_model: bool
+
+
 def drag_integrals(
     history: ElementHistory,
     step_s: float | None = None,
@@ -239,6 +253,19 @@ def drag_integrals(
     integrated with the same weight (``model_integral``); with ``grid`` (a
     :class:`abrupt.model.msis_grid.MsisGrid`) it is interpolated from the grid on every node.
     """
+    nodes = propagate_nodes(history, step_s, nodes_per_rev=nodes_per_rev, space_weather=space_weather, grid=grid)
+    return integrate_nodes(nodes, model_stride)
+
+
+def propagate_nodes(
+    history: ElementHistory,
+    step_s: float | None = None,
+    *,
+    nodes_per_rev: float = DEFAULT_NODES_PER_REV,
+    space_weather: Any = None,
+    grid: MsisGrid | None = None,
+) -> PropagatedNodes:
+    """The first half of :func:`drag_integrals`: every gap's nodes, SGP4 on them and the weight."""
     el = history.elements
     n_sets = len(el)
     epochs = el["epoch_utc"].to_numpy(dtype="datetime64[ns]")
@@ -246,10 +273,6 @@ def drag_integrals(
     n_bar = el["n_rad_s"].to_numpy(dtype=float)
     jd0 = np.array([s.jdsatepoch for s in history.satrecs])
     jf0 = np.array([s.jdsatepochF for s in history.satrecs])
-    cum_w = np.zeros(n_sets)
-    cum_m = np.zeros(n_sets) if space_weather is not None else None
-    alt = np.full(n_sets, np.nan)
-    wf = np.full(n_sets, np.nan)
     # Build every gap's grid at once, propagate gap by gap (each from its earlier set).
     gaps = np.diff(t)
     counts = gap_node_counts(gaps, n_bar[:-1], el["e"].to_numpy(dtype=float)[:-1], nodes_per_rev, step_s)
@@ -277,13 +300,25 @@ def drag_integrals(
     integrand = np.cbrt(n_bar[gap_index]) * speed3 * f_all
     if np.any(errors != 0):
         integrand[errors != 0] = 0.0  # SGP4 failed (decayed record): no contribution
-    rho_all: FloatArray | None = None
     when = epochs[gap_index] + (tau_all * 1e9).astype("timedelta64[ns]")
-    starts = offsets[:-1]
-    nodes = ModelNodes(when, pos, errors == 0, tau_all, integrand, starts, space_weather, grid)
-    if grid is not None:
+    nodes = ModelNodes(when, pos, errors == 0, tau_all, integrand, offsets[:-1], space_weather, grid)
+    return PropagatedNodes(t, n_bar, counts, radius, f_all, nodes, space_weather is not None)
+
+
+def integrate_nodes(propagated: PropagatedNodes, model_stride: int = 2) -> DragIntegrals:
+    """The second half of :func:`drag_integrals`: the cumulative integrals at the sets, the model's
+    with it (NRLMSIS evaluated on the nodes not yet evaluated), the gaps' mean altitude and F."""
+    p, nodes = propagated, propagated.nodes
+    n_sets = p.t_s.size
+    cum_w = np.zeros(n_sets)
+    cum_m = np.zeros(n_sets) if p.with_model else None
+    alt = np.full(n_sets, np.nan)
+    wf = np.full(n_sets, np.nan)
+    starts = nodes.starts
+    rho_all: FloatArray | None = None
+    if nodes.grid is not None:
         model_stride = 1
-    if space_weather is not None and n_sets > 1:
+    if p.with_model and n_sets > 1:
         # NRLMSIS on every ``model_stride``-th node (≈ 7 µs a point); log ρ is interpolated in time
         # between them (the nodes of consecutive gaps are consecutive in time)
         rho_all, cum = nodes.integral(model_stride)
@@ -292,15 +327,16 @@ def drag_integrals(
     if n_sets > 1:
         # every gap's trapezoid sum and node means in one pass (sums in node order, not numpy's
         # pairwise order: the same values to ~1e-15 relative)
-        cum_w[1:] = np.cumsum(gap_trapezoids(tau_all, integrand, starts))
-        alt[1:] = (np.add.reduceat(radius, starts) / counts - 6378137.0) / 1e3
-        wf[1:] = np.add.reduceat(f_all, starts) / counts
+        cum_w[1:] = np.cumsum(gap_trapezoids(nodes.tau_s, nodes.weight, starts))
+        alt[1:] = (np.add.reduceat(p.radius_m, starts) / p.counts - 6378137.0) / 1e3
+        wf[1:] = np.add.reduceat(p.wind, starts) / p.counts
         alt[0] = alt[1]
         wf[0] = wf[1]
-    set_index = np.concatenate([offsets[:-1], [offsets[-1] - 1]]) if n_sets > 1 else np.zeros(1, dtype=np.int64)
-    integ = DragIntegrals(t, n_bar, cum_w, cum_m, alt, wf, when, integrand, rho_all, set_index, nodes)
+    n_nodes = nodes.ok.size
+    set_index = np.concatenate([starts, [n_nodes - 1]]) if n_sets > 1 else np.zeros(1, dtype=np.int64)
+    integ = DragIntegrals(p.t_s, p.n_rad_s, cum_w, cum_m, alt, wf, nodes.when, nodes.weight, rho_all, set_index, nodes)
     integ.model_points = nodes.n_evaluated
-    integ.model_stride = model_stride if space_weather is not None else None
+    integ.model_stride = model_stride if p.with_model else None
     return integ
 
 

@@ -112,9 +112,16 @@ def case_of(row: Mapping[Any, Any]) -> OrbitCase:
     )
 
 
-def bin_efficiency(edges: NDArray[np.float64], curves: NDArray[np.float64], n_sub: int = 16) -> NDArray[np.float64]:
-    """Mean efficiency over each |ΔH| bin (points uniform in ln|ΔH|; the open top bin over one bin width),
-    for curves (U, 3) of (x50, slope, plateau), so that steep curves are not sampled at the centre only."""
+def bin_efficiency(
+    edges: NDArray[np.float64],
+    curves: NDArray[np.float64],
+    n_sub: int = 16,
+    slopes: NDArray[np.float64] | None = None,
+) -> NDArray[np.float64]:
+    """Efficiency over each |ΔH| bin for curves (U, 3) of (x50, slope, plateau), sampled at ``n_sub`` points
+    uniform in ln|ΔH| (the open top bin over one bin width), so that steep curves are not sampled at the
+    centre only: (U, K), the plain mean; with ``slopes`` (..., K), local power-law slopes α of the strike
+    spectrum (dG ∝ x^−α d ln x), the mean weighted by that spectrum within the bin, (U, ..., K)."""
     lo = np.log(edges[:-1])
     upper = np.append(edges[1:-1], edges[-2] * (edges[-2] / edges[-3]))
     hi = np.log(upper)
@@ -123,7 +130,12 @@ def bin_efficiency(edges: NDArray[np.float64], curves: NDArray[np.float64], n_su
     eff = logistic_efficiency(
         x[None, :, :], curves[:, 0, None, None], curves[:, 1, None, None], curves[:, 2, None, None]
     )
-    return np.asarray(eff.mean(axis=2), dtype=np.float64)
+    if slopes is None:
+        return np.asarray(eff.mean(axis=2), dtype=np.float64)
+    alpha = np.clip(np.asarray(slopes, dtype=np.float64), -20.0, 20.0)[..., None]  # (..., K, 1)
+    w = np.exp(-alpha * (np.log(x) - lo[:, None]))  # (..., K, S), relative to the bin's lower edge
+    w = w / w.sum(axis=-1, keepdims=True)
+    return np.asarray(np.einsum("uks,...ks->u...k", eff, w), dtype=np.float64)
 
 
 def case_groups(exposure: pd.DataFrame) -> tuple[list[OrbitCase], NDArray[np.int64]]:

@@ -120,6 +120,15 @@ class Template:
         vals[:, -1] = 0.0  # G(+inf) = 0
         return np.asarray(-np.diff(vals, axis=1).reshape(p, c, -1), dtype=np.float64)
 
+    def local_slopes(self) -> NDArray[np.float64]:
+        """Local power-law slope α_pk of each population's unit-β spectrum (all classes) across observed bin k,
+        G(e_k)/G(e_k+1) = (e_k+1/e_k)^α; the open top bin takes its neighbour's. (P, K)."""
+        edges = self.config.edges_Nms[:-1]
+        g = np.log(np.maximum(self.cumulative.sum(axis=1), 1e-300))  # (P, H)
+        vals = np.stack([np.interp(np.log(edges), self.log_h_grid, row, left=row[0], right=-690.0) for row in g])
+        alpha = -np.diff(vals, axis=1) / np.diff(np.log(edges))[None, :]
+        return np.asarray(np.concatenate([alpha, alpha[:, -1:]], axis=1), dtype=np.float64)
+
 
 def flux_table(model: str, population: str, case: OrbitCase, config: ForwardConfig) -> FluxTable:
     """The flux table of a population for an orbit: analytic model by name, or a table file."""

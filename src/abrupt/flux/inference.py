@@ -46,6 +46,7 @@ from abrupt.flux.forward import (
     direction_class,
 )
 from abrupt.flux.grid import refine_max
+from abrupt.flux.linear import ESTIMATOR, linear_fit
 
 PARAMS: tuple[str, ...] = ("debris_scale", "meteoroid_scale", "beta")
 # what a fit with β free measures well (docs/flux-inference.md, "The debris scale on the β ridge")
@@ -67,7 +68,7 @@ class FluxData:
     event_group: NDArray[np.int64]
     event_bin: NDArray[np.int64]
     event_class: NDArray[np.int64]  # -1: direction unknown
-    event_coef: NDArray[np.float64]  # f_d ε_d(x_k) / 365.25 of the event's day [yr]
+    event_coef: NDArray[np.float64]  # f_d ε_d(x_k) / 365.25 of the event's day [yr], plain bin mean of ε
     event_background: NDArray[np.float64]  # background expectation in the event's (day, class, bin)
     observed_bins: NDArray[np.int64]  # (K,) events per bin
     n_dropped: int  # events without an exposure day, or below the lowest bin edge
@@ -82,6 +83,9 @@ class FluxData:
     # per exposure day: template group, whether its cells are (class, bin) (orbit attitude and directions
     # used) or bins only, efficiency curve, f_d and f_d b_d; per curve: bin efficiency and false-alarm share
     days: dict[str, NDArray[Any]] = field(default_factory=dict)
+    # as exposure_years and event_coef, with ε weighted by each population's spectrum within the bin
+    exposure_years_pop: NDArray[np.float64] | None = None  # (G, P, K)
+    event_coef_pop: NDArray[np.float64] | None = None  # (E, P)
 
     @property
     def n_events(self) -> int:
@@ -119,12 +123,14 @@ def prepare(
     curve_of = np.asarray(exp.groupby(eff_cols, sort=False).ngroup().to_numpy(), dtype=np.int64)
     curves = exp.drop_duplicates(eff_cols).loc[:, eff_cols].to_numpy(dtype=np.float64)
     eff_u = bin_efficiency(edges, curves)  # (U, K)
+    eff_pop = bin_efficiency(edges, curves, slopes=np.stack([t.local_slopes() for t in tlist]))  # (U, G, P, K)
     cdf = logistic_efficiency(edges[None, :-1], curves[:, :1], curves[:, 1:2], 1.0)
     # share of false alarms per bin; those below the lowest edge are left out like their events
     share_u = np.diff(np.concatenate([cdf, np.ones((len(curves), 1))], axis=1), axis=1).astype(np.float64)
     n_u = len(curves)
     weight = np.bincount(group * n_u + curve_of, weights=f, minlength=len(keys) * n_u).reshape(len(keys), n_u)
     exposure_years = weight @ eff_u / DAYS_PER_YEAR  # (G, K)
+    exposure_pop = np.einsum("gu,ugpk->gpk", weight, eff_pop) / DAYS_PER_YEAR
     fa = exp["false_alarms_per_day"].to_numpy() * f
     background_bins = np.bincount(curve_of, weights=fa, minlength=n_u) @ share_u
     ga = (group * 2 + (exp["attitude"].to_numpy() == "orbit")) * n_u + curve_of
@@ -162,12 +168,14 @@ def prepare(
         n_dropped=int((~keep).sum()),
         n_days=len(exp),
         n_with_direction=int((cls >= 0).sum()),
-        exposure_years_att=(w_att @ eff_u / DAYS_PER_YEAR).reshape(len(keys), 2, -1),
+        exposure_years_att=np.einsum("gau,ugpk->gapk", w_att.reshape(len(keys), 2, n_u), eff_pop) / DAYS_PER_YEAR,
         background_att=(fa_att @ share_u).reshape(len(keys), 2, -1),
         rows_set_aside=chosen.rows_set_aside,
         events_set_aside=chosen.events_set_aside,
         days={"group": group, "directional": (exp["attitude"].to_numpy() == "orbit") & directional, "curve": curve_of}
-        | {"f": f, "fa": fa, "efficiency": eff_u, "share": share_u},
+        | {"f": f, "fa": fa, "efficiency": eff_pop, "share": share_u},
+        exposure_years_pop=exposure_pop,
+        event_coef_pop=f[rows_a][:, None] * eff_pop[u_ev, group[rows_a], :, kbin] / DAYS_PER_YEAR,
     )
 
 
@@ -177,6 +185,9 @@ class Likelihood:
     def __init__(self, data: FluxData, beta_grid: NDArray[np.float64] = DEFAULT_BETA_GRID) -> None:
         self.data = data
         self.beta_grid = np.asarray(beta_grid, dtype=np.float64)
+        if data.exposure_years_pop is None or data.event_coef_pop is None:
+            raise ConfigError("these flux data carry no per-population exposure; build them with prepare()", key="data")
+        exp_pop, coef_pop = data.exposure_years_pop, data.event_coef_pop
         nb, ne, npop = self.beta_grid.size, data.n_events, len(POPULATIONS)
         self.a = np.zeros((nb, ne, npop))  # per-event signal expectation at unit scales
         self.totals = np.zeros((nb, npop))  # total signal expectation at unit scales
@@ -184,13 +195,13 @@ class Likelihood:
         for b, beta in enumerate(self.beta_grid):
             for g, tpl in enumerate(data.templates):
                 r = tpl.bin_rates(float(beta))  # (P, C, K)
-                sig = r.sum(axis=1) * data.exposure_years[g][None, :]
+                sig = r.sum(axis=1) * exp_pop[g]
                 self.bin_signal[b] += sig
                 sel = data.event_group == g
                 if sel.any():
                     cls, kb = data.event_class[sel], data.event_bin[sel]
                     per = np.where(cls[:, None] >= 0, r[:, np.maximum(cls, 0), kb].T, r.sum(axis=1)[:, kb].T)
-                    self.a[b, sel] = per * data.event_coef[sel][:, None]
+                    self.a[b, sel] = per * coef_pop[sel]
             self.totals[b] = self.bin_signal[b].sum(axis=1)
         self.bg_events = data.event_background
         self.bg_total = float(data.background_bins.sum())
@@ -293,7 +304,8 @@ class Likelihood:
         for g, tpl in enumerate(d.templates):
             r = tpl.bin_rates(float(beta))  # (P, C, K)
             n_pop, n_cls, _ = r.shape
-            sig += [r.sum(axis=1) * d.exposure_years_att[g, 0], (r * d.exposure_years_att[g, 1]).reshape(n_pop, -1)]
+            att = d.exposure_years_att[g]  # (2, P, K)
+            sig += [r.sum(axis=1) * att[0], (r * att[1][:, None, :]).reshape(n_pop, -1)]
             bg += [d.background_att[g, 0], np.tile(d.background_att[g, 1] / n_cls, n_cls)]
         return np.concatenate(sig, axis=1), np.concatenate(bg)
 
@@ -374,9 +386,23 @@ class FitResult:
     signed_estimates: dict[str, float] = field(default_factory=dict)  # scales not bounded at 0
     corrected_estimates: dict[str, float] = field(default_factory=dict)  # signed minus Cox-Snell bias
     penalised_estimates: dict[str, float] = field(default_factory=dict)  # Jeffreys-penalised in (ln s, ln β)
+    # β known: the fixed-weight linear estimate (exactly unbiased), its standard errors and score intervals
+    linear_estimates: dict[str, float] = field(default_factory=dict)
+    standard_errors: dict[str, float] = field(default_factory=dict)
+    linear_intervals: dict[str, tuple[float, float]] = field(default_factory=dict)
+
+    def reported(self) -> dict[str, Any]:
+        """The estimates to quote: with β known the linear ones and their intervals, else the ML ones."""
+        if self.linear_estimates:
+            est, iv, se = self.linear_estimates, self.linear_intervals, self.standard_errors
+            return {"estimator": ESTIMATOR, "estimates": est, "standard_errors": se, "intervals": iv}
+        ml = "maximum likelihood, profile-likelihood intervals"
+        return {"estimator": ml, "estimates": self.estimates, "standard_errors": {}, "intervals": self.intervals}
 
     def as_dict(self) -> dict[str, Any]:
+        rep = self.reported()
         return {
+            "reported": rep | {"intervals": {k: list(v) for k, v in rep["intervals"].items()}},
             "estimates": self.estimates,
             "intervals": {k: list(v) for k, v in self.intervals.items()},
             "confidence": self.confidence,
@@ -391,6 +417,9 @@ class FitResult:
             "signed_estimates": self.signed_estimates,
             "corrected_estimates": self.corrected_estimates,
             "penalised_estimates": self.penalised_estimates,
+            "linear_estimates": self.linear_estimates,
+            "linear_standard_errors": self.standard_errors,
+            "linear_intervals": {k: list(v) for k, v in self.linear_intervals.items()},
         }
 
 
@@ -412,7 +441,8 @@ def fit(
     intervals: bool = True,
     penalised: bool = False,
 ) -> FitResult:
-    """Maximum likelihood and profile-likelihood intervals of the free parameters.
+    """Maximum likelihood and profile-likelihood intervals of the free parameters; with β fixed also the
+    linear estimates of the scales (:mod:`abrupt.flux.linear`), the reported ones (``FitResult.reported``).
 
     Args:
         data: from :func:`prepare`.
@@ -462,6 +492,7 @@ def fit(
     signed = _signed_estimates(lik, scale_fixed) if data.n_events else dict(estimates)
     corrected = bias_corrected(lik, fixed, signed) if data.n_events else dict(estimates)
     pen = penalised_estimates(lik, fixed, estimates) if penalised else {}
+    lin = linear_fit(lik, scale_fixed, confidence) if "beta" in fixed and lik.beta_grid.size == 1 else None
     return FitResult(
         estimates,
         bounds,
@@ -477,6 +508,9 @@ def fit(
         signed,
         corrected,
         pen,
+        {} if lin is None else lin.estimates,
+        {} if lin is None else lin.standard_errors,
+        {} if lin is None else lin.intervals,
     )
 
 

@@ -33,8 +33,9 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from abrupt.density.drag_batch import rho_b_from_histories
 from abrupt.density.drag_plausibility import IMPLAUSIBLE_STATUS
-from abrupt.density.tle_drag import TleDragConfig, rho_b_from_history
+from abrupt.density.tle_drag import TleDragConfig
 from abrupt.errors import InputError
 from abrupt.events import empty_frame, normalise_frame, read_events
 from abrupt.model.atmosphere import read_space_weather
@@ -147,10 +148,15 @@ def density_task(task: CatalogueTask) -> tuple[pd.DataFrame, list[str]]:
     maneuvers = maneuver_times_of(key) if key else None
     frames = []
     notes: list[str] = []
-    for history in read_element_histories(task.path):
-        label = history.name or f"NORAD-{history.norad_id}"
-        given: str | list[Any] = task.settings["maneuvers"] if maneuvers is None else maneuvers.get(label, [])
-        res = rho_b_from_history(history, cfg, maneuvers=given, space_weather=sw)
+    histories = read_element_histories(task.path)
+    labels = [h.name or f"NORAD-{h.norad_id}" for h in histories]
+    given: list[str | list[Any]] = [
+        task.settings["maneuvers"] if maneuvers is None else maneuvers.get(label, []) for label in labels
+    ]
+    # the objects of the file together: NRLMSIS from the grid slot by slot over all of them
+    for history, label, res in zip(
+        histories, labels, rho_b_from_histories(histories, cfg, given, space_weather=sw), strict=True
+    ):
         if len(res.windows):
             frames.append(res.windows)
         if res.skipped:

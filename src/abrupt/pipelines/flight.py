@@ -35,7 +35,7 @@ import pandas as pd
 
 from abrupt.clean.comb import CombConfig, estimate_period, smooth_model
 from abrupt.clean.flight_masks import SlewMaskConfig, event_mask, flag_intervals, slew_mask
-from abrupt.detect.attitude.evidence import EventEvidence, event_evidence
+from abrupt.detect.attitude.evidence import EventEvidence, event_evidence, profile_fits
 from abrupt.detect.attitude.flight_glr import MIN_BLOCKS, FlightGlrDetector, Peak
 from abrupt.errors import ConfigError, InputError
 from abrupt.events import config_hash, new_run_id
@@ -371,11 +371,12 @@ def _clean_and_scan(
     info: dict[str, float] = {"harmonics_mean": 0.0}
     fit_cache: dict[tuple[float, ...], Any] = {}
     h_ok = np.where(ok[:, None], h_n, 0.0)
-    for _ in range(max(1, c.passes)):
+    passes = max(1, c.passes)
+    for k in range(passes):
         model, info = smooth_model(h_ok, t_s, ok, period, c.comb_config, steps, cache=fit_cache)
         hc = np.where(ok[:, None], h_n - np.nan_to_num(model), np.nan)
         stat = detector.statistic(hc, ok, win)
-        if not (c.comb or c.trend):
+        if not (c.comb or c.trend) or k == passes - 1:  # the last pass's candidates would enter no fit
             break
         taus = detector.step_candidates(hc, ok, stat, win, c.candidate_sigma)
         new_steps = np.array([t_s[tau] - 0.5 * dt for tau in taus])
@@ -427,15 +428,14 @@ def process_span(
     hc, stat, info = _clean_and_scan(h_n, ok, g.astype(np.float64) / NS, dt, period, c, detector)
     core = (g >= start_ns) & (g < end_ns)
     peaks = detector.find_peaks(hc, ok, stat, g, dt, detector.windows(dt), keep=core)
+    above = {pk.time_ns: pk for _, pk in peaks if pk.value > config.evidence_floor}
+    fits = {t: profile_fits(table, hc, t) for t in above}  # shared by the evidence and the rescan after a ramp
     evidence = {
-        pk.time_ns: event_evidence(
-            table, hc, spacecraft, pk.time_ns, pk.dH_N_Nms, inertia_kgm2=inertia_kgm2, raw_H_N=h_n
-        )
-        for _, pk in peaks
-        if pk.value > config.evidence_floor
+        t: event_evidence(table, hc, spacecraft, t, pk.dH_N_Nms, inertia_kgm2=inertia_kgm2, raw_H_N=h_n, fits=fits[t])
+        for t, pk in above.items()
     }
     found, found_ev = rescan_after_faults(
-        table, spacecraft, h_n, hc, ok, detector, peaks, evidence, config.evidence_floor, core, inertia_kgm2
+        table, spacecraft, h_n, hc, ok, detector, peaks, evidence, config.evidence_floor, core, inertia_kgm2, fits=fits
     )
     peaks, evidence = peaks + found, {**evidence, **found_ev}
     faults = scan_span(samples, flight, table, spacecraft, ok, start_ns, end_ns)

@@ -34,10 +34,10 @@ from abrupt.detect.attitude.evidence import EventEvidence, event_evidence
 from abrupt.detect.attitude.flight_glr import FlightGlrDetector, Peak
 from abrupt.detect.attitude.ramp_step import (
     RampStep,
+    WindowFits,
     body_frame_momentum,
     fit_ramp_step,
     from_body_increments,
-    step_siblings,
 )
 from abrupt.detect.attitude.repair import repair_sensor_fault
 from abrupt.events import format_time_utc, make_event_id
@@ -144,25 +144,29 @@ def _best_peak(
     return max(cands, key=lambda c: c[1].value) if cands else None
 
 
-def _off_ramp(table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int) -> FloatArray | None:
+def _off_ramp(
+    table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int, fits: WindowFits | None = None
+) -> FloatArray | None:
     """Cleaned ᴺH over rows [a, b) with the component along the body direction of the ramp or sequence
     around row ``i0`` removed, or None when the window needs no ramp. A leak or a venting sequence keeps
     one body direction; what steps off it is a second source. The direction is that of the event's own
     step when other impulses share it (a venting train:
     :func:`~abrupt.detect.attitude.ramp_step.step_siblings`), else the ramp's
-    (:func:`~abrupt.detect.attitude.ramp_step.fit_ramp_step`)."""
+    (:func:`~abrupt.detect.attitude.ramp_step.fit_ramp_step`). ``fits``: the event's evidence fits, used
+    when they are of this window."""
     g = table.time_ns
     half = round(RAMP_WINDOW_S / table.dt_s)
     lo, hi = max(0, i0 - half), min(g.size, i0 + half + 1)
     q = table.quaternion_BN
-    tau, y_win = (g[lo:hi] - g[i0]) / NS, body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi])
+    if fits is None or fits.key != (lo, i0, hi):
+        fits = WindowFits((lo, i0, hi), (g[lo:hi] - g[i0]) / NS, body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi]))
     # A train of impulses along the event's own direction is a venting sequence: that direction is the
     # torque's (the ramp fit would take the largest other step, a strike's, for the ramp).
-    seq = step_siblings(tau, y_win, 0.0)
+    seq = fits.siblings()
     if seq is not None and seq.sharp_siblings > 0:
         u_b = seq.step_B / float(np.linalg.norm(seq.step_B))
     else:
-        fit = fit_ramp_step(tau, y_win, 0.0)
+        fit = fits.ramp()
         if fit is None or not float(np.linalg.norm(fit.ramp_B)) > RAMP_SIGMA_MIN * fit.ramp_sigma:
             return None
         u_b = fit.ramp_B / float(np.linalg.norm(fit.ramp_B))
@@ -182,19 +186,23 @@ LEAK_DURATIONS = 48
 
 
 def _without_step(
-    table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int
+    table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int, fits: WindowFits | None = None
 ) -> tuple[FloatArray, RampStep] | None:
     """Cleaned ᴺH over rows [a, b) with the step at row ``i0`` taken out, and the fit, when the window
     around it also holds a ramp beyond its noise (a leak beside a strike); None otherwise. The step is
     that of the step-on-a-ramp fit (:func:`~abrupt.detect.attitude.ramp_step.fit_ramp_step`), fixed in
-    body axes at ``i0``, so what is left is the ramp and the rest of the window."""
+    body axes at ``i0``, so what is left is the ramp and the rest of the window. ``fits``: the event's
+    evidence fits, used when they are of this window."""
     g = table.time_ns
     half = round(RAMP_WINDOW_S / table.dt_s)
     lo, hi = max(0, i0 - half), min(g.size, i0 + half + 1)
     q = table.quaternion_BN
-    y_win = body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi])
-    tau = (g[lo:hi] - g[i0]) / NS
-    fit = fit_ramp_step(tau, y_win, 0.0, n_durations=LEAK_DURATIONS, max_ramp_fraction=LEAK_FRACTION, refine_s=3.0)
+    if fits is None or fits.key != (lo, i0, hi):
+        fits = WindowFits((lo, i0, hi), (g[lo:hi] - g[i0]) / NS, body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi]))
+    # The window's momentum is the evidence's; its ramp fit is not (the leak may be longer than its ramps).
+    fit = fit_ramp_step(
+        fits.tau_s, fits.y_B, 0.0, n_durations=LEAK_DURATIONS, max_ramp_fraction=LEAK_FRACTION, refine_s=3.0
+    )
     if fit is None or not float(np.linalg.norm(fit.ramp_B)) > RAMP_SIGMA_MIN * fit.ramp_sigma:
         return None
     h = cleaned_H_N[a:b]
@@ -223,6 +231,7 @@ def rescan_after_faults(
     keep: BoolArray | None = None,
     inertia_kgm2: FloatArray | None = None,
     rules: AttributionRules | None = None,
+    fits: Mapping[int, WindowFits] | None = None,
 ) -> tuple[list[tuple[int, Peak]], dict[int, EventEvidence]]:
     """New peaks (above ``floor``) and their evidence found after repairing each sensor fault's channel.
 
@@ -236,6 +245,8 @@ def rescan_after_faults(
     detector's suppression zone around the torque's peak. For every ``strike`` peak whose window also
     holds a ramp, the strike's fitted step is taken out and the rest rescanned
     (:func:`_torque_beside_strike`): a peak there is kept when its evidence is an external torque's.
+    ``fits``: each peak's :func:`~abrupt.detect.attitude.evidence.profile_fits` as its evidence made
+    them (by peak time).
     """
     g = table.time_ns
     dt = table.dt_s
@@ -253,7 +264,7 @@ def rescan_after_faults(
         a, b = max(0, i0 - round((half_s + 240.0) / dt)), min(g.size, i0 + round((half_s + 240.0) / dt))
         keep_sub = None if keep is None else keep[a:b]
         if a_.kind == "external_non_strike":
-            hc_sub = _off_ramp(table, cleaned_H_N, i0, a, b)
+            hc_sub = _off_ramp(table, cleaned_H_N, i0, a, b, None if fits is None else fits.get(pk.time_ns))
             if hc_sub is None:
                 continue
             hc_sub = np.where(ok[a:b, None], hc_sub, np.nan)
@@ -280,7 +291,7 @@ def rescan_after_faults(
         if a_.kind == "strike":
             got = _torque_beside_strike(
                 table, spacecraft, raw_H_N, cleaned_H_N, ok, detector, pk, (i0, a, b), floor, keep_sub, others,
-                inertia_kgm2, rules,
+                inertia_kgm2, rules, None if fits is None else fits.get(pk.time_ns),
             )  # fmt: skip
             if got is not None:
                 found.append(got[0])
@@ -323,6 +334,7 @@ def _torque_beside_strike(
     others: tuple[tuple[int, float, float], ...],
     inertia_kgm2: FloatArray | None,
     rules: AttributionRules | None,
+    fits: WindowFits | None = None,
 ) -> tuple[tuple[int, Peak], EventEvidence] | None:
     """A lasting external torque's own peak beside a strike's event, or None.
 
@@ -334,7 +346,7 @@ def _torque_beside_strike(
     """
     g, dt = table.time_ns, table.dt_s
     i0, a, b = rows
-    got = _without_step(table, cleaned_H_N, i0, a, b)
+    got = _without_step(table, cleaned_H_N, i0, a, b, fits)
     if got is None:
         return None
     hc_sub, fit = np.where(ok[a:b, None], got[0], np.nan), got[1]

@@ -28,7 +28,7 @@ import pandas as pd
 
 from abrupt.detect.attitude.attribution import momentum_stepped
 from abrupt.detect.attitude.evidence import EventEvidence
-from abrupt.detect.attitude.fault_scan import FAULT_FALSE_ALARMS, FaultFinding, FaultScan, scan_faults
+from abrupt.detect.attitude.fault_scan import FAULT_FALSE_ALARMS, FaultFinding, FaultScan, scan_faults_each
 from abrupt.detect.attitude.torque_scan import scan_torque
 from abrupt.events import Event, events_frame, format_time_utc, make_event_id
 from abrupt.model.flight_config import FlightConfig
@@ -196,7 +196,7 @@ def scan_span(
     (:mod:`abrupt.detect.attitude.torque_scan`, its own stated rate; the flight pipeline does not pass it)."""
     first = -(-start_ns // DAY_NS) * DAY_NS
     edges = [start_ns, *range(first if first > start_ns else first + DAY_NS, end_ns, DAY_NS), end_ns]
-    parts = [scan_faults(samples, flight, table, spacecraft, ok, (a, b), budget) for a, b in itertools.pairwise(edges)]
+    parts = scan_faults_each(samples, flight, table, spacecraft, ok, list(itertools.pairwise(edges)), budget)
     if h_clean is not None:
         parts += [scan_torque(table.time_ns, h_clean, ok, (a, b)) for a, b in itertools.pairwise(edges)]
     return FaultScan([f for p in parts for f in p.findings], [c for p in parts for c in p.calibrations])

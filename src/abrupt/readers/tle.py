@@ -434,32 +434,28 @@ def split_by_satellite(
 
 def elements_frame(sets: Sequence[RawElementSet]) -> pd.DataFrame:
     """The :data:`ELEMENT_COLUMNS` frame of SGP4 mean elements (SI units) from initialised records."""
-    rows = []
-    for s in sets:
-        sat = s.satrec
-        jd = np.float64(sat.jdsatepoch) - 2440587.5 + np.float64(sat.jdsatepochF)
-        epoch = np.datetime64(round(float(jd) * 86400e6), "us").astype("datetime64[ns]")
-        rows.append(
-            (
-                epoch,
-                s.norad_id,
-                s.element_set_no,
-                sat.xke * sat.a**-1.5 / 60.0,  # Brouwer mean motion, a = (xke/n)^(2/3)
-                sat.a * EARTH_RADIUS_WGS72_M,
-                sat.ecco,
-                sat.inclo,
-                sat.nodeo,
-                sat.argpo,
-                sat.mo,
-                sat.bstar,
-                sat.nodedot / 60.0,
-                sat.argpdot / 60.0,
-                s.line,
-            )
-        )
-    frame = pd.DataFrame(rows, columns=list(ELEMENT_COLUMNS))
-    frame["epoch_utc"] = pd.to_datetime(frame["epoch_utc"]).astype("datetime64[ns]")
-    return frame
+    if not sets:
+        return pd.DataFrame([], columns=list(ELEMENT_COLUMNS)).astype({"epoch_utc": "datetime64[ns]"})
+    sats = [s.satrec for s in sets]
+    # the epoch to the microsecond: (jd − 1970-01-01) in days, as float64, × 86400e6, rounded
+    epoch_us = [round((sat.jdsatepoch - 2440587.5 + sat.jdsatepochF) * 86400e6) for sat in sats]
+    columns = (
+        np.array(epoch_us, dtype=np.int64).astype("datetime64[us]").astype("datetime64[ns]"),
+        [s.norad_id for s in sets],
+        [s.element_set_no for s in sets],
+        [sat.xke * sat.a**-1.5 / 60.0 for sat in sats],  # Brouwer mean motion, a = (xke/n)^(2/3)
+        [sat.a * EARTH_RADIUS_WGS72_M for sat in sats],
+        [sat.ecco for sat in sats],
+        [sat.inclo for sat in sats],
+        [sat.nodeo for sat in sats],
+        [sat.argpo for sat in sats],
+        [sat.mo for sat in sats],
+        [sat.bstar for sat in sats],
+        [sat.nodedot / 60.0 for sat in sats],
+        [sat.argpdot / 60.0 for sat in sats],
+        [s.line for s in sets],
+    )
+    return pd.DataFrame(dict(zip(ELEMENT_COLUMNS, columns, strict=True)))
 
 
 def read_element_bytes(path: Path) -> bytes:

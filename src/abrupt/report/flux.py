@@ -89,17 +89,26 @@ def _table(frame: pd.DataFrame, floatfmt: str = "{:.4g}") -> str:
 
 def fits_table(result: FluxInference) -> pd.DataFrame:
     rows = []
+    nan = float("nan")
     for name, f in result.fits.items():
+        rep = f.reported()
+        linear = bool(f.linear_estimates)
         for p, v in f.estimates.items():
-            lo, hi = f.intervals.get(p, (float("nan"), float("nan")))
+            lo, hi = rep["intervals"].get(p, (nan, nan))
+            ml_lo, ml_hi = f.intervals.get(p, (nan, nan))
             rows.append(
                 {
                     "fit": name,
                     "parameter": p,
-                    "estimate (ML)": v,
-                    "bias-corrected": f.corrected_estimates.get(p, float("nan")),
+                    "estimate": rep["estimates"].get(p, v),
+                    "s.e.": rep["standard_errors"].get(p, nan),
                     f"{f.confidence:.0%} low": lo,
                     f"{f.confidence:.0%} high": hi,
+                    "estimator": "linear, score interval" if linear else "ML, profile likelihood",
+                    "ML": v,
+                    "ML low": ml_lo if linear else nan,
+                    "ML high": ml_hi if linear else nan,
+                    "bias-corrected": f.corrected_estimates.get(p, nan),
                     "fixed": p in f.fixed,
                 }
             )
@@ -107,7 +116,7 @@ def fits_table(result: FluxInference) -> pd.DataFrame:
             for pop, v in f.expected_events.items():
                 if pop != "false_alarms":
                     rows.append(
-                        {"fit": name, "parameter": f"expected {pop} detections s·T(β) (identified)", "estimate (ML)": v}
+                        {"fit": name, "parameter": f"expected {pop} detections s·T(β) (identified)", "estimate": v}
                     )
     return pd.DataFrame(rows)
 
@@ -128,7 +137,9 @@ def write_flux_report(path: str | Path, result: FluxInference) -> Path:
         f"<p>{free.n_events} strike events on {free.n_days} analysed spacecraft-days "
         f"({free.n_with_direction} with an orbit-frame direction); {free.n_dropped} left out.</p>",
         f'<img src="data:image/png;base64,{cum}">',
-        "<h2>Fitted parameters (profile likelihood)</h2>",
+        "<h2>Fitted parameters</h2><p>With β known the scales are the linear fixed-weight estimates (unbiased; "
+        "score-type intervals), the maximum-likelihood ones beside them; with β free, maximum likelihood and "
+        "profile-likelihood intervals (docs/flux-inference.md).</p>",
         _table(fits_table(result)),
         "<h2>Upper limits (95 %, CLs, one population at a time, β = reference)</h2>",
         _table(pd.DataFrame(result.upper_limits)),

@@ -28,8 +28,11 @@ def robust_scale(x: ArrayLike, axis: int | None = None) -> FloatArray:
     otherwise the scale of each slice along ``axis``.
     """
     a = np.asarray(x, dtype=np.float64)
-    med = np.nanmedian(a, axis=axis, keepdims=True)
-    mad = np.nanmedian(np.abs(a - med), axis=axis)
+    # Without NaN the plain median is the same number and several times cheaper (nanmedian goes
+    # through a Python loop over the columns).
+    median = np.median if a.size and not np.isnan(a).any() else np.nanmedian
+    med = median(a, axis=axis, keepdims=True)
+    mad = median(np.abs(a - med), axis=axis)
     return np.asarray(MAD_TO_SIGMA * mad, dtype=np.float64)
 
 

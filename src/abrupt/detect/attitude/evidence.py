@@ -64,10 +64,9 @@ from scipy.ndimage import median_filter
 
 from abrupt.clean.flight_masks import tracker_rate_rad_s
 from abrupt.detect.attitude.ramp_step import (
+    WindowFits,
     body_frame_momentum,
-    fit_ramp_step,
     ramp_step_evidence,
-    step_siblings,
     step_siblings_evidence,
 )
 from abrupt.model.rotations import dcm_from_quaternion
@@ -217,10 +216,18 @@ def ramp_duration(tau_s: FloatArray, y: FloatArray, sigma: float) -> tuple[float
     # A linear background (slow residual drift) is projected out of the data and of each ramp.
     basis, _ = np.linalg.qr(np.column_stack([np.ones_like(t), (t - t.mean()) / max(span, 1.0)]))
     vc = v - basis @ (basis.T @ v)
+    # One set of (onsets × samples) buffers for every duration: a fresh array per step of the loop cost
+    # more in page faults than in arithmetic. The operations are those of the plain expressions.
+    lag = t[None, :] - onsets[:, None]
+    xc, proj, sq = np.empty_like(lag), np.empty_like(lag), np.empty_like(lag)
     for j, d in enumerate(durations):
-        x = np.clip((t[None, :] - onsets[:, None]) / d, 0.0, 1.0) if d > 0 else (t[None, :] >= onsets[:, None]) * 1.0
-        xc = x - (x @ basis) @ basis.T
-        sxx = np.sum(xc * xc, axis=1)
+        if d > 0:
+            np.clip(np.divide(lag, d, out=xc), 0.0, 1.0, out=xc)  # clip((t − τ_s) / D, 0, 1)
+        else:
+            np.greater_equal(t[None, :], onsets[:, None], out=xc)  # the step: 1(t ≥ τ_s)
+        np.matmul(xc @ basis, basis.T, out=proj)
+        np.subtract(xc, proj, out=xc)  # the ramp with the linear background projected out
+        sxx = np.sum(np.multiply(xc, xc, out=sq), axis=1)
         sxy = xc @ vc
         with np.errstate(invalid="ignore", divide="ignore"):
             sse = np.sum(vc * vc) - np.where(sxx > 0, sxy**2 / sxx, 0.0)
@@ -258,6 +265,20 @@ def _idx(g: np.ndarray, i0: int, a_s: float, b_s: float, dt: float) -> np.ndarra
     return np.arange(lo, hi)
 
 
+def profile_fits(
+    table: Timetable, cleaned_H_N: FloatArray, time_ns: int, windows: EvidenceWindows | None = None
+) -> WindowFits:
+    """The body-frame momentum of cleaned ᴺH over ± ``profile_s`` around the event at ``time_ns``, with its
+    ramp and sibling fits made when first asked (:class:`~abrupt.detect.attitude.ramp_step.WindowFits`)."""
+    w = windows or EvidenceWindows()
+    g = table.time_ns
+    i0 = int(np.clip(np.searchsorted(g, time_ns), 0, g.size - 1))
+    span = _idx(g, i0, -w.profile_s, w.profile_s, table.dt_s)
+    lo, hi = (int(span[0]), int(span[-1]) + 1) if span.size else (i0, i0)
+    y_b = body_frame_momentum(cleaned_H_N[lo:hi], table.quaternion_BN[lo:hi])
+    return WindowFits((lo, i0, hi), (g[lo:hi] - g[i0]) / NS, y_b)
+
+
 def event_evidence(
     table: Timetable,
     cleaned_H_N: FloatArray,
@@ -268,8 +289,11 @@ def event_evidence(
     inertia_kgm2: FloatArray | None = None,
     windows: EvidenceWindows | None = None,
     raw_H_N: FloatArray | None = None,
+    fits: WindowFits | None = None,
 ) -> EventEvidence:
-    """The evidence of the event at ``time_ns`` with step ``dH_N_Nms`` (module docstring)."""
+    """The evidence of the event at ``time_ns`` with step ``dH_N_Nms`` (module docstring). ``fits``: the
+    :func:`profile_fits` of this event on ``cleaned_H_N`` when the caller keeps them for later use (used
+    when their rows are this event's window; made here otherwise)."""
     w = windows or EvidenceWindows()
     g = table.time_ns
     if g.size < 10:
@@ -324,15 +348,14 @@ def event_evidence(
         out.update(_sensor_residuals(q[i0], bn0, J, dh_n, step_vec, slope_vec, raw_H_N, pre))
     out.update(_gyro_spike(q, omega, valid, i0, dt))
     out.update(_profile(g, cleaned_H_N, dh_n, i0, dt, w))
-    if not float(out.get("duration_lo_s", NAN)) <= w.ramp_min_s:  # an impulse needs no ramp besides it
-        span = _idx(g, i0, -w.profile_s, w.profile_s, dt)
-        y_b = body_frame_momentum(cleaned_H_N[span], q[span])
-        fit = fit_ramp_step((g[span] - g[i0]) / NS, y_b, 0.0, min_ramp_s=w.ramp_min_s)
-        out.update(ramp_step_evidence(fit, mag))
-    if mag > 0:
-        span = _idx(g, i0, -w.profile_s, w.profile_s, dt)
-        y_b = body_frame_momentum(cleaned_H_N[span], q[span])
-        out.update(step_siblings_evidence(step_siblings((g[span] - g[i0]) / NS, y_b, 0.0), mag))
+    need_ramp = not float(out.get("duration_lo_s", NAN)) <= w.ramp_min_s  # an impulse needs no ramp besides it
+    if need_ramp or mag > 0:
+        own = profile_fits(table, cleaned_H_N, time_ns, w)
+        fits = fits if fits is not None and fits.key == own.key else own
+        if need_ramp:
+            out.update(ramp_step_evidence(fits.ramp(w.ramp_min_s), mag))
+        if mag > 0:
+            out.update(step_siblings_evidence(fits.siblings(), mag))
     out.update(_appendage(table, i0, dt))
     out.update(surface_evidence(spacecraft, dh_b))
     if raw_H_N is not None and mag > 0:

@@ -97,10 +97,15 @@ def _best_ramp(
     """(−gain, onset, duration) of the ramp of ``durations`` × ``onsets`` that explains most of ``vc`` (the
     data with the basis projected out, in units of its noise) and ends 30 s before the window's end."""
     best = (math.inf, NAN, NAN)
+    # One set of (onsets × samples) buffers for every duration (fresh arrays cost page faults); the
+    # operations are those of xc = x − (x B) Bᵀ, x = clip((t − τ_s) / D, 0, 1).
+    lag = t[None, :] - onsets[:, None]
+    xc, proj, sq = np.empty_like(lag), np.empty_like(lag), np.empty_like(lag)
     for d in durations:
-        x = np.clip((t[None, :] - onsets[:, None]) / d, 0.0, 1.0)
-        xc = x - (x @ basis) @ basis.T
-        sxx = np.sum(xc * xc, axis=1)
+        np.clip(np.divide(lag, d, out=xc), 0.0, 1.0, out=xc)
+        np.matmul(xc @ basis, basis.T, out=proj)
+        np.subtract(xc, proj, out=xc)
+        sxx = np.sum(np.multiply(xc, xc, out=sq), axis=1)
         with np.errstate(invalid="ignore", divide="ignore"):
             gain = np.where(sxx > 0, np.sum((xc @ vc) ** 2, axis=1) / sxx, 0.0)
         gain = np.where(onsets + d < t[-1] - 30.0, gain, -np.inf)
@@ -312,3 +317,27 @@ def step_siblings_evidence(fit: StepSiblings | None, dh_mag: float) -> dict[str,
         "step_siblings": float(fit.siblings),
         "step_sharp_siblings": float(fit.sharp_siblings),
     }
+
+
+class WindowFits:
+    """The body-frame momentum of one window around an event (``key`` = its grid rows (first, event,
+    end)) and its two fits, :func:`step_siblings` and :func:`fit_ramp_step` at the event (τ = 0), each
+    made once, when first asked: the evidence and the rescan after a ramp both need them on the same
+    window."""
+
+    def __init__(self, key: tuple[int, int, int], tau_s: FloatArray, y_B: FloatArray) -> None:
+        self.key = key
+        self.tau_s = tau_s
+        self.y_B = y_B
+        self._siblings: tuple[StepSiblings | None] | None = None
+        self._ramps: dict[float, RampStep | None] = {}
+
+    def siblings(self) -> StepSiblings | None:
+        if self._siblings is None:
+            self._siblings = (step_siblings(self.tau_s, self.y_B, 0.0),)
+        return self._siblings[0]
+
+    def ramp(self, min_ramp_s: float = 8.0) -> RampStep | None:
+        if min_ramp_s not in self._ramps:
+            self._ramps[min_ramp_s] = fit_ramp_step(self.tau_s, self.y_B, 0.0, min_ramp_s=min_ramp_s)
+        return self._ramps[min_ramp_s]
