@@ -179,8 +179,8 @@ def _off_ramp(
 
 
 #: The ramp beside a strike may be a leak as long as the window allows (a ramp starts in the window's middle
-#: half and ends 30 s before its end: up to 3/4 of it); its duration is refined to 3 s (the onsets' grid)
-#: so that a ramp's end is never so far off that a shift of its onset into the strike's step fits better.
+#: half and ends 30 s before its end: up to 3/4 of it), on a grid of durations fine enough (ratio 1.1) that
+#: a ramp's length is rarely so far off that a shift of its onset into the strike's step fits it better.
 LEAK_FRACTION = 0.75
 LEAK_DURATIONS = 48
 
@@ -200,9 +200,7 @@ def _without_step(
     if fits is None or fits.key != (lo, i0, hi):
         fits = WindowFits((lo, i0, hi), (g[lo:hi] - g[i0]) / NS, body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi]))
     # The window's momentum is the evidence's; its ramp fit is not (the leak may be longer than its ramps).
-    fit = fit_ramp_step(
-        fits.tau_s, fits.y_B, 0.0, n_durations=LEAK_DURATIONS, max_ramp_fraction=LEAK_FRACTION, refine_s=3.0
-    )
+    fit = fit_ramp_step(fits.tau_s, fits.y_B, 0.0, n_durations=LEAK_DURATIONS, max_ramp_fraction=LEAK_FRACTION)
     if fit is None or not float(np.linalg.norm(fit.ramp_B)) > RAMP_SIGMA_MIN * fit.ramp_sigma:
         return None
     h = cleaned_H_N[a:b]

@@ -122,14 +122,11 @@ def fit_ramp_step(
     min_ramp_s: float = 8.0,
     n_durations: int = 16,
     max_ramp_fraction: float = 1.0 / 3.0,
-    refine_s: float = 0.0,
 ) -> RampStep | None:
     """The fit of the module docstring, or None when the window is too short or its noise unknown.
 
     Ramps last from ``min_ramp_s`` to ``max_ramp_fraction`` of the window (``n_durations`` on a log
-    grid) and start in its middle half. With ``refine_s`` > 0 the durations between the best one's grid
-    neighbours are searched again in steps of ``refine_s`` [s]: a ramp's end that the grid misses by
-    more than its onset is off otherwise moves the onset (into a step next to it) instead."""
+    grid) and start in its middle half."""
     window = _finite_window(tau_s, y_B)
     if window is None:
         return None
@@ -144,10 +141,6 @@ def fit_ramp_step(
     best = _best_ramp(t, basis, vc, onsets, durations)
     if not math.isfinite(best[0]):
         return None
-    if refine_s > 0:
-        ratio = float(durations[1] / durations[0])
-        fine = np.arange(max(min_ramp_s, best[2] / ratio), best[2] * ratio, refine_s)
-        best = min(best, _best_ramp(t, basis, vc, onsets, fine))
     _, ts, d = best
     x = np.column_stack([np.ones_like(t), t - t.mean(), x_step, np.clip((t - ts) / d, 0.0, 1.0)])
     coef, *_ = np.linalg.lstsq(x, v, rcond=None)
