@@ -250,3 +250,31 @@ def test_the_rescan_looks_where_the_detector_suppressed_and_never_at_another_pea
     assert best is not None and abs(best[1].time_ns / NS - 1305) <= 2
     assert abs(np.linalg.norm(best[1].dH_N_Nms) - 0.052) < 0.005
     assert fa._best_peak(det, hc, ok, g, 1.0, t0, 5.0, None, zone, ((1305 * NS, 10.0, 10.0),)) is None
+
+
+def test_a_long_leak_hidden_by_a_strike_gets_its_event_at_its_onset() -> None:
+    """Leaks of 450 and 550 s (2.5e-4 and 8e-4 N·m) with the 0.12 N·m·s strike 40 s after their onset:
+    longer than a third of the fit's window, where the ramp fit's durations used to stop (its onset then
+    slid onto the strike or into the leak, the step taking the leak's first part). The leak's event is at
+    its onset, with the leak's whole τ·D along its torque, ``external_non_strike``."""
+    sc = load_spacecraft(KESTREL)
+    dh_b = np.array([0.08, -0.06, 0.05])
+    cases = ((21, 450, 2.5e-4, 40, 1.0), (22, 550, 8e-4, 40, 1.0))
+    for seed, duration, torque, after, scale in cases:
+        table = _leak_and_strike_table(
+            np.random.default_rng(seed), (1200, 1200 + duration), np.array([0.0, 0.0, torque]), 1200 + after,
+            scale * dh_b,
+        )  # fmt: skip
+        h_n, hc, ok, det, peaks = _scan(table)
+        strikes = [p for _, p in peaks if abs(p.time_ns / NS - 1200 - after) <= 3]
+        assert len(strikes) == 1
+        ev = {p.time_ns: event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n) for _, p in peaks}
+        assert classify(ev[strikes[0].time_ns]).kind == "strike"
+        found, found_ev = rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)
+        beside = [p for _, p in found if found_ev[p.time_ns].after_strike_s == (p.time_ns - strikes[0].time_ns) / NS]
+        assert len(beside) == 1, (seed, duration)
+        p = beside[0]
+        assert abs(p.time_ns / NS - 1200) <= 15, (duration, p.time_ns / NS)
+        leak_dir = table_leak_dir(table)
+        assert abs(p.dH_N_Nms @ leak_dir - torque * duration) < 0.1 * torque * duration
+        assert classify(found_ev[p.time_ns]).kind == "external_non_strike"

@@ -36,6 +36,7 @@ from abrupt.detect.attitude.ramp_step import (
     RampStep,
     WindowFits,
     body_frame_momentum,
+    fit_ramp_step,
     from_body_increments,
 )
 from abrupt.detect.attitude.repair import repair_sensor_fault
@@ -177,6 +178,13 @@ def _off_ramp(
     return np.where(np.isfinite(h), from_body_increments(y_off, q[a:b], h0), np.nan)
 
 
+#: The ramp beside a strike may be a leak as long as the window allows (a ramp starts in the window's middle
+#: half and ends 30 s before its end: up to 3/4 of it), on a grid of durations fine enough (ratio 1.1) that
+#: a ramp's length is rarely so far off that a shift of its onset into the strike's step fits it better.
+LEAK_FRACTION = 0.75
+LEAK_DURATIONS = 48
+
+
 def _without_step(
     table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int, fits: WindowFits | None = None
 ) -> tuple[FloatArray, RampStep] | None:
@@ -191,7 +199,8 @@ def _without_step(
     q = table.quaternion_BN
     if fits is None or fits.key != (lo, i0, hi):
         fits = WindowFits((lo, i0, hi), (g[lo:hi] - g[i0]) / NS, body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi]))
-    fit = fits.ramp()
+    # The window's momentum is the evidence's; its ramp fit is not (the leak may be longer than its ramps).
+    fit = fit_ramp_step(fits.tau_s, fits.y_B, 0.0, n_durations=LEAK_DURATIONS, max_ramp_fraction=LEAK_FRACTION)
     if fit is None or not float(np.linalg.norm(fit.ramp_B)) > RAMP_SIGMA_MIN * fit.ramp_sigma:
         return None
     h = cleaned_H_N[a:b]

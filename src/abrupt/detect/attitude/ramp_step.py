@@ -91,21 +91,11 @@ def _finite_window(tau_s: FloatArray, y_B: FloatArray) -> tuple[FloatArray, Floa
     return t, v, sig
 
 
-def fit_ramp_step(
-    tau_s: FloatArray, y_B: FloatArray, step_s: float, min_ramp_s: float = 8.0, n_durations: int = 16
-) -> RampStep | None:
-    """The fit of the module docstring, or None when the window is too short or its noise unknown."""
-    window = _finite_window(tau_s, y_B)
-    if window is None:
-        return None
-    t, v, sig = window
-    span = float(t[-1] - t[0])
-    x_step = (t >= step_s).astype(np.float64)
-    basis, _ = np.linalg.qr(np.column_stack([np.ones_like(t), (t - t.mean()) / max(span, 1.0), x_step]))
-    w = 1.0 / sig  # each axis in units of its own noise
-    vc = (v - basis @ (basis.T @ v)) * w
-    durations = np.geomspace(min_ramp_s, max(span / 3, 2 * min_ramp_s), n_durations)
-    onsets = t[(t > t[0] + 0.25 * span) & (t < t[-1] - 0.25 * span)][::3]
+def _best_ramp(
+    t: FloatArray, basis: FloatArray, vc: FloatArray, onsets: FloatArray, durations: FloatArray
+) -> tuple[float, float, float]:
+    """(−gain, onset, duration) of the ramp of ``durations`` × ``onsets`` that explains most of ``vc`` (the
+    data with the basis projected out, in units of its noise) and ends 30 s before the window's end."""
     best = (math.inf, NAN, NAN)
     # One set of (onsets × samples) buffers for every duration (fresh arrays cost page faults); the
     # operations are those of xc = x − (x B) Bᵀ, x = clip((t − τ_s) / D, 0, 1).
@@ -122,6 +112,33 @@ def fit_ramp_step(
         m = int(np.argmax(gain))
         if -gain[m] < best[0]:
             best = (-float(gain[m]), float(onsets[m]), float(d))
+    return best
+
+
+def fit_ramp_step(
+    tau_s: FloatArray,
+    y_B: FloatArray,
+    step_s: float,
+    min_ramp_s: float = 8.0,
+    n_durations: int = 16,
+    max_ramp_fraction: float = 1.0 / 3.0,
+) -> RampStep | None:
+    """The fit of the module docstring, or None when the window is too short or its noise unknown.
+
+    Ramps last from ``min_ramp_s`` to ``max_ramp_fraction`` of the window (``n_durations`` on a log
+    grid) and start in its middle half."""
+    window = _finite_window(tau_s, y_B)
+    if window is None:
+        return None
+    t, v, sig = window
+    span = float(t[-1] - t[0])
+    x_step = (t >= step_s).astype(np.float64)
+    basis, _ = np.linalg.qr(np.column_stack([np.ones_like(t), (t - t.mean()) / max(span, 1.0), x_step]))
+    w = 1.0 / sig  # each axis in units of its own noise
+    vc = (v - basis @ (basis.T @ v)) * w
+    durations = np.geomspace(min_ramp_s, max(max_ramp_fraction * span, 2 * min_ramp_s), n_durations)
+    onsets = t[(t > t[0] + 0.25 * span) & (t < t[-1] - 0.25 * span)][::3]
+    best = _best_ramp(t, basis, vc, onsets, durations)
     if not math.isfinite(best[0]):
         return None
     _, ts, d = best
