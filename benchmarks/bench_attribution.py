@@ -28,6 +28,7 @@ kind not a strike >= 95 % and its own class >= 80 %.
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import math
 import sys
@@ -440,9 +441,12 @@ if __name__ == "__main__":
 
     if "--figure" in sys.argv:
         sys.exit(main())
+    # Draws other than the default seed's are a further held-out sample: their own result file.
+    seed = next((b for a, b in itertools.pairwise(sys.argv[1:]) if a == "--seed"), "1")
     with write_results(
         "bench_attribution",
-        variant({"--ranges=eval": "eval", "--ranges=widened": "widened", "--ranges=tests": "tests"}),
+        variant({"--ranges=eval": "eval", "--ranges=widened": "widened", "--ranges=tests": "tests"})
+        + ("" if seed == "1" else f"_seed{seed}"),
     ):
         code = main()
     sys.exit(code)
