@@ -46,7 +46,7 @@ from abrupt.flux.forward import (
     direction_class,
 )
 from abrupt.flux.grid import refine_max
-from abrupt.flux.linear import ESTIMATOR, linear_fit
+from abrupt.flux.linear import ESTIMATOR, OUT_OF_RANGE, in_physical_range, linear_fit
 
 PARAMS: tuple[str, ...] = ("debris_scale", "meteoroid_scale", "beta")
 # what a fit with β free measures well (docs/flux-inference.md, "The debris scale on the β ridge")
@@ -392,30 +392,15 @@ class FitResult:
     linear_intervals: dict[str, tuple[float, float]] = field(default_factory=dict)
 
     def linear_in_range(self) -> bool:
-        """Whether the linear estimates can be quoted: every free scale's estimate non-negative and inside
-        its own interval. Their weights are fixed at the reference scales; with counts many times the
-        reference (an archive of placed strikes) they can split the events into a negative scale, which no
-        flux has, with a degenerate score interval."""
-        if not self.linear_estimates:
-            return False
-        for k, v in self.linear_estimates.items():
-            lo, hi = self.linear_intervals.get(k, (v, v))
-            if k not in self.fixed and not (v >= 0.0 and lo <= v <= hi and hi > lo):
-                return False
-        return True
+        """Whether the linear estimates can be quoted (:func:`~abrupt.flux.linear.in_physical_range`)."""
+        return in_physical_range(self.linear_estimates, self.linear_intervals, self.fixed)
 
     def reported(self) -> dict[str, Any]:
-        """The estimates to quote: with β known the linear ones and their intervals when they are in range
-        (:meth:`linear_in_range`), else the ML ones."""
+        """The estimates to quote: with β known the linear ones when in range, else the ML ones."""
         if self.linear_in_range():
             est, iv, se = self.linear_estimates, self.linear_intervals, self.standard_errors
             return {"estimator": ESTIMATOR, "estimates": est, "standard_errors": se, "intervals": iv}
-        ml = "maximum likelihood, profile-likelihood intervals"
-        if self.linear_estimates:
-            ml += (
-                " (the linear estimates, weights at the reference scales, fall outside the physical range:"
-                " the data are far from the reference)"
-            )
+        ml = "maximum likelihood, profile-likelihood intervals" + (OUT_OF_RANGE if self.linear_estimates else "")
         return {"estimator": ml, "estimates": self.estimates, "standard_errors": {}, "intervals": self.intervals}
 
     def as_dict(self) -> dict[str, Any]:

@@ -38,6 +38,27 @@ if TYPE_CHECKING:
     from abrupt.flux.inference import Likelihood
 
 ESTIMATOR = "linear (fixed weights at the published models, unbiased with beta known)"
+#: Why the ML estimates are reported when the linear ones are out of range.
+OUT_OF_RANGE = (
+    " (the linear estimates, weights at the reference scales, fall outside the physical range:"
+    " the data are far from the reference)"
+)
+
+
+def in_physical_range(
+    estimates: Mapping[str, float], intervals: Mapping[str, tuple[float, float]], fixed: Mapping[str, float]
+) -> bool:
+    """Whether linear estimates can be quoted: every free scale's estimate non-negative and inside its own
+    (non-degenerate) interval. Their weights are fixed at the reference scales; with counts many times
+    the reference (an archive of placed strikes) they can split the events into a negative scale, which
+    no flux has, with a score interval collapsed to [0, 0]."""
+    if not estimates:
+        return False
+    for k, v in estimates.items():
+        lo, hi = intervals.get(k, (v, v))
+        if k not in fixed and not (v >= 0.0 and lo <= v <= hi and hi > lo):
+            return False
+    return True
 
 
 @dataclass
