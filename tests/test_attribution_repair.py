@@ -143,10 +143,18 @@ def test_a_wheel_reading_fault_is_undone_from_the_null_space_and_a_take_up_is_ke
     assert np.max(np.abs(np.median(h[760:840], 0) - np.median(h_true[760:840], 0))) < 0.01
 
 
-def _closed_loop_table(rng: np.random.Generator, strike_at: int, dh_b: np.ndarray) -> Timetable:
+def closed_loop_table(
+    rng: np.random.Generator,
+    strike_at: int,
+    dh_b: np.ndarray,
+    leak: tuple[int, int] = (0, 0),
+    torque_b: np.ndarray | None = None,
+) -> Timetable:
     """3000 s of a body turning slowly, its wheels (minimum-norm, plus a null-space offset) holding ᴺH,
     and an external impulse ΔH_B at ``strike_at``: the body takes it first (Δω₀ = J⁻¹ ΔH_B, decaying
-    as (1 − τ/τ_c) e^(−τ/τ_c), τ_c = 10 s) and the wheels the rest; total ᴺH steps by [NB] ΔH_B."""
+    as (1 − τ/τ_c) e^(−τ/τ_c), τ_c = 10 s) and the wheels the rest; total ᴺH steps by [NB] ΔH_B. With
+    ``torque_b``, a body-fixed torque over ``leak`` [s] too (a slow ramp the loop keeps up with: the
+    wheels take it), so total ᴺH also ramps by Σ [NB] τ_B dt."""
     sc = load_spacecraft(KESTREL)
     j = np.asarray(sc.inertia_kgm2, float)
     n = 3000
@@ -159,7 +167,9 @@ def _closed_loop_table(rng: np.random.Generator, strike_at: int, dh_b: np.ndarra
         rot = rot * Rotation.from_rotvec(omega[k])
     qa = np.asarray(quats)
     bn = Rotation.from_quat(qa).inv().as_matrix()  # [BN]: inertial to body
-    h_n = np.tile([3.0, -2.0, 1.0], (n, 1))
+    on = ((np.arange(n) >= leak[0]) & (np.arange(n) < leak[1])).astype(float)
+    tq = np.zeros(3) if torque_b is None else torque_b
+    h_n = np.array([3.0, -2.0, 1.0]) + np.cumsum(on[:, None] * np.einsum("nji,j->ni", bn, tq), axis=0)
     h_n[strike_at:] += bn[strike_at].T @ dh_b
     h_w = np.einsum("nij,nj->ni", bn, h_n) - omega @ j.T
     js_g = sc.wheel_axes * sc.wheel_spin_inertias_kgm2[None, :]
@@ -176,7 +186,7 @@ def _closed_loop_table(rng: np.random.Generator, strike_at: int, dh_b: np.ndarra
     )
 
 
-def _glr_peaks(
+def glr_peaks(
     sc: Spacecraft, table: Timetable
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, FlightGlrDetector, list[tuple[int, Any]]]:
     """ᴺH of the table, ᴺH less the median of its first 1000 s, the all-true mask, the detector and its
@@ -198,11 +208,11 @@ def test_a_strike_covered_by_a_wheel_glitchs_event_is_found_after_the_wheel_is_r
     rng = np.random.default_rng(5)
     sc = load_spacecraft(KESTREL)
     dh_b = np.array([0.05, -0.04, 0.05])
-    table = _closed_loop_table(rng, 1240, dh_b)
+    table = closed_loop_table(rng, 1240, dh_b)
     w = table.wheel_speed_rad_s.copy()
     w[1200:1500, 1] += 30 * 2 * np.pi / 60
     table = replace(table, wheel_speed_rad_s=w)
-    h_n, hc, ok, det, peaks = _glr_peaks(sc, table)
+    h_n, hc, ok, det, peaks = glr_peaks(sc, table)
     ev = {p.time_ns: event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n) for _, p in peaks}
     assert len(peaks) == 1
     first = classify(ev[peaks[0][1].time_ns])
@@ -223,11 +233,11 @@ def test_a_strike_after_a_large_gyro_bias_step_is_found_beside_what_the_repair_l
     rng = np.random.default_rng(7)
     sc = load_spacecraft(KESTREL)
     dh_b = np.array([0.05, -0.04, 0.05])
-    table = _closed_loop_table(rng, 1230, dh_b)
+    table = closed_loop_table(rng, 1230, dh_b)
     om = table.body_rate_rad_s.copy()
     om[1200:, 0] += np.deg2rad(0.02)
     table = replace(table, body_rate_rad_s=om)
-    h_n, hc, ok, det, peaks = _glr_peaks(sc, table)
+    h_n, hc, ok, det, peaks = glr_peaks(sc, table)
     # The event: the strongest peak (the bias turns with the body in ᴺH, a slow drift that the flight
     # pipeline's cleaning takes out and this bare median does not).
     peaks = [max(peaks, key=lambda c: c[1].value)]

@@ -24,7 +24,7 @@ from abrupt.pipelines import flight_attribution as fa
 from abrupt.pipelines.flight_attribution import rescan_after_faults
 from abrupt.pipelines.flight_faults import merge_fault_findings
 from abrupt.series.timetable import NS, Timetable
-from abrupt.series.timetable_momentum import timetable_momentum
+from test_attribution_repair import closed_loop_table, glr_peaks
 
 ROOT = Path(__file__).resolve().parent.parent
 KESTREL = ROOT / "examples" / "spacecraft" / "kestrel.toml"
@@ -151,42 +151,6 @@ def test_the_merge_names_no_fault_where_total_momentum_stepped_and_counts_what_i
     assert list(still["kind"]) == ["sensor_fault"]
 
 
-def _leak_and_strike_table(rng: np.random.Generator, leak: tuple[int, int], torque_b: np.ndarray,
-                           strike_at: int, dh_b: np.ndarray) -> Timetable:  # fmt: skip
-    """3000 s of a body turning slowly, its wheels holding ᴺH; a body-fixed torque over ``leak`` [s] (a
-    slow ramp the loop keeps up with: the wheels take it) and an impulse ΔH_B at ``strike_at`` (the body
-    takes it first, Δω₀ = J⁻¹ ΔH_B decaying as (1 − τ/τ_c) e^(−τ/τ_c), τ_c = 10 s): total ᴺH ramps by
-    Σ [NB] τ_B dt and steps by [NB] ΔH_B."""
-    sc = load_spacecraft(KESTREL)
-    j = np.asarray(sc.inertia_kgm2, float)
-    n = 3000
-    tau = np.arange(n) - strike_at
-    f = np.where(tau >= 0, (1 - tau / 10.0) * np.exp(-np.clip(tau, 0, None) / 10.0), 0.0)
-    omega = np.array([1e-4, -1.0e-3, 5e-5]) + np.outer(f, np.linalg.solve(j, dh_b))
-    rot, quats = Rotation.identity(), []
-    for k in range(n):
-        quats.append(rot.as_quat())
-        rot = rot * Rotation.from_rotvec(omega[k])
-    qa = np.asarray(quats)
-    bn = Rotation.from_quat(qa).inv().as_matrix()  # [BN]: inertial to body
-    on = ((np.arange(n) >= leak[0]) & (np.arange(n) < leak[1])).astype(float)
-    h_n = np.array([3.0, -2.0, 1.0]) + np.cumsum(on[:, None] * np.einsum("nji,j->ni", bn, torque_b), axis=0)
-    h_n[strike_at:] += bn[strike_at].T @ dh_b
-    h_w = np.einsum("nij,nj->ni", bn, h_n) - omega @ j.T
-    js_g = sc.wheel_axes * sc.wheel_spin_inertias_kgm2[None, :]
-    wheels = h_w @ np.linalg.pinv(js_g).T + 150.0 * np.array([1, -1, 1, -1]) * 2 * np.pi / 60
-    q_noisy = (Rotation.from_quat(qa) * Rotation.from_rotvec(rng.normal(0, 2e-6, (n, 3)))).as_quat()
-    return Timetable(
-        time_ns=np.arange(n, dtype=np.int64) * NS,
-        quaternion_BN=np.column_stack([q_noisy[:, 3], q_noisy[:, :3]]),
-        body_rate_rad_s=omega + rng.normal(0, 1e-6, (n, 3)),
-        wheel_speed_rad_s=wheels + rng.normal(0, 0.01, (n, 4)),
-        appendage_rate_rad_s=np.zeros((n, 0)),
-        flags=np.zeros((n, 0)),
-        valid=np.ones(n, bool),
-    )
-
-
 def table_leak_dir(table: Timetable) -> np.ndarray:
     """The leak's body z axis in inertial axes at the middle of the leak (1350 s)."""
     q = table.quaternion_BN[1350]
@@ -194,15 +158,7 @@ def table_leak_dir(table: Timetable) -> np.ndarray:
 
 
 def _scan(table: Timetable) -> tuple[np.ndarray, np.ndarray, np.ndarray, FlightGlrDetector, list]:
-    sc = load_spacecraft(KESTREL)
-    h_n, _ = timetable_momentum(sc, table)
-    hc = h_n - np.median(h_n[:1000], axis=0)
-    ok = np.ones(len(table), bool)
-    det = FlightGlrDetector()
-    win = det.windows(1.0)
-    stat = det.statistic(hc, ok, win)
-    peaks = [(i, p) for i, p in det.find_peaks(hc, ok, stat, table.time_ns, 1.0, win) if p.value > 5.0]
-    return h_n, hc, ok, det, peaks
+    return glr_peaks(load_spacecraft(KESTREL), table)
 
 
 def test_a_leak_hidden_by_a_strike_40_s_after_its_onset_gets_an_event_of_its_own() -> None:
@@ -213,7 +169,7 @@ def test_a_leak_hidden_by_a_strike_40_s_after_its_onset_gets_an_event_of_its_own
     rng = np.random.default_rng(11)
     sc = load_spacecraft(KESTREL)
     torque_b, dh_b = np.array([0.0, 0.0, 4e-4]), np.array([0.08, -0.06, 0.05])
-    table = _leak_and_strike_table(rng, (1200, 1500), torque_b, 1240, dh_b)
+    table = closed_loop_table(rng, 1240, dh_b, (1200, 1500), torque_b)
     h_n, hc, ok, det, peaks = _scan(table)
     assert len(peaks) == 1 and abs(peaks[0][1].time_ns / NS - 1240) <= 3
     ev = {p.time_ns: event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n) for _, p in peaks}
@@ -226,7 +182,7 @@ def test_a_leak_hidden_by_a_strike_40_s_after_its_onset_gets_an_event_of_its_own
     assert classify(found_ev[p.time_ns]).kind == "external_non_strike"
     assert found_ev[p.time_ns].after_strike_s == (p.time_ns - peaks[0][1].time_ns) / NS
     # The strike alone: nothing beside it.
-    table = _leak_and_strike_table(np.random.default_rng(12), (0, 0), torque_b, 1240, dh_b)
+    table = closed_loop_table(np.random.default_rng(12), 1240, dh_b, (0, 0), torque_b)
     h_n, hc, ok, det, peaks = _scan(table)
     ev = {p.time_ns: event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n) for _, p in peaks}
     assert [classify(e).kind for e in ev.values()] == ["strike"]
@@ -261,10 +217,13 @@ def test_a_long_leak_hidden_by_a_strike_gets_its_event_at_its_onset() -> None:
     dh_b = np.array([0.08, -0.06, 0.05])
     cases = ((21, 450, 2.5e-4, 40, 1.0), (22, 550, 8e-4, 40, 1.0))
     for seed, duration, torque, after, scale in cases:
-        table = _leak_and_strike_table(
-            np.random.default_rng(seed), (1200, 1200 + duration), np.array([0.0, 0.0, torque]), 1200 + after,
+        table = closed_loop_table(
+            np.random.default_rng(seed),
+            1200 + after,
             scale * dh_b,
-        )  # fmt: skip
+            (1200, 1200 + duration),
+            np.array([0.0, 0.0, torque]),
+        )
         h_n, hc, ok, det, peaks = _scan(table)
         strikes = [p for _, p in peaks if abs(p.time_ns / NS - 1200 - after) <= 3]
         assert len(strikes) == 1
