@@ -144,6 +144,25 @@ def _best_peak(
     return max(cands, key=lambda c: c[1].value) if cands else None
 
 
+def _window_fits(table: Timetable, cleaned_H_N: FloatArray, i0: int, fits: WindowFits | None) -> WindowFits:
+    """The ramp window's fits around row ``i0``: ``fits`` (the event's evidence fits) when they are of this
+    window, else new ones."""
+    g, q = table.time_ns, table.quaternion_BN
+    half = round(RAMP_WINDOW_S / table.dt_s)
+    lo, hi = max(0, i0 - half), min(g.size, i0 + half + 1)
+    if fits is not None and fits.key == (lo, i0, hi):
+        return fits
+    return WindowFits((lo, i0, hi), (g[lo:hi] - g[i0]) / NS, body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi]))
+
+
+def _to_inertial(h_N: FloatArray, y_B: FloatArray, q_BN: FloatArray) -> FloatArray:
+    """Body-frame momentum ``y_B`` (changed from that of ``h_N``) back in inertial axes, anchored at the
+    first finite row of ``h_N``; rows where ``h_N`` is not finite stay NaN."""
+    first = int(np.argmax(np.isfinite(h_N).all(axis=1)))
+    h0 = np.where(np.isfinite(h_N[first]), h_N[first], 0.0)
+    return np.where(np.isfinite(h_N), from_body_increments(y_B, q_BN, h0), np.nan)
+
+
 def _off_ramp(
     table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int, fits: WindowFits | None = None
 ) -> FloatArray | None:
@@ -154,12 +173,7 @@ def _off_ramp(
     :func:`~abrupt.detect.attitude.ramp_step.step_siblings`), else the ramp's
     (:func:`~abrupt.detect.attitude.ramp_step.fit_ramp_step`). ``fits``: the event's evidence fits, used
     when they are of this window."""
-    g = table.time_ns
-    half = round(RAMP_WINDOW_S / table.dt_s)
-    lo, hi = max(0, i0 - half), min(g.size, i0 + half + 1)
-    q = table.quaternion_BN
-    if fits is None or fits.key != (lo, i0, hi):
-        fits = WindowFits((lo, i0, hi), (g[lo:hi] - g[i0]) / NS, body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi]))
+    fits = _window_fits(table, cleaned_H_N, i0, fits)
     # A train of impulses along the event's own direction is a venting sequence: that direction is the
     # torque's (the ramp fit would take the largest other step, a strike's, for the ramp).
     seq = fits.siblings()
@@ -170,12 +184,9 @@ def _off_ramp(
         if fit is None or not float(np.linalg.norm(fit.ramp_B)) > RAMP_SIGMA_MIN * fit.ramp_sigma:
             return None
         u_b = fit.ramp_B / float(np.linalg.norm(fit.ramp_B))
-    h = cleaned_H_N[a:b]
-    y_b = body_frame_momentum(h, q[a:b])
-    y_off = y_b - (y_b @ u_b)[:, None] * u_b
-    first = int(np.argmax(np.isfinite(h).all(axis=1)))
-    h0 = np.where(np.isfinite(h[first]), h[first], 0.0)
-    return np.where(np.isfinite(h), from_body_increments(y_off, q[a:b], h0), np.nan)
+    q = table.quaternion_BN[a:b]
+    y_b = body_frame_momentum(cleaned_H_N[a:b], q)
+    return _to_inertial(cleaned_H_N[a:b], y_b - (y_b @ u_b)[:, None] * u_b, q)
 
 
 #: The ramp beside a strike may be a leak as long as the window allows (a ramp starts in the window's middle
@@ -193,22 +204,14 @@ def _without_step(
     that of the step-on-a-ramp fit (:func:`~abrupt.detect.attitude.ramp_step.fit_ramp_step`), fixed in
     body axes at ``i0``, so what is left is the ramp and the rest of the window. ``fits``: the event's
     evidence fits, used when they are of this window."""
-    g = table.time_ns
-    half = round(RAMP_WINDOW_S / table.dt_s)
-    lo, hi = max(0, i0 - half), min(g.size, i0 + half + 1)
-    q = table.quaternion_BN
-    if fits is None or fits.key != (lo, i0, hi):
-        fits = WindowFits((lo, i0, hi), (g[lo:hi] - g[i0]) / NS, body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi]))
+    fits = _window_fits(table, cleaned_H_N, i0, fits)
     # The window's momentum is the evidence's; its ramp fit is not (the leak may be longer than its ramps).
     fit = fit_ramp_step(fits.tau_s, fits.y_B, 0.0, n_durations=LEAK_DURATIONS, max_ramp_fraction=LEAK_FRACTION)
     if fit is None or not float(np.linalg.norm(fit.ramp_B)) > RAMP_SIGMA_MIN * fit.ramp_sigma:
         return None
-    h = cleaned_H_N[a:b]
-    y_b = body_frame_momentum(h, q[a:b])
-    y_b = y_b - (g[a:b] >= g[i0])[:, None] * fit.step_B[None, :]
-    first = int(np.argmax(np.isfinite(h).all(axis=1)))
-    h0 = np.where(np.isfinite(h[first]), h[first], 0.0)
-    return np.where(np.isfinite(h), from_body_increments(y_b, q[a:b], h0), np.nan), fit
+    g, q = table.time_ns, table.quaternion_BN[a:b]
+    y_b = body_frame_momentum(cleaned_H_N[a:b], q)
+    return _to_inertial(cleaned_H_N[a:b], y_b - (g[a:b] >= g[i0])[:, None] * fit.step_B[None, :], q), fit
 
 
 #: After a strike the closed loop hands the impulse from the body to the wheels within its settling time
