@@ -52,6 +52,27 @@ def _sift(heap: np.ndarray, size: int, pos: np.ndarray, vals: np.ndarray, i: int
 
 
 @nb.njit(cache=True)
+def _push(heap: np.ndarray, size: int, pos: np.ndarray, where: np.ndarray, vals: np.ndarray, s: int,
+          side: int, is_max: bool) -> int:  # fmt: skip
+    """Slot ``s`` into ``heap`` (``side`` 0 lower, 1 upper); the new size."""
+    heap[size] = s
+    pos[s] = size
+    where[s] = side
+    _sift(heap, size + 1, pos, vals, size, is_max)
+    return size + 1
+
+
+@nb.njit(cache=True)
+def _remove(heap: np.ndarray, size: int, pos: np.ndarray, vals: np.ndarray, p: int, is_max: bool) -> int:
+    """The slot at heap position ``p`` out of ``heap``; the new size."""
+    size -= 1
+    if p != size:
+        _swap(heap, pos, p, size)
+        _sift(heap, size, pos, vals, p, is_max)
+    return size
+
+
+@nb.njit(cache=True)
 def _running_median(x: np.ndarray, window: int, min_periods: int) -> np.ndarray:
     n = x.size
     out = np.full(n, np.nan)
@@ -72,17 +93,10 @@ def _running_median(x: np.ndarray, window: int, min_periods: int) -> np.ndarray:
             h = where[s]
             if h < 0:
                 continue
-            p = pos[s]
             if h == 0:
-                n_lo -= 1
-                if p != n_lo:
-                    _swap(lo, pos, p, n_lo)
-                    _sift(lo, n_lo, pos, vals, p, True)
+                n_lo = _remove(lo, n_lo, pos, vals, pos[s], True)
             else:
-                n_hi -= 1
-                if p != n_hi:
-                    _swap(hi, pos, p, n_hi)
-                    _sift(hi, n_hi, pos, vals, p, False)
+                n_hi = _remove(hi, n_hi, pos, vals, pos[s], False)
             where[s] = -1
         for j in range(prev_end, end):  # the samples that came in
             v = x[j]
@@ -91,38 +105,18 @@ def _running_median(x: np.ndarray, window: int, min_periods: int) -> np.ndarray:
             s = j % window
             vals[s] = v
             if n_lo == 0 or v <= vals[lo[0]]:
-                lo[n_lo] = s
-                pos[s] = n_lo
-                where[s] = 0
-                n_lo += 1
-                _sift(lo, n_lo, pos, vals, n_lo - 1, True)
+                n_lo = _push(lo, n_lo, pos, where, vals, s, 0, True)
             else:
-                hi[n_hi] = s
-                pos[s] = n_hi
-                where[s] = 1
-                n_hi += 1
-                _sift(hi, n_hi, pos, vals, n_hi - 1, False)
+                n_hi = _push(hi, n_hi, pos, where, vals, s, 1, False)
         # Rebalance: the lower half holds ceil(count / 2) values.
         while n_lo > n_hi + 1:
             s = lo[0]
-            n_lo -= 1
-            _swap(lo, pos, 0, n_lo)
-            _sift(lo, n_lo, pos, vals, 0, True)
-            hi[n_hi] = s
-            pos[s] = n_hi
-            where[s] = 1
-            n_hi += 1
-            _sift(hi, n_hi, pos, vals, n_hi - 1, False)
+            n_lo = _remove(lo, n_lo, pos, vals, 0, True)
+            n_hi = _push(hi, n_hi, pos, where, vals, s, 1, False)
         while n_hi > n_lo:
             s = hi[0]
-            n_hi -= 1
-            _swap(hi, pos, 0, n_hi)
-            _sift(hi, n_hi, pos, vals, 0, False)
-            lo[n_lo] = s
-            pos[s] = n_lo
-            where[s] = 0
-            n_lo += 1
-            _sift(lo, n_lo, pos, vals, n_lo - 1, True)
+            n_hi = _remove(hi, n_hi, pos, vals, 0, False)
+            n_lo = _push(lo, n_lo, pos, where, vals, s, 0, True)
         count = n_lo + n_hi
         if count >= min_periods and count > 0:
             if count % 2:
