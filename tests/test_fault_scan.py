@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -136,23 +137,73 @@ def test_rate_sensor_scan_names_the_gyro_axis_and_the_tracker_and_ignores_real_m
     assert any(ch == "star_tracker" and abs(t - 12000) <= 1 for t, ch in got)
     assert len(got) == 2
     calib = {c.channel: c for c in res.calibrations}
-    assert set(calib) == {"gyro_x", "gyro_y", "gyro_z", "star_tracker"}
-    assert all(c.false_alarms_per_day == 0.1 and c.threshold > 4 for c in calib.values())
+    gyro = {f"gyro_{a}{s}" for a in "xyz" for s in ("", "_bias")}
+    assert set(calib) == gyro | {"star_tracker"}
+    # a gyro axis's stated rate is shared by its spike and bias-step scans; the tracker has its own
+    assert sum(calib[c].false_alarms_per_day for c in ("gyro_x", "gyro_x_bias")) == pytest.approx(0.1)
+    assert calib["star_tracker"].false_alarms_per_day == 0.1 and all(c.threshold > 4 for c in calib.values())
 
 
 def test_a_strike_moves_both_rate_sensors_and_no_scan_calls_it_a_fault() -> None:
-    n = N
-    w0 = np.array([1e-3, -5e-4, 2e-4])
-    dw = np.array([0.0, 3e-3, 0.0])  # an impulse: the rate steps and stays (no controller here)
-    rate = np.where(np.arange(n)[:, None] >= 8000, w0 + dw, w0)
-    ang = np.cumsum(np.vstack([np.zeros(3), rate[:-1]]), axis=0)  # small-angle attitude: q ≈ (1, θ/2)
-    table = _table(n, rate_B=w0)
-    table.body_rate_rad_s[:] = rate + 2e-5 * np.random.default_rng(2).standard_normal((n, 3))
-    half = 0.5 * np.linalg.norm(ang, axis=1)
-    axis = ang / np.maximum(np.linalg.norm(ang, axis=1, keepdims=True), 1e-30)
-    table.quaternion_BN[:] = np.column_stack([np.cos(half), axis * np.sin(half)[:, None]])
-    res = scan_rate_sensors(table, table.valid, (T0, T0 + n * NS), BUDGET)
+    table = _strike_table(N, 8000, np.array([0.0, 3e-3, 0.0]))  # an impulse: the rate steps and stays
+    res = scan_rate_sensors(table, table.valid, (T0, T0 + N * NS), BUDGET)
     assert not [f for f in res.findings if abs(f.time_ns - (T0 + 8000 * NS)) < 30 * NS]
+
+
+def _strike_table(n: int, at: int, dw: np.ndarray, gyro_scale: float = 1.0, seed: int = 2) -> Timetable:
+    """A body turning at a constant rate whose rate steps by ``dw`` at sample ``at`` and stays (no
+    controller), seen by both sensors: the attitude integrated exactly, q_k+1 = q_k ⊗ exp(ω_k dt / 2);
+    the gyro reads ``gyro_scale`` times the true rate, with white noise."""
+    w0 = np.array([1e-3, -5e-4, 2e-4])
+    rate = np.where(np.arange(n)[:, None] >= at, w0 + dw, w0)
+    table = _table(n, rate_B=w0)
+    table.body_rate_rad_s[:] = gyro_scale * rate + 2e-5 * np.random.default_rng(seed).standard_normal((n, 3))
+    q = np.empty((n, 4))
+    q[: at + 1] = _rotation(w0, at + 1)
+    after = _rotation(w0 + dw, n - at)  # exp of the new constant rate from sample `at` on
+    q0 = q[at]
+    q[at:, 0] = q0[0] * after[:, 0] - after[:, 1:] @ q0[1:]
+    q[at:, 1:] = q0[0] * after[:, 1:] + after[:, :1] * q0[1:] + np.cross(q0[1:], after[:, 1:])
+    table.quaternion_BN[:] = q
+    return table
+
+
+def test_gyro_bias_step_far_below_the_per_sample_noise_is_found_on_its_axis() -> None:
+    # The gyro's noise is 2e-5 rad/s a sample; a bias of 1e-5 rad/s (0.00057°/s, half the noise) on y.
+    # The mean of W = 100 samples either side has noise 2e-5·√(2/100) = 2.8e-6: the step is 3.5 of it
+    # at W and ≈ 6 at 3 W; the W statistic crosses its threshold at a larger step. 4e-5 is 14σ at W.
+    for bias, axis in ((4e-5, 1), (-3e-5, 2)):
+        table = _table()
+        table.body_rate_rad_s[9000:, axis] += bias
+        res = scan_rate_sensors(table, table.valid, (T0, T0 + N * NS), BUDGET)
+        got = [(f.channel, (f.time_ns - T0) / NS) for f in res.findings]
+        assert len(got) == 1 and got[0][0] == f"gyro_{'xyz'[axis]}" and abs(got[0][1] - 9000) <= 10, got
+        size = float(re.search(r"stepped (\S+) rad/s", res.findings[0].reason).group(1))  # over 3 W: σ 1.6e-6
+        assert size == pytest.approx(bias, abs=5e-6)
+
+
+def test_gyro_bias_scan_ignores_a_strike_seen_through_a_gyro_scale_error() -> None:
+    # A strike steps the rate by 3e-3 rad/s; a gyro reading 0.5 % high turns it into a lasting 1.5e-5 rad/s
+    # step of gyro − tracker (5σ of the window mean), but the tracker's own rate stepped by 3e-3: motion.
+    table = _strike_table(N, 8000, np.array([0.0, 3e-3, 0.0]), gyro_scale=1.005)
+    res = scan_rate_sensors(table, table.valid, (T0, T0 + N * NS), BUDGET)
+    assert not [f for f in res.findings if abs(f.time_ns - (T0 + 8000 * NS)) < 300 * NS]
+    # the same gyro with a bias step of its own 4000 s later is still found
+    table.body_rate_rad_s[12000:, 0] += 4e-5
+    res = scan_rate_sensors(table, table.valid, (T0, T0 + N * NS), BUDGET)
+    assert [(f.channel, round((f.time_ns - T0) / NS, -1)) for f in res.findings] == [("gyro_x", 12000.0)]
+
+
+def test_gyro_bias_scan_is_quiet_on_a_random_walk_bias_and_a_transient_offset() -> None:
+    # Two days of a gyro whose bias wanders (a random walk of 2e-8 rad/s per √s, about 6e-6 rad/s in a day)
+    # and a transient: the gyro off by 1e-4 rad/s for 30 s, then back (not a lasting step). No bias finding.
+    n = 2 * 86_400
+    rng = np.random.default_rng(7)
+    table = _table(n, rng=rng)
+    table.body_rate_rad_s[:] += np.cumsum(2e-8 * rng.standard_normal((n, 3)), axis=0)
+    table.body_rate_rad_s[50_000:50_030, 0] += 1e-4
+    res = scan_rate_sensors(table, table.valid, (T0, T0 + n * NS), BUDGET)
+    assert not [f for f in res.findings if "bias step" in f.reason]
 
 
 def test_appendage_scan_finds_a_snap_of_the_drive() -> None:

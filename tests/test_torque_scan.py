@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from abrupt.detect.attitude.torque_scan import jump_share, scan_torque, window_difference
+from abrupt.detect.attitude.torque_scan import jump_share, scan_torque
+from abrupt.detect.attitude.window_stats import window_difference
 from abrupt.series.timetable import NS
 from abrupt.thresholds.budget import FalseAlarmBudget
 

@@ -15,6 +15,15 @@ each channel against the physics the other channels must obey:
   sensors, so the difference of the gyro's rate and the tracker's (2 vec(q_k⁻¹ ⊗ q_k+1)/dt, centred)
   stays at its noise. Where it leaves it, the sensor that left its own 11-sample running median while
   the other stayed on its own is the faulty one; both moving is motion (a strike), never a fault;
+* **gyro bias step** (channels ``gyro_x/y/z``): a small offset of one gyro axis is buried in the
+  per-sample noise, but the mean of gyro − tracker over W = ``BIAS_WINDOW_S`` after an instant against
+  the W before it averages the noise down (the tracker's rate is a difference of attitudes, so its noise
+  telescopes in the mean: the difference falls faster than 1/√W). The statistic is that difference over
+  its robust scale on the day; its threshold comes from the day's own upcrossings (the torque scan's
+  fit, :mod:`abrupt.detect.attitude.window_stats`). Spikes and a tracker's jumps are left out of the
+  means (samples either sensor's departure puts beyond ``QUIET_SIGMA``). A crossing is a bias step when
+  the offset lasts (the 3 W difference keeps half of it: a strike's transient through a gyro's scale
+  error does not) and the tracker's own mean rate did not step (motion moves both);
 * **appendage drive** (channel ``appendage_N``, class ``internal``): a drive's rate against its own
   61-sample running median (a sun-tracking drive turns smoothly); a snap or slip moves momentum
   between hub and array and leaves the total as it was.
@@ -39,6 +48,7 @@ from scipy.ndimage import median_filter
 
 from abrupt.detect.attitude.attribution import AttributionRules
 from abrupt.detect.attitude.evidence import hamilton_product
+from abrupt.detect.attitude.window_stats import clusters, trimmed_threshold, window_difference
 from abrupt.model.flight_config import FlightConfig
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.timetable import NS, Timetable
@@ -55,6 +65,14 @@ BODY_SHARE_MAX = 0.5
 QUIET_SIGMA = 5.0
 #: Smallest angle [rad] an appendage jump must add to be a snap (the attribution rules' 0.2°).
 SNAP_MIN_RAD = math.radians(AttributionRules().appendage_min_deg)
+#: The window W [s] of the gyro bias-step scan: the mean of gyro − tracker over W after against W before.
+BIAS_WINDOW_S = 100.0
+#: Share of each W window's samples that must be analysed.
+BIAS_MIN_COVER = 0.8
+#: A bias step lasts: the 3 W windows either side keep at least this share of the W windows' difference.
+BIAS_LASTING_SHARE = 0.5
+#: A bias step is the gyro's alone: the tracker's own W-window difference is below this share of it.
+BIAS_TRACKER_SHARE = 0.5
 #: Fewest exceedances of the lowest and the highest level of the tail fit.
 TAIL_COUNTS = (3000, 300)
 
@@ -155,15 +173,6 @@ def contiguous_runs(mask: BoolArray) -> list[slice]:
     return [slice(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
 
 
-def clusters(t_ns: np.ndarray, z: FloatArray, above: BoolArray, gap_s: float = CLUSTER_S) -> list[int]:
-    """Index of the largest ``z`` in each run of ``above`` samples no more than ``gap_s`` apart."""
-    idx = np.flatnonzero(above)
-    if not idx.size:
-        return []
-    breaks = np.flatnonzero(np.diff(t_ns[idx]) > gap_s * NS) + 1
-    return [int(g[np.argmax(z[g])]) for g in np.split(idx, breaks)]
-
-
 def column_median(x: FloatArray, size: int) -> FloatArray:
     """``median_filter(x, size=(size, 1), mode="nearest")``, computed column by column: the same ranks
     of the same windows (so the same values), on SciPy's one-dimensional filter, which is about ten
@@ -192,12 +201,9 @@ def wheel_jump_statistic(speed_rad_s: FloatArray, quantum_rad_s: float = 0.0) ->
     return np.maximum(np.abs(r), pair) / sigma, sigma
 
 
-def rate_departures(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Per sample and axis: gyro − tracker rate against its 31-sample running median (a bias is slow),
-    gyro − its 11-sample running median, tracker − its 11-sample running median.
-
-    The tracker's rate at sample k is the mean of 2 vec(q⁻¹ ⊗ q')/dt over the intervals either side.
-    """
+def rate_difference(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:
+    """(gyro − tracker rate, tracker rate) [rad/s] per sample and axis; the tracker's rate at sample k is
+    the mean of 2 vec(q⁻¹ ⊗ q')/dt over the intervals either side."""
     qn = q_BN / np.linalg.norm(q_BN, axis=1, keepdims=True)
     d = hamilton_product(qn[:-1] * np.array([1.0, -1.0, -1.0, -1.0]), qn[1:])
     d *= np.where(d[:, :1] < 0, -1.0, 1.0)
@@ -205,7 +211,13 @@ def rate_departures(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> tuple[F
     ref = np.empty_like(omega_B)
     ref[1:-1] = 0.5 * (w_st[:-1] + w_st[1:])
     ref[0], ref[-1] = w_st[0], w_st[-1]
-    err = omega_B - ref
+    return omega_B - ref, ref
+
+
+def rate_departures(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Per sample and axis: gyro − tracker rate (:func:`rate_difference`) against its 31-sample running
+    median (a bias is slow), gyro − its 11-sample running median, tracker − its 11-sample running median."""
+    err, ref = rate_difference(q_BN, omega_B, dt)
     err = err - column_median(err, 31)  # a gyro bias is slow: taken out
     e_g = omega_B - column_median(omega_B, 11)
     e_t = ref - column_median(ref, 11)
@@ -283,7 +295,7 @@ def _wheel_findings(
         p, days = _rate(budget, t_jump[in_core])
         thr = _threshold(z[in_core], p)
         js = float(spacecraft.wheel_spin_inertias_kgm2[w.component])
-        peaks = clusters(t_jump, z, in_core & (z > thr))
+        peaks = clusters(t_jump, z, in_core & (z > thr), CLUSTER_S)
         n_found = 0
         for k in peaks:
             claimed = js * z[k] * sigma  # the momentum the reading says the wheel exchanged
@@ -311,9 +323,30 @@ def scan_wheels(
     return _wheel_findings(_wheel_series(samples, flight, table, ok), table, spacecraft, core, budget)
 
 
-def _rate_series(table: Timetable, ok: BoolArray) -> tuple[np.ndarray, FloatArray, FloatArray, FloatArray] | None:
-    """Times and the three departures of :func:`rate_departures` on every gap-free run of ``ok`` at least
-    61 samples long (each run's end samples left out: no centred rate); None when there is none."""
+@dataclass(frozen=True)
+class _RateSeries:
+    """The rate sensors over a whole span: the departures of :func:`rate_departures` on the analysed
+    samples (times ``t``), and on the whole grid (times ``grid_t``) the window differences of the gyro
+    bias-step scan: W = ``BIAS_WINDOW_S`` of gyro − tracker (``d``, share analysed ``cover``), 3 W of it
+    (``d_long``, ``cover_long``), and W of the tracker's own rate (``d_tracker``)."""
+
+    t: np.ndarray
+    err: FloatArray
+    e_g: FloatArray
+    e_t: FloatArray
+    grid_t: np.ndarray
+    d: FloatArray
+    cover: FloatArray
+    d_long: FloatArray
+    cover_long: FloatArray
+    d_tracker: FloatArray
+
+
+def _rate_series(table: Timetable, ok: BoolArray) -> _RateSeries | None:
+    """The departures of :func:`rate_departures` on every gap-free run of ``ok`` at least 61 samples long
+    (each run's end samples left out: no centred rate), and the bias-step windows over them; samples where
+    either sensor left its own running median by ``QUIET_SIGMA`` (a spike, a tracker's jump) are left out of
+    the windows' means. None when there is no such run."""
     g = table.time_ns
     if g.size < 2 * TAIL_COUNTS[0]:
         return None
@@ -328,18 +361,59 @@ def _rate_series(table: Timetable, ok: BoolArray) -> tuple[np.ndarray, FloatArra
     idx = np.concatenate([np.arange(r.start + 1, r.stop - 1) for r in runs])  # each run's ends: no centred rate
     parts = [rate_departures(table.quaternion_BN[r], table.body_rate_rad_s[r], dt) for r in runs]
     err, e_g, e_t = (np.concatenate([p[j][1:-1] for p in parts]) for j in range(3))
-    return g[idx], err, e_g, e_t
+    raw = [rate_difference(table.quaternion_BN[r], table.body_rate_rad_s[r], dt) for r in runs]
+    diff, tracker = (np.concatenate([p[j][1:-1] for p in raw]) for j in range(2))
+    sig = [np.array([max(robust_sigma(x[:, k]), 1e-15) for k in range(3)]) for x in (err, e_g, e_t)]
+    quiet = np.all((np.abs(err) < QUIET_SIGMA * sig[0]) & (np.abs(e_t) < QUIET_SIGMA * sig[2]), axis=1)
+    use = np.zeros(g.size, bool)
+    use[idx] = quiet
+    full_diff, full_tracker = np.full((g.size, 3), np.nan), np.full((g.size, 3), np.nan)
+    full_diff[idx], full_tracker[idx] = diff, tracker
+    n = max(2, round(BIAS_WINDOW_S / dt))
+    d, cover = window_difference(full_diff, use, n)
+    d_long, cover_long = window_difference(full_diff, use, 3 * n)
+    d_tracker, _ = window_difference(full_tracker, use, n)
+    return _RateSeries(g[idx], err, e_g, e_t, g, d, cover, d_long, cover_long, d_tracker)
 
 
-def _rate_findings(
-    series: tuple[np.ndarray, FloatArray, FloatArray, FloatArray] | None,
-    core: tuple[int, int],
-    budget: FalseAlarmBudget,
-) -> FaultScan:
-    """The gyro and star-tracker scan of one core [start, end): noise, thresholds and findings on it."""
+def _bias_findings(s: _RateSeries, core: tuple[int, int], budget: FalseAlarmBudget) -> FaultScan:
+    """The gyro bias-step scan of one core (module docstring): per axis, the W-window difference of
+    gyro − tracker over its own robust scale, its threshold from the day's own upcrossings at the stated
+    rate; a crossing is a bias step when the offset lasts (the 3 W difference keeps ``BIAS_LASTING_SHARE``
+    of it) and the tracker's own rate did not step (less than ``BIAS_TRACKER_SHARE`` of it)."""
+    g = s.grid_t
+    dt = float(np.median(np.diff(g))) / NS
+    n = max(2, round(BIAS_WINDOW_S / dt))
+    use = (g >= core[0]) & (g < core[1]) & (s.cover >= BIAS_MIN_COVER)
+    found: list[FaultFinding] = []
+    cals: list[ChannelCalibration] = []
+    if use.sum() < 2 * TAIL_COUNTS[0]:
+        return FaultScan(found, cals)
+    days = float(use.sum()) * dt / SECONDS_PER_DAY
+    for k in range(3):
+        d = s.d[:, k]
+        z = np.where(use, np.abs(d) / max(robust_sigma(d[use]), 1e-15), np.nan)
+        thr = max(trimmed_threshold(g, z, use, BIAS_WINDOW_S, n, budget.per_day * days), QUIET_SIGMA)
+        peaks = clusters(g, np.nan_to_num(z), use & (z > thr), BIAS_WINDOW_S)
+        name = f"gyro_{'xyz'[k]}"
+        hits = []
+        for j in peaks:
+            lasting = s.cover_long[j] >= 1.0 / 3.0 and s.d_long[j, k] * np.sign(d[j]) >= BIAS_LASTING_SHARE * abs(d[j])
+            if lasting and abs(s.d_tracker[j, k]) < BIAS_TRACKER_SHARE * abs(d[j]):
+                hits.append(j)
+                reason = (f"gyro's mean stepped {s.d_long[j, k]:.3g} rad/s against the star tracker (means over "
+                          f"{3 * BIAS_WINDOW_S:.0f} s) and stayed; the tracker's did not (a bias step)")  # fmt: skip
+                found.append(FaultFinding(int(g[j]), "sensor_fault", name, float(z[j]), thr, budget.per_day, reason))
+        cals.append(ChannelCalibration(f"{name}_bias", core[0], thr, budget.per_day, len(peaks), len(hits), days))
+    return FaultScan(found, cals)
+
+
+def _rate_findings(series: _RateSeries | None, core: tuple[int, int], budget: FalseAlarmBudget) -> FaultScan:
+    """The gyro and star-tracker scans of one core [start, end): noise, thresholds and findings on it. Each
+    gyro axis's stated rate is shared by its two scans, spikes and bias steps (:meth:`~FalseAlarmBudget.bonferroni`)."""
     if series is None:
         return FaultScan([], [])
-    t, err, e_g, e_t = series
+    t, err, e_g, e_t = series.t, series.err, series.e_g, series.e_t
     in_core = (t >= core[0]) & (t < core[1])
     sig_err = np.array([robust_sigma(err[in_core, k]) for k in range(3)])
     sig_g = np.array([robust_sigma(e_g[in_core, k]) for k in range(3)])
@@ -350,28 +424,30 @@ def _rate_findings(
     gyro_moved = np.abs(e_g) > QUIET_SIGMA * np.maximum(sig_g, 1e-15)
     st_moved = np.abs(e_t) > QUIET_SIGMA * np.maximum(sig_t, 1e-15)
     p, days = _rate(budget, t[in_core])
+    gyro = budget.bonferroni(2)  # spikes and bias steps
     found: list[FaultFinding] = []
     cals: list[ChannelCalibration] = []
     # Gyro axis k: it left its median, the tracker stayed on its own on every axis.
     for k in range(3):
-        thr = _threshold(z_err[in_core, k], p)
-        peaks = clusters(t, z_err[:, k], in_core & (z_err[:, k] > thr))
+        thr = _threshold(z_err[in_core, k], p / 2.0)
+        peaks = clusters(t, z_err[:, k], in_core & (z_err[:, k] > thr), CLUSTER_S)
         hits = [j for j in peaks if gyro_moved[j, k] and not st_moved[j].any()]
         name = f"gyro_{'xyz'[k]}"
         for j in hits:
             reason = "gyro left the star tracker and its own median; the tracker stayed"
-            found.append(FaultFinding(int(t[j]), "sensor_fault", name, float(z_err[j, k]), thr, budget.per_day, reason))
-        cals.append(ChannelCalibration(name, core[0], thr, budget.per_day, len(peaks), len(hits), days))
+            found.append(FaultFinding(int(t[j]), "sensor_fault", name, float(z_err[j, k]), thr, gyro.per_day, reason))
+        cals.append(ChannelCalibration(name, core[0], thr, gyro.per_day, len(peaks), len(hits), days))
     # Star tracker: the 3-axis mismatch; the tracker left its median, the gyro stayed on its own.
     z3 = np.max(z_err, axis=1)
     thr = _threshold(z3[in_core], p * 3.0)  # the largest of three axes: three chances per sample
-    peaks = clusters(t, z3, in_core & (z3 > thr))
+    peaks = clusters(t, z3, in_core & (z3 > thr), CLUSTER_S)
     hits = [j for j in peaks if st_moved[j].any() and not gyro_moved[j].any()]
     for j in hits:
         reason = "star tracker left the gyro and its own median; the gyro stayed"
         found.append(FaultFinding(int(t[j]), "sensor_fault", "star_tracker", float(z3[j]), thr, budget.per_day, reason))
     cals.append(ChannelCalibration("star_tracker", core[0], thr, budget.per_day, len(peaks), len(hits), days))
-    return FaultScan(found, cals)
+    bias = _bias_findings(series, core, gyro)
+    return FaultScan(found + bias.findings, cals + bias.calibrations)
 
 
 def scan_rate_sensors(table: Timetable, ok: BoolArray, core: tuple[int, int], budget: FalseAlarmBudget) -> FaultScan:
