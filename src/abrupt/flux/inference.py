@@ -47,13 +47,9 @@ from abrupt.flux.forward import (
 )
 from abrupt.flux.grid import refine_max
 from abrupt.flux.linear import ESTIMATOR, OUT_OF_RANGE, in_physical_range, linear_fit
+from abrupt.flux.notes import IDENTIFIED_NOTE, beta_free_note
 
 PARAMS: tuple[str, ...] = ("debris_scale", "meteoroid_scale", "beta")
-# what a fit with β free measures well (docs/flux-inference.md, "The debris scale on the β ridge")
-IDENTIFIED_NOTE = (
-    "beta free: the data identify s_p·T_p(beta), the expected detections of each population (expected_events), "
-    "far better than s_p itself, whose estimate inherits beta's spread (its mean is biased high on small exposures)"
-)
 DEFAULT_BETA_GRID = np.exp(np.linspace(math.log(0.1), math.log(100.0), 161))
 
 
@@ -479,8 +475,9 @@ def fit(
     notes: list[str] = []
     if "beta" not in fixed and intervals:
         bounds["beta"] = _beta_interval(logb, ll, ll_max - half, notes)
-    if "beta" not in fixed:
-        notes.append(IDENTIFIED_NOTE)
+    if "beta" not in fixed:  # what a β-free fit measures, and whether its exposure suffices for the scales
+        short = beta_free_note(float(data.analysed_years.sum()))
+        notes += [IDENTIFIED_NOTE] + ([short] if short else [])
     # a β whose profile is below the interval's level cannot hold a boundary of a scale's interval
     near = lik
     if ll.size > 3:
