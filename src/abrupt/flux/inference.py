@@ -46,7 +46,7 @@ from abrupt.flux.forward import (
     direction_class,
 )
 from abrupt.flux.grid import refine_max
-from abrupt.flux.linear import ESTIMATOR, OUT_OF_RANGE, in_physical_range, linear_fit
+from abrupt.flux.linear import ESTIMATOR, OUT_OF_RANGE, below_zero_notes, in_physical_range, linear_fit
 from abrupt.flux.notes import IDENTIFIED_NOTE, beta_free_note
 
 PARAMS: tuple[str, ...] = ("debris_scale", "meteoroid_scale", "beta")
@@ -392,12 +392,14 @@ class FitResult:
         return in_physical_range(self.linear_estimates, self.linear_intervals, self.fixed)
 
     def reported(self) -> dict[str, Any]:
-        """The estimates to quote: with β known the linear ones when in range, else the ML ones."""
+        """The estimates to quote: with β known the linear ones when in range (``notes`` on any below 0), else ML."""
         if self.linear_in_range():
             est, iv, se = self.linear_estimates, self.linear_intervals, self.standard_errors
-            return {"estimator": ESTIMATOR, "estimates": est, "standard_errors": se, "intervals": iv}
+            notes = below_zero_notes(est, iv, self.fixed)
+            return {"estimator": ESTIMATOR, "estimates": est, "standard_errors": se, "intervals": iv, "notes": notes}
         ml = "maximum likelihood, profile-likelihood intervals" + (OUT_OF_RANGE if self.linear_estimates else "")
-        return {"estimator": ml, "estimates": self.estimates, "standard_errors": {}, "intervals": self.intervals}
+        est, iv = self.estimates, self.intervals
+        return {"estimator": ml, "estimates": est, "standard_errors": {}, "intervals": iv, "notes": []}
 
     def as_dict(self) -> dict[str, Any]:
         rep = self.reported()
