@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
+from abrupt.cli.flux import _fit_lines
 from abrupt.errors import ConfigError
 from abrupt.flux.exposure import DAYS_PER_YEAR
 from abrupt.flux.inference import FitResult, Likelihood, fit, prepare
@@ -110,6 +111,9 @@ def test_linear_scales_out_of_the_physical_range_are_not_reported() -> None:
     assert below.linear_in_range() and rep["estimates"]["meteoroid_scale"] == -0.4
     assert len(rep["notes"]) == 1 and rep["notes"][0].startswith("meteoroid_scale = -0.4 < 0")
     assert "[0, 1.1]" in rep["notes"][0]
+    lines = _fit_lines("free", below)  # the command prints it under the fit
+    assert lines[0].startswith("free: debris_scale = 1.9e+03") and "meteoroid_scale = -0.4" in lines[0]
+    assert lines[2] == "  below 0: " + rep["notes"][0]
 
 
 def test_quoting_negative_linear_scales_keeps_the_reported_estimate_unbiased_and_covering() -> None:
