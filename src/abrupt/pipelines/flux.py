@@ -147,7 +147,8 @@ LINEAR_NOTE = (
     "ones (estimates, kept as diagnostics with their profile intervals) carry a small-sample bias of several per "
     "cent at 5-10 detections of a population; their intervals are score-type, from the exact variance of the "
     "linear statistic. Their precision is the ML's when the truth is near the published models and lower far "
-    "from them (docs/flux-inference.md)."
+    "from them. A linear scale below 0 is reported as it is (unbiased) with its interval clipped at 0; the ML "
+    "estimates replace them only when an interval holds no scale above 0 (docs/flux-inference.md)."
 )
 
 
