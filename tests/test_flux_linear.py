@@ -4,6 +4,7 @@ Poisson score interval in closed form, and their bias and coverage on simulated 
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -14,6 +15,7 @@ from abrupt.errors import ConfigError
 from abrupt.flux.exposure import DAYS_PER_YEAR
 from abrupt.flux.inference import FitResult, Likelihood, fit, prepare
 from abrupt.flux.linear import linear_fit
+from abrupt.report.flux import fits_table
 from test_flux_inference import AMPLITUDE, CASE, CONFIG, SLOPE, events_from_counts, exposure, power_law_template
 
 
@@ -114,6 +116,9 @@ def test_linear_scales_out_of_the_physical_range_are_not_reported() -> None:
     lines = _fit_lines("free", below)  # the command prints it under the fit
     assert lines[0].startswith("free: debris_scale = 1.9e+03") and "meteoroid_scale = -0.4" in lines[0]
     assert lines[2] == "  below 0: " + rep["notes"][0]
+    table = fits_table(SimpleNamespace(fits={"free": below})).set_index("parameter")  # the HTML report's table
+    assert table.loc["meteoroid_scale", "estimate"] == -0.4 and "below 0" in table.loc["meteoroid_scale", "estimator"]
+    assert table.loc["debris_scale", "estimator"] == "linear, score interval"
 
 
 def test_quoting_negative_linear_scales_keeps_the_reported_estimate_unbiased_and_covering() -> None:
