@@ -41,6 +41,13 @@ Run: ``nice -n 10 python benchmarks/bench_flux_coverage.py --beta 1 --bias-reps 
 coverage of the profile intervals (first ``--reps`` fleets) and of the linear intervals (all fleets), e.g.
 ``... --known-beta --beta 1 --reps 200 --bias-reps 1000`` (and ``--beta 3``; ``--beta 2 --scales 0.5 2``).
 About 0.08 s of CPU per fleet, 0.2 s with the profile intervals.
+``--fallback``: fit B alone at all eight truths (file suffix ``_fallback``): per truth, how often the linear
+scales fall outside the physical range and what reporting the ML estimate (with its profile interval) in
+their place does to the reported estimate's bias and coverage, for two rules: fall back when a linear scale is
+below 0 (or outside its own interval), and fall back only when a scale's score interval clipped at 0 is empty
+(a negative linear estimate is then quoted, unbiased, beside its interval [0, upper end]). "reported − linear"
+is the fallback's own shift of the mean (paired on the same fleets). E.g. ``... --fallback --reps 0
+--bias-reps 500``.
 """
 
 from __future__ import annotations
@@ -48,6 +55,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import sys
 import time
 from pathlib import Path
 
@@ -104,10 +112,10 @@ def interval_stats(
     lo = np.array([r[f"{name}_lo"] for r in with_iv])
     hi = np.array([r[f"{name}_hi"] for r in with_iv])
     cover = float(np.mean((lo <= truth) & (truth <= hi))) if with_iv else math.nan
-    if estimate == "lin":  # the linear estimate's own interval, on every fleet
+    if estimate in ("lin", "rneg", "rempty"):  # the linear (or reported) estimate's own interval, every fleet
         with_iv = rows
-        lo = np.array([r[f"{name}_lin_lo"] for r in rows])
-        hi = np.array([r[f"{name}_lin_hi"] for r in rows])
+        lo = np.array([r[f"{name}_{estimate}_lo"] for r in rows])
+        hi = np.array([r[f"{name}_{estimate}_hi"] for r in rows])
         cover = float(np.mean((lo <= truth) & (truth <= hi)))
     mean, se = control_variate_mean(est / truth, None if controls is None else controls[: est.size])
     plain_mean, plain_se = control_variate_mean(est / truth, None)
@@ -132,6 +140,72 @@ def verdict(bias: float, se: float, target: float = 0.05) -> str:
 
 
 ESTIMATORS = {"hat": "MLE", "signed": "signed", "corr": "corrected", "firth": "Firth", "lin": "linear"}
+# the reported estimate of a fit with β known (linear, else ML with its profile interval) under two rules
+ESTIMATORS |= {"rneg": "rep.neg", "rempty": "rep.empty"}
+FREE_B = ("debris_scale", "meteoroid_scale")
+
+
+def negative_rule(row: dict[str, float]) -> bool:
+    """Linear estimates quoted when every free scale is >= 0 and inside its non-degenerate interval (else ML)."""
+    return all(
+        row[f"{p}_lin"] >= 0 and row[f"{p}_lin_lo"] <= row[f"{p}_lin"] <= row[f"{p}_lin_hi"] > row[f"{p}_lin_lo"]
+        for p in FREE_B
+    )
+
+
+def empty_rule(row: dict[str, float]) -> bool:
+    """Linear estimates quoted (a negative one too) when every free scale's interval, clipped at 0, is not empty
+    or degenerate (upper end above its lower end >= 0); else ML."""
+    return all(row[f"{p}_lin_hi"] > row[f"{p}_lin_lo"] for p in FREE_B)
+
+
+def add_reported(row: dict[str, float]) -> None:
+    """The reported estimate and interval of a fit-B row under both rules (``rneg``, ``rempty``)."""
+    for key, rule in (("rneg", negative_rule), ("rempty", empty_rule)):
+        use_lin = rule(row)
+        row[f"in_{key}"] = float(use_lin)
+        for p in FREE_B:
+            src = "lin" if use_lin else "hat"
+            row[f"{p}_{key}"] = row[f"{p}_{src}"]
+            ml = "" if f"{p}_lo" in row else "_fb"  # ML intervals of a fleet past --reps: its fallback refit
+            lo, hi = (f"{p}_lin_lo", f"{p}_lin_hi") if use_lin else (f"{p}{ml}_lo", f"{p}{ml}_hi")
+            row[f"{p}_{key}_lo"], row[f"{p}_{key}_hi"] = row[lo], row[hi]
+
+
+def fit_known_beta(data, beta: float, intervals: bool, fallback: bool) -> dict[str, float]:  # type: ignore[no-untyped-def]
+    """Fit B; with ``fallback`` also the reported estimates, refitting with the ML profile intervals the fleets
+    whose linear estimates fall outside the physical range (the ML interval is then the reported one)."""
+    row = one_fit(data, {"beta": beta}, intervals=intervals)
+    if fallback:
+        if not intervals and not (negative_rule(row) and empty_rule(row)):
+            refit = one_fit(data, {"beta": beta}, intervals=True)
+            row |= {f"{p}_fb_{end}": refit[f"{p}_{end}"] for p in FREE_B for end in ("lo", "hi")}
+        add_reported(row)
+    return row
+
+
+def fallback_summary(rows: list[dict[str, float]], truth: dict[str, float], controls: NDArray[np.float64]) -> None:
+    """Per truth: how often each rule falls back to the ML estimate, and the reported estimate's bias and coverage."""
+    n = len(rows)
+    lib = sum(r["in_library"] for r in rows)
+    rules = (("rneg", "a linear scale < 0 (or outside its interval)"), ("rempty", "an interval empty at s >= 0"))
+    for key, text in rules:
+        k = n - int(sum(r[f"in_{key}"] for r in rows))
+        same = sum(r[f"in_{key}"] == r["in_library"] for r in rows)
+        print(
+            f"{'':>22} fallback to ML when {text}: linear outside the physical range in {k} of {n} fleets "
+            f"({k / n:.3f} ± {math.sqrt(max(k * (n - k), 1) / n) / n:.3f}); library rule agrees on {same} of {n}"
+        )
+        for p in FREE_B:
+            neg = sum(r[f"{p}_lin"] < 0 for r in rows)
+            cov, bias, se, *_ = interval_stats(rows, p, truth[p], key, controls)
+            shift = np.array([r[f"{p}_{key}"] - r[f"{p}_lin"] for r in rows]) / truth[p]  # what the fallback adds
+            print(
+                f"{'':>22}   {p}: linear < 0 in {neg} of {n}; reported estimate's bias {bias:+.3f} ± {se:.3f} "
+                f"({verdict(bias, se)}), coverage {cov:.3f}; reported − linear {shift.mean():+.3f} ± "
+                f"{shift.std(ddof=1) / math.sqrt(n):.3f}"
+            )
+    print(f"{'':>22} library (flux infer) quotes the linear estimates in {lib:.0f} of {n} fleets")
 
 
 def exact_cells(exposure, templates: dict[OrbitCase, Template], beta: float) -> NDArray[np.float64]:  # type: ignore[no-untyped-def]
@@ -176,7 +250,7 @@ def score_controls(
 
 def one_fit(data, fixed, lik=None, intervals=True) -> dict[str, float]:  # type: ignore[no-untyped-def]
     res = fit(data, fixed=fixed, confidence=0.9, likelihood=lik, intervals=intervals, penalised=True)
-    out = {"debris_detections_hat": res.expected_events["debris"]}
+    out = {"debris_detections_hat": res.expected_events["debris"], "in_library": float(res.linear_in_range())}
     for p, v in res.linear_estimates.items():  # β known: the reported linear estimate and its interval
         out[f"{p}_lin"] = v
         out[f"{p}_lin_lo"], out[f"{p}_lin_hi"] = res.linear_intervals.get(p, (v, v))
@@ -214,7 +288,19 @@ def main() -> None:
     parser.add_argument("--beta", type=float, action="append", help="truth β (repeatable; default 1 and 3)")
     parser.add_argument("--scales", type=float, nargs="+", default=[1.0, 0.3, 3.0], help="truth debris scales")
     parser.add_argument("--known-beta", action="store_true", help="fit B alone (β known): ML and linear scales")
+    parser.add_argument(
+        "--fallback",
+        action="store_true",
+        help="fit B alone at all eight truths (unless --beta is given): how often the linear scales fall outside "
+        "the physical range and the reported estimate's bias and coverage",
+    )
     args = parser.parse_args()
+    args.known_beta = args.known_beta or args.fallback
+    if args.fallback and not args.beta:
+        eight = ((1.0, (1.0, 0.3, 3.0)), (3.0, (1.0, 0.3, 3.0)), (2.0, (0.5, 2.0)))  # the last two held out
+        truths = [(b, s) for b, scales in eight for s in scales]
+    else:
+        truths = [(b, s) for b in args.beta or (1.0, 3.0) for s in args.scales]
     spec = study_fleet()
     t0 = time.perf_counter()
     cfg = ForwardConfig(n_draws=args.draws)
@@ -229,82 +315,81 @@ def main() -> None:
     )
     summary = []
     n_all = max(args.reps, args.bias_reps)
-    for beta in args.beta or (1.0, 3.0):
-        for s_d in args.scales:
-            truth = {"debris_scale": s_d, "meteoroid_scale": 1.0, "beta": beta}
-            rows: dict[str, list[dict[str, float]]] = {"A": [], "B": [], "C": [], "D": []}
-            n_events: list[int] = []
-            counts: list[NDArray[np.int64]] = []
-            cells = exact_cells(exposure, draw_tpl, beta)
-            weights = score_controls(
-                cells,
-                truth,
-                exact_cells(exposure, draw_tpl, beta * math.exp(0.05)),
-                exact_cells(exposure, draw_tpl, beta * math.exp(-0.05)),
-            )
-            n_bins = cells.shape[2]
-            mu_cells = np.einsum("p,pck->ck", np.array([s_d, 1.0, 1.0]), cells).ravel()  # at the truth
-            t1, c1 = time.perf_counter(), time.process_time()
-            for rep in range(n_all):
-                # the first 500 fleets as before; past them seeds that no other truth uses
-                seed = 10_000 * int(beta) + 100 * int(10 * s_d) + rep
-                if rep >= 500:
-                    seed = 10_000_000 * int(beta) + 100_000 * int(10 * s_d) + rep
-                ev = draw_population(exposure, draw_tpl, truth, seed=seed)
-                n_events.append(len(ev))
-                data = prepare(exposure, ev, fit_tpl)
-                counts.append(np.bincount(data.event_class * n_bins + data.event_bin, minlength=mu_cells.size))
-                iv = rep < args.reps
-                if not args.known_beta:
-                    rows["A"].append(one_fit(data, {"meteoroid_scale": 1.0}, intervals=iv))
-                rows["B"].append(one_fit(data, {"beta": beta}, intervals=iv))
-                if iv and not args.known_beta:
-                    rows["D"].append(one_fit(prepare(exposure, ev, fit_tpl, use_direction=False), {"beta": beta}))
-                if rep < args.free_reps and not args.known_beta:
-                    rows["C"].append(one_fit(data, {}, Likelihood(data)))
-                if rep == 0:  # expected debris detections of the truth (what s_debris·β^α measures)
-                    truth_det = s_d * float(Likelihood(data, np.array([beta])).totals[0, 0])
-            label = f"s_d={s_d:g} s_m=1 beta={beta:g}"
-            controls = (np.array(counts) - mu_cells) @ weights.T  # the score at the truth: exact mean 0
-            for key, params, estimators in (
-                ("A", ("beta", "debris_scale"), ("hat", "signed", "corr", "firth")),
-                ("B", ("debris_scale", "meteoroid_scale"), ("hat", "signed", "corr", "lin")),
-                ("D", ("debris_scale", "meteoroid_scale"), ("hat",)),
-                ("C", ("debris_scale", "meteoroid_scale", "beta"), ("hat",)),
-            ):
-                for p in params:
-                    for est in estimators:
-                        if not rows[key]:
-                            continue
-                        cov, bias, se, pbias, pse, mbias, width, _ = interval_stats(
-                            rows[key], p, truth[p], est, controls
-                        )
-                        v = verdict(bias, se) if key in "AB" else ""
-                        summary.append((label, key, p, ESTIMATORS[est], cov, bias, mbias, width, se, v))
-                        print(
-                            f"{label:>22} {key:>3} {p:>16} {ESTIMATORS[est]:>9} {cov:9.3f} {bias:+10.3f} {se:7.3f} "
-                            f"{pbias:+11.3f} {pse:7.3f} {mbias:+12.3f} {width:6.2f} {len(rows[key]):5d}  {v}"
-                        )
-            if rows["A"]:
-                det = np.array([r["debris_detections_hat"] for r in rows["A"]])
-                bias, se = control_variate_mean(det / truth_det, controls)
-                bias -= 1
-                v = verdict(bias, se)
-                print(
-                    f"{label:>22} {'A':>3} {'debris detect.':>16} {'MLE':>9} {'':>9} {bias:+10.3f} {se:7.3f} "
-                    f"{np.median(det) / truth_det - 1:+12.3f}  (truth {truth_det:.1f}: s_debris·β^α) {v}"
-                )
-                summary.append((label, "A*", "debris_detections", "MLE", math.nan, bias, 0.0, 0.0, se, v))
-            floor = np.mean([r["beta_hat"] < 0.11 for r in rows["A"]]) if rows["A"] else math.nan
+    for beta, s_d in truths:
+        truth = {"debris_scale": s_d, "meteoroid_scale": 1.0, "beta": beta}
+        rows: dict[str, list[dict[str, float]]] = {"A": [], "B": [], "C": [], "D": []}
+        n_events: list[int] = []
+        counts: list[NDArray[np.int64]] = []
+        cells = exact_cells(exposure, draw_tpl, beta)
+        weights = score_controls(
+            cells,
+            truth,
+            exact_cells(exposure, draw_tpl, beta * math.exp(0.05)),
+            exact_cells(exposure, draw_tpl, beta * math.exp(-0.05)),
+        )
+        n_bins = cells.shape[2]
+        mu_cells = np.einsum("p,pck->ck", np.array([s_d, 1.0, 1.0]), cells).ravel()  # at the truth
+        t1, c1 = time.perf_counter(), time.process_time()
+        for rep in range(n_all):
+            # the first 500 fleets as before; past them seeds that no other truth uses
+            seed = 10_000 * int(beta) + 100 * int(10 * s_d) + rep
+            if rep >= 500:
+                seed = 10_000_000 * int(beta) + 100_000 * int(10 * s_d) + rep
+            ev = draw_population(exposure, draw_tpl, truth, seed=seed)
+            n_events.append(len(ev))
+            data = prepare(exposure, ev, fit_tpl)
+            counts.append(np.bincount(data.event_class * n_bins + data.event_bin, minlength=mu_cells.size))
+            iv = rep < args.reps
+            if not args.known_beta:
+                rows["A"].append(one_fit(data, {"meteoroid_scale": 1.0}, intervals=iv))
+            rows["B"].append(fit_known_beta(data, beta, iv, args.fallback))
+            if iv and not args.known_beta:
+                rows["D"].append(one_fit(prepare(exposure, ev, fit_tpl, use_direction=False), {"beta": beta}))
+            if rep < args.free_reps and not args.known_beta:
+                rows["C"].append(one_fit(data, {}, Likelihood(data)))
+            if rep == 0:  # expected debris detections of the truth (what s_debris·β^α measures)
+                truth_det = s_d * float(Likelihood(data, np.array([beta])).totals[0, 0])
+        label = f"s_d={s_d:g} s_m=1 beta={beta:g}"
+        controls = (np.array(counts) - mu_cells) @ weights.T  # the score at the truth: exact mean 0
+        for key, params, estimators in (
+            ("A", ("beta", "debris_scale"), ("hat", "signed", "corr", "firth")),
+            ("B", ("debris_scale", "meteoroid_scale"), ("hat", "signed", "corr", "lin")),
+            ("D", ("debris_scale", "meteoroid_scale"), ("hat",)),
+            ("C", ("debris_scale", "meteoroid_scale", "beta"), ("hat",)),
+        ):
+            for p in params:
+                for est in estimators:
+                    if not rows[key]:
+                        continue
+                    cov, bias, se, pbias, pse, mbias, width, _ = interval_stats(rows[key], p, truth[p], est, controls)
+                    v = verdict(bias, se) if key in "AB" else ""
+                    summary.append((label, key, p, ESTIMATORS[est], cov, bias, mbias, width, se, v))
+                    print(
+                        f"{label:>22} {key:>3} {p:>16} {ESTIMATORS[est]:>9} {cov:9.3f} {bias:+10.3f} {se:7.3f} "
+                        f"{pbias:+11.3f} {pse:7.3f} {mbias:+12.3f} {width:6.2f} {len(rows[key]):5d}  {v}"
+                    )
+        if args.fallback:
+            fallback_summary(rows["B"], truth, controls)
+        if rows["A"]:
+            det = np.array([r["debris_detections_hat"] for r in rows["A"]])
+            bias, se = control_variate_mean(det / truth_det, controls)
+            bias -= 1
+            v = verdict(bias, se)
             print(
-                f"{'':>22} detections per fleet in the fit's bins: mean {np.sum(counts) / len(counts):.2f}, exact "
-                f"expectation {mu_cells.sum():.2f}; control variates: the score at the truth (exact mean 0)"
+                f"{label:>22} {'A':>3} {'debris detect.':>16} {'MLE':>9} {'':>9} {bias:+10.3f} {se:7.3f} "
+                f"{np.median(det) / truth_det - 1:+12.3f}  (truth {truth_det:.1f}: s_debris·β^α) {v}"
             )
-            print(
-                f"{'':>22} events per fleet: mean {np.mean(n_events):.1f}; fit A beta at the grid floor in "
-                f"{floor:.3f} of fleets; {n_all} fleets ({args.reps} with intervals) in "
-                f"{time.perf_counter() - t1:.1f} s wall, {time.process_time() - c1:.1f} s CPU"
-            )
+            summary.append((label, "A*", "debris_detections", "MLE", math.nan, bias, 0.0, 0.0, se, v))
+        floor = np.mean([r["beta_hat"] < 0.11 for r in rows["A"]]) if rows["A"] else math.nan
+        print(
+            f"{'':>22} detections per fleet in the fit's bins: mean {np.sum(counts) / len(counts):.2f}, exact "
+            f"expectation {mu_cells.sum():.2f}; control variates: the score at the truth (exact mean 0)"
+        )
+        print(
+            f"{'':>22} events per fleet: mean {np.mean(n_events):.1f}; fit A beta at the grid floor in "
+            f"{floor:.3f} of fleets; {n_all} fleets ({args.reps} with intervals) in "
+            f"{time.perf_counter() - t1:.1f} s wall, {time.process_time() - c1:.1f} s CPU"
+        )
     print(
         f"\nTargets: coverage 0.85-0.95 (90 % intervals, {args.reps} fleets; linear intervals: all {n_all}); mean "
         f"bias within ±0.05 ({n_all} fleets): 'met' when bias ± 2 s.e. lies inside ±0.05."
@@ -341,5 +426,7 @@ if __name__ == "__main__":
     names = {"--beta=1": "beta1", "--beta=3": "beta3", "--beta=2": "beta2_heldout", "--reps=0": "points"}
     names["--scales=0.3"] = "worst"
     names["--known-beta"] = "known"
+    if "--fallback" in sys.argv:  # its own file, whatever --reps
+        names = {"--fallback": "fallback"}
     with write_results("bench_flux_coverage", variant(names)):
         main()

@@ -4,15 +4,18 @@ Poisson score interval in closed form, and their bias and coverage on simulated 
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 from scipy import stats
 
+from abrupt.cli.flux import _fit_lines
 from abrupt.errors import ConfigError
 from abrupt.flux.exposure import DAYS_PER_YEAR
 from abrupt.flux.inference import FitResult, Likelihood, fit, prepare
 from abrupt.flux.linear import linear_fit
+from abrupt.report.flux import fits_table
 from test_flux_inference import AMPLITUDE, CASE, CONFIG, SLOPE, events_from_counts, exposure, power_law_template
 
 
@@ -87,7 +90,8 @@ def _beta_known_result(linear: dict[str, float], linear_iv: dict[str, tuple[floa
 
 
 def test_linear_scales_out_of_the_physical_range_are_not_reported() -> None:
-    """A negative linear scale (weights far from the data) is no flux: the ML estimates are quoted."""
+    """A linear scale whose interval holds no flux above 0 (weights far from the data: [0, 0]) is not quoted:
+    the ML estimates are. A negative one with an interval reaching above 0 is quoted, with a note."""
     bad = _beta_known_result(
         {"debris_scale": 1.0e4, "meteoroid_scale": -3.8e4},
         {"debris_scale": (5.4e3, 1.9e4), "meteoroid_scale": (0.0, 0.0)},
@@ -100,4 +104,59 @@ def test_linear_scales_out_of_the_physical_range_are_not_reported() -> None:
         {"debris_scale": (1.2e3, 3.1e3), "meteoroid_scale": (0.5, 90.0)},
     )
     assert good.linear_in_range()
-    assert good.reported()["estimates"] is good.linear_estimates
+    assert good.reported()["estimates"] is good.linear_estimates and not good.reported()["notes"]
+    below = _beta_known_result(
+        {"debris_scale": 1.9e3, "meteoroid_scale": -0.4},
+        {"debris_scale": (1.2e3, 3.1e3), "meteoroid_scale": (0.0, 1.1)},
+    )
+    rep = below.reported()
+    assert below.linear_in_range() and rep["estimates"]["meteoroid_scale"] == -0.4
+    assert len(rep["notes"]) == 1 and rep["notes"][0].startswith("meteoroid_scale = -0.4 < 0")
+    assert "[0, 1.1]" in rep["notes"][0]
+    lines = _fit_lines("free", below)  # the command prints it under the fit
+    assert lines[0].startswith("free: debris_scale = 1.9e+03") and "meteoroid_scale = -0.4" in lines[0]
+    assert lines[2] == "  below 0: " + rep["notes"][0]
+    table = fits_table(SimpleNamespace(fits={"free": below})).set_index("parameter")  # the HTML report's table
+    assert table.loc["meteoroid_scale", "estimate"] == -0.4 and "below 0" in table.loc["meteoroid_scale", "estimator"]
+    assert table.loc["debris_scale", "estimator"] == "linear, score interval"
+
+
+def test_quoting_negative_linear_scales_keeps_the_reported_estimate_unbiased_and_covering() -> None:
+    """The data sets of the study above (3 spacecraft-years, truth s = (0.3, 1), 4 debris and 10 meteoroid
+    detections on 11 false alarms): a linear scale is below 0 in about half of them. Reporting the ML
+    estimate and its profile interval whenever one is (the rule before) lifts the reported debris mean far
+    above the truth (about +25 %); the rule of ``FitResult.reported`` (the ML only when an interval holds no
+    scale above 0) keeps the reported means at the truth within 4 s.e. and both 90 % intervals at 90 %
+    ± 3 binomial σ, the linear estimator's own properties. (Seed 11: 47 % negative; before +20 % / +2 % bias,
+    coverage 0.967 / 0.960; after −4 ± 12 % / +3 ± 6 %, coverage 0.913 / 0.907.)"""
+    exp = exposure(3, 1.0, false_alarms=0.01)
+    exp["dH50_Nms"] = 1.2e-3
+    data = prepare(exp, events_from_counts(np.ones(CONFIG.n_bins, dtype=int), exp), {CASE: power_law_template()})
+    lik = Likelihood(data, np.array([1.0]))
+    truth = {"debris_scale": 0.3, "meteoroid_scale": 1.0}
+    mu = np.array(list(truth.values())) @ lik.bin_signal[0] + data.background_bins
+    rng = np.random.default_rng(11)
+    before: list[list[tuple[float, float, float]]] = []
+    after: list[list[tuple[float, float, float]]] = []
+    negative = 0
+    for _ in range(300):
+        counts = lik.reweighted(rng.poisson(mu).astype(float))
+        lin = linear_fit(counts, {}, 0.9)
+        neg = any(v < 0 for k, v in lin.estimates.items() if k in truth)
+        res = fit(data, fixed={"beta": 1.0}, likelihood=counts, intervals=neg)  # ML intervals where quoted
+        if not neg and not res.linear_in_range():
+            res = fit(data, fixed={"beta": 1.0}, likelihood=counts, intervals=True)
+        negative += neg
+        old = (res.estimates, res.intervals) if neg else (res.linear_estimates, res.linear_intervals)
+        rep = res.reported()
+        before.append([(old[0][k], *old[1][k]) for k in truth])
+        after.append([(rep["estimates"][k], *rep["intervals"][k]) for k in truth])
+    assert 0.3 < negative / 300 < 0.7
+    t = np.array(list(truth.values()))
+    b, a = np.array(before), np.array(after)  # (data sets, scale, estimate/lo/hi)
+    se = a[:, :, 0].std(axis=0) / math.sqrt(300)
+    assert np.all(np.abs(a[:, :, 0].mean(axis=0) - t) < 4 * se)
+    lift = (b[:, 0, 0] - a[:, 0, 0]) / t[0]  # the fallback's own shift of the debris mean, paired
+    assert lift.mean() > max(0.1, 4 * lift.std() / math.sqrt(300))
+    cover = np.mean((a[:, :, 1] <= t) & (t <= a[:, :, 2]), axis=0)
+    assert np.all(np.abs(cover - 0.9) < 3 * math.sqrt(0.09 / 300))

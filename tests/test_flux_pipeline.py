@@ -12,8 +12,9 @@ import pytest
 from click.testing import CliRunner
 from scipy import stats
 
+from abrupt.catalog import Catalog
 from abrupt.cli.main import cli
-from abrupt.flux.exposure import DAYS_PER_YEAR
+from abrupt.flux.exposure import DAYS_PER_YEAR, load_exposure
 from abrupt.flux.forward import ForwardConfig, build_template
 from abrupt.flux.inference import Likelihood, expected_bins, prepare
 from abrupt.flux.showers import shower_association, shower_calendar
@@ -86,6 +87,11 @@ def test_simulate_population_then_flux_infer_end_to_end(tmp_path) -> None:
     assert any("identify s_p·T_p(beta)" in n for n in prior["notes"])
     assert any("identify each population's expected detections" in n for n in result["notes"])
     assert "expected debris detections s·T(β) (identified)" in report.read_text()
+    # ... and the exposure falls short of the figure from which a β-free scale's mean is within 5 %
+    years = float(load_exposure(Catalog(str(cat), create=False))["analysed_fraction"].sum()) / DAYS_PER_YEAR
+    short = f"Beta free on {years:.3g} analysed spacecraft-years"
+    assert sum(n.startswith(short) for n in result["notes"]) == 1
+    assert short in report.read_text() and short.lower() in prior["notes"][-1].lower()
     assert {g["model"] for g in result["goodness_of_fit"]} >= {"NASA-90/91 + Grün", "Grün only"}
     text = report.read_text()
     assert "data:image/png;base64" in text and "Exposure" in text
@@ -97,6 +103,7 @@ def test_simulate_population_then_flux_infer_end_to_end(tmp_path) -> None:
     known_result = json.loads(out.read_text())
     known = known_result["fits"]["free"]
     assert any("linear fixed-weight" in n for n in known_result["notes"])
+    assert not any("analysed spacecraft-years" in n for n in known_result["notes"])
     assert "linear" in known["reported"]["estimator"]
     assert known["reported"]["estimates"] == known["linear_estimates"]
     assert set(known["linear_standard_errors"]) == {"debris_scale", "meteoroid_scale"}

@@ -95,6 +95,7 @@ def _fit_lines(name: str, f: FitResult) -> list[str]:
     return [
         f"{name}: " + _estimates_text(f, f.linear_estimates, f.linear_intervals) + size,
         f"  reported: {f.reported()['estimator']}; ± standard error, [{level} score interval]",
+        *(f"  below 0: {n}" for n in f.reported()["notes"]),
         "  maximum likelihood (diagnostic; profile intervals): " + _estimates_text(f, f.estimates, f.intervals),
     ]
 

@@ -46,14 +46,10 @@ from abrupt.flux.forward import (
     direction_class,
 )
 from abrupt.flux.grid import refine_max
-from abrupt.flux.linear import ESTIMATOR, OUT_OF_RANGE, in_physical_range, linear_fit
+from abrupt.flux.linear import ESTIMATOR, OUT_OF_RANGE, below_zero_notes, in_physical_range, linear_fit
+from abrupt.flux.notes import IDENTIFIED_NOTE, beta_free_note
 
 PARAMS: tuple[str, ...] = ("debris_scale", "meteoroid_scale", "beta")
-# what a fit with β free measures well (docs/flux-inference.md, "The debris scale on the β ridge")
-IDENTIFIED_NOTE = (
-    "beta free: the data identify s_p·T_p(beta), the expected detections of each population (expected_events), "
-    "far better than s_p itself, whose estimate inherits beta's spread (its mean is biased high on small exposures)"
-)
 DEFAULT_BETA_GRID = np.exp(np.linspace(math.log(0.1), math.log(100.0), 161))
 
 
@@ -396,12 +392,14 @@ class FitResult:
         return in_physical_range(self.linear_estimates, self.linear_intervals, self.fixed)
 
     def reported(self) -> dict[str, Any]:
-        """The estimates to quote: with β known the linear ones when in range, else the ML ones."""
+        """The estimates to quote: with β known the linear ones when in range (``notes`` on any below 0), else ML."""
         if self.linear_in_range():
             est, iv, se = self.linear_estimates, self.linear_intervals, self.standard_errors
-            return {"estimator": ESTIMATOR, "estimates": est, "standard_errors": se, "intervals": iv}
+            notes = below_zero_notes(est, iv, self.fixed)
+            return {"estimator": ESTIMATOR, "estimates": est, "standard_errors": se, "intervals": iv, "notes": notes}
         ml = "maximum likelihood, profile-likelihood intervals" + (OUT_OF_RANGE if self.linear_estimates else "")
-        return {"estimator": ml, "estimates": self.estimates, "standard_errors": {}, "intervals": self.intervals}
+        est, iv = self.estimates, self.intervals
+        return {"estimator": ml, "estimates": est, "standard_errors": {}, "intervals": iv, "notes": []}
 
     def as_dict(self) -> dict[str, Any]:
         rep = self.reported()
@@ -479,8 +477,9 @@ def fit(
     notes: list[str] = []
     if "beta" not in fixed and intervals:
         bounds["beta"] = _beta_interval(logb, ll, ll_max - half, notes)
-    if "beta" not in fixed:
-        notes.append(IDENTIFIED_NOTE)
+    if "beta" not in fixed:  # what a β-free fit measures, and whether its exposure suffices for the scales
+        short = beta_free_note(float(data.analysed_years.sum()))
+        notes += [IDENTIFIED_NOTE] + ([short] if short else [])
     # a β whose profile is below the interval's level cannot hold a boundary of a scale's interval
     near = lik
     if ll.size > 3:

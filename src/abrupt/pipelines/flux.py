@@ -42,6 +42,7 @@ from abrupt.flux.inference import (
     prepare,
     upper_limit,
 )
+from abrupt.flux.notes import beta_free_note
 from abrupt.flux.showers import shower_association
 from abrupt.model.spacecraft import Spacecraft, load_spacecraft
 from abrupt.simulate.population import FleetSpec, draw_population, fleet_exposure
@@ -146,7 +147,8 @@ LINEAR_NOTE = (
     "ones (estimates, kept as diagnostics with their profile intervals) carry a small-sample bias of several per "
     "cent at 5-10 detections of a population; their intervals are score-type, from the exact variance of the "
     "linear statistic. Their precision is the ML's when the truth is near the published models and lower far "
-    "from them (docs/flux-inference.md)."
+    "from them. A linear scale below 0 is reported as it is (unbiased) with its interval clipped at 0; the ML "
+    "estimates replace them only when an interval holds no scale above 0 (docs/flux-inference.md)."
 )
 
 
@@ -202,10 +204,11 @@ def infer_flux(
     else:
         notes.append(
             "With beta free the data identify each population's expected detections s_p·T_p(beta) (expected_events "
-            "of each fit), not s_p alone: on 10 spacecraft-years the mean of the debris scale itself is biased high "
-            "(its median is not), while the expected detections are nearly unbiased; docs/flux-inference.md gives "
-            "the simulation study. Quote the expected detections or the median, or fix beta from independent data."
+            "of each fit), not s_p alone; docs/flux-inference.md gives the simulation study."
         )
+        short = beta_free_note(float(data.analysed_years.sum()))
+        if short:
+            notes.append(short[0].upper() + short[1:])
     if data.rows_set_aside:
         notes.append(
             f"{data.rows_set_aside} exposure rows of spacecraft-days analysed by several detectors were set aside "

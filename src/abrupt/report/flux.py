@@ -87,6 +87,13 @@ def _table(frame: pd.DataFrame, floatfmt: str = "{:.4g}") -> str:
     return f"<table><tr>{head}</tr>{rows}</table>"
 
 
+def _estimator_label(linear: bool, parameter: str, reported: dict[str, Any]) -> str:
+    if not linear:
+        return "ML, profile likelihood"
+    below = any(n.startswith(f"{parameter} =") for n in reported["notes"])
+    return "linear, score interval" + (" (estimate below 0, unbiased: quote the interval)" if below else "")
+
+
 def fits_table(result: FluxInference) -> pd.DataFrame:
     rows = []
     nan = float("nan")
@@ -104,7 +111,7 @@ def fits_table(result: FluxInference) -> pd.DataFrame:
                     "s.e.": rep["standard_errors"].get(p, nan),
                     f"{f.confidence:.0%} low": lo,
                     f"{f.confidence:.0%} high": hi,
-                    "estimator": "linear, score interval" if linear else "ML, profile likelihood",
+                    "estimator": _estimator_label(linear, p, rep),
                     "ML": v,
                     "ML low": ml_lo if linear else nan,
                     "ML high": ml_hi if linear else nan,
