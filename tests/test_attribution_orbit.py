@@ -16,6 +16,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from abrupt.cli.flight_orbit import orbit_input
 from abrupt.cli.main import main as cli_main
 from abrupt.detect.attitude.evidence import surface_evidence
 from abrupt.detect.attitude.orbit_evidence import (
@@ -271,10 +272,16 @@ def test_bad_orbit_files_get_one_line_errors(
     assert "order.parquet" in msg and "times out of order" in msg
     good = tmp_path / "good.csv"
     write_events(_orbit((0.0, 1e-3, 5.0)), str(good))
-    msg = _run_bad(cli_inputs, good, capsys, "--orbit-span", "2026-01-05T00:00..2026-01-06T00:00")
-    assert "--orbit-floor-mps" in msg
-    msg = _run_bad(cli_inputs, good, capsys, "--orbit-floor-mps", "2e-4")
-    assert "--orbit-span" in msg
+    cat = ("--catalog", str(tmp_path / "c.sqlite"))
+    msg = _run_bad(cli_inputs, good, capsys, "--orbit-span", "2026-01-05T00:00..2026-01-06T00:00", *cat)
+    assert "give --orbit-floor-mps (" in msg and "no run 'o' in the catalog" in msg
+    msg = _run_bad(cli_inputs, good, capsys, "--orbit-floor-mps", "2e-4", *cat)
+    assert "give --orbit-span (" in msg
+    empty = tmp_path / "empty.csv"
+    write_events(_orbit(), str(empty))
+    msg = _run_bad(cli_inputs, empty, capsys, *cat)
+    assert "empty.csv: give --orbit-floor-mps and --orbit-span" in msg
+    assert "holds no events, and no orbit run in the catalog wrote it (give --orbit-run)" in msg
     msg = _run_bad(cli_inputs, good, capsys, "--orbit-floor-mps", "2e-4", "--orbit-span", "yesterday..today")
     assert "yesterday..today" in msg
 
@@ -322,3 +329,28 @@ def test_cli_strike_on_a_light_spacecraft_that_the_orbit_did_not_feel(tmp_path: 
     assert r["kind"] == "unknown" and "not a strike" in r["kind_reason"], r["kind_reason"]
     # The attitude rules alone called it a strike (the reason keeps theirs in front).
     assert r["kind_reason"].startswith("impulsive")
+
+
+def test_span_and_floor_come_from_the_orbit_runs_record(tmp_path: Path) -> None:
+    """A quiet orbit run (12 h of simulated navigation at 60 s) records the epochs it tested: the arc less
+    the filters' settling, 3.33 h at each end with the auto tuning; an attitude event inside is covered with
+    the run's own 90 %-detectable ΔV as the floor, one in the settling zone (inside the arc) is not."""
+    nav, ev, cat = tmp_path / "nav.csv", tmp_path / "orbit.csv", tmp_path / "c.sqlite"
+    cli_main(["simulate", "orbit", "--out", str(nav), "--duration-s", "43200", "--rate-hz", str(1 / 60),
+              "--seed", "3", "--sigma-pos-m", "0.05", "--sigma-vel-mps", "0.0005"])  # fmt: skip
+    cli_main(["detect", "orbit", str(nav), "--out", str(ev), "--catalog", str(cat), "--name", "SC-Z",
+              "--block-days", "0"])  # fmt: skip
+    got = orbit_input(str(ev), None, (), 0.0, None, spacecraft="SC-Z", catalog_target=str(cat))
+    assert got is not None and len(got.events) == 0
+    ((a, b),) = got.coverage.spans_utc
+    settle = np.timedelta64(12000, "s")  # 3.33 h (the filter's settling time of the auto tuning)
+    t0, t1 = np.datetime64("2020-01-01T00:00:00", "ns"), np.datetime64("2020-01-01T12:00:00", "ns")
+    assert abs((a - (t0 + settle)) / np.timedelta64(1, "s")) <= 60.0
+    assert abs((b - (t1 - np.timedelta64(60, "s") - settle)) / np.timedelta64(1, "s")) <= 60.0
+    assert 0.0 < got.coverage.dv_floor_mps < 1.0  # the run's dv90, m/s (tens of mm/s on this arc)
+    att = pd.concat([_attitude(), _attitude()], ignore_index=True)
+    att["time_utc"] = ["2020-01-01T06:00:00.000000Z", "2020-01-01T01:00:00.000000Z"]
+    with_orbit = got.attach(att, 500.0)
+    assert with_orbit["ev_orbit_dv_mps"].iloc[0] == 0.0
+    assert with_orbit["ev_orbit_dv_floor_mps"].iloc[0] == got.coverage.dv_floor_mps
+    assert math.isnan(with_orbit["ev_orbit_dv_mps"].iloc[1])  # in the arc, but never tested

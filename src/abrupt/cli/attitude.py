@@ -364,11 +364,12 @@ def detect_attitude_cmd(
     orbit_floor_mps: float | None = None,
     orbit_spans: tuple[str, ...] = (),
     orbit_edge_s: float = 0.0,
+    orbit_run: str | None = None,
     **settings: Any,
 ) -> None:
     """Detect strikes in attitude TELEMETRY (CSV or Parquet), or in a --store; write events and the catalog."""
     exposure = {"recovery": exposure_recovery, "dh90": exposure_dh90, "surfaces": exposure_surfaces}
-    orbit = (orbit_events, orbit_floor_mps, orbit_spans, orbit_edge_s)
+    orbit = (orbit_events, orbit_floor_mps, orbit_spans, orbit_edge_s, orbit_run)
     if store_dir is not None:  # flight-telemetry pipeline (abrupt.pipelines.flight)
         budget = pop_budget(settings, "1/day")
         detect_from_store(
@@ -376,7 +377,7 @@ def detect_attitude_cmd(
             orbit=orbit,
         )  # fmt: skip
         return
-    if orbit_events or orbit_floor_mps is not None or orbit_spans:
+    if orbit_events or orbit_floor_mps is not None or orbit_spans or orbit_run:
         raise click.UsageError("--orbit-events needs --store (the flight pipeline's attribution)")
     if exposure_recovery or exposure_dh90:
         raise click.UsageError("--exposure-recovery/--exposure-dH90 need --store (the flight pipeline's daily table)")

@@ -122,14 +122,14 @@ def detect_from_store(
     report_path: str | None,
     daily_path: str | None = None,
     exposure: dict[str, Any] | None = None,
-    orbit: tuple[str | None, float | None, tuple[str, ...], float] = (None, None, (), 0.0),
+    orbit: tuple[str | None, float | None, tuple[str, ...], float, str | None] = (None, None, (), 0.0, None),
 ) -> None:
     """``abrupt detect attitude --store``: run the flight pipeline on stored days; write events and reports
     (and, with ``exposure`` options and a catalog, the run's exposure rows: :func:`store_run_exposure`);
-    ``orbit``: the orbit events file, ΔV floor [m/s], spans and edge [s] of an orbit run
+    ``orbit``: the orbit events file, ΔV floor [m/s], spans, edge [s] and run id of an orbit run
     (:mod:`abrupt.cli.flight_orbit`)."""
     sc = load_spacecraft(spacecraft_path)
-    orbit_in = orbit_input(*orbit, spacecraft=sc.name)
+    orbit_in = orbit_input(*orbit, spacecraft=sc.name, catalog_target=catalog_target)
     cfg = FlightRunConfig(budget=budget, cleaning=_cleaning(no_clean))
     day_list = day_range(TelemetryStore(store_dir), sc.name, days or None)
     bar = _progress(len(day_list), "detect")

@@ -10,8 +10,8 @@ import click
 import pandas as pd
 
 from abrupt.detect.attitude.orbit_evidence import NavigationCoverage, spans_from_text
-from abrupt.errors import ConfigError
-from abrupt.pipelines.flight_orbit import attach_orbit_evidence, read_orbit_events
+from abrupt.errors import ConfigError, InputError
+from abrupt.pipelines.flight_orbit import attach_orbit_evidence, orbit_run_id, read_orbit_events, recorded_coverage
 
 
 @dataclass(frozen=True)
@@ -26,7 +26,7 @@ class OrbitInput:
 
 
 def orbit_evidence_options(f: Any) -> Any:
-    """``--orbit-events``, ``--orbit-floor-mps``, ``--orbit-span``, ``--orbit-edge-s``."""
+    """``--orbit-events``, ``--orbit-floor-mps``, ``--orbit-span``, ``--orbit-edge-s``, ``--orbit-run``."""
     options = [
         click.option(
             "--orbit-events",
@@ -39,14 +39,15 @@ def orbit_evidence_options(f: Any) -> Any:
             "--orbit-floor-mps",
             type=float,
             default=None,
-            help="The orbit run's ΔV floor [m/s]: the 90 %-detectable |ΔV| (worst direction) it printed.",
+            help="The orbit run's ΔV floor [m/s] (default: the 90 %-detectable |ΔV|, worst direction, that the "
+            "orbit run recorded in --catalog).",
         ),
         click.option(
             "--orbit-span",
             "orbit_spans",
             multiple=True,
-            help="START..END (UTC) the orbit run's navigation solution covered (its arc); repeatable. Events "
-            "outside get no orbit evidence (not covered is not 'no ΔV').",
+            help="START..END (UTC) the orbit run's navigation solution covered; repeatable (default: the arc "
+            "the orbit run recorded in --catalog). Events outside get no orbit evidence (not covered is not 'no ΔV').",
         ),
         click.option(
             "--orbit-edge-s",
@@ -55,6 +56,12 @@ def orbit_evidence_options(f: Any) -> Any:
             show_default=True,
             help="Margin at each end of each span that does not count as covered [s].",
         ),
+        click.option(
+            "--orbit-run",
+            default=None,
+            help="The orbit run (run id in --catalog) whose span and floor to use (default: the run that wrote "
+            "the --orbit-events file).",
+        ),
     ]
     for opt in reversed(options):
         f = opt(f)
@@ -62,27 +69,43 @@ def orbit_evidence_options(f: Any) -> Any:
 
 
 def orbit_input(
-    orbit_events: str | None, floor_mps: float | None, spans: tuple[str, ...], edge_s: float, spacecraft: str
+    orbit_events: str | None,
+    floor_mps: float | None,
+    spans: tuple[str, ...],
+    edge_s: float,
+    run_id: str | None,
+    *,
+    spacecraft: str,
+    catalog_target: str | None,
 ) -> OrbitInput | None:
-    """The orbit input of the options (None without ``--orbit-events``); a one-line error for a bad one."""
+    """The orbit input of the options (None without ``--orbit-events``); a one-line error for a bad one.
+    The span and the floor not given come from the orbit run's record in the catalog."""
     if orbit_events is None:
-        if floor_mps is not None or spans:
-            raise click.UsageError("--orbit-floor-mps and --orbit-span need --orbit-events")
+        if floor_mps is not None or spans or run_id is not None:
+            raise click.UsageError("--orbit-floor-mps, --orbit-span and --orbit-run need --orbit-events")
         return None
-    if floor_mps is None:
-        raise ConfigError(
-            "--orbit-events needs --orbit-floor-mps: the smallest ΔV the orbit run would have found "
-            "(the '90 % detectable |ΔV|' line of `abrupt detect orbit`)",
-            key="orbit_floor_mps",
-        )
-    if not spans:
-        raise ConfigError(
-            "--orbit-events needs --orbit-span START..END: the times the navigation solution covered "
-            "(an events file does not say where its run found nothing)",
-            key="orbit_span",
-        )
+    events = read_orbit_events(orbit_events, spacecraft)
     try:
-        coverage = NavigationCoverage(spans_from_text(spans), floor_mps, edge_s, source=orbit_events)
+        given = spans_from_text(spans)
+        if floor_mps is not None and spans:
+            return OrbitInput(events, NavigationCoverage(given, floor_mps, edge_s, source="given"))
     except ValueError as exc:
         raise ConfigError(str(exc), key="orbit_span" if "span" in str(exc) else "orbit_floor_mps") from None
-    return OrbitInput(read_orbit_events(orbit_events, spacecraft), coverage)
+    try:
+        if catalog_target is None:
+            raise ConfigError("no catalog to read the orbit run's record from", key="catalog")
+        rec = recorded_coverage(catalog_target, run_id or orbit_run_id(events, orbit_events, catalog_target), edge_s)
+    except (ConfigError, InputError) as exc:
+        missing = " and ".join(n for n, v in (("--orbit-floor-mps", floor_mps), ("--orbit-span", spans)) if not v)
+        raise InputError(
+            f"give {missing} (the smallest ΔV the orbit run would have found; the times its navigation solution "
+            f"covered), or the orbit run's record: {getattr(exc, 'reason', exc)}",
+            file=orbit_events,
+        ) from None
+    coverage = NavigationCoverage(
+        given or rec.spans_utc,
+        floor_mps if floor_mps is not None else rec.dv_floor_mps,
+        edge_s,
+        source=rec.source,
+    )
+    return OrbitInput(events, coverage)

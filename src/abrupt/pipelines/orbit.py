@@ -315,7 +315,15 @@ def fit_summary(run: OrbitRun) -> dict[str, Any]:
         "warnings": list(run.result.warnings),
         "product_boundaries": orbit_product_boundaries(run.result),
         **_detectable(run),
+        **_tested_span(an),
     }
+
+
+def _tested_span(an: OrbitAnalysis) -> dict[str, str]:
+    """The first and last epoch the statistics were evaluated at (the arc less the filters' settling at each
+    end): where a quiet run means no impulse above its detectable ΔV."""
+    tested = an.ephemeris.times_utc[np.asarray(an.valid, dtype=bool)]
+    return {"start_utc": str(tested[0])[:19], "end_utc": str(tested[-1])[:19]} if tested.size else {}
 
 
 def _detectable(run: OrbitRun) -> dict[str, float]:
