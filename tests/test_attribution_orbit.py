@@ -254,6 +254,8 @@ OK = ("--orbit-floor-mps", "2e-4", "--orbit-span", "2026-01-05T00:00..2026-01-06
 def test_bad_orbit_files_get_one_line_errors(
     cli_inputs: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
+    msg = _run_bad(cli_inputs, tmp_path / "missing.csv", capsys, *OK)
+    assert "missing.csv: orbit events file does not exist" in msg
     telemetry = tmp_path / "telemetry.csv"
     telemetry.write_text("time,mnemonic,value\n2026-01-05T00:00:00Z,X,1.0\n")
     msg = _run_bad(cli_inputs, telemetry, capsys, *OK)
@@ -284,6 +286,18 @@ def test_bad_orbit_files_get_one_line_errors(
     assert "holds no events, and no orbit run in the catalog wrote it (give --orbit-run)" in msg
     msg = _run_bad(cli_inputs, good, capsys, "--orbit-floor-mps", "2e-4", "--orbit-span", "yesterday..today")
     assert "yesterday..today" in msg
+
+
+def test_orbit_events_need_the_flight_pipeline(
+    cli_inputs: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    sc, _ = cli_inputs
+    tel = tmp_path / "t.csv"
+    tel.write_text("t\n0\n")
+    args = ["detect", "attitude", str(tel), "--spacecraft", str(sc), "--out", str(tmp_path / "e.csv")]
+    with pytest.raises(SystemExit) as exc:
+        cli_main([*args, "--orbit-events", str(tel), *OK])
+    assert exc.value.code == 2 and "--orbit-events needs --store" in capsys.readouterr().err
 
 
 def test_orbit_events_read_from_json_and_csv_alike(tmp_path: Path) -> None:
