@@ -46,7 +46,7 @@ def orbit_evidence_options(f: Any) -> Any:
             "--orbit-span",
             "orbit_spans",
             multiple=True,
-            help="START..END (UTC) the orbit run's navigation solution covered; repeatable (default: the arc "
+            help="START..END (UTC) the orbit run tested (its 'tested' line); repeatable (default: the span "
             "the orbit run recorded in --catalog). Events outside get no orbit evidence (not covered is not 'no ΔV').",
         ),
         click.option(

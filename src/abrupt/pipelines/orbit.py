@@ -368,6 +368,8 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
             f"{1e3 * s['dv90_best_mps']:.3g} mm/s in the best (median over the arc; a quiet result means no "
             "impulse above this)"
         )
+    if "start_utc" in s and "end_utc" in s:
+        lines.append(f"  tested           {s['start_utc']} – {s['end_utc']} (the arc less the filters' settling)")
     bounds = s.get("product_boundaries") or []
     if bounds:
         nuisance = [b for b in bounds if not b["raised"]]
