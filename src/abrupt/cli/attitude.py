@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 
 from abrupt.cli.flight import CLEANING_STAGES, detect_from_store
+from abrupt.cli.flight_orbit import orbit_evidence_options
 from abrupt.cli.flux import exposure_options
 from abrupt.cli.groups import (
     StageProgress,
@@ -344,6 +345,7 @@ def telemetry_or_store_options(f: Any) -> Any:
     help="Also write the report (.png, .svg, .pdf or a self-contained .html page).",
 )
 @exposure_options
+@orbit_evidence_options
 def detect_attitude_cmd(
     telemetry: str,
     spacecraft_path: str,
@@ -358,16 +360,25 @@ def detect_attitude_cmd(
     exposure_recovery: str | None = None,
     exposure_dh90: float | None = None,
     exposure_surfaces: str | None = None,
+    orbit_events: str | None = None,
+    orbit_floor_mps: float | None = None,
+    orbit_spans: tuple[str, ...] = (),
+    orbit_edge_s: float = 0.0,
+    orbit_run: str | None = None,
     **settings: Any,
 ) -> None:
     """Detect strikes in attitude TELEMETRY (CSV or Parquet), or in a --store; write events and the catalog."""
     exposure = {"recovery": exposure_recovery, "dh90": exposure_dh90, "surfaces": exposure_surfaces}
+    orbit = (orbit_events, orbit_floor_mps, orbit_spans, orbit_edge_s, orbit_run)
     if store_dir is not None:  # flight-telemetry pipeline (abrupt.pipelines.flight)
         budget = pop_budget(settings, "1/day")
         detect_from_store(
-            store_dir, spacecraft_path, days, budget, no_clean, catalog_target, out, report_path, exposure=exposure
-        )
+            store_dir, spacecraft_path, days, budget, no_clean, catalog_target, out, report_path, exposure=exposure,
+            orbit=orbit,
+        )  # fmt: skip
         return
+    if orbit_events or orbit_floor_mps is not None or orbit_spans or orbit_run:
+        raise click.UsageError("--orbit-events needs --store (the flight pipeline's attribution)")
     if exposure_recovery or exposure_dh90:
         raise click.UsageError("--exposure-recovery/--exposure-dH90 need --store (the flight pipeline's daily table)")
     if telemetry is None:

@@ -14,6 +14,7 @@ import click
 import numpy as np
 
 from abrupt import progress
+from abrupt.cli.flight_orbit import orbit_input
 from abrupt.cli.flux import store_run_exposure
 from abrupt.cli.groups import cli, inject, record_run, simulate
 from abrupt.cli.options import budget_options, pop_budget
@@ -121,10 +122,14 @@ def detect_from_store(
     report_path: str | None,
     daily_path: str | None = None,
     exposure: dict[str, Any] | None = None,
+    orbit: tuple[str | None, float | None, tuple[str, ...], float, str | None] = (None, None, (), 0.0, None),
 ) -> None:
     """``abrupt detect attitude --store``: run the flight pipeline on stored days; write events and reports
-    (and, with ``exposure`` options and a catalog, the run's exposure rows: :func:`store_run_exposure`)."""
+    (and, with ``exposure`` options and a catalog, the run's exposure rows: :func:`store_run_exposure`);
+    ``orbit``: the orbit events file, ΔV floor [m/s], spans, edge [s] and run id of an orbit run
+    (:mod:`abrupt.cli.flight_orbit`)."""
     sc = load_spacecraft(spacecraft_path)
+    orbit_in = orbit_input(*orbit, spacecraft=sc.name, catalog_target=catalog_target)
     cfg = FlightRunConfig(budget=budget, cleaning=_cleaning(no_clean))
     day_list = day_range(TelemetryStore(store_dir), sc.name, days or None)
     bar = _progress(len(day_list), "detect")
@@ -137,6 +142,8 @@ def detect_from_store(
 
     result = run_flight(store_dir, sc, cfg, days=day_list, keep_series=report_path is not None, progress=tick)
     bar.close()
+    if orbit_in is not None:
+        result.events = orbit_in.attach(result.events, sc.mass_kg)
     if out:
         write_events(result.events, out)
     if catalog_target:

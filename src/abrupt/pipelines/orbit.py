@@ -315,7 +315,15 @@ def fit_summary(run: OrbitRun) -> dict[str, Any]:
         "warnings": list(run.result.warnings),
         "product_boundaries": orbit_product_boundaries(run.result),
         **_detectable(run),
+        **_tested_span(an),
     }
+
+
+def _tested_span(an: OrbitAnalysis) -> dict[str, str]:
+    """The first and last epoch the statistics were evaluated at (the arc less the filters' settling at each
+    end): where a quiet run means no impulse above its detectable ΔV."""
+    tested = an.ephemeris.times_utc[np.asarray(an.valid, dtype=bool)]
+    return {"start_utc": str(tested[0])[:19], "end_utc": str(tested[-1])[:19]} if tested.size else {}
 
 
 def _detectable(run: OrbitRun) -> dict[str, float]:
@@ -360,6 +368,8 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
             f"{1e3 * s['dv90_best_mps']:.3g} mm/s in the best (median over the arc; a quiet result means no "
             "impulse above this)"
         )
+    if "start_utc" in s and "end_utc" in s:
+        lines.append(f"  tested           {s['start_utc']} – {s['end_utc']} (the arc less the filters' settling)")
     bounds = s.get("product_boundaries") or []
     if bounds:
         nuisance = [b for b in bounds if not b["raised"]]

@@ -109,6 +109,15 @@ class BlockOutcome:
             "n": th.n_samples if th is not None else 0,
             "events": len(self.events),
             **{k: s[k] for k in ("tau_s", "q_m2_s5", "sigma_pos_m", "sigma_vel_mps", "dv90_mps") if k in s},
+            # the part of the block its statistics were evaluated at (its arc's tested epochs within it)
+            **(
+                {
+                    "tested_start_utc": max(str(self.start_utc)[:19], s["start_utc"]),
+                    "tested_end_utc": min(str(self.end_utc)[:19], s["end_utc"]),
+                }
+                if "start_utc" in s and "end_utc" in s
+                else {}
+            ),
         }
 
 
@@ -167,6 +176,10 @@ def blocks_summary(outcomes: list[BlockOutcome], eph: Ephemeris) -> dict[str, An
         nuisance={},
         blocks=[o.record() for o in outcomes],
     )
+    tested = [(b["tested_start_utc"], b["tested_end_utc"]) for b in out["blocks"] if "tested_start_utc" in b]
+    out.pop("start_utc", None), out.pop("end_utc", None)  # the first block's own, not the run's
+    if tested:
+        out.update(start_utc=min(a for a, _ in tested), end_utc=max(b for _, b in tested))
     return out
 
 

@@ -32,6 +32,10 @@ The rules read the evidence of :mod:`abrupt.detect.attitude.evidence`; none is f
 6. **internal** when the sensors agree, the body moved, and nothing lasts (a pulse that returns);
 7. **unknown** otherwise, or when the evidence is missing.
 
+Where an orbit run's navigation solution covers the event,
+:func:`abrupt.detect.attitude.orbit_evidence.apply_orbit_rules` checks the class against the orbit side
+afterwards (a net ΔV that a pure torque cannot make).
+
 The confidence is the fraction of the kind's supporting tests that pass, each test counting once,
 scaled into [0.5, 0.99]: it says how many independent pieces agree, not a calibrated probability.
 """

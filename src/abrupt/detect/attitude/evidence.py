@@ -630,10 +630,30 @@ def surface_evidence(sc: Spacecraft, dh_b: FloatArray, direction_sigma_rad: floa
     rn = np.einsum("ij,ij->i", pts, normals)
     incoming = (np.abs(rn) > 1e-9) | (np.einsum("ij,ij->i", p0, normals) < 0)
     m = sc.mass_kg
+    # The farthest surface point is a corner (the samples are cell centres, up to ~3 % nearer).
+    r_max = max(float(r.max()), _farthest_corner_m(sc))
     return {
         "surface_fraction": float(np.mean(perp & incoming)),
-        "min_dv_mps": float(mag / (m * float(r.max()))) if math.isfinite(m) and m > 0 else NAN,
+        "min_dv_mps": float(mag / (m * r_max)) if math.isfinite(m) and m > 0 else NAN,
     }
+
+
+def _farthest_corner_m(sc: Spacecraft) -> float:
+    """The largest distance [m] of a surface corner from the centre of mass (boxes: 8 corners; panels: 4)."""
+    best = 0.0
+    for s in sc.surfaces:
+        c, size = np.asarray(s.center_m, float), np.asarray(s.size_m, float)
+        signs = np.array([[i, j, k] for i in (-0.5, 0.5) for j in (-0.5, 0.5) for k in (-0.5, 0.5)])
+        if s.shape == "box":
+            corners = c + signs * size
+        else:
+            n = np.asarray(s.normal if s.normal is not None else [0, 0, 1], float)
+            n = n / np.linalg.norm(n)
+            ua = np.asarray(s.u_axis if s.u_axis is not None else np.cross(n, [1.0, 0, 0]), float)
+            ua = ua / np.linalg.norm(ua)
+            corners = c + np.outer(signs[::2, 0] * size[0], ua) + np.outer(signs[::2, 1] * size[1], np.cross(n, ua))
+        best = max(best, float(np.linalg.norm(corners, axis=1).max()))
+    return best
 
 
 def _surface_points(sc: Spacecraft, per_side: int = 12) -> tuple[FloatArray, FloatArray]:
