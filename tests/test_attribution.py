@@ -305,7 +305,7 @@ def test_cli_draws_confounders_injects_them_and_detect_writes_their_class(
               "--confounders-file", str(plan), "--out-store", str(out_store)])  # fmt: skip
     events = tmp_path / "ev.csv"
     cli_main(["detect", "attitude", "--store", str(out_store), "--spacecraft", str(a.spacecraft),  # type: ignore[attr-defined]
-              "--out", str(events)])  # fmt: skip
+              "--out", str(events), "--catalog", str(tmp_path / "cat.sqlite")])  # fmt: skip
     ev = pd.read_csv(events)
     t = pd.to_datetime(ev["time_utc"].str.rstrip("Z"))
     at_jump = ev[(t - pd.Timestamp(t_jump)).abs() < pd.Timedelta(seconds=30)]
