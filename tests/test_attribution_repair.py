@@ -223,7 +223,7 @@ def test_a_strike_covered_by_a_wheel_glitchs_event_is_found_after_the_wheel_is_r
     assert len(peaks) == 1
     first = classify(ev[peaks[0][1].time_ns])
     assert (first.kind, first.channel) == ("sensor_fault", "wheel_2")
-    found, found_ev = rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)
+    found, found_ev, _ = rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)
     assert len(found) == 1
     _, p = found[0]
     assert abs(p.time_ns / NS - 1240) <= 3
@@ -251,7 +251,7 @@ def test_a_strike_after_a_large_gyro_bias_step_is_found_beside_what_the_repair_l
     ev = {p.time_ns: event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n) for _, p in peaks}
     first = classify(ev[peaks[0][1].time_ns])
     assert (first.kind, first.channel) == ("sensor_fault", "gyro_x"), first
-    found, found_ev = rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)
+    found, found_ev, _ = rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)
     strikes = [p for _, p in found if classify(found_ev[p.time_ns]).kind == "strike"]
     assert len(strikes) == 1, [(p.time_ns / NS, classify(found_ev[p.time_ns])) for _, p in found]
     p = strikes[0]
