@@ -96,6 +96,9 @@ RESCAN_APART_S = 10.0
 #: and how far beyond its noise the ramp must be to have a direction [σ].
 RAMP_WINDOW_S = 600.0
 RAMP_SIGMA_MIN = 5.0
+#: The running median [s] that takes a torque's signal out along its body direction (a venting pulse train's
+#: steps 5-60 s apart, a leak's ramp: each followed; the white noise left).
+TORQUE_MEDIAN_S = 61.0
 
 
 def _rows(table: Timetable, a: int, b: int) -> Timetable:
@@ -167,8 +170,9 @@ def _to_inertial(h_N: FloatArray, y_B: FloatArray, q_BN: FloatArray) -> FloatArr
 def _off_ramp(
     table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int, fits: WindowFits | None = None
 ) -> FloatArray | None:
-    """Cleaned ᴺH over rows [a, b) with the component along the body direction of the ramp or sequence
-    around row ``i0`` removed, or None when the window needs no ramp. A leak or a venting sequence keeps
+    """Cleaned ᴺH over rows [a, b) with the signal along the body direction of the ramp or sequence around
+    row ``i0`` removed (its running median over ``TORQUE_MEDIAN_S``; the noise along it stays), or None
+    when the window needs no ramp. A leak or a venting sequence keeps
     one body direction; what steps off it is a second source. The direction is that of the event's own
     step when other impulses share it (a venting train:
     :func:`~abrupt.detect.attitude.ramp_step.step_siblings`), else the ramp's
@@ -187,7 +191,14 @@ def _off_ramp(
         u_b = fit.ramp_B / float(np.linalg.norm(fit.ramp_B))
     q = table.quaternion_BN[a:b]
     y_b = body_frame_momentum(cleaned_H_N[a:b], q)
-    return _to_inertial(cleaned_H_N[a:b], y_b - (y_b @ u_b)[:, None] * u_b, q)
+    # The torque's signal along its direction is taken out and the noise there kept: a running median
+    # follows a ramp or a staircase of one sign (a monotone signal is its own median) and leaves the noise.
+    # Projecting the direction out left the statistic's pre-window covariance nearly singular along it: on
+    # quiet archive stretches its peaks doubled (4.7 → 10-12, above the run's threshold of 6.4), and tiny
+    # wobbles (0.001 N·m·s) became "strikes" inside torques.
+    k = max(3, round(TORQUE_MEDIAN_S / table.dt_s)) | 1
+    along = pd.Series(y_b @ u_b).rolling(k, center=True, min_periods=1).median().to_numpy()
+    return _to_inertial(cleaned_H_N[a:b], y_b - along[:, None] * u_b, q)
 
 
 #: The ramp beside a strike may be a leak as long as the window allows (a ramp starts in the window's middle
