@@ -29,6 +29,8 @@ from abrupt.types import FloatArray
 NAN = float("nan")
 #: The body moved when its share is beyond this many σ of its noise (the rules' ``body_sigma``).
 BODY_SIGMA = 5.0
+#: The body's response to an impulse is looked for up to this long after it [s] (the evidence's window).
+RESPONSE_S = 20.0
 
 
 def hamilton_product(p: FloatArray, q: FloatArray) -> FloatArray:
@@ -128,7 +130,11 @@ def moved_siblings(
 ) -> tuple[int, int]:
     """(moved, still): of the sharp siblings of ``fit`` (the event's window fit at row ``i0``), how many the
     body felt (:func:`body_share` along the sibling's own body direction beyond ``sigma`` σ of its noise)
-    and how many it did not (a one-channel fault's step, or a pulse too small for the body's noise)."""
+    and how many it did not (a one-channel fault's step, or a pulse too small for the body's noise).
+
+    The response of a sibling before the event is looked for up to 3 s before the event (an impulse's
+    share peaks at once; the event's own response, along nearly the same direction, must not count as
+    the sibling's)."""
     if fit is None or fit.other_B is None or not fit.sharp:
         return 0, 0
     g = table.time_ns
@@ -138,7 +144,8 @@ def moved_siblings(
             continue
         mag = float(np.linalg.norm(p_b))
         k = int(np.clip(np.searchsorted(g, int(g[i0]) + round(tau_s * NS)), 0, g.size - 1))
-        share, sig, _ = body_share(table, J, k, p_b / mag, mag) if mag > 0 else (NAN, NAN, NAN)
+        until = min(RESPONSE_S, -tau_s - 3.0) if tau_s < 0 else RESPONSE_S
+        share, sig, _ = body_share(table, J, k, p_b / mag, mag, response_s=until) if mag > 0 else (NAN, NAN, NAN)
         if math.isfinite(share) and math.isfinite(sig) and share > 0 and share >= sigma * sig:
             moved += 1
         else:
