@@ -149,18 +149,23 @@ def closed_loop_table(
     dh_b: np.ndarray,
     leak: tuple[int, int] = (0, 0),
     torque_b: np.ndarray | None = None,
+    more: tuple[tuple[int, np.ndarray], ...] = (),
 ) -> Timetable:
     """3000 s of a body turning slowly, its wheels (minimum-norm, plus a null-space offset) holding ᴺH,
     and an external impulse ΔH_B at ``strike_at``: the body takes it first (Δω₀ = J⁻¹ ΔH_B, decaying
     as (1 − τ/τ_c) e^(−τ/τ_c), τ_c = 10 s) and the wheels the rest; total ᴺH steps by [NB] ΔH_B. With
     ``torque_b``, a body-fixed torque over ``leak`` [s] too (a slow ramp the loop keeps up with: the
-    wheels take it), so total ᴺH also ramps by Σ [NB] τ_B dt."""
+    wheels take it), so total ᴺH also ramps by Σ [NB] τ_B dt; ``more``: further impulses (time [s],
+    ΔH_B), each with the same response (the loop is linear: the responses add)."""
     sc = load_spacecraft(KESTREL)
     j = np.asarray(sc.inertia_kgm2, float)
     n = 3000
-    tau = np.arange(n) - strike_at
-    f = np.where(tau >= 0, (1 - tau / 10.0) * np.exp(-np.clip(tau, 0, None) / 10.0), 0.0)
-    omega = np.array([1e-4, -1.0e-3, 5e-5]) + np.outer(f, np.linalg.solve(j, dh_b))
+    impulses = ((strike_at, dh_b), *more)
+    omega = np.tile([1e-4, -1.0e-3, 5e-5], (n, 1))
+    for at, dh in impulses:
+        tau = np.arange(n) - at
+        f = np.where(tau >= 0, (1 - tau / 10.0) * np.exp(-np.clip(tau, 0, None) / 10.0), 0.0)
+        omega = omega + np.outer(f, np.linalg.solve(j, dh))
     rot, quats = Rotation.identity(), []
     for k in range(n):
         quats.append(rot.as_quat())
@@ -170,7 +175,8 @@ def closed_loop_table(
     on = ((np.arange(n) >= leak[0]) & (np.arange(n) < leak[1])).astype(float)
     tq = np.zeros(3) if torque_b is None else torque_b
     h_n = np.array([3.0, -2.0, 1.0]) + np.cumsum(on[:, None] * np.einsum("nji,j->ni", bn, tq), axis=0)
-    h_n[strike_at:] += bn[strike_at].T @ dh_b
+    for at, dh in impulses:
+        h_n[at:] += bn[at].T @ dh
     h_w = np.einsum("nij,nj->ni", bn, h_n) - omega @ j.T
     js_g = sc.wheel_axes * sc.wheel_spin_inertias_kgm2[None, :]
     wheels = h_w @ np.linalg.pinv(js_g).T + 150.0 * np.array([1, -1, 1, -1]) * 2 * np.pi / 60
@@ -217,7 +223,7 @@ def test_a_strike_covered_by_a_wheel_glitchs_event_is_found_after_the_wheel_is_r
     assert len(peaks) == 1
     first = classify(ev[peaks[0][1].time_ns])
     assert (first.kind, first.channel) == ("sensor_fault", "wheel_2")
-    found, found_ev = rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)
+    found, found_ev, _ = rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)
     assert len(found) == 1
     _, p = found[0]
     assert abs(p.time_ns / NS - 1240) <= 3
@@ -245,7 +251,7 @@ def test_a_strike_after_a_large_gyro_bias_step_is_found_beside_what_the_repair_l
     ev = {p.time_ns: event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n) for _, p in peaks}
     first = classify(ev[peaks[0][1].time_ns])
     assert (first.kind, first.channel) == ("sensor_fault", "gyro_x"), first
-    found, found_ev = rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)
+    found, found_ev, _ = rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)
     strikes = [p for _, p in found if classify(found_ev[p.time_ns]).kind == "strike"]
     assert len(strikes) == 1, [(p.time_ns / NS, classify(found_ev[p.time_ns])) for _, p in found]
     p = strikes[0]

@@ -174,7 +174,7 @@ def test_a_leak_hidden_by_a_strike_40_s_after_its_onset_gets_an_event_of_its_own
     assert len(peaks) == 1 and abs(peaks[0][1].time_ns / NS - 1240) <= 3
     ev = {p.time_ns: event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n) for _, p in peaks}
     assert classify(ev[peaks[0][1].time_ns]).kind == "strike"
-    found, found_ev = rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)
+    found, found_ev, _ = rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)
     assert len(found) == 1
     _, p = found[0]
     assert abs(p.time_ns / NS - 1200) <= 15  # at the leak's onset
@@ -229,7 +229,7 @@ def test_a_long_leak_hidden_by_a_strike_gets_its_event_at_its_onset() -> None:
         assert len(strikes) == 1
         ev = {p.time_ns: event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n) for _, p in peaks}
         assert classify(ev[strikes[0].time_ns]).kind == "strike"
-        found, found_ev = rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)
+        found, found_ev, _ = rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)
         beside = [p for _, p in found if found_ev[p.time_ns].after_strike_s == (p.time_ns - strikes[0].time_ns) / NS]
         assert len(beside) == 1, (seed, duration)
         p = beside[0]

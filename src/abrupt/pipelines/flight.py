@@ -256,11 +256,8 @@ def chunk_margin_s(spacecraft: Spacecraft, config: FlightRunConfig) -> float:
     the slew mask on half its nominal-rate window; Savitzky-Golay on half its window.
     """
     c = config.cleaning
-    period = (
-        config.orbit_period_s
-        if config.orbit_period_s is not None
-        else (spacecraft.orbit.period_s if spacecraft.orbit is not None else 0.0)
-    )
+    orbit = spacecraft.orbit.period_s if spacecraft.orbit is not None else 0.0
+    period = config.orbit_period_s if config.orbit_period_s is not None else orbit
     fit = (c.spacing_orbits + c.half_width_orbits) * period if (c.comb or c.trend) else 0.0
     span = 2 * config.window_s + config.guard_s
     per_pass = fit + 2 * span
@@ -292,6 +289,7 @@ class ChunkResult:
     series: dict[str, np.ndarray] | None = None
     evidence: dict[int, EventEvidence] = field(default_factory=dict)
     faults: FaultScan = field(default_factory=lambda: FaultScan([], []))
+    rescan_merged: int = 0
 
 
 def process_chunk(
@@ -434,7 +432,7 @@ def process_span(
         t: event_evidence(table, hc, spacecraft, t, pk.dH_N_Nms, inertia_kgm2=inertia_kgm2, raw_H_N=h_n, fits=fits[t])
         for t, pk in above.items()
     }
-    found, found_ev = rescan_after_faults(
+    found, found_ev, merged = rescan_after_faults(
         table, spacecraft, h_n, hc, ok, detector, peaks, evidence, config.evidence_floor, core, inertia_kgm2, fits=fits
     )
     peaks, evidence = peaks + found, {**evidence, **found_ev}
@@ -476,6 +474,7 @@ def process_span(
                 series=series,
                 evidence={t: e for t, e in evidence.items() if p0 <= t < p1},
                 faults=faults.within(p0, p1),
+                rescan_merged=merged if p0 == start_ns else 0,
             )
         )
     return out
@@ -548,12 +547,8 @@ def run_flight(
     if spacecraft.orbit is None and config.orbit_period_s is None and (c.comb or c.trend):
         # One period for the whole run (from its first day), so that every chunk uses the same one.
         d0 = int(np.datetime64(day_list[0], "D").astype("datetime64[ns]").astype(np.int64))
-        samples = store.read_range(
-            spacecraft.name,
-            np.datetime64(d0, "ns"),
-            np.datetime64(d0 + DAY_NS, "ns"),
-            flight_channels(spacecraft).mnemonics,
-        )
+        first_day = (np.datetime64(d0, "ns"), np.datetime64(d0 + DAY_NS, "ns"))
+        samples = store.read_range(spacecraft.name, *first_day, flight_channels(spacecraft).mnemonics)
         table = build_timetable(
             samples, flight_channels(spacecraft), tuple(a.name for a in spacecraft.appendages), d0, d0 + DAY_NS
         )
@@ -604,6 +599,8 @@ def run_flight(
     events = attribute_events(events, {t: e for r in chunks for t, e in r.evidence.items()})
     events = merge_fault_findings(events, [f for r in chunks for f in r.faults.findings], spacecraft.name, run_id,
                                   cfg_hash, warnings)  # fmt: skip
+    if merged := sum(r.rescan_merged for r in chunks):
+        warnings.append(f"{merged} peak(s) found by two rescans (or twice by one) merged into the strongest")
     daily = daily_table(chunks, events, threshold)
     return FlightResult(events, threshold, daily, peaks, chunks if keep_series else [], run_id, cfg_hash, warnings)
 

@@ -18,7 +18,8 @@ repaired, since the torque is real; the ramp's body direction is taken out of �
 evidence says strike (an impulsive step off the torque's direction), not another piece of the torque.
 Around a strike whose window also holds a ramp (a leak beside it: one event, at the larger step), the
 strike's fitted step is taken out and the rest rescanned: a peak there is kept when its evidence is an
-external torque's, so the leak gets an event of its own.
+external torque's, so the leak gets an event of its own. No rescan looks at a step the detector already
+has, and a step found by several rescans is one new peak (:func:`merge_found`).
 """
 
 from __future__ import annotations
@@ -95,6 +96,9 @@ RESCAN_APART_S = 10.0
 #: and how far beyond its noise the ramp must be to have a direction [σ].
 RAMP_WINDOW_S = 600.0
 RAMP_SIGMA_MIN = 5.0
+#: The running median [s] that takes a torque's signal out along its body direction (a venting pulse train's
+#: steps 5-60 s apart, a leak's ramp: each followed; the white noise left).
+TORQUE_MEDIAN_S = 61.0
 
 
 def _rows(table: Timetable, a: int, b: int) -> Timetable:
@@ -166,8 +170,9 @@ def _to_inertial(h_N: FloatArray, y_B: FloatArray, q_BN: FloatArray) -> FloatArr
 def _off_ramp(
     table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int, fits: WindowFits | None = None
 ) -> FloatArray | None:
-    """Cleaned ᴺH over rows [a, b) with the component along the body direction of the ramp or sequence
-    around row ``i0`` removed, or None when the window needs no ramp. A leak or a venting sequence keeps
+    """Cleaned ᴺH over rows [a, b) with the signal along the body direction of the ramp or sequence around
+    row ``i0`` removed (its running median over ``TORQUE_MEDIAN_S``; the noise along it stays), or None
+    when the window needs no ramp. A leak or a venting sequence keeps
     one body direction; what steps off it is a second source. The direction is that of the event's own
     step when other impulses share it (a venting train:
     :func:`~abrupt.detect.attitude.ramp_step.step_siblings`), else the ramp's
@@ -186,7 +191,14 @@ def _off_ramp(
         u_b = fit.ramp_B / float(np.linalg.norm(fit.ramp_B))
     q = table.quaternion_BN[a:b]
     y_b = body_frame_momentum(cleaned_H_N[a:b], q)
-    return _to_inertial(cleaned_H_N[a:b], y_b - (y_b @ u_b)[:, None] * u_b, q)
+    # The torque's signal along its direction is taken out and the noise there kept: a running median
+    # follows a ramp or a staircase of one sign (a monotone signal is its own median) and leaves the noise.
+    # Projecting the direction out left the statistic's pre-window covariance nearly singular along it: on
+    # quiet archive stretches its peaks doubled (4.7 → 10-12, above the run's threshold of 6.4), and tiny
+    # wobbles (0.001 N·m·s) became "strikes" inside torques.
+    k = max(3, round(TORQUE_MEDIAN_S / table.dt_s)) | 1
+    along = pd.Series(y_b @ u_b).rolling(k, center=True, min_periods=1).median().to_numpy()
+    return _to_inertial(cleaned_H_N[a:b], y_b - along[:, None] * u_b, q)
 
 
 #: The ramp beside a strike may be a leak as long as the window allows (a ramp starts in the window's middle
@@ -233,8 +245,9 @@ def rescan_after_faults(
     inertia_kgm2: FloatArray | None = None,
     rules: AttributionRules | None = None,
     fits: Mapping[int, WindowFits] | None = None,
-) -> tuple[list[tuple[int, Peak]], dict[int, EventEvidence]]:
-    """New peaks (above ``floor``) and their evidence found after repairing each sensor fault's channel.
+) -> tuple[list[tuple[int, Peak]], dict[int, EventEvidence], int]:
+    """New peaks (above ``floor``), their evidence and how many found twice were merged, found after
+    repairing each sensor fault's channel.
 
     For every peak whose evidence the rules call a ``sensor_fault`` with a channel that has a repair
     model, the channel is corrected, ᴺH recomputed (the cleaning's slow model is kept: cleaned ᴺH moves
@@ -248,12 +261,15 @@ def rescan_after_faults(
     (:func:`_torque_beside_strike`): a peak there is kept when its evidence is an external torque's.
     ``fits``: each peak's :func:`~abrupt.detect.attitude.evidence.profile_fits` as its evidence made
     them (by peak time).
+
+    No rescan looks within ``RESCAN_APART_S`` of a peak of ``peaks`` (the detector has that step already),
+    and one step found by several rescans (a strike between two faults' events, each repaired in turn) is
+    one new peak, the strongest (:func:`merge_found`); the third value counts the others.
     """
     g = table.time_ns
     dt = table.dt_s
     win = detector.windows(dt)
-    found: list[tuple[int, Peak]] = []
-    found_ev: dict[int, EventEvidence] = {}
+    found: list[tuple[int, Peak, EventEvidence]] = []
     half_s = RESCAN_SPAN_S[1] + win.span * dt
     others = tuple((int(p.time_ns), RESCAN_APART_S, RESCAN_APART_S) for _, p in peaks)
     for i_pk, pk in peaks:
@@ -286,8 +302,7 @@ def rescan_after_faults(
             # Only an impulse of its own is a second source; another piece of the same torque adds nothing.
             if classify(ev_new, rules).kind != "strike":
                 continue
-            found.append((a + j, p))
-            found_ev[p.time_ns] = replace(ev_new, after_torque_s=(p.time_ns - pk.time_ns) / NS)
+            found.append((a + j, p, replace(ev_new, after_torque_s=(p.time_ns - pk.time_ns) / NS)))
             continue
         if a_.kind == "strike":
             got = _torque_beside_strike(
@@ -295,8 +310,7 @@ def rescan_after_faults(
                 inertia_kgm2, rules, None if fits is None else fits.get(pk.time_ns),
             )  # fmt: skip
             if got is not None:
-                found.append(got[0])
-                found_ev[got[0][1].time_ns] = got[1]
+                found.append((*got[0], got[1]))
             continue
         if a_.kind != "sensor_fault" or not a_.channel:
             continue
@@ -305,7 +319,7 @@ def rescan_after_faults(
             continue
         h_new, _ = timetable_momentum(spacecraft, _rows(rep.table, a, b), inertia_kgm2)
         hc_sub = np.where(ok[a:b, None], cleaned_H_N[a:b] + (h_new - raw_H_N[a:b]), np.nan)
-        best = _best_peak(detector, hc_sub, ok[a:b], g[a:b], dt, pk.time_ns, floor, keep_sub)
+        best = _best_peak(detector, hc_sub, ok[a:b], g[a:b], dt, pk.time_ns, floor, keep_sub, None, others)
         if best is None:
             continue
         j, p = best
@@ -313,12 +327,25 @@ def rescan_after_faults(
         hc_full[a:b] = hc_sub
         raw_full = raw_H_N.copy()
         raw_full[a:b] = h_new
-        found.append((a + j, p))
         ev_new = event_evidence(
             rep.table, hc_full, spacecraft, p.time_ns, p.dH_N_Nms, inertia_kgm2=inertia_kgm2, raw_H_N=raw_full
         )
-        found_ev[p.time_ns] = replace(ev_new, after_fault_s=(p.time_ns - pk.time_ns) / NS)
-    return found, found_ev
+        found.append((a + j, p, replace(ev_new, after_fault_s=(p.time_ns - pk.time_ns) / NS)))
+    return merge_found(found)
+
+
+def merge_found(
+    found: list[tuple[int, Peak, EventEvidence]], resolution_s: float = RESCAN_APART_S
+) -> tuple[list[tuple[int, Peak]], dict[int, EventEvidence], int]:
+    """The rescans' (row, peak, evidence) one per step: of peaks within ``resolution_s`` of each other (the
+    rescans' own resolution: nearer steps cannot be told apart), the strongest with its own evidence; the
+    peaks by time, their evidence by peak time, and how many were merged into a stronger one."""
+    kept: list[tuple[int, Peak, EventEvidence]] = []
+    for j, p, ev in sorted(found, key=lambda c: -c[1].value):
+        if not any(abs(p.time_ns - q.time_ns) <= resolution_s * NS for _, q, _ in kept):
+            kept.append((j, p, ev))
+    kept.sort(key=lambda c: c[1].time_ns)
+    return [(j, p) for j, p, _ in kept], {p.time_ns: ev for _, p, ev in kept}, len(found) - len(kept)
 
 
 def _torque_beside_strike(

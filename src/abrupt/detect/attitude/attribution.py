@@ -18,8 +18,9 @@ The rules read the evidence of :mod:`abrupt.detect.attitude.evidence`; none is f
    (null-space part, or one wheel carrying it);
 4. **strike** when the sensors agree, the body took the impulse first (body share), the step lasts,
    is in the momentum before cleaning too (``raw_step_fraction``) and is impulsive (its duration
-   interval reaches below ``impulsive_s``) and no other impulse of the window shares its body direction
-   (a venting train's pulse has such siblings); or (4b, only with ``step_on_ramp``, off by default),
+   interval reaches below ``impulsive_s``) and no other impulse of the window that moved the body shares
+   its body direction (a venting train's pulse has such siblings; a wheel reading's glitch or miscount
+   beside a strike is none); or (4b, only with ``step_on_ramp``, off by default),
    inside a ramp or a sequence, the step at the event is impulsive and off the ramp's body direction;
    or (4c, ``step_alone``, on), inside a ramp or a sequence, no other step of the window shares the
    event's step's body direction (:func:`abrupt.detect.attitude.ramp_step.step_siblings`) and that

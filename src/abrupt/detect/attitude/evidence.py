@@ -48,7 +48,10 @@ telemetry (:class:`~abrupt.series.timetable.Timetable`) around the event:
   momentum in body axes fitted by the step at the event plus every other step of the window, found one
   at a time (:func:`abrupt.detect.attitude.ramp_step.step_siblings`); the number of those others
   within 30° of the event's body direction (a venting sequence's pulses, a leak's ramp: > 0), and of
-  those the impulses (``step_sharp_siblings``: a venting sequence's pulses); ``alone_step_lasting``: what
+  those the impulses that moved the body (``step_sharp_siblings``: a venting sequence's pulses; the body's
+  share along the sibling's own direction, :func:`abrupt.detect.attitude.body_response.moved_siblings`),
+  the impulses it did not feel (``step_still_siblings``: a wheel reading's glitch or miscount, a gyro or
+  star-tracker fault, all left out of ``step_siblings``); ``alone_step_lasting``: what
   lasts of that fitted step (with the other steps within 150 s after it that point back against it)
   along itself over |ΔH|, judged beside the window's other steps rather than on the raw balance.
 """
@@ -63,6 +66,13 @@ import numpy as np
 from scipy.ndimage import median_filter
 
 from abrupt.clean.flight_masks import tracker_rate_rad_s
+from abrupt.detect.attitude.body_response import (
+    body_share,
+    hamilton_product,
+    moved_siblings,
+    white_noise_sigma,
+)
+from abrupt.detect.attitude.body_response import window_rows as _idx
 from abrupt.detect.attitude.ramp_step import (
     WindowFits,
     body_frame_momentum,
@@ -123,26 +133,12 @@ class EventEvidence:
     alone_step_z: float = NAN
     step_siblings: float = NAN
     step_sharp_siblings: float = NAN
+    step_still_siblings: float = NAN
     alone_step_lasting: float = NAN
     after_strike_s: float = NAN
 
     def as_dict(self) -> dict[str, float]:
         return {f"ev_{k}": float(v) for k, v in asdict(self).items()}
-
-
-def hamilton_product(p: FloatArray, q: FloatArray) -> FloatArray:
-    """Hamilton product p ⊗ q, scalar first (the convention of q_BN in the flight archives)."""
-    p0, p1, p2, p3 = np.moveaxis(p, -1, 0)
-    q0, q1, q2, q3 = np.moveaxis(q, -1, 0)
-    return np.stack(
-        [
-            p0 * q0 - p1 * q1 - p2 * q2 - p3 * q3,
-            p0 * q1 + p1 * q0 + p2 * q3 - p3 * q2,
-            p0 * q2 - p1 * q3 + p2 * q0 + p3 * q1,
-            p0 * q3 + p1 * q2 - p2 * q1 + p3 * q0,
-        ],
-        axis=-1,
-    )
 
 
 def st_gyro_mismatch(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> FloatArray:
@@ -188,14 +184,6 @@ def _line(tau: FloatArray, y: FloatArray) -> tuple[FloatArray, FloatArray, Float
     res = y - a_mat @ coef
     dof = max(tau.size - 2, 1)
     return coef[0], coef[1], np.sqrt(np.sum(res**2, axis=0) / dof)
-
-
-def white_noise_sigma(y: FloatArray) -> float:
-    """Robust white-noise σ from first differences (MAD / 0.6745 / √2)."""
-    d = np.diff(y[np.isfinite(y)])
-    if d.size < 4:
-        return NAN
-    return float(np.median(np.abs(d - np.median(d))) / 0.6745 / math.sqrt(2.0))
 
 
 def ramp_duration(tau_s: FloatArray, y: FloatArray, sigma: float) -> tuple[float, float, float, float]:
@@ -259,12 +247,6 @@ class EvidenceWindows:
     ramp_min_s: float = 8.0
 
 
-def _idx(g: np.ndarray, i0: int, a_s: float, b_s: float, dt: float) -> np.ndarray:
-    lo = max(0, i0 + round(a_s / dt))
-    hi = min(g.size, i0 + round(b_s / dt) + 1)
-    return np.arange(lo, hi)
-
-
 def profile_fits(
     table: Timetable, cleaned_H_N: FloatArray, time_ns: int, windows: EvidenceWindows | None = None
 ) -> WindowFits:
@@ -313,28 +295,11 @@ def event_evidence(
     omega = table.body_rate_rad_s
     pre = _idx(g, i0, -w.pre_s, -w.guard_s, dt)
     pre = pre[valid[pre]]
-    # The body's rate just before the event is the baseline: a gyro bias that stepped a minute earlier
-    # (or a slow drift) must not count as the body's response.
-    base = _idx(g, i0, -w.baseline_s, -2.0, dt)
-    base = base[valid[base]]
-    resp = _idx(g, i0, -2.0, w.response_s, dt)
-    resp = resp[valid[resp]]
-    peak_rate = NAN
-    if base.size > 10 and resp.size > 3 and mag > 0:
-        d_om = omega[resp] - np.median(omega[base], axis=0)
-        proj = (d_om @ J.T) @ u_b
-        proj = np.convolve(proj, np.ones(3) / 3.0, mode="same")
-        share = float(np.max(proj) / mag)
-        # The same from the star tracker's rate: real motion shows in both attitude sensors, a spike of
-        # one sensor's reading in one only, so the body share is the smaller of the two.
-        w_st = _st_rate(q, base, resp)
-        if w_st is not None:
-            p_st = np.convolve((w_st @ J.T) @ u_b, np.ones(3) / 3.0, mode="same")
-            share = min(share, float(np.max(p_st) / mag))
-        out["body_share"] = share
-        out["body_share_sigma"] = white_noise_sigma((omega[pre] @ J.T) @ u_b) / math.sqrt(3.0) / mag
-        # Real motion lasts the loop's settling time; a running median keeps it and drops a sensor spike.
-        peak_rate = float(np.max(np.linalg.norm(median_filter(d_om, size=(5, 1), mode="nearest"), axis=1)))
+    share, share_sigma, peak_rate = body_share(
+        table, J, i0, u_b, mag, pre_s=w.pre_s, guard_s=w.guard_s, baseline_s=w.baseline_s, response_s=w.response_s
+    )
+    if math.isfinite(share):
+        out["body_share"], out["body_share_sigma"] = share, share_sigma
     wheels = _wheel_evidence(table, spacecraft, i0, dt, w)
     hw = wheels.pop("_hw_B", None)
     out.update(wheels)
@@ -356,6 +321,11 @@ def event_evidence(
             out.update(ramp_step_evidence(fits.ramp(w.ramp_min_s), mag))
         if mag > 0:
             out.update(step_siblings_evidence(fits.siblings(), mag))
+            # A sibling is a momentum change of the body; a one-channel fault's step beside the event is none.
+            if "step_sharp_siblings" in out:
+                moved, still = moved_siblings(table, J, i0, fits.siblings())
+                out["step_sharp_siblings"], out["step_still_siblings"] = moved, still
+                out["step_siblings"] = float(out["step_siblings"]) - still
     out.update(_appendage(table, i0, dt))
     out.update(surface_evidence(spacecraft, dh_b))
     if raw_H_N is not None and mag > 0:
@@ -367,26 +337,6 @@ def event_evidence(
             out["raw_step_fraction"] = float(step @ (dh_n / mag) / mag)
     typed: dict[str, Any] = {k: (int(v) if k.endswith(("_axis", "_index")) else float(v)) for k, v in out.items()}
     return EventEvidence(**typed)
-
-
-def _st_rate(q: FloatArray, base: np.ndarray, resp: np.ndarray) -> FloatArray | None:
-    """Body rate change [rad/s] from consecutive star-tracker attitudes over ``resp`` against ``base``."""
-    n = q.shape[0]
-    if base.size < 5 or resp.size < 3 or resp[-1] + 1 >= n or np.any(np.diff(resp) != 1):
-        return None
-
-    def rate(ix: np.ndarray) -> FloatArray:
-        a = q[ix] / np.linalg.norm(q[ix], axis=1, keepdims=True)
-        b = q[ix + 1] / np.linalg.norm(q[ix + 1], axis=1, keepdims=True)
-        d = hamilton_product(a * np.array([1.0, -1.0, -1.0, -1.0]), b)
-        d *= np.where(d[:, :1] < 0, -1.0, 1.0)
-        return np.asarray(2.0 * d[:, 1:], dtype=np.float64)
-
-    base = base[base + 1 < n]
-    w_b, w_r = rate(base), rate(resp)
-    if not (np.isfinite(w_b).all() and np.isfinite(w_r).all()):
-        return None
-    return np.asarray(w_r - np.median(w_b, axis=0), dtype=np.float64)
 
 
 def _wheel_takeup_B(

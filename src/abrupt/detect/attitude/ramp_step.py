@@ -190,6 +190,8 @@ class StepSiblings:
     #: ``sibling_deg`` of −Ŝ): the part of a pulse that returns. S plus this is what lasts of the event's step
     #: once the window's other steps (a venting train, a ramp cut into steps) are fitted beside it.
     returns_B: FloatArray | None = None
+    #: Per other step (in the order of ``other_tau_s``): is it a sharp sibling?
+    sharp: tuple[bool, ...] = ()
 
 
 def step_siblings(
@@ -278,6 +280,7 @@ def step_siblings(
         other_B=others,
         sharp_siblings=int(np.sum(parallel & sharp.astype(bool))),
         returns_B=np.sum(others[back], axis=0) if back.any() else np.zeros(3),
+        sharp=tuple(bool(x) for x in parallel & sharp.astype(bool)),
     )
 
 

@@ -1,0 +1,101 @@
+"""A sibling of a strike must have moved the body: a wheel-reading fault beside a strike is no venting pulse.
+
+Truths used: a closed-loop body (tests/test_attribution_repair.py) whose total ᴺH steps by exactly the
+impulses put in and whose rates respond to them; a wheel reading's fault added to the telemetry
+afterwards changes no momentum and moves neither attitude sensor (the body did not move, by
+construction); the step sizes, directions and times put in.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from abrupt.detect.attitude.attribution import classify
+from abrupt.detect.attitude.body_response import body_share, moved_siblings
+from abrupt.detect.attitude.evidence import event_evidence
+from abrupt.detect.attitude.ramp_step import body_frame_momentum, step_siblings
+from abrupt.model.spacecraft import load_spacecraft
+from abrupt.series.timetable import NS, Timetable
+from test_attribution_repair import closed_loop_table, glr_peaks
+
+ROOT = Path(__file__).resolve().parent.parent
+KESTREL = ROOT / "examples" / "spacecraft" / "kestrel.toml"
+WHEEL = 1  # wheel 2
+RPM = 2 * np.pi / 60  # [rad/s] per rpm
+PULSE = 2 * np.pi / 64  # [rad/s] one pulse of a 64-pulse tachometer over a 1-s gate
+
+
+def _wheel_direction() -> np.ndarray:
+    """The body direction along which wheel 2's reading moves ᴺH (its spin axis)."""
+    sc = load_spacecraft(KESTREL)
+    g = sc.wheel_axes[:, WHEEL]
+    return np.asarray(g / np.linalg.norm(g))
+
+
+def _fault(table: Timetable, kind: str, at: int = 1200) -> Timetable:
+    """Wheel 2's reading from ``at`` [s]: a 4-rpm glitch until 1500 s (0.05 N·m·s of apparent ᴺH, along the
+    strike) or a 40-pulse miscount of one sample."""
+    w = table.wheel_speed_rad_s.copy()
+    if kind == "wheel_speed_glitch":
+        w[at:1500, WHEEL] += 4 * RPM
+    else:
+        w[at, WHEEL] += 40 * PULSE
+    return replace(table, wheel_speed_rad_s=w)
+
+
+@pytest.mark.parametrize("before", [40, 15])
+@pytest.mark.parametrize("kind", ["wheel_speed_glitch", "tachometer_miscount"])
+@pytest.mark.parametrize("seed", [1, 2])
+def test_a_strike_after_a_wheel_reading_fault_along_it_is_a_strike(kind: str, seed: int, before: int) -> None:
+    """A 0.08 N·m·s strike at 1240 s along wheel 2's axis, the wheel's reading fault 40 or 15 s before: the
+    fault's step of ᴺH is sharp and along the strike, but the body never felt it (15 s before, the body's
+    response to the strike itself, along nearly the same direction, must not count as the fault's); the
+    event is a strike."""
+    sc = load_spacecraft(KESTREL)
+    table = closed_loop_table(np.random.default_rng(seed), 1240, 0.08 * _wheel_direction())
+    table = _fault(table, kind, 1240 - before)
+    h_n, hc, _, _, peaks = glr_peaks(sc, table)
+    strikes = [p for _, p in peaks if abs(p.time_ns / NS - 1240) <= 3]
+    assert len(strikes) == 1
+    ev = event_evidence(table, hc, sc, strikes[0].time_ns, strikes[0].dH_N_Nms, raw_H_N=h_n)
+    assert classify(ev).kind == "strike", ev
+    # The fault's step was found beside the strike, along it, and set aside: no body momentum change.
+    assert ev.step_still_siblings >= 1 and ev.step_sharp_siblings == 0
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_a_two_pulse_venting_sequence_is_still_a_sequence(seed: int) -> None:
+    """Two real impulses along one body direction, 0.04 N·m·s at 1200 s and 0.08 N·m·s at 1240 s: the first
+    moved the body, so the event is one of a sequence (``external_non_strike``)."""
+    sc = load_spacecraft(KESTREL)
+    u = _wheel_direction()
+    table = closed_loop_table(np.random.default_rng(seed), 1240, 0.08 * u, more=((1200, 0.04 * u),))
+    h_n, hc, _, _, peaks = glr_peaks(sc, table)
+    assert len(peaks) == 1 and abs(peaks[0][1].time_ns / NS - 1240) <= 3
+    p = peaks[0][1]
+    ev = event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n)
+    assert ev.step_sharp_siblings == 1 and ev.step_still_siblings == 0
+    assert classify(ev).kind == "external_non_strike"
+
+
+def test_the_body_share_of_a_real_impulse_is_beyond_its_noise_and_that_of_a_wheel_fault_is_not() -> None:
+    """Along the impulse's own direction the body's share peaks at (1 − τ/τ_c) e^(−τ/τ_c) of it at τ = 0 (1,
+    less the 3-sample mean and the rate sampling); a wheel reading's step of the same size moved nothing."""
+    sc = load_spacecraft(KESTREL)
+    j = np.asarray(sc.inertia_kgm2, float)
+    u = _wheel_direction()
+    table = _fault(closed_loop_table(np.random.default_rng(3), 1240, 0.08 * u), "wheel_speed_glitch")
+    share, sigma, _ = body_share(table, j, 1240, u, 0.08)
+    assert 0.5 < share <= 1.0 and share > 20 * sigma
+    share, sigma, _ = body_share(table, j, 1200, u, 0.05)
+    assert abs(share) < 5 * sigma
+    # The same, sibling by sibling, on the window's fit: the glitch's onset is sharp and still.
+    h_n = glr_peaks(sc, table)[0]
+    y = body_frame_momentum(h_n[640:1841], table.quaternion_BN[640:1841])
+    fit = step_siblings(np.arange(-600.0, 601.0), y, 0.0)
+    assert fit is not None and any(fit.sharp)
+    assert moved_siblings(table, j, 1240, fit) == (0, sum(fit.sharp))
