@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from threadpoolctl import threadpool_limits
 
 from abrupt.clean.comb import CombConfig, estimate_period, smooth_model
 from abrupt.clean.flight_masks import SlewMaskConfig, event_mask, flag_intervals, slew_mask
@@ -384,6 +385,7 @@ def _clean_and_scan(
     return hc, stat, info
 
 
+@threadpool_limits.wrap(limits=1, user_api="blas")  # small fits: threads only contend (docs/performance.md)
 def process_span(
     store: TelemetryStore,
     spacecraft: Spacecraft,
