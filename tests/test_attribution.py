@@ -20,6 +20,8 @@ from abrupt.cli.main import main as cli_main
 from abrupt.detect.attitude.attribution import classify
 from abrupt.detect.attitude.evidence import (
     EventEvidence,
+    EvidenceWindows,
+    _consistency,
     _sensor_residuals,
     _wheel_takeup_B,
     ramp_duration,
@@ -32,7 +34,7 @@ from abrupt.events import EVENT_KINDS
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import load_spacecraft
 from abrupt.pipelines.flight import CleaningConfig, FlightRunConfig, ingest_archives, process_chunk
-from abrupt.series.timetable import NS
+from abrupt.series.timetable import NS, Timetable
 from abrupt.simulate.confounders import Confounder, ConfounderRanges, draw_confounders, inject_confounders
 from abrupt.simulate.injection import InjectedStrike, inject_strikes
 from abrupt.store import TelemetryStore
@@ -98,6 +100,33 @@ def test_rate_mismatch_keeps_a_persistent_bias_linear_and_shows_a_jump_as_a_step
     # |θ × ω| ≈ 3e-5 rad/s that the two samples here leave at 1e-4 rad).
     np.testing.assert_allclose(e[152] - e[148], -jump, atol=1.5e-4)
     assert np.linalg.norm(e[152] - e[148] + jump) < 0.01 * np.linalg.norm(jump)
+
+
+def test_a_gyro_bias_step_is_named_by_the_axis_whose_slope_changed_not_by_the_noisiest_jump() -> None:
+    """E's slope changes on the biased axis only; its jump across the event is noise on every axis. The
+    channel (``st_gyro_axis``) must be the slope's axis: the repair corrects that gyro, and a strike a
+    minute after the bias step is found once it is. Star-tracker noise 20 times larger about z than about
+    x and y (a tracker's boresight) makes the jump's noisiest axis z, whatever the bias's axis."""
+    dt, n, i0 = 1.0, 400, 200
+    w = np.array([1e-4, -1.1e-3, 3e-4])
+    q_true = _spin(n, dt, w)
+    for axis in range(3):
+        for seed in range(4):
+            rng = np.random.default_rng(seed)
+            noise = rng.standard_normal((n, 3)) * np.array([2e-6, 2e-6, 4e-5])  # tracker angle noise [rad]
+            q = (
+                Rotation.from_quat(np.column_stack([q_true[:, 1:], q_true[:, 0]])) * Rotation.from_rotvec(noise)
+            ).as_quat()
+            omega = np.tile(w, (n, 1)) + 2e-6 * rng.standard_normal((n, 3))
+            omega[i0:, axis] += 2e-4  # the bias step
+            table = Timetable(
+                time_ns=np.arange(n, dtype=np.int64) * NS, quaternion_BN=q[:, [3, 0, 1, 2]], body_rate_rad_s=omega,
+                wheel_speed_rad_s=np.zeros((n, 4)), appendage_rate_rad_s=np.zeros((n, 0)), flags=np.zeros((n, 0)),
+                valid=np.ones(n, bool),
+            )  # fmt: skip
+            out, _, slope = _consistency(table, i0, dt, EvidenceWindows(), math.nan)
+            assert out["st_gyro_slope_rad_s"] > out["st_gyro_slope_limit_rad_s"]
+            assert out["st_gyro_axis"] == axis, (axis, seed, slope)
 
 
 def test_a_sensor_fault_explains_its_own_step_and_not_a_strike() -> None:

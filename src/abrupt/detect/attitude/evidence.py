@@ -455,13 +455,20 @@ def _consistency(
     step_sig = sig * lever * 2.0 * math.sqrt(1.0 / n_a + 1.0 / n_b)
     slope_sig = sig * math.sqrt(12.0 / n_a) / (n_a * dt) + sig * math.sqrt(12.0 / n_b) / (n_b * dt)
     timing = (peak_rate if math.isfinite(peak_rate) else 0.0) * w.timing_s
-    k = int(np.argmax(np.abs(step) / np.maximum(step_sig, 1e-12)))
+    step_limit = float(8.0 * np.linalg.norm(step_sig) + timing)
+    slope_limit = float(8.0 * np.linalg.norm(slope_sig) + timing / w.consistency_after_s[1])
+    # The axis of the larger change against its limit: a bias step's is its slope's (the jump's axis is
+    # then noise), a tracker jump's its step's.
+    if np.linalg.norm(slope) / max(slope_limit, 1e-300) >= np.linalg.norm(step) / max(step_limit, 1e-300):
+        k = int(np.argmax(np.abs(slope) / np.maximum(slope_sig, 1e-12)))
+    else:
+        k = int(np.argmax(np.abs(step) / np.maximum(step_sig, 1e-12)))
     return (
         {
             "st_gyro_step_rad": float(np.linalg.norm(step)),
-            "st_gyro_step_limit_rad": float(8.0 * np.linalg.norm(step_sig) + timing),
+            "st_gyro_step_limit_rad": step_limit,
             "st_gyro_slope_rad_s": float(np.linalg.norm(slope)),
-            "st_gyro_slope_limit_rad_s": float(8.0 * np.linalg.norm(slope_sig) + timing / w.consistency_after_s[1]),
+            "st_gyro_slope_limit_rad_s": slope_limit,
             "st_gyro_axis": k,
         },
         np.asarray(step, dtype=np.float64),
