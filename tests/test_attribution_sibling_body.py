@@ -99,3 +99,29 @@ def test_the_body_share_of_a_real_impulse_is_beyond_its_noise_and_that_of_a_whee
     fit = step_siblings(np.arange(-600.0, 601.0), y, 0.0)
     assert fit is not None and any(fit.sharp)
     assert moved_siblings(table, j, 1240, fit) == (0, sum(fit.sharp))
+
+
+@pytest.mark.parametrize("dt_s", [1.0, 0.2, 0.125])
+def test_the_body_share_is_the_same_at_every_telemetry_cadence(dt_s: float) -> None:
+    """A body at rest starts turning at Δω = J⁻¹ ΔH (no controller) at 120 s; the gyro reads Δω and the star
+    tracker's attitudes are the exact rotation. Both sensors show the whole impulse: the share is 1 at a
+    sample every second, every fifth and every eighth of a second (the tracker's rate is an angle over the
+    sampling interval, not over a second)."""
+    sc = load_spacecraft(KESTREL)
+    j = np.asarray(sc.inertia_kgm2, float)
+    dh = 0.08 * _wheel_direction()
+    dw = np.linalg.solve(j, dh)
+    n, i0 = round(240 / dt_s), round(120 / dt_s)
+    t_s = np.arange(n) * dt_s
+    rate = np.where(t_s[:, None] >= t_s[i0], dw, 0.0)
+    ang = np.linalg.norm(dw) * np.clip(t_s - t_s[i0], 0.0, None)  # about the fixed axis dw/|dw|
+    axis = dw / np.linalg.norm(dw)
+    q = np.column_stack([np.cos(ang / 2), np.outer(np.sin(ang / 2), axis)])
+    table = Timetable(
+        time_ns=np.round(t_s * NS).astype(np.int64), quaternion_BN=q, body_rate_rad_s=rate,
+        wheel_speed_rad_s=np.zeros((n, 4)), appendage_rate_rad_s=np.zeros((n, 0)), flags=np.zeros((n, 0)),
+        valid=np.ones(n, bool),
+    )  # fmt: skip
+    share, _, peak = body_share(table, j, i0, dh / 0.08, 0.08)
+    assert share == pytest.approx(1.0, rel=0.02)
+    assert peak == pytest.approx(np.linalg.norm(dw), rel=1e-6)

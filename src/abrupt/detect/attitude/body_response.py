@@ -22,6 +22,7 @@ import math
 import numpy as np
 from scipy.ndimage import median_filter
 
+from abrupt.clean.flight_masks import tracker_rate_rad_s
 from abrupt.detect.attitude.ramp_step import StepSiblings
 from abrupt.series.timetable import NS, Timetable
 from abrupt.types import FloatArray
@@ -63,21 +64,26 @@ def white_noise_sigma(y: FloatArray) -> float:
     return float(np.median(np.abs(d - np.median(d))) / 0.6745 / math.sqrt(2.0))
 
 
-def tracker_rate_change(q: FloatArray, base: np.ndarray, resp: np.ndarray) -> FloatArray | None:
-    """Body rate change [rad/s] from consecutive star-tracker attitudes over ``resp`` against ``base``."""
+def centred_tracker_rate(q_BN: FloatArray, dt_s: float) -> FloatArray:
+    """The star tracker's body rate [rad/s] at each sample: the mean of the rates of the intervals either
+    side (:func:`~abrupt.clean.flight_masks.tracker_rate_rad_s`), the end samples their one interval's."""
+    w = tracker_rate_rad_s(q_BN, dt_s)[:-1]
+    ref = np.empty((q_BN.shape[0], 3))
+    ref[1:-1] = 0.5 * (w[:-1] + w[1:])
+    ref[0], ref[-1] = w[0], w[-1]
+    return ref
+
+
+def tracker_rate_change(q: FloatArray, base: np.ndarray, resp: np.ndarray, dt_s: float) -> FloatArray | None:
+    """Body rate change [rad/s] from consecutive star-tracker attitudes (the rate of the interval after each
+    row, :func:`~abrupt.clean.flight_masks.tracker_rate_rad_s`) over ``resp`` against the median over ``base``."""
     n = q.shape[0]
     if base.size < 5 or resp.size < 3 or resp[-1] + 1 >= n or np.any(np.diff(resp) != 1):
         return None
-
-    def rate(ix: np.ndarray) -> FloatArray:
-        a = q[ix] / np.linalg.norm(q[ix], axis=1, keepdims=True)
-        b = q[ix + 1] / np.linalg.norm(q[ix + 1], axis=1, keepdims=True)
-        d = hamilton_product(a * np.array([1.0, -1.0, -1.0, -1.0]), b)
-        d *= np.where(d[:, :1] < 0, -1.0, 1.0)
-        return np.asarray(2.0 * d[:, 1:], dtype=np.float64)
-
     base = base[base + 1 < n]
-    w_b, w_r = rate(base), rate(resp)
+    lo, hi = int(min(base.min(), resp.min())), int(max(base.max(), resp.max())) + 2
+    w = tracker_rate_rad_s(q[lo:hi], dt_s)
+    w_b, w_r = w[base - lo], w[resp - lo]
     if not (np.isfinite(w_b).all() and np.isfinite(w_r).all()):
         return None
     return np.asarray(w_r - np.median(w_b, axis=0), dtype=np.float64)
@@ -117,7 +123,7 @@ def body_share(
     proj = np.convolve((d_om @ J.T) @ u_b, np.ones(3) / 3.0, mode="same")
     share = float(np.max(proj) / mag)
     # Real motion shows in both attitude sensors, a spike of one sensor's reading in one only.
-    w_st = tracker_rate_change(table.quaternion_BN, base, resp)
+    w_st = tracker_rate_change(table.quaternion_BN, base, resp, dt)
     if w_st is not None:
         share = min(share, float(np.max(np.convolve((w_st @ J.T) @ u_b, np.ones(3) / 3.0, mode="same")) / mag))
     sigma = white_noise_sigma((omega[pre] @ J.T) @ u_b) / math.sqrt(3.0) / mag

@@ -68,6 +68,7 @@ from scipy.ndimage import median_filter
 from abrupt.clean.flight_masks import tracker_rate_rad_s
 from abrupt.detect.attitude.body_response import (
     body_share,
+    centred_tracker_rate,
     hamilton_product,
     moved_siblings,
     white_noise_sigma,
@@ -488,15 +489,7 @@ def gyro_excursions(
     tracker jump leaves the gyro on its median, a gyro spike of up to five samples does neither.
     Returns (departure minus its median (n, 3) [rad/s], mask (n, 3)).
     """
-    n = q_BN.shape[0]
-    qn = q_BN / np.linalg.norm(q_BN, axis=1, keepdims=True)
-    d = hamilton_product(qn[:-1] * np.array([1.0, -1.0, -1.0, -1.0]), qn[1:])
-    d *= np.where(d[:, :1] < 0, -1.0, 1.0)
-    w_st = 2.0 * d[:, 1:] / dt
-    ref = np.empty((n, 3))
-    ref[1:-1] = 0.5 * (w_st[:-1] + w_st[1:])
-    ref[0], ref[-1] = w_st[0], w_st[-1]
-    err = omega_B - ref
+    err = omega_B - centred_tracker_rate(q_BN, dt)
     err = err - np.median(err, axis=0)
     sig_ref = np.median(np.abs(err), axis=0) / 0.6745
     r = omega_B - median_filter(omega_B, size=(11, 1), mode="nearest")

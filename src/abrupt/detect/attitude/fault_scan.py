@@ -47,7 +47,7 @@ import pandas as pd
 from scipy.ndimage import median_filter
 
 from abrupt.detect.attitude.attribution import AttributionRules
-from abrupt.detect.attitude.evidence import hamilton_product
+from abrupt.detect.attitude.body_response import centred_tracker_rate
 from abrupt.detect.attitude.window_stats import clusters, trimmed_threshold, window_difference
 from abrupt.model.flight_config import FlightConfig
 from abrupt.model.spacecraft import Spacecraft
@@ -204,13 +204,7 @@ def wheel_jump_statistic(speed_rad_s: FloatArray, quantum_rad_s: float = 0.0) ->
 def rate_difference(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:
     """(gyro − tracker rate, tracker rate) [rad/s] per sample and axis; the tracker's rate at sample k is
     the mean of 2 vec(q⁻¹ ⊗ q')/dt over the intervals either side."""
-    qn = q_BN / np.linalg.norm(q_BN, axis=1, keepdims=True)
-    d = hamilton_product(qn[:-1] * np.array([1.0, -1.0, -1.0, -1.0]), qn[1:])
-    d *= np.where(d[:, :1] < 0, -1.0, 1.0)
-    w_st = 2.0 * d[:, 1:] / dt
-    ref = np.empty_like(omega_B)
-    ref[1:-1] = 0.5 * (w_st[:-1] + w_st[1:])
-    ref[0], ref[-1] = w_st[0], w_st[-1]
+    ref = centred_tracker_rate(q_BN, dt)
     return omega_B - ref, ref
 
 
