@@ -211,8 +211,12 @@ def rate_difference(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> tuple[F
 def rate_departures(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Per sample and axis: gyro − tracker rate (:func:`rate_difference`) against its 31-sample running
     median (a bias is slow), gyro − its 11-sample running median, tracker − its 11-sample running median."""
-    err, ref = rate_difference(q_BN, omega_B, dt)
-    err = err - column_median(err, 31)  # a gyro bias is slow: taken out
+    return _departures(omega_B, *rate_difference(q_BN, omega_B, dt))
+
+
+def _departures(omega_B: FloatArray, diff: FloatArray, ref: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """:func:`rate_departures` from the gyro's rate, gyro − tracker and the tracker's rate."""
+    err = diff - column_median(diff, 31)  # a gyro bias is slow: taken out
     e_g = omega_B - column_median(omega_B, 11)
     e_t = ref - column_median(ref, 11)
     return err, e_g, e_t
@@ -353,9 +357,9 @@ def _rate_series(table: Timetable, ok: BoolArray) -> _RateSeries | None:
     if not runs:
         return None
     idx = np.concatenate([np.arange(r.start + 1, r.stop - 1) for r in runs])  # each run's ends: no centred rate
-    parts = [rate_departures(table.quaternion_BN[r], table.body_rate_rad_s[r], dt) for r in runs]
-    err, e_g, e_t = (np.concatenate([p[j][1:-1] for p in parts]) for j in range(3))
     raw = [rate_difference(table.quaternion_BN[r], table.body_rate_rad_s[r], dt) for r in runs]
+    parts = [_departures(table.body_rate_rad_s[r], *d) for r, d in zip(runs, raw, strict=True)]
+    err, e_g, e_t = (np.concatenate([p[j][1:-1] for p in parts]) for j in range(3))
     diff, tracker = (np.concatenate([p[j][1:-1] for p in raw]) for j in range(2))
     sig = [np.array([max(robust_sigma(x[:, k]), 1e-15) for k in range(3)]) for x in (err, e_g, e_t)]
     quiet = np.all((np.abs(err) < QUIET_SIGMA * sig[0]) & (np.abs(e_t) < QUIET_SIGMA * sig[2]), axis=1)
