@@ -101,6 +101,24 @@ def make_event_id(spacecraft: str, detector: str, kind: str, time_utc: str, cfg_
     return hashlib.sha256(key.encode()).hexdigest()[:20]
 
 
+def event_ids(frame: pd.DataFrame) -> pd.Series:
+    """Every row's ``event_id`` from its own columns (:func:`make_event_id`): after a row's ``kind``
+    changed, its identifier changes with it."""
+    ids = [
+        make_event_id(str(r.spacecraft), str(r.detector), str(r.kind), str(r.time_utc), str(r.config_hash))
+        for r in frame[["spacecraft", "detector", "kind", "time_utc", "config_hash"]].itertuples()
+    ]
+    return pd.Series(ids, index=frame.index, dtype="string")
+
+
+def event_times_ns(frame: pd.DataFrame, column: str = "time_utc") -> np.ndarray:
+    """The events' times [ns since 1970, UTC] from ``column`` (ISO-8601 text, ``Z`` or not, or datetimes)."""
+    if not len(frame):
+        return np.zeros(0, dtype=np.int64)
+    t = pd.to_datetime(frame[column].astype(str), utc=True, format="ISO8601")
+    return np.asarray(t.dt.tz_localize(None).to_numpy(dtype="datetime64[ns]").astype(np.int64))
+
+
 def format_time_utc(t: Any) -> str:
     """ISO-8601 UTC with microseconds and a ``Z`` suffix, from datetime64, Timestamp or string."""
     ts = pd.Timestamp(t)

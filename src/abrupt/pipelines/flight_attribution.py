@@ -41,7 +41,7 @@ from abrupt.detect.attitude.ramp_step import (
     from_body_increments,
 )
 from abrupt.detect.attitude.repair import repair_sensor_fault
-from abrupt.events import format_time_utc, make_event_id
+from abrupt.events import event_ids, format_time_utc
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.timetable import NS, Timetable
@@ -79,11 +79,7 @@ def attribute_events(
     out["kind"] = extra.pop("kind").astype(out["kind"].dtype)
     for c in extra.columns:
         out[c] = extra[c].astype("string") if c in ("kind_channel", "kind_reason") else extra[c]
-    out["event_id"] = [
-        make_event_id(str(r.spacecraft), str(r.detector), str(r.kind), str(r.time_utc), str(r.config_hash))
-        for r in out.itertuples()
-    ]
-    out["event_id"] = out["event_id"].astype(events["event_id"].dtype)
+    out["event_id"] = event_ids(out)
     return out
 
 

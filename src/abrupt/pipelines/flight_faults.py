@@ -30,7 +30,7 @@ from abrupt.detect.attitude.attribution import momentum_stepped
 from abrupt.detect.attitude.evidence import EventEvidence
 from abrupt.detect.attitude.fault_scan import FAULT_FALSE_ALARMS, FaultFinding, FaultScan, scan_faults_each
 from abrupt.detect.attitude.torque_scan import scan_torque
-from abrupt.events import Event, events_frame, format_time_utc, make_event_id
+from abrupt.events import Event, event_ids, event_times_ns, events_frame, format_time_utc
 from abrupt.model.flight_config import FlightConfig
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.timetable import NS, Timetable
@@ -47,13 +47,6 @@ MERGE_S = 30.0
 STRIKE_S = 10.0
 FAULT_DETECTOR = "attitude.fault_scan"
 FAULT_COLUMNS = ("fault_channel", "fault_statistic", "fault_threshold")
-
-
-def _times_ns(events: pd.DataFrame) -> np.ndarray:
-    if not len(events):
-        return np.empty(0, np.int64)
-    t = pd.to_datetime(events["time_utc"].astype(str).str.rstrip("Z"))
-    return np.asarray(t.to_numpy().astype("datetime64[ns]").astype(np.int64))
 
 
 def _new_rows(
@@ -132,7 +125,7 @@ def merge_fault_findings(
     out.attrs["fault_findings_dropped"] = 0
     if not findings:
         return out
-    t_ev = _times_ns(out)
+    t_ev = event_times_ns(out)
     kinds = out["kind"].astype(str).to_numpy() if len(out) else np.empty(0, str)
     # A finding is one channel that moved while the physics it must obey did not; an internal event conserves
     # total ᴺH. An event at which total ᴺH stepped, the body moving and the wheels taking it up, is neither,
@@ -168,10 +161,7 @@ def merge_fault_findings(
         extra["fault_threshold"] = [f.threshold for f in new]
         extra = extra.astype({c: out[c].dtype for c in out.columns if c in extra and len(out)}, errors="ignore")
         out = pd.concat([out, extra[list(out.columns)]], ignore_index=True) if len(out) else extra
-    out["event_id"] = [
-        make_event_id(str(r.spacecraft), str(r.detector), str(r.kind), str(r.time_utc), str(r.config_hash))
-        for r in out.itertuples()
-    ]
+    out["event_id"] = event_ids(out)
     out = out.sort_values("time_utc", kind="stable").reset_index(drop=True)
     out.attrs["fault_findings_dropped"] = dropped
     if dropped and warnings is not None:

@@ -39,11 +39,11 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from abrupt.events import make_event_id
+from abrupt.detect.attitude.attribution import AttributionRules
+from abrupt.events import event_ids, event_times_ns
+from abrupt.series.timetable import NS
 
 ORBIT_EVIDENCE_COLUMNS = ("ev_orbit_dv_mps", "ev_orbit_dt_s", "ev_orbit_dv_floor_mps")
-
-NS = 1_000_000_000
 
 
 def _ns(t: object) -> np.datetime64:
@@ -100,11 +100,6 @@ class OrbitMatch:
     floor_s: float = 30.0
 
 
-def _times_ns(frame: pd.DataFrame) -> np.ndarray:
-    t = pd.to_datetime(frame["time_utc"].astype(str), utc=True, format="ISO8601")
-    return np.asarray(t.dt.tz_localize(None).to_numpy(dtype="datetime64[ns]").astype(np.int64))
-
-
 def _column(frame: pd.DataFrame, name: str) -> np.ndarray:
     if name not in frame.columns:
         return np.full(len(frame), np.nan)
@@ -138,10 +133,10 @@ def orbit_evidence(
     dt_out = np.full(n, np.nan)
     floor_out = np.full(n, np.nan)
     if n:
-        t_a = _times_ns(out)
+        t_a = event_times_ns(out)
         sig_a = np.nan_to_num(_column(out, "time_sigma_s"), nan=0.0)
         dur_a = np.nan_to_num(np.clip(_column(out, "ev_duration_s"), 0.0, None), nan=0.0)
-        t_o = _times_ns(orbit_events) if len(orbit_events) else np.zeros(0, dtype=np.int64)
+        t_o = event_times_ns(orbit_events)
         sig_o = np.nan_to_num(_column(orbit_events, "time_sigma_s"), nan=0.0)
         dur_o = np.nan_to_num(np.clip(_column(orbit_events, "duration_s"), 0.0, None), nan=0.0)
         dv_o = orbit_dv_mps(orbit_events)
@@ -181,8 +176,8 @@ class OrbitRules:
     """
 
     decisive: float = 3.0
-    body_sigma: float = 5.0
-    takeup_min: float = 0.5
+    body_sigma: float = AttributionRules().body_sigma
+    takeup_min: float = AttributionRules().takeup_min
 
 
 def _lowered(confidence: float) -> float:
@@ -320,13 +315,7 @@ def apply_orbit_rules(events: pd.DataFrame, rules: OrbitRules | None = None, mas
     out["kind"] = pd.Series(kinds, index=out.index).astype(events["kind"].dtype)
     out["kind_confidence"] = confs
     out["kind_reason"] = pd.Series(reasons, index=out.index, dtype="string")
-    out["event_id"] = pd.Series(
-        [
-            make_event_id(str(r.spacecraft), str(r.detector), str(r.kind), str(r.time_utc), str(r.config_hash))
-            for r in out.itertuples()
-        ],
-        index=out.index,
-    ).astype(events["event_id"].dtype)
+    out["event_id"] = event_ids(out)
     return out
 
 
