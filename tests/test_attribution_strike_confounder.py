@@ -51,7 +51,7 @@ def test_the_fitted_step_lasts_beside_a_venting_train_that_swamps_the_raw_balanc
     mag = float(np.linalg.norm(STRIKE))
     uh = STRIKE / mag
     raw_balance = (np.median(y[(T >= 60) & (T < 150)] @ uh) - np.median(y[(T >= -90) & (T < -5)] @ uh)) / mag
-    assert raw_balance < 0.5  # the balance the rules used to judge "lasting" on
+    assert raw_balance < 0.5  # venting swamps the raw balance: "lasting" is judged on the fitted step
     ev = step_siblings_evidence(step_siblings(T, y, 0.0), mag)
     assert abs(ev["alone_step_lasting"] - 1.0) < 0.1
     assert ev["step_siblings"] == 0.0
@@ -210,8 +210,8 @@ def test_the_rescan_looks_where_the_detector_suppressed_and_never_at_another_pea
 
 def test_a_long_leak_hidden_by_a_strike_gets_its_event_at_its_onset() -> None:
     """Leaks of 450 and 550 s (2.5e-4 and 8e-4 N·m) with the 0.12 N·m·s strike 40 s after their onset:
-    longer than a third of the fit's window, where the ramp fit's durations used to stop (its onset then
-    slid onto the strike or into the leak, the step taking the leak's first part). The leak's event is at
+    longer than a third of the fit's window (a ramp fit allowed only shorter durations slides the leak's onset
+    onto the strike or into the leak, the step taking the leak's first part). The leak's event is at
     its onset, with the leak's whole τ·D along its torque, ``external_non_strike``."""
     sc = load_spacecraft(KESTREL)
     dh_b = np.array([0.08, -0.06, 0.05])
