@@ -50,7 +50,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from abrupt.detect.attitude.evidence import APPENDAGE_MIN_DEG, APPENDAGE_Z, EventEvidence
+from abrupt.detect.attitude.evidence import EventEvidence
+from abrupt.detect.attitude.sibling_evidence import APPENDAGE_MIN_DEG, APPENDAGE_Z
 
 ATTRIBUTION_KINDS = ("strike", "sensor_fault", "external_non_strike", "internal", "unknown")
 
@@ -127,6 +128,18 @@ def _lasting_impulse(ev: EventEvidence, r: AttributionRules) -> bool:
     )
 
 
+def _body_moved(ev: EventEvidence, r: AttributionRules) -> bool:
+    """The body felt the event: its share along ΔĤ, or along the step the window's fit puts at the event
+    (``step_body_share``), beyond ``body_sigma`` σ of its noise. The two differ when a neighbour's step
+    (a wheel glitch's edge 20-60 s before) shares the detector's windows: ΔH then mixes both, and along
+    its direction the body shows little of a strike the fit separates from the neighbour."""
+
+    def moved(share: float, sigma: float) -> bool:
+        return _finite(share, sigma) and share >= max(r.body_share_min, r.body_sigma * sigma)
+
+    return moved(ev.body_share, ev.body_share_sigma) or moved(ev.step_body_share, ev.step_body_share_sigma)
+
+
 def momentum_stepped(ev: EventEvidence, r: AttributionRules | None = None) -> bool:
     """Total ᴺH stepped for good at the event, beyond its noise, with the body's and the wheels' response.
 
@@ -138,9 +151,7 @@ def momentum_stepped(ev: EventEvidence, r: AttributionRules | None = None) -> bo
     do this, whatever its duration looks like.
     """
     r = r or AttributionRules()
-    body_moved = _finite(ev.body_share, ev.body_share_sigma) and ev.body_share >= max(
-        r.body_share_min, r.body_sigma * ev.body_share_sigma
-    )
+    body_moved = _body_moved(ev, r)
     return (
         _finite(ev.alone_step_lasting, ev.raw_step_fraction, ev.alone_step_fraction, ev.alone_step_z, ev.wheel_takeup)
         and ev.alone_step_lasting >= r.lasting_min
@@ -203,8 +214,7 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
     # fault cannot have made the step (its own prediction of the step misses) while the wheels took the
     # step up (only a torque on the body moves the wheels).
     body = ev.body_share if _finite(ev.body_share) else float("nan")
-    body_floor = max(r.body_share_min, r.body_sigma * ev.body_share_sigma)
-    body_moved = _finite(body, ev.body_share_sigma) and body >= body_floor
+    body_moved = _body_moved(ev, r)
     takeup = _finite(ev.wheel_takeup) and ev.wheel_takeup >= r.takeup_min
     torque_seen = takeup and body_moved
     bias_explains = _finite(ev.bias_residual) and ev.bias_residual < r.residual_max

@@ -61,7 +61,7 @@ telemetry (:class:`~abrupt.series.timetable.Timetable`) around the event:
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -77,11 +77,15 @@ from abrupt.detect.attitude.body_response import (
 )
 from abrupt.detect.attitude.body_response import window_rows as _idx
 from abrupt.detect.attitude.ramp_step import (
-    StepSiblings,
     WindowFits,
     body_frame_momentum,
     ramp_step_evidence,
     step_siblings_evidence,
+)
+from abrupt.detect.attitude.sibling_evidence import (
+    appendage_jump,
+    external_siblings,
+    step_body_share,
 )
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import Spacecraft
@@ -89,11 +93,6 @@ from abrupt.series.timetable import NS, Timetable
 from abrupt.types import FloatArray
 
 NAN = float("nan")
-#: An appendage drive jumped when its rate leaves its running median by more than this many σ of its
-#: noise and the excess turns it by more than ``APPENDAGE_MIN_DEG`` (a snap or slip; a body-rate change
-#: that the drive follows turns it by far less).
-APPENDAGE_Z = 12.0
-APPENDAGE_MIN_DEG = 0.2
 
 
 @dataclass(frozen=True)
@@ -145,6 +144,8 @@ class EventEvidence:
     step_still_siblings: float = NAN
     step_internal_siblings: float = NAN
     alone_step_sharpness: float = NAN
+    step_body_share: float = NAN
+    step_body_share_sigma: float = NAN
     step_close_siblings: float = NAN
     alone_step_lasting: float = NAN
     after_strike_s: float = NAN
@@ -333,14 +334,15 @@ def event_evidence(
             out.update(ramp_step_evidence(fits.ramp(w.ramp_min_s), mag))
         if mag > 0:
             out.update(step_siblings_evidence(fits.siblings(), mag))
+            out.update(step_body_share(table, J, i0, fits.siblings(), (w.pre_s, w.guard_s, w.baseline_s, w.response_s)))
             # A sibling is a momentum change of the body; a one-channel fault's step beside the event is none.
             if "step_sharp_siblings" in out:
-                sib, internal = _external_siblings(table, i0, dt, fits.siblings())
+                sib, internal = external_siblings(table, i0, dt, fits.siblings())
                 moved, still = moved_siblings(table, J, i0, sib)
                 out["step_sharp_siblings"], out["step_still_siblings"] = moved, still
                 out["step_internal_siblings"] = internal
                 out["step_siblings"] = float(out["step_siblings"]) - still - internal
-    out.update(_appendage(table, i0, dt))
+    out.update(appendage_jump(table, i0, dt))
     out.update(surface_evidence(spacecraft, dh_b))
     if raw_H_N is not None and mag > 0:
         b = _idx(g, i0, -w.wheel_s, -w.guard_s, dt)
@@ -552,61 +554,6 @@ def _profile(
     if np.isfinite(yb).sum() > 10 and np.isfinite(ya).sum() > 10:
         out["lasting_fraction"] = float((np.nanmedian(ya) - np.nanmedian(yb)) / mag)
     return out
-
-
-def _external_siblings(
-    table: Timetable, i0: int, dt: float, fit: StepSiblings | None
-) -> tuple[StepSiblings | None, int]:
-    """``fit`` without the sharp siblings at whose time an appendage drive jumped (:data:`APPENDAGE_Z`,
-    :data:`APPENDAGE_MIN_DEG`), and how many those were. A snap moves momentum between the hub and the
-    appendage; where the momentum model does not carry the appendage's momentum through the snap, the
-    computed ᴺH steps along the drive's axis and the body moves: a sharp step that is no external impulse,
-    so no pulse of a sequence the event could belong to. The drive is looked at from 5 s before the
-    sibling to 10 s after it, never within 3 s of the event (an impulse at the event may turn the drive)."""
-    if fit is None or not any(fit.sharp):
-        return fit, 0
-    g = table.time_ns
-    sharp = list(fit.sharp)
-    internal = 0
-    for j, tau_s in enumerate(fit.other_tau_s):
-        if not sharp[j]:
-            continue
-        k = int(np.clip(np.searchsorted(g, int(g[i0]) + round(tau_s * NS)), 0, g.size - 1))
-        after = min(10.0, -tau_s - 3.0) if tau_s < 0 else 10.0
-        a = _appendage(table, k, dt, near_s=(-5.0, after))
-        if a and a["appendage_z"] > APPENDAGE_Z and a["appendage_excess_deg"] > APPENDAGE_MIN_DEG:
-            sharp[j] = False
-            internal += 1
-    if not internal:
-        return fit, 0
-    return replace(fit, sharp=tuple(sharp), sharp_siblings=fit.sharp_siblings - internal), internal
-
-
-def _appendage(table: Timetable, i0: int, dt: float, near_s: tuple[float, float] = (-15.0, 25.0)) -> dict[str, float]:
-    """The largest abrupt change of an appendage drive's rate against its 61-s running median within
-    ``near_s`` of row ``i0``: its significance (``appendage_z``), the angle it adds and the drive."""
-    rates = table.appendage_rate_rad_s
-    if rates.ndim != 2 or rates.shape[1] == 0:
-        return {}
-    lo, hi = max(0, i0 - int(120 / dt)), min(rates.shape[0], i0 + int(120 / dt))
-    best: dict[str, float] = {}
-    for k in range(rates.shape[1]):
-        seg = rates[lo:hi, k]
-        if seg.size < 60 or not np.isfinite(seg).all():
-            continue
-        excess = seg - median_filter(seg, size=int(61 / dt) | 1, mode="nearest")
-        sig = white_noise_sigma(seg)
-        near = slice(max(0, i0 - lo + int(near_s[0] / dt)), min(seg.size, i0 - lo + int(near_s[1] / dt)))
-        if near.stop - near.start < 1:
-            continue
-        z = float(np.max(np.abs(excess[near])) / max(sig, 1e-9))
-        if not best or z > best["appendage_z"]:
-            best = {
-                "appendage_excess_deg": float(math.degrees(abs(np.sum(excess[near]) * dt))),
-                "appendage_z": z,
-                "appendage_index": k,
-            }
-    return best
 
 
 def surface_evidence(sc: Spacecraft, dh_b: FloatArray, direction_sigma_rad: float = 0.1) -> dict[str, float]:
