@@ -242,7 +242,7 @@ def test_api_and_cli_give_the_same_classes_and_evidence(tmp_path: Path, capsys: 
     capsys.readouterr()
     cli_main(["detect", "attitude", "--store", str(tmp_path / "injected"), "--spacecraft", str(a.spacecraft),
               "--out", str(out), "--orbit-events", str(orbit), "--orbit-floor-mps", "2e-4",
-              *[x for s in spans for x in ("--orbit-span", s)]])  # fmt: skip
+              *[x for s in spans for x in ("--orbit-span", s)], "--report", str(tmp_path / "r.html")])  # fmt: skip
     repair = "orbit side: navigation spans: 1 overlapping an earlier one, merged (3 given, 2 left)"
     assert f"warning: {repair}" in capsys.readouterr().err
     sc = load_spacecraft(a.spacecraft)
@@ -265,6 +265,10 @@ def test_api_and_cli_give_the_same_classes_and_evidence(tmp_path: Path, capsys: 
     assert covered["ev_orbit_dv_mps"] == 0.0 and covered["kind"] == "unknown"
     assert math.isnan(gapped["ev_orbit_dv_mps"]) and gapped["kind"] == "strike"
     assert seen["ev_orbit_dv_mps"] == 3e-3 and seen["kind"] == "strike" and "3 mm/s" in seen["kind_reason"]
+    # The report lists each event's orbit side.
+    html = (tmp_path / "r.html").read_text()
+    assert "<h2>Orbit side</h2>" in html and "orbit ΔV 3 mm/s at +" in html
+    assert "orbit: not covered by the navigation solution" in html and "orbit: no ΔV above the floor" in html
 
 
 def test_calibration_blocks_record_their_own_tested_intervals(tmp_path: Path) -> None:
