@@ -198,6 +198,16 @@ def test_api_bad_input_gets_the_clis_errors_in_its_own_names(tmp_path: Path) -> 
         load_orbit_input(OrbitSource(ev, -1.0, ["2026-01-05T00:00..2026-01-06T00:00"]), "SC-Z")
     with pytest.raises(ConfigError, match=r"\[floor_mps\]"):
         load_orbit_input(OrbitSource(ev, 0.0), "SC-Z")  # checked before any record is read
+    with pytest.raises(ConfigError, match=r"\[edge_s\]: the edge margin must be ≥ 0 s, got -1"):
+        load_orbit_input(OrbitSource(ev, FLOOR, ["2026-01-05T00:00..2026-01-06T00:00"], edge_s=-1.0), "SC-Z")
+    # A record edited by hand into a reversed interval: named, with the run.
+    cat = tmp_path / "c.sqlite"
+    reversed_interval = [["2026-01-05T12:00:00", "2026-01-05T00:00:00"]]
+    details = {"statistic": "glr", "thresholds": {"glr": {}}, "dv90_mps": FLOOR, "start_utc": "2026-01-05T00:00:00",
+               "end_utc": "2026-01-05T12:00:00", "tested_intervals_utc": reversed_interval}  # fmt: skip
+    _record(cat, "o", details)
+    with pytest.raises(InputError, match=r"orbit\.csv: give floor_mps and spans .* run 'o''s record: navigation span"):
+        load_orbit_input(OrbitSource(ev, catalog=str(cat)), "SC-Z")
 
 
 def test_cli_reversed_span_is_a_one_line_error(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -204,9 +204,11 @@ def recorded_coverage(
             f"orbit run {run_id!r} records no ΔV floor (dv90_mps: its statistic is not glr): give {names.floor}",
             key=names.key(names.floor),
         )
-    spans = tuple((np.datetime64(a, "ns"), np.datetime64(b, "ns")) for a, b in spans_text)
     source = f"orbit run {run_id}" + ("" if with_gaps else f" ({NO_INTERVALS})")
-    return NavigationCoverage(spans, max(floors), edge_s, source=source)
+    try:
+        return NavigationCoverage(spans_from_text(spans_text), max(floors), edge_s, source=source)
+    except ValueError as exc:  # a record edited by hand
+        raise ConfigError(f"orbit run {run_id!r}'s record: {exc}", key=names.key(names.spans)) from None
 
 
 def orbit_run_id(
@@ -263,6 +265,8 @@ class OrbitInput:
 
 def _given_coverage(source: OrbitSource, names: OrbitOptionNames) -> tuple[tuple[Any, ...], NavigationCoverage | None]:
     """The spans given and, with a floor given too, the coverage they make (ConfigError naming the bad one)."""
+    if not (math.isfinite(source.edge_s) and source.edge_s >= 0):
+        raise ConfigError(f"the edge margin must be ≥ 0 s, got {source.edge_s}", key="edge_s")
     try:
         given = spans_from_text(source.spans)
         if source.floor_mps is not None and given:
@@ -282,6 +286,7 @@ def load_orbit_input(source: OrbitSource, spacecraft: str, names: OrbitOptionNam
     n = names or OrbitOptionNames()
     events = read_orbit_events(source.events, spacecraft)
     given, coverage = _given_coverage(source, n)
+    repairs = coverage.repairs if coverage is not None else ""
     if coverage is None:
         try:
             if source.catalog is None:
@@ -297,9 +302,8 @@ def load_orbit_input(source: OrbitSource, spacecraft: str, names: OrbitOptionNam
             ) from None
         floor = source.floor_mps if source.floor_mps is not None else rec.dv_floor_mps
         coverage = NavigationCoverage(given or rec.spans_utc, floor, source.edge_s, source=rec.source)
-        if not given and rec.repairs:  # the record's own intervals were repaired
-            object.__setattr__(coverage, "repairs", rec.repairs)
-    notes = [coverage.repairs] if coverage.repairs else []
+        repairs = coverage.repairs if given else rec.repairs  # the given spans', or the record's own
+    notes = [repairs] if repairs else []
     if NO_INTERVALS in coverage.source and not given:
         notes.append(f"{coverage.source.split(' (')[0]} {NO_INTERVALS}")
     return OrbitInput(events, coverage, tuple(notes))

@@ -81,8 +81,8 @@ def merged_spans(spans: Sequence[Span]) -> tuple[tuple[Span, ...], str]:
 class NavigationCoverage:
     """Where a navigation solution was searched for impulses, and the smallest ΔV it would have found.
 
-    ``spans_utc``: (start, end) pairs of the orbit run's arcs (UTC); ``dv_floor_mps``: the orbit run's
-    detection floor [m/s] (its 90 %-detectable |ΔV| in the worst direction, or a value the user gives);
+    ``spans_utc``: (start, end) pairs of the intervals the orbit run tested (UTC); ``dv_floor_mps``: the
+    orbit run's detection floor [m/s] (its 90 %-detectable |ΔV| in the worst direction, or a value the user gives);
     ``edge_s``: a margin at each end of each span that does not count as covered [s] (the filters have
     seen little data there); ``source``: where the floor and the spans came from (for the reasons).
     Spans that do not end after they start are a ValueError naming the span; spans out of order or
