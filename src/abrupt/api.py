@@ -6,7 +6,9 @@ One entry per job, each the function the command line calls:
 
 ==========================  ==========================================================================
 attitude strikes            :func:`detect_attitude` (telemetry + spacecraft + budget -> events);
-                            :func:`run_flight` (an ingested flight archive, chunked, resumable)
+                            :func:`run_flight` (an ingested flight archive, chunked, resumable);
+                            :func:`run_flight_with_orbit` (the same with an orbit run's evidence per
+                            event: :class:`OrbitSource`, read and checked by :func:`load_orbit_input`)
 one detector by name        :func:`get_detector`, :func:`detector_names`
 orbit                       :func:`detect_orbit` (SP3, OEM, CPF, CSV or an :class:`Ephemeris`)
 TLE / OMM histories         :func:`detect_tle` (a TLE/3LE/OMM file), :func:`read_tle`
@@ -35,6 +37,7 @@ from abrupt.model.tracking_measurements import TrackingArrays
 from abrupt.pipelines.attitude import detect_attitude
 from abrupt.pipelines.density import tle_density as density_from_tles
 from abrupt.pipelines.flight import FlightRunConfig, run_flight
+from abrupt.pipelines.flight_orbit import OrbitSource, load_orbit_input, run_flight_with_orbit
 from abrupt.pipelines.mass import estimate_inertia_run as estimate_inertia
 from abrupt.pipelines.orbit import detect_orbit
 from abrupt.pipelines.rates import rate_table
@@ -68,6 +71,7 @@ __all__ = [
     "Event",
     "FalseAlarmBudget",
     "FlightRunConfig",
+    "OrbitSource",
     "RateConfig",
     "Scenario",
     "Spacecraft",
@@ -90,6 +94,7 @@ __all__ = [
     "events_frame",
     "expected_rates",
     "get_detector",
+    "load_orbit_input",
     "load_spacecraft",
     "rate_table",
     "read_ephemeris",
@@ -98,6 +103,7 @@ __all__ = [
     "read_tle",
     "read_tracking_series",
     "run_flight",
+    "run_flight_with_orbit",
     "simulate_attitude",
     "simulate_tracking",
     "telemetry_from_frame",

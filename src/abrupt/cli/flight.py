@@ -24,6 +24,7 @@ from abrupt.events import write_events
 from abrupt.model.spacecraft import load_spacecraft
 from abrupt.pipelines.flight import CleaningConfig, FlightRunConfig, day_range, ingest_archives, run_flight
 from abrupt.pipelines.flight_injection import injection_recovery
+from abrupt.pipelines.flight_orbit import run_flight_with_orbit
 from abrupt.readers.archive import pseudonymise_text, read_decoder
 from abrupt.report.flight import write_flight_report
 from abrupt.simulate.confounders import (
@@ -140,10 +141,9 @@ def detect_from_store(
             seen.add(day)
             bar.update(1)
 
-    result = run_flight(store_dir, sc, cfg, days=day_list, keep_series=report_path is not None, progress=tick)
+    keep = report_path is not None
+    result = run_flight_with_orbit(store_dir, sc, orbit_in, cfg, days=day_list, keep_series=keep, progress=tick)
     bar.close()
-    if orbit_in is not None:
-        result.events = orbit_in.attach(result.events, sc.mass_kg)
     if out:
         write_events(result.events, out)
     if catalog_target:

@@ -1,28 +1,13 @@
 """Options of ``abrupt detect attitude --store`` for orbit-side evidence (thin: options →
-:mod:`abrupt.pipelines.flight_orbit`)."""
+:func:`abrupt.pipelines.flight_orbit.load_orbit_input`, the function the Python API calls)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import click
-import pandas as pd
 
-from abrupt.detect.attitude.orbit_evidence import NavigationCoverage, spans_from_text
-from abrupt.errors import ConfigError, InputError
-from abrupt.pipelines.flight_orbit import attach_orbit_evidence, orbit_run_id, read_orbit_events, recorded_coverage
-
-
-@dataclass(frozen=True)
-class OrbitInput:
-    """An orbit run's checked events and where its navigation solution looked, with which floor."""
-
-    events: pd.DataFrame
-    coverage: NavigationCoverage
-
-    def attach(self, events: pd.DataFrame, mass_kg: float) -> pd.DataFrame:
-        return attach_orbit_evidence(events, self.events, self.coverage, mass_kg=mass_kg)
+from abrupt.pipelines.flight_orbit import CLI_NAMES, OrbitInput, OrbitSource, load_orbit_input
 
 
 def orbit_evidence_options(f: Any) -> Any:
@@ -46,8 +31,9 @@ def orbit_evidence_options(f: Any) -> Any:
             "--orbit-span",
             "orbit_spans",
             multiple=True,
-            help="START..END (UTC) the orbit run tested (its 'tested' line); repeatable (default: the span "
-            "the orbit run recorded in --catalog). Events outside get no orbit evidence (not covered is not 'no ΔV').",
+            help="START..END (UTC) the orbit run's navigation solution covered (its 'tested' line, less its gaps); "
+            "repeatable; overlapping ones are merged (default: the intervals the orbit run recorded in --catalog). "
+            "Events outside get no orbit evidence (not covered is not 'no ΔV').",
         ),
         click.option(
             "--orbit-edge-s",
@@ -78,34 +64,12 @@ def orbit_input(
     spacecraft: str,
     catalog_target: str | None,
 ) -> OrbitInput | None:
-    """The orbit input of the options (None without ``--orbit-events``); a one-line error for a bad one.
-    The span and the floor not given come from the orbit run's record in the catalog."""
+    """The orbit input of the options (None without ``--orbit-events``); a one-line error for a bad one (a
+    repair is in its notes, which the run's warnings print). The span and the floor not given come from the
+    orbit run's record in the catalog."""
     if orbit_events is None:
         if floor_mps is not None or spans or run_id is not None:
             raise click.UsageError("--orbit-floor-mps, --orbit-span and --orbit-run need --orbit-events")
         return None
-    events = read_orbit_events(orbit_events, spacecraft)
-    try:
-        given = spans_from_text(spans)
-        if floor_mps is not None and spans:
-            return OrbitInput(events, NavigationCoverage(given, floor_mps, edge_s, source="given"))
-    except ValueError as exc:
-        raise ConfigError(str(exc), key="orbit_span" if "span" in str(exc) else "orbit_floor_mps") from None
-    try:
-        if catalog_target is None:
-            raise ConfigError("no catalog to read the orbit run's record from", key="catalog")
-        rec = recorded_coverage(catalog_target, run_id or orbit_run_id(events, orbit_events, catalog_target), edge_s)
-    except (ConfigError, InputError) as exc:
-        missing = " and ".join(n for n, v in (("--orbit-floor-mps", floor_mps), ("--orbit-span", spans)) if not v)
-        raise InputError(
-            f"give {missing} (the smallest ΔV the orbit run would have found; the times its navigation solution "
-            f"covered), or the orbit run's record: {getattr(exc, 'reason', exc)}",
-            file=orbit_events,
-        ) from None
-    coverage = NavigationCoverage(
-        given or rec.spans_utc,
-        floor_mps if floor_mps is not None else rec.dv_floor_mps,
-        edge_s,
-        source=rec.source,
-    )
-    return OrbitInput(events, coverage)
+    source = OrbitSource(orbit_events, floor_mps, spans, edge_s, run_id, catalog_target)
+    return load_orbit_input(source, spacecraft, CLI_NAMES)

@@ -319,11 +319,32 @@ def fit_summary(run: OrbitRun) -> dict[str, Any]:
     }
 
 
-def _tested_span(an: OrbitAnalysis) -> dict[str, str]:
+#: Epochs further apart than this many nominal steps leave a gap: no epoch, no test of an impulse in it.
+GAP_STEPS = 1.5
+
+
+def epoch_intervals(times_utc: np.ndarray, step_s: float) -> list[tuple[str, str]]:
+    """The tested epochs ``times_utc`` (datetime64, in order) as intervals (UTC text, to the second): a new
+    interval wherever two epochs are more than :data:`GAP_STEPS` nominal steps ``step_s`` apart (a gap of
+    the navigation solution, where no epoch tested an impulse; one missing epoch is such a gap)."""
+    t = np.asarray(times_utc, dtype="datetime64[ns]")
+    if not t.size:
+        return []
+    jumps = np.flatnonzero(np.diff(t.astype(np.int64)).astype(np.float64) * 1e-9 > GAP_STEPS * step_s)
+    starts = np.concatenate([[0], jumps + 1])
+    ends = np.concatenate([jumps, [t.size - 1]])
+    return [(str(t[a])[:19], str(t[b])[:19]) for a, b in zip(starts, ends, strict=True)]
+
+
+def _tested_span(an: OrbitAnalysis) -> dict[str, Any]:
     """The first and last epoch the statistics were evaluated at (the arc less the filters' settling at each
-    end): where a quiet run means no impulse above its detectable ΔV."""
+    end): where a quiet run means no impulse above its detectable ΔV; and the intervals between them that
+    epochs cover (``tested_intervals_utc``: the span less the navigation solution's gaps)."""
     tested = an.ephemeris.times_utc[np.asarray(an.valid, dtype=bool)]
-    return {"start_utc": str(tested[0])[:19], "end_utc": str(tested[-1])[:19]} if tested.size else {}
+    if not tested.size:
+        return {}
+    intervals = [list(iv) for iv in epoch_intervals(tested, an.ephemeris.nominal_step_s)]
+    return {"start_utc": str(tested[0])[:19], "end_utc": str(tested[-1])[:19], "tested_intervals_utc": intervals}
 
 
 def _detectable(run: OrbitRun) -> dict[str, float]:
@@ -370,6 +391,9 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
         )
     if "start_utc" in s and "end_utc" in s:
         lines.append(f"  tested           {s['start_utc']} – {s['end_utc']} (the arc less the filters' settling)")
+        gaps = max(0, len(s.get("tested_intervals_utc") or [1]) - 1)
+        if gaps:
+            lines.append(f"                   less {gaps} gap(s) of the navigation solution (no epoch: not tested)")
     bounds = s.get("product_boundaries") or []
     if bounds:
         nuisance = [b for b in bounds if not b["raised"]]

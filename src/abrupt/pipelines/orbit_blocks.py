@@ -114,11 +114,20 @@ class BlockOutcome:
                 {
                     "tested_start_utc": max(str(self.start_utc)[:19], s["start_utc"]),
                     "tested_end_utc": min(str(self.end_utc)[:19], s["end_utc"]),
+                    **self._tested_intervals(),
                 }
                 if "start_utc" in s and "end_utc" in s
                 else {}
             ),
         }
+
+    def _tested_intervals(self) -> dict[str, list[list[str]]]:
+        """The arc's tested intervals (the span less its gaps) clipped to the block; none when not recorded."""
+        if "tested_intervals_utc" not in self.summary:
+            return {}
+        lo, hi = str(self.start_utc)[:19], str(self.end_utc)[:19]
+        clipped = [[max(a, lo), min(b, hi)] for a, b in self.summary["tested_intervals_utc"]]
+        return {"tested_intervals_utc": [iv for iv in clipped if iv[0] <= iv[1]]}
 
 
 def events_in(events: pd.DataFrame, start: np.datetime64, stop: np.datetime64 | None) -> pd.DataFrame:
@@ -177,9 +186,12 @@ def blocks_summary(outcomes: list[BlockOutcome], eph: Ephemeris) -> dict[str, An
         blocks=[o.record() for o in outcomes],
     )
     tested = [(b["tested_start_utc"], b["tested_end_utc"]) for b in out["blocks"] if "tested_start_utc" in b]
-    out.pop("start_utc", None), out.pop("end_utc", None)  # the first block's own, not the run's
+    # the first block's own, not the run's
+    out.pop("start_utc", None), out.pop("end_utc", None), out.pop("tested_intervals_utc", None)
     if tested:
         out.update(start_utc=min(a for a, _ in tested), end_utc=max(b for _, b in tested))
+    if any("tested_intervals_utc" in b for b in out["blocks"]):
+        out["tested_intervals_utc"] = [iv for b in out["blocks"] for iv in b.get("tested_intervals_utc", [])]
     return out
 
 

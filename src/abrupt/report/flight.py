@@ -7,6 +7,10 @@ Panels (one figure; PNG, or an HTML page embedding it with the daily table):
 3. after the trend (slow external torque) and comb (orbit harmonics) stages — the series detectors read;
 4. the GLR statistic, its threshold at the stated false-alarm rate, and the events;
 5. daily statistics: analysed and masked fractions, noise floor, events (what an operator looks at first).
+
+The HTML page adds, when the events carry an orbit run's evidence (``ev_orbit_*``), one line per event of
+the orbit side (:meth:`abrupt.report.attribution.OrbitSide.text`: the coincident ΔV against the floor,
+nothing above it, or not covered).
 """
 
 from __future__ import annotations
@@ -23,6 +27,7 @@ import numpy as np
 import pandas as pd
 
 from abrupt.pipelines.flight import FlightResult
+from abrupt.report.attribution import EventPanel
 
 MAX_POINTS = 20000
 
@@ -117,6 +122,17 @@ def flight_figure(result: FlightResult) -> plt.Figure:
     return fig
 
 
+def orbit_side_html(events: pd.DataFrame) -> str:
+    """A table of each event's orbit side ("" when the events carry no orbit evidence)."""
+    if "ev_orbit_dv_mps" not in events.columns or not len(events):
+        return ""
+    rows = []
+    for _, ev in events.iterrows():
+        side = EventPanel.from_event(ev).orbit
+        rows.append({"time_utc": ev["time_utc"], "kind": ev.get("kind", ""), "orbit side": side.text() if side else ""})
+    return "<h2>Orbit side</h2>" + pd.DataFrame(rows).to_html(index=False)
+
+
 def write_flight_report(path: str | Path, result: FlightResult) -> None:
     """Write the report as PNG or as HTML (figure + daily table + events)."""
     path = Path(path)
@@ -137,6 +153,7 @@ def write_flight_report(path: str | Path, result: FlightResult) -> None:
         f"<img src='data:image/png;base64,{img}' style='max-width:100%'>"
         "<h2>Daily statistics</h2>"
         + result.daily.to_html(index=False, float_format=lambda v: f"{v:.4g}")
+        + orbit_side_html(result.events)
         + "<h2>Events</h2>"
         + result.events.to_html(index=False)
         + "</body></html>"

@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -54,20 +54,46 @@ def _ns(t: object) -> np.datetime64:
     return np.datetime64(int(ts.value), "ns")
 
 
+Span = tuple[np.datetime64, np.datetime64]
+
+
+def merged_spans(spans: Sequence[Span]) -> tuple[tuple[Span, ...], str]:
+    """``spans`` (each ending after it starts) as disjoint intervals in time order, and the repair made, counted
+    ("" when none): spans out of order are sorted, spans that overlap are merged into one (the navigation
+    solution covered their union; spans that only touch, as calibration blocks' do, are joined uncounted)."""
+    starts = [int(a.astype(np.int64)) for a, _ in spans]
+    unordered = sum(1 for k in range(1, len(starts)) if starts[k] < starts[k - 1])
+    out: list[Span] = []
+    merged = 0
+    for a, b in sorted(spans, key=lambda s: (int(s[0].astype(np.int64)), int(s[1].astype(np.int64)))):
+        if out and a <= out[-1][1]:
+            merged += int(a < out[-1][1])  # one that only touches the last is no mistake
+            out[-1] = (out[-1][0], max(out[-1][1], b))
+            continue
+        out.append((a, b))
+    what = [f"{unordered} out of order, sorted"] if unordered else []
+    what += [f"{merged} overlapping an earlier one, merged"] if merged else []
+    repairs = f"navigation spans: {'; '.join(what)} ({len(spans)} given, {len(out)} left)" if what else ""
+    return tuple(out), repairs
+
+
 @dataclass(frozen=True)
 class NavigationCoverage:
     """Where a navigation solution was searched for impulses, and the smallest ΔV it would have found.
 
-    ``spans_utc``: (start, end) pairs of the orbit run's arcs (UTC); ``dv_floor_mps``: the orbit run's
-    detection floor [m/s] (its 90 %-detectable |ΔV| in the worst direction, or a value the user gives);
+    ``spans_utc``: (start, end) pairs of the intervals the orbit run tested (UTC); ``dv_floor_mps``: the
+    orbit run's detection floor [m/s] (its 90 %-detectable |ΔV| in the worst direction, or a value the user gives);
     ``edge_s``: a margin at each end of each span that does not count as covered [s] (the filters have
     seen little data there); ``source``: where the floor and the spans came from (for the reasons).
+    Spans that do not end after they start are a ValueError naming the span; spans out of order or
+    overlapping are sorted and merged (:func:`merged_spans`), the repair counted in ``repairs``.
     """
 
     spans_utc: tuple[tuple[np.datetime64, np.datetime64], ...]
     dv_floor_mps: float
     edge_s: float = 0.0
     source: str = ""
+    repairs: str = field(default="", init=False, compare=False)
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.dv_floor_mps) and self.dv_floor_mps > 0):
@@ -75,10 +101,12 @@ class NavigationCoverage:
         if not (math.isfinite(self.edge_s) and self.edge_s >= 0):
             raise ValueError(f"the edge margin must be ≥ 0 s, got {self.edge_s}")
         spans = tuple((_ns(a), _ns(b)) for a, b in self.spans_utc)
-        for a, b in spans:
+        for k, (a, b) in enumerate(spans):
             if not b > a:
-                raise ValueError(f"navigation span {a}..{b} does not end after it starts")
-        object.__setattr__(self, "spans_utc", spans)
+                raise ValueError(f"navigation span {k + 1} ({a}..{b}) does not end after it starts")
+        merged, repairs = merged_spans(spans)
+        object.__setattr__(self, "spans_utc", merged)
+        object.__setattr__(self, "repairs", repairs)
 
     def covers(self, t_ns: np.ndarray) -> np.ndarray:
         """Whether each time [ns since the epoch] is inside a span, ``edge_s`` away from its ends."""
@@ -319,16 +347,21 @@ def apply_orbit_rules(events: pd.DataFrame, rules: OrbitRules | None = None, mas
     return out
 
 
-def spans_from_text(texts: Sequence[str]) -> tuple[tuple[np.datetime64, np.datetime64], ...]:
-    """Spans ``START..END`` (ISO-8601 UTC, a trailing ``Z`` allowed) as datetime64 pairs; ValueError names
-    the text that is not one."""
+def spans_from_text(texts: Sequence[str | tuple[object, object]]) -> tuple[Span, ...]:
+    """Spans ``START..END`` (ISO-8601 UTC, a trailing ``Z`` allowed), or (start, end) pairs of times, as
+    datetime64 pairs; ValueError names the span that is not one."""
     spans = []
-    for text in texts:
-        parts = text.split("..")
-        if len(parts) != 2:
-            raise ValueError(f"navigation span {text!r} is not START..END")
+    for k, text in enumerate(texts):
+        if isinstance(text, str):
+            parts: Sequence[object] = text.split("..")
+            if len(parts) != 2:
+                raise ValueError(f"navigation span {text!r} is not START..END")
+        else:
+            parts = tuple(text)
+            if len(parts) != 2:
+                raise ValueError(f"navigation span {k + 1} ({text!r}) is not a (start, end) pair")
         try:
-            a, b = (np.datetime64(p.strip().rstrip("Z"), "ns") for p in parts)
+            a, b = (_ns(str(p).strip().rstrip("Z")) for p in parts)
         except ValueError:
             raise ValueError(f"navigation span {text!r}: a time is not ISO-8601") from None
         spans.append((a, b))
