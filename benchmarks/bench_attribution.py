@@ -165,7 +165,8 @@ def one_run(
         c = draw_confounder(kind, t_ns, sc, ranges, rng)
         confs.append(c)
         truth.append({"kind": kind, "class": CONFOUNDER_CLASS[kind], "t_ns": t_ns,
-                      "end_ns": t_ns + int(c.duration_s * NS), "size": float("nan"), "near": False})  # fmt: skip
+                      "end_ns": t_ns + int(c.duration_s * NS), "size": float("nan"), "near": False,
+                      "params": json.dumps({"channel": c.channel, **c.params})})  # fmt: skip
         if rng.uniform() < near_fraction:  # a strike 20-60 s after the confounder's onset
             t2 = t_ns + int(rng.uniform(20, 60) * NS)
             size = float(math.exp(rng.uniform(math.log(0.05), math.log(0.6))))

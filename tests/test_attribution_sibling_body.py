@@ -125,3 +125,47 @@ def test_the_body_share_is_the_same_at_every_telemetry_cadence(dt_s: float) -> N
     share, _, peak = body_share(table, j, i0, dh / 0.08, 0.08)
     assert share == pytest.approx(1.0, rel=0.02)
     assert peak == pytest.approx(np.linalg.norm(dw), rel=1e-6)
+
+
+def _with_drive(table: Timetable, rng: np.random.Generator, snap_at: int | None) -> Timetable:
+    """One appendage drive turning at a steady 1.1e-3 rad/s (a sun-tracking array) with white rate noise,
+    and with ``snap_at``, a 3° slip over 2 s from that second."""
+    n = len(table)
+    rate = 1.1e-3 + rng.normal(0, 2e-5, n)
+    if snap_at is not None:
+        rate[snap_at : snap_at + 2] += np.radians(3.0) / 2.0
+    return replace(table, appendage_rate_rad_s=rate[:, None])
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_a_sibling_at_an_appendage_snap_is_internal_and_the_strike_beside_it_stays_a_strike(seed: int) -> None:
+    """The two-pulse sequence above, but the first step at 1200 s comes with the array's drive slipping by
+    3°: a snap moves momentum between hub and array, a step a momentum model without the array reads at
+    that time, no external pulse. It is no sibling (``step_internal_siblings``) and the event at 1240 s is
+    a strike. The same drive slipping at 900 s, far from every step, changes nothing: still a sequence."""
+    sc = load_spacecraft(KESTREL)
+    u = _wheel_direction()
+    base = closed_loop_table(np.random.default_rng(seed), 1240, 0.08 * u, more=((1200, 0.04 * u),))
+    # ᴺH as a momentum model without the array's momentum reads it (the step at 1200 s is in it); the drive's
+    # rate is the evidence that the step came from the array.
+    h_n, hc, _, _, peaks = glr_peaks(sc, base)
+    p = next(p for _, p in peaks if abs(p.time_ns / NS - 1240) <= 3)
+    for snap_at, kind, internal in ((1200, "strike", 1), (900, "external_non_strike", 0)):
+        table = _with_drive(base, np.random.default_rng(seed + 10), snap_at)
+        ev = event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n)
+        assert ev.step_internal_siblings == internal, ev
+        assert ev.step_sharp_siblings == 1 - internal
+        assert classify(ev).kind == kind, ev
+
+
+def test_a_drive_slip_at_the_event_itself_does_not_hide_a_sibling() -> None:
+    """The drive is looked at around the sibling, never within 3 s of the event: a slip at 1240 s (the
+    event's own time) leaves the sibling at 1200 s a real pulse of the sequence."""
+    sc = load_spacecraft(KESTREL)
+    u = _wheel_direction()
+    base = closed_loop_table(np.random.default_rng(4), 1240, 0.08 * u, more=((1200, 0.04 * u),))
+    h_n, hc, _, _, peaks = glr_peaks(sc, base)
+    p = next(p for _, p in peaks if abs(p.time_ns / NS - 1240) <= 3)
+    table = _with_drive(base, np.random.default_rng(14), 1240)
+    ev = event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n)
+    assert ev.step_internal_siblings == 0 and ev.step_sharp_siblings == 1

@@ -7,6 +7,8 @@ of its own; the step sizes and times put into the signals; the rules' reading of
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -115,3 +117,54 @@ def test_an_impulsive_step_with_siblings_is_a_sequence_not_a_strike() -> None:
     train = EventEvidence(**drift, step_sharp_siblings=1.0)  # type: ignore[arg-type]
     assert classify(train).kind == "external_non_strike"
     assert classify(train, AttributionRules(step_alone=False)).kind == "strike"
+
+
+@pytest.mark.parametrize("seed", [11, 12, 13])
+def test_a_strike_along_a_leaks_ramp_is_sharp_and_a_piece_of_the_ramp_is_not(seed: int) -> None:
+    """A leak's ramp (0.08 N·m·s over 300 s) along the strike's own direction: the ramp's staircase steps
+    are siblings of the strike (same direction), yet the strike's step is an impulse (a 16-s ramp fits it
+    worse by far more than 3 σ) and rule 4d calls it a strike; a step put inside the ramp alone (the
+    leak's own event) fits a 16-s ramp as well as a step (its sharpness below 9), and so do ramps of
+    30 s and 60 s (a short leak) of the strike's size."""
+    u = STRIKE / np.linalg.norm(STRIKE)
+    ramp = np.clip((T + 150.0) / 300.0, 0.0, 1.0)[:, None] * (0.08 * u)
+    fit = step_siblings(T, ramp + _h(0.0) * STRIKE + _noise(seed), 0.0)
+    assert fit is not None and fit.siblings >= 1 and fit.sharp_siblings == 0
+    assert fit.own_sharpness > 100.0
+    ev = EventEvidence(
+        body_share=0.3, body_share_sigma=0.01, wheel_takeup=1.0, st_gyro_step_rad=1e-5,
+        st_gyro_step_limit_rad=1e-3, lasting_fraction=1.6, raw_step_fraction=1.0, duration_lo_s=120.0,
+        **step_siblings_evidence(fit, float(np.linalg.norm(STRIKE))),
+    )  # fmt: skip
+    assert classify(ev).kind == "strike"
+    assert classify(ev, AttributionRules(step_sharp=False)).kind == "external_non_strike"
+    piece = step_siblings(T, ramp + _noise(seed), 0.0)
+    assert piece is not None and piece.own_sharpness < 9.0
+    for d in (30.0, 60.0):
+        short = np.clip((T + d / 2) / d, 0.0, 1.0)[:, None] * STRIKE
+        fit = step_siblings(T, short + _noise(seed), 0.0)
+        assert fit is not None and fit.own_sharpness < 9.0, d
+
+
+@pytest.mark.parametrize("seed", [21, 22])
+def test_a_pulse_followed_within_the_settling_time_by_another_along_it_is_no_lone_impulse(seed: int) -> None:
+    """Two pulses along one direction 21 s apart (a venting sequence, 0.08 then 0.05 N·m·s): the second is
+    inside the first's settling window, where no sibling is looked for, but it is more than a quarter of the
+    first along it (``close_siblings``), so rule 4d does not call the first a strike. A strike alone, or with
+    a pulse 21 s after it in another direction, has none."""
+    u = STRIKE / np.linalg.norm(STRIKE)
+    y = _h(0.0) * (0.08 * u) + _h(21.0) * (0.05 * u) + _noise(seed)
+    fit = step_siblings(T, y, 0.0)
+    assert fit is not None and fit.close_siblings == 1 and fit.own_sharpness > 100.0
+    ev = EventEvidence(
+        body_share=0.3, body_share_sigma=0.01, wheel_takeup=1.0, st_gyro_step_rad=1e-5,
+        st_gyro_step_limit_rad=1e-3, lasting_fraction=1.6, raw_step_fraction=1.0, duration_lo_s=20.0,
+        **step_siblings_evidence(fit, 0.08),
+    )  # fmt: skip
+    assert classify(ev).kind == "external_non_strike"
+    assert classify(replace(ev, step_close_siblings=0.0)).kind == "strike"  # what the close pulse changes
+    alone = step_siblings(T, _h(0.0) * (0.08 * u) + _noise(seed), 0.0)
+    assert alone is not None and alone.close_siblings == 0
+    w = np.cross(u, [1.0, 0.0, 0.0])
+    other = step_siblings(T, _h(0.0) * (0.08 * u) + _h(21.0) * (0.05 * w / np.linalg.norm(w)) + _noise(seed), 0.0)
+    assert other is not None and other.close_siblings == 0

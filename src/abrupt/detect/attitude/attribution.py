@@ -25,7 +25,11 @@ The rules read the evidence of :mod:`abrupt.detect.attitude.evidence`; none is f
    or (4c, ``step_alone``, on), inside a ramp or a sequence, no other step of the window shares the
    event's step's body direction (:func:`abrupt.detect.attitude.ramp_step.step_siblings`) and that
    fitted step lasts (``alone_step_lasting``: judged beside the window's other steps, which a raw
-   before/after balance counts too);
+   before/after balance counts too); or (4d, ``step_sharp``, on), that fitted step lasts and is itself an
+   impulse beside the window's other steps (``alone_step_sharpness``: a ramp of twice ``impulsive_s``
+   fits it worse), and no impulse of the window that moved the body shares its direction: an impulse on
+   a leak's ramp along its own direction, or beside a neighbouring torque that spoils the window's
+   one-ramp profile;
 5. **external_non_strike** when the sensors agree and a step lasts (either sign: the event's own ΔH
    may be a piece of a longer ramp) but it is a ramp or a sequence
    (duration interval above ``impulsive_s``), or the body share is small (a slow torque the loop kept
@@ -46,7 +50,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from abrupt.detect.attitude.evidence import EventEvidence
+from abrupt.detect.attitude.evidence import APPENDAGE_MIN_DEG, APPENDAGE_Z, EventEvidence
 
 ATTRIBUTION_KINDS = ("strike", "sensor_fault", "external_non_strike", "internal", "unknown")
 
@@ -70,8 +74,8 @@ class AttributionRules:
     wheel_sigma: float = 5.0
     spike_z: float = 8.0
     spike_match: float = 0.5
-    appendage_z: float = 12.0
-    appendage_min_deg: float = 0.2
+    appendage_z: float = APPENDAGE_Z
+    appendage_min_deg: float = APPENDAGE_MIN_DEG
     takeup_min: float = 0.5
     residual_max: float = 0.5
     #: A step at the event on top of a ramp/sequence is a second source when its part off the ramp's body
@@ -85,6 +89,10 @@ class AttributionRules:
     #: Rule 4c: an impulsive step that no other step of the window shares the body direction of is a strike
     #: inside a ramp or a sequence (or next to another source's step).
     step_alone: bool = True
+    #: Rule 4d: the event's fitted step is an impulse when a ramp of ``2 impulsive_s`` centred on it fits worse
+    #: by more than ``sharp_chi2`` (3 σ), every other step of the window fitted beside it.
+    step_sharp: bool = True
+    sharp_chi2: float = 9.0
 
 
 @dataclass(frozen=True)
@@ -164,6 +172,20 @@ def _alone(ev: EventEvidence, r: AttributionRules) -> bool:
         and ev.alone_step_lasting >= r.lasting_min
         and ev.alone_step_z > r.ramp_off_z
         and ev.step_siblings == 0
+    )
+
+
+def _sharp_alone(ev: EventEvidence, r: AttributionRules) -> bool:
+    """Rule 4d's test: the step at the event is the event's size, beyond its noise, lasts, and is an
+    impulse beside the window's other steps (its sharpness beyond ``sharp_chi2``), with no pulse along it
+    inside the settling time after it (where the siblings' search does not look)."""
+    return (
+        _finite(ev.alone_step_fraction, ev.alone_step_z, ev.alone_step_lasting, ev.alone_step_sharpness)
+        and ev.step_close_siblings == 0
+        and r.lasting_min <= ev.alone_step_fraction <= 1.0 / r.lasting_min
+        and ev.alone_step_lasting >= r.lasting_min
+        and ev.alone_step_z > r.ramp_off_z
+        and ev.alone_step_sharpness > r.sharp_chi2
     )
 
 
@@ -271,6 +293,12 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
     if r.step_alone and _alone(ev, r) and body_moved and in_raw:
         return Attribution(
             "strike", _confidence([True, True, False, surface_ok]), "", "impulsive step, alone in its body direction"
+        )
+    # 4d. An impulse beside the window's other steps (a leak's ramp along it, a neighbour's lasting change)
+    # that no impulse of the window which moved the body shares the direction of.
+    if r.step_sharp and _sharp_alone(ev, r) and body_moved and in_raw and not in_sequence:
+        return Attribution(
+            "strike", _confidence([True, True, False, surface_ok]), "", "impulsive step beside the window's other steps"
         )
     if abs(ev.lasting_fraction) >= r.lasting_min and (not impulsive or not body_moved or in_sequence):
         tests = [True, not impulsive or in_sequence, not body_moved]

@@ -51,7 +51,9 @@ telemetry (:class:`~abrupt.series.timetable.Timetable`) around the event:
   those the impulses that moved the body (``step_sharp_siblings``: a venting sequence's pulses; the body's
   share along the sibling's own direction, :func:`abrupt.detect.attitude.body_response.moved_siblings`),
   the impulses it did not feel (``step_still_siblings``: a wheel reading's glitch or miscount, a gyro or
-  star-tracker fault, all left out of ``step_siblings``); ``alone_step_lasting``: what
+  star-tracker fault, all left out of ``step_siblings``), and those at whose time an appendage drive
+  jumped (``step_internal_siblings``: a snap moves momentum between hub and appendage, which a momentum
+  model without the appendage reads as a step; no external impulse, also left out); ``alone_step_lasting``: what
   lasts of that fitted step (with the other steps within 150 s after it that point back against it)
   along itself over |ΔH|, judged beside the window's other steps rather than on the raw balance.
 """
@@ -59,7 +61,7 @@ telemetry (:class:`~abrupt.series.timetable.Timetable`) around the event:
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -75,6 +77,7 @@ from abrupt.detect.attitude.body_response import (
 )
 from abrupt.detect.attitude.body_response import window_rows as _idx
 from abrupt.detect.attitude.ramp_step import (
+    StepSiblings,
     WindowFits,
     body_frame_momentum,
     ramp_step_evidence,
@@ -86,6 +89,11 @@ from abrupt.series.timetable import NS, Timetable
 from abrupt.types import FloatArray
 
 NAN = float("nan")
+#: An appendage drive jumped when its rate leaves its running median by more than this many σ of its
+#: noise and the excess turns it by more than ``APPENDAGE_MIN_DEG`` (a snap or slip; a body-rate change
+#: that the drive follows turns it by far less).
+APPENDAGE_Z = 12.0
+APPENDAGE_MIN_DEG = 0.2
 
 
 @dataclass(frozen=True)
@@ -135,6 +143,9 @@ class EventEvidence:
     step_siblings: float = NAN
     step_sharp_siblings: float = NAN
     step_still_siblings: float = NAN
+    step_internal_siblings: float = NAN
+    alone_step_sharpness: float = NAN
+    step_close_siblings: float = NAN
     alone_step_lasting: float = NAN
     after_strike_s: float = NAN
 
@@ -324,9 +335,11 @@ def event_evidence(
             out.update(step_siblings_evidence(fits.siblings(), mag))
             # A sibling is a momentum change of the body; a one-channel fault's step beside the event is none.
             if "step_sharp_siblings" in out:
-                moved, still = moved_siblings(table, J, i0, fits.siblings())
+                sib, internal = _external_siblings(table, i0, dt, fits.siblings())
+                moved, still = moved_siblings(table, J, i0, sib)
                 out["step_sharp_siblings"], out["step_still_siblings"] = moved, still
-                out["step_siblings"] = float(out["step_siblings"]) - still
+                out["step_internal_siblings"] = internal
+                out["step_siblings"] = float(out["step_siblings"]) - still - internal
     out.update(_appendage(table, i0, dt))
     out.update(surface_evidence(spacecraft, dh_b))
     if raw_H_N is not None and mag > 0:
@@ -541,7 +554,37 @@ def _profile(
     return out
 
 
-def _appendage(table: Timetable, i0: int, dt: float) -> dict[str, float]:
+def _external_siblings(
+    table: Timetable, i0: int, dt: float, fit: StepSiblings | None
+) -> tuple[StepSiblings | None, int]:
+    """``fit`` without the sharp siblings at whose time an appendage drive jumped (:data:`APPENDAGE_Z`,
+    :data:`APPENDAGE_MIN_DEG`), and how many those were. A snap moves momentum between the hub and the
+    appendage; where the momentum model does not carry the appendage's momentum through the snap, the
+    computed ᴺH steps along the drive's axis and the body moves: a sharp step that is no external impulse,
+    so no pulse of a sequence the event could belong to. The drive is looked at from 5 s before the
+    sibling to 10 s after it, never within 3 s of the event (an impulse at the event may turn the drive)."""
+    if fit is None or not any(fit.sharp):
+        return fit, 0
+    g = table.time_ns
+    sharp = list(fit.sharp)
+    internal = 0
+    for j, tau_s in enumerate(fit.other_tau_s):
+        if not sharp[j]:
+            continue
+        k = int(np.clip(np.searchsorted(g, int(g[i0]) + round(tau_s * NS)), 0, g.size - 1))
+        after = min(10.0, -tau_s - 3.0) if tau_s < 0 else 10.0
+        a = _appendage(table, k, dt, near_s=(-5.0, after))
+        if a and a["appendage_z"] > APPENDAGE_Z and a["appendage_excess_deg"] > APPENDAGE_MIN_DEG:
+            sharp[j] = False
+            internal += 1
+    if not internal:
+        return fit, 0
+    return replace(fit, sharp=tuple(sharp), sharp_siblings=fit.sharp_siblings - internal), internal
+
+
+def _appendage(table: Timetable, i0: int, dt: float, near_s: tuple[float, float] = (-15.0, 25.0)) -> dict[str, float]:
+    """The largest abrupt change of an appendage drive's rate against its 61-s running median within
+    ``near_s`` of row ``i0``: its significance (``appendage_z``), the angle it adds and the drive."""
     rates = table.appendage_rate_rad_s
     if rates.ndim != 2 or rates.shape[1] == 0:
         return {}
@@ -553,7 +596,9 @@ def _appendage(table: Timetable, i0: int, dt: float) -> dict[str, float]:
             continue
         excess = seg - median_filter(seg, size=int(61 / dt) | 1, mode="nearest")
         sig = white_noise_sigma(seg)
-        near = slice(max(0, i0 - lo - int(15 / dt)), min(seg.size, i0 - lo + int(25 / dt)))
+        near = slice(max(0, i0 - lo + int(near_s[0] / dt)), min(seg.size, i0 - lo + int(near_s[1] / dt)))
+        if near.stop - near.start < 1:
+            continue
         z = float(np.max(np.abs(excess[near])) / max(sig, 1e-9))
         if not best or z > best["appendage_z"]:
             best = {

@@ -192,6 +192,12 @@ class StepSiblings:
     returns_B: FloatArray | None = None
     #: Per other step (in the order of ``other_tau_s``): is it a sharp sibling?
     sharp: tuple[bool, ...] = ()
+    #: How much worse (χ², noise units) the event's own step fits as a ramp of ``impulse_ramp_s`` centred on
+    #: it, every other step of the window in: > 0 when it is shorter than about half that ramp.
+    own_sharpness: float = NAN
+    #: 1 when a step within the settling time after the event points along S and is at least ``close_min``
+    #: of it (beyond what the loop's settling leaves): a pulse of a sequence too close to be a sibling.
+    close_siblings: int = 0
 
 
 def step_siblings(
@@ -206,6 +212,8 @@ def step_siblings(
     sibling_min: float = 0.1,
     sharp_chi2: float = 9.0,
     return_s: float = 150.0,
+    impulse_ramp_s: float = 16.0,
+    close_min: float = 0.25,
 ) -> StepSiblings | None:
     """The step at ``step_s`` and the other steps of the window around it, found one at a time.
 
@@ -226,7 +234,13 @@ def step_siblings(
     elsewhere). ``sharp_siblings`` counts those that are impulses themselves: a ramp over 2 ``settle_s``
     centred on the step fits worse by more than ``sharp_chi2`` (3 σ; a train of pulses; a piece of a
     leak's ramp or of the cleaning's smooth drift around a large step is not). ``returns_B`` sums the
-    other steps within ``return_s`` after the event that point against S (a pulse that returns). None
+    other steps within ``return_s`` after the event that point against S (a pulse that returns).
+    ``own_sharpness`` is the event's own step judged the same way against a ramp of ``impulse_ramp_s``
+    centred on it, beside the window's other steps: a step fits a ramp of duration D better than a ramp of
+    ``impulse_ramp_s`` when D is below about half of it, wherever a neighbouring torque's ramp or steps
+    fall (the window's one-ramp profile, :func:`abrupt.detect.attitude.evidence.ramp_duration`, has no
+    room for them). ``close_siblings`` looks once more inside the settling time, where only a step's size
+    tells a pulse of a sequence from the settling (a step at least ``close_min`` of S along it). None
     when the window is too short or its noise unknown.
     """
     window = _finite_window(tau_s, y_B)
@@ -237,21 +251,12 @@ def step_siblings(
     vw = v / sig
     steps = [step_s]
     cand = (t > t[0] + merge_s) & (t < t[-1] - merge_s)
+    settling = (t >= step_s) & (t <= step_s + settle_s)
     for _ in range(max_steps):
-        x = np.column_stack([np.ones_like(t), (t - t.mean()) / span, *[(t >= s).astype(np.float64) for s in steps]])
-        basis, _ = np.linalg.qr(x)
-        r = vw - basis @ (basis.T @ vw)
-        free = cand & np.all(np.abs(t[:, None] - np.asarray(steps)[None, :]) > merge_s, axis=1)
-        free &= ~((t >= step_s) & (t <= step_s + settle_s))
+        free = cand & np.all(np.abs(t[:, None] - np.asarray(steps)[None, :]) > merge_s, axis=1) & ~settling
         if not free.any():
             break
-        # Column H(τ − τ_k) against the residual (already orthogonal to the basis) and its part orthogonal
-        # to the basis, both from sums over the samples from k on.
-        tail_r = np.cumsum(r[::-1], axis=0)[::-1]
-        tail_b = np.cumsum(basis[::-1], axis=0)[::-1]
-        sxx = np.arange(t.size, 0, -1, dtype=np.float64) - np.sum(tail_b**2, axis=1)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            gain = np.where(free & (sxx > 1e-9), np.sum(tail_r**2, axis=1) / sxx, 0.0)
+        gain = _step_gain(t, vw, span, steps, free)
         m = int(np.argmax(gain))
         if not gain[m] > z_min**2:
             break
@@ -272,6 +277,7 @@ def step_siblings(
     after = (np.asarray(steps[1:]) > step_s) & (np.asarray(steps[1:]) <= step_s + return_s)
     back = after & (cosines <= -cos_min) if len(others) else np.zeros(0, bool)
     return StepSiblings(
+        close_siblings=_close_sibling(t, vw, v, span, steps, settling, merge_s, z_min, s_b, cos_min, close_min),
         step_B=s_b,
         step_sigma=float(np.sqrt(np.mean(sig**2))) * math.sqrt(max(cov[2, 2], 0.0)),
         siblings=int(np.sum(parallel)),
@@ -281,7 +287,51 @@ def step_siblings(
         sharp_siblings=int(np.sum(parallel & sharp.astype(bool))),
         returns_B=np.sum(others[back], axis=0) if back.any() else np.zeros(3),
         sharp=tuple(bool(x) for x in parallel & sharp.astype(bool)),
+        own_sharpness=_sharpness(t, vw, cols, 2, impulse_ramp_s),
     )
+
+
+def _close_sibling(
+    t: FloatArray,
+    vw: FloatArray,
+    v: FloatArray,
+    span: float,
+    steps: list[float],
+    settling: np.ndarray,
+    merge_s: float,
+    z_min: float,
+    s_b: FloatArray,
+    cos_min: float,
+    close_min: float,
+) -> int:
+    """1 when the best further step inside the settling time (beyond ``z_min``², more than ``merge_s`` from every
+    step) points within ``cos_min`` of ``s_b`` with at least ``close_min`` of its size; else 0."""
+    free = settling & np.all(np.abs(t[:, None] - np.asarray(steps)[None, :]) > merge_s, axis=1)
+    if not free.any():
+        return 0
+    gain = _step_gain(t, vw, span, steps, free)
+    m = int(np.argmax(gain))
+    if not gain[m] > z_min**2:
+        return 0
+    x = np.column_stack([np.ones_like(t), t - t.mean(), *[(t >= s).astype(np.float64) for s in [*steps, float(t[m])]]])
+    coef, *_ = np.linalg.lstsq(x, v, rcond=None)
+    p, mag = coef[-1], float(np.linalg.norm(s_b))
+    p_mag = float(np.linalg.norm(p))
+    return int(mag > 0 and p_mag >= close_min * mag and float(p @ s_b) >= cos_min * p_mag * mag)
+
+
+def _step_gain(t: FloatArray, vw: FloatArray, span: float, steps: list[float], free: np.ndarray) -> FloatArray:
+    """Per sample k where ``free``: the χ² a step H(τ − τ_k) takes from the residual of the fit with ``steps``
+    (0 elsewhere). The column against the residual (already orthogonal to the basis) and its part
+    orthogonal to the basis both come from sums over the samples from k on."""
+    x = np.column_stack([np.ones_like(t), (t - t.mean()) / span, *[(t >= s).astype(np.float64) for s in steps]])
+    basis, _ = np.linalg.qr(x)
+    r = vw - basis @ (basis.T @ vw)
+    tail_r = np.cumsum(r[::-1], axis=0)[::-1]
+    tail_b = np.cumsum(basis[::-1], axis=0)[::-1]
+    sxx = np.arange(t.size, 0, -1, dtype=np.float64) - np.sum(tail_b**2, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(free & (sxx > 1e-9), np.sum(tail_r**2, axis=1) / sxx, 0.0)
 
 
 def _chi2(x: FloatArray, vw: FloatArray) -> float:
@@ -307,6 +357,8 @@ def step_siblings_evidence(fit: StepSiblings | None, dh_mag: float) -> dict[str,
     back = fit.returns_B if fit.returns_B is not None else np.zeros(3)
     lasting = float((fit.step_B + back) @ fit.step_B) / s / dh_mag if s > 0 else NAN
     return {
+        "alone_step_sharpness": fit.own_sharpness,
+        "step_close_siblings": float(fit.close_siblings),
         "alone_step_lasting": lasting,
         "alone_step_fraction": s / dh_mag,
         "alone_step_z": s / fit.step_sigma if fit.step_sigma > 0 else NAN,
