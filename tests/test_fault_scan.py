@@ -12,6 +12,7 @@ import pytest
 from scipy.ndimage import median_filter
 
 from abrupt.detect.attitude.fault_scan import (
+    CLUSTER_S,
     FaultFinding,
     column_median,
     rate_departures,
@@ -20,9 +21,19 @@ from abrupt.detect.attitude.fault_scan import (
     scan_faults_each,
     scan_rate_sensors,
     scan_wheels,
-    tail_threshold,
-    wheel_jump_statistic,
 )
+from abrupt.detect.attitude.tail_fit import tail_threshold
+from abrupt.detect.attitude.wheel_reading import (
+    PAIR_COEFFS,
+    STEP_COEFFS,
+    WheelReading,
+    quantisation_bound,
+    quantisation_variance,
+    wheel_jump_statistic,
+    wheel_statistics,
+    wheel_threshold,
+)
+from abrupt.detect.attitude.window_stats import clusters
 from abrupt.events import Event, events_frame
 from abrupt.model.spacecraft import load_spacecraft
 from abrupt.pipelines.flight_checks import flight_channels
@@ -81,17 +92,108 @@ def test_wheel_jump_statistic_of_a_miscount_and_a_step_on_a_quantised_ramp() -> 
     q = 0.098  # rad/s per pulse
     t = np.arange(4000.0)
     speed = q * np.round((100.0 + 0.01 * t + 1e-6 * t**2) / q)  # a quantised smooth speed
-    sigma_floor = q / math.sqrt(6.0)
     miscount = speed.copy()
     miscount[1000] += 12 * q  # one reading off by 12 pulses
-    z, sigma = wheel_jump_statistic(miscount, q)
-    assert sigma == pytest.approx(sigma_floor)
-    assert int(np.argmax(z)) == 999  # the pair of jumps into and out of the sample
-    assert z.max() == pytest.approx(math.sqrt(2.0) * 12 * q / sigma_floor, rel=0.1)
+    z, sigma = wheel_jump_statistic(miscount, WheelReading(q, 1))
+    assert int(np.nanargmax(z)) == 999  # the pair of jumps into and out of the sample
+    assert np.nanmax(z) * sigma == pytest.approx(12 * q, abs=q)  # the pair: the reading against its neighbours
     step = speed.copy()
     step[2000:] += 20 * q
-    z2, _ = wheel_jump_statistic(step, q)
-    assert int(np.argmax(z2)) == 1999 and z2.max() == pytest.approx(20 * q / sigma_floor, rel=0.1)
+    z2, sigma2 = wheel_jump_statistic(step, WheelReading(q, 1))
+    # The step less twice the mean first difference over 11 samples, which holds 1/11 of it.
+    assert int(np.nanargmax(z2)) == 1999 and np.nanmax(z2) * sigma2 == pytest.approx(20 * q * 9 / 11, abs=q)
+
+
+def _counter(speed_q: np.ndarray, gate_lag: int | None, rng: np.random.Generator) -> np.ndarray:
+    """Readings [quanta] of a counter: with a gate of one sample, ⌊P_k⌋ − ⌊P_(k−1)⌋ of the pulse phase P
+    (cumulative speed in quanta); with a gate that shares no instant with another, ⌊u_k + v_k⌋ − ⌊u_k⌋ with
+    an independent start fraction u_k."""
+    if gate_lag == 1:
+        return np.diff(np.floor(np.cumsum(np.r_[rng.uniform(), speed_q])))
+    u = rng.uniform(size=speed_q.size)
+    return np.floor(u + speed_q) - np.floor(u)
+
+
+def _speed_q(n: int, noise_q: float, rng: np.random.Generator) -> np.ndarray:
+    """A wheel's speed in quanta per gate: a slow sweep over hundreds of pulses, a random walk, and a white
+    noise of ``noise_q`` quanta (before the counter)."""
+    t = np.arange(n, dtype=np.float64)
+    walk = np.cumsum(0.002 * rng.standard_normal(n))
+    return 1000.0 + 300.0 * np.sin(2 * np.pi * t / 5800.0) + walk + noise_q * rng.standard_normal(n)
+
+
+@pytest.mark.parametrize("gate_lag", [1, None])
+def test_quantisation_of_a_counter_stays_within_its_bound_with_the_stated_variance(gate_lag: int | None) -> None:
+    rng = np.random.default_rng(21)
+    true = _speed_q(200_000, 0.0, rng)
+    x = _counter(true, gate_lag, rng)
+    reading = WheelReading(1.0, gate_lag)
+    for coeffs, k in ((STEP_COEFFS, 0), (PAIR_COEFFS, 1)):
+        e = wheel_statistics(x)[k] - wheel_statistics(true)[k]  # |s| − |c| ≤ |e|: checked through the bound
+        quant = np.abs(wheel_statistics(x - true)[k])  # the quantisation part alone (the statistics are linear)
+        assert np.nanmax(quant) < quantisation_bound(coeffs, 1.0)
+        assert np.nanmax(np.abs(e)) < quantisation_bound(coeffs, 1.0)
+        assert np.nanmean(quant**2) == pytest.approx(quantisation_variance(coeffs, reading), rel=0.03)
+
+
+@pytest.mark.parametrize(
+    ("quantum", "noise_q", "gate_lag"),
+    [(1.0, 0.0, 1), (1.0, 0.1, 1), (1.0, 0.3, 1), (1.0, 0.3, None), (1.0, 1.0, 1), (1.0, 3.0, 1), (0.0, 1.0, None)],
+)
+def test_wheel_threshold_keeps_its_rate_on_counters_from_coarse_to_unquantised(
+    quantum: float, noise_q: float, gate_lag: int | None
+) -> None:
+    # Null days: a speed read through a counter of quantum q at several noise/quantum ratios (q = 0: the
+    # speed read as it is, with a Laplace noise). Every cluster of samples above the day's threshold (the
+    # scan's: exceedances within CLUSTER_S are one finding) is a false alarm; their count over all days
+    # stays within the stated rate (Poisson, one-sided 0.1 %).
+    rng = np.random.default_rng(int(10 * noise_q) + (7 if gate_lag is None else 0) + int(quantum))
+    p, n, days = 2e-5, 86_400, 12
+    t = np.arange(n - 1, dtype=np.int64) * NS
+    exceed = 0
+    for _ in range(days):
+        true = _speed_q(n, 0.0, rng)
+        if quantum > 0:
+            x = _counter(true + noise_q * rng.standard_normal(n), gate_lag, rng)
+        else:
+            x = true + rng.laplace(scale=noise_q / math.sqrt(2.0), size=n)
+        reading = WheelReading(quantum, gate_lag)
+        z, sigma = wheel_jump_statistic(x, reading)
+        thr = wheel_threshold(*wheel_statistics(x), reading, p, sigma)
+        exceed += len(clusters(t, np.nan_to_num(z), z > thr, CLUSTER_S))
+    expected = p * n * days  # 20.7
+    assert exceed <= expected + 3.1 * math.sqrt(expected) + 1
+
+
+@pytest.mark.parametrize("noise_q", [0.0, 0.1])
+def test_a_miscount_of_five_pulses_is_found_on_a_coarse_counter(noise_q: float) -> None:
+    # Without continuous noise the threshold is the step's quantisation bound, (2 + 4/11) quanta, plus the
+    # Laplace tail of the continuous part's estimate (its sampling noise, a few hundredths of a quantum);
+    # a miscount of N pulses gives a pair of N + e/2 with e an integer, |e| < 4, so every N >= 5 is found;
+    # N = 3 unless the quantisation takes 1 or more from it; N = 1 never stands out. With a noise of 0.1
+    # quantum before the counter its tail adds about a quantum: N = 3 is then lost, N >= 5 still found.
+    # Each day has a miscount every half hour and is calibrated with them in it.
+    rng = np.random.default_rng(5)
+    n = 86_400
+    reading = WheelReading(1.0, 1)
+    found, sizes = [], []
+    for _ in range(4):
+        x = _counter(_speed_q(n, noise_q, rng), 1, rng)
+        at = np.arange(900, n - 900, 1800) + rng.integers(-300, 300, size=47)
+        pulses = rng.choice([1, 3, 5, 6, 8], size=at.size)
+        x[at] += pulses * rng.choice([-1, 1], size=at.size)
+        z, sigma = wheel_jump_statistic(x, reading)
+        thr = wheel_threshold(*wheel_statistics(x), reading, 0.1 / 86_400, sigma)
+        # The bound, plus a Laplace tail of the continuous part (its standard deviation in the pair: √1.5 σ_n).
+        assert thr * sigma < 2.37 + 0.7 + math.sqrt(1.5) * noise_q * 10.2
+        found.append(z[at - 1] > thr)
+        sizes.append(pulses)
+    hit, size = np.concatenate(found), np.concatenate(sizes)
+    rate = {k: float(np.mean(hit[size == k])) for k in (1, 3, 5, 6, 8)}
+    if noise_q == 0.0:
+        assert rate[5] == rate[6] == rate[8] == 1.0
+        assert rate[3] > 0.4
+    assert min(rate[5], rate[6], rate[8]) > 0.9 and rate[1] < 0.1
 
 
 def test_rate_departures_real_motion_moves_both_sensors_a_fault_only_one() -> None:

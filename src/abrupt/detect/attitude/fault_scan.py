@@ -7,10 +7,14 @@ each channel against the physics the other channels must obey:
 * **wheel tachometer** (channel ``wheel_N``): a wheel's speed changes only through its motor torque,
   whose reaction turns the body: a real change J_s ΔΩ in one sample is matched by the body's
   momentum change J Δω (Bennett 2022, Eq. 2.5: H = J ω + Σ J_s Ω ĝ is conserved without external
-  torque). The statistic is the jump of the wheel's raw reading (its first difference against an
-  11-sample running median) over its noise (robust scale, never below the tachometer's quantum
-  q/√6, the standard deviation of the difference of two quantised readings); a jump is a fault when
-  the body's momentum change around it is less than half of the momentum the reading claims;
+  torque). The statistics are linear in the wheel's raw readings: a step (the mean of the two readings
+  after an instant against the two before, less the wheel's steady acceleration over 11 samples) and a
+  pair (a reading against the mean of its neighbours: a miscount of N pulses and back gives N quanta),
+  :mod:`abrupt.detect.attitude.wheel_reading`. A tachometer's reading is the speed plus an error within
+  one quantum, so their quantisation part is bounded and only the speed's own noise has a tail: the
+  threshold is that bound plus the tail of the continuous part (``wheel_threshold``), or on a fine or
+  unquantised reading the exponential tail fitted beyond the bound. A jump is a fault when the body's
+  momentum change around it is less than half of the momentum the reading claims;
 * **gyro and star tracker** (channels ``gyro_x/y/z``, ``star_tracker``): real motion moves both rate
   sensors, so the difference of the gyro's rate and the tracker's (2 vec(q_k⁻¹ ⊗ q_k+1)/dt, centred)
   stays at its noise. Where it leaves it, the sensor that left its own 11-sample running median while
@@ -30,10 +34,10 @@ each channel against the physics the other channels must obey:
 
 Each channel's threshold is set on the day in front of it for a stated false-alarm rate per channel
 (:data:`FAULT_FALSE_ALARMS`): an exponential tail fitted to the exceedance counts of its own
-statistic (:func:`tail_threshold`), which a few faults in the day do not move (the fit uses levels
-that hundreds of samples exceed). A channel with fewer than 2 ``TAIL_COUNTS[0]`` analysed samples
-in the day is not scanned (its tail cannot be fitted). The exceedances of each channel are counted
-and reported beside the stated rate (:class:`ChannelCalibration`).
+statistic (:func:`~abrupt.detect.attitude.tail_fit.tail_threshold`), which a few faults in the day do
+not move (the fit uses levels that hundreds of samples exceed); a wheel's as above. A channel with
+fewer than 2 ``TAIL_COUNTS[0]`` analysed samples in the day is not scanned (its tail cannot be fitted).
+The exceedances of each channel are counted and reported beside the stated rate (:class:`ChannelCalibration`).
 """
 
 from __future__ import annotations
@@ -48,6 +52,14 @@ from scipy.ndimage import median_filter
 
 from abrupt.detect.attitude.attribution import AttributionRules
 from abrupt.detect.attitude.body_response import centred_tracker_rate
+from abrupt.detect.attitude.tail_fit import QUIET_SIGMA, TAIL_COUNTS, floored_threshold, robust_sigma
+from abrupt.detect.attitude.wheel_reading import (
+    WheelReading,
+    wheel_jump_statistic,
+    wheel_reading,
+    wheel_statistics,
+    wheel_threshold,
+)
 from abrupt.detect.attitude.window_stats import clusters, trimmed_threshold, window_difference
 from abrupt.model.flight_config import FlightConfig
 from abrupt.model.spacecraft import Spacecraft
@@ -61,8 +73,6 @@ FAULT_FALSE_ALARMS = FalseAlarmBudget(0.1, "day")
 CLUSTER_S = 5.0
 #: A wheel jump is a fault when the body shows less than this share of the momentum the reading claims.
 BODY_SHARE_MAX = 0.5
-#: A sensor "stayed on its own median" when its departure is below this many σ of its own noise.
-QUIET_SIGMA = 5.0
 #: Smallest angle [rad] an appendage jump must add to be a snap (the attribution rules' 0.2°).
 SNAP_MIN_RAD = math.radians(AttributionRules().appendage_min_deg)
 #: The window W [s] of the gyro bias-step scan: the mean of gyro − tracker over W after against W before.
@@ -73,8 +83,6 @@ BIAS_MIN_COVER = 0.8
 BIAS_LASTING_SHARE = 0.5
 #: A bias step is the gyro's alone: the tracker's own W-window difference is below this share of it.
 BIAS_TRACKER_SHARE = 0.5
-#: Fewest exceedances of the lowest and the highest level of the tail fit.
-TAIL_COUNTS = (3000, 300)
 
 SECONDS_PER_DAY = 86400.0
 
@@ -124,48 +132,6 @@ class FaultScan:
         )
 
 
-def robust_sigma(x: FloatArray) -> float:
-    """σ from the median absolute deviation of the finite values (0 when there are none)."""
-    v = x[np.isfinite(x)]
-    return float(np.median(np.abs(v - np.median(v))) / 0.6745) if v.size else 0.0
-
-
-def tail_threshold(z: FloatArray, p_sample: float) -> float:
-    """The level a sample of ``z`` exceeds with probability ``p_sample``, from an exponential tail.
-
-    log N(z ≥ u) is fitted by a line in u over the levels exceeded by between ``TAIL_COUNTS[0]`` and
-    ``TAIL_COUNTS[1]`` samples (at least three distinct ones: a quantised statistic takes few values,
-    so the range is widened downwards until it has them) and extrapolated to N = p_sample · n. A
-    Laplace tail is exactly exponential; a Gaussian one falls faster, so its realised rate is below
-    the stated one.
-    """
-    v = np.sort(z[np.isfinite(z)])
-    n = v.size
-    if n < 2 * TAIL_COUNTS[0]:
-        raise ValueError(f"need at least {2 * TAIL_COUNTS[0]} samples to fit a tail, got {n}")
-    top = TAIL_COUNTS[0]
-    while True:
-        ranks = np.unique(np.geomspace(top, TAIL_COUNTS[1], 12).astype(int))
-        levels = np.unique(v[n - ranks])
-        if levels.size >= 3 or top >= n // 4:
-            break
-        top *= 4
-    counts = n - np.searchsorted(v, levels, side="left")
-    if levels.size < 2:
-        return float(v[-1])
-    slope, icpt = np.polyfit(levels, np.log(counts), 1)
-    if not slope < 0:
-        return float(v[-1])
-    return float(max((math.log(max(p_sample * n, 1e-300)) - icpt) / slope, levels[-1]))
-
-
-def _threshold(z: FloatArray, p_sample: float) -> float:
-    """The tail's level for ``p_sample``, never below ``QUIET_SIGMA``: a channel whose statistic is
-    degenerate (a noiseless or coarsely quantised reading) has no tail to fit, and nothing within
-    ``QUIET_SIGMA`` of its own noise is a fault."""
-    return max(tail_threshold(z, p_sample), QUIET_SIGMA)
-
-
 def contiguous_runs(mask: BoolArray) -> list[slice]:
     """The runs of True in ``mask`` as slices."""
     m = np.concatenate([[False], np.asarray(mask, bool), [False]])
@@ -183,22 +149,6 @@ def column_median(x: FloatArray, size: int) -> FloatArray:
     for k in range(x.shape[1]):
         out[:, k] = median_filter(x[:, k], size=size, mode="nearest")
     return out
-
-
-def wheel_jump_statistic(speed_rad_s: FloatArray, quantum_rad_s: float = 0.0) -> tuple[FloatArray, float]:
-    """Jumps of a wheel's raw speed against its own noise [σ], element k between samples k and k+1.
-
-    r is each first difference minus its 11-sample running median; σ its robust scale, at least q/√6
-    for a tachometer of quantum q (the difference of two quantised readings). The statistic is the
-    larger of |r_k| / σ (a step: a reading that moved and stayed) and |r_k − r_k+1| / (√2 σ) (one
-    sample off and back, a miscount: the matched filter of the pair). Returns (statistic, σ [rad/s]).
-    """
-    d = np.diff(speed_rad_s)
-    r = d - median_filter(d, size=11, mode="nearest")
-    sigma = max(robust_sigma(r), quantum_rad_s / math.sqrt(6.0), 1e-12)
-    pair = np.zeros_like(r)
-    pair[:-1] = np.abs(r[:-1] - r[1:]) / math.sqrt(2.0)
-    return np.maximum(np.abs(r), pair) / sigma, sigma
 
 
 def rate_difference(q_BN: FloatArray, omega_B: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:
@@ -249,6 +199,9 @@ class _WheelSeries:
     t_jump: np.ndarray
     z: FloatArray
     sigma: float
+    step: FloatArray
+    pair: FloatArray
+    reading: WheelReading
 
 
 def _wheel_series(samples: pd.DataFrame, flight: FlightConfig, table: Timetable, ok: BoolArray) -> list[_WheelSeries]:
@@ -263,13 +216,15 @@ def _wheel_series(samples: pd.DataFrame, flight: FlightConfig, table: Timetable,
         t, x = t[order], sub["value"].to_numpy(np.float64)[order] * ch.to_si
         if t.size < 2 * TAIL_COUNTS[0]:
             continue
-        quantum = ch.tachometer.quantum_rad_s if ch.tachometer is not None else 0.0
-        z, sigma = wheel_jump_statistic(x, quantum)
+        reading = wheel_reading(ch.tachometer, float(np.median(np.diff(t))) / NS)
+        z, sigma = wheel_jump_statistic(x, reading)
+        step, pair = wheel_statistics(x)
         on_grid = np.clip(np.searchsorted(table.time_ns, t[1:]), 0, max(table.time_ns.size - 1, 0))
         z[~ok_near[on_grid]] = np.nan
         gaps = np.diff(t) > 1.5 * np.median(np.diff(t))
         z[gaps | np.r_[False, gaps[:-1]] | np.r_[gaps[1:], False]] = np.nan  # a jump across a gap is no jump
-        out.append(_WheelSeries(f"wheel_{ch.component + 1}", ch.component, t[1:], z, sigma))
+        step[~np.isfinite(z)], pair[~np.isfinite(z)] = np.nan, np.nan
+        out.append(_WheelSeries(f"wheel_{ch.component + 1}", ch.component, t[1:], z, sigma, step, pair, reading))
     return out
 
 
@@ -291,7 +246,7 @@ def _wheel_findings(
         if np.isfinite(z[in_core]).sum() < 2 * TAIL_COUNTS[0]:
             continue
         p, days = _rate(budget, t_jump[in_core])
-        thr = _threshold(z[in_core], p)
+        thr = wheel_threshold(w.step[in_core], w.pair[in_core], w.reading, p, sigma)
         js = float(spacecraft.wheel_spin_inertias_kgm2[w.component])
         peaks = clusters(t_jump, z, in_core & (z > thr), CLUSTER_S)
         n_found = 0
@@ -427,7 +382,7 @@ def _rate_findings(series: _RateSeries | None, core: tuple[int, int], budget: Fa
     cals: list[ChannelCalibration] = []
     # Gyro axis k: it left its median, the tracker stayed on its own on every axis.
     for k in range(3):
-        thr = _threshold(z_err[in_core, k], p / 2.0)
+        thr = floored_threshold(z_err[in_core, k], p / 2.0)
         peaks = clusters(t, z_err[:, k], in_core & (z_err[:, k] > thr), CLUSTER_S)
         hits = [j for j in peaks if gyro_moved[j, k] and not st_moved[j].any()]
         name = f"gyro_{'xyz'[k]}"
@@ -437,7 +392,7 @@ def _rate_findings(series: _RateSeries | None, core: tuple[int, int], budget: Fa
         cals.append(ChannelCalibration(name, core[0], thr, gyro.per_day, len(peaks), len(hits), days))
     # Star tracker: the 3-axis mismatch; the tracker left its median, the gyro stayed on its own.
     z3 = np.max(z_err, axis=1)
-    thr = _threshold(z3[in_core], p * 3.0)  # the largest of three axes: three chances per sample
+    thr = floored_threshold(z3[in_core], p * 3.0)  # the largest of three axes: three chances per sample
     peaks = clusters(t, z3, in_core & (z3 > thr), CLUSTER_S)
     hits = [j for j in peaks if st_moved[j].any() and not gyro_moved[j].any()]
     for j in hits:
@@ -498,7 +453,7 @@ def _appendage_findings(series: list[_DriveSeries], core: tuple[int, int], budge
         p, days = _rate(budget, t[in_core])
         if np.isfinite(z[in_core]).sum() < 2 * TAIL_COUNTS[0]:
             continue
-        thr = _threshold(z[in_core], p)
+        thr = floored_threshold(z[in_core], p)
         peaks = clusters(t, z, in_core & (z > thr), gap_s=30.0)
         name = f"appendage_{d.k + 1}"
         # The angle the jump adds over ±15 s must be beyond the drive's resolution (a physical floor).
