@@ -176,13 +176,15 @@ def _off_ramp(ev: EventEvidence, r: AttributionRules) -> bool:
 def _alone(ev: EventEvidence, r: AttributionRules) -> bool:
     """Rule 4c's test: the step at the event is the event's size, beyond its noise, lasts (judged on the
     fitted steps: a venting train or a ramp around it swamps a raw before/after balance), and no other
-    step of the window shares its body direction (within 30°, same sign)."""
+    step of the window shares its body direction (within 30°, same sign), nor a pulse within the settling
+    time after it (``step_close_siblings``)."""
     return (
         _finite(ev.alone_step_fraction, ev.alone_step_z, ev.step_siblings, ev.alone_step_lasting)
         and r.lasting_min <= ev.alone_step_fraction <= 1.0 / r.lasting_min
         and ev.alone_step_lasting >= r.lasting_min
         and ev.alone_step_z > r.ramp_off_z
         and ev.step_siblings == 0
+        and not ev.step_close_siblings > 0
     )
 
 
