@@ -131,30 +131,16 @@ def body_share(
     return share, sigma, float(np.max(np.linalg.norm(median_filter(d_om, size=(5, 1), mode="nearest"), axis=1)))
 
 
-def _felt_less_than_an_impulse(share: float, sigma: float, impulse_share: float) -> bool:
-    """The body's share is below half of what an impulse gives (``impulse_share``, the event's own share)
-    by more than 3 σ; without a reference (NaN), below ``BODY_SIGMA`` σ is enough."""
-    if not (math.isfinite(share) and math.isfinite(sigma)):
-        return True
-    if not (math.isfinite(impulse_share) and impulse_share > 0):
-        return True
-    return share + 3.0 * sigma < 0.5 * impulse_share
-
-
 def moved_siblings(
     table: Timetable,
     J: FloatArray,
     i0: int,
     fit: StepSiblings | None,
     sigma: float = BODY_SIGMA,
-    impulse_share: float = float("nan"),
 ) -> tuple[int, int]:
     """(moved, still): of the sharp siblings of ``fit`` (the event's window fit at row ``i0``), how many the
     body felt (:func:`body_share` along the sibling's own body direction beyond ``sigma`` σ of its noise)
-    and how many it did not (a one-channel fault's step). With ``impulse_share``, the share an impulse
-    gives this body's loop (the event's own), a sibling is still only when its share is below half of
-    that by more than 3 σ; a pulse too small for the body's noise to tell either way (a venting pulse of
-    0.01 N·m·s beside one of 0.04) counts as moved: the loop's response, not the telemetry, decides.
+    and how many it did not (a one-channel fault's step, or a pulse too small for the body's noise).
 
     The response of a sibling before the event is looked for up to 3 s before the event (an impulse's
     share peaks at once; the event's own response, along nearly the same direction, must not count as
@@ -172,8 +158,6 @@ def moved_siblings(
         share, sig, _ = body_share(table, J, k, p_b / mag, mag, response_s=until) if mag > 0 else (NAN, NAN, NAN)
         if math.isfinite(share) and math.isfinite(sig) and share > 0 and share >= sigma * sig:
             moved += 1
-        elif _felt_less_than_an_impulse(share, sig, impulse_share):
-            still += 1
         else:
-            moved += 1  # too small for the body's noise to say: an impulse as likely as not
+            still += 1
     return moved, still

@@ -338,8 +338,7 @@ def event_evidence(
             # A sibling is a momentum change of the body; a one-channel fault's step beside the event is none.
             if "step_sharp_siblings" in out:
                 sib, internal = external_siblings(table, i0, dt, fits.siblings())
-                ref = float(out.get("body_share", NAN))
-                moved, still = moved_siblings(table, J, i0, sib, impulse_share=ref)
+                moved, still = moved_siblings(table, J, i0, sib)
                 out["step_sharp_siblings"], out["step_still_siblings"] = moved, still
                 out["step_internal_siblings"] = internal
                 out["step_siblings"] = float(out["step_siblings"]) - still - internal
