@@ -131,8 +131,9 @@ def _lasting_impulse(ev: EventEvidence, r: AttributionRules) -> bool:
 def _body_moved(ev: EventEvidence, r: AttributionRules) -> bool:
     """The body felt the event: its share along ΔĤ, or along the step the window's fit puts at the event
     (``step_body_share``), beyond ``body_sigma`` σ of its noise. The two differ when a neighbour's step
-    (a wheel glitch's edge 20-60 s before) shares the detector's windows: ΔH then mixes both, and along
-    its direction the body shows little of a strike the fit separates from the neighbour."""
+    (a wheel glitch's end a few seconds after a strike) shares the detector's windows: ΔH then mixes
+    both, and along its direction the body shows little of a strike the fit separates from the
+    neighbour."""
 
     def moved(share: float, sigma: float) -> bool:
         return _finite(share, sigma) and share >= max(r.body_share_min, r.body_sigma * sigma)
