@@ -30,6 +30,7 @@ from abrupt.events import Event, events_frame, make_event_id, write_events
 from abrupt.model.spacecraft import load_spacecraft
 from abrupt.pipelines.flight import ingest_archives
 from abrupt.pipelines.flight_orbit import read_orbit_events
+from attitude_events import attitude_event
 from flight_synth import make_archive, spacecraft_toml
 
 T0 = np.datetime64("2026-01-05T03:00:00", "ns")
@@ -42,22 +43,7 @@ def _at(seconds: float) -> str:
 
 def _attitude(kind: str = "strike", *, dh: float = 0.05, **ev: float) -> pd.DataFrame:
     """One attributed attitude event at T0 (the flight pipeline's columns that the orbit rules read)."""
-    e = Event(
-        spacecraft="SC-Z",
-        kind=kind,
-        detector="attitude.flight_glr",
-        time_utc=_at(0.0),
-        statistic=50.0,
-        threshold=10.0,
-        false_alarms_per_day=1.0,
-        run_id="r",
-        config_hash="c",
-        time_sigma_s=1.0,
-        dH_N_x_Nms=dh,
-        dH_N_y_Nms=0.0,
-        dH_N_z_Nms=0.0,
-        extra={"kind_confidence": 0.9, "kind_channel": "", "kind_reason": "impulsive external step", **ev},
-    )
+    e = attitude_event(kind, _at(0.0), dh_x_Nms=dh, **ev)
     return events_frame([e])
 
 

@@ -25,6 +25,7 @@ from abrupt.pipelines.flight import ingest_archives
 from abrupt.pipelines.orbit import epoch_intervals
 from abrupt.pipelines.orbit_blocks import BlockOutcome
 from abrupt.thresholds import Threshold
+from attitude_events import attitude_event
 from flight_synth import make_archive, spacecraft_toml
 
 H = np.timedelta64(3600, "s")
@@ -32,22 +33,7 @@ FLOOR = 2e-4  # [m/s]
 
 
 def _event(kind: str, t_utc: str, **extra: float) -> Event:
-    return Event(
-        spacecraft="SC-Z",
-        kind=kind,
-        detector="attitude.flight_glr",
-        time_utc=t_utc,
-        statistic=50.0,
-        threshold=10.0,
-        false_alarms_per_day=1.0,
-        run_id="r",
-        config_hash="c",
-        time_sigma_s=1.0,
-        dH_N_x_Nms=0.5,
-        dH_N_y_Nms=0.0,
-        dH_N_z_Nms=0.0,
-        extra={"kind_confidence": 0.9, "kind_channel": "", "kind_reason": "impulsive external step", **extra},
-    )
+    return attitude_event(kind, t_utc, dh_x_Nms=0.5, **extra)
 
 
 def _orbit_events(*rows: tuple[str, float], run_id: str = "o") -> pd.DataFrame:

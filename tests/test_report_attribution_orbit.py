@@ -16,11 +16,12 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from abrupt.events import Event, events_frame
+from abrupt.events import events_frame
 from abrupt.model.spacecraft import bundled_spacecraft_path, load_spacecraft
 from abrupt.report.attribution import EventPanel, OrbitSide, event_panels_figure
 from abrupt.report.flight import orbit_side_html
 from abrupt.series.timetable import NS, Timetable
+from attitude_events import attitude_event
 
 T0_NS = int(pd.Timestamp("2026-01-05T03:00:00").value)
 FLOOR = 2e-4  # [m/s]
@@ -40,23 +41,7 @@ def _table(n_wheels: int) -> Timetable:
 def _events(**orbit: list[float]) -> pd.DataFrame:
     times = ["2026-01-05T03:00:00.000000Z", "2026-01-05T03:00:00.000000Z", "2026-01-05T03:00:00.000000Z"]
     frame = events_frame(
-        [
-            Event(
-                spacecraft="SC-Z",
-                kind=k,
-                detector="attitude.flight_glr",
-                time_utc=t,
-                statistic=50.0,
-                threshold=10.0,
-                false_alarms_per_day=1.0,
-                run_id="r",
-                config_hash="c",
-                dH_N_x_Nms=0.05,
-                dH_N_y_Nms=0.0,
-                dH_N_z_Nms=0.0,
-            )
-            for k, t in zip(("strike", "unknown", "strike"), times, strict=True)
-        ]
+        [attitude_event(k, t, attributed=False) for k, t in zip(("strike", "unknown", "strike"), times, strict=True)]
     )
     for name, values in orbit.items():
         frame[name] = values
