@@ -31,7 +31,7 @@ import numpy as np
 import pandas as pd
 
 from abrupt.detect.attitude.attribution import AttributionRules, classify
-from abrupt.detect.attitude.evidence import EventEvidence, event_evidence
+from abrupt.detect.attitude.evidence import EventEvidence, event_evidence, profile_fits, profile_key
 from abrupt.detect.attitude.flight_glr import FlightGlrDetector, Peak
 from abrupt.detect.attitude.ramp_step import (
     RampStep,
@@ -88,9 +88,8 @@ def attribute_events(
 #: step it must be [s] (nearer, the two cannot be told apart).
 RESCAN_SPAN_S = (-300.0, 300.0)
 RESCAN_APART_S = 10.0
-#: The window of the ramp fit around an external torque's event [s] (that of the evidence's time profile),
-#: and how far beyond its noise the ramp must be to have a direction [σ].
-RAMP_WINDOW_S = 600.0
+#: How far beyond its noise the ramp fit around an external torque's event (the evidence's window,
+#: :func:`~abrupt.detect.attitude.evidence.profile_fits`) must be to have a direction [σ].
 RAMP_SIGMA_MIN = 5.0
 #: The running median [s] that takes a torque's signal out along its body direction (a venting pulse train's
 #: steps 5-60 s apart, a leak's ramp: each followed; the white noise left).
@@ -145,14 +144,12 @@ def _best_peak(
 
 
 def _window_fits(table: Timetable, cleaned_H_N: FloatArray, i0: int, fits: WindowFits | None) -> WindowFits:
-    """The ramp window's fits around row ``i0``: ``fits`` (the event's evidence fits) when they are of this
-    window, else new ones."""
-    g, q = table.time_ns, table.quaternion_BN
-    half = round(RAMP_WINDOW_S / table.dt_s)
-    lo, hi = max(0, i0 - half), min(g.size, i0 + half + 1)
-    if fits is not None and fits.key == (lo, i0, hi):
+    """The ramp window's fits around row ``i0`` (the evidence's, :func:`profile_fits`): ``fits`` (the
+    event's evidence fits) when they are of this window, else new ones."""
+    t0 = int(table.time_ns[i0])
+    if fits is not None and fits.key == profile_key(table, t0):
         return fits
-    return WindowFits((lo, i0, hi), (g[lo:hi] - g[i0]) / NS, body_frame_momentum(cleaned_H_N[lo:hi], q[lo:hi]))
+    return profile_fits(table, cleaned_H_N, t0)
 
 
 def _to_inertial(h_N: FloatArray, y_B: FloatArray, q_BN: FloatArray) -> FloatArray:

@@ -26,7 +26,7 @@ The rules read the evidence of :mod:`abrupt.detect.attitude.evidence`; none is f
    event's step's body direction (:func:`abrupt.detect.attitude.ramp_step.step_siblings`) and that
    fitted step lasts (``alone_step_lasting``: judged beside the window's other steps, which a raw
    before/after balance counts too); or (4d, ``step_sharp``, on), that fitted step lasts and is itself an
-   impulse beside the window's other steps (``alone_step_sharpness``: a ramp of twice ``impulsive_s``
+   impulse beside the window's other steps (``alone_step_sharpness``: a ramp of twice the evidence's ``ramp_min_s``
    fits it worse), and no impulse of the window that moved the body shares its direction: an impulse on
    a leak's ramp along its own direction, or beside a neighbouring torque that spoils the window's
    one-ramp profile;
@@ -90,8 +90,8 @@ class AttributionRules:
     #: Rule 4c: an impulsive step that no other step of the window shares the body direction of is a strike
     #: inside a ramp or a sequence (or next to another source's step).
     step_alone: bool = True
-    #: Rule 4d: the event's fitted step is an impulse when a ramp of ``2 impulsive_s`` centred on it fits worse
-    #: by more than ``sharp_chi2`` (3 σ), every other step of the window fitted beside it.
+    #: Rule 4d: the event's fitted step is an impulse when a ramp of 2 ``EvidenceWindows.ramp_min_s`` (16 s)
+    #: centred on it fits worse by more than ``sharp_chi2`` (3 σ), every other step of the window beside it.
     step_sharp: bool = True
     sharp_chi2: float = 9.0
 

@@ -25,6 +25,7 @@ from scipy.ndimage import median_filter
 from abrupt.clean.flight_masks import tracker_rate_rad_s
 from abrupt.detect.attitude.ramp_step import StepSiblings
 from abrupt.series.timetable import NS, Timetable
+from abrupt.thresholds.noise import robust_noise_sigma
 from abrupt.types import FloatArray
 
 NAN = float("nan")
@@ -57,11 +58,10 @@ def window_rows(g: np.ndarray, i0: int, a_s: float, b_s: float, dt: float) -> np
 
 
 def white_noise_sigma(y: FloatArray) -> float:
-    """Robust white-noise σ from first differences (MAD / 0.6745 / √2)."""
-    d = np.diff(y[np.isfinite(y)])
-    if d.size < 4:
-        return NAN
-    return float(np.median(np.abs(d - np.median(d))) / 0.6745 / math.sqrt(2.0))
+    """Robust white-noise σ of a series' finite samples (:func:`~abrupt.thresholds.noise.robust_noise_sigma`);
+    NaN for fewer than 5."""
+    v = y[np.isfinite(y)]
+    return float(robust_noise_sigma(v)[0]) if v.size >= 5 else NAN
 
 
 def centred_tracker_rate(q_BN: FloatArray, dt_s: float) -> FloatArray:

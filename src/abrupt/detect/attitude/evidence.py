@@ -260,18 +260,27 @@ class EvidenceWindows:
     ramp_min_s: float = 8.0
 
 
-def profile_fits(
-    table: Timetable, cleaned_H_N: FloatArray, time_ns: int, windows: EvidenceWindows | None = None
-) -> WindowFits:
-    """The body-frame momentum of cleaned ᴺH over ± ``profile_s`` around the event at ``time_ns``, with its
-    ramp and sibling fits made when first asked (:class:`~abrupt.detect.attitude.ramp_step.WindowFits`)."""
+def profile_key(table: Timetable, time_ns: int, windows: EvidenceWindows | None = None) -> tuple[int, int, int]:
+    """The grid rows (first, event, end) of the ± ``profile_s`` window around the event at ``time_ns``."""
     w = windows or EvidenceWindows()
     g = table.time_ns
     i0 = int(np.clip(np.searchsorted(g, time_ns), 0, g.size - 1))
     span = _idx(g, i0, -w.profile_s, w.profile_s, table.dt_s)
-    lo, hi = (int(span[0]), int(span[-1]) + 1) if span.size else (i0, i0)
+    return (int(span[0]), i0, int(span[-1]) + 1) if span.size else (i0, i0, i0)
+
+
+def profile_fits(
+    table: Timetable, cleaned_H_N: FloatArray, time_ns: int, windows: EvidenceWindows | None = None
+) -> WindowFits:
+    """The body-frame momentum of cleaned ᴺH over ± ``profile_s`` around the event at ``time_ns``, with its
+    ramp and sibling fits made when first asked (:class:`~abrupt.detect.attitude.ramp_step.WindowFits`); the
+    sibling fit judges the event's own step against a ramp of twice ``ramp_min_s`` (an impulse is shorter
+    than ``ramp_min_s``)."""
+    w = windows or EvidenceWindows()
+    lo, i0, hi = key = profile_key(table, time_ns, w)
+    g = table.time_ns
     y_b = body_frame_momentum(cleaned_H_N[lo:hi], table.quaternion_BN[lo:hi])
-    return WindowFits((lo, i0, hi), (g[lo:hi] - g[i0]) / NS, y_b)
+    return WindowFits(key, (g[lo:hi] - g[i0]) / NS, y_b, impulse_ramp_s=2.0 * w.ramp_min_s)
 
 
 def event_evidence(
@@ -328,8 +337,8 @@ def event_evidence(
     out.update(_profile(g, cleaned_H_N, dh_n, i0, dt, w))
     need_ramp = not float(out.get("duration_lo_s", NAN)) <= w.ramp_min_s  # an impulse needs no ramp besides it
     if need_ramp or mag > 0:
-        own = profile_fits(table, cleaned_H_N, time_ns, w)
-        fits = fits if fits is not None and fits.key == own.key else own
+        if fits is None or fits.key != profile_key(table, time_ns, w):
+            fits = profile_fits(table, cleaned_H_N, time_ns, w)
         if need_ramp:
             out.update(ramp_step_evidence(fits.ramp(w.ramp_min_s), mag))
         if mag > 0:

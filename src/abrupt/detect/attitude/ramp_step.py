@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from abrupt.model.rotations import dcm_from_quaternion
+from abrupt.thresholds.noise import robust_noise_sigma
 from abrupt.types import FloatArray
 
 NAN = float("nan")
@@ -46,13 +47,6 @@ class RampStep:
             return self.step_B
         u = self.ramp_B / a
         return self.step_B - (self.step_B @ u) * u
-
-
-def _noise_sigma(y: FloatArray) -> float:
-    d = np.diff(y[np.isfinite(y)])
-    if d.size < 10:
-        return NAN
-    return float(np.median(np.abs(d - np.median(d))) / 0.6745 / math.sqrt(2.0))
 
 
 def body_frame_momentum(h_N: FloatArray, q_BN: FloatArray) -> FloatArray:
@@ -85,7 +79,7 @@ def _finite_window(tau_s: FloatArray, y_B: FloatArray) -> tuple[FloatArray, Floa
     t, v = tau_s[ok], y_B[ok]
     if t.size < 60:
         return None
-    sig = np.array([_noise_sigma(v[:, k]) for k in range(3)])
+    sig = robust_noise_sigma(v)
     if not np.all(np.isfinite(sig)) or not np.all(sig > 0):
         return None
     return t, v, sig
@@ -373,16 +367,19 @@ class WindowFits:
     made once, when first asked: the evidence and the rescan after a ramp both need them on the same
     window."""
 
-    def __init__(self, key: tuple[int, int, int], tau_s: FloatArray, y_B: FloatArray) -> None:
+    def __init__(
+        self, key: tuple[int, int, int], tau_s: FloatArray, y_B: FloatArray, impulse_ramp_s: float = 16.0
+    ) -> None:
         self.key = key
         self.tau_s = tau_s
         self.y_B = y_B
+        self.impulse_ramp_s = impulse_ramp_s
         self._siblings: tuple[StepSiblings | None] | None = None
         self._ramps: dict[float, RampStep | None] = {}
 
     def siblings(self) -> StepSiblings | None:
         if self._siblings is None:
-            self._siblings = (step_siblings(self.tau_s, self.y_B, 0.0),)
+            self._siblings = (step_siblings(self.tau_s, self.y_B, 0.0, impulse_ramp_s=self.impulse_ramp_s),)
         return self._siblings[0]
 
     def ramp(self, min_ramp_s: float = 8.0) -> RampStep | None:
