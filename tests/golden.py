@@ -23,9 +23,17 @@ import numpy as np
 GOLDEN_DIR = Path(__file__).resolve().parent / "golden"
 
 
-def check_golden(name: str, values: Mapping[str, float | Sequence[float]], *, rtol: float = 1e-9) -> None:
-    """Compare ``values`` with ``tests/golden/<name>.json`` (relative tolerance ``rtol``), or write the
-    file when ``ABRUPT_UPDATE_GOLDEN=1``."""
+#: The precision a golden value of abrupt's own output keeps across machines: simulations and filters
+#: run through BLAS, libm and compiled kernels whose last bits differ between CPUs and library releases
+#: (measured: 1.05e-7 relative on the Kaderali K_max chain between two installs of the same code). A
+#: change of the code's numbers moves them by far more; the published value is checked separately at the
+#: source's own precision.
+GOLDEN_RTOL = 1e-5
+
+
+def check_golden(name: str, values: Mapping[str, float | Sequence[float]], *, rtol: float = GOLDEN_RTOL) -> None:
+    """Compare ``values`` with ``tests/golden/<name>.json`` (relative tolerance ``rtol``, by default
+    :data:`GOLDEN_RTOL`), or write the file when ``ABRUPT_UPDATE_GOLDEN=1``."""
     path = GOLDEN_DIR / f"{name}.json"
     plain = {k: np.asarray(v, dtype=np.float64).tolist() for k, v in values.items()}
     if os.environ.get("ABRUPT_UPDATE_GOLDEN") == "1":

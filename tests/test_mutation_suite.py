@@ -14,6 +14,8 @@ kinds (a 50 MB line, 5 MB of garbage) in a child process whose own peak memory i
 
 from __future__ import annotations
 
+import atexit
+import functools
 import gzip
 import io
 import json
@@ -105,7 +107,7 @@ def _elements_outcome(history: Any) -> mh.Outcome:
 def _tracking_outcome(path: Path) -> mh.Outcome:
     """The path ``abrupt detect tracking --setup od_test_W3.in`` runs: the measurements on the set-up's
     stations (which the implied-orbit check needs: a range in the wrong unit is refused there)."""
-    setup = read_od_input(_real("tracking/od_test_W3.in"))
+    setup = read_od_input(_companion("tracking/od_test_W3.in"))
     log = RepairLog(str(path))
     data = read_tracking_arrays(path, setup, refraction=setup.refraction_correction, repairs=log)
     rows = [
@@ -146,7 +148,7 @@ def _spacecraft_outcome(path: Path) -> mh.Outcome:
     try:
         archive = scratch / "KESTREL2_2026-03-10.csv"
         archive.write_bytes(_archive_slice())
-        summary = ingest_archives([archive], SHARED / "flight-like" / "decoder.csv", scratch / "store", spacecraft=sc)
+        summary = ingest_archives([archive], _companion("flight-like/decoder.csv"), scratch / "store", spacecraft=sc)
         counts: Counter[str] = Counter(sc.defaults)
         for day in summary.days:
             counts.update(day.get("removed", {}))
@@ -170,7 +172,7 @@ KESTREL = load_spacecraft(KESTREL_TOML)
 
 
 def _ingested(path: Path, store: Path) -> mh.Outcome:
-    summary = ingest_archives([path], SHARED / "flight-like" / "decoder.csv", store, spacecraft=KESTREL)
+    summary = ingest_archives([path], _companion("flight-like/decoder.csv"), store, spacecraft=KESTREL)
     counts: Counter[str] = Counter()
     for file_counts in summary.files.values():
         counts.update(file_counts)
@@ -203,6 +205,22 @@ def _real(rel: str) -> Path:
     if not path.exists():
         pytest.skip(f"real dataset {rel} not found under {SHARED}")
     return path
+
+
+_COMPANIONS = Path(tempfile.mkdtemp(prefix="abrupt-mutation-companions-"))
+_COMPANIONS.chmod(0o755)
+atexit.register(shutil.rmtree, _COMPANIONS, True)
+
+
+@functools.cache
+def _companion(rel: str) -> Path:
+    """A world-readable copy of a real companion file (a tracking set-up, a decoder) in the system's
+    temporary folder. The "unreadable" mutation runs the reader as an unprivileged user, which must be
+    refused the file under test only: the checkout and ``../shared`` may sit in a private folder."""
+    copy = _COMPANIONS / rel.replace("/", "__")
+    shutil.copyfile(_real(rel), copy)
+    copy.chmod(0o644)
+    return copy
 
 
 def _text(rel: str) -> str:
