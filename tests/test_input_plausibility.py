@@ -15,6 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from abrupt.errors import InputError
+from abrupt.readers.orbit_envelope import power_of_ten_repair
 from abrupt.readers.sp3 import SP3_DOUBLED, SP3_NO_VELOCITY, SP3_ORPHAN_VELOCITY, parse_sp3
 from abrupt.readers.sp3_checks import check_position_velocity
 from abrupt.readers.tle import read_tle, tle_checksum
@@ -81,15 +82,20 @@ def test_an_epoch_without_its_velocity_is_removed_and_counted(damage: str, share
     np.testing.assert_array_equal(eph.position_m, truth.position_m[kept])
 
 
-@pytest.mark.parametrize("factor", [0.1, 0.5, -1.0])
-def test_velocities_in_the_wrong_unit_are_refused(factor: float, shared_data: Path, tmp_path: Path) -> None:
+def _scaled_velocities(shared_data: Path, factor: float) -> list[str]:
     lines = []
     for line in _short_sp3(shared_data):
-        if line.startswith("V"):  # dm/s written as m/s (x0.1), as cm/s... (x0.5 for a halved value), flipped
+        if line.startswith("V"):
             vals = [float(line[4 + 14 * j : 18 + 14 * j]) * factor for j in range(3)]
             line = line[:4] + "".join(f"{v:14.6f}" for v in vals) + line[46:]
         lines.append(line)
-    path = _write(tmp_path, lines)
+    return lines
+
+
+@pytest.mark.parametrize("factor", [0.5, -1.0, 0.3])
+def test_velocities_in_the_wrong_unit_are_refused(factor: float, shared_data: Path, tmp_path: Path) -> None:
+    """Halved, reversed or scaled by a factor that is no power of ten: refused."""
+    path = _write(tmp_path, _scaled_velocities(shared_data, factor))
     with pytest.raises(InputError) as info:
         parse_sp3(path)
     message = str(info.value)
@@ -97,15 +103,30 @@ def test_velocities_in_the_wrong_unit_are_refused(factor: float, shared_data: Pa
     assert "L08" in message and "derivative of its positions" in message
 
 
+@pytest.mark.parametrize("factor", [0.1, 0.01])
+def test_velocities_a_power_of_ten_off_are_rescaled_and_counted(
+    factor: float, shared_data: Path, tmp_path: Path
+) -> None:
+    """m/s written in the dm/s field (GRG DORIS products of Jason-2 and TOPEX) or cm/s, with the positions
+    intact: the velocities are restored to the unmutated file's (to its 1e-7 m/s resolution
+    divided by the factor) and the repair is counted at every epoch."""
+    truth = parse_sp3(_write(tmp_path, _short_sp3(shared_data), "clean.sp3")).ephemerides["L08"]
+    eph = parse_sp3(_write(tmp_path, _scaled_velocities(shared_data, factor))).ephemerides["L08"]
+    k = round(-np.log10(factor))
+    assert eph.repairs.counts[power_of_ten_repair(k)] == N_EPOCHS
+    np.testing.assert_array_equal(eph.position_m, truth.position_m)
+    np.testing.assert_allclose(eph.velocity_mps, truth.velocity_mps, rtol=0, atol=2e-7 / factor)
+
+
 def test_the_unmutated_file_passes_the_position_velocity_check(shared_data: Path) -> None:
     eph = parse_sp3(shared_data / JASON1_SP3).ephemerides["L08"]
     t = eph.times_utc.astype("datetime64[ns]").astype(np.int64)
-    ratio, suspect = check_position_velocity(
+    ratio, suspect, exponent = check_position_velocity(
         "L08", t, eph.position_m / 1e3, eph.velocity_mps * 10.0, np.arange(t.size), "x"
     )
     # the chord of a 60 s step is shorter than the arc by (n h)^2/6 = 7e-4 at the mean motion of Jason-1
     n = 2 * np.pi / (112.4 * 60)
-    assert not suspect.any()
+    assert not suspect.any() and exponent == 0
     assert ratio is not None and abs(ratio - (1 - (n * 60) ** 2 / 6)) < 2e-4
 
 
@@ -298,14 +319,20 @@ def _head_sp3(shared_data: Path, tmp_path: Path, n_epochs: int) -> Path:
     return _write(tmp_path, out, f"head{n_epochs}.sp3")
 
 
-def test_an_arc_shorter_than_the_filters_settling_is_refused(shared_data: Path, tmp_path: Path) -> None:
-    """6 hours of 60 s data with auto tuning: the filters settle for 20 τ at each end, so no epoch would
-    be tested (the run was quiet and printed a NaN post-fit RMS); an error names the file and the spans."""
-    from abrupt.pipelines.orbit import detect_orbit
+def test_an_arc_shorter_than_the_filters_settling_is_a_run_that_tested_nothing(
+    shared_data: Path, tmp_path: Path
+) -> None:
+    """6 hours of 60 s data with auto tuning: the filters settle for 20 τ at each end, so no epoch can be
+    tested. Not an error (a batch over many files must not stop) and not a quiet pass: no events, a
+    warning naming both spans, and a summary that says nothing was tested."""
+    from abrupt.pipelines.orbit import detect_orbit, summary_lines
 
-    path = _head_sp3(shared_data, tmp_path, 360)
-    with pytest.raises(InputError, match=r"head360\.sp3: the arc spans 5\.98 h but the filter .* to settle"):
-        detect_orbit(path)
+    run = detect_orbit(_head_sp3(shared_data, tmp_path, 360))
+    assert len(run.events) == 0 and run.analysis is None
+    assert len(run.result.warnings) == 1
+    assert "nothing tested: the arc spans 5.98 h but the filter" in run.result.warnings[0]
+    assert run.summary["tested"] is False
+    assert "no epoch tested" in summary_lines(run.summary)[0]
 
 
 def test_the_thesis_tuning_on_a_real_arc_is_refused_naming_the_file(shared_data: Path, tmp_path: Path) -> None:

@@ -3,16 +3,19 @@ counted repairs."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from abrupt.errors import InputError
+from abrupt.model.orbit.constants import OMEGA_EARTH_RAD_S
 from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.readers.navigation_csv import read_navigation_csv, write_navigation_csv
 from abrupt.readers.oem import read_oem
 from abrupt.readers.sp3 import list_satellites, read_sp3
+from abrupt.series.ephemeris import Ephemeris
 
 SP3_NAME = "sp3/ssas3a20.b18358.e19003.DG_.sp3"
 
@@ -290,8 +293,21 @@ def test_oem_malformed_data_line_names_the_line(tmp_path: Path) -> None:
         read_oem(path)
 
 
+def _earth_fixed(eph: Ephemeris) -> Ephemeris:
+    """The fixture's inertial circular orbit seen from a frame turning at the Earth's rate (so that an
+    ``ITRF`` label fits its dynamics): r_E = Rz(−ωt) r, v_E = Rz(−ωt) (v − ω × r)."""
+    angle = -OMEGA_EARTH_RAD_S * eph.seconds
+    c, s = np.cos(angle), np.sin(angle)
+    r, v = eph.position_m, eph.velocity_mps - np.cross([0.0, 0.0, OMEGA_EARTH_RAD_S], eph.position_m)
+
+    def turn(x: np.ndarray) -> np.ndarray:
+        return np.column_stack([c * x[:, 0] - s * x[:, 1], s * x[:, 0] + c * x[:, 1], x[:, 2]])
+
+    return replace(eph, position_m=turn(r), velocity_mps=turn(v))
+
+
 def test_navigation_csv_round_trip_and_dispatch(tmp_path: Path) -> None:
-    eph = read_sp3(_write(tmp_path, _sp3_text()))
+    eph = _earth_fixed(read_sp3(_write(tmp_path, _sp3_text())))
     out = tmp_path / "nav.csv"
     write_navigation_csv(eph, out)
     back = read_ephemeris(out)

@@ -22,7 +22,7 @@ def _ephemeris(sid: str, phase: float) -> Ephemeris:
     r = 12.27e6
     pos = np.column_stack([r * np.cos(ang), r * np.sin(ang), np.zeros(N)])
     vel = np.column_stack([-5700.0 * np.sin(ang), 5700.0 * np.cos(ang), np.zeros(N)])
-    return Ephemeris(satellite=sid, times_utc=t, position_m=pos, velocity_mps=vel, frame="ITRF", source="synthetic")
+    return Ephemeris(satellite=sid, times_utc=t, position_m=pos, velocity_mps=vel, frame="GCRF", source="synthetic")
 
 
 def _write(tmp_path: Path) -> list[str]:

@@ -23,6 +23,7 @@ from abrupt.detect.base import DetectionResult, Diagnostics, get_detector
 from abrupt.detect.orbit.analysis import OrbitAnalysis, innovation_scale
 from abrupt.detect.orbit.detectors import (
     SETTLE_CAP_S,
+    ArcTooShortError,
     OrbitDetector,
     orbit_analysis,
     orbit_product_boundaries,
@@ -37,9 +38,12 @@ from abrupt.pipelines.orbit_blocks import (
     arc_test_mask,
     block_lines,
     blocks_summary,
+    bridge_limit_s,
     calibration_blocks,
+    data_arcs,
     events_in,
     extended_block,
+    gap_warnings,
     joined_events,
     part,
     per_epoch_thresholds,
@@ -146,16 +150,46 @@ def detect_orbit(
         raise KeyError(f"{detector!r} is not an orbit filter detector")
     det = cls(null=null_eph, **settings)
     fa = as_budget(budget)
-    blocks = calibration_blocks(eph.times_utc, 86400.0 * block_days if block_days else None)
+    # a gap longer than the filters bridge ends one arc; each arc in its own calibration blocks
+    limit = bridge_limit_s(eph)
+    arcs = data_arcs(eph.times_utc, limit)
+    span = 86400.0 * block_days if block_days else None
+    blocks = [(a + lo, a + hi) for a, b in arcs for lo, hi in calibration_blocks(eph.times_utc[a:b], span)]
     if len(blocks) > 1:
-        return _detect_blocks(det, eph, fa, sequences, blocks, workers)
+        return _detect_blocks(det, eph, fa, sequences, blocks, workers, arcs, gap_warnings(eph.times_utc, arcs, limit))
     run = _detect_arc(det, eph, fa, sequences)
     return run
 
 
+def _untested(det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, reason: str) -> OrbitRun:
+    """A run that tested nothing (an arc too short for the filters to settle): no events, its reason as a
+    warning, and a summary that says so."""
+    warning = f"nothing tested: {reason}"
+    run = OrbitRun(eph, det, DetectionResult.empty(warnings=(warning,)), fa)
+    run.summary = untested_summary(eph, fa, [warning])
+    return run
+
+
+def untested_summary(eph: Ephemeris, fa: FalseAlarmBudget, warnings: list[str]) -> dict[str, Any]:
+    """The summary of a run that tested no epoch."""
+    return {
+        "satellite": eph.satellite,
+        "epochs": len(eph),
+        "span_days": float(eph.seconds[-1]) / 86400.0 if len(eph) else 0.0,
+        "tested": False,
+        "events": 0,
+        "budget": str(fa),
+        "warnings": warnings,
+    }
+
+
 def _detect_arc(det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, sequences: bool) -> OrbitRun:
-    """One arc: detection, burn sequences, the fit summary and its check."""
-    result = det.detect(eph, fa)
+    """One arc: detection, burn sequences, the fit summary and its check; an arc too short to test gives a
+    run that tested nothing (:func:`_untested`)."""
+    try:
+        result = det.detect(eph, fa)
+    except ArcTooShortError as exc:
+        return _untested(det, eph, fa, exc.reason)
     # the removal needs the sharp time of the GLR; the thesis statistics' broad humps would re-raise
     if sequences and det.statistic == "glr" and len(result.events):
         events, notes = resolve_sequence(det, eph, fa, result)
@@ -173,17 +207,23 @@ def _detect_blocks(
     sequences: bool,
     blocks: list[tuple[int, int]],
     workers: int = 1,
+    arcs: list[tuple[int, int]] | None = None,
+    notes: list[str] | None = None,
 ) -> OrbitRun:
     """A long span in calibration blocks (:mod:`abrupt.pipelines.orbit_blocks`), each by :func:`_block`, on
-    ``workers`` processes."""
+    ``workers`` processes. A block's filters reach into its neighbours but never across the ends of its
+    data arc (``arcs``: index ranges split at gaps the filters do not bridge); ``notes`` join the warnings."""
     gcrf = eph.to_frame("GCRF")
     times = gcrf.times_utc
     step = gcrf.nominal_step_s
     # room for the longest settling time the tuning can choose (the block's own is set inside)
     room = max(SETTLE_CAP_S, 30.0 * step) + 4.0 * step
+    arcs = arcs or [(0, len(gcrf))]
     jobs = []
     for lo, hi in blocks:
+        arc_lo, arc_hi = next((a, b) for a, b in arcs if a <= lo < b)
         a, b = extended_block(times, lo, hi, room)
+        a, b = max(a, arc_lo), min(b, arc_hi)
         jobs.append((part(gcrf, a, b), lo - a, hi - a))
     parts, los, his = (list(x) for x in zip(*jobs, strict=True))
     n = len(jobs)
@@ -202,9 +242,13 @@ def _detect_blocks(
         epoch_utc=times[0],
         extra={"blocks": [o.record() for o in outcomes], "threshold_per_epoch": per_epoch_thresholds(outcomes, sizes)},
     )
-    warnings = tuple(w for o in outcomes for w in o.warnings)
+    warnings = (*(notes or ()), *(w for o in outcomes for w in o.warnings))
     run = OrbitRun(eph, det, DetectionResult(joined_events(outcomes, empty), (diag,), warnings), fa)
     run.summary = blocks_summary(outcomes, gcrf)
+    if run.summary:
+        run.summary["warnings"] = [*(notes or ()), *run.summary["warnings"]]
+    else:  # no block could be tested
+        run.summary = untested_summary(gcrf, fa, list(warnings))
     return run
 
 
@@ -227,6 +271,10 @@ def _block(det: OrbitDetector, ext: Ephemeris, lo: int, hi: int, fa: FalseAlarmB
     block.fixed_config = cfg
     block.calibration_mask = arc_test_mask(arc, cfg.settle_s, ehi - elo, lo - elo)
     run = _detect_arc(block, part(ext, elo, ehi), fa, sequences)
+    if run.summary.get("tested") is False:
+        nothing = np.full(hi - lo, np.nan)
+        notes = tuple(f"{label}: {w}" for w in run.result.warnings)
+        return BlockOutcome(times[lo], times[hi - 1], pd.DataFrame(), nothing, None, {}, notes)
     diag = run.result.diagnostics[0] if run.result.diagnostics else None
     stat = diag.statistic[lo - elo : hi - elo] if diag is not None else np.full(hi - lo, np.nan)
     return BlockOutcome(
@@ -361,6 +409,12 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
     if not summary:
         return ["no fit"]
     s = summary
+    if s.get("tested") is False:
+        return [
+            f"orbit fit: none ({s['satellite']}, {s['epochs']} epochs over {24 * s['span_days']:.3g} h): "
+            "no epoch tested, no event possible",
+            *(f"  warning          {w}" for w in s["warnings"]),
+        ]
     lines = [
         f"orbit fit: {s['satellite']}, {s['epochs']} epochs over {s['span_days']:.2f} days at {s['step_s']:g} s",
         f"  force model      {s['force_model']}",

@@ -33,6 +33,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from abrupt.model.orbit.constants import MU_EARTH_M3_S2, R_EARTH_M
 from abrupt.series.ephemeris import Ephemeris
 from abrupt.thresholds import Threshold
 from abrupt.types import FloatArray
@@ -57,6 +58,40 @@ def calibration_blocks(times_utc: NDArray[np.datetime64], block_s: float | None)
     cuts = np.searchsorted(offsets, block_ns * np.arange(1, count, dtype=np.int64), side="left")
     edges = [0, *(int(c) for c in cuts), n]
     return [(lo, hi) for lo, hi in itertools.pairwise(edges) if hi > lo]
+
+
+def bridge_limit_s(eph: Ephemeris) -> float:
+    """The longest data gap (s) an orbit filter bridges: half an orbital period at the arc's median radius.
+
+    Across a longer gap the time of an impulse in it is not told apart by the data (its periodic
+    signature repeats every half revolution while the along-track drift grows), and a time-tag error
+    (the second half of a file hours late) would look like a burn of km/s: the arcs on either side are
+    analysed separately and nothing is tested in the gap."""
+    radius = float(np.median(np.linalg.norm(eph.position_m, axis=1))) if len(eph) else R_EARTH_M
+    return float(np.pi * np.sqrt(radius**3 / MU_EARTH_M3_S2))
+
+
+def data_arcs(times_utc: NDArray[np.datetime64], limit_s: float) -> list[tuple[int, int]]:
+    """Index ranges ``[lo, hi)`` of the arcs of a span: a new arc after every gap longer than ``limit_s``."""
+    n = int(np.asarray(times_utc).size)
+    if n < 2:
+        return [(0, n)]
+    steps = np.diff(times_utc).astype("timedelta64[ns]").astype(np.float64) * 1e-9
+    cuts = [int(i) + 1 for i in np.flatnonzero(steps > limit_s)]
+    return list(itertools.pairwise([0, *cuts, n]))
+
+
+def gap_warnings(times_utc: NDArray[np.datetime64], arcs: list[tuple[int, int]], limit_s: float) -> list[str]:
+    """One line per gap between ``arcs``."""
+    out = []
+    for (_, hi), (lo, _) in itertools.pairwise(arcs):
+        a, b = times_utc[hi - 1], times_utc[lo]
+        hours = float((b - a) / np.timedelta64(1, "s")) / 3600.0
+        out.append(
+            f"gap of {hours:.3g} h from {str(a)[:19]} to {str(b)[:19]} (longer than half a revolution, "
+            f"{limit_s / 3600:.3g} h): the arcs on either side analysed separately, nothing tested in the gap"
+        )
+    return out
 
 
 def extended_block(times_utc: NDArray[np.datetime64], lo: int, hi: int, margin_s: float) -> tuple[int, int]:

@@ -28,6 +28,7 @@ from abrupt.detect.orbit.pooled import ArcNull, pooled_thresholds
 from abrupt.errors import ConfigError
 from abrupt.pipelines.orbit import OrbitRun, as_budget, detector_class_name, fit_summary
 from abrupt.pipelines.orbit_sequence import resolve_sequence
+from abrupt.readers.orbit_envelope import check_orbit_envelope
 from abrupt.readers.sp3 import parse_sp3
 from abrupt.series.ephemeris import Ephemeris
 from abrupt.thresholds import FalseAlarmBudget
@@ -38,10 +39,12 @@ MIN_EPOCHS = 10
 def product_ephemerides(
     source: str | Path | Mapping[str, Ephemeris], *, allow_truncated: bool = False, strict: bool = False
 ) -> dict[str, Ephemeris]:
-    """Every satellite of an SP3 file (by SP3 id), or the mapping as given."""
+    """Every satellite of an SP3 file (by SP3 id), each inside the orbit envelope
+    (:func:`~abrupt.readers.orbit_envelope.check_orbit_envelope`), or the mapping as given."""
     if isinstance(source, Mapping):
         return dict(source)
-    return parse_sp3(source, allow_truncated=allow_truncated, strict=strict).ephemerides
+    ephs = parse_sp3(source, allow_truncated=allow_truncated, strict=strict).ephemerides
+    return {sid: check_orbit_envelope(eph) for sid, eph in ephs.items()}
 
 
 def detect_orbit_product(

@@ -18,6 +18,7 @@ from abrupt.readers.compression import read_bytes
 from abrupt.readers.cpf import read_cpf
 from abrupt.readers.navigation_csv import read_navigation_csv, write_navigation_csv
 from abrupt.readers.oem import TIME_SYSTEMS, read_oem, read_opm, write_oem
+from abrupt.readers.orbit_envelope import check_orbit_envelope
 from abrupt.readers.sp3 import KNOWN_TIME_SYSTEMS, read_sp3, write_sp3
 from abrupt.series.ephemeris import Ephemeris
 
@@ -52,18 +53,22 @@ def sniff_format(path: str | Path) -> EphemerisFormat:
 def read_ephemeris(
     path: str | Path, satellite: str | None = None, *, allow_truncated: bool = False, strict: bool = False
 ) -> Ephemeris:
-    """Read one satellite's ephemeris from any supported orbit file (UTC times, SI units). ``strict``: an
-    SP3 header count the body does not match is an error even when the records are complete."""
+    """Read one satellite's ephemeris from any supported orbit file (UTC times, SI units), inside the
+    physical envelope of an Earth orbit (:func:`~abrupt.readers.orbit_envelope.check_orbit_envelope`:
+    refused or repaired and counted). ``strict``: an SP3 header count the body does not match is an error
+    even when the records are complete."""
     fmt = sniff_format(path)
     if fmt == "sp3":
-        return read_sp3(path, satellite, allow_truncated=allow_truncated, strict=strict)
-    if fmt in ("oem-kvn", "oem-xml"):
-        return read_oem(path, satellite)
-    if fmt == "opm":
-        return read_opm(path, satellite)
-    if fmt == "cpf":
-        return read_cpf(path, satellite, allow_truncated=allow_truncated)
-    return read_navigation_csv(path, satellite)
+        eph = read_sp3(path, satellite, allow_truncated=allow_truncated, strict=strict)
+    elif fmt in ("oem-kvn", "oem-xml"):
+        eph = read_oem(path, satellite)
+    elif fmt == "opm":
+        eph = read_opm(path, satellite)
+    elif fmt == "cpf":
+        eph = read_cpf(path, satellite, allow_truncated=allow_truncated)
+    else:
+        eph = read_navigation_csv(path, satellite)
+    return check_orbit_envelope(eph)
 
 
 def write_ephemeris(

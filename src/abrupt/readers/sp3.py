@@ -23,8 +23,9 @@ Documented repairs (counted in the :class:`~abrupt.errors.RepairLog` of each eph
 - two ``P`` (or two ``V``) records of a satellite in one epoch remove that epoch for it; a ``V`` record
   without its ``P`` is dropped; when a satellite has velocities at most epochs, an epoch without a
   usable velocity (missing, malformed, marker) is removed (:func:`_epoch_structure`);
-- positions against velocities (:mod:`abrupt.readers.sp3_checks`): a satellite whose velocities are
-  not the derivative of its positions (a unit error) is an error naming it;
+- positions against velocities (:mod:`abrupt.readers.sp3_checks`): velocities a power of ten off at
+  every epoch with the positions intact (m/s in the dm/s field) are rescaled and counted; a satellite
+  whose velocities are otherwise not the derivative of its positions is an error naming it;
 - a malformed ephemeris record (unreadable number, truncated ``P``/``V`` line, unknown record type,
   implausible radius, malformed epoch line) in a long file is skipped and counted, up to 1 % of the
   records (so none in a file of fewer than 100 records); more is an error naming the first bad line;
@@ -59,6 +60,7 @@ from numpy.typing import NDArray
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.timescales import offline_astropy
 from abrupt.readers.compression import read_bytes
+from abrupt.readers.orbit_envelope import power_of_ten_repair
 from abrupt.readers.sp3_checks import check_position_velocity
 from abrupt.readers.sp3_header import (
     KNOWN_TIME_SYSTEMS,
@@ -457,7 +459,10 @@ def _finish(
     log.record("duplicate epoch dropped", int(np.count_nonzero(~keep)))
     t_sys, st, lines = t_sys[keep], st[keep], lines[keep]
     if header.has_velocity:
-        _, suspect = check_position_velocity(sid, t_sys.astype(np.int64), st[:, :3], st[:, 3:6], lines, file)
+        _, suspect, exponent = check_position_velocity(sid, t_sys.astype(np.int64), st[:, :3], st[:, 3:6], lines, file)
+        if exponent:
+            st[:, 3:6] *= 10.0**exponent
+            log.record(power_of_ten_repair(exponent), int(np.count_nonzero(np.isfinite(st[:, 3]))))
         log.record(SP3_PV_MISMATCH, int(np.count_nonzero(suspect)))
         t_sys, st, lines = t_sys[~suspect], st[~suspect], lines[~suspect]
     if t_sys.size >= 2 and header.interval_s > 0:

@@ -81,6 +81,11 @@ def nuisance_force_model(gravity_degree: int, third_body: bool, zonal_degree: in
     )
 
 
+class ArcTooShortError(InputError):
+    """An arc shorter than the filters' settling at both ends: no epoch can be tested. Pipelines turn it into
+    a warning and a recorded run that tested nothing, so that a batch over many files does not stop."""
+
+
 class OrbitDetector(Detector[Ephemeris]):
     """The orbit detector; registered once per statistic (:data:`ORBIT_DETECTORS`), which sets ``name``
     and ``statistic``. The detection result's first diagnostics carry, in ``extra``, the whole
@@ -201,7 +206,7 @@ class OrbitDetector(Detector[Ephemeris]):
         cfg = self.detector_config(series, budget)
         span_s = float((series.times_utc[-1] - series.times_utc[0]) / np.timedelta64(1, "s"))
         if span_s < 2.0 * cfg.settle_s + series.nominal_step_s:
-            raise InputError(
+            raise ArcTooShortError(
                 f"the arc spans {span_s / 3600:.3g} h but the filter ({self.tuning} tuning) needs "
                 f"{cfg.settle_s / 3600:.3g} h to settle at each end: no epoch could be tested; give at least "
                 f"{(2 * cfg.settle_s + series.nominal_step_s) / 3600:.3g} h of data",

@@ -1,0 +1,231 @@
+"""Only an Earth orbit becomes a result: the physical envelope every orbit file passes at the reader's door.
+
+Each case writes a simulated orbit (two-body + J2 truth, 60 s, mm-level noise: the independent truth)
+in a real format inside the test's folder, damages it as a careless producer would, and reads it with
+:func:`abrupt.readers.ephemeris.read_ephemeris`: the damage is refused naming the envelope it breaks, or
+repaired and counted so that what is read equals the undamaged truth.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from abrupt.errors import InputError
+from abrupt.model.frames import gcrf_to_itrf
+from abrupt.model.orbit import ForceModel
+from abrupt.readers.ephemeris import read_ephemeris
+from abrupt.readers.navigation_csv import write_navigation_csv
+from abrupt.readers.oem import write_oem
+from abrupt.readers.orbit_envelope import (
+    OUTLIER_REPAIR,
+    check_orbit_envelope,
+    power_of_ten_repair,
+    single_epoch_outliers,
+)
+from abrupt.readers.sp3 import write_sp3
+from abrupt.series.ephemeris import Ephemeris
+from abrupt.simulate.orbit import OrbitSimulationConfig, inject_impulse, simulate_orbit
+
+HOURS = 6.0
+
+
+def _truth(altitude_km: float = 1336.0, sigma_pos_m: float = 0.002, eccentricity: float = 0.0) -> Ephemeris:
+    cfg = OrbitSimulationConfig(
+        altitude_m=altitude_km * 1e3,
+        eccentricity=eccentricity,
+        inclination_deg=66.0,
+        duration_s=HOURS * 3600.0,
+        rate_hz=1 / 60,
+        sigma_pos_m=sigma_pos_m,
+        sigma_vel_mps=sigma_pos_m / 100,
+        epoch_utc="2008-08-30T21:00:00",
+        forces=ForceModel(zonal_degree=2),
+        seed=3,
+    )
+    return simulate_orbit(cfg).ephemeris("L27")
+
+
+def _itrf(eph: Ephemeris) -> Ephemeris:
+    r, v = gcrf_to_itrf(eph.times_utc, eph.position_m, eph.velocity_mps)
+    return replace(eph, position_m=r, velocity_mps=v, frame="ITRF")
+
+
+def _refused(path: Path, envelope: str) -> str:
+    with pytest.raises(InputError) as info:
+        read_ephemeris(path)
+    message = str(info.value)
+    assert "\n" not in message and str(path) in message
+    assert f"outside the orbit envelope ({envelope})" in message
+    return message
+
+
+# ------------------------------------------------------------------------------------------ unmutated
+
+
+@pytest.mark.parametrize("fmt", ["sp3", "oem", "csv"])
+def test_the_undamaged_orbit_passes_in_every_format(fmt: str, tmp_path: Path) -> None:
+    eph = _truth()
+    path = tmp_path / f"orbit.{fmt}"
+    {
+        "sp3": lambda: write_sp3(eph, path),
+        "oem": lambda: write_oem(eph, path),
+        "csv": lambda: write_navigation_csv(eph, path),
+    }[fmt]()
+    back = read_ephemeris(path)
+    assert len(back) == len(eph) and back.repairs.total == 0
+    np.testing.assert_allclose(back.position_m, eph.position_m, atol=1e-3)
+
+
+# ------------------------------------------------------------------------------------------ velocities
+
+
+def test_oem_velocities_written_in_m_per_s_are_rescaled_and_counted(tmp_path: Path) -> None:
+    """OEM states are km and km/s; velocities written in m/s (1000x too large) with intact positions."""
+    eph = _truth()
+    path = tmp_path / "m_per_s.oem"
+    write_oem(replace(eph, velocity_mps=eph.velocity_mps * 1e3), path)
+    back = read_ephemeris(path)
+    assert back.repairs.counts[power_of_ten_repair(-3)] == len(eph)
+    np.testing.assert_allclose(back.velocity_mps, eph.velocity_mps, rtol=1e-9, atol=1e-6)
+
+
+def test_navigation_csv_velocities_in_km_per_s_are_rescaled_and_counted(tmp_path: Path) -> None:
+    eph = _truth()
+    path = tmp_path / "km_per_s.csv"
+    write_navigation_csv(replace(eph, velocity_mps=eph.velocity_mps / 1e3), path)
+    back = read_ephemeris(path)
+    assert back.repairs.counts[power_of_ten_repair(3)] == len(eph)
+    # the CSV keeps 6 decimals of the km/s values written: 1 mm/s once rescaled
+    np.testing.assert_allclose(back.velocity_mps, eph.velocity_mps, rtol=0, atol=1e-3)
+
+
+@pytest.mark.parametrize("fmt", ["oem", "csv"])
+def test_all_zero_velocities_are_refused(fmt: str, tmp_path: Path) -> None:
+    eph = replace(_truth(), velocity_mps=np.zeros((len(_truth()), 3)))
+    path = tmp_path / f"zero.{fmt}"
+    (write_oem if fmt == "oem" else write_navigation_csv)(eph, path)
+    assert "every velocity is zero" in _refused(path, "velocity = derivative of position")
+
+
+def test_velocities_halved_are_refused_not_repaired(tmp_path: Path) -> None:
+    eph = _truth()
+    path = tmp_path / "halved.csv"
+    write_navigation_csv(replace(eph, velocity_mps=eph.velocity_mps * 0.5), path)
+    assert "2 times the velocities" in _refused(path, "velocity = derivative of position")
+
+
+# ------------------------------------------------------------------------------------------ scale, frame
+
+
+def test_an_sp3_scaled_by_one_and_a_half_is_refused(tmp_path: Path) -> None:
+    """Positions and velocities x1.5: kinematically consistent, but faster than escape at that radius."""
+    eph = _itrf(_truth())
+    path = tmp_path / "scaled.sp3"
+    write_sp3(replace(eph, position_m=eph.position_m * 1.5, velocity_mps=eph.velocity_mps * 1.5), path)
+    assert "above the escape speed" in _refused(path, "speed below escape")
+
+
+def test_a_bound_orbit_scaled_by_one_point_one_is_refused_by_its_dynamics(tmp_path: Path) -> None:
+    """x1.1 stays bound, but the accelerations it implies are 1.1³ = 1.33 times gravity at its radius."""
+    eph = _truth()
+    path = tmp_path / "scaled.csv"
+    write_navigation_csv(replace(eph, position_m=eph.position_m * 1.1, velocity_mps=eph.velocity_mps * 1.1), path)
+    _refused(path, "dynamics of the stated frame")
+
+
+def test_itrf_data_labelled_j2000_is_refused_naming_the_frame_that_fits(tmp_path: Path) -> None:
+    eph = _itrf(_truth())
+    path = tmp_path / "mislabelled.oem"
+    write_oem(replace(eph, frame="GCRF"), path)  # Earth-fixed states under an inertial label
+    message = _refused(path, "dynamics of the stated frame")
+    assert "they fit Earth-fixed (ITRF) data" in message
+
+
+def test_the_same_itrf_data_labelled_itrf_passes(tmp_path: Path) -> None:
+    eph = _itrf(_truth())
+    path = tmp_path / "itrf.sp3"
+    write_sp3(eph, path)
+    assert len(read_ephemeris(path)) == len(eph)
+
+
+# ------------------------------------------------------------------------------------------ radius, epochs
+
+
+def test_positions_below_the_surface_are_refused(tmp_path: Path) -> None:
+    eph = _truth()
+    path = tmp_path / "low.csv"
+    write_navigation_csv(replace(eph, position_m=eph.position_m * 0.8), path)  # 7714 km -> 6171 km
+    assert "below the surface" in _refused(path, "radius above the Earth's surface")
+
+
+def test_positions_beyond_the_moon_are_refused(tmp_path: Path) -> None:
+    eph = _truth()
+    path = tmp_path / "far.csv"
+    write_navigation_csv(replace(eph, position_m=eph.position_m * 100.0), path)
+    _refused(path, "radius below the Moon's distance")
+
+
+def test_epochs_decades_in_the_future_are_refused(tmp_path: Path) -> None:
+    eph = _truth()
+    path = tmp_path / "future.oem"
+    write_oem(replace(eph, times_utc=eph.times_utc + np.timedelta64(48 * 365, "D")), path)  # 2056
+    assert "days after today" in _refused(path, "epochs not in the future")
+
+
+def test_a_prediction_a_week_ahead_is_accepted() -> None:
+    eph = _truth()
+    now = eph.times_utc[0] - np.timedelta64(7, "D")
+    assert len(check_orbit_envelope(eph, now_utc=now)) == len(eph)
+
+
+# ------------------------------------------------------------------------------------------ outliers
+
+
+@pytest.mark.parametrize("offset_m", [50.0, 1e3, 1e4])
+def test_one_bad_record_is_removed_and_counted(offset_m: float, tmp_path: Path) -> None:
+    """A 50 m step in one record, or one epoch 1-10 km off: that epoch only is removed, counted."""
+    eph = _truth()
+    k = 150
+    bad = eph.position_m.copy()
+    bad[k] += offset_m * np.array([0.6, -0.48, 0.64])
+    path = tmp_path / "outlier.sp3"
+    write_sp3(replace(eph, position_m=bad), path)
+    back = read_ephemeris(path)
+    assert back.repairs.counts[OUTLIER_REPAIR] == 1
+    assert len(back) == len(eph) - 1 and eph.times_utc[k] not in back.times_utc
+
+
+@pytest.mark.parametrize("dv_mps", [0.01, 1.0, 10.0])
+def test_a_burn_is_never_an_outlier(dv_mps: float) -> None:
+    """A burn changes the velocity, not the position: no epoch around it is removed."""
+    eph = _truth()
+    burned = inject_impulse(eph, eph.times_utc[150] + np.timedelta64(17, "s"), (0.3 * dv_mps, dv_mps, 0.2 * dv_mps))
+    assert not single_epoch_outliers(burned.seconds, burned.position_m).any()
+
+
+def test_a_step_of_every_later_record_is_not_an_outlier() -> None:
+    eph = _truth()
+    stepped = eph.position_m.copy()
+    stepped[150:] += 50.0
+    assert not single_epoch_outliers(eph.seconds, stepped).any()
+
+
+def test_noise_alone_removes_nothing_on_many_arcs() -> None:
+    """Navigation-like noise (σ 10 m): no epoch of 20 arcs of 6 h is called an outlier."""
+    removed = 0
+    for seed in range(20):
+        rng = np.random.default_rng(seed)
+        eph = _truth(sigma_pos_m=0.0)
+        removed += int(
+            single_epoch_outliers(eph.seconds, eph.position_m + rng.normal(0, 10.0, eph.position_m.shape)).sum()
+        )
+    assert removed == 0
+
+
+def test_an_eccentric_orbit_removes_nothing() -> None:
+    eph = _truth(altitude_km=20000.0, eccentricity=0.6)  # perigee 4170 km altitude, 60 s steps
+    assert len(check_orbit_envelope(eph)) == len(eph)
