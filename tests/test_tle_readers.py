@@ -195,3 +195,37 @@ def test_kvn_line_without_equals_sign_is_an_error(tmp_path: Path, omm_records: l
     p.write_text(_kvn(omm_records[:1]) + "MEAN_MOTION 12.8\n")
     with pytest.raises(InputError, match=r"bad\.kvn:\d+: KVN line is not 'KEY = value'"):
         read_omm(p, strict=True)
+
+
+def _with_field(line: str, start: int, text: str) -> str:
+    return _fix_checksum(line[:start] + text + line[start + len(text) :])
+
+
+def test_set_with_perigee_inside_the_earth_is_skipped_and_counted(tmp_path: Path) -> None:
+    # e = 0.9999999 at a = 7716 km: perigee a(1 - e) = 0.8 m from the Earth's centre
+    bad = (J3_B[0], _with_field(J3_B[1], 26, "9999999"))
+    path = _write(tmp_path, [*J3_A, *bad])
+    h = read_tle(path)
+    assert len(h) == 1
+    assert h.repairs.as_dict()["malformed element sets skipped"] == 1
+    assert "inside the Earth" in str(h.skipped[0]) and h.skipped[0].line == 3
+    with pytest.raises(InputError, match=r"x\.tle:3.*perigee radius .* inside the Earth"):
+        read_tle(path, strict=True)
+
+
+def test_set_with_a_future_epoch_is_skipped_and_counted(tmp_path: Path) -> None:
+    # two-digit year 56 is 2056 (TLE years 57-99 are 19xx)
+    future = (_with_field(J3_B[0], 18, "56"), J3_B[1])
+    path = _write(tmp_path, [*J3_A, *future])
+    h = read_tle(path)
+    assert len(h) == 1
+    assert "2056" in str(h.skipped[0]) and "future" in str(h.skipped[0])
+    with pytest.raises(InputError, match=r"x\.tle:3.*epoch 2056-.* in the future"):
+        read_tle(path, strict=True)
+
+
+def test_kilobytes_long_name_line_is_a_one_line_error_naming_the_line(tmp_path: Path) -> None:
+    path = _write(tmp_path, ["0 " + "X" * 10_000, *J3_A, "0 JASON-3", *J3_B])
+    with pytest.raises(InputError, match=r"x\.tle:1.*10002 characters") as info:
+        read_elements(path)
+    assert "\n" not in str(info.value) and len(str(info.value)) < 400

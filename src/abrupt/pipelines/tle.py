@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
 from abrupt import progress
 from abrupt.detect.base import DetectionResult, Detector, get_detector
@@ -112,6 +113,34 @@ def detect_tle_file(
                 kwargs["run_id"] = run_id
             det = cls(**kwargs)
         out.satellites.append(SatelliteResult(history, det.name, det.detect(history, budget)))
+    return out
+
+
+def burns_above_floor(truth: pd.DataFrame, detectable_by_year: list[dict[str, Any]]) -> NDArray[np.bool_]:
+    """Per operator burn: is it at or above the floor the run states for its year?
+
+    A burn is above when its in-track |ΔV| reaches the year's smallest detectable in-track ΔV or its
+    cross-track |ΔV| the cross-track one (``noise_model["detectable_by_year"]``). A burn whose file
+    gives no ΔV (Fengyun windows) cannot be judged and counts as above; a burn in a year the history
+    does not cover counts as below (nothing could see it).
+    """
+    out = np.zeros(len(truth), dtype=bool)
+    if not detectable_by_year or len(truth) == 0:
+        return out
+    by_year = {int(r["year"]): r for r in detectable_by_year}
+    times = pd.to_datetime(truth["time_utc"].astype(str), utc=True)
+    dv_t = truth["dv_t_mps"].to_numpy(dtype=float) if "dv_t_mps" in truth else np.full(len(truth), np.nan)
+    dv_n = truth["dv_n_mps"].to_numpy(dtype=float) if "dv_n_mps" in truth else np.full(len(truth), np.nan)
+    for k, t in enumerate(times):
+        row = by_year.get(int(t.year))
+        if row is None:
+            continue
+        if not (np.isfinite(dv_t[k]) or np.isfinite(dv_n[k])):
+            out[k] = True
+            continue
+        t_ok = np.isfinite(dv_t[k]) and abs(dv_t[k]) >= row["min_detectable_dv_t_mps"]
+        n_ok = np.isfinite(dv_n[k]) and abs(dv_n[k]) >= row["min_detectable_dv_n_mps"]
+        out[k] = bool(t_ok or n_ok)
     return out
 
 

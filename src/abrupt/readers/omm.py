@@ -24,6 +24,7 @@ from sgp4 import omm
 from sgp4.api import Satrec
 
 from abrupt.errors import InputError, RepairLog
+from abrupt.readers.tle_checks import check_orbit_envelope
 from abrupt.readers.tle import (
     ElementHistory,
     RawElementSet,
@@ -132,6 +133,7 @@ def record_to_set(
         omm.initialize(sat, rec)
     except (ValueError, KeyError) as exc:
         raise InputError(f"{where}sgp4 cannot initialise this record: {exc}", file=file, line=line) from None
+    check_orbit_envelope(sat, file, line)
     key = "|".join(rec.get(k, "") for k in ("NORAD_CAT_ID", "EPOCH", *NUMERIC))
     return RawElementSet(sat, norad, elnum, line if line is not None else index, key, rec.get("OBJECT_NAME") or None)
 
@@ -319,7 +321,8 @@ def _is_tle(path: Path) -> bool:
     another kind (SP3) is an :class:`InputError` that says what the file is."""
     if not path.is_file():
         raise InputError("no such file", file=path)
-    head = read_element_bytes(path)[:4000].decode("utf-8", errors="replace")
+    # the first lines, however long (a 3LE name line of kilobytes must not hide the element sets)
+    head = read_element_bytes(path)[:1_000_000].decode("utf-8", errors="replace")
     if not head.strip():
         raise InputError("the file is empty: no TLE/3LE or OMM element sets", file=path, line=1)
     first = head.lstrip("\ufeff").split("\n", 1)[0]

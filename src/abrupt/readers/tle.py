@@ -42,7 +42,7 @@ from sgp4.api import WGS72, Satrec
 
 from abrupt.errors import InputError, RepairLog, quote
 from abrupt.readers.compression import read_bytes
-from abrupt.readers.tle_checks import check_element_history
+from abrupt.readers.tle_checks import check_element_history, check_orbit_envelope
 
 logger = logging.getLogger(__name__)
 
@@ -266,6 +266,7 @@ def parse_tle_pair(line1: str, line2: str, *, file: str = "<input>", line_no: in
         sat = Satrec.twoline2rv(l1, l2, WGS72)
     except (ValueError, IndexError) as exc:
         raise InputError(f"sgp4 cannot read this element set: {exc}", file=file, line=line_no) from None
+    check_orbit_envelope(sat, file, line_no)
     return sat
 
 
@@ -507,7 +508,8 @@ def read_tle_histories(path: str | Path, *, strict: bool = False) -> list[Elemen
     return split_by_satellite(sets, source=str(path), skipped=skipped)
 
 
-def is_tle_text(head: str) -> bool:
-    """Whether the first lines of a file look like TLE/3LE text (a line starting '1 ' then one '2 ')."""
-    lines = [ln.lstrip("\ufeff") for ln in head.splitlines() if ln.strip()]
+def is_tle_text(head: str, max_lines: int = 60) -> bool:
+    """Whether the first ``max_lines`` non-blank lines of a file look like TLE/3LE text (a line starting
+    '1 ' then one '2 '), however long a line before them is."""
+    lines = [ln.lstrip("\ufeff") for ln in head.splitlines() if ln.strip()][:max_lines]
     return any(a.startswith("1 ") and b.startswith("2 ") for a, b in itertools.pairwise(lines))

@@ -9,16 +9,29 @@ A checksum cannot catch a field written in the wrong unit. Two physical consiste
   revolution count restarted or wrapped) is counted, not repaired (:data:`TLE_REVNUM_DISAGREE`);
 - **isolated jumps**: a set whose mean motion is more than twice or less than half that of both its
   neighbours, which agree with each other within 10 %, is refused (no manoeuvre goes and comes back).
+
+And one element set on its own (:func:`check_orbit_envelope`, per record: a set outside is a
+malformed record, skipped and counted, or an error with ``strict``): an Earth orbiter's perigee is
+above the Earth's surface and its apogee below the Moon's distance (a mean eccentricity of
+0.9999999 puts the perigee inside the Earth), and its epoch is not in the future (a history cannot
+hold tracking that has not happened; a day's margin for clocks and time zones).
 """
 
 from __future__ import annotations
 
+import datetime
 import itertools
 import math
+import time
 from collections.abc import Sequence
 from typing import Any
 
 from abrupt.errors import InputError, RepairLog
+
+EARTH_RADIUS_WGS72_KM = 6378.135  # SGP4's WGS-72 equatorial radius
+MOON_DISTANCE_KM = 384400.0  # mean Earth-Moon distance: an Earth orbiter's apogee is below it
+FUTURE_MARGIN_DAYS = 1.0
+JD_UNIX_EPOCH = 2440587.5
 
 TLE_REVNUM_DISAGREE = "consecutive sets whose revolution numbers disagree with the mean motion (kept)"
 REVNUM_PAIR_DAYS = (0.25, 30.0)  # pairs of sets this far apart are compared
@@ -33,6 +46,35 @@ def _rev_per_day(satrec: Any) -> float:
 
 def _epoch_days(satrec: Any) -> float:
     return float(satrec.jdsatepoch) + float(satrec.jdsatepochF)
+
+
+def check_orbit_envelope(satrec: Any, file: str, line: int | None, now_unix_s: float | None = None) -> None:
+    """Refuse one element set that no Earth orbiter can have (module docstring): perigee radius
+    ``a(1 − e)`` below the Earth's radius, apogee ``a(1 + e)`` beyond the Moon's distance, or an
+    epoch more than a day after ``now_unix_s`` (default: the clock). ``a`` is SGP4's Brouwer mean
+    semi-major axis (``satrec.a``, Earth radii)."""
+    a_km = float(satrec.a) * EARTH_RADIUS_WGS72_KM
+    e = float(satrec.ecco)
+    perigee_km, apogee_km = a_km * (1.0 - e), a_km * (1.0 + e)
+    if not perigee_km >= EARTH_RADIUS_WGS72_KM:
+        raise InputError(
+            f"perigee radius {perigee_km:.6g} km is inside the Earth (radius {EARTH_RADIUS_WGS72_KM} km): "
+            f"eccentricity {e:.7g} with a mean semi-major axis of {a_km:.6g} km is no orbit",
+            file=file,
+            line=line,
+        )
+    if not apogee_km <= MOON_DISTANCE_KM:
+        raise InputError(
+            f"apogee radius {apogee_km:.6g} km is beyond the Moon's distance ({MOON_DISTANCE_KM:.0f} km): "
+            f"eccentricity {e:.7g}, mean semi-major axis {a_km:.6g} km is no Earth orbit",
+            file=file,
+            line=line,
+        )
+    now = time.time() if now_unix_s is None else now_unix_s
+    epoch_unix_s = (_epoch_days(satrec) - JD_UNIX_EPOCH) * 86400.0
+    if epoch_unix_s > now + FUTURE_MARGIN_DAYS * 86400.0:
+        when = datetime.datetime.fromtimestamp(epoch_unix_s, datetime.UTC).strftime("%Y-%m-%d")
+        raise InputError(f"epoch {when} is in the future: no element set can have been fitted then", file=file, line=line)
 
 
 def check_element_history(sets: Sequence[Any], source: str, repairs: RepairLog) -> None:

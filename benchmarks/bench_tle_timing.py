@@ -1,0 +1,165 @@
+"""TLE maneuver timing per shared history: offset from the operator epoch, interval coverage and
+recall above the stated floor, in one figure for ``docs/tle.md``.
+
+Every shared history (``../shared/data/tle``) runs through ``tle.mean_elements`` /
+``tle.geo_station_keeping`` at default settings and a budget of 1 false alarm per satellite-year,
+and is scored against its operator file (``../shared/data/maneuvers``) by :mod:`abrupt.score`:
+
+* precision, recall, F1 at ±1 day one-to-one (all operator maneuvers in the span);
+* recall of operator maneuvers of at least 2 cm/s (IDS files give ΔV), and recall of the maneuvers
+  above the floor the run states for their year (``noise_model["detectable_by_year"]``);
+* offsets (event − operator) of the one-to-one pairs within ±3 days: median, median |Δt|, share
+  more than a day late;
+* interval coverage: the share of those pairs whose operator epoch lies inside the event's stated
+  interval (``interval_start_utc``-``interval_end_utc``); nominal 90 %;
+* unmatched detections per year beside the budget.
+
+Jason-1 (2001-2013) is the held-out older-era history: nothing was tuned on it.
+
+Usage::
+
+    python benchmarks/bench_tle_timing.py                 # table + docs/tle_timing.png
+    python benchmarks/bench_tle_timing.py --figure /tmp/x.png --only Jason-3
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+
+from abrupt.detect.tle.detectors import detector_for
+from abrupt.pipelines.tle import burns_above_floor
+from abrupt.readers.fengyun import read_maneuver_file
+from abrupt.readers.tle import read_tle
+from abrupt.score import score_events
+from abrupt.thresholds import FalseAlarmBudget
+
+ROOT = Path(__file__).resolve().parent.parent
+DATA = ROOT.parent / "shared" / "data"
+SATELLITES: dict[str, str] = {
+    "Jason-1": "ja1man.txt",
+    "Jason-3": "ja3man.txt",
+    "Sentinel-3A": "s3aman.txt",
+    "CryoSat-2": "cs2man.txt",
+    "Fengyun-2D": "manFY2D.txt.fy",
+    "Fengyun-2E": "manFY2E.txt.fy",
+}
+HELD_OUT = ("Jason-1",)
+BUDGET = FalseAlarmBudget(1.0, "year")
+TOLERANCE_S = 86400.0
+OFFSET_WINDOW_S = 3 * 86400.0
+BIG_BURN_MPS = 0.02
+
+
+def evaluate(sat: str) -> dict[str, Any]:
+    """Run the detector on one shared history and score it (module docstring)."""
+    history = read_tle(DATA / "tle" / f"{sat}.tle")
+    truth = read_maneuver_file(DATA / "maneuvers" / SATELLITES[sat])
+    el = history.elements
+    start, end = el["epoch_utc"].iloc[0], el["epoch_utc"].iloc[-1]
+    t0 = time.perf_counter()
+    run = detector_for(history).detect(history, BUDGET)
+    seconds = time.perf_counter() - t0
+    events = run.events
+    events = events.loc[(events["kind"] == "maneuver") & (events["statistic"] >= events["threshold"])]
+    events = events.reset_index(drop=True)
+    res = score_events(events, truth, tolerance_s=TOLERANCE_S, start=start, end=end)
+    t_utc = pd.to_datetime(truth["time_utc"])
+    in_span = ((t_utc >= start) & (t_utc <= end)).to_numpy()
+    matched = {j for _, j, _ in res.pairs}
+    big = in_span & (truth["dv_mps"].fillna(np.inf).to_numpy(dtype=float) >= BIG_BURN_MPS)
+    nm = run.diagnostics[0].noise_model or {}
+    above = in_span & burns_above_floor(truth, nm.get("detectable_by_year", []))
+    wide = score_events(events, truth, tolerance_s=OFFSET_WINDOW_S, start=start, end=end)
+    offsets_d = np.array([dt for _, _, dt in wide.pairs]) / 86400.0
+    covered = []
+    lo = pd.to_datetime(events["interval_start_utc"].astype(str), format="ISO8601")
+    hi = pd.to_datetime(events["interval_end_utc"].astype(str), format="ISO8601")
+    for i, j, _ in wide.pairs:
+        covered.append(bool(lo.iloc[i] <= t_utc.iloc[j] <= hi.iloc[i]))
+    years = (end - start).total_seconds() / (86400.0 * 365.25)
+    n_big = int(big.sum())
+    n_above = int(above.sum())
+    return {
+        "satellite": sat,
+        "sets": len(history),
+        "years": years,
+        "det": res.n_detections,
+        "truth": res.n_truth,
+        "precision": res.precision,
+        "recall": res.recall,
+        "f1": res.f1,
+        "n_big": n_big,
+        "recall_big": sum(1 for j in np.flatnonzero(big) if j in matched) / n_big if n_big else float("nan"),
+        "n_above_floor": n_above,
+        "recall_above_floor": sum(1 for j in np.flatnonzero(above) if j in matched) / n_above
+        if n_above
+        else float("nan"),
+        "pairs_3d": len(offsets_d),
+        "median_offset_d": float(np.median(offsets_d)) if offsets_d.size else float("nan"),
+        "median_abs_offset_d": float(np.median(np.abs(offsets_d))) if offsets_d.size else float("nan"),
+        "late_over_1d": int((offsets_d > 1.0).sum()),
+        "coverage": float(np.mean(covered)) if covered else float("nan"),
+        "unmatched_per_year": res.false_positives / years,
+        "outlier_sets": int(nm.get("outlier_sets", 0)),
+        "offsets_d": offsets_d,
+        "seconds": seconds,
+    }
+
+
+def figure(rows: list[dict[str, Any]], path: Path) -> None:
+    """One panel per history: histogram of offsets (event − operator, days) within ±3 days, with the
+    median |offset|, interval coverage, full recall and above-floor recall in its title."""
+    n = len(rows)
+    fig, axes = plt.subplots(2, (n + 1) // 2, figsize=(4.2 * ((n + 1) // 2), 6.4), squeeze=False)
+    bins = np.linspace(-3.0, 3.0, 49)
+    for ax, r in zip(axes.flat, rows, strict=False):
+        ax.hist(r["offsets_d"], bins=bins, color="tab:blue")
+        ax.axvline(0.0, color="k", lw=0.8)
+        tag = " (held out)" if r["satellite"] in HELD_OUT else ""
+        ax.set_title(
+            f"{r['satellite']}{tag}\nmedian |Δt| {r['median_abs_offset_d']:.2f} d, coverage {r['coverage']:.0%}\n"
+            f"recall {r['recall']:.2f}, above floor {r['recall_above_floor']:.2f} (n={r['n_above_floor']})",
+            fontsize=8,
+        )
+        ax.set_xlabel("event − operator epoch (days)", fontsize=8)
+    for ax in list(axes.flat)[n:]:
+        ax.set_visible(False)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--figure", type=Path, default=ROOT / "docs" / "tle_timing.png")
+    ap.add_argument("--only", nargs="*", default=None)
+    args = ap.parse_args()
+    sats = [s for s in SATELLITES if args.only is None or s in args.only]
+    rows = [evaluate(s) for s in sats]
+    cols = (
+        "satellite sets years det truth precision recall f1 n_big recall_big n_above_floor recall_above_floor "
+        "pairs_3d median_offset_d median_abs_offset_d late_over_1d coverage unmatched_per_year outlier_sets seconds"
+    ).split()
+    table = pd.DataFrame([{k: r[k] for k in cols} for r in rows])
+    with pd.option_context("display.width", 250, "display.max_columns", 40):
+        print(table.to_string(index=False, float_format=lambda v: f"{v:.3f}"))
+    print(f"budget {BUDGET}; ±1 day one-to-one; offsets and coverage on pairs within ±3 days; held out: {HELD_OUT}")
+    figure(rows, args.figure)
+    print(f"figure: {args.figure.relative_to(ROOT) if args.figure.is_relative_to(ROOT) else args.figure}")
+
+
+if __name__ == "__main__":
+    from _results import write_results
+
+    with write_results("bench_tle_timing"):
+        main()
