@@ -22,7 +22,7 @@ from abrupt.flux.exposure import (
     store_exposure,
     store_spacecraft_model,
 )
-from abrupt.flux.forward import ForwardConfig
+from abrupt.flux.forward import MODEL_MASS_LAW, ForwardConfig
 from abrupt.flux.inference import PARAMS, FitResult
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.pipelines.flux import covered_days, flight_exposure, infer_flux, simulate_population
@@ -38,7 +38,13 @@ def flux() -> None:
 def _model_options(f: Any) -> Any:
     f = click.option("--debris-model", default="nasa90", show_default=True, help="nasa90 or a flux-table .toml.")(f)
     f = click.option("--meteoroid-model", default="grun", show_default=True, help="grun or a flux-table .toml.")(f)
-    f = click.option("--mass-model", default="al_sphere", show_default=True, help="Size-to-mass law.")(f)
+    f = click.option(
+        "--mass-model",
+        default=MODEL_MASS_LAW,
+        show_default=True,
+        help="Size-to-mass law: 'model' = each flux model's own (NASA-90/91 density law, Grün 2.5 g/cm³, a "
+        "table's density classes), or one law of `abrupt rates` for both populations.",
+    )(f)
     f = click.option("--draws", type=int, default=400_000, show_default=True, help="Monte Carlo draws per population.")(
         f
     )

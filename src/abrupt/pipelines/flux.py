@@ -72,7 +72,7 @@ class FluxInference:
 
     def as_dict(self) -> dict[str, Any]:
         return {
-            "forward_model": {k: v for k, v in vars(self.config).items()},
+            "forward_model": self.config.describe(),
             "fits": {k: v.as_dict() for k, v in self.fits.items()},
             "upper_limits": self.upper_limits,
             "goodness_of_fit": self.goodness,
