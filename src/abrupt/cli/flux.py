@@ -25,7 +25,13 @@ from abrupt.flux.exposure import (
 from abrupt.flux.forward import MODEL_MASS_LAW, ForwardConfig
 from abrupt.flux.inference import PARAMS, FitResult
 from abrupt.model.spacecraft import Spacecraft
-from abrupt.pipelines.flux import covered_days, flight_exposure, infer_flux, simulate_population
+from abrupt.pipelines.flux import (
+    LIMIT_THRESHOLDS_NMS,
+    covered_days,
+    flight_exposure,
+    infer_flux,
+    simulate_population,
+)
 from abrupt.report.flux import write_flux_report
 from abrupt.simulate.population import DETECTOR, FleetSpec
 
@@ -89,6 +95,18 @@ def _fit_lines(name: str, f: FitResult) -> list[str]:
     """The printed lines of one fit: the reported estimates first (with β known the linear ones with their
     standard errors and score intervals, then the maximum-likelihood ones as a diagnostic)."""
     size = f"  ({f.n_events} events, {f.n_days} spacecraft-days)"
+    if not f.beta_identified:  # β unbounded: the identified quantity first, the scales only as a diagnostic
+        head = f.headline()
+        level = f"{f.confidence:.0%}"
+        ident = ", ".join(
+            f"{k} {v:.3g} [{head['intervals'][k][0]:.3g}, {head['intervals'][k][1]:.3g}]"
+            for k, v in head["estimates"].items()
+        )
+        return [
+            f"{name}: expected detections s_p*T_p(beta) {ident} ({level} profile intervals)" + size,
+            f"  {head['statement']}",
+            "  scales (diagnostic, not measured): " + _estimates_text(f, f.estimates, f.intervals),
+        ]
     if not f.linear_estimates:
         return [f"{name}: " + _estimates_text(f, f.estimates, f.intervals) + size]
     level = f"{f.confidence:.0%}"
@@ -106,6 +124,21 @@ def _fit_lines(name: str, f: FitResult) -> list[str]:
     ]
 
 
+def _limit_lines(limits: list[dict[str, Any]]) -> list[str]:
+    """One printed line per upper limit: population, threshold, β, events, background, limit."""
+    out = []
+    for u in limits:
+        above = f"|ΔH| >= {u['dH_min_Nms']:.3g} N·m·s"
+        if u["dH_min_stated_Nms"] < u["dH_min_Nms"]:
+            above += " (all sizes: the lowest bin edge)"
+        out.append(
+            f"upper limit {u['confidence']:.0%} ({u['method']}) {u['population']}, {above}, beta {u['beta']:.3g} "
+            f"{u['beta_source']}: scale <= {u['scale_upper_limit']:.3g} (n = {u['n_observed']}, expected at "
+            f"scale 1: {u['signal_per_unit_scale']:.3g}, background {u['background_expected']:.3g})"
+        )
+    return out
+
+
 @flux.command("infer")
 @click.option("--catalog", "catalog_target", default=DEFAULT_CATALOG, show_default=True, help="Catalog file or URL.")
 @click.option("--spacecraft", multiple=True, help="Only these spacecraft pseudonyms (repeatable).")
@@ -114,7 +147,21 @@ def _fit_lines(name: str, f: FitResult) -> list[str]:
 @click.option("--fix", multiple=True, help="Hold a parameter fixed, e.g. --fix beta=2 (repeatable).")
 @click.option("--confidence", type=float, default=0.9, show_default=True, help="Interval level.")
 @click.option("--no-direction", is_flag=True, help="Ignore the direction of ΔH (|ΔH| only).")
-@click.option("--beta", "reference_beta", type=float, default=1.0, show_default=True, help="β for the model curves.")
+@click.option(
+    "--beta",
+    "reference_beta",
+    type=float,
+    default=1.0,
+    show_default=True,
+    help="β for the model curves and, unless --fix beta, the upper limits.",
+)
+@click.option(
+    "--limit-dH",
+    "limit_dh",
+    type=float,
+    multiple=True,
+    help="|ΔH| [N·m·s] from which to count for the upper limits (repeatable; default: all sizes and 0.1).",
+)
 @_model_options
 def infer(
     catalog_target: str,
@@ -125,9 +172,12 @@ def infer(
     confidence: float,
     no_direction: bool,
     reference_beta: float,
+    limit_dh: tuple[float, ...],
     **model: Any,
 ) -> None:
     """Fit flux scales and β to a catalog's strikes and exposure; intervals, upper limits, goodness of fit."""
+    if any(not (math.isfinite(x) and x >= 0) for x in limit_dh):
+        raise click.BadParameter(f"{limit_dh}: thresholds must be finite and >= 0 N·m·s", param_hint="--limit-dH")
     cat = Catalog(catalog_target, create=False)
     note("building forward-model templates and fitting ...")
     result = infer_flux(
@@ -138,15 +188,16 @@ def infer(
         confidence=confidence,
         use_direction=not no_direction,
         reference_beta=reference_beta,
+        limit_dH_Nms=limit_dh or LIMIT_THRESHOLDS_NMS,
     )
     for name, f in result.fits.items():
         for line in _fit_lines(name, f):
             click.echo(line)
         free = [p for p in f.estimates if p not in f.fixed]
-        if f.corrected_estimates and free and not f.linear_estimates:
+        if f.corrected_estimates and free and not f.linear_estimates and f.beta_identified:
             corr = ", ".join(f"{p} = {f.corrected_estimates[p]:.3g}" for p in free)
             click.echo(f"  bias-corrected point estimate (signed ML, Cox-Snell correction of beta): {corr}")
-        if "beta" in free:
+        if "beta" in free and f.beta_identified:
             ident = ", ".join(f"{k} {v:.3g}" for k, v in f.expected_events.items() if k != "false_alarms")
             click.echo(f"  identified with beta free: expected detections s_p*T_p(beta): {ident}")
     for g in result.goodness:
@@ -154,6 +205,8 @@ def infer(
             f"  {g['model']}: expected {g['expected_events']:.1f}, observed {g['observed_events']}, "
             f"deviance p = {g['deviance_p_value']:.3g}, count p = {g['count_p_value']:.3g}"
         )
+    for line in _limit_lines(result.upper_limits):
+        click.echo(line)
     for n in result.notes:
         note(f"note: {n}")
     if out_path:

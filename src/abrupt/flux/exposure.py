@@ -336,3 +336,24 @@ def load_spacecraft_models(catalog: Catalog) -> dict[str, Spacecraft]:
             raise ConfigError(f"stored spacecraft model is not valid TOML: {exc}", file=source) from None
         out[str(row["model"])] = spacecraft_from_dict(data, source=source)
     return out
+
+
+def spacecraft_model_digests(catalog: Catalog) -> dict[str, str]:
+    """SHA-256 of each stored spacecraft description's TOML text, by model name (empty when none)."""
+    if "spacecraft_models" not in sa.inspect(catalog.engine).get_table_names():
+        return {}
+    t = spacecraft_model_table
+    with catalog.engine.connect() as conn:
+        rows = conn.execute(sa.select(t.c.model, t.c.sha256)).all()
+    return {str(m): str(h) for m, h in rows}
+
+
+def share_identical_models(exposure: pd.DataFrame, digests: dict[str, str]) -> pd.DataFrame:
+    """The exposure with every ``spacecraft_file`` that names a stored description replaced by the first name
+    (sorted) holding the same TOML text, so that spacecraft sharing a model share one forward-model template
+    (the cost of an inference then grows with the number of distinct models and orbits, not of names)."""
+    first: dict[str, str] = {}
+    canonical = {name: first.setdefault(digest, name) for name, digest in sorted(digests.items())}
+    if all(k == v for k, v in canonical.items()):
+        return exposure
+    return exposure.assign(spacecraft_file=exposure["spacecraft_file"].map(lambda n: canonical.get(n, n)))
