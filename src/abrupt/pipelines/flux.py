@@ -71,6 +71,7 @@ class FluxInference:
     showers: pd.DataFrame
     n_events_total: int
     notes: list[str] = field(default_factory=list)
+    n_templates: int = 0  # forward-model templates: one per distinct spacecraft model and orbit
 
     def as_dict(self) -> dict[str, Any]:
         return {
@@ -82,6 +83,7 @@ class FluxInference:
             "cumulative_rate": self.cumulative.to_dict("list"),
             "showers": self.showers.to_dict("records"),
             "n_events_in_catalog": self.n_events_total,
+            "n_forward_model_templates": self.n_templates,
             "notes": self.notes,
         }
 
@@ -243,6 +245,7 @@ def infer_flux(
         showers,
         len(events),
         notes,
+        len(data.templates),
     )
 
 
