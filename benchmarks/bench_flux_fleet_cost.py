@@ -71,16 +71,17 @@ def main() -> None:
         one = exposure[exposure["spacecraft"] == names[0]]
         single = _catalog(Path(tmp) / "one.sqlite", spec, names[:1], events[events["spacecraft"] == names[0]], one)
         years = len(exposure) / 365.25
-        print(
-            f"{len(names)} spacecraft, {len(exposure)} spacecraft-days ({years:.0f} spacecraft-years), {len(events)} events"
-        )
+        print(f"{len(names)} spacecraft, {len(exposure)} spacecraft-days ({years:.0f} spacecraft-years), ", end="")
+        print(f"{len(events)} events")
         wall, cpu, n_tpl = _timed(fleet, cfg)
         print(
-            f"fleet of {len(names)} names, one model: inference {wall:6.2f} s wall, {cpu:6.2f} s CPU, {n_tpl} template(s)  (target < {TARGET_S:.0f} s)"
+            f"fleet of {len(names)} names, one model: inference {wall:6.2f} s wall, {cpu:6.2f} s CPU, "
+            f"{n_tpl} template(s)  (target < {TARGET_S:.0f} s)"
         )
         wall1, cpu1, n_tpl1 = _timed(single, cfg)
         print(
-            f"one spacecraft ({len(one) / 365.25:.0f} years):     inference {wall1:6.2f} s wall, {cpu1:6.2f} s CPU, {n_tpl1} template(s)"
+            f"one spacecraft ({len(one) / 365.25:.0f} years):     inference {wall1:6.2f} s wall, {cpu1:6.2f} s CPU, "
+            f"{n_tpl1} template(s)"
         )
 
 
