@@ -17,8 +17,10 @@ from abrupt.cli.options import budget_options, pop_budget
 from abrupt.errors import ConfigError
 from abrupt.flux.exposure import (
     EfficiencyCurve,
+    day_range,
     efficiency_per_day,
     exposure_frame,
+    read_day_table,
     store_exposure,
     store_spacecraft_model,
 )
@@ -224,10 +226,20 @@ def infer(
     "--spacecraft-file", required=True, type=click.Path(exists=True, dir_okay=False), help="TOML with [[surfaces]]."
 )
 @click.option("--days", multiple=True, help="Days YYYY-MM-DD (default: every day the catalog's runs covered).")
+@click.option("--from", "first_day", help="First day YYYY-MM-DD of a range (with --to; instead of --days).")
+@click.option("--to", "last_day", help="Last day YYYY-MM-DD of the range (inclusive).")
+@click.option(
+    "--table",
+    "day_table",
+    type=click.Path(exists=True, dir_okay=False),
+    help="Per-day CSV: day, analysed_fraction[, dH50_Nms and efficiency_slope | dH90_Nms][, efficiency_max]"
+    "[, false_alarms_per_day][, altitude_km, inclination_deg, epoch_year][, attitude]; its columns override "
+    "the options day by day.",
+)
 @click.option("--detector", default="", help="Detector name the exposure belongs to.")
-@click.option("--altitude-km", type=float, required=True)
-@click.option("--inclination-deg", type=float, required=True)
-@click.option("--epoch", "epoch_year", type=float, default=2020.0, show_default=True)
+@click.option("--altitude-km", type=float, help="Orbit altitude [km] (or an altitude_km column in --table).")
+@click.option("--inclination-deg", type=float, help="Orbit inclination [deg] (or an inclination_deg column).")
+@click.option("--epoch", "epoch_year", type=float, default=None, help="Decimal year (default: each day's year).")
 @click.option(
     "--analysed-fraction", default="1.0", show_default=True, help="One value, or one per day (comma-separated)."
 )
@@ -246,10 +258,13 @@ def exposure_command(
     spacecraft: str,
     spacecraft_file: str,
     days: tuple[str, ...],
+    first_day: str | None,
+    last_day: str | None,
+    day_table: str | None,
     detector: str,
-    altitude_km: float,
-    inclination_deg: float,
-    epoch_year: float,
+    altitude_km: float | None,
+    inclination_deg: float | None,
+    epoch_year: float | None,
     analysed_fraction: str,
     recovery_csv: str | None,
     dh90: float | None,
@@ -259,51 +274,89 @@ def exposure_command(
 ) -> None:
     """Store exposure rows (one per spacecraft-day) in a catalog, beside its events.
 
-    The false-alarm budget is the one the detection threshold was set for (``--false-alarms``); it
-    must be stated, since the inference subtracts it as background.
+    Days: --days, a range --from/--to, the days of a per-day --table, or every day the catalog's runs
+    covered. The false-alarm budget is the one the detection threshold was set for (``--false-alarms``, or a
+    false_alarms_per_day column); it must be stated, since the inference subtracts it as background.
     """
-    if all(v is None for v in budget_text.values()):
-        raise click.UsageError("give --false-alarms: the rate the detection threshold was set for (e.g. 1/day)")
-    false_alarms_per_day = pop_budget(budget_text).per_day
+    table = read_day_table(day_table) if day_table else None
+    given = [
+        name
+        for name, v in (("--days", days), ("--from/--to", first_day or last_day), ("--table", table))
+        if v is not None and len(v)
+    ]
+    if len(given) > 1:
+        raise click.UsageError(f"give the days one way: {' or '.join(given)}")
+    if (first_day is None) != (last_day is None):
+        raise click.UsageError("a day range needs both --from and --to")
     cat = Catalog(catalog_target, create=False)
+    if table is not None:
+        days = tuple(table["day"])
+    elif first_day and last_day:
+        days = tuple(day_range(first_day, last_day))
     if not days:
         days = covered_days(cat, spacecraft)
     if not days:
-        raise click.UsageError(f"no days found for {spacecraft} in {catalog_target}; give --days")
+        raise click.UsageError(
+            f"no days found for {spacecraft} in {catalog_target}; give --days, --from/--to or --table"
+        )
+    per_day = table.set_index("day") if table is not None else pd.DataFrame(index=pd.Index(list(days), name="day"))
+    has_curve = "dH50_Nms" in per_day.columns and per_day["dH50_Nms"].notna().all()
     if recovery_csv:
         curves = efficiency_per_day(pd.read_csv(recovery_csv), days, source=recovery_csv)
     elif dh90:
         curves = dict.fromkeys(days, EfficiencyCurve.from_dH90(dh90, slope))
+    elif has_curve:
+        curves = {}
     else:
-        raise click.UsageError("give --recovery CSV or --dH90")
+        raise click.UsageError("give --recovery CSV, --dH90, or dH50_Nms/dH90_Nms columns in --table")
     fractions = [float(x) for x in str(analysed_fraction).split(",")]
     if len(fractions) not in (1, len(days)):
         raise click.UsageError(f"--analysed-fraction: give one value or one per day ({len(days)})")
+    budget_given = any(v is not None for v in budget_text.values())
+    if not budget_given and "false_alarms_per_day" not in per_day.columns:
+        raise click.UsageError("give --false-alarms: the rate the detection threshold was set for (e.g. 1/day)")
+    false_alarms_per_day = pop_budget(budget_text).per_day if budget_given else math.nan
+
+    def cell(day: str, column: str, default: Any) -> Any:
+        if column in per_day.columns and pd.notna(per_day.at[day, column]):
+            return per_day.at[day, column]
+        return default
+
+    records = []
+    for i, d in enumerate(days):
+        curve = curves.get(d)
+        record = {
+            "spacecraft": spacecraft,
+            "day": d,
+            "detector": detector,
+            "analysed_fraction": cell(d, "analysed_fraction", fractions[i % len(fractions)]),
+            "false_alarms_per_day": cell(d, "false_alarms_per_day", false_alarms_per_day),
+            "dH50_Nms": cell(d, "dH50_Nms", curve.dH50_Nms if curve else math.nan),
+            "efficiency_slope": cell(d, "efficiency_slope", curve.slope if curve else math.nan),
+            "efficiency_max": cell(d, "efficiency_max", curve.max_efficiency if curve else 1.0),
+            "altitude_km": cell(d, "altitude_km", altitude_km),
+            "inclination_deg": cell(d, "inclination_deg", inclination_deg),
+            "epoch_year": cell(d, "epoch_year", epoch_year if epoch_year is not None else float(d[:4])),
+            "attitude": cell(d, "attitude", attitude),
+        }
+        for column, option in (
+            ("altitude_km", "--altitude-km"),
+            ("inclination_deg", "--inclination-deg"),
+            ("false_alarms_per_day", "--false-alarms"),
+            ("dH50_Nms", "--recovery or --dH90"),
+        ):
+            if record[column] is None or (isinstance(record[column], float) and math.isnan(record[column])):
+                raise click.UsageError(f"day {d}: no {column}; give {option} or a {column} column in --table")
+        records.append(record)
     model = store_spacecraft_model(cat, spacecraft, spacecraft_file)  # rows name it by the pseudonym
-    rows = exposure_frame(
-        [
-            {
-                "spacecraft": spacecraft,
-                "day": d,
-                "detector": detector,
-                "analysed_fraction": fractions[i % len(fractions)],
-                "false_alarms_per_day": false_alarms_per_day,
-                "dH50_Nms": curves[d].dH50_Nms,
-                "efficiency_slope": curves[d].slope,
-                "efficiency_max": curves[d].max_efficiency,
-                "altitude_km": altitude_km,
-                "inclination_deg": inclination_deg,
-                "epoch_year": epoch_year,
-                "spacecraft_file": model,
-                "attitude": attitude,
-            }
-            for i, d in enumerate(days)
-        ]
-    )
+    rows = exposure_frame([r | {"spacecraft_file": model} for r in records])
     n = store_exposure(cat, rows)
-    for d in days:
-        c = curves[d]
-        click.echo(f"{spacecraft} {d}: x50 {c.dH50_Nms:.4g} N·m·s, slope {c.slope:.3g}, plateau {c.max_efficiency:.3f}")
+    for r in rows.to_dict("records"):
+        click.echo(
+            f"{spacecraft} {r['day']}: analysed {r['analysed_fraction']:.3g}, x50 {r['dH50_Nms']:.4g} N·m·s, slope "
+            f"{r['efficiency_slope']:.3g}, plateau {r['efficiency_max']:.3f}, {r['altitude_km']:.1f} km "
+            f"{r['inclination_deg']:.2f} deg, {r['false_alarms_per_day']:.3g} false alarms/day"
+        )
     click.echo(f"stored {n} exposure rows for {spacecraft} ({days[0]} .. {days[-1]}) in {cat.name}")
 
 
