@@ -130,9 +130,9 @@ def visible_points(
     shadowed = np.zeros(n, dtype=bool)
     for g in range(c.shape[0]):
         dn = np.einsum("nk,nk->n", d, normal[:, g])
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore"):  # dn = 0: a face edge-on to the ray, never hit
             tg = np.einsum("nk,nk->n", c[g] - p, normal[:, g]) / dn
-        q = p + tg[:, None] * d - c[g]
+            q = p + tg[:, None] * d - c[g]
         inside = (np.abs(np.einsum("nk,nk->n", q, ub[:, g])) <= half[g, 0]) & (
             np.abs(np.einsum("nk,nk->n", q, v[:, g])) <= half[g, 1]
         )

@@ -113,15 +113,20 @@ def read_event_table(path: str | Path) -> pd.DataFrame:
     return normalise_frame(frame)
 
 
+def _number(value: object) -> float:
+    """A parsed numeric cell, NaN for anything else (an empty cell)."""
+    return float(value) if isinstance(value, (int, float)) else math.nan
+
+
 def _check_orbit_frame(row: dict[str, object], path: Path, line_no: int) -> None:
     """Orbit-frame ΔH given in full or not at all, and its norm equal to ``dH_Nms`` (1 %) when both are given."""
-    present = [c for c in ORBIT_FRAME_DH if c in row and not (isinstance(row[c], float) and math.isnan(row[c]))]
+    present = [c for c in ORBIT_FRAME_DH if not math.isnan(_number(row.get(c)))]
     if not present:
         return
     if len(present) != len(ORBIT_FRAME_DH):
         absent = [c for c in ORBIT_FRAME_DH if c not in present]
         raise InputError("orbit-frame ΔH needs all three components", file=path, line=line_no, column=absent[0])
-    norm = float(np.linalg.norm([float(row[c]) for c in ORBIT_FRAME_DH]))  # type: ignore[arg-type]
+    norm = float(np.linalg.norm([_number(row[c]) for c in ORBIT_FRAME_DH]))
     size = row.get("dH_Nms")
     if isinstance(size, float) and math.isfinite(size) and abs(norm - size) > 0.01 * max(size, 1e-300):
         raise InputError(
