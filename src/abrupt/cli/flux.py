@@ -318,9 +318,8 @@ def exposure_command(
     false_alarms_per_day = pop_budget(budget_text).per_day if budget_given else math.nan
 
     def cell(day: str, column: str, default: Any) -> Any:
-        if column in per_day.columns and pd.notna(per_day.at[day, column]):
-            return per_day.at[day, column]
-        return default
+        value: Any = per_day.at[day, column] if column in per_day.columns else None
+        return default if value is None or (isinstance(value, float) and math.isnan(value)) else value
 
     records = []
     for i, d in enumerate(days):
