@@ -320,3 +320,22 @@ def slr_setup(shared: Path, target: Path) -> None:
             f"ground.station.range.tropospheric.correction [{k}] = true",
         ]
     target.write_text("\n".join(lines) + "\n")
+
+
+def other_detector_events(shared: Path, target: Path) -> None:
+    """Two strikes of another detector (SC-B, March 2026) in the event schema, orbit-frame ΔH given."""
+    target.write_text(
+        "spacecraft,kind,detector,time_utc,dH_Nms,false_alarms_per_day,dH_O_r_Nms,dH_O_t_Nms,dH_O_n_Nms\n"
+        "SC-B,strike,other.glr,2026-03-10T01:02:03Z,0.05,1,0.03,0.0,0.04\n"
+        "SC-B,strike,other.glr,2026-03-12T11:00:00Z,0.13,1,0.0,0.12,0.05\n"
+    )
+
+
+def exposure_days(shared: Path, target: Path) -> None:
+    """A per-day exposure table of three March 2026 days: analysed fraction, efficiency and orbit."""
+    target.write_text(
+        "day,analysed_fraction,dH90_Nms,efficiency_slope,altitude_km,inclination_deg,false_alarms_per_day\n"
+        "2026-03-10,0.93,0.02,4,700,98.2,1\n"
+        "2026-03-11,0.88,0.02,4,700,98.2,1\n"
+        "2026-03-12,0.91,0.025,4,700,98.2,1\n"
+    )

@@ -96,6 +96,8 @@ DOC_INPUTS: dict[str, dict[str, di.Maker]] = {
         "store": di.store,
         "sc.toml": di.example("kestrel.toml"),
         "sc_surfaces.toml": di.example("kestrel_surfaces.toml"),
+        "other_events.csv": di.other_detector_events,
+        "days.csv": di.exposure_days,
     },
     "orbit.md": {"quiet.csv": di.quiet_navigation, "iss.oem": di.iss_like_oem},
     "formats.md": {

@@ -1,15 +1,18 @@
-"""``abrupt catalog``: list and export the event catalog (never creating one)."""
+"""``abrupt catalog``: list and export the event catalog (never creating one), import events into it."""
 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Any
 
 import click
 import pandas as pd
 
 from abrupt.catalog import Catalog
+from abrupt.catalog.event_import import read_event_table
 from abrupt.cli.groups import catalog_option, cli
+from abrupt.events import new_run_id
 
 #: Width the default view fits in (characters).
 VIEW_WIDTH = 120
@@ -122,3 +125,27 @@ def list_(catalog_target: str, runs: bool, wide: bool, **filters: Any) -> None:
         click.echo("\n".join(narrow_view(frame)))
     n_events = frame["event_key"].nunique()
     click.echo(f"{len(frame)} detection(s) of {n_events} event(s)", err=True)
+
+
+@catalog_group.command("import")
+@catalog_option
+@click.argument("events_csv", type=click.Path(exists=True, dir_okay=False))
+def import_events(catalog_target: str, events_csv: str) -> None:
+    """Import EVENTS_CSV (any detector's events in the event schema) into the catalog, creating it if needed.
+
+    Required columns: spacecraft, kind, detector, time_utc; the other schema columns may be absent or empty,
+    extra columns are kept (the orbit-frame ΔH dH_O_r_Nms, dH_O_t_Nms, dH_O_n_Nms of the flux inference).
+    Every cell is checked (a one-line error names file, line and column); re-importing a file adds nothing.
+    """
+    target = Path(catalog_target)
+    if target.exists() and target.resolve() == Path(events_csv).resolve():
+        raise click.BadParameter("the catalog would overwrite the events file it imports", param_hint="--catalog")
+    events = read_event_table(events_csv)
+    run_id = new_run_id()
+    events["run_id"] = pd.array([run_id] * len(events), dtype="string")
+    cat = Catalog(catalog_target)
+    cat.start_run(run_id, f"catalog import {Path(events_csv).name}", details={"file": str(events_csv)})
+    added = cat.store_events(events)
+    cat.finish_run(run_id, n_found=len(events), n_new=added.events)
+    kinds = events["kind"].value_counts().to_dict()
+    click.echo(f"imported {len(events)} event(s) {kinds} from {events_csv} into {cat.name}: {added.events} new")

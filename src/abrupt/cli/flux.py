@@ -17,15 +17,23 @@ from abrupt.cli.options import budget_options, pop_budget
 from abrupt.errors import ConfigError
 from abrupt.flux.exposure import (
     EfficiencyCurve,
+    day_range,
     efficiency_per_day,
     exposure_frame,
+    read_day_table,
     store_exposure,
     store_spacecraft_model,
 )
-from abrupt.flux.forward import ForwardConfig
+from abrupt.flux.forward import MODEL_MASS_LAW, ForwardConfig
 from abrupt.flux.inference import PARAMS, FitResult
 from abrupt.model.spacecraft import Spacecraft
-from abrupt.pipelines.flux import covered_days, flight_exposure, infer_flux, simulate_population
+from abrupt.pipelines.flux import (
+    LIMIT_THRESHOLDS_NMS,
+    covered_days,
+    flight_exposure,
+    infer_flux,
+    simulate_population,
+)
 from abrupt.report.flux import write_flux_report
 from abrupt.simulate.population import DETECTOR, FleetSpec
 
@@ -38,7 +46,13 @@ def flux() -> None:
 def _model_options(f: Any) -> Any:
     f = click.option("--debris-model", default="nasa90", show_default=True, help="nasa90 or a flux-table .toml.")(f)
     f = click.option("--meteoroid-model", default="grun", show_default=True, help="grun or a flux-table .toml.")(f)
-    f = click.option("--mass-model", default="al_sphere", show_default=True, help="Size-to-mass law.")(f)
+    f = click.option(
+        "--mass-model",
+        default=MODEL_MASS_LAW,
+        show_default=True,
+        help="Size-to-mass law: 'model' = each flux model's own (NASA-90/91 density law, Grün 2.5 g/cm³, a "
+        "table's density classes), or one law of `abrupt rates` for both populations.",
+    )(f)
     f = click.option("--draws", type=int, default=400_000, show_default=True, help="Monte Carlo draws per population.")(
         f
     )
@@ -83,6 +97,18 @@ def _fit_lines(name: str, f: FitResult) -> list[str]:
     """The printed lines of one fit: the reported estimates first (with β known the linear ones with their
     standard errors and score intervals, then the maximum-likelihood ones as a diagnostic)."""
     size = f"  ({f.n_events} events, {f.n_days} spacecraft-days)"
+    if not f.beta_identified:  # β unbounded: the identified quantity first, the scales only as a diagnostic
+        head = f.headline()
+        level = f"{f.confidence:.0%}"
+        ident = ", ".join(
+            f"{k} {v:.3g} [{head['intervals'][k][0]:.3g}, {head['intervals'][k][1]:.3g}]"
+            for k, v in head["estimates"].items()
+        )
+        return [
+            f"{name}: expected detections s_p*T_p(beta) {ident} ({level} profile intervals)" + size,
+            f"  {head['statement']}",
+            "  scales (diagnostic, not measured): " + _estimates_text(f, f.estimates, f.intervals),
+        ]
     if not f.linear_estimates:
         return [f"{name}: " + _estimates_text(f, f.estimates, f.intervals) + size]
     level = f"{f.confidence:.0%}"
@@ -100,6 +126,21 @@ def _fit_lines(name: str, f: FitResult) -> list[str]:
     ]
 
 
+def _limit_lines(limits: list[dict[str, Any]]) -> list[str]:
+    """One printed line per upper limit: population, threshold, β, events, background, limit."""
+    out = []
+    for u in limits:
+        above = f"|ΔH| >= {u['dH_min_Nms']:.3g} N·m·s"
+        if u["dH_min_stated_Nms"] < u["dH_min_Nms"]:
+            above += " (all sizes: the lowest bin edge)"
+        out.append(
+            f"upper limit {u['confidence']:.0%} ({u['method']}) {u['population']}, {above}, beta {u['beta']:.3g} "
+            f"{u['beta_source']}: scale <= {u['scale_upper_limit']:.3g} (n = {u['n_observed']}, expected at "
+            f"scale 1: {u['signal_per_unit_scale']:.3g}, background {u['background_expected']:.3g})"
+        )
+    return out
+
+
 @flux.command("infer")
 @click.option("--catalog", "catalog_target", default=DEFAULT_CATALOG, show_default=True, help="Catalog file or URL.")
 @click.option("--spacecraft", multiple=True, help="Only these spacecraft pseudonyms (repeatable).")
@@ -108,7 +149,21 @@ def _fit_lines(name: str, f: FitResult) -> list[str]:
 @click.option("--fix", multiple=True, help="Hold a parameter fixed, e.g. --fix beta=2 (repeatable).")
 @click.option("--confidence", type=float, default=0.9, show_default=True, help="Interval level.")
 @click.option("--no-direction", is_flag=True, help="Ignore the direction of ΔH (|ΔH| only).")
-@click.option("--beta", "reference_beta", type=float, default=1.0, show_default=True, help="β for the model curves.")
+@click.option(
+    "--beta",
+    "reference_beta",
+    type=float,
+    default=1.0,
+    show_default=True,
+    help="β for the model curves and, unless --fix beta, the upper limits.",
+)
+@click.option(
+    "--limit-dH",
+    "limit_dh",
+    type=float,
+    multiple=True,
+    help="|ΔH| [N·m·s] from which to count for the upper limits (repeatable; default: all sizes and 0.1).",
+)
 @_model_options
 def infer(
     catalog_target: str,
@@ -119,9 +174,12 @@ def infer(
     confidence: float,
     no_direction: bool,
     reference_beta: float,
+    limit_dh: tuple[float, ...],
     **model: Any,
 ) -> None:
     """Fit flux scales and β to a catalog's strikes and exposure; intervals, upper limits, goodness of fit."""
+    if any(not (math.isfinite(x) and x >= 0) for x in limit_dh):
+        raise click.BadParameter(f"{limit_dh}: thresholds must be finite and >= 0 N·m·s", param_hint="--limit-dH")
     cat = Catalog(catalog_target, create=False)
     note("building forward-model templates and fitting ...")
     result = infer_flux(
@@ -132,15 +190,16 @@ def infer(
         confidence=confidence,
         use_direction=not no_direction,
         reference_beta=reference_beta,
+        limit_dH_Nms=limit_dh or LIMIT_THRESHOLDS_NMS,
     )
     for name, f in result.fits.items():
         for line in _fit_lines(name, f):
             click.echo(line)
         free = [p for p in f.estimates if p not in f.fixed]
-        if f.corrected_estimates and free and not f.linear_estimates:
+        if f.corrected_estimates and free and not f.linear_estimates and f.beta_identified:
             corr = ", ".join(f"{p} = {f.corrected_estimates[p]:.3g}" for p in free)
             click.echo(f"  bias-corrected point estimate (signed ML, Cox-Snell correction of beta): {corr}")
-        if "beta" in free:
+        if "beta" in free and f.beta_identified:
             ident = ", ".join(f"{k} {v:.3g}" for k, v in f.expected_events.items() if k != "false_alarms")
             click.echo(f"  identified with beta free: expected detections s_p*T_p(beta): {ident}")
     for g in result.goodness:
@@ -148,6 +207,8 @@ def infer(
             f"  {g['model']}: expected {g['expected_events']:.1f}, observed {g['observed_events']}, "
             f"deviance p = {g['deviance_p_value']:.3g}, count p = {g['count_p_value']:.3g}"
         )
+    for line in _limit_lines(result.upper_limits):
+        click.echo(line)
     for n in result.notes:
         note(f"note: {n}")
     if out_path:
@@ -165,10 +226,20 @@ def infer(
     "--spacecraft-file", required=True, type=click.Path(exists=True, dir_okay=False), help="TOML with [[surfaces]]."
 )
 @click.option("--days", multiple=True, help="Days YYYY-MM-DD (default: every day the catalog's runs covered).")
+@click.option("--from", "first_day", help="First day YYYY-MM-DD of a range (with --to; instead of --days).")
+@click.option("--to", "last_day", help="Last day YYYY-MM-DD of the range (inclusive).")
+@click.option(
+    "--table",
+    "day_table",
+    type=click.Path(exists=True, dir_okay=False),
+    help="Per-day CSV: day, analysed_fraction[, dH50_Nms and efficiency_slope | dH90_Nms][, efficiency_max]"
+    "[, false_alarms_per_day][, altitude_km, inclination_deg, epoch_year][, attitude]; its columns override "
+    "the options day by day.",
+)
 @click.option("--detector", default="", help="Detector name the exposure belongs to.")
-@click.option("--altitude-km", type=float, required=True)
-@click.option("--inclination-deg", type=float, required=True)
-@click.option("--epoch", "epoch_year", type=float, default=2020.0, show_default=True)
+@click.option("--altitude-km", type=float, help="Orbit altitude [km] (or an altitude_km column in --table).")
+@click.option("--inclination-deg", type=float, help="Orbit inclination [deg] (or an inclination_deg column).")
+@click.option("--epoch", "epoch_year", type=float, default=None, help="Decimal year (default: each day's year).")
 @click.option(
     "--analysed-fraction", default="1.0", show_default=True, help="One value, or one per day (comma-separated)."
 )
@@ -187,10 +258,13 @@ def exposure_command(
     spacecraft: str,
     spacecraft_file: str,
     days: tuple[str, ...],
+    first_day: str | None,
+    last_day: str | None,
+    day_table: str | None,
     detector: str,
-    altitude_km: float,
-    inclination_deg: float,
-    epoch_year: float,
+    altitude_km: float | None,
+    inclination_deg: float | None,
+    epoch_year: float | None,
     analysed_fraction: str,
     recovery_csv: str | None,
     dh90: float | None,
@@ -200,51 +274,88 @@ def exposure_command(
 ) -> None:
     """Store exposure rows (one per spacecraft-day) in a catalog, beside its events.
 
-    The false-alarm budget is the one the detection threshold was set for (``--false-alarms``); it
-    must be stated, since the inference subtracts it as background.
+    Days: --days, a range --from/--to, the days of a per-day --table, or every day the catalog's runs
+    covered. The false-alarm budget is the one the detection threshold was set for (``--false-alarms``, or a
+    false_alarms_per_day column); it must be stated, since the inference subtracts it as background.
     """
-    if all(v is None for v in budget_text.values()):
-        raise click.UsageError("give --false-alarms: the rate the detection threshold was set for (e.g. 1/day)")
-    false_alarms_per_day = pop_budget(budget_text).per_day
+    table = read_day_table(day_table) if day_table else None
+    given = [
+        name
+        for name, v in (("--days", days), ("--from/--to", first_day or last_day), ("--table", table))
+        if v is not None and len(v)
+    ]
+    if len(given) > 1:
+        raise click.UsageError(f"give the days one way: {' or '.join(given)}")
+    if (first_day is None) != (last_day is None):
+        raise click.UsageError("a day range needs both --from and --to")
     cat = Catalog(catalog_target, create=False)
+    if table is not None:
+        days = tuple(table["day"])
+    elif first_day and last_day:
+        days = tuple(day_range(first_day, last_day))
     if not days:
         days = covered_days(cat, spacecraft)
     if not days:
-        raise click.UsageError(f"no days found for {spacecraft} in {catalog_target}; give --days")
+        raise click.UsageError(
+            f"no days found for {spacecraft} in {catalog_target}; give --days, --from/--to or --table"
+        )
+    per_day = table.set_index("day") if table is not None else pd.DataFrame(index=pd.Index(list(days), name="day"))
+    has_curve = "dH50_Nms" in per_day.columns and per_day["dH50_Nms"].notna().all()
     if recovery_csv:
         curves = efficiency_per_day(pd.read_csv(recovery_csv), days, source=recovery_csv)
     elif dh90:
         curves = dict.fromkeys(days, EfficiencyCurve.from_dH90(dh90, slope))
+    elif has_curve:
+        curves = {}
     else:
-        raise click.UsageError("give --recovery CSV or --dH90")
+        raise click.UsageError("give --recovery CSV, --dH90, or dH50_Nms/dH90_Nms columns in --table")
     fractions = [float(x) for x in str(analysed_fraction).split(",")]
     if len(fractions) not in (1, len(days)):
         raise click.UsageError(f"--analysed-fraction: give one value or one per day ({len(days)})")
+    budget_given = any(v is not None for v in budget_text.values())
+    if not budget_given and "false_alarms_per_day" not in per_day.columns:
+        raise click.UsageError("give --false-alarms: the rate the detection threshold was set for (e.g. 1/day)")
+    false_alarms_per_day = pop_budget(budget_text).per_day if budget_given else math.nan
+
+    def cell(day: str, column: str, default: Any) -> Any:
+        value: Any = per_day.at[day, column] if column in per_day.columns else None
+        return default if value is None or (isinstance(value, float) and math.isnan(value)) else value
+
+    records = []
+    for i, d in enumerate(days):
+        curve = curves.get(d)
+        record = {
+            "spacecraft": spacecraft,
+            "day": d,
+            "detector": detector,
+            "analysed_fraction": cell(d, "analysed_fraction", fractions[i % len(fractions)]),
+            "false_alarms_per_day": cell(d, "false_alarms_per_day", false_alarms_per_day),
+            "dH50_Nms": cell(d, "dH50_Nms", curve.dH50_Nms if curve else math.nan),
+            "efficiency_slope": cell(d, "efficiency_slope", curve.slope if curve else math.nan),
+            "efficiency_max": cell(d, "efficiency_max", curve.max_efficiency if curve else 1.0),
+            "altitude_km": cell(d, "altitude_km", altitude_km),
+            "inclination_deg": cell(d, "inclination_deg", inclination_deg),
+            "epoch_year": cell(d, "epoch_year", epoch_year if epoch_year is not None else float(d[:4])),
+            "attitude": cell(d, "attitude", attitude),
+        }
+        for column, option in (
+            ("altitude_km", "--altitude-km"),
+            ("inclination_deg", "--inclination-deg"),
+            ("false_alarms_per_day", "--false-alarms"),
+            ("dH50_Nms", "--recovery or --dH90"),
+        ):
+            if record[column] is None or (isinstance(record[column], float) and math.isnan(record[column])):
+                raise click.UsageError(f"day {d}: no {column}; give {option} or a {column} column in --table")
+        records.append(record)
     model = store_spacecraft_model(cat, spacecraft, spacecraft_file)  # rows name it by the pseudonym
-    rows = exposure_frame(
-        [
-            {
-                "spacecraft": spacecraft,
-                "day": d,
-                "detector": detector,
-                "analysed_fraction": fractions[i % len(fractions)],
-                "false_alarms_per_day": false_alarms_per_day,
-                "dH50_Nms": curves[d].dH50_Nms,
-                "efficiency_slope": curves[d].slope,
-                "efficiency_max": curves[d].max_efficiency,
-                "altitude_km": altitude_km,
-                "inclination_deg": inclination_deg,
-                "epoch_year": epoch_year,
-                "spacecraft_file": model,
-                "attitude": attitude,
-            }
-            for i, d in enumerate(days)
-        ]
-    )
+    rows = exposure_frame([r | {"spacecraft_file": model} for r in records])
     n = store_exposure(cat, rows)
-    for d in days:
-        c = curves[d]
-        click.echo(f"{spacecraft} {d}: x50 {c.dH50_Nms:.4g} N·m·s, slope {c.slope:.3g}, plateau {c.max_efficiency:.3f}")
+    for r in rows.to_dict("records"):
+        click.echo(
+            f"{spacecraft} {r['day']}: analysed {r['analysed_fraction']:.3g}, x50 {r['dH50_Nms']:.4g} N·m·s, slope "
+            f"{r['efficiency_slope']:.3g}, plateau {r['efficiency_max']:.3f}, {r['altitude_km']:.1f} km "
+            f"{r['inclination_deg']:.2f} deg, {r['false_alarms_per_day']:.3g} false alarms/day"
+        )
     click.echo(f"stored {n} exposure rows for {spacecraft} ({days[0]} .. {days[-1]}) in {cat.name}")
 
 

@@ -20,6 +20,8 @@ of a flux measurement.
 
 from __future__ import annotations
 
+import csv
+import datetime as dt
 import hashlib
 import math
 import tomllib
@@ -336,3 +338,137 @@ def load_spacecraft_models(catalog: Catalog) -> dict[str, Spacecraft]:
             raise ConfigError(f"stored spacecraft model is not valid TOML: {exc}", file=source) from None
         out[str(row["model"])] = spacecraft_from_dict(data, source=source)
     return out
+
+
+def spacecraft_model_digests(catalog: Catalog) -> dict[str, str]:
+    """SHA-256 of each stored spacecraft description's TOML text, by model name (empty when none)."""
+    if "spacecraft_models" not in sa.inspect(catalog.engine).get_table_names():
+        return {}
+    t = spacecraft_model_table
+    with catalog.engine.connect() as conn:
+        rows = conn.execute(sa.select(t.c.model, t.c.sha256)).all()
+    return {str(m): str(h) for m, h in rows}
+
+
+def share_identical_models(exposure: pd.DataFrame, digests: dict[str, str]) -> pd.DataFrame:
+    """The exposure with every ``spacecraft_file`` that names a stored description replaced by the first name
+    (sorted) holding the same TOML text, so that spacecraft sharing a model share one forward-model template
+    (the cost of an inference then grows with the number of distinct models and orbits, not of names)."""
+    first: dict[str, str] = {}
+    canonical = {name: first.setdefault(digest, name) for name, digest in sorted(digests.items())}
+    if all(k == v for k, v in canonical.items()):
+        return exposure
+    return exposure.assign(spacecraft_file=exposure["spacecraft_file"].map(lambda n: canonical.get(n, n)))
+
+
+#: Columns of a per-day exposure table (``abrupt flux exposure --table``); ``day`` and ``analysed_fraction``
+#: are required, the others override the command's options day by day.
+DAY_TABLE_COLUMNS: tuple[str, ...] = (
+    "day",
+    "analysed_fraction",
+    "dH50_Nms",
+    "dH90_Nms",
+    "efficiency_slope",
+    "efficiency_max",
+    "false_alarms_per_day",
+    "altitude_km",
+    "inclination_deg",
+    "epoch_year",
+    "attitude",
+)
+_DAY_TABLE_RANGES: dict[str, tuple[float, float, str]] = {  # (low, high, reason): low < v <= high unless noted
+    "analysed_fraction": (0.0, 1.0, "must be in [0, 1]"),
+    "dH50_Nms": (0.0, math.inf, "must be > 0"),
+    "dH90_Nms": (0.0, math.inf, "must be > 0"),
+    "efficiency_slope": (0.0, math.inf, "must be > 0"),
+    "efficiency_max": (0.0, 1.0, "must be in (0, 1]"),
+    "false_alarms_per_day": (0.0, math.inf, "must be >= 0"),
+    "altitude_km": (100.0, 2_000_000.0, "must be above 100 km (an orbit)"),
+    "inclination_deg": (0.0, 180.0, "must be in [0, 180]"),
+    "epoch_year": (1957.0, 2200.0, "must be a year"),
+}
+
+
+def read_day_table(path: str | Path) -> pd.DataFrame:
+    """Read a per-day exposure table (CSV, columns :data:`DAY_TABLE_COLUMNS`): each day's analysed fraction,
+    efficiency (``dH50_Nms`` and ``efficiency_slope``, or ``dH90_Nms`` with an optional slope, default 4),
+    false-alarm rate and orbit. Columns absent from the file come from the command's options. Every bad
+    cell (not a number, out of range, a day that is not YYYY-MM-DD or given twice, an unknown column, both
+    dH50 and dH90 on one row) raises :class:`InputError` naming file, line and column."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except OSError as exc:
+        raise InputError(f"cannot read: {exc.strerror}", file=path) from None
+    except UnicodeDecodeError:
+        raise InputError("not UTF-8 text", file=path) from None
+    lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines()) if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        raise InputError("empty day table (no header)", file=path)
+    header_line, header = lines[0]
+    names = [h.strip() for h in next(csv.reader([header]))]
+    unknown = [n for n in names if n not in DAY_TABLE_COLUMNS]
+    if unknown:
+        raise InputError(
+            f"unknown column(s) {unknown}; expected some of {list(DAY_TABLE_COLUMNS)}", file=path, line=header_line
+        )
+    for col in ("day", "analysed_fraction"):
+        if col not in names:
+            raise InputError(f"missing column {col!r}", file=path, line=header_line)
+    rows: list[dict[str, Any]] = []
+    seen: dict[str, int] = {}
+    for line_no, row_text in lines[1:]:
+        values = [v.strip() for v in next(csv.reader([row_text]))]
+        if len(values) != len(names):
+            raise InputError(f"expected {len(names)} fields, got {len(values)}", file=path, line=line_no)
+        cells = dict(zip(names, values, strict=True))
+        row: dict[str, Any] = {}
+        try:
+            day = pd.Timestamp(dt.date.fromisoformat(cells["day"])).strftime("%Y-%m-%d")
+        except ValueError:
+            raise InputError(
+                f"{cells['day']!r} is not a day YYYY-MM-DD", file=path, line=line_no, column="day"
+            ) from None
+        if day in seen:
+            raise InputError(f"day {day} also on line {seen[day]}", file=path, line=line_no, column="day")
+        seen[day] = line_no
+        row["day"] = day
+        for col, (low, high, reason) in _DAY_TABLE_RANGES.items():
+            if col not in cells or cells[col] == "":
+                continue
+            try:
+                value = float(cells[col])
+            except ValueError:
+                raise InputError(f"not a number: {cells[col]!r}", file=path, line=line_no, column=col) from None
+            inclusive_low = col in ("analysed_fraction", "false_alarms_per_day", "inclination_deg")
+            if not (math.isfinite(value) and (value >= low if inclusive_low else value > low) and value <= high):
+                raise InputError(f"{value!r} {reason}", file=path, line=line_no, column=col)
+            row[col] = value
+        if "dH50_Nms" in row and "dH90_Nms" in row:
+            raise InputError("give dH50_Nms or dH90_Nms, not both", file=path, line=line_no, column="dH90_Nms")
+        if "dH90_Nms" in row:
+            curve = EfficiencyCurve.from_dH90(row.pop("dH90_Nms"), row.get("efficiency_slope", 4.0))
+            row["dH50_Nms"], row["efficiency_slope"] = curve.dH50_Nms, curve.slope
+        elif "efficiency_slope" in row and "dH50_Nms" not in row:
+            raise InputError("a slope without dH50_Nms or dH90_Nms", file=path, line=line_no, column="efficiency_slope")
+        if cells.get("attitude", ""):
+            if cells["attitude"] not in ATTITUDES:
+                raise InputError(
+                    f"{cells['attitude']!r} not in {ATTITUDES}", file=path, line=line_no, column="attitude"
+                )
+            row["attitude"] = cells["attitude"]
+        rows.append(row)
+    if not rows:
+        raise InputError("empty day table (header but no rows)", file=path)
+    return pd.DataFrame(rows)
+
+
+def day_range(first: str, last: str) -> list[str]:
+    """Every day from ``first`` to ``last`` inclusive (YYYY-MM-DD); error when they are not days or reversed."""
+    try:
+        a, b = dt.date.fromisoformat(first), dt.date.fromisoformat(last)
+    except ValueError as exc:
+        raise ConfigError(f"date range {first!r} .. {last!r}: {exc} (use YYYY-MM-DD)", key="from/to") from None
+    if b < a:
+        raise ConfigError(f"date range {first} .. {last} ends before it starts", key="from/to")
+    return [str(d.date()) for d in pd.date_range(a, b, freq="D")]

@@ -1,7 +1,9 @@
 """Forward model: expected detected events per |ΔH| bin (and direction class) for given flux parameters.
 
 For one spacecraft in one orbit, the rates package's Monte Carlo (:func:`abrupt.rates.montecarlo.
-simulate_strikes`: flux table → size, speed, direction → strike point on the silhouette → mass → ΔH)
+simulate_strikes`: flux table → size, speed, direction → strike point by face sampling with ray
+visibility, each draw weighted by the visible projected area of its direction, so that directions, points
+and |ΔH| follow flux × visible area → mass by each flux model's own size-to-mass law → ΔH)
 is run once per population (debris: NASA-90/91 or an imported ORDEM table; meteoroids: Grün) with a
 reference momentum-enhancement model (β_ref, default a constant 1). The result is a *template*:
 
@@ -40,6 +42,7 @@ from numpy.typing import NDArray
 from abrupt.errors import ConfigError
 from abrupt.model.spacecraft import Spacecraft, load_spacecraft
 from abrupt.rates.geometry import geometry_from_spacecraft
+from abrupt.rates.mass_models import MASS_MODELS
 from abrupt.rates.montecarlo import RateConfig, simulate_strikes
 from abrupt.rates.tables import FluxTable, grun_table, nasa90_table, read_flux_table
 
@@ -49,13 +52,41 @@ DIRECTION_CLASSES: tuple[str, ...] = ("radial", "along_track", "cross_track")
 ORBIT_FRAME_COLUMNS: tuple[str, ...] = ("dH_O_r_Nms", "dH_O_t_Nms", "dH_O_n_Nms")
 
 
+#: ``mass_model`` value meaning "each flux model's own size-to-mass law" (:func:`mass_law`).
+MODEL_MASS_LAW = "model"
+
+
+def mass_law(model: str, population: str, mass_model: str = MODEL_MASS_LAW) -> str:
+    """The size-to-mass law (:mod:`abrupt.rates.mass_models`) of a population under a flux model.
+
+    By default each model's own: NASA-90/91 debris the density law published with it (Kessler et al. 1991,
+    ECSS-E-10-04A: 4 g/cm³ up to 0.62 cm, 2.8 d^-0.74 above; ``nasa90_density``); Grün meteoroids spheres of
+    the 2.5 g/cm³ the Grün table was sized with (:data:`abrupt.rates.flux.METEOROID_DENSITY_KG_M3`, so the
+    masses are Grün's own); a flux table (ORDEM, MASTER) spheres of each row's density class
+    (``ordem_sphere``). Any other ``mass_model`` applies to both populations as given."""
+    if mass_model != MODEL_MASS_LAW:
+        return mass_model
+    if model in ("nasa90", "nasa91"):
+        return "nasa90_density"
+    return "ordem_sphere"  # Grün: class "meteoroid" = 2500 kg/m³; tables: their density classes
+
+
+#: How each default law reads, stated in results beside the law's name.
+MASS_LAW_TEXT: dict[str, str] = {
+    "nasa90_density": "NASA-90/91 density law: 4 g/cm³ for d <= 0.62 cm, 2.8 d^-0.74 g/cm³ above (Kessler et al. 1991)",
+    "ordem_sphere": "solid spheres of the density class (meteoroid 2.5 g/cm³, the Grün table's; ORDEM classes "
+    "0.9/1.4/2.8/7.9 g/cm³)",
+    "al_sphere": "solid aluminium spheres, 2.8 g/cm³",
+}
+
+
 @dataclass(frozen=True)
 class ForwardConfig:
     """Model choices of the forward model (flux models, size-to-mass law, MEF reference, bins)."""
 
     debris_model: str = "nasa90"  # "nasa90" or an abrupt-flux-table/1 .toml (e.g. imported ORDEM)
     meteoroid_model: str = "grun"  # "grun" or a flux-table .toml
-    mass_model: str = "al_sphere"  # size-to-mass law (abrupt.rates.mass_models)
+    mass_model: str = MODEL_MASS_LAW  # size-to-mass law: each flux model's own, or one law for both
     reference_mef: str = "const1"  # β multiplies this model; const1 makes β the MEF itself
     solar_flux_sfu: float = 100.0  # [sfu] NASA-90/91 S
     lc_min_m: float = 3e-5  # [m] smallest characteristic length drawn
@@ -71,6 +102,26 @@ class ForwardConfig:
             raise ConfigError("need 0 < dH_min_Nms < dH_max_Nms", key="dH_bins")
         if self.n_bins < 2:
             raise ConfigError("need at least 2 |ΔH| bins", key="n_bins")
+        if self.mass_model != MODEL_MASS_LAW and self.mass_model not in MASS_MODELS:
+            raise ConfigError(
+                f"unknown mass model {self.mass_model!r}; use {MODEL_MASS_LAW!r} (each flux model's own) or one of "
+                f"{list(MASS_MODELS)}",
+                key="mass_model",
+            )
+
+    def mass_laws(self) -> dict[str, str]:
+        """The size-to-mass law used for each population (``debris``, ``meteoroid``)."""
+        models = {"debris": self.debris_model, "meteoroid": self.meteoroid_model}
+        return {pop: mass_law(models[pop], pop, self.mass_model) for pop in POPULATIONS}
+
+    def describe(self) -> dict[str, object]:
+        """The model choices as a result states them (the mass law per population spelled out)."""
+        laws = self.mass_laws()
+        return vars(self) | {
+            "mass_laws": {pop: f"{law}: {MASS_LAW_TEXT.get(law, law)}" for pop, law in laws.items()},
+            "strike_weighting": "flux × visible (unshadowed) projected area per direction "
+            "(face sampling, ray visibility)",
+        }
 
     @property
     def edges_Nms(self) -> NDArray[np.float64]:
@@ -200,11 +251,12 @@ def build_template(
     for p, pop in enumerate(POPULATIONS):
         table = flux_table(models[pop], pop, case, config)
         rc = RateConfig(
-            mass_model=config.mass_model,
+            mass_model=mass_law(models[pop], pop, config.mass_model),
             mef_model=config.reference_mef,
             lc_min_m=config.lc_min_m,
             n_draws=config.n_draws,
             area="silhouette",
+            location="visible",
             seed=config.seed + 7919 * p,
         )
         s = simulate_strikes([table], geometry, sc.mass_kg, case.altitude_km * 1e3, rc)

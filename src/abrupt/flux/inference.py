@@ -50,6 +50,12 @@ from abrupt.flux.linear import ESTIMATOR, OUT_OF_RANGE, below_zero_notes, in_phy
 from abrupt.flux.notes import IDENTIFIED_NOTE, beta_free_note
 
 PARAMS: tuple[str, ...] = ("debris_scale", "meteoroid_scale", "beta")
+BETA_UNIDENTIFIED = (
+    "beta is not bounded by these data (its profile likelihood stays within the interval's level at an end of "
+    "the beta grid), so the flux scales are not measured: quoted instead are the expected detections of each "
+    "population over this exposure, s_p·T_p(beta), which the data do measure. To measure the scales, fix beta "
+    "from independent data (--fix beta=..., docs/flux-inference.md)"
+)
 DEFAULT_BETA_GRID = np.exp(np.linspace(math.log(0.1), math.log(100.0), 161))
 
 
@@ -82,6 +88,7 @@ class FluxData:
     # as exposure_years and event_coef, with ε weighted by each population's spectrum within the bin
     exposure_years_pop: NDArray[np.float64] | None = None  # (G, P, K)
     event_coef_pop: NDArray[np.float64] | None = None  # (E, P)
+    event_dH: NDArray[np.float64] | None = None  # (E,) measured |ΔH| [N·m·s] of the events used
 
     @property
     def n_events(self) -> int:
@@ -169,9 +176,10 @@ def prepare(
         rows_set_aside=chosen.rows_set_aside,
         events_set_aside=chosen.events_set_aside,
         days={"group": group, "directional": (exp["attitude"].to_numpy() == "orbit") & directional, "curve": curve_of}
-        | {"f": f, "fa": fa, "efficiency": eff_pop, "share": share_u},
+        | {"f": f, "fa": fa, "efficiency": eff_pop, "share": share_u, "curves": curves},
         exposure_years_pop=exposure_pop,
         event_coef_pop=f[rows_a][:, None] * eff_pop[u_ev, group[rows_a], :, kbin] / DAYS_PER_YEAR,
+        event_dH=dh[keep],
     )
 
 
@@ -386,6 +394,10 @@ class FitResult:
     linear_estimates: dict[str, float] = field(default_factory=dict)
     standard_errors: dict[str, float] = field(default_factory=dict)
     linear_intervals: dict[str, tuple[float, float]] = field(default_factory=dict)
+    # β free: profile-likelihood intervals of each population's expected detections s_p·T_p(β), and the
+    # headline (what to quote): those when β is not bounded by the data, else the estimates
+    expected_intervals: dict[str, tuple[float, float]] = field(default_factory=dict)
+    beta_identified: bool = True
 
     def linear_in_range(self) -> bool:
         """Whether the linear estimates can be quoted (:func:`~abrupt.flux.linear.in_physical_range`)."""
@@ -401,9 +413,32 @@ class FitResult:
         est, iv = self.estimates, self.intervals
         return {"estimator": ml, "estimates": est, "standard_errors": {}, "intervals": iv, "notes": []}
 
+    def headline(self) -> dict[str, Any]:
+        """What to quote first. With β free and not bounded by the data (its profile reaches an end of the β
+        grid) the flux scales are not measured, only each population's expected detections s_p·T_p(β): the
+        headline is those with their profile intervals and a plain statement; otherwise the reported scales."""
+        if self.beta_identified or "beta" in self.fixed or not self.expected_intervals:
+            rep = self.reported()
+            return {
+                "quantity": "flux scales (× the published models)",
+                "estimates": {k: v for k, v in rep["estimates"].items() if k not in self.fixed},
+                "intervals": {k: list(v) for k, v in rep["intervals"].items() if k not in self.fixed},
+                "statement": rep["estimator"],
+            }
+        est = {k: v for k, v in self.expected_events.items() if k in self.expected_intervals}
+        return {
+            "quantity": "expected detections s_p·T_p(beta) over the exposure",
+            "estimates": est,
+            "intervals": {k: list(v) for k, v in self.expected_intervals.items()},
+            "statement": BETA_UNIDENTIFIED,
+        }
+
     def as_dict(self) -> dict[str, Any]:
         rep = self.reported()
         return {
+            "headline": self.headline(),
+            "beta_identified": self.beta_identified,
+            "expected_events_intervals": {k: list(v) for k, v in self.expected_intervals.items()},
             "reported": rep | {"intervals": {k: list(v) for k, v in rep["intervals"].items()}},
             "estimates": self.estimates,
             "intervals": {k: list(v) for k, v in self.intervals.items()},
@@ -491,6 +526,19 @@ def fit(
         bounds[name] = _scale_interval(near, name, float(s_hat[p]), scale_fixed, ll_max - half)
     b = int(np.argmin(np.abs(logb - math.log(beta_hat))))
     expected = {pop: float(s_hat[p] * lik.totals[b, p]) for p, pop in enumerate(POPULATIONS)}
+    expected_iv: dict[str, tuple[float, float]] = {}
+    identified = True
+    if "beta" not in fixed and lik.beta_grid.size > 1:
+        above = ll >= ll_max - half
+        identified = not (above[0] or above[-1])  # the profile stays above the level at an end of the grid
+        if intervals:
+            for p, name in enumerate(SCALES):
+                if name not in fixed:
+                    expected_iv[POPULATIONS[p]] = _expected_interval(
+                        near, p, expected[POPULATIONS[p]], scale_fixed, ll_max - half
+                    )
+    if not identified:
+        notes.append(BETA_UNIDENTIFIED)
     expected["false_alarms"] = lik.bg_total
     signed = _signed_estimates(lik, scale_fixed) if data.n_events else dict(estimates)
     corrected = bias_corrected(lik, fixed, signed) if data.n_events else dict(estimates)
@@ -514,6 +562,8 @@ def fit(
         {} if lin is None else lin.estimates,
         {} if lin is None else lin.standard_errors,
         {} if lin is None else lin.intervals,
+        expected_iv,
+        identified,
     )
 
 
@@ -556,6 +606,31 @@ def _beta_interval(logb: NDArray[Any], ll: NDArray[Any], level: float, notes: li
     hi = cross(hi_i, hi_i + 1) if hi_i < ll.size - 1 else float(math.exp(logb[-1]))
     if lo_i == 0 or hi_i == ll.size - 1:
         notes.append("beta interval reaches the edge of the beta grid: beta is not bounded by these data there")
+    return lo, hi
+
+
+def _expected_interval(
+    lik: Likelihood, p: int, d_hat: float, scale_fixed: Mapping[str, float], level: float
+) -> tuple[float, float]:
+    """Profile-likelihood interval of population p's expected detections D = s_p·T_p(β): at each D the
+    likelihood is maximised over β and the other free scale with s_p = D / T_p(β) on every β of the grid."""
+    name = SCALES[p]
+    totals = np.maximum(lik.totals[:, p], 1e-300)
+
+    def f(v: float) -> float:
+        return _profile_value(lik, {**scale_fixed, name: v / totals}) - level  # type: ignore[dict-item]
+
+    lo = 0.0
+    if d_hat > 0 and f(0.0) < 0:
+        lo = float(optimize.brentq(f, 0.0, d_hat, xtol=1e-5 * max(d_hat, 1e-12), rtol=1e-4))
+    hi_b = max(d_hat, 1.0) * 2.0
+    for _ in range(80):
+        if f(hi_b) < 0:
+            break
+        hi_b *= 2.0
+    else:
+        return lo, math.inf
+    hi = float(optimize.brentq(f, max(d_hat, 0.0), hi_b, xtol=1e-5 * hi_b, rtol=1e-4))
     return lo, hi
 
 
@@ -615,6 +690,45 @@ def poisson_upper_limit(n: int, background: float = 0.0, confidence: float = 0.9
     return float(optimize.brentq(g, 0.0, hi, xtol=1e-10, rtol=1e-12))
 
 
+def expected_above(data: FluxData, beta: float, dH_min_Nms: float, *, n_grid: int = 4000) -> NDArray[np.float64]:
+    """Expected detections per population at unit flux scales with |ΔH| >= dH_min, (P,):
+
+        S_p(x, β) = Σ_d f_d/365.25 ∫_x^∞ ε_d(h) dG_p(h/β),
+
+    integrated from the stated x itself (not from a bin edge) on a grid of ``n_grid`` points uniform in
+    ln h up to the templates' largest |ΔH|, each efficiency curve of the exposure evaluated once; the
+    cumulative rate G_p is interpolated log-log in the template (exact for a power law)."""
+    d = data.days
+    curves = np.asarray(d["curves"], dtype=np.float64)
+    groups = np.asarray(d["group"], dtype=np.int64)
+    weight = np.zeros((len(data.templates), curves.shape[0]))
+    np.add.at(weight, (groups, np.asarray(d["curve"], dtype=np.int64)), np.asarray(d["f"], dtype=np.float64))
+    out = np.zeros(len(POPULATIONS))
+    for g, tpl in enumerate(data.templates):
+        lo = math.log(max(dH_min_Nms, 1e-300))
+        hi = float(tpl.log_h_grid[-1]) + math.log(beta)
+        if lo >= hi:
+            continue
+        u = np.linspace(lo, hi, n_grid)
+        cum = np.log(np.maximum(tpl.cumulative.sum(axis=1), 1e-300))  # (P, H)
+        g_u = np.exp(np.stack([np.interp(u - math.log(beta), tpl.log_h_grid, row, right=-690.0) for row in cum]))
+        g_u[:, -1] = 0.0  # nothing above the grid's top
+        mid = np.exp(0.5 * (u[1:] + u[:-1]))
+        eff = logistic_efficiency(mid[None, :], curves[:, :1], curves[:, 1:2], curves[:, 2:3])  # (U, M)
+        out += (weight[g] @ eff) @ (-np.diff(g_u, axis=1)).T / DAYS_PER_YEAR
+    return out
+
+
+def false_alarms_above(data: FluxData, dH_min_Nms: float) -> float:
+    """Expected false alarms with |ΔH| >= dH_min: Σ_d b_d f_d (1 − L_d(x)), L_d the day's logistic curve
+    without its plateau (false alarms have the size the detector just reaches, as in the binned model)."""
+    d = data.days
+    curves = np.asarray(d["curves"], dtype=np.float64)
+    fa_u = np.bincount(np.asarray(d["curve"], dtype=np.int64), weights=d["fa"], minlength=curves.shape[0])
+    below = logistic_efficiency(dH_min_Nms, curves[:, 0], curves[:, 1], 1.0)
+    return float(fa_u @ (1.0 - below))
+
+
 def upper_limit(
     data: FluxData,
     population: str,
@@ -624,32 +738,39 @@ def upper_limit(
     confidence: float = 0.95,
     method: str = "cls",
     dH_min_Nms: float = 0.0,
-) -> dict[str, float]:
-    """Upper limit on one population's flux scale at a given β (counting events with |ΔH| >= dH_min).
+) -> dict[str, Any]:
+    """Upper limit on one population's flux scale at a given β, counting events with |ΔH| >= dH_min.
 
-    The other population (at ``other_scale``) and the false alarms are the background.
+    The threshold is the one stated: events are counted from their measured |ΔH| and the expectation
+    integrated from dH_min itself (:func:`expected_above`); below the lowest bin edge of the forward model
+    the edge is used (events under it are not kept) and the limit says so (``dH_min_Nms``). The other
+    population (at ``other_scale``) and the false alarms above the threshold are the background.
     """
     if population not in POPULATIONS:
         raise ConfigError(f"unknown population {population!r}; choose from {list(POPULATIONS)}", key="population")
+    if not (math.isfinite(beta) and beta > 0):
+        raise ConfigError(f"beta must be positive, got {beta!r}", key="beta")
     p = POPULATIONS.index(population)
-    lik = Likelihood(data, np.array([beta]))
-    lower_edges = data.templates[0].config.edges_Nms[:-1]
-    use = lower_edges >= dH_min_Nms * (1 - 1e-12)
-    signal = float(lik.bin_signal[0, p, use].sum())
-    other = float(lik.bin_signal[0, 1 - p, use].sum()) * other_scale
-    bg = float(data.background_bins[use].sum()) + other
-    n = int(data.observed_bins[use].sum())
+    x = max(float(dH_min_Nms), float(data.templates[0].config.dH_min_Nms))
+    unit = expected_above(data, beta, x)
+    signal = float(unit[p])
+    bg = false_alarms_above(data, x) + float(unit[1 - p]) * other_scale
+    dh = data.event_dH if data.event_dH is not None else np.zeros(0)
+    n = int(np.sum(dh >= x))
     s_up = poisson_upper_limit(n, bg, confidence, method)
     return {
-        "population": float(p),
-        "n_observed": float(n),
+        "population": population,
+        "n_observed": n,
         "background_expected": bg,
         "signal_per_unit_scale": signal,
         "signal_upper_limit": s_up,
         "scale_upper_limit": s_up / signal if signal > 0 else math.inf,
         "confidence": confidence,
+        "method": method,
         "beta": beta,
-        "dH_min_Nms": dH_min_Nms,
+        "dH_min_Nms": x,
+        "dH_min_stated_Nms": float(dH_min_Nms),
+        "other_scale": other_scale,
     }
 
 

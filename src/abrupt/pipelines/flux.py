@@ -29,6 +29,8 @@ from abrupt.flux.exposure import (
     exposure_summary,
     load_exposure,
     load_spacecraft_models,
+    share_identical_models,
+    spacecraft_model_digests,
     store_exposure,
     store_spacecraft_model,
 )
@@ -61,7 +63,7 @@ class FluxInference:
 
     config: ForwardConfig
     fits: dict[str, FitResult]
-    upper_limits: list[dict[str, float]]
+    upper_limits: list[dict[str, Any]]
     goodness: list[dict[str, Any]]
     exposure_table: pd.DataFrame
     cumulative: pd.DataFrame  # measured rate >= |ΔH| with its band, and model curves
@@ -69,10 +71,11 @@ class FluxInference:
     showers: pd.DataFrame
     n_events_total: int
     notes: list[str] = field(default_factory=list)
+    n_templates: int = 0  # forward-model templates: one per distinct spacecraft model and orbit
 
     def as_dict(self) -> dict[str, Any]:
         return {
-            "forward_model": {k: v for k, v in vars(self.config).items()},
+            "forward_model": self.config.describe(),
             "fits": {k: v.as_dict() for k, v in self.fits.items()},
             "upper_limits": self.upper_limits,
             "goodness_of_fit": self.goodness,
@@ -80,6 +83,7 @@ class FluxInference:
             "cumulative_rate": self.cumulative.to_dict("list"),
             "showers": self.showers.to_dict("records"),
             "n_events_in_catalog": self.n_events_total,
+            "n_forward_model_templates": self.n_templates,
             "notes": self.notes,
         }
 
@@ -141,6 +145,9 @@ def cumulative_rate(
     return pd.DataFrame(out)
 
 
+#: |ΔH| thresholds [N·m·s] of the upper limits by default: all sizes, and 0.1 N·m·s.
+LIMIT_THRESHOLDS_NMS: tuple[float, ...] = (0.0, 0.1)
+
 LINEAR_NOTE = (
     "With beta fixed the reported flux scales (reported, linear_estimates) are the linear fixed-weight estimates "
     "(weights of the published models): exactly unbiased given the forward model, where the maximum-likelihood "
@@ -162,8 +169,13 @@ def infer_flux(
     use_direction: bool = True,
     reference_beta: float = 1.0,
     templates: dict[OrbitCase, Template] | None = None,
+    limit_dH_Nms: Sequence[float] = LIMIT_THRESHOLDS_NMS,
+    limit_confidence: float = 0.95,
 ) -> FluxInference:
-    """The whole inference on a catalog (events of kind ``strike`` and the exposure table)."""
+    """The whole inference on a catalog (events of kind ``strike`` and the exposure table).
+
+    Upper limits are given for each population at each |ΔH| of ``limit_dH_Nms`` (0: all sizes the forward
+    model bins), at the β held fixed (``fixed["beta"]``) or else at ``reference_beta``."""
     config = config or ForwardConfig()
     exposure = load_exposure(catalog, spacecraft)
     if len(exposure) == 0:
@@ -173,6 +185,7 @@ def infer_flux(
     events = catalog.events(kind="strike")
     if spacecraft:
         events = events[events["spacecraft"].isin(list(spacecraft))]
+    exposure = share_identical_models(exposure, spacecraft_model_digests(catalog))  # one template per model
     tpl = templates_for(exposure, config, templates, load_spacecraft_models(catalog))
     data = prepare(exposure, events, tpl, use_direction=use_direction)
     lik = Likelihood(data)
@@ -181,10 +194,12 @@ def infer_flux(
         fits["meteoroid_scale=1 (Grün as a prior)"] = fit(
             data, fixed={**(fixed or {}), "meteoroid_scale": 1.0}, confidence=confidence
         )
+    limit_beta = float((fixed or {}).get("beta", reference_beta))
     limits = [
-        upper_limit(data, pop, beta=reference_beta, other_scale=0.0, confidence=0.95, dH_min_Nms=x)
+        upper_limit(data, pop, beta=limit_beta, other_scale=0.0, confidence=limit_confidence, dH_min_Nms=x)
+        | {"beta_source": "fixed (--fix beta)" if "beta" in (fixed or {}) else "reference (--beta)"}
         for pop in POPULATIONS
-        for x in (0.0, 0.1)
+        for x in limit_dH_Nms
     ]
     goodness = [goodness_of_fit(data, {**p, "beta": reference_beta}, name=name) for name, p in NAMED_MODELS.items()]
     best = fits["free"].estimates
@@ -230,6 +245,7 @@ def infer_flux(
         showers,
         len(events),
         notes,
+        len(data.templates),
     )
 
 

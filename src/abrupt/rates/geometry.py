@@ -20,6 +20,11 @@ Frames: body B = orbit frame O in the trades (x radial o_r, y along-track o_θ, 
 frame V, i.e. minus the unit relative velocity). Positions are measured from the centre of mass, taken
 at the geometric centre of the first bus box unless given.
 
+* ``visible`` (the flux forward model's): face sampling with ray visibility (:func:`visible_strikes`): a
+  point drawn on the surfaces facing the flow in proportion to their projected area, weighted by that
+  area when nothing shadows it. Unlike the two above, which place a strike on the silhouette of a direction
+  drawn by flux alone, its weights make the strike directions ∝ flux × visible area per direction.
+
 Effective area: :func:`thesis_effective_area_m2` (Eqs. 5.15-5.18) and the flux-weighted mean silhouette
 area :func:`mean_silhouette_area_m2` (spec erratum A14 option).
 """
@@ -301,6 +306,76 @@ def _silhouette_area_kernel(dirs, angles, box_lo, box_hi, pc, pn0, pu, ph, prot,
 
 
 @numba.njit(cache=True)
+def _visible_strike_kernel(dirs, angles, box_lo, box_hi, pc, pn0, pu, ph, prot, rng):
+    """Face sampling with ray visibility: per direction d, a surface element f facing the flow is drawn with
+    probability A_f cos θ_f / S(d), S(d) = Σ_f A_f max(cos θ_f, 0) (boxes: six faces; panels: two-sided,
+    |cos θ|), a point uniform on it, and a ray cast from it toward the source. Returns the points, the
+    element kind (0 box, 1 + j panel j) and S(d) · 1[nothing lies in front of the point]: an unbiased
+    estimate of the visible (unshadowed) projected area A(d), E[S 1_vis] = Σ_f A_f cos θ_f P(vis | f)."""
+    n = dirs.shape[0]
+    nb = box_lo.shape[0]
+    npan = pc.shape[0]
+    pos = np.empty((n, 3))
+    kind_out = np.empty(n, dtype=np.int64)
+    area_out = np.empty(n)
+    pn = np.empty_like(pn0)
+    pv = np.empty_like(pn0)
+    proj = np.empty(6 * nb + npan)
+    p = np.empty(3)
+    for i in range(n):
+        d = dirs[i]
+        _rotate_panels_into(angles[i], pn0, pu, prot, pn, pv)
+        total = 0.0
+        for b in range(nb):
+            for a in range(3):
+                a1 = (a + 1) % 3
+                a2 = (a + 2) % 3
+                face = (box_hi[b, a1] - box_lo[b, a1]) * (box_hi[b, a2] - box_lo[b, a2])
+                proj[6 * b + 2 * a] = face * max(d[a], 0.0)  # face at box_hi[a], outward normal +e_a
+                proj[6 * b + 2 * a + 1] = face * max(-d[a], 0.0)  # face at box_lo[a], normal -e_a
+                total += proj[6 * b + 2 * a] + proj[6 * b + 2 * a + 1]
+        for j in range(npan):
+            dn = d[0] * pn[j, 0] + d[1] * pn[j, 1] + d[2] * pn[j, 2]
+            proj[6 * nb + j] = 4.0 * ph[j, 0] * ph[j, 1] * abs(dn)
+            total += proj[6 * nb + j]
+        if total <= 0.0:
+            pos[i, 0], pos[i, 1], pos[i, 2] = 0.0, 0.0, 0.0
+            kind_out[i] = -1
+            area_out[i] = 0.0
+            continue
+        u = rng.random() * total
+        f = 0
+        acc = proj[0]
+        while acc < u and f < proj.size - 1:
+            f += 1
+            acc += proj[f]
+        while proj[f] <= 0.0:  # u landed on a boundary: the previous element with area
+            f -= 1
+        if f < 6 * nb:
+            b = f // 6
+            a = (f % 6) // 2
+            a1 = (a + 1) % 3
+            a2 = (a + 2) % 3
+            p[a] = box_hi[b, a] if f % 2 == 0 else box_lo[b, a]
+            p[a1] = box_lo[b, a1] + (box_hi[b, a1] - box_lo[b, a1]) * rng.random()
+            p[a2] = box_lo[b, a2] + (box_hi[b, a2] - box_lo[b, a2]) * rng.random()
+            kind = 0
+        else:
+            j = f - 6 * nb
+            s = (2.0 * rng.random() - 1.0) * ph[j, 0]
+            t = (2.0 * rng.random() - 1.0) * ph[j, 1]
+            for c in range(3):
+                p[c] = pc[j, c] + s * pu[j, c] + t * pv[j, c]
+            kind = 1 + j
+        t_front, _ = _cast(p[0], p[1], p[2], d, box_lo, box_hi, pc, pn, pu, pv, ph)
+        scale = 1.0 + abs(p[0]) + abs(p[1]) + abs(p[2])
+        pos[i, 0], pos[i, 1], pos[i, 2] = p[0], p[1], p[2]
+        kind_out[i] = kind
+        area_out[i] = total if t_front <= 1e-9 * scale else 0.0  # something in front: shadowed
+    return pos, kind_out, area_out
+
+
+@numba.njit(cache=True)
 def _locate_point_cloud_kernel(dirs, angles, bus_pts, pc, pn0, pu, ph, prot, pan_ab, pan_id, spacing, rng):
     n = dirs.shape[0]
     nb = bus_pts.shape[0]
@@ -440,6 +515,42 @@ def locate_strikes(
     panel_hit = kind >= 1
     on_array[panel_hit] = g.panel_is_array[kind[panel_hit] - 1]
     return pos, on_array
+
+
+def visible_strikes(
+    geometry: Geometry,
+    directions: NDArray[np.float64],
+    array_angles_rad: NDArray[np.float64] | None = None,
+    *,
+    seed: int = 0,
+) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64]]:
+    """Strike points [m], whether each is on a solar array, and the visible-area weight [m²] per direction.
+
+    Face sampling with ray visibility (:func:`_visible_strike_kernel`): a point is drawn on the surfaces
+    facing the flow in proportion to their projected area, and kept with weight S(d) (the total projected
+    area of the facing surfaces) when no surface lies in front of it toward the source, 0 when it is
+    shadowed. The weight's mean over points is the visible projected area A(d) of direction d, so a flux
+    φ(d) over directions gives strikes at the rate Σ φ(d) · weight: direction, point and everything that
+    follows (|ΔH|) are weighted by flux × visible area, the exact strike distribution on the spacecraft.
+    """
+    d, a = _check_dirs(directions, array_angles_rad)
+    g = geometry
+    pos, kind, area = _visible_strike_kernel(
+        d,
+        a,
+        g.box_lo,
+        g.box_hi,
+        g.panel_center,
+        g.panel_normal,
+        g.panel_u,
+        g.panel_half,
+        g.panel_rotates,
+        np.random.default_rng(seed),
+    )
+    on_array = np.zeros(kind.shape, dtype=bool)
+    panel_hit = kind >= 1
+    on_array[panel_hit] = g.panel_is_array[kind[panel_hit] - 1]
+    return pos, on_array, np.asarray(area, dtype=np.float64)
 
 
 def _grid_1d(length: float, spacing: float) -> NDArray[np.float64]:

@@ -10,6 +10,13 @@ solar-array angle ~ U(0, π/2), strike location on the silhouette, mass (mass mo
 with the body frame equal to the orbit frame and v the circular velocity along o_θ. The strike rate is
 R = A_eff f (Eq. 5.14), f the cross-sectional flux above the Lc truncation, and the expected annual
 number of detectable perturbations is N_det(T) = R · P(M >= T) for a metric M in {ΔH, ΔV, Δa}.
+
+The thesis draws the direction by flux alone and the point uniformly on that direction's silhouette
+(``location = silhouette`` or ``point_cloud``): the total rate is right (A_eff is the flux-weighted mean
+area) but directions, points and the |ΔH| spectrum are not weighted by how large the spacecraft looks
+from each direction. ``location = visible`` (the flux forward model's) weights each draw by the visible
+projected area of its direction (:func:`abrupt.rates.geometry.visible_strikes`), so strikes follow
+flux × visible area per direction, and R is the mean of those weights times the flux.
 """
 
 from __future__ import annotations
@@ -28,6 +35,7 @@ from abrupt.rates.geometry import (
     locate_strikes,
     mean_silhouette_area_m2,
     thesis_effective_area_m2,
+    visible_strikes,
 )
 from abrupt.rates.mass_models import CLASS_NAMES, MASS_MODELS, particle_mass_kg
 from abrupt.rates.mef import momentum_enhancement
@@ -44,7 +52,7 @@ class RateConfig:
     mef_model: str = "const2"
     lc_min_m: float = 3e-5  # [m] lower Lc truncation (thesis "3E-5", spec erratum A15)
     n_draws: int = 10_000
-    location: str = "silhouette"  # or "point_cloud"
+    location: str = "silhouette"  # or "point_cloud", or "visible" (flux × visible area per direction)
     grid_spacing_m: float | None = None  # point-cloud spacing; default 1/6 smallest dimension
     area: str = "thesis"  # "thesis" (Eqs. 5.15-5.18) or "silhouette"
     array_angle_max_rad: float = math.pi / 2  # array angle ~ U(0, max)
@@ -62,6 +70,13 @@ class RateConfig:
             raise ConfigError("lower Lc bound must be positive", key="lc_min_m")
         if self.n_draws < 1:
             raise ConfigError("need at least one draw", key="n_draws")
+        if self.location not in ("silhouette", "point_cloud", "visible"):
+            raise ConfigError(
+                f"unknown strike-location method {self.location!r}; use silhouette, point_cloud or visible",
+                key="location",
+            )
+        if self.location == "visible" and self.area != "silhouette":
+            raise ConfigError("location 'visible' measures its own area: use area 'silhouette'", key="area")
         if self.area not in ("thesis", "silhouette"):
             raise ConfigError("area must be 'thesis' or 'silhouette'", key="area")
         if self.size_sampling not in ("population", "log_uniform"):
@@ -248,18 +263,22 @@ def simulate_strikes(
     rng = np.random.default_rng(config.seed)
     tabs = [t.bounded(config.flux_bound_sigma) for t in tables]
     fluxes = np.array([t.flux_above(config.lc_min_m) for t in tabs])
-    areas = np.array([effective_area_m2(geometry, t, config, rng) for t in tabs])
+    if config.location == "visible":  # draws allocated by flux; each carries its own visible area below
+        areas = np.ones(len(tabs))
+    else:
+        areas = np.array([effective_area_m2(geometry, t, config, rng) for t in tabs])
     rates = fluxes * areas
     total_rate = float(rates.sum())
     if not total_rate > 0:
         raise ConfigError("zero flux above the Lc lower bound for this orbit", key="lc_min_m")
     counts = rng.multinomial(config.n_draws, rates / total_rate)
-    lc_parts, cls_parts, spd_parts, dir_parts, w_parts = [], [], [], [], []
-    for t, n in zip(tabs, counts, strict=True):
+    lc_parts, cls_parts, spd_parts, dir_parts, w_parts, tab_parts = [], [], [], [], [], []
+    for i_tab, (t, n) in enumerate(zip(tabs, counts, strict=True)):
         if n == 0:
             continue
         lc, ci, w = sample_sizes(t, config.lc_min_m, int(n), rng, importance=config.size_sampling == "log_uniform")
         w_parts.append(w)
+        tab_parts.append(np.full(int(n), i_tab))
         spd, d = sample_directions(t.directions, int(n), rng)
         lc_parts.append(lc)
         cls_parts.append(np.array([CLASS_NAMES.index(c) for c in t.classes], dtype=np.int64)[ci])
@@ -271,14 +290,26 @@ def simulate_strikes(
     direction = np.concatenate(dir_parts)
     n = lc.size
     angles = rng.uniform(0.0, config.array_angle_max_rad, n)
-    pos, on_array = locate_strikes(
-        geometry,
-        direction,
-        angles,
-        method=config.location,
-        grid_spacing_m=config.grid_spacing_m,
-        seed=int(rng.integers(2**31)),
-    )
+    weight = np.concatenate(w_parts)
+    if config.location == "visible":
+        pos, on_array, visible_m2 = visible_strikes(geometry, direction, angles, seed=int(rng.integers(2**31)))
+        # importance sampling: draw i of table t carries the rate flux_t · A_vis(d_i) · w_i / n_t
+        tab = np.concatenate(tab_parts)
+        per_draw = fluxes[tab] * visible_m2 * weight / counts[tab]
+        areas = np.array([np.mean(visible_m2[tab == k] * weight[tab == k]) if c else 0.0 for k, c in enumerate(counts)])
+        total_rate = float(per_draw.sum())
+        if not total_rate > 0:
+            raise ConfigError("no strike reaches the spacecraft's surfaces from these directions", key="surfaces")
+        weight = per_draw / per_draw.mean()
+    else:
+        pos, on_array = locate_strikes(
+            geometry,
+            direction,
+            angles,
+            method=config.location,
+            grid_spacing_m=config.grid_spacing_m,
+            seed=int(rng.integers(2**31)),
+        )
     mass = particle_mass_kg(config.mass_model, lc, classes, rng=rng)
     beta = momentum_enhancement(config.mef_model, speed, on_array)
     dp = (-(beta * mass * speed))[:, None] * direction  # particle moves along -direction (Eq. 5.1)
@@ -305,8 +336,8 @@ def simulate_strikes(
         dV_mps=np.linalg.norm(dv, axis=1),
         da_m=np.abs(da),
         strikes_per_year=total_rate,
-        weight=np.concatenate(w_parts),
+        weight=weight,
         area_m2=float(np.sum(areas * fluxes) / fluxes.sum()),
         flux_m2_yr=float(fluxes.sum()),
-        details={f"rate_{t.name}": float(rr) for t, rr in zip(tabs, rates, strict=True)},
+        details={f"rate_{t.name}": float(rr) for t, rr in zip(tabs, fluxes * areas, strict=True)},
     )

@@ -148,7 +148,7 @@ def write_flux_report(path: str | Path, result: FluxInference) -> Path:
         "score-type intervals), the maximum-likelihood ones beside them; with β free, maximum likelihood and "
         "profile-likelihood intervals (docs/flux-inference.md).</p>",
         _table(fits_table(result)),
-        "<h2>Upper limits (95 %, CLs, one population at a time, β = reference)</h2>",
+        "<h2>Upper limits (CLs, one population at a time, at the β and |ΔH| of each row)</h2>",
         _table(pd.DataFrame(result.upper_limits)),
         "<h2>Goodness of fit</h2>",
         _table(pd.DataFrame(result.goodness).drop(columns=["params"])),

@@ -1,0 +1,115 @@
+"""Coverage of the flux inference on fleets drawn by an independent generator (benchmarks/independent_strikes.py).
+
+The generator shares no Monte Carlo with abrupt.flux: its own size laws, masses, face sampling with ray
+visibility, ΔH, detection and Poisson counts (see its docstring). Fleet: 2 Fermi-like spacecraft at
+550 km / 28.5° and 2 at 800 km / 98°, 5 years each (20 spacecraft-years, 18 analysed), ΔH90 10 mN·m·s
+(slope 4), 0.01 false alarms a day, nadir pointing (orbit-frame ΔH known); truths debris 0.3× and 3×
+NASA-90/91, meteoroids 1× Grün, β = 1.5 known (``--fix beta``). Per fleet the reported 90 % intervals
+(linear score intervals with β known, ML profile ones where the linear are out of range) are checked
+against the truth; pooled coverage per scale and the median estimate / truth are printed.
+Target (issue acceptance 1): pooled coverage 85-95 % for both scales, median within 5 % of truth.
+
+Run: ``nice python benchmarks/bench_flux_independent_coverage.py [--fleets 100] [--draws 1500000]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from abrupt.flux.forward import ForwardConfig, OrbitCase, build_template
+from abrupt.flux.inference import fit, prepare
+from abrupt.model.spacecraft import load_spacecraft
+from abrupt.simulate.population import FleetSpec, fleet_exposure
+from independent_strikes import draw_fleet, strike_sample
+
+ROOT = Path(__file__).resolve().parent.parent
+FERMI = str(ROOT / "examples" / "spacecraft" / "fermi_like.toml")
+ORBITS = ((550.0, 28.5), (800.0, 98.0))
+BETA = 1.5
+TRUTHS = (
+    {"debris_scale": 0.3, "meteoroid_scale": 1.0, "beta": BETA},
+    {"debris_scale": 3.0, "meteoroid_scale": 1.0, "beta": BETA},
+)
+
+
+def fleet_exposure_rows() -> pd.DataFrame:
+    parts = []
+    for k, (alt, inc) in enumerate(ORBITS):
+        spec = FleetSpec(
+            FERMI, n_spacecraft=2, years=5.0, altitude_km=alt, inclination_deg=inc, epoch_year=2020.0,
+            dH50_Nms=0.01 * np.exp(-np.log(9.0) / 4.0), efficiency_slope=4.0, false_alarms_per_day=0.01,
+            analysed_fraction=0.9, name_prefix=f"O{k}",
+        )  # fmt: skip
+        parts.append(fleet_exposure(spec))
+    return pd.concat(parts, ignore_index=True)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--fleets", type=int, default=100, help="Fleets per truth.")
+    parser.add_argument("--draws", type=int, default=1_500_000, help="Generator draws per orbit and population.")
+    args = parser.parse_args()
+    sc = load_spacecraft(FERMI)
+    t0 = time.perf_counter()
+    samples = {
+        orbit: {
+            pop: strike_sample(sc, pop, *orbit, 2020.0, args.draws, seed=11 + 7 * j + 3 * i)
+            for j, pop in enumerate(("debris", "meteoroid"))
+        }
+        for i, orbit in enumerate(ORBITS)
+    }
+    templates = {
+        OrbitCase(FERMI, alt, inc, 2020.0): build_template(OrbitCase(FERMI, alt, inc, 2020.0), ForwardConfig())
+        for alt, inc in ORBITS
+    }
+    print(f"generator samples and abrupt templates: {time.perf_counter() - t0:.0f} s")
+    for orbit in ORBITS:
+        tpl = templates[OrbitCase(FERMI, *orbit, 2020.0)]
+        gen = [samples[orbit][p].rate.sum() for p in ("debris", "meteoroid")]
+        ours = tpl.strikes_per_year
+        print(f"  {orbit}: strikes/yr generator {gen[0]:.4g} debris, {gen[1]:.4g} meteoroid; ", end="")
+        print(f"abrupt template {ours[0]:.4g}, {ours[1]:.4g}")
+    exposure = fleet_exposure_rows()
+    rng = np.random.default_rng(2026)
+    rows = []
+    for truth in TRUTHS:
+        for _ in range(args.fleets):
+            events = draw_fleet(exposure, samples, truth, rng)
+            res = fit(prepare(exposure, events, templates), fixed={"beta": BETA}, confidence=0.9)
+            rep = res.reported()
+            row = {"truth_debris": truth["debris_scale"], "n_events": len(events)}
+            for name in ("debris_scale", "meteoroid_scale"):
+                lo, hi = rep["intervals"][name]
+                row[name] = rep["estimates"][name]
+                row[f"{name}_covered"] = lo <= truth[name] <= hi
+                ml_lo, ml_hi = res.intervals[name]
+                row[f"{name}_ml_covered"] = ml_lo <= truth[name] <= ml_hi
+            rows.append(row)
+    table = pd.DataFrame(rows)
+    print(f"{len(table)} fleets, {args.fleets} per truth, {time.perf_counter() - t0:.0f} s in all; ", end="")
+    print(f"events per fleet median {table['n_events'].median():.0f}")
+    for name, key in (("debris", "debris_scale"), ("meteoroid", "meteoroid_scale")):
+        pooled = table[f"{key}_covered"].mean()
+        ml = table[f"{key}_ml_covered"].mean()
+        se = np.sqrt(pooled * (1 - pooled) / len(table))
+        print(f"{name} scale: pooled 90 % coverage {pooled:.1%} ± {se:.1%} (reported intervals), ML profile {ml:.1%}")
+        for t, grp in table.groupby("truth_debris"):
+            truth = t if key == "debris_scale" else 1.0
+            med = grp[key].median() / truth - 1
+            mean = grp[key].mean() / truth - 1
+            cov = grp[f"{key}_covered"].mean()
+            print(
+                f"  debris truth {t:g}: coverage {cov:.1%}, median/truth - 1 = {med:+.1%}, mean/truth - 1 = {mean:+.1%}"
+            )
+
+
+if __name__ == "__main__":
+    from _results import write_results
+
+    with write_results("bench_flux_independent_coverage"):
+        main()
