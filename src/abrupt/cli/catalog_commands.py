@@ -10,9 +10,12 @@ import pandas as pd
 
 from abrupt.catalog import Catalog
 from abrupt.cli.groups import catalog_option, cli
+from abrupt.kinds import EVENT_KINDS
 
 #: Width the default view fits in (characters).
 VIEW_WIDTH = 120
+#: Width of the kind column: every kind shown whole.
+KIND_WIDTH = max(len(kind) for kind in EVENT_KINDS)
 
 
 @cli.group("catalog")
@@ -23,7 +26,12 @@ def catalog_group() -> None:
 def _filter_options(f: Any) -> Any:
     options = [
         click.option("--spacecraft", default=None, help="Only this spacecraft pseudonym."),
-        click.option("--kind", type=click.Choice(["strike", "maneuver", "mass_change", "unknown"]), default=None),
+        click.option(
+            "--kind",
+            type=click.Choice(EVENT_KINDS),
+            default=None,
+            help="Only events of this kind (the vocabulary of abrupt.kinds: what each means and who writes it).",
+        ),
         click.option(
             "--detector", default=None, help="A detector (attitude.glr), a capability (attitude) or a method (glr)."
         ),
@@ -66,7 +74,7 @@ def export(catalog_target: str, out: str, **filters: Any) -> None:
 def narrow_view(frame: Any) -> list[str]:
     """Events as lines of at most :data:`VIEW_WIDTH` characters: time, spacecraft, kind, detector, size, margin."""
     header = (
-        f"{'time (UTC)':<23} {'spacecraft':<16} {'kind':<11} {'detector':<24} {'size':>16} {'stat/thr':>8} {'event':>8}"
+        f"{'time (UTC)':<23} {'spacecraft':<16} {'kind':<{KIND_WIDTH}} {'detector':<24} {'size':>16} {'stat/thr':>8} {'event':>8}"
     )
     lines = [header]
     for row in frame.itertuples(index=False):
@@ -78,7 +86,7 @@ def narrow_view(frame: Any) -> list[str]:
             size = "–"
         ratio = row.statistic / row.threshold if row.threshold else math.nan
         lines.append(
-            f"{str(row.time_utc)[:23]:<23} {str(row.spacecraft)[:16]:<16} {str(row.kind)[:11]:<11} "
+            f"{str(row.time_utc)[:23]:<23} {str(row.spacecraft)[:16]:<16} {str(row.kind):<{KIND_WIDTH}} "
             f"{str(row.detector)[:24]:<24} {size:>16} {ratio:>8.2f} {str(row.event_key)[:8]:>8}"
         )
     return lines
