@@ -74,7 +74,8 @@ def export(catalog_target: str, out: str, **filters: Any) -> None:
 def narrow_view(frame: Any) -> list[str]:
     """Events as lines of at most :data:`VIEW_WIDTH` characters: time, spacecraft, kind, detector, size, margin."""
     header = (
-        f"{'time (UTC)':<23} {'spacecraft':<16} {'kind':<{KIND_WIDTH}} {'detector':<24} {'size':>16} {'stat/thr':>8} {'event':>8}"
+        f"{'time (UTC)':<23} {'spacecraft':<16} {'kind':<{KIND_WIDTH}} "
+        f"{'detector':<24} {'size':>16} {'stat/thr':>8} {'event':>8}"
     )
     lines = [header]
     for row in frame.itertuples(index=False):
@@ -86,7 +87,7 @@ def narrow_view(frame: Any) -> list[str]:
             size = "–"
         ratio = row.statistic / row.threshold if row.threshold else math.nan
         lines.append(
-            f"{str(row.time_utc)[:23]:<23} {str(row.spacecraft)[:16]:<16} {str(row.kind):<{KIND_WIDTH}} "
+            f"{str(row.time_utc)[:23]:<23} {str(row.spacecraft)[:16]:<16} {row.kind!s:<{KIND_WIDTH}} "
             f"{str(row.detector)[:24]:<24} {size:>16} {ratio:>8.2f} {str(row.event_key)[:8]:>8}"
         )
     return lines
