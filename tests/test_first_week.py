@@ -6,9 +6,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import click
 import pytest
+from click.testing import CliRunner
 
 from abrupt.catalog import Catalog
+from abrupt.cli.commands import cli
 from abrupt.cli.main import main
 from abrupt.detect.base import detector_names, get_detector
 from abrupt.errors import InputError
@@ -85,3 +88,62 @@ def test_catalog_list_filters_on_every_kind_and_shows_it_whole(
     assert len(lines) == 2  # the header and the one event of this kind
     assert lines[1].split()[2] == kind  # time, spacecraft, then the kind, whole
     assert max(len(line) for line in lines) <= 120
+
+
+def _leaves(group: click.Group, ctx: click.Context, path: tuple[str, ...] = ()) -> list[tuple[str, click.Command]]:
+    """Every leaf command of the tree under ``group``, with its command line (imports every capability)."""
+    out: list[tuple[str, click.Command]] = []
+    for name in group.list_commands(ctx):
+        command = group.get_command(ctx, name)
+        assert command is not None, name
+        if isinstance(command, click.Group):
+            out += _leaves(command, click.Context(command, parent=ctx, info_name=name), (*path, name))
+        else:
+            out.append((" ".join((*path, name)), command))
+    return out
+
+
+def test_every_option_of_every_command_is_described_and_shows_a_readable_default() -> None:
+    leaves = _leaves(cli, click.Context(cli, info_name="abrupt"))
+    assert len(leaves) > 30
+    undescribed, unreadable = [], []
+    for line, command in leaves:
+        for param in command.params:
+            if not isinstance(param, click.Option) or param.hidden:
+                continue
+            if not (param.help or "").strip():
+                undescribed.append(f"{line} {param.opts[0]}")
+            # a default shown as a float's full repr (0.0006946543314535649) is not read by a person
+            if param.show_default is True and isinstance(param.default, float) and len(repr(param.default)) > 10:
+                unreadable.append(f"{line} {param.opts[0]} = {param.default!r}")
+    assert not undescribed, "options without a description: " + ", ".join(undescribed)
+    assert not unreadable, "defaults shown unreadably: " + ", ".join(unreadable)
+
+
+def test_detect_laser_help_shows_the_area_to_mass_default_with_its_unit() -> None:
+    result = CliRunner().invoke(cli, ["detect", "laser", "--help"], terminal_width=200)
+    assert result.exit_code == 0
+    assert "0.0006946543314535649" not in result.output
+    assert "6.95e-4 m²/kg" in result.output
+
+
+@pytest.mark.parametrize(
+    ("argv", "nearest"),
+    [(["detect", "orbt"], "'orbit'"), (["detect", "tle-bach"], "'tle-batch'"), (["reprot"], "'report'")],
+)
+def test_a_misspelt_sub_command_suggests_the_nearest(
+    argv: list[str], nearest: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert f"No such command '{argv[-1]}'. Did you mean {nearest}?" in err
+    assert err.count("Did you mean") == 1
+
+
+def test_a_sub_command_nothing_like_any_suggests_nothing(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit):
+        main(["detect", "zzzzzz"])
+    err = capsys.readouterr().err
+    assert "No such command 'zzzzzz'." in err and "Did you mean" not in err

@@ -103,7 +103,7 @@ def random_strikes(n: int, duration_s: float, dh_min: float, dh_max: float, seed
 )
 @click.option("--wheel-resolution", type=float, default=None, help="Tachometer discretisation [rad/s].")
 @click.option("--start", "start_utc", default="2026-01-01T00:00:00", show_default=True, help="Start time (UTC).")
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--seed", type=int, default=0, show_default=True, help="Random seed of noise and strikes (reproducible).")
 @click.option(
     "--out",
     type=click.Path(dir_okay=False),
@@ -411,7 +411,13 @@ def detect_attitude_cmd(
 
 @report.command("attitude")
 @telemetry_or_store_options
-@click.option("--spacecraft", "spacecraft_path", type=click.Path(exists=True, dir_okay=False), required=True)
+@click.option(
+    "--spacecraft",
+    "spacecraft_path",
+    type=click.Path(exists=True, dir_okay=False),
+    required=True,
+    help="Spacecraft TOML with the telemetry column mapping.",
+)
 @_with_options(detector_options)
 @click.option(
     "--truth",
@@ -477,7 +483,7 @@ def matches_truth(events: pd.DataFrame, t_true: pd.Timestamp) -> np.ndarray:
     help="Folder for the demo's telemetry, events, catalog and report.",
 )
 @click.option("--duration", "duration_s", type=float, default=3 * 3600.0, show_default=True, help="[s]")
-@click.option("--seed", type=int, default=7, show_default=True)
+@click.option("--seed", type=int, default=7, show_default=True, help="Random seed of the demo's noise and strikes.")
 def demo(out_dir: str, duration_s: float, seed: int) -> None:
     """Simulate telemetry of the thesis spacecraft with strikes, detect them, write catalog and report."""
 

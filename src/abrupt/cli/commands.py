@@ -10,6 +10,7 @@ from :mod:`abrupt.cli.groups` and decorate their commands onto them as usual.
 from __future__ import annotations
 
 import ast
+import difflib
 import functools
 import importlib
 import importlib.util
@@ -219,6 +220,13 @@ class LazyGroup(click.Group):
         reporter = progress.current()
         if ctx.parent is not None and reporter is not None and args and not args[0].startswith("-"):
             reporter.label = f"{reporter.label} {args[0]}"  # "abrupt detect" -> "abrupt detect orbit", before loading
+        name = args[0] if args else ""
+        known = self.list_commands(ctx)
+        if name and not name.startswith("-") and name not in known and not ctx.resilient_parsing:
+            # a misspelt sub-command: name the nearest ones among all (click's own hint sees loaded ones only)
+            close = difflib.get_close_matches(name, known, n=2, cutoff=0.6)
+            hint = f" Did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
+            raise click.UsageError(f"No such command {name!r}.{hint}", ctx)
         return super().resolve_command(ctx, args)
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:

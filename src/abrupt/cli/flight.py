@@ -53,7 +53,13 @@ def _progress(total: int, label: str, unit: str = "day") -> Any:
     help="Pseudonym decoder CSV (real_name,pseudonym); read here only, never downstream.",
 )
 @click.option("--store", "store_dir", required=True, type=click.Path(file_okay=False), help="Parquet store directory.")
-@click.option("--layout", type=click.Choice(["auto", "long", "wide"]), default="auto", show_default=True)
+@click.option(
+    "--layout",
+    type=click.Choice(["auto", "long", "wide"]),
+    default="auto",
+    show_default=True,
+    help="Archive layout: long (time, name, value rows), wide (one column per mnemonic), auto (from the header).",
+)
 @click.option("--assume-utc", is_flag=True, help="Read times without a zone as UTC (counted in the report).")
 @click.option(
     "--spacecraft",
@@ -193,8 +199,20 @@ def detect_from_store(
 
 
 @inject.command("attitude")
-@click.option("--store", "store_dir", required=True, type=click.Path(exists=True, file_okay=False))
-@click.option("--spacecraft", "spacecraft_path", required=True, type=click.Path(exists=True, dir_okay=False))
+@click.option(
+    "--store",
+    "store_dir",
+    required=True,
+    type=click.Path(exists=True, file_okay=False),
+    help="The store written by `abrupt ingest` whose days get strikes.",
+)
+@click.option(
+    "--spacecraft",
+    "spacecraft_path",
+    required=True,
+    type=click.Path(exists=True, dir_okay=False),
+    help="Spacecraft TOML of the stored spacecraft (its name is the store's pseudonym).",
+)
 @click.option(
     "--out-store",
     default=None,
@@ -223,7 +241,7 @@ def detect_from_store(
 @click.option("--recovery", is_flag=True, help="Injection-recovery study: 90%-detectable ΔH per day.")
 @click.option("--days", multiple=True, help="Days (YYYY-MM-DD or A..B); default all stored days.")
 @budget_options()
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--seed", type=int, default=0, show_default=True, help="Random seed (reproducible).")
 @click.option("--out", default=None, type=click.Path(dir_okay=False), help="Recovery table (.csv).")
 def inject_attitude_cmd(
     store_dir: str,
@@ -331,7 +349,13 @@ def _confounders(
 
 
 @simulate.command("confounders")
-@click.option("--spacecraft", "spacecraft_path", required=True, type=click.Path(exists=True, dir_okay=False))
+@click.option(
+    "--spacecraft",
+    "spacecraft_path",
+    required=True,
+    type=click.Path(exists=True, dir_okay=False),
+    help="Spacecraft TOML (wheels, appendages) the confounders act on.",
+)
 @click.option("--confounder", "specs", multiple=True, help="KIND@TIME_UTC; repeatable.")
 @click.option(
     "--random", "n_random", type=int, default=0, help="This many more, kinds cycled, times uniform in --span."
@@ -340,7 +364,7 @@ def _confounders(
 @click.option("--confounder-ranges", default=None, type=click.Path(exists=True, dir_okay=False),
               help="TOML of parameter ranges, name = [low, high].")  # fmt: skip
 @click.option("--show-ranges", is_flag=True, help="Print the ranges in use (TOML) and exit.")
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--seed", type=int, default=0, show_default=True, help="Random seed (reproducible).")
 @click.option("--out", default=None, type=click.Path(dir_okay=False), help="Confounders with parameters (.json).")
 def simulate_confounders_cmd(
     spacecraft_path: str,

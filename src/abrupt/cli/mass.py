@@ -45,7 +45,13 @@ _store = click.option(
     default=None,
     help="The ingest store (abrupt ingest), or a folder of telemetry files.",
 )
-_spacecraft = click.option("--spacecraft", "spacecraft_file", required=True, type=click.Path(dir_okay=False))
+_spacecraft = click.option(
+    "--spacecraft",
+    "spacecraft_file",
+    required=True,
+    type=click.Path(dir_okay=False),
+    help="Spacecraft TOML: the a-priori inertia, wheels and telemetry column mapping.",
+)
 _orbit = click.option(
     "--orbit-period",
     "orbit_period_s",
@@ -203,7 +209,14 @@ def _glr_summary(result: DetectionResult, track: InertiaTrack, budget: str) -> s
     show_default=True,
     help="Attachment point from the CoM, body axes [m].",
 )
-@click.option("--orbit-period", "orbit_period_s", type=float, default=5926.4, show_default=True)
+@click.option(
+    "--orbit-period",
+    "orbit_period_s",
+    type=float,
+    default=5926.4,
+    show_default=True,
+    help="Orbit period [s] (gravity-gradient torque of the nadir-pointing spacecraft).",
+)
 @click.option(
     "--dump-threshold",
     "dump_threshold_Nms",
@@ -212,7 +225,7 @@ def _glr_summary(result: DetectionResult, track: InertiaTrack, budget: str) -> s
     show_default=True,
     help="Momentum dump when the system momentum exceeds this at the start of a day [N m s]; 0: no dumps.",
 )
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--seed", type=int, default=0, show_default=True, help="Random seed (reproducible).")
 def simulate_docking_cmd(
     spacecraft_file: str,
     out_dir: str,

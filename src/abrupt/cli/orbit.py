@@ -110,12 +110,12 @@ def _filter_options(f: Any) -> Any:
 @simulate.command("orbit")
 @click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Navigation CSV to write (GCRF).")
 @click.option("--truth", "truth_out", type=click.Path(dir_okay=False), default=None, help="Also write the truth.")
-@click.option("--duration-s", type=float, default=10800.0, show_default=True)
-@click.option("--rate-hz", type=float, default=1.0, show_default=True)
-@click.option("--altitude-km", type=float, default=800.0, show_default=True)
-@click.option("--inclination-deg", type=float, default=40.0, show_default=True)
-@click.option("--sigma-pos-m", type=float, default=10.0, show_default=True)
-@click.option("--sigma-vel-mps", type=float, default=0.25, show_default=True)
+@click.option("--duration-s", type=float, default=10800.0, show_default=True, help="Length of the simulated arc [s].")
+@click.option("--rate-hz", type=float, default=1.0, show_default=True, help="Navigation solution rate [Hz].")
+@click.option("--altitude-km", type=float, default=800.0, show_default=True, help="Circular orbit altitude [km].")
+@click.option("--inclination-deg", type=float, default=40.0, show_default=True, help="Orbit inclination [deg].")
+@click.option("--sigma-pos-m", type=float, default=10.0, show_default=True, help="Position noise 1σ per axis [m].")
+@click.option("--sigma-vel-mps", type=float, default=0.25, show_default=True, help="Velocity noise 1σ per axis [m/s].")
 @click.option(
     "--impulse",
     "impulses",
@@ -130,7 +130,7 @@ def _filter_options(f: Any) -> Any:
     help="thesis-perturbed: J3 + exponential drag (§3.4.4); full: J2-J4, MSIS drag, SRP, Sun, Moon.",
 )
 @click.option("--epoch", default="2020-01-01T00:00:00", show_default=True, help="Start time (UTC).")
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--seed", type=int, default=0, show_default=True, help="Random seed of the noise (reproducible).")
 def simulate_orbit_command(
     out: str,
     truth_out: str | None,
@@ -245,7 +245,13 @@ def simulate_orbit_command(
     help="Every satellite of a multi-satellite SP3 file, each satellite's threshold calibrated on the "
     "other satellites of the file (leave-one-satellite-out; see docs/orbit.md).",
 )
-@click.option("--kind", type=click.Choice(["unknown", "maneuver", "strike"]), default="unknown", show_default=True)
+@click.option(
+    "--kind",
+    type=click.Choice(["unknown", "maneuver", "strike"]),
+    default="unknown",
+    show_default=True,
+    help="Event kind written for a detected ΔV (unknown: the data cannot tell a manoeuvre from a strike).",
+)
 @click.option(
     "--statistics-out", type=click.Path(dir_okay=False), default=None, help="Per-epoch statistics (.parquet/.csv)."
 )
@@ -512,7 +518,13 @@ def inject_orbit_command(
 @click.argument("file", type=click.Path(exists=True, dir_okay=False))
 @click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="PNG to write.")
 @_filter_options
-@click.option("--events", "events_file", type=click.Path(exists=True, dir_okay=False), default=None)
+@click.option(
+    "--events",
+    "events_file",
+    type=click.Path(exists=True, dir_okay=False),
+    default=None,
+    help="Events file of a detect orbit run (.csv/.parquet) to mark on the figure.",
+)
 @budget_options("1/week")
 def report_orbit_command(
     file: str,

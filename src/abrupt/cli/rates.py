@@ -224,11 +224,26 @@ def trade_command(vary: tuple[str, ...], workers: int | None, scheduler: str | N
 
 
 @rates.command("flux")
-@click.option("--model", type=click.Choice(["nasa90", "grun"]), default="nasa90", show_default=True)
-@click.option("--altitude-km", type=float, required=True)
-@click.option("--inclination-deg", type=float, default=28.5, show_default=True)
-@click.option("--epoch", "epoch_year", type=float, default=2020.0, show_default=True)
-@click.option("--solar-flux", "solar_flux_sfu", type=float, default=100.0, show_default=True)
+@click.option(
+    "--model",
+    type=click.Choice(["nasa90", "grun"]),
+    default="nasa90",
+    show_default=True,
+    help="Flux model: nasa90 (orbital debris, NASA-90/91) or grun (meteoroids, Grün 1985).",
+)
+@click.option("--altitude-km", type=float, required=True, help="Orbit altitude [km].")
+@click.option("--inclination-deg", type=float, default=28.5, show_default=True, help="Orbit inclination [deg].")
+@click.option(
+    "--epoch", "epoch_year", type=float, default=2020.0, show_default=True, help="Debris model epoch [decimal year]."
+)
+@click.option(
+    "--solar-flux",
+    "solar_flux_sfu",
+    type=float,
+    default=100.0,
+    show_default=True,
+    help="13-month mean F10.7 solar flux [sfu] of the debris model.",
+)
 @click.option(
     "--sizes-m",
     default="1e-5,1e-4,1e-3,1e-2,1e-1",
@@ -306,17 +321,40 @@ def flux_command(
     required=True,
     help="Manifest (.toml) of the flux table to write.",
 )
-@click.option("--name", default="ORDEM", show_default=True)
-@click.option("--altitude-km", type=float, default=float("nan"))
-@click.option("--inclination-deg", type=float, default=float("nan"))
-@click.option("--epoch", "epoch_year", type=float, default=float("nan"))
+@click.option("--name", default="ORDEM", show_default=True, help="Name of the flux table in the manifest and reports.")
+@click.option(
+    "--altitude-km",
+    type=float,
+    default=float("nan"),
+    help="Altitude [km] of the ORDEM run (recorded).",
+)
+@click.option(
+    "--inclination-deg",
+    type=float,
+    default=float("nan"),
+    help="Inclination [deg] the ORDEM run was for (recorded; default: unknown).",
+)
+@click.option(
+    "--epoch",
+    "epoch_year",
+    type=float,
+    default=float("nan"),
+    help="Epoch [decimal year] the ORDEM run was for (recorded; default: unknown).",
+)
 @click.option(
     "--flux-convention",
     type=click.Choice(["cross_section", "tumbling"]),
     default="cross_section",
     show_default=True,
+    help="ORDEM's flux per cross-section area, or per tumbling-plate area (×4 on import).",
 )
-@click.option("--intact-class", type=click.Choice(["nak", "low", "medium", "high"]), default="high", show_default=True)
+@click.option(
+    "--intact-class",
+    type=click.Choice(["nak", "low", "medium", "high"]),
+    default="high",
+    show_default=True,
+    help="Density class the intact-object column is counted with.",
+)
 def import_ordem_command(
     size_file: str,
     igloo_file: str,

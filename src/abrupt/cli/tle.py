@@ -211,7 +211,13 @@ def detect_tle(
     default=None,
     help="Operator maneuver file (IDS format) or events file.",
 )
-@click.option("--tolerance-days", type=float, default=1.0, show_default=True)
+@click.option(
+    "--tolerance-days",
+    type=float,
+    default=1.0,
+    show_default=True,
+    help="A detection within this many days of a true manoeuvre counts as found [days].",
+)
 @click.option("--out", type=click.Path(dir_okay=False), required=True, help="Figure file (.png, .svg, .pdf).")
 @norad_option
 @budget_options(TLE_BUDGET)

@@ -50,6 +50,7 @@ from abrupt.simulate.tracking import CASE1, CASE2, TrackingScenario, simulate_tr
     type=click.Choice(["perigee", "apogee", "quarter_after_perigee", "quarter_after_apogee"]),
     default="apogee",
     show_default=True,
+    help="Where on the orbit the burn is centred.",
 )
 @click.option(
     "--direction",
@@ -84,8 +85,14 @@ from abrupt.simulate.tracking import CASE1, CASE2, TrackingScenario, simulate_tr
     help="Multiply the thesis noise (5 m, 0.02 rad, 0.5 m/s).",
 )
 @click.option("--epoch", "epoch_utc", default="2024-01-01T00:00:00", show_default=True, help="UTC epoch of the start.")
-@click.option("--earth-rotation", type=click.Choice(["simple", "iers"]), default="simple", show_default=True)
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option(
+    "--earth-rotation",
+    type=click.Choice(["simple", "iers"]),
+    default="simple",
+    show_default=True,
+    help="Earth rotation: simple (uniform spin, as the thesis) or iers (IERS orientation table, bundled).",
+)
+@click.option("--seed", type=int, default=0, show_default=True, help="Random seed of the noise (reproducible).")
 @click.option("--name", "spacecraft", default="SIM-TRACK", show_default=True, help="Spacecraft pseudonym.")
 def simulate_tracking_command(
     out: str,
@@ -175,7 +182,13 @@ def _write_aer(measurements: Any, path: Path) -> None:
     help="Orekit-style input: a-priori orbit and stations (e.g. od_test_W3.in).",
 )
 @click.option("--out", "out", type=click.Path(dir_okay=False), default=None, help="Events file (.csv/.parquet).")
-@click.option("--method", type=click.Choice(["both", "kaderali", "glrt"]), default="both", show_default=True)
+@click.option(
+    "--method",
+    type=click.Choice(["both", "kaderali", "glrt"]),
+    default="both",
+    show_default=True,
+    help="Detector: kaderali (Ψ/K filter statistics, Kaderali 2021), glrt (batch GLR test), or both.",
+)
 @budget_options("0.1/day")
 @click.option(
     "--psi-threshold",
@@ -201,7 +214,9 @@ def _write_aer(measurements: Any, path: Path) -> None:
     default=None,
     help="Correct elevations for refraction (default: as the setup file says).",
 )
-@click.option("--max-maneuvers", type=int, default=3, show_default=True)
+@click.option(
+    "--max-maneuvers", type=int, default=3, show_default=True, help="At most this many manoeuvres sought in the arc."
+)
 @click.option(
     "--kaderali-threshold",
     type=click.Choice(["simulated", "chi2"]),
