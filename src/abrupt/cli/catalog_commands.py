@@ -3,14 +3,21 @@
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
-import pandas as pd
 
-from abrupt.catalog import Catalog
+from abrupt.cli.commands import lazy_module
 from abrupt.cli.groups import catalog_option, cli
 from abrupt.kinds import EVENT_KINDS
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from abrupt import catalog
+else:
+    catalog = lazy_module("abrupt.catalog")
+    pd = lazy_module("pandas")
 
 #: Width the default view fits in (characters).
 VIEW_WIDTH = 120
@@ -67,7 +74,7 @@ def export(catalog_target: str, out: str, **filters: Any) -> None:
     """Export events to OUT (.csv or .parquet; Parquet keeps times as UTC timestamps)."""
     if not out.lower().endswith((".csv", ".parquet", ".pq")):
         raise click.BadParameter(f"{out!r} must end in .csv or .parquet", param_hint="OUT")
-    n = Catalog(catalog_target, create=False).export(out, **_filters(filters))
+    n = catalog.Catalog(catalog_target, create=False).export(out, **_filters(filters))
     click.echo(f"{n} event(s) written to {out}")
 
 
@@ -100,7 +107,7 @@ def narrow_view(frame: Any) -> list[str]:
 @click.option("--wide", is_flag=True, help="Every column (wide lines) instead of the narrow view.")
 def list_(catalog_target: str, runs: bool, wide: bool, **filters: Any) -> None:
     """Print the events (or run records) in the catalog; the latest configuration by default."""
-    cat = Catalog(catalog_target, create=False)
+    cat = catalog.Catalog(catalog_target, create=False)
     if runs:
         frame = cat.runs()
         if frame.empty:

@@ -20,6 +20,7 @@ import sys
 from collections.abc import Callable, Iterator, Mapping
 from functools import cache
 from pathlib import Path
+from types import ModuleType
 from typing import Any, TypeGuard
 
 import click
@@ -78,6 +79,22 @@ REPORT_COMMANDS = {
     "tle": "abrupt.cli.tle:report_tle",
     "tracking": "abrupt.cli.tracking:report_tracking_command",
 }
+
+
+class DeferredModule(ModuleType):
+    """A stand-in for the module it names, imported on the first attribute looked up through it."""
+
+    def __getattr__(self, attribute: str) -> Any:
+        return getattr(importlib.import_module(self.__name__), attribute)
+
+
+def lazy_module(name: str) -> ModuleType:
+    """The module ``name``, imported when one of its attributes is first used (not when named).
+
+    A command module names the library modules it uses at its top through this, so that declaring its
+    options (``--help``, a missing option) imports none of them: only running the command does.
+    """
+    return DeferredModule(name)
 
 
 def load_command(target: str) -> click.Command:
