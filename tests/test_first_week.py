@@ -4,6 +4,9 @@ thresholds."""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import click
@@ -147,3 +150,63 @@ def test_a_sub_command_nothing_like_any_suggests_nothing(capsys: pytest.CaptureF
         main(["detect", "zzzzzz"])
     err = capsys.readouterr().err
     assert "No such command 'zzzzzz'." in err and "Did you mean" not in err
+
+
+HEAVY_MODULES = ("numba", "scipy", "pandas", "numpy", "astropy", "matplotlib", "sqlalchemy", "dask", "pyarrow")
+
+#: Run in a fresh interpreter: the command line given, then print the heavy packages it imported.
+_HEAVY_PROBE = """
+import sys
+from abrupt.cli.main import main
+try:
+    main(sys.argv[1:])
+except SystemExit:
+    pass
+heavy = sorted({name.split(".")[0] for name in sys.modules} & set(HEAVY))
+print("HEAVY=" + ",".join(heavy))
+"""
+
+#: Run in a fresh interpreter: every leaf command's help, then print the heavy packages imported.
+_ALL_HELP_PROBE = """
+import sys
+import click
+from abrupt.cli.commands import cli
+
+def walk(group, ctx):
+    for name in group.list_commands(ctx):
+        command = group.get_command(ctx, name)
+        sub = click.Context(command, parent=ctx, info_name=name)
+        if isinstance(command, click.Group):
+            yield from walk(command, sub)
+        else:
+            yield sub
+
+helps = [ctx.get_help() for ctx in walk(cli, click.Context(cli, info_name="abrupt"))]
+heavy = sorted({name.split(".")[0] for name in sys.modules} & set(HEAVY))
+print(f"LEAVES={len(helps)}")
+print("HEAVY=" + ",".join(heavy))
+"""
+
+
+def _probe(script: str, *args: str) -> str:
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    code = f"HEAVY = {HEAVY_MODULES!r}\n{script}"
+    done = subprocess.run([sys.executable, "-c", code, *args], env=env, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    return done.stdout
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [("detect", "tle", "--help"), ("detect", "attitude", "--help"), ("detect", "tle"), ("report", "catalog", "--bad")],
+    ids=["tle-help", "attitude-help", "tle-missing-argument", "catalog-bad-option"],
+)
+def test_a_leaf_help_or_option_error_imports_no_heavy_package(argv: tuple[str, ...]) -> None:
+    """Help and option errors come from the declarations alone (timings: benchmarks/bench_cli_help.py)."""
+    assert _probe(_HEAVY_PROBE, *argv).strip().splitlines()[-1] == "HEAVY="
+
+
+def test_every_leaf_help_imports_no_heavy_package() -> None:
+    lines = _probe(_ALL_HELP_PROBE).strip().splitlines()
+    assert int(lines[-2].removeprefix("LEAVES=")) > 30
+    assert lines[-1] == "HEAVY="
