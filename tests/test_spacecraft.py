@@ -88,3 +88,13 @@ def test_invalid_toml_and_missing_file_are_clear_errors(tmp_path: Path) -> None:
         load_spacecraft(_write(tmp_path, "name = "))
     with pytest.raises(ConfigError, match="cannot read"):
         load_spacecraft(tmp_path / "missing.toml")
+
+
+@pytest.mark.parametrize("path", sorted((ROOT / "examples" / "spacecraft").glob("*.toml")), ids=lambda p: p.name)
+def test_bundled_example_loads_without_a_warning(path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    """An example states every physical value it uses, so no command that reads it warns (a default taken
+    from the code would be said on every run, the demo included)."""
+    with caplog.at_level("WARNING", logger="abrupt"):
+        sc = load_spacecraft(path)
+    assert sc.defaults == ()
+    assert not [r for r in caplog.records if r.levelname == "WARNING"], caplog.text

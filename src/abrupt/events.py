@@ -3,7 +3,8 @@
 A detector returns a :class:`pandas.DataFrame` whose first columns are exactly
 :data:`EVENT_COLUMNS`, in that order; further columns may follow. A value a detector does not
 estimate is empty (NaN). A detector that finds nothing returns :func:`empty_frame`, which has the
-same columns and no rows.
+same columns and no rows. An event's ``kind`` is one of :data:`EVENT_KINDS`, the vocabulary of
+:mod:`abrupt.kinds` (its ``EVENT_KIND_MEANINGS`` says what each means and which detectors write it).
 
 Event identifiers are deterministic (a hash of spacecraft, detector, kind, time and configuration
 hash), so re-running the same input and configuration yields the same ``event_id`` and the catalog
@@ -26,16 +27,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-EVENT_KINDS = (
-    "strike",
-    "maneuver",
-    "mass_change",
-    "unknown",
-    "maneuver_campaign",
-    "sensor_fault",
-    "external_non_strike",
-    "internal",
-)
+from abrupt.kinds import EVENT_KINDS
 
 EVENT_COLUMNS: tuple[str, ...] = (
     "event_id",

@@ -48,6 +48,15 @@ class TelemetryStore:
         base = self.root / f"spacecraft={spacecraft}"
         return sorted(p.name.split("=", 1)[1] for p in base.glob("day=*") if (p / "samples.parquet").exists())
 
+    def holdings(self) -> str:
+        """What the store holds, for an error naming a spacecraft it does not: each pseudonym with its
+        number of days and their span (a spacecraft file's ``name`` is the pseudonym its days are under)."""
+        held = [(name, days) for name in self.spacecraft() if (days := self.days(name))]
+        if not held:
+            return "the store holds no spacecraft days (ingest archives into it first: abrupt ingest)"
+        listing = ", ".join(f"{name!r} ({len(days)} day(s), {days[0]}..{days[-1]})" for name, days in held)
+        return f"the store holds {listing}: give the spacecraft file whose name is one of these"
+
     def write_day(self, spacecraft: str, day: str, samples: pd.DataFrame, report: dict[str, Any]) -> int:
         """Merge ``samples`` (mnemonic, time, value) into the partition; return rows added."""
         d = self._dir(spacecraft, day)

@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
-import numpy as np
-import pandas as pd
 
+from abrupt.cli.commands import lazy_module
 from abrupt.cli.flight import CLEANING_STAGES, detect_from_store
 from abrupt.cli.flight_orbit import orbit_evidence_options
 from abrupt.cli.flux import exposure_options
@@ -25,25 +24,35 @@ from abrupt.cli.groups import (
     warn,
 )
 from abrupt.cli.options import budget_options, pop_budget
-from abrupt.detect.attitude.change_detection import WindowConfig
-from abrupt.detect.attitude.momentum import (
-    AttitudeDetectionConfig,
-    MomentumChangeDetector,
-    attitude_detector_class,
-    attitude_detector_names,
-)
-from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike
-from abrupt.pipelines.attitude import detect_attitude, load_spacecraft, read_attitude_inputs
-from abrupt.readers.telemetry import read_telemetry
-from abrupt.report.attitude import write_attitude_report
-from abrupt.simulate.attitude import simulate_attitude, write_telemetry
+
+if TYPE_CHECKING:
+    import numpy as np
+    import pandas as pd
+
+    from abrupt.detect.attitude import change_detection as detect_attitude_change_detection
+    from abrupt.detect.attitude import momentum as detect_attitude_momentum
+    from abrupt.model import attitude_dynamics as model_attitude_dynamics
+    from abrupt.pipelines import attitude as pipelines_attitude
+    from abrupt.readers import telemetry as readers_telemetry
+    from abrupt.report import attitude as report_attitude
+    from abrupt.simulate import attitude as abrupt_simulate_attitude
+else:
+    detect_attitude_change_detection = lazy_module("abrupt.detect.attitude.change_detection")
+    detect_attitude_momentum = lazy_module("abrupt.detect.attitude.momentum")
+    model_attitude_dynamics = lazy_module("abrupt.model.attitude_dynamics")
+    pipelines_attitude = lazy_module("abrupt.pipelines.attitude")
+    readers_telemetry = lazy_module("abrupt.readers.telemetry")
+    report_attitude = lazy_module("abrupt.report.attitude")
+    abrupt_simulate_attitude = lazy_module("abrupt.simulate.attitude")
+    np = lazy_module("numpy")
+    pd = lazy_module("pandas")
 
 
 def _spacecraft(path: str | None) -> Any:
-    return load_spacecraft(path)
+    return pipelines_attitude.load_spacecraft(path)
 
 
-def parse_strike(text: str) -> Strike:
+def parse_strike(text: str) -> model_attitude_dynamics.Strike:
     """``TIME_S:DHX,DHY,DHZ`` (seconds from start; angular impulse in body axes, N·m·s)."""
 
     try:
@@ -51,12 +60,14 @@ def parse_strike(text: str) -> Strike:
         dh = tuple(float(v) for v in vec_part.split(","))
         if len(dh) != 3:
             raise ValueError
-        return Strike(float(time_part), (dh[0], dh[1], dh[2]))
+        return model_attitude_dynamics.Strike(float(time_part), (dh[0], dh[1], dh[2]))
     except ValueError:
         raise click.BadParameter(f"{text!r}: expected TIME_S:DHX,DHY,DHZ, e.g. 600:0.08,0,0") from None
 
 
-def random_strikes(n: int, duration_s: float, dh_min: float, dh_max: float, seed: int) -> list[Strike]:
+def random_strikes(
+    n: int, duration_s: float, dh_min: float, dh_max: float, seed: int
+) -> list[model_attitude_dynamics.Strike]:
     """n strikes, evenly spaced with random jitter, log-uniform |ΔH| in [dh_min, dh_max], random directions."""
 
     rng = np.random.default_rng(seed + 1)
@@ -67,7 +78,7 @@ def random_strikes(n: int, duration_s: float, dh_min: float, dh_max: float, seed
         mag = float(np.exp(rng.uniform(np.log(dh_min), np.log(dh_max))))
         u = rng.normal(size=3)
         u /= np.linalg.norm(u)
-        out.append(Strike(round(float(t), 2), tuple(float(v) for v in mag * u)))  # type: ignore[arg-type]
+        out.append(model_attitude_dynamics.Strike(round(float(t), 2), tuple(float(v) for v in mag * u)))  # type: ignore[arg-type]
     return out
 
 
@@ -103,7 +114,7 @@ def random_strikes(n: int, duration_s: float, dh_min: float, dh_max: float, seed
 )
 @click.option("--wheel-resolution", type=float, default=None, help="Tachometer discretisation [rad/s].")
 @click.option("--start", "start_utc", default="2026-01-01T00:00:00", show_default=True, help="Start time (UTC).")
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--seed", type=int, default=0, show_default=True, help="Random seed of noise and strikes (reproducible).")
 @click.option(
     "--out",
     type=click.Path(dir_okay=False),
@@ -134,7 +145,7 @@ def simulate_attitude_cmd(
     strike_list = [parse_strike(s) for s in strikes]
     if n_random_strikes:
         strike_list += random_strikes(n_random_strikes, duration_s, strike_range[0], strike_range[1], seed)
-    cfg = AttitudeSimConfig(
+    cfg = model_attitude_dynamics.AttitudeSimConfig(
         duration_s=duration_s,
         telemetry_rate_hz=telemetry_rate_hz,
         telemetry_noise_rate_rad_s=rate_noise,
@@ -143,8 +154,8 @@ def simulate_attitude_cmd(
         start_time_utc=start_utc,
         seed=seed,
     )
-    result = simulate_attitude(sc, cfg, sorted(strike_list, key=lambda s: s.time_s))
-    tel_path, truth_path = write_telemetry(result, out)
+    result = abrupt_simulate_attitude.simulate_attitude(sc, cfg, sorted(strike_list, key=lambda s: s.time_s))
+    tel_path, truth_path = abrupt_simulate_attitude.write_telemetry(result, out)
     click.echo(
         f"telemetry: {tel_path} ({len(result.telemetry)} samples); truth: {truth_path} ({len(result.truth)} strikes)"
     )
@@ -161,7 +172,7 @@ def _detection_config(
 ) -> Any:
     """The run configuration; detector names are checked against the registry now (plug-ins included)."""
 
-    names = attitude_detector_names()
+    names = detect_attitude_momentum.attitude_detector_names()
     if "all" in detectors:
         chosen = tuple(n.removeprefix("attitude.") for n in names if n.startswith("attitude."))
     else:
@@ -170,10 +181,10 @@ def _detection_config(
         if d not in names and f"attitude.{d}" not in names:
             short = ", ".join(n.removeprefix("attitude.") for n in names)
             raise click.BadParameter(f"{d!r} is not a registered attitude detector; choose from {short}, all")
-    return AttitudeDetectionConfig(
+    return detect_attitude_momentum.AttitudeDetectionConfig(
         detectors=chosen,
-        windows=WindowConfig(pre=pre, post=post),
-        glr_windows=WindowConfig(pre=glr_window, post=glr_window),
+        windows=detect_attitude_change_detection.WindowConfig(pre=pre, post=post),
+        glr_windows=detect_attitude_change_detection.WindowConfig(pre=glr_window, post=glr_window),
         budget=budget,
         threshold_method=method,
         null_samples=null_samples,
@@ -254,7 +265,13 @@ def _with_options(options: list[Any]) -> Any:
 def _stage_count(cfg: Any) -> int:
     """Progress stages of the pipeline: calibrate and run per change detector, one for the others."""
 
-    n_change = sum(1 for d in cfg.detectors if issubclass(attitude_detector_class(d), MomentumChangeDetector))
+    n_change = sum(
+        1
+        for d in cfg.detectors
+        if issubclass(
+            detect_attitude_momentum.attitude_detector_class(d), detect_attitude_momentum.MomentumChangeDetector
+        )
+    )
     return 2 * n_change + (1 if n_change < len(cfg.detectors) else 0)
 
 
@@ -269,7 +286,9 @@ def run_attitude_detection(
     """Call the attitude pipeline, with a progress line per stage. Returns (sc, telemetry, config, run)."""
 
     budget = pop_budget(settings, "1/day")
-    sc, tel, cal = read_attitude_inputs(telemetry_path, spacecraft_path, calibration_path=calibration, mask_path=mask)
+    sc, tel, cal = pipelines_attitude.read_attitude_inputs(
+        telemetry_path, spacecraft_path, calibration_path=calibration, mask_path=mask
+    )
     for line in tel.repairs.summary():
         note(f"repaired: {line}")
     if cal is not None:
@@ -278,7 +297,9 @@ def run_attitude_detection(
     cfg = _detection_config(budget=budget, **settings)
     stages = StageProgress(_stage_count(cfg), desc="detect attitude")
     try:
-        result = detect_attitude(tel, sc, cfg, calibration=cal, spacecraft_name=name, progress=stages, budget=budget)
+        result = pipelines_attitude.detect_attitude(
+            tel, sc, cfg, calibration=cal, spacecraft_name=name, progress=stages, budget=budget
+        )
     finally:
         stages.close()
     for warning in result.details.get("warnings", []):
@@ -405,13 +426,19 @@ def detect_attitude_cmd(
     for k, thr in result.thresholds.items():
         note(f"threshold {k}: {thr.value:.4g} ({thr.false_alarms_per_day:g} false alarms/day, {thr.method})")
     if report_path:
-        write_attitude_report(report_path, tel, result)
+        report_attitude.write_attitude_report(report_path, tel, result)
         click.echo(f"report: {report_path}", err=True)
 
 
 @report.command("attitude")
 @telemetry_or_store_options
-@click.option("--spacecraft", "spacecraft_path", type=click.Path(exists=True, dir_okay=False), required=True)
+@click.option(
+    "--spacecraft",
+    "spacecraft_path",
+    type=click.Path(exists=True, dir_okay=False),
+    required=True,
+    help="Spacecraft TOML with the telemetry column mapping.",
+)
 @_with_options(detector_options)
 @click.option(
     "--truth",
@@ -448,7 +475,7 @@ def report_attitude_cmd(
     mask = settings.pop("mask")
     _, tel, _, result = run_attitude_detection(telemetry, spacecraft_path, calibration, None, settings, mask)
     truth_frame = pd.read_csv(truth) if truth else None
-    write_attitude_report(out, tel, result, truth=truth_frame)
+    report_attitude.write_attitude_report(out, tel, result, truth=truth_frame)
     click.echo(f"report: {out}")
 
 
@@ -477,7 +504,7 @@ def matches_truth(events: pd.DataFrame, t_true: pd.Timestamp) -> np.ndarray:
     help="Folder for the demo's telemetry, events, catalog and report.",
 )
 @click.option("--duration", "duration_s", type=float, default=3 * 3600.0, show_default=True, help="[s]")
-@click.option("--seed", type=int, default=7, show_default=True)
+@click.option("--seed", type=int, default=7, show_default=True, help="Random seed of the demo's noise and strikes.")
 def demo(out_dir: str, duration_s: float, seed: int) -> None:
     """Simulate telemetry of the thesis spacecraft with strikes, detect them, write catalog and report."""
 
@@ -492,14 +519,16 @@ def demo(out_dir: str, duration_s: float, seed: int) -> None:
     for t, size in zip(times, sizes, strict=True):
         u = rng.normal(size=3)
         u /= np.linalg.norm(u)
-        strikes.append(Strike(round(float(t), 1), tuple(float(v) for v in size * u)))  # type: ignore[arg-type]
+        strikes.append(model_attitude_dynamics.Strike(round(float(t), 1), tuple(float(v) for v in size * u)))  # type: ignore[arg-type]
     note(f"[1/4] simulating {duration_s / 3600:g} h of 10 Hz telemetry with {len(strikes)} strikes ...")
-    sim = simulate_attitude(sc, AttitudeSimConfig(duration_s=duration_s, seed=seed), strikes)
-    tel_path, truth_path = write_telemetry(sim, out / "telemetry.parquet")
+    sim = abrupt_simulate_attitude.simulate_attitude(
+        sc, model_attitude_dynamics.AttitudeSimConfig(duration_s=duration_s, seed=seed), strikes
+    )
+    tel_path, truth_path = abrupt_simulate_attitude.write_telemetry(sim, out / "telemetry.parquet")
     note("[2/4] reading telemetry and calibrating thresholds (one false alarm per day) ...")
-    tel = read_telemetry(tel_path, sc)
-    cfg = AttitudeDetectionConfig(detectors=("glr", "cusum", "summation"))
-    result = detect_attitude(tel, sc, cfg, spacecraft_name="demo-sat")
+    tel = readers_telemetry.read_telemetry(tel_path, sc)
+    cfg = detect_attitude_momentum.AttitudeDetectionConfig(detectors=("glr", "cusum", "summation"))
+    result = pipelines_attitude.detect_attitude(tel, sc, cfg, spacecraft_name="demo-sat")
     note("[3/4] writing events and catalog ...")
     record_run(
         catalog_target=str(out / "catalog.sqlite"),
@@ -513,8 +542,12 @@ def demo(out_dir: str, duration_s: float, seed: int) -> None:
     )
     note("[4/4] drawing the report ...")
     truth = pd.read_csv(truth_path)
-    write_attitude_report(out / "report.png", tel, result, truth=truth, title="abrupt demo: thesis spacecraft")
-    write_attitude_report(out / "report.html", tel, result, truth=truth, title="abrupt demo: thesis spacecraft")
+    report_attitude.write_attitude_report(
+        out / "report.png", tel, result, truth=truth, title="abrupt demo: thesis spacecraft"
+    )
+    report_attitude.write_attitude_report(
+        out / "report.html", tel, result, truth=truth, title="abrupt demo: thesis spacecraft"
+    )
     click.echo(
         f"\ntruth vs detections (match within {MATCH_FLOOR_S:g} s or {MATCH_SIGMAS:g} σ of the event's time estimate):"
     )

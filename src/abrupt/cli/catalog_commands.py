@@ -4,18 +4,30 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
-import pandas as pd
 
-from abrupt.catalog import Catalog
-from abrupt.catalog.event_import import read_event_table
+from abrupt.cli.commands import lazy_module
 from abrupt.cli.groups import catalog_option, cli
-from abrupt.events import new_run_id
+from abrupt.kinds import EVENT_KINDS
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from abrupt import catalog
+    from abrupt import events as abrupt_events
+    from abrupt.catalog import event_import
+else:
+    catalog = lazy_module("abrupt.catalog")
+    event_import = lazy_module("abrupt.catalog.event_import")
+    abrupt_events = lazy_module("abrupt.events")
+    pd = lazy_module("pandas")
 
 #: Width the default view fits in (characters).
 VIEW_WIDTH = 120
+#: Width of the kind column: every kind shown whole.
+KIND_WIDTH = max(len(kind) for kind in EVENT_KINDS)
 
 
 @cli.group("catalog")
@@ -26,7 +38,12 @@ def catalog_group() -> None:
 def _filter_options(f: Any) -> Any:
     options = [
         click.option("--spacecraft", default=None, help="Only this spacecraft pseudonym."),
-        click.option("--kind", type=click.Choice(["strike", "maneuver", "mass_change", "unknown"]), default=None),
+        click.option(
+            "--kind",
+            type=click.Choice(EVENT_KINDS),
+            default=None,
+            help="Only events of this kind (the vocabulary of abrupt.kinds: what each means and who writes it).",
+        ),
         click.option(
             "--detector", default=None, help="A detector (attitude.glr), a capability (attitude) or a method (glr)."
         ),
@@ -62,14 +79,15 @@ def export(catalog_target: str, out: str, **filters: Any) -> None:
     """Export events to OUT (.csv or .parquet; Parquet keeps times as UTC timestamps)."""
     if not out.lower().endswith((".csv", ".parquet", ".pq")):
         raise click.BadParameter(f"{out!r} must end in .csv or .parquet", param_hint="OUT")
-    n = Catalog(catalog_target, create=False).export(out, **_filters(filters))
+    n = catalog.Catalog(catalog_target, create=False).export(out, **_filters(filters))
     click.echo(f"{n} event(s) written to {out}")
 
 
 def narrow_view(frame: Any) -> list[str]:
     """Events as lines of at most :data:`VIEW_WIDTH` characters: time, spacecraft, kind, detector, size, margin."""
     header = (
-        f"{'time (UTC)':<23} {'spacecraft':<16} {'kind':<11} {'detector':<24} {'size':>16} {'stat/thr':>8} {'event':>8}"
+        f"{'time (UTC)':<23} {'spacecraft':<16} {'kind':<{KIND_WIDTH}} "
+        f"{'detector':<24} {'size':>16} {'stat/thr':>8} {'event':>8}"
     )
     lines = [header]
     for row in frame.itertuples(index=False):
@@ -81,7 +99,7 @@ def narrow_view(frame: Any) -> list[str]:
             size = "–"
         ratio = row.statistic / row.threshold if row.threshold else math.nan
         lines.append(
-            f"{str(row.time_utc)[:23]:<23} {str(row.spacecraft)[:16]:<16} {str(row.kind)[:11]:<11} "
+            f"{str(row.time_utc)[:23]:<23} {str(row.spacecraft)[:16]:<16} {row.kind!s:<{KIND_WIDTH}} "
             f"{str(row.detector)[:24]:<24} {size:>16} {ratio:>8.2f} {str(row.event_key)[:8]:>8}"
         )
     return lines
@@ -94,7 +112,7 @@ def narrow_view(frame: Any) -> list[str]:
 @click.option("--wide", is_flag=True, help="Every column (wide lines) instead of the narrow view.")
 def list_(catalog_target: str, runs: bool, wide: bool, **filters: Any) -> None:
     """Print the events (or run records) in the catalog; the latest configuration by default."""
-    cat = Catalog(catalog_target, create=False)
+    cat = catalog.Catalog(catalog_target, create=False)
     if runs:
         frame = cat.runs()
         if frame.empty:
@@ -140,10 +158,10 @@ def import_events(catalog_target: str, events_csv: str) -> None:
     target = Path(catalog_target)
     if target.exists() and target.resolve() == Path(events_csv).resolve():
         raise click.BadParameter("the catalog would overwrite the events file it imports", param_hint="--catalog")
-    events = read_event_table(events_csv)
-    run_id = new_run_id()
+    events = event_import.read_event_table(events_csv)
+    run_id = abrupt_events.new_run_id()
     events["run_id"] = pd.array([run_id] * len(events), dtype="string")
-    cat = Catalog(catalog_target)
+    cat = catalog.Catalog(catalog_target)
     cat.start_run(run_id, f"catalog import {Path(events_csv).name}", details={"file": str(events_csv)})
     added = cat.store_events(events)
     cat.finish_run(run_id, n_found=len(events), n_new=added.events)

@@ -10,6 +10,7 @@ from :mod:`abrupt.cli.groups` and decorate their commands onto them as usual.
 from __future__ import annotations
 
 import ast
+import difflib
 import functools
 import importlib
 import importlib.util
@@ -19,6 +20,7 @@ import sys
 from collections.abc import Callable, Iterator, Mapping
 from functools import cache
 from pathlib import Path
+from types import ModuleType
 from typing import Any, TypeGuard
 
 import click
@@ -77,6 +79,22 @@ REPORT_COMMANDS = {
     "tle": "abrupt.cli.tle:report_tle",
     "tracking": "abrupt.cli.tracking:report_tracking_command",
 }
+
+
+class DeferredModule(ModuleType):
+    """A stand-in for the module it names, imported on the first attribute looked up through it."""
+
+    def __getattr__(self, attribute: str) -> Any:
+        return getattr(importlib.import_module(self.__name__), attribute)
+
+
+def lazy_module(name: str) -> ModuleType:
+    """The module ``name``, imported when one of its attributes is first used (not when named).
+
+    A command module names the library modules it uses at its top through this, so that declaring its
+    options (``--help``, a missing option) imports none of them: only running the command does.
+    """
+    return DeferredModule(name)
 
 
 def load_command(target: str) -> click.Command:
@@ -219,6 +237,13 @@ class LazyGroup(click.Group):
         reporter = progress.current()
         if ctx.parent is not None and reporter is not None and args and not args[0].startswith("-"):
             reporter.label = f"{reporter.label} {args[0]}"  # "abrupt detect" -> "abrupt detect orbit", before loading
+        name = args[0] if args else ""
+        known = self.list_commands(ctx)
+        if name and not name.startswith("-") and name not in known and not ctx.resilient_parsing:
+            # a misspelt sub-command: name the nearest ones among all (click's own hint sees loaded ones only)
+            close = difflib.get_close_matches(name, known, n=2, cutoff=0.6)
+            hint = f" Did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
+            raise click.UsageError(f"No such command {name!r}.{hint}", ctx)
         return super().resolve_command(ctx, args)
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:

@@ -4,27 +4,41 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
+from abrupt.cli.commands import lazy_module
 from abrupt.cli.fleet import gather_paths, with_parts_options
 from abrupt.cli.groups import cli, progress_hidden
 from abrupt.cli.options import budget_options, pop_budget
-from abrupt.density.constellation import ConstellationConfig
-from abrupt.density.drag_plausibility import IMPLAUSIBLE_STATUS
-from abrupt.density.joint import JointConfig
-from abrupt.density.meteors import estimate_density_ratios, read_radar_csv
-from abrupt.density.precise_orbit import OrbitDensityConfig
-from abrupt.density.tle_drag import TleDragConfig
-from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET
-from abrupt.events import read_events
-from abrupt.pipelines.catalogue import file_key, run_catalogue
-from abrupt.pipelines.density import orbit_density, tle_density, write_table
-from abrupt.report.density import NothingToPlot, plot_density_bands, plot_meteor_profile
+from abrupt.detect.tle.default_rate import DEFAULT_TLE_RATE
 from abrupt.scale import Executor
 
-TLE_BUDGET = str(DEFAULT_TLE_BUDGET)  # "1/year", the maneuver detector's
+if TYPE_CHECKING:
+    from abrupt import events
+    from abrupt.density import constellation as density_constellation
+    from abrupt.density import drag_plausibility as density_drag_plausibility
+    from abrupt.density import joint as density_joint
+    from abrupt.density import meteors as abrupt_density_meteors
+    from abrupt.density import precise_orbit as density_precise_orbit
+    from abrupt.density import tle_drag as density_tle_drag
+    from abrupt.pipelines import catalogue as pipelines_catalogue
+    from abrupt.pipelines import density as pipelines_density
+    from abrupt.report import density as report_density
+else:
+    density_constellation = lazy_module("abrupt.density.constellation")
+    density_drag_plausibility = lazy_module("abrupt.density.drag_plausibility")
+    density_joint = lazy_module("abrupt.density.joint")
+    abrupt_density_meteors = lazy_module("abrupt.density.meteors")
+    density_precise_orbit = lazy_module("abrupt.density.precise_orbit")
+    density_tle_drag = lazy_module("abrupt.density.tle_drag")
+    events = lazy_module("abrupt.events")
+    pipelines_catalogue = lazy_module("abrupt.pipelines.catalogue")
+    pipelines_density = lazy_module("abrupt.pipelines.density")
+    report_density = lazy_module("abrupt.report.density")
+
+TLE_BUDGET = DEFAULT_TLE_RATE  # the maneuver detector's
 
 
 @cli.group("density")
@@ -170,36 +184,38 @@ def density_tle(
     if maneuvers_from or scheduler:
         raise click.UsageError("--maneuvers-from and --scheduler go with --windows-only")
     paths = tuple(files)
-    res = tle_density(
+    res = pipelines_density.tle_density(
         list(paths),
         platforms=platforms,
-        config=TleDragConfig(
+        config=density_tle_drag.TleDragConfig(
             interval_days=interval_days,
             with_model=not no_model or len(paths) > 1,
             maneuver_budget=maneuver_budget,
             model_tolerance=model_tolerance,
             model_grid=grid,
         ),
-        constellation=ConstellationConfig(kappa=kappa),
+        constellation=density_constellation.ConstellationConfig(kappa=kappa),
         maneuvers=maneuvers,
         space_weather=space_weather,
         workers=workers,
-        joint=JointConfig(node_days=node_days, block_days=block_days),
+        joint=density_joint.JointConfig(node_days=node_days, block_days=block_days),
         order_statistics=not no_order_statistics,
     )
-    write_table(res.windows, out)
+    pipelines_density.write_table(res.windows, out)
     for src, log in res.repairs.items():
         for kind, n in log.counts.items():
             click.echo(f"{src}: {kind}: {n}", err=True)
     for msg in res.warnings:
         click.echo(f"warning: {msg}", err=True)
     ok = int((res.windows["status"] == "ok").sum()) if len(res.windows) else 0
-    refused = int((res.windows["status"] == IMPLAUSIBLE_STATUS).sum()) if len(res.windows) else 0
+    refused = (
+        int((res.windows["status"] == density_drag_plausibility.IMPLAUSIBLE_STATUS).sum()) if len(res.windows) else 0
+    )
     no_signal = sum(n for log in res.repairs.values() for k, n in log.counts.items() if "no drag signal" in k)
     click.echo(_plausibility_line(no_signal, refused), err=True)
     click.echo(f"{ok} window(s) of {len(paths)} object(s) written to {out}")
     if report:
-        _report(lambda: plot_density_bands(res.windows, report, title="density from TLE decay"), report)
+        _report(lambda: report_density.plot_density_bands(res.windows, report, title="density from TLE decay"), report)
 
 
 @density.command("orbit")
@@ -260,10 +276,10 @@ def density_orbit(
     if gravity_degree < 2:
         raise click.BadParameter("must be >= 2", param_hint="--gravity-degree")
     known = mass_kg is not None and drag_area_m2 is not None
-    base = OrbitDensityConfig()
+    base = density_precise_orbit.OrbitDensityConfig()
     mass = mass_kg if mass_kg is not None else base.mass_kg
     area = drag_area_m2 if drag_area_m2 is not None else base.drag_area_m2
-    cfg = OrbitDensityConfig(
+    cfg = density_precise_orbit.OrbitDensityConfig(
         window_days=window_days,
         gravity_degree=gravity_degree,
         fit_srp=not no_srp_fit,
@@ -276,10 +292,10 @@ def density_orbit(
         srp_coefficient=srp_coefficient,
         spacecraft_known=known,
     )
-    run = orbit_density(
+    run = pipelines_density.orbit_density(
         list(paths), cfg, satellite=satellite, space_weather=space_weather, allow_truncated=allow_truncated
     )
-    write_table(run.windows, out)
+    pipelines_density.write_table(run.windows, out)
     for src, log in run.repairs.items():
         for kind, n in log.counts.items():
             click.echo(f"{src}: {kind}: {n}", err=True)
@@ -290,7 +306,9 @@ def density_orbit(
     ok = int((run.windows["status"] == "ok").sum()) if len(run.windows) else 0
     click.echo(f"{ok} window(s) of {len(paths)} file(s) written to {out}")
     if report:
-        _report(lambda: plot_density_bands(run.windows, report, title="density from precise orbits"), report)
+        _report(
+            lambda: report_density.plot_density_bands(run.windows, report, title="density from precise orbits"), report
+        )
 
 
 @density.command("meteors")
@@ -302,33 +320,30 @@ def density_meteors(radar: str, out: str, report: str | None) -> None:
 
     RADAR columns: meteor_id, altitude_km, velocity_mps, deceleration_mps2.
     """
-    res = estimate_density_ratios(read_radar_csv(radar))
-    write_table(res.ratios, out)
+    res = abrupt_density_meteors.estimate_density_ratios(abrupt_density_meteors.read_radar_csv(radar))
+    pipelines_density.write_table(res.ratios, out)
     click.echo(
         f"{len(res.ratios)} ratio(s) from {res.n_equations} equation(s), {len(res.d_s2_m2)} meteoroid(s); "
         f"residual RMS {res.residual_rms:.3f}; written to {out}"
     )
     if report:
-        _report(lambda: plot_meteor_profile(res.ratios, report), report)
+        _report(lambda: report_density.plot_meteor_profile(res.ratios, report), report)
 
 
 def _report(plot: Callable[[], object], path: str) -> None:
     """Write a report figure; a table with nothing to plot gets a note instead (the table is written)."""
     try:
         plot()
-    except NothingToPlot as exc:
+    except report_density.NothingToPlot as exc:
         click.echo(f"report {path} not written: {exc}", err=True)
         return
     click.echo(f"report: {path}")
 
 
-_REFUSED = re.compile(r": (\d+) window\(s\) refused: " + re.escape(IMPLAUSIBLE_STATUS))
-
-
 def _plausibility_line(no_signal: int, refused: int) -> str:
     return (
         f"{no_signal} object(s) skipped: no drag signal (density.drag_plausibility); "
-        f"{refused} window(s) refused: {IMPLAUSIBLE_STATUS}"
+        f"{refused} window(s) refused: {density_drag_plausibility.IMPLAUSIBLE_STATUS}"
     )
 
 
@@ -352,7 +367,7 @@ def _windows_only(
     if not out.lower().endswith((".parquet", ".csv")):
         raise click.BadParameter(f"{out!r} must end in .parquet or .csv", param_hint="--out")
     executor = Executor(workers=workers if workers > 1 else None, scheduler=scheduler)
-    cfg = TleDragConfig(
+    cfg = density_tle_drag.TleDragConfig(
         interval_days=interval_days,
         with_model=not no_model,
         maneuver_budget=maneuver_budget,
@@ -370,10 +385,10 @@ def _windows_only(
         "drag_object": cfg,
     }
     if maneuvers_from:
-        read_events(maneuvers_from)  # a bad file is refused here, before any task runs
-        settings["maneuvers_from"] = file_key(maneuvers_from)  # each worker reads the times once
+        events.read_events(maneuvers_from)  # a bad file is refused here, before any task runs
+        settings["maneuvers_from"] = pipelines_catalogue.file_key(maneuvers_from)  # each worker reads the times once
     click.echo(f"{len(files)} element file(s) on {executor.describe()}", err=True)
-    run = run_catalogue(
+    run = pipelines_catalogue.run_catalogue(
         files,
         "density",
         settings,
@@ -388,7 +403,8 @@ def _windows_only(
     for line in run.skipped[:20]:
         click.echo(f"skipped: {line}", err=True)
     no_signal = sum(1 for line in run.skipped if "skipped: no drag signal" in line)
-    refused = sum(int(m.group(1)) for m in (_REFUSED.search(line) for line in run.skipped) if m)
+    pattern = re.compile(r": (\d+) window\(s\) refused: " + re.escape(density_drag_plausibility.IMPLAUSIBLE_STATUS))
+    refused = sum(int(m.group(1)) for m in (pattern.search(line) for line in run.skipped) if m)
     resumed = f" (files run now; {run.n_resumed} resumed file(s) not counted)" if run.n_resumed else ""
     click.echo(_plausibility_line(no_signal, refused) + resumed, err=True)
     click.echo(f"{run.rows} window(s) of {run.n_files} file(s) written to {out}")

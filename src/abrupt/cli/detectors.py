@@ -2,10 +2,17 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import click
 
+from abrupt.cli.commands import lazy_module
 from abrupt.cli.groups import cli
-from abrupt.detect.base import detector_names, get_detector
+
+if TYPE_CHECKING:
+    from abrupt.detect import base as detect_base
+else:
+    detect_base = lazy_module("abrupt.detect.base")
 
 
 @cli.command("detectors")
@@ -15,6 +22,6 @@ def list_detectors(capability: str | None) -> None:
 
     A detector is found by this name by `abrupt detect ... --detector NAME`.
     """
-    for name in detector_names(capability):
-        cls = get_detector(name)
+    for name in detect_base.detector_names(capability):
+        cls = detect_base.get_detector(name)
         click.echo(f"{name:28s} {cls.kind:12s} {cls.series_type.__name__:16s} {cls.summary}")

@@ -3,18 +3,26 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
+from abrupt.cli.commands import lazy_module
 from abrupt.cli.groups import catalog_option, check_suffix, detect, note, progress_hidden, record_run, warn
 from abrupt.cli.options import budget_options, pop_budget
-from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
 from abrupt.errors import InputError
-from abrupt.events import config_hash, empty_frame, normalise_frame, write_events
-from abrupt.pipelines.catalogue import read_table, remove_parts, run_catalogue
-from abrupt.pipelines.fleet import detect_attitude_fleet, read_manifest
 from abrupt.scale import Executor
+
+if TYPE_CHECKING:
+    from abrupt import events as abrupt_events
+    from abrupt.detect.attitude import momentum as detect_attitude_momentum
+    from abrupt.pipelines import catalogue as pipelines_catalogue
+    from abrupt.pipelines import fleet as pipelines_fleet
+else:
+    detect_attitude_momentum = lazy_module("abrupt.detect.attitude.momentum")
+    abrupt_events = lazy_module("abrupt.events")
+    pipelines_catalogue = lazy_module("abrupt.pipelines.catalogue")
+    pipelines_fleet = lazy_module("abrupt.pipelines.fleet")
 
 executor_options = [
     click.option(
@@ -87,13 +95,13 @@ def detect_fleet_cmd(
     again with the same inputs and settings. The budget is per spacecraft.
     """
     budget = pop_budget(budget_args, "1/day")
-    members = read_manifest(manifest)
+    members = pipelines_fleet.read_manifest(manifest)
     executor = executor_from(workers, scheduler)
-    config = AttitudeDetectionConfig(
+    config = detect_attitude_momentum.AttitudeDetectionConfig(
         detectors=tuple(dict.fromkeys(detectors)), budget=budget, null_samples=null_samples
     )
     note(f"{len(members)} task(s) (spacecraft, file) on {executor.describe()}")
-    result = detect_attitude_fleet(
+    result = pipelines_fleet.detect_attitude_fleet(
         members,
         config,
         catalog=catalog_target,
@@ -107,7 +115,7 @@ def detect_fleet_cmd(
     for w in result.warnings:
         warn(w)
     Path(out).parent.mkdir(parents=True, exist_ok=True)
-    write_events(result.events, out)
+    abrupt_events.write_events(result.events, out)
     resumed = f" ({result.n_resumed} finished earlier, resumed)" if result.n_resumed else ""
     note(f"{len(result.events)} event(s) from {result.n_tasks} task(s){resumed}; run {result.run_id}; written to {out}")
 
@@ -192,7 +200,7 @@ def detect_tle_batch_cmd(
     files = gather_paths(paths, paths_from)
     settings = {"budget": str(budget), "detector": "auto", "budget_object": budget}
     note(f"{len(files)} TLE/OMM file(s) on {executor.describe()}")
-    run = run_catalogue(
+    run = pipelines_catalogue.run_catalogue(
         files,
         "maneuvers",
         settings,
@@ -206,17 +214,17 @@ def detect_tle_batch_cmd(
         note(f"{run.n_resumed} of {run.n_files} file(s) finished earlier, resumed")
     for line in run.skipped[:20]:
         note(f"skipped: {line}")
-    events = read_table(out)
-    events = normalise_frame(events) if len(events) else empty_frame()
+    events = pipelines_catalogue.read_table(out)
+    events = abrupt_events.normalise_frame(events) if len(events) else abrupt_events.empty_frame()
     events = events.sort_values(["spacecraft", "time_utc", "detector"]).reset_index(drop=True)
     record_run(
         catalog_target=catalog_target,
         command="detect tle-batch " + (f"--paths-from {paths_from} " if paths_from else "") + " ".join(paths),
         events=events,
-        config_hash=config_hash({"budget": str(budget), "detector": "auto"}),
+        config_hash=abrupt_events.config_hash({"budget": str(budget), "detector": "auto"}),
         run_id=run.run_id,
         out=out,
         details={"files": len(files), "budget": str(budget), "resumed_files": run.n_resumed},
     )
     if not keep_parts:
-        remove_parts(run.parts)
+        pipelines_catalogue.remove_parts(run.parts)

@@ -8,35 +8,47 @@ import os
 import tomllib
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
-import numpy as np
 
 from abrupt import progress
+from abrupt.cli.commands import lazy_module
 from abrupt.cli.flight_orbit import orbit_input
 from abrupt.cli.flux import store_run_exposure
 from abrupt.cli.groups import cli, inject, record_run, simulate
 from abrupt.cli.options import budget_options, pop_budget
-from abrupt.detect.attitude.flight_glr import FlightGlrDetector
 from abrupt.errors import InputError
-from abrupt.events import write_events
-from abrupt.model.spacecraft import load_spacecraft
-from abrupt.pipelines.flight import CleaningConfig, FlightRunConfig, day_range, ingest_archives, run_flight
-from abrupt.pipelines.flight_injection import injection_recovery
-from abrupt.pipelines.flight_orbit import run_flight_with_orbit
-from abrupt.readers.archive import pseudonymise_text, read_decoder
-from abrupt.report.flight import write_flight_report
-from abrupt.simulate.confounders import (
-    CONFOUNDER_KINDS,
-    Confounder,
-    ConfounderRanges,
-    draw_confounders,
-    inject_confounders,
-)
-from abrupt.simulate.injection import InjectedStrike, inject_strikes
-from abrupt.store import TelemetryStore
-from abrupt.thresholds import FalseAlarmBudget
+from abrupt.simulate.confounder_kinds import CONFOUNDER_KINDS
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from abrupt import events, thresholds
+    from abrupt import store as abrupt_store
+    from abrupt.detect.attitude import flight_glr as detect_attitude_flight_glr
+    from abrupt.model import spacecraft as model_spacecraft
+    from abrupt.pipelines import flight as pipelines_flight
+    from abrupt.pipelines import flight_injection as pipelines_flight_injection
+    from abrupt.pipelines import flight_orbit as pipelines_flight_orbit
+    from abrupt.readers import archive as readers_archive
+    from abrupt.report import flight as report_flight
+    from abrupt.simulate import confounders as simulate_confounders
+    from abrupt.simulate import injection as simulate_injection
+else:
+    detect_attitude_flight_glr = lazy_module("abrupt.detect.attitude.flight_glr")
+    events = lazy_module("abrupt.events")
+    model_spacecraft = lazy_module("abrupt.model.spacecraft")
+    pipelines_flight = lazy_module("abrupt.pipelines.flight")
+    pipelines_flight_injection = lazy_module("abrupt.pipelines.flight_injection")
+    pipelines_flight_orbit = lazy_module("abrupt.pipelines.flight_orbit")
+    readers_archive = lazy_module("abrupt.readers.archive")
+    report_flight = lazy_module("abrupt.report.flight")
+    simulate_confounders = lazy_module("abrupt.simulate.confounders")
+    simulate_injection = lazy_module("abrupt.simulate.injection")
+    abrupt_store = lazy_module("abrupt.store")
+    thresholds = lazy_module("abrupt.thresholds")
+    np = lazy_module("numpy")
 
 
 def _progress(total: int, label: str, unit: str = "day") -> Any:
@@ -53,7 +65,13 @@ def _progress(total: int, label: str, unit: str = "day") -> Any:
     help="Pseudonym decoder CSV (real_name,pseudonym); read here only, never downstream.",
 )
 @click.option("--store", "store_dir", required=True, type=click.Path(file_okay=False), help="Parquet store directory.")
-@click.option("--layout", type=click.Choice(["auto", "long", "wide"]), default="auto", show_default=True)
+@click.option(
+    "--layout",
+    type=click.Choice(["auto", "long", "wide"]),
+    default="auto",
+    show_default=True,
+    help="Archive layout: long (time, name, value rows), wide (one column per mnemonic), auto (from the header).",
+)
 @click.option("--assume-utc", is_flag=True, help="Read times without a zone as UTC (counted in the report).")
 @click.option(
     "--spacecraft",
@@ -71,14 +89,14 @@ def ingest_cmd(
     spacecraft_path: str | None,
 ) -> None:
     """Ingest archive dumps (long or wide; CSV, CSV.gz, Parquet) into a pseudonymised store, one report per day."""
-    decoder = read_decoder(decoder_path)
-    spacecraft = load_spacecraft(spacecraft_path) if spacecraft_path else None
+    decoder = readers_archive.read_decoder(decoder_path)
+    spacecraft = model_spacecraft.load_spacecraft(spacecraft_path) if spacecraft_path else None
     for archive in archives:  # click's own message would print the real name
         if not Path(archive).is_file() or not os.access(archive, os.R_OK):
             why = "is not a readable file" if Path(archive).exists() else "does not exist"
-            raise InputError(f"archive {why}", file=pseudonymise_text(archive, decoder))
+            raise InputError(f"archive {why}", file=readers_archive.pseudonymise_text(archive, decoder))
     bar = _progress(len(archives), "ingest", "file")
-    summary = ingest_archives(
+    summary = pipelines_flight.ingest_archives(
         archives,
         decoder_path,
         store_dir,
@@ -102,9 +120,9 @@ def ingest_cmd(
 
 
 def _cleaning(no_clean: tuple[str, ...]) -> Any:
-    c = CleaningConfig()
+    c = pipelines_flight.CleaningConfig()
     if "all" in no_clean:
-        return CleaningConfig.off()
+        return pipelines_flight.CleaningConfig.off()
     off: dict[str, Any] = {name.replace("-", "_"): False for name in no_clean}
     return replace(c, **off)
 
@@ -116,7 +134,7 @@ def detect_from_store(
     store_dir: str,
     spacecraft_path: str,
     days: tuple[str, ...],
-    budget: FalseAlarmBudget,
+    budget: thresholds.FalseAlarmBudget,
     no_clean: tuple[str, ...],
     catalog_target: str | None,
     out: str | None,
@@ -129,10 +147,10 @@ def detect_from_store(
     (and, with ``exposure`` options and a catalog, the run's exposure rows: :func:`store_run_exposure`);
     ``orbit``: the orbit events file, ΔV floor [m/s], spans, edge [s] and run id of an orbit run
     (:mod:`abrupt.cli.flight_orbit`)."""
-    sc = load_spacecraft(spacecraft_path)
+    sc = model_spacecraft.load_spacecraft(spacecraft_path)
     orbit_in = orbit_input(*orbit, spacecraft=sc.name, catalog_target=catalog_target)
-    cfg = FlightRunConfig(budget=budget, cleaning=_cleaning(no_clean))
-    day_list = day_range(TelemetryStore(store_dir), sc.name, days or None)
+    cfg = pipelines_flight.FlightRunConfig(budget=budget, cleaning=_cleaning(no_clean))
+    day_list = pipelines_flight.day_range(abrupt_store.TelemetryStore(store_dir), sc.name, days or None)
     bar = _progress(len(day_list), "detect")
     seen: set[str] = set()
 
@@ -142,10 +160,12 @@ def detect_from_store(
             bar.update(1)
 
     keep = report_path is not None
-    result = run_flight_with_orbit(store_dir, sc, orbit_in, cfg, days=day_list, keep_series=keep, progress=tick)
+    result = pipelines_flight_orbit.run_flight_with_orbit(
+        store_dir, sc, orbit_in, cfg, days=day_list, keep_series=keep, progress=tick
+    )
     bar.close()
     if out:
-        write_events(result.events, out)
+        events.write_events(result.events, out)
     if catalog_target:
         record_run(
             catalog_target=catalog_target,
@@ -161,7 +181,7 @@ def detect_from_store(
                 "daily": result.daily.to_dict("records"),
             },
             spacecraft=sc.name,
-            detectors=[FlightGlrDetector.name],
+            detectors=[detect_attitude_flight_glr.FlightGlrDetector.name],
             span_utc=(f"{day_list[0]}T00:00:00", f"{day_list[-1]}T23:59:59.999999") if day_list else None,
         )
         if exposure and (exposure.get("recovery") or exposure.get("dh90")):
@@ -170,7 +190,7 @@ def detect_from_store(
                 result.daily,
                 sc,
                 false_alarms_per_day=result.threshold.false_alarms_per_day,
-                detector=FlightGlrDetector.name,
+                detector=detect_attitude_flight_glr.FlightGlrDetector.name,
                 config_hash=result.config_hash,
                 run_id=result.run_id,
                 recovery=exposure.get("recovery"),
@@ -188,13 +208,25 @@ def detect_from_store(
     if daily_path:
         result.daily.to_csv(daily_path, index=False)
     if report_path:
-        write_flight_report(report_path, result)
+        report_flight.write_flight_report(report_path, result)
         click.echo(f"report: {report_path}", err=True)
 
 
 @inject.command("attitude")
-@click.option("--store", "store_dir", required=True, type=click.Path(exists=True, file_okay=False))
-@click.option("--spacecraft", "spacecraft_path", required=True, type=click.Path(exists=True, dir_okay=False))
+@click.option(
+    "--store",
+    "store_dir",
+    required=True,
+    type=click.Path(exists=True, file_okay=False),
+    help="The store written by `abrupt ingest` whose days get strikes.",
+)
+@click.option(
+    "--spacecraft",
+    "spacecraft_path",
+    required=True,
+    type=click.Path(exists=True, dir_okay=False),
+    help="Spacecraft TOML of the stored spacecraft (its name is the store's pseudonym).",
+)
 @click.option(
     "--out-store",
     default=None,
@@ -223,7 +255,7 @@ def detect_from_store(
 @click.option("--recovery", is_flag=True, help="Injection-recovery study: 90%-detectable ΔH per day.")
 @click.option("--days", multiple=True, help="Days (YYYY-MM-DD or A..B); default all stored days.")
 @budget_options()
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--seed", type=int, default=0, show_default=True, help="Random seed (reproducible).")
 @click.option("--out", default=None, type=click.Path(dir_okay=False), help="Recovery table (.csv).")
 def inject_attitude_cmd(
     store_dir: str,
@@ -241,8 +273,8 @@ def inject_attitude_cmd(
 ) -> None:
     """Add synthetic strikes and confounders to stored telemetry (Harris et al. 2025 §3.5), or measure
     detectable ΔH per day."""
-    sc = load_spacecraft(spacecraft_path)
-    store = TelemetryStore(store_dir)
+    sc = model_spacecraft.load_spacecraft(spacecraft_path)
+    store = abrupt_store.TelemetryStore(store_dir)
     conf_list = _confounders(sc, confounders, confounders_file, confounder_ranges, seed)
     if strikes or conf_list:
         if not out_store:
@@ -257,11 +289,13 @@ def inject_attitude_cmd(
                 t_ns = int(np.datetime64(t_text.rstrip("Z"), "ns").astype(np.int64))
             except ValueError:
                 raise InputError(f"--strike {text!r}: expected TIME_UTC:DHX,DHY,DHZ") from None
-            parsed.append(InjectedStrike(t_ns, vec))
-        dst = TelemetryStore(out_store)
-        for day in day_range(store, sc.name, days or None):
+            parsed.append(simulate_injection.InjectedStrike(t_ns, vec))
+        dst = abrupt_store.TelemetryStore(out_store)
+        for day in pipelines_flight.day_range(store, sc.name, days or None):
             frame = store.read_day(sc.name, day)
-            frame = inject_strikes(inject_confounders(frame, sc, conf_list, seed=seed), sc, parsed, seed=seed)
+            frame = simulate_injection.inject_strikes(
+                simulate_confounders.inject_confounders(frame, sc, conf_list, seed=seed), sc, parsed, seed=seed
+            )
             frame["time"] = frame["time"].dt.tz_localize("UTC")
             report = store.report(sc.name, day)
             report["injected_strikes"] = [
@@ -275,9 +309,11 @@ def inject_attitude_cmd(
             dst.write_day(sc.name, day, frame, report)
         click.echo(f"{len(parsed)} strike(s), {len(conf_list)} confounder(s) injected; store written to {out_store}")
     if recovery:
-        cfg = FlightRunConfig(budget=pop_budget(budget))
-        base = run_flight(store_dir, sc, cfg, days=days or None)
-        rec = injection_recovery(store_dir, sc, cfg, base.threshold, days=days or None, seed=seed)
+        cfg = pipelines_flight.FlightRunConfig(budget=pop_budget(budget))
+        base = pipelines_flight.run_flight(store_dir, sc, cfg, days=days or None)
+        rec = pipelines_flight_injection.injection_recovery(
+            store_dir, sc, cfg, base.threshold, days=days or None, seed=seed
+        )
         click.echo(rec.per_day.to_string(index=False))
         if out:
             rec.per_day.to_csv(out, index=False)
@@ -286,15 +322,15 @@ def inject_attitude_cmd(
         raise click.UsageError("give --strike/--confounder ... --out-store DIR, or --recovery")
 
 
-def _confounder_json(c: Confounder) -> dict[str, Any]:
+def _confounder_json(c: simulate_confounders.Confounder) -> dict[str, Any]:
     return {"kind": c.kind, "time_utc": str(np.datetime64(c.time_ns, "ns")) + "Z", "channel": c.channel,
             "expected_class": c.expected_class, "params": dict(c.params)}  # fmt: skip
 
 
-def _ranges(path: str | None) -> ConfounderRanges:
+def _ranges(path: str | None) -> simulate_confounders.ConfounderRanges:
     if path is None:
-        return ConfounderRanges()
-    return ConfounderRanges.from_mapping(tomllib.loads(Path(path).read_text()))
+        return simulate_confounders.ConfounderRanges()
+    return simulate_confounders.ConfounderRanges.from_mapping(tomllib.loads(Path(path).read_text()))
 
 
 def _parse_time(text: str, what: str) -> int:
@@ -306,7 +342,7 @@ def _parse_time(text: str, what: str) -> int:
 
 def _confounders(
     sc: Any, specs: tuple[str, ...], file: str | None, ranges_path: str | None, seed: int
-) -> list[Confounder]:
+) -> list[simulate_confounders.Confounder]:
     """Confounders from KIND@TIME specs (parameters drawn) and from a JSON file (parameters given)."""
     kinds, times = [], []
     for text in specs:
@@ -317,13 +353,13 @@ def _confounders(
             )
         kinds.append(kind)
         times.append(_parse_time(t_text, "--confounder"))
-    out = draw_confounders(kinds, times, sc, _ranges(ranges_path), seed=seed)
+    out = simulate_confounders.draw_confounders(kinds, times, sc, _ranges(ranges_path), seed=seed)
     if file:
         for i, d in enumerate(json.loads(Path(file).read_text())):
             if d.get("kind") not in CONFOUNDER_KINDS:
                 raise InputError(f"confounder {i}: unknown kind {d.get('kind')!r}", file=file)
             out.append(
-                Confounder(
+                simulate_confounders.Confounder(
                     d["kind"], _parse_time(d["time_utc"], f"{file}: confounder {i}"), d.get("channel", ""), d["params"]
                 )
             )
@@ -331,7 +367,13 @@ def _confounders(
 
 
 @simulate.command("confounders")
-@click.option("--spacecraft", "spacecraft_path", required=True, type=click.Path(exists=True, dir_okay=False))
+@click.option(
+    "--spacecraft",
+    "spacecraft_path",
+    required=True,
+    type=click.Path(exists=True, dir_okay=False),
+    help="Spacecraft TOML (wheels, appendages) the confounders act on.",
+)
 @click.option("--confounder", "specs", multiple=True, help="KIND@TIME_UTC; repeatable.")
 @click.option(
     "--random", "n_random", type=int, default=0, help="This many more, kinds cycled, times uniform in --span."
@@ -340,7 +382,7 @@ def _confounders(
 @click.option("--confounder-ranges", default=None, type=click.Path(exists=True, dir_okay=False),
               help="TOML of parameter ranges, name = [low, high].")  # fmt: skip
 @click.option("--show-ranges", is_flag=True, help="Print the ranges in use (TOML) and exit.")
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--seed", type=int, default=0, show_default=True, help="Random seed (reproducible).")
 @click.option("--out", default=None, type=click.Path(dir_okay=False), help="Confounders with parameters (.json).")
 def simulate_confounders_cmd(
     spacecraft_path: str,
@@ -361,7 +403,7 @@ def simulate_confounders_cmd(
         for k, (lo, hi) in ranges.as_dict().items():
             click.echo(f"{k} = [{lo:g}, {hi:g}]")
         return
-    sc = load_spacecraft(spacecraft_path)
+    sc = model_spacecraft.load_spacecraft(spacecraft_path)
     specs = tuple(specs)
     if n_random:
         if span is None:
@@ -383,4 +425,4 @@ def simulate_confounders_cmd(
 
 def ingest_report_json(store_dir: str, spacecraft: str, day: str) -> str:
     """The ingest report of one stored day, as JSON text."""
-    return json.dumps(TelemetryStore(store_dir).report(spacecraft, day), indent=1)
+    return json.dumps(abrupt_store.TelemetryStore(store_dir).report(spacecraft, day), indent=1)

@@ -3,11 +3,16 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
-from abrupt.pipelines.flight_orbit import CLI_NAMES, OrbitInput, OrbitSource, load_orbit_input
+from abrupt.cli.commands import lazy_module
+
+if TYPE_CHECKING:
+    from abrupt.pipelines import flight_orbit as pipelines_flight_orbit
+else:
+    pipelines_flight_orbit = lazy_module("abrupt.pipelines.flight_orbit")
 
 
 def orbit_evidence_options(f: Any) -> Any:
@@ -63,7 +68,7 @@ def orbit_input(
     *,
     spacecraft: str,
     catalog_target: str | None,
-) -> OrbitInput | None:
+) -> pipelines_flight_orbit.OrbitInput | None:
     """The orbit input of the options (None without ``--orbit-events``); a one-line error for a bad one (a
     repair is in its notes, which the run's warnings print). The span and the floor not given come from the
     orbit run's record in the catalog."""
@@ -71,5 +76,5 @@ def orbit_input(
         if floor_mps is not None or spans or run_id is not None:
             raise click.UsageError("--orbit-floor-mps, --orbit-span and --orbit-run need --orbit-events")
         return None
-    source = OrbitSource(orbit_events, floor_mps, spans, edge_s, run_id, catalog_target)
-    return load_orbit_input(source, spacecraft, CLI_NAMES)
+    source = pipelines_flight_orbit.OrbitSource(orbit_events, floor_mps, spans, edge_s, run_id, catalog_target)
+    return pipelines_flight_orbit.load_orbit_input(source, spacecraft, pipelines_flight_orbit.CLI_NAMES)

@@ -6,36 +6,36 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
-import pandas as pd
 
-from abrupt.catalog import Catalog
+from abrupt.cli.commands import lazy_module
 from abrupt.cli.groups import DEFAULT_CATALOG, cli, note, simulate
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.errors import ConfigError
-from abrupt.flux.exposure import (
-    EfficiencyCurve,
-    day_range,
-    efficiency_per_day,
-    exposure_frame,
-    read_day_table,
-    store_exposure,
-    store_spacecraft_model,
-)
-from abrupt.flux.forward import MODEL_MASS_LAW, ForwardConfig
-from abrupt.flux.inference import PARAMS, FitResult
-from abrupt.model.spacecraft import Spacecraft
-from abrupt.pipelines.flux import (
-    LIMIT_THRESHOLDS_NMS,
-    covered_days,
-    flight_exposure,
-    infer_flux,
-    simulate_population,
-)
-from abrupt.report.flux import write_flux_report
-from abrupt.simulate.population import DETECTOR, FleetSpec
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from abrupt import catalog
+    from abrupt.flux import exposure as flux_exposure
+    from abrupt.flux import forward as flux_forward
+    from abrupt.flux import inference as flux_inference
+    from abrupt.model import spacecraft as model_spacecraft
+    from abrupt.pipelines import flux as pipelines_flux
+    from abrupt.report import flux as report_flux
+    from abrupt.simulate import population as abrupt_simulate_population
+else:
+    catalog = lazy_module("abrupt.catalog")
+    flux_exposure = lazy_module("abrupt.flux.exposure")
+    flux_forward = lazy_module("abrupt.flux.forward")
+    flux_inference = lazy_module("abrupt.flux.inference")
+    model_spacecraft = lazy_module("abrupt.model.spacecraft")
+    pipelines_flux = lazy_module("abrupt.pipelines.flux")
+    report_flux = lazy_module("abrupt.report.flux")
+    abrupt_simulate_population = lazy_module("abrupt.simulate.population")
+    pd = lazy_module("pandas")
 
 
 @cli.group()
@@ -48,7 +48,7 @@ def _model_options(f: Any) -> Any:
     f = click.option("--meteoroid-model", default="grun", show_default=True, help="grun or a flux-table .toml.")(f)
     f = click.option(
         "--mass-model",
-        default=MODEL_MASS_LAW,
+        default="model",  # abrupt.flux.forward.MODEL_MASS_LAW, named here without importing the model
         show_default=True,
         help="Size-to-mass law: 'model' = each flux model's own (NASA-90/91 density law, Grün 2.5 g/cm³, a "
         "table's density classes), or one law of `abrupt rates` for both populations.",
@@ -59,8 +59,8 @@ def _model_options(f: Any) -> Any:
     return f
 
 
-def _config(o: dict[str, Any]) -> ForwardConfig:
-    return ForwardConfig(
+def _config(o: dict[str, Any]) -> flux_forward.ForwardConfig:
+    return flux_forward.ForwardConfig(
         debris_model=o.pop("debris_model"),
         meteoroid_model=o.pop("meteoroid_model"),
         mass_model=o.pop("mass_model"),
@@ -72,8 +72,8 @@ def _parse_fix(items: tuple[str, ...]) -> dict[str, float]:
     out = {}
     for item in items:
         name, _, value = item.partition("=")
-        if name not in PARAMS or not value:
-            raise ConfigError(f"--fix {item!r}: use NAME=VALUE with NAME in {list(PARAMS)}", key="fix")
+        if name not in flux_inference.PARAMS or not value:
+            raise ConfigError(f"--fix {item!r}: use NAME=VALUE with NAME in {list(flux_inference.PARAMS)}", key="fix")
         try:
             out[name] = float(value)
         except ValueError:
@@ -83,7 +83,9 @@ def _parse_fix(items: tuple[str, ...]) -> dict[str, float]:
     return out
 
 
-def _estimates_text(f: FitResult, estimates: dict[str, float], intervals: dict[str, tuple[float, float]]) -> str:
+def _estimates_text(
+    f: flux_inference.FitResult, estimates: dict[str, float], intervals: dict[str, tuple[float, float]]
+) -> str:
     parts = []
     for p, v in estimates.items():
         lo, hi = intervals.get(p, (v, v))
@@ -93,7 +95,7 @@ def _estimates_text(f: FitResult, estimates: dict[str, float], intervals: dict[s
     return ", ".join(parts)
 
 
-def _fit_lines(name: str, f: FitResult) -> list[str]:
+def _fit_lines(name: str, f: flux_inference.FitResult) -> list[str]:
     """The printed lines of one fit: the reported estimates first (with β known the linear ones with their
     standard errors and score intervals, then the maximum-likelihood ones as a diagnostic)."""
     size = f"  ({f.n_events} events, {f.n_days} spacecraft-days)"
@@ -180,9 +182,9 @@ def infer(
     """Fit flux scales and β to a catalog's strikes and exposure; intervals, upper limits, goodness of fit."""
     if any(not (math.isfinite(x) and x >= 0) for x in limit_dh):
         raise click.BadParameter(f"{limit_dh}: thresholds must be finite and >= 0 N·m·s", param_hint="--limit-dH")
-    cat = Catalog(catalog_target, create=False)
+    cat = catalog.Catalog(catalog_target, create=False)
     note("building forward-model templates and fitting ...")
-    result = infer_flux(
+    result = pipelines_flux.infer_flux(
         cat,
         spacecraft=spacecraft,
         config=_config(model),
@@ -190,7 +192,7 @@ def infer(
         confidence=confidence,
         use_direction=not no_direction,
         reference_beta=reference_beta,
-        limit_dH_Nms=limit_dh or LIMIT_THRESHOLDS_NMS,
+        limit_dH_Nms=limit_dh or pipelines_flux.LIMIT_THRESHOLDS_NMS,
     )
     for name, f in result.fits.items():
         for line in _fit_lines(name, f):
@@ -215,7 +217,7 @@ def infer(
         Path(out_path).write_text(json.dumps(result.as_dict(), indent=1, default=float))
         note(f"wrote {out_path}")
     if report_path:
-        write_flux_report(report_path, result)
+        report_flux.write_flux_report(report_path, result)
         note(f"wrote {report_path}")
 
 
@@ -278,7 +280,7 @@ def exposure_command(
     covered. The false-alarm budget is the one the detection threshold was set for (``--false-alarms``, or a
     false_alarms_per_day column); it must be stated, since the inference subtracts it as background.
     """
-    table = read_day_table(day_table) if day_table else None
+    table = flux_exposure.read_day_table(day_table) if day_table else None
     given = [
         name
         for name, v in (("--days", days), ("--from/--to", first_day or last_day), ("--table", table))
@@ -288,13 +290,13 @@ def exposure_command(
         raise click.UsageError(f"give the days one way: {' or '.join(given)}")
     if (first_day is None) != (last_day is None):
         raise click.UsageError("a day range needs both --from and --to")
-    cat = Catalog(catalog_target, create=False)
+    cat = catalog.Catalog(catalog_target, create=False)
     if table is not None:
         days = tuple(table["day"])
     elif first_day and last_day:
-        days = tuple(day_range(first_day, last_day))
+        days = tuple(flux_exposure.day_range(first_day, last_day))
     if not days:
-        days = covered_days(cat, spacecraft)
+        days = pipelines_flux.covered_days(cat, spacecraft)
     if not days:
         raise click.UsageError(
             f"no days found for {spacecraft} in {catalog_target}; give --days, --from/--to or --table"
@@ -302,9 +304,9 @@ def exposure_command(
     per_day = table.set_index("day") if table is not None else pd.DataFrame(index=pd.Index(list(days), name="day"))
     has_curve = "dH50_Nms" in per_day.columns and per_day["dH50_Nms"].notna().all()
     if recovery_csv:
-        curves = efficiency_per_day(pd.read_csv(recovery_csv), days, source=recovery_csv)
+        curves = flux_exposure.efficiency_per_day(pd.read_csv(recovery_csv), days, source=recovery_csv)
     elif dh90:
-        curves = dict.fromkeys(days, EfficiencyCurve.from_dH90(dh90, slope))
+        curves = dict.fromkeys(days, flux_exposure.EfficiencyCurve.from_dH90(dh90, slope))
     elif has_curve:
         curves = {}
     else:
@@ -347,9 +349,9 @@ def exposure_command(
             if record[column] is None or (isinstance(record[column], float) and math.isnan(record[column])):
                 raise click.UsageError(f"day {d}: no {column}; give {option} or a {column} column in --table")
         records.append(record)
-    model = store_spacecraft_model(cat, spacecraft, spacecraft_file)  # rows name it by the pseudonym
-    rows = exposure_frame([r | {"spacecraft_file": model} for r in records])
-    n = store_exposure(cat, rows)
+    model = flux_exposure.store_spacecraft_model(cat, spacecraft, spacecraft_file)  # rows name it by the pseudonym
+    rows = flux_exposure.exposure_frame([r | {"spacecraft_file": model} for r in records])
+    n = flux_exposure.store_exposure(cat, rows)
     for r in rows.to_dict("records"):
         click.echo(
             f"{spacecraft} {r['day']}: analysed {r['analysed_fraction']:.3g}, x50 {r['dH50_Nms']:.4g} N·m·s, slope "
@@ -399,8 +401,8 @@ def population(
 ) -> None:
     """Draw a fleet's detected strikes from a flux truth; store events and exposure in a catalog."""
     false_alarms_per_day = pop_budget(model, "0.01/day").per_day
-    curve = EfficiencyCurve.from_dH90(dh90, slope)
-    spec = FleetSpec(
+    curve = flux_exposure.EfficiencyCurve.from_dH90(dh90, slope)
+    spec = abrupt_simulate_population.FleetSpec(
         str(Path(spacecraft_file).resolve()),
         n_spacecraft=n_spacecraft,
         years=years,
@@ -413,12 +415,14 @@ def population(
         analysed_fraction=analysed_fraction,
     )
     truth = {"debris_scale": debris_scale, "meteoroid_scale": meteoroid_scale, "beta": beta}
-    cat = Catalog(catalog_target)
-    events, exposure = simulate_population(cat, spec, truth, config=_config(model), seed=seed, dH_rel_sigma=dh_error)
+    cat = catalog.Catalog(catalog_target)
+    events, exposure = pipelines_flux.simulate_population(
+        cat, spec, truth, config=_config(model), seed=seed, dH_rel_sigma=dh_error
+    )
     counts = events["source"].value_counts().to_dict() if len(events) else {}
     click.echo(
         f"{len(events)} detected events ({counts}) on {len(exposure)} spacecraft-days; "
-        f"detector {DETECTOR}; catalog {cat.name}"
+        f"detector {abrupt_simulate_population.DETECTOR}; catalog {cat.name}"
     )
     if out_path:
         events.to_csv(out_path, index=False)
@@ -454,7 +458,7 @@ def exposure_options(f: Any) -> Any:
 def store_run_exposure(
     catalog_target: str,
     daily: pd.DataFrame,
-    spacecraft: Spacecraft,
+    spacecraft: model_spacecraft.Spacecraft,
     *,
     false_alarms_per_day: float,
     detector: str,
@@ -467,13 +471,13 @@ def store_run_exposure(
     """Store a detection run's exposure rows (one per analysed day) in its catalog; returns the row count."""
     days = [str(d) for d in daily["day"]]
     if recovery:
-        curves = efficiency_per_day(pd.read_csv(recovery), days, source=recovery)
+        curves = flux_exposure.efficiency_per_day(pd.read_csv(recovery), days, source=recovery)
     elif dh90:
-        curves = dict.fromkeys(days, EfficiencyCurve.from_dH90(dh90))
+        curves = dict.fromkeys(days, flux_exposure.EfficiencyCurve.from_dH90(dh90))
     else:
         raise click.UsageError("give --exposure-recovery CSV or --exposure-dH90 to store exposure")
-    rows = flight_exposure(
-        Catalog(catalog_target, create=False),
+    rows = pipelines_flux.flight_exposure(
+        catalog.Catalog(catalog_target, create=False),
         daily,
         spacecraft=spacecraft,
         curves=curves,

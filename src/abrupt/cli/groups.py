@@ -14,14 +14,29 @@ import logging
 import sys
 from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import click
 
 from abrupt import progress as progress_report
-from abrupt.catalog import Catalog, coverage_of
-from abrupt.cli.commands import GLOBAL_FLAGS, State, cli, detect, hoist_global_flags, inject, report, simulate
-from abrupt.events import write_events
+from abrupt.cli.commands import (
+    GLOBAL_FLAGS,
+    State,
+    cli,
+    detect,
+    hoist_global_flags,
+    inject,
+    lazy_module,
+    report,
+    simulate,
+)
+
+if TYPE_CHECKING:
+    from abrupt import catalog as abrupt_catalog
+    from abrupt import events as abrupt_events
+else:
+    abrupt_catalog = lazy_module("abrupt.catalog")
+    abrupt_events = lazy_module("abrupt.events")
 
 __all__ = [
     "DEFAULT_CATALOG",
@@ -180,11 +195,11 @@ def record_run(
     Returns the number of events that were new to the catalog.
     """
     details = {**(details or {}), **command_options()}
-    catalog = Catalog(catalog_target)  # open (and check) the catalog before writing anything
+    catalog = abrupt_catalog.Catalog(catalog_target)  # open (and check) the catalog before writing anything
     catalog.check_fits(events)  # texts too long for the catalog: refused before the file is written
     if out is not None:  # then the file: a bad path must not leave events in the catalog only
         Path(out).parent.mkdir(parents=True, exist_ok=True)
-        write_events(events, str(out))
+        abrupt_events.write_events(events, str(out))
     catalog.start_run(
         run_id,
         command,
@@ -193,7 +208,7 @@ def record_run(
         details=details,
     )
     added = catalog.store_events(events)
-    coverage = coverage_of(
+    coverage = abrupt_catalog.coverage_of(
         events,
         config_hash=config_hash,
         spacecraft=spacecraft,

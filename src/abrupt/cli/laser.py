@@ -5,14 +5,21 @@ from __future__ import annotations
 import json
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
+from abrupt.cli.commands import lazy_module
 from abrupt.cli.groups import catalog_option, detect, record_run
 from abrupt.cli.options import budget_options, pop_budget
-from abrupt.model.range_reduction import RANGE_MODEL_TERMS, RangeModel
-from abrupt.pipelines.laser_ranging import LASER_FORCE, run_laser_ranging_files
+from abrupt.model.range_terms import RANGE_MODEL_TERMS
+
+if TYPE_CHECKING:
+    from abrupt.model import range_reduction as model_range_reduction
+    from abrupt.pipelines import laser_ranging as pipelines_laser_ranging
+else:
+    model_range_reduction = lazy_module("abrupt.model.range_reduction")
+    pipelines_laser_ranging = lazy_module("abrupt.pipelines.laser_ranging")
 
 TERMS = RANGE_MODEL_TERMS
 
@@ -59,8 +66,8 @@ TERMS = RANGE_MODEL_TERMS
 @click.option(
     "--area-to-mass",
     "area_to_mass_m2_per_kg",
-    default=0.2827 / 406.965,
-    show_default=True,
+    default=0.2827 / 406.965,  # [m²/kg] LAGEOS: 0.2827 m² cross-section, 406.965 kg
+    show_default="6.95e-4 m²/kg (LAGEOS: 0.2827 m² / 406.965 kg)",
     type=click.FloatRange(min=0.0, min_open=True),
     help="A-priori cross-section per mass [m²/kg] for radiation pressure (and drag); its scale is estimated.",
 )
@@ -106,10 +113,10 @@ def detect_laser_command(
     stated false-alarm budget (detector ``tracking.laser_glrt``; docs/tracking.md, "Laser ranging").
     """
     budget = pop_budget(budget_args, "0.1/day")
-    model = RangeModel()
+    model = model_range_reduction.RangeModel()
     for term in without:
         model = model.without(term)
-    run = run_laser_ranging_files(
+    run = pipelines_laser_ranging.run_laser_ranging_files(
         list(crd_files),
         sinex_path,
         apriori_path,
@@ -120,11 +127,11 @@ def detect_laser_command(
         arc_days=arc_days,
         time_biases=time_biases,
         force=replace(
-            LASER_FORCE,
+            pipelines_laser_ranging.LASER_FORCE,
             gravity_degree=gravity_degree,
-            srp_area_m2=area_to_mass_m2_per_kg * LASER_FORCE.mass_kg,
+            srp_area_m2=area_to_mass_m2_per_kg * pipelines_laser_ranging.LASER_FORCE.mass_kg,
             drag="exponential" if drag else "none",
-            drag_area_m2=area_to_mass_m2_per_kg * LASER_FORCE.mass_kg,
+            drag_area_m2=area_to_mass_m2_per_kg * pipelines_laser_ranging.LASER_FORCE.mass_kg,
         ),
     )
     for line in run.summary_lines():

@@ -3,28 +3,31 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
-import numpy as np
 
+from abrupt.cli.commands import lazy_module
 from abrupt.cli.groups import catalog_option, check_suffix, cli, detect, record_run, simulate
 from abrupt.cli.options import budget_options, pop_budget
-from abrupt.detect.base import DetectionResult
-from abrupt.events import config_hash, new_run_id, read_events
-from abrupt.massprops.track import InertiaTrack
-from abrupt.pipelines.mass import (
-    MomentumOptions,
-    detect_mass_change_run,
-    estimate_inertia_run,
-    inertia_report,
-    simulate_docking_run,
-    telemetry_input,
-    updated_spacecraft_toml,
-    write_report,
-)
-from abrupt.simulate.docking import DockingScenario
-from abrupt.simulate.pointing import CircularOrbit
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from abrupt import events
+    from abrupt.detect import base as detect_base
+    from abrupt.massprops import track as massprops_track
+    from abrupt.pipelines import mass as pipelines_mass
+    from abrupt.simulate import docking as simulate_docking
+    from abrupt.simulate import pointing as simulate_pointing
+else:
+    detect_base = lazy_module("abrupt.detect.base")
+    events = lazy_module("abrupt.events")
+    massprops_track = lazy_module("abrupt.massprops.track")
+    pipelines_mass = lazy_module("abrupt.pipelines.mass")
+    simulate_docking = lazy_module("abrupt.simulate.docking")
+    simulate_pointing = lazy_module("abrupt.simulate.pointing")
+    np = lazy_module("numpy")
 
 #: The mass-change detector's default false-alarm budget: one per satellite-year (daily windows).
 MASS_CHANGE_BUDGET = "1/year"
@@ -35,8 +38,8 @@ def estimate() -> None:
     """Estimate spacecraft properties from routine telemetry (inertia)."""
 
 
-def _options(orbit_period_s: float | None, tachometer_gate_s: float) -> MomentumOptions:
-    return MomentumOptions(orbit_period_s=orbit_period_s, tachometer_gate_s=tachometer_gate_s)
+def _options(orbit_period_s: float | None, tachometer_gate_s: float) -> pipelines_mass.MomentumOptions:
+    return pipelines_mass.MomentumOptions(orbit_period_s=orbit_period_s, tachometer_gate_s=tachometer_gate_s)
 
 
 _store = click.option(
@@ -45,7 +48,13 @@ _store = click.option(
     default=None,
     help="The ingest store (abrupt ingest), or a folder of telemetry files.",
 )
-_spacecraft = click.option("--spacecraft", "spacecraft_file", required=True, type=click.Path(dir_okay=False))
+_spacecraft = click.option(
+    "--spacecraft",
+    "spacecraft_file",
+    required=True,
+    type=click.Path(dir_okay=False),
+    help="Spacecraft TOML: the a-priori inertia, wheels and telemetry column mapping.",
+)
 _orbit = click.option(
     "--orbit-period",
     "orbit_period_s",
@@ -100,8 +109,8 @@ def estimate_inertia_cmd(
     updated spacecraft file and a JSON report. Parameters the telemetry cannot determine are named and
     kept at the catalogue value.
     """
-    paths = telemetry_input(store, telemetry)
-    est, sc, repairs = estimate_inertia_run(
+    paths = pipelines_mass.telemetry_input(store, telemetry)
+    est, sc, repairs = pipelines_mass.estimate_inertia_run(
         paths,
         spacecraft_file,
         _options(orbit_period_s, tachometer_gate_s),
@@ -110,9 +119,9 @@ def estimate_inertia_cmd(
     )
     click.echo(est.summary())
     Path(out_toml).parent.mkdir(parents=True, exist_ok=True)
-    Path(out_toml).write_text(updated_spacecraft_toml(spacecraft_file, est))
+    Path(out_toml).write_text(pipelines_mass.updated_spacecraft_toml(spacecraft_file, est))
     rep = report_path or str(Path(out_toml).with_suffix(".json"))
-    write_report(inertia_report(est, sc, repairs), rep)
+    pipelines_mass.write_report(pipelines_mass.inertia_report(est, sc, repairs), rep)
     click.echo(f"updated spacecraft file {out_toml}; report {rep}", err=True)
 
 
@@ -143,11 +152,11 @@ def detect_mass_change_cmd(
 ) -> None:
     """Track the inertia window by window and report a mass change (GLR at the false-alarm budget)."""
     budget = pop_budget(budget_args, MASS_CHANGE_BUDGET)
-    paths = telemetry_input(store, telemetry)
-    att = read_events(attitude_events) if attitude_events else None
-    run_id = new_run_id()
-    cfg = config_hash({"window_s": window_s, "budget": str(budget), "radius_m": radius_m, "sc": spacecraft_file})
-    result, track = detect_mass_change_run(
+    paths = pipelines_mass.telemetry_input(store, telemetry)
+    att = events.read_events(attitude_events) if attitude_events else None
+    run_id = events.new_run_id()
+    cfg = events.config_hash({"window_s": window_s, "budget": str(budget), "radius_m": radius_m, "sc": spacecraft_file})
+    result, track = pipelines_mass.detect_mass_change_run(
         paths,
         spacecraft_file,
         budget,
@@ -177,7 +186,7 @@ def detect_mass_change_cmd(
     )
 
 
-def _glr_summary(result: DetectionResult, track: InertiaTrack, budget: str) -> str:
+def _glr_summary(result: detect_base.DetectionResult, track: massprops_track.InertiaTrack, budget: str) -> str:
     """One line: windows, the largest GLR statistic and the threshold (or that no change could be tested)."""
     diag = result.diagnostic("inertia_glr")
     tested = diag.statistic[np.isfinite(diag.statistic)]
@@ -203,7 +212,14 @@ def _glr_summary(result: DetectionResult, track: InertiaTrack, budget: str) -> s
     show_default=True,
     help="Attachment point from the CoM, body axes [m].",
 )
-@click.option("--orbit-period", "orbit_period_s", type=float, default=5926.4, show_default=True)
+@click.option(
+    "--orbit-period",
+    "orbit_period_s",
+    type=float,
+    default=5926.4,
+    show_default=True,
+    help="Orbit period [s] (gravity-gradient torque of the nadir-pointing spacecraft).",
+)
 @click.option(
     "--dump-threshold",
     "dump_threshold_Nms",
@@ -212,7 +228,7 @@ def _glr_summary(result: DetectionResult, track: InertiaTrack, budget: str) -> s
     show_default=True,
     help="Momentum dump when the system momentum exceeds this at the start of a day [N m s]; 0: no dumps.",
 )
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--seed", type=int, default=0, show_default=True, help="Random seed (reproducible).")
 def simulate_docking_cmd(
     spacecraft_file: str,
     out_dir: str,
@@ -226,14 +242,14 @@ def simulate_docking_cmd(
 ) -> None:
     """Simulate routine telemetry (nadir pointing, slews, momentum dumps) with a parasite docking; one CSV
     per day (the dumps are listed in docking_truth.json)."""
-    scenario = DockingScenario(
+    scenario = simulate_docking.DockingScenario(
         days=days,
         docking_time_s=None if docking_day < 0 else docking_day * 86400.0,
         parasite_mass_kg=mass_kg,
         attachment_B_m=attachment,
-        orbit=CircularOrbit(period_s=orbit_period_s),
+        orbit=simulate_pointing.CircularOrbit(period_s=orbit_period_s),
         dump_threshold_Nms=dump_threshold_Nms if dump_threshold_Nms > 0 else None,
         seed=seed,
     )
-    paths = simulate_docking_run(spacecraft_file, out_dir, scenario)
+    paths = pipelines_mass.simulate_docking_run(spacecraft_file, out_dir, scenario)
     click.echo(f"wrote {len(paths) - 1} day file(s) and {paths[-1]}", err=True)

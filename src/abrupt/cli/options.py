@@ -9,11 +9,17 @@ aliases that map to it.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
-from abrupt.thresholds import FalseAlarmBudget
+from abrupt.cli.commands import lazy_module
+
+if TYPE_CHECKING:
+    from abrupt import thresholds
+else:
+    thresholds = lazy_module("abrupt.thresholds")
+
 
 BUDGET_KEYS = ("false_alarms", "false_alarms_per_day", "false_alarms_per_week", "false_alarms_per_year")
 
@@ -42,7 +48,7 @@ def budget_options(default: str = "1/day") -> Callable[[Any], Any]:
     return wrap
 
 
-def pop_budget(options: dict[str, Any], default: str = "1/day") -> FalseAlarmBudget:
+def pop_budget(options: dict[str, Any], default: str = "1/day") -> thresholds.FalseAlarmBudget:
     """Remove the budget options from a command's keyword arguments and return the one budget they give."""
     given = {k: options.pop(k, None) for k in BUDGET_KEYS}
     chosen = {k: v for k, v in given.items() if v is not None}
@@ -50,11 +56,11 @@ def pop_budget(options: dict[str, Any], default: str = "1/day") -> FalseAlarmBud
         names = ", ".join("--" + k.replace("_", "-") for k in chosen)
         raise click.UsageError(f"give the false-alarm budget once; got {names}")
     if not chosen:
-        return FalseAlarmBudget.parse(default)
+        return thresholds.FalseAlarmBudget.parse(default)
     key, value = next(iter(chosen.items()))
     if key == "false_alarms":
         try:
-            return FalseAlarmBudget.parse(str(value))
+            return thresholds.FalseAlarmBudget.parse(str(value))
         except ValueError as exc:
             raise click.BadParameter(str(exc), param_hint="--false-alarms") from None
-    return FalseAlarmBudget(float(value), key.removeprefix("false_alarms_per_"))  # type: ignore[arg-type]
+    return thresholds.FalseAlarmBudget(float(value), key.removeprefix("false_alarms_per_"))  # type: ignore[arg-type]

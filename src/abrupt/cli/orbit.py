@@ -7,12 +7,11 @@ from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
-import numpy as np
-import pandas as pd
 
+from abrupt.cli.commands import lazy_module
 from abrupt.cli.groups import (
     catalog_option,
     detect,
@@ -24,17 +23,34 @@ from abrupt.cli.groups import (
     spacecraft_name_option,
 )
 from abrupt.cli.options import budget_options, pop_budget
-from abrupt.detect.orbit.detectors import STATISTIC_SUMMARIES
+from abrupt.detect.orbit.statistic_names import STATISTIC_SUMMARIES
 from abrupt.errors import ConfigError, InputError
-from abrupt.events import config_hash, new_run_id, read_events
-from abrupt.model.orbit import ForceModel
-from abrupt.pipelines.orbit import OrbitRun, detect_orbit, inject_orbit, summary_lines
-from abrupt.pipelines.orbit_product import detect_orbit_product
-from abrupt.readers.ephemeris import write_ephemeris
-from abrupt.readers.navigation_csv import write_navigation_csv
-from abrupt.report.orbit import plot_orbit_report
-from abrupt.simulate.orbit import Impulse, OrbitSimulationConfig, simulate_orbit
-from abrupt.thresholds import FalseAlarmBudget
+
+if TYPE_CHECKING:
+    import numpy as np
+    import pandas as pd
+
+    from abrupt import events as abrupt_events
+    from abrupt import thresholds
+    from abrupt.model import orbit as model_orbit
+    from abrupt.pipelines import orbit as pipelines_orbit
+    from abrupt.pipelines import orbit_product as pipelines_orbit_product
+    from abrupt.readers import ephemeris as readers_ephemeris
+    from abrupt.readers import navigation_csv as readers_navigation_csv
+    from abrupt.report import orbit as report_orbit
+    from abrupt.simulate import orbit as abrupt_simulate_orbit
+else:
+    abrupt_events = lazy_module("abrupt.events")
+    model_orbit = lazy_module("abrupt.model.orbit")
+    pipelines_orbit = lazy_module("abrupt.pipelines.orbit")
+    pipelines_orbit_product = lazy_module("abrupt.pipelines.orbit_product")
+    readers_ephemeris = lazy_module("abrupt.readers.ephemeris")
+    readers_navigation_csv = lazy_module("abrupt.readers.navigation_csv")
+    report_orbit = lazy_module("abrupt.report.orbit")
+    abrupt_simulate_orbit = lazy_module("abrupt.simulate.orbit")
+    thresholds = lazy_module("abrupt.thresholds")
+    np = lazy_module("numpy")
+    pd = lazy_module("pandas")
 
 #: the statistics ``--statistic`` accepts (each is the registered detector ``orbit.<statistic>``)
 STATISTIC_CHOICES = tuple(STATISTIC_SUMMARIES)
@@ -110,12 +126,12 @@ def _filter_options(f: Any) -> Any:
 @simulate.command("orbit")
 @click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Navigation CSV to write (GCRF).")
 @click.option("--truth", "truth_out", type=click.Path(dir_okay=False), default=None, help="Also write the truth.")
-@click.option("--duration-s", type=float, default=10800.0, show_default=True)
-@click.option("--rate-hz", type=float, default=1.0, show_default=True)
-@click.option("--altitude-km", type=float, default=800.0, show_default=True)
-@click.option("--inclination-deg", type=float, default=40.0, show_default=True)
-@click.option("--sigma-pos-m", type=float, default=10.0, show_default=True)
-@click.option("--sigma-vel-mps", type=float, default=0.25, show_default=True)
+@click.option("--duration-s", type=float, default=10800.0, show_default=True, help="Length of the simulated arc [s].")
+@click.option("--rate-hz", type=float, default=1.0, show_default=True, help="Navigation solution rate [Hz].")
+@click.option("--altitude-km", type=float, default=800.0, show_default=True, help="Circular orbit altitude [km].")
+@click.option("--inclination-deg", type=float, default=40.0, show_default=True, help="Orbit inclination [deg].")
+@click.option("--sigma-pos-m", type=float, default=10.0, show_default=True, help="Position noise 1σ per axis [m].")
+@click.option("--sigma-vel-mps", type=float, default=0.25, show_default=True, help="Velocity noise 1σ per axis [m/s].")
 @click.option(
     "--impulse",
     "impulses",
@@ -130,7 +146,7 @@ def _filter_options(f: Any) -> Any:
     help="thesis-perturbed: J3 + exponential drag (§3.4.4); full: J2-J4, MSIS drag, SRP, Sun, Moon.",
 )
 @click.option("--epoch", default="2020-01-01T00:00:00", show_default=True, help="Start time (UTC).")
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--seed", type=int, default=0, show_default=True, help="Random seed of the noise (reproducible).")
 def simulate_orbit_command(
     out: str,
     truth_out: str | None,
@@ -155,14 +171,14 @@ def simulate_orbit_command(
             t_imp = float(t_txt)
         except ValueError:
             raise ConfigError(f"impulse time {t_txt!r} is not a number", key="impulse") from None
-        kicks.append(Impulse(t_imp, _parse_vector(dv_txt, "impulse"), frame="rtn"))
+        kicks.append(abrupt_simulate_orbit.Impulse(t_imp, _parse_vector(dv_txt, "impulse"), frame="rtn"))
     model = {
-        "two-body": ForceModel(),
-        "j2-j4": ForceModel(zonal_degree=4),
-        "thesis-perturbed": ForceModel(j3_only=True, drag="exponential", array_area_m2=5.0),
-        "full": ForceModel(gravity_degree=40, drag="msis", srp=True, sun=True, moon=True),
+        "two-body": model_orbit.ForceModel(),
+        "j2-j4": model_orbit.ForceModel(zonal_degree=4),
+        "thesis-perturbed": model_orbit.ForceModel(j3_only=True, drag="exponential", array_area_m2=5.0),
+        "full": model_orbit.ForceModel(gravity_degree=40, drag="msis", srp=True, sun=True, moon=True),
     }[forces]
-    cfg = OrbitSimulationConfig(
+    cfg = abrupt_simulate_orbit.OrbitSimulationConfig(
         altitude_m=altitude_km * 1e3,
         inclination_deg=inclination_deg,
         duration_s=duration_s,
@@ -174,12 +190,12 @@ def simulate_orbit_command(
         impulses=tuple(kicks),
         seed=seed,
     )
-    sim = simulate_orbit(cfg)
+    sim = abrupt_simulate_orbit.simulate_orbit(cfg)
     eph = sim.ephemeris()
-    write_navigation_csv(eph, out)
+    readers_navigation_csv.write_navigation_csv(eph, out)
     if truth_out:
         truth = replace(eph, position_m=sim.truth_position_m, velocity_mps=sim.truth_velocity_mps)
-        write_navigation_csv(truth, truth_out)
+        readers_navigation_csv.write_navigation_csv(truth, truth_out)
     click.echo(f"{len(eph)} navigation solutions written to {out} ({len(kicks)} impulse(s))", err=True)
 
 
@@ -245,7 +261,13 @@ def simulate_orbit_command(
     help="Every satellite of a multi-satellite SP3 file, each satellite's threshold calibrated on the "
     "other satellites of the file (leave-one-satellite-out; see docs/orbit.md).",
 )
-@click.option("--kind", type=click.Choice(["unknown", "maneuver", "strike"]), default="unknown", show_default=True)
+@click.option(
+    "--kind",
+    type=click.Choice(["unknown", "maneuver", "strike"]),
+    default="unknown",
+    show_default=True,
+    help="Event kind written for a detected ΔV (unknown: the data cannot tell a manoeuvre from a strike).",
+)
 @click.option(
     "--statistics-out", type=click.Path(dir_okay=False), default=None, help="Per-epoch statistics (.parquet/.csv)."
 )
@@ -291,7 +313,7 @@ def detect_orbit_command(
     if detector_name is not None and statistic is not None:
         raise ConfigError("give --detector or --statistic, not both", key="detector")
     name = detector_name or statistic or ("glr" if tuning == "auto" else "mcr_w")
-    run_id = new_run_id()
+    run_id = abrupt_events.new_run_id()
     if all_satellites:
         if satellite is not None or null_file is not None or report_path or statistics_out:
             raise ConfigError(
@@ -315,7 +337,7 @@ def detect_orbit_command(
         _detect_all_satellites(file, out, name, budget, allow_truncated, strict, sequences, catalog_target, settings)
         return
     try:
-        run = detect_orbit(
+        run = pipelines_orbit.detect_orbit(
             file,
             detector=name,
             budget=budget,
@@ -346,7 +368,7 @@ def detect_orbit_command(
     for warning in run.result.warnings:
         click.echo(f"warning: {warning}", err=True)
     # the fit (residual RMS, estimated parameters, thresholds) is printed on every run
-    click.echo("\n".join(summary_lines(run.summary)), err=True)
+    click.echo("\n".join(pipelines_orbit.summary_lines(run.summary)), err=True)
     if statistics_out and run.result.diagnostics:
         frame = _statistics_frame(run)
         Path(statistics_out).parent.mkdir(parents=True, exist_ok=True)
@@ -370,11 +392,11 @@ def detect_orbit_command(
     if report_path and run.analysis is None:
         click.echo("warning: no report for a run in calibration blocks; give --block-days 0 for one", err=True)
     if report_path and run.analysis is not None:
-        path = plot_orbit_report(run.analysis, run.thresholds, events, report_path)
+        path = report_orbit.plot_orbit_report(run.analysis, run.thresholds, events, report_path)
         click.echo(f"report written to {path}", err=True)
 
 
-def _statistics_frame(run: OrbitRun) -> pd.DataFrame:
+def _statistics_frame(run: pipelines_orbit.OrbitRun) -> pd.DataFrame:
     """Per-epoch statistics of a run: every statistic of its analysis, or for a run in calibration blocks
     the event statistic and each epoch's threshold (its block's)."""
     if run.analysis is not None:
@@ -388,18 +410,18 @@ def _statistics_frame(run: OrbitRun) -> pd.DataFrame:
     )
 
 
-def _config_hash_of(events: pd.DataFrame, detector_config: dict[str, Any], budget: FalseAlarmBudget) -> str:
+def _config_hash_of(events: pd.DataFrame, detector_config: dict[str, Any], budget: thresholds.FalseAlarmBudget) -> str:
     """The run's configuration hash: the events' own, or for a run without events the one they would carry."""
     if len(events) and str(events["config_hash"].iloc[0]):
         return str(events["config_hash"].iloc[0])
-    return config_hash({**detector_config, "budget": str(budget)})
+    return abrupt_events.config_hash({**detector_config, "budget": str(budget)})
 
 
 def _detect_all_satellites(
     file: str,
     out: str,
     name: str,
-    budget: FalseAlarmBudget,
+    budget: thresholds.FalseAlarmBudget,
     allow_truncated: bool,
     strict: bool,
     sequences: bool,
@@ -408,7 +430,7 @@ def _detect_all_satellites(
 ) -> None:
     """``detect orbit --all-satellites``: every satellite of the file, thresholds from the others."""
     try:
-        runs = detect_orbit_product(
+        runs = pipelines_orbit_product.detect_orbit_product(
             file,
             detector=name,
             budget=budget,
@@ -487,7 +509,7 @@ def inject_orbit_command(
 ) -> None:
     """Add the effect of a ΔV (impulse or finite burn) at a chosen time to a real ephemeris."""
     try:
-        out_eph = inject_orbit(
+        out_eph = pipelines_orbit.inject_orbit(
             file,
             time_utc,
             _parse_vector(dv_rtn, "dv-rtn"),
@@ -502,7 +524,7 @@ def inject_orbit_command(
         raise ConfigError(str(exc), key="time") from None
     for line in out_eph.repairs.summary():
         click.echo(f"repaired: {line}", err=True)
-    fmt = write_ephemeris(out_eph, out, like=file)
+    fmt = readers_ephemeris.write_ephemeris(out_eph, out, like=file)
     click.echo(
         f"ΔV {dv_rtn} m/s (RTN) injected at {time_utc} into {len(out_eph)} epochs; written to {out} ({fmt})", err=True
     )
@@ -512,7 +534,13 @@ def inject_orbit_command(
 @click.argument("file", type=click.Path(exists=True, dir_okay=False))
 @click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="PNG to write.")
 @_filter_options
-@click.option("--events", "events_file", type=click.Path(exists=True, dir_okay=False), default=None)
+@click.option(
+    "--events",
+    "events_file",
+    type=click.Path(exists=True, dir_okay=False),
+    default=None,
+    help="Events file of a detect orbit run (.csv/.parquet) to mark on the figure.",
+)
 @budget_options("1/week")
 def report_orbit_command(
     file: str,
@@ -532,7 +560,7 @@ def report_orbit_command(
     **budget_args: Any,
 ) -> None:
     """Report panels: filter residuals, each statistic with its threshold, and events."""
-    run = detect_orbit(
+    run = pipelines_orbit.detect_orbit(
         file,
         detector="glr" if tuning == "auto" else "mcr_w",
         budget=pop_budget(budget_args, "1/week"),
@@ -549,6 +577,6 @@ def report_orbit_command(
         nuisance=nuisance,
     )
     assert run.analysis is not None
-    events = read_events(events_file) if events_file else None
-    path = plot_orbit_report(run.analysis, run.thresholds, events, out)
+    events = abrupt_events.read_events(events_file) if events_file else None
+    path = report_orbit.plot_orbit_report(run.analysis, run.thresholds, events, out)
     click.echo(f"report written to {path}", err=True)

@@ -4,21 +4,32 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
-import numpy as np
 
+from abrupt.cli.commands import lazy_module
 from abrupt.cli.fleet import executor_from, with_executor_options
 from abrupt.cli.groups import cli, progress_hidden
 from abrupt.errors import ConfigError
-from abrupt.pipelines.rates import METRIC_UNITS, build_scenario, metric_thresholds, parse_vary, rate_table
-from abrupt.rates import flux as fx
-from abrupt.rates import tables
-from abrupt.rates.ordem import describe_mapping, import_ordem, read_numeric_table
-from abrupt.rates.tables import write_flux_table
-from abrupt.rates.trades import run_case, run_trade
-from abrupt.report.rates import plot_dh_dv_scatter, plot_rate_curves
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from abrupt import rates as abrupt_rates
+    from abrupt.pipelines import rates as pipelines_rates
+    from abrupt.rates import ordem as rates_ordem
+    from abrupt.rates import tables as rates_tables
+    from abrupt.rates import trades as rates_trades
+    from abrupt.report import rates as report_rates
+else:
+    pipelines_rates = lazy_module("abrupt.pipelines.rates")
+    abrupt_rates = lazy_module("abrupt.rates")
+    rates_ordem = lazy_module("abrupt.rates.ordem")
+    rates_tables = lazy_module("abrupt.rates.tables")
+    rates_trades = lazy_module("abrupt.rates.trades")
+    report_rates = lazy_module("abrupt.report.rates")
+    np = lazy_module("numpy")
 
 
 @cli.group()
@@ -167,7 +178,7 @@ def _scenario_options(func: Callable[..., Any]) -> Callable[..., Any]:
 
 def _report(results: Sequence[Any], kw: dict[str, Any]) -> None:
     metrics = list(kw["metric"]) or ["dH", "dV", "da"]
-    frame = rate_table(results, metrics, kw["thresholds"])
+    frame = pipelines_rates.rate_table(results, metrics, kw["thresholds"])
     for r in results:
         click.echo(
             f"{r.label}: {r.strikes_per_year:.4g} strikes/yr above Lc {kw['lc_min_m']:g} m "
@@ -175,7 +186,7 @@ def _report(results: Sequence[Any], kw: dict[str, Any]) -> None:
         )
     for m in metrics:
         sub = frame[frame.metric == m].pivot(index="threshold_SI", columns="case", values="detectable_per_year")
-        click.echo(f"\nexpected detectable strikes per year, {m} threshold [{METRIC_UNITS[m]}]:")
+        click.echo(f"\nexpected detectable strikes per year, {m} threshold [{pipelines_rates.METRIC_UNITS[m]}]:")
         click.echo(sub.to_string(float_format=lambda v: f"{v:.4g}"))
     if kw["out"]:
         Path(kw["out"]).parent.mkdir(parents=True, exist_ok=True)
@@ -185,11 +196,11 @@ def _report(results: Sequence[Any], kw: dict[str, Any]) -> None:
         m = metrics[0]
         thr_plot = None
         if kw["thresholds"]:
-            thr_plot = np.asarray(metric_thresholds(m, kw["thresholds"], True), dtype=np.float64)
-        plot_rate_curves(results, m, kw["plot"], thresholds=thr_plot)
+            thr_plot = np.asarray(pipelines_rates.metric_thresholds(m, kw["thresholds"], True), dtype=np.float64)
+        report_rates.plot_rate_curves(results, m, kw["plot"], thresholds=thr_plot)
         click.echo(f"plot written to {kw['plot']}", err=True)
     if kw["scatter"]:
-        plot_dh_dv_scatter(results, kw["scatter"])
+        report_rates.plot_dh_dv_scatter(results, kw["scatter"])
         click.echo(f"scatter written to {kw['scatter']}", err=True)
 
 
@@ -197,8 +208,8 @@ def _report(results: Sequence[Any], kw: dict[str, Any]) -> None:
 @_scenario_options
 def run_command(**kw: Any) -> None:
     """One Monte Carlo: expected detectable strikes per year against threshold."""
-    base = build_scenario(kw)
-    _report([run_case(base)], kw)
+    base = pipelines_rates.build_scenario(kw)
+    _report([rates_trades.run_case(base)], kw)
 
 
 @rates.command("trade")
@@ -215,20 +226,35 @@ def run_command(**kw: Any) -> None:
 @with_executor_options
 def trade_command(vary: tuple[str, ...], workers: int | None, scheduler: str | None, **kw: Any) -> None:
     """A trade over one or two variables; one Monte Carlo per case (Dask-parallel with --workers/--scheduler)."""
-    variables = parse_vary(vary)
-    base = build_scenario(kw)
-    results = run_trade(
+    variables = pipelines_rates.parse_vary(vary)
+    base = pipelines_rates.build_scenario(kw)
+    results = rates_trades.run_trade(
         base, variables, executor=executor_from(workers, scheduler), show_progress=not progress_hidden()
     )
     _report(results, kw)
 
 
 @rates.command("flux")
-@click.option("--model", type=click.Choice(["nasa90", "grun"]), default="nasa90", show_default=True)
-@click.option("--altitude-km", type=float, required=True)
-@click.option("--inclination-deg", type=float, default=28.5, show_default=True)
-@click.option("--epoch", "epoch_year", type=float, default=2020.0, show_default=True)
-@click.option("--solar-flux", "solar_flux_sfu", type=float, default=100.0, show_default=True)
+@click.option(
+    "--model",
+    type=click.Choice(["nasa90", "grun"]),
+    default="nasa90",
+    show_default=True,
+    help="Flux model: nasa90 (orbital debris, NASA-90/91) or grun (meteoroids, Grün 1985).",
+)
+@click.option("--altitude-km", type=float, required=True, help="Orbit altitude [km].")
+@click.option("--inclination-deg", type=float, default=28.5, show_default=True, help="Orbit inclination [deg].")
+@click.option(
+    "--epoch", "epoch_year", type=float, default=2020.0, show_default=True, help="Debris model epoch [decimal year]."
+)
+@click.option(
+    "--solar-flux",
+    "solar_flux_sfu",
+    type=float,
+    default=100.0,
+    show_default=True,
+    help="13-month mean F10.7 solar flux [sfu] of the debris model.",
+)
 @click.option(
     "--sizes-m",
     default="1e-5,1e-4,1e-3,1e-2,1e-1",
@@ -259,7 +285,7 @@ def flux_command(
         raise ConfigError("sizes must be positive", key="sizes_m")
     alt = altitude_km * 1e3
     if model == "nasa90":
-        f = fx.nasa90_flux_tumbling(
+        f = abrupt_rates.flux.nasa90_flux_tumbling(
             sizes,
             altitude_m=alt,
             inclination_deg=inclination_deg,
@@ -273,27 +299,27 @@ def flux_command(
         for s, v in zip(sizes, f, strict=True):
             click.echo(f"{s:12.4g} {v:16.5g} {4 * v:21.5g}")
         table = (
-            tables.nasa90_table(alt, inclination_deg, epoch_year, solar_flux_sfu=solar_flux_sfu)
+            abrupt_rates.tables.nasa90_table(alt, inclination_deg, epoch_year, solar_flux_sfu=solar_flux_sfu)
             if write_table
             else None
         )
     else:
-        fac = fx.meteoroid_earth_factors(alt)
-        masses = fx.sphere_mass_kg(sizes, fx.METEOROID_DENSITY_KG_M3)
-        f0 = fx.grun_flux_interplanetary(masses)
+        fac = abrupt_rates.flux.meteoroid_earth_factors(alt)
+        masses = abrupt_rates.flux.sphere_mass_kg(sizes, abrupt_rates.flux.METEOROID_DENSITY_KG_M3)
+        f0 = abrupt_rates.flux.grun_flux_interplanetary(masses)
         click.echo(
             f"Grün meteoroids at {altitude_km:g} km: focusing G={fac.focusing:.3f}, "
             f"shielding sf={fac.shielding:.3f}, "
-            f"motion K={fac.motion:.3f}, density {fx.METEOROID_DENSITY_KG_M3:g} kg/m3"
+            f"motion K={fac.motion:.3f}, density {abrupt_rates.flux.METEOROID_DENSITY_KG_M3:g} kg/m3"
         )
         click.echo(
             f"{'diameter_m':>12} {'mass_kg':>12} {'1AU_/m2/yr':>12} {'orbit_plate_/m2/yr':>19} {'cross_section':>14}"
         )
         for s, m, v in zip(sizes, masses, f0, strict=True):
             click.echo(f"{s:12.4g} {m:12.4g} {v:12.5g} {v * fac.total:19.5g} {4 * v * fac.total:14.5g}")
-        table = tables.grun_table(alt) if write_table else None
+        table = abrupt_rates.tables.grun_table(alt) if write_table else None
     if table is not None and write_table:
-        tables.write_flux_table(table, write_table)
+        abrupt_rates.tables.write_flux_table(table, write_table)
         click.echo(f"flux table written to {write_table}", err=True)
 
 
@@ -306,17 +332,40 @@ def flux_command(
     required=True,
     help="Manifest (.toml) of the flux table to write.",
 )
-@click.option("--name", default="ORDEM", show_default=True)
-@click.option("--altitude-km", type=float, default=float("nan"))
-@click.option("--inclination-deg", type=float, default=float("nan"))
-@click.option("--epoch", "epoch_year", type=float, default=float("nan"))
+@click.option("--name", default="ORDEM", show_default=True, help="Name of the flux table in the manifest and reports.")
+@click.option(
+    "--altitude-km",
+    type=float,
+    default=float("nan"),
+    help="Altitude [km] of the ORDEM run (recorded).",
+)
+@click.option(
+    "--inclination-deg",
+    type=float,
+    default=float("nan"),
+    help="Inclination [deg] the ORDEM run was for (recorded; default: unknown).",
+)
+@click.option(
+    "--epoch",
+    "epoch_year",
+    type=float,
+    default=float("nan"),
+    help="Epoch [decimal year] the ORDEM run was for (recorded; default: unknown).",
+)
 @click.option(
     "--flux-convention",
     type=click.Choice(["cross_section", "tumbling"]),
     default="cross_section",
     show_default=True,
+    help="ORDEM's flux per cross-section area, or per tumbling-plate area (×4 on import).",
 )
-@click.option("--intact-class", type=click.Choice(["nak", "low", "medium", "high"]), default="high", show_default=True)
+@click.option(
+    "--intact-class",
+    type=click.Choice(["nak", "low", "medium", "high"]),
+    default="high",
+    show_default=True,
+    help="Density class the intact-object column is counted with.",
+)
 def import_ordem_command(
     size_file: str,
     igloo_file: str,
@@ -329,10 +378,10 @@ def import_ordem_command(
     intact_class: str,
 ) -> None:
     """Convert ORDEM 3.x spacecraft-mode size and igloo tables into an abrupt flux table."""
-    header, _, _ = read_numeric_table(Path(size_file))
-    for col, meaning in describe_mapping(header).items():
+    header, _, _ = rates_ordem.read_numeric_table(Path(size_file))
+    for col, meaning in rates_ordem.describe_mapping(header).items():
         click.echo(f"  {col}: {meaning}", err=True)
-    table = import_ordem(
+    table = rates_ordem.import_ordem(
         size_file,
         igloo_file,
         name=name,
@@ -342,7 +391,7 @@ def import_ordem_command(
         flux_convention=flux_convention,
         intact_class=intact_class,
     )
-    write_flux_table(table, out)
+    rates_tables.write_flux_table(table, out)
     click.echo(
         f"{len(table.classes)} class(es) x {table.sizes_m.size} sizes, "
         f"{table.directions.weight.size} direction "

@@ -11,12 +11,11 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
-import pandas as pd
-from scipy.stats import binom
 
+from abrupt.cli.commands import lazy_module
 from abrupt.cli.groups import (
     catalog_option,
     cli,
@@ -28,20 +27,40 @@ from abrupt.cli.groups import (
     spacecraft_name_option,
 )
 from abrupt.cli.options import budget_options, pop_budget
-from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET, TleDetectorConfig
-from abrupt.detect.tle.detectors import detector_for
+from abrupt.detect.tle.default_rate import DEFAULT_TLE_RATE
 from abrupt.errors import InputError
-from abrupt.events import config_hash, new_run_id, read_events
-from abrupt.pipelines.tle import burns_below_detectable, detect_tle_file, satellite_label
-from abrupt.readers.fengyun import read_maneuver_file
-from abrupt.readers.omm import read_elements
-from abrupt.report.tle import plot_injection_recall, plot_tle_report
-from abrupt.score import interval_ns, recall_at_false_alarm_rate, score_events
-from abrupt.simulate.tle_injection import KINDS, MIN_ELEMENT_SETS, injection_recall, ladder_around
-from abrupt.simulate.tle_own_null import own_null_rate
-from abrupt.thresholds import DAYS_PER_YEAR, FalseAlarmBudget
 
-TLE_BUDGET = str(DEFAULT_TLE_BUDGET)  # "1/year"
+if TYPE_CHECKING:
+    import pandas as pd
+    from scipy import stats as scipy_stats
+
+    from abrupt import events as abrupt_events
+    from abrupt import score as abrupt_score
+    from abrupt import thresholds
+    from abrupt.detect.tle import config as detect_tle_config
+    from abrupt.detect.tle import detectors as detect_tle_detectors
+    from abrupt.pipelines import tle as pipelines_tle
+    from abrupt.readers import fengyun as readers_fengyun
+    from abrupt.readers import omm as readers_omm
+    from abrupt.report import tle as abrupt_report_tle
+    from abrupt.simulate import tle_injection as simulate_tle_injection
+    from abrupt.simulate import tle_own_null as simulate_tle_own_null
+else:
+    detect_tle_config = lazy_module("abrupt.detect.tle.config")
+    detect_tle_detectors = lazy_module("abrupt.detect.tle.detectors")
+    abrupt_events = lazy_module("abrupt.events")
+    pipelines_tle = lazy_module("abrupt.pipelines.tle")
+    readers_fengyun = lazy_module("abrupt.readers.fengyun")
+    readers_omm = lazy_module("abrupt.readers.omm")
+    abrupt_report_tle = lazy_module("abrupt.report.tle")
+    abrupt_score = lazy_module("abrupt.score")
+    simulate_tle_injection = lazy_module("abrupt.simulate.tle_injection")
+    simulate_tle_own_null = lazy_module("abrupt.simulate.tle_own_null")
+    thresholds = lazy_module("abrupt.thresholds")
+    pd = lazy_module("pandas")
+    scipy_stats = lazy_module("scipy.stats")
+
+TLE_BUDGET = DEFAULT_TLE_RATE
 
 norad_option = click.option(
     "--norad",
@@ -114,11 +133,11 @@ def detect_tle(
     budget = pop_budget(budget_given, TLE_BUDGET)
     try:
         settings: dict[str, Any] = {"window_sets": window_sets, "threshold": threshold}
-        TleDetectorConfig(window_sets=window_sets, threshold=threshold)  # validate before reading
+        detect_tle_config.TleDetectorConfig(window_sets=window_sets, threshold=threshold)  # validate before reading
     except ValueError as exc:
         raise click.BadParameter(str(exc)) from None
-    run_id = new_run_id()
-    result = detect_tle_file(
+    run_id = abrupt_events.new_run_id()
+    result = pipelines_tle.detect_tle_file(
         path,
         budget,
         detector=detector,
@@ -147,7 +166,7 @@ def detect_tle(
         multi = int((found["burns_max"] > 1).sum()) if "burns_max" in found else 0
         n_burns = int(camps["burn_count"].sum()) if len(camps) else 0
         click.echo(
-            f"{satellite_label(h)}: {len(h)} element sets, {sat.detector}, {n_det} maneuver(s)"
+            f"{pipelines_tle.satellite_label(h)}: {len(h)} element sets, {sat.detector}, {n_det} maneuver(s)"
             + (f" ({multi} with an interval long enough for several burns at its campaign cadence)" if multi else "")
             + (f", {len(camps)} campaign(s) of {n_burns} burns in all" if len(camps) else "")
             + "; "
@@ -182,7 +201,7 @@ def detect_tle(
         catalog_target=catalog_target,
         command="detect tle",
         events=result.events,
-        config_hash=config_hash({"detector": detector, "budget": str(budget), **settings}),
+        config_hash=abrupt_events.config_hash({"detector": detector, "budget": str(budget), **settings}),
         run_id=run_id,
         input_path=path,
         out=out,
@@ -193,7 +212,9 @@ def detect_tle(
             target = Path(report_path)
             if len(result.satellites) > 1:
                 target = target.with_name(f"{target.stem}_{sat.history.norad_id}{target.suffix}")
-            click.echo(f"report written to {plot_tle_report(sat.history, sat.events, target)}", err=True)
+            click.echo(
+                f"report written to {abrupt_report_tle.plot_tle_report(sat.history, sat.events, target)}", err=True
+            )
 
 
 @report.command("tle")
@@ -211,7 +232,13 @@ def detect_tle(
     default=None,
     help="Operator maneuver file (IDS format) or events file.",
 )
-@click.option("--tolerance-days", type=float, default=1.0, show_default=True)
+@click.option(
+    "--tolerance-days",
+    type=float,
+    default=1.0,
+    show_default=True,
+    help="A detection within this many days of a true manoeuvre counts as found [days].",
+)
 @click.option("--out", type=click.Path(dir_okay=False), required=True, help="Figure file (.png, .svg, .pdf).")
 @norad_option
 @budget_options(TLE_BUDGET)
@@ -229,10 +256,16 @@ def report_tle(
     Without --events the detector of the orbit runs now at --false-alarms.
     """
     budget = pop_budget(budget_given, TLE_BUDGET)
-    history = read_elements(path, norad_id=norad_id)
-    events = read_events(events_path) if events_path else detector_for(history).detect(history, budget).events
+    history = readers_omm.read_elements(path, norad_id=norad_id)
+    events = (
+        abrupt_events.read_events(events_path)
+        if events_path
+        else detect_tle_detectors.detector_for(history).detect(history, budget).events
+    )
     truth_frame = _read_truth(truth) if truth else None
-    written = plot_tle_report(history, events, out, truth=truth_frame, tolerance_s=tolerance_days * 86400.0)
+    written = abrupt_report_tle.plot_tle_report(
+        history, events, out, truth=truth_frame, tolerance_s=tolerance_days * 86400.0
+    )
     click.echo(f"report written to {written}", err=True)
 
 
@@ -241,14 +274,17 @@ def _own_null(sat: Any, budget: Any, seeds: int, years: float, settings: dict[st
     (quiet: away from its detections) beside the budget; None when skipped or impossible."""
     if seeds == 0:
         return None
-    if len(sat.history) < MIN_ELEMENT_SETS:
-        click.echo(f"  own null: {len(sat.history)} element sets, too few (at least {MIN_ELEMENT_SETS})", err=True)
+    if len(sat.history) < (least_sets := simulate_tle_injection.MIN_ELEMENT_SETS):
+        click.echo(
+            f"  own null: {len(sat.history)} element sets, too few (at least {least_sets})",
+            err=True,
+        )
         return None
     found = sat.events.loc[sat.events["statistic"] >= sat.events["threshold"]] if len(sat.events) else sat.events
     known = list(pd.to_datetime(found["time_utc"].astype(str), utc=True).dt.tz_localize(None)) if len(found) else []
     kw = {k: v for k, v in settings.items() if v is not None}
     try:
-        rate = own_null_rate(sat.history, known, budget, years=years, seeds=range(seeds), **kw)
+        rate = simulate_tle_own_null.own_null_rate(sat.history, known, budget, years=years, seeds=range(seeds), **kw)
     except ValueError as exc:
         click.echo(f"  own null: not measured ({exc})", err=True)
         return None
@@ -266,12 +302,12 @@ def _read_truth(path: str) -> Any:
     """Truth list: an events file (.csv/.parquet with the event columns) or an operator maneuver file
     (IDS ``*man.txt``, TAI epochs; Fengyun ``.fy``, China Standard Time)."""
     if path.lower().endswith((".parquet", ".pq")):
-        return read_events(path)
+        return abrupt_events.read_events(path)
     with open(path, encoding="utf-8", errors="replace") as fh:
         first = fh.readline()
     if first.startswith("event_id,"):
-        return read_events(path)
-    return read_maneuver_file(path)
+        return abrupt_events.read_events(path)
+    return readers_fengyun.read_maneuver_file(path)
 
 
 def chance_matches(n_det: int, n_truth: int, tolerance_s: float, start: Any, end: Any, events: Any) -> float:
@@ -351,22 +387,22 @@ def score(
 
     Example: abrupt score jason3_events.csv --truth ja3man.txt --elements Jason-3.tle
     """
-    events = read_events(events_path)
+    events = abrupt_events.read_events(events_path)
     truth_frame = _read_truth(truth)
     if elements:
-        history = read_elements(elements)
+        history = readers_omm.read_elements(elements)
         _same_satellite(events, history.norad_id, events_path, elements)
         el = history.elements
         start, end = str(el["epoch_utc"].iloc[0]), str(el["epoch_utc"].iloc[-1])
     if len(truth_frame) == 0:
         raise InputError("truth file lists no maneuvers: nothing to score against", file=truth)
     tol = tolerance_days * 86400.0
-    result = score_events(events, truth_frame, tolerance_s=tol, start=start, end=end)
+    result = abrupt_score.score_events(events, truth_frame, tolerance_s=tol, start=start, end=end)
     if result.n_truth == 0:
         raise InputError("no truth maneuver inside the observed span: nothing to score against", file=truth)
     chance = chance_matches(result.n_detections, result.n_truth, tol, start, end, events)
     if result.n_truth >= 5:
-        p_chance = float(binom.sf(result.true_positives - 1, result.n_truth, chance / result.n_truth))
+        p_chance = float(scipy_stats.binom.sf(result.true_positives - 1, result.n_truth, chance / result.n_truth))
         if p_chance > 0.01:  # as many matches as random times would give: likely another satellite's file
             click.echo(
                 f"warning: {result.true_positives} match(es) where chance alone gives {chance:.1f} "
@@ -383,8 +419,8 @@ def score(
         f"TP {result.true_positives}  FP {result.false_positives}  FN {result.false_negatives}  "
         f"precision {result.precision:.3f}  recall {result.recall:.3f}  F1 {result.f1:.3f}"
     )
-    if interval_ns(events) is not None:
-        stated = score_events(events, truth_frame, tolerance_s=tol, start=start, end=end, intervals=True)
+    if abrupt_score.interval_ns(events) is not None:
+        stated = abrupt_score.score_events(events, truth_frame, tolerance_s=tol, start=start, end=end, intervals=True)
         click.echo(
             f"with the events' stated intervals (truth inside an event's interval or within ±{tolerance_days:g} d "
             f"of its time): TP {stated.true_positives}  FP {stated.false_positives}  FN {stated.false_negatives}  "
@@ -394,7 +430,7 @@ def score(
     if start is not None and end is not None:
         out["operating_points"] = []
         for rate in fa_rates:
-            op = recall_at_false_alarm_rate(
+            op = abrupt_score.recall_at_false_alarm_rate(
                 events, truth_frame, false_alarms_per_year=rate, start=start, end=end, tolerance_s=tol
             )
             click.echo(
@@ -415,12 +451,21 @@ def _flag_undetectable(elements: str, events: Any, truth: Any, start: Any, end: 
     """Compare the truth's burns with the smallest ΔV the history's element sets resolve per year (at the
     events' budget) and flag a history whose listed burns are mostly below it."""
     per_day = events["false_alarms_per_day"].dropna() if "false_alarms_per_day" in events else pd.Series([])
-    budget = FalseAlarmBudget(float(per_day.iloc[0]) * DAYS_PER_YEAR, "year") if len(per_day) else DEFAULT_TLE_BUDGET
-    history = read_elements(elements)
-    by_year = detector_for(history).detect(history, budget).diagnostics[0].noise_model.get("detectable_by_year", [])
+    budget = (
+        thresholds.FalseAlarmBudget(float(per_day.iloc[0]) * thresholds.DAYS_PER_YEAR, "year")
+        if len(per_day)
+        else detect_tle_config.DEFAULT_TLE_BUDGET
+    )
+    history = readers_omm.read_elements(elements)
+    by_year = (
+        detect_tle_detectors.detector_for(history)
+        .detect(history, budget)
+        .diagnostics[0]
+        .noise_model.get("detectable_by_year", [])
+    )
     times = pd.to_datetime(truth["time_utc"].astype(str), utc=True)
     inside = truth.loc[(times >= pd.Timestamp(start, tz="UTC")) & (times <= pd.Timestamp(end, tz="UTC"))]
-    below, total = burns_below_detectable(inside, by_year)
+    below, total = pipelines_tle.burns_below_detectable(inside, by_year)
     if total == 0:
         click.echo("detectable ΔV: the truth file states no ΔV; burns below what the element sets resolve unknown")
         return {"burns_with_dv": 0, "below": 0, "flagged": False}
@@ -482,7 +527,7 @@ def inject_tle(
         raise click.BadParameter(f"{seeds} seeds: give 1 to 100", param_hint="--seeds")
     if out and not str(out).lower().endswith(".csv"):
         raise click.BadParameter(f"{out}: write a .csv", param_hint="--out")
-    result = detect_tle_file(path, budget, norad_id=norad_id, strict=strict)
+    result = pipelines_tle.detect_tle_file(path, budget, norad_id=norad_id, strict=strict)
     if len(result.satellites) != 1:
         raise InputError(f"{len(result.satellites)} satellites in the file: select one with --norad", file=path, line=1)
     sat = result.satellites[0]
@@ -495,39 +540,40 @@ def inject_tle(
         found = sat.events.loc[sat.events["statistic"] >= sat.events["threshold"]] if len(sat.events) else sat.events
         known = list(pd.to_datetime(found["time_utc"].astype(str), utc=True).dt.tz_localize(None))
         source = f"the detector's own {len(known)} detections"
-    if len(sat.history) < MIN_ELEMENT_SETS:
+    if len(sat.history) < (least_sets := simulate_tle_injection.MIN_ELEMENT_SETS):
         raise InputError(
-            f"{len(sat.history)} element sets: too few to draw noise blocks from (at least {MIN_ELEMENT_SETS})",
+            f"{len(sat.history)} element sets: too few to draw noise blocks from (at least {least_sets})",
             file=path,
         )
     nm = sat.noise_model
     try:
         # sizes at 1/4 to 8 times what the detector states it finds half the time on this history
         ladders = (
-            ladder_around(100.0 * float(nm["min_detectable_dv_t_mps"])),
-            ladder_around(100.0 * float(nm["min_detectable_dv_n_mps"])),
+            simulate_tle_injection.ladder_around(100.0 * float(nm["min_detectable_dv_t_mps"])),
+            simulate_tle_injection.ladder_around(100.0 * float(nm["min_detectable_dv_n_mps"])),
         )
-        burns, summary = injection_recall(
+        burns, summary = simulate_tle_injection.injection_recall(
             sat.history, known, budget, years=years, seeds=range(seeds), ladders_cm_s=ladders
         )
     except (ValueError, KeyError) as exc:
         raise InputError(str(exc), file=path) from None
     click.echo(
-        f"{satellite_label(sat.history)} ({summary['regime'].upper()}): {seeds} histories of its own noise "
+        f"{pipelines_tle.satellite_label(sat.history)} ({summary['regime'].upper()}): "
+        f"{seeds} histories of its own noise "
         f"(quiet = away from {source}), {summary['sat_years']:.1f} satellite-years, budget {budget}",
         err=True,
     )
     if burns.empty:
         raise InputError("no injected burn fell in a gap clear of the noise blocks' junctions", file=path)
     table = burns.groupby(["kind", "dv_cm_s"])["found"].agg(["sum", "size"])
-    for kind in KINDS[summary["regime"]]:
+    for kind in simulate_tle_injection.KINDS[summary["regime"]]:
         if kind not in table.index.get_level_values(0):
             continue
         sub = table.loc[kind]
         cells = ", ".join(f"{dv:g} cm/s {int(r['sum'])}/{int(r['size'])}" for dv, r in sub.iterrows())
         click.echo(
             f"  {kind}: {cells}; stated 50 % size {summary['stated_min_dv_cm_s'][kind]:.2g} cm/s "
-            f"(real history {ladders[KINDS[summary['regime']].index(kind)][2]:.2g}), "
+            f"(real history {ladders[simulate_tle_injection.KINDS[summary['regime']].index(kind)][2]:.2g}), "
             f"found >= 90 % from {summary['found_90pct_from_cm_s'][kind]:g} cm/s"
         )
     click.echo(
@@ -538,6 +584,6 @@ def inject_tle(
         burns.to_csv(out, index=False)
         click.echo(f"burns written to {out}", err=True)
     if report_path:
-        label = f"{satellite_label(sat.history)}: injected burns"
-        target = plot_injection_recall(burns, summary, report_path, title=label)
+        label = f"{pipelines_tle.satellite_label(sat.history)}: injected burns"
+        target = abrupt_report_tle.plot_injection_recall(burns, summary, report_path, title=label)
         click.echo(f"report written to {target}", err=True)

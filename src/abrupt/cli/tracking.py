@@ -5,22 +5,36 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
-import numpy as np
-import pandas as pd
 
+from abrupt.cli.commands import lazy_module
 from abrupt.cli.groups import catalog_option, detect, progress, record_run, report, report_option, simulate
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.errors import ConfigError
-from abrupt.events import read_events, write_events
-from abrupt.model.stations import ascension
-from abrupt.pipelines.tracking import TrackingSettings, detect_tracking, read_tracking_series
-from abrupt.readers.orekit_od_input import write_od_input
-from abrupt.readers.tdm import write_tdm
-from abrupt.report.tracking import plot_tracking_report
-from abrupt.simulate.tracking import CASE1, CASE2, TrackingScenario, simulate_tracking, thesis_burn
+
+if TYPE_CHECKING:
+    import numpy as np
+    import pandas as pd
+
+    from abrupt import events as abrupt_events
+    from abrupt.model import stations as model_stations
+    from abrupt.pipelines import tracking as pipelines_tracking
+    from abrupt.readers import orekit_od_input as readers_orekit_od_input
+    from abrupt.readers import tdm as readers_tdm
+    from abrupt.report import tracking as report_tracking
+    from abrupt.simulate import tracking as abrupt_simulate_tracking
+else:
+    abrupt_events = lazy_module("abrupt.events")
+    model_stations = lazy_module("abrupt.model.stations")
+    pipelines_tracking = lazy_module("abrupt.pipelines.tracking")
+    readers_orekit_od_input = lazy_module("abrupt.readers.orekit_od_input")
+    readers_tdm = lazy_module("abrupt.readers.tdm")
+    report_tracking = lazy_module("abrupt.report.tracking")
+    abrupt_simulate_tracking = lazy_module("abrupt.simulate.tracking")
+    np = lazy_module("numpy")
+    pd = lazy_module("pandas")
 
 
 @simulate.command("tracking")
@@ -50,6 +64,7 @@ from abrupt.simulate.tracking import CASE1, CASE2, TrackingScenario, simulate_tr
     type=click.Choice(["perigee", "apogee", "quarter_after_perigee", "quarter_after_apogee"]),
     default="apogee",
     show_default=True,
+    help="Where on the orbit the burn is centred.",
 )
 @click.option(
     "--direction",
@@ -84,8 +99,14 @@ from abrupt.simulate.tracking import CASE1, CASE2, TrackingScenario, simulate_tr
     help="Multiply the thesis noise (5 m, 0.02 rad, 0.5 m/s).",
 )
 @click.option("--epoch", "epoch_utc", default="2024-01-01T00:00:00", show_default=True, help="UTC epoch of the start.")
-@click.option("--earth-rotation", type=click.Choice(["simple", "iers"]), default="simple", show_default=True)
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option(
+    "--earth-rotation",
+    type=click.Choice(["simple", "iers"]),
+    default="simple",
+    show_default=True,
+    help="Earth rotation: simple (uniform spin, as the thesis) or iers (IERS orientation table, bundled).",
+)
+@click.option("--seed", type=int, default=0, show_default=True, help="Random seed of the noise (reproducible).")
 @click.option("--name", "spacecraft", default="SIM-TRACK", show_default=True, help="Spacecraft pseudonym.")
 def simulate_tracking_command(
     out: str,
@@ -112,11 +133,15 @@ def simulate_tracking_command(
     """
     if cadence_s <= 0 or burn_s <= 0 or noise_scale < 0:
         raise ConfigError("cadence, burn duration must be > 0 and noise scale >= 0", key="simulate tracking")
-    case = CASE1 if orbit == "case1" else CASE2
-    burns = () if dv_mps == 0 else (thesis_burn(location, direction, dv_mps, duration_s=burn_s, orbit=case),)
-    scenario = TrackingScenario(
+    case = abrupt_simulate_tracking.CASE1 if orbit == "case1" else abrupt_simulate_tracking.CASE2
+    burns = (
+        ()
+        if dv_mps == 0
+        else (abrupt_simulate_tracking.thesis_burn(location, direction, dv_mps, duration_s=burn_s, orbit=case),)
+    )
+    scenario = abrupt_simulate_tracking.TrackingScenario(
         orbit=case,
-        stations=(ascension(mask_deg),),
+        stations=(model_stations.ascension(mask_deg),),
         cadence_s=cadence_s,
         burns=burns,
         earth_rotation=earth_rotation,  # type: ignore[arg-type]
@@ -124,15 +149,15 @@ def simulate_tracking_command(
         noise_scale=noise_scale,
         spacecraft=spacecraft,
     )
-    sim = simulate_tracking(scenario, seed=seed)
+    sim = abrupt_simulate_tracking.simulate_tracking(scenario, seed=seed)
     out_path = Path(out)
     out_path.parent.mkdir(parents=True, exist_ok=True)
     if out_path.suffix.lower() == ".aer":
         _write_aer(sim.measurements, out_path)
     else:
-        write_tdm(sim.measurements, out_path, spacecraft=spacecraft)
+        readers_tdm.write_tdm(sim.measurements, out_path, spacecraft=spacecraft)
     setup_path = Path(setup_out) if setup_out else out_path.with_suffix(".in")
-    write_od_input(
+    readers_orekit_od_input.write_od_input(
         setup_path,
         epoch_utc=sim.epoch_utc,
         state=sim.initial_state,
@@ -141,7 +166,7 @@ def simulate_tracking_command(
         mu_m3_s2=scenario.mu_m3_s2,
     )
     if truth_out:
-        write_events(sim.truth_events, truth_out)
+        abrupt_events.write_events(sim.truth_events, truth_out)
     click.echo(
         f"{len(sim.measurements)} measurement epochs written to {out_path}; setup {setup_path}"
         + (f"; truth {truth_out}" if truth_out else ""),
@@ -175,7 +200,13 @@ def _write_aer(measurements: Any, path: Path) -> None:
     help="Orekit-style input: a-priori orbit and stations (e.g. od_test_W3.in).",
 )
 @click.option("--out", "out", type=click.Path(dir_okay=False), default=None, help="Events file (.csv/.parquet).")
-@click.option("--method", type=click.Choice(["both", "kaderali", "glrt"]), default="both", show_default=True)
+@click.option(
+    "--method",
+    type=click.Choice(["both", "kaderali", "glrt"]),
+    default="both",
+    show_default=True,
+    help="Detector: kaderali (Ψ/K filter statistics, Kaderali 2021), glrt (batch GLR test), or both.",
+)
 @budget_options("0.1/day")
 @click.option(
     "--psi-threshold",
@@ -201,7 +232,9 @@ def _write_aer(measurements: Any, path: Path) -> None:
     default=None,
     help="Correct elevations for refraction (default: as the setup file says).",
 )
-@click.option("--max-maneuvers", type=int, default=3, show_default=True)
+@click.option(
+    "--max-maneuvers", type=int, default=3, show_default=True, help="At most this many manoeuvres sought in the arc."
+)
 @click.option(
     "--kaderali-threshold",
     type=click.Choice(["simulated", "chi2"]),
@@ -245,7 +278,7 @@ def detect_tracking_command(
     runs the Kaderali EKF (Ψ, K) and the out-of-view GLRT. Events go to the catalog and --out.
     """
     budget = pop_budget(budget_args, "0.1/day")
-    settings = TrackingSettings(
+    settings = pipelines_tracking.TrackingSettings(
         method=method,  # type: ignore[arg-type]
         psi_threshold=psi_threshold,
         eta_threshold_km=eta_threshold,
@@ -256,8 +289,8 @@ def detect_tracking_command(
         max_maneuvers=max_maneuvers,
         kaderali_threshold=kaderali_threshold,  # type: ignore[arg-type]
     )
-    inputs = read_tracking_series(file, setup_path, settings, name=spacecraft)
-    run = detect_tracking(inputs, settings, budget, file_name=Path(file).name)
+    inputs = pipelines_tracking.read_tracking_series(file, setup_path, settings, name=spacecraft)
+    run = pipelines_tracking.detect_tracking(inputs, settings, budget, file_name=Path(file).name)
     for line in run.summary_lines():
         click.echo(line, err=True)
     if fit_out:
@@ -277,7 +310,7 @@ def detect_tracking_command(
     if report_path and len(run.diagnostics):
         diag = run.diagnostics.copy()
         diag["time_utc"] = pd.to_datetime(diag["time_utc"])
-        plot_tracking_report(diag, events=run.events, path=report_path)
+        report_tracking.plot_tracking_report(diag, events=run.events, path=report_path)
         click.echo(f"report written to {report_path}", err=True)
 
 
@@ -295,8 +328,8 @@ def detect_tracking_command(
 def report_tracking_command(diagnostics: str, events_path: str | None, truth_path: str | None, out: str) -> None:
     """Ψ and K against time (Kaderali 2021 Figs. 3.2-3.4) and the GLRT statistic, with events and truth."""
     diag = pd.read_csv(diagnostics, parse_dates=["time_utc"])
-    events = read_events(events_path) if events_path else None
-    truth = read_events(truth_path) if truth_path else None
+    events = abrupt_events.read_events(events_path) if events_path else None
+    truth = abrupt_events.read_events(truth_path) if truth_path else None
     for _ in progress([0], total=1, desc="report"):
-        plot_tracking_report(diag, events=events, truth=truth, path=out)
+        report_tracking.plot_tracking_report(diag, events=events, truth=truth, path=out)
     click.echo(f"report written to {out}", err=True)

@@ -36,6 +36,7 @@ from scipy.interpolate import CubicHermiteSpline, CubicSpline
 from abrupt.errors import RepairLog
 from abrupt.model.light_time import shapiro_delay_m, two_way_range_m
 from abrupt.model.orbit import OMEGA_EARTH_RAD_S
+from abrupt.model.range_terms import RANGE_MODEL_TERMS as RANGE_MODEL_TERMS  # re-exported
 from abrupt.model.station_motion import eccentricity_ecef_m, solid_tide_displacement_m, sun_moon_ecef_m
 from abrupt.model.tracking_measurements import as_datetime64_ns, earth_rotation_matrices
 from abrupt.model.troposphere import laser_delay_m, radio_delay_m, water_vapour_pressure_hpa
@@ -67,9 +68,6 @@ class RangeModel:
         flags |= {"eccentricity": self.eccentricity, "solid_tides": self.solid_tides}
         flags[term] = False
         return RangeModel(troposphere=self.troposphere, wavelength_um=self.wavelength_um, **flags)
-
-
-RANGE_MODEL_TERMS = ("light_time", "troposphere", "shapiro", "plate_motion", "eccentricity", "solid_tides")
 
 
 @dataclass(frozen=True)

@@ -504,7 +504,7 @@ class FlightResult:
 def day_range(store: TelemetryStore, spacecraft: str, days: Iterable[str] | None) -> list[str]:
     stored = store.days(spacecraft)
     if not stored:
-        raise InputError(f"no stored days for spacecraft {spacecraft!r}", file=store.root)
+        raise InputError(f"no stored days for spacecraft {spacecraft!r}; {store.holdings()}", file=store.root)
     if days is None:
         return stored
     out: list[str] = []

@@ -36,6 +36,7 @@ import pandas as pd
 from abrupt.errors import ConfigError
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.timetable import NS
+from abrupt.simulate.confounder_kinds import CONFOUNDER_CLASS, CONFOUNDER_KINDS
 from abrupt.simulate.injection import (
     InjectionAttitude,
     InjectionRows,
@@ -45,19 +46,6 @@ from abrupt.simulate.injection import (
     rate_response,
 )
 from abrupt.types import FloatArray
-
-#: Confounder kinds and the class a correct attribution gives them.
-CONFOUNDER_CLASS: dict[str, str] = {
-    "star_tracker_jump": "sensor_fault",
-    "gyro_spike": "sensor_fault",
-    "gyro_bias_step": "sensor_fault",
-    "tachometer_miscount": "sensor_fault",
-    "wheel_speed_glitch": "sensor_fault",
-    "thruster_leak": "external_non_strike",
-    "venting": "external_non_strike",
-    "appendage_snap": "internal",
-}
-CONFOUNDER_KINDS: tuple[str, ...] = tuple(CONFOUNDER_CLASS)
 
 Range = tuple[float, float]
 

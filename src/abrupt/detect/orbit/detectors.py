@@ -46,6 +46,7 @@ from abrupt.detect.orbit.boundaries import (
 from abrupt.detect.orbit.calibration import calibrate_thresholds, self_calibrate
 from abrupt.detect.orbit.ekf import FilterConfig, NuisanceConfig
 from abrupt.detect.orbit.events import find_events
+from abrupt.detect.orbit.statistic_names import STATISTIC_SUMMARIES
 from abrupt.detect.orbit.tuning import auto_tune
 from abrupt.errors import InputError
 from abrupt.events import config_hash
@@ -325,19 +326,6 @@ class OrbitDetector(Detector[Ephemeris]):
                 out.append(Diagnostics(f"orbit.{key}", analysis.t_s, values, thresholds.get(key), epoch))
         return tuple(out)
 
-
-#: The statistics that raise events, each the registered detector ``orbit.<statistic>``, with its summary.
-STATISTIC_SUMMARIES: dict[str, str] = {
-    "glr": "sliding GLR of a velocity jump in the forward filter's innovations (default)",
-    "accel_smoothed": "smoothed unmodelled acceleration (Bennett 2022 TS3)",
-    "mcr_w": "McReynolds consistency of the acceleration states (Bennett 2022 TS4)",
-    "mcr_scalar": "scalar McReynolds consistency (Bennett 2022 TS4)",
-    "mahalanobis_v": "velocity Mahalanobis distance (Bennett 2022 TS2)",
-    "dv_fb": "forward-backward velocity difference (Bennett 2022 TS1)",
-    "d_sma": "change of semi-major axis (Bennett 2022 TS6)",
-    "d_ecc": "change of eccentricity vector (Bennett 2022 TS6)",
-    "d_hdir": "change of angular-momentum direction (Bennett 2022 TS6)",
-}
 
 #: ``orbit.<statistic>`` → its class: :class:`OrbitDetector` with the statistic set (defining each
 #: subclass registers it).

@@ -6,6 +6,7 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
+from abrupt.detect.tle.default_rate import DEFAULT_TLE_RATE
 from abrupt.thresholds import FalseAlarmBudget
 
 EXTRA_COLUMNS: tuple[str, ...] = (
@@ -36,8 +37,7 @@ EXTRA_COLUMNS: tuple[str, ...] = (
 # scores the same or better with 2, every GEO history the same or better with 3 (docs/tle.md).
 CAMPAIGN_SIDE_SETS = {"leo": 2, "geo": 3}
 
-# A TLE history has a few hundred element sets a year: its budget is stated per satellite-year.
-DEFAULT_TLE_BUDGET = FalseAlarmBudget(1.0, "year")
+DEFAULT_TLE_BUDGET = FalseAlarmBudget.parse(DEFAULT_TLE_RATE)
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,212 @@
+"""What a new user trips over in the first week: a store opened with another spacecraft's file, help that
+misses a description or a sub-command's spelling, kinds the catalog refuses, figures that hide their
+thresholds."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import click
+import pytest
+from click.testing import CliRunner
+
+from abrupt.catalog import Catalog
+from abrupt.cli.commands import cli
+from abrupt.cli.main import main
+from abrupt.detect.base import detector_names, get_detector
+from abrupt.errors import InputError
+from abrupt.events import Event, events_frame
+from abrupt.kinds import EVENT_KIND_MEANINGS, EVENT_KINDS
+from abrupt.pipelines.flight import day_range
+from abrupt.simulate.confounders import CONFOUNDER_CLASS
+from abrupt.store import TelemetryStore
+
+ROOT = Path(__file__).resolve().parent.parent
+THESIS_TOML = ROOT / "examples" / "spacecraft" / "thesis.toml"
+
+
+def _store_with_days(root: Path, spacecraft: str, days: list[str]) -> TelemetryStore:
+    """A store layout holding ``days`` of ``spacecraft`` (the day listing reads the partition files only)."""
+    for day in days:
+        folder = root / f"spacecraft={spacecraft}" / f"day={day}"
+        folder.mkdir(parents=True)
+        (folder / "samples.parquet").write_bytes(b"")
+    return TelemetryStore(root)
+
+
+def test_a_store_opened_with_another_spacecraft_file_names_what_it_holds(tmp_path: Path) -> None:
+    store = _store_with_days(tmp_path / "store", "SC-A", ["2026-03-10", "2026-03-11", "2026-03-12"])
+    with pytest.raises(InputError, match=r"'thesis'.*holds 'SC-A' \(3 day\(s\), 2026-03-10\.\.2026-03-12\)"):
+        day_range(store, "thesis", None)
+
+
+def test_an_empty_store_says_it_is_empty(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match="holds no spacecraft days"):
+        day_range(TelemetryStore(tmp_path), "thesis", None)
+
+
+def test_detect_attitude_on_a_store_of_another_spacecraft_is_one_line_naming_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    store = _store_with_days(tmp_path / "store", "SC-A", ["2026-03-10"])
+    args = ["detect", "attitude", "--store", str(store.root), "--spacecraft", str(THESIS_TOML)]
+    with pytest.raises(SystemExit) as exc:
+        main([*args, "--out", str(tmp_path / "e.csv"), "--catalog", str(tmp_path / "c.sqlite")])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "'thesis'" in err and "'SC-A' (1 day(s), 2026-03-10..2026-03-10)" in err
+
+
+def test_every_kind_a_detector_or_attribution_writes_is_in_the_documented_vocabulary() -> None:
+    written = {get_detector(name).kind for name in detector_names()} | set(CONFOUNDER_CLASS.values())
+    assert written <= set(EVENT_KINDS)
+    assert all(EVENT_KIND_MEANINGS[kind].strip() for kind in EVENT_KINDS)
+
+
+def _event_of_kind(kind: str, day: int) -> Event:
+    return Event(
+        spacecraft="sat-a",
+        kind=kind,
+        detector="attitude.glr",
+        time_utc=f"2026-01-{day:02d}T00:00:00",
+        statistic=7.0,
+        threshold=5.0,
+        false_alarms_per_day=1.0,
+        run_id="r",
+        config_hash="cfg",
+    )
+
+
+@pytest.mark.parametrize("kind", EVENT_KINDS)
+def test_catalog_list_filters_on_every_kind_and_shows_it_whole(
+    kind: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    target = str(tmp_path / "c.sqlite")
+    Catalog(target).add_events(events_frame([_event_of_kind(k, i + 1) for i, k in enumerate(EVENT_KINDS)]))
+    main(["catalog", "list", "--catalog", target, "--kind", kind])
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 2  # the header and the one event of this kind
+    assert lines[1].split()[2] == kind  # time, spacecraft, then the kind, whole
+    assert max(len(line) for line in lines) <= 120
+
+
+def _leaves(group: click.Group, ctx: click.Context, path: tuple[str, ...] = ()) -> list[tuple[str, click.Command]]:
+    """Every leaf command of the tree under ``group``, with its command line (imports every capability)."""
+    out: list[tuple[str, click.Command]] = []
+    for name in group.list_commands(ctx):
+        command = group.get_command(ctx, name)
+        assert command is not None, name
+        if isinstance(command, click.Group):
+            out += _leaves(command, click.Context(command, parent=ctx, info_name=name), (*path, name))
+        else:
+            out.append((" ".join((*path, name)), command))
+    return out
+
+
+def test_every_option_of_every_command_is_described_and_shows_a_readable_default() -> None:
+    leaves = _leaves(cli, click.Context(cli, info_name="abrupt"))
+    assert len(leaves) > 30
+    undescribed, unreadable = [], []
+    for line, command in leaves:
+        for param in command.params:
+            if not isinstance(param, click.Option) or param.hidden:
+                continue
+            if not (param.help or "").strip():
+                undescribed.append(f"{line} {param.opts[0]}")
+            # a default shown as a float's full repr (0.0006946543314535649) is not read by a person
+            if param.show_default is True and isinstance(param.default, float) and len(repr(param.default)) > 10:
+                unreadable.append(f"{line} {param.opts[0]} = {param.default!r}")
+    assert not undescribed, "options without a description: " + ", ".join(undescribed)
+    assert not unreadable, "defaults shown unreadably: " + ", ".join(unreadable)
+
+
+def test_detect_laser_help_shows_the_area_to_mass_default_with_its_unit() -> None:
+    result = CliRunner().invoke(cli, ["detect", "laser", "--help"], terminal_width=200)
+    assert result.exit_code == 0
+    assert "0.0006946543314535649" not in result.output
+    assert "6.95e-4 m²/kg" in result.output
+
+
+@pytest.mark.parametrize(
+    ("argv", "nearest"),
+    [(["detect", "orbt"], "'orbit'"), (["detect", "tle-bach"], "'tle-batch'"), (["reprot"], "'report'")],
+)
+def test_a_misspelt_sub_command_suggests_the_nearest(
+    argv: list[str], nearest: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert f"No such command '{argv[-1]}'. Did you mean {nearest}?" in err
+    assert err.count("Did you mean") == 1
+
+
+def test_a_sub_command_nothing_like_any_suggests_nothing(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit):
+        main(["detect", "zzzzzz"])
+    err = capsys.readouterr().err
+    assert "No such command 'zzzzzz'." in err and "Did you mean" not in err
+
+
+HEAVY_MODULES = ("numba", "scipy", "pandas", "numpy", "astropy", "matplotlib", "sqlalchemy", "dask", "pyarrow")
+
+#: Run in a fresh interpreter: the command line given, then print the heavy packages it imported.
+_HEAVY_PROBE = """
+import sys
+from abrupt.cli.main import main
+try:
+    main(sys.argv[1:])
+except SystemExit:
+    pass
+heavy = sorted({name.split(".")[0] for name in sys.modules} & set(HEAVY))
+print("HEAVY=" + ",".join(heavy))
+"""
+
+#: Run in a fresh interpreter: every leaf command's help, then print the heavy packages imported.
+_ALL_HELP_PROBE = """
+import sys
+import click
+from abrupt.cli.commands import cli
+
+def walk(group, ctx):
+    for name in group.list_commands(ctx):
+        command = group.get_command(ctx, name)
+        sub = click.Context(command, parent=ctx, info_name=name)
+        if isinstance(command, click.Group):
+            yield from walk(command, sub)
+        else:
+            yield sub
+
+helps = [ctx.get_help() for ctx in walk(cli, click.Context(cli, info_name="abrupt"))]
+heavy = sorted({name.split(".")[0] for name in sys.modules} & set(HEAVY))
+print(f"LEAVES={len(helps)}")
+print("HEAVY=" + ",".join(heavy))
+"""
+
+
+def _probe(script: str, *args: str) -> str:
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    code = f"HEAVY = {HEAVY_MODULES!r}\n{script}"
+    done = subprocess.run([sys.executable, "-c", code, *args], env=env, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    return done.stdout
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [("detect", "tle", "--help"), ("detect", "attitude", "--help"), ("detect", "tle"), ("report", "catalog", "--bad")],
+    ids=["tle-help", "attitude-help", "tle-missing-argument", "catalog-bad-option"],
+)
+def test_a_leaf_help_or_option_error_imports_no_heavy_package(argv: tuple[str, ...]) -> None:
+    """Help and option errors come from the declarations alone (timings: benchmarks/bench_cli_help.py)."""
+    assert _probe(_HEAVY_PROBE, *argv).strip().splitlines()[-1] == "HEAVY="
+
+
+def test_every_leaf_help_imports_no_heavy_package() -> None:
+    lines = _probe(_ALL_HELP_PROBE).strip().splitlines()
+    assert int(lines[-2].removeprefix("LEAVES=")) > 30
+    assert lines[-1] == "HEAVY="
