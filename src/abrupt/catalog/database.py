@@ -54,6 +54,8 @@ from abrupt.catalog.schema import (
     events_table,
     metadata,
     migrate_v1,
+    migrate_v2,
+    read_coverage,
     runs_table,
     schema_table,
     sqlite_begin_immediate,
@@ -92,13 +94,29 @@ class Added:
 
 @dataclass(frozen=True)
 class Coverage:
-    """What a run analysed: a spacecraft, a detector and a time span, under one configuration."""
+    """What a run analysed: a spacecraft, a detector and a time span, under one configuration.
+
+    ``span_of`` says what the span is: ``data`` (the first and last sample the run analysed) or
+    ``events`` (its first and last event, when the run did not say what it analysed).
+    """
 
     spacecraft: str
     detector: str
     config_hash: str
     start_utc: str
     end_utc: str
+    span_of: str = "data"
+
+
+@dataclass(frozen=True)
+class AnalysedSpan:
+    """The data a run analysed for one spacecraft: its first and last sample time (UTC), and the
+    detector that analysed it (None: every detector of the run)."""
+
+    spacecraft: str
+    start_utc: Any
+    end_utc: Any
+    detector: str | None = None
 
 
 def catalog_url(target: str | Path) -> str:
@@ -212,6 +230,7 @@ class Catalog:
                 if foreign := foreign_table(conn, (coverage_table, tasks_table), schema_table.name):
                     raise CatalogError(f"{self.name}: {foreign}; abrupt never alters it: choose another --catalog")
                 migrate_v1(conn)
+                migrate_v2(conn)
                 metadata.create_all(conn)
                 if conn.execute(sa.select(sa.func.count()).select_from(schema_table)).scalar_one() == 0:
                     conn.execute(schema_table.insert().values(version=SCHEMA_VERSION))
@@ -288,6 +307,7 @@ class Catalog:
                 "start_utc": to_naive_utc(c.start_utc),
                 "end_utc": to_naive_utc(c.end_utc),
                 "recorded_utc": _now(),
+                "span_of": c.span_of,
             }
             for c in coverage
         }
@@ -451,16 +471,11 @@ class Catalog:
             frame = pd.DataFrame(
                 conn.execute(query).mappings().all(), columns=[*EVENT_COLUMNS, "event_key", "extra_json"]
             )
-            cover = pd.DataFrame(
-                conn.execute(
-                    sa.select(coverage_table, runs_table.c.started_utc).join(
-                        runs_table, runs_table.c.run_id == coverage_table.c.run_id
-                    )
-                )
-                .mappings()
-                .all(),
-                columns=[*(col.name for col in coverage_table.columns), "started_utc"],
+            started = pd.DataFrame(
+                conn.execute(sa.select(runs_table.c.run_id, runs_table.c.started_utc)).all(),
+                columns=["run_id", "started_utc"],
             )
+            cover = read_coverage(conn).merge(started, on="run_id", how="inner")
         if run_id is not None:
             frame = frame[_reported_by(frame, cover, run_id)]
         elif not all_configurations:
@@ -575,21 +590,46 @@ def coverage_of(
     detectors: Iterable[str] = (),
     start_utc: Any = None,
     end_utc: Any = None,
+    analysed: Iterable[AnalysedSpan] = (),
 ) -> list[Coverage]:
-    """What a run covered: the given spacecraft, detectors and span, or else those of its events."""
-    names = sorted(set(detectors) | set(events["detector"].astype(str))) if len(events) or detectors else []
-    if not names:
-        return []
-    times = pd.to_datetime(events["time_utc"].astype(str), utc=True) if len(events) else None
-    start = start_utc if start_utc is not None else (times.min() if times is not None else None)
-    end = end_utc if end_utc is not None else (times.max() if times is not None else None)
-    if start is None or end is None:
-        return []
-    crafts = [spacecraft] if spacecraft else sorted(set(events["spacecraft"].astype(str)))
-    out = []
-    for sc in crafts:
+    """What a run covered, per spacecraft and detector.
+
+    ``analysed`` spans (one per spacecraft, from the data each spacecraft's analysis read) come first;
+    else ``start_utc``/``end_utc`` for the one ``spacecraft`` the run analysed. A spacecraft with
+    neither gets the span of its own events (``span_of="events"``), never another spacecraft's. A
+    spacecraft analysed without events (a quiet run) is covered under ``detectors``.
+    """
+    given = list(analysed)
+    if not given and spacecraft is not None and start_utc is not None and end_utc is not None:
+        given = [AnalysedSpan(spacecraft, start_utc, end_utc)]
+    detectors = list(detectors)
+    out: list[Coverage] = []
+    seen: set[tuple[str, str]] = set()
+
+    def config_of(sc: str, det: str) -> str:
+        sel = events[(events["spacecraft"].astype(str) == sc) & (events["detector"].astype(str) == det)]
+        return str(sel["config_hash"].iloc[0]) if len(sel) else config_hash
+
+    for span in given:
+        sc = str(span.spacecraft)
+        own = (
+            sorted(set(events.loc[events["spacecraft"].astype(str) == sc, "detector"].astype(str)))
+            if len(events)
+            else []
+        )
+        names = [span.detector] if span.detector else sorted(set(detectors) | set(own))
         for det in names:
-            sel = events[(events["spacecraft"] == sc) & (events["detector"] == det)]
-            cfg = str(sel["config_hash"].iloc[0]) if len(sel) else config_hash
-            out.append(Coverage(sc, det, cfg, format_time_utc(start), format_time_utc(end)))
+            if (sc, det) not in seen:
+                seen.add((sc, det))
+                start, end = format_time_utc(span.start_utc), format_time_utc(span.end_utc)
+                out.append(Coverage(sc, det, config_of(sc, det), start, end, "data"))
+    if len(events):
+        times = pd.to_datetime(events["time_utc"].astype(str), utc=True)
+        groups = times.groupby([events["spacecraft"].astype(str), events["detector"].astype(str)])
+        for (sc, det), t in groups:
+            if (sc, det) not in seen:
+                seen.add((sc, det))
+                out.append(
+                    Coverage(sc, det, config_of(sc, det), format_time_utc(t.min()), format_time_utc(t.max()), "events")
+                )
     return out

@@ -217,6 +217,7 @@ def detect_tle_batch_cmd(
         run_id=run.run_id,
         out=out,
         details={"files": len(files), "budget": str(budget), "resumed_files": run.n_resumed},
+        analysed=run.analysed,
     )
     if not keep_parts:
         remove_parts(run.parts)

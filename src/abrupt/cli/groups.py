@@ -19,7 +19,7 @@ from typing import Any, TypeVar
 import click
 
 from abrupt import progress as progress_report
-from abrupt.catalog import Catalog, coverage_of
+from abrupt.catalog import AnalysedSpan, Catalog, coverage_of
 from abrupt.cli.commands import GLOBAL_FLAGS, State, cli, detect, hoist_global_flags, inject, report, simulate
 from abrupt.events import write_events
 
@@ -172,11 +172,13 @@ def record_run(
     spacecraft: str | None = None,
     detectors: Iterable[str] = (),
     span_utc: tuple[Any, Any] | None = None,
+    analysed: Iterable[AnalysedSpan] = (),
 ) -> int:
     """Store a run's events in the catalog and the output file; print a one-line summary.
 
-    ``spacecraft``, ``detectors`` and ``span_utc`` say what the run analysed (default: what its events
-    show), so the catalog's latest view can tell an event no longer found from one never looked for.
+    ``spacecraft``, ``detectors`` and ``span_utc`` (one spacecraft) or ``analysed`` (a span per
+    spacecraft) say what the run analysed (default: each spacecraft's own events), so the catalog's
+    latest view can tell an event no longer found from one never looked for, and a quiet run is seen.
     Returns the number of events that were new to the catalog.
     """
     details = {**(details or {}), **command_options()}
@@ -200,6 +202,7 @@ def record_run(
         detectors=detectors,
         start_utc=span_utc[0] if span_utc else None,
         end_utc=span_utc[1] if span_utc else None,
+        analysed=analysed,
     )
     catalog.finish_run(run_id, n_found=len(events), n_new=added.events, details=details, coverage=coverage)
     again = len(events) - added.detections

@@ -140,4 +140,5 @@ def detect_laser_command(
         input_path=crd_files[0],
         out=out,
         details={"fit": run.summary},
+        analysed=run.analysed,
     )

@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import CubicSpline
 
+from abrupt.catalog import AnalysedSpan
 from abrupt.detect.tracking.glrt import DEFAULT_BUDGET, GlrtDetection, glrt_events
 from abrupt.detect.tracking.laser import LaserGlrtDetector
 from abrupt.errors import InputError, RepairLog
@@ -323,6 +324,7 @@ class LaserRangingRun:
     summary: dict[str, object]
     run_id: str
     config_hash: str
+    analysed: list[AnalysedSpan] = field(default_factory=list)
 
     def summary_lines(self) -> list[str]:
         lines = [f"post-fit range RMS per station (mm): {self.summary['residual_rms_mm']}"]
@@ -456,7 +458,9 @@ def run_laser_ranging_files(
     )
     frame = events_frame(events) if events else empty_frame()
     summary = _run_summary(result, len(meas), repairs)
-    return LaserRangingRun(frame, result, summary, run_id, cfg_hash)
+    times = np.asarray(meas["time_utc"], dtype="datetime64[ns]")
+    analysed = [AnalysedSpan(name, times.min(), times.max(), LaserGlrtDetector.name)]
+    return LaserRangingRun(frame, result, summary, run_id, cfg_hash, analysed)
 
 
 def laser_stations(sites: Mapping[str, StationSite], meas: pd.DataFrame) -> dict[str, Station]:
