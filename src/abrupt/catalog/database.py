@@ -52,6 +52,8 @@ from abrupt.catalog.schema import (
     coverage_table,
     event_key,
     events_table,
+    evidence_rows,
+    evidence_table,
     metadata,
     migrate_v1,
     migrate_v2,
@@ -66,10 +68,11 @@ from abrupt.catalog.schema import (
 from abrupt.errors import AbruptError
 from abrupt.events import (
     EVENT_COLUMNS,
+    EVIDENCE_PREFIX,
     format_time_columns,
     format_time_utc,
     normalise_frame,
-    write_events,
+    write_events_and_evidence,
 )
 
 #: Key of the PostgreSQL advisory lock that serialises catalog writers (any fixed 64-bit integer).
@@ -415,7 +418,8 @@ class Catalog:
             keys.append(key)
         order = np.argsort(times.to_numpy(), kind="stable")
         key_of_row = dict(zip(order.tolist(), keys, strict=True))
-        extra_cols = [col for col in new.columns if col not in EVENT_COLUMNS]
+        evidence_cols = [col for col in new.columns if str(col).startswith(EVIDENCE_PREFIX)]
+        extra_cols = [col for col in new.columns if col not in EVENT_COLUMNS and col not in evidence_cols]
         records: list[dict[str, Any]] = []
         for i, new_rec in enumerate(new.to_dict("records")):
             row = {col: clean_value(new_rec[col]) for col in EVENT_COLUMNS}
@@ -424,6 +428,8 @@ class Catalog:
             row["extra_json"] = json.dumps({str(col): clean_value(new_rec[col]) for col in extra_cols}, default=str)
             records.append(row)
         conn.execute(events_table.insert(), records)
+        if evidence := evidence_rows(new, evidence_cols):
+            conn.execute(evidence_table.insert(), evidence)
         return Added(len(records), n_new_events)
 
     @_one_line_errors
@@ -482,7 +488,10 @@ class Catalog:
             frame = frame[_current(frame, cover)]
         frame = frame.reset_index(drop=True)
         frame["time_utc"] = [format_time_utc(t) for t in frame["time_utc"]]
-        extras = [json.loads(x) if x else {} for x in frame.pop("extra_json")]
+        extras = [  # evidence written inside an event by an older abrupt is in :meth:`evidence`
+            {k: v for k, v in json.loads(x).items() if not k.startswith(EVIDENCE_PREFIX)} if x else {}
+            for x in frame.pop("extra_json")
+        ]
         extra_frame = pd.DataFrame(extras, index=frame.index)
         if not extra_frame.empty:
             frame = pd.concat([frame, extra_frame.drop(columns=[k for k in extra_frame if k in frame])], axis=1)
@@ -491,14 +500,49 @@ class Catalog:
         return frame
 
     @_one_line_errors
+    def evidence(self, event_ids: Iterable[str] | None = None) -> pd.DataFrame:
+        """The attribution evidence of events (all, or ``event_ids``): one row per event, ``event_id`` and
+        the ``ev_*`` quantities (NaN where an event has none). Evidence an older abrupt stored inside the
+        event rows is read from there."""
+        wanted = None if event_ids is None else {str(x) for x in event_ids}
+        c = events_table.c
+        with self.engine.connect() as conn:
+            rows: list[tuple[str, str, Any]] = []
+            if evidence_table.name in set(sa.inspect(conn).get_table_names()):
+                for eid, name, value, text in conn.execute(sa.select(evidence_table)).all():
+                    rows.append((str(eid), str(name), value if text is None else text))
+            stored = {r[0] for r in rows}
+            query = sa.select(c.event_id, c.extra_json).where(c.extra_json.contains(f'"{EVIDENCE_PREFIX}'))
+            for eid, extra in conn.execute(query).all():
+                if str(eid) not in stored and extra:
+                    rows += [(str(eid), k, v) for k, v in json.loads(extra).items() if k.startswith(EVIDENCE_PREFIX)]
+        if wanted is not None:
+            rows = [r for r in rows if r[0] in wanted]
+        if not rows:
+            return pd.DataFrame({"event_id": pd.Series([], dtype="string")})
+        long = pd.DataFrame(rows, columns=["event_id", "name", "value"])
+        wide = long.pivot(index="event_id", columns="name", values="value").reset_index()
+        wide.columns.name = None
+        for col in wide.columns[1:]:
+            numeric = pd.to_numeric(wide[col], errors="coerce")
+            if numeric.notna().sum() == wide[col].notna().sum():
+                wide[col] = numeric.astype("float64")
+        wide["event_id"] = wide["event_id"].astype("string")
+        return wide
+
+    @_one_line_errors
     def export(self, path: str | Path, **filters: Any) -> int:
         """Export events (filters as :meth:`events`) to CSV or Parquet (by suffix); return the row count.
 
         Parquet stores ``time_utc`` as a UTC timestamp; every other ``*_utc`` column (the detectors'
-        details) is ISO-8601 UTC text with a ``Z``, the format of ``time_utc`` in CSV.
+        details) is ISO-8601 UTC text with a ``Z``, the format of ``time_utc`` in CSV. The events'
+        attribution evidence, when they have any, goes beside it (:func:`abrupt.events.evidence_path`).
         """
         frame = format_time_columns(self.events(**filters))
-        write_events(frame, str(path))
+        evidence = self.evidence(frame["event_id"].astype(str))
+        if evidence.shape[1] > 1:
+            frame = frame.merge(evidence, on="event_id", how="left")
+        write_events_and_evidence(frame, str(path))
         return len(frame)
 
     # ------------------------------------------------------------------------------------- tasks

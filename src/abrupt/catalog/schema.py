@@ -138,6 +138,26 @@ def migrate_v2(conn: sa.Connection) -> None:
         )
 
 
+def evidence_rows(frame: pd.DataFrame, columns: list[str]) -> list[dict[str, Any]]:
+    """Rows of the ``evidence`` table for the ``columns`` of ``frame`` (a number in ``value``, anything
+    else as text in ``text``; an empty value is no row)."""
+    rows: list[dict[str, Any]] = []
+    for rec in frame[["event_id", *columns]].to_dict("records"):
+        for name in columns:
+            value = clean_value(rec[name])
+            if value is None:
+                continue
+            if isinstance(value, bool | int | float):
+                number = float(value)
+                if math.isfinite(number):
+                    rows.append({"event_id": str(rec["event_id"]), "name": name, "value": number, "text": None})
+                else:
+                    rows.append({"event_id": str(rec["event_id"]), "name": name, "value": None, "text": str(number)})
+            else:
+                rows.append({"event_id": str(rec["event_id"]), "name": name, "value": None, "text": str(value)})
+    return rows
+
+
 def read_coverage(conn: sa.Connection) -> pd.DataFrame:
     """The coverage rows, with ``span_of`` NULL where the catalog predates it (read-only: no upgrade)."""
     columns = [c.name for c in coverage_table.columns]

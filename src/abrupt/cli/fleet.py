@@ -11,7 +11,7 @@ from abrupt.cli.groups import catalog_option, check_suffix, detect, note, progre
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.detect.attitude.momentum import AttitudeDetectionConfig
 from abrupt.errors import InputError
-from abrupt.events import config_hash, empty_frame, normalise_frame, write_events
+from abrupt.events import config_hash, empty_frame, normalise_frame, write_events_and_evidence
 from abrupt.pipelines.catalogue import read_table, remove_parts, run_catalogue
 from abrupt.pipelines.fleet import detect_attitude_fleet, read_manifest
 from abrupt.scale import Executor
@@ -107,7 +107,7 @@ def detect_fleet_cmd(
     for w in result.warnings:
         warn(w)
     Path(out).parent.mkdir(parents=True, exist_ok=True)
-    write_events(result.events, out)
+    write_events_and_evidence(result.events, out)
     resumed = f" ({result.n_resumed} finished earlier, resumed)" if result.n_resumed else ""
     note(f"{len(result.events)} event(s) from {result.n_tasks} task(s){resumed}; run {result.run_id}; written to {out}")
 

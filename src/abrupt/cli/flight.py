@@ -20,7 +20,7 @@ from abrupt.cli.groups import cli, inject, record_run, simulate
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.detect.attitude.flight_glr import FlightGlrDetector
 from abrupt.errors import InputError
-from abrupt.events import write_events
+from abrupt.events import write_events_and_evidence
 from abrupt.model.spacecraft import load_spacecraft
 from abrupt.pipelines.flight import CleaningConfig, FlightRunConfig, day_range, ingest_archives, run_flight
 from abrupt.pipelines.flight_injection import injection_recovery
@@ -145,7 +145,7 @@ def detect_from_store(
     result = run_flight_with_orbit(store_dir, sc, orbit_in, cfg, days=day_list, keep_series=keep, progress=tick)
     bar.close()
     if out:
-        write_events(result.events, out)
+        write_events_and_evidence(result.events, out)
     if catalog_target:
         record_run(
             catalog_target=catalog_target,

@@ -21,7 +21,7 @@ import click
 from abrupt import progress as progress_report
 from abrupt.catalog import AnalysedSpan, Catalog, coverage_of
 from abrupt.cli.commands import GLOBAL_FLAGS, State, cli, detect, hoist_global_flags, inject, report, simulate
-from abrupt.events import write_events
+from abrupt.events import write_events_and_evidence
 
 __all__ = [
     "DEFAULT_CATALOG",
@@ -184,9 +184,10 @@ def record_run(
     details = {**(details or {}), **command_options()}
     catalog = Catalog(catalog_target)  # open (and check) the catalog before writing anything
     catalog.check_fits(events)  # texts too long for the catalog: refused before the file is written
+    evidence_file = None
     if out is not None:  # then the file: a bad path must not leave events in the catalog only
         Path(out).parent.mkdir(parents=True, exist_ok=True)
-        write_events(events, str(out))
+        evidence_file = write_events_and_evidence(events, str(out))
     catalog.start_run(
         run_id,
         command,
@@ -213,5 +214,6 @@ def record_run(
         + (f", {again} already in the catalog" if again else "")
         + f" ({catalog.name})"
         + (f"; written to {out}" if out is not None else "")
+        + (f" (attribution evidence: {evidence_file})" if evidence_file is not None else "")
     )
     return added.events

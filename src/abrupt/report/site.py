@@ -74,6 +74,7 @@ class _View:
     coverage: pd.DataFrame
     details: dict[str, dict[str, Any]]
     exposure: pd.DataFrame
+    evidence: pd.DataFrame
 
 
 def _esc(value: Any) -> str:
@@ -133,7 +134,7 @@ def load_view(catalog: Catalog) -> _View:
             details[str(row.run_id)] = json.loads(str(row.details_json)) if row.details_json else {}
         except (TypeError, ValueError):
             details[str(row.run_id)] = {"details": str(row.details_json)}
-    return _View(events, runs, coverage, details, load_exposure(catalog))
+    return _View(events, runs, coverage, details, load_exposure(catalog), catalog.evidence())
 
 
 def _size(row: Mapping[Any, Any]) -> tuple[str, float]:
@@ -432,6 +433,18 @@ def _event_page(view: _View, event: pd.Series, out: Path, reports: Mapping[str, 
         for k, v in event.items()
         if k in EVENT_COLUMNS or k == "event_key" or not (isinstance(v, float) and math.isnan(v))
     )
+    evidence = view.evidence.loc[view.evidence["event_id"].astype(str) == str(event["event_id"])]
+    evidence_html = (
+        '<dl class="fields">'
+        + "".join(
+            f"<dt>{_esc(k)}</dt><dd>{_esc(v if not isinstance(v, float) else _fmt(v, 6))}</dd>"
+            for k, v in evidence.iloc[0].items()
+            if k != "event_id" and not (isinstance(v, float) and math.isnan(v))
+        )
+        + "</dl>"
+        if len(evidence)
+        else '<p class="muted">(no attribution evidence stored for this event)</p>'
+    )
     run_id = str(event["run_id"])
     report = reports.get(run_id)
     if report is None:
@@ -445,6 +458,7 @@ def _event_page(view: _View, event: pd.Series, out: Path, reports: Mapping[str, 
         f'<a href="../runs/{_slug(run_id)}.html">run {_esc(run_id)}</a></p>'
         f'<h2>Diagnostic figure</h2><img alt="diagnostic figure of the event" src="../figures/events/{fig.name}">'
         f'<h2>Fields</h2><dl class="fields">{fields}</dl>'
+        f"<h2>Attribution evidence</h2>{evidence_html}"
         f"<h2>The run's report figure</h2>{run_fig}"
         f"<h2>The run's configuration</h2>{_run_config_html(view, run_id, 1)}"
     )
