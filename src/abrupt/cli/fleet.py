@@ -80,11 +80,13 @@ def detect_fleet_cmd(
     out: str,
     **budget_args: Any,
 ) -> None:
-    """Detect strikes in every telemetry file listed in MANIFEST (CSV: spacecraft,telemetry,spacecraft_file).
+    """Detect strikes in every telemetry file or store in MANIFEST (CSV: spacecraft,telemetry,spacecraft_file[,store]).
 
-    One task per row (spacecraft, file), each calibrated on its own noise. Finished tasks are stored in
-    the catalog as they end: a run that was stopped or killed resumes where it stopped when started
-    again with the same inputs and settings. The budget is per spacecraft.
+    One task per row (spacecraft, file), each calibrated on its own noise. A row with an empty telemetry
+    and a store (written by `abrupt ingest`) runs the flight pipeline over that spacecraft's stored days,
+    as `abrupt detect attitude --store` does (--detector and --null-samples apply to telemetry rows).
+    Finished tasks are stored in the catalog as they end: a run that was stopped or killed resumes
+    where it stopped when started again with the same inputs and settings. The budget is per spacecraft.
     """
     budget = pop_budget(budget_args, "1/day")
     members = read_manifest(manifest)
