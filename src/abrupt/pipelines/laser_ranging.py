@@ -29,7 +29,7 @@ from abrupt.model.orbit.batch_fit import BatchFit, BatchFitConfig
 from abrupt.model.range_reduction import RangeModel, StationSite
 from abrupt.model.stations import Station
 from abrupt.model.tracking_measurements import TrackingArrays, as_datetime64_ns, earth_rotation_matrices
-from abrupt.pipelines.laser_apriori import ElementApriori, is_element_file, short_arc_fit
+from abrupt.pipelines.laser_apriori import MAX_ELEMENT_AGE_DAYS, ElementApriori, is_element_file, short_arc_fit
 from abrupt.readers.crd import read_crd
 from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.readers.sinex import SinexStation, bundled_ilrs_sinex, read_sinex, sinex_station
@@ -415,6 +415,14 @@ def run_laser_ranging_files(
     )
     elements = ElementApriori.read(apriori_path) if is_element_file(apriori_path) else None
     if elements is not None:
+        _, gap_days = elements.nearest(epoch)
+        if gap_days > MAX_ELEMENT_AGE_DAYS:
+            first_range = f"{np.datetime_as_string(epoch, unit='s')}Z"
+            raise InputError(
+                f"the element set nearest the first range epoch {first_range} is {gap_days:.0f} days from it (at most "
+                f"{MAX_ELEMENT_AGE_DAYS:g}: SGP4 drifts by kilometres a day); the a-priori orbit does not cover it",
+                file=apriori_path,
+            )
         apriori = _element_apriori(elements, meas, sites, stations, cfg, model)
     else:
         apriori = _ephemeris_apriori(apriori_path, repairs)
