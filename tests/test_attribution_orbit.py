@@ -26,7 +26,7 @@ from abrupt.detect.attitude.orbit_evidence import (
     orbit_evidence,
     spans_from_text,
 )
-from abrupt.events import Event, events_frame, make_event_id, write_events
+from abrupt.events import Event, events_frame, make_event_id, read_evidence, write_events
 from abrupt.model.spacecraft import load_spacecraft
 from abrupt.pipelines.flight import ingest_archives
 from abrupt.pipelines.flight_orbit import read_orbit_events
@@ -318,7 +318,7 @@ def test_cli_strike_on_a_light_spacecraft_that_the_orbit_did_not_feel(tmp_path: 
     cli_main(["detect", "attitude", "--store", str(tmp_path / "injected"), "--spacecraft", str(a.spacecraft),
               "--out", str(out), "--catalog", str(tmp_path / "cat.sqlite"), "--orbit-events", str(orbit),
               "--orbit-floor-mps", "2e-4", "--orbit-span", "2026-01-05T00:00..2026-01-05T12:00"])  # fmt: skip
-    ev = pd.read_csv(out)
+    ev = pd.read_csv(out).merge(read_evidence(out), on="event_id", how="left")  # the evidence: one join away
     t = (pd.to_datetime(ev["time_utc"].str.rstrip("Z")) - pd.Timestamp("2026-01-05T02:00:00")).dt.total_seconds()
     row = ev[t.abs() < 30.0]
     assert len(row) == 1

@@ -296,3 +296,63 @@ def read_events(path: str) -> pd.DataFrame:
             na_values={c: [""] for c in _FLOAT_COLUMNS},
         )
     return normalise_frame(frame)
+
+
+# ------------------------------------------------------------------------------ attribution evidence
+EVIDENCE_PREFIX = "ev_"
+"""Columns of attribution evidence (``ev_min_dv_mps``, ``ev_orbit_dv_mps``, ...): written to their own
+table keyed by ``event_id`` (:func:`write_events_and_evidence`), not beside the event."""
+
+
+def evidence_path(path: str | Path) -> Path:
+    """The evidence table beside an events file: ``events.csv`` → ``events.evidence.csv``,
+    ``events.parquet`` → ``events.evidence.parquet``."""
+    p = Path(path)
+    return p.with_name(f"{p.stem}.evidence{p.suffix}")
+
+
+def split_evidence(frame: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(the event table without ``ev_*`` columns, the evidence table: ``event_id`` and the ``ev_*`` columns).
+
+    The evidence table has only ``event_id`` when the events carry no evidence.
+    """
+    names = [c for c in frame.columns if str(c).startswith(EVIDENCE_PREFIX)]
+    evidence = frame[["event_id", *names]].copy() if "event_id" in frame else pd.DataFrame({"event_id": []})
+    return frame.drop(columns=names), evidence.reset_index(drop=True)
+
+
+def write_events_and_evidence(frame: pd.DataFrame, path: str) -> Path | None:
+    """Write the event table to ``path`` (:func:`write_events`) and, when the events carry attribution
+    evidence, the evidence table to :func:`evidence_path` (same format, keyed by ``event_id``; written
+    first, through a temporary file). Returns the evidence file, or None when there was no evidence."""
+    events, evidence = split_evidence(normalise_frame(frame))
+    target = None
+    if evidence.shape[1] > 1:
+        target = evidence_path(path)
+        if target.resolve() == Path(path).resolve():
+            raise ValueError(f"{path}: the evidence table would overwrite the events file")
+        tmp = target.with_name(f".{target.name}.{uuid.uuid4().hex[:12]}.tmp")
+        try:
+            if str(path).lower().endswith(".csv"):
+                evidence.to_csv(tmp, index=False)
+            else:
+                evidence.to_parquet(tmp, index=False)
+            os.replace(tmp, target)
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise
+    write_events(events, path)
+    return target
+
+
+def read_evidence(path: str | Path) -> pd.DataFrame:
+    """The evidence table written beside an events file (``event_id`` as text; empty when there is none)."""
+    target = evidence_path(path)
+    if not target.is_file():
+        return pd.DataFrame({"event_id": pd.Series([], dtype="string")})
+    if target.suffix.lower() == ".csv":
+        frame = pd.read_csv(target, dtype={"event_id": str})
+    else:
+        frame = pd.read_parquet(target)
+    frame["event_id"] = frame["event_id"].astype("string")
+    return frame

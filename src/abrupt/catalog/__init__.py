@@ -4,11 +4,21 @@
 the upgrade of old catalogs; :mod:`abrupt.catalog.foreign` the refusal of tables abrupt did not create.
 """
 
-from abrupt.catalog.database import Added, Catalog, CatalogError, Coverage, catalog_url, coverage_of, run_key
+from abrupt.catalog.database import (
+    Added,
+    AnalysedSpan,
+    Catalog,
+    CatalogError,
+    Coverage,
+    catalog_url,
+    coverage_of,
+    run_key,
+)
 from abrupt.catalog.schema import coverage_table, event_key
 
 __all__ = [
     "Added",
+    "AnalysedSpan",
     "Catalog",
     "CatalogError",
     "Coverage",

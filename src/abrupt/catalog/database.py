@@ -52,8 +52,12 @@ from abrupt.catalog.schema import (
     coverage_table,
     event_key,
     events_table,
+    evidence_rows,
+    evidence_table,
     metadata,
     migrate_v1,
+    migrate_v2,
+    read_coverage,
     runs_table,
     schema_table,
     sqlite_begin_immediate,
@@ -64,10 +68,11 @@ from abrupt.catalog.schema import (
 from abrupt.errors import AbruptError
 from abrupt.events import (
     EVENT_COLUMNS,
+    EVIDENCE_PREFIX,
     format_time_columns,
     format_time_utc,
     normalise_frame,
-    write_events,
+    write_events_and_evidence,
 )
 
 #: Key of the PostgreSQL advisory lock that serialises catalog writers (any fixed 64-bit integer).
@@ -92,13 +97,29 @@ class Added:
 
 @dataclass(frozen=True)
 class Coverage:
-    """What a run analysed: a spacecraft, a detector and a time span, under one configuration."""
+    """What a run analysed: a spacecraft, a detector and a time span, under one configuration.
+
+    ``span_of`` says what the span is: ``data`` (the first and last sample the run analysed) or
+    ``events`` (its first and last event, when the run did not say what it analysed).
+    """
 
     spacecraft: str
     detector: str
     config_hash: str
     start_utc: str
     end_utc: str
+    span_of: str = "data"
+
+
+@dataclass(frozen=True)
+class AnalysedSpan:
+    """The data a run analysed for one spacecraft: its first and last sample time (UTC), and the
+    detector that analysed it (None: every detector of the run)."""
+
+    spacecraft: str
+    start_utc: Any
+    end_utc: Any
+    detector: str | None = None
 
 
 def catalog_url(target: str | Path) -> str:
@@ -212,6 +233,7 @@ class Catalog:
                 if foreign := foreign_table(conn, (coverage_table, tasks_table), schema_table.name):
                     raise CatalogError(f"{self.name}: {foreign}; abrupt never alters it: choose another --catalog")
                 migrate_v1(conn)
+                migrate_v2(conn)
                 metadata.create_all(conn)
                 if conn.execute(sa.select(sa.func.count()).select_from(schema_table)).scalar_one() == 0:
                     conn.execute(schema_table.insert().values(version=SCHEMA_VERSION))
@@ -288,6 +310,7 @@ class Catalog:
                 "start_utc": to_naive_utc(c.start_utc),
                 "end_utc": to_naive_utc(c.end_utc),
                 "recorded_utc": _now(),
+                "span_of": c.span_of,
             }
             for c in coverage
         }
@@ -395,7 +418,8 @@ class Catalog:
             keys.append(key)
         order = np.argsort(times.to_numpy(), kind="stable")
         key_of_row = dict(zip(order.tolist(), keys, strict=True))
-        extra_cols = [col for col in new.columns if col not in EVENT_COLUMNS]
+        evidence_cols = [col for col in new.columns if str(col).startswith(EVIDENCE_PREFIX)]
+        extra_cols = [col for col in new.columns if col not in EVENT_COLUMNS and col not in evidence_cols]
         records: list[dict[str, Any]] = []
         for i, new_rec in enumerate(new.to_dict("records")):
             row = {col: clean_value(new_rec[col]) for col in EVENT_COLUMNS}
@@ -404,6 +428,8 @@ class Catalog:
             row["extra_json"] = json.dumps({str(col): clean_value(new_rec[col]) for col in extra_cols}, default=str)
             records.append(row)
         conn.execute(events_table.insert(), records)
+        if evidence := evidence_rows(new, evidence_cols):
+            conn.execute(evidence_table.insert(), evidence)
         return Added(len(records), n_new_events)
 
     @_one_line_errors
@@ -451,23 +477,21 @@ class Catalog:
             frame = pd.DataFrame(
                 conn.execute(query).mappings().all(), columns=[*EVENT_COLUMNS, "event_key", "extra_json"]
             )
-            cover = pd.DataFrame(
-                conn.execute(
-                    sa.select(coverage_table, runs_table.c.started_utc).join(
-                        runs_table, runs_table.c.run_id == coverage_table.c.run_id
-                    )
-                )
-                .mappings()
-                .all(),
-                columns=[*(col.name for col in coverage_table.columns), "started_utc"],
+            started = pd.DataFrame(
+                conn.execute(sa.select(runs_table.c.run_id, runs_table.c.started_utc)).all(),
+                columns=["run_id", "started_utc"],
             )
+            cover = read_coverage(conn).merge(started, on="run_id", how="inner")
         if run_id is not None:
             frame = frame[_reported_by(frame, cover, run_id)]
         elif not all_configurations:
             frame = frame[_current(frame, cover)]
         frame = frame.reset_index(drop=True)
         frame["time_utc"] = [format_time_utc(t) for t in frame["time_utc"]]
-        extras = [json.loads(x) if x else {} for x in frame.pop("extra_json")]
+        extras = [  # evidence written inside an event by an older abrupt is in :meth:`evidence`
+            {k: v for k, v in json.loads(x).items() if not k.startswith(EVIDENCE_PREFIX)} if x else {}
+            for x in frame.pop("extra_json")
+        ]
         extra_frame = pd.DataFrame(extras, index=frame.index)
         if not extra_frame.empty:
             frame = pd.concat([frame, extra_frame.drop(columns=[k for k in extra_frame if k in frame])], axis=1)
@@ -476,14 +500,49 @@ class Catalog:
         return frame
 
     @_one_line_errors
+    def evidence(self, event_ids: Iterable[str] | None = None) -> pd.DataFrame:
+        """The attribution evidence of events (all, or ``event_ids``): one row per event, ``event_id`` and
+        the ``ev_*`` quantities (NaN where an event has none). Evidence an older abrupt stored inside the
+        event rows is read from there."""
+        wanted = None if event_ids is None else {str(x) for x in event_ids}
+        c = events_table.c
+        with self.engine.connect() as conn:
+            rows: list[tuple[str, str, Any]] = []
+            if evidence_table.name in set(sa.inspect(conn).get_table_names()):
+                for eid, name, value, text in conn.execute(sa.select(evidence_table)).all():
+                    rows.append((str(eid), str(name), value if text is None else text))
+            stored = {r[0] for r in rows}
+            query = sa.select(c.event_id, c.extra_json).where(c.extra_json.contains(f'"{EVIDENCE_PREFIX}'))
+            for eid, extra in conn.execute(query).all():
+                if str(eid) not in stored and extra:
+                    rows += [(str(eid), k, v) for k, v in json.loads(extra).items() if k.startswith(EVIDENCE_PREFIX)]
+        if wanted is not None:
+            rows = [r for r in rows if r[0] in wanted]
+        if not rows:
+            return pd.DataFrame({"event_id": pd.Series([], dtype="string")})
+        long = pd.DataFrame(rows, columns=["event_id", "name", "value"])
+        wide = long.pivot(index="event_id", columns="name", values="value").reset_index()
+        wide.columns.name = None
+        for col in wide.columns[1:]:
+            numeric = pd.to_numeric(wide[col], errors="coerce")
+            if numeric.notna().sum() == wide[col].notna().sum():
+                wide[col] = numeric.astype("float64")
+        wide["event_id"] = wide["event_id"].astype("string")
+        return wide
+
+    @_one_line_errors
     def export(self, path: str | Path, **filters: Any) -> int:
         """Export events (filters as :meth:`events`) to CSV or Parquet (by suffix); return the row count.
 
         Parquet stores ``time_utc`` as a UTC timestamp; every other ``*_utc`` column (the detectors'
-        details) is ISO-8601 UTC text with a ``Z``, the format of ``time_utc`` in CSV.
+        details) is ISO-8601 UTC text with a ``Z``, the format of ``time_utc`` in CSV. The events'
+        attribution evidence, when they have any, goes beside it (:func:`abrupt.events.evidence_path`).
         """
         frame = format_time_columns(self.events(**filters))
-        write_events(frame, str(path))
+        evidence = self.evidence(frame["event_id"].astype(str))
+        if evidence.shape[1] > 1:
+            frame = frame.merge(evidence, on="event_id", how="left")
+        write_events_and_evidence(frame, str(path))
         return len(frame)
 
     # ------------------------------------------------------------------------------------- tasks
@@ -575,21 +634,46 @@ def coverage_of(
     detectors: Iterable[str] = (),
     start_utc: Any = None,
     end_utc: Any = None,
+    analysed: Iterable[AnalysedSpan] = (),
 ) -> list[Coverage]:
-    """What a run covered: the given spacecraft, detectors and span, or else those of its events."""
-    names = sorted(set(detectors) | set(events["detector"].astype(str))) if len(events) or detectors else []
-    if not names:
-        return []
-    times = pd.to_datetime(events["time_utc"].astype(str), utc=True) if len(events) else None
-    start = start_utc if start_utc is not None else (times.min() if times is not None else None)
-    end = end_utc if end_utc is not None else (times.max() if times is not None else None)
-    if start is None or end is None:
-        return []
-    crafts = [spacecraft] if spacecraft else sorted(set(events["spacecraft"].astype(str)))
-    out = []
-    for sc in crafts:
+    """What a run covered, per spacecraft and detector.
+
+    ``analysed`` spans (one per spacecraft, from the data each spacecraft's analysis read) come first;
+    else ``start_utc``/``end_utc`` for the one ``spacecraft`` the run analysed. A spacecraft with
+    neither gets the span of its own events (``span_of="events"``), never another spacecraft's. A
+    spacecraft analysed without events (a quiet run) is covered under ``detectors``.
+    """
+    given = list(analysed)
+    if not given and spacecraft is not None and start_utc is not None and end_utc is not None:
+        given = [AnalysedSpan(spacecraft, start_utc, end_utc)]
+    detectors = list(detectors)
+    out: list[Coverage] = []
+    seen: set[tuple[str, str]] = set()
+
+    def config_of(sc: str, det: str) -> str:
+        sel = events[(events["spacecraft"].astype(str) == sc) & (events["detector"].astype(str) == det)]
+        return str(sel["config_hash"].iloc[0]) if len(sel) else config_hash
+
+    for span in given:
+        sc = str(span.spacecraft)
+        own = (
+            sorted(set(events.loc[events["spacecraft"].astype(str) == sc, "detector"].astype(str)))
+            if len(events)
+            else []
+        )
+        names = [span.detector] if span.detector else sorted(set(detectors) | set(own))
         for det in names:
-            sel = events[(events["spacecraft"] == sc) & (events["detector"] == det)]
-            cfg = str(sel["config_hash"].iloc[0]) if len(sel) else config_hash
-            out.append(Coverage(sc, det, cfg, format_time_utc(start), format_time_utc(end)))
+            if (sc, det) not in seen:
+                seen.add((sc, det))
+                start, end = format_time_utc(span.start_utc), format_time_utc(span.end_utc)
+                out.append(Coverage(sc, det, config_of(sc, det), start, end, "data"))
+    if len(events):
+        times = pd.to_datetime(events["time_utc"].astype(str), utc=True)
+        groups = times.groupby([events["spacecraft"].astype(str), events["detector"].astype(str)])
+        for (sc, det), t in groups:
+            if (sc, det) not in seen:
+                seen.add((sc, det))
+                out.append(
+                    Coverage(sc, det, config_of(sc, det), format_time_utc(t.min()), format_time_utc(t.max()), "events")
+                )
     return out

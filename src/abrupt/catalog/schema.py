@@ -1,4 +1,11 @@
-"""The catalog's tables, their version marker and the upgrade of catalogs written by abrupt 0.1."""
+"""The catalog's tables, their version marker and the upgrade of catalogs written by older abrupts.
+
+Version 3 added ``coverage.span_of`` (what a coverage span is: ``data``, the first and last sample the
+run analysed, or ``events``, its first and last event when the run did not say; NULL in rows written
+before) and the ``evidence`` table (the attribution evidence of an event, one row per quantity, keyed
+by ``event_id``). Both are added in place by :func:`migrate_v2` and read by :func:`read_coverage`
+and :func:`read_evidence` from catalogs of any version, so an old catalog stays readable as it is.
+"""
 
 from __future__ import annotations
 
@@ -12,7 +19,7 @@ import sqlalchemy as sa
 
 from abrupt.events import EVENT_COLUMNS, FLOAT_COLUMNS, format_time_utc
 
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 
 metadata = sa.MetaData()
 
@@ -61,6 +68,16 @@ coverage_table = sa.Table(
     sa.Column("start_utc", sa.DateTime(timezone=False), primary_key=True),
     sa.Column("end_utc", sa.DateTime(timezone=False), nullable=False),
     sa.Column("recorded_utc", sa.DateTime(timezone=False), nullable=False),
+    sa.Column("span_of", sa.String(16), nullable=True),  # "data" or "events"; NULL: written before version 3
+)
+
+evidence_table = sa.Table(
+    "evidence",
+    metadata,
+    sa.Column("event_id", sa.String(64), primary_key=True),
+    sa.Column("name", sa.String(200), primary_key=True),
+    sa.Column("value", sa.Float, nullable=True),  # a number (NULL: not finite, or a text below)
+    sa.Column("text", sa.Text, nullable=True),  # a label, a flag or a list, as written by the detector
 )
 
 tasks_table = sa.Table(
@@ -106,6 +123,50 @@ def sqlite_manual_transactions(dbapi_connection: Any, connection_record: Any) ->
 
 def sqlite_begin_immediate(conn: sa.Connection) -> None:
     conn.exec_driver_sql("BEGIN IMMEDIATE")
+
+
+def migrate_v2(conn: sa.Connection) -> None:
+    """Upgrade a version-2 catalog in place: add ``coverage.span_of`` (NULL in its rows) and mark version 3
+    (the ``evidence`` table is created with the others)."""
+    inspector = sa.inspect(conn)
+    names = set(inspector.get_table_names())
+    if "coverage" in names and "span_of" not in {c["name"] for c in inspector.get_columns("coverage")}:
+        conn.execute(sa.text("ALTER TABLE coverage ADD COLUMN span_of VARCHAR(16)"))
+    if schema_table.name in names:
+        conn.execute(
+            schema_table.update().where(schema_table.c.version < SCHEMA_VERSION).values(version=SCHEMA_VERSION)
+        )
+
+
+def evidence_rows(frame: pd.DataFrame, columns: list[str]) -> list[dict[str, Any]]:
+    """Rows of the ``evidence`` table for the ``columns`` of ``frame`` (a number in ``value``, anything
+    else as text in ``text``; an empty value is no row)."""
+    rows: list[dict[str, Any]] = []
+    for rec in frame[["event_id", *columns]].to_dict("records"):
+        for name in columns:
+            value = clean_value(rec[name])
+            if value is None:
+                continue
+            if isinstance(value, bool | int | float):
+                number = float(value)
+                if math.isfinite(number):
+                    rows.append({"event_id": str(rec["event_id"]), "name": name, "value": number, "text": None})
+                else:
+                    rows.append({"event_id": str(rec["event_id"]), "name": name, "value": None, "text": str(number)})
+            else:
+                rows.append({"event_id": str(rec["event_id"]), "name": name, "value": None, "text": str(value)})
+    return rows
+
+
+def read_coverage(conn: sa.Connection) -> pd.DataFrame:
+    """The coverage rows, with ``span_of`` NULL where the catalog predates it (read-only: no upgrade)."""
+    columns = [c.name for c in coverage_table.columns]
+    inspector = sa.inspect(conn)
+    if "coverage" not in set(inspector.get_table_names()):
+        return pd.DataFrame(columns=columns)
+    present = {c["name"] for c in inspector.get_columns("coverage")}
+    query = sa.select(*(c if c.name in present else sa.null().label(c.name) for c in coverage_table.columns))
+    return pd.DataFrame(conn.execute(query).mappings().all(), columns=columns)
 
 
 def migrate_v1(conn: sa.Connection) -> None:

@@ -539,6 +539,9 @@ def demo(out_dir: str, duration_s: float, seed: int) -> None:
         input_path=tel_path,
         out=out / "events.csv",
         details={"thresholds": {k: v.as_dict() for k, v in result.thresholds.items()}},
+        spacecraft="demo-sat",
+        detectors=[f"attitude.{d}" for d in cfg.detectors],
+        span_utc=(tel.time[0], tel.time[-1]),
     )
     note("[4/4] drawing the report ...")
     truth = pd.read_csv(truth_path)

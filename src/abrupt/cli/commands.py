@@ -48,6 +48,7 @@ TOP_COMMANDS = {
     "rates": "abrupt.cli.rates:rates",
     "flux": "abrupt.cli.flux:flux",
     "score": "abrupt.cli.tle:score",
+    "store": "abrupt.cli.store_commands:store_group",
 }
 SIMULATE_COMMANDS = {
     "attitude": "abrupt.cli.attitude:simulate_attitude_cmd",

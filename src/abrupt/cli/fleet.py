@@ -88,11 +88,13 @@ def detect_fleet_cmd(
     out: str,
     **budget_args: Any,
 ) -> None:
-    """Detect strikes in every telemetry file listed in MANIFEST (CSV: spacecraft,telemetry,spacecraft_file).
+    """Detect strikes in every telemetry file or store in MANIFEST (CSV: spacecraft,telemetry,spacecraft_file[,store]).
 
-    One task per row (spacecraft, file), each calibrated on its own noise. Finished tasks are stored in
-    the catalog as they end: a run that was stopped or killed resumes where it stopped when started
-    again with the same inputs and settings. The budget is per spacecraft.
+    One task per row (spacecraft, file), each calibrated on its own noise. A row with an empty telemetry
+    and a store (written by `abrupt ingest`) runs the flight pipeline over that spacecraft's stored days,
+    as `abrupt detect attitude --store` does (--detector and --null-samples apply to telemetry rows).
+    Finished tasks are stored in the catalog as they end: a run that was stopped or killed resumes
+    where it stopped when started again with the same inputs and settings. The budget is per spacecraft.
     """
     budget = pop_budget(budget_args, "1/day")
     members = pipelines_fleet.read_manifest(manifest)
@@ -115,7 +117,7 @@ def detect_fleet_cmd(
     for w in result.warnings:
         warn(w)
     Path(out).parent.mkdir(parents=True, exist_ok=True)
-    abrupt_events.write_events(result.events, out)
+    abrupt_events.write_events_and_evidence(result.events, out)
     resumed = f" ({result.n_resumed} finished earlier, resumed)" if result.n_resumed else ""
     note(f"{len(result.events)} event(s) from {result.n_tasks} task(s){resumed}; run {result.run_id}; written to {out}")
 
@@ -225,6 +227,7 @@ def detect_tle_batch_cmd(
         run_id=run.run_id,
         out=out,
         details={"files": len(files), "budget": str(budget), "resumed_files": run.n_resumed},
+        analysed=run.analysed,
     )
     if not keep_parts:
         pipelines_catalogue.remove_parts(run.parts)

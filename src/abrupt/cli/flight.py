@@ -165,7 +165,7 @@ def detect_from_store(
     )
     bar.close()
     if out:
-        events.write_events(result.events, out)
+        events.write_events_and_evidence(result.events, out)
     if catalog_target:
         record_run(
             catalog_target=catalog_target,

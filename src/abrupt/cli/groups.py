@@ -187,19 +187,22 @@ def record_run(
     spacecraft: str | None = None,
     detectors: Iterable[str] = (),
     span_utc: tuple[Any, Any] | None = None,
+    analysed: Iterable[abrupt_catalog.AnalysedSpan] = (),
 ) -> int:
     """Store a run's events in the catalog and the output file; print a one-line summary.
 
-    ``spacecraft``, ``detectors`` and ``span_utc`` say what the run analysed (default: what its events
-    show), so the catalog's latest view can tell an event no longer found from one never looked for.
+    ``spacecraft``, ``detectors`` and ``span_utc`` (one spacecraft) or ``analysed`` (a span per
+    spacecraft) say what the run analysed (default: each spacecraft's own events), so the catalog's
+    latest view can tell an event no longer found from one never looked for, and a quiet run is seen.
     Returns the number of events that were new to the catalog.
     """
     details = {**(details or {}), **command_options()}
     catalog = abrupt_catalog.Catalog(catalog_target)  # open (and check) the catalog before writing anything
     catalog.check_fits(events)  # texts too long for the catalog: refused before the file is written
+    evidence_file = None
     if out is not None:  # then the file: a bad path must not leave events in the catalog only
         Path(out).parent.mkdir(parents=True, exist_ok=True)
-        abrupt_events.write_events(events, str(out))
+        evidence_file = abrupt_events.write_events_and_evidence(events, str(out))
     catalog.start_run(
         run_id,
         command,
@@ -215,6 +218,7 @@ def record_run(
         detectors=detectors,
         start_utc=span_utc[0] if span_utc else None,
         end_utc=span_utc[1] if span_utc else None,
+        analysed=analysed,
     )
     catalog.finish_run(run_id, n_found=len(events), n_new=added.events, details=details, coverage=coverage)
     again = len(events) - added.detections
@@ -225,5 +229,6 @@ def record_run(
         + (f", {again} already in the catalog" if again else "")
         + f" ({catalog.name})"
         + (f"; written to {out}" if out is not None else "")
+        + (f" (attribution evidence: {evidence_file})" if evidence_file is not None else "")
     )
     return added.events

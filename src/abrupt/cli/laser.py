@@ -39,7 +39,8 @@ TERMS = RANGE_MODEL_TERMS
     "apriori_path",
     required=True,
     type=click.Path(exists=True, dir_okay=False),
-    help="A-priori orbit: CPF prediction, SP3 or OEM.",
+    help="A-priori orbit: CPF prediction, SP3 or OEM; or TLE/3LE/OMM element sets (SGP4, then fitted to the "
+    "first hours of ranges before detection).",
 )
 @click.option(
     "--without",
@@ -147,4 +148,5 @@ def detect_laser_command(
         input_path=crd_files[0],
         out=out,
         details={"fit": run.summary},
+        analysed=run.analysed,
     )

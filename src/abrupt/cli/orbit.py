@@ -388,6 +388,7 @@ def detect_orbit_command(
         out=out,
         details={k: v for k, v in run.summary.items() if k != "warnings"}
         | {"repairs": run.ephemeris.repairs.as_dict()},
+        analysed=[span] if (span := run.analysed) is not None else [],
     )
     if report_path and run.analysis is None:
         click.echo("warning: no report for a run in calibration blocks; give --block-days 0 for one", err=True)
@@ -472,6 +473,7 @@ def _detect_all_satellites(
             },
             "repairs": first.ephemeris.repairs.as_dict(),
         },
+        analysed=[span for run in runs.values() if (span := run.analysed) is not None],
     )
 
 

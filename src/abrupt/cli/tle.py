@@ -206,6 +206,7 @@ def detect_tle(
         input_path=path,
         out=out,
         details=details,
+        analysed=result.analysed,
     )
     if report_path:
         for sat in result.satellites:  # one figure per satellite: NAME.png, or NAME_<norad>.png for several

@@ -306,6 +306,7 @@ def detect_tracking_command(
         input_path=file,
         out=out,
         details={"settings": run.settings, "fit": run.fit_summary},
+        analysed=run.analysed,
     )
     if report_path and len(run.diagnostics):
         diag = run.diagnostics.copy()

@@ -33,6 +33,7 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from abrupt.catalog import AnalysedSpan
 from abrupt.density.drag_batch import rho_b_from_histories
 from abrupt.density.drag_plausibility import IMPLAUSIBLE_STATUS
 from abrupt.density.tle_drag import TleDragConfig
@@ -44,6 +45,7 @@ from abrupt.readers.omm import read_element_histories
 from abrupt.scale import Executor, TaskResult, run_tasks
 
 PART_SUFFIX = ".parquet"
+SPANS_SUFFIX = ".spans.json"  # beside a part: the span of data each object of the file had analysed
 
 
 def file_key(path: str | Path) -> str:
@@ -88,6 +90,7 @@ class CatalogueRun:
     out: Path
     parts: Path
     skipped: list[str] = field(default_factory=list)
+    analysed: list[AnalysedSpan] = field(default_factory=list)
 
 
 def catalogue_tasks(
@@ -104,12 +107,35 @@ def catalogue_tasks(
     return run, tasks
 
 
-def maneuver_task(task: CatalogueTask) -> tuple[pd.DataFrame, list[str]]:
+def maneuver_task(task: CatalogueTask) -> tuple[pd.DataFrame, list[str], list[AnalysedSpan]]:
     """Maneuver events of every object of one file, in the events schema (a pure function of the task;
-    the schema is applied here, in the worker, not in the calling process that only writes parts)."""
+    the schema is applied here, in the worker, not in the calling process that only writes parts), and
+    the span of element sets each object had analysed (quiet objects included)."""
     res = detect_tle_file(task.path, task.settings["budget_object"], run_id=task.run_id)
     events = res.events
-    return (normalise_frame(events) if len(events) else empty_frame()), [str(e) for e in res.skipped[:20]]
+    frame = normalise_frame(events) if len(events) else empty_frame()
+    return frame, [str(e) for e in res.skipped[:20]], res.analysed
+
+
+def _write_spans(folder: Path, part: str, spans: Sequence[AnalysedSpan]) -> None:
+    """The analysed spans of a part, beside it (written before the part, atomically)."""
+    rows = [
+        {"spacecraft": s.spacecraft, "detector": s.detector, "start_utc": str(s.start_utc), "end_utc": str(s.end_utc)}
+        for s in spans
+    ]
+    tmp = folder / f".{part}{SPANS_SUFFIX}.tmp"
+    tmp.write_text(json.dumps(rows))
+    os.replace(tmp, folder / f"{part}{SPANS_SUFFIX}")
+
+
+def read_spans(folder: Path, parts: Sequence[str]) -> list[AnalysedSpan]:
+    """The analysed spans beside the parts (a part written by an older abrupt has none)."""
+    out: list[AnalysedSpan] = []
+    for part in parts:
+        path = folder / f"{part}{SPANS_SUFFIX}"
+        if path.is_file():
+            out.extend(AnalysedSpan(**row) for row in json.loads(path.read_text()))
+    return out
 
 
 def maneuver_times_by_object(events: pd.DataFrame) -> dict[str, list[Any]]:
@@ -261,14 +287,16 @@ def run_catalogue(
     todo = [replace(t, settings={**t.settings, "work_dir": str(folder)}) for t in tasks if t.part not in done]
     skipped: list[str] = []
 
-    def store(res: TaskResult[CatalogueTask, tuple[pd.DataFrame, list[str]]]) -> None:
-        frame, notes = res.result
+    def store(res: TaskResult[CatalogueTask, tuple[Any, ...]]) -> None:
+        frame, notes, *spans = res.result
+        if spans:
+            _write_spans(folder, res.task.part, spans[0])
         _write_part(folder, res.task.part, frame)
         skipped.extend(f"{res.task.path}: {n}" for n in notes)
         if on_part is not None:
             on_part(res.task.part)
 
-    fn = maneuver_task if kind == "maneuvers" else density_task
+    fn: Callable[[CatalogueTask], tuple[Any, ...]] = maneuver_task if kind == "maneuvers" else density_task
     run_tasks(
         fn,
         todo,
@@ -280,9 +308,10 @@ def run_catalogue(
         keep_results=False,
     )
     rows = merge_parts([folder / t.part for t in tasks], out)
+    analysed = read_spans(folder, [t.part for t in tasks])
     if not keep_parts:
         remove_parts(folder)
-    return CatalogueRun(run[:16], run, len(tasks), len(tasks) - len(todo), rows, out, folder, skipped)
+    return CatalogueRun(run[:16], run, len(tasks), len(tasks) - len(todo), rows, out, folder, skipped, analysed)
 
 
 def remove_parts(folder: str | Path) -> None:

@@ -1,9 +1,13 @@
 """Attitude strike detection over a fleet: many spacecraft, many telemetry files, resumable, on Dask.
 
-A fleet is a manifest (CSV with columns ``spacecraft,telemetry,spacecraft_file``; paths relative to
-the manifest) of telemetry files, typically one spacecraft-day each. Each row is one independent task
-(spacecraft, chunk): read the file, fit the thresholds on that file's own noise (Bennett 2022 §2.4.3:
-calibration by simulation from the measured noise model), detect. Tasks run through
+A fleet is a manifest (CSV with columns ``spacecraft,telemetry,spacecraft_file`` and optionally
+``store``; paths relative to the manifest) of telemetry files, typically one spacecraft-day each, or of
+stores written by ``abrupt ingest``. Each row is one independent task (spacecraft, chunk). A telemetry
+row: read the file, fit the thresholds on that file's own noise (Bennett 2022 §2.4.3: calibration by
+simulation from the measured noise model), detect. A store row (``telemetry`` empty, ``store`` naming
+the store; ``spacecraft`` the pseudonym it is stored under): the flight pipeline over every stored day
+of that spacecraft, as ``abrupt detect attitude --store`` runs it (detector ``attitude.flight_glr``,
+threshold calibrated on the store's own days). Tasks run through
 :func:`abrupt.scale.run_tasks` (in-process, ``workers`` local processes, or a Dask scheduler) and each
 finished task is stored in the catalog in one transaction with its events, so a run killed at any
 point and started again does only the unfinished tasks and ends with exactly the events of an
@@ -15,29 +19,41 @@ from __future__ import annotations
 import csv
 import hashlib
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
 from abrupt.catalog import Catalog, Coverage, run_key
+from abrupt.detect.attitude.flight_glr import FlightGlrDetector
 from abrupt.errors import InputError
 from abrupt.events import config_hash, empty_frame, format_time_utc, new_run_id
+from abrupt.model.spacecraft import load_spacecraft
 from abrupt.pipelines.attitude import detect_attitude, read_attitude_inputs
+from abrupt.pipelines.flight import FlightRunConfig, run_flight
 from abrupt.pipelines.tle import detect_tle_file
 from abrupt.scale import Executor, TaskResult, run_tasks
+from abrupt.store import TelemetryStore
 
 MANIFEST_COLUMNS = ("spacecraft", "telemetry", "spacecraft_file")
+OPTIONAL_COLUMNS = ("store",)
 
 
 @dataclass(frozen=True)
 class FleetMember:
-    """One telemetry file of one spacecraft (pseudonym), with the spacecraft description to use."""
+    """One telemetry file, or one store, of one spacecraft (pseudonym), with the spacecraft description
+    to use (``telemetry`` empty for a store row)."""
 
     spacecraft: str
     telemetry: str
     spacecraft_file: str
+    store: str = ""
+
+    @property
+    def chunk(self) -> str:
+        """What the task reads, as task keys and records name it: the file name, or ``store=<folder>``."""
+        return f"store={Path(self.store).name}" if self.store else Path(self.telemetry).name
 
 
 @dataclass(frozen=True)
@@ -50,7 +66,7 @@ class AttitudeTask:
 
     @property
     def key(self) -> str:
-        return f"{self.member.spacecraft}|{Path(self.member.telemetry).name}"
+        return f"{self.member.spacecraft}|{self.member.chunk}"
 
 
 @dataclass(frozen=True)
@@ -76,7 +92,11 @@ class FleetResult:
 
 
 def read_manifest(path: str | Path) -> list[FleetMember]:
-    """Read a fleet manifest; relative paths are taken from the manifest's folder."""
+    """Read a fleet manifest; relative paths are taken from the manifest's folder.
+
+    Each row names a ``telemetry`` file or (column ``store``) a store holding days of its ``spacecraft``;
+    an error names the manifest line and column, and for a store what it holds.
+    """
     path = Path(path)
     try:
         text = path.read_text()
@@ -88,8 +108,12 @@ def read_manifest(path: str | Path) -> list[FleetMember]:
     header = [h.strip() for h in rows[0]]
     missing = [c for c in MANIFEST_COLUMNS if c not in header]
     if missing:
-        raise InputError(f"manifest lacks column(s) {missing}; expected {list(MANIFEST_COLUMNS)}", file=path, line=1)
-    cols = {c: header.index(c) for c in MANIFEST_COLUMNS}
+        raise InputError(
+            f"manifest lacks column(s) {missing}; expected {list(MANIFEST_COLUMNS)} (and optionally 'store')",
+            file=path,
+            line=1,
+        )
+    cols = {c: header.index(c) for c in (*MANIFEST_COLUMNS, *OPTIONAL_COLUMNS) if c in header}
     members: list[FleetMember] = []
     for lineno, row in enumerate(rows[1:], start=2):
         if not any(cell.strip() for cell in row):
@@ -97,16 +121,24 @@ def read_manifest(path: str | Path) -> list[FleetMember]:
         if len(row) < len(header):
             raise InputError(f"expected {len(header)} fields, got {len(row)}", file=path, line=lineno)
         values = {c: row[i].strip() for c, i in cols.items()}
+        values.setdefault("store", "")
+        if not values["spacecraft"]:
+            raise InputError("empty spacecraft pseudonym", file=path, line=lineno, column="spacecraft")
+        if bool(values["telemetry"]) == bool(values["store"]):
+            raise InputError(
+                "give a telemetry file or a store, not both and not neither", file=path, line=lineno, column="telemetry"
+            )
         for c in ("telemetry", "spacecraft_file"):
-            p = Path(values[c])
-            p = p if p.is_absolute() else path.parent / p
+            if c == "telemetry" and not values[c]:
+                continue
+            p = _relative(path, values[c])
             if not p.is_file():
                 raise InputError(f"no such file {values[c]!r}", file=path, line=lineno, column=c)
             values[c] = str(p)
-        if not values["spacecraft"]:
-            raise InputError("empty spacecraft pseudonym", file=path, line=lineno, column="spacecraft")
+        if values["store"]:
+            values["store"] = str(_checked_store(path, lineno, values["store"], values["spacecraft"]))
         members.append(FleetMember(**values))
-    keys = [f"{m.spacecraft}|{Path(m.telemetry).name}" for m in members]
+    keys = [f"{m.spacecraft}|{m.chunk}" for m in members]
     if len(set(keys)) != len(keys):
         dup = next(k for k in keys if keys.count(k) > 1)
         raise InputError(f"the same spacecraft and file name appear twice ({dup})", file=path)
@@ -115,8 +147,32 @@ def read_manifest(path: str | Path) -> list[FleetMember]:
     return members
 
 
+def _relative(manifest: Path, name: str) -> Path:
+    p = Path(name)
+    return p if p.is_absolute() else manifest.parent / p
+
+
+def _checked_store(manifest: Path, lineno: int, name: str, spacecraft: str) -> Path:
+    """The store of a manifest row, which must hold days of ``spacecraft`` (else: what it holds)."""
+    p = _relative(manifest, name)
+    if not p.is_dir():
+        raise InputError(f"no such store folder {name!r}", file=manifest, line=lineno, column="store")
+    store = TelemetryStore(p)
+    if not store.days(spacecraft):
+        held = ", ".join(f"{sc} ({len(store.days(sc))} days)" for sc in store.spacecraft()) or "nothing"
+        raise InputError(
+            f"store {name!r} holds no days of spacecraft {spacecraft!r}; it holds {held}",
+            file=manifest,
+            line=lineno,
+            column="spacecraft",
+        )
+    return p
+
+
 def detect_attitude_task(task: AttitudeTask) -> TaskOutput:
     """Run one task: read, calibrate on the file's own noise, detect (a pure function of the task)."""
+    if task.member.store:
+        return detect_store_task(task)
     sc, tel, _ = read_attitude_inputs(task.member.telemetry, task.member.spacecraft_file)
     result = detect_attitude(tel, sc, task.config, run_id=task.run_id, spacecraft_name=task.member.spacecraft)
     coverage: tuple[Coverage, ...] = ()
@@ -127,6 +183,28 @@ def detect_attitude_task(task: AttitudeTask) -> TaskOutput:
             for d in task.config.detectors
         )
     return TaskOutput(result.events, coverage, tel.repairs.as_dict(), tuple(result.details.get("warnings", [])))
+
+
+def detect_store_task(task: AttitudeTask) -> TaskOutput:
+    """A store row: the flight pipeline over every stored day of the spacecraft (threshold calibrated
+    on those days at the fleet's budget), covering those days."""
+    sc = replace(load_spacecraft(task.member.spacecraft_file), name=task.member.spacecraft)
+    days = TelemetryStore(task.member.store).days(sc.name)
+    result = run_flight(task.member.store, sc, FlightRunConfig(budget=task.config.budget), run_id=task.run_id)
+    start, end = f"{days[0]}T00:00:00Z", f"{days[-1]}T23:59:59.999999Z"
+    coverage = (Coverage(sc.name, FlightGlrDetector.name, result.config_hash, start, end),)
+    return TaskOutput(result.events, coverage, {}, tuple(result.warnings))
+
+
+def _store_digest(store: str, spacecraft: str) -> str:
+    """Name, size and modification time of every stored day file of a spacecraft (what a resumed run must
+    see unchanged; the bytes of a whole archive are not read again)."""
+    h = hashlib.sha256()
+    for day in TelemetryStore(store).days(spacecraft):
+        f = Path(store) / f"spacecraft={spacecraft}" / f"day={day}" / "samples.parquet"
+        st = f.stat()
+        h.update(f"{day}:{st.st_size}:{st.st_mtime_ns};".encode())
+    return h.hexdigest()[:16]
 
 
 def _file_digest(path: str) -> str:
@@ -140,7 +218,9 @@ def _file_digest(path: str) -> str:
 def fleet_run_key(members: Sequence[FleetMember], config: Any) -> str:
     """Same telemetry bytes, spacecraft files and configuration: the same (resumable) run."""
     parts = sorted(
-        f"{m.spacecraft}:{Path(m.telemetry).name}:{_file_digest(m.telemetry)}:{_file_digest(m.spacecraft_file)}"
+        f"{m.spacecraft}:{m.chunk}:"
+        f"{_store_digest(m.store, m.spacecraft) if m.store else _file_digest(m.telemetry)}:"
+        f"{_file_digest(m.spacecraft_file)}"
         for m in members
     )
     return run_key("detect attitude fleet", config_hash(config.hash_fields()), *parts)
@@ -179,7 +259,7 @@ def detect_attitude_fleet(
                 key,
                 res.task.key,
                 spacecraft=res.task.member.spacecraft,
-                chunk=Path(res.task.member.telemetry).name,
+                chunk=res.task.member.chunk,
                 run_id=run_id,
                 events=res.result.events,
                 coverage=res.result.coverage,
@@ -203,6 +283,9 @@ def detect_attitude_fleet(
         n_new = int((events["run_id"] == run_id).sum())
         cat.finish_run(run_id, n_found=len(events), n_new=n_new)
         events = events.drop(columns=["event_key"])
+        evidence = cat.evidence(events["event_id"].astype(str))  # the attribution evidence, for the file
+        if evidence.shape[1] > 1:
+            events = events.merge(evidence, on="event_id", how="left")
     else:
         frames = [o.events for o in outputs.values() if len(o.events)]
         events = pd.concat(frames, ignore_index=True) if frames else empty_frame()

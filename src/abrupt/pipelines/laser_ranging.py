@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import CubicSpline
 
+from abrupt.catalog import AnalysedSpan
 from abrupt.detect.tracking.glrt import DEFAULT_BUDGET, GlrtDetection, glrt_events
 from abrupt.detect.tracking.laser import LaserGlrtDetector
 from abrupt.errors import InputError, RepairLog
@@ -28,6 +29,7 @@ from abrupt.model.orbit.batch_fit import BatchFit, BatchFitConfig
 from abrupt.model.range_reduction import RangeModel, StationSite
 from abrupt.model.stations import Station
 from abrupt.model.tracking_measurements import TrackingArrays, as_datetime64_ns, earth_rotation_matrices
+from abrupt.pipelines.laser_apriori import MAX_ELEMENT_AGE_DAYS, ElementApriori, is_element_file, short_arc_fit
 from abrupt.readers.crd import read_crd
 from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.readers.sinex import SinexStation, bundled_ilrs_sinex, read_sinex, sinex_station
@@ -323,6 +325,7 @@ class LaserRangingRun:
     summary: dict[str, object]
     run_id: str
     config_hash: str
+    analysed: list[AnalysedSpan] = field(default_factory=list)
 
     def summary_lines(self) -> list[str]:
         lines = [f"post-fit range RMS per station (mm): {self.summary['residual_rms_mm']}"]
@@ -376,7 +379,10 @@ def run_laser_ranging_files(
     force: ForceModel | None = None,
     time_biases: bool = False,
 ) -> LaserRangingRun:
-    """Read CRD normal points, SINEX sites and an a-priori ephemeris; detect maneuvers; build events.
+    """Read CRD normal points, SINEX sites and an a-priori orbit; detect maneuvers; build events.
+
+    The a-priori orbit is an ephemeris (CPF, SP3, OEM) or element sets (TLE/3LE, OMM: SGP4, then a
+    short-arc fit to each arc's first ranges, :mod:`abrupt.pipelines.laser_apriori`).
 
     ``sinex_path`` None: the ILRS station coordinates bundled with abrupt (:func:`bundled_ilrs_sinex`).
 
@@ -399,18 +405,6 @@ def run_laser_ranging_files(
     sinex_file = str(sinex_path or bundled_ilrs_sinex())
     sites = sites_from_sinex(read_sinex(sinex_file), sorted(meas["station"].unique()), epoch, file=sinex_file)
     stations = laser_stations(sites, meas)
-    ephemeris = read_ephemeris(apriori_path)
-    for kind, n in ephemeris.repairs.counts.items():
-        repairs.record(f"a-priori ephemeris: {kind}", n)
-    eph_times = np.asarray(ephemeris.times_utc, dtype="datetime64[ns]")
-
-    def apriori(arc_epoch: np.datetime64) -> FloatArray | None:
-        if eph_times.min() <= arc_epoch <= eph_times.max():
-            return apriori_state_gcrf(ephemeris, arc_epoch)
-        return None
-
-    if apriori(epoch) is None:
-        raise ValueError(f"{apriori_path}: the ephemeris does not cover the first range epoch {epoch}")
     force = force or LASER_FORCE
     cfg = replace(
         LASER_FIT_CONFIG,
@@ -419,6 +413,21 @@ def run_laser_ranging_files(
         estimate_scales=estimated_scales(force),
         estimate_time_bias=time_biases,
     )
+    elements = ElementApriori.read(apriori_path) if is_element_file(apriori_path) else None
+    if elements is not None:
+        _, gap_days = elements.nearest(epoch)
+        if gap_days > MAX_ELEMENT_AGE_DAYS:
+            first_range = f"{np.datetime_as_string(epoch, unit='s')}Z"
+            raise InputError(
+                f"the element set nearest the first range epoch {first_range} is {gap_days:.0f} days from it (at most "
+                f"{MAX_ELEMENT_AGE_DAYS:g}: SGP4 drifts by kilometres a day); the a-priori orbit does not cover it",
+                file=apriori_path,
+            )
+        apriori = _element_apriori(elements, meas, sites, stations, cfg, model)
+    else:
+        apriori = _ephemeris_apriori(apriori_path, repairs)
+    if apriori(epoch) is None:
+        raise ValueError(f"{apriori_path}: the a-priori orbit does not cover the first range epoch {epoch}")
     result = detect_laser_ranging_arcs(
         meas,
         sites,
@@ -456,7 +465,54 @@ def run_laser_ranging_files(
     )
     frame = events_frame(events) if events else empty_frame()
     summary = _run_summary(result, len(meas), repairs)
-    return LaserRangingRun(frame, result, summary, run_id, cfg_hash)
+    if elements is not None:
+        summary["apriori_from_elements"] = elements.fits
+    times = np.asarray(meas["time_utc"], dtype="datetime64[ns]")
+    analysed = [AnalysedSpan(name, times.min(), times.max(), LaserGlrtDetector.name)]
+    return LaserRangingRun(frame, result, summary, run_id, cfg_hash, analysed)
+
+
+def _ephemeris_apriori(path: str, repairs: RepairLog) -> Callable[[np.datetime64], FloatArray | None]:
+    """A-priori states from an ephemeris (CPF, SP3, OEM) where it covers the arc epoch."""
+    ephemeris = read_ephemeris(path)
+    for kind, n in ephemeris.repairs.counts.items():
+        repairs.record(f"a-priori ephemeris: {kind}", n)
+    eph_times = np.asarray(ephemeris.times_utc, dtype="datetime64[ns]")
+
+    def apriori(arc_epoch: np.datetime64) -> FloatArray | None:
+        if eph_times.min() <= arc_epoch <= eph_times.max():
+            return apriori_state_gcrf(ephemeris, arc_epoch)
+        return None
+
+    return apriori
+
+
+def _element_apriori(
+    elements: ElementApriori,
+    meas: pd.DataFrame,
+    sites: dict[str, StationSite],
+    stations: dict[str, Station],
+    cfg: BatchFitConfig,
+    model: RangeModel,
+) -> Callable[[np.datetime64], FloatArray | None]:
+    """A-priori states from element sets: SGP4 at the arc epoch, then fitted to the arc's first ranges
+    (:func:`abrupt.pipelines.laser_apriori.short_arc_fit`); each arc epoch fitted once."""
+    done: dict[np.datetime64, FloatArray | None] = {}
+
+    def apriori(arc_epoch: np.datetime64) -> FloatArray | None:
+        if arc_epoch not in done:
+            x_sgp4 = elements.state_gcrf(arc_epoch)
+            if x_sgp4 is None:
+                done[arc_epoch] = None
+            else:
+                x, info = short_arc_fit(
+                    meas, sites, stations, x_sgp4, arc_epoch, cfg, range_model=model, source=elements.source
+                )
+                elements.fits.append(info)
+                done[arc_epoch] = x
+        return done[arc_epoch]
+
+    return apriori
 
 
 def laser_stations(sites: Mapping[str, StationSite], meas: pd.DataFrame) -> dict[str, Station]:

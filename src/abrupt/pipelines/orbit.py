@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from abrupt.catalog import AnalysedSpan
 from abrupt.detect.base import DetectionResult, Diagnostics, get_detector
 from abrupt.detect.orbit.analysis import OrbitAnalysis, innovation_scale
 from abrupt.detect.orbit.detectors import (
@@ -68,6 +69,15 @@ class OrbitRun:
     @property
     def events(self) -> pd.DataFrame:
         return self.result.events
+
+    @property
+    def analysed(self) -> AnalysedSpan | None:
+        """The epochs of the ephemeris the detector read (None for an empty one)."""
+        times = np.asarray(self.ephemeris.times_utc)
+        if times.size == 0:
+            return None
+        name = self.detector.spacecraft or self.ephemeris.satellite
+        return AnalysedSpan(str(name), times.min(), times.max(), self.detector.name)
 
     @property
     def analysis(self) -> OrbitAnalysis | None:

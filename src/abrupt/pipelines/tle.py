@@ -17,6 +17,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from abrupt import progress
+from abrupt.catalog import AnalysedSpan
 from abrupt.detect.base import DetectionResult, Detector, get_detector
 from abrupt.detect.tle.detectors import TleMeanElements, detector_for
 from abrupt.errors import InputError
@@ -33,6 +34,15 @@ class SatelliteResult:
     history: ElementHistory
     detector: str
     result: DetectionResult
+    spacecraft: str = ""
+
+    @property
+    def analysed(self) -> AnalysedSpan | None:
+        """The epochs the detector read: first to last element set (None for an empty history)."""
+        epochs = self.history.elements["epoch_utc"]
+        if len(epochs) == 0:
+            return None
+        return AnalysedSpan(self.spacecraft, epochs.min(), epochs.max(), self.detector)
 
     @property
     def events(self) -> pd.DataFrame:
@@ -57,6 +67,11 @@ class TleRunResult:
         if not frames:
             return empty_frame()
         return pd.concat(frames, ignore_index=True).sort_values("time_utc", kind="stable").reset_index(drop=True)
+
+    @property
+    def analysed(self) -> list[AnalysedSpan]:
+        """Per satellite, the span of element sets analysed (quiet satellites included)."""
+        return [span for s in self.satellites if (span := s.analysed) is not None]
 
     @property
     def skipped(self) -> list[InputError]:
@@ -112,7 +127,7 @@ def detect_tle_file(
             if issubclass(cls, TleMeanElements):  # a plug-in tle detector may not take a run_id
                 kwargs["run_id"] = run_id
             det = cls(**kwargs)
-        out.satellites.append(SatelliteResult(history, det.name, det.detect(history, budget)))
+        out.satellites.append(SatelliteResult(history, det.name, det.detect(history, budget), name))
     return out
 
 

@@ -18,6 +18,7 @@ from typing import Any, Literal
 import numpy as np
 import pandas as pd
 
+from abrupt.catalog import AnalysedSpan
 from abrupt.detect.tracking.glrt import GlrtManeuverDetector
 from abrupt.detect.tracking.kaderali import KaderaliManeuverDetector
 from abrupt.detect.tracking.noise_scale import calibrate_noise, misfit, residual_scales
@@ -77,6 +78,7 @@ class TrackingRun:
     config_hash: str
     run_id: str
     settings: dict[str, Any] = field(default_factory=dict)
+    analysed: list[AnalysedSpan] = field(default_factory=list)
 
     def summary_lines(self) -> list[str]:
         return fit_summary_lines(self.fit_summary)
@@ -306,7 +308,14 @@ def detect_tracking(
     if settings.method in ("both", "glrt"):
         summary["glrt_threshold"] = glrt_thresholds[0] if glrt_thresholds else None
     diagnostics = pd.concat(diag_frames, ignore_index=True) if diag_frames else pd.DataFrame()
-    return TrackingRun(events, summary, diagnostics, cfg_hash, run_id, run_settings)
+    times = np.asarray(data.times_utc)
+    detectors = [
+        cls.name
+        for cls, methods in ((GlrtManeuverDetector, ("both", "glrt")), (KaderaliManeuverDetector, ("both", "kaderali")))
+        if settings.method in methods
+    ]
+    analysed = [AnalysedSpan(series.spacecraft_name, times.min(), times.max(), d) for d in detectors if times.size]
+    return TrackingRun(events, summary, diagnostics, cfg_hash, run_id, run_settings, analysed)
 
 
 def fit_summary(fit: BatchFit, force: ForceModel, sun_m: Any) -> dict[str, Any]:

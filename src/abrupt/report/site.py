@@ -30,10 +30,9 @@ from pathlib import Path
 from typing import Any
 
 import pandas as pd
-import sqlalchemy as sa
 
 from abrupt.catalog import Catalog
-from abrupt.catalog.schema import coverage_table
+from abrupt.catalog.schema import read_coverage
 from abrupt.events import EVENT_COLUMNS, format_time_utc
 from abrupt.flux.exposure import EfficiencyCurve, load_exposure
 from abrupt.report.site_figures import daily_figure, event_figure, timeline_figure
@@ -75,6 +74,7 @@ class _View:
     coverage: pd.DataFrame
     details: dict[str, dict[str, Any]]
     exposure: pd.DataFrame
+    evidence: pd.DataFrame
 
 
 def _esc(value: Any) -> str:
@@ -127,16 +127,14 @@ def load_view(catalog: Catalog) -> _View:
     events = catalog.events()
     runs = catalog.runs()
     with catalog.engine.connect() as conn:
-        coverage = pd.DataFrame(
-            conn.execute(sa.select(coverage_table)).mappings().all(), columns=[c.name for c in coverage_table.columns]
-        )
+        coverage = read_coverage(conn)
     details: dict[str, dict[str, Any]] = {}
     for row in runs.itertuples(index=False):
         try:
             details[str(row.run_id)] = json.loads(str(row.details_json)) if row.details_json else {}
         except (TypeError, ValueError):
             details[str(row.run_id)] = {"details": str(row.details_json)}
-    return _View(events, runs, coverage, details, load_exposure(catalog))
+    return _View(events, runs, coverage, details, load_exposure(catalog), catalog.evidence())
 
 
 def _size(row: Mapping[Any, Any]) -> tuple[str, float]:
@@ -269,6 +267,21 @@ def _with_exposure_dh90(daily: pd.DataFrame, exposure: pd.DataFrame, spacecraft:
     return out
 
 
+SPAN_OF = {
+    "data": "data analysed",
+    "events": "first to last event (the run did not record its data span)",
+}
+
+
+def _span_of(value: Any) -> str:
+    """What a coverage span is, in words (a row written before spans were labelled: not recorded)."""
+    return (
+        SPAN_OF.get(str(value), "not recorded (catalog of an older abrupt)")
+        if isinstance(value, str)
+        else ("not recorded (catalog of an older abrupt)")
+    )
+
+
 def _detectability_page(view: _View, out: Path) -> str:
     parts = []
     shown: set[tuple[str, tuple[str, ...]]] = set()
@@ -319,6 +332,7 @@ def _detectability_page(view: _View, out: Path) -> str:
                 _utc(start),
                 _utc(end),
                 _fmt((end - start).total_seconds() / 86400.0, 4),
+                _esc(_span_of(rec.get("span_of"))),
                 _esc(rec["run_id"]),
                 _esc(noise),
             ]
@@ -329,16 +343,22 @@ def _detectability_page(view: _View, out: Path) -> str:
             continue
         name = str(details.get("satellite") or details.get("spacecraft") or "–")
         noise = "; ".join(f"{k} = {v}" for k, v in _noise_items(details, name)) or "–"
-        cov_rows.append([_esc(name), _esc(details.get("statistic", "–")), "–", "–", "–", _esc(run_id), _esc(noise)])
+        cov_rows.append(
+            [_esc(name), _esc(details.get("statistic", "–")), "–", "–", "–", "not recorded", _esc(run_id), _esc(noise)]
+        )
     head = (
         '<p class="muted">Per day where the run measured it (the flight pipeline: analysed fraction, noise floor, '
         "threshold, events; ΔH90 where an injection-recovery study measured it or the catalog's exposure rows "
         "give the day's efficiency curve). Other runs: the span they "
-        "analysed and the noise and threshold figures they stored.</p>"
+        "analysed (per spacecraft, from the first to the last sample of the data the run read) and the noise "
+        "and threshold figures they stored.</p>"
     )
     coverage = (
         "<h2>Coverage of the other runs</h2>"
-        + _table(["spacecraft", "detector", "from (UTC)", "to (UTC)", "days", "run", "noise and thresholds"], cov_rows)
+        + _table(
+            ["spacecraft", "detector", "from (UTC)", "to (UTC)", "days", "span of", "run", "noise and thresholds"],
+            cov_rows,
+        )
         if cov_rows
         else ""
     )
@@ -413,6 +433,18 @@ def _event_page(view: _View, event: pd.Series, out: Path, reports: Mapping[str, 
         for k, v in event.items()
         if k in EVENT_COLUMNS or k == "event_key" or not (isinstance(v, float) and math.isnan(v))
     )
+    evidence = view.evidence.loc[view.evidence["event_id"].astype(str) == str(event["event_id"])]
+    evidence_html = (
+        '<dl class="fields">'
+        + "".join(
+            f"<dt>{_esc(k)}</dt><dd>{_esc(v if not isinstance(v, float) else _fmt(v, 6))}</dd>"
+            for k, v in evidence.iloc[0].items()
+            if k != "event_id" and not (isinstance(v, float) and math.isnan(v))
+        )
+        + "</dl>"
+        if len(evidence)
+        else '<p class="muted">(no attribution evidence stored for this event)</p>'
+    )
     run_id = str(event["run_id"])
     report = reports.get(run_id)
     if report is None:
@@ -426,10 +458,36 @@ def _event_page(view: _View, event: pd.Series, out: Path, reports: Mapping[str, 
         f'<a href="../runs/{_slug(run_id)}.html">run {_esc(run_id)}</a></p>'
         f'<h2>Diagnostic figure</h2><img alt="diagnostic figure of the event" src="../figures/events/{fig.name}">'
         f'<h2>Fields</h2><dl class="fields">{fields}</dl>'
+        f"<h2>Attribution evidence</h2>{evidence_html}"
         f"<h2>The run's report figure</h2>{run_fig}"
         f"<h2>The run's configuration</h2>{_run_config_html(view, run_id, 1)}"
     )
     return page(f"{event['spacecraft']} {event['kind']} at {event['time_utc']}", body, depth=1)
+
+
+def _runs_overview(view: _View) -> str:
+    """Every run with what it analysed and how many events it found: a quiet run (no events) is a result."""
+    rows = []
+    for rec in view.runs.sort_values("started_utc", ascending=False).to_dict("records"):
+        run_id = str(rec["run_id"])
+        cov = view.coverage.loc[view.coverage["run_id"].astype(str) == run_id]
+        spans = []
+        for sc, g in cov.groupby(cov["spacecraft"].astype(str)) if len(cov) else []:
+            spans.append(f"{sc}: {_utc(g['start_utc'].min())} → {_utc(g['end_utc'].max())}")
+        found = rec["n_events_found"]
+        n = int(found) if found is not None and math.isfinite(_num(found)) else None
+        result = "not finished" if n is None else ("no events (quiet)" if n == 0 else f"{n} event(s)")
+        rows.append(
+            [
+                f'<a href="runs/{_slug(run_id)}.html">{_esc(run_id)}</a>',
+                _esc(str(rec["command"])[:80]),
+                "<br>".join(_esc(x) for x in spans) or '<span class="muted">span not recorded</span>',
+                _esc(result),
+            ]
+        )
+    if not rows:
+        return ""
+    return "<h2>Runs</h2>" + _table(["run", "command", "analysed (UTC)", "result"], rows)
 
 
 def _index_page(view: _View, out: Path) -> str:
@@ -450,7 +508,7 @@ def _index_page(view: _View, out: Path) -> str:
         f"{len(spacecraft)} spacecraft, {len(view.runs)} run(s). Grey spans: what the runs analysed; a point: "
         "an event's statistic over its threshold (above 1: above the threshold).</p>"
     )
-    return page("Event catalog", summary + ("".join(parts) or "<p>(the catalog is empty)</p>"))
+    return page("Event catalog", summary + ("".join(parts) or "<p>(the catalog is empty)</p>") + _runs_overview(view))
 
 
 def write_catalog_site(catalog: Catalog, out: str | Path) -> SiteSummary:
