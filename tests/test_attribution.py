@@ -275,13 +275,15 @@ def test_strike_and_confounders_on_the_synthetic_archive_get_their_own_class(syn
     d, a = synth
     sc = load_spacecraft(a.spacecraft)  # type: ignore[attr-defined]
     t0 = int(a.start.astype(np.int64))  # type: ignore[attr-defined]
-    kinds = ["star_tracker_jump", "wheel_speed_glitch", "thruster_leak", "gyro_bias_step"]
-    times = [t0 + k * NS for k in (9000, 13000, 16500, 20000)]
+    kinds = ["star_tracker_jump", "wheel_speed_glitch", "thruster_leak", "gyro_bias_step", "momentum_dump"]
+    times = [t0 + k * NS for k in (9000, 13000, 16500, 20000, 2500)]
     ranges = ConfounderRanges(
         star_tracker_angle_deg=(3.0, 4.0),
         wheel_glitch_rpm=(40.0, 60.0),
         leak_torque_Nm=(1e-3, 2e-3),
         gyro_bias_deg_s=(0.004, 0.006),
+        dump_impulse_Nms=(0.1, 0.2),
+        dump_pulses=(2.0, 4.0),
     )
     confs = draw_confounders(kinds, times, sc, ranges, seed=2)
     strike = InjectedStrike(t0 + 5000 * NS + NS // 3, np.array([0.05, -0.04, 0.03]))
@@ -296,7 +298,8 @@ def test_strike_and_confounders_on_the_synthetic_archive_get_their_own_class(syn
     ev_near = [res.evidence[p.time_ns] for p in strong if abs(p.time_ns - strike.time_ns) < 10 * NS]
     assert near and near[0].kind == "strike", ev_near
     expected = {"star_tracker_jump": "sensor_fault", "wheel_speed_glitch": "sensor_fault",
-                "thruster_leak": "external_non_strike", "gyro_bias_step": "sensor_fault"}  # fmt: skip
+                "thruster_leak": "external_non_strike", "gyro_bias_step": "sensor_fault",
+                "momentum_dump": "external_non_strike"}  # fmt: skip
     for c in confs:
         got = [
             from_rules[p.time_ns]

@@ -15,6 +15,7 @@ CONFOUNDER_CLASS: dict[str, str] = {
     "wheel_speed_glitch": "sensor_fault",
     "thruster_leak": "external_non_strike",
     "venting": "external_non_strike",
+    "momentum_dump": "external_non_strike",
     "appendage_snap": "internal",
 }
 CONFOUNDER_KINDS: tuple[str, ...] = tuple(CONFOUNDER_CLASS)

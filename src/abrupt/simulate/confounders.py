@@ -10,7 +10,10 @@ Each confounder is added to the raw samples (mnemonic, time, value) of a stored 
   reading offset for a while, quantised like the tachometer);
 * **external non-strikes** change total momentum, slowly or in pieces, through a body-fixed torque
   (a nozzle): ``thruster_leak`` (constant torque for minutes, with the net force r × F = τ of a thruster
-  at ``lever_arm_m``), ``venting`` (a sequence of small impulses along one body direction);
+  at ``lever_arm_m``), ``venting`` (a sequence of small impulses along one body direction),
+  ``momentum_dump`` (an unflagged dump: a few thruster pulses seconds apart whose total unloads part of
+  the momentum the wheels hold at the onset, aimed at −H_w,B to within ``dump_aim_deg``; the flag that
+  would mask it is not in the telemetry);
 * **internal** events move momentum between parts: ``appendage_snap`` (the solar array slips by a few
   degrees in a second; the hub reacts, total momentum is conserved).
 
@@ -48,6 +51,9 @@ from abrupt.simulate.injection import (
 from abrupt.types import FloatArray
 
 Range = tuple[float, float]
+#: An unloading law aims its torque against the wheels' momentum; thruster geometry and minimum impulse
+#: bits leave an error of a few degrees, never more than this [deg] (a widened range is cut here).
+DUMP_AIM_MAX_DEG = 15.0
 
 
 @dataclass(frozen=True)
@@ -74,6 +80,12 @@ class ConfounderRanges:
     vent_interval_s: Range = (5.0, 60.0)
     snap_angle_deg: Range = (1.0, 8.0)
     snap_duration_s: Range = (0.5, 3.0)
+    #: A dump's total impulse (capped at the wheels' stored momentum at injection), its pulses, the time
+    #: between pulses and the aim's error from −H_w,B (capped at ``DUMP_AIM_MAX_DEG``).
+    dump_impulse_Nms: Range = (0.03, 0.3)
+    dump_pulses: Range = (1.0, 6.0)
+    dump_pulse_gap_s: Range = (1.0, 3.0)
+    dump_aim_deg: Range = (0.5, 5.0)
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -197,6 +209,17 @@ def draw_confounder(
             "duration_s": float(sum(gaps)),
         }
         return Confounder(kind, time_ns, "vent", p)
+    if kind == "momentum_dump":
+        n = max(1, round(rng.uniform(*r.dump_pulses)))
+        gaps = [float(rng.uniform(*r.dump_pulse_gap_s)) for _ in range(n - 1)]
+        p = {
+            "impulse_Nms": _log_uniform(rng, r.dump_impulse_Nms),
+            "offsets_s": np.concatenate([[0.0], np.cumsum(gaps)]).tolist(),
+            "aim_deg": min(_log_uniform(rng, r.dump_aim_deg), DUMP_AIM_MAX_DEG),
+            "aim_axis_B": _unit(rng).tolist(),
+            "duration_s": float(sum(gaps)),
+        }
+        return Confounder(kind, time_ns, "thruster", p)
     if kind == "appendage_snap":
         if not spacecraft.appendages:
             raise ConfigError("appendage_snap needs an appendage in the spacecraft file", key="appendages")
@@ -250,6 +273,11 @@ def _hub_impulses(c: Confounder, spacecraft: Spacecraft) -> tuple[FloatArray, Fl
         d = np.asarray(c.params["direction_B"], float)
         offs = np.asarray(c.params["offsets_s"], float)
         return offs, np.outer(np.asarray(c.params["impulses_Nms"], float), d), True
+    if c.kind == "momentum_dump":
+        d = np.asarray(c.params["direction_B"], float)
+        offs = np.asarray(c.params["offsets_s"], float)
+        each = float(c.params["impulse_Nms"]) / offs.size
+        return offs, np.tile(each * d, (offs.size, 1)), True
     if c.kind == "appendage_snap":
         app = next(a for a in spacecraft.appendages if a.name == c.params["appendage"])
         axis = np.asarray(app.gimbal_axes[0], float)
@@ -394,6 +422,34 @@ def _add_appendage_angle(s: _Samples, spacecraft: Spacecraft, c: Confounder) -> 
         s.values[sel] = np.mod(s.values[sel] + d, full)
 
 
+def stored_wheel_momentum_B(s: _Samples, spacecraft: Spacecraft, t_ns: int, span_s: float = 20.0) -> FloatArray:
+    """The wheels' momentum Σ J_s Ω ĝ [N·m·s] in body axes over the ``span_s`` before ``t_ns`` (median of
+    each wheel's raw reading; the wheels' injected changes are not in it yet)."""
+    assert spacecraft.flight is not None
+    speeds = np.zeros(len(spacecraft.wheels))
+    for ch in spacecraft.flight.of("wheel_speed"):
+        sel = s.rows(ch.mnemonic, t_ns - int(span_s * NS), t_ns)
+        if sel.size:
+            speeds[ch.component] = float(np.median(s.values[sel])) * ch.to_si
+    return np.asarray((spacecraft.wheel_axes * spacecraft.wheel_spin_inertias_kgm2[None, :]) @ speeds)
+
+
+def aimed_dump(c: Confounder, stored_B_Nms: FloatArray) -> Confounder:
+    """The dump ``c`` aimed against the wheels' stored momentum: its direction −Ĥ_w turned by ``aim_deg``
+    about the part of ``aim_axis_B`` across it, its impulse at most |H_w| (a dump unloads what is stored)."""
+    h = float(np.linalg.norm(stored_B_Nms))
+    if not h > 0:
+        raise ConfigError("momentum_dump: the wheels hold no momentum at its onset", key="momentum_dump")
+    u = -np.asarray(stored_B_Nms, float) / h
+    a = np.asarray(c.params["aim_axis_B"], float)
+    a = a - u * (a @ u)
+    a = a / np.linalg.norm(a) if np.linalg.norm(a) > 0 else np.zeros(3)
+    ang = math.radians(float(c.params["aim_deg"]))
+    d = u * math.cos(ang) + np.cross(a, u) * math.sin(ang)
+    p = {**c.params, "direction_B": d.tolist(), "impulse_Nms": min(float(c.params["impulse_Nms"]), h)}
+    return replace(c, params=p)
+
+
 def inject_confounders(
     samples: pd.DataFrame,
     spacecraft: Spacecraft,
@@ -415,6 +471,8 @@ def inject_confounders(
     s = _Samples(out["value"].to_numpy(np.float64).copy(), t_all, rows, WheelChanges(t_all.size))
     bn_at = InjectionAttitude(samples, spacecraft)
     for c in confounders:
+        if c.kind == "momentum_dump" and "direction_B" not in c.params:
+            c = aimed_dump(c, stored_wheel_momentum_B(s, spacecraft, c.time_ns))
         if CONFOUNDER_CLASS[c.kind] == "sensor_fault":
             _add_sensor_fault(s, spacecraft, c)
         else:

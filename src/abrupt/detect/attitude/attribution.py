@@ -16,6 +16,10 @@ The rules read the evidence of :mod:`abrupt.detect.attitude.evidence`; none is f
    momentum changed, while the body never felt it (body share below ``body_share_min`` and below
    ``body_sigma`` times its noise), and the change is not one the minimum-norm controller makes
    (null-space part, or one wheel carrying it);
+3b. **external_non_strike** when a lasting step is a momentum dump: ΔH against the
+    momentum the wheels held, the likelihood ratio of that hypothesis to a strike's random direction
+    beyond ``dump_lr_min`` (:func:`momentum_dump`, :mod:`abrupt.detect.attitude.dump_evidence`); its
+    confidence is the dump's posterior probability at even prior odds;
 4. **strike** when the sensors agree, the body took the impulse first (body share), the step lasts,
    is in the momentum before cleaning too (``raw_step_fraction``) and is impulsive (its duration
    interval reaches below ``impulsive_s``) and no other impulse of the window that moved the body shares
@@ -94,6 +98,11 @@ class AttributionRules:
     #: centred on it fits worse by more than ``sharp_chi2`` (3 σ), every other step of the window beside it.
     step_sharp: bool = True
     sharp_chi2: float = 9.0
+    #: Rule 3b: a lasting external step is a momentum dump when the likelihood ratio of the dump hypothesis
+    #: (ΔH against the wheels' stored momentum) to the strike's (any direction) exceeds this; a strike's
+    #: random direction does so with probability at most 1 / (e · ``dump_lr_min``) = 1.8 %, on any
+    #: spacecraft (:mod:`abrupt.detect.attitude.dump_evidence`).
+    dump_lr_min: float = 20.0
 
 
 @dataclass(frozen=True)
@@ -116,6 +125,18 @@ def _ratio(x: float, limit: float) -> float:
 
 def _confidence(tests: list[bool]) -> float:
     return 0.5 + 0.49 * (sum(tests) / len(tests)) if tests else 0.5
+
+
+def momentum_dump(ev: EventEvidence, r: AttributionRules) -> float:
+    """The probability that the event is a momentum dump rather than a strike (even prior odds), when the
+    dump hypothesis wins: ΔH_B against the wheels' stored momentum with a likelihood ratio beyond
+    ``dump_lr_min``, and the wheels' stored momentum shrinks (``dump_unloads`` below 1: a dump cannot
+    unload more than twice what is stored along its direction); 0 otherwise."""
+    if not (_finite(ev.dump_log_lr, ev.dump_unloads) and ev.dump_unloads < 1.0):
+        return 0.0
+    if ev.dump_log_lr <= math.log(r.dump_lr_min):
+        return 0.0
+    return 1.0 / (1.0 + math.exp(-ev.dump_log_lr))
 
 
 def _lasting_impulse(ev: EventEvidence, r: AttributionRules) -> bool:
@@ -291,6 +312,12 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
     # An impulse that other impulses of the window share the direction of (same sign, within 30°) is one of
     # a sequence: a venting train's pulse, however isolated in time it looks.
     in_sequence = r.step_alone and _finite(ev.step_sharp_siblings) and ev.step_sharp_siblings > 0
+    # 3b. A momentum dump: a lasting external step against the momentum the wheels hold.
+    p_dump = momentum_dump(ev, r)
+    if p_dump > 0 and abs(ev.lasting_fraction) >= r.lasting_min:
+        return Attribution(
+            "external_non_strike", min(p_dump, 0.99), "", "momentum dump: ΔH against the wheels' stored momentum"
+        )
     # 4./5. External.
     if lasting and impulsive and body_moved and in_raw and not in_sequence:
         return Attribution("strike", _confidence([True, True, True, surface_ok]), "", "impulsive external step")

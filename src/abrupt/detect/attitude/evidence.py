@@ -55,7 +55,11 @@ telemetry (:class:`~abrupt.series.timetable.Timetable`) around the event:
   jumped (``step_internal_siblings``: a snap moves momentum between hub and appendage, which a momentum
   model without the appendage reads as a step; no external impulse, also left out); ``alone_step_lasting``: what
   lasts of that fitted step (with the other steps within 150 s after it that point back against it)
-  along itself over |ΔH|, judged beside the window's other steps rather than on the raw balance.
+  along itself over |ΔH|, judged beside the window's other steps rather than on the raw balance;
+* **momentum dump** (``wheel_momentum_Nms``, ``dump_angle_deg``, ``dump_angle_sigma_deg``,
+  ``dump_log_lr``, ``dump_unloads``): ΔH_B against the momentum the wheels held before the event, and the
+  likelihood ratio of a dump (aimed at −H_w) to a strike (any direction):
+  :mod:`abrupt.detect.attitude.dump_evidence`.
 """
 
 from __future__ import annotations
@@ -76,6 +80,7 @@ from abrupt.detect.attitude.body_response import (
     white_noise_sigma,
 )
 from abrupt.detect.attitude.body_response import window_rows as _idx
+from abrupt.detect.attitude.dump_evidence import dump_evidence
 from abrupt.detect.attitude.ramp_step import (
     WindowFits,
     body_frame_momentum,
@@ -149,6 +154,11 @@ class EventEvidence:
     step_close_siblings: float = NAN
     alone_step_lasting: float = NAN
     after_strike_s: float = NAN
+    wheel_momentum_Nms: float = NAN
+    dump_angle_deg: float = NAN
+    dump_angle_sigma_deg: float = NAN
+    dump_log_lr: float = NAN
+    dump_unloads: float = NAN
 
     def as_dict(self) -> dict[str, float]:
         return {f"ev_{k}": float(v) for k, v in asdict(self).items()}
@@ -352,6 +362,7 @@ def event_evidence(
                 out["step_internal_siblings"] = internal
                 out["step_siblings"] = float(out["step_siblings"]) - still - internal
     out.update(appendage_jump(table, i0, dt))
+    out.update(dump_evidence(table, spacecraft, cleaned_H_N, i0, dh_b))
     out.update(surface_evidence(spacecraft, dh_b))
     if raw_H_N is not None and mag > 0:
         b = _idx(g, i0, -w.wheel_s, -w.guard_s, dt)
