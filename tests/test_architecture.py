@@ -29,6 +29,7 @@ LAYERS: dict[str, int] = {
     "errors": 0,
     "units": 0,
     "progress": 0,
+    "outputs": 0,
     "events": 1,
     "thresholds": 1,
     "store": 1,

@@ -16,15 +16,15 @@ import functools
 import hashlib
 import json
 import math
-import os
 import uuid
 from collections.abc import Iterable, Mapping
 from dataclasses import asdict, dataclass, field, is_dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
+
+from abrupt.outputs import atomic_output
 
 EVENT_KINDS = (
     "strike",
@@ -275,19 +275,13 @@ def write_events(frame: pd.DataFrame, path: str) -> None:
     lower = str(path).lower()
     if not lower.endswith((".parquet", ".pq", ".csv")):
         raise ValueError(f"{path}: events file must end in .csv or .parquet")
-    target = Path(path)
-    tmp_name = target.with_name(f".{target.name}.{uuid.uuid4().hex[:12]}.tmp")
-    try:
+    with atomic_output(path) as tmp_name:
         if lower.endswith(".csv"):
             frame.to_csv(tmp_name, index=False)
         else:
             typed = frame.copy()
             typed["time_utc"] = pd.to_datetime(typed["time_utc"].astype(str), utc=True).astype("datetime64[us, UTC]")
             typed.to_parquet(tmp_name, index=False)
-        os.replace(tmp_name, target)
-    except BaseException:
-        tmp_name.unlink(missing_ok=True)
-        raise
 
 
 def read_events(path: str) -> pd.DataFrame:

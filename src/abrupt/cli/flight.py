@@ -22,6 +22,7 @@ from abrupt.detect.attitude.flight_glr import FlightGlrDetector
 from abrupt.errors import InputError
 from abrupt.events import write_events
 from abrupt.model.spacecraft import load_spacecraft
+from abrupt.outputs import atomic_output, write_text_atomic
 from abrupt.pipelines.flight import CleaningConfig, FlightRunConfig, day_range, ingest_archives, run_flight
 from abrupt.pipelines.flight_injection import injection_recovery
 from abrupt.pipelines.flight_orbit import run_flight_with_orbit
@@ -93,7 +94,7 @@ def ingest_cmd(
         reported = ", ".join(f"{k} {v}" for k, v in d.get("reported", {}).items()) or "none"
         click.echo(
             f"{d['spacecraft']} {d['day']}: {d.get('rows_stored', d.get('rows_kept', 0))} rows; "
-            f"removed: {removed}; reported: {reported}"
+            f"removed: {removed}; reported: {reported}" + (f"; {d['last_ingest']}" if "last_ingest" in d else "")
         )
     for name, counts in summary.files.items():
         extra = {k: v for k, v in counts.items() if k != "rows read"}
@@ -186,7 +187,8 @@ def detect_from_store(
     for w in result.warnings:
         click.echo(f"warning: {w}", err=True)
     if daily_path:
-        result.daily.to_csv(daily_path, index=False)
+        with atomic_output(daily_path) as tmp:
+            result.daily.to_csv(tmp, index=False)
     if report_path:
         write_flight_report(report_path, result)
         click.echo(f"report: {report_path}", err=True)
@@ -280,8 +282,9 @@ def inject_attitude_cmd(
         rec = injection_recovery(store_dir, sc, cfg, base.threshold, days=days or None, seed=seed)
         click.echo(rec.per_day.to_string(index=False))
         if out:
-            rec.per_day.to_csv(out, index=False)
-            Path(out).with_suffix(".injections.csv").write_text(rec.injections.to_csv(index=False))
+            with atomic_output(out) as tmp:
+                rec.per_day.to_csv(tmp, index=False)
+            write_text_atomic(Path(out).with_suffix(".injections.csv"), rec.injections.to_csv(index=False))
     if not strikes and not conf_list and not recovery:
         raise click.UsageError("give --strike/--confounder ... --out-store DIR, or --recovery")
 
@@ -375,7 +378,7 @@ def simulate_confounders_cmd(
     conf = _confounders(sc, specs, None, confounder_ranges, seed)
     text = json.dumps([_confounder_json(c) for c in conf], indent=1)
     if out:
-        Path(out).write_text(text + "\n")
+        write_text_atomic(out, text + "\n")
         click.echo(f"{len(conf)} confounder(s) written to {out}")
     else:
         click.echo(text)

@@ -25,6 +25,7 @@ from abrupt.flux.exposure import (
 from abrupt.flux.forward import ForwardConfig
 from abrupt.flux.inference import PARAMS, FitResult
 from abrupt.model.spacecraft import Spacecraft
+from abrupt.outputs import atomic_output, write_text_atomic
 from abrupt.pipelines.flux import covered_days, flight_exposure, infer_flux, simulate_population
 from abrupt.report.flux import write_flux_report
 from abrupt.simulate.population import DETECTOR, FleetSpec
@@ -151,7 +152,7 @@ def infer(
     for n in result.notes:
         note(f"note: {n}")
     if out_path:
-        Path(out_path).write_text(json.dumps(result.as_dict(), indent=1, default=float))
+        write_text_atomic(out_path, json.dumps(result.as_dict(), indent=1, default=float))
         note(f"wrote {out_path}")
     if report_path:
         write_flux_report(report_path, result)
@@ -250,8 +251,15 @@ def exposure_command(
 
 @simulate.command("population")
 @click.option("--spacecraft-file", required=True, type=click.Path(exists=True, dir_okay=False))
-@click.option("--count", "n_spacecraft", type=int, default=10, show_default=True, help="Spacecraft in the fleet.")
-@click.option("--years", type=float, default=1.0, show_default=True)
+@click.option(
+    "--count",
+    "n_spacecraft",
+    type=click.IntRange(min=1),
+    default=10,
+    show_default=True,
+    help="Spacecraft in the fleet.",
+)
+@click.option("--years", type=click.FloatRange(min=0.0, min_open=True), default=1.0, show_default=True)
 @click.option("--altitude-km", type=float, default=550.0, show_default=True)
 @click.option("--inclination-deg", type=float, default=28.5, show_default=True)
 @click.option("--epoch", "epoch_year", type=float, default=2020.0, show_default=True)
@@ -310,7 +318,8 @@ def population(
         f"detector {DETECTOR}; catalog {cat.name}"
     )
     if out_path:
-        events.to_csv(out_path, index=False)
+        with atomic_output(out_path) as tmp:
+            events.to_csv(tmp, index=False)
         note(f"wrote {out_path}")
 
 

@@ -13,6 +13,7 @@ import hashlib
 import logging
 import sys
 from collections.abc import Iterable, Iterator, Mapping
+from contextlib import ExitStack
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -22,6 +23,7 @@ from abrupt import progress as progress_report
 from abrupt.catalog import Catalog, coverage_of
 from abrupt.cli.commands import GLOBAL_FLAGS, State, cli, detect, hoist_global_flags, inject, report, simulate
 from abrupt.events import write_events
+from abrupt.outputs import atomic_output
 
 __all__ = [
     "DEFAULT_CATALOG",
@@ -182,17 +184,6 @@ def record_run(
     details = {**(details or {}), **command_options()}
     catalog = Catalog(catalog_target)  # open (and check) the catalog before writing anything
     catalog.check_fits(events)  # texts too long for the catalog: refused before the file is written
-    if out is not None:  # then the file: a bad path must not leave events in the catalog only
-        Path(out).parent.mkdir(parents=True, exist_ok=True)
-        write_events(events, str(out))
-    catalog.start_run(
-        run_id,
-        command,
-        config_hash=config_hash,
-        input_hash=file_hash(input_path) if input_path is not None else None,
-        details=details,
-    )
-    added = catalog.store_events(events)
     coverage = coverage_of(
         events,
         config_hash=config_hash,
@@ -201,7 +192,22 @@ def record_run(
         start_utc=span_utc[0] if span_utc else None,
         end_utc=span_utc[1] if span_utc else None,
     )
-    catalog.finish_run(run_id, n_found=len(events), n_new=added.events, details=details, coverage=coverage)
+    # The events file is written aside first (a bad path or a full disk fails before the catalog holds
+    # the run), and renamed into place only once the catalog has stored the run: a catalog that fails
+    # leaves no events file.
+    with ExitStack() as stack:
+        if out is not None:
+            Path(out).parent.mkdir(parents=True, exist_ok=True)
+            write_events(events, str(stack.enter_context(atomic_output(out))))
+        catalog.start_run(
+            run_id,
+            command,
+            config_hash=config_hash,
+            input_hash=file_hash(input_path) if input_path is not None else None,
+            details=details,
+        )
+        added = catalog.store_events(events)
+        catalog.finish_run(run_id, n_found=len(events), n_new=added.events, details=details, coverage=coverage)
     again = len(events) - added.detections
     other_config = added.detections - added.events
     note(

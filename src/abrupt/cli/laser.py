@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 from dataclasses import replace
-from pathlib import Path
 from typing import Any
 
 import click
@@ -12,6 +11,7 @@ import click
 from abrupt.cli.groups import catalog_option, detect, record_run
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.model.range_reduction import RANGE_MODEL_TERMS, RangeModel
+from abrupt.outputs import write_text_atomic
 from abrupt.pipelines.laser_ranging import LASER_FORCE, run_laser_ranging_files
 
 TERMS = RANGE_MODEL_TERMS
@@ -130,7 +130,7 @@ def detect_laser_command(
     for line in run.summary_lines():
         click.echo(line, err=True)
     if fit_out:
-        Path(fit_out).write_text(json.dumps(run.summary, indent=2, default=float))
+        write_text_atomic(fit_out, json.dumps(run.summary, indent=2, default=float))
     record_run(
         catalog_target=catalog_target,
         command="detect laser",

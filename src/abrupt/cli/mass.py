@@ -13,6 +13,7 @@ from abrupt.cli.options import budget_options, pop_budget
 from abrupt.detect.base import DetectionResult
 from abrupt.events import config_hash, new_run_id, read_events
 from abrupt.massprops.track import InertiaTrack
+from abrupt.outputs import write_text_atomic
 from abrupt.pipelines.mass import (
     MomentumOptions,
     detect_mass_change_run,
@@ -110,7 +111,7 @@ def estimate_inertia_cmd(
     )
     click.echo(est.summary())
     Path(out_toml).parent.mkdir(parents=True, exist_ok=True)
-    Path(out_toml).write_text(updated_spacecraft_toml(spacecraft_file, est))
+    write_text_atomic(out_toml, updated_spacecraft_toml(spacecraft_file, est))
     rep = report_path or str(Path(out_toml).with_suffix(".json"))
     write_report(inertia_report(est, sc, repairs), rep)
     click.echo(f"updated spacecraft file {out_toml}; report {rep}", err=True)

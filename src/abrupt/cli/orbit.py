@@ -28,6 +28,7 @@ from abrupt.detect.orbit.detectors import STATISTIC_SUMMARIES
 from abrupt.errors import ConfigError, InputError
 from abrupt.events import config_hash, new_run_id, read_events
 from abrupt.model.orbit import ForceModel
+from abrupt.outputs import atomic_output
 from abrupt.pipelines.orbit import OrbitRun, detect_orbit, inject_orbit, summary_lines
 from abrupt.pipelines.orbit_product import detect_orbit_product
 from abrupt.readers.ephemeris import write_ephemeris
@@ -348,12 +349,7 @@ def detect_orbit_command(
     # the fit (residual RMS, estimated parameters, thresholds) is printed on every run
     click.echo("\n".join(summary_lines(run.summary)), err=True)
     if statistics_out and run.result.diagnostics:
-        frame = _statistics_frame(run)
-        Path(statistics_out).parent.mkdir(parents=True, exist_ok=True)
-        if statistics_out.endswith(".csv"):
-            frame.to_csv(statistics_out, index=False)
-        else:
-            frame.to_parquet(statistics_out, index=False)
+        _write_statistics(run, statistics_out)
     events = run.events
     chash = _config_hash_of(events, run.detector.config(), budget)
     record_run(
@@ -372,6 +368,17 @@ def detect_orbit_command(
     if report_path and run.analysis is not None:
         path = plot_orbit_report(run.analysis, run.thresholds, events, report_path)
         click.echo(f"report written to {path}", err=True)
+
+
+def _write_statistics(run: OrbitRun, path: str) -> None:
+    """``--statistics-out``: the per-epoch statistics as CSV or Parquet (by suffix), written atomically."""
+    frame = _statistics_frame(run)
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    with atomic_output(path) as tmp:
+        if path.endswith(".csv"):
+            frame.to_csv(tmp, index=False)
+        else:
+            frame.to_parquet(tmp, index=False)
 
 
 def _statistics_frame(run: OrbitRun) -> pd.DataFrame:

@@ -12,6 +12,7 @@ import numpy as np
 from abrupt.cli.fleet import executor_from, with_executor_options
 from abrupt.cli.groups import cli, progress_hidden
 from abrupt.errors import ConfigError
+from abrupt.outputs import atomic_output
 from abrupt.pipelines.rates import METRIC_UNITS, build_scenario, metric_thresholds, parse_vary, rate_table
 from abrupt.rates import flux as fx
 from abrupt.rates import tables
@@ -179,7 +180,8 @@ def _report(results: Sequence[Any], kw: dict[str, Any]) -> None:
         click.echo(sub.to_string(float_format=lambda v: f"{v:.4g}"))
     if kw["out"]:
         Path(kw["out"]).parent.mkdir(parents=True, exist_ok=True)
-        frame.to_csv(kw["out"], index=False)
+        with atomic_output(kw["out"]) as tmp:
+            frame.to_csv(tmp, index=False)
         click.echo(f"table written to {kw['out']}", err=True)
     if kw["plot"]:
         m = metrics[0]

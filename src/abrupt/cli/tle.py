@@ -32,6 +32,7 @@ from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET, TleDetectorConfig
 from abrupt.detect.tle.detectors import detector_for
 from abrupt.errors import InputError
 from abrupt.events import config_hash, new_run_id, read_events
+from abrupt.outputs import atomic_output, write_text_atomic
 from abrupt.pipelines.tle import burns_below_detectable, detect_tle_file, satellite_label
 from abrupt.readers.fengyun import read_maneuver_file
 from abrupt.readers.omm import read_elements
@@ -408,7 +409,7 @@ def score(
     if elements:
         out["below_detectable"] = _flag_undetectable(elements, events, truth_frame, start, end)
     if json_out:
-        Path(json_out).write_text(json.dumps(out, indent=2, default=str))
+        write_text_atomic(json_out, json.dumps(out, indent=2, default=str))
 
 
 def _flag_undetectable(elements: str, events: Any, truth: Any, start: Any, end: Any) -> dict[str, Any]:
@@ -535,7 +536,8 @@ def inject_tle(
         f"({summary['false_alarms_per_year']:.2f} per year; {summary['echoes']} within 3 days of a burn)"
     )
     if out:
-        burns.to_csv(out, index=False)
+        with atomic_output(out) as tmp:
+            burns.to_csv(tmp, index=False)
         click.echo(f"burns written to {out}", err=True)
     if report_path:
         label = f"{satellite_label(sat.history)}: injected burns"

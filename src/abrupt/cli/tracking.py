@@ -16,6 +16,7 @@ from abrupt.cli.options import budget_options, pop_budget
 from abrupt.errors import ConfigError
 from abrupt.events import read_events, write_events
 from abrupt.model.stations import ascension
+from abrupt.outputs import atomic_output, write_text_atomic
 from abrupt.pipelines.tracking import TrackingSettings, detect_tracking, read_tracking_series
 from abrupt.readers.orekit_od_input import write_od_input
 from abrupt.readers.tdm import write_tdm
@@ -162,7 +163,7 @@ def _write_aer(measurements: Any, path: Path) -> None:
             )
         if np.isfinite(row["range_rate_mps"]):
             lines.append(f"{t}   RANGE_RATE   {row['station']}   {row['range_rate_mps'] / 1e3:.9f}")
-    path.write_text("\n".join(lines) + "\n")
+    write_text_atomic(path, "\n".join(lines) + "\n")
 
 
 @detect.command("tracking")
@@ -261,9 +262,10 @@ def detect_tracking_command(
     for line in run.summary_lines():
         click.echo(line, err=True)
     if fit_out:
-        Path(fit_out).write_text(json.dumps(run.fit_summary, indent=2, default=float))
+        write_text_atomic(fit_out, json.dumps(run.fit_summary, indent=2, default=float))
     if diagnostics_out:
-        run.diagnostics.to_csv(diagnostics_out, index=False)
+        with atomic_output(diagnostics_out) as tmp:
+            run.diagnostics.to_csv(tmp, index=False)
     record_run(
         catalog_target=catalog_target,
         command="detect tracking",
