@@ -76,12 +76,21 @@ class TelemetryStore:
             self._write_report(d, {**prev, "last_ingest": f"{source}: unchanged (already stored)"})
             return 0
         old = _normalised(self.read_day(spacecraft, day)) if path.exists() else new.iloc[:0]
-        merged = merge_version(old, new, replace=source in archives)
         span = (int(new["time"].min()), int(new["time"].max())) if len(new) else (0, -1)
-        for name, entry in list(archives.items()):
-            lo, hi = entry.get("span_ns", (0, -1))
-            if merged.replaced and name != source and span[0] <= lo and hi <= span[1]:
-                del archives[name]  # every sample of that archive was in the replaced span
+        # the earlier versions: stored archives whose time span meets this one's (or the same name)
+        earlier = {
+            name: tuple(entry.get("span_ns") or (-(2**62), 2**62))
+            for name, entry in archives.items()
+            if name == source or _meets(tuple(entry.get("span_ns") or (-(2**62), 2**62)), span)
+        }
+        reach = (
+            min([span[0], *(lo for lo, _ in earlier.values())]),
+            max([span[1], *(hi for _, hi in earlier.values())]),
+        )
+        merged = merge_version(old, new, replace=source in archives, span_ns=reach)
+        if merged.replaced or source in archives:
+            for name in earlier:
+                archives.pop(name, None)  # replaced by this version: its counts go with it
         archives[source] = {**_counts(report), "digest": digest, "span_ns": list(span)}
         d.mkdir(parents=True, exist_ok=True)
         with atomic_output(path) as tmp:
@@ -241,13 +250,20 @@ def _totals(archives: dict[str, dict[str, Any]]) -> dict[str, Any]:
 
 
 def _normalised(samples: pd.DataFrame) -> pd.DataFrame:
-    """mnemonic (str), time (int64 ns UTC), value (float64)."""
+    """mnemonic (categorical of str, sorted names), time (int64 ns UTC), value (float64)."""
     t = pd.DatetimeIndex(samples["time"])
     if t.tz is not None:
         t = t.tz_convert("UTC").tz_localize(None)
+    mnemonic = samples["mnemonic"].astype("category")
+    names = pd.Index(mnemonic.cat.categories.astype(str))
+    order = np.argsort(names.to_numpy(dtype=object), kind="stable")
+    rank = np.empty(order.size, np.int64)
+    rank[order] = np.arange(order.size)
+    codes = mnemonic.cat.codes.to_numpy()
+    sorted_codes = np.where(codes >= 0, rank[np.maximum(codes, 0)] if rank.size else 0, -1)
     return pd.DataFrame(
         {
-            "mnemonic": samples["mnemonic"].astype(str).to_numpy(),
+            "mnemonic": pd.Categorical.from_codes(sorted_codes, names[order]),
             "time": t.asi8,
             "value": samples["value"].to_numpy(np.float64),
         }
@@ -256,11 +272,14 @@ def _normalised(samples: pd.DataFrame) -> pd.DataFrame:
 
 def _digest(frame: pd.DataFrame) -> str:
     """SHA-256 of samples' content in a canonical order (independent of row order and file name)."""
-    ordered = frame.sort_values(["mnemonic", "time", "value"], kind="stable")
+    codes = frame["mnemonic"].cat.codes.to_numpy(np.int64)  # over sorted names (:func:`_normalised`)
+    t = frame["time"].to_numpy(np.int64)
+    v = frame["value"].to_numpy(np.float64)
+    order = np.lexsort((v, t, codes))
     h = hashlib.sha256()
-    h.update("\n".join(ordered["mnemonic"].tolist()).encode())
-    h.update(ordered["time"].to_numpy(np.int64).tobytes())
-    h.update(ordered["value"].to_numpy(np.float64).tobytes())
+    h.update("\n".join(map(str, frame["mnemonic"].cat.categories)).encode())
+    for column in (codes, t, v):
+        h.update(np.ascontiguousarray(column[order]).tobytes())
     return h.hexdigest()
 
 
@@ -283,22 +302,80 @@ class MergedDay:
         return f"{source}: {self.added} row(s) added"
 
 
-def merge_version(old: pd.DataFrame, new: pd.DataFrame, *, replace: bool = False) -> MergedDay:
+def _common_names(a: pd.DataFrame, b: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Both frames with their mnemonic categoricals over the same (sorted) names, so that they concatenate
+    as one categorical."""
+    a, b = (f.assign(mnemonic=f["mnemonic"].astype("category")) for f in (a, b))
+    names = a["mnemonic"].cat.categories.union(b["mnemonic"].cat.categories)
+    out = []
+    for frame in (a, b):
+        remap = names.get_indexer(frame["mnemonic"].cat.categories)
+        codes = frame["mnemonic"].cat.codes.to_numpy()
+        new_codes = np.where(codes >= 0, remap[np.maximum(codes, 0)] if remap.size else 0, -1)
+        out.append(frame.assign(mnemonic=pd.Categorical.from_codes(new_codes, names)))
+    return out[0], out[1]
+
+
+def _sample_keys(a: pd.DataFrame, b: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
+    """One int64 key per (mnemonic, time) row of two frames of :func:`_common_names`: the mnemonic's code
+    in the high bits, nanoseconds since the earlier start in the low 47 (a day is 8.6e13 ns < 2^47)."""
+    names = a["mnemonic"].cat.categories
+    times = np.concatenate([a["time"].to_numpy(np.int64), b["time"].to_numpy(np.int64)])
+    t0 = int(times.min()) if times.size else 0
+    if times.size and (int(times.max()) - t0 >= 1 << 47 or len(names) >= 1 << 15):
+        raise InputError("a stored day spans more than 1.6 days or holds 32768 channels or more")
+    out = []
+    for frame in (a, b):
+        code = frame["mnemonic"].cat.codes.to_numpy(np.int64)
+        out.append((code << 47) | (frame["time"].to_numpy(np.int64) - t0))
+    return out[0], out[1]
+
+
+def _lookup(keys: np.ndarray, wanted: np.ndarray) -> np.ndarray:
+    """Index in ``keys`` of each of ``wanted`` (its first occurrence), -1 where absent."""
+    first = ~pd.Index(keys).duplicated()
+    positions = np.flatnonzero(first)
+    found = pd.Index(keys[first]).get_indexer(wanted)
+    return np.where(found >= 0, positions[np.maximum(found, 0)], -1) if positions.size else found
+
+
+def _gather(values: np.ndarray, index: np.ndarray) -> np.ndarray:
+    """``values[index]`` with NaN where ``index`` is -1."""
+    if not values.size:
+        return np.full(index.size, np.nan)
+    return np.where(index >= 0, values[np.maximum(index, 0)], np.nan)
+
+
+def _equal(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return (a == b) | (np.isnan(a) & np.isnan(b))
+
+
+def _meets(a: tuple[int, ...], b: tuple[int, ...]) -> bool:
+    return a[0] <= b[1] and b[0] <= a[1]
+
+
+def merge_version(
+    old: pd.DataFrame, new: pd.DataFrame, *, replace: bool = False, span_ns: tuple[int, int] | None = None
+) -> MergedDay:
     """One version of a day from the stored samples ``old`` and an archive's ``new`` (normalised frames).
 
     Samples equal in mnemonic, time and value are kept once. When ``new`` holds another value at a stored
     mnemonic and time (a corrected archive), or ``replace`` (the same archive name was stored with other
-    content), every stored sample within ``new``'s time span is replaced by ``new``; stored samples
-    outside it (another archive's part of the day) are kept. ``added`` and ``replaced`` count the rows
-    that differ: rows stored again unchanged count in neither."""
-    key_old = pd.MultiIndex.from_arrays([old["mnemonic"], old["time"]])
-    key_new = pd.MultiIndex.from_arrays([new["mnemonic"], new["time"]])
-    same_old = pd.MultiIndex.from_frame(old).isin(pd.MultiIndex.from_frame(new))
-    same_new = pd.MultiIndex.from_frame(new).isin(pd.MultiIndex.from_frame(old))
-    conflicts = int((key_old.isin(key_new) & ~same_old).sum())
+    content), every stored sample within ``span_ns`` (default: ``new``'s time span; the store widens it
+    to the spans of the earlier versions) is replaced by ``new``; stored samples outside it (another
+    archive's part of the day) are kept. ``added`` and ``replaced`` count the rows that differ: rows
+    stored again unchanged count in neither."""
+    old, new = _common_names(old, new)
+    key_old, key_new = _sample_keys(old, new)
+    at_new = _lookup(key_new, key_old)  # row of new at each old row's mnemonic and time (-1: none)
+    at_old = _lookup(key_old, key_new)
+    same_old = (at_new >= 0) & _equal(old["value"].to_numpy(), _gather(new["value"].to_numpy(), at_new))
+    same_new = (at_old >= 0) & _equal(new["value"].to_numpy(), _gather(old["value"].to_numpy(), at_old))
+    conflicts = int(((at_new >= 0) & ~same_old).sum())
     if (conflicts or replace) and len(new):
-        inside = ((old["time"] >= new["time"].min()) & (old["time"] <= new["time"].max())).to_numpy()
+        lo, hi = span_ns if span_ns is not None else (int(new["time"].min()), int(new["time"].max()))
+        inside = ((old["time"] >= lo) & (old["time"] <= hi)).to_numpy()
         frame = pd.concat([old.loc[~inside], new], ignore_index=True)
         return MergedDay(frame, int((~same_new).sum()), int((inside & ~same_old).sum()), conflicts)
-    fresh = new.loc[~key_new.isin(key_old)]
+    fresh = new.loc[at_old < 0]
     return MergedDay(pd.concat([old, fresh], ignore_index=True), len(fresh), 0, 0)
