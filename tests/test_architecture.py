@@ -30,6 +30,7 @@ LAYERS: dict[str, int] = {
     "units": 0,
     "progress": 0,
     "kinds": 0,
+    "outputs": 0,
     "events": 1,
     "thresholds": 1,
     "store": 1,

@@ -78,6 +78,16 @@ class ConfigError(AbruptError, ValueError):
         super().__init__(f"{where}: {self.reason}")
 
 
+class OutputError(AbruptError):
+    """An output that cannot or must not be written (full disk, read-only folder, an input's path);
+    names the file and the reason."""
+
+    def __init__(self, reason: str, *, file: str | Path) -> None:
+        self.reason = bounded(" ".join(str(reason).split()))
+        self.file = str(file)
+        super().__init__(f"{self.file}: {self.reason}")
+
+
 @dataclass
 class RepairLog:
     """Counts documented repairs made to input data.

@@ -17,7 +17,6 @@ import functools
 import hashlib
 import json
 import math
-import os
 import uuid
 from collections.abc import Iterable, Mapping
 from dataclasses import asdict, dataclass, field, is_dataclass
@@ -28,6 +27,7 @@ import numpy as np
 import pandas as pd
 
 from abrupt.kinds import EVENT_KINDS
+from abrupt.outputs import atomic_output
 
 EVENT_COLUMNS: tuple[str, ...] = (
     "event_id",
@@ -267,19 +267,13 @@ def write_events(frame: pd.DataFrame, path: str) -> None:
     lower = str(path).lower()
     if not lower.endswith((".parquet", ".pq", ".csv")):
         raise ValueError(f"{path}: events file must end in .csv or .parquet")
-    target = Path(path)
-    tmp_name = target.with_name(f".{target.name}.{uuid.uuid4().hex[:12]}.tmp")
-    try:
+    with atomic_output(path) as tmp_name:
         if lower.endswith(".csv"):
             frame.to_csv(tmp_name, index=False)
         else:
             typed = frame.copy()
             typed["time_utc"] = pd.to_datetime(typed["time_utc"].astype(str), utc=True).astype("datetime64[us, UTC]")
             typed.to_parquet(tmp_name, index=False)
-        os.replace(tmp_name, target)
-    except BaseException:
-        tmp_name.unlink(missing_ok=True)
-        raise
 
 
 def read_events(path: str) -> pd.DataFrame:
@@ -321,26 +315,27 @@ def split_evidence(frame: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
     return frame.drop(columns=names), evidence.reset_index(drop=True)
 
 
+def write_evidence(evidence: pd.DataFrame, path: str | Path) -> None:
+    """Write an evidence table (keyed by ``event_id``) to CSV or Parquet, chosen by the suffix, atomically."""
+    with atomic_output(path) as tmp:
+        if str(path).lower().endswith(".csv"):
+            evidence.to_csv(tmp, index=False)
+        else:
+            evidence.to_parquet(tmp, index=False)
+
+
 def write_events_and_evidence(frame: pd.DataFrame, path: str) -> Path | None:
     """Write the event table to ``path`` (:func:`write_events`) and, when the events carry attribution
     evidence, the evidence table to :func:`evidence_path` (same format, keyed by ``event_id``; written
-    first, through a temporary file). Returns the evidence file, or None when there was no evidence."""
+    first). Both are written aside and renamed into place. Returns the evidence file, or None when there
+    was no evidence."""
     events, evidence = split_evidence(normalise_frame(frame))
     target = None
     if evidence.shape[1] > 1:
         target = evidence_path(path)
         if target.resolve() == Path(path).resolve():
             raise ValueError(f"{path}: the evidence table would overwrite the events file")
-        tmp = target.with_name(f".{target.name}.{uuid.uuid4().hex[:12]}.tmp")
-        try:
-            if str(path).lower().endswith(".csv"):
-                evidence.to_csv(tmp, index=False)
-            else:
-                evidence.to_parquet(tmp, index=False)
-            os.replace(tmp, target)
-        except BaseException:
-            tmp.unlink(missing_ok=True)
-            raise
+        write_evidence(evidence, target)
     write_events(events, path)
     return target
 

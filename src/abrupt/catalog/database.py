@@ -34,6 +34,7 @@ import datetime as dt
 import functools
 import hashlib
 import json
+import re
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -141,8 +142,20 @@ def _display(target: str | Path) -> str:
         return text
     try:
         return sa.engine.make_url(text).render_as_string(hide_password=True)
-    except sa.exc.ArgumentError:
-        return text
+    except (sa.exc.ArgumentError, ValueError):
+        return re.sub(r"://([^:/@]*):[^@/]*@", r"://\1:***@", text)  # unparsable: hide the password anyway
+
+
+def _check_url(name: str, url: str) -> None:
+    """A one-line :class:`CatalogError` for a URL SQLAlchemy cannot parse (a port that is not a number)."""
+    try:
+        sa.engine.make_url(url)
+    except sa.exc.ArgumentError as exc:
+        raise CatalogError(f"{name}: not a valid catalog URL ({_first_line(exc)})") from None
+    except ValueError:
+        raise CatalogError(
+            f"{name}: not a valid catalog URL: expected kind://user:password@host:port/database with a numeric port"
+        ) from None
 
 
 def _first_line(exc: BaseException) -> str:
@@ -203,12 +216,15 @@ class Catalog:
     def __init__(self, target: str | Path = "abrupt_catalog.sqlite", *, create: bool = True) -> None:
         self.name = _display(target)
         self.url = catalog_url(target)
+        _check_url(self.name, self.url)
         self._open(target, create)
 
     # ----------------------------------------------------------------------------------- opening
     @_one_line_errors
     def _open(self, target: str | Path, create: bool) -> None:
-        if "://" not in str(target) or self.url.startswith("sqlite:///"):
+        if self.url in ("sqlite://", "sqlite:///:memory:") or self.url.startswith("sqlite:///:memory:?"):
+            raise CatalogError(f"{self.name}: an in-memory catalog keeps nothing after the command; give a file")
+        if "://" not in str(target) or (self.url.startswith("sqlite:///") and "?" not in self.url):
             path = Path(self.url.removeprefix("sqlite:///")) if "://" in str(target) else Path(str(target))
             path = path.expanduser()
             if str(path) not in ("", ":memory:"):
@@ -237,6 +253,8 @@ class Catalog:
                 metadata.create_all(conn)
                 if conn.execute(sa.select(sa.func.count()).select_from(schema_table)).scalar_one() == 0:
                     conn.execute(schema_table.insert().values(version=SCHEMA_VERSION))
+                # a write the catalog keeps unchanged: a read-only catalog fails here, before any output
+                conn.execute(schema_table.update().values(version=schema_table.c.version))
         else:
             names = set(sa.inspect(self.engine).get_table_names())
             if "events" not in names or "runs" not in names:

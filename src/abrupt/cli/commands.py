@@ -26,6 +26,7 @@ from typing import Any, TypeGuard
 import click
 
 from abrupt import __version__, progress
+from abrupt.outputs import clear_protected, protect_inputs
 
 #: Global options accepted anywhere on the command line (moved before the sub-command by ``main``).
 GLOBAL_FLAGS = frozenset({"-v", "-vv", "-vvv", "--verbose", "-q", "--quiet"})
@@ -136,15 +137,27 @@ def _is_command_decorator(node: ast.expr) -> TypeGuard[ast.Call]:
 
 
 # ------------------------------------------------------------------ outputs never destroy inputs
-# Every parameter named ``out`` or ``out_*`` (``--out``) is an output. It is refused when it resolves to
-# the same file as any other parameter naming an existing file (an input) or the SQLite catalog
-# (``--catalog``, existing or not), when it is a symbolic link (not followed: give the real path), and when
-# it is an existing file unless ``--overwrite`` (added to every command with an output) is given.
-# Kept here, not in a module of its own, so that ``abrupt --help`` imports no other CLI module.
+# Every parameter that names an output (``--out``, ``--out-*``, ``--*-out``, ``--report``, ``--plot``,
+# ``--scatter``, ``--write-table``, ``--parts``) goes through one guard before the command runs. It is
+# refused when it is the same file (by path, or by device and inode: a hard link) as any other parameter
+# naming an existing file (an input) or the SQLite catalog (``--catalog``, existing or not), when two
+# outputs name the same file, when it is a symbolic link (not followed: give the real path), and when it
+# is an existing file unless ``--overwrite`` (added to every command with an output) is given. The inputs
+# are also registered with :func:`abrupt.outputs.protect_inputs`, so a path a command derives from an
+# option (``OUT.json``) cannot replace one either. Kept here, not in a module of its own, so that
+# ``abrupt --help`` imports no other CLI module.
+
+#: Output parameters whose name does not say ``out``.
+OUTPUT_PARAMETERS = frozenset({"report", "report_path", "plot", "scatter", "write_table", "parts"})
 
 
-def _is_output(name: str) -> bool:
-    return name == "out" or name.startswith("out_")
+def is_output_parameter(name: str) -> bool:
+    """Whether the command parameter ``name`` names a file or folder the command writes."""
+    return name == "out" or name.startswith("out_") or name.endswith("_out") or name in OUTPUT_PARAMETERS
+
+
+def _option_name(param: str, hints: Mapping[str, str]) -> str:
+    return hints.get(param) or "--" + param.removesuffix("_path").replace("_", "-")
 
 
 def _paths(value: Any) -> Iterator[str]:
@@ -157,42 +170,75 @@ def _paths(value: Any) -> Iterator[str]:
 
 def _same(a: str, b: str) -> bool:
     try:
+        if os.path.exists(a) and os.path.exists(b) and os.path.samefile(a, b):
+            return True  # also a hard link
         return Path(a).resolve() == Path(b).resolve()
     except (OSError, RuntimeError):
         return False
 
 
-def check_output_paths(params: Mapping[str, Any], *, overwrite: bool = True) -> None:
-    """Raise :class:`click.BadParameter` when an output would overwrite an input or follow a link, or (unless
-    ``overwrite``) when it is an existing file."""
-    outputs = [(name, path) for name, value in params.items() if _is_output(name) for path in _paths(value)]
-    if not outputs:
-        return
+def _input_paths(params: Mapping[str, Any]) -> list[tuple[str, str]]:
     inputs: list[tuple[str, str]] = []
     for name, value in params.items():
-        if _is_output(name):
+        if is_output_parameter(name):
             continue
         for path in _paths(value):
             if name == "catalog_target" and ("://" not in path or path.startswith("sqlite:///")):
                 inputs.append((name, path.removeprefix("sqlite:///")))
             elif "://" not in path and os.path.isfile(path):
                 inputs.append((name, path))
-    for out_name, out in outputs:
-        hint = "--" + out_name.replace("_", "-") if out_name == "out" else "--out"
+    return inputs
+
+
+def check_output_paths(
+    params: Mapping[str, Any], *, overwrite: bool = True, hints: Mapping[str, str] | None = None
+) -> None:
+    """Raise :class:`click.BadParameter` when an output would overwrite an input or another output or
+    follow a link, or (unless ``overwrite``) when it is an existing file; register the inputs.
+    ``hints`` maps a parameter to the option that sets it (``report_path`` -> ``--report``)."""
+    hints = {"catalog_target": "--catalog", **(hints or {})}
+    inputs = _input_paths(params)
+    protect_inputs(path for name, path in inputs if name != "catalog_target")
+    outputs = [(name, path) for name, value in params.items() if is_output_parameter(name) for path in _paths(value)]
+    for catalog in (path for name, path in inputs if name == "catalog_target"):
+        for in_name, path in inputs:
+            if in_name != "catalog_target" and _same(catalog, path):
+                what = f"{_option_name(in_name, hints)} {path}"
+                raise click.BadParameter(
+                    f"{catalog} is {what}: the catalog would write into it", param_hint="--catalog"
+                )
+    for k, (out_name, out) in enumerate(outputs):
+        hint = _option_name(out_name, hints)
         if os.path.islink(out):
             raise click.BadParameter(f"{out} is a symbolic link (not followed); give the real path", param_hint=hint)
+        if os.path.exists(out) and not os.path.isfile(out) and not os.path.isdir(out):
+            raise click.BadParameter(
+                f"{out} is not a regular file (a device or a pipe); outputs are new files renamed into place",
+                param_hint=hint,
+            )
         for in_name, path in inputs:
             if _same(out, path):
-                what = "--catalog" if in_name == "catalog_target" else "--" + in_name.replace("_", "-")
+                what = f"{_option_name(in_name, hints)} {path}"
                 raise click.BadParameter(
-                    f"{out} is the same file as {what} {path}: writing it would destroy that input", param_hint=hint
+                    f"{out} is the same file as {what}: writing it would destroy that input", param_hint=hint
                 )
+        for other_name, other in outputs[:k]:
+            if _same(out, other):
+                raise click.BadParameter(f"{out} is also given as {_option_name(other_name, hints)}", param_hint=hint)
         if not overwrite and os.path.isfile(out):
             raise click.BadParameter(f"{out} exists; give --overwrite to replace it", param_hint=hint)
 
 
-def guard_outputs(command: click.Command) -> click.Command:
-    """Make ``command`` check its output paths before its body runs (once per command object)."""
+def open_catalog_first(target: str) -> None:
+    """Open (create or upgrade) and check the catalog a ``detect`` command will record its run in, before
+    the command reads anything: a catalog that cannot be written (read-only, in memory, not a catalog)
+    fails at once, before any work and any output."""
+    importlib.import_module("abrupt.catalog").Catalog(target)
+
+
+def guard_outputs(command: click.Command, *, records_runs: bool = False) -> click.Command:
+    """Make ``command`` check its output paths before its body runs (once per command object); with
+    ``records_runs`` (the ``detect`` commands) also open its ``--catalog`` first."""
     if isinstance(command, click.Group):  # its loaded sub-commands (a lazy group guards the others)
         for sub in command.commands.values():
             guard_outputs(sub)
@@ -200,19 +246,30 @@ def guard_outputs(command: click.Command) -> click.Command:
     callback: Callable[..., Any] | None = command.callback
     if callback is None or getattr(callback, "_outputs_guarded", False):
         return command
-    has_output = any(p.name and _is_output(p.name) for p in command.params)
+    has_output = any(p.name and is_output_parameter(p.name) for p in command.params)
     if has_output and not any(p.name == "overwrite" for p in command.params):
         command.params.append(click.Option(["--overwrite"], is_flag=True, help="Replace an existing output file."))
+
+    hints = {p.name: _longest(p.opts) for p in command.params if p.name and p.opts}
 
     @functools.wraps(callback)
     def guarded(*args: Any, **kwargs: Any) -> Any:
         overwrite = bool(kwargs.pop("overwrite", False)) if has_output else True
-        check_output_paths(kwargs, overwrite=overwrite)
+        clear_protected()
+        check_output_paths(kwargs, overwrite=overwrite, hints=hints)
+        if records_runs and kwargs.get("catalog_target"):
+            open_catalog_first(str(kwargs["catalog_target"]))
         return callback(*args, **kwargs)
 
     guarded._outputs_guarded = True  # type: ignore[attr-defined]
     command.callback = guarded
     return command
+
+
+def _longest(opts: list[str]) -> str:
+    """The long form of an option (``--out`` of ``-o/--out``); an argument's name in capitals."""
+    long = [o for o in opts if o.startswith("--")]
+    return long[0] if long else opts[0].upper()
 
 
 class LazyGroup(click.Group):
@@ -230,7 +287,7 @@ class LazyGroup(click.Group):
             command = load_command(self.lazy_commands[cmd_name])  # its decorator registers it here
             self.commands.setdefault(cmd_name, command)
         found = super().get_command(ctx, cmd_name)
-        return guard_outputs(found) if found is not None else None
+        return guard_outputs(found, records_runs=self.name == "detect") if found is not None else None
 
     def resolve_command(
         self, ctx: click.Context, args: list[str]

@@ -19,6 +19,7 @@ from abrupt.cli.flux import store_run_exposure
 from abrupt.cli.groups import cli, inject, record_run, simulate
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.errors import InputError
+from abrupt.outputs import atomic_output, write_text_atomic
 from abrupt.simulate.confounder_kinds import CONFOUNDER_KINDS
 
 if TYPE_CHECKING:
@@ -111,7 +112,7 @@ def ingest_cmd(
         reported = ", ".join(f"{k} {v}" for k, v in d.get("reported", {}).items()) or "none"
         click.echo(
             f"{d['spacecraft']} {d['day']}: {d.get('rows_stored', d.get('rows_kept', 0))} rows; "
-            f"removed: {removed}; reported: {reported}"
+            f"removed: {removed}; reported: {reported}" + (f"; {d['last_ingest']}" if "last_ingest" in d else "")
         )
     for name, counts in summary.files.items():
         extra = {k: v for k, v in counts.items() if k != "rows read"}
@@ -206,7 +207,8 @@ def detect_from_store(
     for w in result.warnings:
         click.echo(f"warning: {w}", err=True)
     if daily_path:
-        result.daily.to_csv(daily_path, index=False)
+        with atomic_output(daily_path) as tmp:
+            result.daily.to_csv(tmp, index=False)
     if report_path:
         report_flight.write_flight_report(report_path, result)
         click.echo(f"report: {report_path}", err=True)
@@ -316,8 +318,9 @@ def inject_attitude_cmd(
         )
         click.echo(rec.per_day.to_string(index=False))
         if out:
-            rec.per_day.to_csv(out, index=False)
-            Path(out).with_suffix(".injections.csv").write_text(rec.injections.to_csv(index=False))
+            with atomic_output(out) as tmp:
+                rec.per_day.to_csv(tmp, index=False)
+            write_text_atomic(Path(out).with_suffix(".injections.csv"), rec.injections.to_csv(index=False))
     if not strikes and not conf_list and not recovery:
         raise click.UsageError("give --strike/--confounder ... --out-store DIR, or --recovery")
 
@@ -417,7 +420,7 @@ def simulate_confounders_cmd(
     conf = _confounders(sc, specs, None, confounder_ranges, seed)
     text = json.dumps([_confounder_json(c) for c in conf], indent=1)
     if out:
-        Path(out).write_text(text + "\n")
+        write_text_atomic(out, text + "\n")
         click.echo(f"{len(conf)} confounder(s) written to {out}")
     else:
         click.echo(text)

@@ -14,6 +14,7 @@ from abrupt.cli.commands import lazy_module
 from abrupt.cli.groups import DEFAULT_CATALOG, cli, note, simulate
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.errors import ConfigError
+from abrupt.outputs import atomic_output, write_text_atomic
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -214,7 +215,7 @@ def infer(
     for n in result.notes:
         note(f"note: {n}")
     if out_path:
-        Path(out_path).write_text(json.dumps(result.as_dict(), indent=1, default=float))
+        write_text_atomic(out_path, json.dumps(result.as_dict(), indent=1, default=float))
         note(f"wrote {out_path}")
     if report_path:
         report_flux.write_flux_report(report_path, result)
@@ -363,8 +364,15 @@ def exposure_command(
 
 @simulate.command("population")
 @click.option("--spacecraft-file", required=True, type=click.Path(exists=True, dir_okay=False))
-@click.option("--count", "n_spacecraft", type=int, default=10, show_default=True, help="Spacecraft in the fleet.")
-@click.option("--years", type=float, default=1.0, show_default=True)
+@click.option(
+    "--count",
+    "n_spacecraft",
+    type=click.IntRange(min=1),
+    default=10,
+    show_default=True,
+    help="Spacecraft in the fleet.",
+)
+@click.option("--years", type=click.FloatRange(min=0.0, min_open=True), default=1.0, show_default=True)
 @click.option("--altitude-km", type=float, default=550.0, show_default=True)
 @click.option("--inclination-deg", type=float, default=28.5, show_default=True)
 @click.option("--epoch", "epoch_year", type=float, default=2020.0, show_default=True)
@@ -425,7 +433,8 @@ def population(
         f"detector {abrupt_simulate_population.DETECTOR}; catalog {cat.name}"
     )
     if out_path:
-        events.to_csv(out_path, index=False)
+        with atomic_output(out_path) as tmp:
+            events.to_csv(tmp, index=False)
         note(f"wrote {out_path}")
 
 

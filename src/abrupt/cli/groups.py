@@ -13,6 +13,7 @@ import hashlib
 import logging
 import sys
 from collections.abc import Iterable, Iterator, Mapping
+from contextlib import ExitStack
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
@@ -30,6 +31,7 @@ from abrupt.cli.commands import (
     report,
     simulate,
 )
+from abrupt.outputs import atomic_output
 
 if TYPE_CHECKING:
     from abrupt import catalog as abrupt_catalog
@@ -199,18 +201,6 @@ def record_run(
     details = {**(details or {}), **command_options()}
     catalog = abrupt_catalog.Catalog(catalog_target)  # open (and check) the catalog before writing anything
     catalog.check_fits(events)  # texts too long for the catalog: refused before the file is written
-    evidence_file = None
-    if out is not None:  # then the file: a bad path must not leave events in the catalog only
-        Path(out).parent.mkdir(parents=True, exist_ok=True)
-        evidence_file = abrupt_events.write_events_and_evidence(events, str(out))
-    catalog.start_run(
-        run_id,
-        command,
-        config_hash=config_hash,
-        input_hash=file_hash(input_path) if input_path is not None else None,
-        details=details,
-    )
-    added = catalog.store_events(events)
     coverage = abrupt_catalog.coverage_of(
         events,
         config_hash=config_hash,
@@ -220,7 +210,27 @@ def record_run(
         end_utc=span_utc[1] if span_utc else None,
         analysed=analysed,
     )
-    catalog.finish_run(run_id, n_found=len(events), n_new=added.events, details=details, coverage=coverage)
+    # The events file is written aside first (a bad path or a full disk fails before the catalog holds
+    # the run), and renamed into place only once the catalog has stored the run: a catalog that fails
+    # leaves no events file.
+    evidence_file = None
+    with ExitStack() as stack:
+        if out is not None:
+            Path(out).parent.mkdir(parents=True, exist_ok=True)
+            table, evidence = abrupt_events.split_evidence(abrupt_events.normalise_frame(events))
+            abrupt_events.write_events(table, str(stack.enter_context(atomic_output(out))))
+            if evidence.shape[1] > 1:  # the attribution evidence, keyed by event_id, beside the events
+                evidence_file = abrupt_events.evidence_path(out)
+                abrupt_events.write_evidence(evidence, stack.enter_context(atomic_output(evidence_file)))
+        catalog.start_run(
+            run_id,
+            command,
+            config_hash=config_hash,
+            input_hash=file_hash(input_path) if input_path is not None else None,
+            details=details,
+        )
+        added = catalog.store_events(events)
+        catalog.finish_run(run_id, n_found=len(events), n_new=added.events, details=details, coverage=coverage)
     again = len(events) - added.detections
     other_config = added.detections - added.events
     note(

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 from dataclasses import replace
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import click
@@ -13,6 +12,7 @@ from abrupt.cli.commands import lazy_module
 from abrupt.cli.groups import catalog_option, detect, record_run
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.model.range_terms import RANGE_MODEL_TERMS
+from abrupt.outputs import write_text_atomic
 
 if TYPE_CHECKING:
     from abrupt.model import range_reduction as model_range_reduction
@@ -138,7 +138,7 @@ def detect_laser_command(
     for line in run.summary_lines():
         click.echo(line, err=True)
     if fit_out:
-        Path(fit_out).write_text(json.dumps(run.summary, indent=2, default=float))
+        write_text_atomic(fit_out, json.dumps(run.summary, indent=2, default=float))
     record_run(
         catalog_target=catalog_target,
         command="detect laser",

@@ -24,6 +24,11 @@ def main(argv: list[str] | None = None) -> None:
         # the same way (a one-line message, exit status 2), never as a traceback.
         click.echo(f"error: {exc}", err=True)
         sys.exit(2)
+    except OSError as exc:
+        # the environment's, not abrupt's: a full disk, a read-only folder, a file that vanished
+        where = f"{exc.filename}: " if exc.filename else ""
+        click.echo(f"error: {where}{(exc.strerror or str(exc)).lower()}", err=True)
+        sys.exit(2)
     except click.exceptions.Abort:
         click.echo("aborted", err=True)
         sys.exit(130)

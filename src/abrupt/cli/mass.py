@@ -10,6 +10,7 @@ import click
 from abrupt.cli.commands import lazy_module
 from abrupt.cli.groups import catalog_option, check_suffix, cli, detect, record_run, simulate
 from abrupt.cli.options import budget_options, pop_budget
+from abrupt.outputs import write_text_atomic
 
 if TYPE_CHECKING:
     import numpy as np
@@ -119,7 +120,7 @@ def estimate_inertia_cmd(
     )
     click.echo(est.summary())
     Path(out_toml).parent.mkdir(parents=True, exist_ok=True)
-    Path(out_toml).write_text(pipelines_mass.updated_spacecraft_toml(spacecraft_file, est))
+    write_text_atomic(out_toml, pipelines_mass.updated_spacecraft_toml(spacecraft_file, est))
     rep = report_path or str(Path(out_toml).with_suffix(".json"))
     pipelines_mass.write_report(pipelines_mass.inertia_report(est, sc, repairs), rep)
     click.echo(f"updated spacecraft file {out_toml}; report {rep}", err=True)

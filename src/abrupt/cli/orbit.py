@@ -25,6 +25,7 @@ from abrupt.cli.groups import (
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.detect.orbit.statistic_names import STATISTIC_SUMMARIES
 from abrupt.errors import ConfigError, InputError
+from abrupt.outputs import atomic_output
 
 if TYPE_CHECKING:
     import numpy as np
@@ -370,12 +371,7 @@ def detect_orbit_command(
     # the fit (residual RMS, estimated parameters, thresholds) is printed on every run
     click.echo("\n".join(pipelines_orbit.summary_lines(run.summary)), err=True)
     if statistics_out and run.result.diagnostics:
-        frame = _statistics_frame(run)
-        Path(statistics_out).parent.mkdir(parents=True, exist_ok=True)
-        if statistics_out.endswith(".csv"):
-            frame.to_csv(statistics_out, index=False)
-        else:
-            frame.to_parquet(statistics_out, index=False)
+        _write_statistics(run, statistics_out)
     events = run.events
     chash = _config_hash_of(events, run.detector.config(), budget)
     record_run(
@@ -395,6 +391,17 @@ def detect_orbit_command(
     if report_path and run.analysis is not None:
         path = report_orbit.plot_orbit_report(run.analysis, run.thresholds, events, report_path)
         click.echo(f"report written to {path}", err=True)
+
+
+def _write_statistics(run: pipelines_orbit.OrbitRun, path: str) -> None:
+    """``--statistics-out``: the per-epoch statistics as CSV or Parquet (by suffix), written atomically."""
+    frame = _statistics_frame(run)
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    with atomic_output(path) as tmp:
+        if path.endswith(".csv"):
+            frame.to_csv(tmp, index=False)
+        else:
+            frame.to_parquet(tmp, index=False)
 
 
 def _statistics_frame(run: pipelines_orbit.OrbitRun) -> pd.DataFrame:

@@ -12,6 +12,7 @@ from abrupt.cli.commands import lazy_module
 from abrupt.cli.fleet import executor_from, with_executor_options
 from abrupt.cli.groups import cli, progress_hidden
 from abrupt.errors import ConfigError
+from abrupt.outputs import atomic_output
 
 if TYPE_CHECKING:
     import numpy as np
@@ -190,7 +191,8 @@ def _report(results: Sequence[Any], kw: dict[str, Any]) -> None:
         click.echo(sub.to_string(float_format=lambda v: f"{v:.4g}"))
     if kw["out"]:
         Path(kw["out"]).parent.mkdir(parents=True, exist_ok=True)
-        frame.to_csv(kw["out"], index=False)
+        with atomic_output(kw["out"]) as tmp:
+            frame.to_csv(tmp, index=False)
         click.echo(f"table written to {kw['out']}", err=True)
     if kw["plot"]:
         m = metrics[0]

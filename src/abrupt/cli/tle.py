@@ -29,6 +29,7 @@ from abrupt.cli.groups import (
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.detect.tle.default_rate import DEFAULT_TLE_RATE
 from abrupt.errors import InputError
+from abrupt.outputs import atomic_output, write_text_atomic
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -445,7 +446,7 @@ def score(
     if elements:
         out["below_detectable"] = _flag_undetectable(elements, events, truth_frame, start, end)
     if json_out:
-        Path(json_out).write_text(json.dumps(out, indent=2, default=str))
+        write_text_atomic(json_out, json.dumps(out, indent=2, default=str))
 
 
 def _flag_undetectable(elements: str, events: Any, truth: Any, start: Any, end: Any) -> dict[str, Any]:
@@ -582,7 +583,8 @@ def inject_tle(
         f"({summary['false_alarms_per_year']:.2f} per year; {summary['echoes']} within 3 days of a burn)"
     )
     if out:
-        burns.to_csv(out, index=False)
+        with atomic_output(out) as tmp:
+            burns.to_csv(tmp, index=False)
         click.echo(f"burns written to {out}", err=True)
     if report_path:
         label = f"{pipelines_tle.satellite_label(sat.history)}: injected burns"

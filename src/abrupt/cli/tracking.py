@@ -13,6 +13,7 @@ from abrupt.cli.commands import lazy_module
 from abrupt.cli.groups import catalog_option, detect, progress, record_run, report, report_option, simulate
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.errors import ConfigError
+from abrupt.outputs import atomic_output, write_text_atomic
 
 if TYPE_CHECKING:
     import numpy as np
@@ -187,7 +188,7 @@ def _write_aer(measurements: Any, path: Path) -> None:
             )
         if np.isfinite(row["range_rate_mps"]):
             lines.append(f"{t}   RANGE_RATE   {row['station']}   {row['range_rate_mps'] / 1e3:.9f}")
-    path.write_text("\n".join(lines) + "\n")
+    write_text_atomic(path, "\n".join(lines) + "\n")
 
 
 @detect.command("tracking")
@@ -294,9 +295,10 @@ def detect_tracking_command(
     for line in run.summary_lines():
         click.echo(line, err=True)
     if fit_out:
-        Path(fit_out).write_text(json.dumps(run.fit_summary, indent=2, default=float))
+        write_text_atomic(fit_out, json.dumps(run.fit_summary, indent=2, default=float))
     if diagnostics_out:
-        run.diagnostics.to_csv(diagnostics_out, index=False)
+        with atomic_output(diagnostics_out) as tmp:
+            run.diagnostics.to_csv(tmp, index=False)
     record_run(
         catalog_target=catalog_target,
         command="detect tracking",

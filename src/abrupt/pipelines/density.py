@@ -28,6 +28,7 @@ from abrupt.density.tle_drag import RhoBResult, TleDragConfig, rho_b_from_histor
 from abrupt.errors import RepairLog
 from abrupt.events import format_time_columns
 from abrupt.model.atmosphere import read_space_weather
+from abrupt.outputs import atomic_output
 from abrupt.pipelines.orbit import load_ephemeris
 from abrupt.readers.omm import read_elements
 
@@ -208,12 +209,14 @@ def write_table(frame: pd.DataFrame, path: str | Path) -> None:
     in the one export time format, ISO-8601 UTC with a ``Z`` (days too: ``2015-01-01T00:00:00.000000Z``)."""
     p = Path(path)
     if p.suffix.lower() == ".parquet":
-        frame.to_parquet(p, index=False)
+        with atomic_output(p) as tmp:
+            frame.to_parquet(tmp, index=False)
     else:
         out = format_time_columns(frame)  # every *_utc column but time_utc (the event schema's own)
         if "time_utc" in out:
             out["time_utc"] = format_time_columns(out[["time_utc"]].set_axis(["t_utc"], axis=1))["t_utc"].to_numpy()
-        out.to_csv(p, index=False)
+        with atomic_output(p) as tmp:
+            out.to_csv(tmp, index=False)
 
 
 __all__ = ["OrbitDensityRun", "TleDensityResult", "orbit_density", "tle_density", "write_table"]

@@ -24,6 +24,7 @@ from abrupt.massprops.telemetry import momentum_data_from_channels, momentum_dat
 from abrupt.massprops.track import InertiaTrack, track_inertia
 from abrupt.model.flight_config import FlightChannel, FlightConfig
 from abrupt.model.spacecraft import ANGLE_UNITS, Spacecraft, load_spacecraft
+from abrupt.outputs import atomic_output, write_text_atomic
 from abrupt.pipelines.flight import day_range
 from abrupt.pipelines.flight_checks import check_channel_units
 from abrupt.readers.telemetry import read_telemetry
@@ -414,7 +415,7 @@ def inertia_report(estimate: InertiaEstimate, spacecraft: Spacecraft, repairs: R
 
 def write_report(report: dict[str, object], path: str | Path) -> None:
     Path(path).parent.mkdir(parents=True, exist_ok=True)
-    Path(path).write_text(json.dumps(report, indent=1))
+    write_text_atomic(path, json.dumps(report, indent=1))
 
 
 def detect_mass_change_run(
@@ -465,7 +466,8 @@ def simulate_docking_run(spacecraft_file: str | Path, out_dir: str | Path, scena
         frame[THRUSTER_FLAG_COLUMN] = firing
         frame[frame.columns[0]] = frame[frame.columns[0]].dt.strftime("%Y-%m-%dT%H:%M:%S.%fZ")
         path = out / f"{sc.name}_day{d:03d}.csv"
-        frame.to_csv(path, index=False, float_format="%.10g")
+        with atomic_output(path) as tmp:
+            frame.to_csv(tmp, index=False, float_format="%.10g")
         written.append(path)
     truth = {
         "epoch_utc": str(epoch),
@@ -477,7 +479,7 @@ def simulate_docking_run(spacecraft_file: str | Path, out_dir: str | Path, scena
         "contact_dH_N_Nms": [None if not math.isfinite(v) else v for v in sim.contact_dH_N_Nms.tolist()],
         "momentum_dumps": [{"time_s": t, "dH_N_Nms": dh.tolist()} for t, dh in sim.dumps],
     }
-    (out / "docking_truth.json").write_text(json.dumps(truth, indent=1))
+    write_text_atomic(out / "docking_truth.json", json.dumps(truth, indent=1))
     written.append(out / "docking_truth.json")
     return written
 

@@ -41,6 +41,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from abrupt.errors import ConfigError, InputError
+from abrupt.outputs import atomic_output, write_text_atomic
 from abrupt.rates import flux as fx
 from abrupt.rates.mass_models import DENSITY_CLASSES_KG_M3
 
@@ -336,7 +337,7 @@ def write_flux_table(table: FluxTable, manifest_path: str | Path) -> Path:
     manifest_path.parent.mkdir(parents=True, exist_ok=True)
     stem = manifest_path.stem
     size_name, dir_name = f"{stem}_size.csv", f"{stem}_direction.csv"
-    with (manifest_path.parent / size_name).open("w", newline="") as fh:
+    with atomic_output(manifest_path.parent / size_name) as tmp, tmp.open("w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(SIZE_COLUMNS)
         for c, cls in enumerate(table.classes):
@@ -351,7 +352,7 @@ def write_flux_table(table: FluxTable, manifest_path: str | Path) -> Path:
                 )
     d = table.directions
     r2d = 180.0 / math.pi
-    with (manifest_path.parent / dir_name).open("w", newline="") as fh:
+    with atomic_output(manifest_path.parent / dir_name) as tmp, tmp.open("w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(DIRECTION_COLUMNS)
         for i in range(d.weight.size):
@@ -375,7 +376,7 @@ def write_flux_table(table: FluxTable, manifest_path: str | Path) -> Path:
         if math.isfinite(value):
             meta.append(f"{key} = {value!r}")
     meta += [f'size_table = "{size_name}"', f'direction_table = "{dir_name}"']
-    manifest_path.write_text("\n".join(meta) + "\n")
+    write_text_atomic(manifest_path, "\n".join(meta) + "\n")
     return manifest_path
 
 

@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 
 from abrupt.errors import InputError, RepairLog
+from abrupt.outputs import atomic_output
 from abrupt.readers.compression import read_text
 from abrupt.series.ephemeris import Ephemeris
 
@@ -152,4 +153,5 @@ def write_navigation_csv(ephemeris: Ephemeris, path: str | Path) -> None:
         }
     )
     Path(path).parent.mkdir(parents=True, exist_ok=True)
-    df.to_csv(path, index=False, float_format="%.6f")
+    with atomic_output(path) as tmp:
+        df.to_csv(tmp, index=False, float_format="%.6f")

@@ -37,6 +37,7 @@ from numpy.typing import NDArray
 
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.timescales import offline_astropy
+from abrupt.outputs import write_text_atomic
 from abrupt.readers.compression import read_bytes
 from abrupt.readers.stated_joins import stated_join_epochs
 from abrupt.readers.timesystems import to_utc_counted
@@ -521,7 +522,7 @@ def write_oem(
             f"{t} " + " ".join(f"{c:.9f}" for c in p) + " " + " ".join(f"{c:.12f}" for c in v)
             for t, p, v in zip(times, pos, vel, strict=True)
         ]
-        Path(path).write_text("\n".join(out) + "\n", encoding="utf-8")
+        write_text_atomic(path, "\n".join(out) + "\n")
         return
 
     out = [
@@ -553,4 +554,4 @@ def write_oem(
             out.append(f'          <{tag} units="km/s">{c:.12f}</{tag}>')
         out.append("        </stateVector>")
     out += ["      </data>", "    </segment>", "  </body>", "</oem>"]
-    Path(path).write_text("\n".join(out) + "\n", encoding="utf-8")
+    write_text_atomic(path, "\n".join(out) + "\n")

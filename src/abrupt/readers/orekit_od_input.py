@@ -27,6 +27,7 @@ import pandas as pd
 from abrupt.errors import InputError, quote
 from abrupt.model.orbit import MU_EARTH_M3_S2, coe_to_rv
 from abrupt.model.stations import WGS84_A_M, Station
+from abrupt.outputs import write_text_atomic
 from abrupt.readers.aer import parse_utc
 from abrupt.readers.text import read_text
 from abrupt.types import FloatArray
@@ -269,4 +270,4 @@ def write_od_input(
     lines.append(f"body.equatorial.radius = {stations[0].equatorial_radius_m!r}")
     f = 1.0 - math.sqrt(1.0 - stations[0].eccentricity ** 2)
     lines.append(f"body.inverse.flattening = {1.0 / f!r}")
-    Path(path).write_text("\n".join(lines) + "\n")
+    write_text_atomic(path, "\n".join(lines) + "\n")

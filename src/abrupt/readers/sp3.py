@@ -59,6 +59,7 @@ from numpy.typing import NDArray
 
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.timescales import offline_astropy
+from abrupt.outputs import write_text_atomic
 from abrupt.readers.compression import read_bytes
 from abrupt.readers.orbit_envelope import power_of_ten_repair
 from abrupt.readers.sp3_checks import check_position_velocity
@@ -620,4 +621,4 @@ def write_sp3(
                 lines.append(f"V{sid}" + "".join(f"{c:14.6f}" for c in vals) + f"{BAD_VALUE_MARKER:14.6f}")
     lines.append("EOF")
     Path(path).parent.mkdir(parents=True, exist_ok=True)
-    Path(path).write_text("\n".join(lines) + "\n", encoding="ascii")
+    write_text_atomic(path, "\n".join(lines) + "\n", encoding="ascii")

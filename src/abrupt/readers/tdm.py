@@ -24,6 +24,7 @@ import pandas as pd
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.timescales import to_utc
 from abrupt.model.tracking_measurements import MEASUREMENT_COLUMNS
+from abrupt.outputs import write_text_atomic
 from abrupt.readers.aer import finish_measurements
 from abrupt.readers.text import read_text
 
@@ -291,4 +292,4 @@ def write_tdm(
             if np.isfinite(row["range_rate_mps"]):
                 out.append(f"DOPPLER_INSTANTANEOUS = {t} {row['range_rate_mps'] / 1e3:.12f}")
         out.append("DATA_STOP")
-    Path(path).write_text("\n".join(out) + "\n")
+    write_text_atomic(path, "\n".join(out) + "\n")

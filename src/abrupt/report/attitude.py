@@ -27,6 +27,7 @@ from numpy.typing import NDArray
 from scipy import stats
 from scipy.ndimage import uniform_filter1d
 
+from abrupt.outputs import write_text_atomic
 from abrupt.pipelines.attitude import AttitudeRun, display_name
 from abrupt.report.style import (
     FIGURE_SUFFIXES,
@@ -271,5 +272,5 @@ td,th{{border:1px solid #ccc;padding:2px 6px}}</style>
 <th>fit</th><th>event-free samples</th></tr>{thr_rows}</table>
 {qq_html}
 <h2>Input repairs</h2><ul>{repairs}</ul></body></html>"""
-    path.write_text(page)
+    write_text_atomic(path, page)
     return path

@@ -23,6 +23,7 @@ import pandas as pd
 from abrupt.detect.attitude.evidence import st_gyro_mismatch
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import Spacecraft
+from abrupt.outputs import atomic_output
 from abrupt.series.timetable import NS, Timetable
 from abrupt.types import FloatArray
 
@@ -183,5 +184,6 @@ def plot_event_panels(
     import matplotlib.pyplot as plt
 
     fig = event_panels_figure(table, cleaned_H_N, spacecraft, panels, half_s=half_s)
-    fig.savefig(path, dpi=110)
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)

@@ -26,6 +26,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from abrupt.outputs import atomic_output, write_text_atomic
 from abrupt.pipelines.flight import FlightResult
 from abrupt.report.attribution import EventPanel
 
@@ -138,7 +139,8 @@ def write_flight_report(path: str | Path, result: FlightResult) -> None:
     path = Path(path)
     fig = flight_figure(result)
     if path.suffix.lower() == ".png":
-        fig.savefig(path, dpi=110)
+        with atomic_output(path) as tmp:
+            fig.savefig(tmp, dpi=110)
         plt.close(fig)
         return
     buf = io.BytesIO()
@@ -158,4 +160,4 @@ def write_flight_report(path: str | Path, result: FlightResult) -> None:
         + result.events.to_html(index=False)
         + "</body></html>"
     )
-    path.write_text(html)
+    write_text_atomic(path, html)

@@ -16,6 +16,7 @@ import numpy as np
 import pandas as pd
 
 from abrupt.flux.showers import shower_calendar
+from abrupt.outputs import atomic_output, write_text_atomic
 from abrupt.pipelines.flux import FluxInference
 from abrupt.report.style import figure_png_base64, html_page
 
@@ -134,7 +135,8 @@ def write_flux_report(path: str | Path, result: FluxInference) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     fig = cumulative_figure(result)
     if path.suffix.lower() not in (".html", ".htm"):
-        fig.savefig(path, dpi=110)
+        with atomic_output(path) as tmp:
+            fig.savefig(tmp, dpi=110)
         plt.close(fig)
         return path
     cum = figure_png_base64(fig)
@@ -159,5 +161,5 @@ def write_flux_report(path: str | Path, result: FluxInference) -> Path:
         _table(result.showers),
         "<h2>Notes</h2><ul>" + "".join(f"<li>{html.escape(n)}</li>" for n in result.notes) + "</ul>",
     ]
-    path.write_text(html_page("Debris and meteoroid flux from detected strikes", "".join(body)))
+    write_text_atomic(path, html_page("Debris and meteoroid flux from detected strikes", "".join(body)))
     return path

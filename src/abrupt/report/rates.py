@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from abrupt.outputs import atomic_output
 from abrupt.rates.trades import CaseResult
 
 # SI units, as in the tables the rate commands print (N·m·s, m/s, m)
@@ -122,7 +123,8 @@ def plot_rate_curves(
     fig.tight_layout()
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=120)
+    with atomic_output(out) as tmp:
+        fig.savefig(tmp, dpi=120)
     plt.close(fig)
     return out
 
@@ -169,6 +171,7 @@ def plot_dh_dv_scatter(results: Sequence[CaseResult], out: str | Path, *, max_po
     fig.tight_layout()
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=120)
+    with atomic_output(out) as tmp:
+        fig.savefig(tmp, dpi=120)
     plt.close(fig)
     return out

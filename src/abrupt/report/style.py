@@ -20,6 +20,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from abrupt.outputs import atomic_output, write_text_atomic
+
 #: Okabe & Ito (2008) colour-blind-safe palette (black excluded: it is the data colour).
 PALETTE = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#7F3C8D", "#11A579")
 
@@ -131,7 +133,8 @@ def save_figure(fig: Any, path: str | Path, *, dpi: int = 110) -> Path:
         plt.close(fig)
         raise ValueError(f"{path}: figure must end in {', '.join(FIGURE_SUFFIXES)}")
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=dpi, format=suffix[1:])
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, dpi=dpi, format=suffix[1:])
     plt.close(fig)
     return path
 
@@ -164,6 +167,6 @@ def write_report(fig: Any, path: str | Path, *, title: str, extra_html: str = ""
     if path.suffix.lower() in (".html", ".htm"):
         path.parent.mkdir(parents=True, exist_ok=True)
         img = figure_png_base64(fig)
-        path.write_text(html_page(title, f'<img alt="{title}" src="data:image/png;base64,{img}">{extra_html}'))
+        write_text_atomic(path, html_page(title, f'<img alt="{title}" src="data:image/png;base64,{img}">{extra_html}'))
         return path
     return save_figure(fig, path)

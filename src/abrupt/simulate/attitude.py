@@ -25,6 +25,7 @@ from numpy.typing import ArrayLike
 from abrupt.errors import ConfigError
 from abrupt.model.attitude_dynamics import AttitudeSimConfig, Strike, kernel_setup, run_closed_loop, strike_arrays
 from abrupt.model.spacecraft import RATE_UNITS, WHEEL_SPEED_UNITS, Spacecraft
+from abrupt.outputs import atomic_output
 from abrupt.types import FloatArray
 
 # The simulator's inputs are defined with the dynamics and offered here with it.
@@ -160,13 +161,16 @@ def write_telemetry(result: AttitudeSimResult, path: str | Path) -> tuple[Path, 
     if suffix == ".csv":
         out = tel.copy()
         out[time_col] = _iso(out[time_col])
-        out.to_csv(path, index=False, float_format="%.17g")
+        with atomic_output(path) as tmp:
+            out.to_csv(tmp, index=False, float_format="%.17g")
     else:
-        tel.to_parquet(path, index=False)
+        with atomic_output(path) as tmp:
+            tel.to_parquet(tmp, index=False)
     truth_path = path.with_name(f"{path.stem}_truth.csv")
     truth = result.truth.copy()
     truth["time_utc"] = _iso(truth["time_utc"])
-    truth.to_csv(truth_path, index=False, float_format="%.17g")
+    with atomic_output(truth_path) as tmp:
+        truth.to_csv(tmp, index=False, float_format="%.17g")
     return path, truth_path
 
 
