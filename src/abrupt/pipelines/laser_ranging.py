@@ -28,6 +28,7 @@ from abrupt.model.orbit.batch_fit import BatchFit, BatchFitConfig
 from abrupt.model.range_reduction import RangeModel, StationSite
 from abrupt.model.stations import Station
 from abrupt.model.tracking_measurements import TrackingArrays, as_datetime64_ns, earth_rotation_matrices
+from abrupt.pipelines.laser_plausibility import check_ranges_against_apriori, fit_bound_violations
 from abrupt.readers.crd import read_crd
 from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.readers.sinex import SinexStation, bundled_ilrs_sinex, read_sinex, sinex_station
@@ -334,6 +335,8 @@ class LaserRangingRun:
             lines.append(f"time biases (µs, last arc): {self.summary['time_bias_us']}")
         arcs = self.summary.get("arcs", [])
         lines.append(f"arcs fitted: {len(arcs) if isinstance(arcs, list) else arcs}")
+        warnings = self.summary.get("warnings", [])
+        lines += [f"warning: {w}" for w in (warnings if isinstance(warnings, list) else [])]
         # every repair: the readers' (CRD, a-priori ephemeris) and the fit's, one line per kind
         repairs = self.summary.get("repairs", {})
         lines += [f"repaired: {k} ({n})" for k, n in (repairs.items() if isinstance(repairs, dict) else [])]
@@ -402,6 +405,7 @@ def run_laser_ranging_files(
     ephemeris = read_ephemeris(apriori_path)
     for kind, n in ephemeris.repairs.counts.items():
         repairs.record(f"a-priori ephemeris: {kind}", n)
+    check_ranges_against_apriori(meas, sites, ephemeris, file=crd_paths[0])
     eph_times = np.asarray(ephemeris.times_utc, dtype="datetime64[ns]")
 
     def apriori(arc_epoch: np.datetime64) -> FloatArray | None:
@@ -456,7 +460,30 @@ def run_laser_ranging_files(
     )
     frame = events_frame(events) if events else empty_frame()
     summary = _run_summary(result, len(meas), repairs)
+    frame, summary["warnings"] = _unabsorbed(frame, result)
     return LaserRangingRun(frame, result, summary, run_id, cfg_hash)
+
+
+def _unabsorbed(frame: pd.DataFrame, result: LaserArcsResult) -> tuple[pd.DataFrame, list[str]]:
+    """Events of arcs whose fit left its physical bounds (:func:`fit_bound_violations`): a residual the
+    fit cannot absorb, reported as kind ``unknown`` with the reason, not as a maneuver; and the warnings."""
+    warnings: list[str] = []
+    if len(frame) != len(result.detections):
+        return frame, warnings
+    frame = frame.copy()
+    for arc in result.arcs:
+        bad = fit_bound_violations(arc.result.fit.range_bias_m, arc.result.fit.scale_factors)
+        if not bad:
+            continue
+        lo, hi = arc.owned_s
+        rows = [i for i, d in enumerate(result.detections) if lo <= d.t_s <= hi]
+        warnings.append(
+            f"arc {str(arc.epoch_utc)[:19]}: the fit leaves its physical bounds ({'; '.join(bad)}): it absorbs what "
+            f"its model cannot explain; {len(rows)} detection(s) reported as unexplained residuals, not maneuvers"
+        )
+        if rows:
+            frame.loc[frame.index[rows], "kind"] = "unknown"
+    return frame, warnings
 
 
 def laser_stations(sites: Mapping[str, StationSite], meas: pd.DataFrame) -> dict[str, Station]:
