@@ -15,9 +15,10 @@ import numpy as np
 import pytest
 
 from abrupt.errors import InputError
+from abrupt.events import Event, events_frame
 from abrupt.model.orbit import propagate
 from abrupt.model.range_reduction import RangeModel, reduce_ranges
-from abrupt.pipelines.laser_plausibility import fit_bound_violations
+from abrupt.pipelines.laser_plausibility import fit_bound_violations, passive_detections
 from abrupt.pipelines.laser_ranging import LASER_FORCE, run_laser_ranging_files
 from abrupt.readers.crd import read_crd
 from abrupt.simulate.slr import SlrScenario, SlrSimulation, simulate_slr, trajectory_interpolator
@@ -132,7 +133,28 @@ def test_a_clean_day_passes_every_check_and_stays_within_bounds(files: dict[str,
     run = run_laser_ranging_files(
         [str(files["crd"])], str(files["snx"]), str(files["oem"]), budget=FalseAlarmBudget(1, "week")
     )
-    assert run.summary["warnings"] == []
+    # LAGEOS-1 (the CRD target) has no propulsion: the only warning states what its model explains
+    assert len(run.summary["warnings"]) == 1 and run.summary["propulsion"] is False
+    assert str(run.summary["warnings"][0]).startswith("lageos1 has no propulsion: its model explains")
     assert len(run.events) == 0
     last = run.result.arcs[-1].result.fit
     assert fit_bound_violations(last.range_bias_m, last.scale_factors) == []
+
+
+def test_laser_detections_of_a_passive_satellite_are_explained_or_named() -> None:
+    """LAGEOS-1 over a 6 h gap between passes: radiation pressure (C_R = 2, +35 % albedo) accumulates
+    0.19 mm/s; a 0.1 mm/s detection is explained, a 15 mm/s one is named as bad input, kind unknown."""
+    t = "2024-03-01T00:00:00Z"
+    events = events_frame(
+        [
+            Event("lageos1", "maneuver", "tracking.laser_glrt", t, 30.0, 20.0, 0.1, "r", "h", dv_t_mps=dv, dv_r_mps=0.0,
+                  dv_n_mps=0.0)
+            for dv in (1e-4, 0.015)
+        ]
+    )  # fmt: skip
+    area_to_mass = 0.2827 / 406.965
+    expected = 4.56e-6 * 2.0 * 1.35 * area_to_mass * 6 * 3600.0
+    out, notes = passive_detections(events, "lageos1", area_to_mass, 6 * 3600.0)
+    assert f"up to {1e3 * expected:.3g} mm/s" in notes[0]
+    assert list(out["dv_mps"]) == [0.015] and list(out["kind"]) == ["unknown"]
+    assert "not burns (no propulsion)" in notes[-1]

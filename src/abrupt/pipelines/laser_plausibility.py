@@ -27,6 +27,7 @@ import pandas as pd
 from scipy.interpolate import CubicSpline
 
 from abrupt.errors import InputError
+from abrupt.model.propulsion import unmodelled_acceleration_mps2
 from abrupt.model.range_reduction import StationSite
 from abrupt.series.ephemeris import Ephemeris
 
@@ -97,3 +98,31 @@ def fit_bound_violations(range_bias_m: Mapping[str, float], scale_factors: Mappi
         if not lo <= value <= hi:
             out.append(f"{name} {value:.3g} (physical {lo:g}-{hi:g})")
     return out
+
+
+def passive_detections(
+    events: pd.DataFrame, satellite: str, area_to_mass_m2_kg: float, longest_gap_s: float
+) -> tuple[pd.DataFrame, list[str]]:
+    """Events of a satellite without propulsion: the ΔV its model explains is the unmodelled
+    non-gravitational acceleration (:func:`abrupt.model.propulsion.unmodelled_acceleration_mps2`) acting
+    over the longest gap between ranges, where the GLRT places impulses. Detections within it are dropped
+    as explained; those above it are kept as kind ``unknown`` and named as bad input or a force the model
+    lacks, never burns. Returns the events and the warnings."""
+    limit = unmodelled_acceleration_mps2(area_to_mass_m2_kg) * max(longest_gap_s, 0.0)
+    notes = [
+        f"{satellite} has no propulsion: its model explains |ΔV| up to {1e3 * limit:.3g} mm/s "
+        f"(radiation pressure and albedo over the longest gap between ranges, {longest_gap_s / 3600:.3g} h)"
+    ]
+    if not len(events):
+        return events, notes
+    explained = events["dv_mps"].to_numpy(dtype=float) <= limit
+    out = events.loc[~explained].copy()
+    if explained.any():
+        notes.append(f"{int(explained.sum())} detection(s) within the ΔV the model explains: not events")
+    if len(out):
+        out["kind"] = "unknown"
+        notes.append(
+            f"{len(out)} detection(s) of |ΔV| up to {1e3 * float(out['dv_mps'].max()):.4g} mm/s exceed it: not burns "
+            "(no propulsion) but bad input or a force the model lacks; kept as kind unknown"
+        )
+    return out.reset_index(drop=True), notes

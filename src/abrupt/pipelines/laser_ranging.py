@@ -25,10 +25,15 @@ from abrupt.errors import InputError, RepairLog
 from abrupt.events import config_hash, empty_frame, events_frame, new_run_id
 from abrupt.model.orbit import OMEGA_EARTH_RAD_S, ForceContext, ForceModel, propagate
 from abrupt.model.orbit.batch_fit import BatchFit, BatchFitConfig
+from abrupt.model.propulsion import DEFAULT_AREA_TO_MASS_M2_KG, passive_satellite
 from abrupt.model.range_reduction import RangeModel, StationSite
 from abrupt.model.stations import Station
 from abrupt.model.tracking_measurements import TrackingArrays, as_datetime64_ns, earth_rotation_matrices
-from abrupt.pipelines.laser_plausibility import check_ranges_against_apriori, fit_bound_violations
+from abrupt.pipelines.laser_plausibility import (
+    check_ranges_against_apriori,
+    fit_bound_violations,
+    passive_detections,
+)
 from abrupt.readers.crd import read_crd
 from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.readers.sinex import SinexStation, bundled_ilrs_sinex, read_sinex, sinex_station
@@ -378,6 +383,7 @@ def run_laser_ranging_files(
     overlap_days: float = 1.0,
     force: ForceModel | None = None,
     time_biases: bool = False,
+    propulsion: bool | None = None,
 ) -> LaserRangingRun:
     """Read CRD normal points, SINEX sites and an a-priori ephemeris; detect maneuvers; build events.
 
@@ -390,6 +396,12 @@ def run_laser_ranging_files(
     absorb the satellite's centre-of-mass offset; with ``time_biases`` each station's time-tag offset is
     estimated too (∂ρ/∂δt = −ρ̇). Files longer than ``arc_days`` are fitted in overlapping arcs
     (:func:`detect_laser_ranging_arcs`), each started from the ephemeris where it covers the arc epoch.
+
+    Plausibility (:mod:`abrupt.pipelines.laser_plausibility`): each station's ranges must be those of the
+    a-priori orbit (else an error); an arc whose fitted biases or force scales leave their physical bounds
+    reports its detections as unexplained residuals; ``propulsion`` False (None: False for the passive
+    satellites of :mod:`abrupt.model.propulsion`, by the CRD target name) judges every detection against
+    the ΔV the model explains.
     """
     model = range_model or RangeModel()
     repairs = RepairLog(", ".join(crd_paths))
@@ -461,6 +473,15 @@ def run_laser_ranging_files(
     frame = events_frame(events) if events else empty_frame()
     summary = _run_summary(result, len(meas), repairs)
     frame, summary["warnings"] = _unabsorbed(frame, result)
+    target = str(meas["satellite"].iloc[0]) if "satellite" in meas else ephemeris.satellite
+    passive = passive_satellite(target) or passive_satellite(ephemeris.satellite)
+    if propulsion is False or (propulsion is None and passive is not None):
+        t = np.sort(np.asarray(meas["time_utc"], dtype="datetime64[ns]"))
+        gap_s = float(np.max(np.diff(t)) / np.timedelta64(1, "s")) if t.size > 1 else 0.0
+        area_to_mass = (force.srp_area_m2 or 0.0) / force.mass_kg if force.mass_kg else DEFAULT_AREA_TO_MASS_M2_KG
+        frame, notes = passive_detections(frame, passive.name if passive else name, area_to_mass, gap_s)
+        summary["warnings"] = [*summary["warnings"], *notes]
+        summary["propulsion"] = False
     return LaserRangingRun(frame, result, summary, run_id, cfg_hash)
 
 
