@@ -230,12 +230,10 @@ def reduce_ranges(
     # each range's own laser wavelength (CRD C0 record, nm) in the optical troposphere; the model's otherwise
     given = out["wavelength_nm"].to_numpy(dtype=float) if "wavelength_nm" in out else np.full(len(out), np.nan)
     out["wavelength_um_used"] = np.where(np.isfinite(given), given * 1e-3, model.wavelength_um)
-    for (name, applied, wavelength_um), rows in out.groupby(
-        ["station", "troposphere_applied", "wavelength_um_used"], sort=True
-    ):
+    for (name, applied, _), rows in out.groupby(["station", "troposphere_applied", "wavelength_um_used"], sort=True):
         site = sites[str(name)]
         row_model = replace(model, troposphere="none") if bool(applied) else model
-        row_model = replace(row_model, wavelength_um=float(wavelength_um))
+        row_model = replace(row_model, wavelength_um=float(rows["wavelength_um_used"].iloc[0]))
         idx = rows.index
         times = np.asarray(rows["time_utc"], dtype="datetime64[ns]")
         t_r = (times - epoch).astype(np.int64) / 1e9

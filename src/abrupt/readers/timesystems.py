@@ -35,7 +35,7 @@ def to_utc_counted(times: NDArray[np.datetime64], scale: TimeScale, repairs: Rep
     return out
 
 
-def day_of_year_date(year: int, day_of_year: int) -> np.datetime64:
+def day_of_year_date(year: int, day_of_year: int) -> np.datetime64[int]:
     """Midnight starting day ``day_of_year`` (1 = 1 January) of ``year``, as ``datetime64[ns]``. A day the
     year does not have (0, 366 of a common year, 400) is a ``ValueError``, never a day of the next year."""
     start = np.datetime64(f"{year:04d}-01-01", "ns")
