@@ -1,4 +1,4 @@
-"""A day of year the year does not have is refused, never read as a day of the next year.
+"""A day the year (or month) does not have is refused, never read as a day of the next year (or month).
 
 Day 400 of 2023 once read as 4 February 2024 and day 366 of a common year as 1 January of the next. Every
 reader of day-of-year epochs (CCSDS OEM/TDM time code B, SINEX ``YY:DDD:SSSSS``, IDS maneuver histories)
@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from abrupt.errors import InputError
+from abrupt.readers.crd import read_crd
 from abrupt.readers.ids_maneuvers import read_ids_maneuvers
 from abrupt.readers.oem import parse_ccsds_epoch, read_oem, write_oem
 from abrupt.readers.sinex import parse_sinex_epoch
@@ -68,3 +69,21 @@ def test_an_ids_maneuver_on_day_366_of_a_common_year_names_the_line(tmp_path: Pa
     path.write_text(good + "\n" + bad + "\n")
     with pytest.raises(InputError, match=r"man.txt:2: burn 1 epoch: .*day of year 366 is not a day of 2001"):
         read_ids_maneuvers(path)
+
+
+def test_a_crd_pass_dated_31_february_names_the_line(tmp_path: Path) -> None:
+    """A CRD H4 date is year, month, day: 31 February was read as 3 March."""
+    lines = [
+        "H1 CRD  2 2024 03 01 00",
+        "H2 GRZL       7839 34 02  4",
+        "H3 lageos1 7603901 1155 08820 0 1",
+        "H4 1 2024 02 31 10 00 00 2024 02 31 10 20 00 0 0 0 0 1 0 2 0",
+        "C0 0 532.000 std1",
+        "11 36000.0000000 0.040000000000 std1 0 120 10 13.3 -1 -1 -1 -1 0",
+        "H8",
+        "H9",
+    ]
+    path = tmp_path / "feb31.npt"
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(InputError, match=r"feb31.npt:4:.*day 31 is not a day of 2024-02"):
+        read_crd(path)

@@ -147,6 +147,8 @@ def _date(tokens: list[str], i: int, what: str) -> np.datetime64:
     if not (1950 <= y <= 2200 and 1 <= mo <= 12 and 1 <= d <= 31 and 0 <= h <= 23 and 0 <= mi <= 59 and 0 <= s <= 60):
         raise _Bad(f"{what}: date {' '.join(tokens[i : i + 6])!r} out of range", i + 1)
     base = np.datetime64(f"{y:04d}-{mo:02d}-01", "ns") + np.timedelta64(d - 1, "D")
+    if base.astype("datetime64[M]") != np.datetime64(f"{y:04d}-{mo:02d}", "M"):  # 31 February: not 3 March
+        raise _Bad(f"{what}: date {' '.join(tokens[i : i + 6])!r}: day {d} is not a day of {y:04d}-{mo:02d}", i + 3)
     return base + np.timedelta64(h * 3600 + mi * 60 + s, "s")
 
 
