@@ -12,11 +12,18 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
+from click.testing import CliRunner
 
+import abrupt.cli.main  # noqa: F401  (registers the command groups)
+from abrupt.catalog import Catalog
+from abrupt.cli.groups import cli
 from abrupt.errors import InputError
 from abrupt.model.frames import gcrf_to_itrf
 from abrupt.model.orbit import ForceModel
+from abrupt.pipelines.orbit import detect_orbit
+from abrupt.pipelines.orbit_blocks import bridge_limit_s, data_arcs
 from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.readers.navigation_csv import write_navigation_csv
 from abrupt.readers.oem import write_oem
@@ -229,3 +236,49 @@ def test_noise_alone_removes_nothing_on_many_arcs() -> None:
 def test_an_eccentric_orbit_removes_nothing() -> None:
     eph = _truth(altitude_km=20000.0, eccentricity=0.6)  # perigee 4170 km altitude, 60 s steps
     assert len(check_orbit_envelope(eph)) == len(eph)
+
+
+# ------------------------------------------------------------------------------------------ gaps, short arcs
+
+
+def test_a_gap_longer_than_half_a_revolution_splits_the_arcs() -> None:
+    eph = _truth()
+    limit = bridge_limit_s(eph)
+    period = 2 * np.pi * np.sqrt(np.median(np.linalg.norm(eph.position_m, axis=1)) ** 3 / 3.986004418e14)
+    assert limit == pytest.approx(period / 2, rel=1e-12)
+    t = eph.times_utc.copy()
+    t[200:] += np.timedelta64(round(limit * 1.2), "s")  # a gap of 1.2 limits after epoch 199
+    t[300:] += np.timedelta64(round(limit * 0.5), "s")  # and one of half a limit (bridged) after 299
+    assert data_arcs(t, limit) == [(0, 200), (200, len(t))]
+    assert data_arcs(eph.times_utc, limit) == [(0, len(t))]
+
+
+def test_an_sp3_whose_second_half_is_three_hours_late_gives_no_event(tmp_path: Path) -> None:
+    """The time tags of the second half moved 3 h later: the filters would have propagated across the
+    3 h and found a 7 km/s "burn". The gap ends one arc; nothing is tested across it, and the run says so."""
+    eph = _itrf(_truth())
+    t = eph.times_utc.copy()
+    t[len(t) // 2 :] += np.timedelta64(3, "h")
+    path = tmp_path / "late.sp3"
+    write_sp3(replace(eph, times_utc=t), path)
+    run = detect_orbit(path)
+    assert len(run.events) == 0
+    assert any(w.startswith("gap of 3.02 h") and "nothing tested in the gap" in w for w in run.result.warnings)
+
+
+def test_an_arc_too_short_to_test_is_a_warning_and_a_recorded_run(tmp_path: Path) -> None:
+    """A 4.95 h arc (the filters settle 3.3 h at each end): exit 0, a warning, an empty events file and a
+    run in the catalog, so that a batch over many files does not stop."""
+    eph = _itrf(_truth())
+    short = eph.select(eph.seconds <= 4.95 * 3600)
+    path = tmp_path / "stella.sp3"
+    write_sp3(short, path)
+    events, catalog = tmp_path / "events.csv", tmp_path / "catalog.sqlite"
+    result = CliRunner().invoke(
+        cli, ["detect", "orbit", str(path), "--out", str(events), "--catalog", str(catalog)], catch_exceptions=False
+    )
+    assert result.exit_code == 0, result.output
+    assert "warning: nothing tested: the arc spans 4.95 h" in result.output
+    assert len(pd.read_csv(events)) == 0
+    runs = Catalog(str(catalog)).runs()
+    assert list(runs["command"]) == ["detect orbit"]

@@ -84,6 +84,13 @@ TERMS = RANGE_MODEL_TERMS
     show_default=True,
     help="Estimate each station's time-tag offset relative to the station with the most ranges.",
 )
+@click.option(
+    "--propulsion/--no-propulsion",
+    default=None,
+    help="Whether the satellite can manoeuvre (default: no for the passive geodetic satellites abrupt knows by "
+    "their CRD target name, LAGEOS, Etalon, Starlette, Stella, Ajisai, LARES; yes otherwise). Without "
+    "propulsion the run states the ΔV its model explains and no detection is a burn.",
+)
 @click.option("--spacecraft", default=None, help="Pseudonym for the events (default: the CRD target name).")
 @click.option("--fit-out", default=None, type=click.Path(dir_okay=False), help="Write the fit summary (JSON).")
 @click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Events (.csv or .parquet).")
@@ -100,6 +107,7 @@ def detect_laser_command(
     area_to_mass_m2_per_kg: float,
     drag: bool,
     time_biases: bool,
+    propulsion: bool | None,
     spacecraft: str | None,
     fit_out: str | None,
     out: str,
@@ -127,6 +135,7 @@ def detect_laser_command(
         max_maneuvers=max_maneuvers,
         arc_days=arc_days,
         time_biases=time_biases,
+        propulsion=propulsion,
         force=replace(
             pipelines_laser_ranging.LASER_FORCE,
             gravity_degree=gravity_degree,

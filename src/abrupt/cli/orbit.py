@@ -270,6 +270,13 @@ def simulate_orbit_command(
     help="Event kind written for a detected ΔV (unknown: the data cannot tell a manoeuvre from a strike).",
 )
 @click.option(
+    "--propulsion/--no-propulsion",
+    default=None,
+    help="Whether the satellite can manoeuvre (default: no for the passive geodetic satellites abrupt knows, "
+    "LAGEOS, Etalon, Starlette, Stella, Ajisai, LARES; yes otherwise). Without propulsion the run states the "
+    "ΔV its model explains and no detection is a burn.",
+)
+@click.option(
     "--statistics-out", type=click.Path(dir_okay=False), default=None, help="Per-epoch statistics (.parquet/.csv)."
 )
 @spacecraft_name_option
@@ -298,6 +305,7 @@ def detect_orbit_command(
     workers: int,
     all_satellites: bool,
     kind: str,
+    propulsion: bool | None,
     statistics_out: str | None,
     pseudonym: str | None,
     catalog_target: str,
@@ -349,6 +357,7 @@ def detect_orbit_command(
             sequences=sequences,
             block_days=block_days,
             workers=workers,
+            propulsion=propulsion,
             tuning=tuning,
             tau_s=tau_s,
             q_m2_s5=q_m2_s5,
@@ -387,7 +396,12 @@ def detect_orbit_command(
         analysed=[span] if (span := run.analysed) is not None else [],
     )
     if report_path and run.analysis is None:
-        click.echo("warning: no report for a run in calibration blocks; give --block-days 0 for one", err=True)
+        why = (
+            "a run that tested nothing"
+            if run.summary.get("tested") is False
+            else "a run in calibration blocks; give --block-days 0 for one"
+        )
+        click.echo(f"warning: no report for {why}", err=True)
     if report_path and run.analysis is not None:
         path = report_orbit.plot_orbit_report(run.analysis, run.thresholds, events, report_path)
         click.echo(f"report written to {path}", err=True)

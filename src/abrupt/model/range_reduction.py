@@ -215,7 +215,9 @@ def reduce_ranges(
     and ``troposphere_applied`` (rows already corrected by the station get no tropospheric delay).
     Rows of a station without meteorology use the standard atmosphere, counted in ``repairs``. The
     returned table is time-tagged at the bounce epoch and keeps the original receive time in
-    ``time_receive_utc`` and the applied correction in ``range_correction_m``.
+    ``time_receive_utc`` and the applied correction in ``range_correction_m``. A ``wavelength_nm`` column
+    (the CRD configuration's laser) sets the wavelength of the optical troposphere row by row (Mendes &
+    Pavlis 2004 dispersion; the model's ``wavelength_um`` where it is NaN); ``wavelength_um_used`` records it.
     """
     out = measurements.copy()
     out["time_receive_utc"] = out["time_utc"]
@@ -223,9 +225,13 @@ def reduce_ranges(
     epoch = as_datetime64_ns(epoch_utc)
     if "troposphere_applied" not in out:
         out["troposphere_applied"] = False
-    for (name, applied), rows in out.groupby(["station", "troposphere_applied"], sort=True):
+    # each range's own laser wavelength (CRD C0 record, nm) in the optical troposphere; the model's otherwise
+    given = out["wavelength_nm"].to_numpy(dtype=float) if "wavelength_nm" in out else np.full(len(out), np.nan)
+    out["wavelength_um_used"] = np.where(np.isfinite(given), given * 1e-3, model.wavelength_um)
+    for (name, applied, _), rows in out.groupby(["station", "troposphere_applied", "wavelength_um_used"], sort=True):
         site = sites[str(name)]
         row_model = replace(model, troposphere="none") if bool(applied) else model
+        row_model = replace(row_model, wavelength_um=float(rows["wavelength_um_used"].iloc[0]))
         idx = rows.index
         times = np.asarray(rows["time_utc"], dtype="datetime64[ns]")
         t_r = (times - epoch).astype(np.int64) / 1e9

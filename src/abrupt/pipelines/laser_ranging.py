@@ -26,13 +26,20 @@ from abrupt.errors import InputError, RepairLog
 from abrupt.events import config_hash, empty_frame, events_frame, new_run_id
 from abrupt.model.orbit import OMEGA_EARTH_RAD_S, ForceContext, ForceModel, propagate
 from abrupt.model.orbit.batch_fit import BatchFit, BatchFitConfig
+from abrupt.model.propulsion import DEFAULT_AREA_TO_MASS_M2_KG, passive_satellite
 from abrupt.model.range_reduction import RangeModel, StationSite
 from abrupt.model.stations import Station
 from abrupt.model.tracking_measurements import TrackingArrays, as_datetime64_ns, earth_rotation_matrices
 from abrupt.pipelines.laser_apriori import MAX_ELEMENT_AGE_DAYS, ElementApriori, is_element_file, short_arc_fit
+from abrupt.pipelines.laser_plausibility import (
+    check_ranges_against_apriori,
+    fit_bound_violations,
+    passive_detections,
+)
 from abrupt.readers.crd import read_crd
 from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.readers.sinex import SinexStation, bundled_ilrs_sinex, read_sinex, sinex_station
+from abrupt.series.ephemeris import Ephemeris
 from abrupt.series.tracking import LaserRangingSeries
 from abrupt.thresholds import FalseAlarmBudget
 from abrupt.types import FloatArray
@@ -337,6 +344,8 @@ class LaserRangingRun:
             lines.append(f"time biases (µs, last arc): {self.summary['time_bias_us']}")
         arcs = self.summary.get("arcs", [])
         lines.append(f"arcs fitted: {len(arcs) if isinstance(arcs, list) else arcs}")
+        warnings = self.summary.get("warnings", [])
+        lines += [f"warning: {w}" for w in (warnings if isinstance(warnings, list) else [])]
         # every repair: the readers' (CRD, a-priori ephemeris) and the fit's, one line per kind
         repairs = self.summary.get("repairs", {})
         lines += [f"repaired: {k} ({n})" for k, n in (repairs.items() if isinstance(repairs, dict) else [])]
@@ -378,6 +387,7 @@ def run_laser_ranging_files(
     overlap_days: float = 1.0,
     force: ForceModel | None = None,
     time_biases: bool = False,
+    propulsion: bool | None = None,
 ) -> LaserRangingRun:
     """Read CRD normal points, SINEX sites and an a-priori orbit; detect maneuvers; build events.
 
@@ -393,6 +403,12 @@ def run_laser_ranging_files(
     absorb the satellite's centre-of-mass offset; with ``time_biases`` each station's time-tag offset is
     estimated too (∂ρ/∂δt = −ρ̇). Files longer than ``arc_days`` are fitted in overlapping arcs
     (:func:`detect_laser_ranging_arcs`), each started from the ephemeris where it covers the arc epoch.
+
+    Plausibility (:mod:`abrupt.pipelines.laser_plausibility`): each station's ranges must be those of the
+    a-priori orbit (else an error); an arc whose fitted biases or force scales leave their physical bounds
+    reports its detections as unexplained residuals; ``propulsion`` False (None: False for the passive
+    satellites of :mod:`abrupt.model.propulsion`, by the CRD target name) judges every detection against
+    the ΔV the model explains.
     """
     model = range_model or RangeModel()
     repairs = RepairLog(", ".join(crd_paths))
@@ -424,8 +440,14 @@ def run_laser_ranging_files(
                 file=apriori_path,
             )
         apriori = _element_apriori(elements, meas, sites, stations, cfg, model)
+        apriori_name: str | None = None
     else:
-        apriori = _ephemeris_apriori(apriori_path, repairs)
+        ephemeris = read_ephemeris(apriori_path)
+        for kind, n in ephemeris.repairs.counts.items():
+            repairs.record(f"a-priori ephemeris: {kind}", n)
+        check_ranges_against_apriori(meas, sites, ephemeris, file=crd_paths[0])
+        apriori = _ephemeris_apriori(ephemeris)
+        apriori_name = ephemeris.satellite
     if apriori(epoch) is None:
         raise ValueError(f"{apriori_path}: the a-priori orbit does not cover the first range epoch {epoch}")
     result = detect_laser_ranging_arcs(
@@ -467,16 +489,23 @@ def run_laser_ranging_files(
     summary = _run_summary(result, len(meas), repairs)
     if elements is not None:
         summary["apriori_from_elements"] = elements.fits
+    frame, summary["warnings"] = _unabsorbed(frame, result)
+    target = str(meas["satellite"].iloc[0]) if "satellite" in meas else (apriori_name or name)
+    passive = passive_satellite(target) or (passive_satellite(apriori_name) if apriori_name else None)
+    if propulsion is False or (propulsion is None and passive is not None):
+        t = np.sort(np.asarray(meas["time_utc"], dtype="datetime64[ns]"))
+        gap_s = float(np.max(np.diff(t)) / np.timedelta64(1, "s")) if t.size > 1 else 0.0
+        area_to_mass = (force.srp_area_m2 or 0.0) / force.mass_kg if force.mass_kg else DEFAULT_AREA_TO_MASS_M2_KG
+        frame, notes = passive_detections(frame, passive.name if passive else name, area_to_mass, gap_s)
+        summary["warnings"] = [*summary["warnings"], *notes]
+        summary["propulsion"] = False
     times = np.asarray(meas["time_utc"], dtype="datetime64[ns]")
     analysed = [AnalysedSpan(name, times.min(), times.max(), LaserGlrtDetector.name)]
     return LaserRangingRun(frame, result, summary, run_id, cfg_hash, analysed)
 
 
-def _ephemeris_apriori(path: str, repairs: RepairLog) -> Callable[[np.datetime64], FloatArray | None]:
+def _ephemeris_apriori(ephemeris: Ephemeris) -> Callable[[np.datetime64], FloatArray | None]:
     """A-priori states from an ephemeris (CPF, SP3, OEM) where it covers the arc epoch."""
-    ephemeris = read_ephemeris(path)
-    for kind, n in ephemeris.repairs.counts.items():
-        repairs.record(f"a-priori ephemeris: {kind}", n)
     eph_times = np.asarray(ephemeris.times_utc, dtype="datetime64[ns]")
 
     def apriori(arc_epoch: np.datetime64) -> FloatArray | None:
@@ -513,6 +542,28 @@ def _element_apriori(
         return done[arc_epoch]
 
     return apriori
+
+
+def _unabsorbed(frame: pd.DataFrame, result: LaserArcsResult) -> tuple[pd.DataFrame, list[str]]:
+    """Events of arcs whose fit left its physical bounds (:func:`fit_bound_violations`): a residual the
+    fit cannot absorb, reported as kind ``unknown`` with the reason, not as a maneuver; and the warnings."""
+    warnings: list[str] = []
+    if len(frame) != len(result.detections):
+        return frame, warnings
+    frame = frame.copy()
+    for arc in result.arcs:
+        bad = fit_bound_violations(arc.result.fit.range_bias_m, arc.result.fit.scale_factors)
+        if not bad:
+            continue
+        lo, hi = arc.owned_s
+        rows = [i for i, d in enumerate(result.detections) if lo <= d.t_s <= hi]
+        warnings.append(
+            f"arc {str(arc.epoch_utc)[:19]}: the fit leaves its physical bounds ({'; '.join(bad)}): it absorbs what "
+            f"its model cannot explain; {len(rows)} detection(s) reported as unexplained residuals, not maneuvers"
+        )
+        if rows:
+            frame.loc[frame.index[rows], "kind"] = "unknown"
+    return frame, warnings
 
 
 def laser_stations(sites: Mapping[str, StationSite], meas: pd.DataFrame) -> dict[str, Station]:

@@ -33,6 +33,7 @@ from abrupt.detect.orbit.detectors import (
 from abrupt.detect.orbit.ekf import NUISANCE_NAMES
 from abrupt.detect.orbit.sensitivity import detectable_dv
 from abrupt.errors import ConfigError, InputError
+from abrupt.model.propulsion import DEFAULT_AREA_TO_MASS_M2_KG, explainable_dv_mps, passive_satellite
 from abrupt.pipelines.orbit_blocks import (
     DEFAULT_BLOCK_S,
     BlockOutcome,
@@ -133,6 +134,7 @@ def detect_orbit(
     sequences: bool = True,
     block_days: float | None = DEFAULT_BLOCK_S / 86400.0,
     workers: int = 1,
+    propulsion: bool | None = None,
     **settings: Any,
 ) -> OrbitRun:
     """Detect impulsive and finite ΔVs in an ephemeris (SP3, OEM, CSV or an :class:`Ephemeris`).
@@ -149,7 +151,11 @@ def detect_orbit(
     None or 0: one arc however long), each tuned and calibrated on its own epochs as its own arc would be,
     with the filters running across the seams (:mod:`abrupt.pipelines.orbit_blocks`); the run's diagnostics
     then hold the whole span's statistic and each block's threshold, not one analysis. ``workers``: the
-    blocks on that many processes.
+    blocks on that many processes. A gap longer than the filters bridge (half a revolution) ends one arc
+    and starts another (:func:`~abrupt.pipelines.orbit_blocks.data_arcs`); an arc too short to test gives
+    a warning and a run that tested nothing. ``propulsion``: False for a satellite that cannot manoeuvre
+    (None: False for the passive satellites of :mod:`abrupt.model.propulsion`, True otherwise); its
+    detections are then judged against the ΔV its model explains (:func:`without_propulsion`).
     """
     eph = load_ephemeris(source, satellite, allow_truncated=allow_truncated, strict=strict)
     null_eph = (
@@ -166,9 +172,46 @@ def detect_orbit(
     span = 86400.0 * block_days if block_days else None
     blocks = [(a + lo, a + hi) for a, b in arcs for lo, hi in calibration_blocks(eph.times_utc[a:b], span)]
     if len(blocks) > 1:
-        return _detect_blocks(det, eph, fa, sequences, blocks, workers, arcs, gap_warnings(eph.times_utc, arcs, limit))
-    run = _detect_arc(det, eph, fa, sequences)
+        run = _detect_blocks(det, eph, fa, sequences, blocks, workers, arcs, gap_warnings(eph.times_utc, arcs, limit))
+    else:
+        run = _detect_arc(det, eph, fa, sequences)
+    passive = passive_satellite(eph.satellite)
+    if propulsion is False or (propulsion is None and passive is not None):
+        run = without_propulsion(run, passive.area_to_mass_m2_kg if passive else DEFAULT_AREA_TO_MASS_M2_KG)
     return run
+
+
+def without_propulsion(run: OrbitRun, area_to_mass_m2_kg: float) -> OrbitRun:
+    """A run of a satellite without propulsion: the ΔV its model explains in the detector's window
+    (:func:`abrupt.model.propulsion.explainable_dv_mps`) is stated; detections within it are dropped as
+    explained, those above it kept as kind ``unknown`` and named as what they are: bad input or a force
+    the model lacks, never a burn."""
+    step = run.ephemeris.nominal_step_s
+    an = run.analysis
+    window_s = (an.config.glr_window_samples if an is not None else 10) * (step if np.isfinite(step) else 0.0)
+    limit = explainable_dv_mps(window_s, float(run.summary.get("dv90_mps", np.nan)), area_to_mass_m2_kg)
+    events = run.events
+    notes = [f"{run.ephemeris.satellite} has no propulsion: its model explains |ΔV| up to {1e3 * limit:.3g} mm/s"]
+    if len(events):
+        explained = events["dv_mps"].to_numpy(dtype=float) <= limit
+        if explained.any():
+            notes.append(f"{int(explained.sum())} detection(s) within the ΔV the model explains: not events")
+        events = events.loc[~explained].copy()
+        if len(events):
+            events["kind"] = "unknown"
+            notes.append(
+                f"{len(events)} detection(s) of |ΔV| up to {1e3 * float(events['dv_mps'].max()):.4g} mm/s exceed it: "
+                "not burns (no propulsion) but bad input or a force the model lacks; kept as kind unknown"
+            )
+    result = replace(run.result, events=events, warnings=(*run.result.warnings, *notes))
+    out = OrbitRun(run.ephemeris, run.detector, result, run.budget, dict(run.summary))
+    out.summary.update(
+        propulsion=False,
+        explainable_dv_mps=limit,
+        events=len(events),
+        warnings=[*out.summary.get("warnings", []), *notes],
+    )
+    return out
 
 
 def _untested(det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, reason: str) -> OrbitRun:

@@ -54,6 +54,7 @@ from abrupt.readers.compression import read_bytes
 
 SPEED_OF_LIGHT_MPS = 299_792_458.0
 BAD_RECORD_FRACTION = 0.01
+LASER_WAVELENGTH_NM = (300.0, 1200.0)  # [nm] ranging lasers: 355 (UV) to 1064 (Nd:YAG infrared)
 MEASUREMENT_COLUMNS = ("range_m", "azimuth_rad", "elevation_rad", "range_rate_mps")
 CRD_COLUMNS = (
     "time_utc",
@@ -146,6 +147,8 @@ def _date(tokens: list[str], i: int, what: str) -> np.datetime64:
     if not (1950 <= y <= 2200 and 1 <= mo <= 12 and 1 <= d <= 31 and 0 <= h <= 23 and 0 <= mi <= 59 and 0 <= s <= 60):
         raise _Bad(f"{what}: date {' '.join(tokens[i : i + 6])!r} out of range", i + 1)
     base = np.datetime64(f"{y:04d}-{mo:02d}-01", "ns") + np.timedelta64(d - 1, "D")
+    if base.astype("datetime64[M]") != np.datetime64(f"{y:04d}-{mo:02d}", "M"):  # 31 February: not 3 March
+        raise _Bad(f"{what}: date {' '.join(tokens[i : i + 6])!r}: day {d} is not a day of {y:04d}-{mo:02d}", i + 3)
     return base + np.timedelta64(h * 3600 + mi * 60 + s, "s")
 
 
@@ -297,9 +300,18 @@ def _wavelength(block: _Block, tokens: list[str], file: str, no: int) -> None:
     """A C0 (system configuration) record: the wavelength of a configuration."""
     if len(tokens) >= 4:
         try:
-            block.wavelengths[tokens[3]] = float(tokens[2])
+            wavelength_nm = float(tokens[2])
         except ValueError:
             raise InputError(f"C0 wavelength {tokens[2]!r} is not a number", file=file, line=no, column=3) from None
+        lo, hi = LASER_WAVELENGTH_NM
+        if not lo <= wavelength_nm <= hi:
+            raise InputError(
+                f"C0 wavelength {wavelength_nm:g} nm is not a ranging laser's ({lo:g}-{hi:g} nm; nm expected)",
+                file=file,
+                line=no,
+                column=3,
+            )
+        block.wavelengths[tokens[3]] = wavelength_nm
 
 
 def _data_record(block: _Block, rec: str, tokens: list[str], no: int, log: RepairLog) -> None:

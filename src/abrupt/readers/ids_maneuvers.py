@@ -34,6 +34,7 @@ from erfa import ErfaWarning
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.timescales import to_utc
 from abrupt.readers.compression import read_text
+from abrupt.readers.timesystems import day_of_year_date
 
 BURN_TOKENS = 15
 COMPONENT_ORDER: dict[str, tuple[int, int, int]] = {
@@ -68,10 +69,13 @@ def _doy_time(tokens: list[str], file: str, line_no: int, what: str) -> np.datet
         raise InputError(
             f"{what}: cannot read {' '.join(tokens)!r} as year, day of year, time", file=file, line=line_no
         ) from None
-    if not (1960 <= year <= 2100 and 1 <= doy <= 366 and 0 <= hh <= 23 and 0 <= mm <= 59 and 0.0 <= sec < 61.0):
+    if not (1960 <= year <= 2100 and 0 <= hh <= 23 and 0 <= mm <= 59 and 0.0 <= sec < 61.0):
         raise InputError(f"{what}: {' '.join(tokens)!r} is not a valid year/day-of-year/time", file=file, line=line_no)
-    base = np.datetime64(f"{year:04d}-01-01T00:00:00", "ns")
-    offset_ns = round((((doy - 1) * 24 + hh) * 60 + mm) * 60e9 + sec * 1e9)
+    try:
+        base = day_of_year_date(year, doy)
+    except ValueError as exc:
+        raise InputError(f"{what}: {' '.join(tokens)!r}: {exc}", file=file, line=line_no) from None
+    offset_ns = round(((hh * 60 + mm) * 60 + sec) * 1e9)
     return base + np.timedelta64(offset_ns, "ns")
 
 

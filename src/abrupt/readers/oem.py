@@ -40,7 +40,7 @@ from abrupt.model.timescales import offline_astropy
 from abrupt.outputs import write_text_atomic
 from abrupt.readers.compression import read_bytes
 from abrupt.readers.stated_joins import stated_join_epochs
-from abrupt.readers.timesystems import to_utc_counted
+from abrupt.readers.timesystems import day_of_year_date, to_utc_counted
 from abrupt.series.ephemeris import Ephemeris
 
 GCRF_NAMES = {"GCRF", "ICRF", "EME2000", "J2000"}
@@ -83,9 +83,7 @@ def parse_ccsds_epoch(text: str) -> np.datetime64:
         if not m:
             raise ValueError(text)
         y, doy, hh, mm, ss = m.groups()
-        base = np.datetime64(f"{y}-01-01", "ns") + np.timedelta64(int(doy) - 1, "D")
-        if not 1 <= int(doy) <= 366 or base.astype("datetime64[Y]") != np.datetime64(y, "Y"):
-            raise ValueError(text)
+        base = day_of_year_date(int(y), int(doy))
     if int(hh) > 23 or int(mm) > 59 or float(ss) >= 61.0:
         raise ValueError(text)
     return base + np.timedelta64(int(hh) * 3600 + int(mm) * 60, "s") + np.timedelta64(round(float(ss) * 1e9), "ns")

@@ -82,7 +82,7 @@ def check_epochs(eph: Ephemeris, now_utc: np.datetime64 | None = None) -> None:
     """Refuse an epoch later than ``now_utc`` (today) by more than :data:`PREDICTION_HORIZON_DAYS`."""
     if not len(eph):
         return
-    now = np.datetime64("now", "ns") if now_utc is None else np.datetime64(now_utc, "ns")
+    now = (np.datetime64("now", "s") if now_utc is None else now_utc).astype("datetime64[ns]")
     limit = now + np.timedelta64(round(PREDICTION_HORIZON_DAYS * 86400), "s")
     late = np.flatnonzero(eph.times_utc > limit)
     if late.size:

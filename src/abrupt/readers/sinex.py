@@ -37,6 +37,7 @@ from numpy.typing import NDArray
 
 from abrupt.errors import InputError
 from abrupt.readers.compression import read_text
+from abrupt.readers.timesystems import day_of_year_date
 
 SECONDS_PER_JULIAN_YEAR = 365.25 * 86400.0
 OPEN_EPOCH = "00:000:00000"
@@ -61,9 +62,13 @@ def parse_sinex_epoch(text: str) -> np.datetime64 | None:
         return None
     yy, doy, sod = int(parts[0]), int(parts[1]), int(parts[2])
     year = yy + (2000 if yy <= 50 else 1900) if len(parts[0]) == 2 else yy
-    if not (1 <= doy <= 366 and 0 <= sod <= 86400):
-        raise ValueError(f"epoch {text!r}: day of year or seconds of day out of range")
-    return np.datetime64(f"{year:04d}-01-01", "ns") + np.timedelta64(doy - 1, "D") + np.timedelta64(sod, "s")
+    if not 0 <= sod <= 86400:
+        raise ValueError(f"epoch {text!r}: seconds of day out of range")
+    try:
+        start = day_of_year_date(year, doy)
+    except ValueError as exc:
+        raise ValueError(f"epoch {text!r}: day of year out of range ({exc})") from None
+    return start + np.timedelta64(sod, "s")
 
 
 def _as_datetime(t: np.datetime64 | str) -> np.datetime64:

@@ -27,6 +27,7 @@ from abrupt.model.tracking_measurements import MEASUREMENT_COLUMNS
 from abrupt.outputs import write_text_atomic
 from abrupt.readers.aer import finish_measurements
 from abrupt.readers.text import read_text
+from abrupt.readers.timesystems import day_of_year_date
 
 #: Epochs outside these years are errors (space tracking; keeps datetime64[ns] from overflowing).
 EPOCH_YEARS = (1957, 2200)
@@ -76,8 +77,8 @@ def _parse_epoch(text: str) -> np.datetime64:
         year, doy, hh, mm, ss = m.groups()
         if not EPOCH_YEARS[0] <= int(year) <= EPOCH_YEARS[1]:
             raise ValueError(text)
-        base = np.datetime64(f"{year}-01-01T00:00:00", "ns") + np.timedelta64(int(doy) - 1, "D")
-        if not 1 <= int(doy) <= 366:
+        base = day_of_year_date(int(year), int(doy))
+        if int(hh) > 23 or int(mm) > 59 or float(ss) >= 61.0:
             raise ValueError(text)
         secs = int(hh) * 3600 + int(mm) * 60 + float(ss)
         return base + np.timedelta64(round(secs * 1e9), "ns")

@@ -33,3 +33,13 @@ def to_utc_counted(times: NDArray[np.datetime64], scale: TimeScale, repairs: Rep
     if dubious:
         repairs.record("epochs outside the leap-second table (TAI-UTC held at its last tabulated value)", 1)
     return out
+
+
+def day_of_year_date(year: int, day_of_year: int) -> np.datetime64[int]:
+    """Midnight starting day ``day_of_year`` (1 = 1 January) of ``year``, as ``datetime64[ns]``. A day the
+    year does not have (0, 366 of a common year, 400) is a ``ValueError``, never a day of the next year."""
+    start = np.datetime64(f"{year:04d}-01-01", "ns")
+    days = int((np.datetime64(f"{year + 1:04d}-01-01", "D") - np.datetime64(f"{year:04d}-01-01", "D")).astype(int))
+    if not 1 <= day_of_year <= days:
+        raise ValueError(f"day of year {day_of_year} is not a day of {year} (1-{days})")
+    return start + np.timedelta64(day_of_year - 1, "D")
