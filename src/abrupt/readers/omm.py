@@ -24,7 +24,6 @@ from sgp4 import omm
 from sgp4.api import Satrec
 
 from abrupt.errors import InputError, RepairLog
-from abrupt.readers.tle_checks import check_orbit_envelope
 from abrupt.readers.tle import (
     ElementHistory,
     RawElementSet,
@@ -35,6 +34,7 @@ from abrupt.readers.tle import (
     read_tle_histories,
     split_by_satellite,
 )
+from abrupt.readers.tle_checks import check_orbit_envelope
 
 REQUIRED = (
     "EPOCH",

@@ -74,7 +74,9 @@ def check_orbit_envelope(satrec: Any, file: str, line: int | None, now_unix_s: f
     epoch_unix_s = (_epoch_days(satrec) - JD_UNIX_EPOCH) * 86400.0
     if epoch_unix_s > now + FUTURE_MARGIN_DAYS * 86400.0:
         when = datetime.datetime.fromtimestamp(epoch_unix_s, datetime.UTC).strftime("%Y-%m-%d")
-        raise InputError(f"epoch {when} is in the future: no element set can have been fitted then", file=file, line=line)
+        raise InputError(
+            f"epoch {when} is in the future: no element set can have been fitted then", file=file, line=line
+        )
 
 
 def check_element_history(sets: Sequence[Any], source: str, repairs: RepairLog) -> None:

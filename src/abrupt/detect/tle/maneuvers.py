@@ -62,7 +62,7 @@ and merges the steps of one burn.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -76,6 +76,14 @@ from abrupt.detect.tle.campaigns import find_campaigns
 from abrupt.detect.tle.config import CAMPAIGN_SIDE_SETS, EXTRA_COLUMNS, TleDetectorConfig
 from abrupt.detect.tle.elements import circular_speed_mps, orbit_regime
 from abrupt.detect.tle.noise import block_thresholds, null_threshold, robust_group_weight
+from abrupt.detect.tle.response import (
+    blended_sets,
+    burn_grid,
+    interval_cost,
+    local_span_s,
+    ramp_profile,
+    ramp_span_s,
+)
 from abrupt.detect.tle.segmentation import segment
 from abrupt.detect.tle.steps import (
     StepModel,
@@ -120,6 +128,8 @@ class StepRun:
     stat: NDArray[np.float64]
     threshold: float
     change_points: list[int]
+    # the interval (s) of each detection timed from its blended sets (abrupt.detect.tle.response)
+    ramp_intervals: dict[int, tuple[float, float]] = field(default_factory=dict)
 
 
 def detect_mean_elements(
@@ -170,12 +180,13 @@ def detect_mean_elements(
     candidates = np.sort(np.asarray(accepted, dtype=np.int64))
     change_points = sorted(int(g) for g in candidates if stat[g] >= threshold)
     run = StepRun(history, cfg, regime, model, steps, stat, threshold, change_points)
-    timed = time_candidates(run, candidates, all_candidates)
+    timed = ramp_times(run, time_candidates(run, candidates, all_candidates))
     kept, span_of = merge_candidates(run, timed)
     detected = [it for it in kept if stat[it.gap] >= threshold]
-    lag_s = tle_lag_s(run, detected)
+    lag_s = tle_lag_s(run, [it for it in detected if it.gap not in run.ramp_intervals])
     for g in span_of:
-        span_of[g][0] = min(span_of[g][0], float(model.t[g]) - lag_s)
+        if g not in run.ramp_intervals:  # a ramp-timed burn states its own interval
+            span_of[g][0] = min(span_of[g][0], float(model.t[g]) - lag_s)
     base: dict[str, Any] = {"spacecraft": name, "detector": detector_name, "threshold": threshold}
     base |= {"false_alarms_per_day": fa_per_day}
     base |= {"run_id": run_id, "config_hash": cfg_hash}
@@ -302,6 +313,68 @@ def time_candidates(run: StepRun, candidates: NDArray[np.int64], all_candidates:
         # the step when that set was still fitted to pre-burn tracking) to the set after the step
         timed.append(Candidate(int(g), t_m, refined, min(float(t_m), float(model.t[int(g)]))))
     return timed
+
+
+RAMP_LEVEL = 0.9  # nominal coverage of a ramp-timed burn's interval
+RAMP_ERA_DAYS = 182.625  # the fit span of an era: from the ramps within half a year
+
+
+def ramp_times(run: StepRun, timed: list[Candidate]) -> list[Candidate]:
+    """Time in-track LEO detections whose step blends over element sets by the sets' response
+    (:mod:`abrupt.detect.tle.response`).
+
+    The blended sets of every in-track candidate are found; the fit span of each era is learned from
+    the candidates with two or more blends within ``RAMP_ERA_DAYS`` (at least three, else nothing
+    changes there: an era whose sets do not blend keeps the along-track time). A candidate with a
+    blend is then timed by the fit of ``a`` to the response (the burn inside the first blend's span)
+    and states the profile-likelihood interval at ``RAMP_LEVEL`` (``run.ramp_intervals``).
+    """
+    if run.regime != "leo" or not run.cfg.refine_time:
+        return timed
+    model, cfg = run.model, run.cfg
+    a = np.asarray(model.s["a_m"], dtype=float)
+    splits: dict[int, tuple[int, int, int, int, float]] = {}
+    for it in timed:
+        g = it.gap
+        if not has_drift_hinge(run.steps, g, cfg.min_statistic) or is_phasing(run.steps, g):
+            continue
+        seg = segment_bounds(g, [c for c in run.change_points if c != g], len(run.history))
+        lo = max(seg[0], g + 1 - cfg.time_window_sets)
+        hi = min(seg[1], g + 1 + cfg.time_window_sets)
+        sigma = float(model.scales["a_m"][g])
+        if g + 1 - lo < 4 or hi - g - 1 < 3 or not (sigma > 0 and math.isfinite(sigma)):
+            continue
+        last_old, first_new, noise = blended_sets(model.t, a, sigma, lo, hi, g)
+        if first_new - last_old > 1:
+            splits[g] = (lo, hi, last_old, first_new, noise)
+    ramps = {
+        g: (lo, hi, lo_old + 1, noise)
+        for g, (lo, hi, lo_old, first_new, noise) in splits.items()
+        if first_new - lo_old > 2
+    }
+    ramp_t = np.asarray([float(model.t[g]) for g in ramps], dtype=float)
+    ramp_span = np.asarray([ramp_span_s(model.t, a, r) for r in ramps.values()], dtype=float)
+    profiles = {}
+    for g, (lo, hi, last_old, _, noise) in splits.items():
+        span = local_span_s(float(model.t[g]), ramp_t, ramp_span, RAMP_ERA_DAYS * SECONDS_PER_DAY)
+        if not math.isfinite(span):
+            continue
+        grid = burn_grid(model.t, last_old + 1, span)
+        profiles[g] = (grid, ramp_profile(model.t, a, lo, hi, grid, span, noise), hi - lo - 3)
+    if not profiles:
+        return timed
+    rise = interval_cost([float(np.min(c)) / max(dof, 1) for _, c, dof in profiles.values()], RAMP_LEVEL)
+    out = []
+    for it in timed:
+        if it.gap not in profiles:
+            out.append(it)
+            continue
+        grid, cost, _ = profiles[it.gap]
+        best = int(np.argmin(cost))
+        inside = grid[cost - cost[best] <= rise]
+        run.ramp_intervals[it.gap] = (float(inside.min()), float(inside.max()))
+        out.append(Candidate(it.gap, float(grid[best]), True, float(inside.min())))
+    return out
 
 
 DV_KEYS = ("dv_r_mps", "dv_t_mps", "dv_n_mps")
@@ -453,7 +526,8 @@ def merge_candidates(run: StepRun, timed: list[Candidate]) -> tuple[list[Candida
                     near = [retimed]
         if not near:
             kept.append(item)
-            span_of[item.gap] = [item.start_s, float(steps.t_after_s[item.gap])]
+            end_s = run.ramp_intervals.get(item.gap, (item.start_s, float(steps.t_after_s[item.gap])))[1]
+            span_of[item.gap] = [item.start_s, end_s]
         elif stat[item.gap] >= run.threshold:
             host = span_of[near[0].gap]
             host[0] = min(host[0], item.start_s)
