@@ -155,6 +155,13 @@ def detect_tle(
             f"cross-track {nm.get('min_detectable_dv_n_mps', float('nan')) * 100:.2g} cm/s",
             err=True,
         )
+        if nm.get("outlier_sets"):
+            first = ", ".join(str(e)[:16] for e in nm["outlier_epochs_utc"][:5])
+            click.echo(
+                f"  outlier element sets (disagree with both neighbours, history continues as before): "
+                f"{nm['outlier_sets']} left out ({first}{', ...' if nm['outlier_sets'] > 5 else ''})",
+                err=True,
+            )
         for row in nm.get("detectable_by_year", []):
             click.echo(
                 f"  {row['year']}: smallest detectable ΔV in-track {row['min_detectable_dv_t_mps'] * 100:.2g} cm/s, "

@@ -76,6 +76,7 @@ from abrupt.detect.tle.campaigns import find_campaigns
 from abrupt.detect.tle.config import CAMPAIGN_SIDE_SETS, EXTRA_COLUMNS, TleDetectorConfig
 from abrupt.detect.tle.elements import circular_speed_mps, orbit_regime
 from abrupt.detect.tle.noise import block_thresholds, null_threshold, robust_group_weight
+from abrupt.detect.tle.outliers import without_outliers
 from abrupt.detect.tle.response import (
     blended_sets,
     burn_grid,
@@ -158,6 +159,11 @@ def detect_mean_elements(
     cfg_hash = config_hash(cfg.hash_fields())
     name = spacecraft or history.name or (f"NORAD-{history.norad_id}" if len(history) else "unknown")
     fa_per_day = cfg.budget.per_day
+    outlier_epochs = pd.Series([], dtype="datetime64[ns]")
+    if len(history):
+        history, outlier_epochs = without_outliers(
+            history, orbit_regime(history) if cfg.regime == "auto" else cfg.regime
+        )
     el = history.elements
     epoch0 = pd.Timestamp(el["epoch_utc"].iloc[0]) if len(el) else pd.Timestamp("1970-01-01")
     epoch0_np = np.datetime64(int(epoch0.value), "ns")
@@ -206,6 +212,8 @@ def detect_mean_elements(
     a_med = float(np.median(el["a_m"]))
     noise = noise_summary(steps, model, threshold, a_med, gaps_per_year)
     noise["detectable_by_year"] = detectable_by_year(steps, model, threshold, a_med, epoch0)
+    noise["outlier_sets"] = len(outlier_epochs)
+    noise["outlier_epochs_utc"] = [str(e) for e in outlier_epochs]
     fitted = Threshold(threshold, p_fa, method, n_gaps, fa_per_day)
     diag = _diagnostics(
         detector_name, 0.5 * (steps.t_before_s + steps.t_after_s), stat, fitted, epoch0_np, noise, regime
