@@ -155,6 +155,12 @@ def detect_tle(
             f"cross-track {nm.get('min_detectable_dv_n_mps', float('nan')) * 100:.2g} cm/s",
             err=True,
         )
+        for gap in nm.get("unbridged_gaps", []):
+            click.echo(
+                f"  gap of {gap['days']:.1f} days ({gap['from_utc'][:16]} to {gap['to_utc'][:16]}) is longer than the "
+                "detector can bridge: one analysed arc ends there and another starts; no event inside it",
+                err=True,
+            )
         if nm.get("outlier_sets"):
             first = ", ".join(str(e)[:16] for e in nm["outlier_epochs_utc"][:5])
             click.echo(

@@ -61,6 +61,7 @@ and merges the steps of one burn.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field, replace
 from typing import Any, NamedTuple
@@ -74,7 +75,7 @@ from abrupt.detect.base import DetectionResult, Diagnostics
 from abrupt.detect.tle.burns import campaign_cadence_s, characterise, label_campaigns
 from abrupt.detect.tle.campaigns import find_campaigns
 from abrupt.detect.tle.config import CAMPAIGN_SIDE_SETS, EXTRA_COLUMNS, TleDetectorConfig
-from abrupt.detect.tle.elements import circular_speed_mps, orbit_regime
+from abrupt.detect.tle.elements import arcs, circular_speed_mps, history_rows, orbit_regime
 from abrupt.detect.tle.noise import block_thresholds, null_threshold, robust_group_weight
 from abrupt.detect.tle.outliers import without_outliers
 from abrupt.detect.tle.response import (
@@ -142,7 +143,99 @@ def detect_mean_elements(
     all_candidates: bool = False,
     detector_name: str | None = None,
 ) -> DetectionResult:
-    """Detect maneuvers in a mean-element history (module docstring).
+    """Detect maneuvers in a mean-element history (module docstring), arc by arc.
+
+    A gap between sets longer than ``config.max_bridge_days`` ends one analysed arc and starts
+    another (:func:`abrupt.detect.tle.elements.arcs`): each arc is detected on its own
+    (:func:`detect_arc`: its own noise, threshold and outliers) and no event is stated inside the gap.
+    With several arcs the result joins theirs: events of all, one diagnostics whose statistic runs
+    over all arcs (times from the first arc's epoch), the threshold and noise model of the longest
+    arc, with ``arcs`` (each arc's first and last epoch, sets, events), ``unbridged_gaps`` (from, to,
+    days), the arcs' ``detectable_by_year`` and ``outlier_sets`` summed into it.
+    """
+    cfg = config or TleDetectorConfig()
+    run_id = run_id or new_run_id()
+    pieces = arcs(history, cfg.max_bridge_days)
+    if len(pieces) <= 1:
+        return detect_arc(
+            history,
+            cfg,
+            spacecraft=spacecraft,
+            run_id=run_id,
+            all_candidates=all_candidates,
+            detector_name=detector_name,
+        )
+    name = spacecraft or history.name or f"NORAD-{history.norad_id}"
+    results = [
+        detect_arc(
+            history_rows(history, rows),
+            cfg,
+            spacecraft=name,
+            run_id=run_id,
+            all_candidates=all_candidates,
+            detector_name=detector_name,
+        )
+        for rows in pieces
+    ]
+    el = history.elements
+    epoch0 = np.datetime64(int(pd.Timestamp(el["epoch_utc"].iloc[0]).value), "ns")
+    frames = [r.events for r in results if len(r.events)]
+    events = pd.concat(frames, ignore_index=True) if frames else empty_frame(EXTRA_COLUMNS)
+    diags = [r.diagnostics[0] for r in results]
+    longest = int(np.argmax([len(rows) for rows in pieces]))
+    times, stats_ = [], []
+    for d in diags:
+        shift_s = (d.epoch_utc - epoch0) / np.timedelta64(1, "s") if d.epoch_utc is not None else 0.0
+        times.append(np.asarray(d.time_s, dtype=float) + float(shift_s))
+        stats_.append(np.asarray(d.statistic, dtype=float))
+    noise = dict(diags[longest].noise_model or {})
+    noise["arcs"] = [
+        {
+            "first_epoch_utc": str(el["epoch_utc"].iloc[rows[0]]),
+            "last_epoch_utc": str(el["epoch_utc"].iloc[rows[-1]]),
+            "sets": len(rows),
+            "events": len(r.events),
+        }
+        for rows, r in zip(pieces, results, strict=True)
+    ]
+    noise["unbridged_gaps"] = [
+        {
+            "from_utc": str(el["epoch_utc"].iloc[a[-1]]),
+            "to_utc": str(el["epoch_utc"].iloc[b[0]]),
+            "days": (el["epoch_utc"].iloc[b[0]] - el["epoch_utc"].iloc[a[-1]]).total_seconds() / SECONDS_PER_DAY,
+        }
+        for a, b in itertools.pairwise(pieces)
+    ]
+    noise["detectable_by_year"] = [row for d in diags for row in (d.noise_model or {}).get("detectable_by_year", [])]
+    noise["outlier_sets"] = sum(int((d.noise_model or {}).get("outlier_sets", 0)) for d in diags)
+    noise["outlier_epochs_utc"] = [e for d in diags for e in (d.noise_model or {}).get("outlier_epochs_utc", [])]
+    d0 = diags[longest]
+    diag = Diagnostics(
+        name=d0.name,
+        time_s=np.concatenate(times),
+        statistic=np.concatenate(stats_),
+        threshold=d0.threshold,
+        epoch_utc=epoch0,
+        unit=d0.unit,
+        noise_model=noise,
+        extra=d0.extra,
+    )
+    gaps = ", ".join(f"{g['days']:.0f} days from {g['from_utc'][:10]}" for g in noise["unbridged_gaps"])
+    note = f"{len(pieces)} arcs analysed apart: gaps longer than {cfg.max_bridge_days:g} days ({gaps}) are not bridged"
+    warnings_ = (*(w for r in results for w in r.warnings), note)
+    return DetectionResult(events.sort_values("time_utc", kind="stable").reset_index(drop=True), (diag,), warnings_)
+
+
+def detect_arc(
+    history: ElementHistory,
+    config: TleDetectorConfig | None = None,
+    *,
+    spacecraft: str | None = None,
+    run_id: str | None = None,
+    all_candidates: bool = False,
+    detector_name: str | None = None,
+) -> DetectionResult:
+    """Detect maneuvers in one arc of a mean-element history (module docstring).
 
     Returns the events and one :class:`~abrupt.detect.base.Diagnostics` (per-gap statistic at the
     middle of each gap, threshold, the satellite's noise model from :func:`noise_summary`; ``extra``

@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from abrupt.detect.tle.elements import mean_element_series
+from abrupt.detect.tle.elements import history_rows, mean_element_series
 from abrupt.readers.tle import ElementHistory
 from abrupt.thresholds.noise import robust_scale
 
@@ -74,14 +74,6 @@ def without_outliers(history: ElementHistory, regime: str) -> tuple[ElementHisto
     mask = outlier_mask(history, regime)
     if not mask.any():
         return history, pd.Series([], dtype="datetime64[ns]")
-    keep = np.flatnonzero(~mask)
-    el = history.elements
-    kept = ElementHistory(
-        el.iloc[keep].reset_index(drop=True),
-        [history.satrecs[k] for k in keep],
-        history.source,
-        history.name,
-        history.repairs,
-        list(history.skipped),
-    )
-    return kept, el["epoch_utc"].iloc[np.flatnonzero(mask)].reset_index(drop=True)
+    return history_rows(history, np.flatnonzero(~mask)), history.elements["epoch_utc"].iloc[
+        np.flatnonzero(mask)
+    ].reset_index(drop=True)
