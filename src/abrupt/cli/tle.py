@@ -32,11 +32,11 @@ from abrupt.detect.tle.config import DEFAULT_TLE_BUDGET, TleDetectorConfig
 from abrupt.detect.tle.detectors import detector_for
 from abrupt.errors import InputError
 from abrupt.events import config_hash, new_run_id, read_events
-from abrupt.pipelines.tle import burns_below_detectable, detect_tle_file, satellite_label
+from abrupt.pipelines.tle import burns_above_floor, burns_below_detectable, detect_tle_file, satellite_label
 from abrupt.readers.fengyun import read_maneuver_file
 from abrupt.readers.omm import read_elements
 from abrupt.report.tle import plot_injection_recall, plot_tle_report
-from abrupt.score import interval_ns, recall_at_false_alarm_rate, score_events
+from abrupt.score import SUMMARY_KINDS, interval_ns, recall_at_false_alarm_rate, score_events
 from abrupt.simulate.tle_injection import KINDS, MIN_ELEMENT_SETS, injection_recall, ladder_around
 from abrupt.simulate.tle_own_null import own_null_rate
 from abrupt.thresholds import DAYS_PER_YEAR, FalseAlarmBudget
@@ -419,14 +419,44 @@ def score(
     else:
         click.echo("recall at a false-alarm rate needs the observed span: give --elements or --start/--end", err=True)
     if elements:
-        out["below_detectable"] = _flag_undetectable(elements, events, truth_frame, start, end)
+        out["below_detectable"] = _flag_undetectable(elements, events, truth_frame, start, end, result)
+        out["unmatched_by_year"] = _unmatched_by_year(events, result, start, end)
     if json_out:
         Path(json_out).write_text(json.dumps(out, indent=2, default=str))
 
 
-def _flag_undetectable(elements: str, events: Any, truth: Any, start: Any, end: Any) -> dict[str, Any]:
+def _unmatched_by_year(events: Any, result: Any, start: Any, end: Any) -> list[dict[str, Any]]:
+    """Print and return the realised rate per calendar year of the span: detections not paired with a
+    truth (±tolerance, one-to-one) per year of observed time, beside the rate the events were set for."""
+    per_day = events["false_alarms_per_day"].dropna() if "false_alarms_per_day" in events else pd.Series([])
+    stated = float(per_day.iloc[0]) * DAYS_PER_YEAR if len(per_day) else float("nan")
+    # the scorer's rows: the events without summary rows (campaigns), renumbered (abrupt.score)
+    counted = events.loc[~events["kind"].isin(SUMMARY_KINDS)] if "kind" in events else events
+    counted = counted.reset_index(drop=True)
+    paired = {i for i, _, _ in result.pairs}
+    if "threshold" in counted and "statistic" in counted:
+        counted = counted.loc[counted["statistic"] >= counted["threshold"]]
+    times = pd.to_datetime(counted["time_utc"].astype(str), utc=True, format="ISO8601")
+    unmatched_year = [t.year for i, t in zip(counted.index, times, strict=True) if i not in paired]
+    t0, t1 = pd.Timestamp(start, tz="UTC"), pd.Timestamp(end, tz="UTC")
+    rows = []
+    for year in range(t0.year, t1.year + 1):
+        lo = max(t0, pd.Timestamp(f"{year}-01-01", tz="UTC"))
+        hi = min(t1, pd.Timestamp(f"{year + 1}-01-01", tz="UTC"))
+        years = (hi - lo).total_seconds() / (86400.0 * DAYS_PER_YEAR)
+        n = unmatched_year.count(year)
+        rows.append({"year": year, "unmatched": n, "years": years, "per_year": n / years if years > 0 else math.nan})
+    cells = ", ".join(f"{r['year']} {r['per_year']:.2g}" for r in rows if r["years"] >= 0.25)
+    click.echo(f"unmatched detections per year (stated {stated:.3g}/year): {cells}")
+    return rows
+
+
+def _flag_undetectable(
+    elements: str, events: Any, truth: Any, start: Any, end: Any, result: Any = None
+) -> dict[str, Any]:
     """Compare the truth's burns with the smallest ΔV the history's element sets resolve per year (at the
-    events' budget) and flag a history whose listed burns are mostly below it."""
+    events' budget), flag a history whose listed burns are mostly below it, and (with the ±tolerance
+    ``result``) print the recall of the burns above that floor beside the full recall."""
     per_day = events["false_alarms_per_day"].dropna() if "false_alarms_per_day" in events else pd.Series([])
     budget = FalseAlarmBudget(float(per_day.iloc[0]) * DAYS_PER_YEAR, "year") if len(per_day) else DEFAULT_TLE_BUDGET
     history = read_elements(elements)
@@ -434,9 +464,24 @@ def _flag_undetectable(elements: str, events: Any, truth: Any, start: Any, end: 
     times = pd.to_datetime(truth["time_utc"].astype(str), utc=True)
     inside = truth.loc[(times >= pd.Timestamp(start, tz="UTC")) & (times <= pd.Timestamp(end, tz="UTC"))]
     below, total = burns_below_detectable(inside, by_year)
+    above_floor: dict[str, Any] = {}
+    if result is not None and result.n_truth:
+        above = burns_above_floor(truth, by_year)
+        t_all = pd.to_datetime(truth["time_utc"].astype(str), utc=True)
+        in_span = ((t_all >= pd.Timestamp(start, tz="UTC")) & (t_all <= pd.Timestamp(end, tz="UTC"))).to_numpy()
+        above &= in_span
+        found = {j for _, j, _ in result.pairs}
+        n_above = int(above.sum())
+        hit = sum(1 for j in range(len(truth)) if above[j] and j in found)
+        above_floor = {"burns_above_floor": n_above, "found": hit, "recall": hit / n_above if n_above else math.nan}
+        click.echo(
+            f"recall above the stated floor (burns whose operator ΔV reaches the smallest detectable ΔV of their "
+            f"year; no ΔV in the file: counted): {hit}/{n_above} = {above_floor['recall']:.3f} "
+            f"(all burns: {result.recall:.3f})"
+        )
     if total == 0:
         click.echo("detectable ΔV: the truth file states no ΔV; burns below what the element sets resolve unknown")
-        return {"burns_with_dv": 0, "below": 0, "flagged": False}
+        return {"burns_with_dv": 0, "below": 0, "flagged": False, "above_floor": above_floor}
     flagged = below > total / 2
     click.echo(
         f"detectable ΔV: {below} of {total} truth burns with a stated ΔV are below the smallest ΔV the element "
@@ -448,7 +493,7 @@ def _flag_undetectable(elements: str, events: Any, truth: Any, start: Any, end: 
             else ""
         )
     )
-    return {"burns_with_dv": total, "below": below, "flagged": flagged}
+    return {"burns_with_dv": total, "below": below, "flagged": flagged, "above_floor": above_floor}
 
 
 @inject.command("tle")
