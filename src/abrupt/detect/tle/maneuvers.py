@@ -82,7 +82,7 @@ from abrupt.detect.tle.response import (
     blended_sets,
     burn_grid,
     interval_cost,
-    local_span_s,
+    local_spans_s,
     ramp_profile,
     ramp_span_s,
 )
@@ -455,24 +455,28 @@ def ramp_times(run: StepRun, timed: list[Candidate]) -> list[Candidate]:
     }
     ramp_t = np.asarray([float(model.t[g]) for g in ramps], dtype=float)
     ramp_span = np.asarray([ramp_span_s(model.t, a, r) for r in ramps.values()], dtype=float)
-    profiles = {}
+    profiles: dict[int, list[tuple[NDArray[np.float64], NDArray[np.float64]]]] = {}
+    dofs: dict[int, int] = {}
     for g, (lo, hi, last_old, _, noise) in splits.items():
-        span = local_span_s(float(model.t[g]), ramp_t, ramp_span, RAMP_ERA_DAYS * SECONDS_PER_DAY)
-        if not math.isfinite(span):
+        spans = local_spans_s(float(model.t[g]), ramp_t, ramp_span, RAMP_ERA_DAYS * SECONDS_PER_DAY)
+        if not math.isfinite(spans[0]):
             continue
-        grid = burn_grid(model.t, last_old + 1, span)
-        profiles[g] = (grid, ramp_profile(model.t, a, lo, hi, grid, span, noise), hi - lo - 3)
+        profiles[g] = []
+        for span in spans:  # the era's median span first, then its smallest and largest
+            grid = burn_grid(model.t, last_old + 1, span)
+            profiles[g].append((grid, ramp_profile(model.t, a, lo, hi, grid, span, noise)))
+        dofs[g] = hi - lo - 3
     if not profiles:
         return timed
-    rise = interval_cost([float(np.min(c)) / max(dof, 1) for _, c, dof in profiles.values()], RAMP_LEVEL)
+    rise = interval_cost([float(np.min(p[0][1])) / max(dofs[g], 1) for g, p in profiles.items()], RAMP_LEVEL)
     out = []
     for it in timed:
         if it.gap not in profiles:
             out.append(it)
             continue
-        grid, cost, _ = profiles[it.gap]
+        (grid, cost), *others = profiles[it.gap]
         best = int(np.argmin(cost))
-        inside = grid[cost - cost[best] <= rise]
+        inside = np.concatenate([gr[c - np.min(c) <= rise] for gr, c in ((grid, cost), *others)])
         run.ramp_intervals[it.gap] = (float(inside.min()), float(inside.max()))
         out.append(Candidate(it.gap, float(grid[best]), True, float(inside.min())))
     return out

@@ -24,11 +24,13 @@ burn when ``S`` spans days (the older catalogue).
 2. **The fit span of an era** (:func:`ramp_span_s`, :func:`local_span_s`): every step with two or
    more blends is fitted for ``S`` (the span whose best burn time fits its ``a`` best); the span at a
    time is the median of those within half a year (at least three; else the era's sets do not
-   blend and nothing here applies).
+   blend and nothing here applies); their smallest and largest bound its uncertainty.
 3. **Burn time and interval** (:func:`ramp_profile`): ``a_k = c₀ + c₁τ_k + Δa·f`` is fitted by least
    squares for every burn time in the first blend's span (its fit saw the burn); the least cost is
    the time, and the times whose cost lies within ``κ·χ²₁(0.9)`` of it the interval (profile
-   likelihood, Wilks 1938; ``κ`` the median reduced χ² of the history's fits, :func:`interval_cost`).
+   likelihood, Wilks 1938; ``κ`` the median reduced χ² of the history's fits, :func:`interval_cost`),
+   joined with the same intervals at the era's smallest and largest span (the span is not known
+   better than its ramps show).
 """
 
 from __future__ import annotations
@@ -163,13 +165,17 @@ def ramp_span_s(t_s: NDArray[np.float64], a_m: NDArray[np.float64], ramp: tuple[
     return float(SPAN_GRID_DAYS[int(np.argmin(costs))]) * SECONDS_PER_DAY
 
 
-def local_span_s(
+def local_spans_s(
     at_s: float, ramp_times_s: NDArray[np.float64], ramp_spans_s: NDArray[np.float64], reach_s: float, minimum: int = 3
-) -> float:
-    """The fit span (s) of the era around ``at_s``: the median span of the ramps within ``reach_s``
-    (NaN with fewer than ``minimum``: the era's sets do not blend, or too few burns show it)."""
+) -> tuple[float, float, float]:
+    """The fit span (s) of the era around ``at_s`` and its spread: the median, smallest and largest span
+    of the ramps within ``reach_s`` (NaNs with fewer than ``minimum``: the era's sets do not blend, or
+    too few burns show it)."""
     near = np.abs(ramp_times_s - at_s) <= reach_s
-    return float(np.median(ramp_spans_s[near])) if int(near.sum()) >= minimum else math.nan
+    if int(near.sum()) < minimum:
+        return math.nan, math.nan, math.nan
+    spans = ramp_spans_s[near]
+    return float(np.median(spans)), float(np.min(spans)), float(np.max(spans))
 
 
 def interval_cost(reduced_chi2: list[float], level: float) -> float:
