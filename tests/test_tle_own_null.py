@@ -167,3 +167,4 @@ def test_history_whose_burns_are_below_what_its_sets_resolve_is_flagged(shared_d
         r = CliRunner().invoke(cli, ["score", str(events), "--truth", str(truth), "--elements", str(tle)])
         assert r.exit_code == 0, r.output
         assert ("FLAG" in r.output) is flagged, r.output
+        assert "recall above the stated floor" in r.output and "unmatched detections per year" in r.output

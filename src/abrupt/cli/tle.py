@@ -175,6 +175,19 @@ def detect_tle(
             f"cross-track {nm.get('min_detectable_dv_n_mps', float('nan')) * 100:.2g} cm/s",
             err=True,
         )
+        for gap in nm.get("unbridged_gaps", []):
+            click.echo(
+                f"  gap of {gap['days']:.1f} days ({gap['from_utc'][:16]} to {gap['to_utc'][:16]}) is longer than the "
+                "detector can bridge: one analysed arc ends there and another starts; no event inside it",
+                err=True,
+            )
+        if nm.get("outlier_sets"):
+            first = ", ".join(str(e)[:16] for e in nm["outlier_epochs_utc"][:5])
+            click.echo(
+                f"  outlier element sets (disagree with both neighbours, history continues as before): "
+                f"{nm['outlier_sets']} left out ({first}{', ...' if nm['outlier_sets'] > 5 else ''})",
+                err=True,
+            )
         for row in nm.get("detectable_by_year", []):
             click.echo(
                 f"  {row['year']}: smallest detectable ΔV in-track {row['min_detectable_dv_t_mps'] * 100:.2g} cm/s, "
@@ -444,14 +457,44 @@ def score(
     else:
         click.echo("recall at a false-alarm rate needs the observed span: give --elements or --start/--end", err=True)
     if elements:
-        out["below_detectable"] = _flag_undetectable(elements, events, truth_frame, start, end)
+        out["below_detectable"] = _flag_undetectable(elements, events, truth_frame, start, end, result)
+        out["unmatched_by_year"] = _unmatched_by_year(events, result, start, end)
     if json_out:
         write_text_atomic(json_out, json.dumps(out, indent=2, default=str))
 
 
-def _flag_undetectable(elements: str, events: Any, truth: Any, start: Any, end: Any) -> dict[str, Any]:
+def _unmatched_by_year(events: Any, result: Any, start: Any, end: Any) -> list[dict[str, Any]]:
+    """Print and return the realised rate per calendar year of the span: detections not paired with a
+    truth (±tolerance, one-to-one) per year of observed time, beside the rate the events were set for."""
+    per_day = events["false_alarms_per_day"].dropna() if "false_alarms_per_day" in events else pd.Series([])
+    stated = float(per_day.iloc[0]) * thresholds.DAYS_PER_YEAR if len(per_day) else float("nan")
+    # the scorer's rows: the events without summary rows (campaigns), renumbered (abrupt.score)
+    counted = events.loc[~events["kind"].isin(abrupt_score.SUMMARY_KINDS)] if "kind" in events else events
+    counted = counted.reset_index(drop=True)
+    paired = {i for i, _, _ in result.pairs}
+    if "threshold" in counted and "statistic" in counted:
+        counted = counted.loc[counted["statistic"] >= counted["threshold"]]
+    times = pd.to_datetime(counted["time_utc"].astype(str), utc=True, format="ISO8601")
+    unmatched_year = [t.year for i, t in zip(counted.index, times, strict=True) if i not in paired]
+    t0, t1 = pd.Timestamp(start, tz="UTC"), pd.Timestamp(end, tz="UTC")
+    rows = []
+    for year in range(t0.year, t1.year + 1):
+        lo = max(t0, pd.Timestamp(f"{year}-01-01", tz="UTC"))
+        hi = min(t1, pd.Timestamp(f"{year + 1}-01-01", tz="UTC"))
+        years = (hi - lo).total_seconds() / (86400.0 * thresholds.DAYS_PER_YEAR)
+        n = unmatched_year.count(year)
+        rows.append({"year": year, "unmatched": n, "years": years, "per_year": n / years if years > 0 else math.nan})
+    cells = ", ".join(f"{r['year']} {r['per_year']:.2g}" for r in rows if r["years"] >= 0.25)
+    click.echo(f"unmatched detections per year (stated {stated:.3g}/year): {cells}")
+    return rows
+
+
+def _flag_undetectable(
+    elements: str, events: Any, truth: Any, start: Any, end: Any, result: Any = None
+) -> dict[str, Any]:
     """Compare the truth's burns with the smallest ΔV the history's element sets resolve per year (at the
-    events' budget) and flag a history whose listed burns are mostly below it."""
+    events' budget), flag a history whose listed burns are mostly below it, and (with the ±tolerance
+    ``result``) print the recall of the burns above that floor beside the full recall."""
     per_day = events["false_alarms_per_day"].dropna() if "false_alarms_per_day" in events else pd.Series([])
     budget = (
         thresholds.FalseAlarmBudget(float(per_day.iloc[0]) * thresholds.DAYS_PER_YEAR, "year")
@@ -468,9 +511,28 @@ def _flag_undetectable(elements: str, events: Any, truth: Any, start: Any, end: 
     times = pd.to_datetime(truth["time_utc"].astype(str), utc=True)
     inside = truth.loc[(times >= pd.Timestamp(start, tz="UTC")) & (times <= pd.Timestamp(end, tz="UTC"))]
     below, total = pipelines_tle.burns_below_detectable(inside, by_year)
+    above_floor: dict[str, Any] = {}
+    if result is not None and result.n_truth:
+        above = pipelines_tle.burns_above_floor(truth, by_year)
+        t_all = pd.to_datetime(truth["time_utc"].astype(str), utc=True)
+        in_span = ((t_all >= pd.Timestamp(start, tz="UTC")) & (t_all <= pd.Timestamp(end, tz="UTC"))).to_numpy()
+        above &= in_span
+        found = {j for _, j, _ in result.pairs}
+        n_above = int(above.sum())
+        hit = sum(1 for j in range(len(truth)) if above[j] and j in found)
+        above_floor = {
+            "burns_above_floor": n_above,
+            "found": hit,
+            "recall": hit / n_above if n_above else math.nan,
+        }
+        click.echo(
+            f"recall above the stated floor (burns whose operator ΔV reaches the smallest detectable ΔV of their "
+            f"year; no ΔV in the file: counted): {hit}/{n_above} = {above_floor['recall']:.3f} "
+            f"(all burns: {result.recall:.3f})"
+        )
     if total == 0:
         click.echo("detectable ΔV: the truth file states no ΔV; burns below what the element sets resolve unknown")
-        return {"burns_with_dv": 0, "below": 0, "flagged": False}
+        return {"burns_with_dv": 0, "below": 0, "flagged": False, "above_floor": above_floor}
     flagged = below > total / 2
     click.echo(
         f"detectable ΔV: {below} of {total} truth burns with a stated ΔV are below the smallest ΔV the element "
@@ -482,7 +544,7 @@ def _flag_undetectable(elements: str, events: Any, truth: Any, start: Any, end: 
             else ""
         )
     )
-    return {"burns_with_dv": total, "below": below, "flagged": flagged}
+    return {"burns_with_dv": total, "below": below, "flagged": flagged, "above_floor": above_floor}
 
 
 @inject.command("tle")

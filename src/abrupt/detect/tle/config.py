@@ -72,6 +72,10 @@ class TleDetectorConfig:
     threshold_follow: str = "raise"
     threshold_block_days: float = 365.25
     threshold_reach_days: float = 182.625
+    # a gap between element sets longer than this ends one analysed arc and starts another: no event
+    # is stated inside it (the step test's windows reach max_window_days; a longer gap holds orbit
+    # changes the sets cannot place or size)
+    max_bridge_days: float = 20.0
 
     def __post_init__(self) -> None:
         if self.window_sets < 2:
@@ -88,6 +92,8 @@ class TleDetectorConfig:
             raise ValueError(f"threshold_follow must be none, raise or follow, got {self.threshold_follow!r}")
         if not (self.threshold_block_days > 0 and self.threshold_reach_days >= 0):
             raise ValueError("threshold_block_days must be positive and threshold_reach_days non-negative")
+        if not (self.max_bridge_days > 0 and math.isfinite(self.max_bridge_days)):
+            raise ValueError("max_bridge_days must be a finite positive number")
         if self.drag_median_sets < 1:
             raise ValueError("drag_median_sets must be >= 1")
         if not (self.drag_min_decay_m_day > 0 and math.isfinite(self.drag_min_decay_m_day)):

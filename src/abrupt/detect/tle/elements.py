@@ -20,6 +20,29 @@ from abrupt.units import SECONDS_PER_DAY
 GEO_MEAN_MOTION_RANGE_REV_DAY = (0.9, 1.1)
 
 
+def history_rows(history: ElementHistory, rows: NDArray[np.int64]) -> ElementHistory:
+    """The sets ``rows`` of a history (same source, name, repairs and skipped list)."""
+    return ElementHistory(
+        history.elements.iloc[rows].reset_index(drop=True),
+        [history.satrecs[k] for k in rows],
+        history.source,
+        history.name,
+        history.repairs,
+        list(history.skipped),
+    )
+
+
+def arcs(history: ElementHistory, max_gap_days: float) -> list[NDArray[np.int64]]:
+    """The set indices of each arc: a gap between consecutive sets longer than ``max_gap_days`` ends
+    one arc and starts the next."""
+    n = len(history)
+    if n == 0:
+        return []
+    days = history.elements["epoch_utc"].diff().dt.total_seconds().to_numpy()[1:] / SECONDS_PER_DAY
+    cuts = np.flatnonzero(days > max_gap_days) + 1
+    return [np.asarray(a, dtype=np.int64) for a in np.split(np.arange(n), cuts)]
+
+
 def orbit_regime(history: ElementHistory) -> str:
     """``"geo"`` for near-geosynchronous near-circular orbits (median mean motion 0.9-1.1 rev/day,
     e < 0.1), else ``"leo"`` (the mean-element detector's general case)."""

@@ -61,8 +61,9 @@ and merges the steps of one burn.
 
 from __future__ import annotations
 
+import itertools
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -74,8 +75,17 @@ from abrupt.detect.base import DetectionResult, Diagnostics
 from abrupt.detect.tle.burns import campaign_cadence_s, characterise, label_campaigns
 from abrupt.detect.tle.campaigns import find_campaigns
 from abrupt.detect.tle.config import CAMPAIGN_SIDE_SETS, EXTRA_COLUMNS, TleDetectorConfig
-from abrupt.detect.tle.elements import circular_speed_mps, orbit_regime
+from abrupt.detect.tle.elements import arcs, circular_speed_mps, history_rows, orbit_regime
 from abrupt.detect.tle.noise import block_thresholds, null_threshold, robust_group_weight
+from abrupt.detect.tle.outliers import without_outliers
+from abrupt.detect.tle.response import (
+    blended_sets,
+    burn_grid,
+    interval_cost,
+    local_spans_s,
+    ramp_profile,
+    ramp_span_s,
+)
 from abrupt.detect.tle.segmentation import segment
 from abrupt.detect.tle.steps import (
     StepModel,
@@ -120,6 +130,8 @@ class StepRun:
     stat: NDArray[np.float64]
     threshold: float
     change_points: list[int]
+    # the interval (s) of each detection timed from its blended sets (abrupt.detect.tle.response)
+    ramp_intervals: dict[int, tuple[float, float]] = field(default_factory=dict)
 
 
 def detect_mean_elements(
@@ -131,7 +143,99 @@ def detect_mean_elements(
     all_candidates: bool = False,
     detector_name: str | None = None,
 ) -> DetectionResult:
-    """Detect maneuvers in a mean-element history (module docstring).
+    """Detect maneuvers in a mean-element history (module docstring), arc by arc.
+
+    A gap between sets longer than ``config.max_bridge_days`` ends one analysed arc and starts
+    another (:func:`abrupt.detect.tle.elements.arcs`): each arc is detected on its own
+    (:func:`detect_arc`: its own noise, threshold and outliers) and no event is stated inside the gap.
+    With several arcs the result joins theirs: events of all, one diagnostics whose statistic runs
+    over all arcs (times from the first arc's epoch), the threshold and noise model of the longest
+    arc, with ``arcs`` (each arc's first and last epoch, sets, events), ``unbridged_gaps`` (from, to,
+    days), the arcs' ``detectable_by_year`` and ``outlier_sets`` summed into it.
+    """
+    cfg = config or TleDetectorConfig()
+    run_id = run_id or new_run_id()
+    pieces = arcs(history, cfg.max_bridge_days)
+    if len(pieces) <= 1:
+        return detect_arc(
+            history,
+            cfg,
+            spacecraft=spacecraft,
+            run_id=run_id,
+            all_candidates=all_candidates,
+            detector_name=detector_name,
+        )
+    name = spacecraft or history.name or f"NORAD-{history.norad_id}"
+    results = [
+        detect_arc(
+            history_rows(history, rows),
+            cfg,
+            spacecraft=name,
+            run_id=run_id,
+            all_candidates=all_candidates,
+            detector_name=detector_name,
+        )
+        for rows in pieces
+    ]
+    el = history.elements
+    epoch0 = np.datetime64(int(pd.Timestamp(el["epoch_utc"].iloc[0]).value), "ns")
+    frames = [r.events for r in results if len(r.events)]
+    events = pd.concat(frames, ignore_index=True) if frames else empty_frame(EXTRA_COLUMNS)
+    diags = [r.diagnostics[0] for r in results]
+    longest = int(np.argmax([len(rows) for rows in pieces]))
+    times, stats_ = [], []
+    for d in diags:
+        shift_s = (d.epoch_utc - epoch0) / np.timedelta64(1, "s") if d.epoch_utc is not None else 0.0
+        times.append(np.asarray(d.time_s, dtype=float) + float(shift_s))
+        stats_.append(np.asarray(d.statistic, dtype=float))
+    noise = dict(diags[longest].noise_model or {})
+    noise["arcs"] = [
+        {
+            "first_epoch_utc": str(el["epoch_utc"].iloc[rows[0]]),
+            "last_epoch_utc": str(el["epoch_utc"].iloc[rows[-1]]),
+            "sets": len(rows),
+            "events": len(r.events),
+        }
+        for rows, r in zip(pieces, results, strict=True)
+    ]
+    noise["unbridged_gaps"] = [
+        {
+            "from_utc": str(el["epoch_utc"].iloc[a[-1]]),
+            "to_utc": str(el["epoch_utc"].iloc[b[0]]),
+            "days": (el["epoch_utc"].iloc[b[0]] - el["epoch_utc"].iloc[a[-1]]).total_seconds() / SECONDS_PER_DAY,
+        }
+        for a, b in itertools.pairwise(pieces)
+    ]
+    noise["detectable_by_year"] = [row for d in diags for row in (d.noise_model or {}).get("detectable_by_year", [])]
+    noise["outlier_sets"] = sum(int((d.noise_model or {}).get("outlier_sets", 0)) for d in diags)
+    noise["outlier_epochs_utc"] = [e for d in diags for e in (d.noise_model or {}).get("outlier_epochs_utc", [])]
+    d0 = diags[longest]
+    diag = Diagnostics(
+        name=d0.name,
+        time_s=np.concatenate(times),
+        statistic=np.concatenate(stats_),
+        threshold=d0.threshold,
+        epoch_utc=epoch0,
+        unit=d0.unit,
+        noise_model=noise,
+        extra=d0.extra,
+    )
+    gaps = ", ".join(f"{g['days']:.0f} days from {g['from_utc'][:10]}" for g in noise["unbridged_gaps"])
+    note = f"{len(pieces)} arcs analysed apart: gaps longer than {cfg.max_bridge_days:g} days ({gaps}) are not bridged"
+    warnings_ = (*(w for r in results for w in r.warnings), note)
+    return DetectionResult(events.sort_values("time_utc", kind="stable").reset_index(drop=True), (diag,), warnings_)
+
+
+def detect_arc(
+    history: ElementHistory,
+    config: TleDetectorConfig | None = None,
+    *,
+    spacecraft: str | None = None,
+    run_id: str | None = None,
+    all_candidates: bool = False,
+    detector_name: str | None = None,
+) -> DetectionResult:
+    """Detect maneuvers in one arc of a mean-element history (module docstring).
 
     Returns the events and one :class:`~abrupt.detect.base.Diagnostics` (per-gap statistic at the
     middle of each gap, threshold, the satellite's noise model from :func:`noise_summary`; ``extra``
@@ -148,6 +252,11 @@ def detect_mean_elements(
     cfg_hash = config_hash(cfg.hash_fields())
     name = spacecraft or history.name or (f"NORAD-{history.norad_id}" if len(history) else "unknown")
     fa_per_day = cfg.budget.per_day
+    outlier_epochs = pd.Series([], dtype="datetime64[ns]")
+    if len(history):
+        history, outlier_epochs = without_outliers(
+            history, orbit_regime(history) if cfg.regime == "auto" else cfg.regime
+        )
     el = history.elements
     epoch0 = pd.Timestamp(el["epoch_utc"].iloc[0]) if len(el) else pd.Timestamp("1970-01-01")
     epoch0_np = np.datetime64(int(epoch0.value), "ns")
@@ -170,12 +279,13 @@ def detect_mean_elements(
     candidates = np.sort(np.asarray(accepted, dtype=np.int64))
     change_points = sorted(int(g) for g in candidates if stat[g] >= threshold)
     run = StepRun(history, cfg, regime, model, steps, stat, threshold, change_points)
-    timed = time_candidates(run, candidates, all_candidates)
+    timed = ramp_times(run, time_candidates(run, candidates, all_candidates))
     kept, span_of = merge_candidates(run, timed)
     detected = [it for it in kept if stat[it.gap] >= threshold]
-    lag_s = tle_lag_s(run, detected)
+    lag_s = tle_lag_s(run, [it for it in detected if it.gap not in run.ramp_intervals])
     for g in span_of:
-        span_of[g][0] = min(span_of[g][0], float(model.t[g]) - lag_s)
+        if g not in run.ramp_intervals:  # a ramp-timed burn states its own interval
+            span_of[g][0] = min(span_of[g][0], float(model.t[g]) - lag_s)
     base: dict[str, Any] = {"spacecraft": name, "detector": detector_name, "threshold": threshold}
     base |= {"false_alarms_per_day": fa_per_day}
     base |= {"run_id": run_id, "config_hash": cfg_hash}
@@ -195,6 +305,8 @@ def detect_mean_elements(
     a_med = float(np.median(el["a_m"]))
     noise = noise_summary(steps, model, threshold, a_med, gaps_per_year)
     noise["detectable_by_year"] = detectable_by_year(steps, model, threshold, a_med, epoch0)
+    noise["outlier_sets"] = len(outlier_epochs)
+    noise["outlier_epochs_utc"] = [str(e) for e in outlier_epochs]
     fitted = Threshold(threshold, p_fa, method, n_gaps, fa_per_day)
     diag = _diagnostics(
         detector_name, 0.5 * (steps.t_before_s + steps.t_after_s), stat, fitted, epoch0_np, noise, regime
@@ -302,6 +414,72 @@ def time_candidates(run: StepRun, candidates: NDArray[np.int64], all_candidates:
         # the step when that set was still fitted to pre-burn tracking) to the set after the step
         timed.append(Candidate(int(g), t_m, refined, min(float(t_m), float(model.t[int(g)]))))
     return timed
+
+
+RAMP_LEVEL = 0.9  # nominal coverage of a ramp-timed burn's interval
+RAMP_ERA_DAYS = 182.625  # the fit span of an era: from the ramps within half a year
+
+
+def ramp_times(run: StepRun, timed: list[Candidate]) -> list[Candidate]:
+    """Time in-track LEO detections whose step blends over element sets by the sets' response
+    (:mod:`abrupt.detect.tle.response`).
+
+    The blended sets of every in-track candidate are found; the fit span of each era is learned from
+    the candidates with two or more blends within ``RAMP_ERA_DAYS`` (at least three, else nothing
+    changes there: an era whose sets do not blend keeps the along-track time). A candidate with a
+    blend is then timed by the fit of ``a`` to the response (the burn inside the first blend's span)
+    and states the profile-likelihood interval at ``RAMP_LEVEL`` (``run.ramp_intervals``).
+    """
+    if run.regime != "leo" or not run.cfg.refine_time:
+        return timed
+    model, cfg = run.model, run.cfg
+    a = np.asarray(model.s["a_m"], dtype=float)
+    splits: dict[int, tuple[int, int, int, int, float]] = {}
+    for it in timed:
+        g = it.gap
+        if not has_drift_hinge(run.steps, g, cfg.min_statistic) or is_phasing(run.steps, g):
+            continue
+        seg = segment_bounds(g, [c for c in run.change_points if c != g], len(run.history))
+        lo = max(seg[0], g + 1 - cfg.time_window_sets)
+        hi = min(seg[1], g + 1 + cfg.time_window_sets)
+        sigma = float(model.scales["a_m"][g])
+        if g + 1 - lo < 4 or hi - g - 1 < 3 or not (sigma > 0 and math.isfinite(sigma)):
+            continue
+        last_old, first_new, noise = blended_sets(model.t, a, sigma, lo, hi, g)
+        if first_new - last_old > 1:
+            splits[g] = (lo, hi, last_old, first_new, noise)
+    ramps = {
+        g: (lo, hi, lo_old + 1, noise)
+        for g, (lo, hi, lo_old, first_new, noise) in splits.items()
+        if first_new - lo_old > 2
+    }
+    ramp_t = np.asarray([float(model.t[g]) for g in ramps], dtype=float)
+    ramp_span = np.asarray([ramp_span_s(model.t, a, r) for r in ramps.values()], dtype=float)
+    profiles: dict[int, list[tuple[NDArray[np.float64], NDArray[np.float64]]]] = {}
+    dofs: dict[int, int] = {}
+    for g, (lo, hi, last_old, _, noise) in splits.items():
+        spans = local_spans_s(float(model.t[g]), ramp_t, ramp_span, RAMP_ERA_DAYS * SECONDS_PER_DAY)
+        if not math.isfinite(spans[0]):
+            continue
+        profiles[g] = []
+        for span in spans:  # the era's median span first, then its smallest and largest
+            grid = burn_grid(model.t, last_old + 1, span)
+            profiles[g].append((grid, ramp_profile(model.t, a, lo, hi, grid, span, noise)))
+        dofs[g] = hi - lo - 3
+    if not profiles:
+        return timed
+    rise = interval_cost([float(np.min(p[0][1])) / max(dofs[g], 1) for g, p in profiles.items()], RAMP_LEVEL)
+    out = []
+    for it in timed:
+        if it.gap not in profiles:
+            out.append(it)
+            continue
+        (grid, cost), *others = profiles[it.gap]
+        best = int(np.argmin(cost))
+        inside = np.concatenate([gr[c - np.min(c) <= rise] for gr, c in ((grid, cost), *others)])
+        run.ramp_intervals[it.gap] = (float(inside.min()), float(inside.max()))
+        out.append(Candidate(it.gap, float(grid[best]), True, float(inside.min())))
+    return out
 
 
 DV_KEYS = ("dv_r_mps", "dv_t_mps", "dv_n_mps")
@@ -453,7 +631,8 @@ def merge_candidates(run: StepRun, timed: list[Candidate]) -> tuple[list[Candida
                     near = [retimed]
         if not near:
             kept.append(item)
-            span_of[item.gap] = [item.start_s, float(steps.t_after_s[item.gap])]
+            end_s = run.ramp_intervals.get(item.gap, (item.start_s, float(steps.t_after_s[item.gap])))[1]
+            span_of[item.gap] = [item.start_s, end_s]
         elif stat[item.gap] >= run.threshold:
             host = span_of[near[0].gap]
             host[0] = min(host[0], item.start_s)
