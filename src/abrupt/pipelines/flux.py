@@ -35,15 +35,8 @@ from abrupt.flux.exposure import (
     store_spacecraft_model,
 )
 from abrupt.flux.forward import POPULATIONS, ForwardConfig, OrbitCase, Template, build_template, with_seed
-from abrupt.flux.inference import (
-    FitResult,
-    FluxData,
-    Likelihood,
-    fit,
-    goodness_of_fit,
-    prepare,
-    upper_limit,
-)
+from abrupt.flux.inference import FitResult, FluxData, Likelihood, fit, prepare
+from abrupt.flux.limits import goodness_of_fit, upper_limit
 from abrupt.flux.notes import beta_free_note
 from abrupt.flux.showers import shower_association
 from abrupt.model.spacecraft import Spacecraft, load_spacecraft
