@@ -531,7 +531,7 @@ def fit(
     if "beta" not in fixed and lik.beta_grid.size > 1:
         above = ll >= ll_max - half
         identified = not (above[0] or above[-1])  # the profile stays above the level at an end of the grid
-        if intervals:
+        if intervals and not identified:  # the headline then: each population's expected detections
             for p, name in enumerate(SCALES):
                 if name not in fixed:
                     expected_iv[POPULATIONS[p]] = _expected_interval(

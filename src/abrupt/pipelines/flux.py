@@ -247,8 +247,8 @@ def _matched_sizes(events: pd.DataFrame, exposure: pd.DataFrame, config: Forward
     if len(events) == 0:
         return np.zeros(0)
     days = pd.to_datetime(events["time_utc"].astype(str), utc=True).dt.strftime("%Y-%m-%d")
-    keys = set(zip(exposure["spacecraft"], exposure["day"], strict=True))
-    on = np.array([(str(s), str(d)) in keys for s, d in zip(events["spacecraft"], days, strict=True)])
+    keys = pd.Index(exposure["spacecraft"].astype(str) + "|" + exposure["day"].astype(str))
+    on = np.asarray(pd.Index(events["spacecraft"].astype(str) + "|" + days.astype(str)).isin(keys))
     dh = pd.to_numeric(events["dH_Nms"], errors="coerce").to_numpy()
     ok = on & np.isfinite(dh) & (dh >= config.dH_min_Nms)
     return np.asarray(dh[ok], dtype=np.float64)
