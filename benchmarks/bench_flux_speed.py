@@ -21,7 +21,8 @@ import numpy as np
 import pandas as pd
 
 from abrupt.flux.forward import ForwardConfig, build_template, with_seed
-from abrupt.flux.inference import Likelihood, fit, goodness_of_fit, prepare, upper_limit
+from abrupt.flux.inference import Likelihood, fit, prepare
+from abrupt.flux.limits import goodness_of_fit, upper_limit
 from abrupt.simulate.population import FleetSpec, draw_population, fleet_exposure
 
 ROOT = Path(__file__).resolve().parent.parent

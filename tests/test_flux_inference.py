@@ -19,7 +19,8 @@ from abrupt.flux.exposure import (
     store_exposure,
 )
 from abrupt.flux.forward import DIRECTION_CLASSES, ForwardConfig, OrbitCase, Template
-from abrupt.flux.inference import Likelihood, fit, goodness_of_fit, poisson_upper_limit, prepare, upper_limit
+from abrupt.flux.inference import Likelihood, fit, prepare
+from abrupt.flux.limits import goodness_of_fit, poisson_upper_limit, upper_limit
 from abrupt.simulate.population import FleetSpec, fleet_exposure
 
 CASE = OrbitCase("synthetic.toml", 550.0, 28.5, 2020.0)

@@ -17,7 +17,8 @@ from scipy import integrate
 from abrupt.catalog import Catalog
 from abrupt.flux.exposure import DAYS_PER_YEAR, logistic_efficiency, store_exposure
 from abrupt.flux.forward import DIRECTION_CLASSES, ForwardConfig, OrbitCase, Template
-from abrupt.flux.inference import prepare, upper_limit
+from abrupt.flux.inference import prepare
+from abrupt.flux.limits import upper_limit
 from abrupt.pipelines.flux import infer_flux
 from abrupt.simulate.population import FleetSpec, fleet_exposure
 

@@ -16,7 +16,8 @@ from abrupt.catalog import Catalog
 from abrupt.cli.main import cli
 from abrupt.flux.exposure import DAYS_PER_YEAR, load_exposure
 from abrupt.flux.forward import ForwardConfig, build_template
-from abrupt.flux.inference import Likelihood, expected_bins, prepare
+from abrupt.flux.inference import Likelihood, prepare
+from abrupt.flux.limits import expected_bins
 from abrupt.flux.showers import shower_association, shower_calendar
 from abrupt.simulate.population import FleetSpec, draw_population, fleet_exposure
 
@@ -264,7 +265,7 @@ def test_no_detections_on_three_simulated_spacecraft_years_bound_the_flux_at_2_9
     limit times the expected detections at scale 1, the latter integrated independently on a fine grid
     (20 000 points of ε(x) dG), equals −ln 0.05 = 2.996 within 1 %, for a gentle and a step-like efficiency."""
     from abrupt.flux.exposure import logistic_efficiency
-    from abrupt.flux.inference import upper_limit
+    from abrupt.flux.limits import upper_limit
 
     spec = FleetSpec(FERMI, n_spacecraft=3, years=1.0, dH50_Nms=0.01, efficiency_slope=slope, false_alarms_per_day=0)
     tpl = build_template(spec.case, ForwardConfig(n_draws=50_000))

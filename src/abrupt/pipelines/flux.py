@@ -35,15 +35,8 @@ from abrupt.flux.exposure import (
     store_spacecraft_model,
 )
 from abrupt.flux.forward import POPULATIONS, ForwardConfig, OrbitCase, Template, build_template, with_seed
-from abrupt.flux.inference import (
-    FitResult,
-    FluxData,
-    Likelihood,
-    fit,
-    goodness_of_fit,
-    prepare,
-    upper_limit,
-)
+from abrupt.flux.inference import FitResult, FluxData, Likelihood, fit, prepare
+from abrupt.flux.limits import goodness_of_fit, upper_limit
 from abrupt.flux.notes import beta_free_note
 from abrupt.flux.showers import shower_association
 from abrupt.model.spacecraft import Spacecraft, load_spacecraft
@@ -254,8 +247,8 @@ def _matched_sizes(events: pd.DataFrame, exposure: pd.DataFrame, config: Forward
     if len(events) == 0:
         return np.zeros(0)
     days = pd.to_datetime(events["time_utc"].astype(str), utc=True).dt.strftime("%Y-%m-%d")
-    keys = set(zip(exposure["spacecraft"], exposure["day"], strict=True))
-    on = np.array([(str(s), str(d)) in keys for s, d in zip(events["spacecraft"], days, strict=True)])
+    keys = pd.Index(exposure["spacecraft"].astype(str) + "|" + exposure["day"].astype(str))
+    on = np.asarray(pd.Index(events["spacecraft"].astype(str) + "|" + days.astype(str)).isin(keys))
     dh = pd.to_numeric(events["dH_Nms"], errors="coerce").to_numpy()
     ok = on & np.isfinite(dh) & (dh >= config.dH_min_Nms)
     return np.asarray(dh[ok], dtype=np.float64)
