@@ -8,8 +8,11 @@ import os
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import click
+import numpy as np
+import pandas as pd
 import pytest
 from click.testing import CliRunner
 
@@ -210,3 +213,28 @@ def test_every_leaf_help_imports_no_heavy_package() -> None:
     lines = _probe(_ALL_HELP_PROBE).strip().splitlines()
     assert int(lines[-2].removeprefix("LEAVES=")) > 30
     assert lines[-1] == "HEAVY="
+
+
+@pytest.mark.parametrize("threshold", [18.4, 21.3, 400.0])
+def test_tracking_glrt_threshold_lies_inside_its_panel_under_a_title(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, threshold: float
+) -> None:
+    """The threshold above every T(τ) (a quiet arc) is drawn inside the axes, not on the frame's top edge."""
+    from abrupt.report import tracking as report
+
+    t = pd.date_range("2024-01-01", periods=50, freq="1h")
+    statistic = np.linspace(0.5, 0.7 * threshold, 50)
+    diagnostics = pd.DataFrame({"series": "glrt", "time_utc": t, "glrt_statistic": statistic, "threshold": threshold})
+    figures: list[Any] = []
+    monkeypatch.setattr(report, "save_figure", lambda fig, path, **kw: figures.append(fig) or Path(path))
+    report.plot_tracking_report(diagnostics, path=tmp_path / "t.png", title="W3B.aer")
+    (fig,) = figures
+    (ax,) = fig.axes
+    bottom, top = ax.get_ylim()
+    assert bottom == 0.0 and top > threshold * 1.2
+    # in display units, the threshold line sits clearly below the top edge
+    y_line = ax.transData.transform((0.0, threshold))[1]
+    y_top = ax.transData.transform((0.0, top))[1]
+    y_bottom = ax.transData.transform((0.0, bottom))[1]
+    assert (y_top - y_line) > 0.1 * (y_top - y_bottom)
+    assert ax.get_title().startswith("W3B.aer") and "0 maneuver(s) detected" in ax.get_title()
