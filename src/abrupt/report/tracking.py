@@ -102,7 +102,8 @@ def plot_tracking_report(
                 )
     axes[0, 0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
     axes[-1, 0].set_xlabel("time (UTC)")
-    shown = " and ".join(name for name, rows in (("Kaderali Ψ/K filter", kad), ("GLRT between passes", glrt)) if len(rows))
+    panels_of = (("Kaderali Ψ/K filter", kad), ("GLRT between passes", glrt))
+    shown = " and ".join(name for name, rows in panels_of if len(rows))
     n_found = 0 if events is None else len(events)
     what = title or f"Maneuver detection in ground tracking ({shown})"
     axes[0, 0].set_title(f"{what}: {n_found} maneuver(s) detected", fontsize=10)
