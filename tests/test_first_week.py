@@ -11,11 +11,13 @@ from pathlib import Path
 from typing import Any
 
 import click
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 import pytest
 from click.testing import CliRunner
 
+from abrupt.api import RateConfig, Scenario, expected_rates
 from abrupt.catalog import Catalog
 from abrupt.cli.commands import cli
 from abrupt.cli.main import main
@@ -24,6 +26,9 @@ from abrupt.errors import InputError
 from abrupt.events import Event, events_frame
 from abrupt.kinds import EVENT_KIND_MEANINGS, EVENT_KINDS
 from abrupt.pipelines.flight import day_range
+from abrupt.pipelines.rates import metric_thresholds
+from abrupt.report import tracking as report
+from abrupt.report.rates import rate_curves_figure
 from abrupt.simulate.confounders import CONFOUNDER_CLASS
 from abrupt.store import TelemetryStore
 
@@ -220,8 +225,6 @@ def test_tracking_glrt_threshold_lies_inside_its_panel_under_a_title(
     monkeypatch: pytest.MonkeyPatch, tmp_path: Path, threshold: float
 ) -> None:
     """The threshold above every T(τ) (a quiet arc) is drawn inside the axes, not on the frame's top edge."""
-    from abrupt.report import tracking as report
-
     t = pd.date_range("2024-01-01", periods=50, freq="1h")
     statistic = np.linspace(0.5, 0.7 * threshold, 50)
     diagnostics = pd.DataFrame({"series": "glrt", "time_utc": t, "glrt_statistic": statistic, "threshold": threshold})
@@ -238,3 +241,23 @@ def test_tracking_glrt_threshold_lies_inside_its_panel_under_a_title(
     y_bottom = ax.transData.transform((0.0, bottom))[1]
     assert (y_top - y_line) > 0.1 * (y_top - y_bottom)
     assert ax.get_title().startswith("W3B.aer") and "0 maneuver(s) detected" in ax.get_title()
+
+
+def test_rate_plot_spans_the_table_thresholds_and_marks_them_on_the_curve() -> None:
+    """The rate figure reads at the thresholds the table prints (1e-3 to 1 N·m·s), where real detectors
+    work (0.02-1 N·m·s), not only over the bulk of the draws (which ended near 3e-3 N·m·s)."""
+    spacecraft = str(ROOT / "examples" / "spacecraft" / "oco2_like.toml")
+    case = expected_rates(Scenario(spacecraft=spacecraft, altitude_km=700.0, config=RateConfig(n_draws=2000)))
+    table = metric_thresholds("dH", None, True)
+    fig = rate_curves_figure([case], "dH", marked=table)
+    (ax,) = fig.axes
+    low, high = ax.get_xlim()
+    assert low <= min(table) and high >= max(table) >= 1.0
+    curve = ax.lines[0]
+    assert max(curve.get_xdata()) >= 1.0  # the curve itself reaches the table's largest threshold
+    points = next(line for line in ax.lines if line.get_marker() == "o" and len(line.get_xdata()))
+    expected = case.detectable_per_year("dH", np.asarray(table, dtype=float))
+    shown = expected > 0
+    np.testing.assert_allclose(points.get_xdata(), np.asarray(table)[shown])
+    np.testing.assert_allclose(points.get_ydata(), expected[shown])
+    plt.close(fig)
