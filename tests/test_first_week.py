@@ -4,6 +4,7 @@ thresholds."""
 
 from __future__ import annotations
 
+import logging
 import os
 import subprocess
 import sys
@@ -11,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 import click
+import dask
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
@@ -29,6 +31,7 @@ from abrupt.pipelines.flight import day_range
 from abrupt.pipelines.rates import metric_thresholds
 from abrupt.report import tracking as report
 from abrupt.report.rates import rate_curves_figure
+from abrupt.scale import Executor, WorkerLostError, dask_log_level, run_tasks
 from abrupt.simulate.confounders import CONFOUNDER_CLASS
 from abrupt.store import TelemetryStore
 
@@ -261,3 +264,42 @@ def test_rate_plot_spans_the_table_thresholds_and_marks_them_on_the_curve() -> N
     np.testing.assert_allclose(points.get_xdata(), np.asarray(table)[shown])
     np.testing.assert_allclose(points.get_ydata(), expected[shown])
     plt.close(fig)
+
+
+#: A fleet run's Dask cluster as the command line starts it (warnings and above shown), with tasks that
+#: leave their worker slow to exit (an interpreter shutdown of 6 s, as after importing numba, scipy and
+#: astropy on a loaded machine): Dask's nanny used to kill such a worker after 4 s with a warning.
+_SLOW_EXIT_CLUSTER = """
+import atexit, functools, logging, time
+logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s", force=True)
+from abrupt.scale import Executor, run_tasks
+print(run_tasks(functools.partial(atexit.register, time.sleep), [6.0, 6.0], executor=Executor(workers=2)))
+"""
+
+
+def test_a_local_cluster_starts_and_closes_without_a_word_on_standard_error() -> None:
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    done = subprocess.run(
+        [sys.executable, "-c", _SLOW_EXIT_CLUSTER], env=env, capture_output=True, text=True, timeout=300
+    )
+    assert done.returncode == 0, done.stderr
+    assert "sleep" in done.stdout  # both tasks ran
+    assert done.stderr.strip() == ""  # no INFO of distributed, no "still alive ... killing", no traceback
+
+
+def test_dask_logs_what_the_user_asked_for() -> None:
+    root = logging.getLogger()
+    before = root.level
+    try:
+        for level, expected in ((logging.WARNING, logging.ERROR), (logging.INFO, logging.INFO), (10, 10)):
+            root.setLevel(level)
+            assert dask_log_level() == expected
+    finally:
+        root.setLevel(before)
+
+
+def test_a_worker_that_dies_is_one_clear_error_naming_the_task() -> None:
+    """The task kills its worker process (exit status 3), as an out-of-memory kill would."""
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        with pytest.raises(WorkerLostError, match=r"died while running task 1 of 1 \(3\).*KilledWorker"):
+            run_tasks(os._exit, [3], executor=Executor(workers=1))
