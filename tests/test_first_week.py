@@ -4,15 +4,22 @@ thresholds."""
 
 from __future__ import annotations
 
+import logging
 import os
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import click
+import dask
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
 import pytest
 from click.testing import CliRunner
 
+from abrupt.api import RateConfig, Scenario, expected_rates
 from abrupt.catalog import Catalog
 from abrupt.cli.commands import cli
 from abrupt.cli.main import main
@@ -21,6 +28,10 @@ from abrupt.errors import InputError
 from abrupt.events import Event, events_frame
 from abrupt.kinds import EVENT_KIND_MEANINGS, EVENT_KINDS
 from abrupt.pipelines.flight import day_range
+from abrupt.pipelines.rates import metric_thresholds
+from abrupt.report import tracking as report
+from abrupt.report.rates import rate_curves_figure
+from abrupt.scale import Executor, WorkerLostError, dask_log_level, run_tasks
 from abrupt.simulate.confounders import CONFOUNDER_CLASS
 from abrupt.store import TelemetryStore
 
@@ -210,3 +221,85 @@ def test_every_leaf_help_imports_no_heavy_package() -> None:
     lines = _probe(_ALL_HELP_PROBE).strip().splitlines()
     assert int(lines[-2].removeprefix("LEAVES=")) > 30
     assert lines[-1] == "HEAVY="
+
+
+@pytest.mark.parametrize("threshold", [18.4, 21.3, 400.0])
+def test_tracking_glrt_threshold_lies_inside_its_panel_under_a_title(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, threshold: float
+) -> None:
+    """The threshold above every T(τ) (a quiet arc) is drawn inside the axes, not on the frame's top edge."""
+    t = pd.date_range("2024-01-01", periods=50, freq="1h")
+    statistic = np.linspace(0.5, 0.7 * threshold, 50)
+    diagnostics = pd.DataFrame({"series": "glrt", "time_utc": t, "glrt_statistic": statistic, "threshold": threshold})
+    figures: list[Any] = []
+    monkeypatch.setattr(report, "save_figure", lambda fig, path, **kw: figures.append(fig) or Path(path))
+    report.plot_tracking_report(diagnostics, path=tmp_path / "t.png", title="W3B.aer")
+    (fig,) = figures
+    (ax,) = fig.axes
+    bottom, top = ax.get_ylim()
+    assert bottom == 0.0 and top > threshold * 1.2
+    # in display units, the threshold line sits clearly below the top edge
+    y_line = ax.transData.transform((0.0, threshold))[1]
+    y_top = ax.transData.transform((0.0, top))[1]
+    y_bottom = ax.transData.transform((0.0, bottom))[1]
+    assert (y_top - y_line) > 0.1 * (y_top - y_bottom)
+    assert ax.get_title().startswith("W3B.aer") and "0 maneuver(s) detected" in ax.get_title()
+
+
+def test_rate_plot_spans_the_table_thresholds_and_marks_them_on_the_curve() -> None:
+    """The rate figure reads at the thresholds the table prints (1e-3 to 1 N·m·s), where real detectors
+    work (0.02-1 N·m·s), not only over the bulk of the draws (which ended near 3e-3 N·m·s)."""
+    spacecraft = str(ROOT / "examples" / "spacecraft" / "oco2_like.toml")
+    case = expected_rates(Scenario(spacecraft=spacecraft, altitude_km=700.0, config=RateConfig(n_draws=2000)))
+    table = metric_thresholds("dH", None, True)
+    fig = rate_curves_figure([case], "dH", marked=table)
+    (ax,) = fig.axes
+    low, high = ax.get_xlim()
+    assert low <= min(table) and high >= max(table) >= 1.0
+    curve = ax.lines[0]
+    assert max(curve.get_xdata()) >= 1.0  # the curve itself reaches the table's largest threshold
+    points = next(line for line in ax.lines if line.get_marker() == "o" and len(line.get_xdata()))
+    expected = case.detectable_per_year("dH", np.asarray(table, dtype=float))
+    shown = expected > 0
+    np.testing.assert_allclose(points.get_xdata(), np.asarray(table)[shown])
+    np.testing.assert_allclose(points.get_ydata(), expected[shown])
+    plt.close(fig)
+
+
+#: A fleet run's Dask cluster as the command line starts it (warnings and above shown), with tasks that
+#: leave their worker slow to exit (an interpreter shutdown of 6 s, as after importing numba, scipy and
+#: astropy on a loaded machine): Dask's nanny used to kill such a worker after 4 s with a warning.
+_SLOW_EXIT_CLUSTER = """
+import atexit, functools, logging, time
+logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s", force=True)
+from abrupt.scale import Executor, run_tasks
+print(run_tasks(functools.partial(atexit.register, time.sleep), [6.0, 6.0], executor=Executor(workers=2)))
+"""
+
+
+def test_a_local_cluster_starts_and_closes_without_a_word_on_standard_error() -> None:
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    done = subprocess.run(
+        [sys.executable, "-c", _SLOW_EXIT_CLUSTER], env=env, capture_output=True, text=True, timeout=300
+    )
+    assert done.returncode == 0, done.stderr
+    assert "sleep" in done.stdout  # both tasks ran
+    assert done.stderr.strip() == ""  # no INFO of distributed, no "still alive ... killing", no traceback
+
+
+def test_dask_logs_what_the_user_asked_for() -> None:
+    root = logging.getLogger()
+    before = root.level
+    try:
+        for level, expected in ((logging.WARNING, logging.ERROR), (logging.INFO, logging.INFO), (10, 10)):
+            root.setLevel(level)
+            assert dask_log_level() == expected
+    finally:
+        root.setLevel(before)
+
+
+def test_a_worker_that_dies_is_one_clear_error_naming_the_task() -> None:
+    """The task kills its worker process (exit status 3), as an out-of-memory kill would."""
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        with pytest.raises(WorkerLostError, match=r"died while running task 1 of 1 \(3\).*KilledWorker"):
+            run_tasks(os._exit, [3], executor=Executor(workers=1))

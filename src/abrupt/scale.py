@@ -24,10 +24,27 @@ from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
 
 from abrupt import progress
-from abrupt.errors import ConfigError
+from abrupt.errors import AbruptError, ConfigError
 
 T = TypeVar("T")
 R = TypeVar("R")
+
+#: Seconds a local worker process gets to finish and exit when the cluster closes. Dask's nanny waits
+#: 4 s and then kills it with a warning; a worker that imported numba, scipy and astropy needs about
+#: 1 s of interpreter shutdown alone on an idle machine, several on a loaded one.
+WORKER_CLOSE_TIMEOUT_S = 60.0
+
+
+class WorkerLostError(AbruptError):
+    """A Dask worker process died (killed, out of memory, crashed) while running a task."""
+
+
+def dask_log_level() -> int:
+    """The level of Dask's own loggers: what the caller's logging shows (``-v`` info, ``-vv`` debug),
+    but only errors when it shows warnings and above (Dask's start-up and shutdown notes are noise
+    to a user who did not ask for them)."""
+    level = logging.getLogger().getEffectiveLevel()
+    return level if level < logging.WARNING else logging.ERROR
 
 
 @dataclass(frozen=True)
@@ -69,7 +86,15 @@ class TaskResult(Generic[T, R]):
 def dask_client(executor: Executor) -> Iterator[Any]:
     """A :class:`distributed.Client` for the executor (a local cluster is shut down afterwards)."""
     import dask
-    from distributed import Client, LocalCluster
+    from distributed import Client, LocalCluster, Nanny
+
+    logging.getLogger("distributed").setLevel(dask_log_level())  # after its import set it to info
+
+    class PatientNanny(Nanny):  # type: ignore[misc]
+        """A nanny that lets its worker process exit by itself on close (Dask's waits 4 s, then kills)."""
+
+        async def close(self, timeout: float = WORKER_CLOSE_TIMEOUT_S, reason: str = "nanny-close") -> Any:
+            return await super().close(timeout=max(timeout, WORKER_CLOSE_TIMEOUT_S), reason=reason)
 
     if executor.scheduler:
         try:
@@ -91,8 +116,9 @@ def dask_client(executor: Executor) -> Iterator[Any]:
             n_workers=executor.workers,
             threads_per_worker=executor.threads_per_worker,
             processes=True,
+            worker_class=PatientNanny,
             dashboard_address=":0",  # any free port: None means the configured :8787, taken by a second run
-            silence_logs=logging.ERROR,
+            silence_logs=dask_log_level(),
         ) as cluster,
         Client(cluster) as client,
     ):
@@ -160,7 +186,7 @@ def run_tasks(
             queue = as_completed(first)
             for future in queue:
                 i = index.pop(future.key)
-                result = future.result()
+                result = task_result(future, i, tasks)
                 future.release()
                 take(i, result)
                 bar.update(1)
@@ -169,3 +195,21 @@ def run_tasks(
                 if nxt is not None:
                     queue.add(nxt)
     return results
+
+
+def task_result(future: Any, index: int, tasks: Sequence[Any]) -> Any:
+    """The result of task ``index``; :class:`WorkerLostError` (one line, naming the task) when the worker
+    process running it died, instead of Dask's ``KilledWorker`` traceback. A task's own error is raised
+    as it is."""
+    from distributed.comm.core import CommClosedError
+    from distributed.scheduler import KilledWorker
+
+    try:
+        return future.result()
+    except (KilledWorker, CommClosedError) as exc:
+        task = tasks[index]
+        name = getattr(task, "path", None) or getattr(task, "name", None) or repr(task)
+        raise WorkerLostError(
+            f"a Dask worker process died while running task {index + 1} of {len(tasks)} ({str(name)[:120]}): "
+            f"{type(exc).__name__}; it was killed, ran out of memory or crashed (see the worker's messages with -v)"
+        ) from None

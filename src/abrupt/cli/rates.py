@@ -195,11 +195,9 @@ def _report(results: Sequence[Any], kw: dict[str, Any]) -> None:
             frame.to_csv(tmp, index=False)
         click.echo(f"table written to {kw['out']}", err=True)
     if kw["plot"]:
-        m = metrics[0]
-        thr_plot = None
-        if kw["thresholds"]:
-            thr_plot = np.asarray(pipelines_rates.metric_thresholds(m, kw["thresholds"], True), dtype=np.float64)
-        report_rates.plot_rate_curves(results, m, kw["plot"], thresholds=thr_plot)
+        m = metrics[0]  # the curves span the draws and the table's thresholds, marked on them
+        table = pipelines_rates.metric_thresholds(m, kw["thresholds"], True)
+        report_rates.plot_rate_curves(results, m, kw["plot"], marked=table)
         click.echo(f"plot written to {kw['plot']}", err=True)
     if kw["scatter"]:
         report_rates.plot_dh_dv_scatter(results, kw["scatter"])

@@ -313,7 +313,8 @@ def detect_tracking_command(
     if report_path and len(run.diagnostics):
         diag = run.diagnostics.copy()
         diag["time_utc"] = pd.to_datetime(diag["time_utc"])
-        report_tracking.plot_tracking_report(diag, events=run.events, path=report_path)
+        title = f"{Path(file).name}: maneuver detection in ground tracking"
+        report_tracking.plot_tracking_report(diag, events=run.events, path=report_path, title=title)
         click.echo(f"report written to {report_path}", err=True)
 
 
@@ -334,5 +335,6 @@ def report_tracking_command(diagnostics: str, events_path: str | None, truth_pat
     events = abrupt_events.read_events(events_path) if events_path else None
     truth = abrupt_events.read_events(truth_path) if truth_path else None
     for _ in progress([0], total=1, desc="report"):
-        report_tracking.plot_tracking_report(diag, events=events, truth=truth, path=out)
+        title = f"{Path(diagnostics).name}: maneuver detection in ground tracking"
+        report_tracking.plot_tracking_report(diag, events=events, truth=truth, path=out, title=title)
     click.echo(f"report written to {out}", err=True)

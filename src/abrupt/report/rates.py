@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -93,26 +94,63 @@ def plot_rate_curves(
     out: str | Path,
     *,
     thresholds: NDArray[np.float64] | None = None,
+    marked: Sequence[float] = (),
     title: str = "",
 ) -> Path:
-    """Log-log plot of detectable strikes per year against threshold, one curve per case."""
+    """Log-log plot of detectable strikes per year against threshold, one curve per case, written to ``out``
+    (:func:`rate_curves_figure`)."""
+    import matplotlib.pyplot as plt
+
+    fig = rate_curves_figure(results, metric, thresholds=thresholds, marked=marked, title=title)
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_output(out) as tmp:
+        fig.savefig(tmp, dpi=120)
+    plt.close(fig)
+    return out
+
+
+def rate_curves_figure(
+    results: Sequence[CaseResult],
+    metric: str,
+    *,
+    thresholds: NDArray[np.float64] | None = None,
+    marked: Sequence[float] = (),
+    title: str = "",
+) -> Any:
+    """The figure of detectable strikes per year against threshold [SI], one curve per case.
+
+    ``thresholds``: the grid of the curves (default: the flux-weighted draws' range,
+    :func:`default_thresholds`), widened to span ``marked``: the thresholds of the printed table, each
+    drawn as a point on every curve, so the figure reads at the same thresholds as the table.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     label, scale = METRIC_LABELS[metric]
-    t = default_thresholds(results, metric) if thresholds is None else np.asarray(thresholds)
+    t = default_thresholds(results, metric) if thresholds is None else np.asarray(thresholds, dtype=np.float64)
+    table = np.asarray([v for v in marked if v > 0], dtype=np.float64)
+    if table.size:
+        lo, hi = min(t.min(), table.min() / 1.5), max(t.max(), table.max() * 1.5)
+        t = np.unique(np.concatenate([t, np.logspace(np.log10(lo), np.log10(hi), 80), table]))
     fig, ax = plt.subplots(figsize=(7.5, 5.0))
     for r in results:
         rate = r.detectable_per_year(metric, t)
         sigma = detectable_rate_sigma(r, metric, t)
         ok = rate > 0
         (line,) = ax.loglog(t[ok] * scale, rate[ok], label=r.label, drawstyle="steps-post")
-        lo = np.maximum(rate - 2 * sigma, rate * 1e-3)
+        lo_band = np.maximum(rate - 2 * sigma, rate * 1e-3)
         ax.fill_between(
-            t[ok] * scale, lo[ok], (rate + 2 * sigma)[ok], step="post", color=line.get_color(), alpha=0.2, lw=0
+            t[ok] * scale, lo_band[ok], (rate + 2 * sigma)[ok], step="post", color=line.get_color(), alpha=0.2, lw=0
         )
+        if table.size:
+            at = r.detectable_per_year(metric, table)
+            shown = at > 0
+            ax.plot(table[shown] * scale, at[shown], "o", ms=4, color=line.get_color())
+    if table.size:
+        ax.plot([], [], "o", ms=4, color="0.3", label="thresholds of the table")
     ax.fill_between([], [], [], color="0.5", alpha=0.2, label="±2σ Monte Carlo")
     ax.set_xlabel(label)
     ax.set_ylabel("expected detectable strikes per year")
@@ -121,12 +159,7 @@ def plot_rate_curves(
     ax.set_title(title or what + (f"\n{scenario_title(results)}" if scenario_title(results) else ""), fontsize=10)
     ax.legend(fontsize=7)
     fig.tight_layout()
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_output(out) as tmp:
-        fig.savefig(tmp, dpi=120)
-    plt.close(fig)
-    return out
+    return fig
 
 
 def plot_dh_dv_scatter(results: Sequence[CaseResult], out: str | Path, *, max_points: int = 20_000) -> Path:

@@ -22,8 +22,10 @@ def plot_tracking_report(
     events: pd.DataFrame | None = None,
     truth: pd.DataFrame | None = None,
     path: str | Path,
+    title: str = "",
 ) -> Path:
-    """Draw the panels present in ``diagnostics`` (series ``kaderali`` and/or ``glrt``) to ``path``."""
+    """Draw the panels present in ``diagnostics`` (series ``kaderali`` and/or ``glrt``) to ``path``, under
+    ``title`` (default: what the figure shows) with the number of events detected."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -53,7 +55,10 @@ def plot_tracking_report(
         ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
         ax = ax_of["k"]
         ax.plot(t, kad["k_db"].to_numpy(dtype=float), ".", ms=2, color="tab:green")
-        ax.axhline(20 * np.log10(th + 1), color="tab:red", lw=1, label="detection K")
+        k_th = 20 * np.log10(th + 1)
+        ax.axhline(k_th, color="tab:red", lw=1, label=f"detection K = {k_th:.1f} dB")
+        k_db = kad["k_db"].to_numpy(dtype=float)
+        ax.set_ylim(top=1.25 * max(float(np.nanmax(k_db)) if np.isfinite(k_db).any() else k_th, k_th))
         ax.set_ylabel("K = 20 log10(Ψ+1) (dB)")
         ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
     if len(glrt):
@@ -65,15 +70,20 @@ def plot_tracking_report(
             color="tab:purple",
         )
         g_th = glrt["threshold"].to_numpy(dtype=float)
-        if np.isfinite(g_th).any():
-            g_value = float(np.nanmax(g_th))
+        g_value = float(np.nanmax(g_th)) if np.isfinite(g_th).any() else float("nan")
+        if np.isfinite(g_value):
             ax.axhline(g_value, color="tab:red", lw=1, label=f"GLRT threshold T = {g_value:.1f}")
             ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
         ax.set_ylabel("GLRT T(τ) (χ²₃, dimensionless)")
-        ax.set_yscale("symlog", linthresh=10.0)
-        ax.set_ylim(bottom=0.0)  # T(τ) >= 0: no negative half of the symlog axis
-        ax.yaxis.set_major_locator(ticker.SymmetricalLogLocator(base=10, linthresh=10.0, subs=(1.0,)))
-        ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+        statistic = glrt["glrt_statistic"].to_numpy(dtype=float)
+        top = np.nanmax(np.append(statistic[np.isfinite(statistic)], [g_value if np.isfinite(g_value) else 1.0]))
+        if top > 100.0:  # a wide range: symmetric log, decades labelled
+            ax.set_yscale("symlog", linthresh=10.0)
+            ax.yaxis.set_major_locator(ticker.SymmetricalLogLocator(base=10, linthresh=10.0, subs=(1.0,)))
+            ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+            ax.set_ylim(0.0, top * 3.0)  # T(τ) >= 0; the threshold line inside the panel, not on its edge
+        else:
+            ax.set_ylim(0.0, top * 1.25)
     for frame, style, label in ((events, "--", "detected"), (truth, ":", "truth")):
         if frame is None or len(frame) == 0:
             continue
@@ -92,6 +102,11 @@ def plot_tracking_report(
                 )
     axes[0, 0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
     axes[-1, 0].set_xlabel("time (UTC)")
+    panels_of = (("Kaderali Ψ/K filter", kad), ("GLRT between passes", glrt))
+    shown = " and ".join(name for name, rows in panels_of if len(rows))
+    n_found = 0 if events is None else len(events)
+    what = title or f"Maneuver detection in ground tracking ({shown})"
+    axes[0, 0].set_title(f"{what}: {n_found} maneuver(s) detected", fontsize=10)
     fig.tight_layout()
     return save_figure(fig, path)
 
