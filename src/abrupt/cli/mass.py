@@ -7,10 +7,12 @@ from typing import Any
 
 import click
 import numpy as np
+import pandas as pd
 
 from abrupt.cli.groups import catalog_option, check_suffix, cli, detect, record_run, simulate
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.detect.base import DetectionResult
+from abrupt.detect.mass.inertia_change import InertiaChangeDetector
 from abrupt.events import config_hash, new_run_id, read_events
 from abrupt.massprops.track import InertiaTrack
 from abrupt.pipelines.mass import (
@@ -174,6 +176,20 @@ def detect_mass_change_cmd(
         config_hash=cfg,
         run_id=run_id,
         out=out,
+        spacecraft=track.spacecraft,
+        detectors=[InertiaChangeDetector.name],
+        span_utc=_track_span_utc(track),
+    )
+
+
+def _track_span_utc(track: InertiaTrack) -> tuple[Any, Any] | None:
+    """First window start to last window end (UTC) of the inertia track: the data the run analysed."""
+    if track.n_windows == 0:
+        return None
+    epoch = pd.Timestamp(track.epoch_utc)
+    return (
+        epoch + pd.Timedelta(seconds=float(np.min(track.t_start_s))),
+        epoch + pd.Timedelta(seconds=float(np.max(track.t_end_s))),
     )
 
 
