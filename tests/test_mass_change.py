@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import sqlite3
 
 import numpy as np
 import pandas as pd
@@ -262,8 +263,6 @@ def test_cli_detect_mass_change_runs_on_simulated_docking(tmp_path):
     assert "windows; GLR statistic max" in r.output
     assert events.exists()
     # the catalog records the span of the windows analysed (0.4 simulated days), a result even without an event
-    import sqlite3
-
     with sqlite3.connect(tmp_path / "c.sqlite") as conn:
         ((sc_name, start, end, span_of),) = conn.execute("SELECT spacecraft, start_utc, end_utc, span_of FROM coverage")
     days = (pd.Timestamp(end) - pd.Timestamp(start)).total_seconds() / 86400.0
