@@ -126,8 +126,9 @@ def test_short_arc_fit_brings_the_sgp4_state_to_the_simulated_orbit(
     assert np.linalg.norm(x_sgp4[:3] - x_true[:3]) > 1_000.0  # the element set is kilometres off
     cfg = replace(LASER_FIT_CONFIG, force=sim.scenario.force)
     x_fit, info = short_arc_fit(meas, sites, stations, x_sgp4, epoch, cfg)
-    assert np.linalg.norm(x_fit[:3] - x_true[:3]) < 2.0  # [m]; range biases of 5 mm and SRP are not fitted
-    assert np.linalg.norm(x_fit[3:] - x_true[3:]) < 2e-3  # [m/s]
+    # measured 9 mm and 6 µm/s from 50 km and 20 m/s; range biases (5 mm spread) are not fitted here
+    assert np.linalg.norm(x_fit[:3] - x_true[:3]) < 0.2  # [m]
+    assert np.linalg.norm(x_fit[3:] - x_true[3:]) < 1e-4  # [m/s]
     assert float(info["short_arc_rms_m"]) < 0.1  # type: ignore[arg-type]
 
 
