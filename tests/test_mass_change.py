@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import sqlite3
 
 import numpy as np
 import pandas as pd
@@ -261,6 +262,11 @@ def test_cli_detect_mass_change_runs_on_simulated_docking(tmp_path):
     assert r.exit_code == 0, r.output
     assert "windows; GLR statistic max" in r.output
     assert events.exists()
+    # the catalog records the span of the windows analysed (0.4 simulated days), a result even without an event
+    with sqlite3.connect(tmp_path / "c.sqlite") as conn:
+        ((sc_name, start, end, span_of),) = conn.execute("SELECT spacecraft, start_utc, end_utc, span_of FROM coverage")
+    days = (pd.Timestamp(end) - pd.Timestamp(start)).total_seconds() / 86400.0
+    assert sc_name == "SC-E" and span_of == "data" and 0.3 < days <= 0.4 + 1e-6
 
 
 @pytest.mark.slow

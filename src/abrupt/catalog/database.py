@@ -688,7 +688,8 @@ def coverage_of(
     if len(events):
         times = pd.to_datetime(events["time_utc"].astype(str), utc=True)
         groups = times.groupby([events["spacecraft"].astype(str), events["detector"].astype(str)])
-        for (sc, det), t in groups:
+        for key, t in groups:
+            sc, det = str(key[0]), str(key[1])
             if (sc, det) not in seen:
                 seen.add((sc, det))
                 out.append(

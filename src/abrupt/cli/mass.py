@@ -14,9 +14,11 @@ from abrupt.outputs import write_text_atomic
 
 if TYPE_CHECKING:
     import numpy as np
+    import pandas as pd
 
     from abrupt import events
     from abrupt.detect import base as detect_base
+    from abrupt.detect.mass import inertia_change as detect_mass_inertia_change
     from abrupt.massprops import track as massprops_track
     from abrupt.pipelines import mass as pipelines_mass
     from abrupt.simulate import docking as simulate_docking
@@ -29,6 +31,8 @@ else:
     simulate_docking = lazy_module("abrupt.simulate.docking")
     simulate_pointing = lazy_module("abrupt.simulate.pointing")
     np = lazy_module("numpy")
+    pd = lazy_module("pandas")
+    detect_mass_inertia_change = lazy_module("abrupt.detect.mass.inertia_change")
 
 #: The mass-change detector's default false-alarm budget: one per satellite-year (daily windows).
 MASS_CHANGE_BUDGET = "1/year"
@@ -184,6 +188,20 @@ def detect_mass_change_cmd(
         config_hash=cfg,
         run_id=run_id,
         out=out,
+        spacecraft=track.spacecraft,
+        detectors=[detect_mass_inertia_change.InertiaChangeDetector.name],
+        span_utc=_track_span_utc(track),
+    )
+
+
+def _track_span_utc(track: massprops_track.InertiaTrack) -> tuple[Any, Any] | None:
+    """First window start to last window end (UTC) of the inertia track: the data the run analysed."""
+    if track.n_windows == 0:
+        return None
+    epoch = pd.Timestamp(track.epoch_utc)
+    return (
+        epoch + pd.Timedelta(seconds=float(np.min(track.t_start_s))),
+        epoch + pd.Timedelta(seconds=float(np.max(track.t_end_s))),
     )
 
 

@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 from sgp4.api import Satrec
 
 from abrupt.model.timescales import offline_astropy
+from abrupt.model.tracking_measurements import as_datetime64_ns
 from abrupt.types import FloatArray
 
 
@@ -50,7 +51,7 @@ def sgp4_state_gcrf(satrec: Satrec, time_utc: np.datetime64) -> FloatArray:
     SGP4's time argument is the UTC Julian date (as element-set epochs are UTC); an element set SGP4
     cannot propagate to that time (decayed, error code) is a :class:`ValueError`.
     """
-    t = np.datetime64(time_utc, "ns")
+    t = as_datetime64_ns(time_utc)
     days = (t - np.datetime64("1949-12-31T00:00:00", "ns")) / np.timedelta64(1, "D")
     jd = 2433281.5 + float(days)  # JD of 1949-12-31 00:00 UTC
     err, r_km, v_kms = satrec.sgp4(np.floor(jd), jd - np.floor(jd))

@@ -6,9 +6,10 @@ off, too far for the detector's fit of a week of ranges (Gauss-Newton converges 
 over a day; :mod:`abrupt.detect.tracking.laser`). So the a-priori state is first fitted to the ranges
 themselves over a short arc that grows (:data:`SHORT_ARC_HOURS`: 6, 12, 24, 48 h, the ranges there
 are): the state only (no station biases, no force scales: a few passes cannot separate them), each
-span started from the last one's state, then the state is the a-priori of the detection. A short arc
-holds no maneuver often enough; a fit that does not reach the ranges' own precision
-(:data:`MAX_SHORT_ARC_RMS_M`) is refused with the figure, never passed on.
+span started from the last one's state, then the state is the a-priori of the detection. A span whose
+fit does not reach the ranges' own precision (:data:`MAX_SHORT_ARC_RMS_M`) holds a maneuver (or did
+not converge): the growth stops at the span before it; when even the first span does not fit, the
+run is refused with the figure, never passed on.
 
 The element set nearest in time to the arc is used; one more than :data:`MAX_ELEMENT_AGE_DAYS` from
 it is refused (SGP4 errors grow by kilometres a day).
@@ -29,6 +30,7 @@ from abrupt.model.orbit.batch_fit import BatchFitConfig, fit_orbit
 from abrupt.model.range_reduction import RangeModel, StationSite
 from abrupt.model.stations import Station
 from abrupt.model.teme import sgp4_state_gcrf
+from abrupt.model.tracking_measurements import as_datetime64_ns
 from abrupt.readers.omm import read_element_histories
 from abrupt.readers.tle import ElementHistory, is_tle_text, read_element_bytes
 from abrupt.series.tracking import LaserRangingSeries
@@ -74,7 +76,7 @@ class ElementApriori:
     def nearest(self, time_utc: np.datetime64) -> tuple[int, float]:
         """Index of the element set nearest in time, and its distance [days]."""
         epochs = np.asarray(self.history.elements["epoch_utc"], dtype="datetime64[ns]")
-        gaps = np.abs((epochs - np.datetime64(time_utc, "ns")) / np.timedelta64(1, "D")).astype(float)
+        gaps = np.abs((epochs - as_datetime64_ns(time_utc)) / np.timedelta64(1, "D")).astype(float)
         k = int(np.argmin(gaps))
         return k, float(gaps[k])
 
@@ -101,13 +103,13 @@ def short_arc_fit(
     """The GCRF state at ``epoch_utc`` fitted to the ranges of the first hours from ``x0_sgp4`` (module
     docstring), and a summary: spans fitted, post-fit RMS [m], the SGP4 state's position and velocity
     offsets from the fitted one [m, m/s]. A fit above :data:`MAX_SHORT_ARC_RMS_M` is an InputError."""
-    epoch = np.datetime64(epoch_utc, "ns")
+    epoch = as_datetime64_ns(epoch_utc)
     t_rel = (np.asarray(measurements["time_utc"], dtype="datetime64[ns]") - epoch) / np.timedelta64(1, "s")
     model_f = fit_config.force.model if isinstance(fit_config.force, ForceContext) else fit_config.force
     cfg = replace(fit_config, estimate_range_bias=False, estimate_time_bias=False, estimate_scales=())
     x = np.asarray(x0_sgp4, float).copy()
     spans: list[float] = []
-    rms_m = math.inf
+    rms_m, worst = math.inf, (0.0, math.inf)
     n_fitted = 0
     for hours in SHORT_ARC_HOURS:
         sel = (t_rel >= 0.0) & (t_rel <= hours * 3600.0)
@@ -122,20 +124,24 @@ def short_arc_fit(
         )
         data = series.reduced(x, {})
         fit = fit_orbit(data, x, config=series.fit_config)
-        x = np.asarray(fit.x0, float)
         resid_m = fit.residuals_white * data.sigma[fit.row_index, fit.row_component]
-        rms_m = float(np.sqrt(np.mean(resid_m[fit.used] ** 2)))
+        span_rms_m = float(np.sqrt(np.mean(resid_m[fit.used] ** 2)))
+        if not span_rms_m <= MAX_SHORT_ARC_RMS_M:
+            # a maneuver inside the longer span (or no convergence): keep the last span that fitted
+            worst = (hours, span_rms_m)
+            break
+        x, rms_m = np.asarray(fit.x0, float), span_rms_m
         spans.append(hours)
-    if not spans:
+    if n_fitted == 0:
         raise InputError(
             f"fewer than {MIN_SHORT_ARC_RANGES} ranges in the first {SHORT_ARC_HOURS[-1]:g} h after {epoch}: "
             "too few to fit the a-priori orbit from the elements",
             file=source,
         )
-    if not rms_m <= MAX_SHORT_ARC_RMS_M:
+    if not spans:
         raise InputError(
-            f"the orbit fitted to the ranges from the element set leaves {rms_m:.3g} m RMS over "
-            f"{spans[-1]:g} h (at most {MAX_SHORT_ARC_RMS_M:g} m): are the elements of this satellite and "
+            f"the orbit fitted to the ranges from the element set leaves {worst[1]:.3g} m RMS over "
+            f"{worst[0]:g} h (at most {MAX_SHORT_ARC_RMS_M:g} m): are the elements of this satellite and "
             "near the ranges' dates?",
             file=source,
         )
