@@ -14,10 +14,11 @@ Harris et al. 2025 §3.3-3.5, §3.7 and Bennett 2022 ch. 4, driven entirely by t
    (:mod:`abrupt.detect.attitude.flight_glr`: the step GLR of Bennett 2022 §2.4.2, its peaks and steps).
 3. :func:`run_flight` runs chunk by chunk (memory flat in the number of days); the detector fits the
    threshold on the spacecraft's own statistic at the stated false-alarm rate per day (robust Gumbel fit
-   of block maxima) and writes the events; daily statistics come with them.
+   of block maxima, refitted without the events on a crowded day:
+   :meth:`~abrupt.detect.attitude.flight_glr.FlightGlrDetector.fit_threshold_crowd`) and writes the events.
 
-Injection and recovery of synthetic strikes is :mod:`abrupt.pipelines.flight_injection`; attribution and
-fault scans are :mod:`abrupt.pipelines.flight_attribution` and :mod:`abrupt.pipelines.flight_faults`.
+Injection: :mod:`abrupt.pipelines.flight_injection`; attribution and fault scans:
+:mod:`abrupt.pipelines.flight_attribution`, :mod:`abrupt.pipelines.flight_faults`.
 Every stage is local in time and anchored at absolute times, so chunks processed with the margin of
 :func:`chunk_margin_s` give the same events as the whole run."""
 
@@ -37,7 +38,7 @@ from threadpoolctl import threadpool_limits
 from abrupt.clean.comb import CombConfig, estimate_period, smooth_model
 from abrupt.clean.flight_masks import SlewMaskConfig, event_mask, flag_intervals, slew_mask
 from abrupt.detect.attitude.evidence import EventEvidence, event_evidence, profile_fits
-from abrupt.detect.attitude.flight_glr import MIN_BLOCKS, FlightGlrDetector, Peak
+from abrupt.detect.attitude.flight_glr import MIN_BLOCKS, FlightGlrDetector, Peak, SubBlocks
 from abrupt.errors import ConfigError, InputError
 from abrupt.events import config_hash, new_run_id
 from abrupt.model.flight_config import FlightConfig
@@ -291,6 +292,7 @@ class ChunkResult:
     evidence: dict[int, EventEvidence] = field(default_factory=dict)
     faults: FaultScan = field(default_factory=lambda: FaultScan([], []))
     rescan_merged: int = 0
+    sub_blocks: SubBlocks = field(default_factory=SubBlocks.empty)
 
 
 def process_chunk(
@@ -446,17 +448,9 @@ def process_span(
     out: list[ChunkResult] = []
     for p0, p1 in itertools.pairwise(edges):
         piece = (g >= p0) & (g < p1)
-        series = None
-        if keep_series:
-            series = {
-                "time_ns": g[piece],
-                "H_N_raw": h_n[piece],
-                "H_N_clean": hc[piece],
-                "valid": valid[piece],
-                "event_mask": ev[piece],
-                "slew_mask": sl[piece],
-                "statistic": stat[piece],
-            }
+        named = {"time_ns": g, "H_N_raw": h_n, "H_N_clean": hc, "valid": valid, "event_mask": ev}
+        named |= {"slew_mask": sl, "statistic": stat}
+        series = {k: v[piece] for k, v in named.items()} if keep_series else None
         good = ok & piece
         out.append(
             ChunkResult(
@@ -477,6 +471,7 @@ def process_span(
                 evidence={t: e for t, e in evidence.items() if p0 <= t < p1},
                 faults=faults.within(p0, p1),
                 rescan_merged=merged if p0 == start_ns else 0,
+                sub_blocks=detector.sub_blocks(g[piece], stat[piece]),
             )
         )
     return out
@@ -591,12 +586,13 @@ def run_flight(
             )
         if maxima.size < 144:
             warnings.append(f"threshold calibrated on {maxima.size} blocks (< one day): uncertain")
-    threshold = detector.fit_threshold(maxima, config.budget, flight_channels(spacecraft).grid_hz)
+    peaks, grid_hz = [p for r in chunks for p in r.peaks], flight_channels(spacecraft).grid_hz
+    blocks, subs = [r.block_maxima for r in chunks], [r.sub_blocks for r in chunks]
+    threshold = detector.fit_threshold_crowd(blocks, subs, peaks, config.budget, grid_hz)
     run_id = run_id or new_run_id()
     cfg_hash = config_hash(
         {"flight": config.hash_fields(), "spacecraft": spacecraft.name, "threshold": threshold.as_dict()}
     )
-    peaks = [p for r in chunks for p in r.peaks]
     events = detector.events(peaks, threshold, spacecraft.name, run_id, cfg_hash)
     events = attribute_events(events, {t: e for r in chunks for t, e in r.evidence.items()})
     events = merge_fault_findings(events, [f for r in chunks for f in r.faults.findings], spacecraft.name, run_id,

@@ -313,13 +313,13 @@ def _add_dynamic(
     imp_N = np.einsum("kji,kj->ki", bn_at(t_k), imp_B) if external else np.zeros_like(imp_B)
     horizon_ns = int((offs[-1] + 20 * settle_s) * NS)
 
+    reach_ns = int(20 * settle_s * NS)  # the transients are e^(−20) of their size beyond
+
     def d_omega(t_ns: np.ndarray) -> FloatArray:
-        tau = (t_ns[:, None] - t_k[None, :]) / NS
-        return np.asarray(rate_response(tau, settle_s) @ imp_B @ j_inv.T, dtype=np.float64)
+        return _banded(t_ns, t_k, imp_B @ j_inv.T, lambda tau: rate_response(tau, settle_s), reach_ns)
 
     def d_theta(t_ns: np.ndarray) -> FloatArray:
-        tau = (t_ns[:, None] - t_k[None, :]) / NS
-        return np.asarray(angle_response(tau, settle_s) @ imp_B @ j_inv.T, dtype=np.float64)
+        return _banded(t_ns, t_k, imp_B @ j_inv.T, lambda tau: angle_response(tau, settle_s), reach_ns)
 
     for ch in flight.of("body_rate"):
         sel = s.rows(ch.mnemonic, c.time_ns, c.time_ns + horizon_ns)
@@ -337,7 +337,8 @@ def _add_dynamic(
         t_w = s.t_all[sel]
         near = t_w <= c.time_ns + horizon_ns
         t_sub = (t_w[near][:, None] + (sub * NS).astype(np.int64)[None, :]).ravel()
-        h_ext_N = (((t_sub[:, None] - t_k[None, :]) >= 0).astype(float)) @ imp_N
+        # The external momentum so far: the impulses up to each time (t_k is sorted).
+        h_ext_N = np.vstack([np.zeros((1, 3)), np.cumsum(imp_N, axis=0)])[np.searchsorted(t_k, t_sub, "right")]
         h_b = np.einsum("nij,nj->ni", bn_at(t_sub), h_ext_N) - d_omega(t_sub) @ spacecraft.inertia_kgm2.T
         h_b -= _appendage_momentum_B(c, spacecraft, (t_sub - c.time_ns) / NS)
         d_mean = np.zeros(t_w.size)
@@ -346,6 +347,21 @@ def _add_dynamic(
             late = bn_at(t_w[~near]) @ imp_N.sum(axis=0)
             d_mean[~near] = (late @ pinv.T)[:, ch.component]
         s.wheels.add(sel, d_mean)
+
+
+def _banded(
+    t_ns: np.ndarray, t_k: np.ndarray, per_impulse: FloatArray, kernel: Any, reach_ns: int, rows: int = 2048
+) -> FloatArray:
+    """Σ_k kernel(t − t_k) per_impulse_k (n, 3) over the impulses within ``reach_ns`` before each time (a
+    transient is nil beyond), ``rows`` times at a time: a leak of hours is thousands of impulses, and the
+    full (times × impulses) matrix would not fit in memory. ``t_k`` sorted."""
+    out = np.zeros((t_ns.size, per_impulse.shape[1]))
+    for a in range(0, t_ns.size, rows):
+        t = t_ns[a : a + rows]
+        lo, hi = np.searchsorted(t_k, t.min() - reach_ns), np.searchsorted(t_k, t.max(), "right")
+        if hi > lo:
+            out[a : a + rows] = kernel((t[:, None] - t_k[None, lo:hi]) / NS) @ per_impulse[lo:hi]
+    return out
 
 
 def _rotate_quaternions(s: _Samples, qch: list[Any], lo_ns: int, hi_ns: int, d_theta: Any) -> None:

@@ -57,6 +57,8 @@ from dataclasses import dataclass
 from abrupt.detect.attitude.evidence import EventEvidence
 from abrupt.detect.attitude.sibling_evidence import APPENDAGE_MIN_DEG, APPENDAGE_Z
 
+#: The reason of a momentum dump's class.
+DUMP_REASON = "momentum dump: ΔH against the wheels' stored momentum"
 ATTRIBUTION_KINDS = ("strike", "sensor_fault", "external_non_strike", "internal", "unknown")
 
 
@@ -313,11 +315,8 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
     # a sequence: a venting train's pulse, however isolated in time it looks.
     in_sequence = r.step_alone and _finite(ev.step_sharp_siblings) and ev.step_sharp_siblings > 0
     # 3b. A momentum dump: a lasting external step against the momentum the wheels hold.
-    p_dump = momentum_dump(ev, r)
-    if p_dump > 0 and abs(ev.lasting_fraction) >= r.lasting_min:
-        return Attribution(
-            "external_non_strike", min(p_dump, 0.99), "", "momentum dump: ΔH against the wheels' stored momentum"
-        )
+    if (p_dump := momentum_dump(ev, r)) > 0 and abs(ev.lasting_fraction) >= r.lasting_min:
+        return Attribution("external_non_strike", min(p_dump, 0.99), "", DUMP_REASON)
     # 4./5. External.
     if lasting and impulsive and body_moved and in_raw and not in_sequence:
         return Attribution("strike", _confidence([True, True, True, surface_ok]), "", "impulsive external step")
