@@ -433,7 +433,7 @@ class TestbedNoise:
 
 
 # The synthetic testbed calibrated on the thesis (benchmarks/calibrate_dabrowski_noise.py and
-# bench_dabrowski.py; docs/mass-properties.md): the satellite tracks a mean gyro drift of −2°/min (thesis
+# bench_dabrowski.py; the module docstring): the satellite tracks a mean gyro drift of −2°/min (thesis
 # §4.1: "approximately −2.5° per minute ... typical"; −2° chosen by the Method 1 mean errors of Table 4.4,
 # one amplitude held out at a time), the gyro's white rate noise and the wheel gain's run-to-run SD fitted
 # by weighted least squares to the six single-run SDs of Tables 4.3-4.4, the 1-2 min wander of §3.3.

@@ -113,7 +113,7 @@ The number was chosen on one simulated catalogue file (10, then 9.5 for the phas
 of the other files were seen when it was chosen) and checked on two other files and on three real LEO histories,
 each against a 150 s step, in units of each window's own σ of ρB (the model density: its relative change over
 σ_K/|K|): `python benchmarks/bench_density_nodes.py` (figures in `docs/results/bench_density_nodes.txt` and
-docs/performance.md "Catalogue scale"). ρB itself moves by ≤ 0.002 σ at 8-12 nodes a revolution; the model
+`docs/results/bench_catalogue_scale_density.txt`). ρB itself moves by ≤ 0.002 σ at 8-12 nodes a revolution; the model
 density is what needs the nodes (8: up to 0.68 σ; 9.5: ≤ 0.26 σ, p99 ≤ 0.095 σ, like the 600 s step's 0.26 σ and
 0.094 σ). Simpson's rule on the same nodes was worse for the model density (p99 0.65-0.95 σ at 8 nodes; the
 half-density sub-grid aliases the diurnal harmonics) and was not kept. Near-geostationary objects are the
@@ -158,7 +158,7 @@ from abrupt.types import FloatArray
 from abrupt.units import SECONDS_PER_DAY
 
 EARTH_ROTATION_RAD_S = 7.292115e-5  # [rad/s]
-# against a 150 s step on simulated catalogue files (docs/density.md "Integration nodes"); a half
+# against a 150 s step on simulated catalogue files (module docstring, "Integration nodes"); a half
 # integer, so that every second node (the direct NRLMSIS sampling) drifts in orbital phase
 DEFAULT_NODES_PER_REV = 9.5
 

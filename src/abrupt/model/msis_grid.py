@@ -61,7 +61,8 @@ Spacing chosen from the model's own curvature on 20,000 random points on three d
 %, mean ≤ 1.3e-4; halving the horizontal steps gave 0.01-0.07 % and twice the memory, ln-altitude steps of 0.1
 below 150 km without the 60 km offset 3 %. Held out (objects and dates not used to choose the spacing: the last
 file of the simulated catalogue, a year): window model densities and pointwise errors against direct evaluation
-on every node are in docs/performance.md (`[density reference]`). Tests: `tests/test_msis_grid.py` (pymsis at
+on every node are in `docs/results/bench_catalogue_scale_density.txt` (`[density reference]`).
+Tests: `tests/test_msis_grid.py` (pymsis at
 random points during a storm, window densities of SGP4 orbits, the shared cache with a stale claim, bad
 spacings, the CLI's refusals).
 """
