@@ -8,6 +8,47 @@ files → densities). Everything was developed on seeds 1-2 (κ, node spacing, b
 simulator checks); report held-out seeds (default 7; several: ``--seeds 7 8 9 10 11``).
 
     python benchmarks/bench_density_constellation.py --objects 25 --seeds 7 8 9 10 11
+
+All on a 2-core machine shared with seven other engineers (load average ~20 during the runs), so times are upper
+bounds.
+
+**Acceptance 1: synthetic constellation** — `python benchmarks/bench_density_constellation.py --objects 25
+--seeds 7 8 9 10 11` (30 days from 2014-10-01, storm +50 % on days 15-17, 3U/6U boxes with a random attitude
+each, redrawn after exponential holding times of mean 60 days, σ_a 3-10 m TLE noise with t tails and 1 %
+outliers, ~2.5 sets/day with gaps; no object's B given, only the platforms' geometry; everything was developed
+on seeds 1-2, seeds 7-11 were held out):
+
+* **joint fit** s(t)/c·ρ_M (`abrupt.density.joint`): RMS error (5 held-out seeds): **4.5 %**; bias: −2.5 %; per
+  seed (RMS): 4.2, 3.7, 3.6, 4.3, 6.1 %; target: < 10 % (goal 5 %); slides: < 10 % with CubeSats
+* slides' mean, K̄/B̄: RMS error (5 held-out seeds): 19.5 %; bias: −14.4 %
+* slides' minimum, K_mk/B̄_mk: RMS error (5 held-out seeds): 81 %; bias: −61 %
+* naive, K/B(C_D = 2.2, mean area): RMS error (5 held-out seeds): 46 %; bias: −22 %; target: (bias shown);
+  slides: "15-50 % error" (slide "MMOD and Neutral Densities")
+
+Storm days (joint): RMS 4.8-7.4 %, bias −4 % to −7 % per seed. Scale c against the truth: +1.2, +2.4, +2.4,
++0.8, +6.2 % (seed 11's 6.2 % is its whole bias). Median 1σ 2.0-2.3 %; truth within 2σ in 66, 76, 78, 75, 32 %
+of the windows. Pipeline 50-68 s per seed (25 objects × 30 days, TLE files → all estimates, 2 workers, load
+average ~11); the slides' ratio inversion is most of it. Tuning seeds 1-2: 3.8 % and 4.4 % RMS.
+
+The joint estimate is the recommended one (`density_joint_kg_m3`). Its error budget, measured on the tuning
+seeds with the truth: (a) the absolute scale c from the platforms' B ranges, −1 % to +4 % (all density windows
+move together; α's prior spread alone is ±2 % of B_max); (b) a per-object mismatch between NRLMSIS along the
+SGP4 orbit of the element sets and along the simulated orbit, 2 % RMS per object (0 to −5 %, drifting over weeks
+for some objects; not understood; it also biases those objects' B and so c); (c) the smoothing of s(t) at the
+storm's edges (storm days −2 % to −6 %). The 1σ given (`density_joint_sigma_kg_m3`) covers (statistical s, c and
+α) but not (b): the truth is within 2σ in 64-82 % of the windows, not 95 %.
+
+The simulator's element sets reproduce its orbit under SGP4: SGP4's Kozai mean motion and its J2 terms put the
+orbit-mean radius a few km from the mean semi-major axis (inclination dependent), i.e. several per cent of
+density per object; each set's mean motion is corrected so that the SGP4 orbit-mean radius equals the simulated
+radius (as a fit of elements to the true orbit would give).
+
+The slides' estimates (order statistics per epoch) are kept (`density_mean_kg_m3`, `density_min_kg_m3`): the
+mean estimate suffers from the sample's own mean B (25 fixed attitudes are not the population) and the ratio
+inversion's noise deconvolution; the minimum estimate from the per-day minimum of K, which noise sets. Small
+constellations: with 16 objects over 12 days the joint estimate was 2.9-8.3 % RMS on four seeds; with 10 objects
+one seed in three failed (15 % RMS: the n̄ data constrain only integrals of s between element sets, and no
+criterion on them — GCV or the object-wise cross-validation used — then keeps s from wiggling inside the gaps).
 """
 
 from __future__ import annotations

@@ -320,7 +320,8 @@ def test_momentum_exchange_spread_attains_its_cramer_rao_bound_under_white_rate_
                                          math.radians(0.07)) for k in range(150)])  # fmt: skip
     assert np.std(est, ddof=1) == pytest.approx(crb, rel=0.2)
     # (Its mean is about 0.8% low: the controller feeds the gyro noise back into the wheel, and the
-    # per-period nuisance lines make the regressor depend on later noise; see docs/mass-properties.md.)
+    # per-period nuisance lines make the regressor depend on later noise; see the docstring of
+    # benchmarks/reproductions/simsat.py.)
 
 
 def test_reduced_rank_gyro_error_covariance_solves_like_the_dense_matrix():

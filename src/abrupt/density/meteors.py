@@ -19,6 +19,22 @@ The simulator integrates the two equations (plus straight-line descent at zenith
 meteoroids of 11-72 km/s entering at 130 km, through an NRLMSIS profile, and reports velocity and
 deceleration at the radar's altitude levels with radar-like noise (velocity σ 0.1 %, at least
 30 m/s; deceleration log-normal, 15 %), only where the deceleration is measurable (> 100 m/s²).
+
+Meteoroids (`abrupt.density.meteors`)
+-------------------------------------
+
+Slides "Assumptions and Equations" to "Ratio Distribution": dv/dt = −3ρ_aC_D v²/(8ρ_m r), dr/dt = −C_Hρ_a
+v³/(8H*ρ_m) give r_1/r_2 = exp((1/6)(C_H/C_D)(1/H*)(v_1² − v_2²)) and, for meteoroid i between levels j and j+1,
+
+ln(a_(j+1)/v²_(j+1)) − ln(a_j/v²_j) = (1/6) D_i (v_j² − v²_(j+1)) + ln ρ_(r,j),  D_i ≥ 0.
+
+The unknowns are linear, so the slide's constrained least squares is `scipy.optimize.lsq_linear` on a sparse
+system with bounds D_i ≥ 0 (exact recovery on noise-free echoes is a test). K_i = (a/v²)·ρ_ref/ρ_e at each
+meteoroid's first echo, grouped, feeds the same order-statistics inversion (`size_density_ratios`). The
+simulator (`simulate_head_echoes`) integrates the two equations with straight-line descent (zenith angle 0-60°),
+11-72 km/s, radii 50 µm-2 mm, ρ_m 0.3-3 g/cm³, C_H 0.5-1, H* 2-8 MJ/kg, through the NRLMSIS profile over ALTAIR
+(9°N, 167°E, 2007-11-08, slide "Results"), from 130 km, recording at 120, 115, …, 80 km with velocity noise 0.1
+% (≥ 30 m/s) and 15 % log-normal deceleration noise where the deceleration exceeds 100 m/s².
 """
 
 from __future__ import annotations

@@ -77,7 +77,7 @@ from abrupt.types import FloatArray
 from abrupt.units import SECONDS_PER_DAY
 
 EARTH_ROTATION_RAD_S = 7.292115e-5  # [rad/s]
-# against a 150 s step on simulated catalogue files (docs/density.md "Integration nodes"); a half
+# against a 150 s step on simulated catalogue files (docstring of abrupt.density, "Integration nodes"); a half
 # integer, so that every second node (the direct NRLMSIS sampling) drifts in orbital phase
 DEFAULT_NODES_PER_REV = 9.5
 

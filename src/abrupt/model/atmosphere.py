@@ -18,6 +18,21 @@ A date the table does not cover is an error (:class:`SpaceWeatherCoverageError`)
 the table covers. Only when the caller asks for it explicitly (``fallback=``) are uncovered dates
 given constant indices (:class:`SpaceWeatherFallback`, default F10.7 = F10.7a = 150 sfu, Ap = 4:
 moderate solar activity, quiet geomagnetic field); each such date is counted in the RepairLog.
+
+NRLMSIS and space weather (`abrupt.model.atmosphere`)
+-----------------------------------------------------
+
+NRLMSIS 2.1 through `pymsis`, always with explicit drivers: the previous day's observed F10.7, the 81-day
+centred observed F10.7 and the 7-element ap array (daily Ap, 3-hourly ap now and 3/6/9 h before, means over
+12-33 h and 36-57 h before; `geomagnetic_activity=-1`). The indices come from the CelesTrak SW-All table bundled
+with abrupt (`abrupt/data/spaceweather/SW-All.txt.gz`, observed rows only by default; data CC-BY-4.0 ©
+CelesTrak, attribution beside the file; no extra package needed), or from `--space-weather FILE` (CelesTrak
+format or CSV `date, f107_obs_sfu, f107a_obs_sfu, ap[, ap_00..ap_21]`). Nothing downloads: pymsis's own fetcher
+is never called, and the tests run with sockets blocked. A time outside the table raises
+`SpaceWeatherCoverageError` naming the span covered; only an explicit `fallback=SpaceWeatherFallback(...)`
+(F10.7 = F10.7a = 150, Ap = 4 by default) fills uncovered dates, counted in the RepairLog. The bundled table's
+observed rows end on 2025-07-20; for later dates download `https://celestrak.org/SpaceData/SW-All.txt` and pass
+it with `--space-weather FILE` (plain or gzipped).
 """
 
 from __future__ import annotations

@@ -10,6 +10,37 @@ false-alarm budget and returns an :class:`AttitudeRun`: the events of the run, s
 >>> sc, tel, cal = read_attitude_inputs("telemetry.parquet")                        # doctest: +SKIP
 >>> run = detect_attitude(tel, sc, AttitudeDetectionConfig(detectors=("glr",)))     # doctest: +SKIP
 >>> run.events                                                                      # doctest: +SKIP
+
+Data path
+---------
+
+* read: module: `abrupt.readers.telemetry`; what it does: CSV/Parquet; columns and units from the spacecraft
+  file's `[telemetry]` table; every bad-input case is an error naming file:line:column or a counted repair
+  (table in the module docstring)
+* series: module: `abrupt.series.telemetry`, `abrupt.series.attitude`; what it does: `Telemetry` with gap-free
+  segments; `AttitudeSeries` = telemetry + spacecraft (+ calibration telemetry)
+* clean: module: `abrupt.clean.masks`, `abrupt.thresholds.noise`; what it does: planned-event masks; robust
+  noise and the white + random-walk momentum noise model
+* model: module: `abrupt.model.momentum`; what it does: ᴮH = J ω + Σ J_s Ω ĝ, ᴺH = [NB] ᴮH, and the body and
+  wheel contributions separately
+* detect: module: `abrupt.detect.attitude.momentum` (classes), `abrupt.detect.attitude.change_detection`
+  (kernels); what it does: one registered class per detector (`attitude.glr`, ...); sliding pre/post windows;
+  numba kernels; batch and streaming forms give the same numbers to the bit
+* thresholds: module: `abrupt.thresholds`; what it does: fit of the event-free statistic for a
+  `FalseAlarmBudget` (`--false-alarms 1/day`, `1/week`, `0.1/year`)
+* pipeline: module: `abrupt.pipelines.attitude`; what it does: read, mask, run the chosen detectors, one run id
+  and configuration hash for the events
+* events: module: `abrupt.events`, `abrupt.catalog`; what it does: frozen schema; SQLite or any SQLAlchemy URL;
+  re-runs add no duplicates
+* report: module: `abrupt.report.attitude`; what it does: stacked, time-linked panels (PNG or self-contained
+  HTML)
+
+`abrupt detectors` lists every registered detector; `--detector NAME` accepts any that reads attitude telemetry,
+including one defined in your own code (a subclass of `abrupt.detect.base.Detector` with `series_type =
+AttitudeSeries`, imported before the command runs).
+
+Matched filters on attitude error and rates are in `abrupt.detect.attitude.matched_filter` (see
+[matched-filter.md](matched-filter.md)); the simulator in [attitude-simulator.md](attitude-simulator.md).
 """
 
 from __future__ import annotations

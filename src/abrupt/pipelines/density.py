@@ -4,6 +4,57 @@
 (:mod:`abrupt.density.tle_drag`, maneuvers removed with abrupt's TLE maneuver detector), the NRLMSIS
 density with the same weighting along each orbit, and — with two or more objects — the
 order-statistics density of :mod:`abrupt.density.constellation`.
+
+Command line
+------------
+
+* `density tle FILES...` — one file per object (TLE/3LE or OMM, read with abrupt's readers). With one object: ρB
+  per window (`rho_b_per_m`, 1/m) and its 1σ, the v³F-weighted NRLMSIS 2.1 density along the same orbit
+  (`model_density_kg_m3`), mean altitude and wind factor. With several objects and a `--platforms` file: the
+  joint estimate (`density_joint_kg_m3` with `_sigma_`, `model_factor_joint`, `b_joint_m2_kg`; three or more
+  objects; the recommended one, see below), the slides' order-statistics estimates (`density_mean_kg_m3`,
+  `density_min_kg_m3`, each with `_sigma_`), the naive estimate (`naive_density_kg_m3`) and each object's
+  implied B (`b_estimate_m2_kg`). Options: `--interval-days` (window, default 1), `--maneuvers detect|none`,
+  `--space-weather FILE`, `--kappa`, `--node-days`, `--block-days`, `--workers`, `--no-model` (single object,
+  faster), `--report PNG`. Repairs and rejections are printed with counts. For a whole catalogue,
+  `--windows-only` writes only every object's ρB windows (no constellation fit), streamed file by file,
+  resumable after a kill, on `--workers` processes or `--scheduler ADDRESS`, with the maneuvers of `detect
+  tle-batch` given by `--maneuvers-from EVENTS` (`--no-model` is honoured there); see docs/scale.md.
+  `--model-tolerance F` evaluates NRLMSIS on fewer nodes where the estimate's own noise allows: per object,
+  every 16th, 8th or 4th node when all its windows' model densities agree with the next finer sampling's within
+  F × each window's stated σ of ρB (relative), else every 2nd node (the default); with F = 1, 20 % less CPU and
+  every window within 0.39 σ of the default (docs/performance.md). `--msis-grid` / `--msis-direct`: NRLMSIS from
+  tables built once per 3-hour space-weather slot and shared by every object of the run, interpolated on every
+  node (the default with `--windows-only`; below, "NRLMSIS on a shared grid"), or evaluated directly on every
+  2nd node (the default otherwise). `--msis-grid` with `--model-tolerance` or `--no-model` is refused (a usage
+  error).
+* platforms file (CSV): `object` (name or catalog number), `shape_class`, `min_area_m2`, `max_area_m2`,
+  `mass_kg`; or the single row `*,similar` (then densities are relative: B_min unknown). A row for an object not
+  given, an object without a row, a duplicate row or impossible numbers are errors naming `file:line`.
+* `density meteors RADAR.csv` — columns `meteor_id, altitude_km, velocity_mps, deceleration_mps2` (each
+  meteoroid at the radar's altitude levels); writes the density ratio between consecutive levels with 1σ and the
+  number of meteoroids per pair.
+* `density orbit FILES...` — precise orbits (SP3, OEM, navigation CSV; abrupt's readers, `--satellite` for
+  multi-satellite SP3): per window (`--window-days`, default 1) a batch least-squares fit of the state, a drag
+  scale and an SRP scale with the full orbit model; writes `drag_scale` with its σ (sandwich, and
+  `formal_drag_scale_sigma`), `srp_scale`, `rho_b_per_m` with σ, NRLMSIS along the same orbit
+  (`model_density_kg_m3`), the post-fit `residual_rms_m`, and — with `--mass-kg` and `--drag-area-m2` (`--cd`,
+  default 2.2) — `density_kg_m3` with σ and `model_factor` (density / NRLMSIS). Options: `--density-model
+  msis|exponential` (the density the scale multiplies), `--gravity-degree` (40), `--cr`, `--srp-area-m2`,
+  `--no-srp-fit`, `--space-weather`, `--allow-truncated`, `--report PNG`. A window with less than 60 % of its
+  epochs is skipped and counted (status `too_few_epochs`); fewer than 10 epochs in a file is an error naming the
+  file.
+
+Python: `abrupt.pipelines.density.tle_density(paths, platforms=...)`,
+`abrupt.pipelines.density.orbit_density(paths, OrbitDensityConfig(...))`,
+`abrupt.density.precise_orbit.fit_orbit_density(ephemeris, config)`,
+`reproductions.density_orbit.simulate_precise_orbit(force, epoch, drag_scales)`,
+`abrupt.density.tle_drag.rho_b_from_history(history, TleDragConfig(...))`,
+`abrupt.density.constellation.estimate_constellation_density(windows, platforms)`,
+`abrupt.density.joint.joint_constellation_density(tracks, windows, platforms, origin)` (tracks:
+`RhoBResult.track` of each object, computed with `with_model=True`),
+`abrupt.density.meteors.estimate_density_ratios(echoes)`, `abrupt.model.atmosphere.msis_density(times, lat, lon,
+alt_km, space_weather)`.
 """
 
 from __future__ import annotations

@@ -1,6 +1,59 @@
-"""Mass-properties orchestration: telemetry → momentum-balance data → inertia estimate / inertia track →
+r"""Mass-properties orchestration: telemetry → momentum-balance data → inertia estimate / inertia track →
 mass-change events; and the docking simulation. No click here: :mod:`abrupt.cli.mass` only parses
 options, calls these functions and writes outputs.
+
+Command line
+------------
+
+::
+
+    abrupt estimate inertia (--store DIR | TELEMETRY...) --spacecraft SC.toml --out UPDATED.toml \
+            [--orbit-period 5926.4] [--tachometer-gate 1.0] [--report REPORT.json] [--uncertainty jackknife|bootstrap]
+    abrupt detect mass-change (--store DIR | TELEMETRY...) --spacecraft SC.toml [--orbit-period S] \
+            [--window 86400] [--false-alarms 1/year] [--radius 1.0] [--attitude-events EVENTS.csv] [--out EVENTS.csv]
+    abrupt simulate docking --spacecraft SC.toml --out DIR [--days 10] [--docking-day 5.3] [--mass 5] [--at 1 0 0] \
+            [--dump-threshold 0.5]   # momentum dumps (on by default); 0: none
+
+`estimate inertia` prints the estimate and its 1σ. It prints the principal moments and axes against the
+catalogue, and the change in each. It writes `UPDATED.toml`, which is the input file with only `inertia_kgm2`
+replaced and a comment giving the 1σ. It also writes a JSON report. The report holds the estimate, 1σ, principal
+axes, the constant torque, the momentum steps found (strikes), the residual and the repairs. Telemetry files are
+the wide CSV/Parquet tables that the spacecraft file maps (`readers/telemetry.py`). An optional `thruster_flag`
+column (1 while the thrusters fire) marks momentum dumps: each firing becomes an impulse window of the
+estimator; `abrupt simulate docking` writes it (files without it are counted in the repairs).
+
+`--store DIR` reads the flight pipeline's Parquet store when DIR is one (what `abrupt ingest` writes:
+`spacecraft=NAME/day=YYYY-MM-DD/samples.parquet`). The spacecraft file's `[flight]` table names the channels by
+pseudonym and unit, and each channel is used on its own stamps, not the flight grid:
+
+* quaternion components 0-3 (scalar first) and the three rate components are joined on their common stamps;
+* the `wheel_speed` components are the `[[wheels]]` in order, with the tachometer gate from the channel;
+* the `appendage_angle` channel drives its `[[appendages]]` entry;
+* `event_flag` channels (thruster dumps) become the dump flag;
+* the orbit period comes from `--orbit-period` or `[orbit]`.
+
+A missing `[flight]` table or a channel without samples is an error that names it. Any other DIR is read as
+before: every `*.parquet`/`*.csv` under it. Test
+(`test_estimate_inertia_reads_the_ingest_store_like_the_day_files`): a simulated quarter day is exported with
+real names, run through `abrupt ingest` with a decoder, and read back. The store and the day files give the same
+estimate, within 1% of the truth.
+
+On the flight-like set the same path runs on the real archive with `examples/spacecraft/kestrel.toml`. `abrupt
+ingest ../shared/data/flight-like/telemetry/*.csv.gz --decoder .../decoder.csv --store S` takes 5 s of CPU (40 s
+wall on two cores shared with other jobs). `abrupt estimate inertia --store S --spacecraft
+examples/spacecraft/kestrel.toml --out U.toml` takes 7 s of CPU (24 s wall on the same shared machine; measured
+with `/usr/bin/time`, numba kernels cached). The principal moments are 1050.05, 619.28 and 1190.09 kg m² against
+the truth's 1050, 620 and 1190, identical to the benchmark loader's "both days" row below. Test:
+`test_estimate_inertia_from_the_ingested_flight_like_store`, which is within 0.5%.
+
+::
+
+    abrupt ingest ARCHIVE... --decoder decoder.csv --store STORE
+    abrupt estimate inertia --store STORE --spacecraft sc_with_flight_table.toml --out UPDATED.toml
+    abrupt detect mass-change --store STORE --spacecraft sc_with_flight_table.toml --out EVENTS.csv
+
+Give `--orbit-period` for a nadir-pointing spacecraft. The gravity-gradient torque is then modelled, and this
+matters: without it the flight-like estimate is off by 3-5% instead of 0.1%.
 """
 
 from __future__ import annotations

@@ -4,6 +4,18 @@ Hub + reaction wheels (``reactionWheelStateEffector``, balanced wheels), ``mrpFe
 Ki = -1 so no integral term, ``controlLawType = 1`` for the ω × H feed-forward of Bennett 2022
 Eq. 2.5), ``rwMotorTorque`` (minimum-norm mapping, Eq. 2.4), ``extForceTorque`` applying ΔH/Δt during
 one step, all at ``sim_rate_hz``. Basilisk is optional: it is imported inside the functions here.
+
+The Basilisk scenario
+---------------------
+
+`spacecraft.Spacecraft` hub, `reactionWheelStateEffector` (balanced wheels, rwFactory `custom` with Js = 0.16
+kg·m², u_max = 0.2 N·m, same axes), `simpleNav` → `attTrackingError` (reference `inertial3D` at σ = 0) →
+`mrpFeedback` (K, P, Ki = -1, `controlLawType = 1`, wheel parameters and speeds connected so its ω×(Jω + G h_s)
+term matches ours) → `rwMotorTorque` (3 control axes, minimum-norm) → wheels; `extForceTorque` holds ΔH/Δt for
+one 0.01 s step. Basilisk's hub inertia excludes the wheels and the effector adds each wheel's Js ĝĝᵀ + Jt(I -
+ĝĝᵀ) back, so the hub gets `J - Σ I_wheel` and both models have the same system inertia. Dynamics run before
+flight software in each 0.01 s step so the command is computed from the state at the start of the step, as in
+ours.
 """
 
 from __future__ import annotations

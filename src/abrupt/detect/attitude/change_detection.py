@@ -17,7 +17,7 @@ Statistics (one value per junction, per inertial axis unless noted):
 ``glr``        beyond the thesis: the three-axis generalised likelihood ratio for a step of unknown
                vector size, sqrt(dᵀ Σ_d⁻¹ d) with d = x̄_post − x̄_pre and Σ_d the pre-window
                covariance times (1/pre + 1/post). An optional guard gap between the windows keeps
-               the control transient out of both windows (see docs/attitude-detection.md).
+               the control transient out of both windows (:mod:`abrupt.detect.attitude.momentum`).
 
 Every kernel is evaluated from running sums that are re-anchored by exact summation at absolute
 sample indices that are multiples of :data:`ANCHOR`, so the value at a junction depends only on the

@@ -4,7 +4,7 @@ Each detector is one registered class (:class:`abrupt.detect.base.Detector`) rea
 :class:`~abrupt.series.attitude.AttitudeSeries`:
 
 ``attitude.glr``        three-axis step GLR (Mahalanobis distance of the pre/post mean difference of
-                        ᴺH) with longer windows; the most sensitive (docs/attitude-detection.md).
+                        ᴺH) with longer windows; the most sensitive (the power study below).
 ``attitude.cusum``      two-sided CUSUM on each inertial axis of ᴺH (Bennett 2022 Eqs. 2.12-2.13).
 ``attitude.summation``  summation filter on each axis (Eq. 2.16), normalised by its standard deviation.
 ``attitude.shiryaev``   multi-hypothesis Shiryaev size estimate on each axis (Eqs. 2.14-2.17).
@@ -18,6 +18,59 @@ event-free data: a calibration telemetry file when given, otherwise momentum noi
 the white + random-walk model measured on the input itself. Every detection gives one event with
 its time, the statistic, the threshold, the rate it was set for, and ΔH in the inertial frame from
 the pre/post mean difference (Bennett 2022 §2.4.2.7).
+
+Detectors
+---------
+
+All run per inertial axis on ᴺH over a pre-window (N_pre samples, estimates μ and σ) and a post-window (N_post
+samples); the junction is the first post sample. Thesis windows: 200/180 at 10 Hz.
+
+* `summation`: statistic: Σ_post (x − μ_pre), normalised by σ_pre √(N_post + N_post²/N_pre); source: Bennett
+  2022 Eq. 2.16
+* `cusum`: statistic: two-sided CUSUM of the Gaussian LLR of N(μ ± Δμ, σ²), Δμ = 0.1 N·m·s, at the end of the
+  post-window; source: Eqs. 2.12-2.13
+* `shiryaev`: statistic: multi-hypothesis Shiryaev, 21 hypotheses N(μ + nΔμ, σ²), Δμ = 0.04, p̃ = 1e-6; output Σ
+  n Δμ F_n; source: Eqs. 2.14-2.17, Malladi & Speyer 1999
+* `glr`: statistic: **beyond the thesis**: three-axis step GLR, √(dᵀ Σ_d⁻¹ d) with d the pre/post mean
+  difference and Σ_d the pre-window covariance × (1/N_pre + 1/N_post), windows 1000/1000; source: Neyman-Pearson
+  test for a step of unknown vector size in Gaussian noise
+
+ΔH of an event is the pre/post mean difference at the peak junction (thesis §2.4.2.7); the event time is refined
+by maximising the projected step of total ᴺH (which is conserved through the control transient, so it steps at
+the strike sample) and its uncertainty is 3 Δt (σ/|ΔH|)² (change-point location theory; factor from simulation).
+
+**Streaming.** `StreamingStatistic(name).push(samples)` keeps only the last N_pre + N_post + 1024 samples.
+Running window sums are re-anchored by exact summation at absolute indices divisible by 1024, so a value depends
+only on the data and its index, never on where a chunk started: streaming and batch are equal bit for bit
+(`tests/test_change_detection.py`). The CUSUM evaluates 64 neighbouring windows at once in float32 so the inner
+loop vectorises across windows.
+
+Thresholds from a false-alarm budget
+------------------------------------
+
+A threshold is stored with the false-alarm rate it was set for (`false_alarms_per_day` in every event).
+Event-free data come from a calibration file (`--calibration`, event-free telemetry of the same spacecraft) or,
+by default, from the **momentum noise model measured on the input itself**: white noise σ_w per axis (robust
+first differences) plus a random walk σ_rw per sample (Allan variance of ᴺH, median-based so that rare steps do
+not inflate it), AVAR(m) = σ_w²/m + σ_rw² m/3. The random walk matters: the thesis's process noise and, on
+orbit, radiation-pressure and gravity-gradient torques make ᴺH drift, and a white-noise null alone under-set the
+thresholds (we measured 6 false alarms/day for a 1/day budget before adding it).
+
+Fits (`abrupt.thresholds`): `gaussian`, `gamma`, `kde` (the thesis's), `empirical`, `gpd` (peaks over threshold)
+and `gev` (default). Sliding-window statistics are strongly correlated, so a per-sample false-alarm probability
+does not say how many alarms an operator will see. The default `gev` fits a generalised extreme-value law to
+10-minute block maxima of 10⁷ event-free samples and sets the level exceeded with probability 1 − exp(−rate · 10
+min) per block: a Poisson rate of alarm *episodes*. Measured false-alarm rates on independent event-free
+simulations (thesis noise) are in
+[results/bench_attitude_false_alarms.txt](results/bench_attitude_false_alarms.txt) (`python
+benchmarks/bench_attitude_detection.py --part c --days 5`); an earlier 4-day run gave 4 alarms for each of glr,
+cusum and summation (1.0/day against a budget of 1/day).
+
+Matched filters keep the thesis's per-sample budget (samples above threshold per day, which is an upper bound on
+alarm episodes); see [matched-filter.md](matched-filter.md).
+
+The thesis procedure (ROC, likelihood-ratio slope at P_FA = α, Eqs. 2.10-2.11) is
+`abrupt.thresholds.neyman_pearson_threshold`; Q-Q diagnostics are `qq_points`.
 """
 
 from __future__ import annotations
