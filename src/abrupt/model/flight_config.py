@@ -57,6 +57,8 @@ from abrupt.errors import ConfigError
 
 MU_EARTH_M3_S2 = 3.986004418e14  # IERS 2010 / WGS-84 GM [m^3/s^2]
 EARTH_RADIUS_M = 6_378_137.0  # WGS-84 equatorial radius [m]
+MOON_DISTANCE_M = 384_400e3  # mean Earth-Moon distance [m]: beyond it an orbit is not an Earth orbit
+MAX_GRID_HZ = 10.0  # [Hz] the flight pipeline's common grid: a 3-day chunk at 10 Hz is 2.6e6 rows per channel
 
 RATE_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0, "arcsec/s": math.pi / 180.0 / 3600.0}
 WHEEL_UNITS = {"rad/s": 1.0, "rpm": 2.0 * math.pi / 60.0, "rps": 2.0 * math.pi, "counts": float("nan")}
@@ -190,12 +192,30 @@ def parse_orbit(table: Any, file: str) -> OrbitInfo:
         if "inclination_deg" in table
         else math.nan
     )
+    if inc > 180.0:
+        raise ConfigError(f"{inc:g} deg is not an inclination (0 to 180 deg)", file=file, key="orbit.inclination_deg")
     if "period_s" in table:
-        return OrbitInfo(_num(table["period_s"], "orbit.period_s", file), inc)
+        period = _num(table["period_s"], "orbit.period_s", file)
+        lo, hi = kepler_period_s(EARTH_RADIUS_M), kepler_period_s(MOON_DISTANCE_M)
+        if not lo <= period <= hi:
+            raise ConfigError(
+                f"{period:g} s is not the period of an Earth orbit: Kepler's third law gives {lo:.0f} s at the "
+                f"surface and {hi:.3g} s at the Moon's distance",
+                file=file,
+                key="orbit.period_s",
+            )
+        return OrbitInfo(period, inc)
     if "altitude_km" in table:
-        a = EARTH_RADIUS_M + 1e3 * _num(table["altitude_km"], "orbit.altitude_km", file)
-        return OrbitInfo(2.0 * math.pi * math.sqrt(a**3 / MU_EARTH_M3_S2), inc)
+        altitude_km = _num(table["altitude_km"], "orbit.altitude_km", file)
+        if altitude_km > (MOON_DISTANCE_M - EARTH_RADIUS_M) / 1e3:
+            raise ConfigError(f"{altitude_km:g} km is beyond the Moon", file=file, key="orbit.altitude_km")
+        return OrbitInfo(kepler_period_s(EARTH_RADIUS_M + 1e3 * altitude_km), inc)
     raise ConfigError("give period_s or altitude_km", file=file, key="orbit.period_s")
+
+
+def kepler_period_s(semi_major_axis_m: float) -> float:
+    """Period [s] of an Earth orbit, T = 2π √(a³/μ) (Kepler's third law)."""
+    return 2.0 * math.pi * math.sqrt(semi_major_axis_m**3 / MU_EARTH_M3_S2)
 
 
 def parse_flight(table: Any, file: str, n_wheels: int, appendages: tuple[str, ...]) -> FlightConfig:
@@ -229,6 +249,14 @@ def parse_flight(table: Any, file: str, n_wheels: int, appendages: tuple[str, ..
     rates = [c.rate_hz for c in channels if c.rate_hz and c.quantity in ("quaternion", "body_rate", "wheel_speed")]
     grid = table.get("grid_hz", min(max(rates), 1.0) if rates else 1.0)
     grid_hz = _num(grid, "flight.grid_hz", file)
+    fastest = max(rates) if rates else MAX_GRID_HZ
+    if grid_hz > min(fastest, MAX_GRID_HZ) * (1.0 + 1e-9):
+        why = (
+            f"above {MAX_GRID_HZ:g} Hz, the fastest grid the flight pipeline holds in memory"
+            if grid_hz > MAX_GRID_HZ
+            else f"faster than the fastest attitude channel ({fastest:g} Hz): interpolation adds no information"
+        )
+        raise ConfigError(f"{grid_hz:g} Hz is {why}", file=file, key="flight.grid_hz")
     gap = _num(table.get("max_gap_intervals", 2.5), "flight.max_gap_intervals", file)
     if gap < 1.0:
         raise ConfigError(

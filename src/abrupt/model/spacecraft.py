@@ -214,10 +214,21 @@ def _vector(value: Any, n: int, where: str, file: str) -> NDArray[np.float64]:
 
 
 def _unit_vector(value: Any, where: str, file: str) -> NDArray[np.float64]:
+    """A direction: direction cosines (unit length), or components of at most 1 in magnitude such as
+    ``[1, 1, 1]``, normalised on load. A largest component above 1 or below 1/√3 cannot be either: a
+    vector 10x too long or too short (a scale slip) is an error naming the key."""
     v = _vector(value, 3, where, file)
     norm = float(np.linalg.norm(v))
     if norm == 0:
         raise ConfigError("axis has zero length", file=file, key=where)
+    largest = float(np.max(np.abs(v)))
+    if largest > 1.0 + AXIS_TOLERANCE or largest < (1.0 - AXIS_TOLERANCE) / math.sqrt(3.0):
+        raise ConfigError(
+            f"{value!r} has length {norm:.4g} and largest component {largest:.4g}: a direction is given by "
+            "direction cosines (unit length) or by components of at most 1 such as [1, 1, 1]",
+            file=file,
+            key=where,
+        )
     return v / norm
 
 
@@ -238,6 +249,73 @@ def _inertia(value: Any, where: str, file: str) -> NDArray[np.float64]:
     if eig[0] + eig[1] < eig[2] * (1 - 1e-9):
         raise ConfigError("principal moments violate the triangle inequality", file=file, key=where)
     return j
+
+
+AXIS_TOLERANCE = 1e-3  # relative: direction cosines written with 4 digits ([0.5774, ...]) pass
+MAX_SPACECRAFT_MASS_KG = 1.0e6  # [kg] the ISS, the heaviest spacecraft, is 4.2e5 kg
+MAX_GYRATION_RADIUS_M = 30.0  # [m] sqrt(I/m) of the ISS is about 20 m (mass 4.2e5 kg, I up to 1.6e8 kg m^2)
+GEOMETRY_GYRATION_FACTOR = 2.0  # sqrt(I/m) at most this x the radius enclosing the declared geometry (k <= R)
+DENSEST_MATERIAL_KG_M3 = 22_590.0  # [kg/m^3] osmium: no body of a given mass is more compact
+
+
+def check_mass_properties(
+    inertia_kgm2: NDArray[np.float64],
+    mass_kg: float,
+    enclosing_radius_m: float,
+    file: str,
+) -> None:
+    """Refuse an inertia that no body of ``mass_kg`` can have (a unit slip: g·m² written as kg·m², a mass
+    in grams), naming ``inertia_kgm2`` or ``mass_kg``.
+
+    Upper bound: every mass element lies within the radius R enclosing the body, so each principal
+    moment is at most m R² (I = Σ mᵢ dᵢ²); with the declared geometry (surfaces, appendage hinges) the
+    radius of gyration √(I_max/m) may reach :data:`GEOMETRY_GYRATION_FACTOR` x R (undeclared booms and
+    antennas), without it :data:`MAX_GYRATION_RADIUS_M`. Lower bound: of all bodies of mass m and density
+    at most ρ the uniform sphere has the least trace, tr I = (6/5) m R_ρ² with R_ρ = (3m / 4πρ)^(1/3)
+    (tr I = 2 Σ mᵢ rᵢ², minimised by packing the mass closest to the centre)."""
+    if not math.isfinite(mass_kg):
+        return
+    if mass_kg > MAX_SPACECRAFT_MASS_KG:
+        raise ConfigError(
+            f"{mass_kg:g} kg is above {MAX_SPACECRAFT_MASS_KG:g} kg (the ISS is 4.2e5 kg): check the unit",
+            file=file,
+            key="mass_kg",
+        )
+    eig = np.linalg.eigvalsh(inertia_kgm2)
+    gyration_m = math.sqrt(float(eig[-1]) / mass_kg)
+    limit_m = GEOMETRY_GYRATION_FACTOR * enclosing_radius_m if enclosing_radius_m > 0 else MAX_GYRATION_RADIUS_M
+    if gyration_m > limit_m:
+        where = f"{GEOMETRY_GYRATION_FACTOR:g} x the {enclosing_radius_m:.3g} m radius of the declared geometry"
+        raise ConfigError(
+            f"radius of gyration sqrt(I/m) = {gyration_m:.3g} m for {mass_kg:g} kg exceeds "
+            f"{where if enclosing_radius_m > 0 else f'{MAX_GYRATION_RADIUS_M:g} m (the ISS: about 20 m)'}: "
+            "is the inertia in g m^2 (1000 x kg m^2) or the mass in tonnes?",
+            file=file,
+            key="inertia_kgm2",
+        )
+    sphere_m = (3.0 * mass_kg / (4.0 * math.pi * DENSEST_MATERIAL_KG_M3)) ** (1.0 / 3.0)
+    least_trace = 1.2 * mass_kg * sphere_m**2
+    if float(np.trace(inertia_kgm2)) < least_trace:
+        raise ConfigError(
+            f"trace {float(np.trace(inertia_kgm2)):.3g} kg m^2 is below {least_trace:.3g} kg m^2, that of a "
+            f"{mass_kg:g} kg sphere of osmium: is the inertia in kg cm^2 or the mass in grams?",
+            file=file,
+            key="inertia_kgm2",
+        )
+
+
+def enclosing_radius_m(surfaces: tuple[Surface, ...], appendages: tuple[Appendage, ...]) -> float:
+    """Radius [m] about the body origin enclosing the declared surfaces and appendages (0 when none):
+    a box or panel reaches |centre| + half its diagonal; an appendage |hinge| + 3.5 x its own radius of
+    gyration (a uniform rod hinged at one end reaches √12 k from the hinge)."""
+    radius = 0.0
+    for s in surfaces:
+        radius = max(radius, float(np.linalg.norm(s.center_m) + 0.5 * np.linalg.norm(s.size_m)))
+    for a in appendages:
+        own = math.sqrt(float(np.linalg.eigvalsh(a.inertia_kgm2)[-1]) / a.mass_kg)
+        if float(np.linalg.norm(a.hinge_m)) > 0:
+            radius = max(radius, float(np.linalg.norm(a.hinge_m)) + 3.5 * own)
+    return radius
 
 
 MAX_WHEEL_SPEED_RAD_S = 2000.0  # about 19 000 rpm; reaction and momentum wheels run below 10 000 rpm
@@ -433,6 +511,7 @@ def spacecraft_from_dict(data: dict[str, Any], *, source: str = "<memory>") -> S
     appendages = tuple(_appendage(a, i, file) for i, a in enumerate(data.get("appendages", [])))
     surfaces = tuple(_surface(s, i, file) for i, s in enumerate(data.get("surfaces", [])))
     telemetry = _telemetry_map(data, wheels, file)
+    check_mass_properties(inertia, mass, enclosing_radius_m(surfaces, appendages), file)
     orbit = parse_orbit(data["orbit"], file) if "orbit" in data else None
     flight = (
         parse_flight(data["flight"], file, len(wheels), tuple(a.name for a in appendages)) if "flight" in data else None

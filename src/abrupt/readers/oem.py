@@ -227,29 +227,50 @@ class _Node:
         return next((c for c in self.children if c.tag == tag), None)
 
 
+class _DoctypeRefused(Exception):
+    """A document type declaration in an OEM XML file (see :func:`_parse_xml_tree`)."""
+
+
 def _parse_xml_tree(raw: bytes, file: str) -> _Node:
-    """A minimal element tree with line and column of each element (expat; no external entities)."""
+    """A minimal element tree with line and column of each element (expat, in one linear pass).
+
+    A document type declaration is refused: CCSDS OEM XML has none, and its entities are how a small file
+    expands into gigabytes ("billion laughs"). Character data is collected in pieces and joined once per
+    element, so reading is linear in the size of the file."""
     parser = xml.parsers.expat.ParserCreate()
     root = _Node("#document", 1, 1)
     stack = [root]
+    pieces: list[list[str]] = [[]]
 
     def start(name: str, _attrs: dict[str, str]) -> None:
         node = _Node(name.rsplit(":", 1)[-1], parser.CurrentLineNumber, parser.CurrentColumnNumber + 1)
         stack[-1].children.append(node)
         stack.append(node)
+        pieces.append([])
 
     def end(_name: str) -> None:
-        stack.pop()
+        stack.pop().text = "".join(pieces.pop())
 
     def chars(data: str) -> None:
-        stack[-1].text += data
+        pieces[-1].append(data)
+
+    def doctype(*_args: object) -> None:
+        raise _DoctypeRefused
 
     parser.StartElementHandler = start
     parser.EndElementHandler = end
     parser.CharacterDataHandler = chars
+    parser.StartDoctypeDeclHandler = doctype
     parser.SetParamEntityParsing(xml.parsers.expat.XML_PARAM_ENTITY_PARSING_NEVER)
     try:
         parser.Parse(raw, True)
+    except _DoctypeRefused:
+        raise InputError(
+            "a document type declaration (<!DOCTYPE ...>) is not part of CCSDS OEM XML; refused, as its "
+            "entities can expand a small file without bound",
+            file=file,
+            line=parser.CurrentLineNumber,
+        ) from None
     except xml.parsers.expat.ExpatError as exc:
         raise InputError(
             f"malformed XML: {xml.parsers.expat.ErrorString(exc.code)}",

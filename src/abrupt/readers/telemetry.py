@@ -32,6 +32,7 @@ series lives in :mod:`abrupt.series.telemetry`; masks (planned events) in :mod:`
 from __future__ import annotations
 
 import logging
+import math
 from pathlib import Path
 from typing import Any
 
@@ -172,6 +173,73 @@ def _check_rates_against_attitude(
         file=path,
         column="body_rate",
     )
+
+
+def _rate_fit(
+    t_s: NDArray[np.float64], q: NDArray[np.float64], w: NDArray[np.float64], segments: list[tuple[int, int]]
+) -> tuple[float, float, float]:
+    """(k, relative residual, signal-to-noise) of the least-squares fit ω_gyro ≈ k ω_q over blocks of
+    :data:`RATE_CHECK_BLOCK_S`, with ω_q = 2 vec(q_k* ⊗ q_k+1) / Δt (body axes) as in
+    :func:`_check_rates_against_attitude`; SNR is the block rate's RMS over its noise."""
+    gyro, quat = [], []
+    for a, b in segments:
+        if b - a < 3:
+            continue
+        dq = quaternion_multiply(quaternion_conjugate(q[a : b - 1]), q[a + 1 : b])
+        dq = np.where(dq[:, :1] < 0, -dq, dq)
+        dt = np.diff(t_s[a:b])[:, None]
+        block = max(2, round(RATE_CHECK_BLOCK_S / float(np.median(dt))))
+        m = ((b - a - 1) // block) * block
+        if m >= 2 * block:
+            quat.append((2.0 * dq[:, 1:] / dt)[:m].reshape(-1, block, 3).mean(axis=1))
+            gyro.append((0.5 * (w[a : b - 1] + w[a + 1 : b]))[:m].reshape(-1, block, 3).mean(axis=1))
+    if not quat:
+        return math.nan, math.nan, 0.0
+    wq, wg = np.concatenate(quat), np.concatenate(gyro)
+    den = float(np.sum(wq * wq))
+    if den <= 0:
+        return math.nan, math.nan, 0.0
+    k = float(np.sum(wg * wq)) / den
+    scale = float(np.sqrt(np.sum(wg * wg)))
+    residual = float(np.sqrt(np.sum((wg - k * wq) ** 2))) / scale if scale > 0 else math.nan
+    noise = float(np.median(robust_noise_sigma(wq)))
+    return k, residual, float(np.sqrt(np.mean(wq**2))) / max(noise, 1e-300)
+
+
+def _check_quaternion_order(
+    t_s: NDArray[np.float64],
+    q: NDArray[np.float64],
+    w: NDArray[np.float64],
+    segments: list[tuple[int, int]],
+    path: Path,
+    tmap: TelemetryMap,
+) -> None:
+    """Refuse quaternions whose scalar is not where the spacecraft file says, verified from kinematics.
+
+    Read with the scalar in the wrong place, a quaternion is still a unit quaternion, but the rotation it
+    implies between samples no longer follows the gyro (q̇ = ½ q ⊗ (0, ω)). When the attitude moves well
+    above noise (:data:`RATE_CHECK_MIN_SNR`), the gyro rates are fitted by the rates implied by the
+    quaternions read both ways; if the other order fits with a factor near 1 and a residual under a third
+    of the declared order's, the file's ``order`` is wrong. A still attitude cannot tell the orders apart
+    (every constant quaternion is a rotation) and is left alone."""
+    order_spec = tmap.quaternion.order or "scalar_first,q_BN"
+    declared, _, frame = order_spec.partition(",")
+    conj = np.array([1.0, -1.0, -1.0, -1.0]) if frame == "q_NB" else np.ones(4)
+    raw = q * conj  # back to the file's frame, scalar first
+    other = raw[:, [3, 0, 1, 2]] if declared == "scalar_first" else raw[:, [1, 2, 3, 0]]
+    k, residual, snr = _rate_fit(t_s, q, w, segments)
+    if not snr >= RATE_CHECK_MIN_SNR:
+        return
+    k_other, residual_other, _ = _rate_fit(t_s, other * conj, w, segments)
+    if 0.8 <= k_other <= 1.25 and residual_other < residual / 3.0:
+        correct = "scalar_last" if declared == "scalar_first" else "scalar_first"
+        raise InputError(
+            f"the quaternions follow the gyro rates when read {correct} (rate factor {k_other:.3f}, residual "
+            f"{residual_other:.2g}), not {declared} as the spacecraft file says (factor {k:.3f}, residual "
+            f'{residual:.2g}): set order = "{correct}" in [telemetry.quaternion]',
+            file=path,
+            column=",".join(tmap.quaternion.columns),
+        )
 
 
 def _check_columns(frame: pd.DataFrame, spacecraft: Spacecraft, path: Path) -> None:
@@ -335,6 +403,7 @@ def telemetry_from_frame(
     interval, gaps, segments = split_at_gaps(t_s, GAP_FACTOR)
     if gaps:
         repairs.record(f"gaps longer than {GAP_FACTOR} sample intervals (data split into segments)", len(gaps))
+    _check_quaternion_order(t_s, q, w, segments, path, tmap)
     _check_rates_against_attitude(t_s, q, w, segments, path, tmap.body_rate.unit or "rad/s")
     return Telemetry(
         time=time_ns,
