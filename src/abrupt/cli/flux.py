@@ -255,7 +255,13 @@ def infer(
 )
 @click.option("--dH90", "dh90", type=float, help="ΔH90 [N·m·s] when no recovery table is given.")
 @click.option("--slope", type=float, default=4.0, show_default=True, help="Logistic slope in ln|ΔH| with --dH90.")
-@click.option("--attitude", type=click.Choice(["orbit", "unknown"]), default="unknown", show_default=True)
+@click.option(
+    "--attitude",
+    type=click.Choice(["orbit", "unknown"]),
+    default="unknown",
+    show_default=True,
+    help="orbit: body axes are the orbit axes (nadir pointing); unknown: surfaces face all directions alike.",
+)
 def exposure_command(
     catalog_target: str,
     spacecraft: str,
@@ -363,7 +369,12 @@ def exposure_command(
 
 
 @simulate.command("population")
-@click.option("--spacecraft-file", required=True, type=click.Path(exists=True, dir_okay=False))
+@click.option(
+    "--spacecraft-file",
+    required=True,
+    type=click.Path(exists=True, dir_okay=False),
+    help="Spacecraft TOML with [[surfaces]] (every spacecraft of the fleet is this one).",
+)
 @click.option(
     "--count",
     "n_spacecraft",
@@ -372,21 +383,37 @@ def exposure_command(
     show_default=True,
     help="Spacecraft in the fleet.",
 )
-@click.option("--years", type=click.FloatRange(min=0.0, min_open=True), default=1.0, show_default=True)
-@click.option("--altitude-km", type=float, default=550.0, show_default=True)
-@click.option("--inclination-deg", type=float, default=28.5, show_default=True)
-@click.option("--epoch", "epoch_year", type=float, default=2020.0, show_default=True)
+@click.option(
+    "--years",
+    type=click.FloatRange(min=0.0, min_open=True),
+    default=1.0,
+    show_default=True,
+    help="Length of each history [years].",
+)
+@click.option("--altitude-km", type=float, default=550.0, show_default=True, help="Orbit altitude [km].")
+@click.option("--inclination-deg", type=float, default=28.5, show_default=True, help="Orbit inclination [deg].")
+@click.option(
+    "--epoch", "epoch_year", type=float, default=2020.0, show_default=True, help="Debris model epoch [decimal year]."
+)
 @click.option("--debris-scale", type=float, default=1.0, show_default=True, help="Truth: × the debris model.")
 @click.option("--meteoroid-scale", type=float, default=1.0, show_default=True, help="Truth: × the meteoroid model.")
 @click.option("--beta", type=float, default=1.0, show_default=True, help="Truth: momentum-enhancement factor.")
 @click.option("--dH90", "dh90", type=float, default=0.02, show_default=True, help="ΔH90 [N·m·s] of every day.")
-@click.option("--slope", type=float, default=4.0, show_default=True)
+@click.option(
+    "--slope", type=float, default=4.0, show_default=True, help="Logistic slope of the detection efficiency in ln|ΔH|."
+)
 @budget_options("0.01/day")
-@click.option("--analysed-fraction", type=float, default=0.9, show_default=True)
+@click.option("--analysed-fraction", type=float, default=0.9, show_default=True, help="Fraction of each day analysed.")
 @click.option("--dH-error", "dh_error", type=float, default=0.0, show_default=True, help="Relative |ΔH| error.")
-@click.option("--catalog", "catalog_target", default=DEFAULT_CATALOG, show_default=True)
+@click.option(
+    "--catalog",
+    "catalog_target",
+    default=DEFAULT_CATALOG,
+    show_default=True,
+    help="Catalog to store the events and each day's exposure in (SQLite path or SQLAlchemy URL).",
+)
 @click.option("--out", "out_path", type=click.Path(dir_okay=False), help="Events CSV (with the truth label).")
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--seed", type=int, default=0, show_default=True, help="Random seed (reproducible).")
 @_model_options
 def population(
     spacecraft_file: str,

@@ -395,16 +395,22 @@ def detect_orbit_command(
         | {"repairs": run.ephemeris.repairs.as_dict()},
         analysed=[span] if (span := run.analysed) is not None else [],
     )
-    if report_path and run.analysis is None:
+    if report_path:
+        _write_report(run, events, report_path)
+
+
+def _write_report(run: pipelines_orbit.OrbitRun, events: pd.DataFrame, report_path: str) -> None:
+    """``--report``: the run's figure, or a warning saying why a run has none."""
+    if run.analysis is None:
         why = (
             "a run that tested nothing"
             if run.summary.get("tested") is False
             else "a run in calibration blocks; give --block-days 0 for one"
         )
         click.echo(f"warning: no report for {why}", err=True)
-    if report_path and run.analysis is not None:
-        path = report_orbit.plot_orbit_report(run.analysis, run.thresholds, events, report_path)
-        click.echo(f"report written to {path}", err=True)
+        return
+    path = report_orbit.plot_orbit_report(run.analysis, run.thresholds, events, report_path)
+    click.echo(f"report written to {path}", err=True)
 
 
 def _write_statistics(run: pipelines_orbit.OrbitRun, path: str) -> None:

@@ -2,11 +2,19 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import click
 
+from abrupt.cli.commands import lazy_module
 from abrupt.cli.groups import check_suffix, cli, note
-from abrupt.pipelines.store_export import export_store
-from abrupt.store import TelemetryStore
+
+if TYPE_CHECKING:
+    from abrupt import store as abrupt_store
+    from abrupt.pipelines import store_export as pipelines_store_export
+else:
+    abrupt_store = lazy_module("abrupt.store")
+    pipelines_store_export = lazy_module("abrupt.pipelines.store_export")
 
 
 @cli.group("store")
@@ -18,7 +26,7 @@ def store_group() -> None:
 @click.argument("store_dir", type=click.Path(exists=True, file_okay=False))
 def list_store(store_dir: str) -> None:
     """The spacecraft of STORE_DIR with their number of stored days and first and last day."""
-    store = TelemetryStore(store_dir)
+    store = abrupt_store.TelemetryStore(store_dir)
     names = store.spacecraft()
     if not names:
         click.echo(f"{store_dir}: no spacecraft stored")
@@ -41,5 +49,5 @@ def list_store(store_dir: str) -> None:
 )
 def export_store_cmd(store_dir: str, spacecraft: str, days: tuple[str, ...], out: str) -> None:
     """Write the stored samples of one spacecraft to OUT as a long archive (pseudonyms kept; UTC times)."""
-    done = export_store(store_dir, spacecraft, out, days=days or None)
+    done = pipelines_store_export.export_store(store_dir, spacecraft, out, days=days or None)
     note(f"{done.samples} sample(s) of {spacecraft} over {len(done.days)} day(s) written to {done.out}")

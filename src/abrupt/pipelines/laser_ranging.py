@@ -429,25 +429,9 @@ def run_laser_ranging_files(
         estimate_scales=estimated_scales(force),
         estimate_time_bias=time_biases,
     )
-    elements = ElementApriori.read(apriori_path) if is_element_file(apriori_path) else None
-    if elements is not None:
-        _, gap_days = elements.nearest(epoch)
-        if gap_days > MAX_ELEMENT_AGE_DAYS:
-            first_range = f"{np.datetime_as_string(epoch, unit='s')}Z"
-            raise InputError(
-                f"the element set nearest the first range epoch {first_range} is {gap_days:.0f} days from it (at most "
-                f"{MAX_ELEMENT_AGE_DAYS:g}: SGP4 drifts by kilometres a day); the a-priori orbit does not cover it",
-                file=apriori_path,
-            )
-        apriori = _element_apriori(elements, meas, sites, stations, cfg, model)
-        apriori_name: str | None = None
-    else:
-        ephemeris = read_ephemeris(apriori_path)
-        for kind, n in ephemeris.repairs.counts.items():
-            repairs.record(f"a-priori ephemeris: {kind}", n)
-        check_ranges_against_apriori(meas, sites, ephemeris, file=crd_paths[0])
-        apriori = _ephemeris_apriori(ephemeris)
-        apriori_name = ephemeris.satellite
+    apriori, elements, apriori_name = _apriori_orbit(
+        apriori_path, meas, sites, stations, cfg, model, epoch, repairs, crd_paths[0]
+    )
     if apriori(epoch) is None:
         raise ValueError(f"{apriori_path}: the a-priori orbit does not cover the first range epoch {epoch}")
     result = detect_laser_ranging_arcs(
@@ -502,6 +486,42 @@ def run_laser_ranging_files(
     times = np.asarray(meas["time_utc"], dtype="datetime64[ns]")
     analysed = [AnalysedSpan(name, times.min(), times.max(), LaserGlrtDetector.name)]
     return LaserRangingRun(frame, result, summary, run_id, cfg_hash, analysed)
+
+
+def _apriori_orbit(
+    apriori_path: str,
+    meas: pd.DataFrame,
+    sites: dict[str, StationSite],
+    stations: dict[str, Station],
+    cfg: BatchFitConfig,
+    model: RangeModel,
+    epoch: np.datetime64,
+    repairs: RepairLog,
+    crd_path: str,
+) -> tuple[Callable[[np.datetime64], FloatArray | None], ElementApriori | None, str | None]:
+    """The a-priori states for each arc epoch, the element sets they come from (None for an ephemeris) and
+    the satellite the ephemeris names: element sets (TLE/OMM) through SGP4 and a short-arc fit, or an
+    ephemeris whose ranges are checked against each station's measurements first."""
+    elements = ElementApriori.read(apriori_path) if is_element_file(apriori_path) else None
+    if elements is not None:
+        _, gap_days = elements.nearest(epoch)
+        if gap_days > MAX_ELEMENT_AGE_DAYS:
+            first_range = f"{np.datetime_as_string(epoch, unit='s')}Z"
+            raise InputError(
+                f"the element set nearest the first range epoch {first_range} is {gap_days:.0f} days from it (at most "
+                f"{MAX_ELEMENT_AGE_DAYS:g}: SGP4 drifts by kilometres a day); the a-priori orbit does not cover it",
+                file=apriori_path,
+            )
+        apriori = _element_apriori(elements, meas, sites, stations, cfg, model)
+        apriori_name: str | None = None
+    else:
+        ephemeris = read_ephemeris(apriori_path)
+        for kind, n in ephemeris.repairs.counts.items():
+            repairs.record(f"a-priori ephemeris: {kind}", n)
+        check_ranges_against_apriori(meas, sites, ephemeris, file=crd_path)
+        apriori = _ephemeris_apriori(ephemeris)
+        apriori_name = ephemeris.satellite
+    return apriori, elements, apriori_name
 
 
 def _ephemeris_apriori(ephemeris: Ephemeris) -> Callable[[np.datetime64], FloatArray | None]:
