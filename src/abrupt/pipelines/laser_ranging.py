@@ -472,7 +472,7 @@ def run_laser_ranging_files(
     )
     frame = events_frame(events) if events else empty_frame()
     summary = _run_summary(result, len(meas), repairs)
-    frame, summary["warnings"] = _unabsorbed(frame, result)
+    frame, warnings = _unabsorbed(frame, result)
     target = str(meas["satellite"].iloc[0]) if "satellite" in meas else ephemeris.satellite
     passive = passive_satellite(target) or passive_satellite(ephemeris.satellite)
     if propulsion is False or (propulsion is None and passive is not None):
@@ -480,8 +480,9 @@ def run_laser_ranging_files(
         gap_s = float(np.max(np.diff(t)) / np.timedelta64(1, "s")) if t.size > 1 else 0.0
         area_to_mass = (force.srp_area_m2 or 0.0) / force.mass_kg if force.mass_kg else DEFAULT_AREA_TO_MASS_M2_KG
         frame, notes = passive_detections(frame, passive.name if passive else name, area_to_mass, gap_s)
-        summary["warnings"] = [*summary["warnings"], *notes]
+        warnings += notes
         summary["propulsion"] = False
+    summary["warnings"] = warnings
     return LaserRangingRun(frame, result, summary, run_id, cfg_hash)
 
 
