@@ -233,6 +233,19 @@ def test_noise_alone_removes_nothing_on_many_arcs() -> None:
     assert removed == 0
 
 
+def test_noise_that_grows_tenfold_along_the_arc_removes_nothing() -> None:
+    """5 cm noise, then 50 cm: the level is each part's own (a level from the whole arc called 2 % of the
+    noisier half's epochs outliers)."""
+    eph = _truth(sigma_pos_m=0.0)
+    rng = np.random.default_rng(8)
+    sigma = np.where(eph.seconds < 3 * 3600.0, 0.05, 0.5)[:, None]
+    noisy = eph.position_m + rng.normal(0.0, 1.0, eph.position_m.shape) * sigma
+    assert not single_epoch_outliers(eph.seconds, noisy).any()
+    bad = noisy.copy()
+    bad[300] += 20.0  # 40 σ of the noisier half
+    assert np.flatnonzero(single_epoch_outliers(eph.seconds, bad)).tolist() == [300]
+
+
 def test_an_eccentric_orbit_removes_nothing() -> None:
     eph = _truth(altitude_km=20000.0, eccentricity=0.6)  # perigee 4170 km altitude, 60 s steps
     assert len(check_orbit_envelope(eph)) == len(eph)
