@@ -494,7 +494,8 @@ def _unabsorbed(frame: pd.DataFrame, result: LaserArcsResult) -> tuple[pd.DataFr
         return frame, warnings
     frame = frame.copy()
     for arc in result.arcs:
-        bad = fit_bound_violations(arc.result.fit.range_bias_m, arc.result.fit.scale_factors)
+        fit = arc.result.fit
+        bad = fit_bound_violations(fit.range_bias_m, fit.scale_factors, arc.result.residual_rms_m)
         if not bad:
             continue
         lo, hi = arc.owned_s
