@@ -295,3 +295,43 @@ def test_an_arc_too_short_to_test_is_a_warning_and_a_recorded_run(tmp_path: Path
     assert len(pd.read_csv(events)) == 0
     runs = Catalog(str(catalog)).runs()
     assert list(runs["command"]) == ["detect orbit"]
+
+
+def _write_cpf(eph: Ephemeris, path: Path) -> None:
+    """An ILRS CPF v2 of an Earth-fixed ephemeris (positions only, ``10`` records), LAGEOS-1 ids."""
+    lines = [
+        "H1 CPF 2 HTS 2018 6 13 12 164 1 lageos1 NONE",
+        "H2 7603901 1155 8820 2018 6 13 0 0 0 2018 6 15 0 0 0 240 1 1 0 0 0 1",
+        "H9",
+    ]
+    mjd0 = 58282  # 2018-06-14
+    for t, r in zip(eph.times_utc, eph.position_m, strict=True):
+        sec = float((t - np.datetime64("2018-06-14", "ns")) / np.timedelta64(1, "s"))
+        day, sod = divmod(sec, 86400.0)
+        lines.append(f"10 0 {mjd0 + int(day)} {sod:12.5f} 0 {r[0]:14.3f} {r[1]:14.3f} {r[2]:14.3f}")
+    lines.append("99")
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_a_50_km_jump_in_one_cpf_record_is_an_outlier_not_a_burn(tmp_path: Path) -> None:
+    """A LAGEOS-like CPF prediction (5900 km, 240 s): one record 50 km off is removed and counted; the
+    detector never sees it."""
+    cfg = OrbitSimulationConfig(
+        altitude_m=5900e3,
+        inclination_deg=109.8,
+        duration_s=86400.0,
+        rate_hz=1 / 240,
+        sigma_pos_m=0.0,
+        sigma_vel_mps=0.0,
+        epoch_utc="2018-06-14T00:00:00",
+        forces=ForceModel(zonal_degree=2),
+    )
+    eph = _itrf(simulate_orbit(cfg).ephemeris("lageos1"))
+    bad = eph.position_m.copy()
+    bad[200] += np.array([30e3, -40e3, 0.0])
+    path = tmp_path / "lageos1.hts"
+    _write_cpf(replace(eph, position_m=bad), path)
+    back = read_ephemeris(path)
+    assert back.repairs.counts[OUTLIER_REPAIR] == 1
+    assert len(back) == len(eph) - 1 and eph.times_utc[200] not in back.times_utc
+    np.testing.assert_allclose(back.position_m, np.delete(eph.position_m, 200, axis=0), atol=1e-3)
