@@ -376,16 +376,22 @@ def detect_orbit_command(
         details={k: v for k, v in run.summary.items() if k != "warnings"}
         | {"repairs": run.ephemeris.repairs.as_dict()},
     )
-    if report_path and run.analysis is None:
+    if report_path:
+        _report(run, events, report_path)
+
+
+def _report(run: OrbitRun, events: pd.DataFrame, report_path: str) -> None:
+    """The run's figure, or a warning saying why a run has none."""
+    if run.analysis is None:
         why = (
             "a run that tested nothing"
             if run.summary.get("tested") is False
             else "a run in calibration blocks; give --block-days 0 for one"
         )
         click.echo(f"warning: no report for {why}", err=True)
-    if report_path and run.analysis is not None:
-        path = plot_orbit_report(run.analysis, run.thresholds, events, report_path)
-        click.echo(f"report written to {path}", err=True)
+        return
+    path = plot_orbit_report(run.analysis, run.thresholds, events, report_path)
+    click.echo(f"report written to {path}", err=True)
 
 
 def _statistics_frame(run: OrbitRun) -> pd.DataFrame:
