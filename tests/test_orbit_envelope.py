@@ -29,6 +29,7 @@ from abrupt.readers.navigation_csv import write_navigation_csv
 from abrupt.readers.oem import write_oem
 from abrupt.readers.orbit_envelope import (
     OUTLIER_REPAIR,
+    ZERO_VELOCITY_REPAIR,
     check_orbit_envelope,
     power_of_ten_repair,
     single_epoch_outliers,
@@ -116,6 +117,17 @@ def test_all_zero_velocities_are_refused(fmt: str, tmp_path: Path) -> None:
     path = tmp_path / f"zero.{fmt}"
     (write_oem if fmt == "oem" else write_navigation_csv)(eph, path)
     assert "every velocity is zero" in _refused(path, "velocity = derivative of position")
+
+
+def test_one_zero_velocity_removes_its_epoch_and_is_counted(tmp_path: Path) -> None:
+    eph = _truth()
+    vel = eph.velocity_mps.copy()
+    vel[100] = 0.0
+    path = tmp_path / "one_zero.csv"
+    write_navigation_csv(replace(eph, velocity_mps=vel), path)
+    back = read_ephemeris(path)
+    assert back.repairs.counts[ZERO_VELOCITY_REPAIR] == 1
+    assert len(back) == len(eph) - 1 and eph.times_utc[100] not in back.times_utc
 
 
 def test_velocities_halved_are_refused_not_repaired(tmp_path: Path) -> None:

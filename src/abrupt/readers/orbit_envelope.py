@@ -60,6 +60,7 @@ OUTLIER_FLOOR_M = 0.05  # [m] and at least this large (precise products: mm-leve
 OUTLIER_NOISE_WINDOW = 101  # epochs of the running median that sets the local noise level
 
 OUTLIER_REPAIR = "single-epoch position outlier (disagrees with both neighbours) removed"
+ZERO_VELOCITY_REPAIR = "epoch with a zero velocity vector in a file with velocities (removed)"
 PV_MISMATCH_REPAIR = "epoch whose velocity disagrees with its neighbours' positions (removed with them)"
 
 
@@ -289,6 +290,10 @@ def check_velocities(eph: Ephemeris) -> Ephemeris:
         return eph
     if not np.any(np.linalg.norm(v[given], axis=1) > 0):
         raise _refuse(eph, "velocity = derivative of position", "every velocity is zero (velocities not given?)")
+    zero = given & ~(np.linalg.norm(np.nan_to_num(v), axis=1) > 0)
+    if zero.any():  # no Earth orbiter stands still: a zero vector is a velocity not given
+        eph.repairs.record(ZERO_VELOCITY_REPAIR, int(zero.sum()))
+        return check_velocities(eph.select(~zero))
     idx = np.flatnonzero(given)
     t_ns = eph.times_utc[idx].astype(np.int64)
     median, usable, residual = velocity_derivative_ratio(t_ns, eph.position_m[idx], v[idx])
