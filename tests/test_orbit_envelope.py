@@ -24,6 +24,7 @@ from abrupt.model.frames import gcrf_to_itrf
 from abrupt.model.orbit import ForceModel
 from abrupt.pipelines.orbit import detect_orbit
 from abrupt.pipelines.orbit_blocks import bridge_limit_s, data_arcs
+from abrupt.pipelines.orbit_product import detect_orbit_product
 from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.readers.navigation_csv import write_navigation_csv
 from abrupt.readers.oem import write_oem
@@ -347,3 +348,13 @@ def test_a_50_km_jump_in_one_cpf_record_is_an_outlier_not_a_burn(tmp_path: Path)
     assert back.repairs.counts[OUTLIER_REPAIR] == 1
     assert len(back) == len(eph) - 1 and eph.times_utc[200] not in back.times_utc
     np.testing.assert_allclose(back.position_m, np.delete(eph.position_m, 200, axis=0), atol=1e-3)
+
+
+def test_every_satellite_of_a_product_too_short_to_test_is_a_run_that_tested_nothing() -> None:
+    eph = _itrf(_truth())
+    short = eph.select(eph.seconds <= 4.0 * 3600)
+    runs = detect_orbit_product({"L27": short, "L28": replace(short, satellite="L28")})
+    assert sorted(runs) == ["L27", "L28"]
+    for run in runs.values():
+        assert run.summary["tested"] is False and len(run.events) == 0
+        assert run.result.warnings[0].startswith("nothing tested: the arc spans 4 h")
