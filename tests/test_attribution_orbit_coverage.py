@@ -110,15 +110,16 @@ def test_intervals_out_of_order_or_overlapping_are_sorted_and_merged_and_counted
 
 
 def test_an_event_in_a_gap_of_the_navigation_solution_is_not_covered(tmp_path: Path) -> None:
-    """12 h of simulated navigation at 60 s with 05:00-07:00 removed: the orbit run records two tested
-    intervals, the gap between; a strike that must have moved the orbit by 10 floors is no strike where the
-    solution saw nothing (04:00), and keeps its class in the gap (06:00: not covered, NaN)."""
+    """12 h of simulated navigation at 60 s with 05:00-05:40 removed (shorter than half a revolution, so
+    the filters bridge it in one arc): the orbit run records two tested intervals, the gap between; a
+    strike that must have moved the orbit by 10 floors is no strike where the solution saw nothing
+    (04:00), and keeps its class in the gap (05:20: not covered, NaN)."""
     nav, ev, cat = tmp_path / "nav.csv", tmp_path / "orbit.csv", tmp_path / "c.sqlite"
     cli_main(["simulate", "orbit", "--out", str(nav), "--duration-s", "43200", "--rate-hz", str(1 / 60),
               "--seed", "3", "--sigma-pos-m", "0.05", "--sigma-vel-mps", "0.0005"])  # fmt: skip
     frame = pd.read_csv(nav)
     t = pd.to_datetime(frame["time_utc"].str.rstrip("Z"))
-    gap = (t >= pd.Timestamp("2020-01-01T05:00")) & (t < pd.Timestamp("2020-01-01T07:00"))
+    gap = (t >= pd.Timestamp("2020-01-01T05:00")) & (t < pd.Timestamp("2020-01-01T05:40"))
     frame[~gap].to_csv(nav, index=False)
     cli_main(["detect", "orbit", str(nav), "--out", str(ev), "--catalog", str(cat), "--name", "SC-Z",
               "--block-days", "0"])  # fmt: skip
@@ -126,14 +127,14 @@ def test_an_event_in_a_gap_of_the_navigation_solution_is_not_covered(tmp_path: P
     ((a0, b0), (a1, b1)) = got.coverage.spans_utc
     sec = np.timedelta64(1, "s")
     assert abs((b0 - np.datetime64("2020-01-01T04:59:00", "ns")) / sec) <= 1.0  # the last epoch before the gap
-    assert abs((a1 - np.datetime64("2020-01-01T07:00:00", "ns")) / sec) <= 1.0  # the first after it
+    assert abs((a1 - np.datetime64("2020-01-01T05:40:00", "ns")) / sec) <= 1.0  # the first after it
     assert a0 < np.datetime64("2020-01-01T04:00", "ns") and b1 > np.datetime64("2020-01-01T08:00", "ns")
     assert got.notes == ()
     floor = got.coverage.dv_floor_mps
     att = events_frame(
         [
             _event("strike", "2020-01-01T04:00:00.000000Z", ev_min_dv_mps=10 * floor),
-            _event("strike", "2020-01-01T06:00:00.000000Z", ev_min_dv_mps=10 * floor),
+            _event("strike", "2020-01-01T05:20:00.000000Z", ev_min_dv_mps=10 * floor),
         ]
     )
     out = got.attach(att, 500.0)

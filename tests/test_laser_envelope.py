@@ -111,6 +111,11 @@ def test_a_wavelength_outside_ranging_lasers_names_the_line(files: dict[str, Pat
         read_crd(bad)
 
 
+def test_a_post_fit_residual_of_metres_is_named_as_one_the_fit_cannot_absorb() -> None:
+    found = fit_bound_violations({"7090": 0.01}, {"srp_scale": 1.0}, {"7090": 0.004, "7839": 74e3})
+    assert found == ["post-fit range RMS 7.4e+04 m at station 7839 (≤ 1 m)"]
+
+
 @pytest.mark.parametrize(
     ("biases", "scales", "named"),
     [
@@ -138,7 +143,7 @@ def test_a_clean_day_passes_every_check_and_stays_within_bounds(files: dict[str,
     assert str(run.summary["warnings"][0]).startswith("lageos1 has no propulsion: its model explains")
     assert len(run.events) == 0
     last = run.result.arcs[-1].result.fit
-    assert fit_bound_violations(last.range_bias_m, last.scale_factors) == []
+    assert fit_bound_violations(last.range_bias_m, last.scale_factors, run.result.arcs[-1].result.residual_rms_m) == []
 
 
 def test_laser_detections_of_a_passive_satellite_are_explained_or_named() -> None:

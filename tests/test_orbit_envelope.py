@@ -24,11 +24,13 @@ from abrupt.model.frames import gcrf_to_itrf
 from abrupt.model.orbit import ForceModel
 from abrupt.pipelines.orbit import detect_orbit
 from abrupt.pipelines.orbit_blocks import bridge_limit_s, data_arcs
+from abrupt.pipelines.orbit_product import detect_orbit_product
 from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.readers.navigation_csv import write_navigation_csv
 from abrupt.readers.oem import write_oem
 from abrupt.readers.orbit_envelope import (
     OUTLIER_REPAIR,
+    ZERO_VELOCITY_REPAIR,
     check_orbit_envelope,
     power_of_ten_repair,
     single_epoch_outliers,
@@ -116,6 +118,17 @@ def test_all_zero_velocities_are_refused(fmt: str, tmp_path: Path) -> None:
     path = tmp_path / f"zero.{fmt}"
     (write_oem if fmt == "oem" else write_navigation_csv)(eph, path)
     assert "every velocity is zero" in _refused(path, "velocity = derivative of position")
+
+
+def test_one_zero_velocity_removes_its_epoch_and_is_counted(tmp_path: Path) -> None:
+    eph = _truth()
+    vel = eph.velocity_mps.copy()
+    vel[100] = 0.0
+    path = tmp_path / "one_zero.csv"
+    write_navigation_csv(replace(eph, velocity_mps=vel), path)
+    back = read_ephemeris(path)
+    assert back.repairs.counts[ZERO_VELOCITY_REPAIR] == 1
+    assert len(back) == len(eph) - 1 and eph.times_utc[100] not in back.times_utc
 
 
 def test_velocities_halved_are_refused_not_repaired(tmp_path: Path) -> None:
@@ -233,6 +246,19 @@ def test_noise_alone_removes_nothing_on_many_arcs() -> None:
     assert removed == 0
 
 
+def test_noise_that_grows_tenfold_along_the_arc_removes_nothing() -> None:
+    """5 cm noise, then 50 cm: the level is each part's own (a level from the whole arc called 2 % of the
+    noisier half's epochs outliers)."""
+    eph = _truth(sigma_pos_m=0.0)
+    rng = np.random.default_rng(8)
+    sigma = np.where(eph.seconds < 3 * 3600.0, 0.05, 0.5)[:, None]
+    noisy = eph.position_m + rng.normal(0.0, 1.0, eph.position_m.shape) * sigma
+    assert not single_epoch_outliers(eph.seconds, noisy).any()
+    bad = noisy.copy()
+    bad[300] += 20.0  # 40 σ of the noisier half
+    assert np.flatnonzero(single_epoch_outliers(eph.seconds, bad)).tolist() == [300]
+
+
 def test_an_eccentric_orbit_removes_nothing() -> None:
     eph = _truth(altitude_km=20000.0, eccentricity=0.6)  # perigee 4170 km altitude, 60 s steps
     assert len(check_orbit_envelope(eph)) == len(eph)
@@ -282,3 +308,53 @@ def test_an_arc_too_short_to_test_is_a_warning_and_a_recorded_run(tmp_path: Path
     assert len(pd.read_csv(events)) == 0
     runs = Catalog(str(catalog)).runs()
     assert list(runs["command"]) == ["detect orbit"]
+
+
+def _write_cpf(eph: Ephemeris, path: Path) -> None:
+    """An ILRS CPF v2 of an Earth-fixed ephemeris (positions only, ``10`` records), LAGEOS-1 ids."""
+    lines = [
+        "H1 CPF 2 HTS 2018 6 13 12 164 1 lageos1 NONE",
+        "H2 7603901 1155 8820 2018 6 13 0 0 0 2018 6 15 0 0 0 240 1 1 0 0 0 1",
+        "H9",
+    ]
+    mjd0 = 58282  # 2018-06-14
+    for t, r in zip(eph.times_utc, eph.position_m, strict=True):
+        sec = float((t - np.datetime64("2018-06-14", "ns")) / np.timedelta64(1, "s"))
+        day, sod = divmod(sec, 86400.0)
+        lines.append(f"10 0 {mjd0 + int(day)} {sod:12.5f} 0 {r[0]:14.3f} {r[1]:14.3f} {r[2]:14.3f}")
+    lines.append("99")
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_a_50_km_jump_in_one_cpf_record_is_an_outlier_not_a_burn(tmp_path: Path) -> None:
+    """A LAGEOS-like CPF prediction (5900 km, 240 s): one record 50 km off is removed and counted; the
+    detector never sees it."""
+    cfg = OrbitSimulationConfig(
+        altitude_m=5900e3,
+        inclination_deg=109.8,
+        duration_s=86400.0,
+        rate_hz=1 / 240,
+        sigma_pos_m=0.0,
+        sigma_vel_mps=0.0,
+        epoch_utc="2018-06-14T00:00:00",
+        forces=ForceModel(zonal_degree=2),
+    )
+    eph = _itrf(simulate_orbit(cfg).ephemeris("lageos1"))
+    bad = eph.position_m.copy()
+    bad[200] += np.array([30e3, -40e3, 0.0])
+    path = tmp_path / "lageos1.hts"
+    _write_cpf(replace(eph, position_m=bad), path)
+    back = read_ephemeris(path)
+    assert back.repairs.counts[OUTLIER_REPAIR] == 1
+    assert len(back) == len(eph) - 1 and eph.times_utc[200] not in back.times_utc
+    np.testing.assert_allclose(back.position_m, np.delete(eph.position_m, 200, axis=0), atol=1e-3)
+
+
+def test_every_satellite_of_a_product_too_short_to_test_is_a_run_that_tested_nothing() -> None:
+    eph = _itrf(_truth())
+    short = eph.select(eph.seconds <= 4.0 * 3600)
+    runs = detect_orbit_product({"L27": short, "L28": replace(short, satellite="L28")})
+    assert sorted(runs) == ["L27", "L28"]
+    for run in runs.values():
+        assert run.summary["tested"] is False and len(run.events) == 0
+        assert run.result.warnings[0].startswith("nothing tested: the arc spans 4 h")

@@ -14,8 +14,9 @@ Two checks frame :func:`abrupt.pipelines.laser_ranging.run_laser_ranging_files`:
   physics bounds it: the radiation-pressure coefficient C_R of a body lies between 1 (absorbing) and 2
   (specular), so with A/m known to ±25 % the scale of the a-priori C_R·A/m lies in
   :data:`SRP_SCALE_BOUNDS`; drag follows an atmosphere model good to a factor of 3 (:data:`DRAG_SCALE_BOUNDS`).
-  A fit that needs more absorbs a residual its model cannot explain; its detections are then reported
-  as such (kind ``unknown``, the violations named), not as maneuvers.
+  A fit that needs more absorbs a residual its model cannot explain, and a post-fit range RMS above
+  :data:`MAX_POSTFIT_RMS_M` is a residual it could not absorb; its detections are then reported as such
+  (kind ``unknown``, the violations named), not as maneuvers.
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from abrupt.series.ephemeris import Ephemeris
 MAX_APRIORI_RANGE_RATIO = 0.01  # median |measured / a-priori range − 1| of a station above this: refused
 MIN_RANGES_CHECKED = 3  # fewer ranges of a station inside the ephemeris: not checked
 MAX_RANGE_BIAS_M = 1.0  # [m] largest physical range bias (station calibration + centre-of-mass offset)
+MAX_POSTFIT_RMS_M = 1.0  # [m] normal points are mm to cm: a metre of post-fit RMS is not noise
 SRP_SCALE_BOUNDS = (0.66, 2.2)  # C_R in [1, 2] against an a-priori 1.13, A/m within ±25 %
 DRAG_SCALE_BOUNDS = (0.33, 3.0)  # an atmosphere model good to a factor of 3
 SCALE_BOUNDS = {"srp_scale": SRP_SCALE_BOUNDS, "drag_scale": DRAG_SCALE_BOUNDS}
@@ -86,9 +88,19 @@ def check_ranges_against_apriori(
     return ratios
 
 
-def fit_bound_violations(range_bias_m: Mapping[str, float], scale_factors: Mapping[str, float]) -> list[str]:
-    """The fitted parameters outside their physical bounds (module docstring), one phrase each."""
+def fit_bound_violations(
+    range_bias_m: Mapping[str, float],
+    scale_factors: Mapping[str, float],
+    residual_rms_m: Mapping[str, float] | None = None,
+) -> list[str]:
+    """The fitted parameters outside their physical bounds (module docstring), and stations whose post-fit
+    range RMS exceeds :data:`MAX_POSTFIT_RMS_M` (residuals the fit cannot absorb), one phrase each."""
     out = [
+        f"post-fit range RMS {rms:.3g} m at station {name} (≤ {MAX_POSTFIT_RMS_M:g} m)"
+        for name, rms in sorted((residual_rms_m or {}).items())
+        if not rms <= MAX_POSTFIT_RMS_M
+    ]
+    out += [
         f"range bias {1e3 * b:.0f} mm at station {name} (|bias| ≤ {1e3 * MAX_RANGE_BIAS_M:.0f} mm)"
         for name, b in sorted(range_bias_m.items())
         if not abs(b) <= MAX_RANGE_BIAS_M

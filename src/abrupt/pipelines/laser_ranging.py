@@ -473,7 +473,7 @@ def run_laser_ranging_files(
     summary = _run_summary(result, len(meas), repairs)
     if elements is not None:
         summary["apriori_from_elements"] = elements.fits
-    frame, summary["warnings"] = _unabsorbed(frame, result)
+    frame, warnings = _unabsorbed(frame, result)
     target = str(meas["satellite"].iloc[0]) if "satellite" in meas else (apriori_name or name)
     passive = passive_satellite(target) or (passive_satellite(apriori_name) if apriori_name else None)
     if propulsion is False or (propulsion is None and passive is not None):
@@ -481,8 +481,9 @@ def run_laser_ranging_files(
         gap_s = float(np.max(np.diff(t)) / np.timedelta64(1, "s")) if t.size > 1 else 0.0
         area_to_mass = (force.srp_area_m2 or 0.0) / force.mass_kg if force.mass_kg else DEFAULT_AREA_TO_MASS_M2_KG
         frame, notes = passive_detections(frame, passive.name if passive else name, area_to_mass, gap_s)
-        summary["warnings"] = [*summary["warnings"], *notes]
+        warnings += notes
         summary["propulsion"] = False
+    summary["warnings"] = warnings
     times = np.asarray(meas["time_utc"], dtype="datetime64[ns]")
     analysed = [AnalysedSpan(name, times.min(), times.max(), LaserGlrtDetector.name)]
     return LaserRangingRun(frame, result, summary, run_id, cfg_hash, analysed)
@@ -572,7 +573,8 @@ def _unabsorbed(frame: pd.DataFrame, result: LaserArcsResult) -> tuple[pd.DataFr
         return frame, warnings
     frame = frame.copy()
     for arc in result.arcs:
-        bad = fit_bound_violations(arc.result.fit.range_bias_m, arc.result.fit.scale_factors)
+        fit = arc.result.fit
+        bad = fit_bound_violations(fit.range_bias_m, fit.scale_factors, arc.result.residual_rms_m)
         if not bad:
             continue
         lo, hi = arc.owned_s

@@ -214,7 +214,7 @@ def without_propulsion(run: OrbitRun, area_to_mass_m2_kg: float) -> OrbitRun:
     return out
 
 
-def _untested(det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, reason: str) -> OrbitRun:
+def untested_run(det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, reason: str) -> OrbitRun:
     """A run that tested nothing (an arc too short for the filters to settle): no events, its reason as a
     warning, and a summary that says so."""
     warning = f"nothing tested: {reason}"
@@ -238,11 +238,11 @@ def untested_summary(eph: Ephemeris, fa: FalseAlarmBudget, warnings: list[str]) 
 
 def _detect_arc(det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, sequences: bool) -> OrbitRun:
     """One arc: detection, burn sequences, the fit summary and its check; an arc too short to test gives a
-    run that tested nothing (:func:`_untested`)."""
+    run that tested nothing (:func:`untested_run`)."""
     try:
         result = det.detect(eph, fa)
     except ArcTooShortError as exc:
-        return _untested(det, eph, fa, exc.reason)
+        return untested_run(det, eph, fa, exc.reason)
     # the removal needs the sharp time of the GLR; the thesis statistics' broad humps would re-raise
     if sequences and det.statistic == "glr" and len(result.events):
         events, notes = resolve_sequence(det, eph, fa, result)

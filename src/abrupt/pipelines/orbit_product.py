@@ -23,10 +23,10 @@ from typing import Any
 from abrupt.detect.base import get_detector
 from abrupt.detect.orbit.analysis import OrbitAnalysis
 from abrupt.detect.orbit.calibration import self_calibrate
-from abrupt.detect.orbit.detectors import OrbitDetector
+from abrupt.detect.orbit.detectors import ArcTooShortError, OrbitDetector
 from abrupt.detect.orbit.pooled import ArcNull, pooled_thresholds
 from abrupt.errors import ConfigError
-from abrupt.pipelines.orbit import OrbitRun, as_budget, detector_class_name, fit_summary
+from abrupt.pipelines.orbit import OrbitRun, as_budget, detector_class_name, fit_summary, untested_run
 from abrupt.pipelines.orbit_sequence import resolve_sequence
 from abrupt.readers.orbit_envelope import check_orbit_envelope
 from abrupt.readers.sp3 import parse_sp3
@@ -68,11 +68,15 @@ def detect_orbit_product(
         raise ConfigError(f"{detector!r} is not an orbit filter detector", key="detector")
     fa = as_budget(budget)
     work: dict[str, tuple[OrbitDetector, Ephemeris, OrbitAnalysis]] = {}
+    untested: dict[str, OrbitRun] = {}
     for sid, eph in ephs.items():
         if len(eph) < MIN_EPOCHS:
             continue
         det = cls(**settings)
-        work[sid] = (det, eph, det.analyse(eph, fa))
+        try:
+            work[sid] = (det, eph, det.analyse(eph, fa))
+        except ArcTooShortError as exc:  # this satellite's arc: a run that tested nothing, the others go on
+            untested[sid] = untested_run(det, eph, fa, exc.reason)
     levels: dict[str, Any] = {}
     if pooled and work:
         first = next(iter(work.values()))[2].config
@@ -80,7 +84,7 @@ def detect_orbit_product(
         arcs = [ArcNull(an.t_s, an.statistics[name], e.nominal_step_s) for _, e, an in work.values()]
         suppress = max(first.merge_s, first.settle_s)
         levels = dict(zip(work, pooled_thresholds(arcs, fa, merge_s=first.merge_s, suppress_s=suppress), strict=True))
-    runs: dict[str, OrbitRun] = {}
+    runs: dict[str, OrbitRun] = dict(untested)
     for sid, (det, eph, an) in work.items():
         level = levels.get(sid)
         if level is not None:

@@ -35,6 +35,7 @@ import math
 from dataclasses import replace
 
 import numpy as np
+import pandas as pd
 from numpy.typing import NDArray
 
 from abrupt.errors import InputError
@@ -56,8 +57,10 @@ DYNAMICS_TRUNCATION = 2e-3  # half-span of the differences: (n h)² / 6 below th
 OUTLIER_NODES = 4  # neighbours on each side that interpolate an epoch (degree-7 Lagrange)
 OUTLIER_SIGMAS = 10.0  # an interpolation residual this many robust σ above the arc's is a candidate
 OUTLIER_FLOOR_M = 0.05  # [m] and at least this large (precise products: mm-level residuals)
+OUTLIER_NOISE_WINDOW = 101  # epochs of the running median that sets the local noise level
 
 OUTLIER_REPAIR = "single-epoch position outlier (disagrees with both neighbours) removed"
+ZERO_VELOCITY_REPAIR = "epoch with a zero velocity vector in a file with velocities (removed)"
 PV_MISMATCH_REPAIR = "epoch whose velocity disagrees with its neighbours' positions (removed with them)"
 
 
@@ -167,15 +170,30 @@ def _residuals(t_s: FloatArray, r_m: FloatArray, keep: NDArray[np.bool_], at: ND
     return out
 
 
+def local_noise_level(residual_m: FloatArray) -> FloatArray:
+    """Per-epoch outlier level (m): :data:`OUTLIER_SIGMAS` robust σ of the interpolation residuals around
+    each epoch (their running median over :data:`OUTLIER_NOISE_WINDOW` epochs over 1.5382, the median of the
+    norm of a 3-d normal vector of unit per-axis σ), and at least :data:`OUTLIER_FLOOR_M`. Local, so that a
+    product whose noise changes along the arc keeps each part's own level."""
+    median = (
+        pd.Series(residual_m)
+        .rolling(OUTLIER_NOISE_WINDOW, center=True, min_periods=OUTLIER_NODES)
+        .median()
+        .bfill()
+        .ffill()
+        .to_numpy(dtype=np.float64)
+    )
+    return np.maximum(OUTLIER_SIGMAS * np.nan_to_num(median, nan=0.0) / 1.5382, OUTLIER_FLOOR_M)
+
+
 def single_epoch_outliers(t_s: FloatArray, r_m: FloatArray) -> NDArray[np.bool_]:
     """Epochs whose position disagrees with both neighbours while the neighbours agree with each other.
 
     Each epoch is compared with the degree-7 Lagrange interpolation of its four neighbours on each side
     (truncation error ~(n h)⁸ r (4!)²/8!: below a millimetre for LEO at 60 s). An epoch whose residual
-    exceeds :data:`OUTLIER_SIGMAS` robust σ of the arc's residuals (and :data:`OUTLIER_FLOOR_M`) is an
-    outlier when, without it, every neighbour's residual falls back below that level: a bad record. A
-    burn (a kink of the positions) or a step of every later record leaves its neighbours disturbed and
-    is not removed. Returns the mask of outliers.
+    exceeds the local level (:func:`local_noise_level`) is an outlier when, without it, every
+    neighbour's residual falls back below that level: a bad record. A burn (a kink of the positions) or
+    a step of every later record leaves its neighbours disturbed and is not removed. Returns the mask.
     """
     n = t_s.size
     outlier = np.zeros(n, dtype=bool)
@@ -183,15 +201,13 @@ def single_epoch_outliers(t_s: FloatArray, r_m: FloatArray) -> NDArray[np.bool_]
         return outlier
     keep = np.ones(n, dtype=bool)
     res = _residuals(t_s, r_m, keep, np.arange(n))
-    finite = res[np.isfinite(res)]
-    if not finite.size:
+    if not np.isfinite(res).any():
         return outlier
-    sigma = float(np.median(finite)) / 1.5382  # median of the norm of a 3-d normal vector, per-axis σ
-    level = max(OUTLIER_SIGMAS * sigma, OUTLIER_FLOOR_M)
-    for i in np.argsort(-np.nan_to_num(res, nan=-1.0)):
-        if not res[i] > level:
+    level = local_noise_level(res)
+    for i in np.argsort(-np.nan_to_num(res / level, nan=-1.0)):
+        if not res[i] > level[i]:
             break
-        if not keep[i] or not _residuals(t_s, r_m, keep, np.array([i]))[0] > level:
+        if not keep[i] or not _residuals(t_s, r_m, keep, np.array([i]))[0] > level[i]:
             continue  # removed, or a neighbour of an outlier removed before it
         trial = keep.copy()
         trial[i] = False
@@ -199,7 +215,7 @@ def single_epoch_outliers(t_s: FloatArray, r_m: FloatArray) -> NDArray[np.bool_]
         p = int(np.searchsorted(kept, i))
         near = kept[max(0, p - OUTLIER_NODES) : p + OUTLIER_NODES]
         after = _residuals(t_s, r_m, trial, near)
-        if np.all(np.nan_to_num(after, nan=0.0) <= level):
+        if np.all(np.nan_to_num(after, nan=0.0) <= level[near]):
             keep[i] = False
             outlier[i] = True
     return outlier
@@ -274,6 +290,10 @@ def check_velocities(eph: Ephemeris) -> Ephemeris:
         return eph
     if not np.any(np.linalg.norm(v[given], axis=1) > 0):
         raise _refuse(eph, "velocity = derivative of position", "every velocity is zero (velocities not given?)")
+    zero = given & ~(np.linalg.norm(np.nan_to_num(v), axis=1) > 0)
+    if zero.any():  # no Earth orbiter stands still: a zero vector is a velocity not given
+        eph.repairs.record(ZERO_VELOCITY_REPAIR, int(zero.sum()))
+        return check_velocities(eph.select(~zero))
     idx = np.flatnonzero(given)
     t_ns = eph.times_utc[idx].astype(np.int64)
     median, usable, residual = velocity_derivative_ratio(t_ns, eph.position_m[idx], v[idx])
