@@ -41,6 +41,7 @@ import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from abrupt.errors import ConfigError, InputError
+from abrupt.readers.text import check_column_count
 
 DEFAULT_PLACEHOLDERS: tuple[float, ...] = (-999999.0, 999999.0, -99999.0, -9999999.0)
 # Beyond any telemetry value: above the largest 64-bit counter (1.8e19); inf and 1e300 are corruption.
@@ -183,6 +184,7 @@ def _read_raw(path: Path) -> pa.Table:
             return pacsv.read_csv(str(path), read_options=read, parse_options=parse, convert_options=opts)
 
         # Only the empty field is null: the text "NaN" parses as a float NaN and is counted as a placeholder.
+        check_column_count(path)
         header = _header(path, gz)
         lower = [h.strip().lower() for h in header]
         if len(header) == 3 and lower[0] in TIME_NAMES and lower[1:] == ["mnemonic", "value"]:
