@@ -9,7 +9,7 @@ import click
 import pandas as pd
 
 from abrupt.catalog import Catalog
-from abrupt.cli.groups import catalog_option, cli
+from abrupt.cli.groups import catalog_option, cli, printable_lines
 
 #: Width the default view fits in (characters).
 VIEW_WIDTH = 120
@@ -109,7 +109,7 @@ def list_(catalog_target: str, runs: bool, wide: bool, **filters: Any) -> None:
                 }
             )
         with pd.option_context("display.width", 400, "display.max_columns", 50, "display.max_colwidth", 400):
-            click.echo(frame.to_string(index=False))
+            click.echo(printable_lines(frame.to_string(index=False)))
         return
     frame = cat.events(**_filters(filters))
     if frame.empty:
@@ -117,8 +117,8 @@ def list_(catalog_target: str, runs: bool, wide: bool, **filters: Any) -> None:
         return
     if wide:
         with pd.option_context("display.width", 1000, "display.max_columns", 100):
-            click.echo(frame.to_string(index=False))
+            click.echo(printable_lines(frame.to_string(index=False)))
     else:
-        click.echo("\n".join(narrow_view(frame)))
+        click.echo(printable_lines("\n".join(narrow_view(frame))))
     n_events = frame["event_key"].nunique()
     click.echo(f"{len(frame)} detection(s) of {n_events} event(s)", err=True)

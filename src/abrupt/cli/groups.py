@@ -22,6 +22,7 @@ import click
 from abrupt import progress as progress_report
 from abrupt.catalog import Catalog, coverage_of
 from abrupt.cli.commands import GLOBAL_FLAGS, State, cli, detect, hoist_global_flags, inject, report, simulate
+from abrupt.errors import printable
 from abrupt.events import write_events
 from abrupt.outputs import atomic_output
 
@@ -37,6 +38,7 @@ __all__ = [
     "hoist_global_flags",
     "inject",
     "note",
+    "printable_lines",
     "progress",
     "progress_hidden",
     "record_run",
@@ -55,12 +57,12 @@ DEFAULT_CATALOG = "abrupt_catalog.sqlite"
 def note(message: str) -> None:
     """A note for the user on standard error (progress stages, summaries); silent with ``--quiet``."""
     if not State.quiet:
-        click.echo(message, err=True)
+        click.echo(printable_lines(message), err=True)
 
 
 def warn(message: str) -> None:
     """A warning on standard error; shown even with ``--quiet``."""
-    click.echo(f"warning: {message}", err=True)
+    click.echo(f"warning: {printable_lines(message)}", err=True)
 
 
 catalog_option = click.option(
@@ -96,6 +98,11 @@ def check_suffix(*suffixes: str) -> Any:
         return value
 
     return callback
+
+
+def printable_lines(text: str) -> str:
+    """``text`` for the terminal: control characters escaped (:func:`abrupt.errors.printable`) in each line."""
+    return "\n".join(printable(line) for line in text.split("\n"))
 
 
 def file_hash(path: str | Path) -> str:

@@ -76,6 +76,28 @@ class Decoder:
         return pseudonym.split(".", 1)[0]
 
 
+def _check_pseudonyms_hide(pseudonym_of: dict[str, str], line_of: dict[str, int], path: Path) -> None:
+    """Refuse a pseudonym that contains (or is) a real name of the decoder, whatever the case
+    (``KESTREL2-anon``, ``kestrel2``): it would carry that name into the store, its reports and the
+    console. Neither name is quoted in the error, which names the lines instead."""
+    line_of_real = {real.lower(): line_of[pseudo] for real, pseudo in pseudonym_of.items()}
+    pattern = re.compile("|".join(re.escape(r) for r in sorted(line_of_real, key=len, reverse=True)), re.IGNORECASE)
+    for pseudo, line in sorted(line_of.items(), key=lambda item: item[1]):
+        found = pattern.search(pseudo)
+        if found:
+            real_line = line_of_real[found.group(0).lower()]
+            raise InputError(
+                f"the pseudonym contains the real name of line {real_line} (case-insensitive): a pseudonym must not "
+                "reveal a real name",
+                file=path,
+                line=line,
+                column=2,
+            )
+    for pseudo, line in line_of.items():
+        if not pseudo.isprintable():
+            raise InputError("the pseudonym holds a control character", file=path, line=line, column=2)
+
+
 def read_decoder(path: str | Path) -> Decoder:
     """Read a ``real_name,pseudonym`` decoder; an error names the line and the reason."""
     path = Path(path)
@@ -104,6 +126,7 @@ def read_decoder(path: str | Path) -> Decoder:
         target[real] = pseudo
     if not mnemonics:
         raise InputError("no mnemonic pseudonyms (pseudonyms of mnemonics contain a dot: 'SC-A.ch01')", file=path)
+    _check_pseudonyms_hide({**mnemonics, **spacecraft}, seen_pseudo, path)
     known = set(spacecraft.values())
     for pseudo in mnemonics.values():
         sc = pseudo.split(".", 1)[0]
