@@ -214,7 +214,8 @@ def test_cli_reversed_span_is_a_one_line_error(tmp_path: Path, capsys: pytest.Ca
 
 def test_api_and_cli_give_the_same_classes_and_evidence(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """The synthetic archive with three 0.087 N·m·s strikes on a 50 kg spacecraft in a 3 m box (a strike
-    there must move the orbit by ≈ 0.67 mm/s, 3 floors) and the orbit side given as options and as an :class:`OrbitSource`:
+    there must move the orbit by ≈ 0.67 mm/s, 3 floors) and the orbit side given as options and as an
+    :class:`OrbitSource`:
     two overlapping intervals (merged, the repair reported by both) cover 00:00-02:30, one covers 04:00-12:00.
     The strike at 02:00 (covered, nothing seen) is no strike; the one at 03:15 (in the gap) keeps its class
     with no orbit evidence; the one at 05:00 has a 3 mm/s orbit event 20 s after it and stays a strike. Both

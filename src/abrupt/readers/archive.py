@@ -50,6 +50,19 @@ ARCHIVE_ABSURD = "infinite or absurd values (|v| > 1e20)"
 TIME_NAMES = ("time", "timestamp", "time_utc", "utc", "datetime")
 
 
+MAX_LISTED_UNKNOWN = 5  # unknown names listed one by one; more are summarised in one count
+
+
+def _unknown_name_counts(unknown_names: Counter[str], n_names: int) -> dict[str, int]:
+    """Rows of names not in the decoder, by name token; more than :data:`MAX_LISTED_UNKNOWN` names are one
+    count naming how many names and the first few tokens (100 000 names must not make a 5 MB line)."""
+    if len(unknown_names) <= MAX_LISTED_UNKNOWN:
+        return {f"rows of a name not in the decoder ({k})": v for k, v in unknown_names.items()}
+    first = ", ".join(k for k, _ in unknown_names.most_common(MAX_LISTED_UNKNOWN))
+    label = f"rows of {n_names} names not in the decoder (most rows: {first}, ...)"
+    return {label: sum(unknown_names.values())}
+
+
 def name_token(real_name: str) -> str:
     """A short hash of a real name, safe to print: ``unknown-<6 hex>`` (SHA-256 with a fixed salt)."""
     return "unknown-" + hashlib.sha256(("abrupt-pseudonym:" + real_name).encode()).hexdigest()[:6]
@@ -543,10 +556,11 @@ def _read_archive(
     if bad_values:
         counts["unparseable values"] += bad_values
     unknown_names: Counter[str] = Counter()
+    counted = ~drop_missing & ~drop_empty & ~drop_placeholder & ~drop_absurd
+    rows_per_code = np.bincount(codes_safe[counted], minlength=len(pseudo_of_code) + 1)
     for c in unknown_codes:
-        n_c = int(np.count_nonzero((codes == c) & ~drop_missing & ~drop_empty & ~drop_placeholder & ~drop_absurd))
-        if n_c:
-            unknown_names[name_token(str(dictionary[c]))] += n_c
+        if rows_per_code[c]:
+            unknown_names[name_token(str(dictionary[c]))] += int(rows_per_code[c])
 
     pseudo_arr = np.array([p if p is not None else "" for p in pseudo_of_code] + [""], dtype=object)
     day_idx = np.where(t_valid, t_int // DAY_NS, -1)
@@ -570,8 +584,7 @@ def _read_archive(
     no_name_rows = int(np.count_nonzero(no_name & t_valid))
     if no_name_rows:
         counts["rows without a mnemonic"] += no_name_rows
-    if unknown_names:
-        counts.update({f"rows of a name not in the decoder ({k})": v for k, v in unknown_names.items()})
+    counts.update(_unknown_name_counts(unknown_names, sum(1 for c in unknown_codes if rows_per_code[c])))
 
     # Categories sorted by name: sorting by mnemonic code groups each spacecraft's mnemonics
     # (names sharing the prefix "SC-A." are contiguous) and orders them by name.
