@@ -110,7 +110,7 @@ def make_archive(
     out_dir: Path,
     *,
     hours: float = 6.0,
-    period_s: float = 3000.0,
+    period_s: float = 5400.0,
     strikes: list[tuple[float, list[float]]] | None = None,
     dump_at_s: float | None = None,
     seed: int = 1,

@@ -78,12 +78,9 @@ COVER = NavigationCoverage((DAY,), FLOOR)
 def test_least_dv_of_a_strike_is_its_dh_over_mass_and_farthest_surface_point(tmp_path: Path) -> None:
     """A strike at the farthest corner with p ⊥ r has |ΔV| = |ΔH| / (m |r|): the bound (1) is met there and
     every other surface point needs more (r × p = ΔH with |r| smaller)."""
-    m = 50.0
+    m = 500.0  # [kg] with the synthetic inertia, a body that fits the box (sqrt(I/m) 1.4 m)
     path = tmp_path / "sc.toml"
-    path.write_text(
-        spacecraft_toml(3000.0).replace("mass_kg = 500.0", f"mass_kg = {m}", 1)
-        + '[[surfaces]]\nshape = "box"\nsize_m = [2.0, 1.0, 1.0]\n'
-    )
+    path.write_text(spacecraft_toml(5400.0) + '[[surfaces]]\nshape = "box"\nsize_m = [2.0, 1.0, 1.0]\n')
     sc = load_spacecraft(path)
     corner = np.array([1.0, 0.5, 0.5])  # farthest point of the box [m]
     p = np.cross(corner, [0.0, 0.0, 1.0])
@@ -217,7 +214,7 @@ def test_spans_and_floor_are_checked() -> None:
 @pytest.fixture
 def cli_inputs(tmp_path: Path) -> tuple[Path, Path]:
     sc = tmp_path / "sc.toml"
-    sc.write_text(spacecraft_toml(3000.0))
+    sc.write_text(spacecraft_toml(5400.0))
     store = tmp_path / "store"
     store.mkdir()
     return sc, store
@@ -301,13 +298,13 @@ def test_orbit_events_read_from_json_and_csv_alike(tmp_path: Path) -> None:
 
 def test_cli_strike_on_a_light_spacecraft_that_the_orbit_did_not_feel(tmp_path: Path) -> None:
     """A strike of 0.087 N·m·s injected into the synthetic archive (closed loop) on a spacecraft file of
-    50 kg with a 1 m box: a strike must move the orbit by ≥ |ΔH| / (m r_max) ≈ 2 mm/s (r_max: the box's
-    corner, 0.87 m); an orbit run covering the day with a 0.2 mm/s floor and no event near it says it was
-    no strike."""
+    50 kg with a 3 m box (large enough for the synthetic inertia at that mass): a strike must move the orbit
+    by ≥ |ΔH| / (m r_max) ≈ 0.67 mm/s (r_max: the box's corner, 2.6 m); an orbit run covering the day with a
+    0.2 mm/s floor and no event near it says it was no strike."""
     a = make_archive(tmp_path, hours=6.0, strikes=[])
     ingest_archives([a.archive], a.decoder, tmp_path / "store")
     text = a.spacecraft.read_text().replace("mass_kg = 500.0", "mass_kg = 50.0", 1)
-    a.spacecraft.write_text(text + '[[surfaces]]\nshape = "box"\nsize_m = [1.0, 1.0, 1.0]\n')
+    a.spacecraft.write_text(text + '[[surfaces]]\nshape = "box"\nsize_m = [3.0, 3.0, 3.0]\n')
     dh = np.array([0.06, -0.05, 0.04])  # [N·m·s], inertial axes
     strike = "2026-01-05T02:00:00:" + ",".join(f"{x:g}" for x in dh)
     cli_main(["inject", "attitude", "--store", str(tmp_path / "store"), "--spacecraft", str(a.spacecraft),
@@ -323,7 +320,7 @@ def test_cli_strike_on_a_light_spacecraft_that_the_orbit_did_not_feel(tmp_path: 
     row = ev[t.abs() < 30.0]
     assert len(row) == 1
     r = row.iloc[0]
-    expected_min = float(np.linalg.norm(dh)) / (50.0 * math.sqrt(0.75))
+    expected_min = float(np.linalg.norm(dh)) / (50.0 * math.sqrt(3 * 1.5**2))
     assert r["ev_min_dv_mps"] == pytest.approx(expected_min, rel=0.02)  # |ΔH| estimated within 1-2 %
     assert r["ev_orbit_dv_mps"] == 0.0 and r["ev_orbit_dv_floor_mps"] == 2e-4
     assert r["kind"] == "unknown" and "not a strike" in r["kind_reason"], r["kind_reason"]

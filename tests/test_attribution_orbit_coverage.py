@@ -199,7 +199,7 @@ def test_api_bad_input_gets_the_clis_errors_in_its_own_names(tmp_path: Path) -> 
 
 def test_cli_reversed_span_is_a_one_line_error(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     sc, store, ev = tmp_path / "sc.toml", tmp_path / "store", tmp_path / "orbit.csv"
-    sc.write_text(spacecraft_toml(3000.0))
+    sc.write_text(spacecraft_toml(5400.0))
     store.mkdir()
     write_events(_orbit_events(("2026-01-05T01:00:00Z", 1e-3)), str(ev))
     with pytest.raises(SystemExit) as exc:
@@ -214,8 +214,9 @@ def test_cli_reversed_span_is_a_one_line_error(tmp_path: Path, capsys: pytest.Ca
 
 
 def test_api_and_cli_give_the_same_classes_and_evidence(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """The synthetic archive with three 0.087 N·m·s strikes on a 50 kg spacecraft (a strike there must move
-    the orbit by ≈ 2 mm/s, 10 floors) and the orbit side given as options and as an :class:`OrbitSource`:
+    """The synthetic archive with three 0.087 N·m·s strikes on a 50 kg spacecraft in a 3 m box (a strike
+    there must move the orbit by ≈ 0.67 mm/s, 3 floors) and the orbit side given as options and as an
+    :class:`OrbitSource`:
     two overlapping intervals (merged, the repair reported by both) cover 00:00-02:30, one covers 04:00-12:00.
     The strike at 02:00 (covered, nothing seen) is no strike; the one at 03:15 (in the gap) keeps its class
     with no orbit evidence; the one at 05:00 has a 3 mm/s orbit event 20 s after it and stays a strike. Both
@@ -223,7 +224,7 @@ def test_api_and_cli_give_the_same_classes_and_evidence(tmp_path: Path, capsys: 
     a = make_archive(tmp_path, hours=6.0, strikes=[])
     ingest_archives([a.archive], a.decoder, tmp_path / "store")
     text = a.spacecraft.read_text().replace("mass_kg = 500.0", "mass_kg = 50.0", 1)
-    a.spacecraft.write_text(text + '[[surfaces]]\nshape = "box"\nsize_m = [1.0, 1.0, 1.0]\n')
+    a.spacecraft.write_text(text + '[[surfaces]]\nshape = "box"\nsize_m = [3.0, 3.0, 3.0]\n')
     dh = "0.06,-0.05,0.04"  # [N·m·s], inertial axes
     strikes = [x for t in ("02:00:00", "03:15:00", "05:00:00") for x in ("--strike", f"2026-01-05T{t}:{dh}")]
     cli_main(["inject", "attitude", "--store", str(tmp_path / "store"), "--spacecraft", str(a.spacecraft),

@@ -208,20 +208,20 @@ def test_orbit_period_estimated_from_the_attitude_when_the_file_has_none(
     d, a = synth
     text = Path(a.spacecraft).read_text()  # type: ignore[attr-defined]
     no_orbit = tmp_path / "no_orbit.toml"
-    no_orbit.write_text(text.replace("[orbit]\nperiod_s = 3000.0\n", ""))
+    no_orbit.write_text(text.replace("[orbit]\nperiod_s = 5400.0\n", ""))
     sc = load_spacecraft(no_orbit)
     assert sc.orbit is None
     res = run_flight(d / "store", sc, FAST)
     note = next(w for w in res.warnings if "orbit period estimated" in w)
     period = float(note.rsplit(":", 1)[1].split()[0])
-    assert period == pytest.approx(3000.0, rel=0.01)  # the generator turns the body once per 3000 s
+    assert period == pytest.approx(5400.0, rel=0.01)  # the generator turns the body once per 5400 s
     assert len(res.events) == len(a.strikes)  # type: ignore[attr-defined]
 
 
 @pytest.mark.slow
 def test_chunked_six_hour_chunks_equal_the_whole_run(tmp_path: Path) -> None:
     a = make_archive(
-        tmp_path, hours=18.0, period_s=2400.0, strikes=[(20000.0, [0.05, 0.02, -0.03]), (43300.0, [0.0, -0.04, 0.03])]
+        tmp_path, hours=18.0, period_s=5400.0, strikes=[(20000.0, [0.05, 0.02, -0.03]), (43300.0, [0.0, -0.04, 0.03])]
     )
     ingest_archives([a.archive], a.decoder, tmp_path / "store")
     sc = load_spacecraft(a.spacecraft)

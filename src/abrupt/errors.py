@@ -24,6 +24,15 @@ def quote(text: str, limit: int = 80) -> str:
     return f"{text[:limit]!r}… ({len(text)} characters)"
 
 
+def printable(text: str) -> str:
+    """``text`` with every control character (C0, DEL, C1: the terminal's escape sequences, the bell)
+    written as a visible escape (``\\x1b``), so that a name read from a file cannot drive the terminal
+    it is printed on; ordinary text is returned unchanged."""
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() or c == " " else c.encode("unicode_escape").decode("ascii") for c in text)
+
+
 def bounded(reason: str) -> str:
     """A reason cut to :data:`MAX_REASON_CHARS` characters."""
     if len(reason) <= MAX_REASON_CHARS:

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from abrupt.cli.commands import lazy_module
-from abrupt.cli.groups import catalog_option, cli
+from abrupt.cli.groups import catalog_option, cli, printable_lines
 from abrupt.kinds import EVENT_KINDS
 
 if TYPE_CHECKING:
@@ -130,7 +130,7 @@ def list_(catalog_target: str, runs: bool, wide: bool, **filters: Any) -> None:
                 }
             )
         with pd.option_context("display.width", 400, "display.max_columns", 50, "display.max_colwidth", 400):
-            click.echo(frame.to_string(index=False))
+            click.echo(printable_lines(frame.to_string(index=False)))
         return
     frame = cat.events(**_filters(filters))
     if frame.empty:
@@ -138,9 +138,9 @@ def list_(catalog_target: str, runs: bool, wide: bool, **filters: Any) -> None:
         return
     if wide:
         with pd.option_context("display.width", 1000, "display.max_columns", 100):
-            click.echo(frame.to_string(index=False))
+            click.echo(printable_lines(frame.to_string(index=False)))
     else:
-        click.echo("\n".join(narrow_view(frame)))
+        click.echo(printable_lines("\n".join(narrow_view(frame))))
     n_events = frame["event_key"].nunique()
     click.echo(f"{len(frame)} detection(s) of {n_events} event(s)", err=True)
 

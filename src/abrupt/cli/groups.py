@@ -31,6 +31,7 @@ from abrupt.cli.commands import (
     report,
     simulate,
 )
+from abrupt.errors import printable
 from abrupt.outputs import atomic_output
 
 if TYPE_CHECKING:
@@ -52,6 +53,7 @@ __all__ = [
     "hoist_global_flags",
     "inject",
     "note",
+    "printable_lines",
     "progress",
     "progress_hidden",
     "record_run",
@@ -70,12 +72,12 @@ DEFAULT_CATALOG = "abrupt_catalog.sqlite"
 def note(message: str) -> None:
     """A note for the user on standard error (progress stages, summaries); silent with ``--quiet``."""
     if not State.quiet:
-        click.echo(message, err=True)
+        click.echo(printable_lines(message), err=True)
 
 
 def warn(message: str) -> None:
     """A warning on standard error; shown even with ``--quiet``."""
-    click.echo(f"warning: {message}", err=True)
+    click.echo(f"warning: {printable_lines(message)}", err=True)
 
 
 catalog_option = click.option(
@@ -111,6 +113,11 @@ def check_suffix(*suffixes: str) -> Any:
         return value
 
     return callback
+
+
+def printable_lines(text: str) -> str:
+    """``text`` for the terminal: control characters escaped (:func:`abrupt.errors.printable`) in each line."""
+    return "\n".join(printable(line) for line in text.split("\n"))
 
 
 def file_hash(path: str | Path) -> str:

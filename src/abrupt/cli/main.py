@@ -7,16 +7,28 @@ when its command runs or its help is shown, so ``abrupt --help`` stays fast.
 from __future__ import annotations
 
 import sys
+import warnings
+from typing import Any
 
 import click
 
 from abrupt.cli.commands import cli, hoist_global_flags
-from abrupt.errors import AbruptError
+from abrupt.errors import AbruptError, bounded, printable
+
+
+def show_warning(
+    message: Warning | str, category: type[Warning], filename: str, lineno: int, file: Any = None, line: Any = None
+) -> None:
+    """A library's warning (ERFA's "dubious year", numpy's invalid value) as one line on standard error,
+    ``warning: Category: message``, without the source line Python would print under it."""
+    click.echo(f"warning: {category.__name__}: {printable(bounded(' '.join(str(message).split())))}", err=True)
 
 
 def main(argv: list[str] | None = None) -> None:
     """Run the command line; turn abrupt's own errors into a one-line message and exit status 2."""
     args = hoist_global_flags(list(sys.argv[1:] if argv is None else argv))
+    previous = warnings.showwarning
+    warnings.showwarning = show_warning
     try:
         cli.main(args=args, prog_name="abrupt", standalone_mode=False)
     except (AbruptError, ValueError) as exc:
@@ -35,6 +47,8 @@ def main(argv: list[str] | None = None) -> None:
     except click.ClickException as exc:
         exc.show()
         sys.exit(exc.exit_code)
+    finally:
+        warnings.showwarning = previous
 
 
 if __name__ == "__main__":

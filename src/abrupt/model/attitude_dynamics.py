@@ -82,6 +82,9 @@ class Strike:
         return float(np.linalg.norm(self.dH_B_Nms))
 
 
+MAX_TELEMETRY_SAMPLES = 5_000_000  # a simulation's telemetry rows held in memory (88 bytes each, per array)
+
+
 @dataclass(frozen=True)
 class AttitudeSimConfig:
     """Simulation settings; noise values are 1-sigma (Bennett 2022 Table 2.1, spec §2.3 and §3.6).
@@ -129,6 +132,13 @@ class AttitudeSimConfig:
             value = getattr(self, key)
             if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
                 raise ConfigError(f"must be a non-negative number, got {value!r}", key=key)
+        samples = self.duration_s * self.telemetry_rate_hz
+        if samples > MAX_TELEMETRY_SAMPLES:
+            raise ConfigError(
+                f"{self.duration_s:g} s at {self.telemetry_rate_hz:g} Hz is {samples:.3g} telemetry samples, more than "
+                f"{MAX_TELEMETRY_SAMPLES:.0e} (held in memory): simulate a shorter span or a lower rate",
+                key="duration_s",
+            )
         ratio = self.sim_rate_hz / self.telemetry_rate_hz
         if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
             raise ConfigError(

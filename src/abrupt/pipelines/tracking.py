@@ -119,6 +119,24 @@ def read_tracking_series(
     return TrackingInputs(series, force, use_refraction, biases, accel, repairs, epoch)
 
 
+MAX_SPAN_FROM_EPOCH_S = 60 * 86_400.0  # [s] measurements this far from the a-priori epoch cannot be fitted
+
+
+def check_span_from_epoch(data: TrackingArrays, file: str | Path) -> None:
+    """Raise :class:`InputError` when measurements lie more than :data:`MAX_SPAN_FROM_EPOCH_S` from the
+    set-up's a-priori epoch (a date typed decades off, or the set-up of another campaign): the a-priori
+    orbit cannot be propagated so far, and trying takes hours and gigabytes."""
+    if not len(data.t_s):
+        return
+    far = float(np.nanmax(np.abs(data.t_s)))
+    if far > MAX_SPAN_FROM_EPOCH_S:
+        raise InputError(
+            f"measurements reach {far / 86400.0:.4g} days from the set-up's a-priori epoch {data.epoch_utc} "
+            f"(at most {MAX_SPAN_FROM_EPOCH_S / 86400.0:g}): a wrong date, or the set-up of another campaign",
+            file=file,
+        )
+
+
 def read_tracking_arrays(
     file: str | Path, setup: OrbitDeterminationSetup, *, refraction: bool, repairs: RepairLog
 ) -> TrackingArrays:
@@ -139,6 +157,7 @@ def read_tracking_arrays(
         theta0_rad=setup.theta0_rad,
         source=str(file),
     )
+    check_span_from_epoch(data, file)
     check_implied_speeds(data, file)
     check_ranges_against_orbit(data, np.asarray(setup.initial_state, float), file, mu_m3_s2=setup.mu_m3_s2)
     return data

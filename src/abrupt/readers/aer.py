@@ -137,7 +137,33 @@ def read_aer(
         rows.append(row)
     if not rows:
         raise InputError("no measurements found", file=path)
-    return finish_measurements(pd.DataFrame(rows), path, log)
+    frame = pd.DataFrame(rows)
+    _check_angles_in_degrees(frame, path)
+    return finish_measurements(frame, path, log)
+
+
+RADIAN_CHECK_MIN_LINES = 10  # AZ_EL lines needed before angles all within radian ranges say "radians"
+
+
+def _check_angles_in_degrees(frame: pd.DataFrame, path: Path) -> None:
+    """Refuse angles written in radians (the format's unit is degrees): over at least
+    :data:`RADIAN_CHECK_MIN_LINES` AZ_EL lines, every azimuth within [0, 2π] and every elevation within
+    [-π/2, π/2] "degrees" means a station that only ever looked within 6° of north and 1.6° of its
+    horizon, which no tracking pass does; radians fill exactly those ranges."""
+    if "azimuth_rad" not in frame:
+        return
+    angles = frame.loc[frame["_kind"] == "AZ_EL", ["azimuth_rad", "elevation_rad"]].to_numpy(float)
+    if len(angles) < RADIAN_CHECK_MIN_LINES:
+        return
+    az_deg, el_deg = np.degrees(angles[:, 0]), np.degrees(angles[:, 1])
+    if np.all(az_deg <= 2 * math.pi) and np.all(np.abs(el_deg) <= math.pi / 2):
+        raise InputError(
+            f"all {len(angles)} azimuths are within 0-{2 * math.pi:.4f} and elevations within ±{math.pi / 2:.4f}: "
+            "the angles look like radians; the .aer format gives them in degrees",
+            file=path,
+            line=int(frame.loc[frame["_kind"] == "AZ_EL", "_line"].iloc[0]),
+            column=4,
+        )
 
 
 def finish_measurements(frame: pd.DataFrame, path: Path, log: RepairLog) -> pd.DataFrame:

@@ -41,12 +41,26 @@ import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from abrupt.errors import ConfigError, InputError
+from abrupt.readers.text import check_column_count
 
 DEFAULT_PLACEHOLDERS: tuple[float, ...] = (-999999.0, 999999.0, -99999.0, -9999999.0)
 # Beyond any telemetry value: above the largest 64-bit counter (1.8e19); inf and 1e300 are corruption.
 MAX_ABS_VALUE = 1e20
 ARCHIVE_ABSURD = "infinite or absurd values (|v| > 1e20)"
 TIME_NAMES = ("time", "timestamp", "time_utc", "utc", "datetime")
+
+
+MAX_LISTED_UNKNOWN = 5  # unknown names listed one by one; more are summarised in one count
+
+
+def _unknown_name_counts(unknown_names: Counter[str], n_names: int) -> dict[str, int]:
+    """Rows of names not in the decoder, by name token; more than :data:`MAX_LISTED_UNKNOWN` names are one
+    count naming how many names and the first few tokens (100 000 names must not make a 5 MB line)."""
+    if len(unknown_names) <= MAX_LISTED_UNKNOWN:
+        return {f"rows of a name not in the decoder ({k})": v for k, v in unknown_names.items()}
+    first = ", ".join(k for k, _ in unknown_names.most_common(MAX_LISTED_UNKNOWN))
+    label = f"rows of {n_names} names not in the decoder (most rows: {first}, ...)"
+    return {label: sum(unknown_names.values())}
 
 
 def name_token(real_name: str) -> str:
@@ -73,6 +87,28 @@ class Decoder:
 
     def spacecraft_of(self, pseudonym: str) -> str:
         return pseudonym.split(".", 1)[0]
+
+
+def _check_pseudonyms_hide(pseudonym_of: dict[str, str], line_of: dict[str, int], path: Path) -> None:
+    """Refuse a pseudonym that contains (or is) a real name of the decoder, whatever the case
+    (``KESTREL2-anon``, ``kestrel2``): it would carry that name into the store, its reports and the
+    console. Neither name is quoted in the error, which names the lines instead."""
+    line_of_real = {real.lower(): line_of[pseudo] for real, pseudo in pseudonym_of.items()}
+    pattern = re.compile("|".join(re.escape(r) for r in sorted(line_of_real, key=len, reverse=True)), re.IGNORECASE)
+    for pseudo, line in sorted(line_of.items(), key=lambda item: item[1]):
+        found = pattern.search(pseudo)
+        if found:
+            real_line = line_of_real[found.group(0).lower()]
+            raise InputError(
+                f"the pseudonym contains the real name of line {real_line} (case-insensitive): a pseudonym must not "
+                "reveal a real name",
+                file=path,
+                line=line,
+                column=2,
+            )
+    for pseudo, line in line_of.items():
+        if not pseudo.isprintable():
+            raise InputError("the pseudonym holds a control character", file=path, line=line, column=2)
 
 
 def read_decoder(path: str | Path) -> Decoder:
@@ -103,6 +139,7 @@ def read_decoder(path: str | Path) -> Decoder:
         target[real] = pseudo
     if not mnemonics:
         raise InputError("no mnemonic pseudonyms (pseudonyms of mnemonics contain a dot: 'SC-A.ch01')", file=path)
+    _check_pseudonyms_hide({**mnemonics, **spacecraft}, seen_pseudo, path)
     known = set(spacecraft.values())
     for pseudo in mnemonics.values():
         sc = pseudo.split(".", 1)[0]
@@ -183,6 +220,7 @@ def _read_raw(path: Path) -> pa.Table:
             return pacsv.read_csv(str(path), read_options=read, parse_options=parse, convert_options=opts)
 
         # Only the empty field is null: the text "NaN" parses as a float NaN and is counted as a placeholder.
+        check_column_count(path)
         header = _header(path, gz)
         lower = [h.strip().lower() for h in header]
         if len(header) == 3 and lower[0] in TIME_NAMES and lower[1:] == ["mnemonic", "value"]:
@@ -518,10 +556,11 @@ def _read_archive(
     if bad_values:
         counts["unparseable values"] += bad_values
     unknown_names: Counter[str] = Counter()
+    counted = ~drop_missing & ~drop_empty & ~drop_placeholder & ~drop_absurd
+    rows_per_code = np.bincount(codes_safe[counted], minlength=len(pseudo_of_code) + 1)
     for c in unknown_codes:
-        n_c = int(np.count_nonzero((codes == c) & ~drop_missing & ~drop_empty & ~drop_placeholder & ~drop_absurd))
-        if n_c:
-            unknown_names[name_token(str(dictionary[c]))] += n_c
+        if rows_per_code[c]:
+            unknown_names[name_token(str(dictionary[c]))] += int(rows_per_code[c])
 
     pseudo_arr = np.array([p if p is not None else "" for p in pseudo_of_code] + [""], dtype=object)
     day_idx = np.where(t_valid, t_int // DAY_NS, -1)
@@ -545,8 +584,7 @@ def _read_archive(
     no_name_rows = int(np.count_nonzero(no_name & t_valid))
     if no_name_rows:
         counts["rows without a mnemonic"] += no_name_rows
-    if unknown_names:
-        counts.update({f"rows of a name not in the decoder ({k})": v for k, v in unknown_names.items()})
+    counts.update(_unknown_name_counts(unknown_names, sum(1 for c in unknown_codes if rows_per_code[c])))
 
     # Categories sorted by name: sorting by mnemonic code groups each spacecraft's mnemonics
     # (names sharing the prefix "SC-A." are contiguous) and orders them by name.

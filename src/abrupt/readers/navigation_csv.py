@@ -22,6 +22,7 @@ import pandas as pd
 from abrupt.errors import InputError, RepairLog
 from abrupt.outputs import atomic_output
 from abrupt.readers.compression import read_text
+from abrupt.readers.text import check_column_count
 from abrupt.series.ephemeris import Ephemeris
 
 REQUIRED_COLUMNS = ("time_utc", "x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps")
@@ -55,6 +56,7 @@ def read_navigation_csv(path: str | Path, satellite: str | None = None, *, frame
     path = Path(path)
     file = str(path)
     repairs = RepairLog(source=file)
+    check_column_count(path)
     df = _table(read_text(path, encoding="utf-8", what="CSV"), file)
     missing = [c for c in REQUIRED_COLUMNS if c not in df.columns]
     if missing:

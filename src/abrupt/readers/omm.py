@@ -23,8 +23,9 @@ from typing import Any
 from sgp4 import omm
 from sgp4.api import Satrec
 
-from abrupt.errors import InputError, RepairLog
+from abrupt.errors import InputError, RepairLog, printable
 from abrupt.readers.tle import (
+    MAX_TLE_LINE_CHARS,
     ElementHistory,
     RawElementSet,
     history_from_sets,
@@ -135,7 +136,8 @@ def record_to_set(
         raise InputError(f"{where}sgp4 cannot initialise this record: {exc}", file=file, line=line) from None
     check_orbit_envelope(sat, file, line)
     key = "|".join(rec.get(k, "") for k in ("NORAD_CAT_ID", "EPOCH", *NUMERIC))
-    return RawElementSet(sat, norad, elnum, line if line is not None else index, key, rec.get("OBJECT_NAME") or None)
+    name = rec.get("OBJECT_NAME") or None
+    return RawElementSet(sat, norad, elnum, line if line is not None else index, key, printable(name) if name else None)
 
 
 def _local(tag: str) -> str:
@@ -329,6 +331,15 @@ def _is_tle(path: Path) -> bool:
     if re.match(r"#[a-d][PV ]?\d{4}", first):
         raise InputError(
             "this is an SP3 precise orbit file, not TLE/3LE or OMM elements (use `abrupt detect orbit`)",
+            file=path,
+            line=1,
+        )
+    omm_like = first.lstrip()[:1] in ("<", "{", "[") or "=" in first or "MEAN_MOTION" in first.upper()
+    if len(first.rstrip("\r")) > MAX_TLE_LINE_CHARS and not omm_like:
+        length = f"{len(first)}" if len(first) < len(head) else f"more than {len(head)}"
+        raise InputError(
+            f"line 1 has {length} characters: neither a TLE line (69) nor a 3LE name line (at most "
+            f"{MAX_TLE_LINE_CHARS}), nor the start of an OMM file (XML, KVN, JSON or CSV)",
             file=path,
             line=1,
         )

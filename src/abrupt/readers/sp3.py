@@ -508,7 +508,20 @@ def read_sp3(
     content = parse_sp3(path, allow_truncated=allow_truncated, strict=strict, repairs=repairs)
     sats = content.header.satellites
     if satellite is None:
-        if len(content.ephemerides) != 1:
+        found = sorted(content.ephemerides)
+        if not found:
+            raise InputError(
+                f"no epoch holds a position of {', '.join(sats) or 'any satellite'} (every position is missing "
+                "or zero): a file of clock records only has no orbit to read",
+                file=path,
+            )
+        if len(found) > 1 and set(found) - set(sats):
+            raise InputError(
+                f"the header lists {sats[:10]} but the records name {found[:10]}: the satellite id changes "
+                "within the file; give the satellite with --satellite or mend the ids",
+                file=path,
+            )
+        if len(found) != 1:
             raise InputError(
                 f"file holds {len(sats)} satellites {sats[:10]}{'…' if len(sats) > 10 else ''}; "
                 "choose one with --satellite",

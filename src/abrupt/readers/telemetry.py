@@ -43,6 +43,7 @@ from numpy.typing import NDArray
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.rotations import quaternion_conjugate, quaternion_multiply
 from abrupt.model.spacecraft import RATE_UNITS, WHEEL_SPEED_UNITS, Spacecraft, TelemetryMap
+from abrupt.readers.text import check_column_count
 from abrupt.series.telemetry import GAP_FACTOR, Telemetry, split_at_gaps
 from abrupt.thresholds.noise import robust_noise_sigma
 from abrupt.types import FloatArray
@@ -65,6 +66,7 @@ def read_table(path: Path) -> pd.DataFrame:
         if suffix in (".parquet", ".pq"):
             return pd.read_parquet(path)
         if suffix in (".csv", ".txt"):
+            check_column_count(path)
             return pd.read_csv(path, dtype=str, keep_default_na=False, skip_blank_lines=True)
     except (ValueError, OSError, pd.errors.ParserError) as exc:
         raise InputError(f"cannot parse table: {exc}", file=path) from None

@@ -40,7 +40,7 @@ import numpy as np
 import pandas as pd
 from sgp4.api import WGS72, Satrec
 
-from abrupt.errors import InputError, RepairLog, quote
+from abrupt.errors import InputError, RepairLog, printable, quote
 from abrupt.readers.compression import read_bytes
 from abrupt.readers.tle_checks import check_element_history, check_orbit_envelope
 
@@ -337,7 +337,7 @@ def iter_tle_sets(
             fail(InputError("TLE line 2 without a preceding line 1", file=file, line=i + 1, column=1))
             i += 1
         else:
-            name = raw[2:].strip() if raw.startswith("0 ") else raw.strip()
+            name = printable(raw[2:].strip() if raw.startswith("0 ") else raw.strip())
             i += 1
 
 
