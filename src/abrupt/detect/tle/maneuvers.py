@@ -132,6 +132,8 @@ class StepRun:
     change_points: list[int]
     # the interval (s) of each detection timed from its blended sets (abrupt.detect.tle.response)
     ramp_intervals: dict[int, tuple[float, float]] = field(default_factory=dict)
+    # the blended sets of each in-track step: (last set on the old level, first on the new)
+    blends: dict[int, tuple[int, int]] = field(default_factory=dict)
 
 
 def detect_mean_elements(
@@ -417,6 +419,7 @@ def time_candidates(run: StepRun, candidates: NDArray[np.int64], all_candidates:
 
 
 RAMP_LEVEL = 0.9  # nominal coverage of a ramp-timed burn's interval
+BLEND_REACH_GAPS = 4  # gaps a blend of up to three sets can spread one burn over
 RAMP_ERA_DAYS = 182.625  # the fit span of an era: from the ramps within half a year
 
 
@@ -439,7 +442,10 @@ def ramp_times(run: StepRun, timed: list[Candidate]) -> list[Candidate]:
         g = it.gap
         if not has_drift_hinge(run.steps, g, cfg.min_statistic) or is_phasing(run.steps, g):
             continue
-        seg = segment_bounds(g, [c for c in run.change_points if c != g], len(run.history))
+        # the window reaches over weaker accepted steps within a blend's reach: a blend spreads one
+        # burn over several gaps, each of which the segmentation may have accepted
+        far = [c for c in run.change_points if abs(c - g) > BLEND_REACH_GAPS or run.stat[c] >= run.stat[g]]
+        seg = segment_bounds(g, far, len(run.history))
         lo = max(seg[0], g + 1 - cfg.time_window_sets)
         hi = min(seg[1], g + 1 + cfg.time_window_sets)
         sigma = float(model.scales["a_m"][g])
@@ -448,6 +454,7 @@ def ramp_times(run: StepRun, timed: list[Candidate]) -> list[Candidate]:
         last_old, first_new, noise = blended_sets(model.t, a, sigma, lo, hi, g)
         if first_new - last_old > 1:
             splits[g] = (lo, hi, last_old, first_new, noise)
+            run.blends[g] = (last_old, first_new)
     ramps = {
         g: (lo, hi, lo_old + 1, noise)
         for g, (lo, hi, lo_old, first_new, noise) in splits.items()
@@ -477,8 +484,9 @@ def ramp_times(run: StepRun, timed: list[Candidate]) -> list[Candidate]:
         (grid, cost), *others = profiles[it.gap]
         best = int(np.argmin(cost))
         inside = np.concatenate([gr[c - np.min(c) <= rise] for gr, c in ((grid, cost), *others)])
-        run.ramp_intervals[it.gap] = (float(inside.min()), float(inside.max()))
-        out.append(Candidate(it.gap, float(grid[best]), True, float(inside.min())))
+        step = float(grid[1] - grid[0])  # the grid's resolution: no interval is narrower
+        run.ramp_intervals[it.gap] = (float(inside.min()) - step, float(inside.max()) + step)
+        out.append(Candidate(it.gap, float(grid[best]), True, float(inside.min()) - step))
     return out
 
 
@@ -599,6 +607,18 @@ def one_burn_with_neighbour(run: StepRun, x: Candidate, lag0_s: float) -> tuple[
     return not (float(model.t[g_x]) - lag0_s <= x.time_s <= float(model.t[g_x + 1])), None, g_y
 
 
+def in_blend(run: StepRun, g: int, host: int) -> bool:
+    """Is the step at gap ``g`` part of the blend of the stronger step at ``host``: between the host's
+    last set on the old level and its first set on the new one (or the gap after that set, whose
+    blend came within the noise of the new level)? A set fitted across a burn spreads it over the
+    gaps of its blend: one burn, not two. Only for a host timed by its blend (an era whose sets
+    blend): elsewhere two burns in consecutive gaps look the same in ``a``."""
+    split = run.blends.get(host)
+    if split is None or host not in run.ramp_intervals:  # only where the era's sets blend
+        return False
+    return split[1] - split[0] > 1 and split[0] <= g <= split[1]
+
+
 def merge_candidates(run: StepRun, timed: list[Candidate]) -> tuple[list[Candidate], dict[int, list[float]]]:
     """One maneuver per TLE cadence: the kept candidates (by time) and each one's interval (s).
 
@@ -613,7 +633,11 @@ def merge_candidates(run: StepRun, timed: list[Candidate]) -> tuple[list[Candida
     kept: list[Candidate] = []
     span_of: dict[int, list[float]] = {}
     for item in sorted(timed, key=lambda it: -stat[it.gap]):
-        near = [k for k in kept if abs(item.time_s - k.time_s) < merge_s or out_of_order(item, k)]
+        near = [
+            k
+            for k in kept
+            if abs(item.time_s - k.time_s) < merge_s or out_of_order(item, k) or in_blend(run, item.gap, k.gap)
+        ]
         if not near:
             merge, t_one, g_host = one_burn_with_neighbour(run, item, lag0_s)
             if merge:
