@@ -229,3 +229,14 @@ def test_kilobytes_long_name_line_is_a_one_line_error_naming_the_line(tmp_path: 
     with pytest.raises(InputError, match=r"x\.tle:1.*10002 characters") as info:
         read_elements(path)
     assert "\n" not in str(info.value) and len(str(info.value)) < 400
+
+
+def test_omm_record_dated_2090_is_skipped_and_counted(tmp_path: Path, omm_records: list[dict[str, str]]) -> None:
+    future = dict(omm_records[1], EPOCH="2090-02-01T12:00:00.000000")
+    p = tmp_path / "future.json"
+    p.write_text(json.dumps([omm_records[0], future]))
+    h = read_omm(p)
+    assert len(h) == 1 and h.repairs.as_dict()["malformed element sets skipped"] == 1
+    assert "2090-02-01 is in the future" in str(h.skipped[0])
+    with pytest.raises(InputError, match=r"future\.json.*epoch 2090-02-01 is in the future"):
+        read_omm(p, strict=True)

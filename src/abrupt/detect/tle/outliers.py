@@ -1,6 +1,6 @@
 """Outlier element sets: a set that disagrees with both its neighbours while the history continues as
-before (a cross-tagged observation, a bad fit) is flagged, counted, reported and left out, so that it
-never reads as a maneuver and its return.
+before (a cross-tagged observation, a bad fit) is flagged, counted and reported (and, in GEO, left out
+of the detection; :func:`abrupt.detect.tle.maneuvers.detect_arc` says why not in LEO).
 
 For each mean-element series of the detector (``a``, the eccentricity vector, the two orbit-normal
 angles; :func:`abrupt.detect.tle.elements.mean_element_series`), a set's departure from its two
@@ -17,10 +17,9 @@ set fitted across the burn lies between the two levels, so neither is an outlier
 from __future__ import annotations
 
 import numpy as np
-import pandas as pd
 from numpy.typing import NDArray
 
-from abrupt.detect.tle.elements import history_rows, mean_element_series
+from abrupt.detect.tle.elements import mean_element_series
 from abrupt.readers.tle import ElementHistory
 from abrupt.thresholds.noise import robust_scale
 
@@ -67,13 +66,3 @@ def outlier_mask(history: ElementHistory, regime: str, level: float = OUTLIER_LE
         agree &= np.abs(y[k + 2] - line(k + 2)) <= 0.25 * np.abs(r)
         out[k] |= big & agree & quiet
     return out
-
-
-def without_outliers(history: ElementHistory, regime: str) -> tuple[ElementHistory, pd.Series]:
-    """The history without its outlier sets (:func:`outlier_mask`) and the outliers' epochs (UTC)."""
-    mask = outlier_mask(history, regime)
-    if not mask.any():
-        return history, pd.Series([], dtype="datetime64[ns]")
-    return history_rows(history, np.flatnonzero(~mask)), history.elements["epoch_utc"].iloc[
-        np.flatnonzero(mask)
-    ].reset_index(drop=True)
