@@ -205,6 +205,7 @@ class Likelihood:
             [data.event_group, data.event_class, data.event_bin, coef_pop, data.event_background]
         ).astype(np.float64)
         self.compressed = compress
+        counts: NDArray[Any]
         if compress and data.n_events:
             unique = np.unique(keys, axis=0, return_index=True, return_inverse=True, return_counts=True)
             first, inverse, counts = unique[1], np.asarray(unique[2]).reshape(-1), unique[3]
