@@ -2,8 +2,8 @@
 population``); docs/flux-inference.md.
 
 A catalog holds events and, in its ``exposure`` table, the analysed spacecraft-days. This pipeline reads
-both, builds one forward-model template per (spacecraft file, orbit), fits the flux scales and β, gives
-upper limits, tests each flux model's goodness of fit, the association with meteoroid showers, and the
+both, builds one forward-model template per distinct (spacecraft model, orbit), fits the flux scales and
+β, gives upper limits, tests each flux model's goodness of fit, the association with meteoroid showers, and the
 measured cumulative rate against |ΔH| that the report draws.
 """
 
