@@ -53,6 +53,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--fleets", type=int, default=100, help="Fleets per truth.")
     parser.add_argument("--draws", type=int, default=1_500_000, help="Generator draws per orbit and population.")
+    parser.add_argument("--seed", type=int, default=2026, help="Seed of the fleets' draws.")
     args = parser.parse_args()
     sc = load_spacecraft(FERMI)
     t0 = time.perf_counter()
@@ -75,7 +76,7 @@ def main() -> None:
         print(f"  {orbit}: strikes/yr generator {gen[0]:.4g} debris, {gen[1]:.4g} meteoroid; ", end="")
         print(f"abrupt template {ours[0]:.4g}, {ours[1]:.4g}")
     exposure = fleet_exposure_rows()
-    rng = np.random.default_rng(2026)
+    rng = np.random.default_rng(args.seed)
     rows = []
     for truth in TRUTHS:
         for _ in range(args.fleets):

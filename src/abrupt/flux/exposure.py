@@ -244,16 +244,16 @@ def store_exposure(catalog: Catalog, rows: pd.DataFrame) -> int:
     with catalog.engine.begin() as conn:
         _metadata.create_all(conn)
         t = exposure_table
-        for rec in records:
+        if records:  # one executemany of the keyed delete: a statement per row costs ~1 ms (365 000 rows: minutes)
             conn.execute(
                 t.delete().where(
-                    (t.c.spacecraft == rec["spacecraft"])
-                    & (t.c.day == rec["day"])
-                    & (t.c.detector == rec["detector"])
-                    & (t.c.config_hash == rec["config_hash"])
-                )
+                    (t.c.spacecraft == sa.bindparam("k_spacecraft"))
+                    & (t.c.day == sa.bindparam("k_day"))
+                    & (t.c.detector == sa.bindparam("k_detector"))
+                    & (t.c.config_hash == sa.bindparam("k_config_hash"))
+                ),
+                [{f"k_{k}": rec[k] for k in ("spacecraft", "day", "detector", "config_hash")} for rec in records],
             )
-        if records:
             conn.execute(t.insert(), records)
     return len(records)
 
@@ -265,10 +265,11 @@ def load_exposure(catalog: Catalog, spacecraft: Sequence[str] = ()) -> pd.DataFr
     query = sa.select(exposure_table)
     if spacecraft:
         query = query.where(exposure_table.c.spacecraft.in_(list(spacecraft)))
-    with catalog.engine.connect() as conn:  # plain tuples: mappings cost 20 µs a row (365 000 rows: 7 s)
+    with catalog.engine.connect() as conn:
         rows = conn.execute(query.order_by(exposure_table.c.spacecraft, exposure_table.c.day)).all()
     names = [c.name for c in exposure_table.columns]
-    return exposure_frame(pd.DataFrame.from_records(rows, columns=names).loc[:, list(EXPOSURE_COLUMNS)])
+    # plain tuples: a frame from row mappings (or Row objects) costs 20-60 µs a row, 365 000 rows 7-20 s
+    return exposure_frame(pd.DataFrame([tuple(r) for r in rows], columns=names).loc[:, list(EXPOSURE_COLUMNS)])
 
 
 def exposure_years(exposure: pd.DataFrame, dH_Nms: ArrayLike) -> NDArray[np.float64]:

@@ -184,16 +184,42 @@ def prepare(
 
 
 class Likelihood:
-    """ln L(scales, β) on a β grid, with batched maximisation over the free scales."""
+    """ln L(scales, β) on a β grid, with batched maximisation over the free scales.
 
-    def __init__(self, data: FluxData, beta_grid: NDArray[np.float64] = DEFAULT_BETA_GRID) -> None:
+    With ``compress``, events that fall in the same cell with the same exposure coefficient (template group,
+    direction class, |ΔH| bin, day coefficient and background) and so have the same expectation at every
+    parameter are held once with their count as weight (``weights``; ``event_index`` maps each event of the
+    data to its row, rows in order of first occurrence), so the cost grows with the number of distinct
+    cells, not of events (a fleet of identical craft with one efficiency curve: a few hundred rows for
+    thousands of events). Without it (the default) row i is event i."""
+
+    def __init__(
+        self, data: FluxData, beta_grid: NDArray[np.float64] = DEFAULT_BETA_GRID, *, compress: bool = False
+    ) -> None:
         self.data = data
         self.beta_grid = np.asarray(beta_grid, dtype=np.float64)
         if data.exposure_years_pop is None or data.event_coef_pop is None:
             raise ConfigError("these flux data carry no per-population exposure; build them with prepare()", key="data")
         exp_pop, coef_pop = data.exposure_years_pop, data.event_coef_pop
-        nb, ne, npop = self.beta_grid.size, data.n_events, len(POPULATIONS)
-        self.a = np.zeros((nb, ne, npop))  # per-event signal expectation at unit scales
+        keys = np.column_stack(
+            [data.event_group, data.event_class, data.event_bin, coef_pop, data.event_background]
+        ).astype(np.float64)
+        self.compressed = compress
+        counts: NDArray[Any]
+        if compress and data.n_events:
+            unique = np.unique(keys, axis=0, return_index=True, return_inverse=True, return_counts=True)
+            first, inverse, counts = unique[1], np.asarray(unique[2]).reshape(-1), unique[3]
+            order = np.argsort(first)  # rows in order of first occurrence
+            position = np.empty_like(order)
+            position[order] = np.arange(order.size)
+            rep, inverse, counts = first[order], position[inverse], counts[order]
+        else:
+            rep = inverse = np.arange(data.n_events)
+            counts = np.ones(data.n_events)
+        self.event_index = np.asarray(inverse, dtype=np.int64).reshape(-1)
+        group, ev_cls, ev_bin, coef = data.event_group[rep], data.event_class[rep], data.event_bin[rep], coef_pop[rep]
+        nb, ne, npop = self.beta_grid.size, rep.size, len(POPULATIONS)
+        self.a = np.zeros((nb, ne, npop))  # per distinct event row: signal expectation at unit scales
         self.totals = np.zeros((nb, npop))  # total signal expectation at unit scales
         self.bin_signal = np.zeros((nb, npop, data.exposure_years.shape[1]))
         for b, beta in enumerate(self.beta_grid):
@@ -201,20 +227,23 @@ class Likelihood:
                 r = tpl.bin_rates(float(beta))  # (P, C, K)
                 sig = r.sum(axis=1) * exp_pop[g]
                 self.bin_signal[b] += sig
-                sel = data.event_group == g
+                sel = group == g
                 if sel.any():
-                    cls, kb = data.event_class[sel], data.event_bin[sel]
+                    cls, kb = ev_cls[sel], ev_bin[sel]
                     per = np.where(cls[:, None] >= 0, r[:, np.maximum(cls, 0), kb].T, r.sum(axis=1)[:, kb].T)
-                    self.a[b, sel] = per * coef_pop[sel]
+                    self.a[b, sel] = per * coef[sel]
             self.totals[b] = self.bin_signal[b].sum(axis=1)
-        self.bg_events = data.event_background
+        self.bg_events = data.event_background[rep]
         self.bg_total = float(data.background_bins.sum())
-        self.weights = np.ones(data.n_events)  # events' multiplicities (a Poisson bootstrap draws them)
+        self.weights = np.asarray(counts, dtype=np.float64)  # multiplicities (a Poisson bootstrap redraws them)
 
     def reweighted(self, weights: NDArray[np.float64]) -> Likelihood:
-        """The same likelihood with each event counted ``weights[i]`` times (arrays shared)."""
+        """The same likelihood with each event of the data counted ``weights[i]`` times (arrays shared)."""
+        w = np.asarray(weights, dtype=np.float64)
+        if w.shape != (self.data.n_events,):
+            raise ConfigError(f"need one weight per event ({self.data.n_events}), got {w.shape}", key="weights")
         out = self.subset(np.ones(self.beta_grid.size, dtype=bool))
-        out.weights = np.asarray(weights, dtype=np.float64)
+        out.weights = np.bincount(self.event_index, weights=w, minlength=self.bg_events.size).astype(np.float64)
         return out
 
     def subset(self, keep: NDArray[np.bool_]) -> Likelihood:
@@ -223,6 +252,7 @@ class Likelihood:
         out.data, out.beta_grid = self.data, self.beta_grid[keep]
         out.a, out.totals, out.bin_signal = self.a[keep], self.totals[keep], self.bin_signal[keep]
         out.bg_events, out.bg_total, out.weights = self.bg_events, self.bg_total, self.weights
+        out.event_index, out.compressed = self.event_index, self.compressed
         return out
 
     def _mu(self, scales: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -366,7 +396,7 @@ def bias_corrected(lik: Likelihood, fixed: Mapping[str, float], signed: Mapping[
     except np.linalg.LinAlgError:
         return out
     new_beta = float(np.clip(beta - b_beta, grid[0], grid[-1]))
-    at_new = Likelihood(lik.data, np.array([new_beta]))
+    at_new = Likelihood(lik.data, np.array([new_beta]), compress=lik.compressed)
     at_new.weights = lik.weights
     scales, _ = at_new.maximise({k: v for k, v in fixed.items() if k in SCALES}, signed=True)
     return {"debris_scale": float(scales[0, 0]), "meteoroid_scale": float(scales[0, 1]), "beta": new_beta}
@@ -495,7 +525,7 @@ def fit(
         raise ConfigError(f"unknown parameter(s) {unknown}; choose from {list(PARAMS)}", key="fix")
     if likelihood is None:
         grid = np.array([fixed["beta"]]) if "beta" in fixed else (DEFAULT_BETA_GRID if beta_grid is None else beta_grid)
-        likelihood = Likelihood(data, grid)
+        likelihood = Likelihood(data, grid, compress=True)
     lik = likelihood
     scale_fixed = {k: v for k, v in fixed.items() if k in SCALES}
     s, ll = lik.maximise(scale_fixed)

@@ -2,8 +2,8 @@
 population``); docs/flux-inference.md.
 
 A catalog holds events and, in its ``exposure`` table, the analysed spacecraft-days. This pipeline reads
-both, builds one forward-model template per (spacecraft file, orbit), fits the flux scales and β, gives
-upper limits, tests each flux model's goodness of fit, the association with meteoroid showers, and the
+both, builds one forward-model template per distinct (spacecraft model, orbit), fits the flux scales and
+β, gives upper limits, tests each flux model's goodness of fit, the association with meteoroid showers, and the
 measured cumulative rate against |ΔH| that the report draws.
 """
 
@@ -22,7 +22,7 @@ from scipy import stats
 from abrupt.catalog import Catalog, coverage_table
 from abrupt.errors import InputError
 from abrupt.events import new_run_id
-from abrupt.flux.days import case_of
+from abrupt.flux.days import case_of, day_keys
 from abrupt.flux.exposure import (
     EfficiencyCurve,
     exposure_frame,
@@ -181,7 +181,7 @@ def infer_flux(
     exposure = share_identical_models(exposure, spacecraft_model_digests(catalog))  # one template per model
     tpl = templates_for(exposure, config, templates, load_spacecraft_models(catalog))
     data = prepare(exposure, events, tpl, use_direction=use_direction)
-    lik = Likelihood(data)
+    lik = Likelihood(data, compress=True)  # events of identical cells held once, with their count
     fits = {"free": fit(data, fixed=fixed, confidence=confidence, likelihood=lik if not fixed else None)}
     if not fixed or "meteoroid_scale" not in fixed:
         fits["meteoroid_scale=1 (Grün as a prior)"] = fit(
@@ -247,8 +247,8 @@ def _matched_sizes(events: pd.DataFrame, exposure: pd.DataFrame, config: Forward
     if len(events) == 0:
         return np.zeros(0)
     days = pd.to_datetime(events["time_utc"].astype(str), utc=True).dt.strftime("%Y-%m-%d")
-    keys = pd.Index(exposure["spacecraft"].astype(str) + "|" + exposure["day"].astype(str))
-    on = np.asarray(pd.Index(events["spacecraft"].astype(str) + "|" + days.astype(str)).isin(keys))
+    keys = set(day_keys(exposure["spacecraft"], exposure["day"]))
+    on = np.array([k in keys for k in day_keys(events["spacecraft"], days)], dtype=bool)
     dh = pd.to_numeric(events["dH_Nms"], errors="coerce").to_numpy()
     ok = on & np.isfinite(dh) & (dh >= config.dH_min_Nms)
     return np.asarray(dh[ok], dtype=np.float64)

@@ -123,8 +123,18 @@ def fits_table(result: FluxInference) -> pd.DataFrame:
         if "beta" not in f.fixed:  # what a β-free fit identifies: each population's expected detections
             for pop, v in f.expected_events.items():
                 if pop != "false_alarms":
+                    lo, hi = f.expected_intervals.get(pop, (nan, nan))
                     rows.append(
-                        {"fit": name, "parameter": f"expected {pop} detections s·T(β) (identified)", "estimate": v}
+                        {
+                            "fit": name,
+                            "parameter": f"expected {pop} detections s·T(β) (identified)",
+                            "estimate": v,
+                            f"{f.confidence:.0%} low": lo,
+                            f"{f.confidence:.0%} high": hi,
+                            "estimator": "headline: beta not bounded, the scales are not measured"
+                            if not f.beta_identified
+                            else "",
+                        }
                     )
     return pd.DataFrame(rows)
 
