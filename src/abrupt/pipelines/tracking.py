@@ -18,6 +18,7 @@ from typing import Any, Literal
 import numpy as np
 import pandas as pd
 
+from abrupt import progress
 from abrupt.detect.tracking.glrt import GlrtManeuverDetector
 from abrupt.detect.tracking.kaderali import KaderaliManeuverDetector
 from abrupt.detect.tracking.noise_scale import calibrate_noise, misfit, residual_scales
@@ -232,11 +233,49 @@ def detect_tracking(
     }
     cfg_hash = config_hash(run_settings)
     run_id = run_id or new_run_id()
-    calibration = calibrate_noise(series)  # what the detectors run themselves; shared through the series cache
+    stages = ["orbit fit and noise calibration"]
+    stages += ["GLRT between passes"] if settings.method in ("both", "glrt") else []
+    stages += ["Kaderali Ψ/K filter"] if settings.method in ("both", "kaderali") else []
+    with progress.task("detect tracking", total=len(stages), unit="stage") as step:
+        step.update(0, status=stages[0])
+        calibration = calibrate_noise(series)  # what the detectors run themselves; shared through the series cache
+        step.update(1, status=stages[1] if len(stages) > 1 else None)
+        frames, diag_frames, final_fit, glrt_thresholds = _run_detectors(calibration.series, settings, budget, step)
     series = calibration.series
+    data = series.data
+    post = residual_scales(data, final_fit)
+    if misfit(post):
+        raise InputError(
+            f"the orbit fit does not describe the data: post-fit weighted RMS {final_fit.rms_white:.3g} "
+            f"with {len(final_fit.impulse_times_s)} impulse(s), against a noise level "
+            f"of {post.noise:.3g} stated sigmas; check the set-up's force model, stations and frames",
+            file=file_name,
+        )
+    found = [f for f in frames if len(f)]
+    events = (
+        restamp(pd.concat(found, ignore_index=True, sort=False), run_id=run_id, config_hash=cfg_hash)
+        if found
+        else empty_frame()
+    )
+    summary = fit_summary(final_fit, force.model, sun_moon_gcrf(np.array([inputs.epoch_utc]))[0][0])
+    summary["repairs"] = inputs.repairs.as_dict()
+    summary["noise"] = {**calibration.as_dict(), "post_fit_rms": post.total, "post_fit_noise": post.noise}
+    if settings.method in ("both", "glrt"):
+        summary["glrt_threshold"] = glrt_thresholds[0] if glrt_thresholds else None
+    diagnostics = pd.concat(diag_frames, ignore_index=True) if diag_frames else pd.DataFrame()
+    return TrackingRun(events, summary, diagnostics, cfg_hash, run_id, run_settings)
+
+
+def _run_detectors(
+    series: TrackingSeries, settings: TrackingSettings, budget: FalseAlarmBudget, step: progress.Task
+) -> tuple[list[pd.DataFrame], list[pd.DataFrame], BatchFit, list[dict[str, Any]]]:
+    """The chosen detectors on the calibrated series: their events, their diagnostics (one frame per
+    series, as :func:`detect_tracking` returns them), the orbit fit the events rest on and the GLRT's
+    thresholds; ``step`` moves on as each detector starts."""
     final_fit: BatchFit = series.orbit_fit()
     frames = []
     diag_frames = []
+    glrt_thresholds: list[dict[str, Any]] = []
     data = series.data
     if settings.method in ("both", "glrt"):
         glrt = GlrtManeuverDetector(max_maneuvers=settings.max_maneuvers)
@@ -244,7 +283,6 @@ def detect_tracking(
         if result.diagnostics:
             final_fit = result.diagnostics[0].extra["fit"]
         frames.append(result.events)
-        glrt_thresholds = []
         for d in result.diagnostics:
             # the scan's own threshold (set for the budget), also when nothing exceeds it
             first = d.threshold.value if d.threshold is not None else np.nan
@@ -261,6 +299,8 @@ def detect_tracking(
                 )
             )
     if settings.method in ("both", "kaderali"):
+        if settings.method == "both":
+            step.update(1, status="Kaderali Ψ/K filter")
         kaderali = KaderaliManeuverDetector(
             psi_threshold=settings.psi_threshold,
             eta_threshold_km=settings.eta_threshold_km,
@@ -286,27 +326,8 @@ def detect_tracking(
                 }
             )
         )
-    post = residual_scales(data, final_fit)
-    if misfit(post):
-        raise InputError(
-            f"the orbit fit does not describe the data: post-fit weighted RMS {final_fit.rms_white:.3g} "
-            f"with {len(final_fit.impulse_times_s)} impulse(s), against a noise level "
-            f"of {post.noise:.3g} stated sigmas; check the set-up's force model, stations and frames",
-            file=file_name,
-        )
-    found = [f for f in frames if len(f)]
-    events = (
-        restamp(pd.concat(found, ignore_index=True, sort=False), run_id=run_id, config_hash=cfg_hash)
-        if found
-        else empty_frame()
-    )
-    summary = fit_summary(final_fit, force.model, sun_moon_gcrf(np.array([inputs.epoch_utc]))[0][0])
-    summary["repairs"] = inputs.repairs.as_dict()
-    summary["noise"] = {**calibration.as_dict(), "post_fit_rms": post.total, "post_fit_noise": post.noise}
-    if settings.method in ("both", "glrt"):
-        summary["glrt_threshold"] = glrt_thresholds[0] if glrt_thresholds else None
-    diagnostics = pd.concat(diag_frames, ignore_index=True) if diag_frames else pd.DataFrame()
-    return TrackingRun(events, summary, diagnostics, cfg_hash, run_id, run_settings)
+    step.update(1)
+    return frames, diag_frames, final_fit, glrt_thresholds
 
 
 def fit_summary(fit: BatchFit, force: ForceModel, sun_m: Any) -> dict[str, Any]:
