@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import logging
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -19,9 +20,10 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
+from abrupt import progress
 from abrupt.api import RateConfig, Scenario, expected_rates
 from abrupt.catalog import Catalog
-from abrupt.cli.commands import cli
+from abrupt.cli.commands import COMPILE_NOTE, cli
 from abrupt.cli.main import main
 from abrupt.detect.base import detector_names, get_detector
 from abrupt.errors import InputError
@@ -31,6 +33,7 @@ from abrupt.pipelines.flight import day_range
 from abrupt.pipelines.rates import metric_thresholds
 from abrupt.report import tracking as report
 from abrupt.report.rates import rate_curves_figure
+from abrupt.report.site import write_catalog_site
 from abrupt.scale import Executor, WorkerLostError, dask_log_level, run_tasks
 from abrupt.simulate.confounders import CONFOUNDER_CLASS
 from abrupt.store import TelemetryStore
@@ -303,3 +306,96 @@ def test_a_worker_that_dies_is_one_clear_error_naming_the_task() -> None:
     with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
         with pytest.raises(WorkerLostError, match=r"died while running task 1 of 1 \(3\).*KilledWorker"):
             run_tasks(os._exit, [3], executor=Executor(workers=1))
+
+
+_KERNELS = """
+from numba import njit
+
+
+@njit
+def recompiled(x):
+    return x - 1.0
+
+
+@njit(cache=True)
+def cached(x):
+    return x + 1.0
+
+
+@njit(cache=True)
+def also_cached(x):
+    return 2.0 * x
+"""
+
+_RUN_KERNELS = """
+from abrupt.cli.commands import lazy_module
+
+kernels = lazy_module("first_week_kernels")
+print(kernels.recompiled(1.0), kernels.cached(1.0), kernels.also_cached(1.0))
+"""
+
+
+def test_a_first_run_says_once_that_it_compiles_and_a_second_run_says_nothing(tmp_path: Path) -> None:
+    """Numba's compile events, on a module of kernels with a disk cache in ``tmp_path``: the first run
+    (cold cache) says it compiles, once for all kernels; the second loads them and says nothing."""
+    (tmp_path / "first_week_kernels.py").write_text(_KERNELS)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "src"), str(tmp_path)])}
+    env.pop("NUMBA_CACHE_DIR", None)
+    env.pop("NUMBA_DISABLE_JIT", None)
+    runs = [
+        subprocess.run([sys.executable, "-c", _RUN_KERNELS], env=env, capture_output=True, text=True, timeout=300)
+        for _ in range(2)
+    ]
+    for done in runs:
+        assert done.returncode == 0, done.stderr
+        assert done.stdout.split() == ["0.0", "2.0", "2.0"]
+    assert runs[0].stderr.count(COMPILE_NOTE) == 1
+    assert COMPILE_NOTE not in runs[1].stderr
+
+
+def _status_lines(err: str, command: str) -> list[str]:
+    return [line for line in err.splitlines() if line.startswith(f"abrupt {command}: ")]
+
+
+def test_detect_orbit_shows_its_stages_with_their_total(
+    shared_data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An 8-hour arc of a real SP3 file; status lines every 50 ms (the real interval is 8 s)."""
+    lines = (shared_data / "sp3" / "ssas3a20.b18358.e19003.DG_.sp3").read_text().splitlines(keepends=True)
+    starts = [i for i, line in enumerate(lines) if line.startswith("*")]
+    short = tmp_path / "short.sp3"
+    short.write_text("".join(lines[: starts[480]]))
+    monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.05)
+    main(["detect", "orbit", str(short), "--allow-truncated", "--out", str(tmp_path / "e.csv"), "--catalog", "none"])
+    status = _status_lines(capsys.readouterr().err, "detect orbit")
+    stages = [int(m.group(1)) for line in status if (m := re.search(r"orbit arc (\d)/3 stage", line))]
+    assert stages and stages == sorted(stages), status[-5:]
+
+
+def test_detect_tracking_shows_its_stages_with_their_total(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    tdm = tmp_path / "track.tdm"
+    main(["-q", "simulate", "tracking", "--out", str(tdm), "--cadence", "20", "--seed", "4"])
+    monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.05)
+    args = ["detect", "tracking", str(tdm), "--setup", str(tdm.with_suffix(".in")), "--max-maneuvers", "1"]
+    main([*args, "--out", str(tmp_path / "e.csv"), "--catalog", "none"])
+    status = _status_lines(capsys.readouterr().err, "detect tracking")
+    stages = [m.group(1) for line in status if (m := re.search(r"detect tracking (\d)/3 stage \(([^)]*)\)", line))]
+    assert "0" in stages and "1" in stages, status[-5:]  # the orbit fit, then the GLRT, each with the total
+
+
+def test_report_catalog_counts_its_event_pages_against_their_total(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    target = str(tmp_path / "c.sqlite")
+    Catalog(target).add_events(events_frame([_event_of_kind("strike", day) for day in range(1, 7)]))
+    reporter = progress.Reporter("abrupt report catalog", "log", interval_s=3600.0)
+    seen: list[str] = []
+    monkeypatch.setattr(reporter, "closed", lambda task: seen.append(task.text()))
+    previous = progress.install(reporter)
+    try:
+        write_catalog_site(Catalog(target), tmp_path / "site")
+    finally:
+        progress.install(previous)
+    assert "event pages 6/6 page" in seen

@@ -90,11 +90,11 @@ def dask_client(executor: Executor) -> Iterator[Any]:
 
     logging.getLogger("distributed").setLevel(dask_log_level())  # after its import set it to info
 
-    class PatientNanny(Nanny):  # type: ignore[misc]
+    class PatientNanny(Nanny):
         """A nanny that lets its worker process exit by itself on close (Dask's waits 4 s, then kills)."""
 
-        async def close(self, timeout: float = WORKER_CLOSE_TIMEOUT_S, reason: str = "nanny-close") -> Any:
-            return await super().close(timeout=max(timeout, WORKER_CLOSE_TIMEOUT_S), reason=reason)
+        async def close(self, timeout: float | None = WORKER_CLOSE_TIMEOUT_S, reason: str = "nanny-close") -> Any:
+            return await super().close(timeout=max(timeout or 0.0, WORKER_CLOSE_TIMEOUT_S), reason=reason)
 
     if executor.scheduler:
         try:

@@ -83,11 +83,50 @@ REPORT_COMMANDS = {
 }
 
 
+#: What the command line says before numba first compiles a kernel that it then caches on disk.
+COMPILE_NOTE = "compiling numerical kernels (first run only, about a minute; later runs load them from the cache)"
+
+
+class FirstCompileNote:
+    """A numba event listener (``numba.core.event``) that says :data:`COMPILE_NOTE` once, when the first
+    kernel with an on-disk cache starts compiling: a cold cache, after installing or changing the code.
+    Kernels loaded from the cache do not compile, so a warm run says nothing."""
+
+    def __init__(self) -> None:
+        self.said = False
+
+    def notify(self, event: Any) -> None:
+        if self.said or not event.is_start:
+            return
+        dispatcher = (event.data or {}).get("dispatcher")
+        if getattr(getattr(dispatcher, "_cache", None), "_cache_file", None) is None:
+            return  # a kernel without a disk cache compiles on every run: nothing "first run" about it
+        self.said = True
+        if not State.quiet:
+            click.echo(COMPILE_NOTE, err=True)
+
+
+_compile_note: FirstCompileNote | None = None
+
+
+def watch_compiles() -> None:
+    """Listen for numba's compile events once numba is imported (never importing it for that)."""
+    global _compile_note
+    if _compile_note is None and "numba" in sys.modules:
+        events = importlib.import_module("numba.core.event")
+        events.Listener.register(FirstCompileNote)  # an abc: a listener by registration, not by import
+        _compile_note = FirstCompileNote()
+        events.register("numba:compile", _compile_note)
+
+
 class DeferredModule(ModuleType):
-    """A stand-in for the module it names, imported on the first attribute looked up through it."""
+    """A stand-in for the module it names, imported on the first attribute looked up through it (and
+    then, if that import brought numba in, :func:`watch_compiles` starts listening)."""
 
     def __getattr__(self, attribute: str) -> Any:
-        return getattr(importlib.import_module(self.__name__), attribute)
+        module = importlib.import_module(self.__name__)
+        watch_compiles()
+        return getattr(module, attribute)
 
 
 def lazy_module(name: str) -> ModuleType:

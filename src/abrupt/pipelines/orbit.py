@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from abrupt import progress
 from abrupt.catalog import AnalysedSpan
 from abrupt.detect.base import DetectionResult, Diagnostics, get_detector
 from abrupt.detect.orbit.analysis import OrbitAnalysis, innovation_scale
@@ -237,18 +238,22 @@ def untested_summary(eph: Ephemeris, fa: FalseAlarmBudget, warnings: list[str]) 
 
 
 def _detect_arc(det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, sequences: bool) -> OrbitRun:
-    """One arc: detection, burn sequences, the fit summary and its check; an arc too short to test gives a
-    run that tested nothing (:func:`untested_run`)."""
-    try:
-        result = det.detect(eph, fa)
-    except ArcTooShortError as exc:
-        return untested_run(det, eph, fa, exc.reason)
-    # the removal needs the sharp time of the GLR; the thesis statistics' broad humps would re-raise
-    if sequences and det.statistic == "glr" and len(result.events):
-        events, notes = resolve_sequence(det, eph, fa, result)
-        result = replace(result, events=events, warnings=(*result.warnings, *notes))
-    run = OrbitRun(eph, det, result, fa)
-    run.summary = fit_summary(run)
+    """One arc: detection, burn sequences, the fit summary and its check (a task of three stages); an arc
+    too short to test gives a run that tested nothing (:func:`untested_run`)."""
+    with progress.task("orbit arc", total=3, unit="stage") as stage:
+        stage.update(0, status="tuning, forward and backward filters, statistics, threshold")
+        try:
+            result = det.detect(eph, fa)
+        except ArcTooShortError as exc:
+            return untested_run(det, eph, fa, exc.reason)
+        stage.update(1, status="burn sequences")
+        # the removal needs the sharp time of the GLR; the thesis statistics' broad humps would re-raise
+        if sequences and det.statistic == "glr" and len(result.events):
+            events, notes = resolve_sequence(det, eph, fa, result)
+            result = replace(result, events=events, warnings=(*result.warnings, *notes))
+        stage.update(1, status="fit summary")
+        run = OrbitRun(eph, det, result, fa)
+        run.summary = fit_summary(run)
     _check_fit(run.summary, eph, det)
     return run
 
@@ -282,9 +287,11 @@ def _detect_blocks(
     n = len(jobs)
     if workers > 1:
         with ProcessPoolExecutor(max_workers=min(workers, n)) as pool:
-            outcomes = list(pool.map(_block, [det] * n, parts, los, his, [fa] * n, [sequences] * n))
+            done = pool.map(_block, [det] * n, parts, los, his, [fa] * n, [sequences] * n)
+            outcomes = list(progress.track(done, "calibration blocks", total=n, unit="block"))
     else:
-        outcomes = [_block(det, *job, fa, sequences) for job in jobs]
+        tracked = progress.track(jobs, "calibration blocks", unit="block")
+        outcomes = [_block(det, *job, fa, sequences) for job in tracked]
     empty = next((o.events.iloc[:0] for o in outcomes if o.events.columns.size), DetectionResult.empty().events)
     sizes = [hi - lo for lo, hi in blocks]
     diag = Diagnostics(

@@ -18,6 +18,7 @@ from typing import Any, Literal
 import numpy as np
 import pandas as pd
 
+from abrupt import progress
 from abrupt.catalog import AnalysedSpan
 from abrupt.detect.tracking.glrt import GlrtManeuverDetector
 from abrupt.detect.tracking.kaderali import KaderaliManeuverDetector
@@ -253,60 +254,16 @@ def detect_tracking(
     }
     cfg_hash = config_hash(run_settings)
     run_id = run_id or new_run_id()
-    calibration = calibrate_noise(series)  # what the detectors run themselves; shared through the series cache
+    stages = ["orbit fit and noise calibration"]
+    stages += ["GLRT between passes"] if settings.method in ("both", "glrt") else []
+    stages += ["Kaderali Ψ/K filter"] if settings.method in ("both", "kaderali") else []
+    with progress.task("detect tracking", total=len(stages), unit="stage") as step:
+        step.update(0, status=stages[0])
+        calibration = calibrate_noise(series)  # what the detectors run themselves; shared through the series cache
+        step.update(1, status=stages[1] if len(stages) > 1 else None)
+        frames, diag_frames, final_fit, glrt_thresholds = _run_detectors(calibration.series, settings, budget, step)
     series = calibration.series
-    final_fit: BatchFit = series.orbit_fit()
-    frames = []
-    diag_frames = []
     data = series.data
-    if settings.method in ("both", "glrt"):
-        glrt = GlrtManeuverDetector(max_maneuvers=settings.max_maneuvers)
-        result = glrt.detect(series, budget)
-        if result.diagnostics:
-            final_fit = result.diagnostics[0].extra["fit"]
-        frames.append(result.events)
-        glrt_thresholds = []
-        for d in result.diagnostics:
-            # the scan's own threshold (set for the budget), also when nothing exceeds it
-            first = d.threshold.value if d.threshold is not None else np.nan
-            if d.threshold is not None:
-                glrt_thresholds.append(d.threshold.as_dict())
-            diag_frames.append(
-                pd.DataFrame(
-                    {
-                        "series": "glrt",
-                        "time_utc": data.epoch_utc + (d.time_s * 1e9).astype("timedelta64[ns]"),
-                        "glrt_statistic": d.statistic,
-                        "threshold": first,
-                    }
-                )
-            )
-    if settings.method in ("both", "kaderali"):
-        kaderali = KaderaliManeuverDetector(
-            psi_threshold=settings.psi_threshold,
-            eta_threshold_km=settings.eta_threshold_km,
-            elevation_mask_deg=settings.elevation_mask_deg,
-            threshold_fit=settings.kaderali_threshold,
-            max_maneuvers=settings.max_maneuvers,
-        )
-        result = kaderali.detect(series, budget)
-        frames.append(result.events)
-        d = result.diagnostics[0]
-        if settings.method == "kaderali":  # the maneuver-aware fit the filter started from, as with the GLRT's
-            final_fit = d.extra["fit"]
-        diag_frames.append(
-            pd.DataFrame(
-                {
-                    "series": "kaderali",
-                    "time_utc": data.epoch_utc + (d.time_s * 1e9).astype("timedelta64[ns]"),
-                    "psi": d.statistic,
-                    "k_db": d.extra["k_db"],
-                    "trace_p_km": d.extra["trace_p_km"],
-                    "inflated": d.extra["inflated"],
-                    "threshold": d.threshold.value if d.threshold is not None else np.nan,
-                }
-            )
-        )
     post = residual_scales(data, final_fit)
     if misfit(post):
         raise InputError(
@@ -335,6 +292,70 @@ def detect_tracking(
     ]
     analysed = [AnalysedSpan(series.spacecraft_name, times.min(), times.max(), d) for d in detectors if times.size]
     return TrackingRun(events, summary, diagnostics, cfg_hash, run_id, run_settings, analysed)
+
+
+def _run_detectors(
+    series: TrackingSeries, settings: TrackingSettings, budget: FalseAlarmBudget, step: progress.Task
+) -> tuple[list[pd.DataFrame], list[pd.DataFrame], BatchFit, list[dict[str, Any]]]:
+    """The chosen detectors on the calibrated series: their events, their diagnostics (one frame per
+    series, as :func:`detect_tracking` returns them), the orbit fit the events rest on and the GLRT's
+    thresholds; ``step`` moves on as each detector starts."""
+    final_fit: BatchFit = series.orbit_fit()
+    frames = []
+    diag_frames = []
+    glrt_thresholds: list[dict[str, Any]] = []
+    data = series.data
+    if settings.method in ("both", "glrt"):
+        glrt = GlrtManeuverDetector(max_maneuvers=settings.max_maneuvers)
+        result = glrt.detect(series, budget)
+        if result.diagnostics:
+            final_fit = result.diagnostics[0].extra["fit"]
+        frames.append(result.events)
+        for d in result.diagnostics:
+            # the scan's own threshold (set for the budget), also when nothing exceeds it
+            first = d.threshold.value if d.threshold is not None else np.nan
+            if d.threshold is not None:
+                glrt_thresholds.append(d.threshold.as_dict())
+            diag_frames.append(
+                pd.DataFrame(
+                    {
+                        "series": "glrt",
+                        "time_utc": data.epoch_utc + (d.time_s * 1e9).astype("timedelta64[ns]"),
+                        "glrt_statistic": d.statistic,
+                        "threshold": first,
+                    }
+                )
+            )
+    if settings.method in ("both", "kaderali"):
+        if settings.method == "both":
+            step.update(1, status="Kaderali Ψ/K filter")
+        kaderali = KaderaliManeuverDetector(
+            psi_threshold=settings.psi_threshold,
+            eta_threshold_km=settings.eta_threshold_km,
+            elevation_mask_deg=settings.elevation_mask_deg,
+            threshold_fit=settings.kaderali_threshold,
+            max_maneuvers=settings.max_maneuvers,
+        )
+        result = kaderali.detect(series, budget)
+        frames.append(result.events)
+        d = result.diagnostics[0]
+        if settings.method == "kaderali":  # the maneuver-aware fit the filter started from, as with the GLRT's
+            final_fit = d.extra["fit"]
+        diag_frames.append(
+            pd.DataFrame(
+                {
+                    "series": "kaderali",
+                    "time_utc": data.epoch_utc + (d.time_s * 1e9).astype("timedelta64[ns]"),
+                    "psi": d.statistic,
+                    "k_db": d.extra["k_db"],
+                    "trace_p_km": d.extra["trace_p_km"],
+                    "inflated": d.extra["inflated"],
+                    "threshold": d.threshold.value if d.threshold is not None else np.nan,
+                }
+            )
+        )
+    step.update(1)
+    return frames, diag_frames, final_fit, glrt_thresholds
 
 
 def fit_summary(fit: BatchFit, force: ForceModel, sun_m: Any) -> dict[str, Any]:

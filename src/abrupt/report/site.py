@@ -31,6 +31,7 @@ from typing import Any
 
 import pandas as pd
 
+from abrupt import progress
 from abrupt.catalog import Catalog
 from abrupt.catalog.schema import read_coverage
 from abrupt.events import EVENT_COLUMNS, format_time_utc
@@ -530,7 +531,7 @@ def write_catalog_site(catalog: Catalog, out: str | Path) -> SiteSummary:
     for run_id in view.runs["run_id"].astype(str):
         body = f'<p><a href="../runs.html">all runs</a></p>{_run_config_html(view, run_id, 1)}'
         pages[f"runs/{_slug(run_id)}.html"] = page(f"Run {run_id}", body, depth=1)
-    for _, event in view.events.iterrows():
+    for _, event in progress.track(view.events.iterrows(), "event pages", total=len(view.events), unit="page"):
         pages[_event_page_name(str(event["event_id"]))] = _event_page(view, event, out, reports)
     for name, text in pages.items():
         (out / name).write_text(text, encoding="utf-8")
