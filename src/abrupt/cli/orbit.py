@@ -355,12 +355,11 @@ def detect_orbit_command(
         else:
             frame.to_parquet(statistics_out, index=False)
     events = run.events
-    chash = _config_hash_of(events, run.detector.config(), budget)
     record_run(
         catalog_target=catalog_target,
         command="detect orbit",
         events=events,
-        config_hash=chash,
+        config_hash=_config_hash_of(events, run.detector.config(), budget),
         run_id=run_id,
         input_path=file,
         out=out,
