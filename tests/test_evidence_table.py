@@ -24,6 +24,7 @@ from abrupt.events import (
     read_evidence,
     write_events_and_evidence,
 )
+from abrupt.report.site import write_catalog_site
 
 
 def _attributed(n: int = 3) -> pd.DataFrame:
@@ -108,3 +109,15 @@ def test_evidence_stored_inside_the_events_by_an_older_abrupt_is_read_as_evidenc
     assert evidence["event_id"].tolist() == frame["event_id"].tolist()
     assert evidence["ev_min_dv_mps"].iloc[0] == pytest.approx(1e-4, rel=1e-12)
     assert "ev_min_dv_mps" not in cat.events().columns
+
+
+def test_the_sites_event_page_shows_the_events_evidence(tmp_path: Path) -> None:
+    frame = _attributed(2)
+    cat = Catalog(tmp_path / "c.sqlite")
+    cat.store_events(frame)
+    write_catalog_site(cat, tmp_path / "site")
+    first = (tmp_path / "site" / "events" / f"{frame['event_id'].iloc[0]}.html").read_text()
+    second = (tmp_path / "site" / "events" / f"{frame['event_id'].iloc[1]}.html").read_text()
+    assert "Attribution evidence" in first
+    assert "<dt>ev_min_dv_mps</dt><dd>0.0001</dd>" in first and "<dt>ev_orbit_dv_mps</dt><dd>0.002</dd>" in second
+    assert "ev_min_dv_mps" not in second  # an empty quantity is not shown
