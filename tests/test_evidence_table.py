@@ -121,3 +121,14 @@ def test_the_sites_event_page_shows_the_events_evidence(tmp_path: Path) -> None:
     assert "Attribution evidence" in first
     assert "<dt>ev_min_dv_mps</dt><dd>0.0001</dd>" in first and "<dt>ev_orbit_dv_mps</dt><dd>0.002</dd>" in second
     assert "ev_min_dv_mps" not in second  # an empty quantity is not shown
+
+
+def test_evidence_round_trips_through_each_catalog_back_end(catalog_target: str, tmp_path: Path) -> None:
+    frame = _attributed()
+    frame["ev_label"] = ["gyro", "star_tracker", "gyro"]  # a text quantity is kept as text
+    cat = Catalog(catalog_target)
+    cat.store_events(frame)
+    evidence = cat.evidence(frame["event_id"].iloc[:2]).set_index("event_id").loc[frame["event_id"].iloc[:2]]
+    assert evidence["ev_label"].tolist() == ["gyro", "star_tracker"]
+    np.testing.assert_allclose(evidence["ev_body_share"].to_numpy(float), [0.9, 0.1], rtol=1e-12)
+    assert np.isnan(evidence["ev_min_dv_mps"].iloc[1])
