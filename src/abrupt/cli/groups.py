@@ -20,14 +20,25 @@ import click
 
 from abrupt import progress as progress_report
 from abrupt.catalog import AnalysedSpan, Catalog, coverage_of
-from abrupt.cli.commands import GLOBAL_FLAGS, State, cli, detect, hoist_global_flags, inject, report, simulate
-from abrupt.events import write_events_and_evidence
+from abrupt.cli.commands import (
+    GLOBAL_FLAGS,
+    State,
+    check_output_paths,
+    cli,
+    detect,
+    hoist_global_flags,
+    inject,
+    report,
+    simulate,
+)
+from abrupt.events import EVIDENCE_PREFIX, evidence_path, write_events_and_evidence
 
 __all__ = [
     "DEFAULT_CATALOG",
     "GLOBAL_FLAGS",
     "StageProgress",
     "catalog_option",
+    "check_evidence_output",
     "check_suffix",
     "cli",
     "detect",
@@ -94,6 +105,16 @@ def check_suffix(*suffixes: str) -> Any:
         return value
 
     return callback
+
+
+def check_evidence_output(out: str | Path | None) -> None:
+    """Refuse the evidence table beside ``out`` (:func:`abrupt.events.evidence_path`) when it would
+    overwrite an input of the running command or follow a link, as ``--out`` itself is refused."""
+    ctx = click.get_current_context(silent=True)
+    if out is None or ctx is None:
+        return
+    inputs = {k: v for k, v in ctx.params.items() if k != "out" and not k.startswith("out_")}
+    check_output_paths({**inputs, "out": str(evidence_path(out))})
 
 
 def file_hash(path: str | Path) -> str:
@@ -185,6 +206,8 @@ def record_run(
     catalog = Catalog(catalog_target)  # open (and check) the catalog before writing anything
     catalog.check_fits(events)  # texts too long for the catalog: refused before the file is written
     evidence_file = None
+    if out is not None and any(str(c).startswith(EVIDENCE_PREFIX) for c in events.columns):
+        check_evidence_output(out)
     if out is not None:  # then the file: a bad path must not leave events in the catalog only
         Path(out).parent.mkdir(parents=True, exist_ok=True)
         evidence_file = write_events_and_evidence(events, str(out))
