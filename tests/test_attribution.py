@@ -30,7 +30,7 @@ from abrupt.detect.attitude.evidence import (
     surface_evidence,
 )
 from abrupt.errors import ConfigError
-from abrupt.events import EVENT_KINDS
+from abrupt.events import EVENT_KINDS, read_evidence
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import load_spacecraft
 from abrupt.pipelines.flight import CleaningConfig, FlightRunConfig, ingest_archives, process_chunk
@@ -343,4 +343,6 @@ def test_cli_draws_confounders_injects_them_and_detect_writes_their_class(
     at_jump = ev[(t - pd.Timestamp(t_jump)).abs() < pd.Timedelta(seconds=30)]
     assert len(at_jump) == 1
     assert at_jump["kind"].iloc[0] == "sensor_fault" and at_jump["kind_channel"].iloc[0] == "star_tracker"
-    assert "ev_st_gyro_step_rad" in ev.columns and (ev["kind"] != "strike").all()
+    evidence = read_evidence(events)  # the evidence: its own table beside the events, keyed by event_id
+    assert "ev_st_gyro_step_rad" in evidence.columns and "ev_st_gyro_step_rad" not in ev.columns
+    assert set(evidence["event_id"]) == set(ev["event_id"]) and (ev["kind"] != "strike").all()

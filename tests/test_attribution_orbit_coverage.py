@@ -20,7 +20,7 @@ from abrupt.catalog import Catalog
 from abrupt.cli.main import main as cli_main
 from abrupt.detect.attitude.orbit_evidence import NavigationCoverage, merged_spans, spans_from_text
 from abrupt.errors import ConfigError, InputError
-from abrupt.events import Event, events_frame, read_events, write_events
+from abrupt.events import Event, events_frame, read_events, read_evidence, write_events
 from abrupt.pipelines.flight import ingest_archives
 from abrupt.pipelines.orbit import epoch_intervals
 from abrupt.pipelines.orbit_blocks import BlockOutcome
@@ -246,7 +246,8 @@ def test_api_and_cli_give_the_same_classes_and_evidence(tmp_path: Path, capsys: 
     sc = load_spacecraft(a.spacecraft)
     result = run_flight_with_orbit(tmp_path / "injected", sc, OrbitSource(orbit, 2e-4, spans), FlightRunConfig())
     assert repair in result.warnings
-    cli_ev, api_ev = read_events(str(out)), result.events.reset_index(drop=True)
+    cli_ev = read_events(str(out)).merge(read_evidence(out), on="event_id", how="left")  # the evidence: one join away
+    api_ev = result.events.reset_index(drop=True)
     cols = ["event_id", "time_utc", "kind", "kind_reason", "kind_channel"]
     pd.testing.assert_frame_equal(cli_ev[cols].astype(str), api_ev[cols].astype(str))
     for c in ("kind_confidence", "ev_orbit_dv_mps", "ev_orbit_dt_s", "ev_orbit_dv_floor_mps", "ev_min_dv_mps"):

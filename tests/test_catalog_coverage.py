@@ -7,11 +7,11 @@ The truth is the data itself: the epochs of the element sets written to each sim
 
 from __future__ import annotations
 
-import sqlite3
 from pathlib import Path
 
 import pandas as pd
 import pytest
+import sqlalchemy as sa
 
 from abrupt.catalog import AnalysedSpan, Catalog, coverage_of
 from abrupt.catalog.schema import SCHEMA_VERSION, read_coverage
@@ -130,26 +130,27 @@ def test_site_shows_the_quiet_run_and_each_satellites_span(
         assert f"{first:%Y-%m-%d}" in row and f"{last:%Y-%m-%d}" in row and "data analysed" in row
 
 
-def test_a_catalog_written_before_span_labels_stays_readable_and_upgrades_in_place(tmp_path: Path) -> None:
-    path = tmp_path / "old.sqlite"
-    cat = Catalog(path)
+def test_a_catalog_written_before_span_labels_stays_readable_and_upgrades_in_place(catalog_target: str) -> None:
+    cat = Catalog(catalog_target)
     cat.start_run("r1", "detect tle x.tle", config_hash="c1")
     events = events_frame([_event("A", "2011-01-01T00:00:00Z")])
     cat.store_events(events)
     cat.finish_run("r1", n_found=1, n_new=1, coverage=coverage_of(events, config_hash="c1"))
-    with sqlite3.connect(path) as conn:  # the version-2 layout: no span_of, no evidence table
-        conn.execute("ALTER TABLE coverage DROP COLUMN span_of")
-        conn.execute("DROP TABLE evidence")
-        conn.execute("UPDATE abrupt_schema SET version = 2")
-    reader = Catalog(path, create=False)
-    assert len(reader.events()) == 1
+    with cat.engine.begin() as conn:  # the version-2 layout: no span_of, no evidence table
+        conn.execute(sa.text("ALTER TABLE coverage DROP COLUMN span_of"))
+        conn.execute(sa.text("DROP TABLE evidence"))
+        conn.execute(sa.text("UPDATE abrupt_schema SET version = 2"))
+    reader = Catalog(catalog_target, create=False)
+    assert len(reader.events()) == 1 and len(reader.evidence()) == 0
     with reader.engine.connect() as conn:
         old = read_coverage(conn)
     assert old["span_of"].isna().all() and len(old) == 1
-    Catalog(path)  # a writer upgrades in place
-    with sqlite3.connect(path) as conn:
-        columns = {row[1] for row in conn.execute("PRAGMA table_info(coverage)")}
-        version = conn.execute("SELECT version FROM abrupt_schema").fetchone()[0]
-        tables = {row[0] for row in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
-    assert "span_of" in columns and version == SCHEMA_VERSION and "evidence" in tables
-    assert len(Catalog(path, create=False).events()) == 1
+    writer = Catalog(catalog_target)  # a writer upgrades in place
+    with writer.engine.connect() as conn:
+        inspector = sa.inspect(conn)
+        columns = {c["name"] for c in inspector.get_columns("coverage")}
+        tables = set(inspector.get_table_names())
+        version = conn.execute(sa.text("SELECT version FROM abrupt_schema")).scalar_one()
+        assert read_coverage(conn)["start_utc"].tolist() == old["start_utc"].tolist()  # the rows kept
+    assert "span_of" in columns and "evidence" in tables and version == SCHEMA_VERSION
+    assert len(Catalog(catalog_target, create=False).events()) == 1

@@ -24,6 +24,7 @@ from abrupt.events import (
     read_evidence,
     write_events_and_evidence,
 )
+from abrupt.report.site import write_catalog_site
 
 
 def _attributed(n: int = 3) -> pd.DataFrame:
@@ -108,3 +109,26 @@ def test_evidence_stored_inside_the_events_by_an_older_abrupt_is_read_as_evidenc
     assert evidence["event_id"].tolist() == frame["event_id"].tolist()
     assert evidence["ev_min_dv_mps"].iloc[0] == pytest.approx(1e-4, rel=1e-12)
     assert "ev_min_dv_mps" not in cat.events().columns
+
+
+def test_the_sites_event_page_shows_the_events_evidence(tmp_path: Path) -> None:
+    frame = _attributed(2)
+    cat = Catalog(tmp_path / "c.sqlite")
+    cat.store_events(frame)
+    write_catalog_site(cat, tmp_path / "site")
+    first = (tmp_path / "site" / "events" / f"{frame['event_id'].iloc[0]}.html").read_text()
+    second = (tmp_path / "site" / "events" / f"{frame['event_id'].iloc[1]}.html").read_text()
+    assert "Attribution evidence" in first
+    assert "<dt>ev_min_dv_mps</dt><dd>0.0001</dd>" in first and "<dt>ev_orbit_dv_mps</dt><dd>0.002</dd>" in second
+    assert "ev_min_dv_mps" not in second  # an empty quantity is not shown
+
+
+def test_evidence_round_trips_through_each_catalog_back_end(catalog_target: str, tmp_path: Path) -> None:
+    frame = _attributed()
+    frame["ev_label"] = ["gyro", "star_tracker", "gyro"]  # a text quantity is kept as text
+    cat = Catalog(catalog_target)
+    cat.store_events(frame)
+    evidence = cat.evidence(frame["event_id"].iloc[:2]).set_index("event_id").loc[frame["event_id"].iloc[:2]]
+    assert evidence["ev_label"].tolist() == ["gyro", "star_tracker"]
+    np.testing.assert_allclose(evidence["ev_body_share"].to_numpy(float), [0.9, 0.1], rtol=1e-12)
+    assert np.isnan(evidence["ev_min_dv_mps"].iloc[1])

@@ -92,3 +92,18 @@ def test_a_store_exports_to_an_archive_that_ingests_back_to_the_same_samples(
         assert (a["mnemonic"].to_numpy() == b["mnemonic"].to_numpy()).all()
         assert (a["time"].to_numpy() == b["time"].to_numpy()).all()
         np.testing.assert_array_equal(a["value"].to_numpy(), b["value"].to_numpy())
+
+
+def test_the_evidence_table_beside_out_never_overwrites_an_input(
+    store: tuple[Path, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    work, spacecraft = store
+    manifest = work / "run.evidence.csv"  # the name the evidence of --out run.csv would take
+    manifest.write_text(f"spacecraft,telemetry,spacecraft_file,store\nSC-Z,,{spacecraft},store\n")
+    before = manifest.read_bytes()
+    with pytest.raises(SystemExit) as exc:
+        main(["detect", "fleet", str(manifest), "--out", str(work / "run.csv"), "--catalog", str(work / "g.sqlite")])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "same file as --manifest" in err and "destroy that input" in err
+    assert manifest.read_bytes() == before and not (work / "run.csv").exists()

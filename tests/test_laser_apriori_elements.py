@@ -9,6 +9,7 @@ kilometres off the truth, as an element set does.
 
 from __future__ import annotations
 
+import json
 from dataclasses import replace
 from pathlib import Path
 
@@ -20,13 +21,13 @@ from astropy.coordinates import GCRS, TEME, CartesianDifferential, CartesianRepr
 from astropy.time import Time
 from click.testing import CliRunner
 from sgp4.api import WGS72, Satrec
-from sgp4.exporter import export_tle
+from sgp4.exporter import export_omm, export_tle
 
 from abrupt.cli.main import cli, main
 from abrupt.model.orbit import propagate
 from abrupt.model.teme import sgp4_state_gcrf
 from abrupt.model.timescales import offline_astropy
-from abrupt.pipelines.laser_apriori import short_arc_fit
+from abrupt.pipelines.laser_apriori import ElementApriori, is_element_file, short_arc_fit
 from abrupt.pipelines.laser_ranging import (
     LASER_FIT_CONFIG,
     LASER_FORCE,
@@ -39,6 +40,7 @@ from abrupt.readers.sinex import read_sinex
 from abrupt.simulate.slr import SlrScenario, SlrSimulation, simulate_slr
 from test_laser_ranging_cli import write_crd, write_sinex
 
+OMM_METADATA = ("OBJECT_NAME", "OBJECT_ID", "CENTER_NAME", "REF_FRAME", "TIME_SYSTEM", "MEAN_ELEMENT_THEORY")
 MU_WGS72_KM3_S2 = 398600.8  # [km^3/s^2] the gravity constant of SGP4's WGS-72
 
 
@@ -93,6 +95,32 @@ def test_sgp4_state_in_gcrf_agrees_with_astropys_teme_transformation(epoch: str)
     # IAU 1976/1980 (here) against IAU 2006/2000A (astropy): milliarcseconds, a few metres at 12,000 km
     assert np.linalg.norm(mine[:3] - gcrs.cartesian.xyz.to_value(u.m)) < 5.0
     assert np.linalg.norm(mine[3:] - gcrs.velocity.d_xyz.to_value(u.m / u.s)) < 1e-3
+
+
+@pytest.mark.parametrize("fmt", ["kvn", "json", "xml"])
+def test_an_omm_gives_the_apriori_of_its_tle(tmp_path: Path, fmt: str) -> None:
+    line1 = "1 08820U 76039A   24061.00000000  .00000000  00000-0  00000-0 0  9998"
+    line2 = "2 08820 109.8400  40.0000 0045000 250.0000  10.0000  6.38664000    09"
+    line1, line2 = export_tle(Satrec.twoline2rv(line1, line2))  # with their checksums
+    record = export_omm(Satrec.twoline2rv(line1, line2), "LAGEOS-1")
+    texts = {
+        "kvn": "CCSDS_OMM_VERS = 2.0\n" + "".join(f"{k} = {v}\n" for k, v in record.items()),
+        "json": json.dumps([record]),
+        "xml": '<?xml version="1.0" encoding="UTF-8"?><omm id="CCSDS_OMM_VERS" version="2.0"><body><segment>'
+        + "<metadata>"
+        + "".join(f"<{k}>{record[k]}</{k}>" for k in OMM_METADATA if k in record)
+        + "</metadata><data><meanElements>"
+        + "".join(f"<{k}>{v}</{k}>" for k, v in record.items() if k not in OMM_METADATA)
+        + "</meanElements></data></segment></body></omm>",
+    }
+    omm, tle = tmp_path / f"lageos.{fmt}", tmp_path / "lageos.tle"
+    omm.write_text(texts[fmt])
+    tle.write_text(f"{line1}\n{line2}\n")
+    assert is_element_file(omm) and is_element_file(tle)
+    t = np.datetime64("2024-03-01T06:00:00", "ns")
+    from_omm, from_tle = ElementApriori.read(omm).state_gcrf(t), ElementApriori.read(tle).state_gcrf(t)
+    assert from_omm is not None and from_tle is not None
+    assert np.linalg.norm(from_omm[:3] - from_tle[:3]) < 1.0  # [m]: the same elements, to their printed digits
 
 
 @pytest.fixture(scope="module")

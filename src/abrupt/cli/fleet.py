@@ -8,7 +8,16 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from abrupt.cli.commands import lazy_module
-from abrupt.cli.groups import catalog_option, check_suffix, detect, note, progress_hidden, record_run, warn
+from abrupt.cli.groups import (
+    catalog_option,
+    check_evidence_output,
+    check_suffix,
+    detect,
+    note,
+    progress_hidden,
+    record_run,
+    warn,
+)
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.errors import InputError
 from abrupt.scale import Executor
@@ -97,6 +106,7 @@ def detect_fleet_cmd(
     where it stopped when started again with the same inputs and settings. The budget is per spacecraft.
     """
     budget = pop_budget(budget_args, "1/day")
+    check_evidence_output(out)  # store rows' attribution evidence goes beside the events
     members = pipelines_fleet.read_manifest(manifest)
     executor = executor_from(workers, scheduler)
     config = detect_attitude_momentum.AttitudeDetectionConfig(

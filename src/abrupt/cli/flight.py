@@ -16,7 +16,7 @@ from abrupt import progress
 from abrupt.cli.commands import lazy_module
 from abrupt.cli.flight_orbit import orbit_input
 from abrupt.cli.flux import store_run_exposure
-from abrupt.cli.groups import cli, inject, record_run, simulate
+from abrupt.cli.groups import check_evidence_output, cli, inject, record_run, simulate
 from abrupt.cli.options import budget_options, pop_budget
 from abrupt.errors import InputError
 from abrupt.outputs import atomic_output, write_text_atomic
@@ -148,6 +148,7 @@ def detect_from_store(
     (and, with ``exposure`` options and a catalog, the run's exposure rows: :func:`store_run_exposure`);
     ``orbit``: the orbit events file, ΔV floor [m/s], spans, edge [s] and run id of an orbit run
     (:mod:`abrupt.cli.flight_orbit`)."""
+    check_evidence_output(out)  # the attribution evidence goes beside the events
     sc = model_spacecraft.load_spacecraft(spacecraft_path)
     orbit_in = orbit_input(*orbit, spacecraft=sc.name, catalog_target=catalog_target)
     cfg = pipelines_flight.FlightRunConfig(budget=budget, cleaning=_cleaning(no_clean))

@@ -23,6 +23,7 @@ from abrupt import progress as progress_report
 from abrupt.cli.commands import (
     GLOBAL_FLAGS,
     State,
+    check_output_paths,
     cli,
     detect,
     hoist_global_flags,
@@ -46,6 +47,7 @@ __all__ = [
     "GLOBAL_FLAGS",
     "StageProgress",
     "catalog_option",
+    "check_evidence_output",
     "check_suffix",
     "cli",
     "detect",
@@ -118,6 +120,16 @@ def check_suffix(*suffixes: str) -> Any:
 def printable_lines(text: str) -> str:
     """``text`` for the terminal: control characters escaped (:func:`abrupt.errors.printable`) in each line."""
     return "\n".join(printable(line) for line in text.split("\n"))
+
+
+def check_evidence_output(out: str | Path | None) -> None:
+    """Refuse the evidence table beside ``out`` (:func:`abrupt.events.evidence_path`) when it would
+    overwrite an input of the running command or follow a link, as ``--out`` itself is refused."""
+    ctx = click.get_current_context(silent=True)
+    if out is None or ctx is None:
+        return
+    inputs = {k: v for k, v in ctx.params.items() if k != "out" and not k.startswith("out_")}
+    check_output_paths({**inputs, "out": str(abrupt_events.evidence_path(out))})
 
 
 def file_hash(path: str | Path) -> str:
@@ -208,6 +220,8 @@ def record_run(
     details = {**(details or {}), **command_options()}
     catalog = abrupt_catalog.Catalog(catalog_target)  # open (and check) the catalog before writing anything
     catalog.check_fits(events)  # texts too long for the catalog: refused before the file is written
+    if out is not None and any(str(c).startswith(abrupt_events.EVIDENCE_PREFIX) for c in events.columns):
+        check_evidence_output(out)
     coverage = abrupt_catalog.coverage_of(
         events,
         config_hash=config_hash,

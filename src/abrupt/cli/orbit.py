@@ -382,12 +382,11 @@ def detect_orbit_command(
     if statistics_out and run.result.diagnostics:
         _write_statistics(run, statistics_out)
     events = run.events
-    chash = _config_hash_of(events, run.detector.config(), budget)
     record_run(
         catalog_target=catalog_target,
         command="detect orbit",
         events=events,
-        config_hash=chash,
+        config_hash=_config_hash_of(events, run.detector.config(), budget),
         run_id=run_id,
         input_path=file,
         out=out,

@@ -48,10 +48,15 @@ MAX_ELEMENT_AGE_DAYS = 30.0
 
 
 def is_element_file(path: str | Path) -> bool:
-    """Whether a file holds TLE/3LE or OMM element sets (rather than an ephemeris), from its first bytes."""
+    """Whether a file holds TLE/3LE or OMM (KVN, XML, JSON) element sets rather than an ephemeris, from its
+    first bytes."""
     head = read_element_bytes(Path(path))[:4000].decode("utf-8", errors="replace").lstrip("\ufeff\r\n\t ")
-    lowered = head[:400].lower()
-    return is_tle_text(head) or head.startswith("CCSDS_OMM_VERS") or (head.startswith("<") and "omm" in lowered)
+    lowered = head.lower()
+    if is_tle_text(head) or head.startswith("CCSDS_OMM_VERS"):
+        return True
+    if head.startswith("<"):  # XML: an OMM, or an OEM (an ephemeris)
+        return "<omm" in lowered or ":omm" in lowered
+    return head.startswith(("[", "{")) and "mean_motion" in lowered  # OMM as JSON (Space-Track, CelesTrak)
 
 
 @dataclass
