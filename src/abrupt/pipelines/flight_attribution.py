@@ -220,11 +220,11 @@ def _without_step(
     fits = _window_fits(table, cleaned_H_N, i0, fits)
     lo, _, hi = fits.key
     y_b = fits.y_B
-    for q in neighbours:  # an impulse is fixed in body axes at its instant (body_frame_momentum)
-        on = table.time_ns[lo:hi] >= q.time_ns
+    for nb in neighbours:  # an impulse is fixed in body axes at its instant (body_frame_momentum)
+        on = table.time_ns[lo:hi] >= nb.time_ns
         if on.any() and not on.all():
             k = lo + int(np.argmax(on))
-            y_b = y_b - on[:, None] * (dcm_from_quaternion(table.quaternion_BN[k]) @ q.dH_N_Nms)[None, :]
+            y_b = y_b - on[:, None] * (dcm_from_quaternion(table.quaternion_BN[k]) @ nb.dH_N_Nms)[None, :]
     # The window's momentum is the evidence's; its ramp fit is not (the leak may be longer than its ramps).
     fit = fit_ramp_step(fits.tau_s, y_b, 0.0, n_durations=LEAK_DURATIONS, max_ramp_fraction=LEAK_FRACTION)
     if fit is None or not float(np.linalg.norm(fit.ramp_B)) > RAMP_SIGMA_MIN * fit.ramp_sigma:
