@@ -1,4 +1,5 @@
-"""An unflagged momentum dump against a strike of the same size: the dump hypothesis of the attribution.
+"""An unflagged momentum dump against a strike of the same size (the dump hypothesis of the attribution),
+and two strikes minutes apart with nothing invented between them.
 
 Truths used: the von Mises-Fisher density's normalisation and the uniform distribution of directions on
 the sphere (the false-dump rate of a strike); the scatter of a least-squares step over noise draws (its
@@ -18,6 +19,7 @@ from abrupt.detect.attitude.attribution import AttributionRules, classify
 from abrupt.detect.attitude.dump_evidence import dump_log_lr, step_with_sigma
 from abrupt.detect.attitude.evidence import event_evidence
 from abrupt.model.spacecraft import load_spacecraft
+from abrupt.pipelines.flight_attribution import rescan_after_faults
 from abrupt.series.timetable import NS
 from abrupt.simulate.confounders import Confounder, ConfounderRanges, aimed_dump, draw_confounder
 from test_attribution_repair import closed_loop_table, glr_peaks
@@ -128,3 +130,33 @@ def test_the_generator_aims_a_dump_against_the_wheels_and_unloads_no_more_than_t
     assert aimed_dump(big, stored).params["impulse_Nms"] == np.linalg.norm(stored)
     wide = ConfounderRanges().widened(3.0)
     assert all(draw_confounder("momentum_dump", 0, sc, wide, rng).params["aim_deg"] <= 15.0 for _ in range(50))
+
+
+def test_two_strikes_minutes_apart_leave_no_torque_event_between_them() -> None:
+    """Two strikes (0.05-0.3 N·m·s, at right angles, both more than 30° from the wheels' −H_w so that each is
+    a strike by its own evidence) 7-9 minutes apart: the rescan for a torque beside a strike invents
+    nothing between them (the other strike's step is a change the telemetry shows, not the end of a
+    ramp). Six draws."""
+    sc = load_spacecraft(KESTREL)
+    u = -_stored_B(sc) / np.linalg.norm(_stored_B(sc))
+    tested, seed = 0, 0
+    while tested < 6:
+        rng = np.random.default_rng(seed)
+        seed += 1
+        gap = int(rng.uniform(420, 540))
+        d1 = rng.normal(size=3)
+        d1 /= np.linalg.norm(d1)
+        d2 = np.cross(d1, rng.normal(size=3))
+        d2 /= np.linalg.norm(d2)
+        if max(d1 @ u, d2 @ u) > math.cos(math.radians(30.0)):
+            continue
+        tested += 1
+        s1, s2 = rng.uniform(0.05, 0.3, 2)
+        table = closed_loop_table(rng, 1000, s1 * d1, more=((1000 + gap, s2 * d2),))
+        h_n, hc, ok, det, peaks = glr_peaks(sc, table)
+        ev = {p.time_ns: event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n) for _, p in peaks}
+        times = sorted(p.time_ns / NS for _, p in peaks)
+        assert len(times) == 2 and abs(times[0] - 1000) <= 3 and abs(times[1] - 1000 - gap) <= 3, (seed, times)
+        assert [classify(e).kind for e in ev.values()] == ["strike", "strike"], seed
+        found, _, _ = rescan_after_faults(table, sc, h_n, hc, ok, det, peaks, ev, floor=5.0)
+        assert not found, (seed, [p.time_ns / NS for _, p in found])

@@ -202,16 +202,31 @@ LEAK_DURATIONS = 48
 
 
 def _without_step(
-    table: Timetable, cleaned_H_N: FloatArray, i0: int, a: int, b: int, fits: WindowFits | None = None
+    table: Timetable,
+    cleaned_H_N: FloatArray,
+    i0: int,
+    a: int,
+    b: int,
+    fits: WindowFits | None = None,
+    neighbours: tuple[Peak, ...] = (),
 ) -> tuple[FloatArray, RampStep] | None:
     """Cleaned ᴺH over rows [a, b) with the step at row ``i0`` taken out, and the fit, when the window
     around it also holds a ramp beyond its noise (a leak beside a strike); None otherwise. The step is
     that of the step-on-a-ramp fit (:func:`~abrupt.detect.attitude.ramp_step.fit_ramp_step`), fixed in
-    body axes at ``i0``, so what is left is the ramp and the rest of the window. ``fits``: the event's
-    evidence fits, used when they are of this window."""
+    body axes at ``i0``, so what is left is the ramp and the rest of the window. The steps of the
+    ``neighbours`` (the detector's other peaks) are taken out of the window before the ramp is fitted:
+    a second strike minutes away is a change the telemetry shows, and a ramp ending at it is no torque
+    of its own. ``fits``: the event's evidence fits, used when they are of this window."""
     fits = _window_fits(table, cleaned_H_N, i0, fits)
+    lo, _, hi = fits.key
+    y_b = fits.y_B
+    for nb in neighbours:  # an impulse is fixed in body axes at its instant (body_frame_momentum)
+        on = table.time_ns[lo:hi] >= nb.time_ns
+        if on.any() and not on.all():
+            k = lo + int(np.argmax(on))
+            y_b = y_b - on[:, None] * (dcm_from_quaternion(table.quaternion_BN[k]) @ nb.dH_N_Nms)[None, :]
     # The window's momentum is the evidence's; its ramp fit is not (the leak may be longer than its ramps).
-    fit = fit_ramp_step(fits.tau_s, fits.y_B, 0.0, n_durations=LEAK_DURATIONS, max_ramp_fraction=LEAK_FRACTION)
+    fit = fit_ramp_step(fits.tau_s, y_b, 0.0, n_durations=LEAK_DURATIONS, max_ramp_fraction=LEAK_FRACTION)
     if fit is None or not float(np.linalg.norm(fit.ramp_B)) > RAMP_SIGMA_MIN * fit.ramp_sigma:
         return None
     g, q = table.time_ns, table.quaternion_BN[a:b]
@@ -265,6 +280,7 @@ def rescan_after_faults(
     found: list[tuple[int, Peak, EventEvidence]] = []
     half_s = RESCAN_SPAN_S[1] + win.span * dt
     others = tuple((int(p.time_ns), RESCAN_APART_S, RESCAN_APART_S) for _, p in peaks)
+    strikes = {t for t, e in evidence.items() if classify(e, rules).kind == "strike"}
     for i_pk, pk in peaks:
         ev = evidence.get(pk.time_ns)
         if ev is None:
@@ -301,6 +317,7 @@ def rescan_after_faults(
             got = _torque_beside_strike(
                 table, spacecraft, raw_H_N, cleaned_H_N, ok, detector, pk, (i0, a, b), floor, keep_sub, others,
                 inertia_kgm2, rules, None if fits is None else fits.get(pk.time_ns),
+                tuple(q for _, q in peaks if q.time_ns != pk.time_ns and q.time_ns in strikes),
             )  # fmt: skip
             if got is not None:
                 found.append((*got[0], got[1]))
@@ -356,8 +373,10 @@ def _torque_beside_strike(
     inertia_kgm2: FloatArray | None,
     rules: AttributionRules | None,
     fits: WindowFits | None = None,
+    neighbours: tuple[Peak, ...] = (),
 ) -> tuple[tuple[int, Peak], EventEvidence] | None:
-    """A lasting external torque's own peak beside a strike's event, or None.
+    """A lasting external torque's own peak beside a strike's event, or None (``neighbours``: the
+    detector's other peaks that are strikes, whose steps are no torque: :func:`_without_step`).
 
     A leak whose onset is within a window span of a strike makes one event, at the (larger) strike: the
     strike's fitted step (:func:`_without_step`) is taken out of ᴺH (raw and cleaned alike) and the
@@ -367,7 +386,7 @@ def _torque_beside_strike(
     """
     g, dt = table.time_ns, table.dt_s
     i0, a, b = rows
-    got = _without_step(table, cleaned_H_N, i0, a, b, fits)
+    got = _without_step(table, cleaned_H_N, i0, a, b, fits, neighbours)
     if got is None:
         return None
     hc_sub, fit = np.where(ok[a:b, None], got[0], np.nan), got[1]
