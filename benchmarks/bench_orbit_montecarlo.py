@@ -24,6 +24,137 @@ latitude).
     nice python benchmarks/bench_orbit_montecarlo.py --quick     # 20 runs, 50 000 null points
     nice python benchmarks/bench_orbit_montecarlo.py             # 200 runs, 200 000 null points
     nice python benchmarks/bench_orbit_montecarlo.py --tuned     # thesis vs tuned P_D curves
+
+**Monte Carlo**, full run (`nice python benchmarks/bench_orbit_montecarlo.py --skip-perturbed`, about 6.5 min,
+output in `docs/results/bench_orbit_montecarlo.txt`): 200 runs per strike, 50 per curve point, and 248 403
+event-free points (KDE thresholds). The quick run (`--quick`: 20 runs, 10 per point, 82 801 points) gave the
+figures in brackets.
+
+Reproduction, with thesis defaults and two-body truth and filter. Each cell is the detection rate at one false
+alarm per week (target ≥ 0.90), with the mean SNR:
+
+* `accel_smoothed` (TS3): 2.4 cm/s: 1.00 (SNR 39); 0.24 cm/s: **0.99** (SNR 4.0) [quick 1.00]
+* `mcr_w` (TS4): 2.4 cm/s: 1.00 (SNR 39); 0.24 cm/s: **0.99** (SNR 4.0) [quick 1.00]
+* `mcr_scalar`: 2.4 cm/s: 1.00 (18); 0.24 cm/s: 0.99 (1.9)
+* `mahalanobis_v` (TS2): 2.4 cm/s: 1.00 (8.8); 0.24 cm/s: 0.33 (0.9) [quick 0.85]
+* `dv_fb` (TS1): 2.4 cm/s: 1.00 (8.2); 0.24 cm/s: 0.15 (0.8) [quick 0.70]
+* `d_sma`, `d_ecc`, `d_hdir` (TS6): 2.4 cm/s: 0.57, 0.71, 0.21; 0.24 cm/s: 0.00
+
+As the thesis reports, the acceleration statistics beat the velocity ones.
+
+Mirroring (§3.2.6), on the same data:
+- unmirrored backward filter: |w| reaches 0.85 m/s² and the velocity error 7.6 m/s (diverged);
+- mirrored backward filter: |w| ≤ 7.5e-6 m/s² and the velocity error ≤ 0.035 m/s.
+
+Detection probability against |ΔV| (random directions, one false alarm per week, 50 runs per point, full run):
+
+* `accel_smoothed`, `mcr_w`: ΔV: 0.10; (mm/s): 0.46; 0.3: 0.58; 0.5: 0.84; 0.7: 0.92; 1.0: 1.00; 1.5: 1.00; 2.0:
+  1.00; 3.0: **1.38 mm/s** (target 1 mm/s; quick run: 1.0)
+* `mcr_scalar`: ΔV: 0; (mm/s): 0; 0.3: 0.02; 0.5: 0.22; 0.7: 0.76; 1.0: 0.98; 1.5: 1.00; 2.0: 1.00; 3.0: 1.82
+  mm/s
+* `mahalanobis_v`: ΔV: 0; (mm/s): 0; 0.3: 0; 0.5: 0; 0.7: 0; 1.0: 0.18; 1.5: 0.80; 2.0: 1.00; 3.0: 4.0 mm/s
+* `dv_fb`: ΔV: 0; (mm/s): 0; 0.3: 0; 0.5: 0; 0.7: 0; 1.0: 0.08; 1.5: 0.70; 2.0: 1.00; 3.0: 4.3 mm/s
+* TS6, `glr` (10 s window at 1 Hz): ΔV: 0; (mm/s): 0; 0.3: 0; 0.5: 0; 0.7: 0; 1.0: 0; 1.5: 0; 2.0: 0; 3.0: –
+
+The full run puts the 90 % point of the best statistic at 1.38 mm/s, so the 1 mm/s target is **not met** (P_D =
+0.84 at 1 mm/s). The quick run's 1.0 mm/s came from only 10 runs per point.
+
+**Small-strike tuning** (beyond the thesis). Command: `nice python benchmarks/bench_orbit_montecarlo.py --tuned`
+(about 8 min; output in `docs/results/bench_orbit_montecarlo_tuned.txt`; `--tuned --quick` takes 1 min). The
+thesis tuning was chosen for the 2.4 cm/s strike. Here τ and q are chosen for 1 mm/s strikes. The measurement
+noise stays at Table 3.1 (10 m, 0.25 m/s, 1 Hz), and the truth and filter stay two-body.
+- **Tuning.** The grid is τ ∈ {1, 10, 100} s × q ∈ {2.15e-16 … 2.15e-11} m²/s⁵, with 20 strikes of 1 mm/s and 24
+  h of event-free 3 h runs. These seeds (5000+, 4242) are disjoint from the evaluation seeds. The criterion is
+  the SNR that 90 % of the tuning strikes exceed, not the mean SNR, because the mean favours statistics whose
+  SNR is large in some directions and small in others. Among points within 2 % of the best, the one with the
+  most process noise (largest qτ²) wins. The SNR follows qτ² (τ = 1, 10, 100 s with the same qτ² give the same
+  row). The choice is **τ = 1 s, q = 2.15e-12 m²/s⁵**, one tenth of the thesis q, with `accel_smoothed`/`mcr_w`
+  best (SNR exceeded by 90 %: 2.04, against 0.75 with the thesis tuning). `mcr_scalar` keeps rising as q falls
+  and levels off at 1.39 below q ≈ 2e-14. There the filters become the batch least-squares fit of the whole run.
+- **Evaluation.** For each tuning, the thresholds are refitted (KDE, one false alarm per week, 201 628
+  event-free points). Each point has 50 strikes, with the same strike seeds for both tunings, so the curves are
+  paired. The event-free runs are 3 h long like the strike runs. With little process noise the filters take
+  hours to converge, and thresholds from 24 h runs misjudge the statistics of a 3 h run. An earlier attempt with
+  24 h null runs gave a non-monotone `accel_smoothed` curve. It also chose q = 2.15e-14 with `mcr_scalar` at
+  0.79 mm/s. Neither result is used, because the null runs did not match the strike runs.
+
+* thesis: `accel_smoothed`, `mcr_w`: ΔV: 0.02; (mm/s): 0.04; 0.2: 0.28; 0.3: 0.32; 0.4: 0.60; 0.5: 0.74; 0.7:
+  1.00; 1.0: 0.98; 1.5: 1.00; 2.0: 1.00; 3.0: 1.31 mm/s
+* **tuned: `accel_smoothed`, `mcr_w`**: ΔV: 0.40; (mm/s): 0.54; 0.2: 0.72; 0.3: 0.70; 0.4: 0.86; 0.5: **0.92**;
+  0.7: 0.98; 1.0: 1.00; 1.5: 1.00; 2.0: 1.00; 3.0: **0.90 mm/s** (target 1)
+* thesis: `mcr_scalar`: ΔV: 0; (mm/s): 0; 0.2: 0; 0.3: 0; 0.4: 0.02; 0.5: 0.10; 0.7: 0.60; 1.0: 0.96; 1.5: 1.00;
+  2.0: 1.00; 3.0: 1.92 mm/s
+* tuned: `mcr_scalar`: ΔV: 0; (mm/s): 0.02; 0.2: 0.06; 0.3: 0.24; 0.4: 0.52; 0.5: 0.76; 0.7: 1.00; 1.0: 1.00;
+  1.5: 1.00; 2.0: 1.00; 3.0: 1.29 mm/s
+* thesis / tuned: `mahalanobis_v`: ΔV: 0 / 0; 0.5: 0 / 0; 0.7: 0 / 0.06; 1.0: 0.02 / 0.18; 1.5: 0.38 / 0.80;
+  2.0: 1.00 / 1.00; 3.0: 4.68 / 4.00 mm/s
+* thesis / tuned: `dv_fb`: ΔV: 0 / 0; 0.5: 0 / 0; 0.7: 0 / 0; 1.0: 0 / 0; 1.5: 0.16 / 0.28; 2.0: 0.98 / 0.98;
+  3.0: 4.80 / 4.77 mm/s
+* TS6, `glr` (10 s window), both: ΔV: ≈ 0; 3.0: not reached
+
+With the small-strike tuning the best statistic reaches 90 % at **0.90 mm/s** (P_D = 0.92 at 1 mm/s), so the **1
+mm/s target is met**. The thesis tuning in the same run gives 1.31 mm/s (P_D = 0.74 at 1 mm/s). With 50 runs per
+point each P_D is uncertain by about ±0.04 near 0.9. The 0.90 mm/s point is interpolated between 0.86 (0.7 mm/s)
+and 0.92 (1 mm/s), so it is only resolved to about ±0.15 mm/s. The 1.31 here and the 1.38 in the table above
+come from different null run lengths and strike draws.
+
+*Threshold check.* The benchmark also counts false alarms on a fresh week of evaluated event-free epochs (seeds
+90000+, 3 h runs; exceedances within 600 s form one episode). It uses the same thresholds. One is expected:
+
+* `accel_smoothed`, `mcr_w`: thesis: 2; tuned: 2
+* `mcr_scalar`, `mahalanobis_v`, `dv_fb`: thesis: 0; tuned: 0
+* `d_sma` / `d_ecc` / `d_hdir`: thesis: 3 / 1 / 10; tuned: 2 / 2 / 7
+* `glr` (10 s window): thesis: 22; tuned: 21
+
+The best statistic gives 2 against 1 expected, the same for both tunings. That is not significant for one week
+(Poisson, p ≈ 0.26), but it is not a proof of one per week either. The statistics vary slowly:
+
+KDE tail at P_fa = 1/604 800 per sample is not pinned down well. For `glr` and TS6 the per-sample KDE threshold
+from 3 h runs is clearly too low (7-22 episodes per week). Their P_D values are close to 0, so this does not
+affect the conclusions.
+
+*How close to the limit?* The benchmark prints a known-time bound. It linearises the two-body motion
+(Clohessy-Wiltshire) about the 800 km orbit, uses the Fisher information of a velocity jump from 1 Hz position
+and velocity data with the Table 3.1 noise over the 3 h run, and marginalises the unknown initial state. The
+jump time is uniform over the evaluated span and the direction is random. The 1σ ΔV from the data is 0.18 / 0.08
+/ 0.30 mm/s (radial / along-track / cross-track). The ideal χ²(3) test at a known time reaches 90 % at:
+
+* P_D at 1 mm/s: 1/604 800: 0.85; 1e-4: 0.91; 1e-2: 0.97
+* 90 % point: 1/604 800: 1.18 mm/s; 1e-4: 0.98 mm/s; 1e-2: 0.70 mm/s
+
+If every 1 Hz sample were an independent test (α = 1/604 800), even the ideal test would need 1.18 mm/s, and 1
+mm/s would be out of reach. The thesis tuning is at that limit (P_D 0.74-0.84 at 1 mm/s against 0.85). The tuned
+statistic does better (0.92 at 1 mm/s, 0.40 at 0.2 mm/s against 0.13) because it is slowly varying. Its
+one-per-week threshold is crossed in 2 episodes per week. If an episode lasts about 600 s, as in an earlier
+check with 24 h runs (3520 exceeding samples in 6 episodes; not measured in this run), that is about 0.2 % of
+samples, a per-sample α of about 2e-3. An episode rate of one per week therefore admits a per-sample α far above
+1/604 800, and against the matching bound (0.7-0.98 mm/s for α = 1e-2…1e-4) the tuned 0.90 mm/s is close to
+optimal. Smaller strikes would need more data (longer runs, higher rate) or lower noise, not a different
+statistic.
+
+**With J3 and exponential drag in the truth only** (§4.9 / thesis §3.4.4: 400 km, e = 0.001, two-body filter).
+Command: `nice python benchmarks/bench_orbit_montecarlo.py --quick --only-perturbed` (75 s; output in
+`docs/results/bench_orbit_montecarlo_perturbed_quick.txt`). The thresholds are refitted on perturbed event-free
+data (25 000 points), and each point uses 10 runs. The τ-q grid (§3.4.2) is τ ∈ {1, 10, 100, 1000} s × q ∈
+{2.15e-12 … 2.15e-8} m²/s⁵. It uses a 6 h event-free run and three 2.4 cm/s strikes, with seeds separate from
+the curve runs. The point with the largest mean SNR of the best statistic is chosen.
+
+The grid SNR follows a broad ridge along qτ ≈ constant. The thesis point (τ = 1 s, q = 2.15e-11) lies well below
+that ridge, at SNR 0.44-0.97. The ridge (τ = 1 s with q ≥ 2.15e-10, τ = 10 s with q ≤ 2.15e-10, τ = 100 s with q
+≤ 2.15e-11) reaches SNR 1.1-1.3. As the thesis says, the perturbed case needs about 10-1000× more process noise.
+The grid picked τ = 10 s, q = 2.15e-12 m²/s⁵.
+
+* thesis tuning: `mcr_scalar`: ΔV: 0; (mm/s): 0; 1: 0.10; 3: 0.60; 10: 0.80; 24: > 48 mm/s
+* thesis tuning: `accel_smoothed`, `mcr_w`: ΔV: 0; (mm/s): 0; 1: 0; 3: 0.20; 10: 0.60; 24: > 48 mm/s
+* re-tuned: `mcr_scalar`: ΔV: 0; (mm/s): 0; 1: 0.10; 3: 0.70; 10: 1.00; 24: **40 mm/s**
+* re-tuned: `accel_smoothed`, `mcr_w`: ΔV: 0; (mm/s): 0; 1: 0; 3: 0.40; 10: 1.00; 24: 44 mm/s
+* re-tuned: `dv_fb`: ΔV: 0; (mm/s): 0; 1: 0; 3: 0.50; 10: 0.90; 24: 48 mm/s
+
+The best statistic's 90 % point moves from **1.38 mm/s** (two-body truth, full run) to **about 40 mm/s** with J3
+and drag in the truth and the re-tuned filter, a factor of about 30. With the thesis tuning it stays above 48
+mm/s. That matches the thesis, where the 2× strike (48 mm/s) was "still detectable". With 10 runs per point,
+each P_D is uncertain by ±0.15. Modelling the known perturbations in the filter (`--dynamics j3`/`j4`) should
+help more than extra process noise, but this was not measured.
 """
 
 from __future__ import annotations

@@ -33,6 +33,96 @@ boundary rule was developed on simulated products with seeds 0 and 1, and its pa
 seeds 5 and 6, not seen before.
 
     nice python benchmarks/bench_orbit_null.py [--max-sats N] [--budget 1/week] [--no-pooled]
+
+False alarms on every real product, burn pairs, day boundaries
+--------------------------------------------------------------
+
+`nice python benchmarks/bench_orbit_null.py` reads every SP3 file in `../shared/data/sp3` and its Orekit corpus
+(every satellite), runs `detect orbit` at its defaults (1/week) on each arc of at least 6 hours — a
+multi-satellite file as `detect orbit --all-satellites` does (thresholds from the other satellites,
+`--no-pooled`: each arc on its own) — counts events per **searched** satellite-day (the epochs where the event
+statistic is defined; the files' span is printed beside it) against the stated rate and prints the 90
+%-detectable ΔV per file. Arcs shorter than 6 hours (most of the corpus: 1-91 epochs) are counted as too short;
+the two real ILRS CPF predictions of `../shared/data/tracking/ilrs-corpus` are added to their classes, and two
+simulated daily-arc products (seeds 5 and 6, not used in development) form a class of their own. The run writes
+`docs/results/bench_orbit_null.txt` (172 s wall, load ~10 on two shared cores):
+
+* GNSS (gbm18432: 71 satellites, 300 s, 1 day, leave-one-satellite-out; Galileo CPF): satellites: 72; searched
+  sat-days (span): 36.64 (72.75); events: 6; expected at 1/week: 5.23; 95 % of expected: [1, 10]; realised rate
+  [95 %]: 0.164 [0.060, 0.36]; pass: yes
+* LEO (Sentinel-3A, Jason-1, 60 s): satellites: 2; searched sat-days (span): 18.48 (19.04); events: 0; expected
+  at 1/week: 2.64; 95 % of expected: [0, 6]; realised rate [95 %]: 0 [0, 0.20]; pass: yes
+* geodetic, real (LAGEOS-1 CPF, 300 s): satellites: 1; searched sat-days (span): 1.52 (2.02); events: 0;
+  expected at 1/week: 0.22; 95 % of expected: [0, 1]; realised rate [95 %]: 0 [0, 2.4]; pass: yes
+* geodetic, simulated daily arcs (2 min / 4 d; 15 min / 7 d): satellites: 2; searched sat-days (span): 9.89
+  (11.00); events: 1; expected at 1/week: 1.41; 95 % of expected: [0, 4]; realised rate [95 %]: 0.10 [0.003,
+  0.56]; pass: yes
+
+The stated rate is 0.143 per day. The GNSS class realises it: 0.164 per searched satellite-day (6 events; 5 in
+the run before the burn-sequence change that resolves burns more than one GLR window apart), where the per-arc
+rule gave 1 event (0.014 per span-day, 0.027 per searched day). The events are the file's null as the
+calibration sees it: four GPS Earth-shadow crossings (G09 14:27, G15 06:57, G23 13:32, G28 15:47 UTC, each
+inside the satellite's computed eclipse), the sequence scan's second G15 "burn" at 07:57 (one GLR window after
+the first: the residual of taking the shadow crossing out as an impulse; the same two events on main before the
+shadow-passage work, checked), and Galileo E14 at the product's common 12:00 feature, 0.09-0.16 mm/s, at the
+detection limit. The pooled thresholds hold the shadow passages in their null, so they are not treated again as
+nuisance there. Each satellite's threshold comes from the other 70 (held out by construction); nothing in the
+rule was tuned on this file. The 90 %-detectable
+
+0.235 mm/s, Jason-1 0.155, Galileo CPF 0.066, LAGEOS-1 CPF 0.10, simulated LAGEOS-like 0.0009 and Etalon-like
+0.033 mm/s (smooth simulated products). Single-satellite files are unchanged (LEO, geodetic: 0 events as
+before). Before the boundary treatment the simulated products raised 3 of 3 and 4 of 6 boundaries as events.
+Held out: every file except Sentinel-3A (on which the self-calibration rules were set earlier); the boundary
+rule's pattern level was relaxed from 10⁻³ to 5 % after simulated seeds 3-4, and the sequence scans were made to
+keep the first scan's thresholds after seed 4 (a removed boundary "burn" changed the re-calibrated threshold and
+let another boundary through), so seeds 3-4 are in-sample and 5-6 held out.
+
+**Simulated null products** (`nice python benchmarks/bench_orbit_null_simulated.py --sats 10`, writes
+`docs/results/bench_orbit_null_simulated.txt`): 10 satellites per product from abrupt's own simulator (EGM2008
+40×40, Sun, Moon, SRP with a conical shadow, drag in LEO; 1 cm / 0.01 mm/s white noise; the filter has no SRP).
+First-scan exceedance episodes over the searched time, realised against stated; "+nuisance": the
+single-satellite detector as a user runs it (per-arc rule with day boundaries and Earth-shadow passages judged
+as nuisance, first-scan events). These seeds are held out for the shadow-passage treatment (developed on
+`--seed-base=6000`, `bench_orbit_null_simulated_dev.txt`):
+
+* LEO 800 km, 30 s, 0.5 d: searched sat-days: 3.61; 1/day: expected [95 %]: 3.61 [0, 8]; per-arc: 0;
+  per-arc+nuisance: 0; leave-one-satellite-out: 4; 1/week: expected [95 %]: 0.52 [0, 2]; per-arc: 0;
+  per-arc+nuisance: 0; leave-one-out: (too few others)
+* geodetic 5900 km, 5 min, 2 d: searched sat-days: 15.03; 1/day: expected [95 %]: 15.03 [8, 23]; per-arc: 2;
+  per-arc+nuisance: 0; leave-one-satellite-out: 17; 1/week: expected [95 %]: 2.15 [0, 5]; per-arc: 0;
+  per-arc+nuisance: 0; leave-one-out: (too few others)
+* GNSS 20 200 km, 5 min, 1 d: searched sat-days: 5.00; 1/day: expected [95 %]: 5.00 [1, 10]; per-arc: 0;
+  per-arc+nuisance: 0; leave-one-satellite-out: 5; 1/week: expected [95 %]: 0.71 [0, 3]; per-arc: 0;
+  per-arc+nuisance: 0; leave-one-out: (too few others)
+* GNSS 20 200 km, 15 min, 3 d: searched sat-days: 23.85; 1/day: expected [95 %]: 23.85 [15, 34]; per-arc: 16;
+  per-arc+nuisance: 7; leave-one-satellite-out: 24; 1/week: expected [95 %]: 3.41 [0, 7]; per-arc: **10**;
+  per-arc+nuisance: **0**; leave-one-out: 5
+* all: searched sat-days: 47.50; 1/day: expected [95 %]: 47.5; per-arc: 18 (0.38/day); per-arc+nuisance: 7
+  (0.15/day); leave-one-satellite-out: **50 (1.05/day [0.78, 1.39])**; 1/week: expected [95 %]: 6.79; per-arc:
+  10 (0.21/day); per-arc+nuisance: 0 (0 [0, 0.078]/day); leave-one-out: 5 (0.105/day [0.034, 0.25])
+
+The product calibration gives the stated rate at every sampling and altitude (1/day: 1.05 per day against 1;
+1/week: 0.105 against 0.143, interval containing it); where the others' exposure allows fewer than two episodes
+(14 searched satellite-days at 1/week) it falls back to the per-arc rule. The per-arc rule alone was **too
+liberal on the simulated 15-minute GNSS product at 1/week (10 against 3.4; every one a shadow passage of the SRP
+the filter lacks)**; with the passages judged as nuisance ("Earth-shadow passages" above) the single-satellite
+detector raises **0 against 3.4 (Poisson 95 % [0, 7]) on these held-out seeds**, and 3 (against 3.41) on the
+development seeds. It is conservative: 7 episodes at 1/day where 23.9 were allowed on the 15-minute product
+(below the interval [15, 34]) and 0.15 per day over all products against 1: a single coarse arc's own null still
+places its level above the bulk (the χ²₃ floor, "Why the one-day GNSS files raised a tenth", item 1), and the
+passage windows are taken out of the search.
+
+`nice python benchmarks/bench_orbit_burn_pairs.py` (10 trials per arc, seed 7): two impulses 30-90 min apart,
+1-2 cm/s each in random directions, injected into 12-hour sub-arcs of the real arcs. Both found within 120 s
+with |ΔV| within 20 %: **Sentinel-3A 10/10** (max time error 0.9 s, max ΔV error 0.5 %), **Jason-1 9/10** (held
+out; the nine within 0.7 s and 0.5 %). The miss: a pair 32 min apart straddling midnight, whose first scan
+located one merged jump between the two burns (18 mm/s at 23:53, burns at 23:36 and 00:08); removing that merged
+estimate does not separate them. A two-jump GLR would. Before (a single scan) the second burn of every pair was
+merged into the first event.
+
+Acceptance figures of the arcs kept: Sentinel-3A and Jason-1 raise 0 events on the whole arcs, and a 2 cm/s
+along-track impulse injected into Sentinel-3A at 2018-12-26T06:00 is found at 06:00:00.34 with ΔV 0.019987 m/s
+(one event; the sequence scan finds nothing more).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Real precise orbits with the full force model: false alarms per arc next to the
+r"""Real precise orbits with the full force model: false alarms per arc next to the
 budget, 5 mm/s burns injected at random times and directions, and the 90 %-detectable ΔV, on two
 satellites.
 
@@ -17,6 +17,89 @@ For each arc:
 3. P_D against |ΔV| and the 90 % point.
 
     nice python benchmarks/bench_orbit_real_arcs.py [--quick] [--arc-days 2]
+
+With the full force model
+-------------------------
+
+Commands: `nice python benchmarks/bench_orbit_real_arcs.py --arc jason1` (full: 30 injections at 5 mm/s, 15 per
+curve point) and `--quick` (10 and 6). Each injection goes into a 2-day sub-arc centred on it, with thresholds
+self-calibrated on that sub-arc at one false alarm per week. Nothing is tuned per arc; the rules that were set
+on data were set on Sentinel-3A (and the χ² floor on GNSS SP3 files), so Jason-1 is held out. The Sentinel-3A
+column's full figures come from a run stopped after the curve began, on code before the χ² floor and the span
+cap; its quick run on today's code is in `docs/results/bench_orbit_real_arcs_quick.txt`.
+
+* post-fit RMS (measurement − forward a-posteriori), whole arc: Sentinel-3A (800 km): 4.5 mm, 0.60 mm/s; Jason-1
+  (1336 km, held out): 3.9 mm, 0.54 mm/s; target: –
+* false alarms, whole arc, `orbit.glr` at 1/week: Sentinel-3A (800 km): **0** (budget 1.30); Jason-1 (1336 km,
+  held out): **0** (budget 1.42); target: no false alarm
+* false alarms, non-overlapping 2-day sub-arcs: Sentinel-3A (800 km): 0, 0, 0, 0 (budget 1.14); Jason-1 (1336
+  km, held out): 0, 0, 0, 0 (budget 1.14); target: –
+* 5 mm/s found within 120 s: Sentinel-3A (800 km): **30/30**; Jason-1 (1336 km, held out): **30/30**; target:
+  all
+* time error within 3 × `time_sigma_s`: Sentinel-3A (800 km): **30/30** (median 1.1 s, σ 2.4 s); Jason-1 (1336
+  km, held out): **30/30** (median 0.6 s, σ 2.2 s); target: ≥ 90 %
+* |ΔV| within 20 %: Sentinel-3A (800 km): **30/30** (median error 0.43 %); Jason-1 (1336 km, held out):
+  **30/30** (median error 0.29 %); target: all
+* P_D at 0.1 / 0.2 / 0.3 / 0.5 / 1 mm/s: Sentinel-3A (800 km): 0.00 / 0.50 / 1.00 / 1.00 / 1.00 (quick, 6 each);
+  Jason-1 (1336 km, held out): 0.00 / 0.87 / 1.00 / 1.00 / 1.00 (15 each; quick: 0.00 / 1.00 / 1.00 ...);
+  target: –
+* 90 % detectable ΔV: Sentinel-3A (800 km): **0.28 mm/s**; Jason-1 (1336 km, held out): **≈ 0.22 mm/s**; target:
+  1 mm/s on S3A
+
+With the older injection: 0.85 and 1.20 mm/s, one Jason-1 5 mm/s injection missed. The change that mattered is
+the injection itself (see "Injects" above): differencing two free J2-J4 propagations left the injected file
+violating the dynamics by an amount that grows with the drift, which raised the self-calibrated thresholds and
+hid small injections; the injection is now carried along the real trajectory. Outputs:
+`docs/results/bench_orbit_real_arcs_jason1.txt` (full, Jason-1) and
+`docs/results/bench_orbit_real_arcs_quick.txt`.
+
+**No-maneuver controls with positions only.** `abrupt detect orbit` at 1/week: LAGEOS-1 CPF prediction
+(`ilrs-corpus/lageos1_cpf_180613_16401.hts`, 300 s, 2 days) 0 events, post-fit 2 mm (test
+`test_position_only_cpf_prediction_of_lageos_is_a_quiet_no_maneuver_control`); Galileo 212 CPF (900 s, 2 days) 0
+events; GFZ multi-GNSS SP3 (`orekit-corpus/gbm18432.sp3.Z`, 300 s, 1 day) G01, G05, G12, E11, E19, R01, R10,
+C06, C11: 0 events each (5 of 9 flagged ~0.1 mm/s before the χ² floor).
+
+**ISS-like reboosts** (`nice python benchmarks/bench_orbit_iss_reboosts.py`; 400 km, 51.6°, A/m = 0.0048 m²/kg,
+truth EGM2008 N×N + Sun/Moon + SRP + exponential drag, 0.3-2 m/s prograde held in the orbit frame for 4-15 min,
+one per 2-day arc, 0.5 m / 0.5 mm/s noise; the filter has no drag or SRP):
+
+* 20×20, 60 s, 20: found: **20/20**; |ΔV| error: ≤ 5.0 %; direction: ≤ 2.1°; start error: ≤ 15 s (20/20 within
+  3σ); all three targets: **20/20**; other events: 1 in 40 days (budget 5.7)
+* 70×70, 60 s, 12: found: **12/12**; |ΔV| error: ≤ 5.2 %; direction: ≤ 0.8°; start error: ≤ 27 s (12/12 within
+  3σ); all three targets: **12/12**; other events: 0 (budget 3.4)
+* 20×20, 240 s (NASA OEM sampling), 8, duration from a coarse profile: found: 8/8; |ΔV| error: 7/8 within 10 %
+  (−13.9 % for a 328 s burn taken as an impulse); direction: ≤ 2.3°; start error: 3/8 within 60 s (up to 125 s:
+  duration from a coarse profile); all three targets: 3/8; other events: 0
+* 20×20, 240 s, 8, duration from the positions: found: **8/8**; |ΔV| error: ≤ 4.3 %; direction: ≤ 2.3°; start
+  error: ≤ 13 s (8/8 within 3σ); all three targets: **8/8**; other events: 0 (budget 2.3)
+* 20×20, 60 s, 8, duration from the positions: found: **8/8**; |ΔV| error: ≤ 5.0 %; direction: ≤ 1.9°; start
+  error: ≤ 10 s (8/8 within 3σ); all three targets: **8/8**; other events: 0 (budget 2.3)
+* 20×20, 60 s, 6, `--nuisance` (MSIS drag, SRP, scales, once-per-rev): found: **6/6**; |ΔV| error: ≤ 5.3 %;
+  direction: ≤ 1.6°; start error: ≤ 20 s; all three targets: **6/6**; other events: 0
+
+Targets: found, \|ΔV\| within 10 %, direction within 5°, start within 60 s. The 0.35 m/s / 737 s reboost missed
+before (threshold 9962 against a GLR peak of 344) is found: see "Leave-out transform and χ² floor"; it is now a
+test case. The direction is given in the orbit frame at the centroid itself (radial bias of up to 4.8° before).
+At 240 s sampling the burn span used to exceed an orbit and the ΔV came out 13-170 % too large with 14-75°
+direction errors; the span is now capped at half an orbit. At 240 s the start time was coarse (durations 150-200
+s too long from the profile's 10-90 % rise) and a 328 s burn straddling an epoch was taken for an impulse; the
+duration now comes from the positions across the burn (see "Finite burns and event times"). `time_sigma_s` at
+240 s (63-141 s) is now conservative against errors ≤ 13 s: it still adds a quarter of the sampling interval.
+
+**Speed.** `python benchmarks/bench_orbit_speed.py --real-only` (9.1-day Sentinel-3A arc at 60 s, EGM2008 40×40
++ Sun/Moon; auto tuning with a position-only pass, forward, backward, fusion, GLR, thresholds, events): **5.05 s
+CPU** (19.0 s wall at load 16 on 2 cores): auto tuning 2.51 s, filters + fusion + GLR 2.44 s, thresholds +
+events 0.10 s; at load 7: 5.35 s CPU, 10.9 s wall. The GLR now reuses the forward pass's stored gains (one
+filter pass less). Cost per 60 s filter step: J2-J4 7.4 µs, full model 84 µs CPU (RK4 sub-steps of 30 s). With
+the 8 nuisance states and MSIS drag (`--real-only --nuisance`, load ~10): **7.84 s CPU** (50 s wall): auto
+tuning 3.10, filters + fusion + GLR + MSIS table 4.58, thresholds + events 0.16; per step 142.5 µs (J2-J4
+9-state 10.6 µs in the same run).
+
+**Reproduction unchanged** (`bench_orbit_montecarlo.py --quick --skip-perturbed`): thesis defaults, 2.4 cm/s:
+every TS1-TS4 statistic 1.00; 0.24 cm/s: `accel_smoothed`/`mcr_w` 1.00, `mahalanobis_v` 0.85, `dv_fb` 0.70 (as
+before); mirroring figures identical. Small-strike tuning, quick (`--tuned --quick`,
+`docs/results/bench_orbit_montecarlo_tuned_quick.txt`): 0.46 mm/s tuned, 0.75 mm/s thesis tuning (10 runs per
+point).
 """
 
 from __future__ import annotations

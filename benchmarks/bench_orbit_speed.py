@@ -6,6 +6,24 @@ straightforward filterpy implementation of the same EKF-DMC (same dynamics, STM,
 Joseph update). Target: < 2 s for the whole chain.
 
     nice python benchmarks/bench_orbit_speed.py [--quick] [--real | --real-only]
+
+Before the full force model
+---------------------------
+
+All runs were on a shared 2-core machine under `nice`. Each figure names the command that produced it, and
+whether it comes from a full or a quick run.
+
+**Speed** (`nice python benchmarks/bench_orbit_speed.py --quick`), one day of 1 Hz data (86 400 epochs) on one
+core:
+
+* forward filter: time: 0.67 s
+* backward filter: time: 0.67 s
+* fusion + TS1-TS4: time: 0.41 s
+* TS6: time: 0.11 s
+* **total**: time: **1.85 s** (target < 2 s)
+
+A straightforward filterpy implementation of the same forward filter takes 196 µs per epoch, against 7.7 µs
+here: **25× faster**, with identical states.
 """
 
 from __future__ import annotations

@@ -25,6 +25,103 @@ Usage::
 
     python benchmarks/bench_tle_null_calibration.py            # ~2-4 min on 2 processes
     python benchmarks/bench_tle_null_calibration.py --seeds 1 --years 3   # quick look
+
+Null calibration: false alarms on maneuver-free histories
+---------------------------------------------------------
+
+`python benchmarks/bench_tle_null_calibration.py` (68 histories of 5 years; 240 simulated and 37 bootstrapped
+satellite-years counted per budget; 60 s on 2 processes). Every history is maneuver-free
+(`abrupt.simulate.tle_null`), so every event is a false alarm; the detectors run with their default settings at
+budgets of 1 per satellite-year and 1 per month (12/yr):
+
+* **parametric**: LEO at 450, 800 and 1300 km — drag decay of `a` at 15·exp(−(h−500 km)/70 km) m/day, modulated
+  ±80 % by the 11-year solar cycle and ±15 % by the 27-day solar rotation; an eccentricity vector circling its
+  frozen point (radius 0.5-2 × 10⁻⁴, 80-200 days); a slow luni-solar inclination drift with a 13.66-day term.
+  GEO — the longitude libration that the Earth's triaxiality drives in `a` (±8 km, 700-1100 days), the yearly
+  solar-radiation-pressure circle of the e-vector (1-3 × 10⁻⁴), the luni-solar drift of the inclination vector
+  (0.85°/yr) with its 13.66-day and 182.6-day terms. Noise on every detector series: Student-t (3 dof) in an
+  AR(1) with a 1.5-day time constant (adjacent fits overlap), at the shared histories' level (LEO `a` 0.2 m, e
+  10⁻⁶, normal 2 µrad, phase 30 m; GEO `a` 35 m, e 4 × 10⁻⁶, i-vector 8 µrad) and at 4×; 0.3 % of sets a gross
+  error of 20-300 σ in every element; Gamma-distributed spacing at 0.3, 1 or 3 sets per day and, after 0.4 % of
+  sets, a 3-10 day gap. The histories are SGP4 records (WGS-72) whose `a` goes through SGP4's Kozai-Brouwer
+  conversion and whose node, perigee and mean anomaly are accumulated with the records' own secular rates, so
+  the detector reads back exactly the series that were simulated (tested).
+* **bootstrap**: each shared history's own noise. Its quiet stretches (farther than 3 days before and 12 days
+  after every operator maneuver and every maneuver the GEO table above finds missing from the files; the
+  operator files only keep maneuvers *out of* the noise) are detrended each on its own sets (the running-median
+  rate integrated out, then a 31-set running median removed); blocks of up to 60 consecutive residual sets with
+  their real gaps are drawn from them, centred and laid end to end on a fresh parametric orbit. A junction
+  between blocks joins two unrelated stretches of slowly correlated noise (an artificial step), so only gaps
+  whose whole test (slope windows of 12 sets each side, ±2-gap localisation) holds no junction count, in the
+  false alarms and in the exposure.
+
+Budget 1 per satellite-year:
+
+* parametric LEO, all 18 cells, without the drag trend: satellite-years: 179.9; false alarms: 158; **per year**
+  (95 % interval): **0.88** (0.75-1.03); cells: 0-1.6 per year except 450 km at 3 sets/day, noise ×1: **7.2**
+* parametric LEO without that cell, without the drag trend: satellite-years: 159.9; false alarms: 86; **per
+  year** (95 % interval): **0.44**; cells: max 1.6 (450 km, 3/day, noise ×4)
+* parametric LEO, all 18 cells, **with the drag trend** (the default): satellite-years: 179.9; false alarms:
+  104; **per year** (95 % interval): **0.58** (0.47-0.70); cells: 0-1.1 per year (next section)
+* parametric GEO, 6 cells (the lunar and solar terms at what mean elements keep): satellite-years: 60.0; false
+  alarms: 31; **per year** (95 % interval): **0.52** (0.35-0.73); cells: 0.1-1.2 (with their osculating sizes:
+  28, 0.47, 0.1-1.0)
+* bootstrap Jason-3 / Sentinel-3A / CryoSat-2: satellite-years: 9.2 / 8.5 / 5.5; false alarms: 3 / 2 / 0; **per
+  year** (95 % interval): **0.33 / 0.23 / 0.00**; cells: pooled 0.22 (0.07-0.50)
+* bootstrap Fengyun-2D / 2E: satellite-years: 7.3 / 7.0; false alarms: 0 / 0; **per year** (95 % interval):
+  **0.00 / 0.00**; cells: pooled 0.00 (0-0.26)
+
+Budget 12 per satellite-year (1 per month): parametric LEO 3.37 per year (0.28 of the budget; without the 450
+km, 3/day cell 1.83), GEO 1.40 (0.12), bootstrap LEO 0.56, GEO 0.91 (0.84); by cell 0-0.31 of the budget except
+the 450 km, 3/day, noise ×1 cell (2.06).
+
+What the table says:
+
+* **At 1 per satellite-year the budget holds within a factor of 2 on every simulated orbit, cadence and noise
+  level but one** (pooled 0.44 LEO, 0.52 GEO), **and on the five satellites' own noise** (0-0.33 per year; their
+  real histories, held out: 0.15-1.31, of which GEO's excess is orbit changes, table above). It is conservative
+  because the budget is turned into a per-gap probability while a noise excursion of the step statistic spans
+  several neighbouring gaps (its windows overlap) and makes one event.
+* **At 1 per month it is conservative by a factor 3-50** (0.02-0.31 of the budget): besides the clustering, the
+  threshold never goes below `min_statistic` = 3 (the level below which no candidate is kept), which binds for
+  per-gap probabilities above ~1/200. A user asking for one a month gets one every 3 months to 4 years.
+* **Correcting for the clustering was measured and not kept.** Dividing the per-gap probability by the extremal
+  index of the event-free statistic (runs estimate at its 97th percentile, clusters 6 gaps apart; Coles 2001
+  §5.3) brings nine parametric histories (800 and 1300 km, GEO; 0.3-3 sets/day) from about half the budget to
+  0.98 per year at 1/yr (2.9 at 12/yr: the floor still binds), and on the real histories (held out) LEO goes
+  from 194/6/69 (TP/FP/FN, F1 0.84, 0.23 false alarms per year) to 202/13/61 (F1 0.85, 0.51), GEO from 64/12/6
+  (F1 0.88, 1.01) to 64/17/6 (F1 0.85, 1.44). The budget is kept as an upper bound: with the correction GEO's
+  real rate would exceed it.
+* **The cell over budget: strong, varying drag with dense sets** (without the drag-consistent trend of the next
+  section, which brings it to 1.0 per year; 450 km, 3 sets per day: 7.2 per year; 1.6 with 4× the noise, 0.8 at
+  1 set per day). Without noise the smooth orbit alone makes steps in `a` of up to 57 m (p99 20 m against a set
+  noise of 0.2 m): the decay rate changes by ~1.8 m/day per day (the 27-day term), and a local straight line
+  fitted to sides of unequal length or across one of the long gaps leaves that curvature in the step. The noise
+  model's random-walk rate absorbs part of it (`a` weight 3.3: the body of `z_a` is over-scaled) but not the
+  tail, and the tail's peaks are taken for maneuvers by the event-free mask, so the threshold is fitted below
+  them. The four changes tried for it (table above) each cost the real histories more than they gained. The fix
+  kept is the next section's.
+* **The bootstrap needs each quiet stretch detrended on its own sets and junction-free tests.** First versions
+  were harsher than the real histories they were drawn from: residuals about a running median over the whole
+  history (which reaches over the maneuvers next to a quiet stretch and puts part of their steps into it) gave
+  CryoSat-2 3.2-12 false alarms per year, and counting tests whose 12-set slope windows reached over a junction
+  gave Sentinel-3A 2.2 (its own history: 0.15); their events moved every element group at once, as a junction
+  does. With both corrected (the table) every bootstrap is within budget. The group weights (`a`/e/n) the
+  detector learns from a bootstrap differ from those it learns from the real history by up to ×3 (Jason-3
+  0.24/1.0/0.16 against 0.23/0.35/0.45, Sentinel-3A 0.21/0.38/0.16 against 0.21/0.44/0.19, Fengyun-2D
+  0.57/0.43/0.43 against 1.5/0.62/0.66) and ×10-20 (CryoSat-2 0.10/0.80/0.17 against 1.1/15/0.99, whose e-vector
+  circulates; Fengyun-2E 1.6/0.81/0.69 against 5.3/1.0/3.9): the real weights are learned with the maneuvers and
+  their flanks in the history. A bootstrap checks the threshold on the satellite's noise; it is not a replica of
+  the real run.
+
+Test (`tests/test_tle_null_calibration.py`, default suite, 4 s): the generator reads back its own noise level
+(0.5-2× the requested robust σ) with heavy tails (kurtosis of set-to-set differences > 5); on a seed-fixed
+ensemble of five 3-year histories (LEO 800/1300 km, GEO; 0.3 and 1 set per day; noise ×1 and ×4) the pooled
+realised rate is at most twice the budget at 1/yr and at 12/yr (measured 0.6 and 1.13 per year); and bootstraps
+of Sentinel-3A's and Fengyun-2D's noise (2 × 5 years, about 4 satellite-years counted away from junctions) stay
+at or below 2 per year at a budget of 1 (measured 0.24 and 0). With 4-15 satellite-years these tests catch a
+miscalibration of more than a factor of ~2-3, not less (a fixed threshold of 3 gives 0.7-1.1 per year on them
+and also passes); the benchmark is the measurement.
 """
 
 from __future__ import annotations

@@ -33,6 +33,258 @@ Usage::
 
     python benchmarks/bench_tle_vs_maneuver_detect.py
     python benchmarks/bench_tle_vs_maneuver_detect.py --no-baseline
+
+Measured figures (leave-one-satellite-out)
+------------------------------------------
+
+`python benchmarks/bench_tle_vs_maneuver_detect.py` — both detectors scored by `abrupt.score`, ±1 day
+one-to-one, operator window starts / first burns in UTC, truth within the TLE span; maneuver-detect 0.3.0's
+classical detector run on the same files in its own venv (`/tmp/md_venv`, torch 2.13.0 CPU wheel first).
+**LOSO**: the data-tuned settings (group gain γ ∈ {0.2, 0.5, 1.0}; for GEO also the campaign side: GEO 2 or 3
+sets, LEO 1 or 2 sets) are chosen for each satellite by the pooled F1 of the *other* satellites of its class and
+the satellite is scored with them. LOSO picks side 2 for every LEO satellite (side 3 is left out of the LEO grid
+to keep the run short: each LEO history scores the same or better with 2 than with 3). Everything else is
+learned per history without truth. Budget 1 false alarm per satellite-year.
+
+* Jason-3 (LEO): detector: abrupt `tle.mean_elements`; γ, side (tuned on): 0.2, 2 (S3A+CS2); det / truth: 34 /
+  40; precision: 0.94; recall: 0.80; **F1**: **0.86**; FA / yr: 0.30; recall @ 1 FA/yr: 0.82; burns ≥ 5 cm/s @ 1
+  FA/yr: burn level / campaign level: 0.62 / 0.85 of 13; median |Δt|: 2.0 h; smallest detectable ΔV t / n: 0.06
+  / 53 cm/s
+* detector: maneuver-detect 0.3.0 classical; det / truth: 56 / 40; precision: 0.43; recall: 0.60; **F1**: 0.50;
+  FA / yr: 4.79; recall @ 1 FA/yr: 0.57; burns ≥ 5 cm/s @ 1 FA/yr: burn level / campaign level: 0.31; median
+  |Δt|: 9.2 h
+* Sentinel-3A (LEO): detector: abrupt `tle.mean_elements`; γ, side (tuned on): 0.2, 2 (J3+CS2); det / truth: 54
+  / 59; precision: 0.98; recall: 0.90; **F1**: **0.94**; FA / yr: 0.15; recall @ 1 FA/yr: 0.92; burns ≥ 5 cm/s @
+  1 FA/yr: burn level / campaign level: 0.88 / 0.88 of 24; median |Δt|: 1.0 h; smallest detectable ΔV t / n:
+  0.07 / 34 cm/s
+* detector: maneuver-detect 0.3.0 classical; det / truth: 70 / 59; precision: 0.74; recall: 0.88; **F1**: 0.81;
+  FA / yr: 2.74; recall @ 1 FA/yr: 0.81; burns ≥ 5 cm/s @ 1 FA/yr: burn level / campaign level: 0.83; median
+  |Δt|: 7.9 h
+* CryoSat-2 (LEO): detector: abrupt `tle.mean_elements`; γ, side (tuned on): 0.2, 2 (J3+S3A); det / truth: 112 /
+  164; precision: 0.97; recall: 0.66; **F1**: **0.79**; FA / yr: 0.24; recall @ 1 FA/yr: 0.77; burns ≥ 5 cm/s @
+  1 FA/yr: burn level / campaign level: 0.58 / 0.79 of 24; median |Δt|: 2.8 h; smallest detectable ΔV t / n:
+  0.84 / 66 cm/s
+* detector: maneuver-detect 0.3.0 classical; det / truth: 222 / 164; precision: 0.48; recall: 0.65; **F1**:
+  0.55; FA / yr: 9.33; recall @ 1 FA/yr: 0.47; burns ≥ 5 cm/s @ 1 FA/yr: burn level / campaign level: 0.25;
+  median |Δt|: 5.3 h
+* Fengyun-2D (GEO): detector: abrupt `tle.geo_station_keeping`; γ, side (tuned on): 0.2, 3 (FY-2E); det / truth:
+  22 / 22; precision: 0.91; recall: 0.91; **F1**: **0.91**; FA / yr: 0.47; recall @ 1 FA/yr: 0.91; burns ≥ 5
+  cm/s @ 1 FA/yr: burn level / campaign level: no ΔV in file; median |Δt|: 4.7 h; smallest detectable ΔV t / n:
+  2.6 / 129 cm/s
+* detector: maneuver-detect 0.3.0 classical; det / truth: 28 / 22; precision: 0.39; recall: 0.50; **F1**: 0.44;
+  FA / yr: 4.03; recall @ 1 FA/yr: 0.09; median |Δt|: 16.9 h
+* Fengyun-2E (GEO): detector: abrupt `tle.geo_station_keeping`; γ, side (tuned on): 0.5, 3 (FY-2D); det / truth:
+  54 / 48; precision: 0.81; recall: 0.92; **F1**: **0.86**; FA / yr: 1.31; recall @ 1 FA/yr: 0.90; burns ≥ 5
+  cm/s @ 1 FA/yr: burn level / campaign level: no ΔV in file; median |Δt|: 4.0 h; smallest detectable ΔV t / n:
+  3.4 / 125 cm/s
+* detector: maneuver-detect 0.3.0 classical; det / truth: 74 / 48; precision: 0.38; recall: 0.58; **F1**: 0.46;
+  FA / yr: 6.04; recall @ 1 FA/yr: 0.19; median |Δt|: 17.2 h
+
+Pooled per class:
+
+* LEO (3 satellites, 263 maneuvers, 25.7 satellite-years): detector: abrupt (block thresholds fitted away from
+  their candidates); TP / FP / FN: 194 / 6 / 69; precision: 0.97; recall: 0.74; **F1**: **0.838**; FA / yr:
+  0.23; recall @ 1 FA/yr: 0.81; burns ≥ 5 cm/s @ 1 FA/yr: burn level (alone in their gap) / campaign level:
+  **0.70** of 61 (0.78 of 46) / 0.84; with campaign events 0.90
+* detector: sensitivity: block thresholds fitted with their candidates; TP / FP / FN: 192 / 5 / 71; precision:
+  0.97; recall: 0.73; **F1**: 0.835; FA / yr: 0.19; recall @ 1 FA/yr: 0.81; burns ≥ 5 cm/s @ 1 FA/yr: burn level
+  (alone in their gap) / campaign level: 0.70 (0.78) / 0.84; 0.90
+* detector: sensitivity: one threshold for the whole history (`threshold_follow="none"`); TP / FP / FN: 194 / 6
+  / 69; precision: 0.97; recall: 0.74; **F1**: 0.838; FA / yr: 0.23; recall @ 1 FA/yr: 0.81; burns ≥ 5 cm/s @ 1
+  FA/yr: burn level (alone in their gap) / campaign level: 0.70 (0.78) / 0.84
+* detector: abrupt without the along-track phase group (`--along-track-gain 0`); TP / FP / FN: 191 / 12 / 72;
+  precision: 0.94; recall: 0.73; **F1**: 0.82; FA / yr: 0.47; recall @ 1 FA/yr: 0.75; burns ≥ 5 cm/s @ 1 FA/yr:
+  burn level (alone in their gap) / campaign level: 0.69 (0.76) / 0.87
+* detector: sensitivity: campaign side of one set for every LEO satellite (held-out γ); TP / FP / FN: 194 / 10 /
+  69; precision: 0.95; recall: 0.74; **F1**: 0.83; FA / yr: 0.39; recall @ 1 FA/yr: 0.79; burns ≥ 5 cm/s @ 1
+  FA/yr: burn level (alone in their gap) / campaign level: 0.74 (45 of 61) / 0.92
+* detector: sensitivity: every event stated as `burns_max` events over its interval; TP / FP / FN: 200 / 62 /
+  63; precision: 0.76; recall: 0.76; **F1**: 0.76; FA / yr: 2.41; recall @ 1 FA/yr: 0.55; burns ≥ 5 cm/s @ 1
+  FA/yr: burn level (alone in their gap) / campaign level: 0.74 (45 of 61) / —
+* detector: maneuver-detect 0.3.0 classical; TP / FP / FN: 182 / 166 / 81; precision: 0.52; recall: 0.69;
+  **F1**: 0.60; FA / yr: 6.46; recall @ 1 FA/yr: 0.56; burns ≥ 5 cm/s @ 1 FA/yr: burn level (alone in their gap)
+  / campaign level: 0.49 (0.59) / 0.49
+* GEO (2 satellites, 70 windows): detector: abrupt; TP / FP / FN: 64 / 12 / 6; precision: 0.84; recall: 0.91;
+  **F1**: **0.88**; FA / yr: 1.01; recall @ 1 FA/yr: 0.90; burns ≥ 5 cm/s @ 1 FA/yr: burn level (alone in their
+  gap) / campaign level: —
+* detector: maneuver-detect 0.3.0 classical; TP / FP / FN: 39 / 63 / 31; precision: 0.38; recall: 0.56; **F1**:
+  0.45; FA / yr: 5.32; recall @ 1 FA/yr: 0.16; burns ≥ 5 cm/s @ 1 FA/yr: burn level (alone in their gap) /
+  campaign level: —
+
+The two sensitivity rows are printed by the same run (`LEO sensitivity`): a side of one set finds two more burns
+≥ 5 cm/s (Jason-3 2 Feb 2016, CryoSat-2 5 May 2010: steps in the gap next to another burn's) but lowers
+Jason-3's and CryoSat-2's F1 (four more false alarms: TLE convergence over several sets, which the middle-set
+test cannot resolve inside short campaign segments), so LOSO does not choose it; stating `burns_max` maneuvers
+per event also finds two more at the 1 FA/yr cut but costs 2.4 false alarms per satellite-year at the budget.
+The phase group's design (what `a` explains, the running median of the rate) was chosen looking at the false
+alarms of all three LEO histories; its gain is not tuned (1, as `z_a`); with it off every LEO figure is the same
+or worse (row above).
+
+**Burn level** is the one-to-one ±1 day score (one event finds one operator maneuver). **Campaign level** also
+credits an event (at the same 1 FA/yr cut) with the operator maneuvers inside its stated interval, at most its
+`burns_max`, largest ΔV first; what counts as a false alarm is unchanged (the one-to-one score). maneuver-detect
+states no interval, so its two figures are equal. The intervals are checked against the operator files (column
+`in_interval`): the operator time of a matched maneuver lies inside its event's interval for 100 % (Jason-3), 94
+% (Sentinel-3A), 90 % (CryoSat-2), 85 % (FY-2D) and 93 % (FY-2E).
+
+Targets: pooled LEO F1 ≥ 0.6 and GEO F1 ≥ 0.6 — **met** (0.84 and 0.88, against 0.60 and 0.45 for
+maneuver-detect on the same files). Recall ≥ 0.9 of burns ≥ 5 cm/s at ≤ 1 false alarm per satellite-year — **not
+met**: burn level 0.70 (43 of 61; 0.74 with a side of one set, not chosen by LOSO), campaign level 0.84.
+
+**The ceiling.** The benchmark also computes (`one_step_ceiling`, independent of abrupt's detector) how many of
+the 61 any detector can match one-to-one if it states one maneuver per element-set step. Two in-track burns
+whose effects reach the element sets in the same gap are the same data: after the gap the orbit depends only on
+the sum of their Δa, the along-track drift only on their Δa-weighted mean time (two numbers for four unknowns),
+so a detector that states two maneuvers there states two for every lone burn too. Burns are grouped where their
+windows (the gap holding the burn to a TLE lag later) overlap; in a group, the gaps that carry in-track change
+(|Δa| between consecutive sets ≥ a quarter of the smallest burn's `2aΔv_t/v`, noise and blended sets counted, so
+generously) bound its matches. Seven groups lose a burn each; in every one the observed Δa sums to the
+operator's (the steps hold all of it):
+
+* Jason-3 31 Jan-3 Feb 2016: in-track burns: 3 (+ the opposed pair of 4 Feb); gaps / carrying: 4 / 2; Σ Δa
+  operator / observed: 26 742 / 26 842 m; at most: 2 (+1)
+* Jason-3 7 and 11 Apr 2022: in-track burns: 2; gaps / carrying: 1 / 1 (an 8.4-day gap); Σ Δa operator /
+  observed: 20 048 / 19 886 m; at most: 1
+* CryoSat-2 18-20 May 2010: in-track burns: 4; gaps / carrying: 4 / 3; Σ Δa operator / observed: 1100 / 1041 m;
+  at most: 3
+* CryoSat-2 27-28 May 2010: in-track burns: 2; gaps / carrying: 2 / 1; Σ Δa operator / observed: −714 / −715 m;
+  at most: 1
+* CryoSat-2 20-21 Jul 2020: in-track burns: 2 (3 h apart); gaps / carrying: 3 / 1; Σ Δa operator / observed: 255
+  / 254 m; at most: 1
+* CryoSat-2 23-24 Jul 2020: in-track burns: 2 (3 h apart); gaps / carrying: 3 / 1; Σ Δa operator / observed: 237
+  / 235 m; at most: 1
+* CryoSat-2 7 Jun 2022: in-track burns: 2 (3 h apart); gaps / carrying: 3 / 1; Σ Δa operator / observed: −359 /
+  −362 m; at most: 1
+
+**Ceiling 54/61 = 0.885** with a 2-day TLE lag; 52/61 = 0.852 with 1 day; 55/61 = 0.902 at the loosest (3 days,
+any gap with a tenth of the smallest burn's Δa counted as a step). So 0.9 is at or beyond what element sets
+allow even for a perfect detector that states one maneuver per step.
+
+**What stands in the way of 0.9.** The 18 burn-level misses at 1 FA/yr (benchmark section `the 18 LEO maneuvers
+>= 5 cm/s missed`), each with what would find it and what that was measured to cost:
+
+* Jason-3 31 Jan 2016: ΔV: 4.68 m/s in-track; why: same 4.0-day gap as 2 Feb: one step holding both (Σ Δa 19 901
+  m for two ~10 km burns); what would find it (measured): nothing: ceiling
+* Jason-3 2 Feb 2016: ΔV: 4.65 m/s; why: that step is in the gap next to the 3 Feb burn's step (one set, 4 Feb
+  19:09, between them): a side of two sets cannot test it; what would find it (measured): a side of one set
+  finds it (sensitivity row: +4 false alarms pooled, F1 of Jason-3 and CryoSat-2 lower, not chosen by LOSO)
+* Jason-3 4 Feb 2016: ΔV: ±0.27 m/s cross-track, 1.5 orbits apart (the normal turns by 75 µrad); why: in the
+  same step as the 3 Feb in-track burn (the set of 4 Feb 19:09 still lags it): one event, matched to 3 Feb; what
+  would find it (measured): a second, cross-track event when the in-track and the gained cross-track groups both
+  pass the threshold; at the budget 21 LEO events do (columns `z_a`, `z_n`): this one, Jason-3's April 2022
+  8.4-day gap (no cross-track burn) and 19 Sentinel-3A inclination burns with their 0.5-0.9 % in-track part, so
+  such a rule gains 1 and costs at least 1
+* Jason-3 7 and 11 Apr 2022: ΔV: 4.66, 4.68 m/s; why: one 8.4-day gap without a set: one step; its hinge is the
+  Δa-weighted mean time, 2 days from each; what would find it (measured): one of the two at most (ceiling), and
+  only by timing the event on one burn, which the sets do not tell
+* Sentinel-3A 7 Mar, 21 Mar, 19 Apr 2016: ΔV: 0.15, 0.87, 1.24 m/s cross-track; why: the TLE inclination ramps
+  over ~12 days in the first months (fit span straddling the burn); what would find it (measured): a ramp-shaped
+  test of the normal (measured: 121 false alarms; not built)
+* CryoSat-2 5 May 2010: ΔV: 8.4 cm/s; why: its step is in the gap next to the 6 May burn's step; what would find
+  it (measured): a side of one set finds it (same row as 2 Feb)
+* CryoSat-2 18 May 00:49, 20 May 00:45, 20 May 23:53 2010: ΔV: 16.7, 16.4, 8.3 cm/s; why: four burns in three
+  days against sets of 17, 18, 20 and 22 May that lag by a day: the 1100 m of Δa arrive in two steps (530, 566
+  m); one event matched (18 May 23:58); what would find it (measured): at most 3 of the 4 (ceiling)
+* CryoSat-2 27 May 2010: ΔV: 16.8 cm/s; why: one step with the 28 May burn (20.9 cm/s); what would find it
+  (measured): nothing: ceiling
+* CryoSat-2 22 Dec 2018: ΔV: +2.8/−2.9 cm/s opposed pair; why: a 0.5 km phase step, z_u ≈ 5 against CryoSat-2's
+  cut of 8.6 (heavy-tailed phase noise); what would find it (measured): a quieter phase series
+* CryoSat-2 20, 23, 27 Jul 2020; 7 Jun 2022: ΔV: 6.0-9.5 cm/s; why: each the first of two windows 3 h apart in
+  one gap; the event matches the second; what would find it (measured): nothing: ceiling (27 Jul counts as
+  possible only because a set fitted across the pair makes a second gap carry Δa)
+
+Adding everything that some rule could find (a side of one set +2, a cross-track split +1, a ramp test +3, the
+phase pair +1, one more of the May 2010 campaign) gives at most 51 of 61 (0.84), the ceiling 54; **0.9 (55)
+needs more maneuvers matched than there are steps**, i.e. events stated for burns the element sets do not
+separate. Measured: stating each event's `burns_max` maneuvers over its interval finds 45 of 61 at 1 FA/yr (as
+many as a side of one set) and costs 2.4 false alarms per satellite-year at the budget (62 instead of 6);
+without the phase group (`--along-track-gain 0`) the same finds 50 of 61 at 5.7 false alarms per satellite-year.
+The number of operator windows inside one step is not in the mean elements: two windows 3 h apart and one window
+of twice the ΔV give the same sets (`one_step_ceiling`).
+
+Every in-track burn ≥ 5 cm/s on these satellites is 68-36 000 σ of the satellite's own step noise (column
+`z_t_exp`), so no miss is a burn too small for the noise model: the misses are burns the element sets do not
+resolve in time, ramp, or (one) hide in heavy-tailed phase noise. The Fengyun files give no ΔV, so the GEO part
+of this target is not measurable.
+
+In-track ΔV of isolated matched maneuvers (no other operator maneuver within ±3 days): within a factor of 2 for
+94 % (Jason-3), 100 % (Sentinel-3A), 98 % (CryoSat-2); median ratio 0.98-1.03; on Sentinel-3A at least half are
+within 3 stated σ (tested). Jason-3 by operator ΔV (all maneuvers, default settings): 2 of 3 below 2 mm/s found,
+14 of 14 of 2-5 mm/s, 7 of 10 of 5-50 mm/s — consistent with its smallest detectable 0.6 mm/s; above 5 cm/s see
+the tables.
+
+Run time: the benchmark does 30 detector runs (3 LEO × 3 gains × 2 sides, 2 GEO × 3 gains × 2 sides) on 2
+processes plus maneuver-detect (1-10 s, torch import included; cached by the SHA-256 of its inputs and runner
+script in `/tmp/abrupt_bench_cache`, `--no-cache` re-runs it), the ceiling and the two sensitivities. Measured
+(`/usr/bin/time ... --no-cache`): **26-35 s wall** (two runs), 225 MB peak, at load average 1.2-2.0 on this
+2-core machine (65-96 s at load average 10-12). Target < 2 minutes: **met**. One detector run takes 0.5-3 s per
+history on an idle machine (CryoSat-2, 4310 sets, the longest).
+
+GEO false alarms one by one
+---------------------------
+
+At the budget of 1 per satellite-year the held-out GEO rows have 12 false alarms in 11.8 satellite-years (1.01
+per year; Fengyun-2E 1.31). Each, with the element sets around it (`.fy` windows converted from China Standard
+Time, UTC+8; dates UTC):
+
+* FY-2D 2011-07-25 01:49: S / cut: 9.9 / 6.3; what the element sets show: `a` +411 m at the gap 27 Jul 23:47 →
+  28 Jul 03:11; two lone sets 0.9-1.0 km high (22 Jul 03:35, 28 Jul 03:11) and a +250 m jump of `a` on 31 Jul in
+  the window; nearest window 10 days later; kind: noise
+* FY-2D 2013-01-04 20:10: S / cut: 279 / 6.3; what the element sets show: the north-south burn the file dates 25
+  Dec 2012 03:00 (window to 26 Dec 07:00): the sets of 31 Dec and 4 Jan still continue the pre-burn
+  inclination-vector drift, the i-vector steps 2.7° → 1.2° only between 4 Jan 17:52 and 7 Jan 19:48; kind: the
+  burn, > 1 day from the window (stale sets)
+* FY-2E 2011-06-21 16:41: S / cut: 183 / 22.8; what the element sets show: `a` −7.1 km: an east-west burn. The
+  file's line `"2012-06-21T16:30 CST"` sits between its 2011-08-15 and 2011-05-05 lines and the 2012 detection
+  it would match does not exist: a year typo; the event is 8 h after 2011-06-21 08:30 UTC; kind: maneuver
+  misdated in the file
+* FY-2E 2012-05-31 14:16: S / cut: 86 / 22.8; what the element sets show: `a` −5.8 km between 31 May 13:47 and 3
+  Jun 19:06, midway between the 16 Apr and 18 Jul windows (the satellite's east-west cadence is ~45 days); kind:
+  maneuver not in the file
+* FY-2E 2012-10-16 18:56: S / cut: 65 / 22.8; what the element sets show: `a` 0.3 km above its drift and the
+  i-vector +0.018° on 16 Oct, 6 days before the 22 Oct window (matched by another event); kind: unclear: small
+  maneuver or noise
+* FY-2E 2014-12-02 08:20: S / cut: 147 / 22.8; what the element sets show: the burn of 1 Dec 07:30: the sets of
+  1 Dec 19:57 and 3 Dec 16:03 still show the pre-burn orbit (2 Dec 21:37 and 5 Dec the new); the mean-longitude
+  hinge is pulled 25 h late; kind: the burn, timing (stale sets)
+* FY-2E 2015-02-17 14:54: S / cut: 23.7 / 22.8; what the element sets show: sets alternating ±1.2 km in `a` and
+  0.01° in the i-vector (19-23 Feb); no step; kind: noise
+* FY-2E 2015-06-03 07:23 and 2015-06-28 11:10: S / cut: 1167, 1119 / 22.8; what the element sets show: `a` +47.7
+  km, drift −0.69°/day for 25 days (≈ 17°), then `a` −53.2 km: the relocation from 105°E to 86.5°E, absent from
+  a station-keeping file; kind: 2 maneuvers not in the file
+* FY-2E 2015-12-24 02:02 and 2015-12-26 04:05: S / cut: 991, 28 / 22.8; what the element sets show: north-south
+  window 21 Dec 16:00 - 23 Dec 16:00: the set of 24 Dec 02:02 has the new i-vector but `a` 229 km low and e =
+  0.02 (a gross error), 27 Dec 15:32 is a pre-burn (stale) set, 30 Dec the new orbit; two events, the first at
+  the bad set (> 1 day after the window start), the second where the stale set returns; kind: the burn, timing;
+  a duplicate
+* FY-2E 2018-04-18 12:55: S / cut: 122 / 22.8; what the element sets show: the burn of 17 Apr 08:15: sets of 18
+  Apr 22:03 and 19 Apr 21:08 still pre-burn (2.5 days of TLE lag); kind: the burn, timing (29 h)
+
+So 4 are maneuvers the operator files do not list (or misdate by a year), 4 are operator burns that the
+catalogue's element sets show only more than a day after the window start (each is also counted as a miss), 1 is
+a duplicate of one of them, and 2-3 are noise: **0.17-0.25 noise false alarms per satellite-year**, within the
+budget. The threshold model is not what puts GEO over budget; stale and gross sets after a burn are.
+
+Tried against these, measured with the held-out benchmark and not kept (the detector is unchanged):
+
+* none (the detector): GEO FP (F1): 12 (0.88); LEO FP (F1): 6 (0.84)
+* leave out lone gross sets (> 30 σ off the line through neighbours that agree with each other, step-aware
+  Hampel rule): GEO FP (F1): 11 (0.88); LEO FP (F1): 13 (0.82); why not kept: removes post-campaign sets in LEO
+  (Jason-3 Feb 2016)
+* the same at > 300 σ: GEO FP (F1): 11 (0.88); LEO FP (F1): 8 (0.83); why not kept: still costs Jason-3 a
+  maneuver
+* step windows cut at gaps longer than max(4 cadences, 2 days): GEO FP (F1): 13 (0.85); LEO FP (F1): 11 (0.82);
+  why not kept: long gaps co-occur with burns (Jason-3's 4- and 8.4-day gaps hold its largest)
+* quadratic local trend from the two sides' own slopes: GEO FP (F1): 21 (0.83); LEO FP (F1): 13 (0.77); why not
+  kept: per-side slopes are noisy with short sides
+* the same for `a` only: GEO FP (F1): 21 (0.83); LEO FP (F1): 10 (0.74); why not kept: CryoSat-2 recall 0.66 →
+  0.48
+* slope = mean of the two sides' Theil-Sen slopes (not the pooled median): GEO FP (F1): 27 (0.80); LEO FP (F1):
+  21 (0.74); why not kept: the pooled median is what keeps the slope robust
+
+The last four were aimed at the null study's high-drag cell (next section): the quadratic trend brings it from
+7.2 to 1.2-1.4 false alarms per year (for `a` only: 1.0-3.2), the side-mean slope to 2.0, and each costs the
+real histories far more.
 """
 
 from __future__ import annotations
