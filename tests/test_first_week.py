@@ -366,7 +366,8 @@ def test_detect_orbit_shows_its_stages_with_their_total(
     short = tmp_path / "short.sp3"
     short.write_text("".join(lines[: starts[480]]))
     monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.05)
-    main(["detect", "orbit", str(short), "--allow-truncated", "--out", str(tmp_path / "e.csv"), "--catalog", "none"])
+    args = ["detect", "orbit", str(short), "--allow-truncated", "--out", str(tmp_path / "e.csv")]
+    main([*args, "--catalog", str(tmp_path / "c.sqlite")])
     status = _status_lines(capsys.readouterr().err, "detect orbit")
     stages = [int(m.group(1)) for line in status if (m := re.search(r"orbit arc (\d)/3 stage", line))]
     assert stages and stages == sorted(stages), status[-5:]
@@ -379,7 +380,7 @@ def test_detect_tracking_shows_its_stages_with_their_total(
     main(["-q", "simulate", "tracking", "--out", str(tdm), "--cadence", "20", "--seed", "4"])
     monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.05)
     args = ["detect", "tracking", str(tdm), "--setup", str(tdm.with_suffix(".in")), "--max-maneuvers", "1"]
-    main([*args, "--out", str(tmp_path / "e.csv"), "--catalog", "none"])
+    main([*args, "--out", str(tmp_path / "e.csv"), "--catalog", str(tmp_path / "c.sqlite")])
     status = _status_lines(capsys.readouterr().err, "detect tracking")
     stages = [m.group(1) for line in status if (m := re.search(r"detect tracking (\d)/3 stage \(([^)]*)\)", line))]
     assert "0" in stages and "1" in stages, status[-5:]  # the orbit fit, then the GLRT, each with the total

@@ -68,9 +68,10 @@ TERMS = RANGE_MODEL_TERMS
     "--area-to-mass",
     "area_to_mass_m2_per_kg",
     default=0.2827 / 406.965,  # [m²/kg] LAGEOS: 0.2827 m² cross-section, 406.965 kg
-    show_default="6.95e-4 m²/kg (LAGEOS: 0.2827 m² / 406.965 kg)",
+    show_default="6.95e-4 m²/kg",
     type=click.FloatRange(min=0.0, min_open=True),
-    help="A-priori cross-section per mass [m²/kg] for radiation pressure (and drag); its scale is estimated.",
+    help="A-priori cross-section per mass [m²/kg] for radiation pressure (and drag); its scale is estimated. "
+    "The default is LAGEOS's: 0.2827 m² / 406.965 kg.",
 )
 @click.option(
     "--drag/--no-drag",
