@@ -9,7 +9,7 @@ import click
 import pandas as pd
 
 from abrupt.catalog import Catalog
-from abrupt.cli.groups import catalog_option, cli
+from abrupt.cli.groups import catalog_option, check_evidence_output, cli
 
 #: Width the default view fits in (characters).
 VIEW_WIDTH = 120
@@ -59,6 +59,7 @@ def export(catalog_target: str, out: str, **filters: Any) -> None:
     """Export events to OUT (.csv or .parquet; Parquet keeps times as UTC timestamps)."""
     if not out.lower().endswith((".csv", ".parquet", ".pq")):
         raise click.BadParameter(f"{out!r} must end in .csv or .parquet", param_hint="OUT")
+    check_evidence_output(out)  # the events' attribution evidence goes beside OUT
     n = Catalog(catalog_target, create=False).export(out, **_filters(filters))
     click.echo(f"{n} event(s) written to {out}")
 
