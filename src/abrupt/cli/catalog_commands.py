@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from abrupt.cli.commands import lazy_module
-from abrupt.cli.groups import catalog_option, cli, printable_lines
+from abrupt.cli.groups import catalog_option, check_evidence_output, cli, printable_lines
 from abrupt.kinds import EVENT_KINDS
 
 if TYPE_CHECKING:
@@ -79,6 +79,7 @@ def export(catalog_target: str, out: str, **filters: Any) -> None:
     """Export events to OUT (.csv or .parquet; Parquet keeps times as UTC timestamps)."""
     if not out.lower().endswith((".csv", ".parquet", ".pq")):
         raise click.BadParameter(f"{out!r} must end in .csv or .parquet", param_hint="OUT")
+    check_evidence_output(out)  # the events' attribution evidence goes beside OUT
     n = catalog.Catalog(catalog_target, create=False).export(out, **_filters(filters))
     click.echo(f"{n} event(s) written to {out}")
 
