@@ -94,14 +94,16 @@ def test_box_one_direction_rate_and_face_shares_are_its_projected_areas() -> Non
 def test_two_direction_stream_strike_shares_are_flux_times_area() -> None:
     """Equal flux from +x (the box shows 6 m²) and +z (2 m²): 75 % of strikes come from +x, not 50 %."""
     table = _one_direction_table([(1.0, 0.0, 0.0), (0.0, 0.0, 1.0)], [1.0, 1.0])
-    cfg = RateConfig(location="visible", area="silhouette", n_draws=40_000, mef_model="const1")
+    # sizes drawn from the population itself (weights 1): the shares carry no size-importance noise
+    cfg = RateConfig(location="visible", area="silhouette", n_draws=40_000, size_sampling="population")
     s = simulate_strikes([table], BOX, 100.0, 500e3, cfg)
     from_x = s.direction[:, 0] > 0.5
     share_x = float(np.sum(s.weight[from_x]) / np.sum(s.weight))
     assert share_x == pytest.approx(6.0 / 8.0, abs=0.01)
     assert s.strikes_per_year == pytest.approx(table.flux_above(3e-5) * (0.5 * 6.0 + 0.5 * 2.0), rel=0.02)
     # the thesis's draw (direction by flux alone, point on its silhouette) gives the directions equal shares
-    old = simulate_strikes([table], BOX, 100.0, 500e3, RateConfig(area="silhouette", n_draws=40_000))
+    thesis = RateConfig(area="silhouette", n_draws=40_000, size_sampling="population")
+    old = simulate_strikes([table], BOX, 100.0, 500e3, thesis)
     old_share = float(np.sum(old.weight[old.direction[:, 0] > 0.5]) / np.sum(old.weight))
     assert old_share == pytest.approx(0.5, abs=0.02)
 

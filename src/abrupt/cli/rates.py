@@ -131,10 +131,11 @@ SCENARIO_OPTIONS = [
     click.option("--seed", type=int, default=0, show_default=True, help="Random seed (reproducible)."),
     click.option(
         "--location",
-        type=click.Choice(["silhouette", "point_cloud"]),
+        type=click.Choice(["silhouette", "point_cloud", "visible"]),
         default="silhouette",
         show_default=True,
-        help="Strike-location method.",
+        help="Strike-location method: the thesis's (direction by flux, point on its silhouette), or 'visible' "
+        "(strikes weighted by flux × visible area per direction, as the flux inference; needs --area silhouette).",
     ),
     click.option(
         "--grid-spacing-m",

@@ -303,7 +303,10 @@ class Likelihood:
             waf = af * self.weights[None, :, None]
             grad = waf.sum(axis=1) - self.totals[:, idx]
             hess = -np.einsum("bei,bej->bij", waf, af) - 1e-12 * np.eye(idx.size)[None]
-            step = -np.linalg.solve(hess, grad[:, :, None])[:, :, 0]
+            try:
+                step = -np.linalg.solve(hess, grad[:, :, None])[:, :, 0]
+            except np.linalg.LinAlgError:  # at some β the free scales' signals are proportional: least-norm step
+                step = -(np.linalg.pinv(hess) @ grad[:, :, None])[:, :, 0]
             cur = s[:, idx].copy()
             if not signed:
                 step = np.where((cur <= 0) & (grad < 0), 0.0, step)  # at the bound, pushing out: stay
