@@ -61,7 +61,6 @@ and merges the steps of one burn.
 
 from __future__ import annotations
 
-import itertools
 import math
 from dataclasses import dataclass, field, replace
 from typing import Any, NamedTuple
@@ -72,6 +71,7 @@ from numpy.typing import NDArray
 from scipy import stats
 
 from abrupt.detect.base import DetectionResult, Diagnostics
+from abrupt.detect.tle.arcs import join_arcs
 from abrupt.detect.tle.burns import campaign_cadence_s, characterise, label_campaigns
 from abrupt.detect.tle.campaigns import find_campaigns
 from abrupt.detect.tle.config import CAMPAIGN_SIDE_SETS, EXTRA_COLUMNS, TleDetectorConfig
@@ -145,87 +145,20 @@ def detect_mean_elements(
     all_candidates: bool = False,
     detector_name: str | None = None,
 ) -> DetectionResult:
-    """Detect maneuvers in a mean-element history (module docstring), arc by arc.
-
-    A gap between sets longer than ``config.max_bridge_days`` ends one analysed arc and starts
-    another (:func:`abrupt.detect.tle.elements.arcs`): each arc is detected on its own
-    (:func:`detect_arc`: its own noise, threshold and outliers) and no event is stated inside the gap.
-    With several arcs the result joins theirs: events of all, one diagnostics whose statistic runs
-    over all arcs (times from the first arc's epoch), the threshold and noise model of the longest
-    arc, with ``arcs`` (each arc's first and last epoch, sets, events), ``unbridged_gaps`` (from, to,
-    days), the arcs' ``detectable_by_year`` and ``outlier_sets`` summed into it.
+    """Detect maneuvers in a mean-element history (module docstring), arc by arc: a gap between sets
+    longer than ``config.max_bridge_days`` ends one arc and starts another; each is detected on its own
+    (:func:`detect_arc`), no event is stated inside the gap, and the results are joined
+    (:func:`abrupt.detect.tle.arcs.join_arcs`).
     """
     cfg = config or TleDetectorConfig()
     run_id = run_id or new_run_id()
     pieces = arcs(history, cfg.max_bridge_days)
+    kw: dict[str, Any] = {"run_id": run_id, "all_candidates": all_candidates, "detector_name": detector_name}
     if len(pieces) <= 1:
-        return detect_arc(
-            history,
-            cfg,
-            spacecraft=spacecraft,
-            run_id=run_id,
-            all_candidates=all_candidates,
-            detector_name=detector_name,
-        )
+        return detect_arc(history, cfg, spacecraft=spacecraft, **kw)
     name = spacecraft or history.name or f"NORAD-{history.norad_id}"
-    results = [
-        detect_arc(
-            history_rows(history, rows),
-            cfg,
-            spacecraft=name,
-            run_id=run_id,
-            all_candidates=all_candidates,
-            detector_name=detector_name,
-        )
-        for rows in pieces
-    ]
-    el = history.elements
-    epoch0 = np.datetime64(int(pd.Timestamp(el["epoch_utc"].iloc[0]).value), "ns")
-    frames = [r.events for r in results if len(r.events)]
-    events = pd.concat(frames, ignore_index=True) if frames else empty_frame(EXTRA_COLUMNS)
-    diags = [r.diagnostics[0] for r in results]
-    longest = int(np.argmax([len(rows) for rows in pieces]))
-    times, stats_ = [], []
-    for d in diags:
-        shift_s = (d.epoch_utc - epoch0) / np.timedelta64(1, "s") if d.epoch_utc is not None else 0.0
-        times.append(np.asarray(d.time_s, dtype=float) + float(shift_s))
-        stats_.append(np.asarray(d.statistic, dtype=float))
-    noise = dict(diags[longest].noise_model or {})
-    noise["arcs"] = [
-        {
-            "first_epoch_utc": str(el["epoch_utc"].iloc[rows[0]]),
-            "last_epoch_utc": str(el["epoch_utc"].iloc[rows[-1]]),
-            "sets": len(rows),
-            "events": len(r.events),
-        }
-        for rows, r in zip(pieces, results, strict=True)
-    ]
-    noise["unbridged_gaps"] = [
-        {
-            "from_utc": str(el["epoch_utc"].iloc[a[-1]]),
-            "to_utc": str(el["epoch_utc"].iloc[b[0]]),
-            "days": (el["epoch_utc"].iloc[b[0]] - el["epoch_utc"].iloc[a[-1]]).total_seconds() / SECONDS_PER_DAY,
-        }
-        for a, b in itertools.pairwise(pieces)
-    ]
-    noise["detectable_by_year"] = [row for d in diags for row in (d.noise_model or {}).get("detectable_by_year", [])]
-    noise["outlier_sets"] = sum(int((d.noise_model or {}).get("outlier_sets", 0)) for d in diags)
-    noise["outlier_epochs_utc"] = [e for d in diags for e in (d.noise_model or {}).get("outlier_epochs_utc", [])]
-    d0 = diags[longest]
-    diag = Diagnostics(
-        name=d0.name,
-        time_s=np.concatenate(times),
-        statistic=np.concatenate(stats_),
-        threshold=d0.threshold,
-        epoch_utc=epoch0,
-        unit=d0.unit,
-        noise_model=noise,
-        extra=d0.extra,
-    )
-    gaps = ", ".join(f"{g['days']:.0f} days from {g['from_utc'][:10]}" for g in noise["unbridged_gaps"])
-    note = f"{len(pieces)} arcs analysed apart: gaps longer than {cfg.max_bridge_days:g} days ({gaps}) are not bridged"
-    warnings_ = (*(w for r in results for w in r.warnings), note)
-    return DetectionResult(events.sort_values("time_utc", kind="stable").reset_index(drop=True), (diag,), warnings_)
+    results = [detect_arc(history_rows(history, rows), cfg, spacecraft=name, **kw) for rows in pieces]
+    return join_arcs(history, pieces, results, cfg.max_bridge_days)
 
 
 def detect_arc(
@@ -254,11 +187,8 @@ def detect_arc(
     cfg_hash = config_hash(cfg.hash_fields())
     name = spacecraft or history.name or (f"NORAD-{history.norad_id}" if len(history) else "unknown")
     fa_per_day = cfg.budget.per_day
-    # outlier sets (abrupt.detect.tle.outliers): counted and reported; removed in GEO, whose series
-    # are the sets' own elements. LEO's RAAN residual and along-track phase integrate each set's own
-    # secular rates from set to set, so taking a set out changes every later value of both (on the
-    # simulated 450 km null histories, 3 -> 23 false alarms); the median step test is robust to one
-    # set there, and it stays in.
+    # outlier sets (abrupt.detect.tle.outliers): counted; left out in GEO only. LEO's RAAN residual
+    # and phase integrate each set's own rates, so a removed set shifts every later value (docs/tle.md)
     outliers = np.zeros(0, dtype=np.int64)
     outlier_epochs: list[Any] = []
     if len(history):

@@ -41,6 +41,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import stats
 
+from abrupt.thresholds.noise import robust_scale
 from abrupt.units import SECONDS_PER_DAY
 
 PENALTY = 25.0  # cost of calling a set a blend: it must be 5 σ off both levels (heavy-tailed noise)
@@ -87,7 +88,7 @@ def blended_sets(
         _, (old0, new0, slope0) = _two_levels(tau, y, far_pre, far_post)
         far = far_pre | far_post
         resid = (y - slope0 * tau - np.where(idx <= gap, old0, new0))[far]
-        scale = max(1.0, 1.4826 * float(np.median(np.abs(resid - np.median(resid)))))
+        scale = max(1.0, float(robust_scale(resid)))
         y = y / scale
     slack = math.sqrt(penalty)
     best, best_cost = (gap, gap + 1), math.inf
