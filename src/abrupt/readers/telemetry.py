@@ -177,17 +177,26 @@ def _check_rates_against_attitude(
     )
 
 
-def _rate_fit(
-    t_s: NDArray[np.float64], q: NDArray[np.float64], w: NDArray[np.float64], segments: list[tuple[int, int]]
+def quaternion_rate_fit(
+    t_s: NDArray[np.float64],
+    q: NDArray[np.float64],
+    w: NDArray[np.float64],
+    segments: list[tuple[int, int]],
+    *,
+    left: bool = False,
 ) -> tuple[float, float, float]:
     """(k, relative residual, signal-to-noise) of the least-squares fit ω_gyro ≈ k ω_q over blocks of
     :data:`RATE_CHECK_BLOCK_S`, with ω_q = 2 vec(q_k* ⊗ q_k+1) / Δt (body axes) as in
-    :func:`_check_rates_against_attitude`; SNR is the block rate's RMS over its noise."""
+    :func:`_check_rates_against_attitude`, or 2 vec(q_k+1 ⊗ q_k*) / Δt with ``left`` (the other
+    multiplication convention); SNR is the block rate's RMS over its noise."""
     gyro, quat = [], []
     for a, b in segments:
         if b - a < 3:
             continue
-        dq = quaternion_multiply(quaternion_conjugate(q[a : b - 1]), q[a + 1 : b])
+        if left:
+            dq = quaternion_multiply(q[a + 1 : b], quaternion_conjugate(q[a : b - 1]))
+        else:
+            dq = quaternion_multiply(quaternion_conjugate(q[a : b - 1]), q[a + 1 : b])
         dq = np.where(dq[:, :1] < 0, -dq, dq)
         dt = np.diff(t_s[a:b])[:, None]
         block = max(2, round(RATE_CHECK_BLOCK_S / float(np.median(dt))))
@@ -229,10 +238,10 @@ def _check_quaternion_order(
     conj = np.array([1.0, -1.0, -1.0, -1.0]) if frame == "q_NB" else np.ones(4)
     raw = q * conj  # back to the file's frame, scalar first
     other = raw[:, [3, 0, 1, 2]] if declared == "scalar_first" else raw[:, [1, 2, 3, 0]]
-    k, residual, snr = _rate_fit(t_s, q, w, segments)
+    k, residual, snr = quaternion_rate_fit(t_s, q, w, segments)
     if not snr >= RATE_CHECK_MIN_SNR:
         return
-    k_other, residual_other, _ = _rate_fit(t_s, other * conj, w, segments)
+    k_other, residual_other, _ = quaternion_rate_fit(t_s, other * conj, w, segments)
     if 0.8 <= k_other <= 1.25 and residual_other < residual / 3.0:
         correct = "scalar_last" if declared == "scalar_first" else "scalar_first"
         raise InputError(
