@@ -228,9 +228,7 @@ def check_quaternion_components(spacecraft: Spacecraft, samples: pd.DataFrame) -
     for c in chans[1:]:
         t = np.intersect1d(t, series[c.mnemonic][0], assume_unique=True)
     q = np.column_stack([series[c.mnemonic][1][np.searchsorted(series[c.mnemonic][0], t)] for c in chans])
-    g = np.column_stack(
-        [np.interp(t, *series[c.mnemonic]) * RATE_UNITS.get(c.unit, 1.0) for c in gyro]  # type: ignore[call-overload]
-    )
+    g = np.column_stack([np.interp(t, *series[c.mnemonic]) * RATE_UNITS.get(c.unit, 1.0) for c in gyro])
     good = np.isfinite(q).all(axis=1) & np.isfinite(g).all(axis=1) & (np.abs(np.linalg.norm(q, axis=1) - 1.0) < 0.1)
     if good.sum() < 100:
         return
