@@ -21,7 +21,7 @@ from abrupt.errors import ConfigError, InputError
 from abrupt.model.flight_config import RATE_UNITS, WHEEL_UNITS, FlightChannel, FlightConfig
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.readers.archive import ArchiveChunk
-from abrupt.readers.telemetry import MAX_BODY_RATE_RAD_S, WHEEL_OVERSPEED_FACTOR, quaternion_rate_fit
+from abrupt.readers.telemetry import MAX_BODY_RATE_RAD_S, WHEEL_OVERSPEED_FACTOR, best_rate_fit
 from abrupt.series.timetable import Timetable, by_mnemonic, continuous_quaternion
 from abrupt.series.timetable_momentum import wheel_scale_from_conservation
 from abrupt.thresholds.noise import robust_noise_sigma
@@ -213,7 +213,7 @@ def check_quaternion_components(spacecraft: Spacecraft, samples: pd.DataFrame) -
     """Raise if the quaternion's scalar is not the channel declared ``component = 0``, from kinematics.
 
     The gyro rates are fitted by the rates implied by the quaternion (q̇ = ½ q ⊗ (0, ω), either
-    multiplication convention: :func:`~abrupt.readers.telemetry.quaternion_rate_fit`) with each channel
+    multiplication convention: :func:`~abrupt.readers.telemetry.best_rate_fit`) with each channel
     taken as the scalar in turn; a channel other than the declared scalar that fits with a factor within
     0.8-1.25 and a third of the declared scalar's residual is named (on the flight-like archive the
     declared order fits with residual 0.008, the best other with 0.15). A still attitude cannot tell
@@ -240,9 +240,7 @@ def check_quaternion_components(spacecraft: Spacecraft, samples: pd.DataFrame) -
     segments = [(int(a), int(b)) for a, b in itertools.pairwise(bounds)]
 
     def best(scalar: int) -> tuple[float, float, float]:
-        order = [(scalar + i) % 4 for i in range(4)]
-        fits = [quaternion_rate_fit(t_s, q[:, order], g, segments, left=left) for left in (False, True)]
-        return min(fits, key=lambda f: f[1] if math.isfinite(f[1]) else math.inf)
+        return best_rate_fit(t_s, q[:, [(scalar + i) % 4 for i in range(4)]], g, segments)
 
     k0, r0, snr = best(0)
     if not snr >= QUATERNION_ORDER_MIN_SNR or not math.isfinite(r0):
