@@ -7,16 +7,19 @@ factor of 1."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from abrupt.errors import InputError
+from abrupt.errors import ConfigError, InputError
 from abrupt.model.rotations import quaternion_multiply
 from abrupt.model.spacecraft import load_spacecraft
+from abrupt.pipelines.flight_checks import check_quaternion_components
 from abrupt.readers.telemetry import telemetry_from_frame
+from flight_synth import spacecraft_toml
 
 THESIS = Path(__file__).resolve().parent.parent / "src" / "abrupt" / "data" / "spacecraft" / "thesis.toml"
 
@@ -75,3 +78,34 @@ def test_a_still_attitude_is_left_alone(tmp_path: Path) -> None:
     frame = _telemetry(amplitude_rad_s=0.0)
     frame = frame.rename(columns={"q0": "q3", "q1": "q0", "q2": "q1", "q3": "q2"})
     telemetry_from_frame(frame, load_spacecraft(_spacecraft(tmp_path, "scalar_first")), source="t.csv")
+
+
+def _scalar_last(spacecraft_text: str) -> str:
+    """The spacecraft file with its quaternion channels renumbered as if the scalar were the last."""
+    blocks = spacecraft_text.split("[[flight.channels]]")
+    for i, block in enumerate(blocks):
+        if 'quantity = "quaternion"' in block:
+            found = re.search(r"component = (\d)", block)
+            assert found is not None
+            blocks[i] = block.replace(found.group(0), f"component = {(int(found.group(1)) + 3) % 4}")
+    return "[[flight.channels]]".join(blocks)
+
+
+def test_a_flight_quaternion_numbered_scalar_last_is_refused_naming_the_channel(tmp_path: Path) -> None:
+    """The tumbling telemetry above as flight channels of the synthetic spacecraft file (gyro in deg/s): its
+    own numbering passes; numbered as if the scalar were last, the error names the scalar channel's key.
+    (A rotation about one fixed axis, such as nadir pointing alone, fits every numbering and is not judged.)"""
+    frame = _telemetry()
+    time = frame["time"].dt.tz_localize(None)
+    columns = {"SC-Z.ch01": "q0", "SC-Z.ch02": "q1", "SC-Z.ch03": "q2", "SC-Z.ch04": "q3"}
+    parts = [pd.DataFrame({"mnemonic": m, "time": time, "value": frame[c]}) for m, c in columns.items()]
+    for m, c in {"SC-Z.ch05": "wx", "SC-Z.ch06": "wy", "SC-Z.ch07": "wz"}.items():
+        parts.append(pd.DataFrame({"mnemonic": m, "time": time, "value": np.degrees(frame[c])}))
+    samples = pd.concat(parts, ignore_index=True)
+    right = tmp_path / "sc.toml"
+    right.write_text(spacecraft_toml(5400.0))
+    check_quaternion_components(load_spacecraft(right), samples)
+    wrong = tmp_path / "scalar_last.toml"
+    wrong.write_text(_scalar_last(spacecraft_toml(5400.0)))
+    with pytest.raises(ConfigError, match=r"\[flight\.channels\[0\]\.component\]: the quaternion follows the gyro"):
+        check_quaternion_components(load_spacecraft(wrong), samples)

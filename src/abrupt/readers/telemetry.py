@@ -177,17 +177,26 @@ def _check_rates_against_attitude(
     )
 
 
-def _rate_fit(
-    t_s: NDArray[np.float64], q: NDArray[np.float64], w: NDArray[np.float64], segments: list[tuple[int, int]]
+def quaternion_rate_fit(
+    t_s: NDArray[np.float64],
+    q: NDArray[np.float64],
+    w: NDArray[np.float64],
+    segments: list[tuple[int, int]],
+    *,
+    left: bool = False,
 ) -> tuple[float, float, float]:
     """(k, relative residual, signal-to-noise) of the least-squares fit ω_gyro ≈ k ω_q over blocks of
     :data:`RATE_CHECK_BLOCK_S`, with ω_q = 2 vec(q_k* ⊗ q_k+1) / Δt (body axes) as in
-    :func:`_check_rates_against_attitude`; SNR is the block rate's RMS over its noise."""
+    :func:`_check_rates_against_attitude`, or 2 vec(q_k+1 ⊗ q_k*) / Δt with ``left`` (the other
+    multiplication convention); SNR is the block rate's RMS over its noise."""
     gyro, quat = [], []
     for a, b in segments:
         if b - a < 3:
             continue
-        dq = quaternion_multiply(quaternion_conjugate(q[a : b - 1]), q[a + 1 : b])
+        if left:
+            dq = quaternion_multiply(q[a + 1 : b], quaternion_conjugate(q[a : b - 1]))
+        else:
+            dq = quaternion_multiply(quaternion_conjugate(q[a : b - 1]), q[a + 1 : b])
         dq = np.where(dq[:, :1] < 0, -dq, dq)
         dt = np.diff(t_s[a:b])[:, None]
         block = max(2, round(RATE_CHECK_BLOCK_S / float(np.median(dt))))
@@ -208,6 +217,16 @@ def _rate_fit(
     return k, residual, float(np.sqrt(np.mean(wq**2))) / max(noise, 1e-300)
 
 
+def best_rate_fit(
+    t_s: NDArray[np.float64], q: NDArray[np.float64], w: NDArray[np.float64], segments: list[tuple[int, int]]
+) -> tuple[float, float, float]:
+    """:func:`quaternion_rate_fit` in the multiplication convention that fits the gyro best (smallest
+    residual): files follow either (the simulator one, the flight-like archive the other), and the sign of
+    the factor says which frame the quaternion maps, not how well it fits."""
+    fits = [quaternion_rate_fit(t_s, q, w, segments, left=left) for left in (False, True)]
+    return min(fits, key=lambda f: f[1] if math.isfinite(f[1]) else math.inf)
+
+
 def _check_quaternion_order(
     t_s: NDArray[np.float64],
     q: NDArray[np.float64],
@@ -221,23 +240,24 @@ def _check_quaternion_order(
     Read with the scalar in the wrong place, a quaternion is still a unit quaternion, but the rotation it
     implies between samples no longer follows the gyro (q̇ = ½ q ⊗ (0, ω)). When the attitude moves well
     above noise (:data:`RATE_CHECK_MIN_SNR`), the gyro rates are fitted by the rates implied by the
-    quaternions read both ways; if the other order fits with a factor near 1 and a residual under a third
-    of the declared order's, the file's ``order`` is wrong. A still attitude cannot tell the orders apart
-    (every constant quaternion is a rotation) and is left alone."""
+    quaternions read both ways (each in its best multiplication convention, :func:`best_rate_fit`); if the
+    other order fits with a factor near ±1 and a residual under a third of the declared order's, the file's
+    ``order`` is wrong. A still attitude, or a rotation about one fixed axis, cannot tell the orders apart
+    and is left alone."""
     order_spec = tmap.quaternion.order or "scalar_first,q_BN"
     declared, _, frame = order_spec.partition(",")
     conj = np.array([1.0, -1.0, -1.0, -1.0]) if frame == "q_NB" else np.ones(4)
     raw = q * conj  # back to the file's frame, scalar first
     other = raw[:, [3, 0, 1, 2]] if declared == "scalar_first" else raw[:, [1, 2, 3, 0]]
-    k, residual, snr = _rate_fit(t_s, q, w, segments)
+    k, residual, snr = best_rate_fit(t_s, q, w, segments)
     if not snr >= RATE_CHECK_MIN_SNR:
         return
-    k_other, residual_other, _ = _rate_fit(t_s, other * conj, w, segments)
-    if 0.8 <= k_other <= 1.25 and residual_other < residual / 3.0:
+    k_other, residual_other, _ = best_rate_fit(t_s, other * conj, w, segments)
+    if 0.8 <= abs(k_other) <= 1.25 and residual_other < residual / 3.0:
         correct = "scalar_last" if declared == "scalar_first" else "scalar_first"
         raise InputError(
-            f"the quaternions follow the gyro rates when read {correct} (rate factor {k_other:.3f}, residual "
-            f"{residual_other:.2g}), not {declared} as the spacecraft file says (factor {k:.3f}, residual "
+            f"the quaternions follow the gyro rates when read {correct} (rate factor {abs(k_other):.3f}, residual "
+            f"{residual_other:.2g}), not {declared} as the spacecraft file says (factor {abs(k):.3f}, residual "
             f'{residual:.2g}): set order = "{correct}" in [telemetry.quaternion]',
             file=path,
             column=",".join(tmap.quaternion.columns),
