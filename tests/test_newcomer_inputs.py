@@ -85,7 +85,7 @@ def test_an_sp3_file_given_as_elements_is_named_as_sp3(
 ) -> None:
     sp3 = shared_data / "sp3" / "ssas3a20.b18358.e19003.DG_.sp3"
     with pytest.raises(SystemExit) as exc:
-        main(["detect", "tle", str(sp3), "--out", str(tmp_path / "e.csv"), "--catalog", "none"])
+        main(["detect", "tle", str(sp3), "--out", str(tmp_path / "e.csv"), "--catalog", str(tmp_path / "c.sqlite")])
     assert exc.value.code == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "SP3 precise orbit file" in err and "abrupt detect orbit" in err
