@@ -50,7 +50,7 @@ PASSIVE_SATELLITES = (
     PassiveSatellite("etalon1", _sphere(1.294), 1415.0, ("etalon-1", "l53", "8900103", "19751")),
     PassiveSatellite("etalon2", _sphere(1.294), 1415.0, ("etalon-2", "l54", "8903903", "20026")),
     PassiveSatellite("starlette", _sphere(0.24), 47.295, ("7501001", "7646")),
-    PassiveSatellite("stella", _sphere(0.24), 48.0, ("9306102", "22824")),
+    PassiveSatellite("stella", _sphere(0.24), 48.0, ("l56", "9306102", "22824")),
     PassiveSatellite("ajisai", _sphere(2.15), 685.0, ("8606101", "16908")),
     PassiveSatellite("lares", _sphere(0.364), 386.8, ("1200601", "38077")),
     PassiveSatellite("lares2", _sphere(0.424), 294.8, ("lares-2", "2208001", "53105")),
