@@ -261,7 +261,7 @@ def inject_attitude_cmd(
         dst = TelemetryStore(out_store)
         for day in day_range(store, sc.name, days or None):
             frame = store.read_day(sc.name, day)
-            frame = inject_strikes(inject_confounders(frame, sc, conf_list, seed=seed), sc, parsed, seed=seed)
+            frame = inject_confounders(inject_strikes(frame, sc, parsed, seed=seed), sc, conf_list, seed=seed)
             frame["time"] = frame["time"].dt.tz_localize("UTC")
             report = store.report(sc.name, day)
             report["injected_strikes"] = [
