@@ -106,6 +106,10 @@ EVIDENCE_SHOWN = (
     "ev_appendage_z",
     "ev_gyro_spike_z",
     "ev_after_fault_s",
+    "ev_wheel_momentum_Nms",
+    "ev_dump_angle_deg",
+    "ev_dump_angle_sigma_deg",
+    "ev_dump_log_lr",
     "fault_channel",
 )
 
@@ -180,8 +184,9 @@ def one_run(
                           "near_kind": kind})  # fmt: skip
 
     def hook(s: pd.DataFrame) -> pd.DataFrame:
-        s = inject_confounders(s, sc, confs, seed=run_seed)
-        return inject_strikes(s, sc, strikes, seed=run_seed)
+        # Strikes first: a dump aims at the wheels' momentum as the strikes before it left it.
+        s = inject_strikes(s, sc, strikes, seed=run_seed)
+        return inject_confounders(s, sc, confs, seed=run_seed)
 
     res = run_flight(store, sc, FlightRunConfig(), days=days, samples_hook=hook, threshold=threshold)
     return truth, res.events

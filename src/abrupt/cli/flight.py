@@ -296,8 +296,8 @@ def inject_attitude_cmd(
         dst = abrupt_store.TelemetryStore(out_store)
         for day in pipelines_flight.day_range(store, sc.name, days or None):
             frame = store.read_day(sc.name, day)
-            frame = simulate_injection.inject_strikes(
-                simulate_confounders.inject_confounders(frame, sc, conf_list, seed=seed), sc, parsed, seed=seed
+            frame = simulate_confounders.inject_confounders(
+                simulate_injection.inject_strikes(frame, sc, parsed, seed=seed), sc, conf_list, seed=seed
             )
             frame["time"] = frame["time"].dt.tz_localize("UTC")
             report = store.report(sc.name, day)

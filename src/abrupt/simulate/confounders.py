@@ -440,13 +440,13 @@ def _add_appendage_angle(s: _Samples, spacecraft: Spacecraft, c: Confounder) -> 
 
 def stored_wheel_momentum_B(s: _Samples, spacecraft: Spacecraft, t_ns: int, span_s: float = 20.0) -> FloatArray:
     """The wheels' momentum Σ J_s Ω ĝ [N·m·s] in body axes over the ``span_s`` before ``t_ns`` (median of
-    each wheel's raw reading; the wheels' injected changes are not in it yet)."""
+    each wheel's raw reading with the changes of the confounders injected so far)."""
     assert spacecraft.flight is not None
     speeds = np.zeros(len(spacecraft.wheels))
     for ch in spacecraft.flight.of("wheel_speed"):
         sel = s.rows(ch.mnemonic, t_ns - int(span_s * NS), t_ns)
         if sel.size:
-            speeds[ch.component] = float(np.median(s.values[sel])) * ch.to_si
+            speeds[ch.component] = float(np.median(s.values[sel] * ch.to_si + s.wheels.d[sel]))
     return np.asarray((spacecraft.wheel_axes * spacecraft.wheel_spin_inertias_kgm2[None, :]) @ speeds)
 
 
@@ -477,7 +477,8 @@ def inject_confounders(
     """Raw samples (mnemonic, time, value) with the confounders added in native units (module docstring).
 
     Deterministic (the wheels' re-quantisation follows the archive's own pulse phase); ``seed`` is kept
-    for callers.
+    for callers. A dump is aimed at the wheels' momentum in ``samples`` at its onset: strikes injected
+    into the same samples go in first (``inject_strikes``), so that it sees them.
     """
     if spacecraft.flight is None or not confounders:
         return samples
@@ -486,7 +487,8 @@ def inject_confounders(
     rows = InjectionRows(t_all, out["mnemonic"].astype(str).to_numpy())
     s = _Samples(out["value"].to_numpy(np.float64).copy(), t_all, rows, WheelChanges(t_all.size))
     bn_at = InjectionAttitude(samples, spacecraft)
-    for c in confounders:
+    # In time order: a dump aims at the wheels' momentum as every earlier confounder left it.
+    for c in sorted(confounders, key=lambda c: c.time_ns):
         if c.kind == "momentum_dump" and "direction_B" not in c.params:
             c = aimed_dump(c, stored_wheel_momentum_B(s, spacecraft, c.time_ns))
         if CONFOUNDER_CLASS[c.kind] == "sensor_fault":
