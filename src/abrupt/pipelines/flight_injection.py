@@ -80,7 +80,7 @@ def injection_recovery(
     """
     store = TelemetryStore(store_root)
     rng = np.random.default_rng(seed)
-    rows = []
+    rows: list[dict[str, Any]] = []
     day_list = list(day_range(store, spacecraft.name, days))
     # one detection pass per day as it is, then one per injection run
     with work_progress.task(
