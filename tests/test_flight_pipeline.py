@@ -4,6 +4,7 @@ detection on a synthetic archive with known truth, chunked = whole, injection, t
 from __future__ import annotations
 
 import gzip
+import io
 import json
 import math
 from pathlib import Path
@@ -492,3 +493,44 @@ def test_spacecraft_flight_schema_errors_name_the_key(tmp_path: Path) -> None:
     with pytest.raises(ConfigError, match=r"wheel_speed needs exactly one channel per component"):
         spacecraft_from_dict(bad2)
     assert math.isfinite(ok.orbit.period_s)
+
+
+def test_injection_recovery_reports_its_detection_passes_with_their_total(
+    synth: tuple[Path, object], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The recovery is minutes of work on real days: it shows a task whose total is the number of
+    detection passes it then runs (counted here at the detector's door)."""
+    from abrupt import progress
+    from abrupt.pipelines import flight_injection
+
+    d, a = synth
+    sc = load_spacecraft(a.spacecraft)  # type: ignore[attr-defined]
+    threshold = run_flight(d / "store", sc, FAST).threshold
+    calls: list[int] = []
+    real_chunk = flight_injection.process_chunk
+
+    def counted(*args: object, **kwargs: object) -> object:
+        calls.append(1)
+        return real_chunk(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(flight_injection, "process_chunk", counted)
+    seen: list[tuple[str, int | None]] = []
+    finished: list[int] = []
+
+    class Recorder(progress.Reporter):
+        def opened(self, task: progress.Task, bar: bool) -> None:
+            seen.append((task.desc, task.total))
+            super().opened(task, bar)
+
+        def closed(self, task: progress.Task) -> None:
+            finished.append(task.done)
+            super().closed(task)
+
+    previous = progress.install(Recorder("abrupt inject attitude", "log", stream=io.StringIO()))
+    try:
+        flight_injection.injection_recovery(d / "store", sc, FAST, threshold, per_run=3, runs_per_day=1)
+    finally:
+        progress.install(previous)
+    totals = [total for desc, total in seen if desc == "injection recovery"]
+    assert totals == [len(calls)] and len(calls) >= 2
+    assert finished[-1] == len(calls)

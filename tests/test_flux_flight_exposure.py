@@ -86,3 +86,25 @@ def test_exposure_options_without_a_store_or_an_orbit_are_clear_errors(tmp_path:
     r = runner.invoke(cli, ["detect", "attitude", "--store", str(store), *common, *extra])
     assert r.exit_code != 0
     assert "inclination_deg" in str(r.exception) + r.output  # the synthetic file's [orbit] has no inclination
+
+
+def test_exposure_without_a_strike_geometry_is_refused_before_the_run(tmp_path: Path) -> None:
+    """A spacecraft file without [[surfaces]] and no --surfaces: the flux could not use the exposure, so
+    the run stops at once, naming the option, and writes nothing."""
+    a = make_archive(tmp_path / "arch", hours=2.0, period_s=5926.4)
+    sc_text = a.spacecraft.read_text().replace("period_s = 5926.4", "period_s = 5926.4\ninclination_deg = 98.19")
+    a.spacecraft.write_text(sc_text)
+    runner = CliRunner()
+    store, cat, out = tmp_path / "store", tmp_path / "c.sqlite", tmp_path / "e.csv"
+    r = runner.invoke(cli, ["ingest", str(a.archive), "--decoder", str(a.decoder), "--store", str(store)])
+    assert r.exit_code == 0, r.output
+    args = ["detect", "attitude", "--store", str(store), "--spacecraft", str(a.spacecraft), "--out", str(out)]
+    args += ["--catalog", str(cat), "--exposure-dH90", "0.02"]
+    r = runner.invoke(cli, args)
+    assert r.exit_code != 0
+    message = str(r.exception) + r.output
+    assert "[surfaces]" in message and "--surfaces" in message and str(a.spacecraft) in message
+    assert not out.exists()
+    r = runner.invoke(cli, [*args, "--surfaces", str(SURFACES)])
+    assert r.exit_code == 0, r.output
+    assert out.exists()

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import sqlite3
 
 import numpy as np
@@ -173,6 +174,25 @@ def test_too_few_windows_give_no_events_a_warning_and_untested_diagnostics():
     diag = res.diagnostic("inertia_glr")
     assert diag.threshold is None
     assert diag.statistic.shape == (2,) and np.isnan(diag.statistic).all()
+
+
+def test_too_few_windows_name_a_window_length_that_does_get_tested():
+    """Two days of one-day windows: the warning names a shorter window, and windows of that length over
+    the same two days are enough for the detector to test them."""
+    rng = np.random.default_rng(5)
+    res = InertiaChangeDetector().detect(_track(2, None, 0.0, rng), FalseAlarmBudget(1, "year"))
+    match = re.search(r"windows of at most (\d+) s", res.warnings[0])
+    assert match is not None, res.warnings[0]
+    window_s = float(match.group(1))
+    n = int(2 * 86400.0 // window_s)
+    t0 = np.arange(n) * window_s
+    sigma = 0.3
+    p = np.array([900.0, 700.0, 1000.0, 5.0, -3.0, 2.0]) + sigma * rng.standard_normal((n, 6))
+    cov = np.broadcast_to(np.eye(6) * sigma**2, (n, 6, 6)).copy()
+    short = InertiaTrack("SC-T", "2026-01-01T00:00:00", t0, t0 + window_s, p, cov, np.ones((n, 6), bool))
+    tested = InertiaChangeDetector().detect(short, FalseAlarmBudget(1, "year"))
+    assert not any("nothing was tested" in w for w in tested.warnings)
+    assert np.isfinite(tested.diagnostic("inertia_glr").statistic).any()
 
 
 # ------------------------------------------------------------------------------------------ command line

@@ -64,6 +64,32 @@ def test_orbit_report_of_a_position_only_file_has_no_velocity_or_empty_panel(
     resid = np.abs(run.analysis.forward.innovation[:, :3])
     lo, hi = fig.axes[0].get_ylim()
     assert hi - lo < 0.5 * np.nanmax(resid)
+    # each threshold line inside its panel, clear of the frame, even where no statistic reaches it
+    for ax in fig.axes:
+        lo, hi = ax.get_ylim()
+        for line in ax.lines:
+            if line.get_label().startswith("threshold"):
+                assert line.get_ydata()[0] <= hi - 0.1 * (hi - lo), ax.get_ylabel()
+
+
+def test_a_threshold_above_quiet_data_gets_room_above_it() -> None:
+    from matplotlib.figure import Figure
+
+    from abrupt.report.orbit import _threshold_headroom
+
+    ax = Figure().subplots()
+    ax.plot(np.arange(10.0), np.linspace(0.0, 3.0, 10))
+    ax.axhline(4.0)
+    _threshold_headroom(ax, 4.0)
+    lo, hi = ax.get_ylim()
+    assert lo <= 0.0 and 4.0 <= hi - 0.1 * (hi - lo)
+    # a threshold the data pass keeps the limits the data set
+    ax2 = Figure().subplots()
+    ax2.plot(np.arange(10.0), np.linspace(0.0, 30.0, 10))
+    ax2.axhline(4.0)
+    before = ax2.get_ylim()
+    _threshold_headroom(ax2, 4.0)
+    assert ax2.get_ylim() == before
 
 
 def test_tracking_report_draws_the_glrt_threshold_without_events(

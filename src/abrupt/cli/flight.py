@@ -18,7 +18,7 @@ from abrupt.cli.flight_orbit import orbit_input
 from abrupt.cli.flux import store_run_exposure
 from abrupt.cli.groups import check_evidence_output, cli, inject, record_run, simulate
 from abrupt.cli.options import budget_options, pop_budget
-from abrupt.errors import InputError
+from abrupt.errors import ConfigError, InputError
 from abrupt.outputs import atomic_output, write_text_atomic
 from abrupt.simulate.confounder_kinds import CONFOUNDER_KINDS
 
@@ -131,6 +131,18 @@ def _cleaning(no_clean: tuple[str, ...]) -> Any:
 CLEANING_STAGES = ("event-masks", "slew-masks", "savgol", "comb", "trend", "all")
 
 
+def _check_exposure_geometry(surfaces_path: str, spacecraft_path: str, sc: model_spacecraft.Spacecraft) -> None:
+    """Refuse before the run an exposure that could not be used: the flux needs the strike geometry."""
+    geometry = sc if surfaces_path == spacecraft_path else model_spacecraft.load_spacecraft(surfaces_path)
+    if not geometry.surfaces:
+        raise ConfigError(
+            "no [[surfaces]]: the exposure rows need the strike geometry (box bus, panel arrays); "
+            "give --surfaces FILE with them (examples/spacecraft/kestrel_surfaces.toml for KESTREL2)",
+            file=surfaces_path,
+            key="surfaces",
+        )
+
+
 def detect_from_store(
     store_dir: str,
     spacecraft_path: str,
@@ -150,6 +162,8 @@ def detect_from_store(
     (:mod:`abrupt.cli.flight_orbit`)."""
     check_evidence_output(out)  # the attribution evidence goes beside the events
     sc = model_spacecraft.load_spacecraft(spacecraft_path)
+    if catalog_target and exposure and (exposure.get("recovery") or exposure.get("dh90")):
+        _check_exposure_geometry(exposure.get("surfaces") or spacecraft_path, spacecraft_path, sc)
     orbit_in = orbit_input(*orbit, spacecraft=sc.name, catalog_target=catalog_target)
     cfg = pipelines_flight.FlightRunConfig(budget=budget, cleaning=_cleaning(no_clean))
     day_list = pipelines_flight.day_range(abrupt_store.TelemetryStore(store_dir), sc.name, days or None)

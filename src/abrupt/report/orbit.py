@@ -83,6 +83,7 @@ def plot_orbit_report(
                 lw=1.0,
                 label=f"threshold {th.value:.3g} ({th.false_alarms_per_day:.3g} false alarms/day)",
             )
+            _threshold_headroom(ax, th.value)
         ax.set_ylabel(f"{name}\n({STATISTIC_UNITS.get(name, '-')})", fontsize=8)
         ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=7, frameon=False)
     for ax in axes:
@@ -96,6 +97,17 @@ def plot_orbit_report(
         handle = Line2D([], [], color="tab:orange", lw=1.5, label=f"events: {len(event_hours)}")
         fig.legend(handles=[handle], loc="outside lower center", fontsize=8, frameon=False)
     return save_figure(fig, path)
+
+
+def _threshold_headroom(ax: Any, threshold: float, fraction: float = 0.15) -> None:
+    """Room above a threshold that tops the data (a quiet arc), so that its dashed line sits inside the
+    panel rather than on the frame: the upper limit at least ``fraction`` of the span above it."""
+    lo, hi = ax.get_ylim()
+    if not (np.isfinite(threshold) and np.isfinite(lo) and np.isfinite(hi) and hi > lo):
+        return
+    room = fraction * (max(hi, threshold) - lo)
+    if hi < threshold + room:
+        ax.set_ylim(lo, threshold + room)
 
 
 def _robust_limits(ax: Any, values: NDArray[np.float64]) -> int:

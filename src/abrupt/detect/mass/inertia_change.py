@@ -332,7 +332,8 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
             return _untested(
                 series,
                 f"{k} window(s): a change needs {self.min_windows_before} windows before it and "
-                f"{self.min_windows_after} after it ({needed} in all); nothing was tested",
+                f"{self.min_windows_after} after it ({needed} in all); nothing was tested"
+                + _shorter_window_hint(series, needed),
             )
         obs = np.all(series.observable, axis=0)
         idx = np.flatnonzero(obs)
@@ -522,6 +523,20 @@ class InertiaChangeDetector(Detector[InertiaTrack]):
 
 def _epoch_datetime64(series: InertiaTrack) -> np.datetime64:
     return np.datetime64(pd.Timestamp(series.epoch_utc or "1970-01-01").tz_localize(None))
+
+
+def _shorter_window_hint(series: InertiaTrack, needed: int) -> str:
+    """What window length would give ``needed`` windows over the span the track covers ("" if none)."""
+    if series.n_windows == 0:
+        return ""
+    span_s = float(np.max(series.t_end_s) - np.min(series.t_start_s))
+    if not (math.isfinite(span_s) and span_s > 0):
+        return ""
+    window_max_s = math.floor(span_s / needed)
+    return (
+        f"; the windows span {span_s / SECONDS_PER_DAY:.3g} d: windows of at most {window_max_s} s "
+        f"(--window) give {needed}, or analyse more days"
+    )
 
 
 def _untested(series: InertiaTrack, reason: str) -> DetectionResult:
