@@ -13,6 +13,8 @@ from __future__ import annotations
 import errno
 import hashlib
 import os
+import subprocess
+import sys
 from pathlib import Path
 
 import click
@@ -261,6 +263,25 @@ def test_a_malformed_postgresql_url_is_one_clear_line(tmp_path: Path, capsys: py
     code, err = _run(["detect", "tle", str(source), "--catalog", "postgresql://user:secret@host:port/db"], capsys)
     assert code == 2 and "not a valid catalog URL" in err and "numeric port" in err
     assert "secret" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_detect_command_imported_before_its_group_still_opens_the_catalog_first(tmp_path: Path) -> None:
+    """However the command was first reached (loaded by its group, or its module imported before the group
+    was walked, as another test or a script may do), a detect command checks its catalog before reading
+    its input. In a fresh interpreter, so that no earlier test has loaded the command."""
+    source = tmp_path / "h.tle"
+    source.write_text("x\n")
+    script = (
+        "import sys, click, importlib\n"
+        "from abrupt.cli.commands import cli\n"
+        "importlib.import_module('abrupt.cli.tle')\n"
+        "cli.get_command(click.Context(cli, info_name='abrupt'), 'detect')\n"
+        "from abrupt.cli.main import main\n"
+        "main(['detect', 'tle', sys.argv[1], '--catalog', 'postgresql://user:secret@host:port/db'])\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parent.parent / "src")}
+    done = subprocess.run([sys.executable, "-c", script, str(source)], env=env, capture_output=True, text=True)
+    assert done.returncode == 2 and "not a valid catalog URL" in done.stderr, done.stderr[-500:]
 
 
 def test_events_of_a_successful_run_are_complete(

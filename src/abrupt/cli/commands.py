@@ -280,7 +280,7 @@ def guard_outputs(command: click.Command, *, records_runs: bool = False) -> clic
     ``records_runs`` (the ``detect`` commands) also open its ``--catalog`` first."""
     if isinstance(command, click.Group):  # its loaded sub-commands (a lazy group guards the others)
         for sub in command.commands.values():
-            guard_outputs(sub)
+            guard_outputs(sub, records_runs=records_runs or command.name == "detect")
         return command
     callback: Callable[..., Any] | None = command.callback
     if callback is None or getattr(callback, "_outputs_guarded", False):
