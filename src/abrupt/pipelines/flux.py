@@ -221,7 +221,7 @@ def infer_flux(
         notes.append(
             f"{data.rows_set_aside} exposure rows of spacecraft-days analysed by several detectors were set aside "
             f"with their detectors' {data.events_set_aside} events of those days: per spacecraft-day the "
-            "detector expected to see the most strikes is used (the docstring of abrupt.flux, Exposure)"
+            "detector expected to see the most strikes is used (docs/flux-inference.md, Exposure)"
         )
     if data.n_dropped:
         notes.append(
