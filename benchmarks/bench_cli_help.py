@@ -19,6 +19,7 @@ from pathlib import Path
 
 import click
 
+from _results import write_results
 from abrupt.cli.commands import cli
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -67,4 +68,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with write_results("bench_cli_help"):
+        main()
