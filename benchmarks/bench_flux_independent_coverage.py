@@ -10,6 +10,36 @@ against the truth; pooled coverage per scale and the median estimate / truth are
 Target (issue acceptance 1): pooled coverage 85-95 % for both scales, median within 5 % of truth.
 
 Run: ``nice python benchmarks/bench_flux_independent_coverage.py [--fleets 100] [--draws 1500000]``.
+
+**Coverage on fleets of an independent generator** (`python benchmarks/bench_flux_independent_coverage.py
+--fleets 150 --draws 800000`, `docs/results/bench_flux_independent_coverage.txt`). The fleets are drawn by
+`benchmarks/independent_strikes.py`, which shares no Monte Carlo with the inference: its own NASA-90/91 and Grün
+size laws (formulas), masses, face sampling with ray visibility (numpy), ΔH = β m v r × d̂, logistic detection
+and Poisson strikes and false alarms; it takes from abrupt only the direction/speed tables, the meteoroid Earth
+factor and Ψ(i) as data. Fleet: 2 Fermi-like craft at 550 km / 28.5° and 2 at 800 km / 98°, 5 years each (18
+analysed spacecraft-years), ΔH90 10 mN·m·s, 0.01 false alarms a day, nadir pointing; debris 0.3× and 3×
+NASA-90/91, meteoroids 1× Grün, β = 1.5 known (`--fix beta`); 150 fleets per truth (median 177 events a fleet,
+false alarms included). The strike rates agree before any fit: generator 2749 / 2092 strikes a year (debris /
+meteoroids, 550 km) against the template's 2754 / 2075, and 2435 / 2147 against 2443 / 2154 at 800 km (within 1
+%).
+
+* pooled 90 % coverage, reported (linear) intervals: debris scale: **88.3 % ± 1.9 %**; meteoroid scale: **88.7 %
+  ± 1.8 %**
+* pooled coverage, ML profile intervals: debris scale: 91.3 %; meteoroid scale: 91.7 %
+* median / truth − 1 at debris 0.3× / 3×: debris scale: −5.2 % / −0.7 %; meteoroid scale: −1.1 % / +3.3 %
+* mean / truth − 1 at debris 0.3× / 3×: debris scale: −3.2 % / −0.0 %; meteoroid scale: +1.8 % / +3.7 %
+
+Both coverages are inside 85-95 %. The medians are within 5 % of the truth but one, the debris scale at 0.3×
+NASA-90/91 (−5.2 %, with a standard error of about 4 % for a spread of ≈ 40 % over 150 fleets: not
+distinguishable from 0). A first run of 50 fleets a truth (same seed, its first third) gave coverage 94.0 % and
+90.0 % and meteoroid medians of −14 % / +12 %, which the 150-fleet run shows to have been chance. The two codes'
+expected detections agree per direction class within 1-2 % (550 km, β = 1.5, this efficiency, a million
+generator draws: debris radial / along-track / cross-track 3.347 / 0.112 / 0.142 a year against the template's
+3.337 / 0.114 / 0.144; meteoroids 0.918 / 0.089 / 0.622 against 0.911 / 0.087 / 0.624), and so do their |ΔH|
+spectra within each class (detections in five |ΔH| ranges from 3 mN·m·s up, per class and population: ratios
+0.95-1.05 with 1.5 million generator draws): the forward model matches the independent physics to the Monte
+Carlo noise. Before the visible-area weighting and the models' own mass laws, a study of this kind by another
+generator measured 81 % and 77.5 %.
 """
 
 from __future__ import annotations

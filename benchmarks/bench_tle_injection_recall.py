@@ -3,7 +3,7 @@
 The TLE detectors are tuned (leave one satellite out) on five real histories; the issue asks for
 recall ≥ 0.9 of LEO burns ≥ 5 cm/s at one false alarm per satellite-year, and will judge abrupt on
 satellites it has not seen. The operator files cannot separate what the detector cannot see from
-what the element sets do not resolve (several burns in one gap between sets, docs/tle.md "What
+what the element sets do not resolve (several burns in one gap between sets, the docstring of abrupt.detect.tle, "What
 stands in the way of 0.9"). Here every burn is alone between element sets and the truth is exact:
 
 * **parametric** histories (:func:`abrupt.simulate.tle_null.simulate_null_history`): LEO at 450, 800

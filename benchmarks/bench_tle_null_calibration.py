@@ -13,7 +13,8 @@ Every history here is maneuver-free, so every event is a false alarm. Two ensemb
   side, ±2-gap localisation) holds no junction between blocks (a junction joins two unrelated
   stretches of slowly correlated noise: an artificial step).
   Quiet = farther than 3 days before / 12 days after every operator maneuver and every maneuver seen
-  in the elements but absent from the operator file (:data:`UNLISTED`, docs/tle.md "GEO false
+  in the elements but absent from the operator file (:data:`UNLISTED`, the docstring of
+  benchmarks/bench_tle_vs_maneuver_detect.py, "GEO false
   alarms"): the operator files only keep maneuvers *out of* the noise blocks.
 
 Both detectors (``tle.mean_elements`` for LEO, ``tle.geo_station_keeping`` for GEO, default
@@ -157,7 +158,8 @@ REAL: dict[str, tuple[str, str]] = {
     "Fengyun-2D": ("manFY2D.txt.fy", "geo"),
     "Fengyun-2E": ("manFY2E.txt.fy", "geo"),
 }
-# Maneuvers the element sets show and the operator files do not list (docs/tle.md, GEO false alarms):
+# Maneuvers the element sets show and the operator files do not list (the docstring of
+# benchmarks/bench_tle_vs_maneuver_detect.py, GEO false alarms):
 # kept out of the noise blocks like the listed ones.
 UNLISTED: dict[str, tuple[str, ...]] = {
     "Fengyun-2D": ("2013-01-05T00:00",),  # the NS burn the file lists on 25 Dec 2012: sets change 4-7 Jan

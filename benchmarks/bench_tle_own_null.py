@@ -1,7 +1,7 @@
 """Does the TLE false-alarm budget hold on each satellite, and does the satellite's own null say so?
 
 For every history the detector runs at a budget of 1 false alarm per satellite-year with its default
-settings and the per-block threshold (``threshold_follow="raise"``, docs/tle.md "A rate per
+settings and the per-block threshold (``threshold_follow="raise"``, the docstring of abrupt.detect.tle, "A rate per
 satellite"), beside the same detector with one whole-history threshold (``"none"``). Printed per
 history, beside the budget:
 

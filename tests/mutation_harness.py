@@ -72,7 +72,7 @@ class ReaderSpec:
     # the records and fields the unit mutations scale where they differ (a unit a producer can get wrong)
     unit_record: Callable[[bytes], bool] | None = None
     unit_fields: tuple[int, ...] | None = None
-    # mutation kind -> why no reader can tell it from valid data (each is listed in docs/formats.md)
+    # mutation kind -> why no reader can tell it from valid data (each is listed in the docstring of abrupt.readers)
     beyond_reach: dict[str, str] = field(default_factory=dict)
 
 

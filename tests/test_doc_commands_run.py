@@ -93,7 +93,6 @@ DOC_INPUTS: dict[str, dict[str, di.Maker]] = {
     },
     "flux-inference.md": {
         "STORE": di.store,
-        "store": di.store,
         "sc.toml": di.example("kestrel.toml"),
         "sc_surfaces.toml": di.example("kestrel_surfaces.toml"),
         "other_events.csv": di.other_detector_events,
@@ -152,7 +151,7 @@ KILLED: dict[tuple[str, str], int] = {("scale.md", "killed after"): 1}
 
 #: Documents whose fenced blocks are separate runs (each block in a folder of its own): a second block
 #: repeats the first on real data under the same output names.
-BLOCKS_APART = {"flux-inference.md"}
+BLOCKS_APART: set[str] = set()
 
 #: Documents run in the default suite (cheap commands); the others are marked slow.
 FAST_DOCS = {"attitude-detection.md", "catalog.md", "density.md", "rates.md", "tle.md", "tracking.md"}

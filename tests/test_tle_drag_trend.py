@@ -1,4 +1,5 @@
-"""Drag-consistent trend of the mean semi-major axis in low LEO (docs/tle.md "Drag-consistent trend").
+"""Drag-consistent trend of the mean semi-major axis in low LEO (the docstring of abrupt.detect.tle,
+"Drag-consistent trend").
 
 Independent truths: the maneuver-free simulated histories hold no maneuver (every event is a false
 alarm, compared with the stated budget); the injected burn's time and in-track ΔV are known; the

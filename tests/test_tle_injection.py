@@ -1,5 +1,5 @@
 """Burns injected into element-set histories whose truth is exact (full study:
-``benchmarks/bench_tle_injection_recall.py``, docs/tle.md "Injected burns").
+``benchmarks/bench_tle_injection_recall.py``, the docstring of benchmarks/bench_tle_injection_recall.py).
 
 The independent truths: the injected burn's time and ΔV, Kepler's third law for the along-track
 drift it starts (the generator bends the phase at the burn, not at the gap between sets), and

@@ -4,7 +4,7 @@ The histories come from :mod:`abrupt.simulate.tle_null` (a smooth LEO or GEO orb
 heavy-tailed, serially correlated noise, bad sets, irregular cadence and long gaps), which does not
 know the detector; the independent truth is that they hold no maneuver. The realised rate per
 satellite-year is compared with the budget the threshold was set for (the full study:
-``benchmarks/bench_tle_null_calibration.py``, docs/tle.md "Null calibration").
+``benchmarks/bench_tle_null_calibration.py``, the docstring of benchmarks/bench_tle_null_calibration.py).
 """
 
 from __future__ import annotations

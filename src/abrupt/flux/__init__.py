@@ -60,10 +60,11 @@ Library: `abrupt.flux.days` (`one_exposure_per_day`, `reference_signal`, `bin_ef
 `store_spacecraft_model`, `load_spacecraft_models`), `abrupt.flux.forward` (`ForwardConfig`, `build_template`),
 `abrupt.flux.inference` (`prepare`, `Likelihood` with `reweighted` event weights, `fit` → `FitResult.estimates`,
 `.signed_estimates`, `.corrected_estimates` and `.penalised_estimates`, `cox_snell_bias`, `bias_corrected`,
-`upper_limit`, `poisson_upper_limit`, `goodness_of_fit`), `abrupt.flux.linear` (`linear_fit` → `LinearResult`
-with `estimates`, `standard_errors`, `intervals`; `linear_estimates`; `in_physical_range`, `below_zero_notes`;
-`FitResult.linear_estimates`, `.standard_errors`, `.linear_intervals`, `.linear_in_range()`, `.reported()`),
-`abrupt.flux.notes` (`beta_free_note`, `UNBIASED_YEARS`, `IDENTIFIED_NOTE`), `abrupt.flux.firth`
+`expected_events_intervals`, `headline()`), `abrupt.flux.limits` (`upper_limit`, `expected_above`,
+`false_alarms_above`, `poisson_upper_limit`, `goodness_of_fit`), `abrupt.flux.linear` (`linear_fit` →
+`LinearResult` with `estimates`, `standard_errors`, `intervals`; `linear_estimates`; `in_physical_range`,
+`below_zero_notes`; `FitResult.linear_estimates`, `.standard_errors`, `.linear_intervals`, `.linear_in_range()`,
+`.reported()`), `abrupt.flux.notes` (`beta_free_note`, `UNBIASED_YEARS`, `IDENTIFIED_NOTE`), `abrupt.flux.firth`
 (`penalised_estimates`: the Jeffreys-penalised estimate in (ln s, ln β)), `abrupt.flux.showers`,
 `abrupt.simulate.population` (`FleetSpec`, `fleet_exposure`, `draw_population`), `abrupt.pipelines.flux`
 (`infer_flux`, `simulate_population`, `flight_exposure`, `altitude_from_period_km`).
@@ -232,8 +233,9 @@ Cost: one template per distinct model
 
 A template depends on the spacecraft description and the orbit, not on the spacecraft's name: exposure rows
 whose stored descriptions have the same TOML text (SHA-256) share one template (`share_identical_models`), so 50
-identical craft under 50 names cost one template per orbit. Benchmark: `nice python
-benchmarks/bench_flux_fleet_cost.py` (figures under *Measured figures*).
+identical craft under 50 names cost one template per orbit. Benchmark: `python
+benchmarks/bench_flux_fleet_cost.py` (4.4 s of CPU for 1 000 spacecraft-years of 50 craft under 50 names;
+*Measured figures*).
 
 What the data constrain: the β / flux-scale degeneracy
 ------------------------------------------------------
@@ -391,12 +393,13 @@ N·m·s/β below 0.03 falls off them):
 Nothing tried therefore replaces the reported point estimates: the ML estimate (with its profile interval, whose
 coverage holds, acceptance 1 below), the bias-corrected β, and for the debris scale of fit A its median or the
 identified product s_debris·T_d(β).
-* **Upper limits** (`upper_limit`, reported at 95 % for each population, all |ΔH| and |ΔH| ≥ 0.1 N·m·s): with
-  few or no events the Wilks approximation fails (for n = 0 it gives μ = 1.35 instead of 3.0), so the limit is
-  the exact Poisson one on the number of signal events, CLs by default (P(N ≤ n | s S₁ + b)/P(N ≤ n | b) = 1 −
-  CL) or Neyman (P(N ≤ n | s S₁ + b) = 1 − CL), and s_up = signal limit / S₁ with S₁ the expected detections at
-  scale 1 through the exposure. With no events, s_up S₁ = −ln 0.05 = 2.996 for any background (CLs). The limit
-  is at a stated β (default 1), because with β free a missing detection can always be blamed on a small β.
+* **Upper limits** (`upper_limit`, reported at 95 % for each population and each `--limit-dH`, default all
+
+with few or no events the Wilks approximation fails (for n = 0 it gives μ = 1.35 instead of 3.0), so the limit
+is the exact Poisson one on the number of signal events, CLs by default (P(N ≤ n | s S₁ + b)/P(N ≤ n | b) = 1 −
+CL) or Neyman (P(N ≤ n | s S₁ + b) = 1 − CL), and s_up = signal limit / S₁ with S₁ the expected detections at
+scale 1 through the exposure. With no events, s_up S₁ = −ln 0.05 = 2.996 for any background (CLs). The limit is
+at a stated β (default 1), because with β free a missing detection can always be blamed on a small β.
 * **Goodness of fit** per flux model (NASA-90/91 + Grün, NASA-90/91 only, Grün only, all at scale 1 and the
   reference β, and the free fit): Poisson deviance of the |ΔH| histogram, p-value from 2 000 histograms
   simulated from that model, and the exact two-sided p-value of the total count. For the fitted model the
@@ -516,4 +519,29 @@ not theirs. Two further caveats of this run: the strike geometry of SC-A is assu
 (`examples/spacecraft/kestrel_surfaces.toml`: the archive gives no dimensions), and the recovery injections
 start at 5 mN·m·s, above this spacecraft's noise floor (4 mN·m·s), so the efficiency curve below 5 mN·m·s is an
 extrapolation (one event at 0.7 mN·m·s lies where the curve says ε ≈ 0); inject smaller sizes to measure it.
+
+Limits
+------
+
+* β is a constant multiplier of a reference MEF model; a speed- or surface-dependent β is a choice of reference
+  model (`--mef` of the rates package is fixed per run), not fitted.
+* With β fixed the reported scales are the linear ones, whose weights are fixed at the published models (s = 1):
+  their bias and coverage are measured for truths 0.3-3 × NASA-90/91 with Grün (above); far from the published
+  models (the flight-like archive's 10³ ×) they stay unbiased, but their spread exceeds the ML's and the
+  coverage of the score interval there is not measured. Setting the reference from an independent earlier data
+  set is not offered on the command line (`linear_fit(..., reference=...)` in the library); taking it from the
+  same data would bring back the ML's bias.
+* The size-to-mass law is a fixed choice (`--mass-model`); its uncertainty is not propagated. Run the inference
+  with several laws to see it, as the rates trades do.
+* Template Monte Carlo noise, the smoothing kernel and the local power law of the bin efficiency are not in the
+  intervals; they matter only when the data are many (free β, see above).
+* The measured |ΔH| is used as exact (no measurement error in the likelihood; the smoothing is a crude
+  stand-in); events with no exposure day are left out and counted.
+* Direction classes need ΔH in the orbit frame (`dH_O_r_Nms`, `dH_O_t_Nms`, `dH_O_n_Nms` columns) and `attitude
+  = orbit` exposure; catalog events of `detect attitude` carry inertial ΔH only, so they enter through |ΔH|.
+* The strike geometry travels with the catalog (`spacecraft_models`); re-storing a spacecraft under the same
+  name replaces its description for all of its rows (the rows keep no version of it).
+* The flux models are orbit-averaged; no shower term in the forward model (the shower test is a separate
+  association test); the meteoroid directions are isotropic outside the Earth's shadow cone (no apex or Sun-side
+  structure: the rates package does not model it).
 """

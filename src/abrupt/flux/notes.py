@@ -1,4 +1,4 @@
-"""What a fit with β free measures, said beside its estimates (docs/flux-inference.md, "With β free").
+"""What a fit with β free measures, said beside its estimates (the docstring of abrupt.flux, "With β free").
 
 A |ΔH| spectrum fixes each population's expected detections s_p·T_p(β); β itself is measured weakly (from
 the meteoroids when their scale is fixed at Grün, or from the spectrum's curvature), and a flux scale taken

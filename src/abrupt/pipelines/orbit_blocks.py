@@ -16,7 +16,8 @@ the settling time and two steps into each neighbour (:func:`extended_block`), so
 to a seam, which a lone arc cannot test, are tested against the block's threshold. Each block keeps
 the events whose time lies in it. Cost and memory are those of one block at a time: linear in the span.
 
-Compared with the same span run as separate arcs (docs/orbit.md, "Long spans"): on the epochs the arcs
+Compared with the same span run as separate arcs (the docstring of abrupt.detect.orbit, "Long spans"): on the
+epochs the arcs
 test, the tuning and the calibration sample are the same and the statistic differs only by the decay of
 the filters' start-up transient (the block's filters start a settling time earlier), so thresholds
 and events agree up to knife-edge ties; within the settling time of each seam the block run tests

@@ -101,8 +101,15 @@ location:
   and forward-most, the thesis algorithm at zero grid spacing (numba);
 * `point_cloud` (thesis): face and panel grid points (spacing ≤ 0.7 × grid), projected, rasterised at the grid
   spacing (default 1/6 of the smallest dimension), Q-slice by cell count, uniform R-cell, forward-most point.
-  Effective area: `--area thesis` (Eqs. 5.15-5.18 with the total array area, erratum A14) or `--area silhouette`
-  (flux-weighted mean projected area, from ray casting).
+* `visible` (`--location visible --area silhouette`; the flux inference's forward model): a surface element
+  facing the flow drawn ∝ its projected area, a point on it, a ray toward the source; the draw carries the
+  facing area when unshadowed, 0 when shadowed, so strikes follow flux × visible area per direction. The two
+  methods above draw the direction by flux alone: their total rate is right but a direction from which the craft
+  looks large gets no more strikes than one from which it looks small (docs/flux-inference.md, *Strikes weighted
+  by flux × visible area*; `tests/test_flux_visible_area.py`).
+
+Effective area: `--area thesis` (Eqs. 5.15-5.18 with the total array area, erratum A14) or `--area silhouette`
+(flux-weighted mean projected area, from ray casting).
 
 Checks against the sources (tests in `tests/test_rates_*.py`)
 -------------------------------------------------------------
@@ -140,4 +147,21 @@ that quote Ψ(45°) = 0.990 and Ψ(52°) = 1.030 "from the table", which this ta
 (0.990 and 1.034). **The nodes at 28.5-60° are thus corroborated only indirectly and those at 70-100° not at
 all**: check them against Kessler et al. (1991) or ECSS-E-10-04A before quoting NASA-90/91 rates for inclined
 orbits above 60° (the polar and sun-synchronous cases).
+
+Limitations
+-----------
+
+* The analytic debris model is NASA-90/91, a 1991 model; it is valid to 2000 km, has no density classes and no
+  uncertainty (use `--flux-sigma-factor` for an assumed one), and its velocity/direction model rests on an
+  assumed inclination mix. For current environments use ORDEM or MASTER output through the table format. The
+  ORDEM importer is keyed on header words and was tested on files written in the documented layout, not on real
+  ORDEM output (none was available offline); check the column mapping it prints.
+* Ψ(i) above 60° is unverified (see above); the 2.5 g/cm³ meteoroid density is the one the Grün sizes are
+  computed with, and the flux inference's default mass law for meteoroids uses the same value. The meteoroid
+  speed distribution is SSP 30425's rather than ECSS Table C-1 (not available offline).
+* Fluxes are orbit-averaged; no polar enhancement, no meteoroid streams, no seasonal variation. Size and
+  direction are drawn independently unless a table gives them jointly (the format does not).
+* Circular orbits only; body frame = orbit frame; arrays rotate about their drive axis only.
+* Particles larger than the table's largest size are counted in the strike rate but never drawn (negligible for
+  the analytic tables, which go to 1 m).
 """

@@ -63,7 +63,7 @@ METEOROID_DENSITY_KG_M3 = 2500.0  # [kg m^-3] assumed meteoroid bulk density for
 # Ψ(i): inclination function of NASA-90/91 (Kessler et al. 1991; ECSS-E-10-04A Annex), i in degrees; linear
 # interpolation between nodes, constant outside. Typed in without a copy of the table: the 28.5-60° nodes agree
 # with values quoted by independent implementations (Ψ(45°) = 0.990, Ψ(52°) = 1.030); 70-100° are unverified
-# (docs/rates.md, "Checks against the sources").
+# (the docstring of abrupt.rates, "Checks against the sources").
 _PSI_INCLINATION_DEG = np.array([28.5, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0, 100.0])
 _PSI_VALUE = np.array([0.91, 0.92, 0.96, 1.02, 1.09, 1.26, 1.18, 1.00, 0.98])
 

@@ -1,4 +1,4 @@
-"""Readers: files into arrays and typed series, every repair counted, every error naming file, line
+r"""Readers: files into arrays and typed series, every repair counted, every error naming file, line
 and column (docs/formats.md).
 
 Orbits → `Ephemeris`
@@ -127,9 +127,11 @@ Each check names itself in the error (`L27: outside the orbit envelope (speed be
   step in one record, an epoch 1-10 km off); counter: `single-epoch position outlier (disagrees with both
   neighbours) removed`
 * velocity = derivative of position (the SP3 check above, in m and m/s): OEM, OPM, CPF and navigation CSV too:
-  outcome: all-zero velocities: **error**; a power-of-ten ratio (OEM velocities in m/s: 10⁻³; CSV velocities in
-  km/s: 10³): rescaled; another ratio: **error**; counter: `velocities off by a power of ten, positions intact
-  (rescaled by 1e+3)`, `epoch whose velocity disagrees with its neighbours' positions (removed with them)`
+  outcome: all-zero velocities: **error**; one epoch's zero vector: that epoch removed; a power-of-ten ratio
+  (OEM velocities in m/s: 10⁻³; CSV velocities in km/s: 10³): rescaled; another ratio: **error**; counter:
+  `velocities off by a power of ten, positions intact (rescaled by 1e+3)`, `epoch whose velocity disagrees with
+  its neighbours' positions (removed with them)`, `epoch with a zero velocity vector in a file with velocities
+  (removed)`
 * speed below escape: v²/2 − μ/r < 0 with the inertial velocity (an Earth-fixed one plus ω × r): outcome:
   **error** (an SP3 scaled ×1.5); counter: —
 * dynamics of the stated frame: the acceleration the states imply (central difference of the velocities, or
@@ -218,10 +220,49 @@ Plausibility checks of other inputs, and outputs
 * telemetry archive (`abrupt.readers.archive`): check: values that are infinite or beyond 1e20 in magnitude
   (above any 64-bit counter); outcome: removed, counted per spacecraft-day in the ingest report; counter:
   `infinite or absurd values (|v| > 1e20)`
-* every command (`abrupt.cli.commands`): check: an `--out` that resolves to an input file or to the SQLite
-  catalog, or is a symbolic link; outcome: **error** before anything runs; counter: —
-* every command with an output: check: an `--out` that is an existing file; outcome: **error** before anything
+* every command (`abrupt.cli.commands`): check: every output option (`--out`, `--report`, `--statistics-out`,
+  `--fit-out`, `--diagnostics-out`, `--truth`, `--setup-out`, `--json`, `--plot`, `--scatter`, `--write-table`,
+  `--parts`) that is the same file as an input or the SQLite catalog (by path, or by device and inode: a hard
+  link), a symbolic link, a device or pipe, or the same file as another output; a `--catalog` that is an input
+  file; outcome: **error** before anything runs; counter: —
+* every command with an output: check: an output that is an existing file; outcome: **error** before anything
   runs, unless `--overwrite`; counter: —
+* every output (`abrupt.outputs.atomic_output`): check: written beside the target under a hidden temporary name
+  and renamed over it; a path a command derives (`OUT.json`, `OUT.injections.csv`) that is one of the command's
+  inputs; a full disk or read-only folder; outcome: the previous file stays whole, no temporary file is left;
+  the derived input path is an **error**; a full disk is a one-line **error** naming the output; counter: —
+* `detect` commands (`abrupt.catalog`): check: the catalog is opened, created or upgraded and written to (one
+  unchanged row) before the work; an in-memory `sqlite://` catalog; a malformed URL (a port that is not a
+  number); outcome: a read-only or unusable catalog is an **error** before anything is read or written; the
+  events file is renamed into place only after the catalog stored the run, so a catalog that fails leaves no
+  events file; counter: —
+* spacecraft TOML (`abrupt.model.spacecraft.check_mass_properties`): check: the radius of gyration √(I_max/m)
+  against 2 × the radius enclosing the declared surfaces and appendages (30 m without geometry); the trace of
+  the inertia against that of an osmium sphere of the same mass; mass above 1e6 kg; a direction (wheel, gimbal
+  axis, panel normal) whose largest component is above 1 or below 1/√3; outcome: **error** naming
+  `inertia_kgm2`, `mass_kg` or the axis key (an inertia in g·m² or kg·cm² is refused for every shipped
+  spacecraft file); counter: —
+* spacecraft TOML `[orbit]`, `[flight]` (`abrupt.model.flight_config`): check: `period_s` outside Kepler's
+  bounds for an Earth orbit (5069 s at the surface to 2.37e6 s at the Moon); `altitude_km` beyond the Moon;
+  `inclination_deg` above 180; `grid_hz` above 10 Hz or above the fastest attitude channel's `rate_hz`; outcome:
+  **error** naming the key; counter: —
+* attitude telemetry (`abrupt.readers.telemetry`): check: when the attitude moves well above noise, the gyro
+  rates fitted by the rates implied by the quaternions read with the scalar first and with it last; outcome: the
+  other order fitting with a factor within 0.8-1.25 and a third of the declared order's residual is an **error**
+  naming the columns and the `order` to set; counter: —
+* CSV inputs (telemetry, archives, navigation CSV; `abrupt.readers.text.check_column_count`): check: more than
+  20 000 columns in the first line; outcome: **error** naming line 1, before parsing; counter: —
+* OEM XML: check: a document type declaration (entity expansion); outcome: **error** naming its line; character
+  data is joined once per element (linear time); counter: —
+* `.aer`: check: at least 10 AZ_EL lines, all azimuths within 0-2π and elevations within ±π/2; outcome:
+  **error**: radians, the format's unit is degrees; counter: —
+* `detect tracking` (`abrupt.pipelines.tracking.check_span_from_epoch`): check: measurements more than 60 days
+  from the set-up's a-priori epoch; outcome: **error** before any propagation; counter: —
+* archive decoder (`abrupt.readers.archive.read_decoder`): check: a pseudonym that contains or equals a real
+  name of the decoder (case-insensitive), or holds a control character; outcome: **error** naming the lines,
+  never the names; counter: —
+* TLE/OMM names, notes, warnings, `catalog list`: check: control characters (terminal escape sequences, the
+  bell); outcome: written as visible escapes (`\x1b`); counter: —
 * archive ingest with `--spacecraft FILE` (`abrupt.pipelines.flight_checks.physical_bounds`): check: a
   quaternion component beyond 1.1, a body rate beyond 2 rad/s, a wheel speed beyond 1.5 × its wheel's
   `max_speed_rad_s` (each in the channel's declared unit); outcome: removed, counted per day; counter: `values

@@ -27,7 +27,7 @@ a smooth maneuver-free orbit plus noise:
                             maneuvers are not in the blocks.
 
 Neither generator knows the detector; the detector is run on their output and its events are all
-false alarms (``benchmarks/bench_tle_null_calibration.py``, docs/tle.md "Null calibration").
+false alarms (``benchmarks/bench_tle_null_calibration.py``, the docstring of benchmarks/bench_tle_null_calibration.py).
 """
 
 from __future__ import annotations
@@ -79,7 +79,8 @@ class NullHistorySpec:
     bad_set_probability: float = 0.003  # a set with a gross error in every element
     long_gap_probability: float = 0.004  # per set: a gap of 3-10 days follows
     solar_cycle_amplitude: float = 0.8  # LEO drag decay × (1 + amp·sin(2π t / 11 y))
-    # The decay rate each set states (ndot, docs/tle.md "Drag-consistent trend"): the true rate of
+    # The decay rate each set states (ndot, the docstring of abrupt.detect.tle, "Drag-consistent trend"): the
+    # true rate of
     # a × (1 + a per-history scale error, uniform ±``ndot_scale_error``) + a per-history bias
     # (uniform ±``ndot_bias_m_day``) + per-set Student-t noise of robust σ
     # ``ndot_noise_m_day`` + ``ndot_relative_noise`` × |rate|; bad sets get a gross error too.
@@ -148,7 +149,7 @@ def _smooth_orbit(spec: NullHistorySpec, t_days: NDArray[np.float64], rng: np.ra
         # What is left of the 13.66-day lunar and 182.6-day solar terms in *mean* elements: SDP4's
         # deep-space periodics (Hoots & Roehrich 1980, dpper) take out most of their osculating
         # 5e-5 / 1.5e-4 rad; the Fengyun-2D/2E histories keep 1-4e-6 / ~1-2.5e-5 rad (amplitudes
-        # fitted after a 61-set running median; docs/tle.md "Injected burns").
+        # fitted after a 61-set running median; the docstring of benchmarks/bench_tle_injection_recall.py).
         lunar = 4e-6 * np.sin(2 * math.pi * t_days / 13.66 + rng.uniform(0, 6.3))
         solar = 2.5e-5 * np.sin(2 * math.pi * t_days / 182.6 + rng.uniform(0, 6.3))
         n1 = i0 * math.cos(d0) + drift + lunar

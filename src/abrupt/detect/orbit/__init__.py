@@ -599,4 +599,49 @@ Method notes and sources
   estimates agree to < 0.1 %. The GLR ΔV is worse on real data (median error 51 %). Its 10-sample window is
   short next to τ = 600 s, and the DMC states take up part of the jump within the window. The cause of its
   along-track bias was not investigated further.
+
+Limitations
+-----------
+
+- Positions-only arcs get their starting velocities for auto tuning from the positions; a file whose positions
+  are rounded coarsely relative to its sampling gives a noisier tuning.
+- Nuisance parameters (drag/SRP scales, once-per-rev accelerations) are estimated only with `--nuisance` (off by
+  default; see "Estimated nuisance parameters" for what they change and what they do not). Solid tides are not
+  modelled.
+- The STM uses the two-body + J2 gradient only.
+- Self-calibrated thresholds extrapolate a generalised-Pareto tail from one arc. The upper-bound rule (z = 1)
+  keeps false alarms down: on the Sentinel-3A arc there are 0 with every statistic, down from 2. The price is
+  sensitivity on short arcs. On 1-2 day arcs at 60 s the threshold can be 2-3× the point estimate, and for a 5
+  mm/s injection this was enough to miss 2 of 30. With `--null` and a long event-free arc of the same satellite,
+  the threshold stays low.
+- The interval ΔV estimate is limited by how well the DMC tracks the unmodelled acceleration over one sampling
+  interval. At 60 s on a LEO orbit the median error is 2.7 % for 5 mm/s. An estimator that fits the navigation
+  velocities directly (propagate each state to the jump time, then fit a step plus a polynomial) was tried and
+  dropped. The unmodelled acceleration changes by ~1e-4 m/s² over 10 minutes, too fast for a low-order
+  polynomial (median error 40 %).
+- The GLR ΔV (`dv_glr_*`) is good when the dynamics match (simulation). On real data it is biased and noisy
+  (median error 51 %), and the cause of its along-track bias was not found.
+- The thesis-study zonal model (J2-J4) is applied about the GCRF z axis; the EGM2008 field is rotated with the
+  full IAU 2006/2000A matrices. MSIS uses geocentric latitude.
+- An impulse within the settle time at either end of an arc is not evaluated. Neither is one inside a gap longer
+  than the GLR window. A gap longer than half a revolution ends one analysed arc and starts another
+  (`abrupt.pipelines.orbit_blocks.data_arcs`): the filters do not propagate across it, and the run's warnings
+  name it. An arc shorter than twice the settle time is not an error: the run is recorded with no events, a
+  warning gives both spans, and the summary says nothing was tested.
+- Every orbit file passes the physical envelope of `abrupt.readers.orbit_envelope` before analysis
+  (docs/formats.md, "The orbit envelope"): outliers of one record are removed and counted, unit slips of the
+  velocities by a power of ten rescaled and counted, impossible orbits refused.
+- A satellite without propulsion (the passive geodetic satellites of `abrupt.model.propulsion`, by name or id,
+  or `--no-propulsion`): the run states the |ΔV| its model explains (radiation pressure with C_R = 2 plus 35 %
+  albedo over the GLR window, plus the 90 % detectable ΔV); detections within it are dropped, those above it are
+  kept as kind `unknown` and named as bad input or a force the model lacks.
+- Product discontinuities are recognised only at UTC midnights, from the statistic's pattern (two or more
+  boundaries above the threshold); boundaries announced in a file's header or comments, joins of predicted
+  segments at other epochs (ISS OEM), and a product with a single interior boundary are not treated. A burn
+  within a boundary window judged nuisance is found only when it exceeds the bound from the other boundaries (a
+  few times the typical boundary jump).
+- Burn sequences: burns closer than about 30 min, or overlapping finite burns, can be located as one merged jump
+  between them; they are then reported as one event with the merged ΔV and no flag.
+- The null benchmark has no long real geodetic arc (the LAGEOS files of the corpus are 1-91 epochs); the
+  geodetic class is shown with simulated daily-arc products.
 """

@@ -59,7 +59,7 @@ def self_calibrate(
 ) -> dict[str, Threshold]:
     """Thresholds from the arc itself when no event-free reference exists (real data).
 
-    Procedure (documented in docs/orbit.md; nothing depends on a particular satellite):
+    Procedure (documented in the docstring of abrupt.detect.orbit; nothing depends on a particular satellite):
     1. robust location and scale: median and the normal-consistent MAD of the statistic over the valid
        epochs, after a transform that makes a positive statistic nearly normal: the Wilson-Hilferty cube
        root of its chi-square form (Wilson & Hilferty 1931; ``glr`` is χ²₃-like under no jump: s^(1/3);

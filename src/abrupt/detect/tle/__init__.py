@@ -479,6 +479,109 @@ Scored with the intervals (column `f1_intervals`, LOSO, same events): Jason-3 0.
 0.90 (0.88): events more than a day from the operator's time whose interval holds it (which ones is not itemised
 here; on GEO the stale sets of "GEO false alarms one by one" are candidates).
 
+Older catalogue eras: blended sets, outlier sets, arcs
+------------------------------------------------------
+
+In the older public catalogue each element set was fitted over several days of tracking, so a burn reaches the
+sets over days: the sets whose fit spans contain it carry part of the change (a **blend**), later sets all of
+it, and the step the detector sees lies in the gap where most of the change arrives, one to three sets after the
+burn. Timed at that step, burns came out late, and the segmentation could accept the blend's gaps as two or
+three burns (`abrupt.detect.tle.response`; `ramp_times`, `in_blend` in `abrupt.detect.tle.maneuvers`):
+
+* **A set as a fit over its span.** A set fitted by a straight line in time to the along-track angle over `[t_k
+  − S, t_k]` carries, of a burn's mean-motion change at `t_b`, the fraction `f = 3ρ² − 2ρ³`, `ρ = (t_k − t_b)/S`
+  clipped to [0, 1] (the least-squares slope through a hinge; checked against numerical least-squares fits,
+  `tests/test_tle_response.py`). Around every in-track step the sets are split into an old level of `a`, up to
+  three blends (each carrying 0.1-0.9 of the change, rising with time) and a new level, by least squares with a
+  penalty of 25 (5 σ) per blend; a blend is looked for only when the step is 20 σ of the window's own scatter of
+  `a` away from the step (a fraction resolved to about ±1/4). The window reaches over weaker accepted steps
+  within four gaps (they may be the same burn's blend).
+* **The fit span of an era.** Each step with two or more blends gives the span `S` that fits its `a` best; the
+  span at a time is the median of those within half a year (at least three; else that era's sets do not blend
+  and its burns keep the along-track time of method item 6), their smallest and largest its uncertainty. Jason-3
+  and Sentinel-3A have no such era; CryoSat-2 has one, 2010-06 to 2012-06, with spans of 3.0-6.0 days (and
+  isolated ramps later).
+* **Time and interval.** A step with a blend is timed by fitting `a_k = c₀ + c₁τ_k + Δa·f` for every burn time
+  inside the first blend's span; the least cost is the time; the interval joins the times within `κ·χ²₁(0.9)` of
+  the least cost (profile likelihood, `κ` the median reduced χ² of the history's fits) at the era's median,
+  smallest and largest span, never narrower than the grid step. It holds the time by construction.
+* **One burn, one event.** In an era whose sets blend, a weaker step inside a stronger step's blend (between its
+  last old and first new set) is merged into it. Elsewhere two burns in consecutive gaps look the same in `a`,
+  so the rule is not applied (it cost Jason-3 and CryoSat-2 burns of their campaigns when it was).
+* **Outlier sets** (`abrupt.detect.tle.outliers`): a set 30 robust σ off the line through both its neighbours,
+  the neighbours agreeing (`|y_{k+1} − y_{k−1}| ≤ |r|/2`), the sets beyond them on that line, and no step of `a`
+  over the five sets, is counted (`noise_model["outlier_sets"]`, `outlier_epochs_utc`) and printed by `detect
+  tle` (6, 5, 3, 51 and 61 sets on Jason-3, Sentinel-3A, CryoSat-2, Fengyun-2D, Fengyun-2E; at 10 σ the LEO
+  histories flagged 2-5 % of their sets, campaign sets among them). In GEO the outliers are left out of the
+  detection (FY-2D F1 0.909 → 0.930: two false alarms gone). In LEO they stay in: the RAAN residual and the
+  along-track phase integrate each set's own secular rates from set to set, so taking a set out changes every
+  later value (on the simulated 450 km null histories of `tests/test_tle_drag_trend.py` false alarms rose from 3
+  to 23, all at the removed sets; suppressing the steps next to an outlier instead lost four real Fengyun-2E
+  burns); the median step test is robust to one set (a 2 km bad set makes no event,
+  `tests/test_tle_outliers.py`).
+* **Arcs.** A gap between sets longer than `max_bridge_days` (20, the reach of the step test's windows) ends one
+  analysed arc and starts another; each arc is detected on its own (noise, threshold, outliers) and no event is
+  stated inside the gap (`noise_model["arcs"]`, `["unbridged_gaps"]`; `detect tle` prints each gap). Tested with
+  a 2 m/s burn inside a 300-day gap (`tests/test_tle_outliers.py`).
+* **Records outside the physical envelope** (`abrupt.readers.tle_checks.check_orbit_envelope`): a set whose
+  perigee `a(1 − e)` is inside the Earth (e = 0.9999999), whose apogee is beyond the Moon's distance or whose
+  epoch is more than a day in the future (2056) is a malformed record: skipped and counted, or an error naming
+  file and line with `--strict`. A kilobytes-long 3LE name line is a one-line error naming the line (it used to
+  hide the file's format: "not an OMM file").
+
+`abrupt score` with `--elements` prints, beside the full recall, the **recall above the stated floor** (operator
+burns whose in-track or cross-track ΔV reaches the smallest detectable ΔV the run states for their year; a file
+without ΔV counts every burn) and the **unmatched detections per calendar year** beside the stated rate. `abrupt
+detect tle` prints each year's smallest detectable ΔV and threshold (as before).
+
+**Measured** (`python benchmarks/bench_tle_timing.py`; default settings, budget 1/year, ±1 day one-to-one;
+offsets and interval coverage over the pairs within ±3 days). Jason-1 (2001-2013) is held out: every choice
+above was made on the other five histories and on simulated histories, and Jason-1 was run **once**, at commit
+`da6fc98` (response timing, outliers, arcs; before the span uncertainty of the intervals and the one-burn merge,
+which were made afterwards on CryoSat-2 and the simulated 4-day-span history and not run on Jason-1).
+`docs/results/bench_tle_timing.txt` and the figure are that run. Before → after (training histories: final
+code):
+
+* **Jason-1 (held out, at `da6fc98`)**: P: 0.53 → 0.60; R: 0.33 → 0.37; F1: 0.41 → 0.45; R burns ≥ 2 cm/s: 0.30
+  → 0.30 (44); R above floor: 0.44 → 0.50; median |Δt| (d): 0.78 → 0.57; > 1 d late: 21 → 15 of 57; coverage:
+  0.71 → 0.51; unmatched / yr: 2.97 → 2.44
+* Jason-3: P: 0.94; R: 0.80; F1: 0.865; R burns ≥ 2 cm/s: 0.62 (13); R above floor: 0.82; median |Δt| (d):
+  0.085; > 1 d late: 0; coverage: 1.00; unmatched / yr: 0.30
+* Sentinel-3A: P: 0.98; R: 0.90; F1: 0.938; R burns ≥ 2 cm/s: 0.85 (26); R above floor: 0.90; median |Δt| (d):
+  0.042; > 1 d late: 0; coverage: 0.94; unmatched / yr: 0.15
+* CryoSat-2: P: 0.973 → 0.964; R: 0.665 → 0.659; F1: 0.790 → 0.783; R burns ≥ 2 cm/s: 0.66 → 0.66 (58); R above
+  floor: 0.83; median |Δt| (d): 0.125 → 0.104; > 1 d late: 2; coverage: 0.87 → 0.93; unmatched / yr: 0.24 → 0.32
+* Fengyun-2D: P: 0.91 → 0.95; R: 0.91; F1: 0.909 → 0.930; R burns ≥ 2 cm/s: (no ΔV); R above floor: 0.91; median
+  |Δt| (d): 0.197 → 0.162; > 1 d late: 0; coverage: 0.85; unmatched / yr: 0.47 → 0.24
+* Fengyun-2E: P: 0.83; R: 0.92; F1: 0.871; R burns ≥ 2 cm/s: (no ΔV); R above floor: 0.92; median |Δt| (d):
+  0.183 → 0.165; > 1 d late: 3 → 2; coverage: 0.915 → 0.935; unmatched / yr: 1.18
+
+![Offset from the operator epoch per shared history](tle_timing.png)
+
+*Offsets (event − operator epoch) of the one-to-one pairs within ±3 days; each title gives the median |Δt|, the
+interval coverage of the operator epochs, the full recall and the recall above the stated floor (run at
+`da6fc98`).*
+
+The leave-one-satellite-out benchmark (`python benchmarks/bench_tle_vs_maneuver_detect.py --no-baseline`, final
+code): LEO pooled TP/FP/FN 192/8/71, F1 0.83 (before: 194/6/69, 0.838; CryoSat-2 0.79 → 0.78 with 0.40 unmatched
+per year), GEO 64/10/6, F1 0.89 (before: 64/12/6, 0.88); the table of "Measured figures" above is the earlier
+run.
+
+CryoSat-2's first era shows what the response model does: nine burns of 2011-05 to 2012-05 that were timed
+0.4-0.9 days late are now 0.0-0.3 days late; one burn of October 2012, after the era's sets stopped blending but
+within half a year of its last ramps, is timed 1.5 days early (the cost in F1 above). On a simulated 800 km
+history whose sets are least-squares fits over 4 days (eight 10-20 cm/s burns; `tests/test_tle_response.py`)
+every burn is one event, timed within 0.02 days, its interval holding the burn.
+
+**What does not hold.** On Jason-1 the acceptance asks for a median |Δt| under 0.3 days, precision ≥ 0.85 and
+recall ≥ 0.8 of burns ≥ 2 cm/s at ±1 day, and the interval coverage of every history within 85-95 %: measured
+(at `da6fc98`) 0.57 days, 0.60, 0.30 and 0.51 — none holds. The response model moved Jason-1's burns earlier (21
+→ 15 more than a day late), but its intervals were far too narrow there (coverage 0.71 → 0.51; the span
+uncertainty added afterwards widens them, unmeasured on Jason-1), and the burns ≥ 2 cm/s that Jason-1 misses are
+not found at all rather than found late (recall unchanged). Jason-3's coverage is 1.00 (its intervals reach back
+a TLE lag of about a day). Not done: the own-null rate per era (the detector prints each year's threshold and
+floor; the realised rate per year is printed by `abrupt score`).
+
 What the element sets cannot see
 --------------------------------
 
@@ -492,4 +595,63 @@ when both its in-track and cross-track |ΔV| are. Jason-3: 2 of 40 below; CryoSa
 sub-cm/s trims), neither flagged; a history whose listed burns are mostly below is flagged
 (`test_history_whose_burns_are_below_what_its_sets_resolve_is_flagged`: burns at a tenth of the stated size
 flagged, at ten times not).
+
+Limitations
+-----------
+
+* The own-null check (`detect tle`) under-predicts the false-alarm rate of dense, noisy histories (5 sets a day,
+  8× noise: 0.26-1.03 predicted, 1.8 realised): its 60-set blocks are shorter than the noise's correlation
+  there. On LEO the realised rate is well below the budget (0.19 per satellite-year held out): the threshold is
+  conservative, not calibrated two-sided.
+* Campaign burn counts: burns in one gap at nearly the same argument of latitude look like one burn (their
+  e-vector change is that of one), and three or more burns in one gap count two (28 of 30 held-out acquisition
+  trials met all criteria; the total ΔV was within 0.2 % in all). The simulated campaigns have no TLE lag: on
+  real histories a set fitted across a burn spreads it over two gaps, each counted.
+
+* Burns inside one gap between element sets cannot be separated; a campaign is reported as one detection
+  (labelled with its campaign) whose ΔV is the sum, with the interval it covers and `burns_max`. Inside a
+  campaign the step is a median over sides of two or three sets that may hold the neighbouring burn's level: ΔV
+  of a campaign burn can be off by half a neighbour's ΔV (synthetic campaign test: −145 m for a −97 m step).
+  Burns two element sets apart are found (segmentation) and timed from their own two sets; burns one set apart
+  only with a side of one set (not the default: on real histories TLE convergence over several sets adds false
+  alarms). A set fitted across a burn can still make a second, duplicate event where the segment is too short
+  for the middle-set test (fewer than three sets before or two after) and the partial mean motion does not
+  reverse the order of the two times.
+* The middle-set test compares a set's along-track deviation with the phase series' set-to-set noise; a
+  calibration of that scale on the history's quiet sets (as for the element groups) was tried and lowered
+  CryoSat-2's F1 (more blends kept as two burns), so it is not used.
+* Along-track phasing pairs are found when their phase step stands out of the satellite's own phase noise
+  (CryoSat-2: 4.9 km found, 0.5 km not); their ΔV is not observable and reported as 0.
+* TLE inclination that ramps over the producer's fit span instead of stepping (Sentinel-3A's first weeks) is not
+  seen: no ramp-shaped test.
+* Radial ΔV and the signs of radial and cross-track ΔV are poorly observable from mean elements; two-burn
+  in-track pairs half an orbit apart that leave `a` unchanged are seen only in the e-vector (which the gain γ =
+  0.2 de-emphasises) and in the along-track phase (3 Δv × half a period: small).
+* **Burns closer than ~15 element sets apart throughout a history** break the per-satellite noise model: the
+  first pass tests every gap with windows of 6 sets each side that reach over the neighbouring burns, so most
+  gaps are burn flanks (the group weights come out small and the threshold lands on the flanks). Measured on
+  injected ±5 cm/s burns at 800 km (4 histories of 3 years each, `simulate_null_history`): at 0.3 sets per day,
+  burns every 30 days (9 sets) all missed, every 45 days (14 sets) 44 of 92 missed (the threshold runs to
+  141-150 on two of the four), every 60 days (18 sets) or more all found; at 1 set per day, every 30 days all
+  found. Campaigns (several burns within days, then weeks of quiet, as CryoSat-2's) are not affected: the
+  medians behind the weights ignore them. A second pass that re-learns the weights and the threshold from the
+  segmented statistic when fewer than 50 gaps are free of flanks was tried and did not help (misses unchanged,
+  false alarms up); not kept.
+* Near-circular formulas: for eccentric orbits ΔV magnitudes are approximate.
+* GEO north-south burns: the shared files hold two (one each); both are found, but the GEO cross-track
+  sensitivity (smallest detectable ≈ 0.9-1.3 m/s from the i-vector noise) is untested beyond them.
+* The threshold's false-alarm rate is extrapolated from a few hundred gaps per year; short histories (< 1 year)
+  scatter by a factor of 2. Null calibration (above): within 2× of a budget of 1 per satellite-year on every
+  simulated LEO and GEO history (largest cell 1.1 per year); the one cell that failed, strong varying drag with
+  dense sets (450 km, 3 sets/day: 7.2 per year with the local straight-line trend alone), is fixed by the
+  drag-consistent trend (1.0 per year), which no real low-LEO history has checked yet (ISS reboosts and
+  continuous low thrust put thrust into the sets' ndot, which the 5-set median only partly removes); budgets
+  above ~1 per 2 months are conservative (the threshold's floor of 3 and clustered exceedances: 1/month gives
+  0.02-0.3 of it).
+* GEO: element sets still on the pre-burn orbit for 1-10 days after a burn (stale sets) and gross single sets
+  after a burn move the event later than the burn (4 of 70 operator windows more than a day off) and can split
+  one burn into two events; what was tried against them is listed in "GEO false alarms one by one".
+* Epochs are UTC (as SGP4 defines them); OMM in another time system is rejected.
+* Tuning: the five shared satellites; held-out figures above. The detector will be judged on other satellites of
+  the same benchmark: nothing refers to these files.
 """

@@ -182,11 +182,19 @@ Laser ranging (ILRS CRD, SINEX): `abrupt detect laser`
     abrupt detect laser lageos1.npt --apriori lageos1.cpf --out laser.csv \
         --false-alarms 0.1/day [--sinex ilrs.snx] [--without troposphere ...] [--fit-out fit.json]
 
-**The a-priori orbit is required** (`--apriori`: a CPF prediction from the ILRS data centres, or any OEM/SP3
-that covers the ranges): the fit linearises the ranges about it and a few normal points cannot start an orbit of
-their own. The shared `lageos1-test.npt` (2021, stations 1893 and 7839) has no CPF at hand, so `abrupt detect
-laser` on it stops at the a-priori check after resolving its stations from the bundled file; the doc test runs
-this command on a simulated day of LAGEOS-1 normal points instead.
+**The a-priori orbit is required** (`--apriori`: a CPF prediction from the ILRS data centres, any OEM/SP3 that
+covers the ranges, or TLE/3LE/OMM element sets): the fit linearises the ranges about it and a few normal points
+cannot start an orbit of their own. Element sets are propagated by SGP4 (the set nearest each arc's start, at
+most 30 days away; TEME to GCRF with ERFA, within 5 m of astropy's) and, since they are hundreds of metres to
+kilometres off, first fitted to the arc's own ranges over a short arc (6, 12, 24, 48 h: the state only; the
+growth stops before a span that leaves more than 1 m, i.e. one holding a maneuver) before detection
+(`abrupt.pipelines.laser_apriori`); `--fit-out` reports each arc's SGP4 offset and short-arc RMS. On a simulated
+LAGEOS day from a TLE 9 km off at its epoch (50 km and 20 m/s at the first range two hours later) the fitted
+state is within 9 mm and 6 µm/s of the truth and the run is as quiet as from a precise a-priori; over two days a
+(3, 8, −5) mm/s burn is found at its time with its ΔV within 20 % (`tests/test_laser_apriori_elements.py`). The
+shared `lageos1-test.npt` (2021, stations 1893 and 7839) has no CPF at hand, so `abrupt detect laser` on it
+stops at the a-priori check after resolving its stations from the bundled file; the doc test runs this command
+on a simulated day of LAGEOS-1 normal points instead.
 
 **Station coordinates come with abrupt**: without `--sinex`, the ILRS SLRF2014 positions and velocities of all
 179 SLR stations (release 2020-04-28; `abrupt/data/ilrs/`, Apache-2.0 via Orekit's test resources, provenance
@@ -285,4 +293,43 @@ fit diverge (overflow); the batch fit now halves a Gauss-Newton step that raises
 `docs/results/bench_slr_lageos.txt`.
 
 A 30-day run takes about 2 minutes of one core (simulation 20 s, five 7-day arcs).
+
+Plausibility (`abrupt.pipelines.laser_plausibility`). Before the fit, each station's one-way ranges are compared
+with the geometric ranges from its site to the a-priori ephemeris: a median ratio more than 1 % from 1 (ranges
+×0.001 or ×6, or the a-priori of another satellite) is an error naming the station and the ratio. The CRD `C0`
+wavelength sets the troposphere of each range (Mendes & Pavlis 2004 dispersion: 1064 nm gives 0.955 of the 532
+nm delay); a wavelength outside 300-1200 nm is an error naming the line. After the fit, a range bias beyond 1 m
+or a force scale outside its physical range (radiation pressure 0.66-2.2 of the a-priori C_R·A/m: C_R between 1
+and 2, A/m within 25 %; drag 0.33-3) means the fit absorbs what its model cannot explain: the arc's detections
+are reported as kind `unknown` with the parameters named, not as maneuvers. A passive satellite (CRD target
+name, or `--no-propulsion`) has every detection judged against the ΔV radiation pressure and albedo can
+accumulate over the longest gap between ranges: within it dropped, above it kind `unknown`, never a burn.
+
+Limitations
+-----------
+
+* Cross-track burns fix only the new orbit plane (node line and tilt r·Δv/h): epochs half an orbit apart fit
+  almost equally and the Δv scales with r(τ). The GLRT reports the alternative epoch and Δv (`alternative_*`
+  columns); with one near-equatorial station the primary solution's magnitude error is 18–32 % (median), the
+  best of the reported set 3–11 %.
+* Below ~0.5 cm/s detections are real (no false alarms in null arcs) but magnitude estimates are poor (median
+  error 36–260 % at 0.2 cm/s).
+* `detect tracking` runs the batch GLRT on the whole file (one arc); `detect laser` cuts long files into
+  overlapping arcs (above). At most `--max-maneuvers` impulses per arc; burns are modelled as impulses (finite
+  burns of 100 s are well represented; long low-thrust arcs are not).
+* `detect tracking` (TDM, .aer) with a real-data set-up applies two-way light time (first order in v/c: within 5
+  mm of the iterative solution for a GTO, `tests/test_tracking_light_time.py`), the Saastamoinen troposphere in
+  the standard atmosphere (no meteorology comes with radio files) and refraction; no ionosphere (a few metres at
+  S-band for low elevations); station biases absorb the constant parts. Simulation set-ups (no
+  central/third-body keys) keep the thesis's instantaneous model.
+* Time biases: `BatchFitConfig(estimate_time_bias=...)` estimates a per-station offset of the range time tags
+  (∂ρ/∂δt = −ρ̇); a common offset of all stations is an along-track shift of the orbit and cannot be seen, so
+  with all stations estimated the one with the most ranges is the time reference (its offset fixed at zero;
+  estimating all four of a LAGEOS day made the normal matrix singular, offsets of −13 s ± 470 s). `abrupt detect
+  laser --time-biases` switches it on; `detect tracking` does not.
+* The EKF follows the thesis literally (Q = 0 below Ψ = 10⁵), so on real data with unmodelled forces its Ψ is
+  inflated; use the GLRT and the fit's acceleration for real data.
+* The K–Δv calibration is scenario specific (thesis §4.2); the default calibration (thesis apogee transverse log
+  fit) is only meaningful for that scenario.
+* TDM: KVN only (no XML), AZEL angles only, range in km only.
 """
