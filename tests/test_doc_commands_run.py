@@ -66,7 +66,8 @@ INPUTS: dict[str, di.Maker] = {
     "manFY2D.txt.fy": di.copy_shared("maneuvers/manFY2D.txt.fy"),
     "manFY2E.txt.fy": di.copy_shared("maneuvers/manFY2E.txt.fy"),
     "ssas3a20.b18358.e19003.DG_.sp3": di.sp3_slice(epochs=480),  # 8 h: the filter settles 3.3 h at each end
-    "orbit.sp3": di.sp3_slice("2018-12-29T08:00", 240),  # the docs inject at 2018-12-29T10:00:30
+    # 12 h: the filter settles for 3.3 h at each end; the docs inject at 2018-12-29T10:00:30, inside
+    "orbit.sp3": di.sp3_slice("2018-12-29T04:00", 720),
     "gbm18432.sp3.Z": di.copy_shared("sp3/orekit-corpus/gbm18432.sp3.Z"),
     "W3B.aer": di.copy_shared("tracking/W3B.aer"),
     "od_test_W3.in": di.copy_shared("tracking/od_test_W3.in"),

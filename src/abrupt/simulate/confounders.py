@@ -440,13 +440,18 @@ def _add_appendage_angle(s: _Samples, spacecraft: Spacecraft, c: Confounder) -> 
 
 def stored_wheel_momentum_B(s: _Samples, spacecraft: Spacecraft, t_ns: int, span_s: float = 20.0) -> FloatArray:
     """The wheels' momentum Σ J_s Ω ĝ [N·m·s] in body axes over the ``span_s`` before ``t_ns`` (median of
-    each wheel's raw reading with the changes of the confounders injected so far)."""
+    each wheel's raw reading with the changes of the confounders injected so far); NaN where no wheel
+    reading falls in that span."""
     assert spacecraft.flight is not None
     speeds = np.zeros(len(spacecraft.wheels))
+    seen = False
     for ch in spacecraft.flight.of("wheel_speed"):
         sel = s.rows(ch.mnemonic, t_ns - int(span_s * NS), t_ns)
         if sel.size:
+            seen = True
             speeds[ch.component] = float(np.median(s.values[sel] * ch.to_si + s.wheels.d[sel]))
+    if not seen:  # these samples do not reach the onset: the stored momentum is not known here
+        return np.full(3, np.nan)
     return np.asarray((spacecraft.wheel_axes * spacecraft.wheel_spin_inertias_kgm2[None, :]) @ speeds)
 
 
@@ -490,7 +495,10 @@ def inject_confounders(
     # In time order: a dump aims at the wheels' momentum as every earlier confounder left it.
     for c in sorted(confounders, key=lambda c: c.time_ns):
         if c.kind == "momentum_dump" and "direction_B" not in c.params:
-            c = aimed_dump(c, stored_wheel_momentum_B(s, spacecraft, c.time_ns))
+            stored = stored_wheel_momentum_B(s, spacecraft, c.time_ns)
+            if not np.all(np.isfinite(stored)):
+                continue  # a dump whose onset these samples do not reach unloads nothing in them
+            c = aimed_dump(c, stored)
         if CONFOUNDER_CLASS[c.kind] == "sensor_fault":
             _add_sensor_fault(s, spacecraft, c)
         else:
