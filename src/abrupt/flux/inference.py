@@ -24,7 +24,7 @@ so a thousand spacecraft-years cost no more than a few.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -642,6 +642,24 @@ def _beta_interval(logb: NDArray[Any], ll: NDArray[Any], level: float, notes: li
     return lo, hi
 
 
+def _level_crossings(f: Callable[[float], float], x_hat: float, *, first_step: float) -> tuple[float, float]:
+    """Where ``f`` (the profile minus its interval level, negative at the estimate ``x_hat`` ≥ 0) crosses
+    zero below and above ``x_hat`` on [0, ∞): 0 when it stays below zero down to 0, ∞ when it stays below
+    zero over 80 doublings of ``max(x_hat, first_step)``."""
+    lo = 0.0
+    if x_hat > 0 and f(0.0) < 0:
+        lo = float(optimize.brentq(f, 0.0, x_hat, xtol=1e-5 * max(x_hat, 1e-12), rtol=1e-4))
+    hi_b = max(x_hat, first_step) * 2.0
+    for _ in range(80):
+        if f(hi_b) < 0:
+            break
+        hi_b *= 2.0
+    else:
+        return lo, math.inf
+    hi = float(optimize.brentq(f, max(x_hat, 0.0), hi_b, xtol=1e-5 * hi_b, rtol=1e-4))
+    return lo, hi
+
+
 def _expected_interval(
     lik: Likelihood, p: int, d_hat: float, scale_fixed: Mapping[str, float], level: float
 ) -> tuple[float, float]:
@@ -653,18 +671,7 @@ def _expected_interval(
     def f(v: float) -> float:
         return _profile_value(lik, {**scale_fixed, name: v / totals}) - level  # type: ignore[dict-item]
 
-    lo = 0.0
-    if d_hat > 0 and f(0.0) < 0:
-        lo = float(optimize.brentq(f, 0.0, d_hat, xtol=1e-5 * max(d_hat, 1e-12), rtol=1e-4))
-    hi_b = max(d_hat, 1.0) * 2.0
-    for _ in range(80):
-        if f(hi_b) < 0:
-            break
-        hi_b *= 2.0
-    else:
-        return lo, math.inf
-    hi = float(optimize.brentq(f, max(d_hat, 0.0), hi_b, xtol=1e-5 * hi_b, rtol=1e-4))
-    return lo, hi
+    return _level_crossings(f, d_hat, first_step=1.0)
 
 
 def _scale_interval(
@@ -673,15 +680,4 @@ def _scale_interval(
     def f(v: float) -> float:
         return _profile_value(lik, {**scale_fixed, name: v}) - level
 
-    lo = 0.0
-    if s_hat > 0 and f(0.0) < 0:
-        lo = float(optimize.brentq(f, 0.0, s_hat, xtol=1e-5 * max(s_hat, 1e-12), rtol=1e-4))
-    hi_b = max(s_hat, 1e-3) * 2.0
-    for _ in range(80):
-        if f(hi_b) < 0:
-            break
-        hi_b *= 2.0
-    else:
-        return lo, math.inf
-    hi = float(optimize.brentq(f, max(s_hat, 0.0), hi_b, xtol=1e-5 * hi_b, rtol=1e-4))
-    return lo, hi
+    return _level_crossings(f, s_hat, first_step=1e-3)
