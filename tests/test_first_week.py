@@ -4,6 +4,7 @@ thresholds."""
 
 from __future__ import annotations
 
+import importlib
 import logging
 import os
 import re
@@ -303,6 +304,9 @@ def test_dask_logs_what_the_user_asked_for() -> None:
 
 def test_a_worker_that_dies_is_one_clear_error_naming_the_task() -> None:
     """The task kills its worker process (exit status 3), as an out-of-memory kill would."""
+    # distributed's defaults are loaded first: a dask.config.set made before they exist removes the whole
+    # "distributed" section when it exits, and every later test's Dask cluster then misses its settings
+    importlib.import_module("distributed")
     with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
         with pytest.raises(WorkerLostError, match=r"died while running task 1 of 1 \(3\).*KilledWorker"):
             run_tasks(os._exit, [3], executor=Executor(workers=1))

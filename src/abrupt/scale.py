@@ -168,6 +168,8 @@ def run_tasks(
                 status.update()
             return results
         from distributed import as_completed
+        from distributed.comm.core import CommClosedError
+        from distributed.scheduler import KilledWorker
 
         limit = max_in_flight or (4 * executor.workers if executor.workers else 64)
         with dask_client(executor) as client:
@@ -186,7 +188,7 @@ def run_tasks(
             queue = as_completed(first)
             for future in queue:
                 i = index.pop(future.key)
-                result = task_result(future, i, tasks)
+                result = task_result(future, i, tasks, lost=(KilledWorker, CommClosedError))
                 future.release()
                 take(i, result)
                 bar.update(1)
@@ -197,16 +199,13 @@ def run_tasks(
     return results
 
 
-def task_result(future: Any, index: int, tasks: Sequence[Any]) -> Any:
+def task_result(future: Any, index: int, tasks: Sequence[Any], *, lost: tuple[type[BaseException], ...]) -> Any:
     """The result of task ``index``; :class:`WorkerLostError` (one line, naming the task) when the worker
-    process running it died, instead of Dask's ``KilledWorker`` traceback. A task's own error is raised
-    as it is."""
-    from distributed.comm.core import CommClosedError
-    from distributed.scheduler import KilledWorker
-
+    process running it died (one of Dask's ``lost`` exceptions: ``KilledWorker``, ``CommClosedError``),
+    instead of Dask's traceback. A task's own error is raised as it is."""
     try:
         return future.result()
-    except (KilledWorker, CommClosedError) as exc:
+    except lost as exc:
         task = tasks[index]
         name = getattr(task, "path", None) or getattr(task, "name", None) or repr(task)
         raise WorkerLostError(
