@@ -23,6 +23,12 @@ Keys (SI units, body axes, inertia about the centre of mass including the wheels
     angle_columns = ["sa_angle"]
     angle_unit = "rad"                   # or "deg"
 
+    [[thrusters]]                        # optional: attitude thrusters (the momentum-dump hypothesis)
+    name = "t1"
+    torque_axis = [1, 0, 0]              # direction of the torque one firing gives (r × F̂), body axes;
+                                         # normalised on load. Without thrusters a dump is aimed at
+                                         # −H_w alone (abrupt.detect.attitude.dump_evidence)
+
     [[surfaces]]                         # optional: geometry for strike rates (Bennett 2022 §5.3.3.6)
     name = "bus"
     shape = "box"                        # "box" (size_m = [x, y, z]) or "panel" (size_m = [u, v])
@@ -73,6 +79,7 @@ _TOP_KEYS = {
     "wheels",
     "appendages",
     "surfaces",
+    "thrusters",
     "telemetry",
     "orbit",
     "flight",
@@ -88,6 +95,7 @@ _APPENDAGE_KEYS = {
     "angle_unit",
     "spin_inertia_kgm2",
 }
+_THRUSTER_KEYS = {"name", "torque_axis"}
 _SURFACE_KEYS = {"name", "shape", "size_m", "center_m", "normal", "u_axis", "kind"}
 _TELEMETRY_KEYS = {"time", "quaternion", "body_rate", "wheel_speed"}
 
@@ -127,6 +135,14 @@ class Appendage:
             return self.spin_inertia_kgm2
         a = self.gimbal_axes[0]
         return float(a @ self.inertia_kgm2 @ a)
+
+
+@dataclass(frozen=True)
+class Thruster:
+    """An attitude thruster: the unit direction (body axes) of the torque one firing gives, r × F̂."""
+
+    name: str
+    torque_axis: NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -175,6 +191,7 @@ class Spacecraft:
     lever_arm_m: float = 1.0
     appendages: tuple[Appendage, ...] = ()
     surfaces: tuple[Surface, ...] = ()
+    thrusters: tuple[Thruster, ...] = ()
     telemetry: TelemetryMap = field(default_factory=TelemetryMap)
     source: str = "<memory>"
     orbit: OrbitInfo | None = None
@@ -189,6 +206,13 @@ class Spacecraft:
         if not self.wheels:
             return np.zeros((3, 0))
         return np.column_stack([w.axis for w in self.wheels])
+
+    @property
+    def thruster_torque_axes(self) -> NDArray[np.float64]:
+        """3 x K matrix of the thrusters' unit torque directions (body axes); 3 x 0 when none are described."""
+        if not self.thrusters:
+            return np.zeros((3, 0))
+        return np.column_stack([t.torque_axis for t in self.thrusters])
 
     @property
     def wheel_spin_inertias_kgm2(self) -> NDArray[np.float64]:
@@ -401,6 +425,16 @@ def _wheels(data: dict[str, Any], file: str) -> tuple[Wheel, ...]:
     return tuple(wheels)
 
 
+def _thrusters(data: dict[str, Any], file: str) -> tuple[Thruster, ...]:
+    out = []
+    for i, t in enumerate(data.get("thrusters", [])):
+        where = f"thrusters[{i}]"
+        t = _check_keys(t, _THRUSTER_KEYS, where, file)
+        axis = _unit_vector(_require(t, "torque_axis", where, file), f"{where}.torque_axis", file)
+        out.append(Thruster(name=str(t.get("name", f"thruster{i + 1}")), torque_axis=axis))
+    return tuple(out)
+
+
 def _appendage(a: Any, i: int, file: str) -> Appendage:
     where = f"appendages[{i}]"
     a = _check_keys(a, _APPENDAGE_KEYS, where, file)
@@ -510,6 +544,7 @@ def spacecraft_from_dict(data: dict[str, Any], *, source: str = "<memory>") -> S
     ]
     appendages = tuple(_appendage(a, i, file) for i, a in enumerate(data.get("appendages", [])))
     surfaces = tuple(_surface(s, i, file) for i, s in enumerate(data.get("surfaces", [])))
+    thrusters = _thrusters(data, file)
     telemetry = _telemetry_map(data, wheels, file)
     check_mass_properties(inertia, mass, enclosing_radius_m(surfaces, appendages), file)
     orbit = parse_orbit(data["orbit"], file) if "orbit" in data else None
@@ -526,6 +561,7 @@ def spacecraft_from_dict(data: dict[str, Any], *, source: str = "<memory>") -> S
         lever_arm_m=lever,
         appendages=appendages,
         surfaces=surfaces,
+        thrusters=thrusters,
         telemetry=telemetry,
         source=source,
         defaults=tuple(defaults),

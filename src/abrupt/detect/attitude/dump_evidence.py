@@ -15,6 +15,16 @@ The two hypotheses are compared by the likelihood of the measured direction u = 
   the residuals of the local least-squares step of ᴺH, the ΔH covariance), the noise of the wheels'
   direction, and the spread of the unloading law's aim ``DUMP_AIM_SIGMA_DEG`` (thruster quantisation).
 
+Thruster torque axes, when the spacecraft file describes them (``[[thrusters]]``, ``torque_axis`` a_k):
+a firing of thruster k adds impulse along a_k only, so a dump's ΔH_B = Σ c_k a_k with c_k ≥ 0 lies in the
+convex cone of the axes, and the unloading law can only aim at the point of that cone nearest to −Ĥ_w
+(non-negative least squares, min ‖A c + Ĥ_w‖ over c ≥ 0). The dump's density is then the von
+Mises-Fisher law about that aim d̂ instead of −Ĥ_w, which carries the span of the axes as likelihood: a
+ΔH outside the cone lies far from every aim the thrusters can realise. With a full set of axes (a cone
+that is all of space) d̂ = −Ĥ_w and the test is the stored-momentum test above; where the thrusters
+cannot push against −Ĥ_w at all (A c* = 0) no dump could unload the wheels, and ``dump_log_lr`` is −∞.
+``dump_cone_angle_deg`` is the angle of ΔH_B from the cone (0 inside it), NaN without thrusters.
+
 The log likelihood ratio ``dump_log_lr`` = ln(κ e^(κ cos θ) / sinh κ). Whatever κ is, a direction
 uniform on the sphere exceeds LR = c with probability at most 1 / (e c) (for large κ, LR > c is
 1 − cos θ < ln(2κ/c)/κ, which holds with probability ln(2κ/c)/(2κ) ≤ 1/(e c)): the attribution's limit
@@ -28,6 +38,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.optimize import nnls
 
 from abrupt.detect.attitude.body_response import window_rows
 from abrupt.model.spacecraft import Spacecraft
@@ -57,6 +68,26 @@ def dump_log_lr(cos_theta: float, kappa: float) -> float:
     return math.log(2.0 * kappa) + kappa * (cos_theta - 1.0) - math.log1p(-math.exp(-2.0 * kappa))
 
 
+def cone_projection(axes: FloatArray, v: FloatArray) -> FloatArray:
+    """The point of the convex cone {A c : c ≥ 0} of the columns of ``axes`` (3 x K) nearest to ``v`` (3,):
+    A c* with c* the non-negative least-squares solution of A c ≈ v (zero when the cone points away)."""
+    c, _ = nnls(np.asarray(axes, dtype=np.float64), np.asarray(v, dtype=np.float64))
+    return np.asarray(axes @ c, dtype=np.float64)
+
+
+def cone_angle_deg(axes: FloatArray, u: FloatArray) -> float:
+    """Angle [deg] of the direction ``u`` from the convex cone of the columns of ``axes`` (0 inside it).
+
+    With p the cone's point nearest to the unit u, u·p = |p|² (projection on a convex cone), so the
+    cosine to the nearest direction of the cone is |p|; when p = 0 (u in the polar cone) the nearest
+    direction is one of the axes (u·d̂ ≤ 0 over the cone is largest on an extreme ray)."""
+    u = np.asarray(u, dtype=np.float64) / float(np.linalg.norm(u))
+    cos = float(np.linalg.norm(cone_projection(axes, u)))
+    if cos <= 1e-12:
+        cos = float(np.max(np.asarray(axes).T @ u))
+    return math.degrees(math.acos(float(np.clip(cos, -1.0, 1.0))))
+
+
 def step_with_sigma(g: np.ndarray, h: FloatArray, i0: int, dt: float) -> tuple[FloatArray, FloatArray] | None:
     """ΔH at row ``i0`` (3,) by least squares of a + b τ + s·1(τ ≥ 0) over ± ``STEP_HALF_S`` (the rows in
     ``STEP_GUARD_S`` left out) and its standard error per axis from the fit's residuals (3,)."""
@@ -81,8 +112,10 @@ def dump_evidence(
     """The dump hypothesis's evidence for the event at row ``i0`` with body-frame step ``dh_b`` [N·m·s]:
     the wheels' stored momentum ``wheel_momentum_Nms`` (|H_w,B| before the event), the angle of ΔH_B from
     −H_w,B ``dump_angle_deg`` with its σ ``dump_angle_sigma_deg`` (noise only, without the aim's spread),
-    ``dump_log_lr`` (module docstring) and ``dump_unloads`` (|ΔH| / (2 |H_w| cos θ): below 1 when the
-    wheels' stored momentum shrinks). Empty when the wheels or the momentum do not allow it."""
+    ``dump_log_lr`` (module docstring; about the thrusters' aim when the spacecraft has thruster axes,
+    with ``dump_cone_angle_deg``, the angle of ΔH_B from their cone) and ``dump_unloads`` (|ΔH| /
+    (2 |H_w| cos θ): below 1 when the wheels' stored momentum shrinks). Empty when the wheels or the
+    momentum do not allow it."""
     g, dt, valid = table.time_ns, table.dt_s, table.valid
     om = table.wheel_speed_rad_s
     mag = float(np.linalg.norm(dh_b))
@@ -107,10 +140,18 @@ def dump_evidence(
     sig_noise = math.hypot(sig_dh, sig_hw)
     kappa = 1.0 / (sig_noise**2 + math.radians(DUMP_AIM_SIGMA_DEG) ** 2)
     cos_t = float(np.clip(-(dh_b @ hw) / (mag * hw_mag), -1.0, 1.0))
-    return {
+    out = {
         "wheel_momentum_Nms": hw_mag,
         "dump_angle_deg": math.degrees(math.acos(cos_t)),
         "dump_angle_sigma_deg": math.degrees(sig_noise),
         "dump_log_lr": dump_log_lr(cos_t, kappa),
         "dump_unloads": mag / (2.0 * hw_mag * cos_t) if cos_t > 0 else math.inf,
     }
+    axes = spacecraft.thruster_torque_axes
+    if axes.shape[1]:  # the aim the thrusters can realise (module docstring)
+        aim = cone_projection(axes, -hw / hw_mag)
+        aim_mag = float(np.linalg.norm(aim))
+        cos_aim = float(np.clip(dh_b @ aim / (mag * aim_mag), -1.0, 1.0)) if aim_mag > 1e-12 else math.nan
+        out["dump_log_lr"] = dump_log_lr(cos_aim, kappa) if aim_mag > 1e-12 else -math.inf
+        out["dump_cone_angle_deg"] = cone_angle_deg(axes, dh_b)
+    return out
