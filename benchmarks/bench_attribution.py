@@ -155,8 +155,11 @@ def one_run(
     threshold,
     days: list[str] | None = None,
     near_fraction: float = 0.25,
+    near_before: float = 0.0,
 ):
-    """Inject the plan (and near-strikes), run the pipeline, return the truth rows and the events."""
+    """Inject the plan (and near-strikes), run the pipeline, return the truth rows and the events.
+    A near strike is 20-60 s after the confounder's onset, or (a share ``near_before`` of them) 15-60 s
+    before it."""
     truth = []
     strikes: list[InjectedStrike] = []
     confs = []
@@ -175,13 +178,14 @@ def one_run(
         truth.append({"kind": kind, "class": CONFOUNDER_CLASS[kind], "t_ns": t_ns,
                       "end_ns": t_ns + int(c.duration_s * NS), "size": float("nan"), "near": False,
                       "params": json.dumps({"channel": c.channel, **c.params})})  # fmt: skip
-        if rng.uniform() < near_fraction:  # a strike 20-60 s after the confounder's onset
-            t2 = t_ns + int(rng.uniform(20, 60) * NS)
+        if rng.uniform() < near_fraction:  # a strike 20-60 s after the confounder's onset (or 15-60 s before)
+            before = near_before > 0 and rng.uniform() < near_before  # default draws unchanged
+            t2 = t_ns + int((-rng.uniform(15, 60) if before else rng.uniform(20, 60)) * NS)
             size = float(math.exp(rng.uniform(math.log(0.05), math.log(0.6))))
             u = rng.normal(size=3)
             strikes.append(InjectedStrike(t2, size * u / np.linalg.norm(u)))
             truth.append({"kind": "strike", "class": "strike", "t_ns": t2, "end_ns": t2, "size": size, "near": True,
-                          "near_kind": kind})  # fmt: skip
+                          "near_kind": kind + (" (before)" if before else "")})  # fmt: skip
 
     def hook(s: pd.DataFrame) -> pd.DataFrame:
         # Strikes first: a dump aims at the wheels' momentum as the strikes before it left it.
@@ -225,6 +229,12 @@ def main() -> int:
     ap.add_argument("--kinds", default=None, help="Comma-separated confounder kinds (default: all)")
     ap.add_argument("--days", type=int, default=2, help="Use the first 1 or both days of the set")
     ap.add_argument("--near-fraction", type=float, default=0.25, help="Share of confounders with a strike after")
+    ap.add_argument(
+        "--near-before",
+        type=float,
+        default=0.0,
+        help="Share of the near strikes put 15-60 s before the confounder's onset instead of after",
+    )
     ap.add_argument("--dump", default=None, help="Write each run's events and truth as CSV files into this folder")
     ap.add_argument("--figure", default=None, help="Write the example panels (one event of each kind) to this PNG")
     args = ap.parse_args()
@@ -267,7 +277,9 @@ def main() -> int:
     archive_rows: list[pd.DataFrame] = []
     for run in range(args.runs):
         plan = plan_run(run, args.per_kind, args.runs, slots, rng, kinds)
-        truth, events = one_run(store, sc, plan, ranges, rng, args.seed + run, threshold, days, args.near_fraction)
+        truth, events = one_run(
+            store, sc, plan, ranges, rng, args.seed + run, threshold, days, args.near_fraction, args.near_before
+        )
         m = match(truth, events)
         m["run"] = run
         claimed = set(m["event_index"].dropna().astype(int)) if "event_index" in m else set()
@@ -459,6 +471,7 @@ def report(t: pd.DataFrame) -> None:
     if len(near):
         print(f"  of which within a minute of a confounder: found {(near['got'] != '(none)').mean():.1%}, "
               f"classified strike {(near['got'] == 'strike').mean():.1%} of {len(near)}")  # fmt: skip
+        print(pd.crosstab(near["near_kind"], pd.Categorical(near["got"], categories=classes), dropna=False).to_string())
         if "ev_after_fault_s" in near:
             rescued = near["ev_after_fault_s"].notna()
             print(f"  found only after the neighbouring fault's channel was repaired: {int(rescued.sum())}, "

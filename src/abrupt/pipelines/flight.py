@@ -43,7 +43,7 @@ from abrupt.errors import ConfigError, InputError
 from abrupt.events import config_hash, new_run_id
 from abrupt.model.flight_config import FlightConfig
 from abrupt.model.spacecraft import Spacecraft
-from abrupt.pipelines.flight_attribution import attribute_events, rescan_after_faults
+from abrupt.pipelines.flight_attribution import attribute_events, neighbours_apart, rescan_after_faults
 from abrupt.pipelines.flight_checks import (
     check_channel_units,
     check_quaternion_norm,
@@ -440,6 +440,11 @@ def process_span(
         table, spacecraft, h_n, hc, ok, detector, peaks, evidence, config.evidence_floor, core, inertia_kgm2, fits=fits
     )
     peaks, evidence = peaks + found, {**evidence, **found_ev}
+    beside, beside_ev, revised = neighbours_apart(
+        table, spacecraft, h_n, hc, ok, detector, peaks, evidence, config.evidence_floor, core, inertia_kgm2
+    )
+    peaks = [(i, replace(p, dH_N_Nms=revised[p.time_ns][0]) if p.time_ns in revised else p) for i, p in peaks]
+    peaks, evidence = peaks + beside, {**evidence, **{t: e for t, (_, e) in revised.items()}, **beside_ev}
     faults = scan_span(samples, flight, table, spacecraft, ok, start_ns, end_ns)
     edges = [start_ns, end_ns]
     if split_days:

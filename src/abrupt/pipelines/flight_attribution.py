@@ -41,6 +41,7 @@ from abrupt.detect.attitude.ramp_step import (
     from_body_increments,
 )
 from abrupt.detect.attitude.repair import repair_sensor_fault
+from abrupt.detect.attitude.steps import best_step_beside, local_steps
 from abrupt.events import event_ids, format_time_utc
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import Spacecraft
@@ -409,3 +410,108 @@ def _torque_beside_strike(
     if classify(ev_new, rules).kind != "external_non_strike":
         return None
     return (k_on, p), replace(ev_new, after_strike_s=(p.time_ns - pk.time_ns) / NS)
+
+
+#: Classes whose event is one step of total momentum that a second step beside it may hide (a sensor fault's
+#: event is repaired instead, a ramp's has its direction taken out: :func:`rescan_after_faults`).
+STEP_KINDS = ("strike", "external_non_strike")
+#: A second step nearer than ``SAME_SEQUENCE_S`` [s] and within ``SAME_SEQUENCE_DEG`` of the first's
+#: direction is more of the same change (a dump's further pulses, a venting train's), not a change of its
+#: own: the sibling evidence judges those.
+SAME_SEQUENCE_S = 60.0
+SAME_SEQUENCE_DEG = 20.0
+#: What a second step's own evidence may call it to be kept (a ramp's piece is not a step).
+BESIDE_KINDS = ("strike", "external_non_strike")
+
+
+def _shifted(h: FloatArray, g: np.ndarray, steps: tuple[tuple[int, FloatArray], ...]) -> FloatArray:
+    """``h`` less each (time [ns], ΔH_N) step: a step of total ᴺH from its instant on."""
+    out = h.copy()
+    for t_ns, d_h in steps:
+        out -= (g >= t_ns)[:, None] * np.asarray(d_h)[None, :]
+    return out
+
+
+def neighbours_apart(
+    table: Timetable,
+    spacecraft: Spacecraft,
+    raw_H_N: FloatArray,
+    cleaned_H_N: FloatArray,
+    ok: BoolArray,
+    detector: FlightGlrDetector,
+    peaks: list[tuple[int, Peak]],
+    evidence: Mapping[int, EventEvidence],
+    floor: float,
+    keep: BoolArray | None = None,
+    inertia_kgm2: FloatArray | None = None,
+    rules: AttributionRules | None = None,
+) -> tuple[list[tuple[int, Peak]], dict[int, EventEvidence], dict[int, tuple[FloatArray, EventEvidence]]]:
+    """Second steps of total momentum hidden beside a step's event, both fitted jointly.
+
+    The detector keeps one peak per window span, so a strike 40 s before a momentum dump leaves one event.
+    For every peak whose evidence is a step's (``STEP_KINDS``), its fitted step is taken out of ᴺH and the
+    statistic rescanned where the detector suppressed (one window span around the peak, as after a ramp);
+    a peak above ``floor`` there, more than ``RESCAN_APART_S`` from every peak of ``peaks``, is a second
+    change. The two steps are then fitted together (:func:`~abrupt.detect.attitude.steps.local_steps`),
+    each's evidence taken with the other's step out of ᴺH (raw and cleaned), and the second kept when its
+    evidence calls it a step (``BESIDE_KINDS``) and it is not more of the same change (within
+    ``SAME_SEQUENCE_S`` and ``SAME_SEQUENCE_DEG`` of the first). Returns the new peaks with their evidence
+    (``beside_step_s``: the time after the first event [s]) and, by peak time, the first events' jointly
+    fitted ΔH_N and evidence. Nothing is raised between two changes: the new peak is where the telemetry
+    steps once the first change is out, and an event only above the run's threshold.
+    """
+    g, dt = table.time_ns, table.dt_s
+    win = detector.windows(dt)
+    found: list[tuple[int, Peak, EventEvidence]] = []
+    revised: dict[int, tuple[FloatArray, EventEvidence]] = {}
+    taken = [int(p.time_ns) for _, p in peaks]
+    half_s = RESCAN_SPAN_S[1] + win.span * dt
+    for i_pk, pk in peaks:
+        ev = evidence.get(pk.time_ns)
+        if ev is None or classify(ev, rules).kind not in STEP_KINDS or not np.all(np.isfinite(pk.dH_N_Nms)):
+            continue
+        i0 = int(np.clip(np.searchsorted(g, pk.time_ns), 0, g.size - 1))
+        a, b = max(0, i0 - round((half_s + 240.0) / dt)), min(g.size, i0 + round((half_s + 240.0) / dt))
+        hc_sub = np.where(ok[a:b, None], _shifted(cleaned_H_N[a:b], g[a:b], ((pk.time_ns, pk.dH_N_Nms),)), np.nan)
+        t_pk = int(g[min(i_pk, g.size - 1)])
+        zone = (min(t_pk - int(win.span * dt * NS), pk.time_ns + int(RESCAN_SPAN_S[0] * NS)),
+                max(t_pk + int(win.span * dt * NS), pk.time_ns + int(RESCAN_SPAN_S[1] * NS)))  # fmt: skip
+        avoid = tuple((t, RESCAN_APART_S, RESCAN_APART_S) for t in taken)
+        best = _best_peak(
+            detector, hc_sub, ok[a:b], g[a:b], dt, pk.time_ns, floor, None if keep is None else keep[a:b], zone, avoid
+        )
+        if best is None:
+            continue
+        j, p = best
+        # The second step where it fits best beside the first (the rescan located it beside a first step
+        # sized as if alone), then both sized together.
+        tau1 = int(np.searchsorted(g, pk.time_ns + int(0.5 * dt * NS)))
+        apart = round(RESCAN_APART_S / dt)
+        tau2 = best_step_beside(cleaned_H_N, ok, tau1, a + j - win.pre, a + j + win.span + 1, win.pre, apart)
+        if tau2 < 0:
+            continue
+        t2 = int(g[tau2]) - int(0.5 * dt * NS)
+        if any(abs(t2 - t) <= RESCAN_APART_S * NS for t in taken):
+            continue
+        p = Peak(t2, p.value, p.dH_N_Nms, p.time_sigma_s)
+        s1, s2 = local_steps(cleaned_H_N, ok, (tau1, tau2), win.pre, win.guard)
+        if not (np.all(np.isfinite(s1)) and np.all(np.isfinite(s2))):
+            continue
+        cos = float(s1 @ s2) / max(float(np.linalg.norm(s1) * np.linalg.norm(s2)), 1e-300)
+        if abs(p.time_ns - pk.time_ns) < SAME_SEQUENCE_S * NS and cos > np.cos(np.radians(SAME_SEQUENCE_DEG)):
+            continue
+        ev2 = event_evidence(
+            table, _shifted(cleaned_H_N, g, ((pk.time_ns, s1),)), spacecraft, p.time_ns, s2,
+            inertia_kgm2=inertia_kgm2, raw_H_N=_shifted(raw_H_N, g, ((pk.time_ns, s1),)),
+        )  # fmt: skip
+        if classify(ev2, rules).kind not in BESIDE_KINDS:
+            continue
+        ev1 = event_evidence(
+            table, _shifted(cleaned_H_N, g, ((p.time_ns, s2),)), spacecraft, pk.time_ns, s1,
+            inertia_kgm2=inertia_kgm2, raw_H_N=_shifted(raw_H_N, g, ((p.time_ns, s2),)),
+        )  # fmt: skip
+        found.append((a + j, replace(p, dH_N_Nms=s2), replace(ev2, beside_step_s=(p.time_ns - pk.time_ns) / NS)))
+        revised[pk.time_ns] = (s1, ev1)
+        taken.append(int(p.time_ns))
+    kept, kept_ev, _ = merge_found(found)
+    return kept, kept_ev, revised

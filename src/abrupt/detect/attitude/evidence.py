@@ -43,7 +43,9 @@ telemetry (:class:`~abrupt.series.timetable.Timetable`) around the event:
   second source (a strike during the torque); ``after_torque_s``: for an event found only once the
   ramp's direction was taken out around an external torque's event, its time after that event [s];
   ``after_strike_s``: for a torque's event found only once a strike's fitted step was taken out beside a
-  ramp, its time after the strike's event [s];
+  ramp, its time after the strike's event [s]; ``beside_step_s``: for a step found only once another
+  step's event had its step taken out (two changes within a window span, fitted jointly:
+  :func:`abrupt.pipelines.flight_attribution.neighbours_apart`), its time after that event [s];
 * **alone in its direction** (``alone_step_fraction``, ``alone_step_z``, ``step_siblings``): the
   momentum in body axes fitted by the step at the event plus every other step of the window, found one
   at a time (:func:`abrupt.detect.attitude.ramp_step.step_siblings`); the number of those others
@@ -155,6 +157,7 @@ class EventEvidence:
     step_close_siblings: float = NAN
     alone_step_lasting: float = NAN
     after_strike_s: float = NAN
+    beside_step_s: float = NAN
     wheel_momentum_Nms: float = NAN
     dump_angle_deg: float = NAN
     dump_angle_sigma_deg: float = NAN

@@ -161,3 +161,63 @@ def local_step(h: FloatArray, ok: BoolArray, tau: int, half: int, guard: int) ->
     design = np.column_stack([np.ones(idx.size), u, (idx >= tau).astype(np.float64)])
     coef, *_ = np.linalg.lstsq(design, h[idx], rcond=None)
     return np.asarray(coef[2], dtype=np.float64)
+
+
+def local_steps(h: FloatArray, ok: BoolArray, taus: tuple[int, ...], half: int, guard: int) -> FloatArray:
+    """ΔH at each sample of ``taus`` fitted jointly: least squares of a + b (t − τ̄) + Σ_k s_k 1(t ≥ τ_k)
+    over ``half`` samples before the first τ to ``half`` after the last (τ̄ their mean), leaving out
+    [τ_k − guard/2, τ_k + guard) around each (the controller transient; a third of the nearest two's gap
+    when that is less), as :func:`local_step` does for one. Two changes seconds to minutes apart each get
+    their own size instead of one taking part of the other's. Returns s (k, 3) [N·m·s], all NaN when a
+    step has no sample on one side."""
+    n = h.shape[0]
+    t = np.asarray(sorted(taus), dtype=np.int64)
+    out = np.full((len(taus), 3), np.nan)
+    idx = np.arange(max(0, int(t[0]) - half), min(n, int(t[-1]) + half))
+    keep = ok[idx] & np.all(np.isfinite(h[idx]), axis=1)
+    # Steps nearer than the guard keep a third of their gap each side of each.
+    g = min(guard, int(np.diff(t).min()) // 3) if t.size > 1 else guard
+    for tk in t:
+        keep &= (idx < tk - g // 2) | (idx >= tk + g)
+    idx = idx[keep]
+    on = idx[:, None] >= t[None, :]
+    # Each step needs samples between it and its neighbours on both sides, else it is not identified.
+    sides = np.r_[True, on[:, :-1].sum(axis=0) > on[:, 1:].sum(axis=0)] if t.size > 1 else np.ones(1, bool)
+    if idx.size < 10 + t.size or not on.any(axis=0).all() or on.all(axis=0).any() or not sides.all():
+        return out
+    u = (idx - t.mean()).astype(np.float64) / half
+    design = np.column_stack([np.ones(idx.size), u, on.astype(np.float64)])
+    coef, *_ = np.linalg.lstsq(design, h[idx], rcond=None)
+    order = np.argsort(np.asarray(taus), kind="stable")
+    out[order] = coef[2:]
+    return out
+
+
+def best_step_beside(h: FloatArray, ok: BoolArray, fixed: int, lo: int, hi: int, half: int, apart: int) -> int:
+    """Sample τ in [lo, hi) (at least ``apart`` samples from ``fixed``) where a second step of ᴺH beside
+    the step at ``fixed`` best fits: the model a + b t + s₀ 1(t ≥ fixed) + s 1(t ≥ τ) fitted by least
+    squares over ``half`` samples either side of the span, each axis weighted by its noise; τ maximises
+    the fit's gain, Σ_axes (r_hᵀ r_y)² / r_hᵀ r_h, with r_y, r_h the data and the step of τ less their
+    projection on the rest of the model (one pass of cumulative sums). Returns τ, or -1 when no τ is
+    allowed."""
+    n = h.shape[0]
+    a, b = max(0, min(fixed, lo) - half), min(n, max(fixed, hi) + half)
+    idx = np.arange(a, b)
+    good = ok[idx] & np.all(np.isfinite(h[idx]), axis=1)
+    idx = idx[good]
+    if idx.size < 20:
+        return -1
+    y = h[idx] / np.where((s := robust_noise_sigma(h[idx])) > 0, s, 1.0)
+    base = np.column_stack([np.ones(idx.size), (idx - idx.mean()) / max(half, 1), (idx >= fixed).astype(np.float64)])
+    q, _ = np.linalg.qr(base)
+    r_y = y - q @ (q.T @ y)
+    # Sums over the samples at or after each position k (a step at idx[k] covers idx[k:]).
+    tail_q = np.cumsum(q[::-1], axis=0)[::-1]
+    tail_y = np.cumsum(r_y[::-1], axis=0)[::-1]
+    count = np.arange(idx.size, 0, -1, dtype=np.float64)
+    rh2 = count - np.sum(tail_q**2, axis=1)
+    gain = np.sum(tail_y**2, axis=1) / np.where(rh2 > 1e-9, rh2, np.inf)
+    allowed = (idx >= lo) & (idx < hi) & (np.abs(idx - fixed) >= apart)
+    if not allowed.any():
+        return -1
+    return int(idx[np.flatnonzero(allowed)[np.argmax(gain[allowed])]])
