@@ -25,7 +25,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from Basilisk.architecture import messaging
 from Basilisk.fswAlgorithms import attRefCorrection, attTrackingError, hillPoint, mrpFeedback, rwMotorTorque
-from Basilisk.simulation import GravityGradientEffector, extForceTorque, reactionWheelStateEffector, simpleNav, spacecraft
+from Basilisk.simulation import (
+    GravityGradientEffector,
+    extForceTorque,
+    reactionWheelStateEffector,
+    simpleNav,
+    spacecraft,
+)
 from Basilisk.utilities import RigidBodyKinematics as rbk
 from Basilisk.utilities import SimulationBaseClass, macros, orbitalMotion, simIncludeGravBody, simIncludeRW
 
@@ -40,6 +46,7 @@ class Piece:
     start_s: float
     end_s: float
     torque_B_Nm: np.ndarray
+    tag: str = ""
 
 
 @dataclass
@@ -289,7 +296,9 @@ def mrp_to_quaternion(sigma: np.ndarray) -> np.ndarray:
     return q
 
 
-def slew_profile(start_s: float, axis_B: np.ndarray, angle_deg: float, ramp_s: float, hold_s: float) -> list[SlewCommand]:
+def slew_profile(
+    start_s: float, axis_B: np.ndarray, angle_deg: float, ramp_s: float, hold_s: float
+) -> list[SlewCommand]:
     """Reference offsets each second: a smooth (1 - cos) ramp out to ``angle_deg`` about ``axis_B``, hold,
     ramp back to nadir."""
     out: list[SlewCommand] = []
@@ -316,3 +325,23 @@ def dcm_BN(sigma: np.ndarray) -> np.ndarray:
     sk = sk - np.transpose(sk, (0, 2, 1))
     eye = np.eye(3)[None]
     return eye + (8 * sk @ sk - 4 * (1 - s2)[:, None, None] * sk) / ((1 + s2) ** 2)[:, None, None]
+
+
+@dataclass
+class Design:
+    """One spacecraft: true dynamics, catalogue values and sensors."""
+
+    name: str
+    vehicle: Vehicle
+    inertia_catalogue: np.ndarray
+    pyramid_axis: str
+    wheel_elevation_deg: float
+    tach_pulses: int
+    tach_gate_s: float
+    gyro_noise_rad_s: float
+    gyro_bias_walk_rad_s15: float
+    st_rate_hz: float
+    st_noise_arcsec: float
+    st_boresight_factor: float
+    st_boresight_B: np.ndarray
+    thruster_torque_Nm: float
