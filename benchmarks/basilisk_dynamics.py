@@ -83,7 +83,7 @@ class Vehicle:
     gain_K: float
     gain_P: float
     background_torque_B_Nm: np.ndarray  # constant aerodynamic-like torque, fixed in the (nadir) body
-    dyn_dt_s: float = 0.1
+    dyn_dt_s: float = 0.25
     fsw_dt_s: float = 0.5
 
 
