@@ -54,7 +54,18 @@ from pathlib import Path
 
 import numpy as np
 
-from basilisk_dynamics import Design, Piece, Record, SlewCommand, Trigger, Vehicle, dcm_BN, simulate, slew_profile
+from basilisk_dynamics import (
+    Design,
+    Piece,
+    Record,
+    SlewCommand,
+    Trigger,
+    Vehicle,
+    dcm_BN,
+    simulate,
+    slew_profile,
+    whole_inertia,
+)
 from basilisk_sensors import DAY_S, START_ISO, gyro, housekeeping, iso_utc, star_tracker, tachometers, write_archive
 from basilisk_sensors import Channel as Channel
 
@@ -520,7 +531,7 @@ def generate_one(out: Path, index: int, days: int, seed: int, strikes_per_day: i
         "events": events,
         "operations": ops,
         "archive_artefacts": counts,
-        "true_inertia_kgm2": design.vehicle.inertia_kgm2.tolist(),
+        "true_inertia_kgm2": whole_inertia(design.vehicle).tolist(),
         "basilisk_wall_s": round(wall, 1),
     }
     (out / "truth_events.json").write_text(json.dumps(_jsonable(truth), indent=1))

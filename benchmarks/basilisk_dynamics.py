@@ -125,14 +125,20 @@ def _initial_nadir(vehicle: Vehicle) -> tuple[np.ndarray, np.ndarray, np.ndarray
     return r, v, np.asarray(rbk.C2MRP(hn)), np.array([0.0, 0.0, n]), 2 * np.pi / np.sqrt(MU_EARTH_M3_S2 / oe.a**3)
 
 
-def simulate(
-    vehicle: Vehicle,
-    duration_s: float,
-    pieces: list[Piece],
-    triggers: list[Trigger],
-    slews: list[SlewCommand],
-) -> Record:
-    """Run the closed loop for ``duration_s`` with the given torque timeline; return the truth record."""
+@dataclass
+class _Sim:
+    """The Basilisk objects the run loop touches."""
+
+    sim: SimulationBaseClass.SimBaseClass
+    rw_eff: reactionWheelStateEffector.ReactionWheelStateEffector
+    ext: extForceTorque.ExtForceTorque
+    corr: attRefCorrection.attRefCorrection
+    logs: tuple
+    keep: list
+
+
+def _build(vehicle: Vehicle) -> _Sim:
+    """The spacecraft, its environment and its flight software, wired by messages."""
     sim = SimulationBaseClass.SimBaseClass()
     dyn, fsw = sim.CreateNewProcess("dyn", 2), sim.CreateNewProcess("fsw", 1)
     dyn.addTask(sim.CreateNewTask("dynTask", macros.sec2nano(vehicle.dyn_dt_s)))
@@ -226,6 +232,21 @@ def simulate(
         sim.AddModelToTask("dynTask", log)
 
     sim.InitializeSimulation()
+    keep = [sc, grav, gg, rw_factory, nav, hill, err, veh_msg, rw_param_msg, ctrl, motor]
+    return _Sim(sim, rw_eff, ext, corr, (state_log, speed_log, mom_log), keep)
+
+
+def simulate(
+    vehicle: Vehicle,
+    duration_s: float,
+    pieces: list[Piece],
+    triggers: list[Trigger],
+    slews: list[SlewCommand],
+) -> Record:
+    """Run the closed loop for ``duration_s`` with the given torque timeline; return the truth record."""
+    bsk = _build(vehicle)
+    sim, rw_eff, ext, corr = bsk.sim, bsk.rw_eff, bsk.ext, bsk.corr
+    state_log, speed_log, mom_log = bsk.logs
     n_wheels = len(vehicle.wheel_axes_B)
     js_g = vehicle.wheel_spin_inertia_kgm2 * vehicle.wheel_axes_B  # (n, 3)
 
@@ -286,6 +307,14 @@ def simulate(
         H_N=np.asarray(mom_log.totRotAngMomPntC_N),
         applied=applied,
     )
+
+
+def whole_inertia(vehicle: Vehicle) -> np.ndarray:
+    """The whole spacecraft's inertia [kg m^2]: the hub's plus the balanced wheels' rigid inertia
+    (Basilisk's rwFactory sets the transverse inertia Jt = Js / 2; the wheels sit at B)."""
+    js = vehicle.wheel_spin_inertia_kgm2
+    extra = sum(js * np.outer(g, g) + 0.5 * js * (np.eye(3) - np.outer(g, g)) for g in vehicle.wheel_axes_B)
+    return np.asarray(vehicle.inertia_kgm2 + extra)
 
 
 def mrp_to_quaternion(sigma: np.ndarray) -> np.ndarray:

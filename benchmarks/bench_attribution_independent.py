@@ -1,6 +1,6 @@
 """Is it a strike, on spacecraft abrupt has never seen: attribution scored on the independent Basilisk set.
 
-    /work/venv-floors/bin/python benchmarks/bench_attribution_independent.py --set DIR
+    PYTHONPATH=src python benchmarks/bench_attribution_independent.py --set DIR [--label NAME] [--work DIR]
 
 Draw the set first (needs Basilisk):
 
@@ -256,6 +256,7 @@ def details(rows: list[dict]) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--set", dest="set_dir", type=Path, required=True, help="folder of spacecraft folders")
+    ap.add_argument("--label", default="", help="suffix of the result file (docs/results/..._LABEL.txt)")
     ap.add_argument("--work", type=Path, default=None, help="stores and events (default: SET/_abrupt)")
     args = ap.parse_args()
     work = args.work or args.set_dir / "_abrupt"
@@ -281,7 +282,8 @@ def main() -> None:
 
 if __name__ == "__main__":
     sys.path.insert(0, str(Path(__file__).resolve().parent))
-    from _results import variant, write_results
+    from _results import write_results
 
-    with write_results("bench_attribution_independent", variant({"--days=1": "1day"})):
+    label = sys.argv[sys.argv.index("--label") + 1] if "--label" in sys.argv[:-1] else ""
+    with write_results("bench_attribution_independent", label):
         main()

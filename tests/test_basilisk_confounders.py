@@ -11,18 +11,11 @@ import pytest
 
 pytest.importorskip("Basilisk")
 
-from Basilisk.utilities import RigidBodyKinematics as rbk  # noqa: E402
-from basilisk_confounders import draw_design, net_momentum_N  # noqa: E402
-from basilisk_dynamics import Piece, dcm_BN, simulate  # noqa: E402
-from basilisk_sensors import quaternion_from_dcm, tachometers  # noqa: E402
+from Basilisk.utilities import RigidBodyKinematics as rbk
 
-
-def _whole_inertia(design) -> np.ndarray:  # type: ignore[no-untyped-def]
-    """Hub inertia plus the balanced wheels' rigid inertia (Basilisk's rwFactory: Jt = Js / 2)."""
-    v = design.vehicle
-    js = v.wheel_spin_inertia_kgm2
-    extra = sum(js * np.outer(g, g) + 0.5 * js * (np.eye(3) - np.outer(g, g)) for g in v.wheel_axes_B)
-    return np.asarray(v.inertia_kgm2 + extra)
+from basilisk_confounders import draw_design, net_momentum_N
+from basilisk_dynamics import Piece, dcm_BN, simulate, whole_inertia
+from basilisk_sensors import quaternion_from_dcm, tachometers
 
 
 @pytest.fixture(scope="module")
@@ -35,7 +28,7 @@ def run() -> tuple:  # type: ignore[type-arg]
 
 
 def test_strike_steps_basilisk_momentum_by_the_applied_impulse(run: tuple) -> None:  # type: ignore[type-arg]
-    design, impulse_B, rec = run
+    _, impulse_B, rec = run
     expected_N = net_momentum_N(rec, "ev0")
     assert np.linalg.norm(expected_N) == pytest.approx(np.linalg.norm(impulse_B), rel=1e-9)
     i0, i1 = np.searchsorted(rec.t1_s, [99.0, 102.0])
@@ -49,7 +42,7 @@ def test_momentum_from_the_recorded_state_is_basilisks(run: tuple) -> None:  # t
     (a wrong sign or frame is off by ~1 N m s; Basilisk's own figure is logged between integrator stages,
     a few 1e-5 N m s apart, far below a tachometer quantum)."""
     design, _, rec = run
-    j = _whole_inertia(design)
+    j = whole_inertia(design.vehicle)
     js_g = design.vehicle.wheel_spin_inertia_kgm2 * design.vehicle.wheel_axes_B
     k = np.searchsorted(rec.t_s, rec.t1_s[5:-1])
     h_b = rec.omega_BN_B[k] @ j.T + rec.wheel_speed_rad_s[k] @ js_g
