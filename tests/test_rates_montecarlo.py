@@ -214,3 +214,33 @@ def test_cli_reports_bad_input_as_errors(tmp_path: Path) -> None:
     assert "nomass.toml" in str(res.exception)
     res = runner.invoke(cli, ["rates", "flux", "--altitude-km", "500", "--sizes-m", "-0.01"])
     assert isinstance(res.exception, ConfigError)
+
+
+def test_cli_places_strikes_by_flux_times_visible_area_by_default(tmp_path: Path) -> None:
+    """`abrupt rates run` without --location is the flux inference's forward model (visible placement, measured
+    area); the thesis's placement stays available and takes the thesis's area; a placement and an area that do
+    not go together are refused."""
+    runner = CliRunner()
+    base = ["rates", "run", "--spacecraft", SMALLSAT, "--draws", "4000", "--metric", "dH"]
+
+    def table(name: str, *extra: str) -> object:
+        import pandas as pd
+
+        res = runner.invoke(cli, [*base, *extra, "--out", str(tmp_path / name)])
+        assert res.exit_code == 0, res.output
+        return pd.read_csv(tmp_path / name)
+
+    default = table("default.csv")
+    visible = table("visible.csv", "--location", "visible", "--area", "silhouette")
+    thesis = table("thesis.csv", "--location", "silhouette")
+    assert set(default["location"]) == {"visible"} and set(default["area"]) == {"silhouette"}
+    np.testing.assert_allclose(default["detectable_per_year"], visible["detectable_per_year"], rtol=0, atol=0)
+    assert set(thesis["location"]) == {"silhouette"} and set(thesis["area"]) == {"thesis"}
+    res = runner.invoke(cli, [*base, "--location", "visible", "--area", "thesis"])
+    assert isinstance(res.exception, ConfigError) and "area" in str(res.exception)
+    res = runner.invoke(
+        cli,
+        ["rates", "trade", *base[2:], "--location", "silhouette", "--vary", "location=silhouette,visible",
+         "--out", str(tmp_path / "trade.csv")],
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output

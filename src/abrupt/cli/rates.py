@@ -131,11 +131,12 @@ SCENARIO_OPTIONS = [
     click.option("--seed", type=int, default=0, show_default=True, help="Random seed (reproducible)."),
     click.option(
         "--location",
-        type=click.Choice(["silhouette", "point_cloud", "visible"]),
-        default="silhouette",
+        type=click.Choice(["visible", "silhouette", "point_cloud"]),
+        default="visible",
         show_default=True,
-        help="Strike-location method: the thesis's (direction by flux, point on its silhouette), or 'visible' "
-        "(strikes weighted by flux × visible area per direction, as the flux inference; needs --area silhouette).",
+        help="Strike placement: 'visible' (strikes weighted by flux × visible, unshadowed area per direction, the "
+        "flux inference's forward model; area from the same draws), or the thesis's, which draws the direction by "
+        "flux alone and the point on its silhouette ('silhouette': exact, 'point_cloud': the thesis's grid).",
     ),
     click.option(
         "--grid-spacing-m",
@@ -146,9 +147,9 @@ SCENARIO_OPTIONS = [
     click.option(
         "--area",
         type=click.Choice(["thesis", "silhouette"]),
-        default="thesis",
-        show_default=True,
-        help="Effective area: thesis Eqs. 5.15-5.18 or mean silhouette.",
+        default=None,
+        help="Effective area: thesis Eqs. 5.15-5.18 or mean silhouette (default: silhouette with --location "
+        "visible, which measures it, thesis with the thesis's placements).",
     ),
     click.option(
         "--metric",

@@ -25,8 +25,15 @@ DEFAULT_THRESHOLDS: dict[str, list[float]] = {
 METRIC_UNITS = {"dH": "N m s", "dV": "m/s", "da": "m"}
 
 
+def default_area(location: str) -> str:
+    """The effective-area method that goes with a strike placement when none is given: the visible placement
+    measures its own (mean silhouette, from the same draws), the thesis's placements use Eqs. 5.15-5.18."""
+    return "silhouette" if location == "visible" else "thesis"
+
+
 def build_scenario(settings: Mapping[str, Any]) -> Scenario:
-    """The base :class:`~abrupt.rates.trades.Scenario` from ``abrupt rates`` settings (names as the options)."""
+    """The base :class:`~abrupt.rates.trades.Scenario` from ``abrupt rates`` settings (names as the options;
+    an ``area`` of None is the placement's own, :func:`default_area`)."""
     config = RateConfig(
         mass_model=settings["mass_model"],
         mef_model=settings["mef"],
@@ -34,7 +41,7 @@ def build_scenario(settings: Mapping[str, Any]) -> Scenario:
         n_draws=settings["n_draws"],
         location=settings["location"],
         grid_spacing_m=settings["grid_spacing_m"],
-        area=settings["area"],
+        area=settings["area"] or default_area(settings["location"]),
         flux_bound_sigma=settings["flux_bound"],
         size_sampling=settings["size_sampling"],
         seed=settings["seed"],

@@ -96,20 +96,22 @@ strike rate (test: importance and population estimates agree within 15 % where t
 **Geometry** (`abrupt.rates.geometry`): boxes and two-sided panels from the spacecraft's `[[surfaces]]`;
 solar-array panels rotate about their `u_axis` by an angle ~ U(0, π/2) per draw; CoM at the bus centre. Strike
 location:
-* `silhouette` (default): uniform point in the bounding rectangle of the projected geometry on the thesis's Q-R
+* `silhouette` (the thesis's; the library's :class:`~abrupt.rates.montecarlo.RateConfig` default, for the thesis
+  reproductions): uniform point in the bounding rectangle of the projected geometry on the thesis's Q-R
   plane, ray cast along the flow, first surface hit kept, misses rejected — exactly uniform over the silhouette
   and forward-most, the thesis algorithm at zero grid spacing (numba);
 * `point_cloud` (thesis): face and panel grid points (spacing ≤ 0.7 × grid), projected, rasterised at the grid
   spacing (default 1/6 of the smallest dimension), Q-slice by cell count, uniform R-cell, forward-most point.
-* `visible` (`--location visible --area silhouette`; the flux inference's forward model): a surface element
-  facing the flow drawn ∝ its projected area, a point on it, a ray toward the source; the draw carries the
-  facing area when unshadowed, 0 when shadowed, so strikes follow flux × visible area per direction. The two
+* `visible` (the default of `abrupt rates`, with `--area silhouette`; the flux inference's forward model): a
+  surface element facing the flow drawn ∝ its projected area, a point on it, a ray toward the source; the draw
+  carries the facing area when unshadowed, 0 when shadowed, so strikes follow flux × visible area per direction. The two
   methods above draw the direction by flux alone: their total rate is right but a direction from which the craft
   looks large gets no more strikes than one from which it looks small (docs/flux-inference.md, *Strikes weighted
   by flux × visible area*; `tests/test_flux_visible_area.py`).
 
 Effective area: `--area thesis` (Eqs. 5.15-5.18 with the total array area, erratum A14) or `--area silhouette`
-(flux-weighted mean projected area, from ray casting).
+(flux-weighted mean projected area, from ray casting); `abrupt rates` takes silhouette with the visible placement
+and thesis with the thesis's placements unless `--area` is given.
 
 Checks against the sources (tests in `tests/test_rates_*.py`)
 -------------------------------------------------------------

@@ -76,7 +76,11 @@ class RateConfig:
                 key="location",
             )
         if self.location == "visible" and self.area != "silhouette":
-            raise ConfigError("location 'visible' measures its own area: use area 'silhouette'", key="area")
+            raise ConfigError(
+                "location 'visible' measures its own area: use area 'silhouette' (or, for the thesis's area, "
+                "location 'silhouette')",
+                key="area",
+            )
         if self.area not in ("thesis", "silhouette"):
             raise ConfigError("area must be 'thesis' or 'silhouette'", key="area")
         if self.size_sampling not in ("population", "log_uniform"):

@@ -200,8 +200,9 @@ def apply_variable(scenario: Scenario, name: str, value: str) -> Scenario:
             return replace(scenario, config=replace(cfg, location="point_cloud", grid_spacing_m=float(value)))
         if name == "size_scale":
             return replace(scenario, size_scale=float(value))
-        if name == "location":
-            return replace(scenario, config=replace(cfg, location=value))
+        if name == "location":  # the visible placement measures its own area
+            area = "silhouette" if value == "visible" else cfg.area
+            return replace(scenario, config=replace(cfg, location=value, area=area))
         if name == "area":
             return replace(scenario, config=replace(cfg, area=value))
         if name == "size_sampling":
