@@ -78,3 +78,24 @@ def test_scoring_with_intervals_finds_a_burn_its_event_times_late() -> None:
     moved.loc[hit.index, "interval_end_utc"] = (EPOCH0 + pd.Timedelta(days=202.0)).isoformat()
     assert score_events(moved, truth).true_positives == 0
     assert score_events(moved, truth, intervals=True).true_positives == 1
+
+
+def test_every_event_time_lies_inside_its_interval_in_the_written_file(tmp_path) -> None:
+    """Written to CSV and read back (times to the microsecond), every event's time, maneuvers and
+    campaigns alike, lies inside its stated interval, on a simulated history with burns at two
+    cadences (the interval's definition, not a fitted figure)."""
+    from abrupt.events import read_events, write_events
+
+    for k, sets_per_day in enumerate((1.0, 0.4)):
+        burns = _burns(k, 2.0)
+        h = simulate_null_history(
+            NullHistorySpec(altitude_km=800.0, sets_per_day=sets_per_day, years=2.0, seed=k), burns=burns
+        )
+        path = tmp_path / f"events_{k}.csv"
+        write_events(TleMeanElements(all_candidates=True).detect(h, BUDGET).events, str(path))
+        ev = read_events(str(path))
+        assert len(ev) >= len(burns) // 2
+        t = pd.to_datetime(ev["time_utc"].astype(str), utc=True, format="ISO8601")
+        lo = pd.to_datetime(ev["interval_start_utc"].astype(str), utc=True, format="ISO8601")
+        hi = pd.to_datetime(ev["interval_end_utc"].astype(str), utc=True, format="ISO8601")
+        assert bool(((lo <= t) & (t <= hi)).all()), ev.loc[~((lo <= t) & (t <= hi)), ["time_utc", "kind"]]

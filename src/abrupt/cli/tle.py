@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
+from abrupt.cli import tle_null as cli_tle_null
 from abrupt.cli.commands import lazy_module
 from abrupt.cli.groups import (
     catalog_option,
@@ -45,7 +46,6 @@ if TYPE_CHECKING:
     from abrupt.readers import omm as readers_omm
     from abrupt.report import tle as abrupt_report_tle
     from abrupt.simulate import tle_injection as simulate_tle_injection
-    from abrupt.simulate import tle_own_null as simulate_tle_own_null
 else:
     detect_tle_config = lazy_module("abrupt.detect.tle.config")
     detect_tle_detectors = lazy_module("abrupt.detect.tle.detectors")
@@ -56,7 +56,6 @@ else:
     abrupt_report_tle = lazy_module("abrupt.report.tle")
     abrupt_score = lazy_module("abrupt.score")
     simulate_tle_injection = lazy_module("abrupt.simulate.tle_injection")
-    simulate_tle_own_null = lazy_module("abrupt.simulate.tle_own_null")
     thresholds = lazy_module("abrupt.thresholds")
     pd = lazy_module("pandas")
     scipy_stats = lazy_module("scipy.stats")
@@ -108,7 +107,21 @@ norad_option = click.option(
     help="Bootstrapped maneuver-free histories of each satellite's own quiet noise on which the realised "
     "false-alarm rate is measured beside the budget (0: skip).",
 )
-@click.option("--null-years", type=click.FloatRange(1.0, 50.0), default=4.0, show_default=True, help="Length of each.")
+@click.option(
+    "--null-years",
+    type=click.FloatRange(1.0, 50.0),
+    default=4.0,
+    show_default=True,
+    help="Length of each (with --null-pooled).",
+)
+@click.option(
+    "--null-eras/--null-pooled",
+    default=True,
+    show_default=True,
+    help="Own null era by era: each null spans the history with the noise and cadence of each time's own "
+    "year, and the realised rate is printed per calendar year; pooled: --null-years of noise drawn from "
+    "the whole history.",
+)
 @catalog_option
 @report_option
 def detect_tle(
@@ -123,6 +136,7 @@ def detect_tle(
     strict: bool,
     null_seeds: int,
     null_years: float,
+    null_eras: bool,
     catalog_target: str,
     report_path: str | None,
     **budget_given: Any,
@@ -195,9 +209,7 @@ def detect_tle(
                 f"(threshold {row['threshold']:.3g}, {row['gaps']} gaps)",
                 err=True,
             )
-        own_null = _own_null(sat, budget, null_seeds, null_years, settings)
-        if own_null is not None:
-            nm = {**nm, "own_null": own_null}
+        nm = {**nm, **cli_tle_null.measure(sat, budget, null_seeds, null_years if not null_eras else None, settings)}
         details["satellites"].append(
             {
                 "norad_id": h.norad_id,
@@ -282,35 +294,6 @@ def report_tle(
         history, events, out, truth=truth_frame, tolerance_s=tolerance_days * 86400.0
     )
     click.echo(f"report written to {written}", err=True)
-
-
-def _own_null(sat: Any, budget: Any, seeds: int, years: float, settings: dict[str, Any]) -> dict[str, Any] | None:
-    """Measure and print the false-alarm rate realised on the satellite's own bootstrapped quiet noise
-    (quiet: away from its detections) beside the budget; None when skipped or impossible."""
-    if seeds == 0:
-        return None
-    if len(sat.history) < (least_sets := simulate_tle_injection.MIN_ELEMENT_SETS):
-        click.echo(
-            f"  own null: {len(sat.history)} element sets, too few (at least {least_sets})",
-            err=True,
-        )
-        return None
-    found = sat.events.loc[sat.events["statistic"] >= sat.events["threshold"]] if len(sat.events) else sat.events
-    known = list(pd.to_datetime(found["time_utc"].astype(str), utc=True).dt.tz_localize(None)) if len(found) else []
-    kw = {k: v for k, v in settings.items() if v is not None}
-    try:
-        rate = simulate_tle_own_null.own_null_rate(sat.history, known, budget, years=years, seeds=range(seeds), **kw)
-    except ValueError as exc:
-        click.echo(f"  own null: not measured ({exc})", err=True)
-        return None
-    lo, hi = rate.interval_per_year()
-    click.echo(
-        f"  own null: {rate.false_alarms} false alarm(s) in {rate.sat_years:.1f} satellite-years of its own quiet "
-        f"noise ({rate.histories} bootstrapped histories): {rate.rate_per_year:.2f} per year "
-        f"(95 % {lo:.2f}-{hi:.2f}) against the budget {budget} ({rate.ratio:.2f}x)",
-        err=True,
-    )
-    return rate.as_dict()
 
 
 def _read_truth(path: str) -> Any:

@@ -444,9 +444,16 @@ def bootstrap_null_history(
     altitude_km: float | None = None,
     median_sets: int = 31,
     burns: Sequence[tuple[float, ...]] = (),
+    era_reach_days: float | None = None,
 ) -> tuple[ElementHistory, NDArray[np.int64]]:
     """A maneuver-free history with ``history``'s own noise (module docstring), and the junctions:
     the index of the first set of every block but the first.
+
+    ``era_reach_days``: the null follows the history's eras. Each block is drawn from the quiet sets
+    within ``era_reach_days`` of the block's own time (days from the history's first epoch; the
+    reach doubles until a quiet stretch is found), so the null's cadence and noise at day ``d`` are
+    those of the real history around day ``d``; ``years`` is then best the history's own span, and
+    the null's day ``d`` stands for the history's day ``d`` (:func:`abrupt.simulate.tle_own_null.own_null_by_year`).
 
     Blocks of ``block_sets`` consecutive sets (fewer where a quiet stretch is shorter, at least 12)
     are drawn at random from the stretches where ``quiet`` holds, with their residuals
@@ -486,9 +493,12 @@ def bootstrap_null_history(
     starts: list[int] = []
     t_out = [0.0]
     while t_out[-1] < span:
-        lo, hi = runs[int(rng.choice(len(runs), p=weights / weights.sum()))]
-        length = min(block_sets, hi - lo)
-        start = int(rng.integers(lo, hi - length + 1))
+        if era_reach_days is None:
+            lo, hi = runs[int(rng.choice(len(runs), p=weights / weights.sum()))]
+            length = min(block_sets, hi - lo)
+            start = int(rng.integers(lo, hi - length + 1))
+        else:
+            start, length = _block_near(rng, runs, t_real_d, t_out[-1], era_reach_days, block_sets)
         block = list(range(start, start + length))
         gaps = np.diff(t_real_d[block])
         if idx:  # the junction gap: a gap drawn from the block's own
@@ -523,6 +533,32 @@ def bootstrap_null_history(
             out["adot_m_s"][k] += rate_m_s
     junctions = np.asarray([j for j in starts[1:] if j < t.size], dtype=np.int64)
     return history_from_series(t, out, regime, norad=99800 + seed % 99), junctions
+
+
+def _block_near(
+    rng: np.random.Generator,
+    runs: list[tuple[int, int]],
+    t_real_d: NDArray[np.float64],
+    t_now_d: float,
+    reach_days: float,
+    block_sets: int,
+) -> tuple[int, int]:
+    """A block (first set, length) of a quiet stretch that starts within ``reach_days`` of ``t_now_d``
+    (days from the first epoch), each candidate start equally likely; the reach doubles until one is
+    found. A block is ``block_sets`` sets, or the rest of its stretch when that is shorter but at least
+    12 sets."""
+    reach = max(float(reach_days), 1.0)
+    while True:
+        starts: list[NDArray[np.int64]] = []
+        for lo, hi in runs:
+            first = np.arange(lo, max(lo + 1, hi - 11), dtype=np.int64)  # at least 12 sets after the start
+            starts.append(first[np.abs(t_real_d[first] - t_now_d) <= reach])
+        pool = np.concatenate(starts)
+        if pool.size:
+            start = int(rng.choice(pool))
+            hi = next(h for lo, h in runs if lo <= start < h)
+            return start, min(block_sets, hi - start)
+        reach *= 2.0
 
 
 def gaps_clear_of_junctions(

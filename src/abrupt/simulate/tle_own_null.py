@@ -107,3 +107,78 @@ def own_null_rate(
             gap = np.clip(np.searchsorted(epochs, before), 0, n_gaps - 1)
             fa += int(counted[gap].sum())
     return OwnNullRate(fa, exposure, budget.per_year, len(seeds))
+
+
+@dataclass(frozen=True)
+class YearRate:
+    """Realised false alarms on the own null in one calendar year of the history, beside the budget."""
+
+    year: int
+    false_alarms: int
+    sat_years: float
+    budget_per_year: float
+
+    @property
+    def rate_per_year(self) -> float:
+        return self.false_alarms / self.sat_years if self.sat_years > 0 else float("nan")
+
+    def as_dict(self) -> dict[str, Any]:
+        lo, hi = poisson_interval(self.false_alarms, self.sat_years)
+        return {**asdict(self), "rate_per_year": self.rate_per_year, "rate_95_lo": lo, "rate_95_hi": hi}
+
+
+def own_null_by_year(
+    history: ElementHistory,
+    maneuvers_utc: Sequence[Any],
+    budget: FalseAlarmBudget,
+    *,
+    seeds: Sequence[int] = (0, 1),
+    era_reach_days: float = DAYS_PER_YEAR / 2.0,
+    block_sets: int = 60,
+    **settings: Any,
+) -> list[YearRate]:
+    """The realised false-alarm rate per calendar year of ``history`` on its own null, era by era.
+
+    Each of ``len(seeds)`` null histories spans ``history`` and draws every noise block from the quiet
+    sets within ``era_reach_days`` of its own time (:func:`bootstrap_null_history` with
+    ``era_reach_days``): day ``d`` of the null has the cadence and noise of day ``d`` of the history.
+    The detector runs once on each whole null (its thresholds per block of the history are fitted as
+    on the real one) and every detection is a false alarm, counted in the calendar year of its gap;
+    exposure is the time of the gaps clear of block junctions in that year. Raises ValueError when no
+    quiet stretch of 12 sets is left."""
+    regime = orbit_regime(history)
+    epochs = history.elements["epoch_utc"]
+    quiet = quiet_mask(epochs, [pd.Timestamp(m) for m in maneuvers_utc])
+    first_utc = pd.Timestamp(epochs.iloc[0])
+    span_years = (epochs.iloc[-1] - epochs.iloc[0]).total_seconds() / SECONDS_PER_DAY / DAYS_PER_YEAR
+    fa: dict[int, int] = {}
+    exposure: dict[int, float] = {}
+    for seed in seeds:
+        null, junctions = bootstrap_null_history(
+            history,
+            quiet,
+            regime=regime,
+            years=span_years,
+            seed=int(seed),
+            block_sets=block_sets,
+            era_reach_days=era_reach_days,
+        )
+        det = detector_for(null, **settings)
+        run = det.detect(null, budget)
+        el = null.elements
+        t_d = (el["epoch_utc"] - el["epoch_utc"].iloc[0]).dt.total_seconds().to_numpy() / SECONDS_PER_DAY
+        year_of_gap = (first_utc + pd.to_timedelta(t_d[:-1], unit="D")).year.to_numpy()
+        counted = gaps_clear_of_junctions(len(el) - 1, junctions, det.settings.window_sets)
+        gap_years = np.diff(t_d) / DAYS_PER_YEAR
+        for y in np.unique(year_of_gap):
+            in_y = year_of_gap == y
+            exposure[int(y)] = exposure.get(int(y), 0.0) + float(gap_years[in_y & counted].sum())
+        ev = run.events
+        if len(ev):
+            found = ev.loc[(ev["statistic"] >= ev["threshold"]) & (ev["kind"] != "maneuver_campaign")]
+            epochs_null = el["epoch_utc"].to_numpy(dtype="datetime64[ns]")
+            before = pd.to_datetime(found["elset_epoch_before_utc"]).to_numpy(dtype="datetime64[ns]")
+            gap = np.clip(np.searchsorted(epochs_null, before), 0, len(el) - 2)
+            for g in gap[counted[gap]]:
+                fa[int(year_of_gap[g])] = fa.get(int(year_of_gap[g]), 0) + 1
+    return [YearRate(y, fa.get(y, 0), exposure[y], budget.per_year) for y in sorted(exposure)]

@@ -473,8 +473,7 @@ def campaign_events(
             "time_method": "first member",
             "campaign_id": int(first["campaign_id"]),
             "campaign_size": len(mem),
-            "interval_start_utc": (epoch0 + pd.Timedelta(seconds=float(t_lo))).isoformat(),
-            "interval_end_utc": (epoch0 + pd.Timedelta(seconds=float(t_hi))).isoformat(),
+            **interval_utc(epoch0, t_lo, t_hi),
             "burns_max": c.burn_count,
             "burn_count": c.burn_count,
         }
@@ -492,6 +491,15 @@ def campaign_events(
             )
         )
     return out
+
+
+def interval_utc(epoch0: pd.Timestamp, t_lo_s: float, t_hi_s: float) -> dict[str, str]:
+    """The interval columns of an event from its bounds (s from ``epoch0``), widened outwards to whole
+    microseconds: event times are written to the microsecond (truncated), so a time inside the interval
+    stays inside it in the file."""
+    lo = (epoch0 + pd.Timedelta(seconds=float(t_lo_s))).floor("us")
+    hi = (epoch0 + pd.Timedelta(seconds=float(t_hi_s))).ceil("us")
+    return {"interval_start_utc": lo.isoformat(), "interval_end_utc": hi.isoformat()}
 
 
 def tle_lag_s(run: StepRun, items: list[Candidate]) -> float:
@@ -621,8 +629,8 @@ def event_fields(
     assert steps.sigma_a_m is not None and steps.sigma_n_rad is not None
     assert steps.z_u is not None and steps.delta_u_m is not None
     out: list[dict[str, Any]] = []
-    for g, _, refined, _ in kept:
-        t_lo, t_hi = span_of[g]
+    for g, t_m, refined, _ in kept:
+        t_lo, t_hi = min(span_of[g][0], t_m), max(span_of[g][1], t_m)  # the event's time lies in its interval
         sigma = (t_hi - t_lo) / math.sqrt(12.0)  # uniform over the stated interval
         burns_max = 1 + int((t_hi - t_lo) // cadence_s) if math.isfinite(cadence_s) and cadence_s > 0 else 1
         a_ref = float(el["a_m"].iloc[g])
@@ -651,8 +659,7 @@ def event_fields(
             "dv_n_sigma_mps": v * float(steps.sigma_n_rad[g]) / w[2] if w[2] > 0 else math.inf,
             "campaign_id": int(camp[0]),
             "campaign_size": int(camp[1]),
-            "interval_start_utc": (epoch0 + pd.Timedelta(seconds=float(t_lo))).isoformat(),
-            "interval_end_utc": (epoch0 + pd.Timedelta(seconds=float(t_hi))).isoformat(),
+            **interval_utc(epoch0, t_lo, t_hi),
             "burns_max": int(burns_max),
             "z_u": float(steps.z_u[g]),
             "delta_u_m": float(steps.delta_u_m[g]),
