@@ -13,6 +13,7 @@ import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -36,7 +37,8 @@ class Run:
     pattern an exit 0 must print for the run to count as a reported repair or warning (``None``: the
     input is impossible and exit 0 is silent-wrong); ``events``: the events file that must hold no
     event after an exit 0 (the input holds no real event); ``ok``: a control case (sane input), exit 0
-    expected; ``before``: command lines run first (e.g. a first ingest), not judged."""
+    expected; ``before``: command lines run first (e.g. a first ingest), not judged; ``impossible``: which
+    events (a mask over the events frame) the damage could have caused (default: every event)."""
 
     argv: list[str]
     inputs: list[str]
@@ -46,6 +48,7 @@ class Run:
     ok: bool = False
     before: list[list[str]] = field(default_factory=list)
     fsize_bytes: int | None = None
+    impossible: Callable[[Any], Any] | None = None
     check: Callable[[str, str, Path], str | None] | None = None
 
 

@@ -42,7 +42,8 @@ from _audit_cases import ROOT, Case, Run
 from _audit_door_cases import door_cases
 from _audit_orbit_cases import orbit_cases
 
-TIME_LIMIT_S = 60.0
+TIME_LIMIT_S = 60.0  # of processor time (RLIMIT_CPU): the machine may be shared, the wall clock is not the run's
+WALL_LIMIT_S = 300.0  # a run waiting (a lock, a read that never ends) is killed here
 MEMORY_LIMIT_BYTES = 2 << 30
 LONG_LINE_CHARS = 2000
 RAW_WARNING = re.compile(r"\.py:\d+: \w*Warning|^\s*warnings\.warn\(", re.MULTILINE)
@@ -77,6 +78,7 @@ def _limits(fsize_bytes: int | None) -> object:
     def apply() -> None:
         os.setsid()
         resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT_BYTES, MEMORY_LIMIT_BYTES))
+        resource.setrlimit(resource.RLIMIT_CPU, (int(TIME_LIMIT_S), int(TIME_LIMIT_S) + 5))
         if fsize_bytes is not None:
             signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write beyond the limit fails with EFBIG
             resource.setrlimit(resource.RLIMIT_FSIZE, (fsize_bytes, fsize_bytes))
@@ -87,8 +89,8 @@ def _limits(fsize_bytes: int | None) -> object:
 def run_bounded(
     argv: list[str], folder: Path, fsize_bytes: int | None = None
 ) -> tuple[int | None, str, str, float, float]:
-    """Run ``abrupt argv`` in ``folder``: exit code (None: killed at the time limit), stdout, stderr, wall
-    seconds and the child's peak resident memory (MB)."""
+    """Run ``abrupt argv`` in ``folder``: exit code (None: killed at the wall limit), stdout, stderr, the
+    processor seconds it used and its peak resident memory (MB)."""
     out_path, err_path = folder.parent / f"{folder.name}.out", folder.parent / f"{folder.name}.err"
     start = time.monotonic()
     with out_path.open("wb") as out, err_path.open("wb") as err:
@@ -107,13 +109,13 @@ def run_bounded(
             if pid:
                 code = os.waitstatus_to_exitcode(status)
                 break
-            if time.monotonic() - start > TIME_LIMIT_S:
+            if time.monotonic() - start > WALL_LIMIT_S:
                 os.killpg(proc.pid, signal.SIGKILL)
                 _, status, usage = os.wait4(proc.pid, 0)
                 break
             time.sleep(0.05)
         proc.returncode = code if code is not None else -9
-    seconds = time.monotonic() - start
+    seconds = usage.ru_utime + usage.ru_stime
     text = (out_path.read_text(errors="replace"), err_path.read_text(errors="replace"))
     out_path.unlink()
     err_path.unlink()
@@ -157,13 +159,16 @@ def _damage_aer(path: Path, kind: str) -> None:
     path.write_text("\n".join(lines) + "\n")
 
 
-def _events(folder: Path, run: Run) -> int:
+def _events(folder: Path, run: Run) -> tuple[int, int]:
+    """The events a run wrote, and how many of them the damage could have caused."""
     if run.events is None or not (folder / run.events).exists():
-        return 0
+        return 0, 0
     try:
-        return len(pd.read_csv(folder / run.events, comment="#"))
+        events = pd.read_csv(folder / run.events, comment="#")
     except pd.errors.EmptyDataError:
-        return 0
+        return 0, 0
+    impossible = len(events) if run.impossible is None or events.empty else int(run.impossible(events).sum())
+    return len(events), impossible
 
 
 def judge(
@@ -176,7 +181,9 @@ def judge(
     if lost:
         return "data loss", "an input changed"
     if code is None or "MemoryError" in err or code in (-signal.SIGKILL, -signal.SIGXCPU):
-        return "runaway", f"killed after {TIME_LIMIT_S:.0f} s" if code is None else first
+        if code is None:
+            return "runaway", f"killed after {WALL_LIMIT_S:.0f} s of wall time"
+        return "runaway", f"killed after {TIME_LIMIT_S:.0f} s of processor time" if code == -signal.SIGXCPU else first
     if "Traceback (most recent call last)" in err or (code is not None and code < 0):
         return "traceback", [ln for ln in err.splitlines() if ln.strip()][-1] if err.strip() else f"signal {-code}"
     if max((len(line) for line in text.splitlines()), default=0) > LONG_LINE_CHARS:
@@ -190,13 +197,14 @@ def judge(
         if code == 2 and len(errors) == 1 and re.search(names, errors[0], re.IGNORECASE):
             return ("left output", f"left {sorted(new_files)}") if new_files else ("clean error", first)
         return "unclear error", f"exit {code}: {first}"
-    n_events = _events(folder, run)
+    n_events, n_impossible = _events(folder, run)
     if run.ok:
         return "ok", f"{n_events} event(s)"
-    if run.said is not None and re.search(run.said, text, re.IGNORECASE) and n_events == 0:
+    if run.said is not None and re.search(run.said, text, re.IGNORECASE) and n_impossible == 0:
         said = re.search(run.said, text, re.IGNORECASE)
         line = next((ln for ln in text.splitlines() if said and said.group(0) in ln), "")
-        return "counted repair", line.strip()
+        others = f" (+{n_events} event(s) outside what the damage touched)" if n_events else ""
+        return "counted repair", line.strip() + others
     return (
         "silent-wrong",
         f"exit 0, {n_events} event(s), repair said: {bool(run.said and re.search(run.said, text, re.I))}",
@@ -226,7 +234,7 @@ def main(argv: list[str] | None = None) -> dict[str, int]:
     SOURCE[0] = args.src.resolve()
     cases = [c for c in (*orbit_cases(), *door_cases()) if args.only in c.name and args.group in c.group]
     totals: Counter[str] = Counter()
-    print(f"{'group':<26} {'case':<46} {'verdict':<15} {'exit':>4} {'s':>5} {'MB':>6}  detail")
+    print(f"{'group':<26} {'case':<46} {'verdict':<15} {'exit':>4} {'cpu s':>5} {'MB':>6}  detail")
     with tempfile.TemporaryDirectory(prefix="abrupt-audit-") as tmp:
         for case in cases:
             outcome = run_case(case, Path(tmp))
