@@ -293,3 +293,25 @@ def test_events_of_a_successful_run_are_complete(
     )
     assert code == 0, err
     assert len(read_events(str(out))) == len(Catalog(tmp_path / "c").events())
+
+
+def test_a_run_that_fails_on_its_input_leaves_no_new_catalog(
+    tle_history: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The catalog is opened first, so a run refused on its input had created it: the failed run removes
+    the catalog it created (no run in it), and leaves a catalog that existed before, with its runs."""
+    bad = tmp_path / "bad.tle"
+    bad.write_text("0 " + "X" * 10_000 + "\n")  # refused when read, after the catalog was opened
+    out, catalog = tmp_path / "e.csv", tmp_path / "c.sqlite"
+    code, err = _run(["-q", "detect", "tle", str(bad), "--out", str(out), "--catalog", str(catalog)], capsys)
+    assert code == 2 and "bad.tle" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.tle"]
+    code, err = _run(["-q", "detect", "tle", str(tle_history), "--out", str(out), "--catalog", str(catalog)], capsys)
+    assert code == 0, err
+    code, _ = _run(
+        ["-q", "detect", "tle", str(bad), "--out", str(tmp_path / "f.csv"), "--catalog", str(catalog)], capsys
+    )
+    assert code == 2 and len(Catalog(catalog).runs()) == 1  # the earlier catalog and its run are kept
+    url = f"sqlite:///{tmp_path / 'u.sqlite'}"
+    code, _ = _run(["-q", "detect", "tle", str(bad), "--out", str(tmp_path / "g.csv"), "--catalog", url], capsys)
+    assert code == 2 and not (tmp_path / "u.sqlite").exists()

@@ -10,12 +10,14 @@ from :mod:`abrupt.cli.groups` and decorate their commands onto them as usual.
 from __future__ import annotations
 
 import ast
+import contextlib
 import difflib
 import functools
 import importlib
 import importlib.util
 import logging
 import os
+import sqlite3
 import sys
 from collections.abc import Callable, Iterator, Mapping
 from functools import cache
@@ -275,6 +277,28 @@ def open_catalog_first(target: str) -> None:
     importlib.import_module("abrupt.catalog").Catalog(target)
 
 
+def sqlite_catalog_file(target: str) -> Path | None:
+    """The file of a SQLite catalog target (a path or a plain ``sqlite:///`` URL); None for a server."""
+    if "://" not in target:
+        return Path(target).expanduser()
+    if target.startswith("sqlite:///") and "?" not in target and target != "sqlite:///:memory:":
+        return Path(target.removeprefix("sqlite:///")).expanduser()
+    return None
+
+
+def remove_unused_catalog(path: Path) -> None:
+    """Remove a catalog file a failed command created, if no run was stored in it (a failed run leaves
+    no new catalog behind); a catalog holding any run, or that cannot be read, is left alone."""
+    try:
+        with contextlib.closing(sqlite3.connect(f"file:{path}?mode=ro", uri=True)) as conn:
+            runs = conn.execute("SELECT count(*) FROM runs").fetchone()[0]
+    except sqlite3.Error:
+        runs = None if path.stat().st_size else 0  # a file the failed open left empty holds nothing
+    if runs == 0:
+        for leftover in (path, *(path.with_name(path.name + s) for s in ("-journal", "-wal", "-shm"))):
+            leftover.unlink(missing_ok=True)
+
+
 def guard_outputs(command: click.Command, *, records_runs: bool = False) -> click.Command:
     """Make ``command`` check its output paths before its body runs (once per command object); with
     ``records_runs`` (the ``detect`` commands) also open its ``--catalog`` first."""
@@ -296,9 +320,17 @@ def guard_outputs(command: click.Command, *, records_runs: bool = False) -> clic
         overwrite = bool(kwargs.pop("overwrite", False)) if has_output else True
         clear_protected()
         check_output_paths(kwargs, overwrite=overwrite, hints=hints)
-        if records_runs and kwargs.get("catalog_target"):
-            open_catalog_first(str(kwargs["catalog_target"]))
-        return callback(*args, **kwargs)
+        if not (records_runs and kwargs.get("catalog_target")):
+            return callback(*args, **kwargs)
+        target = str(kwargs["catalog_target"])
+        new_file = (path := sqlite_catalog_file(target)) is not None and not path.exists()
+        try:
+            open_catalog_first(target)
+            return callback(*args, **kwargs)
+        except BaseException:
+            if new_file and path is not None and path.is_file():
+                remove_unused_catalog(path)
+            raise
 
     guarded._outputs_guarded = True  # type: ignore[attr-defined]
     command.callback = guarded
