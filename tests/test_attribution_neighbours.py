@@ -38,8 +38,8 @@ def test_two_steps_fitted_together_each_get_their_own_size_where_one_alone_takes
     assert np.allclose(got[1], s1, atol=1e-3) and np.allclose(got[0], s2, atol=1e-3)
     alone = local_step(h, ok, 1500, 300, 20)
     assert np.linalg.norm(alone - s1) > 10 * np.linalg.norm(got[1] - s1)
-    assert best_step_beside(h, ok, 1500, 1200, 1800, 300, 10) == 1530
-    assert best_step_beside(h, ok, 1530, 1200, 1800, 300, 10) == 1500
+    assert best_step_beside(h, ok, (1500,), 1200, 1800, 300, 10) == 1530
+    assert best_step_beside(h, ok, (1530,), 1200, 1800, 300, 10) == 1500
     # Steps with no analysed sample between them (a gap over both) cannot be told apart.
     gap = ok & ((k < 1490) | (k >= 1540))
     assert np.isnan(local_steps(h, gap, (1500, 1530), 300, 20)).all()
@@ -82,3 +82,23 @@ def test_a_strike_beside_a_dump_and_the_dump_each_keep_their_event_and_class() -
         dump = [k for t, k in got if abs(t - AT - gap) <= 10]
         good += strike == ["strike"] and dump == ["external_non_strike"] and len(got) == 2
     assert good >= 8, good
+
+
+def test_two_strikes_minutes_apart_get_no_step_between_them() -> None:
+    """Two strikes (0.05-0.3 N·m·s, at right angles) 7-9 minutes apart, each its own event: with both
+    steps known, the rescan beside each finds no third change (six draws)."""
+    sc = load_spacecraft(KESTREL)
+    for seed in range(6):
+        rng = np.random.default_rng(seed)
+        gap = int(rng.uniform(420, 540))
+        d1 = rng.normal(size=3)
+        d1 /= np.linalg.norm(d1)
+        d2 = np.cross(d1, rng.normal(size=3))
+        d2 /= np.linalg.norm(d2)
+        s1, s2 = rng.uniform(0.05, 0.3, 2)
+        table = closed_loop_table(rng, 1000, s1 * d1, more=((1000 + gap, s2 * d2),))
+        h_n, hc, ok, det, peaks = glr_peaks(sc, table)
+        assert len(peaks) == 2, seed
+        ev = {p.time_ns: event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n) for _, p in peaks}
+        beside, _, _ = neighbours_apart(table, sc, h_n, hc, ok, det, peaks, ev, 5.0)
+        assert not beside, (seed, [p.time_ns / NS for _, p in beside])

@@ -30,7 +30,7 @@ from dataclasses import fields, replace
 import numpy as np
 import pandas as pd
 
-from abrupt.detect.attitude.attribution import AttributionRules, classify
+from abrupt.detect.attitude.attribution import DUMP_REASON, Attribution, AttributionRules, classify
 from abrupt.detect.attitude.evidence import EventEvidence, event_evidence, profile_fits, profile_key
 from abrupt.detect.attitude.flight_glr import FlightGlrDetector, Peak
 from abrupt.detect.attitude.ramp_step import (
@@ -413,18 +413,21 @@ def _torque_beside_strike(
 
 
 #: Classes whose event is one step of total momentum that a second step beside it may hide (a sensor fault's
-#: event is repaired instead, a ramp's has its direction taken out: :func:`rescan_after_faults`).
+#: event is repaired instead: :func:`rescan_after_faults`).
 STEP_KINDS = ("strike", "external_non_strike")
 #: A second step nearer than ``SAME_SEQUENCE_S`` [s] and within ``SAME_SEQUENCE_DEG`` of the first's
 #: direction is more of the same change (a dump's further pulses, a venting train's), not a change of its
 #: own: the sibling evidence judges those.
 SAME_SEQUENCE_S = 60.0
 SAME_SEQUENCE_DEG = 20.0
-#: What a second step's own evidence may call it to be kept (a ramp's piece is not a step).
-BESIDE_KINDS = ("strike", "external_non_strike")
 
 
-def _shifted(h: FloatArray, g: np.ndarray, steps: tuple[tuple[int, FloatArray], ...]) -> FloatArray:
+def _impulsive(a: Attribution) -> bool:
+    """An impulsive step by its own evidence: a strike, or a dump's step (a ramp's piece is neither)."""
+    return a.kind == "strike" or a.reason == DUMP_REASON
+
+
+def _shifted(h: FloatArray, g: np.ndarray, steps: list[tuple[int, FloatArray]]) -> FloatArray:
     """``h`` less each (time [ns], ΔH_N) step: a step of total ᴺH from its instant on."""
     out = h.copy()
     for t_ns, d_h in steps:
@@ -446,72 +449,75 @@ def neighbours_apart(
     inertia_kgm2: FloatArray | None = None,
     rules: AttributionRules | None = None,
 ) -> tuple[list[tuple[int, Peak]], dict[int, EventEvidence], dict[int, tuple[FloatArray, EventEvidence]]]:
-    """Second steps of total momentum hidden beside a step's event, both fitted jointly.
+    """Impulsive steps of total momentum hidden beside a step's event, fitted jointly with every step known.
 
     The detector keeps one peak per window span, so a strike 40 s before a momentum dump leaves one event.
-    For every peak whose evidence is a step's (``STEP_KINDS``), its fitted step is taken out of ᴺH and the
-    statistic rescanned where the detector suppressed (one window span around the peak, as after a ramp);
-    a peak above ``floor`` there, more than ``RESCAN_APART_S`` from every peak of ``peaks``, is a second
-    change. The two steps are then fitted together (:func:`~abrupt.detect.attitude.steps.local_steps`),
-    each's evidence taken with the other's step out of ᴺH (raw and cleaned), and the second kept when its
-    evidence calls it a step (``BESIDE_KINDS``) and it is not more of the same change (within
-    ``SAME_SEQUENCE_S`` and ``SAME_SEQUENCE_DEG`` of the first). Returns the new peaks with their evidence
-    (``beside_step_s``: the time after the first event [s]) and, by peak time, the first events' jointly
-    fitted ΔH_N and evidence. Nothing is raised between two changes: the new peak is where the telemetry
-    steps once the first change is out, and an event only above the run's threshold.
+    For every peak whose evidence is a step's (``STEP_KINDS``), the steps of every peak of ``peaks`` near it
+    are taken out of ᴺH and the statistic rescanned where the detector suppressed (one window span around
+    the peak, as after a ramp); a peak above ``floor`` there, more than ``RESCAN_APART_S`` from every known
+    step, is a candidate. It is put where one more step fits best beside the known ones
+    (:func:`~abrupt.detect.attitude.steps.best_step_beside`) and all are sized together
+    (:func:`~abrupt.detect.attitude.steps.local_steps`); its evidence is taken with the known steps out of
+    ᴺH (raw and cleaned), and the event's own with the new step and the other known ones out. It is kept
+    when its evidence is an impulsive step's (a strike, a dump) and it is not more of the event's own change
+    (within ``SAME_SEQUENCE_S`` and ``SAME_SEQUENCE_DEG``). Returns the new peaks with their evidence
+    (``beside_step_s``: the time after the event [s]) and, by peak time, the events' jointly fitted ΔH_N and
+    evidence. Nothing is raised between two changes: the new peak is where the telemetry steps once the
+    known changes are out, and an event only above the run's threshold.
     """
     g, dt = table.time_ns, table.dt_s
     win = detector.windows(dt)
     found: list[tuple[int, Peak, EventEvidence]] = []
     revised: dict[int, tuple[FloatArray, EventEvidence]] = {}
-    taken = [int(p.time_ns) for _, p in peaks]
+    known = {int(p.time_ns): np.asarray(p.dH_N_Nms) for _, p in peaks if np.all(np.isfinite(p.dH_N_Nms))}
     half_s = RESCAN_SPAN_S[1] + win.span * dt
     for i_pk, pk in peaks:
         ev = evidence.get(pk.time_ns)
-        if ev is None or classify(ev, rules).kind not in STEP_KINDS or not np.all(np.isfinite(pk.dH_N_Nms)):
+        if ev is None or classify(ev, rules).kind not in STEP_KINDS or pk.time_ns not in known:
             continue
         i0 = int(np.clip(np.searchsorted(g, pk.time_ns), 0, g.size - 1))
         a, b = max(0, i0 - round((half_s + 240.0) / dt)), min(g.size, i0 + round((half_s + 240.0) / dt))
-        hc_sub = np.where(ok[a:b, None], _shifted(cleaned_H_N[a:b], g[a:b], ((pk.time_ns, pk.dH_N_Nms),)), np.nan)
+        near = sorted(t for t in known if g[a] < t < g[b - 1])
+        hc_sub = np.where(ok[a:b, None], _shifted(cleaned_H_N[a:b], g[a:b], [(t, known[t]) for t in near]), np.nan)
         t_pk = int(g[min(i_pk, g.size - 1)])
         zone = (min(t_pk - int(win.span * dt * NS), pk.time_ns + int(RESCAN_SPAN_S[0] * NS)),
                 max(t_pk + int(win.span * dt * NS), pk.time_ns + int(RESCAN_SPAN_S[1] * NS)))  # fmt: skip
-        avoid = tuple((t, RESCAN_APART_S, RESCAN_APART_S) for t in taken)
+        avoid = tuple((t, RESCAN_APART_S, RESCAN_APART_S) for t in known)
         best = _best_peak(
             detector, hc_sub, ok[a:b], g[a:b], dt, pk.time_ns, floor, None if keep is None else keep[a:b], zone, avoid
         )
         if best is None:
             continue
-        j, p = best
-        # The second step where it fits best beside the first (the rescan located it beside a first step
-        # sized as if alone), then both sized together.
-        tau1 = int(np.searchsorted(g, pk.time_ns + int(0.5 * dt * NS)))
-        apart = round(RESCAN_APART_S / dt)
-        tau2 = best_step_beside(cleaned_H_N, ok, tau1, a + j - win.pre, a + j + win.span + 1, win.pre, apart)
-        if tau2 < 0:
+        j = best[0]
+        taus = tuple(int(np.searchsorted(g, t + int(0.5 * dt * NS))) for t in near)
+        lo, hi = a + j - win.pre, a + j + win.span + 1
+        tau = best_step_beside(cleaned_H_N, ok, taus, lo, hi, win.pre, round(RESCAN_APART_S / dt))
+        if tau < 0:
             continue
-        t2 = int(g[tau2]) - int(0.5 * dt * NS)
-        if any(abs(t2 - t) <= RESCAN_APART_S * NS for t in taken):
+        t_new = int(g[tau]) - int(0.5 * dt * NS)
+        sizes = local_steps(cleaned_H_N, ok, (*taus, tau), win.pre, win.guard)
+        if not np.all(np.isfinite(sizes)):
             continue
-        p = Peak(t2, p.value, p.dH_N_Nms, p.time_sigma_s)
-        s1, s2 = local_steps(cleaned_H_N, ok, (tau1, tau2), win.pre, win.guard)
-        if not (np.all(np.isfinite(s1)) and np.all(np.isfinite(s2))):
-            continue
+        fitted = dict(zip(near, sizes[:-1], strict=True))
+        s1, s2 = fitted[pk.time_ns], sizes[-1]
         cos = float(s1 @ s2) / max(float(np.linalg.norm(s1) * np.linalg.norm(s2)), 1e-300)
-        if abs(p.time_ns - pk.time_ns) < SAME_SEQUENCE_S * NS and cos > np.cos(np.radians(SAME_SEQUENCE_DEG)):
+        if abs(t_new - pk.time_ns) < SAME_SEQUENCE_S * NS and cos > np.cos(np.radians(SAME_SEQUENCE_DEG)):
             continue
+        out_new = list(fitted.items())
         ev2 = event_evidence(
-            table, _shifted(cleaned_H_N, g, ((pk.time_ns, s1),)), spacecraft, p.time_ns, s2,
-            inertia_kgm2=inertia_kgm2, raw_H_N=_shifted(raw_H_N, g, ((pk.time_ns, s1),)),
+            table, _shifted(cleaned_H_N, g, out_new), spacecraft, t_new, s2,
+            inertia_kgm2=inertia_kgm2, raw_H_N=_shifted(raw_H_N, g, out_new),
         )  # fmt: skip
-        if classify(ev2, rules).kind not in BESIDE_KINDS:
+        if not _impulsive(classify(ev2, rules)):
             continue
+        out_pk = [(t, s) for t, s in out_new if t != pk.time_ns] + [(t_new, s2)]
         ev1 = event_evidence(
-            table, _shifted(cleaned_H_N, g, ((p.time_ns, s2),)), spacecraft, pk.time_ns, s1,
-            inertia_kgm2=inertia_kgm2, raw_H_N=_shifted(raw_H_N, g, ((p.time_ns, s2),)),
+            table, _shifted(cleaned_H_N, g, out_pk), spacecraft, pk.time_ns, s1,
+            inertia_kgm2=inertia_kgm2, raw_H_N=_shifted(raw_H_N, g, out_pk),
         )  # fmt: skip
-        found.append((a + j, replace(p, dH_N_Nms=s2), replace(ev2, beside_step_s=(p.time_ns - pk.time_ns) / NS)))
+        p = Peak(t_new, best[1].value, s2, best[1].time_sigma_s)
+        found.append((a + j, p, replace(ev2, beside_step_s=(t_new - pk.time_ns) / NS)))
         revised[pk.time_ns] = (s1, ev1)
-        taken.append(int(p.time_ns))
+        known[t_new] = s2
     kept, kept_ev, _ = merge_found(found)
     return kept, kept_ev, revised

@@ -193,22 +193,25 @@ def local_steps(h: FloatArray, ok: BoolArray, taus: tuple[int, ...], half: int, 
     return out
 
 
-def best_step_beside(h: FloatArray, ok: BoolArray, fixed: int, lo: int, hi: int, half: int, apart: int) -> int:
-    """Sample τ in [lo, hi) (at least ``apart`` samples from ``fixed``) where a second step of ᴺH beside
-    the step at ``fixed`` best fits: the model a + b t + s₀ 1(t ≥ fixed) + s 1(t ≥ τ) fitted by least
-    squares over ``half`` samples either side of the span, each axis weighted by its noise; τ maximises
+def best_step_beside(
+    h: FloatArray, ok: BoolArray, fixed: tuple[int, ...], lo: int, hi: int, half: int, apart: int
+) -> int:
+    """Sample τ in [lo, hi) (at least ``apart`` samples from each of ``fixed``) where one more step of ᴺH
+    beside the steps at ``fixed`` best fits: the model a + b t + Σ s_k 1(t ≥ fixed_k) + s 1(t ≥ τ) fitted by
+    least squares over ``half`` samples either side of the span, each axis weighted by its noise; τ maximises
     the fit's gain, Σ_axes (r_hᵀ r_y)² / r_hᵀ r_h, with r_y, r_h the data and the step of τ less their
     projection on the rest of the model (one pass of cumulative sums). Returns τ, or -1 when no τ is
     allowed."""
     n = h.shape[0]
-    a, b = max(0, min(fixed, lo) - half), min(n, max(fixed, hi) + half)
+    a, b = max(0, min(*fixed, lo) - half), min(n, max(*fixed, hi) + half)
     idx = np.arange(a, b)
     good = ok[idx] & np.all(np.isfinite(h[idx]), axis=1)
     idx = idx[good]
     if idx.size < 20:
         return -1
     y = h[idx] / np.where((s := robust_noise_sigma(h[idx])) > 0, s, 1.0)
-    base = np.column_stack([np.ones(idx.size), (idx - idx.mean()) / max(half, 1), (idx >= fixed).astype(np.float64)])
+    steps = [(idx >= f).astype(np.float64) for f in fixed]
+    base = np.column_stack([np.ones(idx.size), (idx - idx.mean()) / max(half, 1), *steps])
     q, _ = np.linalg.qr(base)
     r_y = y - q @ (q.T @ y)
     # Sums over the samples at or after each position k (a step at idx[k] covers idx[k:]).
@@ -217,7 +220,7 @@ def best_step_beside(h: FloatArray, ok: BoolArray, fixed: int, lo: int, hi: int,
     count = np.arange(idx.size, 0, -1, dtype=np.float64)
     rh2 = count - np.sum(tail_q**2, axis=1)
     gain = np.sum(tail_y**2, axis=1) / np.where(rh2 > 1e-9, rh2, np.inf)
-    allowed = (idx >= lo) & (idx < hi) & (np.abs(idx - fixed) >= apart)
+    allowed = (idx >= lo) & (idx < hi) & np.all(np.abs(idx[:, None] - np.asarray(fixed)[None, :]) >= apart, axis=1)
     if not allowed.any():
         return -1
     return int(idx[np.flatnonzero(allowed)[np.argmax(gain[allowed])]])
