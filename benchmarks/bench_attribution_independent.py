@@ -120,7 +120,7 @@ def run_abrupt(folder: Path, work: Path) -> pd.DataFrame:
         if cmd[1] == "detect" and events.exists():
             events.unlink()
             events.with_name("events.evidence.csv").unlink(missing_ok=True)
-        done = subprocess.run(cmd, env=env, capture_output=True, text=True, check=False)
+        done = subprocess.run(cmd, env=env, cwd=work, capture_output=True, text=True, check=False)
         if done.returncode != 0:
             raise SystemExit(f"{' '.join(cmd[:3])} failed ({done.returncode}): {done.stderr.strip()[-2000:]}")
     frame = pd.read_csv(events)
