@@ -96,6 +96,21 @@ def _rotation(rng: np.random.Generator, angle_deg: float) -> np.ndarray:
     return np.eye(3) + np.sin(a) * k + (1 - np.cos(a)) * k @ k
 
 
+def _initial_wheel_rpm(
+    inertia: np.ndarray, axes: np.ndarray, js: float, altitude_m: float, rng: np.random.Generator
+) -> np.ndarray:
+    """Wheel speeds at the start: the system momentum left by the last dump (0.2-1.5 N·m·s, any direction)
+    minus the nadir-pointing body's J ω, by minimum norm, plus a null-space bias of 300-1500 rpm that the
+    minimum-norm torque distribution keeps (it holds the wheels away from zero speed)."""
+    a_m = 6_378_136.3 + altitude_m
+    body_B = inertia @ np.array([0.0, 0.0, np.sqrt(3.986004418e14 / a_m**3)])
+    h_wheels_B = _unit(rng) * rng.uniform(0.2, 1.5) - body_B
+    speeds = np.linalg.pinv(js * axes.T) @ h_wheels_B
+    null = np.linalg.svd(axes.T)[2][-1]
+    bias = rng.choice([-1, 1]) * rng.uniform(300.0, 1500.0) * 2 * np.pi / 60
+    return np.asarray((speeds + bias * null / np.max(np.abs(null))) * 60 / (2 * np.pi))
+
+
 def draw_design(index: int, rng: np.random.Generator) -> Design:
     """A spacecraft from the ranges of the module docstring."""
     mass = rng.uniform(250.0, 1200.0)
@@ -120,6 +135,7 @@ def draw_design(index: int, rng: np.random.Generator) -> Design:
     wn = 2 * np.pi / rng.uniform(40.0, 150.0)
     zeta = rng.uniform(0.7, 1.0)
     torque_dir = rng.normal(size=3)
+    altitude = rng.uniform(450e3, 850e3)
     vehicle = Vehicle(
         inertia_kgm2=inertia,
         mass_kg=mass,
@@ -127,8 +143,8 @@ def draw_design(index: int, rng: np.random.Generator) -> Design:
         wheel_spin_inertia_kgm2=js,
         wheel_max_torque_Nm=rng.uniform(0.05, 0.2),
         wheel_max_speed_rpm=max_rpm,
-        wheel_initial_rpm=rng.choice([-1, 1], 4) * rng.uniform(150.0, 900.0, 4),
-        altitude_m=rng.uniform(450e3, 850e3),
+        wheel_initial_rpm=_initial_wheel_rpm(inertia, np.asarray(axes), js, altitude, rng),
+        altitude_m=altitude,
         inclination_deg=rng.uniform(40.0, 98.0),
         raan_deg=rng.uniform(0.0, 360.0),
         arg_lat_deg=rng.uniform(0.0, 360.0),

@@ -120,7 +120,7 @@ def run_abrupt(folder: Path, work: Path) -> pd.DataFrame:
         if cmd[1] == "detect" and events.exists():
             events.unlink()
             events.with_name("events.evidence.csv").unlink(missing_ok=True)
-        done = subprocess.run(cmd, env=env, capture_output=True, text=True, check=False)
+        done = subprocess.run(cmd, env=env, cwd=work, capture_output=True, text=True, check=False)
         if done.returncode != 0:
             raise SystemExit(f"{' '.join(cmd[:3])} failed ({done.returncode}): {done.stderr.strip()[-2000:]}")
     frame = pd.read_csv(events)
@@ -131,7 +131,8 @@ def run_abrupt(folder: Path, work: Path) -> pd.DataFrame:
 
 def match(events: pd.DataFrame, truth: dict) -> tuple[list[dict], pd.DataFrame]:
     """Each truth event with the event it claims (``None`` when none); the events left, with what they are
-    near (``operations`` or ``none``)."""
+    near: ``truth`` (a second event in a truth event's window, e.g. a fault's end), ``operations``
+    (10 min of a flagged dump, slew or gap) or ``none``."""
     strength = events["statistic"].to_numpy(float) if "statistic" in events else events["dH_Nms"].to_numpy(float)
     t = events["t_s"].to_numpy(float)
     claimed = np.zeros(len(events), bool)
@@ -166,10 +167,14 @@ def match(events: pd.DataFrame, truth: dict) -> tuple[list[dict], pd.DataFrame]:
     ]
     spans += [(g["start_s"], g["end_s"]) for g in ops["gaps"]]
     left = events[~claimed].copy()
+    lt = left["t_s"].to_numpy()
+    near_truth = np.zeros(len(left), bool)
+    for ev in truth["events"]:
+        near_truth |= (lt >= ev["start_s"] - 30.0) & (lt <= ev["end_s"] + 60.0)
     near_ops = np.zeros(len(left), bool)
     for a, b in spans:
-        near_ops |= (left["t_s"].to_numpy() >= a - 600.0) & (left["t_s"].to_numpy() <= b + 600.0)
-    left["near"] = np.where(near_ops, "operations", "none")
+        near_ops |= (lt >= a - 600.0) & (lt <= b + 600.0)
+    left["near"] = np.where(near_truth, "truth", np.where(near_ops, "operations", "none"))
     return rows, left
 
 
@@ -229,11 +234,13 @@ def report(rows: list[dict], left: pd.DataFrame, days: float) -> None:
     print(
         f"events at no truth event: {len(free)} in {days:g} days ({n_strike} called strike) = "
         f"{len(free) * 5 / days:.1f} per 5 days; {int((left['near'] == 'operations').sum())} more "
-        "within 10 min of a flagged dump, slew or gap"
+        f"within 10 min of a flagged dump, slew or gap; {int((left['near'] == 'truth').sum())} second events "
+        "in a truth event's window"
     )
     for _, ev in free.iterrows():
         print(
-            f"  {ev['spacecraft']} {ev['time_utc']} {ev['kind']} {ev.get('kind_channel', '')} {ev['dH_Nms']:.4f} N·m·s"
+            f"  {ev['spacecraft']} {ev['time_utc']} {ev['kind']} {ev.get('kind_channel', '')} {ev['dH_Nms']:.4f} N·m·s "
+            f"statistic {ev['statistic']:.0f} (threshold {ev['threshold']:.0f}): {ev.get('kind_reason', '')}"
         )
 
 

@@ -14,12 +14,14 @@ pytest.importorskip("Basilisk")
 from Basilisk.utilities import RigidBodyKinematics as rbk
 
 from basilisk_confounders import draw_design, net_momentum_N
-from basilisk_dynamics import Piece, dcm_BN, simulate, whole_inertia
+from basilisk_dynamics import Design, Piece, Record, dcm_BN, simulate, whole_inertia
 from basilisk_sensors import quaternion_from_dcm, tachometers
+
+Run = tuple[Design, np.ndarray, Record]
 
 
 @pytest.fixture(scope="module")
-def run() -> tuple:  # type: ignore[type-arg]
+def run() -> Run:
     design = draw_design(0, np.random.default_rng(7))
     impulse_B = np.array([0.12, -0.05, 0.08])  # N m s
     dt = design.vehicle.dyn_dt_s
@@ -27,7 +29,7 @@ def run() -> tuple:  # type: ignore[type-arg]
     return design, impulse_B, rec
 
 
-def test_strike_steps_basilisk_momentum_by_the_applied_impulse(run: tuple) -> None:  # type: ignore[type-arg]
+def test_strike_steps_basilisk_momentum_by_the_applied_impulse(run: Run) -> None:
     _, impulse_B, rec = run
     expected_N = net_momentum_N(rec, "ev0")
     assert np.linalg.norm(expected_N) == pytest.approx(np.linalg.norm(impulse_B), rel=1e-9)
@@ -37,7 +39,7 @@ def test_strike_steps_basilisk_momentum_by_the_applied_impulse(run: tuple) -> No
     assert np.linalg.norm(step - expected_N) < 2e-3
 
 
-def test_momentum_from_the_recorded_state_is_basilisks(run: tuple) -> None:  # type: ignore[type-arg]
+def test_momentum_from_the_recorded_state_is_basilisks(run: Run) -> None:
     """H_N = [BN]^T (J ω + Σ Js Ω_i g_i) with the whole inertia: frames, wheel-speed sign and units right
     (a wrong sign or frame is off by ~1 N m s; Basilisk's own figure is logged between integrator stages,
     a few 1e-5 N m s apart, far below a tachometer quantum)."""
@@ -63,7 +65,7 @@ def test_quaternion_and_dcm_follow_basilisk_kinematics() -> None:
         assert np.allclose(qq, ref, atol=1e-9)
 
 
-def test_tachometer_counts_pulses_of_the_recorded_speed(run: tuple) -> None:  # type: ignore[type-arg]
+def test_tachometer_counts_pulses_of_the_recorded_speed(run: Run) -> None:
     design, _, rec = run
     chans = tachometers(design, rec, [], np.random.default_rng(1))
     quantum = 60.0 / (design.tach_pulses * design.tach_gate_s)
