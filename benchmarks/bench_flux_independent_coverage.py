@@ -149,7 +149,8 @@ def main() -> None:
 
 
 def plot_coverage(table: pd.DataFrame, path: Path) -> None:
-    """Each fleet's reported 90 % interval / truth, sorted by its estimate, per scale and truth; red: misses."""
+    """Each fleet's reported 90 % interval / truth (blue, red where it misses the truth) and estimate / truth
+    (black), fleets sorted by their estimate, per scale and truth."""
     fig, axes = plt.subplots(2, 2, figsize=(10, 6), sharey="row")
     for i, (name, key) in enumerate((("debris", "debris_scale"), ("meteoroid", "meteoroid_scale"))):
         for j, (t, grp) in enumerate(table.groupby("truth_debris")):
@@ -163,7 +164,7 @@ def plot_coverage(table: pd.DataFrame, path: Path) -> None:
                           color=colour, lw=1)  # fmt: skip
             ax.plot(x, g[key].to_numpy() / truth, ".", color="k", ms=2)
             ax.axhline(1.0, color="0.3", lw=1)
-            ax.set_yscale("symlog", linthresh=0.1)
+            ax.set_ylim(-1.0, 3.0)
             ax.set_title(f"{name} scale, fleets at debris {t:g}× NASA-90/91: covered {hit.mean():.0%}", fontsize=9)
             ax.set_xlabel("fleet (sorted by its estimate)")
         axes[i, 0].set_ylabel(f"{name} scale / truth")

@@ -128,7 +128,8 @@ def cell_expectations(
     mu0 = np.asarray(reference, dtype=np.float64) @ sig + bg
     u = np.where(mu0 > 0, sig / np.where(mu0 > 0, mu0, 1.0), 0.0)
     inv = np.linalg.inv((u * mult) @ sig.T)
-    return sig, bg, mult, inv @ u, inv @ ((u * mult) @ bg)
+    coef = np.asarray(inv @ u, dtype=np.float64)
+    return sig, bg, mult, coef, np.asarray(inv @ ((u * mult) @ bg), dtype=np.float64)
 
 
 def linear_fit(
