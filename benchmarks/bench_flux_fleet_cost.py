@@ -13,6 +13,7 @@ Run: ``nice python benchmarks/bench_flux_fleet_cost.py [--draws 400000]``.
 from __future__ import annotations
 
 import argparse
+import os
 import tempfile
 import time
 from pathlib import Path
@@ -45,6 +46,11 @@ def _timed(cat: Catalog, cfg: ForwardConfig) -> tuple[float, float, int]:
     return time.perf_counter() - t0, time.process_time() - c0, res.n_templates
 
 
+def _load() -> str:
+    """The machine's 1-minute load average and core count (wall time on a shared machine depends on both)."""
+    return f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--draws", type=int, default=400_000)
@@ -73,10 +79,11 @@ def main() -> None:
         years = len(exposure) / 365.25
         print(f"{len(names)} spacecraft, {len(exposure)} spacecraft-days ({years:.0f} spacecraft-years), ", end="")
         print(f"{len(events)} events")
+        before = _load()
         wall, cpu, n_tpl = _timed(fleet, cfg)
         print(
             f"fleet of {len(names)} names, one model: inference {wall:6.2f} s wall, {cpu:6.2f} s CPU, "
-            f"{n_tpl} template(s)  (target < {TARGET_S:.0f} s)"
+            f"{n_tpl} template(s)  (target < {TARGET_S:.0f} s; {before} before, {_load()} after)"
         )
         wall1, cpu1, n_tpl1 = _timed(single, cfg)
         print(

@@ -48,6 +48,7 @@ import argparse
 import time
 from pathlib import Path
 
+import matplotlib
 import numpy as np
 import pandas as pd
 
@@ -57,7 +58,11 @@ from abrupt.model.spacecraft import load_spacecraft
 from abrupt.simulate.population import FleetSpec, fleet_exposure
 from independent_strikes import draw_fleet, strike_sample
 
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
 ROOT = Path(__file__).resolve().parent.parent
+FIGURE = ROOT / "docs" / "results" / "flux_independent_coverage.png"
 FERMI = str(ROOT / "examples" / "spacecraft" / "fermi_like.toml")
 ORBITS = ((550.0, 28.5), (800.0, 98.0))
 BETA = 1.5
@@ -117,6 +122,7 @@ def main() -> None:
             for name in ("debris_scale", "meteoroid_scale"):
                 lo, hi = rep["intervals"][name]
                 row[name] = rep["estimates"][name]
+                row[f"{name}_lo"], row[f"{name}_hi"] = lo, hi
                 row[f"{name}_covered"] = lo <= truth[name] <= hi
                 ml_lo, ml_hi = res.intervals[name]
                 row[f"{name}_ml_covered"] = ml_lo <= truth[name] <= ml_hi
@@ -131,12 +137,40 @@ def main() -> None:
         print(f"{name} scale: pooled 90 % coverage {pooled:.1%} ± {se:.1%} (reported intervals), ML profile {ml:.1%}")
         for t, grp in table.groupby("truth_debris"):
             truth = t if key == "debris_scale" else 1.0
-            med = grp[key].median() / truth - 1
-            mean = grp[key].mean() / truth - 1
+            rel = grp[key].to_numpy() / truth - 1
+            boot = np.median(rng.choice(rel, size=(2000, rel.size)), axis=1)  # s.e. of the median, bootstrap
             cov = grp[f"{key}_covered"].mean()
             print(
-                f"  debris truth {t:g}: coverage {cov:.1%}, median/truth - 1 = {med:+.1%}, mean/truth - 1 = {mean:+.1%}"
+                f"  fleets at debris truth {t:g}: coverage {cov:.1%}, median/truth - 1 = {np.median(rel):+.1%} "
+                f"± {boot.std():.1%}, mean/truth - 1 = {rel.mean():+.1%} ± {rel.std() / np.sqrt(rel.size):.1%}"
             )
+    plot_coverage(table, FIGURE)
+    print(f"figure written to {FIGURE.relative_to(ROOT)}")
+
+
+def plot_coverage(table: pd.DataFrame, path: Path) -> None:
+    """Each fleet's reported 90 % interval / truth (blue, red where it misses the truth) and estimate / truth
+    (black), fleets sorted by their estimate, per scale and truth."""
+    fig, axes = plt.subplots(2, 2, figsize=(10, 6), sharey="row")
+    for i, (name, key) in enumerate((("debris", "debris_scale"), ("meteoroid", "meteoroid_scale"))):
+        for j, (t, grp) in enumerate(table.groupby("truth_debris")):
+            truth = t if key == "debris_scale" else 1.0
+            g = grp.sort_values(key)
+            x = np.arange(len(g))
+            hit = g[f"{key}_covered"].to_numpy()
+            ax = axes[i, j]
+            for mask, colour in ((hit, "tab:blue"), (~hit, "tab:red")):
+                ax.vlines(x[mask], g[f"{key}_lo"].to_numpy()[mask] / truth, g[f"{key}_hi"].to_numpy()[mask] / truth,
+                          color=colour, lw=1)  # fmt: skip
+            ax.plot(x, g[key].to_numpy() / truth, ".", color="k", ms=2)
+            ax.axhline(1.0, color="0.3", lw=1)
+            ax.set_ylim(-1.0, 3.0)
+            ax.set_title(f"{name} scale, fleets at debris {t:g}× NASA-90/91: covered {hit.mean():.0%}", fontsize=9)
+            ax.set_xlabel("fleet (sorted by its estimate)")
+        axes[i, 0].set_ylabel(f"{name} scale / truth")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 
 if __name__ == "__main__":

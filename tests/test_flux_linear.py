@@ -14,7 +14,7 @@ from abrupt.cli.flux import _fit_lines
 from abrupt.errors import ConfigError
 from abrupt.flux.exposure import DAYS_PER_YEAR
 from abrupt.flux.inference import FitResult, Likelihood, fit, prepare
-from abrupt.flux.linear import linear_fit
+from abrupt.flux.linear import cell_expectations, linear_fit
 from abrupt.report.flux import fits_table
 from test_flux_inference import AMPLITUDE, CASE, CONFIG, SLOPE, events_from_counts, exposure, power_law_template
 
@@ -160,3 +160,24 @@ def test_quoting_negative_linear_scales_keeps_the_reported_estimate_unbiased_and
     assert lift.mean() > max(0.1, 4 * lift.std() / math.sqrt(300))
     cover = np.mean((a[:, :, 1] <= t) & (t <= a[:, :, 2]), axis=0)
     assert np.all(np.abs(cover - 0.9) < 3 * math.sqrt(0.09 / 300))
+
+
+def test_the_estimate_as_a_function_of_cell_counts_is_the_linear_fit() -> None:
+    """cell_expectations writes s̃ = coef @ n − offset over the distinct day cells (here the |ΔH| bins of one kind
+    of day, directions unknown): for random counts it equals linear_fit on events with those counts, and the
+    cells' expectations are the likelihood's bin expectations (what benchmarks/bench_flux_median_decomposition.py
+    draws the estimator's exact distribution from)."""
+    exp = exposure(3, 1.0, false_alarms=0.01)
+    exp["dH50_Nms"] = 1.2e-3
+    data = prepare(exp, events_from_counts(np.ones(CONFIG.n_bins, dtype=int), exp), {CASE: power_law_template()})
+    lik = Likelihood(data, np.array([1.0]))
+    sig, bg, mult, coef, offset = cell_expectations(lik, 1.0)
+    truth = np.array([0.3, 1.0])
+    np.testing.assert_allclose((truth @ sig + bg) * mult, truth @ lik.bin_signal[0] + data.background_bins, rtol=1e-9)
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        counts = rng.poisson(3.0, CONFIG.n_bins).astype(float)
+        res = linear_fit(lik.reweighted(counts), {}, 0.9)
+        expected = coef @ counts - offset
+        got = [res.estimates["debris_scale"], res.estimates["meteoroid_scale"]]
+        np.testing.assert_allclose(got, expected, rtol=1e-9, atol=1e-12)

@@ -115,6 +115,23 @@ def _cells(lik: Likelihood, beta: float) -> tuple[NDArray[np.float64], NDArray[n
     return np.concatenate(sig, axis=1), np.concatenate(bg), np.concatenate(weight)
 
 
+def cell_expectations(
+    lik: Likelihood, beta: float, reference: tuple[float, float] = (1.0, 1.0)
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The linear estimate (both scales free) as a function of the counts of the distinct day cells.
+
+    Returns the cells' signal at unit scales (P, N), false alarms (N,) and multiplicity (N,) (the expected
+    count of cell i at scales s is (s·sig_i + bg_i)·mult_i), and ``coef`` (P, N), ``offset`` (P,) such that
+    s̃ = coef @ n − offset for the counts n of the cells: what :func:`linear_fit` computes from the events,
+    written for drawing its exact sampling distribution from Poisson counts."""
+    sig, bg, mult = _cells(lik, beta)
+    mu0 = np.asarray(reference, dtype=np.float64) @ sig + bg
+    u = np.where(mu0 > 0, sig / np.where(mu0 > 0, mu0, 1.0), 0.0)
+    inv = np.linalg.inv((u * mult) @ sig.T)
+    coef = np.asarray(inv @ u, dtype=np.float64)
+    return sig, bg, mult, coef, np.asarray(inv @ ((u * mult) @ bg), dtype=np.float64)
+
+
 def linear_fit(
     lik: Likelihood,
     fixed: Mapping[str, float],

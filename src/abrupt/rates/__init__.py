@@ -141,13 +141,20 @@ Checks against the sources (tests in `tests/test_rates_*.py`)
 
 The Grün flux for m ≥ 1e-6 g is 1.49 m⁻² yr⁻¹ (4.7e-8 m⁻² s⁻¹) at 1 AU, computed from Eq. 101 itself
 (F1 = 47.1^−4.38 = 4.7e-8 s⁻¹ dominates); the NASA-90/91 value above is of order 1e-5, as published.
-Ψ(i), the NASA-90/91 inclination table (Kessler et al. 1991, reproduced in ECSS-E-10-04A), was
-typed in without a copy of the publication at hand (28.5°: 0.91, 30°: 0.92, 40°: 0.96, 50°: 1.02, 60°: 1.09,
-70°: 1.26, 80°: 1.18, 90°: 1.00, 100°: 0.98). A search of the stored public sources (web pages, code,
-documentation) found no copy of the table itself; it found two independent course implementations of the model
-that quote Ψ(45°) = 0.990 and Ψ(52°) = 1.030 "from the table", which this table gives by linear interpolation
-(0.990 and 1.034). **The nodes at 28.5-60° are thus corroborated only indirectly and those at 70-100° not at
-all**: check them against Kessler et al. (1991) or ECSS-E-10-04A before quoting NASA-90/91 rates for inclined
+Checked against the publications' text (tests/test_rates_published.py): Grün's F1-F3 coefficients as
+ECSS-E-ST-10-04C §10.2.4.1 Eq. 101 prints them; R_E = 6378 km, the 100 km atmosphere (Annex C.1.3) and μ (Eq.
+C-4). Corroborated only by secondary sources (two independent public implementations of NASA-90/91): the
+NASA-90/91 constants (1.22e-5 d^-2.5, 8.1e10 (d+700)^-6, H(d) 0.78/0.637, Φ, p, q, q'). Not checked (no copy
+reachable): ECSS Tables C-1 and J-6 (meteoroid speeds, focusing/shielding per orbit), the SSP 30425 speed
+distribution used instead, the debris direction/speed model, and Ψ(i). Ψ(i), the NASA-90/91 inclination table
+(Kessler et al. 1991; Kessler, Reynolds & Anz-Meador 1989, NASA TM-100471; ECSS-E-10-04A), was typed in without
+a copy of the publication (28.5°: 0.91, 30°: 0.92, 40°: 0.96, 50°: 1.02, 60°: 1.09, 70°: 1.26, 80°: 1.18, 90°:
+1.00, 100°: 0.98). The stored copies of the sources that hold it (Meshishnek 1995, Aerospace TR-95(5231)-3;
+SPENVIS's NASA90 background page; the ESABASE2/Debris technical description) return their opening pages only,
+and no public code holds the table. Two independent implementations quote Ψ(45°) = 0.990 and Ψ(52°) = 1.030
+"from the table", which this table gives as 0.990 and 1.034. **The nodes at 28.5-60° are thus corroborated only
+indirectly and those at 70-100° not at all** (the 80° value is doubtful: some sources reportedly put the peak
+near 80° at about 1.7; not verified here): check them against Kessler et al. before quoting NASA-90/91 rates for
 orbits above 60° (the polar and sun-synchronous cases).
 
 Limitations

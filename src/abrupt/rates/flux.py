@@ -15,7 +15,8 @@ Both are the engineering models given in ECSS-E-ST-10-04C (and its predecessor E
   S the 13-month smoothed F10.7 of year t-1 [10^-22 W m^-2 Hz^-1], and Ψ(i) a tabulated function
   of inclination. F is in impacts m^-2 yr^-1 on a randomly tumbling surface (k = 1).
 
-* **Grün meteoroids** (Grün et al. 1985; ECSS-E-ST-10-04C §10.2.4.1, Eq. 101), cumulative flux of
+* **Grün meteoroids** (Grün et al. 1985; ECSS-E-ST-10-04C §10.2.4.1, Eq. 101; the F1-F3 coefficients checked
+  against the standard's text in tests/test_rates_published.py), cumulative flux of
   meteoroids of mass >= m [g] at 1 AU onto a single-sided randomly oriented flat plate,
 
   .. math::
@@ -60,10 +61,14 @@ GRUN_MIN_MASS_KG = 1.0e-21  # [kg] 1e-18 g: lower validity limit of the Grün fi
 GRUN_MAX_MASS_KG = 1.0e-1  # [kg] 100 g: upper validity limit of the Grün fit
 METEOROID_DENSITY_KG_M3 = 2500.0  # [kg m^-3] assumed meteoroid bulk density for mass <-> size
 
-# Ψ(i): inclination function of NASA-90/91 (Kessler et al. 1991; ECSS-E-10-04A Annex), i in degrees; linear
-# interpolation between nodes, constant outside. Typed in without a copy of the table: the 28.5-60° nodes agree
-# with values quoted by independent implementations (Ψ(45°) = 0.990, Ψ(52°) = 1.030); 70-100° are unverified
-# (the docstring of abrupt.rates, "Checks against the sources").
+# Ψ(i): inclination function of NASA-90/91 (Kessler et al. 1991; Kessler, Reynolds & Anz-Meador 1989, NASA
+# TM-100471; ECSS-E-10-04A Annex), i in degrees; linear interpolation between nodes, constant outside. NOT checked
+# against the publication: no copy of the table was reachable (the stored copies of Meshishnek 1995, SPENVIS's
+# NASA90 background page and the ESABASE2/Debris technical description return their opening pages only, and no
+# public code holds the table). Evidence per node: 28.5-60° agree with the values two independent public
+# implementations quote "from the table" (Ψ(45°) = 0.990, this table 0.990; Ψ(52°) = 1.030, this table 1.034);
+# 70°, 80°, 90°, 100° have none (80°: 1.18 is doubtful; some sources reportedly put the peak near 80° at
+# about 1.7, not verified here). tests/test_rates_published.py holds the corroborated values.
 _PSI_INCLINATION_DEG = np.array([28.5, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0, 100.0])
 _PSI_VALUE = np.array([0.91, 0.92, 0.96, 1.02, 1.09, 1.26, 1.18, 1.00, 0.98])
 
