@@ -18,12 +18,13 @@ Command line
   maneuvers and campaigns found, the smallest detectable in-track and cross-track ΔV of the whole history and
   **of each calendar year** (its own step noise and threshold), and the **realised false-alarm rate on
   bootstrapped histories of its own quiet noise** beside the budget, per year, with its exact 95 % interval
-  (also in the run record's `noise_model`: `detectable_by_year`, `own_null_by_year` or `own_null`). Events have the event columns of the README plus `maneuver_type` (LEO:
-  in-track / radial / cross-track; GEO: east-west / north-south), `regime`, `dv_t_sigma_mps`, `dv_n_sigma_mps`
-  (1σ), `campaign_id`/`campaign_size` (detections less than 3 days apart), `burn_count` (1 for a maneuver; see
-  campaign events below), `interval_start_utc` / `interval_end_utc` (the interval the burn or burns behind the
-  step fall in) and `burns_max` (how many burns that interval may hold), `z_a`, `z_e`, `z_n`, `delta_a_m`, the
-  bracketing element-set epochs and `time_method`. The run record in the catalog holds, per satellite, the
+  (also in the run record's `noise_model`: `detectable_by_year`, `own_null_by_year` or `own_null`). Events have
+  the event columns of the README plus `maneuver_type` (LEO: in-track / radial / cross-track; GEO: east-west /
+  north-south), `regime`, `dv_t_sigma_mps`, `dv_n_sigma_mps` (1σ), `campaign_id`/`campaign_size` (detections less
+  than 3 days apart), `burn_count` (1 for a maneuver; see campaign events below), `interval_start_utc` /
+  `interval_end_utc` (the interval the burn or burns behind the step fall in) and `burns_max` (how many burns that
+  interval may hold), `z_a`, `z_e`, `z_n`, `delta_a_m`, the bracketing element-set epochs and `time_method`. The run
+  record in the catalog holds, per satellite, the
   repairs, the skipped lines and the noise model. **Campaign events**: beside its maneuvers, every chain of
   detections (each within 7 days or 6 element sets of the previous one) is also one event of kind
   `maneuver_campaign`, at its first member's time, with `burn_count` (how many burns its element sets show),
