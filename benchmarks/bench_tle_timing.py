@@ -6,13 +6,20 @@ Every shared history (``../shared/data/tle``) runs through ``tle.mean_elements``
 and is scored against its operator file (``../shared/data/maneuvers``) by :mod:`abrupt.score`:
 
 * precision, recall, F1 at ±1 day one-to-one (all operator maneuvers in the span);
-* recall of operator maneuvers of at least 2 cm/s (IDS files give ΔV), and recall of the maneuvers
-  above the floor the run states for their year (``noise_model["detectable_by_year"]``);
+* recall of operator maneuvers of at least 2 cm/s (IDS files give ΔV), twice: by the sum of the
+  burn magnitudes of the file's line (``dv_mps``) and by its net ΔV, the magnitude of the summed
+  components (``dv_r/t/n_mps``: a pair of opposite burns hours apart nets to nothing in the file and
+  moves the element sets little); and recall of the maneuvers above the floor the run states for
+  their year (``noise_model["detectable_by_year"]``);
 * offsets (event − operator) of the one-to-one pairs within ±3 days: median, median |Δt|, share
   more than a day late;
 * interval coverage: the share of those pairs whose operator epoch lies inside the event's stated
   interval (``interval_start_utc``-``interval_end_utc``); nominal 90 %;
-* unmatched detections per year beside the budget.
+* unmatched detections per year beside the budget;
+* the share of events whose time lies inside their interval (by definition 1);
+* the TLE lag of the history: how long before the last set on the old level (the event's
+  ``elset_epoch_before_utc``) the operator epoch lies, median and 90th percentile over the pairs
+  within ±3 days (days; positive: the sets still showed the old orbit after the burn).
 
 Jason-1 (2001-2013) is the held-out older-era history: nothing was tuned on it.
 
@@ -58,6 +65,7 @@ BUDGET = FalseAlarmBudget(1.0, "year")
 TOLERANCE_S = 86400.0
 OFFSET_WINDOW_S = 3 * 86400.0
 BIG_BURN_MPS = 0.02
+NET_COLUMNS = ("dv_r_mps", "dv_t_mps", "dv_n_mps")
 
 
 def evaluate(sat: str) -> dict[str, Any]:
@@ -77,6 +85,8 @@ def evaluate(sat: str) -> dict[str, Any]:
     in_span = ((t_utc >= start) & (t_utc <= end)).to_numpy()
     matched = {j for _, j, _ in res.pairs}
     big = in_span & (truth["dv_mps"].fillna(np.inf).to_numpy(dtype=float) >= BIG_BURN_MPS)
+    net = np.hypot.reduce([truth[c].fillna(np.inf).to_numpy(dtype=float) for c in NET_COLUMNS], axis=0)
+    big_net = in_span & (net >= BIG_BURN_MPS)
     nm = run.diagnostics[0].noise_model or {}
     above = in_span & burns_above_floor(truth, nm.get("detectable_by_year", []))
     wide = score_events(events, truth, tolerance_s=OFFSET_WINDOW_S, start=start, end=end)
@@ -84,8 +94,13 @@ def evaluate(sat: str) -> dict[str, Any]:
     covered = []
     lo = pd.to_datetime(events["interval_start_utc"].astype(str), format="ISO8601")
     hi = pd.to_datetime(events["interval_end_utc"].astype(str), format="ISO8601")
+    t_ev = pd.to_datetime(events["time_utc"].astype(str), format="ISO8601", utc=True).dt.tz_localize(None)
+    before = pd.to_datetime(events["elset_epoch_before_utc"].astype(str), format="ISO8601")
+    lag_d = []
     for i, j, _ in wide.pairs:
         covered.append(bool(lo.iloc[i] <= t_utc.iloc[j] <= hi.iloc[i]))
+        lag_d.append((before.iloc[i] - t_utc.iloc[j]).total_seconds() / 86400.0)
+    in_interval = ((lo <= t_ev) & (t_ev <= hi)).to_numpy()
     years = (end - start).total_seconds() / (86400.0 * 365.25)
     n_big = int(big.sum())
     n_above = int(above.sum())
@@ -100,6 +115,10 @@ def evaluate(sat: str) -> dict[str, Any]:
         "f1": res.f1,
         "n_big": n_big,
         "recall_big": sum(1 for j in np.flatnonzero(big) if j in matched) / n_big if n_big else float("nan"),
+        "n_big_net": int(big_net.sum()),
+        "recall_big_net": sum(1 for j in np.flatnonzero(big_net) if j in matched) / int(big_net.sum())
+        if big_net.any()
+        else float("nan"),
         "n_above_floor": n_above,
         "recall_above_floor": sum(1 for j in np.flatnonzero(above) if j in matched) / n_above
         if n_above
@@ -110,6 +129,9 @@ def evaluate(sat: str) -> dict[str, Any]:
         "late_over_1d": int((offsets_d > 1.0).sum()),
         "coverage": float(np.mean(covered)) if covered else float("nan"),
         "unmatched_per_year": res.false_positives / years,
+        "time_in_interval": float(in_interval.mean()) if in_interval.size else float("nan"),
+        "lag_p50_d": float(np.median(lag_d)) if lag_d else float("nan"),
+        "lag_p90_d": float(np.quantile(lag_d, 0.9)) if lag_d else float("nan"),
         "outlier_sets": int(nm.get("outlier_sets", 0)),
         "offsets_d": offsets_d,
         "seconds": seconds,
@@ -147,8 +169,9 @@ def main() -> None:
     sats = [s for s in SATELLITES if args.only is None or s in args.only]
     rows = [evaluate(s) for s in sats]
     cols = (
-        "satellite sets years det truth precision recall f1 n_big recall_big n_above_floor recall_above_floor "
-        "pairs_3d median_offset_d median_abs_offset_d late_over_1d coverage unmatched_per_year outlier_sets seconds"
+        "satellite sets years det truth precision recall f1 n_big recall_big n_big_net recall_big_net n_above_floor "
+        "recall_above_floor pairs_3d median_offset_d median_abs_offset_d late_over_1d coverage time_in_interval "
+        "lag_p50_d lag_p90_d unmatched_per_year outlier_sets seconds"
     ).split()
     table = pd.DataFrame([{k: r[k] for k in cols} for r in rows])
     with pd.option_context("display.width", 250, "display.max_columns", 40):

@@ -470,7 +470,7 @@ def bootstrap_null_history(
     """
     rng = np.random.default_rng(seed)
     t_real = pd.to_datetime(history.elements["epoch_utc"]) - pd.to_datetime(history.elements["epoch_utc"]).iloc[0]
-    t_real_d = t_real.dt.total_seconds().to_numpy() / SECONDS_PER_DAY
+    t_real_d = np.asarray(t_real.dt.total_seconds().to_numpy(), dtype=np.float64) / SECONDS_PER_DAY
     # quiet stretches of at least 12 sets; each is detrended on its own sets
     runs: list[tuple[int, int]] = []
     k = 0
