@@ -23,6 +23,7 @@ from abrupt import progress
 from abrupt.catalog import AnalysedSpan
 from abrupt.detect.base import DetectionResult, Diagnostics, get_detector
 from abrupt.detect.orbit.analysis import OrbitAnalysis, innovation_scale
+from abrupt.detect.orbit.boundaries import ProductBoundary, day_boundary_indices
 from abrupt.detect.orbit.detectors import (
     SETTLE_CAP_S,
     ArcTooShortError,
@@ -185,19 +186,29 @@ def detect_orbit(
 def without_propulsion(run: OrbitRun, area_to_mass_m2_kg: float) -> OrbitRun:
     """A run of a satellite without propulsion: the ΔV its model explains in the detector's window
     (:func:`abrupt.model.propulsion.explainable_dv_mps`) is stated; detections within it are dropped as
-    explained, those above it kept as kind ``unknown`` and named as what they are: bad input or a force
-    the model lacks, never a burn."""
+    explained; those above it at a product epoch (a UTC midnight inside the arc or a segment start the file
+    states, within the GLR window plus two samples) are the product's discontinuity there and are reported
+    with the product boundaries, not as events; the others are kept as kind ``unknown`` and named as what
+    they are: bad input or a force the model lacks, never a burn."""
     step = run.ephemeris.nominal_step_s
     an = run.analysis
     window_s = (an.config.glr_window_samples if an is not None else 10) * (step if np.isfinite(step) else 0.0)
     limit = explainable_dv_mps(window_s, float(run.summary.get("dv90_mps", np.nan)), area_to_mass_m2_kg)
     events = run.events
     notes = [f"{run.ephemeris.satellite} has no propulsion: its model explains |ΔV| up to {1e3 * limit:.3g} mm/s"]
+    joins: list[dict[str, object]] = []
     if len(events):
         explained = events["dv_mps"].to_numpy(dtype=float) <= limit
         if explained.any():
             notes.append(f"{int(explained.sum())} detection(s) within the ΔV the model explains: not events")
         events = events.loc[~explained].copy()
+        pad_s = 2.0 * step if np.isfinite(step) else 0.0  # the boundary window: GLR window plus two samples
+        events, joins = _at_product_epochs(run.ephemeris, events, window_s + pad_s)
+        if joins:
+            notes.append(
+                f"{len(joins)} detection(s) at a product day boundary or segment join: the product's "
+                "discontinuity (a satellite without propulsion cannot change its velocity there), not events"
+            )
         if len(events):
             events["kind"] = "unknown"
             notes.append(
@@ -211,8 +222,38 @@ def without_propulsion(run: OrbitRun, area_to_mass_m2_kg: float) -> OrbitRun:
         explainable_dv_mps=limit,
         events=len(events),
         warnings=[*out.summary.get("warnings", []), *notes],
+        product_boundaries=[*out.summary.get("product_boundaries", []), *joins],
     )
     return out
+
+
+def _at_product_epochs(
+    eph: Ephemeris, events: pd.DataFrame, window_s: float
+) -> tuple[pd.DataFrame, list[dict[str, object]]]:
+    """The events farther than ``window_s`` from every UTC midnight inside the arc and every segment start
+    the file states, and the others as product boundaries (dicts as in the run summary)."""
+    times = np.asarray(eph.times_utc, dtype="datetime64[ns]")
+    if events.empty or times.size < 2:
+        return events, []
+    epochs = [(times[k], "day boundary") for k in day_boundary_indices(times)]
+    epochs += [(np.datetime64(s, "ns"), "segment join") for s in eph.segment_starts_utc if times[0] < s <= times[-1]]
+    if not epochs:
+        return events, []
+    start = pd.to_datetime(events["time_utc"]).dt.tz_localize(None).to_numpy("datetime64[ns]")
+    duration = events["duration_s"].to_numpy(float) if "duration_s" in events else np.zeros(len(events))
+    keep = np.ones(len(events), dtype=bool)
+    found: list[dict[str, object]] = []
+    for i, (t0, d) in enumerate(zip(start, np.nan_to_num(duration), strict=True)):
+        t1 = t0 + np.timedelta64(round(d * 1e9), "ns")
+        for when, kind in epochs:
+            if (t0 - when) / np.timedelta64(1, "s") <= window_s and (when - t1) / np.timedelta64(1, "s") <= window_s:
+                keep[i] = False
+                k = int(np.searchsorted(times, when))
+                peak = float(events["statistic"].iloc[i])
+                bound = float(events["threshold"].iloc[i])
+                found.append(ProductBoundary(when, k, peak, bound, False, window_s, kind).as_dict())
+                break
+    return events.loc[keep].copy(), found
 
 
 def untested_run(det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, reason: str) -> OrbitRun:
