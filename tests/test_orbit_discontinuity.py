@@ -130,3 +130,47 @@ def test_a_file_without_velocities_is_not_tested(keplerian) -> None:  # type: ig
 
 def _shared_s3a(shared_data: Path) -> Path:
     return shared_data / "sp3" / "ssas3a20.b18358.e19003.DG_.sp3"
+
+
+def test_a_position_step_in_every_later_record_is_a_discontinuity_not_a_burn(shared_data: Path) -> None:
+    """Sentinel-3A (real DORIS SP3): a 50 m position step in every record after one epoch, velocities
+    untouched. Before the test the same step in a two-day arc raised five "burns" of 0.1-0.34 m/s (the step
+    and the filters' ringing after it); now there is no event and one product discontinuity of 50 m, and
+    the arc is analysed on either side of it."""
+    from abrupt.pipelines.orbit import detect_orbit, load_ephemeris
+    from abrupt.pipelines.orbit_blocks import part
+
+    path = _shared_s3a(shared_data)
+    if not path.exists():
+        pytest.skip(f"{path} not available")
+    arc = part(load_ephemeris(path, None), 0, 1800)
+    u = np.array([0.3, -0.5, 0.81]) / np.linalg.norm([0.3, -0.5, 0.81])
+    pos = arc.position_m.copy()
+    pos[900:] += 50.0 * u
+    run = detect_orbit(replace(arc, position_m=pos), budget="1/week")
+    assert run.events.empty
+    jumps = [b for b in run.summary["product_boundaries"] if b["kind"] == "product discontinuity"]
+    assert len(jumps) == 1
+    assert np.datetime64(jumps[0]["time_utc"]) == arc.times_utc[900]
+    assert jumps[0]["position_jump_m"] == pytest.approx(50.0, rel=0.01)
+
+
+def test_a_passive_satellites_detection_at_a_day_boundary_is_the_products_boundary() -> None:
+    """A LAGEOS-2-like two-day product (satellite L52, no propulsion) whose days join with a velocity jump
+    of ~0.5 mm/s and a continuous position: a velocity change, so the discontinuity test leaves it, and a
+    satellite with propulsion would report it (the control). LAGEOS-2 cannot change its velocity: at the
+    product's day boundary it is the product's boundary, not an event."""
+    from abrupt.pipelines.orbit import detect_orbit
+    from abrupt.simulate.products import DailyArcProduct, simulate_daily_arcs
+
+    cfg = DailyArcProduct(days=2, step_s=240.0, sigma_jump_pos_m=0.0, sigma_jump_vel_mps=3e-4, seed=1)
+    eph = simulate_daily_arcs(cfg)
+    boundary = cfg.boundaries_utc()[0]
+    active = detect_orbit(eph, budget="1/week", propulsion=True)
+    assert len(active.events) == 1
+    when = np.datetime64(active.events["time_utc"].iloc[0].rstrip("Z"), "ns")
+    assert abs((when - boundary) / np.timedelta64(1, "s")) < 600.0
+    passive = detect_orbit(eph, budget="1/week")
+    assert passive.events.empty
+    found = [b for b in passive.summary["product_boundaries"] if b["kind"] == "day boundary"]
+    assert [np.datetime64(b["time_utc"]) for b in found] == [boundary]

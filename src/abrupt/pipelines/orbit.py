@@ -11,6 +11,7 @@ Python API both call these functions.
 from __future__ import annotations
 
 import copy
+import itertools
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -32,6 +33,7 @@ from abrupt.detect.orbit.detectors import (
     orbit_product_boundaries,
     orbit_thresholds,
 )
+from abrupt.detect.orbit.discontinuity import DISCONTINUITY
 from abrupt.detect.orbit.ekf import NUISANCE_NAMES
 from abrupt.detect.orbit.sensitivity import detectable_dv
 from abrupt.errors import ConfigError, InputError
@@ -287,6 +289,10 @@ def _detect_arc(det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, sequen
             result = det.detect(eph, fa)
         except ArcTooShortError as exc:
             return untested_run(det, eph, fa, exc.reason)
+        jumps = [b for b in orbit_product_boundaries(result) if b.get("kind") == DISCONTINUITY]
+        # a calibration block (fixed tuning, mask over its extended span) is not split again
+        if jumps and len(result.events) and det.fixed_config is None and det.calibration_mask is None:
+            return _split_at_discontinuities(det, eph, fa, sequences, jumps)
         stage.update(1, status="burn sequences")
         # the removal needs the sharp time of the GLR; the thesis statistics' broad humps would re-raise
         if sequences and det.statistic == "glr" and len(result.events):
@@ -296,6 +302,29 @@ def _detect_arc(det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, sequen
         run = OrbitRun(eph, det, result, fa)
         run.summary = fit_summary(run)
     _check_fit(run.summary, eph, det)
+    return run
+
+
+def _split_at_discontinuities(
+    det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, sequences: bool, jumps: list[dict[str, Any]]
+) -> OrbitRun:
+    """The arc analysed again as separate arcs ended at its product discontinuities: the filters must not
+    run across a jump of the product, whose transient (a 50 m position step: hours of orbit-period
+    ringing) raises events far from it. The discontinuities are reported with the product boundaries."""
+    times = np.asarray(eph.times_utc, dtype="datetime64[ns]")
+    cuts = sorted({int(np.searchsorted(times, np.datetime64(str(b["time_utc"]), "ns"))) for b in jumps})
+    edges = [0, *[k for k in cuts if 0 < k < len(eph)], len(eph)]
+    arcs = [(a, b) for a, b in itertools.pairwise(edges) if b > a]
+    notes = [
+        f"product discontinuity at {str(b['time_utc'])[:19]}: position jump {float(b['position_jump_m']):.3g} m, "
+        f"velocity jump {1e3 * float(b['velocity_jump_mps']):.3g} mm/s, not a velocity change: not a burn"
+        for b in jumps
+    ]
+    notes.append(f"the arc is analysed as {len(arcs)} arcs ended at its product discontinuities")
+    run = _detect_blocks(det, eph, fa, sequences, arcs, 1, arcs, notes)
+    run.summary["product_boundaries"] = sorted(
+        [*run.summary.get("product_boundaries", []), *jumps], key=lambda b: str(b["time_utc"])
+    )
     return run
 
 
