@@ -11,6 +11,7 @@ Python API both call these functions.
 from __future__ import annotations
 
 import copy
+import itertools
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -23,6 +24,7 @@ from abrupt import progress
 from abrupt.catalog import AnalysedSpan
 from abrupt.detect.base import DetectionResult, Diagnostics, get_detector
 from abrupt.detect.orbit.analysis import OrbitAnalysis, innovation_scale
+from abrupt.detect.orbit.boundaries import ProductBoundary, day_boundary_indices
 from abrupt.detect.orbit.detectors import (
     SETTLE_CAP_S,
     ArcTooShortError,
@@ -31,6 +33,7 @@ from abrupt.detect.orbit.detectors import (
     orbit_product_boundaries,
     orbit_thresholds,
 )
+from abrupt.detect.orbit.discontinuity import DISCONTINUITY
 from abrupt.detect.orbit.ekf import NUISANCE_NAMES
 from abrupt.detect.orbit.sensitivity import detectable_dv
 from abrupt.errors import ConfigError, InputError
@@ -185,19 +188,29 @@ def detect_orbit(
 def without_propulsion(run: OrbitRun, area_to_mass_m2_kg: float) -> OrbitRun:
     """A run of a satellite without propulsion: the ΔV its model explains in the detector's window
     (:func:`abrupt.model.propulsion.explainable_dv_mps`) is stated; detections within it are dropped as
-    explained, those above it kept as kind ``unknown`` and named as what they are: bad input or a force
-    the model lacks, never a burn."""
+    explained; those above it at a product epoch (a UTC midnight inside the arc or a segment start the file
+    states, within the GLR window plus two samples) are the product's discontinuity there and are reported
+    with the product boundaries, not as events; the others are kept as kind ``unknown`` and named as what
+    they are: bad input or a force the model lacks, never a burn."""
     step = run.ephemeris.nominal_step_s
     an = run.analysis
     window_s = (an.config.glr_window_samples if an is not None else 10) * (step if np.isfinite(step) else 0.0)
     limit = explainable_dv_mps(window_s, float(run.summary.get("dv90_mps", np.nan)), area_to_mass_m2_kg)
     events = run.events
     notes = [f"{run.ephemeris.satellite} has no propulsion: its model explains |ΔV| up to {1e3 * limit:.3g} mm/s"]
+    joins: list[dict[str, object]] = []
     if len(events):
         explained = events["dv_mps"].to_numpy(dtype=float) <= limit
         if explained.any():
             notes.append(f"{int(explained.sum())} detection(s) within the ΔV the model explains: not events")
         events = events.loc[~explained].copy()
+        pad_s = 2.0 * step if np.isfinite(step) else 0.0  # the boundary window: GLR window plus two samples
+        events, joins = _at_product_epochs(run.ephemeris, events, window_s + pad_s)
+        if joins:
+            notes.append(
+                f"{len(joins)} detection(s) at a product day boundary or segment join: the product's "
+                "discontinuity (a satellite without propulsion cannot change its velocity there), not events"
+            )
         if len(events):
             events["kind"] = "unknown"
             notes.append(
@@ -211,8 +224,38 @@ def without_propulsion(run: OrbitRun, area_to_mass_m2_kg: float) -> OrbitRun:
         explainable_dv_mps=limit,
         events=len(events),
         warnings=[*out.summary.get("warnings", []), *notes],
+        product_boundaries=[*out.summary.get("product_boundaries", []), *joins],
     )
     return out
+
+
+def _at_product_epochs(
+    eph: Ephemeris, events: pd.DataFrame, window_s: float
+) -> tuple[pd.DataFrame, list[dict[str, object]]]:
+    """The events farther than ``window_s`` from every UTC midnight inside the arc and every segment start
+    the file states, and the others as product boundaries (dicts as in the run summary)."""
+    times = np.asarray(eph.times_utc, dtype="datetime64[ns]")
+    if events.empty or times.size < 2:
+        return events, []
+    epochs = [(times[k], "day boundary") for k in day_boundary_indices(times)]
+    epochs += [(np.datetime64(s, "ns"), "segment join") for s in eph.segment_starts_utc if times[0] < s <= times[-1]]
+    if not epochs:
+        return events, []
+    start = pd.to_datetime(events["time_utc"]).dt.tz_localize(None).to_numpy("datetime64[ns]")
+    duration = events["duration_s"].to_numpy(float) if "duration_s" in events else np.zeros(len(events))
+    keep = np.ones(len(events), dtype=bool)
+    found: list[dict[str, object]] = []
+    for i, (t0, d) in enumerate(zip(start, np.nan_to_num(duration), strict=True)):
+        t1 = t0 + np.timedelta64(round(d * 1e9), "ns")
+        for when, kind in epochs:
+            if (t0 - when) / np.timedelta64(1, "s") <= window_s and (when - t1) / np.timedelta64(1, "s") <= window_s:
+                keep[i] = False
+                k = int(np.searchsorted(times, when))
+                peak = float(events["statistic"].iloc[i])
+                bound = float(events["threshold"].iloc[i])
+                found.append(ProductBoundary(when, k, peak, bound, False, window_s, kind).as_dict())
+                break
+    return events.loc[keep].copy(), found
 
 
 def untested_run(det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, reason: str) -> OrbitRun:
@@ -246,6 +289,10 @@ def _detect_arc(det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, sequen
             result = det.detect(eph, fa)
         except ArcTooShortError as exc:
             return untested_run(det, eph, fa, exc.reason)
+        jumps = [b for b in orbit_product_boundaries(result) if b.get("kind") == DISCONTINUITY]
+        # a calibration block (fixed tuning, mask over its extended span) is not split again
+        if jumps and len(result.events) and det.fixed_config is None and det.calibration_mask is None:
+            return _split_at_discontinuities(det, eph, fa, sequences, jumps)
         stage.update(1, status="burn sequences")
         # the removal needs the sharp time of the GLR; the thesis statistics' broad humps would re-raise
         if sequences and det.statistic == "glr" and len(result.events):
@@ -255,6 +302,29 @@ def _detect_arc(det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, sequen
         run = OrbitRun(eph, det, result, fa)
         run.summary = fit_summary(run)
     _check_fit(run.summary, eph, det)
+    return run
+
+
+def _split_at_discontinuities(
+    det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, sequences: bool, jumps: list[dict[str, Any]]
+) -> OrbitRun:
+    """The arc analysed again as separate arcs ended at its product discontinuities: the filters must not
+    run across a jump of the product, whose transient (a 50 m position step: hours of orbit-period
+    ringing) raises events far from it. The discontinuities are reported with the product boundaries."""
+    times = np.asarray(eph.times_utc, dtype="datetime64[ns]")
+    cuts = sorted({int(np.searchsorted(times, np.datetime64(str(b["time_utc"]), "ns"))) for b in jumps})
+    edges = [0, *[k for k in cuts if 0 < k < len(eph)], len(eph)]
+    arcs = [(a, b) for a, b in itertools.pairwise(edges) if b > a]
+    notes = [
+        f"product discontinuity at {str(b['time_utc'])[:19]}: position jump {float(b['position_jump_m']):.3g} m, "
+        f"velocity jump {1e3 * float(b['velocity_jump_mps']):.3g} mm/s, not a velocity change: not a burn"
+        for b in jumps
+    ]
+    notes.append(f"the arc is analysed as {len(arcs)} arcs ended at its product discontinuities")
+    run = _detect_blocks(det, eph, fa, sequences, arcs, 1, arcs, notes)
+    run.summary["product_boundaries"] = sorted(
+        [*run.summary.get("product_boundaries", []), *jumps], key=lambda b: str(b["time_utc"])
+    )
     return run
 
 

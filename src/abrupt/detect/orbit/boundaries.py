@@ -65,7 +65,8 @@ class ProductBoundary:
     the event statistic's peak within its window, the bound it was compared with, and whether it was left
     to the event search (``raised``). The window runs from ``window_s`` before ``time_utc`` to ``after_s``
     after it (None: as long as before); ``index`` is the first epoch at or after ``time_utc``. A shadow
-    passage has its entry as ``time_utc`` and its exit as ``end_utc``."""
+    passage has its entry as ``time_utc`` and its exit as ``end_utc``; a product discontinuity
+    (:mod:`~abrupt.detect.orbit.discontinuity`) its position and velocity jumps."""
 
     time_utc: np.datetime64
     index: int
@@ -76,6 +77,8 @@ class ProductBoundary:
     kind: str = "day boundary"
     after_s: float | None = None
     end_utc: np.datetime64 | None = None
+    position_jump_m: float | None = None
+    velocity_jump_mps: float | None = None
 
     def span_mask(self, t_s: FloatArray, epoch_utc: np.datetime64) -> NDArray[np.bool_]:
         """True at the epochs (``t_s``: seconds from ``epoch_utc``) inside the window."""
@@ -100,6 +103,9 @@ class ProductBoundary:
         }
         if self.end_utc is not None:
             out["end_utc"] = str(self.end_utc)
+        if self.position_jump_m is not None:
+            out["position_jump_m"] = self.position_jump_m
+            out["velocity_jump_mps"] = self.velocity_jump_mps
         return out
 
 

@@ -23,7 +23,9 @@ from abrupt.types import FloatArray
 @dataclass(frozen=True)
 class JumpInterval:
     """A velocity change across epochs (k_first − 1, k_last): ΔV (inertial, m/s) and its covariance, the
-    centroid time (s), its 1σ, the estimated start time and duration (s; 0 for an impulse)."""
+    centroid time (s), its 1σ, the estimated start time and duration (s; 0 for an impulse). ``dr_m``: the
+    position offset left at the centroid (inertial, m; zero for a velocity change, whose position is
+    continuous) and ``dr_cov``, its covariance (m²)."""
 
     k_first: int
     k_last: int
@@ -33,6 +35,8 @@ class JumpInterval:
     centroid_sigma_s: float
     start_s: float
     duration_s: float
+    dr_m: FloatArray | None = None
+    dr_cov: FloatArray | None = None
 
 
 def interval_jump(analysis: OrbitAnalysis, k_first: int, k_last: int | None = None) -> JumpInterval:
@@ -121,7 +125,18 @@ def interval_jump(analysis: OrbitAnalysis, k_first: int, k_last: int | None = No
     u = dv / max(mag, 1e-300)
     lead = float(t[k_last]) - t_c
     var_lead = float(u @ cov_r @ u) / max(mag * mag, 1e-300) + lead * lead * float(u @ cov @ u) / max(mag * mag, 1e-300)
-    return JumpInterval(k_first, k_last, np.asarray(dv, dtype=np.float64), cov, t_c, float(np.sqrt(var_lead)), t_c, 0.0)
+    return JumpInterval(
+        k_first,
+        k_last,
+        np.asarray(dv, dtype=np.float64),
+        cov,
+        t_c,
+        float(np.sqrt(var_lead)),
+        t_c,
+        0.0,
+        np.asarray(dr, dtype=np.float64),
+        cov_r,
+    )
 
 
 def _quiet(analysis: OrbitAnalysis, w: FloatArray) -> bool:

@@ -44,6 +44,7 @@ from abrupt.detect.orbit.boundaries import (
     product_boundaries,
 )
 from abrupt.detect.orbit.calibration import calibrate_thresholds, self_calibrate
+from abrupt.detect.orbit.discontinuity import split_discontinuities
 from abrupt.detect.orbit.ekf import FilterConfig, NuisanceConfig
 from abrupt.detect.orbit.events import find_events
 from abrupt.detect.orbit.statistic_names import STATISTIC_SUMMARIES
@@ -246,7 +247,10 @@ class OrbitDetector(Detector[Ephemeris]):
         events = find_events(
             searched, thresholds, spacecraft=self.spacecraft or series.satellite, run_id=self.run_id, cfg_hash=chash
         )
-        return DetectionResult(events, self._diagnostics(analysis, thresholds, boundaries), warnings)
+        # a position jump no velocity change explains is the product's, not a burn
+        events, jumps, notes = split_discontinuities(analysis, events, thresholds[self.statistic].value)
+        boundaries = sorted([*boundaries, *jumps], key=lambda b: b.index)
+        return DetectionResult(events, self._diagnostics(analysis, thresholds, boundaries), (*warnings, *notes))
 
     def _boundaries(
         self, analysis: OrbitAnalysis, thresholds: dict[str, Threshold], budget: FalseAlarmBudget
