@@ -235,7 +235,7 @@ def _doy_400(folder: Path) -> Run:
     stamp = str(eph.times_utc[300])[:19]
     text = path.read_text()
     path.write_text(text.replace(stamp, stamp[:4] + "-400" + stamp[10:], 1))
-    return _orbit_run(path, None)
+    return _orbit_run(path, "malformed state line skipped")
 
 
 def _sat_switch(folder: Path) -> Run:

@@ -14,7 +14,7 @@ and runs there; the verdict of one run is:
   more than 2000 characters;
 - ``traceback``, ``data loss`` (an input's SHA-256 changed), ``runaway`` (60 s or 2 GB).
 
-    python benchmarks/bench_audit_cases.py [--only TEXT] [--group TEXT] [--src OTHER/src]
+    python benchmarks/bench_audit_cases.py [--only TEXT] [--group TEXT] [--src OTHER/src] [--jobs N]
 """
 
 from __future__ import annotations
@@ -31,6 +31,7 @@ import sys
 import tempfile
 import time
 from collections import Counter
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -74,9 +75,11 @@ def _environment() -> dict[str, str]:
     return env
 
 
-def _limits(fsize_bytes: int | None) -> object:
+def _limits(fsize_bytes: int | None, bounded: bool) -> object:
     def apply() -> None:
         os.setsid()
+        if not bounded:  # a case's preparation (not judged)
+            return
         resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT_BYTES, MEMORY_LIMIT_BYTES))
         resource.setrlimit(resource.RLIMIT_CPU, (int(TIME_LIMIT_S), int(TIME_LIMIT_S) + 5))
         if fsize_bytes is not None:
@@ -87,7 +90,7 @@ def _limits(fsize_bytes: int | None) -> object:
 
 
 def run_bounded(
-    argv: list[str], folder: Path, fsize_bytes: int | None = None
+    argv: list[str], folder: Path, fsize_bytes: int | None = None, *, bounded: bool = True
 ) -> tuple[int | None, str, str, float, float]:
     """Run ``abrupt argv`` in ``folder``: exit code (None: killed at the wall limit), stdout, stderr, the
     processor seconds it used and its peak resident memory (MB)."""
@@ -101,7 +104,7 @@ def run_bounded(
             stderr=err,
             stdin=subprocess.DEVNULL,
             env=_environment(),
-            preexec_fn=_limits(fsize_bytes),
+            preexec_fn=_limits(fsize_bytes, bounded),
         )
         code: int | None = None
         while True:
@@ -141,7 +144,7 @@ def _prepare(run: Run, folder: Path) -> None:
         elif step[0] == "__aer__":
             _damage_aer(folder / step[2], step[1])
         else:
-            code, _, err, _, _ = run_bounded(step, folder)
+            code, _, err, _, _ = run_bounded(step, folder, bounded=False)
             if code != 0:
                 raise RuntimeError(f"preparing step {step} failed: {err.strip()[-300:]}")
 
@@ -229,15 +232,15 @@ def main(argv: list[str] | None = None) -> dict[str, int]:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", default="", help="run the cases whose name holds this text")
     parser.add_argument("--group", default="", help="run the groups whose name holds this text")
+    parser.add_argument("--jobs", type=int, default=1, help="cases run at once (each its own subprocess)")
     parser.add_argument("--src", type=Path, default=ROOT / "src", help="source tree the runs import")
     args = parser.parse_args(argv)
     SOURCE[0] = args.src.resolve()
     cases = [c for c in (*orbit_cases(), *door_cases()) if args.only in c.name and args.group in c.group]
     totals: Counter[str] = Counter()
     print(f"{'group':<26} {'case':<46} {'verdict':<15} {'exit':>4} {'cpu s':>5} {'MB':>6}  detail")
-    with tempfile.TemporaryDirectory(prefix="abrupt-audit-") as tmp:
-        for case in cases:
-            outcome = run_case(case, Path(tmp))
+    with tempfile.TemporaryDirectory(prefix="abrupt-audit-") as tmp, ThreadPoolExecutor(args.jobs) as pool:
+        for case, outcome in zip(cases, pool.map(lambda c: run_case(c, Path(tmp)), cases), strict=True):
             totals[outcome.verdict] += 1
             code = "-" if outcome.exit_code is None else str(outcome.exit_code)
             detail = outcome.detail.replace("\n", " ")[:150]

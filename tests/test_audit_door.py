@@ -9,6 +9,11 @@ velocities restored, and detection on it must give no event.
 
 from __future__ import annotations
 
+import os
+import resource
+import subprocess
+import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -16,9 +21,14 @@ import pytest
 
 from _audit_cases import itrf, truth_orbit
 from _audit_orbit_cases import grg_proxy
+from abrupt.cli.commands import cli
+from abrupt.cli.main import main
+from abrupt.errors import InputError
 from abrupt.pipelines.orbit import detect_orbit
 from abrupt.readers.ephemeris import read_ephemeris
-from abrupt.readers.orbit_envelope import power_of_ten_repair
+from abrupt.readers.navigation_csv import write_navigation_csv
+from abrupt.readers.orbit_envelope import PV_MISMATCH_REPAIR, power_of_ten_repair
+from abrupt.readers.sp3 import write_sp3
 
 
 @pytest.mark.parametrize(
@@ -49,3 +59,69 @@ def test_detection_on_a_grg_proxy_gives_no_event(tmp_path: Path) -> None:
     run = detect_orbit(path)
     assert len(run.events) == 0
     assert run.result.diagnostics and not any("nothing tested" in w for w in run.result.warnings)
+
+
+@pytest.mark.parametrize("order", [[1, 0, 2], [0, 2, 1]])
+def test_position_columns_in_the_wrong_order_are_refused_not_emptied(order: list[int], tmp_path: Path) -> None:
+    """x and y (or y and z) position columns swapped, the velocities left: the median speed still agrees,
+    but the velocities point elsewhere at nearly every epoch. Refused (it once removed all 721 epochs
+    as mismatched, leaving a run that tested nothing with exit 0)."""
+    truth = truth_orbit(hours=3.0)
+    path = tmp_path / "swapped.csv"
+    write_navigation_csv(replace(truth, position_m=truth.position_m[:, order]), path)
+    with pytest.raises(InputError, match=r"velocity = derivative of position.*columns in the wrong order") as info:
+        read_ephemeris(path)
+    assert "swapped.csv" in str(info.value) and "\n" not in str(info.value)
+
+
+def test_a_few_mismatched_velocities_are_still_removed_and_counted(tmp_path: Path) -> None:
+    truth = truth_orbit(hours=3.0)
+    vel = truth.velocity_mps.copy()
+    vel[[40, 90]] *= -1.0  # two records' velocities reversed: 6 of 181 epochs removed with their neighbours
+    path = tmp_path / "two.csv"
+    write_navigation_csv(replace(truth, velocity_mps=vel), path)
+    eph = read_ephemeris(path)
+    assert eph.repairs.counts[PV_MISMATCH_REPAIR] == 6 and len(eph) == len(truth) - 6
+
+
+def _address_space_2_gb() -> None:
+    resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="an address-space limit binds as on Linux only there")
+def test_an_orbit_run_fits_in_2_gb_of_address_space(tmp_path: Path) -> None:
+    """The audit bounds every run to 2 GB with ``ulimit -v``: a 12 h orbit (about 450 MB resident) once
+    needed 3 GB of address space, two 1 GiB arenas of the mimalloc allocator reserved and never used."""
+    path = tmp_path / "o.sp3"
+    write_sp3(itrf(truth_orbit(hours=12.0)), path)
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parent.parent / "src")}
+    env.pop("MIMALLOC_ARENA_RESERVE", None)
+    argv = [sys.executable, "-m", "abrupt.cli.main", "-q", "detect", "orbit", path.name, "--out", "e.csv"]
+    done = subprocess.run(
+        [*argv, "--catalog", "c.sqlite"],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        preexec_fn=_address_space_2_gb,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr[-800:]
+    assert (tmp_path / "e.csv").exists()
+
+
+def test_running_out_of_memory_is_one_line(capsys: pytest.CaptureFixture[str]) -> None:
+    @cli.command("exhaust", hidden=True)
+    def exhaust() -> None:
+        raise MemoryError("Unable to allocate 229. MiB for an array with shape (10000000, 3) and data type float64")
+
+    try:
+        with pytest.raises(SystemExit) as info:
+            main(["exhaust"])
+    finally:
+        cli.commands.pop("exhaust")
+    assert info.value.code == 2
+    assert capsys.readouterr().err.splitlines() == [
+        "error: not enough memory for this run (Unable to allocate 229. MiB for an array with shape (10000000, 3) "
+        "and data type float64)"
+    ]

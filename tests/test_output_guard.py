@@ -119,6 +119,7 @@ def test_an_output_equal_to_an_input_is_refused_whatever_the_option(
     before = _digest(source)
     code, err = _run([a.format(input=source, tmp=tmp_path) for a in argv], capsys)
     assert code == 2 and "same file" in err and option in err, err
+    assert err.strip().splitlines() == [line for line in err.splitlines() if line.startswith("error: ")]  # one line
     assert _digest(source) == before and not (tmp_path / "e.csv").exists()
 
 

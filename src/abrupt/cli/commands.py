@@ -28,6 +28,7 @@ from typing import Any, TypeGuard
 import click
 
 from abrupt import __version__, progress
+from abrupt.errors import OutputError
 from abrupt.outputs import clear_protected, protect_inputs
 
 #: Global options accepted anywhere on the command line (moved before the sub-command by ``main``).
@@ -234,9 +235,10 @@ def _input_paths(params: Mapping[str, Any]) -> list[tuple[str, str]]:
 def check_output_paths(
     params: Mapping[str, Any], *, overwrite: bool = True, hints: Mapping[str, str] | None = None
 ) -> None:
-    """Raise :class:`click.BadParameter` when an output would overwrite an input or another output or
-    follow a link, or (unless ``overwrite``) when it is an existing file; register the inputs.
-    ``hints`` maps a parameter to the option that sets it (``report_path`` -> ``--report``)."""
+    """Raise :class:`~abrupt.errors.OutputError` (one line: the option, the path and the reason) when an
+    output would overwrite an input or another output or follow a link, or (unless ``overwrite``) when
+    it is an existing file; register the inputs. ``hints`` maps a parameter to the option that sets it
+    (``report_path`` -> ``--report``)."""
     hints = {"catalog_target": "--catalog", **(hints or {})}
     inputs = _input_paths(params)
     protect_inputs(path for name, path in inputs if name != "catalog_target")
@@ -245,29 +247,24 @@ def check_output_paths(
         for in_name, path in inputs:
             if in_name != "catalog_target" and _same(catalog, path):
                 what = f"{_option_name(in_name, hints)} {path}"
-                raise click.BadParameter(
-                    f"{catalog} is {what}: the catalog would write into it", param_hint="--catalog"
-                )
+                raise OutputError(f"is {what}: the catalog would write into it", file=f"--catalog {catalog}")
     for k, (out_name, out) in enumerate(outputs):
-        hint = _option_name(out_name, hints)
+        where = f"{_option_name(out_name, hints)} {out}"
         if os.path.islink(out):
-            raise click.BadParameter(f"{out} is a symbolic link (not followed); give the real path", param_hint=hint)
+            raise OutputError("is a symbolic link (not followed); give the real path", file=where)
         if os.path.exists(out) and not os.path.isfile(out) and not os.path.isdir(out):
-            raise click.BadParameter(
-                f"{out} is not a regular file (a device or a pipe); outputs are new files renamed into place",
-                param_hint=hint,
+            raise OutputError(
+                "is not a regular file (a device or a pipe); outputs are new files renamed into place", file=where
             )
         for in_name, path in inputs:
             if _same(out, path):
                 what = f"{_option_name(in_name, hints)} {path}"
-                raise click.BadParameter(
-                    f"{out} is the same file as {what}: writing it would destroy that input", param_hint=hint
-                )
+                raise OutputError(f"is the same file as {what}: writing it would destroy that input", file=where)
         for other_name, other in outputs[:k]:
             if _same(out, other):
-                raise click.BadParameter(f"{out} is also given as {_option_name(other_name, hints)}", param_hint=hint)
+                raise OutputError(f"is also given as {_option_name(other_name, hints)}", file=where)
         if not overwrite and os.path.isfile(out):
-            raise click.BadParameter(f"{out} exists; give --overwrite to replace it", param_hint=hint)
+            raise OutputError("exists; give --overwrite to replace it", file=where)
 
 
 def open_catalog_first(target: str) -> None:

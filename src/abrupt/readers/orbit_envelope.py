@@ -18,7 +18,8 @@ The envelope, in the order it is checked:
   central difference of the positions to the velocities must be 1. A ratio of a power of ten (the
   velocities written in a unit ten, a hundred or a thousand times too small or too large, the positions
   intact) is repaired and counted; any other ratio, or velocities that are all zero, is refused; an
-  epoch whose velocity disagrees with its neighbours' positions by more than 5 % is removed with them;
+  epoch whose velocity disagrees with its neighbours' positions by more than 5 % is removed with them,
+  unless more than 10 % of the epochs do (columns swapped, velocities of another frame): refused;
 - **bound orbit**: the specific energy v²/2 − μ/r of the inertial velocity is negative (speed below
   escape);
 - **dynamics of the stated frame**: the acceleration implied by the states (central difference of the
@@ -50,6 +51,7 @@ PV_TRUNCATION_LIMIT = 0.01  # central differences used only where their error bo
 PV_RATIO_RANGE = (0.8, 1.25)  # accepted median ratio of the derivative of the positions to the velocities
 PV_EPOCH_LIMIT = 0.05  # one epoch's derivative and velocity differ by more than this fraction of |v|
 PV_MIN_EPOCHS = 3  # fewer usable epochs: the check is not made
+PV_MISMATCH_SHARE = 0.1  # more of the epochs than this disagreeing: the file is wrong, not a few records
 POWER_OF_TEN_TOLERANCE = 0.02  # a median ratio within 2 % of 10^k (k = ±1..±3) is a unit slip
 POWER_OF_TEN_AGREEMENT = 0.9  # ... when at least this share of the epochs' ratios are within 5 % of it
 DYNAMICS_LIMIT = 0.03  # median |implied − modelled acceleration| above 3 % of gravity: not this frame
@@ -318,8 +320,18 @@ def check_velocities(eph: Ephemeris) -> Ephemeris:
         eph.repairs.record(power_of_ten_repair(k), int(given.sum()))
         eph = replace(eph, velocity_mps=v * 10.0**k)
         return check_velocities(eph)
+    mismatched = usable & (residual > PV_EPOCH_LIMIT)
+    if np.count_nonzero(mismatched) > PV_MISMATCH_SHARE * np.count_nonzero(usable):
+        first = int(idx[1:-1][mismatched][0])
+        raise _refuse(
+            eph,
+            "velocity = derivative of position",
+            f"the velocities differ from the derivative of the positions by more than {PV_EPOCH_LIMIT:.0%} of "
+            f"the speed at {int(np.count_nonzero(mismatched))} of {int(np.count_nonzero(usable))} epochs (first "
+            f"{_where(eph, first)}): columns in the wrong order, or velocities of another satellite or frame",
+        )
     suspect = np.zeros(len(eph), dtype=bool)
-    for i in np.flatnonzero(usable & (residual > PV_EPOCH_LIMIT)):
+    for i in np.flatnonzero(mismatched):
         suspect[idx[i : i + 3]] = True  # the epoch and both neighbours
     if suspect.any():
         eph.repairs.record(PV_MISMATCH_REPAIR, int(suspect.sum()))
