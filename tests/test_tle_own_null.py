@@ -222,3 +222,21 @@ def test_history_whose_burns_are_below_what_its_sets_resolve_is_flagged(shared_d
         assert r.exit_code == 0, r.output
         assert ("FLAG" in r.output) is flagged, r.output
         assert "recall above the stated floor" in r.output and "unmatched detections per year" in r.output
+
+
+def test_detect_tle_prints_the_own_null_per_calendar_year(shared_data, tmp_path) -> None:
+    """``abrupt detect tle`` (era by era, the default) prints one own-null line per calendar year of the
+    history beside the stated rate."""
+    from click.testing import CliRunner
+
+    from abrupt.cli.main import cli
+    from abrupt.readers.tle import read_tle
+
+    tle = shared_data / "tle" / "Jason-3.tle"
+    args = ["detect", "tle", str(tle), "--out", str(tmp_path / "e.csv"), "--null-seeds", "1"]
+    r = CliRunner().invoke(cli, [*args, "--catalog", str(tmp_path / "c.db")])
+    assert r.exit_code == 0, r.output
+    years = sorted({int(y) for y in pd.to_datetime(read_tle(tle).elements["epoch_utc"]).dt.year})
+    assert "own null, era by era" in r.output
+    for y in years:
+        assert f"    {y}: " in r.output and "stated 1" in r.output, y

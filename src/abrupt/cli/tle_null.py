@@ -88,6 +88,9 @@ def own_null_by_year(sat: Any, budget: Any, seeds: int, settings: dict[str, Any]
     )
     for r in rows:
         d = r.as_dict()
+        if not r.sat_years > 0:
+            click.echo(f"    {r.year}: not measured (no gap of this year clear of block junctions)", err=True)
+            continue
         click.echo(
             f"    {r.year}: {r.false_alarms} in {r.sat_years:.2f} satellite-years, realised "
             f"{d['rate_per_year']:.2f} per year (95 % {d['rate_95_lo']:.2f}-{d['rate_95_hi']:.2f}), stated "
