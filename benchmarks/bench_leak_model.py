@@ -68,7 +68,9 @@ def example(path: str | None) -> None:
         r = np.clip((t - f.onset_ns) / (f.end_ns - f.onset_ns), 0, 1)
         ax[1].plot(x, np.outer(r, f.dH_B_Nms), "k--", lw=0.8)
         ax[1].axvspan((f.onset_ns - T0) / NS / 60, (f.end_ns - T0) / NS / 60, color="0.9")
-    ax[1].set(title="y_B = Σ [BN] ΔᴺH: a straight ramp (fit dashed), the strike a step", xlabel="min")
+    ax[1].set(title="y_B = Σ [BN] ΔᴺH: ramp (fit dashed) + strike step", xlabel="min")
+    for a in ax:
+        a.set_xlim(80, 140)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     print(f"figure written to {path}")

@@ -232,17 +232,23 @@ def ramp_log_lr(tau_s: FloatArray, y: FloatArray, s2: float) -> tuple[float, flo
     # ramp: onset, duration, A (3) = 5; one step 4, two steps 8, ramp + step 9, three steps 12
     alone = 0.5 * (min(rss1 - pen, rss2 + 3 * pen) - rss_ramp) / s2
     yc = y - y.mean(axis=0)
-    step_fit = yc - _without_best_step(tau_s, y)
-    rest = yc
-    for _ in range(3):
-        t0b, durb, ab, _ = fit_ramp(tau_s, yc - step_fit)
-        if not math.isfinite(t0b):
-            break
-        t0, dur, a = t0b, durb, ab
-        ramp_fit = _ramp_part(tau_s, t0, dur, a)
-        rest = _without_best_step(tau_s, yc - ramp_fit)
-        step_fit = yc - ramp_fit - rest
-    rss_both = float(np.sum(rest**2))
+    rss_both, ramp_alone = math.inf, (t0, dur, a)
+    # Alternate ramp and step from both ends: the best step first, or the ramp alone first.
+    for step_fit in (yc - _without_best_step(tau_s, y), None):
+        cur = ramp_alone
+        rest = yc - _ramp_part(tau_s, *cur) if step_fit is None else yc
+        for _ in range(3):
+            if step_fit is not None:
+                t0b, durb, ab, _ = fit_ramp(tau_s, yc - step_fit)
+                if not math.isfinite(t0b):
+                    break
+                cur = (t0b, durb, ab)
+            ramp_fit = _ramp_part(tau_s, *cur)
+            rest = _without_best_step(tau_s, yc - ramp_fit)
+            step_fit = yc - ramp_fit - rest
+        rss = float(np.sum(rest**2))
+        if rss < rss_both:
+            rss_both, (t0, dur, a) = rss, cur
     rss3 = fit_steps(tau_s, _without_best_step(tau_s, y), 2)
     with_step = 0.5 * (min(rss2 - pen, rss3 + 3 * pen) - rss_both) / s2
     if alone >= with_step:
@@ -320,9 +326,10 @@ def scan_leaks(
 
 
 def one_per_interval(found: list[LeakFinding]) -> list[LeakFinding]:
-    """The strongest finding (statistic over threshold) of each set of overlapping intervals."""
+    """The finding of each set of overlapping intervals whose ramp beats the steps most (the scale whose
+    window holds the whole leak)."""
     kept: list[LeakFinding] = []
-    for f in sorted(found, key=lambda f: -f.statistic / f.threshold):
+    for f in sorted(found, key=lambda f: -f.log_lr):
         if all(f.end_ns <= g.onset_ns or f.onset_ns >= g.end_ns for g in kept):
             kept.append(f)
     return sorted(kept, key=lambda f: f.onset_ns)
