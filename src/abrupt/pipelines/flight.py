@@ -35,10 +35,11 @@ import numpy as np
 import pandas as pd
 from threadpoolctl import threadpool_limits
 
-from abrupt.clean.comb import CombConfig, estimate_period, smooth_model
+from abrupt.clean.comb import CombConfig, estimate_period
 from abrupt.clean.flight_masks import SlewMaskConfig, event_mask, flag_intervals, slew_mask
 from abrupt.detect.attitude.evidence import EventEvidence, event_evidence, profile_fits
 from abrupt.detect.attitude.flight_glr import MIN_BLOCKS, FlightGlrDetector, Peak, SubBlocks
+from abrupt.detect.attitude.leak_scan import LeakScan
 from abrupt.errors import ConfigError, InputError
 from abrupt.events import config_hash, new_run_id
 from abrupt.model.flight_config import FlightConfig
@@ -53,7 +54,9 @@ from abrupt.pipelines.flight_checks import (
     physical_bounds,
     within_bounds,
 )
+from abrupt.pipelines.flight_cleaning import clean_and_scan
 from abrupt.pipelines.flight_faults import FaultScan, merge_fault_findings, scan_span
+from abrupt.pipelines.flight_leaks import merge_leaks
 from abrupt.readers.archive import Decoder, pseudonymise_text, read_archive, read_decoder
 from abrupt.scale import Executor, TaskResult, run_tasks
 from abrupt.series.timetable import NS, Timetable, build_timetable
@@ -293,6 +296,7 @@ class ChunkResult:
     faults: FaultScan = field(default_factory=lambda: FaultScan([], []))
     rescan_merged: int = 0
     sub_blocks: SubBlocks = field(default_factory=SubBlocks.empty)
+    leaks: LeakScan = field(default_factory=lambda: LeakScan([], []))
 
 
 def process_chunk(
@@ -352,41 +356,6 @@ def _masks(
     return ev, sl
 
 
-def _clean_and_scan(
-    h_n: FloatArray,
-    ok: BoolArray,
-    t_s: FloatArray,
-    dt: float,
-    period: float,
-    c: CleaningConfig,
-    detector: FlightGlrDetector,
-) -> tuple[FloatArray, FloatArray, dict[str, float]]:
-    """Remove trend and orbit comb in ``c.passes`` passes; the steps one pass finds enter the next as free steps.
-
-    Returns the cleaned ᴺH (NaN where not ``ok``), the detector's statistic on it and the fit's summary.
-    """
-    win = detector.windows(dt)
-    steps = np.empty(0)
-    hc = h_n
-    stat = np.full(t_s.size, np.nan)
-    info: dict[str, float] = {"harmonics_mean": 0.0}
-    fit_cache: dict[tuple[float, ...], Any] = {}
-    h_ok = np.where(ok[:, None], h_n, 0.0)
-    passes = max(1, c.passes)
-    for k in range(passes):
-        model, info = smooth_model(h_ok, t_s, ok, period, c.comb_config, steps, cache=fit_cache)
-        hc = np.where(ok[:, None], h_n - np.nan_to_num(model), np.nan)
-        stat = detector.statistic(hc, ok, win)
-        if not (c.comb or c.trend) or k == passes - 1:  # the last pass's candidates would enter no fit
-            break
-        taus = detector.step_candidates(hc, ok, stat, win, c.candidate_sigma)
-        new_steps = np.array([t_s[tau] - 0.5 * dt for tau in taus])
-        if new_steps.size == steps.size and np.array_equal(new_steps, steps):
-            break
-        steps = new_steps
-    return hc, stat, info
-
-
 @threadpool_limits.wrap(limits=1, user_api="blas")  # small fits: threads only contend (docs/performance.md)
 def process_span(
     store: TelemetryStore,
@@ -427,7 +396,9 @@ def process_span(
     ok = valid & ~ev & ~sl
     detector = config.detector()
     period = orbit_period_s(spacecraft, config) if (c.comb or c.trend) else 1.0
-    hc, stat, info = _clean_and_scan(h_n, ok, g.astype(np.float64) / NS, dt, period, c, detector)
+    q_bn = table.quaternion_BN
+    cleaned = clean_and_scan(h_n, ok, g, q_bn, period, c.comb_config, c.passes, c.candidate_sigma, detector)
+    hc, stat, info = cleaned.h_clean_N, cleaned.statistic, cleaned.info
     core = (g >= start_ns) & (g < end_ns)
     peaks = detector.find_peaks(hc, ok, stat, g, dt, detector.windows(dt), keep=core)
     above = {pk.time_ns: pk for _, pk in peaks if pk.value > config.evidence_floor}
@@ -477,6 +448,7 @@ def process_span(
                 faults=faults.within(p0, p1),
                 rescan_merged=merged if p0 == start_ns else 0,
                 sub_blocks=detector.sub_blocks(g[piece], stat[piece]),
+                leaks=cleaned.leaks.within(p0, p1),
             )
         )
     return out
@@ -602,6 +574,7 @@ def run_flight(
     events = attribute_events(events, {t: e for r in chunks for t, e in r.evidence.items()})
     events = merge_fault_findings(events, [f for r in chunks for f in r.faults.findings], spacecraft.name, run_id,
                                   cfg_hash, warnings)  # fmt: skip
+    events = merge_leaks(events, [f for r in chunks for f in r.leaks.findings], spacecraft.name, run_id, cfg_hash)
     if merged := sum(r.rescan_merged for r in chunks):
         warnings.append(f"{merged} peak(s) found by two rescans (or twice by one) merged into the strongest")
     daily = daily_table(chunks, events, threshold)

@@ -58,8 +58,8 @@ before the event and σ_aim = 10° the unloading law's aim. A uniform direction 
 most 1/(e c) for any κ; with c = 20 (`dump_lr_min`) **at most 1.8 % of strikes can be called dumps, on any
 spacecraft and at any noise** (`tests/test_attribution_dump.py` checks the bound and its tightness on 200 000
 directions, and the density's normalisation). A lasting step beyond it is `external_non_strike`, reason
-"momentum dump", confidence LR/(1 + LR). Thruster torque axes are not used: the spacecraft file has no
-thrusters.
+"momentum dump", confidence LR/(1 + LR). With thruster torque axes in the spacecraft file
+(``[[thrusters]]``), the dump is aimed at the point of their cone nearest to −Ĥ_w (`dump_evidence`).
 
 Neighbours
 ----------
@@ -83,9 +83,14 @@ Fault scans and the torque scan
 Faults that carry little apparent momentum are looked for directly, each channel against the physics the others
 obey, with a threshold set on the day's own statistic at a stated rate per channel and the realised exceedances
 reported beside it (`abrupt.detect.attitude.fault_scan`, `wheel_reading`, `window_stats`; merged with the events
-by `abrupt.pipelines.flight_faults`). A scan for lasting torques (`torque_scan`, calibrated on the day's own
-level crossings) is in the library but not run by the pipeline: on days with an unmodelled ramp every half hour
-its realised rate was ~6/day against 0.03 stated, with no leak gained over the step detector.
+by `abrupt.pipelines.flight_faults`). A scan for lasting torques on ᴺH (`torque_scan`) is in the library but not
+run by the pipeline: on days with an unmodelled ramp every half hour its realised rate was ~6/day against 0.03
+stated, with no leak gained over the step detector (its exceedances were the ringing of a comb fitted through the
+ramps, and the steps of strikes). The pipeline runs `leak_scan` instead: the same window statistic on the
+body-axis sum of ᴺH's increments (a body-fixed torque is a straight ramp there), a ramp kept only where it beats
+one and two steps (and, beside a strike, ramp + step beats two and three) by likelihood, one event per leak with
+its onset, duration, torque and total, and the leak's interval left out of the next pass's comb fit
+(`abrupt.pipelines.flight_cleaning`, `abrupt.pipelines.flight_leaks`).
 
 Calibration that survives a crowd
 ---------------------------------
