@@ -37,6 +37,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from abrupt.errors import ConfigError
+from abrupt.model.spacecraft import load_spacecraft
+
 ROOT = Path(__file__).resolve().parent.parent
 STRIKE_MIN_NMS = 0.05
 SENSOR_CHANNEL = {"star_tracker_jump": "star_tracker", "gyro_spike": "gyro", "gyro_bias_step": "gyro"}
@@ -52,6 +55,36 @@ EXPECTED_CLASS = {
     "leak": "external_non_strike",
     "appendage_snap": "internal",
 }
+
+
+def thruster_lines(sc: dict) -> list[str]:
+    """``[[thrusters]]`` tables: the torque direction of every firing (each couple of spacecraft.json fires
+    either way, so each listed axis and its opposite)."""
+    axes: list[list[float]] = []
+    for axis in sc.get("thrusters", {}).get("torque_axes_B", []):
+        for sign in (1.0, -1.0):
+            a = [sign * float(x) + 0.0 for x in axis]
+            if a not in axes:
+                axes.append(a)
+    out: list[str] = []
+    for i, a in enumerate(axes):
+        out += ["", "[[thrusters]]", f'name = "thr{i + 1}"', f"torque_axis = {a}"]
+    return out
+
+
+def write_spacecraft_toml(sc: dict, decoder: dict[str, str], path: Path) -> bool:
+    """Write the operator's file with the thruster axes when this abrupt reads them (else without);
+    returns whether they are in."""
+    text = spacecraft_toml(sc, decoder)
+    path.write_text(text + "\n".join(thruster_lines(sc)) + "\n")
+    try:
+        load_spacecraft(path)
+    except ConfigError as err:
+        if "thrusters" not in str(err):
+            raise
+        path.write_text(text)
+        return False
+    return True
 
 
 def spacecraft_toml(sc: dict, decoder: dict[str, str]) -> str:
@@ -106,7 +139,8 @@ def run_abrupt(folder: Path, work: Path, *, reuse: bool = False) -> pd.DataFrame
     with (folder / "decoder.csv").open() as fh:
         decoder = {row["real_name"]: row["pseudonym"] for row in csv.DictReader(fh)}
     toml = work / "spacecraft.toml"
-    toml.write_text(spacecraft_toml(sc, decoder))
+    if not write_spacecraft_toml(sc, decoder, toml):
+        print(f"{sc['spacecraft']}: this abrupt reads no thruster axes; the spacecraft file has none", flush=True)
     store, events = work / "store", work / "events.csv"
     exe = str(Path(sys.executable).parent / "abrupt")
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
