@@ -465,7 +465,7 @@ def spacecraft_json(design: Design, channels: list[Channel], rec_period_s: float
             },
         },
         "thrusters": {
-            "purpose": "momentum dumping, pure couples",
+            "purpose": "momentum dumping, pure couples along the torque axes, each fires either way",
             "torque_axes_B": np.eye(3).tolist(),
             "couple_torque_Nm": round(design.thruster_torque_Nm, 4),
         },
