@@ -48,8 +48,8 @@ Why these ranges: tracker jumps span a misidentified or disturbed attitude (arcs
 gyro spikes and bias steps are upsets and rate-sensor anomalies of 1-50 deg/h; tachometer miscounts are
 electrical counts; a leak is a stuck valve of a 1-5 N thruster at 10^-5..10^-4 of its thrust on a
 0.5-1.5 m arm; venting is outgassing or a purge; a snap is a thermal snap of a boom or array whose
-first modes sit at 0.05-0.5 Hz. Operations: 2-3 slews a day (10-35° about a random axis, 60-150 s ramps, 60-400 s hold) and flagged
-dumps every 7-11 h (6-12 pulses unloading the wheels toward zero).
+first modes sit at 0.05-0.5 Hz. Operations: 2-3 slews a day (10-35° about a random axis, 60-150 s
+ramps, 60-400 s hold) and flagged dumps every 7-11 h (6-12 pulses unloading the wheels toward zero).
 """
 
 from __future__ import annotations
