@@ -238,6 +238,11 @@ def truth_step_Nms(folder: Path, t_s: np.ndarray) -> np.ndarray:
     return np.asarray(np.linalg.norm(after - before - slope * 80.0, axis=1) * 370.0 / 290.0)
 
 
+def _stated(events: pd.DataFrame) -> str:
+    rates = sorted({float(r) for r in events.get("false_alarms_per_day", pd.Series([], dtype=float)).dropna()})
+    return "/".join(f"{r:g}" for r in rates) or "?"
+
+
 def _pct(n: int, d: int) -> str:
     return f"{n} of {d} ({100.0 * n / d:.0f} %)" if d else "0 of 0"
 
@@ -299,7 +304,8 @@ def report(rows: list[dict], left: pd.DataFrame, days: float) -> None:
         )
     print(
         f"events at no truth event: {len(free)} in {days:g} days ({n_strike} called strike) = "
-        f"{len(free) * 5 / days:.1f} per 5 days; {int((left['near'] == 'operations').sum())} more "
+        f"{len(free) * 5 / days:.1f} per 5 days (stated false-alarm rate {_stated(left)} a day); "
+        f"{int((left['near'] == 'operations').sum())} more "
         f"within 10 min of a flagged dump, slew or gap; {int((left['near'] == 'truth').sum())} second events "
         "in a truth event's window"
     )
