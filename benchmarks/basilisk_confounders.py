@@ -3,6 +3,8 @@
     /work/venv-floors/bin/python benchmarks/basilisk_confounders.py --out DIR [--spacecraft 3] [--days 2]
         [--seed 1] [--strikes-per-day 7] [--per-kind-per-day 2]
 
+Three spacecraft × 2 days take about 2.2 CPU-minutes (Basilisk at 0.25 s steps, flight software at 0.5 s).
+
 An evaluation set that shares no code with abrupt (nothing is imported from ``abrupt``): the dynamics
 are Basilisk's (``basilisk_dynamics.py``), the sensors, faults and archive writer are written here from
 the sensors' physics, and every range below is chosen from the physics of small LEO spacecraft, not
@@ -25,6 +27,8 @@ white noise and a random-walk bias; star tracker at 1 or 2 Hz, 3-15 arcsec acros
 4-8× that about it; orbit 450-850 km at 40-98°; loop natural period 40-150 s, damping 0.7-1.0; three
 thruster couples along the body axes of 0.01-0.06 N·m each; an aerodynamic-like body torque of
 1e-6..1e-5 N·m. Body frame = the Hill frame in nadir pointing: +X zenith, +Y along track, +Z orbit normal.
+The run starts from the system momentum a dump leaves (0.2-1.5 N·m·s, any direction) with a null-space
+wheel bias of 300-1500 rpm. The arrays are fixed: no channel sees an appendage.
 
 Events a day (at least 20 min apart, 10 min clear of gaps, slews and flagged dumps, except the "near"
 strikes placed 15-60 s before or after another event's onset):
@@ -40,8 +44,12 @@ strikes placed 15-60 s before or after another event's onset):
 * leak: a body-fixed torque of 2e-5..5e-4 N·m for 2-30 min with 5-30 s valve ramps;
 * appendage snap: an internal exchange h0 (0.005-0.1 N·m·s) that returns as a damped oscillation
   (0.05-0.5 Hz, e-folding 5-60 s): the hub sees h0 e^{-t/τ} cos(2πft).
-Operations: 2-3 slews a day (10-35° about a random axis, 60-150 s ramps, 60-400 s hold) and flagged
-dumps every 7-11 h (6-12 pulses unloading the wheels toward zero).
+Why these ranges: tracker jumps span a misidentified or disturbed attitude (arcseconds to a degree);
+gyro spikes and bias steps are upsets and rate-sensor anomalies of 1-50 deg/h; tachometer miscounts are
+electrical counts; a leak is a stuck valve of a 1-5 N thruster at 10^-5..10^-4 of its thrust on a
+0.5-1.5 m arm; venting is outgassing or a purge; a snap is a thermal snap of a boom or array whose
+first modes sit at 0.05-0.5 Hz. Operations: 2-3 slews a day (10-35° about a random axis, 60-150 s
+ramps, 60-400 s hold) and flagged dumps every 7-11 h (6-12 pulses unloading the wheels toward zero).
 """
 
 from __future__ import annotations
@@ -465,7 +473,7 @@ def spacecraft_json(design: Design, channels: list[Channel], rec_period_s: float
             },
         },
         "thrusters": {
-            "purpose": "momentum dumping, pure couples",
+            "purpose": "momentum dumping, pure couples along the torque axes, each fires either way",
             "torque_axes_B": np.eye(3).tolist(),
             "couple_torque_Nm": round(design.thruster_torque_Nm, 4),
         },

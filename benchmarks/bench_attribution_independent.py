@@ -37,6 +37,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from abrupt.errors import ConfigError
+from abrupt.model.spacecraft import load_spacecraft
+
 ROOT = Path(__file__).resolve().parent.parent
 STRIKE_MIN_NMS = 0.05
 SENSOR_CHANNEL = {"star_tracker_jump": "star_tracker", "gyro_spike": "gyro", "gyro_bias_step": "gyro"}
@@ -52,6 +55,36 @@ EXPECTED_CLASS = {
     "leak": "external_non_strike",
     "appendage_snap": "internal",
 }
+
+
+def thruster_lines(sc: dict) -> list[str]:
+    """``[[thrusters]]`` tables: the torque direction of every firing (each couple of spacecraft.json fires
+    either way, so each listed axis and its opposite)."""
+    axes: list[list[float]] = []
+    for axis in sc.get("thrusters", {}).get("torque_axes_B", []):
+        for sign in (1.0, -1.0):
+            a = [sign * float(x) + 0.0 for x in axis]
+            if a not in axes:
+                axes.append(a)
+    out: list[str] = []
+    for i, a in enumerate(axes):
+        out += ["", "[[thrusters]]", f'name = "thr{i + 1}"', f"torque_axis = {a}"]
+    return out
+
+
+def write_spacecraft_toml(sc: dict, decoder: dict[str, str], path: Path) -> bool:
+    """Write the operator's file with the thruster axes when this abrupt reads them (else without);
+    returns whether they are in."""
+    text = spacecraft_toml(sc, decoder)
+    path.write_text(text + "\n".join(thruster_lines(sc)) + "\n")
+    try:
+        load_spacecraft(path)
+    except ConfigError as err:
+        if "thrusters" not in str(err):
+            raise
+        path.write_text(text)
+        return False
+    return True
 
 
 def spacecraft_toml(sc: dict, decoder: dict[str, str]) -> str:
@@ -99,14 +132,15 @@ def spacecraft_toml(sc: dict, decoder: dict[str, str]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def run_abrupt(folder: Path, work: Path) -> pd.DataFrame:
+def run_abrupt(folder: Path, work: Path, *, reuse: bool = False) -> pd.DataFrame:
     """``abrupt ingest`` and ``abrupt detect attitude --store`` on one spacecraft's folder; the events."""
     work.mkdir(parents=True, exist_ok=True)
     sc = json.loads((folder / "spacecraft.json").read_text())
     with (folder / "decoder.csv").open() as fh:
         decoder = {row["real_name"]: row["pseudonym"] for row in csv.DictReader(fh)}
     toml = work / "spacecraft.toml"
-    toml.write_text(spacecraft_toml(sc, decoder))
+    if not write_spacecraft_toml(sc, decoder, toml):
+        print(f"{sc['spacecraft']}: this abrupt reads no thruster axes; the spacecraft file has none", flush=True)
     store, events = work / "store", work / "events.csv"
     exe = str(Path(sys.executable).parent / "abrupt")
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
@@ -116,6 +150,8 @@ def run_abrupt(folder: Path, work: Path) -> pd.DataFrame:
         [exe, "detect", "attitude", "--store", str(store), "--spacecraft", str(toml), "--out", str(events)],
     ):
         if cmd[1] == "ingest" and store.exists():
+            continue
+        if cmd[1] == "detect" and reuse and events.exists():
             continue
         if cmd[1] == "detect" and events.exists():
             events.unlink()
@@ -129,7 +165,7 @@ def run_abrupt(folder: Path, work: Path) -> pd.DataFrame:
     return frame
 
 
-def match(events: pd.DataFrame, truth: dict) -> tuple[list[dict], pd.DataFrame]:
+def match(events: pd.DataFrame, truth: dict, folder: Path) -> tuple[list[dict], pd.DataFrame]:
     """Each truth event with the event it claims (``None`` when none); the events left, with what they are
     near: ``truth`` (a second event in a truth event's window, e.g. a fault's end), ``operations``
     (10 min of a flagged dump, slew or gap) or ``none``."""
@@ -175,7 +211,36 @@ def match(events: pd.DataFrame, truth: dict) -> tuple[list[dict], pd.DataFrame]:
     for a, b in spans:
         near_ops |= (lt >= a - 600.0) & (lt <= b + 600.0)
     left["near"] = np.where(near_truth, "truth", np.where(near_ops, "operations", "none"))
+    left["truth_step_Nms"] = truth_step_Nms(folder, lt)
     return rows, left
+
+
+def truth_step_Nms(folder: Path, t_s: np.ndarray) -> np.ndarray:
+    """|ΔH| of Basilisk's true total momentum across each time: the means over 10-70 s after and before,
+    less the slow trend of the means over 70-300 s either side (gravity gradient) [N m s]."""
+    z = np.load(folder / "truth_momentum.npz")
+    h, t = z["H_N"], z["t_s"]
+    csum = np.vstack([np.zeros(3), np.cumsum(h, axis=0)])
+
+    def mean(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        i, j = np.searchsorted(t, a).clip(0, len(t) - 1), np.searchsorted(t, b).clip(1, len(t))
+        j = np.maximum(j, i + 1)
+        return np.asarray((csum[j] - csum[i]) / (j - i)[:, None])
+
+    before2, before, after, after2 = (
+        mean(t_s - 300, t_s - 70),
+        mean(t_s - 70, t_s - 10),
+        mean(t_s + 10, t_s + 70),
+        mean(t_s + 70, t_s + 300),
+    )
+    slope = (after2 - before2) / 370.0
+    # a step ΔH at t moves the trend estimate by ΔH 80/370: scaled back, a step reads as ΔH, a trend as 0
+    return np.asarray(np.linalg.norm(after - before - slope * 80.0, axis=1) * 370.0 / 290.0)
+
+
+def _stated(events: pd.DataFrame) -> str:
+    rates = sorted({float(r) for r in events.get("false_alarms_per_day", pd.Series([], dtype=float)).dropna()})
+    return "/".join(f"{r:g}" for r in rates) or "?"
 
 
 def _pct(n: int, d: int) -> str:
@@ -231,16 +296,24 @@ def report(rows: list[dict], left: pd.DataFrame, days: float) -> None:
     )
     free = left[left["near"] == "none"]
     n_strike = int((free["kind"] == "strike").sum())
+    steps = free["truth_step_Nms"].to_numpy()
+    if len(steps):
+        print(
+            f"Basilisk's true momentum at those events steps by at most {steps.max():.5f} N·m·s "
+            f"(median {np.median(steps):.5f}): nothing happened there"
+        )
     print(
         f"events at no truth event: {len(free)} in {days:g} days ({n_strike} called strike) = "
-        f"{len(free) * 5 / days:.1f} per 5 days; {int((left['near'] == 'operations').sum())} more "
+        f"{len(free) * 5 / days:.1f} per 5 days (stated false-alarm rate {_stated(left)} a day); "
+        f"{int((left['near'] == 'operations').sum())} more "
         f"within 10 min of a flagged dump, slew or gap; {int((left['near'] == 'truth').sum())} second events "
         "in a truth event's window"
     )
     for _, ev in free.iterrows():
         print(
             f"  {ev['spacecraft']} {ev['time_utc']} {ev['kind']} {ev.get('kind_channel', '')} {ev['dH_Nms']:.4f} N·m·s "
-            f"statistic {ev['statistic']:.0f} (threshold {ev['threshold']:.0f}): {ev.get('kind_reason', '')}"
+            f"statistic {ev['statistic']:.0f} (threshold {ev['threshold']:.0f}), true step {ev['truth_step_Nms']:.4f}: "
+            f"{ev.get('kind_reason', '')}"
         )
 
 
@@ -264,6 +337,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--set", dest="set_dir", type=Path, required=True, help="folder of spacecraft folders")
     ap.add_argument("--label", default="", help="suffix of the result file (docs/results/..._LABEL.txt)")
+    ap.add_argument("--reuse-events", action="store_true", help="score the events of the last run again")
     ap.add_argument("--work", type=Path, default=None, help="stores and events (default: SET/_abrupt)")
     args = ap.parse_args()
     work = args.work or args.set_dir / "_abrupt"
@@ -272,8 +346,8 @@ def main() -> None:
     days = 0.0
     for folder in sorted(p for p in args.set_dir.iterdir() if (p / "truth_events.json").is_file()):
         truth = json.loads((folder / "truth_events.json").read_text())
-        events = run_abrupt(folder, work / folder.name)
-        r, left = match(events, truth)
+        events = run_abrupt(folder, work / folder.name, reuse=args.reuse_events)
+        r, left = match(events, truth, folder)
         rows += [{**x, "spacecraft_name": truth["spacecraft"]} for x in r]
         lefts.append(left)
         days += truth["duration_s"] / 86400.0
