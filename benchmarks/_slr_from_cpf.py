@@ -230,12 +230,12 @@ def simulate_normal_points(
         tropo = marini_murray_m(elev[visible], lat, h, p, t_k, rh, wavelength_um)
         t_r = t_all[visible]
         sun, moon = sun_moon_itrf_m(cpf.times_utc[0] + (t_r * 1e9).astype("timedelta64[ns]"))
-        ranges = two_way_ranges_m(cpf, xyz + solid_tide_m(xyz, sun, moon), t_r, tropo) + rng.normal(
-            0.0, noise_m, t_r.size
-        )
-        for t, r, e in zip(t_r, ranges, elev[visible], strict=True):
-            rows.append((code, cpf.times_utc[0] + np.timedelta64(round(t * 1e9), "ns"), r, p, t_k, rh, math.degrees(e)))
-    cols = ["station", "time_utc", "range_m", "pressure_hpa", "temperature_k", "humidity", "elevation_deg"]
+        noise = rng.normal(0.0, noise_m, t_r.size)
+        ranges = two_way_ranges_m(cpf, xyz + solid_tide_m(xyz, sun, moon), t_r, tropo) + noise
+        for t, r, e, n in zip(t_r, ranges, elev[visible], noise, strict=True):
+            t_utc = cpf.times_utc[0] + np.timedelta64(round(t * 1e9), "ns")
+            rows.append((code, t_utc, r, p, t_k, rh, math.degrees(e), n))
+    cols = ["station", "time_utc", "range_m", "pressure_hpa", "temperature_k", "humidity", "elevation_deg", "noise_m"]
     return pd.DataFrame(rows, columns=cols).sort_values(["station", "time_utc"], ignore_index=True)
 
 
