@@ -72,7 +72,12 @@ class Cpf:
             k = int(np.searchsorted(grid, ti))
             lo = min(max(k - half, 0), grid.size - order - 1)
             nodes = grid[lo : lo + order + 1]
-            weights = np.array([np.prod([(ti - nodes[m]) / (nodes[j] - nodes[m]) for m in range(nodes.size) if m != j]) for j in range(nodes.size)])
+            weights = np.array(
+                [
+                    np.prod([(ti - nodes[m]) / (nodes[j] - nodes[m]) for m in range(nodes.size) if m != j])
+                    for j in range(nodes.size)
+                ]
+            )
             out[i] = weights @ self.position_m[lo : lo + order + 1]
         return out
 
@@ -97,7 +102,7 @@ def read_cpf(path: Path) -> Cpf:
 def read_slrf_sites(path: Path, codes: list[str], when_utc: np.datetime64) -> dict[str, np.ndarray]:
     """ITRF positions (m) of the stations ``codes`` at ``when_utc``: SLRF2014 position at its epoch plus
     velocity × time, for the solution whose validity interval (``SOLUTION/EPOCHS``) holds the date."""
-    text = (gzip.open(path, "rt") if str(path).endswith(".gz") else open(path)).read()  # noqa: SIM115
+    text = gzip.decompress(path.read_bytes()).decode() if str(path).endswith(".gz") else path.read_text()
     year_frac = 1970.0 + (when_utc - np.datetime64("1970-01-01", "ns")) / np.timedelta64(1, "s") / (365.25 * 86400)
 
     def yds(token: str) -> float:
@@ -133,7 +138,7 @@ def sun_moon_itrf_m(t_utc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     for t in np.asarray(t_utc, dtype="datetime64[ns]"):
         jd = (t - np.datetime64("2000-01-01T12:00", "ns")) / np.timedelta64(1, "D")
         tt = jd + 69.184 / 86400.0
-        pvh, pvb = erfa.epv00(2451545.0, tt)
+        pvh, _ = erfa.epv00(2451545.0, tt)
         c2t = erfa.c2t06a(2451545.0, tt, 2451545.0, jd, 0.0, 0.0)
         sun.append(c2t @ (-np.asarray(pvh[0]) * AU_M))
         moon.append(c2t @ (np.asarray(erfa.moon98(2451545.0, tt)[0]) * AU_M))
@@ -156,7 +161,9 @@ def solid_tide_m(site_m: np.ndarray, sun_m: np.ndarray, moon_m: np.ndarray) -> n
     return out
 
 
-def marini_murray_m(elev_rad: np.ndarray, lat_rad: float, h_m: float, p_hpa: float, t_k: float, rh: float, wavelength_um: float) -> np.ndarray:
+def marini_murray_m(
+    elev_rad: np.ndarray, lat_rad: float, h_m: float, p_hpa: float, t_k: float, rh: float, wavelength_um: float
+) -> np.ndarray:
     """One-way tropospheric delay (m) of Marini & Murray (1973), as in the ILRS/MERIT standards."""
     e0 = rh * 6.11 * 10.0 ** (7.5 * (t_k - 273.15) / (237.3 + (t_k - 273.15)))
     k = 1.163 - 0.00968 * math.cos(2 * lat_rad) - 0.00104 * t_k + 0.00001435 * p_hpa
@@ -196,7 +203,14 @@ def two_way_ranges_m(cpf: Cpf, station_m: np.ndarray, t_receive_s: np.ndarray, t
 
 
 def simulate_normal_points(
-    cpf: Cpf, sites: dict[str, np.ndarray], *, noise_m: float = 0.003, step_s: float = 120.0, mask_deg: float = 20.0, wavelength_um: float = 0.532, seed: int = 0
+    cpf: Cpf,
+    sites: dict[str, np.ndarray],
+    *,
+    noise_m: float = 0.003,
+    step_s: float = 120.0,
+    mask_deg: float = 20.0,
+    wavelength_um: float = 0.532,
+    seed: int = 0,
 ) -> pd.DataFrame:
     """Normal points of every pass above ``mask_deg`` inside the CPF span: station, receive time (UTC),
     two-way range (m), meteorology of the pass, and the geometric range for reference."""
@@ -216,10 +230,12 @@ def simulate_normal_points(
         tropo = marini_murray_m(elev[visible], lat, h, p, t_k, rh, wavelength_um)
         t_r = t_all[visible]
         sun, moon = sun_moon_itrf_m(cpf.times_utc[0] + (t_r * 1e9).astype("timedelta64[ns]"))
-        ranges = two_way_ranges_m(cpf, xyz + solid_tide_m(xyz, sun, moon), t_r, tropo) + rng.normal(0.0, noise_m, t_r.size)
-        for t, r, e in zip(t_r, ranges, elev[visible], strict=True):
-            rows.append((code, cpf.times_utc[0] + np.timedelta64(round(t * 1e9), "ns"), r, p, t_k, rh, math.degrees(e)))
-    cols = ["station", "time_utc", "range_m", "pressure_hpa", "temperature_k", "humidity", "elevation_deg"]
+        noise = rng.normal(0.0, noise_m, t_r.size)
+        ranges = two_way_ranges_m(cpf, xyz + solid_tide_m(xyz, sun, moon), t_r, tropo) + noise
+        for t, r, e, n in zip(t_r, ranges, elev[visible], noise, strict=True):
+            t_utc = cpf.times_utc[0] + np.timedelta64(round(t * 1e9), "ns")
+            rows.append((code, t_utc, r, p, t_k, rh, math.degrees(e), n))
+    cols = ["station", "time_utc", "range_m", "pressure_hpa", "temperature_k", "humidity", "elevation_deg", "noise_m"]
     return pd.DataFrame(rows, columns=cols).sort_values(["station", "time_utc"], ignore_index=True)
 
 
@@ -233,14 +249,20 @@ def write_crd_transmit_epochs(points: pd.DataFrame, target: str, path: Path, wav
             r = rows.iloc[chunk]
             t0, t1 = t[chunk[0]], t[chunk[-1]]
             lines += ["H1 CRD  2 2018 06 16 00", f"H2 {SIX_STATIONS.get(str(code), 'STAT'):<10s} {code} 01 01 4"]
-            lines += [f"H3 {target} 7603901 1155 08820 0 1", f"H4 1 {t0:%Y %m %d %H %M %S} {t1:%Y %m %d %H %M %S} 0 0 0 0 1 0 2 0"]
+            lines += [
+                f"H3 {target} 7603901 1155 08820 0 1",
+                f"H4 1 {t0:%Y %m %d %H %M %S} {t1:%Y %m %d %H %M %S} 0 0 0 0 1 0 2 0",
+            ]
             lines.append(f"C0 0 {wavelength_nm:.3f} std1")
             day0 = t0.normalize()
             for k, (_, row) in enumerate(r.iterrows()):
                 tof = 2.0 * row["range_m"] / C_M_S
                 sod = (pd.Timestamp(row["time_utc"]) - day0).total_seconds() - tof
                 if k == 0:
-                    lines.append(f"20 {sod:.3f} {row['pressure_hpa']:.2f} {row['temperature_k']:.2f} {100 * row['humidity']:.1f} 0")
+                    lines.append(
+                        f"20 {sod:.3f} {row['pressure_hpa']:.2f} {row['temperature_k']:.2f} "
+                        f"{100 * row['humidity']:.1f} 0"
+                    )
                 lines.append(f"11 {sod:.12f} {tof:.12f} std1 2 120 10 20.0 -1 -1 -1 -1 0")
             lines.append("H8")
     lines.append("H9")

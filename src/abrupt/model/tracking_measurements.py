@@ -26,6 +26,7 @@ import numba
 import numpy as np
 import pandas as pd
 from astropy.time import Time
+from astropy.utils import iers
 from numpy.typing import NDArray
 
 from abrupt.errors import InputError
@@ -61,7 +62,8 @@ def earth_rotation_matrices(
     """C_FI(t) (n,3,3): inertial→Earth-fixed rotation at ``t_s`` seconds after ``epoch_utc``.
 
     ``simple`` is the thesis's C3(θ₀ + ω_E t) (spec §3.4); ``iers`` uses ERFA's IAU 2006/2000A
-    celestial-to-terrestrial matrix (needs ``epoch_utc``).
+    celestial-to-terrestrial matrix with UT1−UTC and polar motion from astropy's bundled IERS table
+    (needs ``epoch_utc``).
     """
     t = np.atleast_1d(np.asarray(t_s, dtype=float))
     if model == "simple":
@@ -85,11 +87,14 @@ def earth_rotation_matrices(
         warnings.simplefilter("ignore")
         try:
             dut1 = np.asarray(tt.get_delta_ut1_utc(return_status=False).to_value("s"), dtype=float)
-        except Exception:  # outside the bundled table: UT1 = UTC (documented limitation)
-            dut1 = np.zeros(t.size)
+            xp, yp = (np.asarray(v.to_value("rad"), dtype=float) for v in iers.earth_orientation_table.get().pm_xy(tt))
+        except Exception:  # outside the bundled table: UT1 = UTC, no polar motion (documented limitation)
+            dut1, xp, yp = np.zeros(t.size), np.zeros(t.size), np.zeros(t.size)
         jd_tt = tt.tt
         ut1_jd2 = tt.jd2 + dut1 / 86400.0
-    return np.asarray(erfa.c2t06a(jd_tt.jd1, jd_tt.jd2, tt.jd1, ut1_jd2, 0.0, 0.0))
+    # polar motion (a few tenths of an arcsecond: ~10 m at the station, ~20 m at LAGEOS) as in the force
+    # model's Earth-fixed frame (abrupt.model.orbit.frames), so that stations and the field share one ITRF
+    return np.asarray(erfa.c2t06a(jd_tt.jd1, jd_tt.jd2, tt.jd1, ut1_jd2, xp, yp))
 
 
 @numba.njit(cache=True)

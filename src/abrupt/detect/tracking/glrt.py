@@ -58,8 +58,14 @@ def glrt_scan(data: TrackingArrays, fit: BatchFit, t_candidates_s: NDArray[np.fl
     used = fit.used
     r = fit.residuals_white[used]
     j0 = fit.jacobian_white[used]
-    q0, _ = np.linalg.qr(j0)
-    r_perp = r - q0 @ (q0.T @ r)
+    n_rows = r.size
+    # the fit's priors (pseudo-observations of biases and scales) enter the projector; an impulse does not
+    # change them (its Jacobian there is zero), so only the measurement rows are kept after projecting
+    prior_r, prior_j = fit.prior_residuals_white, fit.prior_jacobian_white
+    q0, _ = np.linalg.qr(np.vstack([j0, prior_j]) if prior_r.size else j0)
+    r_all = np.concatenate([r, prior_r]) if prior_r.size else r
+    r_perp = (r_all - q0 @ (q0.T @ r_all))[:n_rows]
+    q0 = q0[:n_rows]
     # whitened ∂y/∂x0 per row: J0[:, :6] (with impulses in the fit this is W H Φ(t_k, t0) through them)
     jx = j0[:, :6]
     t_rows = data.t_s[fit.row_index[used]]

@@ -3,6 +3,13 @@
 Weighted Gauss-Newton least squares (Montenbruck & Gill 2000, §8.1) of all measurements of an arc:
 the state at t0, optional per-station range, angle and time-tag biases, an optional constant
 unmodelled acceleration, force-model scale factors, and impulses at given epochs (RSW components).
+Range biases and scale factors may carry priors: each is then also a pseudo-observation of its a-priori
+value with a stated σ (Tapley, Schutz & Born 2004 §4.6: the a-priori information matrix added to the
+normal equations). For range biases the prior is on each station's departure from the stations' mean
+bias: the common part is the target's centre-of-mass offset (0.25 m for LAGEOS, unknown for most
+targets) and stays free, the departures are station calibrations (millimetres to centimetres). So a
+fit whose force model misses part of the dynamics cannot absorb it into a range bias of metres or a
+radiation-pressure scale of 8 at the price of nothing.
 :func:`trajectory` propagates a state with these parameters and returns the sensitivities the fit's
 Jacobian needs; :func:`model_corrections` says what the fit's measurement model (light time,
 troposphere, time biases) adds to the instantaneous geometry. The impulse GLRT
@@ -52,6 +59,11 @@ class BatchFitConfig:
     troposphere: bool = False  # radio range delay: Saastamoinen zenith delays, Chao mapping, standard weather
     estimate_time_bias: bool | tuple[str, ...] = False  # per-station epoch offset of the range time tags
     estimate_scales: tuple[str, ...] = ()  # force-model scale factors: "drag_scale", "srp_scale"
+    # priors (pseudo-observations, module doc): σ [m] of each station's range bias about the stations' common
+    # bias (the target's centre-of-mass offset, left free), and σ of each estimated scale factor about the
+    # force model's value, e.g. (("srp_scale", 0.1),)
+    range_bias_prior_m: float | None = None
+    scale_priors: tuple[tuple[str, float], ...] = ()
 
 
 @dataclass
@@ -81,6 +93,9 @@ class BatchFit:
     stm_x0: NDArray[np.float64]  # (n_meas, 6, 6): d state(t_k) / d x0
     states: NDArray[np.float64]
     config: BatchFitConfig
+    # the priors' whitened residuals and Jacobian rows (in chi2 and the covariance; not measurements)
+    prior_residuals_white: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    prior_jacobian_white: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 0)))
 
     def propagate(self, t_out_s: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """States and parameter sensitivities of the fitted trajectory (impulses included) at sorted
@@ -284,7 +299,8 @@ def fit_orbit(
             integrator=cfg.integrator,
         )
         resid, jac = _residuals(data, states, dmat, bias, bias_keys, cfg, len(scales), n_imp, row_i, row_c)
-        cost = float(np.sum(resid[used] ** 2))
+        p_resid, p_jac = _prior_rows(data, cfg, bias, bias_keys, scales, base_model, len(names))
+        cost = float(np.sum(resid[used] ** 2) + np.sum(p_resid**2))
         if base is not None and halvings < 8 and (not math.isfinite(cost) or cost > 1.5 * prev_cost + 10.0):
             # Gauss-Newton overshot (far from the minimum the linearisation fails, e.g. an a-priori
             # orbit kilometres off over a long arc): go back and take half the step (step halving,
@@ -300,8 +316,8 @@ def fit_orbit(
             keep = np.abs(resid) <= cfg.outlier_sigma
             if keep.sum() >= 0.8 * resid.size:
                 used = keep
-            cost = float(np.sum(resid[used] ** 2))
-        cov, step = _normal_equations(jac[used], resid[used])
+            cost = float(np.sum(resid[used] ** 2) + np.sum(p_resid**2))
+        cov, step = _normal_equations(np.vstack([jac[used], p_jac]), np.concatenate([resid[used], p_resid]))
         normalised = np.abs(step) / np.sqrt(np.maximum(np.diag(cov), 1e-300))
         if it >= 2 and (abs(prev_cost - cost) <= cfg.tolerance * max(cost, 1.0) or float(normalised.max()) < 1e-3):
             converged = True
@@ -327,14 +343,52 @@ def fit_orbit(
         row_index=row_i,
         row_component=row_c,
         used=used,
-        chi2=float(np.sum(resid[used] ** 2)),
+        chi2=float(np.sum(resid[used] ** 2) + np.sum(p_resid**2)),
         n_obs=int(used.sum()),
         iterations=it,
         converged=converged,
         stm_x0=dmat[:, :, :6],
         states=states,
         config=cfg,
+        prior_residuals_white=p_resid,
+        prior_jacobian_white=p_jac,
     )
+
+
+def _prior_rows(
+    data: TrackingArrays,
+    cfg: BatchFitConfig,
+    bias: dict[tuple[str, int], float],
+    bias_keys: list[tuple[str, int]],
+    scales: Mapping[str, float],
+    model: ForceModel,
+    n_par: int,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Whitened residuals and Jacobian rows of the priors (module doc): (a priori − current)/σ. Range
+    biases: each station's departure from the mean of the estimated biases (both less the stations'
+    a-priori biases), none with one station; scale factors: the force model's value. Columns in the order
+    of :func:`_parameter_names`."""
+    resid: list[float] = []
+    jac: list[NDArray[np.float64]] = []
+    cols = [6 + k for k, (_, c) in enumerate(bias_keys) if c == 0]
+    if cfg.range_bias_prior_m is not None and len(cols) >= 2:
+        w = 1.0 / cfg.range_bias_prior_m
+        shift = np.array([bias[key] - data.stations[key[0]].range_bias_m for key in bias_keys if key[1] == 0])
+        for i, col in enumerate(cols):
+            row = np.zeros(n_par)
+            row[cols] = -w / len(cols)
+            row[col] += w
+            resid.append(-w * float(shift[i] - shift.mean()))
+            jac.append(row)
+    sigma = dict(cfg.scale_priors)
+    first = 6 + len(bias_keys) + (3 if cfg.estimate_acceleration else 0)
+    for k, name in enumerate(scales):
+        if name in sigma:
+            row = np.zeros(n_par)
+            row[first + k] = 1.0 / sigma[name]
+            resid.append((float(getattr(model, name)) - scales[name]) / sigma[name])
+            jac.append(row)
+    return np.array(resid, dtype=float), (np.array(jac) if jac else np.zeros((0, n_par)))
 
 
 def _parameter_names(bias_keys: list[tuple[str, int]], cfg: BatchFitConfig, n_imp: int) -> list[str]:

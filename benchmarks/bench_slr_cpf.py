@@ -1,0 +1,117 @@
+"""LAGEOS-1 normal points simulated from the shared ILRS CPF, then ``abrupt detect laser --apriori <CPF>``.
+
+The truth is the CPF prediction itself (``lageos1_cpf_180613_16401.hts``, two days of June 2018); six
+SLRF2014 stations range to it with light time, Shapiro delay, Marini-Murray troposphere, solid tides and
+3 mm noise, no range bias, no scale error (``benchmarks/_slr_from_cpf.py``, which shares no code with
+abrupt's range model). Prints
+
+* the independent ranges against abrupt's own range model on the same orbit (acceptance: ~0.1 m);
+* the command's events, fitted range biases, radiation-pressure scale and post-fit RMS (acceptance: no
+  maneuver of this satellite without propulsion; biases and scales inside their physical bounds);
+* the CPU time of the command.
+
+Usage: ``python benchmarks/bench_slr_cpf.py [--seed N]`` (needs ../shared/data).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from _slr_from_cpf import SIX_STATIONS, read_cpf, read_slrf_sites, simulate_normal_points, write_crd_transmit_epochs
+from abrupt.model.range_reduction import RangeModel, model_two_way_ranges
+from abrupt.model.tracking_measurements import earth_rotation_matrices
+from abrupt.pipelines.laser_ranging import sites_from_sinex
+from abrupt.readers.sinex import bundled_ilrs_sinex, read_sinex
+
+SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "tracking"
+CPF = SHARED / "ilrs-corpus" / "lageos1_cpf_180613_16401.hts"
+SINEX = SHARED / "SLRF2014_POS+VEL_2030.0_200428.snx"
+
+
+def agreement_m(points: pd.DataFrame, cpf_path: Path = CPF) -> dict[str, float]:
+    """Largest |abrupt's modelled range − the independent range| per station (m), noise left out: abrupt's
+    :func:`model_two_way_ranges` on the CPF orbit (turned inertial with abrupt's Earth rotation) against the
+    simulation's ranges less their noise (``range_m − noise_m``)."""
+    cpf = read_cpf(cpf_path)
+    mid = cpf.times_utc[len(cpf.times_utc) // 2]
+    sites = sites_from_sinex(read_sinex(str(bundled_ilrs_sinex())), sorted(points["station"].unique()), mid)
+    epoch = cpf.times_utc[0]
+
+    def sat_gcrf(t_s: np.ndarray) -> np.ndarray:
+        t = np.atleast_1d(t_s)
+        c_fi = earth_rotation_matrices(t, model="iers", epoch_utc=epoch)
+        return np.einsum("nji,nj->ni", c_fi, cpf.position_at(t))
+
+    out = {}
+    for code, rows in points.groupby("station"):
+        t_r = cpf.seconds(rows["time_utc"].to_numpy())
+        p, tk, rh = rows[["pressure_hpa", "temperature_k", "humidity"]].to_numpy().T
+        ours, _ = model_two_way_ranges(
+            t_r, epoch, sat_gcrf, sites[str(code)], RangeModel(), pressure_hpa=p, temperature_k=tk, humidity=rh
+        )
+        truth = rows["range_m"].to_numpy() - rows["noise_m"].to_numpy()
+        out[str(code)] = float(np.max(np.abs(ours - truth)))
+    return out
+
+
+def simulate(folder: Path, seed: int) -> pd.DataFrame:
+    """Write ``lageos1.npt`` (CRD v2) into ``folder`` and return the normal points."""
+    cpf = read_cpf(CPF)
+    sites = read_slrf_sites(SINEX, list(SIX_STATIONS), cpf.times_utc[len(cpf.times_utc) // 2])
+    points = simulate_normal_points(cpf, sites, seed=seed)
+    write_crd_transmit_epochs(points, cpf.target, folder / "lageos1.npt")
+    return points
+
+
+def run_command(folder: Path) -> tuple[subprocess.CompletedProcess[str], float]:
+    """``abrupt detect laser`` as documented, and its CPU time (s, the child process)."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    args = [str(Path(sys.executable).parent / "abrupt"), "detect", "laser", str(folder / "lageos1.npt")]
+    args += ["--apriori", str(CPF), "--out", str(folder / "laser.csv"), "--fit-out", str(folder / "fit.json")]
+    args += ["--catalog", str(folder / "catalog.sqlite")]
+    done = subprocess.run(args, capture_output=True, text=True, check=False)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return done, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seed", type=int, default=1)
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        points = simulate(folder, args.seed)
+        print(f"normal points: {len(points)} from {points['station'].nunique()} stations")
+        worst = agreement_m(points)
+        print(
+            f"independent vs abrupt's range model, largest |difference| per station (mm): "
+            f"{ {k: round(1e3 * v, 1) for k, v in worst.items()} }"
+        )
+        start = time.time()
+        done, cpu_s = run_command(folder)
+        print(f"exit {done.returncode}; CPU {cpu_s / 60:.2f} min (wall {(time.time() - start) / 60:.2f} min)")
+        print("\n".join(line for line in done.stdout.splitlines() if "abrupt detect laser:" not in line))
+        if done.returncode == 0:
+            events = pd.read_csv(folder / "laser.csv")
+            print(f"events: {len(events)}; kinds {events['kind'].value_counts().to_dict()}")
+            fit = json.loads((folder / "fit.json").read_text())
+            print(f"range biases (mm): {fit['range_bias_mm']}; scales: {fit.get('scale_factors')}")
+        else:
+            print(done.stderr[-2000:])
+
+
+if __name__ == "__main__":
+    from _results import variant, write_results
+
+    with write_results("bench_slr_cpf", variant({})):
+        main()
