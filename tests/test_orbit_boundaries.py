@@ -47,7 +47,9 @@ def test_an_impulse_at_a_boundary_is_still_found(lageos_like, which: int) -> Non
     cfg, eph = lageos_like
     t_b = cfg.boundaries_utc()[which]
     t_imp = t_b - np.timedelta64(30, "s")
-    run = detect_orbit(inject_impulse(eph, t_imp, (0.0, 0.001, 0.0)), budget="1/week")
+    # declared propelled: a burn needs propulsion (a passive satellite's change at a day boundary is the
+    # product's boundary, tests/test_orbit_discontinuity.py)
+    run = detect_orbit(inject_impulse(eph, t_imp, (0.0, 0.001, 0.0)), budget="1/week", propulsion=True)
     assert len(run.events) == 1, run.events[["time_utc", "dv_mps"]]
     ev = run.events.iloc[0]
     assert abs((pd.Timestamp(ev["time_utc"]).tz_localize(None) - pd.Timestamp(t_imp)).total_seconds()) <= 120.0

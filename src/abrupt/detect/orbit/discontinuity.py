@@ -23,8 +23,12 @@ the interval (an ISS reboost sampled every 240 s: 27 % of |δv|Δt), and the gra
 neglected in the first-order model. e is compared with the arc's own null: the same quantity on every
 interval of the arc, whose median and robust scale give the level median + ``Z_DISCONTINUITY``
 robust sigmas (a file without velocities has no test: its velocities would come from its positions).
+Two solutions of the orbit differ by a velocity of the order of n·|δr| (an error δa in semi-major axis
+gives δr_R = δa and δv_T = nδa/2); an interval above the level whose velocity jump exceeds
+``MAX_FIT_RATIO``·n·e holds a velocity change no second solution explains: a burn at a join of the
+product (products are often split into arcs at manoeuvres), which stays a burn.
 An event whose span (its burn, widened by the GLR window and two samples on either side, where its
-exceedance can start) holds an interval above the level is a product discontinuity: it is not a burn,
+exceedance can start) holds a discontinuity is a product discontinuity: it is not a burn,
 and is reported with the nuisance epochs of :mod:`~abrupt.detect.orbit.boundaries` (kind
 ``product discontinuity``) with the position jump it holds.
 """
@@ -47,6 +51,9 @@ from abrupt.types import FloatArray
 Z_DISCONTINUITY = 12.0
 #: the kind of a nuisance epoch found by this test
 DISCONTINUITY = "product discontinuity"
+#: a velocity jump above this many n·(unexplained position) is a burn, not two solutions of the orbit (two
+#: fits differ by |δv| ~ n|δr|: an error δa gives δr_R = δa, δv_T = nδa/2; empirical accelerations add more)
+MAX_FIT_RATIO = 30.0
 #: intervals spread over the arc whose excesses give the level (the arc's own null)
 NULL_INTERVALS = 400
 
@@ -61,15 +68,21 @@ class IntervalMismatch:
     position_jump_m: FloatArray
     velocity_jump_mps: FloatArray
     level_m: float
+    mean_motion_rad_s: FloatArray | None = None
 
     def discontinuity(self, lo: int, hi: int) -> int | None:
-        """The interval in [lo, hi] with the largest excess when it is above the level, else None."""
+        """The interval in [lo, hi] with the largest excess when it is above the level and its velocity jump
+        is one two solutions of the orbit can differ by (at most ``MAX_FIT_RATIO``·n·excess; a larger one is
+        a burn at a join of the product), else None."""
         lo, hi = max(1, lo), min(self.excess_m.size - 1, hi)
         if hi < lo or not np.isfinite(self.level_m):
             return None
         seg = np.nan_to_num(self.excess_m[lo : hi + 1], nan=-np.inf)
         k = lo + int(np.argmax(seg))
-        return k if self.excess_m[k] > self.level_m else None
+        if not self.excess_m[k] > self.level_m:
+            return None
+        n = self.mean_motion_rad_s[k] if self.mean_motion_rad_s is not None else 0.0
+        return k if self.velocity_jump_mps[k] <= MAX_FIT_RATIO * n * self.excess_m[k] else None
 
 
 def interval_mismatch(analysis: OrbitAnalysis, intervals: NDArray[np.intp] | None = None) -> IntervalMismatch:
@@ -83,9 +96,10 @@ def interval_mismatch(analysis: OrbitAnalysis, intervals: NDArray[np.intp] | Non
     excess = np.full(n, np.nan)
     jump_r = np.full(n, np.nan)
     jump_v = np.full(n, np.nan)
+    motion = np.full(n, np.nan)
     given = np.isfinite(r).all(axis=1) & np.isfinite(v).all(axis=1)
     if n < 10 or given.mean() < 0.5:
-        return IntervalMismatch(excess, jump_r, jump_v, float("nan"))
+        return IntervalMismatch(excess, jump_r, jump_v, float("nan"), motion)
     null = np.unique(np.linspace(1, n - 1, min(n - 1, NULL_INTERVALS)).astype(np.intp))
     wanted = np.arange(1, n) if intervals is None else np.asarray(intervals, dtype=np.intp)
     ctx = analysis.force_context()
@@ -109,11 +123,12 @@ def interval_mismatch(analysis: OrbitAnalysis, intervals: NDArray[np.intp] | Non
         excess[k] = float(np.linalg.norm(dr - lead * dv)) - allowance
         jump_r[k] = float(np.linalg.norm(dr))
         jump_v[k] = float(np.sqrt(dv2))
+        motion[k] = mean_motion
     ok = excess[null][np.isfinite(excess[null])]
     if ok.size < 10:
-        return IntervalMismatch(excess, jump_r, jump_v, float("nan"))
+        return IntervalMismatch(excess, jump_r, jump_v, float("nan"), motion)
     level = float(np.median(ok)) + Z_DISCONTINUITY * max(float(robust_scale(ok)), 1e-12)
-    return IntervalMismatch(excess, jump_r, jump_v, level)
+    return IntervalMismatch(excess, jump_r, jump_v, level, motion)
 
 
 def split_discontinuities(
