@@ -94,3 +94,20 @@ def test_running_out_of_memory_is_one_line(capsys: pytest.CaptureFixture[str]) -
         "error: not enough memory for this run (Unable to allocate 229. MiB for an array with shape (10000000, 3) "
         "and data type float64)"
     ]
+
+
+@pytest.mark.parametrize(
+    ("argv", "says"),
+    [
+        (["simulate", "population", "--count", "-5"], "Invalid value for '--count': -5 is not in the range x>=1."),
+        (["detect", "tle", "--bogus", "x"], "No such option '--bogus'."),
+    ],
+)
+def test_a_wrong_option_is_one_error_line_naming_the_help(
+    argv: list[str], says: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    err = capsys.readouterr().err.splitlines()
+    assert info.value.code == 2 and len(err) == 1, err
+    assert err[0].startswith("error: ") and says in err[0] and f"(options: abrupt {' '.join(argv[:2])} -h)" in err[0]

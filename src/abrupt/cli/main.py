@@ -49,6 +49,11 @@ def main(argv: list[str] | None = None) -> None:
     except click.exceptions.Abort:
         click.echo("aborted", err=True)
         sys.exit(130)
+    except click.UsageError as exc:
+        # a wrong option or value: one line like every other error, naming where the help is
+        where = f" (options: {exc.ctx.command_path} -h)" if exc.ctx is not None else ""
+        click.echo(f"error: {printable(' '.join(exc.format_message().split()))}{where}", err=True)
+        sys.exit(exc.exit_code)
     except click.ClickException as exc:
         exc.show()
         sys.exit(exc.exit_code)
