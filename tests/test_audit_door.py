@@ -9,10 +9,6 @@ velocities restored, and detection on it must give no event.
 
 from __future__ import annotations
 
-import os
-import resource
-import subprocess
-import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -28,7 +24,6 @@ from abrupt.pipelines.orbit import detect_orbit
 from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.readers.navigation_csv import write_navigation_csv
 from abrupt.readers.orbit_envelope import PV_MISMATCH_REPAIR, power_of_ten_repair
-from abrupt.readers.sp3 import write_sp3
 
 
 @pytest.mark.parametrize(
@@ -84,32 +79,6 @@ def test_a_few_mismatched_velocities_are_still_removed_and_counted(tmp_path: Pat
     assert eph.repairs.counts[PV_MISMATCH_REPAIR] == 6 and len(eph) == len(truth) - 6
 
 
-def _address_space_2_gb() -> None:
-    resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
-
-
-@pytest.mark.skipif(sys.platform != "linux", reason="an address-space limit binds as on Linux only there")
-def test_an_orbit_run_fits_in_2_gb_of_address_space(tmp_path: Path) -> None:
-    """The audit bounds every run to 2 GB with ``ulimit -v``: a 12 h orbit (about 450 MB resident) once
-    needed 3 GB of address space, two 1 GiB arenas of the mimalloc allocator reserved and never used."""
-    path = tmp_path / "o.sp3"
-    write_sp3(itrf(truth_orbit(hours=12.0)), path)
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parent.parent / "src")}
-    env.pop("MIMALLOC_ARENA_RESERVE", None)
-    argv = [sys.executable, "-m", "abrupt.cli.main", "-q", "detect", "orbit", path.name, "--out", "e.csv"]
-    done = subprocess.run(
-        [*argv, "--catalog", "c.sqlite"],
-        cwd=tmp_path,
-        env=env,
-        capture_output=True,
-        text=True,
-        preexec_fn=_address_space_2_gb,
-        check=False,
-    )
-    assert done.returncode == 0, done.stderr[-800:]
-    assert (tmp_path / "e.csv").exists()
-
-
 def test_running_out_of_memory_is_one_line(capsys: pytest.CaptureFixture[str]) -> None:
     @cli.command("exhaust", hidden=True)
     def exhaust() -> None:
@@ -125,3 +94,20 @@ def test_running_out_of_memory_is_one_line(capsys: pytest.CaptureFixture[str]) -
         "error: not enough memory for this run (Unable to allocate 229. MiB for an array with shape (10000000, 3) "
         "and data type float64)"
     ]
+
+
+@pytest.mark.parametrize(
+    ("argv", "says"),
+    [
+        (["simulate", "population", "--count", "-5"], "Invalid value for '--count': -5 is not in the range x>=1."),
+        (["detect", "tle", "--bogus", "x"], "No such option '--bogus'."),
+    ],
+)
+def test_a_wrong_option_is_one_error_line_naming_the_help(
+    argv: list[str], says: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    err = capsys.readouterr().err.splitlines()
+    assert info.value.code == 2 and len(err) == 1, err
+    assert err[0].startswith("error: ") and says in err[0] and f"(options: abrupt {' '.join(argv[:2])} -h)" in err[0]

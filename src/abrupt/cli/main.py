@@ -6,7 +6,6 @@ when its command runs or its help is shown, so ``abrupt --help`` stays fast.
 
 from __future__ import annotations
 
-import os
 import sys
 import warnings
 from typing import Any
@@ -15,11 +14,6 @@ import click
 
 from abrupt.cli.commands import cli, hoist_global_flags
 from abrupt.errors import AbruptError, bounded, printable
-
-#: Address space the mimalloc allocator (bundled by Arrow and other libraries) reserves per arena, in KiB.
-#: Its default, 1 GiB per arena, is reserved but never touched: two arenas made a run holding 450 MB
-#: need 3 GB of address space and fail under an address-space limit (``ulimit -v``) of 2 GB.
-ALLOCATOR_ENVIRONMENT = {"MIMALLOC_ARENA_RESERVE": "65536"}
 
 
 def show_warning(
@@ -32,8 +26,6 @@ def show_warning(
 
 def main(argv: list[str] | None = None) -> None:
     """Run the command line; turn abrupt's own errors into a one-line message and exit status 2."""
-    for name, value in ALLOCATOR_ENVIRONMENT.items():  # read when the libraries load: before any import
-        os.environ.setdefault(name, value)
     args = hoist_global_flags(list(sys.argv[1:] if argv is None else argv))
     previous = warnings.showwarning
     warnings.showwarning = show_warning
@@ -57,6 +49,11 @@ def main(argv: list[str] | None = None) -> None:
     except click.exceptions.Abort:
         click.echo("aborted", err=True)
         sys.exit(130)
+    except click.UsageError as exc:
+        # a wrong option or value: one line like every other error, naming where the help is
+        where = f" (options: {exc.ctx.command_path} -h)" if exc.ctx is not None else ""
+        click.echo(f"error: {printable(' '.join(exc.format_message().split()))}{where}", err=True)
+        sys.exit(exc.exit_code)
     except click.ClickException as exc:
         exc.show()
         sys.exit(exc.exit_code)
