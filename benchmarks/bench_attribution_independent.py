@@ -159,6 +159,9 @@ def run_abrupt(folder: Path, work: Path, *, reuse: bool = False) -> pd.DataFrame
         done = subprocess.run(cmd, env=env, cwd=work, capture_output=True, text=True, check=False)
         if done.returncode != 0:
             raise SystemExit(f"{' '.join(cmd[:3])} failed ({done.returncode}): {done.stderr.strip()[-2000:]}")
+        said = (done.stdout + done.stderr).splitlines()
+        for line in (x for x in said if cmd[1] == "detect" and x.startswith(("threshold", "warning"))):
+            print(f"{sc['spacecraft']}: {line}", flush=True)
     frame = pd.read_csv(events)
     t0 = np.datetime64(json.loads((folder / "truth_events.json").read_text())["start_utc"].rstrip("Z"), "ns")
     frame["t_s"] = (pd.to_datetime(frame["time_utc"]).dt.tz_localize(None).to_numpy() - t0) / np.timedelta64(1, "s")
