@@ -22,7 +22,11 @@ import pytest
 from abrupt.detect.orbit.detectors import OrbitDetector
 from abrupt.detect.orbit.discontinuity import interval_mismatch
 from abrupt.model.orbit import MU_EARTH_M3_S2, kepler_to_cartesian
+from abrupt.pipelines.orbit import detect_orbit, load_ephemeris
+from abrupt.pipelines.orbit_blocks import part
+from abrupt.pipelines.orbit_product import detect_orbit_product
 from abrupt.series.ephemeris import Ephemeris
+from abrupt.simulate.products import DailyArcProduct, simulate_daily_arcs
 from abrupt.thresholds import FalseAlarmBudget
 
 STEP_S = 60.0
@@ -162,8 +166,6 @@ def test_a_position_step_in_every_later_record_is_a_discontinuity_not_a_burn(sha
     untouched. Before the test the same step in a two-day arc raised five "burns" of 0.1-0.34 m/s (the step
     and the filters' ringing after it); now there is no event and one product discontinuity of 50 m, and
     the arc is analysed on either side of it."""
-    from abrupt.pipelines.orbit import detect_orbit, load_ephemeris
-    from abrupt.pipelines.orbit_blocks import part
 
     path = _shared_s3a(shared_data)
     if not path.exists():
@@ -185,8 +187,6 @@ def test_a_passive_satellites_detection_at_a_day_boundary_is_the_products_bounda
     of ~0.5 mm/s and a continuous position: a velocity change, so the discontinuity test leaves it, and a
     satellite with propulsion would report it (the control). LAGEOS-2 cannot change its velocity: at the
     product's day boundary it is the product's boundary, not an event."""
-    from abrupt.pipelines.orbit import detect_orbit
-    from abrupt.simulate.products import DailyArcProduct, simulate_daily_arcs
 
     cfg = DailyArcProduct(days=2, step_s=240.0, sigma_jump_pos_m=0.0, sigma_jump_vel_mps=3e-4, seed=1)
     eph = simulate_daily_arcs(cfg)
@@ -196,9 +196,12 @@ def test_a_passive_satellites_detection_at_a_day_boundary_is_the_products_bounda
     when = np.datetime64(active.events["time_utc"].iloc[0].rstrip("Z"), "ns")
     assert abs((when - boundary) / np.timedelta64(1, "s")) < 600.0
     passive = detect_orbit(eph, budget="1/week")
-    assert passive.events.empty
-    found = [b for b in passive.summary["product_boundaries"] if b["kind"] == "day boundary"]
-    assert [np.datetime64(b["time_utc"]) for b in found] == [boundary]
+    # the same in a multi-satellite product (``--all-satellites``): the passive satellite known by its id
+    in_product = detect_orbit_product({"L52": eph}, budget="1/week")["L52"]
+    for run in (passive, in_product):
+        assert run.events.empty
+        found = [b for b in run.summary["product_boundaries"] if b["kind"] == "day boundary"]
+        assert [np.datetime64(b["time_utc"]) for b in found] == [boundary]
 
 
 @pytest.mark.parametrize("stated", [True, False], ids=["segment-stated", "not-stated"])
@@ -208,7 +211,6 @@ def test_an_iss_like_join_of_a_predicted_segment_is_a_discontinuity(stated: bool
     mm/s in velocity at the join. A single join (stated by a new segment, or not stated at all) has no
     population of joins to bound it; the test finds the position jump and reports a product
     discontinuity instead of a ~1 mm/s event."""
-    from abrupt.pipelines.orbit import detect_orbit
 
     r0, v0 = kepler_to_cartesian(6.778e6, 0.0005, math.radians(51.6), 1.0, 0.5, 0.2)
     step = 240.0

@@ -591,6 +591,7 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
             f"    {b['time_utc'][:19]}  {b.get('kind', 'day boundary'):<13} peak {b['peak']:.4g}"
             f"  bound {b['bound']:.4g}"
             f"{'  -> searched' if b['raised'] else ''}"
+            + (f"  position jump {b['position_jump_m']:.3g} m" if b.get("position_jump_m") is not None else "")
             for b in bounds
         )
     lines.append(f"  events           {s['events']}")

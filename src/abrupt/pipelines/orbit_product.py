@@ -26,7 +26,15 @@ from abrupt.detect.orbit.calibration import self_calibrate
 from abrupt.detect.orbit.detectors import ArcTooShortError, OrbitDetector
 from abrupt.detect.orbit.pooled import ArcNull, pooled_thresholds
 from abrupt.errors import ConfigError
-from abrupt.pipelines.orbit import OrbitRun, as_budget, detector_class_name, fit_summary, untested_run
+from abrupt.model.propulsion import passive_satellite
+from abrupt.pipelines.orbit import (
+    OrbitRun,
+    as_budget,
+    detector_class_name,
+    fit_summary,
+    untested_run,
+    without_propulsion,
+)
 from abrupt.pipelines.orbit_sequence import resolve_sequence
 from abrupt.readers.orbit_envelope import check_orbit_envelope
 from abrupt.readers.sp3 import parse_sp3
@@ -103,4 +111,6 @@ def _finish(det: OrbitDetector, eph: Ephemeris, fa: FalseAlarmBudget, an: OrbitA
         result = replace(result, events=events, warnings=(*result.warnings, *notes))
     run = OrbitRun(eph, det, result, fa)
     run.summary = fit_summary(run)
-    return run
+    passive = passive_satellite(eph.satellite)
+    # a satellite that cannot manoeuvre (the product's passive satellites, by id) as in a single-satellite run
+    return without_propulsion(run, passive.area_to_mass_m2_kg) if passive is not None else run

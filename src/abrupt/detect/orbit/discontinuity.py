@@ -97,7 +97,7 @@ def interval_mismatch(analysis: OrbitAnalysis, intervals: NDArray[np.intp] | Non
     jump_r = np.full(n, np.nan)
     jump_v = np.full(n, np.nan)
     motion = np.full(n, np.nan)
-    given = np.isfinite(r).all(axis=1) & np.isfinite(v).all(axis=1)
+    given: NDArray[np.bool_] = np.asarray(np.isfinite(r).all(axis=1) & np.isfinite(v).all(axis=1))
     if n < 10 or given.mean() < 0.5:
         return IntervalMismatch(excess, jump_r, jump_v, float("nan"), motion)
     null = np.unique(np.linspace(1, n - 1, min(n - 1, NULL_INTERVALS)).astype(np.intp))
@@ -107,7 +107,7 @@ def interval_mismatch(analysis: OrbitAnalysis, intervals: NDArray[np.intp] | Non
     ns = analysis.forward.x.shape[1]
     phi = np.empty((ns, ns))
     x = np.zeros(ns)
-    for k in np.union1d(null, wanted[(wanted >= 1) & (wanted < n)]):
+    for k in np.union1d(null, wanted[(wanted >= 1) & (wanted < n)]).tolist():
         if not (given[k - 1] and given[k]):
             continue
         dt = float(t[k] - t[k - 1])
