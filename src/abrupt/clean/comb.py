@@ -243,7 +243,7 @@ def smooth_model(
     kmax = config.max_harmonics if config.comb else 0
     good = valid & np.all(np.isfinite(h), axis=1)
     extra = np.asarray(step_times_s if step_times_s is not None else [], dtype=np.float64)
-    steps_all = np.unique(np.concatenate([gap_step_times(t_s, good), extra]))  # a known step at a gap is one
+    steps_all = np.sort(np.concatenate([gap_step_times(t_s, good), extra]))
     a0 = int(np.floor((t_s[0] - spacing) / spacing))
     a1 = int(np.ceil((t_s[-1] + spacing) / spacing))
     ks: list[int] = []

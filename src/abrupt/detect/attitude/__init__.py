@@ -89,8 +89,7 @@ stated, with no leak gained over the step detector (its exceedances were the rin
 ramps, and the steps of strikes). The pipeline runs `leak_scan` instead: the same window statistic on the
 body-axis sum of ᴺH's increments (a body-fixed torque is a straight ramp there), a ramp kept only where it beats
 one and two steps (and, beside a strike, ramp + step beats two and three) by likelihood, one event per leak with
-its onset, duration, torque and total, and the leak's interval left out of the next pass's comb fit
-(`abrupt.pipelines.flight_cleaning`, `abrupt.pipelines.flight_leaks`).
+its onset, duration, torque and total (`abrupt.pipelines.flight_cleaning`, `abrupt.pipelines.flight_leaks`).
 
 Calibration that survives a crowd
 ---------------------------------
