@@ -37,10 +37,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+import abrupt
 from abrupt.errors import ConfigError
 from abrupt.model.spacecraft import load_spacecraft
 
-ROOT = Path(__file__).resolve().parent.parent
 STRIKE_MIN_NMS = 0.05
 SENSOR_CHANNEL = {"star_tracker_jump": "star_tracker", "gyro_spike": "gyro", "gyro_bias_step": "gyro"}
 EXPECTED_CLASS = {
@@ -143,7 +143,7 @@ def run_abrupt(folder: Path, work: Path, *, reuse: bool = False) -> pd.DataFrame
         print(f"{sc['spacecraft']}: this abrupt reads no thruster axes; the spacecraft file has none", flush=True)
     store, events = work / "store", work / "events.csv"
     exe = str(Path(sys.executable).parent / "abrupt")
-    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    env = {**os.environ, "PYTHONPATH": str(Path(abrupt.__file__).resolve().parents[1])}  # the abrupt imported here
     archives = sorted(str(p) for p in (folder / "telemetry").glob("*.csv.gz"))
     for cmd in (
         [exe, "ingest", *archives, "--decoder", str(folder / "decoder.csv"), "--store", str(store)],
