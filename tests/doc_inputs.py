@@ -265,13 +265,20 @@ def _slr_simulation() -> object:
 
 @functools.cache
 def _slr_simulation_real_forces() -> object:
-    """The same day with the forces of ``abrupt detect laser`` in the truth (EGM2008 20×20, Sun, Moon,
-    radiation pressure): a J2-only truth is not an orbit the command's richer model can fit (metres of
-    misfit a day at LAGEOS height), so it would show the difference of the force models, not the data."""
-    from abrupt.pipelines.laser_ranging import LASER_FORCE
+    """The same day as the command sees it by default: its forces in the truth (EGM2008 20×20, Sun, Moon,
+    radiation pressure; a J2-only truth is metres a day from the command's richer model at LAGEOS height)
+    and the stations at their ILRS SLRF2014 coordinates, which the command uses without ``--sinex``
+    (the approximate sites of the simulator are 0.7-12 m from them)."""
+    from abrupt.pipelines.laser_ranging import LASER_FORCE, sites_from_sinex
+    from abrupt.readers.sinex import bundled_ilrs_sinex, read_sinex
     from abrupt.simulate.slr import SlrScenario, simulate_slr
+    from test_laser_ranging_cli import CDP
 
-    return simulate_slr(SlrScenario(duration_days=1.0, noise_m=0.003, force=LASER_FORCE), seed=21)
+    scenario = SlrScenario(duration_days=1.0, noise_m=0.003, force=LASER_FORCE)
+    start = np.datetime64(scenario.start_utc)
+    by_code = sites_from_sinex(read_sinex(str(bundled_ilrs_sinex())), list(CDP.values()), start)
+    sites = {name: replace(by_code[code], name=name) for name, code in CDP.items()}
+    return simulate_slr(scenario, seed=21, sites=sites)
 
 
 def _slr_campaign(folder: Path) -> dict[str, Path]:

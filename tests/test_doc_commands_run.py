@@ -133,7 +133,6 @@ SHRINK: list[tuple[str, str]] = [
 
 #: Optional parts kept (the stand-in of their file is made): by document, the option's text.
 KEEP_OPTIONAL: dict[str, tuple[str, ...]] = {
-    "tracking.md": ("[--sinex ilrs.snx]",),  # the simulated stations are not the ILRS ones
     "flux-inference.md": ("[--surfaces sc_surfaces.toml]",),  # kestrel.toml has no geometry; the flux needs it
 }
 

@@ -29,7 +29,9 @@ MU = 3.986004418e14
 EPOCH = np.datetime64("2024-01-01T00:00:00", "ns")
 
 
-def _ranges(truth: ForceModel, stations: dict[str, Station], bias_m: dict[str, float], seed: int) -> tuple:  # type: ignore[type-arg]
+def _ranges(
+    truth: ForceModel, stations: dict[str, Station], bias_m: dict[str, float], seed: int
+) -> tuple[TrackingArrays, np.ndarray]:
     """One day of 1 m ranges every 20 s above 10° to a 350 km orbit, each station biased by ``bias_m``."""
     x0 = coe_to_rv(6378e3 + 350e3, 0.001, math.radians(51.6), 0.3, 0.2, 0.1, MU)
     t = np.arange(0.0, 86_400.0, 20.0)

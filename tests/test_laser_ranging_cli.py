@@ -73,6 +73,8 @@ def write_sinex(sim: SlrSimulation, path: Path, drop: str | None = None) -> None
         if name == drop:
             continue
         site = sim.sites[name]
+        ref = pd.Timestamp(site.reference_epoch)  # each site's own reference epoch
+        doy = f"{ref:%y}:{ref.day_of_year:03d}:{ref.hour * 3600 + ref.minute * 60 + ref.second:05d}"
         for axis, value in zip("XYZ", site.position_ecef_m, strict=True):
             k += 1
             out.append(f" {k:5d} STA{axis}   {code}  A    1 {doy} m    2 {value: .15E} 0.10000E-02")

@@ -68,8 +68,9 @@ LASER_FORCE = ForceModel(
     mass_kg=406.965,
 )
 """Real-data force model: EGM2008 20×20, Sun, Moon, solar radiation pressure (conical shadow) with a
-priori LAGEOS-1 values (C_R 1.13, 0.2827 m², 406.965 kg); the SRP scale is estimated, so only the
-product C_R·A/m's order of magnitude matters. At LAGEOS height degree 20 leaves ~(R/r)^21 ≈ 1e-6 of
+priori LAGEOS-1 values (C_R 1.13, 0.2827 m², 406.965 kg); the SRP scale is estimated about 1 ± 0.5
+(:data:`LASER_FIT_CONFIG`), so C_R·A/m must be the target's to within tens of percent (the command's
+``--area-to-mass``). At LAGEOS height degree 20 leaves ~(R/r)^21 ≈ 1e-6 of
 the field's effect; lower satellites need a higher ``--gravity-degree``."""
 
 

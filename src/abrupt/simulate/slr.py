@@ -105,8 +105,15 @@ class SlrSimulation:
     force: ForceContext  # the truth's force model, Sun and Moon (ERFA) at the campaign's own dates
 
 
-def simulate_slr(scenario: SlrScenario, *, seed: int = 0, grid_step_s: float = 20.0) -> SlrSimulation:
-    """Simulate the campaign of ``scenario`` (module doc)."""
+def simulate_slr(
+    scenario: SlrScenario,
+    *,
+    seed: int = 0,
+    grid_step_s: float = 20.0,
+    sites: dict[str, StationSite] | None = None,
+) -> SlrSimulation:
+    """Simulate the campaign of ``scenario`` (module doc); ``sites`` (by station name) replaces the
+    approximate :data:`DEFAULT_SITES`, e.g. with the ILRS SLRF2014 coordinates abrupt bundles."""
     rng = np.random.default_rng(seed)
     epoch = np.datetime64(scenario.start_utc, "ns")
     sinex_epoch = np.datetime64(scenario.sinex_epoch, "ns")
@@ -131,10 +138,11 @@ def simulate_slr(scenario: SlrScenario, *, seed: int = 0, grid_step_s: float = 2
     states = propagate(x0, grid, burns=burns, force=force, rtol=1e-13, atol_m=1e-8)
     sat = trajectory_interpolator(grid, states)
 
-    sites = {
-        name: site_from_geodetic(name, lat, lon, h, vel, ecc, sinex_epoch)
-        for name, lat, lon, h, vel, ecc in DEFAULT_SITES
-    }
+    if sites is None:
+        sites = {
+            name: site_from_geodetic(name, lat, lon, h, vel, ecc, sinex_epoch)
+            for name, lat, lon, h, vel, ecc in DEFAULT_SITES
+        }
     rows = []
     bias = {name: float(rng.normal(0.0, scenario.bias_sigma_m)) for name in sites}
     np_times = np.arange(grid_step_s, duration, scenario.normal_point_s)
