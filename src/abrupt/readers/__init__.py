@@ -128,7 +128,8 @@ Each check names itself in the error (`L27: outside the orbit envelope (speed be
   neighbours) removed`
 * velocity = derivative of position (the SP3 check above, in m and m/s): OEM, OPM, CPF and navigation CSV too:
   outcome: all-zero velocities: **error**; one epoch's zero vector: that epoch removed; a power-of-ten ratio
-  (OEM velocities in m/s: 10⁻³; CSV velocities in km/s: 10³): rescaled; another ratio: **error**; counter:
+  (OEM velocities in m/s: 10⁻³; CSV velocities in km/s: 10³): rescaled; another ratio: **error**; more than
+  10 % of the epochs off by over 5 % of the speed (position columns swapped): **error**; counter:
   `velocities off by a power of ten, positions intact (rescaled by 1e+3)`, `epoch whose velocity disagrees with
   its neighbours' positions (removed with them)`, `epoch with a zero velocity vector in a file with velocities
   (removed)`
