@@ -247,23 +247,24 @@ def write_crd_transmit_epochs(points: pd.DataFrame, target: str, path: Path, wav
         brk = np.flatnonzero(np.diff(t.astype("int64").to_numpy()) > 1800e9) + 1
         for chunk in np.split(np.arange(len(t)), brk):
             r = rows.iloc[chunk]
-            t0, t1 = t[chunk[0]], t[chunk[-1]]
+            tof = 2.0 * r["range_m"].to_numpy() / C_M_S
+            sent = [pd.Timestamp(x) - pd.Timedelta(seconds=f) for x, f in zip(r["time_utc"], tof, strict=True)]
             lines += ["H1 CRD  2 2018 06 16 00", f"H2 {SIX_STATIONS.get(str(code), 'STAT'):<10s} {code} 01 01 4"]
             lines += [
                 f"H3 {target} 7603901 1155 08820 0 1",
-                f"H4 1 {t0:%Y %m %d %H %M %S} {t1:%Y %m %d %H %M %S} 0 0 0 0 1 0 2 0",
+                f"H4 1 {sent[0]:%Y %m %d %H %M %S} {sent[-1]:%Y %m %d %H %M %S} 0 0 0 0 1 0 2 0",
             ]
             lines.append(f"C0 0 {wavelength_nm:.3f} std1")
-            day0 = t0.normalize()
+            day0 = sent[0].normalize()
             for k, (_, row) in enumerate(r.iterrows()):
-                tof = 2.0 * row["range_m"] / C_M_S
-                sod = (pd.Timestamp(row["time_utc"]) - day0).total_seconds() - tof
+                # seconds of the day of the epoch itself: a pass over midnight rolls over (CRD v2 §2.2)
+                sod = (sent[k] - day0).total_seconds() % 86400.0
                 if k == 0:
                     lines.append(
                         f"20 {sod:.3f} {row['pressure_hpa']:.2f} {row['temperature_k']:.2f} "
                         f"{100 * row['humidity']:.1f} 0"
                     )
-                lines.append(f"11 {sod:.12f} {tof:.12f} std1 2 120 10 20.0 -1 -1 -1 -1 0")
+                lines.append(f"11 {sod:.12f} {tof[k]:.12f} std1 2 120 10 20.0 -1 -1 -1 -1 0")
             lines.append("H8")
     lines.append("H9")
     path.write_text("\n".join(lines) + "\n")
