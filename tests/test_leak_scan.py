@@ -117,13 +117,15 @@ def test_a_leaks_step_events_merge_into_its_one_event_and_a_strike_within_it_sta
         _event("strike", "attitude.flight_glr", T0 + 1400 * NS),  # a strike during the leak
         _event("external_non_strike", "attitude.flight_glr", T0 + 1950 * NS),  # the leak's end
         _event("sensor_fault", "attitude.fault_scan", T0 + 1500 * NS),  # another channel's fault
+        _event("sensor_fault", "attitude.flight_glr", T0 + 1600 * NS),  # a sensor fault during the leak
         _event("external_non_strike", "attitude.flight_glr", T0 + 5000 * NS),  # something else
     ]
     out = merge_leaks(events_frame(rows), [leak], "SC", "r", "h")
     assert out.attrs["leak_events_absorbed"] == 2
     assert sorted(zip(out["detector"], out["kind"], strict=True)) == sorted(
         [("attitude.flight_glr", "strike"), ("attitude.fault_scan", "sensor_fault"),
-         ("attitude.flight_glr", "external_non_strike"), (LEAK_DETECTOR, "external_non_strike")])  # fmt: skip
+         ("attitude.flight_glr", "sensor_fault"), ("attitude.flight_glr", "external_non_strike"),
+         (LEAK_DETECTOR, "external_non_strike")])  # fmt: skip
     row = out[out["detector"] == LEAK_DETECTOR].iloc[0]
     assert row["leak_duration_s"] == 900.0 and row["leak_torque_Nm"] == pytest.approx(1e-4)
     assert row["dH_Nms"] == pytest.approx(np.hypot(0.05, 0.07)) and "thruster leak" in row["kind_reason"]

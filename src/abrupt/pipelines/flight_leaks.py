@@ -5,9 +5,9 @@ duration, its body torque (vector and magnitude), its total ᴺH change and the 
 ratio over the step models in ``leak_*`` columns, its statistic and threshold in σ of the scan's noise,
 and the rate that threshold was set for. The step detector scans the cleaned ᴺH with the leaks' ramps
 taken out (:mod:`abrupt.pipelines.flight_cleaning`); a step event it still raises within a leak's
-interval (± ``LEAK_MARGIN_S``) that is not a strike is the leak's (the ramp's imperfect removal: its
-onset and end) and is dropped, counted in ``attrs["leak_events_absorbed"]``. A strike within a leak is a
-step on the ramp and keeps its own event.
+interval (± ``LEAK_MARGIN_S``) classed ``external_non_strike`` or ``unknown`` is the leak's (the step
+detector answers its onset and end) and is dropped, counted in ``attrs["leak_events_absorbed"]``. A strike
+within a leak is a step on the ramp and keeps its own event, and so does a sensor fault.
 """
 
 from __future__ import annotations
@@ -88,7 +88,7 @@ def merge_leaks(
     inside = np.zeros(len(out), bool)
     for f in leaks:
         inside |= (t_ev >= f.onset_ns - margin) & (t_ev <= f.end_ns + margin)
-    drop = inside & steps & (kinds != "strike")
+    drop = inside & steps & np.isin(kinds, ("external_non_strike", "unknown"))
     kept = out.loc[~drop]
     new = leak_events(leaks, spacecraft, run_id, cfg_hash)
     merged = pd.concat([kept, new], ignore_index=True) if len(kept) else new
