@@ -318,7 +318,10 @@ ORBITS = cases_of(
         ("sp3 one epoch 1 km off", _case("sp3", lambda e: offset_record(e, 360, 1e3), "outlier|removed")),
         ("sp3 one epoch 10 km off", _case("sp3", lambda e: offset_record(e, 360, 1e4), "outlier|removed")),
         ("sp3 one record 50 m off", _case("sp3", lambda e: offset_record(e, 360, 50.0), "outlier|removed")),
-        ("sp3 50 m step of every later record", _case("sp3", lambda e: offset_record(e, 360, 50.0, later=True), None)),
+        (
+            "sp3 50 m step of every later record",
+            _case("sp3", lambda e: offset_record(e, 360, 50.0, later=True), "discontinuity"),
+        ),
         ("sp3 below the surface (x0.8)", _case("sp3", _scaled(0.8, 0.8), None)),
         ("sp3 scaled x1.5 (faster than escape)", _case("sp3", _scaled(1.5, 1.5), None)),
         ("sp3 positions in m (x1000)", _case("sp3", _scaled(1000.0, 1.0), None)),
