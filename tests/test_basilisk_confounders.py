@@ -6,16 +6,19 @@ The truth it is checked against is Basilisk's own: its total angular momentum bo
 
 from __future__ import annotations
 
+import matplotlib
 import numpy as np
 import pytest
 
 pytest.importorskip("Basilisk")
 
-from Basilisk.utilities import RigidBodyKinematics as rbk
+# Basilisk's utilities turn on matplotlib's figure.autolayout when imported: keep the suite's settings.
+with matplotlib.rc_context():
+    from Basilisk.utilities import RigidBodyKinematics as rbk
 
-from basilisk_confounders import draw_design, net_momentum_N
-from basilisk_dynamics import Design, Piece, Record, dcm_BN, simulate, whole_inertia
-from basilisk_sensors import quaternion_from_dcm, tachometers
+    from basilisk_confounders import draw_design, net_momentum_N
+    from basilisk_dynamics import Design, Piece, Record, dcm_BN, simulate, whole_inertia
+    from basilisk_sensors import quaternion_from_dcm, tachometers
 
 Run = tuple[Design, np.ndarray, Record]
 

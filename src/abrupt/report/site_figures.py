@@ -129,7 +129,8 @@ def _size_panel(ax: Any, event: pd.Series) -> bool:
 def event_figure(event: pd.Series, neighbours: pd.DataFrame, path: Path) -> Path:
     """The diagnostic figure of one event from the catalog: its detector's statistic over threshold for
     every detection of the same spacecraft and detector (this event marked), and its size components."""
-    fig = plt.figure(figsize=(11, 3.6))
+    # Axes placed by hand: no layout engine, whatever a library imported beside abrupt set as the default.
+    fig = plt.figure(figsize=(11, 3.6), layout="none")
     ax = fig.add_axes((0.08, 0.22, 0.5, 0.6))
     ratio = _ratio(neighbours)
     times = _times(neighbours["time_utc"])
