@@ -1,6 +1,6 @@
 """The flux models' constants against the values their publications print (read here as data, with the citation).
 
-Verified against the publication's text:
+Verified against the publication's text (ECSS-E-ST-10-04C as SPENVIS serves it, one page per clause):
 
 * Grün et al. (1985) as ECSS-E-ST-10-04C §10.2.4.1 Eq. (101) prints it: F1 = (2.2·10³ m^0.306 + 15)^−4.38,
   F2 = 1.3·10⁻⁹ (m + 10¹¹ m² + 10²⁷ m⁴)^−0.36, F3 = 1.3·10⁻¹⁶ (m + 10⁶ m²)^−0.85, m in g, single-sided randomly
@@ -9,9 +9,12 @@ Verified against the publication's text:
 * ECSS-E-ST-10-04C Annex C.1.3: R_E = 6 378 km and the 100 km that account for the atmosphere (Eqs. C-13/C-14);
   Annex C.1.2 Eq. (C-4): μ = 3.986·10⁵ km³ s⁻².
 
-Corroborated only by secondary sources (two independent public implementations of NASA-90/91, not the
-publication): the NASA-90/91 constants and the two Ψ(i) values they quote "from the table". The Ψ nodes at
-70-100° have no source at all (see abrupt.rates.flux).
+No ECSS table feeds abrupt.rates.flux: the meteoroid speeds are NASA SSP 30425's, not Table C-1's, and the Earth
+factors G, sf and K are computed by the Annex C.1.2/C.1.3 procedure, not read from Table J-6. Neither table's body
+could be read (the SPENVIS pages of C.1.1 and J.1.2 carry the clause text without the tables).
+
+Corroborated only by secondary sources (public implementations and a design note, not the publication): the
+NASA-90/91 constants and parts of the Ψ(i) table, node by node as stated in abrupt.rates.flux and tested below.
 """
 
 from __future__ import annotations
@@ -32,11 +35,21 @@ GRUN_EQ_101 = {
 ECSS_EARTH_RADIUS_KM = 6378.0
 ECSS_ATMOSPHERE_KM = 100.0
 ECSS_MU_KM3_S2 = 3.986e5
-#: NASA-90/91 constants as two independent public implementations write them (secondary sources).
+#: NASA-90/91 constants as two independent public implementations write them (secondary sources; a third one and the
+#: design note below print the same F1, F2, Φ, p, q and q', the third the width as 0.6372, i.e. 0.637²).
 NASA90_SECONDARY = {"F1": 1.22e-5, "F1_power": -2.5, "F2": 8.1e10, "F2_add_cm": 700.0, "F2_power": -6.0,
                     "H_centre": 0.78, "H_width": 0.637, "p": 0.05, "q": 0.02, "q_after_2011": 0.04}  # fmt: skip
 #: Ψ(i) values the same implementations quote from the table (secondary; rounded to 3 decimals there).
 PSI_SECONDARY = {45.0: 0.990, 52.0: 1.030}
+#: Ψ(i) as a public design note prints it, copying NASA-90 from SPENVIS's background page (secondary; "0-28.5: 0.91"
+#: covers every inclination up to 28.5°). Not an exact copy of the publication: see the tests below.
+PSI_DESIGN_NOTE = {28.5: "0.91", 50.0: "1.0", 60.0: "1.07", 70.0: "1.2", 80.0: "1.4", 90.0: "1.6", 100.0: "1.78"}
+#: What supports each node of abrupt's table (the statement in abrupt.rates.flux).
+PSI_NODES_AS_PRINTED = (28.5, 50.0)  # equal to the note within its printed digits
+PSI_NODES_NEAR = (60.0, 70.0)  # within 0.06 of the note
+PSI_NODES_CONSISTENT_WITH_QUOTES = (40.0, 50.0, 60.0)  # interpolate to the implementations' Ψ(45°), Ψ(52°)
+PSI_NODES_WITHOUT_SOURCE = (30.0,)
+PSI_NODES_CONTRADICTED = (80.0, 90.0, 100.0)  # 0.2 or more below the note
 
 
 def _grun_printed(m_g: float) -> float:
@@ -77,3 +90,31 @@ def test_nasa90_constants_agree_with_the_secondary_sources() -> None:
 def test_psi_reproduces_the_values_quoted_from_the_table(inclination_deg: float, value: float) -> None:
     """Within the sources' rounding plus linear interpolation between 10° nodes (0.005)."""
     assert fx.nasa90_psi(inclination_deg) == pytest.approx(value, abs=0.005)
+
+
+def _half_unit(printed: str) -> float:
+    """Half a unit of the last printed digit: the rounding a printed value carries."""
+    return 0.5 * 10.0 ** -len(printed.split(".")[1])
+
+
+def test_every_psi_node_has_a_stated_source_or_none() -> None:
+    stated = set(PSI_NODES_AS_PRINTED) | set(PSI_NODES_NEAR) | set(PSI_NODES_CONSISTENT_WITH_QUOTES)
+    stated |= set(PSI_NODES_WITHOUT_SOURCE) | set(PSI_NODES_CONTRADICTED)
+    assert stated == {float(i) for i in fx.PSI_INCLINATION_DEG}
+
+
+@pytest.mark.parametrize("inclination_deg", [*PSI_NODES_AS_PRINTED, 0.0, 10.0, 20.0])
+def test_psi_equals_the_design_note_where_stated(inclination_deg: float) -> None:
+    printed = PSI_DESIGN_NOTE[max(inclination_deg, 28.5)]
+    assert abs(fx.nasa90_psi(inclination_deg) - float(printed)) <= _half_unit(printed) + 1e-12
+
+
+@pytest.mark.parametrize("inclination_deg", PSI_NODES_NEAR)
+def test_psi_is_near_the_design_note_up_to_70_degrees(inclination_deg: float) -> None:
+    assert abs(fx.nasa90_psi(inclination_deg) - float(PSI_DESIGN_NOTE[inclination_deg])) <= 0.06 + 1e-12
+
+
+@pytest.mark.parametrize("inclination_deg", PSI_NODES_CONTRADICTED)
+def test_psi_above_70_degrees_is_contradicted_by_the_design_note(inclination_deg: float) -> None:
+    """The documented warning holds: abrupt's nodes at 80-100° lie 0.2 or more below the note's."""
+    assert float(PSI_DESIGN_NOTE[inclination_deg]) - fx.nasa90_psi(inclination_deg) >= 0.2

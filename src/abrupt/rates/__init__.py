@@ -143,19 +143,17 @@ The Grün flux for m ≥ 1e-6 g is 1.49 m⁻² yr⁻¹ (4.7e-8 m⁻² s⁻¹) at
 (F1 = 47.1^−4.38 = 4.7e-8 s⁻¹ dominates); the NASA-90/91 value above is of order 1e-5, as published.
 Checked against the publications' text (tests/test_rates_published.py): Grün's F1-F3 coefficients as
 ECSS-E-ST-10-04C §10.2.4.1 Eq. 101 prints them; R_E = 6378 km, the 100 km atmosphere (Annex C.1.3) and μ (Eq.
-C-4). Corroborated only by secondary sources (two independent public implementations of NASA-90/91): the
-NASA-90/91 constants (1.22e-5 d^-2.5, 8.1e10 (d+700)^-6, H(d) 0.78/0.637, Φ, p, q, q'). Not checked (no copy
-reachable): ECSS Tables C-1 and J-6 (meteoroid speeds, focusing/shielding per orbit), the SSP 30425 speed
-distribution used instead, the debris direction/speed model, and Ψ(i). Ψ(i), the NASA-90/91 inclination table
-(Kessler et al. 1991; Kessler, Reynolds & Anz-Meador 1989, NASA TM-100471; ECSS-E-10-04A), was typed in without
-a copy of the publication (28.5°: 0.91, 30°: 0.92, 40°: 0.96, 50°: 1.02, 60°: 1.09, 70°: 1.26, 80°: 1.18, 90°:
-1.00, 100°: 0.98). The stored copies of the sources that hold it (Meshishnek 1995, Aerospace TR-95(5231)-3;
-SPENVIS's NASA90 background page; the ESABASE2/Debris technical description) return their opening pages only,
-and no public code holds the table. Two independent implementations quote Ψ(45°) = 0.990 and Ψ(52°) = 1.030
-"from the table", which this table gives as 0.990 and 1.034. **The nodes at 28.5-60° are thus corroborated only
-indirectly and those at 70-100° not at all** (the 80° value is doubtful: some sources reportedly put the peak
-near 80° at about 1.7; not verified here): check them against Kessler et al. before quoting NASA-90/91 rates for
-orbits above 60° (the polar and sun-synchronous cases).
+C-4). No ECSS table is used: the meteoroid speeds are SSP 30425's (not Table C-1's) and G, sf and K are computed
+by the Annex C.1.2/C.1.3 procedure (not read from Table J-6); neither table's body could be read. Corroborated only
+by secondary sources (public implementations of NASA-90/91 and a design note): the NASA-90/91 constants (1.22e-5
+d^-2.5, 8.1e10 (d+700)^-6, H(d) 0.78/0.637, Φ, p, q, q'). Not checked: the SSP 30425 speed distribution, the
+debris direction/speed model, and Ψ(i), the NASA-90/91 inclination table (Kessler et al. 1991; NASA TM-100471 and
+TM-4527; ECSS-E-10-04A), of which no readable copy was found (28.5°: 0.91, 30°: 0.92, 40°: 0.96, 50°: 1.02, 60°:
+1.09, 70°: 1.26, 80°: 1.18, 90°: 1.00, 100°: 0.98). Up to 70° the nodes agree with a public design note
+that copies the model from SPENVIS (28.5° and 50° as printed, 60° and 70° within 0.06) and with Ψ(45°) = 0.990 and
+Ψ(52°) = 1.030 quoted by two implementations. **At 80°, 90° and 100° the note prints 1.4, 1.6 and 1.78, 0.22-0.80
+above this table**: NASA-90/91 debris rates for polar and sun-synchronous orbits may be low by up to a factor of
+1.8 (Ψ is a factor of the flux). Per-node evidence: the comment above ``PSI_VALUE`` in :mod:`abrupt.rates.flux`.
 
 Limitations
 -----------
@@ -165,9 +163,9 @@ Limitations
   assumed inclination mix. For current environments use ORDEM or MASTER output through the table format. The
   ORDEM importer is keyed on header words and was tested on files written in the documented layout, not on real
   ORDEM output (none was available offline); check the column mapping it prints.
-* Ψ(i) above 60° is unverified (see above); the 2.5 g/cm³ meteoroid density is the one the Grün sizes are
-  computed with, and the flux inference's default mass law for meteoroids uses the same value. The meteoroid
-  speed distribution is SSP 30425's rather than ECSS Table C-1 (not available offline).
+* Ψ(i) above 70° is contradicted by the one readable secondary copy (see above); the 2.5 g/cm³ meteoroid density
+  is the one the Grün sizes are computed with, and the flux inference's default mass law for meteoroids uses the
+  same value. The meteoroid speed distribution is SSP 30425's rather than ECSS Table C-1 (not readable offline).
 * Fluxes are orbit-averaged; no polar enhancement, no meteoroid streams, no seasonal variation. Size and
   direction are drawn independently unless a table gives them jointly (the format does not).
 * Circular orbits only; body frame = orbit frame; arrays rotate about their drive axis only.

@@ -62,15 +62,20 @@ GRUN_MAX_MASS_KG = 1.0e-1  # [kg] 100 g: upper validity limit of the Grün fit
 METEOROID_DENSITY_KG_M3 = 2500.0  # [kg m^-3] assumed meteoroid bulk density for mass <-> size
 
 # Ψ(i): inclination function of NASA-90/91 (Kessler et al. 1991; Kessler, Reynolds & Anz-Meador 1989, NASA
-# TM-100471; ECSS-E-10-04A Annex), i in degrees; linear interpolation between nodes, constant outside. NOT checked
-# against the publication: no copy of the table was reachable (the stored copies of Meshishnek 1995, SPENVIS's
-# NASA90 background page and the ESABASE2/Debris technical description return their opening pages only, and no
-# public code holds the table). Evidence per node: 28.5-60° agree with the values two independent public
-# implementations quote "from the table" (Ψ(45°) = 0.990, this table 0.990; Ψ(52°) = 1.030, this table 1.034);
-# 70°, 80°, 90°, 100° have none (80°: 1.18 is doubtful; some sources reportedly put the peak near 80° at
-# about 1.7, not verified here). tests/test_rates_published.py holds the corroborated values.
-_PSI_INCLINATION_DEG = np.array([28.5, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0, 100.0])
-_PSI_VALUE = np.array([0.91, 0.92, 0.96, 1.02, 1.09, 1.26, 1.18, 1.00, 0.98])
+# TM-100471; Anderson & Smith 1994, NASA TM-4527; ECSS-E-10-04A), i in degrees; linear interpolation between nodes,
+# constant outside. NOT checked against the publication: no readable copy of its table was found (the stored copies
+# of Meshishnek 1995, SPENVIS's NASA90 background page and the ESABASE2/Debris technical description give their
+# opening pages only, NASA TM-4527 and TM-100471 their catalogue records; ECSS-E-ST-10-04C has no NASA-90/91).
+# Evidence per node, each statement tested in tests/test_rates_published.py against the values the sources print:
+# * 28.5° (and the constant value below it) and 50°: as printed by a public design note that copies the model from
+#   SPENVIS ("0-28.5°: 0.91", "50°: 1.0"); 60° and 70° within 0.06 of it (1.07 and 1.2 printed);
+# * 40-60°: consistent with Ψ(45°) = 0.990 and Ψ(52°) = 1.030 quoted by two public implementations;
+# * 30°: no source;
+# * 80°, 90°, 100°: CONTRADICTED by that note (1.4, 1.6, 1.78 printed: 0.22-0.80 higher). A recollection of the
+#   publication, not a source (80°: 1.71, 90°: 1.37, 100°: 1.78, 120°: 1.18), also puts them higher. Debris rates
+#   for polar and sun-synchronous orbits may therefore be low by up to a factor of 1.8 (Ψ is a factor of the flux).
+PSI_INCLINATION_DEG = np.array([28.5, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0, 100.0])
+PSI_VALUE = np.array([0.91, 0.92, 0.96, 1.02, 1.09, 1.26, 1.18, 1.00, 0.98])
 
 
 def check_orbit(altitude_m: float, *, max_altitude_m: float | None = None, model: str = "") -> None:
@@ -105,7 +110,7 @@ def nasa90_psi(inclination_deg: float) -> float:
     Retrograde inclinations above 100 deg use the last tabulated value; below 28.5 deg the first.
     """
     _check_inclination(inclination_deg)
-    return float(np.interp(inclination_deg, _PSI_INCLINATION_DEG, _PSI_VALUE))
+    return float(np.interp(inclination_deg, PSI_INCLINATION_DEG, PSI_VALUE))
 
 
 def nasa90_growth(
