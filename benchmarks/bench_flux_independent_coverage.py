@@ -70,19 +70,26 @@ import matplotlib.pyplot as plt
 ROOT = Path(__file__).resolve().parent.parent
 FIGURE = ROOT / "docs" / "results" / "flux_independent_coverage.png"
 FERMI = str(ROOT / "examples" / "spacecraft" / "fermi_like.toml")
-ORBITS = ((550.0, 28.5), (800.0, 98.0))
+ORBITS = ((550.0, 28.5), (800.0, 98.0))  # the mixed fleet: 2 craft in each
+ORBIT_CLASSES = {  # --by-orbit: fleets of 4 craft in one orbit class each
+    "near-equatorial 600 km / 6 deg": (600.0, 6.0),
+    "low 550 km / 28.5 deg": (550.0, 28.5),
+    "ISS-like 400 km / 51.6 deg": (400.0, 51.6),
+    "sun-synchronous 800 km / 98 deg": (800.0, 98.0),
+}
 BETA = 1.5
 TRUTHS = (
     {"debris_scale": 0.3, "meteoroid_scale": 1.0, "beta": BETA},
     {"debris_scale": 3.0, "meteoroid_scale": 1.0, "beta": BETA},
 )
+SCALES = (("debris", "debris_scale"), ("meteoroid", "meteoroid_scale"))
 
 
-def fleet_exposure_rows() -> pd.DataFrame:
+def fleet_exposure_rows(orbits: tuple[tuple[float, float], ...], per_orbit: int) -> pd.DataFrame:
     parts = []
-    for k, (alt, inc) in enumerate(ORBITS):
+    for k, (alt, inc) in enumerate(orbits):
         spec = FleetSpec(
-            FERMI, n_spacecraft=2, years=5.0, altitude_km=alt, inclination_deg=inc, epoch_year=2020.0,
+            FERMI, n_spacecraft=per_orbit, years=5.0, altitude_km=alt, inclination_deg=inc, epoch_year=2020.0,
             dH50_Nms=0.01 * np.exp(-np.log(9.0) / 4.0), efficiency_slope=4.0, false_alarms_per_day=0.01,
             analysed_fraction=0.9, name_prefix=f"O{k}",
         )  # fmt: skip
@@ -90,42 +97,42 @@ def fleet_exposure_rows() -> pd.DataFrame:
     return pd.concat(parts, ignore_index=True)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--fleets", type=int, default=100, help="Fleets per truth.")
-    parser.add_argument("--draws", type=int, default=1_500_000, help="Generator draws per orbit and population.")
-    parser.add_argument("--seed", type=int, default=2026, help="Seed of the fleets' draws.")
-    args = parser.parse_args()
+def orbit_models(orbits: tuple[tuple[float, float], ...], draws: int) -> tuple[dict, dict]:
+    """Generator samples and abrupt templates per orbit; prints their strike rates side by side."""
     sc = load_spacecraft(FERMI)
-    t0 = time.perf_counter()
+    all_orbits = [*ORBITS, *ORBIT_CLASSES.values()]
     samples = {
         orbit: {
-            pop: strike_sample(sc, pop, *orbit, 2020.0, args.draws, seed=11 + 7 * j + 3 * i)
+            pop: strike_sample(sc, pop, *orbit, 2020.0, draws, seed=11 + 7 * j + 3 * all_orbits.index(orbit))
             for j, pop in enumerate(("debris", "meteoroid"))
         }
-        for i, orbit in enumerate(ORBITS)
+        for orbit in orbits
     }
     templates = {
         OrbitCase(FERMI, alt, inc, 2020.0): build_template(OrbitCase(FERMI, alt, inc, 2020.0), ForwardConfig())
-        for alt, inc in ORBITS
+        for alt, inc in orbits
     }
-    print(f"generator samples and abrupt templates: {time.perf_counter() - t0:.0f} s")
-    for orbit in ORBITS:
+    for orbit in orbits:
         tpl = templates[OrbitCase(FERMI, *orbit, 2020.0)]
         gen = [samples[orbit][p].rate.sum() for p in ("debris", "meteoroid")]
         ours = tpl.strikes_per_year
         print(f"  {orbit}: strikes/yr generator {gen[0]:.4g} debris, {gen[1]:.4g} meteoroid; ", end="")
         print(f"abrupt template {ours[0]:.4g}, {ours[1]:.4g}")
-    exposure = fleet_exposure_rows()
-    rng = np.random.default_rng(args.seed)
+    return samples, templates
+
+
+def run_fleets(
+    exposure: pd.DataFrame, samples: dict, templates: dict, fleets: int, rng: np.random.Generator
+) -> pd.DataFrame:
+    """Draw ``fleets`` fleets per truth with the independent generator and fit each with β fixed."""
     rows = []
     for truth in TRUTHS:
-        for _ in range(args.fleets):
+        for _ in range(fleets):
             events = draw_fleet(exposure, samples, truth, rng)
             res = fit(prepare(exposure, events, templates), fixed={"beta": BETA}, confidence=0.9)
             rep = res.reported()
             row = {"truth_debris": truth["debris_scale"], "n_events": len(events)}
-            for name in ("debris_scale", "meteoroid_scale"):
+            for _, name in SCALES:
                 lo, hi = rep["intervals"][name]
                 row[name] = rep["estimates"][name]
                 row[f"{name}_lo"], row[f"{name}_hi"] = lo, hi
@@ -133,10 +140,12 @@ def main() -> None:
                 ml_lo, ml_hi = res.intervals[name]
                 row[f"{name}_ml_covered"] = ml_lo <= truth[name] <= ml_hi
             rows.append(row)
-    table = pd.DataFrame(rows)
-    print(f"{len(table)} fleets, {args.fleets} per truth, {time.perf_counter() - t0:.0f} s in all; ", end="")
-    print(f"events per fleet median {table['n_events'].median():.0f}")
-    for name, key in (("debris", "debris_scale"), ("meteoroid", "meteoroid_scale")):
+    return pd.DataFrame(rows)
+
+
+def summarise(table: pd.DataFrame, rng: np.random.Generator) -> None:
+    print(f"{len(table)} fleets; events per fleet median {table['n_events'].median():.0f}")
+    for name, key in SCALES:
         pooled = table[f"{key}_covered"].mean()
         ml = table[f"{key}_ml_covered"].mean()
         se = np.sqrt(pooled * (1 - pooled) / len(table))
@@ -150,8 +159,40 @@ def main() -> None:
                 f"  fleets at debris truth {t:g}: coverage {cov:.1%}, median/truth - 1 = {np.median(rel):+.1%} "
                 f"± {boot.std():.1%}, mean/truth - 1 = {rel.mean():+.1%} ± {rel.std() / np.sqrt(rel.size):.1%}"
             )
-    plot_coverage(table, FIGURE)
-    print(f"figure written to {FIGURE.relative_to(ROOT)}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--fleets", type=int, default=100, help="Fleets per truth (per orbit class with --by-orbit).")
+    parser.add_argument("--draws", type=int, default=1_500_000, help="Generator draws per orbit and population.")
+    parser.add_argument("--seed", type=int, default=2026, help="Seed of the fleets' draws.")
+    parser.add_argument("--by-orbit", action="store_true", help="Fleets of 4 craft in one orbit class each.")
+    args = parser.parse_args()
+    t0 = time.perf_counter()
+    rng = np.random.default_rng(args.seed)
+    if not args.by_orbit:
+        samples, templates = orbit_models(ORBITS, args.draws)
+        table = run_fleets(fleet_exposure_rows(ORBITS, 2), samples, templates, args.fleets, rng)
+        print(f"mixed fleets (2 craft at each of {ORBITS}), {args.fleets} per truth, {time.perf_counter() - t0:.0f} s")
+        summarise(table, rng)
+        plot_coverage(table, FIGURE)
+        print(f"figure written to {FIGURE.relative_to(ROOT)}")
+        return
+    per_class = {}
+    for label, orbit in ORBIT_CLASSES.items():
+        print(f"== {label}: 4 craft x 5 years, {args.fleets} fleets per truth")
+        samples, templates = orbit_models((orbit,), args.draws)
+        table = run_fleets(fleet_exposure_rows((orbit,), 4), samples, templates, args.fleets, rng)
+        summarise(table, rng)
+        per_class[label] = table
+        print(f"   ({time.perf_counter() - t0:.0f} s so far)")
+    print("pooled 90 % coverage per orbit class (reported intervals; binomial s.e.):")
+    for label, table in per_class.items():
+        cells = []
+        for name, key in SCALES:
+            c = table[f"{key}_covered"].mean()
+            cells.append(f"{name} {c:.1%} ± {np.sqrt(c * (1 - c) / len(table)):.1%}")
+        print(f"  {label}: " + ", ".join(cells))
 
 
 def plot_coverage(table: pd.DataFrame, path: Path) -> None:
@@ -180,7 +221,7 @@ def plot_coverage(table: pd.DataFrame, path: Path) -> None:
 
 
 if __name__ == "__main__":
-    from _results import write_results
+    from _results import variant, write_results
 
-    with write_results("bench_flux_independent_coverage"):
+    with write_results("bench_flux_independent_coverage", variant({"--by-orbit": "by_orbit"})):
         main()
