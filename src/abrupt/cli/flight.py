@@ -180,7 +180,7 @@ def detect_from_store(
         store_dir, sc, orbit_in, cfg, days=day_list, keep_series=keep, progress=tick
     )
     bar.close()
-    if out:
+    if out and not catalog_target:  # with a catalog, record_run writes the events once the run is stored
         events.write_events_and_evidence(result.events, out)
     if catalog_target:
         record_run(

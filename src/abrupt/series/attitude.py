@@ -4,7 +4,8 @@ Total angular momentum ᴺH (Bennett 2022 Eqs. 2.6-2.7) needs the spacecraft's i
 an attitude detector reads an :class:`AttitudeSeries`: the :class:`~abrupt.series.telemetry.Telemetry`,
 its :class:`~abrupt.model.spacecraft.Spacecraft`, optionally event-free ``calibration`` telemetry of
 the same spacecraft, and the pseudonym events carry. Quantities every detector of a run needs
-(momentum, its noise model, simulated event-free momentum) are computed once per series and kept.
+(momentum, its noise model) are computed once per series and kept; simulated event-free momentum is
+drawn chunk by chunk for each calibration and never kept.
 
 The flight pipeline (:mod:`abrupt.pipelines.flight`) computes ᴺH itself (appendages, masks, orbit
 comb and trend removed) and hands the detector a :class:`CleanedMomentum`: ᴺH on a regular time grid
@@ -13,9 +14,9 @@ with the samples that may be analysed.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from collections.abc import Iterator
+from dataclasses import dataclass, replace
 from functools import cached_property
-from typing import Any
 
 import numpy as np
 
@@ -37,7 +38,6 @@ class AttitudeSeries:
     spacecraft: Spacecraft
     calibration: Telemetry | None = None
     name: str | None = None
-    _cache: dict[Any, Any] = field(default_factory=dict, init=False, repr=False)
 
     def __len__(self) -> int:
         return len(self.telemetry)
@@ -52,28 +52,27 @@ class AttitudeSeries:
         t = self.telemetry
         return system_momentum(self.spacecraft, t.quaternion_BN, t.body_rate_rad_s, t.wheel_speed_rad_s)
 
-    def event_free_momentum(
-        self, null_samples: int, seed: int
-    ) -> tuple[FloatArray, list[tuple[int, int]], MomentumNoiseModel]:
-        """Event-free ᴺH to calibrate thresholds on, its segments and the noise model behind it.
+    @cached_property
+    def calibration_momentum(self) -> tuple[FloatArray, list[tuple[int, int]]] | None:
+        """ᴺH of the event-free ``calibration`` telemetry and its segments (None without one)."""
+        cal = self.calibration
+        if cal is None:
+            return None
+        h = system_momentum(self.spacecraft, cal.quaternion_BN, cal.body_rate_rad_s, cal.wheel_speed_rad_s).H_N_Nms
+        return h, cal.segments
 
-        From the ``calibration`` telemetry when given; otherwise ``null_samples`` simulated from the
-        white + random-walk noise model measured on the input itself
-        (:func:`abrupt.thresholds.noise.momentum_noise_model`). Computed once per (null_samples, seed).
-        """
-        key = ("event_free", null_samples, seed)
-        if key not in self._cache:
-            if self.calibration is not None:
-                cal = self.calibration
-                h = system_momentum(
-                    self.spacecraft, cal.quaternion_BN, cal.body_rate_rad_s, cal.wheel_speed_rad_s
-                ).H_N_Nms
-                self._cache[key] = (h, cal.segments, momentum_noise_model(h, cal.segments))
-            else:
-                model = momentum_noise_model(self.momentum.H_N_Nms, self.telemetry.segments)
-                h = model.simulate(null_samples, seed)
-                self._cache[key] = (h, [(0, h.shape[0])], model)
-        return self._cache[key]
+    @cached_property
+    def noise_model(self) -> MomentumNoiseModel:
+        """The white + random-walk noise of ᴺH (:func:`abrupt.thresholds.noise.momentum_noise_model`) that
+        thresholds rest on: measured on the ``calibration`` telemetry when given, otherwise on the input."""
+        if self.calibration_momentum is not None:
+            return momentum_noise_model(*self.calibration_momentum)
+        return momentum_noise_model(self.momentum.H_N_Nms, self.telemetry.segments)
+
+    def simulated_null(self, null_samples: int, seed: int, rows: int | None = None) -> Iterator[FloatArray]:
+        """Event-free ᴺH simulated from :attr:`noise_model`: the first ``rows`` of ``null_samples``, chunk by
+        chunk (:meth:`~abrupt.thresholds.noise.MomentumNoiseModel.simulate_chunks`), never held whole."""
+        return self.noise_model.simulate_chunks(null_samples, seed, rows=rows)
 
     def shifted(self, seconds: float) -> AttitudeSeries:
         """The same series with every time stamp (input and calibration) moved by ``seconds``."""

@@ -195,11 +195,38 @@ def fit_threshold(
 
 def block_maxima(statistic: ArrayLike, block_samples: int) -> NDArray[np.float64]:
     """Maxima of consecutive blocks of ``block_samples`` (blocks with no finite value are skipped)."""
-    x = np.asarray(statistic, dtype=np.float64).ravel()
-    m = (x.size // block_samples) * block_samples
-    blocks = np.where(np.isfinite(x[:m]), x[:m], -np.inf).reshape(-1, block_samples)
-    maxima = blocks.max(axis=1)
-    return np.asarray(maxima[np.isfinite(maxima)], dtype=np.float64)
+    stream = BlockMaxima(block_samples)
+    stream.push(statistic)
+    return stream.maxima
+
+
+class BlockMaxima:
+    """Block maxima of a statistic given piece by piece, in order: :func:`block_maxima` of the pieces joined.
+
+    Blocks start at the first value pushed; values of an unfinished block wait for the next piece and a
+    last unfinished block is left out. Memory holds one block and the maxima, whatever the length pushed.
+    """
+
+    def __init__(self, block_samples: int) -> None:
+        if block_samples < 1:
+            raise ValueError(f"block_samples must be positive, got {block_samples}")
+        self.block_samples = int(block_samples)
+        self._pending = np.empty(0)
+        self._maxima: list[NDArray[np.float64]] = []
+
+    def push(self, values: ArrayLike) -> None:
+        x = np.asarray(values, dtype=np.float64).ravel()
+        if self._pending.size:
+            x = np.concatenate([self._pending, x])
+        m = (x.size // self.block_samples) * self.block_samples
+        blocks = np.where(np.isfinite(x[:m]), x[:m], -np.inf).reshape(-1, self.block_samples)
+        maxima = blocks.max(axis=1)
+        self._maxima.append(maxima[np.isfinite(maxima)])
+        self._pending = x[m:].copy()
+
+    @property
+    def maxima(self) -> NDArray[np.float64]:
+        return np.asarray(np.concatenate(self._maxima) if self._maxima else np.empty(0), dtype=np.float64)
 
 
 def fit_block_maxima_threshold(
@@ -217,8 +244,21 @@ def fit_block_maxima_threshold(
     1 − exp(−rate · block length) (:meth:`FalseAlarmBudget.per_block`), i.e. a Poisson rate of
     ``budget`` episodes.
     """
-    block = max(2, round(block_s * sample_rate_hz))
-    maxima = block_maxima(null_statistic, block)
+    maxima = block_maxima(null_statistic, block_samples_of(block_s, sample_rate_hz))
+    return gev_threshold_from_maxima(maxima, sample_rate_hz=sample_rate_hz, budget=budget, block_s=block_s)
+
+
+def block_samples_of(block_s: float, sample_rate_hz: float) -> int:
+    """Samples in a block of ``block_s`` seconds (at least 2)."""
+    return max(2, round(block_s * sample_rate_hz))
+
+
+def gev_threshold_from_maxima(
+    maxima: ArrayLike, *, sample_rate_hz: float, budget: FalseAlarmBudget, block_s: float
+) -> Threshold:
+    """:func:`fit_block_maxima_threshold` from the block maxima themselves (e.g. of :class:`BlockMaxima`)."""
+    maxima = np.asarray(maxima, dtype=np.float64)
+    block = block_samples_of(block_s, sample_rate_hz)
     if maxima.size < 20:
         raise ValueError(
             f"need at least 20 blocks of {block_s:g} s of event-free data for a GEV fit, got {maxima.size}"

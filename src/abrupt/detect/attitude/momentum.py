@@ -75,7 +75,7 @@ The thesis procedure (ROC, likelihood-ratio slope at P_FA = α, Eqs. 2.10-2.11) 
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import asdict, dataclass, field
 from typing import Any, ClassVar
 
@@ -92,7 +92,14 @@ from abrupt.detect.base import DetectionResult, Detector, Diagnostics, detector_
 from abrupt.events import Event, config_hash, empty_frame, events_frame, format_time_utc
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.attitude import AttitudeSeries
-from abrupt.thresholds import FalseAlarmBudget, Threshold, block_maxima, fit_block_maxima_threshold, fit_threshold
+from abrupt.thresholds import (
+    BlockMaxima,
+    FalseAlarmBudget,
+    Threshold,
+    block_samples_of,
+    fit_threshold,
+    gev_threshold_from_maxima,
+)
 from abrupt.thresholds.noise import MomentumNoiseModel, robust_noise_sigma
 from abrupt.types import FloatArray
 
@@ -175,6 +182,36 @@ def _max_over_axes(raw: FloatArray) -> FloatArray:
     with np.errstate(invalid="ignore"):
         out = np.where(np.all(np.isnan(raw), axis=1), np.nan, np.nanmax(np.where(np.isnan(raw), -np.inf, raw), axis=1))
     return np.asarray(out, dtype=np.float64)
+
+
+def statistic_in_chunks(
+    statistic: Callable[[FloatArray], FloatArray], chunks: Iterable[FloatArray], windows: WindowConfig
+) -> Iterator[FloatArray]:
+    """``statistic`` of the rows of ``chunks`` joined, piece by piece: the pieces joined equal
+    ``statistic(np.concatenate(chunks))`` to the bit, and at most a chunk and a window span are held.
+
+    ``statistic`` maps ᴺH rows (n, 3) to one value per junction (NaN where the windows do not fit), from
+    running sums anchored at row indices divisible by :data:`ANCHOR` (the kernels of
+    :mod:`abrupt.detect.attitude.change_detection`). Each piece is evaluated on rows starting at such an
+    index, a pre-window or more before its first junction, so every value is the one the whole gives; the
+    junctions whose post-window runs past the last row are NaN, as in the whole.
+    """
+    buffer = np.empty((0, 3))
+    start = 0  # row index of buffer[0], divisible by ANCHOR
+    done = end = 0  # the next junction to give; rows seen
+    for chunk in chunks:
+        buffer = np.concatenate([buffer, chunk]) if buffer.size else np.asarray(chunk, dtype=np.float64)
+        end = start + buffer.shape[0]
+        upto = end - windows.guard - windows.post + 1  # junctions [done, upto) have all their rows
+        if upto <= done:
+            continue
+        values = statistic(buffer)
+        yield values[done - start : upto - start]
+        done = upto
+        keep = max(0, (done - windows.pre) // ANCHOR * ANCHOR)
+        buffer, start = buffer[keep - start :], keep
+    if end > done:  # the last junctions, whose post-windows run past the end
+        yield np.full(end - done, np.nan)
 
 
 @dataclass(frozen=True)
@@ -260,25 +297,35 @@ class MomentumChangeDetector(Detector[AttitudeSeries]):
             return 0
         return round(21 * self.block_s(dt) / dt) + self.windows.span
 
-    def calibration_rows(
-        self, h: FloatArray, segments: list[tuple[int, int]], simulated: bool, block_s: float, dt: float
-    ) -> tuple[FloatArray, list[tuple[int, int]]]:
-        """Event-free rows the threshold is fitted on (all of them unless a subclass is costly)."""
-        return h, segments
+    def simulated_rows(self, null_samples: int, block_s: float, dt: float) -> int:
+        """Rows of the simulated event-free ᴺH the threshold is fitted on (all unless a subclass is costly)."""
+        return null_samples
+
+    def null_statistic(self, series: AttitudeSeries, dt: float, block_s: float) -> Iterator[FloatArray]:
+        """The statistic on event-free ᴺH, piece by piece: of the calibration telemetry when given,
+        otherwise of momentum simulated chunk by chunk, so memory does not grow with ``null_samples``."""
+        if series.calibration_momentum is not None:
+            yield self.statistic(*series.calibration_momentum)
+            return
+        n = max(self.null_samples, self.null_samples_needed(dt))
+        chunks = series.simulated_null(n, self.seed, rows=self.simulated_rows(n, block_s, dt))
+        yield from statistic_in_chunks(self.combined_statistic, chunks, self.windows)
 
     def calibrate(self, series: AttitudeSeries, budget: FalseAlarmBudget) -> Calibration:
         """Fit the threshold for ``budget`` on event-free momentum (calibration data or simulated)."""
         dt = series.telemetry.sample_interval_s
         rate = 1.0 / dt
-        h, segments, model = series.event_free_momentum(max(self.null_samples, self.null_samples_needed(dt)), self.seed)
         block_s = self.block_s(dt)
-        h, segments = self.calibration_rows(h, segments, series.calibration is None, block_s, dt)
-        stat = self.statistic(h, segments)
+        pieces = self.null_statistic(series, dt, block_s)
         if self.threshold_method == "gev":
-            thr = fit_block_maxima_threshold(stat, sample_rate_hz=rate, budget=budget, block_s=block_s)
-            return Calibration(thr, block_maxima(stat, max(2, round(block_s / dt))), model)
+            maxima = BlockMaxima(block_samples_of(block_s, rate))
+            for piece in pieces:
+                maxima.push(piece)
+            thr = gev_threshold_from_maxima(maxima.maxima, sample_rate_hz=rate, budget=budget, block_s=block_s)
+            return Calibration(thr, maxima.maxima, series.noise_model)
+        stat = np.concatenate(list(pieces))
         thr = fit_threshold(stat, budget=budget, sample_rate_hz=rate, method=self.threshold_method)  # type: ignore[arg-type]
-        return Calibration(thr, None, model)
+        return Calibration(thr, None, series.noise_model)
 
     def warnings_for(self, threshold: Threshold) -> list[str]:
         """Warnings about a threshold this detector cannot alarm at (none by default)."""
@@ -433,14 +480,9 @@ class ShiryaevDetector(MomentumChangeDetector):
     def combined_statistic(self, h: FloatArray) -> FloatArray:
         return _max_over_axes(np.abs(sliding_statistic("shiryaev", h, self.windows)))
 
-    def calibration_rows(
-        self, h: FloatArray, segments: list[tuple[int, int]], simulated: bool, block_s: float, dt: float
-    ) -> tuple[FloatArray, list[tuple[int, int]]]:
+    def simulated_rows(self, null_samples: int, block_s: float, dt: float) -> int:
         """Shiryaev costs 21 likelihoods per sample per window: calibrate on 40 simulated blocks only."""
-        if not simulated:
-            return h, segments
-        h = h[: max(self.windows.span * 20, round(40 * block_s / dt))]
-        return h, [(0, h.shape[0])]
+        return min(null_samples, max(self.windows.span * 20, round(40 * block_s / dt)))
 
     def warnings_for(self, threshold: Threshold) -> list[str]:
         w = self.windows
