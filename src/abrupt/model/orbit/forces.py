@@ -119,9 +119,9 @@ class ForceModel:
     "exponential" or "msis" (simulator only); ``drag_area_m2`` the reference area; ``array_area_m2`` a
     sun-tracking panel whose drag area is A_array |n̂·v̂_rel| with n̂ = +X inertial (Bennett 2022 §3.4.4).
     ``srp`` with ``shadow`` "cylindrical" or "conical". ``solid_tides`` (Sun and Moon, degree 2) and
-    ``relativity`` (Schwarzschild) add the small forces of the module docstring. ``drag_scale``/``srp_scale`` multiply the
-    accelerations (the estimated nuisance factors). ``f107_sfu``, ``f107a_sfu`` and ``ap`` are the
-    explicit NRLMSIS space-weather indices.
+    ``relativity`` (Schwarzschild) add the small forces of the module docstring. ``drag_scale`` and
+    ``srp_scale`` multiply the accelerations (the estimated nuisance factors). ``f107_sfu``,
+    ``f107a_sfu`` and ``ap`` are the explicit NRLMSIS space-weather indices.
     """
 
     two_body: bool = True
@@ -167,9 +167,7 @@ class ForceModel:
     @property
     def needs_time(self) -> bool:
         """True when the forces depend on the epoch (Earth orientation, Sun, Moon, MSIS)."""
-        return (
-            self.srp or self.sun or self.moon or self.solid_tides or self.drag == "msis" or self.gravity_degree >= 2
-        )
+        return self.srp or self.sun or self.moon or self.solid_tides or self.drag == "msis" or self.gravity_degree >= 2
 
     @classmethod
     def full(cls, degree: int = 40, **kwargs: object) -> ForceModel:
