@@ -8,7 +8,13 @@ abrupt's range model). Prints
 * the independent ranges against abrupt's own range model on the same orbit (acceptance: ~0.1 m);
 * the command's events, fitted range biases, radiation-pressure scale and post-fit RMS (acceptance: no
   maneuver of this satellite without propulsion; biases and scales inside their physical bounds);
-* the CPU time of the command.
+* the CPU time and peak resident memory of the command (``/usr/bin/time -v``) beside the bounds every
+  run must keep on inputs under 10 MB (60 CPU-s, 2 GB).
+
+The CPF itself is not a dynamically consistent orbit in IERS ITRF at the metre level
+(``benchmarks/bench_slr_cpf_dynamics.py``: its Earth-fixed frame is offset from ITRF by a pole offset of
+~0.17 arcsec and an Earth-rotation drift of ~1.7 ms/day of UT1), so no force model fits these ranges to
+millimetres: the expected outcome is an unexplained residual, named, with no maneuver.
 
 Usage: ``python benchmarks/bench_slr_cpf.py [--seed N]`` (needs ../shared/data).
 """
@@ -17,7 +23,7 @@ from __future__ import annotations
 
 import argparse
 import json
-import resource
+import re
 import subprocess
 import sys
 import tempfile
@@ -73,15 +79,24 @@ def simulate(folder: Path, seed: int) -> pd.DataFrame:
     return points
 
 
-def run_command(folder: Path) -> tuple[subprocess.CompletedProcess[str], float]:
-    """``abrupt detect laser`` as documented, and its CPU time (s, the child process)."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    args = [str(Path(sys.executable).parent / "abrupt"), "detect", "laser", str(folder / "lageos1.npt")]
-    args += ["--apriori", str(CPF), "--out", str(folder / "laser.csv"), "--fit-out", str(folder / "fit.json")]
-    args += ["--catalog", str(folder / "catalog.sqlite")]
+CPU_BOUND_S = 60.0
+MEMORY_BOUND_GB = 2.0
+
+
+def run_command(folder: Path) -> tuple[subprocess.CompletedProcess[str], float, float]:
+    """``abrupt detect laser`` as documented under ``/usr/bin/time -v``: the run, its CPU time (user +
+    system, s) and its peak resident memory (GB)."""
+    args = ["/usr/bin/time", "-v", str(Path(sys.executable).parent / "abrupt"), "detect", "laser"]
+    args += [str(folder / "lageos1.npt"), "--apriori", str(CPF), "--out", str(folder / "laser.csv")]
+    args += ["--fit-out", str(folder / "fit.json"), "--catalog", str(folder / "catalog.sqlite")]
     done = subprocess.run(args, capture_output=True, text=True, check=False)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return done, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+    def field(name: str) -> float:
+        found = re.search(rf"{name}: ([0-9.]+)", done.stderr)
+        return float(found.group(1)) if found else float("nan")
+
+    cpu_s = field(r"User time \(seconds\)") + field(r"System time \(seconds\)")
+    return done, cpu_s, field(r"Maximum resident set size \(kbytes\)") / 1024**2
 
 
 def main() -> None:
@@ -98,8 +113,11 @@ def main() -> None:
             f"{ {k: round(1e3 * v, 1) for k, v in worst.items()} }"
         )
         start = time.time()
-        done, cpu_s = run_command(folder)
-        print(f"exit {done.returncode}; CPU {cpu_s / 60:.2f} min (wall {(time.time() - start) / 60:.2f} min)")
+        done, cpu_s, peak_gb = run_command(folder)
+        print(
+            f"exit {done.returncode}; CPU {cpu_s:.1f} s (bound {CPU_BOUND_S:g} s), peak resident {peak_gb:.2f} GB "
+            f"(bound {MEMORY_BOUND_GB:g} GB); wall {time.time() - start:.0f} s"
+        )
         print("\n".join(line for line in done.stdout.splitlines() if "abrupt detect laser:" not in line))
         if done.returncode == 0:
             events = pd.read_csv(folder / "laser.csv")
@@ -107,7 +125,7 @@ def main() -> None:
             fit = json.loads((folder / "fit.json").read_text())
             print(f"range biases (mm): {fit['range_bias_mm']}; scales: {fit.get('scale_factors')}")
         else:
-            print(done.stderr[-2000:])
+            print(done.stderr[:2000])
 
 
 if __name__ == "__main__":
