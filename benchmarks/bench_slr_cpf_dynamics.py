@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import replace
+from pathlib import Path
 
 import astropy.units as u
 import numpy as np
@@ -34,8 +35,9 @@ from abrupt.model.orbit.propagation import propagate_with_stm
 from abrupt.model.timescales import offline_astropy
 from abrupt.model.tracking_measurements import earth_rotation_matrices
 from abrupt.pipelines.laser_ranging import LASER_FORCE
-from bench_slr_cpf import CPF
 
+CPF = Path(__file__).resolve().parents[2] / "shared" / "data" / "tracking" / "ilrs-corpus"
+CPF = CPF / "lageos1_cpf_180613_16401.hts"
 ARCSEC = np.pi / 180.0 / 3600.0
 OMEGA_EARTH_RAD_S = 7.292115e-5
 
@@ -74,6 +76,17 @@ def fit_positions(
             break
         rms = new_rms
     return new_rms, frame, srp
+
+
+def frame_rotation_rad(t_s: np.ndarray, frame: np.ndarray) -> np.ndarray:
+    """θ(t) (n, 3) [rad] of the frame parameters of :func:`fit_positions`: r_CPF ≈ r_ITRF + θ × r_ITRF."""
+    days = np.asarray(t_s, float) / 86400.0
+    theta = np.zeros((days.size, 3))
+    theta[:, 0] = frame[0]
+    theta[:, 1] = frame[1]
+    if frame.size == 4:
+        theta[:, 2] = frame[2] * days + frame[3] * days**2
+    return theta
 
 
 def main() -> None:
