@@ -99,6 +99,19 @@ def read_cpf(path: Path) -> Cpf:
     return Cpf(target, np.array(times, dtype="datetime64[ns]"), np.array(pos))
 
 
+def write_cpf_positions(source: Path, position_m: np.ndarray, path: Path) -> None:
+    """``source`` with the positions of its type-10 records, in order, replaced by ``position_m`` (m)."""
+    rows = iter(np.asarray(position_m, float))
+    out = []
+    for line in source.read_text().splitlines():
+        fields = line.split()
+        if fields[:1] == ["10"]:
+            x, y, z = next(rows)
+            line = f"10 {fields[1]} {fields[2]} {fields[3]} {fields[4]} {x:.3f} {y:.3f} {z:.3f}"
+        out.append(line)
+    path.write_text("\n".join(out) + "\n")
+
+
 def read_slrf_sites(path: Path, codes: list[str], when_utc: np.datetime64) -> dict[str, np.ndarray]:
     """ITRF positions (m) of the stations ``codes`` at ``when_utc``: SLRF2014 position at its epoch plus
     velocity × time, for the solution whose validity interval (``SOLUTION/EPOCHS``) holds the date."""

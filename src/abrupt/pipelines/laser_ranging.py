@@ -32,6 +32,7 @@ from abrupt.model.stations import Station
 from abrupt.model.tracking_measurements import TrackingArrays, as_datetime64_ns, earth_rotation_matrices
 from abrupt.pipelines.laser_apriori import MAX_ELEMENT_AGE_DAYS, ElementApriori, is_element_file, short_arc_fit
 from abrupt.pipelines.laser_plausibility import (
+    MAX_POSTFIT_RMS_M,
     check_ranges_against_apriori,
     fit_bound_violations,
     passive_detections,
@@ -89,6 +90,7 @@ class LaserRangingResult:
     sigma_scale: dict[str, float]
     data: TrackingArrays
     repairs: RepairLog = field(default_factory=RepairLog)
+    unexplained: list[str] = field(default_factory=list)
 
 
 def laser_series(
@@ -125,12 +127,21 @@ def detect_laser_ranging(
     fit_config: BatchFitConfig | None = None,
     max_maneuvers: int = 3,
     weight_by_residuals: bool = True,
+    bounded: bool = True,
 ) -> LaserRangingResult:
-    """``tracking.laser_glrt`` on one arc; ``x0_apriori`` is the GCRF state at ``epoch_utc``."""
+    """``tracking.laser_glrt`` on one arc; ``x0_apriori`` is the GCRF state at ``epoch_utc``. With
+    ``bounded`` the detector stops at a residual its model cannot absorb (the physical bounds of
+    :func:`~abrupt.pipelines.laser_plausibility.fit_bound_violations`; no epoch search when no single
+    impulse explains the arc), which the result names in ``unexplained``."""
     series = laser_series(
         measurements, sites, stations, x0_apriori, epoch_utc, range_model=range_model, fit_config=fit_config
     )
-    detector = LaserGlrtDetector(max_maneuvers=max_maneuvers, weight_by_residuals=weight_by_residuals)
+    detector = LaserGlrtDetector(
+        max_maneuvers=max_maneuvers,
+        weight_by_residuals=weight_by_residuals,
+        fit_bounds=_fit_bounds if bounded else None,
+        max_unexplained_rms_m=MAX_POSTFIT_RMS_M if bounded else None,
+    )
     extra = detector.detect(series, budget or DEFAULT_BUDGET).diagnostic(detector.name).extra
     return LaserRangingResult(
         extra["detections"],
@@ -139,7 +150,13 @@ def detect_laser_ranging(
         extra["sigma_scale"],
         extra["data"],
         extra["repairs"],
+        list(extra.get("unexplained", [])),
     )
+
+
+def _fit_bounds(fit: BatchFit, residual_rms_m: Mapping[str, float]) -> list[str]:
+    """The fit's physical bounds (:func:`fit_bound_violations`) in the detector's calling convention."""
+    return fit_bound_violations(fit.range_bias_m, fit.scale_factors, residual_rms_m)
 
 
 @dataclass
@@ -586,10 +603,17 @@ def _unabsorbed(frame: pd.DataFrame, result: LaserArcsResult) -> tuple[pd.DataFr
     for arc in result.arcs:
         fit = arc.result.fit
         bad = fit_bound_violations(fit.range_bias_m, fit.scale_factors, arc.result.residual_rms_m)
+        bad += [b for b in arc.result.unexplained if b not in bad]
         if not bad:
             continue
         lo, hi = arc.owned_s
         rows = [i for i, d in enumerate(result.detections) if lo <= d.t_s <= hi]
+        if not arc.result.detections:
+            warnings.append(
+                f"arc {str(arc.epoch_utc)[:19]}: unexplained residual ({'; '.join(bad)}): the model cannot absorb "
+                "it, and no maneuver is reported"
+            )
+            continue
         warnings.append(
             f"arc {str(arc.epoch_utc)[:19]}: the fit leaves its physical bounds ({'; '.join(bad)}): it absorbs what "
             f"its model cannot explain; {len(rows)} detection(s) reported as unexplained residuals, not maneuvers"
@@ -624,17 +648,18 @@ def _run_summary(result: LaserArcsResult, n_ranges: int, repairs: RepairLog) -> 
     """The fit summary of a file run (JSON-ready): residual RMS, weights, biases and scales per arc."""
     last = result.arcs[-1].result
     return {
-        "residual_rms_mm": {k: round(v * 1000, 2) for k, v in result.residual_rms_m.items()},
-        "sigma_scale": {k: round(v, 2) for k, v in last.sigma_scale.items()},
-        "range_bias_mm": {k: round(v * 1000, 1) for k, v in last.fit.range_bias_m.items()},
-        "scale_factors": {k: round(v, 4) for k, v in last.fit.scale_factors.items()},
-        "time_bias_us": {k: round(v * 1e6, 2) for k, v in last.fit.time_bias_s.items()},
+        "residual_rms_mm": {k: round(float(v) * 1000, 2) for k, v in result.residual_rms_m.items()},
+        "sigma_scale": {k: round(float(v), 2) for k, v in last.sigma_scale.items()},
+        "range_bias_mm": {k: round(float(v) * 1000, 1) for k, v in last.fit.range_bias_m.items()},
+        "scale_factors": {k: round(float(v), 4) for k, v in last.fit.scale_factors.items()},
+        "time_bias_us": {k: round(float(v) * 1e6, 2) for k, v in last.fit.time_bias_s.items()},
         "arcs": [
             {
                 "epoch_utc": str(arc.epoch_utc),
                 "owned_s": list(arc.owned_s),
-                "residual_rms_mm": {k: round(v * 1000, 2) for k, v in arc.result.residual_rms_m.items()},
-                "range_bias_mm": {k: round(v * 1000, 1) for k, v in arc.result.fit.range_bias_m.items()},
+                "residual_rms_mm": {k: round(float(v) * 1000, 2) for k, v in arc.result.residual_rms_m.items()},
+                "range_bias_mm": {k: round(float(v) * 1000, 1) for k, v in arc.result.fit.range_bias_m.items()},
+                "unexplained": list(arc.result.unexplained),
             }
             for arc in result.arcs
         ],

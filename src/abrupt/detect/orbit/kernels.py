@@ -6,7 +6,8 @@ forward and mirrored backward filter loops (Bennett 2022 §3.2; the equations ar
 All kernels use explicit loops over the state dimension (9, or 17 with nuisance states) and take and
 return plain arrays. Process-noise γ coefficients use the closed forms of Eqs. 3.11-3.21 when
 |Δt/τ| ≥ 0.1 and Gauss-Legendre quadrature of the same integrals otherwise (the closed forms cancel
-catastrophically for Δt ≪ τ).
+catastrophically for Δt ≪ τ). The dynamics call the force kernel of :mod:`abrupt.model.orbit.forces`
+with every switch of its force model (solid tides and relativity when on).
 """
 
 from __future__ import annotations

@@ -16,12 +16,22 @@ On a :class:`~abrupt.series.tracking.LaserRangingSeries` of one arc the detector
 5. **re-reduces** on the trajectory with the detected impulses and repeats steps 3-4 until the weights
    settle, so that the corrections of the ranges after a maneuver are computed on the right orbit.
 
+Bounded cost (optional, set by the pipeline): before the epoch search, the linear scan of step 4 tells how
+much of the maneuver-free fit's residual the best single impulse removes (its statistic T_max of the
+residual's χ²). When it removes less than half and leaves more than ``max_unexplained_rms_m`` of range
+RMS, no impulse explains the arc: the nonlinear epoch search (tens of full refits) is skipped and the arc
+is reported as an unexplained residual. After each search round the fit with its impulses is checked
+against ``fit_bounds`` (physical range biases, force scales, post-fit RMS); a fit outside them ends the
+re-weighting rounds, whose further searches could only fit more of what the model cannot explain.
+
 It is not ``tracking.glrt``: the scan is the same, but the measurements it scans are re-reduced and
 re-weighted between scans, so the events (epochs, Δv, statistics) differ from one GLRT on fixed data.
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable, Mapping
 from dataclasses import replace
 
 import numpy as np
@@ -33,10 +43,12 @@ from abrupt.detect.tracking.glrt import (
     GlrtScan,
     detect_maneuvers_glrt,
     glrt_events,
+    glrt_scan,
     glrt_threshold_fit,
 )
 from abrupt.errors import RepairLog
 from abrupt.events import empty_frame, events_frame
+from abrupt.model.orbit import ForceContext
 from abrupt.model.orbit.batch_fit import BatchFit, fit_orbit
 from abrupt.model.tracking_measurements import TrackingArrays
 from abrupt.series.tracking import LaserRangingSeries
@@ -51,6 +63,7 @@ class LaserGlrtDetector(Detector[LaserRangingSeries]):
     candidate epochs with its χ²₃ threshold; ``noise_model`` the station sigma scales applied;
     ``extra`` holds ``detections`` (:class:`~abrupt.detect.tracking.glrt.GlrtDetection`, times in s
     from the series epoch), ``fit`` (the final :class:`~abrupt.model.orbit.batch_fit.BatchFit`),
+    ``unexplained`` (why the arc is an unexplained residual, one phrase each; empty when it is not),
     ``data`` (the reduced, weighted measurements), ``sigma_scale`` and ``residual_rms_m`` (post-fit
     range RMS per station, m) and ``repairs`` (the reduction's :class:`~abrupt.errors.RepairLog`).
     """
@@ -60,11 +73,20 @@ class LaserGlrtDetector(Detector[LaserRangingSeries]):
     kind = "maneuver"
     summary = "impulse GLRT on reduced laser ranges, stations weighted by their own residuals"
 
-    def __init__(self, *, max_maneuvers: int = 3, weight_by_residuals: bool = True) -> None:
+    def __init__(
+        self,
+        *,
+        max_maneuvers: int = 3,
+        weight_by_residuals: bool = True,
+        fit_bounds: Callable[[BatchFit, Mapping[str, float]], list[str]] | None = None,
+        max_unexplained_rms_m: float | None = None,
+    ) -> None:
         if max_maneuvers < 1:
             raise ValueError(f"max_maneuvers must be at least 1, got {max_maneuvers}")
         self.max_maneuvers = int(max_maneuvers)
         self.weight_by_residuals = bool(weight_by_residuals)
+        self.fit_bounds = fit_bounds
+        self.max_unexplained_rms_m = max_unexplained_rms_m
 
     def detect(self, series: LaserRangingSeries, budget: FalseAlarmBudget) -> DetectionResult:
         if len(series) == 0:
@@ -76,7 +98,17 @@ class LaserGlrtDetector(Detector[LaserRangingSeries]):
         data, fit = _initial_fit(series, repairs)
         detections: list[GlrtDetection] = []
         scans: list[GlrtScan] = []
-        for it in range(4):
+        unexplained: list[str] = []
+        if self.max_unexplained_rms_m is not None:
+            force = fcfg.force.model if isinstance(fcfg.force, ForceContext) else fcfg.force
+            scan0, rms_after_m, share = single_impulse_share(data, fit, force.mu_m3_s2)
+            if share < 0.5 and rms_after_m > self.max_unexplained_rms_m:
+                scans = [scan0]
+                unexplained.append(
+                    f"the best single impulse removes {100 * share:.0f} % of the residual and leaves "
+                    f"{rms_after_m:.3g} m of range RMS (≤ {self.max_unexplained_rms_m:g} m): no maneuver search"
+                )
+        for it in range(0 if unexplained else 4):
             if self.weight_by_residuals:
                 # relative to the stated sigmas and never below them; it comes back down once a detected
                 # maneuver is in the fit (the first weighting sees its residuals as noise), so after a
@@ -87,6 +119,10 @@ class LaserGlrtDetector(Detector[LaserRangingSeries]):
                 scale = new
                 data = series.reduced(fit, scale, repairs=repairs)
             detections, fit, scans = detect_maneuvers_glrt(data, fit.x0, fit_config=fcfg, config=gcfg)
+            bad = self.fit_bounds(fit, _station_rms_m(data, fit)) if self.fit_bounds is not None else []
+            if bad:
+                unexplained += bad
+                break
             if not detections or not self.weight_by_residuals:
                 break
             data = series.reduced(fit, scale, repairs=repairs)
@@ -118,6 +154,7 @@ class LaserGlrtDetector(Detector[LaserRangingSeries]):
                 "sigma_scale": scale,
                 "residual_rms_m": _station_rms_m(data, fit),
                 "repairs": repairs,
+                "unexplained": unexplained,
             },
         )
         return DetectionResult(events_frame(events) if events else empty_frame(), (diagnostics,))
@@ -146,6 +183,23 @@ def _initial_fit(series: LaserRangingSeries, repairs: RepairLog) -> tuple[Tracki
     data = series.reduced(fit, {}, repairs=repairs)
     fit = fit_orbit(data, fit.x0, config=fcfg, initial_range_bias_m=fit.range_bias_m)
     return data, fit
+
+
+def single_impulse_share(data: TrackingArrays, fit: BatchFit, mu_m3_s2: float) -> tuple[GlrtScan, float, float]:
+    """The linear GLRT scan of ``fit`` (candidates every 1/120 of the orbital period), the range RMS [m] the
+    best single impulse would leave, and the share of the residual's χ² it removes (T_max / χ²)."""
+    r, v = fit.x0[:3], fit.x0[3:]
+    energy = float(v @ v) / 2 - mu_m3_s2 / float(np.linalg.norm(r))
+    period = 2 * math.pi * math.sqrt((-mu_m3_s2 / (2 * energy)) ** 3 / mu_m3_s2) if energy < 0 else 86400.0
+    t_first, t_last = float(data.t_s.min()), float(data.t_s.max())
+    scan = glrt_scan(data, fit, np.arange(t_first + period / 120.0, t_last, period / 120.0))
+    used = fit.used
+    chi2 = float(np.sum(fit.residuals_white[used] ** 2))
+    resid_m = fit.residuals_white * data.sigma[fit.row_index, fit.row_component]
+    rms_m = float(np.sqrt(np.mean(resid_m[used] ** 2))) if used.any() else 0.0
+    t_max = float(np.nanmax(scan.statistic)) if np.any(np.isfinite(scan.statistic)) else 0.0
+    share = min(max(t_max / chi2, 0.0), 1.0) if chi2 > 0 else 1.0
+    return scan, rms_m * math.sqrt(1.0 - share), share
 
 
 def _station_rms_white(data: TrackingArrays, fit: BatchFit) -> dict[str, float]:

@@ -21,8 +21,13 @@ Forces (each switchable in :class:`ForceModel`):
   the indices come from the offline space-weather table of :mod:`abrupt.model.atmosphere`); without
   a reference, MSIS is evaluated point by point in Python with explicit F10.7/F10.7a/Ap (simulator).
 
-Solid Earth tides are not modelled (their ~1e-7 m/s² in LEO is left to the filters' Gauss-Markov
-accelerations).
+- solid Earth tides of degree 2 raised by the Sun and the Moon with one frequency-independent Love
+  number k₂ (IERS Conventions 2010 §6.2.1 Step 1, Eq. 6.6 with k₂₀ ≈ k₂₁ ≈ k₂₂; the permanent tide
+  included, as the shipped EGM2008 is tide-free), in closed form (:func:`solid_tide_acceleration`);
+- the Schwarzschild relativistic correction (IERS Conventions 2010 Eq. 10.12, β = γ = 1).
+
+Both are off by default (a LEO filter leaves their ~1e-7 m/s² to its Gauss-Markov accelerations); a
+week of laser ranging to LAGEOS needs them (metres otherwise).
 
 The kernels take a :class:`ForceContext`: plain arrays (flags, scalars, coefficients, Earth-orientation
 and Sun/Moon tables) built once per arc, so the numba code needs no Python objects. Time in the
@@ -56,6 +61,7 @@ from abrupt.model.orbit.constants import (
     R_EARTH_M,
     R_SUN_M,
     SOLAR_PRESSURE_N_M2,
+    SPEED_OF_LIGHT_MPS,
 )
 from abrupt.model.orbit.frames import earth_orientation_table, era_rate_rad_s
 from abrupt.model.orbit.gravity import field_acceleration, gravity_coefficients
@@ -95,6 +101,10 @@ EXPONENTIAL_ATMOSPHERE = np.array(
     ]
 )
 
+LOVE_K2 = 0.30
+"""Degree-2 Love number of the solid tide (IERS Conventions 2010 Table 6.3: elastic k₂₀ 0.29525,
+k₂₁ 0.29470, k₂₂ 0.29801; anelastic 0.30190, 0.29830, 0.30102): one value for all orders."""
+
 DRAG_MODELS = ("none", "exponential", "msis")
 SHADOW_MODELS = ("cylindrical", "conical")
 
@@ -108,9 +118,10 @@ class ForceModel:
     ``gravity_model`` to that degree and ``gravity_order`` (default = degree). ``drag``: "none",
     "exponential" or "msis" (simulator only); ``drag_area_m2`` the reference area; ``array_area_m2`` a
     sun-tracking panel whose drag area is A_array |n̂·v̂_rel| with n̂ = +X inertial (Bennett 2022 §3.4.4).
-    ``srp`` with ``shadow`` "cylindrical" or "conical". ``drag_scale``/``srp_scale`` multiply the
-    accelerations (the estimated nuisance factors). ``f107_sfu``, ``f107a_sfu`` and ``ap`` are the
-    explicit NRLMSIS space-weather indices.
+    ``srp`` with ``shadow`` "cylindrical" or "conical". ``solid_tides`` (Sun and Moon, degree 2) and
+    ``relativity`` (Schwarzschild) add the small forces of the module docstring. ``drag_scale`` and
+    ``srp_scale`` multiply the accelerations (the estimated nuisance factors). ``f107_sfu``,
+    ``f107a_sfu`` and ``ap`` are the explicit NRLMSIS space-weather indices.
     """
 
     two_body: bool = True
@@ -136,6 +147,8 @@ class ForceModel:
     f107_sfu: float = 150.0
     f107a_sfu: float = 150.0
     ap: float = 4.0
+    solid_tides: bool = False
+    relativity: bool = False
 
     def __post_init__(self) -> None:
         if self.zonal_degree not in (0, 2, 3, 4):
@@ -154,7 +167,7 @@ class ForceModel:
     @property
     def needs_time(self) -> bool:
         """True when the forces depend on the epoch (Earth orientation, Sun, Moon, MSIS)."""
-        return self.srp or self.sun or self.moon or self.drag == "msis" or self.gravity_degree >= 2
+        return self.srp or self.sun or self.moon or self.solid_tides or self.drag == "msis" or self.gravity_degree >= 2
 
     @classmethod
     def full(cls, degree: int = 40, **kwargs: object) -> ForceModel:
@@ -171,7 +184,7 @@ class ForceModel:
 
 
 # Context layout (indices into the integer and float parameter arrays)
-I_TWO_BODY, I_ZONAL, I_J3_ONLY, I_DEGREE, I_ORDER, I_DRAG, I_SRP, I_SUN, I_MOON = range(9)
+I_TWO_BODY, I_ZONAL, I_J3_ONLY, I_DEGREE, I_ORDER, I_DRAG, I_SRP, I_SUN, I_MOON, I_TIDES, I_RELATIVITY = range(11)
 F_MU, F_GM, F_RADIUS, F_MASS, F_CD, F_AREA, F_ARRAY, F_CR, F_SRP_AREA = range(9)
 F_EOP_T0, F_EOP_STEP, F_BODY_T0, F_BODY_STEP, F_ERA0, F_ERA_RATE, F_DRAG_SCALE, F_SRP_SCALE = range(9, 17)
 F_RHO_T0, F_RHO_STEP = range(17, 19)
@@ -214,7 +227,7 @@ class ForceContext:
         epoch = np.asarray(epoch_utc if epoch_utc is not None else "2000-01-01T12:00:00", dtype="datetime64[ns]")
         epoch = epoch.reshape(-1)[0]
         lo, hi = min(t_from_s, t_to_s), max(t_from_s, t_to_s)
-        ints = np.zeros(9, dtype=np.int64)
+        ints = np.zeros(11, dtype=np.int64)
         floats = np.zeros(19)
         ints[I_TWO_BODY] = int(model.two_body)
         ints[I_ZONAL] = model.zonal_degree
@@ -225,6 +238,8 @@ class ForceContext:
         ints[I_SRP] = (1 if model.shadow == "cylindrical" else 2) if model.srp else 0
         ints[I_SUN] = int(model.sun)
         ints[I_MOON] = int(model.moon)
+        ints[I_TIDES] = int(model.solid_tides)
+        ints[I_RELATIVITY] = int(model.relativity)
         floats[F_MU] = model.mu_m3_s2
         floats[F_MASS] = model.mass_kg
         floats[F_CD] = model.drag_coefficient
@@ -249,7 +264,7 @@ class ForceContext:
             floats[F_EOP_STEP] = 1.0
             c2i = pom = np.zeros((1, 9))
             dut1 = np.zeros(1)
-        if model.sun or model.moon or model.srp:
+        if model.sun or model.moon or model.srp or model.solid_tides:
             bodies = body_table(epoch, lo, hi)
             floats[F_BODY_T0] = bodies.t0_s
             floats[F_BODY_STEP] = bodies.step_s
@@ -276,7 +291,7 @@ class ForceContext:
         if self.model.gravity_degree >= 2:
             n = self.kernel_args[4].shape[0]
             ok &= floats[F_EOP_T0] <= lo and hi <= floats[F_EOP_T0] + (n - 1) * floats[F_EOP_STEP]
-        if self.model.sun or self.model.moon or self.model.srp:
+        if self.model.sun or self.model.moon or self.model.srp or self.model.solid_tides:
             n = self.kernel_args[7].shape[0]
             ok &= floats[F_BODY_T0] <= lo and hi <= floats[F_BODY_T0] + (n - 1) * floats[F_BODY_STEP]
         return bool(ok)
@@ -353,6 +368,33 @@ def third_body_acceleration(r: FloatArray, s: FloatArray, mu_body: float) -> Flo
     dn = math.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2)
     sn = math.sqrt(s[0] ** 2 + s[1] ** 2 + s[2] ** 2)
     return mu_body * (d / dn**3 - s / sn**3)
+
+
+@nb.njit(cache=True)
+def solid_tide_acceleration(r: FloatArray, body: FloatArray, mu_body: float) -> FloatArray:
+    """Acceleration (m/s²) of the degree-2 solid tide that a body at ``body`` (m) raises, with one Love
+    number k₂ = :data:`LOVE_K2`: the gradient of U = k₂ μ_b R⁵ P₂(u) / (r_b³ r³), u = r̂·r̂_b (IERS
+    Conventions 2010 Eq. 6.6 summed over m with k₂ₘ = k₂, by the addition theorem),
+
+        a = 3 k₂ μ_b R⁵ / (2 r_b³ r⁴) [(1 − 5u²) r̂ + 2u r̂_b].
+
+    It is rotation-invariant, so it holds in GCRF components with GCRF positions."""
+    rn = math.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
+    bn = math.sqrt(body[0] * body[0] + body[1] * body[1] + body[2] * body[2])
+    u = (r[0] * body[0] + r[1] * body[1] + r[2] * body[2]) / (rn * bn)
+    f = 1.5 * LOVE_K2 * mu_body * R_EARTH_M**5 / (bn**3 * rn**4)
+    return np.array([f * ((1.0 - 5.0 * u * u) * r[k] / rn + 2.0 * u * body[k] / bn) for k in range(3)])
+
+
+@nb.njit(cache=True)
+def schwarzschild_acceleration(r: FloatArray, v: FloatArray, mu: float) -> FloatArray:
+    """Schwarzschild correction (m/s²; IERS Conventions 2010 Eq. 10.12, β = γ = 1, Lense-Thirring and de
+    Sitter left out): a = μ/(c² r³) [(4μ/r − v²) r + 4 (r·v) v]."""
+    rn = math.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
+    v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
+    rv = r[0] * v[0] + r[1] * v[1] + r[2] * v[2]
+    f = mu / (SPEED_OF_LIGHT_MPS**2 * rn**3)
+    return np.array([f * ((4.0 * mu / rn - v2) * r[k] + 4.0 * rv * v[k]) for k in range(3)])
 
 
 @nb.njit(cache=True)
@@ -460,8 +502,13 @@ def acceleration_kernel(
         a += floats[F_DRAG_SCALE] * drag_acceleration(
             r, v, rho, floats[F_CD], floats[F_AREA], floats[F_ARRAY], floats[F_MASS]
         )
-    if ints[I_SUN] or ints[I_MOON] or ints[I_SRP]:
+    if ints[I_RELATIVITY]:
+        a += schwarzschild_acceleration(r, v, MU_EARTH_M3_S2)
+    if ints[I_SUN] or ints[I_MOON] or ints[I_SRP] or ints[I_TIDES]:
         sun = _interp_row(sun_t, floats[F_BODY_T0], floats[F_BODY_STEP], t)
+        if ints[I_TIDES]:
+            moon = _interp_row(moon_t, floats[F_BODY_T0], floats[F_BODY_STEP], t)
+            a += solid_tide_acceleration(r, sun, MU_SUN_M3_S2) + solid_tide_acceleration(r, moon, MU_MOON_M3_S2)
         if ints[I_SUN]:
             a += third_body_acceleration(r, sun, MU_SUN_M3_S2)
         if ints[I_MOON]:

@@ -12,7 +12,9 @@ filters and batch fits.
   scale factors ``drag_scale`` and ``srp_scale`` (∂a/∂k = the drag or SRP acceleration at k = 1;
   Montenbruck & Gill 2000, Eqs. 7.5-7.6 and §7.2.3). The variational equations use the two-body
   gradient (Eq. 3.4), the J2 gradient when the force model has a field of degree ≥ 2, and the drag
-  partials ∂a/∂r, ∂a/∂v when the kernel has drag.
+  partials ∂a/∂r, ∂a/∂v when the kernel has drag. The integrated acceleration is the whole kernel of
+  :mod:`abrupt.model.orbit.forces` (solid tides and relativity included when switched on); their small
+  gradients are left out of the variational equations.
 * :func:`propagate_deviation`: the deviation of a displaced orbit from a given reference trajectory
   (a real ephemeris), re-anchored on the reference at every epoch (used to inject ΔV into real data).
 """
