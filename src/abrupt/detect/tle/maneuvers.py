@@ -76,6 +76,7 @@ from abrupt.detect.tle.burns import campaign_cadence_s, characterise, label_camp
 from abrupt.detect.tle.campaigns import find_campaigns
 from abrupt.detect.tle.config import CAMPAIGN_SIDE_SETS, EXTRA_COLUMNS, TleDetectorConfig
 from abrupt.detect.tle.elements import arcs, circular_speed_mps, history_rows, orbit_regime
+from abrupt.detect.tle.intervals import interval_utc, lag_bound_s, own_lags_s
 from abrupt.detect.tle.noise import block_thresholds, null_threshold, robust_group_weight
 from abrupt.detect.tle.outliers import outlier_mask
 from abrupt.detect.tle.response import (
@@ -222,10 +223,16 @@ def detect_arc(
     timed = ramp_times(run, time_candidates(run, candidates, all_candidates))
     kept, span_of = merge_candidates(run, timed)
     detected = [it for it in kept if stat[it.gap] >= threshold]
-    lag_s = tle_lag_s(run, [it for it in detected if it.gap not in run.ramp_intervals])
-    for g in span_of:
-        if g not in run.ramp_intervals:  # a ramp-timed burn states its own interval
-            span_of[g][0] = min(span_of[g][0], float(model.t[g]) - lag_s)
+    # each interval reaches back over the era's own TLE lag (abrupt.detect.tle.intervals)
+    t_old = {it.gap: float(model.t[it.gap]) for it in kept}
+    chain_s = cfg.campaign_chain_days * SECONDS_PER_DAY
+    lags = own_lags_s(
+        [t_old[it.gap] for it in detected], [it.time_s for it in detected], [it.refined for it in detected], chain_s
+    )
+    for it in kept:
+        span_of[it.gap][0] = min(
+            span_of[it.gap][0], t_old[it.gap] - lag_bound_s(lags, t_old[it.gap] - it.time_s, cfg.interval_level)
+        )
     base: dict[str, Any] = {"spacecraft": name, "detector": detector_name, "threshold": threshold}
     base |= {"false_alarms_per_day": fa_per_day}
     base |= {"run_id": run_id, "config_hash": cfg_hash}
@@ -425,7 +432,7 @@ def ramp_times(run: StepRun, timed: list[Candidate]) -> list[Candidate]:
         inside = np.concatenate([gr[c - np.min(c) <= rise] for gr, c in ((grid, cost), *others)])
         step = float(grid[1] - grid[0])  # the grid's resolution: no interval is narrower
         run.ramp_intervals[it.gap] = (float(inside.min()) - step, float(inside.max()) + step)
-        out.append(Candidate(it.gap, float(grid[best]), True, float(inside.min()) - step))
+        out.append(Candidate(it.gap, float(grid[best]), True, min(float(grid[best]), float(model.t[it.gap]))))
     return out
 
 
@@ -491,15 +498,6 @@ def campaign_events(
             )
         )
     return out
-
-
-def interval_utc(epoch0: pd.Timestamp, t_lo_s: float, t_hi_s: float) -> dict[str, str]:
-    """The interval columns of an event from its bounds (s from ``epoch0``), widened outwards to whole
-    microseconds: event times are written to the microsecond (truncated), so a time inside the interval
-    stays inside it in the file."""
-    lo = (epoch0 + pd.Timedelta(seconds=float(t_lo_s))).floor("us")
-    hi = (epoch0 + pd.Timedelta(seconds=float(t_hi_s))).ceil("us")
-    return {"interval_start_utc": lo.isoformat(), "interval_end_utc": hi.isoformat()}
 
 
 def tle_lag_s(run: StepRun, items: list[Candidate]) -> float:
@@ -607,8 +605,7 @@ def merge_candidates(run: StepRun, timed: list[Candidate]) -> tuple[list[Candida
                     near = [retimed]
         if not near:
             kept.append(item)
-            end_s = run.ramp_intervals.get(item.gap, (item.start_s, float(steps.t_after_s[item.gap])))[1]
-            span_of[item.gap] = [item.start_s, end_s]
+            span_of[item.gap] = [item.start_s, float(steps.t_after_s[item.gap])]
         elif stat[item.gap] >= run.threshold:
             host = span_of[near[0].gap]
             host[0] = min(host[0], item.start_s)
