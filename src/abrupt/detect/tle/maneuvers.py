@@ -220,19 +220,19 @@ def detect_arc(
     candidates = np.sort(np.asarray(accepted, dtype=np.int64))
     change_points = sorted(int(g) for g in candidates if stat[g] >= threshold)
     run = StepRun(history, cfg, regime, model, steps, stat, threshold, change_points)
-    timed = ramp_times(run, time_candidates(run, candidates, all_candidates))
-    kept, span_of = merge_candidates(run, timed)
+    hinge = {c.gap: c for c in time_candidates(run, candidates, all_candidates)}  # along-track times
+    kept, span_of = merge_candidates(run, ramp_times(run, list(hinge.values())))
     detected = [it for it in kept if stat[it.gap] >= threshold]
-    # each interval reaches back over the era's own TLE lag (abrupt.detect.tle.intervals)
-    t_old = {it.gap: float(model.t[it.gap]) for it in kept}
+    # each interval reaches back over the era's own TLE lag, learned from the along-track hinges
+    # (abrupt.detect.tle.intervals; a ramp time assumes sets published as soon as their tracking ends)
+    h_of = [hinge.get(it.gap, it) for it in detected]
     chain_s = cfg.campaign_chain_days * SECONDS_PER_DAY
-    lags = own_lags_s(
-        [t_old[it.gap] for it in detected], [it.time_s for it in detected], [it.refined for it in detected], chain_s
-    )
+    first = [min(it.time_s, h.time_s) for it, h in zip(detected, h_of, strict=True)]
+    lags = own_lags_s([model.t[it.gap] for it in detected], first, [it.refined for it in detected], chain_s)
     for it in kept:
-        span_of[it.gap][0] = min(
-            span_of[it.gap][0], t_old[it.gap] - lag_bound_s(lags, t_old[it.gap] - it.time_s, cfg.interval_level)
-        )
+        t_old, t_first = float(model.t[it.gap]), min(it.time_s, hinge.get(it.gap, it).time_s)
+        bound = t_old - lag_bound_s(lags, t_old - t_first, cfg.interval_level)
+        span_of[it.gap][0] = min(span_of[it.gap][0], bound)
     base: dict[str, Any] = {"spacecraft": name, "detector": detector_name, "threshold": threshold}
     base |= {"false_alarms_per_day": fa_per_day}
     base |= {"run_id": run_id, "config_hash": cfg_hash}
