@@ -46,8 +46,9 @@ Method (each step cites its source; the combination is abrupt's own):
 
 6. **Campaign events.** Burns inside one gap between element sets make one step (ΔV the sum), and
    a set fitted across a burn spreads it over two gaps. Each event states the interval its burn(s)
-   fall in (``interval_start_utc``, ``interval_end_utc``: from the satellite's own TLE lag before
-   the set preceding the step to the set after it, widened over merged neighbours) and
+   fall in (``interval_start_utc``, ``interval_end_utc``: from the 90 % quantile of the history's own
+   TLE lag before the set preceding the step to the set after it, widened over merged neighbours;
+   :mod:`~abrupt.detect.tle.intervals`) and
    ``burns_max = 1 + ⌊interval / cadence⌋`` with the satellite's own burn cadence inside campaigns
    (:func:`campaign_cadence_s`). Steps one or two gaps apart are one burn when the sets between
    them lie on one burn's along-track trajectory (:func:`middle_set_phase_z`), else two.
@@ -377,7 +378,8 @@ def ramp_times(run: StepRun, timed: list[Candidate]) -> list[Candidate]:
     the candidates with two or more blends within ``RAMP_ERA_DAYS`` (at least three, else nothing
     changes there: an era whose sets do not blend keeps the along-track time). A candidate with a
     blend is then timed by the fit of ``a`` to the response (the burn inside the first blend's span)
-    and states the profile-likelihood interval at ``RAMP_LEVEL`` (``run.ramp_intervals``).
+    and records the profile-likelihood interval at ``RAMP_LEVEL`` (``run.ramp_intervals``; the event states the
+    TLE-lag interval of :mod:`~abrupt.detect.tle.intervals`).
     """
     if run.regime != "leo" or not run.cfg.refine_time:
         return timed
