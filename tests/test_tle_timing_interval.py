@@ -1,7 +1,7 @@
 """The interval a TLE maneuver event states for its burn time (``interval_start_utc`` to
-``interval_end_utc``: from the satellite's own TLE lag, the 90th percentile of how far the
-along-track hinge falls before the set preceding the step, to the set after the step) and its use by
-the scorer.
+``interval_end_utc``: from the history's own TLE lag, the 90 % quantile of how far its isolated
+detections' along-track hinges fall before the set preceding the step, to the set after the step;
+:mod:`abrupt.detect.tle.intervals`) and its use by the scorer.
 
 Independent truth: burns injected with exact times (:func:`abrupt.simulate.tle_null.simulate_null_history`,
 Gauss's equations), so whether an interval holds its burn is known exactly.
@@ -19,7 +19,7 @@ from abrupt.simulate.tle_null import EPOCH0, NullHistorySpec, simulate_null_hist
 from abrupt.thresholds import FalseAlarmBudget
 
 BUDGET = FalseAlarmBudget(1.0, "year")
-NOMINAL_COVERAGE = 0.9  # the TLE lag is the 90th percentile of the history's own hinge leads
+NOMINAL_COVERAGE = 0.9  # the TLE lag is the 90 % quantile of the history's own hinge lags
 
 
 def _burns(seed: int, years: float) -> list[tuple[float, float]]:

@@ -196,9 +196,9 @@ Vallado et al. 2006): the Brouwer mean semi-major axis `a`, and
    (table below). **Campaign events.** Burns inside one gap between element sets cannot be told apart from the
    elements (one step in `a` whose ΔV is their sum), and a set fitted across a burn spreads one burn over two
    gaps. So every event states the interval its burn or burns fall in, `interval_start_utc`-`interval_end_utc`:
-   from the satellite's own TLE lag before the set that precedes the step (the 90th percentile of how far the
-   along-track hinge falls before that set over the history's detections: 0 for Sentinel-3A, about a day for
-   Jason-3 and CryoSat-2) to the set after it, widened over candidates merged into it; and how many burns it may
+   from the history's own TLE lag before the set that precedes the step (the 90 % quantile of how far the
+   isolated detections' hinges fall before that set, or the event's own when longer; `abrupt.detect.tle.intervals`)
+   to the set after it, widened over candidates merged into it; and how many burns it may
    hold, `burns_max = 1 + ⌊interval / cadence⌋`, the cadence being the median spacing of the satellite's own
    detections inside campaigns (no campaign: 1).
 6. **Burn time by along-track continuity.** The along-track angle (LEO: ω + M; GEO: the mean longitude Ω + ω +
@@ -468,11 +468,11 @@ Timing intervals and the score
 
 Every maneuver event states the time of its burn (`time_utc`: the along-track hinge fit, or the two-set estimate
 inside campaigns, method item 6) and the **interval** the burn lies in (`interval_start_utc`-`interval_end_utc`,
-with `time_sigma_s` its uniform-equivalent 1σ): from the set before the step, moved earlier by the satellite's
-own TLE lag (the 90th percentile of how far the hinge falls before that set over the history's detections), to
-the set after the step, widened over candidates merged into the event. So the interval comes from the
-element-set gap and from the fit, and its nominal coverage is 90 %. Campaign events state the union of their
-members'.
+with `time_sigma_s` its uniform-equivalent 1σ): from the set before the step, moved earlier by the history's
+own TLE lag (the 90 % quantile of how far its isolated detections' hinges fall before that set, or the event's
+own lag when longer; `abrupt.detect.tle.intervals`, whose docstring gives the model, the leave-one-out choice
+of the level and the coverage measured on all six shared histories), to the set after the step, widened over
+candidates merged into the event. Campaign events state the union of their members'.
 
 `abrupt score` (and `score_events(..., intervals=True)`) uses it: a truth inside an event's interval may pair
 with that event even beyond `--tolerance-days`; pairs stay one-to-one and the nearest times win. The ±1 day
@@ -512,9 +512,9 @@ three burns (`abrupt.detect.tle.response`; `ramp_times`, `in_blend` in `abrupt.d
   and Sentinel-3A have no such era; CryoSat-2 has one, 2010-06 to 2012-06, with spans of 3.0-6.0 days (and
   isolated ramps later).
 * **Time and interval.** A step with a blend is timed by fitting `a_k = c₀ + c₁τ_k + Δa·f` for every burn time
-  inside the first blend's span; the least cost is the time; the interval joins the times within `κ·χ²₁(0.9)` of
-  the least cost (profile likelihood, `κ` the median reduced χ² of the history's fits) at the era's median,
-  smallest and largest span, never narrower than the grid step. It holds the time by construction.
+  inside the first blend's span; the least cost is the time. The profile interval (times within `κ·χ²₁(0.9)` of
+  the least cost, `κ` the median reduced χ² of the history's fits, at the era's median, smallest and largest
+  span) held 43 % of Jason-1's operator epochs; the event states the TLE-lag interval like every other.
 * **One burn, one event.** In an era whose sets blend, a weaker step inside a stronger step's blend (between its
   last old and first new set) is merged into it. Elsewhere two burns in consecutive gaps look the same in `a`,
   so the rule is not applied (it cost Jason-3 and CryoSat-2 burns of their campaigns when it was).

@@ -7,6 +7,7 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 from abrupt.detect.tle.default_rate import DEFAULT_TLE_RATE
+from abrupt.detect.tle.intervals import LAG_LEVEL
 from abrupt.thresholds import FalseAlarmBudget
 
 EXTRA_COLUMNS: tuple[str, ...] = (
@@ -76,6 +77,8 @@ class TleDetectorConfig:
     # is stated inside it (the step test's windows reach max_window_days; a longer gap holds orbit
     # changes the sets cannot place or size)
     max_bridge_days: float = 20.0
+    # an interval reaches this quantile of the history's own TLE lags back (abrupt.detect.tle.intervals)
+    interval_level: float = LAG_LEVEL
 
     def __post_init__(self) -> None:
         if self.window_sets < 2:
@@ -94,6 +97,8 @@ class TleDetectorConfig:
             raise ValueError("threshold_block_days must be positive and threshold_reach_days non-negative")
         if not (self.max_bridge_days > 0 and math.isfinite(self.max_bridge_days)):
             raise ValueError("max_bridge_days must be a finite positive number")
+        if not 0.0 < self.interval_level < 1.0:
+            raise ValueError(f"interval_level must lie in (0, 1), got {self.interval_level}")
         if self.drag_median_sets < 1:
             raise ValueError("drag_median_sets must be >= 1")
         if not (self.drag_min_decay_m_day > 0 and math.isfinite(self.drag_min_decay_m_day)):

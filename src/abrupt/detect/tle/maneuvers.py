@@ -46,8 +46,9 @@ Method (each step cites its source; the combination is abrupt's own):
 
 6. **Campaign events.** Burns inside one gap between element sets make one step (ΔV the sum), and
    a set fitted across a burn spreads it over two gaps. Each event states the interval its burn(s)
-   fall in (``interval_start_utc``, ``interval_end_utc``: from the satellite's own TLE lag before
-   the set preceding the step to the set after it, widened over merged neighbours) and
+   fall in (``interval_start_utc``, ``interval_end_utc``: from the 90 % quantile of the history's own
+   TLE lag before the set preceding the step to the set after it, widened over merged neighbours;
+   :mod:`~abrupt.detect.tle.intervals`) and
    ``burns_max = 1 + ⌊interval / cadence⌋`` with the satellite's own burn cadence inside campaigns
    (:func:`campaign_cadence_s`). Steps one or two gaps apart are one burn when the sets between
    them lie on one burn's along-track trajectory (:func:`middle_set_phase_z`), else two.
@@ -76,6 +77,7 @@ from abrupt.detect.tle.burns import campaign_cadence_s, characterise, label_camp
 from abrupt.detect.tle.campaigns import find_campaigns
 from abrupt.detect.tle.config import CAMPAIGN_SIDE_SETS, EXTRA_COLUMNS, TleDetectorConfig
 from abrupt.detect.tle.elements import arcs, circular_speed_mps, history_rows, orbit_regime
+from abrupt.detect.tle.intervals import interval_utc, lag_bound_s, own_lags_s
 from abrupt.detect.tle.noise import block_thresholds, null_threshold, robust_group_weight
 from abrupt.detect.tle.outliers import outlier_mask
 from abrupt.detect.tle.response import (
@@ -219,13 +221,19 @@ def detect_arc(
     candidates = np.sort(np.asarray(accepted, dtype=np.int64))
     change_points = sorted(int(g) for g in candidates if stat[g] >= threshold)
     run = StepRun(history, cfg, regime, model, steps, stat, threshold, change_points)
-    timed = ramp_times(run, time_candidates(run, candidates, all_candidates))
-    kept, span_of = merge_candidates(run, timed)
+    hinge = {c.gap: c for c in time_candidates(run, candidates, all_candidates)}  # along-track times
+    kept, span_of = merge_candidates(run, ramp_times(run, list(hinge.values())))
     detected = [it for it in kept if stat[it.gap] >= threshold]
-    lag_s = tle_lag_s(run, [it for it in detected if it.gap not in run.ramp_intervals])
-    for g in span_of:
-        if g not in run.ramp_intervals:  # a ramp-timed burn states its own interval
-            span_of[g][0] = min(span_of[g][0], float(model.t[g]) - lag_s)
+    # each interval reaches back over the era's own TLE lag, learned from the along-track hinges
+    # (abrupt.detect.tle.intervals; a ramp time assumes sets published as soon as their tracking ends)
+    h_of = [hinge.get(it.gap, it) for it in detected]
+    chain_s = cfg.campaign_chain_days * SECONDS_PER_DAY
+    first = [min(it.time_s, h.time_s) for it, h in zip(detected, h_of, strict=True)]
+    lags = own_lags_s([model.t[it.gap] for it in detected], first, [it.refined for it in detected], chain_s)
+    for it in kept:
+        t_old, t_first = float(model.t[it.gap]), min(it.time_s, hinge.get(it.gap, it).time_s)
+        bound = t_old - lag_bound_s(lags, t_old - t_first, cfg.interval_level)
+        span_of[it.gap][0] = min(span_of[it.gap][0], bound)
     base: dict[str, Any] = {"spacecraft": name, "detector": detector_name, "threshold": threshold}
     base |= {"false_alarms_per_day": fa_per_day}
     base |= {"run_id": run_id, "config_hash": cfg_hash}
@@ -370,7 +378,8 @@ def ramp_times(run: StepRun, timed: list[Candidate]) -> list[Candidate]:
     the candidates with two or more blends within ``RAMP_ERA_DAYS`` (at least three, else nothing
     changes there: an era whose sets do not blend keeps the along-track time). A candidate with a
     blend is then timed by the fit of ``a`` to the response (the burn inside the first blend's span)
-    and states the profile-likelihood interval at ``RAMP_LEVEL`` (``run.ramp_intervals``).
+    and records the profile-likelihood interval at ``RAMP_LEVEL`` (``run.ramp_intervals``; the event states the
+    TLE-lag interval of :mod:`~abrupt.detect.tle.intervals`).
     """
     if run.regime != "leo" or not run.cfg.refine_time:
         return timed
@@ -425,7 +434,7 @@ def ramp_times(run: StepRun, timed: list[Candidate]) -> list[Candidate]:
         inside = np.concatenate([gr[c - np.min(c) <= rise] for gr, c in ((grid, cost), *others)])
         step = float(grid[1] - grid[0])  # the grid's resolution: no interval is narrower
         run.ramp_intervals[it.gap] = (float(inside.min()) - step, float(inside.max()) + step)
-        out.append(Candidate(it.gap, float(grid[best]), True, float(inside.min()) - step))
+        out.append(Candidate(it.gap, float(grid[best]), True, min(float(grid[best]), float(model.t[it.gap]))))
     return out
 
 
@@ -491,15 +500,6 @@ def campaign_events(
             )
         )
     return out
-
-
-def interval_utc(epoch0: pd.Timestamp, t_lo_s: float, t_hi_s: float) -> dict[str, str]:
-    """The interval columns of an event from its bounds (s from ``epoch0``), widened outwards to whole
-    microseconds: event times are written to the microsecond (truncated), so a time inside the interval
-    stays inside it in the file."""
-    lo = (epoch0 + pd.Timedelta(seconds=float(t_lo_s))).floor("us")
-    hi = (epoch0 + pd.Timedelta(seconds=float(t_hi_s))).ceil("us")
-    return {"interval_start_utc": lo.isoformat(), "interval_end_utc": hi.isoformat()}
 
 
 def tle_lag_s(run: StepRun, items: list[Candidate]) -> float:
@@ -607,8 +607,7 @@ def merge_candidates(run: StepRun, timed: list[Candidate]) -> tuple[list[Candida
                     near = [retimed]
         if not near:
             kept.append(item)
-            end_s = run.ramp_intervals.get(item.gap, (item.start_s, float(steps.t_after_s[item.gap])))[1]
-            span_of[item.gap] = [item.start_s, end_s]
+            span_of[item.gap] = [item.start_s, float(steps.t_after_s[item.gap])]
         elif stat[item.gap] >= run.threshold:
             host = span_of[near[0].gap]
             host[0] = min(host[0], item.start_s)
