@@ -216,6 +216,26 @@ def _less(x: FloatArray, v: FloatArray) -> FloatArray:
     return np.asarray((flat - x @ np.linalg.lstsq(x, flat, rcond=None)[0]).reshape(v.shape), dtype=np.float64)
 
 
+def _search_ramp(
+    win: _Window, y: FloatArray, x: FloatArray | None, on: float, end: float
+) -> tuple[float, float, float, FloatArray, FloatArray]:
+    """(RSS, onset [s], duration [s], A, normal matrix) of the best ramp on the grid near [on, end), with the
+    step columns ``x`` (or none) fitted beside it."""
+    yx = y if x is None else _less(x, y)
+    best = (math.inf, 0.0, 0.0, np.zeros(3), np.eye(3))
+    for dur in DURATIONS_S:
+        if dur > 2.0 * max(end - on, 60.0) + 2 * ONSET_REACH_S:
+            continue
+        for t0 in np.arange(on - ONSET_REACH_S, on + ONSET_REACH_S + 1.0, BIN_S):
+            if t0 < win.t[0] + 60.0 or t0 + dur > win.t[-1] - 60.0:
+                continue
+            g = _ramp_cols(win, t0, dur)
+            a, rss, m = _ramp_fit(yx, g if x is None else _less(x, g))
+            if rss < best[0]:
+                best = (rss, float(t0), float(dur), a, m)
+    return best
+
+
 def joint_leak_fit(
     t_ns: np.ndarray,
     h_n: FloatArray,
@@ -239,41 +259,27 @@ def joint_leak_fit(
     if win is None:
         return None
     y, n_rows = win.y_perp, win.y_perp.size
-    best = (math.inf, 0.0, 0.0, np.zeros(3), np.eye(3))
-    for dur in DURATIONS_S:
-        if dur > 2.0 * max(end - on, 60.0) + 2 * ONSET_REACH_S:
-            continue
-        for t0 in np.arange(on - ONSET_REACH_S, on + ONSET_REACH_S + 1.0, BIN_S):
-            if t0 < win.t[0] + 60.0 or t0 + dur > win.t[-1] - 60.0:
-                continue
-            a, rss, m = _ramp_fit(y, _ramp_cols(win, t0, dur))
-            if rss < best[0]:
-                best = (rss, float(t0), float(dur), a, m)
-    rss_ramp, t0, dur, a, mat = best
+    rss_ramp, t0, dur, a, mat = _search_ramp(win, y, None, on, end)
     if not math.isfinite(rss_ramp):
         return None
-    s2 = rss_ramp / max(n_rows - 3 * win.p - 5, 1)
     grid = win.t[(win.t > on - reach + 60.0) & (win.t < end + reach - 60.0)]
     cols = _step_cols(win, grid)
     pen = math.log(n_rows)
-    rss1, _ = _best_steps(y, cols, 1)
+    rss1, j = _best_steps(y, cols, 1)
     rss2, _ = _best_steps(y, cols, 2)
     rss3, _ = _best_steps(y, cols, 3)
-    # ramp: onset, duration, A (3) = 5 parameters; k steps 4k - 1 more than ... charged beyond the ramp's 5
-    alone = (
-        0.5 * min(rss1 / s2 + pen * (4 - 5), rss2 / s2 + pen * (8 - 5), rss3 / s2 + pen * (12 - 5))
-        - 0.5 * rss_ramp / s2
-    )
-    # the ramp with a step beside it (a strike during the leak) against two and three steps
-    g = _ramp_cols(win, t0, dur)
-    _, j = _best_steps(y - np.einsum("tik,k->ti", g, a), cols, 1)
-    x = cols[:, j]
-    a2, r_both, mat2 = _ramp_fit(_less(x, y), _less(x, g))
-    with_step = 0.5 * (min(rss2 / s2 - pen, rss3 / s2 + 3 * pen) - r_both / s2)
+    # The ramp with a step beside it (a strike during the leak), alternated from the best single step.
+    for _ in range(2):
+        both = _search_ramp(win, y, cols[:, j], on, end)
+        _, j = _best_steps(y - np.einsum("tik,k->ti", _ramp_cols(win, both[1], both[2]), both[3]), cols, 1)
+    both = _search_ramp(win, y, cols[:, j], on, end)
+    s2 = min(rss_ramp, both[0]) / max(n_rows - 3 * win.p - 9, 1)
+    # BIC: the ramp has 5 parameters (onset, duration, A), k steps 4k, the ramp with a step 9
+    alone = 0.5 * (min(rss1 / s2 - pen, rss2 / s2 + 3 * pen, rss3 / s2 + 7 * pen) - rss_ramp / s2)
+    with_step = 0.5 * (min(rss2 / s2 - pen, rss3 / s2 + 3 * pen) - both[0] / s2)
+    log_lr = max(alone, with_step)
     if with_step > alone:
-        a, mat, log_lr = a2, mat2, with_step
-    else:
-        log_lr = alone
+        _, t0, dur, a, mat = both
     try:
         cov = np.linalg.inv(mat) * s2
     except np.linalg.LinAlgError:
