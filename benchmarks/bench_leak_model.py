@@ -21,6 +21,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from abrupt.detect.attitude.leak_fit import accepted, joint_leak_fit
 from abrupt.detect.attitude.leak_scan import (
     LEAK_FALSE_ALARMS,
     LeakFinding,
@@ -56,6 +57,12 @@ def example(path: str | None) -> None:
     for f in scan.findings:
         print(f"  found onset {(f.onset_ns - T0) / NS:.0f} s, {f.duration_s:.0f} s, τ_B {np.round(f.torque_B_Nm, 6)} "
               f"N·m, |ΔH_B| {np.linalg.norm(f.dH_B_Nms):.3f} N·m·s, log LR over steps {f.log_lr:.0f}")  # fmt: skip
+    for f in scan.findings:
+        j = joint_leak_fit(t, h, np.ones(n, bool), q, 5700.0, f.onset_ns, f.end_ns, np.empty(0, np.int64))
+        if j is not None:
+            print(f"  joint fit (uncleaned, with trend and comb): onset {(j.onset_ns - T0) / NS:.0f} s, "
+                  f"{j.duration_s:.0f} s, |ΔH_B| {np.linalg.norm(j.dH_B_Nms):.3f} ± "
+                  f"{np.linalg.norm(j.dH_B_sigma_Nms):.3f} N·m·s, log LR over steps {j.log_lr:.0f}, kept {accepted(j)}")  # fmt: skip
     if path is None:
         return
     y = body_frame_momentum(h, filled_quaternions(q))

@@ -29,7 +29,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pandas as pd
 
-from abrupt.detect.attitude.change_detection import WindowConfig
+from abrupt.detect.attitude.change_detection import WindowConfig, sliding_statistic
 from abrupt.detect.attitude.momentum import ATTITUDE_EVENT_COLUMNS, GlrDetector
 from abrupt.detect.attitude.steps import gap_free_segments, local_step, locate_step_near_peak, peaks
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
@@ -55,6 +55,9 @@ MAX_REFITS = 10
 #: Quantiles of the block maxima the events' level is fitted on (the lowest blocks: a Gumbel law through
 #: them stands events in up to three quarters of the blocks).
 LOW_QUANTILES = (0.02, 0.06, 0.1)
+#: The shortened pre- or post-windows at a segment's edge, as shares of the window: a change this close
+#: to a masked slew, dump or gap is scanned with the window that fits (the longest of these).
+EDGE_WINDOW_SHARES = (0.8, 0.6, 0.4, 0.2)
 
 
 def low_quantile_level(maxima: FloatArray, p_block: float) -> float:
@@ -158,9 +161,13 @@ class FlightGlrDetector(Detector[CleanedMomentum]):
     # ------------------------------------------------------------------ statistic and peaks
     @staticmethod
     def statistic(h: FloatArray, ok: BoolArray, win: WindowConfig) -> FloatArray:
-        """The ``attitude.glr`` statistic on each gap-free run of ``ok`` at least one window span long."""
-        segments = [(a, b) for a, b in gap_free_segments(ok) if b - a >= win.span]
-        return np.asarray(GlrDetector(windows=win).statistic(h, segments), dtype=np.float64)
+        """The ``attitude.glr`` statistic on each gap-free run of ``ok`` at least one window span long, and
+        within a window of a run's ends with the pre- (at its start) or post-window (at its end) shortened
+        to what the run holds (:func:`edge_statistic`)."""
+        runs = gap_free_segments(ok)
+        segments = [(a, b) for a, b in runs if b - a >= win.span]
+        stat = np.asarray(GlrDetector(windows=win).statistic(h, segments), dtype=np.float64)
+        return edge_statistic(h, runs, win, stat)
 
     @staticmethod
     def step_candidates(h: FloatArray, ok: BoolArray, stat: FloatArray, win: WindowConfig, floor: float) -> list[int]:
@@ -361,6 +368,28 @@ class FlightGlrDetector(Detector[CleanedMomentum]):
             extra={"analysed_fraction": float(np.isfinite(scan.statistic).mean())},
         )
         return DetectionResult(frame, (diagnostics,))
+
+
+def edge_statistic(h: FloatArray, runs: list[tuple[int, int]], win: WindowConfig, stat: FloatArray) -> FloatArray:
+    """``stat`` with the junctions within a window of each run's ends filled in by the same GLR with the
+    pre-window (first ``pre`` junctions of a run) or the post-window (last ``guard + post``) shortened to
+    the longest of ``EDGE_WINDOW_SHARES`` that fits in the run. Without this, a change up to one window
+    after a masked slew or dump has no statistic at all. The GLR is normalised by the covariance of its
+    pre-window (a Hotelling T² with ``pre`` − 1 degrees of freedom), so a shorter window is a noisier
+    but unbiased statistic of the same change: the shortest, 0.2 of a 300 s window at 1 Hz, has 59 degrees
+    of freedom, and its 3-axis T² exceeds 10σ with probability 3e-12 a junction (χ₃: 2e-21)."""
+    out = stat.copy()
+    for share in EDGE_WINDOW_SHARES:
+        m = max(2, round(share * win.pre))
+        for cfg, at_start in ((replace(win, pre=m), True), (replace(win, post=max(1, round(share * win.post))), False)):
+            for a, b in runs:
+                lo, hi = (a, min(b, a + win.pre + cfg.guard + cfg.post)) if at_start else (max(a, b - win.span), b)
+                if hi - lo < cfg.span:
+                    continue
+                piece = sliding_statistic("glr", h[lo:hi], cfg)[:, 0]
+                fill = np.isnan(out[lo:hi]) & np.isfinite(piece)
+                out[lo:hi][fill] = piece[fill]
+    return out
 
 
 def _maxima_left(block: IntArray, subs: SubBlocks, known: BoolArray, free: BoolArray, need: float) -> FloatArray:

@@ -257,9 +257,11 @@ def ramp_log_lr(tau_s: FloatArray, y: FloatArray, s2: float) -> tuple[float, flo
     return with_step, t0, dur, a
 
 
-def ramp_or_steps(t_ns: np.ndarray, y: FloatArray, ok: BoolArray, j: int, half_n: int) -> LeakFinding | None:
+def ramp_or_steps(
+    t_ns: np.ndarray, y: FloatArray, ok: BoolArray, j: int, half_n: int, min_log_lr: float = MIN_LOG_LR
+) -> LeakFinding | None:
     """The ramp fitted around row ``j`` (± ``half_n`` rows) when it beats one and two steps by
-    ``MIN_LOG_LR``, on the momentum as it is or less its largest step (a strike in the window); None
+    ``min_log_lr``, on the momentum as it is or less its largest step (a strike in the window); None
     otherwise (statistic and threshold are filled in by the caller)."""
     lo, hi = max(0, j - half_n), min(y.shape[0], j + half_n)
     rows = np.arange(lo, hi)[ok[lo:hi] & np.isfinite(y[lo:hi]).all(axis=1)]
@@ -271,7 +273,7 @@ def ramp_or_steps(t_ns: np.ndarray, y: FloatArray, ok: BoolArray, j: int, half_n
     if not s2 > 0:
         return None
     log_lr, t0, dur, a = ramp_log_lr(tau, v, s2)
-    if not (math.isfinite(t0) and dur >= MIN_DURATION_S and log_lr >= MIN_LOG_LR):
+    if not (math.isfinite(t0) and dur >= MIN_DURATION_S and log_lr >= min_log_lr):
         return None
     onset = int(t_ns[j] + t0 * NS)
     return LeakFinding(onset, onset + int(dur * NS), a / dur, a, math.nan, math.nan, math.nan, log_lr)
@@ -286,9 +288,13 @@ def scan_leaks(
     budget: FalseAlarmBudget = LEAK_FALSE_ALARMS,
     scales_s: tuple[float, ...] = SCALES_S,
     floor: float = MIN_SIGMA,
+    screen: bool = True,
 ) -> LeakScan:
     """Sustained torques in [core) of the cleaned ᴺH [N·m·s] (NaN or not ``ok`` where not analysed) with
-    the attitude ``q_BN`` (scalar first) on the grid ``t_ns`` (module docstring)."""
+    the attitude ``q_BN`` (scalar first) on the grid ``t_ns`` (module docstring). Without ``screen`` every
+    exceedance is a candidate with the interval of its ramp fit, whatever the jump share and the ramp's
+    likelihood ratio on the cleaned series (for a test on data the cleaning has not bent,
+    :mod:`abrupt.detect.attitude.leak_fit`)."""
     if t_ns.size < 2 * TAIL_COUNTS[0]:
         return LeakScan([], [])
     dt = float(np.median(np.diff(t_ns))) / NS
@@ -311,9 +317,9 @@ def scan_leaks(
         peaks = clusters(t_ns, np.nan_to_num(z), use & (z > thr), gap_s=w)
         kept = 0
         for j in peaks:
-            if jump_share(y, good, j, n, k, d[j]) >= JUMP_SHARE_MAX:
+            if screen and jump_share(y, good, j, n, k, d[j]) >= JUMP_SHARE_MAX:
                 continue
-            f = ramp_or_steps(t_ns, y, good, j, 2 * n + round(FIT_MARGIN_S / dt))
+            f = ramp_or_steps(t_ns, y, good, j, 2 * n + round(FIT_MARGIN_S / dt), MIN_LOG_LR if screen else -math.inf)
             if f is None:
                 continue
             kept += 1
