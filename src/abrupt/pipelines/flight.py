@@ -38,7 +38,14 @@ from threadpoolctl import threadpool_limits
 from abrupt.clean.comb import CombConfig, estimate_period
 from abrupt.clean.flight_masks import SlewMaskConfig, event_mask, flag_intervals, slew_mask
 from abrupt.detect.attitude.evidence import EventEvidence, event_evidence, profile_fits
-from abrupt.detect.attitude.flight_glr import MIN_BLOCKS, FlightGlrDetector, Peak, SubBlocks
+from abrupt.detect.attitude.flight_glr import (
+    LOCAL_REACH_S,
+    MIN_BLOCKS,
+    FlightGlrDetector,
+    Peak,
+    SubBlocks,
+    local_ratio_level,
+)
 from abrupt.detect.attitude.leak_scan import LeakScan
 from abrupt.errors import ConfigError, InputError
 from abrupt.events import config_hash, new_run_id
@@ -258,7 +265,8 @@ def chunk_margin_s(spacecraft: Spacecraft, config: FlightRunConfig) -> float:
     """Data needed either side of a chunk so that its events equal those of the whole run [s].
 
     Each pass depends on data within (anchor spacing + fit half-width) of the model plus one GLR span;
-    the slew mask on half its nominal-rate window; Savitzky-Golay on half its window.
+    the slew mask on half its nominal-rate window; Savitzky-Golay on half its window; a peak's local level
+    on ``LOCAL_REACH_S`` of the statistic either side.
     """
     c = config.cleaning
     orbit = spacecraft.orbit.period_s if spacecraft.orbit is not None else 0.0
@@ -267,7 +275,7 @@ def chunk_margin_s(spacecraft: Spacecraft, config: FlightRunConfig) -> float:
     span = 2 * config.window_s + config.guard_s
     per_pass = fit + 2 * span
     sg = max((ch.savgol_window_s for ch in flight_channels(spacecraft).channels), default=0.0)
-    return c.passes * per_pass + c.slew.nominal_window_s / 2 + c.slew.window_s + sg + 60.0
+    return c.passes * per_pass + c.slew.nominal_window_s / 2 + c.slew.window_s + sg + 60.0 + LOCAL_REACH_S
 
 
 # ------------------------------------------------------------------------------------------------
@@ -297,6 +305,7 @@ class ChunkResult:
     rescan_merged: int = 0
     sub_blocks: SubBlocks = field(default_factory=SubBlocks.empty)
     leaks: LeakScan = field(default_factory=lambda: LeakScan([], []))
+    peak_ratios: FloatArray = field(default_factory=lambda: np.empty(0))
 
 
 def process_chunk(
@@ -416,6 +425,8 @@ def process_span(
     )
     peaks = [(i, replace(p, dH_N_Nms=revised[p.time_ns][0]) if p.time_ns in revised else p) for i, p in peaks]
     peaks, evidence = peaks + beside, {**evidence, **{t: e for t, (_, e) in revised.items()}, **beside_ev}
+    peaks = detector.with_local_levels(peaks, stat, g)
+    ratio_times, ratios = detector.null_ratios(stat, g, dt, keep=core)
     faults = scan_span(samples, flight, table, spacecraft, ok, start_ns, end_ns)
     edges = [start_ns, end_ns]
     if split_days:
@@ -449,6 +460,7 @@ def process_span(
                 rescan_merged=merged if p0 == start_ns else 0,
                 sub_blocks=detector.sub_blocks(g[piece], stat[piece]),
                 leaks=cleaned.leaks.within(p0, p1),
+                peak_ratios=ratios[(ratio_times >= p0) & (ratio_times < p1)],
             )
         )
     return out
@@ -566,11 +578,15 @@ def run_flight(
     peaks, grid_hz = [p for r in chunks for p in r.peaks], flight_channels(spacecraft).grid_hz
     blocks, subs = [r.block_maxima for r in chunks], [r.sub_blocks for r in chunks]
     threshold = detector.fit_threshold_crowd(blocks, subs, peaks, config.budget, grid_hz)
+    days = sum(r.n_analysed for r in chunks) / (86_400.0 * grid_hz)
+    ratio_level = local_ratio_level(np.concatenate([r.peak_ratios for r in chunks]), config.budget, days)
+    if math.isfinite(ratio_level):
+        threshold = replace(threshold, method=f"{threshold.method}; {ratio_level:.1f}x the local level")
     run_id = run_id or new_run_id()
     cfg_hash = config_hash(
         {"flight": config.hash_fields(), "spacecraft": spacecraft.name, "threshold": threshold.as_dict()}
     )
-    events = detector.events(peaks, threshold, spacecraft.name, run_id, cfg_hash)
+    events = detector.events(peaks, threshold, spacecraft.name, run_id, cfg_hash, ratio_level=ratio_level)
     events = attribute_events(events, {t: e for r in chunks for t, e in r.evidence.items()})
     events = merge_fault_findings(events, [f for r in chunks for f in r.faults.findings], spacecraft.name, run_id,
                                   cfg_hash, warnings)  # fmt: skip

@@ -37,7 +37,7 @@ from abrupt.events import Event, config_hash, empty_frame, events_frame, format_
 from abrupt.series.attitude import CleanedMomentum
 from abrupt.thresholds import FalseAlarmBudget, Threshold
 from abrupt.thresholds.noise import robust_noise_sigma
-from abrupt.thresholds.robust import robust_block_maxima_threshold
+from abrupt.thresholds.robust import gumbel_quantile_fit, robust_block_maxima_threshold
 from abrupt.types import BoolArray, FloatArray, IntArray
 
 NS = 1_000_000_000
@@ -58,6 +58,42 @@ LOW_QUANTILES = (0.02, 0.06, 0.1)
 #: The shortened pre- or post-windows at a segment's edge, as shares of the window: a change this close
 #: to a masked slew, dump or gap is scanned with the window that fits (the longest of these).
 EDGE_WINDOW_SHARES = (0.8, 0.6, 0.4, 0.2)
+
+#: Reach [s] of the reference cells either side of a peak whose median is its local level (ordered-statistic
+#: CFAR, Rohling 1983): long enough to hold many window spans, short against the hours over which the noise
+#: of cleaned ᴺH changes (a gyro bias step, a busy stretch).
+LOCAL_REACH_S = 3600.0
+
+
+def local_level(
+    stat: FloatArray, time_ns: IntArray, t_ns: int, guard_s: float, reach_s: float = LOCAL_REACH_S
+) -> float:
+    """The median of ``stat`` over the reference cells ``guard_s`` to ``reach_s`` either side of ``t_ns``
+    (ordered-statistic CFAR, Rohling 1983: the median stands other events in up to half of the cells);
+    NaN when fewer than a quarter of the cells are analysed."""
+    g = np.asarray(time_ns, np.int64)
+    i0, i1 = np.searchsorted(g, [t_ns - int(reach_s * NS), t_ns - int(guard_s * NS)])
+    j0, j1 = np.searchsorted(g, [t_ns + int(guard_s * NS), t_ns + int(reach_s * NS)], side="right")
+    cells = np.concatenate([stat[i0:i1], stat[j0:j1]])
+    cells = cells[np.isfinite(cells)]
+    dt = float(np.median(np.diff(g))) / NS if g.size > 1 else 1.0
+    if cells.size < 0.25 * 2.0 * (reach_s - guard_s) / dt:
+        return float("nan")
+    return float(np.median(cells))
+
+
+def local_ratio_level(ratios: FloatArray, budget: FalseAlarmBudget, days: float) -> float:
+    """The ratio of a peak to its local level that the null's peaks exceed ``budget`` times a day: a Gumbel
+    law through the quartiles of ``ratios`` (every peak of the statistic one window span apart, events
+    included: the quartiles stand them in a quarter of the peaks) at the per-peak rate
+    ``budget.per_day × days / len(ratios)``; NaN for fewer than ``MIN_BLOCKS`` ratios."""
+    x = np.asarray(ratios, dtype=np.float64)
+    x = x[np.isfinite(x) & (x > 0)]
+    if x.size < MIN_BLOCKS or not days > 0:
+        return float("nan")
+    p_peak = min(budget.per_day * days / x.size, 0.5)
+    mu, beta = gumbel_quantile_fit(x)
+    return float(mu - beta * math.log(-math.log1p(-p_peak)))
 
 
 def low_quantile_level(maxima: FloatArray, p_block: float) -> float:
@@ -106,12 +142,14 @@ class SubBlocks:
 
 @dataclass
 class Peak:
-    """A local maximum of the statistic: time [ns], value, step ΔH_N [N·m·s], its time σ [s]."""
+    """A local maximum of the statistic: time [ns], value, step ΔH_N [N·m·s], its time σ [s] and the
+    statistic's local level around it (:func:`local_level`; NaN when not measured)."""
 
     time_ns: int
     value: float
     dH_N_Nms: FloatArray
     time_sigma_s: float
+    local_level: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -213,6 +251,31 @@ class FlightGlrDetector(Detector[CleanedMomentum]):
             found.append((i, Peak(t_event, float(stat[i]), d_h, float(time_sigma))))
         return found
 
+    # ------------------------------------------------------------------ local level
+    @property
+    def local_guard_s(self) -> float:
+        """Half-width [s] of the cells left out around a peak when its local level is measured: the
+        statistic's whole response to a step (one window and guard either side) and its shoulders."""
+        return 2.0 * (self.window_s + self.guard_s)
+
+    def with_local_levels(
+        self, found: list[tuple[int, Peak]], stat: FloatArray, time_ns: IntArray
+    ) -> list[tuple[int, Peak]]:
+        """``found`` with each peak's :func:`local_level` of ``stat`` (the statistic of the whole stretch)."""
+        guard = self.local_guard_s
+        return [(i, replace(p, local_level=local_level(stat, time_ns, p.time_ns, guard))) for i, p in found]
+
+    def null_ratios(
+        self, stat: FloatArray, time_ns: IntArray, dt: float, keep: BoolArray | None = None
+    ) -> tuple[IntArray, FloatArray]:
+        """Times [ns] and ratios to their :func:`local_level` of every peak of ``stat`` (no floor, one window
+        span apart; those where ``keep``): the sample :func:`local_ratio_level` is fitted on."""
+        win = self.windows(dt)
+        idx = np.array([i for i in self.peak_samples(stat, 0.0, win) if keep is None or keep[i]], np.int64)
+        g = np.asarray(time_ns, np.int64)
+        out = [float(stat[i]) / local_level(stat, g, int(g[i]), self.local_guard_s) for i in idx]
+        return g[idx], np.asarray(out, dtype=np.float64)
+
     # ------------------------------------------------------------------ threshold
     def block_maxima(self, time_ns: IntArray, stat: FloatArray, dt: float, origin_ns: int = 0) -> dict[int, float]:
         """Largest statistic per block of ``block_s`` (blocks anchored at ``origin_ns`` + k ``block_s``).
@@ -310,12 +373,24 @@ class FlightGlrDetector(Detector[CleanedMomentum]):
 
     # ------------------------------------------------------------------ events
     def events(
-        self, peaks: list[Peak], threshold: Threshold, spacecraft: str, run_id: str, cfg_hash: str
+        self,
+        peaks: list[Peak],
+        threshold: Threshold,
+        spacecraft: str,
+        run_id: str,
+        cfg_hash: str,
+        ratio_level: float = float("nan"),
     ) -> pd.DataFrame:
-        """Events (frozen schema, by time) for the peaks above the threshold."""
+        """Events (frozen schema, by time) for the peaks above the threshold and, with a finite
+        ``ratio_level`` (:func:`local_ratio_level`), above that many times their local level: a peak no
+        higher above its surroundings than the null's peaks are above theirs is the wander of cleaned ᴺH
+        there (the residual of a gyro bias step's onset, of a busy stretch's fit), not a change."""
         events = []
         for p in peaks:
             if not p.value > threshold.value:
+                continue
+            local = ratio_level * p.local_level
+            if math.isfinite(local) and not p.value > local:
                 continue
             d = p.dH_N_Nms
             events.append(
@@ -355,8 +430,11 @@ class FlightGlrDetector(Detector[CleanedMomentum]):
                 ),
             )
         thr = self.fit_threshold(maxima, budget, 1.0 / dt)
+        days = float(np.isfinite(scan.statistic).sum()) * dt / 86_400.0
+        ratio = local_ratio_level(self.null_ratios(scan.statistic, g, dt)[1], budget, days)
         cfg_hash = config_hash({"detector": self.name, **self.config(), "budget": str(budget)})
-        frame = self.events([p for _, p in scan.peaks], thr, series.spacecraft_name, "", cfg_hash)
+        found = [p for _, p in self.with_local_levels(scan.peaks, scan.statistic, g)]
+        frame = self.events(found, thr, series.spacecraft_name, "", cfg_hash, ratio_level=ratio)
         diagnostics = Diagnostics(
             name=self.name,
             time_s=(g - g[0]).astype(np.float64) / NS,
