@@ -54,6 +54,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from abrupt.detect.attitude.evidence import EventEvidence
 from abrupt.detect.attitude.sibling_evidence import APPENDAGE_MIN_DEG, APPENDAGE_Z
 
@@ -105,6 +107,12 @@ class AttributionRules:
     #: random direction does so with probability at most 1 / (e · ``dump_lr_min``) = 1.8 %, on any
     #: spacecraft (:mod:`abrupt.detect.attitude.dump_evidence`).
     dump_lr_min: float = 20.0
+    #: A lasting step is an attitude sensor's when that hypothesis's likelihood ratio to the strike's
+    #: (:func:`compare_hypotheses`, the wheels' take-up) exceeds this.
+    sensor_lr_min: float = 20.0
+    #: A step is no impulse when a torque of some duration fits it better by this likelihood ratio
+    #: (:func:`compare_hypotheses`, the time profile, BIC-penalised), whatever ``impulsive_s`` says.
+    extended_lr_min: float = 20.0
 
 
 @dataclass(frozen=True)
@@ -129,16 +137,81 @@ def _confidence(tests: list[bool]) -> float:
     return 0.5 + 0.49 * (sum(tests) / len(tests)) if tests else 0.5
 
 
+#: The spread of the wheels' take-up of an external step about 1 beyond its noise: the catalogue inertia
+#: and the loop's settling leave ~10-30 % (an attitude sensor's fault: about 0).
+TAKEUP_MODEL_SIGMA = 0.25
+
+
+@dataclass(frozen=True)
+class Hypotheses:
+    """Log likelihood ratios of a lasting step's hypotheses against the strike's (an impulse of total
+    momentum in any direction, taken up by the wheels): ``dump`` (thruster pulses that unload the wheels:
+    the direction), ``extended`` (a torque of some duration rather than an impulse: the time profile) and
+    ``attitude_sensor`` (a step of one attitude sensor's reading: the wheels do not respond). NaN where the
+    evidence does not allow the comparison."""
+
+    dump: float
+    extended: float
+    attitude_sensor: float
+
+
+def compare_hypotheses(ev: EventEvidence) -> Hypotheses:
+    """Each hypothesis's signal model, fitted to its channels, against the strike's.
+
+    * **dump**: the direction, a mixture of the two unloading laws: aimed at −H_w (``dump_log_lr``) and any
+      mix of the unloading thrusters (``dump_cone_log_lr``; :mod:`~abrupt.detect.attitude.dump_evidence`,
+      :mod:`~abrupt.detect.attitude.signal_models`). A dump's duration (a pulse train of one to many
+      seconds) may be as short as the grid's resolution, so the time profile does not tell a dump from the
+      other torques of some duration, only from an impulse;
+    * **extended**: the BIC-penalised ratio of a torque of some duration to an impulse along ΔĤ
+      (``duration_log_lr``);
+    * **attitude_sensor**: the wheels' take-up t of the step along ΔĤ (``wheel_takeup``), Gaussian about 0
+      (a sensor's step: the loop does not move the wheels by it) against about 1 (an external step that the
+      loop hands to the wheels), σ² = (noise of t)² + ``TAKEUP_MODEL_SIGMA``²: ln LR = (1 − 2t) / 2σ².
+    """
+    dump = float("nan")
+    if _finite(ev.dump_log_lr):
+        dump = ev.dump_log_lr
+        if _finite(ev.dump_cone_log_lr) or ev.dump_cone_log_lr == -math.inf:
+            dump = float(np.logaddexp(ev.dump_log_lr, ev.dump_cone_log_lr) - math.log(2.0))
+    sensor = float("nan")
+    mag = math.sqrt(ev.dH_B_x_Nms**2 + ev.dH_B_y_Nms**2 + ev.dH_B_z_Nms**2)
+    if _finite(ev.wheel_takeup, ev.wheel_change_sigma_Nms, mag) and mag > 0:
+        var = (ev.wheel_change_sigma_Nms / mag) ** 2 + TAKEUP_MODEL_SIGMA**2
+        sensor = (1.0 - 2.0 * ev.wheel_takeup) / (2.0 * var)
+    return Hypotheses(dump, ev.duration_log_lr, sensor)
+
+
 def momentum_dump(ev: EventEvidence, r: AttributionRules) -> float:
     """The probability that the event is a momentum dump rather than a strike (even prior odds), when the
-    dump hypothesis wins: ΔH_B against the wheels' stored momentum with a likelihood ratio beyond
-    ``dump_lr_min``, and the wheels' stored momentum shrinks (``dump_unloads`` below 1: a dump cannot
-    unload more than twice what is stored along its direction); 0 otherwise."""
+    dump hypothesis wins (:func:`compare_hypotheses`): its direction is likelier than any other torque's
+    (``dump`` > 0) and, with the time profile when that favours a duration (``extended`` > 0: a strike is
+    an impulse, a dump's pulse train may not be), its likelihood ratio to the strike is beyond
+    ``dump_lr_min``; and the wheels' stored momentum shrinks (``dump_unloads`` below 1: a dump cannot unload
+    more than twice what is stored along its direction). 0 otherwise."""
     if not (_finite(ev.dump_log_lr, ev.dump_unloads) and ev.dump_unloads < 1.0):
         return 0.0
-    if ev.dump_log_lr <= math.log(r.dump_lr_min):
+    h = compare_hypotheses(ev)
+    log_lr = h.dump + (max(h.extended, 0.0) if _finite(h.extended) else 0.0)
+    if not (h.dump > 0.0 and log_lr > math.log(r.dump_lr_min)):
         return 0.0
-    return 1.0 / (1.0 + math.exp(-ev.dump_log_lr))
+    return 1.0 / (1.0 + math.exp(-min(log_lr, 700.0)))
+
+
+def attitude_sensor_step(ev: EventEvidence, r: AttributionRules) -> Attribution | None:
+    """A sensor fault when the step's wheels say so (:func:`compare_hypotheses`: ``attitude_sensor`` beyond
+    ln ``sensor_lr_min``): the gyro of the axis whose rate mismatch with the tracker changed slope more
+    (against its limit) than it jumped, else the star tracker; None otherwise."""
+    log_lr = compare_hypotheses(ev).attitude_sensor
+    if not log_lr > math.log(r.sensor_lr_min):
+        return None
+    conf = min(1.0 / (1.0 + math.exp(-log_lr)), 0.99)
+    why = f"the wheels did not take the step up (likelihood ratio {math.exp(min(log_lr, 700.0)):.3g} to a strike)"
+    z_slope = _ratio(ev.st_gyro_slope_rad_s, ev.st_gyro_slope_limit_rad_s)
+    z_step = _ratio(ev.st_gyro_step_rad, ev.st_gyro_step_limit_rad)
+    if z_slope >= z_step and ev.st_gyro_axis >= 0:
+        return Attribution("sensor_fault", conf, f"gyro_{'xyz'[ev.st_gyro_axis]}", f"gyro bias step: {why}")
+    return Attribution("sensor_fault", conf, "star_tracker", f"star-tracker jump: {why}")
 
 
 def _lasting_impulse(ev: EventEvidence, r: AttributionRules) -> bool:
@@ -309,11 +382,18 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
         return Attribution("unknown", 0.5, "", "evidence missing")
     lasting = ev.lasting_fraction >= r.lasting_min
     in_raw = not _finite(ev.raw_step_fraction) or ev.raw_step_fraction >= r.lasting_min
-    impulsive = _finite(ev.duration_lo_s) and ev.duration_lo_s <= r.impulsive_s
+    impulsive = (
+        _finite(ev.duration_lo_s)
+        and ev.duration_lo_s <= r.impulsive_s
+        and not compare_hypotheses(ev).extended > math.log(r.extended_lr_min)
+    )
     surface_ok = not (_finite(ev.surface_fraction) and ev.surface_fraction == 0.0)
     # An impulse that other impulses of the window share the direction of (same sign, within 30°) is one of
     # a sequence: a venting train's pulse, however isolated in time it looks.
     in_sequence = r.step_alone and _finite(ev.step_sharp_siblings) and ev.step_sharp_siblings > 0
+    # 3a. An attitude sensor's step: the wheels did not take it up (hypotheses compared).
+    if lasting and impulsive and (sensor := attitude_sensor_step(ev, r)) is not None:
+        return sensor
     # 3b. A momentum dump: a lasting external step against the momentum the wheels hold.
     if (p_dump := momentum_dump(ev, r)) > 0 and abs(ev.lasting_fraction) >= r.lasting_min:
         return Attribution("external_non_strike", min(p_dump, 0.99), "", DUMP_REASON)

@@ -24,6 +24,8 @@ Mises-Fisher law about that aim d̂ instead of −Ĥ_w, which carries the span o
 that is all of space) d̂ = −Ĥ_w and the test is the stored-momentum test above; where the thrusters
 cannot push against −Ĥ_w at all (A c* = 0) no dump could unload the wheels, and ``dump_log_lr`` is −∞.
 ``dump_cone_angle_deg`` is the angle of ΔH_B from the cone (0 inside it), NaN without thrusters.
+``dump_cone_log_lr`` weighs ΔH_B against the cone of the thrusters that unload the wheels, whatever the
+law that fires them (:func:`~abrupt.detect.attitude.signal_models.unloading_cone_log_lr`).
 
 The log likelihood ratio ``dump_log_lr`` = ln(κ e^(κ cos θ) / sinh κ). Whatever κ is, a direction
 uniform on the sphere exceeds LR = c with probability at most 1 / (e c) (for large κ, LR > c is
@@ -41,6 +43,7 @@ import numpy as np
 from scipy.optimize import nnls
 
 from abrupt.detect.attitude.body_response import window_rows
+from abrupt.detect.attitude.signal_models import unloading_cone_log_lr
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.timetable import NS, Timetable
 from abrupt.types import FloatArray
@@ -113,7 +116,8 @@ def dump_evidence(
     the wheels' stored momentum ``wheel_momentum_Nms`` (|H_w,B| before the event), the angle of ΔH_B from
     −H_w,B ``dump_angle_deg`` with its σ ``dump_angle_sigma_deg`` (noise only, without the aim's spread),
     ``dump_log_lr`` (module docstring; about the thrusters' aim when the spacecraft has thruster axes,
-    with ``dump_cone_angle_deg``, the angle of ΔH_B from their cone) and ``dump_unloads`` (|ΔH| /
+    with ``dump_cone_angle_deg``, the angle of ΔH_B from their cone, and ``dump_cone_log_lr``, the unloading
+    thrusters' cone against any direction) and ``dump_unloads`` (|ΔH| /
     (2 |H_w| cos θ): below 1 when the wheels' stored momentum shrinks). Empty when the wheels or the
     momentum do not allow it."""
     g, dt, valid = table.time_ns, table.dt_s, table.valid
@@ -154,4 +158,5 @@ def dump_evidence(
         cos_aim = float(np.clip(dh_b @ aim / (mag * aim_mag), -1.0, 1.0)) if aim_mag > 1e-12 else math.nan
         out["dump_log_lr"] = dump_log_lr(cos_aim, kappa) if aim_mag > 1e-12 else -math.inf
         out["dump_cone_angle_deg"] = cone_angle_deg(axes, dh_b)
+        out["dump_cone_log_lr"] = unloading_cone_log_lr(axes, hw, dh_b, math.degrees(sig_noise))
     return out

@@ -27,7 +27,9 @@ telemetry (:class:`~abrupt.series.timetable.Timetable`) around the event:
   made, not the telemetry, has none);
 * **time profile** (``duration_s`` with ``duration_lo_s``, ``duration_hi_s``): a ramp of duration D
   (D = 0 a step) fitted to the cleaned ᴺH along ΔĤ, with the interval where the fit is within
-  Δχ² = 4 of the best (noise from the data's first differences);
+  Δχ² = 4 of the best (noise from the data's first differences); ``duration_log_lr`` the BIC-penalised log
+  likelihood ratio of a torque of some duration to an impulse
+  (:mod:`abrupt.detect.attitude.signal_models`);
 * **appendage** (``appendage_excess_deg``, ``appendage_z``): an abrupt change of a drive's rate
   (against its 61-s running median), the angle it adds and its significance;
 * **surfaces** (``surface_fraction``, ``min_dv_mps``): when the spacecraft file has surfaces, the
@@ -59,7 +61,8 @@ telemetry (:class:`~abrupt.series.timetable.Timetable`) around the event:
   lasts of that fitted step (with the other steps within 150 s after it that point back against it)
   along itself over |ΔH|, judged beside the window's other steps rather than on the raw balance;
 * **momentum dump** (``wheel_momentum_Nms``, ``dump_angle_deg``, ``dump_angle_sigma_deg``,
-  ``dump_log_lr``, ``dump_unloads``, ``dump_cone_angle_deg`` with thruster axes): ΔH_B against the momentum
+  ``dump_log_lr``, ``dump_unloads``, ``dump_cone_angle_deg`` and ``dump_cone_log_lr`` with thruster axes):
+  ΔH_B against the momentum
   the wheels held before the event, and the likelihood ratio of a dump (aimed at −H_w, or at the point of the
   thrusters' torque cone nearest to it) to a strike (any direction):
   :mod:`abrupt.detect.attitude.dump_evidence`.
@@ -95,6 +98,7 @@ from abrupt.detect.attitude.sibling_evidence import (
     external_siblings,
     step_body_share,
 )
+from abrupt.detect.attitude.signal_models import duration_log_lr, duration_profile, impulse_chi2
 from abrupt.model.rotations import dcm_from_quaternion
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.timetable import NS, Timetable
@@ -164,6 +168,8 @@ class EventEvidence:
     dump_log_lr: float = NAN
     dump_unloads: float = NAN
     dump_cone_angle_deg: float = NAN
+    dump_cone_log_lr: float = NAN
+    duration_log_lr: float = NAN
 
     def as_dict(self) -> dict[str, float]:
         return {f"ev_{k}": float(v) for k, v in asdict(self).items()}
@@ -214,42 +220,16 @@ def _line(tau: FloatArray, y: FloatArray) -> tuple[FloatArray, FloatArray, Float
     return coef[0], coef[1], np.sqrt(np.sum(res**2, axis=0) / dof)
 
 
-def ramp_duration(tau_s: FloatArray, y: FloatArray, sigma: float) -> tuple[float, float, float, float]:
-    """Best duration D [s] of y = c + A clip((τ − τ_s)/D, 0, 1), its Δχ² = 4 interval (lo, hi) and onset τ_s.
-
-    Onsets τ_s on the samples of the middle half of the window, durations 0 (a step) to a third of the
-    window on a log grid; the ramp must end inside the window.
-    """
-    ok = np.isfinite(y)
-    t, v = tau_s[ok], y[ok]
-    if t.size < 20 or not (sigma > 0):
+def ramp_duration(
+    tau_s: FloatArray, y: FloatArray, sigma: float, prof: tuple[FloatArray, FloatArray, FloatArray] | None = None
+) -> tuple[float, float, float, float]:
+    """Best duration D [s] of y = c + A clip((τ − τ_s)/D, 0, 1), its Δχ² = 4 interval (lo, hi) and onset τ_s
+    (``prof``: :func:`~abrupt.detect.attitude.signal_models.duration_profile` of the same data, made when
+    None)."""
+    prof = prof if prof is not None else duration_profile(tau_s, y)
+    if prof is None or not (sigma > 0):
         return NAN, NAN, NAN, NAN
-    span = float(t[-1] - t[0])
-    durations = np.concatenate([[0.0], np.geomspace(1.0, max(span / 3, 2.0), 20)])
-    onsets = t[(t > t[0] + 0.25 * span) & (t < t[-1] - 0.25 * span)][::2]
-    best = np.full(durations.size, np.inf)
-    where = np.zeros(durations.size)
-    # A linear background (slow residual drift) is projected out of the data and of each ramp.
-    basis, _ = np.linalg.qr(np.column_stack([np.ones_like(t), (t - t.mean()) / max(span, 1.0)]))
-    vc = v - basis @ (basis.T @ v)
-    # One set of (onsets × samples) buffers for every duration: a fresh array per step of the loop cost
-    # more in page faults than in arithmetic. The operations are those of the plain expressions.
-    lag = t[None, :] - onsets[:, None]
-    xc, proj, sq = np.empty_like(lag), np.empty_like(lag), np.empty_like(lag)
-    for j, d in enumerate(durations):
-        if d > 0:
-            np.clip(np.divide(lag, d, out=xc), 0.0, 1.0, out=xc)  # clip((t − τ_s) / D, 0, 1)
-        else:
-            np.greater_equal(t[None, :], onsets[:, None], out=xc)  # the step: 1(t ≥ τ_s)
-        np.matmul(xc @ basis, basis.T, out=proj)
-        np.subtract(xc, proj, out=xc)  # the ramp with the linear background projected out
-        sxx = np.sum(np.multiply(xc, xc, out=sq), axis=1)
-        sxy = xc @ vc
-        with np.errstate(invalid="ignore", divide="ignore"):
-            sse = np.sum(vc * vc) - np.where(sxx > 0, sxy**2 / sxx, 0.0)
-        sse = np.where(onsets + d < t[-1] - 30.0, sse, np.inf)
-        m = int(np.argmin(sse))
-        best[j], where[j] = float(sse[m]), float(onsets[m])
+    durations, best, where = prof
     k = int(np.argmin(best))
     inside = np.flatnonzero(best <= best[k] + 4.0 * sigma**2)
     # The interval reaches to the grid neighbours of the accepted durations (the grid's own resolution).
@@ -567,8 +547,12 @@ def _profile(
     span = _idx(g, i0, -w.profile_s, w.profile_s, dt)
     ys = y[span]
     sigma = white_noise_sigma(ys)
-    d, lo, hi, onset = ramp_duration((g[span] - g[i0]) / NS, ys, sigma)
+    prof = duration_profile((g[span] - g[i0]) / NS, ys)
+    d, lo, hi, onset = ramp_duration((g[span] - g[i0]) / NS, ys, sigma, prof)
     out.update({"duration_s": d, "duration_lo_s": lo, "duration_hi_s": hi})
+    if prof is not None:
+        n = int(np.isfinite(ys).sum())
+        out["duration_log_lr"] = duration_log_lr(impulse_chi2(prof[0], prof[1], sigma, dt), n)
     # The lasting step: before the event (or the fitted onset) against after it (or the fitted ramp's end).
     start = min(-w.guard_s, onset - w.guard_s) if math.isfinite(onset) else -w.guard_s
     end = max(w.lasting_s[0], onset + d + 30.0) if math.isfinite(onset) else w.lasting_s[0]

@@ -1,0 +1,147 @@
+"""Signal models of the hypotheses an event is compared under: the time profile and the dump's direction.
+
+**Time profile.** Along the event's direction the cleaned ᴺH is fitted by y = c + A clip((τ − τ_s)/D, 0, 1)
+over a linear background, for durations D from 0 (a step) to a third of the window on a log grid
+(:func:`duration_profile`: the least-squares sum of squares at each D, its onset τ_s free). A strike is an
+impulse: its D is the telemetry's own resolution (a torque of a fraction of a second between two samples
+of the grid, read through the rates' one-sample means: up to ``IMPULSE_SAMPLES`` samples). A momentum
+dump is a train of thruster pulses of seconds; a leak or a venting sequence longer still. The impulse's
+Δχ² (:func:`impulse_chi2`: the best sum of squares with D within the resolution, less the best of all,
+over σ²) is the likelihood-ratio statistic of "a torque of some duration" against "an impulse", one
+parameter more (D): ½ Δχ² − ½ ln n is its BIC-penalised log likelihood ratio (Schwarz 1978).
+
+**Dump direction.** An unloading law fires only thrusters that unload the wheels: thruster k adds
+impulse along its torque axis a_k, which the loop hands to the wheels, so it unloads when a_k · H_w < 0.
+Whatever the law (proportional to −H_w, or each couple on for the same time, or a deadband that leaves
+small axes out), the dump's ΔH_B lies in the convex cone of the unloading axes. Under the dump hypothesis
+the direction is uniform over that cone blurred by the direction's noise σ (a direction δ off the cone
+weighs e^(−δ²/2σ²)); under the strike's it is uniform on the sphere. :func:`unloading_cone_log_lr` is the
+log of their ratio, 4π e^(−δ²/2σ²) / Z with Z = ∫ e^(−δ²/2σ²) dΩ over the sphere (≈ the cone's solid
+angle for a full cone; for six body-axis couples the octant of −H_w, LR = 8 inside it). A strike's random
+direction lies in that cone with probability Z / 4π (1/8 for the octant): the cone alone never calls a
+strike a dump; it adds its weight to the stored-momentum aim and to the time profile
+(:func:`abrupt.detect.attitude.attribution.compare_hypotheses`).
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+
+import numpy as np
+from scipy.optimize import nnls
+
+from abrupt.types import FloatArray
+
+NAN = float("nan")
+#: An impulse spans up to this many samples of the grid (a torque between two samples, read through the
+#: one-sample means of the rates and the wheels' smoothing).
+IMPULSE_SAMPLES = 2.0
+#: The spread of a dump's direction about the unloading cone beyond the measured noise [deg]: the
+#: thrusters' axes are known to about this (alignment, plume impingement).
+CONE_SIGMA_DEG = 5.0
+#: Directions of the quadrature of the blurred cone's normalisation (a Fibonacci sphere).
+SPHERE_POINTS = 4000
+
+
+def duration_profile(tau_s: FloatArray, y: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray] | None:
+    """Durations D [s] (0 first, then a log grid up to a third of the window), the least-squares sum of
+    squares of the ramp y = c + A clip((τ − τ_s)/D, 0, 1) over a linear background at each D (onset τ_s
+    free on the samples of the middle half, the ramp ending 30 s before the window does), and the best
+    onset of each; None with fewer than 20 finite samples."""
+    ok = np.isfinite(y)
+    t, v = tau_s[ok], y[ok]
+    if t.size < 20:
+        return None
+    span = float(t[-1] - t[0])
+    durations = np.concatenate([[0.0], np.geomspace(1.0, max(span / 3, 2.0), 20)])
+    onsets = t[(t > t[0] + 0.25 * span) & (t < t[-1] - 0.25 * span)][::2]
+    best = np.full(durations.size, np.inf)
+    where = np.zeros(durations.size)
+    if onsets.size == 0:
+        return None
+    # A linear background (slow residual drift) is projected out of the data and of each ramp.
+    basis, _ = np.linalg.qr(np.column_stack([np.ones_like(t), (t - t.mean()) / max(span, 1.0)]))
+    vc = v - basis @ (basis.T @ v)
+    # One set of (onsets × samples) buffers for every duration: a fresh array per step of the loop cost
+    # more in page faults than in arithmetic. The operations are those of the plain expressions.
+    lag = t[None, :] - onsets[:, None]
+    xc, proj, sq = np.empty_like(lag), np.empty_like(lag), np.empty_like(lag)
+    for j, d in enumerate(durations):
+        if d > 0:
+            np.clip(np.divide(lag, d, out=xc), 0.0, 1.0, out=xc)  # clip((t − τ_s) / D, 0, 1)
+        else:
+            np.greater_equal(t[None, :], onsets[:, None], out=xc)  # the step: 1(t ≥ τ_s)
+        np.matmul(xc @ basis, basis.T, out=proj)
+        np.subtract(xc, proj, out=xc)  # the ramp with the linear background projected out
+        sxx = np.sum(np.multiply(xc, xc, out=sq), axis=1)
+        sxy = xc @ vc
+        with np.errstate(invalid="ignore", divide="ignore"):
+            sse = np.sum(vc * vc) - np.where(sxx > 0, sxy**2 / sxx, 0.0)
+        sse = np.where(onsets + d < t[-1] - 30.0, sse, np.inf)
+        m = int(np.argmin(sse))
+        best[j], where[j] = float(sse[m]), float(onsets[m])
+    return durations, best, where
+
+
+def impulse_chi2(durations: FloatArray, best_sse: FloatArray, sigma: float, dt_s: float) -> float:
+    """Δχ² of the impulse hypothesis (the best fit with D ≤ ``IMPULSE_SAMPLES`` dt) against the best of
+    every duration, in units of the noise variance σ² (0 when the impulse fits best)."""
+    if not (sigma > 0 and np.isfinite(best_sse).any()):
+        return NAN
+    imp = durations <= IMPULSE_SAMPLES * dt_s + 1e-9
+    return float(max(np.min(best_sse[imp]) - np.min(best_sse), 0.0) / sigma**2)
+
+
+def duration_log_lr(chi2: float, n_samples: int) -> float:
+    """BIC-penalised log likelihood ratio of a torque of some duration to an impulse: ½ Δχ² − ½ ln n."""
+    if not (math.isfinite(chi2) and n_samples > 1):
+        return NAN
+    return 0.5 * chi2 - 0.5 * math.log(n_samples)
+
+
+def _fibonacci_sphere(n: int) -> FloatArray:
+    k = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * k / n
+    r = np.sqrt(1.0 - z * z)
+    phi = np.pi * (1.0 + 5**0.5) * k
+    return np.column_stack([r * np.cos(phi), r * np.sin(phi), z])
+
+
+def _cone_cos(axes: FloatArray, u: FloatArray) -> float:
+    """cos of the angle of the unit ``u`` from the convex cone of the columns of ``axes`` (1 inside it)."""
+    c, _ = nnls(axes, u)
+    p = axes @ c
+    cos = float(np.linalg.norm(p))
+    return cos if cos > 1e-12 else float(np.max(axes.T @ u))
+
+
+@lru_cache(maxsize=256)
+def _cone_norm(axes_key: tuple[float, ...], sigma_deg: float) -> float:
+    """Z / 4π of the cone blurred by σ: the sphere mean of e^(−δ²/2σ²) (quadrature on a Fibonacci sphere)."""
+    axes = np.asarray(axes_key, dtype=np.float64).reshape(3, -1)
+    pts = _fibonacci_sphere(SPHERE_POINTS)
+    delta = np.arccos(np.clip([_cone_cos(axes, p) for p in pts], -1.0, 1.0))
+    return float(np.mean(np.exp(-0.5 * (delta / math.radians(sigma_deg)) ** 2)))
+
+
+def unloading_axes(axes: FloatArray, hw_B: FloatArray) -> FloatArray:
+    """The columns of ``axes`` (3 x K unit torque axes) whose firing unloads the wheels' momentum ``hw_B``
+    (a_k · H_w < 0): 3 x m."""
+    return np.asarray(axes[:, axes.T @ hw_B < 0.0], dtype=np.float64)
+
+
+def unloading_cone_log_lr(axes: FloatArray, hw_B: FloatArray, u_B: FloatArray, noise_deg: float) -> float:
+    """ln of the likelihood ratio of the dump (uniform over the unloading axes' cone, blurred by σ =
+    hypot(``noise_deg``, ``CONE_SIGMA_DEG``), rounded to whole degrees) to the strike (uniform on the
+    sphere) for the direction ``u_B`` (module docstring); −∞ when no thruster unloads, NaN without axes."""
+    if axes.shape[1] == 0 or not np.all(np.isfinite(hw_B)) or not np.all(np.isfinite(u_B)):
+        return NAN
+    a = unloading_axes(axes, hw_B)
+    if a.shape[1] == 0:
+        return -math.inf
+    u = u_B / float(np.linalg.norm(u_B))
+    sigma_deg = float(round(math.hypot(noise_deg if math.isfinite(noise_deg) else 0.0, CONE_SIGMA_DEG)))
+    delta = math.acos(float(np.clip(_cone_cos(a, u), -1.0, 1.0)))
+    norm = _cone_norm(tuple(np.round(a, 9).ravel().tolist()), sigma_deg)
+    return -0.5 * (delta / math.radians(sigma_deg)) ** 2 - math.log(norm)
