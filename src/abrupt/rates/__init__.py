@@ -152,7 +152,8 @@ TM-4527; ECSS-E-10-04A), of which no readable copy was found. abrupt uses the ta
 (28.5°: 0.91, 30°: 0.92, 40°: 0.96, 50°: 1.02, 60°: 1.09, 70°: 1.26, 80°: 1.71, 90°: 1.37, 100°: 1.78, 120°:
 1.18). A public design note that copies the model from SPENVIS prints 28.5°, 50° and 100° as here, 60° and 70°
 within 0.06, and a monotone 1.4 and 1.6 at 80° and 90°; at the sun-synchronous 98° the readings differ by 2.6 %.
-Ψ(45°) = 0.990 and Ψ(52°) = 1.030 quoted by two implementations agree. Per-node evidence: the comment above ``PSI_VALUE`` in :mod:`abrupt.rates.flux`.
+Ψ(45°) = 0.990 and Ψ(52°) = 1.030 quoted by two implementations agree. Per-node evidence: the comment above
+``PSI_VALUE`` in :mod:`abrupt.rates.flux`.
 
 Limitations
 -----------
@@ -162,8 +163,8 @@ Limitations
   assumed inclination mix. For current environments use ORDEM or MASTER output through the table format. The
   ORDEM importer is keyed on header words and was tested on files written in the documented layout, not on real
   ORDEM output (none was available offline); check the column mapping it prints.
-* Ψ(i) at 80° and 90° is read differently by the one readable secondary copy (see above); the 2.5 g/cm³ meteoroid density
-  is the one the Grün sizes are computed with, and the flux inference's default mass law for meteoroids uses the
+* Ψ(i) at 80° and 90° is read differently by the one readable secondary copy (see above); the 2.5 g/cm³
+  meteoroid density is the one the Grün sizes are computed with, and the flux inference's default mass law for meteoroids uses the
   same value. The meteoroid speed distribution is SSP 30425's rather than ECSS Table C-1 (not readable offline).
 * Fluxes are orbit-averaged; no polar enhancement, no meteoroid streams, no seasonal variation. Size and
   direction are drawn independently unless a table gives them jointly (the format does not).
