@@ -165,7 +165,8 @@ Limitations
   ORDEM output (none was available offline); check the column mapping it prints.
 * Ψ(i) at 80° and 90° is read differently by the one readable secondary copy (see above); the 2.5 g/cm³
   meteoroid density is the one the Grün sizes are computed with, and the flux inference's default mass law for
-  meteoroids uses the same value. The meteoroid speed distribution is SSP 30425's rather than ECSS Table C-1 (not readable offline).
+  meteoroids uses the same value. The meteoroid speed distribution is SSP 30425's rather than ECSS Table C-1
+  (not readable offline).
 * Fluxes are orbit-averaged; no polar enhancement, no meteoroid streams, no seasonal variation. Size and
   direction are drawn independently unless a table gives them jointly (the format does not).
 * Circular orbits only; body frame = orbit frame; arrays rotate about their drive axis only.
