@@ -228,8 +228,8 @@ def detect_arc(
     # (abrupt.detect.tle.intervals; a ramp time assumes sets published as soon as their tracking ends)
     h_of = [hinge.get(it.gap, it) for it in detected]
     chain_s = cfg.campaign_chain_days * SECONDS_PER_DAY
-    first = [min(it.time_s, h.time_s) for it, h in zip(detected, h_of, strict=True)]
-    lags = own_lags_s([model.t[it.gap] for it in detected], first, [it.refined for it in detected], chain_s)
+    t_first_s = [min(it.time_s, h.time_s) for it, h in zip(detected, h_of, strict=True)]
+    lags = own_lags_s([model.t[it.gap] for it in detected], t_first_s, [it.refined for it in detected], chain_s)
     for it in kept:
         t_old, t_first = float(model.t[it.gap]), min(it.time_s, hinge.get(it.gap, it).time_s)
         bound = t_old - lag_bound_s(lags, t_old - t_first, cfg.interval_level)
