@@ -16,6 +16,7 @@ import pytest
 from abrupt.detect.tle.detectors import TleMeanElements
 from abrupt.detect.tle.elements import mean_element_series
 from abrupt.detect.tle.response import span_fraction
+from abrupt.detect.tle.timing import smoothed_hinge_d
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
 from abrupt.simulate.tle_null import EPOCH0, NullHistorySpec, history_from_series, simulate_null_history
 from abrupt.thresholds import FalseAlarmBudget
@@ -43,7 +44,18 @@ def _fitted_phase(x_days: float, span_days: float) -> float:
     return float(slope * x_days + intercept)
 
 
-def _blended_history(burn_days: list[float], dvs: list[float], seed: int) -> ElementHistory:
+@pytest.mark.parametrize("span_days", [0.0, 2.0, 7.0])
+@pytest.mark.parametrize("x_days", [-1.0, 0.0, 0.5, 1.5, 3.0, 6.9, 7.0, 9.0])
+def test_along_track_angle_a_set_shows_is_the_least_squares_line_at_its_epoch(x_days: float, span_days: float) -> None:
+    """The smoothed hinge the burn timing fits is the value at the epoch of a least-squares line through
+    the kinked along-track track over the set's span (numerical fit; a sharp hinge for a span of 0)."""
+    expected = _fitted_phase(x_days, span_days) if span_days > 0 else max(x_days, 0.0)
+    assert float(smoothed_hinge_d(np.array([x_days]), span_days)[0]) == pytest.approx(expected, abs=2e-3)
+
+
+def _blended_history(
+    burn_days: list[float], dvs: list[float], seed: int, span_days: float = SPAN_DAYS
+) -> ElementHistory:
     """A maneuver-free simulated history plus in-track burns whose sets are least-squares fits over
     ``SPAN_DAYS``: ``a`` and the e-vector carry the fitted fraction of each burn, the along-track phase
     the fitted line's value at the epoch (minus what the sets' own blended rates integrate)."""
@@ -65,8 +77,8 @@ def _blended_history(burn_days: list[float], dvs: list[float], seed: int) -> Ele
     rng = np.random.default_rng([seed, 3])
     for day, dv in zip(burn_days, dvs, strict=True):
         x = t_days - day
-        frac = np.array([_fitted_fraction(xi, SPAN_DAYS) for xi in x])
-        phase = np.array([_fitted_phase(xi, SPAN_DAYS) if xi > 0 else 0.0 for xi in x])  # days
+        frac = np.array([_fitted_fraction(xi, span_days) for xi in x])
+        phase = np.array([_fitted_phase(xi, span_days) if xi > 0 else 0.0 for xi in x])  # days
         da = 2.0 * a0 * dv / v
         dn = -1.5 * n0 * da / a0  # [rad/s]
         u_arg = float(rng.uniform(0.0, 2.0 * np.pi))
