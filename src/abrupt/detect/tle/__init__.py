@@ -518,6 +518,18 @@ three burns (`abrupt.detect.tle.response`; `ramp_times`, `in_blend` in `abrupt.d
 * **One burn, one event.** In an era whose sets blend, a weaker step inside a stronger step's blend (between its
   last old and first new set) is merged into it. Elsewhere two burns in consecutive gaps look the same in `a`,
   so the rule is not applied (it cost Jason-3 and CryoSat-2 burns of their campaigns when it was).
+* **The along-track angle as the sets show it** (`timing.smoothed_hinge_d`). A small burn's step in `a` is too
+  weak for the blend test, but a set fitted as a line over `[t_k − S, t_k]` shows the kinked track `β·max(0, t −
+  t_b)` at its epoch as `β·S·(2ρ² − ρ³)`, `ρ = (t_k − t_b)/S` (checked against numerical least-squares fits,
+  `tests/test_tle_response.py`); a sharp hinge fitted to such sets lands inside the ramp, a day or more late.
+  Every in-track candidate is fitted for spans of 0 (sharp), 1, 2, 3, 4, 6 and 8 days; the **era's span** is
+  the median best span of the detections within half a year (at least three, else sharp), and each burn is
+  timed at it. Learned from the sets alone: Sentinel-3A 0-0.25 days, Jason-3 0-2.5, CryoSat-2 4 in 2011 (the
+  blend test's era) and 0-2 otherwise, Jason-1 6-8 in 2001-2005. A detection where only the phase moved is
+  timed by this hinge when its phase bends rather than jumps (`timing.phase_kinks`: smaller L1 residual than a
+  jump): an opposed pair jumps, a burn whose `a` ramps over many sets bends. **A ramp found twice**
+  (`in_response`): where the era's span is 3 days or more, a later in-track step of the same sign whose set
+  before lies within the span after an earlier detection's burn is that burn (one event, the earlier time).
 * **Outlier sets** (`abrupt.detect.tle.outliers`): a set 30 robust σ off the line through both its neighbours,
   the neighbours agreeing (`|y_{k+1} − y_{k−1}| ≤ |r|/2`), the sets beyond them on that line, and no step of `a`
   over the five sets, is counted (`noise_model["outlier_sets"]`, `outlier_epochs_utc`) and printed by `detect

@@ -69,7 +69,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from abrupt.detect.base import DetectionResult, Diagnostics
+from abrupt.detect.base import DetectionResult
 from abrupt.detect.tle.arcs import join_arcs
 from abrupt.detect.tle.burns import campaign_cadence_s, characterise, label_campaigns
 from abrupt.detect.tle.campaigns import find_campaigns
@@ -94,6 +94,7 @@ from abrupt.detect.tle.steps import (
     noise_summary,
     operating_threshold,
     segment_bounds,
+    step_diagnostics,
 )
 from abrupt.detect.tle.timing import (
     SPAN_DAYS,
@@ -139,6 +140,8 @@ class StepRun:
     ramp_intervals: dict[int, tuple[float, float]] = field(default_factory=dict)
     # the blended sets of each in-track step: (last set on the old level, first on the new)
     blends: dict[int, tuple[int, int]] = field(default_factory=dict)
+    # the fit span (s) of the era of each in-track candidate's sets (time_candidates; 0: sharp)
+    era_span_s: dict[int, float] = field(default_factory=dict)
 
 
 def detect_mean_elements(
@@ -210,7 +213,7 @@ def detect_arc(
     if len(history) < 2 * cfg.window_sets + 1:
         msg = f"{len(history)} element sets: at least {2 * cfg.window_sets + 1} are needed; nothing tested"
         none = Threshold(math.inf, float("nan"), "none", 0, fa_per_day)
-        diag = _diagnostics(detector_name, np.zeros(0), np.zeros(0), none, epoch0_np, {"regime": regime}, regime)
+        diag = step_diagnostics(detector_name, np.zeros(0), np.zeros(0), none, epoch0_np, {"regime": regime}, regime)
         return DetectionResult(empty_frame(EXTRA_COLUMNS), (diag,), (msg,))
     span_days = (el["epoch_utc"].iloc[-1] - el["epoch_utc"].iloc[0]).total_seconds() / SECONDS_PER_DAY
     n_gaps = len(history) - 1
@@ -254,31 +257,10 @@ def detect_arc(
     noise["outlier_epochs_utc"] = [str(e) for e in outlier_epochs]
     noise["outlier_sets_removed"] = bool(regime == "geo")
     fitted = Threshold(threshold, p_fa, method, n_gaps, fa_per_day)
-    diag = _diagnostics(
+    diag = step_diagnostics(
         detector_name, 0.5 * (steps.t_before_s + steps.t_after_s), stat, fitted, epoch0_np, noise, regime
     )
     return DetectionResult(frame, (diag,))
-
-
-def _diagnostics(
-    detector_name: str,
-    gap_time_s: NDArray[np.float64],
-    statistic: NDArray[np.float64],
-    threshold: Threshold,
-    epoch_utc: np.datetime64,
-    noise_model: dict[str, Any],
-    regime: str,
-) -> Diagnostics:
-    return Diagnostics(
-        name=f"{detector_name}.step_statistic",
-        time_s=gap_time_s,
-        statistic=statistic,
-        threshold=threshold,
-        epoch_utc=epoch_utc,
-        unit="normal-equivalent z (max over element groups)",
-        noise_model=noise_model,
-        extra={"regime": regime},
-    )
 
 
 def time_candidates(run: StepRun, candidates: NDArray[np.int64], all_candidates: bool) -> list[Candidate]:
@@ -317,13 +299,17 @@ def time_candidates(run: StepRun, candidates: NDArray[np.int64], all_candidates:
         )
 
     first = {g: hinge(g, seg, SPAN_DAYS if leo else (0.0,)) for g, seg, ok in plan if ok}
-    fitted = [(float(model.t[g]), f[2]) for g, f in first.items() if math.isfinite(f[2])]
+    # the era from the detections alone (sub-threshold candidates, kept for recall curves, are noise)
+    fitted = [
+        (float(model.t[g]), f[2]) for g, f in first.items() if math.isfinite(f[2]) and run.stat[g] >= run.threshold
+    ]
     at_s, span_d = (np.asarray(x, dtype=float) for x in zip(*fitted, strict=True)) if fitted else (np.zeros(0),) * 2
     timed: list[Candidate] = []
     for g, seg, ok in plan:
         if ok:
             era_d = local_spans_s(float(model.t[g]), at_s, span_d, RAMP_ERA_DAYS * SECONDS_PER_DAY)[0]
-            t_m, refined, _ = hinge(g, seg, (era_d if math.isfinite(era_d) else 0.0,))
+            run.era_span_s[g] = (era_d if math.isfinite(era_d) else 0.0) * SECONDS_PER_DAY
+            t_m, refined, _ = hinge(g, seg, (run.era_span_s[g] / SECONDS_PER_DAY,))
         else:
             t_m, refined = 0.5 * (steps.t_before_s[g] + steps.t_after_s[g]), False
         # the burn(s) behind this step: from the estimated burn time (earlier than the set before
@@ -546,6 +532,25 @@ def in_blend(run: StepRun, g: int, host: int) -> bool:
     return split[1] - split[0] > 1 and split[0] <= g <= split[1]
 
 
+def in_response(run: StepRun, late: Candidate, early: Candidate) -> bool:
+    """Is the in-track step ``late`` the rest of the ``early`` burn's response? In an era whose sets are
+    fits over a span S of days, a set ``x`` after a burn carries ``f(x/S)`` of its change
+    (:func:`abrupt.detect.tle.response.span_fraction`): ``a`` ramps for S after it and the step test
+    can find the ramp twice, once where the phase bends and once where most of ``a`` arrives. A later
+    step of the same sign whose set before lies within S of the early burn is that burn. Only where
+    S is at least ``RESPONSE_MIN_SPAN_DAYS``: with sets fitted over a day or two, burns of a campaign
+    two days apart are separate steps (Jason-3, CryoSat-2)."""
+    span_s = run.era_span_s.get(early.gap, 0.0)
+    if span_s < RESPONSE_MIN_SPAN_DAYS * SECONDS_PER_DAY or late.gap <= early.gap or not early.refined:
+        return False
+    da = run.steps.delta_a_m
+    x_s = float(run.model.t[late.gap]) - early.time_s
+    return 0.0 <= x_s < span_s and float(da[late.gap]) * float(da[early.gap]) > 0
+
+
+RESPONSE_MIN_SPAN_DAYS = 3.0
+
+
 def merge_candidates(run: StepRun, timed: list[Candidate]) -> tuple[list[Candidate], dict[int, list[float]]]:
     """One maneuver per TLE cadence: the kept candidates (by time) and each one's interval (s).
 
@@ -563,7 +568,11 @@ def merge_candidates(run: StepRun, timed: list[Candidate]) -> tuple[list[Candida
         near = [
             k
             for k in kept
-            if abs(item.time_s - k.time_s) < merge_s or out_of_order(item, k) or in_blend(run, item.gap, k.gap)
+            if abs(item.time_s - k.time_s) < merge_s
+            or out_of_order(item, k)
+            or in_blend(run, item.gap, k.gap)
+            or in_response(run, item, k)
+            or in_response(run, k, item)
         ]
         if not near:
             merge, t_one, g_host = one_burn_with_neighbour(run, item, lag0_s)
@@ -580,6 +589,11 @@ def merge_candidates(run: StepRun, timed: list[Candidate]) -> tuple[list[Candida
                     kept[kept.index(near[0])] = retimed
                     span_of[retimed.gap][0] = min(span_of[retimed.gap][0], t_one)
                     near = [retimed]
+        if near and stat[item.gap] >= run.threshold and in_response(run, near[0], item):  # host: its response
+            retimed = Candidate(near[0].gap, item.time_s, item.refined, min(near[0].start_s, item.start_s))
+            kept[kept.index(near[0])] = retimed
+            span_of[retimed.gap][0] = min(span_of[retimed.gap][0], item.start_s)
+            continue
         if not near:
             kept.append(item)
             end_s = run.ramp_intervals.get(item.gap, (item.start_s, float(steps.t_after_s[item.gap])))[1]

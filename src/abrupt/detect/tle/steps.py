@@ -15,6 +15,7 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy import special, stats
 
+from abrupt.detect.base import Diagnostics
 from abrupt.detect.tle.config import TleDetectorConfig
 from abrupt.detect.tle.elements import (
     circular_speed_mps,
@@ -35,6 +36,7 @@ from abrupt.detect.tle.noise import (
 )
 from abrupt.detect.tle.step_kernels import gap_steps, localise_costs
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
+from abrupt.thresholds import Threshold
 from abrupt.units import SECONDS_PER_DAY
 
 
@@ -525,6 +527,28 @@ def block_scale(
     if cfg.threshold_follow == "raise":
         local = np.maximum(local, threshold)
     return np.asarray(threshold / local, dtype=float)
+
+
+def step_diagnostics(
+    detector_name: str,
+    gap_time_s: NDArray[np.float64],
+    statistic: NDArray[np.float64],
+    threshold: Threshold,
+    epoch_utc: np.datetime64,
+    noise_model: dict[str, Any],
+    regime: str,
+) -> Diagnostics:
+    """The detector's one Diagnostics: the combined statistic per gap (at the gap's middle) and its threshold."""
+    return Diagnostics(
+        name=f"{detector_name}.step_statistic",
+        time_s=gap_time_s,
+        statistic=statistic,
+        threshold=threshold,
+        epoch_utc=epoch_utc,
+        unit="normal-equivalent z (max over element groups)",
+        noise_model=noise_model,
+        extra={"regime": regime},
+    )
 
 
 def noise_summary(
