@@ -299,10 +299,14 @@ def time_candidates(run: StepRun, candidates: NDArray[np.int64], all_candidates:
         )
 
     first = {g: hinge(g, seg, SPAN_DAYS if leo else (0.0,)) for g, seg, ok in plan if ok}
-    # the era from the detections alone (sub-threshold candidates, kept for recall curves, are noise)
-    fitted = [
+    # the era from detections outside campaigns: sub-threshold candidates (kept for recall curves) are
+    # noise, and a hinge fit reaching over a neighbouring burn days away is bent by it
+    found = [
         (float(model.t[g]), f[2]) for g, f in first.items() if math.isfinite(f[2]) and run.stat[g] >= run.threshold
     ]
+    at = np.asarray([f[0] for f in found], dtype=float)
+    alone = [int(np.sum(np.abs(at - x) < cfg.campaign_days * SECONDS_PER_DAY)) == 1 for x, _ in found]
+    fitted = [f for f, a in zip(found, alone, strict=True) if a]
     at_s, span_d = (np.asarray(x, dtype=float) for x in zip(*fitted, strict=True)) if fitted else (np.zeros(0),) * 2
     timed: list[Candidate] = []
     for g, seg, ok in plan:
@@ -532,25 +536,6 @@ def in_blend(run: StepRun, g: int, host: int) -> bool:
     return split[1] - split[0] > 1 and split[0] <= g <= split[1]
 
 
-def in_response(run: StepRun, late: Candidate, early: Candidate) -> bool:
-    """Is the in-track step ``late`` the rest of the ``early`` burn's response? In an era whose sets are
-    fits over a span S of days, a set ``x`` after a burn carries ``f(x/S)`` of its change
-    (:func:`abrupt.detect.tle.response.span_fraction`): ``a`` ramps for S after it and the step test
-    can find the ramp twice, once where the phase bends and once where most of ``a`` arrives. A later
-    step of the same sign whose set before lies within S of the early burn is that burn. Only where
-    S is at least ``RESPONSE_MIN_SPAN_DAYS``: with sets fitted over a day or two, burns of a campaign
-    two days apart are separate steps (Jason-3, CryoSat-2)."""
-    span_s = run.era_span_s.get(early.gap, 0.0)
-    if span_s < RESPONSE_MIN_SPAN_DAYS * SECONDS_PER_DAY or late.gap <= early.gap or not early.refined:
-        return False
-    da = run.steps.delta_a_m
-    x_s = float(run.model.t[late.gap]) - early.time_s
-    return 0.0 <= x_s < span_s and float(da[late.gap]) * float(da[early.gap]) > 0
-
-
-RESPONSE_MIN_SPAN_DAYS = 3.0
-
-
 def merge_candidates(run: StepRun, timed: list[Candidate]) -> tuple[list[Candidate], dict[int, list[float]]]:
     """One maneuver per TLE cadence: the kept candidates (by time) and each one's interval (s).
 
@@ -568,11 +553,7 @@ def merge_candidates(run: StepRun, timed: list[Candidate]) -> tuple[list[Candida
         near = [
             k
             for k in kept
-            if abs(item.time_s - k.time_s) < merge_s
-            or out_of_order(item, k)
-            or in_blend(run, item.gap, k.gap)
-            or in_response(run, item, k)
-            or in_response(run, k, item)
+            if abs(item.time_s - k.time_s) < merge_s or out_of_order(item, k) or in_blend(run, item.gap, k.gap)
         ]
         if not near:
             merge, t_one, g_host = one_burn_with_neighbour(run, item, lag0_s)
@@ -589,11 +570,6 @@ def merge_candidates(run: StepRun, timed: list[Candidate]) -> tuple[list[Candida
                     kept[kept.index(near[0])] = retimed
                     span_of[retimed.gap][0] = min(span_of[retimed.gap][0], t_one)
                     near = [retimed]
-        if near and stat[item.gap] >= run.threshold and in_response(run, near[0], item):  # host: its response
-            retimed = Candidate(near[0].gap, item.time_s, item.refined, min(near[0].start_s, item.start_s))
-            kept[kept.index(near[0])] = retimed
-            span_of[retimed.gap][0] = min(span_of[retimed.gap][0], item.start_s)
-            continue
         if not near:
             kept.append(item)
             end_s = run.ramp_intervals.get(item.gap, (item.start_s, float(steps.t_after_s[item.gap])))[1]
