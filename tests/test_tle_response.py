@@ -16,6 +16,7 @@ import pytest
 from abrupt.detect.tle.detectors import TleMeanElements
 from abrupt.detect.tle.elements import mean_element_series
 from abrupt.detect.tle.response import span_fraction
+from abrupt.detect.tle.timing import phase_kinks, smoothed_hinge_d
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
 from abrupt.simulate.tle_null import EPOCH0, NullHistorySpec, history_from_series, simulate_null_history
 from abrupt.thresholds import FalseAlarmBudget
@@ -43,7 +44,18 @@ def _fitted_phase(x_days: float, span_days: float) -> float:
     return float(slope * x_days + intercept)
 
 
-def _blended_history(burn_days: list[float], dvs: list[float], seed: int) -> ElementHistory:
+@pytest.mark.parametrize("span_days", [0.0, 2.0, 7.0])
+@pytest.mark.parametrize("x_days", [-1.0, 0.0, 0.5, 1.5, 3.0, 6.9, 7.0, 9.0])
+def test_along_track_angle_a_set_shows_is_the_least_squares_line_at_its_epoch(x_days: float, span_days: float) -> None:
+    """The smoothed hinge the burn timing fits is the value at the epoch of a least-squares line through
+    the kinked along-track track over the set's span (numerical fit; a sharp hinge for a span of 0)."""
+    expected = _fitted_phase(x_days, span_days) if span_days > 0 else max(x_days, 0.0)
+    assert float(smoothed_hinge_d(np.array([x_days]), span_days)[0]) == pytest.approx(expected, abs=2e-3)
+
+
+def _blended_history(
+    burn_days: list[float], dvs: list[float], seed: int, span_days: float = SPAN_DAYS
+) -> ElementHistory:
     """A maneuver-free simulated history plus in-track burns whose sets are least-squares fits over
     ``SPAN_DAYS``: ``a`` and the e-vector carry the fitted fraction of each burn, the along-track phase
     the fitted line's value at the epoch (minus what the sets' own blended rates integrate)."""
@@ -65,8 +77,8 @@ def _blended_history(burn_days: list[float], dvs: list[float], seed: int) -> Ele
     rng = np.random.default_rng([seed, 3])
     for day, dv in zip(burn_days, dvs, strict=True):
         x = t_days - day
-        frac = np.array([_fitted_fraction(xi, SPAN_DAYS) for xi in x])
-        phase = np.array([_fitted_phase(xi, SPAN_DAYS) if xi > 0 else 0.0 for xi in x])  # days
+        frac = np.array([_fitted_fraction(xi, span_days) for xi in x])
+        phase = np.array([_fitted_phase(xi, span_days) if xi > 0 else 0.0 for xi in x])  # days
         da = 2.0 * a0 * dv / v
         dn = -1.5 * n0 * da / a0  # [rad/s]
         u_arg = float(rng.uniform(0.0, 2.0 * np.pi))
@@ -103,3 +115,31 @@ def test_burns_blended_over_days_of_fit_span_are_timed_from_the_blends() -> None
         assert abs(t_days[near[0]] - day) < 0.35, (day, t_days[near[0]])
         covered += int(lo_d[near[0]] <= day <= hi_d[near[0]])
     assert covered >= 6
+
+
+def _phase_history(kind: str, seed: int) -> tuple[ElementHistory, int]:
+    """Daily sets of an 800 km orbit whose along-track phase either bends at day 20.4 (an in-track burn,
+    2 km/day of drift, as sets fitted over 6 days show it) or jumps by 5 km there (an opposed pair
+    between two sets), with 30 m of per-set phase noise; and the gap just after the change."""
+    rng = np.random.default_rng(seed)
+    t_days = np.arange(40.0) + rng.uniform(-0.2, 0.2, 40)
+    x = t_days - 20.4
+    signal = 2000.0 * smoothed_hinge_d(x, 6.0) if kind == "bend" else np.where(x > 0, 5000.0, 0.0)
+    series = {
+        "a_m": np.full(40, 7178.0e3),
+        "ex": np.full(40, 1.0e-3),
+        "ey": np.zeros(40),
+        "n1_rad": np.full(40, np.radians(98.6)),
+        "n2_rad": np.zeros(40),
+        "u_m": signal + rng.normal(0.0, 30.0, 40),
+    }
+    return history_from_series(t_days, series, "leo", norad=99912), int(np.searchsorted(t_days, 20.4))
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_phase_that_bends_is_a_burn_and_one_that_jumps_is_a_pair(seed: int) -> None:
+    """``phase_kinks`` tells the two shapes of a phase-only detection apart on the sets themselves."""
+    for kind, expected in (("bend", True), ("jump", False)):
+        h, gap = _phase_history(kind, seed)
+        t_s = mean_element_series(h, "leo")["t_s"]
+        assert phase_kinks(h, gap, 8, t_s, 3) is expected, kind

@@ -69,16 +69,14 @@ from typing import Any, NamedTuple
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
-from scipy import stats
 
-from abrupt.detect.base import DetectionResult, Diagnostics
+from abrupt.detect.base import DetectionResult
 from abrupt.detect.tle.arcs import join_arcs
 from abrupt.detect.tle.burns import campaign_cadence_s, characterise, label_campaigns
 from abrupt.detect.tle.campaigns import find_campaigns
 from abrupt.detect.tle.config import CAMPAIGN_SIDE_SETS, EXTRA_COLUMNS, TleDetectorConfig
 from abrupt.detect.tle.elements import arcs, circular_speed_mps, history_rows, orbit_regime
 from abrupt.detect.tle.intervals import interval_utc, lag_bound_s, own_lags_s
-from abrupt.detect.tle.noise import block_thresholds, null_threshold, robust_group_weight
 from abrupt.detect.tle.outliers import outlier_mask
 from abrupt.detect.tle.response import (
     blended_sets,
@@ -92,14 +90,22 @@ from abrupt.detect.tle.segmentation import segment
 from abrupt.detect.tle.steps import (
     StepModel,
     StepSeries,
-    component_weights,
+    block_scale,
     detectable_by_year,
-    empty_steps,
-    fill_gaps,
+    first_pass,
     noise_summary,
+    operating_threshold,
     segment_bounds,
+    step_diagnostics,
 )
-from abrupt.detect.tle.timing import has_drift_hinge, is_phasing, middle_set_phase_z, refine_burn_time
+from abrupt.detect.tle.timing import (
+    SPAN_DAYS,
+    has_drift_hinge,
+    is_phasing,
+    middle_set_phase_z,
+    phase_kinks,
+    refine_burn_time,
+)
 from abrupt.events import Event, config_hash, empty_frame, events_frame, new_run_id
 from abrupt.readers.tle import ElementHistory
 from abrupt.thresholds import DAYS_PER_YEAR, Threshold
@@ -136,6 +142,8 @@ class StepRun:
     ramp_intervals: dict[int, tuple[float, float]] = field(default_factory=dict)
     # the blended sets of each in-track step: (last set on the old level, first on the new)
     blends: dict[int, tuple[int, int]] = field(default_factory=dict)
+    # the fit span (s) of the era of each in-track candidate's sets (time_candidates; 0: sharp)
+    era_span_s: dict[int, float] = field(default_factory=dict)
 
 
 def detect_mean_elements(
@@ -207,7 +215,7 @@ def detect_arc(
     if len(history) < 2 * cfg.window_sets + 1:
         msg = f"{len(history)} element sets: at least {2 * cfg.window_sets + 1} are needed; nothing tested"
         none = Threshold(math.inf, float("nan"), "none", 0, fa_per_day)
-        diag = _diagnostics(detector_name, np.zeros(0), np.zeros(0), none, epoch0_np, {"regime": regime}, regime)
+        diag = step_diagnostics(detector_name, np.zeros(0), np.zeros(0), none, epoch0_np, {"regime": regime}, regime)
         return DetectionResult(empty_frame(EXTRA_COLUMNS), (diag,), (msg,))
     span_days = (el["epoch_utc"].iloc[-1] - el["epoch_utc"].iloc[0]).total_seconds() / SECONDS_PER_DAY
     n_gaps = len(history) - 1
@@ -257,111 +265,68 @@ def detect_arc(
     noise["outlier_epochs_utc"] = [str(e) for e in outlier_epochs]
     noise["outlier_sets_removed"] = bool(regime == "geo")
     fitted = Threshold(threshold, p_fa, method, n_gaps, fa_per_day)
-    diag = _diagnostics(
+    diag = step_diagnostics(
         detector_name, 0.5 * (steps.t_before_s + steps.t_after_s), stat, fitted, epoch0_np, noise, regime
     )
     return DetectionResult(frame, (diag,))
 
 
-def _diagnostics(
-    detector_name: str,
-    gap_time_s: NDArray[np.float64],
-    statistic: NDArray[np.float64],
-    threshold: Threshold,
-    epoch_utc: np.datetime64,
-    noise_model: dict[str, Any],
-    regime: str,
-) -> Diagnostics:
-    return Diagnostics(
-        name=f"{detector_name}.step_statistic",
-        time_s=gap_time_s,
-        statistic=statistic,
-        threshold=threshold,
-        epoch_utc=epoch_utc,
-        unit="normal-equivalent z (max over element groups)",
-        noise_model=noise_model,
-        extra={"regime": regime},
-    )
-
-
-def first_pass(history: ElementHistory, cfg: TleDetectorConfig, regime: str) -> tuple[StepModel, StepSeries]:
-    """The step model and the unsegmented statistics with the satellite's own group weights."""
-    model = StepModel(history, cfg)
-    n_gaps = len(history) - 1
-    first = empty_steps(model.t, n_gaps)
-    fill_gaps(first, model, np.arange(n_gaps), [])
-    first.weights = component_weights(first, cfg.window_sets + 2)
-    first.group_gain = cfg.group_gain
-    if regime == "leo" and first.z_u is not None:
-        first.weight_u = robust_group_weight(first.z_u, float(stats.chi.ppf(0.5, 1)), cfg.window_sets + 2)
-        first.gain_u = cfg.along_track_gain
-    return model, first
-
-
-def operating_threshold(cfg: TleDetectorConfig, first: StepSeries, p_fa: float) -> tuple[float, str]:
-    """The detection threshold on S and its method for a per-gap false-alarm probability ``p_fa``."""
-    if cfg.threshold is not None:
-        return float(cfg.threshold), "fixed"
-    # Floor: the level the maximum of three Gaussian groups would need; a short history's tail
-    # fit cannot promise fewer false alarms than that.
-    threshold = max(
-        cfg.min_statistic,
-        float(stats.norm.isf(p_fa / 6.0)),  # max of three groups, two-sided (Bonferroni)
-        null_threshold(first.statistic, cfg.window_sets + 2, p_fa, cfg.threshold_method),
-    )
-    return threshold, cfg.threshold_method
-
-
-def block_scale(
-    cfg: TleDetectorConfig, first: StepSeries, t_s: NDArray[np.float64], threshold: float
-) -> NDArray[np.float64] | None:
-    """Per-gap factor ``threshold / block threshold`` (:func:`block_thresholds`) that lets one cut on
-    the statistic hold the threshold of each block of the history; None with a fixed threshold or
-    ``threshold_follow="none"``. ``"raise"`` never lowers a block below the whole-history threshold."""
-    if cfg.threshold is not None or cfg.threshold_follow == "none" or not math.isfinite(threshold):
-        return None
-    local, _ = block_thresholds(
-        first.statistic,
-        t_s,
-        cfg.window_sets + 2,
-        cfg.budget,
-        cfg.threshold_method,
-        cfg.threshold_block_days,
-        cfg.threshold_reach_days,
-        candidates_above=threshold,
-    )
-    local = np.maximum(local, cfg.min_statistic)
-    if cfg.threshold_follow == "raise":
-        local = np.maximum(local, threshold)
-    return np.asarray(threshold / local, dtype=float)
-
-
 def time_candidates(run: StepRun, candidates: NDArray[np.int64], all_candidates: bool) -> list[Candidate]:
-    """The burn time of every candidate gap (above the threshold unless ``all_candidates``)."""
+    """The burn time of every candidate gap (above the threshold unless ``all_candidates``).
+
+    LEO in-track burns are timed by the hinge of the along-track angle as the sets respond to it
+    (:func:`refine_burn_time`) at the fit span of their era: each candidate's best span (sharp hinge
+    or 1-8 days, :data:`SPAN_DAYS`) is found first, and the era's span is the median of those within
+    ``RAMP_ERA_DAYS`` (at least three; else a sharp hinge), so one noisy fit does not choose its own.
+    """
     cfg, steps, model, history = run.cfg, run.steps, run.model, run.history
-    timed: list[Candidate] = []
+    leo = run.regime == "leo"
+    plan = []
     for g in candidates:
         if not all_candidates and run.stat[g] < run.threshold:
             continue
         # LEO campaigns: stay inside this burn's segment; GEO burns are weeks apart and the
         # mean-longitude kink needs the full window (bounded: 2 of 70 FY times > 1 day off)
-        leo = run.regime == "leo"
         seg = segment_bounds(int(g), run.change_points, len(history)) if leo else (0, len(history))
-        if cfg.refine_time and has_drift_hinge(steps, int(g), cfg.min_statistic) and not is_phasing(steps, int(g)):
-            t_m, refined = refine_burn_time(
-                history,
-                int(g),
-                cfg.time_window_sets,
-                search_sets_before=cfg.time_search_sets_before,
-                geo=run.regime == "geo",
-                bounds=seg if leo else None,
-                t_s=model.t,
-            )
+        in_track = has_drift_hinge(steps, int(g), cfg.min_statistic) and not is_phasing(steps, int(g))
+        if leo and is_phasing(steps, int(g)):  # phase moved alone: a bend is a burn blended over sets
+            in_track = phase_kinks(history, int(g), cfg.time_window_sets, model.t, cfg.time_search_sets_before, seg)
+        plan.append((int(g), seg, cfg.refine_time and in_track))
+
+    def hinge(g: int, seg: tuple[int, int], spans_d: tuple[float, ...]) -> tuple[float, bool, float]:
+        before, bounds = cfg.time_search_sets_before, seg if leo else None
+        return refine_burn_time(
+            history,
+            g,
+            cfg.time_window_sets,
+            search_sets_before=before,
+            geo=not leo,
+            bounds=bounds,
+            t_s=model.t,
+            spans_d=spans_d,
+        )
+
+    first = {g: hinge(g, seg, SPAN_DAYS if leo else (0.0,)) for g, seg, ok in plan if ok}
+    # the era from detections outside campaigns: sub-threshold candidates (kept for recall curves) are
+    # noise, and a hinge fit reaching over a neighbouring burn days away is bent by it
+    found = [
+        (float(model.t[g]), f[2]) for g, f in first.items() if math.isfinite(f[2]) and run.stat[g] >= run.threshold
+    ]
+    at = np.asarray([f[0] for f in found], dtype=float)
+    alone = [int(np.sum(np.abs(at - x) < cfg.campaign_days * SECONDS_PER_DAY)) == 1 for x, _ in found]
+    fitted = [f for f, a in zip(found, alone, strict=True) if a]
+    at_s, span_d = (np.asarray(x, dtype=float) for x in zip(*fitted, strict=True)) if fitted else (np.zeros(0),) * 2
+    timed: list[Candidate] = []
+    for g, seg, ok in plan:
+        if ok:
+            era_d = local_spans_s(float(model.t[g]), at_s, span_d, RAMP_ERA_DAYS * SECONDS_PER_DAY)[0]
+            run.era_span_s[g] = (era_d if math.isfinite(era_d) else 0.0) * SECONDS_PER_DAY
+            t_m, refined, _ = hinge(g, seg, (run.era_span_s[g] / SECONDS_PER_DAY,))
         else:
             t_m, refined = 0.5 * (steps.t_before_s[g] + steps.t_after_s[g]), False
         # the burn(s) behind this step: from the estimated burn time (earlier than the set before
         # the step when that set was still fitted to pre-burn tracking) to the set after the step
-        timed.append(Candidate(int(g), t_m, refined, min(float(t_m), float(model.t[int(g)]))))
+        timed.append(Candidate(g, t_m, refined, min(float(t_m), float(model.t[g]))))
     return timed
 
 

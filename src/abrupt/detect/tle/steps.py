@@ -15,6 +15,7 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy import special, stats
 
+from abrupt.detect.base import Diagnostics
 from abrupt.detect.tle.config import TleDetectorConfig
 from abrupt.detect.tle.elements import (
     circular_speed_mps,
@@ -25,14 +26,17 @@ from abrupt.detect.tle.elements import (
     stated_decay_m_s,
 )
 from abrupt.detect.tle.noise import (
+    block_thresholds,
     chi2_as_normal,
     drift_noise_rate,
+    null_threshold,
     robust_group_weight,
     robust_scale_rolling,
     rolling_rate,
 )
 from abrupt.detect.tle.step_kernels import gap_steps, localise_costs
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
+from abrupt.thresholds import Threshold
 from abrupt.units import SECONDS_PER_DAY
 
 
@@ -471,6 +475,80 @@ def component_weights(first: StepSeries, guard: int, quantile: float = 0.5) -> t
     for z, ref in zip((first.z_a, first.z_e, first.z_n), refs, strict=True):
         out.append(robust_group_weight(z, ref, guard, quantile))
     return out[0], out[1], out[2]
+
+
+def first_pass(history: ElementHistory, cfg: TleDetectorConfig, regime: str) -> tuple[StepModel, StepSeries]:
+    """The step model and the unsegmented statistics with the satellite's own group weights."""
+    model = StepModel(history, cfg)
+    n_gaps = len(history) - 1
+    first = empty_steps(model.t, n_gaps)
+    fill_gaps(first, model, np.arange(n_gaps), [])
+    first.weights = component_weights(first, cfg.window_sets + 2)
+    first.group_gain = cfg.group_gain
+    if regime == "leo" and first.z_u is not None:
+        first.weight_u = robust_group_weight(first.z_u, float(stats.chi.ppf(0.5, 1)), cfg.window_sets + 2)
+        first.gain_u = cfg.along_track_gain
+    return model, first
+
+
+def operating_threshold(cfg: TleDetectorConfig, first: StepSeries, p_fa: float) -> tuple[float, str]:
+    """The detection threshold on S and its method for a per-gap false-alarm probability ``p_fa``."""
+    if cfg.threshold is not None:
+        return float(cfg.threshold), "fixed"
+    # Floor: the level the maximum of three Gaussian groups would need; a short history's tail
+    # fit cannot promise fewer false alarms than that.
+    threshold = max(
+        cfg.min_statistic,
+        float(stats.norm.isf(p_fa / 6.0)),  # max of three groups, two-sided (Bonferroni)
+        null_threshold(first.statistic, cfg.window_sets + 2, p_fa, cfg.threshold_method),
+    )
+    return threshold, cfg.threshold_method
+
+
+def block_scale(
+    cfg: TleDetectorConfig, first: StepSeries, t_s: NDArray[np.float64], threshold: float
+) -> NDArray[np.float64] | None:
+    """Per-gap factor ``threshold / block threshold`` (:func:`block_thresholds`) that lets one cut on
+    the statistic hold the threshold of each block of the history; None with a fixed threshold or
+    ``threshold_follow="none"``. ``"raise"`` never lowers a block below the whole-history threshold."""
+    if cfg.threshold is not None or cfg.threshold_follow == "none" or not math.isfinite(threshold):
+        return None
+    local, _ = block_thresholds(
+        first.statistic,
+        t_s,
+        cfg.window_sets + 2,
+        cfg.budget,
+        cfg.threshold_method,
+        cfg.threshold_block_days,
+        cfg.threshold_reach_days,
+        candidates_above=threshold,
+    )
+    local = np.maximum(local, cfg.min_statistic)
+    if cfg.threshold_follow == "raise":
+        local = np.maximum(local, threshold)
+    return np.asarray(threshold / local, dtype=float)
+
+
+def step_diagnostics(
+    detector_name: str,
+    gap_time_s: NDArray[np.float64],
+    statistic: NDArray[np.float64],
+    threshold: Threshold,
+    epoch_utc: np.datetime64,
+    noise_model: dict[str, Any],
+    regime: str,
+) -> Diagnostics:
+    """The detector's one Diagnostics: the combined statistic per gap (at the gap's middle) and its threshold."""
+    return Diagnostics(
+        name=f"{detector_name}.step_statistic",
+        time_s=gap_time_s,
+        statistic=statistic,
+        threshold=threshold,
+        epoch_utc=epoch_utc,
+        unit="normal-equivalent z (max over element groups)",
+        noise_model=noise_model,
+        extra={"regime": regime},
+    )
 
 
 def noise_summary(

@@ -25,15 +25,19 @@ def refine_burn_time(
     geo: bool = False,
     bounds: tuple[int, int] | None = None,
     t_s: NDArray[np.float64] | None = None,
-) -> tuple[float, bool]:
+    spans_d: tuple[float, ...] = (0.0,),
+) -> tuple[float, bool, float]:
     """Burn time (s from the first epoch) by along-track position continuity (method step 4).
 
     The along-track angle is the mean argument of latitude ω + M (LEO) or the mean longitude
     Ω + ω + M (GEO, where Ω and ω are ill-defined separately). The search runs from
     ``search_sets_before`` sets before the step to the set after it: the first sets after a burn are
     often still fitted to pre-burn tracking, so the step in the elements shows late while the
-    change of along-track drift (the hinge) does not. Returns ``(t_m, refined)``; ``refined`` is
-    False when the fit was not usable and the gap middle was returned instead.
+    change of along-track drift (the hinge) does not. Returns ``(t_m, refined, span_d)``; ``refined``
+    is False when the fit was not usable and the gap middle was returned instead. The hinge is the
+    sets' response to it (:func:`smoothed_hinge_d`) for each fit span of ``spans_d`` (days; 0 a sharp
+    hinge); ``span_d`` is the span whose fit has the least L1 residual (NaN when no window fit was
+    made: the gap middle or the two-set estimate).
 
     ``bounds`` (set indices ``[lo, hi)``, from the neighbouring accepted maneuvers) keep the fit and
     the search inside this maneuver's segment: in a campaign the along-track drift changes at every
@@ -54,9 +58,9 @@ def refine_burn_time(
     elif bounds is not None:
         t_two = two_set_burn_time(history, t, gap, search_sets_before)
         if t_two is not None:
-            return t_two, True
+            return t_two, True, math.nan
     if gap - lo < 2 or hi - (gap + 1) < 2:
-        return mid, False
+        return mid, False, math.nan
 
     def along(sat: Any) -> float:
         return float(sat.argpo + sat.mo + (sat.nodeo if geo else 0.0))
@@ -72,13 +76,40 @@ def refine_burn_time(
     t_lo = t[max(lo, gap - search_sets_before)]
     t_hi = t[gap + 1]
     grid = np.linspace(t_lo, t_hi, 97)
-    hinge = np.maximum(0.0, (t[idx][None, :] - grid[:, None]) / SECONDS_PER_DAY)  # (grid, sets)
     base = np.broadcast_to(np.column_stack([np.ones_like(tau), tau, tau**2]), (grid.size, tau.size, 3))
-    A = np.concatenate([base, hinge[:, :, None]], axis=2)  # (grid, sets, 4)
-    coef = np.linalg.pinv(A) @ du  # least squares for every candidate time at once
-    r = du[None, :] - np.einsum("gsk,gk->gs", A, coef)
-    cost = np.sum(np.abs(r), axis=1)  # L1: one poor set does not move the time
-    return float(grid[int(np.argmin(cost))]), True
+    best_t, best_cost, best_span = float(grid[0]), math.inf, math.nan
+    for span_d in spans_d if not geo else (0.0,):
+        hinge = smoothed_hinge_d((t[idx][None, :] - grid[:, None]) / SECONDS_PER_DAY, span_d)  # (grid, sets)
+        A = np.concatenate([base, hinge[:, :, None]], axis=2)  # (grid, sets, 4)
+        coef = np.linalg.pinv(A) @ du  # least squares for every candidate time at once
+        r = du[None, :] - np.einsum("gsk,gk->gs", A, coef)
+        cost = np.sum(np.abs(r), axis=1)  # L1: one poor set does not move the time
+        k = int(np.argmin(cost))
+        if cost[k] < best_cost:
+            best_t, best_cost, best_span = float(grid[k]), float(cost[k]), float(span_d)
+    return best_t, True, best_span
+
+
+# fit spans (days) tried for the sets' response to an in-track burn (0: a sharp hinge)
+SPAN_DAYS = (0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0)
+
+
+def smoothed_hinge_d(x_d: NDArray[np.float64], span_d: float) -> NDArray[np.float64]:
+    """The along-track angle (in units of the drift change × days) that element sets fitted over
+    ``span_d`` days show ``x_d`` days after an in-track burn: ``S·(2ρ² − ρ³)``, ``ρ = x/S``, for
+    ``0 < x < S`` and ``x`` after; a sharp hinge ``max(0, x)`` for ``S = 0``.
+
+    A set is a straight-line fit of the along-track angle over ``[t_k − S, t_k]``; through a kinked
+    track ``β·max(0, t − t_b)`` the line's value at its epoch is ``β·S·(ρ²/2 + (3ρ² − 2ρ³)/2)``
+    (mean plus half the slope fraction of :func:`abrupt.detect.tle.response.span_fraction`), which
+    joins the true track with its slope at ``ρ = 1``. A sharp hinge fitted to such sets falls
+    inside the ramp, up to days after the burn; the smoothed one is timed by the asymptote.
+    """
+    x = np.asarray(x_d, dtype=float)
+    if span_d <= 0:
+        return np.maximum(0.0, x)
+    rho = np.clip(x / span_d, 0.0, 1.0)
+    return np.where(x >= span_d, x, span_d * rho * rho * (2.0 - rho))
 
 
 def middle_set_phase_z(
@@ -152,6 +183,48 @@ def is_phasing(steps: StepSeries, g: int, significance: float = 5.0) -> bool:
     w = steps.weights
     others = max(w[0] * float(steps.z_a[g]), w[1] * float(steps.z_e[g]), w[2] * float(steps.z_n[g]))
     return steps.weight_u * float(steps.z_u[g]) >= significance and others < significance
+
+
+def phase_kinks(
+    history: ElementHistory,
+    gap: int,
+    window_sets: int,
+    t_s: NDArray[np.float64],
+    search_sets_before: int = 3,
+    bounds: tuple[int, int] | None = None,
+) -> bool:
+    """Does the along-track phase around gap ``gap`` bend (a drift-rate change: an in-track burn) rather
+    than jump (an opposed in-track pair: phasing)? LEO, mean argument of latitude ω + M.
+
+    Both models are fitted to the sets of the window (``c₀ + c₁τ + c₂τ²`` plus ``β·max(0, t − t_m)``
+    for a burn, Vallado 2013 Eq. 9-41, or plus ``γ·H(t − t_m)`` for a pair whose burns fall between two
+    sets) for every ``t_m`` from ``search_sets_before`` sets before the gap to the set after it; the
+    one with the smaller least L1 residual wins. A burn whose step in ``a`` spreads over the several
+    sets that were fitted across it (older catalogue eras) leaves ``a`` below the in-track test at
+    every single gap while its phase drifts from the burn on; the bend times it, a jump does not.
+    """
+    n = t_s.size
+    lo, hi = max(0, gap - window_sets + 1), min(n, gap + 1 + window_sets)
+    if bounds is not None:
+        lo, hi = max(lo, bounds[0]), min(hi, bounds[1])
+    if gap - lo < 2 or hi - (gap + 1) < 2:
+        return False
+    sats = history.satrecs
+    ref = sats[gap]
+    rate = (ref.argpdot + ref.mdot) / 60.0  # [rad/s] SGP4 secular rate
+    idx = np.arange(lo, hi)
+    u = np.array([sats[k].argpo + sats[k].mo for k in idx], dtype=float)
+    du = np.angle(np.exp(1j * (u - (ref.argpo + ref.mo) - rate * (t_s[idx] - t_s[gap]))))
+    tau = (t_s[idx] - t_s[gap]) / SECONDS_PER_DAY
+    grid = np.linspace(t_s[max(lo, gap - search_sets_before)], t_s[gap + 1], 49)
+    after = (t_s[idx][None, :] - grid[:, None]) / SECONDS_PER_DAY
+    base = np.broadcast_to(np.column_stack([np.ones_like(tau), tau, tau**2]), (grid.size, tau.size, 3))
+    costs = []
+    for extra in (np.maximum(0.0, after), (after > 0).astype(float)):  # bend, jump
+        design = np.concatenate([base, extra[:, :, None]], axis=2)
+        coef = np.linalg.pinv(design) @ du
+        costs.append(float(np.min(np.sum(np.abs(du[None, :] - np.einsum("gsk,gk->gs", design, coef)), axis=1))))
+    return costs[0] < costs[1]
 
 
 def has_drift_hinge(steps: StepSeries, g: int, significance: float = 3.0) -> bool:
