@@ -149,7 +149,8 @@ def main() -> None:
             f"exit {done.returncode}; CPU {cpu_s:.1f} s (bound {CPU_BOUND_S:g} s), peak resident {peak_gb:.2f} GB "
             f"(bound {MEMORY_BOUND_GB:g} GB); wall {time.time() - start:.0f} s"
         )
-        print("\n".join(line for line in done.stdout.splitlines() if "abrupt detect laser:" not in line))
+        said = (done.stdout + done.stderr).splitlines()  # the run's report; /usr/bin/time's lines are indented
+        print("\n".join(line for line in said if line[:1].strip() and "abrupt detect laser:" not in line))
         if done.returncode == 0:
             events = pd.read_csv(folder / "laser.csv")
             print(f"events: {len(events)}; kinds {events['kind'].value_counts().to_dict()}")

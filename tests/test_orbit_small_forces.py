@@ -10,14 +10,9 @@ import pytest
 
 from abrupt.model.orbit import MU_EARTH_M3_S2, R_EARTH_M, ForceContext, ForceModel, acceleration
 from abrupt.model.orbit.constants import MU_MOON_M3_S2, MU_SUN_M3_S2
-from abrupt.model.orbit.forces import (
-    F_BODY_STEP,
-    F_BODY_T0,
-    LOVE_K2,
-    schwarzschild_acceleration,
-    solid_tide_acceleration,
-)
+from abrupt.model.orbit.forces import F_BODY_STEP, F_BODY_T0
 from abrupt.model.orbit.gravity import field_acceleration
+from abrupt.model.orbit.small_forces import LOVE_K2, schwarzschild_acceleration, solid_tide_acceleration
 
 
 def _tide_coefficients(body_m: np.ndarray, mu_body: float) -> tuple[np.ndarray, np.ndarray]:
