@@ -120,8 +120,6 @@ def _attitude_run(folder: Path, toml: str, frame: pd.DataFrame | None = None, sa
     (folder / "sc.toml").write_text(toml)
     (_tumbling() if frame is None else frame).to_csv(folder / "t.csv", index=False)
     argv = ["detect", "attitude", "t.csv", "--spacecraft", "sc.toml", "--out", "e.csv", "--catalog", "c.sqlite"]
-    # 2e6 simulated event-free samples instead of the default 1e7, whose calibration holds 1.8 GB
-    argv += ["--null-samples", "2000000"]
     return Run(argv, ["t.csv", "sc.toml"], names="sc.toml|t.csv", said=said)
 
 
@@ -155,7 +153,6 @@ def _simulated(folder: Path, *damage: list[str]) -> Run:
     simulate = ["-q", "simulate", "attitude", "--duration", "3600", "--telemetry-rate", "1", "--out", "t.csv"]
     (folder / "sc.toml").write_text(THESIS_TOML.read_text())
     argv = ["detect", "attitude", "t.csv", "--spacecraft", "sc.toml", "--out", "e.csv", "--catalog", "c.sqlite"]
-    argv += ["--null-samples", "2000000"]  # the default 1e7 calibration samples hold 1.8 GB
     return Run(argv, ["t.csv", "sc.toml"], names="sc.toml|t.csv", before=[simulate, *damage])
 
 

@@ -2,7 +2,7 @@
 kinds, through the installed ``abrupt`` as a subprocess, each bounded to 60 s and 2 GB of address space.
 
 Each case builds its inputs in its own empty folder (``_audit_orbit_cases.py``, ``_audit_door_cases.py``,
-``_audit_laser_cases.py``)
+``_audit_laser_cases.py``, ``_audit_scaled_cases.py``)
 and runs there; the verdict of one run is:
 
 - ``clean error``: exit 2 and one ``error:`` line naming the file (or the key, the option) and the reason,
@@ -44,6 +44,7 @@ from _audit_cases import ROOT, Case, Run
 from _audit_door_cases import door_cases
 from _audit_laser_cases import laser_cases
 from _audit_orbit_cases import orbit_cases
+from _audit_scaled_cases import apply_edit, scaled_cases
 
 TIME_LIMIT_S = 60.0  # of processor time (RLIMIT_CPU): the machine may be shared, the wall clock is not the run's
 WALL_LIMIT_S = 300.0  # a run waiting (a lock, a read that never ends) is killed here
@@ -149,6 +150,8 @@ def _prepare(run: Run, folder: Path) -> None:
             frame.to_csv(folder / step[1], index=False)
         elif step[0] == "__aer__":
             _damage_aer(folder / step[2], step[1])
+        elif step[0] == "__edit__":  # a case's own edit of a file the steps before wrote
+            apply_edit(folder, step[1])
         else:
             code, _, err, _, _ = run_bounded(step, folder, bounded=False)
             if code != 0:
@@ -243,7 +246,9 @@ def main(argv: list[str] | None = None) -> dict[str, int]:
     args = parser.parse_args(argv)
     SOURCE[0] = args.src.resolve()
     cases = [
-        c for c in (*orbit_cases(), *door_cases(), *laser_cases()) if args.only in c.name and args.group in c.group
+        c
+        for c in (*orbit_cases(), *door_cases(), *laser_cases(), *scaled_cases())
+        if args.only in c.name and args.group in c.group
     ]
     totals: Counter[str] = Counter()
     print(f"{'group':<26} {'case':<46} {'verdict':<15} {'exit':>4} {'cpu s':>5} {'MB':>6}  detail")

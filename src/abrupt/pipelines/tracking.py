@@ -10,6 +10,7 @@ the events (one ``run_id`` and configuration hash), the fit summary and the diag
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,7 +23,7 @@ from abrupt import progress
 from abrupt.catalog import AnalysedSpan
 from abrupt.detect.tracking.glrt import GlrtManeuverDetector
 from abrupt.detect.tracking.kaderali import KaderaliManeuverDetector
-from abrupt.detect.tracking.noise_scale import calibrate_noise, misfit, residual_scales
+from abrupt.detect.tracking.noise_scale import calibrate_noise, misfit, residual_scales, single_record_outliers
 from abrupt.errors import InputError, RepairLog
 from abrupt.events import config_hash, empty_frame, new_run_id, restamp
 from abrupt.model.implied_orbit import check_implied_speeds, check_ranges_against_orbit
@@ -117,7 +118,22 @@ def read_tracking_series(
         troposphere=setup.range_troposphere and real if settings.troposphere is None else settings.troposphere,
     )
     series = TrackingSeries(data, np.asarray(setup.initial_state, float), fit_cfg, name=name or Path(file).stem)
+    series = without_single_record_outliers(series, repairs)
     return TrackingInputs(series, force, use_refraction, biases, accel, repairs, epoch)
+
+
+def without_single_record_outliers(series: TrackingSeries, repairs: RepairLog) -> TrackingSeries:
+    """``series`` without the measurements that disagree with both neighbours
+    (:func:`~abrupt.detect.tracking.noise_scale.single_record_outliers` of its orbit fit), counted in
+    ``repairs``: one bad record is never a maneuver. The same series (and its fit) when there is none."""
+    fit = series.orbit_fit()
+    bad = single_record_outliers(series.data, fit, residual_scales(series.data, fit).noise)
+    if not bad.any():
+        return series
+    data = copy.copy(series.data)
+    data.y = np.where(bad, np.nan, series.data.y)
+    repairs.record("single-record outliers (disagree with both neighbours) removed", int(bad.sum()))
+    return TrackingSeries(data, series.x0_apriori_m_mps, series.fit_config, name=series.name)
 
 
 MAX_SPAN_FROM_EPOCH_S = 60 * 86_400.0  # [s] measurements this far from the a-priori epoch cannot be fitted

@@ -42,7 +42,7 @@ from sgp4.api import WGS72, Satrec
 
 from abrupt.errors import InputError, RepairLog, printable, quote
 from abrupt.readers.compression import read_bytes
-from abrupt.readers.tle_checks import check_element_history, check_orbit_envelope
+from abrupt.readers.tle_checks import check_element_history, check_orbit_envelope, drop_isolated_elements
 
 logger = logging.getLogger(__name__)
 
@@ -400,7 +400,7 @@ def history_from_sets(
             replaced += 1
         by_epoch[key_ms] = unique[k]
     repairs.record("same-epoch element sets replaced", replaced)
-    final = [by_epoch[k] for k in sorted(by_epoch)]
+    final = drop_isolated_elements([by_epoch[k] for k in sorted(by_epoch)], repairs)
     check_element_history(final, source, repairs)
     name = next((s.name for s in final if s.name), None)
     return ElementHistory(elements_frame(final), [s.satrec for s in final], source, name, repairs, list(skipped))

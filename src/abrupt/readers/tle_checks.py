@@ -70,6 +70,13 @@ def check_orbit_envelope(satrec: Any, file: str, line: int | None, now_unix_s: f
             file=file,
             line=line,
         )
+    if not 1.0 <= float(satrec.epochdays) < 367.0:
+        raise InputError(
+            f"epoch day of year {float(satrec.epochdays):.8g} is outside 1-366 (it would be read as another year)",
+            file=file,
+            line=line,
+            column=21,
+        )
     now = time.time() if now_unix_s is None else now_unix_s
     epoch_unix_s = (_epoch_days(satrec) - JD_UNIX_EPOCH) * 86400.0
     if epoch_unix_s > now + FUTURE_MARGIN_DAYS * 86400.0:
@@ -123,3 +130,62 @@ def _check_isolated_jumps(sets: Sequence[Any], source: str) -> None:
                 file=source,
                 line=sets[k].line,
             )
+
+
+TLE_ISOLATED_ELEMENTS = "element sets whose inclination, eccentricity or node departs from both neighbours (dropped)"
+ISOLATED_NEIGHBOUR_DAYS = 30.0  # neighbours further apart than this are not compared
+ISOLATED_LIMITS = (
+    # element, absolute floor, multiple of the neighbours' own difference
+    ("inclination", math.radians(0.5), 5.0),
+    ("eccentricity", 0.005, 5.0),
+    ("node", math.radians(1.0), 0.2),
+)
+
+
+def _wrap_rad(x: float) -> float:
+    return (x + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def drop_isolated_elements(sets: Sequence[Any], repairs: RepairLog) -> list[Any]:
+    """The epoch-ordered ``sets`` without those whose inclination, eccentricity or right ascension of the
+    node departs from both neighbours while the neighbours agree (a field written in another unit, one
+    corrupted set), counted in ``repairs``: no manoeuvre changes an element and changes it back.
+
+    The node is compared with its linear interpolation between the neighbours (it drifts steadily under
+    J2), as the displacement of the orbit pole (ΔΩ sin i); inclination and eccentricity with the
+    neighbours' mean. A departure counts when it exceeds both
+    the floor of :data:`ISOLATED_LIMITS` (0.5°, 0.005, 1°: far beyond element-set noise) and its multiple of
+    the neighbours' own difference. Mean motion is checked separately (:func:`check_element_history`).
+    """
+    n = len(sets)
+    departure = {name: [0.0] * n for name, _, _ in ISOLATED_LIMITS}
+    beyond = {name: [False] * n for name, _, _ in ISOLATED_LIMITS}
+    for k in range(1, n - 1):
+        a, b, c = sets[k - 1].satrec, sets[k].satrec, sets[k + 1].satrec
+        span = _epoch_days(c) - _epoch_days(a)
+        if not 0.0 < span <= ISOLATED_NEIGHBOUR_DAYS:
+            continue
+        frac = (_epoch_days(b) - _epoch_days(a)) / span
+        for name, floor, multiple in ISOLATED_LIMITS:
+            if name == "node":
+                step = _wrap_rad(float(c.nodeo) - float(a.nodeo))
+                # the orbit pole moves by ΔΩ sin i: near the equator the node itself is ill-defined
+                pole = math.sin(0.5 * (float(a.inclo) + float(c.inclo)))
+                step *= pole
+                here = pole * _wrap_rad(float(b.nodeo) - (float(a.nodeo) + frac * step / max(pole, 1e-12)))
+            else:
+                attr = "inclo" if name == "inclination" else "ecco"
+                step = float(getattr(c, attr)) - float(getattr(a, attr))
+                here = float(getattr(b, attr)) - 0.5 * (float(getattr(a, attr)) + float(getattr(c, attr)))
+            departure[name][k] = abs(here)
+            beyond[name][k] = abs(here) > max(floor, multiple * abs(step))
+    # the bad set is where the departure peaks: its neighbours depart by about half as much
+    keep = [
+        not any(
+            beyond[name][k] and departure[name][k] > max(departure[name][k - 1], departure[name][k + 1])
+            for name, _, _ in ISOLATED_LIMITS
+        )
+        for k in range(n)
+    ]
+    repairs.record(TLE_ISOLATED_ELEMENTS, keep.count(False))
+    return [s for s, kept in zip(sets, keep, strict=True) if kept]

@@ -26,6 +26,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from abrupt.model.orbit.batch_fit import BatchFit
 from abrupt.model.tracking_measurements import TrackingArrays
@@ -39,6 +40,9 @@ PASS_GAP_S = 900.0
 """Consecutive measurements of one station further apart than this belong to different passes [s]."""
 MISFIT_RATIO = 2.5
 """The fit does not describe the data when its residuals' scale exceeds this many noise levels."""
+OUTLIER_SIGMA = 6.0
+"""A record departing from both neighbours by more than this many of its standard deviations is an
+outlier (a Gaussian record does so with probability 2e-9)."""
 
 
 @dataclass(frozen=True)
@@ -77,6 +81,37 @@ def residual_scales(data: TrackingArrays, fit: BatchFit) -> ResidualScales:
         return ResidualScales(math.nan, total, int(d.size), int(r.size))
     noise = float(robust_scale(d)) / math.sqrt(6.0)
     return ResidualScales(noise, total, int(d.size), int(r.size))
+
+
+def single_record_outliers(data: TrackingArrays, fit: BatchFit, noise: float) -> NDArray[np.bool_]:
+    """Measurements (a mask over ``data.y``) that disagree with both neighbours of their station, type and
+    pass: a single bad record, which a detector would otherwise take for a maneuver.
+
+    On the fit's whitened residuals r, a record's departure from its neighbours' mean,
+    e = r_i − (r_{i−1} + r_{i+1})/2 (standard deviation √1.5 noise), must exceed
+    :data:`OUTLIER_SIGMA` of that, and exceed the neighbours' own disagreement |r_{i+1} − r_{i−1}|: a
+    step (a bias or a product join, where e is half the neighbours' difference) and a maneuver's smooth
+    signature are left alone. The fit need not hold the maneuvers; a first or last record of a pass has no
+    two neighbours and is kept.
+    """
+    out = np.zeros(data.y.shape, dtype=bool)
+    used = fit.used
+    r, rows, comp = fit.residuals_white[used], fit.row_index[used], fit.row_component[used]
+    if r.size < 3 or not math.isfinite(noise) or noise <= 0:
+        return out
+    t = data.t_s[rows]
+    codes = np.unique(np.asarray(data.station_names, dtype=object)[rows], return_inverse=True)[1]
+    order = np.lexsort((t, comp, codes))
+    dt = np.diff(t[order])
+    same = (np.diff(codes[order]) == 0) & (np.diff(comp[order]) == 0) & (dt <= PASS_GAP_S) & (dt > 0)
+    both = same[:-1] & same[1:]
+    rs = r[order]
+    departure = rs[1:-1] - 0.5 * (rs[:-2] + rs[2:])
+    neighbours = np.abs(rs[2:] - rs[:-2])
+    bad = both & (np.abs(departure) > OUTLIER_SIGMA * math.sqrt(1.5) * noise) & (np.abs(departure) > neighbours)
+    centre = order[1:-1][bad]
+    out[rows[centre], comp[centre]] = True
+    return out
 
 
 def calibration_factor(scales: ResidualScales) -> float:
