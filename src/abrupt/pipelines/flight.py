@@ -15,7 +15,8 @@ Harris et al. 2025 §3.3-3.5, §3.7 and Bennett 2022 ch. 4, driven entirely by t
 3. :func:`run_flight` runs chunk by chunk (memory flat in the number of days); the detector fits the
    threshold on the spacecraft's own statistic at the stated false-alarm rate per day (robust Gumbel fit
    of block maxima, refitted without the events on a crowded day:
-   :meth:`~abrupt.detect.attitude.flight_glr.FlightGlrDetector.fit_threshold_crowd`) and writes the events.
+   :meth:`~abrupt.detect.attitude.flight_glr.FlightGlrDetector.fit_threshold_crowd`) and writes the events
+   of the peaks above it also above their local level (:func:`~abrupt.detect.attitude.flight_glr.local_level`).
 
 Injection: :mod:`abrupt.pipelines.flight_injection`; attribution and fault scans:
 :mod:`abrupt.pipelines.flight_attribution`, :mod:`abrupt.pipelines.flight_faults`.
