@@ -38,6 +38,7 @@ from threadpoolctl import threadpool_limits
 
 from abrupt.clean.comb import CombConfig, estimate_period
 from abrupt.clean.flight_masks import SlewMaskConfig, event_mask, flag_intervals, slew_mask
+from abrupt.detect.attitude.attribution import classify
 from abrupt.detect.attitude.evidence import EventEvidence, event_evidence, profile_fits
 from abrupt.detect.attitude.flight_glr import (
     LOCAL_REACH_S,
@@ -426,7 +427,8 @@ def process_span(
     )
     peaks = [(i, replace(p, dH_N_Nms=revised[p.time_ns][0]) if p.time_ns in revised else p) for i, p in peaks]
     peaks, evidence = peaks + beside, {**evidence, **{t: e for t, (_, e) in revised.items()}, **beside_ev}
-    peaks = detector.with_local_levels(peaks, stat, g)
+    strikes = {t for t, e in evidence.items() if classify(e).kind == "strike"}
+    peaks = detector.with_local_levels(peaks, stat, g, exempt=strikes)
     ratio_times, ratios = detector.null_ratios(stat, g, dt, keep=core)
     faults = scan_span(samples, flight, table, spacecraft, ok, start_ns, end_ns)
     edges = [start_ns, end_ns]
