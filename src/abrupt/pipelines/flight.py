@@ -581,8 +581,8 @@ def run_flight(
     peaks, grid_hz = [p for r in chunks for p in r.peaks], flight_channels(spacecraft).grid_hz
     blocks, subs = [r.block_maxima for r in chunks], [r.sub_blocks for r in chunks]
     threshold = detector.fit_threshold_crowd(blocks, subs, peaks, config.budget, grid_hz)
-    days = sum(r.n_analysed for r in chunks) / (86_400.0 * grid_hz)
-    ratio_level = local_ratio_level(np.concatenate([r.peak_ratios for r in chunks]), config.budget, days)
+    analysed_days = sum(r.n_analysed for r in chunks) / (86_400.0 * grid_hz)
+    ratio_level = local_ratio_level(np.concatenate([r.peak_ratios for r in chunks]), config.budget, analysed_days)
     if math.isfinite(ratio_level):
         threshold = replace(threshold, method=f"{threshold.method}; {ratio_level:.1f}x the local level")
     run_id = run_id or new_run_id()
