@@ -15,7 +15,8 @@ Harris et al. 2025 §3.3-3.5, §3.7 and Bennett 2022 ch. 4, driven entirely by t
 3. :func:`run_flight` runs chunk by chunk (memory flat in the number of days); the detector fits the
    threshold on the spacecraft's own statistic at the stated false-alarm rate per day (robust Gumbel fit
    of block maxima, refitted without the events on a crowded day:
-   :meth:`~abrupt.detect.attitude.flight_glr.FlightGlrDetector.fit_threshold_crowd`) and writes the events.
+   :meth:`~abrupt.detect.attitude.flight_glr.FlightGlrDetector.fit_threshold_crowd`) and writes the events
+   of the peaks above it also above their local level (:func:`~abrupt.detect.attitude.flight_glr.local_level`).
 
 Injection: :mod:`abrupt.pipelines.flight_injection`; attribution and fault scans:
 :mod:`abrupt.pipelines.flight_attribution`, :mod:`abrupt.pipelines.flight_faults`.
@@ -37,6 +38,7 @@ from threadpoolctl import threadpool_limits
 
 from abrupt.clean.comb import CombConfig, estimate_period
 from abrupt.clean.flight_masks import SlewMaskConfig, event_mask, flag_intervals, slew_mask
+from abrupt.detect.attitude.attribution import classify
 from abrupt.detect.attitude.evidence import EventEvidence, event_evidence, profile_fits
 from abrupt.detect.attitude.flight_glr import (
     LOCAL_REACH_S,
@@ -425,7 +427,8 @@ def process_span(
     )
     peaks = [(i, replace(p, dH_N_Nms=revised[p.time_ns][0]) if p.time_ns in revised else p) for i, p in peaks]
     peaks, evidence = peaks + beside, {**evidence, **{t: e for t, (_, e) in revised.items()}, **beside_ev}
-    peaks = detector.with_local_levels(peaks, stat, g)
+    strikes = {t for t, e in evidence.items() if classify(e).kind == "strike"}
+    peaks = detector.with_local_levels(peaks, stat, g, exempt=strikes)
     ratio_times, ratios = detector.null_ratios(stat, g, dt, keep=core)
     faults = scan_span(samples, flight, table, spacecraft, ok, start_ns, end_ns)
     edges = [start_ns, end_ns]
@@ -578,8 +581,8 @@ def run_flight(
     peaks, grid_hz = [p for r in chunks for p in r.peaks], flight_channels(spacecraft).grid_hz
     blocks, subs = [r.block_maxima for r in chunks], [r.sub_blocks for r in chunks]
     threshold = detector.fit_threshold_crowd(blocks, subs, peaks, config.budget, grid_hz)
-    days = sum(r.n_analysed for r in chunks) / (86_400.0 * grid_hz)
-    ratio_level = local_ratio_level(np.concatenate([r.peak_ratios for r in chunks]), config.budget, days)
+    analysed_days = sum(r.n_analysed for r in chunks) / (86_400.0 * grid_hz)
+    ratio_level = local_ratio_level(np.concatenate([r.peak_ratios for r in chunks]), config.budget, analysed_days)
     if math.isfinite(ratio_level):
         threshold = replace(threshold, method=f"{threshold.method}; {ratio_level:.1f}x the local level")
     run_id = run_id or new_run_id()

@@ -24,6 +24,7 @@ one threshold for the whole run (:meth:`~FlightGlrDetector.fit_threshold`, :meth
 from __future__ import annotations
 
 import math
+from collections.abc import Set
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -259,11 +260,16 @@ class FlightGlrDetector(Detector[CleanedMomentum]):
         return 2.0 * (self.window_s + self.guard_s)
 
     def with_local_levels(
-        self, found: list[tuple[int, Peak]], stat: FloatArray, time_ns: IntArray
+        self, found: list[tuple[int, Peak]], stat: FloatArray, time_ns: IntArray, exempt: Set[int] = frozenset()
     ) -> list[tuple[int, Peak]]:
-        """``found`` with each peak's :func:`local_level` of ``stat`` (the statistic of the whole stretch)."""
+        """``found`` with each peak's :func:`local_level` of ``stat`` (the statistic of the whole stretch);
+        peaks at the times of ``exempt`` keep none (no local test: an impulsive step whose evidence is a
+        strike's, which a wander never is, or a step found beside a neighbour's fitted change)."""
         guard = self.local_guard_s
-        return [(i, replace(p, local_level=local_level(stat, time_ns, p.time_ns, guard))) for i, p in found]
+        return [
+            (i, p if p.time_ns in exempt else replace(p, local_level=local_level(stat, time_ns, p.time_ns, guard)))
+            for i, p in found
+        ]
 
     def null_ratios(
         self, stat: FloatArray, time_ns: IntArray, dt: float, keep: BoolArray | None = None
