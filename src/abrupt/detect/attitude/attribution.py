@@ -399,7 +399,8 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
     # a sequence: a venting train's pulse, however isolated in time it looks.
     in_sequence = r.step_alone and _finite(ev.step_sharp_siblings) and ev.step_sharp_siblings > 0
     # 3a. An attitude sensor's step: the wheels did not take it up (hypotheses compared).
-    if lasting and impulsive and (sensor := attitude_sensor_step(ev, r)) is not None:
+    sensor = attitude_sensor_step(ev, r)
+    if lasting and impulsive and sensor is not None:
         return sensor
     # 3b. A momentum dump: a lasting external step against the momentum the wheels hold.
     if (p_dump := momentum_dump(ev, r)) > 0 and abs(ev.lasting_fraction) >= r.lasting_min:
@@ -415,15 +416,15 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
         )
     # 4c. A leak is a ramp and a venting sequence a train of impulses, each along one body direction: the
     # steps they make point one way. A step at the event that no other step of the window shares the
-    # direction of is an impulse of its own.
+    # direction of is an impulse of its own, unless the wheels never took it up (an attitude sensor's, 3a).
     if r.step_alone and _alone(ev, r) and body_moved and in_raw:
-        return Attribution(
+        return sensor or Attribution(
             "strike", _confidence([True, True, False, surface_ok]), "", "impulsive step, alone in its body direction"
         )
     # 4d. An impulse beside the window's other steps (a leak's ramp along it, a neighbour's lasting change)
     # that no impulse of the window which moved the body shares the direction of.
     if r.step_sharp and _sharp_alone(ev, r) and body_moved and in_raw and not in_sequence:
-        return Attribution(
+        return sensor or Attribution(
             "strike", _confidence([True, True, False, surface_ok]), "", "impulsive step beside the window's other steps"
         )
     if abs(ev.lasting_fraction) >= r.lasting_min and (not impulsive or not body_moved or in_sequence):
