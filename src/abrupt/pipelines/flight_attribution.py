@@ -24,13 +24,20 @@ has, and a step found by several rescans is one new peak (:func:`merge_found`).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import fields, replace
 
 import numpy as np
 import pandas as pd
 
-from abrupt.detect.attitude.attribution import DUMP_REASON, Attribution, AttributionRules, classify
+from abrupt.detect.attitude.attribution import (
+    DUMP_REASON,
+    Attribution,
+    AttributionRules,
+    classify,
+    compare_hypotheses,
+)
 from abrupt.detect.attitude.evidence import EventEvidence, event_evidence, profile_fits, profile_key
 from abrupt.detect.attitude.flight_glr import FlightGlrDetector, Peak
 from abrupt.detect.attitude.ramp_step import (
@@ -422,9 +429,14 @@ SAME_SEQUENCE_S = 60.0
 SAME_SEQUENCE_DEG = 20.0
 
 
-def _impulsive(a: Attribution) -> bool:
-    """An impulsive step by its own evidence: a strike, or a dump's step (a ramp's piece is neither)."""
-    return a.kind == "strike" or a.reason == DUMP_REASON
+def _impulsive(a: Attribution, ev: EventEvidence, rules: AttributionRules | None = None) -> bool:
+    """An impulsive step by its own evidence: a strike, or a dump's step whose time profile is an impulse's
+    (a ramp's piece is neither, nor a piece of a longer torque that points against the stored momentum)."""
+    if a.kind == "strike":
+        return True
+    extended = compare_hypotheses(ev).extended
+    limit = math.log((rules or AttributionRules()).extended_lr_min)
+    return a.reason == DUMP_REASON and not extended > limit
 
 
 def _shifted(h: FloatArray, g: np.ndarray, steps: list[tuple[int, FloatArray]]) -> FloatArray:
@@ -508,7 +520,7 @@ def neighbours_apart(
             table, _shifted(cleaned_H_N, g, out_new), spacecraft, t_new, s2,
             inertia_kgm2=inertia_kgm2, raw_H_N=_shifted(raw_H_N, g, out_new),
         )  # fmt: skip
-        if not _impulsive(classify(ev2, rules)):
+        if not _impulsive(classify(ev2, rules), ev2, rules):
             continue
         out_pk = [(t, s) for t, s in out_new if t != pk.time_ns] + [(t_new, s2)]
         ev1 = event_evidence(

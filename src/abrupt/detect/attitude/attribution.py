@@ -16,15 +16,22 @@ The rules read the evidence of :mod:`abrupt.detect.attitude.evidence`; none is f
    momentum changed, while the body never felt it (body share below ``body_share_min`` and below
    ``body_sigma`` times its noise), and the change is not one the minimum-norm controller makes
    (null-space part, or one wheel carrying it);
-3b. **external_non_strike** when a lasting step is a momentum dump: ΔH against the
-    momentum the wheels held, the likelihood ratio of that hypothesis to a strike's random direction
-    beyond ``dump_lr_min`` (:func:`momentum_dump`, :mod:`abrupt.detect.attitude.dump_evidence`); its
-    confidence is the dump's posterior probability at even prior odds;
+3a. **sensor_fault** when a lasting impulsive step is an attitude sensor's by the hypotheses compared
+    (:func:`compare_hypotheses`): the wheels did not take it up (take-up about 0, not about 1), the
+    likelihood ratio beyond ``sensor_lr_min``; the gyro whose mismatch with the tracker changed slope, else
+    the tracker; its confidence is that hypothesis's posterior probability at even prior odds;
+3b. **external_non_strike** when a lasting step is a momentum dump: ΔH against the momentum the wheels
+    held or in the cone of the thrusters that unload them, likelier than any other direction, and with
+    the time profile (a pulse train of seconds is no impulse) the likelihood ratio of the dump to the strike
+    beyond ``dump_lr_min`` (:func:`momentum_dump`, :mod:`abrupt.detect.attitude.dump_evidence`,
+    :mod:`abrupt.detect.attitude.signal_models`); its confidence is the dump's posterior probability at
+    even prior odds;
 4. **strike** when the sensors agree, the body took the impulse first (body share), the step lasts,
    is in the momentum before cleaning too (``raw_step_fraction``) and is impulsive (its duration
-   interval reaches below ``impulsive_s``) and no other impulse of the window that moved the body shares
-   its body direction (a venting train's pulse has such siblings; a wheel reading's glitch or miscount
-   beside a strike is none); or (4b, only with ``step_on_ramp``, off by default),
+   interval reaches below ``impulsive_s`` and a torque of some duration does not fit it better by
+   ``extended_lr_min``, BIC-penalised: :func:`compare_hypotheses`) and no other impulse of the window
+   that moved the body shares its body direction (a venting train's pulse has such siblings; a wheel
+   reading's glitch or miscount beside a strike is none); or (4b, only with ``step_on_ramp``, off by default),
    inside a ramp or a sequence, the step at the event is impulsive and off the ramp's body direction;
    or (4c, ``step_alone``, on), inside a ramp or a sequence, no other step of the window shares the
    event's step's body direction (:func:`abrupt.detect.attitude.ramp_step.step_siblings`) and that
@@ -392,7 +399,8 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
     # a sequence: a venting train's pulse, however isolated in time it looks.
     in_sequence = r.step_alone and _finite(ev.step_sharp_siblings) and ev.step_sharp_siblings > 0
     # 3a. An attitude sensor's step: the wheels did not take it up (hypotheses compared).
-    if lasting and impulsive and (sensor := attitude_sensor_step(ev, r)) is not None:
+    sensor = attitude_sensor_step(ev, r)
+    if lasting and impulsive and sensor is not None:
         return sensor
     # 3b. A momentum dump: a lasting external step against the momentum the wheels hold.
     if (p_dump := momentum_dump(ev, r)) > 0 and abs(ev.lasting_fraction) >= r.lasting_min:
@@ -408,15 +416,15 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
         )
     # 4c. A leak is a ramp and a venting sequence a train of impulses, each along one body direction: the
     # steps they make point one way. A step at the event that no other step of the window shares the
-    # direction of is an impulse of its own.
+    # direction of is an impulse of its own, unless the wheels never took it up (an attitude sensor's, 3a).
     if r.step_alone and _alone(ev, r) and body_moved and in_raw:
-        return Attribution(
+        return sensor or Attribution(
             "strike", _confidence([True, True, False, surface_ok]), "", "impulsive step, alone in its body direction"
         )
     # 4d. An impulse beside the window's other steps (a leak's ramp along it, a neighbour's lasting change)
     # that no impulse of the window which moved the body shares the direction of.
     if r.step_sharp and _sharp_alone(ev, r) and body_moved and in_raw and not in_sequence:
-        return Attribution(
+        return sensor or Attribution(
             "strike", _confidence([True, True, False, surface_ok]), "", "impulsive step beside the window's other steps"
         )
     if abs(ev.lasting_fraction) >= r.lasting_min and (not impulsive or not body_moved or in_sequence):
