@@ -130,3 +130,16 @@ def test_a_leaks_step_events_merge_into_its_one_event_and_a_strike_within_it_sta
     assert row["leak_duration_s"] == 900.0 and row["leak_torque_Nm"] == pytest.approx(1e-4)
     assert row["dH_Nms"] == pytest.approx(np.hypot(0.05, 0.07)) and "thruster leak" in row["kind_reason"]
     assert pd.Timestamp(row["time_utc"].rstrip("Z")) == pd.Timestamp(np.datetime64(T0 + 1000 * NS, "ns"))
+
+
+def test_a_ramp_that_ends_or_begins_at_a_sensor_fault_is_the_faults() -> None:
+    """A gyro bias step moves the measured momentum and then drifts: the ramp it leaves is not a leak."""
+    leak = LeakFinding(T0 + 1000 * NS, T0 + 1600 * NS, np.array([1e-4, 0, 0]), np.array([0.06, 0, 0]), 20.0, 5.5,
+                       0.025, 300.0, np.array([0.06, 0.0, 0.0]))  # fmt: skip
+    for fault_s, kept in ((1590, 0), (1040, 0), (1300, 1), (1800, 1)):
+        rows = [_event("sensor_fault", "attitude.fault_scan", T0 + fault_s * NS)]
+        out = merge_leaks(events_frame(rows), [leak], "SC", "r", "h")
+        assert int((out["detector"] == LEAK_DETECTOR).sum()) == kept, fault_s
+        assert out.attrs["leaks_explained_by_faults"] == 1 - kept
+    out = merge_leaks(events_frame([]), [leak], "SC", "r", "h")
+    assert int((out["detector"] == LEAK_DETECTOR).sum()) == 1

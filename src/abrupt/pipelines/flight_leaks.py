@@ -8,6 +8,11 @@ taken out (:mod:`abrupt.pipelines.flight_cleaning`); a step event it still raise
 interval (± ``LEAK_MARGIN_S``) classed ``external_non_strike`` or ``unknown`` is the leak's (the step
 detector answers its onset and end) and is dropped, counted in ``attrs["leak_events_absorbed"]``. A strike
 within a leak is a step on the ramp and keeps its own event, and so does a sensor fault.
+
+A ramp that begins or ends within ``FAULT_MARGIN_S`` of a sensor fault's event is that fault's: a gyro
+bias step moves the measured momentum at once and then drifts as the attitude estimate takes the bias
+in, which a ramp fits. The fault explains it, so no leak is reported (counted in
+``attrs["leaks_explained_by_faults"]``).
 """
 
 from __future__ import annotations
@@ -26,6 +31,8 @@ LEAK_DETECTOR = "attitude.leak_scan"
 STEP_DETECTOR = "attitude.flight_glr"
 #: A non-strike step event this close [s] to a leak's interval is the leak's.
 LEAK_MARGIN_S = 60.0
+#: A ramp beginning or ending this close [s] to a sensor fault's event is the fault's.
+FAULT_MARGIN_S = 120.0
 
 
 def leak_events(leaks: Sequence[LeakFinding], spacecraft: str, run_id: str, cfg_hash: str) -> pd.DataFrame:
@@ -76,13 +83,23 @@ def leak_events(leaks: Sequence[LeakFinding], spacecraft: str, run_id: str, cfg_
 def merge_leaks(
     events: pd.DataFrame, leaks: Sequence[LeakFinding], spacecraft: str, run_id: str, cfg_hash: str
 ) -> pd.DataFrame:
-    """``events`` with one event per leak added and the leaks' own step events dropped (module docstring)."""
+    """``events`` with one event per leak added and the leaks' own step events dropped, less the leaks a sensor
+    fault explains (module docstring)."""
+    n_leaks = len(leaks)
     out = events.copy()
     out.attrs["leak_events_absorbed"] = 0
-    if not leaks:
-        return out
     t_ev = event_times_ns(out)
     kinds = out["kind"].astype(str).to_numpy() if len(out) else np.empty(0, str)
+    t_fault = t_ev[kinds == "sensor_fault"]
+    fault_ns = int(FAULT_MARGIN_S * NS)
+    leaks = [
+        f
+        for f in leaks
+        if not any(np.min(np.abs(t_fault - t)) <= fault_ns for t in (f.onset_ns, f.end_ns) if t_fault.size)
+    ]
+    out.attrs["leaks_explained_by_faults"] = n_leaks - len(leaks)
+    if not leaks:
+        return out
     steps = out["detector"].astype(str).to_numpy() == STEP_DETECTOR if len(out) else np.empty(0, bool)
     margin = int(LEAK_MARGIN_S * NS)
     inside = np.zeros(len(out), bool)
@@ -95,4 +112,5 @@ def merge_leaks(
     merged["event_id"] = event_ids(merged)
     merged = merged.sort_values("time_utc", kind="stable").reset_index(drop=True)
     merged.attrs["leak_events_absorbed"] = int(drop.sum())
+    merged.attrs["leaks_explained_by_faults"] = out.attrs["leaks_explained_by_faults"]
     return merged
