@@ -118,7 +118,6 @@ def read_tracking_series(
         troposphere=setup.range_troposphere and real if settings.troposphere is None else settings.troposphere,
     )
     series = TrackingSeries(data, np.asarray(setup.initial_state, float), fit_cfg, name=name or Path(file).stem)
-    series = without_single_record_outliers(series, repairs)
     return TrackingInputs(series, force, use_refraction, biases, accel, repairs, epoch)
 
 
@@ -275,6 +274,7 @@ def detect_tracking(
     stages += ["Kaderali Ψ/K filter"] if settings.method in ("both", "kaderali") else []
     with progress.task("detect tracking", total=len(stages), unit="stage") as step:
         step.update(0, status=stages[0])
+        series = without_single_record_outliers(series, inputs.repairs)
         calibration = calibrate_noise(series)  # what the detectors run themselves; shared through the series cache
         step.update(1, status=stages[1] if len(stages) > 1 else None)
         frames, diag_frames, final_fit, glrt_thresholds = _run_detectors(calibration.series, settings, budget, step)
