@@ -306,6 +306,27 @@ def _sharp_alone(ev: EventEvidence, r: AttributionRules) -> bool:
     )
 
 
+def _impulsive_profile(ev: EventEvidence, r: AttributionRules) -> bool:
+    """The step's duration interval reaches below ``impulsive_s`` and a torque of some duration does not fit
+    it better than an impulse by ``extended_lr_min`` (:func:`compare_hypotheses`)."""
+    return (
+        _finite(ev.duration_lo_s)
+        and ev.duration_lo_s <= r.impulsive_s
+        and not compare_hypotheses(ev).extended > math.log(r.extended_lr_min)
+    )
+
+
+def _sensor_or_dump(
+    ev: EventEvidence, r: AttributionRules, sensor: Attribution | None, lasting_impulse: bool
+) -> Attribution | None:
+    """Rules 3a (``sensor``, for a lasting impulsive step) and 3b (a lasting step that is a dump), or None."""
+    if lasting_impulse and sensor is not None:
+        return sensor
+    if (p_dump := momentum_dump(ev, r)) > 0 and abs(ev.lasting_fraction) >= r.lasting_min:
+        return Attribution("external_non_strike", min(p_dump, 0.99), "", DUMP_REASON)
+    return None
+
+
 def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attribution:
     """Apply the rules of the module docstring to one event's evidence."""
     r = rules or AttributionRules()
@@ -389,22 +410,15 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
         return Attribution("unknown", 0.5, "", "evidence missing")
     lasting = ev.lasting_fraction >= r.lasting_min
     in_raw = not _finite(ev.raw_step_fraction) or ev.raw_step_fraction >= r.lasting_min
-    impulsive = (
-        _finite(ev.duration_lo_s)
-        and ev.duration_lo_s <= r.impulsive_s
-        and not compare_hypotheses(ev).extended > math.log(r.extended_lr_min)
-    )
+    impulsive = _impulsive_profile(ev, r)
     surface_ok = not (_finite(ev.surface_fraction) and ev.surface_fraction == 0.0)
     # An impulse that other impulses of the window share the direction of (same sign, within 30°) is one of
     # a sequence: a venting train's pulse, however isolated in time it looks.
     in_sequence = r.step_alone and _finite(ev.step_sharp_siblings) and ev.step_sharp_siblings > 0
-    # 3a. An attitude sensor's step: the wheels did not take it up (hypotheses compared).
+    # 3a./3b. An attitude sensor's step (the wheels did not take it up) or a momentum dump (hypotheses compared).
     sensor = attitude_sensor_step(ev, r)
-    if lasting and impulsive and sensor is not None:
-        return sensor
-    # 3b. A momentum dump: a lasting external step against the momentum the wheels hold.
-    if (p_dump := momentum_dump(ev, r)) > 0 and abs(ev.lasting_fraction) >= r.lasting_min:
-        return Attribution("external_non_strike", min(p_dump, 0.99), "", DUMP_REASON)
+    if (other := _sensor_or_dump(ev, r, sensor, lasting and impulsive)) is not None:
+        return other
     # 4./5. External.
     if lasting and impulsive and body_moved and in_raw and not in_sequence:
         return Attribution("strike", _confidence([True, True, True, surface_ok]), "", "impulsive external step")
@@ -414,9 +428,8 @@ def classify(ev: EventEvidence, rules: AttributionRules | None = None) -> Attrib
         return Attribution(
             "strike", _confidence([True, True, False, surface_ok]), "", "impulsive step on a ramp, off its direction"
         )
-    # 4c. A leak is a ramp and a venting sequence a train of impulses, each along one body direction: the
-    # steps they make point one way. A step at the event that no other step of the window shares the
-    # direction of is an impulse of its own, unless the wheels never took it up (an attitude sensor's, 3a).
+    # 4c. A leak's ramp and a venting train's impulses point one body direction: a step no other step of the
+    # window shares the direction of is an impulse of its own, unless the wheels never took it up (3a).
     if r.step_alone and _alone(ev, r) and body_moved and in_raw:
         return sensor or Attribution(
             "strike", _confidence([True, True, False, surface_ok]), "", "impulsive step, alone in its body direction"
