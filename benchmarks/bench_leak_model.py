@@ -60,9 +60,9 @@ def example(path: str | None) -> None:
     for f in scan.findings:
         j = joint_leak_fit(t, h, np.ones(n, bool), q, 5700.0, f.onset_ns, f.end_ns, np.empty(0, np.int64))
         if j is not None:
+            size = f"|ΔH_B| {np.linalg.norm(j.dH_B_Nms):.3f} ± {np.linalg.norm(j.dH_B_sigma_Nms):.3f} N·m·s"
             print(f"  joint fit (uncleaned, with trend and comb): onset {(j.onset_ns - T0) / NS:.0f} s, "
-                  f"{j.duration_s:.0f} s, |ΔH_B| {np.linalg.norm(j.dH_B_Nms):.3f} ± "
-                  f"{np.linalg.norm(j.dH_B_sigma_Nms):.3f} N·m·s, log LR over steps {j.log_lr:.0f}, kept {accepted(j)}")  # fmt: skip
+                  f"{j.duration_s:.0f} s, {size}, log LR over steps {j.log_lr:.0f}, kept {accepted(j)}")  # fmt: skip
     if path is None:
         return
     y = body_frame_momentum(h, filled_quaternions(q))

@@ -30,6 +30,9 @@ def leak_rows(folder: Path, events: pd.DataFrame) -> tuple[list[dict], int, floa
     truth = json.loads((folder / "truth_events.json").read_text())
     t0 = np.datetime64(truth["start_utc"].rstrip("Z"), "ns")
     leaks = events[events["detector"] == LEAK_DETECTOR].copy()
+    for col in ("leak_duration_s", "leak_dH_B_Nms", "false_alarms_per_day"):
+        if col not in leaks:
+            leaks[col] = pd.Series(dtype=float)
     leaks["t_s"] = (pd.to_datetime(leaks["time_utc"]).dt.tz_localize(None).to_numpy() - t0) / np.timedelta64(1, "s")
     leaks["end_s"] = leaks["t_s"] + leaks["leak_duration_s"]
     used = np.zeros(len(leaks), bool)
@@ -62,12 +65,18 @@ def main() -> None:
     rows: list[dict] = []
     free, days = 0, 0.0
     for folder in sorted(p for p in args.set_dir.iterdir() if (p / "truth_events.json").is_file()):
-        events = pd.read_csv(args.work / folder.name / "events.csv")
+        path = args.work / folder.name / "events.csv"
+        if not path.is_file():
+            print(f"{folder.name}: no events in {path.parent} (not run yet): left out")
+            continue
+        events = pd.read_csv(path)
         r, f, d, _ = leak_rows(folder, events)
         rows += r
         free += f
         days += d
-    table = pd.DataFrame(rows)
+    cols = ["spacecraft", "start_s", "duration_s", "total_Nms", "reported", "onset_err_s", "duration_err_s"]
+    table = pd.DataFrame(rows).reindex(columns=[*cols, "total_rel_err"])
+    table["reported"] = table["reported"].astype(bool)
     print(f"{len(table)} truth leaks in {days:g} spacecraft-days; per leak (errors: event less truth):")
     with pd.option_context("display.width", 200, "display.max_columns", 20, "display.float_format", "{:.3f}".format):
         print(table.to_string(index=False))

@@ -90,14 +90,15 @@ def _bins(
     during masked stretches too)."""
     k = np.floor((t_s - t_s[0]) / BIN_S).astype(np.int64)
     m = int(k[-1]) + 1
-    cnt = np.bincount(k, weights=ok.astype(float), minlength=m)
-    mean = np.stack([np.bincount(k, weights=np.where(ok, h[:, a], 0.0), minlength=m) for a in range(3)], axis=1)
-    tm = np.bincount(k, weights=np.where(ok, t_s, 0.0), minlength=m)
+    cnt = np.asarray(np.bincount(k, weights=ok.astype(float), minlength=m), dtype=np.float64)
+    sums = [np.bincount(k, weights=np.where(ok, h[:, a], 0.0), minlength=m) for a in range(3)]
+    mean: FloatArray = np.asarray(np.stack(sums, axis=1), dtype=np.float64)
+    tm = np.asarray(np.bincount(k, weights=np.where(ok, t_s, 0.0), minlength=m), dtype=np.float64)
     with np.errstate(invalid="ignore", divide="ignore"):
         mean, tm = mean / cnt[:, None], tm / cnt
     nb_cum = np.concatenate([np.zeros((1, 3, 3)), np.cumsum(dcm_nb * dt, axis=0)])
     edge_idx = np.searchsorted(k, np.arange(m + 1))
-    return cnt, mean, tm, nb_cum[edge_idx], t_s[0] + BIN_S * np.arange(m + 1)
+    return cnt, mean, tm, np.asarray(nb_cum[edge_idx], dtype=np.float64), t_s[0] + BIN_S * np.arange(m + 1.0)
 
 
 def _window(
@@ -206,8 +207,8 @@ def _best_steps(y: FloatArray, cols: FloatArray, k: int) -> tuple[float, list[in
         return rss, pick
     x = cols[:, pick]
     res = y - x @ np.linalg.lstsq(x, y, rcond=None)[0]
-    r1, j = _best_steps(res, cols - x @ np.linalg.lstsq(x, cols, rcond=None)[0], 1)
-    return r1, [*pick, *j]
+    r1, third = _best_steps(res, cols - x @ np.linalg.lstsq(x, cols, rcond=None)[0], 1)
+    return r1, [*pick, *third]
 
 
 def _less(x: FloatArray, v: FloatArray) -> FloatArray:
@@ -284,7 +285,7 @@ def joint_leak_fit(
         cov = np.linalg.inv(mat) * s2
     except np.linalg.LinAlgError:
         return None
-    amp = float(math.sqrt(max(a @ np.linalg.solve(cov, a), 0.0)))
+    amp = math.sqrt(max(float(a @ np.linalg.solve(cov, a)), 0.0))
     return JointLeak(int(t_ns[0] + t0 * NS), dur, a, np.sqrt(np.clip(np.diag(cov), 0.0, None)), log_lr, amp)
 
 
