@@ -75,3 +75,20 @@ def test_a_day_of_year_beyond_366_is_a_malformed_set_named_by_line_and_column(tm
     history = read_tle(_write(tmp_path, sets))
     assert len(history.satrecs) == len(sets) - 1
     assert any(f":{2 * k + 1}:21: epoch day of year 400.5" in str(e) for e in history.skipped)
+
+
+def test_a_bad_set_just_before_a_plane_change_is_the_only_one_dropped(tmp_path: Path) -> None:
+    """A cross-tagged set (another object's inclination and eccentricity) just before a real 1.7° plane
+    change makes the last good set before the change look isolated too (its neighbours, the bad set and the
+    first set after the change, agree); compared again once the bad set is gone, it is kept."""
+    sets = _sets(tmp_path)
+    k = len(sets) // 2
+    for s in sets[k:]:
+        s[1] = _field(s[1], 8, f"{float(s[1][8:16]) + 1.7:8.4f}")
+    bad = sets[k - 2][1]
+    bad = _field(bad, 8, f"{float(bad[8:16]) + 1.69:8.4f}")
+    sets[k - 2] = [sets[k - 2][0], _field(bad, 26, "0200000")]
+    clean = read_tle(_write(tmp_path, [s for j, s in enumerate(sets) if j != k - 2]))
+    history = read_tle(_write(tmp_path, sets))
+    assert history.repairs.as_dict()[TLE_ISOLATED_ELEMENTS] == 1
+    assert list(history.elements["epoch_utc"]) == list(clean.elements["epoch_utc"])

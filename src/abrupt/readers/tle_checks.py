@@ -146,20 +146,14 @@ def _wrap_rad(x: float) -> float:
     return (x + math.pi) % (2.0 * math.pi) - math.pi
 
 
-def drop_isolated_elements(sets: Sequence[Any], repairs: RepairLog) -> list[Any]:
-    """The epoch-ordered ``sets`` without those whose inclination, eccentricity or right ascension of the
-    node departs from both neighbours while the neighbours agree (a field written in another unit, one
-    corrupted set), counted in ``repairs``: no manoeuvre changes an element and changes it back.
-
-    The node is compared with its linear interpolation between the neighbours (it drifts steadily under
-    J2), as the displacement of the orbit pole (ΔΩ sin i); inclination and eccentricity with the
-    neighbours' mean. A departure counts when it exceeds both
-    the floor of :data:`ISOLATED_LIMITS` (0.5°, 0.005, 1°: far beyond element-set noise) and its multiple of
-    the neighbours' own difference. Mean motion is checked separately (:func:`check_element_history`).
-    """
+def _isolated_scores(sets: Sequence[Any]) -> list[float]:
+    """Per set, how far its inclination, eccentricity or node departs from both neighbours, as a multiple of
+    the limit of :data:`ISOLATED_LIMITS` (the largest over the three); 0 where no element is beyond its limit
+    or where a neighbour departs more (the bad set is where the departure peaks: its neighbours depart by
+    about half as much)."""
     n = len(sets)
     departure = {name: [0.0] * n for name, _, _ in ISOLATED_LIMITS}
-    beyond = {name: [False] * n for name, _, _ in ISOLATED_LIMITS}
+    ratio = {name: [0.0] * n for name, _, _ in ISOLATED_LIMITS}
     for k in range(1, n - 1):
         a, b, c = sets[k - 1].satrec, sets[k].satrec, sets[k + 1].satrec
         span = _epoch_days(c) - _epoch_days(a)
@@ -178,14 +172,47 @@ def drop_isolated_elements(sets: Sequence[Any], repairs: RepairLog) -> list[Any]
                 step = float(getattr(c, attr)) - float(getattr(a, attr))
                 here = float(getattr(b, attr)) - 0.5 * (float(getattr(a, attr)) + float(getattr(c, attr)))
             departure[name][k] = abs(here)
-            beyond[name][k] = abs(here) > max(floor, multiple * abs(step))
-    # the bad set is where the departure peaks: its neighbours depart by about half as much
-    keep = [
-        not any(
-            beyond[name][k] and departure[name][k] > max(departure[name][k - 1], departure[name][k + 1])
-            for name, _, _ in ISOLATED_LIMITS
+            ratio[name][k] = abs(here) / max(floor, multiple * abs(step))
+    return [
+        max(
+            (
+                ratio[name][k]
+                for name, _, _ in ISOLATED_LIMITS
+                if ratio[name][k] > 1.0 and departure[name][k] > max(departure[name][k - 1], departure[name][k + 1])
+            ),
+            default=0.0,
         )
+        if 0 < k < n - 1
+        else 0.0
         for k in range(n)
     ]
-    repairs.record(TLE_ISOLATED_ELEMENTS, keep.count(False))
-    return [s for s, kept in zip(sets, keep, strict=True) if kept]
+
+
+def drop_isolated_elements(sets: Sequence[Any], repairs: RepairLog) -> list[Any]:
+    """The epoch-ordered ``sets`` without those whose inclination, eccentricity or right ascension of the
+    node departs from both neighbours while the neighbours agree (a field written in another unit, one
+    corrupted or cross-tagged set), counted in ``repairs``: no manoeuvre changes an element and changes it
+    back.
+
+    The node is compared with its linear interpolation between the neighbours (it drifts steadily under
+    J2), as the displacement of the orbit pole (ΔΩ sin i); inclination and eccentricity with the
+    neighbours' mean. A departure counts when it exceeds both the floor of :data:`ISOLATED_LIMITS` (0.5°,
+    0.005, 1°: far beyond element-set noise) and its multiple of the neighbours' own difference. Sets are
+    dropped one cluster at a time and the rest compared again: a bad set next to a real plane change makes
+    the first good set after the change look isolated, until the bad one is gone. Mean motion is checked
+    separately (:func:`check_element_history`).
+    """
+    kept = list(sets)
+    dropped = 0
+    while True:
+        score = _isolated_scores(kept)
+        flagged = [k for k, x in enumerate(score) if x > 0.0]
+        if not flagged:
+            break
+        # of flagged sets within two places of each other, only the one departing most goes this round
+        worst = [k for k in flagged if all(score[k] >= score[j] for j in flagged if 0 < abs(j - k) <= 2)]
+        drop = set(worst)
+        kept = [s for k, s in enumerate(kept) if k not in drop]
+        dropped += len(drop)
+    repairs.record(TLE_ISOLATED_ELEMENTS, dropped)
+    return kept
