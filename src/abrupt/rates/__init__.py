@@ -148,10 +148,11 @@ by the Annex C.1.2/C.1.3 procedure (not read from Table J-6); neither table's bo
 by secondary sources (public implementations of NASA-90/91 and a design note): the NASA-90/91 constants (1.22e-5
 d^-2.5, 8.1e10 (d+700)^-6, H(d) 0.78/0.637, Φ, p, q, q'). Not checked: the SSP 30425 speed distribution, the
 debris direction/speed model, and Ψ(i), the NASA-90/91 inclination table (Kessler et al. 1991; NASA TM-100471 and
-TM-4527; ECSS-E-10-04A), of which no readable copy was found. abrupt uses the table as it is commonly reproduced
-(28.5°: 0.91, 30°: 0.92, 40°: 0.96, 50°: 1.02, 60°: 1.09, 70°: 1.26, 80°: 1.71, 90°: 1.37, 100°: 1.78, 120°:
-1.18). A public design note that copies the model from SPENVIS prints 28.5°, 50° and 100° as here, 60° and 70°
-within 0.06, and a monotone 1.4 and 1.6 at 80° and 90°; at the sun-synchronous 98° the readings differ by 2.6 %.
+TM-4527; ECSS-E-10-04A), of which no readable copy was found. abrupt uses the table as recalled from its
+reproductions (no whole copy could be read; 30°, 80°, 90° and 120° rest on that recollection alone): 28.5°: 0.91,
+30°: 0.92, 40°: 0.96, 50°: 1.02, 60°: 1.09, 70°: 1.26, 80°: 1.71, 90°: 1.37, 100°: 1.78, 120°: 1.18. A public
+design note that copies the model from SPENVIS prints 28.5°, 50° and 100° as here, 60° and 70° within 0.06,
+and a monotone 1.4 and 1.6 at 80° and 90°; at the sun-synchronous 98° the readings differ by 2.6 %.
 Ψ(45°) = 0.990 and Ψ(52°) = 1.030 quoted by two implementations agree. Per-node evidence: the comment above
 ``PSI_VALUE`` in :mod:`abrupt.rates.flux`.
 

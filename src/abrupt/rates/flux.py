@@ -65,9 +65,11 @@ METEOROID_DENSITY_KG_M3 = 2500.0  # [kg m^-3] assumed meteoroid bulk density for
 # TM-100471; Anderson & Smith 1994, NASA TM-4527; ECSS-E-10-04A), i in degrees; linear interpolation between nodes,
 # constant outside. The publication's table could not be read (the stored copies of Meshishnek 1995, SPENVIS's
 # NASA90 and metdeb pages and the ESABASE2/Debris technical description give their opening pages only, NASA TM-4527
-# and TM-100471 their catalogue records; ECSS-E-ST-10-04C has no NASA-90/91). The nodes are the table as it is
-# commonly reproduced (28.5° ... 120°: 0.91 0.92 0.96 1.02 1.09 1.26 1.71 1.37 1.78 1.18; the peaks at 80° and
-# 100° follow the 74-83° and sun-synchronous populations). Evidence per node, tested in tests/test_rates_published.py:
+# and TM-100471 their catalogue records; ECSS-E-ST-10-04C has no NASA-90/91). The nodes are the table as recalled
+# from its reproductions (28.5° ... 120°: 0.91 0.92 0.96 1.02 1.09 1.26 1.71 1.37 1.78 1.18; the peaks at 80° and
+# 100° follow the 74-83° and sun-synchronous populations); no reproduction of the whole table could be read
+# here, so 30°, 80°, 90° and 120° rest on that recollection alone. Evidence per node, tested in
+# tests/test_rates_published.py:
 # * 28.5° (and the constant value below it), 50° and 100°: as printed by a public design note that copies the model
 #   from SPENVIS ("0-28.5°: 0.91", "50°: 1.0", "100°: 1.78"); 60° and 70° within 0.06 of it (1.07 and 1.2);
 # * 40-60°: consistent with Ψ(45°) = 0.990 and Ψ(52°) = 1.030 quoted by two public implementations;
