@@ -132,6 +132,11 @@ Checks against the sources (tests in `tests/test_rates_*.py`)
 * Focusing at 400 km: Source value: ECSS-E-10-04A mean-speed factor 1 + R/r = 1.94; abrupt: 2.07 (per-speed
   form; within 10 %)
 * Debris relative speed, 30° / polar: Source value: Kessler 1988: ≈ 9 km/s / ≈ 13 km/s; abrupt: 10.1 / 12.5 km/s
+* Debris mean impact speed, 28.5° / 98°: Source value: ECSS-E-ST-10-04C J.2.2.1.3: 10 / 13 km/s; abrupt: 10.1 / 13.1
+  km/s
+* SSP 30425 speed law at its joins, 16.3 / 55 km/s: Source value: the printed pieces meet within their digits;
+  abrupt: 0.112 vs 0.11197, 1.695e-4 vs 1.693e-4 (allowed 1.9 % / 2.0 %); lower bound 11.1 km/s = v_esc at 100 km
+  (11.09)
 * Strike points for a bus alone: Source value: uniform over the silhouette, faces ∝ area·|n·d|; abrupt: χ² p >
   1e-3 for 5 random directions; KS uniform along axis views
 * Silhouette area of a 1 × 2 × 3 m box: Source value: Σ |d·n| A; abrupt: within 3 % for 50 directions
@@ -143,17 +148,23 @@ The Grün flux for m ≥ 1e-6 g is 1.49 m⁻² yr⁻¹ (4.7e-8 m⁻² s⁻¹) at
 (F1 = 47.1^−4.38 = 4.7e-8 s⁻¹ dominates); the NASA-90/91 value above is of order 1e-5, as published.
 Checked against the publications' text (tests/test_rates_published.py): Grün's F1-F3 coefficients as
 ECSS-E-ST-10-04C §10.2.4.1 Eq. 101 prints them; R_E = 6378 km, the 100 km atmosphere (Annex C.1.3) and μ (Eq.
-C-4). No ECSS table is used: the meteoroid speeds are SSP 30425's (not Table C-1's) and G, sf and K are computed
-by the Annex C.1.2/C.1.3 procedure (not read from Table J-6); neither table's body could be read. Corroborated only
-by secondary sources (public implementations of NASA-90/91 and a design note): the NASA-90/91 constants (1.22e-5
-d^-2.5, 8.1e10 (d+700)^-6, H(d) 0.78/0.637, Φ, p, q, q'). Not checked: the SSP 30425 speed distribution, the
-debris direction/speed model, and Ψ(i), the NASA-90/91 inclination table (Kessler et al. 1991; NASA TM-100471 and
-TM-4527; ECSS-E-10-04A), of which no readable copy was found. abrupt uses the table as recalled from its
-reproductions (no whole copy could be read; 30°, 80°, 90° and 120° rest on that recollection alone): 28.5°: 0.91,
-30°: 0.92, 40°: 0.96, 50°: 1.02, 60°: 1.09, 70°: 1.26, 80°: 1.71, 90°: 1.37, 100°: 1.78, 120°: 1.18. A public
+C-4). No ECSS table is used: the meteoroid speeds are SSP 30425's (not Table C-1's, which is Taylor's re-evaluation
+of Harvard Radio Meteor Project data, C.1.1) and G, sf and K are computed by the Annex C.1.2/C.1.3 procedure (Eqs.
+C-1 to C-11, C-13, C-14; not read from Table J-6); neither table's body could be read. Corroborated only by
+secondary sources (public implementations of NASA-90/91 and a design note): the NASA-90/91 constants (1.22e-5
+d^-2.5, 8.1e10 (d+700)^-6, H(d) 0.78/0.637, with H in the SPENVIS form 0.406 = 0.637², Φ, p, q, q'). Checked only
+for consistency: the SSP 30425 speed law (its pieces join; its start is the escape speed at 100 km) and the debris
+directions (mean speeds as ECSS J.2.2.1.3 and Kessler 1988 state them). Not checked against its publication: Ψ(i),
+the NASA-90/91 inclination table (Kessler et al. 1991; NASA TM-100471 and TM-4527; ECSS-E-10-04A), of which no
+readable copy was found (about 110 look-ups; sources named in :mod:`abrupt.rates.flux`). abrupt uses the table as
+recalled from its reproductions (no whole copy could be read; 30°, 80°, 90° and 120° rest on that recollection
+alone): 28.5°: 0.91, 30°: 0.92, 40°: 0.96, 50°: 1.02, 60°: 1.09, 70°: 1.26, 80°: 1.71, 90°: 1.37, 100°: 1.78,
+120°: 1.18. A public
 design note that copies the model from SPENVIS prints 28.5°, 50° and 100° as here, 60° and 70° within 0.06,
 and a monotone 1.4 and 1.6 at 80° and 90°; at the sun-synchronous 98° the readings differ by 2.6 %.
-Ψ(45°) = 0.990 and Ψ(52°) = 1.030 quoted by two implementations agree. Per-node evidence: the comment above
+Ψ(45°) = 0.990 and Ψ(52°) = 1.030 quoted by two implementations agree. The inclination mix behind the debris
+directions implies (:func:`~abrupt.rates.tables.debris_crossing_rate`, relative to 28.5°) values within 0.025 of the
+table at 30-70° and 1.61 / 1.52 / 1.58 / 1.40 at 80° / 90° / 100° / 120°. Per-node evidence: the comment above
 ``PSI_VALUE`` in :mod:`abrupt.rates.flux`.
 
 Limitations

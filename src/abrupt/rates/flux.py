@@ -63,18 +63,22 @@ METEOROID_DENSITY_KG_M3 = 2500.0  # [kg m^-3] assumed meteoroid bulk density for
 
 # Ψ(i): inclination function of NASA-90/91 (Kessler et al. 1991; Kessler, Reynolds & Anz-Meador 1989, NASA
 # TM-100471; Anderson & Smith 1994, NASA TM-4527; ECSS-E-10-04A), i in degrees; linear interpolation between nodes,
-# constant outside. The publication's table could not be read (the stored copies of Meshishnek 1995, SPENVIS's
-# NASA90 and metdeb pages and the ESABASE2/Debris technical description give their opening pages only, NASA TM-4527
-# and TM-100471 their catalogue records; ECSS-E-ST-10-04C has no NASA-90/91). The nodes are the table as recalled
-# from its reproductions (28.5° ... 120°: 0.91 0.92 0.96 1.02 1.09 1.26 1.71 1.37 1.78 1.18; the peaks at 80° and
-# 100° follow the 74-83° and sun-synchronous populations); no reproduction of the whole table could be read
-# here, so 30°, 80°, 90° and 120° rest on that recollection alone. Evidence per node, tested in
-# tests/test_rates_published.py:
+# constant outside. The publication's table could not be read. About 110 look-ups in the stored pages,
+# documentation, code and issue corpora, and four PyPI packages, found only: the opening pages of Meshishnek 1995
+# (SMC-TR-95-9), Skibinski 1991 (PL-TR-91-3001), NSS 1740.14, ECSS-E-10-04A, the ESABASE2/Debris technical
+# description and SPENVIS's NASA90 and metdeb pages; catalogue records of TM-100471, TM-4527 and Kessler 1991;
+# no repository or package that implements the table (ECSS-E-ST-10-04C has no NASA-90/91). The nodes are the table as
+# recalled from its reproductions (28.5° ... 120°: 0.91 0.92 0.96 1.02 1.09 1.26 1.71 1.37 1.78 1.18); 30°, 80°, 90°
+# and 120° rest on that recollection alone. Evidence per node, tested in tests/test_rates_published.py:
 # * 28.5° (and the constant value below it), 50° and 100°: as printed by a public design note that copies the model
 #   from SPENVIS ("0-28.5°: 0.91", "50°: 1.0", "100°: 1.78"); 60° and 70° within 0.06 of it (1.07 and 1.2);
 # * 40-60°: consistent with Ψ(45°) = 0.990 and Ψ(52°) = 1.030 quoted by two public implementations;
 # * 80° and 90°: the note prints a monotone 1.4 and 1.6 (0.31 below, 0.23 above these nodes); at the sun-synchronous
-#   98° the two readings differ by 2.6 % (1.698 here, 1.744 by the note); 30° and 120°: no readable source.
+#   98° the two readings differ by 2.6 % (1.698 here, 1.744 by the note); 30° and 120°: no readable source;
+# * the inclination dependence implied by the direction model's own inclination mix
+#   (:func:`abrupt.rates.tables.debris_crossing_rate`; the mix was chosen independently of these nodes), relative to
+#   28.5°: within 0.025 at 30-70°; 1.61, 1.52, 1.58 at 80, 90, 100° (between the two readings at 80° and 90°, 11.5 %
+#   below both at 100°); 1.40 at 120° against this node's 1.18.
 PSI_INCLINATION_DEG = np.array([28.5, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0, 100.0, 120.0])
 PSI_VALUE = np.array([0.91, 0.92, 0.96, 1.02, 1.09, 1.26, 1.71, 1.37, 1.78, 1.18])
 
@@ -184,7 +188,9 @@ def meteoroid_speed_pdf_100km(speed_mps: ArrayLike) -> NDArray[np.float64]:
 
     n(v) = 0.112 for 11.1 <= v < 16.3 km/s; 3.328e5 v^-5.34 for 16.3 <= v < 55; 1.695e-4 for
     55 <= v <= 72.2; zero outside. The lower bound 11.1 km/s is the escape speed at 100 km altitude,
-    so this module treats it as the distribution at the top of the atmosphere.
+    so this module treats it as the distribution at the top of the atmosphere. Neither SSP 30425 nor TM-4527
+    could be read; the pieces join at 16.3 and 55 km/s within their printed digits (tested). ECSS-E-ST-10-04C
+    Table C-1 is a different law (Harvard Radio Meteor Project data re-evaluated by Taylor, Annex C.1.1).
     """
     v = np.asarray(speed_mps, dtype=np.float64) / 1e3
     out = np.zeros_like(v)
@@ -230,7 +236,9 @@ def meteoroid_focusing(altitude_m: float, n_bins: int = 400) -> tuple[float, NDA
     The near-Earth (100 km) distribution :func:`meteoroid_speed_pdf_100km` is mapped to speeds at
     infinity, v_inf² = v_100² - v_esc(100 km)², whose flux weights are reduced by the Liouville factor
     v_inf²/v_100²; the flux at radius r is then enhanced per speed bin by 1 + v_esc(r)²/v_inf²
-    (ECSS-E-ST-10-04C Annex C.1.2 procedure; Öpik 1951). Returns (G, speed grid at r [m/s], pdf).
+    (ECSS-E-ST-10-04C Annex C.1.2 procedure: G per speed, Eqs. C-1 to C-3; v_esc, Eq. C-4; the flux-weighted
+    mean G of a normalised distribution, Eqs. C-5 to C-7; the distribution at r, Eqs. C-8 to C-11; Öpik 1951).
+    Returns (G, speed grid at r [m/s], pdf).
     """
     check_orbit(altitude_m)
     r100 = EARTH_RADIUS_M + ATMOSPHERE_HEIGHT_M

@@ -402,23 +402,12 @@ DEFAULT_DEBRIS_INCLINATIONS: dict[float, float] = {
 }
 
 
-def debris_crossing_directions(
-    altitude_m: float,
-    inclination_deg: float,
-    debris_inclinations: dict[float, float] | None = None,
-    *,
-    n_samples: int = 400_000,
-    seed: int = 0,
-    speed_bin_mps: float = 500.0,
-    azimuth_bin_deg: float = 5.0,
-) -> DirectionBins:
-    """Speed and azimuth of debris on circular orbits crossing a circular orbit (Kessler's geometry).
+def _crossings(
+    altitude_m: float, inclination_deg: float, debris_inclinations: dict[float, float] | None, n_samples: int, seed: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], float]:
+    """Sampled crossings of the debris mix (geometry in :func:`debris_crossing_rate`).
 
-    The spacecraft is at argument of latitude u ~ U(0, 2π); debris of inclination i_d reachable at the
-    same latitude φ crosses with heading east component cos i_d / cos φ (two branches). The relative
-    velocity is horizontal with magnitude 2 v sin(Δψ/2); each crossing is weighted by the relative speed
-    and by the debris spatial density at φ, ∝ 1/sqrt(sin² i_d - sin² φ) (uniform in argument of latitude).
-    Returns flux-weighted (speed × azimuth) bins at zero elevation.
+    Returns relative speed [m/s], azimuth of the incoming direction [rad], weight and orbital speed [m/s].
     """
     fx.check_orbit(altitude_m)
     mix = DEFAULT_DEBRIS_INCLINATIONS if debris_inclinations is None else debris_inclinations
@@ -453,6 +442,24 @@ def debris_crossing_directions(
     w = np.where(ok, speed * density, 0.0)
     if not w.sum() > 0:
         raise ConfigError("no debris inclination family crosses this orbit", key="debris_inclinations")
+    return speed, az, w, v
+
+
+def debris_crossing_directions(
+    altitude_m: float,
+    inclination_deg: float,
+    debris_inclinations: dict[float, float] | None = None,
+    *,
+    n_samples: int = 400_000,
+    seed: int = 0,
+    speed_bin_mps: float = 500.0,
+    azimuth_bin_deg: float = 5.0,
+) -> DirectionBins:
+    """Speed and azimuth of debris on circular orbits crossing a circular orbit (Kessler's geometry).
+
+    Crossings as in :func:`debris_crossing_rate`; returns flux-weighted (speed × azimuth) bins at zero elevation.
+    """
+    speed, az, w, v = _crossings(altitude_m, inclination_deg, debris_inclinations, n_samples, seed)
     s_edges = np.arange(0.0, 2 * v + speed_bin_mps, speed_bin_mps)
     a_edges = np.radians(np.arange(-180.0, 180.0 + azimuth_bin_deg, azimuth_bin_deg))
     hist, _, _ = np.histogram2d(speed, az, bins=[s_edges, a_edges], weights=w)
@@ -460,6 +467,28 @@ def debris_crossing_directions(
     weight = hist[si, ai] / hist.sum()
     zeros = np.zeros(si.size)
     return DirectionBins(s_edges[si], s_edges[si + 1], a_edges[ai], a_edges[ai + 1], zeros, zeros.copy(), weight)
+
+
+def debris_crossing_rate(
+    altitude_m: float,
+    inclination_deg: float,
+    debris_inclinations: dict[float, float] | None = None,
+    *,
+    n_samples: int = 400_000,
+    seed: int = 0,
+) -> float:
+    """Relative rate at which the debris mix crosses a circular orbit [m/s × arbitrary density units].
+
+    The spacecraft is at argument of latitude u ~ U(0, 2π); debris of inclination i_d reachable at the
+    same latitude φ crosses with heading east component cos i_d / cos φ (two branches). The relative
+    velocity is horizontal with magnitude 2 v sin(Δψ/2); each crossing is weighted by the relative speed
+    and by the debris spatial density at φ, ∝ 1/sqrt(sin² i_d - sin² φ) (uniform in argument of latitude).
+    Only ratios between inclinations mean anything: they are the inclination dependence the mix implies,
+    the construction by which NASA-90/91 bases its inclination dependence on the catalogued objects'
+    inclinations (NRC, nap.edu record 5532, p. 19); compared with Ψ(i) in tests/test_rates_published.py.
+    """
+    _, _, w, _ = _crossings(altitude_m, inclination_deg, debris_inclinations, n_samples, seed)
+    return float(np.mean(w))
 
 
 def meteoroid_directions(
