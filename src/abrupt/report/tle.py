@@ -28,6 +28,13 @@ def _utc(values: Any) -> pd.DatetimeIndex:
     return pd.DatetimeIndex(pd.to_datetime(pd.Series(values).astype(str), utc=True, format="ISO8601")).tz_localize(None)
 
 
+def report_title(history: ElementHistory, maneuvers: int) -> str:
+    """The figure's title: the satellite's name (3LE name line, OMM ``OBJECT_NAME``), else, for a plain
+    two-line file, the name of the file it was read from, with its NORAD number and the maneuvers drawn."""
+    label = history.name or Path(history.source).name or "satellite"
+    return f"{label} (NORAD {history.norad_id}): {maneuvers} maneuver(s)"
+
+
 def plot_tle_report(
     history: ElementHistory,
     events: pd.DataFrame,
@@ -113,8 +120,7 @@ def plot_tle_report(
     if axes[0].get_legend_handles_labels()[0]:
         axes[0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
     axes[0].set_title(
-        (title or f"{history.name or 'satellite'} (NORAD {history.norad_id}): {len(shown)} maneuver(s)")
-        + (f" — {summary}" if summary else ""),
+        (title or report_title(history, len(shown))) + (f" — {summary}" if summary else ""),
         pad=14,  # room for the truth triangles on the panel's top edge
     )
     return save_figure(fig, out)
