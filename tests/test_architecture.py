@@ -24,13 +24,14 @@ SRC = Path(__file__).resolve().parent.parent / "src" / "abrupt"
 #: those series, cleaning, the models that use clean data, the detectors, the tools that run detectors
 #: (simulators, density), the orchestration, and the faces (reports, command line, the Python API).
 LAYERS: dict[str, int] = {
-    "abrupt": 0,  # abrupt/__init__.py: the version only
+    "abrupt": 0,  # abrupt/__init__.py: the version and the numba cache folder
     "types": 0,
     "errors": 0,
     "units": 0,
     "progress": 0,
     "kinds": 0,
     "outputs": 0,
+    "jit_cache": 0,
     "events": 1,
     "thresholds": 1,
     "store": 1,

@@ -6,3 +6,7 @@ predicts how many detectable events a spacecraft should see per year.
 """
 
 __version__ = "0.1.0"
+
+from abrupt.jit_cache import use_keyed_numba_cache
+
+use_keyed_numba_cache(__version__)
