@@ -74,26 +74,11 @@ from basilisk_dynamics import (
     slew_profile,
     whole_inertia,
 )
+from basilisk_kinds import CONFOUNDER_KINDS, DYNAMIC_KINDS
 from basilisk_sensors import DAY_S, START_ISO, gyro, housekeeping, iso_utc, star_tracker, tachometers, write_archive
 from basilisk_sensors import Channel as Channel
 
 NAMES = ("HERON", "OSPREY", "PLOVER", "TERN", "AVOCET", "GANNET")
-SENSOR_KINDS = ("star_tracker_jump", "gyro_spike", "gyro_bias_step", "tachometer_miscount", "wheel_glitch")
-DYNAMIC_KINDS = ("venting", "unflagged_dump", "leak", "appendage_snap")
-CONFOUNDER_KINDS = SENSOR_KINDS + DYNAMIC_KINDS
-#: The class an ideal attribution gives each kind.
-EXPECTED_CLASS = {
-    "strike": "strike",
-    "star_tracker_jump": "sensor_fault",
-    "gyro_spike": "sensor_fault",
-    "gyro_bias_step": "sensor_fault",
-    "tachometer_miscount": "sensor_fault",
-    "wheel_glitch": "sensor_fault",
-    "venting": "external_non_strike",
-    "unflagged_dump": "external_non_strike",
-    "leak": "external_non_strike",
-    "appendage_snap": "internal",
-}
 
 
 def _rotation(rng: np.random.Generator, angle_deg: float) -> np.ndarray:

@@ -40,21 +40,10 @@ import pandas as pd
 import abrupt
 from abrupt.errors import ConfigError
 from abrupt.model.spacecraft import load_spacecraft
+from basilisk_kinds import EXPECTED_CLASS
 
 STRIKE_MIN_NMS = 0.05
 SENSOR_CHANNEL = {"star_tracker_jump": "star_tracker", "gyro_spike": "gyro", "gyro_bias_step": "gyro"}
-EXPECTED_CLASS = {
-    "strike": "strike",
-    "star_tracker_jump": "sensor_fault",
-    "gyro_spike": "sensor_fault",
-    "gyro_bias_step": "sensor_fault",
-    "tachometer_miscount": "sensor_fault",
-    "wheel_glitch": "sensor_fault",
-    "venting": "external_non_strike",
-    "unflagged_dump": "external_non_strike",
-    "leak": "external_non_strike",
-    "appendage_snap": "internal",
-}
 
 
 def thruster_lines(sc: dict) -> list[str]:

@@ -52,6 +52,12 @@ TOLERANCE_S = 86400.0
 NULL_YEARS = 4.0
 
 
+def detection_times(found: pd.DataFrame) -> list[pd.Timestamp]:
+    """The detections' times (UTC, naive): the maneuvers the own null's quiet mask keeps away from (no
+    truth used)."""
+    return list(pd.to_datetime(found["time_utc"].astype(str), utc=True).dt.tz_localize(None))
+
+
 def spliced(first: ElementHistory, second: ElementHistory, after_days: float) -> ElementHistory:
     """``first`` up to ``after_days``, then ``second`` (same epochs and orbit: a noise change inside)."""
     el = first.elements
@@ -125,7 +131,7 @@ def run_one(job: dict[str, Any]) -> dict[str, Any]:
         row[f"unmatched_{follow}"] = unmatched
         row[f"rate_{follow}"] = unmatched / years
         if follow == "raise":
-            known = list(pd.to_datetime(found["time_utc"].astype(str), utc=True).dt.tz_localize(None))
+            known = detection_times(found)
             own = own_null_rate(history, known, BUDGET, years=NULL_YEARS, seeds=range(job["null_seeds"]))
             row.update(own_fa=own.false_alarms, own_years=own.sat_years, own_rate=own.rate_per_year)
             lo, hi = own.interval_per_year()

@@ -20,19 +20,14 @@ from __future__ import annotations
 
 import argparse
 import time
-from pathlib import Path
-
-import pandas as pd
 
 from abrupt.detect.tle.detectors import detector_for
 from abrupt.readers.tle import read_tle
 from abrupt.simulate.tle_own_null import own_null_by_year, poisson_interval
-from abrupt.thresholds import FalseAlarmBudget
+from bench_tle_null_calibration import DATA
+from bench_tle_own_null import BUDGET, detection_times
 
-ROOT = Path(__file__).resolve().parent.parent
-DATA = ROOT.parent / "shared" / "data" / "tle"
 SATELLITES = ("Jason-1", "Jason-3", "Sentinel-3A", "CryoSat-2", "Fengyun-2D", "Fengyun-2E")
-BUDGET = FalseAlarmBudget(1.0, "year")
 
 
 def main() -> None:
@@ -41,10 +36,9 @@ def main() -> None:
     ap.add_argument("--only", nargs="*", default=None)
     args = ap.parse_args()
     for sat in (s for s in SATELLITES if args.only is None or s in args.only):
-        history = read_tle(DATA / f"{sat}.tle")
+        history = read_tle(DATA / "tle" / f"{sat}.tle")
         ev = detector_for(history).detect(history, BUDGET).events
-        found = ev.loc[ev["statistic"] >= ev["threshold"]]
-        known = list(pd.to_datetime(found["time_utc"].astype(str), utc=True).dt.tz_localize(None))
+        known = detection_times(ev.loc[ev["statistic"] >= ev["threshold"]])
         t0 = time.perf_counter()
         rows = own_null_by_year(history, known, BUDGET, seeds=range(args.seeds))
         fa, years = sum(r.false_alarms for r in rows), sum(r.sat_years for r in rows)
