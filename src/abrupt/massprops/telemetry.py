@@ -48,14 +48,19 @@ def _window_mean(t_ref: FloatArray, v: FloatArray, t_query: FloatArray, half: fl
     return np.asarray(out, dtype=np.float64)
 
 
+def _first_per_stamp(t: FloatArray, v: FloatArray) -> Channel:
+    """Samples sorted by time stamp (stable), the first of each repeated stamp kept."""
+    order = np.argsort(t, kind="stable")
+    t, v = t[order], v[order]
+    first = np.concatenate([[True], np.diff(t) > 0])
+    return t[first], v[first]
+
+
 def _sorted(ch: Channel, name: str, source: str) -> Channel:
     t, v = (np.asarray(a, dtype=np.float64) for a in ch)
     if t.size < 2:
         raise InputError(f"channel {name!r} has fewer than 2 samples", file=source, column=name)
-    order = np.argsort(t, kind="stable")
-    t, v = t[order], v[order]
-    keep = np.concatenate([[True], np.diff(t) > 0])
-    return t[keep], v[keep]
+    return _first_per_stamp(t, v)
 
 
 def _attitude(quaternion: Channel, repairs: RepairLog) -> Channel:
@@ -69,10 +74,7 @@ def _attitude(quaternion: Channel, repairs: RepairLog) -> Channel:
         repairs.record("quaternion samples with |q| far from 1 dropped", int(bad_norm.sum()))
     ok &= ~bad_norm
     tq, q = tq[ok], normalise_quaternion(q[ok])
-    order = np.argsort(tq, kind="stable")
-    tq, q = tq[order], q[order]
-    first = np.concatenate([[True], np.diff(tq) > 0])
-    return tq[first], q[first]
+    return _first_per_stamp(tq, q)
 
 
 def _body_rate(body_rate: Channel, source: str) -> Channel:

@@ -99,28 +99,21 @@ def clip_with_markers(ax: Any, x: NDArray[Any], y: NDArray[np.float64], lo: floa
     ax.set_ylim(lo, hi)
     above = np.isfinite(y) & (y > hi)
     below = np.isfinite(y) & (y < lo)
-    n = int(above.sum() + below.sum())
-    if above.any():
-        ax.plot(
-            np.asarray(x)[above],
-            np.full(int(above.sum()), hi),
-            "^",
-            color="tab:red",
-            ms=5,
-            clip_on=False,
-            label=f"off-scale above: {int(above.sum())} point(s), up to {np.max(y[above]):.6g}{unit}",
-        )
-    if below.any():
-        ax.plot(
-            np.asarray(x)[below],
-            np.full(int(below.sum()), lo),
-            "v",
-            color="tab:red",
-            ms=5,
-            clip_on=False,
-            label=f"off-scale below: {int(below.sum())} point(s), down to {np.min(y[below]):.6g}{unit}",
-        )
-    return n
+    for off, edge, marker, side, extreme in (
+        (above, hi, "^", "above: {} point(s), up to", np.max),
+        (below, lo, "v", "below: {} point(s), down to", np.min),
+    ):
+        if off.any():
+            ax.plot(
+                np.asarray(x)[off],
+                np.full(int(off.sum()), edge),
+                marker,
+                color="tab:red",
+                ms=5,
+                clip_on=False,
+                label=f"off-scale {side.format(int(off.sum()))} {extreme(y[off]):.6g}{unit}",
+            )
+    return int(above.sum() + below.sum())
 
 
 def save_figure(fig: Any, path: str | Path, *, dpi: int = 110) -> Path:
