@@ -22,17 +22,10 @@ from abrupt.readers.oem import read_oem
 from abrupt.readers.orekit_od_input import read_od_input
 from abrupt.readers.telemetry import read_telemetry
 from abrupt.readers.text import MAX_CSV_COLUMNS
+from cli_run import exit_code_and_err as _run
 
 THESIS = Path(__file__).resolve().parent.parent / "src" / "abrupt" / "data" / "spacecraft" / "thesis.toml"
 COLUMNS = 200_000
-
-
-def _run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
-    try:
-        main(argv)
-    except SystemExit as exc:
-        return int(exc.code or 0), capsys.readouterr().err
-    return 0, capsys.readouterr().err
 
 
 @pytest.fixture(scope="module")

@@ -10,19 +10,9 @@ import pandas as pd
 import pytest
 
 from abrupt.cli.groups import hoist_global_flags
-from abrupt.cli.main import main
 from abrupt.events import Event, events_frame, write_events
 from abrupt.readers.omm import read_elements
-
-
-def _run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
-    try:
-        main(argv)
-        code = 0
-    except SystemExit as exc:
-        code = int(exc.code or 0)
-    out = capsys.readouterr()
-    return code, out.out, out.err
+from cli_run import exit_code_out_err as _run
 
 
 def test_global_flags_are_accepted_after_the_sub_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

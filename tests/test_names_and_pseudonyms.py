@@ -10,22 +10,12 @@ from pathlib import Path
 
 import pytest
 
-from abrupt.cli.main import main
 from abrupt.errors import InputError, printable
 from abrupt.readers.archive import read_decoder
 from abrupt.simulate.tle_catalogue import write_catalogue
+from cli_run import exit_code_out_err as _run
 
 ESCAPES = "\x1b[31mRED\x1b[0m\x07"
-
-
-def _run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
-    try:
-        main(argv)
-    except SystemExit as exc:
-        captured = capsys.readouterr()
-        return int(exc.code or 0), captured.out, captured.err
-    captured = capsys.readouterr()
-    return 0, captured.out, captured.err
 
 
 @pytest.fixture(scope="module")

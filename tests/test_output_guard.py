@@ -23,11 +23,11 @@ import pytest
 
 from abrupt.catalog import Catalog, CatalogError
 from abrupt.cli.commands import cli, is_output_parameter
-from abrupt.cli.main import main
 from abrupt.errors import OutputError
 from abrupt.events import read_events
 from abrupt.outputs import atomic_output, clear_protected, protect_inputs, write_text_atomic
 from abrupt.simulate.tle_catalogue import write_catalogue
+from cli_run import exit_code_and_err as _run
 
 #: Path parameters that are not required to exist and are inputs all the same (the command checks them
 #: itself, e.g. to print a pseudonymised name, or they are folders it reads).
@@ -44,14 +44,6 @@ INPUT_PATHS = {
 
 def _digest(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
-
-
-def _run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
-    try:
-        main(argv)
-    except SystemExit as exc:
-        return int(exc.code or 0), capsys.readouterr().err
-    return 0, capsys.readouterr().err
 
 
 def _commands() -> list[tuple[tuple[str, ...], click.Command]]:
