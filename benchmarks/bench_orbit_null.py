@@ -163,6 +163,16 @@ class ClassTally:
     too_short: int = 0
     files: set[str] = field(default_factory=set)
 
+    def count_whole_arc(self, eph: Ephemeris, run: OrbitRun) -> float:
+        """Count one satellite run on its whole arc (span from the epochs); returns its searched days."""
+        days = searched_days(run)
+        self.span_days += float(eph.seconds[-1] - eph.seconds[0]) / 86400.0
+        self.satellites += 1
+        self.sat_days += days
+        self.events += len(run.events)
+        self.methods.add(run.summary.get("thresholds", {}).get("glr", {}).get("method", "-"))
+        return days
+
 
 def orbit_class(eph: Ephemeris) -> str:
     """LEO below 2000 km; GNSS: a GNSS system letter and a navigation-satellite altitude (MEO, IGSO, GEO);
@@ -279,12 +289,7 @@ def main() -> None:
         cls = orbit_class(eph)
         total = tallies.setdefault(cls, ClassTally())
         run = detect_orbit(eph, budget=budget)
-        days = searched_days(run)
-        total.span_days += float(eph.seconds[-1] - eph.seconds[0]) / 86400.0
-        total.satellites += 1
-        total.sat_days += days
-        total.events += len(run.events)
-        total.methods.add(run.summary.get("thresholds", {}).get("glr", {}).get("method", "-"))
+        days = total.count_whole_arc(eph, run)
         dv90_one = 1e3 * float(run.summary.get("dv90_mps", np.nan))
         print(
             f"{path.name:44s} {cls:8s} {1:5d} {days:8.2f} {len(run.events):6d} {budget.per_day * days:8.2f}  "
@@ -297,12 +302,7 @@ def main() -> None:
         for name, cfg in SIMULATED.items():
             eph = simulate_daily_arcs(cfg)
             run = detect_orbit(eph, budget=budget)
-            days = searched_days(run)
-            total.span_days += float(eph.seconds[-1] - eph.seconds[0]) / 86400.0
-            total.satellites += 1
-            total.sat_days += days
-            total.events += len(run.events)
-            total.methods.add(run.summary.get("thresholds", {}).get("glr", {}).get("method", "-"))
+            days = total.count_whole_arc(eph, run)
             nuisance = sum(not b["raised"] for b in run.summary.get("product_boundaries", []))
             dv90_one = 1e3 * float(run.summary.get("dv90_mps", np.nan))
             print(
