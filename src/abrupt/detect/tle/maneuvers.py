@@ -46,7 +46,7 @@ Method (each step cites its source; the combination is abrupt's own):
 
 6. **Campaign events.** Burns inside one gap between element sets make one step (ΔV the sum), and
    a set fitted across a burn spreads it over two gaps. Each event states the interval its burn(s)
-   fall in (``interval_start_utc``, ``interval_end_utc``: from the 90 % quantile of the history's own
+   fall in (``interval_start_utc``, ``interval_end_utc``: from the predictive bound of the history's own
    TLE lag before the set preceding the step to the set after it, widened over merged neighbours;
    :mod:`~abrupt.detect.tle.intervals`) and
    ``burns_max = 1 + ⌊interval / cadence⌋`` with the satellite's own burn cadence inside campaigns
