@@ -46,7 +46,7 @@ Method (each step cites its source; the combination is abrupt's own):
 
 6. **Campaign events.** Burns inside one gap between element sets make one step (ΔV the sum), and
    a set fitted across a burn spreads it over two gaps. Each event states the interval its burn(s)
-   fall in (``interval_start_utc``, ``interval_end_utc``: from the 90 % quantile of the history's own
+   fall in (``interval_start_utc``, ``interval_end_utc``: from the predictive bound of the history's own
    TLE lag before the set preceding the step to the set after it, widened over merged neighbours;
    :mod:`~abrupt.detect.tle.intervals`) and
    ``burns_max = 1 + ⌊interval / cadence⌋`` with the satellite's own burn cadence inside campaigns
@@ -85,6 +85,7 @@ from abrupt.detect.tle.response import (
     local_spans_s,
     ramp_profile,
     ramp_span_s,
+    response_hosts,
 )
 from abrupt.detect.tle.segmentation import segment
 from abrupt.detect.tle.steps import (
@@ -578,7 +579,32 @@ def merge_candidates(run: StepRun, timed: list[Candidate]) -> tuple[list[Candida
             host[0] = min(host[0], item.start_s)
             host[1] = max(host[1], float(steps.t_after_s[item.gap]))
     kept.sort(key=lambda it: it.time_s)
-    return kept, span_of
+    return join_response_tails(run, kept, span_of), span_of
+
+
+def join_response_tails(run: StepRun, kept: list[Candidate], span_of: dict[int, list[float]]) -> list[Candidate]:
+    """One event per burn whose response spreads over sets fitted across it: a later detected step of
+    the same sign whose last old set still holds the burn in its era's fit span is the rest of that
+    response (:func:`abrupt.detect.tle.response.response_hosts`); it is dropped and the burn's interval
+    reaches to its first new set. The span is the era's along-track fit span (``run.era_span_s``)."""
+    found = [it for it in kept if run.stat[it.gap] >= run.threshold]
+    if len(found) < 2:
+        return kept
+    host = response_hosts(
+        run.model.t,
+        np.asarray(run.model.s["a_m"], dtype=float),
+        np.array([it.gap for it in found], dtype=np.int64),
+        np.array([it.time_s for it in found]),
+        np.array([float(run.steps.delta_a_m[it.gap]) for it in found]),
+        np.array([run.era_span_s.get(it.gap, 0.0) for it in found]),
+        np.array([float(run.model.scales["a_m"][it.gap]) for it in found]),
+        run.cfg.time_window_sets,
+    )
+    tails = {found[k].gap for k in np.flatnonzero(host >= 0)}
+    for k in np.flatnonzero(host >= 0):
+        root, tail = span_of[found[int(host[k])].gap], span_of[found[int(k)].gap]
+        root[0], root[1] = min(root[0], tail[0]), max(root[1], tail[1])
+    return [it for it in kept if it.gap not in tails]
 
 
 def event_fields(

@@ -49,6 +49,7 @@ GATE = 4.0  # a step under GATE·sqrt(PENALTY) σ cannot resolve a blend's fract
 MIN_FRACTION = 0.1  # a blend carries between this and 1 − this of the change
 SPAN_GRID_DAYS = np.arange(0.5, 8.01, 0.25)
 GRID_POINTS = 145
+ONE_RESPONSE_LEVEL = 0.99  # goodness of fit of one burn's response to the sets of two steps
 
 
 def _two_levels(
@@ -184,3 +185,76 @@ def interval_cost(reduced_chi2: list[float], level: float) -> float:
     ``κ`` the median reduced χ² of the history's ramp fits (at least 1: correlated, heavy-tailed noise)."""
     kappa = max(1.0, float(np.median(reduced_chi2))) if reduced_chi2 else 1.0
     return kappa * float(stats.chi2.ppf(level, 1))
+
+
+def one_response_fits(
+    t_s: NDArray[np.float64],
+    a_m: NDArray[np.float64],
+    lo: int,
+    hi: int,
+    g_first: int,
+    g_second: int,
+    span_s: float,
+    sigma_m: float,
+) -> bool:
+    """Do the sets ``lo..hi-1`` of ``a`` follow one burn's response, and at least as well as two steps?
+
+    One burn: ``a_k = c₀ + c₁τ_k + Δa·f(t_k − t_b; S)`` with the least cost over the burn times the
+    first new set of the first step saw (``[t − S, t]``, :func:`burn_grid`); two burns: ``c₀ + c₁τ_k``
+    plus a step after each of the gaps ``g_first`` and ``g_second``. Both have four free parameters;
+    one burn needs the smaller sum of squares (ties: one burn) and a fit within the sets' noise:
+    ``Σ (r/σ)²`` under the 0.99 quantile of χ² with ``n − 4`` degrees of freedom, ``σ`` the larger of
+    ``sigma_m`` and the window's own scatter (robust, from differences of neighbouring sets); where
+    neither fits (e.g. more burns between), nothing is joined.
+    """
+    t = t_s[lo:hi]
+    tau = (t - t[0]) / SECONDS_PER_DAY
+    idx = np.arange(lo, hi)
+    two = np.column_stack([np.ones_like(tau), tau, (idx > g_first).astype(float), (idx > g_second).astype(float)])
+    y = a_m[lo:hi]
+    coef, *_ = np.linalg.lstsq(two, y, rcond=None)
+    cost_two = float(np.sum((y - two @ coef) ** 2))
+    cost_one = float(np.min(ramp_profile(t_s, a_m, lo, hi, burn_grid(t_s, g_first + 1, span_s), span_s, 1.0)))
+    # the sets' own scatter in the window (differences of neighbours, robust to the steps between)
+    sigma = max(sigma_m, float(robust_scale(np.diff(y))) / math.sqrt(2.0))
+    fits = cost_one / sigma**2 <= float(stats.chi2.ppf(ONE_RESPONSE_LEVEL, hi - lo - 4))
+    return fits and cost_one <= cost_two
+
+
+def response_hosts(
+    t_s: NDArray[np.float64],
+    a_m: NDArray[np.float64],
+    gaps: NDArray[np.int64],
+    burn_s: NDArray[np.float64],
+    delta_a_m: NDArray[np.float64],
+    span_s: NDArray[np.float64],
+    sigma_m: NDArray[np.float64],
+    window_sets: int,
+) -> NDArray[np.int64]:
+    """Which detected steps are the tail of an earlier burn's response (index of that burn's step, or −1).
+
+    Steps in time order: ``gaps`` the gap of each (the step lies between sets ``g`` and ``g + 1``),
+    ``burn_s`` its burn time, ``delta_a_m`` its step in ``a`` and ``span_s`` the fit span of its era
+    (``sigma_m``: the scatter of ``a`` at each step).
+    A set whose span ``[t_k − S, t_k]`` holds a burn carries only the fraction ``f(ρ)`` of it (module
+    docstring): while the last set before a later step still holds the earlier burn in its span
+    (``t_g − t_b < S``), the sets have not finished responding to it. That later step is the rest of
+    the response, not a second burn, when its ``a`` has the same sign and the sets from
+    ``window_sets`` before the first step to ``window_sets`` after the second (not past a neighbouring
+    step) follow one burn's response at least as well as two steps (:func:`one_response_fits`).
+    Chains follow the first burn. Eras whose sets do not blend (``S = 0``) never join steps.
+    """
+    n = gaps.size
+    host = np.full(n, -1, dtype=np.int64)
+    for k in range(1, n):
+        root = int(host[k - 1]) if host[k - 1] >= 0 else k - 1
+        s, g0, g1 = float(span_s[root]), int(gaps[root]), int(gaps[k])
+        if not (s > 0.0 and math.isfinite(s)) or not 0.0 < float(t_s[g1]) - float(burn_s[root]) < s:
+            continue
+        if delta_a_m[k] * delta_a_m[root] <= 0.0:
+            continue
+        lo = max(int(gaps[root - 1]) + 1 if root > 0 else 0, g0 + 1 - window_sets)
+        hi = min(int(gaps[k + 1]) + 1 if k + 1 < n else t_s.size, g1 + 1 + window_sets)
+        if hi - lo >= 6 and one_response_fits(t_s, a_m, lo, hi, g0, g1, s, float(sigma_m[root])):
+            host[k] = root
+    return host
