@@ -43,6 +43,7 @@ from numpy.typing import NDArray
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.rotations import quaternion_conjugate, quaternion_multiply
 from abrupt.model.spacecraft import RATE_UNITS, WHEEL_SPEED_UNITS, Spacecraft, TelemetryMap
+from abrupt.readers.attitude_kinematics import REFUSE_LR, KinematicVerdict, compare_readings
 from abrupt.readers.text import check_column_count
 from abrupt.series.telemetry import GAP_FACTOR, Telemetry, split_at_gaps
 from abrupt.thresholds.noise import robust_noise_sigma
@@ -234,7 +235,7 @@ def _check_quaternion_order(
     segments: list[tuple[int, int]],
     path: Path,
     tmap: TelemetryMap,
-) -> None:
+) -> float:
     """Refuse quaternions whose scalar is not where the spacecraft file says, verified from kinematics.
 
     Read with the scalar in the wrong place, a quaternion is still a unit quaternion, but the rotation it
@@ -243,16 +244,12 @@ def _check_quaternion_order(
     quaternions read both ways (each in its best multiplication convention, :func:`best_rate_fit`); if the
     other order fits with a factor near ±1 and a residual under a third of the declared order's, the file's
     ``order`` is wrong. A still attitude, or a rotation about one fixed axis, cannot tell the orders apart
-    and is left alone."""
-    order_spec = tmap.quaternion.order or "scalar_first,q_BN"
-    declared, _, frame = order_spec.partition(",")
-    conj = np.array([1.0, -1.0, -1.0, -1.0]) if frame == "q_NB" else np.ones(4)
-    raw = q * conj  # back to the file's frame, scalar first
-    other = raw[:, [3, 0, 1, 2]] if declared == "scalar_first" else raw[:, [1, 2, 3, 0]]
+    and is left to :func:`_check_still_kinematics`. Returns the attitude motion's signal-to-noise ratio."""
+    declared = (tmap.quaternion.order or "scalar_first").partition(",")[0]
     k, residual, snr = best_rate_fit(t_s, q, w, segments)
     if not snr >= RATE_CHECK_MIN_SNR:
-        return
-    k_other, residual_other, _ = best_rate_fit(t_s, other * conj, w, segments)
+        return snr
+    k_other, residual_other, _ = best_rate_fit(t_s, _other_order(q, tmap), w, segments)
     if 0.8 <= abs(k_other) <= 1.25 and residual_other < residual / 3.0:
         correct = "scalar_last" if declared == "scalar_first" else "scalar_first"
         raise InputError(
@@ -262,6 +259,69 @@ def _check_quaternion_order(
             file=path,
             column=",".join(tmap.quaternion.columns),
         )
+    return snr
+
+
+def _other_order(q: NDArray[np.float64], tmap: TelemetryMap) -> NDArray[np.float64]:
+    """The quaternions (q_BN, scalar first) as they would read with the scalar at the file's other end."""
+    declared, _, frame = (tmap.quaternion.order or "scalar_first,q_BN").partition(",")
+    conj = np.array([1.0, -1.0, -1.0, -1.0]) if frame == "q_NB" else np.ones(4)
+    raw = q * conj  # back to the file's frame, scalar first
+    other = (raw[:, [3, 0, 1, 2]] if declared == "scalar_first" else raw[:, [1, 2, 3, 0]]) * conj
+    return np.asarray(np.where(other[:, :1] < 0, -other, other), dtype=np.float64)
+
+
+def _reading_error(verdict: KinematicVerdict, tmap: TelemetryMap) -> tuple[str, list[str]]:
+    """What the kinematics say is wrong with the declared reading, and the columns concerned."""
+    other = verdict.best_other
+    declared = (tmap.quaternion.order or "scalar_first").partition(",")[0]
+    unit = tmap.body_rate.unit or "rad/s"
+    wrong, columns = [], []
+    if other is not None and not other.declared_order:
+        correct = "scalar_last" if declared == "scalar_first" else "scalar_first"
+        wrong.append(f'the quaternion is not {declared}: set order = "{correct}" in [telemetry.quaternion]')
+        columns += list(tmap.quaternion.columns)
+    if other is not None and abs(other.scale) != 1.0:
+        factor = 1.0 / abs(other.scale)
+        looks = "deg/s" if factor > 1 else "rad/s"
+        wrong.append(f"the body rates are {factor:.4g} x the attitude's rate: they look like {looks}, not {unit!r}")
+        columns += list(tmap.body_rate.columns)
+    return "; ".join(wrong), columns
+
+
+def _check_still_kinematics(
+    t_s: NDArray[np.float64],
+    q: NDArray[np.float64],
+    w: NDArray[np.float64],
+    segments: list[tuple[int, int]],
+    path: Path,
+    tmap: TelemetryMap,
+) -> None:
+    """Decide the rate unit and the quaternion order of telemetry whose attitude moves too little for the
+    checks above (:mod:`abrupt.readers.attitude_kinematics`): refuse a reading the kinematics reject, and
+    warn, naming the file, when the motion cannot tell the readings apart."""
+    verdict = compare_readings(t_s, q, _other_order(q, tmap), w, segments)
+    if verdict.lr > REFUSE_LR and verdict.best_other is not None:
+        wrong, columns = _reading_error(verdict, tmap)
+        raise InputError(
+            f"{wrong} (attitude kinematics: {verdict.blocks} blocks of motion fit that reading better by "
+            f"chi2 {verdict.lr:.0f}, refused beyond {REFUSE_LR:g})",
+            file=path,
+            column=",".join(columns),
+        )
+    if verdict.lr < -REFUSE_LR:
+        return
+    motion = "holds still within noise" if verdict.blocks == 0 else f"moves above noise in {verdict.blocks} blocks only"
+    logging.getLogger("abrupt").warning(
+        "%s: rate unit %r and quaternion order %r not verified from kinematics: the attitude %s (chi2 difference "
+        "%.1f, decided beyond %g); check them in the spacecraft file",
+        path,
+        tmap.body_rate.unit or "rad/s",
+        (tmap.quaternion.order or "scalar_first").partition(",")[0],
+        motion,
+        verdict.lr,
+        REFUSE_LR,
+    )
 
 
 def _check_columns(frame: pd.DataFrame, spacecraft: Spacecraft, path: Path) -> None:
@@ -425,8 +485,10 @@ def telemetry_from_frame(
     interval, gaps, segments = split_at_gaps(t_s, GAP_FACTOR)
     if gaps:
         repairs.record(f"gaps longer than {GAP_FACTOR} sample intervals (data split into segments)", len(gaps))
-    _check_quaternion_order(t_s, q, w, segments, path, tmap)
+    snr = _check_quaternion_order(t_s, q, w, segments, path, tmap)
     _check_rates_against_attitude(t_s, q, w, segments, path, tmap.body_rate.unit or "rad/s")
+    if not snr >= RATE_CHECK_MIN_SNR:
+        _check_still_kinematics(t_s, q, w, segments, path, tmap)
     return Telemetry(
         time=time_ns,
         t_s=t_s,

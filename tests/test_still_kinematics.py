@@ -1,0 +1,120 @@
+"""Units and quaternion order of a spacecraft that holds its attitude, decided from kinematics.
+
+Analytic telemetry (no simulator): a still spacecraft at a fixed attitude whose pointing wanders in
+Gaussian bumps about one axis each (θ(t) = A u exp(−(t − t₀)²/2τ²), so ω = θ̇ exactly and the quaternion
+is q_ref ⊗ (cos θ/2, u sin θ/2)), or one turning at orbit rate about its pitch axis (nadir pointing) with
+the same jitter; white noise on the gyro and on each quaternion component. The truth is the declared
+reading, so the written file and its deg/s and scalar-last versions have known answers.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from abrupt.errors import InputError
+from abrupt.model.rotations import normalise_quaternion, quaternion_multiply
+from abrupt.model.spacecraft import load_spacecraft
+from abrupt.readers.attitude_kinematics import REFUSE_LR, compare_readings
+from abrupt.readers.telemetry import read_telemetry
+
+THESIS = Path(__file__).resolve().parent.parent / "src" / "abrupt" / "data" / "spacecraft" / "thesis.toml"
+ORBIT_RATE_RAD_S = 2 * math.pi / 5926.4
+
+
+def _telemetry(seed: int, *, bumps: int, amplitude_rad: float = 5e-4, orbit_rate: float = 0.0) -> pd.DataFrame:
+    """One hour at 10 Hz of still (or nadir-pointing) attitude with ``bumps`` pointing excursions."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(36_000) / 10.0
+    theta = np.zeros((t.size, 3))
+    rate = np.zeros((t.size, 3))
+    for k, t0 in enumerate(np.linspace(120.0, 3480.0, bumps) if bumps else []):
+        axis = np.eye(3)[k % 3] * rng.choice([-1.0, 1.0])
+        g = np.exp(-((t - t0) ** 2) / (2 * 5.0**2))
+        theta += amplitude_rad * np.outer(g, axis)
+        rate += amplitude_rad * np.outer(-(t - t0) / 5.0**2 * g, axis)
+    angle = np.linalg.norm(theta, axis=1)
+    unit = np.divide(theta, angle[:, None], out=np.zeros_like(theta), where=angle[:, None] > 0)
+    excursion = np.column_stack([np.cos(angle / 2), unit * np.sin(angle / 2)[:, None]])
+    pitch = np.column_stack([np.cos(orbit_rate * t / 2), np.zeros(t.size), np.sin(orbit_rate * t / 2), np.zeros(t.size)])
+    reference = normalise_quaternion(rng.normal(size=4))
+    q = quaternion_multiply(quaternion_multiply(np.broadcast_to(reference, (t.size, 4)), pitch), excursion)
+    q = normalise_quaternion(q + rng.normal(0.0, 7e-5, q.shape))
+    w = rate + np.array([0.0, orbit_rate, 0.0]) + rng.normal(0.0, 4e-5, rate.shape)
+    frame = pd.DataFrame({"time": pd.Timestamp("2026-01-01", tz="UTC") + pd.to_timedelta(t, unit="s")})
+    for i, name in enumerate(("q0", "q1", "q2", "q3")):
+        frame[name] = q[:, i]
+    for i, name in enumerate(("wx", "wy", "wz")):
+        frame[name] = w[:, i]
+    for name in ("rw1", "rw2", "rw3", "rw4"):
+        frame[name] = 10.0
+    return frame
+
+
+def _deg(frame: pd.DataFrame) -> pd.DataFrame:
+    frame[["wx", "wy", "wz"]] *= 180.0 / math.pi
+    return frame
+
+
+def _scalar_last(frame: pd.DataFrame) -> pd.DataFrame:
+    frame[["q0", "q1", "q2", "q3"]] = frame[["q1", "q2", "q3", "q0"]].to_numpy()
+    return frame
+
+
+def _read(tmp_path: Path, frame: pd.DataFrame) -> None:
+    path = tmp_path / "t.csv"
+    frame.to_csv(path, index=False)
+    read_telemetry(path, load_spacecraft(THESIS))
+
+
+def _verdict(frame: pd.DataFrame) -> float:
+    t = (frame["time"] - frame["time"].iloc[0]).dt.total_seconds().to_numpy()
+    q = normalise_quaternion(frame[["q0", "q1", "q2", "q3"]].to_numpy())
+    other = normalise_quaternion(q[:, [3, 0, 1, 2]])
+    return compare_readings(t, q, other, frame[["wx", "wy", "wz"]].to_numpy(), [(0, t.size)]).lr
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_still_jitter_verifies_the_declared_reading_and_rejects_the_others(seed: int) -> None:
+    assert _verdict(_telemetry(seed, bumps=12)) < -REFUSE_LR
+    assert _verdict(_deg(_telemetry(seed, bumps=12))) > 5 * REFUSE_LR
+    assert _verdict(_scalar_last(_telemetry(seed, bumps=12))) > 2 * REFUSE_LR
+
+
+def test_still_jitter_read_as_written_is_accepted_quietly(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    with caplog.at_level(logging.WARNING, logger="abrupt"):
+        _read(tmp_path, _telemetry(5, bumps=12))
+    assert "not verified" not in caplog.text
+
+
+def test_still_rates_in_deg_are_refused_naming_the_rate_columns(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match=r"deg/s.*t\.csv|t\.csv.*deg/s") as err:
+        _read(tmp_path, _deg(_telemetry(6, bumps=12)))
+    assert "wx,wy,wz" in str(err.value)
+
+
+def test_still_scalar_last_is_refused_naming_the_quaternion_columns(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match="scalar_last") as err:
+        _read(tmp_path, _scalar_last(_telemetry(7, bumps=12)))
+    assert "q0,q1,q2,q3" in str(err.value)
+
+
+def test_motionless_attitude_is_a_warning_naming_the_file(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    """No motion above noise: no reading can be told from another, and the reader says so."""
+    for frame in (_telemetry(8, bumps=0), _scalar_last(_telemetry(8, bumps=0))):
+        caplog.clear()
+        with caplog.at_level(logging.WARNING, logger="abrupt"):
+            _read(tmp_path, frame)
+        assert "t.csv" in caplog.text and "not verified from kinematics" in caplog.text
+
+
+@pytest.mark.parametrize("damage", [_deg, _scalar_last])
+def test_nadir_pointing_with_a_wrong_reading_is_refused(tmp_path: Path, damage: object) -> None:
+    _read(tmp_path, _telemetry(9, bumps=12, orbit_rate=ORBIT_RATE_RAD_S))
+    with pytest.raises(InputError):
+        _read(tmp_path, damage(_telemetry(9, bumps=12, orbit_rate=ORBIT_RATE_RAD_S)))  # type: ignore[operator]
