@@ -1,6 +1,7 @@
 """The kinematic reading check on still attitude telemetry: its null and its power (``attitude_kinematics``).
 
-Draws one hour of simulated telemetry of the thesis spacecraft holding a random inertial attitude (the simulated q_BN turned by a random constant frame rotation), with 0-4
+Draws one hour of simulated telemetry of the thesis spacecraft holding a random inertial attitude (the
+simulated q_BN turned by a random constant frame rotation), with 0-4
 strikes of 0.05-0.4 N·m·s at random times (abrupt's closed-loop simulator, 10 Hz or 100 Hz), and scores three
 readings of each file with :func:`abrupt.readers.attitude_kinematics.compare_readings`: as written
 (the null: Λ must stay below the refusal level), the rates in deg/s declared rad/s, and a scalar-last
@@ -51,9 +52,7 @@ def main() -> None:
             )
             for _ in range(n_strikes)
         ]
-        config = AttitudeSimConfig(
-            duration_s=duration_s, telemetry_rate_hz=args.rate_hz, seed=draw
-        )
+        config = AttitudeSimConfig(duration_s=duration_s, telemetry_rate_hz=args.rate_hz, seed=draw)
         f = simulate_attitude(sc, config, strikes).telemetry
         t = (f["time"] - f["time"].iloc[0]).dt.total_seconds().to_numpy()
         q = quaternion_multiply(np.broadcast_to(frame, (len(f), 4)), f[["q0", "q1", "q2", "q3"]].to_numpy())
@@ -64,16 +63,19 @@ def main() -> None:
             )
             scores.setdefault(name, []).append(verdict.lr)
     print(
-        f"{args.draws} files of {duration_s:g} s at {args.rate_hz:g} Hz, 0-4 strikes of 0.05-0.4 N m s; refusal at Λ > {REFUSE_LR:g}"
+        f"{args.draws} files of {duration_s:g} s at {args.rate_hz:g} Hz, 0-4 strikes of 0.05-0.4 N m s; "
+        f"refusal at Λ > {REFUSE_LR:g}"
     )
     print(
-        f"{'reading':<16} {'median':>8} {'q05':>8} {'q95':>8} {'max':>8} {'refused':>8} {'verified':>9} {'undecided':>10}"
+        f"{'reading':<16} {'median':>8} {'q05':>8} {'q95':>8} {'max':>8} {'refused':>8} {'verified':>9} "
+        f"{'undecided':>10}"
     )
     for name, lr in scores.items():
         a = np.asarray(lr)
+        undecided = int(np.sum(np.abs(a) <= REFUSE_LR))
         print(
             f"{name:<16} {np.median(a):8.1f} {np.quantile(a, 0.05):8.1f} {np.quantile(a, 0.95):8.1f} {a.max():8.1f} "
-            f"{int(np.sum(a > REFUSE_LR)):8d} {int(np.sum(a < -REFUSE_LR)):9d} {int(np.sum(np.abs(a) <= REFUSE_LR)):10d}"
+            f"{int(np.sum(a > REFUSE_LR)):8d} {int(np.sum(a < -REFUSE_LR)):9d} {undecided:10d}"
         )
 
 
