@@ -11,6 +11,7 @@ conservation of angular momentum (after the other two, so that a wrong gyro is n
 from __future__ import annotations
 
 import itertools
+import logging
 import math
 from collections import Counter
 
@@ -21,6 +22,7 @@ from abrupt.errors import ConfigError, InputError
 from abrupt.model.flight_config import RATE_UNITS, WHEEL_UNITS, FlightChannel, FlightConfig
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.readers.archive import ArchiveChunk
+from abrupt.readers.attitude_kinematics import REFUSE_LR, compare_readings
 from abrupt.readers.telemetry import MAX_BODY_RATE_RAD_S, WHEEL_OVERSPEED_FACTOR, best_rate_fit
 from abrupt.series.timetable import Timetable, by_mnemonic, continuous_quaternion
 from abrupt.series.timetable_momentum import wheel_scale_from_conservation
@@ -209,21 +211,25 @@ def check_angle_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> None:
 QUATERNION_ORDER_MIN_SNR = 10.0  # the attitude must move this far above noise for the order to show
 
 
-def check_quaternion_components(spacecraft: Spacecraft, samples: pd.DataFrame) -> None:
+_Still = tuple[np.ndarray, np.ndarray, np.ndarray, list[tuple[int, int]]]
+
+
+def check_quaternion_components(spacecraft: Spacecraft, samples: pd.DataFrame) -> _Still | None:
     """Raise if the quaternion's scalar is not the channel declared ``component = 0``, from kinematics.
 
     The gyro rates are fitted by the rates implied by the quaternion (q̇ = ½ q ⊗ (0, ω), either
     multiplication convention: :func:`~abrupt.readers.telemetry.best_rate_fit`) with each channel
     taken as the scalar in turn; a channel other than the declared scalar that fits with a factor within
     0.8-1.25 and a third of the declared scalar's residual is named (on the flight-like archive the
-    declared order fits with residual 0.008, the best other with 0.15). A still attitude cannot tell
-    and is left alone."""
+    declared order fits with residual 0.008, the best other with 0.15). A still attitude, which cannot tell,
+    is left to :func:`_check_still_components`, as is a rotation about one axis that leaves the orders
+    equally good: their inputs (times s, quaternions, gyro rad/s, segments) are returned."""
     flight = flight_channels(spacecraft)
     chans = sorted(flight.of("quaternion"), key=lambda c: c.component)
     gyro = sorted(flight.of("body_rate"), key=lambda c: c.component)
     series = by_mnemonic(samples)
     if len(chans) != 4 or len(gyro) != 3 or any(c.mnemonic not in series for c in [*chans, *gyro]):
-        return
+        return None
     t = series[chans[0].mnemonic][0]
     for c in chans[1:]:
         t = np.intersect1d(t, series[c.mnemonic][0], assume_unique=True)
@@ -231,7 +237,7 @@ def check_quaternion_components(spacecraft: Spacecraft, samples: pd.DataFrame) -
     g = np.column_stack([np.interp(t, *series[c.mnemonic]) * RATE_UNITS.get(c.unit, 1.0) for c in gyro])
     good = np.isfinite(q).all(axis=1) & np.isfinite(g).all(axis=1) & (np.abs(np.linalg.norm(q, axis=1) - 1.0) < 0.1)
     if good.sum() < 100:
-        return
+        return None
     t_s = (t[good] - t[good][0]).astype(np.float64) / NS
     q, g = q[good] / np.linalg.norm(q[good], axis=1, keepdims=True), g[good]
     step = float(np.median(np.diff(t_s)))
@@ -243,26 +249,82 @@ def check_quaternion_components(spacecraft: Spacecraft, samples: pd.DataFrame) -
         return best_rate_fit(t_s, q[:, [(scalar + i) % 4 for i in range(4)]], g, segments)
 
     k0, r0, snr = best(0)
-    if not snr >= QUATERNION_ORDER_MIN_SNR or not math.isfinite(r0):
-        return
+    verified = False
+    if snr >= QUATERNION_ORDER_MIN_SNR and math.isfinite(r0):
+        others = []
+        for scalar in (3, 1, 2):
+            k, r, _ = best(scalar)
+            others.append(r)
+            if 0.8 <= abs(k) <= 1.25 and r < r0 / 3.0:
+                key = f"flight.channels[{flight.channels.index(chans[scalar])}].component"
+                raise ConfigError(
+                    f"the quaternion follows the gyro rates with channel {chans[scalar].mnemonic} (declared component "
+                    f"{scalar}) as the scalar (rate factor {abs(k):.3f}, residual {r:.2g}), not with component 0 "
+                    f"(factor {abs(k0):.3f}, residual {r0:.2g}): number the scalar channel 0 (scalar first)",
+                    file=spacecraft.source,
+                    key=key,
+                )
+        verified = all(r0 < r / 3.0 for r in others)
+    return None if verified else (t_s, q, g, segments)
+
+
+def _check_still_components(
+    spacecraft: Spacecraft, t_s: np.ndarray, q: np.ndarray, g: np.ndarray, segments: list[tuple[int, int]]
+) -> None:
+    """The quaternion's scalar channel and the gyro's unit of an attitude that moves too little (or about one
+    axis only) for the checks above, from :func:`~abrupt.readers.attitude_kinematics.compare_readings` with
+    each other channel taken as the scalar: an error naming the key when another reading fits beyond
+    :data:`~abrupt.readers.attitude_kinematics.REFUSE_LR`, a warning naming the file when none can be told."""
+    flight = flight_channels(spacecraft)
+    chans = sorted(flight.of("quaternion"), key=lambda c: c.component)
+    gyro = sorted(flight.of("body_rate"), key=lambda c: c.component)
+    declared = q / np.linalg.norm(q, axis=1, keepdims=True)
+    declared = np.where(declared[:, :1] < 0, -declared, declared)
+    verdicts = []
     for scalar in (3, 1, 2):
-        k, r, _ = best(scalar)
-        if 0.8 <= abs(k) <= 1.25 and r < r0 / 3.0:
-            key = f"flight.channels[{flight.channels.index(chans[scalar])}].component"
-            raise ConfigError(
-                f"the quaternion follows the gyro rates with channel {chans[scalar].mnemonic} (declared component "
-                f"{scalar}) as the scalar (rate factor {abs(k):.3f}, residual {r:.2g}), not with component 0 "
-                f"(factor {abs(k0):.3f}, residual {r0:.2g}): number the scalar channel 0 (scalar first)",
-                file=spacecraft.source,
-                key=key,
+        other = declared[:, [(scalar + i) % 4 for i in range(4)]]
+        verdicts.append(
+            (compare_readings(t_s, declared, np.where(other[:, :1] < 0, -other, other), g, segments), scalar)
+        )
+    verdict, scalar = max(verdicts, key=lambda v: v[0].lr)
+    reading = verdict.best_other
+    if verdict.lr > REFUSE_LR and reading is not None:
+        if not reading.declared_order:
+            key, what = (
+                f"flight.channels[{flight.channels.index(chans[scalar])}].component",
+                (f"the quaternion's scalar is channel {chans[scalar].mnemonic}, not component 0: number it 0"),
             )
+        else:
+            key, what = (
+                f"flight.channels[{flight.channels.index(gyro[0])}].unit",
+                (f"the gyro rates are {1.0 / abs(reading.scale):.4g} x the attitude's rate: check their unit"),
+            )
+        raise ConfigError(
+            f"{what} (attitude kinematics: {verdict.blocks} blocks of motion fit that reading better by chi2 "
+            f"{verdict.lr:.0f}, refused beyond {REFUSE_LR:g})",
+            file=spacecraft.source,
+            key=key,
+        )
+    if min(v.lr for v, _ in verdicts) < -REFUSE_LR:
+        return
+    logging.getLogger("abrupt").warning(
+        "%s: gyro unit and quaternion scalar channel not verified from kinematics: the attitude moves above noise "
+        "in %d blocks only (chi2 difference %.1f, decided beyond %g); check the [flight] channels",
+        spacecraft.source,
+        verdict.blocks,
+        verdict.lr,
+        REFUSE_LR,
+    )
 
 
 def check_channel_units(spacecraft: Spacecraft, samples: pd.DataFrame) -> None:
-    """The quaternion order, gyro and angle checks above, in that order (the wheel checks need the timetable)."""
-    check_quaternion_components(spacecraft, samples)
+    """The quaternion order, gyro and angle checks above, in that order, then the kinematics of an attitude too
+    still for the first (the wheel checks need the timetable)."""
+    still = check_quaternion_components(spacecraft, samples)
     check_gyro_units(spacecraft, samples)
     check_angle_units(spacecraft, samples)
+    if still is not None:
+        _check_still_components(spacecraft, *still)
 
 
 BOUNDS_REMOVED = "values beyond the spacecraft file's physical bounds"

@@ -15,6 +15,11 @@ quaternion norm off by 1e-6 .. 10%     repair: renormalised, counted
 |body rate| above 2 rad/s              error (deg/s declared as rad/s?)
 gyro rates k x the quaternion rate     error when the attitude moves well above noise and k is
                                        outside [0.5, 2] (names deg/rad confusion when k ≈ 57.3)
+still or one-axis motion near noise    the gyro's and the quaternion's rates on 4 s blocks where the gyro
+                                       shows motion decide the rate unit and the scalar position
+                                       (:mod:`abrupt.readers.attitude_kinematics`): error naming the
+                                       columns when another reading fits by chi2 > 20; a warning naming
+                                       the file when the motion cannot tell the readings apart
 wheel speed above 1.5 x its maximum    error naming the unit to check (rpm declared as rad/s?)
 empty cells (NaN)                      repair: row removed, counted; leaves a gap
 infinite or |value| > 1e20             repair: row removed, counted; leaves a gap
@@ -43,6 +48,7 @@ from numpy.typing import NDArray
 from abrupt.errors import InputError, RepairLog
 from abrupt.model.rotations import quaternion_conjugate, quaternion_multiply
 from abrupt.model.spacecraft import RATE_UNITS, WHEEL_SPEED_UNITS, Spacecraft, TelemetryMap
+from abrupt.readers.attitude_kinematics import REFUSE_LR, KinematicVerdict, compare_readings
 from abrupt.readers.text import check_column_count
 from abrupt.series.telemetry import GAP_FACTOR, Telemetry, split_at_gaps
 from abrupt.thresholds.noise import robust_noise_sigma
@@ -160,7 +166,9 @@ def _check_rates_against_attitude(
             logging.getLogger("abrupt").warning("%s: %s", path, message)
     if not signal or den <= 0 or max(signal) < RATE_CHECK_MIN_SNR * max(min(noise), 1e-300):
         return
-    k = num / den
+    # Files follow either multiplication convention (and a q_NB file read as q_BN flips the sign): the
+    # factor is taken in the convention that fits the gyro best, its magnitude compared with 1.
+    k = abs(best_rate_fit(t_s, q, w, segments)[0])
     if 0.5 <= k <= 2.0:
         return
     deg = np.pi / 180.0
@@ -234,7 +242,7 @@ def _check_quaternion_order(
     segments: list[tuple[int, int]],
     path: Path,
     tmap: TelemetryMap,
-) -> None:
+) -> bool:
     """Refuse quaternions whose scalar is not where the spacecraft file says, verified from kinematics.
 
     Read with the scalar in the wrong place, a quaternion is still a unit quaternion, but the rotation it
@@ -243,16 +251,13 @@ def _check_quaternion_order(
     quaternions read both ways (each in its best multiplication convention, :func:`best_rate_fit`); if the
     other order fits with a factor near ±1 and a residual under a third of the declared order's, the file's
     ``order`` is wrong. A still attitude, or a rotation about one fixed axis, cannot tell the orders apart
-    and is left alone."""
-    order_spec = tmap.quaternion.order or "scalar_first,q_BN"
-    declared, _, frame = order_spec.partition(",")
-    conj = np.array([1.0, -1.0, -1.0, -1.0]) if frame == "q_NB" else np.ones(4)
-    raw = q * conj  # back to the file's frame, scalar first
-    other = raw[:, [3, 0, 1, 2]] if declared == "scalar_first" else raw[:, [1, 2, 3, 0]]
+    and is left to :func:`_check_still_kinematics`. Returns whether the declared order is verified: the
+    attitude moves above noise and the other order fits the gyro three times worse."""
+    declared = (tmap.quaternion.order or "scalar_first").partition(",")[0]
     k, residual, snr = best_rate_fit(t_s, q, w, segments)
     if not snr >= RATE_CHECK_MIN_SNR:
-        return
-    k_other, residual_other, _ = best_rate_fit(t_s, other * conj, w, segments)
+        return False
+    k_other, residual_other, _ = best_rate_fit(t_s, other_scalar_order(q, tmap), w, segments)
     if 0.8 <= abs(k_other) <= 1.25 and residual_other < residual / 3.0:
         correct = "scalar_last" if declared == "scalar_first" else "scalar_first"
         raise InputError(
@@ -262,6 +267,70 @@ def _check_quaternion_order(
             file=path,
             column=",".join(tmap.quaternion.columns),
         )
+    return bool(residual < residual_other / 3.0)
+
+
+def other_scalar_order(q: NDArray[np.float64], tmap: TelemetryMap) -> NDArray[np.float64]:
+    """The quaternions (q_BN, scalar first) as they would read with the scalar at the file's other end."""
+    declared, _, frame = (tmap.quaternion.order or "scalar_first,q_BN").partition(",")
+    conj = np.array([1.0, -1.0, -1.0, -1.0]) if frame == "q_NB" else np.ones(4)
+    raw = q * conj  # back to the file's frame, scalar first
+    other = (raw[:, [3, 0, 1, 2]] if declared == "scalar_first" else raw[:, [1, 2, 3, 0]]) * conj
+    return np.asarray(np.where(other[:, :1] < 0, -other, other), dtype=np.float64)
+
+
+def _reading_error(verdict: KinematicVerdict, tmap: TelemetryMap) -> tuple[str, list[str]]:
+    """What the kinematics say is wrong with the declared reading, and the columns concerned."""
+    other = verdict.best_other
+    declared = (tmap.quaternion.order or "scalar_first").partition(",")[0]
+    unit = tmap.body_rate.unit or "rad/s"
+    wrong, columns = [], []
+    if other is not None and not other.declared_order:
+        correct = "scalar_last" if declared == "scalar_first" else "scalar_first"
+        wrong.append(f'the quaternion is not {declared}: set order = "{correct}" in [telemetry.quaternion]')
+        columns += list(tmap.quaternion.columns)
+    if other is not None and abs(other.scale) != 1.0:
+        factor = 1.0 / abs(other.scale)
+        looks = "deg/s" if factor > 1 else "rad/s"
+        wrong.append(f"the body rates are {factor:.4g} x the attitude's rate: they look like {looks}, not {unit!r}")
+        columns += list(tmap.body_rate.columns)
+    return "; ".join(wrong), columns
+
+
+def _check_still_kinematics(
+    t_s: NDArray[np.float64],
+    q: NDArray[np.float64],
+    w: NDArray[np.float64],
+    segments: list[tuple[int, int]],
+    path: Path,
+    tmap: TelemetryMap,
+) -> None:
+    """Decide the rate unit and the quaternion order of telemetry whose attitude moves too little, or about
+    one axis only (nadir pointing), for the checks above (:mod:`abrupt.readers.attitude_kinematics`: the
+    windows' mean rate is removed, the jitter compared): refuse a reading the kinematics reject, and warn,
+    naming the file, when the motion cannot tell the readings apart."""
+    verdict = compare_readings(t_s, q, other_scalar_order(q, tmap), w, segments)
+    if verdict.lr > REFUSE_LR and verdict.best_other is not None:
+        wrong, columns = _reading_error(verdict, tmap)
+        raise InputError(
+            f"{wrong} (attitude kinematics: {verdict.blocks} blocks of motion fit that reading better by "
+            f"chi2 {verdict.lr:.0f}, refused beyond {REFUSE_LR:g})",
+            file=path,
+            column=",".join(columns),
+        )
+    if verdict.lr < -REFUSE_LR:
+        return
+    motion = "holds still within noise" if verdict.blocks == 0 else f"moves above noise in {verdict.blocks} blocks only"
+    logging.getLogger("abrupt").warning(
+        "%s: rate unit %r and quaternion scalar position %r not verified from kinematics: the attitude %s (chi2 "
+        "difference %.1f, decided beyond %g); check them in the spacecraft file",
+        path,
+        tmap.body_rate.unit or "rad/s",
+        (tmap.quaternion.order or "scalar_first").partition(",")[0],
+        motion,
+        verdict.lr,
+        REFUSE_LR,
+    )
 
 
 def _check_columns(frame: pd.DataFrame, spacecraft: Spacecraft, path: Path) -> None:
@@ -425,8 +494,10 @@ def telemetry_from_frame(
     interval, gaps, segments = split_at_gaps(t_s, GAP_FACTOR)
     if gaps:
         repairs.record(f"gaps longer than {GAP_FACTOR} sample intervals (data split into segments)", len(gaps))
-    _check_quaternion_order(t_s, q, w, segments, path, tmap)
+    order_verified = _check_quaternion_order(t_s, q, w, segments, path, tmap)
     _check_rates_against_attitude(t_s, q, w, segments, path, tmap.body_rate.unit or "rad/s")
+    if not order_verified:  # still, or turning about one axis (nadir pointing): the jitter decides
+        _check_still_kinematics(t_s, q, w, segments, path, tmap)
     return Telemetry(
         time=time_ns,
         t_s=t_s,
