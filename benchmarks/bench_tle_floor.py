@@ -1,5 +1,5 @@
 """The stated floor per year and the operator burns above it: how much of the recall a history's
-element sets allow (the issue's "a fair report separates the two").
+element sets allow, reported apart from the recall the detector reaches.
 
 Every shared history (``../shared/data/tle``) runs at default settings and a budget of 1 false alarm
 per satellite-year. Per calendar year the run states the smallest in-track and cross-track ΔV it

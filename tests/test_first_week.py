@@ -344,8 +344,9 @@ def test_a_first_run_says_once_that_it_compiles_and_a_second_run_says_nothing(tm
     (cold cache) says it compiles, once for all kernels; the second loads them and says nothing."""
     (tmp_path / "first_week_kernels.py").write_text(_KERNELS)
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "src"), str(tmp_path)])}
-    env.pop("NUMBA_CACHE_DIR", None)
-    env.pop("NUMBA_DISABLE_JIT", None)
+    env["XDG_CACHE_HOME"] = str(tmp_path / "cache")  # abrupt keys numba's cache folder below this
+    for inherited in ("NUMBA_CACHE_DIR", "ABRUPT_NUMBA_KEY", "NUMBA_DISABLE_JIT"):
+        env.pop(inherited, None)
     runs = [
         subprocess.run([sys.executable, "-c", _RUN_KERNELS], env=env, capture_output=True, text=True, timeout=300)
         for _ in range(2)

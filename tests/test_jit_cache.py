@@ -12,6 +12,7 @@ import importlib
 import os
 import subprocess
 import sys
+import tempfile
 import types
 from pathlib import Path
 
@@ -21,7 +22,14 @@ from numba.core import config as numba_config
 from numba.core.registry import CPUDispatcher
 
 from abrupt import __version__
-from abrupt.jit_cache import JIT_SOURCES, PACKAGE_ROOT, keyed_cache_dir, sources_key, use_keyed_numba_cache
+from abrupt.jit_cache import (
+    JIT_SOURCES,
+    KEY_VARIABLE,
+    PACKAGE_ROOT,
+    keyed_cache_dir,
+    sources_key,
+    use_keyed_numba_cache,
+)
 
 #: What a jitted function can compile in from another module: a kernel, a number, an array or a module.
 COMPILED_IN = (CPUDispatcher, int, float, complex, np.ndarray, np.generic, tuple, types.ModuleType)
@@ -100,14 +108,40 @@ def test_the_package_points_numba_at_its_sources_folder_unless_one_is_set(
 ) -> None:
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
     monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.delenv(KEY_VARIABLE, raising=False)
     monkeypatch.setattr(numba_config, "CACHE_DIR", numba_config.CACHE_DIR)  # restored after the test
     use_keyed_numba_cache(__version__)
     expected = keyed_cache_dir(tmp_path / "abrupt", __version__, sources_key(PACKAGE_ROOT, JIT_SOURCES))
     assert os.environ["NUMBA_CACHE_DIR"] == str(expected)
     assert numba_config.CACHE_DIR == str(expected)  # numba is imported here: its configuration follows
-    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "mine"))
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "child"))  # inherited from an abrupt of this state
+    use_keyed_numba_cache(__version__)
+    assert os.environ["NUMBA_CACHE_DIR"] == str(tmp_path / "child")
+    monkeypatch.setenv(KEY_VARIABLE, "0-another-checkout")  # inherited from an abrupt of another state
+    use_keyed_numba_cache(__version__)
+    assert os.environ["NUMBA_CACHE_DIR"] == str(expected)
+    monkeypatch.delenv(KEY_VARIABLE)
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "mine"))  # the user's own
     use_keyed_numba_cache(__version__)
     assert os.environ["NUMBA_CACHE_DIR"] == str(tmp_path / "mine")
+
+
+def test_an_unwritable_home_cache_falls_back_to_a_temporary_folder_and_says_so(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    blocker = tmp_path / "not-a-folder"
+    blocker.write_text("")  # a file where the cache folder would go: no user can create it
+    monkeypatch.setenv("XDG_CACHE_HOME", str(blocker))
+    monkeypatch.setenv("TMPDIR", str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", None)  # re-read TMPDIR; restored after the test
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.delenv(KEY_VARIABLE, raising=False)
+    monkeypatch.setattr(numba_config, "CACHE_DIR", numba_config.CACHE_DIR)
+    with pytest.warns(RuntimeWarning, match="cannot be written"):
+        use_keyed_numba_cache(__version__)
+    folder = Path(os.environ["NUMBA_CACHE_DIR"])
+    assert folder.is_dir() and folder.is_relative_to(tmp_path / "tmp")
 
 
 _CALLEE = "from numba import njit\n\n\n@njit(cache=True)\ndef callee(x):\n    return x + {offset}\n"

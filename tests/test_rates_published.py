@@ -200,8 +200,8 @@ def test_psi_follows_the_inclination_dependence_of_the_direction_model() -> None
     """The inclination mix behind the direction table (chosen independently of Ψ) implies Ψ relative to 28.5°.
 
     Measured: within 0.025 of the table at 30-70°; 1.61, 1.52, 1.58 at 80, 90, 100° (table 1.71, 1.37, 1.78; design
-    note 1.4, 1.6, 1.78), i.e. within 12 % and between the two readings at 80° and 90°; the former unsourced 1.18,
-    1.00, 0.98 were 27-38 % off. At 120° (no source) the mix gives 1.40 against the node's 1.18: not asserted.
+    note 1.4, 1.6, 1.78), i.e. within 12 % and between the two readings at 80° and 90°; values of 1.18, 1.00, 0.98
+    there would be 27-38 % off. At 120° (no source) the mix gives 1.40 against the node's 1.18: not asserted.
     """
     ref = tables.debris_crossing_rate(600e3, 28.5)
     nodes = (*PSI_GEOMETRY_CLOSE, *PSI_GEOMETRY_LOOSE)

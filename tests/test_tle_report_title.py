@@ -43,3 +43,13 @@ def test_the_drawn_figure_carries_the_title(tmp_path: Path) -> None:
     path.write_text(text)
     out = plot_tle_report(read_tle(path), pd.DataFrame(columns=EVENT_COLUMNS), tmp_path / "report.svg")
     assert "kestrel-elements.tle (NORAD 99017): 0 maneuver(s)" in out.read_text()  # SVG keeps text as comments
+
+
+def test_a_pseudonym_replaces_the_name_and_control_characters_are_escaped(tmp_path: Path) -> None:
+    text, _ = synthetic_tle_text(days=60.0, norad=99017)
+    path = tmp_path / "elements.tle"
+    path.write_text(_three_line(text, "KESTREL 2"))
+    history = read_tle(path)
+    assert report_title(history, 1, name="bird-7") == "bird-7 (NORAD 99017): 1 maneuver(s)"
+    assert "KESTREL" not in report_title(history, 1, name="bird-7")
+    assert report_title(history, 1, name="x\x1b[31my") == "x\\x1b[31my (NORAD 99017): 1 maneuver(s)"

@@ -18,6 +18,8 @@ from __future__ import annotations
 import hashlib
 import os
 import sys
+import tempfile
+import warnings
 from pathlib import Path
 
 #: Package-relative paths of the sources numba's compiled kernels depend on.
@@ -47,6 +49,7 @@ JIT_SOURCES: tuple[str, ...] = (
 )
 
 PACKAGE_ROOT = Path(__file__).resolve().parent
+KEY_VARIABLE = "ABRUPT_NUMBA_KEY"  # the source state an inherited NUMBA_CACHE_DIR was keyed on
 
 
 def sources_key(root: Path, sources: tuple[str, ...]) -> str:
@@ -76,16 +79,56 @@ def default_cache_base() -> Path | None:
         return None
 
 
+def writable_folder(folder: Path) -> bool:
+    """True when ``folder`` exists or can be created and a file can be written in it."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=folder):
+            pass
+    except OSError:
+        return False
+    return True
+
+
 def use_keyed_numba_cache(version: str) -> None:
-    """Set ``NUMBA_CACHE_DIR`` to the folder of the installed sources' state, unless it is already set;
-    when numba is already imported its configuration is updated too (never importing numba here)."""
-    if os.environ.get("NUMBA_CACHE_DIR") or (base := default_cache_base()) is None:
+    """Set ``NUMBA_CACHE_DIR`` to the folder of the installed sources' state.
+
+    A ``NUMBA_CACHE_DIR`` set by the user is kept; one set by an abrupt process of another source state
+    (its ``ABRUPT_NUMBA_KEY`` differs, e.g. a child started from another checkout) is replaced. When the
+    home cache cannot be written, a per-user folder under the system's temporary directory is used and one
+    warning says so; when neither can be written, numba's own per-file stamps stay in force, also said.
+    When numba is already imported its configuration is updated too (never importing numba here).
+    Side effect: other numba code in the same process caches in this folder too.
+    """
+    inherited_key = os.environ.get(KEY_VARIABLE)
+    if os.environ.get("NUMBA_CACHE_DIR") and inherited_key is None:
         return
     try:
-        key = sources_key(PACKAGE_ROOT, JIT_SOURCES)
+        source_hash = sources_key(PACKAGE_ROOT, JIT_SOURCES)
     except OSError:  # sources unreadable (a zipped install): numba's own per-file stamps stay in force
         return
-    folder = str(keyed_cache_dir(base, version, key))
-    os.environ["NUMBA_CACHE_DIR"] = folder
+    key = f"{version}-{source_hash}"
+    if os.environ.get("NUMBA_CACHE_DIR") and inherited_key == key:
+        return
+    user = os.getuid() if hasattr(os, "getuid") else 0
+    bases = [b for b in (default_cache_base(), Path(tempfile.gettempdir()) / f"abrupt-{user}") if b is not None]
+    candidates = [keyed_cache_dir(base, version, source_hash) for base in bases]
+    folder = next((c for c in candidates if writable_folder(c)), None)
+    if folder is None:
+        warnings.warn(
+            f"abrupt: no writable numba cache folder ({', '.join(map(str, candidates))}); compiled kernels are "
+            "cached beside the sources, keyed by each file only",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+        return
+    if folder != candidates[0]:
+        warnings.warn(
+            f"abrupt: {candidates[0]} cannot be written; numba kernels are cached in {folder}",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    os.environ["NUMBA_CACHE_DIR"] = str(folder)
+    os.environ[KEY_VARIABLE] = key
     if (config := sys.modules.get("numba.core.config")) is not None:
-        config.CACHE_DIR = folder  # type: ignore[attr-defined]
+        config.CACHE_DIR = str(folder)  # type: ignore[attr-defined]

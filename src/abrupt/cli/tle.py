@@ -239,9 +239,8 @@ def detect_tle(
             target = Path(report_path)
             if len(result.satellites) > 1:
                 target = target.with_name(f"{target.stem}_{sat.history.norad_id}{target.suffix}")
-            click.echo(
-                f"report written to {abrupt_report_tle.plot_tle_report(sat.history, sat.events, target)}", err=True
-            )
+            drawn = abrupt_report_tle.plot_tle_report(sat.history, sat.events, target, name=pseudonym)
+            click.echo(f"report written to {drawn}", err=True)
 
 
 @report.command("tle")

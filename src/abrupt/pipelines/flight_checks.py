@@ -305,7 +305,7 @@ def _check_still_components(
             file=spacecraft.source,
             key=key,
         )
-    if min(v.lr for v, _ in verdicts) < -REFUSE_LR:
+    if max(v.lr for v, _ in verdicts) < -REFUSE_LR:
         return
     logging.getLogger("abrupt").warning(
         "%s: gyro unit and quaternion scalar channel not verified from kinematics: the attitude moves above noise "

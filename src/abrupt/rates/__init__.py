@@ -156,7 +156,7 @@ d^-2.5, 8.1e10 (d+700)^-6, H(d) 0.78/0.637, with H in the SPENVIS form 0.406 = 0
 for consistency: the SSP 30425 speed law (its pieces join; its start is the escape speed at 100 km) and the debris
 directions (mean speeds as ECSS J.2.2.1.3 and Kessler 1988 state them). Not checked against its publication: Ψ(i),
 the NASA-90/91 inclination table (Kessler et al. 1991; NASA TM-100471 and TM-4527; ECSS-E-10-04A), of which no
-readable copy was found (about 120 look-ups; sources named in :mod:`abrupt.rates.flux`). abrupt uses the table as
+readable copy was found (the sources tried are named in :mod:`abrupt.rates.flux`). abrupt uses the table as
 recalled from its reproductions (no whole copy could be read; 30°, 80°, 90° and 120° rest on that recollection
 alone): 28.5°: 0.91, 30°: 0.92, 40°: 0.96, 50°: 1.02, 60°: 1.09, 70°: 1.26, 80°: 1.71, 90°: 1.37, 100°: 1.78,
 120°: 1.18. A public

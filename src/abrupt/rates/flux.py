@@ -63,8 +63,8 @@ METEOROID_DENSITY_KG_M3 = 2500.0  # [kg m^-3] assumed meteoroid bulk density for
 
 # Ψ(i): inclination function of NASA-90/91 (Kessler et al. 1991; Kessler, Reynolds & Anz-Meador 1989, NASA
 # TM-100471; Anderson & Smith 1994, NASA TM-4527; ECSS-E-10-04A), i in degrees; linear interpolation between nodes,
-# constant outside. The publication's table could not be read. About 120 look-ups in the stored pages,
-# documentation, code and issue corpora, and six PyPI packages, found only: the opening pages of Meshishnek 1995
+# constant outside. The publication's table could not be read: the stored pages, documentation, code and issue
+# corpora, and six PyPI packages, hold only: the opening pages of Meshishnek 1995
 # (SMC-TR-95-9), Skibinski 1991 (PL-TR-91-3001), NSS 1740.14, ECSS-E-10-04A, the ESABASE2/Debris technical
 # description and SPENVIS's NASA90 and metdeb pages; catalogue records of TM-100471, TM-4527 and Kessler 1991;
 # no repository or package that implements the table (ECSS-E-ST-10-04C has no NASA-90/91). The nodes are the table as

@@ -126,7 +126,7 @@ def _check_rates_against_attitude(
     any other factor outside [0.5, 2] means a wrong unit, axis order or quaternion convention. For an
     inertially pointing spacecraft the attitude rate is at noise level and the check stays silent.
     """
-    num = den = 0.0
+    den = 0.0
     signal: list[float] = []
     noise: list[float] = []
     gyro_noise: list[float] = []
@@ -144,7 +144,6 @@ def _check_rates_against_attitude(
             continue
         wq_b = wq[:m].reshape(-1, block, 3).mean(axis=1)
         wg_b = wg[:m].reshape(-1, block, 3).mean(axis=1)
-        num += float(np.sum(wg_b * wq_b))
         den += float(np.sum(wq_b * wq_b))
         signal.append(float(np.sqrt(np.mean(wq_b**2))))
         noise.append(float(np.median(robust_noise_sigma(wq_b))))

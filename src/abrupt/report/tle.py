@@ -19,6 +19,7 @@ import pandas as pd
 from abrupt.detect.tle.config import TleDetectorConfig
 from abrupt.detect.tle.elements import mean_element_series, orbit_regime
 from abrupt.detect.tle.steps import component_weights, step_statistics
+from abrupt.errors import printable
 from abrupt.readers.tle import ElementHistory
 from abrupt.report.style import clip_with_markers, save_figure
 from abrupt.score import score_events
@@ -28,11 +29,13 @@ def _utc(values: Any) -> pd.DatetimeIndex:
     return pd.DatetimeIndex(pd.to_datetime(pd.Series(values).astype(str), utc=True, format="ISO8601")).tz_localize(None)
 
 
-def report_title(history: ElementHistory, maneuvers: int) -> str:
-    """The figure's title: the satellite's name (3LE name line, OMM ``OBJECT_NAME``), else, for a plain
-    two-line file, the name of the file it was read from, with its NORAD number and the maneuvers drawn."""
-    label = history.name or Path(history.source).name or "satellite"
-    return f"{label} (NORAD {history.norad_id}): {maneuvers} maneuver(s)"
+def report_title(history: ElementHistory, maneuvers: int, *, name: str | None = None) -> str:
+    """The figure's title: ``name`` (a pseudonym, which then replaces every name read from the input),
+    else the satellite's name (3LE name line, OMM ``OBJECT_NAME``), else, for a plain two-line file, the
+    name of the file it was read from; with its NORAD number and the maneuvers drawn. Control characters
+    are escaped."""
+    label = name or history.name or Path(history.source).name or "satellite"
+    return f"{printable(label)} (NORAD {history.norad_id}): {maneuvers} maneuver(s)"
 
 
 def plot_tle_report(
@@ -43,8 +46,10 @@ def plot_tle_report(
     truth: pd.DataFrame | None = None,
     tolerance_s: float = 86400.0,
     title: str | None = None,
+    name: str | None = None,
 ) -> Path:
-    """Draw the report figure to ``out`` (PNG, SVG or PDF by suffix) and return its path."""
+    """Draw the report figure to ``out`` (PNG, SVG or PDF by suffix) and return its path; ``name`` (a
+    pseudonym) replaces the satellite's own name in the title."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -120,7 +125,7 @@ def plot_tle_report(
     if axes[0].get_legend_handles_labels()[0]:
         axes[0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
     axes[0].set_title(
-        (title or report_title(history, len(shown))) + (f" — {summary}" if summary else ""),
+        (title or report_title(history, len(shown), name=name)) + (f" — {summary}" if summary else ""),
         pad=14,  # room for the truth triangles on the panel's top edge
     )
     return save_figure(fig, out)

@@ -613,7 +613,7 @@ every burn is one event, timed within 0.02 days, its interval holding the burn.
 
 **What does not hold.** On Jason-1 the acceptance asks for a median |Δt| under 0.3 days, precision ≥ 0.85 and
 recall ≥ 0.8 of burns ≥ 2 cm/s at ±1 day, and the interval coverage of every history within 85-95 %: measured on
-the current code 0.41 days, 0.73 (one event per burn response: 0.69 → 0.73), 0.23 and 0.79 — none holds; 17 of
+the current code 0.41 days, 0.73, 0.23 and 0.79 — none holds; 17 of
 its 44 lines ≥ 2 cm/s lie above the stated floor, 8 found (`benchmarks/bench_tle_floor.py`). The predictive lag
 bound (level 0.82, chosen on the five modern histories) keeps every one of them inside 85-95 % leave-one-out.
 Jason-1's own null: 2 false alarms in 15.7 satellite-years, 0.69 a year in 2005 (`bench_tle_own_null_by_year.py`).

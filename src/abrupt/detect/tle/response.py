@@ -217,6 +217,8 @@ def one_response_fits(
     cost_one = float(np.min(ramp_profile(t_s, a_m, lo, hi, burn_grid(t_s, g_first + 1, span_s), span_s, 1.0)))
     # the sets' own scatter in the window (differences of neighbours, robust to the steps between)
     sigma = max(sigma_m, float(robust_scale(np.diff(y))) / math.sqrt(2.0))
+    if not sigma > 0.0:  # a constant window: no scatter to judge one response against two steps
+        return False
     fits = cost_one / sigma**2 <= float(stats.chi2.ppf(ONE_RESPONSE_LEVEL, hi - lo - 4))
     return fits and cost_one <= cost_two
 
