@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from abrupt.errors import ConfigError, InputError
+from abrupt.errors import ConfigError, InputError, RepairLog
 from abrupt.massprops.inertia import (
     axis_errors_deg,
     euler321_dcm,
@@ -272,6 +272,20 @@ def test_missing_wheel_channel_is_an_error_naming_the_wheels():
     q, w, wheels = _channels(n_wheels=3)
     with pytest.raises(InputError, match="3 wheel-speed channels for 4 wheels"):
         momentum_data_from_channels(q, w, wheels, np.array(PYRAMID).T, np.full(4, 0.12))
+
+
+def test_samples_at_a_repeated_time_stamp_are_counted_not_dropped_silently():
+    (tq, q), (tw, w), wheels = _channels()
+    t_dup = np.sort(np.concatenate([tq, tq[50:53]]))  # three stamps written twice
+    wheels[1] = (t_dup, np.zeros(t_dup.size))
+    q_dup = np.vstack([q, q[:3]])
+    repairs = RepairLog("telemetry")
+    momentum_data_from_channels(
+        (np.concatenate([tq, tq[:3]]), q_dup), (tw, w), wheels, np.array(PYRAMID).T, np.full(4, 0.12), repairs=repairs
+    )
+    counts = repairs.as_dict()
+    assert counts["wheel 2 samples at a repeated time stamp dropped (the first kept)"] == 3
+    assert counts["quaternion samples at a repeated time stamp dropped (the first kept)"] == 3
 
 
 def test_rates_in_degrees_declared_as_radians_are_refused():

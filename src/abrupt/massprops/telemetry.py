@@ -48,19 +48,21 @@ def _window_mean(t_ref: FloatArray, v: FloatArray, t_query: FloatArray, half: fl
     return np.asarray(out, dtype=np.float64)
 
 
-def _first_per_stamp(t: FloatArray, v: FloatArray) -> Channel:
-    """Samples sorted by time stamp (stable), the first of each repeated stamp kept."""
+def _first_per_stamp(t: FloatArray, v: FloatArray, name: str, repairs: RepairLog) -> Channel:
+    """Samples sorted by time stamp (stable), the first of each repeated stamp kept, the others counted."""
     order = np.argsort(t, kind="stable")
     t, v = t[order], v[order]
     first = np.concatenate([[True], np.diff(t) > 0])
+    if repeated := int((~first).sum()):
+        repairs.record(f"{name} samples at a repeated time stamp dropped (the first kept)", repeated)
     return t[first], v[first]
 
 
-def _sorted(ch: Channel, name: str, source: str) -> Channel:
+def _sorted(ch: Channel, name: str, source: str, repairs: RepairLog) -> Channel:
     t, v = (np.asarray(a, dtype=np.float64) for a in ch)
     if t.size < 2:
         raise InputError(f"channel {name!r} has fewer than 2 samples", file=source, column=name)
-    return _first_per_stamp(t, v)
+    return _first_per_stamp(t, v, name, repairs)
 
 
 def _attitude(quaternion: Channel, repairs: RepairLog) -> Channel:
@@ -74,7 +76,7 @@ def _attitude(quaternion: Channel, repairs: RepairLog) -> Channel:
         repairs.record("quaternion samples with |q| far from 1 dropped", int(bad_norm.sum()))
     ok &= ~bad_norm
     tq, q = tq[ok], normalise_quaternion(q[ok])
-    return _first_per_stamp(tq, q)
+    return _first_per_stamp(tq, q, "quaternion", repairs)
 
 
 def _body_rate(body_rate: Channel, source: str) -> Channel:
@@ -123,13 +125,18 @@ def _rate_at_stamps(
 
 
 def _wheel_speeds_at_stamps(
-    tq: FloatArray, wheel_speeds: list[Channel], tachometer_gate_s: float, max_hold_s: float, source: str
+    tq: FloatArray,
+    wheel_speeds: list[Channel],
+    tachometer_gate_s: float,
+    max_hold_s: float,
+    source: str,
+    repairs: RepairLog,
 ) -> tuple[FloatArray, BoolArray]:
     """Wheel speeds (n, N) at the attitude stamps (gate-centred), and the stamps near a sample of each."""
     keep = np.ones(tq.size, dtype=bool)
     wheel = np.empty((tq.size, len(wheel_speeds)))
     for i, ch in enumerate(wheel_speeds):
-        tw, vw = _sorted(ch, f"wheel {i + 1}", source)
+        tw, vw = _sorted(ch, f"wheel {i + 1}", source, repairs)
         fin = np.isfinite(vw)
         tw, vw = tw[fin], vw[fin]
         if tw.size < 2:
@@ -147,9 +154,10 @@ def _appendage_momentum(
     spin_inertia_kgm2: float,
     max_hold_s: float,
     source: str,
+    repairs: RepairLog,
 ) -> tuple[FloatArray, BoolArray]:
     """``I_app θ̇ a`` (n, 3) [N m s] at the attitude stamps, and the stamps near an angle sample."""
-    ta, va = _sorted(angle, "appendage angle", source)
+    ta, va = _sorted(angle, "appendage angle", source, repairs)
     fin = np.isfinite(va)
     ta, va = ta[fin], np.unwrap(va[fin])
     rate = np.gradient(va, ta)
@@ -159,9 +167,9 @@ def _appendage_momentum(
     return spin_inertia_kgm2 * np.interp(tq, ta, rate)[:, None] * ax[None, :], near
 
 
-def _thruster_windows(thruster_flag: Channel, source: str) -> list[tuple[float, float]]:
+def _thruster_windows(thruster_flag: Channel, source: str, repairs: RepairLog) -> list[tuple[float, float]]:
     """Firing intervals (flag 1 → 0) [s]; firings closer than a minute merged into one window."""
-    tf, vf = _sorted(thruster_flag, "thruster flag", source)
+    tf, vf = _sorted(thruster_flag, "thruster flag", source, repairs)
     windows: list[tuple[float, float]] = []
     on = None
     for ti, vi in zip(tf, vf, strict=True):
@@ -225,18 +233,18 @@ def momentum_data_from_channels(
     tr, wr = _body_rate(body_rate, source)
     keep = _nearest_distance(tq, tr) <= max_hold_s
     omega = _rate_at_stamps(tq, (tr, wr), wheel_speeds[0] if wheel_speeds else None, tachometer_gate_s, rate_average_s)
-    wheel, near_wheels = _wheel_speeds_at_stamps(tq, wheel_speeds, tachometer_gate_s, max_hold_s, source)
+    wheel, near_wheels = _wheel_speeds_at_stamps(tq, wheel_speeds, tachometer_gate_s, max_hold_s, source, repairs)
     keep &= near_wheels
     h_app = None
     if appendage_angle is not None and appendage_axis_B is not None and appendage_spin_inertia_kgm2 > 0:
         h_app, near_angle = _appendage_momentum(
-            tq, appendage_angle, appendage_axis_B, appendage_spin_inertia_kgm2, max_hold_s, source
+            tq, appendage_angle, appendage_axis_B, appendage_spin_inertia_kgm2, max_hold_s, source, repairs
         )
         keep &= near_angle
     dropped = int((~keep).sum())
     if dropped:
         repairs.record("attitude stamps without a nearby sample of every channel dropped", dropped)
-    windows = _thruster_windows(thruster_flag, source) if thruster_flag is not None else []
+    windows = _thruster_windows(thruster_flag, source, repairs) if thruster_flag is not None else []
     t_k, q_k = tq[keep], q[keep]
     nadir = None
     rate_orbit = None
