@@ -48,7 +48,7 @@ from abrupt.detect.attitude.flight_glr import (
     SubBlocks,
     local_ratio_level,
 )
-from abrupt.detect.attitude.gyro_bias import debiased_momentum
+from abrupt.detect.attitude.gyro_bias import BIAS_TRACK_S, debiased_momentum
 from abrupt.detect.attitude.leak_scan import LeakScan
 from abrupt.errors import ConfigError, InputError
 from abrupt.events import config_hash, new_run_id
@@ -178,7 +178,7 @@ class CleaningConfig:
     max_harmonics: int = 6
     trend_order: int = 2
     spacing_orbits: float = 0.25
-    half_width_orbits: float = 1.0
+    half_width_orbits: float = 0.5
     gyro_bias: bool = True
 
     @classmethod
@@ -272,7 +272,7 @@ def chunk_margin_s(spacecraft: Spacecraft, config: FlightRunConfig) -> float:
 
     Each pass depends on data within (anchor spacing + fit half-width) of the model plus one GLR span;
     the slew mask on half its nominal-rate window; Savitzky-Golay on half its window; a peak's local level
-    on ``LOCAL_REACH_S`` of the statistic either side.
+    on ``LOCAL_REACH_S`` of the statistic either side; the gyro bias on half its window.
     """
     c = config.cleaning
     orbit = spacecraft.orbit.period_s if spacecraft.orbit is not None else 0.0
@@ -281,7 +281,8 @@ def chunk_margin_s(spacecraft: Spacecraft, config: FlightRunConfig) -> float:
     span = 2 * config.window_s + config.guard_s
     per_pass = fit + 2 * span
     sg = max((ch.savgol_window_s for ch in flight_channels(spacecraft).channels), default=0.0)
-    return c.passes * per_pass + c.slew.nominal_window_s / 2 + c.slew.window_s + sg + 60.0 + LOCAL_REACH_S
+    bias = BIAS_TRACK_S / 2 if c.gyro_bias else 0.0
+    return c.passes * per_pass + c.slew.nominal_window_s / 2 + c.slew.window_s + sg + 60.0 + LOCAL_REACH_S + bias
 
 
 # ------------------------------------------------------------------------------------------------

@@ -71,7 +71,7 @@ def windowed_bias(
     if n < 2:
         return np.zeros((n, 3))
     dt = float(np.median(np.diff(t_ns))) / NS
-    use = np.isfinite(d).all(axis=1)
+    use: BoolArray = np.asarray(np.isfinite(d).all(axis=1))
     c = np.concatenate([np.zeros((1, 3)), np.cumsum(np.where(use[:, None], d, 0.0), axis=0)])
     m = np.concatenate([[0], np.cumsum(use)])
     half = int(0.5 * window_s * NS)
