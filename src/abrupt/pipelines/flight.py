@@ -159,8 +159,8 @@ def ingest_archives(
 class CleaningConfig:
     """Switchable cleaning stages (each shown before/after in the report).
 
-    ``event_masks``: mask event-flag firings (thrusters) with the channel's margins; ``gyro_bias``: form ᴺH
-    from the gyro rate less its bias against the star tracker (:mod:`abrupt.detect.attitude.gyro_bias`);
+    ``event_masks``: mask event-flag firings (thrusters) with the channel's margins; ``gyro_bias`` (off by
+    default): form ᴺH from the gyro rate less its bias against the star tracker (module ``gyro_bias``);
     ``slew_masks``: mask slews found from the gyro; ``savgol``: Savitzky-Golay on channels that declare
     it (otherwise linear); ``comb``: orbit harmonics; ``trend``: slow external-torque trend;
     ``passes``: fit iterations with candidate steps; ``candidate_sigma``: GLR value above which a peak
@@ -178,8 +178,8 @@ class CleaningConfig:
     max_harmonics: int = 6
     trend_order: int = 2
     spacing_orbits: float = 0.25
-    half_width_orbits: float = 0.5
-    gyro_bias: bool = True
+    half_width_orbits: float = 1.0
+    gyro_bias: bool = False
 
     @classmethod
     def off(cls) -> CleaningConfig:
