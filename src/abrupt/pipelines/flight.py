@@ -48,6 +48,7 @@ from abrupt.detect.attitude.flight_glr import (
     SubBlocks,
     local_ratio_level,
 )
+from abrupt.detect.attitude.gyro_bias import BIAS_TRACK_S, debiased_momentum
 from abrupt.detect.attitude.leak_scan import LeakScan
 from abrupt.errors import ConfigError, InputError
 from abrupt.events import config_hash, new_run_id
@@ -158,7 +159,8 @@ def ingest_archives(
 class CleaningConfig:
     """Switchable cleaning stages (each shown before/after in the report).
 
-    ``event_masks``: mask event-flag firings (thrusters) with the channel's margins;
+    ``event_masks``: mask event-flag firings (thrusters) with the channel's margins; ``gyro_bias`` (off by
+    default): form ᴺH from the gyro rate less its bias against the star tracker (module ``gyro_bias``);
     ``slew_masks``: mask slews found from the gyro; ``savgol``: Savitzky-Golay on channels that declare
     it (otherwise linear); ``comb``: orbit harmonics; ``trend``: slow external-torque trend;
     ``passes``: fit iterations with candidate steps; ``candidate_sigma``: GLR value above which a peak
@@ -177,11 +179,13 @@ class CleaningConfig:
     trend_order: int = 2
     spacing_orbits: float = 0.25
     half_width_orbits: float = 1.0
+    gyro_bias: bool = False
 
     @classmethod
     def off(cls) -> CleaningConfig:
         """No cleaning at all: raw ᴺH with gaps only (the baseline)."""
-        return cls(event_masks=False, slew_masks=False, savgol=False, comb=False, trend=False, passes=1)
+        return cls(event_masks=False, slew_masks=False, savgol=False, comb=False, trend=False, passes=1,
+                   gyro_bias=False)  # fmt: skip
 
     @property
     def comb_config(self) -> CombConfig:
@@ -268,7 +272,7 @@ def chunk_margin_s(spacecraft: Spacecraft, config: FlightRunConfig) -> float:
 
     Each pass depends on data within (anchor spacing + fit half-width) of the model plus one GLR span;
     the slew mask on half its nominal-rate window; Savitzky-Golay on half its window; a peak's local level
-    on ``LOCAL_REACH_S`` of the statistic either side.
+    on ``LOCAL_REACH_S`` of the statistic either side; the gyro bias on half its window.
     """
     c = config.cleaning
     orbit = spacecraft.orbit.period_s if spacecraft.orbit is not None else 0.0
@@ -277,7 +281,8 @@ def chunk_margin_s(spacecraft: Spacecraft, config: FlightRunConfig) -> float:
     span = 2 * config.window_s + config.guard_s
     per_pass = fit + 2 * span
     sg = max((ch.savgol_window_s for ch in flight_channels(spacecraft).channels), default=0.0)
-    return c.passes * per_pass + c.slew.nominal_window_s / 2 + c.slew.window_s + sg + 60.0 + LOCAL_REACH_S
+    bias = BIAS_TRACK_S / 2 if c.gyro_bias else 0.0
+    return c.passes * per_pass + c.slew.nominal_window_s / 2 + c.slew.window_s + sg + 60.0 + LOCAL_REACH_S + bias
 
 
 # ------------------------------------------------------------------------------------------------
@@ -401,10 +406,11 @@ def process_span(
     check_channel_units(spacecraft, samples)
     check_wheel_units(spacecraft, table)
     check_tachometer_units(spacecraft, samples)
-    h_n, _ = timetable_momentum(spacecraft, table, inertia_kgm2)
     valid = table.valid.copy()
     ev, sl = _masks(samples, table, flight, c, dt)
     ok = valid & ~ev & ~sl
+    h_n = debiased_momentum(spacecraft, table, ok, inertia_kgm2)[0] if c.gyro_bias else None
+    h_n = timetable_momentum(spacecraft, table, inertia_kgm2)[0] if h_n is None else h_n
     detector = config.detector()
     period = orbit_period_s(spacecraft, config) if (c.comb or c.trend) else 1.0
     q_bn = table.quaternion_BN

@@ -6,13 +6,14 @@ strike is not absorbed by the smooth part). The cleaned series of the last pass 
 (:func:`abrupt.detect.attitude.leak_scan.scan_leaks`, each UTC day of the span calibrated on its own
 data), reported as events of their own (:mod:`abrupt.pipelines.flight_leaks`).
 
-The scan runs on the cleaned series, which the smooth model has bent around each leak (about half of a
-15-min leak's change is absorbed on a ±1-orbit fit, and the residual rings for an orbit): there it only
-proposes candidates, each exceedance of its calibrated threshold with the interval of its ramp fit. Each
-candidate is then tested and sized on the uncleaned ᴺH (:func:`abrupt.detect.attitude.leak_fit.joint_leak_fit`):
-the ramp fitted jointly with a local trend and orbit comb, free steps at the gaps and at the step
-detector's candidates of the last pass (the neighbouring events, fitted together), against one to three
-steps. Only the candidates it keeps are leaks, with its onset, duration and total.
+The scan runs on the cleaned series, which the smooth model has bent around each leak (about half of a 15-min
+leak's change is absorbed on a ±1-orbit fit, and the residual rings for an orbit):
+there it only proposes candidates, each exceedance of its calibrated threshold with the interval of its ramp
+fit. Each candidate is then tested and sized on the uncleaned ᴺH
+(:func:`abrupt.detect.attitude.leak_fit.joint_leak_fit`): the ramp fitted jointly with a local trend and orbit
+comb, free steps at the gaps and at the step detector's candidates of the last pass (the neighbouring events,
+fitted together), against one to three steps. Only the candidates it keeps are leaks, with its onset, duration
+and total.
 """
 
 from __future__ import annotations

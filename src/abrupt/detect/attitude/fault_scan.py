@@ -403,6 +403,15 @@ def _rate_findings(series: _RateSeries | None, core: tuple[int, int], budget: Fa
     return FaultScan(found + bias.findings, cals + bias.calibrations)
 
 
+def bias_step_times(table: Timetable, ok: BoolArray, core: tuple[int, int], budget: FalseAlarmBudget) -> list[int]:
+    """Times [ns] of the gyro bias steps the scan finds in ``core`` (each axis's share of the gyro's rate,
+    as in :func:`scan_rate_sensors`), sorted."""
+    series = _rate_series(table, ok)
+    if series is None:
+        return []
+    return sorted(f.time_ns for f in _bias_findings(series, core, budget.bonferroni(2)).findings)
+
+
 def scan_rate_sensors(table: Timetable, ok: BoolArray, core: tuple[int, int], budget: FalseAlarmBudget) -> FaultScan:
     """Gyro (per axis) and star tracker against each other on the grid (module docstring)."""
     return _rate_findings(_rate_series(table, ok), core, budget)
