@@ -5,7 +5,8 @@ spacecraft name and every mnemonic by the pseudonyms of a decoder file (``real_n
 nothing downstream of this module ever sees the decoder or a real name. Archiver artifacts are then
 removed and counted (they are not data): blank rows, rows with an empty field, placeholder values
 (``-999999``, the text ``NaN``), infinite or absurd values (``inf``, ``1e300``: beyond 1e20, above
-any 64-bit counter; counter "infinite or absurd values (|v| > 1e20)"), exact duplicate rows.
+any 64-bit counter; counter "infinite or absurd values (|v| > 1e20)"), rows dated more than a day after
+today (counter "rows dated after today"), exact duplicate rows.
 Conflicting duplicates (same time and mnemonic, different values) and time reversals are reported
 and resolved by keeping the first value in file order and sorting by time.
 
@@ -47,6 +48,16 @@ DEFAULT_PLACEHOLDERS: tuple[float, ...] = (-999999.0, 999999.0, -99999.0, -99999
 # Beyond any telemetry value: above the largest 64-bit counter (1.8e19); inf and 1e300 are corruption.
 MAX_ABS_VALUE = 1e20
 ARCHIVE_ABSURD = "infinite or absurd values (|v| > 1e20)"
+ARCHIVE_SHORT_ROWS = "rows with a wrong number of fields (a cut line: skipped)"
+ARCHIVE_FUTURE = "rows dated after today (telemetry is recorded, not predicted)"
+FUTURE_MARGIN_NS = 86_400 * 10**9  # a day of clock and time-zone slack before a time counts as in the future
+
+
+def _latest_time_ns() -> int:
+    """The latest sample time (ns since 1970, UTC) an archive may hold: now plus a day."""
+    return int(np.datetime64("now", "ns").astype(np.int64)) + FUTURE_MARGIN_NS
+
+
 TIME_NAMES = ("time", "timestamp", "time_utc", "utc", "datetime")
 
 
@@ -203,7 +214,23 @@ def pseudonymise_text(text: str, decoder: Decoder) -> str:
     return pattern.sub(lambda m: by_lower[m.group(0).lower()], text)
 
 
-def _read_raw(path: Path) -> pa.Table:
+class _ShortRows:
+    """Rows whose number of fields is not the header's (a line cut by an interrupted export): skipped and
+    counted, unless there are more than :data:`MAX_SHORT_ROWS` of them (then the file is not a table and
+    the parser's error names the row)."""
+
+    def __init__(self) -> None:
+        self.rows = 0
+
+    def __call__(self, row: Any) -> str:
+        self.rows += 1
+        return "skip" if self.rows <= MAX_SHORT_ROWS else "error"
+
+
+MAX_SHORT_ROWS = 10
+
+
+def _read_raw(path: Path, counts: Counter[str]) -> pa.Table:
     name = path.name.lower()
     try:
         if name.endswith(".parquet") or name.endswith(".pq"):
@@ -211,7 +238,8 @@ def _read_raw(path: Path) -> pa.Table:
         with open(path, "rb") as fh:
             gz = fh.read(2) == b"\x1f\x8b"
         read = pacsv.ReadOptions(block_size=1 << 24)
-        parse = pacsv.ParseOptions(ignore_empty_lines=True)
+        short = _ShortRows()
+        parse = pacsv.ParseOptions(ignore_empty_lines=True, invalid_row_handler=short)
 
         def csv_with(opts: pacsv.ConvertOptions) -> pa.Table:
             if gz:
@@ -238,12 +266,18 @@ def _read_raw(path: Path) -> pa.Table:
                 quoted_strings_can_be_null=True,
             )
             try:
-                return csv_with(typed)
+                table = csv_with(typed)
+                if short.rows:
+                    counts[ARCHIVE_SHORT_ROWS] += short.rows
+                return table
             except pa.ArrowInvalid:
-                pass
-        return csv_with(
+                short.rows = 0
+        table = csv_with(
             pacsv.ConvertOptions(null_values=[""], strings_can_be_null=True, quoted_strings_can_be_null=True)
         )
+        if short.rows:
+            counts[ARCHIVE_SHORT_ROWS] += short.rows
+        return table
     except pa.ArrowInvalid as exc:
         raise InputError(f"not a readable table: {str(exc).splitlines()[0]}", file=path) from None
     except OSError as exc:
@@ -375,9 +409,9 @@ def read_archive(
 DAY_NS = 86_400 * 1_000_000_000
 
 
-def _long_table(path: Path, layout: str) -> pa.Table:
+def _long_table(path: Path, layout: str, counts: Counter[str]) -> pa.Table:
     """The file as a long table ``time, mnemonic, value`` (wide tables are melted)."""
-    table = _read_raw(path)
+    table = _read_raw(path, counts)
     cols = [c.strip() for c in table.column_names]
     table = table.rename_columns(cols)
     lower = [c.lower() for c in cols]
@@ -519,8 +553,8 @@ def _read_archive(
 ) -> ArchiveChunk:
     """:func:`read_archive` without the pseudonymisation of error messages."""
     path = Path(path)
-    table = _long_table(path, layout)
     counts: Counter[str] = Counter()
+    table = _long_table(path, layout, counts)
     n0 = table.num_rows
     # Rows that are entirely empty (",,") are blank-line artifacts.
     all_empty = pc.and_(pc.is_null(table.column("time")), pc.is_null(table.column("mnemonic")))
@@ -541,11 +575,12 @@ def _read_archive(
     t_valid = ~np.asarray(times.is_null().to_numpy(zero_copy_only=False), dtype=bool)
     t_int = np.where(t_valid, np.asarray(times.cast(pa.int64()).fill_null(0).to_numpy(), np.int64), 0)
     no_name = codes < 0
+    future = t_valid & (t_int > _latest_time_ns())
     is_placeholder = np.isin(values, np.asarray(placeholders, dtype=np.float64)) | (np.isnan(values) & ~value_null)
     with np.errstate(invalid="ignore"):
         is_absurd = ~np.isnan(values) & ~(np.abs(values) <= MAX_ABS_VALUE)  # inf, -inf, 1e300
     # Order of judgement: missing time or name -> empty value -> placeholder -> absurd -> not in decoder.
-    drop_missing = ~t_valid | no_name
+    drop_missing = ~t_valid | no_name | future
     drop_empty = ~drop_missing & value_null
     drop_placeholder = ~drop_missing & ~drop_empty & is_placeholder
     drop_absurd = ~drop_missing & ~drop_empty & ~drop_placeholder & is_absurd
@@ -581,6 +616,8 @@ def _read_archive(
     missing_time_rows = int(np.count_nonzero(~t_valid))
     if missing_time_rows:
         counts["rows without a time"] += missing_time_rows
+    if future.any():
+        counts[ARCHIVE_FUTURE] += int(np.count_nonzero(future))
     no_name_rows = int(np.count_nonzero(no_name & t_valid))
     if no_name_rows:
         counts["rows without a mnemonic"] += no_name_rows
