@@ -328,6 +328,8 @@ OEM = cases_of(
         ("oem CENTER_NAME MOON", _orbit("oem", edit=_replace_text("CENTER_NAME = EARTH", "CENTER_NAME = MOON"))),
         ("oem REF_FRAME TEME", _orbit("oem", edit=_replace_text("REF_FRAME = GCRF", "REF_FRAME = TEME"))),
         ("oem epochs in 2078", _orbit("oem", _future)),
+        ("oem across the 2016 leap second (control)", _orbit("oem", ok=True, epoch="2016-12-31T20:00:00")),
+        ("sp3 across the 2016 leap second (control)", _orbit("sp3", ok=True, epoch="2016-12-31T20:00:00")),
         ("oem one epoch twice, 2 km apart", _orbit("oem", _conflicting_epoch)),
         ("oem-xml velocities in m/s", _orbit("oem-xml", _scaled(1.0, 1e3), said=r"rescaled by 1e-3")),
         ("oem-xml external entity", _orbit("oem-xml", edit=_oem_xxe)),
@@ -698,5 +700,27 @@ OUTPUTS = cases_of(
 )
 
 
+def _platforms(row: str) -> Callable[[Path], Run]:
+    """``density tle`` of the quiet history with a platforms file of one row."""
+
+    def build(folder: Path) -> Run:
+        h = _history(folder)
+        (folder / "p.csv").write_text(f"object,shape_class,min_area_m2,max_area_m2,mass_kg\n{row}\n")
+        argv = ["density", "tle", h.name, "--platforms", "p.csv", "--out", "w.csv", "--no-model", "--maneuvers", "none"]
+        return Run(argv, [h.name, "p.csv"], events=None, names="p.csv")
+
+    return build
+
+
+DENSITY = cases_of(
+    "hostile files: density platforms",
+    [
+        ("platform area in cm^2", _platforms("10000,3U,100,600,4")),
+        ("platform negative mass", _platforms("10000,3U,0.01,0.035,-4")),
+        ("platform NaN area", _platforms("10000,3U,nan,0.035,4")),
+    ],
+)
+
+
 def hostile_cases() -> list[Case]:
-    return [*TLE, *SP3, *OEM, *CPF, *TRACKING, *ATTITUDE, *STORE, *OUTPUTS]
+    return [*TLE, *SP3, *OEM, *CPF, *TRACKING, *ATTITUDE, *STORE, *OUTPUTS, *DENSITY]

@@ -19,6 +19,7 @@ from click.testing import CliRunner
 from _audit_cases import truth_orbit, with_field
 from abrupt.catalog.event_import import MAX_DV_MPS, read_event_table
 from abrupt.cli.commands import cli
+from abrupt.density.constellation import read_platforms
 from abrupt.errors import InputError, OutputError
 from abrupt.readers.archive import ARCHIVE_FUTURE, ARCHIVE_SHORT_ROWS, read_archive, read_decoder
 from abrupt.readers.ephemeris import read_ephemeris
@@ -151,3 +152,13 @@ def test_an_omm_record_with_an_impossible_bstar_is_refused(tmp_path: Path) -> No
     )
     with pytest.raises(InputError, match=r"BSTAR 250\.0 /earth radius is beyond 10"):
         read_omm(path, strict=True)
+
+
+def test_a_platform_area_in_square_centimetres_is_refused(tmp_path: Path) -> None:
+    p = tmp_path / "platforms.csv"
+    header = "object,shape_class,min_area_m2,max_area_m2,mass_kg\n"
+    p.write_text(header + "A,3U,0.01,0.035,4\nB,3U,100,600,4\n")  # B: a 3U's faces written in cm²
+    with pytest.raises(InputError, match=r"platforms\.csv:3: max_area_m2 / mass_kg = 150 m²/kg is beyond 100"):
+        read_platforms(p, ["A", "B"])
+    p.write_text(header + "A,3U,0.01,0.035,4\nB,3U,0.01,0.06,4\n")
+    assert list(read_platforms(p, ["A", "B"])["object"]) == ["A", "B"]
