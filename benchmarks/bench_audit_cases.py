@@ -2,8 +2,8 @@
 kinds, through the installed ``abrupt`` as a subprocess, each bounded to 60 s and 2 GB of address space.
 
 Each case builds its inputs in its own empty folder (``_audit_orbit_cases.py``, ``_audit_door_cases.py``,
-``_audit_laser_cases.py``, ``_audit_scaled_cases.py``, ``_audit_hostile_cases.py``)
-and runs there; the verdict of one run is:
+``_audit_laser_cases.py``, ``_audit_scaled_cases.py``, ``_audit_hostile_cases.py``,
+``_audit_hostile_tracking_cases.py``) and runs there; the verdict of one run is:
 
 - ``clean error``: exit 2 and one ``error:`` line naming the file (or the key, the option) and the reason,
   no file left behind (no new catalog, no partial output);
@@ -43,6 +43,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _audit_cases import ROOT, Case, Run
 from _audit_door_cases import door_cases
 from _audit_hostile_cases import apply_bytes, hostile_cases, store_target
+from _audit_hostile_tracking_cases import more_hostile_cases
 from _audit_laser_cases import laser_cases
 from _audit_orbit_cases import orbit_cases
 from _audit_scaled_cases import apply_edit, scaled_cases
@@ -252,7 +253,14 @@ def main(argv: list[str] | None = None) -> dict[str, int]:
     SOURCE[0] = args.src.resolve()
     cases = [
         c
-        for c in (*orbit_cases(), *door_cases(), *laser_cases(), *scaled_cases(), *hostile_cases())
+        for c in (
+            *orbit_cases(),
+            *door_cases(),
+            *laser_cases(),
+            *scaled_cases(),
+            *hostile_cases(),
+            *more_hostile_cases(),
+        )
         if args.only in c.name and args.group in c.group
     ]
     totals: Counter[str] = Counter()
