@@ -26,6 +26,7 @@ from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.readers.navigation_csv import write_navigation_csv
 from abrupt.readers.oem import write_oem
 from abrupt.readers.omm import read_omm
+from abrupt.readers.orekit_od_input import read_od_input
 from abrupt.readers.tle import read_tle
 from abrupt.simulate.tle_catalogue import write_catalogue
 
@@ -162,3 +163,21 @@ def test_a_platform_area_in_square_centimetres_is_refused(tmp_path: Path) -> Non
         read_platforms(p, ["A", "B"])
     p.write_text(header + "A,3U,0.01,0.035,4\nB,3U,0.01,0.06,4\n")
     assert list(read_platforms(p, ["A", "B"])["object"]) == ["A", "B"]
+
+
+@pytest.mark.parametrize(
+    ("vy_mps", "reason"),
+    [
+        (7.673765765, r"setup\.txt:6: .*perigee radius 0\.0 km is inside the Earth"),  # km/s written for m/s
+        (1.5 * 7673.765765, r"setup\.txt:6: .*not bound to the Earth"),  # above the escape speed at 7378 km
+    ],
+)
+def test_a_setup_whose_a_priori_state_is_no_earth_orbit_is_refused(vy_mps: float, reason: str, tmp_path: Path) -> None:
+    runner = CliRunner()
+    argv = ["-q", "simulate", "tracking", "--dv", "0", "--out", str(tmp_path / "t.aer")]
+    assert runner.invoke(cli, [*argv, "--setup-out", str(tmp_path / "setup.txt")]).exit_code == 0
+    setup = tmp_path / "setup.txt"
+    assert list(read_od_input(setup).stations) == ["ASCENSION"]  # the simulated set-up is a bound orbit
+    setup.write_text(setup.read_text().replace("orbit.cartesian.vy = 7673.765765", f"orbit.cartesian.vy = {vy_mps!r}"))
+    with pytest.raises(InputError, match=reason):
+        read_od_input(setup)
