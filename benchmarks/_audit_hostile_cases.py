@@ -621,7 +621,7 @@ STORE = cases_of(
         ("flux exposure analysed fraction 1.5", _exposure("day,analysed_fraction\n2026-03-10,1.5\n")),
         ("flux exposure analysed fraction -0.2", _exposure("day,analysed_fraction\n2026-03-10,-0.2\n")),
         ("flux exposure a day 2026-02-30", _exposure("day,analysed_fraction\n2026-02-30,0.9\n")),
-        ("flux exposure altitude 70 000 km", _exposure("day,analysed_fraction,altitude_km\n2026-03-10,0.9,70000\n")),
+        ("flux exposure altitude 5e5 km", _exposure("day,analysed_fraction,altitude_km\n2026-03-10,0.9,5e5\n")),
         ("flux exposure altitude -50 km", _exposure("day,analysed_fraction,altitude_km\n2026-03-10,0.9,-50\n")),
     ],
 )

@@ -159,14 +159,16 @@ TRACKING = cases_of(
 # ------------------------------------------------------------------------------------------------ outputs
 
 
-def _orbit_out(out: str, *extra: str, make: Callable[[Path], None] | None = None) -> Callable[[Path], Run]:
+def _orbit_out(
+    out: str, *extra: str, make: Callable[[Path], None] | None = None, ok: bool = False
+) -> Callable[[Path], Run]:
     def build(folder: Path) -> Run:
         path = folder / "o.csv"
         write_navigation_csv(truth_orbit(hours=3.0), path)
         if make is not None:
             make(folder)
         argv = ["detect", "orbit", path.name, "--out", out, "--catalog", "c.sqlite", *extra]
-        return Run(argv, [path.name], names=re.escape(out) + "|c.sqlite", events=None)
+        return Run(argv, [path.name], names=re.escape(out) + "|c.sqlite", events=None, ok=ok)
 
     return build
 
@@ -200,7 +202,7 @@ OUTPUTS = cases_of(
         ("--out a symlink to the input, --overwrite", _orbit_out("e.csv", "--overwrite", make=_symlink_out)),
         ("--out a hard link to the input, --overwrite", _orbit_out("e.csv", "--overwrite", make=_hardlink_out)),
         ("--out an existing folder", _orbit_out("e.csv", make=_folder_out)),
-        ("--out in a missing folder", _orbit_out("missing/e.csv")),
+        ("--out in a missing folder (created)", _orbit_out("missing/e.csv", ok=True)),
         ("--out the input via ./ and --overwrite", _orbit_out("./o.csv", "--overwrite")),
         ("--out /dev/null", _orbit_out("/dev/null")),
         ("--out on a full disk (4 kB)", lambda f: replace(_orbit_out("e.csv")(f), fsize_bytes=4096)),

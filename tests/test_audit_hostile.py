@@ -21,6 +21,7 @@ from abrupt.catalog.event_import import MAX_DV_MPS, read_event_table
 from abrupt.cli.commands import cli
 from abrupt.density.constellation import read_platforms
 from abrupt.errors import InputError, OutputError
+from abrupt.flux.exposure import read_day_table
 from abrupt.readers.archive import ARCHIVE_FUTURE, ARCHIVE_SHORT_ROWS, read_archive, read_decoder
 from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.readers.navigation_csv import write_navigation_csv
@@ -181,3 +182,12 @@ def test_a_setup_whose_a_priori_state_is_no_earth_orbit_is_refused(vy_mps: float
     setup.write_text(setup.read_text().replace("orbit.cartesian.vy = 7673.765765", f"orbit.cartesian.vy = {vy_mps!r}"))
     with pytest.raises(InputError, match=reason):
         read_od_input(setup)
+
+
+def test_an_exposure_day_beyond_the_moon_is_refused(tmp_path: Path) -> None:
+    table = tmp_path / "days.csv"
+    table.write_text("day,analysed_fraction,altitude_km\n2026-03-10,0.9,35786\n2026-03-11,0.9,5e5\n")
+    with pytest.raises(InputError, match=r"days\.csv:3: column 'altitude_km': .*below the Moon's distance"):
+        read_day_table(table)
+    table.write_text("day,analysed_fraction,altitude_km\n2026-03-10,0.9,35786\n")  # a geostationary day
+    assert read_day_table(table)["altitude_km"].tolist() == [35786.0]
