@@ -191,3 +191,11 @@ def test_an_exposure_day_beyond_the_moon_is_refused(tmp_path: Path) -> None:
         read_day_table(table)
     table.write_text("day,analysed_fraction,altitude_km\n2026-03-10,0.9,35786\n")  # a geostationary day
     assert read_day_table(table)["altitude_km"].tolist() == [35786.0]
+
+
+def test_an_archive_that_is_not_utf8_is_refused_not_dropped_row_by_row(tmp_path: Path, decoder: Path) -> None:
+    path = tmp_path / "BIRD_day.csv"
+    rows = _rows("2026-03-10", 30)
+    path.write_bytes((HEADER + "\n".join(rows[:5])).encode() + b"\n2026-03-10T01:00:00Z,BIRD.\xc9,1.0\n")
+    with pytest.raises(InputError, match=r":7:27: not UTF-8 text \(byte 0xc9\)"):
+        read_archive(path, read_decoder(decoder))

@@ -42,6 +42,7 @@ import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from abrupt.errors import ConfigError, InputError
+from abrupt.readers.compression import read_bytes
 from abrupt.readers.text import check_column_count
 
 DEFAULT_PLACEHOLDERS: tuple[float, ...] = (-999999.0, 999999.0, -99999.0, -9999999.0)
@@ -409,9 +410,30 @@ def read_archive(
 DAY_NS = 86_400 * 1_000_000_000
 
 
+def _refuse_non_utf8(path: Path) -> None:
+    """Raise the :class:`InputError` of a text archive that is not UTF-8 (a column the CSV parser left as
+    bytes would match no decoder name, and every row would be dropped), naming the first bad byte."""
+    raw = read_bytes(path)
+    try:
+        raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        column = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise InputError(
+            f"not UTF-8 text (byte 0x{raw[exc.start]:02x}); export the archive as UTF-8",
+            file=path,
+            line=line,
+            column=column,
+        ) from None
+    raise InputError("a column holds bytes that are not text", file=path)
+
+
 def _long_table(path: Path, layout: str, counts: Counter[str]) -> pa.Table:
     """The file as a long table ``time, mnemonic, value`` (wide tables are melted)."""
     table = _read_raw(path, counts)
+    text = not path.name.lower().endswith((".parquet", ".pq"))
+    if text and any(pa.types.is_binary(f.type) or pa.types.is_large_binary(f.type) for f in table.schema):
+        _refuse_non_utf8(path)
     cols = [c.strip() for c in table.column_names]
     table = table.rename_columns(cols)
     lower = [c.lower() for c in cols]
