@@ -543,6 +543,22 @@ def store_target(folder: Path, run: Run, store: str) -> None:
     run.inputs.append(target)
 
 
+STORED = f"store/spacecraft=SC-B/day={DAY}/samples.parquet"
+
+
+def _cut_store(argv: list[str]) -> Callable[[Path], Run]:
+    """``argv`` run on a store whose one Parquet file was cut in half by a kill (after a first ingest)."""
+
+    def build(folder: Path) -> Run:
+        _decoder(folder)
+        archive = _archive(folder, "BIRD_day.csv", 300)
+        first = ["-q", "ingest", archive.name, "--decoder", "decoder.csv", "--store", "store"]
+        names = r"samples\.parquet|store|archive 1 of 1"
+        return Run(argv, [archive.name], events=None, before=[first, ["__truncate__", STORED]], names=names)
+
+    return build
+
+
 EVENTS_HEADER = "spacecraft,kind,detector,time_utc,dH_Nms,dv_mps\n"
 
 
@@ -611,6 +627,14 @@ STORE = cases_of(
         ("store export --overwrite onto a stored file", _store_export_over),
         ("catalog import a header line only", _import("", ok=True)),
         ("catalog import an empty file", _import(None)),
+        (
+            "store export of a Parquet file cut by a kill",
+            _cut_store(["store", "export", "store", "--spacecraft", "SC-B", "--out", "x.csv"]),
+        ),
+        (
+            "ingest into a day whose Parquet file was cut",
+            _cut_store(["ingest", "BIRD_day.csv", "--decoder", "decoder.csv", "--store", "store"]),
+        ),
         ("catalog import a time 'nan'", _import("SC-B,strike,attitude.glr,nan,0.1,\n")),
         ("catalog import an event in 2090", _import("SC-B,strike,attitude.glr,2090-03-10T00:00:00Z,0.1,\n")),
         ("catalog import a negative |dH|", _import(f"SC-B,strike,attitude.glr,{GOOD},-0.1,\n")),

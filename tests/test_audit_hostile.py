@@ -199,3 +199,19 @@ def test_an_archive_that_is_not_utf8_is_refused_not_dropped_row_by_row(tmp_path:
     path.write_bytes((HEADER + "\n".join(rows[:5])).encode() + b"\n2026-03-10T01:00:00Z,BIRD.\xc9,1.0\n")
     with pytest.raises(InputError, match=r":7:27: not UTF-8 text \(byte 0xc9\)"):
         read_archive(path, read_decoder(decoder))
+
+
+def test_a_stored_day_cut_by_a_kill_is_named_not_taken_as_stored(tmp_path: Path, decoder: Path) -> None:
+    archive = tmp_path / "BIRD_day.csv"
+    archive.write_text(HEADER + "\n".join(_rows("2026-03-10", 40)) + "\n")
+    store = tmp_path / "store"
+    runner = CliRunner()
+    ingest = ["-q", "ingest", str(archive), "--decoder", str(decoder), "--store", str(store)]
+    assert runner.invoke(cli, ingest).exit_code == 0
+    (stored,) = store.rglob("samples.parquet")
+    stored.write_bytes(stored.read_bytes()[: stored.stat().st_size // 2])
+    for argv in (ingest, ["store", "export", str(store), "--spacecraft", "SC-B", "--out", str(tmp_path / "x.csv")]):
+        result = runner.invoke(cli, argv)
+        assert isinstance(result.exception, InputError), result.output
+        assert "samples.parquet" in str(result.exception) and "do not read" in str(result.exception)
+    assert not (tmp_path / "x.csv").exists()
