@@ -22,7 +22,7 @@ from abrupt.cli.commands import cli
 from abrupt.density.constellation import read_platforms
 from abrupt.errors import InputError, OutputError
 from abrupt.flux.exposure import read_day_table
-from abrupt.readers.archive import ARCHIVE_FUTURE, ARCHIVE_SHORT_ROWS, read_archive, read_decoder
+from abrupt.readers.archive import ARCHIVE_CUT_LINE, ARCHIVE_FUTURE, read_archive, read_decoder
 from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.readers.navigation_csv import write_navigation_csv
 from abrupt.readers.oem import write_oem
@@ -102,12 +102,12 @@ def test_an_archive_cut_in_its_last_line_keeps_every_whole_row(tmp_path: Path, d
     path = tmp_path / "BIRD_day.csv"
     path.write_text(HEADER + "\n".join(rows)[:-24])  # the last row cut inside its time
     chunk = read_archive(path, read_decoder(decoder))
-    assert chunk.file_counts[ARCHIVE_SHORT_ROWS] == 1
+    assert chunk.file_counts[ARCHIVE_CUT_LINE] == 1
     np.testing.assert_array_equal(np.sort(chunk.samples["value"].to_numpy()), np.arange(49) + 0.25)
-    garbage = tmp_path / "BIRD_bad.csv"
-    garbage.write_text(HEADER + "a,b,c,d\n" * 11 + "\n".join(rows) + "\n")
+    inside = tmp_path / "BIRD_bad.csv"  # a short line inside the file is no interrupted write
+    inside.write_text(HEADER + "\n".join([*rows[:10], rows[10][:24], *rows[11:]]) + "\n")
     with pytest.raises(InputError, match="not a readable table"):
-        read_archive(garbage, read_decoder(decoder))
+        read_archive(inside, read_decoder(decoder))
 
 
 @pytest.mark.parametrize(

@@ -49,7 +49,7 @@ DEFAULT_PLACEHOLDERS: tuple[float, ...] = (-999999.0, 999999.0, -99999.0, -99999
 # Beyond any telemetry value: above the largest 64-bit counter (1.8e19); inf and 1e300 are corruption.
 MAX_ABS_VALUE = 1e20
 ARCHIVE_ABSURD = "infinite or absurd values (|v| > 1e20)"
-ARCHIVE_SHORT_ROWS = "rows with a wrong number of fields (a cut line: skipped)"
+ARCHIVE_CUT_LINE = "last line cut (no line end, fields missing: skipped)"
 ARCHIVE_FUTURE = "rows dated after today (telemetry is recorded, not predicted)"
 FUTURE_MARGIN_NS = 86_400 * 10**9  # a day of clock and time-zone slack before a time counts as in the future
 
@@ -215,20 +215,19 @@ def pseudonymise_text(text: str, decoder: Decoder) -> str:
     return pattern.sub(lambda m: by_lower[m.group(0).lower()], text)
 
 
-class _ShortRows:
-    """Rows whose number of fields is not the header's (a line cut by an interrupted export): skipped and
-    counted, unless there are more than :data:`MAX_SHORT_ROWS` of them (then the file is not a table and
-    the parser's error names the row)."""
-
-    def __init__(self) -> None:
-        self.rows = 0
-
-    def __call__(self, row: Any) -> str:
-        self.rows += 1
-        return "skip" if self.rows <= MAX_SHORT_ROWS else "error"
-
-
-MAX_SHORT_ROWS = 10
+def _cut_last_line(path: Path, n_fields: int) -> int | None:
+    """The byte length of the file without its last line when that line was cut by an interrupted export:
+    no line end after it and fewer fields than the header's ``n_fields``; None otherwise (a plain file)."""
+    size = path.stat().st_size
+    with open(path, "rb") as fh:
+        fh.seek(max(0, size - 65536))
+        tail = fh.read()
+    if not tail or tail.endswith(b"\n"):
+        return None
+    start = tail.rfind(b"\n") + 1
+    if start == 0 or tail[start:].count(b",") + 1 >= n_fields:
+        return None
+    return size - (len(tail) - start)
 
 
 def _read_raw(path: Path, counts: Counter[str]) -> pa.Table:
@@ -239,18 +238,23 @@ def _read_raw(path: Path, counts: Counter[str]) -> pa.Table:
         with open(path, "rb") as fh:
             gz = fh.read(2) == b"\x1f\x8b"
         read = pacsv.ReadOptions(block_size=1 << 24)
-        short = _ShortRows()
-        parse = pacsv.ParseOptions(ignore_empty_lines=True, invalid_row_handler=short)
+        parse = pacsv.ParseOptions(ignore_empty_lines=True)
+        check_column_count(path)
+        header = _header(path, gz)
+        cut = None if gz else _cut_last_line(path, len(header))
 
         def csv_with(opts: pacsv.ConvertOptions) -> pa.Table:
             if gz:
                 with pa.CompressedInputStream(pa.OSFile(str(path)), "gzip") as stream:
                     return pacsv.read_csv(stream, read_options=read, parse_options=parse, convert_options=opts)
+            if cut is not None:  # the whole lines only, read in place
+                whole = pa.BufferReader(pa.memory_map(str(path)).read_buffer(cut))
+                return pacsv.read_csv(whole, read_options=read, parse_options=parse, convert_options=opts)
             return pacsv.read_csv(str(path), read_options=read, parse_options=parse, convert_options=opts)
 
+        if cut is not None:
+            counts[ARCHIVE_CUT_LINE] += 1
         # Only the empty field is null: the text "NaN" parses as a float NaN and is counted as a placeholder.
-        check_column_count(path)
-        header = _header(path, gz)
         lower = [h.strip().lower() for h in header]
         if len(header) == 3 and lower[0] in TIME_NAMES and lower[1:] == ["mnemonic", "value"]:
             # The usual long export, typed while parsing (UTC times, dictionary-encoded names, float
@@ -267,18 +271,12 @@ def _read_raw(path: Path, counts: Counter[str]) -> pa.Table:
                 quoted_strings_can_be_null=True,
             )
             try:
-                table = csv_with(typed)
-                if short.rows:
-                    counts[ARCHIVE_SHORT_ROWS] += short.rows
-                return table
+                return csv_with(typed)
             except pa.ArrowInvalid:
-                short.rows = 0
-        table = csv_with(
+                pass
+        return csv_with(
             pacsv.ConvertOptions(null_values=[""], strings_can_be_null=True, quoted_strings_can_be_null=True)
         )
-        if short.rows:
-            counts[ARCHIVE_SHORT_ROWS] += short.rows
-        return table
     except pa.ArrowInvalid as exc:
         raise InputError(f"not a readable table: {str(exc).splitlines()[0]}", file=path) from None
     except OSError as exc:
