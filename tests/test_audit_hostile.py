@@ -16,18 +16,20 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
-from _audit_cases import truth_orbit, with_field
+from _audit_cases import THESIS_TOML, truth_orbit, with_field
 from abrupt.catalog.event_import import MAX_DV_MPS, read_event_table
 from abrupt.cli.commands import cli
 from abrupt.density.constellation import read_platforms
 from abrupt.errors import InputError, OutputError
 from abrupt.flux.exposure import read_day_table
+from abrupt.model.spacecraft import load_spacecraft
 from abrupt.readers.archive import ARCHIVE_CUT_LINE, ARCHIVE_FUTURE, read_archive, read_decoder
 from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.readers.navigation_csv import write_navigation_csv
 from abrupt.readers.oem import write_oem
 from abrupt.readers.omm import read_omm
 from abrupt.readers.orekit_od_input import read_od_input
+from abrupt.readers.telemetry import read_telemetry
 from abrupt.readers.tle import read_tle
 from abrupt.simulate.tle_catalogue import write_catalogue
 
@@ -215,3 +217,17 @@ def test_a_stored_day_cut_by_a_kill_is_named_not_taken_as_stored(tmp_path: Path,
         assert isinstance(result.exception, InputError), result.output
         assert "samples.parquet" in str(result.exception) and "do not read" in str(result.exception)
     assert not (tmp_path / "x.csv").exists()
+
+
+def test_attitude_telemetry_dated_after_today_is_refused(tmp_path: Path) -> None:
+    runner = CliRunner()
+    telemetry = tmp_path / "t.csv"
+    simulate = ["-q", "simulate", "attitude", "--duration", "120", "--telemetry-rate", "1", "--out", str(telemetry)]
+    assert runner.invoke(cli, simulate).exit_code == 0
+    sc = load_spacecraft(THESIS_TOML)
+    assert len(read_telemetry(telemetry, sc).time) == 121  # the simulated two minutes of 2026 read
+    lines = telemetry.read_text().splitlines()
+    lines[60] = lines[60].replace("2026-", "2090-", 1)
+    telemetry.write_text("\n".join(lines) + "\n")
+    with pytest.raises(InputError, match=r"t\.csv:61: column 'time': time '2090-.*after today"):
+        read_telemetry(telemetry, sc)
