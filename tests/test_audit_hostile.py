@@ -29,6 +29,7 @@ from abrupt.readers.navigation_csv import write_navigation_csv
 from abrupt.readers.oem import write_oem
 from abrupt.readers.omm import read_omm
 from abrupt.readers.orekit_od_input import read_od_input
+from abrupt.readers.tdm import read_tdm
 from abrupt.readers.telemetry import read_telemetry
 from abrupt.readers.tle import read_tle
 from abrupt.simulate.tle_catalogue import write_catalogue
@@ -231,3 +232,11 @@ def test_attitude_telemetry_dated_after_today_is_refused(tmp_path: Path) -> None
     telemetry.write_text("\n".join(lines) + "\n")
     with pytest.raises(InputError, match=r"t\.csv:61: column 'time': time '2090-.*after today"):
         read_telemetry(telemetry, sc)
+
+
+def test_a_tdm_with_a_byte_order_mark_and_crlf_reads_as_without(tmp_path: Path) -> None:
+    plain, marked = tmp_path / "t.tdm", tmp_path / "b.tdm"
+    argv = ["-q", "simulate", "tracking", "--dv", "0", "--out", str(plain), "--setup-out", str(tmp_path / "s.txt")]
+    assert CliRunner().invoke(cli, argv).exit_code == 0
+    marked.write_bytes(BOM + plain.read_bytes().replace(b"\n", b"\r\n"))
+    pd.testing.assert_frame_equal(read_tdm(plain), read_tdm(marked))
