@@ -185,6 +185,11 @@ def test_a_setup_whose_a_priori_state_is_no_earth_orbit_is_refused(vy_mps: float
     setup.write_text(setup.read_text().replace("orbit.cartesian.vy = 7673.765765", f"orbit.cartesian.vy = {vy_mps!r}"))
     with pytest.raises(InputError, match=reason):
         read_od_input(setup)
+    setup.write_text(setup.read_text().replace(f"orbit.cartesian.vy = {vy_mps!r}", "orbit.cartesian.vy = 7673.765765"))
+    assert list(read_od_input(setup).stations) == ["ASCENSION"]
+    setup.write_text(setup.read_text().replace("orbit.date = 2024-", "orbit.date = 2090-"))
+    with pytest.raises(InputError, match=r"setup\.txt:2: orbit\.date 2090-.* days after today"):
+        read_od_input(setup)
 
 
 def test_an_exposure_day_beyond_the_moon_is_refused(tmp_path: Path) -> None:

@@ -29,6 +29,7 @@ from abrupt.model.orbit import MU_EARTH_M3_S2, coe_to_rv
 from abrupt.model.stations import WGS84_A_M, Station
 from abrupt.outputs import write_text_atomic
 from abrupt.readers.aer import parse_utc
+from abrupt.readers.orbit_envelope import PREDICTION_HORIZON_DAYS
 from abrupt.readers.text import read_text
 from abrupt.types import FloatArray
 
@@ -114,6 +115,14 @@ def _orbit(path: Path, plain: Entries) -> tuple[np.datetime64, FloatArray, float
         raise InputError(
             f"orbit.date: cannot parse {plain['orbit.date'][0]!r}", file=path, line=plain["orbit.date"][1]
         ) from None
+    days_ahead = float((epoch - np.datetime64("now", "ns")) / np.timedelta64(1, "D"))
+    if days_ahead > PREDICTION_HORIZON_DAYS:
+        raise InputError(
+            f"orbit.date {plain['orbit.date'][0]} is {days_ahead:.0f} days after today: an a-priori orbit is a "
+            f"past state or a prediction of at most {PREDICTION_HORIZON_DAYS:g} days (wrong year?)",
+            file=path,
+            line=plain["orbit.date"][1],
+        )
     mu = _number(path, plain, "abrupt.mu", MU_EARTH_M3_S2)
     if "orbit.cartesian.px" in plain:
         state = np.array([_number(path, plain, f"orbit.cartesian.{k}") for k in ("px", "py", "pz", "vx", "vy", "vz")])
