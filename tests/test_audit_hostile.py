@@ -24,6 +24,7 @@ from abrupt.errors import InputError, OutputError
 from abrupt.flux.exposure import read_day_table
 from abrupt.model.spacecraft import load_spacecraft
 from abrupt.readers.archive import ARCHIVE_CUT_LINE, ARCHIVE_FUTURE, read_archive, read_decoder
+from abrupt.readers.crd import read_crd
 from abrupt.readers.ephemeris import read_ephemeris
 from abrupt.readers.navigation_csv import write_navigation_csv
 from abrupt.readers.oem import write_oem
@@ -33,6 +34,7 @@ from abrupt.readers.tdm import read_tdm
 from abrupt.readers.telemetry import read_telemetry
 from abrupt.readers.tle import read_tle
 from abrupt.simulate.tle_catalogue import write_catalogue
+from doc_inputs import _slr_campaign
 
 BOM = b"\xef\xbb\xbf"
 HEADER = "time,mnemonic,value\n"
@@ -245,3 +247,12 @@ def test_a_tdm_with_a_byte_order_mark_and_crlf_reads_as_without(tmp_path: Path) 
     assert CliRunner().invoke(cli, argv).exit_code == 0
     marked.write_bytes(BOM + plain.read_bytes().replace(b"\n", b"\r\n"))
     pd.testing.assert_frame_equal(read_tdm(plain), read_tdm(marked))
+
+
+def test_crd_ranges_dated_after_today_are_refused_at_the_h4_record(tmp_path: Path) -> None:
+    paths = _slr_campaign(tmp_path)
+    assert len(read_crd(paths["crd"])) > 100  # the docs' simulated day of 2024 reads
+    dated = tmp_path / "f.npt"
+    dated.write_text(paths["crd"].read_text().replace(" 2024 03 01 ", " 2090 03 01 "))
+    with pytest.raises(InputError, match=r"f\.npt:4:3: H4 start 2090-03-01.* after today"):
+        read_crd(dated)
