@@ -288,5 +288,7 @@ def main(argv: list[str] | None = None) -> dict[str, int]:
 if __name__ == "__main__":
     from _results import variant, write_results
 
-    with write_results("bench_audit_cases", variant({"--only": "only", "--group": "group"})):
+    group = next((b for a, b in zip(sys.argv, sys.argv[1:], strict=False) if a == "--group"), "")
+    suffix = "_".join(p for p in (variant({"--only": "only", "--group": "group"}), re.sub(r"\W+", "_", group)) if p)
+    with write_results("bench_audit_cases", suffix):  # a group run is named by its group
         main()
