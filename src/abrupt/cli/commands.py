@@ -233,7 +233,7 @@ def _input_paths(params: Mapping[str, Any]) -> list[tuple[str, str]]:
 
 
 def _input_folders(params: Mapping[str, Any]) -> list[tuple[str, str]]:
-    """The folders a command reads (a store, a folder of telemetry files)."""
+    """The folders a command reads (a telemetry store, a folder of telemetry files)."""
     return [
         (name, path)
         for name, value in params.items()
@@ -280,7 +280,7 @@ def check_output_paths(
                 what = f"{_option_name(in_name, hints)} {path}"
                 raise OutputError(f"is the same file as {what}: writing it would destroy that input", file=where)
         for in_name, folder in _input_folders(params):
-            if _inside(out, folder) and ("store" in in_name or os.path.isfile(out)):
+            if "store" in in_name and _inside(out, folder):
                 what = f"{_option_name(in_name, hints)} {folder}"
                 reason = "writing it would destroy that input" if os.path.isfile(out) else "it would be read with it"
                 raise OutputError(f"is inside {what}: {reason}", file=where)

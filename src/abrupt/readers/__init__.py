@@ -228,9 +228,9 @@ Plausibility checks of other inputs, and outputs
   file; outcome: **error** before anything runs; counter: —
 * every command with an output: check: an output that is an existing file; outcome: **error** before anything
   runs, unless `--overwrite`; counter: —
-* every command with an output: check: an output inside a folder the command reads: an existing file there, or
-  any path inside a store (`store export`, `detect attitude --store`); outcome: **error** before anything runs,
-  also with `--overwrite`; counter: —
+* every command with an output: check: an output inside the telemetry store the command reads (`store export`,
+  `detect attitude --store`): a stored file, or a new file the store would then hold; outcome: **error** before
+  anything runs, also with `--overwrite`; counter: —
 * telemetry store (`abrupt.store`): check: a stored day's Parquet file that does not read (cut by a kill or a
   full disk), also when an ingest finds the same archive already stored; outcome: **error** naming the file;
   counter: —
