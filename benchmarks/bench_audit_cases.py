@@ -2,8 +2,8 @@
 kinds, through the installed ``abrupt`` as a subprocess, each bounded to 60 s and 2 GB of address space.
 
 Each case builds its inputs in its own empty folder (``_audit_orbit_cases.py``, ``_audit_door_cases.py``,
-``_audit_laser_cases.py``, ``_audit_scaled_cases.py``)
-and runs there; the verdict of one run is:
+``_audit_laser_cases.py``, ``_audit_scaled_cases.py``, ``_audit_hostile_cases.py``,
+``_audit_hostile_tracking_cases.py``) and runs there; the verdict of one run is:
 
 - ``clean error``: exit 2 and one ``error:`` line naming the file (or the key, the option) and the reason,
   no file left behind (no new catalog, no partial output);
@@ -42,6 +42,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _audit_cases import ROOT, Case, Run
 from _audit_door_cases import door_cases
+from _audit_hostile_cases import apply_bytes, hostile_cases, store_target
+from _audit_hostile_tracking_cases import more_hostile_cases
 from _audit_laser_cases import laser_cases
 from _audit_orbit_cases import orbit_cases
 from _audit_scaled_cases import apply_edit, scaled_cases
@@ -152,6 +154,10 @@ def _prepare(run: Run, folder: Path) -> None:
             _damage_aer(folder / step[2], step[1])
         elif step[0] == "__edit__":  # a case's own edit of a file the steps before wrote
             apply_edit(folder, step[1])
+        elif step[0] == "__bytes__":
+            apply_bytes(folder, step[1])
+        elif step[0] == "__store_target__":
+            store_target(folder, run, step[1])
         else:
             code, _, err, _, _ = run_bounded(step, folder, bounded=False)
             if code != 0:
@@ -247,7 +253,14 @@ def main(argv: list[str] | None = None) -> dict[str, int]:
     SOURCE[0] = args.src.resolve()
     cases = [
         c
-        for c in (*orbit_cases(), *door_cases(), *laser_cases(), *scaled_cases())
+        for c in (
+            *orbit_cases(),
+            *door_cases(),
+            *laser_cases(),
+            *scaled_cases(),
+            *hostile_cases(),
+            *more_hostile_cases(),
+        )
         if args.only in c.name and args.group in c.group
     ]
     totals: Counter[str] = Counter()
@@ -275,5 +288,7 @@ def main(argv: list[str] | None = None) -> dict[str, int]:
 if __name__ == "__main__":
     from _results import variant, write_results
 
-    with write_results("bench_audit_cases", variant({"--only": "only", "--group": "group"})):
+    group = next((b for a, b in zip(sys.argv, sys.argv[1:], strict=False) if a == "--group"), "")
+    suffix = "_".join(p for p in (variant({"--only": "only", "--group": "group"}), re.sub(r"\W+", "_", group)) if p)
+    with write_results("bench_audit_cases", suffix):  # a group run is named by its group
         main()

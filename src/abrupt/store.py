@@ -82,6 +82,7 @@ class TelemetryStore:
         if not archives and prev:  # a report written before archives were kept apart: one entry
             archives[",".join(prev.get("sources", [])) or "<earlier ingest>"] = _counts(prev)
         if path.exists() and archives.get(source, {}).get("digest") == digest:
+            _read_table(path, columns=["mnemonic"])  # "unchanged" only if the stored samples still read
             self._write_report(d, {**prev, "last_ingest": f"{source}: unchanged (already stored)"})
             return 0
         old = _normalised(self.read_day(spacecraft, day)) if path.exists() else new.iloc[:0]
@@ -130,7 +131,7 @@ class TelemetryStore:
         filt = None
         if mnemonics is not None:
             filt = [("mnemonic", "in", list(mnemonics))]
-        table = pq.read_table(path, filters=filt)
+        table = _read_table(path, filters=filt)
         # Naive datetime64[ns] holding UTC: tz-aware columns turn into Python objects on to_numpy.
         time_idx = table.schema.get_field_index("time")
         table = table.set_column(time_idx, "time", table.column("time").cast(pa.timestamp("ns")))
@@ -157,7 +158,7 @@ class TelemetryStore:
             path = self._dir(spacecraft, str(d)) / "samples.parquet"
             if not path.exists():
                 continue
-            table = pq.read_table(path, columns=["mnemonic", "time", "value"])
+            table = _read_table(path, columns=["mnemonic", "time", "value"])
             mcol = table.column("mnemonic").combine_chunks()
             if not pa.types.is_dictionary(mcol.type):
                 mcol = mcol.dictionary_encode()
@@ -207,6 +208,20 @@ class TelemetryStore:
         if not isinstance(report, dict):
             raise InputError("ingest report is not a JSON object; restore it, or remove the day's folder", file=path)
         return report
+
+
+def _read_table(path: Path, **options: Any) -> pa.Table:
+    """A stored day's samples; a file that does not read (cut by a kill or a full disk, or not written by
+    abrupt) is an :class:`InputError` naming it, never silently an empty or partial day."""
+    try:
+        return pq.read_table(path, **options)
+    except (pa.ArrowInvalid, OSError) as exc:
+        why = str(exc).split(": ", 1)[-1].split(".")[0][:80]
+        raise InputError(
+            f"stored samples do not read ({why}); the file was cut or damaged: move the day's folder aside and "
+            "ingest its archives again",
+            file=path,
+        ) from None
 
 
 def _sorted_table(frame: pd.DataFrame) -> pa.Table:

@@ -5,10 +5,11 @@ A file holds one event per row with a header naming the schema columns (:data:`a
 absent or empty (not estimated), and further columns are kept (e.g. the orbit-frame ΔH
 ``dH_O_r_Nms, dH_O_t_Nms, dH_O_n_Nms`` the flux inference uses). Every cell is checked: a kind outside
 :data:`~abrupt.events.EVENT_KINDS`, a time that is not ISO 8601, a number that is not finite, a negative
-size or false-alarm rate, an orbit-frame ΔH whose norm disagrees with ``dH_Nms`` by more than 1 %, or an
-event given twice raises :class:`~abrupt.errors.InputError` naming the file, line and column. Empty
-``event_id`` cells get the deterministic identifier of :func:`abrupt.events.make_event_id`, empty
-``config_hash`` cells the hash of the file's content (re-importing the same file adds nothing).
+size or false-alarm rate, a time after today, a ΔV beyond 20 km/s, an orbit-frame ΔH whose norm disagrees
+with ``dH_Nms`` by more than 1 %, or an event given twice raises :class:`~abrupt.errors.InputError` naming
+the file, line and column. Empty ``event_id`` cells get the deterministic identifier of
+:func:`abrupt.events.make_event_id`, empty ``config_hash`` cells the hash of the file's content
+(re-importing the same file adds nothing).
 """
 
 from __future__ import annotations
@@ -28,6 +29,9 @@ REQUIRED_COLUMNS: tuple[str, ...] = ("spacecraft", "kind", "detector", "time_utc
 #: Orbit-frame ΔH columns (radial, along-track, cross-track) [N·m·s] the flux inference reads when present.
 ORBIT_FRAME_DH: tuple[str, ...] = ("dH_O_r_Nms", "dH_O_t_Nms", "dH_O_n_Nms")
 _NON_NEGATIVE = ("dH_Nms", "dv_mps", "false_alarms_per_day", "time_sigma_s")
+#: [m/s] Upper bound of |ΔV| of an Earth orbiter: reversing a 7.9 km/s orbit and adding the 11.2 km/s escape
+#: speed stays below it.
+MAX_DV_MPS = 20_000.0
 
 
 def read_event_table(path: str | Path) -> pd.DataFrame:
@@ -75,6 +79,13 @@ def read_event_table(path: str | Path) -> pd.DataFrame:
         if stamp is pd.NaT:
             raise InputError("not a time", file=path, line=line_no, column="time_utc")
         stamp = stamp.tz_localize("UTC") if stamp.tzinfo is None else stamp.tz_convert("UTC")
+        if stamp > pd.Timestamp.now(tz="UTC") + pd.Timedelta(days=1):
+            raise InputError(
+                f"{row['time_utc']} is after today: an event is detected in recorded data (wrong year?)",
+                file=path,
+                line=line_no,
+                column="time_utc",
+            )
         row["time_utc"] = format_time_utc(stamp)
         for col in numeric:
             cell = str(row[col])
@@ -89,6 +100,14 @@ def read_event_table(path: str | Path) -> pd.DataFrame:
                 raise InputError(f"not finite: {cell!r}", file=path, line=line_no, column=col)
             if col in _NON_NEGATIVE and value < 0:
                 raise InputError(f"must be >= 0, got {value!r}", file=path, line=line_no, column=col)
+            if col == "dv_mps" and value > MAX_DV_MPS:
+                raise InputError(
+                    f"{value:.6g} m/s is more than any velocity change of an Earth orbiter ({MAX_DV_MPS:.0f} m/s: "
+                    "orbital plus escape speed); wrong unit?",
+                    file=path,
+                    line=line_no,
+                    column=col,
+                )
             row[col] = value
         _check_orbit_frame(row, path, line_no)
         row["config_hash"] = row.get("config_hash") or digest

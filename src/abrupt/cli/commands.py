@@ -232,6 +232,25 @@ def _input_paths(params: Mapping[str, Any]) -> list[tuple[str, str]]:
     return inputs
 
 
+def _input_folders(params: Mapping[str, Any]) -> list[tuple[str, str]]:
+    """The folders a command reads (a telemetry store, a folder of telemetry files)."""
+    return [
+        (name, path)
+        for name, value in params.items()
+        if not is_output_parameter(name)
+        for path in _paths(value)
+        if "://" not in path and os.path.isdir(path)
+    ]
+
+
+def _inside(path: str, folder: str) -> bool:
+    """Whether ``path`` lies under ``folder`` (links resolved)."""
+    try:
+        return Path(folder).resolve() in Path(path).resolve().parents
+    except (OSError, RuntimeError):
+        return False
+
+
 def check_output_paths(
     params: Mapping[str, Any], *, overwrite: bool = True, hints: Mapping[str, str] | None = None
 ) -> None:
@@ -260,6 +279,11 @@ def check_output_paths(
             if _same(out, path):
                 what = f"{_option_name(in_name, hints)} {path}"
                 raise OutputError(f"is the same file as {what}: writing it would destroy that input", file=where)
+        for in_name, folder in _input_folders(params):
+            if "store" in in_name and _inside(out, folder):
+                what = f"{_option_name(in_name, hints)} {folder}"
+                reason = "writing it would destroy that input" if os.path.isfile(out) else "it would be read with it"
+                raise OutputError(f"is inside {what}: {reason}", file=where)
         for other_name, other in outputs[:k]:
             if _same(out, other):
                 raise OutputError(f"is also given as {_option_name(other_name, hints)}", file=where)

@@ -42,6 +42,9 @@ from abrupt.errors import InputError
 from abrupt.model.atmosphere import msis_density, read_space_weather
 from abrupt.types import FloatArray
 
+#: [m²/kg] Largest area-to-mass ratio of a platform: beyond that of the lightest catalogued debris (sheets
+#: of multi-layer insulation, of the order of 10-40 m²/kg).
+MAX_AREA_TO_MASS_M2_KG = 100.0
 PLATFORM_COLUMNS = ("object", "shape_class", "min_area_m2", "max_area_m2", "mass_kg")
 NOMINAL_DRAG_COEFFICIENT = 2.2
 
@@ -86,6 +89,13 @@ def read_platforms(path: str | Path, objects: list[str], aliases: dict[str, str]
         a0, a1, m = float(row["min_area_m2"]), float(row["max_area_m2"]), float(row["mass_kg"])
         if not (a0 > 0 and a1 >= a0 and m > 0):
             raise InputError("need 0 < min_area_m2 <= max_area_m2 and mass_kg > 0", file=p, line=i)
+        if a1 / m > MAX_AREA_TO_MASS_M2_KG:
+            raise InputError(
+                f"max_area_m2 / mass_kg = {a1 / m:.4g} m²/kg is beyond {MAX_AREA_TO_MASS_M2_KG:g}, more than the "
+                "lightest debris (multi-layer insulation, about 40 m²/kg): area in cm² or mass in tonnes?",
+                file=p,
+                line=i,
+            )
     return frame
 
 

@@ -385,7 +385,7 @@ _DAY_TABLE_RANGES: dict[str, tuple[float, float, str]] = {  # (low, high, reason
     "efficiency_slope": (0.0, math.inf, "must be > 0"),
     "efficiency_max": (0.0, 1.0, "must be in (0, 1]"),
     "false_alarms_per_day": (0.0, math.inf, "must be >= 0"),
-    "altitude_km": (100.0, 2_000_000.0, "must be above 100 km (an orbit)"),
+    "altitude_km": (100.0, 384_400.0, "must be an Earth orbit's: above 100 km, below the Moon's distance (384 400 km)"),
     "inclination_deg": (0.0, 180.0, "must be in [0, 180]"),
     "epoch_year": (1957.0, 2200.0, "must be a year"),
 }

@@ -153,6 +153,11 @@ def tle_density(
     repairs = {str(p): r[0].repairs for p, r in zip(paths, results, strict=True)}
     warnings: list[str] = []
     result = None
+    if not many and platforms is not None and len(windows):
+        objects = sorted(windows["object"].astype(str).unique())
+        aliases = {str(n): str(o) for o, n in zip(windows["object"], windows["norad_id"], strict=True)}
+        read_platforms(platforms, objects, aliases)  # checked, though one object's ρB needs no geometry
+        warnings.append("--platforms is used by the fit of several objects; one object's windows give ρB only")
     if many:
         objects = sorted(windows["object"].astype(str).unique())
         aliases = {str(n): str(o) for o, n in zip(windows["object"], windows["norad_id"], strict=True)}

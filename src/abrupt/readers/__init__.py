@@ -228,6 +228,28 @@ Plausibility checks of other inputs, and outputs
   file; outcome: **error** before anything runs; counter: —
 * every command with an output: check: an output that is an existing file; outcome: **error** before anything
   runs, unless `--overwrite`; counter: —
+* every command with an output: check: an output inside the telemetry store the command reads (`store export`,
+  `detect attitude --store`): a stored file, or a new file the store would then hold; outcome: **error** before
+  anything runs, also with `--overwrite`; counter: —
+* telemetry store (`abrupt.store`): check: a stored day's Parquet file that does not read (cut by a kill or a
+  full disk), also when an ingest finds the same archive already stored; outcome: **error** naming the file;
+  counter: —
+* telemetry archive (`abrupt.readers.archive`): check: rows dated more than a day after today; a last line cut
+  by an interrupted export (no line end, fields missing); a CSV that is not UTF-8; outcome: the rows removed and
+  counted, the cut line skipped and counted, the non-UTF-8 file an **error** naming line and column; counter:
+  `rows dated after today (telemetry is recorded, not predicted)`, `last line cut (no line end, fields missing:
+  skipped)`
+* attitude telemetry, `catalog import`: check: a time more than a day after today; a ΔV above 20 km/s (orbital
+  plus escape speed); outcome: **error** naming line and column; counter: —
+* TLE, OMM: check: |B*| above 10 per earth radius (ρ0·Cd·A/(2m) of the lightest debris is 6.9); outcome: the set
+  skipped and named; counter: `malformed element sets skipped`
+* Orekit set-up (`abrupt.readers.orekit_od_input`): check: an a-priori state with v²/2 − μ/r ≥ 0, a perigee
+  inside the Earth or an apogee beyond the Moon (a velocity in km/s or ×1.5); outcome: **error** naming the line;
+  counter: —
+* density platforms, flux exposure table: check: max_area_m2/mass_kg above 100 m²/kg (an area in cm²); an
+  altitude beyond the Moon's distance; outcome: **error** naming the line; counter: —
+* every text reader (`abrupt.readers.compression.read_bytes`): a leading UTF-8 byte-order mark is dropped (it is
+  no part of any format); outcome: read as without it; counter: —
 * every output (`abrupt.outputs.atomic_output`): check: written beside the target under a hidden temporary name
   and renamed over it; a path a command derives (`OUT.json`, `OUT.injections.csv`) that is one of the command's
   inputs; a full disk or read-only folder; outcome: the previous file stays whole, no temporary file is left;

@@ -5,7 +5,8 @@ spacecraft name and every mnemonic by the pseudonyms of a decoder file (``real_n
 nothing downstream of this module ever sees the decoder or a real name. Archiver artifacts are then
 removed and counted (they are not data): blank rows, rows with an empty field, placeholder values
 (``-999999``, the text ``NaN``), infinite or absurd values (``inf``, ``1e300``: beyond 1e20, above
-any 64-bit counter; counter "infinite or absurd values (|v| > 1e20)"), exact duplicate rows.
+any 64-bit counter; counter "infinite or absurd values (|v| > 1e20)"), rows dated more than a day after
+today (counter "rows dated after today"), exact duplicate rows.
 Conflicting duplicates (same time and mnemonic, different values) and time reversals are reported
 and resolved by keeping the first value in file order and sorting by time.
 
@@ -41,12 +42,23 @@ import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from abrupt.errors import ConfigError, InputError
+from abrupt.readers.compression import read_bytes
 from abrupt.readers.text import check_column_count
 
 DEFAULT_PLACEHOLDERS: tuple[float, ...] = (-999999.0, 999999.0, -99999.0, -9999999.0)
 # Beyond any telemetry value: above the largest 64-bit counter (1.8e19); inf and 1e300 are corruption.
 MAX_ABS_VALUE = 1e20
 ARCHIVE_ABSURD = "infinite or absurd values (|v| > 1e20)"
+ARCHIVE_CUT_LINE = "last line cut (no line end, fields missing: skipped)"
+ARCHIVE_FUTURE = "rows dated after today (telemetry is recorded, not predicted)"
+FUTURE_MARGIN_NS = 86_400 * 10**9  # a day of clock and time-zone slack before a time counts as in the future
+
+
+def _latest_time_ns() -> int:
+    """The latest sample time (ns since 1970, UTC) an archive may hold: now plus a day."""
+    return int(np.datetime64("now", "ns").astype(np.int64)) + FUTURE_MARGIN_NS
+
+
 TIME_NAMES = ("time", "timestamp", "time_utc", "utc", "datetime")
 
 
@@ -203,7 +215,22 @@ def pseudonymise_text(text: str, decoder: Decoder) -> str:
     return pattern.sub(lambda m: by_lower[m.group(0).lower()], text)
 
 
-def _read_raw(path: Path) -> pa.Table:
+def _cut_last_line(path: Path, n_fields: int) -> int | None:
+    """The byte length of the file without its last line when that line was cut by an interrupted export:
+    no line end after it and fewer fields than the header's ``n_fields``; None otherwise (a plain file)."""
+    size = path.stat().st_size
+    with open(path, "rb") as fh:
+        fh.seek(max(0, size - 65536))
+        tail = fh.read()
+    if not tail or tail.endswith(b"\n"):
+        return None
+    start = tail.rfind(b"\n") + 1
+    if start == 0 or tail[start:].count(b",") + 1 >= n_fields:
+        return None
+    return size - (len(tail) - start)
+
+
+def _read_raw(path: Path, counts: Counter[str]) -> pa.Table:
     name = path.name.lower()
     try:
         if name.endswith(".parquet") or name.endswith(".pq"):
@@ -212,16 +239,22 @@ def _read_raw(path: Path) -> pa.Table:
             gz = fh.read(2) == b"\x1f\x8b"
         read = pacsv.ReadOptions(block_size=1 << 24)
         parse = pacsv.ParseOptions(ignore_empty_lines=True)
+        check_column_count(path)
+        header = _header(path, gz)
+        cut = None if gz else _cut_last_line(path, len(header))
 
         def csv_with(opts: pacsv.ConvertOptions) -> pa.Table:
             if gz:
                 with pa.CompressedInputStream(pa.OSFile(str(path)), "gzip") as stream:
                     return pacsv.read_csv(stream, read_options=read, parse_options=parse, convert_options=opts)
+            if cut is not None:  # the whole lines only, read in place
+                whole = pa.BufferReader(pa.memory_map(str(path)).read_buffer(cut))
+                return pacsv.read_csv(whole, read_options=read, parse_options=parse, convert_options=opts)
             return pacsv.read_csv(str(path), read_options=read, parse_options=parse, convert_options=opts)
 
+        if cut is not None:
+            counts[ARCHIVE_CUT_LINE] += 1
         # Only the empty field is null: the text "NaN" parses as a float NaN and is counted as a placeholder.
-        check_column_count(path)
-        header = _header(path, gz)
         lower = [h.strip().lower() for h in header]
         if len(header) == 3 and lower[0] in TIME_NAMES and lower[1:] == ["mnemonic", "value"]:
             # The usual long export, typed while parsing (UTC times, dictionary-encoded names, float
@@ -375,9 +408,30 @@ def read_archive(
 DAY_NS = 86_400 * 1_000_000_000
 
 
-def _long_table(path: Path, layout: str) -> pa.Table:
+def _refuse_non_utf8(path: Path) -> None:
+    """Raise the :class:`InputError` of a text archive that is not UTF-8 (a column the CSV parser left as
+    bytes would match no decoder name, and every row would be dropped), naming the first bad byte."""
+    raw = read_bytes(path)
+    try:
+        raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        column = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise InputError(
+            f"not UTF-8 text (byte 0x{raw[exc.start]:02x}); export the archive as UTF-8",
+            file=path,
+            line=line,
+            column=column,
+        ) from None
+    raise InputError("a column holds bytes that are not text", file=path)
+
+
+def _long_table(path: Path, layout: str, counts: Counter[str]) -> pa.Table:
     """The file as a long table ``time, mnemonic, value`` (wide tables are melted)."""
-    table = _read_raw(path)
+    table = _read_raw(path, counts)
+    text = not path.name.lower().endswith((".parquet", ".pq"))
+    if text and any(pa.types.is_binary(f.type) or pa.types.is_large_binary(f.type) for f in table.schema):
+        _refuse_non_utf8(path)
     cols = [c.strip() for c in table.column_names]
     table = table.rename_columns(cols)
     lower = [c.lower() for c in cols]
@@ -519,8 +573,8 @@ def _read_archive(
 ) -> ArchiveChunk:
     """:func:`read_archive` without the pseudonymisation of error messages."""
     path = Path(path)
-    table = _long_table(path, layout)
     counts: Counter[str] = Counter()
+    table = _long_table(path, layout, counts)
     n0 = table.num_rows
     # Rows that are entirely empty (",,") are blank-line artifacts.
     all_empty = pc.and_(pc.is_null(table.column("time")), pc.is_null(table.column("mnemonic")))
@@ -541,11 +595,12 @@ def _read_archive(
     t_valid = ~np.asarray(times.is_null().to_numpy(zero_copy_only=False), dtype=bool)
     t_int = np.where(t_valid, np.asarray(times.cast(pa.int64()).fill_null(0).to_numpy(), np.int64), 0)
     no_name = codes < 0
+    future = t_valid & (t_int > _latest_time_ns())
     is_placeholder = np.isin(values, np.asarray(placeholders, dtype=np.float64)) | (np.isnan(values) & ~value_null)
     with np.errstate(invalid="ignore"):
         is_absurd = ~np.isnan(values) & ~(np.abs(values) <= MAX_ABS_VALUE)  # inf, -inf, 1e300
     # Order of judgement: missing time or name -> empty value -> placeholder -> absurd -> not in decoder.
-    drop_missing = ~t_valid | no_name
+    drop_missing = ~t_valid | no_name | future
     drop_empty = ~drop_missing & value_null
     drop_placeholder = ~drop_missing & ~drop_empty & is_placeholder
     drop_absurd = ~drop_missing & ~drop_empty & ~drop_placeholder & is_absurd
@@ -581,6 +636,8 @@ def _read_archive(
     missing_time_rows = int(np.count_nonzero(~t_valid))
     if missing_time_rows:
         counts["rows without a time"] += missing_time_rows
+    if future.any():
+        counts[ARCHIVE_FUTURE] += int(np.count_nonzero(future))
     no_name_rows = int(np.count_nonzero(no_name & t_valid))
     if no_name_rows:
         counts["rows without a mnemonic"] += no_name_rows

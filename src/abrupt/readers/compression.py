@@ -21,10 +21,12 @@ from abrupt.errors import InputError
 
 GZIP_MAGIC = b"\x1f\x8b"
 COMPRESS_MAGIC = b"\x1f\x9d"
+UTF8_BOM = b"\xef\xbb\xbf"  # a byte-order mark some editors write first; not part of any format's text
 
 
 def read_bytes(path: str | Path, *, decompress: bool = True) -> bytes:
-    """The file's content, decompressed when it is gzip or Unix-compress data (unless not ``decompress``)."""
+    """The file's content, decompressed when it is gzip or Unix-compress data (unless not ``decompress``),
+    without a leading UTF-8 byte-order mark."""
     path = Path(path)
     try:
         raw = path.read_bytes()
@@ -35,18 +37,18 @@ def read_bytes(path: str | Path, *, decompress: bool = True) -> bytes:
     except OSError as exc:  # no permission, a device error...
         raise InputError(f"cannot read file: {exc.strerror or exc}", file=path) from None
     if not decompress:
-        return raw
+        return raw.removeprefix(UTF8_BOM)
     if raw[:2] == GZIP_MAGIC:
         try:
-            return gzip.decompress(raw)
+            return gzip.decompress(raw).removeprefix(UTF8_BOM)
         except (OSError, EOFError, zlib.error) as exc:
             raise InputError(f"corrupt or truncated gzip data ({exc})", file=path) from None
     if raw[:2] == COMPRESS_MAGIC:
         try:
-            return bytes(unlzw3.unlzw(raw))
+            return bytes(unlzw3.unlzw(raw)).removeprefix(UTF8_BOM)
         except (ValueError, IndexError, TypeError, RuntimeError) as exc:
             raise InputError(f"corrupt or truncated Unix-compress (.Z) data ({exc})", file=path) from None
-    return raw
+    return raw.removeprefix(UTF8_BOM)
 
 
 def read_text(path: str | Path, *, encoding: str = "ascii", what: str = "text", decompress: bool = True) -> str:

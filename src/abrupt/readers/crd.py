@@ -366,6 +366,13 @@ def _header4(block: _Block, tokens: list[str], file: str, no: int) -> None:
         raise InputError(f"H4: {exc.reason}", file=file, line=no, column=exc.column) from None
     if block.data_type not in DATA_TYPES:
         raise InputError(f"H4 data type {block.data_type} is not 0, 1 or 2", file=file, line=no, column=4)
+    if block.start is not None and block.start > np.datetime64("now", "ns") + np.timedelta64(1, "D"):
+        raise InputError(
+            f"H4 start {block.start} is after today: ranges are measured, not predicted (wrong year?)",
+            file=file,
+            line=no,
+            column=3,
+        )
     block.troposphere_applied = flags[1] == 1
     block.com_applied = flags[2] == 1
     block.delay_applied = flags[4] == 1

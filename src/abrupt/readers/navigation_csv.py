@@ -61,6 +61,8 @@ def read_navigation_csv(path: str | Path, satellite: str | None = None, *, frame
     missing = [c for c in REQUIRED_COLUMNS if c not in df.columns]
     if missing:
         raise InputError(f"missing required columns {missing}", file=file, line=1)
+    if df.empty:
+        raise InputError("no data rows (a header line only)", file=file, line=2)
     if "satellite" in df.columns:
         sats = sorted(df["satellite"].dropna().unique())
         if satellite is None:

@@ -25,6 +25,7 @@ from sgp4.api import Satrec
 
 from abrupt.errors import InputError, RepairLog, printable
 from abrupt.readers.tle import (
+    MAX_BSTAR_PER_EARTH_RADIUS,
     MAX_TLE_LINE_CHARS,
     ElementHistory,
     RawElementSet,
@@ -129,6 +130,14 @@ def record_to_set(
         raise InputError(f"{where}MEAN_MOTION {rec['MEAN_MOTION']} rev/day is not positive", file=file, line=line)
     if not 0.0 <= float(rec["ECCENTRICITY"]) < 1.0:
         raise InputError(f"{where}ECCENTRICITY {rec['ECCENTRICITY']} outside [0, 1)", file=file, line=line)
+    if abs(float(rec["BSTAR"])) > MAX_BSTAR_PER_EARTH_RADIUS:
+        raise InputError(
+            f"{where}BSTAR {rec['BSTAR']} /earth radius is beyond {MAX_BSTAR_PER_EARTH_RADIUS:g}, the drag term of "
+            "the lightest debris; a field in another unit?",
+            file=file,
+            line=line,
+            column="BSTAR",
+        )
     sat = Satrec()
     try:
         omm.initialize(sat, rec)

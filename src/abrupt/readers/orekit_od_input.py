@@ -29,6 +29,7 @@ from abrupt.model.orbit import MU_EARTH_M3_S2, coe_to_rv
 from abrupt.model.stations import WGS84_A_M, Station
 from abrupt.outputs import write_text_atomic
 from abrupt.readers.aer import parse_utc
+from abrupt.readers.orbit_envelope import PREDICTION_HORIZON_DAYS
 from abrupt.readers.text import read_text
 from abrupt.types import FloatArray
 
@@ -114,6 +115,14 @@ def _orbit(path: Path, plain: Entries) -> tuple[np.datetime64, FloatArray, float
         raise InputError(
             f"orbit.date: cannot parse {plain['orbit.date'][0]!r}", file=path, line=plain["orbit.date"][1]
         ) from None
+    days_ahead = float((epoch - np.datetime64("now", "ns")) / np.timedelta64(1, "D"))
+    if days_ahead > PREDICTION_HORIZON_DAYS:
+        raise InputError(
+            f"orbit.date {plain['orbit.date'][0]} is {days_ahead:.0f} days after today: an a-priori orbit is a "
+            f"past state or a prediction of at most {PREDICTION_HORIZON_DAYS:g} days (wrong year?)",
+            file=path,
+            line=plain["orbit.date"][1],
+        )
     mu = _number(path, plain, "abrupt.mu", MU_EARTH_M3_S2)
     if "orbit.cartesian.px" in plain:
         state = np.array([_number(path, plain, f"orbit.cartesian.{k}") for k in ("px", "py", "pz", "vx", "vy", "vz")])
@@ -132,7 +141,41 @@ def _orbit(path: Path, plain: Entries) -> tuple[np.datetime64, FloatArray, float
         state = coe_to_rv(a, e, angles[0], angles[1], angles[2], nu, mu)
     else:
         raise InputError("no orbit: give orbit.cartesian.* or orbit.keplerian.*", file=path)
+    key = "orbit.cartesian.vx" if "orbit.cartesian.px" in plain else "orbit.keplerian.a"
+    _check_bound_orbit(path, state, mu, plain.get(key, ("", None))[1])
     return epoch, state, mu
+
+
+#: [m] Limits of the a-priori orbit of an Earth orbiter: perigee above the polar radius, apogee below the
+#: Moon's mean distance.
+POLAR_RADIUS_M = 6_356_752.0
+MOON_DISTANCE_M = 384_400e3
+
+
+def _check_bound_orbit(path: Path, state: FloatArray, mu: float, line: int | None) -> None:
+    """Refuse an a-priori state that is no Earth orbit: specific energy v²/2 − μ/r not negative (it
+    escapes), perigee a(1 − e) inside the Earth, or apogee a(1 + e) beyond the Moon (Vallado 2013 §2.2)."""
+    r, v = state[:3], state[3:]
+    radius, speed = float(np.linalg.norm(r)), float(np.linalg.norm(v))
+    energy = speed**2 / 2.0 - mu / radius
+    where = f"a-priori state (|r| {radius / 1e3:.1f} km, |v| {speed:.1f} m/s)"
+    if energy >= 0.0:
+        raise InputError(
+            f"{where}: not bound to the Earth (speed above the escape speed {math.sqrt(2 * mu / radius):.1f} m/s; "
+            "velocity in the wrong unit?)",
+            file=path,
+            line=line,
+        )
+    a = -mu / (2.0 * energy)
+    e = float(np.linalg.norm(np.cross(v, np.cross(r, v)) / mu - r / radius))
+    if a * (1.0 - e) < POLAR_RADIUS_M:
+        raise InputError(
+            f"{where}: perigee radius {a * (1 - e) / 1e3:.1f} km is inside the Earth (velocity in the wrong unit?)",
+            file=path,
+            line=line,
+        )
+    if a * (1.0 + e) > MOON_DISTANCE_M:
+        raise InputError(f"{where}: apogee {a * (1 + e) / 1e3:.0f} km is beyond the Moon", file=path, line=line)
 
 
 def _stations(path: Path, plain: Entries, indexed: dict[int, Entries]) -> tuple[dict[str, Station], dict[str, bool]]:

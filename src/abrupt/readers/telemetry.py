@@ -9,6 +9,7 @@ input                                  outcome
 =====================================  ==========================================================
 empty file, header only, one sample    error
 unparseable time or number             error naming the line and column
+a time more than a day after today     error naming the line and column (wrong year?)
 a mapped column missing                error naming the column and the spacecraft-file key
 quaternion norm off by more than 10%   error (wrong scaling or not a quaternion)
 quaternion norm off by 1e-6 .. 10%     repair: renormalised, counted
@@ -358,6 +359,14 @@ def _parse_times(raw_time: pd.Series, path: Path, is_csv: bool, column: str) -> 
         row = int(np.flatnonzero(times.isna().to_numpy())[0])
         raise InputError(
             f"not an ISO-8601 time: {raw_time.iloc[row]!r}", file=path, line=_line(row, is_csv), column=column
+        )
+    late = np.flatnonzero((times > pd.Timestamp.now(tz="UTC") + pd.Timedelta(days=1)).to_numpy())
+    if late.size:
+        raise InputError(
+            f"time {raw_time.iloc[late[0]]!r} is after today: telemetry is recorded, not predicted (wrong year?)",
+            file=path,
+            line=_line(int(late[0]), is_csv),
+            column=column,
         )
     return times.dt.tz_localize(None).to_numpy(dtype="datetime64[ns]")
 

@@ -11,10 +11,11 @@ from abrupt.errors import InputError
 
 
 def read_text(path: str | Path) -> str:
-    """The file's text; a byte that is not UTF-8 raises :class:`InputError` at its line and column."""
+    """The file's text without a leading UTF-8 byte-order mark; a byte that is not UTF-8 raises
+    :class:`InputError` at its line and column."""
     path = Path(path)
     try:
-        raw = path.read_bytes()
+        raw = path.read_bytes().removeprefix(b"\xef\xbb\xbf")
     except OSError as exc:
         raise InputError(f"cannot read file: {exc.strerror}", file=path) from None
     try:

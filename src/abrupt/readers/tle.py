@@ -16,9 +16,9 @@ or is repaired in a documented, counted way (:class:`~abrupt.errors.RepairLog`):
   (the others are skipped and counted, ``element sets of other satellites skipped``);
   :func:`read_tle_histories` returns one history per satellite instead;
 * a malformed element set (bad field, checksum, truncated or missing line, a B* such as
-  ``+0153801`` with no exponent sign) is skipped and counted (``malformed element sets skipped``),
-  and the :class:`InputError` naming its line is kept in ``ElementHistory.skipped``; with
-  ``strict=True`` the first one is raised instead;
+  ``+0153801`` with no exponent sign, a |B*| beyond 10 per earth radius) is skipped and counted
+  (``malformed element sets skipped``), and the :class:`InputError` naming its line is kept in
+  ``ElementHistory.skipped``; with ``strict=True`` the first one is raised instead;
 * tolerated as written: explicit ``+`` signs, non-breaking spaces (read as spaces), trailing blanks,
   ``\r\n`` line ends, 3LE name lines (with or without ``0 ``), Alpha-5 catalogue numbers
   (``A0001`` = 100001: the letter counts 10..33 with I and O skipped).
@@ -189,6 +189,11 @@ def _check_line(text: str, expected: str, file: str, line_no: int) -> str:
     return line
 
 
+#: [1/earth radius] Largest |B*|: B* = ρ0·Cd·A/(2m) with ρ0 = 0.15696615 kg/m²/ER (Vallado et al. 2006),
+#: Cd 2.2 and A/m 40 m²/kg (the lightest catalogued debris, multi-layer insulation) gives 6.9.
+MAX_BSTAR_PER_EARTH_RADIUS = 10.0
+
+
 def _field(line: str, start: int, stop: int, what: str, file: str, line_no: int) -> float:
     """Numeric field in 1-based inclusive columns ``start..stop``; supports the TLE implied-decimal form."""
     raw = line[start - 1 : stop].strip()
@@ -236,7 +241,15 @@ def parse_tle_pair(line1: str, line2: str, *, file: str = "<input>", line_no: in
     # Validate the numeric fields sgp4 itself reads loosely.
     _field(l1, 19, 32, "epoch", file, line_no)
     _field(l1, 34, 43, "mean motion derivative", file, line_no)
-    _field(l1, 54, 61, "bstar", file, line_no)
+    bstar = _field(l1, 54, 61, "bstar", file, line_no)
+    if abs(bstar) > MAX_BSTAR_PER_EARTH_RADIUS:
+        raise InputError(
+            f"B* {bstar:.4g} /earth radius is beyond {MAX_BSTAR_PER_EARTH_RADIUS:g}, the drag term of the lightest "
+            "debris (B* = rho0 Cd A/(2m), A/m 40 m^2/kg); a field in another unit?",
+            file=file,
+            line=line_no,
+            column=54,
+        )
     checks = (
         (9, 16, "inclination"),
         (18, 25, "RAAN"),
