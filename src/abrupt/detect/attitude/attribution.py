@@ -165,8 +165,9 @@ class Hypotheses:
 def compare_hypotheses(ev: EventEvidence) -> Hypotheses:
     """Each hypothesis's signal model, fitted to its channels, against the strike's.
 
-    * **dump**: the direction, a mixture of the two unloading laws: aimed at −H_w (``dump_log_lr``) and any
-      mix of the unloading thrusters (``dump_cone_log_lr``; :mod:`~abrupt.detect.attitude.dump_evidence`,
+    * **dump**: the direction, an equal-weight mixture of the unloading laws: aimed at −H_w (``dump_log_lr``),
+      any mix of the unloading thrusters (``dump_cone_log_lr``) and equal pulses on a subset of them
+      (``dump_pulse_log_lr``; :mod:`~abrupt.detect.attitude.dump_evidence`,
       :mod:`~abrupt.detect.attitude.signal_models`). A dump's duration (a pulse train of one to many
       seconds) may be as short as the grid's resolution, so the time profile does not tell a dump from the
       other torques of some duration, only from an impulse;
@@ -178,9 +179,10 @@ def compare_hypotheses(ev: EventEvidence) -> Hypotheses:
     """
     dump = float("nan")
     if _finite(ev.dump_log_lr):
-        dump = ev.dump_log_lr
-        if _finite(ev.dump_cone_log_lr) or ev.dump_cone_log_lr == -math.inf:
-            dump = float(np.logaddexp(ev.dump_log_lr, ev.dump_cone_log_lr) - math.log(2.0))
+        laws = [ev.dump_log_lr] + [
+            x for x in (ev.dump_cone_log_lr, ev.dump_pulse_log_lr) if _finite(x) or x == -math.inf
+        ]
+        dump = float(np.logaddexp.reduce(laws) - math.log(len(laws)))
     sensor = float("nan")
     mag = math.sqrt(ev.dH_B_x_Nms**2 + ev.dH_B_y_Nms**2 + ev.dH_B_z_Nms**2)
     if _finite(ev.wheel_takeup, ev.wheel_change_sigma_Nms, mag) and mag > 0:
