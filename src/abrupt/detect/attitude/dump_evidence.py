@@ -46,6 +46,7 @@ from abrupt.detect.attitude.body_response import window_rows
 from abrupt.detect.attitude.signal_models import pulse_lattice_log_lr, unloading_cone_log_lr
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.timetable import NS, Timetable
+from abrupt.thresholds.noise import robust_scale
 from abrupt.types import FloatArray
 
 NAN = float("nan")
@@ -170,9 +171,8 @@ def dump_evidence(
     # The direction's noise: the step's σ across its direction over |ΔH| (isotropic: the mean variance);
     # the wheels' direction: the spread of their momentum over the window over |H_w|.
     sig_dh = float(np.sqrt(np.mean(sig_n**2))) / mag
-    # (robust: 1.4826 MAD, so a neighbour's step of the wheels inside the window does not count as noise).
-    mad = 1.4826 * np.median(np.abs(hw_rows - hw), axis=0)
-    sig_hw = float(np.sqrt(np.mean(mad**2) / max(before.size - 1, 1))) / hw_mag
+    # (robust: a neighbour's step of the wheels inside the window does not count as noise).
+    sig_hw = float(np.sqrt(np.mean(robust_scale(hw_rows, axis=0) ** 2) / max(before.size - 1, 1))) / hw_mag
     sig_noise = math.hypot(sig_dh, sig_hw)
     kappa = 1.0 / (sig_noise**2 + math.radians(DUMP_AIM_SIGMA_DEG) ** 2)
     cos_t = float(np.clip(-(dh_b @ hw) / (mag * hw_mag), -1.0, 1.0))
