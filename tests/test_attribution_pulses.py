@@ -101,8 +101,8 @@ def test_one_pulse_of_two_couples_far_from_the_stored_momentum_is_a_dump_and_wei
     d = min(faces, key=lambda f: float(f @ u))
     assert math.degrees(math.acos(float(d @ u))) > 20.0
     table = closed_loop_table(np.random.default_rng(90), AT, 0.12 * d)
-    h_n, hc, _, _, peaks = glr_peaks(sc, table)  # type: ignore[arg-type]
-    (ev,) = [event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n) for _, p in peaks if p.value > 20]  # type: ignore[arg-type]
+    h_n, hc, _, _, peaks = glr_peaks(sc, table)
+    (ev,) = [event_evidence(table, hc, sc, p.time_ns, p.dH_N_Nms, raw_H_N=h_n) for _, p in peaks if p.value > 20]
     assert ev.dump_pulse_log_lr > math.log(20.0) + 1
     without = dataclasses.replace(ev, dump_pulse_log_lr=float("nan"))
     assert compare_hypotheses(ev).dump > compare_hypotheses(without).dump

@@ -99,8 +99,10 @@ def _neighbour_step(tau: FloatArray, y: FloatArray, design: FloatArray) -> float
     penalty of its four parameters (time and three amplitudes), 4 ln N, plus 2 ln of the candidates tried."""
     n = tau.size
     before, after = np.flatnonzero(tau < 0), np.flatnonzero(tau >= 0)
-    cands = np.concatenate([tau[before[:-10]], tau[after[10:]]]) if before.size > 20 and after.size > 20 else []
-    if len(cands) == 0:
+    if before.size <= 20 or after.size <= 20:
+        return NAN
+    cands = np.concatenate([tau[before[:-10]], tau[after[10:]]])
+    if cands.size == 0:
         return NAN
     coef, *_ = np.linalg.lstsq(design, y, rcond=None)
     sse0 = float(np.sum((y - design @ coef) ** 2))
