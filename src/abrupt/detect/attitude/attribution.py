@@ -336,8 +336,8 @@ def _sensor_or_dump(
 #: (``CONFIDENCE_SLOPE``) are the maximum-likelihood logistic fit to whether the class was right, over
 #: the events of the independent simulated set ``benchmarks/bench_attribution_confidence.py`` names (its
 #: reliability table, on that set and on held-out ones, is in docs/attribution.md).
-CONFIDENCE_OFFSET = 0.0
-CONFIDENCE_SLOPE = 1.0
+CONFIDENCE_OFFSET = 3.437
+CONFIDENCE_SLOPE = 0.540
 #: The calibrated confidence stays within these bounds (a probability from a handful of wrong calls in a
 #: set of ~150 events says nothing finer).
 CONFIDENCE_BOUNDS = (0.01, 0.999)
