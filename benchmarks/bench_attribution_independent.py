@@ -184,6 +184,7 @@ def match(events: pd.DataFrame, truth: dict, folder: Path) -> tuple[list[dict], 
         rows.append(
             {
                 **ev,
+                "event_id": None if got is None else got["event_id"],
                 "event_kind": None if got is None else got["kind"],
                 "event_channel": None if got is None else str(got.get("kind_channel", "")),
                 "event_dH_Nms": None if got is None else float(got["dH_Nms"]),

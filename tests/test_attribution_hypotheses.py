@@ -18,6 +18,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from abrupt.detect.attitude.attribution import classify, compare_hypotheses
+from abrupt.detect.attitude.dump_evidence import cone_angle_deg
 from abrupt.detect.attitude.evidence import event_evidence
 from abrupt.detect.attitude.signal_models import (
     duration_log_lr,
@@ -85,7 +86,10 @@ def _events(sc: object, table: object) -> list:
 def test_a_dump_on_the_unloading_couples_is_no_strike_and_an_impulse_along_it_is() -> None:
     """Body-axis couples, each firing against the wheels' momentum on its axis for the same time (the octant's
     diagonal, tens of degrees off −H_w): three pulses 2 s apart are an external non-strike; one impulse of
-    the same ΔH is a strike (the time profile separates them; the direction alone cannot)."""
+    the same size 10° off the diagonal, away from −H_w (still inside the unloading cone, but where no equal
+    pulses on a subset of the couples point) is a strike: the time profile separates the first, the pulse
+    law's direction the second. Exactly along the diagonal one impulse is what one pulse of the three
+    couples makes, and is called a dump."""
     sc = load_spacecraft(KESTREL)
     hw = _stored_B(sc)
     # Couples along the axes of a frame turned so that the octant's diagonal is 20-35° off −H_w.
@@ -101,9 +105,16 @@ def test_a_dump_on_the_unloading_couples_is_no_strike_and_an_impulse_along_it_is
     (dump,) = _events(sc, pulses)
     assert classify(dump).kind == "external_non_strike", (classify(dump), compare_hypotheses(dump))
     assert compare_hypotheses(dump).extended > 3 * math.log(20)
-    (strike,) = _events(sc, closed_loop_table(np.random.default_rng(4), AT, dh))
+    u = -hw / np.linalg.norm(hw)
+    away = diag - (diag @ u) * u
+    off = Rotation.from_rotvec(math.radians(10.0) * np.cross(diag, away) / np.linalg.norm(np.cross(diag, away)))
+    d_strike = off.apply(diag)
+    assert cone_angle_deg(unloading_axes(axes, hw), d_strike) == pytest.approx(0.0, abs=1e-6)
+    (strike,) = _events(sc, closed_loop_table(np.random.default_rng(4), AT, 0.15 * d_strike))
     assert classify(strike).kind == "strike", (classify(strike), compare_hypotheses(strike))
     assert compare_hypotheses(strike).extended < 0
+    (along,) = _events(sc, closed_loop_table(np.random.default_rng(4), AT, dh))
+    assert classify(along).kind == "external_non_strike" and along.dump_pulse_log_lr > math.log(20)
 
 
 def test_a_gyro_bias_step_is_an_attitude_sensors_and_a_strike_of_its_size_is_a_strike() -> None:

@@ -58,8 +58,10 @@ before the event and σ_aim = 10° the unloading law's aim. A uniform direction 
 most 1/(e c) for any κ; with c = 20 (`dump_lr_min`) **at most 1.8 % of strikes can be called dumps, on any
 spacecraft and at any noise** (`tests/test_attribution_dump.py` checks the bound and its tightness on 200 000
 directions, and the density's normalisation). A lasting step beyond it is `external_non_strike`, reason
-"momentum dump", confidence LR/(1 + LR). With thruster torque axes in the spacecraft file
-(``[[thrusters]]``), the dump is aimed at the point of their cone nearest to −Ĥ_w (`dump_evidence`).
+"momentum dump". With thruster torque axes in the spacecraft file (``[[thrusters]]``), the aim is the point of
+their cone nearest to −Ĥ_w, mixed with two more unloading laws (any mix of the unloading axes; equal pulses on a
+subset of them: `signal_models`). The confidence of a strike, a dump or an attitude sensor's step is the
+probability, calibrated on simulated events, that the class is right (`attribution.calibrated_confidence`).
 
 Neighbours
 ----------

@@ -43,9 +43,10 @@ import numpy as np
 from scipy.optimize import nnls
 
 from abrupt.detect.attitude.body_response import window_rows
-from abrupt.detect.attitude.signal_models import unloading_cone_log_lr
+from abrupt.detect.attitude.signal_models import pulse_lattice_log_lr, unloading_cone_log_lr
 from abrupt.model.spacecraft import Spacecraft
 from abrupt.series.timetable import NS, Timetable
+from abrupt.thresholds.noise import robust_scale
 from abrupt.types import FloatArray
 
 NAN = float("nan")
@@ -91,9 +92,38 @@ def cone_angle_deg(axes: FloatArray, u: FloatArray) -> float:
     return math.degrees(math.acos(float(np.clip(cos, -1.0, 1.0))))
 
 
+def _neighbour_step(tau: FloatArray, y: FloatArray, design: FloatArray) -> float:
+    """The time [s] of a neighbour's step in the window, or NaN: a second step of ᴺH (all three axes) at
+    the sample that fits best, on either side of the event with at least 10 samples between it and the
+    event, kept when its Δχ² (the drop of the sum of squares over the residual variance) beats the BIC
+    penalty of its four parameters (time and three amplitudes), 4 ln N, plus 2 ln of the candidates tried."""
+    n = tau.size
+    before, after = np.flatnonzero(tau < 0), np.flatnonzero(tau >= 0)
+    if before.size <= 20 or after.size <= 20:
+        return NAN
+    cands = np.concatenate([tau[before[:-10]], tau[after[10:]]])
+    if cands.size == 0:
+        return NAN
+    coef, *_ = np.linalg.lstsq(design, y, rcond=None)
+    sse0 = float(np.sum((y - design @ coef) ** 2))
+    best, where = np.inf, NAN
+    for tc in cands:
+        col = (tau >= tc) if tc > 0 else (tau < tc)
+        d = np.column_stack([design, col.astype(float)])
+        c, *_ = np.linalg.lstsq(d, y, rcond=None)
+        sse = float(np.sum((y - d @ c) ** 2))
+        if sse < best:
+            best, where = sse, float(tc)
+    dof = max(3 * (n - design.shape[1] - 1), 1)
+    chi2 = (sse0 - best) / max(best / dof, 1e-300)
+    return where if chi2 > 4.0 * math.log(3 * n) + 2.0 * math.log(len(cands)) else NAN
+
+
 def step_with_sigma(g: np.ndarray, h: FloatArray, i0: int, dt: float) -> tuple[FloatArray, FloatArray] | None:
     """ΔH at row ``i0`` (3,) by least squares of a + b τ + s·1(τ ≥ 0) over ± ``STEP_HALF_S`` (the rows in
-    ``STEP_GUARD_S`` left out) and its standard error per axis from the fit's residuals (3,)."""
+    ``STEP_GUARD_S`` left out) and its standard error per axis from the fit's residuals (3,). A neighbour's
+    step inside the window (a strike half a minute before a dump) is fitted beside it
+    (:func:`_neighbour_step`), else its jump would count in the event's residuals and the event's."""
     rows = window_rows(g, i0, -STEP_HALF_S, STEP_HALF_S, dt)
     tau = (g[rows] - g[i0]) / NS
     keep = ((tau < STEP_GUARD_S[0]) | (tau >= STEP_GUARD_S[1])) & np.isfinite(h[rows]).all(axis=1)
@@ -101,9 +131,12 @@ def step_with_sigma(g: np.ndarray, h: FloatArray, i0: int, dt: float) -> tuple[F
     if (tau < 0).sum() < 10 or (tau >= 0).sum() < 10:
         return None
     design = np.column_stack([np.ones(tau.size), tau / STEP_HALF_S, (tau >= 0).astype(float)])
+    tc = _neighbour_step(tau, y, design)
+    if math.isfinite(tc):
+        design = np.column_stack([design, ((tau >= tc) if tc > 0 else (tau < tc)).astype(float)])
     coef, *_ = np.linalg.lstsq(design, y, rcond=None)
     res = y - design @ coef
-    dof = max(tau.size - 3, 1)
+    dof = max(tau.size - design.shape[1], 1)
     cov = np.linalg.inv(design.T @ design)
     sigma = np.sqrt(np.sum(res**2, axis=0) / dof * cov[2, 2])
     return np.asarray(coef[2], dtype=np.float64), np.asarray(sigma, dtype=np.float64)
@@ -116,10 +149,10 @@ def dump_evidence(
     the wheels' stored momentum ``wheel_momentum_Nms`` (|H_w,B| before the event), the angle of ΔH_B from
     −H_w,B ``dump_angle_deg`` with its σ ``dump_angle_sigma_deg`` (noise only, without the aim's spread),
     ``dump_log_lr`` (module docstring; about the thrusters' aim when the spacecraft has thruster axes,
-    with ``dump_cone_angle_deg``, the angle of ΔH_B from their cone, and ``dump_cone_log_lr``, the unloading
-    thrusters' cone against any direction) and ``dump_unloads`` (|ΔH| /
-    (2 |H_w| cos θ): below 1 when the wheels' stored momentum shrinks). Empty when the wheels or the
-    momentum do not allow it."""
+    with ``dump_cone_angle_deg``, the angle of ΔH_B from their cone, ``dump_cone_log_lr``, the unloading
+    thrusters' cone against any direction, and ``dump_pulse_log_lr``, equal pulses on a subset of them) and
+    ``dump_unloads`` (|ΔH| / (2 |H_w| cos θ): below 1 when the wheels' stored momentum shrinks). Empty when
+    the wheels or the momentum do not allow it."""
     g, dt, valid = table.time_ns, table.dt_s, table.valid
     om = table.wheel_speed_rad_s
     mag = float(np.linalg.norm(dh_b))
@@ -140,7 +173,8 @@ def dump_evidence(
     # The direction's noise: the step's σ across its direction over |ΔH| (isotropic: the mean variance);
     # the wheels' direction: the spread of their momentum over the window over |H_w|.
     sig_dh = float(np.sqrt(np.mean(sig_n**2))) / mag
-    sig_hw = float(np.sqrt(np.mean(np.var(hw_rows, axis=0)) / max(before.size - 1, 1))) / hw_mag
+    # (robust: a neighbour's step of the wheels inside the window does not count as noise).
+    sig_hw = float(np.sqrt(np.mean(robust_scale(hw_rows, axis=0) ** 2) / max(before.size - 1, 1))) / hw_mag
     sig_noise = math.hypot(sig_dh, sig_hw)
     kappa = 1.0 / (sig_noise**2 + math.radians(DUMP_AIM_SIGMA_DEG) ** 2)
     cos_t = float(np.clip(-(dh_b @ hw) / (mag * hw_mag), -1.0, 1.0))
@@ -159,4 +193,5 @@ def dump_evidence(
         out["dump_log_lr"] = dump_log_lr(cos_aim, kappa) if aim_mag > 1e-12 else -math.inf
         out["dump_cone_angle_deg"] = cone_angle_deg(axes, dh_b)
         out["dump_cone_log_lr"] = unloading_cone_log_lr(axes, hw, dh_b, math.degrees(sig_noise))
+        out["dump_pulse_log_lr"] = pulse_lattice_log_lr(axes, hw, dh_b, math.degrees(sig_noise))
     return out

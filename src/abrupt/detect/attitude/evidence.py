@@ -61,7 +61,8 @@ telemetry (:class:`~abrupt.series.timetable.Timetable`) around the event:
   lasts of that fitted step (with the other steps within 150 s after it that point back against it)
   along itself over |ΔH|, judged beside the window's other steps rather than on the raw balance;
 * **momentum dump** (``wheel_momentum_Nms``, ``dump_angle_deg``, ``dump_angle_sigma_deg``,
-  ``dump_log_lr``, ``dump_unloads``, ``dump_cone_angle_deg`` and ``dump_cone_log_lr`` with thruster axes):
+  ``dump_log_lr``, ``dump_unloads``, ``dump_cone_angle_deg``, ``dump_cone_log_lr`` and ``dump_pulse_log_lr``
+  with thruster axes):
   ΔH_B against the momentum
   the wheels held before the event, and the likelihood ratio of a dump (aimed at −H_w, or at the point of the
   thrusters' torque cone nearest to it) to a strike (any direction):
@@ -169,6 +170,7 @@ class EventEvidence:
     dump_unloads: float = NAN
     dump_cone_angle_deg: float = NAN
     dump_cone_log_lr: float = NAN
+    dump_pulse_log_lr: float = NAN
     duration_log_lr: float = NAN
 
     def as_dict(self) -> dict[str, float]:

@@ -21,6 +21,16 @@ angle for a full cone; for six body-axis couples the octant of −H_w, LR = 8 in
 direction lies in that cone with probability Z / 4π (1/8 for the octant): the cone alone never calls a
 strike a dump; it adds its weight to the stored-momentum aim and to the time profile
 (:func:`abrupt.detect.attitude.attribution.compare_hypotheses`).
+
+**Dump pulses.** A thruster fires in pulses of one on-time (a minimum impulse bit, or the unloading law's
+pulse width), and a bang-bang law fires every couple it selects for that same on-time. A dump too short
+for the time profile to tell from an impulse (one or two pulses) then adds equal impulses along a subset
+of the unloading axes: ΔĤ_B is one of the directions Σ_{k∈S} a_k / |Σ_{k∈S} a_k| over the non-empty
+subsets S (for six body-axis couples: the three axes of the octant of −H_w, its three face diagonals and
+its body diagonal, 7 points). Under this law the direction is a von Mises-Fisher law about one of those J
+points, κ = 1/σ², σ = hypot(noise, ``PULSE_SIGMA_DEG``); :func:`pulse_lattice_log_lr` is the log of
+(1/J) Σ_j 2κ e^(κ(u·d_j − 1)) / (1 − e^(−2κ)) against the strike's uniform 1/(4π). A strike's random
+direction comes within θ of one of the points with probability J (1 − cos θ)/2 (7 points, 2°: 0.2 %).
 """
 
 from __future__ import annotations
@@ -42,6 +52,11 @@ IMPULSE_SAMPLES = 2.0
 CONE_SIGMA_DEG = 5.0
 #: Directions of the quadrature of the blurred cone's normalisation (a Fibonacci sphere).
 SPHERE_POINTS = 4000
+#: The spread of a pulse's direction about the sum of its couples' axes beyond the measured noise [deg]:
+#: thruster alignment and plume impingement (a fraction of a degree to a degree on flight hardware).
+PULSE_SIGMA_DEG = 1.0
+#: The pulse directions are enumerated for at most this many unloading axes (2^m − 1 subsets).
+PULSE_AXES_MAX = 12
 
 
 def duration_profile(tau_s: FloatArray, y: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray] | None:
@@ -145,3 +160,36 @@ def unloading_cone_log_lr(axes: FloatArray, hw_B: FloatArray, u_B: FloatArray, n
     delta = math.acos(float(np.clip(_cone_cos(a, u), -1.0, 1.0)))
     norm = _cone_norm(tuple(np.round(a, 9).ravel().tolist()), sigma_deg)
     return -0.5 * (delta / math.radians(sigma_deg)) ** 2 - math.log(norm)
+
+
+def pulse_directions(axes: FloatArray) -> FloatArray:
+    """The unit directions of equal pulses on every non-empty subset of the columns of ``axes`` (3 x m unit
+    torque axes, m ≤ ``PULSE_AXES_MAX``), parallel ones once: J x 3 (empty where the subsets cancel)."""
+    m = axes.shape[1]
+    subsets = (np.arange(1, 2**m)[:, None] >> np.arange(m)[None, :]) & 1
+    sums = subsets.astype(np.float64) @ axes.T
+    norm = np.linalg.norm(sums, axis=1)
+    dirs = sums[norm > 1e-9] / norm[norm > 1e-9, None]
+    return np.asarray(np.unique(np.round(dirs, 9), axis=0), dtype=np.float64)
+
+
+def pulse_lattice_log_lr(axes: FloatArray, hw_B: FloatArray, u_B: FloatArray, noise_deg: float) -> float:
+    """ln of the likelihood ratio of equal pulses on a subset of the unloading axes (module docstring) to
+    the strike (uniform on the sphere) for the direction ``u_B``, σ = hypot(``noise_deg``,
+    ``PULSE_SIGMA_DEG``); −∞ when no thruster unloads, NaN without axes or with too many to enumerate."""
+    if axes.shape[1] == 0 or not np.all(np.isfinite(hw_B)) or not np.all(np.isfinite(u_B)):
+        return NAN
+    a = unloading_axes(axes, hw_B)
+    if a.shape[1] == 0:
+        return -math.inf
+    if a.shape[1] > PULSE_AXES_MAX:
+        return NAN
+    dirs = pulse_directions(a)
+    if dirs.shape[0] == 0:
+        return -math.inf
+    u = u_B / float(np.linalg.norm(u_B))
+    sigma = math.radians(math.hypot(noise_deg if math.isfinite(noise_deg) else 0.0, PULSE_SIGMA_DEG))
+    kappa = 1.0 / sigma**2
+    # ln[2κ e^(κ(c − 1)) / (1 − e^(−2κ))] per point, then the mean over the J points (log-sum-exp).
+    each = math.log(2.0 * kappa) - math.log1p(-math.exp(-2.0 * kappa)) + kappa * (dirs @ u - 1.0)
+    return float(np.logaddexp.reduce(each) - math.log(dirs.shape[0]))
