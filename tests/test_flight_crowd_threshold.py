@@ -9,8 +9,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
-from abrupt.detect.attitude.flight_glr import FlightGlrDetector
+from abrupt.detect.attitude.flight_glr import FlightGlrDetector, crowd_ratio_level, local_ratio_level
 from abrupt.series.timetable import NS
 from abrupt.thresholds.budget import FalseAlarmBudget
 
@@ -86,3 +87,21 @@ def test_a_crowd_far_above_the_noise_is_calibrated_like_the_quiet_day_and_loses_
         assert len(big) > 40 and plain > 50.0 * quiet_plain
         assert abs(crowd - quiet_plain) < 0.15 * quiet_plain, (seed, crowd, quiet_plain)
         assert not [t for t in big if not _found(peaks, t, crowd)]
+
+
+def test_the_local_ratio_of_a_crowd_is_fitted_on_the_null_peaks() -> None:
+    """Peaks of a null (statistic 2-6, ratio to the local level 0.5-3) and of events (statistic 50-500,
+    ratio 10-50): with events in 60 % of the peaks the fit of all ratios lies among the events' and would
+    drop them; the crowd's fit is that of the null's peaks alone. With events in a tenth of the peaks the
+    quartile fit stands them and is kept."""
+    rng = np.random.default_rng(4)
+    null_r, null_v = rng.uniform(0.5, 3.0, 60), rng.uniform(2.0, 6.0, 60)
+    for n_events, crowd in ((90, True), (6, False)):
+        ev_r, ev_v = rng.uniform(10.0, 50.0, n_events), rng.uniform(50.0, 500.0, n_events)
+        r, v = np.r_[null_r, ev_r], np.r_[null_v, ev_v]
+        got = crowd_ratio_level([r[:40], r[40:]], [v[:40], v[40:]], 20.0, BUDGET, 1.0)
+        if crowd:
+            assert local_ratio_level(r, BUDGET, 1.0) > 10.0  # among the events'
+            assert got == pytest.approx(local_ratio_level(null_r, BUDGET, 1.0), rel=1e-9) and got < 5.0
+        else:
+            assert got == pytest.approx(local_ratio_level(r, BUDGET, 1.0), rel=1e-9)

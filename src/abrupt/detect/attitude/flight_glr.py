@@ -97,6 +97,22 @@ def local_ratio_level(ratios: FloatArray, budget: FalseAlarmBudget, days: float)
     return float(mu - beta * math.log(-math.log1p(-p_peak)))
 
 
+def crowd_ratio_level(
+    ratios: list[FloatArray], peak_values: list[FloatArray], threshold: float, budget: FalseAlarmBudget, days: float
+) -> float:
+    """:func:`local_ratio_level` of every peak's ratio (the stretches' ``ratios`` and the statistic at those
+    peaks, ``peak_values``), or, on a crowd (at least ``CROWD_FRACTION`` of the
+    peaks above ``threshold``: the quartiles of the ratios are then the events'), of the peaks not above
+    it, the null's; NaN (no local test) when fewer than ``MIN_BLOCKS`` of those are left. On a day of 100
+    strikes the ratio of all peaks is 154, and a strike's peak stands 10-50 times above the median of its
+    surroundings (its neighbours' responses): the test would drop nearly every one."""
+    r = np.concatenate([np.empty(0), *ratios]).astype(np.float64)
+    v = np.concatenate([np.empty(0), *peak_values]).astype(np.float64)
+    if r.size and np.count_nonzero(v > threshold) >= CROWD_FRACTION * r.size:
+        r = r[~(v > threshold)]
+    return local_ratio_level(r, budget, days)
+
+
 def low_quantile_level(maxima: FloatArray, p_block: float) -> float:
     """The level a block maximum exceeds with probability ``p_block`` under a Gumbel law through the
     ``LOW_QUANTILES`` of ``maxima`` (Q(p) = μ − β ln(−ln p)); NaN for fewer than ``MIN_BLOCKS``."""
