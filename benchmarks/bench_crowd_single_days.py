@@ -3,7 +3,8 @@
     PYTHONPATH=$PWD/src python benchmarks/bench_crowd_single_days.py --set /work/bsk3/set1 --work W [--label L]
 
 ``W`` is the ``--work`` folder of ``bench_attribution_independent.py`` on the same set (its stores,
-spacecraft files and whole-run ``events.csv`` are used; a missing one is made). Each stored day is run
+spacecraft files and whole-run ``events.csv`` are used; a missing one is made; ``--reuse-days`` scores the
+``events_DAY.csv`` of a previous run). Each stored day is run
 alone (``abrupt detect attitude --store S --days D``), so its threshold is fitted on that day's own
 statistic, where events fill a larger share of the blocks than over the whole run. For each day: the
 threshold of the day alone and of the whole run, and the truth strikes >= 0.05 N·m·s with an event
@@ -16,7 +17,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import re
 import subprocess
 import sys
 from pathlib import Path
@@ -31,9 +31,17 @@ BIG_NMS = 0.05
 NS = 1_000_000_000
 
 
-def detect_day(work: Path, day: str) -> tuple[pd.DataFrame, str]:
-    """``abrupt detect attitude`` on one stored day: its events and its threshold line."""
+def glr_threshold(events: pd.DataFrame) -> float:
+    """The step detector's threshold of a run (NaN when it raised no event)."""
+    glr = events.loc[events["detector"] == "attitude.flight_glr", "threshold"]
+    return float(glr.iloc[0]) if len(glr) else float("nan")
+
+
+def detect_day(work: Path, day: str, reuse: bool) -> pd.DataFrame:
+    """``abrupt detect attitude`` on one stored day (``--days DAY``): its events."""
     out = work / f"events_{day}.csv"
+    if reuse and out.exists():
+        return pd.read_csv(out)
     out.unlink(missing_ok=True)
     out.with_name(f"events_{day}.evidence.csv").unlink(missing_ok=True)
     exe = str(Path(sys.executable).parent / "abrupt")
@@ -43,8 +51,7 @@ def detect_day(work: Path, day: str) -> tuple[pd.DataFrame, str]:
                           check=False)  # fmt: skip
     if done.returncode != 0:
         raise SystemExit(f"detect --days {day} failed ({done.returncode}): {done.stderr.strip()[-2000:]}")
-    line = next((x for x in (done.stdout + done.stderr).splitlines() if x.startswith("threshold")), "threshold ?")
-    return pd.read_csv(out), line
+    return pd.read_csv(out)
 
 
 def strikes_found(events: pd.DataFrame, strikes_ns: np.ndarray) -> tuple[int, int]:
@@ -65,6 +72,7 @@ def main() -> None:
     ap.add_argument("--set", dest="set_dir", type=Path, required=True)
     ap.add_argument("--work", type=Path, required=True, help="bench_attribution_independent.py's --work folder")
     ap.add_argument("--label", default="")
+    ap.add_argument("--reuse-days", action="store_true", help="score the single days' events of the last run again")
     args = ap.parse_args()
     tot = {"alone": [0, 0], "whole": [0, 0], "n": 0}
     for folder in sorted(p for p in args.set_dir.iterdir() if (p / "truth_events.json").is_file()):
@@ -76,21 +84,19 @@ def main() -> None:
         days = sorted(
             {str(np.datetime64(int(t0 + e["start_s"] * NS), "ns").astype("datetime64[D]")) for e in truth["events"]}
         )
-        glr = whole.loc[whole["detector"] == "attitude.flight_glr", "threshold"]
-        whole_thr = float(glr.iloc[0]) if len(glr) else float("nan")
+        whole_thr = glr_threshold(whole)
         for day in days:
             d0 = np.datetime64(day, "D").astype("datetime64[ns]").astype(np.int64)
             s_ns = np.array([int(t0 + e["start_s"] * NS) for e in big], np.int64)
             s_ns = s_ns[(s_ns >= d0) & (s_ns < d0 + 86_400 * NS)]
             n_events = sum(d0 <= t0 + e["start_s"] * NS < d0 + 86_400 * NS for e in truth["events"])
-            alone, line = detect_day(work, day)
-            thr = re.search(r"threshold ([0-9.]+)", line)
+            alone = detect_day(work, day, args.reuse_days)
             a, w = strikes_found(alone, s_ns), strikes_found(whole, s_ns)
             tot["n"] += s_ns.size
             for k, v in (("alone", a), ("whole", w)):
                 tot[k] = [tot[k][0] + v[0], tot[k][1] + v[1]]
             print(f"{truth['spacecraft']} {day}: {n_events} truth events; threshold alone "
-                  f"{thr.group(1) if thr else '?'} against {whole_thr:.1f} over the whole run; strikes >= {BIG_NMS} "
+                  f"{glr_threshold(alone):.1f} against {whole_thr:.1f} over the whole run; strikes >= {BIG_NMS} "
                   f"N·m·s with an event (called strike): alone {a[0]} ({a[1]}), whole run {w[0]} ({w[1]}) "
                   f"of {s_ns.size}", flush=True)  # fmt: skip
     print(f"all days: strikes >= {BIG_NMS} N·m·s with an event (called strike): each day alone {tot['alone'][0]} "
