@@ -103,8 +103,8 @@ pieces pooled into blocks), at a level where the events left out are consistent 
 lowest fit above which exactly the peaks left out lie (a crowd far above the noise has two such fits, one
 among the events, one at the null). It is used only when those events touch a quarter of the blocks (the
 quartile fit's breakdown point); a quiet day keeps its plain fit. When more than half of the peaks are above
-the threshold the local-level ratio is fitted on those not above it (`crowd_ratio_level`; on a day of 100 strikes the ratio of all
-peaks was 154, a strike's peak 10-50 times its surroundings).
+the threshold the local-level ratio is fitted on those not above it (`crowd_ratio_level`; on a day of 100
+strikes the ratio of all peaks was 154, a strike's peak 10-50 times its surroundings).
 
 * analytic, white noise of 0.01 N·m·s per axis (strikes far above the noise, as in flight momentum), 100
   steps of 0.03-0.6 N·m·s, three draws: 5.37, 5.41, 4.98 against 5.76, 5.01, 4.78 quiet (within 8 %; plain
