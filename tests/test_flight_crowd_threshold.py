@@ -9,8 +9,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
-from abrupt.detect.attitude.flight_glr import FlightGlrDetector
+from abrupt.detect.attitude.flight_glr import FlightGlrDetector, crowd_ratio_level, local_ratio_level
 from abrupt.series.timetable import NS
 from abrupt.thresholds.budget import FalseAlarmBudget
 
@@ -40,7 +41,7 @@ def test_a_day_of_100_events_keeps_most_strikes_of_0_1_nms_that_the_quiet_day_fi
     """100 steps of 0.03-0.6 N·m·s (log-uniform), 760-920 s apart, in white noise: the plain quartile fit
     of block maxima rises more than ten-fold with them (nearly every block holds an event) and loses
     nearly every strike of 0.1 N·m·s and more that the quiet day's threshold finds; the fit without the
-    events' neighbourhoods loses at most a fifth of them (a tenth on this draw), and on the quiet day it is
+    events' neighbourhoods loses at most a fifth of them (none on this draw), and on the quiet day it is
     the plain fit."""
     rng = np.random.default_rng(8)
     noise = rng.normal(0, SIGMA, (DAY_S, 3))
@@ -61,3 +62,46 @@ def test_a_day_of_100_events_keeps_most_strikes_of_0_1_nms_that_the_quiet_day_fi
     lost = [t for t in big if not _found(peaks, t, crowd)]
     assert plain > 5.0 * quiet_plain and len(lost_plain) > 0.8 * len(big)  # the crowd blinds the plain fit
     assert crowd < 0.5 * plain and len(lost) <= 0.2 * len(big), (crowd, quiet_plain, len(lost), len(big))
+
+
+def test_a_crowd_far_above_the_noise_is_calibrated_like_the_quiet_day_and_loses_no_strike() -> None:
+    """The regime of flight momentum, where a strike of 0.03 N·m·s stands tens of noise levels above the
+    null (white noise of 0.01 N·m·s per axis): on three draws of 100 steps of 0.03-0.6 N·m·s 760-920 s
+    apart, the plain fit rises a hundred-fold, and the fit without the events' neighbourhoods is within
+    15 % of the same noise's quiet threshold (the pooled free pieces of blocks hold the null's maxima) and
+    loses no strike of 0.1 N·m·s or more that the quiet threshold finds."""
+    det = FlightGlrDetector()
+    for seed in (1, 2, 3):
+        rng = np.random.default_rng(seed)
+        noise = rng.normal(0, 0.1 * SIGMA, (DAY_S, 3))
+        quiet_plain, quiet_crowd, _ = _calibrate(det, noise)
+        assert quiet_crowd == quiet_plain  # a quiet day keeps the plain fit
+        times = 300.0 + np.cumsum(rng.uniform(760, 920, 100))
+        sizes = np.exp(rng.uniform(math.log(0.03), math.log(0.6), 100))
+        u = rng.normal(size=(100, 3))
+        h = noise.copy()
+        for t, size, d in zip(times, sizes, u, strict=True):
+            h[int(t) :] += size * d / np.linalg.norm(d)
+        plain, crowd, peaks = _calibrate(det, h)
+        big = [t for t, s in zip(times, sizes, strict=True) if s >= 0.1 and _found(peaks, t, quiet_plain)]
+        assert len(big) > 40 and plain > 50.0 * quiet_plain
+        assert abs(crowd - quiet_plain) < 0.15 * quiet_plain, (seed, crowd, quiet_plain)
+        assert not [t for t in big if not _found(peaks, t, crowd)]
+
+
+def test_the_local_ratio_of_a_crowd_is_fitted_on_the_null_peaks() -> None:
+    """Peaks of a null (statistic 2-6, ratio to the local level 0.5-3) and of events (statistic 50-500,
+    ratio 10-50): with events in 60 % of the peaks the fit of all ratios lies among the events' and would
+    drop them; the crowd's fit is that of the null's peaks alone. With events in under half of the peaks
+    (here 40 %) the quartile fit of all is kept."""
+    rng = np.random.default_rng(4)
+    null_r, null_v = rng.uniform(0.5, 3.0, 60), rng.uniform(2.0, 6.0, 60)
+    for n_events, crowd in ((90, True), (40, False)):
+        ev_r, ev_v = rng.uniform(10.0, 50.0, n_events), rng.uniform(50.0, 500.0, n_events)
+        r, v = np.r_[null_r, ev_r], np.r_[null_v, ev_v]
+        got = crowd_ratio_level([r[:40], r[40:]], [v[:40], v[40:]], 20.0, BUDGET, 1.0)
+        if crowd:
+            assert local_ratio_level(r, BUDGET, 1.0) > 10.0  # among the events'
+            assert got == pytest.approx(local_ratio_level(null_r, BUDGET, 1.0), rel=1e-9) and got < 5.0
+        else:
+            assert got == pytest.approx(local_ratio_level(r, BUDGET, 1.0), rel=1e-9)

@@ -46,7 +46,7 @@ from abrupt.detect.attitude.flight_glr import (
     FlightGlrDetector,
     Peak,
     SubBlocks,
-    local_ratio_level,
+    crowd_ratio_level,
 )
 from abrupt.detect.attitude.gyro_bias import BIAS_TRACK_S, debiased_momentum
 from abrupt.detect.attitude.leak_scan import LeakScan
@@ -313,6 +313,7 @@ class ChunkResult:
     sub_blocks: SubBlocks = field(default_factory=SubBlocks.empty)
     leaks: LeakScan = field(default_factory=lambda: LeakScan([], []))
     peak_ratios: FloatArray = field(default_factory=lambda: np.empty(0))
+    peak_values: FloatArray = field(default_factory=lambda: np.empty(0))
 
 
 def process_chunk(
@@ -470,6 +471,7 @@ def process_span(
                 sub_blocks=detector.sub_blocks(g[piece], stat[piece]),
                 leaks=cleaned.leaks.within(p0, p1),
                 peak_ratios=ratios[(ratio_times >= p0) & (ratio_times < p1)],
+                peak_values=stat[np.searchsorted(g, ratio_times[(ratio_times >= p0) & (ratio_times < p1)])],
             )
         )
     return out
@@ -588,7 +590,8 @@ def run_flight(
     blocks, subs = [r.block_maxima for r in chunks], [r.sub_blocks for r in chunks]
     threshold = detector.fit_threshold_crowd(blocks, subs, peaks, config.budget, grid_hz)
     analysed_days = sum(r.n_analysed for r in chunks) / (86_400.0 * grid_hz)
-    ratio_level = local_ratio_level(np.concatenate([r.peak_ratios for r in chunks]), config.budget, analysed_days)
+    ratio_level = crowd_ratio_level([r.peak_ratios for r in chunks], [r.peak_values for r in chunks],
+                                    threshold.value, config.budget, analysed_days)  # fmt: skip
     if math.isfinite(ratio_level):
         threshold = replace(threshold, method=f"{threshold.method}; {ratio_level:.1f}x the local level")
     run_id = run_id or new_run_id()
