@@ -1,7 +1,6 @@
 """Flight-telemetry pipeline: archive → store → timetable → momentum → cleaning → detection → events.
 
-Harris et al. 2025 §3.3-3.5, §3.7 and Bennett 2022 ch. 4, driven entirely by the spacecraft file
-(adding a spacecraft is a file, not code):
+Harris et al. 2025 §3.3-3.5, §3.7 and Bennett 2022 ch. 4, driven entirely by the spacecraft file:
 
 1. :func:`ingest_archives` reads archive dumps, replaces names by pseudonyms at the door, removes
    archiver artifacts and stores raw samples per spacecraft-day (:class:`abrupt.store.TelemetryStore`).
