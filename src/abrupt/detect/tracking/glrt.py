@@ -280,11 +280,16 @@ class _EpochSearch:
             )
         return self.tried[tau]
 
-    def locate(self, max_steps: int = 8) -> tuple[float, float]:
-        """Epoch [s] of the impulse and its 1σ [s] (class doc). Each Gauss-Newton step is held within one
-        candidate step; the search stops when the step is under a tenth of the epoch's 1σ."""
+    def locate(self) -> tuple[float, float]:
+        """Epoch [s] of the impulse and its 1σ [s] (class doc), from the scan's best candidate."""
         tau = float(self.scan.t_candidates_s[self.scan.best])
-        fit = self.refit(tau)
+        tau, information = self.descend(tau, self.refit(tau))
+        return tau, self.epoch_sigma(information)
+
+    def descend(self, tau: float, fit: BatchFit, max_steps: int = 8) -> tuple[float, float]:
+        """Gauss-Newton steps of the new impulse's epoch from ``fit`` (the refit at ``tau``): the epoch of
+        smallest χ² reached and its Fisher information [1/s²]. Each step is held within one candidate
+        step; the descent stops when the step is under a tenth of the epoch's 1σ."""
         k_new = len(self.impulse_times_s)
         shift, information = epoch_step(self.data, fit, k_new)
         for _ in range(max_steps):
@@ -302,7 +307,7 @@ class _EpochSearch:
                     break
             tau, fit = trial_tau, trial
             shift, information = epoch_step(self.data, fit, k_new)
-        return tau, self.epoch_sigma(information)
+        return tau, information
 
     def epoch_sigma(self, information: float) -> float:
         """1σ of the epoch: 1/√information, or (information lost) the half-width of the scan's candidates
@@ -319,23 +324,19 @@ class _EpochSearch:
         """The better epoch and the alternatives (χ² within 9) of a cross-track impulse.
 
         A cross-track impulse only fixes the new plane (node line and tilt r·Δv/h): epochs half an
-        orbit apart fit almost equally, with Δv scaled by r(τ); the better of the ambiguous solutions
-        becomes the primary one.
+        orbit apart fit almost equally, with Δv scaled by r(τ). Around each of τ̂ ± T/2 the scan's best
+        candidate within 2.5 steps is refitted and descended (:meth:`descend`); the better of the
+        ambiguous solutions becomes the primary one.
         """
-        step = self.step
+        cand, stat = self.scan.t_candidates_s, self.scan.statistic
         best = self.tried[best_tau]
         alt: list[tuple[float, NDArray[np.float64]]] = []
         for centre in (best_tau - period_s / 2.0, best_tau + period_s / 2.0):
-            local = [centre + k * step for k in (-2, -1, 0, 1, 2) if self.inside(centre + k * step)]
-            if not local:
+            local = np.flatnonzero((np.abs(cand - centre) <= 2.5 * self.step) & np.isfinite(stat))
+            if not local.size:
                 continue
-            tau_alt = min(local, key=lambda t: self.refit(float(t)).chi2)
-            for half in (step / 2.0, step / 4.0):
-                for t_try in (tau_alt - half, tau_alt + half):
-                    if self.inside(t_try):
-                        self.refit(float(t_try))
-                near_alt = [t for t in self.tried if abs(t - tau_alt) <= step]
-                tau_alt = min(near_alt, key=lambda t: self.tried[t].chi2)
+            tau_start = float(cand[local[np.argmax(stat[local])]])
+            tau_alt, _ = self.descend(tau_start, self.refit(tau_start))
             alt.append((float(tau_alt), self.tried[tau_alt].impulse_dv_rsw_mps[-1].copy()))
         if alt:
             cand_best = min([best_tau, *[t for t, _ in alt]], key=lambda t: self.tried[t].chi2)
