@@ -125,7 +125,8 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    from _results import write_results
+    from _results import variant, write_results
 
-    with write_results("bench_slr_lageos"):
+    # the maneuver-free and the maneuver runs may be split over two processes (--runs 0 / --null-runs 0)
+    with write_results("bench_slr_lageos", variant({"--runs=0": "null", "--null-runs=0": "maneuvers"})):
         main()

@@ -19,7 +19,7 @@ On a :class:`~abrupt.series.tracking.LaserRangingSeries` of one arc the detector
 Bounded cost (optional, set by the pipeline): before the epoch search, the linear scan of step 4 tells how
 much of the maneuver-free fit's residual the best single impulse removes (its statistic T_max of the
 residual's χ²). When it removes less than half and leaves more than ``max_unexplained_rms_m`` of range
-RMS, no impulse explains the arc: the nonlinear epoch search (tens of full refits) is skipped and the arc
+RMS, no impulse explains the arc: the nonlinear epoch search is skipped and the arc
 is reported as an unexplained residual. After each search round the fit with its impulses is checked
 against ``fit_bounds`` (physical range biases, force scales, post-fit RMS); a fit outside them ends the
 re-weighting rounds, whose further searches could only fit more of what the model cannot explain.
