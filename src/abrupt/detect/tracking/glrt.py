@@ -31,6 +31,7 @@ from functools import partial
 
 import numpy as np
 from numpy.typing import NDArray
+from threadpoolctl import threadpool_limits
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.detect.tracking.noise_scale import calibrate_noise, misfit_warnings
@@ -250,6 +251,7 @@ class _EpochSearch:
         self.t0_s, self.config, self.step = t0_s, config, step_s
         self.t_first, self.t_last = float(data.t_s.min()), float(data.t_s.max())
         self.tried: dict[float, BatchFit] = {}
+        self.sigma_s = math.nan  # 1σ of the located epoch [s]
 
     def inside(self, tau: float) -> bool:
         return self.t_first < tau < self.t_last
@@ -284,7 +286,8 @@ class _EpochSearch:
         """Epoch [s] of the impulse and its 1σ [s] (class doc), from the scan's best candidate."""
         tau = float(self.scan.t_candidates_s[self.scan.best])
         tau, information = self.descend(tau, self.refit(tau))
-        return tau, self.epoch_sigma(information)
+        self.sigma_s = self.epoch_sigma(information)
+        return tau, self.sigma_s
 
     def descend(self, tau: float, fit: BatchFit, max_steps: int = 8) -> tuple[float, float]:
         """Gauss-Newton steps of the new impulse's epoch from ``fit`` (the refit at ``tau``): the epoch of
@@ -325,8 +328,8 @@ class _EpochSearch:
 
         A cross-track impulse only fixes the new plane (node line and tilt r·Δv/h): epochs half an
         orbit apart fit almost equally, with Δv scaled by r(τ). Around each of τ̂ ± T/2 the scan's best
-        candidate within 2.5 steps is refitted and descended (:meth:`descend`); the better of the
-        ambiguous solutions becomes the primary one.
+        candidate within 2.5 steps is refitted and moved by one Gauss-Newton step of its epoch
+        (:meth:`descend`); the better of the ambiguous solutions becomes the primary one.
         """
         cand, stat = self.scan.t_candidates_s, self.scan.statistic
         best = self.tried[best_tau]
@@ -336,16 +339,18 @@ class _EpochSearch:
             if not local.size:
                 continue
             tau_start = float(cand[local[np.argmax(stat[local])]])
-            tau_alt, _ = self.descend(tau_start, self.refit(tau_start))
+            tau_alt, _ = self.descend(tau_start, self.refit(tau_start), max_steps=1)
             alt.append((float(tau_alt), self.tried[tau_alt].impulse_dv_rsw_mps[-1].copy()))
         if alt:
             cand_best = min([best_tau, *[t for t, _ in alt]], key=lambda t: self.tried[t].chi2)
             if cand_best != best_tau:
                 alt = [(best_tau, best.impulse_dv_rsw_mps[-1].copy())] + [a for a in alt if a[0] != cand_best]
-                best_tau, best = cand_best, self.tried[cand_best]
+                best_tau, information = self.descend(cand_best, self.tried[cand_best])  # primary: refined fully
+                best, self.sigma_s = self.tried[best_tau], self.epoch_sigma(information)
         return best_tau, [(t, v) for t, v in alt if self.tried[t].chi2 <= best.chi2 + 9.0]
 
 
+@threadpool_limits.wrap(limits=1, user_api="blas")  # tall, narrow matrices: BLAS threads only contend
 def detect_maneuvers_glrt(
     data: TrackingArrays,
     x0_apriori: NDArray[np.float64],
@@ -395,6 +400,7 @@ def detect_maneuvers_glrt(
         dv_new = best.impulse_dv_rsw_mps[-1]
         if abs(dv_new[2]) > 0.9 * float(np.linalg.norm(dv_new)):
             best_tau, alt = search.cross_track_alternatives(best_tau, period)
+            time_sigma = search.sigma_s
             best = search.tried[best_tau]
         alternatives.append(alt)
         times.append(best_tau)

@@ -35,6 +35,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import replace
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.detect.tracking.glrt import (
@@ -88,6 +89,9 @@ class LaserGlrtDetector(Detector[LaserRangingSeries]):
         self.fit_bounds = fit_bounds
         self.max_unexplained_rms_m = max_unexplained_rms_m
 
+    # the fits' matrices are thousands of rows by tens of columns: BLAS threads only contend (a QR of
+    # 1139 × 25 takes 0.4 ms on one thread and 100 CPU-ms on two of a loaded machine)
+    @threadpool_limits.wrap(limits=1, user_api="blas")
     def detect(self, series: LaserRangingSeries, budget: FalseAlarmBudget) -> DetectionResult:
         if len(series) == 0:
             return DetectionResult.empty(warnings=("no ranges",))
