@@ -282,9 +282,9 @@ class _EpochSearch:
             )
         return self.tried[tau]
 
-    def locate(self) -> tuple[float, float]:
-        """Epoch [s] of the impulse and its 1σ [s] (class doc), from the scan's best candidate."""
-        tau = float(self.scan.t_candidates_s[self.scan.best])
+    def locate(self, start_s: float | None = None) -> tuple[float, float]:
+        """Epoch [s] of the impulse and its 1σ [s] (class doc), from ``start_s`` or the scan's best candidate."""
+        tau = float(self.scan.t_candidates_s[self.scan.best]) if start_s is None else float(start_s)
         tau, information = self.descend(tau, self.refit(tau))
         self.sigma_s = self.epoch_sigma(information)
         return tau, self.sigma_s
@@ -358,12 +358,15 @@ def detect_maneuvers_glrt(
     t0_s: float = 0.0,
     fit_config: BatchFitConfig | None = None,
     config: GlrtConfig | None = None,
+    epoch_hints_s: Sequence[float] = (),
 ) -> GlrtSearch:
     """Fit, scan, refine, refit: greedy detection of up to ``max_maneuvers`` impulses.
 
     Each round scans the current fit's residuals (:func:`glrt_scan`) and, when the largest statistic
     exceeds the threshold, chooses the epoch by nonlinear refits (:class:`_EpochSearch`). The reported
-    statistic is the nonlinear likelihood ratio χ²(no new impulse) − χ²(with it).
+    statistic is the nonlinear likelihood ratio χ²(no new impulse) − χ²(with it). ``epoch_hints_s``
+    (epochs found before on the same arc, e.g. with other weights) start the epoch descent when one lies
+    within three candidate steps of the scan's best candidate; the detection itself is the scan's.
     """
     cfg = config or GlrtConfig()
     fcfg = fit_config or BatchFitConfig()
@@ -383,6 +386,7 @@ def detect_maneuvers_glrt(
     times: list[float] = []
     sigmas: list[float] = []
     stats: list[float] = []
+    hints = [float(h) for h in epoch_hints_s]
     for _ in range(cfg.max_maneuvers):
         scan = glrt_scan(data, fit, cand)
         scans.append(scan)
@@ -392,7 +396,12 @@ def detect_maneuvers_glrt(
         if t_max <= threshold:
             break
         search = _EpochSearch(data, fit, scan, times, t0_s=t0_s, config=scan_cfg, step_s=step)
-        best_tau, time_sigma = search.locate()
+        t_best = float(scan.t_candidates_s[scan.best])
+        near = [h for h in hints if abs(h - t_best) <= 3.0 * step and search.inside(h)]
+        start = min(near, key=lambda h: abs(h - t_best)) if near else None
+        if start is not None:
+            hints.remove(start)
+        best_tau, time_sigma = search.locate(start)
         best = search.tried[best_tau]
         if fit.chi2 - best.chi2 <= threshold:
             break

@@ -14,7 +14,8 @@ On a :class:`~abrupt.series.tracking.LaserRangingSeries` of one arc the detector
 4. **scans** for impulses between and during passes with the GLRT of
    :func:`abrupt.detect.tracking.glrt.detect_maneuvers_glrt`, threshold from the false-alarm budget;
 5. **re-reduces** on the trajectory with the detected impulses and repeats steps 3-4 until the weights
-   settle, so that the corrections of the ranges after a maneuver are computed on the right orbit.
+   settle, so that the corrections of the ranges after a maneuver are computed on the right orbit; a
+   round's epoch descents start from the epochs the round before found.
 
 Bounded cost (optional, set by the pipeline): before the epoch search, the linear scan of step 4 tells how
 much of the maneuver-free fit's residual the best single impulse removes (its statistic T_max of the
@@ -122,7 +123,10 @@ class LaserGlrtDetector(Detector[LaserRangingSeries]):
                     break
                 scale = new
                 data = series.reduced(fit, scale, repairs=repairs)
-            detections, fit, scans = detect_maneuvers_glrt(data, fit.x0, fit_config=fcfg, config=gcfg)
+            hints = [d.t_s for d in detections]  # the last round's epochs start this round's descents
+            detections, fit, scans = detect_maneuvers_glrt(
+                data, fit.x0, fit_config=fcfg, config=gcfg, epoch_hints_s=hints
+            )
             bad = self.fit_bounds(fit, _station_rms_m(data, fit)) if self.fit_bounds is not None else []
             if bad:
                 unexplained += bad
