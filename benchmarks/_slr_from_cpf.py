@@ -63,23 +63,24 @@ class Cpf:
         return (np.asarray(t_utc, dtype="datetime64[ns]") - self.times_utc[0]) / np.timedelta64(1, "s")
 
     def position_at(self, t_s: np.ndarray, order: int = 10) -> np.ndarray:
-        """Lagrange interpolation of order ``order`` (s from the first record) on the centred node window."""
+        """Lagrange interpolation of order ``order`` (s from the first record) on the centred node window.
+
+        All epochs at once: w_j(t) = Π_{m≠j} (t − t_m)/(t_j − t_m) over each epoch's ``order`` + 1 nodes
+        (arrays of epochs × nodes × nodes, the diagonal m = j set to 1)."""
         grid = self.seconds(self.times_utc)
         t = np.atleast_1d(np.asarray(t_s, dtype=float))
-        out = np.empty((t.size, 3))
         half = (order + 1) // 2
-        for i, ti in enumerate(t):
-            k = int(np.searchsorted(grid, ti))
-            lo = min(max(k - half, 0), grid.size - order - 1)
-            nodes = grid[lo : lo + order + 1]
-            weights = np.array(
-                [
-                    np.prod([(ti - nodes[m]) / (nodes[j] - nodes[m]) for m in range(nodes.size) if m != j])
-                    for j in range(nodes.size)
-                ]
-            )
-            out[i] = weights @ self.position_m[lo : lo + order + 1]
-        return out
+        k = np.searchsorted(grid, t)
+        lo = np.clip(k - half, 0, grid.size - order - 1)
+        window = lo[:, None] + np.arange(order + 1)  # (n, K) node indices
+        nodes = grid[window]
+        numerator = np.broadcast_to((t[:, None] - nodes)[:, None, :], (t.size, order + 1, order + 1)).copy()
+        denominator = nodes[:, :, None] - nodes[:, None, :]  # [i, j, m] = t_j − t_m
+        diagonal = np.arange(order + 1)
+        numerator[:, diagonal, diagonal] = 1.0
+        denominator[:, diagonal, diagonal] = 1.0
+        weights = np.prod(numerator / denominator, axis=2)  # (n, K)
+        return np.einsum("nk,nkc->nc", weights, self.position_m[window])
 
 
 def read_cpf(path: Path) -> Cpf:

@@ -56,6 +56,7 @@ def main() -> None:
     ap.add_argument("--ablation-runs", type=int, default=1)
     ap.add_argument("--null-runs", type=int, default=None, help="maneuver-free runs (default: --runs)")
     ap.add_argument("--first-run", type=int, default=0, help="index of the first maneuver run (to split runs)")
+    ap.add_argument("--first-null-run", type=int, default=0, help="index of the first maneuver-free run")
     ap.add_argument("--arc-days", type=float, default=7.0, help="arc length; 1-day overlaps")
     ap.add_argument("--terms", nargs="*", default=list(RANGE_MODEL_TERMS), help="ablation terms (default: all)")
     args = ap.parse_args()
@@ -65,7 +66,7 @@ def main() -> None:
 
     alarms = 0
     null_runs = args.runs if args.null_runs is None else args.null_runs
-    for seed in range(null_runs):
+    for seed in range(args.first_null_run, args.first_null_run + null_runs):
         res = run(SlrScenario(duration_days=args.days), seed, RangeModel(), budget, args.step_s, args.arc_days)
         alarms += len(res.detections)
         rms = ", ".join(f"{k} {v * 1000:.1f}" for k, v in res.residual_rms_m.items())
@@ -125,7 +126,15 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    from _results import write_results
+    from _results import variant, write_results
 
-    with write_results("bench_slr_lageos"):
+    # the maneuver-free and the maneuver runs may be split over two processes (--runs 0 / --null-runs 0)
+    with write_results(
+        "bench_slr_lageos",
+        variant(
+            {"--runs=0": "null", "--null-runs=0": "maneuvers"}
+            | {f"--first-null-run={k}": f"from{k}" for k in range(1, 100)}
+            | {f"--first-run={k}": f"from{k}" for k in range(1, 100)}
+        ),
+    ):
         main()

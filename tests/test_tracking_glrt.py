@@ -12,7 +12,13 @@ import pytest
 from click.testing import CliRunner
 
 from abrupt.cli.main import cli, main
-from abrupt.detect.tracking.glrt import GlrtConfig, detect_maneuvers_glrt, glrt_scan, glrt_threshold_fit
+from abrupt.detect.tracking.glrt import (
+    GlrtConfig,
+    detect_maneuvers_glrt,
+    epoch_step,
+    glrt_scan,
+    glrt_threshold_fit,
+)
 from abrupt.model.orbit import rsw_basis
 from abrupt.model.orbit.batch_fit import BatchFitConfig, fit_orbit, trajectory
 from abrupt.model.stations import ascension
@@ -262,3 +268,30 @@ def test_glrt_scan_equals_the_direct_projection_at_every_candidate() -> None:
         np.testing.assert_allclose(scan.dv_rsw_mps[k], dv, rtol=1e-3, atol=1e-7)
         checked += 1
     assert checked > 20
+
+
+@pytest.mark.parametrize(
+    ("location", "direction", "offset_s"), [("perigee", "S", -200.0), ("apogee", "R", -200.0), ("perigee", "W", 60.0)]
+)
+def test_the_epoch_step_is_the_minimum_of_the_nonlinear_refits(location: str, direction: str, offset_s: float) -> None:
+    """The Gauss-Newton epoch step from the fit's variational matrices against nonlinear refits: an impulse
+    put ``offset_s`` from a 5 cm/s burn, refitted at ±20 s around there; the parabola through the three χ²
+    has its minimum where the step points and its curvature is the step's Fisher information."""
+    burn = thesis_burn(location, direction, 0.05)
+    data, sim = _data(burn)
+    cfg = BatchFitConfig(outlier_sigma=None)
+    base = fit_orbit(data, _perturbed(sim.initial_state), config=cfg)
+    tau = burn.t_start_s + 0.5 * burn.duration_s + offset_s
+    at = fit_orbit(data, base.x0, config=cfg, impulse_times_s=[tau])
+    shift_s, information = epoch_step(data, at, 0)
+    h = 20.0
+    chi2_lo, chi2_hi = (
+        fit_orbit(data, at.x0, config=cfg, impulse_times_s=[t], initial_impulse_dv_rsw=at.impulse_dv_rsw_mps).chi2
+        for t in (tau - h, tau + h)
+    )
+    curvature = (chi2_lo - 2.0 * at.chi2 + chi2_hi) / (2.0 * h * h)  # χ²(τ) ≈ χ²_min + c (τ − τ*)²
+    assert curvature > 0
+    parabola_shift_s = -(chi2_hi - chi2_lo) / (4.0 * curvature * h)
+    assert abs(parabola_shift_s) > 10.0  # the epoch is off by more than the test's tolerance
+    assert shift_s == pytest.approx(parabola_shift_s, rel=0.25)
+    assert information == pytest.approx(curvature, rel=0.25)

@@ -121,9 +121,11 @@ maneuver is never rejected as outliers). (2) For each candidate epoch τ (period
 = J₀δp + J_v(τ)Δv + w with J_v(τ) = W H Φ(t,t0) Φ(τ,t0)⁻¹ [0;I] C_RSW(τ) for t > τ; T(τ) =
 r̃ᵀJ̃_v(J̃_vᵀJ̃_v)⁻¹J̃_vᵀr̃ (projected orthogonally to J₀) is χ²₃ under "no maneuver" (Willsky & Jones 1976).
 (3) If max T exceeds the χ²₃ threshold for the false-alarm budget (Bonferroni over candidates), the epoch is
-chosen by full nonlinear refits over the plateau of T and a local bisection; the statistic reported is the
-nonlinear likelihood ratio χ²(without) − χ²(with); Δv and its covariance come from the joint fit; the epoch
-uncertainty is the half-width of {τ : χ² ≤ χ²_min + 1}. Repeats for further maneuvers.
+chosen coarse to fine: one nonlinear refit at the candidate of largest T, then Gauss-Newton steps of the
+epoch itself from that refit's variational matrices (moving the impulse by δτ changes the state after it by
+δτ [−Δv; Ċ_RSW Δv_RSW]; Montenbruck & Gill 2000 §7.2), each confirmed by one refit; the statistic reported is
+the nonlinear likelihood ratio χ²(without) − χ²(with); Δv and its covariance come from the joint fit; the
+epoch uncertainty is 1/√(Fisher information of τ), the other parameters free. Repeats for further maneuvers.
 
 Real tracking: Eutelsat W3B
 ---------------------------
@@ -256,8 +258,8 @@ per day. The filter integrates with an eighth-order fixed-step Runge-Kutta (Dorm
 12 stages) at 60 s: over 30 days of a LAGEOS orbit it stays within 2-5 mm of DOP853 at rtol 1e-13, where RK4
 needs 5 s steps (RK4 at 60 s is metres off; `tests/test_tracking_model.py`).
 
-**Epoch refinement.** After the plateau search and bisection, the impulse epoch is refined by parabolic
-interpolation of the nonlinear χ²(τ), and its 1σ is 1/√c from the curvature c (Δχ² = 1). With millimetre ranging
+**Epoch refinement.** The Gauss-Newton steps of the epoch bring it to the minimum of the nonlinear χ²(τ)
+(within a tenth of its 1σ, 1/√c with c the curvature of χ²(τ): Δχ² = 1). With millimetre ranging
 a 2 s epoch error leaves Δv·δτ ≈ 2 cm for 1 cm/s; without the refinement the GLRT absorbs that residue with a
 second, spurious "impulse" of 0.03 mm/s next to every real maneuver.
 

@@ -13,8 +13,13 @@ passes' residuals. This module
    T(τ) = r̃ᵀ J̃_v (J̃_vᵀ J̃_v)⁻¹ J̃_vᵀ r̃ (tildes: projected orthogonally to J₀) is χ²₃ under "no maneuver";
    Δv̂(τ) = (J̃_vᵀ J̃_v)⁻¹ J̃_vᵀ r̃ with covariance (J̃_vᵀ J̃_v)⁻¹;
 3. declares a maneuver when max_τ T(τ) exceeds a threshold set for a false-alarm rate (Bonferroni over the
-   candidate epochs: P_fa per arc / n_candidates, χ²₃), refits jointly with the impulse at τ̂, and repeats
-   for further maneuvers. The epoch uncertainty is the half-width of the set {τ : T(τ) ≥ T_max − 1}.
+   candidate epochs: P_fa per arc / n_candidates, χ²₃; the GLRT with unknown Δv, Kay 1998 §6.4-6.5),
+   refits jointly with the impulse at τ̂, and repeats for further maneuvers;
+4. refines the epoch coarse to fine: all candidates cost one linear solve each (step 2, the variational
+   matrices Φ of the no-maneuver fit; Montenbruck & Gill 2000 §7.2), only the best is refitted
+   nonlinearly, and its epoch then moves by Gauss-Newton steps of τ itself (:func:`epoch_step`), each
+   from the refit's own Φ and confirmed by one refit: a few refits per detection instead of a bracket
+   of tens. The epoch's 1σ is 1/√(Fisher information of τ) with all other parameters free.
 """
 
 from __future__ import annotations
@@ -26,6 +31,7 @@ from functools import partial
 
 import numpy as np
 from numpy.typing import NDArray
+from threadpoolctl import threadpool_limits
 
 from abrupt.detect.base import DetectionResult, Detector, Diagnostics
 from abrupt.detect.tracking.noise_scale import calibrate_noise, misfit_warnings
@@ -175,12 +181,58 @@ def _period_s(x0: NDArray[np.float64], fit_config: BatchFitConfig) -> float:
     return 2 * math.pi * math.sqrt((-mu / (2 * energy)) ** 3 / mu) if energy < 0 else 86400.0
 
 
-class _EpochSearch:
-    """Nonlinear refits of ``fit`` with one more impulse at trial epochs, kept by epoch.
+def epoch_step(data: TrackingArrays, fit: BatchFit, k_impulse: int) -> tuple[float, float]:
+    """Gauss-Newton step [s] of the epoch of impulse ``k_impulse`` of ``fit`` and its Fisher information
+    [1/s²], from the fit's own variational matrices (no propagation beyond the impulse epoch).
 
-    The linear scan finds the plateau of candidate epochs; the epoch is chosen by the full nonlinear
-    refit (minimum weighted residual sum of squares), because a transverse impulse anywhere between
-    two passes has nearly the same linear signature.
+    Moving an impulse Δv (RSW components Δv_RSW, inertial C Δv_RSW) from τ to τ + δτ changes the state just
+    after τ by δx = δτ [−C Δv_RSW; Ċ Δv_RSW] to first order (the position misses δτ of the extra velocity;
+    the RSW frame turns, Ċ from r̂' = (v − r̂ (r̂·v))/|r|, ŵ' = 0). It reaches a later row i through the state
+    transition of the variational equations (Montenbruck & Gill 2000, §7.2), J_τ,i = jx_i Φ(τ, t₀)⁻¹ δx/δτ,
+    with jx_i the fit's whitened ∂y_i/∂x₀. Projected orthogonally to the fit's Jacobian (all other
+    parameters free, priors included): δτ = J̃_τᵀ r / J̃_τᵀ J̃_τ and the epoch's Fisher information
+    J̃_τᵀ J̃_τ (its 1σ is 1/√information: Δχ² = 1; Kay 1993, §3.7).
+    """
+    tau = float(fit.impulse_times_s[k_impulse])
+    states, d_tau = fit.propagate(np.array([tau]))  # the state just before the impulse
+    x = states[0]
+    c = rsw_basis(x)
+    r_norm = float(np.linalg.norm(x[:3]))
+    r_hat, v = x[:3] / r_norm, x[3:]
+    r_hat_dot = (v - r_hat * float(r_hat @ v)) / r_norm
+    c_dot = np.column_stack([r_hat_dot, np.cross(c[:, 2], r_hat_dot), np.zeros(3)])
+    dv_rsw = fit.impulse_dv_rsw_mps[k_impulse]
+    delta = np.concatenate([-(c @ dv_rsw), c_dot @ dv_rsw])
+    phi = d_tau[0][:, :6]
+    if not (np.all(np.isfinite(phi)) and abs(np.linalg.det(phi)) > 0):
+        return math.nan, 0.0
+    m = np.linalg.solve(phi, delta)
+    used = fit.used
+    j0 = fit.jacobian_white[used]
+    t_rows = data.t_s[fit.row_index[used]]
+    j_tau = np.where(t_rows > tau, j0[:, :6] @ m, 0.0)
+    prior_r, prior_j = fit.prior_residuals_white, fit.prior_jacobian_white
+    if prior_r.size:
+        j0 = np.vstack([j0, prior_j])
+        j_tau = np.concatenate([j_tau, np.zeros(prior_r.size)])
+    r_all = np.concatenate([fit.residuals_white[used], prior_r])
+    q0, _ = np.linalg.qr(j0)
+    j_perp = j_tau - q0 @ (q0.T @ j_tau)
+    information = float(j_perp @ j_perp)
+    if not information > 0:
+        return math.nan, 0.0
+    return float(j_perp @ r_all) / information, information
+
+
+class _EpochSearch:
+    """Coarse to fine: the linear scan's best candidate, then Gauss-Newton steps of the epoch itself.
+
+    The linear scan (:func:`glrt_scan`) puts the impulse at the candidate of largest statistic; one
+    nonlinear refit there gives the impulse; :func:`epoch_step` then moves its epoch by Gauss-Newton
+    steps from the refit's own variational matrices, each confirmed by one refit (kept when χ² drops).
+    A burn found in a few refits instead of a bracket of tens; the epoch's 1σ is 1/√information of the
+    last step (with precise ranging a few seconds of epoch error leave Δv·δτ, centimetres for 1 cm/s,
+    that a second "impulse" would otherwise absorb).
     """
 
     def __init__(
@@ -199,91 +251,75 @@ class _EpochSearch:
         self.t0_s, self.config, self.step = t0_s, config, step_s
         self.t_first, self.t_last = float(data.t_s.min()), float(data.t_s.max())
         self.tried: dict[float, BatchFit] = {}
+        self.sigma_s = math.nan  # 1σ of the located epoch [s]
 
     def inside(self, tau: float) -> bool:
         return self.t_first < tau < self.t_last
 
-    def refit(self, tau: float) -> BatchFit:
-        """The fit with an impulse at ``tau`` (started from the scan's Δv̂ at the nearest candidate)."""
+    def refit(self, tau: float, start: BatchFit | None = None) -> BatchFit:
+        """The fit with an impulse at ``tau``: started from ``start`` (a fit with the same impulses, one at
+        another epoch) or from the no-impulse fit and the scan's Δv̂ at the nearest candidate."""
         if tau not in self.tried:
-            cand, dv_scan = self.scan.t_candidates_s, self.scan.dv_rsw_mps
-            k_near = int(np.argmin(np.abs(cand - tau)))
-            guess = dv_scan[k_near] if np.all(np.isfinite(dv_scan[k_near])) else np.zeros(3)
-            dv0 = np.vstack([self.fit.impulse_dv_rsw_mps, guess[None, :]])
+            origin = start or self.fit
+            if start is not None:
+                dv0 = start.impulse_dv_rsw_mps
+            else:
+                cand, dv_scan = self.scan.t_candidates_s, self.scan.dv_rsw_mps
+                k_near = int(np.argmin(np.abs(cand - tau)))
+                guess = dv_scan[k_near] if np.all(np.isfinite(dv_scan[k_near])) else np.zeros(3)
+                dv0 = np.vstack([self.fit.impulse_dv_rsw_mps, guess[None, :]])
             self.tried[tau] = fit_orbit(
                 self.data,
-                self.fit.x0,
+                origin.x0,
                 t0_s=self.t0_s,
                 config=self.config,
                 impulse_times_s=[*self.impulse_times_s, tau],
-                initial_range_bias_m=self.fit.range_bias_m or None,
+                initial_range_bias_m=origin.range_bias_m or None,
                 initial_impulse_dv_rsw=dv0,
-                initial_acceleration_mps2=self.fit.acceleration_mps2,
-                initial_angle_bias_rad=self.fit.angle_bias_rad,
-                initial_scale_factors=self.fit.scale_factors,
+                initial_acceleration_mps2=origin.acceleration_mps2,
+                initial_angle_bias_rad=origin.angle_bias_rad,
+                initial_scale_factors=origin.scale_factors,
             )
         return self.tried[tau]
 
-    def best(self) -> float:
-        return min(self.tried, key=lambda t: self.tried[t].chi2)
+    def locate(self, start_s: float | None = None) -> tuple[float, float]:
+        """Epoch [s] of the impulse and its 1σ [s] (class doc), from ``start_s`` or the scan's best candidate."""
+        tau = float(self.scan.t_candidates_s[self.scan.best]) if start_s is None else float(start_s)
+        tau, information = self.descend(tau, self.refit(tau))
+        self.sigma_s = self.epoch_sigma(information)
+        return tau, self.sigma_s
 
-    def locate(self, t_max: float) -> tuple[float, float, float]:
-        """Epoch of the smallest χ², the last bracket's half-width and the curvature of χ²(τ).
-
-        Refits over the scan's plateau (T ≥ 0.9 T_max, at most 8 epochs), then bisection down to
-        1/16 of the candidate step, then parabolic steps (:meth:`parabolic`).
-        """
-        cand, stat, step = self.scan.t_candidates_s, self.scan.statistic, self.step
-        plateau = cand[np.isfinite(stat) & (stat >= 0.9 * t_max)]
-        if plateau.size > 8:
-            plateau = plateau[np.linspace(0, plateau.size - 1, 8).round().astype(int)]
-        for tau in {*plateau.tolist(), float(cand[self.scan.best])}:
-            self.refit(float(tau))
-        best_tau = self.best()
-        width = step if plateau.size <= 1 else max(step, float(np.median(np.diff(np.sort(plateau)))))
-        while width > step / 16.0:
-            width /= 2.0
-            for tau in (best_tau - width, best_tau + width):
-                if self.inside(tau):
-                    self.refit(float(tau))
-            best_tau = self.best()
-        return self.parabolic(best_tau, width)
-
-    def parabolic(self, best_tau: float, width: float) -> tuple[float, float, float]:
-        """Parabolic refinement of the epoch from a bracket of half-width ``width`` around ``best_tau``.
-
-        χ²(τ) is smooth near its minimum, and with precise ranging a few seconds of epoch error leave
-        Δv·δτ (centimetres for 1 cm/s) that a second "impulse" would otherwise absorb. The curvature c
-        gives the epoch's 1σ, 1/√c (Δχ² = 1); it is taken on the first, widest bracket, where Δχ²
-        stands above the refits' own convergence noise.
-        """
-        curvature = math.nan
-        for _ in range(6):
-            lo_t, hi_t = best_tau - width, best_tau + width
-            if not (self.t_first < lo_t and hi_t < self.t_last):
+    def descend(self, tau: float, fit: BatchFit, max_steps: int = 8) -> tuple[float, float]:
+        """Gauss-Newton steps of the new impulse's epoch from ``fit`` (the refit at ``tau``): the epoch of
+        smallest χ² reached and its Fisher information [1/s²]. Each step is held within one candidate
+        step; the descent stops when the step is under a tenth of the epoch's 1σ."""
+        k_new = len(self.impulse_times_s)
+        shift, information = epoch_step(self.data, fit, k_new)
+        for _ in range(max_steps):
+            sigma = 1.0 / math.sqrt(information) if information > 0 else math.inf
+            if not math.isfinite(shift) or abs(shift) <= max(0.1 * sigma, 1e-3):
                 break
-            c_lo, c_0, c_hi = self.refit(float(lo_t)).chi2, self.tried[best_tau].chi2, self.refit(float(hi_t)).chi2
-            c_here = (c_lo - 2.0 * c_0 + c_hi) / (2.0 * width**2)
-            if math.isnan(curvature):
-                curvature = c_here
-            if not c_here > 0:
-                break
-            shift = -(c_hi - c_lo) / (4.0 * c_here * width)
-            shift = float(np.clip(shift, -width, width))
-            if abs(shift) < 1e-3:
-                break
-            self.refit(float(best_tau + shift))
-            best_tau = self.best()
-            width = max(min(width, 4.0 * abs(shift)), 1e-2)
-        return best_tau, width, curvature
+            shift = float(np.clip(shift, -self.step, self.step))
+            trial_tau = tau + shift
+            trial = self.refit(trial_tau, fit) if self.inside(trial_tau) else None
+            if trial is None or not trial.chi2 < fit.chi2:
+                shift /= 4.0  # the linearised step overshot: one shorter try, then stop
+                trial_tau = tau + shift
+                trial = self.refit(trial_tau, fit) if self.inside(trial_tau) else None
+                if trial is None or not trial.chi2 < fit.chi2:
+                    break
+            tau, fit = trial_tau, trial
+            shift, information = epoch_step(self.data, fit, k_new)
+        return tau, information
 
-    def epoch_sigma(self, best: BatchFit, width: float, curvature: float) -> float:
-        """1σ of the epoch: 1/√c, or the half-spread of the epochs within Δχ² = 1 (wide in a data gap)."""
-        ok = [t for t, f in self.tried.items() if f.chi2 <= best.chi2 + 1.0]
-        spread = 0.5 * (max(ok) - min(ok))
-        if curvature > 0:
-            return max(1.0 / math.sqrt(curvature), spread, 1e-3)
-        return max(spread, width / math.sqrt(3.0))
+    def epoch_sigma(self, information: float) -> float:
+        """1σ of the epoch: 1/√information, or (information lost) the half-width of the scan's candidates
+        within 1 of its largest statistic, at least a third of a candidate step."""
+        if information > 0:
+            return max(1.0 / math.sqrt(information), 1e-3)
+        cand, stat = self.scan.t_candidates_s, self.scan.statistic
+        near = cand[np.isfinite(stat) & (stat >= np.nanmax(stat) - 1.0)]
+        return max(0.5 * float(np.ptp(near)) if near.size else 0.0, self.step / math.sqrt(3.0))
 
     def cross_track_alternatives(
         self, best_tau: float, period_s: float
@@ -291,32 +327,30 @@ class _EpochSearch:
         """The better epoch and the alternatives (χ² within 9) of a cross-track impulse.
 
         A cross-track impulse only fixes the new plane (node line and tilt r·Δv/h): epochs half an
-        orbit apart fit almost equally, with Δv scaled by r(τ); the better of the ambiguous solutions
-        becomes the primary one.
+        orbit apart fit almost equally, with Δv scaled by r(τ). Around each of τ̂ ± T/2 the scan's best
+        candidate within 2.5 steps is refitted and moved by one Gauss-Newton step of its epoch
+        (:meth:`descend`); the better of the ambiguous solutions becomes the primary one.
         """
-        step = self.step
+        cand, stat = self.scan.t_candidates_s, self.scan.statistic
         best = self.tried[best_tau]
         alt: list[tuple[float, NDArray[np.float64]]] = []
         for centre in (best_tau - period_s / 2.0, best_tau + period_s / 2.0):
-            local = [centre + k * step for k in (-2, -1, 0, 1, 2) if self.inside(centre + k * step)]
-            if not local:
+            local = np.flatnonzero((np.abs(cand - centre) <= 2.5 * self.step) & np.isfinite(stat))
+            if not local.size:
                 continue
-            tau_alt = min(local, key=lambda t: self.refit(float(t)).chi2)
-            for half in (step / 2.0, step / 4.0):
-                for t_try in (tau_alt - half, tau_alt + half):
-                    if self.inside(t_try):
-                        self.refit(float(t_try))
-                near_alt = [t for t in self.tried if abs(t - tau_alt) <= step]
-                tau_alt = min(near_alt, key=lambda t: self.tried[t].chi2)
+            tau_start = float(cand[local[np.argmax(stat[local])]])
+            tau_alt, _ = self.descend(tau_start, self.refit(tau_start), max_steps=1)
             alt.append((float(tau_alt), self.tried[tau_alt].impulse_dv_rsw_mps[-1].copy()))
         if alt:
             cand_best = min([best_tau, *[t for t, _ in alt]], key=lambda t: self.tried[t].chi2)
             if cand_best != best_tau:
                 alt = [(best_tau, best.impulse_dv_rsw_mps[-1].copy())] + [a for a in alt if a[0] != cand_best]
-                best_tau, best = cand_best, self.tried[cand_best]
+                best_tau, information = self.descend(cand_best, self.tried[cand_best])  # primary: refined fully
+                best, self.sigma_s = self.tried[best_tau], self.epoch_sigma(information)
         return best_tau, [(t, v) for t, v in alt if self.tried[t].chi2 <= best.chi2 + 9.0]
 
 
+@threadpool_limits.wrap(limits=1, user_api="blas")  # tall, narrow matrices: BLAS threads only contend
 def detect_maneuvers_glrt(
     data: TrackingArrays,
     x0_apriori: NDArray[np.float64],
@@ -324,12 +358,15 @@ def detect_maneuvers_glrt(
     t0_s: float = 0.0,
     fit_config: BatchFitConfig | None = None,
     config: GlrtConfig | None = None,
+    epoch_hints_s: Sequence[float] = (),
 ) -> GlrtSearch:
     """Fit, scan, refine, refit: greedy detection of up to ``max_maneuvers`` impulses.
 
     Each round scans the current fit's residuals (:func:`glrt_scan`) and, when the largest statistic
     exceeds the threshold, chooses the epoch by nonlinear refits (:class:`_EpochSearch`). The reported
-    statistic is the nonlinear likelihood ratio χ²(no new impulse) − χ²(with it).
+    statistic is the nonlinear likelihood ratio χ²(no new impulse) − χ²(with it). ``epoch_hints_s``
+    (epochs found before on the same arc, e.g. with other weights) start the epoch descent when one lies
+    within three candidate steps of the scan's best candidate; the detection itself is the scan's.
     """
     cfg = config or GlrtConfig()
     fcfg = fit_config or BatchFitConfig()
@@ -349,6 +386,7 @@ def detect_maneuvers_glrt(
     times: list[float] = []
     sigmas: list[float] = []
     stats: list[float] = []
+    hints = [float(h) for h in epoch_hints_s]
     for _ in range(cfg.max_maneuvers):
         scan = glrt_scan(data, fit, cand)
         scans.append(scan)
@@ -358,15 +396,20 @@ def detect_maneuvers_glrt(
         if t_max <= threshold:
             break
         search = _EpochSearch(data, fit, scan, times, t0_s=t0_s, config=scan_cfg, step_s=step)
-        best_tau, width, curvature = search.locate(t_max)
+        t_best = float(scan.t_candidates_s[scan.best])
+        near = [h for h in hints if abs(h - t_best) <= 3.0 * step and search.inside(h)]
+        start = min(near, key=lambda h: abs(h - t_best)) if near else None
+        if start is not None:
+            hints.remove(start)
+        best_tau, time_sigma = search.locate(start)
         best = search.tried[best_tau]
         if fit.chi2 - best.chi2 <= threshold:
             break
-        time_sigma = search.epoch_sigma(best, width, curvature)
         alt: list[tuple[float, NDArray[np.float64]]] = []
         dv_new = best.impulse_dv_rsw_mps[-1]
         if abs(dv_new[2]) > 0.9 * float(np.linalg.norm(dv_new)):
             best_tau, alt = search.cross_track_alternatives(best_tau, period)
+            time_sigma = search.sigma_s
             best = search.tried[best_tau]
         alternatives.append(alt)
         times.append(best_tau)
