@@ -222,7 +222,7 @@ def cli_inputs(tmp_path: Path) -> tuple[Path, Path]:
 
 def _run_bad(cli_inputs: tuple[Path, Path], orbit: Path, capsys: pytest.CaptureFixture[str], *extra: str) -> str:
     sc, store = cli_inputs
-    args = ["detect", "attitude", "--store", str(store), "--spacecraft", str(sc), "--out", str(store / "e.csv")]
+    args = ["detect", "attitude", "--store", str(store), "--spacecraft", str(sc), "--out", str(store.parent / "e.csv")]
     with pytest.raises(SystemExit) as exc:
         cli_main([*args, "--orbit-events", str(orbit), *extra])
     assert exc.value.code == 2
