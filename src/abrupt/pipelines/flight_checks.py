@@ -308,8 +308,8 @@ def _check_still_components(
     if max(v.lr for v, _ in verdicts) < -REFUSE_LR:
         return
     logging.getLogger("abrupt").warning(
-        "%s: gyro unit and quaternion scalar channel not verified from kinematics: the attitude moves above noise "
-        "in %d blocks only (chi2 difference %.1f, decided beyond %g); check the [flight] channels",
+        "%s: gyro unit and quaternion scalar channel taken as declared, not verified from kinematics: the attitude "
+        "moves above noise in %d blocks only (chi2 difference %.1f, decided beyond %g); check the [flight] channels",
         spacecraft.source,
         verdict.blocks,
         verdict.lr,

@@ -322,8 +322,8 @@ def _check_still_kinematics(
         return
     motion = "holds still within noise" if verdict.blocks == 0 else f"moves above noise in {verdict.blocks} blocks only"
     logging.getLogger("abrupt").warning(
-        "%s: rate unit %r and quaternion scalar position %r not verified from kinematics: the attitude %s (chi2 "
-        "difference %.1f, decided beyond %g); check them in the spacecraft file",
+        "%s: rate unit %r and quaternion scalar position %r taken as declared, not verified from kinematics: the "
+        "attitude %s (chi2 difference %.1f, decided beyond %g); check them in the spacecraft file",
         path,
         tmap.body_rate.unit or "rad/s",
         (tmap.quaternion.order or "scalar_first").partition(",")[0],
