@@ -91,6 +91,7 @@ class LaserRangingResult:
     data: TrackingArrays
     repairs: RepairLog = field(default_factory=RepairLog)
     unexplained: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)  # the detector's warnings (e.g. its refit bound reached)
 
 
 def laser_series(
@@ -128,11 +129,13 @@ def detect_laser_ranging(
     max_maneuvers: int = 3,
     weight_by_residuals: bool = True,
     bounded: bool = True,
+    propulsion: bool = True,
 ) -> LaserRangingResult:
     """``tracking.laser_glrt`` on one arc; ``x0_apriori`` is the GCRF state at ``epoch_utc``. With
     ``bounded`` the detector stops at a residual its model cannot absorb (the physical bounds of
     :func:`~abrupt.pipelines.laser_plausibility.fit_bound_violations`; no epoch search when no single
-    impulse explains the arc), which the result names in ``unexplained``."""
+    impulse explains the arc), which the result names in ``unexplained``. Without ``propulsion`` the
+    epochs half an orbit from a cross-track detection are not refined (they choose a burn's epoch)."""
     series = laser_series(
         measurements, sites, stations, x0_apriori, epoch_utc, range_model=range_model, fit_config=fit_config
     )
@@ -141,8 +144,10 @@ def detect_laser_ranging(
         weight_by_residuals=weight_by_residuals,
         fit_bounds=_fit_bounds if bounded else None,
         max_unexplained_rms_m=MAX_POSTFIT_RMS_M if bounded else None,
+        cross_track_alternatives=propulsion,
     )
-    extra = detector.detect(series, budget or DEFAULT_BUDGET).diagnostic(detector.name).extra
+    found = detector.detect(series, budget or DEFAULT_BUDGET)
+    extra = found.diagnostic(detector.name).extra
     return LaserRangingResult(
         extra["detections"],
         extra["fit"],
@@ -151,6 +156,7 @@ def detect_laser_ranging(
         extra["data"],
         extra["repairs"],
         list(extra.get("unexplained", [])),
+        list(found.warnings),
     )
 
 
@@ -215,6 +221,7 @@ def detect_laser_ranging_arcs(
     max_maneuvers: int = 3,
     weight_by_residuals: bool = True,
     min_ranges_per_arc: int = 30,
+    propulsion: bool = True,
 ) -> LaserArcsResult:
     """Long campaigns in overlapping arcs (ILRS analyses fit LAGEOS in 7-day arcs), each run through
     :func:`detect_laser_ranging`.
@@ -274,6 +281,7 @@ def detect_laser_ranging_arcs(
             fit_config=fit_config,
             max_maneuvers=max_maneuvers,
             weight_by_residuals=weight_by_residuals,
+            propulsion=propulsion,
         )
         arcs.append(LaserArc(arc_epoch, (lo, hi), result))
         for kind, count in result.repairs.counts.items():
@@ -462,6 +470,10 @@ def run_laser_ranging_files(
     )
     if apriori(epoch) is None:
         raise ValueError(f"{apriori_path}: the a-priori orbit does not cover the first range epoch {epoch}")
+    name = spacecraft or str(meas["satellite"].iloc[0] if "satellite" in meas else "satellite")
+    target = str(meas["satellite"].iloc[0]) if "satellite" in meas else (apriori_name or name)
+    passive = passive_satellite(target) or (passive_satellite(apriori_name) if apriori_name else None)
+    without_propulsion = propulsion is False or (propulsion is None and passive is not None)
     result = detect_laser_ranging_arcs(
         meas,
         sites,
@@ -474,8 +486,8 @@ def run_laser_ranging_files(
         range_model=model,
         fit_config=cfg,
         max_maneuvers=max_maneuvers,
+        propulsion=not without_propulsion,
     )
-    name = spacecraft or str(meas["satellite"].iloc[0] if "satellite" in meas else "satellite")
     settings = {
         "range_model": model.__dict__,
         "force": repr(force),
@@ -502,9 +514,8 @@ def run_laser_ranging_files(
     if elements is not None:
         summary["apriori_from_elements"] = elements.fits
     frame, warnings = _unabsorbed(frame, result)
-    target = str(meas["satellite"].iloc[0]) if "satellite" in meas else (apriori_name or name)
-    passive = passive_satellite(target) or (passive_satellite(apriori_name) if apriori_name else None)
-    if propulsion is False or (propulsion is None and passive is not None):
+    warnings += [note for arc in result.arcs for note in arc.result.notes]
+    if without_propulsion:
         t = np.sort(np.asarray(meas["time_utc"], dtype="datetime64[ns]"))
         gap_s = float(np.max(np.diff(t)) / np.timedelta64(1, "s")) if t.size > 1 else 0.0
         area_to_mass = (force.srp_area_m2 or 0.0) / force.mass_kg if force.mass_kg else DEFAULT_AREA_TO_MASS_M2_KG

@@ -134,6 +134,39 @@ class GlrtConfig:
     candidate_step_s: float | None = None  # default: orbital period / 120
     max_maneuvers: int = 3
     threshold: float | None = None  # override the χ² threshold
+    cross_track_alternatives: bool = True  # False: a satellite without propulsion, no burn epoch to choose
+
+
+REFITS_PER_DETECTION = 12
+"""Nonlinear refits an arc's epoch search may spend per detection allowed (the scan's refit, a Gauss-Newton
+descent of a few steps and the two cross-track alternatives), over all its re-weighting rounds."""
+
+
+@dataclass
+class RefitBudget:
+    """The nonlinear refits left to one arc's epoch search, and the candidate epochs left unrefined once
+    it is spent (a candidate's first refit, which decides the detection, is always made and counted)."""
+
+    limit: int
+    used: int = 0
+    unrefined: int = 0
+
+    @classmethod
+    def for_arc(cls, max_maneuvers: int) -> RefitBudget:
+        return cls(REFITS_PER_DETECTION * max(int(max_maneuvers), 1))
+
+    @property
+    def spent(self) -> bool:
+        return self.used >= self.limit
+
+    def warning(self, arc: str) -> str | None:
+        """One line naming ``arc`` and the candidates left unrefined; None when the budget sufficed."""
+        if not self.unrefined:
+            return None
+        return (
+            f"{arc}: epoch search stopped at its bound of {self.limit} nonlinear refits; "
+            f"{self.unrefined} candidate epoch(s) left unrefined (the scan's epoch kept)"
+        )
 
 
 @dataclass
@@ -245,8 +278,10 @@ class _EpochSearch:
         t0_s: float,
         config: BatchFitConfig,
         step_s: float,
+        budget: RefitBudget | None = None,
     ) -> None:
         self.data, self.fit, self.scan = data, fit, scan
+        self.budget = budget or RefitBudget(10**9)
         self.impulse_times_s = list(impulse_times_s)
         self.t0_s, self.config, self.step = t0_s, config, step_s
         self.t_first, self.t_last = float(data.t_s.min()), float(data.t_s.max())
@@ -268,6 +303,7 @@ class _EpochSearch:
                 k_near = int(np.argmin(np.abs(cand - tau)))
                 guess = dv_scan[k_near] if np.all(np.isfinite(dv_scan[k_near])) else np.zeros(3)
                 dv0 = np.vstack([self.fit.impulse_dv_rsw_mps, guess[None, :]])
+            self.budget.used += 1
             self.tried[tau] = fit_orbit(
                 self.data,
                 origin.x0,
@@ -298,6 +334,9 @@ class _EpochSearch:
         for _ in range(max_steps):
             sigma = 1.0 / math.sqrt(information) if information > 0 else math.inf
             if not math.isfinite(shift) or abs(shift) <= max(0.1 * sigma, 1e-3):
+                break
+            if self.budget.spent:
+                self.budget.unrefined += 1
                 break
             shift = float(np.clip(shift, -self.step, self.step))
             trial_tau = tau + shift
@@ -338,6 +377,9 @@ class _EpochSearch:
             local = np.flatnonzero((np.abs(cand - centre) <= 2.5 * self.step) & np.isfinite(stat))
             if not local.size:
                 continue
+            if self.budget.spent:
+                self.budget.unrefined += 1
+                continue
             tau_start = float(cand[local[np.argmax(stat[local])]])
             tau_alt, _ = self.descend(tau_start, self.refit(tau_start), max_steps=1)
             alt.append((float(tau_alt), self.tried[tau_alt].impulse_dv_rsw_mps[-1].copy()))
@@ -359,6 +401,7 @@ def detect_maneuvers_glrt(
     fit_config: BatchFitConfig | None = None,
     config: GlrtConfig | None = None,
     epoch_hints_s: Sequence[float] = (),
+    refit_budget: RefitBudget | None = None,
 ) -> GlrtSearch:
     """Fit, scan, refine, refit: greedy detection of up to ``max_maneuvers`` impulses.
 
@@ -367,11 +410,16 @@ def detect_maneuvers_glrt(
     statistic is the nonlinear likelihood ratio χ²(no new impulse) − χ²(with it). ``epoch_hints_s``
     (epochs found before on the same arc, e.g. with other weights) start the epoch descent when one lies
     within three candidate steps of the scan's best candidate; the detection itself is the scan's.
+    ``refit_budget`` (default :meth:`RefitBudget.for_arc`; shared by the calls of one arc) bounds the
+    nonlinear refits: once spent, epochs stay where the scan and the refits so far put them, counted in
+    ``refit_budget.unrefined``. ``config.cross_track_alternatives`` False (a satellite without
+    propulsion) skips the epochs half an orbit away: they choose a burn's epoch, not the detection.
     """
     cfg = config or GlrtConfig()
     fcfg = fit_config or BatchFitConfig()
     # no outlier rejection while searching: a maneuver's signature must not be rejected as outliers
     scan_cfg = replace(fcfg, outlier_sigma=None)
+    refits = refit_budget if refit_budget is not None else RefitBudget.for_arc(cfg.max_maneuvers)
     fit = fit_orbit(data, np.asarray(x0_apriori, float), t0_s=t0_s, config=scan_cfg)
     period = _period_s(fit.x0, fcfg)
     step = cfg.candidate_step_s or period / 120.0
@@ -395,7 +443,7 @@ def detect_maneuvers_glrt(
         t_max = float(np.nanmax(scan.statistic))
         if t_max <= threshold:
             break
-        search = _EpochSearch(data, fit, scan, times, t0_s=t0_s, config=scan_cfg, step_s=step)
+        search = _EpochSearch(data, fit, scan, times, t0_s=t0_s, config=scan_cfg, step_s=step, budget=refits)
         t_best = float(scan.t_candidates_s[scan.best])
         near = [h for h in hints if abs(h - t_best) <= 3.0 * step and search.inside(h)]
         start = min(near, key=lambda h: abs(h - t_best)) if near else None
@@ -407,7 +455,7 @@ def detect_maneuvers_glrt(
             break
         alt: list[tuple[float, NDArray[np.float64]]] = []
         dv_new = best.impulse_dv_rsw_mps[-1]
-        if abs(dv_new[2]) > 0.9 * float(np.linalg.norm(dv_new)):
+        if cfg.cross_track_alternatives and abs(dv_new[2]) > 0.9 * float(np.linalg.norm(dv_new)):
             best_tau, alt = search.cross_track_alternatives(best_tau, period)
             time_sigma = search.sigma_s
             best = search.tried[best_tau]

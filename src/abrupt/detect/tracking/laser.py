@@ -43,6 +43,7 @@ from abrupt.detect.tracking.glrt import (
     GlrtConfig,
     GlrtDetection,
     GlrtScan,
+    RefitBudget,
     detect_maneuvers_glrt,
     glrt_events,
     glrt_scan,
@@ -82,6 +83,7 @@ class LaserGlrtDetector(Detector[LaserRangingSeries]):
         weight_by_residuals: bool = True,
         fit_bounds: Callable[[BatchFit, Mapping[str, float]], list[str]] | None = None,
         max_unexplained_rms_m: float | None = None,
+        cross_track_alternatives: bool = True,
     ) -> None:
         if max_maneuvers < 1:
             raise ValueError(f"max_maneuvers must be at least 1, got {max_maneuvers}")
@@ -89,6 +91,7 @@ class LaserGlrtDetector(Detector[LaserRangingSeries]):
         self.weight_by_residuals = bool(weight_by_residuals)
         self.fit_bounds = fit_bounds
         self.max_unexplained_rms_m = max_unexplained_rms_m
+        self.cross_track_alternatives = bool(cross_track_alternatives)
 
     # the fits' matrices are thousands of rows by tens of columns: BLAS threads only contend (a QR of
     # 1139 × 25 takes 0.4 ms on one thread and 100 CPU-ms on two of a loaded machine)
@@ -98,7 +101,10 @@ class LaserGlrtDetector(Detector[LaserRangingSeries]):
             return DetectionResult.empty(warnings=("no ranges",))
         repairs = RepairLog("laser ranging")
         fcfg = series.fit_config
-        gcfg = GlrtConfig(budget=budget, max_maneuvers=self.max_maneuvers)
+        gcfg = GlrtConfig(
+            budget=budget, max_maneuvers=self.max_maneuvers, cross_track_alternatives=self.cross_track_alternatives
+        )
+        refits = RefitBudget.for_arc(self.max_maneuvers)  # shared by the re-weighting rounds
         scale: dict[str, float] = {}
         data, fit = _initial_fit(series, repairs)
         detections: list[GlrtDetection] = []
@@ -125,7 +131,7 @@ class LaserGlrtDetector(Detector[LaserRangingSeries]):
                 data = series.reduced(fit, scale, repairs=repairs)
             hints = [d.t_s for d in detections]  # the last round's epochs start this round's descents
             detections, fit, scans = detect_maneuvers_glrt(
-                data, fit.x0, fit_config=fcfg, config=gcfg, epoch_hints_s=hints
+                data, fit.x0, fit_config=fcfg, config=gcfg, epoch_hints_s=hints, refit_budget=refits
             )
             bad = self.fit_bounds(fit, _station_rms_m(data, fit)) if self.fit_bounds is not None else []
             if bad:
@@ -163,9 +169,12 @@ class LaserGlrtDetector(Detector[LaserRangingSeries]):
                 "residual_rms_m": _station_rms_m(data, fit),
                 "repairs": repairs,
                 "unexplained": unexplained,
+                "refits": refits,
             },
         )
-        return DetectionResult(events_frame(events) if events else empty_frame(), (diagnostics,))
+        note = refits.warning(f"arc {str(series.epoch_utc)[:19]}")
+        frame = events_frame(events) if events else empty_frame()
+        return DetectionResult(frame, (diagnostics,), warnings=(note,) if note else ())
 
 
 def _initial_fit(series: LaserRangingSeries, repairs: RepairLog) -> tuple[TrackingArrays, BatchFit]:
