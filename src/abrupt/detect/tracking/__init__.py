@@ -126,6 +126,9 @@ epoch itself from that refit's variational matrices (moving the impulse by δτ 
 δτ [−Δv; Ċ_RSW Δv_RSW]; Montenbruck & Gill 2000 §7.2), each confirmed by one refit; the statistic reported is
 the nonlinear likelihood ratio χ²(without) − χ²(with); Δv and its covariance come from the joint fit; the
 epoch uncertainty is 1/√(Fisher information of τ), the other parameters free. Repeats for further maneuvers.
+An arc's epoch search spends at most 12 nonlinear refits per detection allowed (`glrt.RefitBudget`, shared
+by the laser detector's re-weighting rounds); once spent, epochs stay where the scan and the refits so far
+put them and one warning line names the arc and the candidates left unrefined.
 
 Real tracking: Eutelsat W3B
 ---------------------------
@@ -313,7 +316,9 @@ Limitations
 * Cross-track burns fix only the new orbit plane (node line and tilt r·Δv/h): epochs half an orbit apart fit
   almost equally and the Δv scales with r(τ). The GLRT reports the alternative epoch and Δv (`alternative_*`
   columns); with one near-equatorial station the primary solution's magnitude error is 18–32 % (median), the
-  best of the reported set 3–11 %.
+  best of the reported set 3–11 %. A satellite without propulsion (`detect laser` without `--propulsion`
+  for the passive geodetic satellites, or `--no-propulsion`) gets no alternative epochs: they choose a burn's
+  epoch, not whether there is a detection.
 * Below ~0.5 cm/s detections are real (no false alarms in null arcs) but magnitude estimates are poor (median
   error 36–260 % at 0.2 cm/s).
 * `detect tracking` runs the batch GLRT on the whole file (one arc); `detect laser` cuts long files into
