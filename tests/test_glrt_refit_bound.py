@@ -2,13 +2,19 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
+from abrupt.detect.tracking import glrt
 from abrupt.detect.tracking.glrt import GlrtConfig, RefitBudget, detect_maneuvers_glrt
 from abrupt.model.stations import ascension
 from abrupt.model.tracking_measurements import TrackingArrays
+from abrupt.pipelines.laser_ranging import LASER_FIT_CONFIG, LASER_FORCE, detect_laser_ranging
+from abrupt.simulate.slr import SlrScenario, simulate_slr
 from abrupt.simulate.tracking import TrackingScenario, simulate_tracking, thesis_burn
+from abrupt.thresholds import FalseAlarmBudget
 
 
 def _burn_data(direction: str):
@@ -54,3 +60,24 @@ def test_without_propulsion_a_cross_track_detection_keeps_its_decision_and_refin
     turns = (passive[0].t_s - with_alt[0].t_s) / half_s
     assert abs(turns - round(turns)) < 0.05
     assert passive[0].dv_mps == pytest.approx(with_alt[0].dv_mps, rel=0.5)
+
+
+def test_a_laser_arc_that_spends_its_refit_bound_keeps_its_burn_and_warns_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A 1 cm/s along-track impulse (simulated with the fit's own forces) with one refit per detection
+    allowed: the burn is still the one detection (the residual its unrefined epoch leaves is not searched),
+    its Δv within 20 % of the truth, and the arc's one warning line names it and the candidates left
+    unrefined."""
+    scenario = SlrScenario(
+        duration_days=1.0, noise_m=0.003, force=LASER_FORCE, maneuver_t_s=40000.0, maneuver_dv_rsw_mps=(0.0, 0.01, 0.0)
+    )
+    sim = simulate_slr(scenario, seed=5)
+    monkeypatch.setattr(glrt, "REFITS_PER_DETECTION", 1)
+    c = replace(LASER_FIT_CONFIG, force=LASER_FORCE, estimate_scales=("srp_scale",))
+    result = detect_laser_ranging(
+        sim.measurements, sim.sites, sim.stations, sim.x0, sim.epoch_utc, budget=FalseAlarmBudget(0.1), fit_config=c
+    )
+    assert len(result.detections) == 1
+    assert result.detections[0].dv_mps == pytest.approx(0.01, rel=0.2)
+    assert abs(result.detections[0].t_s - 40000.0) < 600.0  # a few candidate steps (period/120: 113 s for LAGEOS)
+    assert len(result.notes) == 1
+    assert result.notes[0].startswith(f"arc {str(sim.epoch_utc)[:19]}: ") and "left unrefined" in result.notes[0]

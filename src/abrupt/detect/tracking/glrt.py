@@ -145,7 +145,7 @@ descent of a few steps and the two cross-track alternatives), over all its re-we
 @dataclass
 class RefitBudget:
     """The nonlinear refits left to one arc's epoch search, and the candidate epochs left unrefined once
-    it is spent (a candidate's first refit, which decides the detection, is always made and counted)."""
+    it is spent (the first refit of a candidate already searched, at its earlier epoch, is still made)."""
 
     limit: int
     used: int = 0
@@ -411,8 +411,9 @@ def detect_maneuvers_glrt(
     (epochs found before on the same arc, e.g. with other weights) start the epoch descent when one lies
     within three candidate steps of the scan's best candidate; the detection itself is the scan's.
     ``refit_budget`` (default :meth:`RefitBudget.for_arc`; shared by the calls of one arc) bounds the
-    nonlinear refits: once spent, epochs stay where the scan and the refits so far put them, counted in
-    ``refit_budget.unrefined``. ``config.cross_track_alternatives`` False (a satellite without
+    nonlinear refits: once spent, epochs stay where the scan and the refits so far put them and a candidate
+    no earlier epoch hints at is not tested (an unrefined epoch leaves Δv·δτ that a second impulse would
+    absorb), each counted in ``refit_budget.unrefined``. ``config.cross_track_alternatives`` False (a satellite without
     propulsion) skips the epochs half an orbit away: they choose a burn's epoch, not the detection.
     """
     cfg = config or GlrtConfig()
@@ -447,6 +448,9 @@ def detect_maneuvers_glrt(
         t_best = float(scan.t_candidates_s[scan.best])
         near = [h for h in hints if abs(h - t_best) <= 3.0 * step and search.inside(h)]
         start = min(near, key=lambda h: abs(h - t_best)) if near else None
+        if start is None and refits.spent:
+            refits.unrefined += 1  # a new candidate, untested: its refit would exceed the bound
+            break
         if start is not None:
             hints.remove(start)
         best_tau, time_sigma = search.locate(start)
