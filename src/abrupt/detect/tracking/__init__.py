@@ -126,8 +126,8 @@ epoch itself from that refit's variational matrices (moving the impulse by δτ 
 δτ [−Δv; Ċ_RSW Δv_RSW]; Montenbruck & Gill 2000 §7.2), each confirmed by one refit; the statistic reported is
 the nonlinear likelihood ratio χ²(without) − χ²(with); Δv and its covariance come from the joint fit; the
 epoch uncertainty is 1/√(Fisher information of τ), the other parameters free. Repeats for further maneuvers.
-An arc's epoch search spends at most 12 nonlinear refits per detection allowed (`glrt.RefitBudget`, shared
-by the laser detector's re-weighting rounds); once spent, epochs stay where the scan and the refits so far
+The laser detector's epoch search spends at most 12 nonlinear refits per arc and detection allowed
+(`glrt.RefitBudget`, shared by its re-weighting rounds); once spent, epochs stay where the scan and the refits so far
 put them and one warning line names the arc and the candidates left unrefined.
 
 Real tracking: Eutelsat W3B

@@ -410,7 +410,7 @@ def detect_maneuvers_glrt(
     statistic is the nonlinear likelihood ratio χ²(no new impulse) − χ²(with it). ``epoch_hints_s``
     (epochs found before on the same arc, e.g. with other weights) start the epoch descent when one lies
     within three candidate steps of the scan's best candidate; the detection itself is the scan's.
-    ``refit_budget`` (default :meth:`RefitBudget.for_arc`; shared by the calls of one arc) bounds the
+    ``refit_budget`` (e.g. :meth:`RefitBudget.for_arc`, shared by the calls of one arc; none by default) bounds the
     nonlinear refits: once spent, epochs stay where the scan and the refits so far put them and a candidate
     no earlier epoch hints at is not tested (an unrefined epoch leaves Δv·δτ that a second impulse would
     absorb), each counted in ``refit_budget.unrefined``. ``config.cross_track_alternatives`` False (a satellite without
@@ -420,7 +420,7 @@ def detect_maneuvers_glrt(
     fcfg = fit_config or BatchFitConfig()
     # no outlier rejection while searching: a maneuver's signature must not be rejected as outliers
     scan_cfg = replace(fcfg, outlier_sigma=None)
-    refits = refit_budget if refit_budget is not None else RefitBudget.for_arc(cfg.max_maneuvers)
+    refits = refit_budget if refit_budget is not None else RefitBudget(10**9)  # callers that state no bound
     fit = fit_orbit(data, np.asarray(x0_apriori, float), t0_s=t0_s, config=scan_cfg)
     period = _period_s(fit.x0, fcfg)
     step = cfg.candidate_step_s or period / 120.0
