@@ -37,6 +37,18 @@ def _found(peaks: list, t_s: float, thr: float) -> bool:
     return any(abs(p.time_ns / NS - t_s) <= 10.0 and p.value > thr for p in peaks)
 
 
+def _crowd_of_steps(rng: np.random.Generator, noise: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """100 momentum steps of 0.03-0.6 N·m·s (log-uniform, random directions) 760-920 s apart, added to
+    ``noise`` (one row a second): their times [s], sizes [N·m·s] and the stepped series."""
+    times = 300.0 + np.cumsum(rng.uniform(760, 920, 100))
+    sizes = np.exp(rng.uniform(math.log(0.03), math.log(0.6), 100))
+    u = rng.normal(size=(100, 3))
+    h = noise.copy()
+    for t, size, d in zip(times, sizes, u, strict=True):
+        h[int(t) :] += size * d / np.linalg.norm(d)
+    return times, sizes, h
+
+
 def test_a_day_of_100_events_keeps_most_strikes_of_0_1_nms_that_the_quiet_day_finds() -> None:
     """100 steps of 0.03-0.6 N·m·s (log-uniform), 760-920 s apart, in white noise: the plain quartile fit
     of block maxima rises more than ten-fold with them (nearly every block holds an event) and loses
@@ -48,13 +60,8 @@ def test_a_day_of_100_events_keeps_most_strikes_of_0_1_nms_that_the_quiet_day_fi
     det = FlightGlrDetector()
     quiet_plain, quiet_crowd, _ = _calibrate(det, noise)
     assert abs(quiet_crowd - quiet_plain) < 0.05 * quiet_plain  # a quiet day: the same threshold
-    times = 300.0 + np.cumsum(rng.uniform(760, 920, 100))
+    times, sizes, h = _crowd_of_steps(rng, noise)
     assert times[-1] < DAY_S - 330
-    sizes = np.exp(rng.uniform(math.log(0.03), math.log(0.6), 100))
-    u = rng.normal(size=(100, 3))
-    h = noise.copy()
-    for t, size, d in zip(times, sizes, u, strict=True):
-        h[int(t) :] += size * d / np.linalg.norm(d)
     plain, crowd, peaks = _calibrate(det, h)
     big = [t for t, s in zip(times, sizes, strict=True) if s >= 0.1 and _found(peaks, t, quiet_plain)]
     assert len(big) > 40
@@ -76,12 +83,7 @@ def test_a_crowd_far_above_the_noise_is_calibrated_like_the_quiet_day_and_loses_
         noise = rng.normal(0, 0.1 * SIGMA, (DAY_S, 3))
         quiet_plain, quiet_crowd, _ = _calibrate(det, noise)
         assert quiet_crowd == quiet_plain  # a quiet day keeps the plain fit
-        times = 300.0 + np.cumsum(rng.uniform(760, 920, 100))
-        sizes = np.exp(rng.uniform(math.log(0.03), math.log(0.6), 100))
-        u = rng.normal(size=(100, 3))
-        h = noise.copy()
-        for t, size, d in zip(times, sizes, u, strict=True):
-            h[int(t) :] += size * d / np.linalg.norm(d)
+        times, sizes, h = _crowd_of_steps(rng, noise)
         plain, crowd, peaks = _calibrate(det, h)
         big = [t for t, s in zip(times, sizes, strict=True) if s >= 0.1 and _found(peaks, t, quiet_plain)]
         assert len(big) > 40 and plain > 50.0 * quiet_plain
