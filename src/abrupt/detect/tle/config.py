@@ -38,6 +38,9 @@ EXTRA_COLUMNS: tuple[str, ...] = (
 # scores the same or better with 2, every GEO history the same or better with 3 (docs/tle.md).
 CAMPAIGN_SIDE_SETS = {"leo": 2, "geo": 3}
 
+# chosen leave-one-satellite-out on the modern shared histories (abrupt.detect.tle.campaign_steps)
+CAMPAIGN_STEP_FRACTION = 0.5
+
 DEFAULT_TLE_BUDGET = FalseAlarmBudget.parse(DEFAULT_TLE_RATE)
 
 
@@ -61,6 +64,9 @@ class TleDetectorConfig:
     campaign_days: float = 3.0
     campaign_chain_days: float = 7.0  # maneuver_campaign events: detections chained this close
     campaign_min_side_sets: int | None = None  # None: by regime (CAMPAIGN_SIDE_SETS)
+    # a gap inside a campaign is a maneuver of its own when its step passes the threshold and its
+    # statistic is at least this fraction of its neighbours' (abrupt.detect.tle.campaign_steps); None: off
+    campaign_step_fraction: float | None = CAMPAIGN_STEP_FRACTION
     time_search_sets_before: int = 3
     group_gain: tuple[float, float, float] = (1.0, 0.2, 0.2)
     along_track_gain: float = 1.0
@@ -99,6 +105,8 @@ class TleDetectorConfig:
             raise ValueError("max_bridge_days must be a finite positive number")
         if not 0.0 < self.interval_level < 1.0:
             raise ValueError(f"interval_level must lie in (0, 1), got {self.interval_level}")
+        if self.campaign_step_fraction is not None and not 0.0 <= self.campaign_step_fraction <= 1.0:
+            raise ValueError(f"campaign_step_fraction must lie in [0, 1] or be None, got {self.campaign_step_fraction}")
         if self.drag_median_sets < 1:
             raise ValueError("drag_median_sets must be >= 1")
         if not (self.drag_min_decay_m_day > 0 and math.isfinite(self.drag_min_decay_m_day)):
