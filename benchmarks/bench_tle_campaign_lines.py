@@ -145,9 +145,10 @@ def scores(sat: str, fraction: float | None) -> dict[str, float]:
 
 def fraction_study(fractions: list[float | None]) -> None:
     """Leave-one-satellite-out choice of ``campaign_step_fraction`` on the modern histories: for each
-    one held out, the fraction with the highest mean F1 on the other four (ties: the larger fraction,
-    the fewer new events), and the held-out history's figures at that fraction beside those with the
-    rule off; Jason-1 at the fraction chosen on all five (it takes part in no choice)."""
+    one held out, among the fractions that lower the precision of none of the other four (against the
+    rule off), the one with the highest mean F1 on them (ties: the larger fraction, the fewer new
+    events; off when none qualifies), and the held-out history's figures at that fraction beside those
+    with the rule off; Jason-1 at the fraction chosen on all five (it takes part in no choice)."""
     sats = list(SATELLITES)
     grid = {s: [scores(s, f) for f in fractions] for s in sats}
     print("per history and fraction: precision / recall / recall >= 2 cm/s / unmatched")
@@ -155,17 +156,21 @@ def fraction_study(fractions: list[float | None]) -> None:
         cells = [f"{r['precision']:.3f}/{r['recall']:.3f}/{r['recall_big']:.3f}/{r['unmatched']}" for r in grid[s]]
         print(f"  {s:<12}" + "  ".join(f"{f!s:>5}: {c}" for f, c in zip(fractions, cells, strict=True)))
     modern = [s for s in sats if s not in HELD_OUT]
+    off = fractions.index(None) if None in fractions else 0
 
     def choose(on: list[str]) -> int:
-        f1 = [float(np.nanmean([grid[s][k]["f1"] for s in on])) for k in range(len(fractions))]
+        keeps = [
+            k
+            for k in range(len(fractions))
+            if all(grid[s][k]["precision"] >= grid[s][off]["precision"] - 1e-9 for s in on)
+        ]
+        f1 = {k: float(np.nanmean([grid[s][k]["f1"] for s in on])) for k in keeps}
         size = [f if f is not None else 2.0 for f in fractions]
-        return max(range(len(fractions)), key=lambda k: (round(f1[k], 6), size[k]))
+        return max(keeps, key=lambda k: (round(f1[k], 6), size[k])) if keeps else off
 
-    off = fractions.index(None) if None in fractions else None
     for held in [*modern, *HELD_OUT]:
         k = choose([s for s in modern if s != held])
-        r = grid[held][k]
-        base = grid[held][off] if off is not None else r
+        r, base = grid[held][k], grid[held][off]
         print(
             f"  held out {held}: fraction {fractions[k]}: P {r['precision']:.3f} (off {base['precision']:.3f}), "
             f"R {r['recall']:.3f} ({base['recall']:.3f}), R>=2cm/s {r['recall_big']:.3f} ({base['recall_big']:.3f})"

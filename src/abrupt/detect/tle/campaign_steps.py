@@ -1,60 +1,50 @@
-"""Steps inside a campaign resolved into maneuvers of their own.
+"""Steps inside a campaign, each resolved into a maneuver of its own.
 
-The greedy segmentation (:mod:`abrupt.detect.tle.segmentation`) never tests the gaps within
-``peak_half_width`` of an accepted maneuver, and the one-burn join (:mod:`abrupt.detect.tle.response`)
-folds a later same-sign step into an earlier burn when one response explains both. Inside a
-campaign (a chain of detections, :func:`abrupt.detect.tle.campaigns.chain`), burns one or two element
-sets apart are then read as one maneuver, and the burns between them are missed.
+A campaign is a chain of detections (:func:`abrupt.detect.tle.campaigns.chain`): burns one to a few
+element sets apart. The window step test sees a staircase of such burns through windows that straddle
+its neighbours, and its single-split localisation (level and slope each side) can place a step a gap
+off, into a quiet gap, while the gap that holds the burn is blocked as that detection's flank; burns
+between two detections are then never tested. Inside a campaign the steps are read where they are, set
+to set, as the campaign's burn count reads them (:func:`abrupt.detect.tle.campaigns.burns_in_gaps`):
 
-Here every gap of a chain (one gap wider each side) that is not already a maneuver is tested again,
-strongest first, by the same two-sided robust step test and statistic as every other gap, with its
-windows cut at the maneuvers already kept (the campaign's own burns) and a side of one set allowed
-(at least one set between two steps). It becomes a maneuver when:
+* a gap carries a step when its set-to-set change of ``a``, the campaign's drift removed (the smaller
+  of the two sides' Theil-Sen slopes, :func:`abrupt.detect.tle.campaigns.total_step`), passes the
+  history's own null for such changes (:func:`own_null_level`: the quantile at the budget's per-gap
+  false-alarm probability of the set-to-set z over the gaps far from every detection, never below the
+  detection threshold), neither of its sets is an outlier
+  (:func:`abrupt.detect.tle.outliers.outlier_mask`), and it is at least ``fraction`` of the campaign's
+  largest step (the sets fitted across a kilometre burn settle by metres for days after it);
+* a member whose own gap carries no step while the next gap on either side does (and holds no other
+  member) is moved there; every other gap that carries a step becomes a maneuver of its own, timed at
+  the middle of its gap (``time_method`` "gap middle"), its interval reaching back over the history's
+  TLE lag as every other event's, its ΔV from the step test between its neighbours (a side of one set
+  allowed), its statistic the larger of the step test's and the set-to-set z.
 
-* its statistic reaches the history's detection threshold (the threshold of its own null, so a step
-  is significant on its own, not by a neighbour);
-* neither set of its gap is an outlier (:func:`abrupt.detect.tle.outliers.outlier_mask`: a set that
-  disagrees with both neighbours, the history continuing as before);
-* its statistic is at least ``fraction`` of that of every maneuver within two gaps: a set fitted
-  across a burn shows part of it, so a large burn's partial response in the next gap passes any
-  noise threshold; a resolved burn of its own is not a small fraction of its neighbour;
-* it is not a ramp: the gaps on both sides are not both steps (kept, or significant in the same
-  trial). Sets converging over several days after a burn (the older catalogue's long fit spans) step
-  in every gap for days; a burn of its own leaves a level on at least one side;
-* it is not the rest of a kept neighbour's response by the library's one-burn test
-  (:func:`abrupt.detect.tle.response.response_hosts`, at the era's fit span: the median of the
-  history's timed steps within half a year).
-
-A resolved step is timed at the middle of its gap (``time_method`` "gap middle"); its interval
-reaches back over the history's TLE lag as every other event's. Gaps that are not accepted keep
-their earlier statistics (the noise model and diagnostics do not change).
-
-``fraction`` was chosen leave-one-satellite-out on the five modern shared histories
-(``benchmarks/bench_tle_campaign_lines.py --fractions``: the highest mean F1 on the other four,
-ties to the larger fraction): 0.5 for four of five held out, off for CryoSat-2; Jason-1 took no
-part. Without the ramp rule every fraction that added burns lowered precision on Jason-3,
-CryoSat-2 or Jason-1 (docs/tle.md).
+Only in-track steps (of ``a``) are resolved; cross-track steps inside a campaign stay as the window test
+found them. ``fraction`` is ``TleDetectorConfig.campaign_step_fraction``; **None (off) by default**:
+chosen leave-one-satellite-out on the five modern shared histories
+(``benchmarks/bench_tle_campaign_lines.py --fractions``: the highest mean F1 on the other four among
+the fractions that lower no other history's precision), every fraction that adds burns lowers
+CryoSat-2's precision (0.964 → 0.948 at 0.1: two added steps 1.2-1.8 days from the nearest operator
+burn), so off is chosen for every held-out history but CryoSat-2 (0.1). Jason-1 took no part.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
-from dataclasses import fields
 from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
-from abrupt.detect.tle.campaigns import chain
+from abrupt.detect.tle.campaigns import chain, total_step
 from abrupt.detect.tle.config import TleDetectorConfig
 from abrupt.detect.tle.outliers import outlier_mask
-from abrupt.detect.tle.response import response_hosts
 from abrupt.detect.tle.steps import StepModel, StepSeries, fill_gaps
 from abrupt.readers.tle import ElementHistory
-
-NEIGHBOUR_GAPS = 2  # a partial response of a burn reaches this many gaps (a blend of up to three sets)
-ERA_REACH_S = 182.625 * 86400.0  # an era's fit span: from the timed steps within half a year
-MIN_SIDE_SETS = 1  # sets on each side of a resolved step before the next one
+from abrupt.thresholds import DAYS_PER_YEAR, FalseAlarmBudget
+from abrupt.units import SECONDS_PER_DAY
 
 
 class _Timed(Protocol):
@@ -73,142 +63,98 @@ class _Run(Protocol):
     steps: StepSeries
     stat: NDArray[np.float64]
     threshold: float
-    era_span_s: dict[int, float]
 
 
-def campaign_step_times(run: _Run, kept: Sequence[_Timed]) -> list[tuple[int, float]]:
-    """(gap, gap-middle time in s) of the steps inside campaigns resolved into maneuvers of their own
-    (module docstring; none when ``campaign_step_fraction`` is None). ``kept``: the maneuvers so far."""
-    cfg, model = run.cfg, run.model
-    if cfg.campaign_step_fraction is None or len(kept) < 2:
-        return []
-    gaps = resolve_campaign_steps(
-        model,
-        run.steps,
-        run.stat,
-        run.threshold,
-        [it.gap for it in kept],
-        np.array([it.time_s for it in kept]),
-        era_span_s=run.era_span_s,
-        window_sets=cfg.time_window_sets,
-        chain_days=cfg.campaign_chain_days,
-        chain_sets=cfg.window_sets,
-        outliers=outlier_mask(run.history, run.regime),
-        fraction=cfg.campaign_step_fraction,
-    )
-    return [(g, 0.5 * float(model.t[g] + model.t[g + 1])) for g in gaps]
-
-
-def _snapshot(steps: StepSeries, gaps: NDArray[np.int64]) -> dict[str, NDArray[np.float64]]:
-    out = {}
-    for f in fields(steps):
-        value = getattr(steps, f.name)
-        if isinstance(value, np.ndarray) and value.shape[:1] == steps.z_a.shape[:1]:
-            out[f.name] = value[gaps].copy()
-    return out
-
-
-def _restore(steps: StepSeries, gaps: NDArray[np.int64], saved: dict[str, NDArray[np.float64]]) -> None:
-    for name, values in saved.items():
-        getattr(steps, name)[gaps] = values
-
-
-def _response_tail(
+def set_steps(
     model: StepModel,
-    kept: list[int],
-    times: dict[int, float],
-    g: int,
-    delta_a_m: float,
-    era_span_s: dict[int, float],
-    steps: StepSeries,
-    window_sets: int,
-) -> bool:
-    """Is a step at gap ``g`` the rest of a kept neighbour's response in the era's fit span (the
-    one-burn test of :func:`abrupt.detect.tle.response.response_hosts`), not a burn of its own?"""
-    near = [c for c in kept if abs(c - g) <= 2 * NEIGHBOUR_GAPS]
-    if not near:
-        return False
-    gaps = np.array(sorted([*near, g]), dtype=np.int64)
-    burn_s = np.array([times.get(int(c), 0.5 * float(model.t[c] + model.t[c + 1])) for c in gaps])
-    d_a = np.array([delta_a_m if c == g else float(steps.delta_a_m[c]) for c in gaps])
-    # the era's fit span: the median over the history's timed steps within half a year
-    t_g = float(model.t[g])
-    era = [v for c, v in era_span_s.items() if abs(float(model.t[c]) - t_g) < ERA_REACH_S and v > 0.0]
-    span = float(np.median(era)) if era else 0.0
-    spans = np.full(gaps.size, span)
-    sigma = np.asarray(model.scales["a_m"], dtype=float)[np.minimum(gaps, model.scales["a_m"].size - 1)]
-    a_m = np.asarray(model.s["a_m"], dtype=float)
-    host = response_hosts(model.t, a_m, gaps, burn_s, d_a, spans, sigma, window_sets)
-    return bool(host[int(np.flatnonzero(gaps == g)[0])] >= 0)
-
-
-def resolve_campaign_steps(
-    model: StepModel,
-    steps: StepSeries,
-    stat: NDArray[np.float64],
+    members: list[int],
+    bounds: tuple[int, int],
     threshold: float,
-    kept_gaps: list[int],
-    times_s: NDArray[np.float64],
-    *,
-    era_span_s: dict[int, float],
-    window_sets: int,
-    chain_days: float,
-    chain_sets: int,
+    window: int,
     outliers: NDArray[np.bool_],
     fraction: float,
-) -> list[int]:
-    """Gaps inside campaigns that carry a resolved step of their own (module docstring), in the order
-    accepted. ``kept_gaps``/``times_s``: the maneuvers kept so far and their burn times (s);
-    ``stat``: the per-gap statistic, updated in place at the accepted gaps (as are ``steps``);
-    ``outliers``: the outlier sets of the history."""
-    kept = sorted(int(g) for g in kept_gaps)
-    above = np.array([stat[g] >= threshold for g in kept_gaps], dtype=bool)
-    gaps = np.asarray(kept_gaps, dtype=np.int64)[above]
-    if gaps.size < 2:
-        return []
-    order = np.argsort(np.asarray(times_s, dtype=float)[above], kind="stable")
-    gaps, t_s = gaps[order], np.asarray(times_s, dtype=float)[above][order]
-    n_gaps = stat.size
-    times = {int(g): float(t) for g, t in zip(kept_gaps, times_s, strict=True)}
-    accepted: list[int] = []
-    side, model.min_side = model.min_side, MIN_SIDE_SETS
-    try:
-        for members in chain(t_s, gaps, chain_days, chain_sets):
-            lo, hi = max(0, int(gaps[members].min()) - 1), min(n_gaps - 1, int(gaps[members].max()) + 1)
-            while True:
-                trial = np.array([g for g in range(lo, hi + 1) if g not in kept], dtype=np.int64)
-                if trial.size == 0:
-                    break
-                saved = _snapshot(steps, trial)
-                fill_gaps(steps, model, trial, kept)
-                s = steps.statistic[trial]
-                ok = s >= threshold
-                ok &= ~outliers[trial] & ~outliers[np.minimum(trial + 1, outliers.size - 1)]
-                for k, g in enumerate(trial):
-                    near = [c for c in kept if abs(c - int(g)) <= NEIGHBOUR_GAPS]
-                    if ok[k] and near and s[k] < fraction * max(float(stat[c]) for c in near):
-                        ok[k] = False
-                # a ramp: steps on both sides (kept or significant) leave no level of its own
-                busy = set(kept) | {int(x) for x in trial[s >= threshold]}
-                ok &= ~np.array([(int(x) - 1 in busy) and (int(x) + 1 in busy) for x in trial], dtype=bool)
-                delta_a = steps.delta_a_m[trial].copy()
-                _restore(steps, trial, saved)
-                best = [int(k) for k in np.argsort(-s) if ok[k]]
-                best = [
-                    k
-                    for k in best
-                    if not _response_tail(
-                        model, kept, times, int(trial[k]), float(delta_a[k]), era_span_s, steps, window_sets
-                    )
-                ]
-                if not best:
-                    break
-                g = int(trial[best[0]])
-                times[g] = 0.5 * float(model.t[g] + model.t[g + 1])
-                fill_gaps(steps, model, [g], kept)
-                stat[g] = float(steps.statistic[g])
-                kept = sorted([*kept, g])
-                accepted.append(g)
-    finally:
-        model.min_side = side
-    return accepted
+) -> dict[int, float]:
+    """The gaps of a campaign (members' gaps, one wider each side, inside ``bounds``) whose set-to-set
+    step of ``a`` (the campaign's drift removed: the smaller of the sides' Theil-Sen slopes,
+    :func:`abrupt.detect.tle.campaigns.total_step`) passes ``threshold`` times its noise ``√2 σ_a``
+    and ``fraction`` of the campaign's largest, neither set an outlier: gap → z of its step."""
+    g1 = max(bounds[0], min(members) - 1)
+    g2 = min(bounds[1] - 2, max(members) + 1)
+    slope = total_step(model, g1, g2, "a_m", window, bounds)[1]
+    a, t, sa = model.s["a_m"], model.t, model.scales["a_m"]
+    rows: dict[int, tuple[float, float]] = {}
+    for g in range(max(0, g1), min(model.n - 1, g2 + 1)):
+        if outliers[g] or outliers[g + 1]:
+            continue
+        da = abs(float(a[g + 1] - a[g]) - slope * float(t[g + 1] - t[g]))
+        z = da / (math.sqrt(2.0) * float(sa[min(g, sa.size - 1)]))
+        if z >= threshold:
+            rows[g] = (da, z)
+    biggest = max((r[0] for r in rows.values()), default=0.0)
+    return {g: z for g, (da, z) in rows.items() if da >= fraction * biggest}
+
+
+def relocated_steps(run: _Run, kept: Sequence[_Timed]) -> tuple[set[int], dict[int, float]]:
+    """(gaps to drop, gap → set-to-set z of the steps to add) inside every campaign: a member whose own
+    gap carries no step of ``a`` while a next gap does is moved there (the window test localises a
+    staircase of burns a gap off), and every other gap carrying a step gets a maneuver of its own."""
+    cfg, model = run.cfg, run.model
+    if cfg.campaign_step_fraction is None or len(kept) < 2:
+        return set(), {}
+    det = sorted((it.time_s, it.gap) for it in kept if run.stat[it.gap] >= run.threshold)
+    t_s = np.array([t for t, _ in det], dtype=float)
+    gaps = np.array([g for _, g in det], dtype=np.int64)
+    all_gaps = sorted(int(it.gap) for it in kept)
+    outliers = outlier_mask(run.history, run.regime)
+    level = own_null_level(model, all_gaps, cfg.window_sets, run.threshold, cfg.budget)
+    drop: set[int] = set()
+    add: dict[int, float] = {}
+    for members in chain(t_s, gaps, cfg.campaign_chain_days, cfg.window_sets):
+        mem = sorted(int(g) for g in gaps[members])
+        prev = [g for g in all_gaps if g < mem[0]]
+        nxt = [g for g in all_gaps if g > mem[-1]]
+        bounds = (prev[-1] + 1 if prev else 0, nxt[0] + 1 if nxt else model.n)
+        found = set_steps(model, mem, bounds, level, cfg.window_sets, outliers, cfg.campaign_step_fraction)
+        free = {g: z for g, z in found.items() if g not in all_gaps}
+        for m in mem:
+            if m in found:
+                continue
+            near = [g for g in (m - 1, m + 1) if g in free]
+            if near:
+                g = max(near, key=lambda q: free[q])
+                drop.add(m)
+                add[g] = free.pop(g)
+        add |= free
+    if add:  # the steps (ΔV) of the new maneuvers between their neighbours, a side of one set allowed
+        cps = sorted((set(all_gaps) - drop) | set(add))
+        side, model.min_side = model.min_side, 1
+        try:
+            fill_gaps(run.steps, model, sorted(add), cps)
+        finally:
+            model.min_side = side
+    return drop, add
+
+
+def own_null_level(
+    model: StepModel, detected: list[int], window: int, threshold: float, budget: FalseAlarmBudget
+) -> float:
+    """The level a set-to-set step z of ``a`` must reach: the history's own null, the quantile at the
+    budget's probability per gap of ``|Δa − ȧ Δt| / (√2 σ_a)`` over the gaps farther than ``window``
+    from every detection (``ȧ``: the median rate of the history), and never below the detection
+    ``threshold``."""
+    a, t = np.asarray(model.s["a_m"], dtype=float), np.asarray(model.t, dtype=float)
+    if t.size < 3:
+        return threshold
+    dt, da = np.diff(t), np.diff(a)
+    ok = dt > 0
+    rate = float(np.median(da[ok] / dt[ok])) if ok.any() else 0.0
+    sigma = np.asarray(model.scales["a_m"], dtype=float)[: dt.size]
+    z = np.abs(da - rate * dt) / (math.sqrt(2.0) * np.maximum(sigma, 1e-12))
+    quiet = np.ones(dt.size, dtype=bool)
+    for g in detected:
+        quiet[max(0, g - window) : g + window + 1] = False
+    years = float(t[-1] - t[0]) / (DAYS_PER_YEAR * SECONDS_PER_DAY)
+    if quiet.sum() < 10 or years <= 0:
+        return threshold
+    p = budget.per_test(dt.size / years, "year", cap=0.5)
+    return max(threshold, float(np.quantile(z[quiet], 1.0 - p)))
