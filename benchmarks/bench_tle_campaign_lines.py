@@ -25,6 +25,8 @@ Usage::
 
     python benchmarks/bench_tle_campaign_lines.py
     python benchmarks/bench_tle_campaign_lines.py --only Jason-1 --lines
+    python benchmarks/bench_tle_campaign_lines.py --fraction 0.1           # campaign steps resolved
+    python benchmarks/bench_tle_campaign_lines.py --fractions none 0.03 0.1 0.2 0.3 0.5   # LOSO choice
 """
 
 from __future__ import annotations
@@ -182,12 +184,15 @@ def main() -> None:
     ap.add_argument("--only", nargs="*", default=None)
     ap.add_argument("--lines", action="store_true", help="print the per-line table of every history")
     ap.add_argument("--fractions", nargs="*", default=None, help="campaign_step_fraction values (none: off)")
+    ap.add_argument("--fraction", type=float, default=None, help="one run with campaign_step_fraction at this value")
     args = ap.parse_args()
     if args.fractions is not None:
         fraction_study([None if f.lower() == "none" else float(f) for f in args.fractions])
         return
     sats = [s for s in IDS_HISTORIES if args.only is None or s in args.only]
-    table = pd.concat([line_table(s) for s in sats], ignore_index=True)
+    settings = {"campaign_step_fraction": args.fraction} if args.fraction is not None else {}
+    print(f"campaign_step_fraction: {args.fraction if args.fraction is not None else 'default (off)'}")
+    table = pd.concat([line_table(s, **settings) for s in sats], ignore_index=True)
     with pd.option_context("display.width", 200, "display.max_rows", 500):
         print(summary(table).to_string(index=False, float_format=lambda v: f"{v:.3f}"))
         for sat in sats:
@@ -199,7 +204,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    from _results import write_results
+    from _results import variant, write_results
 
-    with write_results("bench_tle_campaign_lines"):
+    with write_results("bench_tle_campaign_lines", variant({"--fractions": "fractions", "--fraction": "on"})):
         main()
