@@ -15,7 +15,10 @@ hours apart, is one maneuver). Every line in the history's span whose summed bur
   row's interval;
 * ``no event``.
 
-Beside the class: the line's net in-track ΔV and its cross-track ΔV by magnitude (the sum of the
+Lines less than 6 hours apart (the two burns of a pair 1.5 orbits apart, which some operators list
+as two lines) are also counted as one maneuver, found when either is (``grouped <6 h``): scoring
+(:func:`abrupt.score.score_events`, as ``abrupt score``) pairs each line one-to-one and groups
+nothing. Beside the class: the line's net in-track ΔV and its cross-track ΔV by magnitude (the sum of the
 burns' |cross-track| components, ``dv_n_abs_mps``: a pair of opposite burns half an orbit apart turns
 the plane by both, while the file's summed components net to zero), and whether the line is
 cross-track (its in-track net below 2 cm/s). Printed: per history the count per class; for Jason-1
@@ -46,6 +49,7 @@ from bench_tle_timing import BIG_BURN_MPS, BUDGET, DATA, HELD_OUT, SATELLITES, T
 CLASSES = ("found", "same gap", "taken", "off 1-3 d", "campaign only", "no event")
 IDS_HISTORIES = ("Jason-1", "Jason-3", "Sentinel-3A", "CryoSat-2")
 DAY_S = 86400.0
+PAIR_S = 6 * 3600.0  # lines closer than this are one maneuver's burns (a pair 1.5 orbits apart)
 
 
 def _utc(values: Any) -> pd.Series:
@@ -69,6 +73,8 @@ def line_table(sat: str, **settings: Any) -> pd.DataFrame:
     c_hi = _utc(camp["interval_end_utc"]).to_numpy(dtype="datetime64[ns]")
     t_tru = pd.to_datetime(truth["time_utc"]).to_numpy(dtype="datetime64[ns]")
     gap_of = np.searchsorted(epochs, t_tru, side="right") - 1  # the set before each line's epoch
+    # a line within PAIR_S of the previous one (any size) continues its maneuver: one group
+    group = np.cumsum(np.r_[True, np.diff(t_tru) / np.timedelta64(1, "s") >= PAIR_S])
     big = (t_tru >= start) & (t_tru <= end) & (truth["dv_mps"].to_numpy(dtype=float) >= BIG_BURN_MPS)
     dv_n_abs = truth["dv_n_abs_mps"] if "dv_n_abs_mps" in truth else truth["dv_n_mps"].abs()
     rows = []
@@ -99,6 +105,7 @@ def line_table(sat: str, **settings: Any) -> pd.DataFrame:
                 "dv_n_abs_mps": float(dv_n_abs.iloc[j]),
                 "cross_track": abs(dv_t) < BIG_BURN_MPS,
                 "class": cls,
+                "group": int(group[j]),
                 "offset_d": pair_of[j] / DAY_S
                 if j in pair_of
                 else (nearest / DAY_S if np.isfinite(nearest) else np.nan),
@@ -120,7 +127,13 @@ def summary(table: pd.DataFrame) -> pd.DataFrame:
         rec.update({c: int((rows["class"] == c).sum()) for c in CLASSES})
         rec["recall"] = rec["found"] / len(rows) if len(rows) else float("nan")
         out.append(rec)
-    return pd.DataFrame(out)
+        groups = rows.groupby("group")["class"].agg(lambda c: bool((c == "found").any()))
+        out.append({"satellite": sat, "lines": f"grouped <{PAIR_S / 3600:.0f} h", "n": len(groups)})
+        out[-1]["found"] = int(groups.sum())
+        out[-1]["recall"] = float(groups.mean()) if len(groups) else float("nan")
+    frame = pd.DataFrame(out)
+    frame[list(CLASSES)] = frame[list(CLASSES)].astype("Int64")
+    return frame
 
 
 def scores(sat: str, fraction: float | None) -> dict[str, float]:
