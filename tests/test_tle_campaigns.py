@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from abrupt.detect.tle.campaign_steps import reversed_by
 from abrupt.detect.tle.campaigns import burns_in_gaps, chain
 from abrupt.detect.tle.detectors import TleMeanElements
 from abrupt.readers.fengyun import read_maneuver_file
@@ -159,3 +160,12 @@ def test_a_staircase_of_burns_two_days_apart_is_resolved_burn_by_burn() -> None:
     assert tp >= 25
     assert tp >= tp_off + 2
     assert fp <= fp_off + 2
+
+
+def test_a_set_undone_by_the_next_step_is_no_burn() -> None:
+    """CryoSat-2, May 2010: after a −399 m burn step, one set sits +67 m off and the next gap takes
+    −65 m back: that set disagrees with both neighbours (an outlier beside a burn); the burn's own
+    step is not undone by the +67 m that follows it."""
+    assert reversed_by(66.7, -65.5) and reversed_by(-65.5, 66.7)
+    assert not reversed_by(-398.6, 66.7)
+    assert not reversed_by(30.9, 25.4)  # a same-sign convergence is no reversal
