@@ -35,6 +35,7 @@ Usage::
 
     python benchmarks/bench_tle_timing.py                 # table + docs/tle_timing.png
     python benchmarks/bench_tle_timing.py --figure /tmp/x.png --only Jason-3 --levels 0.9
+    python benchmarks/bench_tle_timing.py --campaign-step-fraction 0.1 --figure /tmp/x.png  # campaign steps
 """
 
 from __future__ import annotations
@@ -79,7 +80,7 @@ COVERAGE_BAND = (0.85, 0.95)
 LEVELS = tuple(round(0.80 + 0.02 * k, 2) for k in range(9))  # 0.80 ... 0.96
 
 
-def evaluate(sat: str, level: float = LAG_LEVEL) -> dict[str, Any]:
+def evaluate(sat: str, level: float = LAG_LEVEL, **settings: Any) -> dict[str, Any]:
     """Run the detector on one shared history at interval level ``level`` and score it (module
     docstring)."""
     history = read_tle(DATA / "tle" / f"{sat}.tle")
@@ -87,7 +88,7 @@ def evaluate(sat: str, level: float = LAG_LEVEL) -> dict[str, Any]:
     el = history.elements
     start, end = el["epoch_utc"].iloc[0], el["epoch_utc"].iloc[-1]
     t0 = time.perf_counter()
-    run = detector_for(history, interval_level=level).detect(history, BUDGET)
+    run = detector_for(history, interval_level=level, **settings).detect(history, BUDGET)
     seconds = time.perf_counter() - t0
     events = run.events
     events = events.loc[(events["kind"] == "maneuver") & (events["statistic"] >= events["threshold"])]
@@ -246,6 +247,9 @@ def main() -> None:
     ap.add_argument("--figure", type=Path, default=ROOT / "docs" / "tle_timing.png")
     ap.add_argument("--only", nargs="*", default=None)
     ap.add_argument("--levels", nargs="*", type=float, default=list(LEVELS), help="interval levels of the study")
+    ap.add_argument(
+        "--campaign-step-fraction", type=float, default=None, help="resolve campaign steps (off by default)"
+    )
     args = ap.parse_args()
     sats = [s for s in SATELLITES if args.only is None or s in args.only]
     loso = level_study(sats, sorted(args.levels))
@@ -255,7 +259,9 @@ def main() -> None:
         if s != "(all modern)":
             width = f"median width {r['median_width_d']:.2f} d"
             print(f"  held out {s}: level {r['level']:.2f}, coverage {r['coverage']:.3f}, {width}")
-    rows = [evaluate(s) for s in sats]
+    settings = {} if args.campaign_step_fraction is None else {"campaign_step_fraction": args.campaign_step_fraction}
+    print(f"settings beside the defaults: {settings or 'none'}")
+    rows = [evaluate(s, **settings) for s in sats]
     cols = (
         "satellite sets years det truth precision recall f1 n_big recall_big n_big_net recall_big_net n_big_t "
         "recall_big_t n_above_floor recall_above_floor pairs_3d median_offset_d median_abs_offset_d late_over_1d "
@@ -273,7 +279,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    from _results import write_results
+    from _results import variant, write_results
 
-    with write_results("bench_tle_timing"):
+    with write_results("bench_tle_timing", variant({"--campaign-step-fraction": "campaign_steps"})):
         main()

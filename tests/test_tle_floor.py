@@ -35,3 +35,18 @@ def test_burns_are_above_the_floor_of_their_own_year() -> None:
     # -3 cm/s over, a 2.5 m/s cross-track burn over the 2 m/s one, no ΔV counted; 2009 not covered
     assert burns_above_floor(truth, BY_YEAR).tolist() == [True, False, False, True, True, True, False]
     assert not burns_above_floor(truth, []).any()
+
+
+def test_opposite_cross_track_burns_are_judged_by_their_summed_magnitude() -> None:
+    """A line of two opposite 1.25 m/s cross-track burns nets to zero in its components but turns the
+    plane by 2.5 m/s: above the 2 m/s floor of 2003; one of 1.5 m/s in all is below it."""
+    truth = pd.DataFrame(
+        {
+            "time_utc": ["2003-03-01", "2003-04-01"],
+            "dv_t_mps": [0.0, 0.0],
+            "dv_n_mps": [0.0, 0.0],
+            "dv_n_abs_mps": [2.5, 1.5],
+        }
+    )
+    assert burns_above_floor(truth, BY_YEAR).tolist() == [True, False]
+    assert not burns_above_floor(truth.drop(columns="dv_n_abs_mps"), BY_YEAR).any()

@@ -75,3 +75,19 @@ def test_duplicate_lines_are_dropped_and_counted(tmp_path: Path) -> None:
     frame = read_ids_maneuvers(_write(tmp_path, [JASON_LINE, JASON_LINE]), repairs=log)
     assert len(frame) == 1
     assert log.counts["duplicate maneuver lines dropped"] == 1
+
+
+def test_opposite_cross_track_burns_net_to_zero_but_keep_their_summed_magnitude(tmp_path: Path) -> None:
+    """A plane change split over two nodes: −2.45 and +2.45 m/s cross-track 1.5 orbits apart. The
+    summed components net to zero; the cross-track magnitude sums both burns (4.9 m/s)."""
+    burn = "{t} 04.3200000000000e+02 00.0000000000000e+00 00.0000000000000e+00 {w} " + ZERO6
+    line = (
+        "JASO1 2010 201 18 59 2010 201 21 56     007 2 "
+        + burn.format(t="2010 201 19 03 01.234", w="-2.4464100000000e+00")
+        + " "
+        + burn.format(t="2010 201 21 51 39.585", w="02.4464100000000e+00")
+    )
+    row = read_ids_maneuvers(_write(tmp_path, [line, JASON_LINE])).iloc[0]
+    assert row["dv_n_mps"] == pytest.approx(0.0, abs=1e-12)
+    assert row["dv_n_abs_mps"] == pytest.approx(2 * 2.44641)
+    assert row["dv_mps"] == pytest.approx(2 * 2.44641)

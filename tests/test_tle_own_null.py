@@ -222,6 +222,7 @@ def test_history_whose_burns_are_below_what_its_sets_resolve_is_flagged(shared_d
         assert r.exit_code == 0, r.output
         assert ("FLAG" in r.output) is flagged, r.output
         assert "recall above the stated floor" in r.output and "unmatched detections per year" in r.output
+        assert "cross-track" in r.output and "sum of its burns' magnitudes" in r.output  # the floors stated
 
 
 def test_detect_tle_prints_the_own_null_per_calendar_year(shared_data, tmp_path) -> None:

@@ -518,7 +518,7 @@ def _flag_undetectable(
     flagged = below > total / 2
     click.echo(
         f"detectable ΔV: {below} of {total} truth burns with a stated ΔV are below the smallest ΔV the element "
-        f"sets resolve in their year at {budget}"
+        f"sets resolve in their year at {budget}{floor_range(by_year)}"
         + (
             " -> FLAG: most listed burns cannot be seen in these element sets; recall here measures the "
             "element sets, not the detector"
@@ -527,6 +527,18 @@ def _flag_undetectable(
         )
     )
     return {"burns_with_dv": total, "below": below, "flagged": flagged, "above_floor": above_floor}
+
+
+def floor_range(by_year: list[dict[str, Any]]) -> str:
+    """The stated floors over the years: `` (in-track a-b m/s, cross-track c-d m/s by magnitude)``."""
+    if not by_year:
+        return ""
+    t = [float(r["min_detectable_dv_t_mps"]) for r in by_year]
+    n = [float(r["min_detectable_dv_n_mps"]) for r in by_year]
+    return (
+        f" (in-track {min(t):.4f}-{max(t):.4f} m/s, cross-track {min(n):.2f}-{max(n):.2f} m/s; a line's cross-track "
+        "ΔV is the sum of its burns' magnitudes)"
+    )
 
 
 @inject.command("tle")

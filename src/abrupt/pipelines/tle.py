@@ -131,13 +131,27 @@ def detect_tle_file(
     return out
 
 
+def cross_track_mps(truth: pd.DataFrame) -> NDArray[np.float64]:
+    """Per operator line, its cross-track ΔV (m/s) judged against the floor: the sum of its burns'
+    magnitudes (``dv_n_abs_mps``) where the file gives it, else the net |``dv_n_mps``| (NaN: none)."""
+    dv_n = np.abs(truth["dv_n_mps"].to_numpy(dtype=float)) if "dv_n_mps" in truth else np.full(len(truth), np.nan)
+    if "dv_n_abs_mps" in truth:
+        summed = truth["dv_n_abs_mps"].to_numpy(dtype=float)
+        dv_n = np.where(np.isfinite(summed), summed, dv_n)
+    return dv_n
+
+
 def burns_above_floor(truth: pd.DataFrame, detectable_by_year: list[dict[str, Any]]) -> NDArray[np.bool_]:
     """Per operator burn: is it at or above the floor the run states for its year?
 
     A burn is above when its in-track |ΔV| reaches the year's smallest detectable in-track ΔV or its
-    cross-track |ΔV| the cross-track one (``noise_model["detectable_by_year"]``). A burn whose file
-    gives no ΔV (Fengyun windows) cannot be judged and counts as above; a burn in a year the history
-    does not cover counts as below (nothing could see it).
+    cross-track ΔV the cross-track one (``noise_model["detectable_by_year"]``). The cross-track ΔV is
+    the sum of the burns' magnitudes where the file gives it (``dv_n_abs_mps``): a pair of opposite
+    burns half an orbit apart (a plane change split over two nodes) turns the orbit normal by both,
+    though its summed components net to zero; else the net |``dv_n_mps``|. The in-track ΔV is the
+    net (the step of ``a`` follows the sum). A burn whose file gives no ΔV (Fengyun windows) cannot be
+    judged and counts as above; a burn in a year the history does not cover counts as below (nothing
+    could see it).
     """
     out = np.zeros(len(truth), dtype=bool)
     if not detectable_by_year or len(truth) == 0:
@@ -145,7 +159,7 @@ def burns_above_floor(truth: pd.DataFrame, detectable_by_year: list[dict[str, An
     by_year = {int(r["year"]): r for r in detectable_by_year}
     times = pd.to_datetime(truth["time_utc"].astype(str), utc=True)
     dv_t = truth["dv_t_mps"].to_numpy(dtype=float) if "dv_t_mps" in truth else np.full(len(truth), np.nan)
-    dv_n = truth["dv_n_mps"].to_numpy(dtype=float) if "dv_n_mps" in truth else np.full(len(truth), np.nan)
+    dv_n = cross_track_mps(truth)
     for k, t in enumerate(times):
         row = by_year.get(int(t.year))
         if row is None:
@@ -154,7 +168,7 @@ def burns_above_floor(truth: pd.DataFrame, detectable_by_year: list[dict[str, An
             out[k] = True
             continue
         t_ok = np.isfinite(dv_t[k]) and abs(dv_t[k]) >= row["min_detectable_dv_t_mps"]
-        n_ok = np.isfinite(dv_n[k]) and abs(dv_n[k]) >= row["min_detectable_dv_n_mps"]
+        n_ok = np.isfinite(dv_n[k]) and dv_n[k] >= row["min_detectable_dv_n_mps"]
         out[k] = bool(t_ok or n_ok)
     return out
 
@@ -162,14 +176,15 @@ def burns_above_floor(truth: pd.DataFrame, detectable_by_year: list[dict[str, An
 def burns_below_detectable(truth: pd.DataFrame, detectable_by_year: list[dict[str, Any]]) -> tuple[int, int]:
     """How many of the operator burns with a stated ΔV lie below what the element sets resolve in their
     year: (burns below, burns with a ΔV in a year of the history). A burn is below when its in-track
-    |ΔV| is under the year's smallest detectable in-track ΔV and its cross-track |ΔV| under the
-    cross-track one (``noise_model["detectable_by_year"]`` of the TLE detectors)."""
+    |ΔV| is under the year's smallest detectable in-track ΔV and its cross-track ΔV
+    (:func:`cross_track_mps`, by magnitude) under the cross-track one
+    (``noise_model["detectable_by_year"]`` of the TLE detectors)."""
     if not detectable_by_year or "dv_t_mps" not in truth or "dv_n_mps" not in truth:
         return 0, 0
     by_year = {int(r["year"]): r for r in detectable_by_year}
     below = total = 0
     times = pd.to_datetime(truth["time_utc"].astype(str), utc=True)
-    for t, dv_t, dv_n in zip(times, truth["dv_t_mps"], truth["dv_n_mps"], strict=True):
+    for t, dv_t, dv_n in zip(times, truth["dv_t_mps"], cross_track_mps(truth), strict=True):
         row = by_year.get(int(t.year))
         if row is None or not (np.isfinite(dv_t) or np.isfinite(dv_n)):
             continue

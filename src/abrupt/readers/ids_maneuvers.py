@@ -55,6 +55,7 @@ MANEUVER_COLUMNS: tuple[str, ...] = (
     "dv_t_mps",
     "dv_n_mps",
     "dv_mps",
+    "dv_n_abs_mps",
     "parameter_type",
     "line",
 )
@@ -85,10 +86,12 @@ MAX_ABS_VALUE = 1e6  # [s, m/s, m/s^2]: a burn duration, delta-v or acceleration
 def read_ids_maneuvers(path: str | Path, *, repairs: RepairLog | None = None) -> pd.DataFrame:
     """Read an IDS maneuver file: one row per maneuver window, times in UTC.
 
-    Columns (:data:`MANEUVER_COLUMNS`): ``time_utc`` is the first burn's epoch, ``dv_*`` the sum of
-    the burns' components in the orbit frame (m/s), ``dv_mps`` the sum of burn magnitudes,
+        Columns (:data:`MANEUVER_COLUMNS`): ``time_utc`` is the first burn's epoch, ``dv_*`` the sum of
+        the burns' components in the orbit frame (m/s), ``dv_mps`` the sum of burn magnitudes,
+        ``dv_n_abs_mps`` the sum of the burns' |cross-track| components (a pair of opposite cross-track
+    burns half an orbit apart turns the orbit plane by both, while their summed components net to zero),
     ``duration_s`` the total burn time. Exact duplicate lines are dropped and counted; rows are
-    sorted by time (counted when the file was out of order).
+        sorted by time (counted when the file was out of order).
     """
     path = Path(path)
     file = str(path)
@@ -137,6 +140,7 @@ def read_ids_maneuvers(path: str | Path, *, repairs: RepairLog | None = None) ->
         win1 = _doy_time(tok[5:9], file, line_no, "window end")
         dv = np.zeros(3)
         mag = 0.0
+        cross_abs = 0.0
         duration = 0.0
         first: np.datetime64 | None = None
         for b in range(n_burns):
@@ -160,6 +164,7 @@ def read_ids_maneuvers(path: str | Path, *, repairs: RepairLog | None = None) ->
             vec = comps[list(order)]
             dv += vec
             mag += float(np.linalg.norm(vec))
+            cross_abs += abs(float(vec[2]))
             burn_tai.append(epoch)
             first = epoch if first is None else min(first, epoch)
         rows.append(
@@ -174,6 +179,7 @@ def read_ids_maneuvers(path: str | Path, *, repairs: RepairLog | None = None) ->
                 dv_t_mps=dv[1],
                 dv_n_mps=dv[2],
                 dv_mps=mag,
+                dv_n_abs_mps=cross_abs,
                 parameter_type=ptype,
                 line=line_no,
             )

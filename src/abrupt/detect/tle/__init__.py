@@ -418,7 +418,9 @@ extend it but join it when they lie between its first and last step) is also rep
   nearly the same `u` are one step of their summed ΔV and are counted as one.
 
 The members stay maneuvers (one-to-one scoring is unchanged: `abrupt.score` leaves `maneuver_campaign` rows
-out); the campaign row states what the element sets say about the whole.
+out); the campaign row states what the element sets say about the whole. With `campaign_step_fraction` (off
+by default; `abrupt.detect.tle.campaign_steps`) every carrying gap over the history's own set-to-set null is a
+maneuver of its own, a member a gap off its step moved to it.
 
 **Simulated acquisition phases in the real quiet noise of each shared LEO satellite** (`python
 benchmarks/bench_tle_campaigns.py`, 29 s; `abrupt.simulate.tle_campaign`): six in-track burns of 0.5-3 m/s (one

@@ -38,6 +38,11 @@ EXTRA_COLUMNS: tuple[str, ...] = (
 # scores the same or better with 2, every GEO history the same or better with 3 (docs/tle.md).
 CAMPAIGN_SIDE_SETS = {"leo": 2, "geo": 3}
 
+# steps inside a campaign resolved into maneuvers (abrupt.detect.tle.campaign_steps) at this fraction
+# of the campaign's largest step when switched on; off by default: chosen leave-one-satellite-out on
+# the modern shared histories, no fraction that adds burns keeps every history's precision
+CAMPAIGN_STEP_FRACTION = 0.1
+
 DEFAULT_TLE_BUDGET = FalseAlarmBudget.parse(DEFAULT_TLE_RATE)
 
 
@@ -61,6 +66,9 @@ class TleDetectorConfig:
     campaign_days: float = 3.0
     campaign_chain_days: float = 7.0  # maneuver_campaign events: detections chained this close
     campaign_min_side_sets: int | None = None  # None: by regime (CAMPAIGN_SIDE_SETS)
+    # a gap inside a campaign whose set-to-set step of a passes the history's own null and this fraction
+    # of the campaign's largest is a maneuver of its own (abrupt.detect.tle.campaign_steps); None: off
+    campaign_step_fraction: float | None = None
     time_search_sets_before: int = 3
     group_gain: tuple[float, float, float] = (1.0, 0.2, 0.2)
     along_track_gain: float = 1.0
@@ -99,6 +107,8 @@ class TleDetectorConfig:
             raise ValueError("max_bridge_days must be a finite positive number")
         if not 0.0 < self.interval_level < 1.0:
             raise ValueError(f"interval_level must lie in (0, 1), got {self.interval_level}")
+        if self.campaign_step_fraction is not None and not 0.0 <= self.campaign_step_fraction <= 1.0:
+            raise ValueError(f"campaign_step_fraction must lie in [0, 1] or be None, got {self.campaign_step_fraction}")
         if self.drag_median_sets < 1:
             raise ValueError("drag_median_sets must be >= 1")
         if not (self.drag_min_decay_m_day > 0 and math.isfinite(self.drag_min_decay_m_day)):

@@ -73,6 +73,7 @@ from numpy.typing import NDArray
 from abrupt.detect.base import DetectionResult
 from abrupt.detect.tle.arcs import join_arcs
 from abrupt.detect.tle.burns import campaign_cadence_s, characterise, label_campaigns
+from abrupt.detect.tle.campaign_steps import relocated_steps
 from abrupt.detect.tle.campaigns import find_campaigns
 from abrupt.detect.tle.config import CAMPAIGN_SIDE_SETS, EXTRA_COLUMNS, TleDetectorConfig
 from abrupt.detect.tle.elements import arcs, circular_speed_mps, history_rows, orbit_regime
@@ -232,6 +233,13 @@ def detect_arc(
     run = StepRun(history, cfg, regime, model, steps, stat, threshold, change_points)
     hinge = {c.gap: c for c in time_candidates(run, candidates, all_candidates)}  # along-track times
     kept, span_of = merge_candidates(run, ramp_times(run, list(hinge.values())))
+    drop, add = relocated_steps(run, kept)  # steps inside campaigns, each a maneuver timed at its gap
+    kept = [it for it in kept if it.gap not in drop]
+    for g, z in add.items():
+        t_m, stat[g] = 0.5 * float(model.t[g] + model.t[g + 1]), max(float(stat[g]), z)
+        kept.append(Candidate(g, t_m, False, min(t_m, float(model.t[g]))))
+        span_of[g] = [kept[-1].start_s, float(model.t[g + 1])]
+    kept.sort(key=lambda it: it.time_s)
     detected = [it for it in kept if stat[it.gap] >= threshold]
     # each interval reaches back over the era's own TLE lag, learned from the along-track hinges
     # (abrupt.detect.tle.intervals; a ramp time assumes sets published as soon as their tracking ends)
