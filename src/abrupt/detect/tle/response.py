@@ -260,3 +260,14 @@ def response_hosts(
         if hi - lo >= 6 and one_response_fits(t_s, a_m, lo, hi, g0, g1, s, float(sigma_m[root])):
             host[k] = root
     return host
+
+
+def span_fraction_with_drift(x_s: NDArray[np.float64], span_s: float) -> NDArray[np.float64]:
+    """The same fraction when each set's fit also solves for a quadratic along-track drift (a drag term,
+    B*): the slope at the epoch of a least-squares parabola through the hinge over the span,
+    ``3ρ² − 2ρ³ + 15ρ²(1 − ρ)²`` (shifted Legendre projection: slope ``2c₁ + 6c₂`` at the span's end,
+    ``c₁ = 3ρ²/2 − ρ³``, ``c₂ = 5ρ²(1 − ρ)²/2``). It overshoots, up to 1.51 of the change at ``ρ = 0.6``.
+    The shared histories' ramps follow :func:`span_fraction` (``benchmarks/bench_tle_response_truth.py``);
+    this one is the alternative they were tested against."""
+    rho = np.clip(np.asarray(x_s, dtype=float) / span_s, 0.0, 1.0)
+    return np.asarray(rho * rho * (3.0 - 2.0 * rho) + 15.0 * rho * rho * (1.0 - rho) ** 2, dtype=float)
