@@ -24,7 +24,10 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import least_squares
 from sgp4.api import WGS72, Satrec
 
-from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2
+from abrupt.detect.tle.elements import mean_element_series
+from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
+from abrupt.simulate.tle_null import NullHistorySpec, history_from_series, simulate_null_history
+from abrupt.units import SECONDS_PER_DAY
 
 EARTH_RADIUS_M = 6378135.0  # WGS-72, as SGP4
 J2_WGS72 = 0.001082616
@@ -165,3 +168,85 @@ def fitted_semi_major_axes(
             _, rec = fit_element_set(t_s[use], track[use], float(epoch), guess_at(sat, float(epoch)), drift)
             out[j, k] = rec.a * EARTH_RADIUS_M
     return out[0], out[1]
+
+
+def fitted_burn_response(
+    sat: Satrec,
+    x_s: NDArray[np.float64],
+    span_s: float,
+    dv_mps: float,
+    phase_s: float,
+    *,
+    cadence_s: float = 600.0,
+    noise_m: float = 30.0,
+    seed: int = 0,
+) -> dict[str, NDArray[np.float64]]:
+    """What a burn of ``dv_mps`` (in-track) changes in sets fitted over ``span_s`` whose epochs lie
+    ``x_s`` after it: ``a_m``, ``ex``, ``ey`` and the mean argument of latitude at the epoch ``u_rad``
+    (burned − unburned fit, same tracking noise). The burn lies ``span_s + phase_s`` after the record's
+    epoch (``phase_s`` sets where in the orbit it falls). Sets with ``x ≤ 0`` are unchanged; sets after
+    ``span_s`` + one day carry the last fitted change, their ``u`` drifting on at the fitted change of
+    mean motion."""
+    t_b = span_s + phase_s
+    inside = (x_s > 0.0) & (x_s <= span_s + SECONDS_PER_DAY)
+    x_fit = np.concatenate([x_s[inside], [span_s + SECONDS_PER_DAY]])
+    epochs = t_b + x_fit
+    t_s = np.arange(0.0, float(epochs.max()) + cadence_s, cadence_s)
+    noise = np.random.default_rng(seed).normal(0.0, noise_m, (t_s.size, 3))
+    zero = np.random.default_rng(0)
+    tracks = [tracked_positions(sat, t_s, b, 0.0, zero) + noise for b in ([(t_b, dv_mps)], [])]
+    fits = np.empty((2, x_fit.size, 4))
+    for j, track in enumerate(tracks):
+        for k, epoch in enumerate(epochs):
+            use = (t_s >= epoch - span_s) & (t_s <= epoch)
+            x, rec = fit_element_set(t_s[use], track[use], float(epoch), guess_at(sat, float(epoch)))
+            fits[j, k] = (rec.a * EARTH_RADIUS_M, x[1], x[2], x[5])
+    d = fits[0] - fits[1]
+    d[:, 3] = np.angle(np.exp(1j * d[:, 3]))
+    dn_rad_s = -1.5 * math.sqrt(MU_EARTH_WGS72_M3_S2 / fits[1, -1, 0] ** 3) * d[-1, 0] / fits[1, -1, 0]
+    out = np.zeros((x_s.size, 4))
+    out[inside] = d[:-1]
+    late = x_s > span_s + SECONDS_PER_DAY
+    out[late] = d[-1]
+    out[late, 3] = d[-1, 3] + dn_rad_s * (x_s[late] - span_s - SECONDS_PER_DAY)
+    return {"a_m": out[:, 0], "ex": out[:, 1], "ey": out[:, 2], "u_rad": out[:, 3]}
+
+
+def blended_history(
+    spec: NullHistorySpec, burns: Sequence[tuple[float, float]], span_days: float, *, seed: int = 0
+) -> ElementHistory:
+    """A maneuver-free simulated history (:func:`abrupt.simulate.tle_null.simulate_null_history`, LEO)
+    plus in-track burns ``(day after its first epoch, Δv m/s)`` as sets fitted over ``span_days``
+    respond to them (:func:`fitted_burn_response`, each burn at a random point of the orbit): ``a`` and
+    the e-vector carry the fitted change, the along-track phase the fitted angle at the epoch (less
+    what the sets' own changed mean motions integrate, which the history's records add back)."""
+    base = simulate_null_history(spec)
+    s = mean_element_series(base, "leo")
+    t_days = np.asarray(s["t_s"], dtype=float) / SECONDS_PER_DAY
+    a0 = float(np.median(s["a_m"]))
+    n0 = math.sqrt(MU_EARTH_WGS72_M3_S2 / a0**3)
+    sat = initial_record(a0, 0.0008, math.radians(spec.inclination_deg), math.radians(90.0), 1.0)
+    series = {k: np.asarray(s[v], dtype=float).copy() for k, v in SERIES_KEYS.items()}
+    rng = np.random.default_rng([seed, 5])
+    for k, (day, dv) in enumerate(burns):
+        phase_s = float(rng.uniform(0.0, 2.0 * math.pi / n0))
+        x_s = (t_days - day) * SECONDS_PER_DAY
+        r = fitted_burn_response(sat, x_s, span_days * SECONDS_PER_DAY, dv, phase_s, seed=seed * 100 + k)
+        series["a_m"] += r["a_m"]
+        series["ex"] += r["ex"]
+        series["ey"] += r["ey"]
+        dn = -1.5 * n0 * r["a_m"] / a0  # [rad/s] the records' own change of mean motion
+        integrated = np.concatenate([[0.0], np.cumsum(0.5 * (dn[1:] + dn[:-1]) * np.diff(x_s))])
+        series["u_m"] += a0 * (r["u_rad"] - integrated)
+    return history_from_series(t_days, series, "leo", norad=99952)
+
+
+# detector series of mean_element_series -> series of history_from_series
+SERIES_KEYS = {
+    "a_m": "a_m",
+    "ex": "ex",
+    "ey": "ey",
+    "n1_rad": "i_rad",
+    "n2_rad": "raan_resid_sin_i_rad",
+    "u_m": "u_m",
+}
