@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from abrupt.detect.tle.response import span_fraction, span_fraction_with_drift
+from abrupt.detect.tle.response import local_spans_s, span_fraction, span_fraction_with_drift
 from abrupt.simulate.tle_fits import fitted_semi_major_axes, initial_record
 
 DAY_S = 86400.0
@@ -41,3 +41,16 @@ def test_fitted_sets_carry_the_stated_fraction_of_a_burn(jason_like: object, dri
     expected = formula(RHO * SPAN_DAYS * DAY_S, SPAN_DAYS * DAY_S)  # type: ignore[operator]
     np.testing.assert_allclose(fraction, expected, atol=0.03)
     assert (np.max(fraction) > 1.3) == drift
+
+
+def test_an_era_with_few_lone_burns_takes_its_span_from_the_nearest_ones() -> None:
+    """Two fitted spans within half a year of a detection (5 and 7 days) and the others a year away
+    (3, 6 and 8 days): the half-year alone is too few; with ``nearest`` the three nearest in time
+    (5, 7 and 6 days: median 6) give the era's span and spread, never the far ones alone."""
+    times = np.array([-400.0, -100.0, 60.0, 300.0, 420.0]) * DAY_S
+    spans = np.array([3.0, 5.0, 7.0, 6.0, 8.0]) * DAY_S
+    reach = 182.625 * DAY_S
+    assert all(math.isnan(v) for v in local_spans_s(0.0, times, spans, reach))
+    median, low, high = local_spans_s(0.0, times, spans, reach, nearest=True)
+    assert (median, low, high) == (6.0 * DAY_S, 5.0 * DAY_S, 7.0 * DAY_S)
+    assert all(math.isnan(v) for v in local_spans_s(0.0, times[:2], spans[:2], reach, nearest=True))

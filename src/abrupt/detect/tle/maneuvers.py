@@ -278,7 +278,8 @@ def time_candidates(run: StepRun, candidates: NDArray[np.int64], all_candidates:
     LEO in-track burns are timed by the hinge of the along-track angle as the sets respond to it
     (:func:`refine_burn_time`) at the fit span of their era: each candidate's best span (sharp hinge
     or 1-8 days, :data:`SPAN_DAYS`) is found first, and the era's span is the median of those within
-    ``RAMP_ERA_DAYS`` (at least three; else a sharp hinge), so one noisy fit does not choose its own.
+    ``RAMP_ERA_DAYS`` (at least three; else the nearest three of the history, else a sharp hinge), so one
+    noisy fit does not choose its own.
     """
     cfg, steps, model, history = run.cfg, run.steps, run.model, run.history
     leo = run.regime == "leo"
@@ -320,7 +321,7 @@ def time_candidates(run: StepRun, candidates: NDArray[np.int64], all_candidates:
     timed: list[Candidate] = []
     for g, seg, ok in plan:
         if ok:
-            era_d = local_spans_s(float(model.t[g]), at_s, span_d, RAMP_ERA_DAYS * SECONDS_PER_DAY)[0]
+            era_d = local_spans_s(float(model.t[g]), at_s, span_d, RAMP_ERA_DAYS * SECONDS_PER_DAY, nearest=True)[0]
             run.era_span_s[g] = (era_d if math.isfinite(era_d) else 0.0) * SECONDS_PER_DAY
             t_m, refined, _ = hinge(g, seg, (run.era_span_s[g] / SECONDS_PER_DAY,))
         else:

@@ -168,12 +168,21 @@ def ramp_span_s(t_s: NDArray[np.float64], a_m: NDArray[np.float64], ramp: tuple[
 
 
 def local_spans_s(
-    at_s: float, ramp_times_s: NDArray[np.float64], ramp_spans_s: NDArray[np.float64], reach_s: float, minimum: int = 3
+    at_s: float,
+    ramp_times_s: NDArray[np.float64],
+    ramp_spans_s: NDArray[np.float64],
+    reach_s: float,
+    minimum: int = 3,
+    nearest: bool = False,
 ) -> tuple[float, float, float]:
     """The fit span (s) of the era around ``at_s`` and its spread: the median, smallest and largest span
     of the ramps within ``reach_s`` (NaNs with fewer than ``minimum``: the era's sets do not blend, or
-    too few burns show it)."""
+    too few burns show it; with ``nearest`` the ``minimum`` ramps nearest in time instead, when the
+    history has that many)."""
     near = np.abs(ramp_times_s - at_s) <= reach_s
+    if int(near.sum()) < minimum and nearest and ramp_times_s.size >= minimum:
+        near = np.zeros(ramp_times_s.size, dtype=bool)
+        near[np.argsort(np.abs(ramp_times_s - at_s), kind="stable")[:minimum]] = True
     if int(near.sum()) < minimum:
         return math.nan, math.nan, math.nan
     spans = ramp_spans_s[near]
