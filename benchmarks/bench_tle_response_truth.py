@@ -13,8 +13,9 @@ to the positions over its span ``[t_k − S, t_k]``. Nothing in the truth knows 
    eight in-track burns of 5-30 mm/s 45 days apart, whose sets respond as fitted over ``S`` days
    (:func:`abrupt.simulate.tle_fits.blended_history`). The detector runs at its defaults and a budget
    of 1 false alarm a year; per span: burns found within 3 days (the nearest event), events per burn,
-   median |event − burn|, the share more than a day late, and the share of burns inside the nearest
-   event's stated interval (target 85-95 %), with the median interval width.
+   median |event − burn|, the share more than a day late, the share of burns inside the nearest
+   event's stated interval (target 85-95 %) with the median interval width, and the event's in-track
+   ΔV over the burn's (median and interquartile range).
 
 Usage::
 
@@ -77,8 +78,9 @@ def timed_history(span_days: float, seed: int) -> list[dict[str, float]]:
         return ts.dt.total_seconds().to_numpy() / DAY_S
 
     t, lo, hi = days("time_utc"), days("interval_start_utc"), days("interval_end_utc")
+    dv_t = ev["dv_t_mps"].to_numpy(dtype=float)
     out = []
-    for day, _ in burns:
+    for day, dv in burns:
         near = np.flatnonzero(np.abs(t - day) < 3.0)
         if not near.size:
             out.append({"found": 0.0, "events": 0.0})
@@ -91,6 +93,7 @@ def timed_history(span_days: float, seed: int) -> list[dict[str, float]]:
                 "offset_d": float(t[i] - day),
                 "covered": float(lo[i] <= day <= hi[i]),
                 "width_d": float(hi[i] - lo[i]),
+                "dv_ratio": float(dv_t[i] / dv),
             }
         )
     return out
@@ -121,6 +124,10 @@ def main() -> None:
                 "late_over_1d": int(np.sum(off > 1.0)),
                 "coverage": float(np.mean([r["covered"] for r in found])) if found else math.nan,
                 "median_width_d": float(np.median([r["width_d"] for r in found])) if found else math.nan,
+                "dv_ratio_p50": float(np.median([r["dv_ratio"] for r in found])) if found else math.nan,
+                "dv_ratio_iqr": float(np.subtract(*np.percentile([r["dv_ratio"] for r in found], [75, 25])))
+                if found
+                else math.nan,
                 "seconds": time.perf_counter() - t0,
             }
         )

@@ -7,10 +7,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 
+from abrupt.detect.tle.detectors import TleMeanElements
 from abrupt.detect.tle.response import local_spans_s, span_fraction, span_fraction_with_drift
-from abrupt.simulate.tle_fits import fitted_semi_major_axes, initial_record
+from abrupt.simulate.tle_fits import blended_history, fitted_semi_major_axes, initial_record
+from abrupt.simulate.tle_null import EPOCH0, NullHistorySpec
+from abrupt.thresholds import FalseAlarmBudget
 
 DAY_S = 86400.0
 BURN_DAY = 6.0
@@ -54,3 +58,34 @@ def test_an_era_with_few_lone_burns_takes_its_span_from_the_nearest_ones() -> No
     median, low, high = local_spans_s(0.0, times, spans, reach, nearest=True)
     assert (median, low, high) == (6.0 * DAY_S, 5.0 * DAY_S, 7.0 * DAY_S)
     assert all(math.isnan(v) for v in local_spans_s(0.0, times[:2], spans[:2], reach, nearest=True))
+
+
+def test_burns_in_fitted_sets_are_timed_and_sized_by_the_whole_response() -> None:
+    """Six in-track burns of 10-25 mm/s, 40 days apart, in a simulated 1336 km history at one set a day
+    whose sets respond as least-squares fits over 6 days (:func:`blended_history`: the fits, not the
+    formula). Each burn is found, timed within 0.5 days (median under 0.25) and its in-track ΔV, from
+    the response fitted through the sets around it, is within 10 % of the burn's for at least five of
+    six (measured: all six within 3 %; the step between two sets alone put four of six more than 10 %
+    low, as the blends carry the rest)."""
+    rng = np.random.default_rng(17)
+    burns = [
+        (40.0 + 40.0 * k + float(rng.uniform(0.0, 1.0)), float(rng.choice([-1.0, 1.0]) * rng.uniform(0.010, 0.025)))
+        for k in range(6)
+    ]
+    spec = NullHistorySpec(
+        altitude_km=1336.0, inclination_deg=66.0, sets_per_day=1.0, years=0.75, bad_set_probability=0.0, seed=5
+    )
+    ev = TleMeanElements().detect(blended_history(spec, burns, 6.0, seed=5), FalseAlarmBudget(1.0, "year")).events
+    ev = ev.loc[(ev["kind"] == "maneuver") & (ev["statistic"] >= ev["threshold"])]
+    t_days = (
+        pd.to_datetime(ev["time_utc"].astype(str), format="ISO8601").dt.tz_localize(None) - pd.Timestamp(EPOCH0)
+    ).dt.total_seconds().to_numpy() / DAY_S
+    errors, sized = [], 0
+    for day, dv in burns:
+        near = np.flatnonzero(np.abs(t_days - day) < 3.0)
+        assert near.size, (day, t_days)
+        i = int(near[np.argmin(np.abs(t_days[near] - day))])
+        errors.append(abs(t_days[i] - day))
+        sized += int(abs(float(ev["dv_t_mps"].iloc[i]) / dv - 1.0) < 0.1)
+    assert max(errors) < 0.5 and float(np.median(errors)) < 0.25, errors
+    assert sized >= 5

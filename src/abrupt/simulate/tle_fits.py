@@ -57,13 +57,13 @@ def initial_record(a_m: float, e: float, inc_rad: float, argp_rad: float, raan_r
 def tracked_positions(
     sat: Satrec,
     t_s: NDArray[np.float64],
-    burns: Sequence[tuple[float, float]],
+    burns: Sequence[tuple[float, ...]],
     noise_m: float,
     rng: np.random.Generator,
 ) -> NDArray[np.float64]:
     """Positions (m, TEME treated as inertial) at ``t_s`` (s after the record's epoch, increasing, from
     0) of the J2 orbit starting at the record's osculating state, with in-track impulses ``burns``
-    (time s, Δv m/s along the velocity), plus Gaussian noise ``noise_m`` per axis."""
+    (time s, Δv m/s along the velocity[, Δv m/s along the orbit normal]), plus Gaussian noise ``noise_m`` per axis."""
     err, r_km, v_km = sat.sgp4(0.0, 0.0)
     if err:
         raise ValueError(f"SGP4 error {err} at the start of the truth")
@@ -74,10 +74,12 @@ def tracked_positions(
 
     out = np.empty((t_s.size, 3))
     edges = [0.0, *sorted(b[0] for b in burns), float(t_s[-1]) + 1.0]
-    dv = dict(burns)
+    dv = {float(b[0]): b[1:] for b in burns}
     for lo, hi in itertools.pairwise(edges):
         if lo in dv:
-            state[3:] += dv[lo] * state[3:] / np.linalg.norm(state[3:])
+            along = state[3:] / np.linalg.norm(state[3:])
+            normal = np.cross(state[:3], state[3:])
+            state[3:] += dv[lo][0] * along + (dv[lo][1] if len(dv[lo]) > 1 else 0.0) * normal / np.linalg.norm(normal)
         sol = solve_ivp(rhs, (lo, hi), state, method="DOP853", rtol=1e-11, atol=1e-4, dense_output=True)
         inside = (t_s >= lo) & (t_s < hi)
         if inside.any():

@@ -83,6 +83,7 @@ from abrupt.detect.tle.response import (
     burn_grid,
     interval_cost,
     local_spans_s,
+    ramp_delta_a_m,
     ramp_profile,
     ramp_span_s,
     response_hosts,
@@ -145,6 +146,8 @@ class StepRun:
     blends: dict[int, tuple[int, int]] = field(default_factory=dict)
     # the fit span (s) of the era of each in-track candidate's sets (time_candidates; 0: sharp)
     era_span_s: dict[int, float] = field(default_factory=dict)
+    # the whole change of ``a`` (m) of each detection timed from its blended sets (the response's fit)
+    ramp_delta_a: dict[int, float] = field(default_factory=dict)
 
 
 def detect_mean_elements(
@@ -388,6 +391,8 @@ def ramp_times(run: StepRun, timed: list[Candidate]) -> list[Candidate]:
             grid = burn_grid(model.t, last_old + 1, span)
             profiles[g].append((grid, ramp_profile(model.t, a, lo, hi, grid, span, noise)))
         dofs[g] = hi - lo - 3
+        t_best = float(profiles[g][0][0][int(np.argmin(profiles[g][0][1]))])
+        run.ramp_delta_a[g] = ramp_delta_a_m(model.t, a, lo, hi, t_best, spans[0])
     if not profiles:
         return timed
     rise = interval_cost([float(np.min(p[0][1])) / max(dofs[g], 1) for g, p in profiles.items()], RAMP_LEVEL)
@@ -632,7 +637,8 @@ def event_fields(
         a_ref = float(el["a_m"].iloc[g])
         w = steps.weights
         wz = (w[0] * float(steps.z_a[g]), w[1] * float(steps.z_e[g]), w[2] * float(steps.z_n[g]))
-        ch = characterise(float(steps.delta_a_m[g]), steps.delta_e[g], steps.delta_normal_rad[g], a_ref, wz)
+        delta_a = run.ramp_delta_a.get(g, float(steps.delta_a_m[g]))  # blended: the response's whole change
+        ch = characterise(delta_a, steps.delta_e[g], steps.delta_normal_rad[g], a_ref, wz)
         v = circular_speed_mps(a_ref)
         kind = str(ch["maneuver_type"])
         if is_phasing(steps, g):
@@ -645,7 +651,7 @@ def event_fields(
             "z_a": float(steps.z_a[g]),
             "z_e": float(steps.z_e[g]),
             "z_n": float(steps.z_n[g]),
-            "delta_a_m": float(steps.delta_a_m[g]),
+            "delta_a_m": delta_a,
             "elset_epoch_before_utc": str(el["epoch_utc"].iloc[g]),
             "elset_epoch_after_utc": str(el["epoch_utc"].iloc[g + 1]),
             "time_method": "along-track continuity" if refined else "gap middle",

@@ -280,3 +280,16 @@ def span_fraction_with_drift(x_s: NDArray[np.float64], span_s: float) -> NDArray
     this one is the alternative they were tested against."""
     rho = np.clip(np.asarray(x_s, dtype=float) / span_s, 0.0, 1.0)
     return np.asarray(rho * rho * (3.0 - 2.0 * rho) + 15.0 * rho * rho * (1.0 - rho) ** 2, dtype=float)
+
+
+def ramp_delta_a_m(
+    t_s: NDArray[np.float64], a_m: NDArray[np.float64], lo: int, hi: int, burn_s: float, span_s: float
+) -> float:
+    """The burn's whole change of ``a`` (m): ``Δa`` of ``a_k = c₀ + c₁τ_k + Δa·f(t_k − t_b; S)`` fitted
+    through sets ``lo..hi-1`` at the burn time ``burn_s`` (:func:`ramp_profile`). A step between two
+    sets misses what the blends before and after it carry."""
+    t = t_s[lo:hi]
+    tau = (t - t[0]) / SECONDS_PER_DAY
+    design = np.column_stack([np.ones_like(tau), tau, span_fraction(t - burn_s, span_s)])
+    coef, *_ = np.linalg.lstsq(design, a_m[lo:hi], rcond=None)
+    return float(coef[2])
