@@ -11,8 +11,8 @@ import pandas as pd
 import pytest
 
 from abrupt.detect.tle.detectors import TleMeanElements
-from abrupt.detect.tle.response import local_spans_s, span_fraction, span_fraction_with_drift
-from abrupt.simulate.tle_fits import blended_history, fitted_semi_major_axes, initial_record
+from abrupt.detect.tle.response import local_spans_s, response_hosts, span_fraction, span_fraction_with_drift
+from abrupt.simulate.tle_fits import blended_history, fitted_burn_response, fitted_semi_major_axes, initial_record
 from abrupt.simulate.tle_null import EPOCH0, NullHistorySpec
 from abrupt.thresholds import FalseAlarmBudget
 
@@ -89,3 +89,35 @@ def test_burns_in_fitted_sets_are_timed_and_sized_by_the_whole_response() -> Non
         sized += int(abs(float(ev["dv_t_mps"].iloc[i]) / dv - 1.0) < 0.1)
     assert max(errors) < 0.5 and float(np.median(errors)) < 0.25, errors
     assert sized >= 5
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_step_detected_before_a_blended_burn_is_the_same_burn(jason_like: object, seed: int) -> None:
+    """Daily sets fitted over 2 days around one 2 cm/s in-track burn (``a`` from :func:`fitted_burn_response`:
+    the fits' own change, ~43 m), 0.1 m noise. A weak same-sign step detected in the gap before the
+    burn's (a leak of the step test's windows) and the burn's largest step are one burn: the later step joins the
+    earlier, and the one response fitted through the window times it within 0.2 days."""
+    rng = np.random.default_rng(seed)
+    t_days = np.arange(40.0) + rng.uniform(-0.1, 0.1, 40)
+    burn_day = 20.3 + float(rng.uniform(-0.2, 0.2))
+    x_s = (t_days - burn_day) * DAY_S
+    response = fitted_burn_response(jason_like, x_s, 2.0 * DAY_S, 0.02, 3000.0, seed=seed)["a_m"]
+    a_m = 7714.4e3 - 0.5 * t_days + response + rng.normal(0.0, 0.1, t_days.size)
+    t_s = t_days * DAY_S
+    g_burn = int(np.searchsorted(t_days, burn_day)) - 1  # the burn lies between sets g_burn and g_burn + 1
+    # the largest step comes a gap later (the first set after the burn carries under half of it)
+    gaps = np.array([g_burn - 1, g_burn + 1], dtype=np.int64)
+    times: dict[int, float] = {}
+    host = response_hosts(
+        t_s,
+        a_m,
+        gaps,
+        t_s[gaps] + 0.5 * DAY_S,
+        np.array([4.0, 30.0]),
+        np.full(2, 2.0 * DAY_S),
+        np.full(2, 0.1),
+        8,
+        times,
+    )
+    assert host.tolist() == [-1, 0]
+    assert abs(times[1] / DAY_S - burn_day) < 0.2

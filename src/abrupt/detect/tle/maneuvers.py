@@ -589,13 +589,14 @@ def merge_candidates(run: StepRun, timed: list[Candidate]) -> tuple[list[Candida
 
 
 def join_response_tails(run: StepRun, kept: list[Candidate], span_of: dict[int, list[float]]) -> list[Candidate]:
-    """One event per burn whose response spreads over sets fitted across it: a later detected step of
-    the same sign whose last old set still holds the burn in its era's fit span is the rest of that
-    response (:func:`abrupt.detect.tle.response.response_hosts`); it is dropped and the burn's interval
-    reaches to its first new set. The span is the era's along-track fit span (``run.era_span_s``)."""
+    """One event per burn whose response spreads over sets fitted across it: a detected step of the same
+    sign while the sets still respond to an earlier one is the rest of that response
+    (:func:`abrupt.detect.tle.response.response_hosts`). The strongest step of the burn is its event,
+    timed by the one response fitted through the window, over the union of the members' intervals."""
     found = [it for it in kept if run.stat[it.gap] >= run.threshold]
     if len(found) < 2:
         return kept
+    t_one: dict[int, float] = {}
     host = response_hosts(
         run.model.t,
         np.asarray(run.model.s["a_m"], dtype=float),
@@ -605,12 +606,17 @@ def join_response_tails(run: StepRun, kept: list[Candidate], span_of: dict[int, 
         np.array([run.era_span_s.get(it.gap, 0.0) for it in found]),
         np.array([float(run.model.scales["a_m"][it.gap]) for it in found]),
         run.cfg.time_window_sets,
+        t_one,
     )
-    tails = {found[k].gap for k in np.flatnonzero(host >= 0)}
-    for k in np.flatnonzero(host >= 0):
-        root, tail = span_of[found[int(host[k])].gap], span_of[found[int(k)].gap]
-        root[0], root[1] = min(root[0], tail[0]), max(root[1], tail[1])
-    return [it for it in kept if it.gap not in tails]
+    drop, timed = set(), {}
+    for root in set(host[host >= 0].tolist()):
+        members = [found[k] for k in (root, *np.flatnonzero(host == root))]
+        keep, t_b = max(members, key=lambda it: run.stat[it.gap]), t_one[int(np.flatnonzero(host == root)[-1])]
+        drop |= {it.gap for it in members if it is not keep}
+        span = [min(t_b, *(span_of[it.gap][0] for it in members)), max(span_of[it.gap][1] for it in members)]
+        span_of[keep.gap][:] = span
+        timed[keep.gap] = Candidate(keep.gap, t_b, True, span[0])
+    return [timed.get(it.gap, it) for it in kept if it.gap not in drop]
 
 
 def event_fields(

@@ -205,11 +205,12 @@ def one_response_fits(
     g_second: int,
     span_s: float,
     sigma_m: float,
-) -> bool:
+) -> tuple[bool, float]:
     """Do the sets ``lo..hi-1`` of ``a`` follow one burn's response, and at least as well as two steps?
+    (and the one burn's time, s: the least cost over the burn times)
 
-    One burn: ``a_k = c₀ + c₁τ_k + Δa·f(t_k − t_b; S)`` with the least cost over the burn times the
-    first new set of the first step saw (``[t − S, t]``, :func:`burn_grid`); two burns: ``c₀ + c₁τ_k``
+    One burn: ``a_k = c₀ + c₁τ_k + Δa·f(t_k − t_b; S)`` with the least cost over the burn times from
+    the span of the first step's first new set to the second step's first new set; two burns: ``c₀ + c₁τ_k``
     plus a step after each of the gaps ``g_first`` and ``g_second``. Both have four free parameters;
     one burn needs the smaller sum of squares (ties: one burn) and a fit within the sets' noise:
     ``Σ (r/σ)²`` under the 0.99 quantile of χ² with ``n − 4`` degrees of freedom, ``σ`` the larger of
@@ -223,13 +224,16 @@ def one_response_fits(
     y = a_m[lo:hi]
     coef, *_ = np.linalg.lstsq(two, y, rcond=None)
     cost_two = float(np.sum((y - two @ coef) ** 2))
-    cost_one = float(np.min(ramp_profile(t_s, a_m, lo, hi, burn_grid(t_s, g_first + 1, span_s), span_s, 1.0)))
+    # the one burn: from the span of the first step's first new set to the second step's first new set
+    grid = np.linspace(float(t_s[g_first + 1]) - span_s, float(t_s[g_second + 1]), GRID_POINTS)
+    profile = ramp_profile(t_s, a_m, lo, hi, grid, span_s, 1.0)
+    cost_one, t_one = float(np.min(profile)), float(grid[int(np.argmin(profile))])
     # the sets' own scatter in the window (differences of neighbours, robust to the steps between)
     sigma = max(sigma_m, float(robust_scale(np.diff(y))) / math.sqrt(2.0))
     if not sigma > 0.0:  # a constant window: no scatter to judge one response against two steps
-        return False
+        return False, t_one
     fits = cost_one / sigma**2 <= float(stats.chi2.ppf(ONE_RESPONSE_LEVEL, hi - lo - 4))
-    return fits and cost_one <= cost_two
+    return fits and cost_one <= cost_two, t_one
 
 
 def response_hosts(
@@ -241,6 +245,7 @@ def response_hosts(
     span_s: NDArray[np.float64],
     sigma_m: NDArray[np.float64],
     window_sets: int,
+    times_s: dict[int, float] | None = None,
 ) -> NDArray[np.int64]:
     """Which detected steps are the tail of an earlier burn's response (index of that burn's step, or −1).
 
@@ -254,6 +259,7 @@ def response_hosts(
     ``window_sets`` before the first step to ``window_sets`` after the second (not past a neighbouring
     step) follow one burn's response at least as well as two steps (:func:`one_response_fits`).
     Chains follow the first burn. Eras whose sets do not blend (``S = 0``) never join steps.
+    ``times_s`` (when given) receives, per joined step, the one burn's time fitted through its window.
     """
     n = gaps.size
     host = np.full(n, -1, dtype=np.int64)
@@ -266,8 +272,13 @@ def response_hosts(
             continue
         lo = max(int(gaps[root - 1]) + 1 if root > 0 else 0, g0 + 1 - window_sets)
         hi = min(int(gaps[k + 1]) + 1 if k + 1 < n else t_s.size, g1 + 1 + window_sets)
-        if hi - lo >= 6 and one_response_fits(t_s, a_m, lo, hi, g0, g1, s, float(sigma_m[root])):
+        if hi - lo < 6:
+            continue
+        fits, t_one = one_response_fits(t_s, a_m, lo, hi, g0, g1, s, float(sigma_m[root]))
+        if fits:
             host[k] = root
+            if times_s is not None:
+                times_s[k] = t_one
     return host
 
 
