@@ -40,7 +40,7 @@ def test_fitted_sets_carry_the_stated_fraction_of_a_burn(jason_like: object, dri
         jason_like, epochs, SPAN_DAYS * DAY_S, [(BURN_DAY * DAY_S, 0.05)], drift=drift, seed=4
     )
     change = a_burn - a_none
-    assert change[-1] == pytest.approx(107.3, rel=0.02)  # 2aΔv/v, Vallado 2013 Eq. 6-5 (Gauss)
+    assert change[-1] == pytest.approx(107.3, rel=0.02)  # Δa = 2aΔv/v (vis-viva, circular orbit)
     fraction = change / change[-1]
     expected = formula(RHO * SPAN_DAYS * DAY_S, SPAN_DAYS * DAY_S)  # type: ignore[operator]
     np.testing.assert_allclose(fraction, expected, atol=0.03)

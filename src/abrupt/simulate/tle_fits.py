@@ -1,7 +1,7 @@
 """Element sets fitted to simulated tracking of an orbit with a known burn: an independent truth for
 how a set responds to a burn inside its fit span.
 
-The orbit is integrated numerically (two-body plus J2, Vallado 2013 Eq. 8-30; DOP853) from the
+The orbit is integrated numerically (two-body plus the J2 zonal term; DOP853) from the
 osculating state an SGP4 record gives at the start, and an in-track impulse ``Δv`` is added to the
 velocity at the burn time. Positions are sampled at a fixed cadence with Gaussian noise (the tracking).
 Each element set is then a **least-squares fit of SGP4 mean elements** (WGS-72; mean motion,
@@ -36,7 +36,7 @@ MINUTES = 60.0
 
 
 def j2_acceleration(r_m: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Two-body plus J2 acceleration (m/s²) at position ``r_m`` (Vallado 2013 Eq. 8-30)."""
+    """Two-body plus J2 acceleration (m/s²) at position ``r_m``: ``−∇V``, ``V = −μ/r + μJ2R²P₂(z/r)/r³``."""
     x, y, z = r_m
     r2 = float(x * x + y * y + z * z)
     r = math.sqrt(r2)
