@@ -84,6 +84,7 @@ from abrupt.detect.tle.response import (
     burn_grid,
     interval_cost,
     local_spans_s,
+    ramp_delta_a_m,
     ramp_profile,
     ramp_span_s,
     response_hosts,
@@ -146,6 +147,8 @@ class StepRun:
     blends: dict[int, tuple[int, int]] = field(default_factory=dict)
     # the fit span (s) of the era of each in-track candidate's sets (time_candidates; 0: sharp)
     era_span_s: dict[int, float] = field(default_factory=dict)
+    # the whole change of ``a`` (m) of each detection timed from its blended sets (the response's fit)
+    ramp_delta_a: dict[int, float] = field(default_factory=dict)
 
 
 def detect_mean_elements(
@@ -286,7 +289,8 @@ def time_candidates(run: StepRun, candidates: NDArray[np.int64], all_candidates:
     LEO in-track burns are timed by the hinge of the along-track angle as the sets respond to it
     (:func:`refine_burn_time`) at the fit span of their era: each candidate's best span (sharp hinge
     or 1-8 days, :data:`SPAN_DAYS`) is found first, and the era's span is the median of those within
-    ``RAMP_ERA_DAYS`` (at least three; else a sharp hinge), so one noisy fit does not choose its own.
+    ``RAMP_ERA_DAYS`` (at least three; else the nearest three of the history, else a sharp hinge), so one
+    noisy fit does not choose its own.
     """
     cfg, steps, model, history = run.cfg, run.steps, run.model, run.history
     leo = run.regime == "leo"
@@ -328,7 +332,7 @@ def time_candidates(run: StepRun, candidates: NDArray[np.int64], all_candidates:
     timed: list[Candidate] = []
     for g, seg, ok in plan:
         if ok:
-            era_d = local_spans_s(float(model.t[g]), at_s, span_d, RAMP_ERA_DAYS * SECONDS_PER_DAY)[0]
+            era_d = local_spans_s(float(model.t[g]), at_s, span_d, RAMP_ERA_DAYS * SECONDS_PER_DAY, nearest=True)[0]
             run.era_span_s[g] = (era_d if math.isfinite(era_d) else 0.0) * SECONDS_PER_DAY
             t_m, refined, _ = hinge(g, seg, (run.era_span_s[g] / SECONDS_PER_DAY,))
         else:
@@ -395,6 +399,8 @@ def ramp_times(run: StepRun, timed: list[Candidate]) -> list[Candidate]:
             grid = burn_grid(model.t, last_old + 1, span)
             profiles[g].append((grid, ramp_profile(model.t, a, lo, hi, grid, span, noise)))
         dofs[g] = hi - lo - 3
+        t_best = float(profiles[g][0][0][int(np.argmin(profiles[g][0][1]))])
+        run.ramp_delta_a[g] = ramp_delta_a_m(model.t, a, lo, hi, t_best, spans[0])
     if not profiles:
         return timed
     rise = interval_cost([float(np.min(p[0][1])) / max(dofs[g], 1) for g, p in profiles.items()], RAMP_LEVEL)
@@ -591,13 +597,14 @@ def merge_candidates(run: StepRun, timed: list[Candidate]) -> tuple[list[Candida
 
 
 def join_response_tails(run: StepRun, kept: list[Candidate], span_of: dict[int, list[float]]) -> list[Candidate]:
-    """One event per burn whose response spreads over sets fitted across it: a later detected step of
-    the same sign whose last old set still holds the burn in its era's fit span is the rest of that
-    response (:func:`abrupt.detect.tle.response.response_hosts`); it is dropped and the burn's interval
-    reaches to its first new set. The span is the era's along-track fit span (``run.era_span_s``)."""
+    """One event per burn whose response spreads over sets fitted across it: a detected step of the same
+    sign while the sets still respond to an earlier one is the rest of that response
+    (:func:`abrupt.detect.tle.response.response_hosts`). The strongest step of the burn is its event,
+    timed by the one response fitted through the window, over the union of the members' intervals."""
     found = [it for it in kept if run.stat[it.gap] >= run.threshold]
     if len(found) < 2:
         return kept
+    t_one: dict[int, float] = {}
     host = response_hosts(
         run.model.t,
         np.asarray(run.model.s["a_m"], dtype=float),
@@ -607,12 +614,17 @@ def join_response_tails(run: StepRun, kept: list[Candidate], span_of: dict[int, 
         np.array([run.era_span_s.get(it.gap, 0.0) for it in found]),
         np.array([float(run.model.scales["a_m"][it.gap]) for it in found]),
         run.cfg.time_window_sets,
+        t_one,
     )
-    tails = {found[k].gap for k in np.flatnonzero(host >= 0)}
-    for k in np.flatnonzero(host >= 0):
-        root, tail = span_of[found[int(host[k])].gap], span_of[found[int(k)].gap]
-        root[0], root[1] = min(root[0], tail[0]), max(root[1], tail[1])
-    return [it for it in kept if it.gap not in tails]
+    drop, timed = set(), {}
+    for root in set(host[host >= 0].tolist()):
+        members = [found[k] for k in (root, *np.flatnonzero(host == root))]
+        keep, t_b = max(members, key=lambda it: run.stat[it.gap]), t_one[int(np.flatnonzero(host == root)[-1])]
+        drop |= {it.gap for it in members if it is not keep}
+        span = [min(t_b, *(span_of[it.gap][0] for it in members)), max(span_of[it.gap][1] for it in members)]
+        span_of[keep.gap][:] = span
+        timed[keep.gap] = Candidate(keep.gap, t_b, True, span[0])
+    return [timed.get(it.gap, it) for it in kept if it.gap not in drop]
 
 
 def event_fields(
@@ -639,7 +651,8 @@ def event_fields(
         a_ref = float(el["a_m"].iloc[g])
         w = steps.weights
         wz = (w[0] * float(steps.z_a[g]), w[1] * float(steps.z_e[g]), w[2] * float(steps.z_n[g]))
-        ch = characterise(float(steps.delta_a_m[g]), steps.delta_e[g], steps.delta_normal_rad[g], a_ref, wz)
+        delta_a = run.ramp_delta_a.get(g, float(steps.delta_a_m[g]))  # blended: the response's whole change
+        ch = characterise(delta_a, steps.delta_e[g], steps.delta_normal_rad[g], a_ref, wz)
         v = circular_speed_mps(a_ref)
         kind = str(ch["maneuver_type"])
         if is_phasing(steps, g):
@@ -652,7 +665,7 @@ def event_fields(
             "z_a": float(steps.z_a[g]),
             "z_e": float(steps.z_e[g]),
             "z_n": float(steps.z_n[g]),
-            "delta_a_m": float(steps.delta_a_m[g]),
+            "delta_a_m": delta_a,
             "elset_epoch_before_utc": str(el["epoch_utc"].iloc[g]),
             "elset_epoch_after_utc": str(el["epoch_utc"].iloc[g + 1]),
             "time_method": "along-track continuity" if refined else "gap middle",

@@ -168,12 +168,21 @@ def ramp_span_s(t_s: NDArray[np.float64], a_m: NDArray[np.float64], ramp: tuple[
 
 
 def local_spans_s(
-    at_s: float, ramp_times_s: NDArray[np.float64], ramp_spans_s: NDArray[np.float64], reach_s: float, minimum: int = 3
+    at_s: float,
+    ramp_times_s: NDArray[np.float64],
+    ramp_spans_s: NDArray[np.float64],
+    reach_s: float,
+    minimum: int = 3,
+    nearest: bool = False,
 ) -> tuple[float, float, float]:
     """The fit span (s) of the era around ``at_s`` and its spread: the median, smallest and largest span
     of the ramps within ``reach_s`` (NaNs with fewer than ``minimum``: the era's sets do not blend, or
-    too few burns show it)."""
+    too few burns show it; with ``nearest`` the ``minimum`` ramps nearest in time instead, when the
+    history has that many)."""
     near = np.abs(ramp_times_s - at_s) <= reach_s
+    if int(near.sum()) < minimum and nearest and ramp_times_s.size >= minimum:
+        near = np.zeros(ramp_times_s.size, dtype=bool)
+        near[np.argsort(np.abs(ramp_times_s - at_s), kind="stable")[:minimum]] = True
     if int(near.sum()) < minimum:
         return math.nan, math.nan, math.nan
     spans = ramp_spans_s[near]
@@ -196,11 +205,12 @@ def one_response_fits(
     g_second: int,
     span_s: float,
     sigma_m: float,
-) -> bool:
+) -> tuple[bool, float]:
     """Do the sets ``lo..hi-1`` of ``a`` follow one burn's response, and at least as well as two steps?
+    (and the one burn's time, s: the least cost over the burn times)
 
-    One burn: ``a_k = c₀ + c₁τ_k + Δa·f(t_k − t_b; S)`` with the least cost over the burn times the
-    first new set of the first step saw (``[t − S, t]``, :func:`burn_grid`); two burns: ``c₀ + c₁τ_k``
+    One burn: ``a_k = c₀ + c₁τ_k + Δa·f(t_k − t_b; S)`` with the least cost over the burn times from
+    the span of the first step's first new set to the second step's first new set; two burns: ``c₀ + c₁τ_k``
     plus a step after each of the gaps ``g_first`` and ``g_second``. Both have four free parameters;
     one burn needs the smaller sum of squares (ties: one burn) and a fit within the sets' noise:
     ``Σ (r/σ)²`` under the 0.99 quantile of χ² with ``n − 4`` degrees of freedom, ``σ`` the larger of
@@ -214,13 +224,16 @@ def one_response_fits(
     y = a_m[lo:hi]
     coef, *_ = np.linalg.lstsq(two, y, rcond=None)
     cost_two = float(np.sum((y - two @ coef) ** 2))
-    cost_one = float(np.min(ramp_profile(t_s, a_m, lo, hi, burn_grid(t_s, g_first + 1, span_s), span_s, 1.0)))
+    # the one burn: from the span of the first step's first new set to the second step's first new set
+    grid = np.linspace(float(t_s[g_first + 1]) - span_s, float(t_s[g_second + 1]), GRID_POINTS)
+    profile = ramp_profile(t_s, a_m, lo, hi, grid, span_s, 1.0)
+    cost_one, t_one = float(np.min(profile)), float(grid[int(np.argmin(profile))])
     # the sets' own scatter in the window (differences of neighbours, robust to the steps between)
     sigma = max(sigma_m, float(robust_scale(np.diff(y))) / math.sqrt(2.0))
     if not sigma > 0.0:  # a constant window: no scatter to judge one response against two steps
-        return False
+        return False, t_one
     fits = cost_one / sigma**2 <= float(stats.chi2.ppf(ONE_RESPONSE_LEVEL, hi - lo - 4))
-    return fits and cost_one <= cost_two
+    return fits and cost_one <= cost_two, t_one
 
 
 def response_hosts(
@@ -232,6 +245,7 @@ def response_hosts(
     span_s: NDArray[np.float64],
     sigma_m: NDArray[np.float64],
     window_sets: int,
+    times_s: dict[int, float] | None = None,
 ) -> NDArray[np.int64]:
     """Which detected steps are the tail of an earlier burn's response (index of that burn's step, or −1).
 
@@ -245,6 +259,7 @@ def response_hosts(
     ``window_sets`` before the first step to ``window_sets`` after the second (not past a neighbouring
     step) follow one burn's response at least as well as two steps (:func:`one_response_fits`).
     Chains follow the first burn. Eras whose sets do not blend (``S = 0``) never join steps.
+    ``times_s`` (when given) receives, per joined step, the one burn's time fitted through its window.
     """
     n = gaps.size
     host = np.full(n, -1, dtype=np.int64)
@@ -257,6 +272,35 @@ def response_hosts(
             continue
         lo = max(int(gaps[root - 1]) + 1 if root > 0 else 0, g0 + 1 - window_sets)
         hi = min(int(gaps[k + 1]) + 1 if k + 1 < n else t_s.size, g1 + 1 + window_sets)
-        if hi - lo >= 6 and one_response_fits(t_s, a_m, lo, hi, g0, g1, s, float(sigma_m[root])):
+        if hi - lo < 6:
+            continue
+        fits, t_one = one_response_fits(t_s, a_m, lo, hi, g0, g1, s, float(sigma_m[root]))
+        if fits:
             host[k] = root
+            if times_s is not None:
+                times_s[k] = t_one
     return host
+
+
+def span_fraction_with_drift(x_s: NDArray[np.float64], span_s: float) -> NDArray[np.float64]:
+    """The same fraction when each set's fit also solves for a quadratic along-track drift (a drag term,
+    B*): the slope at the epoch of a least-squares parabola through the hinge over the span,
+    ``3ρ² − 2ρ³ + 15ρ²(1 − ρ)²`` (shifted Legendre projection: slope ``2c₁ + 6c₂`` at the span's end,
+    ``c₁ = 3ρ²/2 − ρ³``, ``c₂ = 5ρ²(1 − ρ)²/2``). It overshoots, up to 1.51 of the change at ``ρ = 0.6``.
+    The shared histories' ramps follow :func:`span_fraction` (``benchmarks/bench_tle_response_truth.py``);
+    this one is the alternative they were tested against."""
+    rho = np.clip(np.asarray(x_s, dtype=float) / span_s, 0.0, 1.0)
+    return np.asarray(rho * rho * (3.0 - 2.0 * rho) + 15.0 * rho * rho * (1.0 - rho) ** 2, dtype=float)
+
+
+def ramp_delta_a_m(
+    t_s: NDArray[np.float64], a_m: NDArray[np.float64], lo: int, hi: int, burn_s: float, span_s: float
+) -> float:
+    """The burn's whole change of ``a`` (m): ``Δa`` of ``a_k = c₀ + c₁τ_k + Δa·f(t_k − t_b; S)`` fitted
+    through sets ``lo..hi-1`` at the burn time ``burn_s`` (:func:`ramp_profile`). A step between two
+    sets misses what the blends before and after it carry."""
+    t = t_s[lo:hi]
+    tau = (t - t[0]) / SECONDS_PER_DAY
+    design = np.column_stack([np.ones_like(tau), tau, span_fraction(t - burn_s, span_s)])
+    coef, *_ = np.linalg.lstsq(design, a_m[lo:hi], rcond=None)
+    return float(coef[2])
