@@ -11,24 +11,14 @@ Method (each step cites its source; the combination is abrupt's own):
 2. **Two-sided robust step test at every gap** between consecutive element sets. On ``W`` sets
    before and ``W`` after the gap, a common local slope (median of the two sides' Theil-Sen slopes,
    Sen 1968) absorbs drag decay, J2/J3 eccentricity motion and luni-solar inclination drift; the step
-   is the difference of the two sides' medians of the detrended values. In low LEO, where drag
-   changes with solar and geomagnetic activity faster than a straight line over the window follows,
-   ``a`` is first freed of the decay the element sets themselves state (``drag_trend="ndot"``: each
-   set's ndot, the fitted mean-motion rate, as ``ȧ = −(2/3)·a·ṅ/n``, running median over five sets,
-   integrated across the gaps; Hoots & Roehrich 1980, Vallado 2013 §9.6; :func:`drag_trend_m`). It is
-   used only where ``a`` decays at least ``drag_min_decay_m_day`` and the stated decay agrees with
-   it within a factor of two: above ~700 km the ndot field is fit noise and bias. It is divided by the local
-   noise of the element (1.4826·MAD of first differences, Hampel 1974, in a ±``noise_half_window``
-   rolling window, divided by √2) times the standard error factor of a median,
-   ``sqrt(π/2)·sqrt(1/n₁ + 1/n₂)``, to give a z-score per element group:
-   ``z_a`` (in-track), ``z_e`` (|Δe-vector|, radial/in-track) and ``z_n`` (|Δ orbit normal|,
-   cross-track).
+   is the difference of the two sides' medians of the detrended values. In low LEO ``a`` is first
+   freed of the decay the element sets themselves state (``drag_trend="ndot"``, :func:`drag_trend_m`).
+   It is divided by the local noise of the element (1.4826·MAD of first differences, Hampel 1974, in
+   a rolling window, divided by √2) times the standard error of a median, ``sqrt(π/2)·sqrt(1/n₁ +
+   1/n₂)``: ``z_a`` (in-track), ``z_e`` (|Δe-vector|) and ``z_n`` (|Δ orbit normal|, cross-track).
 
-3. **Combined statistic** ``S = sqrt(z_a² + z_e² + z_n²)``; under the null hypothesis with Gaussian
-   noise S would be χ with 5 degrees of freedom; TLE noise is heavier-tailed, so the threshold comes
-   from a fit of S on the history itself with the maneuver footprints removed
-   (:func:`abrupt.thresholds.fit_threshold`, generalised Pareto tail) for a budget stated in false
-   alarms per satellite-year.
+3. **Combined statistic and threshold**: as the package docstring states (:mod:`abrupt.detect.tle`,
+   item 3-4), from the history's own null for a budget in false alarms per satellite-year.
 
 4. **Peaks and time.** Local maxima of S (``±peak_half_width`` gaps) above threshold are events. The
    burn time is refined by position continuity along the track: the mean argument of latitude
