@@ -15,7 +15,8 @@ with b_j the nuisance (a quadratic in time, ``HARMONICS`` cosines and sines of t
 al. 2025 Eq. 1, and a free step at every gap: a masked dump or slew moves momentum) and r(t) =
 clip((t − t₀)/D, 0, 1) the leak's profile, so A = ΔH_B [N·m·s] is the body-axis total and A/D the torque
 (the body turns under a body-fixed torque: G carries [NB(t)]). Onset t₀ and duration D are searched on
-a grid around the scan's finding, and the grid's best is refined between its neighbouring durations.
+a grid around the scan's finding; the kept model is then refined between the grid's neighbouring durations
+(the likelihood ratio stays the grid's).
 
 **Against its alternatives.** The same nuisance with one, two or three steps of ᴺH (strikes, dump
 pulses, a venting sequence) at any bin, a step of a body-fixed offset ([NB(t)] b_B from tₛ on: a gyro bias
@@ -229,7 +230,7 @@ def _search_ramp(
     win: _Window, y: FloatArray, x: FloatArray | None, on: float, end: float
 ) -> tuple[float, float, float, FloatArray, FloatArray]:
     """(RSS, onset [s], duration [s], A, normal matrix) of the best ramp on the grid near [on, end), with the
-    step columns ``x`` (or none) fitted beside it; the grid's best is then refined (:func:`_refine_ramp`)."""
+    step columns ``x`` (or none) fitted beside it."""
     yx = y if x is None else _less(x, y)
     best = (math.inf, 0.0, 0.0, np.zeros(3), np.eye(3))
     for dur in DURATIONS_S:
@@ -237,7 +238,7 @@ def _search_ramp(
             continue
         for t0 in np.arange(on - ONSET_REACH_S, on + ONSET_REACH_S + 1.0, BIN_S):
             best = _try_ramp(win, yx, x, float(t0), float(dur), best)
-    return _refine_ramp(win, yx, x, best) if math.isfinite(best[0]) else best
+    return best
 
 
 def _try_ramp(
@@ -330,8 +331,12 @@ def joint_leak_fit(
     alone = 0.5 * (min(min(rss1, rss_body) / s2 - pen, rss2 / s2 + 3 * pen, rss3 / s2 + 7 * pen) - rss_ramp / s2)
     with_step = 0.5 * (min(min(rss2, rss_body2) / s2 - pen, rss3 / s2 + 3 * pen) - both[0] / s2)
     log_lr = max(alone, with_step)
+    # The likelihood ratio is that of the grid (its acceptance level was set there); the kept model's onset,
+    # duration and total are then refined between the grid durations.
     if with_step > alone:
-        _, t0, dur, a, mat = both
+        _, t0, dur, a, mat = _refine_ramp(win, _less(cols[:, j], y), cols[:, j], both)
+    else:
+        _, t0, dur, a, mat = _refine_ramp(win, y, None, (rss_ramp, t0, dur, a, mat))
     try:
         cov = np.linalg.inv(mat) * s2
     except np.linalg.LinAlgError:
