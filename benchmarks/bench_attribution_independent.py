@@ -302,6 +302,12 @@ def report(rows: list[dict], left: pd.DataFrame, days: float) -> None:
         f"within 10 min of a flagged dump, slew or gap; {int((left['near'] == 'truth').sum())} second events "
         "in a truth event's window"
     )
+    for det, group in left.groupby("detector"):
+        n_free = int((group["near"] == "none").sum())
+        print(
+            f"  {det}: {n_free} at no truth = {n_free / days:.3f} a day realised, stated {_stated(group)} a day "
+            "per channel"
+        )
     for _, ev in free.iterrows():
         print(
             f"  {ev['spacecraft']} {ev['time_utc']} {ev['kind']} {ev.get('kind_channel', '')} {ev['dH_Nms']:.4f} N·m·s "

@@ -91,8 +91,8 @@ def test_a_body_fixed_torque_on_a_turning_body_is_one_leak_with_its_torque_and_t
 
 
 def test_white_noise_days_raise_leaks_at_no_more_than_the_stated_rate() -> None:
-    """Ten half-days of white noise on a turning body: expected 0.1/day × 5 days = 0.5 at most (the
-    threshold's floor keeps it lower); more than 4 would be a Poisson tail of 2e-4."""
+    """Ten half-days of white noise on a turning body: expected 0.05/day × 5 days = 0.25 at most (the
+    threshold's floor keeps it lower); more than 4 would be a Poisson tail of 1e-5."""
     n = 43_200
     q = _turning(n)
     found = 0

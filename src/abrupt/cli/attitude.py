@@ -47,6 +47,11 @@ else:
     np = lazy_module("numpy")
     pd = lazy_module("pandas")
 
+#: The default budget of the flight pipeline (``--store``): its step detector's stated rate
+#: (``FlightGlrDetector.STATED_RATE``), so that with the leak scan's it states at most one event at no
+#: change in five days.
+STORE_BUDGET = "0.1/day"
+
 
 def _spacecraft(path: str | None) -> Any:
     return pipelines_attitude.load_spacecraft(path)
@@ -201,7 +206,7 @@ detector_options = [
         help="Detector(s) by registered name (`abrupt detectors`); glr, cusum, summation, shiryaev, mf_attitude, "
         "mf_rate, mf_joint or a plug-in's full name; repeatable; 'all' runs every attitude.* detector.",
     ),
-    budget_options("1/day"),
+    budget_options("1/day; 0.1/day with --store"),
     click.option(
         "--pre",
         type=click.IntRange(min=2),
@@ -392,7 +397,7 @@ def detect_attitude_cmd(
     exposure = {"recovery": exposure_recovery, "dh90": exposure_dh90, "surfaces": exposure_surfaces}
     orbit = (orbit_events, orbit_floor_mps, orbit_spans, orbit_edge_s, orbit_run)
     if store_dir is not None:  # flight-telemetry pipeline (abrupt.pipelines.flight)
-        budget = pop_budget(settings, "1/day")
+        budget = pop_budget(settings, STORE_BUDGET)
         detect_from_store(
             store_dir, spacecraft_path, days, budget, no_clean, catalog_target, out, report_path, exposure=exposure,
             orbit=orbit,
@@ -466,7 +471,7 @@ def report_attitude_cmd(
 ) -> None:
     """Draw the attitude report: momentum, contributions, raw channels, statistics, thresholds, events."""
     if store_dir is not None:  # flight pipeline: cleaning stages before/after and daily statistics
-        budget = pop_budget(settings, "1/day")
+        budget = pop_budget(settings, STORE_BUDGET)
         detect_from_store(store_dir, spacecraft_path, days, budget, no_clean, None, None, out)
         return
     if telemetry is None:

@@ -208,7 +208,7 @@ class FlightRunConfig:
 
     window_s: float = 300.0
     guard_s: float = 20.0
-    budget: FalseAlarmBudget = field(default_factory=lambda: FalseAlarmBudget(1.0, "day"))
+    budget: FalseAlarmBudget = FlightGlrDetector.STATED_RATE
     block_s: float = 600.0
     chunk_s: float = 3 * 86_400.0
     cleaning: CleaningConfig = field(default_factory=CleaningConfig)

@@ -19,6 +19,7 @@ and total.
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -26,13 +27,12 @@ import numpy as np
 
 from abrupt.clean.comb import CombConfig, smooth_model
 from abrupt.detect.attitude.flight_glr import FlightGlrDetector
-from abrupt.detect.attitude.leak_fit import accepted, joint_leak_fit
+from abrupt.detect.attitude.leak_fit import HALF_WIDTH_ORBITS, ONSET_REACH_S, accepted, joint_leak_fit
 from abrupt.detect.attitude.leak_scan import (
     LeakFinding,
     LeakScan,
     filled_quaternions,
     leak_momentum_N,
-    one_per_interval,
     scan_leaks,
 )
 from abrupt.series.timetable import NS
@@ -78,18 +78,28 @@ def joint_leaks(
     step_ns: np.ndarray,
 ) -> LeakScan:
     """The candidates the joint fit on the uncleaned ᴺH keeps, with its onset, duration, torque and totals
-    (module docstring); the scan's statistic, threshold and rate stay."""
+    (module docstring); the scan's statistic, threshold and rate stay. Fit, remove, fit again: the candidates
+    are fitted strongest first, each on ᴺH less the leaks already kept within its window's reach (the tail
+    of a leak is not a second leak)."""
     q = filled_quaternions(q_BN)
+    reach_ns = int((HALF_WIDTH_ORBITS * period_s + ONSET_REACH_S) * NS)
+    fits = [joint_leak_fit(t_ns, h_n, ok, q, period_s, f.onset_ns, f.end_ns, step_ns) for f in candidates.findings]
+    first = list(zip(candidates.findings, fits, strict=True))
+    first.sort(key=lambda p: -p[1].log_lr if p[1] is not None else math.inf)
     kept: list[LeakFinding] = []
-    for f in candidates.findings:
-        fit = joint_leak_fit(t_ns, h_n, ok, q, period_s, f.onset_ns, f.end_ns, step_ns)
+    for f, fit in first:
+        near = [g for g in kept if g.onset_ns - reach_ns < f.end_ns and f.onset_ns < g.end_ns + reach_ns]
+        if near and fit is not None:
+            fit = joint_leak_fit(t_ns, h_n - leak_momentum_N(t_ns, q, near), ok, q, period_s, f.onset_ns, f.end_ns,
+                                 step_ns)  # fmt: skip
         if fit is None or not accepted(fit):
             continue
         end = fit.onset_ns + int(fit.duration_s * NS)
         a = np.asarray(fit.dH_B_Nms, dtype=np.float64)
-        kept.append(replace(f, onset_ns=fit.onset_ns, end_ns=end, torque_B_Nm=a / fit.duration_s, dH_B_Nms=a,
-                            log_lr=fit.log_lr))  # fmt: skip
-    leaks = one_per_interval(kept)
+        g = replace(f, onset_ns=fit.onset_ns, end_ns=end, torque_B_Nm=a / fit.duration_s, dH_B_Nms=a, log_lr=fit.log_lr)
+        if all(g.end_ns <= k.onset_ns or g.onset_ns >= k.end_ns for k in kept):
+            kept.append(g)
+    leaks = sorted(kept, key=lambda f: f.onset_ns)
     return LeakScan([replace(f, dH_N_Nms=leak_momentum_N(t_ns, q, [f])[-1]) for f in leaks], candidates.calibrations)
 
 

@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Set
 from dataclasses import dataclass, replace
+from typing import ClassVar
 
 import numpy as np
 import pandas as pd
@@ -192,6 +193,9 @@ class FlightGlrDetector(Detector[CleanedMomentum]):
     """
 
     name = "attitude.flight_glr"
+    #: The flight pipeline's stated false-alarm rate of this detector by default: with the leak scan's
+    #: (:data:`~abrupt.detect.attitude.leak_scan.LEAK_FALSE_ALARMS`) 0.15 events a day at no change in all.
+    STATED_RATE: ClassVar[FalseAlarmBudget] = FalseAlarmBudget(0.1, "day")
     series_type = CleanedMomentum
     kind = "strike"
     summary = "step GLR on cleaned flight momentum, threshold from its own block maxima (flight pipeline)"

@@ -15,10 +15,13 @@ with b_j the nuisance (a quadratic in time, ``HARMONICS`` cosines and sines of t
 al. 2025 Eq. 1, and a free step at every gap: a masked dump or slew moves momentum) and r(t) =
 clip((t − t₀)/D, 0, 1) the leak's profile, so A = ΔH_B [N·m·s] is the body-axis total and A/D the torque
 (the body turns under a body-fixed torque: G carries [NB(t)]). Onset t₀ and duration D are searched on
-a grid around the scan's finding.
+a grid around the scan's finding; the kept model is then refined between the grid's neighbouring durations
+(the likelihood ratio stays the grid's).
 
 **Against its alternatives.** The same nuisance with one, two or three steps of ᴺH (strikes, dump
-pulses, a venting sequence) at any bin, and the ramp with one such step beside it, are fitted too; the
+pulses, a venting sequence) at any bin, a step of a body-fixed offset ([NB(t)] b_B from tₛ on: a gyro bias
+step times the inertia, which turns with the body as a torque's integral does), alone or beside one step
+of ᴺH, and the ramp with one step of ᴺH beside it, are fitted too; the
 ramp is kept when its log likelihood ratio over the best step model, with each model's parameters
 beyond the ramp's charged ln n (BIC), is at least ``MIN_JOINT_LOG_LR``. The noise variance of a bin is
 the ramp model's own residual variance (red noise that survives the binning raises it, so the ratio is
@@ -49,6 +52,10 @@ HALF_WIDTH_ORBITS = 0.5
 ONSET_REACH_S = 300.0
 #: The durations [s] tried.
 DURATIONS_S = (90.0, 120.0, 180.0, 240.0, 300.0, 420.0, 600.0, 900.0, 1200.0, 1500.0, 1800.0, 2400.0)
+#: Duration step [s] of the refinement between the grid durations.
+REFINE_DURATION_S = 20.0
+#: Onset reach [s] of the refinement about the grid ramp's middle less half the duration.
+REFINE_ONSET_S = 60.0
 #: The ramp must beat the step models by this log likelihood ratio (after the BIC charges).
 MIN_JOINT_LOG_LR = 10.0
 #: The total |ΔH_B| must be this many standard errors.
@@ -81,6 +88,7 @@ class _Window:
     q: FloatArray  # (m, p) orthonormal basis of the weighted nuisance
     nb_cum: FloatArray  # (m, 3, 3): ∫ [NB] dt from the window's start to each bin's mean time
     p: int
+    nb: FloatArray  # (m, 3, 3): the bin's mean [NB]
 
 
 def _bins(
@@ -125,6 +133,7 @@ def _window(
     frac = np.clip((tm[use] - edges[:-1][use]) / BIN_S, 0.0, 1.0)[:, None, None]
     idx = np.flatnonzero(use)
     nb_at = nb_edges[idx] + frac * (nb_edges[idx + 1] - nb_edges[idx])
+    nb_mean = (nb_edges[idx + 1] - nb_edges[idx]) / np.maximum(np.diff(edges)[idx], 1e-9)[:, None, None]
     t = tm[use]
     w = np.sqrt(cnt[use])
     c = 0.5 * (t[0] + t[-1])
@@ -138,7 +147,7 @@ def _window(
     qm = qm[:, keep]
     yw = mean[use] * w[:, None]
     y_perp = yw - qm @ (qm.T @ yw)
-    return _Window(t, w, y_perp, qm, nb_at, qm.shape[1])
+    return _Window(t, w, y_perp, qm, nb_at, qm.shape[1], nb_mean)
 
 
 def _ramp_cols(win: _Window, t0: float, dur: float) -> FloatArray:
@@ -228,12 +237,52 @@ def _search_ramp(
         if dur > 2.0 * max(end - on, 60.0) + 2 * ONSET_REACH_S:
             continue
         for t0 in np.arange(on - ONSET_REACH_S, on + ONSET_REACH_S + 1.0, BIN_S):
-            if t0 < win.t[0] + 60.0 or t0 + dur > win.t[-1] - 60.0:
-                continue
-            g = _ramp_cols(win, t0, dur)
-            a, rss, m = _ramp_fit(yx, g if x is None else _less(x, g))
-            if rss < best[0]:
-                best = (rss, float(t0), float(dur), a, m)
+            best = _try_ramp(win, yx, x, float(t0), float(dur), best)
+    return best
+
+
+def _try_ramp(
+    win: _Window,
+    yx: FloatArray,
+    x: FloatArray | None,
+    t0: float,
+    dur: float,
+    best: tuple[float, float, float, FloatArray, FloatArray],
+) -> tuple[float, float, float, FloatArray, FloatArray]:
+    """The better of ``best`` and the ramp (t₀, D) (skipped within 60 s of the window's ends)."""
+    if t0 < win.t[0] + 60.0 or t0 + dur > win.t[-1] - 60.0:
+        return best
+    g = _ramp_cols(win, t0, dur)
+    a, rss, m = _ramp_fit(yx, g if x is None else _less(x, g))
+    return (rss, t0, dur, a, m) if rss < best[0] else best
+
+
+def _refine_ramp(
+    win: _Window, yx: FloatArray, x: FloatArray | None, best: tuple[float, float, float, FloatArray, FloatArray]
+) -> tuple[float, float, float, FloatArray, FloatArray]:
+    """The grid's best ramp refined: durations between the neighbouring grid durations every
+    ``REFINE_DURATION_S``, each with its onsets within ``REFINE_ONSET_S`` of the grid ramp's middle less half
+    the duration (a 765-s ramp on the 600/900-s grid is otherwise placed up to 70 s early)."""
+    _, t0, dur, _, _ = best
+    grid = np.asarray(DURATIONS_S)
+    lo = float(grid[grid < dur].max()) if (grid < dur).any() else max(dur - 30.0, 60.0)
+    hi = float(grid[grid > dur].min()) if (grid > dur).any() else dur + 300.0
+    mid = t0 + 0.5 * dur
+    for d in np.arange(lo, hi + 1.0, REFINE_DURATION_S):
+        for t in np.arange(mid - 0.5 * d - REFINE_ONSET_S, mid - 0.5 * d + REFINE_ONSET_S + 1.0, BIN_S):
+            best = _try_ramp(win, yx, x, float(t), float(d), best)
+    return best
+
+
+def _best_body_step(win: _Window, y: FloatArray, times: FloatArray) -> float:
+    """RSS of the best step of a body-fixed offset (ᴺH += [NB(t)] b_B 1(t ≥ tₛ): a sensor's bias step, a
+    gyro's by the inertia, that the loop never sees as momentum) at any of ``times``."""
+    best = float(np.sum(y**2))
+    for ts in times:
+        g = win.nb * ((win.t >= ts) * win.w)[:, None, None]
+        flat = g.reshape(g.shape[0], 9)
+        g = (flat - win.q @ (win.q.T @ flat)).reshape(g.shape)
+        best = min(best, _ramp_fit(y, g)[1])
     return best
 
 
@@ -269,6 +318,9 @@ def joint_leak_fit(
     rss1, j = _best_steps(y, cols, 1)
     rss2, _ = _best_steps(y, cols, 2)
     rss3, _ = _best_steps(y, cols, 3)
+    rss_body = _best_body_step(win, y, grid)
+    # a body-fixed offset beside an inertial step (greedy: the best single step first)
+    rss_body2 = _best_body_step(win, _less(cols[:, j], y), grid)
     # The ramp with a step beside it (a strike during the leak), alternated from the best single step.
     for _ in range(2):
         both = _search_ramp(win, y, cols[:, j], on, end)
@@ -276,11 +328,15 @@ def joint_leak_fit(
     both = _search_ramp(win, y, cols[:, j], on, end)
     s2 = min(rss_ramp, both[0]) / max(n_rows - 3 * win.p - 9, 1)
     # BIC: the ramp has 5 parameters (onset, duration, A), k steps 4k, the ramp with a step 9
-    alone = 0.5 * (min(rss1 / s2 - pen, rss2 / s2 + 3 * pen, rss3 / s2 + 7 * pen) - rss_ramp / s2)
-    with_step = 0.5 * (min(rss2 / s2 - pen, rss3 / s2 + 3 * pen) - both[0] / s2)
+    alone = 0.5 * (min(min(rss1, rss_body) / s2 - pen, rss2 / s2 + 3 * pen, rss3 / s2 + 7 * pen) - rss_ramp / s2)
+    with_step = 0.5 * (min(min(rss2, rss_body2) / s2 - pen, rss3 / s2 + 3 * pen) - both[0] / s2)
     log_lr = max(alone, with_step)
+    # The likelihood ratio is that of the grid (its acceptance level was set there); the kept model's onset,
+    # duration and total are then refined between the grid durations.
     if with_step > alone:
-        _, t0, dur, a, mat = both
+        _, t0, dur, a, mat = _refine_ramp(win, _less(cols[:, j], y), cols[:, j], both)
+    else:
+        _, t0, dur, a, mat = _refine_ramp(win, y, None, (rss_ramp, t0, dur, a, mat))
     try:
         cov = np.linalg.inv(mat) * s2
     except np.linalg.LinAlgError:

@@ -50,7 +50,7 @@ from abrupt.thresholds.budget import FalseAlarmBudget
 from abrupt.types import BoolArray, FloatArray
 
 #: The stated false-alarm rate of the scan (all scales together).
-LEAK_FALSE_ALARMS = FalseAlarmBudget(0.1, "day")
+LEAK_FALSE_ALARMS = FalseAlarmBudget(0.05, "day")
 #: The window lengths W [s] of the statistic.
 SCALES_S = (120.0, 300.0, 600.0, 1200.0)
 #: The durations D [s] the ramp fit tries.
