@@ -7,7 +7,13 @@ by component if the order is read right). The argument of latitude ``u`` at each
 (Vallado 2013 §9.3): ``Δi = Δv_W cos u / v`` and ``ΔΩ = Δv_W sin u / (v sin i)``. The per-line and
 campaign sums are printed beside the inclination of the element sets before, during and after.
 
-Run: ``python benchmarks/bench_tle_plane_check.py``.
+``--lines``: every line with cross-track burns on the four shared LEO histories: the operator's plane
+rotation (burns summed as vectors at their own u, so opposite burns half an orbit apart add), the sets'
+change of (i, sin i · ΔΩ residual) from the 20 days before (linear drift removed) to 4-10 days after,
+the cross-track ΔV the sets imply along the operator's direction, the share of it across the burn's
+own gap (1: a sharp step; small: a ramp over the sets' fit spans) and the normal step noise in m/s.
+
+Run: ``python benchmarks/bench_tle_plane_check.py [--lines]``.
 """
 
 from __future__ import annotations
@@ -16,11 +22,17 @@ import datetime as dt
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 from sgp4.api import Satrec, jday
+
+from abrupt.detect.tle.elements import mean_element_series
+from abrupt.readers.tle import read_tle
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT.parent / "shared" / "data"
 TAI_MINUS_UTC_2010_S = 34.0  # leap seconds in force during 2010 (IERS Bulletin C)
+SATS = {"Jason-1": "ja1man.txt", "Jason-3": "ja3man.txt", "Sentinel-3A": "s3aman.txt", "CryoSat-2": "cs2man.txt"}
+MIN_W_MPS = 0.02
 TOKENS_PER_BURN = 15
 
 
@@ -40,6 +52,111 @@ def read_burns(path: Path, year: int, doy_first: int, doy_last: int) -> list[dic
             worst = max(abs(a * 1e-6 * dur - d) for a, d in zip(acc, dv, strict=True))
             out.append({"line": line_no, "utc": when, "q": dv[0], "s": dv[1], "w": dv[2], "acc_mismatch_mps": worst})
     return out
+
+
+LEAP_STEPS_UTC = (  # (first day, TAI − UTC in s) from IERS Bulletin C, 1999-2022
+    (dt.datetime(1999, 1, 1), 32.0),
+    (dt.datetime(2006, 1, 1), 33.0),
+    (dt.datetime(2009, 1, 1), 34.0),
+    (dt.datetime(2012, 7, 1), 35.0),
+    (dt.datetime(2015, 7, 1), 36.0),
+    (dt.datetime(2017, 1, 1), 37.0),
+)
+
+
+def tai_minus_utc_s(when: dt.datetime) -> float:
+    """TAI − UTC (s) in force at ``when`` (1999-2022)."""
+    return [v for start, v in LEAP_STEPS_UTC if when >= start][-1]
+
+
+def argument_of_latitude(sat: Satrec, when: dt.datetime) -> tuple[float, float, float]:
+    """u (rad), i (rad) and speed (m/s) of the SGP4 state of ``sat`` at ``when`` (TEME)."""
+    jd, fr = jday(when.year, when.month, when.day, when.hour, when.minute, when.second + when.microsecond / 1e6)
+    _, r_km, v_kms = sat.sgp4(jd, fr)
+    r, v = np.asarray(r_km), np.asarray(v_kms)
+    h = np.cross(r, v) / np.linalg.norm(np.cross(r, v))
+    node = np.cross([0.0, 0.0, 1.0], h)
+    node /= np.linalg.norm(node)
+    u = float(np.arctan2(np.dot(np.cross(node, r), h), np.dot(node, r)))
+    return u, float(np.arccos(h[2])), float(np.linalg.norm(v)) * 1e3
+
+
+def line_rotations(sat_name: str) -> pd.DataFrame:
+    """Per IDS line with cross-track burns: the plane rotation its burns make (Gauss equations at each
+    burn's u, summed as vectors) against the element sets' change of (i, sin i · ΔΩ residual)."""
+    text = (DATA / "tle" / f"{sat_name}.tle").read_text().splitlines()
+    sats = [Satrec.twoline2rv(text[k], text[k + 1]) for k in range(len(text) - 1) if text[k].startswith("1 ")]
+    jd_sets = np.array([s.jdsatepoch + s.jdsatepochF for s in sats])
+    history = read_tle(DATA / "tle" / f"{sat_name}.tle")
+    series = mean_element_series(history, "leo")
+    t_set = pd.DatetimeIndex(history.elements["epoch_utc"]).tz_localize(None)
+    normal = np.column_stack([series["i_rad"], series["raan_resid_sin_i_rad"]])
+    step = np.diff(normal, axis=0)
+    noise = 1.4826 * np.median(np.abs(step - np.median(step, axis=0)), axis=0)
+    rows = []
+    for line_no, line in enumerate((DATA / "maneuvers" / SATS[sat_name]).read_text().splitlines(), 1):
+        tok = line.split()
+        if len(tok) < 11:
+            continue
+        rot, dv_w, first = np.zeros(2), 0.0, None
+        for b in range(int(tok[10])):
+            t = tok[11 + TOKENS_PER_BURN * b : 11 + TOKENS_PER_BURN * (b + 1)]
+            tai = dt.datetime(int(t[0]), 1, 1) + dt.timedelta(days=int(t[1]) - 1, hours=int(t[2]), minutes=int(t[3]))
+            when = tai + dt.timedelta(seconds=float(t[4]) - tai_minus_utc_s(tai))
+            first = first or when
+            w = float(t[8])
+            if w == 0.0:
+                continue
+            jd = (when - dt.datetime(2000, 1, 1, 12)).total_seconds() / 86400 + 2451545.0
+            u, _, speed = argument_of_latitude(sats[max(0, int(np.searchsorted(jd_sets, jd)) - 1)], when)
+            rot += (w / speed) * np.array([np.cos(u), np.sin(u)])  # (Δi, sin i ΔΩ), Vallado 2013 §9.3
+            dv_w += abs(w)
+        if dv_w < MIN_W_MPS or first is None:
+            continue
+        before = np.flatnonzero((t_set < first) & (t_set >= first - pd.Timedelta(days=20)))
+        after = np.flatnonzero((t_set > first + pd.Timedelta(days=4)) & (t_set <= first + pd.Timedelta(days=10)))
+        if before.size < 5 or after.size < 2:
+            continue
+        days = (t_set - first).total_seconds().to_numpy() / 86400.0
+        fit = [np.polyfit(days[before], normal[before, c], 1) for c in (0, 1)]
+        wide = np.array([np.median(normal[after, c] - np.polyval(fit[c], days[after])) for c in (0, 1)])
+        k0 = before[-1]
+        sharp = normal[k0 + 1] - normal[k0] - np.array([fit[c][0] for c in (0, 1)]) * (days[k0 + 1] - days[k0])
+        unit = rot / np.linalg.norm(rot) if np.linalg.norm(rot) > 0 else np.zeros(2)
+        rows.append(
+            {
+                "line": line_no,
+                "first_burn_utc": f"{first:%Y-%m-%d %H:%M}",
+                "sum_abs_w_mps": dv_w,
+                "dv_plane_op_mps": speed * float(np.linalg.norm(rot)),
+                "di_op_mdeg": 1e3 * np.degrees(rot[0]),
+                "sin_i_dnode_op_mdeg": 1e3 * np.degrees(rot[1]),
+                "di_sets_mdeg": 1e3 * np.degrees(wide[0]),
+                "sin_i_dnode_sets_mdeg": 1e3 * np.degrees(wide[1]),
+                "dv_plane_sets_mps": speed * float(np.dot(wide, unit)),
+                "first_gap_share": float(np.dot(sharp, unit) / np.dot(wide, unit)) if np.dot(wide, unit) else np.nan,
+                "step_noise_mps": speed * float(np.hypot(*noise)),
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def lines_table() -> None:
+    """Every shared LEO history's cross-track lines (module docstring)."""
+    for sat_name in SATS:
+        table = line_rotations(sat_name)
+        print(f"\n{sat_name}: {len(table)} lines with Σ|W| >= {MIN_W_MPS} m/s")
+        if table.empty:
+            continue
+        with pd.option_context("display.width", 250, "display.max_columns", 20):
+            print(table.to_string(index=False, float_format=lambda v: f"{v:.3f}"))
+        ratio = table["dv_plane_sets_mps"] / table["dv_plane_op_mps"]
+        ok = table["dv_plane_op_mps"] > 0
+        print(
+            f"  median sets/operator plane ΔV {np.nanmedian(ratio[ok]):.2f}; median share of the change across the "
+            f"burn's own gap {np.nanmedian(table['first_gap_share']):.2f}; lines whose burns net out in plane "
+            f"(rotation < 10 % of Σ|W|): {int((table['dv_plane_op_mps'] < 0.1 * table['sum_abs_w_mps']).sum())}"
+        )
 
 
 def main() -> None:
@@ -90,7 +207,9 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    from _results import write_results
+    import sys
 
-    with write_results("bench_tle_plane_check"):
-        main()
+    from _results import variant, write_results
+
+    with write_results("bench_tle_plane_check", variant({"--lines": "lines"})):
+        lines_table() if "--lines" in sys.argv[1:] else main()
