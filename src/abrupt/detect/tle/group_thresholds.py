@@ -57,6 +57,21 @@ def group_threshold(score: NDArray[np.float64], keep: NDArray[np.bool_], p_fa: f
     return max(floor, fitted) if math.isfinite(fitted) else floor
 
 
+def group_null_masks(
+    scores: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]], guard: int
+) -> tuple[NDArray[np.bool_], NDArray[np.bool_], NDArray[np.bool_]]:
+    """The gaps each group's null is fitted on: away from the in-track steps (burns move ``a`` first;
+    their flanks also disturb the e-vector and normal fits) and, for e and n, away from the group's own
+    outliers on a log scale (a heavy noise tail stays in, a GEO north-south burn thousands of σ high
+    does not)."""
+    keep_a = event_free_mask(scores[0], guard)
+    return (
+        keep_a,
+        keep_a & event_free_mask(np.log1p(scores[1]), guard),
+        keep_a & event_free_mask(np.log1p(scores[2]), guard),
+    )
+
+
 def own_null_gains(
     z_a: NDArray[np.float64],
     z_e: NDArray[np.float64],
@@ -69,12 +84,8 @@ def own_null_gains(
     """Per-group thresholds at ``p_fa / 3`` each and the gains ``T_a / T_k`` (module docstring)."""
     p_group = p_fa / len(GROUP_NAMES)
     scores = group_scores(z_a, z_e, z_n, weights)
-    # the null of every group: gaps away from the in-track steps (burns move a first; their flanks
-    # also disturb the e-vector and normal fits), and away from the group's own outliers on a log
-    # scale (a heavy noise tail stays in, a GEO north-south burn thousands of σ high does not)
-    keep_a = event_free_mask(scores[0], guard)
-    t_a = group_threshold(scores[0], keep_a, p_group, method)
-    t_e, t_n = (group_threshold(s, keep_a & event_free_mask(np.log1p(s), guard), p_group, method) for s in scores[1:])
+    masks = group_null_masks(scores, guard)
+    t_a, t_e, t_n = (group_threshold(s, m, p_group, method) for s, m in zip(scores, masks, strict=True))
     return GroupNull((t_a, t_e, t_n), (1.0, t_a / t_e, t_a / t_n), p_group)
 
 
@@ -87,13 +98,12 @@ def realised_group_rates(
     guard: int,
     years: float,
 ) -> dict[str, float]:
-    """Exceedances per year of each group's own threshold on its event-free gaps, and of any group
-    (the union), to report beside the stated rate."""
+    """Exceedances per year of each group's own threshold on the gaps its null is fitted on
+    (:func:`group_null_masks`), and of any group (the union), to report beside the stated rate."""
     scores = group_scores(z_a, z_e, z_n, weights)
     above_any = np.zeros(np.asarray(z_a).size, dtype=bool)
     out: dict[str, float] = {}
-    for name, s, t in zip(GROUP_NAMES, scores, thresholds, strict=True):
-        keep = event_free_mask(s, guard)
+    for name, s, t, keep in zip(GROUP_NAMES, scores, thresholds, group_null_masks(scores, guard), strict=True):
         above = keep & (s >= t)
         above_any |= above
         out[name] = float(above.sum()) / max(years, 1e-9)
