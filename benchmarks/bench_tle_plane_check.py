@@ -10,7 +10,9 @@ campaign sums are printed beside the inclination of the element sets before, dur
 ``--lines``: every line with cross-track burns on the four shared LEO histories: the operator's plane
 rotation (burns summed as vectors at their own u, so opposite burns half an orbit apart add), the sets'
 change of (i, sin i · ΔΩ residual) from the 20 days before (linear drift removed) to 4-10 days after,
-the cross-track ΔV the sets imply along the operator's direction, the share of it across the burn's
+the cross-track ΔV the sets imply along the operator's direction and from i and the node separately
+(:func:`abrupt.detect.tle.plane.implied_cross_track_dv` at the burns' effective u; NaN where its lever
+is below 0.2), the share of it across the burn's
 own gap (1: a sharp step; small: a ramp over the sets' fit spans) and the normal step noise in m/s.
 
 Run: ``python benchmarks/bench_tle_plane_check.py [--lines]``.
@@ -26,6 +28,7 @@ import pandas as pd
 from sgp4.api import Satrec, jday
 
 from abrupt.detect.tle.elements import mean_element_series
+from abrupt.detect.tle.plane import implied_cross_track_dv
 from abrupt.readers.tle import read_tle
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -123,6 +126,9 @@ def line_rotations(sat_name: str) -> pd.DataFrame:
         k0 = before[-1]
         sharp = normal[k0 + 1] - normal[k0] - np.array([fit[c][0] for c in (0, 1)]) * (days[k0 + 1] - days[k0])
         unit = rot / np.linalg.norm(rot) if np.linalg.norm(rot) > 0 else np.zeros(2)
+        # the burns' effective u (the direction of their summed rotation): each element's own estimate
+        u_eff = float(np.arctan2(rot[1], rot[0]))
+        from_i, from_node = implied_cross_track_dv(wide[0], wide[1], u_eff, speed)
         rows.append(
             {
                 "line": line_no,
@@ -134,6 +140,9 @@ def line_rotations(sat_name: str) -> pd.DataFrame:
                 "di_sets_mdeg": 1e3 * np.degrees(wide[0]),
                 "sin_i_dnode_sets_mdeg": 1e3 * np.degrees(wide[1]),
                 "dv_plane_sets_mps": speed * float(np.dot(wide, unit)),
+                "u_eff_deg": float(np.degrees(u_eff)),
+                "dv_from_i_mps": float(from_i),
+                "dv_from_node_mps": float(from_node),
                 "first_gap_share": float(np.dot(sharp, unit) / np.dot(wide, unit)) if np.dot(wide, unit) else np.nan,
                 "step_noise_mps": speed * float(np.hypot(*noise)),
             }
@@ -153,8 +162,10 @@ def lines_table() -> None:
         ratio = table["dv_plane_sets_mps"] / table["dv_plane_op_mps"]
         ok = table["dv_plane_op_mps"] > 0
         print(
-            f"  median sets/operator plane ΔV {np.nanmedian(ratio[ok]):.2f}; median share of the change across the "
-            f"burn's own gap {np.nanmedian(table['first_gap_share']):.2f}; lines whose burns net out in plane "
+            f"  median sets/operator plane ΔV {np.nanmedian(ratio[ok]):.2f} (from i alone "
+            f"{np.nanmedian(table['dv_from_i_mps'] / table['dv_plane_op_mps']):.2f}, from the node alone "
+            f"{np.nanmedian(table['dv_from_node_mps'] / table['dv_plane_op_mps']):.2f}); median share of the change "
+            f"across the burn's own gap {np.nanmedian(table['first_gap_share']):.2f}; lines whose burns net out in plane "
             f"(rotation < 10 % of Σ|W|): {int((table['dv_plane_op_mps'] < 0.1 * table['sum_abs_w_mps']).sum())}"
         )
 
