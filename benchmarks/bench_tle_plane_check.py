@@ -165,8 +165,8 @@ def lines_table() -> None:
             f"  median sets/operator plane ΔV {np.nanmedian(ratio[ok]):.2f} (from i alone "
             f"{np.nanmedian(table['dv_from_i_mps'] / table['dv_plane_op_mps']):.2f}, from the node alone "
             f"{np.nanmedian(table['dv_from_node_mps'] / table['dv_plane_op_mps']):.2f}); median share of the change "
-            f"across the burn's own gap {np.nanmedian(table['first_gap_share']):.2f}; lines whose burns net out in plane "
-            f"(rotation < 10 % of Σ|W|): {int((table['dv_plane_op_mps'] < 0.1 * table['sum_abs_w_mps']).sum())}"
+            f"across the burn's own gap {np.nanmedian(table['first_gap_share']):.2f}; lines whose burns net out in "
+            f"plane (rotation < 10 % of Σ|W|): {int((table['dv_plane_op_mps'] < 0.1 * table['sum_abs_w_mps']).sum())}"
         )
 
 
