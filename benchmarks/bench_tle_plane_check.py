@@ -13,7 +13,9 @@ change of (i, sin i · ΔΩ residual) from the 20 days before (linear drift remo
 the cross-track ΔV the sets imply along the operator's direction and from i and the node separately
 (:func:`abrupt.detect.tle.plane.implied_cross_track_dv` at the burns' effective u; NaN where its lever
 is below 0.2), the share of it across the burn's
-own gap (1: a sharp step; small: a ramp over the sets' fit spans) and the normal step noise in m/s.
+own gap (1: a sharp step; small: a ramp over the sets' fit spans) and the normal step noise in m/s;
+then per run of lines (each within 7 days of the previous) the net operator rotation, its largest
+running sum, and the sets' change across the whole run.
 
 Run: ``python benchmarks/bench_tle_plane_check.py [--lines]``.
 """
@@ -150,8 +152,47 @@ def line_rotations(sat_name: str) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def runs_table(sat_name: str, table: pd.DataFrame, chain_days: float = 7.0) -> pd.DataFrame:
+    """Lines chained within ``chain_days`` form a run: its net operator rotation (the lines' vectors summed)
+    against the sets' change from the 20 days before its first line to 4-10 days after its last."""
+    history = read_tle(DATA / "tle" / f"{sat_name}.tle")
+    series = mean_element_series(history, "leo")
+    t_set = pd.DatetimeIndex(history.elements["epoch_utc"]).tz_localize(None)
+    normal = np.column_stack([series["i_rad"], series["raan_resid_sin_i_rad"]])
+    starts = pd.to_datetime(table["first_burn_utc"])
+    run_id = np.concatenate(([0], np.cumsum(np.diff(starts.to_numpy()) > np.timedelta64(int(chain_days * 86400), "s"))))
+    rows = []
+    for rid in np.unique(run_id):
+        sub, first = table.loc[run_id == rid], starts[run_id == rid].iloc[0]
+        last = starts[run_id == rid].iloc[-1]
+        days = (t_set - first).total_seconds().to_numpy() / 86400.0
+        span = (last - first).total_seconds() / 86400.0
+        before = np.flatnonzero((days < 0) & (days >= -20))
+        after = np.flatnonzero((days > span + 4) & (days <= span + 10))
+        if before.size < 5 or after.size < 2:
+            continue
+        fit = [np.polyfit(days[before], normal[before, c], 1) for c in (0, 1)]
+        sets = 1e3 * np.degrees([np.median(normal[after, c] - np.polyval(fit[c], days[after])) for c in (0, 1)])
+        op = np.array([sub["di_op_mdeg"].sum(), sub["sin_i_dnode_op_mdeg"].sum()])
+        peak = np.abs(np.cumsum(sub["di_op_mdeg"].to_numpy())).max()
+        rows.append(
+            {
+                "first_line_utc": f"{first:%Y-%m-%d}",
+                "lines": len(sub),
+                "days": span,
+                "largest_line_mdeg": float(np.abs(sub["di_op_mdeg"]).max()),
+                "largest_running_sum_mdeg": float(peak),
+                "net_di_op_mdeg": float(op[0]),
+                "net_sin_i_dnode_op_mdeg": float(op[1]),
+                "di_sets_mdeg": float(sets[0]),
+                "sin_i_dnode_sets_mdeg": float(sets[1]),
+            }
+        )
+    return pd.DataFrame(rows)
+
+
 def lines_table() -> None:
-    """Every shared LEO history's cross-track lines (module docstring)."""
+    """Every shared LEO history's cross-track lines and runs of lines (module docstring)."""
     for sat_name in SATS:
         table = line_rotations(sat_name)
         print(f"\n{sat_name}: {len(table)} lines with Σ|W| >= {MIN_W_MPS} m/s")
@@ -168,6 +209,8 @@ def lines_table() -> None:
             f"across the burn's own gap {np.nanmedian(table['first_gap_share']):.2f}; lines whose burns net out in "
             f"plane (rotation < 10 % of Σ|W|): {int((table['dv_plane_op_mps'] < 0.1 * table['sum_abs_w_mps']).sum())}"
         )
+        print("  runs of lines (each within 7 days of the previous): net operator rotation against the sets")
+        print(runs_table(sat_name, table).to_string(index=False, float_format=lambda v: f"{v:.2f}"))
 
 
 def main() -> None:
