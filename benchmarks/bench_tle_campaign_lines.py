@@ -198,12 +198,15 @@ def main() -> None:
     ap.add_argument("--lines", action="store_true", help="print the per-line table of every history")
     ap.add_argument("--fractions", nargs="*", default=None, help="campaign_step_fraction values (none: off)")
     ap.add_argument("--fraction", type=float, default=None, help="one run with campaign_step_fraction at this value")
+    ap.add_argument("--own-null-gains", action="store_true", help="group gains from each group's own null")
     args = ap.parse_args()
     if args.fractions is not None:
         fraction_study([None if f.lower() == "none" else float(f) for f in args.fractions])
         return
     sats = [s for s in IDS_HISTORIES if args.only is None or s in args.only]
-    settings = {"campaign_step_fraction": args.fraction} if args.fraction is not None else {}
+    settings: dict[str, Any] = {"campaign_step_fraction": args.fraction} if args.fraction is not None else {}
+    if args.own_null_gains:
+        settings["group_gain"] = None
     print(f"campaign_step_fraction: {args.fraction if args.fraction is not None else 'default (off)'}")
     table = pd.concat([line_table(s, **settings) for s in sats], ignore_index=True)
     with pd.option_context("display.width", 200, "display.max_rows", 500):
@@ -219,5 +222,8 @@ def main() -> None:
 if __name__ == "__main__":
     from _results import variant, write_results
 
-    with write_results("bench_tle_campaign_lines", variant({"--fractions": "fractions", "--fraction": "on"})):
+    with write_results(
+        "bench_tle_campaign_lines",
+        variant({"--fractions": "fractions", "--fraction": "on", "--own-null-gains": "own_null"}),
+    ):
         main()

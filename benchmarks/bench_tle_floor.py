@@ -38,14 +38,14 @@ from abrupt.score import score_events
 from bench_tle_timing import BIG_BURN_MPS, BUDGET, DATA, SATELLITES, TOLERANCE_S
 
 
-def floor_study(sat: str) -> tuple[pd.DataFrame, dict[str, Any]]:
+def floor_study(sat: str, **settings: Any) -> tuple[pd.DataFrame, dict[str, Any]]:
     """Per year of one history: floors, burns ≥ 2 cm/s above and below them and how many were found;
     and the history's totals."""
     history = read_tle(DATA / "tle" / f"{sat}.tle")
     truth = read_maneuver_file(DATA / "maneuvers" / SATELLITES[sat])
     el = history.elements
     start, end = el["epoch_utc"].iloc[0], el["epoch_utc"].iloc[-1]
-    run = detector_for(history).detect(history, BUDGET)
+    run = detector_for(history, **settings).detect(history, BUDGET)
     events = run.events
     events = events.loc[(events["kind"] == "maneuver") & (events["statistic"] >= events["threshold"])]
     res = score_events(events.reset_index(drop=True), truth, tolerance_s=TOLERANCE_S, start=start, end=end)
@@ -101,11 +101,13 @@ def floor_study(sat: str) -> tuple[pd.DataFrame, dict[str, Any]]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--only", nargs="*", default=None)
+    ap.add_argument("--own-null-gains", action="store_true", help="group gains from each group's own null")
     args = ap.parse_args()
+    settings: dict[str, Any] = {"group_gain": None} if args.own_null_gains else {}
     sats = [s for s, f in SATELLITES.items() if not f.endswith(".fy") and (args.only is None or s in args.only)]
     totals = []
     for sat in sats:
-        table, tot = floor_study(sat)
+        table, tot = floor_study(sat, **settings)
         totals.append(tot)
         print(f"{sat}: per year, floors (m/s) and operator burns of {BIG_BURN_MPS * 100:.0f} cm/s or more")
         print(table.to_string(index=False, float_format=lambda v: f"{v:.4f}"))
@@ -114,7 +116,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    from _results import write_results
+    from _results import variant, write_results
 
-    with write_results("bench_tle_floor"):
+    with write_results("bench_tle_floor", variant({"--own-null-gains": "own_null"})):
         main()

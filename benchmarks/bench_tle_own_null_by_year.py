@@ -34,13 +34,15 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--seeds", type=int, default=4)
     ap.add_argument("--only", nargs="*", default=None)
+    ap.add_argument("--own-null-gains", action="store_true", help="group gains from each group's own null")
     args = ap.parse_args()
+    settings = {"group_gain": None} if args.own_null_gains else {}
     for sat in (s for s in SATELLITES if args.only is None or s in args.only):
         history = read_tle(DATA / "tle" / f"{sat}.tle")
-        ev = detector_for(history).detect(history, BUDGET).events
+        ev = detector_for(history, **settings).detect(history, BUDGET).events
         known = detection_times(ev.loc[ev["statistic"] >= ev["threshold"]])
         t0 = time.perf_counter()
-        rows = own_null_by_year(history, known, BUDGET, seeds=range(args.seeds))
+        rows = own_null_by_year(history, known, BUDGET, seeds=range(args.seeds), **settings)
         fa, years = sum(r.false_alarms for r in rows), sum(r.sat_years for r in rows)
         lo, hi = poisson_interval(fa, years)
         worst = max((r for r in rows if r.sat_years >= 0.5), key=lambda r: r.rate_per_year, default=None)
@@ -63,5 +65,5 @@ def main() -> None:
 if __name__ == "__main__":
     from _results import variant, write_results
 
-    with write_results("bench_tle_own_null_by_year", variant({"--only": "only"})):
+    with write_results("bench_tle_own_null_by_year", variant({"--only": "only", "--own-null-gains": "own_null"})):
         main()

@@ -250,6 +250,7 @@ def main() -> None:
     ap.add_argument(
         "--campaign-step-fraction", type=float, default=None, help="resolve campaign steps (off by default)"
     )
+    ap.add_argument("--own-null-gains", action="store_true", help="group gains from each group's own null")
     args = ap.parse_args()
     sats = [s for s in SATELLITES if args.only is None or s in args.only]
     loso = level_study(sats, sorted(args.levels))
@@ -259,7 +260,11 @@ def main() -> None:
         if s != "(all modern)":
             width = f"median width {r['median_width_d']:.2f} d"
             print(f"  held out {s}: level {r['level']:.2f}, coverage {r['coverage']:.3f}, {width}")
-    settings = {} if args.campaign_step_fraction is None else {"campaign_step_fraction": args.campaign_step_fraction}
+    settings: dict[str, Any] = {}
+    if args.campaign_step_fraction is not None:
+        settings["campaign_step_fraction"] = args.campaign_step_fraction
+    if args.own_null_gains:
+        settings["group_gain"] = None
     print(f"settings beside the defaults: {settings or 'none'}")
     rows = [evaluate(s, **settings) for s in sats]
     cols = (
@@ -281,5 +286,7 @@ def main() -> None:
 if __name__ == "__main__":
     from _results import variant, write_results
 
-    with write_results("bench_tle_timing", variant({"--campaign-step-fraction": "campaign_steps"})):
+    with write_results(
+        "bench_tle_timing", variant({"--campaign-step-fraction": "campaign_steps", "--own-null-gains": "own_null"})
+    ):
         main()

@@ -321,6 +321,9 @@ GAINS = (0.2, 0.5, 1.0)  # gain of the e-vector and orbit-normal groups (the a g
 # same or better with 2 than with 3, so LOSO picks 2 over 3 for each)
 CAMPAIGN_SIDES = {"LEO": (1, 2), "GEO": (2, 3)}
 GRID = {cls: tuple((g, c) for g in GAINS for c in sides) for cls, sides in CAMPAIGN_SIDES.items()}
+# with --own-null-gains the grid also holds this entry: every group's gain from its own null
+# (TleDetectorConfig(group_gain=None), abrupt.detect.tle.group_thresholds), chosen LOSO like the others
+OWN_NULL_GAIN = -1.0
 BUDGET = FalseAlarmBudget(1.0, "year")
 TOLERANCE_S = 86400.0
 BIG_BURN_MPS = 0.05
@@ -335,7 +338,7 @@ def detect_one(
     history = read_tle(DATA / "tle" / f"{sat}.tle")
     cls = TleGeoStationKeeping if SATELLITES[sat][1] == "GEO" else TleMeanElements
     det = cls(
-        group_gain=(1.0, gain, gain),
+        group_gain=None if gain == OWN_NULL_GAIN else (1.0, gain, gain),
         campaign_min_side_sets=sides,
         along_track_gain=along,
         threshold_follow=follow,
@@ -729,7 +732,14 @@ def main() -> None:
         default=1.0,
         help="gain of the along-track phase group (LEO; 0 switches it off: the sensitivity run in docs/tle.md)",
     )
+    parser.add_argument(
+        "--own-null-gains", action="store_true", help="add gains from each group's own null to the grid"
+    )
     args = parser.parse_args()
+    if args.own_null_gains:
+        global GAINS, GRID
+        GAINS = (*GAINS, OWN_NULL_GAIN)
+        GRID = {cls: tuple((g, c) for g in GAINS for c in sides) for cls, sides in CAMPAIGN_SIDES.items()}
     t_start = time.perf_counter()
     sats = list(SATELLITES)
     truth = {s: read_maneuver_file(DATA / "maneuvers" / SATELLITES[s][0]) for s in sats}
@@ -918,6 +928,7 @@ if __name__ == "__main__":
                 "--threshold-follow=none": "one_threshold",
                 "--threshold-follow=follow": "follow",
                 "--along-track-gain=0": "no_phase",
+                "--own-null-gains": "own_null",
             }
         ),
     ):

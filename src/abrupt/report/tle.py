@@ -18,7 +18,7 @@ import pandas as pd
 
 from abrupt.detect.tle.config import TleDetectorConfig
 from abrupt.detect.tle.elements import mean_element_series, orbit_regime
-from abrupt.detect.tle.steps import component_weights, step_statistics
+from abrupt.detect.tle.steps import component_weights, gains_for, step_statistics
 from abrupt.errors import printable
 from abrupt.readers.tle import ElementHistory
 from abrupt.report.style import clip_with_markers, save_figure
@@ -62,7 +62,7 @@ def plot_tle_report(
     cfg = TleDetectorConfig(regime=regime)
     steps = step_statistics(history, cfg)
     steps.weights = component_weights(steps, cfg.window_sets + 2)
-    steps.group_gain = cfg.group_gain
+    steps.group_gain = gains_for(steps, cfg, len(history))
     gap_t = t[:-1] + (t[1:] - t[:-1]) / 2
     fig, axes = plt.subplots(5, 1, figsize=(12, 12), sharex=True, constrained_layout=True)
     a = s["a_m"]

@@ -148,12 +148,12 @@ Vallado et al. 2006): the Brouwer mean semi-major axis `a`, and
    t_g))`, at most `(3/4) n |Δa| (Δt + 1 day)` for any burn from one TLE lag before the gap to its end; only the
    excess counts (`delta_u_m`), so `z_u` is a second look at phasing, not a duplicate of `z_a`.
 3. **Combined statistic**: the maximum over groups of normal-equivalent scores (a χ₂ magnitude is mapped to the
-   two-sided normal deviate of equal tail probability), the e and n groups multiplied by a gain γ = 0.2 (the one
-   setting tuned on data, by leave-one-satellite-out, below); `z_u` with gain 1 like `z_a` (same in-track
-   physics; not tuned, sensitivity below). An event where only `z_u` is significant is typed `along-track
-   phasing` (ΔV unobservable: the phase step is `3 Δv Δt_s` with unknown spacing) and timed at its gap. An
-   in-track burn of a few cm/s is a 10-100σ step in `a` while e-vector and normal noise is heavier-tailed; a
-   maximum, unlike a sum of squares, is not diluted by quiet groups.
+   two-sided normal deviate of equal tail probability), the e and n groups multiplied by a gain γ = 0.2 (tuned
+   leave-one-satellite-out, below; `group_gain=None` sets γ_k = T_a/T_k from each group's own null tail,
+   `group_thresholds`: LOSO never picks it, `bench_tle_timing_own_null.txt`); `z_u` with gain 1 like `z_a`.
+   An event where only `z_u` is significant is typed `along-track phasing` (ΔV unobservable: the phase step
+   is `3 Δv Δt_s` with unknown spacing) and timed at its gap. An in-track burn of a few cm/s is a 10-100σ step
+   in `a` while e-vector and normal noise is heavier-tailed; a maximum is not diluted by quiet groups.
 4. **Threshold from the false-alarm budget** (`FalseAlarmBudget(1, "year")`; per year-long block of the history,
    "A rate per satellite" below): per-gap probability = budget per year / gaps per year (`per_test`); a
    generalised Pareto tail (`abrupt.thresholds.fit_threshold`, method `gpd`) of the statistic on its event-free

@@ -70,7 +70,11 @@ class TleDetectorConfig:
     # of the campaign's largest is a maneuver of its own (abrupt.detect.tle.campaign_steps); None: off
     campaign_step_fraction: float | None = None
     time_search_sets_before: int = 3
-    group_gain: tuple[float, float, float] = (1.0, 0.2, 0.2)
+    # gains of the (a, e, normal) groups in the combined statistic, tuned leave-one-satellite-out;
+    # None: each group's own null sets them (abrupt.detect.tle.group_thresholds: T_a / T_k from each
+    # group's own tail away from the in-track steps; measured in docs/results/bench_tle_timing_own_null.txt,
+    # it costs CryoSat-2 recall and Jason-3 precision, so it is not the default)
+    group_gain: tuple[float, float, float] | None = (1.0, 0.2, 0.2)
     along_track_gain: float = 1.0
     drag_trend: str = "ndot"  # LEO a: "ndot" removes the sets' own stated decay (drag_trend_m)
     drag_median_sets: int = 5
@@ -95,7 +99,9 @@ class TleDetectorConfig:
             raise ValueError("peak_half_width must be >= 1")
         if self.regime not in ("auto", "leo", "geo"):
             raise ValueError(f"regime must be auto, leo or geo, got {self.regime!r}")
-        if any(not (g >= 0 and math.isfinite(g)) for g in self.group_gain) or len(self.group_gain) != 3:
+        if self.group_gain is not None and (
+            any(not (g >= 0 and math.isfinite(g)) for g in self.group_gain) or len(self.group_gain) != 3
+        ):
             raise ValueError("group_gain must be three finite non-negative numbers")
         if self.drag_trend not in ("none", "ndot"):
             raise ValueError(f"drag_trend must be none or ndot, got {self.drag_trend!r}")

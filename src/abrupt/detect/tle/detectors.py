@@ -56,7 +56,7 @@ class TleMeanElements(Detector[ElementHistory]):
         unknown = set(settings) - _SETTING_NAMES
         if unknown:
             raise ValueError(f"{self.name}: unknown setting(s) {sorted(unknown)}; known: {sorted(_SETTING_NAMES)}")
-        if "group_gain" in settings:
+        if settings.get("group_gain") is not None:
             settings["group_gain"] = tuple(float(g) for g in settings["group_gain"])
         self.settings = TleDetectorConfig(regime=self.regime, **settings)  # validates
         self.all_candidates = bool(all_candidates)

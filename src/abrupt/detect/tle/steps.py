@@ -25,6 +25,7 @@ from abrupt.detect.tle.elements import (
     orbit_regime,
     stated_decay_m_s,
 )
+from abrupt.detect.tle.group_thresholds import own_null_gains
 from abrupt.detect.tle.noise import (
     block_thresholds,
     chi2_as_normal,
@@ -36,7 +37,7 @@ from abrupt.detect.tle.noise import (
 )
 from abrupt.detect.tle.step_kernels import gap_steps, localise_costs
 from abrupt.readers.tle import MU_EARTH_WGS72_M3_S2, ElementHistory
-from abrupt.thresholds import Threshold
+from abrupt.thresholds import DAYS_PER_YEAR, Threshold
 from abrupt.units import SECONDS_PER_DAY
 
 
@@ -64,6 +65,8 @@ class StepSeries:
     # per-gap factor (global threshold / the gap's block threshold): one cut on S holds a threshold
     # that follows the history's cadence and noise (:func:`abrupt.detect.tle.noise.block_thresholds`)
     scale: NDArray[np.float64] | None = None
+    # each group's own threshold (a, e, n) when the gains come from the groups' own nulls
+    group_thresholds: tuple[float, float, float] | None = None
 
     @property
     def statistic(self) -> NDArray[np.float64]:
@@ -477,6 +480,20 @@ def component_weights(first: StepSeries, guard: int, quantile: float = 0.5) -> t
     return out[0], out[1], out[2]
 
 
+def gains_for(first: StepSeries, cfg: TleDetectorConfig, n_sets: int) -> tuple[float, float, float]:
+    """The configured group gains, or with ``group_gain=None`` those of each group's own null
+    (:func:`abrupt.detect.tle.group_thresholds.own_null_gains`) at the budget's per-gap probability."""
+    if cfg.group_gain is not None:
+        return cfg.group_gain
+    t = first.t_before_s
+    span_years = float(first.t_after_s[-1] - t[0]) / (DAYS_PER_YEAR * SECONDS_PER_DAY) if t.size else 0.0
+    p_fa = cfg.budget.per_test((n_sets - 1) / max(span_years, 1e-9), "year", cap=0.5)
+    guard = cfg.window_sets + 2
+    own = own_null_gains(first.z_a, first.z_e, first.z_n, first.weights, guard, p_fa, cfg.threshold_method)
+    first.group_thresholds = own.thresholds
+    return own.gains
+
+
 def first_pass(history: ElementHistory, cfg: TleDetectorConfig, regime: str) -> tuple[StepModel, StepSeries]:
     """The step model and the unsegmented statistics with the satellite's own group weights."""
     model = StepModel(history, cfg)
@@ -484,7 +501,7 @@ def first_pass(history: ElementHistory, cfg: TleDetectorConfig, regime: str) -> 
     first = empty_steps(model.t, n_gaps)
     fill_gaps(first, model, np.arange(n_gaps), [])
     first.weights = component_weights(first, cfg.window_sets + 2)
-    first.group_gain = cfg.group_gain
+    first.group_gain = gains_for(first, cfg, len(history))
     if regime == "leo" and first.z_u is not None:
         first.weight_u = robust_group_weight(first.z_u, float(stats.chi.ppf(0.5, 1)), cfg.window_sets + 2)
         first.gain_u = cfg.along_track_gain
