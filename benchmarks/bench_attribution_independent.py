@@ -38,6 +38,7 @@ import numpy as np
 import pandas as pd
 
 import abrupt
+from abrupt.detect.attitude.leak_scan import LEAK_FALSE_ALARMS, SCALES_S
 from abrupt.errors import ConfigError
 from abrupt.model.spacecraft import load_spacecraft
 from basilisk_kinds import EXPECTED_CLASS
@@ -304,10 +305,12 @@ def report(rows: list[dict], left: pd.DataFrame, days: float) -> None:
     )
     for det, group in left.groupby("detector"):
         n_free = int((group["near"] == "none").sum())
-        print(
-            f"  {det}: {n_free} at no truth = {n_free / days:.3f} a day realised, stated {_stated(group)} a day "
-            "per channel"
+        stated = (
+            f"{LEAK_FALSE_ALARMS.per_day:g} a day over all {len(SCALES_S)} windows"
+            if det == "attitude.leak_scan"
+            else f"{_stated(group)} a day per channel"
         )
+        print(f"  {det}: {n_free} at no truth = {n_free / days:.3f} a day realised, stated {stated}")
     for _, ev in free.iterrows():
         print(
             f"  {ev['spacecraft']} {ev['time_utc']} {ev['kind']} {ev.get('kind_channel', '')} {ev['dH_Nms']:.4f} N·m·s "

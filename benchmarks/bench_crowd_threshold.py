@@ -32,6 +32,9 @@ from abrupt.pipelines.flight import FlightRunConfig, ingest_archives, run_flight
 from abrupt.simulate.injection import InjectedStrike, inject_strikes
 from abrupt.thresholds.budget import FalseAlarmBudget
 
+# The budget of the documented figures (docs/flight-pipeline.md; the pipeline's default is lower).
+BUDGET = FalseAlarmBudget(1.0, "day")
+
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT.parent / "shared" / "data" / "flight-like"
 KESTREL = ROOT / "examples" / "spacecraft" / "kestrel.toml"
@@ -52,7 +55,7 @@ def _day_strikes_ns() -> list[int]:
 
 def quiet_day(store: Path, sc) -> float:
     """The day as it is: threshold, its own strikes found, its other events (false alarms)."""
-    res = run_flight(store, sc, FlightRunConfig(), days=[DAY])
+    res = run_flight(store, sc, FlightRunConfig(budget=BUDGET), days=[DAY])
     truth = _day_strikes_ns()
     t_ev = _times_ns(res.events)
     hit = sum(bool(np.any(np.abs(t_ev - t) <= 10 * NS)) for t in truth)
@@ -72,7 +75,9 @@ def crowded_day(store: Path, sc, quiet_thr: float, seed: int) -> tuple[int, int]
     strikes = [
         InjectedStrike(T0_NS + int(t * NS), s * d / np.linalg.norm(d)) for t, s, d in zip(times, sizes, u, strict=True)
     ]
-    res = run_flight(store, sc, FlightRunConfig(), days=[DAY], samples_hook=lambda s: inject_strikes(s, sc, strikes))
+    res = run_flight(
+        store, sc, FlightRunConfig(budget=BUDGET), days=[DAY], samples_hook=lambda s: inject_strikes(s, sc, strikes)
+    )
     thr = res.threshold.value
     peak_t = np.array([p.time_ns for p in res.peaks], np.int64)
     peak_v = np.array([p.value for p in res.peaks])

@@ -23,7 +23,7 @@ from abrupt.cli.groups import (
     simulate,
     warn,
 )
-from abrupt.cli.options import budget_options, pop_budget
+from abrupt.cli.options import FLIGHT_STORE_BUDGET, budget_options, pop_budget
 
 if TYPE_CHECKING:
     import numpy as np
@@ -47,10 +47,8 @@ else:
     np = lazy_module("numpy")
     pd = lazy_module("pandas")
 
-#: The default budget of the flight pipeline (``--store``): its step detector's stated rate
-#: (``FlightGlrDetector.STATED_RATE``), so that with the leak scan's it states at most one event at no
-#: change in five days.
-STORE_BUDGET = "0.1/day"
+#: The default budget of the flight pipeline (``--store``): see :data:`abrupt.cli.options.FLIGHT_STORE_BUDGET`.
+STORE_BUDGET = FLIGHT_STORE_BUDGET
 
 
 def _spacecraft(path: str | None) -> Any:

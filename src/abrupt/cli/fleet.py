@@ -18,7 +18,7 @@ from abrupt.cli.groups import (
     record_run,
     warn,
 )
-from abrupt.cli.options import budget_options, pop_budget
+from abrupt.cli.options import FLIGHT_STORE_BUDGET, budget_given, budget_options, pop_budget
 from abrupt.errors import InputError
 from abrupt.scale import Executor
 
@@ -103,8 +103,10 @@ def detect_fleet_cmd(
     and a store (written by `abrupt ingest`) runs the flight pipeline over that spacecraft's stored days,
     as `abrupt detect attitude --store` does (--detector and --null-samples apply to telemetry rows).
     Finished tasks are stored in the catalog as they end: a run that was stopped or killed resumes
-    where it stopped when started again with the same inputs and settings. The budget is per spacecraft.
+    where it stopped when started again with the same inputs and settings. The budget is per spacecraft;
+    without one, telemetry rows use 1/day and store rows the flight pipeline's own default (0.1/day).
     """
+    store_budget = None if budget_given(budget_args) else pop_budget({}, FLIGHT_STORE_BUDGET)
     budget = pop_budget(budget_args, "1/day")
     check_evidence_output(out)  # store rows' attribution evidence goes beside the events
     members = pipelines_fleet.read_manifest(manifest)
@@ -120,6 +122,7 @@ def detect_fleet_cmd(
         executor=executor,
         command="detect fleet " + manifest,
         show_progress=not progress_hidden(),
+        store_budget=store_budget,
     )
     for key, repairs in result.repairs.items():
         for kind, n in sorted(repairs.items()):

@@ -17,7 +17,7 @@ from abrupt.cli.commands import lazy_module
 from abrupt.cli.flight_orbit import orbit_input
 from abrupt.cli.flux import store_run_exposure
 from abrupt.cli.groups import check_evidence_output, cli, inject, record_run, simulate
-from abrupt.cli.options import budget_options, pop_budget
+from abrupt.cli.options import FLIGHT_STORE_BUDGET, budget_options, pop_budget
 from abrupt.errors import ConfigError, InputError
 from abrupt.outputs import atomic_output, write_text_atomic
 from abrupt.simulate.confounder_kinds import CONFOUNDER_KINDS
@@ -271,7 +271,7 @@ def detect_from_store(
 )
 @click.option("--recovery", is_flag=True, help="Injection-recovery study: 90%-detectable ΔH per day.")
 @click.option("--days", multiple=True, help="Days (YYYY-MM-DD or A..B); default all stored days.")
-@budget_options()
+@budget_options(FLIGHT_STORE_BUDGET)
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed (reproducible).")
 @click.option("--out", default=None, type=click.Path(dir_okay=False), help="Recovery table (.csv).")
 def inject_attitude_cmd(
@@ -326,7 +326,7 @@ def inject_attitude_cmd(
             dst.write_day(sc.name, day, frame, report)
         click.echo(f"{len(parsed)} strike(s), {len(conf_list)} confounder(s) injected; store written to {out_store}")
     if recovery:
-        cfg = pipelines_flight.FlightRunConfig(budget=pop_budget(budget))
+        cfg = pipelines_flight.FlightRunConfig(budget=pop_budget(budget, FLIGHT_STORE_BUDGET))
         base = pipelines_flight.run_flight(store_dir, sc, cfg, days=days or None)
         rec = pipelines_flight_injection.injection_recovery(
             store_dir, sc, cfg, base.threshold, days=days or None, seed=seed

@@ -21,6 +21,12 @@ else:
     thresholds = lazy_module("abrupt.thresholds")
 
 
+#: The default budget of the flight pipeline (a telemetry ``--store``): its step detector's stated rate
+#: (``abrupt.detect.attitude.flight_glr.FlightGlrDetector.STATED_RATE``; a test holds them equal). Every
+#: command that runs the flight pipeline (detection, injection recovery, fleet store rows) defaults to it,
+#: so that a recovery study measures the efficiency at the threshold the detection uses.
+FLIGHT_STORE_BUDGET = "0.1/day"
+
 BUDGET_KEYS = ("false_alarms", "false_alarms_per_day", "false_alarms_per_week", "false_alarms_per_year")
 
 
@@ -46,6 +52,11 @@ def budget_options(default: str = "1/day") -> Callable[[Any], Any]:
 
     wrap.default = default  # type: ignore[attr-defined]
     return wrap
+
+
+def budget_given(options: dict[str, Any]) -> bool:
+    """Whether the command line named a budget (any of the budget options)."""
+    return any(options.get(k) is not None for k in BUDGET_KEYS)
 
 
 def pop_budget(options: dict[str, Any], default: str = "1/day") -> thresholds.FalseAlarmBudget:

@@ -63,6 +63,7 @@ class AttitudeTask:
     member: FleetMember
     config: Any  # AttitudeDetectionConfig
     run_id: str
+    store_budget: Any = None  # FalseAlarmBudget of store rows; None: the config's
 
     @property
     def key(self) -> str:
@@ -187,10 +188,11 @@ def detect_attitude_task(task: AttitudeTask) -> TaskOutput:
 
 def detect_store_task(task: AttitudeTask) -> TaskOutput:
     """A store row: the flight pipeline over every stored day of the spacecraft (threshold calibrated
-    on those days at the fleet's budget), covering those days."""
+    on those days at the store rows' budget, else the fleet's), covering those days."""
     sc = replace(load_spacecraft(task.member.spacecraft_file), name=task.member.spacecraft)
     days = TelemetryStore(task.member.store).days(sc.name)
-    result = run_flight(task.member.store, sc, FlightRunConfig(budget=task.config.budget), run_id=task.run_id)
+    budget = task.store_budget if task.store_budget is not None else task.config.budget
+    result = run_flight(task.member.store, sc, FlightRunConfig(budget=budget), run_id=task.run_id)
     start, end = f"{days[0]}T00:00:00Z", f"{days[-1]}T23:59:59.999999Z"
     coverage = (Coverage(sc.name, FlightGlrDetector.name, result.config_hash, start, end),)
     return TaskOutput(result.events, coverage, {}, tuple(result.warnings))
@@ -215,7 +217,7 @@ def _file_digest(path: str) -> str:
     return h.hexdigest()[:16]
 
 
-def fleet_run_key(members: Sequence[FleetMember], config: Any) -> str:
+def fleet_run_key(members: Sequence[FleetMember], config: Any, store_budget: Any = None) -> str:
     """Same telemetry bytes, spacecraft files and configuration: the same (resumable) run."""
     parts = sorted(
         f"{m.spacecraft}:{m.chunk}:"
@@ -223,7 +225,9 @@ def fleet_run_key(members: Sequence[FleetMember], config: Any) -> str:
         f"{_file_digest(m.spacecraft_file)}"
         for m in members
     )
-    return run_key("detect attitude fleet", config_hash(config.hash_fields()), *parts)
+    stores = any(m.store for m in members)
+    budget = [f"store budget {store_budget.per_day}/day"] if stores and store_budget is not None else []
+    return run_key("detect attitude fleet", config_hash(config.hash_fields()), *budget, *parts)
 
 
 def detect_attitude_fleet(
@@ -235,18 +239,20 @@ def detect_attitude_fleet(
     command: str = "detect fleet",
     show_progress: bool | None = None,
     on_task: Callable[[str], None] | None = None,
+    store_budget: Any = None,
 ) -> FleetResult:
     """Detect strikes in every fleet member's telemetry; store each task in ``catalog`` as it finishes.
 
     With a catalog the run is resumable: tasks already stored under the same run key (same inputs and
     configuration) are not run again. The run id is derived from the run key, so a resumed run's
-    events are identical to those of an uninterrupted one.
+    events are identical to those of an uninterrupted one. ``store_budget``: the false-alarm budget of
+    store rows (the flight pipeline), when it differs from the telemetry detectors' ``config.budget``.
     """
-    key = fleet_run_key(members, config)
+    key = fleet_run_key(members, config, store_budget)
     run_id = key[:16]
     cat = Catalog(catalog) if catalog is not None else None
     done = cat.finished_tasks(key) if cat is not None else {}
-    tasks = [AttitudeTask(m, config, run_id) for m in members]
+    tasks = [AttitudeTask(m, config, run_id, store_budget if m.store else None) for m in members]
     todo = [t for t in tasks if t.key not in done]
     if cat is not None:
         cat.start_run(run_id, command, config_hash=config_hash(config.hash_fields()), details={"tasks": len(tasks)})
