@@ -56,6 +56,7 @@ from abrupt.simulate.confounders import (
     CONFOUNDER_CLASS,
     CONFOUNDER_KINDS,
     ConfounderRanges,
+    PhysicalLimits,
     draw_confounder,
     inject_confounders,
 )
@@ -161,6 +162,7 @@ def one_run(
     days: list[str] | None = None,
     near_fraction: float = 0.25,
     near_before: float = 0.0,
+    limits: PhysicalLimits | None = None,
 ):
     """Inject the plan (and near-strikes), run the pipeline, return the truth rows and the events.
     A near strike is 20-60 s after the confounder's onset, or (a share ``near_before`` of them) 15-60 s
@@ -178,7 +180,7 @@ def one_run(
                 {"kind": "strike", "class": "strike", "t_ns": t_ns, "end_ns": t_ns, "size": size, "near": False}
             )
             continue
-        c = draw_confounder(kind, t_ns, sc, ranges, rng)
+        c = draw_confounder(kind, t_ns, sc, ranges, rng, limits)
         confs.append(c)
         truth.append({"kind": kind, "class": CONFOUNDER_CLASS[kind], "t_ns": t_ns,
                       "end_ns": t_ns + int(c.duration_s * NS), "size": float("nan"), "near": False,
@@ -242,6 +244,11 @@ def main() -> int:
         default=0.0,
         help="Share of the near strikes put 15-60 s before the confounder's onset instead of after",
     )
+    ap.add_argument(
+        "--unbounded",
+        action="store_true",
+        help="Draw beyond the spacecraft's physical limits (wheel momentum and torque; the studies before them)",
+    )
     ap.add_argument("--dump", default=None, help="Write each run's events and truth as CSV files into this folder")
     ap.add_argument("--figure", default=None, help="Write the example panels (one event of each kind) to this PNG")
     args = ap.parse_args()
@@ -272,6 +279,16 @@ def main() -> int:
         f"ranges: {args.ranges}{f' x{args.widen:g}' if args.ranges == 'widened' else ''} "
         f"({'in-sample: the tests draw from these' if args.ranges == 'tests' else 'held out from the tests'})"
     )
+    limits = PhysicalLimits.none() if args.unbounded else PhysicalLimits.of(sc)
+    print(
+        f"physical limits of {sc.name}: "
+        + (
+            "none (--unbounded)"
+            if args.unbounded
+            else f"a leak, venting or dump moves <= {limits.momentum_Nms / 2:.1f} N·m·s (half the wheels' "
+            f"{limits.momentum_Nms:.1f} in any direction), a leak's torque <= {limits.torque_Nm:.3g} N·m"
+        )
+    )
     print(f"{len(slots)} quiet slots per run over {args.days} day(s); {args.runs} runs; kinds: {', '.join(kinds)}")
     t_start = time.time()
     # The threshold of the days as they are (1 false alarm/day): days with a confounder every 40 min
@@ -287,7 +304,17 @@ def main() -> int:
     for run in range(args.runs):
         plan = plan_run(run, args.per_kind, args.runs, slots, rng, kinds)
         truth, events = one_run(
-            store, sc, plan, ranges, rng, args.seed + run, threshold, days, args.near_fraction, args.near_before
+            store,
+            sc,
+            plan,
+            ranges,
+            rng,
+            args.seed + run,
+            threshold,
+            days,
+            args.near_fraction,
+            args.near_before,
+            limits,
         )
         m = match(truth, events)
         m["run"] = run
@@ -302,7 +329,9 @@ def main() -> int:
             events.to_csv(Path(args.dump) / f"events_run{run + 1}.csv", index=False)
             pd.concat([m, own], ignore_index=True).to_csv(Path(args.dump) / f"truth_run{run + 1}.csv", index=False)
         rows.append(m)
-        print(f"run {run + 1}: {len(plan)} injections, {len(events)} events, {time.time() - t_start:.0f} s", flush=True)
+        n_cap = sum('"capped"' in str(r.get("params", "")) for r in truth)
+        print(f"run {run + 1}: {len(plan)} injections ({n_cap} held within the physical limits), {len(events)} events, "
+              f"{time.time() - t_start:.0f} s", flush=True)  # fmt: skip
     table = pd.concat(rows, ignore_index=True)
     report(table)
     own = pd.concat(archive_rows, ignore_index=True) if archive_rows else pd.DataFrame({"got": []})
@@ -512,7 +541,7 @@ if __name__ == "__main__":
     seed = next((b for a, b in itertools.pairwise(sys.argv[1:]) if a == "--seed"), "1")
     with write_results(
         "bench_attribution",
-        variant({f"--ranges={r}": r for r in ("eval", "widened", "tests", "leaks")})
+        variant({**{f"--ranges={r}": r for r in ("eval", "widened", "tests", "leaks")}, "--unbounded": "unbounded"})
         + ("" if seed == "1" else f"_seed{seed}"),
     ):
         code = main()
