@@ -123,7 +123,8 @@ def step_with_sigma(g: np.ndarray, h: FloatArray, i0: int, dt: float) -> tuple[F
     """ΔH at row ``i0`` (3,) by least squares of a + b τ + s·1(τ ≥ 0) over ± ``STEP_HALF_S`` (the rows in
     ``STEP_GUARD_S`` left out) and its standard error per axis from the fit's residuals (3,). A neighbour's
     step inside the window (a strike half a minute before a dump) is fitted beside it
-    (:func:`_neighbour_step`), else its jump would count in the event's residuals and the event's."""
+    (:func:`_neighbour_step`), its own ``STEP_GUARD_S`` left out too, else its jump and its response would
+    count in the event's residuals."""
     rows = window_rows(g, i0, -STEP_HALF_S, STEP_HALF_S, dt)
     tau = (g[rows] - g[i0]) / NS
     keep = ((tau < STEP_GUARD_S[0]) | (tau >= STEP_GUARD_S[1])) & np.isfinite(h[rows]).all(axis=1)
@@ -133,6 +134,16 @@ def step_with_sigma(g: np.ndarray, h: FloatArray, i0: int, dt: float) -> tuple[F
     design = np.column_stack([np.ones(tau.size), tau / STEP_HALF_S, (tau >= 0).astype(float)])
     tc = _neighbour_step(tau, y, design)
     if math.isfinite(tc):
+        # The pair fitted together: the neighbour's step is a column, and its own pulses and the loop's first
+        # response (``STEP_GUARD_S`` about it, as about the event) are left out like the event's: a strike
+        # half a minute before a dump leaves a transient of a few per cent of its size (the loop's and the
+        # inertia's errors) that is neither step, and would count as the dump's noise.
+        clear = ((tau - tc) < STEP_GUARD_S[0]) | ((tau - tc) >= STEP_GUARD_S[1])
+        lo, hi = min(tc, 0.0), max(tc, 0.0)
+        between = ((tau[clear] >= lo) & (tau[clear] < hi)).sum()  # the level between the two steps
+        if (tau[clear] < lo).sum() >= 10 and (tau[clear] >= hi).sum() >= 10 and between >= 5:
+            tau, y = tau[clear], y[clear]
+            design = design[clear]
         design = np.column_stack([design, ((tau >= tc) if tc > 0 else (tau < tc)).astype(float)])
     coef, *_ = np.linalg.lstsq(design, y, rcond=None)
     res = y - design @ coef
