@@ -19,8 +19,12 @@ are reported apart; what is left is the events claimed by nothing.
 
 Ranges: ``eval`` (default) are this benchmark's own, different from the tests' defaults
 (``ConfounderRanges()``) in every parameter; ``widened`` stretches ``eval`` by 2 on a log scale
-(``--widen F``: by F); ``leaks`` is ``eval`` with the leaks of the issue's independent study (2e-5 to
-5e-4 N·m over 2-30 minutes; with ``--kinds thruster_leak`` the leak-detection study); ``tests`` uses
+(``--widen F``: by F), each draw then held within the spacecraft's hardware
+(``abrupt.simulate.confounders.PhysicalLimits``: a leak, venting or dump moves at most half of what the
+wheels hold in any direction, 50.3 N·m·s on kestrel; ``--unbounded`` draws as before those limits, when
+×3 gave a 0.25 N·m leak for 4.9 h, 4,387 N·m·s); ``leaks`` is ``eval`` with the leaks of the issue's
+independent study (2e-5 to 5e-4 N·m over 2-30 minutes; with ``--kinds thruster_leak`` the leak-detection
+study); ``tests`` uses
 the tests' ranges (in-sample for the rules' sanity, said in the output). The rules of
 ``abrupt.detect.attitude.attribution`` were set from physics and checked on the archive's 11 real strikes;
 no limit was tuned on these runs.
@@ -249,6 +253,7 @@ def main() -> int:
         action="store_true",
         help="Draw beyond the spacecraft's physical limits (wheel momentum and torque; the studies before them)",
     )
+    ap.add_argument("--label", default="", help="Suffix of the result file (a study of a subset, e.g. --kinds)")
     ap.add_argument("--dump", default=None, help="Write each run's events and truth as CSV files into this folder")
     ap.add_argument("--figure", default=None, help="Write the example panels (one event of each kind) to this PNG")
     args = ap.parse_args()
@@ -539,10 +544,12 @@ if __name__ == "__main__":
         sys.exit(main())
     # Draws other than the default seed's are a further held-out sample: their own result file.
     seed = next((b for a, b in itertools.pairwise(sys.argv[1:]) if a == "--seed"), "1")
+    label = next((b for a, b in itertools.pairwise(sys.argv[1:]) if a == "--label"), "")
     with write_results(
         "bench_attribution",
         variant({**{f"--ranges={r}": r for r in ("eval", "widened", "tests", "leaks")}, "--unbounded": "unbounded"})
-        + ("" if seed == "1" else f"_seed{seed}"),
+        + ("" if seed == "1" else f"_seed{seed}")
+        + (f"_{label}" if label else ""),
     ):
         code = main()
     sys.exit(code)
