@@ -72,30 +72,32 @@ def test_the_steps_standard_error_is_its_scatter_over_noise_draws() -> None:
 
 def test_a_step_half_a_minute_after_a_strike_keeps_the_sigma_of_its_noise() -> None:
     """A 0.024 N·m·s step 29 s after a 0.5 N·m·s strike whose loop leaves a transient of 3 % of it in ᴺH
-    (e-folding 5 s, settled within the 15 s the fit leaves out after a step; the catalogue inertia's error):
-    fitted together, the pair's step keeps its size, its σ stays that of the noise alone (within 30 %), and
-    the scatter of 300 draws is that σ (within 20 %)."""
+    (e-folding 8 s; the catalogue inertia's error), with the strike's step in ᴺH or already taken out: the
+    step keeps its size (within 6 %), its σ stays that of the noise alone (within 30 %), and the scatter of
+    300 draws is that σ (within 20 %)."""
     rng = np.random.default_rng(11)
     g = np.arange(600) * NS
     tau = np.arange(600) - 300.0
     strike = np.array([0.3, -0.35, 0.2])
     step = np.array([-0.02, 0.008, -0.0085])
     on = tau >= -29.0
-    transient = (0.03 * np.exp(-np.clip(tau + 29.0, 0.0, None) / 5.0) * on)[:, None] * strike
-    h_pair = on[:, None] * strike + transient + (tau >= 0)[:, None] * step
-    est, sig, sig_alone = [], [], []
-    for _ in range(300):
-        noise = rng.normal(0, 1e-3, (600, 3))
-        fit = step_with_sigma(g, h_pair + noise, 300, 1.0)
-        alone = step_with_sigma(g, (tau >= 0)[:, None] * step + noise, 300, 1.0)
-        assert fit is not None and alone is not None
-        est.append(fit[0])
-        sig.append(fit[1])
-        sig_alone.append(alone[1])
-    est_a, sig_a = np.asarray(est), np.asarray(sig)
-    assert np.allclose(est_a.mean(axis=0), step, atol=5e-4)
-    assert np.all(np.median(sig_a, axis=0) < 1.3 * np.median(sig_alone, axis=0))
-    assert np.allclose(est_a.std(axis=0) / np.median(sig_a, axis=0), 1.0, atol=0.2)
+    transient = (0.03 * np.exp(-np.clip(tau + 29.0, 0.0, None) / 8.0) * on)[:, None] * strike
+    # As the detector sees it, and once the strike's own fitted step is taken out of ᴺH (its transient stays).
+    for h_pair in (on[:, None] * strike + transient, transient):
+        h_pair = h_pair + (tau >= 0)[:, None] * step
+        est, sig, sig_alone = [], [], []
+        for _ in range(300):
+            noise = rng.normal(0, 5e-4, (600, 3))
+            fit = step_with_sigma(g, h_pair + noise, 300, 1.0)
+            alone = step_with_sigma(g, (tau >= 0)[:, None] * step + noise, 300, 1.0)
+            assert fit is not None and alone is not None
+            est.append(fit[0])
+            sig.append(fit[1])
+            sig_alone.append(alone[1])
+        est_a, sig_a = np.asarray(est), np.asarray(sig)
+        assert np.allclose(est_a.mean(axis=0), step, atol=1.5e-3)  # what is left of the transient biases it
+        assert np.all(np.median(sig_a, axis=0) < 1.3 * np.median(sig_alone, axis=0))
+        assert np.allclose(est_a.std(axis=0) / np.median(sig_a, axis=0), 1.0, atol=0.2)
 
 
 def _stored_B(sc: object) -> np.ndarray:
