@@ -71,10 +71,11 @@ def test_the_steps_standard_error_is_its_scatter_over_noise_draws() -> None:
 
 
 def test_a_step_half_a_minute_after_a_strike_keeps_the_sigma_of_its_noise() -> None:
-    """A 0.024 N·m·s step 29 s after a 0.5 N·m·s strike whose loop leaves a transient of 3 % of it in ᴺH
-    (e-folding 8 s; the catalogue inertia's error), with the strike's step in ᴺH or already taken out: the
-    step keeps its size (within 6 %), its σ stays that of the noise alone (within 30 %), and the scatter of
-    300 draws is that σ (within 20 %)."""
+    """A 0.024 N·m·s step 29 s after a 0.5 N·m·s strike, in noise of 5e-4 N·m·s: as the detector sees ᴺH (the
+    strike's step and a transient of 3 % of it, e-folding 8 s: the catalogue inertia's error), and as the
+    evidence sees it once the strike's fitted step is out (a bump of 0.024 N·m·s, 5 s wide, as on a Basilisk
+    spacecraft). The step keeps its size (within 1.5e-3 N·m·s), its σ stays within 50 % of the noise's alone
+    (the whole-window fit gave 3-5 times), and the scatter of 200 draws is that σ within 35 %."""
     rng = np.random.default_rng(11)
     g = np.arange(600) * NS
     tau = np.arange(600) - 300.0
@@ -82,11 +83,11 @@ def test_a_step_half_a_minute_after_a_strike_keeps_the_sigma_of_its_noise() -> N
     step = np.array([-0.02, 0.008, -0.0085])
     on = tau >= -29.0
     transient = (0.03 * np.exp(-np.clip(tau + 29.0, 0.0, None) / 8.0) * on)[:, None] * strike
-    # As the detector sees it, and once the strike's own fitted step is taken out of ᴺH (its transient stays).
-    for h_pair in (on[:, None] * strike + transient, transient):
-        h_pair = h_pair + (tau >= 0)[:, None] * step
+    bump = (0.024 * np.exp(-0.5 * ((tau + 24.0) / 5.0) ** 2))[:, None] * strike / np.linalg.norm(strike)
+    for neighbour in (on[:, None] * strike + transient, bump):
+        h_pair = neighbour + (tau >= 0)[:, None] * step
         est, sig, sig_alone = [], [], []
-        for _ in range(300):
+        for _ in range(200):
             noise = rng.normal(0, 5e-4, (600, 3))
             fit = step_with_sigma(g, h_pair + noise, 300, 1.0)
             alone = step_with_sigma(g, (tau >= 0)[:, None] * step + noise, 300, 1.0)
@@ -96,8 +97,8 @@ def test_a_step_half_a_minute_after_a_strike_keeps_the_sigma_of_its_noise() -> N
             sig_alone.append(alone[1])
         est_a, sig_a = np.asarray(est), np.asarray(sig)
         assert np.allclose(est_a.mean(axis=0), step, atol=1.5e-3)  # what is left of the transient biases it
-        assert np.all(np.median(sig_a, axis=0) < 1.3 * np.median(sig_alone, axis=0))
-        assert np.allclose(est_a.std(axis=0) / np.median(sig_a, axis=0), 1.0, atol=0.2)
+        assert np.all(np.median(sig_a, axis=0) < 1.5 * np.median(sig_alone, axis=0))
+        assert np.allclose(est_a.std(axis=0) / np.median(sig_a, axis=0), 1.0, atol=0.35)
 
 
 def _stored_B(sc: object) -> np.ndarray:
