@@ -19,8 +19,12 @@ are reported apart; what is left is the events claimed by nothing.
 
 Ranges: ``eval`` (default) are this benchmark's own, different from the tests' defaults
 (``ConfounderRanges()``) in every parameter; ``widened`` stretches ``eval`` by 2 on a log scale
-(``--widen F``: by F); ``leaks`` is ``eval`` with the leaks of the issue's independent study (2e-5 to
-5e-4 N·m over 2-30 minutes; with ``--kinds thruster_leak`` the leak-detection study); ``tests`` uses
+(``--widen F``: by F), each draw then held within the spacecraft's hardware
+(``abrupt.simulate.confounders.PhysicalLimits``: a leak, venting or dump moves at most half of what the
+wheels hold in any direction, 50.3 N·m·s on kestrel; ``--unbounded`` draws as before those limits, when
+×3 gave a 0.25 N·m leak for 4.9 h, 4,387 N·m·s); ``leaks`` is ``eval`` with the leaks of the issue's
+independent study (2e-5 to 5e-4 N·m over 2-30 minutes; with ``--kinds thruster_leak`` the leak-detection
+study); ``tests`` uses
 the tests' ranges (in-sample for the rules' sanity, said in the output). The rules of
 ``abrupt.detect.attitude.attribution`` were set from physics and checked on the archive's 11 real strikes;
 no limit was tuned on these runs.
@@ -56,6 +60,7 @@ from abrupt.simulate.confounders import (
     CONFOUNDER_CLASS,
     CONFOUNDER_KINDS,
     ConfounderRanges,
+    PhysicalLimits,
     draw_confounder,
     inject_confounders,
 )
@@ -161,6 +166,7 @@ def one_run(
     days: list[str] | None = None,
     near_fraction: float = 0.25,
     near_before: float = 0.0,
+    limits: PhysicalLimits | None = None,
 ):
     """Inject the plan (and near-strikes), run the pipeline, return the truth rows and the events.
     A near strike is 20-60 s after the confounder's onset, or (a share ``near_before`` of them) 15-60 s
@@ -178,7 +184,7 @@ def one_run(
                 {"kind": "strike", "class": "strike", "t_ns": t_ns, "end_ns": t_ns, "size": size, "near": False}
             )
             continue
-        c = draw_confounder(kind, t_ns, sc, ranges, rng)
+        c = draw_confounder(kind, t_ns, sc, ranges, rng, limits)
         confs.append(c)
         truth.append({"kind": kind, "class": CONFOUNDER_CLASS[kind], "t_ns": t_ns,
                       "end_ns": t_ns + int(c.duration_s * NS), "size": float("nan"), "near": False,
@@ -242,6 +248,12 @@ def main() -> int:
         default=0.0,
         help="Share of the near strikes put 15-60 s before the confounder's onset instead of after",
     )
+    ap.add_argument(
+        "--unbounded",
+        action="store_true",
+        help="Draw beyond the spacecraft's physical limits (wheel momentum and torque; the studies before them)",
+    )
+    ap.add_argument("--label", default="", help="Suffix of the result file (a study of a subset, e.g. --kinds)")
     ap.add_argument("--dump", default=None, help="Write each run's events and truth as CSV files into this folder")
     ap.add_argument("--figure", default=None, help="Write the example panels (one event of each kind) to this PNG")
     args = ap.parse_args()
@@ -272,6 +284,16 @@ def main() -> int:
         f"ranges: {args.ranges}{f' x{args.widen:g}' if args.ranges == 'widened' else ''} "
         f"({'in-sample: the tests draw from these' if args.ranges == 'tests' else 'held out from the tests'})"
     )
+    limits = PhysicalLimits.none() if args.unbounded else PhysicalLimits.of(sc)
+    print(
+        f"physical limits of {sc.name}: "
+        + (
+            "none (--unbounded)"
+            if args.unbounded
+            else f"a leak, venting or dump moves <= {limits.momentum_Nms / 2:.1f} N·m·s (half the wheels' "
+            f"{limits.momentum_Nms:.1f} in any direction), a leak's torque <= {limits.torque_Nm:.3g} N·m"
+        )
+    )
     print(f"{len(slots)} quiet slots per run over {args.days} day(s); {args.runs} runs; kinds: {', '.join(kinds)}")
     t_start = time.time()
     # The threshold of the days as they are (1 false alarm/day): days with a confounder every 40 min
@@ -287,7 +309,17 @@ def main() -> int:
     for run in range(args.runs):
         plan = plan_run(run, args.per_kind, args.runs, slots, rng, kinds)
         truth, events = one_run(
-            store, sc, plan, ranges, rng, args.seed + run, threshold, days, args.near_fraction, args.near_before
+            store,
+            sc,
+            plan,
+            ranges,
+            rng,
+            args.seed + run,
+            threshold,
+            days,
+            args.near_fraction,
+            args.near_before,
+            limits,
         )
         m = match(truth, events)
         m["run"] = run
@@ -302,7 +334,9 @@ def main() -> int:
             events.to_csv(Path(args.dump) / f"events_run{run + 1}.csv", index=False)
             pd.concat([m, own], ignore_index=True).to_csv(Path(args.dump) / f"truth_run{run + 1}.csv", index=False)
         rows.append(m)
-        print(f"run {run + 1}: {len(plan)} injections, {len(events)} events, {time.time() - t_start:.0f} s", flush=True)
+        n_cap = sum('"capped"' in str(r.get("params", "")) for r in truth)
+        print(f"run {run + 1}: {len(plan)} injections ({n_cap} held within the physical limits), {len(events)} events, "
+              f"{time.time() - t_start:.0f} s", flush=True)  # fmt: skip
     table = pd.concat(rows, ignore_index=True)
     report(table)
     own = pd.concat(archive_rows, ignore_index=True) if archive_rows else pd.DataFrame({"got": []})
@@ -510,10 +544,12 @@ if __name__ == "__main__":
         sys.exit(main())
     # Draws other than the default seed's are a further held-out sample: their own result file.
     seed = next((b for a, b in itertools.pairwise(sys.argv[1:]) if a == "--seed"), "1")
+    label = next((b for a, b in itertools.pairwise(sys.argv[1:]) if a == "--label"), "")
     with write_results(
         "bench_attribution",
-        variant({f"--ranges={r}": r for r in ("eval", "widened", "tests", "leaks")})
-        + ("" if seed == "1" else f"_seed{seed}"),
+        variant({**{f"--ranges={r}": r for r in ("eval", "widened", "tests", "leaks")}, "--unbounded": "unbounded"})
+        + ("" if seed == "1" else f"_seed{seed}")
+        + (f"_{label}" if label else ""),
     ):
         code = main()
     sys.exit(code)

@@ -433,8 +433,8 @@ def process_span(
     )
     peaks = [(i, replace(p, dH_N_Nms=revised[p.time_ns][0]) if p.time_ns in revised else p) for i, p in peaks]
     peaks, evidence = peaks + beside, {**evidence, **{t: e for t, (_, e) in revised.items()}, **beside_ev}
-    strikes = {t for t, e in evidence.items() if classify(e).kind == "strike"}
-    peaks = detector.with_local_levels(peaks, stat, g, exempt=strikes)
+    strikes = {t for t, e in evidence.items() if classify(e).kind == "strike"} | {p.time_ns for _, p in beside}
+    peaks = detector.with_local_levels(peaks, stat, g, exempt=strikes)  # and steps fitted beside a neighbour
     ratio_times, ratios = detector.null_ratios(stat, g, dt, keep=core)
     faults = scan_span(samples, flight, table, spacecraft, ok, start_ns, end_ns)
     edges = [start_ns, end_ns]

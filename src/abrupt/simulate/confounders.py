@@ -137,6 +137,49 @@ class Confounder:
         return float(self.params.get("duration_s", 0.0))
 
 
+@dataclass(frozen=True)
+class PhysicalLimits:
+    """What the spacecraft's hardware allows a confounder to be (from its file; ``inf`` without wheels).
+
+    * ``momentum_Nms``: momentum the wheel array holds in ANY direction with the min-norm allocation
+      h = G⁺H (G the 3×n wheel axes): |h_i| ≤ J_s,i Ω_max,i gives |H| ≤ 1 / max_i(‖row_i G⁺‖ / (J_s Ω_max)_i).
+      A confounder that moves more than half of it would saturate the wheels (they already hold momentum),
+      and the spacecraft would lose attitude control: that is no subtle confounder.
+    * ``torque_Nm``: the torque the wheels counter in any direction (same bound with the wheels' torques).
+    * ``wheel_speed_rad_s``: the slowest wheel's speed limit (a reading offset beyond it is no reading).
+    * ``tachometer_pulses``: the most pulses a tachometer counts in one gate at that speed.
+    """
+
+    momentum_Nms: float
+    torque_Nm: float
+    wheel_speed_rad_s: float
+    tachometer_pulses: float
+
+    @classmethod
+    def none(cls) -> PhysicalLimits:
+        """No limit: the ranges' draws as they are (to reproduce studies made before the limits)."""
+        return cls(math.inf, math.inf, math.inf, math.inf)
+
+    @classmethod
+    def of(cls, spacecraft: Spacecraft) -> PhysicalLimits:
+        if not spacecraft.wheels:
+            return cls.none()
+        rows = np.linalg.norm(np.linalg.pinv(spacecraft.wheel_axes), axis=1)
+        h_max = spacecraft.wheel_spin_inertias_kgm2 * spacecraft.wheel_max_speeds_rad_s
+        speed = float(spacecraft.wheel_max_speeds_rad_s.min())
+        pulses = math.inf
+        for ch in spacecraft.flight.of("wheel_speed") if spacecraft.flight is not None else []:
+            if ch.tachometer is not None:
+                t = ch.tachometer
+                pulses = min(pulses, t.pulses_per_rev * speed / (2 * math.pi) * t.gate_s)
+        return cls(
+            momentum_Nms=float(1.0 / np.max(rows / h_max)),
+            torque_Nm=float(1.0 / np.max(rows / spacecraft.wheel_max_torques_Nm)),
+            wheel_speed_rad_s=speed,
+            tachometer_pulses=pulses,
+        )
+
+
 def _log_uniform(rng: np.random.Generator, r: Range) -> float:
     return float(math.exp(rng.uniform(math.log(r[0]), math.log(r[1]))))
 
@@ -147,10 +190,22 @@ def _unit(rng: np.random.Generator) -> FloatArray:
 
 
 def draw_confounder(
-    kind: str, time_ns: int, spacecraft: Spacecraft, ranges: ConfounderRanges, rng: np.random.Generator
+    kind: str,
+    time_ns: int,
+    spacecraft: Spacecraft,
+    ranges: ConfounderRanges,
+    rng: np.random.Generator,
+    limits: PhysicalLimits | None = None,
 ) -> Confounder:
-    """One confounder of ``kind`` at ``time_ns`` with parameters drawn from ``ranges``."""
+    """One confounder of ``kind`` at ``time_ns`` with parameters drawn from ``ranges``, then held within
+    the spacecraft's :class:`PhysicalLimits` (``limits``; its own by default): a leak, venting or dump
+    moves at most half the wheels' momentum capacity and a leak's torque is one the wheels counter; a
+    snap's hub momentum I_a θ̇ is at most half that capacity; a wheel reading is off by at most the wheel's
+    speed range, a miscount by at most one gate's pulses at that speed. The draws of ``rng`` are the same
+    with or without a cap, and ``params["capped"]`` names what was cut (a widened range reaches these)."""
     r = ranges
+    lim = PhysicalLimits.of(spacecraft) if limits is None else limits
+    half_h = 0.5 * lim.momentum_Nms
     n_wheels = len(spacecraft.wheels)
     if kind == "star_tracker_jump":
         p = {
@@ -175,45 +230,56 @@ def draw_confounder(
         w = int(rng.integers(max(n_wheels, 1)))
         sign = float(rng.choice([-1.0, 1.0]))
         if kind == "tachometer_miscount":
-            p = {"pulses": sign * round(_log_uniform(rng, r.tachometer_miscount_pulses)), "wheel": w}
+            n_p = round(_log_uniform(rng, r.tachometer_miscount_pulses))
+            capped = n_p > lim.tachometer_pulses
+            p = {"pulses": sign * (math.floor(lim.tachometer_pulses) if capped else n_p), "wheel": w}
         else:
+            rpm = _log_uniform(rng, r.wheel_glitch_rpm)
+            rpm_max = lim.wheel_speed_rad_s * 60.0 / (2 * math.pi)
             p = {
-                "offset_rpm": sign * _log_uniform(rng, r.wheel_glitch_rpm),
+                "offset_rpm": sign * min(rpm, rpm_max),
                 "duration_s": float(rng.uniform(*r.wheel_glitch_duration_s)),
                 "wheel": w,
             }
-        return Confounder(kind, time_ns, f"wheel_{w + 1}", p)
+            capped = rpm > rpm_max
+        return Confounder(kind, time_ns, f"wheel_{w + 1}", p | ({"capped": "wheel speed range"} if capped else {}))
     if kind == "thruster_leak":
-        tau = _log_uniform(rng, r.leak_torque_Nm) * _unit(rng)
+        tau_Nm = _log_uniform(rng, r.leak_torque_Nm)
+        tau = min(tau_Nm, lim.torque_Nm) * _unit(rng)
         arm = float(rng.uniform(*r.leak_lever_arm_m))
         r_hat = _unit(rng)
         r_hat -= tau * (tau @ r_hat) / (tau @ tau)  # r ⊥ τ so that r × F = τ with F ⊥ r
         r_vec = arm * r_hat / np.linalg.norm(r_hat)
         force = np.cross(tau, r_vec) / arm**2  # r × (τ × r)/|r|² = τ
+        dur = float(rng.uniform(*r.leak_duration_s))
+        dur_max = half_h / float(np.linalg.norm(tau))
         p = {
             "torque_B_Nm": tau.tolist(),
-            "duration_s": float(rng.uniform(*r.leak_duration_s)),
+            "duration_s": min(dur, dur_max),
             "force_B_N": force.tolist(),
             "position_B_m": r_vec.tolist(),
         }
-        return Confounder(kind, time_ns, "thruster", p)
+        cut = [n for n, c in (("wheel torque", tau_Nm > lim.torque_Nm), ("wheel momentum", dur > dur_max)) if c]
+        return Confounder(kind, time_ns, "thruster", p | ({"capped": ", ".join(cut)} if cut else {}))
     if kind == "venting":
         n = round(rng.uniform(*r.vent_pulses))
         direction = _unit(rng)
         gaps = [float(rng.uniform(*r.vent_interval_s)) for _ in range(n - 1)]
         sizes = [_log_uniform(rng, r.vent_impulse_Nms) for _ in range(n)]
+        scale = min(1.0, half_h / sum(sizes))
+        sizes = [scale * x for x in sizes]
         p = {
             "direction_B": direction.tolist(),
             "offsets_s": np.concatenate([[0.0], np.cumsum(gaps)]).tolist(),
             "impulses_Nms": sizes,
             "duration_s": float(sum(gaps)),
         }
-        return Confounder(kind, time_ns, "vent", p)
+        return Confounder(kind, time_ns, "vent", p | ({"capped": "wheel momentum"} if scale < 1.0 else {}))
     if kind == "momentum_dump":
         n = max(1, round(rng.uniform(*r.dump_pulses)))
         gaps = [float(rng.uniform(*r.dump_pulse_gap_s)) for _ in range(n - 1)]
         p = {
-            "impulse_Nms": _log_uniform(rng, r.dump_impulse_Nms),
+            "impulse_Nms": min(_log_uniform(rng, r.dump_impulse_Nms), half_h),
             "offsets_s": np.concatenate([[0.0], np.cumsum(gaps)]).tolist(),
             "aim_deg": min(_log_uniform(rng, r.dump_aim_deg), DUMP_AIM_MAX_DEG),
             "aim_axis_B": _unit(rng).tolist(),
@@ -223,12 +289,13 @@ def draw_confounder(
     if kind == "appendage_snap":
         if not spacecraft.appendages:
             raise ConfigError("appendage_snap needs an appendage in the spacecraft file", key="appendages")
-        p = {
-            "angle_deg": float(rng.choice([-1.0, 1.0])) * _log_uniform(rng, r.snap_angle_deg),
-            "duration_s": float(rng.uniform(*r.snap_duration_s)),
-            "appendage": spacecraft.appendages[0].name,
-        }
-        return Confounder(kind, time_ns, spacecraft.appendages[0].name, p)
+        sign = float(rng.choice([-1.0, 1.0]))
+        angle = _log_uniform(rng, r.snap_angle_deg)
+        dur = float(rng.uniform(*r.snap_duration_s))
+        app = spacecraft.appendages[0]
+        angle_max = math.degrees(half_h * dur / app.drive_inertia_kgm2)  # I_a θ̇ ≤ half the wheels' capacity
+        p = {"angle_deg": sign * min(angle, angle_max), "duration_s": dur, "appendage": app.name}
+        return Confounder(kind, time_ns, app.name, p | ({"capped": "wheel momentum"} if angle > angle_max else {}))
     raise ConfigError(f"unknown confounder kind {kind!r}; known: {', '.join(CONFOUNDER_KINDS)}", key="kind")
 
 
