@@ -9,6 +9,7 @@ import math
 import numpy as np
 import pandas as pd
 import pytest
+from sgp4.conveniences import sat_epoch_datetime
 
 from abrupt.detect.tle.detectors import TleMeanElements
 from abrupt.detect.tle.response import local_spans_s, response_hosts, span_fraction, span_fraction_with_drift
@@ -26,6 +27,13 @@ RHO = np.array([-0.3, 0.2, 0.4, 0.6, 0.8, 1.0, 1.3])
 def jason_like() -> object:
     """A 1336 km, 66° near-circular orbit (Jason's)."""
     return initial_record(7714.4e3, 0.0008, math.radians(66.04), math.radians(90.0), 1.0)
+
+
+def test_the_fitted_truth_starts_at_the_simulated_histories_epoch(jason_like: object) -> None:
+    """The SGP4 record the fitted truth starts from has the simulated histories' first epoch, as sgp4
+    itself reads its epoch (days since 1949-12-31 00:00 UTC)."""
+    epoch = sat_epoch_datetime(jason_like)  # type: ignore[arg-type]
+    assert epoch.replace(tzinfo=None) == EPOCH0.to_pydatetime()
 
 
 @pytest.mark.parametrize(("drift", "formula"), [(False, span_fraction), (True, span_fraction_with_drift)])
