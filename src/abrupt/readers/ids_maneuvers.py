@@ -86,12 +86,12 @@ MAX_ABS_VALUE = 1e6  # [s, m/s, m/s^2]: a burn duration, delta-v or acceleration
 def read_ids_maneuvers(path: str | Path, *, repairs: RepairLog | None = None) -> pd.DataFrame:
     """Read an IDS maneuver file: one row per maneuver window, times in UTC.
 
-        Columns (:data:`MANEUVER_COLUMNS`): ``time_utc`` is the first burn's epoch, ``dv_*`` the sum of
-        the burns' components in the orbit frame (m/s), ``dv_mps`` the sum of burn magnitudes,
-        ``dv_n_abs_mps`` the sum of the burns' |cross-track| components (a pair of opposite cross-track
+    Columns (:data:`MANEUVER_COLUMNS`): ``time_utc`` is the first burn's epoch, ``dv_*`` the sum of
+    the burns' components in the orbit frame (m/s), ``dv_mps`` the sum of burn magnitudes,
+    ``dv_n_abs_mps`` the sum of the burns' |cross-track| components (a pair of opposite cross-track
     burns half an orbit apart turns the orbit plane by both, while their summed components net to zero),
     ``duration_s`` the total burn time. Exact duplicate lines are dropped and counted; rows are
-        sorted by time (counted when the file was out of order).
+    sorted by time (counted when the file was out of order).
     """
     path = Path(path)
     file = str(path)

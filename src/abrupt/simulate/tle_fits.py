@@ -31,7 +31,7 @@ from abrupt.units import SECONDS_PER_DAY
 
 EARTH_RADIUS_M = 6378135.0  # WGS-72, as SGP4
 J2_WGS72 = 0.001082616
-EPOCH_1949_DAYS = 22645.0  # 2012-01-01 in days since 1949-12-31 (SGP4's epoch origin)
+EPOCH_1949_DAYS = 22646.0  # 2012-01-01 00:00 UTC (tle_null.EPOCH0) in days since 1949-12-31 00:00 UTC (SGP4's origin)
 MINUTES = 60.0
 
 
@@ -243,7 +243,7 @@ def blended_history(
     return history_from_series(t_days, series, "leo", norad=99952)
 
 
-# detector series of mean_element_series -> series of history_from_series
+# series of history_from_series (keys) <- detector series of mean_element_series (values)
 SERIES_KEYS = {
     "a_m": "a_m",
     "ex": "ex",

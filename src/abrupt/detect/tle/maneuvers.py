@@ -54,7 +54,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import Any, NamedTuple
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -65,6 +65,7 @@ from abrupt.detect.tle.arcs import join_arcs
 from abrupt.detect.tle.burns import campaign_cadence_s, characterise, label_campaigns
 from abrupt.detect.tle.campaign_steps import relocated_steps
 from abrupt.detect.tle.campaigns import find_campaigns
+from abrupt.detect.tle.candidates import Candidate, out_of_order
 from abrupt.detect.tle.config import CAMPAIGN_SIDE_SETS, EXTRA_COLUMNS, TleDetectorConfig
 from abrupt.detect.tle.elements import arcs, circular_speed_mps, history_rows, orbit_regime
 from abrupt.detect.tle.intervals import interval_utc, lag_bound_s, own_lags_s
@@ -108,16 +109,6 @@ from abrupt.units import SECONDS_PER_DAY
 DETECTOR_NAMES = {"leo": "tle.mean_elements", "geo": "tle.geo_station_keeping"}
 
 
-class Candidate(NamedTuple):
-    """A step kept for timing: its gap, the burn time and whether the along-track fit gave it, and the
-    start of the interval the burn lies in (s from the first epoch)."""
-
-    gap: int
-    time_s: float
-    refined: bool
-    start_s: float
-
-
 @dataclass
 class StepRun:
     """What the stages after the segmentation share: the history, settings, step model, the final
@@ -139,6 +130,9 @@ class StepRun:
     era_span_s: dict[int, float] = field(default_factory=dict)
     # the whole change of ``a`` (m) of each detection timed from its blended sets (the response's fit)
     ramp_delta_a: dict[int, float] = field(default_factory=dict)
+    # the sets ``lo..hi-1`` each such fit spans, and the ramps' (times, fitted spans) (s) of the history
+    ramp_windows: dict[int, tuple[int, int]] = field(default_factory=dict)
+    ramp_eras: tuple[NDArray[np.float64], NDArray[np.float64]] = (np.zeros(0), np.zeros(0))
 
 
 def detect_mean_elements(
@@ -378,6 +372,7 @@ def ramp_times(run: StepRun, timed: list[Candidate]) -> list[Candidate]:
     }
     ramp_t = np.asarray([float(model.t[g]) for g in ramps], dtype=float)
     ramp_span = np.asarray([ramp_span_s(model.t, a, r) for r in ramps.values()], dtype=float)
+    run.ramp_eras = (ramp_t, ramp_span)
     profiles: dict[int, list[tuple[NDArray[np.float64], NDArray[np.float64]]]] = {}
     dofs: dict[int, int] = {}
     for g, (lo, hi, last_old, _, noise) in splits.items():
@@ -390,7 +385,7 @@ def ramp_times(run: StepRun, timed: list[Candidate]) -> list[Candidate]:
             profiles[g].append((grid, ramp_profile(model.t, a, lo, hi, grid, span, noise)))
         dofs[g] = hi - lo - 3
         t_best = float(profiles[g][0][0][int(np.argmin(profiles[g][0][1]))])
-        run.ramp_delta_a[g] = ramp_delta_a_m(model.t, a, lo, hi, t_best, spans[0])
+        run.ramp_delta_a[g], run.ramp_windows[g] = ramp_delta_a_m(model.t, a, lo, hi, t_best, spans[0]), (lo, hi)
     if not profiles:
         return timed
     rise = interval_cost([float(np.min(p[0][1])) / max(dofs[g], 1) for g, p in profiles.items()], RAMP_LEVEL)
@@ -484,13 +479,6 @@ def tle_lag_s(run: StepRun, items: list[Candidate]) -> float:
     alone = [int(np.sum(np.abs(times - it.time_s) <= reach_s)) == 1 for it in items]
     lags = [float(run.model.t[it.gap]) - it.time_s for it, a in zip(items, alone, strict=True) if it.refined and a]
     return float(np.quantile(np.maximum(lags, 0.0), 0.9)) if len(lags) >= 5 else 0.0
-
-
-def out_of_order(x: Candidate, y: Candidate) -> bool:
-    """Steps in neighbouring gaps (≤ 2 apart) whose burn times run against the gaps' order are one burn
-    spread by a set fitted across it (its partial mean motion times the later step before the earlier
-    one), not two burns."""
-    return 0 < abs(x.gap - y.gap) <= 2 and (x.gap - y.gap) * (x.time_s - y.time_s) < 0
 
 
 def one_burn_with_neighbour(run: StepRun, x: Candidate, lag0_s: float) -> tuple[bool, float | None, int]:
@@ -590,18 +578,23 @@ def join_response_tails(run: StepRun, kept: list[Candidate], span_of: dict[int, 
     """One event per burn whose response spreads over sets fitted across it: a detected step of the same
     sign while the sets still respond to an earlier one is the rest of that response
     (:func:`abrupt.detect.tle.response.response_hosts`). The strongest step of the burn is its event,
-    timed by the one response fitted through the window, over the union of the members' intervals."""
+    timed by the one response fitted through the window, over the union of the members' intervals, and
+    carries the response's whole change of ``a`` fitted through the members' windows. The fit span is
+    the era's from its ramps (:func:`ramp_times`), else the hinge fits' (short where one burn shows twice)."""
     found = [it for it in kept if run.stat[it.gap] >= run.threshold]
     if len(found) < 2:
         return kept
     t_one: dict[int, float] = {}
+    reach_s, t, a = RAMP_ERA_DAYS * SECONDS_PER_DAY, run.model.t, np.asarray(run.model.s["a_m"], dtype=float)
+    ramp_s = [local_spans_s(float(t[it.gap]), *run.ramp_eras, reach_s)[0] for it in found]
+    spans = [r if math.isfinite(r) else run.era_span_s.get(it.gap, 0.0) for r, it in zip(ramp_s, found, strict=True)]
     host = response_hosts(
-        run.model.t,
-        np.asarray(run.model.s["a_m"], dtype=float),
+        t,
+        a,
         np.array([it.gap for it in found], dtype=np.int64),
         np.array([it.time_s for it in found]),
         np.array([float(run.steps.delta_a_m[it.gap]) for it in found]),
-        np.array([run.era_span_s.get(it.gap, 0.0) for it in found]),
+        np.array(spans),
         np.array([float(run.model.scales["a_m"][it.gap]) for it in found]),
         run.cfg.time_window_sets,
         t_one,
@@ -614,6 +607,11 @@ def join_response_tails(run: StepRun, kept: list[Candidate], span_of: dict[int, 
         span = [min(t_b, *(span_of[it.gap][0] for it in members)), max(span_of[it.gap][1] for it in members)]
         span_of[keep.gap][:] = span
         timed[keep.gap] = Candidate(keep.gap, t_b, True, span[0])
+        w = run.cfg.time_window_sets
+        lo = max(0, min(run.ramp_windows.get(it.gap, (it.gap + 1 - w, 0))[0] for it in members))
+        hi = min(t.size, max(run.ramp_windows.get(it.gap, (0, it.gap + 1 + w))[1] for it in members))
+        run.ramp_windows[keep.gap] = (lo, hi)
+        run.ramp_delta_a[keep.gap] = ramp_delta_a_m(t, a, lo, hi, t_b, spans[root])
     return [timed.get(it.gap, it) for it in kept if it.gap not in drop]
 
 
@@ -634,6 +632,7 @@ def event_fields(
     assert steps.sigma_a_m is not None and steps.sigma_n_rad is not None
     assert steps.z_u is not None and steps.delta_u_m is not None
     out: list[dict[str, Any]] = []
+    gaps = np.asarray([it.gap for it in kept], dtype=np.int64)
     for g, t_m, refined, _ in kept:
         t_lo, t_hi = min(span_of[g][0], t_m), max(span_of[g][1], t_m)  # the event's time lies in its interval
         sigma = (t_hi - t_lo) / math.sqrt(12.0)  # uniform over the stated interval
@@ -641,7 +640,10 @@ def event_fields(
         a_ref = float(el["a_m"].iloc[g])
         w = steps.weights
         wz = (w[0] * float(steps.z_a[g]), w[1] * float(steps.z_e[g]), w[2] * float(steps.z_n[g]))
-        delta_a = run.ramp_delta_a.get(g, float(steps.delta_a_m[g]))  # blended: the response's whole change
+        # blended: the response's whole change, unless another event lies in its window (then the step's)
+        lo, hi = run.ramp_windows.get(g, (g, g + 1))
+        alone = int(np.sum((gaps >= lo) & (gaps < hi - 1))) == 1
+        delta_a = run.ramp_delta_a[g] if g in run.ramp_delta_a and alone else float(steps.delta_a_m[g])
         ch = characterise(delta_a, steps.delta_e[g], steps.delta_normal_rad[g], a_ref, wz)
         v = circular_speed_mps(a_ref)
         kind = str(ch["maneuver_type"])
