@@ -66,6 +66,10 @@ from abrupt.simulate.confounders import (
 )
 from abrupt.simulate.injection import InjectedStrike, inject_strikes
 from abrupt.store import TelemetryStore
+from abrupt.thresholds import FalseAlarmBudget
+
+# The budget of the documented figures (docs/attribution.md; the flight pipeline's default is lower).
+BUDGET = FalseAlarmBudget(1.0, "day")
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT.parent / "shared" / "data" / "flight-like"
@@ -203,7 +207,7 @@ def one_run(
         s = inject_strikes(s, sc, strikes, seed=run_seed)
         return inject_confounders(s, sc, confs, seed=run_seed)
 
-    res = run_flight(store, sc, FlightRunConfig(), days=days, samples_hook=hook, threshold=threshold)
+    res = run_flight(store, sc, FlightRunConfig(budget=BUDGET), days=days, samples_hook=hook, threshold=threshold)
     return truth, res.events
 
 
@@ -298,7 +302,7 @@ def main() -> int:
     t_start = time.time()
     # The threshold of the days as they are (1 false alarm/day): days with a confounder every 40 min
     # are no null to calibrate on (their block maxima are the confounders).
-    plain = run_flight(store, sc, FlightRunConfig(), days=days, keep_series=True)
+    plain = run_flight(store, sc, FlightRunConfig(budget=BUDGET), days=days, keep_series=True)
     threshold = plain.threshold
     print(f"threshold {threshold.value:.2f} calibrated on the days without injections")
     archive_figures(plain.events, args.days)
@@ -429,7 +433,13 @@ def figure(store: Path, sc, ranges: ConfounderRanges, path: str, seed: int, verb
         return captured["s"]
 
     chunk = process_chunk(
-        TelemetryStore(store), sc, T0_NS, T0_NS + DAY_NS, FlightRunConfig(), keep_series=True, samples_hook=hook
+        TelemetryStore(store),
+        sc,
+        T0_NS,
+        T0_NS + DAY_NS,
+        FlightRunConfig(budget=BUDGET),
+        keep_series=True,
+        samples_hook=hook,
     )
     assert chunk.series is not None
     flight = flight_channels(sc)
