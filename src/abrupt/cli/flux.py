@@ -507,7 +507,9 @@ def store_run_exposure(
     """Store a detection run's exposure rows (one per analysed day) in its catalog; returns the row count."""
     days = [str(d) for d in daily["day"]]
     if recovery:
-        curves = flux_exposure.efficiency_per_day(pd.read_csv(recovery), days, source=recovery)
+        curves = flux_exposure.efficiency_per_day(
+            pd.read_csv(recovery), days, source=recovery, false_alarms_per_day=false_alarms_per_day
+        )
     elif dh90:
         curves = dict.fromkeys(days, flux_exposure.EfficiencyCurve.from_dH90(dh90))
     else:

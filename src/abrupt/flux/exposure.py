@@ -165,16 +165,32 @@ def fit_efficiency(dH_Nms: ArrayLike, found: ArrayLike, *, fit_plateau: bool = F
 
 
 def efficiency_per_day(
-    injections: pd.DataFrame, days: Sequence[str], *, source: str = "recovery table"
+    injections: pd.DataFrame,
+    days: Sequence[str],
+    *,
+    source: str = "recovery table",
+    false_alarms_per_day: float | None = None,
 ) -> dict[str, EfficiencyCurve]:
     """Efficiency curve per day from an injection-recovery table (``dH_Nms``, ``found``, optional ``day``).
 
     Each day with injections that bracket the threshold gets its own fit (plateau included); a day
-    without (no injections, or all or none recovered) gets the fit of all days pooled.
+    without (no injections, or all or none recovered) gets the fit of all days pooled. A table that
+    states the budget it was made at (``false_alarms_per_day``, written by ``inject attitude
+    --recovery``) is refused for a detection run at another budget: its efficiency was measured at
+    another threshold, and the flux inferred from it would be biased.
     """
     for col in ("dH_Nms", "found"):
         if col not in injections.columns:
             raise InputError(f"{source}: no column {col!r} (expected dH_Nms, found[, day])")
+    if false_alarms_per_day is not None and "false_alarms_per_day" in injections.columns:
+        made = pd.to_numeric(injections["false_alarms_per_day"], errors="coerce").dropna().unique()
+        if any(not math.isclose(float(m), false_alarms_per_day, rel_tol=1e-6) for m in made):
+            raise InputError(
+                f"{source}: injections recovered at {', '.join(f'{m:g}' for m in made)} false alarms/day, "
+                f"the detection ran at {false_alarms_per_day:g}/day: rerun `inject attitude --recovery` at "
+                f"--false-alarms {false_alarms_per_day:g}/day",
+                column="false_alarms_per_day",
+            )
     found = injections["found"].astype(str).str.lower().isin(("true", "1", "yes"))
     sizes = pd.to_numeric(injections["dH_Nms"], errors="coerce").to_numpy()
     pooled = fit_efficiency(sizes, found.to_numpy(), fit_plateau=True)

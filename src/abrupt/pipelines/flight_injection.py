@@ -154,7 +154,8 @@ def _recover_day(
             if found:
                 best = min(match, key=lambda p: abs(p.time_ns - s.time_ns))
                 err = float(np.linalg.norm(best.dH_N_Nms) / s.magnitude_Nms - 1.0)
-            rows.append({"day": day, "time_ns": s.time_ns, "dH_Nms": s.magnitude_Nms, "found": found, "rel_err": err})
+            rows.append({"day": day, "time_ns": s.time_ns, "dH_Nms": s.magnitude_Nms, "found": found, "rel_err": err,
+                         "false_alarms_per_day": config.budget.per_day})  # fmt: skip
 
 
 def _recovery_result(rows: list[dict[str, Any]], rng: np.random.Generator) -> RecoveryResult:
