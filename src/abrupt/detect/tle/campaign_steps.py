@@ -38,37 +38,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
 from abrupt.detect.tle.campaigns import chain, total_step
-from abrupt.detect.tle.config import TleDetectorConfig
+from abrupt.detect.tle.candidates import Candidate, StepRun
 from abrupt.detect.tle.outliers import outlier_mask
-from abrupt.detect.tle.steps import StepModel, StepSeries, fill_gaps
-from abrupt.readers.tle import ElementHistory
+from abrupt.detect.tle.steps import StepModel, fill_gaps
 from abrupt.thresholds import DAYS_PER_YEAR, FalseAlarmBudget
 from abrupt.units import SECONDS_PER_DAY
-
-
-class _Timed(Protocol):
-    @property
-    def gap(self) -> int: ...
-
-    @property
-    def time_s(self) -> float: ...
-
-
-class _Run(Protocol):
-    history: ElementHistory
-    cfg: TleDetectorConfig
-    regime: str
-    model: StepModel
-    steps: StepSeries
-    stat: NDArray[np.float64]
-    threshold: float
-
 
 REVERSAL_FRACTION = 0.5  # a neighbouring step of the opposite sign and this share of the size undoes it
 
@@ -114,7 +93,7 @@ def set_steps(
     return {g: z for g, (da, z) in rows.items() if da >= fraction * biggest}
 
 
-def relocated_steps(run: _Run, kept: Sequence[_Timed]) -> tuple[set[int], dict[int, float]]:
+def relocated_steps(run: StepRun, kept: Sequence[Candidate]) -> tuple[set[int], dict[int, float]]:
     """(gaps to drop, gap → set-to-set z of the steps to add) inside every campaign: a member whose own
     gap carries no step of ``a`` while a next gap does is moved there (the window test localises a
     staircase of burns a gap off), and every other gap carrying a step gets a maneuver of its own."""

@@ -53,7 +53,7 @@ and merges the steps of one burn.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -65,7 +65,7 @@ from abrupt.detect.tle.arcs import join_arcs
 from abrupt.detect.tle.burns import campaign_cadence_s, characterise, label_campaigns
 from abrupt.detect.tle.campaign_steps import relocated_steps
 from abrupt.detect.tle.campaigns import find_campaigns
-from abrupt.detect.tle.candidates import Candidate, out_of_order
+from abrupt.detect.tle.candidates import Candidate, StepRun, out_of_order
 from abrupt.detect.tle.config import CAMPAIGN_SIDE_SETS, EXTRA_COLUMNS, TleDetectorConfig
 from abrupt.detect.tle.elements import arcs, circular_speed_mps, history_rows, orbit_regime
 from abrupt.detect.tle.intervals import interval_utc, lag_bound_s, own_lags_s
@@ -82,8 +82,6 @@ from abrupt.detect.tle.response import (
 )
 from abrupt.detect.tle.segmentation import segment
 from abrupt.detect.tle.steps import (
-    StepModel,
-    StepSeries,
     block_scale,
     detectable_by_year,
     first_pass,
@@ -107,32 +105,6 @@ from abrupt.units import SECONDS_PER_DAY
 
 # The registered detector of each regime (abrupt.detect.tle.detectors): the name its events carry.
 DETECTOR_NAMES = {"leo": "tle.mean_elements", "geo": "tle.geo_station_keeping"}
-
-
-@dataclass
-class StepRun:
-    """What the stages after the segmentation share: the history, settings, step model, the final
-    per-gap statistics and the operating threshold."""
-
-    history: ElementHistory
-    cfg: TleDetectorConfig
-    regime: str
-    model: StepModel
-    steps: StepSeries
-    stat: NDArray[np.float64]
-    threshold: float
-    change_points: list[int]
-    # the interval (s) of each detection timed from its blended sets (abrupt.detect.tle.response)
-    ramp_intervals: dict[int, tuple[float, float]] = field(default_factory=dict)
-    # the blended sets of each in-track step: (last set on the old level, first on the new)
-    blends: dict[int, tuple[int, int]] = field(default_factory=dict)
-    # the fit span (s) of the era of each in-track candidate's sets (time_candidates; 0: sharp)
-    era_span_s: dict[int, float] = field(default_factory=dict)
-    # the whole change of ``a`` (m) of each detection timed from its blended sets (the response's fit)
-    ramp_delta_a: dict[int, float] = field(default_factory=dict)
-    # the sets ``lo..hi-1`` each such fit spans, and the ramps' (times, fitted spans) (s) of the history
-    ramp_windows: dict[int, tuple[int, int]] = field(default_factory=dict)
-    ramp_eras: tuple[NDArray[np.float64], NDArray[np.float64]] = (np.zeros(0), np.zeros(0))
 
 
 def detect_mean_elements(
