@@ -224,14 +224,7 @@ def main() -> None:
         when = b["utc"]
         assert isinstance(when, dt.datetime)
         jd, fr = jday(when.year, when.month, when.day, when.hour, when.minute, when.second + when.microsecond / 1e6)
-        sat = sats[max(0, int(np.searchsorted(epochs, jd + fr)) - 1)]
-        _, r_km, v_kms = sat.sgp4(jd, fr)
-        r, v = np.asarray(r_km), np.asarray(v_kms)
-        h = np.cross(r, v) / np.linalg.norm(np.cross(r, v))
-        node = np.cross([0.0, 0.0, 1.0], h)
-        node /= np.linalg.norm(node)
-        u = float(np.arctan2(np.dot(np.cross(node, r), h), np.dot(node, r)))
-        inc, speed = float(np.arccos(h[2])), float(np.linalg.norm(v)) * 1e3
+        u, inc, speed = argument_of_latitude(sats[max(0, int(np.searchsorted(epochs, jd + fr)) - 1)], when)
         w = float(b["w"])  # type: ignore[arg-type]
         di, dnode = w * np.cos(u) / speed, w * np.sin(u) / (speed * np.sin(inc))
         acc = per_line.setdefault(int(b["line"]), [0.0, 0.0, 0.0])  # type: ignore[call-overload]
