@@ -35,3 +35,11 @@ def test_a_table_at_the_same_budget_or_without_one_gives_the_same_curve() -> Non
     unstated = efficiency_per_day(_table(None), DAYS, false_alarms_per_day=0.1)[DAYS[0]]
     assert same == unstated
     assert same.dH50_Nms == pytest.approx(0.01, rel=0.1)
+
+
+@pytest.mark.parametrize("bad", ["x", "", "-1"])
+def test_a_stated_budget_that_is_not_a_positive_rate_is_refused_naming_its_line(bad: str) -> None:
+    table = _table(0.1).astype({"false_alarms_per_day": object})
+    table.loc[5, "false_alarms_per_day"] = bad
+    with pytest.raises(InputError, match=r"rec\.csv:7: .*false_alarms_per_day.*not a positive rate"):
+        efficiency_per_day(table, DAYS, source="rec.csv", false_alarms_per_day=0.1)  # data row 6: line 7

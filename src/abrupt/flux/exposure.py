@@ -183,7 +183,11 @@ def efficiency_per_day(
         if col not in injections.columns:
             raise InputError(f"{source}: no column {col!r} (expected dH_Nms, found[, day])")
     if false_alarms_per_day is not None and "false_alarms_per_day" in injections.columns:
-        made = pd.to_numeric(injections["false_alarms_per_day"], errors="coerce").dropna().unique()
+        stated = pd.to_numeric(injections["false_alarms_per_day"], errors="coerce")
+        if not (stated > 0).all():
+            row = int(np.flatnonzero(~(stated > 0).to_numpy())[0]) + 2  # the header is line 1
+            raise InputError("not a positive rate", file=source, line=row, column="false_alarms_per_day")
+        made = stated.unique()
         if any(not math.isclose(float(m), false_alarms_per_day, rel_tol=1e-6) for m in made):
             raise InputError(
                 f"{source}: injections recovered at {', '.join(f'{m:g}' for m in made)} false alarms/day, "
